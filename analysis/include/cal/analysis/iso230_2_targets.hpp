@@ -1,0 +1,67 @@
+#pragma once
+// ISO 230-2 target positions and test cycles: the ordered moves the machine makes.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cal::iso230_2 {
+
+enum class Direction { up, down };  // up = towards increasing position ("positive", ↑)
+std::string_view to_string(Direction d);
+
+enum class Cycle {
+  linear,       // ISO 230-2 standard test cycle: all targets up, over-run, all down, over-run
+  pendulum,     // at each target, up and down approaches alternate `runs` times, then next target
+  pilgrim_step  // each target approached up, then over-run and approached down, then next target
+};
+std::string_view to_string(Cycle c);
+Cycle cycle_from_string(std::string_view name);  // linear | pendulum | pilgrim-step
+
+struct TargetSpec {
+  double first_mm = 0.0;
+  double last_mm = 1000.0;
+  std::optional<double> interval_mm;  // nominal spacing; or
+  std::optional<int> count;           // number of targets (including first and last)
+  // Random offset of each inner target, as a fraction of the nominal interval, uniform in
+  // [-f, +f]; ISO 230-2 asks for unequal spacing so that periodic errors (scale pitch,
+  // ball-screw lead) are not sampled at one phase. 0 gives uniform spacing.
+  double random_fraction = 0.0;
+  std::uint64_t seed = 1;
+  double round_to_mm = 0.001;  // targets land on the machine's programming resolution
+};
+
+struct CycleSpec {
+  Cycle cycle = Cycle::linear;
+  bool bidirectional = true;
+  int runs = 5;             // per direction
+  double overrun_mm = 5.0;  // beyond the end targets, so each approach comes from one side
+};
+
+enum class MoveKind { measure, overrun, reposition };
+
+struct Move {
+  MoveKind kind = MoveKind::measure;
+  int run = 1;                  // 1-based
+  Direction direction = Direction::up;
+  int target_index = 0;         // 1-based for measure moves, 0 otherwise
+  double position_mm = 0.0;     // commanded position
+};
+
+struct Plan {
+  std::vector<double> targets_mm;
+  std::vector<Move> moves;
+  std::vector<std::string> warnings;  // departures from the ISO 230-2 recommendations
+};
+
+// Targets in increasing order; throws InputError for an empty or inverted range, a bad
+// interval or count, or a random fraction outside [0, 0.5).
+std::vector<double> generate_targets(const TargetSpec& spec);
+
+// The full plan. Throws InputError on bad specs (runs < 1, overrun < 0, ...); ISO 230-2
+// recommendations not met (fewer than 5 runs per direction, fewer than 5 targets or than
+// 5 per metre) are warnings.
+Plan make_plan(const TargetSpec& targets, const CycleSpec& cycle);
+
+}  // namespace cal::iso230_2

@@ -1,0 +1,181 @@
+#include <fmt/format.h>
+
+#include <cmath>
+#include <random>
+
+#include "cal/analysis/error.hpp"
+#include "cal/analysis/iso230_2_targets.hpp"
+
+namespace cal::iso230_2 {
+namespace {
+
+// Uniform in [-1, 1) from a 64-bit Mersenne Twister. std::mt19937_64's sequence is fixed by
+// the C++ standard, unlike std::uniform_real_distribution's mapping, so plans are identical
+// across compilers and library versions.
+class SignedUniform {
+ public:
+  explicit SignedUniform(std::uint64_t seed) : rng_(seed) {}
+  double operator()() { return 2.0 * static_cast<double>(rng_() >> 11) * 0x1.0p-53 - 1.0; }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+double round_to(double v, double step) { return step > 0 ? std::round(v / step) * step : v; }
+
+void add(std::vector<Move>& moves, MoveKind kind, int run, Direction dir, int target,
+         double pos_mm) {
+  moves.push_back(Move{kind, run, dir, target, pos_mm});
+}
+
+void linear_moves(const std::vector<double>& t, const CycleSpec& c, std::vector<Move>& m) {
+  const int n = static_cast<int>(t.size());
+  const double low = t.front() - c.overrun_mm, high = t.back() + c.overrun_mm;
+  add(m, MoveKind::reposition, 1, Direction::up, 0, low);
+  for (int run = 1; run <= c.runs; ++run) {
+    for (int i = 0; i < n; ++i) add(m, MoveKind::measure, run, Direction::up, i + 1, t[i]);
+    if (!c.bidirectional) {
+      add(m, MoveKind::reposition, run, Direction::down, 0, low);
+      continue;
+    }
+    add(m, MoveKind::overrun, run, Direction::up, 0, high);
+    for (int i = n - 1; i >= 0; --i) add(m, MoveKind::measure, run, Direction::down, i + 1, t[i]);
+    add(m, MoveKind::overrun, run, Direction::down, 0, low);
+  }
+}
+
+void pendulum_moves(const std::vector<double>& t, const CycleSpec& c, std::vector<Move>& m) {
+  add(m, MoveKind::reposition, 1, Direction::up, 0, t.front() - c.overrun_mm);
+  for (int i = 0; i < static_cast<int>(t.size()); ++i) {
+    for (int run = 1; run <= c.runs; ++run) {
+      // The first up approach of a target comes from the previous target (below it).
+      if (run > 1) add(m, MoveKind::overrun, run, Direction::down, 0, t[i] - c.overrun_mm);
+      add(m, MoveKind::measure, run, Direction::up, i + 1, t[i]);
+      if (!c.bidirectional) continue;
+      add(m, MoveKind::overrun, run, Direction::up, 0, t[i] + c.overrun_mm);
+      add(m, MoveKind::measure, run, Direction::down, i + 1, t[i]);
+    }
+  }
+}
+
+void pilgrim_moves(const std::vector<double>& t, const CycleSpec& c, std::vector<Move>& m) {
+  for (int run = 1; run <= c.runs; ++run) {
+    add(m, MoveKind::reposition, run, Direction::up, 0, t.front() - c.overrun_mm);
+    for (int i = 0; i < static_cast<int>(t.size()); ++i) {
+      add(m, MoveKind::measure, run, Direction::up, i + 1, t[i]);
+      add(m, MoveKind::overrun, run, Direction::up, 0, t[i] + c.overrun_mm);
+      add(m, MoveKind::measure, run, Direction::down, i + 1, t[i]);
+    }
+  }
+}
+
+}  // namespace
+
+std::string_view to_string(Direction d) { return d == Direction::up ? "up" : "down"; }
+
+std::string_view to_string(Cycle c) {
+  switch (c) {
+    case Cycle::linear:
+      return "linear";
+    case Cycle::pendulum:
+      return "pendulum";
+    case Cycle::pilgrim_step:
+      return "pilgrim-step";
+  }
+  return "?";
+}
+
+Cycle cycle_from_string(std::string_view name) {
+  if (name == "linear") return Cycle::linear;
+  if (name == "pendulum") return Cycle::pendulum;
+  if (name == "pilgrim-step" || name == "pilgrim_step" || name == "step") return Cycle::pilgrim_step;
+  throw InputError(
+      fmt::format("unknown test cycle '{}': expected linear, pendulum or pilgrim-step", name));
+}
+
+std::vector<double> generate_targets(const TargetSpec& s) {
+  if (!std::isfinite(s.first_mm) || !std::isfinite(s.last_mm) || !(s.last_mm > s.first_mm)) {
+    throw InputError(fmt::format("targets: last ({} mm) must be greater than first ({} mm)",
+                                 s.last_mm, s.first_mm));
+  }
+  if (s.interval_mm.has_value() == s.count.has_value()) {
+    throw InputError("targets: give either an interval or a count, not both or neither");
+  }
+  const double length = s.last_mm - s.first_mm;
+  int count = 0;
+  if (s.count) {
+    count = *s.count;
+    if (count < 2) throw InputError(fmt::format("targets: count = {} must be >= 2", count));
+  } else {
+    const double iv = *s.interval_mm;
+    if (!(iv > 0)) throw InputError(fmt::format("targets: interval = {} mm must be > 0", iv));
+    const double steps = length / iv;
+    if (std::abs(steps - std::round(steps)) > 1e-6 * std::max(1.0, steps)) {
+      throw InputError(fmt::format(
+          "targets: interval {} mm does not divide the travel {} .. {} mm into whole steps", iv,
+          s.first_mm, s.last_mm));
+    }
+    count = static_cast<int>(std::round(steps)) + 1;
+  }
+  if (!(s.random_fraction >= 0 && s.random_fraction < 0.5)) {
+    throw InputError(fmt::format("targets: random fraction = {} must be in [0, 0.5)",
+                                 s.random_fraction));
+  }
+  const double interval = length / (count - 1);
+  SignedUniform uniform(s.seed);
+  std::vector<double> t(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const bool inner = i > 0 && i < count - 1;  // the end targets stay on the travel limits
+    const double offset = inner ? s.random_fraction * interval * uniform() : 0.0;
+    t[i] = round_to(s.first_mm + i * interval + offset, s.round_to_mm);
+  }
+  for (int i = 1; i < count; ++i) {
+    if (!(t[i] > t[i - 1])) {
+      throw InputError(fmt::format(
+          "targets: rounding to {} mm merges targets {} and {}; use a finer rounding",
+          s.round_to_mm, i, i + 1));
+    }
+  }
+  return t;
+}
+
+Plan make_plan(const TargetSpec& ts, const CycleSpec& cs) {
+  if (cs.runs < 1) throw InputError(fmt::format("cycle: runs = {} must be >= 1", cs.runs));
+  if (!(cs.overrun_mm >= 0)) {
+    throw InputError(fmt::format("cycle: over-run = {} mm must be >= 0", cs.overrun_mm));
+  }
+  if (cs.cycle == Cycle::pilgrim_step && !cs.bidirectional) {
+    throw InputError("cycle: the pilgrim-step cycle approaches every target in both directions; "
+                     "use the linear cycle for a unidirectional test");
+  }
+  Plan p;
+  p.targets_mm = generate_targets(ts);
+  const double length_m = (ts.last_mm - ts.first_mm) / 1000.0;
+  const auto n_targets = p.targets_mm.size();
+  if (cs.runs < 5) {
+    p.warnings.push_back(
+        fmt::format("{} runs per direction: ISO 230-2 asks for at least 5", cs.runs));
+  }
+  if (n_targets < 5 || static_cast<double>(n_targets) < 5.0 * length_m) {
+    p.warnings.push_back(fmt::format(
+        "{} targets over {} m: ISO 230-2 asks for at least 5 per metre and at least 5 in all",
+        n_targets, length_m));
+  }
+  if (cs.overrun_mm == 0 && cs.bidirectional) {
+    p.warnings.push_back("no over-run: reversals happen at the end targets themselves");
+  }
+  switch (cs.cycle) {
+    case Cycle::linear:
+      linear_moves(p.targets_mm, cs, p.moves);
+      break;
+    case Cycle::pendulum:
+      pendulum_moves(p.targets_mm, cs, p.moves);
+      break;
+    case Cycle::pilgrim_step:
+      pilgrim_moves(p.targets_mm, cs, p.moves);
+      break;
+  }
+  return p;
+}
+
+}  // namespace cal::iso230_2

@@ -1,0 +1,11 @@
+#pragma once
+// Each file cmd_*.cpp adds its subcommands to the application.
+#include <CLI/CLI.hpp>
+
+namespace daq {
+
+void add_env_command(CLI::App& app);
+void add_iso230_2_commands(CLI::App& app, CLI::App& analyse);
+void add_demo_command(CLI::App& app);
+
+}  // namespace daq

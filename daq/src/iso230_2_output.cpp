@@ -1,0 +1,101 @@
+#include "iso230_2_output.hpp"
+
+#include <fmt/format.h>
+
+namespace daq {
+
+nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
+  nlohmann::json j;
+  j["schema"] = "caldaq.iso230-2.v1";
+  j["standard"] = {{"key", e.standard.key}, {"title", e.standard.title}, {"note", e.standard.note}};
+  j["bidirectional"] = e.bidirectional;
+  j["runs_per_direction"] = e.runs;
+  j["targets"] = nlohmann::json::array();
+  for (const auto& t : e.targets) {
+    nlohmann::json tj = {{"target_mm", t.target_mm}, {"runs_up", t.runs_up},
+                         {"mean_up_um", t.mean_up_um}, {"s_up_um", t.s_up_um},
+                         {"mean_bi_um", t.mean_bi_um}};
+    if (e.bidirectional) {
+      tj["runs_down"] = t.runs_down;
+      tj["mean_down_um"] = t.mean_down_um;
+      tj["s_down_um"] = t.s_down_um;
+      tj["reversal_um"] = t.reversal_um;
+    }
+    j["targets"].push_back(tj);
+  }
+  j["per_target"] = nlohmann::json::object();
+  for (const auto& p : e.per_target) {
+    j["per_target"][p.key] = {
+        {"symbol", p.symbol}, {"description", p.description}, {"values_um", p.values_um}};
+  }
+  j["axis"] = nlohmann::json::object();
+  for (const auto& a : e.axis) {
+    j["axis"][a.key] = {{"symbol", a.symbol}, {"description", a.description}, {"value_um", a.value_um}};
+  }
+  j["warnings"] = e.warnings;
+  return j;
+}
+
+nlohmann::json to_json(const cal::iso230_2::Plan& p) {
+  nlohmann::json j;
+  j["schema"] = "caldaq.plan.v1";
+  j["targets_mm"] = p.targets_mm;
+  j["moves"] = nlohmann::json::array();
+  for (const auto& m : p.moves) {
+    const char* kind = m.kind == cal::iso230_2::MoveKind::measure   ? "measure"
+                       : m.kind == cal::iso230_2::MoveKind::overrun ? "overrun"
+                                                                    : "reposition";
+    j["moves"].push_back({{"kind", kind},
+                          {"run", m.run},
+                          {"direction", cal::iso230_2::to_string(m.direction)},
+                          {"target", m.target_index},
+                          {"position_mm", m.position_mm}});
+  }
+  j["warnings"] = p.warnings;
+  return j;
+}
+
+nlohmann::json to_json(const cal::unc::Budget& b) {
+  nlohmann::json j;
+  j["contributors"] = nlohmann::json::array();
+  for (const auto& c : b.contributors) {
+    j["contributors"].push_back({{"name", c.name}, {"model", c.model}, {"u_um", c.u_um}});
+  }
+  j["u_index"] = b.u_index;
+  j["u_combined_um"] = b.u_combined_um;
+  j["k"] = b.k;
+  j["expanded_um"] = b.expanded_um;
+  j["warnings"] = b.warnings;
+  return j;
+}
+
+void print(const cal::iso230_2::Evaluation& e) {
+  fmt::print("{} ({})\n", e.standard.title, e.standard.note);
+  fmt::print("{} targets, {} runs per direction, {}\n\n", e.targets.size(), e.runs,
+             e.bidirectional ? "bidirectional" : "unidirectional");
+  fmt::print("{:>12}", "target/mm");
+  for (const auto& p : e.per_target) fmt::print(" {:>9}", p.symbol);
+  fmt::print("   (um)\n");
+  for (std::size_t i = 0; i < e.targets.size(); ++i) {
+    fmt::print("{:>12.3f}", e.targets[i].target_mm);
+    for (const auto& p : e.per_target) fmt::print(" {:>9.3f}", p.values_um[i]);
+    fmt::print("\n");
+  }
+  fmt::print("\n");
+  for (const auto& a : e.axis) {
+    fmt::print("  {:<8} {:>10.3f} um   {}\n", a.symbol, a.value_um, a.description);
+  }
+  for (const auto& w : e.warnings) fmt::print("warning: {}\n", w);
+}
+
+void print(const cal::unc::Budget& b, double length_m) {
+  fmt::print("Measurement uncertainty of the positional deviation at L = {} m\n", length_m);
+  for (const auto& c : b.contributors) {
+    fmt::print("  {:<38} u = {:>8.4f} um   {}\n", c.name, c.u_um, c.model);
+  }
+  fmt::print("  combined standard uncertainty u_c = {:.4f} um\n", b.u_combined_um);
+  fmt::print("  expanded uncertainty U (k = {:g})  = {:.3f} um\n", b.k, b.expanded_um);
+  for (const auto& w : b.warnings) fmt::print("warning: {}\n", w);
+}
+
+}  // namespace daq

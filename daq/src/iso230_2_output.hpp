@@ -1,0 +1,16 @@
+#pragma once
+// Text and JSON presentation of ISO 230-2 evaluations, plans and uncertainty budgets.
+#include <nlohmann/json.hpp>
+
+#include "cal/analysis/iso230_2.hpp"
+#include "cal/analysis/uncertainty.hpp"
+
+namespace daq {
+
+nlohmann::json to_json(const cal::iso230_2::Evaluation& e);  // schema caldaq.iso230-2.v1
+nlohmann::json to_json(const cal::iso230_2::Plan& p);        // schema caldaq.plan.v1
+nlohmann::json to_json(const cal::unc::Budget& b);
+void print(const cal::iso230_2::Evaluation& e);
+void print(const cal::unc::Budget& b, double length_m);
+
+}  // namespace daq

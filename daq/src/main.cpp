@@ -1,0 +1,39 @@
+// daq: data acquisition and analysis for machine-tool calibration.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "cal/analysis/error.hpp"
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "daq - machine-tool calibration: laser interferometer, environment and ballbar\n"
+      "acquisition, compensation and ISO 230 analysis.\n\n"
+      "Every command that prints results takes --json for machine-readable output."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "daq 0.1.0");
+
+  CLI::App* analyse = app.add_subcommand("analyse", "Evaluate a measured test by a standard");
+  analyse->alias("analyze");
+  analyse->require_subcommand(1);
+
+  daq::add_env_command(app);
+  daq::add_iso230_2_commands(app, *analyse);
+  daq::add_demo_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const cal::InputError& e) {
+    std::fprintf(stderr, "daq: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "daq: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
