@@ -1,2 +1,48 @@
-#!/bin/sh
-exit 0
+#!/usr/bin/env bash
+# End-to-end tests of the daq command line: exit codes, key numbers in the output, and the
+# error messages for bad input. Usage: cli_test.sh DAQ_BINARY DATA_DIR
+set -u
+DAQ=$1
+DATA=$2
+fails=0
+passes=0
+
+check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
+  local name=$1 want=$2 pattern=$3
+  shift 4
+  local out
+  out=$("$@" 2>&1)
+  local rc=$?
+  if [ "$rc" -ne "$want" ]; then
+    echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return
+  fi
+  if ! grep -qE -- "$pattern" <<<"$out"; then
+    echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -20; fails=$((fails + 1)); return
+  fi
+  passes=$((passes + 1))
+}
+
+check help 0 "analyse" -- "$DAQ" --help
+check analyse_help 0 "iso230-2" -- "$DAQ" analyse --help
+# NIST shop-floor equation by hand at 20 degC, 101.325 kPa, 50 %RH:
+# 1 + 7.86e-4 x 101.325 / 293 - 1.5e-11 x 50 x 560 = 1.000271393 (to 9 decimals)
+check env_shop_floor 0 '"n": 1\.00027139' -- "$DAQ" env -t 20 -p 1013.25 -r 50 -e shop-floor --json
+check env_text 0 "ciddor +1\.0002713" -- "$DAQ" env -t 20 -p 1013.25 -r 50
+check env_material 0 '"material_temperature_degc": 20\.5' -- "$DAQ" env -m 20 -m 21 -m 99 --disable-sensor 3 --json
+check env_out_of_range 2 "air temperature = 150 degC is outside the valid range" -- "$DAQ" env -t 150 -e ciddor
+check env_bad_sensor 2 "there are 1 material sensors" -- "$DAQ" env -m 20 --disable-sensor 2
+# Hand-calculated data set: R = 9, E = 7, A = 10 (see tests/analysis/iso230_2_test.cpp)
+check iso_json 0 '"R_bi": \{[^}]*"value_um": 9\.0' -- bash -c "\"$DAQ\" analyse iso230-2 --input \"$DATA/hand.csv\" --json | tr -d '\n'"
+check iso_text 0 "E +7\.000 um" -- "$DAQ" analyse iso230-2 -i "$DATA/hand.csv"
+check iso_vdi 0 '"P": \{[^}]*"value_um": 13\.0' -- bash -c "\"$DAQ\" analyse iso230-2 -i \"$DATA/hand.csv\" -s vdi3441 --json | tr -d '\n'"
+check iso_unknown_standard 2 "unknown standard 'iso9999'" -- "$DAQ" analyse iso230-2 -i "$DATA/hand.csv" -s iso9999
+check iso_bad_csv 2 "bad_direction.csv:3: column direction: 'sideways'" -- "$DAQ" analyse iso230-2 -i "$DATA/bad_direction.csv"
+check iso_missing_file 2 "no_such.csv: cannot open" -- "$DAQ" analyse iso230-2 -i "$DATA/no_such.csv"
+check targets 0 "121 moves" -- "$DAQ" targets --first 0 --last 1000 --interval 100 --random-fraction 0.2
+check targets_json 0 '"schema": "caldaq.plan.v1"' -- "$DAQ" targets --first 0 --last 100 --count 6 --json
+check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --interval 30
+check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
+check demo 0 "Simulated truth vs measured" -- "$DAQ" demo
+
+echo "$passes passed, $fails failed"
+[ "$fails" -eq 0 ]
