@@ -1,7 +1,8 @@
 #include "cal/analysis/air.hpp"
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "cal/analysis/error.hpp"
 
@@ -21,13 +22,15 @@ struct Range {
 
 void check(const Range& r, double v, Equation eq, std::vector<std::string>& warnings) {
   if (!std::isfinite(v) || v < r.lo || v > r.hi) {
-    throw InputError(fmt::format("{} = {} {} is outside the valid range {} .. {} {} of the {} equation",
-                                 r.name, v, r.unit, r.lo, r.hi, r.unit, to_string(eq)));
+    throw InputError(
+        fmt::format("{} = {} {} is outside the valid range {} .. {} {} of the {} equation", r.name,
+                    v, r.unit, r.lo, r.hi, r.unit, to_string(eq)));
   }
   if (v < r.warn_lo || v > r.warn_hi) {
-    warnings.push_back(fmt::format("{} = {} {} is outside {} .. {} {}, where the {} equation is "
-                                   "tested; its uncertainty is larger there",
-                                   r.name, v, r.unit, r.warn_lo, r.warn_hi, r.unit, to_string(eq)));
+    warnings.push_back(
+        fmt::format("{} = {} {} is outside {} .. {} {}, where the {} equation is "
+                    "tested; its uncertainty is larger there",
+                    r.name, v, r.unit, r.warn_lo, r.warn_hi, r.unit, to_string(eq)));
   }
 }
 
@@ -99,9 +102,9 @@ double ciddor(double t, double p, double pv, double lambda_um, double co2) {
   const double raxs = ras * (1.0 + 5.34e-7 * (co2 - 450.0));
   const double T = t + kKelvinOffset;
   const double xv = pv / p;
-  const double Zm = 1.0 - (p / T) * (a0 + a1 * t + a2 * t * t + (b0 + b1 * t) * xv +
-                                     (c0 + c1 * t) * xv * xv) +
-                    (p / T) * (p / T) * (d + e * xv * xv);
+  const double Zm =
+      1.0 - (p / T) * (a0 + a1 * t + a2 * t * t + (b0 + b1 * t) * xv + (c0 + c1 * t) * xv * xv) +
+      (p / T) * (p / T) * (d + e * xv * xv);
   const double rho_axs = pR1 * Ma / (Za * R * TR1);
   const double rho_v = xv * p * Mv / (Zm * R * T);
   const double rho_a = (1.0 - xv) * p * Ma / (Zm * R * T);
@@ -176,8 +179,9 @@ double water_vapour_pressure_pa(const Conditions& c) {
     case Humidity::Kind::dew_point_degc: {
       const double td = c.humidity.value;
       if (!std::isfinite(td) || td > c.temperature_degc + 1e-9) {
-        throw InputError(fmt::format("dew point = {} degC must not exceed the air temperature {} degC",
-                                     td, c.temperature_degc));
+        throw InputError(
+            fmt::format("dew point = {} degC must not exceed the air temperature {} degC", td,
+                        c.temperature_degc));
       }
       return enhancement_factor(c.pressure_pa, td) * saturation_vapour_pressure_pa(td);
     }

@@ -69,21 +69,25 @@ void check_measurement(const Measurement& m, std::size_t row) {
 }
 
 std::vector<std::pair<double, Samples>> group(std::span<const Measurement> data) {
-  std::vector<std::pair<double, Samples>> g;
+  // Sort row indices by target, then sweep: O(N log N) rather than a search per row.
+  std::vector<std::size_t> order(data.size());
   for (std::size_t k = 0; k < data.size(); ++k) {
+    check_measurement(data[k], k);
+    order[k] = k;
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return data[a].target_mm < data[b].target_mm;
+  });
+  std::vector<std::pair<double, Samples>> g;
+  for (std::size_t k : order) {
     const auto& m = data[k];
-    check_measurement(m, k);
-    auto it = std::find_if(g.begin(), g.end(), [&](const auto& e) {
-      return std::abs(e.first - m.target_mm) < kSameTargetMm;
-    });
-    if (it == g.end()) it = g.insert(g.end(), {m.target_mm, Samples{}});
-    auto& runs = m.direction == Direction::up ? it->second.up : it->second.down;
+    if (g.empty() || m.target_mm - g.back().first >= kSameTargetMm) g.push_back({m.target_mm, {}});
+    auto& runs = m.direction == Direction::up ? g.back().second.up : g.back().second.down;
     if (!runs.emplace(m.run, m.deviation_um).second) {
       throw InputError(fmt::format("target {} mm, run {}, direction {} is measured twice",
                                    m.target_mm, m.run, to_string(m.direction)));
     }
   }
-  std::sort(g.begin(), g.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   return g;
 }
 
@@ -100,7 +104,9 @@ void check_runs(double target_mm, const std::map<int, double>& x, Direction d) {
 struct Band {
   double lo, hi;
 };
-Band band(double mean_um, double s_um, double k) { return {mean_um - k * s_um, mean_um + k * s_um}; }
+Band band(double mean_um, double s_um, double k) {
+  return {mean_um - k * s_um, mean_um + k * s_um};
+}
 
 template <typename F>
 std::vector<double> per_target(const std::vector<TargetStats>& t, F f) {
@@ -153,8 +159,10 @@ void iso(Evaluation& e, double k, bool has_e_and_m) {
            per_target(t, [](auto& s) { return s.s_up_um; }));
   const auto& r_up = b.target("R_i_up", "Ri↑", "unidirectional repeatability, up (" + rs + " si↑)",
                               per_target(t, [k](auto& s) { return 2 * k * s.s_up_um; }));
-  std::vector<double> hi_all = per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).hi; });
-  std::vector<double> lo_all = per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).lo; });
+  std::vector<double> hi_all =
+      per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).hi; });
+  std::vector<double> lo_all =
+      per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).lo; });
   std::vector<double> means_up = per_target(t, [](auto& s) { return s.mean_up_um; });
   b.axis("R_up", "R↑", "unidirectional repeatability of the axis, up", max_of(r_up));
   if (has_e_and_m) {
@@ -176,15 +184,18 @@ void iso(Evaluation& e, double k, bool has_e_and_m) {
                                  per_target(t, [](auto& s) { return s.mean_bi_um; }));
   const auto& rev = b.target("B_i", "Bi", "reversal value (x̄i↑ − x̄i↓)",
                              per_target(t, [](auto& s) { return s.reversal_um; }));
-  const auto& r_bi = b.target(
-      "R_i_bi", "Ri", "bidirectional repeatability, max(" + ks + " si↑ + " + ks + " si↓ + |Bi|; Ri↑; Ri↓)",
-      per_target(t, [k](auto& s) {
-        return std::max({k * s.s_up_um + k * s.s_down_um + std::abs(s.reversal_um),
-                         2 * k * s.s_up_um, 2 * k * s.s_down_um});
-      }));
+  const auto& r_bi =
+      b.target("R_i_bi", "Ri",
+               "bidirectional repeatability, max(" + ks + " si↑ + " + ks + " si↓ + |Bi|; Ri↑; Ri↓)",
+               per_target(t, [k](auto& s) {
+                 return std::max({k * s.s_up_um + k * s.s_down_um + std::abs(s.reversal_um),
+                                  2 * k * s.s_up_um, 2 * k * s.s_down_um});
+               }));
   std::vector<double> means_down = per_target(t, [](auto& s) { return s.mean_down_um; });
-  std::vector<double> hi_down = per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).hi; });
-  std::vector<double> lo_down = per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).lo; });
+  std::vector<double> hi_down =
+      per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).hi; });
+  std::vector<double> lo_down =
+      per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).lo; });
   std::vector<double> abs_rev = per_target(t, [](auto& s) { return std::abs(s.reversal_um); });
 
   b.axis("B", "B", "reversal value of the axis, max |Bi|", max_of(abs_rev));
@@ -276,8 +287,8 @@ std::vector<TargetStats> target_stats(std::span<const Measurement> data) {
   const auto groups = group(data);
   const bool any_down = std::any_of(groups.begin(), groups.end(),
                                     [](const auto& g) { return !g.second.down.empty(); });
-  const bool any_up = std::any_of(groups.begin(), groups.end(),
-                                  [](const auto& g) { return !g.second.up.empty(); });
+  const bool any_up =
+      std::any_of(groups.begin(), groups.end(), [](const auto& g) { return !g.second.up.empty(); });
   std::vector<TargetStats> out;
   for (const auto& [target, s] : groups) {
     TargetStats ts;
@@ -319,16 +330,16 @@ Evaluation evaluate(std::span<const Measurement> data, Standard standard) {
   }
   e.runs = min_runs;
   if (min_runs != max_runs) {
-    e.warnings.push_back(fmt::format("targets have between {} and {} runs per direction", min_runs,
-                                     max_runs));
+    e.warnings.push_back(
+        fmt::format("targets have between {} and {} runs per direction", min_runs, max_runs));
   }
   if (min_runs < 5) {
-    e.warnings.push_back(fmt::format("{} runs per direction: {} asks for at least 5", min_runs,
-                                     e.standard.title));
+    e.warnings.push_back(
+        fmt::format("{} runs per direction: {} asks for at least 5", min_runs, e.standard.title));
   }
   if (e.targets.size() < 5) {
-    e.warnings.push_back(fmt::format("{} targets: {} asks for at least 5", e.targets.size(),
-                                     e.standard.title));
+    e.warnings.push_back(
+        fmt::format("{} targets: {} asks for at least 5", e.targets.size(), e.standard.title));
   }
   switch (standard) {
     case Standard::iso230_2_2014:

@@ -1,10 +1,11 @@
+#include "cal/analysis/iso230_2_targets.hpp"
+
 #include <fmt/format.h>
 
 #include <cmath>
 #include <random>
 
 #include "cal/analysis/error.hpp"
-#include "cal/analysis/iso230_2_targets.hpp"
 
 namespace cal::iso230_2 {
 namespace {
@@ -88,7 +89,8 @@ std::string_view to_string(Cycle c) {
 Cycle cycle_from_string(std::string_view name) {
   if (name == "linear") return Cycle::linear;
   if (name == "pendulum") return Cycle::pendulum;
-  if (name == "pilgrim-step" || name == "pilgrim_step" || name == "step") return Cycle::pilgrim_step;
+  if (name == "pilgrim-step" || name == "pilgrim_step" || name == "step")
+    return Cycle::pilgrim_step;
   throw InputError(
       fmt::format("unknown test cycle '{}': expected linear, pendulum or pilgrim-step", name));
 }
@@ -118,8 +120,8 @@ std::vector<double> generate_targets(const TargetSpec& s) {
     count = static_cast<int>(std::round(steps)) + 1;
   }
   if (!(s.random_fraction >= 0 && s.random_fraction < 0.5)) {
-    throw InputError(fmt::format("targets: random fraction = {} must be in [0, 0.5)",
-                                 s.random_fraction));
+    throw InputError(
+        fmt::format("targets: random fraction = {} must be in [0, 0.5)", s.random_fraction));
   }
   const double interval = length / (count - 1);
   SignedUniform uniform(s.seed);
@@ -131,9 +133,9 @@ std::vector<double> generate_targets(const TargetSpec& s) {
   }
   for (int i = 1; i < count; ++i) {
     if (!(t[i] > t[i - 1])) {
-      throw InputError(fmt::format(
-          "targets: rounding to {} mm merges targets {} and {}; use a finer rounding",
-          s.round_to_mm, i, i + 1));
+      throw InputError(
+          fmt::format("targets: rounding to {} mm merges targets {} and {}; use a finer rounding",
+                      s.round_to_mm, i, i + 1));
     }
   }
   return t;
@@ -145,8 +147,9 @@ Plan make_plan(const TargetSpec& ts, const CycleSpec& cs) {
     throw InputError(fmt::format("cycle: over-run = {} mm must be >= 0", cs.overrun_mm));
   }
   if (cs.cycle == Cycle::pilgrim_step && !cs.bidirectional) {
-    throw InputError("cycle: the pilgrim-step cycle approaches every target in both directions; "
-                     "use the linear cycle for a unidirectional test");
+    throw InputError(
+        "cycle: the pilgrim-step cycle approaches every target in both directions; "
+        "use the linear cycle for a unidirectional test");
   }
   Plan p;
   p.targets_mm = generate_targets(ts);

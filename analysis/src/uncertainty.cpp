@@ -66,16 +66,19 @@ Budget positioning_budget(const PositioningSetup& s) {
   PositioningSetup srh = s;
   srh.air = rh_air;
   const double rh_step = std::min(0.1, std::max(1e-3, 100.0 - rh_air.humidity.value));
-  const double c_h = dn(srh, rh_step / 2, [](air::Conditions& c, double h) { c.humidity.value += h; });
+  const double c_h =
+      dn(srh, rh_step / 2, [](air::Conditions& c, double h) { c.humidity.value += h; });
   const double u_eq = air::equation_standard_uncertainty(s.equation);
-  b.u_index = std::sqrt(std::pow(c_t * s.u_air_temperature_k, 2) + std::pow(c_p * s.u_pressure_pa, 2) +
-                        std::pow(c_h * s.u_humidity_pct, 2) + u_eq * u_eq);
+  b.u_index =
+      std::sqrt(std::pow(c_t * s.u_air_temperature_k, 2) + std::pow(c_p * s.u_pressure_pa, 2) +
+                std::pow(c_h * s.u_humidity_pct, 2) + u_eq * u_eq);
 
   auto add = [&](std::string name, std::string model, double u_um) {
     b.contributors.push_back({std::move(name), std::move(model), u_um});
   };
   add("laser (certificate)", "sqrt(U_ppm² L² + U_um²) / k",
-      std::hypot(s.laser_cert_expanded_ppm * 1e-6 * L_um, s.laser_cert_expanded_um) / s.laser_cert_k);
+      std::hypot(s.laser_cert_expanded_ppm * 1e-6 * L_um, s.laser_cert_expanded_um) /
+          s.laser_cert_k);
   add("air temperature sensor", fmt::format("L |dn/dt| u(t), dn/dt = {:.4g} /K", c_t),
       L_um * std::abs(c_t) * s.u_air_temperature_k);
   add("air pressure sensor", fmt::format("L |dn/dp| u(p), dn/dp = {:.4g} /Pa", c_p),

@@ -48,15 +48,20 @@ void run_demo() {
   const double material_degc = 21.2, alpha = 11.5e-6;
   const auto f = cal::comp::combined_factor(n.n, alpha, material_degc);
   fmt::print("Air 22.5 degC, 1005.00 hPa, 45 %RH: n (Ciddor) = {:.9f}\n", n.n);
-  fmt::print("Material 21.2 degC, alpha 11.5 ppm/K: compensation {:+.3f} ppm (air {:+.3f}, "
-             "material {:+.3f})\n",
-             f.total_ppm, f.air_ppm, f.material_ppm);
+  fmt::print(
+      "Material 21.2 degC, alpha 11.5 ppm/K: compensation {:+.3f} ppm (air {:+.3f}, "
+      "material {:+.3f})\n",
+      f.total_ppm, f.air_ppm, f.material_ppm);
   fmt::print("An uncompensated reading at 1000 mm would be off by {:.1f} um.\n\n",
              -f.total_ppm * 1e-3 * 1000.0);
 
   // 2. The test plan: 11 targets with random spacing, the standard linear cycle, 5 runs.
-  cal::iso230_2::TargetSpec ts{.first_mm = 0, .last_mm = 1000, .interval_mm = 100.0,
-                               .count = std::nullopt, .random_fraction = 0.25, .seed = 2026};
+  cal::iso230_2::TargetSpec ts{.first_mm = 0,
+                               .last_mm = 1000,
+                               .interval_mm = 100.0,
+                               .count = std::nullopt,
+                               .random_fraction = 0.25,
+                               .seed = 2026};
   const auto plan = cal::iso230_2::make_plan(ts, {});
   fmt::print("Plan: {} targets, {} moves (linear cycle, 5 runs each way)\n\n",
              plan.targets_mm.size(), plan.moves.size());
@@ -87,12 +92,17 @@ void run_demo() {
       }
     }
   }
-  fmt::print("\nSimulated truth vs measured (noise sigma {:.1f} um, 5 runs):\n", axis.noise_sigma_um);
-  fmt::print("  B   truth {:7.3f} um   measured {:7.3f} um\n", axis.backlash_um, e.at("B_mean").value_um);
-  fmt::print("  E↑  truth {:7.3f} um   measured {:7.3f} um\n", up_max - up_min, e.at("E_up").value_um);
-  fmt::print("  E   truth {:7.3f} um   measured {:7.3f} um\n", all_max - all_min, e.at("E_bi").value_um);
-  fmt::print("  R↑  truth {:7.3f} um   measured {:7.3f} um  (4 sigma; the max over targets of 4 s)\n",
-             4 * axis.noise_sigma_um, e.at("R_up").value_um);
+  fmt::print("\nSimulated truth vs measured (noise sigma {:.1f} um, 5 runs):\n",
+             axis.noise_sigma_um);
+  fmt::print("  B   truth {:7.3f} um   measured {:7.3f} um\n", axis.backlash_um,
+             e.at("B_mean").value_um);
+  fmt::print("  E↑  truth {:7.3f} um   measured {:7.3f} um\n", up_max - up_min,
+             e.at("E_up").value_um);
+  fmt::print("  E   truth {:7.3f} um   measured {:7.3f} um\n", all_max - all_min,
+             e.at("E_bi").value_um);
+  fmt::print(
+      "  R↑  truth {:7.3f} um   measured {:7.3f} um  (4 sigma; the max over targets of 4 s)\n",
+      4 * axis.noise_sigma_um, e.at("R_up").value_um);
 
   // 5. Measurement uncertainty of this set-up.
   cal::unc::PositioningSetup s;

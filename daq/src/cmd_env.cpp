@@ -30,7 +30,8 @@ struct EnvOptions {
 cal::air::Conditions conditions(const EnvOptions& o) {
   cal::air::Conditions c;
   c.temperature_degc = o.temperature_degc;
-  c.pressure_pa = o.pressure_pa ? *o.pressure_pa : (o.pressure_hpa ? *o.pressure_hpa : 1013.25) * 100.0;
+  c.pressure_pa =
+      o.pressure_pa ? *o.pressure_pa : (o.pressure_hpa ? *o.pressure_hpa : 1013.25) * 100.0;
   if (o.dew_point_degc) {
     c.humidity = cal::air::Humidity::dew_point_degc(*o.dew_point_degc);
   } else if (o.vapour_pressure_pa) {
@@ -50,8 +51,8 @@ std::vector<cal::comp::MaterialSensor> sensors(const EnvOptions& o) {
   }
   for (int d : o.disabled_sensors) {
     if (d < 1 || d > static_cast<int>(s.size())) {
-      throw cal::InputError(fmt::format("--disable-sensor {}: there are {} material sensors", d,
-                                        s.size()));
+      throw cal::InputError(
+          fmt::format("--disable-sensor {}: there are {} material sensors", d, s.size()));
     }
     s[static_cast<std::size_t>(d - 1)].enabled = false;
   }
@@ -106,8 +107,8 @@ void run_env(const EnvOptions& o) {
   fmt::print("Material {:.3f} degC (mean of {} enabled sensor(s)), alpha {:.3f} ppm/K\n\n",
              material, std::count_if(mat.begin(), mat.end(), [](auto& s) { return s.enabled; }),
              o.alpha_ppm_per_k);
-  fmt::print("{:<12} {:>16} {:>10} {:>12} {:>13} {:>11}\n", "equation", "n", "pv / Pa",
-             "air / ppm", "material/ppm", "total/ppm");
+  fmt::print("{:<12} {:>16} {:>10} {:>12} {:>13} {:>11}\n", "equation", "n", "pv / Pa", "air / ppm",
+             "material/ppm", "total/ppm");
   for (const auto& r : j["results"]) {
     fmt::print("{:<12} {:>16.10f} {:>10.2f} {:>12.4f} {:>13.4f} {:>11.4f}\n",
                r["equation"].get<std::string>(), r["n"].get<double>(),
@@ -122,15 +123,17 @@ void run_env(const EnvOptions& o) {
 
 void add_env_command(CLI::App& app) {
   auto o = std::make_shared<EnvOptions>();
-  auto* cmd = app.add_subcommand(
-      "env", "Refractive index of air and the length compensation factor (ppm)");
+  auto* cmd =
+      app.add_subcommand("env", "Refractive index of air and the length compensation factor (ppm)");
   cmd->add_option("-t,--temperature", o->temperature_degc, "Air temperature, degC")
       ->capture_default_str();
-  auto* hpa = cmd->add_option("-p,--pressure-hpa", o->pressure_hpa, "Air pressure, hPa (default 1013.25)");
+  auto* hpa =
+      cmd->add_option("-p,--pressure-hpa", o->pressure_hpa, "Air pressure, hPa (default 1013.25)");
   cmd->add_option("--pressure-pa", o->pressure_pa, "Air pressure, Pa")->excludes(hpa);
   auto* rh = cmd->add_option("-r,--rh", o->rh_pct, "Relative humidity, % (default 50)");
   auto* dp = cmd->add_option("--dew-point", o->dew_point_degc, "Dew point, degC")->excludes(rh);
-  cmd->add_option("--vapour-pressure-pa", o->vapour_pressure_pa, "Water vapour partial pressure, Pa")
+  cmd->add_option("--vapour-pressure-pa", o->vapour_pressure_pa,
+                  "Water vapour partial pressure, Pa")
       ->excludes(rh)
       ->excludes(dp);
   cmd->add_option("--co2", o->co2, "CO2 mole fraction, umol/mol")->capture_default_str();

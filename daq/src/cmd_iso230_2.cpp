@@ -132,7 +132,8 @@ void add_targets(CLI::App& app) {
   cmd->add_option("--seed", o->targets.seed, "Seed of the random offsets")->capture_default_str();
   cmd->add_option("--round", o->targets.round_to_mm, "Round targets to this step, mm")
       ->capture_default_str();
-  cmd->add_option("--cycle", o->cycle_name, "linear | pendulum | pilgrim-step")->capture_default_str();
+  cmd->add_option("--cycle", o->cycle_name, "linear | pendulum | pilgrim-step")
+      ->capture_default_str();
   cmd->add_option("--runs", o->cycle.runs, "Runs per direction")->capture_default_str();
   cmd->add_option("--overrun", o->cycle.overrun_mm, "Over-run beyond the targets, mm")
       ->capture_default_str();
@@ -144,8 +145,8 @@ void add_targets(CLI::App& app) {
 void add_uncertainty(CLI::App& app) {
   auto o = std::make_shared<UncOptions>();
   auto& s = o->s;
-  auto* cmd = app.add_subcommand(
-      "uncertainty", "Uncertainty budget of a laser positioning test (U, k = 2)");
+  auto* cmd = app.add_subcommand("uncertainty",
+                                 "Uncertainty budget of a laser positioning test (U, k = 2)");
   cmd->add_option("-L,--length-m", s.length_m, "Measured travel, m")->capture_default_str();
   cmd->add_option("--laser-ppm", s.laser_cert_expanded_ppm, "Laser certificate U, ppm")
       ->capture_default_str();
@@ -157,7 +158,8 @@ void add_uncertainty(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("-p,--pressure-hpa", o->pressure_hpa, "Air pressure, hPa")->capture_default_str();
   cmd->add_option("-r,--rh", o->rh_pct, "Relative humidity, %")->capture_default_str();
-  cmd->add_option("-e,--equation", o->equation, "edlen | ciddor | shop-floor")->capture_default_str();
+  cmd->add_option("-e,--equation", o->equation, "edlen | ciddor | shop-floor")
+      ->capture_default_str();
   cmd->add_option("--u-air-temp", s.u_air_temperature_k, "u(air temperature), K")
       ->capture_default_str();
   cmd->add_option("--u-pressure-pa", s.u_pressure_pa, "u(pressure), Pa")->capture_default_str();
@@ -166,7 +168,8 @@ void add_uncertainty(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--u-material-temp", s.u_material_temperature_k, "u(material temperature), K")
       ->capture_default_str();
-  cmd->add_option("-a,--alpha-ppm", o->alpha_ppm, "Expansion coefficient, ppm/K")->capture_default_str();
+  cmd->add_option("-a,--alpha-ppm", o->alpha_ppm, "Expansion coefficient, ppm/K")
+      ->capture_default_str();
   cmd->add_option("--u-alpha-ppm", o->u_alpha_ppm, "u(expansion coefficient), ppm/K")
       ->capture_default_str();
   cmd->add_option("--drift-um", s.environmental_variation_um,

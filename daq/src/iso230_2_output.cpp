@@ -12,8 +12,10 @@ nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
   j["runs_per_direction"] = e.runs;
   j["targets"] = nlohmann::json::array();
   for (const auto& t : e.targets) {
-    nlohmann::json tj = {{"target_mm", t.target_mm}, {"runs_up", t.runs_up},
-                         {"mean_up_um", t.mean_up_um}, {"s_up_um", t.s_up_um},
+    nlohmann::json tj = {{"target_mm", t.target_mm},
+                         {"runs_up", t.runs_up},
+                         {"mean_up_um", t.mean_up_um},
+                         {"s_up_um", t.s_up_um},
                          {"mean_bi_um", t.mean_bi_um}};
     if (e.bidirectional) {
       tj["runs_down"] = t.runs_down;
@@ -30,7 +32,8 @@ nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
   }
   j["axis"] = nlohmann::json::object();
   for (const auto& a : e.axis) {
-    j["axis"][a.key] = {{"symbol", a.symbol}, {"description", a.description}, {"value_um", a.value_um}};
+    j["axis"][a.key] = {
+        {"symbol", a.symbol}, {"description", a.description}, {"value_um", a.value_um}};
   }
   j["warnings"] = e.warnings;
   return j;

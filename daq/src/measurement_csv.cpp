@@ -16,7 +16,8 @@ namespace {
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+    s.remove_suffix(1);
   return s;
 }
 
@@ -86,7 +87,8 @@ std::vector<cal::iso230_2::Measurement> parse_measurements(std::string_view text
         const auto it = std::find(f.begin(), f.end(), kColumns[c]);
         if (it == f.end()) {
           fail(w, fmt::format("header lacks column '{}' (expected target_mm,run,direction,"
-                              "deviation_um)", kColumns[c]));
+                              "deviation_um)",
+                              kColumns[c]));
         }
         col[c] = static_cast<std::size_t>(it - f.begin());
       }

@@ -21,8 +21,12 @@ TEST(Targets, UniformByIntervalAndByCount) {
 }
 
 TEST(Targets, RandomOffsetsAreReproducibleBoundedAndKeepTheEnds) {
-  TargetSpec s{.first_mm = -200, .last_mm = 800, .interval_mm = 50.0, .count = std::nullopt,
-               .random_fraction = 0.3, .seed = 17};
+  TargetSpec s{.first_mm = -200,
+               .last_mm = 800,
+               .interval_mm = 50.0,
+               .count = std::nullopt,
+               .random_fraction = 0.3,
+               .seed = 17};
   const auto a = generate_targets(s);
   const auto b = generate_targets(s);
   EXPECT_EQ(a, b);  // same seed, same targets
@@ -45,17 +49,21 @@ TEST(Targets, RandomOffsetsAreReproducibleBoundedAndKeepTheEnds) {
 }
 
 TEST(Targets, BadSpecsAreRefused) {
-  EXPECT_THROW(generate_targets({.first_mm = 10, .last_mm = 0, .interval_mm = 1.0}), cal::InputError);
+  EXPECT_THROW(generate_targets({.first_mm = 10, .last_mm = 0, .interval_mm = 1.0}),
+               cal::InputError);
   EXPECT_THROW(generate_targets({.first_mm = 0, .last_mm = 100}), cal::InputError);  // neither
   EXPECT_THROW(generate_targets({.first_mm = 0, .last_mm = 100, .interval_mm = 30.0}),
                cal::InputError);  // 30 does not divide 100
   EXPECT_THROW(generate_targets({.first_mm = 0, .last_mm = 100, .interval_mm = -10.0}),
                cal::InputError);
-  EXPECT_THROW(generate_targets({.first_mm = 0, .last_mm = 100, .interval_mm = std::nullopt,
-                                 .count = 1}),
-               cal::InputError);
-  EXPECT_THROW(generate_targets({.first_mm = 0, .last_mm = 100, .interval_mm = 10.0,
-                                 .count = std::nullopt, .random_fraction = 0.5}),
+  EXPECT_THROW(
+      generate_targets({.first_mm = 0, .last_mm = 100, .interval_mm = std::nullopt, .count = 1}),
+      cal::InputError);
+  EXPECT_THROW(generate_targets({.first_mm = 0,
+                                 .last_mm = 100,
+                                 .interval_mm = 10.0,
+                                 .count = std::nullopt,
+                                 .random_fraction = 0.5}),
                cal::InputError);
 }
 
@@ -102,8 +110,12 @@ TEST(Plan, LinearCycleOrder) {
 }
 
 TEST(Plan, EveryCycleApproachesFromTheRightSide) {
-  const TargetSpec t{.first_mm = 0, .last_mm = 1000, .interval_mm = 100.0, .count = std::nullopt,
-                     .random_fraction = 0.2, .seed = 3};
+  const TargetSpec t{.first_mm = 0,
+                     .last_mm = 1000,
+                     .interval_mm = 100.0,
+                     .count = std::nullopt,
+                     .random_fraction = 0.2,
+                     .seed = 3};
   for (auto cyc : {Cycle::linear, Cycle::pendulum, Cycle::pilgrim_step}) {
     for (bool bi : {true, false}) {
       if (cyc == Cycle::pilgrim_step && !bi) continue;

@@ -8,8 +8,8 @@
 
 namespace {
 
-using cal::unc::PositioningSetup;
 using cal::unc::positioning_budget;
+using cal::unc::PositioningSetup;
 
 double component(const cal::unc::Budget& b, std::string_view name_start) {
   for (const auto& c : b.contributors)
@@ -23,13 +23,13 @@ PositioningSetup hand_setup() {
   s.length_m = 1.0;
   s.laser_cert_expanded_ppm = 0.1;  // U = 0.1 um at 1 m, k = 2 -> u = 0.05 um
   s.laser_cert_expanded_um = 0.0;
-  s.u_air_temperature_k = 0.0;      // air sensors perfect: only the equation's 1e-8 remains
+  s.u_air_temperature_k = 0.0;  // air sensors perfect: only the equation's 1e-8 remains
   s.u_pressure_pa = 0.0;
   s.u_humidity_pct = 0.0;
   s.material_degc = 21.2;
   s.alpha_per_k = 11.5e-6;
-  s.u_material_temperature_k = 0.1;  // 1e6 um x 11.5e-6 x 0.1 = 1.15 um
-  s.u_alpha_per_k = 1e-6;            // 1e6 um x 1.2 K x 1e-6 = 1.2 um
+  s.u_material_temperature_k = 0.1;    // 1e6 um x 11.5e-6 x 0.1 = 1.15 um
+  s.u_alpha_per_k = 1e-6;              // 1e6 um x 1.2 K x 1e-6 = 1.2 um
   s.environmental_variation_um = 0.5;  // 0.5 / (2 sqrt 3) = 0.1443376 um
   s.misalignment_offset_mm = 0.5;      // (500 um)^2 / (2e6 um) = 0.125 um; / (2 sqrt 3) = 0.0360844
   s.dead_path_m = 0.0;

@@ -17,7 +17,8 @@ namespace cal::air {
 enum class Equation { edlen, ciddor, shop_floor };
 
 std::string_view to_string(Equation e);
-// Accepts "edlen", "ciddor", "shop-floor" (also "shop_floor", "nist-shop-floor"); throws InputError.
+// Accepts "edlen", "ciddor", "shop-floor" (also "shop_floor", "nist-shop-floor"); throws
+// InputError.
 Equation equation_from_string(std::string_view name);
 
 // How the humidity of the air is given.
@@ -52,7 +53,7 @@ double enhancement_factor(double pressure_pa, double t_degc);
 double water_vapour_pressure_pa(const Conditions& c);
 
 struct Result {
-  double n = 1.0;                      // refractive index of the air (phase index)
+  double n = 1.0;                       // refractive index of the air (phase index)
   double water_vapour_pressure_pa = 0;  // the p_v the equation used
   Equation equation = Equation::ciddor;
   std::vector<std::string> warnings;  // inputs where the equation's accuracy is degraded

@@ -21,9 +21,7 @@ struct CountScale {
 double vacuum_displacement_m(std::int64_t counts, const CountScale& scale);
 
 // A displacement measured along the same beam in vacuum equals n times the one measured in air.
-inline double air_length_m(double vacuum_length_m, double n_air) {
-  return vacuum_length_m / n_air;
-}
+inline double air_length_m(double vacuum_length_m, double n_air) { return vacuum_length_m / n_air; }
 
 // Dead path: the beam length d between interferometer and reflector at the datum (zero).
 // When the datum was set with index n_datum and the reading is now compensated with n, the

@@ -33,9 +33,9 @@ enum class Standard {
 
 struct StandardInfo {
   Standard id;
-  std::string_view key;      // the name used on the command line and in JSON
-  std::string_view title;    // e.g. "ISO 230-2:2014"
-  std::string_view note;     // how it relates to the others
+  std::string_view key;    // the name used on the command line and in JSON
+  std::string_view title;  // e.g. "ISO 230-2:2014"
+  std::string_view note;   // how it relates to the others
 };
 
 std::span<const StandardInfo> standards();

@@ -43,10 +43,10 @@ enum class MoveKind { measure, overrun, reposition };
 
 struct Move {
   MoveKind kind = MoveKind::measure;
-  int run = 1;                  // 1-based
+  int run = 1;  // 1-based
   Direction direction = Direction::up;
-  int target_index = 0;         // 1-based for measure moves, 0 otherwise
-  double position_mm = 0.0;     // commanded position
+  int target_index = 0;      // 1-based for measure moves, 0 otherwise
+  double position_mm = 0.0;  // commanded position
 };
 
 struct Plan {

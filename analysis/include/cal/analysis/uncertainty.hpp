@@ -14,7 +14,7 @@ namespace cal::unc {
 // What the user knows about the set-up. Uncertainties named u_* are STANDARD uncertainties
 // (one standard deviation); a calibration certificate's expanded value is divided by its k.
 struct PositioningSetup {
-  double length_m = 1.0;                 // the measured travel L
+  double length_m = 1.0;  // the measured travel L
 
   // Laser: certificate of the interferometer system (wavelength, electronics), U at k.
   double laser_cert_expanded_ppm = 0.1;  // length-proportional part (ppm of L)
@@ -53,13 +53,13 @@ struct PositioningSetup {
 
 struct Contributor {
   std::string name;
-  std::string model;   // the formula, for the report
-  double u_um = 0.0;   // standard uncertainty at L
+  std::string model;  // the formula, for the report
+  double u_um = 0.0;  // standard uncertainty at L
 };
 
 struct Budget {
   std::vector<Contributor> contributors;
-  double u_index = 0.0;     // standard uncertainty of n from the sensors and the equation
+  double u_index = 0.0;  // standard uncertainty of n from the sensors and the equation
   double u_combined_um = 0.0;
   double k = 2.0;
   double expanded_um = 0.0;  // U = k u_c
