@@ -38,35 +38,34 @@ struct Ranges {
   Range wavelength, temperature, pressure, humidity, co2;
 };
 
-// Valid and warning ranges of NIST's calculator (see docs/refractive-index.md for the source).
+// Valid ranges and warning ranges of NIST's calculator: wavelength 300 .. 1700 nm, pressure
+// 10 .. 140 kPa, temperature -40 .. 100 degC, humidity 0 .. 100 %, CO2 0 .. 2000 umol/mol;
+// it warns outside 350 .. 1600 nm, 60 .. 120 kPa, 0 .. 40 degC and above 85 %RH. The
+// Edlén equation was fitted to data between 350 and 650 nm, so it warns outside those.
+// The shop-floor equation is NIST's simplification for 633 nm near room conditions; its
+// ranges are ours (see docs/refractive-index.md).
 Ranges ranges_for(Equation eq) {
+  const Range temperature{"air temperature", "degC", -40, 100, 0, 40};
+  const Range pressure{"pressure", "Pa", 10e3, 140e3, 60e3, 120e3};
+  const Range humidity{"relative humidity", "%", 0, 100, 0, 85};
+  const Range co2{"CO2 mole fraction", "umol/mol", 0, 2000, 0, 2000};
   switch (eq) {
     case Equation::ciddor:
-      return {{"wavelength", "nm", 300, 1700, 300, 1700},
-              {"air temperature", "degC", -40, 100, -40, 100},
-              {"pressure", "Pa", 10e3, 140e3, 10e3, 140e3},
-              {"relative humidity", "%", 0, 100, 0, 100},
-              {"CO2 mole fraction", "umol/mol", 0, 2000, 0, 2000}};
+      return {{"wavelength", "nm", 300, 1700, 350, 1600}, temperature, pressure, humidity, co2};
     case Equation::edlen:
-      return {{"wavelength", "nm", 300, 1700, 350, 650},
-              {"air temperature", "degC", -40, 100, 0, 40},
-              {"pressure", "Pa", 10e3, 140e3, 80e3, 120e3},
-              {"relative humidity", "%", 0, 100, 0, 100},
-              {"CO2 mole fraction", "umol/mol", 0, 2000, 0, 2000}};
+      return {{"wavelength", "nm", 300, 1700, 350, 650}, temperature, pressure, humidity, co2};
     case Equation::shop_floor:
       break;
   }
   return {{"wavelength", "nm", 632.5, 633.5, 632.5, 633.5},
-          {"air temperature", "degC", 0, 40, 15, 35},
-          {"pressure", "Pa", 50e3, 120e3, 80e3, 110e3},
-          {"relative humidity", "%", 0, 100, 0, 100},
-          {"CO2 mole fraction", "umol/mol", 0, 2000, 0, 2000}};
+          {"air temperature", "degC", 0, 40, 15, 30},
+          {"pressure", "Pa", 60e3, 120e3, 80e3, 110e3},
+          humidity,
+          co2};
 }
 
 double relative_humidity_pct(const Conditions& c, double pv_pa) {
-  return 100.0 * pv_pa /
-         (enhancement_factor(c.pressure_pa, c.temperature_degc) *
-          saturation_vapour_pressure_pa(c.temperature_degc));
+  return 100.0 * pv_pa / saturation_vapour_pressure_pa(c.temperature_degc);
 }
 
 // Modified Edlén equation, Birch & Downs (1993) with the 1994 correction, as written in
@@ -85,7 +84,7 @@ double edlen(double t, double p, double pv, double lambda_um, double co2) {
 }
 
 // Ciddor (1996), Appl. Opt. 35, 1566, with the constants NIST EMT lists.
-double ciddor(double t, double p, double pv, double lambda_um, double co2) {
+double ciddor(double t, double p, double xv, double lambda_um, double co2) {
   constexpr double w0 = 295.235, w1 = 2.6422, w2 = -0.032380, w3 = 0.004028;
   constexpr double k0 = 238.0185, k1 = 5792105, k2 = 57.362, k3 = 167917;
   constexpr double a0 = 1.58123e-6, a1 = -2.9331e-8, a2 = 1.1043e-10;
@@ -101,7 +100,6 @@ double ciddor(double t, double p, double pv, double lambda_um, double co2) {
   const double Ma = 0.0289635 + 1.2011e-8 * (co2 - 400.0);
   const double raxs = ras * (1.0 + 5.34e-7 * (co2 - 450.0));
   const double T = t + kKelvinOffset;
-  const double xv = pv / p;
   const double Zm =
       1.0 - (p / T) * (a0 + a1 * t + a2 * t * t + (b0 + b1 * t) * xv + (c0 + c1 * t) * xv * xv) +
       (p / T) * (p / T) * (d + e * xv * xv);
@@ -171,19 +169,26 @@ double enhancement_factor(double pressure_pa, double t_degc) {
   return alpha + beta * pressure_pa + gamma * t_degc * t_degc;
 }
 
+// NIST EMT A-II: the partial pressure is pv = (RH/100) psv(t) for a relative humidity, and
+// pv = psv(td) for a dew point (over ice below 0 degC: a frost point). The enhancement
+// factor enters only the mole fraction xv = f pv / p that the Ciddor equation uses; the
+// Edlén equation takes pv itself.
 double water_vapour_pressure_pa(const Conditions& c) {
   switch (c.humidity.kind) {
     case Humidity::Kind::relative_pct:
-      return c.humidity.value / 100.0 * enhancement_factor(c.pressure_pa, c.temperature_degc) *
-             saturation_vapour_pressure_pa(c.temperature_degc);
+      if (!std::isfinite(c.humidity.value) || c.humidity.value < 0 || c.humidity.value > 100) {
+        throw InputError(
+            fmt::format("relative humidity = {} % is outside 0 .. 100 %", c.humidity.value));
+      }
+      return c.humidity.value / 100.0 * saturation_vapour_pressure_pa(c.temperature_degc);
     case Humidity::Kind::dew_point_degc: {
       const double td = c.humidity.value;
-      if (!std::isfinite(td) || td > c.temperature_degc + 1e-9) {
-        throw InputError(
-            fmt::format("dew point = {} degC must not exceed the air temperature {} degC", td,
-                        c.temperature_degc));
+      if (!std::isfinite(td) || td > c.temperature_degc + 1e-9 || td < -100.0) {
+        throw InputError(fmt::format(
+            "dew point = {} degC must lie between -100 degC and the air temperature {} degC", td,
+            c.temperature_degc));
       }
-      return enhancement_factor(c.pressure_pa, td) * saturation_vapour_pressure_pa(td);
+      return saturation_vapour_pressure_pa(td);
     }
     case Humidity::Kind::vapour_pressure_pa:
       if (!std::isfinite(c.humidity.value) || c.humidity.value < 0) {
@@ -195,6 +200,14 @@ double water_vapour_pressure_pa(const Conditions& c) {
   return 0.0;
 }
 
+double water_vapour_mole_fraction(const Conditions& c) {
+  // The enhancement factor at the temperature where the vapour is saturated: the dew point
+  // when one is given, else the air temperature.
+  const double t_f =
+      c.humidity.kind == Humidity::Kind::dew_point_degc ? c.humidity.value : c.temperature_degc;
+  return enhancement_factor(c.pressure_pa, t_f) * water_vapour_pressure_pa(c) / c.pressure_pa;
+}
+
 Result refractive_index(const Conditions& c, Equation eq) {
   Result r;
   r.equation = eq;
@@ -203,10 +216,6 @@ Result refractive_index(const Conditions& c, Equation eq) {
   check(rg.temperature, c.temperature_degc, eq, r.warnings);
   check(rg.pressure, c.pressure_pa, eq, r.warnings);
   check(rg.co2, c.co2_umol_per_mol, eq, r.warnings);
-  if (c.humidity.kind == Humidity::Kind::dew_point_degc &&
-      (!std::isfinite(c.humidity.value) || c.humidity.value < -60.0)) {
-    throw InputError(fmt::format("dew point = {} degC is below -60 degC", c.humidity.value));
-  }
   const double pv = water_vapour_pressure_pa(c);
   const double rh = relative_humidity_pct(c, pv);
   // A dew point or vapour pressure may imply RH slightly above 100 % through rounding.
@@ -220,7 +229,7 @@ Result refractive_index(const Conditions& c, Equation eq) {
       r.n = edlen(t, p, pv, lambda_um, c.co2_umol_per_mol);
       break;
     case Equation::ciddor:
-      r.n = ciddor(t, p, pv, lambda_um, c.co2_umol_per_mol);
+      r.n = ciddor(t, p, water_vapour_mole_fraction(c), lambda_um, c.co2_umol_per_mol);
       break;
     case Equation::shop_floor:
       r.n = shop_floor(t, p, rh);

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "cal/analysis/error.hpp"
 
@@ -11,15 +13,17 @@ namespace {
 
 const double kSqrt3 = std::sqrt(3.0);
 
-// Sensitivity of n to one input by a central difference on the chosen equation. The step is
-// small against the input but large against rounding (n - 1 has ~1e-16 relative noise).
-template <typename Set>
-double dn(const PositioningSetup& s, double step, Set set) {
-  air::Conditions a = s.air, b = s.air;
-  set(a, -step);
-  set(b, +step);
-  return (air::refractive_index(b, s.equation).n - air::refractive_index(a, s.equation).n) /
-         (2 * step);
+// Sensitivity of n to one input by a central difference on the chosen equation, the two
+// points kept inside [lo, hi] (a relative humidity of 100 % can only step down). The step
+// is small against the input but large against rounding (n - 1 carries ~1e-16 noise).
+template <typename Get>
+double dn(const air::Conditions& at, air::Equation eq, double step, double lo, double hi, Get get) {
+  air::Conditions a = at, b = at;
+  double& va = get(a);
+  double& vb = get(b);
+  va = std::max(lo, va - step / 2);
+  vb = std::min(hi, vb + step / 2);
+  return (air::refractive_index(b, eq).n - air::refractive_index(a, eq).n) / (vb - va);
 }
 
 void require_non_negative(double v, const char* name) {
@@ -52,22 +56,20 @@ Budget positioning_budget(const PositioningSetup& s) {
   b.warnings = air::refractive_index(s.air, s.equation).warnings;
 
   // Index of air: sensitivities dn/dt, dn/dp, dn/dRH of the equation in use.
-  const double c_t = dn(s, 0.01, [](air::Conditions& c, double h) { c.temperature_degc += h; });
-  const double c_p = dn(s, 1.0, [](air::Conditions& c, double h) { c.pressure_pa += h; });
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const double c_t = dn(s.air, s.equation, 0.02, -inf, inf,
+                        [](air::Conditions& c) -> double& { return c.temperature_degc; });
+  const double c_p = dn(s.air, s.equation, 2.0, -inf, inf,
+                        [](air::Conditions& c) -> double& { return c.pressure_pa; });
   air::Conditions rh_air = s.air;
   if (rh_air.humidity.kind != air::Humidity::Kind::relative_pct) {
     // Express the humidity as RH so that u(RH) applies.
-    const double pv = air::water_vapour_pressure_pa(s.air);
-    rh_air.humidity = air::Humidity::relative_pct(
-        100.0 * pv /
-        (air::enhancement_factor(s.air.pressure_pa, s.air.temperature_degc) *
-         air::saturation_vapour_pressure_pa(s.air.temperature_degc)));
+    rh_air.humidity =
+        air::Humidity::relative_pct(100.0 * air::water_vapour_pressure_pa(s.air) /
+                                    air::saturation_vapour_pressure_pa(s.air.temperature_degc));
   }
-  PositioningSetup srh = s;
-  srh.air = rh_air;
-  const double rh_step = std::min(0.1, std::max(1e-3, 100.0 - rh_air.humidity.value));
-  const double c_h =
-      dn(srh, rh_step / 2, [](air::Conditions& c, double h) { c.humidity.value += h; });
+  const double c_h = dn(rh_air, s.equation, 0.1, 0.0, 100.0,
+                        [](air::Conditions& c) -> double& { return c.humidity.value; });
   const double u_eq = air::equation_standard_uncertainty(s.equation);
   b.u_index =
       std::sqrt(std::pow(c_t * s.u_air_temperature_k, 2) + std::pow(c_p * s.u_pressure_pa, 2) +

@@ -49,8 +49,11 @@ double saturation_vapour_pressure_ice_pa(double t_degc);
 double saturation_vapour_pressure_pa(double t_degc);
 // Enhancement factor f = alpha + beta p + gamma t^2 of moist air.
 double enhancement_factor(double pressure_pa, double t_degc);
-// Partial pressure of water vapour for the given conditions (from RH, dew point or itself).
+// Partial pressure of water vapour as NIST EMT A-II defines it: (RH/100) psv(t) from a
+// relative humidity, psv(td) from a dew point (frost point below 0 degC), or as given.
 double water_vapour_pressure_pa(const Conditions& c);
+// Mole fraction of water vapour xv = f pv / p (the Ciddor equation's humidity input).
+double water_vapour_mole_fraction(const Conditions& c);
 
 struct Result {
   double n = 1.0;                       // refractive index of the air (phase index)
