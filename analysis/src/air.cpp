@@ -200,12 +200,18 @@ double water_vapour_pressure_pa(const Conditions& c) {
   return 0.0;
 }
 
+namespace {
+// xv = f pv / p, with f at the temperature where the vapour is saturated: the dew point
+// when one is given, else the air temperature.
+double mole_fraction(const Conditions& c, double pv_pa) {
+  const double t_f = c.humidity.kind == Humidity::Kind::dew_point_degc ? c.humidity.value
+                                                                        : c.temperature_degc;
+  return enhancement_factor(c.pressure_pa, t_f) * pv_pa / c.pressure_pa;
+}
+}  // namespace
+
 double water_vapour_mole_fraction(const Conditions& c) {
-  // The enhancement factor at the temperature where the vapour is saturated: the dew point
-  // when one is given, else the air temperature.
-  const double t_f =
-      c.humidity.kind == Humidity::Kind::dew_point_degc ? c.humidity.value : c.temperature_degc;
-  return enhancement_factor(c.pressure_pa, t_f) * water_vapour_pressure_pa(c) / c.pressure_pa;
+  return mole_fraction(c, water_vapour_pressure_pa(c));
 }
 
 Result refractive_index(const Conditions& c, Equation eq) {
@@ -229,7 +235,7 @@ Result refractive_index(const Conditions& c, Equation eq) {
       r.n = edlen(t, p, pv, lambda_um, c.co2_umol_per_mol);
       break;
     case Equation::ciddor:
-      r.n = ciddor(t, p, water_vapour_mole_fraction(c), lambda_um, c.co2_umol_per_mol);
+      r.n = ciddor(t, p, mole_fraction(c, pv), lambda_um, c.co2_umol_per_mol);
       break;
     case Equation::shop_floor:
       r.n = shop_floor(t, p, rh);
