@@ -1,8 +1,8 @@
 #pragma once
-// Evaluation of the positioning test of a numerically controlled axis: ISO 230-2 (all
-// editions) and the standards that define the same test differently (VDI/DGQ 3441,
-// JIS B 6190-2, ASME B5.54, GB/T 17421.2). Formulas and sources: docs/iso230-2.md and the
-// comments in iso230_2.cpp.
+// Evaluation of the positioning test of a numerically controlled axis: ISO 230-2 (2014,
+// 2006, 1997, 1988), VDI/DGQ 3441, and the national adoptions JIS B 6190-2 and GB/T
+// 17421.2. ASME B5.54 is not implemented: its definitions are not public (see
+// docs/iso230-2.md). Formulas and sources: docs/iso230-2.md and iso230_2.cpp.
 #include <span>
 #include <string>
 #include <string_view>
