@@ -7,5 +7,11 @@ namespace daq {
 void add_env_command(CLI::App& app);
 void add_iso230_2_commands(CLI::App& app, CLI::App& analyse);
 void add_demo_command(CLI::App& app);
+// analyse straightness, analyse squareness
+void add_geometry_commands(CLI::App& app, CLI::App& analyse);
+// analyse circle
+void add_circle_commands(CLI::App& app, CLI::App& analyse);
+// compensate
+void add_compensate_commands(CLI::App& app, CLI::App& analyse);
 
 }  // namespace daq

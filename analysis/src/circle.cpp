@@ -1,0 +1,2 @@
+// Placeholder: being written.
+#include "cal/analysis/circle.hpp"
