@@ -1,0 +1,3 @@
+#!/usr/bin/env bash
+# Placeholder: being written. Usage: compensate_test.sh DAQ_BINARY DATA_DIR
+echo "0 passed, 0 failed"
