@@ -39,6 +39,47 @@ TEST(Air, MatchesIndependentImplementationOfNistEquations) {
   }
 }
 
+// NIST EMT modified-Edlén calculator (emtoolbox.nist.gov/Wavelength/Edlen.asp) outputs at
+// 20 degC, 101.325 kPa, 30 %RH, printed to 9 decimals, as recorded in the KOTO/E14 "Gsim"
+// Geant4 material table (GsimMaterialManager). Tolerance: half a unit of the last printed
+// digit plus our own rounding, 6e-10.
+TEST(Air, EdlenMatchesNistCalculatorOutputs) {
+  constexpr std::pair<double, double> kTable[] = {
+      {300, 1.000286349}, {325, 1.000283315}, {350, 1.000280985}, {375, 1.000279151},
+      {400, 1.000277679}, {425, 1.000276478}, {450, 1.000275484}, {475, 1.000274653},
+      {500, 1.000273949}, {525, 1.000273348}, {550, 1.000272831}, {575, 1.000272382},
+      {600, 1.000271990}, {625, 1.000271646}, {650, 1.000271341}, {675, 1.000271071},
+      {700, 1.000270830}};
+  for (const auto& [nm, n] : kTable) {
+    EXPECT_NEAR(refractive_index(at(20, 101325, 30, nm), Equation::edlen).n, n, 6e-10) << nm;
+  }
+  // The calculator's default conditions (20 degC, 101.325 kPa, 50 %RH) at 633 nm,
+  // 1.000271374, as used in the NOVAC SpectralEvaluation tests.
+  EXPECT_NEAR(refractive_index(at(20, 101325, 50), Equation::edlen).n, 1.000271374, 6e-10);
+}
+
+// Ciddor (1996), Appl. Opt. 35, 1566, Table 1 (dry air) and Table 3 (moist air), 633 nm,
+// 450 umol/mol CO2, given as 1e8 (n - 1) to 0.1 (values as quoted in a public C++ unit
+// test of the equation). Dry: tolerance 0.06e-8 (printed resolution). Moist: Ciddor used
+// his own saturation vapour pressure formula, not IAPWS; tolerance 0.1e-8.
+TEST(Air, CiddorMatchesCiddor1996Tables) {
+  struct Row {
+    double t_degc, p_pa, rh_pct, n_minus_1_e8, tol_e8;
+  };
+  constexpr Row kRows[] = {
+      {20, 80000, 0, 21458.0, 0.06},   {20, 100000, 0, 26824.4, 0.06},
+      {20, 120000, 0, 32191.6, 0.06},  {10, 100000, 0, 27774.7, 0.06},
+      {30, 100000, 0, 25937.2, 0.06},  {20, 80000, 75, 21394.0, 0.1},
+      {20, 120000, 75, 32127.8, 0.1},  {40, 120000, 75, 29941.8, 0.1},
+      {50, 80000, 100, 19058.4, 0.1},  {50, 120000, 100, 28792.4, 0.1},
+  };
+  for (const auto& r : kRows) {
+    const double n = refractive_index(at(r.t_degc, r.p_pa, r.rh_pct), Equation::ciddor).n;
+    EXPECT_NEAR((n - 1.0) * 1e8, r.n_minus_1_e8, r.tol_e8) << r.t_degc << " " << r.p_pa << " "
+                                                           << r.rh_pct;
+  }
+}
+
 TEST(Air, CiddorStandardAirIsTheDispersionFormula) {
   // Ciddor (1996) defines standard air as dry, 15 degC, 101325 Pa, 450 umol/mol CO2, where
   // n - 1 = 0.05792105 / (238.0185 - σ²) + 0.00167917 / (57.362 - σ²), σ = 1/λ in 1/um
