@@ -9,7 +9,7 @@ JOBS=${JOBS:-2}
 PACKAGES=(
   build-essential cmake pkg-config
   libusb-1.0-0-dev libhidapi-dev libeigen3-dev libboost-dev libsqlite3-dev libspdlog-dev
-  libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+  libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev clang
 )
 
 install_packages() {

@@ -1,0 +1,155 @@
+#pragma once
+// The common shape of every codec (see docs/codecs.md): a pure function object, bytes in,
+// typed frames out; no I/O, no clock, no threads, no exceptions on bad bytes. Each bad input
+// is counted in CodecStats and reported as a CodecError event (kind, stream offset, text) so
+// the instrument layer can log it; the codec then resynchronises and carries on.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cal::drivers::codec {
+
+enum class ErrorKind {
+  garbage,        // bytes that cannot belong to the protocol (control characters, ...)
+  overlong_line,  // no terminator within the bounded line buffer: dropped up to the next one
+  bad_checksum,   // the frame's checksum does not match its bytes
+  out_of_range,   // a well-formed value outside its plausible range (or flagged invalid)
+  malformed,      // well-formed bytes that do not parse as a frame of the protocol
+};
+std::string_view to_string(ErrorKind kind);
+
+struct CodecError {
+  ErrorKind kind = ErrorKind::malformed;
+  std::uint64_t offset = 0;  // byte offset in the stream of the start of the offending frame
+  std::string description;
+};
+
+struct CodecStats {
+  std::uint64_t frames = 0;  // frames emitted
+  std::uint64_t bytes = 0;   // bytes fed
+  std::uint64_t garbage = 0;
+  std::uint64_t overlong_line = 0;
+  std::uint64_t bad_checksum = 0;
+  std::uint64_t out_of_range = 0;
+  std::uint64_t malformed = 0;
+
+  std::uint64_t count(ErrorKind kind) const;
+  std::uint64_t errors() const;
+  void add(ErrorKind kind);
+  bool operator==(const CodecStats&) const = default;
+};
+
+inline std::span<const std::byte> as_bytes(std::string_view s) {
+  return std::as_bytes(std::span<const char>(s.data(), s.size()));
+}
+inline std::string_view as_chars(std::span<const std::byte> b) {
+  return {reinterpret_cast<const char*>(b.data()), b.size()};
+}
+
+// Base of the codecs (CRTP): the overloads of feed() and the stats/error bookkeeping. The
+// derived class implements do_feed(bytes, frames, errors).
+template <class Derived, class FrameT>
+class CodecBase {
+ public:
+  using Frame = FrameT;
+
+  // Decodes `bytes` (any chunk of the stream: frames may be split at any byte), appending
+  // complete frames to `frames` and one event per error to `errors`.
+  void feed(std::span<const std::byte> bytes, std::vector<Frame>& frames,
+            std::vector<CodecError>& errors) {
+    stats_.bytes += bytes.size();
+    static_cast<Derived*>(this)->do_feed(bytes, frames, errors);
+  }
+  void feed(std::string_view bytes, std::vector<Frame>& frames, std::vector<CodecError>& errors) {
+    feed(as_bytes(bytes), frames, errors);
+  }
+  // The same, for callers that only want the counts of errors (in stats()).
+  void feed(std::span<const std::byte> bytes, std::vector<Frame>& frames) {
+    scratch_errors_.clear();
+    feed(bytes, frames, scratch_errors_);
+  }
+  void feed(std::string_view bytes, std::vector<Frame>& frames) { feed(as_bytes(bytes), frames); }
+
+  const CodecStats& stats() const { return stats_; }
+
+ protected:
+  void report(std::vector<CodecError>& errors, ErrorKind kind, std::uint64_t offset,
+              std::string description) {
+    stats_.add(kind);
+    errors.push_back({kind, offset, std::move(description)});
+  }
+  void emit(std::vector<Frame>& frames, Frame&& frame) {
+    ++stats_.frames;
+    frames.push_back(std::move(frame));
+  }
+
+ private:
+  CodecStats stats_;
+  std::vector<CodecError> scratch_errors_;
+};
+
+// Splits a byte stream into lines with a bounded buffer. Any CR or LF ends a line (so LF,
+// CR-LF and CR-only devices all work) and empty lines are skipped. A line longer than
+// max_line_bytes is reported once through on_overlong(start_offset) and discarded up to the
+// next terminator, where the splitter resynchronises.
+class LineSplitter {
+ public:
+  static constexpr std::size_t default_max_line_bytes = 4096;
+  explicit LineSplitter(std::size_t max_line_bytes = default_max_line_bytes);
+
+  template <class OnLine, class OnOverlong>
+  void feed(std::span<const std::byte> bytes, OnLine&& on_line, OnOverlong&& on_overlong) {
+    const std::string_view chars = as_chars(bytes);
+    std::size_t i = 0;
+    while (i < chars.size()) {
+      const std::size_t eol = chars.find_first_of("\r\n", i);
+      const std::size_t end = eol == std::string_view::npos ? chars.size() : eol;
+      append(chars.substr(i, end - i), on_overlong);
+      if (eol == std::string_view::npos) {
+        offset_ += end - i;
+        break;
+      }
+      offset_ += end - i + 1;
+      i = end + 1;
+      if (!discarding_ && !buffer_.empty()) on_line(std::string_view(buffer_), line_start_);
+      buffer_.clear();
+      discarding_ = false;
+      line_start_ = offset_;
+    }
+  }
+
+ private:
+  template <class OnOverlong>
+  void append(std::string_view piece, OnOverlong& on_overlong) {
+    if (discarding_) return;
+    if (buffer_.size() + piece.size() > max_line_bytes_) {
+      discarding_ = true;
+      buffer_.clear();
+      on_overlong(line_start_);
+      return;
+    }
+    buffer_.append(piece);
+  }
+
+  std::size_t max_line_bytes_;
+  std::string buffer_;
+  bool discarding_ = false;
+  std::uint64_t offset_ = 0;      // stream offset of the next byte fed
+  std::uint64_t line_start_ = 0;  // stream offset of the first byte of the current line
+};
+
+// True if every byte is printable ASCII or a tab: the line can belong to a text protocol.
+bool is_printable_ascii(std::string_view line);
+
+// Parses the whole of `s` as a decimal number (a leading '+' is allowed, as gauges print it);
+// nullopt if anything is left over or nothing is a number.
+std::optional<double> parse_number(std::string_view s);
+
+// Splits at runs of spaces and tabs; no empty tokens.
+std::vector<std::string_view> split_whitespace(std::string_view s);
+
+}  // namespace cal::drivers::codec

@@ -1,0 +1,99 @@
+#include "cal/drivers/codec/common.hpp"
+
+#include <algorithm>
+#include <charconv>
+
+namespace cal::drivers::codec {
+
+std::string_view to_string(ErrorKind kind) {
+  switch (kind) {
+    case ErrorKind::garbage:
+      return "garbage";
+    case ErrorKind::overlong_line:
+      return "overlong_line";
+    case ErrorKind::bad_checksum:
+      return "bad_checksum";
+    case ErrorKind::out_of_range:
+      return "out_of_range";
+    case ErrorKind::malformed:
+      return "malformed";
+  }
+  return "unknown";
+}
+
+std::uint64_t CodecStats::count(ErrorKind kind) const {
+  switch (kind) {
+    case ErrorKind::garbage:
+      return garbage;
+    case ErrorKind::overlong_line:
+      return overlong_line;
+    case ErrorKind::bad_checksum:
+      return bad_checksum;
+    case ErrorKind::out_of_range:
+      return out_of_range;
+    case ErrorKind::malformed:
+      return malformed;
+  }
+  return 0;
+}
+
+std::uint64_t CodecStats::errors() const {
+  return garbage + overlong_line + bad_checksum + out_of_range + malformed;
+}
+
+void CodecStats::add(ErrorKind kind) {
+  switch (kind) {
+    case ErrorKind::garbage:
+      ++garbage;
+      break;
+    case ErrorKind::overlong_line:
+      ++overlong_line;
+      break;
+    case ErrorKind::bad_checksum:
+      ++bad_checksum;
+      break;
+    case ErrorKind::out_of_range:
+      ++out_of_range;
+      break;
+    case ErrorKind::malformed:
+      ++malformed;
+      break;
+  }
+}
+
+LineSplitter::LineSplitter(std::size_t max_line_bytes) : max_line_bytes_(max_line_bytes) {}
+
+bool is_printable_ascii(std::string_view line) {
+  return std::all_of(line.begin(), line.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u == '\t' || (u >= 0x20 && u < 0x7f);
+  });
+}
+
+std::optional<double> parse_number(std::string_view s) {
+  // from_chars refuses a leading '+'; a second sign after it ("+-1") must stay an error.
+  if (!s.empty() && s.front() == '+') {
+    s.remove_prefix(1);
+    if (!s.empty() && (s.front() == '-' || s.front() == '+')) return std::nullopt;
+  }
+  if (s.empty()) return std::nullopt;
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+std::vector<std::string_view> split_whitespace(std::string_view s) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (true) {
+    i = s.find_first_not_of(" \t", i);
+    if (i == std::string_view::npos) break;
+    const std::size_t end = std::min(s.find_first_of(" \t", i), s.size());
+    out.push_back(s.substr(i, end - i));
+    i = end;
+  }
+  return out;
+}
+
+}  // namespace cal::drivers::codec

@@ -1,0 +1,64 @@
+#pragma once
+// Helpers shared by the codec tests: feed a stream whole, one byte at a time, or in seeded
+// random chunks, and collect what the codec produced.
+#include <cstdint>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cal/drivers/codec/common.hpp"
+
+namespace codec_test {
+
+template <class Frame>
+struct Decoded {
+  std::vector<Frame> frames;
+  std::vector<cal::drivers::codec::CodecError> errors;
+  cal::drivers::codec::CodecStats stats;
+};
+
+template <class Codec>
+Decoded<typename Codec::Frame> feed_whole(Codec codec, std::string_view stream) {
+  Decoded<typename Codec::Frame> d;
+  codec.feed(stream, d.frames, d.errors);
+  d.stats = codec.stats();
+  return d;
+}
+
+// Every chunk boundary: the stream is fed one byte at a time.
+template <class Codec>
+Decoded<typename Codec::Frame> feed_bytewise(Codec codec, std::string_view stream) {
+  Decoded<typename Codec::Frame> d;
+  for (std::size_t i = 0; i < stream.size(); ++i) codec.feed(stream.substr(i, 1), d.frames, d.errors);
+  d.stats = codec.stats();
+  return d;
+}
+
+// Random chunk sizes 0..max_chunk (zero-length feeds included on purpose), seeded.
+template <class Codec>
+Decoded<typename Codec::Frame> feed_random_chunks(Codec codec, std::string_view stream,
+                                                  std::uint32_t seed, std::size_t max_chunk = 17) {
+  Decoded<typename Codec::Frame> d;
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::size_t> size(0, max_chunk);
+  std::size_t i = 0;
+  while (i < stream.size()) {
+    const std::size_t n = std::min(size(rng), stream.size() - i);
+    codec.feed(stream.substr(i, n), d.frames, d.errors);
+    i += n;
+  }
+  d.stats = codec.stats();
+  return d;
+}
+
+inline bool same_errors(const std::vector<cal::drivers::codec::CodecError>& a,
+                        const std::vector<cal::drivers::codec::CodecError>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].kind != b[i].kind || a[i].offset != b[i].offset) return false;
+  }
+  return true;
+}
+
+}  // namespace codec_test

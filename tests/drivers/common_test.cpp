@@ -1,0 +1,81 @@
+#include "cal/drivers/codec/common.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace {
+
+using cal::drivers::codec::LineSplitter;
+
+struct Collected {
+  std::vector<std::pair<std::string, std::uint64_t>> lines;
+  std::vector<std::uint64_t> overlong;
+};
+
+Collected split(LineSplitter s, std::string_view stream, std::size_t chunk) {
+  Collected c;
+  for (std::size_t i = 0; i < stream.size(); i += chunk) {
+    s.feed(
+        cal::drivers::codec::as_bytes(stream.substr(i, chunk)),
+        [&](std::string_view line, std::uint64_t off) { c.lines.emplace_back(line, off); },
+        [&](std::uint64_t off) { c.overlong.push_back(off); });
+  }
+  return c;
+}
+
+TEST(CodecLineSplitter, AnyEolEndsALineAndEmptyLinesAreSkipped) {
+  // Offsets by hand: "ab" starts at 0, "\r\n" at 2..3, "cd" at 4, "\n" at 6, "\r" at 7,
+  // "ef" at 8, "\r" at 10; "gh" (8 + 3 = 11) has no terminator yet and stays pending.
+  const std::string stream = "ab\r\ncd\n\ref\rgh";
+  for (std::size_t chunk = 1; chunk <= stream.size(); ++chunk) {
+    const auto c = split(LineSplitter{}, stream, chunk);
+    ASSERT_EQ(c.lines.size(), 3u) << "chunk " << chunk;
+    EXPECT_EQ(c.lines[0], (std::pair<std::string, std::uint64_t>{"ab", 0}));
+    EXPECT_EQ(c.lines[1], (std::pair<std::string, std::uint64_t>{"cd", 4}));
+    EXPECT_EQ(c.lines[2], (std::pair<std::string, std::uint64_t>{"ef", 8}));
+    EXPECT_TRUE(c.overlong.empty());
+  }
+}
+
+TEST(CodecLineSplitter, OverlongLineIsReportedOnceAndResyncsAtTheNextTerminator) {
+  // Limit 4: "abcdefgh" (offset 0) is too long; "ok" starts after its '\n' at offset 9.
+  const std::string stream = "abcdefgh\nok\n";
+  for (std::size_t chunk = 1; chunk <= stream.size(); ++chunk) {
+    const auto c = split(LineSplitter{4}, stream, chunk);
+    ASSERT_EQ(c.overlong.size(), 1u) << "chunk " << chunk;
+    EXPECT_EQ(c.overlong[0], 0u);
+    ASSERT_EQ(c.lines.size(), 1u);
+    EXPECT_EQ(c.lines[0], (std::pair<std::string, std::uint64_t>{"ok", 9}));
+  }
+  // Exactly at the limit is still a line.
+  const auto c = split(LineSplitter{4}, "abcd\n", 5);
+  ASSERT_EQ(c.lines.size(), 1u);
+  EXPECT_TRUE(c.overlong.empty());
+}
+
+TEST(CodecCommon, ParseNumber) {
+  using cal::drivers::codec::parse_number;
+  EXPECT_DOUBLE_EQ(*parse_number("+012.3456"), 12.3456);
+  EXPECT_DOUBLE_EQ(*parse_number("-1.17"), -1.17);
+  EXPECT_FALSE(parse_number("+-1").has_value());
+  EXPECT_FALSE(parse_number("1.5mm").has_value());
+  EXPECT_FALSE(parse_number("").has_value());
+  EXPECT_FALSE(parse_number("+").has_value());
+}
+
+TEST(CodecCommon, StatsCountEachKind) {
+  using cal::drivers::codec::ErrorKind;
+  cal::drivers::codec::CodecStats s;
+  s.add(ErrorKind::garbage);
+  s.add(ErrorKind::bad_checksum);
+  s.add(ErrorKind::bad_checksum);
+  EXPECT_EQ(s.count(ErrorKind::bad_checksum), 2u);
+  EXPECT_EQ(s.count(ErrorKind::garbage), 1u);
+  EXPECT_EQ(s.count(ErrorKind::malformed), 0u);
+  EXPECT_EQ(s.errors(), 3u);
+  EXPECT_EQ(cal::drivers::codec::to_string(ErrorKind::overlong_line), "overlong_line");
+}
+
+}  // namespace
