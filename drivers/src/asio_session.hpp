@@ -1,0 +1,95 @@
+#pragma once
+// Private to drivers/: the asynchronous read loop and ordered write queue shared by the Asio
+// transports (serial port, TCP socket). Includes Boost.Asio, so only transport .cpp files
+// include it.
+#include <array>
+#include <boost/asio.hpp>
+#include <deque>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cal/drivers/transport/transport.hpp"
+
+namespace cal::drivers::transport::detail {
+
+// The session outlives the Transport object that owns it until its last pending handler has
+// run: every handler holds a shared_ptr, so closing (or destroying) a transport while a read
+// is in flight is safe. After close(), the user's handlers are never called again.
+template <class Stream>
+class Session : public std::enable_shared_from_this<Session<Stream>> {
+ public:
+  Session(Stream stream, std::string description)
+      : stream_(std::move(stream)), description_(std::move(description)) {}
+
+  Stream& stream() { return stream_; }
+  const std::string& description() const { return description_; }
+  bool active() const { return static_cast<bool>(on_data_); }
+
+  void start(Transport::DataHandler on_data, Transport::ErrorHandler on_error) {
+    on_data_ = std::move(on_data);
+    on_error_ = std::move(on_error);
+    read_next();
+  }
+
+  void write(std::span<const std::byte> bytes) {
+    if (!active()) return;
+    const auto* p = reinterpret_cast<const char*>(bytes.data());
+    queue_.emplace_back(p, p + bytes.size());
+    if (queue_.size() == 1) write_next();
+  }
+
+  void close() {
+    on_data_ = nullptr;
+    on_error_ = nullptr;
+    queue_.clear();
+    boost::system::error_code ignored;
+    stream_.close(ignored);
+  }
+
+  // Reports the first error of the session and closes it; later errors are consequences.
+  void fail(ErrorKind kind, const std::string& what) {
+    auto on_error = std::move(on_error_);
+    close();
+    if (on_error) on_error(Error{kind, description_ + ": " + what});
+  }
+
+ private:
+  void read_next() {
+    stream_.async_read_some(
+        boost::asio::buffer(buffer_),
+        [self = this->shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
+          self->on_read(ec, n);
+        });
+  }
+
+  void on_read(const boost::system::error_code& ec, std::size_t n) {
+    if (!active()) return;  // closed while the read was in flight
+    if (n > 0) on_data_(std::span<const std::byte>(buffer_.data(), n));
+    if (!active()) return;  // the data handler closed us
+    if (ec == boost::asio::error::eof) return fail(ErrorKind::closed_by_peer, "end of stream");
+    if (ec) return fail(ErrorKind::read_failed, "read failed: " + ec.message());
+    read_next();
+  }
+
+  void write_next() {
+    boost::asio::async_write(
+        stream_, boost::asio::buffer(queue_.front()),
+        [self = this->shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+          if (!self->active()) return;
+          if (ec) return self->fail(ErrorKind::write_failed, "write failed: " + ec.message());
+          self->queue_.pop_front();
+          if (!self->queue_.empty()) self->write_next();
+        });
+  }
+
+  Stream stream_;
+  std::string description_;
+  Transport::DataHandler on_data_;
+  Transport::ErrorHandler on_error_;
+  std::array<std::byte, 4096> buffer_{};
+  std::deque<std::vector<char>> queue_;
+};
+
+}  // namespace cal::drivers::transport::detail
