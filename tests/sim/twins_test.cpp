@@ -1,0 +1,170 @@
+// The real transports against the simulated twins: the bytes on the wire are those of the
+// protocols, and the values are the simulated truth converted by hand.
+#include "cal/drivers/sim/twins.hpp"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <boost/asio/io_context.hpp>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cal/drivers/transport/transport.hpp"
+
+namespace {
+
+namespace sim = cal::drivers::sim;
+namespace t = cal::drivers::transport;
+using namespace std::chrono_literals;
+
+std::span<const std::byte> bytes(std::string_view s) {
+  return std::as_bytes(std::span(s.data(), s.size()));
+}
+
+template <class Pred>
+void run_until(boost::asio::io_context& io, Pred done) {
+  const auto deadline = std::chrono::steady_clock::now() + 3s;
+  while (!done() && std::chrono::steady_clock::now() < deadline) {
+    io.run_for(5ms);
+    io.restart();
+  }
+}
+
+// A machine parked at x = 100 mm (no errors), still air at 20 degC, 101325 Pa, 50 %RH.
+struct Bench {
+  boost::asio::io_context io;
+  double now_s = 0.0;
+  sim::Clock clock = [this] { return now_s; };
+  sim::World world{[] {
+                     sim::MachineConfig c;
+                     c.start_mm = {100, 0, 0};
+                     return c;
+                   }(),
+                   sim::AirConfig{}};
+  std::string received;
+  std::optional<t::Error> error;
+
+  void open(t::Transport& tr) {
+    tr.open(
+        [this](std::span<const std::byte> b) {
+          received.append(reinterpret_cast<const char*>(b.data()), b.size());
+        },
+        [this](const t::Error& e) { error = e; });
+  }
+  std::string next_line() {
+    run_until(io, [&] { return received.find('\n') != std::string::npos; });
+    const auto eol = received.find('\n');
+    if (eol == std::string::npos) return "(nothing)";
+    std::string line = received.substr(0, eol + 1);
+    received.erase(0, eol + 1);
+    return line;
+  }
+};
+
+nlohmann::json call(Bench& b, t::Transport& tr, std::string_view method, int id) {
+  tr.write(
+      bytes(fmt::format(R"({{"jsonrpc": "2.0", "method": "{}", "params": [], "id": {}, "api": 2}})"
+                        "\n",
+                        method, id)));
+  return nlohmann::json::parse(b.next_line());
+}
+
+TEST(IdsTwin, AnswersJsonRpcWithTheOpticalPathInPicometres) {
+  Bench b;
+  sim::IdsTwin twin(b.io, b.world, b.clock, {.datum_mm = {0, 0, 0}});
+  auto tcp = t::make_tcp(b.io, {.host = "127.0.0.1", .port = twin.port()});
+  b.open(*tcp);
+  run_until(b.io, [&] { return tcp->is_open(); });
+
+  // Not measuring yet: the twin's error code 1, and the id is echoed.
+  auto r = call(b, *tcp, "com.attocube.ids.displacement.getAxesDisplacement", 7);
+  EXPECT_EQ(r["id"], 7);
+  EXPECT_EQ(r["result"][0], sim::IdsTwin::error_not_measuring);
+
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ids.system.startMeasurement", 8)["result"][0], 0);
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ids.system.getCurrentMode", 9)["result"][1],
+            "measurement starting");
+  b.now_s = 1.0;  // past the 0.2 s start-up
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ids.system.getCurrentMode", 10)["result"][1],
+            "measurement running");
+  // Edlen/Ciddor n = 1.000271374 at 20 degC, 101325 Pa, 50 %RH: 100 mm reads
+  // 100.0271374 mm = 100027137400 pm (within 1e-8 relative: 1000 pm).
+  r = call(b, *tcp, "com.attocube.ids.displacement.getAxesDisplacement", 11);
+  EXPECT_EQ(r["result"][0], 0);
+  EXPECT_NEAR(r["result"][1].get<double>(), 100027137400.0, 1000.0);
+  EXPECT_EQ(r["result"][2], 0);  // axis 2 measures nothing
+
+  r = call(b, *tcp, "com.attocube.ecu.getPressureInHPa", 12);
+  EXPECT_NEAR(r["result"][1].get<double>(), 1013.25, 1e-9);
+
+  twin.set_beam_lost(0, true);
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ids.displacement.getAxesDisplacement", 13)["result"][0],
+            sim::IdsTwin::error_beam_lost);
+
+  r = call(b, *tcp, "com.attocube.ids.no.suchMethod", 14);
+  EXPECT_EQ(r["error"]["code"], -32601);
+  EXPECT_EQ(r["id"], 14);
+  EXPECT_EQ(twin.requests_served(), 8u);
+
+  twin.drop_connections();
+  run_until(b.io, [&] { return b.error.has_value(); });
+  ASSERT_TRUE(b.error);
+  EXPECT_EQ(b.error->kind, t::ErrorKind::closed_by_peer);
+}
+
+TEST(Ptu300Twin, AnswersSendAt4800SevenEvenOne) {
+  Bench b;
+  sim::Ptu300Twin twin(b.io, b.world, b.clock);
+  auto port =
+      t::make_serial(b.io, t::parse_serial_settings("4800 7E1", {.device = twin.device_path()}));
+  b.open(*port);
+  port->write(bytes("SEND\r"));
+  EXPECT_EQ(b.next_line(), "P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n");
+  port->write(bytes("INTV 2 S\r"));
+  EXPECT_EQ(b.next_line(), "Output intrv. : 2 s\r\n");
+  // RUN mode: one line per 2 s of simulated time.
+  port->write(bytes("R\r"));
+  EXPECT_EQ(b.next_line().substr(0, 3), "P= ");
+  const auto before = twin.lines_sent();
+  b.now_s = 1.0;
+  b.io.run_for(30ms);
+  EXPECT_EQ(twin.lines_sent(), before);
+  b.now_s = 2.0;
+  run_until(b.io, [&] { return twin.lines_sent() > before; });
+  EXPECT_EQ(twin.lines_sent(), before + 1);
+  port->write(bytes("S\r"));
+  EXPECT_EQ(b.next_line().substr(0, 3), "P= ");
+  twin.unplug();
+  run_until(b.io, [&] { return b.error.has_value(); });
+  ASSERT_TRUE(b.error);
+}
+
+TEST(GaugeTwin, StreamsTheBarLengthAtItsSampleRate) {
+  // Tool at (100, 0, 0), table ball at (0, 0, 0), gauge zeroed at 99.99 mm: reads +0.01 mm.
+  Bench b;
+  sim::GaugeTwin twin(b.io, b.world, b.clock,
+                      {.pivot_mm = {0, 0, 0}, .zero_length_mm = 99.99, .sample_rate_hz = 1000});
+  auto port = t::make_serial(b.io, {.device = twin.device_path(), .baud = 115200});
+  b.open(*port);
+  EXPECT_EQ(b.next_line(), "+000.01000\r\n");
+  // Samples k / 1000 s for k = 0..250 are due at t = 0.25 s: 251 lines in all.
+  b.now_s = 0.25;
+  run_until(b.io, [&] { return twin.lines_sent() >= 251 && b.received.size() >= 250 * 12; });
+  EXPECT_EQ(twin.lines_sent(), 251u);
+  EXPECT_EQ(b.received.size(), 250u * 12u);  // 250 more lines of 12 bytes
+}
+
+TEST(GaugeTwin, AnswersItsRequestInPolledMode) {
+  Bench b;
+  sim::GaugeTwin twin(
+      b.io, b.world, b.clock,
+      {.zero_length_mm = 100.5, .continuous = false, .request = "?", .decimals = 4});
+  auto port = t::make_serial(b.io, {.device = twin.device_path()});
+  b.open(*port);
+  port->write(bytes("?\r"));
+  EXPECT_EQ(b.next_line(), "-000.5000\r\n");
+  EXPECT_EQ(twin.lines_sent(), 1u);
+}
+
+}  // namespace
