@@ -27,10 +27,16 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   const std::string& description() const { return description_; }
   bool active() const { return static_cast<bool>(on_data_); }
 
-  void start(Transport::DataHandler on_data, Transport::ErrorHandler on_error) {
-    on_data_ = std::move(on_data);
-    on_error_ = std::move(on_error);
+  void start(Transport::Handlers handlers) {
+    on_data_ = std::move(handlers.data);
+    on_error_ = std::move(handlers.error);
     read_next();
+    // Announced from the loop, after open() returned, like every other event.
+    if (handlers.opened)
+      boost::asio::post(stream_.get_executor(),
+                        [self = this->shared_from_this(), opened = std::move(handlers.opened)] {
+                          if (self->active()) opened();
+                        });
   }
 
   void write(std::span<const std::byte> bytes) {

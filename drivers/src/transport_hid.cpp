@@ -101,7 +101,7 @@ class HidTransport final : public Transport {
       : io_(io), settings_(std::move(settings)) {}
   ~HidTransport() override { close(); }
 
-  void open(DataHandler on_data, ErrorHandler on_error) override {
+  void open(Handlers handlers) override {
     close();
     session_ = std::make_shared<HidSession>(io_, describe());
     session_->interval = settings_.poll_interval;
@@ -120,11 +120,15 @@ class HidTransport final : public Transport {
       problem = e.what();
     }
     if (problem.empty()) {
-      session_->on_data = std::move(on_data);
-      session_->on_error = std::move(on_error);
+      session_->on_data = std::move(handlers.data);
+      session_->on_error = std::move(handlers.error);
+      if (handlers.opened)
+        asio::post(io_, [s = std::weak_ptr(session_), opened = std::move(handlers.opened)] {
+          if (auto live = s.lock(); live && live->device) opened();
+        });
       return session_->poll();
     }
-    asio::post(io_, [on_error = std::move(on_error), message = describe() + ": " + problem] {
+    asio::post(io_, [on_error = std::move(handlers.error), message = describe() + ": " + problem] {
       on_error(Error{ErrorKind::open_failed, message});
     });
   }

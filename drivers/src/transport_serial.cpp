@@ -111,7 +111,7 @@ class SerialTransport final : public Transport {
       : io_(io), settings_(std::move(settings)) {}
   ~SerialTransport() override { close(); }
 
-  void open(DataHandler on_data, ErrorHandler on_error) override {
+  void open(Handlers handlers) override {
     close();
     session_ = std::make_shared<detail::Session<Port>>(Port(io_), describe());
     boost::system::error_code ec;
@@ -123,10 +123,10 @@ class SerialTransport final : public Transport {
       problem = "cannot open: " + ec.message();
     else
       problem = configure(session_->stream().native_handle(), settings_);
-    if (problem.empty()) return session_->start(std::move(on_data), std::move(on_error));
+    if (problem.empty()) return session_->start(std::move(handlers));
     // Reported from the event loop, like every other error, so callers see one code path.
     session_->close();
-    asio::post(io_, [on_error = std::move(on_error), message = describe() + ": " + problem] {
+    asio::post(io_, [on_error = std::move(handlers.error), message = describe() + ": " + problem] {
       on_error(Error{ErrorKind::open_failed, message});
     });
   }

@@ -13,12 +13,8 @@ using asio::ip::tcp;
 // so that a transport closed mid-connect is never called back.
 struct Connect : std::enable_shared_from_this<Connect> {
   Connect(asio::io_context& io, std::shared_ptr<detail::Session<tcp::socket>> s,
-          Transport::DataHandler d, Transport::ErrorHandler e)
-      : resolver(io),
-        timer(io),
-        session(std::move(s)),
-        on_data(std::move(d)),
-        on_error(std::move(e)) {}
+          Transport::Handlers h)
+      : resolver(io), timer(io), session(std::move(s)), handlers(std::move(h)) {}
 
   void start(const TcpSettings& settings) {
     timer.expires_after(settings.connect_timeout);
@@ -48,7 +44,7 @@ struct Connect : std::enable_shared_from_this<Connect> {
     boost::system::error_code ignored;
     // Requests are small and latency-bound (one JSON-RPC line per poll): no Nagle delay.
     session->stream().set_option(tcp::no_delay(true), ignored);
-    session->start(std::move(on_data), std::move(on_error));
+    session->start(std::move(handlers));
   }
 
   void finish(ErrorKind kind, const std::string& what) {
@@ -57,14 +53,13 @@ struct Connect : std::enable_shared_from_this<Connect> {
     resolver.cancel();
     session->close();
     if (cancelled) return;
-    if (on_error) on_error(Error{kind, session->description() + ": " + what});
+    if (handlers.error) handlers.error(Error{kind, session->description() + ": " + what});
   }
 
   tcp::resolver resolver;
   asio::steady_timer timer;
   std::shared_ptr<detail::Session<tcp::socket>> session;
-  Transport::DataHandler on_data;
-  Transport::ErrorHandler on_error;
+  Transport::Handlers handlers;
   bool done = false;
   bool cancelled = false;
 };
@@ -75,10 +70,10 @@ class TcpTransport final : public Transport {
       : io_(io), settings_(std::move(settings)) {}
   ~TcpTransport() override { close(); }
 
-  void open(DataHandler on_data, ErrorHandler on_error) override {
+  void open(Handlers handlers) override {
     close();
     session_ = std::make_shared<detail::Session<tcp::socket>>(tcp::socket(io_), describe());
-    connect_ = std::make_shared<Connect>(io_, session_, std::move(on_data), std::move(on_error));
+    connect_ = std::make_shared<Connect>(io_, session_, std::move(handlers));
     connect_->start(settings_);
   }
   void write(std::span<const std::byte> bytes) override {

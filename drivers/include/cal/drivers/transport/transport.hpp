@@ -44,10 +44,20 @@ class Transport {
   Transport(const Transport&) = delete;
   Transport& operator=(const Transport&) = delete;
 
-  // Opens (connects) and starts reading asynchronously. Data arrive in on_data in stream
-  // order; the first error ends the session: on_error is called once and nothing follows
-  // until the owner opens again (reconnection policy belongs to the instrument).
-  virtual void open(DataHandler on_data, ErrorHandler on_error) = 0;
+  struct Handlers {
+    std::function<void()> opened;  // the device is open / the connection is up
+    DataHandler data;
+    ErrorHandler error;
+  };
+
+  // Opens (connects) and starts reading asynchronously. `opened` is called from the event
+  // loop once the device can be written to; data then arrive in stream order. The first
+  // error ends the session: `error` is called once and nothing follows until the owner opens
+  // again (the reconnection policy belongs to the instrument).
+  virtual void open(Handlers handlers) = 0;
+  void open(DataHandler on_data, ErrorHandler on_error) {
+    open(Handlers{{}, std::move(on_data), std::move(on_error)});
+  }
   // Queues bytes to send; writes are performed in order. Ignored (with an error report)
   // when the transport is not open.
   virtual void write(std::span<const std::byte> bytes) = 0;

@@ -1,0 +1,109 @@
+#pragma once
+// Instruments: a transport plus a codec plus the device's state machine, emitting typed,
+// timestamped readings in SI units (see ../shared/DESIGN.md). The common part here owns the
+// life cycle: open, configure, stream or poll, signal lost, error, reconnect with backoff
+// (the gap is reported, never hidden), closed. Each device adds only its protocol steps.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "cal/drivers/codec/common.hpp"
+#include "cal/drivers/transport/transport.hpp"
+
+namespace cal::drivers {
+
+enum class Quantity : std::uint8_t {
+  displacement_m,  // interferometer axis, raw (vacuum-wavelength) optical length
+  length_m,        // gauge / ballbar transducer reading
+  air_temperature_degc,
+  air_pressure_pa,
+  air_humidity_pct,  // relative humidity, %RH
+  dew_point_degc,
+  refractive_index,  // as computed by the instrument (e.g. the IDS ECU)
+  material_temperature_degc,
+  machine_position_m,  // a machine position feed (actual or commanded)
+};
+std::string_view to_string(Quantity q);
+
+enum class ReadingStatus : std::uint8_t {
+  ok,
+  signal_lost,   // beam interrupted / weak signal: the value is not a measurement
+  out_of_range,  // the device flagged the value
+};
+
+struct Reading {
+  std::int64_t time_ns = 0;  // monotonic, from the instrument's clock (see Instrument::Clock)
+  std::uint16_t device = 0;  // the instrument's id in the session
+  std::uint8_t channel = 0;  // axis or sensor number on the device
+  Quantity quantity = Quantity::displacement_m;
+  ReadingStatus status = ReadingStatus::ok;
+  double value = 0.0;  // SI (m, Pa, degC, %RH)
+};
+
+enum class InstrumentState : std::uint8_t {
+  closed,
+  connecting,    // the transport is opening
+  configuring,   // opened; the device is being set up (start measurement, INTV, ...)
+  streaming,     // readings flow
+  signal_lost,   // connected, but the device says its readings are not valid
+  reconnecting,  // the connection failed or dropped; waiting for the next attempt
+};
+std::string_view to_string(InstrumentState s);
+
+// A period without readings because the connection was down; reported when it ends (or when
+// the instrument is stopped), with the reason of the drop.
+struct Gap {
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  std::string reason;
+};
+
+struct Backoff {
+  std::chrono::milliseconds initial{250};
+  std::chrono::milliseconds max{8000};
+  double factor = 2.0;
+  int max_attempts = -1;  // -1: forever; otherwise give up (state closed) after that many
+};
+
+struct InstrumentEvents {
+  std::function<void(const Reading&)> reading;
+  std::function<void(InstrumentState, std::string_view why)> state;
+  std::function<void(const Gap&)> gap;
+  std::function<void(const codec::CodecError&)> codec_error;
+};
+
+// Monotonic nanoseconds. The default is the steady clock; replay substitutes the recorded
+// time of the bytes being delivered, so replayed readings carry their original timestamps.
+using Clock = std::function<std::int64_t()>;
+Clock steady_clock_ns();
+
+struct InstrumentOptions {
+  std::uint16_t device = 0;
+  std::string name;  // for logs and errors, e.g. "laser" or "PTU300 #1"
+  Backoff backoff;
+  // Poll period of polled devices (IDS displacement, PTU300 in SEND mode, polled gauges).
+  std::chrono::microseconds poll_period{10'000};
+  // A connected device that sends nothing for this long is treated as a dropped connection.
+  std::chrono::milliseconds silence_timeout{3000};
+  Clock clock;  // empty: steady_clock_ns()
+};
+
+class Instrument {
+ public:
+  virtual ~Instrument() = default;
+  Instrument() = default;
+  Instrument(const Instrument&) = delete;
+  Instrument& operator=(const Instrument&) = delete;
+
+  virtual void start(InstrumentEvents events) = 0;
+  virtual void stop() = 0;
+  virtual InstrumentState state() const = 0;
+  virtual const codec::CodecStats& codec_stats() const = 0;
+  virtual std::string describe() const = 0;
+};
+
+}  // namespace cal::drivers

@@ -1,0 +1,36 @@
+#pragma once
+// The supported instruments: factories that combine a transport (real, or the replay
+// transport) with the device's codec and protocol steps. The transport is passed in so that
+// the same instrument code runs on hardware, on the simulated twins and on a replayed capture.
+#include <array>
+#include <chrono>
+#include <memory>
+
+#include "cal/drivers/codec/vaisala_ptu300.hpp"
+#include "cal/drivers/instrument.hpp"
+
+namespace cal::drivers {
+
+struct Ids3010Options {
+  std::array<bool, 3> axes{true, false, false};  // interferometer axes to read
+  bool start_measurement = true;  // send startMeasurement on connect (else only observe)
+  bool read_environment = true;   // poll the ECU (air temperature, pressure, humidity, n)
+  std::chrono::milliseconds environment_period{1000};
+};
+
+// Polls getAxesDisplacement every options.poll_period (one request in flight at a time; the
+// reading's time is the midpoint between request and answer). Readings: displacement_m per
+// axis (raw: the IDS counts the vacuum wavelength), status signal_lost while the device
+// reports a non-zero error code; with the ECU, air readings on channel 0.
+std::unique_ptr<Instrument> make_ids3010(boost::asio::io_context& io,
+                                         std::unique_ptr<transport::Transport> transport,
+                                         InstrumentOptions options, Ids3010Options ids = {});
+
+// Vaisala PTU300: stops any RUN output on connect, then polls with SEND every
+// options.poll_period (a PTU300 updates about once a second; 1 s is the usual period).
+// Readings: air_pressure_pa, air_temperature_degc, air_humidity_pct, dew_point_degc.
+std::unique_ptr<Instrument> make_ptu300(boost::asio::io_context& io,
+                                        std::unique_ptr<transport::Transport> transport,
+                                        InstrumentOptions options, codec::Ptu300Config config = {});
+
+}  // namespace cal::drivers

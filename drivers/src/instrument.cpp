@@ -1,0 +1,224 @@
+// The common instrument life cycle (see instrument_core.hpp).
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "instrument_core.hpp"
+
+namespace cal::drivers {
+
+std::string_view to_string(Quantity q) {
+  switch (q) {
+    case Quantity::displacement_m:
+      return "displacement_m";
+    case Quantity::length_m:
+      return "length_m";
+    case Quantity::air_temperature_degc:
+      return "air_temperature_degc";
+    case Quantity::air_pressure_pa:
+      return "air_pressure_pa";
+    case Quantity::air_humidity_pct:
+      return "air_humidity_pct";
+    case Quantity::dew_point_degc:
+      return "dew_point_degc";
+    case Quantity::refractive_index:
+      return "refractive_index";
+    case Quantity::material_temperature_degc:
+      return "material_temperature_degc";
+    case Quantity::machine_position_m:
+      return "machine_position_m";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(InstrumentState s) {
+  switch (s) {
+    case InstrumentState::closed:
+      return "closed";
+    case InstrumentState::connecting:
+      return "connecting";
+    case InstrumentState::configuring:
+      return "configuring";
+    case InstrumentState::streaming:
+      return "streaming";
+    case InstrumentState::signal_lost:
+      return "signal lost";
+    case InstrumentState::reconnecting:
+      return "reconnecting";
+  }
+  return "unknown";
+}
+
+Clock steady_clock_ns() {
+  return [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  };
+}
+
+namespace detail {
+
+InstrumentCore::InstrumentCore(boost::asio::io_context& io,
+                               std::unique_ptr<transport::Transport> transport,
+                               InstrumentOptions options)
+    : io_(io),
+      transport_(std::move(transport)),
+      options_(std::move(options)),
+      clock_(options_.clock ? options_.clock : steady_clock_ns()),
+      reconnect_timer_(io),
+      poll_timer_(io),
+      watchdog_(io),
+      next_delay_(options_.backoff.initial) {}
+
+InstrumentCore::~InstrumentCore() {
+  *alive_ = false;
+  running_ = false;
+  transport_->close();
+}
+
+std::string InstrumentCore::describe() const {
+  return options_.name.empty() ? transport_->describe()
+                               : options_.name + " (" + transport_->describe() + ")";
+}
+
+void InstrumentCore::start(InstrumentEvents events) {
+  events_ = std::move(events);
+  running_ = true;
+  attempts_ = 0;
+  next_delay_ = options_.backoff.initial;
+  connect();
+}
+
+void InstrumentCore::stop() {
+  if (!running_) return;
+  running_ = false;
+  polling_ = false;
+  reconnect_timer_.cancel();
+  poll_timer_.cancel();
+  watchdog_.cancel();
+  transport_->close();
+  on_disconnected();
+  if (gap_ && events_.gap) {  // a gap still open at the end is reported, not dropped
+    gap_->end_ns = now_ns();
+    events_.gap(*gap_);
+  }
+  gap_.reset();
+  set_state(InstrumentState::closed, "stopped");
+}
+
+void InstrumentCore::connect() {
+  set_state(InstrumentState::connecting);
+  ++attempts_;
+  transport::Transport::Handlers handlers;
+  handlers.opened = [this, alive = alive_] {
+    if (!*alive || !running_) return;
+    set_state(InstrumentState::configuring);
+    last_bytes_ns_ = now_ns();
+    arm_watchdog();
+    on_connected();
+  };
+  handlers.data = [this, alive = alive_](std::span<const std::byte> bytes) {
+    if (!*alive || !running_) return;
+    last_bytes_ns_ = now_ns();
+    on_bytes(bytes);
+  };
+  handlers.error = [this, alive = alive_](const transport::Error& e) {
+    if (*alive && running_) fail(e.message);
+  };
+  transport_->open(std::move(handlers));
+}
+
+void InstrumentCore::fail(const std::string& reason) {
+  if (!running_) return;
+  polling_ = false;
+  poll_timer_.cancel();
+  watchdog_.cancel();
+  transport_->close();
+  on_disconnected();
+  if (!gap_) gap_ = Gap{now_ns(), 0, reason};
+  if (options_.backoff.max_attempts >= 0 && attempts_ >= options_.backoff.max_attempts) {
+    running_ = false;
+    if (events_.gap) {
+      gap_->end_ns = now_ns();
+      events_.gap(*gap_);
+    }
+    gap_.reset();
+    return set_state(InstrumentState::closed,
+                     fmt::format("gave up after {} attempts: {}", attempts_, reason));
+  }
+  set_state(InstrumentState::reconnecting, reason);
+  schedule_reconnect();
+}
+
+void InstrumentCore::schedule_reconnect() {
+  reconnect_timer_.expires_after(next_delay_);
+  next_delay_ = std::min(options_.backoff.max,
+                         std::chrono::milliseconds(static_cast<std::int64_t>(
+                             static_cast<double>(next_delay_.count()) * options_.backoff.factor)));
+  reconnect_timer_.async_wait([this, alive = alive_](const boost::system::error_code& ec) {
+    if (!ec && *alive && running_) connect();
+  });
+}
+
+// A silent device is a dropped connection (a TCP peer that vanished without a FIN, a serial
+// adapter whose instrument was switched off): without this, the gap would never be seen.
+void InstrumentCore::arm_watchdog() {
+  watchdog_.expires_after(options_.silence_timeout);
+  watchdog_.async_wait([this, alive = alive_](const boost::system::error_code& ec) {
+    if (ec || !*alive || !running_) return;
+    const auto silent_ns = now_ns() - last_bytes_ns_;
+    if (silent_ns >= std::chrono::nanoseconds(options_.silence_timeout).count())
+      return fail(fmt::format("no data for {} ms", options_.silence_timeout.count()));
+    arm_watchdog();
+  });
+}
+
+void InstrumentCore::send(std::string_view text) {
+  transport_->write(std::as_bytes(std::span(text.data(), text.size())));
+}
+
+void InstrumentCore::emit(Reading r) {
+  r.device = options_.device;
+  if (gap_) {  // the first reading after a reconnection closes the gap
+    gap_->end_ns = r.time_ns;
+    if (events_.gap) events_.gap(*gap_);
+    gap_.reset();
+    attempts_ = 0;
+    next_delay_ = options_.backoff.initial;
+  }
+  if (r.status == ReadingStatus::signal_lost) {
+    if (state_ != InstrumentState::signal_lost) set_state(InstrumentState::signal_lost);
+  } else if (state_ != InstrumentState::streaming) {
+    set_state(InstrumentState::streaming);
+  }
+  if (events_.reading) events_.reading(r);
+}
+
+void InstrumentCore::set_state(InstrumentState s, std::string_view why) {
+  state_ = s;
+  if (events_.state) events_.state(s, why);
+}
+
+void InstrumentCore::start_polling() {
+  if (polling_) return;
+  polling_ = true;
+  poll_tick();
+}
+
+void InstrumentCore::poll_tick() {
+  if (!polling_ || !running_) return;
+  on_poll();
+  poll_timer_.expires_after(options_.poll_period);
+  poll_timer_.async_wait([this, alive = alive_](const boost::system::error_code& ec) {
+    if (!ec && *alive) poll_tick();
+  });
+}
+
+void InstrumentCore::report_codec_errors(std::span<const codec::CodecError> errors) {
+  if (!events_.codec_error) return;
+  for (const auto& e : errors) events_.codec_error(e);
+}
+
+}  // namespace detail
+}  // namespace cal::drivers

@@ -1,0 +1,69 @@
+#pragma once
+// Private to drivers/: the life cycle shared by every instrument (open, configure, stream,
+// signal lost, reconnect with backoff and gap reporting, silence watchdog). Includes
+// Boost.Asio, so only instrument .cpp files include it.
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "cal/drivers/instrument.hpp"
+
+namespace cal::drivers::detail {
+
+class InstrumentCore : public Instrument {
+ public:
+  InstrumentCore(boost::asio::io_context& io, std::unique_ptr<transport::Transport> transport,
+                 InstrumentOptions options);
+  ~InstrumentCore() override;
+
+  void start(InstrumentEvents events) final;
+  void stop() final;
+  InstrumentState state() const final { return state_; }
+  std::string describe() const override;
+
+ protected:
+  // Device steps. on_connected: the transport is open; send the set-up (state is
+  // configuring). on_bytes: bytes from the device. on_poll: the poll timer fired (only while
+  // polling is on). on_disconnected: forget in-flight requests.
+  virtual void on_connected() = 0;
+  virtual void on_bytes(std::span<const std::byte> bytes) = 0;
+  virtual void on_poll() {}
+  virtual void on_disconnected() {}
+
+  void send(std::string_view text);
+  void emit(Reading r);
+  void set_state(InstrumentState s, std::string_view why = {});
+  // Ends the connection and schedules a reconnection (reason recorded in the gap).
+  void fail(const std::string& reason);
+  void start_polling();
+  void report_codec_errors(std::span<const codec::CodecError> errors);
+  std::int64_t now_ns() const { return clock_(); }
+  const InstrumentOptions& options() const { return options_; }
+  boost::asio::io_context& io() { return io_; }
+
+ private:
+  void connect();
+  void schedule_reconnect();
+  void arm_watchdog();
+  void poll_tick();
+
+  boost::asio::io_context& io_;
+  std::unique_ptr<transport::Transport> transport_;
+  InstrumentOptions options_;
+  Clock clock_;
+  InstrumentEvents events_;
+  InstrumentState state_ = InstrumentState::closed;
+  boost::asio::steady_timer reconnect_timer_, poll_timer_, watchdog_;
+  std::chrono::milliseconds next_delay_{};
+  int attempts_ = 0;
+  bool running_ = false;
+  bool polling_ = false;
+  std::int64_t last_bytes_ns_ = 0;
+  std::optional<Gap> gap_;  // open while the connection is down
+  // Shared with the timers' handlers: a handler that runs after destruction does nothing.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace cal::drivers::detail
