@@ -1,0 +1,144 @@
+#pragma once
+// The run store: one SQLite file (one per site by default), WAL mode, a versioned schema
+// with migrations. Raw readings are kept uncompensated, in chunks (a BLOB of timestamps and
+// values per device/channel/quantity), so a run can be re-compensated and re-analysed later
+// and ingest keeps up with a 10 kHz interferometer many times over. Nothing is lost on a
+// crash: every committed batch survives a kill -9 or a power loss (synchronous=FULL), and a
+// run that never finished is shown as incomplete when the store is next opened.
+//
+// sqlite3.h stays out of this header.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cal::storage {
+
+// Every storage failure: the message names the database file and what failed (SQLite's own
+// text, e.g. "database or disk is full").
+class StoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+inline constexpr int schema_version = 1;
+
+enum class RunStatus { running, complete, incomplete, aborted };
+std::string_view to_string(RunStatus s);
+
+struct MachineRecord {
+  std::int64_t id = 0;
+  std::string name;
+  std::string description;
+  std::string config_json = "{}";
+};
+
+struct RunRecord {
+  std::int64_t id = 0;
+  std::int64_t machine_id = 0;
+  std::string campaign;              // free text grouping runs, e.g. "2026-11 annual"
+  std::string kind;                  // "linear", "circle", "straightness", ...
+  std::string axis;                  // "X", "XY", ...
+  std::string settings_json = "{}";  // test set-up: targets, cycle, feed, compensation, ...
+  std::string capture_path;          // the wire-level capture of the run, if one was recorded
+  std::string software_version;
+  std::int64_t started_unix_ms = 0;
+  std::optional<std::int64_t> ended_unix_ms;
+  RunStatus status = RunStatus::running;
+  std::string note;  // why a run was aborted, and the like
+};
+
+struct InstrumentRecord {
+  std::int64_t run_id = 0;
+  int device = 0;         // the device number used in the run's readings
+  std::string driver;     // "ids3010", "ptu300", ...
+  std::string transport;  // "tcp 192.168.1.5:9090", "serial /dev/ttyUSB0 4800 7E1"
+  std::string settings_json = "{}";
+};
+
+// One raw reading (the storage's own POD, so storage does not depend on drivers).
+struct RawReading {
+  std::int64_t time_ns = 0;
+  std::uint16_t device = 0;
+  std::uint8_t channel = 0;
+  std::uint8_t quantity = 0;  // cal::drivers::Quantity
+  std::uint8_t status = 0;    // cal::drivers::ReadingStatus
+  double value = 0.0;
+};
+
+struct CapturedTarget {
+  std::int64_t run_id = 0;
+  int target_index = 0;  // 0-based, as in the plan
+  int run_number = 0;    // 1-based ISO 230-2 run j
+  char direction = '+';  // '+' or '-'
+  double nominal_mm = 0.0;
+  std::int64_t time_ns = 0;
+  double raw_m = 0.0;         // the laser reading used (mean over the capture window)
+  double deviation_um = 0.0;  // compensated actual minus nominal, at 20 degC
+  double refractive_index = 1.0;
+  double material_temperature_degc = 20.0;
+};
+
+struct ResultRecord {
+  std::int64_t run_id = 0;
+  std::string standard;  // "ISO 230-2:2014", "VDI/DGQ 3441", "ISO 230-4"
+  std::string json;      // the full result document (caldaq.*.v1 schema)
+  std::int64_t created_unix_ms = 0;
+};
+
+struct StoreOptions {
+  bool full_sync = true;  // synchronous=FULL: a committed batch survives a power loss
+  // A cap on the file size in pages (0: none). SQLite then fails a write exactly as on a full
+  // disk ("database or disk is full"), which is how the tests exercise that path.
+  std::int64_t max_pages = 0;
+};
+
+class Store {
+ public:
+  // Opens or creates the database, migrates it to schema_version, and marks runs left
+  // `running` by a crashed session as `incomplete`. Throws StoreError (file named) when the
+  // file is not a database, is from a newer version, or cannot be written.
+  explicit Store(const std::filesystem::path& path, StoreOptions options = {});
+  ~Store();
+  Store(Store&&) noexcept;
+  Store& operator=(Store&&) noexcept;
+
+  const std::filesystem::path& path() const;
+  int version() const;  // the schema version found on disk after migration
+
+  std::int64_t add_machine(const MachineRecord& m);
+  std::optional<MachineRecord> machine_by_name(std::string_view name) const;
+
+  std::int64_t begin_run(const RunRecord& r);  // returns the new run id
+  void add_instrument(const InstrumentRecord& i);
+  void finish_run(std::int64_t run_id, RunStatus status, std::string_view note = {});
+  void set_capture_path(std::int64_t run_id, std::string_view path);
+  std::vector<RunRecord> runs() const;
+  std::optional<RunRecord> run(std::int64_t run_id) const;
+  std::vector<InstrumentRecord> instruments(std::int64_t run_id) const;
+
+  // Appends readings in one transaction (chunked by device/channel/quantity).
+  void append_readings(std::int64_t run_id, std::span<const RawReading> readings);
+  // All readings of a run in time order (stable for equal times).
+  std::vector<RawReading> readings(std::int64_t run_id) const;
+  std::int64_t reading_count(std::int64_t run_id) const;
+
+  void add_targets(std::span<const CapturedTarget> targets);
+  std::vector<CapturedTarget> targets(std::int64_t run_id) const;
+  // Replaces the targets of a run (re-compensation keeps the raw values, changes deviations).
+  void replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets);
+
+  void add_result(const ResultRecord& r);
+  std::vector<ResultRecord> results(std::int64_t run_id) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cal::storage

@@ -1,0 +1,514 @@
+// The SQLite run store (see store.hpp; schema and chunk format in docs/storage.md).
+#include "cal/storage/store.hpp"
+
+#include <fmt/format.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <tuple>
+
+namespace cal::storage {
+
+std::string_view to_string(RunStatus s) {
+  switch (s) {
+    case RunStatus::running:
+      return "running";
+    case RunStatus::complete:
+      return "complete";
+    case RunStatus::incomplete:
+      return "incomplete";
+    case RunStatus::aborted:
+      return "aborted";
+  }
+  return "unknown";
+}
+
+namespace {
+
+RunStatus status_from(std::string_view s) {
+  if (s == "complete") return RunStatus::complete;
+  if (s == "incomplete") return RunStatus::incomplete;
+  if (s == "aborted") return RunStatus::aborted;
+  return RunStatus::running;
+}
+
+struct DbCloser {
+  void operator()(sqlite3* db) const { sqlite3_close_v2(db); }
+};
+struct StmtFinalizer {
+  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
+};
+
+// The schema, one entry per version: entry k migrates from version k to k + 1. A migration
+// runs in one transaction with the user_version update, so a crash mid-migration leaves the
+// previous version intact.
+constexpr const char* kMigrations[] = {
+    R"sql(
+CREATE TABLE machines(
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  description TEXT NOT NULL DEFAULT '',
+  config_json TEXT NOT NULL DEFAULT '{}');
+CREATE TABLE runs(
+  id INTEGER PRIMARY KEY,
+  machine_id INTEGER REFERENCES machines(id),
+  campaign TEXT NOT NULL DEFAULT '',
+  kind TEXT NOT NULL,
+  axis TEXT NOT NULL DEFAULT '',
+  settings_json TEXT NOT NULL DEFAULT '{}',
+  capture_path TEXT NOT NULL DEFAULT '',
+  software_version TEXT NOT NULL DEFAULT '',
+  started_unix_ms INTEGER NOT NULL,
+  ended_unix_ms INTEGER,
+  status TEXT NOT NULL CHECK(status IN ('running', 'complete', 'incomplete', 'aborted')),
+  note TEXT NOT NULL DEFAULT '',
+  owner_pid INTEGER NOT NULL DEFAULT 0);
+CREATE TABLE instruments(
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  device INTEGER NOT NULL,
+  driver TEXT NOT NULL,
+  transport TEXT NOT NULL,
+  settings_json TEXT NOT NULL DEFAULT '{}',
+  PRIMARY KEY(run_id, device));
+CREATE TABLE reading_chunks(
+  id INTEGER PRIMARY KEY,
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  device INTEGER NOT NULL,
+  channel INTEGER NOT NULL,
+  quantity INTEGER NOT NULL,
+  first_ns INTEGER NOT NULL,
+  last_ns INTEGER NOT NULL,
+  count INTEGER NOT NULL,
+  data BLOB NOT NULL);
+CREATE INDEX reading_chunks_by_run ON reading_chunks(run_id, first_ns);
+CREATE TABLE captured_targets(
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  target_index INTEGER NOT NULL,
+  run_number INTEGER NOT NULL,
+  direction TEXT NOT NULL CHECK(direction IN ('+', '-')),
+  nominal_mm REAL NOT NULL,
+  time_ns INTEGER NOT NULL,
+  raw_m REAL NOT NULL,
+  deviation_um REAL NOT NULL,
+  refractive_index REAL NOT NULL,
+  material_temperature_degc REAL NOT NULL,
+  PRIMARY KEY(run_id, run_number, direction, target_index));
+CREATE TABLE results(
+  id INTEGER PRIMARY KEY,
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  standard TEXT NOT NULL,
+  json TEXT NOT NULL,
+  created_unix_ms INTEGER NOT NULL);
+)sql",
+};
+static_assert(std::size(kMigrations) == schema_version);
+
+// Chunk BLOB: per reading 8 bytes time_ns (int64), 1 byte status, 8 bytes value (IEEE-754
+// double), all little-endian, packed (17 bytes). The host is little-endian (x86-64, arm64).
+constexpr std::size_t kRecordBytes = 17;
+
+std::int64_t unix_ms_now() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+struct Store::Impl {
+  std::filesystem::path path;
+  std::unique_ptr<sqlite3, DbCloser> db;
+  int version = 0;
+
+  [[noreturn]] void fail(std::string_view what) const {
+    throw StoreError(fmt::format("{}: {}: {}", path.string(), what, sqlite3_errmsg(db.get())));
+  }
+
+  void exec(const char* sql, std::string_view what) {
+    char* err = nullptr;
+    if (sqlite3_exec(db.get(), sql, nullptr, nullptr, &err) != SQLITE_OK) {
+      const std::string text = err ? err : "unknown error";
+      sqlite3_free(err);
+      throw StoreError(fmt::format("{}: {}: {}", path.string(), what, text));
+    }
+  }
+
+  using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalizer>;
+  Stmt prepare(const char* sql) const {
+    sqlite3_stmt* s = nullptr;
+    if (sqlite3_prepare_v2(db.get(), sql, -1, &s, nullptr) != SQLITE_OK) fail("prepare");
+    return Stmt(s);
+  }
+
+  void step_done(sqlite3_stmt* s, std::string_view what) const {
+    if (sqlite3_step(s) != SQLITE_DONE) fail(what);
+    sqlite3_reset(s);
+  }
+
+  void insert_targets(std::span<const CapturedTarget> targets);
+
+  // A transaction that rolls back unless committed (RAII), so a failed batch leaves the
+  // database as it was before the batch, never half-written.
+  struct Transaction {
+    Impl& impl;
+    bool done = false;
+    explicit Transaction(Impl& i) : impl(i) { impl.exec("BEGIN IMMEDIATE", "begin transaction"); }
+    void commit() {
+      impl.exec("COMMIT", "commit");
+      done = true;
+    }
+    ~Transaction() {
+      if (!done) sqlite3_exec(impl.db.get(), "ROLLBACK", nullptr, nullptr, nullptr);
+    }
+  };
+};
+
+namespace {
+
+void bind_text(sqlite3_stmt* s, int i, std::string_view v) {
+  // An empty view may have a null data(), which SQLite would store as NULL, not ''.
+  sqlite3_bind_text(s, i, v.empty() ? "" : v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+}
+std::string column_text(sqlite3_stmt* s, int i) {
+  const auto* p = sqlite3_column_text(s, i);
+  return p ? reinterpret_cast<const char*>(p) : "";
+}
+
+bool process_alive(std::int64_t pid) {
+  if (pid <= 0) return false;
+  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
+}
+
+}  // namespace
+
+Store::Store(const std::filesystem::path& path, StoreOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.path = path;
+  sqlite3* raw = nullptr;
+  const int rc =
+      sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  m.db.reset(raw);
+  if (rc != SQLITE_OK) m.fail("cannot open");
+  sqlite3_busy_timeout(raw, 5000);  // a reader (daq runs) and the writer share the file
+  // The first statement reads the header: a file that is not a database fails here.
+  m.exec("PRAGMA journal_mode=WAL", "not a caldaq database (cannot set WAL mode)");
+  m.exec(options.full_sync ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL",
+         "set synchronous");
+  m.exec("PRAGMA foreign_keys=ON", "enable foreign keys");
+  if (options.max_pages > 0)
+    m.exec(fmt::format("PRAGMA max_page_count={}", options.max_pages).c_str(), "set max pages");
+  {
+    auto s = m.prepare("PRAGMA user_version");
+    if (sqlite3_step(s.get()) != SQLITE_ROW) m.fail("read schema version");
+    m.version = sqlite3_column_int(s.get(), 0);
+  }
+  if (m.version > schema_version)
+    throw StoreError(fmt::format(
+        "{}: schema version {} is newer than this daq understands ({}); use a newer daq",
+        path.string(), m.version, schema_version));
+  for (int v = m.version; v < schema_version; ++v) {
+    Impl::Transaction tx(m);
+    m.exec(kMigrations[v], fmt::format("migrate schema {} -> {}", v, v + 1).c_str());
+    m.exec(fmt::format("PRAGMA user_version={}", v + 1).c_str(), "set schema version");
+    tx.commit();
+    m.version = v + 1;
+  }
+  // Runs whose writing process is gone were interrupted (kill -9, power loss, crash).
+  std::vector<std::int64_t> orphans;
+  {
+    auto s = m.prepare("SELECT id, owner_pid FROM runs WHERE status = 'running'");
+    while (sqlite3_step(s.get()) == SQLITE_ROW)
+      if (!process_alive(sqlite3_column_int64(s.get(), 1)))
+        orphans.push_back(sqlite3_column_int64(s.get(), 0));
+  }
+  for (auto id : orphans)
+    finish_run(id, RunStatus::incomplete,
+               "interrupted: the writing process ended without finishing the run");
+}
+
+Store::~Store() = default;
+Store::Store(Store&&) noexcept = default;
+Store& Store::operator=(Store&&) noexcept = default;
+
+const std::filesystem::path& Store::path() const { return impl_->path; }
+int Store::version() const { return impl_->version; }
+
+std::int64_t Store::add_machine(const MachineRecord& r) {
+  auto s = impl_->prepare("INSERT INTO machines(name, description, config_json) VALUES(?, ?, ?)");
+  bind_text(s.get(), 1, r.name);
+  bind_text(s.get(), 2, r.description);
+  bind_text(s.get(), 3, r.config_json);
+  impl_->step_done(s.get(), fmt::format("add machine '{}'", r.name));
+  return sqlite3_last_insert_rowid(impl_->db.get());
+}
+
+std::optional<MachineRecord> Store::machine_by_name(std::string_view name) const {
+  auto s = impl_->prepare("SELECT id, name, description, config_json FROM machines WHERE name = ?");
+  bind_text(s.get(), 1, name);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
+  return MachineRecord{sqlite3_column_int64(s.get(), 0), column_text(s.get(), 1),
+                       column_text(s.get(), 2), column_text(s.get(), 3)};
+}
+
+std::int64_t Store::begin_run(const RunRecord& r) {
+  auto s = impl_->prepare(
+      "INSERT INTO runs(machine_id, campaign, kind, axis, settings_json, capture_path, "
+      "software_version, started_unix_ms, status, note, owner_pid) "
+      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, 'running', ?, ?)");
+  if (r.machine_id > 0) sqlite3_bind_int64(s.get(), 1, r.machine_id);
+  bind_text(s.get(), 2, r.campaign);
+  bind_text(s.get(), 3, r.kind);
+  bind_text(s.get(), 4, r.axis);
+  bind_text(s.get(), 5, r.settings_json);
+  bind_text(s.get(), 6, r.capture_path);
+  bind_text(s.get(), 7, r.software_version);
+  sqlite3_bind_int64(s.get(), 8, r.started_unix_ms ? r.started_unix_ms : unix_ms_now());
+  bind_text(s.get(), 9, r.note);
+  sqlite3_bind_int64(s.get(), 10, ::getpid());
+  impl_->step_done(s.get(), "begin run");
+  return sqlite3_last_insert_rowid(impl_->db.get());
+}
+
+void Store::add_instrument(const InstrumentRecord& i) {
+  auto s = impl_->prepare(
+      "INSERT INTO instruments(run_id, device, driver, transport, settings_json) "
+      "VALUES(?, ?, ?, ?, ?)");
+  sqlite3_bind_int64(s.get(), 1, i.run_id);
+  sqlite3_bind_int(s.get(), 2, i.device);
+  bind_text(s.get(), 3, i.driver);
+  bind_text(s.get(), 4, i.transport);
+  bind_text(s.get(), 5, i.settings_json);
+  impl_->step_done(s.get(), fmt::format("add instrument {} to run {}", i.device, i.run_id));
+}
+
+void Store::finish_run(std::int64_t run_id, RunStatus status, std::string_view note) {
+  auto s = impl_->prepare(
+      "UPDATE runs SET status = ?, ended_unix_ms = ?, note = CASE WHEN ? = '' THEN note ELSE ? "
+      "END WHERE id = ?");
+  bind_text(s.get(), 1, to_string(status));
+  sqlite3_bind_int64(s.get(), 2, unix_ms_now());
+  bind_text(s.get(), 3, note);
+  bind_text(s.get(), 4, note);
+  sqlite3_bind_int64(s.get(), 5, run_id);
+  impl_->step_done(s.get(), fmt::format("finish run {}", run_id));
+  if (sqlite3_changes(impl_->db.get()) == 0)
+    throw StoreError(fmt::format("{}: no run {}", impl_->path.string(), run_id));
+}
+
+void Store::set_capture_path(std::int64_t run_id, std::string_view path) {
+  auto s = impl_->prepare("UPDATE runs SET capture_path = ? WHERE id = ?");
+  bind_text(s.get(), 1, path);
+  sqlite3_bind_int64(s.get(), 2, run_id);
+  impl_->step_done(s.get(), "set capture path");
+}
+
+namespace {
+constexpr const char* kRunColumns =
+    "SELECT id, IFNULL(machine_id, 0), campaign, kind, axis, settings_json, capture_path, "
+    "software_version, started_unix_ms, ended_unix_ms, status, note FROM runs";
+
+RunRecord read_run(sqlite3_stmt* s) {
+  RunRecord r;
+  r.id = sqlite3_column_int64(s, 0);
+  r.machine_id = sqlite3_column_int64(s, 1);
+  r.campaign = column_text(s, 2);
+  r.kind = column_text(s, 3);
+  r.axis = column_text(s, 4);
+  r.settings_json = column_text(s, 5);
+  r.capture_path = column_text(s, 6);
+  r.software_version = column_text(s, 7);
+  r.started_unix_ms = sqlite3_column_int64(s, 8);
+  if (sqlite3_column_type(s, 9) != SQLITE_NULL) r.ended_unix_ms = sqlite3_column_int64(s, 9);
+  r.status = status_from(column_text(s, 10));
+  r.note = column_text(s, 11);
+  return r;
+}
+}  // namespace
+
+std::vector<RunRecord> Store::runs() const {
+  auto s = impl_->prepare((std::string(kRunColumns) + " ORDER BY id").c_str());
+  std::vector<RunRecord> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) out.push_back(read_run(s.get()));
+  return out;
+}
+
+std::optional<RunRecord> Store::run(std::int64_t run_id) const {
+  auto s = impl_->prepare((std::string(kRunColumns) + " WHERE id = ?").c_str());
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
+  return read_run(s.get());
+}
+
+std::vector<InstrumentRecord> Store::instruments(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT run_id, device, driver, transport, settings_json FROM instruments WHERE run_id = ? "
+      "ORDER BY device");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  std::vector<InstrumentRecord> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW)
+    out.push_back({sqlite3_column_int64(s.get(), 0), sqlite3_column_int(s.get(), 1),
+                   column_text(s.get(), 2), column_text(s.get(), 3), column_text(s.get(), 4)});
+  return out;
+}
+
+void Store::append_readings(std::int64_t run_id, std::span<const RawReading> readings) {
+  if (readings.empty()) return;
+  // Group by (device, channel, quantity), keeping each group's order: one chunk per group.
+  using Key = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;
+  std::map<Key, std::vector<const RawReading*>> groups;
+  for (const auto& r : readings) groups[{r.device, r.channel, r.quantity}].push_back(&r);
+  Impl::Transaction tx(*impl_);
+  auto s = impl_->prepare(
+      "INSERT INTO reading_chunks(run_id, device, channel, quantity, first_ns, last_ns, count, "
+      "data) VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
+  std::vector<unsigned char> blob;
+  for (const auto& [key, group] : groups) {
+    blob.resize(group.size() * kRecordBytes);
+    unsigned char* p = blob.data();
+    std::int64_t first = group.front()->time_ns, last = first;
+    for (const RawReading* r : group) {
+      std::memcpy(p, &r->time_ns, 8);
+      p[8] = r->status;
+      std::memcpy(p + 9, &r->value, 8);
+      p += kRecordBytes;
+      first = std::min(first, r->time_ns);
+      last = std::max(last, r->time_ns);
+    }
+    sqlite3_bind_int64(s.get(), 1, run_id);
+    sqlite3_bind_int(s.get(), 2, std::get<0>(key));
+    sqlite3_bind_int(s.get(), 3, std::get<1>(key));
+    sqlite3_bind_int(s.get(), 4, std::get<2>(key));
+    sqlite3_bind_int64(s.get(), 5, first);
+    sqlite3_bind_int64(s.get(), 6, last);
+    sqlite3_bind_int64(s.get(), 7, static_cast<std::int64_t>(group.size()));
+    sqlite3_bind_blob64(s.get(), 8, blob.data(), blob.size(), SQLITE_STATIC);
+    impl_->step_done(s.get(), fmt::format("store {} readings of run {}", group.size(), run_id));
+  }
+  tx.commit();
+}
+
+std::vector<RawReading> Store::readings(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT device, channel, quantity, count, data FROM reading_chunks WHERE run_id = ? "
+      "ORDER BY id");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  std::vector<RawReading> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    const auto count = static_cast<std::size_t>(sqlite3_column_int64(s.get(), 3));
+    const auto* p = static_cast<const unsigned char*>(sqlite3_column_blob(s.get(), 4));
+    const auto bytes = static_cast<std::size_t>(sqlite3_column_bytes(s.get(), 4));
+    if (bytes != count * kRecordBytes)
+      throw StoreError(fmt::format("{}: run {}: a reading chunk holds {} bytes for {} readings",
+                                   impl_->path.string(), run_id, bytes, count));
+    for (std::size_t i = 0; i < count; ++i, p += kRecordBytes) {
+      RawReading r;
+      std::memcpy(&r.time_ns, p, 8);
+      r.status = p[8];
+      std::memcpy(&r.value, p + 9, 8);
+      r.device = static_cast<std::uint16_t>(sqlite3_column_int(s.get(), 0));
+      r.channel = static_cast<std::uint8_t>(sqlite3_column_int(s.get(), 1));
+      r.quantity = static_cast<std::uint8_t>(sqlite3_column_int(s.get(), 2));
+      out.push_back(r);
+    }
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const RawReading& a, const RawReading& b) { return a.time_ns < b.time_ns; });
+  return out;
+}
+
+std::int64_t Store::reading_count(std::int64_t run_id) const {
+  auto s = impl_->prepare("SELECT IFNULL(SUM(count), 0) FROM reading_chunks WHERE run_id = ?");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  sqlite3_step(s.get());
+  return sqlite3_column_int64(s.get(), 0);
+}
+
+void Store::Impl::insert_targets(std::span<const CapturedTarget> targets) {
+  Impl& m = *this;
+  auto s = m.prepare(
+      "INSERT INTO captured_targets(run_id, target_index, run_number, direction, nominal_mm, "
+      "time_ns, raw_m, deviation_um, refractive_index, material_temperature_degc) "
+      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  for (const auto& t : targets) {
+    sqlite3_bind_int64(s.get(), 1, t.run_id);
+    sqlite3_bind_int(s.get(), 2, t.target_index);
+    sqlite3_bind_int(s.get(), 3, t.run_number);
+    bind_text(s.get(), 4, std::string_view(&t.direction, 1));
+    sqlite3_bind_double(s.get(), 5, t.nominal_mm);
+    sqlite3_bind_int64(s.get(), 6, t.time_ns);
+    sqlite3_bind_double(s.get(), 7, t.raw_m);
+    sqlite3_bind_double(s.get(), 8, t.deviation_um);
+    sqlite3_bind_double(s.get(), 9, t.refractive_index);
+    sqlite3_bind_double(s.get(), 10, t.material_temperature_degc);
+    m.step_done(s.get(), fmt::format("store target {} run {} {} of run {}", t.target_index,
+                                     t.run_number, t.direction, t.run_id));
+  }
+}
+
+void Store::add_targets(std::span<const CapturedTarget> targets) {
+  Impl::Transaction tx(*impl_);
+  impl_->insert_targets(targets);
+  tx.commit();
+}
+
+void Store::replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets) {
+  Impl::Transaction tx(*impl_);
+  auto s = impl_->prepare("DELETE FROM captured_targets WHERE run_id = ?");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  impl_->step_done(s.get(), "delete targets");
+  impl_->insert_targets(targets);
+  tx.commit();
+}
+
+std::vector<CapturedTarget> Store::targets(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT run_id, target_index, run_number, direction, nominal_mm, time_ns, raw_m, "
+      "deviation_um, refractive_index, material_temperature_degc FROM captured_targets "
+      "WHERE run_id = ? ORDER BY time_ns, run_number, target_index");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  std::vector<CapturedTarget> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    CapturedTarget t;
+    t.run_id = sqlite3_column_int64(s.get(), 0);
+    t.target_index = sqlite3_column_int(s.get(), 1);
+    t.run_number = sqlite3_column_int(s.get(), 2);
+    t.direction = column_text(s.get(), 3).front();
+    t.nominal_mm = sqlite3_column_double(s.get(), 4);
+    t.time_ns = sqlite3_column_int64(s.get(), 5);
+    t.raw_m = sqlite3_column_double(s.get(), 6);
+    t.deviation_um = sqlite3_column_double(s.get(), 7);
+    t.refractive_index = sqlite3_column_double(s.get(), 8);
+    t.material_temperature_degc = sqlite3_column_double(s.get(), 9);
+    out.push_back(t);
+  }
+  return out;
+}
+
+void Store::add_result(const ResultRecord& r) {
+  auto s = impl_->prepare(
+      "INSERT INTO results(run_id, standard, json, created_unix_ms) VALUES(?, ?, ?, ?)");
+  sqlite3_bind_int64(s.get(), 1, r.run_id);
+  bind_text(s.get(), 2, r.standard);
+  bind_text(s.get(), 3, r.json);
+  sqlite3_bind_int64(s.get(), 4, r.created_unix_ms ? r.created_unix_ms : unix_ms_now());
+  impl_->step_done(s.get(), fmt::format("store result of run {}", r.run_id));
+}
+
+std::vector<ResultRecord> Store::results(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT run_id, standard, json, created_unix_ms FROM results WHERE run_id = ? ORDER BY id");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  std::vector<ResultRecord> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW)
+    out.push_back({sqlite3_column_int64(s.get(), 0), column_text(s.get(), 1),
+                   column_text(s.get(), 2), sqlite3_column_int64(s.get(), 3)});
+  return out;
+}
+
+}  // namespace cal::storage

@@ -1,0 +1,214 @@
+// The run store: round trips are bit-exact, a crashed writer (a real child process killed
+// with SIGKILL) leaves a readable database with every committed batch and the run marked
+// incomplete, and bad files and a full disk give errors that name the file.
+#include "cal/storage/store.hpp"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+namespace {
+
+namespace fs = std::filesystem;
+using cal::storage::RawReading;
+using cal::storage::RunStatus;
+using cal::storage::Store;
+using cal::storage::StoreError;
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("caldaq-store-" + std::to_string(::getpid()) + "-" +
+                                        std::to_string(std::random_device{}()));
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+std::vector<RawReading> make_readings(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<RawReading> v(n);
+  for (std::size_t i = 0; i < n; ++i)
+    v[i] = {.time_ns = static_cast<std::int64_t>(i) * 100'000,
+            .device = static_cast<std::uint16_t>(i % 3),
+            .channel = static_cast<std::uint8_t>(i % 2),
+            .quantity = static_cast<std::uint8_t>(i % 3 == 2 ? 2 : 0),
+            .status = static_cast<std::uint8_t>(i % 17 == 0),
+            .value = u(rng) * 1e-3};
+  return v;
+}
+
+TEST(Store, CreatesTheSchemaAndReopensIt) {
+  TempDir dir;
+  const auto file = dir.path / "site.sqlite";
+  { EXPECT_EQ(Store(file).version(), cal::storage::schema_version); }
+  Store again(file);
+  EXPECT_EQ(again.version(), cal::storage::schema_version);
+  EXPECT_TRUE(again.runs().empty());
+}
+
+TEST(Store, RunLifeCycleAndBitExactReadings) {
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  const auto machine = store.add_machine({.name = "VMC-1", .description = "3-axis mill"});
+  EXPECT_EQ(store.machine_by_name("VMC-1")->id, machine);
+  EXPECT_FALSE(store.machine_by_name("nope"));
+  const auto run = store.begin_run({.machine_id = machine,
+                                    .kind = "linear",
+                                    .axis = "X",
+                                    .settings_json = R"({"targets": 11})"});
+  store.add_instrument(
+      {.run_id = run, .device = 1, .driver = "ids3010", .transport = "tcp 127.0.0.1:9090"});
+  const auto readings = make_readings(10'000, 7);
+  // Two batches, split unevenly, must come back as one time-ordered stream.
+  store.append_readings(run, std::span(readings).first(3333));
+  store.append_readings(run, std::span(readings).subspan(3333));
+  EXPECT_EQ(store.reading_count(run), 10'000);
+  const auto back = store.readings(run);
+  ASSERT_EQ(back.size(), readings.size());
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].time_ns, readings[i].time_ns);
+    EXPECT_EQ(back[i].device, readings[i].device);
+    EXPECT_EQ(back[i].channel, readings[i].channel);
+    EXPECT_EQ(back[i].quantity, readings[i].quantity);
+    EXPECT_EQ(back[i].status, readings[i].status);
+    EXPECT_EQ(std::memcmp(&back[i].value, &readings[i].value, 8), 0) << i;  // bit-exact
+  }
+  EXPECT_EQ(store.run(run)->status, RunStatus::running);
+  store.add_targets(std::vector<cal::storage::CapturedTarget>{{.run_id = run,
+                                                               .target_index = 0,
+                                                               .run_number = 1,
+                                                               .direction = '+',
+                                                               .nominal_mm = 0.0,
+                                                               .deviation_um = 1.5},
+                                                              {.run_id = run,
+                                                               .target_index = 1,
+                                                               .run_number = 1,
+                                                               .direction = '+',
+                                                               .nominal_mm = 50.0,
+                                                               .time_ns = 10,
+                                                               .deviation_um = -2.25}});
+  store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  store.finish_run(run, RunStatus::complete);
+  const auto r = store.run(run);
+  EXPECT_EQ(r->status, RunStatus::complete);
+  EXPECT_TRUE(r->ended_unix_ms.has_value());
+  EXPECT_EQ(r->settings_json, R"({"targets": 11})");
+  EXPECT_EQ(store.instruments(run).at(0).driver, "ids3010");
+  EXPECT_EQ(store.targets(run).at(1).deviation_um, -2.25);
+  EXPECT_EQ(store.results(run).at(0).standard, "ISO 230-2:2014");
+  EXPECT_THROW(store.finish_run(run + 100, RunStatus::complete), StoreError);
+}
+
+// The child writes batches of 1000 readings and tells the parent after each commit; the
+// parent kills it with SIGKILL mid-stream. Every reported batch must be there, and the count
+// a whole number of batches (a transaction is all or nothing).
+TEST(Store, KillDashNineLeavesEveryCommittedBatchAndAnIncompleteRun) {
+  TempDir dir;
+  const auto file = dir.path / "site.sqlite";
+  { Store create(file); }
+  int pipe_fd[2];
+  ASSERT_EQ(::pipe(pipe_fd), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(pipe_fd[0]);
+    Store store(file);
+    const auto run = store.begin_run({.kind = "linear", .axis = "X"});
+    const auto batch = make_readings(1000, 1);
+    for (int i = 0;; ++i) {
+      store.append_readings(run, batch);
+      const char one = 1;
+      if (::write(pipe_fd[1], &one, 1) != 1) ::_exit(3);
+    }
+  }
+  ::close(pipe_fd[1]);
+  int committed = 0;
+  char c = 0;
+  while (committed < 25 && ::read(pipe_fd[0], &c, 1) == 1) ++committed;
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  // Batches committed after the 25th report may also be there, but never part of one.
+  while (::read(pipe_fd[0], &c, 1) == 1) ++committed;
+  ::close(pipe_fd[0]);
+
+  Store store(file);
+  const auto runs = store.runs();
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].status, RunStatus::incomplete);
+  EXPECT_NE(runs[0].note.find("interrupted"), std::string::npos);
+  const auto n = store.reading_count(runs[0].id);
+  EXPECT_GE(n, 1000 * committed);
+  EXPECT_LE(n, 1000 * (committed + 1));
+  EXPECT_EQ(n % 1000, 0);
+  EXPECT_EQ(static_cast<std::int64_t>(store.readings(runs[0].id).size()), n);
+}
+
+TEST(Store, AFullDiskFailsTheBatchAndKeepsWhatWasStored) {
+  TempDir dir;
+  Store store(dir.path / "small.sqlite", {.max_pages = 64});  // 64 x 4 KiB
+  const auto run = store.begin_run({.kind = "linear"});
+  const auto batch = make_readings(1000, 3);  // 17 kB per batch
+  int stored = 0;
+  try {
+    for (; stored < 100; ++stored) store.append_readings(run, batch);
+    FAIL() << "the cap was never reached";
+  } catch (const StoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("small.sqlite"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("full"), std::string::npos) << e.what();
+  }
+  EXPECT_GT(stored, 0);
+  EXPECT_EQ(store.reading_count(run), 1000 * stored);
+}
+
+TEST(Store, RefusesAFileThatIsNotADatabase) {
+  TempDir dir;
+  const auto file = dir.path / "notes.txt";
+  std::ofstream(file) << "this is a text file, not a database, and long enough to have a header";
+  try {
+    Store store(file);
+    FAIL() << "opened";
+  } catch (const StoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("notes.txt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not a"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Store, RefusesANewerSchema) {
+  TempDir dir;
+  const auto file = dir.path / "future.sqlite";
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  sqlite3_exec(db, "PRAGMA user_version=99", nullptr, nullptr, nullptr);
+  sqlite3_close(db);
+  try {
+    Store store(file);
+    FAIL() << "opened";
+  } catch (const StoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("schema version 99 is newer"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Store, NamesAPathThatCannotBeCreated) {
+  try {
+    Store store("/nonexistent-dir/caldaq/site.sqlite");
+    FAIL() << "opened";
+  } catch (const StoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/caldaq/site.sqlite"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
