@@ -1,0 +1,2 @@
+#pragma once
+// Placeholder: arrives with the service issue.
