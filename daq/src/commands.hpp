@@ -7,6 +7,8 @@ namespace daq {
 void add_env_command(CLI::App& app);
 void add_iso230_2_commands(CLI::App& app, CLI::App& analyse);
 void add_demo_command(CLI::App& app);
+// devices: attached and reachable instruments
+void add_devices_command(CLI::App& app);
 // analyse straightness, analyse squareness
 void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 // analyse circle

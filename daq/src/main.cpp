@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   daq::add_env_command(app);
   daq::add_iso230_2_commands(app, *analyse);
   daq::add_demo_command(app);
+  daq::add_devices_command(app);
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);

@@ -44,5 +44,11 @@ check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --i
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 check demo 0 "Simulated truth vs measured" -- "$DAQ" demo
 
+# Device discovery: the listing works without hardware, probes name what failed.
+check devices_json 0 '"schema": "caldaq.devices.v1"' -- "$DAQ" devices --json
+check devices_probe_refused 0 "tcp 127.0.0.1:1: cannot connect" -- "$DAQ" devices --probe 127.0.0.1:1
+check devices_probe_not_serial 0 "serial /dev/null 4800 7E1: not a serial port" -- "$DAQ" devices --probe-serial /dev/null
+check devices_probe_bad_settings 2 "parity 'X'" -- "$DAQ" devices --probe-serial /dev/null@9600\ 8X1
+
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]
