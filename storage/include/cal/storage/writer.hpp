@@ -1,0 +1,58 @@
+#pragma once
+// Batched writes off the event loop: the loop appends readings to the current batch (cheap,
+// no I/O); full batches go through a bounded queue to a writer thread that owns the Store's
+// connection and commits each batch in one transaction. When the queue is full the loop
+// waits (back-pressure) rather than dropping: no reading is ever silently lost, and the time
+// spent waiting is measured and reported as overload.
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "cal/storage/store.hpp"
+
+namespace cal::storage {
+
+struct WriterOptions {
+  std::size_t batch_readings = 16384;        // a batch is committed when this full, or
+  std::chrono::milliseconds batch_age{200};  // when its oldest reading is this old
+  std::size_t max_queued_batches = 8;        // then the producer waits
+  StoreOptions store;                        // for the writer's own connection
+};
+
+struct WriterStats {
+  std::uint64_t readings_in = 0;
+  std::uint64_t readings_committed = 0;
+  std::uint64_t batches_committed = 0;
+  std::size_t max_queue_depth = 0;
+  std::uint64_t overload_waits = 0;           // times the producer found the queue full
+  std::chrono::nanoseconds overload_time{0};  // total time it waited
+};
+
+class BatchWriter {
+ public:
+  // Opens its own connection to the store at `path` on the writer thread. Errors (e.g. a full
+  // disk) are reported through on_error once, from the writer thread; later pushes then throw
+  // StoreError so the run stops instead of pretending to record.
+  BatchWriter(std::filesystem::path path, std::int64_t run_id, WriterOptions options = {},
+              std::function<void(const std::string&)> on_error = {});
+  ~BatchWriter();  // flushes and joins
+  BatchWriter(const BatchWriter&) = delete;
+  BatchWriter& operator=(const BatchWriter&) = delete;
+
+  void push(const RawReading& r);
+  // Hands the current batch over (even if small), e.g. from a periodic timer on the loop.
+  void flush_if_old(std::chrono::steady_clock::time_point now);
+  // Hands over the current batch and waits until everything pushed so far is committed.
+  void flush();
+  // Call from the producer's thread (the event loop).
+  WriterStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cal::storage

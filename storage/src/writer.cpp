@@ -1,0 +1,155 @@
+#include "cal/storage/writer.hpp"
+
+#include <algorithm>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+namespace cal::storage {
+
+struct BatchWriter::Impl {
+  std::filesystem::path path;
+  std::int64_t run_id;
+  WriterOptions options;
+  std::function<void(const std::string&)> on_error;
+
+  std::vector<RawReading> current;  // producer side only
+  std::uint64_t pushed = 0;         // producer side only
+  std::chrono::steady_clock::time_point current_started{};
+
+  mutable std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<std::vector<RawReading>> queue;
+  bool closing = false;
+  bool busy = false;  // the writer holds a batch it has not committed yet
+  std::string error;
+  WriterStats stats;
+  std::thread thread;
+
+  void run() {
+    std::optional<Store> store;
+    try {
+      store.emplace(path, options.store);
+    } catch (const std::exception& e) {
+      return fail(e.what());
+    }
+    for (;;) {
+      std::vector<RawReading> batch;
+      {
+        std::unique_lock lock(mutex);
+        changed.wait(lock, [&] { return closing || !queue.empty(); });
+        if (queue.empty()) return;
+        batch = std::move(queue.front());
+        queue.pop_front();
+        busy = true;
+      }
+      changed.notify_all();  // a producer waiting for room may go on
+      try {
+        store->append_readings(run_id, batch);
+      } catch (const std::exception& e) {
+        return fail(e.what());
+      }
+      std::lock_guard lock(mutex);
+      busy = false;
+      stats.readings_committed += batch.size();
+      ++stats.batches_committed;
+      changed.notify_all();
+    }
+  }
+
+  void fail(const std::string& what) {
+    {
+      std::lock_guard lock(mutex);
+      error = what;
+      busy = false;
+      queue.clear();
+    }
+    changed.notify_all();
+    if (on_error) on_error(what);
+  }
+
+  void check_error() const {
+    std::lock_guard lock(mutex);
+    if (!error.empty()) throw StoreError(error);
+  }
+
+  void hand_over() {
+    if (current.empty()) return;
+    std::unique_lock lock(mutex);
+    if (queue.size() >= options.max_queued_batches) {
+      ++stats.overload_waits;
+      const auto start = std::chrono::steady_clock::now();
+      changed.wait(lock,
+                   [&] { return queue.size() < options.max_queued_batches || !error.empty(); });
+      stats.overload_time += std::chrono::steady_clock::now() - start;
+    }
+    if (!error.empty()) throw StoreError(error);
+    queue.push_back(std::move(current));
+    stats.max_queue_depth = std::max(stats.max_queue_depth, queue.size());
+    current = {};
+    current.reserve(options.batch_readings);
+    lock.unlock();
+    changed.notify_all();
+  }
+};
+
+BatchWriter::BatchWriter(std::filesystem::path path, std::int64_t run_id, WriterOptions options,
+                         std::function<void(const std::string&)> on_error)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->path = std::move(path);
+  impl_->run_id = run_id;
+  impl_->options = options;
+  impl_->on_error = std::move(on_error);
+  impl_->current.reserve(options.batch_readings);
+  impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });
+}
+
+BatchWriter::~BatchWriter() {
+  try {
+    impl_->hand_over();
+  } catch (const std::exception&) {
+    // already reported through on_error; nothing more can be stored
+  }
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->closing = true;
+  }
+  impl_->changed.notify_all();
+  impl_->thread.join();
+}
+
+void BatchWriter::push(const RawReading& r) {
+  Impl& m = *impl_;
+  if (m.current.empty()) {
+    m.check_error();
+    m.current_started = std::chrono::steady_clock::now();
+  }
+  m.current.push_back(r);
+  ++m.pushed;  // producer-side only; stats() is called from the producer's thread
+  if (m.current.size() >= m.options.batch_readings) m.hand_over();
+}
+
+void BatchWriter::flush_if_old(std::chrono::steady_clock::time_point now) {
+  if (!impl_->current.empty() && now - impl_->current_started >= impl_->options.batch_age)
+    impl_->hand_over();
+}
+
+void BatchWriter::flush() {
+  Impl& m = *impl_;
+  m.hand_over();
+  std::unique_lock lock(m.mutex);
+  m.changed.wait(lock, [&] { return (m.queue.empty() && !m.busy) || !m.error.empty(); });
+  if (!m.error.empty()) throw StoreError(m.error);
+}
+
+WriterStats BatchWriter::stats() const {
+  std::lock_guard lock(impl_->mutex);
+  WriterStats s = impl_->stats;
+  s.readings_in = impl_->pushed;
+  return s;
+}
+
+}  // namespace cal::storage
