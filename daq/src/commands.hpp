@@ -9,6 +9,8 @@ void add_iso230_2_commands(CLI::App& app, CLI::App& analyse);
 void add_demo_command(CLI::App& app);
 // devices: attached and reachable instruments
 void add_devices_command(CLI::App& app);
+// runs, show, export: stored runs
+void add_runs_commands(CLI::App& app);
 // analyse straightness, analyse squareness
 void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 // analyse circle

@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "cal/analysis/error.hpp"
+#include "cal/storage/store.hpp"
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   daq::add_iso230_2_commands(app, *analyse);
   daq::add_demo_command(app);
   daq::add_devices_command(app);
+  daq::add_runs_commands(app);
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);
@@ -33,6 +35,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const cal::InputError& e) {
+    std::fprintf(stderr, "daq: error: %s\n", e.what());
+    return 2;
+  } catch (const cal::storage::StoreError& e) {
     std::fprintf(stderr, "daq: error: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
