@@ -405,7 +405,9 @@ struct GaugeTwin::Impl : std::enable_shared_from_this<GaugeTwin::Impl> {
 
   std::string line_at(double t) {
     world.advance_to(t);
-    const double value = ballbar_length_mm(world.state(), config.pivot_mm) - config.zero_length_mm;
+    const double value =
+        config.value ? config.value(world)
+                     : ballbar_length_mm(world.state(), config.pivot_mm) - config.zero_length_mm;
     return fmt::format("{:+0{}.{}f}\r\n", value, config.decimals + 5, config.decimals);
   }
 

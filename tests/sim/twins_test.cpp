@@ -167,4 +167,17 @@ TEST(GaugeTwin, AnswersItsRequestInPolledMode) {
   EXPECT_EQ(twin.lines_sent(), 1u);
 }
 
+TEST(GaugeTwin, CarriesAnyScalarAsAThermometer) {
+  // A thermometer on the structure: the machine temperature, 20 degC at t = 0.
+  Bench b;
+  sim::GaugeTwin twin(b.io, b.world, b.clock,
+                      {.continuous = false, .decimals = 3, .value = [](const sim::World& w) {
+                         return w.state().machine_temperature_degc;
+                       }});
+  auto port = t::make_serial(b.io, {.device = twin.device_path()});
+  b.open(*port);
+  port->write(bytes("?\r"));
+  EXPECT_EQ(b.next_line(), "+020.000\r\n");
+}
+
 }  // namespace

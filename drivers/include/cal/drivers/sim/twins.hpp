@@ -100,7 +100,8 @@ class Ptu300Twin {
   std::shared_ptr<Impl> impl_;
 };
 
-// --- A digital length gauge (the transducer of a telescoping ballbar) on a pty ---------------
+// --- A line-oriented serial sensor on a pty: by default the length gauge of a telescoping ---
+// --- ballbar; with a value function, any scalar (a material thermometer) -------------------
 
 struct GaugeTwinConfig {
   Vec3 pivot_mm{};                 // centre of the table ball, workpiece coordinates
@@ -109,6 +110,9 @@ struct GaugeTwinConfig {
   bool continuous = true;          // false: one reading per request line
   std::string request = "?";       // the request line (without its CR) in polled mode
   int decimals = 5;                // "+000.12345": 10 nm resolution
+  // What the line carries; empty: the ballbar, length(tool, pivot) - zero_length_mm. Another
+  // function makes a serial thermometer on the structure, e.g. the machine temperature.
+  std::function<double(const World&)> value;
 };
 
 class GaugeTwin {
