@@ -2,6 +2,8 @@
 // the WebSocket pushing only the latest state at its period.
 #include "server.hpp"
 
+#include "assets.hpp"
+
 #include <gtest/gtest.h>
 
 #include <boost/asio.hpp>
@@ -115,6 +117,19 @@ TEST(LiveServer, WebSocketGetsTheLatestStateNotAQueue) {
   }
   EXPECT_LE(messages, 4);
   ws.close(websocket::close_code::normal);
+}
+
+TEST(LivePage, IsOneSelfContainedDocument) {
+  // The chart library and its style are inlined: no external script, style or font, so the
+  // page works on a machine-shop PC without internet.
+  const std::string page = cal::daq::web::live_page();
+  EXPECT_EQ(page.find("/*UPLOT_JS*/"), std::string::npos);
+  EXPECT_EQ(page.find("/*UPLOT_CSS*/"), std::string::npos);
+  EXPECT_NE(page.find("uPlot"), std::string::npos);
+  EXPECT_GT(page.size(), 50'000u);  // uPlot.iife.min.js alone is 51 kB
+  EXPECT_EQ(page.find("<script src="), std::string::npos);
+  EXPECT_EQ(page.find("<link"), std::string::npos);
+  EXPECT_NE(page.find("new WebSocket"), std::string::npos);
 }
 
 }  // namespace

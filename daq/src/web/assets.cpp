@@ -1,0 +1,25 @@
+#include "assets.hpp"
+
+#include <string_view>
+
+namespace caldaq_assets {
+extern const std::string_view live_html;
+extern const std::string_view uplot_js;
+extern const std::string_view uplot_css;
+}  // namespace caldaq_assets
+
+namespace cal::daq::web {
+namespace {
+void replace(std::string& s, std::string_view marker, std::string_view with) {
+  if (const auto at = s.find(marker); at != std::string::npos) s.replace(at, marker.size(), with);
+}
+}  // namespace
+
+std::string live_page() {
+  std::string page(caldaq_assets::live_html);
+  replace(page, "/*UPLOT_CSS*/", caldaq_assets::uplot_css);
+  replace(page, "/*UPLOT_JS*/", caldaq_assets::uplot_js);
+  return page;
+}
+
+}  // namespace cal::daq::web
