@@ -1,0 +1,88 @@
+#pragma once
+// Machine and campaign configuration files (TOML): the machine, the instruments and how to
+// reach them, the environment policy, and the tests. Documented with a full example in
+// docs/config.md. Every error names the file, the line and column, and the key.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cal::daq {
+
+struct DeviceConfig {
+  std::string id;         // the table name, e.g. "laser" in [devices.laser]
+  std::string driver;     // ids3010 | ptu300 | gauge | temper | halsampler | shdr
+  std::string transport;  // "tcp HOST:PORT", "serial DEVICE BAUD FRAME [FLOW]", "hid VID:PID"
+  double poll_s = 0.0;    // 0: the driver's default
+  std::vector<int> axes;  // ids3010: interferometer axes to read (0..2)
+  std::string role;       // laser | air | material | ballbar | position (what the run uses it for)
+};
+
+enum class StalePolicy { fallback, stop };
+
+struct EnvironmentConfig {
+  std::string equation = "ciddor";  // ciddor | edlen | shop-floor
+  double stale_after_s = 10.0;
+  StalePolicy on_stale = StalePolicy::stop;
+  double fallback_temperature_degc = 20.0;
+  double fallback_pressure_pa = 101325.0;
+  double fallback_humidity_pct = 50.0;
+  double fallback_material_degc = 20.0;
+  double co2_umol_per_mol = 450.0;
+  double wavelength_nm = 632.991;
+  double expansion_ppm_per_k = 11.5;  // of the measured part of the machine (scale, spindle)
+};
+
+struct TriggerConfig {
+  double tolerance_um = 1.0;  // readings within +/- this band ...
+  double dwell_s = 1.5;       // ... for this long count as a stop
+  double window_mm = 0.5;     // and within this of an expected target
+};
+
+struct LinearTestConfig {
+  std::string axis = "X";
+  double first_mm = 0.0, last_mm = 500.0;
+  std::optional<double> interval_mm;
+  std::optional<int> count;
+  double random_fraction = 0.0;
+  std::string cycle = "linear";  // linear | pendulum | pilgrim-step
+  int runs = 5;
+  bool bidirectional = true;
+  double overrun_mm = 5.0;
+  double feed_mm_per_min = 2000.0;
+  double dwell_s = 4.0;
+  double dead_path_mm = 0.0;
+  std::string standard = "iso230-2:2014";
+};
+
+struct CircleTestConfig {
+  std::string plane = "XY";
+  double radius_mm = 100.0;
+  double feed_mm_per_min = 1000.0;
+  double sample_rate_hz = 1000.0;
+  double overshoot_deg = 45.0;
+  std::vector<double> centre_mm{0.0, 0.0, 0.0};
+  double calibrated_radius_mm = 0.0;  // 0: the nominal
+};
+
+struct Config {
+  std::filesystem::path source;
+  std::string machine_name = "machine";
+  std::string machine_description;
+  std::string campaign;
+  std::vector<DeviceConfig> devices;
+  EnvironmentConfig environment;
+  TriggerConfig trigger;
+  std::optional<LinearTestConfig> linear;
+  std::optional<CircleTestConfig> circle;
+  // The device with a role, or nullptr.
+  const DeviceConfig* device_for(std::string_view role) const;
+};
+
+// Throws cal::InputError: "FILE:LINE:COL: key 'devices.laser.driver': unknown driver 'foo'
+// (expected one of ...)", or TOML syntax errors with their position.
+Config load_config(const std::filesystem::path& file);
+Config parse_config(std::string_view toml_text, const std::filesystem::path& source_name);
+
+}  // namespace cal::daq
