@@ -1,2 +1,76 @@
 #pragma once
-// Placeholder: arrives with the service issue.
+// Environmental compensation of laser readings (pipeline stage; plain C++, no I/O, no clock:
+// time comes with each sample). Air temperature, pressure and humidity and the material
+// temperatures arrive as timestamped samples (about 1 Hz); a laser reading (up to 10 kHz) is
+// compensated with the environment linearly interpolated to its own time, or, when it is
+// newer than the newest sample, with the newest sample held (and flagged: `held`).
+//
+// A sensor that has sent nothing for `stale_after_s` (or never) is stale. The configured
+// policy either continues on the configured fallback value, which is recorded in every
+// compensated result (`fallback_air`, `fallback_material`) and announced once per episode,
+// or asks the run to stop (`must_stop`). Formulas: cal::air (refractive index),
+// cal::comp (normalisation to 20 degC); docs/acquisition.md.
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/air.hpp"
+#include "cal/daq/config.hpp"
+
+namespace cal::daq {
+
+enum class AirQuantity { temperature_degc, pressure_pa, humidity_pct };
+
+struct Compensated {
+  std::int64_t time_ns = 0;
+  double raw_m = 0.0;     // as the laser gave it (vacuum wavelength)
+  double length_m = 0.0;  // raw / n, normalised to 20 degC
+  double n = 1.0;         // refractive index used
+  double air_temperature_degc = 0.0, pressure_pa = 0.0, humidity_pct = 0.0;
+  double material_degc = 20.0;
+  double factor_ppm = 0.0;    // (length / raw - 1) 1e6
+  bool fallback_air = false;  // a fallback value was used for an air quantity
+  bool fallback_material = false;
+  bool held = false;  // the reading is newer than the newest sample: held value
+};
+
+struct EnvHealth {
+  bool must_stop = false;             // a sensor is stale and the policy is stop
+  std::vector<std::string> messages;  // new events since the last check (stale, fallback, back)
+};
+
+class EnvStage {
+ public:
+  // material_sensors: how many material thermometers there are (their mean is used; a
+  // disabled one is simply not fed). Throws cal::InputError for an unknown equation.
+  EnvStage(const EnvironmentConfig& config, int material_sensors);
+
+  void add_air(std::int64_t time_ns, AirQuantity q, double value);
+  void add_material(std::int64_t time_ns, int sensor, double value_degc);
+
+  // Stale detection at time t (call it for each laser reading or on a timer).
+  EnvHealth check(std::int64_t time_ns);
+  Compensated compensate(std::int64_t time_ns, double raw_m) const;
+
+ private:
+  struct Series {
+    std::string name;
+    double fallback = 0.0;
+    std::deque<std::pair<std::int64_t, double>> samples;  // time-ordered, bounded
+    bool stale_reported = false;
+    // The value at t: interpolated, held (newest), or nullopt (none / stale).
+    std::optional<double> at(std::int64_t t, std::int64_t stale_ns, bool& held) const;
+  };
+  void add(Series& s, std::int64_t t, double v);
+  void check_series(Series& s, std::int64_t t, EnvHealth& h);
+
+  EnvironmentConfig config_;
+  air::Equation equation_;
+  std::int64_t stale_ns_;
+  Series air_[3];
+  std::vector<Series> material_;
+};
+
+}  // namespace cal::daq
