@@ -1,2 +1,69 @@
 #pragma once
-// Placeholder: arrives with the service issue.
+// The ISO 230-2 sequencer (pipeline stage): it knows the expected stops of the plan (its
+// measure moves, in order) and labels each captured stop with its target, run and direction.
+// It never guesses: a stop that matches a later expected stop of the same pass (or the first
+// of the next pass) marks the ones between as missed; a stop near no expected target, or approached
+// from the wrong side, is extra and ignored; a stop matching a target reported missed earlier is
+// taken as out of order, with that said. Every such event is reported with the positions involved.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/iso230_2.hpp"
+#include "cal/analysis/iso230_2_targets.hpp"
+#include "cal/daq/trigger.hpp"
+
+namespace cal::daq {
+
+struct ExpectedStop {
+  int target_index = 0;  // 1-based
+  int run = 1;
+  iso230_2::Direction direction = iso230_2::Direction::up;
+  double position_mm = 0.0;
+  bool captured = false;
+  bool missed = false;
+  double deviation_um = 0.0;
+  std::int64_t time_ns = 0;
+};
+
+struct SequenceEvent {
+  enum class Kind { captured, missed, extra, wrong_direction, out_of_order, complete };
+  Kind kind = Kind::captured;
+  std::size_t stop = 0;  // index into stops() (not meaningful for extra)
+  std::string message;
+};
+
+struct Progress {
+  int run = 0, runs = 0;        // run k of n (of the next expected stop)
+  int target = 0, targets = 0;  // target i of m
+  iso230_2::Direction direction = iso230_2::Direction::up;
+  std::size_t captured = 0, expected = 0;
+  std::optional<double> next_position_mm;
+};
+
+class Sequencer {
+ public:
+  // window_mm: how far a stop may be from its target (the trigger's window).
+  Sequencer(const iso230_2::Plan& plan, double window_mm);
+
+  std::optional<double> next_expected_mm() const;
+  std::vector<SequenceEvent> on_capture(const Capture& c);
+  bool complete() const { return next_ >= stops_.size(); }
+  Progress progress() const;
+  const std::vector<ExpectedStop>& stops() const { return stops_; }
+  // The captured stops as the ISO 230-2 evaluation wants them.
+  std::vector<iso230_2::Measurement> measurements() const;
+
+ private:
+  bool fits(const ExpectedStop& e, const Capture& c) const;
+  std::string describe(const ExpectedStop& e) const;
+  std::size_t pass_end(std::size_t i) const;
+
+  std::vector<ExpectedStop> stops_;
+  double window_mm_;
+  int runs_ = 0, targets_ = 0;
+  std::size_t next_ = 0;
+};
+
+}  // namespace cal::daq
