@@ -1,0 +1,310 @@
+// ISO 230-2 acquisition (see linear_run.hpp).
+#include "linear_run.hpp"
+
+#include <fmt/format.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <nlohmann/json.hpp>
+
+#include "cal/daq/env_stage.hpp"
+#include "cal/daq/trigger.hpp"
+#include "cal/storage/store.hpp"
+#include "cal/storage/writer.hpp"
+#include "iso230_2_output.hpp"
+
+namespace daq {
+
+using cal::drivers::Quantity;
+using cal::drivers::Reading;
+using cal::drivers::ReadingStatus;
+using nlohmann::json;
+
+std::string to_json_text(const LiveState& s) {
+  json j{{"schema", "caldaq.live.v1"},
+         {"time_s", s.time_s},
+         {"state", s.state},
+         {"message", s.message},
+         {"reading", {{"value", s.deviation_um}, {"unit", "µm"}, {"decimals", 2},
+                      {"position_mm", s.position_mm}}},
+         {"air", {{"temperature_degc", s.air_temperature_degc}, {"pressure_pa", s.pressure_pa},
+                  {"humidity_pct", s.humidity_pct}, {"n", s.n}}},
+         {"material_degc", s.material_degc},
+         {"factor_ppm", s.factor_ppm},
+         {"fallback", s.fallback}};
+  if (s.progress.next_position_mm) {
+    j["target"] = {{"index", s.progress.target}, {"count", s.progress.targets},
+                   {"nominal_mm", *s.progress.next_position_mm}};
+    j["run"] = {{"number", s.progress.run}, {"count", s.progress.runs},
+                {"direction", s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down"}};
+  }
+  j["captured"] = s.progress.captured;
+  j["expected"] = s.progress.expected;
+  return j.dump();
+}
+
+namespace {
+
+cal::iso230_2::Plan make_plan(const cal::daq::LinearTestConfig& l) {
+  return cal::iso230_2::make_plan(
+      {.first_mm = l.first_mm, .last_mm = l.last_mm, .interval_mm = l.interval_mm,
+       .count = l.count, .random_fraction = l.random_fraction},
+      {.cycle = cal::iso230_2::cycle_from_string(l.cycle), .bidirectional = l.bidirectional,
+       .runs = l.runs, .overrun_mm = l.overrun_mm});
+}
+
+json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, double datum_mm) {
+  const auto& l = *c.linear;
+  return {{"machine", c.machine_name},
+          {"axis", l.axis},
+          {"targets_mm", plan.targets_mm},
+          {"cycle", l.cycle},
+          {"runs", l.runs},
+          {"bidirectional", l.bidirectional},
+          {"feed_mm_per_min", l.feed_mm_per_min},
+          {"dwell_s", l.dwell_s},
+          {"datum_mm", datum_mm},
+          {"standard", l.standard},
+          {"environment",
+           {{"equation", c.environment.equation},
+            {"expansion_ppm_per_k", c.environment.expansion_ppm_per_k},
+            {"stale_after_s", c.environment.stale_after_s},
+            {"on_stale", c.environment.on_stale == cal::daq::StalePolicy::stop ? "stop" : "fallback"},
+            {"co2_umol_per_mol", c.environment.co2_umol_per_mol},
+            {"wavelength_nm", c.environment.wavelength_nm}}},
+          {"trigger",
+           {{"tolerance_um", c.trigger.tolerance_um},
+            {"dwell_s", c.trigger.dwell_s},
+            {"window_mm", c.trigger.window_mm}}}};
+}
+
+}  // namespace
+
+struct LinearRun::Impl {
+  boost::asio::io_context& io;
+  LinearRunSetup setup;
+  cal::iso230_2::Plan plan;
+  cal::daq::EnvStage env;
+  cal::daq::StabilityTrigger trigger;
+  cal::daq::Sequencer sequencer;
+  std::optional<cal::storage::Store> store;
+  std::unique_ptr<cal::storage::BatchWriter> writer;
+  boost::asio::steady_timer timer;
+  LinearRunOutcome outcome;
+  LiveState live;
+  bool running = false, done = false;
+  std::int64_t first_ns = -1;
+
+  Impl(boost::asio::io_context& i, LinearRunSetup s)
+      : io(i),
+        setup(std::move(s)),
+        plan(make_plan(*setup.config.linear)),
+        env(setup.config.environment, static_cast<int>(setup.material.size())),
+        trigger({.tolerance_um = setup.config.trigger.tolerance_um,
+                 .dwell_s = setup.config.trigger.dwell_s,
+                 .window_mm = setup.config.trigger.window_mm}),
+        sequencer(plan, setup.config.trigger.window_mm),
+        timer(i) {}
+
+  void event(const std::string& text) {
+    live.message = text;
+    if (setup.on_event) setup.on_event(text);
+  }
+
+  void start() {
+    store.emplace(setup.database);
+    const auto& c = setup.config;
+    std::int64_t machine = 0;
+    if (auto m = store->machine_by_name(c.machine_name)) machine = m->id;
+    else machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
+    outcome.run_id = store->begin_run({.machine_id = machine,
+                                       .campaign = c.campaign,
+                                       .kind = "linear",
+                                       .axis = c.linear->axis,
+                                       .settings_json = settings_json(c, plan, setup.datum_mm).dump(),
+                                       .capture_path = setup.capture_path,
+                                       .software_version = setup.software_version});
+    auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view driver) {
+      store->add_instrument({.run_id = outcome.run_id, .device = device, .driver = std::string(driver),
+                             .transport = i.describe()});
+    };
+    add(0, *setup.laser, "laser");
+    add(1, *setup.air, "air");
+    for (std::size_t k = 0; k < setup.material.size(); ++k) add(static_cast<int>(2 + k), *setup.material[k], "material");
+    writer = std::make_unique<cal::storage::BatchWriter>(
+        setup.database, outcome.run_id, cal::storage::WriterOptions{},
+        [this](const std::string& e) {
+          boost::asio::post(io, [this, e] { abort("storage failed: " + e); });
+        });
+    running = true;
+    live.state = "waiting";
+    trigger.expect(sequencer.next_expected_mm());
+    start_instrument(*setup.laser, 0);
+    start_instrument(*setup.air, 1);
+    for (std::size_t k = 0; k < setup.material.size(); ++k)
+      start_instrument(*setup.material[k], static_cast<std::uint16_t>(2 + k));
+    event(fmt::format("run {}: {} targets x {} runs, {} stops expected", outcome.run_id,
+                      plan.targets_mm.size(), c.linear->runs, sequencer.stops().size()));
+    tick();
+  }
+
+  void start_instrument(cal::drivers::Instrument& inst, std::uint16_t device) {
+    inst.start({.reading = [this, device](const Reading& r) { on_reading(r, device); },
+                .state = [this, &inst](cal::drivers::InstrumentState s, std::string_view why) {
+                  if (s == cal::drivers::InstrumentState::closed && running)
+                    abort(fmt::format("{} closed: {}", inst.describe(), why));
+                  else if (s == cal::drivers::InstrumentState::reconnecting)
+                    event(fmt::format("{}: reconnecting ({})", inst.describe(), why));
+                },
+                .gap = [this, &inst](const cal::drivers::Gap& g) {
+                  event(fmt::format("{}: no data for {:.2f} s ({})", inst.describe(),
+                                    static_cast<double>(g.end_ns - g.start_ns) * 1e-9, g.reason));
+                },
+                .codec_error = {}});
+  }
+
+  void on_reading(Reading r, std::uint16_t device) {
+    if (!running) return;
+    r.device = device;
+    ++outcome.readings;
+    writer->push({.time_ns = r.time_ns, .device = r.device, .channel = r.channel,
+                  .quantity = static_cast<std::uint8_t>(r.quantity),
+                  .status = static_cast<std::uint8_t>(r.status), .value = r.value});
+    if (setup.on_reading) setup.on_reading(r);
+    if (first_ns < 0) first_ns = r.time_ns;
+    switch (r.quantity) {
+      case Quantity::air_temperature_degc:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
+      case Quantity::air_pressure_pa:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa, r.value);
+      case Quantity::air_humidity_pct:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value);
+      case Quantity::material_temperature_degc:
+      case Quantity::length_m:  // a line thermometer reports through the gauge codec
+        if (device >= 2) env.add_material(r.time_ns, device - 2, r.value);
+        return;
+      case Quantity::displacement_m:
+        if (device == 0 && r.channel == setup.laser_channel) return on_laser(r);
+        return;
+      default:
+        return;
+    }
+  }
+
+  void on_laser(const Reading& r) {
+    const auto health = env.check(r.time_ns);
+    for (const auto& m : health.messages) event(m);
+    if (health.must_stop) return abort(live.message);
+    const auto c = env.compensate(r.time_ns, r.value);
+    const double position_mm = setup.datum_mm + c.length_m * 1e3;
+    live.time_s = static_cast<double>(r.time_ns - first_ns) * 1e-9;
+    live.position_mm = position_mm;
+    live.air_temperature_degc = c.air_temperature_degc;
+    live.pressure_pa = c.pressure_pa;
+    live.humidity_pct = c.humidity_pct;
+    live.n = c.n;
+    live.material_degc = c.material_degc;
+    live.factor_ppm = c.factor_ppm;
+    live.fallback = c.fallback_air || c.fallback_material;
+    if (const auto next = sequencer.next_expected_mm()) live.deviation_um = (position_mm - *next) * 1e3;
+    live.state = "measuring";
+    const bool valid = r.status == ReadingStatus::ok;
+    if (auto cap = trigger.add(r.time_ns, position_mm, valid)) on_capture(*cap, c);
+  }
+
+  void on_capture(const cal::daq::Capture& cap, const cal::daq::Compensated& c) {
+    for (const auto& e : sequencer.on_capture(cap)) {
+      event(e.message);
+      using Kind = cal::daq::SequenceEvent::Kind;
+      if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
+        const auto& s = sequencer.stops()[e.stop];
+        const cal::storage::CapturedTarget t{
+            .run_id = outcome.run_id, .target_index = s.target_index - 1, .run_number = s.run,
+            .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+            .nominal_mm = s.position_mm, .time_ns = cap.end_ns,
+            .raw_m = (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
+            .deviation_um = s.deviation_um, .refractive_index = c.n,
+            .material_temperature_degc = c.material_degc};
+        store->add_targets(std::span(&t, 1));
+      }
+    }
+    trigger.expect(sequencer.next_expected_mm());
+    if (sequencer.complete()) finish();
+  }
+
+  void finish() {
+    running = false;
+    writer->flush();
+    const auto& l = *setup.config.linear;
+    const auto standard = cal::iso230_2::standard_from_string(l.standard);
+    outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
+    store->add_result({.run_id = outcome.run_id,
+                       .standard = std::string(outcome.evaluation->standard.title),
+                       .json = to_json(*outcome.evaluation).dump()});
+    store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    outcome.complete = true;
+    live.state = "complete";
+    end();
+  }
+
+  void abort(const std::string& reason) {
+    if (done) return;
+    running = false;
+    outcome.reason = reason;
+    live.state = "aborted";
+    live.message = reason;
+    try {
+      if (writer) writer->flush();
+    } catch (const std::exception& e) {
+      outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
+    }
+    if (store) store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    end();
+  }
+
+  void end() {
+    done = true;
+    timer.cancel();
+    setup.laser->stop();
+    setup.air->stop();
+    for (auto& m : setup.material) m->stop();
+    writer.reset();
+    publish();
+  }
+
+  void publish() {
+    live.progress = sequencer.progress();
+    if (setup.on_live) setup.on_live(live);
+  }
+
+  // 10 Hz: live state, and the writer's age-based flush so a slow stream is still committed.
+  void tick() {
+    if (done) return;
+    publish();
+    if (writer) writer->flush_if_old(std::chrono::steady_clock::now());
+    timer.expires_after(std::chrono::milliseconds(100));
+    timer.async_wait([this](const boost::system::error_code& ec) {
+      if (!ec) tick();
+    });
+  }
+};
+
+LinearRun::LinearRun(boost::asio::io_context& io, LinearRunSetup setup)
+    : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
+LinearRun::~LinearRun() {
+  if (!impl_->done && impl_->running) impl_->abort("stopped");
+}
+void LinearRun::start() { impl_->start(); }
+void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }
+void LinearRun::manual_capture() {
+  if (auto c = impl_->trigger.capture_now()) {
+    const auto comp = impl_->env.compensate(c->end_ns, 0.1);
+    impl_->on_capture(*c, comp);
+  }
+}
+bool LinearRun::finished() const { return impl_->done; }
+const LinearRunOutcome& LinearRun::outcome() const { return impl_->outcome; }
+const cal::iso230_2::Plan& LinearRun::plan() const { return impl_->plan; }
+
+}  // namespace daq

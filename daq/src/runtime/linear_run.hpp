@@ -1,0 +1,77 @@
+#pragma once
+// One ISO 230-2 linear positioning run, acquired: the laser, air and material instruments
+// feed the pipeline stages on one io_context (environment compensation -> stability trigger
+// -> sequencer), every raw reading goes to the run store through the batch writer, captured
+// targets are stored as they come, and at the end the run is evaluated by its standard and
+// the result stored. A stale sensor under the stop policy, or an instrument that gives up,
+// aborts the run with the reason recorded; what was stored stays.
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "cal/analysis/iso230_2.hpp"
+#include "cal/daq/config.hpp"
+#include "cal/daq/sequencer.hpp"
+#include "cal/drivers/instrument.hpp"
+
+namespace boost::asio {
+class io_context;
+}
+
+namespace daq {
+
+struct LiveState {
+  double time_s = 0.0;
+  std::string state;    // "waiting", "measuring", "complete", "aborted"
+  std::string message;  // the last event
+  double position_mm = 0.0;
+  double deviation_um = 0.0;  // from the next expected target
+  cal::daq::Progress progress;
+  double air_temperature_degc = 0.0, pressure_pa = 0.0, humidity_pct = 0.0, n = 1.0;
+  double material_degc = 20.0, factor_ppm = 0.0;
+  bool fallback = false;
+};
+std::string to_json_text(const LiveState& s);  // schema caldaq.live.v1 (docs/cli.md)
+
+struct LinearRunSetup {
+  cal::daq::Config config;  // needs config.linear
+  std::filesystem::path database;
+  std::unique_ptr<cal::drivers::Instrument> laser;
+  std::unique_ptr<cal::drivers::Instrument> air;
+  std::vector<std::unique_ptr<cal::drivers::Instrument>> material;  // one per sensor
+  int laser_channel = 0;
+  double datum_mm = 0.0;  // axis position where the laser reads 0
+  std::string software_version = "daq 0.1.0";
+  std::string capture_path;
+  std::function<void(const LiveState&)> on_live;        // about 10 Hz
+  std::function<void(const std::string&)> on_event;     // captures, missed stops, stale sensors
+  std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
+};
+
+struct LinearRunOutcome {
+  std::int64_t run_id = 0;
+  bool complete = false;
+  std::string reason;  // why it stopped, when not complete
+  std::optional<cal::iso230_2::Evaluation> evaluation;
+  std::size_t readings = 0;
+};
+
+class LinearRun {
+ public:
+  LinearRun(boost::asio::io_context& io, LinearRunSetup setup);
+  ~LinearRun();
+  void start();
+  void stop(const std::string& reason);  // aborts
+  void manual_capture();                 // the operator's "capture now"
+  bool finished() const;
+  const LinearRunOutcome& outcome() const;
+  const cal::iso230_2::Plan& plan() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace daq
