@@ -139,4 +139,37 @@ TEST(Ptu300Instrument, PollsAt4800SevenEvenOneAndGivesUpOnAVanishedPort) {
       << rec.reasons.back();
 }
 
+TEST(GaugeInstrument, StreamsTheBallbarAndPollsAThermometer) {
+  boost::asio::io_context io;
+  double now_s = 0.0;
+  sim::World world = parked_at_100mm();
+  // The bar zeroed at 99.99 mm reads +0.01 mm = 1e-5 m; 1000 samples per simulated second.
+  sim::GaugeTwin bar(io, world, [&] { return now_s; }, {.zero_length_mm = 99.99});
+  sim::GaugeTwin thermo(
+      io, world, [&] { return now_s; },
+      {.continuous = false, .request = "?", .decimals = 3, .value = [](const sim::World& w) {
+         return w.state().machine_temperature_degc;
+       }});
+  auto gauge = d::make_gauge(io, t::make_serial(io, {.device = bar.device_path(), .baud = 115200}),
+                             {.device = 4});
+  auto therm = d::make_gauge(io, t::make_serial(io, {.device = thermo.device_path()}),
+                             {.device = 5, .poll_period = 10ms},
+                             {.request = "?\r",
+                              .unit = cal::drivers::codec::GaugeUnit::degc,
+                              .min_si = -40,
+                              .max_si = 150});
+  Recorder rec;
+  gauge->start(rec.events());
+  therm->start(rec.events());
+  now_s = 0.5;  // samples 0..500
+  ASSERT_TRUE(run_until(io, [&] {
+    return rec.count(d::Quantity::length_m) >= 501 &&
+           rec.count(d::Quantity::material_temperature_degc) >= 2;
+  }));
+  EXPECT_EQ(rec.count(d::Quantity::length_m), 501u);
+  EXPECT_DOUBLE_EQ(rec.last(d::Quantity::length_m)->value, 1e-5);
+  EXPECT_DOUBLE_EQ(rec.last(d::Quantity::material_temperature_degc)->value, 20.0);
+  EXPECT_EQ(rec.codec_errors, 0u);
+}
+
 }  // namespace

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <memory>
 
+#include "cal/drivers/codec/line_gauge.hpp"
 #include "cal/drivers/codec/vaisala_ptu300.hpp"
 #include "cal/drivers/instrument.hpp"
 
@@ -32,5 +33,12 @@ std::unique_ptr<Instrument> make_ids3010(boost::asio::io_context& io,
 std::unique_ptr<Instrument> make_ptu300(boost::asio::io_context& io,
                                         std::unique_ptr<transport::Transport> transport,
                                         InstrumentOptions options, codec::Ptu300Config config = {});
+
+// A line gauge (codec/line_gauge.hpp): streaming, or polled with config.request every
+// options.poll_period. Readings: length_m, or material_temperature_degc for a degC gauge
+// (a serial thermometer on the machine structure), channel 0.
+std::unique_ptr<Instrument> make_gauge(boost::asio::io_context& io,
+                                       std::unique_ptr<transport::Transport> transport,
+                                       InstrumentOptions options, codec::GaugeConfig config = {});
 
 }  // namespace cal::drivers
