@@ -1,126 +1,166 @@
-// daq demo: an analysis demonstration on a SIMULATED axis with known injected errors. Later
-// issues replace it with the whole acquisition chain (simulated machine, instrument twins,
-// storage); until then it exercises the analysis library end to end and prints the
-// simulated truth beside what the analysis recovers.
+// daq demo: the whole acquisition chain on the built-in SIMULATED shop. A simulated machine
+// with known injected errors runs the ISO 230-2 program; the real drivers read the simulated
+// IDS3010 (loopback TCP), PTU300 and material thermometer (pseudo-terminals); the pipeline
+// compensates, detects the stops, labels them, stores everything in SQLite and evaluates the
+// run; the simulated truth is printed beside the measured results.
 #include <fmt/format.h>
+#include <unistd.h>
 
-#include <cmath>
-#include <numbers>
-#include <random>
+#include <boost/asio/io_context.hpp>
+#include <cstdio>
+#include <filesystem>
 
-#include "cal/analysis/air.hpp"
-#include "cal/analysis/compensation.hpp"
 #include "cal/analysis/iso230_2.hpp"
-#include "cal/analysis/iso230_2_targets.hpp"
-#include "cal/analysis/uncertainty.hpp"
+#include "cal/daq/config.hpp"
+#include "cal/drivers/instruments.hpp"
+#include "cal/drivers/transport/transport.hpp"
 #include "commands.hpp"
 #include "iso230_2_output.hpp"
+#include "linear_run.hpp"
+#include "sim_shop.hpp"
 
 namespace daq {
 namespace {
 
-// The simulated axis: a scale error, a periodic (ball-screw lead) error, a reversal
-// (backlash) and random noise, in micrometres.
-struct SimulatedAxis {
-  double scale_um_per_m = 6.0;
-  double periodic_amplitude_um = 1.5;
-  double periodic_pitch_mm = 20.0;
-  double backlash_um = 3.0;  // up runs stop +B/2, down runs -B/2
-  double noise_sigma_um = 0.4;
+namespace t = cal::drivers::transport;
+namespace d = cal::drivers;
+using namespace std::chrono_literals;
 
-  double systematic_um(double x_mm, cal::iso230_2::Direction d) const {
-    const double half = d == cal::iso230_2::Direction::up ? backlash_um / 2 : -backlash_um / 2;
-    return scale_um_per_m * x_mm / 1000.0 +
-           periodic_amplitude_um * std::sin(2 * std::numbers::pi * x_mm / periodic_pitch_mm) + half;
-  }
+struct DemoOptions {
+  std::string db = "caldaq-demo.sqlite";
+  double speed = 60.0;
+  bool quiet = false;
 };
 
-void run_demo() {
-  fmt::print("daq demo: ISO 230-2 positioning test of a SIMULATED axis (0 .. 1000 mm)\n");
-  fmt::print("(the acquisition chain with simulated instruments arrives with later issues)\n\n");
+cal::daq::Config demo_config() {
+  cal::daq::Config c;
+  c.machine_name = "SIMULATED VMC";
+  c.machine_description = "built-in simulated 3-axis machine with injected errors";
+  c.campaign = "demo (simulated)";
+  c.environment.equation = "ciddor";
+  c.environment.expansion_ppm_per_k = 11.5;
+  c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5};
+  c.linear = cal::daq::LinearTestConfig{.axis = "X",
+                                        .first_mm = 0,
+                                        .last_mm = 500,
+                                        .interval_mm = 50.0,
+                                        .random_fraction = 0.2,
+                                        .runs = 5,
+                                        .overrun_mm = 3,
+                                        .feed_mm_per_min = 6000,
+                                        .dwell_s = 3};
+  return c;
+}
 
-  // 1. Air and material on a simulated shop floor.
-  cal::air::Conditions air;
-  air.temperature_degc = 22.5;
-  air.pressure_pa = 100500.0;
-  air.humidity = cal::air::Humidity::relative_pct(45.0);
-  const auto n = cal::air::refractive_index(air, cal::air::Equation::ciddor);
-  const double material_degc = 21.2, alpha = 11.5e-6;
-  const auto f = cal::comp::combined_factor(n.n, alpha, material_degc);
-  fmt::print("Air 22.5 degC, 1005.00 hPa, 45 %RH: n (Ciddor) = {:.9f}\n", n.n);
-  fmt::print(
-      "Material 21.2 degC, alpha 11.5 ppm/K: compensation {:+.3f} ppm (air {:+.3f}, "
-      "material {:+.3f})\n",
-      f.total_ppm, f.air_ppm, f.material_ppm);
-  fmt::print("An uncompensated reading at 1000 mm would be off by {:.1f} um.\n\n",
-             -f.total_ppm * 1e-3 * 1000.0);
+// One line of progress, rewritten in place on a terminal.
+void progress_line(const LiveState& s, bool tty) {
+  if (!s.progress.next_position_mm) return;
+  const auto line = fmt::format(
+      "run {} of {} {}  target {:2} of {}  {:+9.2f} um  air {:.2f} degC {:.0f} Pa {:.0f} %RH  "
+      "material {:.2f} degC  {:+.2f} ppm",
+      s.progress.run, s.progress.runs,
+      s.progress.direction == cal::iso230_2::Direction::up ? "up  " : "down", s.progress.target,
+      s.progress.targets, s.deviation_um, s.air_temperature_degc, s.pressure_pa, s.humidity_pct,
+      s.material_degc, s.factor_ppm);
+  if (tty) fmt::print("\r{}", line), std::fflush(stdout);
+}
 
-  // 2. The test plan: 11 targets with random spacing, the standard linear cycle, 5 runs.
-  cal::iso230_2::TargetSpec ts{.first_mm = 0,
-                               .last_mm = 1000,
-                               .interval_mm = 100.0,
-                               .count = std::nullopt,
-                               .random_fraction = 0.25,
-                               .seed = 2026};
-  const auto plan = cal::iso230_2::make_plan(ts, {});
-  fmt::print("Plan: {} targets, {} moves (linear cycle, 5 runs each way)\n\n",
-             plan.targets_mm.size(), plan.moves.size());
-
-  // 3. "Measure": the simulated truth plus noise at every measure move.
-  const SimulatedAxis axis;
-  std::mt19937_64 rng(42);
-  std::normal_distribution<double> noise(0.0, axis.noise_sigma_um);
-  std::vector<cal::iso230_2::Measurement> data;
-  for (const auto& m : plan.moves) {
-    if (m.kind != cal::iso230_2::MoveKind::measure) continue;
-    data.push_back({m.position_mm, m.run, m.direction,
-                    axis.systematic_um(m.position_mm, m.direction) + noise(rng)});
+void print_comparison(const cal::iso230_2::Evaluation& measured,
+                      const cal::iso230_2::Evaluation& truth, const ShopTruth& t) {
+  fmt::print("\nSimulated truth vs measured ({}):\n", measured.standard.title);
+  fmt::print("  {:<8} {:>10} {:>10} {:>9}\n", "", "truth um", "measured", "diff");
+  for (const char* key : {"B_mean", "E_up", "E_down", "E_bi", "M"}) {
+    const double a = truth.at(key).value_um, b = measured.at(key).value_um;
+    fmt::print("  {:<8} {:10.3f} {:10.3f} {:+9.3f}\n", measured.at(key).symbol, a, b, b - a);
   }
-  const auto e = cal::iso230_2::evaluate(data, cal::iso230_2::Standard::iso230_2_2014);
-  print(e);
-
-  // 4. Truth beside result.
-  double up_max = -1e9, up_min = 1e9, all_max = -1e9, all_min = 1e9;
-  for (double t : plan.targets_mm) {
-    for (auto d : {cal::iso230_2::Direction::up, cal::iso230_2::Direction::down}) {
-      const double v = axis.systematic_um(t, d);
-      all_max = std::max(all_max, v);
-      all_min = std::min(all_min, v);
-      if (d == cal::iso230_2::Direction::up) {
-        up_max = std::max(up_max, v);
-        up_min = std::min(up_min, v);
-      }
-    }
-  }
-  fmt::print("\nSimulated truth vs measured (noise sigma {:.1f} um, 5 runs):\n",
-             axis.noise_sigma_um);
-  fmt::print("  B   truth {:7.3f} um   measured {:7.3f} um\n", axis.backlash_um,
-             e.at("B_mean").value_um);
-  fmt::print("  E↑  truth {:7.3f} um   measured {:7.3f} um\n", up_max - up_min,
-             e.at("E_up").value_um);
-  fmt::print("  E   truth {:7.3f} um   measured {:7.3f} um\n", all_max - all_min,
-             e.at("E_bi").value_um);
   fmt::print(
-      "  R↑  truth {:7.3f} um   measured {:7.3f} um  (4 sigma; the max over targets of 4 s)\n",
-      4 * axis.noise_sigma_um, e.at("R_up").value_um);
+      "  {:<8} {:>10} {:10.3f}   (repeatability: 4 s of the stop means; the noise-free\n"
+      "  {:<8} {:>10} {:>10}    truth has none, the {:.2f} um noise is averaged over each stop)\n",
+      measured.at("R_up").symbol, "-", measured.at("R_up").value_um, "", "", "", t.noise_um);
+  fmt::print(
+      "  Injected: scale {:+.1f} um/m, backlash {:.1f} um, pitch error {:.1f} um / {:.0f} mm,\n"
+      "  noise {:.2f} um; machine at {:.1f} degC ({:.1f} ppm/K), so an uncompensated reading\n"
+      "  would have been off by about {:+.0f} ppm (air) and {:+.0f} ppm (material).\n",
+      t.scale_um_per_m, t.backlash_um, t.cyclic_amplitude_um, t.cyclic_period_mm, t.noise_um,
+      t.machine_degc, t.expansion_ppm_per_k, 270.0, t.expansion_ppm_per_k * (t.machine_degc - 20));
+}
 
-  // 5. Measurement uncertainty of this set-up.
-  cal::unc::PositioningSetup s;
-  s.length_m = 1.0;
-  s.air = air;
-  s.material_degc = material_degc;
-  s.environmental_variation_um = 0.5;
-  s.misalignment_offset_mm = 0.5;
-  s.dead_path_m = 0.1;
-  fmt::print("\n");
-  print(cal::unc::positioning_budget(s), s.length_m);
+int run_demo(const DemoOptions& o) {
+  const bool tty = !o.quiet && ::isatty(STDOUT_FILENO);
+  boost::asio::io_context io;
+  SimulatedShop shop(io, ShopTruth{}, o.speed);
+  const auto config = demo_config();
+  fmt::print("daq demo: ISO 230-2 test of the X axis of a SIMULATED machine (0 .. 500 mm)\n");
+  fmt::print("  laser: simulated IDS3010 on tcp 127.0.0.1:{}\n", shop.laser_port());
+  fmt::print("  air: simulated PTU300 on {} (4800 7E1)\n", shop.air_device());
+  fmt::print("  material: simulated serial thermometer on {}\n", shop.material_device());
+  fmt::print("  simulated time runs {}x faster than real time\n\n", o.speed);
+
+  const auto clock = shop.clock_ns();
+  const auto poll = [&](double sim_s) {
+    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / o.speed * 1e6));
+  };
+  LinearRunSetup setup;
+  setup.config = config;
+  setup.database = o.db;
+  setup.laser = d::make_ids3010(
+      io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
+      {.name = "laser (simulated IDS3010)", .poll_period = poll(0.05), .clock = clock},
+      {.environment_period = 1000ms});
+  setup.air = d::make_ptu300(
+      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
+      {.name = "air (simulated PTU300)", .poll_period = poll(1.0), .clock = clock});
+  setup.material.push_back(d::make_gauge(
+      io, t::make_serial(io, {.device = shop.material_device(), .baud = 9600}),
+      {.name = "material (simulated thermometer)", .poll_period = poll(1.0), .clock = clock},
+      {.request = "?\r",
+       .unit = cal::drivers::codec::GaugeUnit::degc,
+       .min_si = -40,
+       .max_si = 150}));
+  setup.on_live = [tty](const LiveState& s) { progress_line(s, tty); };
+  setup.on_event = [tty, &o](const std::string& e) {
+    if (o.quiet) return;
+    if (tty) fmt::print("\r\033[K");
+    fmt::print("  {}\n", e);
+  };
+  LinearRun run(io, std::move(setup));
+  run.start();
+  shop.run_linear(run.plan(), config.linear->feed_mm_per_min, config.linear->dwell_s);
+  const auto limit = std::chrono::steady_clock::now() +
+                     std::chrono::duration<double>(shop.program_end_s() / o.speed + 20.0);
+  while (!run.finished() && std::chrono::steady_clock::now() < limit) io.run_for(50ms);
+  if (!run.finished()) run.stop("the simulated program ended without all stops captured");
+  if (tty) fmt::print("\r\033[K");
+  const auto& out = run.outcome();
+  fmt::print("\nrun {} stored in {} ({} readings)\n", out.run_id,
+             std::filesystem::absolute(o.db).string(), out.readings);
+  if (!out.complete) {
+    fmt::print(stderr, "daq demo: the run did not complete: {}\n", out.reason);
+    return 1;
+  }
+  print(*out.evaluation);
+  const auto truth =
+      cal::iso230_2::evaluate(shop.true_measurements(run.plan()), out.evaluation->standard.id);
+  print_comparison(*out.evaluation, truth, shop.truth());
+  fmt::print("\nSee it again: daq runs --db {0}; daq show {1} --db {0}; daq export {1} --db {0}\n",
+             o.db, out.run_id);
+  return 0;
 }
 
 }  // namespace
 
 void add_demo_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("demo", "Run the demonstration on a simulated axis");
-  cmd->callback([] { run_demo(); });
+  auto o = std::make_shared<DemoOptions>();
+  auto* cmd = app.add_subcommand(
+      "demo", "Run the whole chain on the built-in SIMULATED machine and instrument twins");
+  cmd->add_option("--db", o->db, "Run database for the demo runs")->capture_default_str();
+  cmd->add_option("--speed", o->speed, "Simulated time per real time")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 200.0));
+  cmd->add_flag("--quiet", o->quiet, "Print only the results");
+  cmd->callback([o] {
+    if (const int rc = run_demo(*o); rc != 0) throw CLI::RuntimeError(rc);
+  });
 }
 
 }  // namespace daq

@@ -42,7 +42,13 @@ check targets 0 "121 moves" -- "$DAQ" targets --first 0 --last 1000 --interval 1
 check targets_json 0 '"schema": "caldaq.plan.v1"' -- "$DAQ" targets --first 0 --last 100 --count 6 --json
 check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --interval 30
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
-check demo 0 "Simulated truth vs measured" -- "$DAQ" demo
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/demo.sqlite"
+check demo_stored 0 "complete" -- "$DAQ" runs --db "$TMP/demo.sqlite"
+check demo_export 0 "^time_ns,device,channel,quantity,status,value" -- "$DAQ" export 1 --db "$TMP/demo.sqlite"
+check demo_targets 0 "^1,\\+,1,0," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"
+check show_missing 2 "no run 7" -- "$DAQ" show 7 --db "$TMP/demo.sqlite"
 
 # Device discovery: the listing works without hardware, probes name what failed.
 check devices_json 0 '"schema": "caldaq.devices.v1"' -- "$DAQ" devices --json

@@ -26,18 +26,27 @@ std::string to_json_text(const LiveState& s) {
          {"time_s", s.time_s},
          {"state", s.state},
          {"message", s.message},
-         {"reading", {{"value", s.deviation_um}, {"unit", "µm"}, {"decimals", 2},
-                      {"position_mm", s.position_mm}}},
-         {"air", {{"temperature_degc", s.air_temperature_degc}, {"pressure_pa", s.pressure_pa},
-                  {"humidity_pct", s.humidity_pct}, {"n", s.n}}},
+         {"reading",
+          {{"value", s.deviation_um},
+           {"unit", "µm"},
+           {"decimals", 2},
+           {"position_mm", s.position_mm}}},
+         {"air",
+          {{"temperature_degc", s.air_temperature_degc},
+           {"pressure_pa", s.pressure_pa},
+           {"humidity_pct", s.humidity_pct},
+           {"n", s.n}}},
          {"material_degc", s.material_degc},
          {"factor_ppm", s.factor_ppm},
          {"fallback", s.fallback}};
   if (s.progress.next_position_mm) {
-    j["target"] = {{"index", s.progress.target}, {"count", s.progress.targets},
+    j["target"] = {{"index", s.progress.target},
+                   {"count", s.progress.targets},
                    {"nominal_mm", *s.progress.next_position_mm}};
-    j["run"] = {{"number", s.progress.run}, {"count", s.progress.runs},
-                {"direction", s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down"}};
+    j["run"] = {
+        {"number", s.progress.run},
+        {"count", s.progress.runs},
+        {"direction", s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down"}};
   }
   j["captured"] = s.progress.captured;
   j["expected"] = s.progress.expected;
@@ -47,36 +56,41 @@ std::string to_json_text(const LiveState& s) {
 namespace {
 
 cal::iso230_2::Plan make_plan(const cal::daq::LinearTestConfig& l) {
-  return cal::iso230_2::make_plan(
-      {.first_mm = l.first_mm, .last_mm = l.last_mm, .interval_mm = l.interval_mm,
-       .count = l.count, .random_fraction = l.random_fraction},
-      {.cycle = cal::iso230_2::cycle_from_string(l.cycle), .bidirectional = l.bidirectional,
-       .runs = l.runs, .overrun_mm = l.overrun_mm});
+  return cal::iso230_2::make_plan({.first_mm = l.first_mm,
+                                   .last_mm = l.last_mm,
+                                   .interval_mm = l.interval_mm,
+                                   .count = l.count,
+                                   .random_fraction = l.random_fraction},
+                                  {.cycle = cal::iso230_2::cycle_from_string(l.cycle),
+                                   .bidirectional = l.bidirectional,
+                                   .runs = l.runs,
+                                   .overrun_mm = l.overrun_mm});
 }
 
 json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, double datum_mm) {
   const auto& l = *c.linear;
-  return {{"machine", c.machine_name},
-          {"axis", l.axis},
-          {"targets_mm", plan.targets_mm},
-          {"cycle", l.cycle},
-          {"runs", l.runs},
-          {"bidirectional", l.bidirectional},
-          {"feed_mm_per_min", l.feed_mm_per_min},
-          {"dwell_s", l.dwell_s},
-          {"datum_mm", datum_mm},
-          {"standard", l.standard},
-          {"environment",
-           {{"equation", c.environment.equation},
-            {"expansion_ppm_per_k", c.environment.expansion_ppm_per_k},
-            {"stale_after_s", c.environment.stale_after_s},
-            {"on_stale", c.environment.on_stale == cal::daq::StalePolicy::stop ? "stop" : "fallback"},
-            {"co2_umol_per_mol", c.environment.co2_umol_per_mol},
-            {"wavelength_nm", c.environment.wavelength_nm}}},
-          {"trigger",
-           {{"tolerance_um", c.trigger.tolerance_um},
-            {"dwell_s", c.trigger.dwell_s},
-            {"window_mm", c.trigger.window_mm}}}};
+  return {
+      {"machine", c.machine_name},
+      {"axis", l.axis},
+      {"targets_mm", plan.targets_mm},
+      {"cycle", l.cycle},
+      {"runs", l.runs},
+      {"bidirectional", l.bidirectional},
+      {"feed_mm_per_min", l.feed_mm_per_min},
+      {"dwell_s", l.dwell_s},
+      {"datum_mm", datum_mm},
+      {"standard", l.standard},
+      {"environment",
+       {{"equation", c.environment.equation},
+        {"expansion_ppm_per_k", c.environment.expansion_ppm_per_k},
+        {"stale_after_s", c.environment.stale_after_s},
+        {"on_stale", c.environment.on_stale == cal::daq::StalePolicy::stop ? "stop" : "fallback"},
+        {"co2_umol_per_mol", c.environment.co2_umol_per_mol},
+        {"wavelength_nm", c.environment.wavelength_nm}}},
+      {"trigger",
+       {{"tolerance_um", c.trigger.tolerance_um},
+        {"dwell_s", c.trigger.dwell_s},
+        {"window_mm", c.trigger.window_mm}}}};
 }
 
 }  // namespace
@@ -116,22 +130,28 @@ struct LinearRun::Impl {
     store.emplace(setup.database);
     const auto& c = setup.config;
     std::int64_t machine = 0;
-    if (auto m = store->machine_by_name(c.machine_name)) machine = m->id;
-    else machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
-    outcome.run_id = store->begin_run({.machine_id = machine,
-                                       .campaign = c.campaign,
-                                       .kind = "linear",
-                                       .axis = c.linear->axis,
-                                       .settings_json = settings_json(c, plan, setup.datum_mm).dump(),
-                                       .capture_path = setup.capture_path,
-                                       .software_version = setup.software_version});
+    if (auto m = store->machine_by_name(c.machine_name))
+      machine = m->id;
+    else
+      machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
+    outcome.run_id =
+        store->begin_run({.machine_id = machine,
+                          .campaign = c.campaign,
+                          .kind = "linear",
+                          .axis = c.linear->axis,
+                          .settings_json = settings_json(c, plan, setup.datum_mm).dump(),
+                          .capture_path = setup.capture_path,
+                          .software_version = setup.software_version});
     auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view driver) {
-      store->add_instrument({.run_id = outcome.run_id, .device = device, .driver = std::string(driver),
+      store->add_instrument({.run_id = outcome.run_id,
+                             .device = device,
+                             .driver = std::string(driver),
                              .transport = i.describe()});
     };
     add(0, *setup.laser, "laser");
     add(1, *setup.air, "air");
-    for (std::size_t k = 0; k < setup.material.size(); ++k) add(static_cast<int>(2 + k), *setup.material[k], "material");
+    for (std::size_t k = 0; k < setup.material.size(); ++k)
+      add(static_cast<int>(2 + k), *setup.material[k], "material");
     writer = std::make_unique<cal::storage::BatchWriter>(
         setup.database, outcome.run_id, cal::storage::WriterOptions{},
         [this](const std::string& e) {
@@ -151,16 +171,19 @@ struct LinearRun::Impl {
 
   void start_instrument(cal::drivers::Instrument& inst, std::uint16_t device) {
     inst.start({.reading = [this, device](const Reading& r) { on_reading(r, device); },
-                .state = [this, &inst](cal::drivers::InstrumentState s, std::string_view why) {
-                  if (s == cal::drivers::InstrumentState::closed && running)
-                    abort(fmt::format("{} closed: {}", inst.describe(), why));
-                  else if (s == cal::drivers::InstrumentState::reconnecting)
-                    event(fmt::format("{}: reconnecting ({})", inst.describe(), why));
-                },
-                .gap = [this, &inst](const cal::drivers::Gap& g) {
-                  event(fmt::format("{}: no data for {:.2f} s ({})", inst.describe(),
-                                    static_cast<double>(g.end_ns - g.start_ns) * 1e-9, g.reason));
-                },
+                .state =
+                    [this, &inst](cal::drivers::InstrumentState s, std::string_view why) {
+                      if (s == cal::drivers::InstrumentState::closed && running)
+                        abort(fmt::format("{} closed: {}", inst.describe(), why));
+                      else if (s == cal::drivers::InstrumentState::reconnecting)
+                        event(fmt::format("{}: reconnecting ({})", inst.describe(), why));
+                    },
+                .gap =
+                    [this, &inst](const cal::drivers::Gap& g) {
+                      event(fmt::format("{}: no data for {:.2f} s ({})", inst.describe(),
+                                        static_cast<double>(g.end_ns - g.start_ns) * 1e-9,
+                                        g.reason));
+                    },
                 .codec_error = {}});
   }
 
@@ -168,9 +191,12 @@ struct LinearRun::Impl {
     if (!running) return;
     r.device = device;
     ++outcome.readings;
-    writer->push({.time_ns = r.time_ns, .device = r.device, .channel = r.channel,
+    writer->push({.time_ns = r.time_ns,
+                  .device = r.device,
+                  .channel = r.channel,
                   .quantity = static_cast<std::uint8_t>(r.quantity),
-                  .status = static_cast<std::uint8_t>(r.status), .value = r.value});
+                  .status = static_cast<std::uint8_t>(r.status),
+                  .value = r.value});
     if (setup.on_reading) setup.on_reading(r);
     if (first_ns < 0) first_ns = r.time_ns;
     switch (r.quantity) {
@@ -207,7 +233,8 @@ struct LinearRun::Impl {
     live.material_degc = c.material_degc;
     live.factor_ppm = c.factor_ppm;
     live.fallback = c.fallback_air || c.fallback_material;
-    if (const auto next = sequencer.next_expected_mm()) live.deviation_um = (position_mm - *next) * 1e3;
+    if (const auto next = sequencer.next_expected_mm())
+      live.deviation_um = (position_mm - *next) * 1e3;
     live.state = "measuring";
     const bool valid = r.status == ReadingStatus::ok;
     if (auto cap = trigger.add(r.time_ns, position_mm, valid)) on_capture(*cap, c);
@@ -220,11 +247,15 @@ struct LinearRun::Impl {
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
         const auto& s = sequencer.stops()[e.stop];
         const cal::storage::CapturedTarget t{
-            .run_id = outcome.run_id, .target_index = s.target_index - 1, .run_number = s.run,
+            .run_id = outcome.run_id,
+            .target_index = s.target_index - 1,
+            .run_number = s.run,
             .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
-            .nominal_mm = s.position_mm, .time_ns = cap.end_ns,
+            .nominal_mm = s.position_mm,
+            .time_ns = cap.end_ns,
             .raw_m = (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
-            .deviation_um = s.deviation_um, .refractive_index = c.n,
+            .deviation_um = s.deviation_um,
+            .refractive_index = c.n,
             .material_temperature_degc = c.material_degc};
         store->add_targets(std::span(&t, 1));
       }

@@ -45,8 +45,8 @@ struct LinearRunSetup {
   double datum_mm = 0.0;  // axis position where the laser reads 0
   std::string software_version = "daq 0.1.0";
   std::string capture_path;
-  std::function<void(const LiveState&)> on_live;        // about 10 Hz
-  std::function<void(const std::string&)> on_event;     // captures, missed stops, stale sensors
+  std::function<void(const LiveState&)> on_live;     // about 10 Hz
+  std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
 };
 

@@ -13,10 +13,12 @@ StabilityTrigger::StabilityTrigger(TriggerSettings settings)
     : s_(settings),
       dwell_ns_(static_cast<std::int64_t>(settings.dwell_s * 1e9)),
       approach_ns_(static_cast<std::int64_t>(settings.approach_s * 1e9)) {
-  if (!(s_.tolerance_um > 0) || !(s_.dwell_s > 0) || !(s_.window_mm > 0) || !(s_.approach_s > 0))
+  if (!(s_.tolerance_um > 0) || !(s_.dwell_s > 0) || !(s_.window_mm > 0) || !(s_.approach_s > 0) ||
+      !(s_.average_fraction > 0 && s_.average_fraction <= 1))
     throw InputError(fmt::format(
-        "trigger: tolerance {} um, dwell {} s, window {} mm and approach {} s must all be > 0",
-        s_.tolerance_um, s_.dwell_s, s_.window_mm, s_.approach_s));
+        "trigger: tolerance {} um, dwell {} s, window {} mm and approach {} s must all be > 0, "
+        "and the averaged fraction {} in (0, 1]",
+        s_.tolerance_um, s_.dwell_s, s_.window_mm, s_.approach_s, s_.average_fraction));
 }
 
 std::optional<Capture> StabilityTrigger::add(std::int64_t t, double x_mm, bool valid) {
@@ -87,13 +89,21 @@ Capture StabilityTrigger::make_capture(bool manual) const {
   c.count = window_.size();
   c.start_ns = window_.front().first;
   c.end_ns = window_.back().first;
-  const double n = static_cast<double>(c.count);
-  c.mean_mm = sum_ / n;
-  // Sample standard deviation; the running sums are of positions of order 1 m with a spread
-  // of um, so recompute around the mean to avoid cancellation.
+  // The newest part of the window (a manual capture takes it all).
+  const double fraction = manual ? 1.0 : s_.average_fraction;
+  const auto from =
+      c.end_ns - static_cast<std::int64_t>(fraction * static_cast<double>(c.end_ns - c.start_ns));
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const auto& [t, x] : window_)
+    if (t >= from) sum += x, ++n;
+  c.count = n;
+  c.mean_mm = sum / static_cast<double>(n);
+  // Sample standard deviation, around the mean (positions of order 1 m, spreads of um).
   double ss = 0.0;
-  for (const auto& [t, x] : window_) ss += (x - c.mean_mm) * (x - c.mean_mm);
-  c.std_um = c.count > 1 ? std::sqrt(ss / (n - 1)) * 1e3 : 0.0;
+  for (const auto& [t, x] : window_)
+    if (t >= from) ss += (x - c.mean_mm) * (x - c.mean_mm);
+  c.std_um = n > 1 ? std::sqrt(ss / static_cast<double>(n - 1)) * 1e3 : 0.0;
   c.approach = approach_to(c.mean_mm, c.start_ns);
   return c;
 }

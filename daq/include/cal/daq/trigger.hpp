@@ -6,8 +6,9 @@
 // spans dwell_s, and the mean lies within window_mm of the expected target (when one is
 // given). The capture is that window: mean, standard deviation, count, start and end. The
 // trigger then disarms until the position leaves the band by 10 tolerances, so one stop gives
-// one capture however long the dwell. Signal-lost readings never count as stable (they break
-// the window).
+// one capture however long the dwell. The capture's mean and standard deviation are over the
+// newest `average_fraction` of the window (see TriggerSettings). Signal-lost readings never count
+// as stable (they break the window).
 //
 // The approach direction is taken from where the axis was before the stop: the last reading
 // more than 10 tolerances away from the stop, within the preceding `approach_s`.
@@ -26,6 +27,10 @@ struct TriggerSettings {
   double dwell_s = 1.5;
   double window_mm = 0.5;
   double approach_s = 10.0;
+  // The capture averages the newest part of the stable window only: the first readings of a
+  // stop still carry the end of the servo's settling (an exponential approach from the side
+  // of travel), which would bias up and down stops apart by a few hundredths of a um.
+  double average_fraction = 0.5;
 };
 
 enum class Approach { from_below, from_above, unknown };

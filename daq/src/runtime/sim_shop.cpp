@@ -1,0 +1,116 @@
+// The simulated shop (see sim_shop.hpp).
+#include "sim_shop.hpp"
+
+#include <boost/asio/io_context.hpp>
+#include <cmath>
+#include <numbers>
+
+#include "cal/drivers/sim/twins.hpp"
+
+namespace daq {
+
+namespace sim = cal::drivers::sim;
+
+// The machine's scales expand with its temperature; the run normalises to 20 degC with the
+// same coefficient, so the truth is the 20 degC error: E_XX, the pitch error at the driven
+// position, and the lost motion (the axis stops b/2 short of the target whichever way it
+// comes: below when approaching from below).
+double ShopTruth::deviation_um(double x_mm, cal::iso230_2::Direction d) const {
+  const double half = 0.5 * backlash_um * 1e-3 * (d == cal::iso230_2::Direction::up ? -1 : 1);
+  const double driven = x_mm + half;
+  return scale_um_per_m * driven * 1e-3 +
+         cyclic_amplitude_um * std::sin(2 * std::numbers::pi * driven / cyclic_period_mm) +
+         half * 1e3;
+}
+
+struct SimulatedShop::Impl {
+  ShopTruth truth;
+  double speed;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  sim::Clock clock;
+  sim::World world;
+  sim::IdsTwin ids;
+  sim::Ptu300Twin ptu;
+  sim::GaugeTwin material;
+  sim::GaugeTwin ballbar;
+
+  static sim::MachineConfig machine(const ShopTruth& t) {
+    sim::MachineConfig c;
+    c.geometry.axes[cal::kinematics::X].ex_um =
+        cal::kinematics::ErrorFunction::polynomial({0.0, t.scale_um_per_m * 1e-3});
+    c.servo[0] = {.kv_per_s = 30.0,
+                  .backlash_um = t.backlash_um,
+                  .cyclic_amplitude_um = t.cyclic_amplitude_um,
+                  .cyclic_period_mm = t.cyclic_period_mm,
+                  .noise_um = t.noise_um};
+    c.servo[1].kv_per_s = c.servo[2].kv_per_s = 30.0;
+    c.thermal = {.start_degc = t.machine_degc, .expansion_ppm_per_k = t.expansion_ppm_per_k};
+    c.acceleration_mm_per_s2 = 2000.0;
+    return c;
+  }
+  static sim::AirConfig air(const ShopTruth& t) {
+    sim::AirConfig a;
+    a.temperature_degc = {
+        .start = t.air_start_degc, .per_hour = t.air_drift_k_per_h, .noise_rms = 0.005};
+    a.pressure_pa = {
+        .start = t.pressure_pa, .amplitude = 30.0, .period_s = 1800.0, .noise_rms = 2.0};
+    a.humidity_pct = {.start = t.humidity_pct, .noise_rms = 0.2};
+    return a;
+  }
+
+  Impl(boost::asio::io_context& io, ShopTruth t, double s)
+      : truth(t),
+        speed(s),
+        clock([this] { return now(); }),
+        world(machine(t), air(t)),
+        ids(io, world, clock, {.machine_axis = {0, -1, -1}}),
+        ptu(io, world, clock),
+        material(io, world, clock,
+                 {.continuous = false,
+                  .request = "?",
+                  .decimals = 3,
+                  .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
+        ballbar(io, world, clock, {}) {}
+
+  double now() const {
+    return speed * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+};
+
+SimulatedShop::SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed)
+    : impl_(std::make_unique<Impl>(io, truth, speed)) {}
+SimulatedShop::~SimulatedShop() = default;
+
+const ShopTruth& SimulatedShop::truth() const { return impl_->truth; }
+double SimulatedShop::now_s() const { return impl_->now(); }
+cal::drivers::Clock SimulatedShop::clock_ns() const {
+  return [impl = impl_.get()] { return static_cast<std::int64_t>(impl->now() * 1e9); };
+}
+std::uint16_t SimulatedShop::laser_port() const { return impl_->ids.port(); }
+const std::string& SimulatedShop::air_device() const { return impl_->ptu.device_path(); }
+const std::string& SimulatedShop::material_device() const { return impl_->material.device_path(); }
+const std::string& SimulatedShop::ballbar_device() const { return impl_->ballbar.device_path(); }
+
+void SimulatedShop::run_linear(const cal::iso230_2::Plan& plan, double feed, double dwell_s) {
+  std::vector<sim::Move> program;
+  for (const auto& m : plan.moves) {
+    program.push_back(sim::Move::linear({m.position_mm, 0, 0}, feed));
+    if (m.kind == cal::iso230_2::MoveKind::measure) program.push_back(sim::Move::dwell(dwell_s));
+  }
+  impl_->world.advance_to(now_s());
+  impl_->world.machine().load(program);
+}
+
+double SimulatedShop::program_end_s() const { return impl_->world.machine().program_duration_s(); }
+
+std::vector<cal::iso230_2::Measurement> SimulatedShop::true_measurements(
+    const cal::iso230_2::Plan& p) const {
+  std::vector<cal::iso230_2::Measurement> out;
+  for (const auto& m : p.moves)
+    if (m.kind == cal::iso230_2::MoveKind::measure)
+      out.push_back({m.position_mm, m.run, m.direction,
+                     impl_->truth.deviation_um(m.position_mm, m.direction)});
+  return out;
+}
+
+}  // namespace daq

@@ -1,0 +1,63 @@
+#pragma once
+// The built-in SIMULATED machine shop for `daq demo` and the end-to-end tests: a machine with
+// known injected errors, drifting air, and the instrument twins (IDS3010 on loopback TCP,
+// PTU300 and a material thermometer and a ballbar gauge on pseudo-terminals), all on one
+// simulated time line running `speed` times faster than the wall clock. The real drivers
+// connect to the twins exactly as to hardware.
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/iso230_2.hpp"
+#include "cal/analysis/iso230_2_targets.hpp"
+#include "cal/drivers/instrument.hpp"
+#include "cal/drivers/sim/machine.hpp"
+
+namespace boost::asio {
+class io_context;
+}
+
+namespace daq {
+
+// The injected errors: the truth the measured results are compared with.
+struct ShopTruth {
+  double scale_um_per_m = 8.0;       // E_XX linear term
+  double cyclic_amplitude_um = 1.0;  // pitch error of the X drive
+  double cyclic_period_mm = 40.0;
+  double backlash_um = 4.0;
+  double noise_um = 0.15;
+  double machine_degc = 21.5;  // the scales expand: the material compensation removes it
+  double expansion_ppm_per_k = 11.5;
+  double air_start_degc = 20.6, air_drift_k_per_h = 0.6;
+  double pressure_pa = 100650.0, humidity_pct = 42.0;
+  // The deviation at 20 degC of a stop at x approached from below (up) or above.
+  double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
+};
+
+class SimulatedShop {
+ public:
+  SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed);
+  ~SimulatedShop();
+
+  const ShopTruth& truth() const;
+  double now_s() const;  // simulated time
+  cal::drivers::Clock clock_ns() const;
+  std::uint16_t laser_port() const;
+  const std::string& air_device() const;
+  const std::string& material_device() const;
+  const std::string& ballbar_device() const;
+
+  // The machine program for an ISO 230-2 plan on X: every move at the feed, a dwell at each
+  // measure move.
+  void run_linear(const cal::iso230_2::Plan& plan, double feed_mm_per_min, double dwell_s);
+  double program_end_s() const;
+  // The truth of a plan: the noise-free deviations at its stops, for the same evaluation.
+  std::vector<cal::iso230_2::Measurement> true_measurements(const cal::iso230_2::Plan& p) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace daq
