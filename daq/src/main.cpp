@@ -19,13 +19,13 @@ int main(int argc, char** argv) {
 
   CLI::App* analyse = app.add_subcommand("analyse", "Evaluate a measured test by a standard");
   analyse->alias("analyze");
-  analyse->require_subcommand(1);
 
   daq::add_env_command(app);
   daq::add_iso230_2_commands(app, *analyse);
   daq::add_demo_command(app);
   daq::add_devices_command(app);
   daq::add_runs_commands(app);
+  daq::add_stored_run_commands(app, *analyse);
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);

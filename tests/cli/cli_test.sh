@@ -48,6 +48,14 @@ check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/dem
 check demo_stored 0 "complete" -- "$DAQ" runs --db "$TMP/demo.sqlite"
 check demo_export 0 "^time_ns,device,channel,quantity,status,value" -- "$DAQ" export 1 --db "$TMP/demo.sqlite"
 check demo_targets 0 "^1,\\+,1,0," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"
+# Stored runs: another standard; recompensation with a corrected expansion coefficient. The
+# demo's machine is at 21.5 degC, the last target 500 mm: 1 ppm/K more moves it by
+# 500 mm x 1e-6 x 1.5 K = 0.75 um (plus a few nm: the stored environment is now interpolated
+# between samples where the live run held the newest).
+check analyse_stored 0 "Pa +[0-9.]+ um +position deviation" -- "$DAQ" analyse 1 --db "$TMP/demo.sqlite" -s vdi3441
+check recompensate 0 "largest change 0\\.7[4-7][0-9] um" -- "$DAQ" recompensate 1 --db "$TMP/demo.sqlite" --alpha-ppm 12.5
+check recompensate_circle 2 "no run 9" -- "$DAQ" recompensate 9 --db "$TMP/demo.sqlite"
+check analyse_needs_run 2 "give a stored RUN number" -- "$DAQ" analyse --db "$TMP/demo.sqlite"
 check show_missing 2 "no run 7" -- "$DAQ" show 7 --db "$TMP/demo.sqlite"
 
 # Device discovery: the listing works without hardware, probes name what failed.
