@@ -1,4 +1,354 @@
-// Placeholder: the capture file format arrives with the drivers issue.
+// The capture file format (see capture.hpp and docs/capture-format.md).
+#include "cal/replay/capture.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <thread>
+#include <utility>
+
 namespace cal::replay {
-int placeholder() { return 0; }
+namespace {
+
+constexpr std::array<char, 8> kMagic{'C', 'A', 'L', 'D', 'A', 'Q', 'C', 'P'};
+constexpr std::uint32_t kBlockMagic = 0x4B4C4243;  // "CBLK" little-endian
+constexpr std::uint32_t kEndMagic = 0x444E4543;    // "CEND": written by close()
+constexpr std::size_t kBlockHeader = 16;           // magic, payload length, records, crc
+constexpr std::size_t kRecordHeader = 16;          // time, device, kind, reserved, length
+constexpr std::uint32_t kMaxHeader = 1 << 20;
+constexpr std::uint32_t kMaxPayload = 64 << 20;
+
+// The table of the reflected CRC-32C polynomial, built at compile time.
+constexpr std::array<std::uint32_t, 256> make_table() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t i = 0; i < 256; ++i) {
+    std::uint32_t c = i;
+    for (int k = 0; k < 8; ++k) c = (c & 1) ? (c >> 1) ^ 0x82F63B78u : c >> 1;
+    t[i] = c;
+  }
+  return t;
+}
+constexpr auto kTable = make_table();
+
+template <class T>
+void put(std::vector<std::byte>& out, T v) {  // little-endian (the host is; static_assert)
+  static_assert(std::endian::native == std::endian::little);
+  const auto* p = reinterpret_cast<const std::byte*>(&v);
+  out.insert(out.end(), p, p + sizeof(T));
+}
+template <class T>
+T get(const std::byte* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+
+}  // namespace
+
+std::uint32_t crc32c(std::span<const std::byte> data, std::uint32_t crc) {
+  crc = ~crc;
+  for (std::byte b : data) crc = kTable[(crc ^ static_cast<std::uint8_t>(b)) & 0xff] ^ (crc >> 8);
+  return ~crc;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct CaptureWriter::Impl {
+  std::filesystem::path path;
+  WriterLimits limits;
+  std::FILE* file = nullptr;
+  std::vector<std::byte> payload;
+  std::uint32_t records = 0;
+  std::uint64_t total = 0;
+  std::size_t peak = 0;
+  std::uint64_t written = 0;
+
+  [[noreturn]] void fail(std::string_view what) const {
+    throw CaptureError(
+        fmt::format("{}: {} at byte {}: {}", path.string(), what, written, std::strerror(errno)));
+  }
+  void write(std::span<const std::byte> bytes) {
+    if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) fail("write failed");
+    written += bytes.size();
+  }
+  void write_block() {
+    if (records == 0) return;
+    std::vector<std::byte> head;
+    put<std::uint32_t>(head, kBlockMagic);
+    put<std::uint32_t>(head, static_cast<std::uint32_t>(payload.size()));
+    put<std::uint32_t>(head, records);
+    // The CRC covers the length and count as well as the payload: a damaged count would
+    // otherwise misalign every record after it.
+    put<std::uint32_t>(head, crc32c(payload, crc32c(std::span(head).subspan(4, 8))));
+    write(head);
+    write(payload);
+    payload.clear();
+    records = 0;
+  }
+};
+
+CaptureWriter::CaptureWriter(const std::filesystem::path& path, std::string_view header_json,
+                             WriterLimits limits)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  impl_->limits = limits;
+  impl_->file = std::fopen(path.c_str(), "wb");
+  if (!impl_->file)
+    throw CaptureError(fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno)));
+  if (header_json.size() > kMaxHeader)
+    throw CaptureError(fmt::format("{}: header of {} bytes is over the 1 MiB limit", path.string(),
+                                   header_json.size()));
+  std::vector<std::byte> head;
+  for (char c : kMagic) head.push_back(static_cast<std::byte>(c));
+  put<std::uint16_t>(head, capture_major_version);
+  put<std::uint16_t>(head, capture_minor_version);
+  put<std::uint32_t>(head, static_cast<std::uint32_t>(header_json.size()));
+  const auto* json = reinterpret_cast<const std::byte*>(header_json.data());
+  head.insert(head.end(), json, json + header_json.size());
+  put<std::uint32_t>(head, crc32c(std::span(head).subspan(8)));
+  impl_->write(head);
+  impl_->payload.reserve(limits.block_bytes + 1024);
+  flush();
+}
+
+CaptureWriter::~CaptureWriter() {
+  if (!impl_->file) return;
+  try {
+    close();
+  } catch (const CaptureError&) {
+    // the destructor cannot report; close() can
+  }
+}
+
+void CaptureWriter::record(std::int64_t time_ns, std::uint16_t device, RecordKind kind,
+                           std::span<const std::byte> bytes) {
+  Impl& m = *impl_;
+  if (!m.file) throw CaptureError(fmt::format("{}: write after close", m.path.string()));
+  put<std::int64_t>(m.payload, time_ns);
+  put<std::uint16_t>(m.payload, device);
+  put<std::uint8_t>(m.payload, static_cast<std::uint8_t>(kind));
+  put<std::uint8_t>(m.payload, 0);
+  put<std::uint32_t>(m.payload, static_cast<std::uint32_t>(bytes.size()));
+  m.payload.insert(m.payload.end(), bytes.begin(), bytes.end());
+  ++m.records;
+  ++m.total;
+  m.peak = std::max(m.peak, m.payload.size());
+  if (m.payload.size() >= m.limits.block_bytes) m.write_block();
+}
+
+void CaptureWriter::event(std::int64_t time_ns, std::uint16_t device, std::string_view text) {
+  record(time_ns, device, RecordKind::event, std::as_bytes(std::span(text.data(), text.size())));
+}
+
+void CaptureWriter::flush() {
+  impl_->write_block();
+  if (std::fflush(impl_->file) != 0) impl_->fail("flush failed");
+}
+
+void CaptureWriter::close() {
+  if (!impl_->file) return;
+  impl_->write_block();
+  // The end block: a capture without it was not closed (the session was interrupted), which a
+  // cut exactly between two blocks could not otherwise show.
+  std::vector<std::byte> end, count;
+  put<std::uint64_t>(count, impl_->total);
+  put<std::uint32_t>(end, kEndMagic);
+  put<std::uint32_t>(end, 8);
+  put<std::uint32_t>(end, 0);
+  put<std::uint32_t>(end, crc32c(count));
+  end.insert(end.end(), count.begin(), count.end());
+  impl_->write(end);
+  if (std::fflush(impl_->file) != 0) impl_->fail("flush failed");
+  std::FILE* f = std::exchange(impl_->file, nullptr);
+  if (std::fclose(f) != 0) impl_->fail("close failed");
+}
+
+std::size_t CaptureWriter::buffered_bytes() const { return impl_->payload.size(); }
+std::size_t CaptureWriter::max_buffered_bytes() const { return impl_->peak; }
+std::uint64_t CaptureWriter::bytes_written() const { return impl_->written; }
+const std::filesystem::path& CaptureWriter::path() const { return impl_->path; }
+
+// ---------------------------------------------------------------------------------------------
+
+struct CaptureReader::Impl {
+  std::filesystem::path path;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file{nullptr, &std::fclose};
+  std::string header;
+  std::uint16_t minor = 0;
+  std::uint64_t offset = 0;  // of the next unread byte
+  std::uint64_t block = 0;
+  std::vector<std::byte> payload;
+  std::size_t pos = 0;     // in payload
+  std::uint32_t left = 0;  // records left in the block
+  std::optional<Damage> damage;
+  std::uint64_t records = 0;
+  bool complete = false;
+  std::uint64_t block_start = 0;
+
+  std::size_t read(void* out, std::size_t n) {
+    const std::size_t got = std::fread(out, 1, n, file.get());
+    offset += got;
+    return got;
+  }
+  [[noreturn]] void bad_header(std::string_view what) const {
+    throw CaptureError(fmt::format("{}: {}", path.string(), what));
+  }
+  template <class Damaged>
+  bool end_block(const std::array<std::byte, kBlockHeader>& h, Damaged& damaged) {
+    std::array<std::byte, 8> count{};
+    if (read(count.data(), 8) != 8) return damaged("truncated end block");
+    if (get<std::uint32_t>(h.data() + 12) != crc32c(count))
+      return damaged("bad CRC in the end block");
+    if (get<std::uint64_t>(count.data()) != records)
+      return damaged(fmt::format("the end block counts {} records, {} were read",
+                                 get<std::uint64_t>(count.data()), records));
+    complete = true;
+    return false;
+  }
+
+  bool load_block() {
+    if (complete) return false;
+    const std::uint64_t at = offset;
+    std::array<std::byte, kBlockHeader> h{};
+    const std::size_t got = read(h.data(), h.size());
+    auto damaged = [&](std::string what) {
+      damage = Damage{at, block, std::move(what)};
+      return false;
+    };
+    if (got == 0)
+      return damaged(
+          fmt::format("no end block: the capture was not closed (the session was "
+                      "interrupted); {} records before it are intact",
+                      records));
+    if (got < h.size()) return damaged(fmt::format("truncated block header ({} of 16 bytes)", got));
+    if (get<std::uint32_t>(h.data()) == kEndMagic) return end_block(h, damaged);
+    if (get<std::uint32_t>(h.data()) != kBlockMagic)
+      return damaged("not a block (bad block magic)");
+    const auto size = get<std::uint32_t>(h.data() + 4);
+    const auto count = get<std::uint32_t>(h.data() + 8);
+    const auto crc = get<std::uint32_t>(h.data() + 12);
+    if (size > kMaxPayload) return damaged(fmt::format("block length {} is implausible", size));
+    payload.resize(size);
+    if (const std::size_t n = read(payload.data(), size); n < size)
+      return damaged(fmt::format("truncated block ({} of {} payload bytes)", n, size));
+    if (crc32c(payload, crc32c(std::span(h).subspan(4, 8))) != crc)
+      return damaged("bad CRC (the block is corrupted)");
+    block_start = at;
+    pos = 0;
+    left = count;
+    ++block;
+    return true;
+  }
+};
+
+CaptureReader::CaptureReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.path = path;
+  m.file.reset(std::fopen(path.c_str(), "rb"));
+  if (!m.file)
+    throw CaptureError(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
+  std::array<char, 8> magic{};
+  if (m.read(magic.data(), 8) != 8 || magic != kMagic) m.bad_header("not a caldaq capture file");
+  std::array<std::byte, 8> v{};
+  if (m.read(v.data(), 8) != 8) m.bad_header("truncated header");
+  const auto major = get<std::uint16_t>(v.data());
+  m.minor = get<std::uint16_t>(v.data() + 2);
+  const auto length = get<std::uint32_t>(v.data() + 4);
+  if (major > capture_major_version)
+    m.bad_header(fmt::format("capture format version {}.{} is newer than this daq reads ({}.x)",
+                             major, m.minor, capture_major_version));
+  if (length > kMaxHeader) m.bad_header(fmt::format("header length {} is implausible", length));
+  m.header.resize(length);
+  std::array<std::byte, 4> crc{};
+  if (m.read(m.header.data(), length) != length || m.read(crc.data(), 4) != 4)
+    m.bad_header("truncated header");
+  std::vector<std::byte> checked(v.begin(), v.end());
+  const auto* h = reinterpret_cast<const std::byte*>(m.header.data());
+  checked.insert(checked.end(), h, h + length);
+  if (crc32c(checked) != get<std::uint32_t>(crc.data()))
+    m.bad_header("header CRC mismatch (damaged header)");
+}
+
+CaptureReader::~CaptureReader() = default;
+CaptureReader::CaptureReader(CaptureReader&&) noexcept = default;
+const std::string& CaptureReader::header_json() const { return impl_->header; }
+std::uint16_t CaptureReader::minor_version() const { return impl_->minor; }
+const std::optional<Damage>& CaptureReader::damage() const { return impl_->damage; }
+std::uint64_t CaptureReader::records_read() const { return impl_->records; }
+
+std::optional<Record> CaptureReader::next() {
+  Impl& m = *impl_;
+  if (m.damage) return std::nullopt;
+  while (m.left == 0)
+    if (!m.load_block()) return std::nullopt;
+  // Within a CRC-checked block a malformed record can only come from a writer bug; it is
+  // still reported as damage rather than read past the end.
+  if (m.payload.size() - m.pos < kRecordHeader) {
+    m.damage = Damage{m.block_start, m.block - 1, "record header past the block end"};
+    return std::nullopt;
+  }
+  const std::byte* p = m.payload.data() + m.pos;
+  Record r;
+  r.time_ns = get<std::int64_t>(p);
+  r.device = get<std::uint16_t>(p + 8);
+  r.kind = static_cast<RecordKind>(get<std::uint8_t>(p + 10));
+  const auto length = get<std::uint32_t>(p + 12);
+  if (m.payload.size() - m.pos - kRecordHeader < length) {
+    m.damage = Damage{m.block_start, m.block - 1, "record longer than its block"};
+    return std::nullopt;
+  }
+  r.bytes.assign(p + kRecordHeader, p + kRecordHeader + length);
+  m.pos += kRecordHeader + length;
+  --m.left;
+  ++m.records;
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+PacingClock system_pacing_clock() {
+  return {[] {
+            return std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::steady_clock::now().time_since_epoch())
+                .count();
+          },
+          [](std::int64_t until_ns) {
+            std::this_thread::sleep_until(
+                std::chrono::steady_clock::time_point(std::chrono::nanoseconds(until_ns)));
+          }};
+}
+
+ReplaySource::ReplaySource(const std::filesystem::path& path, double speed,
+                           std::vector<std::uint16_t> devices, PacingClock clock)
+    : reader_(path), speed_(speed), devices_(std::move(devices)), clock_(std::move(clock)) {
+  if (speed < 0)
+    throw CaptureError(fmt::format("{}: replay speed {} must be >= 0", path.string(), speed));
+}
+
+const std::string& ReplaySource::header_json() const { return reader_.header_json(); }
+const std::optional<Damage>& ReplaySource::damage() const { return reader_.damage(); }
+
+std::optional<Record> ReplaySource::next() {
+  for (;;) {
+    auto r = reader_.next();
+    if (!r) return r;
+    if (!devices_.empty() &&
+        std::find(devices_.begin(), devices_.end(), r->device) == devices_.end())
+      continue;
+    if (speed_ > 0) {
+      if (!start_ns_) start_ns_ = clock_.now_ns(), first_record_ns_ = r->time_ns;
+      const auto due =
+          *start_ns_ +
+          static_cast<std::int64_t>(static_cast<double>(r->time_ns - *first_record_ns_) / speed_);
+      if (clock_.now_ns() < due) clock_.sleep_until(due);
+    }
+    return r;
+  }
+}
+
 }  // namespace cal::replay
