@@ -14,9 +14,12 @@
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instruments.hpp"
 #include "cal/drivers/transport/transport.hpp"
+#include "cal/replay/capture.hpp"
+#include "cal/replay/session.hpp"
 #include "commands.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
+#include "session_spec.hpp"
 #include "sim_shop.hpp"
 
 namespace daq {
@@ -28,6 +31,7 @@ using namespace std::chrono_literals;
 
 struct DemoOptions {
   std::string db = "caldaq-demo.sqlite";
+  std::string capture = "caldaq-demo.cdq";
   double speed = 60.0;
   bool quiet = false;
 };
@@ -100,23 +104,47 @@ int run_demo(const DemoOptions& o) {
   const auto poll = [&](double sim_s) {
     return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / o.speed * 1e6));
   };
+  // The instruments as the capture header records them, so `daq replay` rebuilds them.
+  const std::vector<InstrumentSpec> specs{
+      {.device = 0,
+       .driver = "ids3010",
+       .role = "laser",
+       .transport = fmt::format("tcp 127.0.0.1:{}", shop.laser_port())},
+      {.device = 1,
+       .driver = "ptu300",
+       .role = "air",
+       .transport = "serial " + shop.air_device() + " 4800 7E1"},
+      {.device = 2,
+       .driver = "gauge",
+       .role = "material",
+       .transport = "serial " + shop.material_device() + " 9600 8N1",
+       .gauge = {.request = "?\r",
+                 .unit = cal::drivers::codec::GaugeUnit::degc,
+                 .min_si = -40,
+                 .max_si = 150}}};
+  cal::replay::CaptureWriter capture(o.capture,
+                                     capture_header(config, specs, "daq 0.1.0 demo (simulated)"));
+  cal::replay::CaptureRecorder recorder(capture);
+  const auto options = [&](std::string name, double poll_s) {
+    return d::InstrumentOptions{.name = std::move(name),
+                                .poll_period = poll(poll_s),
+                                .clock = clock,
+                                .recorder = &recorder};
+  };
   LinearRunSetup setup;
   setup.config = config;
   setup.database = o.db;
-  setup.laser = d::make_ids3010(
-      io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-      {.name = "laser (simulated IDS3010)", .poll_period = poll(0.05), .clock = clock},
-      {.environment_period = 1000ms});
-  setup.air = d::make_ptu300(
-      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
-      {.name = "air (simulated PTU300)", .poll_period = poll(1.0), .clock = clock});
-  setup.material.push_back(d::make_gauge(
-      io, t::make_serial(io, {.device = shop.material_device(), .baud = 9600}),
-      {.name = "material (simulated thermometer)", .poll_period = poll(1.0), .clock = clock},
-      {.request = "?\r",
-       .unit = cal::drivers::codec::GaugeUnit::degc,
-       .min_si = -40,
-       .max_si = 150}));
+  setup.capture_path = std::filesystem::absolute(o.capture).string();
+  setup.laser = make_instrument(io, specs[0],
+                                t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
+                                options("laser (simulated IDS3010)", 0.05));
+  setup.air = make_instrument(
+      io, specs[1],
+      t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
+      options("air (simulated PTU300)", 1.0));
+  setup.material.push_back(make_instrument(io, specs[2],
+                                           t::make_serial(io, {.device = shop.material_device()}),
+                                           options("material (simulated thermometer)", 1.0)));
   setup.on_live = [tty](const LiveState& s) { progress_line(s, tty); };
   setup.on_event = [tty, &o](const std::string& e) {
     if (o.quiet) return;
@@ -128,9 +156,13 @@ int run_demo(const DemoOptions& o) {
   shop.run_linear(run.plan(), config.linear->feed_mm_per_min, config.linear->dwell_s);
   const auto limit = std::chrono::steady_clock::now() +
                      std::chrono::duration<double>(shop.program_end_s() / o.speed + 20.0);
-  while (!run.finished() && std::chrono::steady_clock::now() < limit) io.run_for(50ms);
+  while (!run.finished() && std::chrono::steady_clock::now() < limit) {
+    io.run_for(50ms);
+    capture.flush();  // what is flushed survives a crash of this process
+  }
   if (!run.finished()) run.stop("the simulated program ended without all stops captured");
   if (tty) fmt::print("\r\033[K");
+  capture.close();
   const auto& out = run.outcome();
   fmt::print("\nrun {} stored in {} ({} readings)\n", out.run_id,
              std::filesystem::absolute(o.db).string(), out.readings);
@@ -144,6 +176,7 @@ int run_demo(const DemoOptions& o) {
   print_comparison(*out.evaluation, truth, shop.truth());
   fmt::print("\nSee it again: daq runs --db {0}; daq show {1} --db {0}; daq export {1} --db {0}\n",
              o.db, out.run_id);
+  fmt::print("Replay the wire-level capture: daq replay {} --db {}\n", o.capture, o.db);
   return 0;
 }
 
@@ -154,6 +187,8 @@ void add_demo_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "demo", "Run the whole chain on the built-in SIMULATED machine and instrument twins");
   cmd->add_option("--db", o->db, "Run database for the demo runs")->capture_default_str();
+  cmd->add_option("--capture", o->capture, "Wire-level capture file of the run")
+      ->capture_default_str();
   cmd->add_option("--speed", o->speed, "Simulated time per real time")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 200.0));

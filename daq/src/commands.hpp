@@ -13,6 +13,8 @@ void add_devices_command(CLI::App& app);
 void add_runs_commands(CLI::App& app);
 // analyse RUN, recompensate RUN: stored runs
 void add_stored_run_commands(CLI::App& app, CLI::App& analyse);
+// replay CAPTURE
+void add_replay_command(CLI::App& app);
 // analyse straightness, analyse squareness
 void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 // analyse circle

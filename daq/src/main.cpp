@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "cal/analysis/error.hpp"
+#include "cal/replay/capture.hpp"
 #include "cal/storage/store.hpp"
 #include "commands.hpp"
 
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   daq::add_devices_command(app);
   daq::add_runs_commands(app);
   daq::add_stored_run_commands(app, *analyse);
+  daq::add_replay_command(app);
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);
@@ -35,6 +37,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const cal::InputError& e) {
+    std::fprintf(stderr, "daq: error: %s\n", e.what());
+    return 2;
+  } catch (const cal::replay::CaptureError& e) {
     std::fprintf(stderr, "daq: error: %s\n", e.what());
     return 2;
   } catch (const cal::storage::StoreError& e) {

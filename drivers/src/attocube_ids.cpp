@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -14,8 +15,17 @@ namespace cal::drivers::codec {
 namespace {
 
 // What result[1..] holds for each method.
-enum class ResultKind { none, three_pm, one_pm, temperature_degc, pressure_hpa, humidity, index,
-                        flag, text };
+enum class ResultKind {
+  none,
+  three_pm,
+  one_pm,
+  temperature_degc,
+  pressure_hpa,
+  humidity,
+  index,
+  flag,
+  text
+};
 
 struct MethodInfo {
   IdsMethod method;
@@ -31,29 +41,23 @@ constexpr MethodInfo kMethods[] = {
      ResultKind::one_pm},
     {IdsMethod::get_absolute_positions, "com.attocube.ids.displacement.getAbsolutePositions", 0,
      ResultKind::three_pm},
-    {IdsMethod::get_measurement_enabled, "com.attocube.ids.displacement.getMeasurementEnabled",
-     0, ResultKind::flag},
-    {IdsMethod::start_measurement, "com.attocube.ids.system.startMeasurement", 0,
-     ResultKind::none},
-    {IdsMethod::stop_measurement, "com.attocube.ids.system.stopMeasurement", 0,
-     ResultKind::none},
+    {IdsMethod::get_measurement_enabled, "com.attocube.ids.displacement.getMeasurementEnabled", 0,
+     ResultKind::flag},
+    {IdsMethod::start_measurement, "com.attocube.ids.system.startMeasurement", 0, ResultKind::none},
+    {IdsMethod::stop_measurement, "com.attocube.ids.system.stopMeasurement", 0, ResultKind::none},
     {IdsMethod::start_optics_alignment, "com.attocube.ids.system.startOpticsAlignment", 0,
      ResultKind::none},
     {IdsMethod::stop_optics_alignment, "com.attocube.ids.system.stopOpticsAlignment", 0,
      ResultKind::none},
-    {IdsMethod::get_current_mode, "com.attocube.ids.system.getCurrentMode", 0,
-     ResultKind::text},
-    {IdsMethod::get_system_error, "com.attocube.ids.system.getSystemError", 0,
-     ResultKind::none},
+    {IdsMethod::get_current_mode, "com.attocube.ids.system.getCurrentMode", 0, ResultKind::text},
+    {IdsMethod::get_system_error, "com.attocube.ids.system.getSystemError", 0, ResultKind::none},
     {IdsMethod::reset_axes, "com.attocube.ids.system.resetAxes", 0, ResultKind::none},
     {IdsMethod::ecu_enable, "com.attocube.ecu.enable", 0, ResultKind::none},
     {IdsMethod::ecu_get_connected, "com.attocube.ecu.getConnected", 0, ResultKind::flag},
     {IdsMethod::ecu_get_temperature, "com.attocube.ecu.getTemperatureInDegrees", 0,
      ResultKind::temperature_degc},
-    {IdsMethod::ecu_get_pressure, "com.attocube.ecu.getPressureInHPa", 0,
-     ResultKind::pressure_hpa},
-    {IdsMethod::ecu_get_humidity, "com.attocube.ecu.getHumidityInPercent", 0,
-     ResultKind::humidity},
+    {IdsMethod::ecu_get_pressure, "com.attocube.ecu.getPressureInHPa", 0, ResultKind::pressure_hpa},
+    {IdsMethod::ecu_get_humidity, "com.attocube.ecu.getHumidityInPercent", 0, ResultKind::humidity},
     {IdsMethod::ecu_get_refractive_index, "com.attocube.ecu.getRefractiveIndex", 0,
      ResultKind::index},
 };
@@ -109,6 +113,26 @@ std::string IdsCodec::encode(IdsMethod method, std::span<const IdsParam> params)
   pending_[id] = method;
   if (pending_.size() > max_pending) pending_.erase(pending_.begin());
   return j.dump() + "\n";
+}
+
+void IdsCodec::note_requests(std::span<const std::byte> bytes) {
+  sent_splitter_.feed(
+      bytes,
+      [&](std::string_view line, std::uint64_t) {
+        const auto j = nlohmann::json::parse(line, nullptr, false);
+        if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j.contains("method"))
+          return;
+        if (!j["id"].is_number_integer() || !j["method"].is_string()) return;
+        const auto name = j["method"].get<std::string>();
+        for (const auto& m : kMethods) {
+          if (m.name != name) continue;
+          const auto id = j["id"].get<std::int64_t>();
+          pending_[id] = m.method;
+          next_id_ = std::max(next_id_, id + 1);
+          if (pending_.size() > max_pending) pending_.erase(pending_.begin());
+        }
+      },
+      [](std::uint64_t) {});
 }
 
 void IdsCodec::do_feed(std::span<const std::byte> bytes, std::vector<IdsResponse>& frames,
@@ -167,9 +191,7 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
   }
   r.error_code = (*res)[0].get<std::int64_t>();
   const ResultKind kind = info(r.method).result;
-  const std::size_t needed = kind == ResultKind::none       ? 0
-                             : kind == ResultKind::three_pm ? 3
-                                                            : 1;
+  const std::size_t needed = kind == ResultKind::none ? 0 : kind == ResultKind::three_pm ? 3 : 1;
   // With a non-zero code the device may leave the values out; that is its answer, not ours
   // to reject.
   if (res->size() < needed + 1) {
@@ -204,9 +226,8 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
       break;
     case ResultKind::three_pm:
       for (std::size_t a = 0; a < 3; ++a) {
-        r.displacement_m[a] =
-            number(a + 1, fmt::format("axis {} displacement (m)", a), kMetresPerPicometre,
-                   -dmax, dmax);
+        r.displacement_m[a] = number(a + 1, fmt::format("axis {} displacement (m)", a),
+                                     kMetresPerPicometre, -dmax, dmax);
       }
       break;
     case ResultKind::one_pm:
@@ -217,8 +238,8 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
                                   limits_.max_temperature_degc);
       break;
     case ResultKind::pressure_hpa:
-      r.pressure_pa = number(1, "ECU pressure (Pa)", kPascalPerHectopascal,
-                             limits_.min_pressure_pa, limits_.max_pressure_pa);
+      r.pressure_pa = number(1, "ECU pressure (Pa)", kPascalPerHectopascal, limits_.min_pressure_pa,
+                             limits_.max_pressure_pa);
       break;
     case ResultKind::humidity:
       r.humidity_pct_rh = number(1, "ECU humidity (%RH)", 1.0, limits_.min_humidity_pct_rh,

@@ -99,6 +99,7 @@ void InstrumentCore::stop() {
   watchdog_.cancel();
   transport_->close();
   on_disconnected();
+  record_event("closed");
   if (gap_ && events_.gap) {  // a gap still open at the end is reported, not dropped
     gap_->end_ns = now_ns();
     events_.gap(*gap_);
@@ -110,18 +111,18 @@ void InstrumentCore::stop() {
 void InstrumentCore::connect() {
   set_state(InstrumentState::connecting);
   ++attempts_;
+  // Each handler only forwards to a member function: a transport may destroy its handlers
+  // while one runs (closing from inside a data handler), so nothing may touch the lambda's
+  // captures after the call.
   transport::Transport::Handlers handlers;
   handlers.opened = [this, alive = alive_] {
-    if (!*alive || !running_) return;
-    set_state(InstrumentState::configuring);
-    last_bytes_ns_ = now_ns();
-    arm_watchdog();
-    on_connected();
+    if (*alive && running_) on_opened();
   };
   handlers.data = [this, alive = alive_](std::span<const std::byte> bytes) {
-    if (!*alive || !running_) return;
-    last_bytes_ns_ = now_ns();
-    on_bytes(bytes);
+    if (*alive && running_) on_data(bytes);
+  };
+  handlers.sent = [this, alive = alive_](std::span<const std::byte> bytes) {
+    if (*alive && running_) on_replayed_sent(bytes);
   };
   handlers.error = [this, alive = alive_](const transport::Error& e) {
     if (*alive && running_) fail(e.message);
@@ -129,8 +130,36 @@ void InstrumentCore::connect() {
   transport_->open(std::move(handlers));
 }
 
+void InstrumentCore::on_opened() {
+  record_event("opened");
+  set_state(InstrumentState::configuring);
+  last_bytes_ns_ = now_ns();
+  arm_watchdog();
+  on_connected();
+}
+
+void InstrumentCore::on_data(std::span<const std::byte> bytes) {
+  latched_ns_ = clock_();
+  last_bytes_ns_ = *latched_ns_;
+  if (options_.recorder) options_.recorder->received(options_.device, *latched_ns_, bytes);
+  on_bytes(bytes);
+  latched_ns_.reset();
+}
+
+void InstrumentCore::on_replayed_sent(std::span<const std::byte> bytes) {
+  latched_ns_ = clock_();
+  last_sent_ns_ = *latched_ns_;
+  on_sent(bytes);
+  latched_ns_.reset();
+}
+
+void InstrumentCore::record_event(std::string_view text) {
+  if (options_.recorder) options_.recorder->event(options_.device, now_ns(), text);
+}
+
 void InstrumentCore::fail(const std::string& reason) {
   if (!running_) return;
+  record_event("error: " + reason);
   polling_ = false;
   poll_timer_.cancel();
   watchdog_.cancel();
@@ -148,6 +177,7 @@ void InstrumentCore::fail(const std::string& reason) {
                      fmt::format("gave up after {} attempts: {}", attempts_, reason));
   }
   set_state(InstrumentState::reconnecting, reason);
+  if (options_.replay) return connect();  // the recording says when it reopened
   schedule_reconnect();
 }
 
@@ -164,6 +194,7 @@ void InstrumentCore::schedule_reconnect() {
 // A silent device is a dropped connection (a TCP peer that vanished without a FIN, a serial
 // adapter whose instrument was switched off): without this, the gap would never be seen.
 void InstrumentCore::arm_watchdog() {
+  if (options_.replay) return;
   watchdog_.expires_after(options_.silence_timeout);
   watchdog_.async_wait([this, alive = alive_](const boost::system::error_code& ec) {
     if (ec || !*alive || !running_) return;
@@ -175,7 +206,11 @@ void InstrumentCore::arm_watchdog() {
 }
 
 void InstrumentCore::send(std::string_view text) {
-  transport_->write(std::as_bytes(std::span(text.data(), text.size())));
+  if (options_.replay) return;
+  const auto bytes = std::as_bytes(std::span(text.data(), text.size()));
+  last_sent_ns_ = now_ns();
+  if (options_.recorder) options_.recorder->sent(options_.device, last_sent_ns_, bytes);
+  transport_->write(bytes);
 }
 
 void InstrumentCore::emit(Reading r) {
@@ -201,7 +236,7 @@ void InstrumentCore::set_state(InstrumentState s, std::string_view why) {
 }
 
 void InstrumentCore::start_polling() {
-  if (polling_) return;
+  if (polling_ || options_.replay) return;
   polling_ = true;
   poll_tick();
 }

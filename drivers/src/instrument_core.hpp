@@ -31,6 +31,8 @@ class InstrumentCore : public Instrument {
   virtual void on_bytes(std::span<const std::byte> bytes) = 0;
   virtual void on_poll() {}
   virtual void on_disconnected() {}
+  // Replay only: bytes the instrument sent in the recorded session (see Handlers::sent).
+  virtual void on_sent(std::span<const std::byte> /*bytes*/) {}
 
   void send(std::string_view text);
   void emit(Reading r);
@@ -39,7 +41,11 @@ class InstrumentCore : public Instrument {
   void fail(const std::string& reason);
   void start_polling();
   void report_codec_errors(std::span<const codec::CodecError> errors);
-  std::int64_t now_ns() const { return clock_(); }
+  // The time of the event being handled: inside a data handler the arrival time of the bytes
+  // (one value for the whole chunk, the one recorded), else the clock.
+  std::int64_t now_ns() const { return latched_ns_ ? *latched_ns_ : clock_(); }
+  std::int64_t last_sent_ns() const { return last_sent_ns_; }
+  bool replaying() const { return options_.replay; }
   const InstrumentOptions& options() const { return options_; }
   boost::asio::io_context& io() { return io_; }
 
@@ -62,6 +68,12 @@ class InstrumentCore : public Instrument {
   bool polling_ = false;
   std::int64_t last_bytes_ns_ = 0;
   std::optional<Gap> gap_;  // open while the connection is down
+  std::optional<std::int64_t> latched_ns_;
+  std::int64_t last_sent_ns_ = 0;
+  void record_event(std::string_view text);
+  void on_opened();
+  void on_data(std::span<const std::byte> bytes);
+  void on_replayed_sent(std::span<const std::byte> bytes);
   // Shared with the timers' handlers: a handler that runs after destruction does nothing.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

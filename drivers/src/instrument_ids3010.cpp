@@ -45,9 +45,15 @@ class Ids3010 final : public detail::InstrumentCore {
   }
 
   void request(IdsMethod method) {
+    if (replaying()) return;  // the recorded requests arrive through on_sent
     in_flight_ = true;
-    sent_ns_ = now_ns();
     send(codec_.encode(method));
+    sent_ns_ = last_sent_ns();
+  }
+
+  void on_sent(std::span<const std::byte> bytes) override {
+    codec_.note_requests(bytes);
+    sent_ns_ = last_sent_ns();
   }
 
   void on_bytes(std::span<const std::byte> bytes) override {

@@ -187,9 +187,9 @@ std::string ptu300_intv(int n, IntervalUnit unit) {
 
 std::string ptu300_form(std::string_view formatter) {
   if (formatter.find_first_of("\r\n") != std::string_view::npos || !is_printable_ascii(formatter)) {
-    throw InputError(fmt::format(
-        "PTU300 FORM formatter {:?}: expected printable ASCII (write #r#n, not CR LF)",
-        std::string(formatter)));
+    throw InputError(
+        fmt::format("PTU300 FORM formatter {:?}: expected printable ASCII (write #r#n, not CR LF)",
+                    std::string(formatter)));
   }
   return with_cr(formatter.empty() ? std::string("FORM") : fmt::format("FORM {}", formatter));
 }
@@ -293,7 +293,8 @@ void Ptu300Codec::decode_line(std::string_view line, std::uint64_t offset,
       report(errors, ErrorKind::bad_checksum, msg_offset, "PTU300: checksum field missing");
       return;
     }
-    const auto covered = msg.substr(0, static_cast<std::size_t>(checksum_token.data() - msg.data()));
+    const auto covered =
+        msg.substr(0, static_cast<std::size_t>(checksum_token.data() - msg.data()));
     const std::string expected = ptu300_checksum_hex(config_.checksum, covered);
     if (!iequals(expected, checksum_token)) {
       report(errors, ErrorKind::bad_checksum, msg_offset,
@@ -313,11 +314,11 @@ void Ptu300Codec::decode_line(std::string_view line, std::uint64_t offset,
     const Ptu300Quantity q = quantity_of(raw.label, raw.unit);
     Ptu300Field field{label, q, raw.value, std::string(raw.unit)};
     if (q != Ptu300Quantity::other) {
-      const UnitKind want = q == Ptu300Quantity::relative_humidity ? UnitKind::humidity
-                            : (q == Ptu300Quantity::pressure ||
-                               q == Ptu300Quantity::pressure_tendency)
-                                ? UnitKind::pressure
-                                : UnitKind::temperature;
+      const UnitKind want =
+          q == Ptu300Quantity::relative_humidity ? UnitKind::humidity
+          : (q == Ptu300Quantity::pressure || q == Ptu300Quantity::pressure_tendency)
+              ? UnitKind::pressure
+              : UnitKind::temperature;
       const UnitInfo* u = find_unit(raw.unit);
       if (u == nullptr || u->kind != want) {
         report(errors, ErrorKind::malformed, msg_offset,

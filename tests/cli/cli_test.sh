@@ -44,7 +44,11 @@ check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --i
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/demo.sqlite"
+check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/demo.sqlite" --capture "$TMP/demo.cdq"
+# A capture cut in half: the replay says where the damage is and stores nothing as complete.
+head -c 300000 "$TMP/demo.cdq" > "$TMP/cut.cdq"
+check replay_damaged 2 "cut.cdq: replay stored as run [0-9]+ but incomplete: the capture is damaged at byte [0-9]+" -- "$DAQ" replay "$TMP/cut.cdq" --db "$TMP/replay.sqlite"
+check replay_not_capture 2 "not a caldaq capture file" -- "$DAQ" replay "$DATA/hand.csv" --db "$TMP/replay.sqlite"
 check demo_stored 0 "complete" -- "$DAQ" runs --db "$TMP/demo.sqlite"
 check demo_export 0 "^time_ns,device,channel,quantity,status,value" -- "$DAQ" export 1 --db "$TMP/demo.sqlite"
 check demo_targets 0 "^1,\\+,1,0," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"

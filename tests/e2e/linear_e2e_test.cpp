@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <boost/asio/io_context.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <thread>
@@ -139,6 +140,39 @@ TEST(LinearEndToEnd, KillDashNineMidRunLeavesAReadableIncompleteRun) {
   EXPECT_EQ(static_cast<std::int64_t>(store.readings(runs[0].id).size()),
             store.reading_count(runs[0].id));
   remove_db(db);
+}
+
+TEST(LinearEndToEnd, ReplayingTheCaptureGivesIdenticalStoredResults) {
+  const auto db = temp_db("replay");
+  const auto capture = fs::path(db.string() + ".cdq");
+  const std::string daq = CALDAQ_DAQ_BINARY;
+  ASSERT_EQ(std::system((daq + " demo --quiet --db '" + db.string() + "' --capture '" +
+                         capture.string() + "' > /dev/null")
+                            .c_str()),
+            0);
+  ASSERT_EQ(std::system(
+                (daq + " replay '" + capture.string() + "' --db '" + db.string() + "' > /dev/null")
+                    .c_str()),
+            0);
+  cal::storage::Store store(db);
+  const auto runs = store.runs();
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[1].capture_path, fs::absolute(capture).string());
+  // The same bytes through the same instruments and stages: the same readings (with their
+  // timestamps), the same captured stops, the same result document.
+  const auto a = store.readings(runs[0].id), b = store.readings(runs[1].id);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].time_ns, b[i].time_ns) << i;
+    ASSERT_EQ(a[i].value, b[i].value) << i;
+  }
+  const auto ta = store.targets(runs[0].id), tb = store.targets(runs[1].id);
+  ASSERT_EQ(ta.size(), tb.size());
+  for (std::size_t i = 0; i < ta.size(); ++i) EXPECT_EQ(ta[i].deviation_um, tb[i].deviation_um);
+  ASSERT_EQ(store.results(runs[0].id).size(), 1u);
+  EXPECT_EQ(store.results(runs[0].id)[0].json, store.results(runs[1].id)[0].json);
+  remove_db(db);
+  fs::remove(capture);
 }
 
 }  // namespace

@@ -81,6 +81,20 @@ struct InstrumentEvents {
 using Clock = std::function<std::int64_t()>;
 Clock steady_clock_ns();
 
+// Receives the exact bytes an instrument exchanged with its device, with the instrument's
+// clock: the capture file (replay/) implements it. Recording at the instrument boundary,
+// right after the transport, gives the readings and the recorded bytes one timestamp, so a
+// replay reproduces the readings exactly.
+class WireRecorder {
+ public:
+  virtual ~WireRecorder() = default;
+  virtual void received(std::uint16_t device, std::int64_t time_ns,
+                        std::span<const std::byte> bytes) = 0;
+  virtual void sent(std::uint16_t device, std::int64_t time_ns,
+                    std::span<const std::byte> bytes) = 0;
+  virtual void event(std::uint16_t device, std::int64_t time_ns, std::string_view text) = 0;
+};
+
 struct InstrumentOptions {
   std::uint16_t device = 0;
   std::string name;  // for logs and errors, e.g. "laser" or "PTU300 #1"
@@ -89,7 +103,13 @@ struct InstrumentOptions {
   std::chrono::microseconds poll_period{10'000};
   // A connected device that sends nothing for this long is treated as a dropped connection.
   std::chrono::milliseconds silence_timeout{3000};
-  Clock clock;  // empty: steady_clock_ns()
+  Clock clock;                       // empty: steady_clock_ns()
+  WireRecorder* recorder = nullptr;  // not owned; must outlive the instrument
+  // Replay: the transport is a replay transport and the clock its recorded time. The
+  // instrument then sends nothing and starts no timer (no polling, watchdog or reconnection
+  // delays): the recorded session drives it, so the same capture always gives the same
+  // readings.
+  bool replay = false;
 };
 
 class Instrument {

@@ -22,23 +22,23 @@
 namespace cal::drivers::codec {
 
 enum class IdsMethod {
-  get_axes_displacement,      // com.attocube.ids.displacement.getAxesDisplacement -> 3 x pm
-  get_axis_displacement,      // ...displacement.getAxisDisplacement [axis] -> pm
-  get_absolute_positions,     // ...displacement.getAbsolutePositions -> 3 x pm
-  get_measurement_enabled,    // ...displacement.getMeasurementEnabled -> bool
-  start_measurement,          // com.attocube.ids.system.startMeasurement
-  stop_measurement,           // com.attocube.ids.system.stopMeasurement
-  start_optics_alignment,     // com.attocube.ids.system.startOpticsAlignment
-  stop_optics_alignment,      // com.attocube.ids.system.stopOpticsAlignment
-  get_current_mode,           // com.attocube.ids.system.getCurrentMode -> string
-  get_system_error,           // com.attocube.ids.system.getSystemError
-  reset_axes,                 // com.attocube.ids.system.resetAxes
-  ecu_enable,                 // com.attocube.ecu.enable
-  ecu_get_connected,          // com.attocube.ecu.getConnected -> bool
-  ecu_get_temperature,        // com.attocube.ecu.getTemperatureInDegrees -> degC
-  ecu_get_pressure,           // com.attocube.ecu.getPressureInHPa -> hPa
-  ecu_get_humidity,           // com.attocube.ecu.getHumidityInPercent -> %RH
-  ecu_get_refractive_index,   // com.attocube.ecu.getRefractiveIndex -> n
+  get_axes_displacement,     // com.attocube.ids.displacement.getAxesDisplacement -> 3 x pm
+  get_axis_displacement,     // ...displacement.getAxisDisplacement [axis] -> pm
+  get_absolute_positions,    // ...displacement.getAbsolutePositions -> 3 x pm
+  get_measurement_enabled,   // ...displacement.getMeasurementEnabled -> bool
+  start_measurement,         // com.attocube.ids.system.startMeasurement
+  stop_measurement,          // com.attocube.ids.system.stopMeasurement
+  start_optics_alignment,    // com.attocube.ids.system.startOpticsAlignment
+  stop_optics_alignment,     // com.attocube.ids.system.stopOpticsAlignment
+  get_current_mode,          // com.attocube.ids.system.getCurrentMode -> string
+  get_system_error,          // com.attocube.ids.system.getSystemError
+  reset_axes,                // com.attocube.ids.system.resetAxes
+  ecu_enable,                // com.attocube.ecu.enable
+  ecu_get_connected,         // com.attocube.ecu.getConnected -> bool
+  ecu_get_temperature,       // com.attocube.ecu.getTemperatureInDegrees -> degC
+  ecu_get_pressure,          // com.attocube.ecu.getPressureInHPa -> hPa
+  ecu_get_humidity,          // com.attocube.ecu.getHumidityInPercent -> %RH
+  ecu_get_refractive_index,  // com.attocube.ecu.getRefractiveIndex -> n
 };
 // The full JSON-RPC method name, e.g. "com.attocube.ecu.getPressureInHPa".
 std::string_view method_name(IdsMethod method);
@@ -80,13 +80,17 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
   // that never answers cannot make the codec grow without bound.
   static constexpr std::size_t max_pending = 256;
 
-  explicit IdsCodec(IdsLimits limits = {}, std::size_t max_line_bytes = LineSplitter::default_max_line_bytes);
+  explicit IdsCodec(IdsLimits limits = {},
+                    std::size_t max_line_bytes = LineSplitter::default_max_line_bytes);
 
   // The request line (with its '\n') for `method`, with the next id (1, 2, 3, ...); the id is
   // remembered so that the response can be matched. Throws cal::InputError if the number of
   // params does not fit the method (e.g. getAxisDisplacement needs the axis 0..2).
   std::string encode(IdsMethod method, std::span<const IdsParam> params = {});
   std::int64_t last_id() const { return next_id_ - 1; }
+  // Replay: learns the requests of a recorded session from the bytes that were sent (request
+  // lines as encode() writes them), so that their answers match. Unknown lines are ignored.
+  void note_requests(std::span<const std::byte> bytes);
   std::size_t pending() const { return pending_.size(); }
 
   void do_feed(std::span<const std::byte> bytes, std::vector<IdsResponse>& frames,
@@ -98,6 +102,7 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
 
   IdsLimits limits_;
   LineSplitter splitter_;
+  LineSplitter sent_splitter_;
   std::int64_t next_id_ = 1;
   std::map<std::int64_t, IdsMethod> pending_;
 };

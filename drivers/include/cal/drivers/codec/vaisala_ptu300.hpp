@@ -19,9 +19,9 @@ namespace cal::drivers::codec {
 // ---- commands (each ends with the <cr> the manual asks for) ----
 enum class Ptu300Mode { stop, run, poll, send };
 std::string ptu300_send(std::optional<int> address = std::nullopt);  // "SEND\r", "SEND 3\r"
-std::string ptu300_run();                                             // "R\r"
-std::string ptu300_stop();                                            // "S\r"
-std::string ptu300_smode(Ptu300Mode mode);                            // "SMODE RUN\r"
+std::string ptu300_run();                                            // "R\r"
+std::string ptu300_stop();                                           // "S\r"
+std::string ptu300_smode(Ptu300Mode mode);                           // "SMODE RUN\r"
 enum class IntervalUnit { s, min, h };
 // "INTV 10 S\r"; throws cal::InputError unless 0 <= n <= 255 (the manual's range).
 std::string ptu300_intv(int n, IntervalUnit unit);

@@ -48,6 +48,9 @@ class Transport {
     std::function<void()> opened;  // the device is open / the connection is up
     DataHandler data;
     ErrorHandler error;
+    // Only replay transports call this: bytes the instrument sent in the recorded session, so
+    // that a request/response codec learns what was asked (live transports never call it).
+    DataHandler sent;
   };
 
   // Opens (connects) and starts reading asynchronously. `opened` is called from the event
