@@ -112,7 +112,9 @@ TEST(LinearEndToEnd, KillDashNineMidRunLeavesAReadableIncompleteRun) {
   if (child == 0) {
     const int devnull = ::open("/dev/null", O_WRONLY);
     ::dup2(devnull, STDOUT_FILENO);
-    ::execl(CALDAQ_DAQ_BINARY, "daq", "demo", "--quiet", "--db", db.c_str(), nullptr);
+    const std::string capture = db.string() + ".cdq";
+    ::execl(CALDAQ_DAQ_BINARY, "daq", "demo", "--quiet", "--db", db.c_str(), "--capture",
+            capture.c_str(), nullptr);
     ::_exit(127);
   }
   // Wait until the run has stored some readings (committed batches), then kill.
@@ -140,6 +142,7 @@ TEST(LinearEndToEnd, KillDashNineMidRunLeavesAReadableIncompleteRun) {
   EXPECT_EQ(static_cast<std::int64_t>(store.readings(runs[0].id).size()),
             store.reading_count(runs[0].id));
   remove_db(db);
+  fs::remove(db.string() + ".cdq");
 }
 
 TEST(LinearEndToEnd, ReplayingTheCaptureGivesIdenticalStoredResults) {
