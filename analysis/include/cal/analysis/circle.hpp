@@ -1,2 +1,85 @@
 #pragma once
-// Placeholder: being written.
+// ISO 230-4 circular tests and ballbar diagnostics (theory, sign conventions and sources:
+// docs/circle.md).
+//
+// Input: the radial deviation of the tool from the nominal radius, as a telescoping ballbar
+// measures it (bar length minus its calibrated length), for a clockwise and/or a
+// counter-clockwise trace, at known angles. A real ballbar has no angle sensor: angles are
+// derived from time, feed and radius (angles_from_time).
+//
+// Results:
+// - ISO 230-4: circular deviation G (bidirectional and per direction; two concentric circles
+//   about the least-squares centre), circular hysteresis H (largest radial difference of the
+//   two directions at one angle, common centre), radial deviation F max/min (from the nominal
+//   radius, about the least-squares centre), the least-squares centre.
+// - Diagnostics: a linear least-squares fit of a first-order error model of a two-axis
+//   machine (each term derived in circle.cpp): centre offset, radius error, scale mismatch,
+//   squareness, servo mismatch (a time lag between the axes), backlash and lateral play per
+//   axis, reversal spikes per axis, cyclic error per axis, straightness (a bow of each axis
+//   along the other). Each is reported with the peak-to-valley of its fitted contribution
+//   and its share of the circularity, ranked.
+//
+// Units: angles in degrees in the interface, lengths mm (radius) and um (deviations).
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace cal::circle {
+
+enum class Plane { xy, yz, zx };   // first/second axis: X/Y, Y/Z, Z/X (G17, G19, G18)
+enum class Direction { cw, ccw };  // seen from the positive third axis
+
+struct Trace {
+  Direction direction = Direction::ccw;
+  std::vector<double> angle_deg;     // angle of each sample from the first axis towards the second
+  std::vector<double> deviation_um;  // measured radius minus the nominal (calibrated) radius
+};
+
+struct Setup {
+  Plane plane = Plane::xy;
+  double radius_mm = 100.0;
+  double feed_mm_per_min = 1000.0;  // needed for the servo-mismatch time
+  // Cyclic-error period along the axes: fixed, or searched over [min, max] when unset.
+  std::optional<double> cyclic_period_mm;
+  double cyclic_search_min_mm = 2.0, cyclic_search_max_mm = 40.0;
+  double spike_decay_deg = 6.0;   // decay angle of a reversal spike
+  bool radius_calibrated = true;  // deviations are from a calibrated length: radius error valid
+};
+
+// theta(t) = start + s * (feed / R) * t, s = +1 ccw, -1 cw: the tool moves at the feed along
+// the circle (after the feed-in and overshoot arcs have been trimmed).
+std::vector<double> angles_from_time(std::span<const double> time_s, double start_deg,
+                                     double feed_mm_per_min, double radius_mm, Direction d);
+
+struct Iso230_4 {
+  double G_bi_um = 0, G_cw_um = 0, G_ccw_um = 0;  // 0 when that direction was not measured
+  double H_um = 0;                                // needs both directions
+  double F_max_um = 0, F_min_um = 0;
+  double centre_u_um = 0, centre_v_um = 0;  // least-squares centre relative to the pivot
+  double arc_deg = 360;                     // the smallest arc measured
+};
+
+struct Diagnostic {
+  std::string key;       // stable id, e.g. "squareness"
+  std::string name;      // e.g. "Squareness XY"
+  double value = 0;      // in `unit`
+  std::string unit;      // "um", "um/m", "ms", "mm"
+  double pv_um = 0;      // peak-to-valley of its fitted contribution over the traces
+  double share_pct = 0;  // pv_um / G_bi, in %
+};
+
+struct Result {
+  Iso230_4 iso;
+  std::vector<Diagnostic> diagnostics;     // ranked by pv_um, largest first (centre excluded)
+  Diagnostic centre_u, centre_v;           // reported apart: set-up, not machine, errors
+  double residual_rms_um = 0;              // what the model leaves unexplained
+  std::optional<double> cyclic_period_mm;  // the period used (given or found)
+  std::vector<std::string> notes;          // e.g. which terms one direction cannot separate
+};
+
+// Throws cal::InputError for no trace, mismatched lengths, fewer than 20 samples, radius or
+// feed <= 0, non-finite values, an arc below 180 degrees, or two traces in one direction.
+Result analyse(const Setup& setup, std::span<const Trace> traces);
+
+}  // namespace cal::circle
