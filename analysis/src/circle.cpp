@@ -127,38 +127,31 @@ struct Model {
 struct Fit {
   Eigen::VectorXd coef;  // per term (0 where off)
   double rss = 0.0;
+  Eigen::MatrixXd basis;  // samples x terms: reused for the contributions
 };
 
 Fit fit(const Model& m, std::span<const Sample> samples) {
-  std::vector<int> idx;
-  for (int k = 0; k < term_count; ++k)
-    if (m.on[static_cast<std::size_t>(k)]) idx.push_back(k);
-  const auto p = static_cast<Eigen::Index>(idx.size());
-  Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(p, p);
-  Eigen::VectorXd aty = Eigen::VectorXd::Zero(p);
+  const auto n = static_cast<Eigen::Index>(samples.size());
+  Fit f;
+  f.basis.resize(n, term_count);
   std::array<double, term_count> b{};
-  Eigen::VectorXd row(p);
-  for (const auto& x : samples) {
-    m.basis(x.theta, x.s, b);
-    for (Eigen::Index i = 0; i < p; ++i)
-      row[i] = b[static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
-    ata.selfadjointView<Eigen::Lower>().rankUpdate(row);
-    aty += row * x.y;
+  Eigen::VectorXd y(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    m.basis(samples[static_cast<std::size_t>(i)].theta, samples[static_cast<std::size_t>(i)].s, b);
+    for (int k = 0; k < term_count; ++k)
+      f.basis(i, k) = m.on[static_cast<std::size_t>(k)] ? b[static_cast<std::size_t>(k)] : 0.0;
+    y[i] = samples[static_cast<std::size_t>(i)].y;
   }
-  ata = ata.selfadjointView<Eigen::Lower>();
-  // Column scaling keeps the system well conditioned (the bases differ in size).
+  // Normal equations on the active columns, with column scaling for conditioning (the bases
+  // differ in size); the inactive columns are zero and get a unit diagonal.
+  Eigen::MatrixXd ata = f.basis.transpose() * f.basis;
+  Eigen::VectorXd aty = f.basis.transpose() * y;
+  for (int k = 0; k < term_count; ++k)
+    if (!m.on[static_cast<std::size_t>(k)]) ata(k, k) = 1.0;
   const Eigen::VectorXd scale = ata.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
   const Eigen::MatrixXd scaled = scale.asDiagonal() * ata * scale.asDiagonal();
-  const Eigen::VectorXd sol = scale.asDiagonal() * scaled.ldlt().solve(scale.asDiagonal() * aty);
-  Fit f;
-  f.coef = Eigen::VectorXd::Zero(term_count);
-  for (Eigen::Index i = 0; i < p; ++i) f.coef[idx[static_cast<std::size_t>(i)]] = sol[i];
-  for (const auto& x : samples) {
-    m.basis(x.theta, x.s, b);
-    double yhat = 0.0;
-    for (int k = 0; k < term_count; ++k) yhat += f.coef[k] * b[static_cast<std::size_t>(k)];
-    f.rss += (x.y - yhat) * (x.y - yhat);
-  }
+  f.coef = scale.asDiagonal() * scaled.ldlt().solve(scale.asDiagonal() * aty);
+  f.rss = (y - f.basis * f.coef).squaredNorm();
   return f;
 }
 
@@ -339,15 +332,9 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
 
   // Each term's contribution over the samples, its peak-to-valley.
   auto contribution_pv = [&](std::initializer_list<int> terms) {
-    double lo = 1e300, hi = -1e300;
-    std::array<double, term_count> b{};
-    for (const auto& x : samples) {
-      m.basis(x.theta, x.s, b);
-      double c = 0.0;
-      for (int k : terms) c += f.coef[k] * b[static_cast<std::size_t>(k)];
-      lo = std::min(lo, c), hi = std::max(hi, c);
-    }
-    return hi - lo;
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(f.basis.rows());
+    for (int k : terms) c += f.coef[k] * f.basis.col(k);
+    return c.maxCoeff() - c.minCoeff();
   };
   const double r_mm = setup.radius_mm;
   const double w = setup.feed_mm_per_min / 60.0 / r_mm;  // rad/s

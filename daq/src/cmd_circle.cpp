@@ -1,7 +1,197 @@
+// daq analyse circle: ISO 230-4 circular test and ballbar diagnostics from a CSV file.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cal/analysis/circle.hpp"
+#include "cal/analysis/error.hpp"
 #include "commands.hpp"
 
 namespace daq {
+namespace {
 
-void add_circle_commands(CLI::App& /*app*/, CLI::App& /*analyse*/) {}
+using nlohmann::json;
+namespace ci = cal::circle;
+
+struct CircleOptions {
+  std::string input;
+  double radius_mm = 0.0;
+  double feed_mm_per_min = 1000.0;
+  std::string plane = "XY";
+  double start_deg = 0.0;
+  std::optional<double> cyclic_period_mm;
+  std::optional<double> calibrated_length_mm;
+  bool uncalibrated = false;
+  bool json = false;
+};
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) {
+    const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
+    out.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+// Columns (docs/circle.md): direction (cw|ccw), angle_deg or time_s, deviation_um or length_mm.
+std::vector<ci::Trace> read_traces(const CircleOptions& o) {
+  std::ifstream in(o.input);
+  if (!in) throw cal::InputError(fmt::format("{}: cannot open", o.input));
+  std::string line;
+  int n = 0;
+  std::map<std::string, std::size_t> col;
+  std::map<ci::Direction, ci::Trace> traces;
+  std::map<ci::Direction, std::vector<double>> times;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty() || line[0] == '#') continue;
+    const auto cells = split_csv(line);
+    if (col.empty()) {
+      for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
+      if (!col.count("direction") || (!col.count("angle_deg") && !col.count("time_s")) ||
+          (!col.count("deviation_um") && !col.count("length_mm")))
+        throw cal::InputError(
+            fmt::format("{}:{}: the header needs direction, angle_deg or time_s, and "
+                        "deviation_um or length_mm",
+                        o.input, n));
+      if (col.count("length_mm") && !col.count("deviation_um") && !o.calibrated_length_mm)
+        throw cal::InputError(fmt::format("{}: length_mm needs --calibrated-length-mm", o.input));
+      continue;
+    }
+    auto cell = [&](const char* name) -> double {
+      const auto& text = cells.at(col.at(name));
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (text.empty() || *end != '\0' || !std::isfinite(v))
+        throw cal::InputError(
+            fmt::format("{}:{}: column {}: '{}' is not a number", o.input, n, name, text));
+      return v;
+    };
+    if (cells.size() < col.size())
+      throw cal::InputError(
+          fmt::format("{}:{}: {} columns, {} expected", o.input, n, cells.size(), col.size()));
+    const auto& d = cells[col.at("direction")];
+    if (d != "cw" && d != "ccw")
+      throw cal::InputError(
+          fmt::format("{}:{}: column direction: '{}' (expected cw or ccw)", o.input, n, d));
+    const auto dir = d == "cw" ? ci::Direction::cw : ci::Direction::ccw;
+    auto& t = traces[dir];
+    t.direction = dir;
+    if (col.count("angle_deg"))
+      t.angle_deg.push_back(cell("angle_deg"));
+    else
+      times[dir].push_back(cell("time_s"));
+    t.deviation_um.push_back(col.count("deviation_um")
+                                 ? cell("deviation_um")
+                                 : (cell("length_mm") - *o.calibrated_length_mm) * 1e3);
+  }
+  std::vector<ci::Trace> out;
+  for (auto& [dir, t] : traces) {
+    if (t.angle_deg.empty())
+      t.angle_deg =
+          ci::angles_from_time(times[dir], o.start_deg, o.feed_mm_per_min, o.radius_mm, dir);
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+json to_json(const ci::Result& r, const CircleOptions& o) {
+  json j{{"schema", "caldaq.circle.v1"},
+         {"standard", "ISO 230-4:2005"},
+         {"radius_mm", o.radius_mm},
+         {"plane", o.plane},
+         {"iso230_4",
+          {{"G_bi_um", r.iso.G_bi_um},
+           {"G_cw_um", r.iso.G_cw_um},
+           {"G_ccw_um", r.iso.G_ccw_um},
+           {"H_um", r.iso.H_um},
+           {"F_max_um", r.iso.F_max_um},
+           {"F_min_um", r.iso.F_min_um},
+           {"centre_um", {r.iso.centre_u_um, r.iso.centre_v_um}},
+           {"arc_deg", r.iso.arc_deg}}},
+         {"residual_rms_um", r.residual_rms_um},
+         {"notes", r.notes}};
+  if (r.cyclic_period_mm) j["cyclic_period_mm"] = *r.cyclic_period_mm;
+  j["diagnostics"] = json::array();
+  for (const auto& d : r.diagnostics)
+    j["diagnostics"].push_back({{"key", d.key},
+                                {"name", d.name},
+                                {"value", d.value},
+                                {"unit", d.unit},
+                                {"pv_um", d.pv_um},
+                                {"share_pct", d.share_pct}});
+  j["centre"] = {{r.centre_u.key, r.centre_u.value}, {r.centre_v.key, r.centre_v.value}};
+  return j;
+}
+
+void print(const ci::Result& r, const CircleOptions& o) {
+  fmt::print("ISO 230-4 circular test, plane {}, R = {} mm, feed {} mm/min\n", o.plane, o.radius_mm,
+             o.feed_mm_per_min);
+  fmt::print("  G (bidirectional)  {:8.3f} um\n", r.iso.G_bi_um);
+  if (r.iso.G_ccw_um > 0) fmt::print("  G ccw              {:8.3f} um\n", r.iso.G_ccw_um);
+  if (r.iso.G_cw_um > 0) fmt::print("  G cw               {:8.3f} um\n", r.iso.G_cw_um);
+  fmt::print("  H                  {:8.3f} um\n", r.iso.H_um);
+  fmt::print("  F max / min        {:8.3f} / {:.3f} um\n", r.iso.F_max_um, r.iso.F_min_um);
+  fmt::print("  LSQ centre         {:8.3f}, {:.3f} um\n\n", r.iso.centre_u_um, r.iso.centre_v_um);
+  fmt::print("Diagnostics (ranked by their share of G):\n");
+  for (const auto& d : r.diagnostics)
+    fmt::print("  {:<40} {:+9.3f} {:<5} {:7.3f} um  {:5.1f} %\n", d.name, d.value, d.unit, d.pv_um,
+               d.share_pct);
+  fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_u.name, r.centre_u.value);
+  fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_v.name, r.centre_v.value);
+  fmt::print("  residual rms {:.3f} um\n", r.residual_rms_um);
+  for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
+}
+
+ci::Plane plane_from(const std::string& p) {
+  if (p == "XY") return ci::Plane::xy;
+  if (p == "YZ") return ci::Plane::yz;
+  if (p == "ZX") return ci::Plane::zx;
+  throw cal::InputError(fmt::format("plane '{}' (expected XY, YZ or ZX)", p));
+}
+
+}  // namespace
+
+void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
+  auto o = std::make_shared<CircleOptions>();
+  auto* cmd =
+      analyse.add_subcommand("circle", "Circular test: ISO 230-4 values and ballbar diagnostics");
+  cmd->add_option("-i,--input", o->input,
+                  "CSV: direction, angle_deg or time_s, deviation_um or length_mm")
+      ->required();
+  cmd->add_option("-R,--radius-mm", o->radius_mm, "Nominal radius")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--feed-mm-min", o->feed_mm_per_min,
+                  "Feed (for time-based angles and the servo lag)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--plane", o->plane, "XY, YZ or ZX")->capture_default_str();
+  cmd->add_option("--start-deg", o->start_deg, "Angle of the first sample when the CSV has time_s");
+  cmd->add_option("--cyclic-period-mm", o->cyclic_period_mm,
+                  "Cyclic-error period (default: searched)");
+  cmd->add_option("--calibrated-length-mm", o->calibrated_length_mm,
+                  "Bar length for length_mm columns");
+  cmd->add_flag("--uncalibrated", o->uncalibrated, "The bar was not calibrated: no radius error");
+  cmd->add_flag("--json", o->json, "Print caldaq.circle.v1 JSON");
+  cmd->callback([o] {
+    const auto traces = read_traces(*o);
+    const auto r = ci::analyse({.plane = plane_from(o->plane),
+                                .radius_mm = o->radius_mm,
+                                .feed_mm_per_min = o->feed_mm_per_min,
+                                .cyclic_period_mm = o->cyclic_period_mm,
+                                .radius_calibrated = !o->uncalibrated},
+                               traces);
+    if (o->json) return fmt::print("{}\n", to_json(r, *o).dump(2));
+    print(r, *o);
+  });
+}
 
 }  // namespace daq
