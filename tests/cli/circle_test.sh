@@ -21,7 +21,7 @@ check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
 # R = 50 mm); a step sampled every 0.25 degrees lets the reversal-spike term take ~2 % of the
 # backlash. So: squareness and the centre to 0.01, the lag to 0.5 %, backlash to 2.5 %.
 check squareness 0 "Squareness XY +\+(19\.99|20\.00)[0-9]* um/m" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10
-check backlash 0 "Backlash X +\+(3\.9[0-9]|4\.0[0-9]) um" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10
+check backlash 0 "Backlash X +\+(3\.9[0-9]*|4\.0[0-9]*) um" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10
 check servo 0 "Servo mismatch \(Y lags X\) +\+(1\.00|0\.99)[0-9]* ms" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10
 check centre 0 "Centre offset X +\+5\.00[0-9]* um" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10
 check json 0 '"schema": "caldaq.circle.v1"' -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --json
