@@ -1,7 +1,167 @@
+// daq analyse straightness | squareness.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cal/analysis/error.hpp"
+#include "cal/analysis/squareness.hpp"
+#include "cal/analysis/straightness.hpp"
 #include "commands.hpp"
 
 namespace daq {
+namespace {
 
-void add_geometry_commands(CLI::App& /*app*/, CLI::App& /*analyse*/) {}
+using nlohmann::json;
+
+// Reads named numeric columns from a CSV with a header line; '#' lines are comments.
+std::map<std::string, std::vector<double>> read_columns(const std::string& path,
+                                                        std::initializer_list<const char*> names) {
+  std::ifstream in(path);
+  if (!in) throw cal::InputError(fmt::format("{}: cannot open", path));
+  std::string line;
+  int n = 0;
+  std::map<std::string, std::size_t> col;
+  std::map<std::string, std::vector<double>> out;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty() || line[0] == '#' || line == "\r") continue;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) {
+      const auto b = c.find_first_not_of(" \t\r"), e = c.find_last_not_of(" \t\r");
+      cells.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
+    }
+    if (col.empty()) {
+      for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
+      for (const char* name : names)
+        if (!col.count(name))
+          throw cal::InputError(fmt::format("{}:{}: the header has no column {}", path, n, name));
+      continue;
+    }
+    for (const char* name : names) {
+      const std::size_t i = col.at(name);
+      const std::string text = i < cells.size() ? cells[i] : "";
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (text.empty() || *end != '\0' || !std::isfinite(v))
+        throw cal::InputError(
+            fmt::format("{}:{}: column {}: '{}' is not a number", path, n, name, text));
+      out[name].push_back(v);
+    }
+  }
+  return out;
+}
+
+struct StraightnessOptions {
+  std::string input;
+  std::string reference = "lsq";
+  bool json = false;
+};
+
+void run_straightness(const StraightnessOptions& o) {
+  auto cols = read_columns(o.input, {"position_mm", "deviation_um"});
+  const auto ref = cal::straightness::reference_from_string(o.reference);
+  const auto r = cal::straightness::evaluate(cols["position_mm"], cols["deviation_um"], ref);
+  if (o.json) {
+    json j{{"schema", "caldaq.straightness.v1"},
+           {"standard", "ISO 230-1:2012"},
+           {"reference", cal::straightness::to_string(ref)},
+           {"straightness_um", r.straightness_um},
+           {"slope_um_per_m", r.slope_um_per_m},
+           {"intercept_um", r.intercept_um},
+           {"position_mm", cols["position_mm"]},
+           {"residual_um", r.residual_um}};
+    return fmt::print("{}\n", j.dump(2));
+  }
+  fmt::print("Straightness (ISO 230-1), {} reference line, {} points\n",
+             cal::straightness::to_string(ref), r.residual_um.size());
+  fmt::print(
+      "  straightness  {:8.3f} um\n  slope         {:8.3f} um/m\n  intercept     {:8.3f} um\n",
+      r.straightness_um, r.slope_um_per_m, r.intercept_um);
+}
+
+struct SquarenessOptions {
+  std::string method;
+  std::string along_a, along_b;  // straightness
+  double square_error = 0.0;
+  double x_mm = 0, y_mm = 0, d1_um = 0, d2_um = 0;  // diagonal
+  std::string circle;                               // circle CSV
+  double radius_mm = 0;
+  bool json = false;
+};
+
+void run_squareness(const SquarenessOptions& o) {
+  cal::squareness::Result r;
+  std::string how;
+  if (o.method == "straightness") {
+    if (o.along_a.empty() || o.along_b.empty())
+      throw cal::InputError("squareness --method straightness needs --along-a and --along-b");
+    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"});
+    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"});
+    r = cal::squareness::from_straightness({a["position_mm"], a["deviation_um"]},
+                                           {b["position_mm"], b["deviation_um"]}, o.square_error);
+    how = "two straightness runs (least-squares lines)";
+  } else if (o.method == "diagonal") {
+    r = cal::squareness::from_diagonals(o.x_mm, o.y_mm, o.d1_um, o.d2_um);
+    how = "ISO 230-6 diagonal displacement test";
+  } else if (o.method == "circle") {
+    if (o.circle.empty() || !(o.radius_mm > 0))
+      throw cal::InputError("squareness --method circle needs --circle FILE and --radius-mm");
+    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"});
+    const cal::squareness::CircleTrace t{c["angle_deg"], c["deviation_um"]};
+    r = cal::squareness::from_circle(o.radius_mm, std::span(&t, 1));
+    how = "circular test (sin 2t term)";
+  } else {
+    throw cal::InputError(fmt::format(
+        "squareness method '{}' (expected straightness, diagonal or circle)", o.method));
+  }
+  if (o.json) {
+    json j{{"schema", "caldaq.squareness.v1"},
+           {"method", o.method},
+           {"squareness_um_per_m", r.squareness_um_per_m},
+           {"squareness_arcsec", r.arcsec()},
+           {"convention",
+            "positive when the angle between the positive axis directions exceeds 90 deg"}};
+    return fmt::print("{}\n", j.dump(2));
+  }
+  fmt::print(
+      "Squareness by {}:\n  {:+.3f} um/m ({:+.3f} arcsec); positive: the angle between the "
+      "positive "
+      "axis directions exceeds 90 degrees\n",
+      how, r.squareness_um_per_m, r.arcsec());
+}
+
+}  // namespace
+
+void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
+  auto s = std::make_shared<StraightnessOptions>();
+  auto* st =
+      analyse.add_subcommand("straightness", "Straightness of an axis (ISO 230-1 reference lines)");
+  st->add_option("-i,--input", s->input, "CSV: position_mm, deviation_um")->required();
+  st->add_option("-r,--reference", s->reference, "lsq, endpoint or minzone")->capture_default_str();
+  st->add_flag("--json", s->json, "Print caldaq.straightness.v1 JSON");
+  st->callback([s] { run_straightness(*s); });
+
+  auto q = std::make_shared<SquarenessOptions>();
+  auto* sq = analyse.add_subcommand("squareness", "Squareness of two axes (ISO 230-1, ISO 230-6)");
+  sq->add_option("-m,--method", q->method, "straightness, diagonal or circle")->required();
+  sq->add_option("--along-a", q->along_a,
+                 "straightness: run moving the reference axis (deviation in +B)");
+  sq->add_option("--along-b", q->along_b,
+                 "straightness: run moving the other axis (deviation in +A)");
+  sq->add_option("--square-error", q->square_error, "straightness: the square's own error, um/m");
+  sq->add_option("--x-mm", q->x_mm, "diagonal: side along A");
+  sq->add_option("--y-mm", q->y_mm, "diagonal: side along B");
+  sq->add_option("--d1-um", q->d1_um, "diagonal: length error of the (X,0)-(0,Y) diagonal");
+  sq->add_option("--d2-um", q->d2_um, "diagonal: length error of the (0,0)-(X,Y) diagonal");
+  sq->add_option("--circle", q->circle, "circle: CSV angle_deg, deviation_um");
+  sq->add_option("--radius-mm", q->radius_mm, "circle: radius");
+  sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
+  sq->callback([q] { run_squareness(*q); });
+}
 
 }  // namespace daq

@@ -1,3 +1,30 @@
 #!/usr/bin/env bash
-# Placeholder: being written. Usage: geometry_test.sh DAQ_BINARY DATA_DIR
-echo "0 passed, 0 failed"
+# daq analyse straightness | squareness. Usage: geometry_test.sh DAQ_BINARY DATA_DIR
+set -u
+DAQ=$1
+DATA=$2
+fails=0
+passes=0
+check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
+  local name=$1 want=$2 pattern=$3
+  shift 4
+  local out
+  out=$("$@" 2>&1)
+  local rc=$?
+  if [ "$rc" -ne "$want" ]; then echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
+  if ! grep -qE -- "$pattern" <<<"$out"; then echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
+  passes=$((passes + 1))
+}
+# The hand set: LSQ 2.7 um at 7 um/m, end point 2.75 um, minimum zone 2.5 um at 5 um/m.
+check lsq 0 "straightness +2\.700 um" -- "$DAQ" analyse straightness -i "$DATA/hand.csv"
+check endpoint 0 "straightness +2\.750 um" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r endpoint
+check minzone 0 '"straightness_um": 2\.5' -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r minzone --json
+# Slopes -20 um/m (B per A) and -10 um/m (A per B): squareness -(-20 - 10) = +30 um/m.
+check square_straightness 0 "\+30\.000 um/m" -- "$DAQ" analyse squareness -m straightness --along-a "$DATA/along_a.csv" --along-b "$DATA/along_b.csv"
+# X 400, Y 300 (D0 500), d1 4.8, d2 -4.8 um: 500 x 9.6 / (2 x 120000) mm^-1 = 20 um/m.
+check square_diagonal 0 '"squareness_um_per_m": 20\.0' -- "$DAQ" analyse squareness -m diagonal --x-mm 400 --y-mm 300 --d1-um 4.8 --d2-um -4.8 --json
+check bad_number 2 "bad.csv:3: column deviation_um: 'x' is not a number" -- "$DAQ" analyse straightness -i "$DATA/bad.csv"
+check bad_reference 2 "unknown reference line 'best'" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r best
+check bad_method 2 "squareness method 'laser'" -- "$DAQ" analyse squareness -m laser
+echo "$passes passed, $fails failed"
+[ "$fails" -eq 0 ]
