@@ -41,8 +41,17 @@ namespace {
 // Writes queued strings to an Asio stream in order; shared by the TCP and pty servers.
 template <class Stream>
 struct LineWriter {
+  // A device sends whether or not anyone listens; with nobody reading the pty, its buffer
+  // fills and a real device's output is lost. Beyond this much queued, new output is dropped
+  // (and counted) instead of growing without bound.
+  static constexpr std::size_t max_queued = 1024;
   std::deque<std::string> queue;
+  std::uint64_t dropped = 0;
   void send(Stream& s, std::string line, std::shared_ptr<void> keep_alive) {
+    if (queue.size() >= max_queued) {
+      ++dropped;
+      return;
+    }
     queue.push_back(std::move(line));
     if (queue.size() == 1) next(s, std::move(keep_alive));
   }

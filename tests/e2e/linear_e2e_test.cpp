@@ -11,11 +11,13 @@
 #include <boost/asio/io_context.hpp>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <thread>
 
 #include "cal/drivers/instruments.hpp"
 #include "cal/storage/store.hpp"
+#include "circle_run.hpp"
 #include "linear_run.hpp"
 #include "sim_shop.hpp"
 
@@ -105,6 +107,48 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   remove_db(db);
 }
 
+TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
+  // The shop's injected errors: squareness +20 um/m, Y lagging X by 1/29.7 - 1/30 s =
+  // 0.3367 ms, backlash X 4 um, scale +8 um/m on X, pitch error 1 um / 40 mm on X, noise
+  // 0.15 um on X. About 2 x 42,000 samples: the noise alone moves a coefficient by
+  // ~0.15 / sqrt(42000) = 0.001 um; the tolerances cover the model's known departures:
+  // the servo's unequal amplitude attenuation in the scale term (+0.3 um/m), the step of the
+  // backlash shared with the reversal-spike term (~2 %), and the feed-in timing (a few ms of
+  // angle offset).
+  const auto db = temp_db("circle");
+  constexpr double speed = 40.0;
+  boost::asio::io_context io;
+  daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
+  const cal::daq::BallbarProgram program{
+      .radius_mm = 100, .feed_mm_per_min = 1000, .sample_rate_hz = 1000};
+  daq::CircleRunSetup setup{
+      .program = program,
+      .database = db,
+      .ballbar =
+          d::make_gauge(io, t::make_serial(io, {.device = shop.ballbar_device(), .baud = 115200}),
+                        {.clock = shop.clock_ns()}, {.min_si = -0.1, .max_si = 0.1})};
+  daq::CircleRun run(io, std::move(setup));
+  run.start();
+  shop.run_circle(program);
+  const auto limit =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration<double>((shop.program_end_s() - shop.now_s()) / speed + 30.0);
+  while (!run.finished() && std::chrono::steady_clock::now() < limit) io.run_for(50ms);
+  ASSERT_TRUE(run.finished());
+  ASSERT_TRUE(run.outcome().complete) << run.outcome().reason;
+  std::map<std::string, double> v;
+  for (const auto& dg : run.outcome().result->diagnostics) v[dg.key] = dg.value;
+  EXPECT_NEAR(v["squareness"], 20.0, 0.2);
+  EXPECT_NEAR(v["servo_mismatch"], (1 / 29.7 - 1 / 30.0) * 1e3, 0.02);
+  EXPECT_NEAR(v["backlash_X"], 4.0, 0.2);
+  EXPECT_NEAR(v["scale_mismatch"], 8.3, 0.5);
+  EXPECT_NEAR(v["cyclic_X"], 1.0, 0.1);
+  cal::storage::Store store(db);
+  ASSERT_EQ(store.results(run.outcome().run_id).size(), 1u);
+  EXPECT_EQ(store.results(run.outcome().run_id)[0].standard, "ISO 230-4:2005");
+  remove_db(db);
+}
+
 TEST(LinearEndToEnd, KillDashNineMidRunLeavesAReadableIncompleteRun) {
   const auto db = temp_db("kill");
   const pid_t child = ::fork();
@@ -159,21 +203,22 @@ TEST(LinearEndToEnd, ReplayingTheCaptureGivesIdenticalStoredResults) {
             0);
   cal::storage::Store store(db);
   const auto runs = store.runs();
-  ASSERT_EQ(runs.size(), 2u);
-  EXPECT_EQ(runs[1].capture_path, fs::absolute(capture).string());
+  ASSERT_EQ(runs.size(), 3u);  // the demo's linear run and circle, then the replay
+  EXPECT_EQ(runs[1].kind, "circle");
+  EXPECT_EQ(runs[2].capture_path, fs::absolute(capture).string());
   // The same bytes through the same instruments and stages: the same readings (with their
   // timestamps), the same captured stops, the same result document.
-  const auto a = store.readings(runs[0].id), b = store.readings(runs[1].id);
+  const auto a = store.readings(runs[0].id), b = store.readings(runs[2].id);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a[i].time_ns, b[i].time_ns) << i;
     ASSERT_EQ(a[i].value, b[i].value) << i;
   }
-  const auto ta = store.targets(runs[0].id), tb = store.targets(runs[1].id);
+  const auto ta = store.targets(runs[0].id), tb = store.targets(runs[2].id);
   ASSERT_EQ(ta.size(), tb.size());
   for (std::size_t i = 0; i < ta.size(); ++i) EXPECT_EQ(ta[i].deviation_um, tb[i].deviation_um);
   ASSERT_EQ(store.results(runs[0].id).size(), 1u);
-  EXPECT_EQ(store.results(runs[0].id)[0].json, store.results(runs[1].id)[0].json);
+  EXPECT_EQ(store.results(runs[0].id)[0].json, store.results(runs[2].id)[0].json);
   remove_db(db);
   fs::remove(capture);
 }

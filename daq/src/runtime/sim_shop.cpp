@@ -43,7 +43,10 @@ struct SimulatedShop::Impl {
                   .cyclic_amplitude_um = t.cyclic_amplitude_um,
                   .cyclic_period_mm = t.cyclic_period_mm,
                   .noise_um = t.noise_um};
-    c.servo[1].kv_per_s = c.servo[2].kv_per_s = 30.0;
+    c.servo[1].kv_per_s = t.kv_y_per_s;
+    c.servo[2].kv_per_s = 30.0;
+    c.servo[0].kv_per_s = t.kv_x_per_s;
+    c.geometry.squareness.c0y_urad = t.squareness_um_per_m;
     c.thermal = {.start_degc = t.machine_degc, .expansion_ppm_per_k = t.expansion_ppm_per_k};
     c.acceleration_mm_per_s2 = 2000.0;
     return c;
@@ -70,7 +73,7 @@ struct SimulatedShop::Impl {
                   .request = "?",
                   .decimals = 3,
                   .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
-        ballbar(io, world, clock, {}) {}
+        ballbar(io, world, clock, {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm}) {}
 
   double now() const {
     return speed * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -97,6 +100,23 @@ void SimulatedShop::run_linear(const cal::iso230_2::Plan& plan, double feed, dou
     program.push_back(sim::Move::linear({m.position_mm, 0, 0}, feed));
     if (m.kind == cal::iso230_2::MoveKind::measure) program.push_back(sim::Move::dwell(dwell_s));
   }
+  impl_->world.advance_to(now_s());
+  impl_->world.machine().load(program);
+}
+
+void SimulatedShop::run_circle(const cal::daq::BallbarProgram& p) {
+  const auto& c = impl_->truth.pivot_mm;
+  const double feed = p.feed_mm_per_min, sweep = 360.0 + 2 * p.overshoot_deg;
+  const sim::Vec3 centre{c[0], c[1], c[2]};
+  const std::vector<sim::Move> program{
+      sim::Move::linear({c[0] + p.radius_mm + p.feed_in_mm, c[1], c[2]}, 3000.0),
+      sim::Move::dwell(0.5),
+      sim::Move::linear({c[0] + p.radius_mm, c[1], c[2]}, feed),
+      sim::Move::dwell(p.dwell_s),
+      sim::Move::arc(false, centre, sim::Plane::xy, sweep, feed),
+      sim::Move::dwell(p.dwell_s),
+      sim::Move::arc(true, centre, sim::Plane::xy, sweep, feed),
+      sim::Move::linear({c[0] + p.radius_mm + p.feed_in_mm, c[1], c[2]}, feed)};
   impl_->world.advance_to(now_s());
   impl_->world.machine().load(program);
 }

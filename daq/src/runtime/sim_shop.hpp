@@ -11,6 +11,7 @@
 
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
+#include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/drivers/sim/machine.hpp"
 
@@ -31,6 +32,12 @@ struct ShopTruth {
   double expansion_ppm_per_k = 11.5;
   double air_start_degc = 20.6, air_drift_k_per_h = 0.6;
   double pressure_pa = 100650.0, humidity_pct = 42.0;
+  // For the circular test in XY: squareness (E_C0Y) and the Y position loop slower than X's
+  // (servo mismatch: Y lags X by 1/kv_y - 1/kv_x), the ballbar's table ball and length.
+  double squareness_um_per_m = 20.0;
+  double kv_x_per_s = 30.0, kv_y_per_s = 29.7;  // Y lags X by 0.337 ms
+  std::array<double, 3> pivot_mm{150.0, 0.0, 0.0};
+  double ballbar_mm = 100.0;
   // The deviation at 20 degC of a stop at x approached from below (up) or above.
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
 };
@@ -51,6 +58,9 @@ class SimulatedShop {
   // The machine program for an ISO 230-2 plan on X: every move at the feed, a dwell at each
   // measure move.
   void run_linear(const cal::iso230_2::Plan& plan, double feed_mm_per_min, double dwell_s);
+  // The ballbar program in XY about the pivot: start feed_in_mm outside the radius at 0 deg,
+  // move in, dwell, ccw arc of 360 + 2 overshoot, dwell, cw arc back, move out.
+  void run_circle(const cal::daq::BallbarProgram& p);
   double program_end_s() const;
   // The truth of a plan: the noise-free deviations at its stops, for the same evaluation.
   std::vector<cal::iso230_2::Measurement> true_measurements(const cal::iso230_2::Plan& p) const;

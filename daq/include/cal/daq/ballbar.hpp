@@ -1,0 +1,54 @@
+#pragma once
+// Ballbar acquisition (pipeline stage; plain C++): turns the stream of bar readings into the
+// clockwise and counter-clockwise traces of a circular test.
+//
+// A ballbar has no angle sensor, so the test program's timing is the reference, as in the
+// usual ballbar procedure: the machine starts `feed_in_mm` outside the radius, moves in along
+// the radius (the bar shortens by feed_in_mm), dwells `dwell_s`, runs the counter-clockwise
+// arc (overshoot + 360 + overshoot degrees) at the feed, dwells again, runs the clockwise arc
+// back, and moves out. The stage finds the end of the feed-in (the reading settles near zero
+// after having been near +feed_in), then every later sample's angle follows from the sample
+// rate, the dwell, the feed and the radius; the overshoot arcs (acceleration, reversal) are
+// trimmed. Samples are timed by their index at the gauge's fixed rate, not by the arrival of
+// USB chunks.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/circle.hpp"
+
+namespace cal::daq {
+
+struct BallbarProgram {
+  double radius_mm = 100.0;
+  double feed_mm_per_min = 1000.0;
+  double sample_rate_hz = 1000.0;
+  double feed_in_mm = 1.5;
+  double dwell_s = 1.0;
+  double overshoot_deg = 45.0;
+  double start_deg = 0.0;  // angle of the start point, from the first axis
+};
+
+class BallbarSegmenter {
+ public:
+  explicit BallbarSegmenter(BallbarProgram p);  // throws cal::InputError for bad values
+  // One bar reading: the deviation of the bar from its calibrated length, in mm.
+  void add(double deviation_mm);
+  std::optional<std::size_t> feed_in_end() const { return feed_in_end_; }
+  // True once both arcs (and their overshoot) have been sampled.
+  bool complete() const;
+  // The trimmed traces (ccw, cw); throws cal::InputError if not complete, naming what is
+  // missing (no feed-in found, or how many samples short).
+  std::vector<circle::Trace> traces() const;
+  double arc_duration_s() const;  // of one arc with its overshoots
+  std::size_t samples() const { return values_.size(); }
+
+ private:
+  BallbarProgram p_;
+  std::vector<double> values_;
+  bool saw_out_ = false;
+  std::optional<std::size_t> feed_in_end_;
+  std::size_t settle_count_ = 0;
+};
+
+}  // namespace cal::daq

@@ -1,0 +1,77 @@
+// Ballbar stream segmentation (see ballbar.hpp).
+#include "cal/daq/ballbar.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "cal/analysis/error.hpp"
+
+namespace cal::daq {
+
+BallbarSegmenter::BallbarSegmenter(BallbarProgram p) : p_(p) {
+  if (!(p.radius_mm > 0) || !(p.feed_mm_per_min > 0) || !(p.sample_rate_hz > 0) ||
+      !(p.feed_in_mm > 0) || !(p.dwell_s >= 0) || !(p.overshoot_deg >= 0))
+    throw InputError(fmt::format(
+        "ballbar program: radius {} mm, feed {} mm/min, rate {} Hz and feed-in {} mm must be > 0, "
+        "dwell {} s and overshoot {} deg >= 0",
+        p.radius_mm, p.feed_mm_per_min, p.sample_rate_hz, p.feed_in_mm, p.dwell_s,
+        p.overshoot_deg));
+}
+
+double BallbarSegmenter::arc_duration_s() const {
+  const double sweep_rad = (360.0 + 2 * p_.overshoot_deg) * std::numbers::pi / 180.0;
+  return sweep_rad * p_.radius_mm / (p_.feed_mm_per_min / 60.0);
+}
+
+void BallbarSegmenter::add(double v) {
+  values_.push_back(v);
+  if (feed_in_end_) return;
+  // The feed-in: first outside (more than half the feed-in), then settled within 5 % of it
+  // around zero for 50 ms: the end of the move is where the settling began.
+  if (v > 0.5 * p_.feed_in_mm) saw_out_ = true, settle_count_ = 0;
+  if (!saw_out_) return;
+  if (std::abs(v) < 0.05 * p_.feed_in_mm) {
+    if (++settle_count_ >= static_cast<std::size_t>(0.05 * p_.sample_rate_hz) + 1)
+      feed_in_end_ = values_.size() - settle_count_;
+  } else {
+    settle_count_ = 0;
+  }
+}
+
+bool BallbarSegmenter::complete() const {
+  if (!feed_in_end_) return false;
+  const double needed_s = 2 * p_.dwell_s + 2 * arc_duration_s();
+  return static_cast<double>(values_.size() - *feed_in_end_) >= needed_s * p_.sample_rate_hz;
+}
+
+std::vector<circle::Trace> BallbarSegmenter::traces() const {
+  if (!feed_in_end_) throw InputError("ballbar: no feed-in move found in the readings");
+  if (!complete())
+    throw InputError(fmt::format(
+        "ballbar: {} samples after the feed-in, {} needed for both arcs",
+        values_.size() - *feed_in_end_,
+        static_cast<std::size_t>((2 * p_.dwell_s + 2 * arc_duration_s()) * p_.sample_rate_hz)));
+  const double rate_deg_s = p_.feed_mm_per_min / 60.0 / p_.radius_mm * 180.0 / std::numbers::pi;
+  std::vector<circle::Trace> out;
+  for (int k = 0; k < 2; ++k) {  // ccw, then cw
+    const double arc_start_s = p_.dwell_s + k * (arc_duration_s() + p_.dwell_s);
+    const double s = k == 0 ? 1.0 : -1.0;
+    circle::Trace t{k == 0 ? circle::Direction::ccw : circle::Direction::cw, {}, {}};
+    const double first = arc_start_s + p_.overshoot_deg / rate_deg_s;
+    const double last = arc_start_s + (p_.overshoot_deg + 360.0) / rate_deg_s;
+    for (auto i = static_cast<std::size_t>(std::ceil(first * p_.sample_rate_hz));
+         static_cast<double>(i) < last * p_.sample_rate_hz; ++i) {
+      const double t_s = static_cast<double>(i) / p_.sample_rate_hz;
+      // ccw starts at start_deg; cw starts where ccw ended (start + 360 + 2 overshoot).
+      const double start = k == 0 ? p_.start_deg : p_.start_deg + 360.0 + 2 * p_.overshoot_deg;
+      t.angle_deg.push_back(start + s * rate_deg_s * (t_s - arc_start_s));
+      t.deviation_um.push_back(values_[*feed_in_end_ + i] * 1e3);
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+}  // namespace cal::daq
