@@ -1,2 +1,245 @@
-// Placeholder: being written.
+// Compensation tables (see comp_table.hpp and docs/compensation-tables.md).
 #include "cal/analysis/comp_table.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "cal/analysis/error.hpp"
+#include "cal/analysis/straightness.hpp"
+
+namespace cal::comptable {
+namespace {
+
+void validate(const Spec& s) {
+  if (!(s.interval_mm > 0) || !std::isfinite(s.interval_mm))
+    throw InputError(fmt::format("compensation table: interval {} mm must be > 0", s.interval_mm));
+  if (s.points < 2)
+    throw InputError(fmt::format("compensation table: {} points, at least 2", s.points));
+  if (!(s.resolution >= 0))
+    throw InputError(fmt::format("compensation table: resolution {} must be >= 0", s.resolution));
+}
+
+double to_units(double um, Units u) {
+  switch (u) {
+    case Units::mm:
+      return um * 1e-3;
+    case Units::um:
+      return um;
+    case Units::inch:
+      return um / 25400.0;  // 1 in = 25.4 mm exactly
+  }
+  return um;
+}
+
+double round_to(double v, double res) { return res > 0 ? std::round(v / res) * res : v; }
+
+// Linear interpolation of y(x) at q; x increasing. Outside: refuse or hold the end value.
+double interpolate(const std::vector<double>& x, const std::vector<double>& y, double q,
+                   Outside o) {
+  const double eps = 1e-9;
+  if (q < x.front() - eps || q > x.back() + eps) {
+    if (o == Outside::refuse)
+      throw InputError(
+          fmt::format("compensation table: grid point {} mm is outside the measured "
+                      "range {} .. {} mm (extend the run, or choose hold)",
+                      q, x.front(), x.back()));
+    return q < x.front() ? y.front() : y.back();
+  }
+  const auto hi = std::upper_bound(x.begin(), x.end(), q) - x.begin();
+  if (hi == 0) return y.front();
+  if (static_cast<std::size_t>(hi) == x.size()) return y.back();
+  const auto lo = hi - 1;
+  const double f = (q - x[static_cast<std::size_t>(lo)]) /
+                   (x[static_cast<std::size_t>(hi)] - x[static_cast<std::size_t>(lo)]);
+  return y[static_cast<std::size_t>(lo)] +
+         f * (y[static_cast<std::size_t>(hi)] - y[static_cast<std::size_t>(lo)]);
+}
+
+// Error (um) -> table value: sign, units, then incremental, then rounding.
+std::vector<double> finish(const Spec& s, const std::vector<double>& error_um) {
+  std::vector<double> v;
+  for (double e : error_um) v.push_back(to_units(s.sign == Sign::correction ? -e : e, s.units));
+  if (s.incremental)
+    for (std::size_t i = v.size(); i-- > 1;) v[i] -= v[i - 1];
+  for (auto& x : v) x = round_to(x, s.resolution);
+  return v;
+}
+
+std::vector<double> grid(const Spec& s) {
+  std::vector<double> g;
+  for (int i = 0; i < s.points; ++i) g.push_back(s.start_mm + i * s.interval_mm);
+  return g;
+}
+
+}  // namespace
+
+std::string units_name(Units u) { return u == Units::mm ? "mm" : u == Units::um ? "um" : "inch"; }
+
+Units units_from_string(const std::string& s) {
+  if (s == "mm") return Units::mm;
+  if (s == "um") return Units::um;
+  if (s == "inch" || s == "in") return Units::inch;
+  throw InputError(fmt::format("units '{}' (expected mm, um or inch)", s));
+}
+
+Table positioning(const Spec& spec, std::span<const iso230_2::TargetStats> targets) {
+  validate(spec);
+  if (targets.size() < 2)
+    throw InputError(fmt::format("compensation table: {} targets, at least 2", targets.size()));
+  std::vector<double> x, up, down, bi;
+  for (const auto& t : targets) {
+    x.push_back(t.target_mm);
+    up.push_back(t.runs_up > 0 ? t.mean_up_um : t.mean_down_um);
+    down.push_back(t.runs_down > 0 ? t.mean_down_um : t.mean_up_um);
+    bi.push_back(0.5 * (up.back() + down.back()));
+  }
+  Table t;
+  t.spec = spec;
+  t.position_mm = grid(spec);
+  std::vector<double> f, r, m;
+  for (double q : t.position_mm) {
+    f.push_back(interpolate(x, up, q, spec.outside));
+    r.push_back(interpolate(x, down, q, spec.outside));
+    m.push_back(interpolate(x, bi, q, spec.outside));
+  }
+  if (spec.bidirectional) {
+    t.forward = finish(spec, f);
+    t.reverse = finish(spec, r);
+  } else {
+    t.forward = finish(spec, m);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) sum += down[i] - up[i];
+    t.backlash =
+        round_to(to_units(sum / static_cast<double>(x.size()), spec.units), spec.resolution);
+  }
+  return t;
+}
+
+Table cross(const Spec& spec, std::span<const double> position_mm,
+            std::span<const double> deviation_um, bool remove_slope) {
+  validate(spec);
+  const auto r =
+      straightness::evaluate(position_mm, deviation_um, straightness::Reference::least_squares);
+  std::vector<std::pair<double, double>> pts;
+  for (std::size_t i = 0; i < position_mm.size(); ++i)
+    pts.emplace_back(position_mm[i],
+                     remove_slope ? r.residual_um[i] + r.intercept_um : deviation_um[i]);
+  std::sort(pts.begin(), pts.end());
+  std::vector<double> x, y;
+  for (const auto& [a, b] : pts) x.push_back(a), y.push_back(b);
+  Table t;
+  t.spec = spec;
+  t.spec.bidirectional = false;
+  t.position_mm = grid(spec);
+  std::vector<double> e;
+  for (double q : t.position_mm) e.push_back(interpolate(x, y, q, spec.outside));
+  t.forward = finish(spec, e);
+  return t;
+}
+
+namespace {
+// The value a direction-specific format needs at point i: the separate tables, or the single
+// table with half the backlash on each side (lost motion b: the axis stops b/2 short in each
+// direction, so the forward correction is larger by b/2 and the reverse smaller).
+double directional(const Table& t, std::size_t i, bool forward) {
+  if (t.spec.bidirectional) return forward ? t.forward[i] : t.reverse[i];
+  const double half = 0.5 * t.backlash * (t.spec.sign == Sign::correction ? 1.0 : -1.0);
+  return round_to(t.forward[i] + (forward ? half : -half), t.spec.resolution);
+}
+
+int decimals(const Spec& s) {
+  if (s.resolution <= 0) return 6;
+  return std::max(0, static_cast<int>(std::ceil(-std::log10(s.resolution) - 1e-9)));
+}
+}  // namespace
+
+std::string write_csv(const Table& t) {
+  const int d = decimals(t.spec);
+  std::string out = fmt::format(
+      "# caldaq compensation table: axis {}, {} values in {}, {}, {}\n", t.spec.axis,
+      t.spec.sign == Sign::correction ? "correction" : "error", units_name(t.spec.units),
+      t.spec.incremental ? "incremental" : "absolute",
+      t.spec.bidirectional ? "forward/reverse" : fmt::format("backlash {:.{}f}", t.backlash, d));
+  out += t.spec.bidirectional ? "point,position_mm,forward,reverse\n" : "point,position_mm,value\n";
+  for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
+    out += fmt::format("{},{:.4f},{:.{}f}", i, t.position_mm[i], t.forward[i], d);
+    if (t.spec.bidirectional) out += fmt::format(",{:.{}f}", t.reverse[i], d);
+    out += "\n";
+  }
+  return out;
+}
+
+// LinuxCNC, [JOINT_n] COMP_FILE with COMP_FILE_TYPE = 1: one line per point, "nominal
+// forward-trim reverse-trim" in machine units; a trim is added to the commanded position, so
+// the values are corrections (docs/compensation-tables.md). Absolute values only.
+std::string write_linuxcnc(const Table& t) {
+  if (t.spec.incremental || t.spec.sign != Sign::correction)
+    throw InputError(
+        "LinuxCNC compensation files hold absolute corrections: use --sign correction, no "
+        "--incremental");
+  const int d = decimals(t.spec);
+  std::string out;
+  for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
+    const double nominal = t.spec.units == Units::inch ? t.position_mm[i] / 25.4
+                           : t.spec.units == Units::um ? t.position_mm[i] * 1e3
+                                                       : t.position_mm[i];
+    out += fmt::format("{:.4f} {:.{}f} {:.{}f}\n", nominal, directional(t, i, true), d,
+                       directional(t, i, false), d);
+  }
+  return out;
+}
+
+// SINUMERIK 840D leadscrew error compensation (LEC), as a part program setting the system
+// variables $AA_ENC_COMP (values in mm), $AA_ENC_COMP_STEP, _MIN, _MAX and _IS_MODULO of the
+// first measuring system, as in Siemens' function manual "Extended Functions", K3
+// Compensation. One table (the controller's backlash is a machine datum, given as a comment).
+std::string write_siemens(const Table& t, int axis_number) {
+  if (t.spec.units != Units::mm) throw InputError("SINUMERIK LEC tables are in mm: use --units mm");
+  if (t.spec.incremental)
+    throw InputError("SINUMERIK LEC tables hold absolute values: no --incremental");
+  if (t.spec.bidirectional)
+    throw InputError("one SINUMERIK LEC table per measuring system: use a table plus backlash");
+  const int d = std::min(decimals(t.spec), 6);
+  std::string out =
+      fmt::format("; LEC for axis {} ({}), written by caldaq\n; backlash (MD32450) {:.{}f} mm\n",
+                  t.spec.axis, axis_number, t.backlash, d);
+  out += "CHANDATA(1)\n";
+  for (std::size_t i = 0; i < t.forward.size(); ++i)
+    out += fmt::format("$AA_ENC_COMP[0,{},AX{}]={:.{}f}\n", i, axis_number, t.forward[i], d);
+  out += fmt::format("$AA_ENC_COMP_STEP[0,AX{}]={:.4f}\n", axis_number, t.spec.interval_mm);
+  out += fmt::format("$AA_ENC_COMP_MIN[0,AX{}]={:.4f}\n", axis_number, t.position_mm.front());
+  out += fmt::format("$AA_ENC_COMP_MAX[0,AX{}]={:.4f}\n", axis_number, t.position_mm.back());
+  out += fmt::format("$AA_ENC_COMP_IS_MODULO[0,AX{}]=0\n", axis_number);
+  out += "M17\n";
+  return out;
+}
+
+// Beckhoff TwinCAT CNC (ISG) leadscrew error compensation list, kw.ssfk.*: the documented
+// interval (P-COMP-00018) and, per point, setpoint (P-COMP-00025), pos and neg (P-COMP-00023,
+// -00024), all in 0.1 um. The header and count/mode lines are named in the docs' parameter
+// list only by number here (see docs/compensation-tables.md).
+std::string write_isg(const Table& t) {
+  if (t.spec.incremental) throw InputError("ISG SSFK lists hold absolute values: no --incremental");
+  auto tenth_um = [&](double v) {  // table units -> 0.1 um
+    const double um = t.spec.units == Units::mm     ? v * 1e3
+                      : t.spec.units == Units::inch ? v * 25400.0
+                                                    : v;
+    return static_cast<long long>(std::llround(um * 10.0));
+  };
+  std::string out = fmt::format(
+      "# ISG/TwinCAT CNC leadscrew error compensation, axis {}, written by caldaq\n", t.spec.axis);
+  out += "# set P-COMP-00019 (start), P-COMP-00020 (number of values) and P-COMP-00021 (mode:\n";
+  out += fmt::format("# bilateral) for this list: start {:.4f} mm, {} values\n",
+                     t.position_mm.front(), t.position_mm.size());
+  out += fmt::format("kw.ssfk.interval {}\n", std::llround(t.spec.interval_mm * 1e4));
+  for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
+    out += fmt::format("kw.ssfk.table[{}].setpoint {}\n", i, std::llround(t.position_mm[i] * 1e4));
+    out += fmt::format("kw.ssfk.table[{}].pos {}\n", i, tenth_um(directional(t, i, true)));
+    out += fmt::format("kw.ssfk.table[{}].neg {}\n", i, tenth_um(directional(t, i, false)));
+  }
+  return out;
+}
+
+}  // namespace cal::comptable

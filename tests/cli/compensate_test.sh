@@ -1,3 +1,32 @@
 #!/usr/bin/env bash
-# Placeholder: being written. Usage: compensate_test.sh DAQ_BINARY DATA_DIR
-echo "0 passed, 0 failed"
+# daq compensate on the hand-calculated axis of tests/analysis/comp_table_test.cpp.
+# Usage: compensate_test.sh DAQ_BINARY DATA_DIR
+set -u
+DAQ=$1
+DATA=$2
+fails=0
+passes=0
+check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
+  local name=$1 want=$2 pattern=$3
+  shift 4
+  local out
+  out=$("$@" 2>&1)
+  local rc=$?
+  if [ "$rc" -ne "$want" ]; then echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
+  if ! grep -qE -- "$pattern" <<<"$out"; then echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
+  passes=$((passes + 1))
+}
+G=(--start-mm 0 --interval-mm 50 --points 5)
+# Corrections -0.002 .. -0.006 mm, backlash 0.004 mm; LinuxCNC trims -(0..4) and -(4..8) um.
+check csv 0 "^2,100\.0000,-0\.0040$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}"
+check backlash 0 "backlash 0\.0040" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}"
+check linuxcnc 0 "^150\.0000 -0\.0030 -0\.0070$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f linuxcnc
+check siemens 0 '^\$AA_ENC_COMP\[0,4,AX2\]=-0\.0060$' -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f siemens --axis-number 2
+check isg 0 "^kw\.ssfk\.table\[1\]\.neg -50$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f isg
+check json 0 '"schema": "caldaq.comp-table.v1"' -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --bidirectional --json
+check cross 0 "^1,100\.0000,-1\.000$" -- "$DAQ" compensate --straightness "$DATA/straightness.csv" --start-mm 0 --interval-mm 100 --points 3 --units um --resolution 0.001
+check outside 2 "grid point -50 mm is outside the measured range 0 \.\. 200 mm" -- "$DAQ" compensate -i "$DATA/meas.csv" --start-mm -50 --interval-mm 50 --points 3
+check linuxcnc_incremental 2 "absolute corrections" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f linuxcnc --incremental
+check bad_format 2 "format 'fanuc'" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f fanuc
+echo "$passes passed, $fails failed"
+[ "$fails" -eq 0 ]

@@ -1,2 +1,64 @@
 #pragma once
-// Placeholder: being written.
+// Compensation tables for the machine's controller from measured ISO 230-2 runs: per-axis
+// positioning compensation on a regular grid (start, interval, points), one table plus
+// backlash or separate forward/reverse tables, absolute or incremental values, error or
+// correction sign, machine units and resolution; and writers for a documented CSV and
+// controller formats (docs/compensation-tables.md says which parts of each format are from
+// public documentation). Analysis does no I/O: writers return the text.
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/iso230_2.hpp"
+
+namespace cal::comptable {
+
+enum class Sign { correction, error };  // correction = -error (what the control adds)
+enum class Units { mm, um, inch };
+enum class Outside { refuse, hold };  // grid points beyond the measured targets
+
+struct Spec {
+  std::string axis = "X";
+  double start_mm = 0.0;
+  double interval_mm = 10.0;
+  int points = 2;
+  bool bidirectional = false;  // separate forward/reverse tables; else one table + backlash
+  bool incremental = false;    // each value relative to the previous point (the first absolute)
+  Sign sign = Sign::correction;
+  Units units = Units::mm;
+  double resolution = 0.0001;  // in `units`; values are rounded to it (0: no rounding)
+  Outside outside = Outside::refuse;
+};
+
+struct Table {
+  Spec spec;
+  std::vector<double> position_mm;
+  std::vector<double> forward;  // in spec.units; also the single table when !bidirectional
+  std::vector<double> reverse;  // bidirectional only
+  double backlash = 0.0;  // !bidirectional: the mean reversal, in spec.units (>= 0 lost motion)
+};
+
+// From the per-target statistics of an evaluation (mean deviations up and down, um): the
+// forward table from x-bar-up, the reverse from x-bar-down, or one table from the
+// bidirectional mean x-bar with backlash = mean(x-bar-down - x-bar-up) (lost motion makes the
+// down approach stop higher). Linear interpolation between targets. Throws cal::InputError
+// for interval <= 0, points < 2, resolution < 0, fewer than 2 targets, or a grid point
+// outside the measured range under Outside::refuse.
+Table positioning(const Spec& spec, std::span<const iso230_2::TargetStats> targets);
+
+// A straightness cross-compensation: the correction of axis `slave` as a function of the
+// position of axis `spec.axis`, from a straightness run (deviations in um); the slope (i.e.
+// squareness) is kept unless remove_slope.
+Table cross(const Spec& spec, std::span<const double> position_mm,
+            std::span<const double> deviation_um, bool remove_slope);
+
+std::string units_name(Units u);
+Units units_from_string(const std::string& s);
+
+// Writers.
+std::string write_csv(const Table& t);       // caldaq comp-table CSV (documented columns)
+std::string write_linuxcnc(const Table& t);  // LinuxCNC COMP_FILE, COMP_FILE_TYPE = 1
+std::string write_siemens(const Table& t, int axis_number = 1);  // 840D LEC, $AA_ENC_COMP
+std::string write_isg(const Table& t);  // Beckhoff TwinCAT CNC / ISG SSFK list
+
+}  // namespace cal::comptable
