@@ -8,6 +8,7 @@
 #include <bit>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <thread>
 #include <utility>
@@ -62,33 +63,51 @@ struct CaptureWriter::Impl {
   std::filesystem::path path;
   WriterLimits limits;
   std::FILE* file = nullptr;
-  std::vector<std::byte> payload;
+  // The block being filled, after room for its 16-byte header so that a block goes to the OS
+  // in one write (the file is unbuffered: `written` is then exact at every error).
+  std::vector<std::byte> payload = std::vector<std::byte>(kBlockHeader);
   std::uint32_t records = 0;
   std::uint64_t total = 0;
   std::size_t peak = 0;
-  std::uint64_t written = 0;
+  std::uint64_t written = 0;  // bytes handed to the OS (or to stdio) without error
+  std::string failure;        // the first write error; set, every later call refuses
 
-  [[noreturn]] void fail(std::string_view what) const {
-    throw CaptureError(
-        fmt::format("{}: {} at byte {}: {}", path.string(), what, written, std::strerror(errno)));
+  [[noreturn]] void fail(std::string_view what) {
+    const int saved = errno;  // fmt and string building must not change the reported errno
+    failure =
+        fmt::format("{}: {} at byte {}: {}", path.string(), what, written, std::strerror(saved));
+    throw CaptureError(failure);
+  }
+  void check_usable() const {
+    if (!failure.empty())
+      throw CaptureError(
+          fmt::format("{} (nothing written since; the blocks before that byte "
+                      "are intact)",
+                      failure));
+    if (!file) throw CaptureError(fmt::format("{}: write after close", path.string()));
   }
   void write(std::span<const std::byte> bytes) {
     if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) fail("write failed");
     written += bytes.size();
   }
+  std::size_t buffered() const { return payload.size() - kBlockHeader; }
   void write_block() {
     if (records == 0) return;
     std::vector<std::byte> head;
     put<std::uint32_t>(head, kBlockMagic);
-    put<std::uint32_t>(head, static_cast<std::uint32_t>(payload.size()));
+    put<std::uint32_t>(head, static_cast<std::uint32_t>(buffered()));
     put<std::uint32_t>(head, records);
     // The CRC covers the length and count as well as the payload: a damaged count would
     // otherwise misalign every record after it.
-    put<std::uint32_t>(head, crc32c(payload, crc32c(std::span(head).subspan(4, 8))));
-    write(head);
+    const auto body = std::span(payload).subspan(kBlockHeader);
+    put<std::uint32_t>(head, crc32c(body, crc32c(std::span(head).subspan(4, 8))));
+    std::copy(head.begin(), head.end(), payload.begin());
     write(payload);
-    payload.clear();
+    payload.resize(kBlockHeader);
     records = 0;
+  }
+  void flush_to_os() {
+    if (std::fflush(file) != 0) fail("flush failed");
   }
 };
 
@@ -97,12 +116,16 @@ CaptureWriter::CaptureWriter(const std::filesystem::path& path, std::string_view
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->limits = limits;
-  impl_->file = std::fopen(path.c_str(), "wb");
-  if (!impl_->file)
-    throw CaptureError(fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno)));
   if (header_json.size() > kMaxHeader)
     throw CaptureError(fmt::format("{}: header of {} bytes is over the 1 MiB limit", path.string(),
                                    header_json.size()));
+  if (limits.block_bytes > max_block_bytes)
+    throw CaptureError(fmt::format("{}: block size {} bytes is over the {} byte limit",
+                                   path.string(), limits.block_bytes, max_block_bytes));
+  impl_->file = std::fopen(path.c_str(), "wb");
+  if (!impl_->file)
+    throw CaptureError(fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno)));
+  std::setvbuf(impl_->file, nullptr, _IONBF, 0);  // our blocks are the buffer
   std::vector<std::byte> head;
   for (char c : kMagic) head.push_back(static_cast<std::byte>(c));
   put<std::uint16_t>(head, capture_major_version);
@@ -111,13 +134,18 @@ CaptureWriter::CaptureWriter(const std::filesystem::path& path, std::string_view
   const auto* json = reinterpret_cast<const std::byte*>(header_json.data());
   head.insert(head.end(), json, json + header_json.size());
   put<std::uint32_t>(head, crc32c(std::span(head).subspan(8)));
-  impl_->write(head);
-  impl_->payload.reserve(limits.block_bytes + 1024);
-  flush();
+  impl_->payload.reserve(kBlockHeader + limits.block_bytes + 1024);
+  try {
+    impl_->write(head);
+    impl_->flush_to_os();
+  } catch (const CaptureError&) {
+    std::fclose(std::exchange(impl_->file, nullptr));  // the destructor does not run
+    throw;
+  }
 }
 
 CaptureWriter::~CaptureWriter() {
-  if (!impl_->file) return;
+  if (!impl_ || !impl_->file) return;
   try {
     close();
   } catch (const CaptureError&) {
@@ -128,7 +156,10 @@ CaptureWriter::~CaptureWriter() {
 void CaptureWriter::record(std::int64_t time_ns, std::uint16_t device, RecordKind kind,
                            std::span<const std::byte> bytes) {
   Impl& m = *impl_;
-  if (!m.file) throw CaptureError(fmt::format("{}: write after close", m.path.string()));
+  m.check_usable();
+  if (bytes.size() > max_record_bytes)
+    throw CaptureError(fmt::format("{}: a record of {} bytes is over the {} byte limit",
+                                   m.path.string(), bytes.size(), max_record_bytes));
   put<std::int64_t>(m.payload, time_ns);
   put<std::uint16_t>(m.payload, device);
   put<std::uint8_t>(m.payload, static_cast<std::uint8_t>(kind));
@@ -137,8 +168,8 @@ void CaptureWriter::record(std::int64_t time_ns, std::uint16_t device, RecordKin
   m.payload.insert(m.payload.end(), bytes.begin(), bytes.end());
   ++m.records;
   ++m.total;
-  m.peak = std::max(m.peak, m.payload.size());
-  if (m.payload.size() >= m.limits.block_bytes) m.write_block();
+  m.peak = std::max(m.peak, m.buffered());
+  if (m.buffered() >= m.limits.block_bytes) m.write_block();
 }
 
 void CaptureWriter::event(std::int64_t time_ns, std::uint16_t device, std::string_view text) {
@@ -146,29 +177,42 @@ void CaptureWriter::event(std::int64_t time_ns, std::uint16_t device, std::strin
 }
 
 void CaptureWriter::flush() {
+  impl_->check_usable();
   impl_->write_block();
-  if (std::fflush(impl_->file) != 0) impl_->fail("flush failed");
+  impl_->flush_to_os();
 }
 
 void CaptureWriter::close() {
-  if (!impl_->file) return;
-  impl_->write_block();
-  // The end block: a capture without it was not closed (the session was interrupted), which a
-  // cut exactly between two blocks could not otherwise show.
-  std::vector<std::byte> end, count;
-  put<std::uint64_t>(count, impl_->total);
-  put<std::uint32_t>(end, kEndMagic);
-  put<std::uint32_t>(end, 8);
-  put<std::uint32_t>(end, 0);
-  put<std::uint32_t>(end, crc32c(count));
-  end.insert(end.end(), count.begin(), count.end());
-  impl_->write(end);
-  if (std::fflush(impl_->file) != 0) impl_->fail("flush failed");
-  std::FILE* f = std::exchange(impl_->file, nullptr);
-  if (std::fclose(f) != 0) impl_->fail("close failed");
+  Impl& m = *impl_;
+  if (!m.file) return;
+  if (!m.failure.empty()) {
+    // Close without writing: an end block after a failed write would claim a complete file.
+    std::FILE* f = std::exchange(m.file, nullptr);
+    std::fclose(f);
+    m.check_usable();
+  }
+  try {
+    m.write_block();
+    // The end block: a capture without it was not closed (the session was interrupted),
+    // which a cut exactly between two blocks could not otherwise show.
+    std::vector<std::byte> end, count;
+    put<std::uint64_t>(count, m.total);
+    put<std::uint32_t>(end, kEndMagic);
+    put<std::uint32_t>(end, 8);
+    put<std::uint32_t>(end, 0);
+    put<std::uint32_t>(end, crc32c(count));
+    end.insert(end.end(), count.begin(), count.end());
+    m.write(end);
+    m.flush_to_os();
+  } catch (const CaptureError&) {
+    std::fclose(std::exchange(m.file, nullptr));
+    throw;
+  }
+  std::FILE* f = std::exchange(m.file, nullptr);
+  if (std::fclose(f) != 0) m.fail("close failed");
 }
 
-std::size_t CaptureWriter::buffered_bytes() const { return impl_->payload.size(); }
+std::size_t CaptureWriter::buffered_bytes() const { return impl_->buffered(); }
 std::size_t CaptureWriter::max_buffered_bytes() const { return impl_->peak; }
 std::uint64_t CaptureWriter::bytes_written() const { return impl_->written; }
 const std::filesystem::path& CaptureWriter::path() const { return impl_->path; }
@@ -200,6 +244,8 @@ struct CaptureReader::Impl {
   }
   template <class Damaged>
   bool end_block(const std::array<std::byte, kBlockHeader>& h, Damaged& damaged) {
+    if (get<std::uint32_t>(h.data() + 4) != 8 || get<std::uint32_t>(h.data() + 8) != 0)
+      return damaged("bad end block (length must be 8 and count 0)");
     std::array<std::byte, 8> count{};
     if (read(count.data(), 8) != 8) return damaged("truncated end block");
     if (get<std::uint32_t>(h.data() + 12) != crc32c(count))
@@ -253,25 +299,33 @@ CaptureReader::CaptureReader(const std::filesystem::path& path) : impl_(std::mak
   if (!m.file)
     throw CaptureError(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
   std::array<char, 8> magic{};
-  if (m.read(magic.data(), 8) != 8 || magic != kMagic) m.bad_header("not a caldaq capture file");
+  if (m.read(magic.data(), 8) != 8 || magic != kMagic)
+    m.bad_header("not a caldaq capture file (no CALDAQCP magic at byte 0)");
   std::array<std::byte, 8> v{};
-  if (m.read(v.data(), 8) != 8) m.bad_header("truncated header");
+  if (const auto got = m.read(v.data(), 8); got != 8)
+    m.bad_header(
+        fmt::format("truncated header at byte {} (the version and length need 8 "
+                    "bytes from byte 8)",
+                    8 + got));
   const auto major = get<std::uint16_t>(v.data());
   m.minor = get<std::uint16_t>(v.data() + 2);
   const auto length = get<std::uint32_t>(v.data() + 4);
-  if (major > capture_major_version)
-    m.bad_header(fmt::format("capture format version {}.{} is newer than this daq reads ({}.x)",
-                             major, m.minor, capture_major_version));
-  if (length > kMaxHeader) m.bad_header(fmt::format("header length {} is implausible", length));
+  if (major > capture_major_version || major == 0)
+    m.bad_header(fmt::format("capture format version {}.{} (byte 8) is {} this daq reads ({}.x)",
+                             major, m.minor, major == 0 ? "not one" : "newer than",
+                             capture_major_version));
+  if (length > kMaxHeader)
+    m.bad_header(fmt::format("header length {} at byte 12 is over the 1 MiB limit", length));
   m.header.resize(length);
   std::array<std::byte, 4> crc{};
   if (m.read(m.header.data(), length) != length || m.read(crc.data(), 4) != 4)
-    m.bad_header("truncated header");
+    m.bad_header(fmt::format("truncated header at byte {} (the header ends at byte {})", m.offset,
+                             20 + std::uint64_t{length}));
   std::vector<std::byte> checked(v.begin(), v.end());
   const auto* h = reinterpret_cast<const std::byte*>(m.header.data());
   checked.insert(checked.end(), h, h + length);
   if (crc32c(checked) != get<std::uint32_t>(crc.data()))
-    m.bad_header("header CRC mismatch (damaged header)");
+    m.bad_header(fmt::format("header CRC mismatch at byte {} (damaged header)", 16 + length));
 }
 
 CaptureReader::~CaptureReader() = default;
@@ -279,6 +333,11 @@ CaptureReader::CaptureReader(CaptureReader&&) noexcept = default;
 const std::string& CaptureReader::header_json() const { return impl_->header; }
 std::uint16_t CaptureReader::minor_version() const { return impl_->minor; }
 const std::optional<Damage>& CaptureReader::damage() const { return impl_->damage; }
+const std::filesystem::path& CaptureReader::path() const { return impl_->path; }
+
+std::string describe(const Damage& d) {
+  return fmt::format("block {} at byte {}: {}", d.block, d.offset, d.what);
+}
 std::uint64_t CaptureReader::records_read() const { return impl_->records; }
 
 std::optional<Record> CaptureReader::next() {
@@ -326,8 +385,11 @@ PacingClock system_pacing_clock() {
 ReplaySource::ReplaySource(const std::filesystem::path& path, double speed,
                            std::vector<std::uint16_t> devices, PacingClock clock)
     : reader_(path), speed_(speed), devices_(std::move(devices)), clock_(std::move(clock)) {
-  if (speed < 0)
-    throw CaptureError(fmt::format("{}: replay speed {} must be >= 0", path.string(), speed));
+  if (!(speed >= 0) || !std::isfinite(speed))
+    throw CaptureError(
+        fmt::format("{}: replay speed {} must be finite and >= 0 (0: as fast as "
+                    "possible)",
+                    path.string(), speed));
 }
 
 const std::string& ReplaySource::header_json() const { return reader_.header_json(); }

@@ -47,6 +47,12 @@ struct Record {
   }
 };
 
+// Limits that keep every block readable: a record's bytes are at most max_record_bytes and
+// block_bytes at most max_block_bytes, so a block payload stays under the reader's 64 MiB
+// plausibility limit (block_bytes + one record + its 16-byte header).
+inline constexpr std::size_t max_record_bytes = 16u << 20;
+inline constexpr std::size_t max_block_bytes = 32u << 20;
+
 struct WriterLimits {
   std::size_t block_bytes = 64 * 1024;  // a block is written when its payload reaches this
 };
@@ -54,13 +60,20 @@ struct WriterLimits {
 class CaptureWriter {
  public:
   // header_json: the session (devices, settings, software, start time), a JSON object as
-  // text (the format does not interpret it). Throws CaptureError naming the path.
+  // text (the format does not interpret it). Throws CaptureError naming the path: cannot
+  // create, header over 1 MiB, block_bytes over max_block_bytes, or the header cannot be
+  // written (e.g. a full disk: the message carries the errno text).
+  //
+  // After any write error every later call throws at once, and nothing more is written: the
+  // blocks flushed before the error stay intact and readable.
   CaptureWriter(const std::filesystem::path& path, std::string_view header_json,
                 WriterLimits limits = {});
   ~CaptureWriter();  // writes the last block; errors there are lost, call close() to see them
   CaptureWriter(const CaptureWriter&) = delete;
   CaptureWriter& operator=(const CaptureWriter&) = delete;
 
+  // Throws CaptureError if bytes is over max_record_bytes, after close(), after an earlier
+  // write error, or when writing a full block fails (path, byte offset and errno text).
   void record(std::int64_t time_ns, std::uint16_t device, RecordKind kind,
               std::span<const std::byte> bytes);
   void event(std::int64_t time_ns, std::uint16_t device, std::string_view text);
@@ -68,7 +81,9 @@ class CaptureWriter {
   // this process).
   void flush();
   void close();
-  std::size_t buffered_bytes() const;      // never above limits.block_bytes + one record
+  // Bytes of records held in memory: below block_bytes between calls, and at most
+  // block_bytes + 16 + the record size inside the call that completes a block.
+  std::size_t buffered_bytes() const;
   std::size_t max_buffered_bytes() const;  // the peak, for the bounded-memory test
   std::uint64_t bytes_written() const;
   const std::filesystem::path& path() const;
@@ -83,6 +98,8 @@ struct Damage {
   std::uint64_t block = 0;   // 0-based block number
   std::string what;          // "truncated block header", "bad CRC", ...
 };
+// "block 3 at byte 1234: bad CRC (the block is corrupted)", for messages.
+std::string describe(const Damage& d);
 
 class CaptureReader {
  public:
@@ -99,6 +116,7 @@ class CaptureReader {
   std::optional<Record> next();
   const std::optional<Damage>& damage() const;
   std::uint64_t records_read() const;
+  const std::filesystem::path& path() const;
 
  private:
   struct Impl;
@@ -116,6 +134,9 @@ PacingClock system_pacing_clock();
 
 class ReplaySource {
  public:
+  // devices: the device ids to hand out (empty: all). The first record is handed out at once;
+  // record k no earlier than start + (t_k - t_first) / speed on the injected clock. Throws
+  // CaptureError for a speed that is negative or not finite, and as CaptureReader does.
   ReplaySource(const std::filesystem::path& path, double speed = 0.0,
                std::vector<std::uint16_t> devices = {}, PacingClock clock = system_pacing_clock());
   const std::string& header_json() const;
