@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cal/analysis/circle.hpp"
@@ -17,16 +18,40 @@ namespace {
 using nlohmann::json;
 namespace ci = cal::circle;
 
+ci::Plane plane_from(const std::string& p) {
+  if (p == "XY") return ci::Plane::xy;
+  if (p == "YZ") return ci::Plane::yz;
+  if (p == "ZX") return ci::Plane::zx;
+  throw cal::InputError(fmt::format("plane '{}' (expected XY, YZ or ZX)", p));
+}
+
 struct CircleOptions {
   std::string input;
   double radius_mm = 0.0;
   double feed_mm_per_min = 1000.0;
   std::string plane = "XY";
   double start_deg = 0.0;
+  double arc_deg = 360.0;
+  double overshoot_deg = 0.0;
+  double spike_decay_deg = 6.0;
   std::optional<double> cyclic_period_mm;
-  std::optional<double> calibrated_length_mm;
+  std::optional<double> calibrated_radius_mm;
   bool uncalibrated = false;
   bool json = false;
+  bool has_lengths = false;  // the CSV gives length_mm (set by read_traces)
+
+  ci::Setup setup() const {
+    return {.plane = plane_from(plane),
+            .radius_mm = radius_mm,
+            .feed_mm_per_min = feed_mm_per_min,
+            .cyclic_period_mm = cyclic_period_mm,
+            .spike_decay_deg = spike_decay_deg,
+            .radius_calibrated = !uncalibrated,
+            .calibrated_radius_mm = calibrated_radius_mm,
+            .start_deg = start_deg,
+            .arc_deg = arc_deg,
+            .overshoot_deg = overshoot_deg};
+  }
 };
 
 std::vector<std::string> split_csv(const std::string& line) {
@@ -41,7 +66,7 @@ std::vector<std::string> split_csv(const std::string& line) {
 }
 
 // Columns (docs/circle.md): direction (cw|ccw), angle_deg or time_s, deviation_um or length_mm.
-std::vector<ci::Trace> read_traces(const CircleOptions& o) {
+std::vector<ci::Trace> read_traces(CircleOptions& o) {
   std::ifstream in(o.input);
   if (!in) throw cal::InputError(fmt::format("{}: cannot open", o.input));
   std::string line;
@@ -55,14 +80,13 @@ std::vector<ci::Trace> read_traces(const CircleOptions& o) {
     const auto cells = split_csv(line);
     if (col.empty()) {
       for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
+      o.has_lengths = !col.count("deviation_um") && col.count("length_mm");
       if (!col.count("direction") || (!col.count("angle_deg") && !col.count("time_s")) ||
           (!col.count("deviation_um") && !col.count("length_mm")))
         throw cal::InputError(
             fmt::format("{}:{}: the header needs direction, angle_deg or time_s, and "
                         "deviation_um or length_mm",
                         o.input, n));
-      if (col.count("length_mm") && !col.count("deviation_um") && !o.calibrated_length_mm)
-        throw cal::InputError(fmt::format("{}: length_mm needs --calibrated-length-mm", o.input));
       continue;
     }
     auto cell = [&](const char* name) -> double {
@@ -88,15 +112,16 @@ std::vector<ci::Trace> read_traces(const CircleOptions& o) {
       t.angle_deg.push_back(cell("angle_deg"));
     else
       times[dir].push_back(cell("time_s"));
-    t.deviation_um.push_back(col.count("deviation_um")
-                                 ? cell("deviation_um")
-                                 : (cell("length_mm") - *o.calibrated_length_mm) * 1e3);
+    // length_mm: the absolute bar length, so the deviation is from the nominal radius (and
+    // --calibrated-radius-mm must not shift it again: read_traces' caller clears it).
+    t.deviation_um.push_back(col.count("deviation_um") ? cell("deviation_um")
+                                                       : (cell("length_mm") - o.radius_mm) * 1e3);
   }
+  if (traces.empty()) throw cal::InputError(fmt::format("{}: no data rows", o.input));
   std::vector<ci::Trace> out;
   for (auto& [dir, t] : traces) {
-    if (t.angle_deg.empty())
-      t.angle_deg =
-          ci::angles_from_time(times[dir], o.start_deg, o.feed_mm_per_min, o.radius_mm, dir);
+    if (t.angle_deg.empty())  // time_s: angles from the program, the overshoot arcs trimmed
+      t = ci::trace_from_time(o.setup(), dir, times[dir], t.deviation_um);
     out.push_back(std::move(t));
   }
   return out;
@@ -106,6 +131,7 @@ json to_json(const ci::Result& r, const CircleOptions& o) {
   json j{{"schema", "caldaq.circle.v1"},
          {"standard", "ISO 230-4:2005"},
          {"radius_mm", o.radius_mm},
+         {"feed_mm_per_min", o.feed_mm_per_min},
          {"plane", o.plane},
          {"iso230_4",
           {{"G_bi_um", r.iso.G_bi_um},
@@ -126,7 +152,8 @@ json to_json(const ci::Result& r, const CircleOptions& o) {
                                 {"value", d.value},
                                 {"unit", d.unit},
                                 {"pv_um", d.pv_um},
-                                {"share_pct", d.share_pct}});
+                                {"share_pct", d.share_pct},
+                                {"g_reduction_um", d.g_reduction_um}});
   j["centre"] = {{r.centre_u.key, r.centre_u.value}, {r.centre_v.key, r.centre_v.value}};
   return j;
 }
@@ -140,21 +167,18 @@ void print(const ci::Result& r, const CircleOptions& o) {
   fmt::print("  H                  {:8.3f} um\n", r.iso.H_um);
   fmt::print("  F max / min        {:8.3f} / {:.3f} um\n", r.iso.F_max_um, r.iso.F_min_um);
   fmt::print("  LSQ centre         {:8.3f}, {:.3f} um\n\n", r.iso.centre_u_um, r.iso.centre_v_um);
-  fmt::print("Diagnostics (ranked by their share of G):\n");
+  fmt::print(
+      "Diagnostics (ranked by their share of G; PV of the fitted contribution, its % of G,\n"
+      "and the reduction of G when it alone is removed):\n");
+  fmt::print("  {:<40} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "% of G",
+             "G gain");
   for (const auto& d : r.diagnostics)
-    fmt::print("  {:<40} {:+9.3f} {:<5} {:7.3f} um  {:5.1f} %\n", d.name, d.value, d.unit, d.pv_um,
-               d.share_pct);
+    fmt::print("  {:<40} {:+9.3f} {:<5} {:7.3f} um {:5.1f} % {:7.3f} um\n", d.name, d.value, d.unit,
+               d.pv_um, d.share_pct, d.g_reduction_um);
   fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_u.name, r.centre_u.value);
   fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_v.name, r.centre_v.value);
   fmt::print("  residual rms {:.3f} um\n", r.residual_rms_um);
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
-}
-
-ci::Plane plane_from(const std::string& p) {
-  if (p == "XY") return ci::Plane::xy;
-  if (p == "YZ") return ci::Plane::yz;
-  if (p == "ZX") return ci::Plane::zx;
-  throw cal::InputError(fmt::format("plane '{}' (expected XY, YZ or ZX)", p));
 }
 
 }  // namespace
@@ -174,21 +198,28 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_option("--plane", o->plane, "XY, YZ or ZX")->capture_default_str();
-  cmd->add_option("--start-deg", o->start_deg, "Angle of the first sample when the CSV has time_s");
+  cmd->add_option("--start-deg", o->start_deg,
+                  "With time_s: angle where the ccw arc move starts (time 0 of each move)")
+      ->capture_default_str();
+  cmd->add_option("--arc-deg", o->arc_deg, "With time_s: the measured arc, 180..360")
+      ->capture_default_str();
+  cmd->add_option("--overshoot-deg", o->overshoot_deg,
+                  "With time_s: overshoot arc before and after the measured arc (trimmed)")
+      ->capture_default_str();
+  cmd->add_option("--spike-decay-deg", o->spike_decay_deg, "Decay angle of a reversal spike")
+      ->capture_default_str();
   cmd->add_option("--cyclic-period-mm", o->cyclic_period_mm,
                   "Cyclic-error period (default: searched)");
-  cmd->add_option("--calibrated-length-mm", o->calibrated_length_mm,
-                  "Bar length for length_mm columns");
+  cmd->add_option("--calibrated-radius-mm,--calibrated-length-mm", o->calibrated_radius_mm,
+                  "Bar length at which deviation_um reads 0 (default: the nominal radius)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--uncalibrated", o->uncalibrated, "The bar was not calibrated: no radius error");
   cmd->add_flag("--json", o->json, "Print caldaq.circle.v1 JSON");
   cmd->callback([o] {
     const auto traces = read_traces(*o);
-    const auto r = ci::analyse({.plane = plane_from(o->plane),
-                                .radius_mm = o->radius_mm,
-                                .feed_mm_per_min = o->feed_mm_per_min,
-                                .cyclic_period_mm = o->cyclic_period_mm,
-                                .radius_calibrated = !o->uncalibrated},
-                               traces);
+    auto setup = o->setup();
+    if (o->has_lengths) setup.calibrated_radius_mm.reset();  // lengths are absolute
+    const auto r = ci::analyse(setup, traces);
     if (o->json) return fmt::print("{}\n", to_json(r, *o).dump(2));
     print(r, *o);
   });

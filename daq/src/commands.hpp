@@ -15,6 +15,8 @@ void add_runs_commands(CLI::App& app);
 void add_stored_run_commands(CLI::App& app, CLI::App& analyse);
 // replay CAPTURE
 void add_replay_command(CLI::App& app);
+// run linear, gcode linear|circle
+void add_run_commands(CLI::App& app);
 // analyse straightness, analyse squareness
 void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 // analyse circle

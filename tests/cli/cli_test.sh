@@ -60,6 +60,14 @@ check analyse_stored 0 "Pa +[0-9.]+ um +position deviation" -- "$DAQ" analyse 1 
 check recompensate 0 "largest change 0\\.7[4-7][0-9] um" -- "$DAQ" recompensate 1 --db "$TMP/demo.sqlite" --alpha-ppm 12.5
 check recompensate_circle 2 "no run 9" -- "$DAQ" recompensate 9 --db "$TMP/demo.sqlite"
 check analyse_needs_run 2 "give a stored RUN number" -- "$DAQ" analyse --db "$TMP/demo.sqlite"
+# Runs against configured devices: a device that cannot be reached is given up, named, and
+# the run is stored as aborted. Part programs from the same configuration.
+check run_refused 2 "stopped: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2
+check run_stored_aborted 0 "aborted" -- "$DAQ" runs --db "$TMP/run.sqlite"
+check gcode_siemens 0 "^G4 F3\\.0000$" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d siemens
+check gcode_circle 0 "^G03 X-10\\.0000 Y0\\.0000 I-10\\.0000 J0\\.0000 F1000$" -- "$DAQ" gcode circle -c "$DATA/run/refused.toml"
+check gcode_dialect 2 "dialect 'mazak'" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d mazak
+check config_error 2 "refused.toml" -- "$DAQ" gcode linear -c "$DATA/run/no_such.toml"
 check show_missing 2 "no run 7" -- "$DAQ" show 7 --db "$TMP/demo.sqlite"
 
 # Device discovery: the listing works without hardware, probes name what failed.

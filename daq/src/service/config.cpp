@@ -125,6 +125,13 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
     d.axes.push_back(static_cast<int>(a));
   }
   t.read("role", d.role);
+  t.read("request", d.request);
+  t.read("pattern", d.pattern);
+  t.read("unit", d.unit);
+  one_of(t, "unit", d.unit, {"mm", "um", "in", "m", "degC"});
+  // TOML has no escapes in literal strings: allow "\r" written as the two characters.
+  for (std::size_t at; (at = d.request.find("\\r")) != std::string::npos;)
+    d.request.replace(at, 2, "\r");
   if (!d.role.empty())
     one_of(t, "role", d.role, {"laser", "air", "material", "ballbar", "position"});
   t.check_unknown();

@@ -1,0 +1,241 @@
+// daq run linear|circle --config FILE: acquisition against the configured devices;
+// daq gcode linear|circle --config FILE: the part program for the test.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/read_until.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/streambuf.hpp>
+#include <filesystem>
+#include <fstream>
+
+#include "cal/analysis/error.hpp"
+#include "cal/daq/config.hpp"
+#include "cal/daq/gcode.hpp"
+#include "cal/drivers/instruments.hpp"
+#include "cal/drivers/transport/hid.hpp"
+#include "cal/replay/capture.hpp"
+#include "cal/replay/session.hpp"
+#include "circle_run.hpp"
+#include "commands.hpp"
+#include "database.hpp"
+#include "iso230_2_output.hpp"
+#include "linear_run.hpp"
+#include "session_spec.hpp"
+
+namespace daq {
+namespace {
+
+namespace d = cal::drivers;
+namespace t = cal::drivers::transport;
+using namespace std::chrono_literals;
+
+std::unique_ptr<t::Transport> make_transport(boost::asio::io_context& io,
+                                             const cal::daq::DeviceConfig& c) {
+  const auto space = c.transport.find(' ');
+  const std::string kind = c.transport.substr(0, space),
+                    rest = space == std::string::npos ? "" : c.transport.substr(space + 1);
+  if (kind == "tcp") {
+    const auto colon = rest.rfind(':');
+    if (colon == std::string::npos)
+      throw cal::InputError(
+          fmt::format("devices.{}.transport '{}': expected tcp HOST:PORT", c.id, c.transport));
+    return t::make_tcp(io, {.host = rest.substr(0, colon),
+                            .port = static_cast<std::uint16_t>(std::stoi(rest.substr(colon + 1)))});
+  }
+  if (kind == "serial") {
+    const auto sp = rest.find(' ');
+    if (sp == std::string::npos)
+      throw cal::InputError(fmt::format(
+          "devices.{}.transport '{}': expected serial DEVICE BAUD FRAME", c.id, c.transport));
+    return t::make_serial(
+        io, t::parse_serial_settings(rest.substr(sp + 1), {.device = rest.substr(0, sp)}));
+  }
+  throw cal::InputError(
+      fmt::format("devices.{}: transport '{}' has no driver here yet", c.id, c.transport));
+}
+
+InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device) {
+  InstrumentSpec s{.device = device, .driver = c.driver, .role = c.role, .transport = c.transport};
+  if (!c.axes.empty()) {
+    s.ids_axes = {false, false, false};
+    for (int a : c.axes) s.ids_axes[static_cast<std::size_t>(a)] = true;
+  }
+  s.gauge = {
+      .request = c.request, .pattern = c.pattern, .unit = d::codec::gauge_unit_from_string(c.unit)};
+  if (s.gauge.unit == d::codec::GaugeUnit::degc) s.gauge.min_si = -40, s.gauge.max_si = 150;
+  if (c.driver != "ids3010" && c.driver != "ptu300" && c.driver != "gauge")
+    throw cal::InputError(
+        fmt::format("devices.{}: driver '{}' is not available for runs yet", c.id, c.driver));
+  return s;
+}
+
+const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role) {
+  if (const auto* d = c.device_for(role)) return *d;
+  throw cal::InputError(fmt::format("{}: no device with role = \"{}\"", c.source.string(), role));
+}
+
+struct RunOptions {
+  std::string config, db, capture;
+  int give_up_after = 20;
+};
+
+// Enter on the keyboard is the manual trigger ("capture now").
+void watch_keyboard(boost::asio::io_context& io, std::function<void()> on_enter) {
+  if (!::isatty(STDIN_FILENO)) return;
+  auto in = std::make_shared<boost::asio::posix::stream_descriptor>(io, ::dup(STDIN_FILENO));
+  auto buf = std::make_shared<boost::asio::streambuf>();
+  auto next = std::make_shared<std::function<void()>>();
+  *next = [in, buf, on_enter, next] {
+    boost::asio::async_read_until(*in, *buf, '\n',
+                                  [in, buf, on_enter, next](auto ec, std::size_t n) {
+                                    if (ec) return;
+                                    buf->consume(n);
+                                    on_enter();
+                                    (*next)();
+                                  });
+  };
+  (*next)();
+}
+
+void run_linear(const RunOptions& o) {
+  const auto config = cal::daq::load_config(o.config);
+  if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
+  boost::asio::io_context io;
+  std::vector<InstrumentSpec> specs;
+  std::uint16_t n = 0;
+  for (const auto& dc : config.devices)
+    if (dc.role == "laser" || dc.role == "air" || dc.role == "material")
+      specs.push_back(spec_of(dc, n++));
+  need(config, "laser"), need(config, "air");
+  std::unique_ptr<cal::replay::CaptureWriter> capture;
+  std::unique_ptr<cal::replay::CaptureRecorder> recorder;
+  if (!o.capture.empty()) {
+    capture = std::make_unique<cal::replay::CaptureWriter>(
+        o.capture, capture_header(config, specs, "daq 0.1.0"));
+    recorder = std::make_unique<cal::replay::CaptureRecorder>(*capture);
+  }
+  LinearRunSetup setup;
+  setup.config = config;
+  setup.database = database_path(o.db);
+  if (capture) setup.capture_path = std::filesystem::absolute(o.capture).string();
+  for (const auto& s : specs) {
+    const auto& dc = *std::find_if(
+        config.devices.begin(), config.devices.end(),
+        [&](const auto& x) { return x.transport == s.transport && x.role == s.role; });
+    d::InstrumentOptions opt{
+        .name = dc.id, .backoff = {.max_attempts = o.give_up_after}, .recorder = recorder.get()};
+    if (dc.poll_s > 0)
+      opt.poll_period = std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6));
+    else if (s.driver == "ptu300" || s.role == "material")
+      opt.poll_period = 1000ms;
+    auto inst = make_instrument(io, s, make_transport(io, dc), opt);
+    if (s.role == "laser")
+      setup.laser = std::move(inst);
+    else if (s.role == "air")
+      setup.air = std::move(inst);
+    else
+      setup.material.push_back(std::move(inst));
+  }
+  const bool tty = ::isatty(STDOUT_FILENO);
+  setup.on_event = [tty](const std::string& e) {
+    fmt::print("{}  {}\n", tty ? "\r\033[K" : "", e);
+  };
+  setup.on_live = [tty](const LiveState& s) {
+    if (!tty || !s.progress.next_position_mm) return;
+    fmt::print(
+        "\rrun {} of {} {}  target {} of {}  {:+9.2f} um  air {:.2f} degC  material {:.2f} degC  ",
+        s.progress.run, s.progress.runs,
+        s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down", s.progress.target,
+        s.progress.targets, s.deviation_um, s.air_temperature_degc, s.material_degc);
+    std::fflush(stdout);
+  };
+  LinearRun run(io, std::move(setup));
+  run.start();
+  fmt::print(
+      "Waiting for the machine: run the program from `daq gcode linear --config {}`; Enter "
+      "captures the current stop by hand; Ctrl-C stops.\n",
+      o.config);
+  watch_keyboard(io, [&] { run.manual_capture(); });
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](auto ec, int) {
+    if (!ec) run.stop("stopped by the operator");
+  });
+  while (!run.finished()) io.run_for(100ms);
+  if (capture) capture->close();
+  const auto& out = run.outcome();
+  if (!out.complete)
+    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+  print(*out.evaluation);
+}
+
+struct GcodeOptions {
+  std::string config, dialect = "fanuc", output;
+};
+
+void gcode(const GcodeOptions& o, bool circle) {
+  const auto config = cal::daq::load_config(o.config);
+  const auto dialect = cal::daq::dialect_from_string(o.dialect);
+  std::string text;
+  if (circle) {
+    if (!config.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", o.config));
+    const auto& c = *config.circle;
+    text = cal::daq::circle_program({.radius_mm = c.radius_mm,
+                                     .feed_mm_per_min = c.feed_mm_per_min,
+                                     .sample_rate_hz = c.sample_rate_hz,
+                                     .overshoot_deg = c.overshoot_deg},
+                                    {.centre_x_mm = c.centre_mm[0], .centre_y_mm = c.centre_mm[1]},
+                                    dialect);
+  } else {
+    if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
+    const auto& l = *config.linear;
+    const auto plan = cal::iso230_2::make_plan({.first_mm = l.first_mm,
+                                                .last_mm = l.last_mm,
+                                                .interval_mm = l.interval_mm,
+                                                .count = l.count,
+                                                .random_fraction = l.random_fraction},
+                                               {.cycle = cal::iso230_2::cycle_from_string(l.cycle),
+                                                .bidirectional = l.bidirectional,
+                                                .runs = l.runs,
+                                                .overrun_mm = l.overrun_mm});
+    text = cal::daq::linear_program(
+        plan, {.axis = l.axis[0], .feed_mm_per_min = l.feed_mm_per_min, .dwell_s = l.dwell_s},
+        dialect);
+  }
+  if (o.output.empty()) return fmt::print("{}", text);
+  std::ofstream out(o.output);
+  if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));
+}
+
+}  // namespace
+
+void add_run_commands(CLI::App& app) {
+  auto o = std::make_shared<RunOptions>();
+  auto* run = app.add_subcommand("run", "Acquire a test with the configured instruments");
+  run->require_subcommand(1);
+  auto* lin = run->add_subcommand("linear", "ISO 230-2 positioning test (laser, air, material)");
+  lin->add_option("-c,--config", o->config, "Machine/campaign TOML (docs/config.md)")->required();
+  add_db_option(*lin, o->db);
+  lin->add_option("--capture", o->capture, "Record the wire-level capture to this file");
+  lin->add_option("--give-up-after", o->give_up_after,
+                  "Reconnection attempts before a device is given up")
+      ->capture_default_str();
+  lin->callback([o] { run_linear(*o); });
+
+  auto g = std::make_shared<GcodeOptions>();
+  auto* gc = app.add_subcommand("gcode", "Part program for a configured test");
+  gc->require_subcommand(1);
+  for (const char* kind : {"linear", "circle"}) {
+    auto* sub = gc->add_subcommand(kind, std::string("Program for [test.") + kind + "]");
+    sub->add_option("-c,--config", g->config, "Machine/campaign TOML")->required();
+    sub->add_option("-d,--dialect", g->dialect, "fanuc, heidenhain or siemens")
+        ->capture_default_str();
+    sub->add_option("-o,--output", g->output, "Write to a file instead of stdout");
+    const bool circle = std::string(kind) == "circle";
+    sub->callback([g, circle] { gcode(*g, circle); });
+  }
+}
+
+}  // namespace daq
