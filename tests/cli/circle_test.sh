@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# daq analyse circle on a fixture from an exact forward model (tests/data/circle/model.csv,
-# parameters in its first line). Usage: circle_test.sh DAQ_BINARY DATA_DIR
+# daq analyse circle on fixtures from an exact forward model, written by
+# tests/data/circle/make_fixtures.py (model.csv: angles; model_time.csv: a timed program with
+# overshoot arcs and absolute bar lengths). Usage: circle_test.sh DAQ_BINARY DATA_DIR
 set -u
 DAQ=$1
 DATA=$2
@@ -28,5 +29,24 @@ check json 0 '"schema": "caldaq.circle.v1"' -- "$DAQ" analyse circle -i "$DATA/m
 check bad_direction 2 "bad_direction.csv:3: column direction: 'sideways'" -- "$DAQ" analyse circle -i "$DATA/bad_direction.csv" -R 50
 check missing 2 "no_such.csv: cannot open" -- "$DAQ" analyse circle -i "$DATA/no_such.csv" -R 50
 check too_few 2 "ccw trace has 3 samples, at least 20 needed" -- "$DAQ" analyse circle -i "$DATA/few.csv" -R 50
+# The timed program (tests/data/circle/model_time.csv, from make_fixtures.py): absolute bar
+# lengths at 100 Hz from the start of each arc move, 30 degree overshoot arcs that are 30 um off
+# the circle (kept samples would show in the residual), cyclic period searched. Injected:
+# squareness -15 um/m, Y lags X by 0.5 ms, cyclic X 1.0 um at 5 mm, centre (-2, 4) um.
+# Noise-free and first order (second-order terms < 1 nm): to the printed 0.01 um/m, 0.001 ms,
+# and 0.5 % of the cyclic amplitude; the period search to 0.01 mm.
+T=(analyse circle -i "$DATA/model_time.csv" -R 50 --start-deg 90 --overshoot-deg 30)
+check time_squareness 0 "Squareness XY +-15\.0[0-9]* um/m" -- "$DAQ" "${T[@]}"
+check time_servo 0 "Servo mismatch \(Y lags X\) +\+0\.500 ms" -- "$DAQ" "${T[@]}"
+check time_cyclic 0 "Cyclic error X \(5\.00 mm period\) +\+(0\.99[5-9]|1\.00[0-5]) um" -- "$DAQ" "${T[@]}"
+check time_centre 0 "LSQ centre +-2\.000, 4\.000 um" -- "$DAQ" "${T[@]}"
+check time_trimmed 0 "residual rms 0\.00[0-9] um" -- "$DAQ" "${T[@]}"
+check time_untrimmed 0 "residual rms ([1-9]|0\.[1-9])" -- "$DAQ" analyse circle -i "$DATA/model_time.csv" -R 50 --start-deg 90 --overshoot-deg 0 --arc-deg 360
+check time_json 0 '"g_reduction_um"' -- "$DAQ" "${T[@]}" --json
+# The bar read 0 at 50.002 mm: every deviation is 2 um more than it says (radius error +2; the
+# backlash step sampled every 0.25 degrees moves the constant term by up to 0.01 um).
+check calibrated 0 "Radius error +\+(1\.99|2\.00)[0-9]* um" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10 --calibrated-radius-mm 50.002
+check too_much_overshoot 2 "keeps 0 samples after trimming the 500 degree overshoot" -- "$DAQ" analyse circle -i "$DATA/model_time.csv" -R 50 --overshoot-deg 500
+check bad_plane 2 "plane 'XZ' \(expected XY, YZ or ZX\)" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --plane XZ
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -38,19 +38,39 @@ struct Trace {
 
 struct Setup {
   Plane plane = Plane::xy;
-  double radius_mm = 100.0;
-  double feed_mm_per_min = 1000.0;  // needed for the servo-mismatch time
+  double radius_mm = 100.0;         // nominal (programmed) radius
+  double feed_mm_per_min = 1000.0;  // needed for the servo-mismatch time and time-based angles
   // Cyclic-error period along the axes: fixed, or searched over [min, max] when unset.
   std::optional<double> cyclic_period_mm;
   double cyclic_search_min_mm = 2.0, cyclic_search_max_mm = 40.0;
   double spike_decay_deg = 6.0;   // decay angle of a reversal spike
-  bool radius_calibrated = true;  // deviations are from a calibrated length: radius error valid
+  bool radius_calibrated = true;  // the bar length is known (calibrator): radius error valid
+  // The bar length at which deviation_um reads 0 (the calibrated length of the bar); unset: the
+  // nominal radius. The deviation from the nominal radius is deviation_um + (this - radius_mm).
+  std::optional<double> calibrated_radius_mm;
+  // The test program, for angles derived from time (trace_from_time, trace_from_samples):
+  double sample_rate_hz = 1000.0;
+  double start_deg = 0.0;      // where the ccw arc move starts (the end of the feed-in)
+  double arc_deg = 360.0;      // the measured arc, 180..360
+  double overshoot_deg = 0.0;  // run before and after the measured arc, trimmed
 };
 
 // theta(t) = start + s * (feed / R) * t, s = +1 ccw, -1 cw: the tool moves at the feed along
 // the circle (after the feed-in and overshoot arcs have been trimmed).
 std::vector<double> angles_from_time(std::span<const double> time_s, double start_deg,
                                      double feed_mm_per_min, double radius_mm, Direction d);
+
+// One arc move of the test program, timed from the start of that move (t = 0 where the arc
+// starts, overshoot included). The ccw move starts at setup.start_deg; the cw move starts where
+// the ccw one ended, start + arc + 2 overshoot, and runs back. Both measure the same arc
+// [start + overshoot, start + overshoot + arc]:
+//   theta(t) = theta_move + s (F / R) t,  theta_move = start (ccw), start + arc + 2 os (cw);
+// samples in the overshoot arcs (where the axes accelerate) are dropped. Throws InputError for
+// mismatched lengths, a bad feed, radius, arc or overshoot, or fewer than 20 samples kept.
+Trace trace_from_time(const Setup& setup, Direction d, std::span<const double> time_s,
+                      std::span<const double> deviation_um);
+// The same with the samples taken at setup.sample_rate_hz from t = 0: t_i = i / rate.
+Trace trace_from_samples(const Setup& setup, Direction d, std::span<const double> deviation_um);
 
 struct Iso230_4 {
   double G_bi_um = 0, G_cw_um = 0, G_ccw_um = 0;  // 0 when that direction was not measured
@@ -66,7 +86,10 @@ struct Diagnostic {
   double value = 0;      // in `unit`
   std::string unit;      // "um", "um/m", "ms", "mm"
   double pv_um = 0;      // peak-to-valley of its fitted contribution over the traces
-  double share_pct = 0;  // pv_um / G_bi, in %
+  double share_pct = 0;  // pv_um / G_bi, in % (can exceed 100: contributions partly cancel)
+  // G_bi minus the G_bi of the traces with this contribution removed (LSQ circle refitted):
+  // what correcting this error alone would gain. Can be negative.
+  double g_reduction_um = 0;
 };
 
 struct Result {
@@ -78,8 +101,9 @@ struct Result {
   std::vector<std::string> notes;          // e.g. which terms one direction cannot separate
 };
 
-// Throws cal::InputError for no trace, mismatched lengths, fewer than 20 samples, radius or
-// feed <= 0, non-finite values, an arc below 180 degrees, or two traces in one direction.
+// Throws cal::InputError for no trace, an empty trace, mismatched lengths, fewer than 20
+// samples, radius or feed <= 0, non-finite values, an arc below 180 degrees, or two traces in
+// one direction.
 Result analyse(const Setup& setup, std::span<const Trace> traces);
 
 }  // namespace cal::circle
