@@ -44,7 +44,7 @@ struct LineWriter {
   // A device sends whether or not anyone listens; with nobody reading the pty, its buffer
   // fills and a real device's output is lost. Beyond this much queued, new output is dropped
   // (and counted) instead of growing without bound.
-  static constexpr std::size_t max_queued = 1024;
+  static constexpr std::size_t max_queued = 1 << 16;
   std::deque<std::string> queue;
   std::uint64_t dropped = 0;
   void send(Stream& s, std::string line, std::shared_ptr<void> keep_alive) {
@@ -468,5 +468,13 @@ void GaugeTwin::unplug() {
   impl_->pty.unplug();
 }
 std::uint64_t GaugeTwin::lines_sent() const { return impl_->pty.lines; }
+void GaugeTwin::set_streaming(bool on) {
+  impl_->timer.cancel();
+  impl_->config.continuous = on;
+  if (!on) return;
+  impl_->next_sample =
+      static_cast<std::uint64_t>(std::ceil(impl_->clock() * impl_->config.sample_rate_hz));
+  impl_->tick();
+}
 
 }  // namespace cal::drivers::sim

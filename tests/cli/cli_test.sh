@@ -44,7 +44,7 @@ check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --i
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/demo.sqlite" --capture "$TMP/demo.cdq"
+check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --speed 30 --db "$TMP/demo.sqlite" --capture "$TMP/demo.cdq"
 # A capture cut in half: the replay says where the damage is and stores nothing as complete.
 head -c 300000 "$TMP/demo.cdq" > "$TMP/cut.cdq"
 check replay_damaged 2 "cut.cdq: replay stored as run [0-9]+ but incomplete: the capture is damaged at byte [0-9]+" -- "$DAQ" replay "$TMP/cut.cdq" --db "$TMP/replay.sqlite"
@@ -67,7 +67,7 @@ check run_stored_aborted 0 "aborted" -- "$DAQ" runs --db "$TMP/run.sqlite"
 check gcode_siemens 0 "^G4 F3\\.0000$" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d siemens
 check gcode_circle 0 "^G03 X-10\\.0000 Y0\\.0000 I-10\\.0000 J0\\.0000 F1000$" -- "$DAQ" gcode circle -c "$DATA/run/refused.toml"
 check gcode_dialect 2 "dialect 'mazak'" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d mazak
-check config_error 2 "refused.toml" -- "$DAQ" gcode linear -c "$DATA/run/no_such.toml"
+check config_error 2 "no_such.toml: cannot open" -- "$DAQ" gcode linear -c "$DATA/run/no_such.toml"
 check show_missing 2 "no run 7" -- "$DAQ" show 7 --db "$TMP/demo.sqlite"
 
 # Device discovery: the listing works without hardware, probes name what failed.

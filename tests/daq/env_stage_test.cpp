@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "cal/analysis/error.hpp"
+
 namespace {
 
 using cal::daq::AirQuantity;
@@ -94,6 +98,127 @@ TEST(EnvStage, FallbackIsUsedRecordedAndAnnouncedOnce) {
   e.add_material(3 * s, 0, 20.2);
   EXPECT_EQ(e.check(3 * s).messages, std::vector<std::string>{"material sensor 1 is back"});
   EXPECT_FALSE(e.compensate(3 * s, 0.1).fallback_material);
+}
+
+TEST(EnvStage, Co2SensorIsInterpolatedIntoCiddor) {
+  // Ciddor standard air (dry, 15 degC, 101325 Pa, 450 umol/mol) at 632.991 nm: n - 1 =
+  // 2.76530324127e-4 (the dispersion formula, tests/analysis/air_test.cpp). For dry air at 15
+  // degC and 101325 Pa the density ratio of Ciddor's equation is 1, so another CO2 content only
+  // scales it by (1 + 0.534e-6 (xc - 450)) (Ciddor 1996, eq. 2). CO2 300 at 0 s and 900 at 10 s
+  // interpolate to 600 at 5 s: n - 1 = 2.76530324127e-4 x 1.0000801 = 2.76552474206e-4.
+  cal::daq::EnvironmentConfig cfg;
+  cfg.equation = "ciddor";
+  cfg.stale_after_s = 20;
+  EnvStage e(cfg, cal::daq::EnvSensors{{true}, true});
+  for (std::int64_t t : {0 * s, 10 * s}) {
+    e.add_air(t, AirQuantity::temperature_degc, 15.0);
+    e.add_air(t, AirQuantity::pressure_pa, 101325.0);
+    e.add_air(t, AirQuantity::humidity_pct, 0.0);
+    e.add_material(t, 0, 20.0);
+  }
+  e.add_air(0, AirQuantity::co2_umol_per_mol, 300.0);
+  e.add_air(10 * s, AirQuantity::co2_umol_per_mol, 900.0);
+  const auto c = e.compensate(5 * s, 0.2);
+  EXPECT_DOUBLE_EQ(c.co2_umol_per_mol, 600.0);
+  EXPECT_NEAR(c.n - 1, 2.76552474206e-4, 1e-11);
+  EXPECT_NEAR(c.length_m, 0.2 / (1 + 2.76552474206e-4), 0.2 * 1e-11);  // material at 20 degC
+  EXPECT_FALSE(c.fallback_air);
+  // The CO2 sensor is checked like the others: silent from 10 s, stale at 31 s.
+  e.add_air(30 * s, AirQuantity::temperature_degc, 15.0);
+  e.add_air(30 * s, AirQuantity::pressure_pa, 101325.0);
+  e.add_air(30 * s, AirQuantity::humidity_pct, 0.0);
+  e.add_material(30 * s, 0, 20.0);
+  const auto h = e.check(31 * s);
+  ASSERT_EQ(h.messages.size(), 1u);
+  EXPECT_EQ(h.messages[0], "air CO2 is stale (last sample 21.0 s ago): stopping");
+}
+
+TEST(EnvStage, WithoutACo2SensorTheConfiguredValueIsNoFallback) {
+  // Same dry standard air, no CO2 sensor: the configured 450 umol/mol gives the dispersion
+  // formula's value itself, and nothing is stale or flagged.
+  cal::daq::EnvironmentConfig cfg;
+  cfg.equation = "ciddor";
+  EnvStage e(cfg, 1);
+  e.add_air(0, AirQuantity::temperature_degc, 15.0);
+  e.add_air(0, AirQuantity::pressure_pa, 101325.0);
+  e.add_air(0, AirQuantity::humidity_pct, 0.0);
+  e.add_material(0, 0, 20.0);
+  EXPECT_TRUE(e.check(1 * s).messages.empty());
+  const auto c = e.compensate(0, 0.2);
+  EXPECT_NEAR(c.n - 1, 2.76530324127e-4, 1e-11);
+  EXPECT_DOUBLE_EQ(c.co2_umol_per_mol, 450.0);
+  EXPECT_FALSE(c.fallback_air);
+}
+
+TEST(EnvStage, DisabledMaterialSensorIsNeitherAveragedNorChecked) {
+  // Three probes; the second is broken (reads 35 degC) and disabled: the material temperature
+  // is the mean of 20.4 and 20.6 = 20.5 degC. With the Edlen reference n = 1.000271374 (20 degC,
+  // 101325 Pa, 50 %RH) and 11.5 ppm/K: L = 0.1 / 1.000271374 / (1 + 11.5e-6 x 0.5)
+  // = 0.0999722951217 m (to +-6e-11 m from the 9-decimal reference n).
+  EnvStage e(edlen(), cal::daq::EnvSensors{{true, false, true}, false});
+  standard_air(e, 0);
+  e.add_material(0, 0, 20.4);
+  e.add_material(0, 1, 35.0);
+  e.add_material(0, 2, 20.6);
+  const auto c = e.compensate(0, 0.1);
+  EXPECT_DOUBLE_EQ(c.material_degc, 20.5);
+  EXPECT_NEAR(c.length_m, 0.0999722951217, 6e-11);
+  // At 5 s nothing is stale; the disabled probe is not reported even after it goes silent.
+  standard_air(e, 9 * s);
+  e.add_material(9 * s, 0, 20.4);
+  e.add_material(9 * s, 2, 20.6);
+  EXPECT_TRUE(e.check(12 * s).messages.empty());
+  // Enabled again (silent since 0 s): stale, reported once; disabling it again is fine, but the
+  // last enabled sensor cannot be disabled.
+  e.set_material_enabled(1, true);
+  EXPECT_EQ(e.check(12 * s).messages,
+            std::vector<std::string>{"material sensor 2 is stale (last sample 12.0 s ago): stopping"});
+  e.set_material_enabled(1, false);
+  e.set_material_enabled(0, false);
+  EXPECT_THROW(e.set_material_enabled(2, false), cal::InputError);
+  EXPECT_THROW(e.set_material_enabled(3, true), cal::InputError);
+}
+
+TEST(EnvStage, StaleAirUsesItsFallbackValue) {
+  // The pressure's last sample (90 kPa) is 20 s old: under the fallback policy the configured
+  // 101325 Pa is used, which with 20 degC and 50 %RH gives the Edlen reference 1.000271374.
+  auto cfg = edlen(cal::daq::StalePolicy::fallback);
+  EnvStage e(cfg, 1);
+  e.add_air(0, AirQuantity::pressure_pa, 90000.0);
+  e.add_air(20 * s, AirQuantity::temperature_degc, 20.0);
+  e.add_air(20 * s, AirQuantity::humidity_pct, 50.0);
+  e.add_material(20 * s, 0, 20.0);
+  const auto h = e.check(20 * s);
+  EXPECT_FALSE(h.must_stop);
+  EXPECT_EQ(h.messages, std::vector<std::string>{
+                            "air pressure is stale (last sample 20.0 s ago): using the fallback "
+                            "101325"});
+  const auto c = e.compensate(20 * s, 0.1);
+  EXPECT_TRUE(c.fallback_air);
+  EXPECT_FALSE(c.fallback_material);
+  EXPECT_DOUBLE_EQ(c.pressure_pa, 101325.0);
+  EXPECT_NEAR(c.n, 1.000271374, 6e-10);
+}
+
+TEST(EnvStage, RefusesBadConfiguration) {
+  auto cfg = edlen();
+  cfg.stale_after_s = 0;
+  EXPECT_THROW(EnvStage(cfg, 1), cal::InputError);
+  cfg = edlen();
+  cfg.expansion_ppm_per_k = std::nan("");
+  EXPECT_THROW(EnvStage(cfg, 1), cal::InputError);
+  cfg = edlen();
+  cfg.equation = "guess";
+  EXPECT_THROW(EnvStage(cfg, 1), cal::InputError);
+  EXPECT_THROW(EnvStage(edlen(), -1), cal::InputError);
+  EXPECT_THROW(EnvStage(edlen(), cal::daq::EnvSensors{{false, false}, false}), cal::InputError);
+  EnvStage e(edlen(), 2);
+  EXPECT_THROW(e.add_material(0, 2, 20.0), cal::InputError);  // sensors are 0 and 1
+  // An impossible environment (a pressure of 0 from a faulty sensor) is not compensated.
+  e.add_air(0, AirQuantity::temperature_degc, 20.0);
+  e.add_air(0, AirQuantity::pressure_pa, 0.0);
+  e.add_air(0, AirQuantity::humidity_pct, 50.0);
+  EXPECT_THROW(e.compensate(0, 0.1), cal::InputError);
 }
 
 }  // namespace

@@ -97,4 +97,152 @@ TEST(StabilityTrigger, RefusesNonPositiveSettings) {
   EXPECT_THROW(StabilityTrigger({.dwell_s = -1}), cal::InputError);
 }
 
+TEST(StabilityTrigger, WithAllTargetsExpectedAStopBetweenThemIsNotCaptured) {
+  // Targets 0, 50, 100; the machine also pauses 4 s at 73 mm (23 mm from the nearest target,
+  // far outside the 0.5 mm window) and passes 50 mm without stopping on the way down.
+  Stream s({.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5}, 0.2);
+  const std::vector<double> targets = {100.0, 0.0, 50.0};  // any order: sorted inside
+  s.trigger.expect_any(targets);
+  s.dwell(4.0);  // at 0
+  s.move_to(50.0);
+  s.dwell(4.0);
+  s.move_to(73.0);
+  s.dwell(4.0);  // extra pause: not at a target
+  s.move_to(100.0);
+  s.dwell(4.0);
+  s.move_to(0.0);  // through 50 without a stop
+  s.dwell(4.0);
+  ASSERT_EQ(s.captures.size(), 4u);
+  const double expected[] = {0.0, 50.0, 100.0, 0.0};
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(s.captures[i].mean_mm, expected[i], 0.05e-3);
+  EXPECT_EQ(s.captures[3].approach, Approach::from_above);
+}
+
+TEST(StabilityTrigger, NoisierThanTheBandIsNeverAStop) {
+  // Noise sigma 1 um against a +-1 um band (2 um wide): in 1.5 s of 1 kHz readings the spread
+  // exceeds 2 um almost surely (the range of 1500 normal samples is about 6.5 sigma), so the
+  // window never reaches the dwell: no capture, as a stop that is not stable must not count.
+  Stream s({.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5}, 1.0);
+  s.dwell(5.0);
+  EXPECT_TRUE(s.captures.empty());
+}
+
+TEST(StabilityTrigger, NaNReadingsBreakTheWindowLikeALostBeam) {
+  StabilityTrigger t({.tolerance_um = 1.0, .dwell_s = 1.0, .window_mm = 0.5});
+  std::int64_t now = 0;
+  for (int i = 0; i < 900; ++i) EXPECT_FALSE(t.add(now += ms, 10.0));
+  EXPECT_FALSE(t.add(now += ms, std::nan("")));  // a NaN marked valid
+  for (int i = 0; i < 900; ++i) EXPECT_FALSE(t.add(now += ms, 10.0)) << i;  // 0.9 s since
+  std::optional<Capture> c;
+  for (int i = 0; i < 200 && !c; ++i) c = t.add(now += ms, 10.0);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->mean_mm, 10.0);
+}
+
+// A machine with a position feed (the commanded position, 100 Hz) and a laser (1 kHz) that
+// reads the actual position: the commanded one plus a known positioning error per target and
+// Gaussian noise.
+struct FedMachine {
+  PositionTrigger trigger;
+  std::mt19937_64 rng{11};
+  std::normal_distribution<double> noise{0.0, 0.2e-3};  // 0.2 um
+  std::int64_t t = 0;
+  double x = 0.0, error_mm = 0.0;
+  std::vector<Capture> captures;
+  explicit FedMachine(PositionTriggerSettings s) : trigger(s) {}
+  void tick(bool laser_valid = true) {  // 1 ms
+    if (t % (10 * ms) == 0)
+      if (auto c = trigger.add_position(t, x)) captures.push_back(*c);
+    if (auto c = trigger.add_reading(t, x + error_mm + noise(rng), laser_valid))
+      captures.push_back(*c);
+    t += ms;
+  }
+  void move_to(double target, double error_at_target_mm) {
+    const double step = 0.1 * (target > x ? 1 : -1);  // 100 mm/s
+    while (std::abs(target - x) > 0.1) x += step, tick();
+    x = target;
+    error_mm = error_at_target_mm;
+  }
+  void dwell(double seconds, bool laser_valid = true) {
+    for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) tick(laser_valid);
+  }
+};
+
+TEST(PositionTrigger, CapturesTheLaserWhileTheFeedIsStillAtATarget) {
+  // Injected errors +3, -2, +1 um at 0, 50, 100 mm. The capture averages the newest half of the
+  // 1.5 s still window: >= 740 readings of sigma 0.2 um, standard error 0.007 um; 0.05 um is
+  // 7 standard errors.
+  FedMachine m({.tolerance_um = 1.0, .dwell_s = 1.5});
+  const std::vector<double> targets = {0.0, 50.0, 100.0};
+  m.trigger.expect_any(targets);
+  m.error_mm = 3e-3;
+  m.dwell(4.0);
+  m.move_to(50.0, -2e-3);
+  m.dwell(4.0);
+  m.move_to(73.0, 0.0);
+  m.dwell(4.0);  // still, but not at a target: no capture
+  m.move_to(100.0, 1e-3);
+  m.dwell(1.0);  // too short ...
+  m.move_to(50.0, -2e-3);
+  m.move_to(100.0, 1e-3);
+  m.dwell(4.0);  // ... the second visit is the stop
+  ASSERT_EQ(m.captures.size(), 3u);
+  EXPECT_NEAR(m.captures[0].mean_mm, 0.003, 0.05e-3);
+  EXPECT_NEAR(m.captures[1].mean_mm, 50.0 - 0.002, 0.05e-3);
+  EXPECT_NEAR(m.captures[2].mean_mm, 100.0 + 0.001, 0.05e-3);
+  EXPECT_EQ(m.captures[0].approach, Approach::unknown);
+  EXPECT_EQ(m.captures[1].approach, Approach::from_below);
+  EXPECT_EQ(m.captures[2].approach, Approach::from_below);  // came back up from 50
+  for (const auto& c : m.captures) {
+    EXPECT_NEAR(c.std_um, 0.2, 0.02);
+    EXPECT_GE(c.count, 740u);
+    EXPECT_GE(c.end_ns - c.start_ns, 1'500 * ms);
+    EXPECT_LE(c.end_ns - c.start_ns, 1'510 * ms);  // one feed period at most beyond the dwell
+  }
+}
+
+TEST(PositionTrigger, ALostBeamRestartsTheDwellAndNoLaserMeansNoCapture) {
+  FedMachine m({.tolerance_um = 1.0, .dwell_s = 1.5});
+  m.trigger.expect(20.0);
+  m.move_to(20.0, 0.0);
+  const std::int64_t arrived = m.t;
+  m.dwell(1.0);
+  m.dwell(0.05, false);  // beam blocked for 50 ms
+  const std::int64_t beam_back = m.t;
+  m.dwell(1.0);  // 1 s of valid laser since: not yet
+  EXPECT_TRUE(m.captures.empty());
+  m.dwell(1.0);
+  ASSERT_EQ(m.captures.size(), 1u);
+  EXPECT_GE(m.captures[0].start_ns, beam_back - ms);  // the window starts after the loss
+  EXPECT_GT(m.captures[0].start_ns, arrived + 1'000 * ms);
+  // A stop where the beam stays lost is never captured.
+  m.trigger.expect(40.0);
+  m.move_to(40.0, 0.0);
+  m.dwell(4.0, false);
+  EXPECT_EQ(m.captures.size(), 1u);
+}
+
+TEST(PositionTrigger, OneCapturePerStopAndManualCapture) {
+  FedMachine m({.tolerance_um = 1.0, .dwell_s = 1.5});
+  m.move_to(10.0, 0.0);
+  m.dwell(10.0);  // any still position counts (nothing expected); 10 s give one capture
+  EXPECT_EQ(m.captures.size(), 1u);
+  EXPECT_FALSE(m.trigger.armed());
+  m.move_to(30.0, 0.0);
+  m.dwell(0.5);
+  const auto c = m.trigger.capture_now();  // the operator presses the key
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(c->manual);
+  EXPECT_NEAR(c->mean_mm, 30.0, 0.05e-3);
+  EXPECT_EQ(c->approach, Approach::from_below);
+  m.dwell(3.0);  // the same stop is not captured again
+  EXPECT_EQ(m.captures.size(), 1u);
+}
+
+TEST(PositionTrigger, RefusesBadSettings) {
+  EXPECT_THROW(PositionTrigger({.tolerance_um = -1}), cal::InputError);
+  EXPECT_THROW(PositionTrigger({.dwell_s = 0}), cal::InputError);
+  EXPECT_THROW(PositionTrigger({.average_fraction = 1.5}), cal::InputError);
+}
+
 }  // namespace

@@ -39,11 +39,12 @@ void remove_db(const fs::path& p) {
 
 TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   const auto db = temp_db("linear");
-  constexpr double speed = 40.0;
+  constexpr double speed = 30.0;
   boost::asio::io_context io;
   daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
   cal::daq::Config c;
   c.machine_name = "e2e";
+  c.environment.stale_after_s = 60.0;  // simulated seconds at 40x: see cmd_demo.cpp
   c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5};
   c.linear = cal::daq::LinearTestConfig{.first_mm = 0,
                                         .last_mm = 200,
@@ -116,7 +117,7 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   // backlash shared with the reversal-spike term (~2 %), and the feed-in timing (a few ms of
   // angle offset).
   const auto db = temp_db("circle");
-  constexpr double speed = 40.0;
+  constexpr double speed = 30.0;
   boost::asio::io_context io;
   daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
   const cal::daq::BallbarProgram program{
@@ -193,7 +194,7 @@ TEST(LinearEndToEnd, ReplayingTheCaptureGivesIdenticalStoredResults) {
   const auto db = temp_db("replay");
   const auto capture = fs::path(db.string() + ".cdq");
   const std::string daq = CALDAQ_DAQ_BINARY;
-  ASSERT_EQ(std::system((daq + " demo --quiet --db '" + db.string() + "' --capture '" +
+  ASSERT_EQ(std::system((daq + " demo --quiet --speed 30 --db '" + db.string() + "' --capture '" +
                          capture.string() + "' > /dev/null")
                             .c_str()),
             0);

@@ -73,10 +73,21 @@ struct SimulatedShop::Impl {
                   .request = "?",
                   .decimals = 3,
                   .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
-        ballbar(io, world, clock, {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm}) {}
+        ballbar(io, world, clock,
+                {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}) {}
 
+  // Simulated time follows the wall clock times `speed`, but a wall-clock interval between
+  // two readings of the clock counts for at most kMaxWall_s: when the process is starved of
+  // CPU (a loaded CI machine), the simulation pauses with it instead of running past the
+  // stops while nothing reads the instruments. Every party reads this one clock.
+  static constexpr double kMaxWall_s = 0.005;
+  mutable double sim_s = 0.0;
+  mutable std::chrono::steady_clock::time_point last = start;
   double now() const {
-    return speed * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto wall = std::chrono::steady_clock::now();
+    sim_s += speed * std::min(std::chrono::duration<double>(wall - last).count(), kMaxWall_s);
+    last = wall;
+    return sim_s;
   }
 };
 
@@ -119,6 +130,7 @@ void SimulatedShop::run_circle(const cal::daq::BallbarProgram& p) {
       sim::Move::linear({c[0] + p.radius_mm + p.feed_in_mm, c[1], c[2]}, feed)};
   impl_->world.advance_to(now_s());
   impl_->world.machine().load(program);
+  impl_->ballbar.set_streaming(true);  // the bar is mounted now
 }
 
 double SimulatedShop::program_end_s() const { return impl_->world.machine().program_duration_s(); }

@@ -17,15 +17,49 @@ constexpr std::int64_t kKeepNs = 120'000'000'000;  // 2 min
 }  // namespace
 
 EnvStage::EnvStage(const EnvironmentConfig& config, int material_sensors)
+    : EnvStage(config,
+               EnvSensors{std::vector<bool>(static_cast<std::size_t>(std::max(material_sensors, 0)),
+                                            true),
+                          false}) {
+  if (material_sensors < 0)
+    throw InputError(fmt::format("material sensors: {} (expected >= 0)", material_sensors));
+}
+
+EnvStage::EnvStage(const EnvironmentConfig& config, const EnvSensors& sensors)
     : config_(config),
       equation_(air::equation_from_string(config.equation)),
-      stale_ns_(static_cast<std::int64_t>(config.stale_after_s * 1e9)) {
-  air_[0] = {"air temperature", config.fallback_temperature_degc, {}, false};
-  air_[1] = {"air pressure", config.fallback_pressure_pa, {}, false};
-  air_[2] = {"air humidity", config.fallback_humidity_pct, {}, false};
-  for (int i = 0; i < material_sensors; ++i)
-    material_.push_back(
-        {fmt::format("material sensor {}", i + 1), config.fallback_material_degc, {}, false});
+      stale_ns_(static_cast<std::int64_t>(std::min(config.stale_after_s, 1e9) * 1e9)) {
+  if (!(config.stale_after_s > 0))
+    throw InputError(fmt::format("environment: stale_after_s {} (expected > 0 s)",
+                                 config.stale_after_s));
+  if (!std::isfinite(config.expansion_ppm_per_k))
+    throw InputError(fmt::format("environment: expansion_ppm_per_k {} (expected a finite value)",
+                                 config.expansion_ppm_per_k));
+  air_[0] = {"air temperature", config.fallback_temperature_degc, {}, false, true, true};
+  air_[1] = {"air pressure", config.fallback_pressure_pa, {}, false, true, true};
+  air_[2] = {"air humidity", config.fallback_humidity_pct, {}, false, true, true};
+  air_[3] = {"air CO2", config.co2_umol_per_mol, {}, false, sensors.co2, true};
+  for (std::size_t i = 0; i < sensors.material_enabled.size(); ++i)
+    material_.push_back({fmt::format("material sensor {}", i + 1), config.fallback_material_degc,
+                         {}, false, true, sensors.material_enabled[i]});
+  if (!material_.empty() &&
+      std::none_of(material_.begin(), material_.end(), [](const auto& m) { return m.enabled; }))
+    throw InputError(fmt::format("material sensors: all {} are disabled (at least one must be on)",
+                                 material_.size()));
+}
+
+void EnvStage::set_material_enabled(int sensor, bool enabled) {
+  if (sensor < 0 || sensor >= static_cast<int>(material_.size()))
+    throw InputError(fmt::format("material sensor {} does not exist (there are {})", sensor + 1,
+                                 material_.size()));
+  auto& s = material_[static_cast<std::size_t>(sensor)];
+  if (!enabled && s.enabled &&
+      std::count_if(material_.begin(), material_.end(), [](const auto& m) { return m.enabled; }) ==
+          1)
+    throw InputError(fmt::format("material sensor {}: the last enabled one cannot be disabled",
+                                 sensor + 1));
+  s.enabled = enabled;
+  s.stale_reported = false;  // a new episode if it is stale when enabled again
 }
 
 void EnvStage::add(Series& s, std::int64_t t, double v) {
@@ -65,6 +99,7 @@ std::optional<double> EnvStage::Series::at(std::int64_t t, std::int64_t stale_ns
 }
 
 void EnvStage::check_series(Series& s, std::int64_t t, EnvHealth& h) {
+  if (!s.required || !s.enabled) return;
   const bool stale = s.samples.empty() || t - s.samples.back().first > stale_ns_;
   if (stale && !s.stale_reported) {
     s.stale_reported = true;
@@ -85,7 +120,7 @@ void EnvStage::check_series(Series& s, std::int64_t t, EnvHealth& h) {
 
 EnvHealth EnvStage::check(std::int64_t t) {
   EnvHealth h;
-  for (auto& s : air_) check_series(s, t, h);
+  for (auto& s : air_) check_series(s, t, h);  // the CO2 only with a sensor (required)
   for (auto& s : material_) check_series(s, t, h);
   return h;
 }
@@ -94,12 +129,14 @@ Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   Compensated c;
   c.time_ns = t;
   c.raw_m = raw_m;
-  double value[3];
-  for (int i = 0; i < 3; ++i) {
+  double value[4];
+  for (int i = 0; i < 4; ++i) {
     const auto v = air_[i].at(t, stale_ns_, c.held);
-    c.fallback_air = c.fallback_air || !v;
+    // Without a CO2 sensor the configured constant is the value, not a fallback.
+    c.fallback_air = c.fallback_air || (!v && air_[i].required);
     value[i] = v.value_or(air_[i].fallback);
   }
+  c.co2_umol_per_mol = value[3];
   c.air_temperature_degc = value[0];
   c.pressure_pa = value[1];
   c.humidity_pct = std::clamp(value[2], 0.0, 100.0);
@@ -107,6 +144,7 @@ Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   double sum = 0.0;
   int n = 0;
   for (const auto& s : material_) {
+    if (!s.enabled) continue;
     if (const auto v = s.at(t, stale_ns_, c.held)) {
       sum += *v;
       ++n;
@@ -119,10 +157,11 @@ Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   air.temperature_degc = c.air_temperature_degc;
   air.pressure_pa = c.pressure_pa;
   air.humidity = air::Humidity::relative_pct(c.humidity_pct);
-  air.co2_umol_per_mol = config_.co2_umol_per_mol;
+  air.co2_umol_per_mol = c.co2_umol_per_mol;
   air.wavelength_vacuum_nm = config_.wavelength_nm;
   c.n = air::refractive_index(air, equation_).n;
   const double alpha = config_.expansion_ppm_per_k * 1e-6;
+  // L20 = raw / (n (1 + alpha (T - 20))): cal::comp (ISO 1 reference temperature).
   c.length_m = comp::normalise_to_20c_m(comp::air_length_m(raw_m, c.n), alpha, c.material_degc);
   c.factor_ppm = comp::combined_factor(c.n, alpha, c.material_degc).total_ppm;
   return c;

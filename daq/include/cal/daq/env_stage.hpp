@@ -10,6 +10,14 @@
 // compensated result (`fallback_air`, `fallback_material`) and announced once per episode,
 // or asks the run to stop (`must_stop`). Formulas: cal::air (refractive index),
 // cal::comp (normalisation to 20 degC); docs/acquisition.md.
+//
+// The CO2 mole fraction is optional: without a CO2 sensor (EnvSensors::co2 false) the
+// configured constant is used, and any CO2 samples that do arrive replace it while current;
+// with one, it is interpolated and checked like the other air quantities. Material sensors may
+// be disabled (a broken or badly placed probe): they are then neither averaged nor checked.
+//
+// Cost per laser reading: a binary search per quantity (samples are kept for 2 minutes) and
+// one evaluation of the refractive-index equation.
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -21,7 +29,7 @@
 
 namespace cal::daq {
 
-enum class AirQuantity { temperature_degc, pressure_pa, humidity_pct };
+enum class AirQuantity { temperature_degc, pressure_pa, humidity_pct, co2_umol_per_mol };
 
 struct Compensated {
   std::int64_t time_ns = 0;
@@ -34,6 +42,12 @@ struct Compensated {
   bool fallback_air = false;  // a fallback value was used for an air quantity
   bool fallback_material = false;
   bool held = false;  // the reading is newer than the newest sample: held value
+  double co2_umol_per_mol = 450.0;
+};
+
+struct EnvSensors {
+  std::vector<bool> material_enabled;  // one per material thermometer; false: disabled
+  bool co2 = false;                    // a CO2 sensor feeds AirQuantity::co2_umol_per_mol
 };
 
 struct EnvHealth {
@@ -43,15 +57,27 @@ struct EnvHealth {
 
 class EnvStage {
  public:
-  // material_sensors: how many material thermometers there are (their mean is used; a
-  // disabled one is simply not fed). Throws cal::InputError for an unknown equation.
+  // material_sensors: how many material thermometers there are (all enabled; their mean is
+  // used), no CO2 sensor. Throws cal::InputError for an unknown equation, a stale age that is
+  // not > 0, a non-finite expansion coefficient, or a negative count.
   EnvStage(const EnvironmentConfig& config, int material_sensors);
+  // The same with the sensors described; at least one material sensor must be enabled when
+  // there are any.
+  EnvStage(const EnvironmentConfig& config, const EnvSensors& sensors);
+
+  // Disable (or enable again) a material sensor during a run; refuses to disable the last
+  // enabled one (cal::InputError), as the material temperature would then be unknown.
+  void set_material_enabled(int sensor, bool enabled);
 
   void add_air(std::int64_t time_ns, AirQuantity q, double value);
+  // sensor is 0-based; throws cal::InputError for a sensor that does not exist. Non-finite
+  // values are dropped (a sensor's error code is no temperature).
   void add_material(std::int64_t time_ns, int sensor, double value_degc);
 
   // Stale detection at time t (call it for each laser reading or on a timer).
   EnvHealth check(std::int64_t time_ns);
+  // Throws cal::InputError when the environment at t is outside the equation's range (a
+  // sensor fault such as a pressure of 0): such a reading cannot be compensated.
   Compensated compensate(std::int64_t time_ns, double raw_m) const;
 
  private:
@@ -60,6 +86,8 @@ class EnvStage {
     double fallback = 0.0;
     std::deque<std::pair<std::int64_t, double>> samples;  // time-ordered, bounded
     bool stale_reported = false;
+    bool required = true;  // checked for staleness (the optional CO2 without a sensor is not)
+    bool enabled = true;   // a disabled material sensor is ignored
     // The value at t: interpolated, held (newest), or nullopt (none / stale).
     std::optional<double> at(std::int64_t t, std::int64_t stale_ns, bool& held) const;
   };
@@ -69,7 +97,7 @@ class EnvStage {
   EnvironmentConfig config_;
   air::Equation equation_;
   std::int64_t stale_ns_;
-  Series air_[3];
+  Series air_[4];
   std::vector<Series> material_;
 };
 

@@ -1,14 +1,19 @@
 #pragma once
-// Part programs for the tests, in the dialects of the common controls (docs/acquisition.md):
-// - Fanuc / ISO 6983: G90 G01 X.. F.., dwell G04 P<ms> (Fanuc counts P in ms), arcs G02/G03
-//   with I J (G17), M30.
-// - Heidenhain conversational: BEGIN PGM .. MM, L X+.. F.., dwell CYCL DEF 9.0/9.1 DWELL, arcs
-//   by CC X.. Y.. (centre) and C X.. Y.. DR+/DR-, END PGM.
-// - Siemens SINUMERIK: G90 G1 X.. F.., dwell G4 F<s>, arcs G2/G3 with I= J= (incremental
-//   centre, the SINUMERIK default), M30.
-// The ISO 230-2 program visits every move of the plan (measure, over-run, reposition) with a
-// dwell at each measure move; the circle program feeds in, dwells, runs the ccw arc with its
-// overshoots, dwells, runs the cw arc back, and feeds out, matching BallbarSegmenter.
+// Part programs for the tests, in the dialects of the common controls (docs/acquisition.md has
+// the syntax of each and where it comes from):
+// - Fanuc / ISO 6983: G90 G01 X.. F..; dwell G04 P<ms> (P counts ms, no decimal point) or
+//   G04 X<s> (seconds, decimal point); arcs G02 (cw) / G03 (ccw) with the incremental centre
+//   I J (G17), I K (G18) or J K (G19), or with R (+ for arcs up to 180 degrees); M30.
+// - Heidenhain conversational: BEGIN PGM .. MM, L X+.. F..; dwell CYCL DEF 9.0 DWELL TIME /
+//   CYCL DEF 9.1 DWELL <s>; arcs by the centre CC X.. Y.. (absolute) and C X.. Y.. DR+ (ccw) /
+//   DR- (cw), or CR X.. Y.. R+.. DR+/-; END PGM.
+// - Siemens SINUMERIK: G90 G1 X.. F..; dwell G4 F<s>; arcs G2/G3 with I= J= (incremental
+//   centre, the SINUMERIK default) or CR=+..; M30.
+// The ISO 230-2 program visits every move of the plan in the plan's order (measure, over-run,
+// reposition) with a dwell at each measure move; the circle program feeds in along the radius,
+// dwells, runs the ccw circle with its overshoot arcs before and after, dwells, runs the cw
+// circle back, and feeds out, matching BallbarSegmenter. Numbers are written with 4 decimals
+// (0.1 um: below any machine's programming resolution, so nothing is rounded twice).
 #include <string>
 #include <string_view>
 
@@ -18,24 +23,49 @@
 namespace cal::daq {
 
 enum class Dialect { fanuc, heidenhain, siemens };
-Dialect dialect_from_string(std::string_view s);  // fanuc | iso | heidenhain | siemens
+Dialect dialect_from_string(std::string_view s);  // fanuc | iso | heidenhain | siemens | sinumerik
+
+// The working plane of a circle. The in-plane axes (u, v) are ordered so that a turn from u to
+// v is counter-clockwise seen from the positive third axis (u x v = w, right-handed), which is
+// the sense of G03 / DR+ in every dialect: XY (G17), ZX (G18: u = Z, v = X), YZ (G19).
+enum class Plane { xy, zx, yz };
+Plane plane_from_string(std::string_view s);  // XY | ZX | XZ | YZ (any case); G17 | G18 | G19
+
+// How arcs are written: by their centre (I J K / CC) or by their radius (R / CR=). Radius arcs
+// are split into pieces of at most 90 degrees: an arc of exactly 180 degrees by radius is
+// ill-conditioned (the rounded end point can lie a hair more than 2R from the start) and
+// controls alarm on it.
+enum class ArcForm { centre, radius };
+
+// Fanuc's dwell word: P in milliseconds (integer) or X in seconds (with a decimal point).
+enum class FanucDwell { p_ms, x_s };
 
 struct LinearProgram {
   char axis = 'X';
   double feed_mm_per_min = 2000.0;
-  double dwell_s = 4.0;
+  double dwell_s = 4.0;  // at each measure move
   std::string name = "ISO2302";
+  // The stability trigger's dwell: when > 0 the program's dwell must exceed it by at least
+  // settle_s (the servo settles for a while after the block ends; the trigger needs dwell_s of
+  // stillness after that), else InputError.
+  double trigger_dwell_s = 0.0;
+  double settle_s = 0.5;
+  FanucDwell fanuc_dwell = FanucDwell::p_ms;
 };
 
 std::string linear_program(const iso230_2::Plan& plan, const LinearProgram& p, Dialect d);
 
 struct CircleProgramSetup {
-  double centre_x_mm = 0.0, centre_y_mm = 0.0;  // the table ball, in the XY plane
+  // The centre of the circle (the table ball); only the plane's two coordinates are used.
+  double centre_x_mm = 0.0, centre_y_mm = 0.0, centre_z_mm = 0.0;
   std::string name = "BALLBAR";
+  Plane plane = Plane::xy;
+  ArcForm arcs = ArcForm::centre;
+  FanucDwell fanuc_dwell = FanucDwell::p_ms;
 };
 
-// Arcs are split into segments of at most 180 degrees (a full circle in one block is not
-// portable between controls).
+// By centre, arcs are split into pieces of at most 180 degrees (a full circle in one block is
+// not portable between controls); by radius, at most 90 degrees (see ArcForm).
 std::string circle_program(const BallbarProgram& b, const CircleProgramSetup& s, Dialect d);
 
 }  // namespace cal::daq

@@ -15,10 +15,18 @@
 //
 // A manual trigger ("capture now", from the keyboard) captures the last window as it is; a
 // position-assisted trigger (PositionTrigger) uses a machine position feed instead: stopped
-// when the fed position has not changed by more than the tolerance for the dwell.
+// when the fed (commanded or actual) position equals an expected target within the tolerance
+// and has not moved by more than the tolerance (velocity zero) for the dwell; the capture is the
+// laser's mean over that time.
+//
+// Cost per reading: O(1) amortised (monotonic min/max deques, running sums); the capture itself
+// is O(window) once per stop.
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <optional>
+#include <span>
+#include <vector>
 
 namespace cal::daq {
 
@@ -49,7 +57,10 @@ class StabilityTrigger {
   explicit StabilityTrigger(TriggerSettings settings);  // throws cal::InputError if <= 0
 
   // The target the machine is expected to stop at next (nullopt: any position).
-  void expect(std::optional<double> position_mm) { expected_mm_ = position_mm; }
+  void expect(std::optional<double> position_mm);
+  // Several candidate targets (e.g. all the targets of the plan): a stop counts when its mean
+  // lies within window_mm of any of them. Empty: any position.
+  void expect_any(std::span<const double> positions_mm);
   // One reading; returns a capture when this reading completes a stop.
   std::optional<Capture> add(std::int64_t time_ns, double position_mm, bool valid = true);
   // Manual trigger: the current window (if it holds any reading), whatever its spread.
@@ -62,7 +73,7 @@ class StabilityTrigger {
 
   TriggerSettings s_;
   std::int64_t dwell_ns_, approach_ns_;
-  std::optional<double> expected_mm_;
+  std::vector<double> expected_mm_;  // sorted; empty: any position
   std::deque<std::pair<std::int64_t, double>> window_;   // the current candidate window
   std::deque<std::pair<std::int64_t, double>> history_;  // approach_s of past positions
   // Monotonic deques of the window's min and max (O(1) per reading at 10 kHz), keyed by the
@@ -73,6 +84,55 @@ class StabilityTrigger {
   double sum_ = 0.0, sum2_ = 0.0;
   bool armed_ = true;
   double last_capture_mm_ = 0.0;
+};
+
+// True when x lies within `window` of one of the sorted positions (all true when empty).
+bool near_any(std::span<const double> sorted_mm, double x_mm, double window_mm);
+
+// The approach direction to a stop at `stop_mm` from the positions before `before_ns`: the
+// newest one farther than far_mm from the stop. History is time-ordered (oldest first).
+Approach approach_from(const std::deque<std::pair<std::int64_t, double>>& history, double stop_mm,
+                       std::int64_t before_ns, double far_mm);
+
+// Position-assisted trigger: a machine position feed (LinuxCNC halsampler, MTConnect SHDR)
+// says when the axis is at a target and still; the laser readings of that time make the
+// capture. Feed and laser carry timestamps of the same clock (the service's).
+struct PositionTriggerSettings {
+  double tolerance_um = 1.0;  // |fed position - target| and the stillness band of the feed
+  double dwell_s = 1.5;       // how long the feed must be still at the target
+  double approach_s = 10.0;   // how far back the approach direction is looked for
+  double average_fraction = 0.5;  // as TriggerSettings: the newest part of the window only
+};
+
+class PositionTrigger {
+ public:
+  explicit PositionTrigger(PositionTriggerSettings settings);  // throws cal::InputError
+
+  void expect(std::optional<double> position_mm);
+  void expect_any(std::span<const double> positions_mm);  // empty: any still position counts
+  // A sample of the position feed (machine coordinates, mm); returns a capture when the feed
+  // has now been still at a target for the dwell and the laser had valid readings all along.
+  std::optional<Capture> add_position(std::int64_t time_ns, double machine_mm);
+  // A laser reading (the measured position, mm). A signal-lost reading restarts the dwell.
+  std::optional<Capture> add_reading(std::int64_t time_ns, double laser_mm, bool valid = true);
+  // Manual trigger: the laser readings of the last dwell_s, whatever the feed says.
+  std::optional<Capture> capture_now();
+  bool armed() const { return armed_; }
+
+ private:
+  std::optional<Capture> try_capture(std::int64_t now_ns);
+  std::optional<Capture> make_capture(std::int64_t from_ns, std::int64_t to_ns, bool manual,
+                                      double at_mm);
+
+  PositionTriggerSettings s_;
+  std::int64_t dwell_ns_, approach_ns_;
+  std::vector<double> expected_mm_;
+  std::deque<std::pair<std::int64_t, double>> feed_;   // approach_s + dwell_s of feed samples
+  std::deque<std::pair<std::int64_t, double>> laser_;  // about 2 dwell_s of valid readings
+  std::optional<std::int64_t> still_since_ns_;         // the feed has been at a target since
+  double still_mm_ = 0.0;                              // the fed position of that stop
+  std::int64_t last_invalid_ns_ = std::numeric_limits<std::int64_t>::min();
+  bool armed_ = true;
 };
 
 }  // namespace cal::daq

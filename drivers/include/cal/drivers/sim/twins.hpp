@@ -125,6 +125,9 @@ class GaugeTwin {
   const std::string& device_path() const;
   void unplug();
   std::uint64_t lines_sent() const;
+  // Starts (from the current simulated time) or stops the continuous output: a bar is only
+  // mounted, and a stream only read, for its test.
+  void set_streaming(bool on);
 
  private:
   struct Impl;
