@@ -9,36 +9,11 @@
 
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
+#include "circle_output.hpp"
 
 namespace daq {
 
 using nlohmann::json;
-
-json circle_json(const cal::circle::Result& r, double radius_mm, const std::string& plane) {
-  json j{{"schema", "caldaq.circle.v1"},
-         {"standard", "ISO 230-4:2005"},
-         {"radius_mm", radius_mm},
-         {"plane", plane},
-         {"iso230_4",
-          {{"G_bi_um", r.iso.G_bi_um},
-           {"G_cw_um", r.iso.G_cw_um},
-           {"G_ccw_um", r.iso.G_ccw_um},
-           {"H_um", r.iso.H_um},
-           {"F_max_um", r.iso.F_max_um},
-           {"F_min_um", r.iso.F_min_um},
-           {"centre_um", {r.iso.centre_u_um, r.iso.centre_v_um}}}},
-         {"residual_rms_um", r.residual_rms_um},
-         {"notes", r.notes}};
-  j["diagnostics"] = json::array();
-  for (const auto& d : r.diagnostics)
-    j["diagnostics"].push_back({{"key", d.key},
-                                {"name", d.name},
-                                {"value", d.value},
-                                {"unit", d.unit},
-                                {"pv_um", d.pv_um},
-                                {"share_pct", d.share_pct}});
-  return j;
-}
 
 struct CircleRun::Impl {
   boost::asio::io_context& io;
@@ -122,10 +97,11 @@ struct CircleRun::Impl {
     } catch (const std::exception& e) {
       return abort(e.what());
     }
-    store->add_result(
-        {.run_id = outcome.run_id,
-         .standard = "ISO 230-4:2005",
-         .json = circle_json(*outcome.result, setup.program.radius_mm, setup.plane).dump()});
+    store->add_result({.run_id = outcome.run_id,
+                       .standard = "ISO 230-4:2005",
+                       .json = circle_json(*outcome.result, setup.program.radius_mm, setup.plane,
+                                           setup.program.feed_mm_per_min)
+                                   .dump()});
     store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
     outcome.complete = true;
     end();
