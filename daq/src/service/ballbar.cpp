@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -70,6 +71,47 @@ std::vector<circle::Trace> BallbarSegmenter::traces() const {
       t.deviation_um.push_back(values_[*feed_in_end_ + i] * 1e3);
     }
     out.push_back(std::move(t));
+  }
+  return out;
+}
+
+std::string_view to_string(BallbarPhase p) {
+  switch (p) {
+    case BallbarPhase::feed_in:
+      return "waiting for the feed-in";
+    case BallbarPhase::dwell:
+      return "dwell";
+    case BallbarPhase::ccw_arc:
+      return "ccw arc";
+    case BallbarPhase::cw_arc:
+      return "cw arc";
+    case BallbarPhase::complete:
+      return "complete";
+  }
+  return "?";
+}
+
+BallbarProgress BallbarSegmenter::progress() const {
+  if (!feed_in_end_ || values_.empty()) return {};
+  const double arc_s = arc_duration_s(), total_s = 2 * p_.dwell_s + 2 * arc_s;
+  const double t_s = static_cast<double>(values_.size() - 1 - *feed_in_end_) / p_.sample_rate_hz;
+  const double rate_deg_s = p_.feed_mm_per_min / 60.0 / p_.radius_mm * 180.0 / std::numbers::pi;
+  BallbarProgress out{.fraction = std::min(1.0, t_s / total_s)};
+  if (complete()) {
+    out.phase = BallbarPhase::complete;
+  } else if (t_s < p_.dwell_s) {
+    out.phase = BallbarPhase::dwell;
+    out.angle_deg = p_.start_deg;
+  } else if (t_s < p_.dwell_s + arc_s) {
+    out.phase = BallbarPhase::ccw_arc;
+    out.angle_deg = p_.start_deg + rate_deg_s * (t_s - p_.dwell_s);
+  } else if (t_s < 2 * p_.dwell_s + arc_s) {
+    out.phase = BallbarPhase::dwell;
+    out.angle_deg = p_.start_deg + 360.0 + 2 * p_.overshoot_deg;
+  } else {
+    out.phase = BallbarPhase::cw_arc;
+    out.angle_deg =
+        p_.start_deg + 360.0 + 2 * p_.overshoot_deg - rate_deg_s * (t_s - 2 * p_.dwell_s - arc_s);
   }
   return out;
 }

@@ -13,6 +13,7 @@
 // USB chunks.
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cal/analysis/circle.hpp"
@@ -29,6 +30,16 @@ struct BallbarProgram {
   double start_deg = 0.0;  // angle of the start point, from the first axis
 };
 
+// Where the stream is in the program, for the operator's display.
+enum class BallbarPhase { feed_in, dwell, ccw_arc, cw_arc, complete };
+std::string_view to_string(BallbarPhase p);  // "waiting for the feed-in", "ccw arc", ...
+
+struct BallbarProgress {
+  BallbarPhase phase = BallbarPhase::feed_in;
+  double angle_deg = 0.0;  // programmed angle of the latest sample (in an arc)
+  double fraction = 0.0;   // of the whole test after the feed-in, 0..1
+};
+
 class BallbarSegmenter {
  public:
   explicit BallbarSegmenter(BallbarProgram p);  // throws cal::InputError for bad values
@@ -42,6 +53,7 @@ class BallbarSegmenter {
   std::vector<circle::Trace> traces() const;
   double arc_duration_s() const;  // of one arc with its overshoots
   std::size_t samples() const { return values_.size(); }
+  BallbarProgress progress() const;
 
  private:
   BallbarProgram p_;
