@@ -1,5 +1,7 @@
 #include "circle_output.hpp"
 
+#include <fmt/format.h>
+
 namespace daq {
 
 using nlohmann::json;
@@ -34,6 +36,30 @@ json circle_json(const cal::circle::Result& r, double radius_mm, std::string_vie
                                 {"g_reduction_um", d.g_reduction_um}});
   j["centre"] = {{r.centre_u.key, r.centre_u.value}, {r.centre_v.key, r.centre_v.value}};
   return j;
+}
+
+void print_circle(const cal::circle::Result& r, double radius_mm, std::string_view plane,
+                  double feed_mm_per_min) {
+  fmt::print("ISO 230-4 circular test, plane {}, R = {} mm, feed {} mm/min\n", plane, radius_mm,
+             feed_mm_per_min);
+  fmt::print("  G (bidirectional)  {:8.3f} um\n", r.iso.G_bi_um);
+  if (r.iso.G_ccw_um > 0) fmt::print("  G ccw              {:8.3f} um\n", r.iso.G_ccw_um);
+  if (r.iso.G_cw_um > 0) fmt::print("  G cw               {:8.3f} um\n", r.iso.G_cw_um);
+  fmt::print("  H                  {:8.3f} um\n", r.iso.H_um);
+  fmt::print("  F max / min        {:8.3f} / {:.3f} um\n", r.iso.F_max_um, r.iso.F_min_um);
+  fmt::print("  LSQ centre         {:8.3f}, {:.3f} um\n\n", r.iso.centre_u_um, r.iso.centre_v_um);
+  fmt::print(
+      "Diagnostics (ranked by their share of G; PV of the fitted contribution, its % of G,\n"
+      "and the reduction of G when it alone is removed):\n");
+  fmt::print("  {:<40} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "% of G",
+             "G gain");
+  for (const auto& d : r.diagnostics)
+    fmt::print("  {:<40} {:+9.3f} {:<5} {:7.3f} um {:5.1f} % {:7.3f} um\n", d.name, d.value, d.unit,
+               d.pv_um, d.share_pct, d.g_reduction_um);
+  fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_u.name, r.centre_u.value);
+  fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_v.name, r.centre_v.value);
+  fmt::print("  residual rms {:.3f} um\n", r.residual_rms_um);
+  for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
 }
 
 }  // namespace daq

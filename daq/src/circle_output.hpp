@@ -11,4 +11,8 @@ namespace daq {
 nlohmann::json circle_json(const cal::circle::Result& r, double radius_mm, std::string_view plane,
                            double feed_mm_per_min);
 
+// The same for a terminal: ISO 230-4 values, then the diagnostics ranked.
+void print_circle(const cal::circle::Result& r, double radius_mm, std::string_view plane,
+                  double feed_mm_per_min);
+
 }  // namespace daq

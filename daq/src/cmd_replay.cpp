@@ -2,11 +2,14 @@
 // into a new stored run. The same capture always gives the same readings and results.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <filesystem>
 
 #include "cal/analysis/error.hpp"
 #include "cal/replay/session.hpp"
+#include "circle_output.hpp"
+#include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
@@ -26,48 +29,94 @@ struct ReplayOptions {
   bool json = false;
 };
 
-void run_replay(const ReplayOptions& o) {
+struct ReplaySession {
   boost::asio::io_context io;
-  cal::replay::ReplayBus bus(io, o.capture, o.speed);
-  const json header = json::parse(bus.header_json(), nullptr, false);
-  if (header.is_discarded() || header.value("format", "") != "caldaq.capture-header.v1")
-    throw cal::InputError(
-        fmt::format("{}: the capture header is not a caldaq session header", o.capture));
-  const auto config = config_from_json(header.at("config"));
-  if (!config.linear)
-    throw cal::InputError(fmt::format("{}: not a linear (ISO 230-2) session", o.capture));
+  cal::replay::ReplayBus bus;
+  json header;
+  cal::daq::Config config;
+  std::vector<InstrumentSpec> specs;
 
-  LinearRunSetup setup;
-  setup.config = config;
-  setup.database = database_path(o.db);
-  setup.capture_path = std::filesystem::absolute(o.capture).string();
-  setup.software_version = "daq 0.1.0 (replay of " + header.value("software", "?") + ")";
-  for (const auto& j : header.at("instruments")) {
-    const auto spec = instrument_spec_from_json(j);
-    auto inst = make_instrument(io, spec, bus.transport(spec.device, spec.transport),
-                                {.name = spec.role, .clock = bus.clock(), .replay = true});
-    if (spec.role == "laser")
-      setup.laser = std::move(inst);
-    else if (spec.role == "air")
-      setup.air = std::move(inst);
-    else if (spec.role == "material")
-      setup.material.push_back(std::move(inst));
+  ReplaySession(const ReplayOptions& o) : bus(io, o.capture, o.speed) {
+    header = json::parse(bus.header_json(), nullptr, false);
+    if (header.is_discarded() || header.value("format", "") != "caldaq.capture-header.v1")
+      throw cal::InputError(
+          fmt::format("{}: the capture header is not a caldaq session header", o.capture));
+    config = config_from_json(header.at("config"));
+    for (const auto& j : header.at("instruments")) specs.push_back(instrument_spec_from_json(j));
   }
-  if (!setup.laser || !setup.air)
-    throw cal::InputError(
-        fmt::format("{}: the session has no laser or no air instrument", o.capture));
-  LinearRun run(io, std::move(setup));
-  run.start();
-  std::optional<cal::replay::ReplayEnd> end;
-  bus.start([&](const cal::replay::ReplayEnd& e) { end = e; });
-  while (!run.finished() && !end) io.run_for(50ms);
-  if (!run.finished()) {
-    std::string why = "the capture ended before every stop was captured";
+  std::string software() const {
+    return "daq 0.1.0 (replay of " + header.value("software", "?") + ")";
+  }
+  std::unique_ptr<cal::drivers::Instrument> instrument(const InstrumentSpec& spec) {
+    return make_instrument(io, spec, bus.transport(spec.device, spec.transport),
+                           {.name = spec.role, .clock = bus.clock(), .replay = true});
+  }
+  // Runs the bus until the run finishes or the capture ends; returns why it ended early.
+  template <class Run>
+  void play(Run& run, const char* incomplete) {
+    std::optional<cal::replay::ReplayEnd> end;
+    bus.start([&](const cal::replay::ReplayEnd& e) { end = e; });
+    while (!run.finished() && !end) io.run_for(50ms);
+    // Readings the instruments still hold are delivered before the run is judged incomplete.
+    if (!run.finished()) io.run_for(10ms);
+    if (run.finished()) return;
+    std::string why = incomplete;
     if (end && end->damage)
       why = fmt::format("the capture is damaged at byte {} (block {}): {}", end->damage->offset,
                         end->damage->block, end->damage->what);
     run.stop(why);
   }
+};
+
+void replay_circle(ReplaySession& s, const ReplayOptions& o) {
+  const auto it = std::find_if(s.specs.begin(), s.specs.end(),
+                               [](const auto& x) { return x.role == "ballbar"; });
+  if (it == s.specs.end())
+    throw cal::InputError(fmt::format("{}: the session has no ballbar instrument", o.capture));
+  const auto [program, analysis] = circle_test(s.config);
+  CircleRunSetup setup{.config = s.config,
+                       .program = program,
+                       .analysis = analysis,
+                       .database = database_path(o.db),
+                       .ballbar = s.instrument(*it),
+                       .capture_path = std::filesystem::absolute(o.capture).string(),
+                       .software_version = s.software()};
+  CircleRun run(s.io, std::move(setup));
+  run.start();
+  s.play(run, "the capture ended before both arcs were recorded");
+  const auto& out = run.outcome();
+  if (!out.complete)
+    throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
+                                      out.run_id, out.reason));
+  if (o.json) {
+    json j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+    j["run_id"] = out.run_id;
+    return fmt::print("{}\n", j.dump(2));
+  }
+  fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+  print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+}
+
+void replay_linear(ReplaySession& s, const ReplayOptions& o) {
+  LinearRunSetup setup;
+  setup.config = s.config;
+  setup.database = database_path(o.db);
+  setup.capture_path = std::filesystem::absolute(o.capture).string();
+  setup.software_version = s.software();
+  for (const auto& spec : s.specs) {
+    if (spec.role == "laser")
+      setup.laser = s.instrument(spec);
+    else if (spec.role == "air")
+      setup.air = s.instrument(spec);
+    else if (spec.role == "material")
+      setup.material.push_back(s.instrument(spec));
+  }
+  if (!setup.laser || !setup.air)
+    throw cal::InputError(
+        fmt::format("{}: the session has no laser or no air instrument", o.capture));
+  LinearRun run(s.io, std::move(setup));
+  run.start();
+  s.play(run, "the capture ended before every stop was captured");
   const auto& out = run.outcome();
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
@@ -79,6 +128,18 @@ void run_replay(const ReplayOptions& o) {
   }
   fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
   print(*out.evaluation);
+}
+
+// A session is replayed as the test it recorded: a ballbar session as a circle, else linear.
+void run_replay(const ReplayOptions& o) {
+  ReplaySession s(o);
+  const bool ballbar = std::any_of(s.specs.begin(), s.specs.end(),
+                                   [](const auto& x) { return x.role == "ballbar"; });
+  if (ballbar && s.config.circle) return replay_circle(s, o);
+  if (!s.config.linear)
+    throw cal::InputError(fmt::format(
+        "{}: neither a linear (ISO 230-2) nor a ballbar (ISO 230-4) session", o.capture));
+  replay_linear(s, o);
 }
 
 }  // namespace
@@ -93,7 +154,8 @@ void add_replay_command(CLI::App& app) {
   cmd->add_option("--speed", o->speed, "0: as fast as possible; 1: real time; 2: twice ...")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--json", o->json, "Print the result as caldaq.iso230-2.v1 JSON");
+  cmd->add_flag("--json", o->json,
+                "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v1)");
   cmd->callback([o] { run_replay(*o); });
 }
 

@@ -18,6 +18,7 @@
 #include "cal/drivers/transport/hid.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
+#include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
@@ -80,6 +81,7 @@ const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role) 
 struct RunOptions {
   std::string config, db, capture;
   int give_up_after = 20;
+  bool json = false;
 };
 
 // Enter on the keyboard is the manual trigger ("capture now").
@@ -100,6 +102,31 @@ void watch_keyboard(boost::asio::io_context& io, std::function<void()> on_enter)
   (*next)();
 }
 
+// Records the capture of a session when asked to (--capture FILE).
+struct SessionCapture {
+  std::unique_ptr<cal::replay::CaptureWriter> writer;
+  std::unique_ptr<cal::replay::CaptureRecorder> recorder;
+  SessionCapture(const std::string& path, const cal::daq::Config& c,
+                 const std::vector<InstrumentSpec>& specs) {
+    if (path.empty()) return;
+    writer =
+        std::make_unique<cal::replay::CaptureWriter>(path, capture_header(c, specs, "daq 0.1.0"));
+    recorder = std::make_unique<cal::replay::CaptureRecorder>(*writer);
+  }
+  std::string absolute_path(const std::string& path) const {
+    return writer ? std::filesystem::absolute(path).string() : std::string{};
+  }
+};
+
+d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const RunOptions& o,
+                                        cal::replay::CaptureRecorder* recorder) {
+  d::InstrumentOptions opt{
+      .name = dc.id, .backoff = {.max_attempts = o.give_up_after}, .recorder = recorder};
+  if (dc.poll_s > 0)
+    opt.poll_period = std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6));
+  return opt;
+}
+
 void run_linear(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
@@ -110,27 +137,17 @@ void run_linear(const RunOptions& o) {
     if (dc.role == "laser" || dc.role == "air" || dc.role == "material")
       specs.push_back(spec_of(dc, n++));
   need(config, "laser"), need(config, "air");
-  std::unique_ptr<cal::replay::CaptureWriter> capture;
-  std::unique_ptr<cal::replay::CaptureRecorder> recorder;
-  if (!o.capture.empty()) {
-    capture = std::make_unique<cal::replay::CaptureWriter>(
-        o.capture, capture_header(config, specs, "daq 0.1.0"));
-    recorder = std::make_unique<cal::replay::CaptureRecorder>(*capture);
-  }
+  SessionCapture capture(o.capture, config, specs);
   LinearRunSetup setup;
   setup.config = config;
   setup.database = database_path(o.db);
-  if (capture) setup.capture_path = std::filesystem::absolute(o.capture).string();
+  setup.capture_path = capture.absolute_path(o.capture);
   for (const auto& s : specs) {
     const auto& dc = *std::find_if(
         config.devices.begin(), config.devices.end(),
         [&](const auto& x) { return x.transport == s.transport && x.role == s.role; });
-    d::InstrumentOptions opt{
-        .name = dc.id, .backoff = {.max_attempts = o.give_up_after}, .recorder = recorder.get()};
-    if (dc.poll_s > 0)
-      opt.poll_period = std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6));
-    else if (s.driver == "ptu300" || s.role == "material")
-      opt.poll_period = 1000ms;
+    auto opt = instrument_options(dc, o, capture.recorder.get());
+    if (dc.poll_s <= 0 && (s.driver == "ptu300" || s.role == "material")) opt.poll_period = 1000ms;
     auto inst = make_instrument(io, s, make_transport(io, dc), opt);
     if (s.role == "laser")
       setup.laser = std::move(inst);
@@ -164,11 +181,63 @@ void run_linear(const RunOptions& o) {
     if (!ec) run.stop("stopped by the operator");
   });
   while (!run.finished()) io.run_for(100ms);
-  if (capture) capture->close();
+  if (capture.writer) capture.writer->close();
   const auto& out = run.outcome();
   if (!out.complete)
     throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
   print(*out.evaluation);
+}
+
+// daq run circle: the ballbar streams; the run waits for the feed-in, then records both arcs.
+void run_circle(const RunOptions& o) {
+  const auto config = cal::daq::load_config(o.config);
+  const auto [program, analysis] = circle_test(config);
+  const auto& dc = need(config, "ballbar");
+  if (dc.driver != "gauge")
+    throw cal::InputError(
+        fmt::format("{}: devices.{}: the ballbar needs driver = \"gauge\"", o.config, dc.id));
+  boost::asio::io_context io;
+  const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
+  SessionCapture capture(o.capture, config, specs);
+  CircleRunSetup setup{
+      .config = config,
+      .program = program,
+      .analysis = analysis,
+      .database = database_path(o.db),
+      .ballbar = make_instrument(io, specs[0], make_transport(io, dc),
+                                 instrument_options(dc, o, capture.recorder.get())),
+      .capture_path = capture.absolute_path(o.capture)};
+  const bool tty = ::isatty(STDOUT_FILENO);
+  setup.on_event = [tty](const std::string& e) {
+    fmt::print("{}  {}\n", tty ? "\r\033[K" : "", e);
+  };
+  setup.on_live = [tty](const CircleLive& s) {
+    if (!tty) return;
+    fmt::print("\r{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  ", s.phase, s.angle_deg,
+               s.deviation_um, 100 * s.fraction);
+    std::fflush(stdout);
+  };
+  CircleRun run(io, std::move(setup));
+  run.start();
+  fmt::print(
+      "Waiting for the feed-in: run the program from `daq gcode circle --config {}`; Ctrl-C "
+      "stops.\n",
+      o.config);
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](auto ec, int) {
+    if (!ec) run.stop("stopped by the operator");
+  });
+  while (!run.finished()) io.run_for(100ms);
+  if (capture.writer) capture.writer->close();
+  const auto& out = run.outcome();
+  if (!out.complete)
+    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+  if (o.json)
+    return fmt::print(
+        "{}\n", circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min)
+                    .dump(2));
+  fmt::print("\nrun {}: {} readings\n", out.run_id, out.readings);
+  print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
 }
 
 struct GcodeOptions {
@@ -191,15 +260,7 @@ void gcode(const GcodeOptions& o, bool circle) {
   } else {
     if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
     const auto& l = *config.linear;
-    const auto plan = cal::iso230_2::make_plan({.first_mm = l.first_mm,
-                                                .last_mm = l.last_mm,
-                                                .interval_mm = l.interval_mm,
-                                                .count = l.count,
-                                                .random_fraction = l.random_fraction},
-                                               {.cycle = cal::iso230_2::cycle_from_string(l.cycle),
-                                                .bidirectional = l.bidirectional,
-                                                .runs = l.runs,
-                                                .overrun_mm = l.overrun_mm});
+    const auto plan = linear_plan(l);
     text = cal::daq::linear_program(
         plan, {.axis = l.axis[0], .feed_mm_per_min = l.feed_mm_per_min, .dwell_s = l.dwell_s},
         dialect);
@@ -223,6 +284,16 @@ void add_run_commands(CLI::App& app) {
                   "Reconnection attempts before a device is given up")
       ->capture_default_str();
   lin->callback([o] { run_linear(*o); });
+  auto* circ = run->add_subcommand("circle", "ISO 230-4 circular test with a ballbar");
+  circ->add_option("-c,--config", o->config, "Machine/campaign TOML with [test.circle]")
+      ->required();
+  add_db_option(*circ, o->db);
+  circ->add_option("--capture", o->capture, "Record the wire-level capture to this file");
+  circ->add_option("--give-up-after", o->give_up_after,
+                   "Reconnection attempts before the ballbar is given up")
+      ->capture_default_str();
+  circ->add_flag("--json", o->json, "Print the result as caldaq.circle.v1 JSON");
+  circ->callback([o] { run_circle(*o); });
 
   auto g = std::make_shared<GcodeOptions>();
   auto* gc = app.add_subcommand("gcode", "Part program for a configured test");

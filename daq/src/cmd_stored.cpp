@@ -8,6 +8,8 @@
 #include "cal/daq/env_stage.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
+#include "circle_output.hpp"
+#include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
@@ -44,10 +46,42 @@ struct AnalyseRunOptions {
   std::string standard = "iso230-2:2014";
   bool store = false;
   bool json = false;
+  // Circle runs: what may be corrected after the fact.
+  std::optional<double> calibrated_radius_mm, cyclic_period_mm;
+  bool uncalibrated = false;
 };
+
+// A stored ballbar run again from its raw bar readings, with the analysis settings it was
+// run with unless corrected here (the calibrated length of the bar, the cyclic period).
+void analyse_circle_run(st::Store& store, const st::RunRecord& run, const AnalyseRunOptions& o) {
+  const json settings = json::parse(run.settings_json, nullptr, false);
+  if (settings.is_discarded() || !settings.contains("radius_mm"))
+    throw cal::InputError(fmt::format("run {}: its circle settings are missing", o.run));
+  auto [program, analysis] = circle_settings_from_json(settings);
+  if (o.calibrated_radius_mm) analysis.calibrated_radius_mm = o.calibrated_radius_mm;
+  if (o.cyclic_period_mm) analysis.cyclic_period_mm = o.cyclic_period_mm;
+  if (o.uncalibrated) analysis.uncalibrated = true;
+  std::vector<double> bar_mm;
+  for (const auto& r : store.readings(o.run))
+    if (r.quantity == static_cast<std::uint8_t>(cal::drivers::Quantity::length_m))
+      bar_mm.push_back(r.value * 1e3);
+  cal::circle::Result result;
+  try {
+    result = analyse_ballbar(program, analysis, bar_mm);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(
+        fmt::format("run {} ({} bar readings stored): {}", o.run, bar_mm.size(), e.what()));
+  }
+  const auto j = circle_json(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  if (o.store) store.add_result({.run_id = o.run, .standard = "ISO 230-4:2005", .json = j.dump()});
+  if (o.json) return fmt::print("{}\n", j.dump(2));
+  print_circle(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+}
 
 void analyse_run(const AnalyseRunOptions& o) {
   st::Store store(database_path(o.db));
+  const auto run = store.run(o.run);
+  if (run && run->kind == "circle") return analyse_circle_run(store, *run, o);
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
   if (targets.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
@@ -155,12 +189,21 @@ void recompensate(const RecompensateOptions& o) {
 void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   auto a = std::make_shared<AnalyseRunOptions>();
   analyse.require_subcommand(0, 1);
-  analyse.add_option("RUN", a->run, "A stored linear run to evaluate (see daq runs)");
+  analyse.add_option("RUN", a->run, "A stored run to evaluate again (see daq runs)");
   add_db_option(analyse, a->db);
   analyse.add_option("-s,--standard", a->standard, "Standard for a stored run")
       ->capture_default_str();
   analyse.add_flag("--store", a->store, "Store the result with the run");
-  analyse.add_flag("--json", a->json, "Print caldaq.iso230-2.v1 JSON");
+  analyse
+      .add_option("--calibrated-radius-mm", a->calibrated_radius_mm,
+                  "Circle runs: the bar's corrected calibrated length")
+      ->check(CLI::PositiveNumber);
+  analyse
+      .add_option("--cyclic-period-mm", a->cyclic_period_mm,
+                  "Circle runs: the cyclic-error period (default: as run, else searched)")
+      ->check(CLI::PositiveNumber);
+  analyse.add_flag("--uncalibrated", a->uncalibrated, "Circle runs: no radius error");
+  analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v1)");
   analyse.callback([a, &analyse] {
     if (!analyse.get_subcommands().empty()) return;
     if (a->run <= 0)

@@ -15,8 +15,10 @@ void add_runs_commands(CLI::App& app);
 void add_stored_run_commands(CLI::App& app, CLI::App& analyse);
 // replay CAPTURE
 void add_replay_command(CLI::App& app);
-// run linear, gcode linear|circle
+// run linear|circle, gcode linear|circle
 void add_run_commands(CLI::App& app);
+// sim: the simulated shop in its own process
+void add_sim_command(CLI::App& app);
 // analyse straightness, analyse squareness
 void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 // analyse circle

@@ -7,6 +7,8 @@
 #include <boost/asio/post.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cal/analysis/error.hpp"
+#include "cal/daq/gcode.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "circle_output.hpp"
@@ -15,6 +17,93 @@ namespace daq {
 
 using nlohmann::json;
 
+namespace {
+
+cal::circle::Plane circle_plane(const std::string& p) {
+  switch (cal::daq::plane_from_string(p)) {
+    case cal::daq::Plane::xy:
+      return cal::circle::Plane::xy;
+    case cal::daq::Plane::yz:
+      return cal::circle::Plane::yz;
+    case cal::daq::Plane::zx:
+      return cal::circle::Plane::zx;
+  }
+  return cal::circle::Plane::xy;
+}
+
+}  // namespace
+
+cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
+                                    const BallbarAnalysis& analysis,
+                                    std::span<const double> deviation_mm) {
+  cal::daq::BallbarSegmenter segmenter(program);
+  for (double v : deviation_mm) segmenter.add(v);
+  const auto traces = segmenter.traces();
+  return cal::circle::analyse({.plane = circle_plane(analysis.plane),
+                               .radius_mm = program.radius_mm,
+                               .feed_mm_per_min = program.feed_mm_per_min,
+                               .cyclic_period_mm = analysis.cyclic_period_mm,
+                               .radius_calibrated = !analysis.uncalibrated,
+                               .calibrated_radius_mm = analysis.calibrated_radius_mm,
+                               .sample_rate_hz = program.sample_rate_hz,
+                               .start_deg = program.start_deg},
+                              traces);
+}
+
+json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalysis& a) {
+  json j{{"radius_mm", p.radius_mm},
+         {"feed_mm_per_min", p.feed_mm_per_min},
+         {"sample_rate_hz", p.sample_rate_hz},
+         {"feed_in_mm", p.feed_in_mm},
+         {"dwell_s", p.dwell_s},
+         {"overshoot_deg", p.overshoot_deg},
+         {"start_deg", p.start_deg},
+         {"plane", a.plane},
+         {"uncalibrated", a.uncalibrated}};
+  if (a.calibrated_radius_mm) j["calibrated_radius_mm"] = *a.calibrated_radius_mm;
+  if (a.cyclic_period_mm) j["cyclic_period_mm"] = *a.cyclic_period_mm;
+  return j;
+}
+
+std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(const json& j) {
+  cal::daq::BallbarProgram p{.radius_mm = j.at("radius_mm"),
+                             .feed_mm_per_min = j.at("feed_mm_per_min"),
+                             .sample_rate_hz = j.at("sample_rate_hz"),
+                             .feed_in_mm = j.at("feed_in_mm"),
+                             .dwell_s = j.at("dwell_s"),
+                             .overshoot_deg = j.at("overshoot_deg"),
+                             .start_deg = j.value("start_deg", 0.0)};
+  BallbarAnalysis a{.plane = j.value("plane", std::string("XY")),
+                    .uncalibrated = j.value("uncalibrated", false)};
+  if (j.contains("calibrated_radius_mm")) a.calibrated_radius_mm = j["calibrated_radius_mm"];
+  if (j.contains("cyclic_period_mm")) a.cyclic_period_mm = j["cyclic_period_mm"];
+  return {p, a};
+}
+
+std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c) {
+  if (!c.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", c.source.string()));
+  const auto& t = *c.circle;
+  BallbarAnalysis a{.plane = t.plane};
+  if (t.calibrated_radius_mm > 0) a.calibrated_radius_mm = t.calibrated_radius_mm;
+  return {cal::daq::BallbarProgram{.radius_mm = t.radius_mm,
+                                   .feed_mm_per_min = t.feed_mm_per_min,
+                                   .sample_rate_hz = t.sample_rate_hz,
+                                   .overshoot_deg = t.overshoot_deg},
+          a};
+}
+
+std::string to_json_text(const CircleLive& s) {
+  return json{{"schema", "caldaq.live-circle.v1"},
+              {"time_s", s.time_s},
+              {"state", s.state},
+              {"phase", s.phase},
+              {"angle_deg", s.angle_deg},
+              {"deviation_um", s.deviation_um},
+              {"fraction", s.fraction},
+              {"samples", s.samples}}
+      .dump();
+}
+
 struct CircleRun::Impl {
   boost::asio::io_context& io;
   CircleRunSetup setup;
@@ -22,6 +111,7 @@ struct CircleRun::Impl {
   std::optional<cal::storage::Store> store;
   std::unique_ptr<cal::storage::BatchWriter> writer;
   CircleRunOutcome outcome;
+  CircleLive live;
   bool running = false, done = false;
 
   Impl(boost::asio::io_context& i, CircleRunSetup s)
@@ -40,18 +130,11 @@ struct CircleRun::Impl {
     else
       machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
     const auto& p = setup.program;
-    const json settings{{"radius_mm", p.radius_mm},
-                        {"feed_mm_per_min", p.feed_mm_per_min},
-                        {"sample_rate_hz", p.sample_rate_hz},
-                        {"feed_in_mm", p.feed_in_mm},
-                        {"dwell_s", p.dwell_s},
-                        {"overshoot_deg", p.overshoot_deg},
-                        {"start_deg", p.start_deg},
-                        {"plane", setup.plane}};
+    const json settings = circle_settings_json(p, setup.analysis);
     outcome.run_id = store->begin_run({.machine_id = machine,
                                        .campaign = c.campaign,
                                        .kind = "circle",
-                                       .axis = setup.plane,
+                                       .axis = setup.analysis.plane,
                                        .settings_json = settings.dump(),
                                        .capture_path = setup.capture_path,
                                        .software_version = setup.software_version});
@@ -72,6 +155,7 @@ struct CircleRun::Impl {
   }
 
   void on_reading(const cal::drivers::Reading& r) {
+    if (setup.on_reading) setup.on_reading(r);
     if (!running || r.quantity != cal::drivers::Quantity::length_m) return;
     ++outcome.readings;
     writer->push({.time_ns = r.time_ns,
@@ -82,7 +166,30 @@ struct CircleRun::Impl {
     const bool had = segmenter.feed_in_end().has_value();
     segmenter.add(r.value * 1e3);
     if (!had && segmenter.feed_in_end()) event("feed-in found: the circle starts after the dwell");
+    publish_live(r);
     if (segmenter.complete()) boost::asio::post(io, [this] { finish(); });
+  }
+
+  // At most every 0.1 s of the bar's own clock, so a replay at full speed is not slowed down.
+  void publish_live(const cal::drivers::Reading& r) {
+    if (!setup.on_live) return;
+    const double t_s = static_cast<double>(r.time_ns) * 1e-9;
+    if (live.samples > 0 && t_s - live.time_s < 0.1 && !segmenter.complete()) return;
+    const auto pr = segmenter.progress();
+    live.time_s = t_s;
+    live.state = segmenter.feed_in_end() ? "measuring" : "waiting";
+    live.phase = std::string(cal::daq::to_string(pr.phase));
+    live.angle_deg = pr.angle_deg;
+    live.deviation_um = r.value * 1e6;
+    live.fraction = pr.fraction;
+    live.samples = segmenter.samples();
+    setup.on_live(live);
+  }
+
+  void publish_end(const char* state) {
+    if (!setup.on_live) return;
+    live.state = state;
+    setup.on_live(live);
   }
 
   void finish() {
@@ -90,20 +197,18 @@ struct CircleRun::Impl {
     running = false;
     writer->flush();
     try {
-      const auto traces = segmenter.traces();
-      outcome.result = cal::circle::analyse(
-          {.radius_mm = setup.program.radius_mm, .feed_mm_per_min = setup.program.feed_mm_per_min},
-          traces);
+      outcome.result = analyse_ballbar(setup.program, setup.analysis, segmenter.values());
     } catch (const std::exception& e) {
       return abort(e.what());
     }
     store->add_result({.run_id = outcome.run_id,
                        .standard = "ISO 230-4:2005",
-                       .json = circle_json(*outcome.result, setup.program.radius_mm, setup.plane,
-                                           setup.program.feed_mm_per_min)
+                       .json = circle_json(*outcome.result, setup.program.radius_mm,
+                                           setup.analysis.plane, setup.program.feed_mm_per_min)
                                    .dump()});
     store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
     outcome.complete = true;
+    publish_end("complete");
     end();
   }
 
@@ -113,6 +218,7 @@ struct CircleRun::Impl {
     outcome.reason = reason;
     if (writer) writer->flush();
     if (store) store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, reason);
+    publish_end("aborted");
     end();
   }
 

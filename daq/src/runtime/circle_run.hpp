@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "cal/analysis/circle.hpp"
@@ -19,15 +21,54 @@ class io_context;
 
 namespace daq {
 
+// How the traces of a ballbar stream are analysed (besides the program's timing).
+struct BallbarAnalysis {
+  std::string plane = "XY";                    // XY | YZ | ZX: names the axes of the diagnostics
+  std::optional<double> calibrated_radius_mm;  // the bar's calibrated length; unset: nominal
+  std::optional<double> cyclic_period_mm;      // unset: searched
+  bool uncalibrated = false;                   // no calibrator: no radius error
+};
+
+// The ISO 230-4 result and diagnostics of a ballbar stream (one deviation per sample, in mm
+// from the calibrated length, from before the feed-in): segmentation by the program's timing,
+// then cal::circle::analyse. Used at the end of a run and again on the stored readings
+// (daq analyse RUN). Throws cal::InputError when the stream is incomplete.
+cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
+                                    const BallbarAnalysis& analysis,
+                                    std::span<const double> deviation_mm);
+
+// The program and analysis settings stored with a circle run (runs.settings_json), and back.
+nlohmann::json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalysis& a);
+std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(
+    const nlohmann::json& j);
+
+// The ballbar program and analysis of a configuration's [test.circle] (the same program that
+// `daq gcode circle` writes: feed-in and dwell at their defaults).
+std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c);
+
+// The live state of a circle run for the operator's display (about 10 Hz).
+struct CircleLive {
+  double time_s = 0.0;
+  std::string state;          // "waiting", "measuring", "complete", "aborted"
+  std::string phase;          // "waiting for the feed-in", "dwell", "ccw arc", "cw arc", "complete"
+  double angle_deg = 0.0;     // programmed angle of the latest sample
+  double deviation_um = 0.0;  // the bar's latest deviation
+  double fraction = 0.0;      // of the test after the feed-in
+  std::size_t samples = 0;
+};
+std::string to_json_text(const CircleLive& s);  // schema caldaq.live-circle.v1 (docs/cli.md)
+
 struct CircleRunSetup {
   cal::daq::Config config;  // machine, campaign
   cal::daq::BallbarProgram program;
-  std::string plane = "XY";
+  BallbarAnalysis analysis;
   std::filesystem::path database;
   std::unique_ptr<cal::drivers::Instrument> ballbar;
   std::string capture_path;
   std::string software_version = "daq 0.1.0";
   std::function<void(const std::string&)> on_event;
+  std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
+  std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading
 };
 
 struct CircleRunOutcome {

@@ -53,9 +53,7 @@ std::string to_json_text(const LiveState& s) {
   return j.dump();
 }
 
-namespace {
-
-cal::iso230_2::Plan make_plan(const cal::daq::LinearTestConfig& l) {
+cal::iso230_2::Plan linear_plan(const cal::daq::LinearTestConfig& l) {
   return cal::iso230_2::make_plan({.first_mm = l.first_mm,
                                    .last_mm = l.last_mm,
                                    .interval_mm = l.interval_mm,
@@ -66,6 +64,8 @@ cal::iso230_2::Plan make_plan(const cal::daq::LinearTestConfig& l) {
                                    .runs = l.runs,
                                    .overrun_mm = l.overrun_mm});
 }
+
+namespace {
 
 json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, double datum_mm) {
   const auto& l = *c.linear;
@@ -113,7 +113,7 @@ struct LinearRun::Impl {
   Impl(boost::asio::io_context& i, LinearRunSetup s)
       : io(i),
         setup(std::move(s)),
-        plan(make_plan(*setup.config.linear)),
+        plan(linear_plan(*setup.config.linear)),
         env(setup.config.environment, static_cast<int>(setup.material.size())),
         trigger({.tolerance_um = setup.config.trigger.tolerance_um,
                  .dwell_s = setup.config.trigger.dwell_s,

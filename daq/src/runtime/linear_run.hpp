@@ -12,6 +12,7 @@
 #include <string>
 
 #include "cal/analysis/iso230_2.hpp"
+#include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/daq/sequencer.hpp"
 #include "cal/drivers/instrument.hpp"
@@ -33,7 +34,11 @@ struct LiveState {
   double material_degc = 20.0, factor_ppm = 0.0;
   bool fallback = false;
 };
-std::string to_json_text(const LiveState& s);  // schema caldaq.live.v1 (docs/cli.md)
+std::string to_json_text(const LiveState& s);
+
+// The plan of a configuration's [test.linear]: what the run expects and the part program does.
+cal::iso230_2::Plan linear_plan(
+    const cal::daq::LinearTestConfig& l);  // schema caldaq.live.v1 (docs/cli.md)
 
 struct LinearRunSetup {
   cal::daq::Config config;  // needs config.linear

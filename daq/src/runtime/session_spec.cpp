@@ -116,6 +116,16 @@ json to_json(const cal::daq::Config& c) {
     if (l.interval_mm) j["linear"]["interval_mm"] = *l.interval_mm;
     if (l.count) j["linear"]["count"] = *l.count;
   }
+  if (c.circle) {
+    const auto& ci = *c.circle;
+    j["circle"] = {{"plane", ci.plane},
+                   {"radius_mm", ci.radius_mm},
+                   {"feed_mm_per_min", ci.feed_mm_per_min},
+                   {"sample_rate_hz", ci.sample_rate_hz},
+                   {"overshoot_deg", ci.overshoot_deg},
+                   {"centre_mm", ci.centre_mm},
+                   {"calibrated_radius_mm", ci.calibrated_radius_mm}};
+  }
   return j;
 }
 
@@ -161,6 +171,17 @@ cal::daq::Config config_from_json(const json& j) {
     x.dead_path_mm = l->value("dead_path_mm", x.dead_path_mm);
     x.standard = l->value("standard", x.standard);
     c.linear = x;
+  }
+  if (const auto ci = j.find("circle"); ci != j.end()) {
+    cal::daq::CircleTestConfig x;
+    x.plane = ci->value("plane", x.plane);
+    x.radius_mm = ci->value("radius_mm", x.radius_mm);
+    x.feed_mm_per_min = ci->value("feed_mm_per_min", x.feed_mm_per_min);
+    x.sample_rate_hz = ci->value("sample_rate_hz", x.sample_rate_hz);
+    x.overshoot_deg = ci->value("overshoot_deg", x.overshoot_deg);
+    x.centre_mm = ci->value("centre_mm", x.centre_mm);
+    x.calibrated_radius_mm = ci->value("calibrated_radius_mm", x.calibrated_radius_mm);
+    c.circle = x;
   }
   return c;
 }

@@ -53,6 +53,7 @@ class BallbarSegmenter {
   std::vector<circle::Trace> traces() const;
   double arc_duration_s() const;  // of one arc with its overshoots
   std::size_t samples() const { return values_.size(); }
+  const std::vector<double>& values() const { return values_; }  // every sample, in mm
   BallbarProgress progress() const;
 
  private:
