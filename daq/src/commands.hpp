@@ -19,6 +19,8 @@ void add_replay_command(CLI::App& app);
 void add_run_commands(CLI::App& app);
 // sim: the simulated shop in its own process
 void add_sim_command(CLI::App& app);
+// import rtx: measurements from other software
+void add_import_commands(CLI::App& app);
 // analyse straightness, analyse squareness
 void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 // analyse circle

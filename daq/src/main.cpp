@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   daq::add_replay_command(app);
   daq::add_run_commands(app);
   daq::add_sim_command(app);
+  daq::add_import_commands(app);
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);

@@ -76,5 +76,18 @@ check devices_probe_refused 0 "tcp 127.0.0.1:1: cannot connect" -- "$DAQ" device
 check devices_probe_not_serial 0 "serial /dev/null 4800 7E1: not a serial port" -- "$DAQ" devices --probe-serial /dev/null
 check devices_probe_bad_settings 2 "parity 'X'" -- "$DAQ" devices --probe-serial /dev/null@9600\ 8X1
 
+# Import of a Renishaw dynamic capture (.rtx): a header and three little-endian float64
+# samples written byte by byte (1.0, -2.5, 0.125 mm at 1 kHz); then the same cut inside the
+# third sample, which is stored as an incomplete run with the two whole samples.
+RTX_HEAD='HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n'
+RTX_DATA='\x00\x00\x00\x00\x00\x00\xf0\x3f\x00\x00\x00\x00\x00\x00\x04\xc0\x00\x00\x00\x00\x00\x00\xc0\x3f'
+{ printf "$RTX_HEAD"; printf "$RTX_DATA"; printf 'EOF::\r\n'; } >"$TMP/t.rtx"
+{ printf "$RTX_HEAD"; printf "$RTX_DATA" | head -c 20; } >"$TMP/cut.rtx"
+check import_rtx 0 "^  range -2\.500000 \.\. 1\.000000 mm" -- "$DAQ" import rtx "$TMP/t.rtx" --db "$TMP/rtx.sqlite"
+check import_rtx_export 0 "^1000000,0,0,displacement_m,0,-0\.0025" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"
+check import_rtx_cut 0 "note: the file ends inside a sample \(4 bytes dropped\)" -- "$DAQ" import rtx "$TMP/cut.rtx" --db "$TMP/rtx.sqlite"
+check import_rtx_cut_incomplete 0 "2 +2026.*dynamic +Y +incomplete +2" -- "$DAQ" runs --db "$TMP/rtx.sqlite"
+check import_not_rtx 2 "data/run/refused.toml: byte 0: not a Renishaw .rtx file" -- "$DAQ" import rtx "$DATA/run/refused.toml" --db "$TMP/rtx.sqlite"
+
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]
