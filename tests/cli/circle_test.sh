@@ -5,18 +5,7 @@
 set -u
 DAQ=$1
 DATA=$2
-fails=0
-passes=0
-check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out
-  out=$("$@" 2>&1)
-  local rc=$?
-  if [ "$rc" -ne "$want" ]; then echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
-  if ! grep -qE -- "$pattern" <<<"$out"; then echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -30; fails=$((fails + 1)); return; fi
-  passes=$((passes + 1))
-}
+source "$(dirname "$0")/check.sh"
 # Injected: squareness +20 um/m, backlash X 4 um, Y lags X by 1.0 ms, centre (5, -3) um.
 # Tolerances: the fixture is noise-free, the fit is first order (second-order terms < 1 nm at
 # R = 50 mm); a step sampled every 0.25 degrees lets the reversal-spike term take ~2 % of the
@@ -48,5 +37,4 @@ check time_json 0 '"g_reduction_um"' -- "$DAQ" "${T[@]}" --json
 check calibrated 0 "Radius error +\+(1\.99|2\.00)[0-9]* um" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10 --calibrated-radius-mm 50.002
 check too_much_overshoot 2 "keeps 0 samples after trimming the 500 degree overshoot" -- "$DAQ" analyse circle -i "$DATA/model_time.csv" -R 50 --overshoot-deg 500
 check bad_plane 2 "plane 'XZ' \(expected XY, YZ or ZX\)" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --plane XZ
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -4,23 +4,8 @@
 set -u
 DAQ=$1
 DATA=$2
-fails=0
-passes=0
 
-check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out
-  out=$("$@" 2>&1)
-  local rc=$?
-  if [ "$rc" -ne "$want" ]; then
-    echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return
-  fi
-  if ! grep -qE -- "$pattern" <<<"$out"; then
-    echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -20; fails=$((fails + 1)); return
-  fi
-  passes=$((passes + 1))
-}
+source "$(dirname "$0")/check.sh"
 
 check help 0 "analyse" -- "$DAQ" --help
 check analyse_help 0 "iso230-2" -- "$DAQ" analyse --help
@@ -89,5 +74,4 @@ check import_rtx_cut 0 "note: the file ends inside a sample \(4 bytes dropped\)"
 check import_rtx_cut_incomplete 0 "2 +2026.*dynamic +Y +incomplete +2" -- "$DAQ" runs --db "$TMP/rtx.sqlite"
 check import_not_rtx 2 "data/run/refused.toml: byte 0: not a Renishaw .rtx file" -- "$DAQ" import rtx "$DATA/run/refused.toml" --db "$TMP/rtx.sqlite"
 
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -4,18 +4,7 @@
 set -u
 DAQ=$1
 DATA=$2
-fails=0
-passes=0
-check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out
-  out=$("$@" 2>&1)
-  local rc=$?
-  if [ "$rc" -ne "$want" ]; then echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
-  if ! grep -qE -- "$pattern" <<<"$out"; then echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
-  passes=$((passes + 1))
-}
+source "$(dirname "$0")/check.sh"
 G=(--start-mm 0 --interval-mm 50 --points 5)
 # Corrections -0.002 .. -0.006 mm, backlash 0.004 mm; LinuxCNC trims -(0..4) and -(4..8) um.
 check csv 0 "^2,100\.0000,-0\.0040$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}"
@@ -28,5 +17,4 @@ check cross 0 "^1,100\.0000,-1\.000$" -- "$DAQ" compensate --straightness "$DATA
 check outside 2 "grid point -50 mm is outside the measured range 0 \.\. 200 mm" -- "$DAQ" compensate -i "$DATA/meas.csv" --start-mm -50 --interval-mm 50 --points 3
 check linuxcnc_incremental 2 "absolute corrections" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f linuxcnc --incremental
 check bad_format 2 "format 'fanuc'" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f fanuc
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -3,18 +3,7 @@
 set -u
 DAQ=$1
 DATA=$2
-fails=0
-passes=0
-check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out
-  out=$("$@" 2>&1)
-  local rc=$?
-  if [ "$rc" -ne "$want" ]; then echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
-  if ! grep -qE -- "$pattern" <<<"$out"; then echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -20; fails=$((fails + 1)); return; fi
-  passes=$((passes + 1))
-}
+source "$(dirname "$0")/check.sh"
 # The hand set: LSQ 2.7 um at 7 um/m, end point 2.75 um, minimum zone 2.5 um at 5 um/m.
 check lsq 0 "straightness +2\.700 um" -- "$DAQ" analyse straightness -i "$DATA/hand.csv"
 check endpoint 0 "straightness +2\.750 um" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r endpoint
@@ -26,5 +15,4 @@ check square_diagonal 0 '"squareness_um_per_m": 20\.0' -- "$DAQ" analyse squaren
 check bad_number 2 "bad.csv:3: column deviation_um: 'x' is not a number" -- "$DAQ" analyse straightness -i "$DATA/bad.csv"
 check bad_reference 2 "unknown reference line 'best'" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r best
 check bad_method 2 "squareness method 'laser'" -- "$DAQ" analyse squareness -m laser
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

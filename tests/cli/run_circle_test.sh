@@ -11,18 +11,7 @@ TMP=$(mktemp -d)
 SIM_PID=
 cleanup() { [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null; rm -rf "$TMP"; }
 trap cleanup EXIT
-fails=0
-passes=0
-check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out
-  out=$("$@" 2>&1)
-  local rc=$?
-  if [ "$rc" -ne "$want" ]; then echo "FAIL $name: exit $rc, expected $want"; echo "$out" | head -40; fails=$((fails + 1)); return; fi
-  if ! grep -qE -- "$pattern" <<<"$out"; then echo "FAIL $name: output lacks /$pattern/"; echo "$out" | head -40; fails=$((fails + 1)); return; fi
-  passes=$((passes + 1))
-}
+source "$(dirname "$0")/check.sh"
 
 "$DAQ" sim --test circle --speed 20 --start-after-s 3 -o "$TMP/sim.toml" >"$TMP/sim.log" 2>&1 &
 SIM_PID=$!
@@ -64,5 +53,4 @@ check runs_listed 0 "circle +XY.*complete" -- "$DAQ" runs --db "$TMP/run.sqlite"
 check no_ballbar 2 "no device with role = \"ballbar\"" -- "$DAQ" run circle -c "$DATA/run/refused.toml" --db "$TMP/x.sqlite"
 check bad_sim_test 2 "--test 'spiral'" -- "$DAQ" sim --test spiral -o "$TMP/y.toml"
 
-echo "$passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish
