@@ -127,6 +127,22 @@ d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const 
   return opt;
 }
 
+// Runs the event loop until the run ends (Ctrl-C or SIGTERM stop it as the operator's
+// abort), closes the capture, and throws with the reason if the run did not complete.
+template <class Run>
+const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& capture) {
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](auto ec, int) {
+    if (!ec) run.stop("stopped by the operator");
+  });
+  while (!run.finished()) io.run_for(100ms);
+  if (capture.writer) capture.writer->close();
+  const auto& out = run.outcome();
+  if (!out.complete)
+    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+  return out;
+}
+
 void run_linear(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
@@ -176,15 +192,7 @@ void run_linear(const RunOptions& o) {
       "captures the current stop by hand; Ctrl-C stops.\n",
       o.config);
   watch_keyboard(io, [&] { run.manual_capture(); });
-  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](auto ec, int) {
-    if (!ec) run.stop("stopped by the operator");
-  });
-  while (!run.finished()) io.run_for(100ms);
-  if (capture.writer) capture.writer->close();
-  const auto& out = run.outcome();
-  if (!out.complete)
-    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+  const auto& out = run_to_end(io, run, capture);
   print(*out.evaluation);
 }
 
@@ -223,15 +231,7 @@ void run_circle(const RunOptions& o) {
       "Waiting for the feed-in: run the program from `daq gcode circle --config {}`; Ctrl-C "
       "stops.\n",
       o.config);
-  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](auto ec, int) {
-    if (!ec) run.stop("stopped by the operator");
-  });
-  while (!run.finished()) io.run_for(100ms);
-  if (capture.writer) capture.writer->close();
-  const auto& out = run.outcome();
-  if (!out.complete)
-    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+  const auto& out = run_to_end(io, run, capture);
   if (o.json)
     return fmt::print(
         "{}\n", circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min)
