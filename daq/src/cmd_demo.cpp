@@ -212,7 +212,7 @@ int run_demo(const DemoOptions& o) {
   setup.capture_path = std::filesystem::absolute(o.capture).string();
   setup.laser = make_instrument(io, specs[0],
                                 t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                                options("laser (simulated IDS3010)", 0.05));
+                                options("laser (simulated IDS3010)", 0.01));
   setup.air = make_instrument(
       io, specs[1],
       t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),

@@ -116,8 +116,14 @@ void run_sim(const SimOptions& o) {
       "  start `daq run {} --config {}` now: the machine starts the program in {} s\n",
       o.speed, o.config_out, o.test, o.config_out, o.start_after_s);
   std::fflush(stdout);
-  io.run_for(std::chrono::duration_cast<std::chrono::milliseconds>(
-      std::chrono::duration<double>(o.start_after_s)));
+  // The shop's clock advances when it is read (a starved process slows the simulation down
+  // rather than skipping it), so the loop reads it every few milliseconds itself: the twins
+  // alone read it only when a client asks.
+  const auto run_until = [&](double sim_s) {
+    while (shop.now_s() < sim_s) io.run_for(2ms);
+  };
+  run_until(shop.now_s() + o.start_after_s * o.speed);
+  const double t0_s = shop.now_s();
   if (o.test == "circle") {
     shop.run_circle(circle_test(config).first);
   } else {
@@ -127,8 +133,7 @@ void run_sim(const SimOptions& o) {
   fmt::print("daq sim: program started ({:.0f} s of simulated time)\n", shop.program_end_s());
   std::fflush(stdout);
   // The program, then a little more so the acquiring side can finish reading.
-  io.run_for(std::chrono::duration_cast<std::chrono::milliseconds>(
-      std::chrono::duration<double>(shop.program_end_s() / o.speed + 3.0)));
+  run_until(t0_s + shop.program_end_s() + 3.0 * o.speed);
   fmt::print("daq sim: program ended\n");
 }
 

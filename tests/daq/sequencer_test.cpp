@@ -39,6 +39,25 @@ TEST(Sequencer, LabelsAFullSequenceAndProducesTheMeasurements) {
   EXPECT_EQ(m[3].target_mm, 100.0);
 }
 
+// The axis at rest on the first target before the program starts looks like a stop with no
+// approach: it must not become run 1 up, target 1 (whose approach is from the overrun).
+// The operator's manual capture is taken at face value, the plan's direction assumed.
+TEST(Sequencer, AStopWithoutApproachIsIgnoredUnlessCapturedByHand) {
+  Sequencer s(plan(), 0.5);
+  auto events = s.on_capture(at(0.0, Approach::unknown));
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, Kind::extra);
+  EXPECT_NE(events[0].message.find("without an approach move"), std::string::npos);
+  EXPECT_FALSE(s.stops()[0].captured);
+  Capture manual = at(0.001, Approach::unknown);
+  manual.manual = true;
+  events = s.on_capture(manual);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, Kind::captured);
+  EXPECT_NE(events[0].message.find("approach direction unknown"), std::string::npos);
+  EXPECT_TRUE(s.stops()[0].captured);
+}
+
 TEST(Sequencer, ReportsMissedExtraWrongDirectionAndOutOfOrder) {
   Sequencer s(plan(), 0.5);
   EXPECT_EQ(s.on_capture(at(0.0, up))[0].kind, Kind::captured);  // run 1 up, target 1

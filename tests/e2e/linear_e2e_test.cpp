@@ -61,8 +61,10 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   setup.config = c;
   setup.database = db;
   setup.laser =
+      // 100 Hz of simulated time: the 3 mm overrun excursions must be seen, or a stop's
+      // approach is unknown (and an automatic capture without one is refused).
       d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                      {.poll_period = poll(0.05), .clock = clock});
+                      {.poll_period = poll(0.01), .clock = clock});
   setup.air = d::make_ptu300(
       io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
       {.poll_period = poll(1.0), .clock = clock});

@@ -26,9 +26,10 @@ std::optional<double> Sequencer::next_expected_mm() const {
 
 bool Sequencer::fits(const ExpectedStop& e, const Capture& c) const {
   if (std::abs(c.mean_mm - e.position_mm) > window_mm_) return false;
-  // An unknown approach (e.g. a manual capture right after start) is accepted: the plan's
-  // direction is then assumed, and the event says so.
-  if (c.approach == Approach::unknown) return true;
+  // An unknown approach is accepted from the operator's manual capture only (the plan's
+  // direction is then assumed, and the event says so). An automatic stop without an
+  // approach move is the axis at rest before the program starts: its direction is undefined.
+  if (c.approach == Approach::unknown) return c.manual;
   return (c.approach == Approach::from_below) == (e.direction == Direction::up);
 }
 
@@ -80,6 +81,13 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
       take(j, SequenceEvent::Kind::out_of_order, "out of order: " + describe(stops_[j]));
       return events;
     }
+  }
+  if (c.approach == Approach::unknown && !c.manual) {
+    events.push_back({SequenceEvent::Kind::extra, next_,
+                      fmt::format("stop at {:.4f} mm without an approach move (the axis has not "
+                                  "moved yet): ignored",
+                                  c.mean_mm)});
+    return events;
   }
   // Right place, wrong side: not a valid approach for the expected stop.
   if (!complete() && std::abs(c.mean_mm - stops_[next_].position_mm) <= window_mm_) {

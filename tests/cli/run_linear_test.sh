@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# daq run linear end to end across processes: `daq sim --test linear` runs the SIMULATED shop
+# (laser twin on TCP, PTU300 and thermometer twins on pseudo-terminals) and writes the devices'
+# configuration; `daq run linear` builds its instruments from that file, captures each stop
+# with the stability trigger, stores and evaluates; its capture replays to the same result.
+# Usage: run_linear_test.sh DAQ_BINARY DATA_DIR
+set -u
+DAQ=$1
+TMP=$(mktemp -d)
+SIM_PID=
+cleanup() { [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null; rm -rf "$TMP"; }
+trap cleanup EXIT
+source "$(dirname "$0")/check.sh"
+
+# Speed 5: the program's 3 s dwells last 0.6 s of wall time, the configured trigger dwell
+# 0.3 s (sim_config divides it by the speed): a loaded CI machine keeps a 2x margin.
+"$DAQ" sim --test linear --speed 5 --start-after-s 3 -o "$TMP/sim.toml" >"$TMP/sim.log" 2>&1 &
+SIM_PID=$!
+for _ in $(seq 100); do [ -s "$TMP/sim.toml" ] && break; sleep 0.1; done
+[ -s "$TMP/sim.toml" ] || { echo "FAIL: daq sim wrote no configuration"; cat "$TMP/sim.log"; exit 1; }
+
+"$DAQ" run linear -c "$TMP/sim.toml" --db "$TMP/run.sqlite" --capture "$TMP/lin.cdq" >"$TMP/run.log" 2>&1
+RUN=$(cat "$TMP/run.log")
+# The machine rests on the first target while the program has not started: that is no stop.
+check rest_is_no_stop 0 "stop at .* without an approach move .*: ignored" -- echo "$RUN"
+check all_stops 0 "all stops captured" -- echo "$RUN"
+# Injected (ShopTruth): backlash 4 um, so the mean reversal value is -4 um; the noise of 0.15 um
+# averaged over each stop and 55 stops per direction leaves it within +/-0.05 um.
+check reversal 0 "B̄ +-(3\.9[5-9]|4\.0[0-5])[0-9]* um" -- echo "$RUN"
+B1=$(sed -nE 's/^  B̄ +([-+0-9.]+) um.*/\1/p' <<<"$RUN" | sed 's/\./\\./')
+check replay 0 "replayed .* into run 2" -- "$DAQ" replay "$TMP/lin.cdq" --db "$TMP/run.sqlite"
+check replay_same_b 0 "^  B̄ +$B1 um" -- "$DAQ" analyse 2 --db "$TMP/run.sqlite"
+finish
