@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "cal/drivers/codec/line_gauge.hpp"
+#include "cal/drivers/codec/temper.hpp"
 #include "cal/drivers/codec/vaisala_ptu300.hpp"
 #include "cal/drivers/instrument.hpp"
 
@@ -40,5 +41,18 @@ std::unique_ptr<Instrument> make_ptu300(boost::asio::io_context& io,
 std::unique_ptr<Instrument> make_gauge(boost::asio::io_context& io,
                                        std::unique_ptr<transport::Transport> transport,
                                        InstrumentOptions options, codec::GaugeConfig config = {});
+
+struct TemperOptions {
+  codec::TemperFamily family = codec::TemperFamily::gold;
+  // What the thermometer measures: the machine structure (material) or the air.
+  Quantity quantity = Quantity::material_temperature_degc;
+};
+
+// A PCsensor TEMPer on a HID transport (transport/hid.hpp): sends the init report once, then
+// polls with the read report every options.poll_period. Readings: `quantity` per sensor
+// (channel 0 inner, 1 the probe), and air_humidity_pct for TEMPerX/HUM models.
+std::unique_ptr<Instrument> make_temper(boost::asio::io_context& io,
+                                        std::unique_ptr<transport::Transport> transport,
+                                        InstrumentOptions options, TemperOptions temper = {});
 
 }  // namespace cal::drivers
