@@ -8,6 +8,7 @@
 #include <boost/asio/read_until.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/streambuf.hpp>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -33,6 +34,21 @@ namespace d = cal::drivers;
 namespace t = cal::drivers::transport;
 using namespace std::chrono_literals;
 
+// "hid VID:PID" (hex, as lsusb prints them), or "hid /dev/hidrawN".
+t::HidSettings hid_settings(const cal::daq::DeviceConfig& c, const std::string& rest) {
+  if (rest.starts_with("/")) return {.path = rest};
+  unsigned vid = 0, pid = 0;
+  char extra = 0;
+  if (std::sscanf(rest.c_str(), "%4x:%4x%c", &vid, &pid, &extra) != 2)
+    throw cal::InputError(
+        fmt::format("devices.{}.transport '{}': expected hid VID:PID (hex) or hid /dev/hidrawN",
+                    c.id, c.transport));
+  // TEMPer sticks expose a keyboard interface too; the sensor answers on interface 1.
+  return {.vendor_id = static_cast<std::uint16_t>(vid),
+          .product_id = static_cast<std::uint16_t>(pid),
+          .interface_number = c.driver == "temper" ? 1 : -1};
+}
+
 std::unique_ptr<t::Transport> make_transport(boost::asio::io_context& io,
                                              const cal::daq::DeviceConfig& c) {
   const auto space = c.transport.find(' ');
@@ -54,6 +70,7 @@ std::unique_ptr<t::Transport> make_transport(boost::asio::io_context& io,
     return t::make_serial(
         io, t::parse_serial_settings(rest.substr(sp + 1), {.device = rest.substr(0, sp)}));
   }
+  if (kind == "hid") return t::make_hid(io, hid_settings(c, rest));
   throw cal::InputError(
       fmt::format("devices.{}: transport '{}' has no driver here yet", c.id, c.transport));
 }
@@ -67,7 +84,8 @@ InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device) {
   s.gauge = {
       .request = c.request, .pattern = c.pattern, .unit = d::codec::gauge_unit_from_string(c.unit)};
   if (s.gauge.unit == d::codec::GaugeUnit::degc) s.gauge.min_si = -40, s.gauge.max_si = 150;
-  if (c.driver != "ids3010" && c.driver != "ptu300" && c.driver != "gauge")
+  s.temper_family = c.family;
+  if (c.driver != "ids3010" && c.driver != "ptu300" && c.driver != "gauge" && c.driver != "temper")
     throw cal::InputError(
         fmt::format("devices.{}: driver '{}' is not available for runs yet", c.id, c.driver));
   return s;
@@ -163,7 +181,8 @@ void run_linear(const RunOptions& o) {
         config.devices.begin(), config.devices.end(),
         [&](const auto& x) { return x.transport == s.transport && x.role == s.role; });
     auto opt = instrument_options(dc, o, capture.recorder.get());
-    if (dc.poll_s <= 0 && (s.driver == "ptu300" || s.role == "material")) opt.poll_period = 1000ms;
+    if (dc.poll_s <= 0 && (s.driver == "ptu300" || s.driver == "temper" || s.role == "material"))
+      opt.poll_period = 1000ms;
     auto inst = make_instrument(io, s, make_transport(io, dc), opt);
     if (s.role == "laser")
       setup.laser = std::move(inst);

@@ -104,6 +104,16 @@ TEST(Config, NamesFileLineColumnAndKey) {
   EXPECT_EQ(
       error_of("[devices.air]\ndriver = \"ptu300\"\ntransport = \"usb x\"\n"),
       "machine.toml:3:13: key 'devices.air.transport': 'usb' is not one of: tcp, serial, hid");
+  EXPECT_EQ(error_of("[devices.t]\ndriver = \"temper\"\ntransport = \"hid 413d:2107\"\n"
+                     "family = \"silver\"\n"),
+            "machine.toml:4:10: key 'devices.t.family': 'silver' is not one of: ds75, gold, "
+            "temperx");
+  EXPECT_EQ(parse_config("[devices.t]\ndriver = \"temper\"\ntransport = \"hid 0c45:7401\"\n"
+                         "family = \"ds75\"\nrole = \"material\"\n",
+                         "m.toml")
+                .device_for("material")
+                ->family,
+            "ds75");
   EXPECT_EQ(error_of("[machine]\nname = 3\n"),
             "machine.toml:2:8: key 'machine.name': expected a string");
 }

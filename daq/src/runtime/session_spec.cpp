@@ -23,6 +23,12 @@ std::unique_ptr<cal::drivers::Instrument> make_instrument(
     return cal::drivers::make_ptu300(io, std::move(transport), std::move(options));
   if (spec.driver == "gauge")
     return cal::drivers::make_gauge(io, std::move(transport), std::move(options), spec.gauge);
+  if (spec.driver == "temper")
+    return cal::drivers::make_temper(
+        io, std::move(transport), std::move(options),
+        {.family = codec::temper_family_from_string(spec.temper_family),
+         .quantity = spec.role == "air" ? cal::drivers::Quantity::air_temperature_degc
+                                        : cal::drivers::Quantity::material_temperature_degc});
   throw cal::InputError("instrument driver '" + spec.driver + "' cannot be built here");
 }
 
@@ -59,7 +65,8 @@ json to_json(const InstrumentSpec& s) {
             {"scale", s.gauge.scale},
             {"offset", s.gauge.offset},
             {"min_si", s.gauge.min_si},
-            {"max_si", s.gauge.max_si}}}};
+            {"max_si", s.gauge.max_si}}},
+          {"temper_family", s.temper_family}};
 }
 
 InstrumentSpec instrument_spec_from_json(const json& j) {
@@ -78,6 +85,7 @@ InstrumentSpec instrument_spec_from_json(const json& j) {
     s.gauge.min_si = g->value("min_si", -10.0);
     s.gauge.max_si = g->value("max_si", 10.0);
   }
+  s.temper_family = j.value("temper_family", s.temper_family);
   return s;
 }
 

@@ -20,11 +20,12 @@ namespace daq {
 
 struct InstrumentSpec {
   std::uint16_t device = 0;
-  std::string driver;     // ids3010 | ptu300 | gauge
+  std::string driver;     // ids3010 | ptu300 | gauge | temper
   std::string role;       // laser | air | material | ballbar
   std::string transport;  // as described live, e.g. "tcp 127.0.0.1:9090"
   std::array<bool, 3> ids_axes{true, false, false};
   cal::drivers::codec::GaugeConfig gauge;
+  std::string temper_family = "gold";  // temper: ds75 | gold | temperx
 };
 
 std::unique_ptr<cal::drivers::Instrument> make_instrument(

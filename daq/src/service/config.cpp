@@ -129,6 +129,8 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   t.read("pattern", d.pattern);
   t.read("unit", d.unit);
   one_of(t, "unit", d.unit, {"mm", "um", "in", "m", "degC"});
+  t.read("family", d.family);
+  one_of(t, "family", d.family, {"ds75", "gold", "temperx"});
   // TOML has no escapes in literal strings: allow "\r" written as the two characters.
   for (std::size_t at; (at = d.request.find("\\r")) != std::string::npos;)
     d.request.replace(at, 2, "\r");

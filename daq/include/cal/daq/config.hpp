@@ -18,9 +18,10 @@ struct DeviceConfig {
   std::vector<int> axes;  // ids3010: interferometer axes to read (0..2)
   std::string role;       // laser | air | material | ballbar | position (what the run uses it for)
   // gauge: the line codec's settings (docs/codecs.md)
-  std::string request;      // sent to poll, e.g. "?\r"; empty: the gauge streams
-  std::string pattern;      // regex with one capture group; empty: a bare number (+unit)
-  std::string unit = "mm";  // mm | um | in | m | degC
+  std::string request;          // sent to poll, e.g. "?\r"; empty: the gauge streams
+  std::string pattern;          // regex with one capture group; empty: a bare number (+unit)
+  std::string unit = "mm";      // mm | um | in | m | degC
+  std::string family = "gold";  // temper: report family ds75 | gold | temperx (docs/codecs)
 };
 
 enum class StalePolicy { fallback, stop };
