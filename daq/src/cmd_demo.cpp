@@ -123,10 +123,7 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
   CircleRun run(io, std::move(setup));
   run.start();
   shop.run_circle(program);
-  const auto limit =
-      std::chrono::steady_clock::now() +
-      std::chrono::duration<double>((shop.program_end_s() - shop.now_s()) / o.speed + 20.0);
-  while (!run.finished() && std::chrono::steady_clock::now() < limit) io.run_for(50ms);
+  shop.run_program([&] { return run.finished(); }, 20.0);
   if (!run.finished()) run.stop("the simulated circle ended before both traces were complete");
   const auto& out = run.outcome();
   if (!out.complete) {
@@ -229,12 +226,8 @@ int run_demo(const DemoOptions& o) {
   LinearRun run(io, std::move(setup));
   run.start();
   shop.run_linear(run.plan(), config.linear->feed_mm_per_min, config.linear->dwell_s);
-  const auto limit = std::chrono::steady_clock::now() +
-                     std::chrono::duration<double>(shop.program_end_s() / o.speed + 20.0);
-  while (!run.finished() && std::chrono::steady_clock::now() < limit) {
-    io.run_for(50ms);
-    capture.flush();  // what is flushed survives a crash of this process
-  }
+  // What is flushed survives a crash of this process.
+  shop.run_program([&] { return run.finished(); }, 20.0, [&] { capture.flush(); });
   if (!run.finished()) run.stop("the simulated program ended without all stops captured");
   if (tty) fmt::print("\r\033[K");
   capture.close();

@@ -130,10 +130,11 @@ void run_sim(const SimOptions& o) {
     const auto& l = *config.linear;
     shop.run_linear(linear_plan(l), l.feed_mm_per_min, l.dwell_s);
   }
-  fmt::print("daq sim: program started ({:.0f} s of simulated time)\n", shop.program_end_s());
+  fmt::print("daq sim: program started ({:.0f} s of simulated time)\n",
+             shop.program_end_s() - t0_s);
   std::fflush(stdout);
   // The program, then a little more so the acquiring side can finish reading.
-  run_until(t0_s + shop.program_end_s() + 3.0 * o.speed);
+  run_until(shop.program_end_s() + 3.0 * o.speed);
   fmt::print("daq sim: program ended\n");
 }
 

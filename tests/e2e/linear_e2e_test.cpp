@@ -75,9 +75,7 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   daq::LinearRun run(io, std::move(setup));
   run.start();
   shop.run_linear(run.plan(), c.linear->feed_mm_per_min, c.linear->dwell_s);
-  const auto limit = std::chrono::steady_clock::now() +
-                     std::chrono::duration<double>(shop.program_end_s() / speed + 30.0);
-  while (!run.finished() && std::chrono::steady_clock::now() < limit) io.run_for(50ms);
+  shop.run_program([&] { return run.finished(); }, 30.0);
   ASSERT_TRUE(run.finished());
   const auto& out = run.outcome();
   ASSERT_TRUE(out.complete) << out.reason;
@@ -133,10 +131,7 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   daq::CircleRun run(io, std::move(setup));
   run.start();
   shop.run_circle(program);
-  const auto limit =
-      std::chrono::steady_clock::now() +
-      std::chrono::duration<double>((shop.program_end_s() - shop.now_s()) / speed + 30.0);
-  while (!run.finished() && std::chrono::steady_clock::now() < limit) io.run_for(50ms);
+  shop.run_program([&] { return run.finished(); }, 30.0);
   ASSERT_TRUE(run.finished());
   ASSERT_TRUE(run.outcome().complete) << run.outcome().reason;
   std::map<std::string, double> v;

@@ -24,6 +24,7 @@ double ShopTruth::deviation_um(double x_mm, cal::iso230_2::Direction d) const {
 }
 
 struct SimulatedShop::Impl {
+  boost::asio::io_context& io;
   ShopTruth truth;
   double speed;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
@@ -61,19 +62,20 @@ struct SimulatedShop::Impl {
     return a;
   }
 
-  Impl(boost::asio::io_context& io, ShopTruth t, double s)
-      : truth(t),
+  Impl(boost::asio::io_context& ctx, ShopTruth t, double s)
+      : io(ctx),
+        truth(t),
         speed(s),
         clock([this] { return now(); }),
         world(machine(t), air(t)),
-        ids(io, world, clock, {.machine_axis = {0, -1, -1}}),
-        ptu(io, world, clock),
-        material(io, world, clock,
+        ids(ctx, world, clock, {.machine_axis = {0, -1, -1}}),
+        ptu(ctx, world, clock),
+        material(ctx, world, clock,
                  {.continuous = false,
                   .request = "?",
                   .decimals = 3,
                   .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
-        ballbar(io, world, clock,
+        ballbar(ctx, world, clock,
                 {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}) {}
 
   // Simulated time follows the wall clock times `speed`, but a wall-clock interval between
@@ -134,6 +136,18 @@ void SimulatedShop::run_circle(const cal::daq::BallbarProgram& p) {
 }
 
 double SimulatedShop::program_end_s() const { return impl_->world.machine().program_duration_s(); }
+
+bool SimulatedShop::run_program(const std::function<bool()>& done, double margin_wall_s,
+                                const std::function<void()>& each) {
+  const double end_s = program_end_s() + margin_wall_s * impl_->speed;
+  // A last resort against a stalled clock: an hour of wall time.
+  const auto hard = std::chrono::steady_clock::now() + std::chrono::hours(1);
+  while (!done() && now_s() < end_s && std::chrono::steady_clock::now() < hard) {
+    impl_->io.run_for(std::chrono::milliseconds(20));
+    if (each) each();
+  }
+  return done();
+}
 
 std::vector<cal::iso230_2::Measurement> SimulatedShop::true_measurements(
     const cal::iso230_2::Plan& p) const {

@@ -4,6 +4,7 @@
 // PTU300 and a material thermometer and a ballbar gauge on pseudo-terminals), all on one
 // simulated time line running `speed` times faster than the wall clock. The real drivers
 // connect to the twins exactly as to hardware.
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -61,7 +62,14 @@ class SimulatedShop {
   // The ballbar program in XY about the pivot: start feed_in_mm outside the radius at 0 deg,
   // move in, dwell, ccw arc of 360 + 2 overshoot, dwell, cw arc back, move out.
   void run_circle(const cal::daq::BallbarProgram& p);
-  double program_end_s() const;
+  double program_end_s() const;  // simulated time at which the loaded program ends
+  // Runs the event loop until `done()` or until simulated time passes the program's end plus
+  // `margin_wall_s` seconds of wall time (times the speed). Bounded by simulated, not wall,
+  // time: a starved process slows the shop's clock down, so a wall-clock limit would cut the
+  // program short on a loaded machine. `each` runs after every slice (e.g. to flush a capture).
+  // Returns done().
+  bool run_program(const std::function<bool()>& done, double margin_wall_s,
+                   const std::function<void()>& each = {});
   // The truth of a plan: the noise-free deviations at its stops, for the same evaluation.
   std::vector<cal::iso230_2::Measurement> true_measurements(const cal::iso230_2::Plan& p) const;
 
