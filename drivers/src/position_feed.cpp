@@ -1,4 +1,193 @@
-// Placeholder: codec arrives with the drivers issue.
+// Machine position feed codecs (see codec/position_feed.hpp).
+#include "cal/drivers/codec/position_feed.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <utility>
+
+#include "cal/analysis/error.hpp"
+
 namespace cal::drivers::codec {
-int position_feed_placeholder() { return 0; }
+namespace {
+
+std::vector<std::string_view> split(std::string_view s, char sep) {
+  std::vector<std::string_view> out;
+  for (std::size_t start = 0;;) {
+    const auto at = s.find(sep, start);
+    out.push_back(s.substr(start, at == std::string_view::npos ? at : at - start));
+    if (at == std::string_view::npos) return out;
+    start = at + 1;
+  }
+}
+
+template <class Int>
+std::optional<Int> parse_int(std::string_view s) {
+  Int v{};
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || p != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+// Days from 1970-01-01 to a proleptic Gregorian date (Howard Hinnant's days_from_civil).
+std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
+  y -= m <= 2;
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const auto yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+}  // namespace
+
+std::optional<std::int64_t> parse_iso8601_utc_ns(std::string_view s) {
+  if (s.ends_with('Z')) s.remove_suffix(1);
+  if (s.size() < 19 || s[4] != '-' || s[7] != '-' || s[10] != 'T' || s[13] != ':' || s[16] != ':')
+    return std::nullopt;
+  const auto y = parse_int<int>(s.substr(0, 4));
+  const auto mo = parse_int<unsigned>(s.substr(5, 2)), d = parse_int<unsigned>(s.substr(8, 2));
+  const auto h = parse_int<unsigned>(s.substr(11, 2)), mi = parse_int<unsigned>(s.substr(14, 2));
+  const auto sec = parse_int<unsigned>(s.substr(17, 2));
+  // Years 1970..2261: Unix nanoseconds in an int64 reach 2262-04-11.
+  if (!y || !mo || !d || !h || !mi || !sec || *y < 1970 || *y > 2261 || *mo < 1 || *mo > 12 ||
+      *d < 1 || *d > 31 || *h > 23 || *mi > 59 || *sec > 60)
+    return std::nullopt;
+  std::int64_t frac_ns = 0;
+  if (s.size() > 19) {
+    if (s[19] != '.' || s.size() == 20 || s.size() > 29) return std::nullopt;
+    const auto digits = s.substr(20);
+    if (digits.find_first_not_of("0123456789") != std::string_view::npos) return std::nullopt;
+    const auto f = parse_int<std::int64_t>(digits);
+    if (!f) return std::nullopt;
+    frac_ns = *f;
+    for (std::size_t i = digits.size(); i < 9; ++i) frac_ns *= 10;
+  }
+  const std::int64_t secs =
+      days_from_civil(*y, *mo, *d) * 86400 + *h * 3600 + *mi * 60 + static_cast<std::int64_t>(*sec);
+  return secs * 1'000'000'000 + frac_ns;
+}
+
+HalsamplerCodec::HalsamplerCodec(HalsamplerConfig config)
+    : config_(config), splitter_(config.max_line_bytes) {
+  if (!(config_.metres_per_unit > 0))
+    throw InputError(
+        fmt::format("halsampler: metres per unit {} must be > 0", config_.metres_per_unit));
+}
+
+void HalsamplerCodec::do_feed(std::span<const std::byte> bytes, std::vector<PositionFrame>& frames,
+                              std::vector<CodecError>& errors) {
+  splitter_.feed(
+      bytes, [&](std::string_view line, std::uint64_t off) { decode(line, off, frames, errors); },
+      [&](std::uint64_t off) {
+        report(errors, ErrorKind::overlong_line, off,
+               fmt::format("halsampler: line longer than {} bytes", config_.max_line_bytes));
+      });
+}
+
+void HalsamplerCodec::decode(std::string_view line, std::uint64_t offset,
+                             std::vector<PositionFrame>& frames, std::vector<CodecError>& errors) {
+  if (!is_printable_ascii(line))
+    return report(errors, ErrorKind::garbage, offset, "halsampler: non-printable bytes");
+  auto tokens = split_whitespace(line);
+  PositionFrame f;
+  if (config_.sample_numbers) {
+    const auto n = tokens.empty() ? std::nullopt : parse_int<std::uint64_t>(tokens.front());
+    if (!n)
+      return report(
+          errors, ErrorKind::malformed, offset,
+          fmt::format("halsampler: '{}' does not start with a sample number", line.substr(0, 40)));
+    f.sample = *n;
+    // Numbers skipped by halsampler are lost samples, carried to the next frame emitted even
+    // when this line turns out malformed (that one is counted as a codec error instead).
+    if (last_sample_ && *n > *last_sample_ + 1) pending_lost_ += *n - *last_sample_ - 1;
+    last_sample_ = *n;
+    tokens.erase(tokens.begin());
+  }
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    const int col = config_.column[axis];
+    if (col < 0) continue;
+    if (static_cast<std::size_t>(col) >= tokens.size())
+      return report(errors, ErrorKind::malformed, offset,
+                    fmt::format("halsampler: {} values, column {} expected", tokens.size(), col));
+    const auto v = parse_number(tokens[static_cast<std::size_t>(col)]);
+    if (!v || !std::isfinite(*v))
+      return report(errors, ErrorKind::malformed, offset,
+                    fmt::format("halsampler: column {} '{}' is not a number", col,
+                                tokens[static_cast<std::size_t>(col)]));
+    f.position_m[axis] = *v * config_.metres_per_unit;
+  }
+  f.lost_before = std::exchange(pending_lost_, 0);
+  emit(frames, std::move(f));
+}
+
+ShdrCodec::ShdrCodec(ShdrConfig config)
+    : config_(std::move(config)), splitter_(config_.max_line_bytes) {
+  for (const auto& [key, axis] : config_.keys)
+    if (axis < 0 || axis > 2)
+      throw InputError(fmt::format("SHDR key '{}': axis {} (expected 0, 1 or 2)", key, axis));
+}
+
+void ShdrCodec::do_feed(std::span<const std::byte> bytes, std::vector<PositionFrame>& frames,
+                        std::vector<CodecError>& errors) {
+  splitter_.feed(
+      bytes, [&](std::string_view line, std::uint64_t off) { decode(line, off, frames, errors); },
+      [&](std::uint64_t off) {
+        report(errors, ErrorKind::overlong_line, off,
+               fmt::format("SHDR: line longer than {} bytes", config_.max_line_bytes));
+      });
+}
+
+void ShdrCodec::heartbeat(std::string_view line) {
+  if (line.starts_with("* PING")) {
+    ++pings_;
+  } else if (line.starts_with("* PONG")) {
+    ++pongs_;
+    const auto t = split_whitespace(line);
+    if (t.size() >= 3)
+      if (auto ms = parse_int<std::int64_t>(t[2])) pong_timeout_ms_ = *ms;
+  }
+  // Other "* key: value" lines are adapter commands or metadata: not positions.
+}
+
+void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
+                       std::vector<PositionFrame>& frames, std::vector<CodecError>& errors) {
+  if (!multiline_tag_.empty()) {  // the body of a multi-line value (an asset document)
+    if (line.find(multiline_tag_) != std::string_view::npos) multiline_tag_.clear();
+    return;
+  }
+  if (line.starts_with("*")) return heartbeat(line);
+  if (!is_printable_ascii(line))
+    return report(errors, ErrorKind::garbage, offset, "SHDR: non-printable bytes");
+  const auto fields = split(line, '|');
+  if (const auto tag = fields.back(); tag.starts_with("--multiline--")) {
+    multiline_tag_ = std::string(tag);
+    return;
+  }
+  PositionFrame f;
+  f.time_unix_ns = parse_iso8601_utc_ns(fields.front());
+  if (!f.time_unix_ns && !fields.front().empty())
+    return report(errors, ErrorKind::malformed, offset,
+                  fmt::format("SHDR: '{}' is not a timestamp", fields.front().substr(0, 40)));
+  bool any = false;
+  for (std::size_t i = 1; i + 1 < fields.size(); ++i) {
+    const auto it = config_.keys.find(fields[i]);
+    if (it == config_.keys.end()) continue;
+    const auto value = fields[++i];
+    if (value == "UNAVAILABLE") continue;  // the control has no value: not a position
+    const auto v = parse_number(value);
+    if (!v || !std::isfinite(*v))
+      return report(errors, ErrorKind::malformed, offset,
+                    fmt::format("SHDR: {} = '{}' is not a number", it->first, value.substr(0, 40)));
+    const double m = *v * config_.metres_per_unit;
+    if (std::abs(m) > config_.max_abs_m)
+      return report(errors, ErrorKind::out_of_range, offset,
+                    fmt::format("SHDR: {} = {} m beyond +/-{} m", it->first, m, config_.max_abs_m));
+    f.position_m[static_cast<std::size_t>(it->second)] = m;
+    any = true;
+  }
+  if (any) emit(frames, std::move(f));
+}
+
 }  // namespace cal::drivers::codec
