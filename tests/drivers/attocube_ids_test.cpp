@@ -1,1 +1,180 @@
-// Placeholder: tests arrive with the codec.
+// Attocube IDS3010 JSON-RPC codec: requests as attocube's own wrappers write them, answers as
+// the device sends them (result[0] the error code, displacements in picometres), then every
+// kind of bad answer. Expected values by hand in the comments.
+#include "cal/drivers/codec/attocube_ids.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cal/analysis/error.hpp"
+#include "codec_test_util.hpp"
+
+namespace {
+
+using namespace cal::drivers::codec;
+
+TEST(IdsCodec, RequestsCarryTheMethodParamsAndIncreasingIds) {
+  IdsCodec c;
+  const auto a = nlohmann::json::parse(c.encode(IdsMethod::get_axes_displacement));
+  EXPECT_EQ(a["jsonrpc"], "2.0");
+  EXPECT_EQ(a["method"], "com.attocube.ids.displacement.getAxesDisplacement");
+  EXPECT_EQ(a["params"], nlohmann::json::array());
+  EXPECT_EQ(a["id"], 1);
+  const IdsParam axis[] = {std::int64_t{2}};
+  const auto line = c.encode(IdsMethod::get_axis_displacement, axis);
+  EXPECT_EQ(line.back(), '\n');  // newline-terminated, one object per line
+  const auto b = nlohmann::json::parse(line);
+  EXPECT_EQ(b["method"], "com.attocube.ids.displacement.getAxisDisplacement");
+  EXPECT_EQ(b["params"], nlohmann::json::array({2}));
+  EXPECT_EQ(b["id"], 2);
+  EXPECT_EQ(c.pending(), 2u);
+  EXPECT_EQ(method_name(IdsMethod::ecu_get_pressure), "com.attocube.ecu.getPressureInHPa");
+  const IdsParam bad_axis[] = {std::int64_t{3}};
+  EXPECT_THROW(c.encode(IdsMethod::get_axis_displacement, bad_axis), cal::InputError);
+  EXPECT_THROW(c.encode(IdsMethod::get_axes_displacement, axis), cal::InputError);  // no params
+}
+
+TEST(IdsCodec, DisplacementsInPicometresBecomeMetres) {
+  IdsCodec c;
+  c.encode(IdsMethod::get_axes_displacement);
+  std::vector<IdsResponse> frames;
+  std::vector<CodecError> errors;
+  // 123456789012 pm = 0.123456789012 m; -4567890 pm = -4.56789 um.
+  c.feed(R"({"jsonrpc":"2.0","result":[0,123456789012,-4567890,0],"id":1})"
+         "\n",
+         frames, errors);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_TRUE(errors.empty());
+  EXPECT_EQ(frames[0].error_code, 0);
+  EXPECT_DOUBLE_EQ(*frames[0].displacement_m[0], 0.123456789012);
+  EXPECT_DOUBLE_EQ(*frames[0].displacement_m[1], -4.56789e-6);
+  EXPECT_DOUBLE_EQ(*frames[0].displacement_m[2], 0.0);
+  EXPECT_EQ(c.pending(), 0u);
+}
+
+TEST(IdsCodec, EnvironmentUnitModeAndFlags) {
+  IdsCodec c;
+  c.encode(IdsMethod::ecu_get_temperature);       // id 1
+  c.encode(IdsMethod::ecu_get_pressure);          // id 2
+  c.encode(IdsMethod::ecu_get_humidity);          // id 3
+  c.encode(IdsMethod::ecu_get_refractive_index);  // id 4
+  c.encode(IdsMethod::get_current_mode);          // id 5
+  c.encode(IdsMethod::ecu_get_connected);         // id 6
+  // Answers out of order, matched by id. 1013.25 hPa = 101325 Pa.
+  const auto d = codec_test::feed_whole(
+      std::move(c), R"({"jsonrpc":"2.0","result":[0,1013.25],"id":2})"
+                    "\n"
+                    R"({"jsonrpc":"2.0","result":[0,20.5],"id":1})"
+                    "\n"
+                    R"({"jsonrpc":"2.0","result":[0,45.0],"id":3})"
+                    "\n"
+                    R"({"jsonrpc":"2.0","result":[0,1.000271],"id":4})"
+                    "\n"
+                    R"({"jsonrpc":"2.0","result":[0,"measurement running"],"id":5})"
+                    "\n"
+                    R"({"jsonrpc":"2.0","result":[0,true],"id":6})"
+                    "\n");
+  ASSERT_EQ(d.frames.size(), 6u);
+  EXPECT_DOUBLE_EQ(*d.frames[0].pressure_pa, 101325.0);
+  EXPECT_EQ(d.frames[1].method, IdsMethod::ecu_get_temperature);
+  EXPECT_DOUBLE_EQ(*d.frames[1].temperature_degc, 20.5);
+  EXPECT_DOUBLE_EQ(*d.frames[2].humidity_pct_rh, 45.0);
+  EXPECT_DOUBLE_EQ(*d.frames[3].refractive_index, 1.000271);
+  EXPECT_EQ(d.frames[4].mode, "measurement running");
+  EXPECT_EQ(d.frames[5].flag, true);
+}
+
+TEST(IdsCodec, DeviceErrorsAreAnswersNotCodecErrors) {
+  IdsCodec c;
+  c.encode(IdsMethod::get_axes_displacement);
+  c.encode(IdsMethod::start_measurement);
+  const auto d = codec_test::feed_whole(
+      std::move(c),
+      R"({"jsonrpc":"2.0","result":[7],"id":1})"  // beam lost: no values
+      "\n"
+      R"({"jsonrpc":"2.0","error":{"code":-32601,"message":"Method not found"},"id":2})"
+      "\n");
+  ASSERT_EQ(d.frames.size(), 2u);
+  EXPECT_EQ(d.frames[0].error_code, 7);
+  EXPECT_FALSE(d.frames[0].displacement_m[0]);
+  EXPECT_EQ(d.frames[1].error_code, -32601);
+  EXPECT_EQ(d.frames[1].error_message, "Method not found");
+  EXPECT_EQ(d.stats.errors(), 0u);
+}
+
+TEST(IdsCodec, BadAnswersAreCountedByKindAndNamed) {
+  IdsCodec c;
+  for (int i = 0; i < 5; ++i) c.encode(IdsMethod::get_axes_displacement);  // ids 1..5
+  c.encode(IdsMethod::ecu_get_pressure);                                   // id 6
+  const auto d = codec_test::feed_whole(
+      std::move(c),
+      "not json\n"                                       // malformed
+      "{\"id\":1,\"result\":[0,1,2,3]}\x01\n"            // control byte: garbage
+      R"({"jsonrpc":"2.0","result":[0,1,2,3],"id":99})"  // unknown id
+      "\n"
+      R"({"jsonrpc":"2.0","result":[0,1,2],"id":2})"  // 2 values of 3
+      "\n"
+      R"({"jsonrpc":"2.0","result":[0,"x",2,3],"id":3})"  // not a number
+      "\n"
+      R"({"jsonrpc":"2.0","result":[0,20000000000000,0,0],"id":4})"  // 20 m > 10 m
+      "\n"
+      R"({"jsonrpc":"2.0","result":[0,2000.0],"id":6})"  // 2000 hPa
+      "\n"
+      R"({"jsonrpc":"2.0","result":[0,5,6,7],"id":5})"  // good
+      "\n");
+  EXPECT_EQ(d.stats.garbage, 1u);
+  EXPECT_EQ(d.stats.malformed, 4u);
+  EXPECT_EQ(d.stats.out_of_range, 2u);
+  // The out-of-range answers still come as frames, without the refused value.
+  ASSERT_EQ(d.frames.size(), 4u);
+  EXPECT_DOUBLE_EQ(*d.frames.back().displacement_m[2], 7e-12);
+  bool named = false;
+  for (const auto& e : d.errors)
+    named |= e.description.find("response id 99 matches no pending request") != std::string::npos;
+  EXPECT_TRUE(named);
+}
+
+TEST(IdsCodec, SplitAtAnyByteAndReplayedRequests) {
+  const std::string answers = R"({"jsonrpc":"2.0","result":[0,1000,2000,3000],"id":1})"
+                              "\n"
+                              R"({"jsonrpc":"2.0","result":[0,20.5],"id":2})"
+                              "\n";
+  auto make = [] {
+    IdsCodec c;
+    c.encode(IdsMethod::get_axes_displacement);
+    c.encode(IdsMethod::ecu_get_temperature);
+    return c;
+  };
+  const auto whole = codec_test::feed_whole(make(), answers);
+  const auto bytewise = codec_test::feed_bytewise(make(), answers);
+  ASSERT_EQ(bytewise.frames.size(), 2u);
+  EXPECT_EQ(whole.stats, bytewise.stats);
+  EXPECT_DOUBLE_EQ(*bytewise.frames[0].displacement_m[2], 3e-9);
+  // Replay: the codec learns the recorded requests from the bytes that were sent.
+  IdsCodec replay;
+  IdsCodec live;
+  const std::string sent =
+      live.encode(IdsMethod::get_axes_displacement) + live.encode(IdsMethod::ecu_get_temperature);
+  replay.note_requests(as_bytes(sent));
+  EXPECT_EQ(replay.pending(), 2u);
+  std::vector<IdsResponse> frames;
+  replay.feed(answers, frames);
+  EXPECT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[1].method, IdsMethod::ecu_get_temperature);
+}
+
+TEST(IdsCodec, PendingRequestsAreBounded) {
+  IdsCodec c;
+  for (std::size_t i = 0; i < IdsCodec::max_pending + 10; ++i)
+    c.encode(IdsMethod::get_axes_displacement);
+  EXPECT_EQ(c.pending(), IdsCodec::max_pending);
+  std::vector<IdsResponse> frames;
+  c.feed(R"({"jsonrpc":"2.0","result":[0,1,2,3],"id":1})"
+         "\n",
+         frames);  // the oldest were forgotten: id 1 no longer matches
+  EXPECT_TRUE(frames.empty());
+  EXPECT_EQ(c.stats().malformed, 1u);
+}
+
+}  // namespace
