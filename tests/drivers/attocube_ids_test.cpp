@@ -154,13 +154,13 @@ TEST(IdsCodec, SplitAtAnyByteAndReplayedRequests) {
   // Replay: the codec learns the recorded requests from the bytes that were sent.
   IdsCodec replay;
   IdsCodec live;
-  const std::string sent =
-      live.encode(IdsMethod::get_axes_displacement) + live.encode(IdsMethod::ecu_get_temperature);
+  std::string sent = live.encode(IdsMethod::get_axes_displacement);  // id 1, then id 2:
+  sent += live.encode(IdsMethod::ecu_get_temperature);               // two statements fix the order
   replay.note_requests(as_bytes(sent));
   EXPECT_EQ(replay.pending(), 2u);
   std::vector<IdsResponse> frames;
   replay.feed(answers, frames);
-  EXPECT_EQ(frames.size(), 2u);
+  ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[1].method, IdsMethod::ecu_get_temperature);
 }
 
