@@ -1,1 +1,102 @@
-// Placeholder: tests arrive with the codec.
+// Vaisala PTU300 codec: output lines as the User's Guide prints them, custom FORM lines with
+// other units, the CS2/CS4/CSX checksums worked out by hand, and every bad line.
+#include "cal/drivers/codec/vaisala_ptu300.hpp"
+
+#include <gtest/gtest.h>
+
+#include "cal/analysis/error.hpp"
+#include "codec_test_util.hpp"
+
+namespace {
+
+using namespace cal::drivers::codec;
+
+TEST(Ptu300Codec, TheManualsDefaultLine) {
+  // 1033.7 hPa = 103370 Pa.
+  const auto d = codec_test::feed_whole(Ptu300Codec{}, "P= 1033.7 hPa T= 22.2 'C RH= 38.3 %RH\r\n");
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_DOUBLE_EQ(*d.frames[0].pressure_pa, 103370.0);
+  EXPECT_DOUBLE_EQ(*d.frames[0].temperature_degc, 22.2);
+  EXPECT_DOUBLE_EQ(*d.frames[0].relative_humidity_pct, 38.3);
+  ASSERT_EQ(d.frames[0].fields.size(), 3u);
+  EXPECT_EQ(d.frames[0].fields[0].label, "P");
+  EXPECT_EQ(d.frames[0].fields[0].unit, "hPa");
+  EXPECT_EQ(d.stats.errors(), 0u);
+}
+
+TEST(Ptu300Codec, OtherUnitsAndNoSpaces) {
+  // "RH= 14.98%RH T= 74.68'F" (the manual's FORM example): (74.68 - 32) x 5/9 = 23.7111 degC.
+  // 29.92 inHg x 3386.389 Pa/inHg = 101320.76 Pa; 101.3 kPa = 101300 Pa; TD 50 'F = 10 degC.
+  const auto d = codec_test::feed_whole(Ptu300Codec{},
+                                        "RH= 14.98%RH T= 74.68'F\r\n"
+                                        "P= 29.92 inHg\r\n"
+                                        "P= 101.3 kPa TD= 50.0 'F\r\n");
+  ASSERT_EQ(d.frames.size(), 3u);
+  EXPECT_DOUBLE_EQ(*d.frames[0].relative_humidity_pct, 14.98);
+  EXPECT_NEAR(*d.frames[0].temperature_degc, 23.711111, 1e-6);
+  EXPECT_NEAR(*d.frames[1].pressure_pa, 101320.759, 1e-3);
+  EXPECT_DOUBLE_EQ(*d.frames[2].pressure_pa, 101300.0);
+  EXPECT_NEAR(*d.frames[2].dew_point_degc, 10.0, 1e-12);
+}
+
+TEST(Ptu300Codec, ChecksumsByHand) {
+  // "RH= 38.3 %RH " byte sum: R82 H72 =61 sp32 '3'51 '8'56 .46 '3'51 sp32 %37 R82 H72 sp32 = 706:
+  // CS2 = 706 mod 256 = 194 = C2, CS4 = 02C2; XOR of the bytes (CSX) = 2E.
+  EXPECT_EQ(ptu300_checksum_hex(Ptu300Checksum::cs2, "RH= 38.3 %RH "), "C2");
+  EXPECT_EQ(ptu300_checksum_hex(Ptu300Checksum::cs4, "RH= 38.3 %RH "), "02C2");
+  EXPECT_EQ(ptu300_checksum_hex(Ptu300Checksum::csx, "RH= 38.3 %RH "), "2E");
+  EXPECT_EQ(ptu300_checksum(Ptu300Checksum::csx, "$A*"), 'A');  // '$' and '*' count as 0
+  const auto ok =
+      codec_test::feed_whole(Ptu300Codec({.checksum = Ptu300Checksum::cs2}), "RH= 38.3 %RH C2\r\n");
+  ASSERT_EQ(ok.frames.size(), 1u);
+  EXPECT_DOUBLE_EQ(*ok.frames[0].relative_humidity_pct, 38.3);
+  const auto bad = codec_test::feed_whole(Ptu300Codec({.checksum = Ptu300Checksum::cs2}),
+                                          "RH= 38.4 %RH C2\r\n"  // one digit changed
+                                          "RH= 38.3 %RH\r\n");   // no checksum at all
+  EXPECT_TRUE(bad.frames.empty());
+  EXPECT_EQ(bad.stats.bad_checksum, 2u);
+  const auto cs4 = codec_test::feed_whole(Ptu300Codec({.checksum = Ptu300Checksum::cs4}),
+                                          "RH= 38.3 %RH 02C2\r\n");
+  EXPECT_EQ(cs4.frames.size(), 1u);
+}
+
+TEST(Ptu300Codec, TextLinesStarsUnitsAndRanges) {
+  const auto d = codec_test::feed_whole(Ptu300Codec{},
+                                        ">SEND\r\n"                     // echo: a text frame
+                                        "P= ****.* hPa T= 22.2 'C\r\n"  // P not available
+                                        "T= 22.2 hPa\r\n"               // a pressure unit on T
+                                        "P= 1500.0 hPa\r\n"             // beyond 1100 hPa
+                                        "RH= 104.0 %RH\r\n"             // beyond 100 %RH
+                                        "P= 1013\x01 hPa\r\n");         // control byte
+  ASSERT_GE(d.frames.size(), 2u);
+  EXPECT_EQ(d.frames[0].text, "SEND");
+  EXPECT_FALSE(d.frames[1].pressure_pa);                  // the stars are no value ...
+  EXPECT_DOUBLE_EQ(*d.frames[1].temperature_degc, 22.2);  // ... the rest of the line is
+  EXPECT_EQ(d.stats.out_of_range, 3u);                    // stars, 1500 hPa, 104 %RH
+  EXPECT_EQ(d.stats.malformed, 1u);
+  EXPECT_EQ(d.stats.garbage, 1u);
+}
+
+TEST(Ptu300Codec, CommandsAsTheManualWritesThem) {
+  EXPECT_EQ(ptu300_send(), "SEND\r");
+  EXPECT_EQ(ptu300_send(3), "SEND 3\r");
+  EXPECT_EQ(ptu300_stop(), "S\r");
+  EXPECT_EQ(ptu300_run(), "R\r");
+  EXPECT_EQ(ptu300_smode(Ptu300Mode::poll), "SMODE POLL\r");
+  EXPECT_EQ(ptu300_intv(10, IntervalUnit::s), "INTV 10 S\r");
+  EXPECT_THROW(ptu300_intv(256, IntervalUnit::s), cal::InputError);
+  EXPECT_EQ(ptu300_form("/"), "FORM /\r");
+  EXPECT_THROW(ptu300_form("4.2 P\r\n"), cal::InputError);
+}
+
+TEST(Ptu300Codec, SplitAtAnyByteGivesTheSameFrames) {
+  const std::string stream =
+      "P= 1033.7 hPa T= 22.2 'C RH= 38.3 %RH\r\nRH= 14.98%RH T= 74.68'F\r\nP= 1500.0 hPa\r\n";
+  const auto whole = codec_test::feed_whole(Ptu300Codec{}, stream);
+  const auto bytewise = codec_test::feed_bytewise(Ptu300Codec{}, stream);
+  EXPECT_EQ(whole.frames, bytewise.frames);
+  EXPECT_EQ(whole.stats, bytewise.stats);
+  EXPECT_EQ(whole.frames.size(), 2u);
+}
+
+}  // namespace
