@@ -246,6 +246,97 @@ void IdsTwin::drop_connections() {
 std::uint64_t IdsTwin::requests_served() const { return impl_->served; }
 
 // ---------------------------------------------------------------------------------------------
+// MTConnect SHDR adapter: position lines to every client on a timer, "* PONG" to "* PING".
+
+struct ShdrTwin::Impl : std::enable_shared_from_this<ShdrTwin::Impl> {
+  struct Client {
+    explicit Client(tcp::socket s) : socket(std::move(s)) {}
+    tcp::socket socket;
+    asio::streambuf input;
+    LineWriter<tcp::socket> writer;
+  };
+
+  Impl(asio::io_context& io, World& w, Clock c, ShdrTwinConfig cfg)
+      : acceptor(io, tcp::endpoint(asio::ip::address_v4::loopback(), cfg.port)),
+        timer(io),
+        world(w),
+        clock(std::move(c)),
+        config(cfg) {}
+
+  void accept() {
+    acceptor.async_accept(
+        [self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
+          if (ec) return;
+          auto client = std::make_shared<Client>(std::move(socket));
+          self->clients.push_back(client);
+          self->read(client);
+          self->accept();
+        });
+  }
+
+  void read(const std::shared_ptr<Client>& client) {
+    asio::async_read_until(
+        client->socket, client->input, '\n',
+        [self = shared_from_this(), client](const boost::system::error_code& ec, std::size_t n) {
+          if (ec) {
+            self->clients.remove(client);
+            return;
+          }
+          const std::string line(asio::buffers_begin(client->input.data()),
+                                 asio::buffers_begin(client->input.data()) + static_cast<long>(n));
+          client->input.consume(n);
+          if (line.starts_with("* PING")) {
+            ++self->pongs;
+            client->writer.send(client->socket,
+                                fmt::format("* PONG {}\n", self->config.pong_timeout_ms), client);
+          }
+          self->read(client);
+        });
+  }
+
+  void tick() {
+    timer.expires_after(config.period);
+    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (ec) return;
+      if (!self->clients.empty()) {
+        self->world.advance_to(self->clock());
+        const auto& c = self->world.state().commanded_mm;
+        const auto line = fmt::format("|Xcom|{:.4f}|Ycom|{:.4f}|Zcom|{:.4f}\n", c[0], c[1], c[2]);
+        for (const auto& client : self->clients) {
+          client->writer.send(client->socket, line, client);
+          ++self->sent;
+        }
+      }
+      self->tick();
+    });
+  }
+
+  tcp::acceptor acceptor;
+  asio::steady_timer timer;
+  World& world;
+  Clock clock;
+  ShdrTwinConfig config;
+  std::list<std::shared_ptr<Client>> clients;
+  std::uint64_t sent = 0, pongs = 0;
+};
+
+ShdrTwin::ShdrTwin(asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config)
+    : impl_(std::make_shared<Impl>(io, world, std::move(clock), config)) {
+  impl_->accept();
+  impl_->tick();
+}
+ShdrTwin::~ShdrTwin() {
+  boost::system::error_code ignored;
+  impl_->acceptor.close(ignored);
+  impl_->timer.cancel();
+  for (auto& c : impl_->clients) c->socket.close(ignored);
+  impl_->clients.clear();
+}
+std::uint16_t ShdrTwin::port() const { return impl_->acceptor.local_endpoint().port(); }
+std::uint64_t ShdrTwin::lines_sent() const { return impl_->sent; }
+std::uint64_t ShdrTwin::pings_answered() const { return impl_->pongs; }
+
+// ---------------------------------------------------------------------------------------------
 // Pseudo-terminal devices: the twin holds the master side (and keeps the slave open so the
 // master does not see EIO before the driver opens it).
 

@@ -173,3 +173,35 @@ TEST(GaugeInstrument, StreamsTheBallbarAndPollsAThermometer) {
 }
 
 }  // namespace
+
+namespace {
+
+// The SHDR twin streams the simulated control's commanded position; the real position feed
+// instrument (SHDR codec over TCP, "* PING" heartbeats) turns it into machine_position_m.
+TEST(PositionFeedInstrument, ShdrAdapterPositionAndHeartbeats) {
+  boost::asio::io_context io;
+  double now_s = 1.0;
+  sim::World world = parked_at_100mm();
+  sim::ShdrTwin twin(io, world, [&] { return now_s; }, {.period = 2ms});
+  auto feed = d::make_position_feed(
+      io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+      {.device = 4, .name = "position", .poll_period = 20ms},
+      {.kind = d::PositionFeedKind::shdr,
+       .shdr = {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}}});
+  Recorder rec;
+  feed->start(rec.events());
+  ASSERT_TRUE(run_until(io, [&] {
+    return rec.count(d::Quantity::machine_position_m) >= 30 && twin.pings_answered() >= 2;
+  }));
+  // Parked at X = 100 mm: 0.1 m on channel 0, 0 on Y and Z.
+  for (const auto& r : rec.readings) {
+    ASSERT_EQ(r.quantity, d::Quantity::machine_position_m);
+    EXPECT_EQ(r.device, 4);
+    EXPECT_NEAR(r.value, r.channel == 0 ? 0.1 : 0.0, 1e-12) << int(r.channel);
+  }
+  EXPECT_EQ(rec.codec_errors, 0u);  // the "* PONG" answers are heartbeats, not errors
+  EXPECT_EQ(feed->state(), d::InstrumentState::streaming);
+  feed->stop();
+}
+
+}  // namespace

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "cal/drivers/codec/line_gauge.hpp"
+#include "cal/drivers/codec/position_feed.hpp"
 #include "cal/drivers/codec/temper.hpp"
 #include "cal/drivers/codec/vaisala_ptu300.hpp"
 #include "cal/drivers/instrument.hpp"
@@ -54,5 +55,20 @@ struct TemperOptions {
 std::unique_ptr<Instrument> make_temper(boost::asio::io_context& io,
                                         std::unique_ptr<transport::Transport> transport,
                                         InstrumentOptions options, TemperOptions temper = {});
+
+enum class PositionFeedKind { halsampler, shdr };
+struct PositionFeedOptions {
+  PositionFeedKind kind = PositionFeedKind::shdr;
+  codec::HalsamplerConfig halsampler;
+  codec::ShdrConfig shdr;
+};
+
+// A machine position feed (LinuxCNC halsampler lines, or an MTConnect SHDR adapter that is
+// sent "* PING" every options.poll_period). Readings: machine_position_m, channel = axis
+// (0 X, 1 Y, 2 Z), timed on arrival with the service's clock.
+std::unique_ptr<Instrument> make_position_feed(boost::asio::io_context& io,
+                                               std::unique_ptr<transport::Transport> transport,
+                                               InstrumentOptions options,
+                                               PositionFeedOptions feed = {});
 
 }  // namespace cal::drivers

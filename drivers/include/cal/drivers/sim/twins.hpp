@@ -75,6 +75,33 @@ class IdsTwin {
   std::shared_ptr<Impl> impl_;
 };
 
+// --- MTConnect SHDR adapter (a machine position feed) on loopback TCP ---------------------------
+
+struct ShdrTwinConfig {
+  std::uint16_t port = 0;  // 0: an ephemeral port on 127.0.0.1
+  // Wall-clock period of the position lines, each "|Xcom|x|Ycom|y|Zcom|z" (no timestamp: the
+  // agent stamps it), the control's commanded position in mm.
+  std::chrono::milliseconds period{5};
+  std::int64_t pong_timeout_ms = 10000;  // the answer to "* PING": "* PONG 10000"
+};
+
+// Streams the simulated control's commanded position to every connected agent and answers
+// its heartbeats, as an MTConnect adapter does.
+class ShdrTwin {
+ public:
+  ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});
+  ~ShdrTwin();
+  ShdrTwin(const ShdrTwin&) = delete;
+  ShdrTwin& operator=(const ShdrTwin&) = delete;
+  std::uint16_t port() const;
+  std::uint64_t lines_sent() const;
+  std::uint64_t pings_answered() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
 // --- Vaisala PTU300 on a pseudo-terminal -----------------------------------------------------
 
 struct Ptu300TwinConfig {
