@@ -110,6 +110,8 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
       setup.air = s.instrument(spec);
     else if (spec.role == "material")
       setup.material.push_back(s.instrument(spec));
+    else if (spec.role == "position")
+      setup.position = s.instrument(spec), setup.position_channel = spec.feed_axis;
   }
   if (!setup.laser || !setup.air)
     throw cal::InputError(

@@ -85,7 +85,12 @@ InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device) {
       .request = c.request, .pattern = c.pattern, .unit = d::codec::gauge_unit_from_string(c.unit)};
   if (s.gauge.unit == d::codec::GaugeUnit::degc) s.gauge.min_si = -40, s.gauge.max_si = 150;
   s.temper_family = c.family;
-  if (c.driver != "ids3010" && c.driver != "ptu300" && c.driver != "gauge" && c.driver != "temper")
+  s.feed_key = c.key;
+  s.feed_column = c.column;
+  s.feed_unit = c.unit == "in" ? "in" : "mm";
+  static constexpr std::string_view drivers[] = {"ids3010", "ptu300",     "gauge",
+                                                 "temper",  "halsampler", "shdr"};
+  if (std::find(std::begin(drivers), std::end(drivers), c.driver) == std::end(drivers))
     throw cal::InputError(
         fmt::format("devices.{}: driver '{}' is not available for runs yet", c.id, c.driver));
   return s;
@@ -167,9 +172,15 @@ void run_linear(const RunOptions& o) {
   boost::asio::io_context io;
   std::vector<InstrumentSpec> specs;
   std::uint16_t n = 0;
-  for (const auto& dc : config.devices)
-    if (dc.role == "laser" || dc.role == "air" || dc.role == "material")
-      specs.push_back(spec_of(dc, n++));
+  // The position feed reports the test axis: its channel is the axis' index.
+  const int axis = config.linear->axis == "Y" ? 1 : config.linear->axis == "Z" ? 2 : 0;
+  for (const auto& dc : config.devices) {
+    if (dc.role != "laser" && dc.role != "air" && dc.role != "material" && dc.role != "position")
+      continue;
+    specs.push_back(spec_of(dc, n++));
+    specs.back().feed_axis = axis;
+    if (specs.back().feed_key.empty()) specs.back().feed_key = config.linear->axis + "act";
+  }
   need(config, "laser"), need(config, "air");
   SessionCapture capture(o.capture, config, specs);
   LinearRunSetup setup;
@@ -183,11 +194,14 @@ void run_linear(const RunOptions& o) {
     auto opt = instrument_options(dc, o, capture.recorder.get());
     if (dc.poll_s <= 0 && (s.driver == "ptu300" || s.driver == "temper" || s.role == "material"))
       opt.poll_period = 1000ms;
+    if (dc.poll_s <= 0 && s.driver == "shdr") opt.poll_period = 5000ms;  // "* PING" heartbeats
     auto inst = make_instrument(io, s, make_transport(io, dc), opt);
     if (s.role == "laser")
       setup.laser = std::move(inst);
     else if (s.role == "air")
       setup.air = std::move(inst);
+    else if (s.role == "position")
+      setup.position = std::move(inst), setup.position_channel = axis;
     else
       setup.material.push_back(std::move(inst));
   }

@@ -24,12 +24,13 @@ struct SimOptions {
   std::string test = "circle";
   double speed = 1.0;
   double start_after_s = 5.0;
+  bool position_feed = false;
 };
 
 // The configuration of the shop's devices and tests. Times the acquiring process measures on
 // its own clock (the trigger's dwell) are divided by the speed: it sees the program `speed`
 // times faster than the program's own times.
-std::string sim_config(const SimulatedShop& shop, double speed) {
+std::string sim_config(const SimulatedShop& shop, double speed, bool position_feed) {
   const auto& t = shop.truth();
   return fmt::format(
       R"TOML(# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {speed}x
@@ -58,7 +59,7 @@ request = "?\r"
 unit = "degC"
 role = "material"
 
-[devices.ballbar]
+{position}[devices.ballbar]
 driver = "gauge"
 transport = "serial {ballbar} 115200 8N1"
 unit = "mm"
@@ -92,6 +93,13 @@ sample_rate_hz = 1000
 overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
 )TOML",
+      fmt::arg("position",
+               position_feed
+                   ? fmt::format("[devices.position]      # the control's commanded position\n"
+                                 "driver = \"shdr\"\ntransport = \"tcp 127.0.0.1:{}\"\n"
+                                 "key = \"Xcom\"\nrole = \"position\"\n\n",
+                                 shop.position_port())
+                   : std::string{}),
       fmt::arg("speed", speed), fmt::arg("laser", shop.laser_port()),
       fmt::arg("laser_poll", 0.05 / speed), fmt::arg("air", shop.air_device()),
       fmt::arg("material", shop.material_device()), fmt::arg("ballbar", shop.ballbar_device()),
@@ -105,7 +113,7 @@ void run_sim(const SimOptions& o) {
     throw cal::InputError(fmt::format("--test '{}' (expected linear or circle)", o.test));
   boost::asio::io_context io;
   SimulatedShop shop(io, ShopTruth{}, o.speed);
-  const std::string text = sim_config(shop, o.speed);
+  const std::string text = sim_config(shop, o.speed, o.position_feed);
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -154,6 +162,8 @@ void add_sim_command(CLI::App& app) {
   cmd->add_option("--start-after-s", o->start_after_s, "Wall-clock delay before the program")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--position-feed", o->position_feed,
+                "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->callback([o] { run_sim(*o); });
 }
 

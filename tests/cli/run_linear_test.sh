@@ -30,4 +30,18 @@ check reversal 0 "B̄ +-(3\.9[5-9]|4\.0[0-5])[0-9]* um" -- echo "$RUN"
 B1=$(sed -nE 's/^  B̄ +([-+0-9.]+) um.*/\1/p' <<<"$RUN" | sed 's/\./\\./')
 check replay 0 "replayed .* into run 2" -- "$DAQ" replay "$TMP/lin.cdq" --db "$TMP/run.sqlite"
 check replay_same_b 0 "^  B̄ +$B1 um" -- "$DAQ" analyse 2 --db "$TMP/run.sqlite"
+
+# The position-assisted trigger: the shop's MTConnect SHDR adapter feeds the control's
+# commanded position; stops are recognised from it and the laser averaged over the dwell.
+kill "$SIM_PID" 2>/dev/null
+"$DAQ" sim --test linear --speed 10 --start-after-s 3 --position-feed -o "$TMP/simp.toml" >"$TMP/simp.log" 2>&1 &
+SIM_PID=$!
+for _ in $(seq 100); do [ -s "$TMP/simp.toml" ] && break; sleep 0.1; done
+"$DAQ" run linear -c "$TMP/simp.toml" --db "$TMP/pos.sqlite" --capture "$TMP/pos.cdq" >"$TMP/pos.log" 2>&1
+POS=$(cat "$TMP/pos.log")
+check position_feed_used 0 "stops are recognised from the machine position feed" -- echo "$POS"
+check position_all_stops 0 "all stops captured" -- echo "$POS"
+check position_reversal 0 "B̄ +-(3\.9[5-9]|4\.0[0-5])[0-9]* um" -- echo "$POS"
+B2=$(sed -nE 's/^  B̄ +([-+0-9.]+) um.*/\1/p' <<<"$POS" | sed 's/\./\\./')
+check position_replay_same_b 0 "^  B̄ +$B2 um" -- "$DAQ" replay "$TMP/pos.cdq" --db "$TMP/pos.sqlite"
 finish

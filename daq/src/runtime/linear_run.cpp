@@ -101,6 +101,7 @@ struct LinearRun::Impl {
   cal::iso230_2::Plan plan;
   cal::daq::EnvStage env;
   cal::daq::StabilityTrigger trigger;
+  std::optional<cal::daq::PositionTrigger> position_trigger;  // with a position feed
   cal::daq::Sequencer sequencer;
   std::optional<cal::storage::Store> store;
   std::unique_ptr<cal::storage::BatchWriter> writer;
@@ -109,6 +110,7 @@ struct LinearRun::Impl {
   LiveState live;
   bool running = false, done = false;
   std::int64_t first_ns = -1;
+  double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
 
   Impl(boost::asio::io_context& i, LinearRunSetup s)
       : io(i),
@@ -119,7 +121,21 @@ struct LinearRun::Impl {
                  .dwell_s = setup.config.trigger.dwell_s,
                  .window_mm = setup.config.trigger.window_mm}),
         sequencer(plan, setup.config.trigger.window_mm),
-        timer(i) {}
+        timer(i) {
+    if (setup.position)
+      position_trigger.emplace(
+          cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
+                                            .dwell_s = setup.config.trigger.dwell_s});
+  }
+
+  std::uint16_t position_device() const {
+    return static_cast<std::uint16_t>(2 + setup.material.size());
+  }
+
+  void expect_next() {
+    trigger.expect(sequencer.next_expected_mm());
+    if (position_trigger) position_trigger->expect(sequencer.next_expected_mm());
+  }
 
   void event(const std::string& text) {
     live.message = text;
@@ -152,6 +168,7 @@ struct LinearRun::Impl {
     add(1, *setup.air, "air");
     for (std::size_t k = 0; k < setup.material.size(); ++k)
       add(static_cast<int>(2 + k), *setup.material[k], "material");
+    if (setup.position) add(position_device(), *setup.position, "position");
     writer = std::make_unique<cal::storage::BatchWriter>(
         setup.database, outcome.run_id, cal::storage::WriterOptions{},
         [this](const std::string& e) {
@@ -159,11 +176,16 @@ struct LinearRun::Impl {
         });
     running = true;
     live.state = "waiting";
-    trigger.expect(sequencer.next_expected_mm());
+    expect_next();
     start_instrument(*setup.laser, 0);
     start_instrument(*setup.air, 1);
     for (std::size_t k = 0; k < setup.material.size(); ++k)
       start_instrument(*setup.material[k], static_cast<std::uint16_t>(2 + k));
+    if (setup.position) {
+      start_instrument(*setup.position, position_device());
+      event("stops are recognised from the machine position feed (" + setup.position->describe() +
+            ")");
+    }
     event(fmt::format("run {}: {} targets x {} runs, {} stops expected", outcome.run_id,
                       plan.targets_mm.size(), c.linear->runs, sequencer.stops().size()));
     tick();
@@ -213,6 +235,11 @@ struct LinearRun::Impl {
       case Quantity::displacement_m:
         if (device == 0 && r.channel == setup.laser_channel) return on_laser(r);
         return;
+      case Quantity::machine_position_m:
+        if (position_trigger && device == position_device() && r.channel == setup.position_channel)
+          if (auto cap = position_trigger->add_position(r.time_ns, r.value * 1e3))
+            on_capture(*cap, env.compensate(r.time_ns, last_raw_m));
+        return;
       default:
         return;
     }
@@ -237,7 +264,13 @@ struct LinearRun::Impl {
       live.deviation_um = (position_mm - *next) * 1e3;
     live.state = "measuring";
     const bool valid = r.status == ReadingStatus::ok;
-    if (auto cap = trigger.add(r.time_ns, position_mm, valid)) on_capture(*cap, c);
+    last_raw_m = r.value;
+    if (position_trigger) {
+      if (auto cap = position_trigger->add_reading(r.time_ns, position_mm, valid))
+        on_capture(*cap, c);
+    } else if (auto cap = trigger.add(r.time_ns, position_mm, valid)) {
+      on_capture(*cap, c);
+    }
   }
 
   void on_capture(const cal::daq::Capture& cap, const cal::daq::Compensated& c) {
@@ -260,7 +293,7 @@ struct LinearRun::Impl {
         store->add_targets(std::span(&t, 1));
       }
     }
-    trigger.expect(sequencer.next_expected_mm());
+    expect_next();
     if (sequencer.complete()) finish();
   }
 
@@ -300,6 +333,7 @@ struct LinearRun::Impl {
     setup.laser->stop();
     setup.air->stop();
     for (auto& m : setup.material) m->stop();
+    if (setup.position) setup.position->stop();
     writer.reset();
     publish();
   }
@@ -329,7 +363,8 @@ LinearRun::~LinearRun() {
 void LinearRun::start() { impl_->start(); }
 void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }
 void LinearRun::manual_capture() {
-  if (auto c = impl_->trigger.capture_now()) {
+  auto& i = *impl_;
+  if (auto c = i.position_trigger ? i.position_trigger->capture_now() : i.trigger.capture_now()) {
     const auto comp = impl_->env.compensate(c->end_ns, 0.1);
     impl_->on_capture(*c, comp);
   }

@@ -46,6 +46,10 @@ struct LinearRunSetup {
   std::unique_ptr<cal::drivers::Instrument> laser;
   std::unique_ptr<cal::drivers::Instrument> air;
   std::vector<std::unique_ptr<cal::drivers::Instrument>> material;  // one per sensor
+  // A machine position feed (optional): with one, stops are recognised from the control's
+  // position (PositionTrigger) instead of the laser's stability; its channel is the test axis.
+  std::unique_ptr<cal::drivers::Instrument> position;
+  int position_channel = 0;
   int laser_channel = 0;
   double datum_mm = 0.0;  // axis position where the laser reads 0
   std::string software_version = "daq 0.1.0";

@@ -29,6 +29,18 @@ std::unique_ptr<cal::drivers::Instrument> make_instrument(
         {.family = codec::temper_family_from_string(spec.temper_family),
          .quantity = spec.role == "air" ? cal::drivers::Quantity::air_temperature_degc
                                         : cal::drivers::Quantity::material_temperature_degc});
+  if (spec.driver == "shdr" || spec.driver == "halsampler") {
+    const double m_per_unit = spec.feed_unit == "in" ? 0.0254 : 1e-3;
+    cal::drivers::PositionFeedOptions f{.kind = spec.driver == "shdr"
+                                                    ? cal::drivers::PositionFeedKind::shdr
+                                                    : cal::drivers::PositionFeedKind::halsampler};
+    f.shdr.keys = {{spec.feed_key, spec.feed_axis}};
+    f.shdr.metres_per_unit = m_per_unit;
+    f.halsampler.column = {-1, -1, -1};
+    f.halsampler.column[static_cast<std::size_t>(spec.feed_axis)] = spec.feed_column;
+    f.halsampler.metres_per_unit = m_per_unit;
+    return cal::drivers::make_position_feed(io, std::move(transport), std::move(options), f);
+  }
   throw cal::InputError("instrument driver '" + spec.driver + "' cannot be built here");
 }
 
@@ -66,7 +78,12 @@ json to_json(const InstrumentSpec& s) {
             {"offset", s.gauge.offset},
             {"min_si", s.gauge.min_si},
             {"max_si", s.gauge.max_si}}},
-          {"temper_family", s.temper_family}};
+          {"temper_family", s.temper_family},
+          {"feed",
+           {{"axis", s.feed_axis},
+            {"key", s.feed_key},
+            {"column", s.feed_column},
+            {"unit", s.feed_unit}}}};
 }
 
 InstrumentSpec instrument_spec_from_json(const json& j) {
@@ -86,6 +103,12 @@ InstrumentSpec instrument_spec_from_json(const json& j) {
     s.gauge.max_si = g->value("max_si", 10.0);
   }
   s.temper_family = j.value("temper_family", s.temper_family);
+  if (const auto f = j.find("feed"); f != j.end()) {
+    s.feed_axis = f->value("axis", 0);
+    s.feed_key = f->value("key", s.feed_key);
+    s.feed_column = f->value("column", 0);
+    s.feed_unit = f->value("unit", s.feed_unit);
+  }
   return s;
 }
 

@@ -20,12 +20,18 @@ namespace daq {
 
 struct InstrumentSpec {
   std::uint16_t device = 0;
-  std::string driver;     // ids3010 | ptu300 | gauge | temper
+  std::string driver;     // ids3010 | ptu300 | gauge | temper | shdr | halsampler
   std::string role;       // laser | air | material | ballbar
   std::string transport;  // as described live, e.g. "tcp 127.0.0.1:9090"
   std::array<bool, 3> ids_axes{true, false, false};
   cal::drivers::codec::GaugeConfig gauge;
   std::string temper_family = "gold";  // temper: ds75 | gold | temperx
+  // shdr | halsampler: the test axis (0 X, 1 Y, 2 Z), its SHDR key or halsampler column, and
+  // the machine unit (mm | in).
+  int feed_axis = 0;
+  std::string feed_key = "Xact";
+  int feed_column = 0;
+  std::string feed_unit = "mm";
 };
 
 std::unique_ptr<cal::drivers::Instrument> make_instrument(

@@ -34,6 +34,7 @@ struct SimulatedShop::Impl {
   sim::Ptu300Twin ptu;
   sim::GaugeTwin material;
   sim::GaugeTwin ballbar;
+  sim::ShdrTwin position;
 
   static sim::MachineConfig machine(const ShopTruth& t) {
     sim::MachineConfig c;
@@ -76,7 +77,8 @@ struct SimulatedShop::Impl {
                   .decimals = 3,
                   .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
         ballbar(ctx, world, clock,
-                {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}) {}
+                {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}),
+        position(ctx, world, clock) {}
 
   // Simulated time follows the wall clock times `speed`, but a wall-clock interval between
   // two readings of the clock counts for at most kMaxWall_s: when the process is starved of
@@ -106,6 +108,7 @@ std::uint16_t SimulatedShop::laser_port() const { return impl_->ids.port(); }
 const std::string& SimulatedShop::air_device() const { return impl_->ptu.device_path(); }
 const std::string& SimulatedShop::material_device() const { return impl_->material.device_path(); }
 const std::string& SimulatedShop::ballbar_device() const { return impl_->ballbar.device_path(); }
+std::uint16_t SimulatedShop::position_port() const { return impl_->position.port(); }
 
 void SimulatedShop::run_linear(const cal::iso230_2::Plan& plan, double feed, double dwell_s) {
   std::vector<sim::Move> program;

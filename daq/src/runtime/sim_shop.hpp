@@ -55,6 +55,7 @@ class SimulatedShop {
   const std::string& air_device() const;
   const std::string& material_device() const;
   const std::string& ballbar_device() const;
+  std::uint16_t position_port() const;  // MTConnect SHDR adapter: Xcom|Ycom|Zcom, commanded mm
 
   // The machine program for an ISO 230-2 plan on X: every move at the feed, a dwell at each
   // measure move.

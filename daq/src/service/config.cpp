@@ -5,6 +5,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
@@ -131,6 +132,12 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   one_of(t, "unit", d.unit, {"mm", "um", "in", "m", "degC"});
   t.read("family", d.family);
   one_of(t, "family", d.family, {"ds75", "gold", "temperx"});
+  t.read("key", d.key);
+  double column = 0;
+  t.read("column", column);
+  if (column < 0 || column != std::floor(column))
+    t.fail(t.node("column"), "column", "a value column is an integer >= 0");
+  d.column = static_cast<int>(column);
   // TOML has no escapes in literal strings: allow "\r" written as the two characters.
   for (std::size_t at; (at = d.request.find("\\r")) != std::string::npos;)
     d.request.replace(at, 2, "\r");

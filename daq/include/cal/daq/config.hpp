@@ -22,6 +22,10 @@ struct DeviceConfig {
   std::string pattern;          // regex with one capture group; empty: a bare number (+unit)
   std::string unit = "mm";      // mm | um | in | m | degC
   std::string family = "gold";  // temper: report family ds75 | gold | temperx (docs/codecs)
+  // Position feeds: the SHDR data item of the test axis (default "<axis>act"), or the
+  // halsampler value column (0-based, after the sample number) of the test axis.
+  std::string key;
+  int column = 0;
 };
 
 enum class StalePolicy { fallback, stop };
