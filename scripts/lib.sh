@@ -10,11 +10,14 @@ PACKAGES=(
   build-essential cmake pkg-config
   libusb-1.0-0-dev libhidapi-dev libeigen3-dev libboost-dev libsqlite3-dev libspdlog-dev
   libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev clang
+  libplplot-dev
 )
+# The headless browser of the report and live-page tests (and of daq report --format pdf).
+TEST_PACKAGES=(chromium chromium-driver python3)
 
 install_packages() {
   local missing=()
-  for p in "${PACKAGES[@]}"; do
+  for p in "${PACKAGES[@]}" "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ ${#missing[@]} -eq 0 ]; then return 0; fi

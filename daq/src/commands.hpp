@@ -27,5 +27,7 @@ void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 void add_circle_commands(CLI::App& app, CLI::App& analyse);
 // compensate
 void add_compensate_commands(CLI::App& app, CLI::App& analyse);
+// report: HTML/PDF reports of stored runs
+void add_report_command(CLI::App& app);
 
 }  // namespace daq

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);
+  daq::add_report_command(app);
 
   try {
     app.parse(argc, argv);

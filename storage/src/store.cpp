@@ -256,6 +256,14 @@ std::optional<MachineRecord> Store::machine_by_name(std::string_view name) const
                        column_text(s.get(), 2), column_text(s.get(), 3)};
 }
 
+std::optional<MachineRecord> Store::machine(std::int64_t id) const {
+  auto s = impl_->prepare("SELECT id, name, description, config_json FROM machines WHERE id = ?");
+  sqlite3_bind_int64(s.get(), 1, id);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
+  return MachineRecord{sqlite3_column_int64(s.get(), 0), column_text(s.get(), 1),
+                       column_text(s.get(), 2), column_text(s.get(), 3)};
+}
+
 std::int64_t Store::begin_run(const RunRecord& r) {
   auto s = impl_->prepare(
       "INSERT INTO runs(machine_id, campaign, kind, axis, settings_json, capture_path, "
@@ -393,11 +401,23 @@ void Store::append_readings(std::int64_t run_id, std::span<const RawReading> rea
   tx.commit();
 }
 
-std::vector<RawReading> Store::readings(std::int64_t run_id) const {
-  auto s = impl_->prepare(
-      "SELECT device, channel, quantity, count, data FROM reading_chunks WHERE run_id = ? "
-      "ORDER BY id");
+std::vector<RawReading> Store::readings(std::int64_t run_id) const { return readings(run_id, {}); }
+
+std::vector<RawReading> Store::readings(std::int64_t run_id,
+                                        std::span<const std::uint8_t> quantities) const {
+  // The chunks hold one device/channel/quantity each: the filter skips whole chunks.
+  std::string sql =
+      "SELECT device, channel, quantity, count, data FROM reading_chunks WHERE run_id = ?";
+  if (!quantities.empty()) {
+    sql += " AND quantity IN (";
+    for (std::size_t i = 0; i < quantities.size(); ++i) sql += i ? ", ?" : "?";
+    sql += ")";
+  }
+  sql += " ORDER BY id";
+  auto s = impl_->prepare(sql.c_str());
   sqlite3_bind_int64(s.get(), 1, run_id);
+  for (std::size_t i = 0; i < quantities.size(); ++i)
+    sqlite3_bind_int(s.get(), static_cast<int>(i + 2), quantities[i]);
   std::vector<RawReading> out;
   while (sqlite3_step(s.get()) == SQLITE_ROW) {
     const auto count = static_cast<std::size_t>(sqlite3_column_int64(s.get(), 3));

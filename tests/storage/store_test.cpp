@@ -61,6 +61,8 @@ TEST(Store, RunLifeCycleAndBitExactReadings) {
   Store store(dir.path / "site.sqlite");
   const auto machine = store.add_machine({.name = "VMC-1", .description = "3-axis mill"});
   EXPECT_EQ(store.machine_by_name("VMC-1")->id, machine);
+  EXPECT_EQ(store.machine(machine)->description, "3-axis mill");
+  EXPECT_FALSE(store.machine(machine + 1));
   EXPECT_FALSE(store.machine_by_name("nope"));
   const auto run = store.begin_run({.machine_id = machine,
                                     .kind = "linear",
@@ -82,6 +84,14 @@ TEST(Store, RunLifeCycleAndBitExactReadings) {
     EXPECT_EQ(back[i].quantity, readings[i].quantity);
     EXPECT_EQ(back[i].status, readings[i].status);
     EXPECT_EQ(std::memcmp(&back[i].value, &readings[i].value, 8), 0) << i;  // bit-exact
+  }
+  // Quantity 2 only: every third reading (i % 3 == 2), still in time order.
+  const std::uint8_t q2[] = {2};
+  const auto only2 = store.readings(run, q2);
+  ASSERT_EQ(only2.size(), 3333u);
+  for (std::size_t i = 0; i < only2.size(); ++i) {
+    EXPECT_EQ(only2[i].time_ns, readings[3 * i + 2].time_ns);
+    EXPECT_EQ(only2[i].quantity, 2);
   }
   EXPECT_EQ(store.run(run)->status, RunStatus::running);
   store.add_targets(std::vector<cal::storage::CapturedTarget>{{.run_id = run,

@@ -113,6 +113,7 @@ class Store {
 
   std::int64_t add_machine(const MachineRecord& m);
   std::optional<MachineRecord> machine_by_name(std::string_view name) const;
+  std::optional<MachineRecord> machine(std::int64_t id) const;
 
   std::int64_t begin_run(const RunRecord& r);  // returns the new run id
   void add_instrument(const InstrumentRecord& i);
@@ -126,6 +127,10 @@ class Store {
   void append_readings(std::int64_t run_id, std::span<const RawReading> readings);
   // All readings of a run in time order (stable for equal times).
   std::vector<RawReading> readings(std::int64_t run_id) const;
+  // Only the readings of these quantities (cal::drivers::Quantity values), in time order: the
+  // environment of a long laser run without loading its millions of laser readings.
+  std::vector<RawReading> readings(std::int64_t run_id,
+                                   std::span<const std::uint8_t> quantities) const;
   std::int64_t reading_count(std::int64_t run_id) const;
 
   void add_targets(std::span<const CapturedTarget> targets);

@@ -1,0 +1,304 @@
+#include "plot.hpp"
+
+#include <fmt/format.h>
+#include <plplot/plplot.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+namespace cal::daq::report {
+
+Rgb palette(std::size_t i) {
+  static constexpr Rgb colours[] = {blue, vermilion, green, orange, purple, sky, black, grey};
+  return colours[i % std::size(colours)];
+}
+
+namespace {
+
+// Colour map 0: 0 background, 1 axes, 2 grid, 3 reference lines; the rest per item.
+constexpr PLINT axes_colour = 1, grid_colour = 2, reference_colour = 3, first_free = 4;
+constexpr PLINT colour_count = 64;
+
+// One PLplot stream writing SVG into memory. PLplot's svg device closes the FILE itself at
+// plend1, which also finalises the memory stream's buffer.
+class SvgStream {
+ public:
+  SvgStream(int width_pt, int height_pt) {
+    file_ = open_memstream(&buffer_, &length_);
+    if (file_ == nullptr) throw std::runtime_error("plot: cannot open a memory stream");
+    plmkstrm(&stream_);
+    plsdev("svg");
+    plsfile(file_);
+    plspage(0, 0, width_pt, height_pt, 0, 0);
+    plscmap0n(colour_count);
+    plscol0(0, 255, 255, 255);
+    plscol0(axes_colour, 0, 0, 0);
+    plscol0(grid_colour, 225, 225, 225);
+    plscol0(reference_colour, 140, 140, 140);
+    plinit();
+    pladv(0);
+    plschr(0, 0.85);
+  }
+  ~SvgStream() {
+    if (!ended_) plend1();
+    std::free(buffer_);
+  }
+  SvgStream(const SvgStream&) = delete;
+  SvgStream& operator=(const SvgStream&) = delete;
+
+  PLINT colour(Rgb c, double alpha = 1.0) {
+    const PLINT i = next_ < colour_count ? next_++ : colour_count - 1;
+    plscol0a(i, c.r, c.g, c.b, alpha);
+    return i;
+  }
+
+  // The <svg> element only (no XML prolog or DOCTYPE, which cannot sit inside HTML), sized
+  // by the page's CSS through its viewBox.
+  std::string finish(std::string_view title) {
+    plend1();
+    ended_ = true;
+    std::string s(buffer_, length_);
+    const auto at = s.find("<svg");
+    if (at == std::string::npos) throw std::runtime_error("plot: PLplot wrote no SVG");
+    s.erase(0, at);
+    for (const char* attr : {"width=\"", "height=\""}) {
+      const auto a = s.find(attr);
+      const auto end = a == std::string::npos ? a : s.find('"', a + std::strlen(attr));
+      if (end != std::string::npos) s.erase(a, end + 1 - a);
+    }
+    s.insert(4, fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", escape(title)));
+    return s;
+  }
+
+  static std::string escape(std::string_view s) {
+    std::string out;
+    for (char c : s) {
+      switch (c) {
+        case '<':
+          out += "&lt;";
+          break;
+        case '>':
+          out += "&gt;";
+          break;
+        case '&':
+          out += "&amp;";
+          break;
+        case '"':
+          out += "&quot;";
+          break;
+        default:
+          out += c;
+      }
+    }
+    return out;
+  }
+
+ private:
+  FILE* file_ = nullptr;
+  char* buffer_ = nullptr;
+  std::size_t length_ = 0;
+  PLINT stream_ = 0;
+  PLINT next_ = first_free;
+  bool ended_ = false;
+};
+
+struct Range {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  void add(double v) {
+    if (!std::isfinite(v)) return;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  bool empty() const { return !(lo <= hi); }
+  // Some room around the data; a flat series still gets a visible span.
+  Range padded(double fraction) const {
+    if (empty()) return {0.0, 1.0};
+    const double span = hi - lo;
+    const double pad = span > 0 ? span * fraction : std::max(std::abs(lo) * 0.1, 1.0);
+    return {lo - pad, hi + pad};
+  }
+};
+
+struct LegendEntry {
+  std::string text;
+  PLINT colour = 1;
+  PLINT opt = PL_LEGEND_LINE;
+  PLINT style = 1;
+  double width = 1.5;
+};
+
+void draw_legend(const std::vector<LegendEntry>& entries, PLINT position) {
+  if (entries.empty()) return;
+  const auto n = static_cast<PLINT>(entries.size());
+  std::vector<PLINT> opt, colours, text_colours, styles, box_patterns, symbol_numbers;
+  std::vector<PLFLT> widths, scales;
+  std::vector<const char*> texts, symbols;
+  for (const auto& e : entries) {
+    opt.push_back(e.opt);
+    colours.push_back(e.colour);
+    text_colours.push_back(axes_colour);
+    styles.push_back(e.style);
+    widths.push_back(e.width);
+    box_patterns.push_back(0);
+    scales.push_back(0.8);
+    symbol_numbers.push_back(0);
+    texts.push_back(e.text.c_str());
+    symbols.push_back("");
+  }
+  PLFLT w = 0, h = 0;
+  pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, 0.0, 0.05, 0,
+           axes_colour, 1, 0, 0, n, opt.data(), 0.6, 0.85, 1.8, 0.0, text_colours.data(),
+           texts.data(), colours.data(), box_patterns.data(), scales.data(), widths.data(),
+           colours.data(), styles.data(), widths.data(), colours.data(), scales.data(),
+           symbol_numbers.data(), symbols.data());
+}
+
+void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
+  const auto n = static_cast<PLINT>(std::min(l.x.size(), l.y.size()));
+  if (n == 0) return;
+  const PLINT c = s.colour(l.colour);
+  plcol0(c);
+  plwidth(l.width);
+  pllsty(l.dashed ? 2 : 1);
+  plline(n, l.x.data(), l.y.data());
+  if (l.markers) plpoin(n, l.x.data(), l.y.data(), 17);
+  pllsty(1);
+  if (!l.label.empty()) legend.push_back({l.label, c, PL_LEGEND_LINE, l.dashed ? 2 : 1, l.width});
+}
+
+}  // namespace
+
+std::string svg(const XyChart& chart) {
+  Range x, y;
+  for (const auto& b : chart.bands) {
+    for (double v : b.x) x.add(v);
+    for (double v : b.lo) y.add(v);
+    for (double v : b.hi) y.add(v);
+  }
+  for (const auto& l : chart.lines) {
+    for (double v : l.x) x.add(v);
+    for (double v : l.y) y.add(v);
+  }
+  if (chart.zero_line) y.add(0.0);
+  SvgStream s(chart.width_pt, chart.height_pt);
+  // The legend goes to the right of the plot, outside the data.
+  const bool has_legend = std::any_of(chart.lines.begin(), chart.lines.end(),
+                                      [](const Line& l) { return !l.label.empty(); }) ||
+                          std::any_of(chart.bands.begin(), chart.bands.end(),
+                                      [](const Band& b) { return !b.label.empty(); });
+  plvpor(0.09, has_legend ? 0.72 : 0.97, 0.13, 0.9);
+  const Range xr = x.empty() ? Range{0, 1} : (x.lo < x.hi ? x : x.padded(0.05));
+  const Range yr = y.padded(0.06);
+  plwind(xr.lo, xr.hi, yr.lo, yr.hi);
+  plcol0(grid_colour);
+  plwidth(0.5);
+  plbox("g", 0, 0, "g", 0, 0);
+  std::vector<LegendEntry> legend;
+  for (const auto& b : chart.bands) {
+    const std::size_t n = std::min({b.x.size(), b.lo.size(), b.hi.size()});
+    if (n == 0) continue;
+    std::vector<PLFLT> px, py;
+    for (std::size_t i = 0; i < n; ++i) px.push_back(b.x[i]), py.push_back(b.hi[i]);
+    for (std::size_t i = n; i-- > 0;) px.push_back(b.x[i]), py.push_back(b.lo[i]);
+    const PLINT c = s.colour(b.colour, b.alpha);
+    plcol0(c);
+    plfill(static_cast<PLINT>(px.size()), px.data(), py.data());
+    if (!b.label.empty()) legend.push_back({b.label, c, PL_LEGEND_COLOR_BOX});
+  }
+  if (chart.zero_line) {
+    plcol0(reference_colour);
+    plwidth(1.0);
+    const PLFLT zx[] = {xr.lo, xr.hi}, zy[] = {0.0, 0.0};
+    plline(2, zx, zy);
+  }
+  for (const auto& l : chart.lines) draw_line(s, l, legend);
+  plcol0(axes_colour);
+  plwidth(1.0);
+  plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+  pllab(chart.x_label.c_str(), chart.y_label.c_str(), chart.title.c_str());
+  if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
+  draw_legend(legend, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
+  return s.finish(chart.title);
+}
+
+namespace {
+
+// 1, 2 or 5 times a power of ten, at least v.
+double nice_step(double v) {
+  if (!(v > 0)) return 1.0;
+  const double p = std::pow(10.0, std::floor(std::log10(v)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * p >= v) return m * p;
+  return 10 * p;
+}
+
+}  // namespace
+
+std::string svg(const PolarChart& chart) {
+  double max_abs_um = 0.0;
+  for (const auto& t : chart.traces)
+    for (double v : t.y)
+      if (std::isfinite(v)) max_abs_um = std::max(max_abs_um, std::abs(v));
+  // Two divisions out and two in: the nominal circle at radius 1, a division 0.2.
+  const double div_um = std::max(nice_step(max_abs_um / 2.0), 0.1);
+  const auto radius = [&](double dev_um) {
+    return std::clamp(1.0 + 0.2 * dev_um / div_um, 0.05, 1.55);
+  };
+
+  SvgStream s(chart.size_pt, chart.size_pt);
+  plvpor(0.02, 0.98, 0.04, 0.92);
+  plwind(-1.7, 1.7, -1.7, 1.7);
+  plcol0(axes_colour);
+  plmtex("t", 1.5, 0.5, 0.5, chart.title.c_str());
+  // Rings every division, the nominal circle darker; spokes every 30 degrees.
+  for (int k = -2; k <= 2; ++k) {
+    const double r = 1.0 + 0.2 * k;
+    plcol0(k == 0 ? reference_colour : grid_colour);
+    plwidth(k == 0 ? 1.2 : 0.6);
+    plarc(0, 0, r, r, 0, 360, 0, 0);
+    plcol0(reference_colour);
+    plptex(r * std::cos(0.42) + 0.02, r * std::sin(0.42), 1, 0, 0,
+           fmt::format("{:+g} µm", k * div_um).c_str());
+  }
+  for (int a = 0; a < 360; a += 30) {
+    const double t = a * std::numbers::pi / 180.0;
+    const PLFLT sx[] = {0.5 * std::cos(t), 1.5 * std::cos(t)},
+                sy[] = {0.5 * std::sin(t), 1.5 * std::sin(t)};
+    plcol0(grid_colour);
+    plwidth(0.6);
+    plline(2, sx, sy);
+    plcol0(reference_colour);
+    plptex(1.6 * std::cos(t), 1.6 * std::sin(t) - 0.03, 1, 0, 0.5, fmt::format("{}°", a).c_str());
+  }
+  plcol0(axes_colour);
+  plptex(1.52, 0.06, 1, 0, 0.5, ("+" + chart.first_axis).c_str());
+  plptex(0.08, 1.52, 1, 0, 0.5, ("+" + chart.second_axis).c_str());
+  std::vector<LegendEntry> legend;
+  for (const auto& t : chart.traces) {
+    Line l = t;
+    l.x.clear();
+    l.y.clear();
+    const std::size_t n = std::min(t.x.size(), t.y.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(t.y[i])) continue;
+      const double th = t.x[i] * std::numbers::pi / 180.0, r = radius(t.y[i]);
+      l.x.push_back(r * std::cos(th));
+      l.y.push_back(r * std::sin(th));
+    }
+    draw_line(s, l, legend);
+  }
+  plcol0(axes_colour);
+  plmtex("b", 1.0, 0.0, 0.0, fmt::format("scale {:g} µm per ring", div_um).c_str());
+  if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
+  draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_RIGHT | PL_POSITION_INSIDE);
+  return s.finish(chart.title);
+}
+
+}  // namespace cal::daq::report

@@ -1,0 +1,62 @@
+#pragma once
+// Report plots as SVG text, drawn by PLplot (Debian's libplplot, its svg device writing to
+// memory), so the report can inline them and open offline. PLplot stays out of this header.
+// PLplot keeps global state: call these from one thread at a time.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cal::daq::report {
+
+struct Rgb {
+  std::uint8_t r = 0, g = 0, b = 0;
+};
+
+// A palette that stays distinguishable in print and for the common colour-vision deficiencies
+// (Okabe & Ito).
+inline constexpr Rgb blue{0, 114, 178}, orange{230, 159, 0}, green{0, 158, 115},
+    vermilion{213, 94, 0}, purple{204, 121, 167}, sky{86, 180, 233}, black{0, 0, 0},
+    grey{120, 120, 120};
+Rgb palette(std::size_t i);
+
+struct Line {
+  std::vector<double> x, y;
+  std::string label;  // empty: not in the legend
+  Rgb colour = blue;
+  double width = 1.5;
+  bool dashed = false;
+  bool markers = false;  // a dot at each point
+};
+
+// A filled band between lo and hi (e.g. mean +/- 2 s).
+struct Band {
+  std::vector<double> x, lo, hi;
+  std::string label;
+  Rgb colour = blue;
+  double alpha = 0.2;
+};
+
+struct XyChart {
+  std::string title, x_label, y_label;
+  std::vector<Band> bands;
+  std::vector<Line> lines;
+  int width_pt = 760, height_pt = 380;
+  bool zero_line = false;  // a grey line at y = 0
+};
+
+// A polar plot of radial deviations around a nominal circle: each line's x is the angle in
+// degrees (counter-clockwise from the first axis), y the radial deviation in um. The
+// deviations are magnified about the nominal circle; the rings are labelled in um.
+struct PolarChart {
+  std::string title;
+  std::string first_axis = "X", second_axis = "Y";
+  std::vector<Line> traces;
+  int size_pt = 520;
+};
+
+// Throws std::runtime_error if PLplot cannot produce the SVG. Empty lines are skipped; a
+// chart with no data gives an SVG that says so.
+std::string svg(const XyChart& chart);
+std::string svg(const PolarChart& chart);
+
+}  // namespace cal::daq::report
