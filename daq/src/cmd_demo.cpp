@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <array>
 #include <boost/asio/io_context.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -223,8 +224,20 @@ int run_demo(const DemoOptions& o) {
     if (tty) fmt::print("\r\033[K");
     fmt::print("  {}\n", e);
   };
+  std::array<bool, 3> read{};  // laser, air, material have each given a reading
+  setup.on_reading = [&read](const cal::drivers::Reading& r) {
+    // The laser counts once it measures (its environment unit reads before that).
+    if (r.device < read.size() &&
+        (r.device != 0 || r.quantity == cal::drivers::Quantity::displacement_m))
+      read[r.device] = true;
+  };
   LinearRun run(io, std::move(setup));
   run.start();
+  if (!shop.wait_until([&] { return read[0] && read[1] && read[2]; })) {
+    run.stop("the simulated instruments did not all answer within 10 s");
+    fmt::print(stderr, "daq demo: the simulated instruments did not all answer within 10 s\n");
+    return 1;
+  }
   shop.run_linear(run.plan(), config.linear->feed_mm_per_min, config.linear->dwell_s);
   // What is flushed survives a crash of this process.
   shop.run_program([&] { return run.finished(); }, 20.0, [&] { capture.flush(); });

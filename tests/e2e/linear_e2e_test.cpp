@@ -72,8 +72,15 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
       io, t::make_serial(io, {.device = shop.material_device()}),
       {.poll_period = poll(1.0), .clock = clock},
       {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
+  std::array<bool, 3> read{};
+  setup.on_reading = [&read](const d::Reading& r) {
+    // The laser counts once it measures (its environment unit reads before that).
+    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
+      read[r.device] = true;
+  };
   daq::LinearRun run(io, std::move(setup));
   run.start();
+  ASSERT_TRUE(shop.wait_until([&] { return read[0] && read[1] && read[2]; }));
   shop.run_linear(run.plan(), c.linear->feed_mm_per_min, c.linear->dwell_s);
   shop.run_program([&] { return run.finished(); }, 30.0);
   ASSERT_TRUE(run.finished());

@@ -152,6 +152,13 @@ bool SimulatedShop::run_program(const std::function<bool()>& done, double margin
   return done();
 }
 
+bool SimulatedShop::wait_until(const std::function<bool()>& ready, double wall_s) {
+  const auto limit = std::chrono::steady_clock::now() + std::chrono::duration<double>(wall_s);
+  while (!ready() && std::chrono::steady_clock::now() < limit)
+    impl_->io.run_for(std::chrono::milliseconds(5));
+  return ready();
+}
+
 std::vector<cal::iso230_2::Measurement> SimulatedShop::true_measurements(
     const cal::iso230_2::Plan& p) const {
   std::vector<cal::iso230_2::Measurement> out;

@@ -71,6 +71,11 @@ class SimulatedShop {
   // Returns done().
   bool run_program(const std::function<bool()>& done, double margin_wall_s,
                    const std::function<void()>& each = {});
+  // Runs the event loop until `ready()` (e.g. every instrument has read once) or wall_s of
+  // wall time pass; returns ready(). Start a program only then, as an operator would: the
+  // first approach move of a program started while the laser still connects goes unseen,
+  // and its first stop cannot be captured.
+  bool wait_until(const std::function<bool()>& ready, double wall_s = 10.0);
   // The truth of a plan: the noise-free deviations at its stops, for the same evaluation.
   std::vector<cal::iso230_2::Measurement> true_measurements(const cal::iso230_2::Plan& p) const;
 

@@ -1,0 +1,102 @@
+"""A minimal W3C WebDriver client (standard library only) for Debian's chromium-driver.
+
+Used by the report rendering test and the live page end-to-end test: start chromedriver,
+open a headless Chromium session, load pages, run scripts, take screenshots.
+"""
+import base64
+import json
+import os
+import shutil
+import socket
+import subprocess
+import time
+import urllib.error
+import urllib.request
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Browser:
+    def __init__(self, width=1200, height=900):
+        driver = shutil.which("chromedriver") or "/usr/lib/chromium/chromedriver"
+        browser = os.environ.get("CALDAQ_CHROMIUM") or shutil.which("chromium")
+        if not os.path.exists(driver) or not browser:
+            raise RuntimeError("chromium and chromium-driver are needed (Debian packages)")
+        self.port = _free_port()
+        self.proc = subprocess.Popen([driver, f"--port={self.port}"],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.base = f"http://127.0.0.1:{self.port}"
+        deadline = time.time() + 20
+        while True:
+            try:
+                self._call("GET", "/status")
+                break
+            except (urllib.error.URLError, ConnectionError):
+                if time.time() > deadline:
+                    raise RuntimeError("chromedriver did not start")
+                time.sleep(0.1)
+        args = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                f"--window-size={width},{height}"]
+        caps = {"capabilities": {"alwaysMatch": {
+            "browserName": "chrome",
+            "goog:chromeOptions": {"binary": browser, "args": args}}}}
+        self.session = self._call("POST", "/session", caps)["sessionId"]
+
+    def _call(self, method, path, body=None):
+        data = None if body is None else json.dumps(body).encode()
+        req = urllib.request.Request(self.base + path, data=data, method=method,
+                                     headers={"Content-Type": "application/json"})
+        try:
+            with urllib.request.urlopen(req, timeout=60) as r:
+                return json.loads(r.read() or b"{}").get("value")
+        except urllib.error.HTTPError as e:
+            raise RuntimeError(f"webdriver {method} {path}: {e.read().decode()[:500]}") from None
+
+    def get(self, url):
+        self._call("POST", f"/session/{self.session}/url", {"url": url})
+
+    def js(self, script, *args):
+        return self._call("POST", f"/session/{self.session}/execute/sync",
+                          {"script": script, "args": list(args)})
+
+    def screenshot(self, path):
+        png = base64.b64decode(self._call("GET", f"/session/{self.session}/screenshot"))
+        with open(path, "wb") as f:
+            f.write(png)
+        return png
+
+    def wait(self, script, timeout_s=20, what="condition"):
+        deadline = time.time() + timeout_s
+        while time.time() < deadline:
+            value = self.js(script)
+            if value:
+                return value
+            time.sleep(0.1)
+        raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+
+    def close(self):
+        try:
+            self._call("DELETE", f"/session/{self.session}")
+        except Exception:
+            pass
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def png_size(png):
+    """Width and height from a PNG's IHDR chunk."""
+    assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    return int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
