@@ -27,6 +27,8 @@ void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 void add_circle_commands(CLI::App& app, CLI::App& analyse);
 // compensate
 void add_compensate_commands(CLI::App& app, CLI::App& analyse);
+// serve: the live web readout and its API
+void add_serve_command(CLI::App& app);
 // report: HTML/PDF reports of stored runs
 void add_report_command(CLI::App& app);
 

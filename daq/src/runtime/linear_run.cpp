@@ -31,14 +31,16 @@ std::string to_json_text(const LiveState& s) {
            {"unit", "µm"},
            {"decimals", 2},
            {"position_mm", s.position_mm}}},
-         {"air",
-          {{"temperature_degc", s.air_temperature_degc},
-           {"pressure_pa", s.pressure_pa},
-           {"humidity_pct", s.humidity_pct},
-           {"n", s.n}}},
-         {"material_degc", s.material_degc},
-         {"factor_ppm", s.factor_ppm},
          {"fallback", s.fallback}};
+  // Until the first air sample the compensation is not known: no numbers rather than zeros.
+  if (s.pressure_pa > 0) {
+    j["air"] = {{"temperature_degc", s.air_temperature_degc},
+                {"pressure_pa", s.pressure_pa},
+                {"humidity_pct", s.humidity_pct},
+                {"n", s.n}};
+    j["material_degc"] = s.material_degc;
+    j["factor_ppm"] = s.factor_ppm;
+  }
   if (s.progress.next_position_mm) {
     j["target"] = {{"index", s.progress.target},
                    {"count", s.progress.targets},
