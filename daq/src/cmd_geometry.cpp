@@ -11,6 +11,7 @@
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
 #include "commands.hpp"
+#include "report/report.hpp"
 
 namespace daq {
 namespace {
@@ -59,13 +60,25 @@ std::map<std::string, std::vector<double>> read_columns(const std::string& path,
 struct StraightnessOptions {
   std::string input;
   std::string reference = "lsq";
+  std::string report;
   bool json = false;
 };
+
+void write_report(const std::string& path, const std::string& html) {
+  std::ofstream out(path, std::ios::binary);
+  if (!(out << html) || !(out.close(), out))
+    throw cal::InputError(fmt::format("{}: cannot write the report", path));
+  fmt::print(stderr, "report written to {}\n", path);
+}
 
 void run_straightness(const StraightnessOptions& o) {
   auto cols = read_columns(o.input, {"position_mm", "deviation_um"});
   const auto ref = cal::straightness::reference_from_string(o.reference);
   const auto r = cal::straightness::evaluate(cols["position_mm"], cols["deviation_um"], ref);
+  if (!o.report.empty())
+    write_report(o.report, cal::daq::report::straightness_report(
+                               {o.input, cols["position_mm"], cols["deviation_um"]},
+                               {.software = "daq 0.1.0"}));
   if (o.json) {
     json j{{"schema", "caldaq.straightness.v1"},
            {"standard", "ISO 230-1:2012"},
@@ -91,6 +104,7 @@ struct SquarenessOptions {
   double x_mm = 0, y_mm = 0, d1_um = 0, d2_um = 0;  // diagonal
   std::string circle;                               // circle CSV
   double radius_mm = 0;
+  std::string report;
   bool json = false;
 };
 
@@ -105,6 +119,13 @@ void run_squareness(const SquarenessOptions& o) {
     r = cal::squareness::from_straightness({a["position_mm"], a["deviation_um"]},
                                            {b["position_mm"], b["deviation_um"]}, o.square_error);
     how = "two straightness runs (least-squares lines)";
+    if (!o.report.empty())
+      write_report(o.report, cal::daq::report::squareness_report(
+                                 {o.along_a, a["position_mm"], a["deviation_um"]},
+                                 {o.along_b, b["position_mm"], b["deviation_um"]}, o.square_error,
+                                 {.software = "daq 0.1.0"}));
+  } else if (!o.report.empty()) {
+    throw cal::InputError("squareness --report draws the two runs of --method straightness");
   } else if (o.method == "diagonal") {
     r = cal::squareness::from_diagonals(o.x_mm, o.y_mm, o.d1_um, o.d2_um);
     how = "ISO 230-6 diagonal displacement test";
@@ -143,6 +164,8 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
       analyse.add_subcommand("straightness", "Straightness of an axis (ISO 230-1 reference lines)");
   st->add_option("-i,--input", s->input, "CSV: position_mm, deviation_um")->required();
   st->add_option("-r,--reference", s->reference, "lsq, endpoint or minzone")->capture_default_str();
+  st->add_option("--report", s->report,
+                 "Also write an HTML report with the deviations and all three reference lines");
   st->add_flag("--json", s->json, "Print caldaq.straightness.v1 JSON");
   st->callback([s] { run_straightness(*s); });
 
@@ -160,6 +183,8 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   sq->add_option("--d2-um", q->d2_um, "diagonal: length error of the (0,0)-(X,Y) diagonal");
   sq->add_option("--circle", q->circle, "circle: CSV angle_deg, deviation_um");
   sq->add_option("--radius-mm", q->radius_mm, "circle: radius");
+  sq->add_option("--report", q->report,
+                 "straightness: also write an HTML report with both runs and their lines");
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
   sq->callback([q] { run_squareness(*q); });
 }

@@ -14,8 +14,6 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "cal/storage/store.hpp"
-
 #include "cal/analysis/error.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/daq/gcode.hpp"
@@ -23,6 +21,7 @@
 #include "cal/drivers/transport/hid.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
+#include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
@@ -328,10 +327,9 @@ class Service {
 
   // The page shows this between runs.
   void publish_idle(const std::string& message) {
-    server_->publish(nlohmann::json{{"schema", "caldaq.live.v1"},
-                                    {"state", "idle"},
-                                    {"message", message}}
-                         .dump());
+    server_->publish(
+        nlohmann::json{{"schema", "caldaq.live.v1"}, {"state", "idle"}, {"message", message}}
+            .dump());
   }
   std::uint16_t port() const { return server_->port(); }
   void shutdown() {
@@ -371,7 +369,8 @@ class Service {
 
   web::Response start(const std::string& body) {
     if (running())
-      return {409, nlohmann::json{{"error", fmt::format("run {} is still running", run_id_)}}.dump()};
+      return {409,
+              nlohmann::json{{"error", fmt::format("run {} is still running", run_id_)}}.dump()};
     const auto req = nlohmann::json::parse(body.empty() ? "{}" : body, nullptr, false);
     const std::string test = req.is_object() ? req.value("test", "linear") : "";
     try {
@@ -429,13 +428,14 @@ class Service {
     const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
-    CircleRunSetup setup{.config = config_,
-                         .program = program,
-                         .analysis = analysis,
-                         .database = database_path(o_.run.db),
-                         .ballbar = make_instrument(io_, specs[0], make_transport(io_, dc),
-                                                    instrument_options(dc, o_.run, capture_->recorder.get())),
-                         .capture_path = capture_->absolute_path(path)};
+    CircleRunSetup setup{
+        .config = config_,
+        .program = program,
+        .analysis = analysis,
+        .database = database_path(o_.run.db),
+        .ballbar = make_instrument(io_, specs[0], make_transport(io_, dc),
+                                   instrument_options(dc, o_.run, capture_->recorder.get())),
+        .capture_path = capture_->absolute_path(path)};
     setup.on_live = [this](const CircleLive& s) { server_->publish(to_json_text(s)); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
@@ -450,7 +450,8 @@ class Service {
   void finish() {
     const bool complete = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
-    last_ = nlohmann::json{{"run", run_id_}, {"test", test_}, {"complete", complete}, {"reason", reason}};
+    last_ = nlohmann::json{
+        {"run", run_id_}, {"test", test_}, {"complete", complete}, {"reason", reason}};
     if (capture_ && capture_->writer) capture_->writer->close();
     fmt::print("run {} {}{}\n", run_id_, complete ? "complete" : "stopped: ", reason);
     std::fflush(stdout);
@@ -534,7 +535,8 @@ void add_serve_command(CLI::App& app) {
       "serve",
       "Serve the live readout page and an HTTP/WebSocket API that starts and stops runs of the "
       "configured test (docs/web.md)");
-  cmd->add_option("-c,--config", o->run.config, "Machine/campaign TOML (docs/config.md)")->required();
+  cmd->add_option("-c,--config", o->run.config, "Machine/campaign TOML (docs/config.md)")
+      ->required();
   add_db_option(*cmd, o->run.db);
   cmd->add_option("--address", o->address, "Listen address; not loopback only with --token")
       ->capture_default_str();

@@ -11,6 +11,8 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
+#include "cal/analysis/squareness.hpp"
+#include "cal/analysis/straightness.hpp"
 #include "cal/analysis/uncertainty.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
@@ -804,6 +806,113 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
   body += figure(svg(trend), "Each result of the standard against the date of its run.");
   return page(fmt::format("Comparison: {} test of axis {}", first.run.kind, first.run.axis), body,
               o);
+}
+
+namespace {
+
+struct Lines {
+  std::vector<Line> lines;
+  std::vector<std::vector<std::string>> rows;
+};
+
+// The profile and its reference lines: least squares and end point as lines, the minimum zone
+// as its two parallel bounding lines.
+Lines reference_lines(const Profile& p, std::size_t colour, std::string_view prefix) {
+  namespace sl = cal::straightness;
+  Lines out;
+  double lo = INFINITY, hi = -INFINITY;
+  for (double x : p.position_mm) lo = std::min(lo, x), hi = std::max(hi, x);
+  out.lines.push_back({.x = p.position_mm,
+                       .y = p.deviation_um,
+                       .label = std::string(prefix) + "measured",
+                       .colour = palette(colour),
+                       .width = 1.6,
+                       .markers = true});
+  const struct {
+    sl::Reference ref;
+    Rgb colour;
+    const char* name;
+  } refs[] = {{sl::Reference::least_squares, grey, "least squares"},
+              {sl::Reference::end_point, orange, "end point"},
+              {sl::Reference::minimum_zone, green, "minimum zone"}};
+  for (const auto& r : refs) {
+    const auto res = sl::evaluate(p.position_mm, p.deviation_um, r.ref);
+    const auto at = [&](double x_mm, double offset) {
+      return res.intercept_um + res.slope_um_per_m * x_mm * 1e-3 + offset;
+    };
+    const double rmin = *std::min_element(res.residual_um.begin(), res.residual_um.end());
+    const double rmax = *std::max_element(res.residual_um.begin(), res.residual_um.end());
+    if (r.ref == sl::Reference::minimum_zone) {
+      for (const double off : {rmin, rmax})
+        out.lines.push_back({.x = {lo, hi},
+                             .y = {at(lo, off), at(hi, off)},
+                             .label = off == rmin ? std::string(prefix) + r.name : "",
+                             .colour = r.colour,
+                             .width = 1.0,
+                             .dashed = true});
+    } else {
+      out.lines.push_back({.x = {lo, hi},
+                           .y = {at(lo, 0), at(hi, 0)},
+                           .label = std::string(prefix) + r.name,
+                           .colour = r.colour,
+                           .width = 1.0});
+    }
+    out.rows.push_back({std::string(prefix) + r.name, um(res.straightness_um),
+                        fmt::format("{:.3f}", res.slope_um_per_m), um(res.intercept_um)});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string straightness_report(const Profile& p, const Options& o) {
+  const auto l = reference_lines(p, 0, "");
+  std::string body = fmt::format(
+      "<p class=\"standard\">Straightness by <strong>ISO 230-1:2012</strong> from {} points "
+      "measured in <code>{}</code>: the range of the deviations from each reference line.</p>\n",
+      p.position_mm.size(), esc(p.source));
+  body += table({"reference line", "straightness (µm)", "slope (µm/m)", "intercept (µm)"}, l.rows,
+                "num results", "lrrr");
+  body += figure(svg(XyChart{.title = "Straightness deviations and reference lines",
+                             .x_label = "position (mm)",
+                             .y_label = "deviation (µm)",
+                             .lines = l.lines}),
+                 "The measured deviations with the least-squares and end-point lines, and the two "
+                 "parallel lines of the minimum zone (dashed) that enclose every point.");
+  return page("Straightness", body, o);
+}
+
+std::string squareness_report(const Profile& a, const Profile& b, double square_error,
+                              const Options& o) {
+  const auto r = cal::squareness::from_straightness({a.position_mm, a.deviation_um},
+                                                    {b.position_mm, b.deviation_um}, square_error);
+  const auto la = reference_lines(a, 0, "A: "), lb = reference_lines(b, 1, "B: ");
+  std::string body = fmt::format(
+      "<p class=\"standard\">Squareness by <strong>ISO 230-1:2012</strong> from two straightness "
+      "runs against one square: <code>{}</code> moving A (deviation in +B) and <code>{}</code> "
+      "moving B (deviation in +A); the square's own error {:+.3f} µm/m is removed.</p>\n",
+      esc(a.source), esc(b.source), square_error);
+  body += table({"result", "value", ""},
+                {{"squareness", fmt::format("{:+.3f} µm/m", r.squareness_um_per_m),
+                  "positive: the angle between the positive axis directions exceeds 90°"},
+                 {"", fmt::format("{:+.3f}″", r.arcsec()), "arc seconds"}},
+                "num results", "lrl");
+  auto rows = la.rows;
+  rows.insert(rows.end(), lb.rows.begin(), lb.rows.end());
+  body += "<h3>The two runs</h3>\n" +
+          table({"run, reference line", "straightness (µm)", "slope (µm/m)", "intercept (µm)"},
+                rows, "num", "lrrr");
+  body += figure(svg(XyChart{.title = "Run A: deviation in +B while A moves",
+                             .x_label = "position along A (mm)",
+                             .y_label = "deviation (µm)",
+                             .lines = la.lines}),
+                 "The slope of the least-squares line of each run enters the squareness.");
+  body += figure(svg(XyChart{.title = "Run B: deviation in +A while B moves",
+                             .x_label = "position along B (mm)",
+                             .y_label = "deviation (µm)",
+                             .lines = lb.lines}),
+                 "The second run, with its reference lines.");
+  return page("Squareness", body, o);
 }
 
 }  // namespace cal::daq::report

@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace cal::storage {
 class Store;
@@ -27,5 +28,17 @@ std::string campaign_report(const storage::Store& store, std::span<const std::in
                             std::string_view title, const Options& o = {});
 std::string comparison_report(const storage::Store& store, std::span<const std::int64_t> runs,
                               const Options& o = {});
+
+// Straightness and squareness are analysed from measured profiles (CSV files, not stored
+// runs): the report shows the deviations with the ISO 230-1 reference lines.
+struct Profile {
+  std::string source;  // the file it came from
+  std::vector<double> position_mm, deviation_um;
+};
+// All three reference lines (least squares, end point, minimum zone).
+std::string straightness_report(const Profile& p, const Options& o = {});
+// Two straightness runs against one square: A moving (deviation in +B), B moving (in +A).
+std::string squareness_report(const Profile& along_a, const Profile& along_b,
+                              double square_error_um_per_m, const Options& o = {});
 
 }  // namespace cal::daq::report
