@@ -36,4 +36,8 @@ check status_api 0 "\"running\":false.*\"tests\":\[\"linear\"" -- python3 -c "im
 check live_page 0 "live page: run 1" -- python3 "$TESTS/web/live_page_test.py" "$URL" "$TMP/live.png"
 check served_log 0 "run 1 stopped: stopped from the web page" -- cat "$TMP/serve.log"
 check stored 0 "aborted" -- "$DAQ" runs --db "$TMP/serve.sqlite"
+# The stopped run has too few stops to evaluate: its report says so and shows what was stored.
+check report_of_aborted 0 "written to $TMP/r.html" -- "$DAQ" report 1 --db "$TMP/serve.sqlite" -o "$TMP/r.html"
+check report_says_why 0 "The results cannot be evaluated: .*run 1" -- cat "$TMP/r.html"
+check report_status 0 "This run is aborted \(stopped from the web page\)" -- cat "$TMP/r.html"
 finish

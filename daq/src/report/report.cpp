@@ -341,7 +341,13 @@ Linear evaluate_linear(const st::Store& store, const RunView& v, const Options& 
                                       store.path().string(), v.run.id));
   const std::string key =
       !o.standard.empty() ? o.standard : v.settings.value("standard", "iso230-2:2014");
-  l.e = cal::iso230_2::evaluate(measurements(l.targets), cal::iso230_2::standard_from_string(key));
+  try {
+    l.e = cal::iso230_2::evaluate(measurements(l.targets),
+                                  cal::iso230_2::standard_from_string(key));
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.path().string(),
+                                      v.run.id, l.targets.size(), e.what()));
+  }
   return l;
 }
 
@@ -665,12 +671,20 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
         "stored.</p>\n",
         st::to_string(v.run.status), v.run.note.empty() ? "" : " (" + esc(v.run.note) + ")");
   h += setup_section(v);
-  if (v.run.kind == "linear")
-    h += linear_section(store, v, o, hl);
-  else if (v.run.kind == "circle")
-    h += circle_section(store, v, hl);
-  else
-    h += generic_section(store, v);
+  // An aborted or interrupted run may hold too little to evaluate: the report still shows what
+  // was stored, and says why there are no results.
+  try {
+    if (v.run.kind == "linear")
+      h += linear_section(store, v, o, hl);
+    else if (v.run.kind == "circle")
+      h += circle_section(store, v, hl);
+    else
+      h += generic_section(store, v);
+  } catch (const cal::InputError& e) {
+    h += fmt::format("<h3>Results</h3>\n<p class=\"warning\">The results cannot be evaluated: "
+                     "{}</p>\n",
+                     esc(e.what()));
+  }
   h += environment_section(v.env);
   return h;
 }
