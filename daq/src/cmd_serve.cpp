@@ -1,0 +1,255 @@
+// daq serve: the live web readout and an HTTP/WebSocket API that starts and stops runs of the
+// configured test (docs/web.md).
+#include <fmt/format.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "cal/analysis/error.hpp"
+#include "cal/storage/store.hpp"
+#include "circle_run.hpp"
+#include "commands.hpp"
+#include "database.hpp"
+#include "linear_run.hpp"
+#include "run_setup.hpp"
+#include "web/assets.hpp"
+#include "web/server.hpp"
+
+namespace daq {
+namespace {
+
+namespace web = cal::daq::web;
+using namespace std::chrono_literals;
+
+struct ServeOptions {
+  RunOptions run;  // config, db, give_up_after
+  std::string address = "127.0.0.1", token, capture_dir;
+  std::uint16_t port = 8080;
+};
+
+// One run at a time on the service's event loop; its live state is pushed to the page (about
+// 10 Hz, the latest state only, so a 10 kHz stream cannot make it fall behind).
+class Service {
+ public:
+  Service(boost::asio::io_context& io, ServeOptions o)
+      : io_(io), o_(std::move(o)), config_(cal::daq::load_config(o_.run.config)), check_(io) {
+    try {
+      make_server();
+    } catch (const std::invalid_argument& e) {
+      throw cal::InputError(fmt::format("daq serve: {}", e.what()));
+    }
+    publish_idle("no run: start one");
+    tick();
+  }
+
+  void make_server() {
+    server_ = std::make_unique<web::LiveServer>(
+        io_, web::ServerOptions{.address = o_.address, .port = o_.port, .token = o_.token},
+        web::Api{.page = [] { return web::live_page(); },
+                 .runs = [this] { return runs(); },
+                 .status = [this] { return web::Response{.body = status().dump()}; },
+                 .start = [this](const std::string& body) { return start(body); },
+                 .stop = [this] { return stop("stopped from the web page"); }});
+  }
+
+  // The page shows this between runs.
+  void publish_idle(const std::string& message) {
+    server_->publish(
+        nlohmann::json{{"schema", "caldaq.live.v1"}, {"state", "idle"}, {"message", message}}
+            .dump());
+  }
+  std::uint16_t port() const { return server_->port(); }
+  void shutdown() {
+    if (running()) stop("the service was stopped");
+    check_.cancel();
+    server_.reset();
+  }
+
+ private:
+  bool running() const { return linear_ || circle_; }
+
+  web::Response runs() const {
+    cal::storage::Store store(database_path(o_.run.db));
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& r : store.runs())
+      list.push_back({{"id", r.id},
+                      {"kind", r.kind},
+                      {"axis", r.axis},
+                      {"campaign", r.campaign},
+                      {"status", cal::storage::to_string(r.status)},
+                      {"started_unix_ms", r.started_unix_ms},
+                      {"note", r.note}});
+    return {.body = nlohmann::json{{"schema", "caldaq.runs.v1"}, {"runs", list}}.dump()};
+  }
+
+  nlohmann::json status() const {
+    nlohmann::json j{{"schema", "caldaq.status.v1"},
+                     {"running", running()},
+                     {"config", o_.run.config},
+                     {"tests", nlohmann::json::array()}};
+    if (config_.linear) j["tests"].push_back("linear");
+    if (config_.circle) j["tests"].push_back("circle");
+    if (running()) j["run"] = {{"id", run_id_}, {"test", test_}};
+    if (last_) j["last"] = *last_;
+    return j;
+  }
+
+  web::Response start(const std::string& body) {
+    if (running())
+      return {409,
+              nlohmann::json{{"error", fmt::format("run {} is still running", run_id_)}}.dump()};
+    const auto req = nlohmann::json::parse(body.empty() ? "{}" : body, nullptr, false);
+    const std::string test = req.is_object() ? req.value("test", "linear") : "";
+    try {
+      if (test == "linear")
+        start_linear();
+      else if (test == "circle")
+        start_circle();
+      else
+        return {400, nlohmann::json{{"error", "give {\"test\": \"linear\"} or \"circle\""}}.dump()};
+    } catch (const std::exception& e) {
+      linear_.reset(), circle_.reset(), capture_.reset();
+      return {400, nlohmann::json{{"error", e.what()}}.dump()};
+    }
+    test_ = test;
+    return {202, nlohmann::json{{"run", run_id_}, {"test", test}}.dump()};
+  }
+
+  web::Response stop(const std::string& why) {
+    if (!running()) return {409, nlohmann::json{{"error", "no run is running"}}.dump()};
+    if (linear_) linear_->stop(why);
+    if (circle_) circle_->stop(why);
+    finish();
+    return {.body = nlohmann::json{{"stopped", last_->at("run")}}.dump()};
+  }
+
+  std::string capture_path() const {
+    if (o_.capture_dir.empty()) return {};
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count();
+    return (std::filesystem::path(o_.capture_dir) / fmt::format("serve-{}.cdq", ms)).string();
+  }
+
+  void start_linear() {
+    const auto specs = linear_specs(config_);
+    const auto path = capture_path();
+    capture_ = std::make_unique<SessionCapture>(path, config_, specs);
+    LinearRunSetup setup;
+    setup.config = config_;
+    setup.database = database_path(o_.run.db);
+    setup.capture_path = capture_->absolute_path(path);
+    add_linear_instruments(io_, config_, specs, o_.run, capture_->recorder.get(), setup);
+    setup.on_live = [this](const LiveState& s) { server_->publish(to_json_text(s)); };
+    setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
+    linear_ = std::make_unique<LinearRun>(io_, std::move(setup));
+    linear_->start();
+    run_id_ = linear_->outcome().run_id;
+    fmt::print("run {} (linear) started from the web page\n", run_id_);
+    std::fflush(stdout);
+  }
+
+  void start_circle() {
+    const auto [program, analysis] = circle_test(config_);
+    const auto& dc = need(config_, "ballbar");
+    const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
+    const auto path = capture_path();
+    capture_ = std::make_unique<SessionCapture>(path, config_, specs);
+    CircleRunSetup setup{
+        .config = config_,
+        .program = program,
+        .analysis = analysis,
+        .database = database_path(o_.run.db),
+        .ballbar = make_instrument(io_, specs[0], make_transport(io_, dc),
+                                   instrument_options(dc, o_.run, capture_->recorder.get())),
+        .capture_path = capture_->absolute_path(path)};
+    setup.on_live = [this](const CircleLive& s) { server_->publish(to_json_text(s)); };
+    setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
+    circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
+    circle_->start();
+    run_id_ = circle_->outcome().run_id;
+    fmt::print("run {} (circle) started from the web page\n", run_id_);
+    std::fflush(stdout);
+  }
+
+  // A run ends by itself (all stops, both arcs) or is stopped: keep its outcome, close its
+  // capture, and accept the next start.
+  void finish() {
+    const bool complete = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
+    const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
+    last_ = nlohmann::json{
+        {"run", run_id_}, {"test", test_}, {"complete", complete}, {"reason", reason}};
+    if (capture_ && capture_->writer) capture_->writer->close();
+    fmt::print("run {} {}{}\n", run_id_, complete ? "complete" : "stopped: ", reason);
+    std::fflush(stdout);
+    linear_.reset(), circle_.reset(), capture_.reset();
+    publish_idle(fmt::format("run {} {}{}", run_id_, complete ? "complete" : "stopped: ", reason));
+  }
+
+  void tick() {
+    check_.expires_after(200ms);
+    check_.async_wait([this](const boost::system::error_code& ec) {
+      if (ec) return;
+      if ((linear_ && linear_->finished()) || (circle_ && circle_->finished())) finish();
+      if (capture_ && capture_->writer) capture_->writer->flush();
+      tick();
+    });
+  }
+
+  boost::asio::io_context& io_;
+  ServeOptions o_;
+  cal::daq::Config config_;
+  boost::asio::steady_timer check_;
+  std::unique_ptr<web::LiveServer> server_;
+  std::unique_ptr<SessionCapture> capture_;
+  std::unique_ptr<LinearRun> linear_;
+  std::unique_ptr<CircleRun> circle_;
+  std::int64_t run_id_ = 0;
+  std::string test_;
+  std::optional<nlohmann::json> last_;
+};
+
+void serve(const ServeOptions& o) {
+  boost::asio::io_context io;
+  Service service(io, o);
+  fmt::print("daq serve: http://{}:{}/ ({}), runs in {}; Ctrl-C stops\n", o.address, service.port(),
+             o.run.config, database_path(o.run.db).string());
+  std::fflush(stdout);
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](auto ec, int) {
+    if (ec) return;
+    service.shutdown();
+    io.stop();
+  });
+  io.run();
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app) {
+  auto o = std::make_shared<ServeOptions>();
+  auto* cmd = app.add_subcommand(
+      "serve",
+      "Serve the live readout page and an HTTP/WebSocket API that starts and stops runs of the "
+      "configured test (docs/web.md)");
+  cmd->add_option("-c,--config", o->run.config, "Machine/campaign TOML (docs/config.md)")
+      ->required();
+  add_db_option(*cmd, o->run.db);
+  cmd->add_option("--address", o->address, "Listen address; not loopback only with --token")
+      ->capture_default_str();
+  cmd->add_option("--port", o->port, "TCP port (0: any free port)")->capture_default_str();
+  cmd->add_option("--token", o->token, "Required from every client (Bearer or ?token=)");
+  cmd->add_option("--capture-dir", o->capture_dir, "Record each run's capture in this directory");
+  cmd->add_option("--give-up-after", o->run.give_up_after,
+                  "Reconnection attempts before a device is given up")
+      ->capture_default_str();
+  cmd->callback([o] { serve(*o); });
+}
+
+}  // namespace daq
