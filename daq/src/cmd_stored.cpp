@@ -30,16 +30,6 @@ st::RunRecord linear_run(const st::Store& store, std::int64_t id) {
   return *r;
 }
 
-std::vector<cal::iso230_2::Measurement> measurements(const std::vector<st::CapturedTarget>& ts) {
-  std::vector<cal::iso230_2::Measurement> out;
-  for (const auto& t : ts)
-    out.push_back(
-        {t.nominal_mm, t.run_number,
-         t.direction == '+' ? cal::iso230_2::Direction::up : cal::iso230_2::Direction::down,
-         t.deviation_um});
-  return out;
-}
-
 struct AnalyseRunOptions {
   std::string db;
   std::int64_t run = 0;

@@ -101,4 +101,15 @@ void print(const cal::unc::Budget& b, double length_m) {
   for (const auto& w : b.warnings) fmt::print("warning: {}\n", w);
 }
 
+std::vector<cal::iso230_2::Measurement> measurements(
+    const std::vector<cal::storage::CapturedTarget>& targets) {
+  std::vector<cal::iso230_2::Measurement> out;
+  for (const auto& t : targets)
+    out.push_back(
+        {t.nominal_mm, t.run_number,
+         t.direction == '+' ? cal::iso230_2::Direction::up : cal::iso230_2::Direction::down,
+         t.deviation_um});
+  return out;
+}
+
 }  // namespace daq

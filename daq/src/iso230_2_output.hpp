@@ -4,6 +4,7 @@
 
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/uncertainty.hpp"
+#include "cal/storage/store.hpp"
 
 namespace daq {
 
@@ -12,5 +13,8 @@ nlohmann::json to_json(const cal::iso230_2::Plan& p);        // schema caldaq.pl
 nlohmann::json to_json(const cal::unc::Budget& b);
 void print(const cal::iso230_2::Evaluation& e);
 void print(const cal::unc::Budget& b, double length_m);
+// The stored captured stops of a run as the deviations ISO 230-2 evaluates.
+std::vector<cal::iso230_2::Measurement> measurements(
+    const std::vector<cal::storage::CapturedTarget>& targets);
 
 }  // namespace daq

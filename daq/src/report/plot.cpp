@@ -14,6 +14,30 @@
 
 namespace cal::daq::report {
 
+std::string html_escape(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
 Rgb palette(std::size_t i) {
   static constexpr Rgb colours[] = {blue, vermilion, green, orange, purple, sky, black, grey};
   return colours[i % std::size(colours)];
@@ -72,31 +96,8 @@ class SvgStream {
       const auto end = a == std::string::npos ? a : s.find('"', a + std::strlen(attr));
       if (end != std::string::npos) s.erase(a, end + 1 - a);
     }
-    s.insert(4, fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", escape(title)));
+    s.insert(4, fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", html_escape(title)));
     return s;
-  }
-
-  static std::string escape(std::string_view s) {
-    std::string out;
-    for (char c : s) {
-      switch (c) {
-        case '<':
-          out += "&lt;";
-          break;
-        case '>':
-          out += "&gt;";
-          break;
-        case '&':
-          out += "&amp;";
-          break;
-        case '"':
-          out += "&quot;";
-          break;
-        default:
-          out += c;
-      }
-    }
-    return out;
   }
 
  private:

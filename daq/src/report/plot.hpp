@@ -4,6 +4,7 @@
 // PLplot keeps global state: call these from one thread at a time.
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace cal::daq::report {
@@ -53,6 +54,9 @@ struct PolarChart {
   std::vector<Line> traces;
   int size_pt = 520;
 };
+
+// Text for HTML and SVG: < > & " escaped.
+std::string html_escape(std::string_view s);
 
 // Throws std::runtime_error if PLplot cannot produce the SVG. Empty lines are skipped; a
 // chart with no data gives an SVG that says so.

@@ -31,29 +31,7 @@ using Q = cal::drivers::Quantity;
 
 // --- HTML helpers ----------------------------------------------------------------------------
 
-std::string esc(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+std::string esc(std::string_view s) { return html_escape(s); }
 
 std::string um(double v) { return fmt::format("{:.3f}", v); }
 
@@ -319,16 +297,6 @@ struct Headline {
 // --- ISO 230-2
 // ------------------------------------------------------------------------------------
 
-std::vector<cal::iso230_2::Measurement> measurements(const std::vector<st::CapturedTarget>& ts) {
-  std::vector<cal::iso230_2::Measurement> out;
-  for (const auto& t : ts)
-    out.push_back(
-        {t.nominal_mm, t.run_number,
-         t.direction == '+' ? cal::iso230_2::Direction::up : cal::iso230_2::Direction::down,
-         t.deviation_um});
-  return out;
-}
-
 struct Linear {
   std::vector<st::CapturedTarget> targets;
   cal::iso230_2::Evaluation e;
@@ -342,7 +310,7 @@ Linear evaluate_linear(const st::Store& store, const RunView& v, const Options& 
   const std::string key =
       !o.standard.empty() ? o.standard : v.settings.value("standard", "iso230-2:2014");
   try {
-    l.e = cal::iso230_2::evaluate(measurements(l.targets),
+    l.e = cal::iso230_2::evaluate(::daq::measurements(l.targets),
                                   cal::iso230_2::standard_from_string(key));
   } catch (const cal::InputError& e) {
     throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.path().string(),
@@ -681,9 +649,10 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
     else
       h += generic_section(store, v);
   } catch (const cal::InputError& e) {
-    h += fmt::format("<h3>Results</h3>\n<p class=\"warning\">The results cannot be evaluated: "
-                     "{}</p>\n",
-                     esc(e.what()));
+    h += fmt::format(
+        "<h3>Results</h3>\n<p class=\"warning\">The results cannot be evaluated: "
+        "{}</p>\n",
+        esc(e.what()));
   }
   h += environment_section(v.env);
   return h;
