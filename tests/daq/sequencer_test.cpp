@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "cal/daq/trigger.hpp"
+
 namespace {
 
 using namespace cal::daq;
@@ -85,6 +87,57 @@ TEST(Sequencer, ReportsMissedExtraWrongDirectionAndOutOfOrder) {
   EXPECT_EQ(ev[0].message, "out of order: target 2 (50.000 mm) run 1 up");
   EXPECT_TRUE(s.stops()[1].captured);
   EXPECT_EQ(s.progress().captured, 4u);
+}
+
+// What the trigger watches (linear_run.cpp: expect_any(acceptable_mm())): the rest of the pass
+// and the first stop of the next one, plus stops reported missed.
+TEST(Sequencer, AcceptablePositionsCoverThePassAndTheMissed) {
+  Sequencer s(plan(), 0.5);
+  EXPECT_EQ(s.acceptable_mm(), (std::vector<double>{0, 50, 100}));  // run 1 up + 100 down
+  s.on_capture(at(0.0, up));
+  s.on_capture(at(100.0, up));  // 50 up missed
+  // Now run 1 down (100, 50, 0) and the first of run 2 up (0), and the missed 50.
+  EXPECT_EQ(s.acceptable_mm(), (std::vector<double>{0, 50, 100}));
+  EXPECT_TRUE(s.stops()[1].missed);
+}
+
+// The failure this prevents, seen on a loaded machine: the first stop of a pass was refused
+// (approach seen from the wrong side), and a trigger that kept waiting for that one position
+// captured nothing for the rest of the pass and the next, until the machine came back to it a
+// run later, which was then labelled with the wrong run. With the trigger watching every
+// acceptable position, the next stop of the pass is captured and the refused one reported
+// missed. Positions come as readings at 100 Hz: dwell 2 s at each stop, 1 s moves.
+TEST(Sequencer, ARefusedStopDoesNotBlindTheTrigger) {
+  Sequencer seq(plan(), 0.5);
+  StabilityTrigger trigger({.tolerance_um = 1.0, .dwell_s = 1.0, .window_mm = 0.5});
+  std::int64_t t_ns = 0;
+  std::vector<SequenceEvent> events;
+  const auto feed = [&](double mm, double seconds) {
+    for (int i = 0; i < static_cast<int>(seconds * 100); ++i, t_ns += 10'000'000) {
+      trigger.expect_any(seq.acceptable_mm());
+      if (const auto c = trigger.add(t_ns, mm)) {
+        const auto e = seq.on_capture(*c);
+        events.insert(events.end(), e.begin(), e.end());
+      }
+    }
+  };
+  const auto move = [&](double from, double to) {
+    for (int i = 1; i <= 100; ++i, t_ns += 10'000'000)
+      trigger.add(t_ns, from + (to - from) * i / 100);
+  };
+  // Run 1 up should start at 0 from below; the machine comes down onto 0 from 20 mm instead:
+  // the stop is refused as approached from the wrong side.
+  feed(20.0, 0.5);
+  move(20.0, 0.0);
+  feed(0.0, 2.0);
+  move(0.0, 50.0);
+  feed(50.0, 2.0);  // run 1 up, target 2: captured, target 1 reported missed
+  ASSERT_GE(events.size(), 3u);
+  EXPECT_EQ(events[0].kind, Kind::wrong_direction) << events[0].message;
+  EXPECT_EQ(events[1].kind, Kind::missed) << events[1].message;
+  EXPECT_EQ(events[2].kind, Kind::captured) << events[2].message;
+  EXPECT_TRUE(seq.stops()[1].captured);
+  EXPECT_EQ(seq.stops()[1].run, 1);
 }
 
 }  // namespace

@@ -64,6 +64,15 @@ with Browser(width=1280, height=800) as b:
     b.js("document.getElementById('stop').click();")
     b.wait("return /stopped/.test(document.getElementById('api').textContent);",
            what="the stop to be acknowledged")
+    # A ballbar run from the same page: its state (caldaq.live-circle.v1) shows the phase.
+    b.js("document.getElementById('start-circle').click();")
+    b.wait("return /run \\d+ started/.test(document.getElementById('api').textContent) && "
+           "window.lastState && /feed-in/.test(document.getElementById('message').textContent);",
+           timeout_s=30, what="the circle run's phase on the page")
+    ok(True, "circle run: " + b.js("return document.getElementById('message').textContent;"))
+    b.js("document.getElementById('stop').click();")
+    b.wait("return /stopped/.test(document.getElementById('api').textContent);",
+           what="the circle stop to be acknowledged")
 with urllib.request.urlopen(url.rstrip("/") + "/api/runs", timeout=10) as r:
     runs = json.load(r)["runs"]
 mine = [r for r in runs if r["id"] == run_id]

@@ -152,6 +152,12 @@ struct CircleRun::Impl {
                               }});
     event(fmt::format("run {}: ballbar circle R {} mm at {} mm/min, waiting for the feed-in",
                       outcome.run_id, p.radius_mm, p.feed_mm_per_min));
+    // The live readout says the run waits even before the bar sends anything.
+    if (setup.on_live) {
+      live.state = "waiting";
+      live.phase = std::string(cal::daq::to_string(segmenter.progress().phase));
+      setup.on_live(live);
+    }
   }
 
   void on_reading(const cal::drivers::Reading& r) {

@@ -134,9 +134,17 @@ struct LinearRun::Impl {
     return static_cast<std::uint16_t>(2 + setup.material.size());
   }
 
+  // The triggers watch every position the sequencer could accept now (see acceptable_mm):
+  // after a missed stop they must still see the following ones.
   void expect_next() {
-    trigger.expect(sequencer.next_expected_mm());
-    if (position_trigger) position_trigger->expect(sequencer.next_expected_mm());
+    const auto positions = sequencer.acceptable_mm();
+    if (positions.empty()) {
+      trigger.expect(std::nullopt);
+      if (position_trigger) position_trigger->expect(std::nullopt);
+      return;
+    }
+    trigger.expect_any(positions);
+    if (position_trigger) position_trigger->expect_any(positions);
   }
 
   void event(const std::string& text) {

@@ -84,7 +84,7 @@ struct SimulatedShop::Impl {
   // two readings of the clock counts for at most kMaxWall_s: when the process is starved of
   // CPU (a loaded CI machine), the simulation pauses with it instead of running past the
   // stops while nothing reads the instruments. Every party reads this one clock.
-  static constexpr double kMaxWall_s = 0.005;
+  static constexpr double kMaxWall_s = 0.001;
   mutable double sim_s = 0.0;
   mutable std::chrono::steady_clock::time_point last = start;
   double now() const {

@@ -46,6 +46,17 @@ std::size_t Sequencer::pass_end(std::size_t i) const {
   return j;  // the first stop of the next pass (or the end)
 }
 
+std::vector<double> Sequencer::acceptable_mm() const {
+  std::vector<double> out;
+  const std::size_t limit = pass_end(next_) < stops_.size() ? pass_end(next_) + 1 : stops_.size();
+  for (std::size_t j = next_; j < limit; ++j) out.push_back(stops_[j].position_mm);
+  for (std::size_t j = 0; j < next_; ++j)
+    if (stops_[j].missed) out.push_back(stops_[j].position_mm);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
   std::vector<SequenceEvent> events;
   auto take = [&](std::size_t i, SequenceEvent::Kind kind, std::string text) {

@@ -48,6 +48,12 @@ class Sequencer {
   Sequencer(const iso230_2::Plan& plan, double window_mm);
 
   std::optional<double> next_expected_mm() const;
+  // Every position a capture could be labelled at now: the rest of the current pass, the first
+  // stop of the next pass, and the stops reported missed (sorted, no repeats). The trigger
+  // must watch all of them, not just the next one: a trigger that waits for a stop the machine
+  // has already passed sees nothing until the machine comes back there, in a later run, which
+  // would then be labelled as this one.
+  std::vector<double> acceptable_mm() const;
   std::vector<SequenceEvent> on_capture(const Capture& c);
   bool complete() const { return next_ >= stops_.size(); }
   Progress progress() const;
