@@ -437,8 +437,13 @@ std::vector<RawReading> Store::readings(std::int64_t run_id,
       out.push_back(r);
     }
   }
-  std::stable_sort(out.begin(), out.end(),
-                   [](const RawReading& a, const RawReading& b) { return a.time_ns < b.time_ns; });
+  // Time order; simultaneous readings of different devices/quantities in a fixed order, so the
+  // result does not depend on where the writer's batch boundaries fell (they differ between a
+  // live run and its replay). Within one device/channel/quantity the stored order is kept.
+  std::stable_sort(out.begin(), out.end(), [](const RawReading& a, const RawReading& b) {
+    return std::tie(a.time_ns, a.device, a.channel, a.quantity) <
+           std::tie(b.time_ns, b.device, b.channel, b.quantity);
+  });
   return out;
 }
 

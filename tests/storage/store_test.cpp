@@ -56,6 +56,31 @@ TEST(Store, CreatesTheSchemaAndReopensIt) {
   EXPECT_TRUE(again.runs().empty());
 }
 
+TEST(Store, SimultaneousReadingsComeBackInOneOrderWhateverTheBatches) {
+  // Two devices read at the same instant (an air sample and a material temperature stamped
+  // with the same capture time). Written in opposite orders and split at different batch
+  // boundaries -- as a live run and its replay may be -- they read back in the same order:
+  // by time, then device, channel, quantity.
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  const auto machine = store.add_machine({.name = "VMC-1"});
+  const RawReading air{.time_ns = 500, .device = 2, .quantity = 3, .value = 100678.0};
+  const RawReading material{.time_ns = 500, .device = 1, .quantity = 5, .value = 20.66};
+  const RawReading later{.time_ns = 600, .device = 0, .quantity = 0, .value = 1e-3};
+  const auto a = store.begin_run({.machine_id = machine, .kind = "linear", .axis = "X"});
+  store.append_readings(a, std::vector{air});
+  store.append_readings(a, std::vector{material, later});
+  const auto b = store.begin_run({.machine_id = machine, .kind = "linear", .axis = "X"});
+  store.append_readings(b, std::vector{material, air, later});
+  for (const auto run : {a, b}) {
+    const auto back = store.readings(run);
+    ASSERT_EQ(back.size(), 3u);
+    EXPECT_EQ(back[0].value, 20.66) << "run " << run;  // device 1 before device 2
+    EXPECT_EQ(back[1].value, 100678.0) << "run " << run;
+    EXPECT_EQ(back[2].value, 1e-3) << "run " << run;
+  }
+}
+
 TEST(Store, RunLifeCycleAndBitExactReadings) {
   TempDir dir;
   Store store(dir.path / "site.sqlite");
