@@ -27,7 +27,18 @@ struct SimulatedShop::Impl {
   boost::asio::io_context& io;
   ShopTruth truth;
   double speed;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  // Simulated time follows the wall clock times `speed`, but between two readings of the
+  // clock it advances by at most kMaxStep_s of simulated time: when the process is starved of
+  // CPU (a loaded CI machine), the simulation pauses with it instead of running past the stops
+  // while nothing reads the instruments. 0.05 s is below the shortest feature a run must see
+  // (a 3 mm overrun excursion at 6000 mm/min lasts about 0.1 s), and a normal event loop reads
+  // the clock far more often (every laser poll), so it binds only under starvation. Every
+  // party reads this one clock.
+  static constexpr double kMaxStep_s = 0.05;
+  // The clock's state is declared before `clock` and the twins that hold it, so it is set
+  // before any twin's constructor can read the time.
+  mutable double sim_s = 0.0;
+  mutable std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
   sim::Clock clock;
   sim::World world;
   sim::IdsTwin ids;
@@ -80,16 +91,6 @@ struct SimulatedShop::Impl {
                 {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}),
         position(ctx, world, clock) {}
 
-  // Simulated time follows the wall clock times `speed`, but between two readings of the
-  // clock it advances by at most kMaxStep_s of simulated time: when the process is starved of
-  // CPU (a loaded CI machine), the simulation pauses with it instead of running past the stops
-  // while nothing reads the instruments. 0.05 s is below the shortest feature a run must see
-  // (a 3 mm overrun excursion at 6000 mm/min lasts about 0.1 s), and a normal event loop reads
-  // the clock far more often (every laser poll), so it binds only under starvation. Every
-  // party reads this one clock.
-  static constexpr double kMaxStep_s = 0.05;
-  mutable double sim_s = 0.0;
-  mutable std::chrono::steady_clock::time_point last = start;
   double now() const {
     const auto wall = std::chrono::steady_clock::now();
     sim_s += std::min(speed * std::chrono::duration<double>(wall - last).count(), kMaxStep_s);
