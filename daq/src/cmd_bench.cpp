@@ -1,0 +1,431 @@
+// daq bench ingest: the end-to-end ingest benchmark with its ceilings measured in the same run
+// (method in docs/benchmarks.md).
+//
+//   1. A capture of `seconds` of a 10 kHz length stream (ten 13-byte gauge lines per 1 ms
+//      record, as a USB-serial gauge or interferometer delivers them) plus 1 Hz PTU300 air
+//      lines is written once.
+//   2. Each round replays it as fast as possible through the real replay bus, the real gauge
+//      and PTU300 instruments (codecs, state machines), the environmental compensation of every
+//      length reading and the batch writer into a fresh SQLite store (WAL, synchronous=FULL).
+//   3. In the same round, the two ceilings for the bytes that ingest stored:
+//      - blob insert: the very rows ingest wrote (every column, the chunk BLOBs as stored) are
+//        inserted into a fresh store with the same schema and settings, committing at the same
+//        points (one transaction per writer batch), with nothing else to do: what SQLite
+//        itself costs for those bytes;
+//      - raw write: the same BLOB bytes written to a plain file with one fdatasync per commit.
+//      The rows are read from the ingest database untimed, one commit's worth at a time.
+//   4. Also the pipeline alone (no storage) for where the time goes.
+// Rounds alternate ingest and ceilings so that a change of load on the machine touches both;
+// the fraction is the median of the per-round ratios.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sqlite3.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <boost/asio/io_context.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/error.hpp"
+#include "cal/daq/env_stage.hpp"
+#include "cal/drivers/instruments.hpp"
+#include "cal/replay/capture.hpp"
+#include "cal/replay/session.hpp"
+#include "cal/storage/store.hpp"
+#include "cal/storage/writer.hpp"
+#include "commands.hpp"
+
+namespace daq {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+long peak_rss_kib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+long current_rss_kib() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * (::sysconf(_SC_PAGESIZE) / 1024);
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void remove_db(const fs::path& p) {
+  for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
+}
+
+void write_capture(const fs::path& path, int seconds) {
+  cal::replay::CaptureWriter w(path, R"({"format": "daq bench ingest"})");
+  const auto bytes = [](const std::string& s) {
+    return std::as_bytes(std::span(s.data(), s.size()));
+  };
+  w.event(0, 0, "opened");
+  w.event(0, 1, "opened");
+  std::string chunk;
+  char line[32];
+  for (std::int64_t ms = 0; ms < seconds * 1000LL; ++ms) {
+    chunk.clear();
+    for (int k = 0; k < 10; ++k) {
+      std::snprintf(line, sizeof line, "%+011.6f\r\n",
+                    100.0 + 1e-6 * static_cast<double>((ms * 10 + k) % 977));
+      chunk += line;
+    }
+    w.record(ms * 1'000'000, 0, cal::replay::RecordKind::received, bytes(chunk));
+    if (ms % 1000 == 0)
+      w.record(ms * 1'000'000, 1, cal::replay::RecordKind::received,
+               bytes("P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n"));
+  }
+  w.close();
+}
+
+struct IngestResult {
+  std::uint64_t readings = 0;
+  double wall_s = 0.0, cpu_s = 0.0;
+  double checksum = 0.0;  // sum of the compensated lengths: the same in every round and version
+  cal::storage::WriterStats writer;
+  std::vector<std::pair<int, long>> rss_marks;  // (recorded minute, current RSS KiB)
+};
+
+// The ingest pipeline; `db` empty: the pipeline alone, readings go nowhere.
+IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t batch_readings) {
+  IngestResult res;
+  std::int64_t run = 0;
+  std::unique_ptr<cal::storage::BatchWriter> writer;
+  if (!db.empty()) {
+    run = cal::storage::Store(db).begin_run({.kind = "bench"});
+    writer = std::make_unique<cal::storage::BatchWriter>(
+        db, run, cal::storage::WriterOptions{.batch_readings = batch_readings});
+  }
+  boost::asio::io_context io;
+  cal::replay::ReplayBus bus(io, capture, 0.0);
+  cal::daq::EnvStage env({}, 0);
+  std::int64_t next_mark_ns = 600'000'000'000;
+  const auto on_reading = [&](const cal::drivers::Reading& r) {
+    ++res.readings;
+    if (writer)
+      writer->push({.time_ns = r.time_ns,
+                    .device = r.device,
+                    .channel = r.channel,
+                    .quantity = static_cast<std::uint8_t>(r.quantity),
+                    .status = static_cast<std::uint8_t>(r.status),
+                    .value = r.value});
+    switch (r.quantity) {
+      case cal::drivers::Quantity::air_temperature_degc:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
+      case cal::drivers::Quantity::air_pressure_pa:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa, r.value);
+      case cal::drivers::Quantity::air_humidity_pct:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value);
+      case cal::drivers::Quantity::length_m:
+        res.checksum += env.compensate(r.time_ns, r.value).length_m;
+        if (r.time_ns >= next_mark_ns) {
+          res.rss_marks.emplace_back(static_cast<int>(r.time_ns / 60'000'000'000),
+                                     current_rss_kib());
+          next_mark_ns += 600'000'000'000;
+        }
+        return;
+      default:
+        return;
+    }
+  };
+  auto laser = cal::drivers::make_gauge(io, bus.transport(0, "laser"),
+                                        {.device = 0, .clock = bus.clock(), .replay = true});
+  auto air = cal::drivers::make_ptu300(io, bus.transport(1, "air"),
+                                       {.device = 1, .clock = bus.clock(), .replay = true});
+  laser->start({.reading = on_reading});
+  air->start({.reading = on_reading});
+  bool done = false;
+  const double cpu0 = cpu_seconds();
+  const auto t0 = Clock::now();
+  bus.start([&](const cal::replay::ReplayEnd&) { done = true; });
+  while (!done) io.run_one();
+  if (writer) {
+    writer->flush();
+    res.writer = writer->stats();
+  }
+  res.wall_s = seconds_since(t0);
+  res.cpu_s = cpu_seconds() - cpu0;
+  return res;
+}
+
+struct SqliteDb {
+  sqlite3* db = nullptr;
+  explicit SqliteDb(const fs::path& p) {
+    if (sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK)
+      throw cal::InputError(fmt::format("{}: cannot open: {}", p.string(), sqlite3_errmsg(db)));
+    sqlite3_busy_timeout(db, 5000);
+  }
+  ~SqliteDb() { sqlite3_close_v2(db); }
+  SqliteDb(const SqliteDb&) = delete;
+  SqliteDb& operator=(const SqliteDb&) = delete;
+  void exec(const char* sql) const {
+    if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) != SQLITE_OK)
+      throw cal::InputError(fmt::format("bench: {}: {}", sql, sqlite3_errmsg(db)));
+  }
+};
+
+struct Stmt {
+  sqlite3_stmt* s = nullptr;
+  Stmt(const SqliteDb& db, const std::string& sql) {
+    if (sqlite3_prepare_v2(db.db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK)
+      throw cal::InputError(fmt::format("bench: {}: {}", sql, sqlite3_errmsg(db.db)));
+  }
+  ~Stmt() { sqlite3_finalize(s); }
+  Stmt(const Stmt&) = delete;
+  Stmt& operator=(const Stmt&) = delete;
+};
+
+// One stored chunk row, every column as SQLite holds it.
+struct Row {
+  std::vector<sqlite3_value*> values;
+  Row() = default;
+  Row(const Row&) = delete;
+  Row& operator=(const Row&) = delete;
+  Row(Row&& o) noexcept : values(std::move(o.values)) {}
+  ~Row() {
+    for (auto* v : values) sqlite3_value_free(v);
+  }
+};
+
+// Reads the chunk rows of the ingest database in the order they were written, one commit's
+// worth (`batch_readings` readings, as the writer cut them) per call.
+class ChunkSource {
+ public:
+  ChunkSource(const fs::path& db, std::size_t batch_readings)
+      : db_(db), batch_(batch_readings), stmt_(db_, "SELECT * FROM reading_chunks ORDER BY id") {
+    columns_ = sqlite3_column_count(stmt_.s);
+    for (int i = 0; i < columns_; ++i) {
+      names_.push_back(sqlite3_column_name(stmt_.s, i));
+      if (names_.back() == "count") count_column_ = i;
+      if (names_.back() == "data") data_column_ = i;
+    }
+  }
+  const std::vector<std::string>& names() const { return names_; }
+  int data_column() const { return data_column_; }
+  bool next_commit(std::vector<Row>& rows) {
+    rows.clear();
+    std::size_t readings = 0;
+    // (A statement stepped after SQLITE_DONE starts again from the first row.)
+    while (!done_ && readings < batch_) {
+      if (sqlite3_step(stmt_.s) != SQLITE_ROW) {
+        done_ = true;
+        break;
+      }
+      Row r;
+      for (int i = 0; i < columns_; ++i)
+        r.values.push_back(sqlite3_value_dup(sqlite3_column_value(stmt_.s, i)));
+      readings += static_cast<std::size_t>(sqlite3_column_int64(stmt_.s, count_column_));
+      rows.push_back(std::move(r));
+    }
+    return !rows.empty();
+  }
+
+ private:
+  SqliteDb db_;
+  std::size_t batch_;
+  Stmt stmt_;
+  int columns_ = 0, count_column_ = 0, data_column_ = 0;
+  bool done_ = false;
+  std::vector<std::string> names_;
+};
+
+struct CeilingResult {
+  double seconds = 0.0;
+  std::uint64_t commits = 0, bytes = 0;
+};
+
+// The same rows into a fresh store (same schema and settings), same commits, nothing else.
+CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t batch) {
+  { cal::storage::Store(to).begin_run({.kind = "bench"}); }
+  ChunkSource src(from, batch);
+  SqliteDb dst(to);
+  dst.exec("PRAGMA synchronous=FULL");
+  std::string sql = "INSERT INTO reading_chunks VALUES(";
+  for (std::size_t i = 0; i < src.names().size(); ++i) sql += i ? ", ?" : "?";
+  sql += ")";
+  Stmt insert(dst, sql);
+  Stmt begin(dst, "BEGIN IMMEDIATE"), commit(dst, "COMMIT");
+  CeilingResult res;
+  std::vector<Row> rows;
+  while (src.next_commit(rows)) {
+    const auto t0 = Clock::now();
+    sqlite3_step(begin.s);
+    sqlite3_reset(begin.s);
+    for (const auto& r : rows) {
+      for (std::size_t i = 0; i < r.values.size(); ++i)
+        sqlite3_bind_value(insert.s, static_cast<int>(i + 1), r.values[i]);
+      if (sqlite3_step(insert.s) != SQLITE_DONE)
+        throw cal::InputError(
+            fmt::format("bench: blob ceiling insert: {}", sqlite3_errmsg(dst.db)));
+      sqlite3_reset(insert.s);
+    }
+    if (sqlite3_step(commit.s) != SQLITE_DONE)
+      throw cal::InputError(fmt::format("bench: blob ceiling commit: {}", sqlite3_errmsg(dst.db)));
+    sqlite3_reset(commit.s);
+    res.seconds += seconds_since(t0);
+    ++res.commits;
+  }
+  return res;
+}
+
+// The chunk BLOB bytes to a plain file, one fdatasync per commit.
+CeilingResult raw_ceiling(const fs::path& from, const fs::path& to, std::size_t batch) {
+  ChunkSource src(from, batch);
+  const int fd = ::open(to.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw cal::InputError(fmt::format("{}: cannot create", to.string()));
+  CeilingResult res;
+  std::vector<Row> rows;
+  while (src.next_commit(rows)) {
+    const auto t0 = Clock::now();
+    for (const auto& r : rows) {
+      auto* v = r.values[static_cast<std::size_t>(src.data_column())];
+      const auto n = static_cast<std::size_t>(sqlite3_value_bytes(v));
+      if (::write(fd, sqlite3_value_blob(v), n) != static_cast<ssize_t>(n)) {
+        ::close(fd);
+        throw cal::InputError(fmt::format("{}: write failed", to.string()));
+      }
+      res.bytes += n;
+    }
+    ::fdatasync(fd);
+    res.seconds += seconds_since(t0);
+    ++res.commits;
+  }
+  ::close(fd);
+  return res;
+}
+
+struct BenchOptions {
+  int seconds = 600;
+  int rounds = 3;
+  std::string dir;
+  std::size_t batch_readings = 16384;
+};
+
+void bench_ingest(const BenchOptions& o) {
+  if (o.seconds < 1 || o.rounds < 1)
+    throw cal::InputError("bench ingest: --seconds and --rounds must be at least 1");
+  const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
+  const auto tag = std::to_string(::getpid());
+  const fs::path capture = dir / ("caldaq-bench-" + tag + ".cdq");
+  const fs::path db = dir / ("caldaq-bench-" + tag + ".sqlite");
+  const fs::path copy = dir / ("caldaq-bench-ceiling-" + tag + ".sqlite");
+  const fs::path raw = dir / ("caldaq-bench-raw-" + tag + ".bin");
+
+  auto t0 = Clock::now();
+  write_capture(capture, o.seconds);
+  fmt::print(
+      "capture: {} s of a 10 kHz gauge stream and 1 Hz PTU300 lines, {:.1f} MB, written "
+      "in {:.2f} s\n",
+      o.seconds, static_cast<double>(fs::file_size(capture)) / 1e6, seconds_since(t0));
+
+  std::vector<double> ingest_rate, blob_rate, raw_rate, pipeline_rate, ratio_blob, ratio_raw;
+  double bytes_per_reading = 0.0, file_bytes_per_reading = 0.0, per_core = 0.0;
+  for (int round = 1; round <= o.rounds; ++round) {
+    remove_db(db);
+    const auto in = ingest(capture, db, o.batch_readings);
+    const auto n = static_cast<double>(in.readings);
+    remove_db(copy);
+    const auto blob = blob_ceiling(db, copy, o.batch_readings);
+    const auto bare = raw_ceiling(db, raw, o.batch_readings);
+    const auto alone = ingest(capture, {}, o.batch_readings);
+    bytes_per_reading = static_cast<double>(bare.bytes) / n;
+    file_bytes_per_reading =
+        static_cast<double>(fs::file_size(db) + (fs::exists(db.string() + "-wal")
+                                                     ? fs::file_size(db.string() + "-wal")
+                                                     : 0)) /
+        n;
+    ingest_rate.push_back(n / in.wall_s);
+    blob_rate.push_back(n / blob.seconds);
+    raw_rate.push_back(n / bare.seconds);
+    pipeline_rate.push_back(n / alone.wall_s);
+    ratio_blob.push_back(blob.seconds / in.wall_s);
+    ratio_raw.push_back(bare.seconds / in.wall_s);
+    per_core = n / in.cpu_s;
+    fmt::print(
+        "round {}: ingest {:.0f} readings/s ({} readings in {:.2f} s, CPU {:.2f} s, {} commits, "
+        "producer waits {}); blob-insert ceiling {:.0f}/s ({} commits); raw write ceiling "
+        "{:.0f}/s; pipeline without storage {:.0f}/s; checksum {:.6f}\n",
+        round, n / in.wall_s, in.readings, in.wall_s, in.cpu_s, in.writer.batches_committed,
+        in.writer.overload_waits, n / blob.seconds, blob.commits, n / bare.seconds,
+        n / alone.wall_s, in.checksum);
+    if (in.writer.readings_committed != in.readings)
+      throw cal::InputError(fmt::format("bench: {} readings ingested but {} committed", in.readings,
+                                        in.writer.readings_committed));
+    if (round == 1) {
+      std::string marks;
+      for (const auto& [minute, kib] : in.rss_marks)
+        marks += fmt::format("{}{} min: {} KiB", marks.empty() ? "" : ", ", minute, kib);
+      fmt::print("  RSS at each 10 minutes of recorded time: {}; peak RSS {} KiB\n",
+                 marks.empty() ? "(run shorter than 10 min)" : marks, peak_rss_kib());
+    }
+  }
+  fmt::print(
+      "\nmedians over {} rounds:\n"
+      "  ingest                    {:>12.0f} readings/s\n"
+      "  blob-insert ceiling       {:>12.0f} readings/s  ingest reaches {:.0f} % of it\n"
+      "  raw write ceiling         {:>12.0f} readings/s  ingest reaches {:.0f} % of it\n"
+      "  pipeline without storage  {:>12.0f} readings/s\n"
+      "  stored                    {:.2f} bytes/reading in the chunk BLOBs, {:.2f} in the "
+      "file: {:.0f} MB per hour of a 10 kHz channel\n"
+      "  one core (process CPU time) ingests {:.0f} readings/s: {:.0f} channels at 10 kHz, {:.1f} "
+      "at 100 kHz\n",
+      o.rounds, median(ingest_rate), median(blob_rate), 100.0 * median(ratio_blob),
+      median(raw_rate), 100.0 * median(ratio_raw), median(pipeline_rate), bytes_per_reading,
+      file_bytes_per_reading, file_bytes_per_reading * 36e6 / 1e6, per_core, per_core / 1e4,
+      per_core / 1e5);
+  remove_db(db);
+  remove_db(copy);
+  fs::remove(raw);
+  fs::remove(capture);
+}
+
+}  // namespace
+
+void add_bench_commands(CLI::App& app) {
+  auto* bench = app.add_subcommand("bench", "Measure this machine: ingest throughput and ceilings");
+  bench->require_subcommand(1);
+  auto o = std::make_shared<BenchOptions>();
+  auto* in = bench->add_subcommand(
+      "ingest",
+      "Replay a generated 10 kHz capture through the real instruments, compensation and store; "
+      "measure the SQLite blob-insert and raw-write ceilings for the same bytes in the same run");
+  in->add_option("--seconds", o->seconds, "Recorded seconds of the 10 kHz stream")
+      ->capture_default_str();
+  in->add_option("--rounds", o->rounds, "Rounds (ingest then ceilings); medians are reported")
+      ->capture_default_str();
+  in->add_option("--dir", o->dir, "Directory for the capture and databases (default: $TMPDIR)");
+  in->add_option("--batch", o->batch_readings, "Readings per committed batch")
+      ->capture_default_str();
+  in->callback([o] { bench_ingest(*o); });
+}
+
+}  // namespace daq
