@@ -16,8 +16,13 @@
 // with one, it is interpolated and checked like the other air quantities. Material sensors may
 // be disabled (a broken or badly placed probe): they are then neither averaged nor checked.
 //
-// Cost per laser reading: a binary search per quantity (samples are kept for 2 minutes) and
-// one evaluation of the refractive-index equation.
+// Cost per laser reading: a binary search per quantity (samples are kept for 2 minutes). The
+// refractive-index equation is evaluated only when the air it is given changes: the index of
+// the last air state (temperature, pressure, humidity, CO2, bit for bit) is kept, so a 10 kHz
+// stream under a 1 Hz station computes it about once per air sample while the newest sample
+// is held, and once per reading while it is interpolated between two samples. The result is
+// the one the equation gives, bit for bit (tests/daq/env_stage_test.cpp). The cache makes
+// compensate() unsafe to call from two threads at once on one stage (one stage per loop).
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -88,14 +93,24 @@ class EnvStage {
     bool stale_reported = false;
     bool required = true;  // checked for staleness (the optional CO2 without a sensor is not)
     bool enabled = true;   // a disabled material sensor is ignored
-    // The value at t: interpolated, held (newest), or nullopt (none / stale).
-    std::optional<double> at(std::int64_t t, std::int64_t stale_ns, bool& held) const;
+    // The value at t: interpolated, held (newest), or false (none / stale). Out-parameters
+    // rather than an optional: this runs several times per 10 kHz reading.
+    bool at(std::int64_t t, std::int64_t stale_ns, bool& held, double& value) const;
   };
   void add(Series& s, std::int64_t t, double v);
   void check_series(Series& s, std::int64_t t, EnvHealth& h);
 
+  // The refractive index of the last air state (see the cost note above).
+  struct IndexCache {
+    bool valid = false;
+    double key[4] = {};  // temperature, pressure, humidity, CO2 as given to the equation
+    double n = 1.0;
+  };
+  double refractive_index(const double (&air)[4]) const;
+
   EnvironmentConfig config_;
   air::Equation equation_;
+  mutable IndexCache index_cache_;
   std::int64_t stale_ns_;
   Series air_[4];
   std::vector<Series> material_;
