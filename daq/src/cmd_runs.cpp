@@ -53,7 +53,7 @@ st::RunRecord need_run(const st::Store& store, std::int64_t id) {
 }
 
 void cmd_runs(const std::string& db, bool as_json) {
-  st::Store store(database_path(db));
+  const auto store = open_database_read_only(db);
   const auto runs = store.runs();
   if (as_json) {
     json j{
@@ -74,7 +74,7 @@ void cmd_runs(const std::string& db, bool as_json) {
 }
 
 void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
-  st::Store store(database_path(db));
+  const auto store = open_database_read_only(db);
   const auto r = need_run(store, id);
   json j = run_json(r);
   j["schema"] = "caldaq.run.v1";
@@ -162,7 +162,7 @@ struct ExportOptions {
 };
 
 void cmd_export(const ExportOptions& o) {
-  st::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);
   need_run(store, o.run);
   std::FILE* out = stdout;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);

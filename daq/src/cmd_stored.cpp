@@ -69,7 +69,8 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
 }
 
 void analyse_run(const AnalyseRunOptions& o) {
-  st::Store store(database_path(o.db));
+  // Only --store writes; without it the database is opened read-only.
+  auto store = o.store ? st::Store(database_path(o.db)) : open_database_read_only(o.db);
   const auto run = store.run(o.run);
   if (run && run->kind == "circle") return analyse_circle_run(store, *run, o);
   linear_run(store, o.run);

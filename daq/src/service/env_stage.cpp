@@ -154,6 +154,17 @@ double EnvStage::refractive_index(const double (&in)[4]) const {
   return n;
 }
 
+double EnvStage::factor_ppm(double n, double material_degc) const {
+  const double key[2] = {n, material_degc};
+  if (factor_cache_.valid && std::memcmp(&factor_cache_.n, &key[0], sizeof(double)) == 0 &&
+      std::memcmp(&factor_cache_.material_degc, &key[1], sizeof(double)) == 0)
+    return factor_cache_.total_ppm;
+  const double ppm =
+      comp::combined_factor(n, config_.expansion_ppm_per_k * 1e-6, material_degc).total_ppm;
+  factor_cache_ = {true, n, material_degc, ppm};
+  return ppm;
+}
+
 Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   Compensated c;
   c.time_ns = t;
@@ -188,7 +199,7 @@ Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   const double alpha = config_.expansion_ppm_per_k * 1e-6;
   // L20 = raw / (n (1 + alpha (T - 20))): cal::comp (ISO 1 reference temperature).
   c.length_m = comp::normalise_to_20c_m(comp::air_length_m(raw_m, c.n), alpha, c.material_degc);
-  c.factor_ppm = comp::combined_factor(c.n, alpha, c.material_degc).total_ppm;
+  c.factor_ppm = factor_ppm(c.n, c.material_degc);
   return c;
 }
 

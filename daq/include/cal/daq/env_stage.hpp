@@ -107,10 +107,18 @@ class EnvStage {
     double n = 1.0;
   };
   double refractive_index(const double (&air)[4]) const;
+  // The same for the combined factor, which depends on n and the material temperature only.
+  struct FactorCache {
+    bool valid = false;
+    double n = 0.0, material_degc = 0.0;
+    double total_ppm = 0.0;
+  };
+  double factor_ppm(double n, double material_degc) const;
 
   EnvironmentConfig config_;
   air::Equation equation_;
   mutable IndexCache index_cache_;
+  mutable FactorCache factor_cache_;
   std::int64_t stale_ns_;
   Series air_[4];
   std::vector<Series> material_;
