@@ -245,8 +245,8 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; 
 
 }  // namespace cached
 
-// The refractive index is computed again only when the air changes (env_stage.hpp). The proof
-// that this changes nothing: every compensation of a long stage (its cache warm, hit and
+// The environment is computed once per held sample and the refractive index again only when
+// the air changes (env_stage.hpp). The proof that this changes nothing: every compensation of a long stage (its cache warm, hit and
 // missed in every way: held samples, interpolation between samples, samples arriving between
 // readings, a stale sensor on its fallback and back) equals bit for bit the compensation of a
 // fresh stage given the same samples, whose cache is empty, and its n is the equation's own
@@ -278,8 +278,13 @@ TEST(EnvStage, CachedIndexGivesTheEquationsResultBitForBit) {
       ASSERT_TRUE(cached::same_bits(a.length_m, b.length_m)) << t;
       ASSERT_TRUE(cached::same_bits(a.factor_ppm, b.factor_ppm)) << t;
       ASSERT_TRUE(cached::same_bits(a.air_temperature_degc, b.air_temperature_degc)) << t;
+      ASSERT_TRUE(cached::same_bits(a.pressure_pa, b.pressure_pa)) << t;
+      ASSERT_TRUE(cached::same_bits(a.humidity_pct, b.humidity_pct)) << t;
+      ASSERT_TRUE(cached::same_bits(a.material_degc, b.material_degc)) << t;
+      ASSERT_EQ(a.time_ns, t);
       ASSERT_EQ(a.held, b.held);
       ASSERT_EQ(a.fallback_air, b.fallback_air);
+      ASSERT_EQ(a.fallback_material, b.fallback_material);
       cal::air::Conditions air;
       air.temperature_degc = a.air_temperature_degc;
       air.pressure_pa = a.pressure_pa;

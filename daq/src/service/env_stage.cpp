@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "cal/analysis/compensation.hpp"
 #include "cal/analysis/error.hpp"
@@ -64,11 +65,13 @@ void EnvStage::set_material_enabled(int sensor, bool enabled) {
     throw InputError(
         fmt::format("material sensor {}: the last enabled one cannot be disabled", sensor + 1));
   s.enabled = enabled;
+  held_cache_.valid = false;
   s.stale_reported = false;  // a new episode if it is stale when enabled again
 }
 
 void EnvStage::add(Series& s, std::int64_t t, double v) {
   if (!std::isfinite(v)) return;
+  held_cache_.valid = false;
   // Out-of-order samples (two sensors on different links) are inserted in place.
   auto it = std::upper_bound(s.samples.begin(), s.samples.end(), t,
                              [](std::int64_t x, const auto& p) { return x < p.first; });
@@ -165,16 +168,28 @@ double EnvStage::factor_ppm(double n, double material_degc) const {
   return ppm;
 }
 
-Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
+Compensated EnvStage::environment_at(std::int64_t t) const {
   Compensated c;
-  c.time_ns = t;
-  c.raw_m = raw_m;
   double value[4];
+  // The interval over which this environment stays held (see HeldCache): after the newest
+  // sample of every sensor consulted, until the first of the current ones goes stale.
+  std::int64_t after = std::numeric_limits<std::int64_t>::min();
+  std::int64_t until = std::numeric_limits<std::int64_t>::max();
+  const auto bound = [&](const Series& s, bool current) {
+    if (s.samples.empty()) return;
+    const std::int64_t newest = s.samples.back().first;
+    after = std::max(after, newest);
+    if (current)
+      until = std::min(until, newest > std::numeric_limits<std::int64_t>::max() - stale_ns_
+                                  ? std::numeric_limits<std::int64_t>::max()
+                                  : newest + stale_ns_);
+  };
   for (int i = 0; i < 4; ++i) {
     const bool current = air_[i].at(t, stale_ns_, c.held, value[i]);
     // Without a CO2 sensor the configured constant is the value, not a fallback.
     c.fallback_air = c.fallback_air || (!current && air_[i].required);
     if (!current) value[i] = air_[i].fallback;
+    bound(air_[i], current);
   }
   c.co2_umol_per_mol = value[3];
   c.air_temperature_degc = value[0];
@@ -186,20 +201,31 @@ Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   for (const auto& s : material_) {
     if (!s.enabled) continue;
     double v = 0.0;
-    if (s.at(t, stale_ns_, c.held, v)) {
+    const bool current = s.at(t, stale_ns_, c.held, v);
+    if (current) {
       sum += v;
       ++n;
     }
+    bound(s, current);
   }
   c.fallback_material = !material_.empty() && n == 0;
   c.material_degc = n > 0 ? sum / n : config_.fallback_material_degc;
-
   c.n =
       refractive_index({c.air_temperature_degc, c.pressure_pa, c.humidity_pct, c.co2_umol_per_mol});
+  c.factor_ppm = factor_ppm(c.n, c.material_degc);
+  if (t > after && t <= until) held_cache_ = {true, after, until, c};
+  return c;
+}
+
+Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
+  Compensated c = held_cache_.valid && t > held_cache_.after_ns && t <= held_cache_.until_ns
+                      ? held_cache_.environment
+                      : environment_at(t);
+  c.time_ns = t;
+  c.raw_m = raw_m;
   const double alpha = config_.expansion_ppm_per_k * 1e-6;
   // L20 = raw / (n (1 + alpha (T - 20))): cal::comp (ISO 1 reference temperature).
   c.length_m = comp::normalise_to_20c_m(comp::air_length_m(raw_m, c.n), alpha, c.material_degc);
-  c.factor_ppm = factor_ppm(c.n, c.material_degc);
   return c;
 }
 

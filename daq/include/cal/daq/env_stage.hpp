@@ -16,13 +16,14 @@
 // with one, it is interpolated and checked like the other air quantities. Material sensors may
 // be disabled (a broken or badly placed probe): they are then neither averaged nor checked.
 //
-// Cost per laser reading: a binary search per quantity (samples are kept for 2 minutes). The
-// refractive-index equation is evaluated only when the air it is given changes: the index of
-// the last air state (temperature, pressure, humidity, CO2, bit for bit) is kept, so a 10 kHz
-// stream under a 1 Hz station computes it about once per air sample while the newest sample
-// is held, and once per reading while it is interpolated between two samples. The result is
-// the one the equation gives, bit for bit (tests/daq/env_stage_test.cpp). The cache makes
-// compensate() unsafe to call from two threads at once on one stage (one stage per loop).
+// Cost per laser reading: while the reading is newer than every sample (the live case: the
+// newest samples are held), the environment is computed once per air sample and each reading
+// costs two divisions. Otherwise a binary search per quantity (samples are kept for 2
+// minutes), and the refractive-index equation only when the air it is given changes (the
+// index of the last air state, bit for bit, is kept): once per reading while interpolating
+// between two samples. The results are those of the full computation, bit for bit
+// (tests/daq/env_stage_test.cpp). The caches make compensate() unsafe to call from two
+// threads at once on one stage (one stage per event loop).
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -114,11 +115,21 @@ class EnvStage {
     double total_ppm = 0.0;
   };
   double factor_ppm(double n, double material_degc) const;
+  // While a reading is newer than every sensor's newest sample and no sensor goes stale, the
+  // environment is held: constant. It is then computed once and kept for that time interval
+  // (until the next sample or a staleness), and each reading only divides by it.
+  struct HeldCache {
+    bool valid = false;
+    std::int64_t after_ns = 0, until_ns = 0;  // valid for after_ns < t <= until_ns
+    Compensated environment;                  // everything but time, raw and length
+  };
+  Compensated environment_at(std::int64_t t) const;
 
   EnvironmentConfig config_;
   air::Equation equation_;
   mutable IndexCache index_cache_;
   mutable FactorCache factor_cache_;
+  mutable HeldCache held_cache_;
   std::int64_t stale_ns_;
   Series air_[4];
   std::vector<Series> material_;
