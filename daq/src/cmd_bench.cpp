@@ -1,5 +1,6 @@
-// daq bench ingest: the end-to-end ingest benchmark with its ceilings measured in the same run
-// (method in docs/benchmarks.md).
+// daq bench: benchmarks of this machine (method in docs/benchmarks.md).
+//
+// daq bench ingest: the end-to-end ingest benchmark with its ceilings measured in the same run.
 //
 //   1. A capture of `seconds` of a 10 kHz length stream (ten 13-byte gauge lines per 1 ms
 //      record, as a USB-serial gauge or interferometer delivers them) plus 1 Hz PTU300 air
@@ -17,16 +18,26 @@
 //   4. Also the pipeline alone (no storage) for where the time goes.
 // Rounds alternate ingest and ceilings so that a change of load on the machine touches both;
 // the fraction is the median of the per-round ratios.
+//
+// daq bench export: memory and time after the run. A store is filled with runs of a 10 kHz
+// length stream plus 1 Hz air (temperature, pressure, humidity), written as the batch writer
+// writes them, of 1/k ... k/k of the given length; `daq export` (CSV and JSON) and `daq report`
+// are run on each as child processes of this same binary, and each child's peak RSS (wait4)
+// and wall time are reported: flat memory and linear time are what is asked.
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <spawn.h>
 #include <sqlite3.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -408,6 +419,113 @@ void bench_ingest(const BenchOptions& o) {
   fs::remove(capture);
 }
 
+// A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
+// batches of 16384 readings as the batch writer stores them. Not timed: this is the input.
+std::int64_t generate_run(cal::storage::Store& store, int seconds) {
+  const auto run = store.begin_run({.campaign = "daq bench export",
+                                    .kind = "bench",
+                                    .axis = "X",
+                                    .settings_json = R"({"generated": "daq bench export"})"});
+  store.add_instrument({.run_id = run, .device = 0, .driver = "gauge", .transport = "generated"});
+  store.add_instrument({.run_id = run, .device = 1, .driver = "ptu300", .transport = "generated"});
+  std::vector<cal::storage::RawReading> batch;
+  batch.reserve(16384 + 3);
+  const std::int64_t n = static_cast<std::int64_t>(seconds) * 10'000;
+  for (std::int64_t i = 0; i < n; ++i) {
+    const std::int64_t t = i * 100'000;
+    batch.push_back({.time_ns = t,
+                     .quantity = 1,
+                     .value = 0.1 + 1e-6 * std::sin(1e-4 * static_cast<double>(i)) +
+                              1e-9 * static_cast<double>(i % 977)});
+    if (i % 10'000 == 0) {
+      const double s = static_cast<double>(i / 10'000);
+      batch.push_back({.time_ns = t, .device = 1, .quantity = 2, .value = 20.0 + 1e-3 * s});
+      batch.push_back({.time_ns = t, .device = 1, .quantity = 3, .value = 101325.0 - 0.1 * s});
+      batch.push_back({.time_ns = t, .device = 1, .quantity = 4, .value = 45.0 + 1e-2 * s});
+    }
+    if (batch.size() >= 16384) {
+      store.append_readings(run, batch);
+      batch.clear();
+    }
+  }
+  store.append_readings(run, batch);
+  store.finish_run(run, cal::storage::RunStatus::complete);
+  return run;
+}
+
+struct ChildResult {
+  double seconds = 0.0;
+  long peak_rss_kib = 0;
+};
+
+// Runs this daq binary with `args`, its output to /dev/null; throws unless it exits with 0.
+ChildResult run_child(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  std::string self = "/proc/self/exe";
+  argv.push_back(self.data());
+  std::vector<std::string> copy = args;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  const auto t0 = Clock::now();
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw cal::InputError(fmt::format("bench: cannot start daq: {}", std::strerror(rc)));
+  int status = 0;
+  rusage usage{};
+  if (::wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw cal::InputError(
+        fmt::format("bench: daq {} failed (status {})", fmt::join(args, " "), status));
+  return {seconds_since(t0), usage.ru_maxrss};
+}
+
+struct ExportBenchOptions {
+  int minutes = 60;
+  int steps = 4;
+  std::string dir;
+};
+
+void bench_export(const ExportBenchOptions& o) {
+  if (o.minutes < 1 || o.steps < 1)
+    throw cal::InputError("bench export: --minutes and --steps must be at least 1");
+  const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
+  const fs::path db = dir / ("caldaq-bench-export-" + std::to_string(::getpid()) + ".sqlite");
+  const fs::path html = dir / ("caldaq-bench-report-" + std::to_string(::getpid()) + ".html");
+  remove_db(db);
+  fmt::print("{:>8} {:>11} {:>9}  {:>16} {:>16} {:>16}\n", "minutes", "readings", "stored MB",
+             "export csv", "export json", "report (html)");
+  for (int k = 1; k <= o.steps; ++k) {
+    const int seconds = o.minutes * 60 * k / o.steps;
+    std::int64_t run = 0, count = 0;
+    const auto size_before = fs::exists(db) ? fs::file_size(db) : 0;
+    {
+      cal::storage::Store store(db, {.full_sync = false});
+      run = generate_run(store, seconds);
+      count = store.reading_count(run);
+    }
+    const double stored_mb = static_cast<double>(fs::file_size(db) - size_before) / 1e6;
+    const auto id = std::to_string(run);
+    const auto csv = run_child({"export", id, "--db", db.string(), "-o", "/dev/null"});
+    const auto json =
+        run_child({"export", id, "--db", db.string(), "--format", "json", "-o", "/dev/null"});
+    const auto report = run_child({"report", id, "--db", db.string(), "-o", html.string()});
+    const auto cell = [](const ChildResult& r) {
+      return fmt::format("{:6.2f} s {:5.0f} MB", r.seconds,
+                         static_cast<double>(r.peak_rss_kib) / 1024);
+    };
+    fmt::print("{:>8.1f} {:>11} {:>9.1f}  {:>16} {:>16} {:>16}\n", seconds / 60.0, count, stored_mb,
+               cell(csv), cell(json), cell(report));
+  }
+  fmt::print(
+      "(wall time and peak RSS of each daq process; readings per second of export: the "
+      "readings column over the time)\n");
+  remove_db(db);
+  fs::remove(html);
+}
+
 }  // namespace
 
 void add_bench_commands(CLI::App& app) {
@@ -426,6 +544,17 @@ void add_bench_commands(CLI::App& app) {
   in->add_option("--batch", o->batch_readings, "Readings per committed batch")
       ->capture_default_str();
   in->callback([o] { bench_ingest(*o); });
+
+  auto e = std::make_shared<ExportBenchOptions>();
+  auto* ex = bench->add_subcommand(
+      "export",
+      "Store generated runs of a 10 kHz stream (up to --minutes long) and measure the peak RSS "
+      "and time of daq export (CSV, JSON) and daq report on each");
+  ex->add_option("--minutes", e->minutes, "Length of the longest run")->capture_default_str();
+  ex->add_option("--steps", e->steps, "Runs of 1/steps ... steps/steps of that length")
+      ->capture_default_str();
+  ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
+  ex->callback([e] { bench_export(*e); });
 }
 
 }  // namespace daq
