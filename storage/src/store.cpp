@@ -244,10 +244,14 @@ void Store::Impl::open_read_only() {
     sqlite3_extended_result_codes(raw, 1);
   };
   open(path.string(), SQLITE_OPEN_READONLY);
-  // Probe: the first read opens the WAL index if there is one.
+  // Probe: the first read (at prepare: the schema) opens the WAL index if there is one.
   {
-    auto s = prepare("SELECT count(*) FROM sqlite_master");
-    const int rc = sqlite3_step(s.get()) & 0xff;
+    sqlite3_stmt* probe = nullptr;
+    int rc =
+        sqlite3_prepare_v2(db.get(), "SELECT count(*) FROM sqlite_master", -1, &probe, nullptr);
+    if (rc == SQLITE_OK) rc = sqlite3_step(probe);
+    sqlite3_finalize(probe);
+    rc &= 0xff;
     if (rc != SQLITE_ROW && rc != SQLITE_CANTOPEN && rc != SQLITE_READONLY && rc != SQLITE_IOERR)
       fail("not a caldaq database");
     if (rc != SQLITE_ROW) {
@@ -259,7 +263,6 @@ void Store::Impl::open_read_only() {
             "disk); copy the database with its -wal file to a writable disk, or open it once "
             "with a command that writes",
             wal.string()));
-      s.reset();
       open(file_uri(path) + "?mode=ro&immutable=1", SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
     }
   }
