@@ -49,6 +49,7 @@
 #include "cal/drivers/instruments.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
+#include "cal/storage/chunk.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "commands.hpp"
@@ -275,7 +276,34 @@ struct CeilingResult {
 };
 
 // The same rows into a fresh store (same schema and settings), same commits, nothing else.
-CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t batch) {
+// The schema-1 form of a stored chunk: its readings as 17-byte records (for the comparison
+// of what the denser encoding does to the ceiling).
+std::vector<unsigned char> as_schema1(const ChunkSource& src, const Row& r) {
+  const auto value = [&](const char* name) {
+    const auto& names = src.names();
+    const auto i =
+        static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+    return r.values.at(i);
+  };
+  auto* data = value("data");
+  std::vector<cal::storage::RawReading> readings;
+  cal::storage::chunk::decode(sqlite3_value_int(value("encoding")),
+                              {static_cast<const unsigned char*>(sqlite3_value_blob(data)),
+                               static_cast<std::size_t>(sqlite3_value_bytes(data))},
+                              static_cast<std::size_t>(sqlite3_value_int64(value("count"))), 0, 0,
+                              0, readings);
+  std::vector<unsigned char> out(readings.size() * 17);
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    std::memcpy(&out[17 * i], &readings[i].time_ns, 8);
+    out[17 * i + 8] = readings[i].status;
+    std::memcpy(&out[17 * i + 9], &readings[i].value, 8);
+  }
+  return out;
+}
+
+// schema1: the chunks' BLOBs replaced by their 17-byte records of schema 1 (prepared untimed).
+CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t batch,
+                           bool schema1 = false) {
   { cal::storage::Store(to).begin_run({.kind = "bench"}); }
   ChunkSource src(from, batch);
   SqliteDb dst(to);
@@ -287,13 +315,26 @@ CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t
   Stmt begin(dst, "BEGIN IMMEDIATE"), commit(dst, "COMMIT");
   CeilingResult res;
   std::vector<Row> rows;
+  std::vector<std::vector<unsigned char>> old_blobs;
+  const auto data_column = static_cast<std::size_t>(src.data_column());
   while (src.next_commit(rows)) {
+    old_blobs.clear();
+    if (schema1)
+      for (const auto& r : rows) old_blobs.push_back(as_schema1(src, r));
     const auto t0 = Clock::now();
     sqlite3_step(begin.s);
     sqlite3_reset(begin.s);
-    for (const auto& r : rows) {
-      for (std::size_t i = 0; i < r.values.size(); ++i)
-        sqlite3_bind_value(insert.s, static_cast<int>(i + 1), r.values[i]);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const auto& r = rows[k];
+      for (std::size_t i = 0; i < r.values.size(); ++i) {
+        if (schema1 && i == data_column) {
+          sqlite3_bind_blob64(insert.s, static_cast<int>(i + 1), old_blobs[k].data(),
+                              old_blobs[k].size(), SQLITE_STATIC);
+          res.bytes += old_blobs[k].size();
+        } else {
+          sqlite3_bind_value(insert.s, static_cast<int>(i + 1), r.values[i]);
+        }
+      }
       if (sqlite3_step(insert.s) != SQLITE_DONE)
         throw cal::InputError(
             fmt::format("bench: blob ceiling insert: {}", sqlite3_errmsg(dst.db)));
@@ -359,13 +400,17 @@ void bench_ingest(const BenchOptions& o) {
       o.seconds, static_cast<double>(fs::file_size(capture)) / 1e6, seconds_since(t0));
 
   std::vector<double> ingest_rate, blob_rate, raw_rate, pipeline_rate, ratio_blob, ratio_raw;
-  double bytes_per_reading = 0.0, file_bytes_per_reading = 0.0, per_core = 0.0;
+  std::vector<double> blob17_rate;
+  double bytes_per_reading = 0.0, file_bytes_per_reading = 0.0;
+  std::vector<double> per_core;
   for (int round = 1; round <= o.rounds; ++round) {
     remove_db(db);
     const auto in = ingest(capture, db, o.batch_readings);
     const auto n = static_cast<double>(in.readings);
     remove_db(copy);
     const auto blob = blob_ceiling(db, copy, o.batch_readings);
+    remove_db(copy);
+    const auto blob17 = blob_ceiling(db, copy, o.batch_readings, true);
     const auto bare = raw_ceiling(db, raw, o.batch_readings);
     const auto alone = ingest(capture, {}, o.batch_readings);
     bytes_per_reading = static_cast<double>(bare.bytes) / n;
@@ -376,18 +421,20 @@ void bench_ingest(const BenchOptions& o) {
         n;
     ingest_rate.push_back(n / in.wall_s);
     blob_rate.push_back(n / blob.seconds);
+    blob17_rate.push_back(n / blob17.seconds);
     raw_rate.push_back(n / bare.seconds);
     pipeline_rate.push_back(n / alone.wall_s);
     ratio_blob.push_back(blob.seconds / in.wall_s);
     ratio_raw.push_back(bare.seconds / in.wall_s);
-    per_core = n / in.cpu_s;
+    per_core.push_back(n / in.cpu_s);
     fmt::print(
         "round {}: ingest {:.0f} readings/s ({} readings in {:.2f} s, CPU {:.2f} s, {} commits, "
-        "producer waits {}); blob-insert ceiling {:.0f}/s ({} commits); raw write ceiling "
-        "{:.0f}/s; pipeline without storage {:.0f}/s; checksum {:.6f}\n",
+        "producer waits {}); blob-insert ceiling {:.0f}/s ({} commits; {:.0f}/s with schema-1 "
+        "records); raw write ceiling {:.0f}/s; pipeline without storage {:.0f}/s; checksum "
+        "{:.6f}\n",
         round, n / in.wall_s, in.readings, in.wall_s, in.cpu_s, in.writer.batches_committed,
-        in.writer.overload_waits, n / blob.seconds, blob.commits, n / bare.seconds,
-        n / alone.wall_s, in.checksum);
+        in.writer.overload_waits, n / blob.seconds, blob.commits, n / blob17.seconds,
+        n / bare.seconds, n / alone.wall_s, in.checksum);
     if (in.writer.readings_committed != in.readings)
       throw cal::InputError(fmt::format("bench: {} readings ingested but {} committed", in.readings,
                                         in.writer.readings_committed));
@@ -405,14 +452,16 @@ void bench_ingest(const BenchOptions& o) {
       "  blob-insert ceiling       {:>12.0f} readings/s  ingest reaches {:.0f} % of it\n"
       "  raw write ceiling         {:>12.0f} readings/s  ingest reaches {:.0f} % of it\n"
       "  pipeline without storage  {:>12.0f} readings/s\n"
+      "  (blob-insert ceiling of the same readings as schema-1 17-byte records: {:.0f} "
+      "readings/s)\n"
       "  stored                    {:.2f} bytes/reading in the chunk BLOBs, {:.2f} in the "
       "file: {:.0f} MB per hour of a 10 kHz channel\n"
-      "  one core (process CPU time) ingests {:.0f} readings/s: {:.0f} channels at 10 kHz, {:.1f} "
-      "at 100 kHz\n",
+      "  one core (process CPU time, producer and writer threads) ingests {:.0f} readings/s: "
+      "{:.0f} channels at 10 kHz, {:.1f} at 100 kHz\n",
       o.rounds, median(ingest_rate), median(blob_rate), 100.0 * median(ratio_blob),
-      median(raw_rate), 100.0 * median(ratio_raw), median(pipeline_rate), bytes_per_reading,
-      file_bytes_per_reading, file_bytes_per_reading * 36e6 / 1e6, per_core, per_core / 1e4,
-      per_core / 1e5);
+      median(raw_rate), 100.0 * median(ratio_raw), median(pipeline_rate), median(blob17_rate),
+      bytes_per_reading, file_bytes_per_reading, file_bytes_per_reading * 36e6 / 1e6,
+      median(per_core), median(per_core) / 1e4, median(per_core) / 1e5);
   remove_db(db);
   remove_db(copy);
   fs::remove(raw);
