@@ -502,4 +502,40 @@ MapSummary summarize(const ErrorMap& map) {
   return s;
 }
 
+std::vector<Contribution> contributions(const Machine& m, const Grid& grid) {
+  check_machine(m);
+  check_grid(grid);
+  Machine base = m;
+  for (Component c : all_components()) component(base, c) = ErrorFunction{};
+  base.squareness = {};
+  std::vector<Contribution> out;
+  auto add = [&](std::string_view name, Axis axis, const Machine& only) {
+    const ErrorMap map = volumetric_error_map(only, grid, Method::first_order);
+    Contribution c{std::string(name), axis, 0.0, 0.0};
+    double sum = 0.0;
+    for (std::size_t p = 0; p < map.size(); ++p) {
+      const double* e = &map.errors_um[3 * p];
+      const double n2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+      c.max_norm_um = std::max(c.max_norm_um, std::sqrt(n2));
+      sum += n2;
+    }
+    c.rms_um = std::sqrt(sum / static_cast<double>(map.size()));
+    out.push_back(c);
+  };
+  for (Component c : all_components()) {
+    Machine only = base;
+    component(only, c) = component(m, c);
+    add(to_string(c), static_cast<Axis>(static_cast<std::size_t>(c) / 6), only);
+  }
+  for (Plane p : {Plane::xy, Plane::xz, Plane::yz}) {
+    Machine only = base;
+    only.squareness.of(p) = m.squareness.of(p);
+    add(location_error_name(p), p == Plane::xy ? Y : Z, only);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Contribution& a, const Contribution& b) {
+    return a.max_norm_um > b.max_norm_um;
+  });
+  return out;
+}
+
 }  // namespace cal::kinematics

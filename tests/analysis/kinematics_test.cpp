@@ -586,6 +586,26 @@ TEST(KinematicsMap, GridOrderValuesAndSummary) {
   for (std::size_t i = 0; i < 36; ++i) EXPECT_NEAR(exact.errors_um[i], map.errors_um[i], 1e-3);
 }
 
+// Contributions over the grid of GridOrderValuesAndSummary (x in {0, 100, 200}, y in {0, 100},
+// z in {0, 50}): E_C0Y = 50 urad gives |e| = 0.05 y: max 5 um, RMS sqrt((0 + 25) / 2) =
+// 3.5355; E_XX = 0.01 um/mm gives 0.01 x: max 2, RMS sqrt((0 + 1 + 4) / 3) = 1.2910. Ranked
+// largest first; the other 19 contribute nothing.
+TEST(KinematicsMap, ContributionsRanked) {
+  Machine m;
+  m.axes[X].ex_um = ErrorFunction::polynomial({0.0, 0.01});
+  m.squareness.c0y_urad = 50.0;
+  const auto c = contributions(m, {{0.0, 0.0, 0.0}, {200.0, 100.0, 50.0}, {3, 2, 2}});
+  ASSERT_EQ(c.size(), 21u);
+  EXPECT_EQ(c[0].name, "E_C0Y");
+  EXPECT_NEAR(c[0].max_norm_um, 5.0, 1e-12);
+  EXPECT_NEAR(c[0].rms_um, std::sqrt(12.5), 1e-12);
+  EXPECT_EQ(c[1].name, "E_XX");
+  EXPECT_EQ(c[1].axis, X);
+  EXPECT_NEAR(c[1].max_norm_um, 2.0, 1e-12);
+  EXPECT_NEAR(c[1].rms_um, std::sqrt(5.0 / 3.0), 1e-12);
+  for (std::size_t i = 2; i < c.size(); ++i) EXPECT_EQ(c[i].max_norm_um, 0.0) << c[i].name;
+}
+
 TEST(KinematicsMap, SinglePointAxisUsesMin) {
   Machine m;
   m.axes[Y].ey_um = ErrorFunction::polynomial({0.0, 0.1});  // 0.1 um/mm

@@ -67,6 +67,14 @@ class ErrorFunction {
   // The same function multiplied by k (for sensitivity studies and tests).
   ErrorFunction scaled(double k) const;
 
+  // What the function is, for writing it out: a polynomial's coefficients (empty for the
+  // default zero), or a table's positions and values.
+  bool is_table() const { return kind_ == Kind::table; }
+  bool is_zero() const { return kind_ == Kind::polynomial && coefficients_.empty(); }
+  std::span<const double> coefficients() const { return coefficients_; }
+  std::span<const double> positions_mm() const { return positions_mm_; }
+  std::span<const double> values() const { return values_; }
+
  private:
   enum class Kind { polynomial, table };
   Kind kind_ = Kind::polynomial;
@@ -215,5 +223,17 @@ struct MapSummary {
   Vec3 range_um{};           // max - min per component
 };
 MapSummary summarize(const ErrorMap& map);  // throws InputError for an empty map
+
+// What each of the 21 errors contributes over a grid: the first-order error of a machine with
+// only that error (same topology and offsets), its largest |e| and its RMS over the points.
+// The first-order model is a sum, so the contributions add up to the whole. Sorted by
+// max_norm_um, largest first. Throws as volumetric_error_map.
+struct Contribution {
+  std::string name;  // "E_CX", ..., "E_C0Y"
+  Axis axis = X;     // the axis it belongs to (squareness: the carrier-free plane's second axis)
+  double max_norm_um = 0.0;
+  double rms_um = 0.0;
+};
+std::vector<Contribution> contributions(const Machine& m, const Grid& grid);
 
 }  // namespace cal::kinematics
