@@ -110,8 +110,22 @@ Vec3 correction_um(const Machine& m, const Vec3& p_mm, const Carriers& carriers)
 Vec3 residual_um(const Machine& m, const Vec3& p_mm, const Vec3& correction) {
   const Vec3 driven{p_mm[0] + correction[0] * 1e-3, p_mm[1] + correction[1] * 1e-3,
                     p_mm[2] + correction[2] * 1e-3};
-  const Vec3 e = kinematics::volumetric_error_um(m, driven, Method::htm);
-  return {correction[0] + e[0], correction[1] + e[1], correction[2] + e[2]};
+  // At the end of a measured table the correction can drive an axis a few micrometres past it,
+  // where the model says nothing: there the table's end value holds (the axis is evaluated at
+  // p), which changes the residual by the error's slope times the correction, ~1e-4 * 10 um.
+  // Fewest axes held first; the last try holds all three and fails like any evaluation at p.
+  for (unsigned held : {0u, 1u, 2u, 4u, 3u, 5u, 6u, 7u}) {
+    Vec3 q = driven;
+    for (std::size_t i = 0; i < 3; ++i)
+      if (held & (1u << i)) q[i] = p_mm[i];
+    try {
+      const Vec3 e = kinematics::volumetric_error_um(m, q, Method::htm);
+      return {correction[0] + e[0], correction[1] + e[1], correction[2] + e[2]};
+    } catch (const InputError&) {
+      if (held == 7u) throw;
+    }
+  }
+  return {};  // not reached
 }
 
 CrossTables cross_tables(const Machine& m, const std::array<AxisGrid, 3>& grid,

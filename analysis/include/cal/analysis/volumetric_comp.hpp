@@ -47,7 +47,9 @@ Vec3 correction_um(const Machine& m, const Vec3& p_mm, const Carriers& carriers 
 // What the tool tip does relative to the commanded position p when the machine is driven to
 // p + correction(p): correction + e_htm(p + correction), um. For the default carriers this is
 // second order in the errors (|e| |de/dp| + |htm - first order|); a carrier on a reference
-// axis adds the rigid turn of the machine frame that it makes.
+// axis adds the rigid turn of the machine frame that it makes. Where the correction drives an
+// axis a few micrometres past the end of a table, that axis is evaluated at p (the table's end
+// value holds). Throws InputError where the model cannot be evaluated at p.
 Vec3 residual_um(const Machine& m, const Vec3& p_mm, const Vec3& correction_um);
 
 // One-dimensional cross-axis tables on a regular grid per axis.
