@@ -2,6 +2,7 @@
 // evaluated with the same reference fits.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -25,6 +26,9 @@ struct Options {
   tp::Layout layout;
   bool json = false;
 };
+
+// Three decimals without a "-0.000".
+double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
 
 // One row per result: name, quantity, predicted, measured (if any).
 struct Row {
@@ -130,9 +134,10 @@ void run(const Options& o) {
   for (const auto& r : rows) {
     std::string extra;
     if (measured)
-      extra = r.measured ? fmt::format(" {:10.3f} {:10.3f}", *r.measured, *r.measured - r.predicted)
+      extra = r.measured ? fmt::format(" {:10.3f} {:10.3f}", shown(*r.measured),
+                                       shown(*r.measured - r.predicted))
                          : fmt::format(" {:>10} {:>10}", "-", "-");
-    fmt::print("{:18} {:22} {:10.3f}{}\n", r.feature, r.quantity, r.predicted, extra);
+    fmt::print("{:18} {:22} {:10.3f}{}\n", r.feature, r.quantity, shown(r.predicted), extra);
   }
   if (measured && !measured->aligned)
     fmt::print("note: the CMM points lack face-Y or bore0, so bore positions are not compared\n");
