@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cal/analysis/comp_formats.hpp"
 #include "cal/analysis/comp_table.hpp"
@@ -28,7 +29,7 @@ struct CompensateOptions {
   int points = 0, axis_number = 1, output_axis_number = 2;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
   ct::FanucOptions fanuc;
-  double fanuc_reference_mm = NAN;
+  std::optional<double> fanuc_reference_mm;  // default: --start-mm
 };
 
 std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
@@ -112,7 +113,7 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
   if (o.format == "heidenhain") return ct::write_heidenhain_com(table);
   if (o.format == "fanuc") {
     ct::FanucOptions f = o.fanuc;
-    f.reference_mm = std::isnan(o.fanuc_reference_mm) ? o.start_mm : o.fanuc_reference_mm;
+    f.reference_mm = o.fanuc_reference_mm.value_or(o.start_mm);
     return ct::write_fanuc_pitch(table, f);
   }
   throw cal::InputError(fmt::format(

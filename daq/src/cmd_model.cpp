@@ -174,10 +174,18 @@ struct MapOptions {
   bool json = false;
 };
 
+// The map, its 21 contributions and its JSON are held in memory: a few million points at most.
+constexpr double kMaxMapPoints = 2e6;
+
 kin::Grid grid_of(const MapOptions& o, const mdl::Model& m) {
   if (o.count.size() != 3 ||
       std::any_of(o.count.begin(), o.count.end(), [](auto c) { return c == 0; }))
     throw cal::InputError("--count needs three counts >= 1 (X Y Z)");
+  if (static_cast<double>(o.count[0]) * static_cast<double>(o.count[1]) *
+          static_cast<double>(o.count[2]) >
+      kMaxMapPoints)
+    throw cal::InputError(fmt::format("--count {} {} {}: more than {:g} points", o.count[0],
+                                      o.count[1], o.count[2], kMaxMapPoints));
   if (o.min_mm.empty() != o.max_mm.empty())
     throw cal::InputError("give both --min-mm and --max-mm, or neither (the model's travel)");
   if (o.min_mm.empty()) return mdl::travel_grid(m, {o.count[0], o.count[1], o.count[2]});

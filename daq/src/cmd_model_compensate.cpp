@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cal/analysis/comp_formats.hpp"
 #include "cal/analysis/error.hpp"
@@ -27,7 +28,8 @@ struct Options {
   std::string file, format = "csv", output, output_dir, report, isg_csv_path = "volcomp.csv";
   std::vector<double> interval_mm, reference_mm;
   std::vector<int> axis_numbers{1, 2, 3};
-  double fanuc_reference_mm = NAN, fanuc_unit_um = 1.0;
+  std::optional<double> fanuc_reference_mm;  // default: the start of each travel
+  double fanuc_unit_um = 1.0;
   int fanuc_first_point = 0, fanuc_magnification = 1;
   bool json = false;
 };
@@ -45,6 +47,11 @@ std::array<vc::AxisGrid, 3> grid_of(const Options& o, const mdl::Model& m) {
     if (!(iv > 0) || !std::isfinite(iv))
       throw cal::InputError(fmt::format("--interval-mm {}: {} is not > 0", kAxis[i], iv));
     const double steps = (hi - lo) / iv;
+    if (steps > 100000)
+      throw cal::InputError(
+          fmt::format("--interval-mm {}: {:g} mm gives more than 100000 points "
+                      "over the travel",
+                      kAxis[i], iv));
     if (std::abs(steps - std::round(steps)) > 1e-6 * std::max(1.0, steps))
       throw cal::InputError(
           fmt::format("--interval-mm {}: the travel {:g} .. {:g} mm is not a whole "
@@ -170,7 +177,7 @@ Written write_format(const Options& o, const mdl::Model& m, const std::array<vc:
     std::string text;
     for (std::size_t a = 0; a < 3; ++a) {
       ct::FanucOptions fo;
-      fo.reference_mm = std::isnan(o.fanuc_reference_mm) ? g[a].start_mm : o.fanuc_reference_mm;
+      fo.reference_mm = o.fanuc_reference_mm.value_or(g[a].start_mm);
       fo.first_point = o.fanuc_first_point;
       fo.detection_unit_um = o.fanuc_unit_um;
       fo.magnification = o.fanuc_magnification;
@@ -253,7 +260,15 @@ void run(const Options& o) {
   const auto after = [machine, correction](const kin::Vec3& p) {
     return vc::residual_um(machine, p, correction(p));
   };
-  const Extremes b = largest(g, before), a = largest(g, after);
+  // Evaluated on at most 21 points per axis over the travel (a fine table grid would make
+  // billions of points); off the table nodes, so interpolation between them shows too.
+  std::array<vc::AxisGrid, 3> eval = g;
+  for (auto& e : eval) {
+    const double end = e.end_mm();
+    e.points = std::min(e.points, 21);
+    e.interval_mm = (end - e.start_mm) / (e.points - 1);
+  }
+  const Extremes b = largest(eval, before), a = largest(eval, after);
   // Write only once everything is computed: a refused format leaves no partial files.
   std::vector<std::string> written;
   const bool several = w.files.size() > 1 || !w.files.front().first.empty();
@@ -301,9 +316,10 @@ void run(const Options& o) {
   }
   for (const auto& f : written) fmt::print(stderr, "written {}\n", f);
   fmt::print(stderr,
-             "{}: largest |e| over the grid {:.3f} um before, {:.3f} um with the compensation "
-             "applied to the model (at {:g}, {:g}, {:g} mm)\n",
-             w.what, b.max_um, a.max_um, a.at[0], a.at[1], a.at[2]);
+             "{}: largest |e| over the travel ({} x {} x {} points) {:.3f} um before, {:.3f} um "
+             "with the compensation applied to the model (at {:g}, {:g}, {:g} mm)\n",
+             w.what, eval[0].points, eval[1].points, eval[2].points, b.max_um, a.max_um, a.at[0],
+             a.at[1], a.at[2]);
   for (const auto& n : w.notes) fmt::print(stderr, "note: {}\n", n);
 }
 
