@@ -143,6 +143,10 @@ TEST(ModelFile, MalformedAndInconsistentFilesAreRefused) {
                  "squareness.E_A0Z", "position_mm");
   expect_refused(file(R"("squareness": {"E_B0Y": {"iso230_1_urad": 1}})"), "squareness.E_B0Y");
   expect_refused(file(R"("tool_offset_mm": [0, 0])"), "tool_offset_mm", "3");
+  expect_refused(file(R"("note": [1])"), "note", "expected a string");
+  expect_refused(file(R"("components": {"E_XX": {"polynomial": [1], "note": 2}})"),
+                 "components.E_XX.note");
+  expect_refused("{\"schema\": \"caldaq.model.v1\", \"machine\": \"\xff\"}", "not valid JSON");
   EXPECT_THROW(mdl::read("/nonexistent/model.json"), InputError);
 }
 

@@ -117,6 +117,11 @@ Json parse_json(const Context& cx, std::string_view text_in) {
   return j;
 }
 
+// "note" is free text: a string, nothing else.
+void check_note(const Context& cx, const Json& obj, const std::string& key) {
+  if (obj.contains("note")) text(cx, obj["note"], key.empty() ? "note" : key + ".note");
+}
+
 Source source_of(const Json& entry) {
   const auto it = entry.find("source");
   return it == entry.end() ? Source{} : Source{it->dump()};
@@ -125,6 +130,7 @@ Source source_of(const Json& entry) {
 kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key) {
   object_at(cx, e, key);
   only_keys(cx, e, key, {"polynomial", "table", "source", "note"});
+  check_note(cx, e, key);
   const bool poly = e.contains("polynomial"), table = e.contains("table");
   if (poly == table)
     cx.fail(key, "give exactly one of \"polynomial\" (coefficients c0, c1, ...) and \"table\"");
@@ -181,6 +187,7 @@ void read_squareness(const Context& cx, const Json& sq, Model& m) {
     only_keys(cx, e, key,
               {"iso230_1_urad", "angle_over_90_urad", "method", "placement", "position_mm",
                "compensated_by", "source", "note"});
+    check_note(cx, e, key);
     const bool iso = e.contains("iso230_1_urad"), angle = e.contains("angle_over_90_urad");
     if (iso == angle)
       cx.fail(key,
@@ -281,6 +288,7 @@ Model parse(std::string_view text_in, std::string_view where) {
   only_keys(cx, j, "",
             {"schema", "machine", "topology", "units", "tool_offset_mm", "table_offset_mm",
              "travel_mm", "components", "squareness", "provenance", "note"});
+  check_note(cx, j, "");
   if (!j.contains("schema")) cx.fail("schema", fmt::format("missing (expected \"{}\")", kSchema));
   if (const auto s = text(cx, j["schema"], "schema"); s != kSchema)
     cx.fail("schema", fmt::format("'{}' is not {} (this version reads only that)", s, kSchema));
