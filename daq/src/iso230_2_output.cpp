@@ -36,6 +36,7 @@ nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
         {"symbol", a.symbol}, {"description", a.description}, {"value_um", a.value_um}};
   }
   j["warnings"] = e.warnings;
+  j["notes"] = e.notes;
   return j;
 }
 
@@ -55,6 +56,7 @@ nlohmann::json to_json(const cal::iso230_2::Plan& p) {
                           {"position_mm", m.position_mm}});
   }
   j["warnings"] = p.warnings;
+  j["notes"] = p.notes;
   return j;
 }
 
@@ -89,6 +91,7 @@ void print(const cal::iso230_2::Evaluation& e) {
     fmt::print("  {:<8} {:>10.3f} um   {}\n", a.symbol, a.value_um, a.description);
   }
   for (const auto& w : e.warnings) fmt::print("warning: {}\n", w);
+  for (const auto& n : e.notes) fmt::print("note: {}\n", n);
 }
 
 void print(const cal::unc::Budget& b, double length_m) {

@@ -26,6 +26,10 @@ check iso_missing_file 2 "no_such.csv: cannot open" -- "$DAQ" analyse iso230-2 -
 check targets 0 "121 moves" -- "$DAQ" targets --first 0 --last 1000 --interval 100 --random-fraction 0.2
 check targets_json 0 '"schema": "caldaq.plan.v1"' -- "$DAQ" targets --first 0 --last 100 --count 6 --json
 check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --interval 30
+# ISO 230-2 over 2000 mm: 250 mm apart by default, one run per direction with a note.
+check targets_long 0 "^13 targets \(mm\): 0\.000 250\.000 " -- "$DAQ" targets --first 0 --last 3000 --runs 1
+check targets_long_note 0 "^note: axis over 2000 mm" -- "$DAQ" targets --first 0 --last 3000 --runs 1
+check targets_short_default 2 "give an interval or a count" -- "$DAQ" targets --first 0 --last 1000
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT

@@ -118,6 +118,17 @@ TEST(Config, NamesFileLineColumnAndKey) {
             "machine.toml:2:8: key 'machine.name': expected a string");
 }
 
+// An axis over 2000 mm may leave out interval_mm and count (ISO 230-2's 250 mm average is
+// then planned); a shorter one may not.
+TEST(Config, LongAxisMayLeaveTheTargetsToTheStandard) {
+  const auto c = parse_config("[test.linear]\nfirst_mm = 0\nlast_mm = 3000\nruns = 1\n", "m.toml");
+  ASSERT_TRUE(c.linear.has_value());
+  EXPECT_FALSE(c.linear->interval_mm.has_value());
+  EXPECT_FALSE(c.linear->count.has_value());
+  EXPECT_NE(error_of("[test.linear]\nfirst_mm = 0\nlast_mm = 2000\n").find("over 2000 mm"),
+            std::string::npos);
+}
+
 TEST(Config, MissingFileIsNamed) {
   try {
     cal::daq::load_config("/nonexistent/machine.toml");

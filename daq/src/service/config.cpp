@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/iso230_2_targets.hpp"
 
 namespace cal::daq {
 namespace {
@@ -175,8 +176,12 @@ LinearTestConfig read_linear(Table& t) {
   t.read("last_mm", l.last_mm);
   l.interval_mm = t.get<double>("interval_mm");
   l.count = t.get<int>("count");
-  if (l.interval_mm.has_value() == l.count.has_value())
-    t.fail(nullptr, "interval_mm", "give exactly one of interval_mm and count");
+  // Neither is allowed on an axis over 2000 mm: ISO 230-2's average interval of 250 mm.
+  const bool long_axis = cal::iso230_2::is_long_axis(l.first_mm, l.last_mm);
+  if ((l.interval_mm && l.count) || (!l.interval_mm && !l.count && !long_axis))
+    t.fail(nullptr, "interval_mm",
+           "give exactly one of interval_mm and count (or neither on an axis over 2000 mm: "
+           "targets an average of 250 mm apart, ISO 230-2)");
   t.read("random_fraction", l.random_fraction);
   t.read("cycle", l.cycle);
   one_of(t, "cycle", l.cycle, {"linear", "pendulum", "pilgrim-step"});
