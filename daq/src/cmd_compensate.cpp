@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <fstream>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/comp_table.hpp"
@@ -21,7 +22,8 @@ struct CompensateOptions {
   std::string input, straightness, db, output;
   std::int64_t run = 0;
   std::string axis = "X", format = "csv", sign = "correction", units = "mm", outside = "refuse";
-  double start_mm = 0, interval_mm = 0, resolution = 0.0001;
+  double start_mm = 0, interval_mm = 0;
+  std::optional<double> resolution;  // unset: by unit (default_resolution)
   int points = 0, axis_number = 1;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
 };
@@ -39,6 +41,13 @@ std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o)
   return out;
 }
 
+// A resolution that suits each unit when none is given: 0.1 um in mm or um tables, 0.00001 in
+// (0.254 um) in inch tables (a rounding of 0.0001 in would be 2.54 um).
+double default_resolution(const std::string& units) {
+  const auto u = ct::units_from_string(units);
+  return u == ct::Units::inch ? 0.00001 : u == ct::Units::um ? 0.1 : 0.0001;
+}
+
 void run(const CompensateOptions& o) {
   if (o.input.empty() && o.run == 0 && o.straightness.empty())
     throw cal::InputError(
@@ -51,7 +60,7 @@ void run(const CompensateOptions& o) {
                       .incremental = o.incremental,
                       .sign = o.sign == "error" ? ct::Sign::error : ct::Sign::correction,
                       .units = ct::units_from_string(o.units),
-                      .resolution = o.resolution,
+                      .resolution = o.resolution.value_or(default_resolution(o.units)),
                       .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
   ct::Table table;
   if (!o.straightness.empty()) {
@@ -127,8 +136,11 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   cmd->add_option("--sign", o->sign, "correction or error")
       ->capture_default_str()
       ->check(CLI::IsMember({"correction", "error"}));
-  cmd->add_option("--units", o->units, "mm, um or inch")->capture_default_str();
-  cmd->add_option("--resolution", o->resolution, "Rounding, in the units")->capture_default_str();
+  cmd->add_option("--units", o->units, "mm, um or inch")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mm", "um", "inch", "in"}));
+  cmd->add_option("--resolution", o->resolution,
+                  "Rounding, in the units (default 0.0001 mm, 0.1 um, 0.00001 inch)");
   cmd->add_option("--outside", o->outside,
                   "refuse or hold (grid points beyond the measured targets)")
       ->capture_default_str()

@@ -14,6 +14,12 @@ check siemens 0 '^\$AA_ENC_COMP\[0,4,AX2\]=-0\.0060$' -- "$DAQ" compensate -i "$
 check isg 0 "^kw\.ssfk\.table\[1\]\.neg -50$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f isg
 check json 0 '"schema": "caldaq.comp-table.v1"' -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --bidirectional --json
 check cross 0 "^1,100\.0000,-1\.000$" -- "$DAQ" compensate --straightness "$DATA/straightness.csv" --start-mm 0 --interval-mm 100 --points 3 --units um --resolution 0.001
+# Inch: the correction -0.004 mm at 100 mm is -0.004 / 25.4 = -0.000157480 in, rounded to the
+# inch default resolution 0.00001 in: -0.00016; the position 100 / 25.4 = 3.93701 in.
+check inch_columns 0 "^point,position_in,value_in$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
+check inch_value 0 "^2,3\.93701,-0\.00016$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
+check inch_header 0 "values in inch" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
+check bad_units 2 "units: 'furlong' not in" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units furlong
 check outside 2 "grid point -50 mm is outside the measured range 0 \.\. 200 mm" -- "$DAQ" compensate -i "$DATA/meas.csv" --start-mm -50 --interval-mm 50 --points 3
 check linuxcnc_incremental 2 "absolute corrections" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f linuxcnc --incremental
 check bad_format 2 "format 'fanuc'" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f fanuc
