@@ -260,6 +260,7 @@ int run_demo(const DemoOptions& o) {
     if (o.quiet) return;
     if (tty) fmt::print("\r\033[K");
     fmt::print("  {}\n", e);
+    std::fflush(stdout);  // into a file or a pipe too, as it happens
   };
   std::array<bool, 3> read{};  // laser, air, material have each given a reading
   setup.on_reading = [&read](const cal::drivers::Reading& r) {

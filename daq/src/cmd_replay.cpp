@@ -149,9 +149,11 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   if (o.json) {
     json j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
+    j["status"] = cal::storage::to_string(out.status);
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+  if (!out.missed.empty()) fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
   print(*out.evaluation);
 }
 

@@ -132,6 +132,14 @@ struct RecompensateOptions {
 // provenance): the options given replace those values, the others are kept, and the result's
 // provenance says which result it re-compensates and what changed. The raw data do not change.
 void recompensate(const RecompensateOptions& o) {
+  // A correction must be a finite number (the option parser takes "nan" and "inf").
+  for (const auto& [name, value] :
+       {std::pair{"--alpha-ppm", o.alpha_ppm_per_k}, std::pair{"--material-offset", o.material_offset_k},
+        std::pair{"--air-temperature-offset", o.air_temperature_offset_k},
+        std::pair{"--pressure-offset", o.pressure_offset_pa},
+        std::pair{"--humidity-offset", o.humidity_offset_pct}})
+    if (value && !std::isfinite(*value))
+      throw cal::InputError(fmt::format("recompensate: {} {}: not a finite number", name, *value));
   st::Store store(database_path(o.db));
   const auto run = linear_run(store, o.run);
   json settings = json::parse(run.settings_json, nullptr, false);
@@ -242,19 +250,6 @@ void recompensate(const RecompensateOptions& o) {
   print_verdict(v);
 }
 
-// A correction must be a finite number (CLI11 would take "nan" and "inf").
-const CLI::Validator finite(
-    [](std::string& text) {
-      try {
-        std::size_t used = 0;
-        const double v = std::stod(text, &used);
-        if (used == text.size() && std::isfinite(v)) return std::string();
-      } catch (const std::exception&) {
-      }
-      return "'" + text + "' is not a finite number";
-    },
-    "NUMBER");
-
 }  // namespace
 
 void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
@@ -291,20 +286,15 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   cmd->add_option("RUN", r->run, "Run number")->required();
   add_db_option(*cmd, r->db);
   cmd->add_option("--alpha-ppm", r->alpha_ppm_per_k,
-                  "Corrected expansion coefficient, ppm/K (default: as the current result)")
-      ->check(finite);
+                  "Corrected expansion coefficient, ppm/K (default: as the current result)");
   cmd->add_option("--material-offset", r->material_offset_k,
-                  "Add to every stored material temperature, K (replaces the current offset)")
-      ->check(finite);
+                  "Add to every stored material temperature, K (replaces the current offset)");
   cmd->add_option("--air-temperature-offset", r->air_temperature_offset_k,
-                  "Add to the stored air temperature, K (replaces the current offset)")
-      ->check(finite);
+                  "Add to the stored air temperature, K (replaces the current offset)");
   cmd->add_option("--pressure-offset", r->pressure_offset_pa,
-                  "Add to the stored pressure, Pa (replaces the current offset)")
-      ->check(finite);
+                  "Add to the stored pressure, Pa (replaces the current offset)");
   cmd->add_option("--humidity-offset", r->humidity_offset_pct,
-                  "Add to the stored humidity, %RH (replaces the current offset)")
-      ->check(finite);
+                  "Add to the stored humidity, %RH (replaces the current offset)");
   cmd->add_option("--equation", r->equation, "ciddor, edlen or shop-floor (default: as current)")
       ->check(CLI::IsMember({"ciddor", "edlen", "shop-floor"}));
   cmd->add_flag("--json", r->json, "Print the result JSON");
