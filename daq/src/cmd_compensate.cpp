@@ -136,9 +136,7 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   cmd->add_option("--sign", o->sign, "correction or error")
       ->capture_default_str()
       ->check(CLI::IsMember({"correction", "error"}));
-  cmd->add_option("--units", o->units, "mm, um or inch")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"mm", "um", "inch", "in"}));
+  cmd->add_option("--units", o->units, "mm, um or inch")->capture_default_str();
   cmd->add_option("--resolution", o->resolution,
                   "Rounding, in the units (default 0.0001 mm, 0.1 um, 0.00001 inch)");
   cmd->add_option("--outside", o->outside,

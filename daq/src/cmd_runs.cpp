@@ -223,6 +223,8 @@ StreamKey key_of(const st::RawReading& r) { return {r.device, r.channel, r.quant
 // sample. Readings of one device that came in one transport read share the time of that read;
 // they are spread back from it by the device's sample period (the configured sample rate of a
 // ballbar, else the stream's mean interval over the run), the last keeping the read's time.
+// Where that would reach back to the previous read (the reads' own timing jitters), the group
+// is spread evenly over the time since the previous read instead: times always rise.
 class ExportClock {
  public:
   ExportClock(const st::Store& store, const st::RunRecord& run, const json& settings) {
@@ -249,11 +251,21 @@ class ExportClock {
       unix0_ns_ = *run.origin_unix_ns;
     }
   }
-  // Session time (ns, fractional) of sample k of n that share one stored time.
-  double spread(const st::RawReading& r, std::size_t k, std::size_t n) const {
-    const auto it = period_ns_.find(key_of(r));
-    const double p = it == period_ns_.end() ? 0.0 : it->second;
-    return static_cast<double>(r.time_ns) - static_cast<double>(n - 1 - k) * p;
+  // Session times (ns, fractional) of a group of one stream's readings sharing one stored time,
+  // in order; remembers the group's time for the stream's next group.
+  std::vector<double> spread(const std::vector<st::RawReading>& group) {
+    const auto key = key_of(group.front());
+    const double read = static_cast<double>(group.front().time_ns);
+    const auto n = group.size();
+    const auto it = period_ns_.find(key);
+    double p = it == period_ns_.end() ? 0.0 : it->second;
+    const auto prev = last_ns_.find(key);
+    if (prev != last_ns_.end() && read - static_cast<double>(n - 1) * p <= prev->second)
+      p = (read - prev->second) / static_cast<double>(n);
+    std::vector<double> out(n);
+    for (std::size_t k = 0; k < n; ++k) out[k] = read - static_cast<double>(n - 1 - k) * p;
+    last_ns_[key] = read;
+    return out;
   }
   double seconds(double session_ns) const {
     return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
@@ -275,6 +287,7 @@ class ExportClock {
 
  private:
   std::map<StreamKey, double> period_ns_;
+  std::map<StreamKey, double> last_ns_;  // the time of each stream's last group
   std::int64_t t0_ns_ = 0;
   std::optional<std::int64_t> unix0_ns_;
 };
@@ -288,11 +301,12 @@ struct ExportRow {
 // Walks the readings and hands them on with their spread times; a group of one stream's
 // readings with one stored time is held until the stream's next time shows how many it has.
 template <class F>
-void each_export_row(const st::Store& store, std::int64_t run, const ExportClock& clock, F&& f) {
+void each_export_row(const st::Store& store, std::int64_t run, ExportClock& clock, F&& f) {
   std::map<StreamKey, std::vector<st::RawReading>> pending;
   const auto flush = [&](std::vector<st::RawReading>& group) {
-    for (std::size_t k = 0; k < group.size(); ++k)
-      f(ExportRow{group[k], clock.spread(group[k], k, group.size())});
+    if (group.empty()) return;
+    const auto times = clock.spread(group);
+    for (std::size_t k = 0; k < group.size(); ++k) f(ExportRow{group[k], times[k]});
     group.clear();
   };
   // Readings come in time order: a group is complete when any later time arrives.
@@ -314,6 +328,14 @@ std::map<int, std::string> device_names(const st::Store& store, std::int64_t run
   return names;
 }
 
+// A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
 constexpr const char* kReadingColumns =
     "time_s,utc,device,device_name,channel,quantity,status,value,time_ns";
 constexpr const char* kTargetColumns =
@@ -322,13 +344,13 @@ constexpr const char* kTargetColumns =
 
 void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
                          std::FILE* out) {
-  const ExportClock clock(store, run, settings);
+  ExportClock clock(store, run, settings);
   const auto names = device_names(store, run.id);
   fmt::print(out, "{}\n", kReadingColumns);
   each_export_row(store, run.id, clock, [&](const ExportRow& x) {
     const auto it = names.find(x.r.device);
     fmt::print(out, "{},{},{},{},{},{},{},{},{}\n", num(clock.seconds(x.session_ns)),
-               clock.utc(x.session_ns), x.r.device, it == names.end() ? "" : it->second,
+               clock.utc(x.session_ns), x.r.device, csv_field(it == names.end() ? "" : it->second),
                x.r.channel, cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
                x.r.status, num(x.r.value), x.r.time_ns);
   });
@@ -391,7 +413,7 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
                  std::FILE* out) {
   json j = run_json(run);
   j["schema"] = "caldaq.export.v1";
-  const ExportClock clock(store, run, settings);
+  ExportClock clock(store, run, settings);
   const auto names = device_names(store, run.id);
   json readings = json::array();
   each_export_row(store, run.id, clock, [&](const ExportRow& x) {

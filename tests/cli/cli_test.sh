@@ -98,7 +98,7 @@ RTX_DATA='\x00\x00\x00\x00\x00\x00\xf0\x3f\x00\x00\x00\x00\x00\x00\x04\xc0\x00\x
 { printf "$RTX_HEAD"; printf "$RTX_DATA"; printf 'EOF::\r\n'; } >"$TMP/t.rtx"
 { printf "$RTX_HEAD"; printf "$RTX_DATA" | head -c 20; } >"$TMP/cut.rtx"
 check import_rtx 0 "^  range -2\.500000 \.\. 1\.000000 mm" -- "$DAQ" import rtx "$TMP/t.rtx" --db "$TMP/rtx.sqlite"
-check import_rtx_export 0 "^0\.001,,0,[a-z0-9]*,0,displacement_m,0,-0\.0025,1000000$" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"
+check import_rtx_export 0 "^0\.001,,0,renishaw-rtx \(CARTO-Dynamic 4\.13\),0,displacement_m,0,-0\.0025,1000000$" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"
 check import_rtx_cut 0 "note: the file ends inside a sample \(4 bytes dropped\)" -- "$DAQ" import rtx "$TMP/cut.rtx" --db "$TMP/rtx.sqlite"
 check import_rtx_cut_incomplete 0 "2 +2026.*dynamic +Y +incomplete +2" -- "$DAQ" runs --db "$TMP/rtx.sqlite"
 check import_not_rtx 2 "data/run/refused.toml: byte 0: not a Renishaw .rtx file" -- "$DAQ" import rtx "$DATA/run/refused.toml" --db "$TMP/rtx.sqlite"

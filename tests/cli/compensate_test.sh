@@ -19,7 +19,7 @@ check cross 0 "^1,100\.0000,-1\.000$" -- "$DAQ" compensate --straightness "$DATA
 check inch_columns 0 "^point,position_in,value_in$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
 check inch_value 0 "^2,3\.93701,-0\.00016$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
 check inch_header 0 "values in inch" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
-check bad_units 2 "units: 'furlong' not in" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units furlong
+check bad_units 2 "units 'furlong' \\(expected mm, um or inch\\)" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units furlong
 check outside 2 "grid point -50 mm is outside the measured range 0 \.\. 200 mm" -- "$DAQ" compensate -i "$DATA/meas.csv" --start-mm -50 --interval-mm 50 --points 3
 check linuxcnc_incremental 2 "absolute corrections" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f linuxcnc --incremental
 check bad_format 2 "format 'fanuc'" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f fanuc
