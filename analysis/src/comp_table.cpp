@@ -169,7 +169,8 @@ std::string write_csv(const Table& t) {
     out += t.spec.bidirectional ? "point,position_in,forward_in,reverse_in\n"
                                 : "point,position_in,value_in\n";
   else
-    out += t.spec.bidirectional ? "point,position_mm,forward,reverse\n" : "point,position_mm,value\n";
+    out +=
+        t.spec.bidirectional ? "point,position_mm,forward,reverse\n" : "point,position_mm,value\n";
   for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
     if (inch)
       out += fmt::format("{},{:.5f},{:.{}f}", i, t.position_mm[i] / 25.4, t.forward[i], d);

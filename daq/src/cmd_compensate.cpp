@@ -2,8 +2,8 @@
 #include <fmt/format.h>
 
 #include <fstream>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"

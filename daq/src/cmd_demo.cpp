@@ -18,15 +18,15 @@
 #include "cal/drivers/transport/transport.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
+#include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
 #include "iso230_2_output.hpp"
-#include "circle_output.hpp"
 #include "linear_run.hpp"
 #include "provenance.hpp"
-#include "verdict.hpp"
 #include "session_spec.hpp"
 #include "sim_shop.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -296,8 +296,8 @@ int run_demo(const DemoOptions& o) {
                  m.direction == '+' ? "up" : "down", m.target_index + 1, m.nominal_mm);
   }
   print(*out.evaluation);
-  print_verdict(linear_verdict(run_context(config, "linear", "X")["tolerances"],
-                               to_json(*out.evaluation)));
+  print_verdict(
+      linear_verdict(run_context(config, "linear", "X")["tolerances"], to_json(*out.evaluation)));
   const auto truth =
       cal::iso230_2::evaluate(shop.true_measurements(run.plan()), out.evaluation->standard.id);
   print_comparison(*out.evaluation, truth, shop.truth());

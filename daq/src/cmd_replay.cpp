@@ -8,13 +8,13 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/replay/session.hpp"
+#include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
-#include "cal/storage/store.hpp"
 #include "session_spec.hpp"
 
 namespace daq {
@@ -153,7 +153,8 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-  if (!out.missed.empty()) fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
+  if (!out.missed.empty())
+    fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
   print(*out.evaluation);
 }
 

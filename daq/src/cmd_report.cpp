@@ -87,7 +87,8 @@ void run_report_command(ReportOptions o) {
                                         store.path().string(), o.campaign));
   }
   if (o.runs.empty() && !o.as_found && !o.as_left)
-    throw cal::InputError("report: give one or more RUN numbers, --campaign, or --as-found and --as-left");
+    throw cal::InputError(
+        "report: give one or more RUN numbers, --campaign, or --as-found and --as-left");
   const cal::daq::report::Options ro{.standard = o.standard, .software = "daq 0.1.0"};
   std::string html, kind, stem;
   if (o.as_found || o.as_left) {
@@ -154,8 +155,9 @@ void add_report_command(CLI::App& app) {
   cmd->add_option("--campaign", o->campaign, "Report every run of this campaign");
   cmd->add_flag("--compare", o->compare,
                 "Overlay the same test of several runs and show the results over time");
-  cmd->add_option("--as-found", o->as_found,
-                  "With --as-left: the run before the compensation, side by side with the run after");
+  cmd->add_option(
+      "--as-found", o->as_found,
+      "With --as-left: the run before the compensation, side by side with the run after");
   cmd->add_option("--as-left", o->as_left, "With --as-found: the run after the compensation");
   cmd->add_option("-f,--format", o->format, "html or pdf")->capture_default_str();
   cmd->add_option("-o,--output", o->output,

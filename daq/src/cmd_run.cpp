@@ -25,9 +25,9 @@
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
 #include "provenance.hpp"
-#include "verdict.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -77,7 +77,8 @@ struct ProgressOut {
   std::FILE* out;
   bool tty;
   std::string last;  // the last progress line written to a file or pipe
-  explicit ProgressOut(bool json) : out(json ? stderr : stdout), tty(::isatty(::fileno(out)) != 0) {}
+  explicit ProgressOut(bool json)
+      : out(json ? stderr : stdout), tty(::isatty(::fileno(out)) != 0) {}
   void event(const std::string& e) {
     fmt::print(out, "{}  {}\n", tty ? "\r\033[K" : "", e);
     std::fflush(out);
@@ -147,8 +148,8 @@ void run_linear(const RunOptions& o) {
     j["verdict"] = to_json(v);
     return fmt::print("{}\n", j.dump(2));
   }
-  fmt::print("{}\nrun {} stored ({}): {} readings\n", progress->tty ? "\r\033[K" : "",
-             out.run_id, cal::storage::to_string(out.status), out.readings);
+  fmt::print("{}\nrun {} stored ({}): {} readings\n", progress->tty ? "\r\033[K" : "", out.run_id,
+             cal::storage::to_string(out.status), out.readings);
   if (!out.missed.empty()) {
     fmt::print("INCOMPLETE: {}; the evaluation uses the stops captured:\n", out.reason);
     for (const auto& m : out.missed)

@@ -7,13 +7,13 @@
 #include <ctime>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <tuple>
-#include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
-#include "cal/drivers/instrument.hpp"
 #include "cal/daq/ballbar.hpp"
+#include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
@@ -96,13 +96,14 @@ std::string missed_text(const st::MissedStop& m) {
 // One line saying how a result was obtained, from its provenance.
 std::string provenance_text(const json& p) {
   if (!p.is_object() || !p.contains("how")) return "provenance not recorded (stored before it was)";
-  std::string s = p.value("how", "") + " " + p.value("created_utc", "") + " by " +
-                  p.value("software", "?");
+  std::string s =
+      p.value("how", "") + " " + p.value("created_utc", "") + " by " + p.value("software", "?");
   if (p.contains("of_result") && !p["of_result"].is_null())
     s += fmt::format(", of result {}", p["of_result"].get<std::int64_t>());
   if (p.contains("replay_of_run"))
-    s += p["replay_of_run"].is_null() ? std::string(", replay of a run not in this database")
-                                      : fmt::format(", replay of run {}", p["replay_of_run"].get<std::int64_t>());
+    s += p["replay_of_run"].is_null()
+             ? std::string(", replay of a run not in this database")
+             : fmt::format(", replay of run {}", p["replay_of_run"].get<std::int64_t>());
   if (const auto c = p.find("coefficients"); c != p.end())
     s += fmt::format("; {}, {} ppm/K", c->value("equation", "?"),
                      c->value("expansion_ppm_per_k", 0.0));
@@ -124,8 +125,8 @@ void print_result_values(const json& doc) {
                runs_text(doc));
     const json axis = doc.value("axis", json::object());
     for (const auto& [key, a] : axis.items())
-      fmt::print("      {:<8} {:>10.3f} um   {}\n", a.value("symbol", key), a.value("value_um", 0.0),
-                 a.value("description", ""));
+      fmt::print("      {:<8} {:>10.3f} um   {}\n", a.value("symbol", key),
+                 a.value("value_um", 0.0), a.value("description", ""));
   } else if (doc.value("schema", "") == "caldaq.circle.v1") {
     const auto iso = doc.value("iso230_4", json::object());
     fmt::print("      G {:.3f} um (ccw {:.3f}, cw {:.3f}), H {:.3f} um, F {:+.3f} / {:+.3f} um\n",
@@ -182,11 +183,12 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
   if (j["results"].empty()) fmt::print("  no results stored\n");
   for (const auto& res : j["results"]) {
     const bool current = res["current"].get<bool>();
-    fmt::print("  result {}: {} ({}){}\n", res["id"].get<std::int64_t>(),
-               res["standard"].get<std::string>(),
-               current ? "current"
-                       : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
-               "");
+    fmt::print(
+        "  result {}: {} ({}){}\n", res["id"].get<std::int64_t>(),
+        res["standard"].get<std::string>(),
+        current ? "current"
+                : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
+        "");
     fmt::print("    {}\n", provenance_text(res["provenance"]));
     if (!current) continue;  // the old values stay in --json
     print_result_values(res["result"]);
@@ -241,7 +243,8 @@ class ExportClock {
       if (!any) t0_ns_ = r.time_ns, any = true;
     });
     for (const auto& [k, sp] : spans)
-      period_ns_[k] = sp.n > 1 ? static_cast<double>(sp.last - sp.first) / static_cast<double>(sp.n - 1) : 0.0;
+      period_ns_[k] =
+          sp.n > 1 ? static_cast<double>(sp.last - sp.first) / static_cast<double>(sp.n - 1) : 0.0;
     // A ballbar's samples come at the programmed rate (device 3 of a circle run).
     if (run.kind == "circle" && settings.is_object() && settings.value("sample_rate_hz", 0.0) > 0)
       for (auto& [k, p] : period_ns_)
@@ -274,9 +277,11 @@ class ExportClock {
   // was recorded, or imported).
   std::string utc(double session_ns) const {
     if (!unix0_ns_) return "";
-    const auto ns = *unix0_ns_ + static_cast<std::int64_t>(std::llround(session_ns - static_cast<double>(t0_ns_)));
+    const auto ns = *unix0_ns_ + static_cast<std::int64_t>(
+                                     std::llround(session_ns - static_cast<double>(t0_ns_)));
     const std::int64_t us = ns >= 0 ? ns / 1000 : (ns - 999) / 1000;
-    const std::time_t s = static_cast<std::time_t>(us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000);
+    const std::time_t s =
+        static_cast<std::time_t>(us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000);
     std::tm tm{};
     gmtime_r(&s, &tm);
     std::array<char, 32> buf{};
@@ -351,7 +356,8 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
     const auto it = names.find(x.r.device);
     fmt::print(out, "{},{},{},{},{},{},{},{},{}\n", num(clock.seconds(x.session_ns)),
                clock.utc(x.session_ns), x.r.device, csv_field(it == names.end() ? "" : it->second),
-               x.r.channel, cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
+               x.r.channel,
+               cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
                x.r.status, num(x.r.value), x.r.time_ns);
   });
 }
@@ -359,9 +365,9 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
 void export_targets_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
                         std::FILE* out) {
   if (run.kind != "linear")
-    throw cal::InputError(fmt::format(
-        "run {} is a {} test and has no captured stops: use --what {} (or readings)", run.id,
-        run.kind, run.kind == "circle" ? "circle" : "readings"));
+    throw cal::InputError(
+        fmt::format("run {} is a {} test and has no captured stops: use --what {} (or readings)",
+                    run.id, run.kind, run.kind == "circle" ? "circle" : "readings"));
   const ExportClock clock(store, run, settings);
   // The header is what `daq analyse iso230-2 --input` reads (target_mm, run, direction,
   // deviation_um); the rest it ignores.
@@ -392,14 +398,18 @@ void export_circle_csv(const st::Store& store, const st::RunRecord& run, const j
   });
   const auto traces = segmenter.traces();
   if (traces.empty())
-    throw cal::InputError(fmt::format("run {}: the stored bar readings hold no complete arc", run.id));
-  std::string options = fmt::format("--radius-mm {} --feed-mm-min {} --plane {}", num(program.radius_mm),
-                                    num(program.feed_mm_per_min), analysis.plane);
+    throw cal::InputError(
+        fmt::format("run {}: the stored bar readings hold no complete arc", run.id));
+  std::string options =
+      fmt::format("--radius-mm {} --feed-mm-min {} --plane {}", num(program.radius_mm),
+                  num(program.feed_mm_per_min), analysis.plane);
   if (analysis.calibrated_radius_mm)
     options += fmt::format(" --calibrated-radius-mm {}", num(*analysis.calibrated_radius_mm));
   if (analysis.uncalibrated) options += " --uncalibrated";
-  if (analysis.cyclic_period_mm) options += fmt::format(" --cyclic-period-mm {}", num(*analysis.cyclic_period_mm));
-  fmt::print(out, "# caldaq run {}: ballbar circle, analyse with: daq analyse circle --input FILE {}\n",
+  if (analysis.cyclic_period_mm)
+    options += fmt::format(" --cyclic-period-mm {}", num(*analysis.cyclic_period_mm));
+  fmt::print(out,
+             "# caldaq run {}: ballbar circle, analyse with: daq analyse circle --input FILE {}\n",
              run.id, options);
   fmt::print(out, "direction,angle_deg,deviation_um\n");
   for (const auto& t : traces) {
@@ -423,8 +433,8 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
                         cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
                         x.r.status, x.r.value, x.r.time_ns});
   });
-  j["reading_columns"] = {"time_s", "utc", "device", "device_name", "channel", "quantity",
-                          "status", "value", "time_ns"};
+  j["reading_columns"] = {"time_s",   "utc",    "device", "device_name", "channel",
+                          "quantity", "status", "value",  "time_ns"};
   j["readings"] = std::move(readings);
   json targets = json::array();
   for (const auto& t : store.targets(run.id))

@@ -2,7 +2,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -134,7 +133,8 @@ struct RecompensateOptions {
 void recompensate(const RecompensateOptions& o) {
   // A correction must be a finite number (the option parser takes "nan" and "inf").
   for (const auto& [name, value] :
-       {std::pair{"--alpha-ppm", o.alpha_ppm_per_k}, std::pair{"--material-offset", o.material_offset_k},
+       {std::pair{"--alpha-ppm", o.alpha_ppm_per_k},
+        std::pair{"--material-offset", o.material_offset_k},
         std::pair{"--air-temperature-offset", o.air_temperature_offset_k},
         std::pair{"--pressure-offset", o.pressure_offset_pa},
         std::pair{"--humidity-offset", o.humidity_offset_pct}})
@@ -238,8 +238,8 @@ void recompensate(const RecompensateOptions& o) {
   const auto v = verdict_of(settings, doc);
   doc["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", doc.dump(2));
-  fmt::print("run {}: {} stops recompensated (largest change {:.3f} um), stored as result {}", o.run,
-             targets.size(), max_change_um, id);
+  fmt::print("run {}: {} stops recompensated (largest change {:.3f} um), stored as result {}",
+             o.run, targets.size(), max_change_um, id);
   if (used.result_id) fmt::print(", superseding result {}", *used.result_id);
   fmt::print("\n");
   if (changed.empty()) fmt::print("  nothing changed: the same coefficients and offsets again\n");

@@ -47,7 +47,8 @@ std::string runs_text(const nlohmann::json& doc) {
   const auto targets = doc.value("targets", nlohmann::json::array());
   for (const auto& t : targets)
     for (const char* key : {"runs_up", "runs_down"})
-      if (t.contains(key)) lo = std::min(lo, t[key].get<int>()), hi = std::max(hi, t[key].get<int>());
+      if (t.contains(key))
+        lo = std::min(lo, t[key].get<int>()), hi = std::max(hi, t[key].get<int>());
   if (hi == 0) return fmt::format("{} runs per direction", doc.value("runs_per_direction", 0));
   if (lo == hi) return fmt::format("{} runs per direction", hi);
   for (const auto& t : targets)
@@ -55,9 +56,11 @@ std::string runs_text(const nlohmann::json& doc) {
       if (t.contains(key) && t[key].get<int>() < hi)
         fewer.push_back(fmt::format("{} at {:.3f} mm {}", t[key].get<int>(),
                                     t.value("target_mm", 0.0),
-                                    !bi ? "" : std::string_view(key) == "runs_up" ? "up" : "down"));
-  return fmt::format("{} to {} runs per direction ({} at every other target and direction; {})",
-                     lo, hi, hi, fmt::join(fewer, ", "));
+                                    !bi                                  ? ""
+                                    : std::string_view(key) == "runs_up" ? "up"
+                                                                         : "down"));
+  return fmt::format("{} to {} runs per direction ({} at every other target and direction; {})", lo,
+                     hi, hi, fmt::join(fewer, ", "));
 }
 
 std::string runs_text(const cal::iso230_2::Evaluation& e) {

@@ -128,7 +128,8 @@ std::optional<cal::storage::ResultRecord> current_result(
 CompensationUsed compensation_used(const json& settings,
                                    const std::vector<cal::storage::ResultRecord>& results) {
   CompensationUsed u;
-  const json env = settings.is_object() ? settings.value("environment", json::object()) : json::object();
+  const json env =
+      settings.is_object() ? settings.value("environment", json::object()) : json::object();
   u.coefficients = {{"equation", env.value("equation", "ciddor")},
                     {"expansion_ppm_per_k", env.value("expansion_ppm_per_k", 11.5)},
                     {"co2_umol_per_mol", env.value("co2_umol_per_mol", 450.0)},
@@ -159,12 +160,14 @@ CompensationUsed compensation_used(const json& settings,
 }
 
 std::string utc_iso(std::int64_t unix_ms) {
-  const std::time_t s = static_cast<std::time_t>(unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000);
+  const std::time_t s =
+      static_cast<std::time_t>(unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000);
   std::tm tm{};
   gmtime_r(&s, &tm);
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
-  return fmt::format("{}.{:03d}Z", buf, static_cast<int>(unix_ms - static_cast<std::int64_t>(s) * 1000));
+  return fmt::format("{}.{:03d}Z", buf,
+                     static_cast<int>(unix_ms - static_cast<std::int64_t>(s) * 1000));
 }
 
 std::string utc_now_iso() {

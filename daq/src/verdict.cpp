@@ -66,7 +66,8 @@ Verdict linear_verdict(const json& tolerances, const json& result) {
       continue;
     }
     const double value = axis[key].value("value_um", 0.0), lim = limits[m.limit].get<double>();
-    v.checks.push_back({key, axis[key].value("symbol", name), value, lim, "um", within(value, lim)});
+    v.checks.push_back(
+        {key, axis[key].value("symbol", name), value, lim, "um", within(value, lim)});
   }
   v.configured = !v.checks.empty();
   v.pass = v.configured;
@@ -90,9 +91,9 @@ Verdict circle_verdict(const json& tolerances, const json& result) {
     for (const auto& d : reported)
       if (d.value("key", "") == key) found = &d;
     if (!found) {
-      v.notes.push_back(fmt::format(
-          "{} limit {:g} not applied: this run's analysis did not report it", key,
-          lim.get<double>()));
+      v.notes.push_back(
+          fmt::format("{} limit {:g} not applied: this run's analysis did not report it", key,
+                      lim.get<double>()));
       continue;
     }
     const double value = found->value("value", 0.0);
@@ -117,12 +118,9 @@ Verdict verdict_of(const json& settings, const json& result) {
 }
 
 json to_json(const Verdict& v) {
-  json j{{"configured", v.configured},
-         {"pass", v.configured ? json(v.pass) : json(nullptr)},
-         {"summary", summary(v)},
-         {"basis", v.basis},
-         {"notes", v.notes},
-         {"checks", json::array()}};
+  json j{{"configured", v.configured}, {"pass", v.configured ? json(v.pass) : json(nullptr)},
+         {"summary", summary(v)},      {"basis", v.basis},
+         {"notes", v.notes},           {"checks", json::array()}};
   for (const auto& c : v.checks)
     j["checks"].push_back({{"key", c.key},
                            {"symbol", c.symbol},

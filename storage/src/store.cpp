@@ -640,8 +640,7 @@ std::vector<MissedStop> Store::missed_stops(std::int64_t run_id) const {
 }
 
 void Store::set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns) {
-  auto s = impl_->prepare(
-      "UPDATE runs SET origin_session_ns = ?, origin_unix_ns = ? WHERE id = ?");
+  auto s = impl_->prepare("UPDATE runs SET origin_session_ns = ?, origin_unix_ns = ? WHERE id = ?");
   sqlite3_bind_int64(s.get(), 1, session_ns);
   sqlite3_bind_int64(s.get(), 2, unix_ns);
   sqlite3_bind_int64(s.get(), 3, run_id);

@@ -197,13 +197,14 @@ TEST(Config, RefusesBadLimitsDatesAndNames) {
   EXPECT_EQ(error_of("[tolerances.X]\nR_um = 0\n"),
             "machine.toml:2:8: key 'tolerances.X.R_um': a limit is a finite number > 0, not 0");
   EXPECT_EQ(error_of("[tolerances.X]\nF_um = 3\n"),
-            "machine.toml:2:1: key 'tolerances.X.F_um': unknown key (a typo?)");
+            "machine.toml:2:8: key 'tolerances.X.F_um': unknown key (a typo?)");
   EXPECT_EQ(error_of("[tolerances.Q]\nE_um = 3\n"),
             "machine.toml:1:1: key 'tolerances.Q': expected an axis (X, Y, Z) or a plane (XY, YZ, "
             "ZX)");
-  EXPECT_NE(error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
-                .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
+          .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),
+      std::string::npos);
   EXPECT_NE(error_of("[[tolerances.X.by_length]]\nup_to_mm = 500\nA_um = 8\n"
                      "[[tolerances.X.by_length]]\nup_to_mm = 300\nA_um = 6\n")
                 .find("entries must ascend in up_to_mm"),
@@ -215,7 +216,7 @@ TEST(Config, RefusesBadLimitsDatesAndNames) {
   EXPECT_EQ(error_of("[conditions]\nstate = \"as new\"\n"),
             "machine.toml:2:9: key 'conditions.state': 'as new' is not one of: as found, as left");
   EXPECT_EQ(error_of("[customer]\nname = \"A\"\ncity = \"B\"\n"),
-            "machine.toml:3:1: key 'customer.city': unknown key (a typo?)");
+            "machine.toml:3:8: key 'customer.city': unknown key (a typo?)");
 }
 
 TEST(Config, MissingFileIsNamed) {

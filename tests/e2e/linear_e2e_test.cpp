@@ -9,9 +9,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <cstdlib>
-#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -19,8 +19,8 @@
 
 #include "cal/drivers/instruments.hpp"
 #include "cal/storage/store.hpp"
-#include "circle_run.hpp"
 #include "circle_output.hpp"
+#include "circle_run.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
 #include "sim_shop.hpp"

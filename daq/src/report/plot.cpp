@@ -107,7 +107,8 @@ class SvgStream {
     static std::atomic<int> counter{0};
     const std::string prefix = fmt::format("plot{}-", ++counter);
     std::vector<std::string> ids;
-    for (std::size_t at = s.find(" id=\""); at != std::string::npos; at = s.find(" id=\"", at + 1)) {
+    for (std::size_t at = s.find(" id=\""); at != std::string::npos;
+         at = s.find(" id=\"", at + 1)) {
       const auto begin = at + 5, end = s.find('"', begin);
       if (end == std::string::npos) break;
       ids.push_back(s.substr(begin, end - begin));
@@ -257,7 +258,8 @@ std::string svg(const XyChart& chart) {
   const Range yr = y.padded(0.08);
   plwind(xr.lo, xr.hi, yr.lo, yr.hi);
   const bool categories = !chart.x_labels.empty();
-  if (categories) plslabelfunc(category_label, const_cast<std::vector<std::string>*>(&chart.x_labels));
+  if (categories)
+    plslabelfunc(category_label, const_cast<std::vector<std::string>*>(&chart.x_labels));
   const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
   const auto [ystep, ydigits] = ticks_for(yr.hi - yr.lo, 6);
   const double xtick = categories ? 1.0 : xstep;
@@ -296,8 +298,7 @@ std::string svg(const XyChart& chart) {
   if (categories) plslabelfunc(nullptr, nullptr);
   pllab(chart.x_label.c_str(), chart.y_label.c_str(), chart.title.c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
-  if (legend)
-    draw_legend(entries, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
+  if (legend) draw_legend(entries, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
   return s.finish(chart.title);
 }
 
@@ -362,7 +363,8 @@ std::string svg(const PolarChart& chart) {
   // The rings' values in the corner, outside the traces (a label on a ring would sit on them).
   plcol0(reference_colour);
   plschr(0, 0.75);
-  plptex(-1.68, 1.62, 1, 0, 0, fmt::format("rings: {:+g} to {:+g} µm", -2 * div_um, 2 * div_um).c_str());
+  plptex(-1.68, 1.62, 1, 0, 0,
+         fmt::format("rings: {:+g} to {:+g} µm", -2 * div_um, 2 * div_um).c_str());
   plptex(-1.68, 1.50, 1, 0, 0, "dark ring: nominal radius");
   plschr(0, 0.85);
   for (int a = 0; a < 360; a += 30) {

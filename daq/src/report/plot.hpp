@@ -46,7 +46,7 @@ struct XyChart {
   // Categories instead of numbers on x: the lines' x are 0, 1, ... and tick k is labelled
   // x_labels[k] (e.g. the dates of runs).
   std::vector<std::string> x_labels;
-  bool legend = true;  // false: no legend even for labelled lines (small multiples)
+  bool legend = true;       // false: no legend even for labelled lines (small multiples)
   double text_scale = 1.0;  // > 1 for a small plot shown small (its text stays readable)
 };
 
@@ -58,8 +58,8 @@ struct PolarChart {
   std::string first_axis = "X", second_axis = "Y";
   std::vector<Line> traces;
   int size_pt = 520;
-  std::string centre_text;   // written at the centre, e.g. "G = 6.96 µm"
-  bool mark_start = true;    // each trace's first point marked, an arrow in its direction
+  std::string centre_text;  // written at the centre, e.g. "G = 6.96 µm"
+  bool mark_start = true;   // each trace's first point marked, an arrow in its direction
 };
 
 // Text for HTML and SVG: < > & " escaped.

@@ -263,7 +263,8 @@ std::string setup_section(const RunView& v) {
     if (k == "context") continue;  // shown in its own sections
     if (val.is_object()) {
       for (const auto& [k2, v2] : val.items())
-        settings.push_back({esc(k + "." + k2), esc(setting_text(v2)) + used_note(k + "." + k2, v2)});
+        settings.push_back(
+            {esc(k + "." + k2), esc(setting_text(v2)) + used_note(k + "." + k2, v2)});
     } else {
       settings.push_back({esc(k), esc(setting_text(val))});
     }
@@ -359,9 +360,10 @@ std::string instruments_section(const RunView& v) {
   const auto list = v.context.value("instruments", json::array());
   std::string h = "<h3>Instruments and calibration</h3>\n";
   if (list.empty())
-    return h + "<p class=\"unstated\">The instruments' serial numbers and calibration "
-               "certificates were not recorded with this run (give serial_number, certificate "
-               "and calibration_due of each device in the configuration).</p>\n";
+    return h +
+           "<p class=\"unstated\">The instruments' serial numbers and calibration "
+           "certificates were not recorded with this run (give serial_number, certificate "
+           "and calibration_due of each device in the configuration).</p>\n";
   std::vector<std::vector<std::string>> rows;
   std::vector<std::string> past;
   const std::string test_day = ymd(v.run.started_unix_ms);
@@ -392,11 +394,10 @@ std::string conditions_section(const RunView& v) {
   if (c.contains("controller_compensation") && c["controller_compensation"].is_boolean())
     comp = c["controller_compensation"].get<bool>() ? "on (the control's own compensation active)"
                                                     : "off (the machine's errors uncompensated)";
-  std::vector<std::vector<std::string>> rows = {
-      {"Controller compensation", comp},
-      {"Warm-up", stated(ctx(c, "warm_up"))},
-      {"Load", stated(ctx(c, "load"))},
-      {"Machine state", stated(ctx(c, "state"))}};
+  std::vector<std::vector<std::string>> rows = {{"Controller compensation", comp},
+                                                {"Warm-up", stated(ctx(c, "warm_up"))},
+                                                {"Load", stated(ctx(c, "load"))},
+                                                {"Machine state", stated(ctx(c, "state"))}};
   if (!ctx(c, "notes").empty()) rows.push_back({"Notes", esc(ctx(c, "notes"))});
   const std::string sign =
       v.run.kind == "circle"
@@ -453,30 +454,33 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
   const auto current = ::daq::current_result(v.results, schema);
   std::string h = "<h3>How these results were obtained</h3>\n";
   if (!current)
-    return h + "<p>No result is stored with this run: the values below are evaluated from the "
-               "stored data now.</p>\n";
+    return h +
+           "<p>No result is stored with this run: the values below are evaluated from the "
+           "stored data now.</p>\n";
   const json p = json::parse(current->provenance_json, nullptr, false);
   std::vector<std::vector<std::string>> rows;
   const std::string how = p.is_object() ? p.value("how", "") : "";
-  rows.push_back({"Current result", fmt::format("result {} ({}), stored {}", current->id,
-                                                esc(current->standard),
-                                                iso_time(current->created_unix_ms))});
-  rows.push_back({"Obtained", how.empty() ? "not recorded (stored before provenance was)"
-                                          : esc(how)});
-  if (p.is_object() && p.contains("software")) rows.push_back({"Software", esc(p.value("software", ""))});
+  rows.push_back(
+      {"Current result", fmt::format("result {} ({}), stored {}", current->id,
+                                     esc(current->standard), iso_time(current->created_unix_ms))});
+  rows.push_back(
+      {"Obtained", how.empty() ? "not recorded (stored before provenance was)" : esc(how)});
+  if (p.is_object() && p.contains("software"))
+    rows.push_back({"Software", esc(p.value("software", ""))});
   if (p.is_object() && p.contains("replay_of_run"))
-    rows.push_back({"Replay of", p["replay_of_run"].is_null()
-                                     ? "a capture whose original run is not in this database"
-                                     : fmt::format("run {} (capture {})",
-                                                   p["replay_of_run"].get<std::int64_t>(),
-                                                   esc(p.value("capture", "")))});
+    rows.push_back({"Replay of",
+                    p["replay_of_run"].is_null()
+                        ? "a capture whose original run is not in this database"
+                        : fmt::format("run {} (capture {})", p["replay_of_run"].get<std::int64_t>(),
+                                      esc(p.value("capture", "")))});
   if (p.is_object() && p.contains("of_result") && !p["of_result"].is_null())
-    rows.push_back({"Re-compensation of", fmt::format("result {}", p["of_result"].get<std::int64_t>())});
+    rows.push_back(
+        {"Re-compensation of", fmt::format("result {}", p["of_result"].get<std::int64_t>())});
   std::size_t older = 0;
   for (const auto& r : v.results) older += r.current() ? 0 : 1;
   if (older)
-    rows.push_back({"Earlier results", fmt::format("{} kept, superseded (daq show {})", older,
-                                                   v.run.id)});
+    rows.push_back(
+        {"Earlier results", fmt::format("{} kept, superseded (daq show {})", older, v.run.id)});
   h += table({"", ""}, rows, "kv");
   if (v.run.kind != "linear") return h;
   // Coefficients and offsets: as acquired, and used by the current result.
@@ -490,8 +494,7 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
   };
   row("Refractive index equation", env.value("equation", "ciddor"),
       u.coefficients.value("equation", "ciddor"));
-  row("Expansion coefficient (ppm/K)",
-      setting_text(env.value("expansion_ppm_per_k", json(11.5))),
+  row("Expansion coefficient (ppm/K)", setting_text(env.value("expansion_ppm_per_k", json(11.5))),
       setting_text(u.coefficients.value("expansion_ppm_per_k", json(11.5))));
   row("CO2 (µmol/mol)", setting_text(env.value("co2_umol_per_mol", json(450))),
       setting_text(u.coefficients.value("co2_umol_per_mol", json(450))));
@@ -520,12 +523,12 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
   for (const auto& [key, x] : a.items()) {
     if (!b.contains(key)) continue;
     const double before = x.value("value_um", 0.0), after = b[key].value("value_um", 0.0);
-    vals.push_back({esc(x.value("symbol", key)), um(before), um(after), fmt::format("{:+.3f}", after - before)});
+    vals.push_back({esc(x.value("symbol", key)), um(before), um(after),
+                    fmt::format("{:+.3f}", after - before)});
   }
   h += fmt::format("<h4>Original (result {}) and re-compensated (result {}) values</h4>\n",
                    original->id, current->id) +
-       table({"value", "original (µm)", "re-compensated (µm)", "change (µm)"}, vals, "num",
-             "lrrr");
+       table({"value", "original (µm)", "re-compensated (µm)", "change (µm)"}, vals, "num", "lrrr");
   return h;
 }
 
@@ -579,7 +582,8 @@ cal::unc::Budget linear_budget(const RunView& v, const Linear& l, double& length
   if (!v.env.pressure_hpa.empty())
     s.air.pressure_pa = stats(v.env.pressure_hpa).mean * 100.0 + off.pressure_pa;
   if (!v.env.humidity.empty())
-    s.air.humidity = cal::air::Humidity::relative_pct(stats(v.env.humidity).mean + off.humidity_pct);
+    s.air.humidity =
+        cal::air::Humidity::relative_pct(stats(v.env.humidity).mean + off.humidity_pct);
   s.air.co2_umol_per_mol = c.value("co2_umol_per_mol", 450.0);
   s.air.wavelength_vacuum_nm = c.value("wavelength_nm", 632.991);
   if (!v.env.material_temperature.empty())
@@ -606,16 +610,23 @@ std::string linear_plots(const Linear& l) {
                 .height_pt = 430,
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
-  means.bands.push_back({.x = x, .lo = up_lo, .hi = up_hi, .label = "", .colour = blue, .alpha = 0.12});
-  means.lines.push_back({.x = x, .y = up_hi, .label = "x̄↑ ± 2s", .colour = blue, .width = 0.8, .dashed = true});
+  means.bands.push_back(
+      {.x = x, .lo = up_lo, .hi = up_hi, .label = "", .colour = blue, .alpha = 0.12});
+  means.lines.push_back(
+      {.x = x, .y = up_hi, .label = "x̄↑ ± 2s", .colour = blue, .width = 0.8, .dashed = true});
   means.lines.push_back({.x = x, .y = up_lo, .colour = blue, .width = 0.8, .dashed = true});
   means.lines.push_back({.x = x, .y = up, .label = "x̄↑", .colour = blue, .markers = true});
   if (e.bidirectional) {
     means.bands.push_back(
         {.x = x, .lo = down_lo, .hi = down_hi, .label = "", .colour = vermilion, .alpha = 0.12});
+    means.lines.push_back({.x = x,
+                           .y = down_hi,
+                           .label = "x̄↓ ± 2s",
+                           .colour = vermilion,
+                           .width = 0.8,
+                           .dashed = true});
     means.lines.push_back(
-        {.x = x, .y = down_hi, .label = "x̄↓ ± 2s", .colour = vermilion, .width = 0.8, .dashed = true});
-    means.lines.push_back({.x = x, .y = down_lo, .colour = vermilion, .width = 0.8, .dashed = true});
+        {.x = x, .y = down_lo, .colour = vermilion, .width = 0.8, .dashed = true});
     means.lines.push_back({.x = x, .y = down, .label = "x̄↓", .colour = vermilion, .markers = true});
     means.lines.push_back({.x = x,
                            .y = bi,
@@ -820,8 +831,8 @@ std::string circle_section(const st::Store& store, const RunView& v, Headline& h
       "230-4:2005</strong> (circular tests for numerically controlled machine tools); radius "
       "{:g} mm, feed {:g} mm/min, plane {}, both directions from the stored bar readings.</p>\n",
       c.program.radius_mm, c.program.feed_mm_per_min, esc(c.analysis.plane));
-  const auto doc = ::daq::circle_json(r, c.program.radius_mm, c.analysis.plane,
-                                     c.program.feed_mm_per_min);
+  const auto doc =
+      ::daq::circle_json(r, c.program.radius_mm, c.analysis.plane, c.program.feed_mm_per_min);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
   const auto* g_check = ::daq::find_check(verdict, "G_bi_um");
@@ -854,15 +865,13 @@ std::string circle_section(const st::Store& store, const RunView& v, Headline& h
     const auto* check = ::daq::find_check(verdict, d.key);
     diag.push_back({std::to_string(i + 1), esc(d.name), fmt::format("{:+.3f}", d.value),
                     esc(unit_text(d.unit)), um(d.pv_um), fmt::format("{:.1f}", d.share_pct),
-                    um(d.g_reduction_um),
-                    check ? fmt::format("≤ {:.3f}", check->limit) : "",
+                    um(d.g_reduction_um), check ? fmt::format("≤ {:.3f}", check->limit) : "",
                     check ? verdict_cell(check) : ""});
     if (i < 4) headline.values_um.push_back({d.name, d.pv_um});
   }
-  h += "<h4>Diagnostics, ranked</h4>\n" +
-       table({"rank", "error", "value", "unit", "PV (µm)", "PV / G (%)", "G gain (µm)", "limit",
-              "verdict"},
-             diag, "num diag", "rlrlrrrrl");
+  h += "<h4>Diagnostics, ranked</h4>\n" + table({"rank", "error", "value", "unit", "PV (µm)",
+                                                 "PV / G (%)", "G gain (µm)", "limit", "verdict"},
+                                                diag, "num diag", "rlrlrrrrl");
   h += fmt::format(
       "<p class=\"note\">Each error is fitted to both traces together. <em>value</em> is the "
       "error in its own unit (a backlash in µm, a squareness in µm/m, a servo mismatch in ms); "
@@ -1015,7 +1024,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
          "and instruments: the numbers show what the software measures, not a real machine.</p>\n";
   if (v.run.status != st::RunStatus::complete) {
     h += fmt::format(
-        "<p class=\"warning\">This run is <strong>{}</strong>{}: the results cover only what was "
+        "<p class=\"warning\">This run is {}{}: the results cover only what was "
         "stored.</p>\n",
         st::to_string(v.run.status), v.run.note.empty() ? "" : " (" + esc(v.run.note) + ")");
     if (!v.missed.empty()) {
@@ -1075,12 +1084,13 @@ std::string campaign_report(const st::Store& store, std::span<const std::int64_t
     std::string numbers;
     std::size_t shown = 0;
     for (const auto& [k, val] : hl.values_um)
-      if (shown++ < 8) numbers += fmt::format("<span class=\"nw\">{} {} µm</span>; ", esc(k), um(val));
-    const std::string verdict =
-        hl.verdict == "PASS"   ? "<span class=\"pass\">PASS</span>"
-        : hl.verdict == "FAIL" ? "<span class=\"fail\">FAIL</span>"
-        : hl.verdict.empty()   ? "<span class=\"unstated\">&ndash;</span>"
-                               : "<span class=\"unstated\">no tolerance</span>";
+      if (shown++ < 8)
+        numbers += fmt::format("<span class=\"nw\">{} {} µm</span>; ", esc(k), um(val));
+    const std::string verdict = hl.verdict == "PASS"   ? "<span class=\"pass\">PASS</span>"
+                                : hl.verdict == "FAIL" ? "<span class=\"fail\">FAIL</span>"
+                                : hl.verdict.empty()
+                                    ? "<span class=\"unstated\">&ndash;</span>"
+                                    : "<span class=\"unstated\">no tolerance</span>";
     summary.push_back({fmt::format("<a href=\"#run-{}\">{}</a>", id, id),
                        "<span class=\"nw\">" + date_of(v) + "</span>", esc(v.run.kind),
                        esc(v.run.axis), std::string(st::to_string(v.run.status)), esc(hl.standard),
@@ -1158,15 +1168,23 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     } else {
       const auto c = analyse_circle(store, v);
       polars.push_back(polar_of(c, "", 2 * i, label + " "));
-      values = {{"G_bi_um", "G", "µm", c.result.iso.G_bi_um}, {"H_um", "H", "µm", c.result.iso.H_um}};
+      values = {{"G_bi_um", "G", "µm", c.result.iso.G_bi_um},
+                {"H_um", "H", "µm", c.result.iso.H_um}};
       for (const auto& d : c.result.diagnostics)
-        values.push_back({d.key, d.name, d.unit == "um" ? "µm" : d.unit == "um/m" ? "µm/m" : d.unit,
+        values.push_back({d.key, d.name,
+                          d.unit == "um"     ? "µm"
+                          : d.unit == "um/m" ? "µm/m"
+                                             : d.unit,
                           d.value});
       doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
                                c.program.feed_mm_per_min);
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
-    std::vector<std::string> row{std::to_string(v.run.id), "<span class=\"nw\">" + dates[i] + "</span>"};
+    // A re-compensated run is compared with the values it has now, and says so.
+    std::vector<std::string> row{
+        std::to_string(v.run.id) +
+            (v.used.recompensated ? " <span class=\"changed\">re-compensated</span>" : ""),
+        "<span class=\"nw\">" + dates[i] + "</span>"};
     for (const auto& x : values) {
       if (!trends.count(x.key)) {
         trend_order.push_back(x.key);
@@ -1216,8 +1234,8 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     body += figure(svg(all), "Both directions of every run on one scale.");
   }
   // One small plot per value: each on its own scale, the runs in date order, the limit dashed.
-  static const std::vector<std::string> linear_keys{"E_bi", "R_bi", "A_bi", "M", "B", "B_mean",
-                                                    "P", "Pa", "Ps_max", "U_max"};
+  static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
+                                                    "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
   body += "<h3>Each value over time</h3>\n<div class=\"multiples\">\n";
   std::size_t plotted = 0;
   for (const auto& k : trend_order) {
@@ -1225,13 +1243,22 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
         std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
       continue;
     if (plotted++ >= 10) break;
-    XyChart small{.title = names[k], .x_label = "", .y_label = names[k], .width_pt = 420,
-                  .height_pt = 260, .x_labels = dates, .legend = false, .text_scale = 1.5};
+    XyChart small{.title = names[k],
+                  .x_label = "",
+                  .y_label = names[k],
+                  .width_pt = 420,
+                  .height_pt = 260,
+                  .x_labels = dates,
+                  .legend = false,
+                  .text_scale = 1.5};
     small.lines.push_back(trends[k]);
     if (limits.count(k)) {
       const double n = static_cast<double>(views.size()) - 1;
-      small.lines.push_back({.x = {-0.4, n + 0.4}, .y = {limits[k], limits[k]}, .colour = vermilion,
-                             .width = 1.0, .dashed = true});
+      small.lines.push_back({.x = {-0.4, n + 0.4},
+                             .y = {limits[k], limits[k]},
+                             .colour = vermilion,
+                             .width = 1.0,
+                             .dashed = true});
     }
     body += figure(svg(small), names[k] + (limits.count(k) ? " (dashed: the limit)" : ""));
   }
@@ -1265,9 +1292,12 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
     Side sd;
     if (v.run.kind == "linear") {
       const auto l = evaluate_linear(store, v, o);
-      Line line{.label = fmt::format("{} (run {})", label, v.run.id), .colour = palette(colour),
-                .width = 1.4, .markers = true};
-      for (const auto& t : l.e.targets) line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
+      Line line{.label = fmt::format("{} (run {})", label, v.run.id),
+                .colour = palette(colour),
+                .width = 1.4,
+                .markers = true};
+      for (const auto& t : l.e.targets)
+        line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
       for (const auto& a : l.e.axis) sd.values.emplace_back(a.key, a.symbol, a.value_um);
       sd.doc = ::daq::to_json(l.e);
@@ -1294,8 +1324,7 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
     const auto* cb = ::daq::find_check(b.verdict, key);
     rows.push_back({esc(symbol), um(va) + " " + (ca ? verdict_cell(ca) : ""),
                     vb ? um(*vb) + " " + (cb ? verdict_cell(cb) : "") : "&ndash;",
-                    vb ? fmt::format("{:+.3f}", *vb - va) : "&ndash;",
-                    limit_cell(cb ? cb : ca)});
+                    vb ? fmt::format("{:+.3f}", *vb - va) : "&ndash;", limit_cell(cb ? cb : ca)});
   }
   const auto banner = [](const ::daq::Verdict& v) {
     return !v.configured ? std::string("<span class=\"unstated\">no tolerance configured</span>")

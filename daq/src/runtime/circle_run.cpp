@@ -4,8 +4,8 @@
 #include <fmt/format.h>
 
 #include <boost/asio/io_context.hpp>
-#include <chrono>
 #include <boost/asio/post.hpp>
+#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"

@@ -4,9 +4,9 @@
 #include <fmt/format.h>
 
 #include <boost/asio/io_context.hpp>
-#include <chrono>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "cal/daq/env_stage.hpp"
@@ -166,15 +166,14 @@ struct LinearRun::Impl {
       machine = m->id;
     else
       machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
-    outcome.run_id =
-        store->begin_run({.machine_id = machine,
-                          .campaign = c.campaign,
-                          .kind = "linear",
-                          .axis = c.linear->axis,
-                          .settings_json =
-                              settings_json(c, plan, setup.datum_mm, setup.context_json).dump(),
-                          .capture_path = setup.capture_path,
-                          .software_version = setup.software_version});
+    outcome.run_id = store->begin_run(
+        {.machine_id = machine,
+         .campaign = c.campaign,
+         .kind = "linear",
+         .axis = c.linear->axis,
+         .settings_json = settings_json(c, plan, setup.datum_mm, setup.context_json).dump(),
+         .capture_path = setup.capture_path,
+         .software_version = setup.software_version});
     auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view driver) {
       store->add_instrument({.run_id = outcome.run_id,
                              .device = device,
@@ -329,11 +328,12 @@ struct LinearRun::Impl {
     writer->flush();
     for (const auto i : sequencer.missed()) {
       const auto& s = sequencer.stops()[i];
-      outcome.missed.push_back({.run_id = outcome.run_id,
-                                .run_number = s.run,
-                                .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
-                                .target_index = s.target_index - 1,
-                                .nominal_mm = s.position_mm});
+      outcome.missed.push_back(
+          {.run_id = outcome.run_id,
+           .run_number = s.run,
+           .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+           .target_index = s.target_index - 1,
+           .nominal_mm = s.position_mm});
     }
     store->set_missed_stops(outcome.run_id, outcome.missed);
     outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
@@ -348,7 +348,8 @@ struct LinearRun::Impl {
     } catch (const std::exception& e) {
       // Too little was captured to evaluate: stored as it is, and said why.
       outcome.status = cal::storage::RunStatus::incomplete;
-      outcome.reason += (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
+      outcome.reason +=
+          (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
       store->finish_run(outcome.run_id, outcome.status, outcome.reason);
       live.state = "incomplete";
       return end();

@@ -277,8 +277,8 @@ AxisTolerance read_axis_tolerance(Table& t) {
 bool circle_diagnostic(std::string_view plane, std::string_view key) {
   for (const char* k : {"radius_error", "scale_mismatch", "squareness", "servo_mismatch"})
     if (key == k) return true;
-  for (const char* prefix : {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_",
-                             "straightness_"}) {
+  for (const char* prefix :
+       {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_", "straightness_"}) {
     const std::string_view p(prefix);
     if (key.size() == p.size() + 1 && key.substr(0, p.size()) == p &&
         plane.find(key.back()) != std::string_view::npos)

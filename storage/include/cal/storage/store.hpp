@@ -96,7 +96,7 @@ struct ResultRecord {
   // re-compensated (of which result, what changed) or replayed (of which run); the
   // coefficients and sensor offsets used; the software; when.
   std::string provenance_json = "{}";
-  std::int64_t id = 0;                         // set when read back
+  std::int64_t id = 0;                        // set when read back
   std::optional<std::int64_t> superseded_by;  // unset: the current result
   bool current() const { return !superseded_by.has_value(); }
 };
