@@ -106,8 +106,8 @@ check verdict_circle_G 0 "≤ 10.000</td><td><span class=\"pass\">pass" -- cat r
 check verdict_none_vdi 0 "No tolerance applies" -- cat vdi.html
 check grid 0 "<th>↑ up</th><th>↓ down</th><th>bidirectional</th>" -- cat r1.html
 check two_s_lines 0 "^x̄↑ ± 2s$" -- svgtext r1.html
-G2=$(json_value circ.json "d['iso230_4']['G_bi_um']")
-check circle_g_on_plot 0 "^G = ${G2:0:${#G2}-1} µm$" -- svgtext r2.html
+G2=$(python3 -c "import json; print(format(json.load(open('circ.json'))['iso230_4']['G_bi_um'], '.2f'))")
+check circle_g_on_plot 0 "^G = $G2 µm$" -- svgtext r2.html
 check circle_start_marked 0 "start of each trace, arrow: direction of travel" -- svgtext r2.html
 check circle_rings_off_traces 0 "^rings: -[0-9.]+ to \+[0-9.]+ µm$" -- svgtext r2.html
 check circle_percent_explained 0 "one share can exceed 100 %" -- cat r2.html
