@@ -249,7 +249,8 @@ std::string svg(const XyChart& chart) {
                                       [](const Band& b) { return !b.label.empty(); });
   const bool legend = chart.legend && has_legend;
   plschr(0, 0.85 * chart.text_scale);
-  plvpor(0.09, legend ? 0.72 : 0.97, 0.13, 0.9);
+  // Room on the left for the tick labels, more when the text is scaled up.
+  plvpor(0.04 + 0.07 * chart.text_scale, legend ? 0.72 : 0.97, 0.13, 0.9);
   // Room on every side: no point or marker sits on the frame.
   const Range xr = x.empty() ? Range{0, 1}
                    : !chart.x_labels.empty()

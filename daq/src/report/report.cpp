@@ -1141,6 +1141,8 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     std::string key, symbol, unit;
     double value = 0;
   };
+  static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
+                                                    "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
   std::map<std::string, Line> trends;        // key -> value run by run
   std::map<std::string, double> limits;      // key -> the limit of the newest run that has one
   std::map<std::string, std::string> names;  // key -> symbol (unit)
@@ -1185,6 +1187,13 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
         std::to_string(v.run.id) +
             (v.used.recompensated ? " <span class=\"changed\">re-compensated</span>" : ""),
         "<span class=\"nw\">" + dates[i] + "</span>"};
+    // A linear run's table keeps to the values a specification limits (the unidirectional ones
+    // are in each run's report): all twelve would not fit a printed page.
+    if (v.run.kind == "linear" &&
+        std::any_of(values.begin(), values.end(), [](const Value& x) { return x.key == "E_bi"; }))
+      std::erase_if(values, [](const Value& x) {
+        return std::find(linear_keys.begin(), linear_keys.end(), x.key) == linear_keys.end();
+      });
     for (const auto& x : values) {
       if (!trends.count(x.key)) {
         trend_order.push_back(x.key);
@@ -1234,8 +1243,6 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     body += figure(svg(all), "Both directions of every run on one scale.");
   }
   // One small plot per value: each on its own scale, the runs in date order, the limit dashed.
-  static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
-                                                    "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
   body += "<h3>Each value over time</h3>\n<div class=\"multiples\">\n";
   std::size_t plotted = 0;
   for (const auto& k : trend_order) {
@@ -1245,7 +1252,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     if (plotted++ >= 10) break;
     XyChart small{.title = names[k],
                   .x_label = "",
-                  .y_label = names[k],
+                  .y_label = "",  // the title names it (a rotated label at this size was clipped)
                   .width_pt = 420,
                   .height_pt = 260,
                   .x_labels = dates,
