@@ -25,7 +25,8 @@ struct CompensateOptions {
   std::string input, straightness, db, output, output_axis;
   std::int64_t run = 0;
   std::string axis = "X", format = "csv", sign = "correction", units = "mm", outside = "refuse";
-  double start_mm = 0, interval_mm = 0, resolution = 0.0001;
+  double start_mm = 0, interval_mm = 0;
+  std::optional<double> resolution;  // unset: by unit (default_resolution)
   int points = 0, axis_number = 1, output_axis_number = 2;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
   ct::FanucOptions fanuc;
@@ -122,6 +123,13 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
       o.format));
 }
 
+// A resolution that suits each unit when none is given: 0.1 um in mm or um tables, 0.00001 in
+// (0.254 um) in inch tables (a rounding of 0.0001 in would be 2.54 um).
+double default_resolution(const std::string& units) {
+  const auto u = ct::units_from_string(units);
+  return u == ct::Units::inch ? 0.00001 : u == ct::Units::um ? 0.1 : 0.0001;
+}
+
 void run(const CompensateOptions& o) {
   if (o.input.empty() && o.run == 0 && o.straightness.empty())
     throw cal::InputError(
@@ -134,7 +142,7 @@ void run(const CompensateOptions& o) {
                       .incremental = o.incremental,
                       .sign = o.sign == "error" ? ct::Sign::error : ct::Sign::correction,
                       .units = ct::units_from_string(o.units),
-                      .resolution = o.resolution,
+                      .resolution = o.resolution.value_or(default_resolution(o.units)),
                       .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
   std::string text;
   if (!o.straightness.empty()) {
@@ -177,7 +185,8 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
       ->capture_default_str()
       ->check(CLI::IsMember({"correction", "error"}));
   cmd->add_option("--units", o->units, "mm, um or inch")->capture_default_str();
-  cmd->add_option("--resolution", o->resolution, "Rounding, in the units")->capture_default_str();
+  cmd->add_option("--resolution", o->resolution,
+                  "Rounding, in the units (default 0.0001 mm, 0.1 um, 0.00001 inch)");
   cmd->add_option("--outside", o->outside,
                   "refuse or hold (grid points beyond the measured targets)")
       ->capture_default_str()

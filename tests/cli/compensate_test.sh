@@ -30,6 +30,12 @@ check cross_json 0 '"schema": "caldaq.cross-table.v1"' -- "$DAQ" compensate "${S
 check heidenhain 0 "^150\.0000 -0\.0030 -0\.0070$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f heidenhain
 check fanuc 0 "^3 150\.0000 -1$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f fanuc
 check fanuc_reference 2 "not a point of the grid" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f fanuc --fanuc-reference-mm 10
+# Inch: the correction -0.004 mm at 100 mm is -0.004 / 25.4 = -0.000157480 in, rounded to the
+# inch default resolution 0.00001 in: -0.00016; the position 100 / 25.4 = 3.93701 in.
+check inch_columns 0 "^point,position_in,value_in$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
+check inch_value 0 "^2,3\.93701,-0\.00016$" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
+check inch_header 0 "values in inch" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units inch
+check bad_units 2 "units 'furlong' \\(expected mm, um or inch\\)" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" --units furlong
 check outside 2 "grid point -50 mm is outside the measured range 0 \.\. 200 mm" -- "$DAQ" compensate -i "$DATA/meas.csv" --start-mm -50 --interval-mm 50 --points 3
 check linuxcnc_incremental 2 "absolute corrections" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f linuxcnc --incremental
 check bad_format 2 "format 'okuma'" -- "$DAQ" compensate -i "$DATA/meas.csv" "${G[@]}" -f okuma
