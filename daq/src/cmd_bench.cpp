@@ -301,7 +301,7 @@ std::vector<unsigned char> as_schema1(const ChunkSource& src, const Row& r) {
   return out;
 }
 
-// schema1: the chunks' BLOBs replaced by their 17-byte records of schema 1 (prepared untimed).
+// schema1: the chunks' BLOBs replaced by the 17-byte records of schemas 1 and 2 (prepared untimed).
 CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t batch,
                            bool schema1 = false) {
   { cal::storage::Store(to).begin_run({.kind = "bench"}); }

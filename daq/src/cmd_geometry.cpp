@@ -5,12 +5,15 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/kinematics.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
 #include "commands.hpp"
+#include "csv_columns.hpp"
 #include "report/report.hpp"
 
 namespace daq {
@@ -18,43 +21,10 @@ namespace {
 
 using nlohmann::json;
 
-// Reads named numeric columns from a CSV with a header line; '#' lines are comments.
+// Named numeric columns of a CSV with a header line (csv_columns.hpp).
 std::map<std::string, std::vector<double>> read_columns(const std::string& path,
                                                         std::initializer_list<const char*> names) {
-  std::ifstream in(path);
-  if (!in) throw cal::InputError(fmt::format("{}: cannot open", path));
-  std::string line;
-  int n = 0;
-  std::map<std::string, std::size_t> col;
-  std::map<std::string, std::vector<double>> out;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty() || line[0] == '#' || line == "\r") continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) {
-      const auto b = c.find_first_not_of(" \t\r"), e = c.find_last_not_of(" \t\r");
-      cells.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
-    }
-    if (col.empty()) {
-      for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
-      for (const char* name : names)
-        if (!col.count(name))
-          throw cal::InputError(fmt::format("{}:{}: the header has no column {}", path, n, name));
-      continue;
-    }
-    for (const char* name : names) {
-      const std::size_t i = col.at(name);
-      const std::string text = i < cells.size() ? cells[i] : "";
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || *end != '\0' || !std::isfinite(v))
-        throw cal::InputError(
-            fmt::format("{}:{}: column {}: '{}' is not a number", path, n, name, text));
-      out[name].push_back(v);
-    }
-  }
-  return out;
+  return read_csv_columns(path, std::vector<std::string>(names.begin(), names.end())).numbers;
 }
 
 struct StraightnessOptions {
@@ -105,6 +75,7 @@ struct SquarenessOptions {
   std::string circle;                               // circle CSV
   double radius_mm = 0;
   std::string report;
+  std::string plane;  // XY, XZ or YZ: also give the model's location error
   bool json = false;
 };
 
@@ -140,6 +111,11 @@ void run_squareness(const SquarenessOptions& o) {
     throw cal::InputError(fmt::format(
         "squareness method '{}' (expected straightness, diagonal or circle)", o.method));
   }
+  std::optional<cal::kinematics::Plane> plane;
+  if (!o.plane.empty()) plane = cal::kinematics::plane_from_string(o.plane);
+  // 1 um/m = 1 urad: the model's location error in the ISO 230-1 sign (E_B0Z opposite).
+  const double location_urad =
+      plane ? cal::kinematics::location_error_from_angle_over_90(*plane, r.squareness_um_per_m) : 0;
   if (o.json) {
     json j{{"schema", "caldaq.squareness.v1"},
            {"method", o.method},
@@ -147,6 +123,10 @@ void run_squareness(const SquarenessOptions& o) {
            {"squareness_arcsec", r.arcsec()},
            {"convention",
             "positive when the angle between the positive axis directions exceeds 90 deg"}};
+    if (plane)
+      j["location_error"] = {{"plane", cal::kinematics::to_string(*plane)},
+                             {"name", cal::kinematics::location_error_name(*plane)},
+                             {"iso230_1_urad", location_urad}};
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print(
@@ -154,6 +134,12 @@ void run_squareness(const SquarenessOptions& o) {
       "positive "
       "axis directions exceeds 90 degrees\n",
       how, r.squareness_um_per_m, r.arcsec());
+  if (plane)
+    fmt::print(
+        "  model ({} plane): {} = {:+.3f} urad (ISO 230-1 location error; "
+        "caldaq.model.v1 \"iso230_1_urad\")\n",
+        cal::kinematics::to_string(*plane), cal::kinematics::location_error_name(*plane),
+        location_urad);
 }
 
 }  // namespace
@@ -185,6 +171,9 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   sq->add_option("--radius-mm", q->radius_mm, "circle: radius");
   sq->add_option("--report", q->report,
                  "straightness: also write an HTML report with both runs and their lines");
+  sq->add_option("--plane", q->plane,
+                 "XY, XZ or YZ: also print the model's location error (E_C0Y, E_B0Z, E_A0Z; "
+                 "E_B0Z has the opposite sign)");
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
   sq->callback([q] { run_squareness(*q); });
 }

@@ -33,5 +33,7 @@ void add_serve_command(CLI::App& app);
 void add_report_command(CLI::App& app);
 // bench ingest: throughput against the storage ceilings, measured on this machine
 void add_bench_commands(CLI::App& app);
+// model show|map|compensate|testpiece: the machine model file
+void add_model_commands(CLI::App& app);
 
 }  // namespace daq

@@ -9,7 +9,7 @@
 // is handed out, so no reading can come late, and only the chunks that overlap the current
 // time are in memory.
 //
-// Integrity: the checksum of every chunk (schema 2) is verified before it is decoded; its
+// Integrity: the checksum of every chunk (schema 3) is verified before it is decoded; its
 // first time must be its smallest; and at the end the chunks read must be exactly those the
 // other index (reading_chunks_by_seq) numbers, so a chunk that a damaged index hides from the
 // time-ordered query is reported as missing instead of silently left out.
@@ -87,7 +87,7 @@ struct ReadingStream::Impl {
         "from {} ns) is damaged: {}. The database file is corrupted; the run's other chunks "
         "and the other runs are not affected by this one",
         store.path.string(), run_id,
-        numbered ? fmt::format("{}", sqlite3_column_int64(s, 9)) : std::string("(schema 1)"),
+        numbered ? fmt::format("{}", sqlite3_column_int64(s, 9)) : std::string("(unnumbered: written before schema 3)"),
         sqlite3_column_int64(s, 0), sqlite3_column_int64(s, 1), sqlite3_column_int64(s, 2),
         sqlite3_column_int64(s, 3), sqlite3_column_int64(s, 6), sqlite3_column_int64(s, 4), what));
   }
@@ -113,7 +113,7 @@ struct ReadingStream::Impl {
         damaged(s, "its checksum does not match its contents");
       seqs.push_back(key.seq);
     } else if (key.encoding != chunk::packed_v1) {
-      damaged(s, "it has no checksum");  // only the chunks of schema 1 have none
+      damaged(s, "it has no checksum");  // only the chunks written before schema 3 have none
     }
     if (count <= 0 || key.device < 0 || key.device > 0xffff || key.channel < 0 ||
         key.channel > 0xff || key.quantity < 0 || key.quantity > 0xff)
@@ -149,7 +149,7 @@ struct ReadingStream::Impl {
            std::tie(b.time_ns, b.device, b.channel, b.quantity, b_row);
   }
 
-  // The chunks read must be those numbered in the other index (schema 2 chunks only).
+  // The chunks read must be those numbered in the other index (schema 3 chunks only).
   void check_complete() {
     checked = true;
     if (!store.chunk_checksums) return;

@@ -30,7 +30,7 @@ struct Store::Impl {
   std::unique_ptr<sqlite3, detail::DbCloser> db;
   int version = 0;
   bool read_only = false;
-  // The chunk columns of schema 2 (encoding, seq, crc) are there: false only for an older
+  // The chunk columns of schema 3 (encoding, seq, crc) are there: false only for an older
   // database opened read-only (read as it is, without checksums).
   bool chunk_checksums = true;
 
@@ -74,6 +74,7 @@ struct Store::Impl {
   void open_read_only();
   void check_caldaq_database();
   void insert_targets(std::span<const CapturedTarget> targets);
+  std::int64_t insert_result(const ResultRecord& r, Supersede how);
 
   // A transaction that rolls back unless committed (RAII), so a failed batch leaves the
   // database as it was before the batch, never half-written.

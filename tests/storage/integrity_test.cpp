@@ -335,3 +335,49 @@ TEST(Integrity, AChunkHiddenByADamagedIndexIsReportedMissing) {
 }
 
 }  // namespace
+
+namespace {
+
+// Read-only, schema 1 is presented in today's shape by temporary views: the results must read
+// as migration 1 -> 2 marks them (the older of two of a standard and everything before a
+// re-compensation superseded), with nothing written; opened for writing, the migration gives
+// the same.
+TEST(ReadOnly, ASchema1DatabasesResultsReadAsTheMigrationMarksThem) {
+  TempDir dir;
+  const auto file = dir.path / "old.sqlite";
+  fs::copy_file(kSchema1, file);
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "INSERT INTO results(run_id, standard, json, created_unix_ms) VALUES "
+                           "(1, 'ISO 230-2:2014', '{}', 2), (1, 'VDI/DGQ 3441', '{}', 3), "
+                           "(1, 'ISO 230-2:2014 (recompensated)', '{}', 4)",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_exec(db, "PRAGMA wal_checkpoint(TRUNCATE)", nullptr, nullptr, nullptr);
+    sqlite3_close(db);
+  }
+  const auto before = bytes_of(file);
+  std::vector<std::pair<std::string, bool>> read_only, migrated;
+  {
+    Store store(file, {.read_only = true});
+    for (const auto& r : store.results(1)) read_only.emplace_back(r.standard, r.current());
+    EXPECT_TRUE(store.missed_stops(1).empty());
+    EXPECT_FALSE(store.run(1)->origin_unix_ns.has_value());
+  }
+  EXPECT_EQ(bytes_of(file), before);
+  {
+    Store store(file);
+    for (const auto& r : store.results(1)) migrated.emplace_back(r.standard, r.current());
+  }
+  ASSERT_EQ(read_only.size(), 4u);
+  EXPECT_EQ(read_only, migrated);
+  // By hand: "fixture" and the first ISO 230-2 and VDI results precede the re-compensation.
+  EXPECT_FALSE(read_only[0].second);
+  EXPECT_FALSE(read_only[1].second);
+  EXPECT_FALSE(read_only[2].second);
+  EXPECT_TRUE(read_only[3].second);
+}
+
+}  // namespace

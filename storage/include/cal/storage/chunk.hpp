@@ -2,7 +2,7 @@
 // The encodings of a reading chunk's BLOB (one device/channel/quantity per chunk) and the
 // checksum stored with it; the layouts are documented in docs/storage.md.
 //
-//   encoding 1 (schema 1): 17-byte records, time_ns int64, status, value double.
+//   encoding 1 (schemas 1 and 2): 17-byte records, time_ns int64, status, value double.
 //   encoding 2: the times as varint deltas (or deltas of deltas, whichever is smaller), the
 //               statuses only when one is not ok, the values XOR-ed with the previous value
 //               with the leading zero bytes dropped (or raw, whichever is smaller). Lossless:
