@@ -178,7 +178,13 @@ void recompensate(const RecompensateOptions& o) {
     if (static_cast<cal::drivers::Quantity>(r.quantity) ==
         cal::drivers::Quantity::material_temperature_degc)
       material_sensors = std::max(material_sensors, r.device - 1);
-  cal::daq::EnvStage stage(cfg, std::max(material_sensors, 1));
+  // Every sample is kept: the stops are compensated after all samples were given, each with
+  // the environment at its own time (the stage otherwise keeps the last 2 minutes, and a long
+  // run's early stops would get the air of its end).
+  cal::daq::EnvStage stage(
+      cfg, cal::daq::EnvSensors{.material_enabled = std::vector<bool>(
+                                    static_cast<std::size_t>(std::max(material_sensors, 1)), true),
+                                .keep_all_samples = true});
   for (const auto& r : readings) {
     switch (static_cast<Q>(r.quantity)) {
       case Q::air_temperature_degc:

@@ -246,11 +246,11 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; 
 }  // namespace cached
 
 // The environment is computed once per held sample and the refractive index again only when
-// the air changes (env_stage.hpp). The proof that this changes nothing: every compensation of a long stage (its cache warm, hit and
-// missed in every way: held samples, interpolation between samples, samples arriving between
-// readings, a stale sensor on its fallback and back) equals bit for bit the compensation of a
-// fresh stage given the same samples, whose cache is empty, and its n is the equation's own
-// for the air it reports.
+// the air changes (env_stage.hpp). The proof that this changes nothing: every compensation of a
+// long stage (its cache warm, hit and missed in every way: held samples, interpolation between
+// samples, samples arriving between readings, a stale sensor on its fallback and back) equals bit
+// for bit the compensation of a fresh stage given the same samples, whose cache is empty, and its n
+// is the equation's own for the air it reports.
 TEST(EnvStage, CachedIndexGivesTheEquationsResultBitForBit) {
   auto cfg = edlen(cal::daq::StalePolicy::fallback);
   cfg.equation = "ciddor";
@@ -303,4 +303,26 @@ TEST(EnvStage, CachedIndexGivesTheEquationsResultBitForBit) {
   EXPECT_GT(held, 100u);
   EXPECT_GT(fallback, 100u);
   EXPECT_GT(compared - held - fallback, 100u);  // interpolated
+}
+
+// After the run (daq recompensate) all samples are given first and the stops compensated
+// afterwards: with keep_all_samples a stop early in an hour-long run gets the air of its own
+// time. The live stage keeps 2 minutes, so there the same query would get the air of the end.
+TEST(EnvStage, KeepingAllSamplesCompensatesAnEarlyStopOfALongRunWithItsOwnAir) {
+  cal::daq::EnvSensors sensors{.material_enabled = {true}};
+  EnvStage live(edlen(), sensors);
+  sensors.keep_all_samples = true;
+  EnvStage after(edlen(), sensors);
+  for (std::int64_t k = 0; k <= 3600; ++k)  // 1 Hz for an hour, 20 -> 21 degC
+    for (EnvStage* e : {&live, &after}) {
+      e->add_air(k * s, AirQuantity::temperature_degc, 20.0 + static_cast<double>(k) / 3600.0);
+      e->add_air(k * s, AirQuantity::pressure_pa, 101325.0);
+      e->add_air(k * s, AirQuantity::humidity_pct, 50.0);
+      e->add_material(k * s, 0, 20.0);
+    }
+  // At 5 min: 20 + 300/3600 degC exactly (a sample's time), and halfway to the next at 5.5 s.
+  EXPECT_DOUBLE_EQ(after.compensate(300 * s, 0.1).air_temperature_degc, 20.0 + 300.0 / 3600.0);
+  EXPECT_NEAR(after.compensate(300 * s + s / 2, 0.1).air_temperature_degc, 20.0 + 300.5 / 3600.0,
+              1e-12);
+  EXPECT_GT(live.compensate(300 * s, 0.1).air_temperature_degc, 20.9);  // the end's air
 }

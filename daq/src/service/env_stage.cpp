@@ -30,6 +30,7 @@ EnvStage::EnvStage(const EnvironmentConfig& config, int material_sensors)
 EnvStage::EnvStage(const EnvironmentConfig& config, const EnvSensors& sensors)
     : config_(config),
       equation_(air::equation_from_string(config.equation)),
+      keep_all_(sensors.keep_all_samples),
       stale_ns_(static_cast<std::int64_t>(std::min(config.stale_after_s, 1e9) * 1e9)) {
   if (!(config.stale_after_s > 0))
     throw InputError(
@@ -76,7 +77,8 @@ void EnvStage::add(Series& s, std::int64_t t, double v) {
   auto it = std::upper_bound(s.samples.begin(), s.samples.end(), t,
                              [](std::int64_t x, const auto& p) { return x < p.first; });
   s.samples.insert(it, {t, v});
-  while (s.samples.size() > 2 && s.samples.back().first - s.samples.front().first > kKeepNs)
+  while (!keep_all_ && s.samples.size() > 2 &&
+         s.samples.back().first - s.samples.front().first > kKeepNs)
     s.samples.pop_front();
 }
 

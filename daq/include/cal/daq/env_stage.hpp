@@ -54,6 +54,10 @@ struct Compensated {
 struct EnvSensors {
   std::vector<bool> material_enabled;  // one per material thermometer; false: disabled
   bool co2 = false;                    // a CO2 sensor feeds AirQuantity::co2_umol_per_mol
+  // Keep every sample instead of the last 2 minutes: for compensating after the run, when all
+  // of a run's samples are given first and the stops are compensated afterwards at their own
+  // times (the memory is then the run's environment samples).
+  bool keep_all_samples = false;
 };
 
 struct EnvHealth {
@@ -127,6 +131,7 @@ class EnvStage {
 
   EnvironmentConfig config_;
   air::Equation equation_;
+  bool keep_all_ = false;
   mutable IndexCache index_cache_;
   mutable FactorCache factor_cache_;
   mutable HeldCache held_cache_;
