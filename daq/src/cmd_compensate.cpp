@@ -8,7 +8,9 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
+#include "csv_table.hpp"
 #include "database.hpp"
 #include "measurement_csv.hpp"
 
@@ -24,10 +26,11 @@ struct CompensateOptions {
   double start_mm = 0, interval_mm = 0, resolution = 0.0001;
   int points = 0, axis_number = 1;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
+  CsvOptions csv;
 };
 
 std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o) {
-  if (!o.input.empty()) return read_measurements(o.input);
+  if (!o.input.empty()) return read_measurements(o.input, o.csv);
   cal::storage::Store store(database_path(o.db));
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
@@ -55,21 +58,10 @@ void run(const CompensateOptions& o) {
                       .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
   ct::Table table;
   if (!o.straightness.empty()) {
-    std::ifstream in(o.straightness);
-    if (!in) throw cal::InputError(fmt::format("{}: cannot open", o.straightness));
-    std::vector<double> x, d;
-    std::string line;
-    int n = 0;
-    while (std::getline(in, line)) {
-      ++n;
-      if (line.empty() || line[0] == '#' || line.rfind("position_mm", 0) == 0) continue;
-      double a = 0, b = 0;
-      if (std::sscanf(line.c_str(), "%lf,%lf", &a, &b) != 2)
-        throw cal::InputError(
-            fmt::format("{}:{}: expected position_mm,deviation_um", o.straightness, n));
-      x.push_back(a), d.push_back(b);
-    }
-    table = ct::cross(spec, x, d, o.remove_slope);
+    const auto csv = CsvTable::read(o.straightness, o.csv);
+    csv.require({"position_mm", "deviation_um"});
+    table =
+        ct::cross(spec, csv.numbers("position_mm"), csv.numbers("deviation_um"), o.remove_slope);
   } else {
     const auto m = measurements(o);
     table = ct::positioning(spec, cal::iso230_2::target_stats(m));
@@ -137,6 +129,7 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
                 "Cross compensation: remove the squareness (slope)");
   cmd->add_option("-f,--format", o->format, "csv, linuxcnc, siemens or isg")->capture_default_str();
   cmd->add_option("-o,--output", o->output, "Write to a file instead of stdout");
+  add_decimal_comma_flag(*cmd, o->csv);
   cmd->add_flag("--json", o->json, "Print caldaq.comp-table.v1 JSON");
   cmd->callback([o] { run(*o); });
 }

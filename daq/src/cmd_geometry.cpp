@@ -10,7 +10,9 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
+#include "csv_table.hpp"
 #include "report/report.hpp"
 
 namespace daq {
@@ -18,42 +20,14 @@ namespace {
 
 using nlohmann::json;
 
-// Reads named numeric columns from a CSV with a header line; '#' lines are comments.
+// Named numeric columns of a CSV with a header line (the strict reader, csv_table.hpp).
 std::map<std::string, std::vector<double>> read_columns(const std::string& path,
-                                                        std::initializer_list<const char*> names) {
-  std::ifstream in(path);
-  if (!in) throw cal::InputError(fmt::format("{}: cannot open", path));
-  std::string line;
-  int n = 0;
-  std::map<std::string, std::size_t> col;
+                                                        std::initializer_list<const char*> names,
+                                                        const CsvOptions& options) {
+  const auto csv = CsvTable::read(path, options);
   std::map<std::string, std::vector<double>> out;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty() || line[0] == '#' || line == "\r") continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) {
-      const auto b = c.find_first_not_of(" \t\r"), e = c.find_last_not_of(" \t\r");
-      cells.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
-    }
-    if (col.empty()) {
-      for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
-      for (const char* name : names)
-        if (!col.count(name))
-          throw cal::InputError(fmt::format("{}:{}: the header has no column {}", path, n, name));
-      continue;
-    }
-    for (const char* name : names) {
-      const std::size_t i = col.at(name);
-      const std::string text = i < cells.size() ? cells[i] : "";
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || *end != '\0' || !std::isfinite(v))
-        throw cal::InputError(
-            fmt::format("{}:{}: column {}: '{}' is not a number", path, n, name, text));
-      out[name].push_back(v);
-    }
-  }
+  for (const char* name : names) csv.require({name});
+  for (const char* name : names) out[name] = csv.numbers(name);
   return out;
 }
 
@@ -62,6 +36,7 @@ struct StraightnessOptions {
   std::string reference = "lsq";
   std::string report;
   bool json = false;
+  CsvOptions csv;
 };
 
 void write_report(const std::string& path, const std::string& html) {
@@ -72,7 +47,7 @@ void write_report(const std::string& path, const std::string& html) {
 }
 
 void run_straightness(const StraightnessOptions& o) {
-  auto cols = read_columns(o.input, {"position_mm", "deviation_um"});
+  auto cols = read_columns(o.input, {"position_mm", "deviation_um"}, o.csv);
   const auto ref = cal::straightness::reference_from_string(o.reference);
   const auto r = cal::straightness::evaluate(cols["position_mm"], cols["deviation_um"], ref);
   if (!o.report.empty())
@@ -106,6 +81,7 @@ struct SquarenessOptions {
   double radius_mm = 0;
   std::string report;
   bool json = false;
+  CsvOptions csv;
 };
 
 void run_squareness(const SquarenessOptions& o) {
@@ -114,8 +90,8 @@ void run_squareness(const SquarenessOptions& o) {
   if (o.method == "straightness") {
     if (o.along_a.empty() || o.along_b.empty())
       throw cal::InputError("squareness --method straightness needs --along-a and --along-b");
-    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"});
-    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"});
+    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"}, o.csv);
+    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"}, o.csv);
     r = cal::squareness::from_straightness({a["position_mm"], a["deviation_um"]},
                                            {b["position_mm"], b["deviation_um"]}, o.square_error);
     how = "two straightness runs (least-squares lines)";
@@ -132,7 +108,7 @@ void run_squareness(const SquarenessOptions& o) {
   } else if (o.method == "circle") {
     if (o.circle.empty() || !(o.radius_mm > 0))
       throw cal::InputError("squareness --method circle needs --circle FILE and --radius-mm");
-    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"});
+    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"}, o.csv);
     const cal::squareness::CircleTrace t{c["angle_deg"], c["deviation_um"]};
     r = cal::squareness::from_circle(o.radius_mm, std::span(&t, 1));
     how = "circular test (sin 2t term)";
@@ -166,6 +142,7 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   st->add_option("-r,--reference", s->reference, "lsq, endpoint or minzone")->capture_default_str();
   st->add_option("--report", s->report,
                  "Also write an HTML report with the deviations and all three reference lines");
+  add_decimal_comma_flag(*st, s->csv);
   st->add_flag("--json", s->json, "Print caldaq.straightness.v1 JSON");
   st->callback([s] { run_straightness(*s); });
 
@@ -185,6 +162,7 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   sq->add_option("--radius-mm", q->radius_mm, "circle: radius");
   sq->add_option("--report", q->report,
                  "straightness: also write an HTML report with both runs and their lines");
+  add_decimal_comma_flag(*sq, q->csv);
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
   sq->callback([q] { run_squareness(*q); });
 }

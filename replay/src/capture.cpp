@@ -87,6 +87,10 @@ struct CaptureWriter::Impl {
     if (!file) throw CaptureError(fmt::format("{}: write after close", path.string()));
   }
   void write(std::span<const std::byte> bytes) {
+    if (limits.max_file_bytes > 0 && written + bytes.size() > limits.max_file_bytes) {
+      errno = ENOSPC;
+      fail("write failed");
+    }
     if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) fail("write failed");
     written += bytes.size();
   }

@@ -14,6 +14,7 @@
 #include "cal/daq/ballbar.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -66,6 +67,7 @@ struct CircleRunSetup {
   std::unique_ptr<cal::drivers::Instrument> ballbar;
   std::string capture_path;
   std::string software_version = "daq 0.1.0";
+  cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
   std::function<void(const std::string&)> on_event;
   std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading

@@ -113,6 +113,8 @@ struct LinearRun::Impl {
   bool running = false, done = false;
   std::int64_t first_ns = -1;
   double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
+  // Handlers posted from the writer's thread run only while the run exists.
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
   Impl(boost::asio::io_context& i, LinearRunSetup s)
       : io(i),
@@ -129,6 +131,7 @@ struct LinearRun::Impl {
           cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
                                             .dwell_s = setup.config.trigger.dwell_s});
   }
+  ~Impl() { *alive = false; }
 
   std::uint16_t position_device() const {
     return static_cast<std::uint16_t>(2 + setup.material.size());
@@ -153,7 +156,7 @@ struct LinearRun::Impl {
   }
 
   void start() {
-    store.emplace(setup.database);
+    store.emplace(setup.database, setup.store_options);
     const auto& c = setup.config;
     std::int64_t machine = 0;
     if (auto m = store->machine_by_name(c.machine_name))
@@ -180,9 +183,11 @@ struct LinearRun::Impl {
       add(static_cast<int>(2 + k), *setup.material[k], "material");
     if (setup.position) add(position_device(), *setup.position, "position");
     writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id, cal::storage::WriterOptions{},
-        [this](const std::string& e) {
-          boost::asio::post(io, [this, e] { abort("storage failed: " + e); });
+        setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
+        [this, alive = alive](const std::string& e) {
+          boost::asio::post(io, [this, alive, e] {
+            if (*alive) abort("storage failed: " + e);
+          });
         });
     running = true;
     live.state = "waiting";
@@ -223,12 +228,16 @@ struct LinearRun::Impl {
     if (!running) return;
     r.device = device;
     ++outcome.readings;
-    writer->push({.time_ns = r.time_ns,
-                  .device = r.device,
-                  .channel = r.channel,
-                  .quantity = static_cast<std::uint8_t>(r.quantity),
-                  .status = static_cast<std::uint8_t>(r.status),
-                  .value = r.value});
+    try {
+      writer->push({.time_ns = r.time_ns,
+                    .device = r.device,
+                    .channel = r.channel,
+                    .quantity = static_cast<std::uint8_t>(r.quantity),
+                    .status = static_cast<std::uint8_t>(r.status),
+                    .value = r.value});
+    } catch (const std::exception& e) {  // the writer failed earlier (a full disk)
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     if (setup.on_reading) setup.on_reading(r);
     if (first_ns < 0) first_ns = r.time_ns;
     switch (r.quantity) {
@@ -300,7 +309,11 @@ struct LinearRun::Impl {
             .deviation_um = s.deviation_um,
             .refractive_index = c.n,
             .material_temperature_degc = c.material_degc};
-        store->add_targets(std::span(&t, 1));
+        try {
+          store->add_targets(std::span(&t, 1));
+        } catch (const std::exception& err) {
+          return abort(fmt::format("storage failed: {}", err.what()));
+        }
       }
     }
     expect_next();
@@ -309,19 +322,29 @@ struct LinearRun::Impl {
 
   void finish() {
     running = false;
-    writer->flush();
-    const auto& l = *setup.config.linear;
-    const auto standard = cal::iso230_2::standard_from_string(l.standard);
-    outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
-    store->add_result({.run_id = outcome.run_id,
-                       .standard = std::string(outcome.evaluation->standard.title),
-                       .json = to_json(*outcome.evaluation).dump()});
-    store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    try {
+      writer->flush();
+      const auto& l = *setup.config.linear;
+      const auto standard = cal::iso230_2::standard_from_string(l.standard);
+      outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
+      store->add_result({.run_id = outcome.run_id,
+                         .standard = std::string(outcome.evaluation->standard.title),
+                         .json = to_json(*outcome.evaluation).dump()});
+      store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    } catch (const cal::storage::StoreError& e) {
+      outcome.evaluation.reset();
+      return abort(fmt::format("storage failed: {}", e.what()));
+    } catch (const std::exception& e) {
+      outcome.evaluation.reset();
+      return abort(fmt::format("the run could not be evaluated: {}", e.what()));
+    }
     outcome.complete = true;
     live.state = "complete";
     end();
   }
 
+  // Never throws: a store that fails here too is named in the reason, which the caller
+  // reports (the run then stays "running" in the file, shown as incomplete).
   void abort(const std::string& reason) {
     if (done) return;
     running = false;
@@ -331,9 +354,15 @@ struct LinearRun::Impl {
     try {
       if (writer) writer->flush();
     } catch (const std::exception& e) {
-      outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
+      if (reason.find(e.what()) == std::string::npos)
+        outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
     }
-    if (store) store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    try {
+      if (store)
+        store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    } catch (const std::exception& e) {
+      outcome.reason += fmt::format(" (and the run's end could not be stored: {})", e.what());
+    }
     end();
   }
 
@@ -368,7 +397,12 @@ struct LinearRun::Impl {
 LinearRun::LinearRun(boost::asio::io_context& io, LinearRunSetup setup)
     : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
 LinearRun::~LinearRun() {
-  if (!impl_->done && impl_->running) impl_->abort("stopped");
+  try {
+    if (!impl_->done && impl_->running) impl_->abort("stopped");
+  } catch (...) {
+    // abort() does not throw; a display callback (on_live, on_event) might: a destructor
+    // must not let it through (std::terminate).
+  }
 }
 void LinearRun::start() { impl_->start(); }
 void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }

@@ -16,6 +16,7 @@
 #include "cal/daq/config.hpp"
 #include "cal/daq/sequencer.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -54,7 +55,8 @@ struct LinearRunSetup {
   double datum_mm = 0.0;  // axis position where the laser reads 0
   std::string software_version = "daq 0.1.0";
   std::string capture_path;
-  std::function<void(const LiveState&)> on_live;     // about 10 Hz
+  cal::storage::StoreOptions store_options;       // the run's and the writer's (tests: max_pages)
+  std::function<void(const LiveState&)> on_live;  // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
 };
@@ -67,6 +69,9 @@ struct LinearRunOutcome {
   std::size_t readings = 0;
 };
 
+// A store or capture that fails (a full disk) ends the run as aborted with the reason
+// ("storage failed: FILE: ..."), keeping what was written; nothing is thrown out of the
+// instruments' handlers or the destructor.
 class LinearRun {
  public:
   LinearRun(boost::asio::io_context& io, LinearRunSetup setup);
