@@ -37,9 +37,11 @@ mount_tmpfs() {  # mount_tmpfs SIZE
 mount_tmpfs 320k
 check store_full_exit 2 "daq: error: run 1 aborted: storage failed: $MNT/d.sqlite: .*(full|No space)" -- \
   "$DAQ" demo --quiet --db "$MNT/d.sqlite" --capture "$TMP/d.cdq"
-# What was committed stays readable (read from a copy: opening the store still writes).
+# What was committed stays readable (read from a copy: opening the store still writes). The
+# run is "aborted" if the abort itself could still be written, else "incomplete" (a run left
+# running, as after a kill): the reason is then only in daq's message.
 cp "$MNT"/d.sqlite* "$TMP/"
-check store_full_kept 0 "^ +1 +.* linear +X +(aborted|running) +[1-9][0-9]*" -- "$DAQ" runs --db "$TMP/d.sqlite"
+check store_full_kept 0 "^ +1 +.* linear +X +(aborted|incomplete) +[1-9][0-9]*" -- "$DAQ" runs --db "$TMP/d.sqlite"
 
 # 2. The capture on a full disk: the run ends, the store says why, the capture replays up to
 #    the failure and is reported as damaged there.

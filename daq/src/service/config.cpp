@@ -48,8 +48,10 @@ class Table {
       }
       fail(node, key, "expected a number");
     } else if constexpr (std::is_same_v<T, int>) {
-      // TOML integers are 64-bit: 4294967297 must not wrap to 1.
-      if (auto v = node->value<std::int64_t>()) {
+      // TOML integers are 64-bit: 4294967297 must not wrap to 1. Only integer nodes: toml++
+      // converts a float such as 3.3e49 to int64 without a range check (undefined
+      // behaviour, found by fuzz_config).
+      if (auto v = node->is_integer() ? node->value<std::int64_t>() : std::nullopt) {
         if (*v < std::numeric_limits<int>::min() || *v > std::numeric_limits<int>::max())
           fail(node, key, fmt::format("{} is out of range", *v));
         return static_cast<int>(*v);
