@@ -6,6 +6,8 @@
 #include <boost/beast/http/verb.hpp>
 #include <boost/beast/websocket/rfc6455.hpp>
 #include <cctype>
+#include <charconv>
+#include <cstdint>
 #include <exception>
 
 namespace cal::daq::web {
@@ -169,8 +171,11 @@ std::optional<Response> screen(const Header& h, std::string_view local_address, 
       return refuse(415, "a POST body must be sent as Content-Type: application/json");
   }
   if (const auto length = h.find(http::field::content_length); length != h.end()) {
+    // Beast has checked the syntax; a value that does not parse here counts as too large.
     const std::string_view l = trim(sv(length->value()));
-    if (l.size() > 18 || std::stoull(std::string(l.empty() ? "0" : l)) > p.max_body_bytes)
+    std::uint64_t n = 0;
+    const auto [end, ec] = std::from_chars(l.data(), l.data() + l.size(), n);
+    if (ec != std::errc{} || end != l.data() + l.size() || n > p.max_body_bytes)
       return refuse(413,
                     "request body over the " + std::to_string(p.max_body_bytes) + " byte limit");
   }
