@@ -195,9 +195,20 @@ std::string write_csv(const Table& t) {
       t.spec.sign == Sign::correction ? "correction" : "error", units_name(t.spec.units),
       t.spec.incremental ? "incremental" : "absolute",
       t.spec.bidirectional ? "forward/reverse" : fmt::format("backlash {:.{}f}", t.backlash, d));
-  out += t.spec.bidirectional ? "point,position_mm,forward,reverse\n" : "point,position_mm,value\n";
+  // An inch table names its columns in inch and gives the positions in inch too (a control in
+  // inch mode reads both in its unit); mm and um tables keep positions in mm.
+  const bool inch = t.spec.units == Units::inch;
+  if (inch)
+    out += t.spec.bidirectional ? "point,position_in,forward_in,reverse_in\n"
+                                : "point,position_in,value_in\n";
+  else
+    out +=
+        t.spec.bidirectional ? "point,position_mm,forward,reverse\n" : "point,position_mm,value\n";
   for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
-    out += fmt::format("{},{:.4f},{:.{}f}", i, t.position_mm[i], t.forward[i], d);
+    if (inch)
+      out += fmt::format("{},{:.5f},{:.{}f}", i, t.position_mm[i] / 25.4, t.forward[i], d);
+    else
+      out += fmt::format("{},{:.4f},{:.{}f}", i, t.position_mm[i], t.forward[i], d);
     if (t.spec.bidirectional) out += fmt::format(",{:.{}f}", t.reverse[i], d);
     out += "\n";
   }

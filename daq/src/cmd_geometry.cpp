@@ -5,14 +5,16 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/kinematics.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
-#include "csv_table.hpp"
+#include "csv_columns.hpp"
 #include "report/report.hpp"
 
 namespace daq {
@@ -20,15 +22,12 @@ namespace {
 
 using nlohmann::json;
 
-// Named numeric columns of a CSV with a header line (the strict reader, csv_table.hpp).
+// Named numeric columns of a CSV with a header line (csv_columns.hpp, the strict reader).
 std::map<std::string, std::vector<double>> read_columns(const std::string& path,
                                                         std::initializer_list<const char*> names,
                                                         const CsvOptions& options) {
-  const auto csv = CsvTable::read(path, options);
-  std::map<std::string, std::vector<double>> out;
-  for (const char* name : names) csv.require({name});
-  for (const char* name : names) out[name] = csv.numbers(name);
-  return out;
+  return read_csv_columns(path, std::vector<std::string>(names.begin(), names.end()), {}, options)
+      .numbers;
 }
 
 struct StraightnessOptions {
@@ -80,6 +79,7 @@ struct SquarenessOptions {
   std::string circle;                               // circle CSV
   double radius_mm = 0;
   std::string report;
+  std::string plane;  // XY, XZ or YZ: also give the model's location error
   bool json = false;
   CsvOptions csv;
 };
@@ -116,6 +116,11 @@ void run_squareness(const SquarenessOptions& o) {
     throw cal::InputError(fmt::format(
         "squareness method '{}' (expected straightness, diagonal or circle)", o.method));
   }
+  std::optional<cal::kinematics::Plane> plane;
+  if (!o.plane.empty()) plane = cal::kinematics::plane_from_string(o.plane);
+  // 1 um/m = 1 urad: the model's location error in the ISO 230-1 sign (E_B0Z opposite).
+  const double location_urad =
+      plane ? cal::kinematics::location_error_from_angle_over_90(*plane, r.squareness_um_per_m) : 0;
   if (o.json) {
     json j{{"schema", "caldaq.squareness.v1"},
            {"method", o.method},
@@ -123,6 +128,10 @@ void run_squareness(const SquarenessOptions& o) {
            {"squareness_arcsec", r.arcsec()},
            {"convention",
             "positive when the angle between the positive axis directions exceeds 90 deg"}};
+    if (plane)
+      j["location_error"] = {{"plane", cal::kinematics::to_string(*plane)},
+                             {"name", cal::kinematics::location_error_name(*plane)},
+                             {"iso230_1_urad", location_urad}};
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print(
@@ -130,6 +139,12 @@ void run_squareness(const SquarenessOptions& o) {
       "positive "
       "axis directions exceeds 90 degrees\n",
       how, r.squareness_um_per_m, r.arcsec());
+  if (plane)
+    fmt::print(
+        "  model ({} plane): {} = {:+.3f} urad (ISO 230-1 location error; "
+        "caldaq.model.v1 \"iso230_1_urad\")\n",
+        cal::kinematics::to_string(*plane), cal::kinematics::location_error_name(*plane),
+        location_urad);
 }
 
 }  // namespace
@@ -162,6 +177,9 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   sq->add_option("--radius-mm", q->radius_mm, "circle: radius");
   sq->add_option("--report", q->report,
                  "straightness: also write an HTML report with both runs and their lines");
+  sq->add_option("--plane", q->plane,
+                 "XY, XZ or YZ: also print the model's location error (E_C0Y, E_B0Z, E_A0Z; "
+                 "E_B0Z has the opposite sign)");
   add_decimal_comma_flag(*sq, q->csv);
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
   sq->callback([q] { run_squareness(*q); });

@@ -79,6 +79,7 @@ void run_plan(PlanOptions o) {
                m.target_index ? std::to_string(m.target_index) : "-", m.position_mm);
   }
   for (const auto& w : plan.warnings) fmt::print("warning: {}\n", w);
+  for (const auto& n : plan.notes) fmt::print("note: {}\n", n);
 }
 
 struct UncOptions {

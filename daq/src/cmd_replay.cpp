@@ -8,6 +8,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/replay/session.hpp"
+#include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
@@ -43,6 +44,22 @@ struct ReplaySession {
           fmt::format("{}: the capture header is not a caldaq session header", o.capture));
     config = config_from_json(header.at("config"));
     for (const auto& j : header.at("instruments")) specs.push_back(instrument_spec_from_json(j));
+  }
+  // The run this capture was first stored as (the earliest run recording it), whose context
+  // (customer, instruments, tolerances) the replay keeps, as the capture header lacks it.
+  std::optional<std::int64_t> original_run;
+  std::string original_context;
+  void find_original(const ReplayOptions& o) {
+    const auto capture = std::filesystem::absolute(o.capture).string();
+    cal::storage::Store store(database_path(o.db));
+    for (const auto& r : store.runs()) {
+      if (r.capture_path != capture) continue;
+      original_run = r.id;
+      const json settings = json::parse(r.settings_json, nullptr, false);
+      if (settings.is_object() && settings.contains("context"))
+        original_context = settings["context"].dump();
+      return;
+    }
   }
   std::string software() const {
     return "daq 0.1.0 (replay of " + header.value("software", "?") + ")";
@@ -101,7 +118,10 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                        .database = database_path(o.db),
                        .ballbar = s.instrument(*it),
                        .capture_path = std::filesystem::absolute(o.capture).string(),
-                       .software_version = s.software()};
+                       .software_version = s.software(),
+                       .context_json = s.original_context,
+                       .replay = true,
+                       .replay_of_run = s.original_run};
   CircleRun run(s.io, std::move(setup));
   run.start();
   const auto end = s.play(run, "the capture ended before both arcs were recorded");
@@ -127,6 +147,9 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   setup.database = database_path(o.db);
   setup.capture_path = std::filesystem::absolute(o.capture).string();
   setup.software_version = s.software();
+  setup.context_json = s.original_context;
+  setup.replay = true;
+  setup.replay_of_run = s.original_run;
   for (const auto& spec : s.specs) {
     if (spec.role == "laser")
       setup.laser = s.instrument(spec);
@@ -150,10 +173,13 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   if (o.json) {
     json j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
+    j["status"] = cal::storage::to_string(out.status);
     j["capture_damage"] = damage_json(end);
     fmt::print("{}\n", j.dump(2));
   } else {
     fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+    if (!out.missed.empty())
+      fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
     print(*out.evaluation);
   }
   report_damage(end, o, out.run_id);
@@ -162,6 +188,7 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
 // A session is replayed as the test it recorded: a ballbar session as a circle, else linear.
 void run_replay(const ReplayOptions& o) {
   ReplaySession s(o);
+  s.find_original(o);
   const bool ballbar = std::any_of(s.specs.begin(), s.specs.end(),
                                    [](const auto& x) { return x.role == "ballbar"; });
   if (ballbar && s.config.circle) return replay_circle(s, o);

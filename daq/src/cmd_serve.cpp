@@ -255,15 +255,19 @@ class Service {
   // A run ends by itself (all stops, both arcs) or is stopped: keep its outcome, close its
   // capture, and accept the next start.
   void finish() {
-    const bool complete = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
+    // A linear run that reached its end with stops missed is evaluated but not complete.
+    const bool complete = linear_ ? linear_->outcome().status == cal::storage::RunStatus::complete
+                                  : circle_->outcome().complete;
+    const bool evaluated = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
     last_ = nlohmann::json{
         {"run", run_id_}, {"test", test_}, {"complete", complete}, {"reason", reason}};
     if (capture_ && capture_->recorder) capture_->recorder->close();
-    fmt::print("run {} {}{}\n", run_id_, complete ? "complete" : "stopped: ", reason);
+    const char* how = complete ? "complete" : evaluated ? "incomplete: " : "stopped: ";
+    fmt::print("run {} {}{}\n", run_id_, how, reason);
     std::fflush(stdout);
     linear_.reset(), circle_.reset(), capture_.reset();
-    publish_idle(fmt::format("run {} {}{}", run_id_, complete ? "complete" : "stopped: ", reason));
+    publish_idle(fmt::format("run {} {}{}", run_id_, how, reason));
   }
 
   void tick() {

@@ -39,7 +39,7 @@ check comp_axis_newline 2 "axis name 'X" -- $COMP --start-mm 0 -f siemens --axis
 check comp_axis_ok 0 "LEC for axis X2 " -- $COMP --start-mm 0 -f siemens --axis X2
 check comp_dev_zero 2 "/dev/zero: over the 256 MiB limit of a measurement file" -- "$DAQ" compensate -i /dev/zero --start-mm 0 --interval-mm 50 --points 5
 printf 'position_mm,deviation_um\n0,0\n100,1.5abc\n200,4\n' >"$TMP/garbage.csv"
-check comp_straightness_sscanf 2 "garbage.csv:3: column deviation_um: '1.5abc' is not a number" -- "$DAQ" compensate --straightness "$TMP/garbage.csv" --start-mm 0 --interval-mm 100 --points 3
+check comp_straightness_sscanf 2 "garbage.csv:3: column deviation_um: '1.5abc' is not a number" -- "$DAQ" compensate --straightness "$TMP/garbage.csv" --output-axis Y --start-mm 0 --interval-mm 100 --points 3
 
 # CSV readers: extra cells (a decimal-comma file), hex, NUL; decimal commas only when asked.
 printf 'position_mm,deviation_um\n0,0,000\n100,4,000\n200,0,000\n' >"$TMP/comma.csv"
@@ -84,7 +84,7 @@ check rtx_angular_needs_unit 2 "angular.rtx: an Angular capture: give --unit arc
 check rtx_angular_not_mm 2 "'mm' is not an angle unit" -- "$DAQ" import rtx "$TMP/angular.rtx" --db "$TMP/bad.sqlite" --unit mm
 check rtx_angular_imported 0 "into run 3: 2 angular samples .* unit arcsec \(from --unit\)" -- "$DAQ" import rtx "$TMP/angular.rtx" --db "$TMP/rtx.sqlite" --unit arcsec
 # 1 arcsec = pi / 648000 rad = 4.8481368110953598e-06 rad
-check rtx_angular_stored_as_angle 0 "^0,0,0,angle_rad,0,4\.84813681109535" -- "$DAQ" export 3 --db "$TMP/rtx.sqlite"
+check rtx_angular_stored_as_angle 0 ",angle_rad,0,4\.848136811095" -- "$DAQ" export 3 --db "$TMP/rtx.sqlite"
 rtx "$TMP/straight.rtx" Straightness 1000 2 '\r\nEOF::\r\n'
 check rtx_type_refused 2 "straight.rtx: header: File Type 'Straightness' is not supported" -- "$DAQ" import rtx "$TMP/straight.rtx" --db "$TMP/bad.sqlite"
 rtx "$TMP/inf.rtx" Linear inf 2 '\r\nEOF::\r\n'

@@ -204,6 +204,119 @@ TEST(Config, NamesHaveNoControlCharacters) {
             "two\nlines");
 }
 
+// An axis over 2000 mm may leave out interval_mm and count (ISO 230-2's 250 mm average is
+// then planned); a shorter one may not.
+TEST(Config, LongAxisMayLeaveTheTargetsToTheStandard) {
+  const auto c = parse_config("[test.linear]\nfirst_mm = 0\nlast_mm = 3000\nruns = 1\n", "m.toml");
+  ASSERT_TRUE(c.linear.has_value());
+  EXPECT_FALSE(c.linear->interval_mm.has_value());
+  EXPECT_FALSE(c.linear->count.has_value());
+  EXPECT_NE(error_of("[test.linear]\nfirst_mm = 0\nlast_mm = 2000\n").find("over 2000 mm"),
+            std::string::npos);
+}
+
+// The report's identity tables and the machine specification: read as written, and every
+// mistake (a non-finite or non-positive limit, an unknown axis or diagnostic, a bad date, a
+// by_length table out of order) refused with its place.
+TEST(Config, ReadsTheCustomerBlockAndTheTolerances) {
+  const auto c = parse_config(R"(
+operator = "J. Smith"
+
+[customer]
+name = "ACME Precision"
+site = "Plant 2"
+
+[machine]
+name = "VMC-1"
+make = "Hermle"
+model = "C 42"
+serial_number = "42-0815"
+
+[conditions]
+controller_compensation = false
+warm_up = "20 min at 50 % rapid"
+load = "no workpiece"
+state = "as found"
+
+[devices.laser]
+driver = "ids3010"
+transport = "tcp 10.0.0.5:9090"
+role = "laser"
+serial_number = "IDS-1234"
+certificate = "DAkkS 4711"
+calibration_due = "2027-02-28"
+
+[tolerances.X]
+E_um = 10
+A_um = 14.5
+[[tolerances.X.by_length]]
+up_to_mm = 500
+A_um = 8
+[[tolerances.X.by_length]]
+up_to_mm = 1000
+A_um = 12
+
+[tolerances.XY]
+G_um = 15
+[tolerances.XY.diagnostics]
+squareness = 20
+backlash_X = 3
+)",
+                              "m.toml");
+  EXPECT_EQ(c.operator_name, "J. Smith");
+  EXPECT_EQ(c.customer.name, "ACME Precision");
+  EXPECT_EQ(c.customer.site, "Plant 2");
+  EXPECT_EQ(c.machine_make, "Hermle");
+  EXPECT_EQ(c.machine_model, "C 42");
+  EXPECT_EQ(c.machine_serial, "42-0815");
+  EXPECT_EQ(c.conditions.controller_compensation, false);
+  EXPECT_EQ(c.conditions.state, "as found");
+  EXPECT_EQ(c.device_for("laser")->serial_number, "IDS-1234");
+  EXPECT_EQ(c.device_for("laser")->certificate, "DAkkS 4711");
+  EXPECT_EQ(c.device_for("laser")->calibration_due, "2027-02-28");
+  const auto& x = c.axis_tolerances.at("X");
+  EXPECT_EQ(x.limits.E_um, 10.0);
+  EXPECT_EQ(x.limits.A_um, 14.5);
+  EXPECT_FALSE(x.limits.R_um.has_value());
+  ASSERT_EQ(x.by_length.size(), 2u);
+  EXPECT_EQ(x.by_length[0].first, 500.0);
+  EXPECT_EQ(x.by_length[1].second.A_um, 12.0);
+  const auto& xy = c.plane_tolerances.at("XY");
+  EXPECT_EQ(xy.G_um, 15.0);
+  EXPECT_EQ(xy.diagnostics.at("backlash_X"), 3.0);
+}
+
+TEST(Config, RefusesBadLimitsDatesAndNames) {
+  // nan and inf are refused where every number of the file is read (issue 15).
+  EXPECT_EQ(error_of("[tolerances.X]\nE_um = nan\n"),
+            "machine.toml:2:8: key 'tolerances.X.E_um': nan is not a finite number");
+  EXPECT_EQ(error_of("[tolerances.X]\nA_um = inf\n"),
+            "machine.toml:2:8: key 'tolerances.X.A_um': inf is not a finite number");
+  EXPECT_EQ(error_of("[tolerances.X]\nR_um = 0\n"),
+            "machine.toml:2:8: key 'tolerances.X.R_um': a limit is a finite number > 0, not 0");
+  EXPECT_EQ(error_of("[tolerances.X]\nF_um = 3\n"),
+            "machine.toml:2:8: key 'tolerances.X.F_um': unknown key (a typo?)");
+  EXPECT_EQ(error_of("[tolerances.Q]\nE_um = 3\n"),
+            "machine.toml:1:1: key 'tolerances.Q': expected an axis (X, Y, Z) or a plane (XY, YZ, "
+            "ZX)");
+  EXPECT_NE(
+      error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
+          .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),
+      std::string::npos);
+  EXPECT_NE(error_of("[[tolerances.X.by_length]]\nup_to_mm = 500\nA_um = 8\n"
+                     "[[tolerances.X.by_length]]\nup_to_mm = 300\nA_um = 6\n")
+                .find("entries must ascend in up_to_mm"),
+            std::string::npos);
+  EXPECT_EQ(error_of("[devices.l]\ndriver = \"ids3010\"\ntransport = \"tcp a:1\"\n"
+                     "calibration_due = \"2027-02-30\"\n"),
+            "machine.toml:4:19: key 'devices.l.calibration_due': '2027-02-30' is not a date "
+            "YYYY-MM-DD");
+  EXPECT_EQ(error_of("[conditions]\nstate = \"as new\"\n"),
+            "machine.toml:2:9: key 'conditions.state': 'as new' is not one of: as found, as left");
+  EXPECT_EQ(error_of("[customer]\nname = \"A\"\ncity = \"B\"\n"),
+            "machine.toml:3:8: key 'customer.city': unknown key (a typo?)");
+}
+
 TEST(Config, MissingFileIsNamed) {
   try {
     cal::daq::load_config("/nonexistent/machine.toml");

@@ -5,6 +5,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
+#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -12,6 +13,7 @@
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "circle_output.hpp"
+#include "provenance.hpp"
 
 namespace daq {
 
@@ -133,7 +135,12 @@ struct CircleRun::Impl {
     else
       machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
     const auto& p = setup.program;
-    const json settings = circle_settings_json(p, setup.analysis);
+    json settings = circle_settings_json(p, setup.analysis);
+    settings["context"] = setup.context_json.empty()
+                              ? json(nullptr)
+                              : json::parse(setup.context_json, nullptr, false);
+    if (!settings["context"].is_object())
+      settings["context"] = run_context(c, "circle", setup.analysis.plane);
     outcome.run_id = store->begin_run({.machine_id = machine,
                                        .campaign = c.campaign,
                                        .kind = "circle",
@@ -172,6 +179,11 @@ struct CircleRun::Impl {
   void on_reading(const cal::drivers::Reading& r) {
     if (setup.on_reading) setup.on_reading(r);
     if (!running || r.quantity != cal::drivers::Quantity::length_m) return;
+    if (outcome.readings == 0)  // the time origin for exports (see linear_run.cpp)
+      store->set_time_origin(outcome.run_id, r.time_ns,
+                             std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count());
     ++outcome.readings;
     try {
       writer->push({.time_ns = r.time_ns,
@@ -224,12 +236,19 @@ struct CircleRun::Impl {
     } catch (const std::exception& e) {
       return abort(e.what());
     }
+    json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+    prov["analysis"] = circle_settings_json(setup.program, setup.analysis);
+    if (setup.replay) {
+      prov["capture"] = setup.capture_path;
+      prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
+    }
     try {
       store->add_result({.run_id = outcome.run_id,
                          .standard = "ISO 230-4:2005",
                          .json = circle_json(*outcome.result, setup.program.radius_mm,
                                              setup.analysis.plane, setup.program.feed_mm_per_min)
-                                     .dump()});
+                                     .dump(),
+                         .provenance_json = prov.dump()});
       store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
     } catch (const std::exception& e) {
       outcome.result.reset();

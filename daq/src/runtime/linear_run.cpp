@@ -6,6 +6,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "cal/daq/env_stage.hpp"
@@ -13,6 +14,7 @@
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "iso230_2_output.hpp"
+#include "provenance.hpp"
 
 namespace daq {
 
@@ -69,9 +71,13 @@ cal::iso230_2::Plan linear_plan(const cal::daq::LinearTestConfig& l) {
 
 namespace {
 
-json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, double datum_mm) {
+json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, double datum_mm,
+                   const std::string& context_json) {
   const auto& l = *c.linear;
+  json context = context_json.empty() ? json(nullptr) : json::parse(context_json, nullptr, false);
+  if (!context.is_object()) context = run_context(c, "linear", l.axis);
   return {
+      {"context", context},
       {"machine", c.machine_name},
       {"axis", l.axis},
       {"targets_mm", plan.targets_mm},
@@ -163,14 +169,14 @@ struct LinearRun::Impl {
       machine = m->id;
     else
       machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
-    outcome.run_id =
-        store->begin_run({.machine_id = machine,
-                          .campaign = c.campaign,
-                          .kind = "linear",
-                          .axis = c.linear->axis,
-                          .settings_json = settings_json(c, plan, setup.datum_mm).dump(),
-                          .capture_path = setup.capture_path,
-                          .software_version = setup.software_version});
+    outcome.run_id = store->begin_run(
+        {.machine_id = machine,
+         .campaign = c.campaign,
+         .kind = "linear",
+         .axis = c.linear->axis,
+         .settings_json = settings_json(c, plan, setup.datum_mm, setup.context_json).dump(),
+         .capture_path = setup.capture_path,
+         .software_version = setup.software_version});
     auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view driver) {
       store->add_instrument({.run_id = outcome.run_id,
                              .device = device,
@@ -239,7 +245,15 @@ struct LinearRun::Impl {
       return abort(fmt::format("storage failed: {}", e.what()));
     }
     if (setup.on_reading) setup.on_reading(r);
-    if (first_ns < 0) first_ns = r.time_ns;
+    if (first_ns < 0) {
+      // The run's time origin: this reading's session time is now in UTC (to the delivery
+      // delay), so exports can give absolute times.
+      first_ns = r.time_ns;
+      store->set_time_origin(outcome.run_id, r.time_ns,
+                             std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count());
+    }
     switch (r.quantity) {
       case Quantity::air_temperature_degc:
         return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
@@ -320,26 +334,59 @@ struct LinearRun::Impl {
     if (sequencer.complete()) finish();
   }
 
+  // The end of the plan. A run is complete only when every planned stop was captured; one
+  // with missed stops is stored incomplete with them listed, and evaluated from what it has.
   void finish() {
     running = false;
     try {
       writer->flush();
+      for (const auto i : sequencer.missed()) {
+        const auto& s = sequencer.stops()[i];
+        outcome.missed.push_back(
+            {.run_id = outcome.run_id,
+             .run_number = s.run,
+             .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+             .target_index = s.target_index - 1,
+             .nominal_mm = s.position_mm});
+      }
+      store->set_missed_stops(outcome.run_id, outcome.missed);
+      outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
+                                              : cal::storage::RunStatus::incomplete;
+      if (!outcome.missed.empty())
+        outcome.reason = fmt::format("{} of {} planned stops missed", outcome.missed.size(),
+                                     sequencer.stops().size());
       const auto& l = *setup.config.linear;
       const auto standard = cal::iso230_2::standard_from_string(l.standard);
-      outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
+      try {
+        outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
+      } catch (const std::exception& e) {
+        // Too little was captured to evaluate: stored as it is, and said why.
+        outcome.status = cal::storage::RunStatus::incomplete;
+        outcome.reason +=
+            (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
+        store->finish_run(outcome.run_id, outcome.status, outcome.reason);
+        live.state = "incomplete";
+        return end();
+      }
+      json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+      prov["standard"] = l.standard;
+      prov["coefficients"] = compensation_json(setup.config.environment);
+      prov["sensor_offsets"] = to_json(SensorOffsets{});
+      if (setup.replay) {
+        prov["capture"] = setup.capture_path;
+        prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
+      }
       store->add_result({.run_id = outcome.run_id,
                          .standard = std::string(outcome.evaluation->standard.title),
-                         .json = to_json(*outcome.evaluation).dump()});
-      store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
-    } catch (const cal::storage::StoreError& e) {
+                         .json = to_json(*outcome.evaluation).dump(),
+                         .provenance_json = prov.dump()});
+      store->finish_run(outcome.run_id, outcome.status, outcome.reason);
+    } catch (const cal::storage::StoreError& e) {  // a full disk: the run ends as aborted
       outcome.evaluation.reset();
       return abort(fmt::format("storage failed: {}", e.what()));
-    } catch (const std::exception& e) {
-      outcome.evaluation.reset();
-      return abort(fmt::format("the run could not be evaluated: {}", e.what()));
     }
     outcome.complete = true;
-    live.state = "complete";
+    live.state = outcome.missed.empty() ? "complete" : "incomplete";
     end();
   }
 
@@ -349,6 +396,7 @@ struct LinearRun::Impl {
     if (done) return;
     running = false;
     outcome.reason = reason;
+    outcome.status = cal::storage::RunStatus::aborted;
     live.state = "aborted";
     live.message = reason;
     try {

@@ -120,6 +120,8 @@ class Table {
     return out;
   }
 
+  void known(std::string_view key) { used_.emplace_back(key); }  // read by the caller
+
   const toml::table* subtable(std::string_view key) {
     used_.emplace_back(key);
     const toml::node* node = table_.get(key);
@@ -145,6 +147,37 @@ class Table {
   const std::filesystem::path& file_;
   std::vector<std::string> used_;
 };
+
+// YYYY-MM-DD with a month 1..12 and a day that month can have.
+bool iso_date(std::string_view s) {
+  if (s.size() != 10 || s[4] != '-' || s[7] != '-') return false;
+  for (std::size_t i : {0, 1, 2, 3, 5, 6, 8, 9})
+    if (s[i] < '0' || s[i] > '9') return false;
+  const int y = std::stoi(std::string(s.substr(0, 4))), m = std::stoi(std::string(s.substr(5, 2))),
+            d = std::stoi(std::string(s.substr(8, 2)));
+  static constexpr int days[] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  if (m < 1 || m > 12 || d < 1 || d > days[m - 1]) return false;
+  const bool leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+  return !(m == 2 && d == 29 && !leap);
+}
+
+// A limit: a finite number > 0 (TOML allows nan and inf, which are no limits).
+std::optional<double> limit(Table& t, std::string_view key) {
+  const auto v = t.get<double>(key);
+  if (v && !(std::isfinite(*v) && *v > 0))
+    t.fail(t.node(key), key, fmt::format("a limit is a finite number > 0, not {}", *v));
+  return v;
+}
+
+PositioningLimits read_limits(Table& t) {
+  PositioningLimits l;
+  l.E_um = limit(t, "E_um");
+  l.R_um = limit(t, "R_um");
+  l.B_um = limit(t, "B_um");
+  l.A_um = limit(t, "A_um");
+  l.M_um = limit(t, "M_um");
+  return l;
+}
 
 void one_of(Table& t, std::string_view key, const std::string& value,
             std::initializer_list<std::string_view> allowed) {
@@ -179,6 +212,12 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   t.read("family", d.family);
   one_of(t, "family", d.family, {"ds75", "gold", "temperx"});
   t.read("key", d.key);
+  t.read("serial_number", d.serial_number);
+  t.read("certificate", d.certificate);
+  t.read("calibration_due", d.calibration_due);
+  if (!d.calibration_due.empty() && !iso_date(d.calibration_due))
+    t.fail(t.node("calibration_due"), "calibration_due",
+           fmt::format("'{}' is not a date YYYY-MM-DD", d.calibration_due));
   double column = 0;
   t.read("column", column);
   if (column < 0 || column != std::floor(column))
@@ -242,8 +281,12 @@ LinearTestConfig read_linear(Table& t) {
   if (l.count && (*l.count < 2 || *l.count > iso230_2::max_plan_targets))
     t.fail(t.node("count"), "count",
            fmt::format("{} must be within 2 .. {}", *l.count, iso230_2::max_plan_targets));
-  if (l.interval_mm.has_value() == l.count.has_value())
-    t.fail(nullptr, "interval_mm", "give exactly one of interval_mm and count");
+  // Neither is allowed on an axis over 2000 mm: ISO 230-2's average interval of 250 mm.
+  const bool long_axis = cal::iso230_2::is_long_axis(l.first_mm, l.last_mm);
+  if ((l.interval_mm && l.count) || (!l.interval_mm && !l.count && !long_axis))
+    t.fail(nullptr, "interval_mm",
+           "give exactly one of interval_mm and count (or neither on an axis over 2000 mm: "
+           "targets an average of 250 mm apart, ISO 230-2)");
   t.read("random_fraction", l.random_fraction);
   if (!(l.random_fraction >= 0 && l.random_fraction < 0.5))
     t.fail(t.node("random_fraction"), "random_fraction",
@@ -300,6 +343,83 @@ CircleTestConfig read_circle(Table& t) {
   return c;
 }
 
+AxisTolerance read_axis_tolerance(Table& t) {
+  AxisTolerance a;
+  a.limits = read_limits(t);
+  t.known("by_length");
+  if (const auto* node = t.node("by_length")) {
+    const auto* arr = node->as_array();
+    if (!arr || !arr->is_array_of_tables())
+      t.fail(node, "by_length", "expected [[" + t.path() + ".by_length]] tables");
+    for (const auto& e : *arr) {
+      Table b(*e.as_table(), t.path() + ".by_length", t.file());
+      const auto up_to = b.get<double>("up_to_mm");
+      if (!up_to || !std::isfinite(*up_to) || *up_to <= 0)
+        b.fail(b.node("up_to_mm"), "up_to_mm", "each entry needs up_to_mm, a length > 0 in mm");
+      auto limits = read_limits(b);
+      if (limits.empty()) b.fail(nullptr, "up_to_mm", "the entry sets no limit (E_um, R_um, ...)");
+      b.check_unknown();
+      if (!a.by_length.empty() && a.by_length.back().first >= *up_to)
+        b.fail(b.node("up_to_mm"), "up_to_mm", "entries must ascend in up_to_mm");
+      a.by_length.emplace_back(*up_to, limits);
+    }
+  }
+  t.check_unknown();
+  return a;
+}
+
+// The diagnostics a circle in plane UV can report (cal::circle: Diagnostic::key).
+bool circle_diagnostic(std::string_view plane, std::string_view key) {
+  for (const char* k : {"radius_error", "scale_mismatch", "squareness", "servo_mismatch"})
+    if (key == k) return true;
+  for (const char* prefix :
+       {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_", "straightness_"}) {
+    const std::string_view p(prefix);
+    if (key.size() == p.size() + 1 && key.substr(0, p.size()) == p &&
+        plane.find(key.back()) != std::string_view::npos)
+      return true;
+  }
+  return false;
+}
+
+CircleTolerance read_circle_tolerance(Table& t, std::string_view plane) {
+  CircleTolerance c;
+  c.G_um = limit(t, "G_um");
+  if (const auto* d = t.subtable("diagnostics")) {
+    Table dt(*d, t.path() + ".diagnostics", t.file());
+    for (const auto& [k, v] : *d) {
+      if (!circle_diagnostic(plane, k.str()))
+        dt.fail(&v, k.str(),
+                fmt::format("not a diagnostic of a circle in {} (radius_error, scale_mismatch, "
+                            "squareness, servo_mismatch, backlash_{}, cyclic_{}, ...)",
+                            plane, plane.substr(0, 1), plane.substr(0, 1)));
+      c.diagnostics[std::string(k.str())] = *limit(dt, k.str());
+    }
+    dt.check_unknown();
+  }
+  t.check_unknown();
+  return c;
+}
+
+void read_tolerances(Config& c, Table& top) {
+  const auto* tol = top.subtable("tolerances");
+  if (!tol) return;
+  Table tt(*tol, "tolerances", top.file());
+  for (const auto& [k, v] : *tol) {
+    const std::string name(k.str());
+    const auto* table = tt.subtable(name);
+    if (!table) continue;
+    Table t(*table, "tolerances." + name, top.file());
+    if (name == "X" || name == "Y" || name == "Z")
+      c.axis_tolerances[name] = read_axis_tolerance(t);
+    else if (name == "XY" || name == "YZ" || name == "ZX")
+      c.plane_tolerances[name] = read_circle_tolerance(t, name);
+    else
+      tt.fail(&v, name, "expected an axis (X, Y, Z) or a plane (XY, YZ, ZX)");
+  }
+  tt.check_unknown();
+}
+
 }  // namespace
 
 const DeviceConfig* Config::device_for(std::string_view role) const {
@@ -324,9 +444,32 @@ Config parse_config(std::string_view text, const std::filesystem::path& file) {
     t.name("name", c.machine_name);
     if (c.machine_name.empty()) t.fail(t.node("name"), "name", "must not be empty");
     t.name("description", c.machine_description, true);
+    t.name("make", c.machine_make);
+    t.name("model", c.machine_model);
+    t.name("serial_number", c.machine_serial);
     t.check_unknown();
   }
   top.name("campaign", c.campaign);
+  top.name("operator", c.operator_name);
+  if (const auto* cu = top.subtable("customer")) {
+    Table t(*cu, "customer", file);
+    t.name("name", c.customer.name);
+    t.name("site", c.customer.site, true);
+    t.name("contact", c.customer.contact, true);
+    t.check_unknown();
+  }
+  if (const auto* co = top.subtable("conditions")) {
+    Table t(*co, "conditions", file);
+    c.conditions.controller_compensation = t.get<bool>("controller_compensation");
+    t.name("warm_up", c.conditions.warm_up, true);
+    t.name("load", c.conditions.load, true);
+    t.read("state", c.conditions.state);
+    if (!c.conditions.state.empty())
+      one_of(t, "state", c.conditions.state, {"as found", "as left"});
+    t.name("notes", c.conditions.notes, true);
+    t.check_unknown();
+  }
+  read_tolerances(c, top);
   if (const auto* devs = top.subtable("devices")) {
     for (const auto& [k, v] : *devs) {
       if (!v.is_table())
