@@ -14,6 +14,7 @@
 #include "cal/daq/ballbar.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -71,6 +72,7 @@ struct CircleRunSetup {
   std::string context_json;
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
+  cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
   std::function<void(const std::string&)> on_event;
   std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading
