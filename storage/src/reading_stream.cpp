@@ -87,7 +87,8 @@ struct ReadingStream::Impl {
         "from {} ns) is damaged: {}. The database file is corrupted; the run's other chunks "
         "and the other runs are not affected by this one",
         store.path.string(), run_id,
-        numbered ? fmt::format("{}", sqlite3_column_int64(s, 9)) : std::string("(unnumbered: written before schema 3)"),
+        numbered ? fmt::format("{}", sqlite3_column_int64(s, 9))
+                 : std::string("(unnumbered: written before schema 3)"),
         sqlite3_column_int64(s, 0), sqlite3_column_int64(s, 1), sqlite3_column_int64(s, 2),
         sqlite3_column_int64(s, 3), sqlite3_column_int64(s, 6), sqlite3_column_int64(s, 4), what));
   }
