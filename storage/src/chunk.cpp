@@ -100,6 +100,7 @@ class Reader {
 
 void decode_v1(std::span<const unsigned char> blob, std::size_t count, RawReading proto,
                std::vector<RawReading>& out) {
+  if (count == 0) throw ChunkError("an empty chunk");  // never written
   if (blob.size() != count * kV1RecordBytes)
     throw ChunkError(fmt::format("{} bytes for {} readings of 17 bytes", blob.size(), count));
   const unsigned char* p = blob.data();

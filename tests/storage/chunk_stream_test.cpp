@@ -156,6 +156,10 @@ TEST(Chunk, ADamagedBlobIsRefusedAtEveryLength) {
   EXPECT_THROW(chunk::decode(chunk::columns_v2, blob, 49, 0, 0, 0, out), chunk::ChunkError);
   EXPECT_THROW(chunk::decode(3, blob, 50, 0, 0, 0, out), chunk::ChunkError);
   EXPECT_THROW(chunk::decode(chunk::packed_v1, blob, 50, 0, 0, 0, out), chunk::ChunkError);
+  // An empty chunk is never written: refused in either encoding (found by fuzz_chunk).
+  EXPECT_THROW(chunk::decode(chunk::packed_v1, {}, 0, 0, 0, 0, out), chunk::ChunkError);
+  EXPECT_THROW(chunk::decode(chunk::columns_v2, std::vector<unsigned char>{0, 0}, 0, 0, 0, 0, out),
+               chunk::ChunkError);
   EXPECT_EQ(out.size(), 1u);
   chunk::decode(chunk::columns_v2, blob, 50, 0, 0, 0, out);
   EXPECT_EQ(out.size(), 51u);
