@@ -95,6 +95,19 @@ void remove_db(const fs::path& p) {
   for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
 }
 
+// Removes the benchmark's files when it ends, also by an error (they can be hundreds of MB).
+struct Cleanup {
+  std::vector<fs::path> files;
+  explicit Cleanup(std::vector<fs::path> f) : files(std::move(f)) {}
+  Cleanup(const Cleanup&) = delete;
+  Cleanup& operator=(const Cleanup&) = delete;
+  ~Cleanup() {
+    std::error_code ec;
+    for (const auto& f : files)
+      for (const char* s : {"", "-wal", "-shm"}) fs::remove(f.string() + s, ec);
+  }
+};
+
 void write_capture(const fs::path& path, int seconds) {
   cal::replay::CaptureWriter w(path, R"({"format": "daq bench ingest"})");
   const auto bytes = [](const std::string& s) {
@@ -385,12 +398,16 @@ struct BenchOptions {
 void bench_ingest(const BenchOptions& o) {
   if (o.seconds < 1 || o.rounds < 1)
     throw cal::InputError("bench ingest: --seconds and --rounds must be at least 1");
+  if (o.batch_readings < 1 || o.batch_readings > 10'000'000)
+    throw cal::InputError(
+        fmt::format("bench ingest: --batch {}: expected 1 to 10000000 readings", o.batch_readings));
   const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
   const auto tag = std::to_string(::getpid());
   const fs::path capture = dir / ("caldaq-bench-" + tag + ".cdq");
   const fs::path db = dir / ("caldaq-bench-" + tag + ".sqlite");
   const fs::path copy = dir / ("caldaq-bench-ceiling-" + tag + ".sqlite");
   const fs::path raw = dir / ("caldaq-bench-raw-" + tag + ".bin");
+  const Cleanup cleanup({capture, db, copy, raw});
 
   auto t0 = Clock::now();
   write_capture(capture, o.seconds);
@@ -462,10 +479,6 @@ void bench_ingest(const BenchOptions& o) {
       median(raw_rate), 100.0 * median(ratio_raw), median(pipeline_rate), median(blob17_rate),
       bytes_per_reading, file_bytes_per_reading, file_bytes_per_reading * 36e6 / 1e6,
       median(per_core), median(per_core) / 1e4, median(per_core) / 1e5);
-  remove_db(db);
-  remove_db(copy);
-  fs::remove(raw);
-  fs::remove(capture);
 }
 
 // A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
@@ -543,6 +556,7 @@ void bench_export(const ExportBenchOptions& o) {
   const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
   const fs::path db = dir / ("caldaq-bench-export-" + std::to_string(::getpid()) + ".sqlite");
   const fs::path html = dir / ("caldaq-bench-report-" + std::to_string(::getpid()) + ".html");
+  const Cleanup cleanup({db, html});
   remove_db(db);
   fmt::print("{:>8} {:>11} {:>9}  {:>16} {:>16} {:>16}\n", "minutes", "readings", "stored MB",
              "export csv", "export json", "report (html)");
@@ -571,8 +585,6 @@ void bench_export(const ExportBenchOptions& o) {
   fmt::print(
       "(wall time and peak RSS of each daq process; readings per second of export: the "
       "readings column over the time)\n");
-  remove_db(db);
-  fs::remove(html);
 }
 
 }  // namespace
