@@ -15,7 +15,6 @@
 #include "cal/analysis/error.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/daq/gcode.hpp"
-#include "cal/drivers/instruments.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "circle_output.hpp"
@@ -107,9 +106,6 @@ void run_circle(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   const auto [program, analysis] = circle_test(config);
   const auto& dc = need(config, "ballbar");
-  if (dc.driver != "gauge")
-    throw cal::InputError(
-        fmt::format("{}: devices.{}: the ballbar needs driver = \"gauge\"", o.config, dc.id));
   boost::asio::io_context io;
   const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
   SessionCapture capture(o.capture, config, specs);
@@ -119,7 +115,7 @@ void run_circle(const RunOptions& o) {
       .analysis = analysis,
       .database = database_path(o.db),
       .ballbar = make_instrument(io, specs[0], make_transport(io, dc),
-                                 instrument_options(dc, o, capture.recorder.get())),
+                                 instrument_options(dc, specs[0], o, capture.recorder.get())),
       .capture_path = capture.absolute_path(o.capture)};
   const bool tty = ::isatty(STDOUT_FILENO);
   setup.on_event = [tty](const std::string& e) {

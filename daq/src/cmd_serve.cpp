@@ -161,14 +161,14 @@ class Service {
     const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
-    CircleRunSetup setup{
-        .config = config_,
-        .program = program,
-        .analysis = analysis,
-        .database = database_path(o_.run.db),
-        .ballbar = make_instrument(io_, specs[0], make_transport(io_, dc),
-                                   instrument_options(dc, o_.run, capture_->recorder.get())),
-        .capture_path = capture_->absolute_path(path)};
+    CircleRunSetup setup{.config = config_,
+                         .program = program,
+                         .analysis = analysis,
+                         .database = database_path(o_.run.db),
+                         .ballbar = make_instrument(
+                             io_, specs[0], make_transport(io_, dc),
+                             instrument_options(dc, specs[0], o_.run, capture_->recorder.get())),
+                         .capture_path = capture_->absolute_path(path)};
     setup.on_live = [this](const CircleLive& s) { server_->publish(to_json_text(s)); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));

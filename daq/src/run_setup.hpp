@@ -21,11 +21,13 @@ struct RunOptions {
   bool json = false;
 };
 
-// "tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or "hid /dev/hidrawN"; throws
-// cal::InputError naming the device and its transport text.
+// The transport of a device ("tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or
+// "hid /dev/hidrawN"); throws cal::InputError naming the device and its transport text.
 std::unique_ptr<cal::drivers::transport::Transport> make_transport(boost::asio::io_context& io,
                                                                    const cal::daq::DeviceConfig& c);
-InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device);
+// The instrument spec of a configured device; throws cal::InputError when its driver's readings
+// cannot fill its role (a PTU300 as the ballbar).
+InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device, int test_axis = 0);
 // The device of a role, or cal::InputError naming the configuration file.
 const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role);
 
@@ -45,13 +47,18 @@ struct SessionCapture {
   }
 };
 
-// The options of a configured device: its name, poll period and the run's reconnection limit.
+// The options of a configured device: its name, poll period (the driver's default when the
+// configuration gives none) and the run's reconnection limit.
 cal::drivers::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc,
-                                                   const RunOptions& o,
+                                                   const InstrumentSpec& s, const RunOptions& o,
                                                    cal::replay::CaptureRecorder* recorder);
 
 // The instruments of a linear run (laser, air, material sensors, optional position feed).
 std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config);
+// Puts an instrument in its role's place in a linear run (the laser's and the position feed's
+// channel from the driver); live and in replay.
+void place_linear_instrument(const InstrumentSpec& s,
+                             std::unique_ptr<cal::drivers::Instrument> inst, LinearRunSetup& setup);
 void add_linear_instruments(boost::asio::io_context& io, const cal::daq::Config& config,
                             const std::vector<InstrumentSpec>& specs, const RunOptions& o,
                             cal::replay::CaptureRecorder* recorder, LinearRunSetup& setup);

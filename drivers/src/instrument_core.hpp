@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "cal/drivers/instrument.hpp"
 
@@ -41,6 +42,16 @@ class InstrumentCore : public Instrument {
   void fail(const std::string& reason);
   void start_polling();
   void report_codec_errors(std::span<const codec::CodecError> errors);
+  // Feeds the bytes to the codec: `frames` holds the frames they completed (cleared first), and
+  // each codec error is reported through the events.
+  template <class Codec>
+  void decode(Codec& codec, std::span<const std::byte> bytes,
+              std::vector<typename Codec::Frame>& frames) {
+    frames.clear();
+    codec_errors_.clear();
+    codec.feed(bytes, frames, codec_errors_);
+    report_codec_errors(codec_errors_);
+  }
   // The time of the event being handled: inside a data handler the arrival time of the bytes
   // (one value for the whole chunk, the one recorded), else the clock.
   std::int64_t now_ns() const { return latched_ns_ ? *latched_ns_ : clock_(); }
@@ -69,6 +80,7 @@ class InstrumentCore : public Instrument {
   std::int64_t last_bytes_ns_ = 0;
   std::optional<Gap> gap_;  // open while the connection is down
   std::optional<std::int64_t> latched_ns_;
+  std::vector<codec::CodecError> codec_errors_;
   std::int64_t last_sent_ns_ = 0;
   void record_event(std::string_view text);
   void on_opened();

@@ -6,11 +6,12 @@
 
 #include <string>
 
-#include "cal/drivers/codec/attocube_ids.hpp"
-#include "cal/drivers/codec/line_gauge.hpp"
-#include "cal/drivers/codec/position_feed.hpp"
-#include "cal/drivers/codec/temper.hpp"
-#include "cal/drivers/codec/vaisala_ptu300.hpp"
+#include "halsampler/codec.hpp"
+#include "ids3010/codec.hpp"
+#include "line_gauge/codec.hpp"
+#include "ptu300/codec.hpp"
+#include "shdr/codec.hpp"
+#include "temper/codec.hpp"
 
 namespace {
 

@@ -1,11 +1,11 @@
 // Machine position feeds: LinuxCNC halsampler and MTConnect SHDR lines written by hand from
 // their documented formats (codec/position_feed.hpp); expected values worked out beside them.
-#include "cal/drivers/codec/position_feed.hpp"
-
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "halsampler/codec.hpp"
+#include "shdr/codec.hpp"
 
 namespace {
 

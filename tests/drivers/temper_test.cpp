@@ -1,11 +1,10 @@
 // TEMPer codec on reports written by hand from the layouts of OpenBSD's ugold(4) (see
 // codec/temper.hpp); every expected temperature is worked out in the comment beside it.
-#include "cal/drivers/codec/temper.hpp"
-
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "temper/codec.hpp"
 
 namespace {
 

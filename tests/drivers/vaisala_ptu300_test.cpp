@@ -1,11 +1,10 @@
 // Vaisala PTU300 codec: output lines as the User's Guide prints them, custom FORM lines with
 // other units, the CS2/CS4/CSX checksums worked out by hand, and every bad line.
-#include "cal/drivers/codec/vaisala_ptu300.hpp"
-
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "ptu300/codec.hpp"
 
 namespace {
 

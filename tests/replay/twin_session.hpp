@@ -17,8 +17,14 @@
 #include <memory>
 #include <vector>
 
-#include "cal/drivers/instruments.hpp"
-#include "cal/drivers/sim/twins.hpp"
+#include "ids3010/instrument.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/instrument.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/instrument.hpp"
+#include "ptu300/twin.hpp"
+#include "shdr/instrument.hpp"
+#include "shdr/twin.hpp"
 
 namespace twin_session {
 
@@ -64,9 +70,8 @@ inline d::InstrumentOptions options(Device device, const char* name) {
 
 inline d::Ids3010Options ids_options() { return {.environment_period = 500ms}; }
 inline d::codec::GaugeConfig gauge_config() { return {}; }
-inline d::PositionFeedOptions feed_options() {
-  return {.kind = d::PositionFeedKind::shdr,
-          .shdr = {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}}};
+inline d::codec::ShdrConfig feed_options() {
+  return {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}};
 }
 
 // The four instruments on the given transports (real ones when recording, the replay bus's
@@ -81,11 +86,11 @@ std::array<std::unique_ptr<d::Instrument>, 4> instruments(boost::asio::io_contex
     o.replay = base.replay;
     return o;
   };
-  return {d::make_ids3010(io, transport(laser), with(options(laser, "laser")), ids_options()),
-          d::make_ptu300(io, transport(ptu300), with(options(ptu300, "PTU300"))),
-          d::make_gauge(io, transport(ballbar), with(options(ballbar, "ballbar")), gauge_config()),
-          d::make_position_feed(io, transport(position), with(options(position, "position")),
-                                feed_options())};
+  return {
+      d::make_ids3010(io, transport(laser), with(options(laser, "laser")), ids_options()),
+      d::make_ptu300(io, transport(ptu300), with(options(ptu300, "PTU300"))),
+      d::make_gauge(io, transport(ballbar), with(options(ballbar, "ballbar")), gauge_config()),
+      d::make_shdr(io, transport(position), with(options(position, "position")), feed_options())};
 }
 
 }  // namespace twin_session

@@ -1,8 +1,6 @@
 // The real instruments (transport + codec + state machine) against the simulated twins:
 // values in SI equal the simulated truth, the states follow the device, and a dropped
 // connection is reconnected with the gap reported.
-#include "cal/drivers/instruments.hpp"
-
 #include <gtest/gtest.h>
 
 #include <boost/asio/io_context.hpp>
@@ -10,7 +8,14 @@
 #include <map>
 #include <vector>
 
-#include "cal/drivers/sim/twins.hpp"
+#include "ids3010/instrument.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/instrument.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/instrument.hpp"
+#include "ptu300/twin.hpp"
+#include "shdr/instrument.hpp"
+#include "shdr/twin.hpp"
 
 namespace {
 
@@ -183,11 +188,9 @@ TEST(PositionFeedInstrument, ShdrAdapterPositionAndHeartbeats) {
   double now_s = 1.0;
   sim::World world = parked_at_100mm();
   sim::ShdrTwin twin(io, world, [&] { return now_s; }, {.period = 2ms});
-  auto feed = d::make_position_feed(
-      io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
-      {.device = 4, .name = "position", .poll_period = 20ms},
-      {.kind = d::PositionFeedKind::shdr,
-       .shdr = {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}}});
+  auto feed = d::make_shdr(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+                           {.device = 4, .name = "position", .poll_period = 20ms},
+                           {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}});
   Recorder rec;
   feed->start(rec.events());
   ASSERT_TRUE(run_until(io, [&] {

@@ -1,7 +1,5 @@
 // The real transports against the simulated twins: the bytes on the wire are those of the
 // protocols, and the values are the simulated truth converted by hand.
-#include "cal/drivers/sim/twins.hpp"
-
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -11,6 +9,9 @@
 #include <string>
 
 #include "cal/drivers/transport/transport.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/twin.hpp"
 
 namespace {
 

@@ -1,0 +1,45 @@
+#pragma once
+// SIMULATED Attocube IDS3010: JSON-RPC 2.0 on a loopback TCP port, answering from the
+// simulated World (see sim/twin.hpp). Boost.Asio stays out of this header.
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "cal/drivers/sim/twin.hpp"
+
+namespace cal::drivers::sim {
+
+struct IdsTwinConfig {
+  std::uint16_t port = 0;  // 0: an ephemeral port on 127.0.0.1 (see IdsTwin::port())
+  // Which machine axis each of the three interferometer axes measures (-1: none, reads 0),
+  // and the tool position (mm along that axis) where its displacement was reset to zero.
+  std::array<int, 3> machine_axis{0, -1, -1};
+  std::array<double, 3> datum_mm{0.0, 0.0, 0.0};
+  double starting_s = 0.2;  // "measurement starting" lasts this long after startMeasurement
+  bool ecu_connected = true;
+};
+
+class IdsTwin final : public Twin {
+ public:
+  IdsTwin(boost::asio::io_context& io, World& world, Clock clock, IdsTwinConfig config = {});
+  ~IdsTwin() override;
+
+  std::uint16_t port() const;
+  std::string transport() const override;
+  void unplug() override { drop_connections(); }
+  // Simulates a blocked beam on one axis: its displacement requests answer with an error
+  // code (the twin's stand-in for the device's signal-lost warning) until restored.
+  void set_beam_lost(int axis, bool lost);
+  // Drops every client connection (as a power cycle or a pulled cable would).
+  void drop_connections();
+  std::uint64_t requests_served() const;
+
+  static constexpr std::int64_t error_not_measuring = 1;  // twin's code: not in measurement
+  static constexpr std::int64_t error_beam_lost = 2;      // twin's code: signal lost on axis
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace cal::drivers::sim

@@ -1,0 +1,40 @@
+#pragma once
+// SIMULATED MTConnect SHDR adapter (a machine position feed) on a loopback TCP port, streaming
+// the simulated control's commanded position (see sim/twin.hpp).
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "cal/drivers/sim/twin.hpp"
+
+namespace cal::drivers::sim {
+
+struct ShdrTwinConfig {
+  std::uint16_t port = 0;  // 0: an ephemeral port on 127.0.0.1
+  // Wall-clock period of the position lines, each "|Xcom|x|Ycom|y|Zcom|z" (no timestamp: the
+  // agent stamps it), the control's commanded position in mm.
+  std::chrono::milliseconds period{5};
+  std::int64_t pong_timeout_ms = 10000;  // the answer to "* PING": "* PONG 10000"
+  std::array<std::string, 3> keys{"Xcom", "Ycom", "Zcom"};  // the data items of X, Y, Z
+};
+
+// Streams the simulated control's commanded position to every connected agent and answers
+// its heartbeats, as an MTConnect adapter does.
+class ShdrTwin final : public Twin {
+ public:
+  ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});
+  ~ShdrTwin() override;
+  std::uint16_t port() const;
+  std::string transport() const override;
+  void unplug() override;
+  std::uint64_t lines_sent() const;
+  std::uint64_t pings_answered() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace cal::drivers::sim
