@@ -67,10 +67,21 @@ const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& ca
   return out;
 }
 
+// Every device opens and speaks before the run starts, or the run is refused naming it.
+void check_at_start(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
+                    const RunOptions& o) {
+  if (o.check_s <= 0) return;
+  fmt::print("Checking the devices (up to {} s):\n", o.check_s);
+  check_devices(config, specs, std::chrono::duration<double>(o.check_s),
+                [](const std::string& line) { fmt::print("{}\n", line); });
+  std::fflush(stdout);
+}
+
 void run_linear(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   boost::asio::io_context io;
   const auto specs = linear_specs(config);
+  check_at_start(config, specs, o);
   SessionCapture capture(o.capture, config, specs);
   LinearRunSetup setup;
   setup.config = config;
@@ -108,6 +119,7 @@ void run_circle(const RunOptions& o) {
   const auto& dc = need(config, "ballbar");
   boost::asio::io_context io;
   const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
+  check_at_start(config, specs, o);
   SessionCapture capture(o.capture, config, specs);
   CircleRunSetup setup{
       .config = config,
@@ -185,6 +197,11 @@ void add_run_commands(CLI::App& app) {
   lin->add_option("--give-up-after", o->give_up_after,
                   "Reconnection attempts before a device is given up")
       ->capture_default_str();
+  lin->add_option("--check-s", o->check_s,
+                  "Before the run, every device must open and speak within this time (0: no "
+                  "check)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   lin->callback([o] { run_linear(*o); });
   auto* circ = run->add_subcommand("circle", "ISO 230-4 circular test with a ballbar");
   circ->add_option("-c,--config", o->config, "Machine/campaign TOML with [test.circle]")
@@ -194,6 +211,10 @@ void add_run_commands(CLI::App& app) {
   circ->add_option("--give-up-after", o->give_up_after,
                    "Reconnection attempts before the ballbar is given up")
       ->capture_default_str();
+  circ->add_option("--check-s", o->check_s,
+                   "Before the run, the ballbar must open within this time (0: no check)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   circ->add_flag("--json", o->json, "Print the result as caldaq.circle.v1 JSON");
   circ->callback([o] { run_circle(*o); });
 

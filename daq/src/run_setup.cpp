@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <boost/asio/io_context.hpp>
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/registry.hpp"
@@ -90,6 +91,77 @@ d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const 
   return opt;
 }
 
+namespace {
+
+const cal::daq::DeviceConfig& device_of(const cal::daq::Config& config, const InstrumentSpec& s) {
+  return *std::find_if(config.devices.begin(), config.devices.end(), [&](const auto& x) {
+    return x.transport == s.transport && x.role == s.role;
+  });
+}
+
+// What the check saw of one device.
+struct Checked {
+  const cal::daq::DeviceConfig* device = nullptr;
+  std::unique_ptr<d::Instrument> instrument;
+  bool may_be_silent = false;
+  bool opened = false, spoke = false, closed = false;
+  std::string why;  // the last state's reason (the transport's error text)
+  bool done() const { return spoke || closed || (may_be_silent && opened); }
+};
+
+}  // namespace
+
+void check_devices(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
+                   std::chrono::duration<double> within,
+                   const std::function<void(const std::string&)>& print) {
+  boost::asio::io_context io;
+  std::vector<Checked> checked(specs.size());
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    const auto& s = specs[k];
+    auto& c = checked[k];
+    c.device = &device_of(config, s);
+    c.may_be_silent = d::driver(s.driver).may_be_silent(s.options);
+    auto options = instrument_options(*c.device, s, RunOptions{.give_up_after = 1}, nullptr);
+    c.instrument = make_instrument(io, s, make_transport(io, *c.device), std::move(options));
+    c.instrument->start({.reading = [&c](const d::Reading&) { c.spoke = true; },
+                         .state =
+                             [&c](d::InstrumentState st, std::string_view why) {
+                               if (st == d::InstrumentState::configuring) c.opened = true;
+                               if (st == d::InstrumentState::closed) c.closed = true;
+                               if (!why.empty()) c.why = std::string(why);
+                             }});
+  }
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::nanoseconds>(within);
+  while (std::chrono::steady_clock::now() < deadline &&
+         !std::all_of(checked.begin(), checked.end(), [](const Checked& c) { return c.done(); }))
+    io.run_for(std::chrono::milliseconds(20));
+  std::vector<std::string> failed;
+  for (auto& c : checked) {
+    const std::string who = fmt::format("devices.{} ({})", c.device->id, c.device->transport);
+    std::string state;
+    if (c.spoke) {
+      state = "speaks";
+    } else if (c.may_be_silent && c.opened && !c.closed) {
+      state = "open (it may be silent until it streams)";
+    } else {
+      // A closed instrument gave up after its one attempt: the reason is what follows.
+      if (const auto at = c.why.find("attempts: "); c.closed && at != std::string::npos)
+        c.why = c.why.substr(at + 10);
+      state = c.closed   ? fmt::format("failed: {}", c.why)
+              : c.opened ? fmt::format("opened but said nothing within {:.0f} s", within.count())
+                         : fmt::format("did not open within {:.0f} s{}", within.count(),
+                                       c.why.empty() ? "" : ": " + c.why);
+      failed.push_back(who + ": " + state);
+    }
+    print(fmt::format("  {}: {}", who, state));
+    c.instrument->stop();
+  }
+  io.poll();
+  if (!failed.empty())
+    throw cal::InputError(fmt::format("device check: {}", fmt::join(failed, "; ")));
+}
+
 // The instruments of a linear run (laser, air, material sensors, optional position feed).
 std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
   if (!config.linear)
@@ -108,7 +180,8 @@ std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
 
 void place_linear_instrument(const InstrumentSpec& s, std::unique_ptr<d::Instrument> inst,
                              LinearRunSetup& setup) {
-  const auto channels = d::driver(s.driver).channels(s.options, s.context());
+  const auto& drv = d::driver(s.driver);
+  const auto channels = drv.channels(s.options, s.context());
   const int first = channels.empty() ? 0 : channels.front();
   if (s.role == "laser") {
     setup.laser = std::move(inst);
@@ -118,8 +191,11 @@ void place_linear_instrument(const InstrumentSpec& s, std::unique_ptr<d::Instrum
   } else if (s.role == "position") {
     setup.position = std::move(inst);
     setup.position_channel = first;
+    setup.position_on_change = drv.sends_on_change();
   } else {
     setup.material.push_back(std::move(inst));
+    setup.material_channels.resize(setup.material.size() - 1);
+    setup.material_channels.push_back(channels);  // each channel its own material sensor
   }
 }
 
@@ -127,9 +203,7 @@ void add_linear_instruments(boost::asio::io_context& io, const cal::daq::Config&
                             const std::vector<InstrumentSpec>& specs, const RunOptions& o,
                             cal::replay::CaptureRecorder* recorder, LinearRunSetup& setup) {
   for (const auto& s : specs) {
-    const auto& dc = *std::find_if(
-        config.devices.begin(), config.devices.end(),
-        [&](const auto& x) { return x.transport == s.transport && x.role == s.role; });
+    const auto& dc = device_of(config, s);
     place_linear_instrument(
         s, make_instrument(io, s, make_transport(io, dc), instrument_options(dc, s, o, recorder)),
         setup);

@@ -1,7 +1,9 @@
 #pragma once
 // What `daq run` and `daq serve` share: the instruments of a configuration's devices, their
 // options, and the session capture. Boost.Asio stays out (io_context is forward-declared).
+#include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +21,7 @@ struct RunOptions {
   std::string config, db, capture;
   int give_up_after = 20;
   bool json = false;
+  double check_s = 10.0;  // the start-up device check's limit; 0: no check
 };
 
 // The transport of a device ("tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or
@@ -52,6 +55,14 @@ struct SessionCapture {
 cal::drivers::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc,
                                                    const InstrumentSpec& s, const RunOptions& o,
                                                    cal::replay::CaptureRecorder* recorder);
+
+// The start-up check of `daq run` and `daq serve`: every device of `specs` is opened once (no
+// reconnection) and must speak (a reading) within `within`; a device that may be silent until
+// something happens (a ballbar gauge before it is mounted) must open. Prints each device's
+// state through `print`; throws cal::InputError naming every device that failed and why.
+void check_devices(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
+                   std::chrono::duration<double> within,
+                   const std::function<void(const std::string&)>& print);
 
 // The instruments of a linear run (laser, air, material sensors, optional position feed).
 std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config);

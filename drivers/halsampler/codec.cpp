@@ -32,6 +32,10 @@ void HalsamplerCodec::decode(std::string_view line, std::uint64_t offset,
   if (!is_printable_ascii(line))
     return report(errors, ErrorKind::garbage, offset, "halsampler: non-printable bytes");
   auto tokens = split_whitespace(line);
+  if (tokens.size() == 1 && tokens.front() == "overrun") {  // samples lost before the next line
+    pending_overrun_ = true;
+    return;
+  }
   PositionFrame f;
   if (config_.sample_numbers) {
     const auto n = tokens.empty() ? std::nullopt : parse_integer<std::uint64_t>(tokens.front());
@@ -60,6 +64,7 @@ void HalsamplerCodec::decode(std::string_view line, std::uint64_t offset,
     f.position_m[axis] = *v * config_.metres_per_unit;
   }
   f.lost_before = std::exchange(pending_lost_, 0);
+  f.overrun = std::exchange(pending_overrun_, false);
   emit(frames, std::move(f));
 }
 

@@ -14,8 +14,9 @@ const std::vector<OptionSpec>& table() {
   static const std::vector<OptionSpec> t{
       {.name = "tagged",
        .type = OptionType::boolean,
-       .default_value = true,
-       .help = "each line starts with the sample number (halsampler -t)"},
+       .default_value = false,
+       .help = "each line starts with the sample number (halsampler -t); halsampler's own "
+               "default is untagged"},
       {.name = "column",
        .type = OptionType::integer,
        .min = 0,
@@ -72,11 +73,17 @@ class Driver final : public DeviceDriver {
     return detail::make_codec_decoder(
         codec::HalsamplerCodec(config_of(o, 0)),
         [](const codec::PositionFrame& f, std::uint64_t offset, std::vector<DecodedItem>& out) {
-          if (f.lost_before > 0)
-            out.push_back({.kind = DecodedItem::Kind::gap,
-                           .offset = offset,
-                           .text = fmt::format("{} samples lost before this one", f.lost_before),
-                           .lost_samples = f.lost_before});
+          if (f.lost_before > 0 || f.overrun) {
+            DecodedItem gap{.kind = DecodedItem::Kind::gap, .offset = offset};
+            if (f.lost_before > 0) {
+              gap.text = fmt::format("{} samples lost before this one{}", f.lost_before,
+                                     f.overrun ? " (overrun)" : "");
+              gap.lost_samples = f.lost_before;
+            } else {
+              gap.text = "overrun: samples lost before this one (untagged: how many is unknown)";
+            }
+            out.push_back(gap);
+          }
           for (std::uint8_t axis = 0; axis < 3; ++axis)
             if (f.position_m[axis])
               out.push_back(detail::reading_item(offset, axis, Quantity::machine_position_m,

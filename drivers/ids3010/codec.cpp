@@ -27,39 +27,53 @@ enum class ResultKind {
   text
 };
 
+// Which interface a method belongs to: the displacement and system interfaces carry the
+// generation (com.attocube.ids / com.attocube.sen), the ECU and the system service do not.
+enum class Interface { generation, ecu, service };
+
 struct MethodInfo {
   IdsMethod method;
-  std::string_view name;
-  std::size_t params;  // number of params the method takes
+  Interface interface;
+  std::string_view name;  // after the interface's prefix
+  std::size_t params;     // number of params the method takes
   ResultKind result;
 };
 
 constexpr MethodInfo kMethods[] = {
-    {IdsMethod::get_axes_displacement, "com.attocube.ids.displacement.getAxesDisplacement", 0,
+    {IdsMethod::get_axes_displacement, Interface::generation, "displacement.getAxesDisplacement", 0,
      ResultKind::three_pm},
-    {IdsMethod::get_axis_displacement, "com.attocube.ids.displacement.getAxisDisplacement", 1,
+    {IdsMethod::get_axis_displacement, Interface::generation, "displacement.getAxisDisplacement", 1,
      ResultKind::one_pm},
-    {IdsMethod::get_absolute_positions, "com.attocube.ids.displacement.getAbsolutePositions", 0,
-     ResultKind::three_pm},
-    {IdsMethod::get_measurement_enabled, "com.attocube.ids.displacement.getMeasurementEnabled", 0,
-     ResultKind::flag},
-    {IdsMethod::start_measurement, "com.attocube.ids.system.startMeasurement", 0, ResultKind::none},
-    {IdsMethod::stop_measurement, "com.attocube.ids.system.stopMeasurement", 0, ResultKind::none},
-    {IdsMethod::start_optics_alignment, "com.attocube.ids.system.startOpticsAlignment", 0,
+    {IdsMethod::get_absolute_positions, Interface::generation, "displacement.getAbsolutePositions",
+     0, ResultKind::three_pm},
+    {IdsMethod::get_measurement_enabled, Interface::generation,
+     "displacement.getMeasurementEnabled", 0, ResultKind::flag},
+    {IdsMethod::start_measurement, Interface::generation, "system.startMeasurement", 0,
      ResultKind::none},
-    {IdsMethod::stop_optics_alignment, "com.attocube.ids.system.stopOpticsAlignment", 0,
+    {IdsMethod::stop_measurement, Interface::generation, "system.stopMeasurement", 0,
      ResultKind::none},
-    {IdsMethod::get_current_mode, "com.attocube.ids.system.getCurrentMode", 0, ResultKind::text},
-    {IdsMethod::get_system_error, "com.attocube.ids.system.getSystemError", 0, ResultKind::none},
-    {IdsMethod::reset_axes, "com.attocube.ids.system.resetAxes", 0, ResultKind::none},
-    {IdsMethod::ecu_enable, "com.attocube.ecu.enable", 0, ResultKind::none},
-    {IdsMethod::ecu_get_connected, "com.attocube.ecu.getConnected", 0, ResultKind::flag},
-    {IdsMethod::ecu_get_temperature, "com.attocube.ecu.getTemperatureInDegrees", 0,
+    {IdsMethod::start_optics_alignment, Interface::generation, "system.startOpticsAlignment", 0,
+     ResultKind::none},
+    {IdsMethod::stop_optics_alignment, Interface::generation, "system.stopOpticsAlignment", 0,
+     ResultKind::none},
+    {IdsMethod::get_current_mode, Interface::generation, "system.getCurrentMode", 0,
+     ResultKind::text},
+    {IdsMethod::get_system_error, Interface::generation, "system.getSystemError", 0,
+     ResultKind::none},
+    {IdsMethod::reset_axes, Interface::generation, "system.resetAxes", 0, ResultKind::none},
+    {IdsMethod::ecu_enable, Interface::ecu, "enable", 0, ResultKind::none},
+    {IdsMethod::ecu_get_enabled, Interface::ecu, "getEnabled", 0, ResultKind::flag},
+    {IdsMethod::ecu_get_connected, Interface::ecu, "getConnected", 0, ResultKind::flag},
+    {IdsMethod::ecu_get_temperature, Interface::ecu, "getTemperatureInDegrees", 0,
      ResultKind::temperature_degc},
-    {IdsMethod::ecu_get_pressure, "com.attocube.ecu.getPressureInHPa", 0, ResultKind::pressure_hpa},
-    {IdsMethod::ecu_get_humidity, "com.attocube.ecu.getHumidityInPercent", 0, ResultKind::humidity},
-    {IdsMethod::ecu_get_refractive_index, "com.attocube.ecu.getRefractiveIndex", 0,
+    {IdsMethod::ecu_get_pressure, Interface::ecu, "getPressureInHPa", 0, ResultKind::pressure_hpa},
+    {IdsMethod::ecu_get_humidity, Interface::ecu, "getHumidityInPercent", 0, ResultKind::humidity},
+    {IdsMethod::ecu_get_refractive_index, Interface::ecu, "getRefractiveIndex", 0,
      ResultKind::index},
+    {IdsMethod::get_firmware_version, Interface::service, "getFirmwareVersion", 0,
+     ResultKind::text},
+    {IdsMethod::error_number_to_string, Interface::service, "errorNumberToString", 2,
+     ResultKind::text},
 };
 
 const MethodInfo& info(IdsMethod m) {
@@ -67,6 +81,18 @@ const MethodInfo& info(IdsMethod m) {
     if (i.method == m) return i;
   }
   return kMethods[0];  // unreachable: every enumerator is in the table (tested)
+}
+
+std::string full_name(const MethodInfo& m, IdsApi api) {
+  switch (m.interface) {
+    case Interface::generation:
+      return fmt::format("{}.{}", to_string(api), m.name);
+    case Interface::ecu:
+      return fmt::format("com.attocube.ecu.{}", m.name);
+    case Interface::service:
+      return fmt::format("com.attocube.system.{}", m.name);
+  }
+  return std::string(m.name);
 }
 
 constexpr double kMetresPerPicometre = 1e-12;
@@ -82,7 +108,20 @@ bool has_control_bytes(std::string_view line) {
 
 }  // namespace
 
-std::string_view method_name(IdsMethod method) { return info(method).name; }
+std::string_view to_string(IdsApi api) {
+  return api == IdsApi::sen ? "com.attocube.sen" : "com.attocube.ids";
+}
+
+std::string method_name(IdsMethod method, IdsApi api) { return full_name(info(method), api); }
+
+bool returns_warning(IdsMethod method) {
+  return info(method).result == ResultKind::three_pm || info(method).result == ResultKind::one_pm;
+}
+
+void IdsCodec::remember(std::int64_t id, Pending p) {
+  pending_[id] = std::move(p);
+  if (pending_.size() > max_pending) pending_.erase(pending_.begin());
+}
 
 IdsCodec::IdsCodec(IdsLimits limits, std::size_t max_line_bytes)
     : limits_(limits), splitter_(max_line_bytes) {}
@@ -90,12 +129,13 @@ IdsCodec::IdsCodec(IdsLimits limits, std::size_t max_line_bytes)
 std::string IdsCodec::encode(IdsMethod method, std::span<const IdsParam> params) {
   const MethodInfo& mi = info(method);
   if (params.size() != mi.params) {
-    throw InputError(fmt::format("IDS request {}: {} params given, {} expected", mi.name,
-                                 params.size(), mi.params));
+    throw InputError(fmt::format("IDS request {}: {} params given, {} expected",
+                                 full_name(mi, api_), params.size(), mi.params));
   }
+  const std::string name = full_name(mi, api_);
   nlohmann::ordered_json j;
   j["jsonrpc"] = "2.0";
-  j["method"] = mi.name;
+  j["method"] = name;
   j["params"] = nlohmann::ordered_json::array();
   for (const auto& p : params) {
     std::visit([&](auto v) { j["params"].push_back(v); }, p);
@@ -103,15 +143,17 @@ std::string IdsCodec::encode(IdsMethod method, std::span<const IdsParam> params)
   if (method == IdsMethod::get_axis_displacement) {
     const auto* axis = std::get_if<std::int64_t>(&params[0]);
     if (axis == nullptr || *axis < 0 || *axis > 2) {
-      throw InputError(fmt::format("IDS request {}: axis {} given, an integer 0..2 expected",
-                                   mi.name, j["params"][0].dump()));
+      throw InputError(fmt::format("IDS request {}: axis {} given, an integer 0..2 expected", name,
+                                   j["params"][0].dump()));
     }
   }
   const std::int64_t id = next_id_++;
   j["id"] = id;
   j["api"] = 2;  // as in attocube's own wrappers (matlab/IDS_*.m)
-  pending_[id] = method;
-  if (pending_.size() > max_pending) pending_.erase(pending_.begin());
+  Pending p{method, api_, {}};
+  for (const auto& param : params)
+    if (const auto* i = std::get_if<std::int64_t>(&param)) p.params.push_back(*i);
+  remember(id, std::move(p));
   return j.dump() + "\n";
 }
 
@@ -124,13 +166,19 @@ void IdsCodec::note_requests(std::span<const std::byte> bytes) {
           return;
         if (!j["id"].is_number_integer() || !j["method"].is_string()) return;
         const auto name = j["method"].get<std::string>();
-        for (const auto& m : kMethods) {
-          if (m.name != name) continue;
-          const auto id = j["id"].get<std::int64_t>();
-          pending_[id] = m.method;
-          next_id_ = std::max(next_id_, id + 1);
-          if (pending_.size() > max_pending) pending_.erase(pending_.begin());
-        }
+        for (const auto& m : kMethods)
+          for (const IdsApi api : {IdsApi::ids, IdsApi::sen}) {
+            if (full_name(m, api) != name) continue;
+            const auto id = j["id"].get<std::int64_t>();
+            Pending p{m.method, api, {}};
+            if (const auto params = j.find("params"); params != j.end() && params->is_array())
+              for (const auto& e : *params)
+                if (e.is_number_integer()) p.params.push_back(e.get<std::int64_t>());
+            remember(id, std::move(p));
+            next_id_ = std::max(next_id_, id + 1);
+            if (m.interface == Interface::generation) api_ = api;  // the session's generation
+            break;
+          }
       },
       [](std::uint64_t) {});
 }
@@ -171,13 +219,16 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
            fmt::format("IDS: response id {} matches no pending request", r.id));
     return;
   }
-  r.method = pending->second;
+  r.method = pending->second.method;
+  r.api = pending->second.api;
+  r.params = std::move(pending->second.params);
   pending_.erase(pending);
 
   // A JSON-RPC 2.0 error object (jsonrpc.org/specification, 5.1) instead of a result.
   if (const auto e = j.find("error"); e != j.end() && e->is_object()) {
     const auto code = e->find("code");
     r.error_code = code != e->end() && code->is_number_integer() ? code->get<std::int64_t>() : -1;
+    r.rpc_error = true;
     const auto msg = e->find("message");
     if (msg != e->end() && msg->is_string()) r.error_message = msg->get<std::string>();
     emit(frames, std::move(r));
@@ -197,7 +248,7 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
   if (res->size() < needed + 1) {
     if (r.error_code == 0) {
       report(errors, ErrorKind::malformed, offset,
-             fmt::format("IDS: {} result has {} values, {} expected", info(r.method).name,
+             fmt::format("IDS: {} result has {} values, {} expected", method_name(r.method, r.api),
                          res->size() - 1, needed));
       return;
     }
@@ -258,9 +309,10 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
       break;
     case ResultKind::text:
       if ((*res)[1].is_string()) {
-        r.mode = (*res)[1].get<std::string>();
+        r.text = (*res)[1].get<std::string>();
+        if (r.method == IdsMethod::get_current_mode) r.mode = r.text;
       } else {
-        report(errors, ErrorKind::malformed, offset, "IDS: mode result is not a string");
+        report(errors, ErrorKind::malformed, offset, "IDS: text result is not a string");
       }
       break;
   }

@@ -1,12 +1,16 @@
 #pragma once
 // Attocube IDS3010 displacement interferometer: JSON-RPC 2.0 over TCP (port 9090), one JSON
 // object per line in each direction. Source: attocube's public API repository
-// github.com/attocube-systems/IDS-APIs (python/displacement.py, python/system.py,
-// python/ecu.py and the matlab/IDS_*.m wrappers, which show the exact request line
-//   {"jsonrpc": "2.0", "method": "com.attocube.ids.displacement.getAxesDisplacement",
+// github.com/attocube-systems/IDS-APIs (python/*.py and the matlab/*.m wrappers, which show the
+// exact request line
+//   {"jsonrpc": "2.0", "method": "com.attocube.sen.displacement.getAxesDisplacement",
 //    "params": [], "id": 1, "api": 2}
-// and that result[0] is the error/warning code, result[1..] the values; displacements and
-// positions are in picometres). Details and units: docs/codecs.md.
+// and that result[0] is the error or warning number, result[1..] the values; displacements and
+// positions are in picometres). Two API generations: firmware before 1.9.1 names the
+// displacement and system interfaces com.attocube.ids.*, firmware 1.9.1 and later (the
+// repository's commit "API-Update for IDS-Firmware 1.9.1", July 2025) com.attocube.sen.*; the
+// ECU (com.attocube.ecu.*) and the system service (com.attocube.system.*: getFirmwareVersion,
+// errorNumberToString) keep their names. Details and units: docs/codecs.md.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -21,27 +25,38 @@
 
 namespace cal::drivers::codec {
 
+// The generation of the displacement and system interfaces (see above).
+enum class IdsApi { ids, sen };
+std::string_view to_string(IdsApi api);  // "com.attocube.ids", "com.attocube.sen"
+
 enum class IdsMethod {
-  get_axes_displacement,     // com.attocube.ids.displacement.getAxesDisplacement -> 3 x pm
+  get_axes_displacement,     // com.attocube.<gen>.displacement.getAxesDisplacement -> 3 x pm
   get_axis_displacement,     // ...displacement.getAxisDisplacement [axis] -> pm
   get_absolute_positions,    // ...displacement.getAbsolutePositions -> 3 x pm
   get_measurement_enabled,   // ...displacement.getMeasurementEnabled -> bool
-  start_measurement,         // com.attocube.ids.system.startMeasurement
-  stop_measurement,          // com.attocube.ids.system.stopMeasurement
-  start_optics_alignment,    // com.attocube.ids.system.startOpticsAlignment
-  stop_optics_alignment,     // com.attocube.ids.system.stopOpticsAlignment
-  get_current_mode,          // com.attocube.ids.system.getCurrentMode -> string
-  get_system_error,          // com.attocube.ids.system.getSystemError
-  reset_axes,                // com.attocube.ids.system.resetAxes
+  start_measurement,         // com.attocube.<gen>.system.startMeasurement
+  stop_measurement,          // com.attocube.<gen>.system.stopMeasurement
+  start_optics_alignment,    // com.attocube.<gen>.system.startOpticsAlignment
+  stop_optics_alignment,     // com.attocube.<gen>.system.stopOpticsAlignment
+  get_current_mode,          // com.attocube.<gen>.system.getCurrentMode -> string
+  get_system_error,          // com.attocube.<gen>.system.getSystemError
+  reset_axes,                // com.attocube.<gen>.system.resetAxes
   ecu_enable,                // com.attocube.ecu.enable
+  ecu_get_enabled,           // com.attocube.ecu.getEnabled -> bool
   ecu_get_connected,         // com.attocube.ecu.getConnected -> bool
   ecu_get_temperature,       // com.attocube.ecu.getTemperatureInDegrees -> degC
   ecu_get_pressure,          // com.attocube.ecu.getPressureInHPa -> hPa
   ecu_get_humidity,          // com.attocube.ecu.getHumidityInPercent -> %RH
   ecu_get_refractive_index,  // com.attocube.ecu.getRefractiveIndex -> n
+  get_firmware_version,      // com.attocube.system.getFirmwareVersion -> string
+  error_number_to_string,    // com.attocube.system.errorNumberToString [language, n] -> string
 };
-// The full JSON-RPC method name, e.g. "com.attocube.ecu.getPressureInHPa".
-std::string_view method_name(IdsMethod method);
+// The full JSON-RPC method name, e.g. "com.attocube.ecu.getPressureInHPa" (the generation
+// matters only for the displacement and system interfaces).
+std::string method_name(IdsMethod method, IdsApi api = IdsApi::ids);
+// True for the methods whose result[0] is a warning number (the displacement getters: the
+// attocube wrappers call it warningNo there, errNo elsewhere).
+bool returns_warning(IdsMethod method);
 
 using IdsParam = std::variant<std::int64_t, double, bool>;
 
@@ -49,6 +64,9 @@ using IdsParam = std::variant<std::int64_t, double, bool>;
 struct IdsResponse {
   std::int64_t id = 0;
   IdsMethod method = IdsMethod::get_axes_displacement;
+  IdsApi api = IdsApi::ids;          // the generation the request was made in
+  std::vector<std::int64_t> params;  // the request's integer params (errorNumberToString's)
+  bool rpc_error = false;            // a JSON-RPC error object (e.g. -32601 unknown method)
   // result[0]: 0 = ok; otherwise the device's error/warning number (errorNumberToString on the
   // device turns it into text). For a JSON-RPC "error" object, its code.
   std::int64_t error_code = 0;
@@ -59,8 +77,9 @@ struct IdsResponse {
   std::optional<double> pressure_pa;
   std::optional<double> humidity_pct_rh;
   std::optional<double> refractive_index;
-  std::optional<bool> flag;  // getMeasurementEnabled, ecu.getConnected
+  std::optional<bool> flag;  // getMeasurementEnabled, ecu.getConnected, ecu.getEnabled
   std::string mode;          // getCurrentMode, e.g. "measurement running"
+  std::string text;          // every string result (mode, firmware version, error text)
 };
 
 // Plausibility limits; a value outside is an out_of_range error and is left out of the frame.
@@ -83,13 +102,17 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
   explicit IdsCodec(IdsLimits limits = {},
                     std::size_t max_line_bytes = LineSplitter::default_max_line_bytes);
 
-  // The request line (with its '\n') for `method`, with the next id (1, 2, 3, ...); the id is
-  // remembered so that the response can be matched. Throws cal::InputError if the number of
-  // params does not fit the method (e.g. getAxisDisplacement needs the axis 0..2).
+  // The request line (with its '\n') for `method` in the current API generation, with the next
+  // id (1, 2, 3, ...); the id is remembered so that the response can be matched. Throws
+  // cal::InputError if the number of params does not fit the method (e.g. getAxisDisplacement
+  // needs the axis 0..2).
   std::string encode(IdsMethod method, std::span<const IdsParam> params = {});
+  void set_api(IdsApi api) { api_ = api; }
+  IdsApi api() const { return api_; }
   std::int64_t last_id() const { return next_id_ - 1; }
   // Replay: learns the requests of a recorded session from the bytes that were sent (request
-  // lines as encode() writes them), so that their answers match. Unknown lines are ignored.
+  // lines as encode() writes them, of either generation), so that their answers match.
+  // Unknown lines are ignored.
   void note_requests(std::span<const std::byte> bytes);
   std::size_t pending() const { return pending_.size(); }
 
@@ -103,8 +126,16 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
   IdsLimits limits_;
   LineSplitter splitter_;
   LineSplitter sent_splitter_;
+  struct Pending {
+    IdsMethod method;
+    IdsApi api;
+    std::vector<std::int64_t> params;
+  };
+  void remember(std::int64_t id, Pending p);
+
   std::int64_t next_id_ = 1;
-  std::map<std::int64_t, IdsMethod> pending_;
+  IdsApi api_ = IdsApi::ids;
+  std::map<std::int64_t, Pending> pending_;
 };
 
 }  // namespace cal::drivers::codec

@@ -31,6 +31,12 @@ const std::vector<OptionSpec>& table() {
        .default_value = true,
        .help = "read the environmental unit (ECU): air temperature, pressure, humidity, "
                "refractive index"},
+      {.name = "api",
+       .type = OptionType::choice,
+       .choices = {"auto", "ids", "sen"},
+       .default_value = std::string("auto"),
+       .help = "the API generation: com.attocube.ids (firmware before 1.9.1), com.attocube.sen "
+               "(1.9.1 and later), or auto: asked at connect"},
       {.name = "environment_period_s",
        .type = OptionType::number,
        .unit = "s",
@@ -79,9 +85,10 @@ class TranscriptDecoder final : public detail::LineDecoder {
     if (r.error_code != 0)
       out.push_back({.kind = DecodedItem::Kind::note,
                      .offset = offset,
-                     .text = fmt::format("{}: the device answered with code {}{}{}",
-                                         codec::method_name(r.method), r.error_code,
-                                         r.error_message.empty() ? "" : ": ", r.error_message)});
+                     .text = fmt::format(
+                         "{}: {} {}{}{}", codec::method_name(r.method, r.api),
+                         codec::returns_warning(r.method) && !r.rpc_error ? "warning" : "error",
+                         r.error_code, r.error_message.empty() ? "" : ": ", r.error_message)});
     const auto status = r.error_code == 0 ? ReadingStatus::ok : ReadingStatus::signal_lost;
     for (std::uint8_t a = 0; a < 3; ++a)
       if (r.displacement_m[a])
@@ -94,8 +101,10 @@ class TranscriptDecoder final : public detail::LineDecoder {
     air(r.pressure_pa, Quantity::air_pressure_pa);
     air(r.humidity_pct_rh, Quantity::air_humidity_pct);
     air(r.refractive_index, Quantity::refractive_index);
-    if (!r.mode.empty())
-      out.push_back({.kind = DecodedItem::Kind::note, .offset = offset, .text = "mode: " + r.mode});
+    if (!r.text.empty())
+      out.push_back({.kind = DecodedItem::Kind::note,
+                     .offset = offset,
+                     .text = fmt::format("{}: {}", codec::method_name(r.method, r.api), r.text)});
   }
 
   codec::IdsCodec codec_;
@@ -127,27 +136,40 @@ class Driver final : public DeviceDriver {
     for (const auto a : o.integers("axes")) c.push_back(static_cast<std::uint8_t>(a));
     return c;
   }
+  // getCurrentMode in both generations at once (ids 1 and 2): the one that answers with a
+  // result names the API generation.
   std::optional<ProbeSpec> probe() const override {
     codec::IdsCodec request;
-    return ProbeSpec{.transport_kind = "tcp",
-                     .default_port = 9090,
-                     .request = request.encode(IdsMethod::get_current_mode),
-                     .recognise = [](std::string_view received) {
-                       using V = ProbeSpec::Verdict;
-                       if (received.find('\n') == std::string_view::npos)
-                         return ProbeSpec::Answer{};
-                       codec::IdsCodec c;
-                       c.encode(IdsMethod::get_current_mode);
-                       std::vector<codec::IdsResponse> frames;
-                       c.feed(received, frames);
-                       if (frames.empty())
-                         return ProbeSpec::Answer{V::no, "no IDS3010 JSON-RPC answer"};
-                       return ProbeSpec::Answer{V::yes, "mode: " + frames[0].mode};
-                     }};
+    request.set_api(codec::IdsApi::sen);
+    std::string lines = request.encode(IdsMethod::get_current_mode);
+    request.set_api(codec::IdsApi::ids);
+    lines += request.encode(IdsMethod::get_current_mode);
+    return ProbeSpec{
+        .transport_kind = "tcp",
+        .default_port = 9090,
+        .request = lines,
+        .recognise = [lines](std::string_view received) {
+          using V = ProbeSpec::Verdict;
+          codec::IdsCodec c;
+          c.note_requests(codec::as_bytes(lines));
+          std::vector<codec::IdsResponse> frames;
+          c.feed(received, frames);
+          for (const auto& f : frames)
+            if (!f.rpc_error)
+              return ProbeSpec::Answer{
+                  V::yes,
+                  fmt::format("API {} (firmware {} 1.9.1), mode: {}", codec::to_string(f.api),
+                              f.api == codec::IdsApi::sen ? ">=" : "<", f.mode)};
+          if (frames.size() >= 2 || c.stats().errors() > 0)
+            return ProbeSpec::Answer{V::no, "no IDS3010 JSON-RPC answer in either API generation"};
+          return ProbeSpec::Answer{};
+        }};
   }
   std::span<const LegacyKey> legacy_keys() const override {
+    // Sessions recorded before the option tables spoke com.attocube.ids.
     static constexpr LegacyKey keys[] = {
-        {"/ids_axes", "axes", LegacyKey::Form::bool_mask_to_indices}};
+        {"/ids_axes", "axes", LegacyKey::Form::bool_mask_to_indices},
+        {"", "api", LegacyKey::Form::as_is, "ids"}};
     return keys;
   }
   std::string_view decode_input() const override {
@@ -164,8 +186,12 @@ class Driver final : public DeviceDriver {
     return std::make_unique<TranscriptDecoder>();
   }
   std::unique_ptr<sim::Twin> make_twin(boost::asio::io_context& io, sim::World& world,
-                                       sim::Clock clock, const Options&) const override {
-    return std::make_unique<sim::IdsTwin>(io, world, std::move(clock));
+                                       sim::Clock clock, const Options& o) const override {
+    // auto: the newer generation (the instrument has to find it out).
+    return std::make_unique<sim::IdsTwin>(
+        io, world, std::move(clock),
+        sim::IdsTwinConfig{.api =
+                               o.text("api") == "ids" ? codec::IdsApi::ids : codec::IdsApi::sen});
   }
 };
 

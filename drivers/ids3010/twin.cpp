@@ -66,7 +66,19 @@ struct IdsTwin::Impl {
   }
 
   json dispatch(const std::string& method, const json& params, double now) {
-    const std::string ids = "com.attocube.ids.", ecu = "com.attocube.ecu.";
+    const std::string ids = std::string(codec::to_string(config.api)) + ".",
+                      ecu = "com.attocube.ecu.", service = "com.attocube.system.";
+    if (method == service + "getFirmwareVersion")
+      return json::array(
+          {0, config.api == codec::IdsApi::sen ? "1.9.1 (simulated)" : "1.8.2 (simulated)"});
+    if (method == service + "errorNumberToString") {
+      const std::int64_t n =
+          params.size() == 2 && params[1].is_number_integer() ? params[1].get<std::int64_t>() : -1;
+      if (n == error_not_measuring) return json::array({0, "measurement not running (simulated)"});
+      if (n == error_beam_lost) return json::array({0, "signal lost on an axis (simulated)"});
+      if (n == error_ecu_disabled) return json::array({0, "ECU interface not enabled (simulated)"});
+      return json::array({0, "unknown error (simulated)"});
+    }
     if (method == ids + "displacement.getAxesDisplacement" ||
         method == ids + "displacement.getAbsolutePositions") {
       std::int64_t code = 0;
@@ -110,8 +122,15 @@ struct IdsTwin::Impl {
               world.state().tool_mm[static_cast<std::size_t>(config.machine_axis[a])];
       return json::array({0});
     }
-    if (method == ecu + "enable") return json::array({0});
+    if (method == ecu + "enable") {
+      ecu_enabled = true;
+      return json::array({0});
+    }
+    if (method == ecu + "getEnabled") return json::array({0, ecu_enabled});
     if (method == ecu + "getConnected") return json::array({0, config.ecu_connected});
+    // The ECU reports only once its interface is enabled (attocube's ecu.py: "Checking if the
+    // ECU is connected can only be done on an enabled ECU interface").
+    if (method.starts_with(ecu) && !ecu_enabled) return json::array({error_ecu_disabled});
     const AirSample air = world.air().sample(now);
     if (method == ecu + "getTemperatureInDegrees") return json::array({0, air.temperature_degc});
     if (method == ecu + "getPressureInHPa") return json::array({0, air.pressure_pa / 100.0});
@@ -127,6 +146,7 @@ struct IdsTwin::Impl {
   std::array<bool, 3> beam_lost{};
   double measuring_since = -1.0;
   bool aligning = false;
+  bool ecu_enabled = false;
   std::uint64_t served = 0;
 };
 

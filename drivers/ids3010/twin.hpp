@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "cal/drivers/sim/twin.hpp"
+#include "ids3010/codec.hpp"
 
 namespace cal::drivers::sim {
 
@@ -17,6 +18,9 @@ struct IdsTwinConfig {
   std::array<double, 3> datum_mm{0.0, 0.0, 0.0};
   double starting_s = 0.2;  // "measurement starting" lasts this long after startMeasurement
   bool ecu_connected = true;
+  // The API generation it speaks (com.attocube.ids before firmware 1.9.1, com.attocube.sen
+  // from it); methods of the other one are unknown to it (JSON-RPC -32601), as on the device.
+  codec::IdsApi api = codec::IdsApi::ids;
 };
 
 class IdsTwin final : public Twin {
@@ -34,8 +38,11 @@ class IdsTwin final : public Twin {
   void drop_connections();
   std::uint64_t requests_served() const;
 
+  // The twin's own numbers (the device's are not published); errorNumberToString gives their
+  // texts, marked simulated.
   static constexpr std::int64_t error_not_measuring = 1;  // twin's code: not in measurement
   static constexpr std::int64_t error_beam_lost = 2;      // twin's code: signal lost on axis
+  static constexpr std::int64_t error_ecu_disabled = 3;   // twin's code: ECU not enabled
 
  private:
   struct Impl;

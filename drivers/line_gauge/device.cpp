@@ -82,6 +82,7 @@ class Driver final : public DeviceDriver {
   std::vector<Quantity> quantities(const Options& o, const InstrumentContext&) const override {
     return {thermometer(o) ? Quantity::material_temperature_degc : Quantity::length_m};
   }
+  bool may_be_silent(const Options& o) const override { return o.text("request").empty(); }
   std::chrono::microseconds default_poll(const Options&,
                                          const InstrumentContext& c) const override {
     if (c.role == "material") return std::chrono::seconds(1);  // a thermometer on the structure

@@ -19,11 +19,14 @@
 namespace cal::drivers::codec {
 namespace {
 
-enum class UnitKind { pressure, temperature, humidity };
+enum class UnitKind { pressure, gauge_pressure, temperature, humidity };
 
 // value_si = (printed - zero) * factor. Pressure factors: NIST SP 811 (2008) appendix B.8
-// (mmHg 1.333224E+02 Pa, inHg 3.386389E+03 Pa, psi 6.894757E+03 Pa, inH2O 2.490889E+02 Pa);
-// torr = 101325/760 Pa by definition; degF -> degC = (F - 32) * 5/9.
+// (mmHg 1.333224E+02 Pa, inHg 3.386389E+03 Pa, psi 6.894757E+03 Pa, inH2O 2.490889E+02 Pa,
+// mmH2O (conventional) 9.80665 Pa); torr = 101325/760 Pa by definition; bar = 1E+05 Pa;
+// degF -> degC = (F - 32) * 5/9. The PTU300 user's guide lists hPa, psia, inHg, torr, bara,
+// barg, psig, mbar, mmHg, kPa, Pa, mmH2O and inH2O; barg and psig are gauge pressures whose
+// reference it does not state: decoded, in Pa, but as gauge_pressure.
 struct UnitInfo {
   std::string_view name;
   UnitKind kind;
@@ -36,12 +39,16 @@ constexpr UnitInfo kUnits[] = {
     {"mbar", UnitKind::pressure, 0.0, 100.0},
     {"kPa", UnitKind::pressure, 0.0, 1000.0},
     {"bar", UnitKind::pressure, 0.0, 1e5},
+    {"bara", UnitKind::pressure, 0.0, 1e5},
+    {"barg", UnitKind::gauge_pressure, 0.0, 1e5},
+    {"mmH2O", UnitKind::pressure, 0.0, 9.80665},
     {"mmHg", UnitKind::pressure, 0.0, 133.322387415},
     {"torr", UnitKind::pressure, 0.0, 101325.0 / 760.0},
     {"inHg", UnitKind::pressure, 0.0, 3386.389},
     {"inH2O", UnitKind::pressure, 0.0, 249.0889},
     {"psi", UnitKind::pressure, 0.0, 6894.757},
     {"psia", UnitKind::pressure, 0.0, 6894.757},
+    {"psig", UnitKind::gauge_pressure, 0.0, 6894.757},
     {"'C", UnitKind::temperature, 0.0, 1.0},
     {"'F", UnitKind::temperature, 32.0, 5.0 / 9.0},
     {"%RH", UnitKind::humidity, 0.0, 1.0},
@@ -244,14 +251,16 @@ Ptu300Quantity Ptu300Codec::quantity_of(std::string_view label, std::string_view
   if (iequals(label, "P3H")) return Ptu300Quantity::pressure_tendency;
   if (iequals(label, "T")) return Ptu300Quantity::temperature;
   if (iequals(label, "RH")) return Ptu300Quantity::relative_humidity;
-  if (iequals(label, "TD") || iequals(label, "TDF") || iequals(label, "Td/f")) {
+  if (iequals(label, "TD") || iequals(label, "TDP") || iequals(label, "TDF") ||
+      iequals(label, "Td/f")) {
     return Ptu300Quantity::dew_point;
   }
   if (label.empty()) {  // an unlabelled custom FORM field: the unit says what it is
     if (const UnitInfo* u = find_unit(unit)) {
-      return u->kind == UnitKind::pressure      ? Ptu300Quantity::pressure
-             : u->kind == UnitKind::temperature ? Ptu300Quantity::temperature
-                                                : Ptu300Quantity::relative_humidity;
+      return u->kind == UnitKind::pressure         ? Ptu300Quantity::pressure
+             : u->kind == UnitKind::gauge_pressure ? Ptu300Quantity::gauge_pressure
+             : u->kind == UnitKind::temperature    ? Ptu300Quantity::temperature
+                                                   : Ptu300Quantity::relative_humidity;
     }
   }
   return Ptu300Quantity::other;
@@ -306,16 +315,22 @@ void Ptu300Codec::decode_line(std::string_view line, std::uint64_t offset,
   Ptu300Frame f;
   for (const RawField& raw : group_fields(atoms)) {
     const std::string label(raw.label);
+    Ptu300Quantity q = quantity_of(raw.label, raw.unit);
+    const UnitInfo* printed = find_unit(raw.unit);
+    // P in barg or psig: a gauge pressure (its reference is not stated), not the air's.
+    if (q == Ptu300Quantity::pressure && printed && printed->kind == UnitKind::gauge_pressure)
+      q = Ptu300Quantity::gauge_pressure;
+    // Stars: the device says the value does not fit or is in error. Its statement, kept as an
+    // unavailable field, not a codec error (a tendency code A3H is "*" until 3 h have passed).
     if (raw.stars) {
-      report(errors, ErrorKind::out_of_range, msg_offset,
-             fmt::format("PTU300: {} not available (stars)", label));
+      f.fields.push_back({label, q, 0.0, std::string(raw.unit), false});
       continue;
     }
-    const Ptu300Quantity q = quantity_of(raw.label, raw.unit);
     Ptu300Field field{label, q, raw.value, std::string(raw.unit)};
     if (q != Ptu300Quantity::other) {
       const UnitKind want =
           q == Ptu300Quantity::relative_humidity ? UnitKind::humidity
+          : q == Ptu300Quantity::gauge_pressure  ? UnitKind::gauge_pressure
           : (q == Ptu300Quantity::pressure || q == Ptu300Quantity::pressure_tendency)
               ? UnitKind::pressure
               : UnitKind::temperature;

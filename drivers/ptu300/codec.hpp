@@ -40,10 +40,12 @@ std::string ptu300_checksum_hex(Ptu300Checksum kind, std::string_view message);
 // ---- output lines ----
 enum class Ptu300Quantity {
   pressure,           // P (also P1, P2: the transducers of a two-barometer unit)
+  gauge_pressure,     // P in barg or psig: relative to a reference the user's guide does not
+                      // state, so never used as the absolute air pressure
   pressure_tendency,  // P3H
   temperature,        // T
   relative_humidity,  // RH
-  dew_point,          // TD, TDF (dew/frost point)
+  dew_point,          // TD, TDP, TDF (dew/frost point)
   other,              // anything else: value kept as printed
 };
 
@@ -53,6 +55,9 @@ struct Ptu300Field {
   // Pa for pressures, degC for temperatures, %RH for humidity; as printed for `other`.
   double value_si = 0.0;
   std::string unit;  // as printed, e.g. "hPa", "'F"
+  // False when the device printed stars: the value does not fit or is in error (the user's
+  // guide); the device's statement, not a codec error. value_si is then 0.
+  bool available = true;
   bool operator==(const Ptu300Field&) const = default;
 };
 

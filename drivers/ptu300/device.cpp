@@ -1,4 +1,6 @@
 // Vaisala PTU300 in the device registry: its options, factories and probe.
+#include <fmt/format.h>
+
 #include "cal/drivers/registry.hpp"
 #include "decode_util.hpp"
 #include "ptu300/codec.hpp"
@@ -74,6 +76,20 @@ class Driver final : public DeviceDriver {
           for_each_reading(f, [&](Quantity q, double v) {
             out.push_back(detail::reading_item(offset, 0, q, v));
           });
+          const auto note = [&](std::string text) {
+            out.push_back(
+                {.kind = DecodedItem::Kind::note, .offset = offset, .text = std::move(text)});
+          };
+          for (const auto& field : f.fields) {
+            if (!field.available)
+              note(fmt::format("{}: not available (the device printed stars)", field.label));
+            else if (field.quantity == codec::Ptu300Quantity::gauge_pressure)
+              note(fmt::format("{} = {} Pa gauge ({}): not taken for the air pressure", field.label,
+                               field.value_si, field.unit));
+            else if (field.quantity == codec::Ptu300Quantity::pressure_tendency)
+              note(fmt::format("{} = {} Pa (3 h pressure trend)", field.label, field.value_si));
+          }
+          if (f.fields.empty() && !f.text.empty()) note("text: " + f.text);
         });
   }
   std::unique_ptr<sim::Twin> make_twin(boost::asio::io_context& io, sim::World& world,

@@ -12,16 +12,6 @@
 namespace cal::drivers::codec {
 namespace {
 
-std::vector<std::string_view> split(std::string_view s, char sep) {
-  std::vector<std::string_view> out;
-  for (std::size_t start = 0;;) {
-    const auto at = s.find(sep, start);
-    out.push_back(s.substr(start, at == std::string_view::npos ? at : at - start));
-    if (at == std::string_view::npos) return out;
-    start = at + 1;
-  }
-}
-
 // Days from 1970-01-01 to a proleptic Gregorian date (Howard Hinnant's days_from_civil).
 std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
   y -= m <= 2;
@@ -80,42 +70,115 @@ void ShdrCodec::do_feed(std::span<const std::byte> bytes, std::vector<PositionFr
       });
 }
 
+std::vector<std::string> shdr_tokens(std::string_view line) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  std::vector<std::string> tokens;
+  std::size_t i = 0;
+  while (true) {
+    while (i < line.size() && space(line[i])) ++i;
+    const std::size_t start = i;
+    std::string token;
+    bool quoted = false;
+    if (i < line.size() && line[i] == '"') {
+      // Up to a closing quote followed (after spaces) by '|' or the end; '\' escapes.
+      std::string body;
+      std::size_t j = i + 1;
+      for (; j < line.size(); ++j) {
+        if (line[j] == '\\' && j + 1 < line.size()) {
+          body.push_back(line[++j]);
+          continue;
+        }
+        if (line[j] == '"') {
+          std::size_t k = j + 1;
+          while (k < line.size() && space(line[k])) ++k;
+          if (k == line.size() || line[k] == '|') break;
+        }
+        if (line[j] == '|') {  // unterminated: a plain token after all
+          j = line.size();
+          break;
+        }
+        body.push_back(line[j]);
+      }
+      if (j < line.size()) {
+        quoted = true;
+        token = std::move(body);
+        i = line.find('|', j);
+        if (i == std::string_view::npos) i = line.size();
+      }
+    }
+    if (!quoted) {
+      i = std::min(line.find('|', start), line.size());
+      std::size_t end = i;
+      while (end > start && space(line[end - 1])) --end;
+      token = std::string(line.substr(start, end - start));
+    }
+    tokens.push_back(std::move(token));
+    if (i >= line.size()) break;
+    ++i;                                          // past the '|'
+    if (i == line.size()) tokens.emplace_back();  // a terminal '|': one more, empty token
+    if (i >= line.size()) break;
+  }
+  return tokens;
+}
+
 void ShdrCodec::heartbeat(std::string_view line) {
-  if (line.starts_with("* PING")) {
-    ++pings_;
-  } else if (line.starts_with("* PONG")) {
+  // As the agent's connector: "* PONG" starts heartbeats when a number follows it.
+  if (line.starts_with("* PONG")) {
     ++pongs_;
     const auto t = split_whitespace(line);
     if (t.size() >= 3)
-      if (auto ms = parse_integer<std::int64_t>(t[2])) pong_timeout_ms_ = *ms;
+      if (auto ms = parse_integer<std::int64_t>(t[2]); ms && *ms > 0) pong_timeout_ms_ = *ms;
+    return;
   }
-  // Other "* key: value" lines are adapter commands or metadata: not positions.
+  if (line.starts_with("* PING")) {
+    ++pings_;
+    return;
+  }
+  ++commands_;  // "* key: value" and "*key:value": adapter commands and metadata
+  last_command_ = std::string(line.substr(0, 80));
 }
 
 void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
                        std::vector<PositionFrame>& frames, std::vector<CodecError>& errors) {
+  while (!line.empty() && (line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+  if (line.empty()) return;
   if (!multiline_tag_.empty()) {  // the body of a multi-line value (an asset document)
-    if (line.find(multiline_tag_) != std::string_view::npos) multiline_tag_.clear();
+    if (line == multiline_tag_) multiline_tag_.clear();
     return;
   }
-  if (line.starts_with("*")) return heartbeat(line);
+  if (line.front() == '*') return heartbeat(line);
   if (!is_printable_ascii(line))
     return report(errors, ErrorKind::garbage, offset, "SHDR: non-printable bytes");
-  const auto fields = split(line, '|');
-  if (const auto tag = fields.back(); tag.starts_with("--multiline--")) {
-    multiline_tag_ = std::string(tag);
+  if (const auto at = line.find("--multiline--"); at != std::string_view::npos) {
+    multiline_tag_ = std::string(line.substr(at));
+    ++assets_;
     return;
   }
+  const auto tokens = shdr_tokens(line);
   PositionFrame f;
-  f.time_unix_ns = parse_iso8601_utc_ns(fields.front());
-  if (!f.time_unix_ns && !fields.front().empty())
-    return report(errors, ErrorKind::malformed, offset,
-                  fmt::format("SHDR: '{}' is not a timestamp", fields.front().substr(0, 40)));
+  std::string_view stamp = tokens.front();
+  if (const auto at = stamp.find('@'); at != std::string_view::npos) {
+    f.duration_s = parse_number(stamp.substr(at + 1));
+    stamp = stamp.substr(0, at);
+  }
+  if (stamp.find('T') != std::string_view::npos) {
+    f.time_unix_ns = parse_iso8601_utc_ns(stamp);
+    if (!f.time_unix_ns)
+      return report(errors, ErrorKind::malformed, offset,
+                    fmt::format("SHDR: '{}' is not a timestamp", stamp.substr(0, 40)));
+  } else if (!stamp.empty()) {
+    const auto ms = parse_number(stamp);
+    if (!ms || !std::isfinite(*ms))
+      return report(errors, ErrorKind::malformed, offset,
+                    fmt::format("SHDR: '{}' is not a timestamp", stamp.substr(0, 40)));
+    if (!relative_origin_ms_) relative_origin_ms_ = *ms;
+    f.relative_time_ms = *ms - *relative_origin_ms_;
+  }
   bool any = false;
-  for (std::size_t i = 1; i + 1 < fields.size(); ++i) {
-    const auto it = config_.keys.find(fields[i]);
+  for (std::size_t i = 1; i + 1 < tokens.size(); ++i) {
+    const auto it = config_.keys.find(tokens[i]);
     if (it == config_.keys.end()) continue;
-    const auto value = fields[++i];
+    const std::string_view value = tokens[++i];
     if (value == "UNAVAILABLE") continue;  // the control has no value: not a position
     const auto v = parse_number(value);
     if (!v || !std::isfinite(*v))

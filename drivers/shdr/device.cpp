@@ -28,6 +28,22 @@ const std::vector<OptionSpec>& table() {
        .choices = {"mm", "in"},
        .default_value = std::string("mm"),
        .help = "the unit of the positions (MTConnect positions are millimetres)"},
+      {.name = "heartbeat_ms",
+       .type = OptionType::integer,
+       .unit = "ms",
+       .min = 0,
+       .max = 1800000,
+       .default_value = std::int64_t{0},
+       .help = "ping this often once the adapter answers * PONG (0: every <ms> its PONG says, as "
+               "the MTConnect agent does); silence beyond twice the period drops the connection"},
+      {.name = "legacy_timeout_s",
+       .type = OptionType::number,
+       .unit = "s",
+       .min = 0,
+       .default_value = 0.0,
+       .help = "for an adapter that never answers * PONG: silence longer than this drops the "
+               "connection (the agent's LegacyTimeout is 600 s); 0: never, since adapters send "
+               "only on change and a machine dwelling at a target is silent"},
   };
   return t;
 }
@@ -68,6 +84,45 @@ codec::ShdrConfig decode_config(const Options& o) {
   return c;
 }
 
+// The codec's frames as readings (with the adapter's time), and what else the stream said
+// (heartbeats, commands, assets) as notes.
+class ShdrDecoder final : public Decoder {
+ public:
+  explicit ShdrDecoder(codec::ShdrConfig config) : codec_(std::move(config)) {}
+  void feed(std::span<const std::byte> bytes, std::vector<DecodedItem>& out) override {
+    const std::uint64_t offset = codec_.stats().bytes;
+    const auto pongs = codec_.pongs(), commands = codec_.commands(), assets = codec_.assets();
+    frames_.clear();
+    errors_.clear();
+    codec_.feed(bytes, frames_, errors_);
+    detail::add_errors(errors_, out);
+    const auto note = [&](std::string text) {
+      out.push_back({.kind = DecodedItem::Kind::note, .offset = offset, .text = std::move(text)});
+    };
+    if (codec_.pongs() != pongs)
+      note(codec_.pong_timeout_ms()
+               ? fmt::format("* PONG: heartbeat every {} ms", *codec_.pong_timeout_ms())
+               : std::string("* PONG without a period"));
+    if (codec_.commands() != commands) note("command: " + codec_.last_command());
+    if (codec_.assets() != assets) note("multi-line asset (skipped)");
+    for (const auto& f : frames_)
+      for (std::uint8_t axis = 0; axis < 3; ++axis) {
+        if (!f.position_m[axis]) continue;
+        auto item =
+            detail::reading_item(offset, axis, Quantity::machine_position_m, *f.position_m[axis]);
+        item.device_time_unix_ns = f.time_unix_ns;
+        if (f.relative_time_ms) item.device_time_relative_s = *f.relative_time_ms * 1e-3;
+        out.push_back(item);
+      }
+  }
+  const codec::CodecStats& stats() const override { return codec_.stats(); }
+
+ private:
+  codec::ShdrCodec codec_;
+  std::vector<codec::PositionFrame> frames_;
+  std::vector<codec::CodecError> errors_;
+};
+
 class Driver final : public DeviceDriver {
  public:
   std::string_view name() const override { return "shdr"; }
@@ -84,11 +139,9 @@ class Driver final : public DeviceDriver {
   std::vector<Quantity> quantities(const Options&, const InstrumentContext&) const override {
     return {Quantity::machine_position_m};
   }
+  bool sends_on_change() const override { return true; }
   std::vector<std::uint8_t> channels(const Options&, const InstrumentContext& c) const override {
     return {static_cast<std::uint8_t>(c.test_axis)};
-  }
-  std::chrono::microseconds default_poll(const Options&, const InstrumentContext&) const override {
-    return std::chrono::seconds(5);  // "* PING" heartbeats
   }
   std::span<const LegacyKey> legacy_keys() const override {
     static constexpr LegacyKey keys[] = {{"/feed/key", "key"}, {"/feed/unit", "unit"}};
@@ -101,20 +154,16 @@ class Driver final : public DeviceDriver {
                                               std::unique_ptr<transport::Transport> t,
                                               InstrumentOptions instrument, const Options& o,
                                               const InstrumentContext& c) const override {
-    return make_shdr(io, std::move(t), std::move(instrument), run_config(o, c.test_axis));
+    ShdrHeartbeat heartbeat{.override_period =
+                                std::chrono::milliseconds(o.integer("heartbeat_ms"))};
+    if (o.number("legacy_timeout_s") > 0)
+      heartbeat.legacy_timeout =
+          std::chrono::milliseconds(static_cast<std::int64_t>(o.number("legacy_timeout_s") * 1e3));
+    return make_shdr(io, std::move(t), std::move(instrument), run_config(o, c.test_axis),
+                     heartbeat);
   }
   std::unique_ptr<Decoder> make_decoder(const Options& o) const override {
-    return detail::make_codec_decoder(
-        codec::ShdrCodec(decode_config(o)),
-        [](const codec::PositionFrame& f, std::uint64_t offset, std::vector<DecodedItem>& out) {
-          for (std::uint8_t axis = 0; axis < 3; ++axis) {
-            if (!f.position_m[axis]) continue;
-            auto item = detail::reading_item(offset, axis, Quantity::machine_position_m,
-                                             *f.position_m[axis]);
-            item.device_time_unix_ns = f.time_unix_ns;
-            out.push_back(item);
-          }
-        });
+    return std::make_unique<ShdrDecoder>(decode_config(o));
   }
   std::unique_ptr<sim::Twin> make_twin(boost::asio::io_context& io, sim::World& world,
                                        sim::Clock clock, const Options& o) const override {

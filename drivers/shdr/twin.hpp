@@ -13,15 +13,17 @@ namespace cal::drivers::sim {
 
 struct ShdrTwinConfig {
   std::uint16_t port = 0;  // 0: an ephemeral port on 127.0.0.1
-  // Wall-clock period of the position lines, each "|Xcom|x|Ycom|y|Zcom|z" (no timestamp: the
-  // agent stamps it), the control's commanded position in mm.
+  // Wall-clock period at which the control's commanded position (mm, 4 decimals) is looked
+  // at. As an adapter does, a line goes out only when a value changed, with only the items
+  // that changed ("2024-01-01T12:00:00.123456Z|Xcom|12.5000"); a new client first gets every
+  // item. So the feed is silent while the machine dwells.
   std::chrono::milliseconds period{5};
   std::int64_t pong_timeout_ms = 10000;  // the answer to "* PING": "* PONG 10000"
   std::array<std::string, 3> keys{"Xcom", "Ycom", "Zcom"};  // the data items of X, Y, Z
 };
 
-// Streams the simulated control's commanded position to every connected agent and answers
-// its heartbeats, as an MTConnect adapter does.
+// Sends the simulated control's commanded position to every connected agent on change and
+// answers its heartbeats ("* PING" -> "* PONG <ms>"), as an MTConnect adapter does.
 class ShdrTwin final : public Twin {
  public:
   ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});

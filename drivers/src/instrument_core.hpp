@@ -40,7 +40,18 @@ class InstrumentCore : public Instrument {
   void set_state(InstrumentState s, std::string_view why = {});
   // Ends the connection and schedules a reconnection (reason recorded in the gap).
   void fail(const std::string& reason);
+  // A period without readings while connected (samples the device says it lost), reported at
+  // once; `start_ns` may equal `end_ns` when the device does not say how long.
+  void report_gap(const Gap& gap);
+  // What the device said that is not a reading: a warning or an error with its own text.
+  void report_message(const DeviceMessage& message);
   void start_polling();
+  // The poll period from now on (the device said how often it wants to be asked).
+  void set_poll_period(std::chrono::microseconds period) { poll_period_ = period; }
+  // How long a connected device may be silent before the connection counts as lost; nullopt:
+  // never (a feed that sends only on change is silent while nothing changes). Re-arms the
+  // watchdog from now.
+  void set_silence_timeout(std::optional<std::chrono::milliseconds> timeout);
   void report_codec_errors(std::span<const codec::CodecError> errors);
   // Feeds the bytes to the codec: `frames` holds the frames they completed (cleared first), and
   // each codec error is reported through the events.
@@ -78,6 +89,8 @@ class InstrumentCore : public Instrument {
   bool running_ = false;
   bool polling_ = false;
   std::int64_t last_bytes_ns_ = 0;
+  std::chrono::microseconds poll_period_;
+  std::optional<std::chrono::milliseconds> silence_timeout_;
   std::optional<Gap> gap_;  // open while the connection is down
   std::optional<std::int64_t> latched_ns_;
   std::vector<codec::CodecError> codec_errors_;

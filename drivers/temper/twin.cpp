@@ -22,14 +22,16 @@ void put16(Report& r, std::size_t at, std::int64_t v) {
 
 struct TemperTwin::Impl {
   Impl(World& w, Clock c, TemperTwinConfig cfg)
-      : world(w), clock(std::move(c)), config(std::move(cfg)) {}
+      : world(w), clock(std::move(c)), config(std::move(cfg)) {
+    if (const auto* m = codec::temper_model_of(config.firmware)) model = *m;
+  }
 
   // The input reports answering one output report (hidapi's report ID first).
   std::vector<Report> answer(std::span<const std::byte> out) {
     if (out.size() < 3) return {};
     const auto cmd = static_cast<std::uint8_t>(out[2]);
     if (cmd == 0x82) {
-      const int n = (config.inner ? 1 : 0) + (config.probe ? 1 : 0);
+      const int n = (model.inner ? 1 : 0) + (model.probe ? 1 : 0);
       return {Report{0x82, static_cast<std::uint8_t>(n), 0x01, 0, 0, 0, 0, 0}};
     }
     if (cmd == 0x86) {
@@ -49,29 +51,34 @@ struct TemperTwin::Impl {
     const double inner_degc = air.temperature_degc;
     const double probe_degc = world.state().machine_temperature_degc;
     std::vector<Report> out_reports;
-    switch (config.family) {
-      case codec::TemperFamily::ds75: {  // one report: 80 LL t1 t2, 1/256 degC, 12 bits
-        Report r{0x80, static_cast<std::uint8_t>(config.probe ? 4 : 2)};
+    const auto value_of = [&](int channel) { return channel == 0 ? inner_degc : probe_degc; };
+    switch (model.family) {
+      case codec::TemperFamily::ds75: {  // one report: 80 LL a b, 1/256 degC, 12 bits
+        const auto& slots = model.ds75_slots;
+        Report r{0x80, static_cast<std::uint8_t>(slots[1] >= 0 ? 4 : 2)};
         const auto ds75 = [](double t) { return std::llround(t * 16.0) * 16; };
-        put16(r, 2, ds75(inner_degc));
-        if (config.probe) put16(r, 4, ds75(probe_degc));
+        for (std::size_t k = 0; k < 2; ++k)
+          if (slots[k] >= 0) put16(r, 2 + 2 * k, ds75(value_of(slots[k])));
         out_reports.push_back(r);
         break;
       }
-      case codec::TemperFamily::gold:
-      case codec::TemperFamily::temperx: {  // a report per sensor: 80 SS th tl [hh hl]
-        if (config.inner) {
+      case codec::TemperFamily::gold:  // a report per sensor: 80 SS th tl, /100
+        if (model.inner) {
           Report r{0x80, 0x80};
           put16(r, 2, std::llround(inner_degc * 100.0));
-          if (config.family == codec::TemperFamily::temperx && config.humidity)
-            put16(r, 4, std::llround(air.humidity_pct * 100.0));
           out_reports.push_back(r);
         }
-        if (config.probe && config.family == codec::TemperFamily::gold) {
+        if (model.probe) {
           Report r{0x80, 0x01};
           put16(r, 2, std::llround(probe_degc * 100.0));
           out_reports.push_back(r);
         }
+        break;
+      default: {  // temperx: 80 80 th tl hh hl, /100 (other layouts are not simulated)
+        Report r{0x80, 0x80};
+        put16(r, 2, std::llround(inner_degc * 100.0));
+        put16(r, 4, std::llround(air.humidity_pct * 100.0));
+        out_reports.push_back(r);
         break;
       }
     }
@@ -81,6 +88,8 @@ struct TemperTwin::Impl {
   World& world;
   Clock clock;
   TemperTwinConfig config;
+  // Unknown firmware: a two-sensor gold stick.
+  codec::TemperModel model{"", codec::TemperFamily::gold, true, true, false, {0, 1}, ""};
   std::uint64_t sent = 0;
   std::uint64_t generation = 0;  // unplug() ends the transports of earlier generations
 };

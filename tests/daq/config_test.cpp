@@ -107,7 +107,7 @@ TEST(Config, NamesFileLineColumnAndKey) {
   EXPECT_EQ(error_of("[devices.t]\ndriver = \"temper\"\ntransport = \"hid 413d:2107\"\n"
                      "family = \"silver\"\n"),
             "machine.toml:4:10: key 'devices.t.family': 'silver' is not one of: ds75, gold, "
-            "temperx");
+            "temperx, sht2x, si7005, si7006");
   EXPECT_EQ(parse_config("[devices.t]\ndriver = \"temper\"\ntransport = \"hid 0c45:7401\"\n"
                          "family = \"ds75\"\nrole = \"material\"\n",
                          "m.toml")
@@ -132,7 +132,7 @@ TEST(Config, DeviceKeysAreCheckedAgainstTheDriversOptionTable) {
   EXPECT_EQ(error_of(laser + "family = \"gold\"\n"),
             "machine.toml:4:10: key 'devices.laser.family': unknown key (a typo?); driver "
             "'ids3010' takes driver, transport, role, poll_s, serial_number, certificate, "
-            "calibration_due, axes, start_measurement, environment, environment_period_s");
+            "calibration_due, axes, start_measurement, environment, api, environment_period_s");
   // Checks between options (a gauge pattern without a capture group) name the driver.
   EXPECT_NE(error_of("[devices.bar]\ndriver = \"gauge\"\ntransport = \"serial /dev/x 9600 8N1\"\n"
                      "pattern = \"[0-9]+\"\n")

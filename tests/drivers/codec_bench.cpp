@@ -101,7 +101,7 @@ void BM_Halsampler(benchmark::State& state) {
   for (int i = 0; i < kFrames; ++i)
     stream += fmt::format("{} {:.6f} {:.6f} {:.6f}\n", i, 0.01 * i, -3.25, 100.0);
   run(
-      state, stream, [] { return HalsamplerCodec{}; }, kFrames);
+      state, stream, [] { return HalsamplerCodec({.sample_numbers = true}); }, kFrames);
 }
 
 void BM_Shdr(benchmark::State& state) {

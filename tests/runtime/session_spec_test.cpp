@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "cal/analysis/error.hpp"
+#include "linear_run.hpp"
 
 namespace {
 
@@ -79,6 +80,20 @@ TEST(SessionSpec, AHeaderThisBuildCannotHonourIsRefusedByName) {
   EXPECT_EQ(error_of({{"device", 2}, {"driver", "gauge"}, {"options", {{"unit", "furlong"}}}}),
             "capture header: instrument 2 (gauge): option 'unit' = \"furlong\": 'furlong' is not "
             "one of: mm, um, in, m, degC");
+}
+
+TEST(MaterialSensors, EachUsedChannelIsItsOwnSensorNeverMerged) {
+  // A serial thermometer (one sensor, its channel unlisted), a TEMPer2 read on both channels,
+  // a TEMPer2 read on its probe only: sensors 0; 1, 2; 3.
+  const daq::MaterialSensors m(3, {{}, {0, 1}, {1}});
+  EXPECT_EQ(m.count(), 4);
+  EXPECT_EQ(m.sensor(0, 0), 0);
+  EXPECT_EQ(m.sensor(0, 5), 0);  // unlisted: whatever its channel
+  EXPECT_EQ(m.sensor(1, 0), 1);  // the stick ...
+  EXPECT_EQ(m.sensor(1, 1), 2);  // ... and the probe are two series
+  EXPECT_EQ(m.sensor(2, 1), 3);
+  EXPECT_EQ(m.sensor(2, 0), -1);  // the stick of the third is not used
+  EXPECT_EQ(m.sensor(3, 0), -1);
 }
 
 }  // namespace

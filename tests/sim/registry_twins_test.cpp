@@ -42,13 +42,16 @@ TEST(RegistryTwins, EveryDevicesInstrumentReadsItsTwin) {
     instrument->start({.reading = [&](const d::Reading& r) { readings.push_back(r); }});
     // The twin's clock moves on (an IDS3010 reports "measurement starting" for 0.2 s).
     const auto deadline = std::chrono::steady_clock::now() + 5s;
-    while (readings.size() < 3 && std::chrono::steady_clock::now() < deadline) {
+    // A device that sends only on change (an MTConnect adapter) says each value once while the
+    // machine is parked.
+    const std::size_t enough = drv->sends_on_change() ? 1 : 3;
+    while (readings.size() < enough && std::chrono::steady_clock::now() < deadline) {
       io.run_for(5ms);
       io.restart();
       now_s += 0.01;
     }
     instrument->stop();
-    ASSERT_GE(readings.size(), 3u);
+    ASSERT_GE(readings.size(), enough);
     EXPECT_EQ(instrument->codec_stats().errors(), 0u);
     const auto declared = drv->quantities(options, context);
     for (const auto& r : readings) {

@@ -125,6 +125,12 @@ class DeviceDriver {
                                                  const InstrumentContext& /*context*/) const {
     return std::chrono::milliseconds(10);
   }
+  // True when the device sends a value only when it changes (the last one holds until the
+  // next): a run must not take its silence for a stale value (an MTConnect adapter).
+  virtual bool sends_on_change() const { return false; }
+  // True when the device may be silent until something happens (a ballbar gauge streams only
+  // once it is mounted): the start-up check then needs it to open, not to speak.
+  virtual bool may_be_silent(const Options& /*options*/) const { return false; }
   // HID interface to open when the transport names only VID:PID (-1: any).
   virtual int hid_interface() const { return -1; }
   virtual std::span<const KnownDevice> usb_ids() const { return {}; }

@@ -10,8 +10,12 @@ namespace cal::drivers::codec {
 struct PositionFrame {
   std::array<std::optional<double>, 3> position_m;  // X, Y, Z: those the line carried
   std::optional<std::uint64_t> sample;              // halsampler's sample number (-t)
-  std::uint64_t lost_before = 0;                    // samples skipped before this one
-  std::optional<std::int64_t> time_unix_ns;         // SHDR's timestamp (UTC)
+  std::uint64_t lost_before = 0;                    // samples skipped before this one (-t)
+  bool overrun = false;  // halsampler printed "overrun" before this sample: samples were lost
+  // SHDR: the timestamp's @duration suffix (s), and a relative timestamp (ms since the first).
+  std::optional<double> duration_s;
+  std::optional<double> relative_time_ms;
+  std::optional<std::int64_t> time_unix_ns;  // SHDR's timestamp (UTC)
 };
 
 }  // namespace cal::drivers::codec
