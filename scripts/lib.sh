@@ -13,7 +13,7 @@ PACKAGES=(
   libplplot-dev
 )
 # The headless browser of the report and live-page tests (and of daq report --format pdf).
-TEST_PACKAGES=(chromium chromium-driver python3)
+TEST_PACKAGES=(chromium chromium-driver python3 poppler-utils)
 
 install_packages() {
   local missing=()

@@ -53,6 +53,7 @@ double mean(const std::map<int, double>& x) {
 // Estimator of the standard uncertainty (ISO 230-2) / standard deviation (VDI 3441, ISO
 // 230-2:1988): s = sqrt(1/(n-1) sum (x_j - x̄)^2).
 double stddev(const std::map<int, double>& x, double m) {
+  if (x.size() < 2) return 0.0;  // one run (axis over 2000 mm): no estimate, not used
   double s = 0;
   for (const auto& [run, v] : x) s += (v - m) * (v - m);
   return std::sqrt(s / static_cast<double>(x.size() - 1));
@@ -91,12 +92,14 @@ std::vector<std::pair<double, Samples>> group(std::span<const Measurement> data)
   return g;
 }
 
-void check_runs(double target_mm, const std::map<int, double>& x, Direction d) {
-  if (x.size() < 2) {
+void check_runs(double target_mm, const std::map<int, double>& x, Direction d, int min_runs) {
+  if (static_cast<int>(x.size()) < min_runs) {
     throw InputError(fmt::format(
-        "target {} mm has {} run(s) in direction {}: at least 2 are needed for a standard "
-        "uncertainty (ISO 230-2 asks for 5)",
-        target_mm, x.size(), to_string(d)));
+        "target {} mm has {} run(s) in direction {}: at least {} are needed{}", target_mm, x.size(),
+        to_string(d), min_runs,
+        min_runs == 2 ? " for a standard uncertainty (ISO 230-2 asks for 5; one run in each "
+                        "direction is allowed by ISO 230-2:2014 on an axis over 2000 mm)"
+                      : ""));
   }
 }
 
@@ -152,56 +155,64 @@ class Builder {
 void iso(Evaluation& e, double k, bool has_e_and_m) {
   Builder b(e);
   const auto& t = e.targets;
+  // One approach per direction (axis over 2000 mm): no s, so no repeatability and no A.
+  const bool with_s = !e.single_run_long_axis;
   const std::string ks = k == 2.0 ? "2" : "3", rs = k == 2.0 ? "4" : "6";
   b.target("mean_up", "x̄i↑", "mean unidirectional positional deviation, up",
            per_target(t, [](auto& s) { return s.mean_up_um; }));
-  b.target("s_up", "si↑", "estimator of the unidirectional standard uncertainty, up",
-           per_target(t, [](auto& s) { return s.s_up_um; }));
-  const auto& r_up = b.target("R_i_up", "Ri↑", "unidirectional repeatability, up (" + rs + " si↑)",
-                              per_target(t, [k](auto& s) { return 2 * k * s.s_up_um; }));
-  std::vector<double> hi_all =
-      per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).hi; });
-  std::vector<double> lo_all =
-      per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).lo; });
+  std::vector<double> r_up, hi_all, lo_all;
+  if (with_s) {
+    b.target("s_up", "si↑", "estimator of the unidirectional standard uncertainty, up",
+             per_target(t, [](auto& s) { return s.s_up_um; }));
+    r_up = b.target("R_i_up", "Ri↑", "unidirectional repeatability, up (" + rs + " si↑)",
+                    per_target(t, [k](auto& s) { return 2 * k * s.s_up_um; }));
+    hi_all = per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).hi; });
+    lo_all = per_target(t, [k](auto& s) { return band(s.mean_up_um, s.s_up_um, k).lo; });
+  }
   std::vector<double> means_up = per_target(t, [](auto& s) { return s.mean_up_um; });
-  b.axis("R_up", "R↑", "unidirectional repeatability of the axis, up", max_of(r_up));
+  if (with_s) b.axis("R_up", "R↑", "unidirectional repeatability of the axis, up", max_of(r_up));
   if (has_e_and_m) {
     b.axis("E_up", "E↑", "unidirectional systematic positional deviation, up",
            max_of(means_up) - min_of(means_up));
   }
-  b.axis("A_up", "A↑", "unidirectional accuracy of positioning, up (±" + ks + " s)",
-         max_of(hi_all) - min_of(lo_all));
+  if (with_s)
+    b.axis("A_up", "A↑", "unidirectional accuracy of positioning, up (±" + ks + " s)",
+           max_of(hi_all) - min_of(lo_all));
   if (!e.bidirectional) return;
 
   b.target("mean_down", "x̄i↓", "mean unidirectional positional deviation, down",
            per_target(t, [](auto& s) { return s.mean_down_um; }));
-  b.target("s_down", "si↓", "estimator of the unidirectional standard uncertainty, down",
-           per_target(t, [](auto& s) { return s.s_down_um; }));
-  const auto& r_down =
-      b.target("R_i_down", "Ri↓", "unidirectional repeatability, down (" + rs + " si↓)",
-               per_target(t, [k](auto& s) { return 2 * k * s.s_down_um; }));
-  const auto& mean_bi = b.target("mean_bi", "x̄i", "mean bidirectional positional deviation",
-                                 per_target(t, [](auto& s) { return s.mean_bi_um; }));
-  const auto& rev = b.target("B_i", "Bi", "reversal value (x̄i↑ − x̄i↓)",
-                             per_target(t, [](auto& s) { return s.reversal_um; }));
-  const auto& r_bi =
-      b.target("R_i_bi", "Ri",
-               "bidirectional repeatability, max(" + ks + " si↑ + " + ks + " si↓ + |Bi|; Ri↑; Ri↓)",
-               per_target(t, [k](auto& s) {
-                 return std::max({k * s.s_up_um + k * s.s_down_um + std::abs(s.reversal_um),
-                                  2 * k * s.s_up_um, 2 * k * s.s_down_um});
-               }));
+  std::vector<double> r_down, r_bi, hi_down, lo_down;
+  if (with_s) {
+    b.target("s_down", "si↓", "estimator of the unidirectional standard uncertainty, down",
+             per_target(t, [](auto& s) { return s.s_down_um; }));
+    r_down = b.target("R_i_down", "Ri↓", "unidirectional repeatability, down (" + rs + " si↓)",
+                      per_target(t, [k](auto& s) { return 2 * k * s.s_down_um; }));
+  }
+  const auto mean_bi = b.target("mean_bi", "x̄i", "mean bidirectional positional deviation",
+                                per_target(t, [](auto& s) { return s.mean_bi_um; }));
+  const auto rev = b.target("B_i", "Bi", "reversal value (x̄i↑ − x̄i↓)",
+                            per_target(t, [](auto& s) { return s.reversal_um; }));
+  if (with_s) {
+    r_bi = b.target(
+        "R_i_bi", "Ri",
+        "bidirectional repeatability, max(" + ks + " si↑ + " + ks + " si↓ + |Bi|; Ri↑; Ri↓)",
+        per_target(t, [k](auto& s) {
+          return std::max({k * s.s_up_um + k * s.s_down_um + std::abs(s.reversal_um),
+                           2 * k * s.s_up_um, 2 * k * s.s_down_um});
+        }));
+    hi_down = per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).hi; });
+    lo_down = per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).lo; });
+  }
   std::vector<double> means_down = per_target(t, [](auto& s) { return s.mean_down_um; });
-  std::vector<double> hi_down =
-      per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).hi; });
-  std::vector<double> lo_down =
-      per_target(t, [k](auto& s) { return band(s.mean_down_um, s.s_down_um, k).lo; });
   std::vector<double> abs_rev = per_target(t, [](auto& s) { return std::abs(s.reversal_um); });
 
   b.axis("B", "B", "reversal value of the axis, max |Bi|", max_of(abs_rev));
   b.axis("B_mean", "B̄", "mean reversal value of the axis, (1/m) Σ Bi", mean_of(rev));
-  b.axis("R_down", "R↓", "unidirectional repeatability of the axis, down", max_of(r_down));
-  b.axis("R_bi", "R", "bidirectional repeatability of the axis, max Ri", max_of(r_bi));
+  if (with_s) {
+    b.axis("R_down", "R↓", "unidirectional repeatability of the axis, down", max_of(r_down));
+    b.axis("R_bi", "R", "bidirectional repeatability of the axis, max Ri", max_of(r_bi));
+  }
   if (has_e_and_m) {
     b.axis("E_down", "E↓", "unidirectional systematic positional deviation, down",
            max_of(means_down) - min_of(means_down));
@@ -211,10 +222,12 @@ void iso(Evaluation& e, double k, bool has_e_and_m) {
     b.axis("M", "M", "range of the mean bidirectional positional deviation",
            max_of(mean_bi) - min_of(mean_bi));
   }
-  b.axis("A_down", "A↓", "unidirectional accuracy of positioning, down (±" + ks + " s)",
-         max_of(hi_down) - min_of(lo_down));
-  b.axis("A_bi", "A", "bidirectional accuracy of positioning (±" + ks + " s)",
-         std::max(max_of(hi_all), max_of(hi_down)) - std::min(min_of(lo_all), min_of(lo_down)));
+  if (with_s) {
+    b.axis("A_down", "A↓", "unidirectional accuracy of positioning, down (±" + ks + " s)",
+           max_of(hi_down) - min_of(lo_down));
+    b.axis("A_bi", "A", "bidirectional accuracy of positioning (±" + ks + " s)",
+           std::max(max_of(hi_all), max_of(hi_down)) - std::min(min_of(lo_all), min_of(lo_down)));
+  }
 }
 
 // VDI/DGQ 3441 (1977), bidirectional only:
@@ -283,6 +296,10 @@ const PerTarget& Evaluation::per_target_at(std::string_view key) const {
 }
 
 std::vector<TargetStats> target_stats(std::span<const Measurement> data) {
+  return target_stats(data, 2);
+}
+
+std::vector<TargetStats> target_stats(std::span<const Measurement> data, int min_runs) {
   if (data.empty()) throw InputError("no measurements");
   const auto groups = group(data);
   const bool any_down = std::any_of(groups.begin(), groups.end(),
@@ -293,8 +310,8 @@ std::vector<TargetStats> target_stats(std::span<const Measurement> data) {
   for (const auto& [target, s] : groups) {
     TargetStats ts;
     ts.target_mm = target;
-    if (any_up) check_runs(target, s.up, Direction::up);
-    if (any_down) check_runs(target, s.down, Direction::down);
+    if (any_up) check_runs(target, s.up, Direction::up, min_runs);
+    if (any_down) check_runs(target, s.down, Direction::down, min_runs);
     // A down-only test is evaluated like an up-only one: its values sit in the "up" slots.
     const auto& first = any_up ? s.up : s.down;
     ts.runs_up = static_cast<int>(first.size());
@@ -316,7 +333,13 @@ std::vector<TargetStats> target_stats(std::span<const Measurement> data) {
 Evaluation evaluate(std::span<const Measurement> data, Standard standard) {
   Evaluation e;
   e.standard = info(standard);
-  e.targets = target_stats(data);
+  if (data.empty()) throw InputError("no measurements");
+  double first = data.front().target_mm, last = first;
+  for (const auto& m : data)
+    first = std::min(first, m.target_mm), last = std::max(last, m.target_mm);
+  // ISO 230-2:2014, 6.2: an axis over 2000 mm may be measured with one approach per direction.
+  const bool long_axis = standard == Standard::iso230_2_2014 && is_long_axis(first, last);
+  e.targets = target_stats(data, long_axis ? 1 : 2);
   e.bidirectional = std::any_of(data.begin(), data.end(),
                                 [](const auto& m) { return m.direction == Direction::down; }) &&
                     std::any_of(data.begin(), data.end(),
@@ -333,7 +356,13 @@ Evaluation evaluate(std::span<const Measurement> data, Standard standard) {
     e.warnings.push_back(
         fmt::format("targets have between {} and {} runs per direction", min_runs, max_runs));
   }
-  if (min_runs < 5) {
+  e.single_run_long_axis = long_axis && min_runs == 1;
+  if (e.single_run_long_axis) {
+    e.notes.push_back(fmt::format(
+        "axis of {} mm (over {} mm) with one approach per direction: ISO 230-2:2014, 6.2, "
+        "evaluates the means, the reversal, E and M; no repeatability and no accuracy A",
+        last - first, kLongAxisMm));
+  } else if (min_runs < 5) {
     e.warnings.push_back(
         fmt::format("{} runs per direction: {} asks for at least 5", min_runs, e.standard.title));
   }

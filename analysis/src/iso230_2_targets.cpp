@@ -95,29 +95,60 @@ Cycle cycle_from_string(std::string_view name) {
       fmt::format("unknown test cycle '{}': expected linear, pendulum or pilgrim-step", name));
 }
 
+bool is_long_axis(double first_mm, double last_mm) { return last_mm - first_mm > kLongAxisMm; }
+
+int long_axis_target_count(double first_mm, double last_mm) {
+  // A hair of slack so that 3000 mm gives 12 intervals of 250, not 13.
+  const double intervals = std::ceil((last_mm - first_mm) / kLongAxisIntervalMm - 1e-9);
+  if (!(intervals < max_plan_targets))  // before the cast, which would overflow
+    throw InputError(fmt::format("targets: {} .. {} mm at {} mm intervals is more than {} targets",
+                                 first_mm, last_mm, kLongAxisIntervalMm, max_plan_targets));
+  return static_cast<int>(intervals) + 1;
+}
+
 std::vector<double> generate_targets(const TargetSpec& s) {
   if (!std::isfinite(s.first_mm) || !std::isfinite(s.last_mm) || !(s.last_mm > s.first_mm)) {
     throw InputError(fmt::format("targets: last ({} mm) must be greater than first ({} mm)",
                                  s.last_mm, s.first_mm));
   }
-  if (s.interval_mm.has_value() == s.count.has_value()) {
-    throw InputError("targets: give either an interval or a count, not both or neither");
+  if (s.interval_mm && s.count) {
+    throw InputError("targets: give either an interval or a count, not both");
+  }
+  const bool long_default = !s.interval_mm && !s.count;
+  if (long_default && !is_long_axis(s.first_mm, s.last_mm)) {
+    throw InputError(fmt::format(
+        "targets: give an interval or a count (only an axis over {} mm gets the ISO 230-2 "
+        "default of an average interval of {} mm; this one is {} mm)",
+        kLongAxisMm, kLongAxisIntervalMm, s.last_mm - s.first_mm));
   }
   const double length = s.last_mm - s.first_mm;
   int count = 0;
-  if (s.count) {
+  if (long_default) {
+    count = long_axis_target_count(s.first_mm, s.last_mm);
+  } else if (s.count) {
     count = *s.count;
-    if (count < 2) throw InputError(fmt::format("targets: count = {} must be >= 2", count));
+    if (count < 2 || count > max_plan_targets)
+      throw InputError(
+          fmt::format("targets: count = {} must be in 2 .. {}", count, max_plan_targets));
   } else {
     const double iv = *s.interval_mm;
-    if (!(iv > 0)) throw InputError(fmt::format("targets: interval = {} mm must be > 0", iv));
+    if (!(iv > 0) || !std::isfinite(iv))
+      throw InputError(fmt::format("targets: interval = {} mm must be finite and > 0", iv));
     const double steps = length / iv;
+    if (!(steps < max_plan_targets))  // before the cast below, which would overflow
+      throw InputError(
+          fmt::format("targets: interval {} mm gives {:.0f} targets over {} .. {} mm, more than {}",
+                      iv, steps + 1, s.first_mm, s.last_mm, max_plan_targets));
     if (std::abs(steps - std::round(steps)) > 1e-6 * std::max(1.0, steps)) {
       throw InputError(fmt::format(
           "targets: interval {} mm does not divide the travel {} .. {} mm into whole steps", iv,
           s.first_mm, s.last_mm));
     }
     count = static_cast<int>(std::round(steps)) + 1;
+  }
+  if (!(s.round_to_mm >= 0) || !std::isfinite(s.round_to_mm)) {
+    throw InputError(
+        fmt::format("targets: rounding step {} mm must be finite and >= 0", s.round_to_mm));
   }
   if (!(s.random_fraction >= 0 && s.random_fraction < 0.5)) {
     throw InputError(
@@ -142,8 +173,9 @@ std::vector<double> generate_targets(const TargetSpec& s) {
 }
 
 Plan make_plan(const TargetSpec& ts, const CycleSpec& cs) {
-  if (cs.runs < 1) throw InputError(fmt::format("cycle: runs = {} must be >= 1", cs.runs));
-  if (!(cs.overrun_mm >= 0)) {
+  if (cs.runs < 1 || cs.runs > max_plan_runs)
+    throw InputError(fmt::format("cycle: runs = {} must be in 1 .. {}", cs.runs, max_plan_runs));
+  if (!(cs.overrun_mm >= 0) || !std::isfinite(cs.overrun_mm)) {
     throw InputError(fmt::format("cycle: over-run = {} mm must be >= 0", cs.overrun_mm));
   }
   if (cs.cycle == Cycle::pilgrim_step && !cs.bidirectional) {
@@ -155,14 +187,31 @@ Plan make_plan(const TargetSpec& ts, const CycleSpec& cs) {
   p.targets_mm = generate_targets(ts);
   const double length_m = (ts.last_mm - ts.first_mm) / 1000.0;
   const auto n_targets = p.targets_mm.size();
-  if (cs.runs < 5) {
-    p.warnings.push_back(
-        fmt::format("{} runs per direction: ISO 230-2 asks for at least 5", cs.runs));
-  }
-  if (n_targets < 5 || static_cast<double>(n_targets) < 5.0 * length_m) {
-    p.warnings.push_back(fmt::format(
-        "{} targets over {} m: ISO 230-2 asks for at least 5 per metre and at least 5 in all",
-        n_targets, length_m));
+  if (is_long_axis(ts.first_mm, ts.last_mm)) {
+    p.notes.push_back(fmt::format(
+        "axis over {} mm: ISO 230-2 tests the whole travel with one approach in each direction "
+        "or more, targets an average of {} mm apart; with one run the repeatability and the "
+        "accuracy A are not evaluated (ISO 230-2:2014, 6.2), and a {} mm section may be tested "
+        "with the usual 5 runs if agreed",
+        kLongAxisMm, kLongAxisIntervalMm, kLongAxisMm));
+    const double average_mm = (ts.last_mm - ts.first_mm) / static_cast<double>(n_targets - 1);
+    if (average_mm > kLongAxisIntervalMm + 1e-9) {
+      p.warnings.push_back(fmt::format(
+          "{} targets over {} m, an average interval of {:.1f} mm: ISO 230-2 asks for {} mm or "
+          "less on an axis over {} mm ({} targets)",
+          n_targets, length_m, average_mm, kLongAxisIntervalMm, kLongAxisMm,
+          long_axis_target_count(ts.first_mm, ts.last_mm)));
+    }
+  } else {
+    if (cs.runs < 5) {
+      p.warnings.push_back(
+          fmt::format("{} runs per direction: ISO 230-2 asks for at least 5", cs.runs));
+    }
+    if (n_targets < 5 || static_cast<double>(n_targets) < 5.0 * length_m) {
+      p.warnings.push_back(fmt::format(
+          "{} targets over {} m: ISO 230-2 asks for at least 5 per metre and at least 5 in all",
+          n_targets, length_m));
+    }
   }
   if (cs.overrun_mm == 0 && cs.bidirectional) {
     p.warnings.push_back("no over-run: reversals happen at the end targets themselves");

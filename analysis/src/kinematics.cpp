@@ -115,16 +115,14 @@ ErrorFunction ErrorFunction::scaled(double k) const {
 
 namespace {
 
-struct TopologyInfo {
-  Topology id;
-  std::string_view name;
-  int workpiece_side;
-};
-constexpr std::array kTopologies{
-    TopologyInfo{Topology::fxyz, "FXYZ", 0},
-    TopologyInfo{Topology::xfyz, "XFYZ", 1},
-    TopologyInfo{Topology::xyfz, "XYFZ", 2},
-    TopologyInfo{Topology::xyzf, "XYZF", 3},
+// The 24 serial orders of X, Y, Z and the frame F, in the order of the Topology enum (the four
+// classic ones first, so that their numeric values are those of earlier versions).
+constexpr std::array<std::string_view, kTopologyCount> kTopologyNames{
+    "FXYZ", "XFYZ", "XYFZ", "XYZF",          // the first four
+    "FXZY", "FYXZ", "FYZX", "FZXY", "FZYX",  // F first
+    "XFZY", "YFXZ", "YFZX", "ZFXY", "ZFYX",  // F second
+    "XZFY", "YXFZ", "YZFX", "ZXFY", "ZYFX",  // F third
+    "XZYF", "YXZF", "YZXF", "ZXYF", "ZYXF",  // F fourth
 };
 
 constexpr std::array kComponents{
@@ -146,18 +144,75 @@ std::string upper(std::string_view s) {
 
 }  // namespace
 
-std::string_view to_string(Topology t) { return kTopologies.at(static_cast<std::size_t>(t)).name; }
+std::string_view to_string(Topology t) { return kTopologyNames.at(static_cast<std::size_t>(t)); }
 
-int workpiece_side_axes(Topology t) {
-  return kTopologies.at(static_cast<std::size_t>(t)).workpiece_side;
+std::span<const Topology> all_topologies() {
+  static const auto all = [] {
+    std::array<Topology, kTopologyCount> a{};
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] = static_cast<Topology>(i);
+    return a;
+  }();
+  return all;
+}
+
+int workpiece_side_axes(Topology t) { return static_cast<int>(to_string(t).find('F')); }
+
+std::array<Axis, 3> chain_order(Topology t) {
+  std::array<Axis, 3> order{};
+  std::size_t n = 0;
+  for (char c : to_string(t)) {
+    if (c != 'F') order.at(n++) = static_cast<Axis>(c - 'X');
+  }
+  return order;
 }
 
 Topology topology_from_string(std::string_view s) {
   const std::string u = upper(s);
-  for (const auto& t : kTopologies) {
-    if (u == t.name) return t.id;
+  for (std::size_t i = 0; i < kTopologyNames.size(); ++i) {
+    if (u == kTopologyNames[i]) return static_cast<Topology>(i);
   }
-  throw InputError(fmt::format("topology '{}' is unknown (expected FXYZ, XFYZ, XYFZ or XYZF)", s));
+  throw InputError(fmt::format(
+      "topology '{}' is unknown (expected the letters F, X, Y and Z once each, read from the "
+      "workpiece to the tool: e.g. FXYZ, XFYZ, XYFZ, YFXZ, ZFXY)",
+      s));
+}
+
+namespace {
+constexpr std::array<std::string_view, 3> kPlaneNames{"XY", "XZ", "YZ"};
+constexpr std::array<std::string_view, 3> kLocationNames{"E_C0Y", "E_B0Z", "E_A0Z"};
+// The sign that takes alpha (angle over 90 deg) to the ISO 230-1 location error: see
+// kinematics.hpp. Only the rotation about Y closes the angle when positive.
+constexpr std::array<double, 3> kAlphaToLocation{+1.0, -1.0, +1.0};
+}  // namespace
+
+std::string_view to_string(Plane p) { return kPlaneNames.at(static_cast<std::size_t>(p)); }
+
+Plane plane_from_string(std::string_view s) {
+  std::string u = upper(s);
+  if (u.size() == 2 && u[0] > u[1]) std::swap(u[0], u[1]);  // "ZX" is the XZ plane
+  for (std::size_t i = 0; i < kPlaneNames.size(); ++i) {
+    if (u == kPlaneNames[i]) return static_cast<Plane>(i);
+  }
+  throw InputError(fmt::format("plane '{}' is unknown (expected XY, XZ or YZ)", s));
+}
+
+std::string_view location_error_name(Plane p) {
+  return kLocationNames.at(static_cast<std::size_t>(p));
+}
+
+double location_error_from_angle_over_90(Plane p, double alpha_urad) {
+  return kAlphaToLocation.at(static_cast<std::size_t>(p)) * alpha_urad;
+}
+
+double angle_over_90_from_location_error(Plane p, double location_error_urad) {
+  return kAlphaToLocation.at(static_cast<std::size_t>(p)) * location_error_urad;
+}
+
+double& Squareness::of(Plane p) {
+  return p == Plane::xy ? c0y_urad : p == Plane::xz ? b0z_urad : a0z_urad;
+}
+double Squareness::of(Plane p) const {
+  return p == Plane::xy ? c0y_urad : p == Plane::xz ? b0z_urad : a0z_urad;
 }
 
 std::span<const Component> all_components() { return kComponents; }
@@ -259,9 +314,10 @@ Eigen::Isometry3d rotation_htm(const Vector3d& eps) {
   return r;
 }
 
-// Exact chain, workpiece (table reference frame) to tool. The HTM of a joint is the pose of its
-// tool-side member in its workpiece-side member (Schwenke et al. 2008, eq. 1-2, with our sign
-// convention that all errors are tool relative to workpiece):
+// Exact chain, workpiece (table reference frame) to tool, in the order of the topology letters
+// with F removed (chain_order). The HTM of a joint is the pose of its tool-side member in its
+// workpiece-side member (Schwenke et al. 2008, eq. 1-2, with our sign convention that all
+// errors are tool relative to workpiece):
 // - tool-side axis: the carriage in its carrier, Trans(q u + delta) * Rot(eps): the rotation is
 //   about the carriage's reference point, which moves with the carriage;
 // - workpiece-side axis: the carrier in the carriage (table), Rot(eps) * Trans(q u + delta):
@@ -269,15 +325,18 @@ Eigen::Isometry3d rotation_htm(const Vector3d& eps) {
 // The table offset sits at the frame, between the two sides.
 VolumetricError by_htm(const Machine& m, const Directions& u, const Vec3& q_mm) {
   const auto s = axis_states(m, u, q_mm);
+  const auto order = chain_order(m.topology);
   const auto k = static_cast<std::size_t>(workpiece_side_axes(m.topology));
   const Vector3d table(m.table_offset_mm.data()), tool(m.tool_offset_mm.data());
   Eigen::Isometry3d h = Eigen::Isometry3d::Identity();
-  for (std::size_t i = 0; i < k; ++i) {
-    h = h * rotation_htm(s[i].eps_rad) * translation(s[i].travel_mm + s[i].delta_mm);
+  for (std::size_t n = 0; n < k; ++n) {
+    const AxisState& a = s[order[n]];
+    h = h * rotation_htm(a.eps_rad) * translation(a.travel_mm + a.delta_mm);
   }
   h = h * translation(table);
-  for (std::size_t i = k; i < 3; ++i) {
-    h = h * translation(s[i].travel_mm + s[i].delta_mm) * rotation_htm(s[i].eps_rad);
+  for (std::size_t n = k; n < 3; ++n) {
+    const AxisState& a = s[order[n]];
+    h = h * translation(a.travel_mm + a.delta_mm) * rotation_htm(a.eps_rad);
   }
   const Vector3d nominal = Vector3d(q_mm.data()) + table + tool;
   const Vector3d e_mm = h * tool - nominal;
@@ -293,19 +352,25 @@ VolumetricError by_htm(const Machine& m, const Directions& u, const Vec3& q_mm) 
 
 // First-order expansion of by_htm, dropping every product of two errors (derivation in
 // docs/kinematics.md): e = sum_i delta_i + sum_i eps_i x a_i + squareness terms, where the
-// Abbe arm a_i is the nominal vector from axis i's reference point to the tool tip:
-//   a_i = sum_{j>i} q_j e_j + tool + [i workpiece side] (q_i e_i + table).
+// Abbe arm a_i is the nominal vector from axis i's reference point to the tool tip. With the
+// axes numbered n = 0, 1, 2 along the chain (chain_order) and k of them on the workpiece side:
+//   a_(n) = sum_{m>n} q_(m) e_(m) + tool + [n < k] (q_(n) e_(n) + table).
 // Squareness (kinematics.hpp): (-E_C0Y y + E_B0Z z, -E_A0Z z, 0). Orientation: sum_i eps_i.
 VolumetricError by_first_order(const Machine& m, const Directions& u, const Vec3& q_mm) {
   const auto s = axis_states(m, u, q_mm);
+  const auto order = chain_order(m.topology);
   const auto k = static_cast<std::size_t>(workpiece_side_axes(m.topology));
   const Vector3d table(m.table_offset_mm.data()), tool(m.tool_offset_mm.data());
   const Vector3d q(q_mm.data());
   Vector3d e = Vector3d::Zero(), rot = Vector3d::Zero();
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t n = 0; n < 3; ++n) {
+    const std::size_t i = order[n];
     Vector3d arm = tool;
-    for (std::size_t j = i + 1; j < 3; ++j) arm[static_cast<Eigen::Index>(j)] += q_mm[j];
-    if (i < k) {
+    for (std::size_t later = n + 1; later < 3; ++later) {
+      const std::size_t j = order[later];
+      arm[static_cast<Eigen::Index>(j)] += q_mm[j];
+    }
+    if (n < k) {
       arm[static_cast<Eigen::Index>(i)] += q_mm[i];
       arm += table;
     }
@@ -435,6 +500,42 @@ MapSummary summarize(const ErrorMap& map) {
   }
   for (std::size_t i = 0; i < 3; ++i) s.range_um[i] = s.max_um[i] - s.min_um[i];
   return s;
+}
+
+std::vector<Contribution> contributions(const Machine& m, const Grid& grid) {
+  check_machine(m);
+  check_grid(grid);
+  Machine base = m;
+  for (Component c : all_components()) component(base, c) = ErrorFunction{};
+  base.squareness = {};
+  std::vector<Contribution> out;
+  auto add = [&](std::string_view name, Axis axis, const Machine& only) {
+    const ErrorMap map = volumetric_error_map(only, grid, Method::first_order);
+    Contribution c{std::string(name), axis, 0.0, 0.0};
+    double sum = 0.0;
+    for (std::size_t p = 0; p < map.size(); ++p) {
+      const double* e = &map.errors_um[3 * p];
+      const double n2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+      c.max_norm_um = std::max(c.max_norm_um, std::sqrt(n2));
+      sum += n2;
+    }
+    c.rms_um = std::sqrt(sum / static_cast<double>(map.size()));
+    out.push_back(c);
+  };
+  for (Component c : all_components()) {
+    Machine only = base;
+    component(only, c) = component(m, c);
+    add(to_string(c), static_cast<Axis>(static_cast<std::size_t>(c) / 6), only);
+  }
+  for (Plane p : {Plane::xy, Plane::xz, Plane::yz}) {
+    Machine only = base;
+    only.squareness.of(p) = m.squareness.of(p);
+    add(location_error_name(p), p == Plane::xy ? Y : Z, only);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Contribution& a, const Contribution& b) {
+    return a.max_norm_um > b.max_norm_um;
+  });
+  return out;
 }
 
 }  // namespace cal::kinematics

@@ -1,14 +1,19 @@
 // daq compensate: compensation tables for the controller from a measured run.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
+#include "cal/analysis/comp_formats.hpp"
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
+#include "csv_columns.hpp"
 #include "database.hpp"
 #include "measurement_csv.hpp"
 
@@ -18,16 +23,26 @@ namespace {
 namespace ct = cal::comptable;
 
 struct CompensateOptions {
-  std::string input, straightness, db, output;
+  std::string input, straightness, db, output, output_axis;
   std::int64_t run = 0;
   std::string axis = "X", format = "csv", sign = "correction", units = "mm", outside = "refuse";
-  double start_mm = 0, interval_mm = 0, resolution = 0.0001;
-  int points = 0, axis_number = 1;
+  double start_mm = 0, interval_mm = 0;
+  std::optional<double> resolution;  // unset: by unit (default_resolution)
+  int points = 0, axis_number = 1, output_axis_number = 2;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
+  CsvOptions csv;
+  ct::FanucOptions fanuc;
+  std::optional<double> fanuc_reference_mm;  // default: --start-mm
 };
 
+std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
+  std::vector<double> p;
+  for (std::size_t i = 0; i < t.correction_mm.size(); ++i) p.push_back(t.position_mm(i));
+  return p;
+}
+
 std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o) {
-  if (!o.input.empty()) return read_measurements(o.input);
+  if (!o.input.empty()) return read_measurements(o.input, o.csv);
   cal::storage::Store store(database_path(o.db));
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
@@ -37,6 +52,84 @@ std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o)
          t.deviation_um});
   if (out.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
   return out;
+}
+
+// A straightness run is the error of another axis (--output-axis) along --axis: its correction
+// belongs in a cross-axis table of the output axis, never in --axis's own pitch table (which
+// corrects --axis along itself: the wrong axis).
+std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) {
+  if (o.output_axis.empty())
+    throw cal::InputError(
+        "--straightness: name the corrected axis with --output-axis (the straightness of --axis "
+        "measured in that axis, e.g. --axis X --output-axis Y for E_YX)");
+  if (o.units != "mm" || o.incremental || o.sign != "correction")
+    throw cal::InputError(
+        "--straightness writes absolute corrections in mm: no --units, --incremental or --sign");
+  const auto csv = read_csv_columns(o.straightness, {"position_mm", "deviation_um"}, {}, o.csv);
+  const ct::CrossAxisTable t =
+      ct::from_straightness(o.axis, o.output_axis, spec, csv.numbers.at("position_mm"),
+                            csv.numbers.at("deviation_um"), o.remove_slope);
+  const std::vector<ct::CrossAxisTable> one{t};
+  if (o.json)
+    return nlohmann::json{{"schema", "caldaq.cross-table.v1"},
+                          {"input_axis", t.input},
+                          {"output_axis", t.output},
+                          {"units", "mm"},
+                          {"sign", "correction"},
+                          {"position_mm", spec_positions(t)},
+                          {"correction", t.correction_mm}}
+               .dump(2) +
+           "\n";
+  if (o.format == "csv") return ct::write_cross_csv(one);
+  if (o.format == "siemens-cec")
+    return ct::write_sinumerik_cec(
+        one, {{o.axis, o.axis_number}, {o.output_axis, o.output_axis_number}});
+  if (o.format == "isg") return ct::write_isg_cross(t, o.output_axis_number, o.axis_number);
+  if (o.format == "heidenhain") return ct::write_heidenhain_com(one);
+  throw cal::InputError(
+      fmt::format("format '{}' cannot hold a straightness: it corrects an axis along itself, and a "
+                  "straightness "
+                  "of {} corrects {} (use csv, siemens-cec, isg or heidenhain{})",
+                  o.format, o.axis, o.output_axis,
+                  o.format == "linuxcnc" ? "; LinuxCNC documents no cross-axis table" : ""));
+}
+
+std::string positioning_text(const CompensateOptions& o, const ct::Table& table) {
+  if (o.json) {
+    nlohmann::json j{{"schema", "caldaq.comp-table.v1"},
+                     {"axis", o.axis},
+                     {"units", o.units},
+                     {"sign", o.sign},
+                     {"incremental", o.incremental},
+                     {"position_mm", table.position_mm},
+                     {"forward", table.forward}};
+    if (o.bidirectional)
+      j["reverse"] = table.reverse;
+    else
+      j["backlash"] = table.backlash;
+    return j.dump(2) + "\n";
+  }
+  if (o.format == "csv") return ct::write_csv(table);
+  if (o.format == "linuxcnc") return ct::write_linuxcnc(table);
+  if (o.format == "siemens") return ct::write_siemens(table, o.axis_number);
+  if (o.format == "isg") return ct::write_isg(table);
+  if (o.format == "heidenhain") return ct::write_heidenhain_com(table);
+  if (o.format == "fanuc") {
+    ct::FanucOptions f = o.fanuc;
+    f.reference_mm = o.fanuc_reference_mm.value_or(o.start_mm);
+    return ct::write_fanuc_pitch(table, f);
+  }
+  throw cal::InputError(fmt::format(
+      "format '{}' (expected csv, linuxcnc, siemens, isg, heidenhain or fanuc; siemens-cec for "
+      "--straightness)",
+      o.format));
+}
+
+// A resolution that suits each unit when none is given: 0.1 um in mm or um tables, 0.00001 in
+// (0.254 um) in inch tables (a rounding of 0.0001 in would be 2.54 um).
+double default_resolution(const std::string& units) {
+  const auto u = ct::units_from_string(units);
+  return u == ct::Units::inch ? 0.00001 : u == ct::Units::um ? 0.1 : 0.0001;
 }
 
 void run(const CompensateOptions& o) {
@@ -51,54 +144,14 @@ void run(const CompensateOptions& o) {
                       .incremental = o.incremental,
                       .sign = o.sign == "error" ? ct::Sign::error : ct::Sign::correction,
                       .units = ct::units_from_string(o.units),
-                      .resolution = o.resolution,
+                      .resolution = o.resolution.value_or(default_resolution(o.units)),
                       .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
-  ct::Table table;
+  std::string text;
   if (!o.straightness.empty()) {
-    std::ifstream in(o.straightness);
-    if (!in) throw cal::InputError(fmt::format("{}: cannot open", o.straightness));
-    std::vector<double> x, d;
-    std::string line;
-    int n = 0;
-    while (std::getline(in, line)) {
-      ++n;
-      if (line.empty() || line[0] == '#' || line.rfind("position_mm", 0) == 0) continue;
-      double a = 0, b = 0;
-      if (std::sscanf(line.c_str(), "%lf,%lf", &a, &b) != 2)
-        throw cal::InputError(
-            fmt::format("{}:{}: expected position_mm,deviation_um", o.straightness, n));
-      x.push_back(a), d.push_back(b);
-    }
-    table = ct::cross(spec, x, d, o.remove_slope);
+    text = straightness_text(o, spec);
   } else {
     const auto m = measurements(o);
-    table = ct::positioning(spec, cal::iso230_2::target_stats(m));
-  }
-  std::string text;
-  if (o.json) {
-    nlohmann::json j{{"schema", "caldaq.comp-table.v1"},
-                     {"axis", o.axis},
-                     {"units", o.units},
-                     {"sign", o.sign},
-                     {"incremental", o.incremental},
-                     {"position_mm", table.position_mm},
-                     {"forward", table.forward}};
-    if (o.bidirectional)
-      j["reverse"] = table.reverse;
-    else
-      j["backlash"] = table.backlash;
-    text = j.dump(2) + "\n";
-  } else if (o.format == "csv") {
-    text = ct::write_csv(table);
-  } else if (o.format == "linuxcnc") {
-    text = ct::write_linuxcnc(table);
-  } else if (o.format == "siemens") {
-    text = ct::write_siemens(table, o.axis_number);
-  } else if (o.format == "isg") {
-    text = ct::write_isg(table);
-  } else {
-    throw cal::InputError(
-        fmt::format("format '{}' (expected csv, linuxcnc, siemens or isg)", o.format));
+    text = positioning_text(o, ct::positioning(spec, cal::iso230_2::target_stats(m)));
   }
   if (o.output.empty()) return fmt::print("{}", text);
   std::ofstream out(o.output);
@@ -114,7 +167,13 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   cmd->add_option("-i,--input", o->input, "ISO 230-2 measurement CSV (see docs/cli.md)");
   cmd->add_option("--run", o->run, "A stored linear run instead of --input");
   add_db_option(*cmd, o->db);
-  cmd->add_option("--straightness", o->straightness, "Cross compensation from a straightness CSV");
+  cmd->add_option("--straightness", o->straightness,
+                  "Cross compensation from a straightness CSV (position_mm, deviation_um)");
+  cmd->add_option("--output-axis", o->output_axis,
+                  "--straightness: the axis the straightness is measured in, which is corrected");
+  cmd->add_option("--output-axis-number", o->output_axis_number,
+                  "siemens-cec, isg: the number of --output-axis")
+      ->capture_default_str();
   cmd->add_option("--axis", o->axis, "Axis name")->capture_default_str();
   cmd->add_option("--axis-number", o->axis_number, "Siemens: the AXn number")
       ->capture_default_str();
@@ -128,16 +187,30 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
       ->capture_default_str()
       ->check(CLI::IsMember({"correction", "error"}));
   cmd->add_option("--units", o->units, "mm, um or inch")->capture_default_str();
-  cmd->add_option("--resolution", o->resolution, "Rounding, in the units")->capture_default_str();
+  cmd->add_option("--resolution", o->resolution,
+                  "Rounding, in the units (default 0.0001 mm, 0.1 um, 0.00001 inch)");
   cmd->add_option("--outside", o->outside,
                   "refuse or hold (grid points beyond the measured targets)")
       ->capture_default_str()
       ->check(CLI::IsMember({"refuse", "hold"}));
   cmd->add_flag("--remove-slope", o->remove_slope,
                 "Cross compensation: remove the squareness (slope)");
-  cmd->add_option("-f,--format", o->format, "csv, linuxcnc, siemens or isg")->capture_default_str();
+  cmd->add_option("-f,--format", o->format,
+                  "csv, linuxcnc, siemens, isg, heidenhain, fanuc; with --straightness: csv, "
+                  "siemens-cec, isg, heidenhain")
+      ->capture_default_str();
+  cmd->add_option("--fanuc-reference-mm", o->fanuc_reference_mm,
+                  "fanuc: the reference position, a grid point (default --start-mm)");
+  cmd->add_option("--fanuc-first-point", o->fanuc.first_point, "fanuc: number of the first point")
+      ->capture_default_str();
+  cmd->add_option("--fanuc-unit-um", o->fanuc.detection_unit_um, "fanuc: the detection unit")
+      ->capture_default_str();
+  cmd->add_option("--fanuc-magnification", o->fanuc.magnification, "fanuc: parameter 3623")
+      ->capture_default_str();
   cmd->add_option("-o,--output", o->output, "Write to a file instead of stdout");
-  cmd->add_flag("--json", o->json, "Print caldaq.comp-table.v1 JSON");
+  add_decimal_comma_flag(*cmd, o->csv);
+  cmd->add_flag("--json", o->json,
+                "Print caldaq.comp-table.v1 JSON (caldaq.cross-table.v1 with --straightness)");
   cmd->callback([o] { run(*o); });
 }
 

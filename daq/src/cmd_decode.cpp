@@ -39,6 +39,8 @@ std::string_view unit_of(d::Quantity q) {
       return "Pa";
     case d::Quantity::air_humidity_pct:
       return "%RH";
+    case d::Quantity::angle_rad:
+      return "rad";
     case d::Quantity::refractive_index:
       return "";
   }

@@ -5,12 +5,16 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/kinematics.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
+#include "csv_columns.hpp"
 #include "report/report.hpp"
 
 namespace daq {
@@ -18,43 +22,12 @@ namespace {
 
 using nlohmann::json;
 
-// Reads named numeric columns from a CSV with a header line; '#' lines are comments.
+// Named numeric columns of a CSV with a header line (csv_columns.hpp, the strict reader).
 std::map<std::string, std::vector<double>> read_columns(const std::string& path,
-                                                        std::initializer_list<const char*> names) {
-  std::ifstream in(path);
-  if (!in) throw cal::InputError(fmt::format("{}: cannot open", path));
-  std::string line;
-  int n = 0;
-  std::map<std::string, std::size_t> col;
-  std::map<std::string, std::vector<double>> out;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty() || line[0] == '#' || line == "\r") continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) {
-      const auto b = c.find_first_not_of(" \t\r"), e = c.find_last_not_of(" \t\r");
-      cells.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
-    }
-    if (col.empty()) {
-      for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
-      for (const char* name : names)
-        if (!col.count(name))
-          throw cal::InputError(fmt::format("{}:{}: the header has no column {}", path, n, name));
-      continue;
-    }
-    for (const char* name : names) {
-      const std::size_t i = col.at(name);
-      const std::string text = i < cells.size() ? cells[i] : "";
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || *end != '\0' || !std::isfinite(v))
-        throw cal::InputError(
-            fmt::format("{}:{}: column {}: '{}' is not a number", path, n, name, text));
-      out[name].push_back(v);
-    }
-  }
-  return out;
+                                                        std::initializer_list<const char*> names,
+                                                        const CsvOptions& options) {
+  return read_csv_columns(path, std::vector<std::string>(names.begin(), names.end()), {}, options)
+      .numbers;
 }
 
 struct StraightnessOptions {
@@ -62,6 +35,7 @@ struct StraightnessOptions {
   std::string reference = "lsq";
   std::string report;
   bool json = false;
+  CsvOptions csv;
 };
 
 void write_report(const std::string& path, const std::string& html) {
@@ -72,7 +46,7 @@ void write_report(const std::string& path, const std::string& html) {
 }
 
 void run_straightness(const StraightnessOptions& o) {
-  auto cols = read_columns(o.input, {"position_mm", "deviation_um"});
+  auto cols = read_columns(o.input, {"position_mm", "deviation_um"}, o.csv);
   const auto ref = cal::straightness::reference_from_string(o.reference);
   const auto r = cal::straightness::evaluate(cols["position_mm"], cols["deviation_um"], ref);
   if (!o.report.empty())
@@ -105,7 +79,9 @@ struct SquarenessOptions {
   std::string circle;                               // circle CSV
   double radius_mm = 0;
   std::string report;
+  std::string plane;  // XY, XZ or YZ: also give the model's location error
   bool json = false;
+  CsvOptions csv;
 };
 
 void run_squareness(const SquarenessOptions& o) {
@@ -114,8 +90,8 @@ void run_squareness(const SquarenessOptions& o) {
   if (o.method == "straightness") {
     if (o.along_a.empty() || o.along_b.empty())
       throw cal::InputError("squareness --method straightness needs --along-a and --along-b");
-    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"});
-    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"});
+    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"}, o.csv);
+    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"}, o.csv);
     r = cal::squareness::from_straightness({a["position_mm"], a["deviation_um"]},
                                            {b["position_mm"], b["deviation_um"]}, o.square_error);
     how = "two straightness runs (least-squares lines)";
@@ -132,7 +108,7 @@ void run_squareness(const SquarenessOptions& o) {
   } else if (o.method == "circle") {
     if (o.circle.empty() || !(o.radius_mm > 0))
       throw cal::InputError("squareness --method circle needs --circle FILE and --radius-mm");
-    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"});
+    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"}, o.csv);
     const cal::squareness::CircleTrace t{c["angle_deg"], c["deviation_um"]};
     r = cal::squareness::from_circle(o.radius_mm, std::span(&t, 1));
     how = "circular test (sin 2t term)";
@@ -140,6 +116,11 @@ void run_squareness(const SquarenessOptions& o) {
     throw cal::InputError(fmt::format(
         "squareness method '{}' (expected straightness, diagonal or circle)", o.method));
   }
+  std::optional<cal::kinematics::Plane> plane;
+  if (!o.plane.empty()) plane = cal::kinematics::plane_from_string(o.plane);
+  // 1 um/m = 1 urad: the model's location error in the ISO 230-1 sign (E_B0Z opposite).
+  const double location_urad =
+      plane ? cal::kinematics::location_error_from_angle_over_90(*plane, r.squareness_um_per_m) : 0;
   if (o.json) {
     json j{{"schema", "caldaq.squareness.v1"},
            {"method", o.method},
@@ -147,6 +128,10 @@ void run_squareness(const SquarenessOptions& o) {
            {"squareness_arcsec", r.arcsec()},
            {"convention",
             "positive when the angle between the positive axis directions exceeds 90 deg"}};
+    if (plane)
+      j["location_error"] = {{"plane", cal::kinematics::to_string(*plane)},
+                             {"name", cal::kinematics::location_error_name(*plane)},
+                             {"iso230_1_urad", location_urad}};
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print(
@@ -154,6 +139,12 @@ void run_squareness(const SquarenessOptions& o) {
       "positive "
       "axis directions exceeds 90 degrees\n",
       how, r.squareness_um_per_m, r.arcsec());
+  if (plane)
+    fmt::print(
+        "  model ({} plane): {} = {:+.3f} urad (ISO 230-1 location error; "
+        "caldaq.model.v1 \"iso230_1_urad\")\n",
+        cal::kinematics::to_string(*plane), cal::kinematics::location_error_name(*plane),
+        location_urad);
 }
 
 }  // namespace
@@ -166,6 +157,7 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   st->add_option("-r,--reference", s->reference, "lsq, endpoint or minzone")->capture_default_str();
   st->add_option("--report", s->report,
                  "Also write an HTML report with the deviations and all three reference lines");
+  add_decimal_comma_flag(*st, s->csv);
   st->add_flag("--json", s->json, "Print caldaq.straightness.v1 JSON");
   st->callback([s] { run_straightness(*s); });
 
@@ -185,6 +177,10 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   sq->add_option("--radius-mm", q->radius_mm, "circle: radius");
   sq->add_option("--report", q->report,
                  "straightness: also write an HTML report with both runs and their lines");
+  sq->add_option("--plane", q->plane,
+                 "XY, XZ or YZ: also print the model's location error (E_C0Y, E_B0Z, E_A0Z; "
+                 "E_B0Z has the opposite sign)");
+  add_decimal_comma_flag(*sq, q->csv);
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
   sq->callback([q] { run_squareness(*q); });
 }

@@ -8,6 +8,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/replay/session.hpp"
+#include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
@@ -45,6 +46,22 @@ struct ReplaySession {
     config = config_from_json(header.at("config"));
     for (const auto& j : header.at("instruments")) specs.push_back(instrument_spec_from_json(j));
   }
+  // The run this capture was first stored as (the earliest run recording it), whose context
+  // (customer, instruments, tolerances) the replay keeps, as the capture header lacks it.
+  std::optional<std::int64_t> original_run;
+  std::string original_context;
+  void find_original(const ReplayOptions& o) {
+    const auto capture = std::filesystem::absolute(o.capture).string();
+    cal::storage::Store store(database_path(o.db));
+    for (const auto& r : store.runs()) {
+      if (r.capture_path != capture) continue;
+      original_run = r.id;
+      const json settings = json::parse(r.settings_json, nullptr, false);
+      if (settings.is_object() && settings.contains("context"))
+        original_context = settings["context"].dump();
+      return;
+    }
+  }
   std::string software() const {
     return "daq 0.1.0 (replay of " + header.value("software", "?") + ")";
   }
@@ -52,22 +69,43 @@ struct ReplaySession {
     return make_instrument(io, spec, bus.transport(spec.device, spec.transport),
                            {.name = spec.role, .clock = bus.clock(), .replay = true});
   }
-  // Runs the bus until the run finishes or the capture ends; returns why it ended early.
+  // Runs the bus until the run finishes or the capture ends (an incomplete run is stopped
+  // with the reason), then reads the rest of the capture: how it ends, damaged or not.
   template <class Run>
-  void play(Run& run, const char* incomplete) {
+  cal::replay::ReplayEnd play(Run& run, const char* incomplete) {
     std::optional<cal::replay::ReplayEnd> end;
     bus.start([&](const cal::replay::ReplayEnd& e) { end = e; });
     while (!run.finished() && !end) io.run_for(50ms);
     // Readings the instruments still hold are delivered before the run is judged incomplete.
     if (!run.finished()) io.run_for(10ms);
-    if (run.finished()) return;
-    std::string why = incomplete;
-    if (end && end->damage)
-      why = fmt::format("the capture is damaged at byte {} (block {}): {}", end->damage->offset,
-                        end->damage->block, end->damage->what);
-    run.stop(why);
+    if (!run.finished()) {
+      std::string why = incomplete;
+      if (end && end->damage) why = "the capture is " + damage_text(*end->damage);
+      run.stop(why);
+    }
+    return end ? *end : bus.read_to_end();
+  }
+  static std::string damage_text(const cal::replay::Damage& d) {
+    return fmt::format("damaged at byte {} (block {}): {}", d.offset, d.block, d.what);
   }
 };
+
+// A complete run from a capture damaged further on: the results stand (printed), and the
+// damage is an error (status 2) so that no script takes the file for a sound one.
+void report_damage(const cal::replay::ReplayEnd& end, const ReplayOptions& o, std::int64_t run_id) {
+  if (!end.damage) return;
+  throw cal::InputError(
+      fmt::format("{}: the capture is {}; run {} was replayed from the {} records before it",
+                  o.capture, ReplaySession::damage_text(*end.damage), run_id, end.records));
+}
+
+json damage_json(const cal::replay::ReplayEnd& end) {
+  if (!end.damage) return nullptr;
+  return {{"offset", end.damage->offset},
+          {"block", end.damage->block},
+          {"what", end.damage->what},
+          {"records_replayed", end.records}};
+}
 
 void replay_circle(ReplaySession& s, const ReplayOptions& o) {
   const auto it = std::find_if(s.specs.begin(), s.specs.end(),
@@ -81,10 +119,13 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                        .database = database_path(o.db),
                        .ballbar = s.instrument(*it),
                        .capture_path = std::filesystem::absolute(o.capture).string(),
-                       .software_version = s.software()};
+                       .software_version = s.software(),
+                       .context_json = s.original_context,
+                       .replay = true,
+                       .replay_of_run = s.original_run};
   CircleRun run(s.io, std::move(setup));
   run.start();
-  s.play(run, "the capture ended before both arcs were recorded");
+  const auto end = s.play(run, "the capture ended before both arcs were recorded");
   const auto& out = run.outcome();
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
@@ -92,10 +133,13 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
   if (o.json) {
     json j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
     j["run_id"] = out.run_id;
-    return fmt::print("{}\n", j.dump(2));
+    j["capture_damage"] = damage_json(end);
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+    print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
   }
-  fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-  print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  report_damage(end, o, out.run_id);
 }
 
 void replay_linear(ReplaySession& s, const ReplayOptions& o) {
@@ -104,6 +148,9 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   setup.database = database_path(o.db);
   setup.capture_path = std::filesystem::absolute(o.capture).string();
   setup.software_version = s.software();
+  setup.context_json = s.original_context;
+  setup.replay = true;
+  setup.replay_of_run = s.original_run;
   for (const auto& spec : s.specs)
     if (spec.role == "laser" || spec.role == "air" || spec.role == "material" ||
         spec.role == "position")
@@ -113,7 +160,7 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
         fmt::format("{}: the session has no laser or no air instrument", o.capture));
   LinearRun run(s.io, std::move(setup));
   run.start();
-  s.play(run, "the capture ended before every stop was captured");
+  const auto end = s.play(run, "the capture ended before every stop was captured");
   const auto& out = run.outcome();
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
@@ -121,15 +168,22 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   if (o.json) {
     json j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
-    return fmt::print("{}\n", j.dump(2));
+    j["status"] = cal::storage::to_string(out.status);
+    j["capture_damage"] = damage_json(end);
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+    if (!out.missed.empty())
+      fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
+    print(*out.evaluation);
   }
-  fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-  print(*out.evaluation);
+  report_damage(end, o, out.run_id);
 }
 
 // A session is replayed as the test it recorded: a ballbar session as a circle, else linear.
 void run_replay(const ReplayOptions& o) {
   ReplaySession s(o);
+  s.find_original(o);
   const bool ballbar = std::any_of(s.specs.begin(), s.specs.end(),
                                    [](const auto& x) { return x.role == "ballbar"; });
   if (ballbar && s.config.circle) return replay_circle(s, o);

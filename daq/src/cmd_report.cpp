@@ -25,6 +25,7 @@ struct ReportOptions {
   std::vector<std::int64_t> runs;
   std::string campaign;
   bool compare = false;
+  std::int64_t as_found = 0, as_left = 0;
   std::string format = "html";
   std::string output;
   std::string standard;
@@ -85,10 +86,19 @@ void run_report_command(ReportOptions o) {
       throw cal::InputError(fmt::format("{}: no runs in campaign \"{}\" (see daq runs)",
                                         store.path().string(), o.campaign));
   }
-  if (o.runs.empty()) throw cal::InputError("report: give one or more RUN numbers, or --campaign");
+  if (o.runs.empty() && !o.as_found && !o.as_left)
+    throw cal::InputError(
+        "report: give one or more RUN numbers, --campaign, or --as-found and --as-left");
   const cal::daq::report::Options ro{.standard = o.standard, .software = "daq 0.1.0"};
   std::string html, kind, stem;
-  if (o.compare) {
+  if (o.as_found || o.as_left) {
+    if (!o.as_found || !o.as_left)
+      throw cal::InputError("report: give both --as-found RUN and --as-left RUN");
+    html = cal::daq::report::as_found_as_left_report(store, o.as_found, o.as_left, ro);
+    kind = "as-found-as-left";
+    stem = fmt::format("as-found-{}-as-left-{}", o.as_found, o.as_left);
+    o.runs = {o.as_found, o.as_left};
+  } else if (o.compare) {
     html = cal::daq::report::comparison_report(store, o.runs, ro);
     kind = "comparison";
     stem = fmt::format("comparison-runs-{}", fmt::join(o.runs, "-"));
@@ -145,6 +155,10 @@ void add_report_command(CLI::App& app) {
   cmd->add_option("--campaign", o->campaign, "Report every run of this campaign");
   cmd->add_flag("--compare", o->compare,
                 "Overlay the same test of several runs and show the results over time");
+  cmd->add_option(
+      "--as-found", o->as_found,
+      "With --as-left: the run before the compensation, side by side with the run after");
+  cmd->add_option("--as-left", o->as_left, "With --as-found: the run after the compensation");
   cmd->add_option("-f,--format", o->format, "html or pdf")->capture_default_str();
   cmd->add_option("-o,--output", o->output,
                   "Output file (default report-run-N.html, report-runs-..., comparison-runs-...)");

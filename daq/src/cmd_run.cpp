@@ -5,6 +5,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/read_until.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/streambuf.hpp>
@@ -23,8 +24,10 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
+#include "provenance.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -52,18 +55,27 @@ void watch_keyboard(boost::asio::io_context& io, std::function<void()> on_enter)
 }
 
 // Runs the event loop until the run ends (Ctrl-C or SIGTERM stop it as the operator's
-// abort), closes the capture, and throws with the reason if the run did not complete.
+// abort), closes the capture, and throws with the reason if the run did not complete. A
+// capture that cannot be written (a full disk) aborts the run, naming the file; what was
+// written before stays readable in both the store and the capture.
 template <class Run>
 const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& capture) {
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](auto ec, int) {
     if (!ec) run.stop("stopped by the operator");
   });
+  if (capture.recorder)  // posted: the failure is seen inside an instrument's handler
+    capture.recorder->on_failure([&io, &run](const std::string& e) {
+      boost::asio::post(io, [&run, e] { run.stop("capture failed: " + e); });
+    });
   while (!run.finished()) io.run_for(100ms);
-  if (capture.writer) capture.writer->close();
+  if (capture.recorder) capture.recorder->close();
   const auto& out = run.outcome();
   if (!out.complete)
-    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+    throw cal::InputError(fmt::format("run {} aborted: {}", out.run_id, out.reason));
+  if (capture.recorder && capture.recorder->failure())
+    throw cal::InputError(fmt::format("run {} is complete and stored, but its capture failed: {}",
+                                      out.run_id, *capture.recorder->failure()));
   return out;
 }
 
@@ -71,10 +83,42 @@ const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& ca
 void check_at_start(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
                     const RunOptions& o) {
   if (o.check_s <= 0) return;
-  fmt::print("Checking the devices (up to {} s):\n", o.check_s);
+  std::FILE* out = o.json ? stderr : stdout;  // stdout carries only the JSON then
+  fmt::print(out, "Checking the devices (up to {} s):\n", o.check_s);
   check_devices(config, specs, std::chrono::duration<double>(o.check_s),
-                [](const std::string& line) { fmt::print("{}\n", line); });
-  std::fflush(stdout);
+                [out](const std::string& line) { fmt::print(out, "{}\n", line); });
+  std::fflush(out);
+}
+
+// Where progress and events go: stdout, or stderr when stdout carries --json. On a terminal
+// the live line is rewritten in place; into a file or a pipe each line is written whole and
+// flushed as it happens (a log that is read while the run goes on).
+struct ProgressOut {
+  std::FILE* out;
+  bool tty;
+  std::string last;  // the last progress line written to a file or pipe
+  explicit ProgressOut(bool json)
+      : out(json ? stderr : stdout), tty(::isatty(::fileno(out)) != 0) {}
+  void event(const std::string& e) {
+    fmt::print(out, "{}  {}\n", tty ? "\r\033[K" : "", e);
+    std::fflush(out);
+  }
+  // `key` names the state: a file gets a line only when it changes (run, target, phase).
+  void live(const std::string& key, const std::string& line) {
+    if (tty) {
+      fmt::print(out, "\r{}", line);
+    } else {
+      if (key == last) return;
+      last = key;
+      fmt::print(out, "{}\n", line);
+    }
+    std::fflush(out);
+  }
+};
+
+Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
+                       const nlohmann::json& result) {
+  return circle_verdict(run_context(c, "circle", plane)["tolerances"], result);
 }
 
 void run_linear(const RunOptions& o) {
@@ -88,28 +132,54 @@ void run_linear(const RunOptions& o) {
   setup.database = database_path(o.db);
   setup.capture_path = capture.absolute_path(o.capture);
   add_linear_instruments(io, config, specs, o, capture.recorder.get(), setup);
-  const bool tty = ::isatty(STDOUT_FILENO);
-  setup.on_event = [tty](const std::string& e) {
-    fmt::print("{}  {}\n", tty ? "\r\033[K" : "", e);
-  };
-  setup.on_live = [tty](const LiveState& s) {
-    if (!tty || !s.progress.next_position_mm) return;
-    fmt::print(
-        "\rrun {} of {} {}  target {} of {}  {:+9.2f} um  air {:.2f} degC  material {:.2f} degC  ",
-        s.progress.run, s.progress.runs,
-        s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down", s.progress.target,
-        s.progress.targets, s.deviation_um, s.air_temperature_degc, s.material_degc);
-    std::fflush(stdout);
+  auto progress = std::make_shared<ProgressOut>(o.json);
+  setup.on_event = [progress](const std::string& e) { progress->event(e); };
+  setup.on_live = [progress](const LiveState& s) {
+    if (!s.progress.next_position_mm) return;
+    const char* dir = s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down";
+    progress->live(
+        fmt::format("{} {} {}", s.progress.run, dir, s.progress.target),
+        fmt::format("run {} of {} {}  target {} of {}  {:+9.2f} um  air {:.2f} degC  material "
+                    "{:.2f} degC  ",
+                    s.progress.run, s.progress.runs, dir, s.progress.target, s.progress.targets,
+                    s.deviation_um, s.air_temperature_degc, s.material_degc));
   };
   LinearRun run(io, std::move(setup));
   run.start();
-  fmt::print(
+  progress->event(fmt::format(
       "Waiting for the machine: run the program from `daq gcode linear --config {}`; Enter "
-      "captures the current stop by hand; Ctrl-C stops.\n",
-      o.config);
+      "captures the current stop by hand; Ctrl-C stops.",
+      o.config));
   watch_keyboard(io, [&] { run.manual_capture(); });
   const auto& out = run_to_end(io, run, capture);
+  const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
+  const auto v = verdict_of(
+      settings ? nlohmann::json::parse(settings->settings_json, nullptr, false) : nlohmann::json(),
+      to_json(*out.evaluation));
+  if (o.json) {
+    auto j = to_json(*out.evaluation);
+    j["run_id"] = out.run_id;
+    j["status"] = cal::storage::to_string(out.status);
+    j["missed_stops"] = nlohmann::json::array();
+    for (const auto& m : out.missed)
+      j["missed_stops"].push_back({{"run", m.run_number},
+                                   {"direction", m.direction == '+' ? "up" : "down"},
+                                   {"target_index", m.target_index + 1},
+                                   {"nominal_mm", m.nominal_mm}});
+    j["verdict"] = to_json(v);
+    return fmt::print("{}\n", j.dump(2));
+  }
+  fmt::print("{}\nrun {} stored ({}): {} readings\n", progress->tty ? "\r\033[K" : "", out.run_id,
+             cal::storage::to_string(out.status), out.readings);
+  if (!out.missed.empty()) {
+    fmt::print("INCOMPLETE: {}; the evaluation uses the stops captured:\n", out.reason);
+    for (const auto& m : out.missed)
+      fmt::print("  missed run {} {} target {} ({:.3f} mm)\n", m.run_number,
+                 m.direction == '+' ? "up" : "down", m.target_index + 1, m.nominal_mm);
+  }
+  fmt::print("\n");
   print(*out.evaluation);
+  print_verdict(v);
 }
 
 // daq run circle: the ballbar streams; the run waits for the feed-in, then records both arcs.
@@ -129,29 +199,30 @@ void run_circle(const RunOptions& o) {
       .ballbar = make_instrument(io, specs[0], make_transport(io, dc),
                                  instrument_options(dc, specs[0], o, capture.recorder.get())),
       .capture_path = capture.absolute_path(o.capture)};
-  const bool tty = ::isatty(STDOUT_FILENO);
-  setup.on_event = [tty](const std::string& e) {
-    fmt::print("{}  {}\n", tty ? "\r\033[K" : "", e);
-  };
-  setup.on_live = [tty](const CircleLive& s) {
-    if (!tty) return;
-    fmt::print("\r{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  ", s.phase, s.angle_deg,
-               s.deviation_um, 100 * s.fraction);
-    std::fflush(stdout);
+  auto progress = std::make_shared<ProgressOut>(o.json);
+  setup.on_event = [progress](const std::string& e) { progress->event(e); };
+  setup.on_live = [progress](const CircleLive& s) {
+    progress->live(s.phase, fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  ", s.phase,
+                                        s.angle_deg, s.deviation_um, 100 * s.fraction));
   };
   CircleRun run(io, std::move(setup));
   run.start();
-  fmt::print(
+  progress->event(fmt::format(
       "Waiting for the feed-in: run the program from `daq gcode circle --config {}`; Ctrl-C "
-      "stops.\n",
-      o.config);
+      "stops.",
+      o.config));
   const auto& out = run_to_end(io, run, capture);
-  if (o.json)
-    return fmt::print(
-        "{}\n", circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min)
-                    .dump(2));
+  auto j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  const auto v = verdict_circle(config, analysis.plane, j);
+  if (o.json) {
+    j["run_id"] = out.run_id;
+    j["status"] = "complete";
+    j["verdict"] = to_json(v);
+    return fmt::print("{}\n", j.dump(2));
+  }
   fmt::print("\nrun {}: {} readings\n", out.run_id, out.readings);
   print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  print_verdict(v);
 }
 
 struct GcodeOptions {
@@ -169,7 +240,10 @@ void gcode(const GcodeOptions& o, bool circle) {
                                      .feed_mm_per_min = c.feed_mm_per_min,
                                      .sample_rate_hz = c.sample_rate_hz,
                                      .overshoot_deg = c.overshoot_deg},
-                                    {.centre_x_mm = c.centre_mm[0], .centre_y_mm = c.centre_mm[1]},
+                                    {.centre_x_mm = c.centre_mm[0],
+                                     .centre_y_mm = c.centre_mm[1],
+                                     .centre_z_mm = c.centre_mm[2],
+                                     .plane = cal::daq::plane_from_string(c.plane)},
                                     dialect);
   } else {
     if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
@@ -202,6 +276,9 @@ void add_run_commands(CLI::App& app) {
                   "check)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  lin->add_flag("--json", o->json,
+                "Print the result as caldaq.iso230-2.v1 JSON with run_id, status, missed_stops "
+                "and verdict (progress goes to stderr)");
   lin->callback([o] { run_linear(*o); });
   auto* circ = run->add_subcommand("circle", "ISO 230-4 circular test with a ballbar");
   circ->add_option("-c,--config", o->config, "Machine/campaign TOML with [test.circle]")
@@ -215,7 +292,9 @@ void add_run_commands(CLI::App& app) {
                    "Before the run, the ballbar must open within this time (0: no check)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  circ->add_flag("--json", o->json, "Print the result as caldaq.circle.v1 JSON");
+  circ->add_flag("--json", o->json,
+                 "Print the result as caldaq.circle.v1 JSON with run_id and verdict (progress "
+                 "goes to stderr)");
   circ->callback([o] { run_circle(*o); });
 
   auto g = std::make_shared<GcodeOptions>();

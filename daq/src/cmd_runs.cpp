@@ -5,14 +5,22 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <tuple>
 
 #include "cal/analysis/error.hpp"
+#include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
+#include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "iso230_2_output.hpp"
+#include "provenance.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -73,6 +81,63 @@ void cmd_runs(const std::string& db, bool as_json) {
                r.kind, r.axis, st::to_string(r.status), store.reading_count(r.id), r.campaign);
 }
 
+json missed_json(const st::MissedStop& m) {
+  return {{"run", m.run_number},
+          {"direction", m.direction == '+' ? "up" : "down"},
+          {"target_index", m.target_index + 1},
+          {"nominal_mm", m.nominal_mm}};
+}
+
+std::string missed_text(const st::MissedStop& m) {
+  return fmt::format("run {} {} target {} ({:.3f} mm)", m.run_number,
+                     m.direction == '+' ? "up" : "down", m.target_index + 1, m.nominal_mm);
+}
+
+// One line saying how a result was obtained, from its provenance.
+std::string provenance_text(const json& p) {
+  if (!p.is_object() || !p.contains("how")) return "provenance not recorded (stored before it was)";
+  std::string s =
+      p.value("how", "") + " " + p.value("created_utc", "") + " by " + p.value("software", "?");
+  if (p.contains("of_result") && !p["of_result"].is_null())
+    s += fmt::format(", of result {}", p["of_result"].get<std::int64_t>());
+  if (p.contains("replay_of_run"))
+    s += p["replay_of_run"].is_null()
+             ? std::string(", replay of a run not in this database")
+             : fmt::format(", replay of run {}", p["replay_of_run"].get<std::int64_t>());
+  if (const auto c = p.find("coefficients"); c != p.end())
+    s += fmt::format("; {}, {} ppm/K", c->value("equation", "?"),
+                     c->value("expansion_ppm_per_k", 0.0));
+  if (const auto o = p.find("sensor_offsets"); o != p.end()) {
+    const auto off = sensor_offsets_from_json(*o);
+    if (off.material_k || off.air_temperature_k || off.pressure_pa || off.humidity_pct)
+      s += fmt::format("; offsets material {:+g} K, air {:+g} K, {:+g} Pa, {:+g} %RH",
+                       off.material_k, off.air_temperature_k, off.pressure_pa, off.humidity_pct);
+  }
+  for (const auto& c : p.value("changed", json::array()))
+    s += fmt::format("; {} {} -> {}", c.value("name", "?"), c["from"].dump(), c["to"].dump());
+  return s;
+}
+
+// The values of a result document, as `daq analyse` prints their headline.
+void print_result_values(const json& doc) {
+  if (doc.value("schema", "") == "caldaq.iso230-2.v1") {
+    fmt::print("      {} targets, {}\n", doc.value("targets", json::array()).size(),
+               runs_text(doc));
+    const json axis = doc.value("axis", json::object());
+    for (const auto& [key, a] : axis.items())
+      fmt::print("      {:<8} {:>10.3f} um   {}\n", a.value("symbol", key),
+                 a.value("value_um", 0.0), a.value("description", ""));
+  } else if (doc.value("schema", "") == "caldaq.circle.v1") {
+    const auto iso = doc.value("iso230_4", json::object());
+    fmt::print("      G {:.3f} um (ccw {:.3f}, cw {:.3f}), H {:.3f} um, F {:+.3f} / {:+.3f} um\n",
+               iso.value("G_bi_um", 0.0), iso.value("G_ccw_um", 0.0), iso.value("G_cw_um", 0.0),
+               iso.value("H_um", 0.0), iso.value("F_max_um", 0.0), iso.value("F_min_um", 0.0));
+    for (const auto& d : doc.value("diagnostics", json::array()))
+      fmt::print("      {:<40} {:+9.3f} {:<5} PV {:.3f} um\n", d.value("name", ""),
+                 d.value("value", 0.0), d.value("unit", ""), d.value("pv_um", 0.0));
+  }
+}
+
 void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
   st::Store store(database_path(db));
   const auto r = need_run(store, id);
@@ -84,72 +149,315 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     j["instruments"].push_back(
         {{"device", i.device}, {"driver", i.driver}, {"transport", i.transport}});
   j["targets"] = store.targets(id).size();
+  const auto missed = store.missed_stops(id);
+  j["missed_stops"] = json::array();
+  for (const auto& m : missed) j["missed_stops"].push_back(missed_json(m));
   j["results"] = json::array();
+  const json& settings = j["settings"];
   for (const auto& res : store.results(id)) {
     json doc = json::parse(res.json, nullptr, false);
-    j["results"].push_back(
-        {{"standard", res.standard}, {"result", doc.is_discarded() ? json(res.json) : doc}});
+    json one{{"id", res.id},
+             {"standard", res.standard},
+             {"created", iso_time(res.created_unix_ms)},
+             {"current", res.current()},
+             {"superseded_by", res.superseded_by ? json(*res.superseded_by) : json(nullptr)},
+             {"provenance", json::parse(res.provenance_json, nullptr, false)},
+             {"result", doc.is_discarded() ? json(res.json) : doc}};
+    if (one["provenance"].is_discarded()) one["provenance"] = json::object();
+    if (!doc.is_discarded()) one["verdict"] = to_json(verdict_of(settings, doc));
+    j["results"].push_back(std::move(one));
   }
   if (as_json) return fmt::print("{}\n", j.dump(2));
   fmt::print("run {}: {} {} ({}), started {}{}\n", r.id, r.kind, r.axis, st::to_string(r.status),
              iso_time(r.started_unix_ms), r.note.empty() ? "" : " - " + r.note);
   fmt::print("  readings: {}, captured targets: {}\n", j["readings"].get<std::int64_t>(),
              j["targets"].get<std::size_t>());
+  if (!missed.empty()) {
+    fmt::print("  missed stops ({}):\n", missed.size());
+    for (const auto& m : missed) fmt::print("    {}\n", missed_text(m));
+  }
   for (const auto& i : j["instruments"])
     fmt::print("  device {}: {} on {}\n", i["device"].get<int>(), i["driver"].get<std::string>(),
                i["transport"].get<std::string>());
-  for (const auto& res : j["results"])
-    fmt::print("  result: {}\n", res["standard"].get<std::string>());
   if (!r.capture_path.empty()) fmt::print("  capture: {}\n", r.capture_path);
-}
-
-// CSV columns are documented in docs/cli.md ("daq export"); numbers are printed with 17
-// significant digits so that a round trip through the CSV is exact.
-void export_csv(const st::Store& store, std::int64_t id, const std::string& what, std::FILE* out) {
-  if (what == "targets") {
-    std::fputs(
-        "run_number,direction,target_index,nominal_mm,deviation_um,time_ns,raw_m,"
-        "refractive_index,material_temperature_degc\n",
-        out);
-    for (const auto& t : store.targets(id))
-      fmt::print(out, "{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g}\n", t.run_number,
-                 t.direction, t.target_index + 1, t.nominal_mm, t.deviation_um, t.time_ns, t.raw_m,
-                 t.refractive_index, t.material_temperature_degc);
-    return;
+  if (j["results"].empty()) fmt::print("  no results stored\n");
+  for (const auto& res : j["results"]) {
+    const bool current = res["current"].get<bool>();
+    fmt::print(
+        "  result {}: {} ({}){}\n", res["id"].get<std::int64_t>(),
+        res["standard"].get<std::string>(),
+        current ? "current"
+                : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
+        "");
+    fmt::print("    {}\n", provenance_text(res["provenance"]));
+    if (!current) continue;  // the old values stay in --json
+    print_result_values(res["result"]);
+    if (res.contains("verdict")) {
+      const auto& v = res["verdict"];
+      fmt::print("      verdict: {}{}\n", v.value("summary", ""),
+                 v.value("basis", "").empty() ? "" : " (" + v.value("basis", "") + ")");
+      for (const auto& c : v.value("checks", json::array()))
+        fmt::print("        {:<26} {:>10.3f} limit {:>8.3f} {:<5} {}\n", c.value("symbol", ""),
+                   c.value("value", 0.0), c.value("limit", 0.0), c.value("unit", ""),
+                   c.value("pass", false) ? "pass" : "FAIL");
+      for (const auto& n : v.value("notes", json::array()))
+        fmt::print("        note: {}\n", n.get<std::string>());
+    }
   }
-  std::fputs("time_ns,device,channel,quantity,status,value\n", out);
-  for (const auto& r : store.readings(id))
-    fmt::print(out, "{},{},{},{},{},{:.17g}\n", r.time_ns, r.device, r.channel,
-               cal::drivers::to_string(static_cast<cal::drivers::Quantity>(r.quantity)), r.status,
-               r.value);
 }
 
-void export_json(const st::Store& store, std::int64_t id, std::FILE* out) {
-  json j = run_json(need_run(store, id));
+// --- exports (columns documented in docs/cli.md, "daq export") -------------------------------
+
+// Numbers in the shortest form that reads back to the same double (fmt's "{}").
+std::string num(double v) { return fmt::format("{}", v); }
+
+// Every reading of the run, in time order: the one place the export reads them, so that it can
+// move to a streaming read without touching the formats.
+template <class F>
+void each_reading(const st::Store& store, std::int64_t run, F&& f) {
+  for (const auto& r : store.readings(run)) f(r);
+}
+
+using StreamKey = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;
+StreamKey key_of(const st::RawReading& r) { return {r.device, r.channel, r.quantity}; }
+
+// Times of a run for the exports: seconds from the run's start and absolute UTC, one per
+// sample. Readings of one device that came in one transport read share the time of that read;
+// they are spread back from it by the device's sample period (the configured sample rate of a
+// ballbar, else the stream's mean interval over the run), the last keeping the read's time.
+// Where that would reach back to the previous read (the reads' own timing jitters), the group
+// is spread evenly over the time since the previous read instead: times always rise.
+class ExportClock {
+ public:
+  ExportClock(const st::Store& store, const st::RunRecord& run, const json& settings) {
+    struct Span {
+      std::int64_t first = 0, last = 0;
+      std::size_t n = 0;
+    };
+    std::map<StreamKey, Span> spans;
+    bool any = false;
+    each_reading(store, run.id, [&](const st::RawReading& r) {
+      auto& sp = spans[key_of(r)];
+      if (sp.n++ == 0) sp.first = r.time_ns;
+      sp.last = r.time_ns;
+      if (!any) t0_ns_ = r.time_ns, any = true;
+    });
+    for (const auto& [k, sp] : spans)
+      period_ns_[k] =
+          sp.n > 1 ? static_cast<double>(sp.last - sp.first) / static_cast<double>(sp.n - 1) : 0.0;
+    // A ballbar's samples come at the programmed rate (device 3 of a circle run).
+    if (run.kind == "circle" && settings.is_object() && settings.value("sample_rate_hz", 0.0) > 0)
+      for (auto& [k, p] : period_ns_)
+        if (std::get<0>(k) == 3) p = 1e9 / settings.value("sample_rate_hz", 1.0);
+    if (run.origin_session_ns && run.origin_unix_ns) {
+      t0_ns_ = *run.origin_session_ns;
+      unix0_ns_ = *run.origin_unix_ns;
+    }
+  }
+  // Session times (ns, fractional) of a group of one stream's readings sharing one stored time,
+  // in order; remembers the group's time for the stream's next group.
+  std::vector<double> spread(const std::vector<st::RawReading>& group) {
+    const auto key = key_of(group.front());
+    const double read = static_cast<double>(group.front().time_ns);
+    const auto n = group.size();
+    const auto it = period_ns_.find(key);
+    double p = it == period_ns_.end() ? 0.0 : it->second;
+    const auto prev = last_ns_.find(key);
+    if (prev != last_ns_.end() && read - static_cast<double>(n - 1) * p <= prev->second)
+      p = (read - prev->second) / static_cast<double>(n);
+    std::vector<double> out(n);
+    for (std::size_t k = 0; k < n; ++k) out[k] = read - static_cast<double>(n - 1 - k) * p;
+    last_ns_[key] = read;
+    return out;
+  }
+  double seconds(double session_ns) const {
+    return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
+  }
+  // ISO 8601 UTC with microseconds, or "" when the run has no time origin (stored before it
+  // was recorded, or imported).
+  std::string utc(double session_ns) const {
+    if (!unix0_ns_) return "";
+    const auto ns = *unix0_ns_ + static_cast<std::int64_t>(
+                                     std::llround(session_ns - static_cast<double>(t0_ns_)));
+    const std::int64_t us = ns >= 0 ? ns / 1000 : (ns - 999) / 1000;
+    const std::time_t s =
+        static_cast<std::time_t>(us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000);
+    std::tm tm{};
+    gmtime_r(&s, &tm);
+    std::array<char, 32> buf{};
+    std::strftime(buf.data(), buf.size(), "%Y-%m-%dT%H:%M:%S", &tm);
+    return fmt::format("{}.{:06d}Z", buf.data(), us - static_cast<std::int64_t>(s) * 1'000'000);
+  }
+  bool has_utc() const { return unix0_ns_.has_value(); }
+
+ private:
+  std::map<StreamKey, double> period_ns_;
+  std::map<StreamKey, double> last_ns_;  // the time of each stream's last group
+  std::int64_t t0_ns_ = 0;
+  std::optional<std::int64_t> unix0_ns_;
+};
+
+// One exported reading (after the time spreading).
+struct ExportRow {
+  st::RawReading r;
+  double session_ns = 0;
+};
+
+// Walks the readings and hands them on with their spread times; a group of one stream's
+// readings with one stored time is held until the stream's next time shows how many it has.
+template <class F>
+void each_export_row(const st::Store& store, std::int64_t run, ExportClock& clock, F&& f) {
+  std::map<StreamKey, std::vector<st::RawReading>> pending;
+  const auto flush = [&](std::vector<st::RawReading>& group) {
+    if (group.empty()) return;
+    const auto times = clock.spread(group);
+    for (std::size_t k = 0; k < group.size(); ++k) f(ExportRow{group[k], times[k]});
+    group.clear();
+  };
+  // Readings come in time order: a group is complete when any later time arrives.
+  std::int64_t current = 0;
+  bool first = true;
+  each_reading(store, run, [&](const st::RawReading& r) {
+    if (!first && r.time_ns != current)
+      for (auto& [k, g] : pending) flush(g);
+    first = false;
+    current = r.time_ns;
+    pending[key_of(r)].push_back(r);
+  });
+  for (auto& [k, g] : pending) flush(g);
+}
+
+std::map<int, std::string> device_names(const st::Store& store, std::int64_t run) {
+  std::map<int, std::string> names;
+  for (const auto& i : store.instruments(run)) names[i.device] = i.driver;
+  return names;
+}
+
+// A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+constexpr const char* kReadingColumns =
+    "time_s,utc,device,device_name,channel,quantity,status,value,time_ns";
+constexpr const char* kTargetColumns =
+    "target_mm,run,direction,deviation_um,target_index,time_s,utc,raw_m,refractive_index,"
+    "material_temperature_degc";
+
+void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
+                         std::FILE* out) {
+  ExportClock clock(store, run, settings);
+  const auto names = device_names(store, run.id);
+  fmt::print(out, "{}\n", kReadingColumns);
+  each_export_row(store, run.id, clock, [&](const ExportRow& x) {
+    const auto it = names.find(x.r.device);
+    fmt::print(out, "{},{},{},{},{},{},{},{},{}\n", num(clock.seconds(x.session_ns)),
+               clock.utc(x.session_ns), x.r.device, csv_field(it == names.end() ? "" : it->second),
+               x.r.channel,
+               cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
+               x.r.status, num(x.r.value), x.r.time_ns);
+  });
+}
+
+void export_targets_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
+                        std::FILE* out) {
+  if (run.kind != "linear")
+    throw cal::InputError(
+        fmt::format("run {} is a {} test and has no captured stops: use --what {} (or readings)",
+                    run.id, run.kind, run.kind == "circle" ? "circle" : "readings"));
+  const ExportClock clock(store, run, settings);
+  // The header is what `daq analyse iso230-2 --input` reads (target_mm, run, direction,
+  // deviation_um); the rest it ignores.
+  fmt::print(out, "{}\n", kTargetColumns);
+  for (const auto& t : store.targets(run.id)) {
+    const auto at = static_cast<double>(t.time_ns);
+    fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,
+               t.direction == '+' ? "up" : "down", num(t.deviation_um), t.target_index + 1,
+               num(clock.seconds(at)), clock.utc(at), num(t.raw_m), num(t.refractive_index),
+               num(t.material_temperature_degc));
+  }
+}
+
+// The two traces of a ballbar run as `daq analyse circle --input` reads them: direction,
+// angle_deg, deviation_um (from the bar's calibrated length), segmented by the run's program.
+void export_circle_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
+                       std::FILE* out) {
+  if (run.kind != "circle")
+    throw cal::InputError(fmt::format(
+        "run {} is a {} test, not a circle: use --what targets or readings", run.id, run.kind));
+  if (!settings.is_object() || !settings.contains("radius_mm"))
+    throw cal::InputError(fmt::format("run {}: its circle settings are missing", run.id));
+  const auto [program, analysis] = circle_settings_from_json(settings);
+  cal::daq::BallbarSegmenter segmenter(program);
+  each_reading(store, run.id, [&](const st::RawReading& r) {
+    if (r.quantity == static_cast<std::uint8_t>(cal::drivers::Quantity::length_m))
+      segmenter.add(r.value * 1e3);
+  });
+  const auto traces = segmenter.traces();
+  if (traces.empty())
+    throw cal::InputError(
+        fmt::format("run {}: the stored bar readings hold no complete arc", run.id));
+  std::string options =
+      fmt::format("--radius-mm {} --feed-mm-min {} --plane {}", num(program.radius_mm),
+                  num(program.feed_mm_per_min), analysis.plane);
+  if (analysis.calibrated_radius_mm)
+    options += fmt::format(" --calibrated-radius-mm {}", num(*analysis.calibrated_radius_mm));
+  if (analysis.uncalibrated) options += " --uncalibrated";
+  if (analysis.cyclic_period_mm)
+    options += fmt::format(" --cyclic-period-mm {}", num(*analysis.cyclic_period_mm));
+  fmt::print(out,
+             "# caldaq run {}: ballbar circle, analyse with: daq analyse circle --input FILE {}\n",
+             run.id, options);
+  fmt::print(out, "direction,angle_deg,deviation_um\n");
+  for (const auto& t : traces) {
+    const char* dir = t.direction == cal::circle::Direction::ccw ? "ccw" : "cw";
+    for (std::size_t i = 0; i < t.angle_deg.size(); ++i)
+      fmt::print(out, "{},{},{}\n", dir, num(t.angle_deg[i]), num(t.deviation_um[i]));
+  }
+}
+
+void export_json(const st::Store& store, const st::RunRecord& run, const json& settings,
+                 std::FILE* out) {
+  json j = run_json(run);
   j["schema"] = "caldaq.export.v1";
+  ExportClock clock(store, run, settings);
+  const auto names = device_names(store, run.id);
   json readings = json::array();
-  for (const auto& r : store.readings(id))
-    readings.push_back({r.time_ns, r.device, r.channel,
-                        cal::drivers::to_string(static_cast<cal::drivers::Quantity>(r.quantity)),
-                        r.status, r.value});
-  j["reading_columns"] = {"time_ns", "device", "channel", "quantity", "status", "value"};
+  each_export_row(store, run.id, clock, [&](const ExportRow& x) {
+    const auto it = names.find(x.r.device);
+    readings.push_back({clock.seconds(x.session_ns), clock.utc(x.session_ns), x.r.device,
+                        it == names.end() ? "" : it->second, x.r.channel,
+                        cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
+                        x.r.status, x.r.value, x.r.time_ns});
+  });
+  j["reading_columns"] = {"time_s",   "utc",    "device", "device_name", "channel",
+                          "quantity", "status", "value",  "time_ns"};
   j["readings"] = std::move(readings);
   json targets = json::array();
-  for (const auto& t : store.targets(id))
-    targets.push_back({{"run_number", t.run_number},
-                       {"direction", std::string(1, t.direction)},
-                       {"target_index", t.target_index + 1},
-                       {"nominal_mm", t.nominal_mm},
+  for (const auto& t : store.targets(run.id))
+    targets.push_back({{"target_mm", t.nominal_mm},
+                       {"run", t.run_number},
+                       {"direction", t.direction == '+' ? "up" : "down"},
                        {"deviation_um", t.deviation_um},
-                       {"time_ns", t.time_ns},
+                       {"target_index", t.target_index + 1},
+                       {"time_s", clock.seconds(static_cast<double>(t.time_ns))},
+                       {"utc", clock.utc(static_cast<double>(t.time_ns))},
                        {"raw_m", t.raw_m},
                        {"refractive_index", t.refractive_index},
                        {"material_temperature_degc", t.material_temperature_degc}});
   j["targets"] = std::move(targets);
+  j["missed_stops"] = json::array();
+  for (const auto& m : store.missed_stops(run.id)) j["missed_stops"].push_back(missed_json(m));
   j["results"] = json::array();
-  for (const auto& res : store.results(id))
-    j["results"].push_back(
-        {{"standard", res.standard}, {"result", json::parse(res.json, nullptr, false)}});
+  for (const auto& res : store.results(run.id))
+    j["results"].push_back({{"id", res.id},
+                            {"standard", res.standard},
+                            {"current", res.current()},
+                            {"provenance", json::parse(res.provenance_json, nullptr, false)},
+                            {"result", json::parse(res.json, nullptr, false)}});
   fmt::print(out, "{}\n", j.dump(1));
 }
 
@@ -163,7 +471,7 @@ struct ExportOptions {
 
 void cmd_export(const ExportOptions& o) {
   st::Store store(database_path(o.db));
-  need_run(store, o.run);
+  need_run(store, o.run);  // before a file is created
   std::FILE* out = stdout;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
   if (!o.output.empty()) {
@@ -172,10 +480,16 @@ void cmd_export(const ExportOptions& o) {
       throw cal::InputError(fmt::format("{}: cannot write: {}", o.output, std::strerror(errno)));
     out = file.get();
   }
+  const auto run = need_run(store, o.run);
+  const json settings = json::parse(run.settings_json, nullptr, false);
   if (o.format == "json")
-    export_json(store, o.run, out);
+    export_json(store, run, settings, out);
+  else if (o.what == "targets")
+    export_targets_csv(store, run, settings, out);
+  else if (o.what == "circle")
+    export_circle_csv(store, run, settings, out);
   else
-    export_csv(store, o.run, o.what, out);
+    export_readings_csv(store, run, settings, out);
   if (std::ferror(out))
     throw cal::InputError(fmt::format("{}: write failed", o.output.empty() ? "stdout" : o.output));
 }
@@ -204,8 +518,11 @@ void add_runs_commands(CLI::App& app) {
   exp->add_option("RUN", ex->run, "Run number (see daq runs)")->required();
   add_db_option(*exp, ex->db);
   exp->add_option("--format", ex->format, "csv or json")->check(CLI::IsMember({"csv", "json"}));
-  exp->add_option("--what", ex->what, "CSV only: readings (raw, uncompensated) or targets")
-      ->check(CLI::IsMember({"readings", "targets"}));
+  exp->add_option("--what", ex->what,
+                  "CSV only: readings (raw, uncompensated), targets (a linear run's stops, as daq "
+                  "analyse iso230-2 reads them) or circle (a circle run's traces, as daq analyse "
+                  "circle reads them)")
+      ->check(CLI::IsMember({"readings", "targets", "circle"}));
   exp->add_option("-o,--output", ex->output, "Write to this file instead of stdout");
   exp->callback([ex] { cmd_export(*ex); });
 }

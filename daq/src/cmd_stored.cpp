@@ -1,6 +1,7 @@
 // Analysis of stored runs: daq analyse RUN --standard ..., daq recompensate RUN ...
 #include <fmt/format.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -13,6 +14,8 @@
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
+#include "provenance.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -44,7 +47,7 @@ struct AnalyseRunOptions {
 // A stored ballbar run again from its raw bar readings, with the analysis settings it was
 // run with unless corrected here (the calibrated length of the bar, the cyclic period).
 void analyse_circle_run(st::Store& store, const st::RunRecord& run, const AnalyseRunOptions& o) {
-  const json settings = json::parse(run.settings_json, nullptr, false);
+  json settings = json::parse(run.settings_json, nullptr, false);
   if (settings.is_discarded() || !settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("run {}: its circle settings are missing", o.run));
   auto [program, analysis] = circle_settings_from_json(settings);
@@ -62,10 +65,21 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
     throw cal::InputError(
         fmt::format("run {} ({} bar readings stored): {}", o.run, bar_mm.size(), e.what()));
   }
-  const auto j = circle_json(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
-  if (o.store) store.add_result({.run_id = o.run, .standard = "ISO 230-4:2005", .json = j.dump()});
+  auto j = circle_json(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  if (o.store) {
+    json prov = provenance("reanalysed", software_version);
+    prov["analysis"] = circle_settings_json(program, analysis);
+    const auto id = store.add_result({.run_id = o.run,
+                                      .standard = "ISO 230-4:2005",
+                                      .json = j.dump(),
+                                      .provenance_json = prov.dump()});
+    j["result_id"] = id;
+  }
+  const auto v = verdict_of(settings, j);
+  j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", j.dump(2));
   print_circle(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  print_verdict(v);
 }
 
 void analyse_run(const AnalyseRunOptions& o) {
@@ -77,39 +91,73 @@ void analyse_run(const AnalyseRunOptions& o) {
   if (targets.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
   const auto e = cal::iso230_2::evaluate(measurements(targets),
                                          cal::iso230_2::standard_from_string(o.standard));
-  if (o.store)
-    store.add_result(
-        {.run_id = o.run, .standard = std::string(e.standard.title), .json = to_json(e).dump()});
-  if (o.json) return fmt::print("{}\n", to_json(e).dump(2));
+  json j = to_json(e);
+  if (o.store) {
+    // The stops' deviations are as compensated for the current result: the same coefficients.
+    const json settings = json::parse(run->settings_json, nullptr, false);
+    const auto used = compensation_used(settings, store.results(o.run));
+    json prov = provenance("reanalysed", software_version);
+    prov["standard"] = o.standard;
+    prov["coefficients"] = used.coefficients;
+    prov["sensor_offsets"] = to_json(used.offsets);
+    if (used.result_id) prov["of_result"] = *used.result_id;
+    j["result_id"] = store.add_result({.run_id = o.run,
+                                       .standard = std::string(e.standard.title),
+                                       .json = j.dump(),
+                                       .provenance_json = prov.dump()});
+  }
+  const auto v = verdict_of(json::parse(run->settings_json, nullptr, false), j);
+  j["verdict"] = to_json(v);
+  if (o.json) return fmt::print("{}\n", j.dump(2));
   print(e);
+  print_verdict(v);
 }
 
 struct RecompensateOptions {
   std::string db;
   std::int64_t run = 0;
   std::optional<double> alpha_ppm_per_k;
-  double material_offset_k = 0.0, air_temperature_offset_k = 0.0;
-  double pressure_offset_pa = 0.0, humidity_offset_pct = 0.0;
+  // Unset: as the current result used them (0 for a run never re-compensated).
+  std::optional<double> material_offset_k, air_temperature_offset_k;
+  std::optional<double> pressure_offset_pa, humidity_offset_pct;
   std::optional<std::string> equation;
   bool json = false;
 };
 
 // Re-runs the environmental compensation of every captured stop from the stored raw laser
-// value and the stored (uncompensated) environment readings, with the corrections applied,
-// then re-evaluates and stores the new targets and result. The raw data are not changed.
+// value and the stored (uncompensated) environment readings, then re-evaluates and stores the
+// new deviations with the new result, which supersedes the earlier ones (they stay stored).
+// It starts from what the current result used (coefficients and sensor offsets, from its
+// provenance): the options given replace those values, the others are kept, and the result's
+// provenance says which result it re-compensates and what changed. The raw data do not change.
 void recompensate(const RecompensateOptions& o) {
+  // A correction must be a finite number (the option parser takes "nan" and "inf").
+  for (const auto& [name, value] :
+       {std::pair{"--alpha-ppm", o.alpha_ppm_per_k},
+        std::pair{"--material-offset", o.material_offset_k},
+        std::pair{"--air-temperature-offset", o.air_temperature_offset_k},
+        std::pair{"--pressure-offset", o.pressure_offset_pa},
+        std::pair{"--humidity-offset", o.humidity_offset_pct}})
+    if (value && !std::isfinite(*value))
+      throw cal::InputError(fmt::format("recompensate: {} {}: not a finite number", name, *value));
   st::Store store(database_path(o.db));
   const auto run = linear_run(store, o.run);
   json settings = json::parse(run.settings_json, nullptr, false);
   if (settings.is_discarded() || !settings.contains("environment"))
     throw cal::InputError(fmt::format("run {}: its stored settings lack the environment", o.run));
-  const auto& env = settings["environment"];
+  const auto used = compensation_used(settings, store.results(o.run));
   cal::daq::EnvironmentConfig cfg;
-  cfg.equation = o.equation.value_or(env.value("equation", "ciddor"));
-  cfg.expansion_ppm_per_k = o.alpha_ppm_per_k.value_or(env.value("expansion_ppm_per_k", 11.5));
-  cfg.co2_umol_per_mol = env.value("co2_umol_per_mol", 450.0);
-  cfg.wavelength_nm = env.value("wavelength_nm", 632.991);
+  cfg.equation = o.equation.value_or(used.coefficients.value("equation", "ciddor"));
+  cfg.expansion_ppm_per_k =
+      o.alpha_ppm_per_k.value_or(used.coefficients.value("expansion_ppm_per_k", 11.5));
+  cfg.co2_umol_per_mol = used.coefficients.value("co2_umol_per_mol", 450.0);
+  cfg.wavelength_nm = used.coefficients.value("wavelength_nm", 632.991);
   cfg.stale_after_s = 1e9;  // every stored sample counts; staleness was judged during the run
+  const SensorOffsets off{
+      .material_k = o.material_offset_k.value_or(used.offsets.material_k),
+      .air_temperature_k = o.air_temperature_offset_k.value_or(used.offsets.air_temperature_k),
+      .pressure_pa = o.pressure_offset_pa.value_or(used.offsets.pressure_pa),
+      .humidity_pct = o.humidity_offset_pct.value_or(used.offsets.humidity_pct)};
   const double datum_mm = settings.value("datum_mm", 0.0);
 
   // The environment as recorded, with the sensor corrections.
@@ -125,19 +173,16 @@ void recompensate(const RecompensateOptions& o) {
     switch (static_cast<Q>(r.quantity)) {
       case Q::air_temperature_degc:
         stage.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc,
-                      r.value + o.air_temperature_offset_k);
+                      r.value + off.air_temperature_k);
         break;
       case Q::air_pressure_pa:
-        stage.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa,
-                      r.value + o.pressure_offset_pa);
+        stage.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa, r.value + off.pressure_pa);
         break;
       case Q::air_humidity_pct:
-        stage.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct,
-                      r.value + o.humidity_offset_pct);
+        stage.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value + off.humidity_pct);
         break;
       case Q::material_temperature_degc:
-        if (r.device >= 2)
-          stage.add_material(r.time_ns, r.device - 2, r.value + o.material_offset_k);
+        if (r.device >= 2) stage.add_material(r.time_ns, r.device - 2, r.value + off.material_k);
         break;
       default:
         break;
@@ -153,25 +198,56 @@ void recompensate(const RecompensateOptions& o) {
     t.refractive_index = c.n;
     t.material_temperature_degc = c.material_degc;
   }
-  store.replace_targets(o.run, targets);
-  const auto standard =
-      cal::iso230_2::standard_from_string(settings.value("standard", "iso230-2:2014"));
-  const auto e = cal::iso230_2::evaluate(measurements(targets), standard);
+  const std::string standard_key = settings.value("standard", "iso230-2:2014");
+  const auto e = cal::iso230_2::evaluate(measurements(targets),
+                                         cal::iso230_2::standard_from_string(standard_key));
+  // What changed, value by value, against what the current result used.
+  json changed = json::array();
+  const auto change = [&](const char* name, const json& from, const json& to) {
+    if (from != to) changed.push_back({{"name", name}, {"from", from}, {"to", to}});
+  };
+  change("equation", used.coefficients.value("equation", "ciddor"), cfg.equation);
+  change("expansion_ppm_per_k", used.coefficients.value("expansion_ppm_per_k", 11.5),
+         cfg.expansion_ppm_per_k);
+  change("material_offset_k", used.offsets.material_k, off.material_k);
+  change("air_temperature_offset_k", used.offsets.air_temperature_k, off.air_temperature_k);
+  change("pressure_offset_pa", used.offsets.pressure_pa, off.pressure_pa);
+  change("humidity_offset_pct", used.offsets.humidity_pct, off.humidity_pct);
   json doc = to_json(e);
   doc["recompensation"] = {{"equation", cfg.equation},
                            {"expansion_ppm_per_k", cfg.expansion_ppm_per_k},
-                           {"material_offset_k", o.material_offset_k},
-                           {"air_temperature_offset_k", o.air_temperature_offset_k},
-                           {"pressure_offset_pa", o.pressure_offset_pa},
-                           {"humidity_offset_pct", o.humidity_offset_pct},
+                           {"material_offset_k", off.material_k},
+                           {"air_temperature_offset_k", off.air_temperature_k},
+                           {"pressure_offset_pa", off.pressure_pa},
+                           {"humidity_offset_pct", off.humidity_pct},
                            {"max_change_um", max_change_um}};
-  store.add_result({.run_id = o.run,
-                    .standard = std::string(e.standard.title) + " (recompensated)",
-                    .json = doc.dump()});
+  json prov = provenance("recompensated", software_version);
+  prov["standard"] = standard_key;
+  prov["coefficients"] = compensation_json(cfg);
+  prov["sensor_offsets"] = to_json(off);
+  prov["of_result"] = used.result_id ? json(*used.result_id) : json(nullptr);
+  prov["changed"] = changed;
+  prov["max_change_um"] = max_change_um;
+  const auto id = store.replace_targets(o.run, targets,
+                                        {.run_id = o.run,
+                                         .standard = std::string(e.standard.title),
+                                         .json = doc.dump(),
+                                         .provenance_json = prov.dump()});
+  doc["result_id"] = id;
+  doc["provenance"] = prov;
+  const auto v = verdict_of(settings, doc);
+  doc["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", doc.dump(2));
-  fmt::print("run {}: {} stops recompensated (largest change {:.3f} um), result stored\n\n", o.run,
-             targets.size(), max_change_um);
+  fmt::print("run {}: {} stops recompensated (largest change {:.3f} um), stored as result {}",
+             o.run, targets.size(), max_change_um, id);
+  if (used.result_id) fmt::print(", superseding result {}", *used.result_id);
+  fmt::print("\n");
+  if (changed.empty()) fmt::print("  nothing changed: the same coefficients and offsets again\n");
+  for (const auto& c : changed)
+    fmt::print("  {}: {} -> {}\n", c["name"].get<std::string>(), c["from"].dump(), c["to"].dump());
+  fmt::print("\n");
   print(e);
+  print_verdict(v);
 }
 
 }  // namespace
@@ -209,14 +285,18 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
       "coefficients or sensor offsets, re-evaluate it and store the result");
   cmd->add_option("RUN", r->run, "Run number")->required();
   add_db_option(*cmd, r->db);
-  cmd->add_option("--alpha-ppm", r->alpha_ppm_per_k, "Corrected expansion coefficient, ppm/K");
+  cmd->add_option("--alpha-ppm", r->alpha_ppm_per_k,
+                  "Corrected expansion coefficient, ppm/K (default: as the current result)");
   cmd->add_option("--material-offset", r->material_offset_k,
-                  "Add to every material temperature, K");
+                  "Add to every stored material temperature, K (replaces the current offset)");
   cmd->add_option("--air-temperature-offset", r->air_temperature_offset_k,
-                  "Add to the air temperature, K");
-  cmd->add_option("--pressure-offset", r->pressure_offset_pa, "Add to the pressure, Pa");
-  cmd->add_option("--humidity-offset", r->humidity_offset_pct, "Add to the humidity, %RH");
-  cmd->add_option("--equation", r->equation, "ciddor, edlen or shop-floor");
+                  "Add to the stored air temperature, K (replaces the current offset)");
+  cmd->add_option("--pressure-offset", r->pressure_offset_pa,
+                  "Add to the stored pressure, Pa (replaces the current offset)");
+  cmd->add_option("--humidity-offset", r->humidity_offset_pct,
+                  "Add to the stored humidity, %RH (replaces the current offset)");
+  cmd->add_option("--equation", r->equation, "ciddor, edlen or shop-floor (default: as current)")
+      ->check(CLI::IsMember({"ciddor", "edlen", "shop-floor"}));
   cmd->add_flag("--json", r->json, "Print the result JSON");
   cmd->callback([r] { recompensate(*r); });
 }

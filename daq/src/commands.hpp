@@ -33,5 +33,7 @@ void add_compensate_commands(CLI::App& app, CLI::App& analyse);
 void add_serve_command(CLI::App& app);
 // report: HTML/PDF reports of stored runs
 void add_report_command(CLI::App& app);
+// model show|map|compensate|testpiece: the machine model file
+void add_model_commands(CLI::App& app);
 
 }  // namespace daq

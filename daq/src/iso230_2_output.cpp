@@ -35,8 +35,46 @@ nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
     j["axis"][a.key] = {
         {"symbol", a.symbol}, {"description", a.description}, {"value_um", a.value_um}};
   }
+  j["runs_text"] = runs_text(e);
   j["warnings"] = e.warnings;
+  j["notes"] = e.notes;
   return j;
+}
+
+std::string runs_text(const nlohmann::json& doc) {
+  int lo = 1 << 30, hi = 0;
+  std::vector<std::string> fewer;
+  const bool bi = doc.value("bidirectional", true);
+  const auto targets = doc.value("targets", nlohmann::json::array());
+  for (const auto& t : targets)
+    for (const char* key : {"runs_up", "runs_down"})
+      if (t.contains(key))
+        lo = std::min(lo, t[key].get<int>()), hi = std::max(hi, t[key].get<int>());
+  if (hi == 0) return fmt::format("{} runs per direction", doc.value("runs_per_direction", 0));
+  if (lo == hi) return fmt::format("{} runs per direction", hi);
+  for (const auto& t : targets)
+    for (const char* key : {"runs_up", "runs_down"})
+      if (t.contains(key) && t[key].get<int>() < hi)
+        fewer.push_back(fmt::format("{} at {:.3f} mm {}", t[key].get<int>(),
+                                    t.value("target_mm", 0.0),
+                                    !bi                                  ? ""
+                                    : std::string_view(key) == "runs_up" ? "up"
+                                                                         : "down"));
+  return fmt::format("{} to {} runs per direction ({} at every other target and direction; {})", lo,
+                     hi, hi, fmt::join(fewer, ", "));
+}
+
+std::string runs_text(const cal::iso230_2::Evaluation& e) {
+  nlohmann::json j;
+  j["bidirectional"] = e.bidirectional;
+  j["runs_per_direction"] = e.runs;
+  j["targets"] = nlohmann::json::array();
+  for (const auto& t : e.targets) {
+    nlohmann::json tj{{"target_mm", t.target_mm}, {"runs_up", t.runs_up}};
+    if (e.bidirectional) tj["runs_down"] = t.runs_down;
+    j["targets"].push_back(tj);
+  }
+  return runs_text(j);
 }
 
 nlohmann::json to_json(const cal::iso230_2::Plan& p) {
@@ -55,6 +93,7 @@ nlohmann::json to_json(const cal::iso230_2::Plan& p) {
                           {"position_mm", m.position_mm}});
   }
   j["warnings"] = p.warnings;
+  j["notes"] = p.notes;
   return j;
 }
 
@@ -74,7 +113,7 @@ nlohmann::json to_json(const cal::unc::Budget& b) {
 
 void print(const cal::iso230_2::Evaluation& e) {
   fmt::print("{} ({})\n", e.standard.title, e.standard.note);
-  fmt::print("{} targets, {} runs per direction, {}\n\n", e.targets.size(), e.runs,
+  fmt::print("{} targets, {}, {}\n\n", e.targets.size(), runs_text(e),
              e.bidirectional ? "bidirectional" : "unidirectional");
   fmt::print("{:>12}", "target/mm");
   for (const auto& p : e.per_target) fmt::print(" {:>9}", p.symbol);
@@ -89,6 +128,7 @@ void print(const cal::iso230_2::Evaluation& e) {
     fmt::print("  {:<8} {:>10.3f} um   {}\n", a.symbol, a.value_um, a.description);
   }
   for (const auto& w : e.warnings) fmt::print("warning: {}\n", w);
+  for (const auto& n : e.notes) fmt::print("note: {}\n", n);
 }
 
 void print(const cal::unc::Budget& b, double length_m) {

@@ -12,6 +12,10 @@ nlohmann::json to_json(const cal::iso230_2::Evaluation& e);  // schema caldaq.is
 nlohmann::json to_json(const cal::iso230_2::Plan& p);        // schema caldaq.plan.v1
 nlohmann::json to_json(const cal::unc::Budget& b);
 void print(const cal::iso230_2::Evaluation& e);
+// "5 runs per direction", or where targets differ "4 to 5 runs per direction (4: 100.000 mm
+// up, ...)": the evaluation's `runs` is the smallest, which alone would misstate the others.
+std::string runs_text(const cal::iso230_2::Evaluation& e);
+std::string runs_text(const nlohmann::json& evaluation);  // from a caldaq.iso230-2.v1 document
 void print(const cal::unc::Budget& b, double length_m);
 // The stored captured stops of a run as the deviations ISO 230-2 evaluates.
 std::vector<cal::iso230_2::Measurement> measurements(

@@ -1,4 +1,4 @@
-// Configurable line gauge codec (see codec/line_gauge.hpp).
+// Configurable line gauge codec (see line_gauge/codec.hpp).
 #include "line_gauge/codec.hpp"
 
 #include <fmt/format.h>

@@ -1,4 +1,4 @@
-// Line gauges and serial thermometers (codec: codec/line_gauge.hpp).
+// Line gauges and serial thermometers (codec: line_gauge/codec.hpp).
 #include "line_gauge/instrument.hpp"
 
 #include "instrument_core.hpp"

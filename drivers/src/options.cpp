@@ -30,6 +30,7 @@ std::string unescape(std::string s) {
 
 // "must be >= 0", "must be <= 2", "must be within [0, 2]"; empty when in range.
 std::string range_error(const OptionSpec& spec, double v) {
+  if (!std::isfinite(v)) return fmt::format("{} is not a finite number", v);
   const bool low = spec.min && v < *spec.min, high = spec.max && v > *spec.max;
   if (!low && !high && std::isfinite(v)) return {};
   if (spec.min && spec.max)

@@ -1,4 +1,4 @@
-// PCsensor TEMPer codec (see codec/temper.hpp).
+// PCsensor TEMPer codec (see temper/codec.hpp).
 #include "temper/codec.hpp"
 
 #include <fmt/format.h>

@@ -105,6 +105,28 @@ CREATE TABLE results(
   json TEXT NOT NULL,
   created_unix_ms INTEGER NOT NULL);
 )sql",
+    // 1 -> 2: what makes a result traceable (docs/storage.md): its provenance and whether a
+    // later result superseded it; the planned stops a run never captured; the run's time
+    // origin. Results already stored: a later result of the same standard, or a later
+    // re-compensation, supersedes an earlier one.
+    R"sql(
+ALTER TABLE results ADD COLUMN provenance_json TEXT NOT NULL DEFAULT '{}';
+ALTER TABLE results ADD COLUMN superseded_by INTEGER REFERENCES results(id);
+UPDATE results SET superseded_by = (
+  SELECT MIN(later.id) FROM results AS later
+  WHERE later.run_id = results.run_id AND later.id > results.id
+    AND (later.standard = results.standard OR later.standard LIKE '%(recompensated)'));
+CREATE INDEX results_by_run ON results(run_id, id);
+CREATE TABLE missed_stops(
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  run_number INTEGER NOT NULL,
+  direction TEXT NOT NULL CHECK(direction IN ('+', '-')),
+  target_index INTEGER NOT NULL,
+  nominal_mm REAL NOT NULL,
+  PRIMARY KEY(run_id, run_number, direction, target_index));
+ALTER TABLE runs ADD COLUMN origin_session_ns INTEGER;
+ALTER TABLE runs ADD COLUMN origin_unix_ns INTEGER;
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -151,6 +173,7 @@ struct Store::Impl {
   }
 
   void insert_targets(std::span<const CapturedTarget> targets);
+  std::int64_t insert_result(const ResultRecord& r, Supersede how);
 
   // A transaction that rolls back unless committed (RAII), so a failed batch leaves the
   // database as it was before the batch, never half-written.
@@ -319,7 +342,8 @@ void Store::set_capture_path(std::int64_t run_id, std::string_view path) {
 namespace {
 constexpr const char* kRunColumns =
     "SELECT id, IFNULL(machine_id, 0), campaign, kind, axis, settings_json, capture_path, "
-    "software_version, started_unix_ms, ended_unix_ms, status, note FROM runs";
+    "software_version, started_unix_ms, ended_unix_ms, status, note, origin_session_ns, "
+    "origin_unix_ns FROM runs";
 
 RunRecord read_run(sqlite3_stmt* s) {
   RunRecord r;
@@ -335,6 +359,8 @@ RunRecord read_run(sqlite3_stmt* s) {
   if (sqlite3_column_type(s, 9) != SQLITE_NULL) r.ended_unix_ms = sqlite3_column_int64(s, 9);
   r.status = status_from(column_text(s, 10));
   r.note = column_text(s, 11);
+  if (sqlite3_column_type(s, 12) != SQLITE_NULL) r.origin_session_ns = sqlite3_column_int64(s, 12);
+  if (sqlite3_column_type(s, 13) != SQLITE_NULL) r.origin_unix_ns = sqlite3_column_int64(s, 13);
   return r;
 }
 }  // namespace
@@ -515,25 +541,110 @@ std::vector<CapturedTarget> Store::targets(std::int64_t run_id) const {
   return out;
 }
 
-void Store::add_result(const ResultRecord& r) {
-  auto s = impl_->prepare(
-      "INSERT INTO results(run_id, standard, json, created_unix_ms) VALUES(?, ?, ?, ?)");
+std::int64_t Store::Impl::insert_result(const ResultRecord& r, Supersede how) {
+  auto s = prepare(
+      "INSERT INTO results(run_id, standard, json, created_unix_ms, provenance_json) "
+      "VALUES(?, ?, ?, ?, ?)");
   sqlite3_bind_int64(s.get(), 1, r.run_id);
   bind_text(s.get(), 2, r.standard);
   bind_text(s.get(), 3, r.json);
   sqlite3_bind_int64(s.get(), 4, r.created_unix_ms ? r.created_unix_ms : unix_ms_now());
-  impl_->step_done(s.get(), fmt::format("store result of run {}", r.run_id));
+  bind_text(s.get(), 5, r.provenance_json.empty() ? std::string_view("{}") : r.provenance_json);
+  step_done(s.get(), fmt::format("store result of run {}", r.run_id));
+  const std::int64_t id = sqlite3_last_insert_rowid(db.get());
+  if (how == Supersede::none) return id;
+  auto u = prepare(how == Supersede::all
+                       ? "UPDATE results SET superseded_by = ? WHERE run_id = ? AND id <> ? AND "
+                         "superseded_by IS NULL"
+                       : "UPDATE results SET superseded_by = ? WHERE run_id = ? AND id <> ? AND "
+                         "superseded_by IS NULL AND standard = ?");
+  sqlite3_bind_int64(u.get(), 1, id);
+  sqlite3_bind_int64(u.get(), 2, r.run_id);
+  sqlite3_bind_int64(u.get(), 3, id);
+  if (how == Supersede::same_standard) bind_text(u.get(), 4, r.standard);
+  step_done(u.get(), fmt::format("mark the results of run {} superseded", r.run_id));
+  return id;
+}
+
+std::int64_t Store::add_result(const ResultRecord& r, Supersede how) {
+  Impl::Transaction tx(*impl_);
+  const auto id = impl_->insert_result(r, how);
+  tx.commit();
+  return id;
+}
+
+std::int64_t Store::replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets,
+                                    const ResultRecord& result) {
+  Impl::Transaction tx(*impl_);
+  auto s = impl_->prepare("DELETE FROM captured_targets WHERE run_id = ?");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  impl_->step_done(s.get(), "delete targets");
+  impl_->insert_targets(targets);
+  const auto id = impl_->insert_result(result, Supersede::all);
+  tx.commit();
+  return id;
 }
 
 std::vector<ResultRecord> Store::results(std::int64_t run_id) const {
   auto s = impl_->prepare(
-      "SELECT run_id, standard, json, created_unix_ms FROM results WHERE run_id = ? ORDER BY id");
+      "SELECT run_id, standard, json, created_unix_ms, provenance_json, id, superseded_by "
+      "FROM results WHERE run_id = ? ORDER BY id");
   sqlite3_bind_int64(s.get(), 1, run_id);
   std::vector<ResultRecord> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW)
-    out.push_back({sqlite3_column_int64(s.get(), 0), column_text(s.get(), 1),
-                   column_text(s.get(), 2), sqlite3_column_int64(s.get(), 3)});
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    ResultRecord r{.run_id = sqlite3_column_int64(s.get(), 0),
+                   .standard = column_text(s.get(), 1),
+                   .json = column_text(s.get(), 2),
+                   .created_unix_ms = sqlite3_column_int64(s.get(), 3),
+                   .provenance_json = column_text(s.get(), 4),
+                   .id = sqlite3_column_int64(s.get(), 5)};
+    if (sqlite3_column_type(s.get(), 6) != SQLITE_NULL)
+      r.superseded_by = sqlite3_column_int64(s.get(), 6);
+    out.push_back(std::move(r));
+  }
   return out;
+}
+
+void Store::set_missed_stops(std::int64_t run_id, std::span<const MissedStop> stops) {
+  Impl::Transaction tx(*impl_);
+  auto d = impl_->prepare("DELETE FROM missed_stops WHERE run_id = ?");
+  sqlite3_bind_int64(d.get(), 1, run_id);
+  impl_->step_done(d.get(), "delete missed stops");
+  auto s = impl_->prepare(
+      "INSERT INTO missed_stops(run_id, run_number, direction, target_index, nominal_mm) "
+      "VALUES(?, ?, ?, ?, ?)");
+  for (const auto& m : stops) {
+    sqlite3_bind_int64(s.get(), 1, run_id);
+    sqlite3_bind_int(s.get(), 2, m.run_number);
+    bind_text(s.get(), 3, std::string_view(&m.direction, 1));
+    sqlite3_bind_int(s.get(), 4, m.target_index);
+    sqlite3_bind_double(s.get(), 5, m.nominal_mm);
+    impl_->step_done(s.get(), fmt::format("store a missed stop of run {}", run_id));
+  }
+  tx.commit();
+}
+
+std::vector<MissedStop> Store::missed_stops(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT run_id, run_number, direction, target_index, nominal_mm FROM missed_stops "
+      "WHERE run_id = ? ORDER BY run_number, direction, target_index");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  std::vector<MissedStop> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW)
+    out.push_back({.run_id = sqlite3_column_int64(s.get(), 0),
+                   .run_number = sqlite3_column_int(s.get(), 1),
+                   .direction = column_text(s.get(), 2).front(),
+                   .target_index = sqlite3_column_int(s.get(), 3),
+                   .nominal_mm = sqlite3_column_double(s.get(), 4)});
+  return out;
+}
+
+void Store::set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns) {
+  auto s = impl_->prepare("UPDATE runs SET origin_session_ns = ?, origin_unix_ns = ? WHERE id = ?");
+  sqlite3_bind_int64(s.get(), 1, session_ns);
+  sqlite3_bind_int64(s.get(), 2, unix_ns);
+  sqlite3_bind_int64(s.get(), 3, run_id);
+  impl_->step_done(s.get(), fmt::format("set the time origin of run {}", run_id));
 }
 
 }  // namespace cal::storage

@@ -156,4 +156,30 @@ TEST(Plan, RecommendationsBecomeWarningsAndBadSpecsErrors) {
   EXPECT_THROW(cycle_from_string("zigzag"), cal::InputError);
 }
 
+// ISO 230-2 over 2000 mm: targets an average of 250 mm apart, one run per direction allowed.
+// 3000 mm: 3000 / 250 = 12 intervals, 13 targets; 2600 mm: ceil(10.4) = 11 intervals, 12 targets
+// (236.4 mm apart); exactly 2000 mm is not a long axis.
+TEST(Iso230_2Targets, LongAxisRule) {
+  EXPECT_TRUE(is_long_axis(0.0, 2000.001));
+  EXPECT_FALSE(is_long_axis(0.0, 2000.0));
+  EXPECT_EQ(long_axis_target_count(0.0, 3000.0), 13);
+  EXPECT_EQ(long_axis_target_count(100.0, 2700.0), 12);
+  const auto t = generate_targets({.first_mm = 0.0, .last_mm = 3000.0});  // neither given
+  ASSERT_EQ(t.size(), 13u);
+  EXPECT_DOUBLE_EQ(t[1], 250.0);
+  EXPECT_DOUBLE_EQ(t.back(), 3000.0);
+  EXPECT_THROW(generate_targets({.first_mm = 0.0, .last_mm = 1500.0}), cal::InputError);
+  // One run per direction over 3000 mm at 250 mm: no warning, a note naming the rule.
+  const auto p = make_plan({.first_mm = 0.0, .last_mm = 3000.0}, {.runs = 1});
+  EXPECT_TRUE(p.warnings.empty()) << p.warnings.front();
+  ASSERT_EQ(p.notes.size(), 1u);
+  EXPECT_NE(p.notes[0].find("6.2"), std::string::npos) << p.notes[0];
+  // Targets 500 mm apart on the long axis: a warning with the count that would do.
+  const auto sparse =
+      make_plan({.first_mm = 0.0, .last_mm = 3000.0, .interval_mm = 500.0}, {.runs = 1});
+  ASSERT_EQ(sparse.warnings.size(), 1u);
+  EXPECT_NE(sparse.warnings[0].find("average interval of 500.0 mm"), std::string::npos);
+  EXPECT_NE(sparse.warnings[0].find("(13 targets)"), std::string::npos);
+}
+
 }  // namespace

@@ -228,4 +228,38 @@ TEST(Iso230_2, BadInputsGiveClearErrors) {
   EXPECT_EQ(cal::iso230_2::standard_from_string("vdi3441"), Standard::vdi_3441_1977);
 }
 
+// An axis of 3000 mm measured once in each direction (ISO 230-2:2014, 6.2), targets every
+// 750 mm: up 0, 2, 5, 3, 1 um; down 2, 3, 6, 5, 2 um. By hand: B_i = up - down = -2, -1, -1,
+// -2, -1: B = 2, B mean = -1.4; E up = 5 - 0 = 5, E down = 6 - 2 = 4, E = 6 - 0 = 6; mean
+// bidirectional 1, 2.5, 5.5, 4, 1.5: M = 4.5. No s, no repeatability, no accuracy A.
+TEST(Iso230_2, LongAxisWithOneRunPerDirection) {
+  const double up[] = {0, 2, 5, 3, 1}, down[] = {2, 3, 6, 5, 2};
+  std::vector<Measurement> data;
+  for (int i = 0; i < 5; ++i) {
+    data.push_back({750.0 * i, 1, Direction::up, up[i]});
+    data.push_back({750.0 * i, 1, Direction::down, down[i]});
+  }
+  const auto e = evaluate(data, Standard::iso230_2_2014);
+  EXPECT_TRUE(e.single_run_long_axis);
+  EXPECT_EQ(e.runs, 1);
+  EXPECT_DOUBLE_EQ(e.at("B").value_um, 2.0);
+  EXPECT_DOUBLE_EQ(e.at("B_mean").value_um, -1.4);
+  EXPECT_DOUBLE_EQ(e.at("E_up").value_um, 5.0);
+  EXPECT_DOUBLE_EQ(e.at("E_down").value_um, 4.0);
+  EXPECT_DOUBLE_EQ(e.at("E_bi").value_um, 6.0);
+  EXPECT_DOUBLE_EQ(e.at("M").value_um, 4.5);
+  for (const char* key : {"R_up", "R_down", "R_bi", "A_up", "A_down", "A_bi"})
+    EXPECT_THROW(e.at(key), std::out_of_range) << key;
+  EXPECT_THROW(e.per_target_at("s_up"), std::out_of_range);
+  ASSERT_EQ(e.notes.size(), 1u);
+  EXPECT_TRUE(e.warnings.empty());
+  // The rule is ISO 230-2:2014's: other standards still need two runs, and so does a short axis.
+  EXPECT_THROW(evaluate(data, Standard::vdi_3441_1977), cal::InputError);
+  EXPECT_THROW(evaluate(data, Standard::iso230_2_2006), cal::InputError);
+  std::vector<Measurement> short_axis;
+  for (const auto& m : data)
+    short_axis.push_back({m.target_mm / 2, m.run, m.direction, m.deviation_um});
+  EXPECT_THROW(evaluate(short_axis, Standard::iso230_2_2014), cal::InputError);
+}
+
 }  // namespace

@@ -7,18 +7,19 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <set>
 #include <string>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/squareness.hpp"
 
 namespace {
 
 using namespace cal::kinematics;
 using cal::InputError;
 
-constexpr std::array kTopologies{Topology::fxyz, Topology::xfyz, Topology::xyfz, Topology::xyzf};
 constexpr std::array kMethods{Method::htm, Method::first_order};
 
 ErrorFunction constant(double v) { return ErrorFunction::polynomial({v}); }
@@ -107,7 +108,27 @@ TEST(KinematicsNames, ComponentsAndTopologies) {
   EXPECT_EQ(to_string(Topology::xyzf), "XYZF");
   EXPECT_EQ(workpiece_side_axes(Topology::fxyz), 0);
   EXPECT_EQ(workpiece_side_axes(Topology::xyfz), 2);
-  EXPECT_THROW(topology_from_string("FYXZ"), InputError);
+  // All 24 orders of F, X, Y, Z exist, each once; other strings are refused.
+  std::set<std::string> topologies;
+  for (Topology t : all_topologies()) {
+    const std::string name(to_string(t));
+    topologies.insert(name);
+    EXPECT_EQ(topology_from_string(name), t);
+    EXPECT_EQ(std::string(name).find('F'), static_cast<std::size_t>(workpiece_side_axes(t)));
+  }
+  EXPECT_EQ(topologies.size(), 24u);
+  EXPECT_EQ(all_topologies().size(), 24u);
+  // The first four keep their numeric values (stored configurations, seeds of the tests).
+  EXPECT_EQ(static_cast<int>(Topology::fxyz), 0);
+  EXPECT_EQ(static_cast<int>(Topology::xyzf), 3);
+  EXPECT_EQ(topology_from_string("yfxz"), Topology::yfxz);
+  EXPECT_EQ(workpiece_side_axes(Topology::yfxz), 1);
+  EXPECT_EQ(chain_order(Topology::yfxz), (std::array<Axis, 3>{Y, X, Z}));
+  EXPECT_EQ(chain_order(Topology::zfxy), (std::array<Axis, 3>{Z, X, Y}));
+  EXPECT_EQ(chain_order(Topology::xyzf), (std::array<Axis, 3>{X, Y, Z}));
+  EXPECT_THROW(topology_from_string("FXXZ"), InputError);   // X twice, no Y
+  EXPECT_THROW(topology_from_string("XYZ"), InputError);    // no frame
+  EXPECT_THROW(topology_from_string("FXYZF"), InputError);  // five letters
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -118,7 +139,7 @@ TEST(KinematicsNames, ComponentsAndTopologies) {
 // x = 300 is 3 um; E_YY = 1.5 um; E_ZZ = 1e-5 um/mm^2 * 200^2 = 0.4 um. Tolerance: rounding
 // of mm-sized doubles, ~1e-13 mm = 1e-10 um.
 TEST(KinematicsVolumetric, PositioningErrorsAppearOneToOne) {
-  for (Topology t : kTopologies) {
+  for (Topology t : all_topologies()) {
     Machine m;
     m.topology = t;
     m.axes[X].ex_um = ErrorFunction::polynomial({0.0, 0.01});
@@ -197,7 +218,7 @@ TEST(KinematicsVolumetric, SquarenessSigns) {
   const Vec3 exact{(-y * std::sin(c) + z * std::cos(a) * std::sin(b)) * 1e3,
                    (y * (std::cos(c) - 1) - z * std::sin(a)) * 1e3,
                    z * (std::cos(a) * std::cos(b) - 1) * 1e3};
-  for (Topology t : kTopologies) {
+  for (Topology t : all_topologies()) {
     Machine m;
     m.topology = t;
     m.squareness = {50.0, 40.0, 25.0};
@@ -210,15 +231,17 @@ TEST(KinematicsVolumetric, SquarenessSigns) {
 }
 
 // Where F sits changes the Abbe arms. E_BX = 40 urad (pitch of X, about Y), p = (500, 0, 0),
-// no offsets. FXYZ: X carries the tool, its reference point moves with it, arm = (0, 0, 0):
-// no error. With X on the table side the arm is the table travel (500, 0, 0):
+// no offsets. X on the tool side (left of F in the name: FXYZ, YFXZ, ...): X's reference point
+// moves with it and the other axes are at 0, arm = (0, 0, 0): no error. With X on the table
+// side the arm is the table travel (500, 0, 0):
 // eps x a = (0, 0, -eb ax) = (0, 0, -40e-6 * 500 mm) = (0, 0, -20 um).
 TEST(KinematicsVolumetric, TopologyChangesArms) {
-  for (Topology t : kTopologies) {
+  for (Topology t : all_topologies()) {
     Machine m;
     m.topology = t;
     m.axes[X].eb_urad = constant(40.0);
-    const double ez = t == Topology::fxyz ? 0.0 : -20.0;
+    const std::string name(to_string(t));
+    const double ez = name.find('X') < name.find('F') ? -20.0 : 0.0;
     expect_near(volumetric_error_um(m, {500.0, 0.0, 0.0}, Method::first_order), {0.0, 0.0, ez},
                 1e-12, std::string(to_string(t)));
     // Second order (40e-6)^2 * 500 mm / 2 = 4e-7 mm: 1e-3 um is a safe bound.
@@ -283,6 +306,120 @@ TEST(KinematicsVolumetric, FirstOrderClosedFormXYZF) {
   const double ez = 3 + 9 + 15 + k * (4 * (y + sy) - 5 * (x + sx)) + k * (10 * (y + sy) - 11 * sx) +
                     k * (16 * sy - 17 * sx);
   expect_near(volumetric_error_um(m, {x, y, z}, Method::first_order), {ex, ey, ez}, 1e-9);
+}
+
+// XYFZ (cross table: Y on the bed carries X carries the work; Z head on the column), the
+// topology of the classic knee-type and bed-type vertical mills. Both table axes rotate about
+// the table reference point, so their arms run from there to the tool tip; Y's arm leaves out
+// X, which Y carries below it:
+//   a_X = (x, y, z) + w + t,  a_Y = (0, y, z) + w + t,  a_Z = t,   w + t = (-203, 79, -90).
+// Written out with (eps x a) = (eb az - ec ay, ec ax - ea az, ea ay - eb ax):
+TEST(KinematicsVolumetric, FirstOrderClosedFormXYFZ) {
+  const Machine m = constant_machine(Topology::xyfz);
+  const double x = 120.0, y = -60.0, z = 240.0, k = 1e-3;
+  const double tx = 7.0, ty = -11.0, tz = -130.0, sx = -203.0, sy = 79.0, sz = -90.0;
+  const double ex = 1 + 7 + 13 + k * (5 * (z + sz) - 6 * (y + sy))  // X
+                    + k * (11 * (z + sz) - 12 * (y + sy))           // Y
+                    + k * (17 * tz - 18 * ty)                       // Z
+                    + k * (-19 * y + 20 * z);                       // squareness
+  const double ey = 2 + 8 + 14 + k * (6 * (x + sx) - 4 * (z + sz))  // X
+                    + k * (12 * sx - 10 * (z + sz))                 // Y
+                    + k * (18 * tx - 16 * tz)                       // Z
+                    + k * (-21 * z);
+  const double ez = 3 + 9 + 15 + k * (4 * (y + sy) - 5 * (x + sx))  // X
+                    + k * (10 * (y + sy) - 11 * sx)                 // Y
+                    + k * (16 * ty - 17 * tx);                      // Z
+  expect_near(volumetric_error_um(m, {x, y, z}, Method::first_order), {ex, ey, ez}, 1e-9);
+}
+
+// YFXZ: the Makino S33 vertical machining centre of the calibration study this project comes
+// from (table in Y on the bed; the spindle moves in X, and the X carriage carries the Z ram).
+// Chain order Y | X, Z with one table axis, so
+//   a_Y = (x, y, z) + w + t   (Y rotates the table about its reference point),
+//   a_X = (0, 0, z) + t       (X carries Z: its arm is Z's travel plus the tool),
+//   a_Z = t.
+// Written out, with t = (7, -11, -130) and w + t = (-203, 79, -90):
+//   e_x = E_XX + E_XY + E_XZ + E_BX (z + tz) - E_CX ty + E_BY (z + sz) - E_CY (y + sy)
+//         + E_BZ tz - E_CZ ty - E_C0Y y + E_B0Z z
+//   e_y = E_YX + E_YY + E_YZ + E_CX tx - E_AX (z + tz) + E_CY (x + sx) - E_AY (z + sz)
+//         + E_CZ tx - E_AZ tz - E_A0Z z
+//   e_z = E_ZX + E_ZY + E_ZZ + E_AX ty - E_BX tx + E_AY (y + sy) - E_BY (x + sx)
+//         + E_AZ ty - E_BZ tx
+// Compared with FXYZ (X carries Y carries Z), X loses the y Abbe arm in its yaw (-E_CX ty
+// instead of -E_CX (y + ty)) and Y's yaw gains x: the table's yaw turns the workpiece under a
+// tool that stands x away.
+TEST(KinematicsVolumetric, FirstOrderClosedFormYFXZ) {
+  const Machine m = constant_machine(Topology::yfxz);
+  const double x = 120.0, y = -60.0, z = 240.0, k = 1e-3;
+  const double tx = 7.0, ty = -11.0, tz = -130.0, sx = -203.0, sy = 79.0, sz = -90.0;
+  const double ex = 21 + k * (5 * (z + tz) - 6 * ty)       // X: E_BX (z + tz) - E_CX ty
+                    + k * (11 * (z + sz) - 12 * (y + sy))  // Y: E_BY (z + sz) - E_CY (y + sy)
+                    + k * (17 * tz - 18 * ty)              // Z
+                    + k * (-19 * y + 20 * z);              // squareness
+  const double ey = 24 + k * (6 * tx - 4 * (z + tz))       // X: E_CX tx - E_AX (z + tz)
+                    + k * (12 * (x + sx) - 10 * (z + sz))  // Y: E_CY (x + sx) - E_AY (z + sz)
+                    + k * (18 * tx - 16 * tz)              // Z
+                    + k * (-21 * z);
+  const double ez = 27 + k * (4 * ty - 5 * tx)             // X: E_AX ty - E_BX tx
+                    + k * (10 * (y + sy) - 11 * (x + sx))  // Y: E_AY (y + sy) - E_BY (x + sx)
+                    + k * (16 * ty - 17 * tx);             // Z
+  const auto r = volumetric_error(m, {x, y, z}, Method::first_order);
+  expect_near(r.translation_um, {ex, ey, ez}, 1e-9);
+  expect_near(r.rotation_urad, {4 + 10 + 16, 5 + 11 + 17, 6 + 12 + 18}, 1e-12);
+}
+
+// ZFXY, a horizontal machining centre: the table moves in Z towards the spindle, the column
+// moves in X and carries the head in Y. Arms: a_Z = (x, y, z) + w + t, a_X = (0, y, 0) + t,
+// a_Y = t.
+TEST(KinematicsVolumetric, FirstOrderClosedFormZFXY) {
+  const Machine m = constant_machine(Topology::zfxy);
+  const double x = 120.0, y = -60.0, z = 240.0, k = 1e-3;
+  const double tx = 7.0, ty = -11.0, tz = -130.0, sx = -203.0, sy = 79.0, sz = -90.0;
+  const double ex = 21 + k * (5 * tz - 6 * (y + ty))       // X: E_BX tz - E_CX (y + ty)
+                    + k * (11 * tz - 12 * ty)              // Y
+                    + k * (17 * (z + sz) - 18 * (y + sy))  // Z on the table
+                    + k * (-19 * y + 20 * z);
+  const double ey = 24 + k * (6 * tx - 4 * tz)             // X
+                    + k * (12 * tx - 10 * tz)              // Y
+                    + k * (18 * (x + sx) - 16 * (z + sz))  // Z
+                    + k * (-21 * z);
+  const double ez = 27 + k * (4 * (y + ty) - 5 * tx)        // X
+                    + k * (10 * ty - 11 * tx)               // Y
+                    + k * (16 * (y + sy) - 17 * (x + sx));  // Z
+  expect_near(volumetric_error_um(m, {x, y, z}, Method::first_order), {ex, ey, ez}, 1e-9);
+}
+
+// The exact model of YFXZ for single errors, against rotation matrices written out here.
+// Roll of X, E_AX = 30 urad: X is on the tool side and carries Z, arm a = (tx, ty, z + tz)
+// = (5, 20, 250 - 100) = (5, 20, 150); the tip moves by Rx(ea) a - a
+//   = (0, ay (c - 1) - az s, ay s + az (c - 1)).
+// Yaw of the table axis Y, E_CY = 25 urad: the table turns about its reference point, arm
+// a = p + w + t = (300 + 40, 200 - 60, 250 - 100) = (340, 140, 150); Rz(ec) a - a
+//   = (ax (c - 1) - ay s, ax s + ay (c - 1), 0).
+TEST(KinematicsVolumetric, ExactSingleTermsYFXZ) {
+  const Vec3 p{300.0, 200.0, 250.0};
+  Machine roll;
+  roll.topology = Topology::yfxz;
+  roll.axes[X].ea_urad = constant(30.0);
+  roll.tool_offset_mm = {5.0, 20.0, -100.0};
+  roll.table_offset_mm = {40.0, -80.0, 0.0};
+  {
+    const double s = std::sin(30e-6), c = std::cos(30e-6), ay = 20.0, az = 150.0;
+    expect_near(volumetric_error_um(roll, p, Method::htm),
+                {0.0, (ay * (c - 1) - az * s) * 1e3, (ay * s + az * (c - 1)) * 1e3}, 1e-9);
+  }
+  Machine yaw;
+  yaw.topology = Topology::yfxz;
+  yaw.axes[Y].ec_urad = constant(25.0);
+  yaw.tool_offset_mm = {0.0, 0.0, -100.0};
+  yaw.table_offset_mm = {40.0, -60.0, 0.0};
+  {
+    const double s = std::sin(25e-6), c = std::cos(25e-6), ax = 340.0, ay = 140.0;
+    expect_near(volumetric_error_um(yaw, p, Method::htm),
+                {(ax * (c - 1) - ay * s) * 1e3, (ax * s + ay * (c - 1)) * 1e3, 0.0}, 1e-9);
+    // First order: (-ec ay, ec ax, 0) = (-25e-6 * 140, 25e-6 * 340, 0) mm = (-3.5, 8.5, 0) um.
+    expect_near(volumetric_error_um(yaw, p, Method::first_order), {-3.5, 8.5, 0.0}, 1e-12);
+  }
 }
 
 // Offsets act where the chain says: the table offset has no effect when nothing is on the
@@ -384,7 +521,7 @@ TEST(KinematicsVolumetric, MethodsAgreeToSecondOrder) {
   std::uniform_real_distribution<double> u(0.0, 800.0);
   std::vector<Vec3> points;
   for (int i = 0; i < 20; ++i) points.push_back({u(rng), u(rng) - 400.0, u(rng) - 600.0});
-  for (Topology t : kTopologies) {
+  for (Topology t : all_topologies()) {
     const Machine base = random_machine(t, 7 + static_cast<std::uint64_t>(t));
     double previous_t = 0.0, previous_r = 0.0;
     for (double k : {0.5, 1.0, 2.0, 4.0}) {
@@ -449,6 +586,26 @@ TEST(KinematicsMap, GridOrderValuesAndSummary) {
   for (std::size_t i = 0; i < 36; ++i) EXPECT_NEAR(exact.errors_um[i], map.errors_um[i], 1e-3);
 }
 
+// Contributions over the grid of GridOrderValuesAndSummary (x in {0, 100, 200}, y in {0, 100},
+// z in {0, 50}): E_C0Y = 50 urad gives |e| = 0.05 y: max 5 um, RMS sqrt((0 + 25) / 2) =
+// 3.5355; E_XX = 0.01 um/mm gives 0.01 x: max 2, RMS sqrt((0 + 1 + 4) / 3) = 1.2910. Ranked
+// largest first; the other 19 contribute nothing.
+TEST(KinematicsMap, ContributionsRanked) {
+  Machine m;
+  m.axes[X].ex_um = ErrorFunction::polynomial({0.0, 0.01});
+  m.squareness.c0y_urad = 50.0;
+  const auto c = contributions(m, {{0.0, 0.0, 0.0}, {200.0, 100.0, 50.0}, {3, 2, 2}});
+  ASSERT_EQ(c.size(), 21u);
+  EXPECT_EQ(c[0].name, "E_C0Y");
+  EXPECT_NEAR(c[0].max_norm_um, 5.0, 1e-12);
+  EXPECT_NEAR(c[0].rms_um, std::sqrt(12.5), 1e-12);
+  EXPECT_EQ(c[1].name, "E_XX");
+  EXPECT_EQ(c[1].axis, X);
+  EXPECT_NEAR(c[1].max_norm_um, 2.0, 1e-12);
+  EXPECT_NEAR(c[1].rms_um, std::sqrt(5.0 / 3.0), 1e-12);
+  for (std::size_t i = 2; i < c.size(); ++i) EXPECT_EQ(c[i].max_norm_um, 0.0) << c[i].name;
+}
+
 TEST(KinematicsMap, SinglePointAxisUsesMin) {
   Machine m;
   m.axes[Y].ey_um = ErrorFunction::polynomial({0.0, 0.1});  // 0.1 um/mm
@@ -457,6 +614,71 @@ TEST(KinematicsMap, SinglePointAxisUsesMin) {
   ASSERT_EQ(map.size(), 1u);
   EXPECT_DOUBLE_EQ(map.positions_mm[1], 30.0);
   EXPECT_NEAR(map.errors_um[1], 3.0, 1e-9);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Squareness conventions
+
+// The conversion between `daq analyse squareness` (alpha, positive when the angle between the
+// positive axis directions exceeds 90 deg) and the model's location errors, checked on all
+// three planes against two independent things: (1) the measurement itself, simulated: a machine
+// with only that location error is "measured" by the two straightness runs of
+// squareness::from_straightness (reference axis A moving with the deviation read in +B, then B
+// moving with the deviation read in +A), the deviations taken from the model; (2) the geometry:
+// the angle between the actual axis directions of the exact model, acos(u_A . u_B) - 90 deg.
+// With a location error of +25 urad:
+//   XY: e_x = -E_C0Y y, the run along Y reads slope -25 um/m, alpha = -(0 - 25) = +25:
+//       E_C0Y = +alpha (Y leans to -X, the angle opens);
+//   XZ: e_x = +E_B0Z z, the run along Z reads +25 um/m, alpha = -25: E_B0Z = -alpha (Z leans
+//       to +X, the angle closes);
+//   YZ: e_y = -E_A0Z z, the run along Z reads -25 um/m, alpha = +25: E_A0Z = +alpha.
+TEST(KinematicsSquareness, ConventionConversionOnAllThreePlanes) {
+  struct Case {
+    Plane plane;
+    Axis a, b;  // reference axis, other axis
+    double expected_alpha;
+  };
+  const std::array cases{Case{Plane::xy, X, Y, 25.0}, Case{Plane::xz, X, Z, -25.0},
+                         Case{Plane::yz, Y, Z, 25.0}};
+  for (const Case& c : cases) {
+    Machine m;
+    m.squareness.of(c.plane) = 25.0;
+    cal::squareness::Run along_a, along_b;
+    for (int k = 0; k <= 10; ++k) {
+      const double q = 50.0 * k;  // 0 .. 500 mm
+      Vec3 pa{}, pb{};
+      pa[c.a] = q;
+      pb[c.b] = q;
+      along_a.position_mm.push_back(q);
+      along_a.deviation_um.push_back(volumetric_error_um(m, pa, Method::htm)[c.b]);
+      along_b.position_mm.push_back(q);
+      along_b.deviation_um.push_back(volumetric_error_um(m, pb, Method::htm)[c.a]);
+    }
+    const double alpha = cal::squareness::from_straightness(along_a, along_b).squareness_um_per_m;
+    const std::string what(to_string(c.plane));
+    // The exact model's cos(25e-6) terms change the runs by ~1e-10 um/m.
+    EXPECT_NEAR(alpha, c.expected_alpha, 1e-6) << what;
+    EXPECT_NEAR(location_error_from_angle_over_90(c.plane, alpha), 25.0, 1e-6) << what;
+    EXPECT_NEAR(angle_over_90_from_location_error(c.plane, 25.0), c.expected_alpha, 0.0) << what;
+    // Geometry: the actual directions are the unit travel of each axis in the exact model.
+    Vec3 ua{}, ub{};
+    ua[c.a] = 1000.0;
+    ub[c.b] = 1000.0;
+    const Vec3 ea = volumetric_error_um(m, ua, Method::htm);
+    const Vec3 eb = volumetric_error_um(m, ub, Method::htm);
+    Vec3 da{}, db{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      da[i] = ua[i] + ea[i] * 1e-3;
+      db[i] = ub[i] + eb[i] * 1e-3;
+    }
+    const double cosine = (da[0] * db[0] + da[1] * db[1] + da[2] * db[2]) / (norm(da) * norm(db));
+    const double over_90_urad = (std::acos(cosine) - std::numbers::pi / 2) * 1e6;
+    EXPECT_NEAR(over_90_urad, c.expected_alpha, 1e-4) << what;
+  }
+  EXPECT_EQ(location_error_name(Plane::xz), "E_B0Z");
+  EXPECT_EQ(plane_from_string("zx"), Plane::xz);  // the same plane, either order
+  EXPECT_EQ(plane_from_string("YZ"), Plane::yz);
+  EXPECT_THROW(plane_from_string("XX"), InputError);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -26,6 +26,10 @@ check iso_missing_file 2 "no_such.csv: cannot open" -- "$DAQ" analyse iso230-2 -
 check targets 0 "121 moves" -- "$DAQ" targets --first 0 --last 1000 --interval 100 --random-fraction 0.2
 check targets_json 0 '"schema": "caldaq.plan.v1"' -- "$DAQ" targets --first 0 --last 100 --count 6 --json
 check targets_bad 2 "does not divide" -- "$DAQ" targets --first 0 --last 100 --interval 30
+# ISO 230-2 over 2000 mm: 250 mm apart by default, one run per direction with a note.
+check targets_long 0 "^13 targets \(mm\): 0\.000 250\.000 " -- "$DAQ" targets --first 0 --last 3000 --runs 1
+check targets_long_note 0 "^note: axis over 2000 mm" -- "$DAQ" targets --first 0 --last 3000 --runs 1
+check targets_short_default 2 "give an interval or a count" -- "$DAQ" targets --first 0 --last 1000
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
@@ -35,8 +39,37 @@ head -c 300000 "$TMP/demo.cdq" > "$TMP/cut.cdq"
 check replay_damaged 2 "cut.cdq: replay stored as run [0-9]+ but incomplete: the capture is damaged at byte [0-9]+" -- "$DAQ" replay "$TMP/cut.cdq" --db "$TMP/replay.sqlite"
 check replay_not_capture 2 "not a caldaq capture file" -- "$DAQ" replay "$DATA/hand.csv" --db "$TMP/replay.sqlite"
 check demo_stored 0 "complete" -- "$DAQ" runs --db "$TMP/demo.sqlite"
-check demo_export 0 "^time_ns,device,channel,quantity,status,value" -- "$DAQ" export 1 --db "$TMP/demo.sqlite"
-check demo_targets 0 "^1,\\+,1,0," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"
+check demo_export 0 "^time_s,utc,device,device_name,channel,quantity,status,value,time_ns$" -- "$DAQ" export 1 --db "$TMP/demo.sqlite"
+check demo_targets 0 "^0,1,up,-?[0-9.e-]+,1,[0-9.e-]+,20[0-9-]+T[0-9:.]+Z," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"
+# Exports loaded back: the targets feed `daq analyse iso230-2` and give the stored run's E; the
+# circle traces feed `daq analyse circle` and give its G; a circle has no targets.
+E=$("$DAQ" analyse 1 --db "$TMP/demo.sqlite" --json | python3 -c "import json,sys; print(format(json.load(sys.stdin)['axis']['E_bi']['value_um'], '.3f'))")
+"$DAQ" export 1 --what targets -o "$TMP/deviations.csv" --db "$TMP/demo.sqlite"
+check targets_feed_analyse 0 "^  E +$E um" -- "$DAQ" analyse iso230-2 --input "$TMP/deviations.csv"
+G=$("$DAQ" analyse 2 --db "$TMP/demo.sqlite" --json | python3 -c "import json,sys; print(format(json.load(sys.stdin)['iso230_4']['G_bi_um'], '.3f'))")
+"$DAQ" export 2 --what circle -o "$TMP/ballbar.csv" --db "$TMP/demo.sqlite"
+opts=$(sed -nE 's/^# .*daq analyse circle --input FILE (.*)$/\1/p' "$TMP/ballbar.csv")
+check circle_feed_analyse 0 "G \(bidirectional\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
+check circle_no_targets 2 "run 2 is a circle test and has no captured stops: use --what circle" -- "$DAQ" export 2 --what targets --db "$TMP/demo.sqlite"
+check linear_no_circle 2 "run 1 is a linear test, not a circle" -- "$DAQ" export 1 --what circle --db "$TMP/demo.sqlite"
+# Readings: one timestamp per sample (the ballbar's lines delivered together are spread by its
+# 1 ms period), seconds from the start rising, UTC sub-second, device names, values that read
+# back exactly (the shortest round-trip form).
+"$DAQ" export 2 -o "$TMP/bar.csv" --db "$TMP/demo.sqlite"
+check readings_times 0 "^ok" -- python3 -c "
+import csv, re, sys
+rows = list(csv.DictReader(open('$TMP/bar.csv')))
+t = [float(r['time_s']) for r in rows if r['device_name'] == 'ballbar']
+assert len(t) > 1000, len(t)
+assert all(b > a for a, b in zip(t, t[1:])), 'two samples share a time, or time goes back'
+gaps = sorted(b - a for a, b in zip(t, t[1:]))
+assert abs(gaps[len(gaps) // 2] - 0.001) < 2e-4, gaps[len(gaps) // 2]
+assert all(re.fullmatch(r'20\d\d-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{6}Z', r['utc']) for r in rows[:50])
+from decimal import Decimal
+digits = lambda x: len(Decimal(x).normalize().as_tuple().digits)
+assert all(digits(r['value']) <= digits(repr(float(r['value']))) for r in rows[:2000]), 'not shortest'
+print('ok', len(t), 'bar samples')
+"
 # Stored runs: another standard; recompensation with a corrected expansion coefficient. The
 # demo's machine is at 21.5 degC, the last target 500 mm: 1 ppm/K more moves it by
 # 500 mm x 1e-6 x 1.5 K = 0.75 um (plus a few nm: the stored environment is now interpolated
@@ -47,7 +80,7 @@ check recompensate_circle 2 "no run 9" -- "$DAQ" recompensate 9 --db "$TMP/demo.
 check analyse_needs_run 2 "give a stored RUN number" -- "$DAQ" analyse --db "$TMP/demo.sqlite"
 # Runs against configured devices: a device that cannot be reached is given up, named, and
 # the run is stored as aborted. Part programs from the same configuration.
-check run_refused 2 "stopped: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2 --check-s 0
+check run_refused 2 "aborted: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2 --check-s 0
 # The start-up check (issue 13): the run is refused at once, naming every device that failed.
 check run_device_check_laser 2 "daq: error: device check: .*devices.laser \(tcp 127.0.0.1:1\): failed: .*Connection refused" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --check-s 5
 check run_device_check_air 2 "daq: error: device check: .*devices.air \(serial /dev/null 4800 7E1\): failed: .*not a serial port" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --check-s 5
@@ -67,12 +100,12 @@ check devices_probe_bad_settings 2 "parity 'X'" -- "$DAQ" devices --probe-serial
 # Import of a Renishaw dynamic capture (.rtx): a header and three little-endian float64
 # samples written byte by byte (1.0, -2.5, 0.125 mm at 1 kHz); then the same cut inside the
 # third sample, which is stored as an incomplete run with the two whole samples.
-RTX_HEAD='HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n'
+RTX_HEAD='HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nFile Type: Linear\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n'
 RTX_DATA='\x00\x00\x00\x00\x00\x00\xf0\x3f\x00\x00\x00\x00\x00\x00\x04\xc0\x00\x00\x00\x00\x00\x00\xc0\x3f'
-{ printf "$RTX_HEAD"; printf "$RTX_DATA"; printf 'EOF::\r\n'; } >"$TMP/t.rtx"
+{ printf "$RTX_HEAD"; printf "$RTX_DATA"; printf '\r\nEOF::\r\n'; } >"$TMP/t.rtx"
 { printf "$RTX_HEAD"; printf "$RTX_DATA" | head -c 20; } >"$TMP/cut.rtx"
 check import_rtx 0 "^  range -2\.500000 \.\. 1\.000000 mm" -- "$DAQ" import rtx "$TMP/t.rtx" --db "$TMP/rtx.sqlite"
-check import_rtx_export 0 "^1000000,0,0,displacement_m,0,-0\.0025" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"
+check import_rtx_export 0 "^0\.001,,0,renishaw-rtx \(CARTO-Dynamic 4\.13\),0,displacement_m,0,-0\.0025,1000000$" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"
 check import_rtx_cut 0 "note: the file ends inside a sample \(4 bytes dropped\)" -- "$DAQ" import rtx "$TMP/cut.rtx" --db "$TMP/rtx.sqlite"
 check import_rtx_cut_incomplete 0 "2 +2026.*dynamic +Y +incomplete +2" -- "$DAQ" runs --db "$TMP/rtx.sqlite"
 check import_not_rtx 2 "data/run/refused.toml: byte 0: not a Renishaw .rtx file" -- "$DAQ" import rtx "$DATA/run/refused.toml" --db "$TMP/rtx.sqlite"

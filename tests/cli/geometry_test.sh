@@ -12,6 +12,12 @@ check minzone 0 '"straightness_um": 2\.5' -- "$DAQ" analyse straightness -i "$DA
 check square_straightness 0 "\+30\.000 um/m" -- "$DAQ" analyse squareness -m straightness --along-a "$DATA/along_a.csv" --along-b "$DATA/along_b.csv"
 # X 400, Y 300 (D0 500), d1 4.8, d2 -4.8 um: 500 x 9.6 / (2 x 120000) mm^-1 = 20 um/m.
 check square_diagonal 0 '"squareness_um_per_m": 20\.0' -- "$DAQ" analyse squareness -m diagonal --x-mm 400 --y-mm 300 --d1-um 4.8 --d2-um -4.8 --json
+# The same +20 um/m in the model's convention: E_C0Y = +20 in XY, E_B0Z = -20 in XZ (a positive
+# rotation of Z about Y closes the angle), E_A0Z = +20 in YZ.
+check square_plane_xy 0 "E_C0Y = \+20\.000 urad" -- "$DAQ" analyse squareness -m diagonal --x-mm 400 --y-mm 300 --d1-um 4.8 --d2-um -4.8 --plane XY
+check square_plane_xz 0 "E_B0Z = -20\.000 urad" -- "$DAQ" analyse squareness -m diagonal --x-mm 400 --y-mm 300 --d1-um 4.8 --d2-um -4.8 --plane ZX
+check square_plane_json 0 '"iso230_1_urad": 20\.0' -- "$DAQ" analyse squareness -m diagonal --x-mm 400 --y-mm 300 --d1-um 4.8 --d2-um -4.8 --plane YZ --json
+check square_plane_bad 2 "plane 'XX'" -- "$DAQ" analyse squareness -m diagonal --x-mm 400 --y-mm 300 --d1-um 4.8 --d2-um -4.8 --plane XX
 check bad_number 2 "bad.csv:3: column deviation_um: 'x' is not a number" -- "$DAQ" analyse straightness -i "$DATA/bad.csv"
 check bad_reference 2 "unknown reference line 'best'" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r best
 # Reports: the hand values of all three reference lines, the plot with its lines.

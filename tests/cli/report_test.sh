@@ -21,6 +21,8 @@ json_value() {  # json_value FILE PYTHON_EXPRESSION_ON_d -> the value with 3 dec
   python3 -c "import json,sys; d=json.load(open('$1')); print(format($2, '.3f'))" || echo "BAD"
 }
 count() { grep -o -- "$2" "$1" | wc -l; }
+# The texts of a report's plots, decoded (PLplot writes every character as &#x..;).
+svgtext() { python3 -c "import html,re,sys; print('\n'.join(html.unescape(t) for t in re.findall(r'<tspan[^>]*>(.*?)</tspan>', open(sys.argv[1]).read())))" "$1"; }
 # A value must be a number, or the content checks below would match anything.
 number() { [[ "$1" =~ ^-?[0-9]+\.[0-9]{3}$ ]] || { echo "FAIL: not a number: '$1'"; fails=$((fails + 1)); }; }
 
@@ -65,18 +67,94 @@ check campaign_sections 0 "^3$" -- count camp.html "<h2 id=\"run-"
 check campaign_summary 0 "<a href=\"#run-2\">2</a>" -- cat camp.html
 check compare 0 "comparison report of runs 1, 3" -- "$DAQ" report --compare 1 3 --db demo.sqlite -o cmp.html
 check compare_overlay 0 "Mean bidirectional deviation, run by run" -- cat cmp.html
-check compare_trend 0 "Results over time" -- cat cmp.html
+check compare_trend 0 "Each value over time" -- cat cmp.html
 e1=$(json_value lin.json "d['axis']['E_bi']['value_um']")
 number "$e1"
-check compare_values 0 "^2$" -- count cmp.html ">$e1<"  # the replay gives the same E
+check compare_values 0 "^2$" -- count cmp.html ">$e1 <span"  # the replay gives the same E
+check compare_multiples 0 "class=\"multiples\"" -- cat cmp.html
+check compare_small_plots 0 "^([7-9]|[1-9][0-9])$" -- count cmp.html "<svg class=\"plot\""
+check compare_dates 0 "run 1 [0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2}" -- cat cmp.html
 check compare_mixed 2 "compare the same test" -- "$DAQ" report --compare 1 2 --db demo.sqlite
 check unknown_run 2 "no run 99" -- "$DAQ" report 99 --db demo.sqlite
 check bad_format 2 "use html or pdf" -- "$DAQ" report 1 --db demo.sqlite --format docx
 
+# --- every plot keeps its text: ids unique in the page, each plot's clip paths its own ---------
+check ids_linear 0 "all unique" -- python3 "$TESTS/../web/report_ids_test.py" r1.html 5
+check ids_circle 0 "all unique" -- python3 "$TESTS/../web/report_ids_test.py" r2.html 1
+check ids_campaign 0 "all unique" -- python3 "$TESTS/../web/report_ids_test.py" camp.html 11
+check ids_compare 0 "all unique" -- python3 "$TESTS/../web/report_ids_test.py" cmp.html 7
+
+# --- what a customer receives (the demo's configuration, cmd_demo.cpp) --------------------------
+check customer 0 "<td>Customer</td><td>Demo customer \(simulated\)</td>" -- cat r1.html
+check machine_serial 0 "<td>Serial number</td><td>SIM-0001</td>" -- cat r1.html
+check operator 0 "<td>Operator</td><td>demo operator</td>" -- cat r1.html
+check instrument_serial 0 "<td>SIM-IDS-0001</td><td>none \(simulated instrument\)</td><td>2099-12-31</td>" -- cat r1.html
+check past_due 0 "2020-01-31 &mdash; PAST DUE" -- cat r1.html
+check past_due_warning 0 "the calibration of material was past due on the test date" -- cat r1.html
+check conditions 0 "<td>Controller compensation</td><td>off" -- cat r1.html
+check sign_convention 0 "<td>Sign convention</td><td>Positional deviation" -- cat r1.html
+check provenance 0 "<td>Obtained</td><td>acquired</td>" -- cat r1.html
+# Verdicts: the demo's limits E 10, R 6, B 3, A 12, M 8 um and, in XY, G 10 um, backlash X 3 um,
+# squareness 30 um/m; the injected backlash of 4 um fails B and backlash X, the rest pass.
+B=$(json_value lin.json "d['axis']['B']['value_um']")
+number "$B"
+check verdict_linear 0 "<strong>FAIL</strong> &mdash; 1 of 5 limited values outside" -- cat r1.html
+check verdict_linear_B 0 ">$B</td><td class=\"r\">≤ 3.000</td><td><span class=\"fail\">FAIL</span>" -- cat r1.html
+check verdict_linear_E 0 "≤ 10.000</td><td><span class=\"pass\">pass</span>" -- cat r1.html
+check verdict_circle 0 "<strong>FAIL</strong> &mdash; 1 of 3 limited values outside" -- cat r2.html
+check verdict_circle_G 0 "≤ 10.000</td><td><span class=\"pass\">pass" -- cat r2.html
+check verdict_none_vdi 0 "No tolerance applies" -- cat vdi.html
+check grid 0 "<th>↑ up</th><th>↓ down</th><th>bidirectional</th>" -- cat r1.html
+check two_s_lines 0 "^x̄↑ ± 2s$" -- svgtext r1.html
+G2=$(python3 -c "import json; print(format(json.load(open('circ.json'))['iso230_4']['G_bi_um'], '.2f'))")
+check circle_g_on_plot 0 "^G = $G2 µm$" -- svgtext r2.html
+check circle_start_marked 0 "start of each trace, arrow: direction of travel" -- svgtext r2.html
+check circle_rings_off_traces 0 "^rings: -[0-9.]+ to \+[0-9.]+ µm$" -- svgtext r2.html
+check circle_percent_explained 0 "one share can exceed 100 %" -- cat r2.html
+check campaign_nowrap 0 "<span class=\"nw\">E [0-9.]+ µm</span>" -- cat camp.html
+check campaign_verdict 0 "<span class=\"fail\">FAIL</span></td>" -- cat camp.html
+check as_found 0 "as-found-as-left report of runs 1, 3 written to af.html" -- "$DAQ" report --as-found 1 --as-left 3 --db demo.sqlite -o af.html
+check as_found_table 0 "<th>as found, run 1</th><th>as left, run 3</th>" -- cat af.html
+check as_found_mixed 2 "give the same test before and after" -- "$DAQ" report --as-found 1 --as-left 2 --db demo.sqlite
+
 # --- rendered by Chromium ------------------------------------------------------------------------
 check rendered 0 "rendered 5 plots" -- python3 "$TESTS/../web/report_render_test.py" "$TMP/r1.html" "$TMP/r1.png"
 check rendered_circle 0 "rendered 1 plots" -- python3 "$TESTS/../web/report_render_test.py" "$TMP/r2.html" "$TMP/r2.png"
+check rendered_campaign 0 "rendered 11 plots" -- python3 "$TESTS/../web/report_render_test.py" "$TMP/camp.html" "$TMP/camp.png" "Campaign"
+check rendered_compare 0 "rendered [0-9]+ plots" -- python3 "$TESTS/../web/report_render_test.py" "$TMP/cmp.html" "$TMP/cmp.png" "Comparison"
+check rendered_as_found 0 "rendered [0-9]+ plots" -- python3 "$TESTS/../web/report_render_test.py" "$TMP/af.html" "$TMP/af.png" "As found"
 check pdf 0 "written to r1.pdf" -- "$DAQ" report 1 --db demo.sqlite --format pdf -o r1.pdf
 check pdf_magic 0 "^%PDF-1" -- head -c 8 r1.pdf
 check pdf_pages 0 "/Type */Page($|[^s])" -- cat r1.pdf
+# Printed: "page n of m" and the running header on every page; no page with only a heading or
+# only the footer (each page holds at least 8 lines of text besides its header and number).
+pages=$(pdfinfo r1.pdf | sed -nE 's/^Pages: +([0-9]+)/\1/p')
+check pdf_page_count 0 "^[3-9]$" -- echo "$pages"
+for p in $(seq 1 "${pages:-0}"); do
+  text=$(pdftotext -f "$p" -l "$p" -layout r1.pdf -)
+  check "pdf_page_${p}_number" 0 "page $p of $pages" -- echo "$text"
+  check "pdf_page_${p}_header" 0 "Run 1: Positioning test \(ISO 230-2\), axis X +Demo customer" -- echo "$text"
+  check "pdf_page_${p}_content" 0 "^([89]|[1-9][0-9]+)$" -- bash -c "grep -cvE '^\s*$|page [0-9]+ of|Run 1: Positioning' <<<\"\$1\"" _ "$text"
+done
+
+# --- a re-compensated run: its report shows both coefficients, the original and new values, and
+# the budget uses the new coefficient. Material temperature term of the budget by hand:
+# L alpha u(T) = 500 mm x 11.5e-6/K x 0.1 K = 0.5750 um; with 12 ppm/K 0.6000 um.
+check budget_before 0 "<td>material temperature</td><td class=\"r\">0.5750</td>" -- cat r1.html
+check recompensate 0 "stored as result [0-9]+, superseding result 1" -- "$DAQ" recompensate 1 --alpha-ppm 12 --db demo.sqlite
+"$DAQ" report 1 --db demo.sqlite -o r1b.html >/dev/null
+check recomp_setting 0 "11.5 <span class=\"changed\">\(as acquired; the current result uses 12\)</span>" -- cat r1b.html
+check recomp_coefficients 0 "Expansion coefficient \(ppm/K\)</td><td class=\"r\">11.5</td><td class=\"r\"><span class=\"changed\">12</span>" -- cat r1b.html
+check recomp_values 0 "Original \(result 1\) and re-compensated \(result [0-9]+\) values" -- cat r1b.html
+check recomp_budget 0 "<td>material temperature</td><td class=\"r\">0.6000</td>" -- cat r1b.html
+check recomp_of 0 "<td>Re-compensation of</td><td>result 1</td>" -- cat r1b.html
+"$DAQ" report --compare 1 3 --db demo.sqlite -o cmp2.html >/dev/null
+check compare_recompensated 0 "<td class=\"r\">1 <span class=\"changed\">re-compensated</span>" -- cat cmp2.html
+check show_superseded 0 "result 1: ISO 230-2:2014 \(superseded by result [0-9]+\)" -- "$DAQ" show 1 --db demo.sqlite
+check show_current 0 "recompensated .* of result 1; ciddor, 12 ppm/K; expansion_ppm_per_k 11.5 -> 12" -- "$DAQ" show 1 --db demo.sqlite
+check show_values 0 "^      E +[0-9]+\.[0-9]{3} um" -- "$DAQ" show 1 --db demo.sqlite
+# A second correction keeps the first: the offset is added, 12 ppm/K stays.
+check recomp_keeps 0 "material_offset_k: 0(\.0)? -> 0\.1" -- "$DAQ" recompensate 1 --material-offset 0.1 --db demo.sqlite
+check recomp_keeps_alpha 0 "ciddor, 12 ppm/K; offsets material \+0.1 K" -- "$DAQ" show 1 --db demo.sqlite
+check recomp_nan 2 "--alpha-ppm: 'nan' is not a finite decimal number" -- "$DAQ" recompensate 1 --alpha-ppm nan --db demo.sqlite
 finish

@@ -19,8 +19,23 @@ SIM_PID=$!
 for _ in $(seq 100); do [ -s "$TMP/sim.toml" ] && break; sleep 0.1; done
 [ -s "$TMP/sim.toml" ] || { echo "FAIL: daq sim wrote no configuration"; cat "$TMP/sim.log"; exit 1; }
 
-"$DAQ" run linear -c "$TMP/sim.toml" --db "$TMP/run.sqlite" --capture "$TMP/lin.cdq" >"$TMP/run.log" 2>&1
+"$DAQ" run linear -c "$TMP/sim.toml" --db "$TMP/run.sqlite" --capture "$TMP/lin.cdq" >"$TMP/run.log" 2>&1 &
+RUN_PID=$!
+# Progress into a file is written as it happens: the second target's line is there while the
+# run still goes on (it was held in the stdio buffer until the end).
+live=no
+for _ in $(seq 1200); do
+  if grep -q "^run 1 of 5 up  target 2 of 11" "$TMP/run.log"; then
+    kill -0 "$RUN_PID" 2>/dev/null && live=yes
+    break
+  fi
+  sleep 0.1
+done
+check progress_flushed 0 "^yes$" -- echo "$live"
+wait "$RUN_PID"
 RUN=$(cat "$TMP/run.log")
+check stored_complete 0 "^run 1 stored \(complete\)" -- echo "$RUN"
+check no_verdict_configured 0 "^verdict: no tolerance configured" -- echo "$RUN"
 # The machine rests on the first target while the program has not started: that is no stop.
 check rest_is_no_stop 0 "stop at .* without an approach move .*: ignored" -- echo "$RUN"
 check all_stops 0 "all stops captured" -- echo "$RUN"
@@ -37,11 +52,14 @@ kill "$SIM_PID" 2>/dev/null
 "$DAQ" sim --test linear --speed 10 --start-after-s 3 --position-feed -o "$TMP/simp.toml" >"$TMP/simp.log" 2>&1 &
 SIM_PID=$!
 for _ in $(seq 100); do [ -s "$TMP/simp.toml" ] && break; sleep 0.1; done
-"$DAQ" run linear -c "$TMP/simp.toml" --db "$TMP/pos.sqlite" --capture "$TMP/pos.cdq" >"$TMP/pos.log" 2>&1
+# --json: the result on stdout, the progress on stderr.
+"$DAQ" run linear -c "$TMP/simp.toml" --db "$TMP/pos.sqlite" --capture "$TMP/pos.cdq" --json >"$TMP/pos.json" 2>"$TMP/pos.log"
 POS=$(cat "$TMP/pos.log")
 check position_feed_used 0 "stops are recognised from the machine position feed" -- echo "$POS"
 check position_all_stops 0 "all stops captured" -- echo "$POS"
-check position_reversal 0 "B̄ +-(3\.9[5-9]|4\.0[0-5])[0-9]* um" -- echo "$POS"
-B2=$(sed -nE 's/^  B̄ +([-+0-9.]+) um.*/\1/p' <<<"$POS" | sed 's/\./\\./')
+check position_json 0 "^complete 1 0 iso230-2:2014$" -- python3 -c "import json; d=json.load(open('$TMP/pos.json')); print(d['status'], d['run_id'], len(d['missed_stops']), d['standard']['key'])"
+B2=$(python3 -c "import json; print(format(json.load(open('$TMP/pos.json'))['axis']['B_mean']['value_um'], '.3f'))")
+check position_reversal 0 "^-(3\.9[5-9]|4\.0[0-5])" -- echo "$B2"
+B2=$(sed 's/\./\\./' <<<"$B2")
 check position_replay_same_b 0 "^  B̄ +$B2 um" -- "$DAQ" replay "$TMP/pos.cdq" --db "$TMP/pos.sqlite"
 finish

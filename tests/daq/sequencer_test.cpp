@@ -141,3 +141,28 @@ TEST(Sequencer, ARefusedStopDoesNotBlindTheTrigger) {
 }
 
 }  // namespace
+
+namespace {
+
+// A dropped stop (run 2 up, 50 mm) and the plan's end: the sequencer must not say "all stops
+// captured" (it did), and must list the one missed stop.
+TEST(Sequencer, ADroppedStopIsListedAndTheEndDoesNotClaimEveryStop) {
+  Sequencer s(plan(), 0.5);
+  std::vector<SequenceEvent> last;
+  for (std::size_t i = 0; i < s.stops().size(); ++i) {
+    if (i == 7) continue;  // run 2 up, target 2 (50 mm): never stopped at
+    const auto& e = s.stops()[i];
+    last = s.on_capture(at(e.position_mm, e.direction == cal::iso230_2::Direction::up ? up : down));
+  }
+  EXPECT_TRUE(s.complete());
+  ASSERT_FALSE(last.empty());
+  EXPECT_EQ(last.back().kind, Kind::complete);
+  EXPECT_EQ(last.back().message, "end of the plan: 1 of 12 stops missed");
+  ASSERT_EQ(s.missed().size(), 1u);
+  EXPECT_EQ(s.missed()[0], 7u);
+  EXPECT_EQ(s.stops()[7].run, 2);
+  EXPECT_EQ(s.stops()[7].position_mm, 50.0);
+  EXPECT_EQ(s.measurements().size(), 11u);
+}
+
+}  // namespace

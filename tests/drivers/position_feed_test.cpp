@@ -1,5 +1,6 @@
 // Machine position feeds: LinuxCNC halsampler and MTConnect SHDR lines written by hand from
-// their documented formats (codec/position_feed.hpp); expected values worked out beside them.
+// their documented formats (halsampler/codec.hpp, shdr/codec.hpp); expected values worked out
+// beside them.
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"

@@ -1,5 +1,5 @@
 // TEMPer codec on reports written by hand from the layouts of OpenBSD's ugold(4) (see
-// codec/temper.hpp); every expected temperature is worked out in the comment beside it.
+// temper/codec.hpp); every expected temperature is worked out in the comment beside it.
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"

@@ -3,11 +3,13 @@
 // evaluated; the stored result must agree with the simulated truth. And a real `daq demo`
 // process killed with SIGKILL mid-run must leave a readable database with the run incomplete.
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -16,12 +18,15 @@
 #include <thread>
 
 #include "cal/storage/store.hpp"
+#include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "ids3010/instrument.hpp"
+#include "iso230_2_output.hpp"
 #include "line_gauge/instrument.hpp"
 #include "linear_run.hpp"
 #include "ptu300/instrument.hpp"
 #include "sim_shop.hpp"
+#include "verdict.hpp"
 
 namespace {
 
@@ -114,6 +119,111 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   EXPECT_EQ(store.results(out.run_id)[0].standard, "ISO 230-2:2014");
   EXPECT_EQ(store.reading_count(out.run_id), static_cast<std::int64_t>(out.readings));
   EXPECT_EQ(store.instruments(out.run_id).size(), 3u);
+  EXPECT_TRUE(store.missed_stops(out.run_id).empty());
+  EXPECT_TRUE(r->origin_unix_ns.has_value());
+
+  // Verdicts against limits set from the simulated truth (not from the measured values): E
+  // 0.3 um above the true E (inside: the measurement is within 0.15 um of it), M 0.3 um below
+  // the true M (outside).
+  const nlohmann::json tol{{"E_um", truth.at("E_bi").value_um + 0.3},
+                           {"M_um", truth.at("M").value_um - 0.3},
+                           {"source", "tolerances.X"}};
+  const auto v = daq::linear_verdict(tol, daq::to_json(*out.evaluation));
+  ASSERT_TRUE(v.configured);
+  EXPECT_FALSE(v.pass);
+  ASSERT_EQ(v.checks.size(), 2u);
+  EXPECT_EQ(v.checks[0].key, "E_bi");
+  EXPECT_TRUE(v.checks[0].pass);
+  EXPECT_EQ(v.checks[1].key, "M");
+  EXPECT_FALSE(v.checks[1].pass);
+  EXPECT_EQ(daq::summary(daq::linear_verdict(nullptr, daq::to_json(*out.evaluation))),
+            "no tolerance configured");
+  remove_db(db);
+}
+
+// A stop the machine never makes (the simulated program skips run 2 up at target 3): the
+// run reaches the end of its plan but is stored incomplete, the stop listed as missed, and
+// the evaluation says that target has one run fewer up.
+TEST(LinearEndToEnd, ADroppedStopIsStoredIncompleteWithTheStopListed) {
+  const auto db = temp_db("dropped");
+  constexpr double speed = 30.0;
+  boost::asio::io_context io;
+  daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
+  cal::daq::Config c;
+  c.machine_name = "e2e";
+  c.environment.stale_after_s = 60.0;
+  c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5};
+  c.linear = cal::daq::LinearTestConfig{.first_mm = 0,
+                                        .last_mm = 200,
+                                        .count = 5,
+                                        .runs = 3,
+                                        .overrun_mm = 3,
+                                        .feed_mm_per_min = 6000,
+                                        .dwell_s = 3};
+  const auto clock = shop.clock_ns();
+  const auto poll = [&](double sim_s) {
+    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / speed * 1e6));
+  };
+  daq::LinearRunSetup setup;
+  setup.config = c;
+  setup.database = db;
+  setup.laser =
+      d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
+                      {.poll_period = poll(0.01), .clock = clock});
+  setup.air = d::make_ptu300(
+      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
+      {.poll_period = poll(1.0), .clock = clock});
+  setup.material.push_back(d::make_gauge(
+      io, t::make_serial(io, {.device = shop.material_device()}),
+      {.poll_period = poll(1.0), .clock = clock},
+      {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
+  std::array<bool, 3> read{};
+  setup.on_reading = [&read](const d::Reading& r) {
+    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
+      read[r.device] = true;
+  };
+  std::vector<std::string> events;
+  setup.on_event = [&events](const std::string& e) { events.push_back(e); };
+  daq::LinearRun run(io, std::move(setup));
+  run.start();
+  ASSERT_TRUE(shop.wait_until([&] { return read[0] && read[1] && read[2]; }));
+  // The machine's program without the stop of run 2 up at target 3 (100 mm): it moves on.
+  auto program = run.plan();
+  const auto skipped = std::find_if(program.moves.begin(), program.moves.end(), [](const auto& m) {
+    return m.kind == cal::iso230_2::MoveKind::measure && m.run == 2 &&
+           m.direction == cal::iso230_2::Direction::up && m.target_index == 3;
+  });
+  ASSERT_NE(skipped, program.moves.end());
+  program.moves.erase(skipped);
+  shop.run_linear(program, c.linear->feed_mm_per_min, c.linear->dwell_s);
+  shop.run_program([&] { return run.finished(); }, 30.0);
+  ASSERT_TRUE(run.finished());
+  const auto& out = run.outcome();
+  ASSERT_TRUE(out.complete) << out.reason;  // the end of the plan was reached and evaluated
+  EXPECT_EQ(out.status, cal::storage::RunStatus::incomplete);
+  ASSERT_EQ(out.missed.size(), 1u);
+  EXPECT_EQ(out.missed[0].run_number, 2);
+  EXPECT_EQ(out.missed[0].direction, '+');
+  EXPECT_EQ(out.missed[0].target_index, 2);  // 0-based: the third target
+  EXPECT_DOUBLE_EQ(out.missed[0].nominal_mm, run.plan().targets_mm[2]);
+  for (const auto& e : events) EXPECT_EQ(e.find("all stops captured"), std::string::npos) << e;
+  EXPECT_NE(std::find(events.begin(), events.end(), "end of the plan: 1 of 30 stops missed"),
+            events.end());
+
+  cal::storage::Store store(db);
+  const auto r = store.run(out.run_id);
+  EXPECT_EQ(r->status, cal::storage::RunStatus::incomplete);
+  EXPECT_EQ(r->note, "1 of 30 planned stops missed");
+  const auto missed = store.missed_stops(out.run_id);
+  ASSERT_EQ(missed.size(), 1u);
+  EXPECT_EQ(missed[0].target_index, 2);
+  EXPECT_EQ(store.targets(out.run_id).size(), 29u);
+  // The evaluation's runs per direction: 3 everywhere but 2 at that target up.
+  EXPECT_EQ(daq::runs_text(*out.evaluation),
+            fmt::format("2 to 3 runs per direction (3 at every other target and direction; 2 at "
+                        "{:.3f} mm up)",
+                        run.plan().targets_mm[2]));
+  ASSERT_EQ(store.results(out.run_id).size(), 1u);
   remove_db(db);
 }
 
@@ -153,6 +263,15 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   cal::storage::Store store(db);
   ASSERT_EQ(store.results(run.outcome().run_id).size(), 1u);
   EXPECT_EQ(store.results(run.outcome().run_id)[0].standard, "ISO 230-4:2005");
+  // Per-diagnostic limits from the injected errors: squareness 20 um/m against 20.3 (inside;
+  // measured within 0.2 of the truth), backlash X 4 um against 3.7 (outside).
+  const nlohmann::json tol{{"diagnostics", {{"squareness", 20.3}, {"backlash_X", 3.7}}}};
+  const auto verdict = daq::circle_verdict(
+      tol, daq::circle_json(*run.outcome().result, 100, "XY", program.feed_mm_per_min));
+  ASSERT_EQ(verdict.checks.size(), 2u);
+  EXPECT_TRUE(daq::find_check(verdict, "squareness")->pass);
+  EXPECT_FALSE(daq::find_check(verdict, "backlash_X")->pass);
+  EXPECT_EQ(daq::summary(verdict), "FAIL");
   remove_db(db);
 }
 

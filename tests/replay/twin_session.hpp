@@ -63,7 +63,10 @@ inline d::InstrumentOptions options(Device device, const char* name) {
   return {.device = device,
           .name = name,
           .backoff = {.initial = 50ms, .max = 200ms},
-          .poll_period = device == laser    ? 20ms
+          // The laser at 10 ms (the checked-in capture was recorded at 20 ms): since issue 13
+          // a warning costs the IDS3010 a mode check and, once, its text, and a loaded machine
+          // polls late, so 20 ms left as few as 2 readings in the 0.2 s of a blocked beam.
+          .poll_period = device == laser    ? 10ms
                          : device == ptu300 ? 250ms
                                             : 1000ms};
 }

@@ -247,3 +247,123 @@ TEST(Store, NamesAPathThatCannotBeCreated) {
 }
 
 }  // namespace
+
+namespace {
+std::int64_t a_run(Store& store) {
+  return store.begin_run({.campaign = "c", .kind = "linear", .axis = "X"});
+}
+}  // namespace
+
+TEST(Store, ANewResultSupersedesTheSameStandardOnlyAndKeepsTheOldOne) {
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  const auto run = a_run(store);
+  const auto first = store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  const auto vdi = store.add_result({.run_id = run, .standard = "VDI/DGQ 3441", .json = "{}"});
+  const auto second = store.add_result({.run_id = run,
+                                        .standard = "ISO 230-2:2014",
+                                        .json = "{}",
+                                        .provenance_json = R"({"how":"reanalysed"})"});
+  const auto rs = store.results(run);
+  ASSERT_EQ(rs.size(), 3u);
+  EXPECT_EQ(rs[0].id, first);
+  EXPECT_EQ(rs[0].superseded_by, second);  // the same standard, later
+  EXPECT_TRUE(rs[1].current());            // another standard stays current
+  EXPECT_TRUE(rs[2].current());
+  EXPECT_EQ(rs[1].id, vdi);
+  EXPECT_EQ(rs[2].provenance_json, R"({"how":"reanalysed"})");
+  EXPECT_EQ(rs[0].provenance_json, "{}");
+}
+
+TEST(Store, ReplacingTheTargetsSupersedesEveryResultInOneTransaction) {
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  const auto run = a_run(store);
+  const cal::storage::CapturedTarget t{
+      .run_id = run, .run_number = 1, .direction = '+', .nominal_mm = 0, .deviation_um = 1.0};
+  store.add_targets(std::span(&t, 1));
+  store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  store.add_result({.run_id = run, .standard = "VDI/DGQ 3441", .json = "{}"});
+  auto changed = t;
+  changed.deviation_um = 2.5;
+  const auto id = store.replace_targets(
+      run, std::span(&changed, 1), {.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  const auto rs = store.results(run);
+  ASSERT_EQ(rs.size(), 3u);
+  EXPECT_EQ(rs[0].superseded_by, id);
+  EXPECT_EQ(rs[1].superseded_by, id);  // made from the old deviations
+  EXPECT_TRUE(rs[2].current());
+  EXPECT_EQ(store.targets(run).at(0).deviation_um, 2.5);
+}
+
+TEST(Store, MissedStopsAndTheTimeOriginRoundTrip) {
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  const auto run = a_run(store);
+  EXPECT_FALSE(store.run(run)->origin_unix_ns.has_value());
+  const cal::storage::MissedStop m[] = {
+      {.run_number = 2, .direction = '-', .target_index = 3, .nominal_mm = 150.25},
+      {.run_number = 2, .direction = '+', .target_index = 7, .nominal_mm = 350.0}};
+  store.set_missed_stops(run, m);
+  const auto back = store.missed_stops(run);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].direction, '+');  // in the order of the test: run, up before down
+  EXPECT_EQ(back[0].target_index, 7);
+  EXPECT_EQ(back[1].nominal_mm, 150.25);
+  store.set_time_origin(run, 123'456'789, 1'780'000'000'123'456'789);
+  EXPECT_EQ(store.run(run)->origin_session_ns, 123'456'789);
+  EXPECT_EQ(store.run(run)->origin_unix_ns, 1'780'000'000'123'456'789);
+}
+
+// A database written by schema 1 (before provenance): migrated in place, its results kept and
+// marked: the older of two results of one standard, and a result followed by a
+// re-compensation, are superseded.
+TEST(Store, MigratesASchemaOneDatabaseAndMarksItsResults) {
+  TempDir dir;
+  const auto file = dir.path / "old.sqlite";
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    const char* v1 = R"sql(
+CREATE TABLE machines(id INTEGER PRIMARY KEY, name TEXT NOT NULL UNIQUE,
+  description TEXT NOT NULL DEFAULT '', config_json TEXT NOT NULL DEFAULT '{}');
+CREATE TABLE runs(id INTEGER PRIMARY KEY, machine_id INTEGER REFERENCES machines(id),
+  campaign TEXT NOT NULL DEFAULT '', kind TEXT NOT NULL, axis TEXT NOT NULL DEFAULT '',
+  settings_json TEXT NOT NULL DEFAULT '{}', capture_path TEXT NOT NULL DEFAULT '',
+  software_version TEXT NOT NULL DEFAULT '', started_unix_ms INTEGER NOT NULL,
+  ended_unix_ms INTEGER, status TEXT NOT NULL CHECK(status IN ('running', 'complete',
+  'incomplete', 'aborted')), note TEXT NOT NULL DEFAULT '', owner_pid INTEGER NOT NULL DEFAULT 0);
+CREATE TABLE instruments(run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  device INTEGER NOT NULL, driver TEXT NOT NULL, transport TEXT NOT NULL,
+  settings_json TEXT NOT NULL DEFAULT '{}', PRIMARY KEY(run_id, device));
+CREATE TABLE reading_chunks(id INTEGER PRIMARY KEY, run_id INTEGER NOT NULL REFERENCES runs(id)
+  ON DELETE CASCADE, device INTEGER NOT NULL, channel INTEGER NOT NULL, quantity INTEGER NOT NULL,
+  first_ns INTEGER NOT NULL, last_ns INTEGER NOT NULL, count INTEGER NOT NULL, data BLOB NOT NULL);
+CREATE INDEX reading_chunks_by_run ON reading_chunks(run_id, first_ns);
+CREATE TABLE captured_targets(run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  target_index INTEGER NOT NULL, run_number INTEGER NOT NULL, direction TEXT NOT NULL
+  CHECK(direction IN ('+', '-')), nominal_mm REAL NOT NULL, time_ns INTEGER NOT NULL,
+  raw_m REAL NOT NULL, deviation_um REAL NOT NULL, refractive_index REAL NOT NULL,
+  material_temperature_degc REAL NOT NULL, PRIMARY KEY(run_id, run_number, direction, target_index));
+CREATE TABLE results(id INTEGER PRIMARY KEY, run_id INTEGER NOT NULL REFERENCES runs(id)
+  ON DELETE CASCADE, standard TEXT NOT NULL, json TEXT NOT NULL, created_unix_ms INTEGER NOT NULL);
+INSERT INTO runs(id, kind, started_unix_ms, status) VALUES(1, 'linear', 1, 'complete');
+INSERT INTO results(run_id, standard, json, created_unix_ms) VALUES
+  (1, 'ISO 230-2:2014', '{}', 1), (1, 'VDI/DGQ 3441', '{}', 2),
+  (1, 'ISO 230-2:2014 (recompensated)', '{}', 3), (1, 'ISO 230-2:2014 (recompensated)', '{}', 4);
+PRAGMA user_version = 1;
+)sql";
+    ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  Store store(file);
+  EXPECT_EQ(store.version(), cal::storage::schema_version);
+  const auto rs = store.results(1);
+  ASSERT_EQ(rs.size(), 4u);
+  EXPECT_EQ(rs[0].superseded_by, rs[2].id);  // the original, by the first re-compensation
+  EXPECT_EQ(rs[1].superseded_by, rs[2].id);  // made from the deviations before it
+  EXPECT_EQ(rs[2].superseded_by, rs[3].id);
+  EXPECT_TRUE(rs[3].current());
+  EXPECT_EQ(rs[3].provenance_json, "{}");
+  EXPECT_TRUE(store.missed_stops(1).empty());
+}

@@ -4,6 +4,7 @@
 #include <plplot/plplot.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -97,6 +98,31 @@ class SvgStream {
       if (end != std::string::npos) s.erase(a, end + 1 - a);
     }
     s.insert(4, fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", html_escape(title)));
+    return unique_ids(std::move(s));
+  }
+
+  // Prefixes every id="..." of the SVG and its references (url(#...), href="#...") with a
+  // number unique in the process, so plots inlined together keep their own clip paths.
+  static std::string unique_ids(std::string s) {
+    static std::atomic<int> counter{0};
+    const std::string prefix = fmt::format("plot{}-", ++counter);
+    std::vector<std::string> ids;
+    for (std::size_t at = s.find(" id=\""); at != std::string::npos;
+         at = s.find(" id=\"", at + 1)) {
+      const auto begin = at + 5, end = s.find('"', begin);
+      if (end == std::string::npos) break;
+      ids.push_back(s.substr(begin, end - begin));
+    }
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    for (const auto& id : ids)
+      for (const auto& [from, to] :
+           {std::pair{"id=\"" + id + "\"", "id=\"" + prefix + id + "\""},
+            std::pair{"url(#" + id + ")", "url(#" + prefix + id + ")"},
+            std::pair{"href=\"#" + id + "\"", "href=\"#" + prefix + id + "\""}})
+        for (std::size_t at = s.find(from); at != std::string::npos;
+             at = s.find(from, at + to.size()))
+          s.replace(at, from.size(), to);
     return s;
   }
 
@@ -174,6 +200,33 @@ void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
   if (!l.label.empty()) legend.push_back({l.label, c, PL_LEGEND_LINE, l.dashed ? 2 : 1, l.width});
 }
 
+// A tick interval of 1, 2 or 5 times a power of ten giving about `ticks` intervals over a
+// span, and the decimals its labels need (0.2 -> 1): PLplot's own choice printed 1006.8 and
+// 1007.0 hPa both as "1007".
+std::pair<double, int> ticks_for(double span, int ticks) {
+  const double raw = span / ticks;
+  if (!(raw > 0) || !std::isfinite(raw)) return {0.0, 0};
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10 * p;
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * p >= raw) {
+      step = m * p;
+      break;
+    }
+  return {step, std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)))};
+}
+
+// Tick labels of a category axis: the label of the category at an integer position.
+void category_label(PLINT axis, PLFLT value, char* out, PLINT length, PLPointer data) {
+  const auto& labels = *static_cast<const std::vector<std::string>*>(data);
+  const long k = std::lround(value);
+  std::string text;
+  if (axis == PL_X_AXIS && k >= 0 && static_cast<std::size_t>(k) < labels.size() &&
+      std::abs(value - static_cast<double>(k)) < 1e-6)
+    text = labels[static_cast<std::size_t>(k)];
+  std::snprintf(out, static_cast<std::size_t>(length), "%s", text.c_str());
+}
+
 }  // namespace
 
 std::string svg(const XyChart& chart) {
@@ -194,14 +247,28 @@ std::string svg(const XyChart& chart) {
                                       [](const Line& l) { return !l.label.empty(); }) ||
                           std::any_of(chart.bands.begin(), chart.bands.end(),
                                       [](const Band& b) { return !b.label.empty(); });
-  plvpor(0.09, has_legend ? 0.72 : 0.97, 0.13, 0.9);
-  const Range xr = x.empty() ? Range{0, 1} : (x.lo < x.hi ? x : x.padded(0.05));
-  const Range yr = y.padded(0.06);
+  const bool legend = chart.legend && has_legend;
+  plschr(0, 0.85 * chart.text_scale);
+  // Room on the left for the tick labels, more when the text is scaled up.
+  plvpor(0.04 + 0.07 * chart.text_scale, legend ? 0.72 : 0.97, 0.13, 0.9);
+  // Room on every side: no point or marker sits on the frame.
+  const Range xr = x.empty() ? Range{0, 1}
+                   : !chart.x_labels.empty()
+                       ? Range{-0.5, static_cast<double>(chart.x_labels.size()) - 0.5}
+                       : x.padded(0.04);
+  const Range yr = y.padded(0.08);
   plwind(xr.lo, xr.hi, yr.lo, yr.hi);
+  const bool categories = !chart.x_labels.empty();
+  if (categories)
+    plslabelfunc(category_label, const_cast<std::vector<std::string>*>(&chart.x_labels));
+  const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
+  const auto [ystep, ydigits] = ticks_for(yr.hi - yr.lo, 6);
+  const double xtick = categories ? 1.0 : xstep;
+  const PLINT nxsub = categories ? 1 : 0;
   plcol0(grid_colour);
   plwidth(0.5);
-  plbox("g", 0, 0, "g", 0, 0);
-  std::vector<LegendEntry> legend;
+  plbox("g", xtick, nxsub, "g", ystep, 0);
+  std::vector<LegendEntry> entries;
   for (const auto& b : chart.bands) {
     const std::size_t n = std::min({b.x.size(), b.lo.size(), b.hi.size()});
     if (n == 0) continue;
@@ -211,7 +278,7 @@ std::string svg(const XyChart& chart) {
     const PLINT c = s.colour(b.colour, b.alpha);
     plcol0(c);
     plfill(static_cast<PLINT>(px.size()), px.data(), py.data());
-    if (!b.label.empty()) legend.push_back({b.label, c, PL_LEGEND_COLOR_BOX});
+    if (!b.label.empty()) entries.push_back({b.label, c, PL_LEGEND_COLOR_BOX});
   }
   if (chart.zero_line) {
     plcol0(reference_colour);
@@ -219,13 +286,20 @@ std::string svg(const XyChart& chart) {
     const PLFLT zx[] = {xr.lo, xr.hi}, zy[] = {0.0, 0.0};
     plline(2, zx, zy);
   }
-  for (const auto& l : chart.lines) draw_line(s, l, legend);
+  for (const auto& l : chart.lines) draw_line(s, l, entries);
   plcol0(axes_colour);
   plwidth(1.0);
-  plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+  // Each axis labelled with the decimals its ticks need (plprec applies to both: the axes are
+  // drawn one at a time).
+  plprec(1, xdigits);
+  plbox(categories ? "bcnto" : "bcnst", xtick, nxsub, "", 0, 0);
+  plprec(1, ydigits);
+  plbox("", 0, 0, "bcnstv", ystep, 0);
+  plprec(0, 0);
+  if (categories) plslabelfunc(nullptr, nullptr);
   pllab(chart.x_label.c_str(), chart.y_label.c_str(), chart.title.c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
-  draw_legend(legend, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
+  if (legend) draw_legend(entries, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
   return s.finish(chart.title);
 }
 
@@ -238,6 +312,28 @@ double nice_step(double v) {
   for (double m : {1.0, 2.0, 5.0, 10.0})
     if (m * p >= v) return m * p;
   return 10 * p;
+}
+
+// The first point of a drawn trace (plot coordinates) as an open circle, and an arrowhead a
+// little further along it pointing the way the machine moved.
+void mark_start(const Line& l, bool ccw) {
+  (void)ccw;  // the trace's own order of points gives the direction
+  const PLFLT x0 = l.x.front(), y0 = l.y.front();
+  plwidth(1.6);
+  plarc(x0, y0, 0.045, 0.045, 0, 360, 0, 0);  // an open circle
+  // The arrow at the point ~0.12 along the trace from the start.
+  std::size_t k = 1;
+  double run = 0;
+  while (k + 1 < l.x.size() && run < 0.2) {
+    run += std::hypot(l.x[k] - l.x[k - 1], l.y[k] - l.y[k - 1]);
+    ++k;
+  }
+  const double dx = l.x[k] - l.x[k - 1], dy = l.y[k] - l.y[k - 1], n = std::hypot(dx, dy);
+  if (!(n > 0)) return;
+  const double ux = dx / n, uy = dy / n, size = 0.09;
+  const PLFLT ax[] = {l.x[k] - size * (ux - 0.5 * uy), l.x[k], l.x[k] - size * (ux + 0.5 * uy)};
+  const PLFLT ay[] = {l.y[k] - size * (uy + 0.5 * ux), l.y[k], l.y[k] - size * (uy - 0.5 * ux)};
+  plline(3, ax, ay);
 }
 
 }  // namespace
@@ -264,10 +360,14 @@ std::string svg(const PolarChart& chart) {
     plcol0(k == 0 ? reference_colour : grid_colour);
     plwidth(k == 0 ? 1.2 : 0.6);
     plarc(0, 0, r, r, 0, 360, 0, 0);
-    plcol0(reference_colour);
-    plptex(r * std::cos(0.42) + 0.02, r * std::sin(0.42), 1, 0, 0,
-           fmt::format("{:+g} µm", k * div_um).c_str());
   }
+  // The rings' values in the corner, outside the traces (a label on a ring would sit on them).
+  plcol0(reference_colour);
+  plschr(0, 0.75);
+  plptex(-1.68, 1.62, 1, 0, 0,
+         fmt::format("rings: {:+g} to {:+g} µm", -2 * div_um, 2 * div_um).c_str());
+  plptex(-1.68, 1.50, 1, 0, 0, "dark ring: nominal radius");
+  plschr(0, 0.85);
   for (int a = 0; a < 360; a += 30) {
     const double t = a * std::numbers::pi / 180.0;
     const PLFLT sx[] = {0.5 * std::cos(t), 1.5 * std::cos(t)},
@@ -294,9 +394,13 @@ std::string svg(const PolarChart& chart) {
       l.y.push_back(r * std::sin(th));
     }
     draw_line(s, l, legend);
+    if (chart.mark_start && l.x.size() > 2) mark_start(l, t.x.front() < t.x.back());
   }
   plcol0(axes_colour);
+  if (!chart.centre_text.empty()) plptex(0, -0.03, 1, 0, 0.5, chart.centre_text.c_str());
   plmtex("b", 1.0, 0.0, 0.0, fmt::format("scale {:g} µm per ring", div_um).c_str());
+  if (chart.mark_start)
+    plmtex("b", 1.0, 1.0, 1.0, "○ start of each trace, arrow: direction of travel");
   if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
   draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_RIGHT | PL_POSITION_INSIDE);
   return s.finish(chart.title);

@@ -43,6 +43,11 @@ struct XyChart {
   std::vector<Line> lines;
   int width_pt = 760, height_pt = 380;
   bool zero_line = false;  // a grey line at y = 0
+  // Categories instead of numbers on x: the lines' x are 0, 1, ... and tick k is labelled
+  // x_labels[k] (e.g. the dates of runs).
+  std::vector<std::string> x_labels;
+  bool legend = true;       // false: no legend even for labelled lines (small multiples)
+  double text_scale = 1.0;  // > 1 for a small plot shown small (its text stays readable)
 };
 
 // A polar plot of radial deviations around a nominal circle: each line's x is the angle in
@@ -53,11 +58,16 @@ struct PolarChart {
   std::string first_axis = "X", second_axis = "Y";
   std::vector<Line> traces;
   int size_pt = 520;
+  std::string centre_text;  // written at the centre, e.g. "G = 6.96 µm"
+  bool mark_start = true;   // each trace's first point marked, an arrow in its direction
 };
 
 // Text for HTML and SVG: < > & " escaped.
 std::string html_escape(std::string_view s);
 
+// Every SVG gets its own prefix on the element ids PLplot writes (its text clip paths are
+// always "text-clipping0", "text-clipping1"...): several plots inlined in one HTML page would
+// otherwise share the first plot's clip path, and lose their text outside it.
 // Throws std::runtime_error if PLplot cannot produce the SVG. Empty lines are skipped; a
 // chart with no data gives an SVG that says so.
 std::string svg(const XyChart& chart);

@@ -21,6 +21,8 @@
 #include "circle_run.hpp"
 #include "iso230_2_output.hpp"
 #include "plot.hpp"
+#include "provenance.hpp"
+#include "verdict.hpp"
 
 namespace cal::daq::report {
 namespace {
@@ -90,7 +92,11 @@ struct RunView {
   std::string machine;
   std::vector<st::InstrumentRecord> instruments;
   json settings;
+  json context;  // settings["context"] (provenance.hpp), or an empty object for older runs
   Environment env;
+  std::vector<st::ResultRecord> results;
+  std::vector<st::MissedStop> missed;
+  ::daq::CompensationUsed used;  // linear runs: what the stored deviations were made with
 };
 
 std::string instrument_name(const RunView& v, int device) {
@@ -150,7 +156,12 @@ RunView load(const st::Store& store, std::int64_t id) {
   v.instruments = store.instruments(id);
   v.settings = json::parse(run->settings_json, nullptr, false);
   if (v.settings.is_discarded()) v.settings = json::object();
+  v.context = v.settings.value("context", json::object());
+  if (!v.context.is_object()) v.context = json::object();
   v.env = load_environment(store, v);
+  v.results = store.results(id);
+  v.missed = store.missed_stops(id);
+  v.used = ::daq::compensation_used(v.settings, v.results);
   return v;
 }
 
@@ -212,6 +223,11 @@ std::string setting_text(const json& v) {
   return v.dump();
 }
 
+std::string missed_text(const st::MissedStop& m) {
+  return fmt::format("run {} {} target {} ({:.3f} mm)", m.run_number,
+                     m.direction == '+' ? "↑" : "↓", m.target_index + 1, m.nominal_mm);
+}
+
 std::string setup_section(const RunView& v) {
   std::vector<std::vector<std::string>> rows = {
       {"Machine", esc(v.machine.empty() ? "(not recorded)" : v.machine)},
@@ -221,13 +237,34 @@ std::string setup_section(const RunView& v) {
       {"Status", std::string(st::to_string(v.run.status)) +
                      (v.run.note.empty() ? "" : " &mdash; " + esc(v.run.note))},
       {"Software", esc(v.run.software_version)},
-      {"Capture file", esc(v.run.capture_path.empty() ? "(none)" : v.run.capture_path)}};
+      {"Capture file", "<span class=\"path\">" +
+                           esc(v.run.capture_path.empty() ? "(none)" : v.run.capture_path) +
+                           "</span>"}};
+  if (!v.missed.empty()) {
+    std::string list;
+    for (const auto& m : v.missed) list += (list.empty() ? "" : "; ") + missed_text(m);
+    rows.insert(rows.begin() + 5, {"Missed stops", fmt::format("<span class=\"fail\">{} never "
+                                                               "captured:</span> {}",
+                                                               v.missed.size(), esc(list))});
+  }
   std::string h = "<h3>Test set-up</h3>\n" + table({"", ""}, rows, "kv");
+  // The settings as recorded at the start; a coefficient the current result used differently
+  // (re-compensation) is shown with both values.
+  const auto used_note = [&](const std::string& key, const json& value) -> std::string {
+    if (v.run.kind != "linear" || !v.used.recompensated) return "";
+    const std::string name = key.substr(key.find('.') + 1);
+    if (!key.starts_with("environment.") || !v.used.coefficients.contains(name)) return "";
+    if (v.used.coefficients[name] == value) return "";
+    return fmt::format(" <span class=\"changed\">(as acquired; the current result uses {})</span>",
+                       esc(setting_text(v.used.coefficients[name])));
+  };
   std::vector<std::vector<std::string>> settings;
   for (const auto& [k, val] : v.settings.items()) {
+    if (k == "context") continue;  // shown in its own sections
     if (val.is_object()) {
       for (const auto& [k2, v2] : val.items())
-        settings.push_back({esc(k + "." + k2), esc(setting_text(v2))});
+        settings.push_back(
+            {esc(k + "." + k2), esc(setting_text(v2)) + used_note(k + "." + k2, v2)});
     } else {
       settings.push_back({esc(k), esc(setting_text(val))});
     }
@@ -288,10 +325,218 @@ std::string environment_section(const Environment& env) {
   return h;
 }
 
+// --- what a customer report states ------------------------------------------------------------
+
+std::string ctx(const json& j, const char* key) {
+  return j.is_object() && j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : "";
+}
+std::string stated(const std::string& s) {
+  return s.empty() ? "<span class=\"unstated\">not stated</span>" : esc(s);
+}
+
+// Customer, site, machine identity, operator, date: from the run's context.
+std::string customer_section(const RunView& v) {
+  const json c = v.context.value("customer", json::object());
+  const json m = v.context.value("machine", json::object());
+  std::string make_model = ctx(m, "make");
+  if (!ctx(m, "model").empty()) make_model += (make_model.empty() ? "" : " ") + ctx(m, "model");
+  const std::vector<std::vector<std::string>> rows = {
+      {"Customer", stated(ctx(c, "name"))},
+      {"Site", stated(ctx(c, "site"))},
+      {"Machine", esc(v.machine.empty() ? ctx(m, "name") : v.machine)},
+      {"Make and model", stated(make_model)},
+      {"Serial number", stated(ctx(m, "serial_number"))},
+      {"Operator", stated(ctx(v.context, "operator"))},
+      {"Test date", iso_time(v.run.started_unix_ms)}};
+  return "<h3>Customer and machine</h3>\n" + table({"", ""}, rows, "kv");
+}
+
+// YYYY-MM-DD of a unix time, to compare with a calibration due date.
+std::string ymd(std::int64_t unix_ms) { return iso_time(unix_ms).substr(0, 10); }
+
+// The instruments with their serial numbers and calibration; a due date before the test is
+// flagged (the instrument was out of calibration when it measured).
+std::string instruments_section(const RunView& v) {
+  const auto list = v.context.value("instruments", json::array());
+  std::string h = "<h3>Instruments and calibration</h3>\n";
+  if (list.empty())
+    return h +
+           "<p class=\"unstated\">The instruments' serial numbers and calibration "
+           "certificates were not recorded with this run (give serial_number, certificate "
+           "and calibration_due of each device in the configuration).</p>\n";
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> past;
+  const std::string test_day = ymd(v.run.started_unix_ms);
+  for (const auto& i : list) {
+    const std::string due = ctx(i, "calibration_due");
+    std::string due_cell = stated(due);
+    if (!due.empty() && due < test_day) {
+      due_cell = "<span class=\"fail\">" + esc(due) + " &mdash; PAST DUE</span>";
+      past.push_back(ctx(i, "id"));
+    }
+    rows.push_back({esc(ctx(i, "role")), esc(ctx(i, "id")), esc(ctx(i, "driver")),
+                    stated(ctx(i, "serial_number")), stated(ctx(i, "certificate")), due_cell});
+  }
+  h += table({"role", "device", "instrument", "serial number", "certificate", "calibration due"},
+             rows);
+  if (!past.empty())
+    h += fmt::format(
+        "<p class=\"warning\">Warning: the calibration of {} was past due on the test date "
+        "({}): its readings are not traceable to a valid certificate.</p>\n",
+        esc(fmt::format("{}", fmt::join(past, ", "))), test_day);
+  return h;
+}
+
+// The state of the machine during the test, and what the sign of a deviation means.
+std::string conditions_section(const RunView& v) {
+  const json c = v.context.value("conditions", json::object());
+  std::string comp = "<span class=\"unstated\">not stated</span>";
+  if (c.contains("controller_compensation") && c["controller_compensation"].is_boolean())
+    comp = c["controller_compensation"].get<bool>() ? "on (the control's own compensation active)"
+                                                    : "off (the machine's errors uncompensated)";
+  std::vector<std::vector<std::string>> rows = {{"Controller compensation", comp},
+                                                {"Warm-up", stated(ctx(c, "warm_up"))},
+                                                {"Load", stated(ctx(c, "load"))},
+                                                {"Machine state", stated(ctx(c, "state"))}};
+  if (!ctx(c, "notes").empty()) rows.push_back({"Notes", esc(ctx(c, "notes"))});
+  const std::string sign =
+      v.run.kind == "circle"
+          ? "Radial deviation = measured radius &minus; nominal radius: positive outward. Angles "
+            "counter-clockwise from the first axis of the plane, seen from the positive third "
+            "axis; ccw and cw are the directions of travel (ISO 230-4)."
+          : "Positional deviation x<sub>ij</sub> = actual position reached &minus; target "
+            "position (ISO 230-2), the laser reading compensated for the air's refractive index "
+            "and the machine's expansion to 20 °C: positive when the axis stopped beyond the "
+            "target in its positive direction. ↑: approach in the positive direction, ↓: in the "
+            "negative.";
+  rows.push_back({"Sign convention", sign});
+  return "<h3>Test conditions</h3>\n" + table({"", ""}, rows, "kv");
+}
+
+// The verdict of a result as a coloured line: pass, fail, or no tolerance configured.
+std::string verdict_banner(const ::daq::Verdict& v) {
+  if (!v.configured) {
+    std::string h =
+        v.notes.empty()
+            ? "<p class=\"verdict none\"><strong>No tolerance configured</strong> for this test: "
+              "the results are not judged (a machine specification is given as [tolerances] in "
+              "the configuration, docs/config.md).</p>\n"
+            : "<p class=\"verdict none\"><strong>No tolerance applies</strong>: the configured "
+              "limits are for values this evaluation does not give, so the results are not "
+              "judged.</p>\n";
+    for (const auto& n : v.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+    return h;
+  }
+  std::string h = fmt::format(
+      "<p class=\"verdict {}\">Verdict against the machine specification ({}): "
+      "<strong>{}</strong>{}</p>\n",
+      v.pass ? "pass" : "fail", esc(v.basis), v.pass ? "PASS" : "FAIL",
+      v.pass ? " &mdash; every limited value within its limit"
+             : fmt::format(" &mdash; {} of {} limited values outside their limits",
+                           std::count_if(v.checks.begin(), v.checks.end(),
+                                         [](const auto& c) { return !c.pass; }),
+                           v.checks.size()));
+  for (const auto& n : v.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+  return h;
+}
+
+std::string verdict_cell(const ::daq::Check* c) {
+  if (!c) return "<span class=\"unstated\">&ndash;</span>";
+  return c->pass ? "<span class=\"pass\">pass</span>" : "<span class=\"fail\">FAIL</span>";
+}
+std::string limit_cell(const ::daq::Check* c) {
+  return c ? fmt::format("≤ {:.3f}", c->limit) : "<span class=\"unstated\">&ndash;</span>";
+}
+
+// How the results shown were obtained: the current result's provenance; for a re-compensated
+// run the coefficients and offsets as acquired beside those used now, and the original values.
+std::string provenance_section(const RunView& v, std::string_view schema) {
+  const auto current = ::daq::current_result(v.results, schema);
+  std::string h = "<h3>How these results were obtained</h3>\n";
+  if (!current)
+    return h +
+           "<p>No result is stored with this run: the values below are evaluated from the "
+           "stored data now.</p>\n";
+  const json p = json::parse(current->provenance_json, nullptr, false);
+  std::vector<std::vector<std::string>> rows;
+  const std::string how = p.is_object() ? p.value("how", "") : "";
+  rows.push_back(
+      {"Current result", fmt::format("result {} ({}), stored {}", current->id,
+                                     esc(current->standard), iso_time(current->created_unix_ms))});
+  rows.push_back(
+      {"Obtained", how.empty() ? "not recorded (stored before provenance was)" : esc(how)});
+  if (p.is_object() && p.contains("software"))
+    rows.push_back({"Software", esc(p.value("software", ""))});
+  if (p.is_object() && p.contains("replay_of_run"))
+    rows.push_back({"Replay of",
+                    p["replay_of_run"].is_null()
+                        ? "a capture whose original run is not in this database"
+                        : fmt::format("run {} (capture {})", p["replay_of_run"].get<std::int64_t>(),
+                                      esc(p.value("capture", "")))});
+  if (p.is_object() && p.contains("of_result") && !p["of_result"].is_null())
+    rows.push_back(
+        {"Re-compensation of", fmt::format("result {}", p["of_result"].get<std::int64_t>())});
+  std::size_t older = 0;
+  for (const auto& r : v.results) older += r.current() ? 0 : 1;
+  if (older)
+    rows.push_back(
+        {"Earlier results", fmt::format("{} kept, superseded (daq show {})", older, v.run.id)});
+  h += table({"", ""}, rows, "kv");
+  if (v.run.kind != "linear") return h;
+  // Coefficients and offsets: as acquired, and used by the current result.
+  const json env = v.settings.value("environment", json::object());
+  const auto& u = v.used;
+  std::vector<std::vector<std::string>> coeff;
+  const auto row = [&](const char* name, const std::string& acquired, const std::string& now) {
+    const bool changed = acquired != now;
+    coeff.push_back({name, esc(acquired),
+                     changed ? "<span class=\"changed\">" + esc(now) + "</span>" : esc(now)});
+  };
+  row("Refractive index equation", env.value("equation", "ciddor"),
+      u.coefficients.value("equation", "ciddor"));
+  row("Expansion coefficient (ppm/K)", setting_text(env.value("expansion_ppm_per_k", json(11.5))),
+      setting_text(u.coefficients.value("expansion_ppm_per_k", json(11.5))));
+  row("CO2 (µmol/mol)", setting_text(env.value("co2_umol_per_mol", json(450))),
+      setting_text(u.coefficients.value("co2_umol_per_mol", json(450))));
+  row("Wavelength (nm)", setting_text(env.value("wavelength_nm", json(632.991))),
+      setting_text(u.coefficients.value("wavelength_nm", json(632.991))));
+  row("Material temperature offset (K)", "0", fmt::format("{:g}", u.offsets.material_k));
+  row("Air temperature offset (K)", "0", fmt::format("{:g}", u.offsets.air_temperature_k));
+  row("Pressure offset (Pa)", "0", fmt::format("{:g}", u.offsets.pressure_pa));
+  row("Humidity offset (%RH)", "0", fmt::format("{:g}", u.offsets.humidity_pct));
+  h += "<h4>Compensation used</h4>\n" +
+       table({"coefficient", "as acquired", "used by the current result"}, coeff, "num", "lrr");
+  if (!u.recompensated) return h;
+  // The values before and after: the acquired result (the first of the schema) against now.
+  const st::ResultRecord* original = nullptr;
+  for (const auto& r : v.results) {
+    const json d = json::parse(r.json, nullptr, false);
+    if (d.is_object() && d.value("schema", "") == schema) {
+      original = &r;
+      break;
+    }
+  }
+  if (!original || original->id == current->id) return h;
+  const json a = json::parse(original->json, nullptr, false).value("axis", json::object());
+  const json b = json::parse(current->json, nullptr, false).value("axis", json::object());
+  std::vector<std::vector<std::string>> vals;
+  for (const auto& [key, x] : a.items()) {
+    if (!b.contains(key)) continue;
+    const double before = x.value("value_um", 0.0), after = b[key].value("value_um", 0.0);
+    vals.push_back({esc(x.value("symbol", key)), um(before), um(after),
+                    fmt::format("{:+.3f}", after - before)});
+  }
+  h += fmt::format("<h4>Original (result {}) and re-compensated (result {}) values</h4>\n",
+                   original->id, current->id) +
+       table({"value", "original (µm)", "re-compensated (µm)", "change (µm)"}, vals, "num", "lrrr");
+  return h;
+}
+
 // Headline numbers of a run, for the campaign summary and the comparison trends.
 struct Headline {
   std::vector<std::pair<std::string, double>> values_um;  // symbol, value
   std::string standard;
+  std::string verdict;  // PASS, FAIL, no tolerance configured
 };
 
 // --- ISO 230-2
@@ -326,16 +571,23 @@ cal::unc::Budget linear_budget(const RunView& v, const Linear& l, double& length
   for (const auto& t : l.targets) lo = std::min(lo, t.nominal_mm), hi = std::max(hi, t.nominal_mm);
   length_m = std::max((hi - lo) * 1e-3, 1e-3);
   cal::unc::PositioningSetup s{.length_m = length_m};
-  const auto& env = v.settings.contains("environment") ? v.settings["environment"] : json::object();
-  s.equation = cal::air::equation_from_string(env.value("equation", "ciddor"));
-  s.alpha_per_k = env.value("expansion_ppm_per_k", 11.5) * 1e-6;
-  if (!v.env.air_temperature.empty()) s.air.temperature_degc = stats(v.env.air_temperature).mean;
-  if (!v.env.pressure_hpa.empty()) s.air.pressure_pa = stats(v.env.pressure_hpa).mean * 100.0;
+  // The coefficients and sensor offsets the current result used (a re-compensated run's, not
+  // the ones it was acquired with).
+  const auto& c = v.used.coefficients;
+  const auto& off = v.used.offsets;
+  s.equation = cal::air::equation_from_string(c.value("equation", "ciddor"));
+  s.alpha_per_k = c.value("expansion_ppm_per_k", 11.5) * 1e-6;
+  if (!v.env.air_temperature.empty())
+    s.air.temperature_degc = stats(v.env.air_temperature).mean + off.air_temperature_k;
+  if (!v.env.pressure_hpa.empty())
+    s.air.pressure_pa = stats(v.env.pressure_hpa).mean * 100.0 + off.pressure_pa;
   if (!v.env.humidity.empty())
-    s.air.humidity = cal::air::Humidity::relative_pct(stats(v.env.humidity).mean);
-  s.air.co2_umol_per_mol = env.value("co2_umol_per_mol", 450.0);
-  s.air.wavelength_vacuum_nm = env.value("wavelength_nm", 632.991);
-  if (!v.env.material_temperature.empty()) s.material_degc = stats(v.env.material_temperature).mean;
+    s.air.humidity =
+        cal::air::Humidity::relative_pct(stats(v.env.humidity).mean + off.humidity_pct);
+  s.air.co2_umol_per_mol = c.value("co2_umol_per_mol", 450.0);
+  s.air.wavelength_vacuum_nm = c.value("wavelength_nm", 632.991);
+  if (!v.env.material_temperature.empty())
+    s.material_degc = stats(v.env.material_temperature).mean + off.material_k;
   return cal::unc::positioning_budget(s);
 }
 
@@ -355,12 +607,26 @@ std::string linear_plots(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
+                .height_pt = 430,
                 .zero_line = true};
-  means.bands.push_back({.x = x, .lo = up_lo, .hi = up_hi, .label = "↑ ±2s", .colour = blue});
+  // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
+  means.bands.push_back(
+      {.x = x, .lo = up_lo, .hi = up_hi, .label = "", .colour = blue, .alpha = 0.12});
+  means.lines.push_back(
+      {.x = x, .y = up_hi, .label = "x̄↑ ± 2s", .colour = blue, .width = 0.8, .dashed = true});
+  means.lines.push_back({.x = x, .y = up_lo, .colour = blue, .width = 0.8, .dashed = true});
   means.lines.push_back({.x = x, .y = up, .label = "x̄↑", .colour = blue, .markers = true});
   if (e.bidirectional) {
     means.bands.push_back(
-        {.x = x, .lo = down_lo, .hi = down_hi, .label = "↓ ±2s", .colour = vermilion});
+        {.x = x, .lo = down_lo, .hi = down_hi, .label = "", .colour = vermilion, .alpha = 0.12});
+    means.lines.push_back({.x = x,
+                           .y = down_hi,
+                           .label = "x̄↓ ± 2s",
+                           .colour = vermilion,
+                           .width = 0.8,
+                           .dashed = true});
+    means.lines.push_back(
+        {.x = x, .y = down_lo, .colour = vermilion, .width = 0.8, .dashed = true});
     means.lines.push_back({.x = x, .y = down, .label = "x̄↓", .colour = vermilion, .markers = true});
     means.lines.push_back({.x = x,
                            .y = bi,
@@ -380,6 +646,7 @@ std::string linear_plots(const Linear& l) {
   XyChart traces{.title = "Run-by-run deviations",
                  .x_label = "target position (mm)",
                  .y_label = "deviation (µm)",
+                 .height_pt = 430,
                  .zero_line = true};
   for (auto& [key, pts] : runs) {
     std::sort(pts.begin(), pts.end());
@@ -396,6 +663,51 @@ std::string linear_plots(const Linear& l) {
                     "positive direction (↑), dashed lines in the negative (↓).");
 }
 
+// The ISO 230-2 values as a grid: one row per kind of value, columns up, down and
+// bidirectional, then the limit and verdict of the value the specification limits. Standards
+// with other values (VDI/DGQ 3441) get a list.
+std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdict& verdict) {
+  const auto value = [&](const char* key) -> const cal::iso230_2::AxisResult* {
+    for (const auto& a : e.axis)
+      if (a.key == key) return &a;
+    return nullptr;
+  };
+  const auto cell = [&](const char* key) {
+    const auto* a = key ? value(key) : nullptr;
+    return a ? um(a->value_um) : std::string("<span class=\"unstated\">&ndash;</span>");
+  };
+  const struct {
+    const char* name;
+    const char* up;
+    const char* down;
+    const char* bi;
+  } grid[] = {{"E &mdash; systematic positional deviation", "E_up", "E_down", "E_bi"},
+              {"R &mdash; repeatability (±2s)", "R_up", "R_down", "R_bi"},
+              {"A &mdash; accuracy (±2s)", "A_up", "A_down", "A_bi"},
+              {"M &mdash; range of the mean bidirectional deviation", nullptr, nullptr, "M"},
+              {"B &mdash; reversal value, max |B<sub>i</sub>|", nullptr, nullptr, "B"},
+              {"B̄ &mdash; mean reversal value", nullptr, nullptr, "B_mean"}};
+  std::vector<std::vector<std::string>> rows;
+  std::size_t shown = 0;
+  for (const auto& g : grid) {
+    if (!value(g.up ? g.up : "") && !value(g.down ? g.down : "") && !value(g.bi)) continue;
+    const ::daq::Check* c = ::daq::find_check(verdict, g.bi);
+    if (!c && g.up) c = ::daq::find_check(verdict, g.up);
+    rows.push_back({g.name, cell(g.up), cell(g.down), cell(g.bi), limit_cell(c), verdict_cell(c)});
+    ++shown;
+  }
+  if (shown == 0) {  // another standard's values
+    std::vector<std::vector<std::string>> axis;
+    for (const auto& a : e.axis)
+      axis.push_back({esc(a.symbol), um(a.value_um), esc(a.description)});
+    return table({"symbol", "value (µm)", "meaning"}, axis, "num results", "lrl");
+  }
+  return table({"value (µm)", "↑ up", "↓ down", "bidirectional", "limit (µm)", "verdict"}, rows,
+               "num results grid", "lrrrrl") +
+         "<p class=\"note\">Unidirectional values (↑, ↓) from the approaches in one direction; "
+         "the limits apply to the bidirectional values (ISO 230-2).</p>\n";
+}
+
 std::string linear_section(const st::Store& store, const RunView& v, const Options& o,
                            Headline& headline) {
   const auto l = evaluate_linear(store, v, o);
@@ -403,15 +715,21 @@ std::string linear_section(const st::Store& store, const RunView& v, const Optio
   headline.standard = std::string(e.standard.title);
   std::string h = fmt::format(
       "<h3>Results: {}</h3>\n<p class=\"standard\">Evaluated by <strong>{}</strong> ({}). {} "
-      "targets, {} runs per direction, {}.</p>\n",
-      esc(e.standard.title), esc(e.standard.title), esc(e.standard.note), e.targets.size(), e.runs,
-      e.bidirectional ? "bidirectional" : "unidirectional");
-  std::vector<std::vector<std::string>> axis;
-  for (const auto& a : e.axis) {
-    axis.push_back({esc(a.symbol), um(a.value_um), esc(a.description)});
-    headline.values_um.push_back({a.symbol, a.value_um});
-  }
-  h += table({"symbol", "value (µm)", "meaning"}, axis, "num results", "lrl");
+      "targets, {}, {}.</p>\n",
+      esc(e.standard.title), esc(e.standard.title), esc(e.standard.note), e.targets.size(),
+      esc(::daq::runs_text(e)), e.bidirectional ? "bidirectional" : "unidirectional");
+  // The headline (campaign summary): the bidirectional values a specification limits, or
+  // every value of a standard without them (VDI/DGQ 3441).
+  for (const char* key : {"E_bi", "R_bi", "A_bi", "M", "B", "B_mean"})
+    for (const auto& a : e.axis)
+      if (a.key == key) headline.values_um.push_back({a.symbol, a.value_um});
+  if (headline.values_um.empty())
+    for (const auto& a : e.axis) headline.values_um.push_back({a.symbol, a.value_um});
+  const auto doc = ::daq::to_json(e);
+  const auto verdict = ::daq::verdict_of(v.settings, doc);
+  headline.verdict = ::daq::summary(verdict);
+  h += verdict_banner(verdict);
+  h += results_grid(e, verdict);
   h += linear_plots(l);
   std::vector<std::string> head{"target (mm)"};
   for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (µm)");
@@ -513,30 +831,57 @@ std::string circle_section(const st::Store& store, const RunView& v, Headline& h
       "230-4:2005</strong> (circular tests for numerically controlled machine tools); radius "
       "{:g} mm, feed {:g} mm/min, plane {}, both directions from the stored bar readings.</p>\n",
       c.program.radius_mm, c.program.feed_mm_per_min, esc(c.analysis.plane));
+  const auto doc =
+      ::daq::circle_json(r, c.program.radius_mm, c.analysis.plane, c.program.feed_mm_per_min);
+  const auto verdict = ::daq::verdict_of(v.settings, doc);
+  headline.verdict = ::daq::summary(verdict);
+  const auto* g_check = ::daq::find_check(verdict, "G_bi_um");
   const std::vector<std::vector<std::string>> iso = {
-      {"G", um(r.iso.G_bi_um), "circular deviation, both directions"},
-      {"G (cw)", um(r.iso.G_cw_um), "circular deviation, clockwise"},
-      {"G (ccw)", um(r.iso.G_ccw_um), "circular deviation, counter-clockwise"},
-      {"H", um(r.iso.H_um), "circular hysteresis"},
-      {"F max", um(r.iso.F_max_um), "largest radial deviation from the nominal radius"},
-      {"F min", um(r.iso.F_min_um), "smallest radial deviation from the nominal radius"},
+      {"G", um(r.iso.G_bi_um), "circular deviation, both directions", limit_cell(g_check),
+       verdict_cell(g_check)},
+      {"G (cw)", um(r.iso.G_cw_um), "circular deviation, clockwise", "", ""},
+      {"G (ccw)", um(r.iso.G_ccw_um), "circular deviation, counter-clockwise", "", ""},
+      {"H", um(r.iso.H_um), "circular hysteresis", "", ""},
+      {"F max", um(r.iso.F_max_um), "largest radial deviation from the nominal radius", "", ""},
+      {"F min", um(r.iso.F_min_um), "smallest radial deviation from the nominal radius", "", ""},
       {"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
-       "least-squares centre relative to the pivot (set-up)"}};
+       "least-squares centre relative to the pivot (set-up)", "", ""}};
   headline.values_um = {{"G", r.iso.G_bi_um}, {"H", r.iso.H_um}};
-  h += table({"symbol", "value (µm)", "meaning"}, iso, "num results", "lrl");
-  h += figure(svg(polar_of(c, "Polar plot, least-squares centre removed", 0, "")),
-              "Radial deviation of both directions around the nominal circle (magnified; the "
-              "scale is the deviation per ring).");
+  h += verdict_banner(verdict);
+  h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
+             "lrlrl");
+  auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
+  polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
+  h += figure(svg(polar),
+              "Radial deviation of both directions around the nominal circle (magnified: the "
+              "rings are the scale, the dark ring the nominal radius). The open circle marks "
+              "where each trace starts, the arrow its direction of travel.");
   std::vector<std::vector<std::string>> diag;
+  const auto unit_text = [](const std::string& u) {
+    return u == "um" ? std::string("µm") : u == "um/m" ? std::string("µm/m") : u;
+  };
   for (std::size_t i = 0; i < r.diagnostics.size(); ++i) {
     const auto& d = r.diagnostics[i];
-    diag.push_back({std::to_string(i + 1), esc(d.name), fmt::format("{:.3f} {}", d.value, d.unit),
-                    um(d.pv_um), fmt::format("{:.1f}", d.share_pct), um(d.g_reduction_um)});
+    const auto* check = ::daq::find_check(verdict, d.key);
+    diag.push_back({std::to_string(i + 1), esc(d.name), fmt::format("{:+.3f}", d.value),
+                    esc(unit_text(d.unit)), um(d.pv_um), fmt::format("{:.1f}", d.share_pct),
+                    um(d.g_reduction_um), check ? fmt::format("≤ {:.3f}", check->limit) : "",
+                    check ? verdict_cell(check) : ""});
     if (i < 4) headline.values_um.push_back({d.name, d.pv_um});
   }
-  h += "<h4>Diagnostics, ranked</h4>\n" +
-       table({"rank", "error", "value", "PV (µm)", "share of G (%)", "G gained if removed (µm)"},
-             diag, "num", "rlrrrr");
+  h += "<h4>Diagnostics, ranked</h4>\n" + table({"rank", "error", "value", "unit", "PV (µm)",
+                                                 "PV / G (%)", "G gain (µm)", "limit", "verdict"},
+                                                diag, "num diag", "rlrlrrrrl");
+  h += fmt::format(
+      "<p class=\"note\">Each error is fitted to both traces together. <em>value</em> is the "
+      "error in its own unit (a backlash in µm, a squareness in µm/m, a servo mismatch in ms); "
+      "<em>PV</em> is the peak-to-valley, in µm, of the radial deviation that error alone "
+      "causes on this circle; <em>PV / G</em> compares it with G = {:.3f} µm. The errors add up "
+      "with their signs around the circle and partly cancel, so one share can exceed 100 % and "
+      "the shares do not sum to 100 %. <em>G gain</em> is how much G falls when that error "
+      "alone is corrected (negative: it partly cancels another). A limit applies to the "
+      "magnitude of the value, in its unit.</p>\n",
+      r.iso.G_bi_um);
   for (const auto& n : r.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
   h += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>The error model leaves a residual of {:.3f} µm rms "
@@ -594,29 +939,73 @@ table { border-collapse: collapse; margin: .5rem 0 1rem; font-size: .9rem; }
 th, td { border: 1px solid #ccc; padding: .2rem .5rem; vertical-align: top; }
 th { background: #f0f4f8; text-align: left; }
 td.r { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
-td { overflow-wrap: anywhere; }
+td { overflow-wrap: break-word; } .path { overflow-wrap: anywhere; }
+.nw { white-space: nowrap; }
+.verdict { padding: .4rem .6rem; border-radius: 3px; margin: .6rem 0; }
+.verdict.pass { background: #e3f4ea; border: 1px solid #2e8b57; }
+.verdict.fail { background: #fde8e4; border: 1px solid #c0392b; }
+.verdict.none { background: #f3f3f3; border: 1px solid #999; }
+span.pass { color: #1e7b45; font-weight: bold; } span.fail { color: #b8271b; font-weight: bold; }
+.unstated { color: #888; font-style: italic; } .changed { color: #a04000; font-weight: bold; }
+table.grid td:first-child { font-weight: normal; }
+.multiples { display: grid; grid-template-columns: 1fr 1fr; gap: .5rem 1rem; }
+.multiples figure { margin: .3rem 0; }
 table.kv td:first-child { color: #555; }
 table.kv thead { display: none; }
 table.results td:first-child { font-weight: bold; }
 figure { margin: 1rem 0; page-break-inside: avoid; break-inside: avoid; }
-svg.plot { width: 100%; height: auto; max-width: 52rem; display: block; }
+svg.plot { width: 100%; height: auto; max-width: 60rem; display: block; }
 figcaption { font-size: .85rem; color: #444; }
 .warning { color: #a40; } .note { color: #444; font-size: .9rem; }
 .simulated { background: #fff3cd; border: 1px solid #e0b000; padding: .5rem; }
-footer { margin-top: 3rem; font-size: .8rem; color: #666; border-top: 1px solid #ccc; }
-@page { size: A4; margin: 14mm; }
-@media print { body { margin: 0; max-width: none; } h2 { page-break-before: always; } }
+footer { margin-top: 2rem; font-size: .8rem; color: #666; border-top: 1px solid #ccc;
+         break-before: avoid; page-break-before: avoid; }
+h3, h4 { break-after: avoid; page-break-after: avoid; }
+table { break-inside: auto; } tr { break-inside: avoid; }
+@media print { body { margin: 0; max-width: none; font-size: 10pt; }
+  h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
+  svg.plot { max-width: 82%; margin: 0 auto; } .multiples svg.plot { max-width: 100%; } }
 )";
 
-std::string page(std::string_view title, const std::string& body, const Options& o) {
+// A CSS string literal (for the printed page's running header).
+std::string css_string(std::string_view s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') continue;
+    out += c;
+  }
+  return out + "\"";
+}
+
+// The printed page: a running header (the report's title and who it is for) and "page n of
+// m" in the page margins (CSS paged-media margin boxes, which Chromium prints).
+std::string print_css(std::string_view title, std::string_view who) {
+  return fmt::format(
+      "@page {{ size: A4; margin: 18mm 14mm 16mm 14mm;\n"
+      "  @top-left {{ content: {}; font: 8pt \"DejaVu Sans\", sans-serif; color: #555; }}\n"
+      "  @top-right {{ content: {}; font: 8pt \"DejaVu Sans\", sans-serif; color: #555; }}\n"
+      "  @bottom-right {{ content: \"page \" counter(page) \" of \" counter(pages); "
+      "font: 8pt \"DejaVu Sans\", sans-serif; color: #555; }} }}\n",
+      css_string(title), css_string(who));
+}
+
+std::string page(std::string_view title, const std::string& body, const Options& o,
+                 std::string_view who = "") {
   const auto now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
                           std::chrono::system_clock::now().time_since_epoch())
                           .count();
   return fmt::format(
       "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n"
-      "<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<footer>Generated by {} on {}. Plots "
+      "<style>{}{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<footer>Generated by {} on {}. Plots "
       "drawn with PLplot. Self-contained: no external resources.</footer>\n</body>\n</html>\n",
-      esc(title), css, esc(title), body, esc(o.software), iso_time(now_ms));
+      esc(title), css, print_css(title, who), esc(title), body, esc(o.software), iso_time(now_ms));
+}
+
+// "Customer — machine" for the running header.
+std::string who_of(const RunView& v) {
+  const std::string customer = ctx(v.context.value("customer", json::object()), "name");
+  return customer.empty() ? v.machine : customer + " — " + v.machine;
 }
 
 bool simulated(const RunView& v) {
@@ -633,11 +1022,25 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
   if (simulated(v))
     h += "<p class=\"simulated\">This run was made on the <strong>simulated</strong> machine "
          "and instruments: the numbers show what the software measures, not a real machine.</p>\n";
-  if (v.run.status != st::RunStatus::complete)
+  if (v.run.status != st::RunStatus::complete) {
     h += fmt::format(
         "<p class=\"warning\">This run is {}{}: the results cover only what was "
         "stored.</p>\n",
         st::to_string(v.run.status), v.run.note.empty() ? "" : " (" + esc(v.run.note) + ")");
+    if (!v.missed.empty()) {
+      std::vector<std::vector<std::string>> rows;
+      for (const auto& m : v.missed)
+        rows.push_back({std::to_string(m.run_number), m.direction == '+' ? "↑ up" : "↓ down",
+                        std::to_string(m.target_index + 1), fmt::format("{:.3f}", m.nominal_mm)});
+      h += "<h4>Missed stops (never captured)</h4>\n" +
+           table({"run", "direction", "target", "nominal (mm)"}, rows, "num", "rlrr");
+    }
+  }
+  h += customer_section(v);
+  h += conditions_section(v);
+  h += instruments_section(v);
+  if (v.run.kind == "linear" || v.run.kind == "circle")
+    h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v1");
   h += setup_section(v);
   // An aborted or interrupted run may hold too little to evaluate: the report still shows what
   // was stored, and says why there are no results.
@@ -665,31 +1068,42 @@ std::string date_of(const RunView& v) { return iso_time(v.run.started_unix_ms).s
 std::string run_report(const st::Store& store, std::int64_t run, const Options& o) {
   const auto v = load(store, run);
   Headline hl;
-  return page(run_title(v), run_body(store, v, o, hl), o);
+  return page(run_title(v), run_body(store, v, o, hl), o, who_of(v));
 }
 
 std::string campaign_report(const st::Store& store, std::span<const std::int64_t> runs,
                             std::string_view title, const Options& o) {
   if (runs.empty()) throw cal::InputError("campaign report: no runs to report");
   std::vector<std::vector<std::string>> summary;
-  std::string sections;
+  std::string sections, who;
   for (const auto id : runs) {
     const auto v = load(store, id);
     Headline hl;
     const auto body = run_body(store, v, o, hl);
+    // Each value kept whole on its line: "E 8.576 µm" never breaks inside.
     std::string numbers;
+    std::size_t shown = 0;
     for (const auto& [k, val] : hl.values_um)
-      if (numbers.size() < 400) numbers += fmt::format("{} {} µm; ", esc(k), um(val));
-    summary.push_back({fmt::format("<a href=\"#run-{}\">{}</a>", id, id), date_of(v),
-                       esc(v.run.kind), esc(v.run.axis), std::string(st::to_string(v.run.status)),
-                       esc(hl.standard), numbers});
+      if (shown++ < 8)
+        numbers += fmt::format("<span class=\"nw\">{} {} µm</span>; ", esc(k), um(val));
+    const std::string verdict = hl.verdict == "PASS"   ? "<span class=\"pass\">PASS</span>"
+                                : hl.verdict == "FAIL" ? "<span class=\"fail\">FAIL</span>"
+                                : hl.verdict.empty()
+                                    ? "<span class=\"unstated\">&ndash;</span>"
+                                    : "<span class=\"unstated\">no tolerance</span>";
+    summary.push_back({fmt::format("<a href=\"#run-{}\">{}</a>", id, id),
+                       "<span class=\"nw\">" + date_of(v) + "</span>", esc(v.run.kind),
+                       esc(v.run.axis), std::string(st::to_string(v.run.status)), esc(hl.standard),
+                       numbers, verdict});
     sections += fmt::format("<h2 id=\"run-{}\">{}</h2>\n{}", id, esc(run_title(v)), body);
+    if (who.empty()) who = who_of(v);
   }
   const std::string body =
       fmt::format("<p>{} runs.</p>\n", runs.size()) +
-      table({"run", "date", "test", "axis", "status", "standard", "results"}, summary, "", "r") +
+      table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
+            "summary", "r") +
       sections;
-  return page(title, body, o);
+  return page(title, body, o, who);
 }
 
 std::string comparison_report(const st::Store& store, std::span<const std::int64_t> runs,
@@ -712,60 +1126,106 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
         fmt::format("comparison report: {} runs cannot be compared (linear and circle runs can)",
                     first.run.kind));
 
-  const double day0_ms = static_cast<double>(first.run.started_unix_ms);
-  std::map<std::string, Line> trends;  // symbol -> value over days
+  // The runs' dates as x labels: the day, or with the time (UTC) when two runs share a day.
+  std::vector<std::string> dates;
+  bool same_day = false;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    dates.push_back(date_of(views[i]));
+    if (i && dates[i] == dates[i - 1]) same_day = true;
+  }
+  if (same_day)
+    for (std::size_t i = 0; i < views.size(); ++i)
+      dates[i] = fmt::format("run {} {}", views[i].run.id,
+                             iso_time(views[i].run.started_unix_ms).substr(5, 11));  // MM-DD HH:MM
+  struct Value {
+    std::string key, symbol, unit;
+    double value = 0;
+  };
+  static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
+                                                    "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
+  std::map<std::string, Line> trends;        // key -> value run by run
+  std::map<std::string, double> limits;      // key -> the limit of the newest run that has one
+  std::map<std::string, std::string> names;  // key -> symbol (unit)
   std::vector<std::string> trend_order;
   std::vector<std::vector<std::string>> rows;
-  std::string overlays;
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
                   .x_label = "target position (mm)",
                   .y_label = "deviation (µm)",
+                  .height_pt = 430,
                   .zero_line = true};
   std::vector<PolarChart> polars;
   for (std::size_t i = 0; i < views.size(); ++i) {
     const auto& v = views[i];
-    Headline hl;
-    const std::string label = fmt::format("run {} ({})", v.run.id, date_of(v));
+    const std::string label = fmt::format("run {} ({})", v.run.id, dates[i]);
+    std::vector<Value> values;
+    json doc;
     if (v.run.kind == "linear") {
       const auto l = evaluate_linear(store, v, o);
       Line line{.label = label, .colour = palette(i), .width = 1.4, .markers = true};
       for (const auto& t : l.e.targets)
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
-      hl.standard = std::string(l.e.standard.title);
-      for (const auto& a : l.e.axis) hl.values_um.push_back({a.symbol, a.value_um});
+      for (const auto& a : l.e.axis) values.push_back({a.key, a.symbol, "µm", a.value_um});
+      doc = ::daq::to_json(l.e);
     } else {
       const auto c = analyse_circle(store, v);
       polars.push_back(polar_of(c, "", 2 * i, label + " "));
-      hl.values_um = {{"G", c.result.iso.G_bi_um}, {"H", c.result.iso.H_um}};
+      values = {{"G_bi_um", "G", "µm", c.result.iso.G_bi_um},
+                {"H_um", "H", "µm", c.result.iso.H_um}};
       for (const auto& d : c.result.diagnostics)
-        if (d.key == "squareness" || d.key == "backlash_X" || d.key == "backlash_Y" ||
-            d.key == "servo_mismatch" || d.key == "scale_mismatch")
-          hl.values_um.push_back({d.name + " (PV)", d.pv_um});
+        values.push_back({d.key, d.name,
+                          d.unit == "um"     ? "µm"
+                          : d.unit == "um/m" ? "µm/m"
+                                             : d.unit,
+                          d.value});
+      doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
+                               c.program.feed_mm_per_min);
     }
-    const double day = (static_cast<double>(v.run.started_unix_ms) - day0_ms) / 86'400'000.0;
-    std::vector<std::string> row{std::to_string(v.run.id), date_of(v)};
-    for (const auto& [k, val] : hl.values_um) {
-      if (!trends.count(k)) {
-        trend_order.push_back(k);
-        trends[k] = Line{.label = k, .colour = palette(trend_order.size() - 1), .markers = true};
+    const auto verdict = ::daq::verdict_of(v.settings, doc);
+    // A re-compensated run is compared with the values it has now, and says so.
+    std::vector<std::string> row{
+        std::to_string(v.run.id) +
+            (v.used.recompensated ? " <span class=\"changed\">re-compensated</span>" : ""),
+        "<span class=\"nw\">" + dates[i] + "</span>"};
+    // A linear run's table keeps to the values a specification limits (the unidirectional ones
+    // are in each run's report): all twelve would not fit a printed page.
+    if (v.run.kind == "linear" &&
+        std::any_of(values.begin(), values.end(), [](const Value& x) { return x.key == "E_bi"; }))
+      std::erase_if(values, [](const Value& x) {
+        return std::find(linear_keys.begin(), linear_keys.end(), x.key) == linear_keys.end();
+      });
+    for (const auto& x : values) {
+      if (!trends.count(x.key)) {
+        trend_order.push_back(x.key);
+        names[x.key] = x.symbol + " (" + x.unit + ")";
+        trends[x.key] = Line{.colour = blue, .width = 1.4, .markers = true};
       }
-      trends[k].x.push_back(day);
-      trends[k].y.push_back(val);
-      row.push_back(um(val));
+      trends[x.key].x.push_back(static_cast<double>(i));
+      trends[x.key].y.push_back(x.value);
+      const auto* check = ::daq::find_check(verdict, x.key);
+      if (check) limits[x.key] = check->limit;
+      row.push_back(um(x.value) + (check ? (check->pass ? " <span class=\"pass\">✓</span>"
+                                                        : " <span class=\"fail\">✗</span>")
+                                         : ""));
     }
+    row.push_back(!verdict.configured ? "<span class=\"unstated\">no tolerance</span>"
+                  : verdict.pass      ? "<span class=\"pass\">PASS</span>"
+                                      : "<span class=\"fail\">FAIL</span>");
     const auto air = stats(v.env.air_temperature), mat = stats(v.env.material_temperature);
     row.push_back(air.n ? fmt::format("{:.2f}", air.mean) : "&ndash;");
     row.push_back(mat.n ? fmt::format("{:.2f}", mat.mean) : "&ndash;");
     rows.push_back(std::move(row));
   }
   std::vector<std::string> head{"run", "date"};
-  for (const auto& k : trend_order) head.push_back(esc(k) + " (µm)");
+  for (const auto& k : trend_order) head.push_back(esc(names[k]));
+  head.push_back("verdict");
   head.push_back("air (°C)");
   head.push_back("material (°C)");
   std::string body = fmt::format(
-      "<p>The same test ({} of axis {}) on {} occasions, from {} to {}.</p>\n", esc(first.run.kind),
-      esc(first.run.axis), views.size(), date_of(first), date_of(views.back()));
+      "<p>The same test ({} of axis {}) on {} occasions, from {} to {}. ✓ / ✗: within / outside "
+      "the limit of that run's specification.</p>\n",
+      esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
+      date_of(views.back()));
   body += table(head, rows, "num");
   if (first.run.kind == "linear") {
     body += figure(svg(overlay),
@@ -782,13 +1242,121 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
       for (auto& t : p.traces) all.traces.push_back(std::move(t));
     body += figure(svg(all), "Both directions of every run on one scale.");
   }
-  XyChart trend{.title = "Results over time",
-                .x_label = fmt::format("days since {}", date_of(first)),
-                .y_label = "value (µm)"};
-  for (const auto& k : trend_order) trend.lines.push_back(trends[k]);
-  body += figure(svg(trend), "Each result of the standard against the date of its run.");
+  // One small plot per value: each on its own scale, the runs in date order, the limit dashed.
+  body += "<h3>Each value over time</h3>\n<div class=\"multiples\">\n";
+  std::size_t plotted = 0;
+  for (const auto& k : trend_order) {
+    if (first.run.kind == "linear" &&
+        std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
+      continue;
+    if (plotted++ >= 10) break;
+    XyChart small{.title = names[k],
+                  .x_label = "",
+                  .y_label = "",  // the title names it (a rotated label at this size was clipped)
+                  .width_pt = 420,
+                  .height_pt = 260,
+                  .x_labels = dates,
+                  .legend = false,
+                  .text_scale = 1.5};
+    small.lines.push_back(trends[k]);
+    if (limits.count(k)) {
+      const double n = static_cast<double>(views.size()) - 1;
+      small.lines.push_back({.x = {-0.4, n + 0.4},
+                             .y = {limits[k], limits[k]},
+                             .colour = vermilion,
+                             .width = 1.0,
+                             .dashed = true});
+    }
+    body += figure(svg(small), names[k] + (limits.count(k) ? " (dashed: the limit)" : ""));
+  }
+  body += "</div>\n";
   return page(fmt::format("Comparison: {} test of axis {}", first.run.kind, first.run.axis), body,
-              o);
+              o, who_of(first));
+}
+
+std::string as_found_as_left_report(const st::Store& store, std::int64_t found_id,
+                                    std::int64_t left_id, const Options& o) {
+  const auto found = load(store, found_id), left = load(store, left_id);
+  if (found.run.kind != left.run.kind || found.run.axis != left.run.axis)
+    throw cal::InputError(fmt::format(
+        "as found / as left: run {} is a {} test of {}, run {} a {} test of {}; give the same test "
+        "before and after the compensation",
+        found_id, found.run.kind, found.run.axis, left_id, left.run.kind, left.run.axis));
+  if (found.run.kind != "linear" && found.run.kind != "circle")
+    throw cal::InputError("as found / as left: linear or circle runs");
+  struct Side {
+    json doc;
+    ::daq::Verdict verdict;
+    std::vector<std::tuple<std::string, std::string, double>> values;  // key, symbol, value
+  };
+  XyChart overlay{.title = "Mean bidirectional deviation, as found and as left",
+                  .x_label = "target position (mm)",
+                  .y_label = "deviation (µm)",
+                  .height_pt = 430,
+                  .zero_line = true};
+  PolarChart polar{.title = "As found and as left (least-squares centres removed)"};
+  const auto side = [&](const RunView& v, std::size_t colour, const char* label) {
+    Side sd;
+    if (v.run.kind == "linear") {
+      const auto l = evaluate_linear(store, v, o);
+      Line line{.label = fmt::format("{} (run {})", label, v.run.id),
+                .colour = palette(colour),
+                .width = 1.4,
+                .markers = true};
+      for (const auto& t : l.e.targets)
+        line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
+      overlay.lines.push_back(std::move(line));
+      for (const auto& a : l.e.axis) sd.values.emplace_back(a.key, a.symbol, a.value_um);
+      sd.doc = ::daq::to_json(l.e);
+    } else {
+      const auto c = analyse_circle(store, v);
+      auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
+      polar.first_axis = p.first_axis, polar.second_axis = p.second_axis;
+      for (auto& t : p.traces) polar.traces.push_back(std::move(t));
+      sd.values = {{"G_bi_um", "G", c.result.iso.G_bi_um}, {"H_um", "H", c.result.iso.H_um}};
+      for (const auto& d : c.result.diagnostics) sd.values.emplace_back(d.key, d.name, d.value);
+      sd.doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
+                                  c.program.feed_mm_per_min);
+    }
+    sd.verdict = ::daq::verdict_of(v.settings, sd.doc);
+    return sd;
+  };
+  const auto a = side(found, 1, "as found"), b = side(left, 2, "as left");
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& [key, symbol, va] : a.values) {
+    std::optional<double> vb;
+    for (const auto& [k2, s2, x] : b.values)
+      if (k2 == key) vb = x;
+    const auto* ca = ::daq::find_check(a.verdict, key);
+    const auto* cb = ::daq::find_check(b.verdict, key);
+    rows.push_back({esc(symbol), um(va) + " " + (ca ? verdict_cell(ca) : ""),
+                    vb ? um(*vb) + " " + (cb ? verdict_cell(cb) : "") : "&ndash;",
+                    vb ? fmt::format("{:+.3f}", *vb - va) : "&ndash;", limit_cell(cb ? cb : ca)});
+  }
+  const auto banner = [](const ::daq::Verdict& v) {
+    return !v.configured ? std::string("<span class=\"unstated\">no tolerance configured</span>")
+           : v.pass      ? std::string("<span class=\"pass\">PASS</span>")
+                         : std::string("<span class=\"fail\">FAIL</span>");
+  };
+  std::string body = fmt::format(
+      "<p>The machine as it was found (run {}, {}) and as it was left after the compensation "
+      "(run {}, {}): the same test, side by side. Each run's full report follows.</p>\n",
+      found_id, date_of(found), left_id, date_of(left));
+  rows.push_back({"<strong>verdict</strong>", banner(a.verdict), banner(b.verdict), "", ""});
+  body += table({"value", fmt::format("as found, run {}", found_id),
+                 fmt::format("as left, run {}", left_id), "change", "limit"},
+                rows, "num results", "lrrrr");
+  if (found.run.kind == "linear")
+    body += figure(svg(overlay), "The mean bidirectional positional deviation before and after.");
+  else
+    body += figure(svg(polar), "Both directions of both runs on one scale.");
+  Headline hl;
+  body += fmt::format("<h2 id=\"run-{}\">As found: {}</h2>\n", found_id, esc(run_title(found))) +
+          run_body(store, found, o, hl);
+  body += fmt::format("<h2 id=\"run-{}\">As left: {}</h2>\n", left_id, esc(run_title(left))) +
+          run_body(store, left, o, hl);
+  return page(fmt::format("As found and as left: {} test of {}", found.run.kind, found.run.axis),
+              body, o, who_of(found));
 }
 
 namespace {

@@ -28,6 +28,10 @@ std::string campaign_report(const storage::Store& store, std::span<const std::in
                             std::string_view title, const Options& o = {});
 std::string comparison_report(const storage::Store& store, std::span<const std::int64_t> runs,
                               const Options& o = {});
+// The same test before ("as found") and after ("as left") a compensation, side by side, then
+// both runs' reports.
+std::string as_found_as_left_report(const storage::Store& store, std::int64_t found,
+                                    std::int64_t left, const Options& o = {});
 
 // Straightness and squareness are analysed from measured profiles (CSV files, not stored
 // runs): the report shows the deviations with the ISO 230-1 reference lines.

@@ -5,6 +5,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
+#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -12,6 +13,7 @@
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "circle_output.hpp"
+#include "provenance.hpp"
 
 namespace daq {
 
@@ -113,16 +115,19 @@ struct CircleRun::Impl {
   CircleRunOutcome outcome;
   CircleLive live;
   bool running = false, done = false;
+  // Handlers posted from the writer's thread run only while the run exists.
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
   Impl(boost::asio::io_context& i, CircleRunSetup s)
       : io(i), setup(std::move(s)), segmenter(setup.program) {}
+  ~Impl() { *alive = false; }
 
   void event(const std::string& e) {
     if (setup.on_event) setup.on_event(e);
   }
 
   void start() {
-    store.emplace(setup.database);
+    store.emplace(setup.database, setup.store_options);
     const auto& c = setup.config;
     std::int64_t machine = 0;
     if (auto m = store->machine_by_name(c.machine_name))
@@ -130,7 +135,12 @@ struct CircleRun::Impl {
     else
       machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
     const auto& p = setup.program;
-    const json settings = circle_settings_json(p, setup.analysis);
+    json settings = circle_settings_json(p, setup.analysis);
+    settings["context"] = setup.context_json.empty()
+                              ? json(nullptr)
+                              : json::parse(setup.context_json, nullptr, false);
+    if (!settings["context"].is_object())
+      settings["context"] = run_context(c, "circle", setup.analysis.plane);
     outcome.run_id = store->begin_run({.machine_id = machine,
                                        .campaign = c.campaign,
                                        .kind = "circle",
@@ -142,7 +152,13 @@ struct CircleRun::Impl {
                            .device = 3,
                            .driver = "ballbar",
                            .transport = setup.ballbar->describe()});
-    writer = std::make_unique<cal::storage::BatchWriter>(setup.database, outcome.run_id);
+    writer = std::make_unique<cal::storage::BatchWriter>(
+        setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
+        [this, alive = alive](const std::string& e) {
+          boost::asio::post(io, [this, alive, e] {
+            if (*alive) abort("storage failed: " + e);
+          });
+        });
     running = true;
     setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
                           .state =
@@ -163,12 +179,21 @@ struct CircleRun::Impl {
   void on_reading(const cal::drivers::Reading& r) {
     if (setup.on_reading) setup.on_reading(r);
     if (!running || r.quantity != cal::drivers::Quantity::length_m) return;
+    if (outcome.readings == 0)  // the time origin for exports (see linear_run.cpp)
+      store->set_time_origin(outcome.run_id, r.time_ns,
+                             std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count());
     ++outcome.readings;
-    writer->push({.time_ns = r.time_ns,
-                  .device = 3,
-                  .quantity = static_cast<std::uint8_t>(r.quantity),
-                  .status = static_cast<std::uint8_t>(r.status),
-                  .value = r.value});
+    try {
+      writer->push({.time_ns = r.time_ns,
+                    .device = 3,
+                    .quantity = static_cast<std::uint8_t>(r.quantity),
+                    .status = static_cast<std::uint8_t>(r.status),
+                    .value = r.value});
+    } catch (const std::exception& e) {  // the writer failed earlier (a full disk)
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     const bool had = segmenter.feed_in_end().has_value();
     segmenter.add(r.value * 1e3);
     if (!had && segmenter.feed_in_end()) event("feed-in found: the circle starts after the dwell");
@@ -201,18 +226,34 @@ struct CircleRun::Impl {
   void finish() {
     if (done) return;
     running = false;
-    writer->flush();
+    try {
+      writer->flush();
+    } catch (const std::exception& e) {
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     try {
       outcome.result = analyse_ballbar(setup.program, setup.analysis, segmenter.values());
     } catch (const std::exception& e) {
       return abort(e.what());
     }
-    store->add_result({.run_id = outcome.run_id,
-                       .standard = "ISO 230-4:2005",
-                       .json = circle_json(*outcome.result, setup.program.radius_mm,
-                                           setup.analysis.plane, setup.program.feed_mm_per_min)
-                                   .dump()});
-    store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+    prov["analysis"] = circle_settings_json(setup.program, setup.analysis);
+    if (setup.replay) {
+      prov["capture"] = setup.capture_path;
+      prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
+    }
+    try {
+      store->add_result({.run_id = outcome.run_id,
+                         .standard = "ISO 230-4:2005",
+                         .json = circle_json(*outcome.result, setup.program.radius_mm,
+                                             setup.analysis.plane, setup.program.feed_mm_per_min)
+                                     .dump(),
+                         .provenance_json = prov.dump()});
+      store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    } catch (const std::exception& e) {
+      outcome.result.reset();
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     outcome.complete = true;
     publish_end("complete");
     end();
@@ -222,8 +263,18 @@ struct CircleRun::Impl {
     if (done) return;
     running = false;
     outcome.reason = reason;
-    if (writer) writer->flush();
-    if (store) store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, reason);
+    try {
+      if (writer) writer->flush();
+    } catch (const std::exception& e) {
+      if (reason.find(e.what()) == std::string::npos)
+        outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
+    }
+    try {
+      if (store)
+        store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    } catch (const std::exception& e) {
+      outcome.reason += fmt::format(" (and the run's end could not be stored: {})", e.what());
+    }
     publish_end("aborted");
     end();
   }
@@ -238,7 +289,11 @@ struct CircleRun::Impl {
 CircleRun::CircleRun(boost::asio::io_context& io, CircleRunSetup setup)
     : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
 CircleRun::~CircleRun() {
-  if (!impl_->done && impl_->running) impl_->abort("stopped");
+  try {
+    if (!impl_->done && impl_->running) impl_->abort("stopped");
+  } catch (...) {
+    // abort() does not throw; a display callback might: not through a destructor.
+  }
 }
 void CircleRun::start() { impl_->start(); }
 void CircleRun::stop(const std::string& reason) { impl_->abort(reason); }

@@ -14,6 +14,7 @@
 #include "cal/daq/ballbar.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -66,6 +67,12 @@ struct CircleRunSetup {
   std::unique_ptr<cal::drivers::Instrument> ballbar;
   std::string capture_path;
   std::string software_version = "daq 0.1.0";
+  // The run's context as JSON (provenance.hpp); empty: made from `config`. A replay passes the
+  // original run's, and says which run it replays when that is known.
+  std::string context_json;
+  bool replay = false;
+  std::optional<std::int64_t> replay_of_run;
+  cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
   std::function<void(const std::string&)> on_event;
   std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading

@@ -16,6 +16,7 @@
 #include "cal/daq/config.hpp"
 #include "cal/daq/sequencer.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -60,7 +61,14 @@ struct LinearRunSetup {
   double datum_mm = 0.0;  // axis position where the laser reads 0
   std::string software_version = "daq 0.1.0";
   std::string capture_path;
-  std::function<void(const LiveState&)> on_live;     // about 10 Hz
+  // The run's context (customer, machine, instruments, tolerances; provenance.hpp) as JSON;
+  // empty: made from `config`. A replay passes the original run's.
+  std::string context_json;
+  // A replay of a capture: the results record it, and the original run when it is known.
+  bool replay = false;
+  std::optional<std::int64_t> replay_of_run;
+  cal::storage::StoreOptions store_options;       // the run's and the writer's (tests: max_pages)
+  std::function<void(const LiveState&)> on_live;  // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
 };
@@ -83,12 +91,19 @@ class MaterialSensors {
 
 struct LinearRunOutcome {
   std::int64_t run_id = 0;
+  // The run reached the end of its plan and was evaluated (also when stops were missed:
+  // `status` is then incomplete and `missed` lists them).
   bool complete = false;
-  std::string reason;  // why it stopped, when not complete
+  cal::storage::RunStatus status = cal::storage::RunStatus::running;
+  std::vector<cal::storage::MissedStop> missed;
+  std::string reason;  // why it stopped, when not complete; the missed stops when incomplete
   std::optional<cal::iso230_2::Evaluation> evaluation;
   std::size_t readings = 0;
 };
 
+// A store or capture that fails (a full disk) ends the run as aborted with the reason
+// ("storage failed: FILE: ..."), keeping what was written; nothing is thrown out of the
+// instruments' handlers or the destructor.
 class LinearRun {
  public:
   LinearRun(boost::asio::io_context& io, LinearRunSetup setup);

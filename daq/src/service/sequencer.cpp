@@ -83,7 +83,15 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
          fmt::format("{}: {:+.3f} um", describe(stops_[j]),
                      (c.mean_mm - stops_[j].position_mm) * 1e3));
     next_ = j + 1;
-    if (complete()) events.push_back({SequenceEvent::Kind::complete, j, "all stops captured"});
+    if (complete()) {
+      // The end of the plan: "all stops captured" only when it is true.
+      const auto missed = std::count_if(stops_.begin(), stops_.end(),
+                                        [](const ExpectedStop& e) { return !e.captured; });
+      events.push_back({SequenceEvent::Kind::complete, j,
+                        missed == 0 ? std::string("all stops captured")
+                                    : fmt::format("end of the plan: {} of {} stops missed", missed,
+                                                  stops_.size())});
+    }
     return events;
   }
   // A stop reported missed earlier, captured late.
@@ -131,6 +139,13 @@ Progress Sequencer::progress() const {
     p.next_position_mm = e.position_mm;
   }
   return p;
+}
+
+std::vector<std::size_t> Sequencer::missed() const {
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < next_ && i < stops_.size(); ++i)
+    if (!stops_[i].captured) out.push_back(i);
+  return out;
 }
 
 std::vector<iso230_2::Measurement> Sequencer::measurements() const {

@@ -77,6 +77,10 @@ struct Evaluation {
   std::vector<PerTarget> per_target;
   std::vector<AxisResult> axis;
   std::vector<std::string> warnings;
+  std::vector<std::string> notes;  // rules applied (an axis over 2000 mm)
+  // An axis over 2000 mm measured with one approach per direction (ISO 230-2:2014, 6.2): only
+  // the means, the reversal, E and M are evaluated; no s, repeatability or accuracy A.
+  bool single_run_long_axis = false;
 
   // Throws std::out_of_range naming the key when the standard does not define it.
   const AxisResult& at(std::string_view key) const;
@@ -86,7 +90,12 @@ struct Evaluation {
 // The statistics per target. Throws InputError for: no data, non-finite values, a run
 // number < 1, a (target, run, direction) measured twice, a target with fewer than 2 runs
 // in a direction, or a target measured in only one direction while others have both.
+// evaluate() accepts one run per direction on an axis over 2000 mm under ISO 230-2:2014
+// (6.2 of the standard) and evaluates what that allows; other standards and shorter axes
+// need 2 runs or more.
 std::vector<TargetStats> target_stats(std::span<const Measurement> data);
+// The same with fewer runs allowed: min_runs = 1 for an axis over 2000 mm (s is then 0).
+std::vector<TargetStats> target_stats(std::span<const Measurement> data, int min_runs);
 
 Evaluation evaluate(std::span<const Measurement> data, Standard standard);
 

@@ -10,12 +10,15 @@
 // Kinematic chain. The topology letters are read from the workpiece to the tool; F is the
 // frame (bed). Axes left of F carry the workpiece (they move the table), axes right of F carry
 // the tool. Each letter carries everything on its left (workpiece side) or on its right (tool
-// side):
+// side). Any of the 24 serial orders of X, Y, Z and F is a topology, for example:
 //
 //   FXYZ  workpiece = F -> X -> Y -> Z -> tool   (workpiece on the bed; X carries Y carries Z)
 //   XFYZ  workpiece <- X <- F -> Y -> Z -> tool  (X table on the bed; column Y carries Z)
 //   XYFZ  workpiece <- X <- Y <- F -> Z -> tool  (cross table: Y on the bed carries X; Z head)
 //   XYZF  workpiece <- X <- Y <- Z <- F = tool   (tool fixed; Z carries Y carries X carries work)
+//   YFXZ  workpiece <- Y <- F -> X -> Z -> tool  (Y table; the spindle moves in X, X carries Z)
+//   ZFXY  workpiece <- Z <- F -> X -> Y -> tool  (horizontal centre: table in Z; column X
+//                                                 carries the head in Y)
 //
 // Conventions (all derived and illustrated in docs/kinematics.md):
 // - Sign: every component error is the error of the tool relative to the workpiece, as an
@@ -64,6 +67,14 @@ class ErrorFunction {
   // The same function multiplied by k (for sensitivity studies and tests).
   ErrorFunction scaled(double k) const;
 
+  // What the function is, for writing it out: a polynomial's coefficients (empty for the
+  // default zero), or a table's positions and values.
+  bool is_table() const { return kind_ == Kind::table; }
+  bool is_zero() const { return kind_ == Kind::polynomial && coefficients_.empty(); }
+  std::span<const double> coefficients() const { return coefficients_; }
+  std::span<const double> positions_mm() const { return positions_mm_; }
+  std::span<const double> values() const { return values_; }
+
  private:
   enum class Kind { polynomial, table };
   Kind kind_ = Kind::polynomial;
@@ -81,20 +92,54 @@ struct AxisErrors {
   ErrorFunction ea_urad, eb_urad, ec_urad;  // rotation about X, Y, Z
 };
 
+// Squareness conventions. `daq analyse squareness` (cal::squareness) reports alpha, positive
+// when the angle between the positive directions of the two axes exceeds 90 degrees. The model
+// holds the ISO 230-1 location errors, rotations about the machine axes: E_C0Y (about Z) of
+// Y in the XY plane, E_B0Z (about Y) and E_A0Z (about X) of Z in the XZ and YZ planes. A
+// positive rotation of Y about Z tilts +Y towards -X and opens the angle (E_C0Y = +alpha_XY);
+// a positive rotation of Z about X tilts +Z towards -Y and opens it (E_A0Z = +alpha_YZ); but a
+// positive rotation of Z about Y tilts +Z towards +X and closes it: E_B0Z = -alpha_XZ. The
+// angle between two directions does not depend on which one is named first, so alpha_XZ =
+// alpha_ZX. Units: urad (1 urad = 1 um/m).
+enum class Plane { xy, xz, yz };
+std::string_view to_string(Plane p);            // "XY", "XZ", "YZ"
+Plane plane_from_string(std::string_view);      // "XY" or "YX", ...; throws InputError
+std::string_view location_error_name(Plane p);  // "E_C0Y", "E_B0Z", "E_A0Z"
+double location_error_from_angle_over_90(Plane p, double alpha_urad);
+double angle_over_90_from_location_error(Plane p, double location_error_urad);
+
 // The three squareness (location) errors, constants in urad; see the sign convention above.
 struct Squareness {
   double c0y_urad = 0.0;  // E_C0Y: Y to X
   double b0z_urad = 0.0;  // E_B0Z: Z to X
   double a0z_urad = 0.0;  // E_A0Z: Z to Y
+  double& of(Plane p);    // the member for a plane: xy -> c0y, xz -> b0z, yz -> a0z
+  double of(Plane p) const;
 };
 
-enum class Topology { fxyz, xfyz, xyfz, xyzf };
+// The 24 serial orders, named by their letters. The first four keep the values they had when
+// only they existed.
+// clang-format off
+enum class Topology {
+  fxyz, xfyz, xyfz, xyzf,        // the classic four
+  fxzy, fyxz, fyzx, fzxy, fzyx,  // F first: every axis carries the tool
+  xfzy, yfxz, yfzx, zfxy, zfyx,  // F second: one table axis
+  xzfy, yxfz, yzfx, zxfy, zyfx,  // F third: two table axes
+  xzyf, yxzf, yzxf, zxyf, zyxf,  // F fourth: the tool is fixed to the frame
+};
+// clang-format on
+inline constexpr std::size_t kTopologyCount = 24;
+std::span<const Topology> all_topologies();
 std::string_view to_string(Topology t);           // "FXYZ", ...
 Topology topology_from_string(std::string_view);  // case-insensitive; throws InputError
 // Number of axes on the workpiece side of the frame (0 for FXYZ ... 3 for XYZF).
 int workpiece_side_axes(Topology t);
 
 enum Axis : std::size_t { X = 0, Y = 1, Z = 2 };
+
+// The axes in chain order from the workpiece to the tool (the topology letters without F):
+// YFXZ gives {Y, X, Z}, of which the first workpiece_side_axes() carry the workpiece.
+std::array<Axis, 3> chain_order(Topology t);
 
 struct Machine {
   Topology topology = Topology::fxyz;
@@ -178,5 +223,17 @@ struct MapSummary {
   Vec3 range_um{};           // max - min per component
 };
 MapSummary summarize(const ErrorMap& map);  // throws InputError for an empty map
+
+// What each of the 21 errors contributes over a grid: the first-order error of a machine with
+// only that error (same topology and offsets), its largest |e| and its RMS over the points.
+// The first-order model is a sum, so the contributions add up to the whole. Sorted by
+// max_norm_um, largest first. Throws as volumetric_error_map.
+struct Contribution {
+  std::string name;  // "E_CX", ..., "E_C0Y"
+  Axis axis = X;     // the axis it belongs to (squareness: the carrier-free plane's second axis)
+  double max_norm_um = 0.0;
+  double rms_um = 0.0;
+};
+std::vector<Contribution> contributions(const Machine& m, const Grid& grid);
 
 }  // namespace cal::kinematics

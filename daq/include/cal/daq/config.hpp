@@ -3,6 +3,7 @@
 // reach them, the environment policy, and the tests. Documented with a full example in
 // docs/config.md. Every error names the file, the line and column, and the key.
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -75,11 +76,50 @@ struct CircleTestConfig {
   double calibrated_radius_mm = 0.0;  // 0: the nominal
 };
 
+// Who the test is for and where ([customer]).
+struct CustomerConfig {
+  std::string name, site, contact;
+};
+
+// The state the machine was tested in ([conditions]), stated in the report.
+struct TestConditions {
+  std::optional<bool> controller_compensation;  // the control's own compensation on or off
+  std::string warm_up;                          // e.g. "20 min axes at 50 % rapid"
+  std::string load;                             // e.g. "no workpiece"
+  std::string state;                            // "as found" | "as left" | "" (not said)
+  std::string notes;
+};
+
+// Limits of the ISO 230-2 values of one axis, in um ([tolerances.X]); applied to the
+// bidirectional values (E, R, A, M, B), or the unidirectional ones of a one-way test.
+struct PositioningLimits {
+  std::optional<double> E_um, R_um, B_um, A_um, M_um;
+  bool empty() const { return !E_um && !R_um && !B_um && !A_um && !M_um; }
+};
+struct AxisTolerance {
+  PositioningLimits limits;  // for any measured length
+  // Limits for a measured travel up to a length ([[tolerances.X.by_length]]), ascending: the
+  // first entry whose up_to_mm is at least the run's travel replaces the axis' limits it sets.
+  std::vector<std::pair<double, PositioningLimits>> by_length;
+};
+// Limits of a circular test in a plane ([tolerances.XY]): G in um, and per diagnostic (its key,
+// e.g. "squareness", "backlash_X") a limit on the magnitude of its value in its own unit.
+struct CircleTolerance {
+  std::optional<double> G_um;
+  std::map<std::string, double> diagnostics;
+};
+
 struct Config {
   std::filesystem::path source;
   std::string machine_name = "machine";
   std::string machine_description;
+  std::string machine_make, machine_model, machine_serial;
   std::string campaign;
+  std::string operator_name;  // the top-level key `operator`
+  CustomerConfig customer;
+  TestConditions conditions;
+  std::map<std::string, AxisTolerance> axis_tolerances;     // by axis: X, Y, Z
+  std::map<std::string, CircleTolerance> plane_tolerances;  // by plane: XY, YZ, ZX
   std::vector<DeviceConfig> devices;
   EnvironmentConfig environment;
   TriggerConfig trigger;

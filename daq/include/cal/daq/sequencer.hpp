@@ -58,6 +58,8 @@ class Sequencer {
   bool complete() const { return next_ >= stops_.size(); }
   Progress progress() const;
   const std::vector<ExpectedStop>& stops() const { return stops_; }
+  // The stops passed without a capture (marked missed and not captured late), in plan order.
+  std::vector<std::size_t> missed() const;
   // The captured stops as the ISO 230-2 evaluation wants them.
   std::vector<iso230_2::Measurement> measurements() const;
 

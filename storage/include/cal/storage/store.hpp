@@ -26,7 +26,7 @@ class StoreError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-inline constexpr int schema_version = 1;
+inline constexpr int schema_version = 2;
 
 enum class RunStatus { running, complete, incomplete, aborted };
 std::string_view to_string(RunStatus s);
@@ -51,6 +51,9 @@ struct RunRecord {
   std::optional<std::int64_t> ended_unix_ms;
   RunStatus status = RunStatus::running;
   std::string note;  // why a run was aborted, and the like
+  // The run's time origin: the session clock (the readings' time_ns) at a known UTC instant,
+  // taken when the first reading arrived. Unset for runs stored before schema 2 and imports.
+  std::optional<std::int64_t> origin_session_ns, origin_unix_ns;
 };
 
 struct InstrumentRecord {
@@ -89,6 +92,30 @@ struct ResultRecord {
   std::string standard;  // "ISO 230-2:2014", "VDI/DGQ 3441", "ISO 230-4"
   std::string json;      // the full result document (caldaq.*.v1 schema)
   std::int64_t created_unix_ms = 0;
+  // How the result was obtained (caldaq.provenance.v1, docs/storage.md): acquired, re-analysed,
+  // re-compensated (of which result, what changed) or replayed (of which run); the
+  // coefficients and sensor offsets used; the software; when.
+  std::string provenance_json = "{}";
+  std::int64_t id = 0;                        // set when read back
+  std::optional<std::int64_t> superseded_by;  // unset: the current result
+  bool current() const { return !superseded_by.has_value(); }
+};
+
+// Which earlier results of the run a new result makes out of date (they stay stored, marked
+// superseded by the new one).
+enum class Supersede {
+  none,           // e.g. an evaluation by another standard shown but kept apart
+  same_standard,  // a new evaluation by the same standard (the default)
+  all,            // the captured data changed (re-compensation): every earlier result
+};
+
+// A planned stop of a linear run that was never captured.
+struct MissedStop {
+  std::int64_t run_id = 0;
+  int run_number = 0;    // 1-based ISO 230-2 run j
+  char direction = '+';  // '+' or '-'
+  int target_index = 0;  // 0-based, as in the plan
+  double nominal_mm = 0.0;
 };
 
 struct StoreOptions {
@@ -138,8 +165,20 @@ class Store {
   // Replaces the targets of a run (re-compensation keeps the raw values, changes deviations).
   void replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets);
 
-  void add_result(const ResultRecord& r);
+  // Stores a result (returns its id) and marks the earlier ones it makes out of date.
+  std::int64_t add_result(const ResultRecord& r, Supersede s = Supersede::same_standard);
+  // Every result of the run, oldest first, with its provenance and whether it is current.
   std::vector<ResultRecord> results(std::int64_t run_id) const;
+  // Re-compensation in one transaction: the new deviations of the stops and the result made
+  // from them, which supersedes every earlier result (a crash leaves the old pair intact).
+  std::int64_t replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets,
+                               const ResultRecord& result);
+
+  // The planned stops a linear run never captured (replaces what was stored).
+  void set_missed_stops(std::int64_t run_id, std::span<const MissedStop> stops);
+  std::vector<MissedStop> missed_stops(std::int64_t run_id) const;
+  // The session clock reading at a UTC instant (ns since the Unix epoch), see RunRecord.
+  void set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns);
 
  private:
   struct Impl;

@@ -1,0 +1,337 @@
+// daq model show | map: the machine model file (caldaq.model.v1) and its volumetric error.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cal/analysis/error.hpp"
+#include "commands.hpp"
+#include "csv_columns.hpp"
+#include "model_cli.hpp"
+
+namespace daq {
+
+namespace kin = cal::kinematics;
+namespace mdl = cal::daq::model;
+using nlohmann::json;
+
+namespace {
+constexpr std::array kAxis{"X", "Y", "Z"};
+}
+
+std::string describe_topology(kin::Topology t) {
+  const auto order = kin::chain_order(t);
+  const int k = kin::workpiece_side_axes(t);
+  std::string chain = "workpiece";
+  for (int n = k - 1; n >= 0; --n) chain += fmt::format(" <- {}", kAxis[order[n]]);
+  chain += " <- F";
+  for (int n = k; n < 3; ++n) chain += fmt::format(" -> {}", kAxis[order[n]]);
+  chain += " -> tool";
+  std::string table_axes, tool_axes;
+  for (int n = 0; n < 3; ++n) {
+    std::string& side = n < k ? table_axes : tool_axes;
+    side += (side.empty() ? "" : ", ") + std::string(kAxis[order[n]]);
+  }
+  return fmt::format("{}: {} ({} moving the workpiece, {} moving the tool)", kin::to_string(t),
+                     chain, table_axes.empty() ? "no axis" : table_axes,
+                     tool_axes.empty() ? "no axis" : tool_axes);
+}
+
+std::vector<std::vector<std::string>> describe_components(const mdl::Model& m, bool html) {
+  const char* um_unit = html ? "µm" : "um";
+  const char* urad_unit = html ? "µrad" : "urad";
+  const char* over_90 = html ? "µm/m over 90°" : "um/m over 90 deg";
+  std::vector<std::vector<std::string>> rows;
+  for (kin::Component c : kin::all_components()) {
+    const auto& f = kin::component(m.machine, c);
+    const auto& entry = m.components[static_cast<std::size_t>(c)];
+    const auto axis = static_cast<std::size_t>(c) / 6;
+    const bool angle = static_cast<std::size_t>(c) % 6 >= 3;
+    const char* unit = angle ? urad_unit : um_unit;
+    std::string form, values;
+    if (!entry.given && f.is_zero()) {
+      form = "not given (zero)";
+    } else if (f.is_table()) {
+      const auto q = f.positions_mm();
+      const auto v = f.values();
+      form = fmt::format("table, {} points, {:g} .. {:g} mm", q.size(), q.front(), q.back());
+      values = fmt::format("{:.3f} .. {:.3f} {}", *std::min_element(v.begin(), v.end()),
+                           *std::max_element(v.begin(), v.end()), unit);
+    } else {
+      form = fmt::format("polynomial, degree {}",
+                         std::max<std::size_t>(f.coefficients().size(), 1) - 1);
+      if (m.travel_mm) {
+        double lo = INFINITY, hi = -INFINITY;
+        const auto [a, b] = (*m.travel_mm)[axis];
+        for (int i = 0; i <= 100; ++i) {
+          const double v = f(a + (b - a) * i / 100.0);
+          lo = std::min(lo, v), hi = std::max(hi, v);
+        }
+        values = fmt::format("{:.3f} .. {:.3f} {} over the travel", lo, hi, unit);
+      } else {
+        values = fmt::format("{:.3f} {} at 0", f(0.0), unit);
+      }
+    }
+    rows.push_back({std::string(kin::to_string(c)), form, values, entry.source.json});
+  }
+  for (kin::Plane p : {kin::Plane::xy, kin::Plane::xz, kin::Plane::yz}) {
+    const auto& s = m.squareness[static_cast<std::size_t>(p)];
+    const double v = m.machine.squareness.of(p);
+    std::string form =
+        s.given ? fmt::format("squareness, stated as {}", s.stated_as) : "not given (zero)";
+    std::string how;
+    if (!s.method.empty()) how += ", " + s.method;
+    if (!s.placement.empty()) how += ", " + s.placement;
+    if (s.position_mm)
+      how += fmt::format(" at ({:g}, {:g}, {:g}) mm", (*s.position_mm)[0], (*s.position_mm)[1],
+                         (*s.position_mm)[2]);
+    rows.push_back({std::string(kin::location_error_name(p)), form + how,
+                    fmt::format("{:+.3f} {} ({:+.3f} {}), carried by {}", v, urad_unit,
+                                kin::angle_over_90_from_location_error(p, v), over_90,
+                                kAxis[m.carriers.of(p)]),
+                    s.source.json});
+  }
+  return rows;
+}
+
+cal::daq::report::ModelPage model_page_of(const mdl::Model& m, const std::string& path,
+                                          const kin::Grid& g, kin::Method method) {
+  cal::daq::report::ModelPage page;
+  page.title = m.name;
+  page.source = path;
+  page.simulated = m.name.find("simulated") != std::string::npos ||
+                   m.name.find("SIMULATED") != std::string::npos;
+  page.machine = m.machine;
+  page.grid = g;
+  page.method = method;
+  page.facts = {
+      {"topology", describe_topology(m.machine.topology)},
+      {"tool offset", fmt::format("({:g}, {:g}, {:g}) mm", m.machine.tool_offset_mm[0],
+                                  m.machine.tool_offset_mm[1], m.machine.tool_offset_mm[2])},
+      {"table offset", fmt::format("({:g}, {:g}, {:g}) mm", m.machine.table_offset_mm[0],
+                                   m.machine.table_offset_mm[1], m.machine.table_offset_mm[2])}};
+  for (auto& r : describe_components(m, true)) page.components.push_back(std::move(r));
+  page.software = "daq 0.1.0";
+  return page;
+}
+
+void write_page(const std::string& path, const std::string& html) {
+  std::ofstream out(path, std::ios::binary);
+  if (!(out << html) || !(out.close(), out))
+    throw cal::InputError(fmt::format("{}: cannot write the report", path));
+  fmt::print(stderr, "report written to {}\n", path);
+}
+
+kin::Method method_from_string(const std::string& s) {
+  if (s == "htm" || s == "exact") return kin::Method::htm;
+  if (s == "first-order" || s == "first_order") return kin::Method::first_order;
+  throw cal::InputError(fmt::format("method '{}' (expected htm or first-order)", s));
+}
+
+namespace {
+
+// --- show ------------------------------------------------------------------------------------
+
+struct ShowOptions {
+  std::string file;
+  bool json = false;
+};
+
+void run_show(const ShowOptions& o) {
+  const mdl::Model m = mdl::read(o.file);
+  if (o.json) return fmt::print("{}", mdl::to_json(m));
+  fmt::print("Model {}{}\n", m.name.empty() ? "(unnamed)" : m.name, " (" + o.file + ")");
+  fmt::print("  topology      {}\n", describe_topology(m.machine.topology));
+  const auto& t = m.machine.tool_offset_mm;
+  const auto& w = m.machine.table_offset_mm;
+  fmt::print("  tool offset   ({:g}, {:g}, {:g}) mm\n  table offset  ({:g}, {:g}, {:g}) mm\n", t[0],
+             t[1], t[2], w[0], w[1], w[2]);
+  if (m.travel_mm)
+    fmt::print("  travel        X {:g} .. {:g}, Y {:g} .. {:g}, Z {:g} .. {:g} mm\n",
+               (*m.travel_mm)[0][0], (*m.travel_mm)[0][1], (*m.travel_mm)[1][0],
+               (*m.travel_mm)[1][1], (*m.travel_mm)[2][0], (*m.travel_mm)[2][1]);
+  else
+    fmt::print("  travel        not given (maps need --min-mm and --max-mm)\n");
+  fmt::print("Errors (translations in um, angles in urad):\n");
+  std::vector<std::string> missing;
+  for (const auto& r : describe_components(m, false)) {
+    fmt::print("  {:6} {:44} {}\n", r[0], r[1], r[2]);
+    if (r[1].rfind("not given", 0) == 0) missing.push_back(r[0]);
+  }
+  if (!missing.empty())
+    fmt::print("Not given ({} of 21, taken as zero): {}\n", missing.size(),
+               fmt::join(missing, ", "));
+}
+
+// --- map -------------------------------------------------------------------------------------
+
+struct MapOptions {
+  std::string file, points, report, method = "htm";
+  std::vector<double> min_mm, max_mm;
+  std::vector<std::size_t> count{5, 5, 5};
+  bool json = false;
+};
+
+// The map, its 21 contributions and its JSON are held in memory: a few million points at most.
+constexpr double kMaxMapPoints = 2e6;
+
+kin::Grid grid_of(const MapOptions& o, const mdl::Model& m) {
+  if (o.count.size() != 3 ||
+      std::any_of(o.count.begin(), o.count.end(), [](auto c) { return c == 0; }))
+    throw cal::InputError("--count needs three counts >= 1 (X Y Z)");
+  if (static_cast<double>(o.count[0]) * static_cast<double>(o.count[1]) *
+          static_cast<double>(o.count[2]) >
+      kMaxMapPoints)
+    throw cal::InputError(fmt::format("--count {} {} {}: more than {:g} points", o.count[0],
+                                      o.count[1], o.count[2], kMaxMapPoints));
+  if (o.min_mm.empty() != o.max_mm.empty())
+    throw cal::InputError("give both --min-mm and --max-mm, or neither (the model's travel)");
+  if (o.min_mm.empty()) return mdl::travel_grid(m, {o.count[0], o.count[1], o.count[2]});
+  kin::Grid g;
+  for (std::size_t i = 0; i < 3; ++i) {
+    g.min_mm[i] = o.min_mm.at(i);
+    g.max_mm[i] = o.max_mm.at(i);
+    g.count[i] = o.count[i];
+  }
+  return g;
+}
+
+json vec_json(const kin::Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+// Three decimals without a "-0.000".
+double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
+
+void run_map(const MapOptions& o) {
+  const mdl::Model m = mdl::read(o.file);
+  const kin::Method method = method_from_string(o.method);
+  const std::string method_name = method == kin::Method::htm ? "htm" : "first-order";
+  if (!o.points.empty()) {
+    if (!o.min_mm.empty() || !o.report.empty())
+      throw cal::InputError("--points maps the given points: no grid options or --report with it");
+    const auto csv = read_csv_columns(o.points, {"x_mm", "y_mm", "z_mm"});
+    json pts = json::array();
+    if (!o.json)
+      fmt::print("{:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "x_mm", "y_mm", "z_mm",
+                 "ex_um", "ey_um", "ez_um", "|e|_um");
+    for (std::size_t r = 0; r < csv.rows(); ++r) {
+      const kin::Vec3 p{csv.numbers.at("x_mm")[r], csv.numbers.at("y_mm")[r],
+                        csv.numbers.at("z_mm")[r]};
+      kin::VolumetricError e;
+      try {
+        e = kin::volumetric_error(m.machine, p, method);
+      } catch (const cal::InputError& err) {
+        throw cal::InputError(fmt::format("{}:{}: {}", o.points, csv.line[r], err.what()));
+      }
+      const auto& t = e.translation_um;
+      if (o.json)
+        pts.push_back({{"position_mm", vec_json(p)},
+                       {"error_um", vec_json(t)},
+                       {"rotation_urad", vec_json(e.rotation_urad)}});
+      else
+        fmt::print("{:10.3f} {:10.3f} {:10.3f} {:10.3f} {:10.3f} {:10.3f} {:10.3f}\n", shown(p[0]),
+                   shown(p[1]), shown(p[2]), shown(t[0]), shown(t[1]), shown(t[2]),
+                   std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]));
+    }
+    if (o.json)
+      fmt::print("{}\n", json{{"schema", "caldaq.volumetric-map.v1"},
+                              {"model", o.file},
+                              {"method", method_name},
+                              {"points", pts}}
+                             .dump(2));
+    return;
+  }
+  const kin::Grid g = grid_of(o, m);
+  const auto map = kin::volumetric_error_map(m.machine, g, method);
+  const auto s = kin::summarize(map);
+  const auto contributions = kin::contributions(m.machine, g);
+  if (!o.report.empty())
+    write_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
+  if (o.json) {
+    json pts = json::array();
+    for (std::size_t p = 0; p < map.size(); ++p)
+      pts.push_back(
+          {{"position_mm", json::array({map.positions_mm[3 * p], map.positions_mm[3 * p + 1],
+                                        map.positions_mm[3 * p + 2]})},
+           {"error_um", json::array({map.errors_um[3 * p], map.errors_um[3 * p + 1],
+                                     map.errors_um[3 * p + 2]})},
+           {"rotation_urad", json::array({map.rotations_urad[3 * p], map.rotations_urad[3 * p + 1],
+                                          map.rotations_urad[3 * p + 2]})}});
+    json cs = json::array();
+    for (const auto& c : contributions)
+      cs.push_back({{"error", c.name},
+                    {"axis", kAxis[c.axis]},
+                    {"max_norm_um", c.max_norm_um},
+                    {"rms_um", c.rms_um}});
+    fmt::print("{}\n", json{{"schema", "caldaq.volumetric-map.v1"},
+                            {"model", o.file},
+                            {"method", method_name},
+                            {"grid",
+                             {{"min_mm", vec_json(g.min_mm)},
+                              {"max_mm", vec_json(g.max_mm)},
+                              {"count", {g.count[0], g.count[1], g.count[2]}}}},
+                            {"summary",
+                             {{"max_norm_um", s.max_norm_um},
+                              {"max_norm_at_mm", vec_json(s.max_norm_at_mm)},
+                              {"min_um", vec_json(s.min_um)},
+                              {"max_um", vec_json(s.max_um)},
+                              {"range_um", vec_json(s.range_um)}}},
+                            {"contributions", cs},
+                            {"points", pts}}
+                           .dump(2));
+    return;
+  }
+  fmt::print(
+      "Volumetric error of {} ({} model), {} x {} x {} points over ({:g} .. {:g}, {:g} .. "
+      "{:g}, {:g} .. {:g}) mm\n",
+      m.name.empty() ? o.file : m.name, method_name, g.count[0], g.count[1], g.count[2],
+      g.min_mm[0], g.max_mm[0], g.min_mm[1], g.max_mm[1], g.min_mm[2], g.max_mm[2]);
+  fmt::print("  largest |e|  {:.3f} um at ({:g}, {:g}, {:g}) mm\n", s.max_norm_um,
+             s.max_norm_at_mm[0], s.max_norm_at_mm[1], s.max_norm_at_mm[2]);
+  for (std::size_t i = 0; i < 3; ++i)
+    fmt::print("  e{}  {:9.3f} .. {:9.3f} um (range {:.3f})\n", static_cast<char>('x' + i),
+               shown(s.min_um[i]), shown(s.max_um[i]), s.range_um[i]);
+  fmt::print("Contributions, ranked (largest |e| of each error alone, first order):\n");
+  for (std::size_t k = 0; k < contributions.size(); ++k) {
+    const auto& c = contributions[k];
+    if (c.max_norm_um == 0.0) break;
+    fmt::print("  {:2}. {:6} {:9.3f} um  (RMS {:.3f})\n", k + 1, c.name, c.max_norm_um, c.rms_um);
+  }
+}
+
+}  // namespace
+
+void add_model_commands(CLI::App& app) {
+  auto* model = app.add_subcommand(
+      "model",
+      "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
+      "compensation, predict a test piece");
+  model->require_subcommand(1);
+
+  auto s = std::make_shared<ShowOptions>();
+  auto* show = model->add_subcommand("show", "Print a model file: chain, offsets, the 21 errors");
+  show->add_option("file", s->file, "Model file (caldaq.model.v1 JSON, docs/model-file.md)")
+      ->required();
+  show->add_flag("--json", s->json, "Print the model as normalised caldaq.model.v1 JSON");
+  show->callback([s] { run_show(*s); });
+
+  auto o = std::make_shared<MapOptions>();
+  auto* map = model->add_subcommand(
+      "map", "Volumetric error over a grid (default: the model's travel, 5 x 5 x 5) or at points");
+  map->add_option("file", o->file, "Model file")->required();
+  map->add_option("--min-mm", o->min_mm, "Grid corner X Y Z (with --max-mm)")->expected(3);
+  map->add_option("--max-mm", o->max_mm, "Grid corner X Y Z")->expected(3);
+  map->add_option("--count", o->count, "Points per axis X Y Z")->expected(3)->capture_default_str();
+  map->add_option("--points", o->points, "CSV of points to evaluate: x_mm,y_mm,z_mm");
+  map->add_option("--method", o->method, "htm (exact) or first-order")->capture_default_str();
+  map->add_option("--report", o->report,
+                  "Also write an HTML page: error vectors in three slices, contributions ranked");
+  map->add_flag("--json", o->json, "Print caldaq.volumetric-map.v1 JSON");
+  map->callback([o] { run_map(*o); });
+
+  add_model_compensate_command(*model);
+  add_model_testpiece_command(*model);
+}
+
+}  // namespace daq

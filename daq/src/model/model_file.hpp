@@ -1,0 +1,69 @@
+#pragma once
+// The machine model file, caldaq.model.v1 (JSON; documented in docs/model-file.md): the
+// kinematic chain, the offsets, each of the 18 component errors as a table or a polynomial, the
+// three squareness errors with their stated convention, method, placement and carrier, and
+// where each came from. Reading validates everything and names the file and the key at fault;
+// writing gives the same model back when read. The maths is in cal::kinematics (analysis/);
+// this is its file form (analysis does no I/O).
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "cal/analysis/kinematics.hpp"
+#include "cal/analysis/volumetric_comp.hpp"
+
+namespace cal::daq::model {
+
+inline constexpr std::string_view kSchema = "caldaq.model.v1";
+
+// Where an error came from (a stored run, another tool, a hand entry). `json` is the JSON text
+// of the file's "source" value, kept as written (empty: none given).
+struct Source {
+  std::string json;
+};
+
+struct ComponentEntry {
+  bool given = false;  // false: not in the file, taken as zero
+  Source source;
+};
+
+// How the squareness of one plane was measured and who carries its correction.
+struct SquarenessEntry {
+  bool given = false;
+  // The convention the file stated the value in: "iso230_1_urad" (the model's location error)
+  // or "angle_over_90_urad" (as daq analyse squareness reports it), converted on reading.
+  std::string stated_as = "iso230_1_urad";
+  std::string method;     // straightness, diagonal, circle, circles, other ("" unknown)
+  std::string placement;  // global or local ("" unknown)
+  std::optional<kinematics::Vec3> position_mm;  // where a local measurement was made
+  Source source;
+};
+
+struct Model {
+  std::string name;
+  kinematics::Machine machine;
+  // Travel of each axis, [min, max] mm; the default volume of maps and the range every table
+  // must cover.
+  std::optional<std::array<std::array<double, 2>, 3>> travel_mm;
+  std::array<ComponentEntry, 18> components;  // indexed by kinematics::Component
+  std::array<SquarenessEntry, 3> squareness;  // indexed by kinematics::Plane
+  volcomp::Carriers carriers;                 // who carries each squareness correction
+  Source provenance;                          // the file's "provenance" value, kept as written
+};
+
+// Parses the text of a model file. `where` names it in errors ("FILE: key: what").
+// Throws cal::InputError on anything malformed, unknown, non-finite, out of convention or
+// inconsistent (a table that does not cover the stated travel, a carrier outside its plane).
+Model parse(std::string_view text, std::string_view where);
+Model read(const std::string& path);  // parse(file contents, path); InputError if unreadable
+
+// The model as caldaq.model.v1 JSON text (pretty-printed, ends in a newline).
+std::string to_json(const Model& m);
+// Writes to_json(m) to path; throws cal::InputError if it cannot (nothing partial is left).
+void write(const Model& m, const std::string& path);
+
+// A grid over the model's travel with `count` points per axis; InputError without travel.
+kinematics::Grid travel_grid(const Model& m, std::array<std::size_t, 3> count);
+
+}  // namespace cal::daq::model

@@ -1,0 +1,32 @@
+#pragma once
+// What the `daq model` subcommands share (cmd_model*.cpp): reading the model and describing it.
+#include <CLI/CLI.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "model/model_file.hpp"
+#include "report/model_report.hpp"
+
+namespace daq {
+
+// "YFXZ: workpiece <- Y <- F -> X -> Z -> tool (Y carries the workpiece; ...)".
+std::string describe_topology(cal::kinematics::Topology t);
+// One line per component for show and the report: name, form, values, source.
+std::vector<std::vector<std::string>> describe_components(const cal::daq::model::Model& m,
+                                                          bool html);
+// The page of a model over a grid (facts and components filled in).
+cal::daq::report::ModelPage model_page_of(const cal::daq::model::Model& m, const std::string& path,
+                                          const cal::kinematics::Grid& g,
+                                          cal::kinematics::Method method);
+// Writes an HTML page, saying where on stderr; InputError if it cannot.
+void write_page(const std::string& path, const std::string& html);
+
+// --method htm|first-order
+cal::kinematics::Method method_from_string(const std::string& s);
+
+// daq model compensate / daq model testpiece (their own files).
+void add_model_compensate_command(CLI::App& model);
+void add_model_testpiece_command(CLI::App& model);
+
+}  // namespace daq

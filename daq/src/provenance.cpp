@@ -1,0 +1,179 @@
+#include "provenance.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <ctime>
+
+namespace daq {
+
+using nlohmann::json;
+
+namespace {
+
+json limits_json(const cal::daq::PositioningLimits& l) {
+  json j = json::object();
+  const auto put = [&](const char* key, const std::optional<double>& v) {
+    if (v) j[key] = *v;
+  };
+  put("E_um", l.E_um);
+  put("R_um", l.R_um);
+  put("B_um", l.B_um);
+  put("A_um", l.A_um);
+  put("M_um", l.M_um);
+  return j;
+}
+
+}  // namespace
+
+json run_context(const cal::daq::Config& c, std::string_view kind, std::string_view where) {
+  json j{{"customer",
+          {{"name", c.customer.name}, {"site", c.customer.site}, {"contact", c.customer.contact}}},
+         {"machine",
+          {{"name", c.machine_name},
+           {"description", c.machine_description},
+           {"make", c.machine_make},
+           {"model", c.machine_model},
+           {"serial_number", c.machine_serial}}},
+         {"operator", c.operator_name},
+         {"conditions",
+          {{"controller_compensation", c.conditions.controller_compensation
+                                           ? json(*c.conditions.controller_compensation)
+                                           : json(nullptr)},
+           {"warm_up", c.conditions.warm_up},
+           {"load", c.conditions.load},
+           {"state", c.conditions.state},
+           {"notes", c.conditions.notes}}},
+         {"configuration", c.source.empty() ? "" : c.source.string()}};
+  j["instruments"] = json::array();
+  for (const auto& d : c.devices) {
+    // A linear run uses laser, air, material and position; a circle the ballbar.
+    const bool used = kind == "circle" ? d.role == "ballbar" : d.role != "ballbar";
+    if (!used || d.role.empty()) continue;
+    j["instruments"].push_back({{"id", d.id},
+                                {"role", d.role},
+                                {"driver", d.driver},
+                                {"transport", d.transport},
+                                {"serial_number", d.serial_number},
+                                {"certificate", d.certificate},
+                                {"calibration_due", d.calibration_due}});
+  }
+  j["tolerances"] = nullptr;
+  const std::string key(where);
+  if (kind == "linear") {
+    if (const auto it = c.axis_tolerances.find(key); it != c.axis_tolerances.end()) {
+      json t = limits_json(it->second.limits);
+      t["by_length"] = json::array();
+      for (const auto& [up_to, l] : it->second.by_length) {
+        json e = limits_json(l);
+        e["up_to_mm"] = up_to;
+        t["by_length"].push_back(e);
+      }
+      t["source"] = "tolerances." + key;
+      j["tolerances"] = t;
+    }
+  } else if (kind == "circle") {
+    if (const auto it = c.plane_tolerances.find(key); it != c.plane_tolerances.end()) {
+      json t = json::object();
+      if (it->second.G_um) t["G_um"] = *it->second.G_um;
+      t["diagnostics"] = it->second.diagnostics;
+      t["source"] = "tolerances." + key;
+      j["tolerances"] = t;
+    }
+  }
+  return j;
+}
+
+json compensation_json(const cal::daq::EnvironmentConfig& e) {
+  return {{"equation", e.equation},
+          {"expansion_ppm_per_k", e.expansion_ppm_per_k},
+          {"co2_umol_per_mol", e.co2_umol_per_mol},
+          {"wavelength_nm", e.wavelength_nm}};
+}
+
+json to_json(const SensorOffsets& o) {
+  return {{"material_k", o.material_k},
+          {"air_temperature_k", o.air_temperature_k},
+          {"pressure_pa", o.pressure_pa},
+          {"humidity_pct", o.humidity_pct}};
+}
+
+SensorOffsets sensor_offsets_from_json(const json& j) {
+  SensorOffsets o;
+  if (!j.is_object()) return o;
+  o.material_k = j.value("material_k", 0.0);
+  o.air_temperature_k = j.value("air_temperature_k", 0.0);
+  o.pressure_pa = j.value("pressure_pa", 0.0);
+  o.humidity_pct = j.value("humidity_pct", 0.0);
+  return o;
+}
+
+json provenance(std::string_view how, std::string_view software) {
+  return {{"schema", "caldaq.provenance.v1"},
+          {"how", how},
+          {"software", software},
+          {"created_utc", utc_now_iso()}};
+}
+
+std::optional<cal::storage::ResultRecord> current_result(
+    const std::vector<cal::storage::ResultRecord>& results, std::string_view schema) {
+  for (auto it = results.rbegin(); it != results.rend(); ++it) {
+    if (!it->current()) continue;
+    const json doc = json::parse(it->json, nullptr, false);
+    if (doc.is_object() && doc.value("schema", "") == schema) return *it;
+  }
+  return std::nullopt;
+}
+
+CompensationUsed compensation_used(const json& settings,
+                                   const std::vector<cal::storage::ResultRecord>& results) {
+  CompensationUsed u;
+  const json env =
+      settings.is_object() ? settings.value("environment", json::object()) : json::object();
+  u.coefficients = {{"equation", env.value("equation", "ciddor")},
+                    {"expansion_ppm_per_k", env.value("expansion_ppm_per_k", 11.5)},
+                    {"co2_umol_per_mol", env.value("co2_umol_per_mol", 450.0)},
+                    {"wavelength_nm", env.value("wavelength_nm", 632.991)}};
+  const auto current = current_result(results, "caldaq.iso230-2.v1");
+  if (!current) return u;
+  u.result_id = current->id;
+  const json doc = json::parse(current->json, nullptr, false);
+  const json prov = json::parse(current->provenance_json, nullptr, false);
+  if (prov.is_object() && prov.contains("coefficients")) {
+    for (const auto& [k, v] : prov["coefficients"].items()) u.coefficients[k] = v;
+    u.offsets = sensor_offsets_from_json(prov.value("sensor_offsets", json::object()));
+    u.recompensated = prov.value("how", "") == "recompensated";
+    u.changed = prov.value("changed", json::array());
+  } else if (doc.is_object() && doc.contains("recompensation")) {
+    // Re-compensated before provenance was recorded: its own note says what it used.
+    const auto& r = doc["recompensation"];
+    u.coefficients["equation"] = r.value("equation", u.coefficients["equation"].get<std::string>());
+    u.coefficients["expansion_ppm_per_k"] =
+        r.value("expansion_ppm_per_k", u.coefficients["expansion_ppm_per_k"].get<double>());
+    u.offsets = {.material_k = r.value("material_offset_k", 0.0),
+                 .air_temperature_k = r.value("air_temperature_offset_k", 0.0),
+                 .pressure_pa = r.value("pressure_offset_pa", 0.0),
+                 .humidity_pct = r.value("humidity_offset_pct", 0.0)};
+    u.recompensated = true;
+  }
+  return u;
+}
+
+std::string utc_iso(std::int64_t unix_ms) {
+  const std::time_t s =
+      static_cast<std::time_t>(unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000);
+  std::tm tm{};
+  gmtime_r(&s, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+  return fmt::format("{}.{:03d}Z", buf,
+                     static_cast<int>(unix_ms - static_cast<std::int64_t>(s) * 1000));
+}
+
+std::string utc_now_iso() {
+  return utc_iso(std::chrono::duration_cast<std::chrono::milliseconds>(
+                     std::chrono::system_clock::now().time_since_epoch())
+                     .count());
+}
+
+}  // namespace daq

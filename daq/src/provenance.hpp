@@ -1,0 +1,62 @@
+#pragma once
+// What makes a stored result traceable (docs/storage.md, "Provenance"): the run's context (who it
+// was for, the machine, the operator, the instruments with their calibration, the test
+// conditions and the tolerances that applied), kept in the run's settings as "context", and each
+// result's provenance (caldaq.provenance.v1): how it was obtained, with which coefficients and
+// sensor offsets, by which software, when.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "cal/daq/config.hpp"
+#include "cal/storage/store.hpp"
+
+namespace daq {
+
+// The context of a run of `kind` ("linear" on an axis, "circle" in a plane) from its
+// configuration; `tolerances` holds only the axis' or plane's entry (null: none configured).
+nlohmann::json run_context(const cal::daq::Config& c, std::string_view kind,
+                           std::string_view axis_or_plane);
+
+// The coefficients of an environmental compensation, as the provenance records them.
+nlohmann::json compensation_json(const cal::daq::EnvironmentConfig& e);
+// Sensor corrections added to the stored readings before compensation (all 0 when acquired).
+struct SensorOffsets {
+  double material_k = 0.0, air_temperature_k = 0.0, pressure_pa = 0.0, humidity_pct = 0.0;
+};
+nlohmann::json to_json(const SensorOffsets& o);
+SensorOffsets sensor_offsets_from_json(const nlohmann::json& j);
+
+// A provenance document: {"schema": "caldaq.provenance.v1", "how", "software", "created_utc"}
+// and what the caller adds (coefficients, sensor_offsets, standard, of_result, changed,
+// replay_of_run, capture, analysis).
+nlohmann::json provenance(std::string_view how, std::string_view software);
+
+// "2026-03-01T12:34:56.789Z" (UTC, milliseconds).
+std::string utc_iso(std::int64_t unix_ms);
+std::string utc_now_iso();
+
+// The newest current result of a run whose document has this schema ("caldaq.iso230-2.v1",
+// "caldaq.circle.v1"), or nullopt.
+std::optional<cal::storage::ResultRecord> current_result(
+    const std::vector<cal::storage::ResultRecord>& results, std::string_view schema);
+
+// The compensation a linear run's stored deviations were made with: the coefficients and sensor
+// offsets of its current result's provenance, else (results stored before provenance) the
+// run's settings with no offsets.
+struct CompensationUsed {
+  nlohmann::json coefficients;  // equation, expansion_ppm_per_k, co2_umol_per_mol, wavelength_nm
+  SensorOffsets offsets;
+  std::optional<std::int64_t> result_id;  // the result they come from
+  bool recompensated = false;
+  nlohmann::json changed = nlohmann::json::array();  // what the re-compensation changed
+};
+CompensationUsed compensation_used(const nlohmann::json& settings,
+                                   const std::vector<cal::storage::ResultRecord>& results);
+
+// The software that writes results (the same string runs record).
+inline constexpr std::string_view software_version = "daq 0.1.0";
+
+}  // namespace daq

@@ -1,0 +1,304 @@
+// The volumetric error page of a machine model (see model_report.hpp). Kept apart from
+// report.cpp: it shares only the plots (plot.hpp) and the look.
+#include "report/model_report.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+
+#include "cal/analysis/error.hpp"
+#include "report/plot.hpp"
+
+namespace cal::daq::report {
+namespace {
+
+namespace kin = cal::kinematics;
+using kin::Vec3;
+using ErrorOf = std::function<Vec3(const Vec3&)>;
+
+constexpr std::array kAxis{"X", "Y", "Z"};
+constexpr int kSliceNodes = 11;
+
+std::string esc(std::string_view s) { return html_escape(s); }
+
+double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+std::string table(const std::vector<std::string>& head,
+                  const std::vector<std::vector<std::string>>& rows, std::string_view cls = "") {
+  std::string h = fmt::format("<table class=\"{}\"><thead><tr>", cls);
+  for (const auto& c : head) h += "<th>" + c + "</th>";
+  h += "</tr></thead><tbody>";
+  for (const auto& r : rows) {
+    h += "<tr>";
+    for (const auto& c : r) h += "<td>" + c + "</td>";
+    h += "</tr>";
+  }
+  return h + "</tbody></table>\n";
+}
+
+std::string figure(const std::string& svg_text, std::string_view caption) {
+  return fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n", svg_text, esc(caption));
+}
+
+// 1, 2 or 5 times a power of ten, at most v (a magnification that reads well).
+double nice_floor(double v) {
+  if (!(v > 0) || !std::isfinite(v)) return 1.0;
+  const double p = std::pow(10.0, std::floor(std::log10(v)));
+  double best = p;
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * p <= v) best = m * p;
+  return best;
+}
+
+struct Slice {
+  std::size_t a = 0, b = 1, c = 2;  // plotted axes a (horizontal), b (vertical); fixed c
+  double at_mm = 0.0;               // the position of c
+  std::vector<Vec3> nodes;          // kSliceNodes x kSliceNodes, a fastest
+  std::vector<Vec3> errors_um;
+};
+
+double lerp(double lo, double hi, int i, int n) {
+  return n <= 1 ? lo : lo + (hi - lo) * static_cast<double>(i) / static_cast<double>(n - 1);
+}
+
+std::vector<Slice> slices(const kin::Grid& g, const ErrorOf& error) {
+  std::vector<Slice> out;
+  for (auto [a, b, c] : {std::array<std::size_t, 3>{0, 1, 2}, {0, 2, 1}, {1, 2, 0}}) {
+    if (!(g.max_mm[a] > g.min_mm[a]) || !(g.max_mm[b] > g.min_mm[b])) continue;
+    Slice s{a, b, c, 0.5 * (g.min_mm[c] + g.max_mm[c]), {}, {}};
+    for (int j = 0; j < kSliceNodes; ++j) {
+      for (int i = 0; i < kSliceNodes; ++i) {
+        Vec3 p{};
+        p[a] = lerp(g.min_mm[a], g.max_mm[a], i, kSliceNodes);
+        p[b] = lerp(g.min_mm[b], g.max_mm[b], j, kSliceNodes);
+        p[c] = s.at_mm;
+        s.nodes.push_back(p);
+        s.errors_um.push_back(error(p));
+      }
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+// Magnification so that the largest in-plane displacement is about 8 % of the larger span.
+double magnification(const std::vector<Slice>& ss) {
+  double m = std::numeric_limits<double>::infinity();
+  for (const auto& s : ss) {
+    double largest = 0.0, span = 0.0;
+    for (std::size_t k = 0; k < s.nodes.size(); ++k)
+      largest = std::max(largest, std::hypot(s.errors_um[k][s.a], s.errors_um[k][s.b]));
+    span = std::max(s.nodes.back()[s.a] - s.nodes.front()[s.a],
+                    s.nodes.back()[s.b] - s.nodes.front()[s.b]);
+    if (largest > 0) m = std::min(m, 0.08 * span / (largest * 1e-3));
+  }
+  return std::isfinite(m) ? nice_floor(m) : 1.0;
+}
+
+std::string slice_chart(const Slice& s, double mag, std::string_view what) {
+  XyChart c;
+  c.title = fmt::format("{}{} slice at {} = {:g} mm", kAxis[s.a], kAxis[s.b], kAxis[s.c], s.at_mm);
+  c.x_label = fmt::format("{} (mm)", kAxis[s.a]);
+  c.y_label = fmt::format("{} (mm)", kAxis[s.b]);
+  const double span_a = s.nodes.back()[s.a] - s.nodes.front()[s.a];
+  const double span_b = s.nodes.back()[s.b] - s.nodes.front()[s.b];
+  c.width_pt = 760;
+  c.height_pt = static_cast<int>(std::clamp(560.0 * span_b / span_a, 260.0, 620.0));
+  auto node = [&](int i, int j) { return static_cast<std::size_t>(i + kSliceNodes * j); };
+  for (int along = 0; along < 2; ++along) {
+    for (int k = 0; k < kSliceNodes; ++k) {
+      Line nominal, moved;
+      nominal.colour = grey;
+      nominal.width = 0.6;
+      nominal.dashed = true;
+      moved.colour = blue;
+      moved.width = 1.4;
+      for (int t = 0; t < kSliceNodes; ++t) {
+        const std::size_t n = along == 0 ? node(t, k) : node(k, t);
+        const Vec3& p = s.nodes[n];
+        const Vec3& e = s.errors_um[n];
+        nominal.x.push_back(p[s.a]);
+        nominal.y.push_back(p[s.b]);
+        moved.x.push_back(p[s.a] + mag * e[s.a] * 1e-3);
+        moved.y.push_back(p[s.b] + mag * e[s.b] * 1e-3);
+      }
+      if (along == 0 && k == 0) {
+        nominal.label = "nominal";
+        moved.label = fmt::format("{} x{:g}", what, mag);
+      }
+      c.lines.push_back(std::move(nominal));
+      c.lines.push_back(std::move(moved));
+    }
+  }
+  return svg(c);
+}
+
+struct Stats {
+  double max_norm_um = 0.0, rms_um = 0.0;
+  Vec3 at_mm{}, min_um{}, max_um{};
+};
+
+Stats stats_over(const kin::Grid& g, const ErrorOf& error) {
+  Stats s;
+  s.min_um.fill(std::numeric_limits<double>::infinity());
+  s.max_um.fill(-std::numeric_limits<double>::infinity());
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < g.count[2]; ++k)
+    for (std::size_t j = 0; j < g.count[1]; ++j)
+      for (std::size_t i = 0; i < g.count[0]; ++i) {
+        const Vec3 p{
+            lerp(g.min_mm[0], g.max_mm[0], static_cast<int>(i), static_cast<int>(g.count[0])),
+            lerp(g.min_mm[1], g.max_mm[1], static_cast<int>(j), static_cast<int>(g.count[1])),
+            lerp(g.min_mm[2], g.max_mm[2], static_cast<int>(k), static_cast<int>(g.count[2]))};
+        const Vec3 e = error(p);
+        const double en = norm(e);
+        if (en > s.max_norm_um) s.max_norm_um = en, s.at_mm = p;
+        for (std::size_t a = 0; a < 3; ++a) {
+          s.min_um[a] = std::min(s.min_um[a], e[a]);
+          s.max_um[a] = std::max(s.max_um[a], e[a]);
+        }
+        sum += en * en;
+        ++n;
+      }
+  s.rms_um = std::sqrt(sum / static_cast<double>(std::max<std::size_t>(n, 1)));
+  return s;
+}
+
+std::string stats_table(const Stats& s) {
+  std::vector<std::vector<std::string>> rows{
+      {"largest |e|", fmt::format("{:.3f} µm at ({:g}, {:g}, {:g}) mm", s.max_norm_um, s.at_mm[0],
+                                  s.at_mm[1], s.at_mm[2])},
+      {"RMS |e| over the grid", fmt::format("{:.3f} µm", s.rms_um)}};
+  for (std::size_t a = 0; a < 3; ++a)
+    rows.push_back({fmt::format("e<sub>{}</sub> range", kAxis[a]),
+                    fmt::format("{:.3f} .. {:.3f} µm (span {:.3f})", s.min_um[a], s.max_um[a],
+                                s.max_um[a] - s.min_um[a])});
+  return table({"", ""}, rows, "kv");
+}
+
+std::string slices_section(const kin::Grid& g, const ErrorOf& error, std::string_view what) {
+  const auto ss = slices(g, error);
+  if (ss.empty())
+    return "<p class=\"note\">The grid is flat in at least two axes: no slice to draw.</p>\n";
+  const double mag = magnification(ss);
+  std::string h;
+  for (const auto& s : ss)
+    h += figure(slice_chart(s, mag, what),
+                fmt::format("Error vectors in the {}{} plane through the middle of the volume: "
+                            "each node of the dashed nominal grid is moved by {:g} times its "
+                            "error (the {} component is not shown).",
+                            kAxis[s.a], kAxis[s.b], mag, kAxis[s.c]));
+  return h;
+}
+
+std::string contributions_section(const ModelPage& p) {
+  const auto cs = kin::contributions(p.machine, p.grid);
+  const double top = cs.empty() ? 0.0 : cs.front().max_norm_um;
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t k = 0; k < cs.size(); ++k) {
+    const auto& c = cs[k];
+    const double w = top > 0 ? 100.0 * c.max_norm_um / top : 0.0;
+    rows.push_back({std::to_string(k + 1), c.name, kAxis[c.axis],
+                    fmt::format("{:.3f}", c.max_norm_um), fmt::format("{:.3f}", c.rms_um),
+                    fmt::format("<div class=\"bar\" style=\"width:{:.1f}%\"></div>", w)});
+  }
+  return "<h2>Contributions, ranked</h2>\n<p>What each error alone gives over the grid (first "
+         "order: the contributions add up to the whole map). Squareness is listed under the axis "
+         "it tilts.</p>\n" +
+         table({"rank", "error", "axis", "largest |e| (µm)", "RMS (µm)", ""}, rows, "rank");
+}
+
+constexpr std::string_view kCss = R"(
+body { font-family: "DejaVu Sans", system-ui, sans-serif; margin: 2rem auto; max-width: 60rem;
+       color: #111; line-height: 1.4; padding: 0 1rem; }
+h1 { font-size: 1.6rem; border-bottom: 2px solid #0072b2; padding-bottom: .3rem; }
+h2 { font-size: 1.3rem; margin-top: 2.5rem; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; margin: .5rem 0 1rem; font-size: .9rem; }
+th, td { border: 1px solid #ccc; padding: .2rem .5rem; vertical-align: top; }
+th { background: #f0f4f8; text-align: left; }
+table.kv thead { display: none; } table.kv td:first-child { color: #555; }
+table.rank td:nth-child(4), table.rank td:nth-child(5) { text-align: right;
+  font-variant-numeric: tabular-nums; }
+table.rank td:last-child { width: 14rem; }
+div.bar { background: #0072b2; height: .8rem; min-width: 1px; }
+figure { margin: 1rem 0; break-inside: avoid; }
+svg.plot { width: 100%; height: auto; max-width: 52rem; display: block; }
+figcaption { font-size: .85rem; color: #444; }
+.note { color: #444; font-size: .9rem; }
+.simulated { background: #fff3cd; border: 1px solid #e0b000; padding: .5rem; }
+footer { margin-top: 3rem; font-size: .8rem; color: #666; border-top: 1px solid #ccc; }
+@page { size: A4; margin: 14mm; }
+)";
+
+std::string now_utc() {
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  return buf;
+}
+
+}  // namespace
+
+std::string model_page(const ModelPage& p) {
+  const kin::Method method = p.method;
+  const ErrorOf before = [&](const Vec3& q) {
+    return kin::volumetric_error_um(p.machine, q, method);
+  };
+  std::string body;
+  if (p.simulated)
+    body +=
+        "<p class=\"simulated\">This model describes the <strong>simulated</strong> machine: "
+        "the numbers show what the software computes, not a real machine.</p>\n";
+  body += "<h2>Model</h2>\n";
+  std::vector<std::vector<std::string>> facts{{"file", esc(p.source)}};
+  for (const auto& [k, v] : p.facts) facts.push_back({esc(k), esc(v)});
+  facts.push_back({"method", method == kin::Method::htm ? "exact (homogeneous transformations)"
+                                                        : "first order"});
+  facts.push_back({"grid", fmt::format("{} x {} x {} points over ({:g} .. {:g}, {:g} .. {:g}, {:g} "
+                                       ".. {:g}) mm",
+                                       p.grid.count[0], p.grid.count[1], p.grid.count[2],
+                                       p.grid.min_mm[0], p.grid.max_mm[0], p.grid.min_mm[1],
+                                       p.grid.max_mm[1], p.grid.min_mm[2], p.grid.max_mm[2])});
+  body += table({"", ""}, facts, "kv");
+  if (!p.components.empty()) {
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& r : p.components) {
+      std::vector<std::string> e;
+      for (const auto& c : r) e.push_back(esc(c));
+      rows.push_back(e);
+    }
+    body += table({"error", "given as", "values", "source"}, rows);
+  }
+  body +=
+      "<h2>Volumetric error</h2>\n<p>The error of the tool tip relative to the workpiece "
+      "(actual minus commanded), over the grid:</p>\n";
+  body += stats_table(stats_over(p.grid, before));
+  body += slices_section(p.grid, before, "with error");
+  body += contributions_section(p);
+  if (p.compensated) {
+    const auto& c = *p.compensated;
+    body += fmt::format("<h2>After compensation: {}</h2>\n", esc(c.what));
+    body +=
+        "<p>What the tool tip does relative to the commanded position with the "
+        "compensation applied to the model (exact model, driven to the corrected "
+        "position):</p>\n";
+    body += stats_table(stats_over(p.grid, c.residual_um));
+    for (const auto& n : c.notes) body += "<p class=\"note\">" + esc(n) + "</p>\n";
+    body += slices_section(p.grid, c.residual_um, "residual");
+  }
+  const std::string title = p.title.empty() ? "Volumetric error" : "Volumetric error: " + p.title;
+  return fmt::format(
+      "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n"
+      "<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<footer>Generated by {} on {}. Plots "
+      "drawn with PLplot. Self-contained: no external resources.</footer>\n</body>\n</html>\n",
+      esc(title), kCss, esc(title), body, esc(p.software), now_utc());
+}
+
+}  // namespace cal::daq::report

@@ -1,0 +1,46 @@
+#pragma once
+// Pass/fail of a result against the machine's specification (the tolerances of the run's
+// context, docs/config.md): each limited value, and the run as a whole. Simple acceptance:
+// the measured value as printed (0.001 of its unit) against the limit; the expanded
+// uncertainty is shown beside it in the report but no ISO 14253-1 guard band is applied.
+// Where no limit applies, the verdict says "no tolerance configured", never a pass.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace daq {
+
+struct Check {
+  std::string key;     // the result's key: "E_bi", "G_bi_um", "squareness"
+  std::string symbol;  // as printed: "E", "G", "Squareness XY"
+  double value = 0.0;  // signed, in `unit`
+  double limit = 0.0;  // on the magnitude
+  std::string unit;    // "um", "um/m", "ms"
+  bool pass = false;
+};
+
+struct Verdict {
+  bool configured = false;  // at least one limit applied
+  bool pass = false;        // every check passed (false when not configured)
+  std::string basis;        // e.g. "tolerances.X (travel up to 500 mm)"
+  std::vector<Check> checks;
+  std::vector<std::string> notes;  // limits that could not be applied, and why
+};
+
+// tolerances: the run context's "tolerances" (null when none); result: a caldaq.iso230-2.v1
+// or caldaq.circle.v1 document.
+Verdict linear_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
+Verdict circle_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
+// The verdict of a result of a stored run by its settings (the context's tolerances).
+Verdict verdict_of(const nlohmann::json& settings, const nlohmann::json& result);
+
+nlohmann::json to_json(const Verdict& v);
+// "PASS", "FAIL", "no tolerance configured", or "no tolerance applies" (limits configured for
+// values this evaluation does not give, e.g. E under VDI/DGQ 3441).
+std::string summary(const Verdict& v);
+// For a terminal: the verdict, each check with its limit, and the notes.
+void print_verdict(const Verdict& v);
+// The check of a result key, or nullptr.
+const Check* find_check(const Verdict& v, const std::string& key);
+
+}  // namespace daq

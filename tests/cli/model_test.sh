@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# daq model show | map | compensate | testpiece on the model files of tests/data/model.
+# Usage: model_test.sh DAQ_BINARY DATA_DIR
+set -u
+DAQ=$1
+DATA=$2
+source "$(dirname "$0")/check.sh"
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+Y=$DATA/yfxz.json
+S=$DATA/square50.json
+check show 0 "topology +YFXZ: workpiece <- Y <- F -> X -> Z -> tool" -- "$DAQ" model show "$Y"
+# E_B0Z stated as +8 um/m over 90 deg is the location error -8 urad.
+check show_b0z 0 "E_B0Z .* -8\.000 urad \(\+8\.000 um/m over 90 deg\), carried by Z" -- "$DAQ" model show "$Y"
+check show_json 0 '"iso230_1_urad": -8\.0' -- "$DAQ" model show "$Y" --json
+# Only E_C0Y = 50 urad: e_x = -0.05 y um, so -5 um at y = 100 and 10 um at y = 200.
+printf 'x_mm,y_mm,z_mm\n0,100,0\n150,0,-50\n' > "$TMP/p.csv"
+check map_point 0 "^ +0\.000 +100\.000 +0\.000 +-5\.000 +0\.000 +0\.000 +5\.000$" -- "$DAQ" model map "$S" --points "$TMP/p.csv"
+check map_grid 0 "largest \|e\| +10\.000 um at \([0-9]+, 200, -?[0-9]+\) mm" -- "$DAQ" model map "$S"
+check map_rank 0 "1\. E_C0Y +10\.000 um" -- "$DAQ" model map "$S"
+check map_json 0 '"schema": "caldaq.volumetric-map.v1"' -- "$DAQ" model map "$Y" --count 3 3 3 --json
+check map_report 0 "report written to $TMP/map.html" -- "$DAQ" model map "$Y" --report "$TMP/map.html"
+check map_report_svg 0 "^3$" -- grep -c "<svg class=\"plot\"" "$TMP/map.html"
+check map_report_rank 0 "<td>E_YY</td>" -- cat "$TMP/map.html"
+check map_outside 2 "E_YY: position 450 mm is outside the error table" -- "$DAQ" model map "$Y" --min-mm 0 0 -300 --max-mm 500 450 0
+# Compensation: the squareness on its carrier Y is the table X = f(Y), +0.05 um per mm of y:
+# 0.0050 mm at y = 100 (point 2 of 0, 50, ...). Exact up to the rotation's second order.
+check cec 0 '^\$AN_CEC\[0,2\]=0\.0050$' -- "$DAQ" model compensate "$S" -f siemens-cec --interval-mm 50 50 50
+check cec_axes 0 '^\$AN_CEC_INPUT_AXIS\[0\]=\(AX2\)$' -- "$DAQ" model compensate "$S" -f siemens-cec --interval-mm 50 50 50
+check cec_residual 0 "10\.000 um before, 0\.000 um with the compensation" -- "$DAQ" model compensate "$S" -f siemens-cec --interval-mm 50 50 50 -o "$TMP/cec.mpf"
+check linuxcnc 0 "written $TMP/lc/matrixkins.hal" -- "$DAQ" model compensate "$S" -f linuxcnc --interval-mm 50 50 50 --output-dir "$TMP/lc"
+check matrixkins 0 "^setp matrixkins\.C_xy 0\.000050000000$" -- cat "$TMP/lc/matrixkins.hal"
+check isg_volumetric 0 "^chain +YXZ$" -- sh -c "'$DAQ' model compensate '$Y' -f isg-volumetric --interval-mm 50 50 50 --output-dir '$TMP/vc' 2>/dev/null && cat '$TMP/vc/volcomp.lis'"
+check isg_cross_refused 2 "use -f isg-volumetric" -- "$DAQ" model compensate "$Y" -f isg-cross --interval-mm 50 50 50 --output-dir "$TMP/ic"
+check no_partial 1 "" -- test -e "$TMP/ic"
+check several_files 2 "give --output-dir" -- "$DAQ" model compensate "$Y" -f heidenhain --interval-mm 50 50 50
+check bad_interval 2 "not a whole number of 30 mm intervals" -- "$DAQ" model compensate "$Y" -f csv --interval-mm 30 50 50
+check compensate_report 0 "report written" -- "$DAQ" model compensate "$Y" -f siemens-cec --interval-mm 50 50 50 -o "$TMP/y.mpf" --report "$TMP/comp.html"
+check compensate_report_after 0 "After compensation: SINUMERIK CEC" -- cat "$TMP/comp.html"
+# The test piece of a machine with only E_C0Y = 50 urad: the faces are out of square by 50 um/m;
+# CMM points of such a part (the Y faces leaning by -50e-6 y) measure the same.
+T=(--origin-mm 100 100 -50 --tool-radius-mm 5)
+check testpiece 0 "face\+Y / face\+X +squareness_um_per_m +50\.000" -- "$DAQ" model testpiece "$S" "${T[@]}"
+check testpiece_cmm 0 "face-Y / face-X +squareness_um_per_m +50\.000 +50\.000 +0\.000" -- "$DAQ" model testpiece "$S" "${T[@]}" --cmm "$DATA/cmm_square50.csv"
+check testpiece_json 0 '"schema": "caldaq.testpiece.v1"' -- "$DAQ" model testpiece "$S" "${T[@]}" --json
+printf 'feature,x_mm,y_mm\nface+Z,0,0\n' > "$TMP/bad_cmm.csv"
+check testpiece_bad_cmm 2 "bad_cmm.csv: feature 'face\+Z' is unknown" -- "$DAQ" model testpiece "$S" "${T[@]}" --cmm "$TMP/bad_cmm.csv"
+check bad_carrier 2 "bad_carrier.json: squareness.E_B0Z.compensated_by: Y is not an axis of the XZ plane" -- "$DAQ" model show "$DATA/bad_carrier.json"
+check missing_file 2 "nope.json: cannot open the model file" -- "$DAQ" model show "$TMP/nope.json"
+finish
