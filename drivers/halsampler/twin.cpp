@@ -9,13 +9,10 @@
 
 namespace cal::drivers::sim {
 
-struct HalsamplerTwin::Impl : std::enable_shared_from_this<HalsamplerTwin::Impl> {
+struct HalsamplerTwin::Impl : detail::TcpChannel,
+                              std::enable_shared_from_this<HalsamplerTwin::Impl> {
   Impl(boost::asio::io_context& io, World& w, Clock c, HalsamplerTwinConfig cfg)
-      : server(std::make_shared<detail::LineServer>(io, cfg.port)),
-        timer(io),
-        world(w),
-        clock(std::move(c)),
-        config(cfg) {}
+      : TcpChannel(io, cfg.port), world(w), clock(std::move(c)), config(cfg) {}
 
   // Every sample that is due (k / rate <= now), in one batch per wake-up.
   void tick() {
@@ -45,8 +42,6 @@ struct HalsamplerTwin::Impl : std::enable_shared_from_this<HalsamplerTwin::Impl>
     if (!batch.empty() && server->has_clients()) server->broadcast(batch);
   }
 
-  std::shared_ptr<detail::LineServer> server;
-  boost::asio::steady_timer timer;
   World& world;
   Clock clock;
   HalsamplerTwinConfig config;
@@ -55,18 +50,12 @@ struct HalsamplerTwin::Impl : std::enable_shared_from_this<HalsamplerTwin::Impl>
 
 HalsamplerTwin::HalsamplerTwin(boost::asio::io_context& io, World& world, Clock clock,
                                HalsamplerTwinConfig config)
-    : impl_(std::make_shared<Impl>(io, world, std::move(clock), config)) {
-  impl_->next = static_cast<std::uint64_t>(impl_->clock() * config.sample_rate_hz);
+    : HalsamplerTwin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+HalsamplerTwin::HalsamplerTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(impl)) {
+  impl_->next = static_cast<std::uint64_t>(impl_->clock() * impl_->config.sample_rate_hz);
   impl_->server->start({});
   impl_->tick();
 }
-HalsamplerTwin::~HalsamplerTwin() {
-  impl_->timer.cancel();
-  impl_->server->close();
-}
-std::uint16_t HalsamplerTwin::port() const { return impl_->server->port(); }
-std::string HalsamplerTwin::transport() const { return fmt::format("tcp 127.0.0.1:{}", port()); }
-void HalsamplerTwin::unplug() { impl_->server->drop_clients(); }
 std::uint64_t HalsamplerTwin::lines_sent() const { return impl_->lines; }
 
 }  // namespace cal::drivers::sim

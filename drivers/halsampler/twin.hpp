@@ -21,18 +21,15 @@ struct HalsamplerTwinConfig {
   std::uint64_t overrun_lost = 5;
 };
 
-class HalsamplerTwin final : public Twin {
+class HalsamplerTwin final : public TcpTwin {
  public:
   HalsamplerTwin(boost::asio::io_context& io, World& world, Clock clock,
                  HalsamplerTwinConfig config = {});
-  ~HalsamplerTwin() override;
-  std::uint16_t port() const;
-  std::string transport() const override;
-  void unplug() override;
   std::uint64_t lines_sent() const;
 
  private:
   struct Impl;
+  explicit HalsamplerTwin(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };
 

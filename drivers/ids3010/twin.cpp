@@ -13,12 +13,9 @@ namespace cal::drivers::sim {
 
 using nlohmann::json;
 
-struct IdsTwin::Impl {
+struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's timer stays idle
   Impl(boost::asio::io_context& io, World& w, Clock c, IdsTwinConfig cfg)
-      : server(std::make_shared<detail::LineServer>(io, cfg.port)),
-        world(w),
-        clock(std::move(c)),
-        config(cfg) {}
+      : TcpChannel(io, cfg.port), world(w), clock(std::move(c)), config(cfg) {}
 
   std::string mode(double now) const {
     if (measuring_since < 0) return aligning ? "optics alignment running" : "system idle";
@@ -139,7 +136,6 @@ struct IdsTwin::Impl {
     return json();  // unknown: JSON-RPC "Method not found"
   }
 
-  std::shared_ptr<detail::LineServer> server;
   World& world;
   Clock clock;
   IdsTwinConfig config;
@@ -151,19 +147,16 @@ struct IdsTwin::Impl {
 };
 
 IdsTwin::IdsTwin(boost::asio::io_context& io, World& world, Clock clock, IdsTwinConfig config)
-    : impl_(std::make_shared<Impl>(io, world, std::move(clock), config)) {
+    : IdsTwin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+IdsTwin::IdsTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(impl)) {
   impl_->server->start([impl = impl_.get(), server = impl_->server.get()](
                            const detail::LineServer::ClientPtr& client, const std::string& line) {
     server->send(client, impl->answer(line) + "\n");
   });
 }
-IdsTwin::~IdsTwin() { impl_->server->close(); }
-std::uint16_t IdsTwin::port() const { return impl_->server->port(); }
-std::string IdsTwin::transport() const { return fmt::format("tcp 127.0.0.1:{}", port()); }
 void IdsTwin::set_beam_lost(int axis, bool lost) {
   impl_->beam_lost.at(static_cast<std::size_t>(axis)) = lost;
 }
-void IdsTwin::drop_connections() { impl_->server->drop_clients(); }
 std::uint64_t IdsTwin::requests_served() const { return impl_->served; }
 
 }  // namespace cal::drivers::sim

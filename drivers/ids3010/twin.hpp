@@ -23,19 +23,15 @@ struct IdsTwinConfig {
   codec::IdsApi api = codec::IdsApi::ids;
 };
 
-class IdsTwin final : public Twin {
+class IdsTwin final : public TcpTwin {
  public:
   IdsTwin(boost::asio::io_context& io, World& world, Clock clock, IdsTwinConfig config = {});
-  ~IdsTwin() override;
 
-  std::uint16_t port() const;
-  std::string transport() const override;
-  void unplug() override { drop_connections(); }
   // Simulates a blocked beam on one axis: its displacement requests answer with an error
   // code (the twin's stand-in for the device's signal-lost warning) until restored.
   void set_beam_lost(int axis, bool lost);
   // Drops every client connection (as a power cycle or a pulled cable would).
-  void drop_connections();
+  void drop_connections() { unplug(); }
   std::uint64_t requests_served() const;
 
   // The twin's own numbers (the device's are not published); errorNumberToString gives their
@@ -46,6 +42,7 @@ class IdsTwin final : public Twin {
 
  private:
   struct Impl;
+  explicit IdsTwin(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };
 

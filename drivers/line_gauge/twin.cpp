@@ -11,9 +11,9 @@
 
 namespace cal::drivers::sim {
 
-struct GaugeTwin::Impl : std::enable_shared_from_this<GaugeTwin::Impl> {
+struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeTwin::Impl> {
   Impl(boost::asio::io_context& io, World& w, Clock c, GaugeTwinConfig cfg)
-      : pty(io), timer(io), world(w), clock(std::move(c)), config(std::move(cfg)) {}
+      : PtyChannel(io), world(w), clock(std::move(c)), config(std::move(cfg)) {}
 
   std::string line_at(double t) {
     world.advance_to(t);
@@ -46,8 +46,6 @@ struct GaugeTwin::Impl : std::enable_shared_from_this<GaugeTwin::Impl> {
     });
   }
 
-  detail::PtyDevice pty;
-  boost::asio::steady_timer timer;
   World& world;
   Clock clock;
   GaugeTwinConfig config;
@@ -55,23 +53,14 @@ struct GaugeTwin::Impl : std::enable_shared_from_this<GaugeTwin::Impl> {
 };
 
 GaugeTwin::GaugeTwin(boost::asio::io_context& io, World& world, Clock clock, GaugeTwinConfig config)
-    : impl_(std::make_shared<Impl>(io, world, std::move(clock), std::move(config))) {
+    : GaugeTwin(std::make_shared<Impl>(io, world, std::move(clock), std::move(config))) {}
+GaugeTwin::GaugeTwin(std::shared_ptr<Impl> impl)
+    : PtyTwin(impl, "115200 8N1"), impl_(std::move(impl)) {
   if (!(impl_->config.sample_rate_hz > 0.0))
     throw std::invalid_argument("gauge twin: sample rate must be > 0");
   detail::read_commands(impl_);
   impl_->tick();
 }
-GaugeTwin::~GaugeTwin() {
-  impl_->timer.cancel();
-  impl_->pty.unplug();
-}
-const std::string& GaugeTwin::device_path() const { return impl_->pty.path; }
-std::string GaugeTwin::transport() const { return "serial " + device_path() + " 115200 8N1"; }
-void GaugeTwin::unplug() {
-  impl_->timer.cancel();
-  impl_->pty.unplug();
-}
-std::uint64_t GaugeTwin::lines_sent() const { return impl_->pty.lines; }
 void GaugeTwin::set_streaming(bool on) {
   impl_->timer.cancel();
   impl_->config.continuous = on;

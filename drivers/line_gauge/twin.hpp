@@ -23,21 +23,18 @@ struct GaugeTwinConfig {
   std::function<double(const World&)> value;
 };
 
-class GaugeTwin final : public Twin {
+// transport(): "serial PATH 115200 8N1".
+class GaugeTwin final : public PtyTwin {
  public:
   GaugeTwin(boost::asio::io_context& io, World& world, Clock clock, GaugeTwinConfig config = {});
-  ~GaugeTwin() override;
 
-  const std::string& device_path() const;
-  std::string transport() const override;  // "serial PATH 115200 8N1"
-  void unplug() override;
-  std::uint64_t lines_sent() const;
   // Starts (from the current simulated time) or stops the continuous output: a bar is only
   // mounted, and a stream only read, for its test.
   void set_streaming(bool on);
 
  private:
   struct Impl;
+  explicit GaugeTwin(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };
 

@@ -11,10 +11,9 @@
 
 namespace cal::drivers::sim {
 
-struct Ptu300Twin::Impl : std::enable_shared_from_this<Ptu300Twin::Impl> {
+struct Ptu300Twin::Impl : detail::PtyChannel, std::enable_shared_from_this<Ptu300Twin::Impl> {
   Impl(boost::asio::io_context& io, World& w, Clock c, Ptu300TwinConfig cfg)
-      : pty(io),
-        timer(io),
+      : PtyChannel(io),
         world(w),
         clock(std::move(c)),
         config(cfg),
@@ -79,8 +78,6 @@ struct Ptu300Twin::Impl : std::enable_shared_from_this<Ptu300Twin::Impl> {
     });
   }
 
-  detail::PtyDevice pty;
-  boost::asio::steady_timer timer;
   World& world;
   Clock clock;
   Ptu300TwinConfig config;
@@ -90,20 +87,11 @@ struct Ptu300Twin::Impl : std::enable_shared_from_this<Ptu300Twin::Impl> {
 
 Ptu300Twin::Ptu300Twin(boost::asio::io_context& io, World& world, Clock clock,
                        Ptu300TwinConfig config)
-    : impl_(std::make_shared<Impl>(io, world, std::move(clock), config)) {
+    : Ptu300Twin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+Ptu300Twin::Ptu300Twin(std::shared_ptr<Impl> impl)
+    : PtyTwin(impl, "4800 7E1"), impl_(std::move(impl)) {
   detail::read_commands(impl_);
   impl_->tick();
 }
-Ptu300Twin::~Ptu300Twin() {
-  impl_->timer.cancel();
-  impl_->pty.unplug();
-}
-const std::string& Ptu300Twin::device_path() const { return impl_->pty.path; }
-std::string Ptu300Twin::transport() const { return "serial " + device_path() + " 4800 7E1"; }
-void Ptu300Twin::unplug() {
-  impl_->timer.cancel();
-  impl_->pty.unplug();
-}
-std::uint64_t Ptu300Twin::lines_sent() const { return impl_->pty.lines; }
 
 }  // namespace cal::drivers::sim

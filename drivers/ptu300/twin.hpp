@@ -14,20 +14,15 @@ struct Ptu300TwinConfig {
   double interval_s = 1.0;         // INTV
 };
 
-class Ptu300Twin final : public Twin {
+// transport(): "serial PATH 4800 7E1".
+class Ptu300Twin final : public PtyTwin {
  public:
   // Opens a pseudo-terminal pair; the driver opens device_path() like a /dev/ttyUSB0.
   Ptu300Twin(boost::asio::io_context& io, World& world, Clock clock, Ptu300TwinConfig config = {});
-  ~Ptu300Twin() override;
-
-  const std::string& device_path() const;
-  std::string transport() const override;  // "serial PATH 4800 7E1"
-  // Closes the master side: the driver sees what an unplugged USB adapter looks like.
-  void unplug() override;
-  std::uint64_t lines_sent() const;
 
  private:
   struct Impl;
+  explicit Ptu300Twin(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };
 

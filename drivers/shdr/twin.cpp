@@ -11,13 +11,9 @@
 
 namespace cal::drivers::sim {
 
-struct ShdrTwin::Impl : std::enable_shared_from_this<ShdrTwin::Impl> {
+struct ShdrTwin::Impl : detail::TcpChannel, std::enable_shared_from_this<ShdrTwin::Impl> {
   Impl(boost::asio::io_context& io, World& w, Clock c, ShdrTwinConfig cfg)
-      : server(std::make_shared<detail::LineServer>(io, cfg.port)),
-        timer(io),
-        world(w),
-        clock(std::move(c)),
-        config(cfg) {}
+      : TcpChannel(io, cfg.port), world(w), clock(std::move(c)), config(cfg) {}
 
   void on_line(const detail::LineServer::ClientPtr& client, const std::string& line) {
     if (!line.starts_with("* PING")) return;
@@ -64,8 +60,6 @@ struct ShdrTwin::Impl : std::enable_shared_from_this<ShdrTwin::Impl> {
     });
   }
 
-  std::shared_ptr<detail::LineServer> server;
-  boost::asio::steady_timer timer;
   World& world;
   Clock clock;
   ShdrTwinConfig config;
@@ -74,7 +68,8 @@ struct ShdrTwin::Impl : std::enable_shared_from_this<ShdrTwin::Impl> {
 };
 
 ShdrTwin::ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config)
-    : impl_(std::make_shared<Impl>(io, world, std::move(clock), config)) {
+    : ShdrTwin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+ShdrTwin::ShdrTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(impl)) {
   impl_->server->start(
       [impl = impl_.get()](const detail::LineServer::ClientPtr& client, const std::string& line) {
         impl->on_line(client, line);
@@ -85,13 +80,6 @@ ShdrTwin::ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrT
       });
   impl_->tick();
 }
-ShdrTwin::~ShdrTwin() {
-  impl_->timer.cancel();
-  impl_->server->close();
-}
-std::uint16_t ShdrTwin::port() const { return impl_->server->port(); }
-std::string ShdrTwin::transport() const { return fmt::format("tcp 127.0.0.1:{}", port()); }
-void ShdrTwin::unplug() { impl_->server->drop_clients(); }
 std::uint64_t ShdrTwin::lines_sent() const { return impl_->sent; }
 std::uint64_t ShdrTwin::pings_answered() const { return impl_->pongs; }
 

@@ -24,18 +24,15 @@ struct ShdrTwinConfig {
 
 // Sends the simulated control's commanded position to every connected agent on change and
 // answers its heartbeats ("* PING" -> "* PONG <ms>"), as an MTConnect adapter does.
-class ShdrTwin final : public Twin {
+class ShdrTwin final : public TcpTwin {
  public:
   ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});
-  ~ShdrTwin() override;
-  std::uint16_t port() const;
-  std::string transport() const override;
-  void unplug() override;
   std::uint64_t lines_sent() const;
   std::uint64_t pings_answered() const;
 
  private:
   struct Impl;
+  explicit ShdrTwin(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };
 

@@ -126,4 +126,25 @@ void PtyDevice::send(std::string line, std::shared_ptr<void> keep_alive, std::ui
 }
 
 }  // namespace detail
+
+PtyTwin::PtyTwin(std::shared_ptr<detail::PtyChannel> channel, std::string settings)
+    : channel_(std::move(channel)), settings_(std::move(settings)) {}
+PtyTwin::~PtyTwin() { unplug(); }
+const std::string& PtyTwin::device_path() const { return channel_->pty.path; }
+std::string PtyTwin::transport() const { return "serial " + device_path() + " " + settings_; }
+void PtyTwin::unplug() {
+  channel_->timer.cancel();
+  channel_->pty.unplug();
+}
+std::uint64_t PtyTwin::lines_sent() const { return channel_->pty.lines; }
+
+TcpTwin::TcpTwin(std::shared_ptr<detail::TcpChannel> channel) : channel_(std::move(channel)) {}
+TcpTwin::~TcpTwin() {
+  channel_->timer.cancel();
+  channel_->server->close();
+}
+std::uint16_t TcpTwin::port() const { return channel_->server->port(); }
+std::string TcpTwin::transport() const { return fmt::format("tcp 127.0.0.1:{}", port()); }
+void TcpTwin::unplug() { channel_->server->drop_clients(); }
+
 }  // namespace cal::drivers::sim

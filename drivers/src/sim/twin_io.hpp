@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include "cal/drivers/sim/twin.hpp"
+
 namespace cal::drivers::sim::detail {
 
 namespace asio = boost::asio;
@@ -94,6 +96,22 @@ struct PtyDevice {
   PtyDevice& operator=(const PtyDevice&) = delete;
   void unplug();
   void send(std::string line, std::shared_ptr<void> keep_alive, std::uint64_t count = 1);
+};
+
+// What a PtyTwin's Impl is built on: the pty and the timer that paces the twin's output.
+struct PtyChannel {
+  explicit PtyChannel(asio::io_context& io) : pty(io), timer(io) {}
+  PtyDevice pty;
+  asio::steady_timer timer;
+};
+
+// What a TcpTwin's Impl is built on: the line server and the timer that paces what the twin
+// sends unasked (idle in a twin that only answers).
+struct TcpChannel {
+  TcpChannel(asio::io_context& io, std::uint16_t port)
+      : server(std::make_shared<LineServer>(io, port)), timer(io) {}
+  std::shared_ptr<LineServer> server;
+  asio::steady_timer timer;
 };
 
 // Reads CR- or LF-terminated command lines from self->pty's master and hands each (without
