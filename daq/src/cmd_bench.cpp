@@ -46,7 +46,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/daq/env_stage.hpp"
-#include "cal/drivers/instruments.hpp"
+#include "cal/drivers/registry.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "cal/storage/chunk.hpp"
@@ -182,10 +182,16 @@ IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t bat
         return;
     }
   };
-  auto laser = cal::drivers::make_gauge(io, bus.transport(0, "laser"),
-                                        {.device = 0, .clock = bus.clock(), .replay = true});
-  auto air = cal::drivers::make_ptu300(io, bus.transport(1, "air"),
-                                       {.device = 1, .clock = bus.clock(), .replay = true});
+  // The benchmark's workload is a line gauge and a PTU300 with their default options, made by
+  // the registry as a run makes them.
+  const auto instrument = [&](std::string_view driver, std::uint16_t device, const char* role) {
+    const auto& d = cal::drivers::driver(driver);
+    return d.make_instrument(io, bus.transport(device, role),
+                             {.device = device, .clock = bus.clock(), .replay = true},
+                             cal::drivers::options_from_text(d, {}), {.role = role});
+  };
+  auto laser = instrument("gauge", std::uint16_t{0}, "laser");
+  auto air = instrument("ptu300", std::uint16_t{1}, "air");
   laser->start({.reading = on_reading});
   air->start({.reading = on_reading});
   bool done = false;
