@@ -78,7 +78,7 @@ void write_file(const fs::path& path, const std::string& text) {
 void run_report_command(ReportOptions o) {
   if (o.format != "html" && o.format != "pdf")
     throw cal::InputError(fmt::format("report: --format {}: use html or pdf", o.format));
-  cal::storage::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);
   if (!o.campaign.empty()) {
     for (const auto& r : store.runs())
       if (r.campaign == o.campaign) o.runs.push_back(r.id);
