@@ -25,12 +25,17 @@ struct SimOptions {
   double speed = 1.0;
   double start_after_s = 5.0;
   bool position_feed = false;
+  // The linear program's size: a short one (e.g. 2 runs over 3 targets) tries the wiring in
+  // seconds; the full ISO 230-2 program (5 runs over 11 targets) takes minutes of wall time.
+  int runs = 5;
+  int targets = 11;
 };
 
 // The configuration of the shop's devices and tests. Times the acquiring process measures on
 // its own clock (the trigger's dwell) are divided by the speed: it sees the program `speed`
 // times faster than the program's own times.
-std::string sim_config(const SimulatedShop& shop, double speed, bool position_feed) {
+std::string sim_config(const SimulatedShop& shop, const SimOptions& o) {
+  const double speed = o.speed;
   const auto& t = shop.truth();
   return fmt::format(
       R"TOML(# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {speed}x
@@ -54,10 +59,10 @@ window_mm = 0.5
 [test.linear]
 axis = "X"
 first_mm = 0
-last_mm = 500
+last_mm = {last_mm}
 interval_mm = 50
 random_fraction = 0.2
-runs = 5
+runs = {runs}
 overrun_mm = 3
 feed_mm_per_min = 6000
 dwell_s = 3
@@ -70,7 +75,8 @@ sample_rate_hz = 1000
 overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
 )TOML",
-      fmt::arg("devices", shop.devices_toml(0.05 / speed, position_feed)), fmt::arg("speed", speed),
+      fmt::arg("devices", shop.devices_toml(0.05 / speed, o.position_feed)),
+      fmt::arg("speed", speed), fmt::arg("last_mm", 50 * (o.targets - 1)), fmt::arg("runs", o.runs),
       fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
       fmt::arg("radius", t.ballbar_mm), fmt::arg("cx", t.pivot_mm[0]),
       fmt::arg("cy", t.pivot_mm[1]), fmt::arg("cz", t.pivot_mm[2]));
@@ -81,7 +87,7 @@ void run_sim(const SimOptions& o) {
     throw cal::InputError(fmt::format("--test '{}' (expected linear or circle)", o.test));
   boost::asio::io_context io;
   SimulatedShop shop(io, ShopTruth{}, o.speed);
-  const std::string text = sim_config(shop, o.speed, o.position_feed);
+  const std::string text = sim_config(shop, o);
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -130,6 +136,14 @@ void add_sim_command(CLI::App& app) {
   cmd->add_option("--start-after-s", o->start_after_s, "Wall-clock delay before the program")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--runs", o->runs, "Runs of the linear program (ISO 230-2: 5)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 10));
+  cmd->add_option(
+         "--targets", o->targets,
+         "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11 over 500 mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 11));
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->callback([o] { run_sim(*o); });

@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
-#include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "cal/daq/env_stage.hpp"
 #include "cal/daq/trigger.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "iso230_2_output.hpp"
@@ -132,7 +132,7 @@ struct LinearRun::Impl {
   cal::daq::Sequencer sequencer;
   std::optional<cal::storage::Store> store;
   std::unique_ptr<cal::storage::BatchWriter> writer;
-  boost::asio::steady_timer timer;
+  cal::drivers::Timer timer;  // on the loop's time: simulated in a simulated session
   LinearRunOutcome outcome;
   LiveState live;
   bool running = false, done = false;

@@ -43,6 +43,10 @@ struct ShopTruth {
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
 };
 
+// On an io_context with cal::drivers::VirtualTime installed (loop_time.hpp), the shop runs on
+// that simulated time, which jumps from event to event: run_program and wait_until then take
+// as long as the CPU needs, not the wall clock. Without it, simulated time follows the wall
+// clock times `speed` (the live mode of `daq sim`).
 class SimulatedShop {
  public:
   SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed);
@@ -51,6 +55,7 @@ class SimulatedShop {
   const ShopTruth& truth() const;
   double now_s() const;  // simulated time
   cal::drivers::Clock clock_ns() const;
+  bool simulated_time() const;  // on the loop's VirtualTime (see above)
   std::uint16_t laser_port() const;
   const std::string& air_device() const;
   const std::string& material_device() const;
