@@ -15,18 +15,13 @@
 #include "cal/drivers/transport/transport.hpp"
 #include "cal/drivers/transport/usb.hpp"
 #include "commands.hpp"
+#include "devices_list.hpp"
 
 namespace daq {
 namespace {
 
 namespace t = cal::drivers::transport;
 using nlohmann::json;
-
-struct DevicesOptions {
-  std::vector<std::string> tcp_probes;     // HOST[:PORT]
-  std::vector<std::string> serial_probes;  // DEVICE[@SETTINGS]
-  bool json = false;
-};
 
 std::vector<std::string> serial_ports() {
   namespace fs = std::filesystem;
@@ -114,6 +109,8 @@ json probe_serial(const std::string& spec) {
   return j;
 }
 
+}  // namespace
+
 json list_devices(const DevicesOptions& o) {
   json out{{"schema", "caldaq.devices.v1"},
            {"usb", json::array()},
@@ -153,6 +150,8 @@ json list_devices(const DevicesOptions& o) {
   for (const auto& p : o.serial_probes) out["probes"].push_back(probe_serial(p));
   return out;
 }
+
+namespace {
 
 void print_text(const json& j) {
   const auto driver = [](const json& d) {

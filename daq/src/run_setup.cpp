@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 
 #include "cal/analysis/error.hpp"
@@ -34,30 +35,56 @@ t::HidSettings hid_settings(const cal::daq::DeviceConfig& c, const std::string& 
 
 }  // namespace
 
-std::unique_ptr<t::Transport> make_transport(boost::asio::io_context& io,
-                                             const cal::daq::DeviceConfig& c) {
+namespace {
+// "tcp HOST:PORT" with a port 1 .. 65535.
+t::TcpSettings tcp_settings(const cal::daq::DeviceConfig& c, const std::string& rest) {
+  const auto colon = rest.rfind(':');
+  unsigned port = 0;
+  const char* first = colon == std::string::npos ? nullptr : rest.data() + colon + 1;
+  const char* last = rest.data() + rest.size();
+  if (colon == std::string::npos || colon == 0 || std::from_chars(first, last, port).ptr != last ||
+      port < 1 || port > 65535)
+    throw cal::InputError(
+        fmt::format("devices.{}.transport '{}': expected tcp HOST:PORT (a port 1 .. 65535)", c.id,
+                    c.transport));
+  return {.host = rest.substr(0, colon), .port = static_cast<std::uint16_t>(port)};
+}
+
+t::SerialSettings serial_settings(const cal::daq::DeviceConfig& c, const std::string& rest) {
+  const auto sp = rest.find(' ');
+  if (sp == std::string::npos || sp == 0)
+    throw cal::InputError(fmt::format(
+        "devices.{}.transport '{}': expected serial DEVICE BAUD FRAME", c.id, c.transport));
+  try {
+    return t::parse_serial_settings(rest.substr(sp + 1), {.device = rest.substr(0, sp)});
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("devices.{}.transport: {}", c.id, e.what()));
+  }
+}
+
+std::pair<std::string, std::string> split_transport(const cal::daq::DeviceConfig& c) {
   const auto space = c.transport.find(' ');
-  const std::string kind = c.transport.substr(0, space),
-                    rest = space == std::string::npos ? "" : c.transport.substr(space + 1);
-  if (kind == "tcp") {
-    const auto colon = rest.rfind(':');
-    if (colon == std::string::npos)
-      throw cal::InputError(
-          fmt::format("devices.{}.transport '{}': expected tcp HOST:PORT", c.id, c.transport));
-    return t::make_tcp(io, {.host = rest.substr(0, colon),
-                            .port = static_cast<std::uint16_t>(std::stoi(rest.substr(colon + 1)))});
-  }
-  if (kind == "serial") {
-    const auto sp = rest.find(' ');
-    if (sp == std::string::npos)
-      throw cal::InputError(fmt::format(
-          "devices.{}.transport '{}': expected serial DEVICE BAUD FRAME", c.id, c.transport));
-    return t::make_serial(
-        io, t::parse_serial_settings(rest.substr(sp + 1), {.device = rest.substr(0, sp)}));
-  }
-  if (kind == "hid") return t::make_hid(io, hid_settings(c, rest));
+  return {c.transport.substr(0, space),
+          space == std::string::npos ? "" : c.transport.substr(space + 1)};
+}
+}  // namespace
+
+void check_transport(const cal::daq::DeviceConfig& c) {
+  const auto [kind, rest] = split_transport(c);
+  if (kind == "tcp") return void(tcp_settings(c, rest));
+  if (kind == "serial") return void(serial_settings(c, rest));
+  if (kind == "hid") return void(hid_settings(c, rest));
   throw cal::InputError(
       fmt::format("devices.{}: transport '{}' has no driver here yet", c.id, c.transport));
+}
+
+std::unique_ptr<t::Transport> make_transport(boost::asio::io_context& io,
+                                             const cal::daq::DeviceConfig& c) {
+  check_transport(c);
+  const auto [kind, rest] = split_transport(c);
+  if (kind == "tcp") return t::make_tcp(io, tcp_settings(c, rest));
+  if (kind == "serial") return t::make_serial(io, serial_settings(c, rest));
+  return t::make_hid(io, hid_settings(c, rest));
 }
 
 InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device) {
@@ -86,12 +113,26 @@ const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role) 
   throw cal::InputError(fmt::format("{}: no device with role = \"{}\"", c.source.string(), role));
 }
 
+std::chrono::microseconds scaled_poll(double poll_s, const RunOptions& o) {
+  return std::chrono::microseconds(
+      std::max<std::int64_t>(100, static_cast<std::int64_t>(poll_s * o.poll_scale * 1e6)));
+}
+
+const cal::daq::DeviceConfig& ballbar_device(const cal::daq::Config& c) {
+  const auto& dc = need(c, "ballbar");
+  if (dc.driver != "gauge")
+    throw cal::InputError(fmt::format("{}: devices.{}: the ballbar needs driver = \"gauge\"",
+                                      c.source.string(), dc.id));
+  return dc;
+}
+
 d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const RunOptions& o,
                                         cal::replay::CaptureRecorder* recorder) {
-  d::InstrumentOptions opt{
-      .name = dc.id, .backoff = {.max_attempts = o.give_up_after}, .recorder = recorder};
-  if (dc.poll_s > 0)
-    opt.poll_period = std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6));
+  d::InstrumentOptions opt{.name = dc.id,
+                           .backoff = {.max_attempts = o.give_up_after},
+                           .clock = o.clock,
+                           .recorder = recorder};
+  if (dc.poll_s > 0) opt.poll_period = scaled_poll(dc.poll_s, o);
   return opt;
 }
 
@@ -123,9 +164,10 @@ void add_linear_instruments(boost::asio::io_context& io, const cal::daq::Config&
         [&](const auto& x) { return x.transport == s.transport && x.role == s.role; });
     auto opt = instrument_options(dc, o, recorder);
     if (dc.poll_s <= 0 && (s.driver == "ptu300" || s.driver == "temper" || s.role == "material"))
-      opt.poll_period = 1000ms;
+      opt.poll_period = scaled_poll(1.0, o);
     if (dc.poll_s <= 0 && s.driver == "shdr") opt.poll_period = 5000ms;  // "* PING" heartbeats
     auto inst = make_instrument(io, s, make_transport(io, dc), opt);
+    if (o.wrap) inst = o.wrap(dc, std::move(inst));
     if (s.role == "laser")
       setup.laser = std::move(inst);
     else if (s.role == "air")

@@ -1,6 +1,8 @@
 // The simulated shop (see sim_shop.hpp).
 #include "sim_shop.hpp"
 
+#include <fmt/format.h>
+
 #include <boost/asio/io_context.hpp>
 #include <cmath>
 #include <numbers>
@@ -171,6 +173,122 @@ std::vector<cal::iso230_2::Measurement> SimulatedShop::true_measurements(
       out.push_back({m.position_mm, m.run, m.direction,
                      impl_->truth.deviation_um(m.position_mm, m.direction)});
   return out;
+}
+
+std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o) {
+  const auto& t = shop.truth();
+  const double wall = o.in_process ? 1.0 : 1.0 / o.speed;  // simulated s -> the reader's s
+  const std::string header =
+      o.in_process
+          ? fmt::format(
+                "# The devices of the built-in SIMULATED shop of `daq serve --simulate` (running\n"
+                "# {}x faster than real time; every time here is simulated time). Valid while\n"
+                "# that process runs.\n",
+                o.speed)
+          : fmt::format(
+                "# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {}x\n"
+                "# faster than real time). Valid while that process runs.\n",
+                o.speed);
+  const std::string position =
+      o.position_feed ? fmt::format(
+                            "[devices.position]      # the control's commanded position\n"
+                            "driver = \"shdr\"\ntransport = \"tcp 127.0.0.1:{}\"\n"
+                            "key = \"Xcom\"\nrole = \"position\"\n\n",
+                            shop.position_port())
+                      : std::string{};
+  return header + fmt::format(
+                      R"TOML(campaign = "simulated"
+
+[machine]
+name = "SIMULATED VMC"
+description = "built-in simulated 3-axis machine with injected errors ({who})"
+
+[devices.laser]
+driver = "ids3010"
+transport = "tcp 127.0.0.1:{laser}"
+role = "laser"
+poll_s = {laser_poll}
+serial_number = "SIM-IDS-0001"
+
+[devices.air]
+driver = "ptu300"
+transport = "serial {air} 4800 {air_frame}"
+role = "air"
+{air_poll}serial_number = "SIM-PTU-0001"
+
+[devices.material]
+driver = "gauge"
+transport = "serial {material} 9600 8N1"
+request = "?\r"
+unit = "degC"
+role = "material"
+{material_poll}serial_number = "SIM-TH-0001"
+
+{position}[devices.ballbar]
+driver = "gauge"
+transport = "serial {ballbar} 115200 8N1"
+unit = "mm"
+role = "ballbar"
+serial_number = "SIM-BB-0001"
+
+[environment]
+equation = "ciddor"
+expansion_ppm_per_k = {alpha}
+{stale}
+[trigger]
+tolerance_um = 1
+dwell_s = {trigger_dwell}
+window_mm = 0.5
+
+[test.linear]
+axis = "X"
+first_mm = 0
+last_mm = 500
+interval_mm = 50
+random_fraction = 0.2
+runs = 5
+overrun_mm = 3
+feed_mm_per_min = 6000
+dwell_s = 3
+
+[test.circle]
+plane = "XY"
+radius_mm = {radius}
+feed_mm_per_min = 1000
+sample_rate_hz = 1000
+overshoot_deg = 45
+centre_mm = [{cx}, {cy}, {cz}]
+
+# The machine's specification (as in `daq demo`): the injected backlash (4 um) and servo
+# mismatch exceed it, the rest is within.
+[tolerances.X]
+E_um = 10
+R_um = 6
+B_um = 3
+A_um = 12
+M_um = 8
+
+[tolerances.XY]
+G_um = 10
+[tolerances.XY.diagnostics]
+squareness = 30
+backlash_X = 3
+)TOML",
+                      fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
+                      fmt::arg("position", position), fmt::arg("laser", shop.laser_port()),
+                      fmt::arg("laser_poll", 0.05 * wall), fmt::arg("air", shop.air_device()),
+                      fmt::arg("air_frame", o.in_process ? "8N1" : "7E1"),
+                      fmt::arg("air_poll", o.in_process ? "poll_s = 1\n" : ""),
+                      fmt::arg("material", shop.material_device()),
+                      fmt::arg("material_poll", o.in_process ? "poll_s = 1\n" : ""),
+                      fmt::arg("ballbar", shop.ballbar_device()),
+                      fmt::arg("alpha", t.expansion_ppm_per_k),
+                      // Simulated seconds: at a high speed the wall-clock timers' jitter is
+                      // magnified, as in daq demo.
+                      fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
+                      fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
+                      fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
+                      fmt::arg("cz", t.pivot_mm[2]));
 }
 
 }  // namespace daq

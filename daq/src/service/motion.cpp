@@ -1,0 +1,77 @@
+// Moving / settling / stable / captured for the operator's display (see motion.hpp).
+#include "cal/daq/motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "cal/analysis/error.hpp"
+
+namespace cal::daq {
+
+std::string_view to_string(Motion m) {
+  switch (m) {
+    case Motion::moving:
+      return "moving";
+    case Motion::settling:
+      return "settling";
+    case Motion::stable:
+      return "stable";
+    case Motion::captured:
+      return "captured";
+  }
+  return "moving";
+}
+
+MotionIndicator::MotionIndicator(MotionSettings s) : s_(s) {
+  if (!(s.tolerance_um > 0 && s.dwell_s > 0 && s.window_mm > 0 && s.still_s > 0))
+    throw InputError("motion indicator: tolerance, dwell, window and still time must be > 0");
+}
+
+void MotionIndicator::add(std::int64_t time_ns, double position_mm, bool valid,
+                          std::span<const double> targets_mm) {
+  const double tol_mm = s_.tolerance_um * 1e-3;
+  // A captured stop stays "captured" until the axis leaves it (the trigger re-arms then too).
+  if (captured_mm_ && std::abs(position_mm - *captured_mm_) <= 10 * tol_mm) {
+    motion_ = Motion::captured;
+    target_mm_ = captured_target_mm_;
+    stable_fraction_ = 1.0;
+    return;
+  }
+  captured_mm_.reset();
+  // The nearest target whose window holds the position.
+  target_mm_.reset();
+  const auto it = std::lower_bound(targets_mm.begin(), targets_mm.end(), position_mm);
+  double best = s_.window_mm;
+  for (auto c : {it, it == targets_mm.begin() ? it : it - 1})
+    if (c != targets_mm.end() && std::abs(*c - position_mm) <= best)
+      best = std::abs(*c - position_mm), target_mm_ = *c;
+  if (!target_mm_ || !valid) {
+    motion_ = target_mm_ ? Motion::settling : Motion::moving;
+    still_since_ns_.reset();
+    stable_fraction_ = 0.0;
+    return;
+  }
+  // Still: every reading since still_since within +/- tolerance of their middle (a band of
+  // 2 tolerances, as the trigger's).
+  const double lo = std::min(band_min_mm_, position_mm), hi = std::max(band_max_mm_, position_mm);
+  if (!still_since_ns_ || hi - lo > 2 * tol_mm) {
+    still_since_ns_ = time_ns;
+    band_min_mm_ = band_max_mm_ = position_mm;
+  } else {
+    band_min_mm_ = lo, band_max_mm_ = hi;
+  }
+  const double still_s = static_cast<double>(time_ns - *still_since_ns_) * 1e-9;
+  motion_ = still_s >= std::min(s_.still_s, s_.dwell_s) ? Motion::stable : Motion::settling;
+  stable_fraction_ = std::clamp(still_s / s_.dwell_s, 0.0, 1.0);
+}
+
+void MotionIndicator::captured(double mean_mm, double target_mm) {
+  captured_mm_ = mean_mm;
+  captured_target_mm_ = target_mm;
+  motion_ = Motion::captured;
+  target_mm_ = target_mm;
+  stable_fraction_ = 1.0;
+  still_since_ns_.reset();
+}
+
+}  // namespace cal::daq
