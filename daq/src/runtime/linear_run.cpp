@@ -57,6 +57,9 @@ std::string to_json_text(const LiveState& s) {
   j["expected"] = s.progress.expected;
   j["valid"] = s.valid;
   j["motion"] = {{"state", s.motion}, {"stable_fraction", s.stable_fraction}};
+  if (s.last_settling_s)
+    j["motion"]["last_stop"] = {{"settling_s", *s.last_settling_s},
+                                {"stable_s", s.last_stable_s.value_or(0.0)}};
   // The number the page shows: a deviation within a target's capture window, else the
   // position; none before the first laser reading.
   if (!s.has_reading)
@@ -358,7 +361,9 @@ struct LinearRun::Impl {
       using Kind = cal::daq::SequenceEvent::Kind;
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
         const auto& s = sequencer.stops()[e.stop];
-        motion.captured(cap.mean_mm, s.position_mm);
+        motion.captured(cap.mean_mm, s.position_mm, cap.end_ns);
+        if (const auto t = motion.last_stop())
+          live.last_settling_s = t->settling_s, live.last_stable_s = t->stable_s;
         const cal::storage::CapturedTarget t{
             .run_id = outcome.run_id,
             .target_index = s.target_index - 1,

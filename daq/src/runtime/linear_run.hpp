@@ -43,6 +43,8 @@ struct LiveState {
   double stable_fraction = 0.0;
   std::optional<double> at_target_mm;
   double at_target_deviation_um = 0.0;
+  // The last captured stop: how long it settled, and was stable before the capture.
+  std::optional<double> last_settling_s, last_stable_s;
   // Stop k of N: the next expected stop in plan order (k = N + 1 when complete).
   std::size_t stop_number = 0, stop_count = 0;
   struct Stop {

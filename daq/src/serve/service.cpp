@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "database.hpp"
@@ -188,7 +189,7 @@ class Service {
   bool running() const { return linear_ || circle_; }
 
   void make_server() {
-    web::Api api{.page = [] { return web::live_page(); },
+    web::Api api{.page = [] { return web::operator_page(); },
                  .runs = [this] { return runs(); },
                  .status = [this] { return ok(status()); },
                  .start = [this](const std::string& body) { return start(body); },
@@ -240,15 +241,20 @@ class Service {
   }
 
   // Every configured device is opened while idle, so the page shows its state and values and
-  // the environment settles in view; a run closes them and opens its own (its capture holds
-  // each device's bytes from the connection on, as `daq replay` needs).
-  void start_monitors() {
-    monitors_.clear();
+  // the environment settles in view; a run closes those it uses and opens its own (its capture
+  // holds each device's bytes from the connection on, as `daq replay` needs), and they are
+  // watched again when it ends (only_of_test: the devices of that test; empty: all, anew).
+  void start_monitors(std::string_view only_of_test = {}) {
+    if (only_of_test.empty()) monitors_.clear();
     const int axis = config_.linear && config_.linear->axis == "Y"   ? 1
                      : config_.linear && config_.linear->axis == "Z" ? 2
                                                                      : 0;
     std::uint16_t n = 0;
     for (const auto& dc : config_.devices) {
+      if (!only_of_test.empty() && !uses(only_of_test, dc)) {
+        ++n;
+        continue;
+      }
       try {
         auto spec = spec_of(dc, n++);
         spec.feed_axis = axis;
@@ -268,22 +274,45 @@ class Service {
         auto inst =
             watched(make_instrument(io_, spec, make_transport(io_, dc), opt), dc.id, board_);
         inst->start({});
-        monitors_.push_back(std::move(inst));
+        monitors_[dc.id] = std::move(inst);
       } catch (const std::exception& e) {
         board_->on_failed(dc.id, e.what());
       }
     }
   }
 
+  // The devices a test's run opens itself: the ballbar for a circle, the rest for a linear run.
+  static bool uses(std::string_view test, const cal::daq::DeviceConfig& dc) {
+    return test == "circle" ? dc.role == "ballbar"
+                            : (dc.role == "laser" || dc.role == "air" || dc.role == "material" ||
+                               dc.role == "position");
+  }
+
+  // Closes the idle monitors of the devices the run opens; the others stay watched.
+  void stop_monitors_of(std::string_view test) {
+    for (const auto& dc : config_.devices)
+      if (uses(test, dc)) monitors_.erase(dc.id);
+  }
+
   web::Response setup_get(std::string_view) {
     const auto setup = setup_of(config_);
     auto check = check_setup(setup);
+    json standards = json::array();
+    for (const auto& s : cal::iso230_2::standards())
+      standards.push_back({{"key", s.key}, {"title", s.title}});
     return ok({{"schema", "caldaq.setup-state.v1"},
                {"setup", setup},
                {"toml", check.toml},
                {"check", to_json(check)},
                {"source", source()},
-               {"simulated", o_.simulate}});
+               {"simulated", o_.simulate},
+               {"choices",
+                {{"standards", standards},
+                 {"dialects", {"fanuc", "heidenhain", "siemens"}},
+                 {"cycles", {"linear", "pendulum", "pilgrim-step"}},
+                 {"equations", {"ciddor", "edlen", "shop-floor"}},
+                 {"axes", {"X", "Y", "Z"}},
+                 {"planes", {"XY", "YZ", "ZX"}}}}});
   }
 
   web::Response setup_check(const std::string& body) {
@@ -525,7 +554,7 @@ class Service {
       return error(409, fmt::format("Start refused: {}", *limit));
     if (const auto refusal = board_->refusal(*test))
       return error(409, fmt::format("Start refused: {}", *refusal));
-    monitors_.clear();  // the run opens the devices itself (its capture starts at the connection)
+    stop_monitors_of(*test);  // the run opens them itself (its capture starts at the connection)
     run_live_.clear();
     try {
       if (*test == "linear")
@@ -701,7 +730,7 @@ class Service {
     fmt::print("run {} {}{}\n", run_id_, how, reason);
     std::fflush(stdout);
     linear_.reset(), circle_.reset(), capture_.reset();
-    start_monitors();
+    start_monitors(test_);
   }
 
   void tick() {
@@ -735,7 +764,7 @@ class Service {
   std::unique_ptr<SimulatedShop> shop_;
   cal::daq::Config config_;
   std::shared_ptr<DeviceBoard> board_;
-  std::vector<std::unique_ptr<cal::drivers::Instrument>> monitors_;
+  std::map<std::string, std::unique_ptr<cal::drivers::Instrument>> monitors_;  // by device id
   std::unique_ptr<web::LiveServer> server_;
   std::unique_ptr<SessionCapture> capture_;
   std::string capture_pending_;

@@ -45,6 +45,8 @@ void MotionIndicator::add(std::int64_t time_ns, double position_mm, bool valid,
   for (auto c : {it, it == targets_mm.begin() ? it : it - 1})
     if (c != targets_mm.end() && std::abs(*c - position_mm) <= best)
       best = std::abs(*c - position_mm), target_mm_ = *c;
+  if (!target_mm_) entered_ns_.reset(), stable_ns_.reset();
+  if (target_mm_ && !entered_ns_) entered_ns_ = time_ns;
   if (!target_mm_ || !valid) {
     motion_ = target_mm_ ? Motion::settling : Motion::moving;
     still_since_ns_.reset();
@@ -62,10 +64,19 @@ void MotionIndicator::add(std::int64_t time_ns, double position_mm, bool valid,
   }
   const double still_s = static_cast<double>(time_ns - *still_since_ns_) * 1e-9;
   motion_ = still_s >= std::min(s_.still_s, s_.dwell_s) ? Motion::stable : Motion::settling;
+  if (motion_ == Motion::stable && !stable_ns_) stable_ns_ = *still_since_ns_;
+  if (motion_ != Motion::stable) stable_ns_.reset();
   stable_fraction_ = std::clamp(still_s / s_.dwell_s, 0.0, 1.0);
 }
 
-void MotionIndicator::captured(double mean_mm, double target_mm) {
+void MotionIndicator::captured(double mean_mm, double target_mm, std::int64_t time_ns) {
+  const auto since = [&](std::optional<std::int64_t> from, std::int64_t to) {
+    return from ? std::max(0.0, static_cast<double>(to - *from) * 1e-9) : 0.0;
+  };
+  const auto stable_from = stable_ns_.value_or(time_ns);
+  last_stop_ = Timeline{.settling_s = since(entered_ns_, stable_from),
+                        .stable_s = since(stable_ns_, time_ns)};
+  entered_ns_.reset(), stable_ns_.reset();
   captured_mm_ = mean_mm;
   captured_target_mm_ = target_mm;
   motion_ = Motion::captured;

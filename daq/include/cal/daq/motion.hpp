@@ -41,13 +41,21 @@ class MotionIndicator {
   // be at now (empty: the plan is done, nothing to stop at).
   void add(std::int64_t time_ns, double position_mm, bool valid,
            std::span<const double> targets_mm);
-  // The trigger captured a stop whose mean is `mean_mm` (at `target_mm`).
-  void captured(double mean_mm, double target_mm);
+  // The trigger captured a stop whose mean is `mean_mm` (at `target_mm`) at `time_ns`.
+  void captured(double mean_mm, double target_mm, std::int64_t time_ns);
 
   Motion motion() const { return motion_; }
   // The target whose window holds the position (or the captured stop's target).
   std::optional<double> target_mm() const { return target_mm_; }
   double stable_fraction() const { return stable_fraction_; }
+
+  // How the last captured stop went: from entering the window to stable (settling), and from
+  // stable to the capture. The states can be shorter than the page's update period; this says
+  // they happened and for how long.
+  struct Timeline {
+    double settling_s = 0.0, stable_s = 0.0;
+  };
+  std::optional<Timeline> last_stop() const { return last_stop_; }
 
  private:
   MotionSettings s_;
@@ -55,6 +63,9 @@ class MotionIndicator {
   std::optional<double> target_mm_;
   double stable_fraction_ = 0.0;
   std::optional<double> captured_mm_, captured_target_mm_;
+  // This stop's times: entering the window, and first stable.
+  std::optional<std::int64_t> entered_ns_, stable_ns_;
+  std::optional<Timeline> last_stop_;
   // The band of the current stillness: min and max since `still_since_ns_`.
   std::optional<std::int64_t> still_since_ns_;
   double band_min_mm_ = 0.0, band_max_mm_ = 0.0;
