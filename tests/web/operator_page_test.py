@@ -336,6 +336,13 @@ try:
         b.wait("const r = window.caldaq.page.run; return r && r.trace && r.trace.ccw.length > 150;",
                timeout_s=60, what="the polar trace")
         shot(b, "10-ballbar-live.png")
+        # Measured, not asserted (a timing assert has no place in a test): the page's update
+        # rate and the size of its state with the polar trace, while the bar streams.
+        c0, t0 = b.js("return window.caldaq.messages;"), time.time()
+        time.sleep(2.0)
+        c1, t1 = b.js("return window.caldaq.messages;"), time.time()
+        print(f"measured: {(c1 - c0) / (t1 - t0):.1f} page updates/s during the ballbar run, "
+              f"{b.js('return window.caldaq.bytes;')} bytes per update")
         b.wait("const l = window.caldaq.page.status.last; return l && l.test === 'circle';",
                timeout_s=120, what="the ballbar run to end")
         ok(b.js("return window.caldaq.page.status.last.status;") == "complete",
