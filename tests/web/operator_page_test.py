@@ -212,10 +212,15 @@ try:
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent);",
                what="the set-up to be applied")
 
-        # --- 4. a dead device ---------------------------------------------------------------
-        good_air = b.js("""return [...document.querySelectorAll('[data-key]')]
-            .find(i => i.dataset.key === 'devices.air.transport').value;""")
+        # --- 4. dead devices -------------------------------------------------------------------
+        # The air station's and the ballbar's ports gone (the issue's ballbar run on a vanished
+        # port showed 0.00 um and "running" for a minute).
+        transport = """return [...document.querySelectorAll('[data-key]')]
+            .find(i => i.dataset.key === arguments[0]).value;"""
+        good_air = b.js(transport, "devices.air.transport")
+        good_bar = b.js(transport, "devices.ballbar.transport")
         set_field(b, "devices.air.transport", f"serial {TMP}/no-such-port 4800 8N1")
+        set_field(b, "devices.ballbar.transport", f"serial {TMP}/no-such-bar 115200 8N1")
         wait_valid(b)
         b.js("document.getElementById('apply').click();")
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent) && "
@@ -227,11 +232,17 @@ try:
                what="the air station reported as reconnecting")
         b.wait("return document.getElementById('env-air').textContent === '—';",
                what="the air temperature shown as dashes")
+        b.wait("const d = window.caldaq.page.devices.devices.find(d => d.id === 'ballbar');"
+               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=15,
+               what="the ballbar reported as reconnecting")
         dead = b.js("""const li = document.querySelector('#devices li[data-device=air]');
             return {state: li.dataset.state, text: li.textContent,
                     air: document.getElementById('env-air').textContent,
                     n: document.getElementById('env-n').textContent,
                     disabled: document.getElementById('start-linear').disabled,
+                    circle_disabled: document.getElementById('start-circle').disabled,
+                    bar: document.querySelector('#devices li[data-device=ballbar]').textContent,
+                    bar_value: document.querySelector('#devices li[data-device=ballbar] .dev-values').textContent,
                     why: document.getElementById('start-why').textContent};""")
         print(json.dumps(dead, ensure_ascii=False))
         ok(dead["air"] == "—" and dead["n"] == "—",
@@ -242,10 +253,18 @@ try:
            f"Start linear refused with the reason: {dead['why']}")
         status, body = post(url + "api/runs/start", {"test": "linear"})
         ok(status == 409 and "air" in body["error"], f"the API refuses it too: {status} {body}")
+        ok(dead["bar_value"] == "—" and "no-such-bar" in dead["bar"],
+           f"dead ballbar: no value, its port and state shown: {dead['bar']}")
+        ok(dead["circle_disabled"] and "no-such-bar" in dead["why"],
+           "Start ballbar refused with the reason (not a run stuck on 0.00 µm)")
+        status, body = post(url + "api/runs/start", {"test": "circle"})
+        ok(status == 409 and "no-such-bar" in body["error"],
+           f"the API refuses the ballbar test too: {status} {body}")
         no_raw_keys(b, "dead device")
-        shot(b, "04-dead-air-station.png")
+        shot(b, "04-dead-devices.png")
         b.js("document.getElementById('tab-setup').click();")
         set_field(b, "devices.air.transport", good_air)
+        set_field(b, "devices.ballbar.transport", good_bar)
         wait_valid(b)
         b.js("document.getElementById('apply').click();")
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent);",
@@ -266,6 +285,7 @@ try:
                         motion: r.motion ? r.motion.state : null, display: r.display || null,
                         big: document.getElementById('reading').textContent,
                         label: document.getElementById('reading-label').textContent,
+                        fits: document.getElementById('big').scrollWidth <= document.getElementById('big').clientWidth,
                         lit: [...document.querySelectorAll('#indicator span.on')].map(e => e.dataset.motion)};""")
             m = s["motion"]
             if s["running"] and m and m not in shots and s["lit"] == [m]:
@@ -296,6 +316,8 @@ try:
            and abs(value) < 5.0, f"at a stop the number is a deviation: {at_stop['label']}: "
            f"{at_stop['big']} µm")
         ok(abs(value - d["value"]) < 0.006, "the number shown is the live value")
+        ok(all(x["fits"] for x in shots.values()),
+           f"the number and its unit fit the panel: {[(k, x['big'], x['fits']) for k, x in shots.items()]}")
         moving = shots.get("moving")
         ok(moving and moving["display"]["mode"] == "position" and moving["label"] == "Position",
            f"while moving the number is a position: {moving and moving['big']} mm")
@@ -372,6 +394,8 @@ try:
         cols = b.js("return getComputedStyle(document.querySelector('.run-grid')).gridTemplateColumns.split(' ').length;")
         ok(overflow <= 0 and cols == 1, f"at 560 px one column, nothing wider than the screen "
            f"({overflow} px over)")
+        ok(b.js("const g = document.getElementById('big'); return g.scrollWidth <= g.clientWidth;"),
+           "at 560 px the number and its unit fit the screen")
         others = b.js("return window.caldaq.page.devices.devices.filter(d => d.role === 'ballbar').map(d => d.state);")
         ok(others and others[0] in ("open", "streaming"),
            f"a linear run leaves the ballbar watched (not silent): {others}")
@@ -380,6 +404,26 @@ try:
         b.js("document.getElementById('confirm-yes').click();")
         b.wait("const l = window.caldaq.page.status.last; return l && l.status === 'aborted';",
                what="the confirmed stop")
+        # The page's rule for a device that dies during a run, on hand-made states (the shop has
+        # no switch to unplug the laser mid-run): the same run state shows the number while the
+        # laser streams, and dashes with the laser's state once it is silent, never the value.
+        b.set_size(1280, 1400)
+        dying = b.js("""const page = structuredClone(window.caldaq.page);
+            const laser = page.devices.devices.find(d => d.role === 'laser');
+            page.status.running = true;
+            page.run = {schema: 'caldaq.live.v1', state: 'measuring', time_s: 1e6, message: '',
+                        display: {mode: 'deviation', value: 1.234, unit: 'µm', decimals: 2, target_mm: 50},
+                        motion: {state: 'stable', stable_fraction: 0.5}, stops: [],
+                        stop: {number: 3, count: 12}};
+            laser.state = 'streaming';
+            show(page);
+            const before = document.getElementById('reading').textContent;
+            laser.state = 'silent'; laser.reason = 'no reading for 2 s';
+            show(page);
+            return {before, after: document.getElementById('reading').textContent,
+                    label: document.getElementById('reading-label').textContent};""")
+        ok(dying["before"] == "1.23" and dying["after"] == "—" and "silent" in dying["label"],
+           f"a laser that falls silent during a run: dashes and why, not its last value: {dying}")
         ok(b.js("return JSON.stringify(window.__errors);") == "[]", "no script error on the page")
     print(f"operator page: {passes} checks passed; screenshots in {SHOTS}")
 finally:
