@@ -46,6 +46,15 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--give-up-after", o->run.give_up_after,
                   "Reconnection attempts before a run's device is given up")
       ->capture_default_str();
+  // The page shows every device's state and refuses Start while one is not ready, so the
+  // service starts whatever state the devices are in; --check-s S > 0 asks for the start-up
+  // check of `daq run` first (refused naming the device that did not speak).
+  o->run.check_s = 0;
+  cmd->add_option("--check-s", o->run.check_s,
+                  "Before serving, every configured device must open and speak within this time, "
+                  "as daq run checks (0: no check; the page shows each device's state anyway)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([o] {
     if (!o->simulate && o->run.config.empty())
       throw cal::InputError("daq serve: give -c FILE (a configuration) or --simulate");

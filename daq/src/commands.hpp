@@ -7,8 +7,10 @@ namespace daq {
 void add_env_command(CLI::App& app);
 void add_iso230_2_commands(CLI::App& app, CLI::App& analyse);
 void add_demo_command(CLI::App& app);
-// devices: attached and reachable instruments
+// devices: attached and reachable instruments, the drivers and their options
 void add_devices_command(CLI::App& app);
+// decode DRIVER FILE: what a driver makes of a dump of bytes
+void add_decode_command(CLI::App& app);
 // runs, show, export: stored runs
 void add_runs_commands(CLI::App& app);
 // analyse RUN, recompensate RUN: stored runs

@@ -10,6 +10,8 @@ struct DevicesOptions {
   std::vector<std::string> tcp_probes;     // HOST[:PORT]
   std::vector<std::string> serial_probes;  // DEVICE[@SETTINGS]
   bool json = false;
+  bool options = false;   // the drivers and their option tables instead of the attached devices
+  bool markdown = false;  // with options: the Markdown of docs/drivers.md
 };
 
 // caldaq.devices.v1: USB devices with the driver that takes them, HID instruments, serial

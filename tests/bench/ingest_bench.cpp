@@ -20,11 +20,12 @@
 #include <string>
 
 #include "cal/daq/env_stage.hpp"
-#include "cal/drivers/instruments.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
+#include "line_gauge/instrument.hpp"
+#include "ptu300/instrument.hpp"
 
 namespace {
 

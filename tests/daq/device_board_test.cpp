@@ -93,17 +93,21 @@ TEST(DeviceBoard, ReconnectingCountsTheAttemptsOfItsLimit) {
   EXPECT_EQ(d["state"], "reconnecting");
   EXPECT_EQ(d["attempt"], 3);
   EXPECT_EQ(d["max_attempts"], 20);
-  // The loader reads the devices in the order of their names: air comes first.
+  // The loader reads the devices in the order of their names: air comes first; every device
+  // that is not ready is named (laser and table have not been opened in this fixture).
   const auto why = b.board.refusal("linear");
   ASSERT_TRUE(why);
   EXPECT_EQ(*why,
             "not ready: air (serial /dev/ttyUSB0 4800 7E1) is reconnecting (attempt 3 of 20): "
-            "serial /dev/ttyUSB0 4800 7E1: cannot open: No such file or directory");
+            "serial /dev/ttyUSB0 4800 7E1: cannot open: No such file or directory; "
+            "laser (tcp 127.0.0.1:9090) is closed; table (serial /dev/ttyUSB1 9600 8N1) is closed");
   // A reading resets the count (as the instrument's own back-off does).
   b.stream("air", 1000ms);
   b.read("air", Quantity::air_pressure_pa, 100000);
   EXPECT_EQ(b.device("air")["attempt"], 0);
-  EXPECT_EQ(*b.board.refusal("linear"), "not ready: laser (tcp 127.0.0.1:9090) is closed");
+  EXPECT_EQ(*b.board.refusal("linear"),
+            "not ready: laser (tcp 127.0.0.1:9090) is closed; "
+            "table (serial /dev/ttyUSB1 9600 8N1) is closed");
 }
 
 TEST(DeviceBoard, GivenUpIsFailedStoppedIsClosed) {

@@ -111,9 +111,10 @@ TEST(SetupForm, AConfigurationSurvivesTheTripThroughTheForm) {
   EXPECT_EQ(again.customer.name, "ACME \"Precision\" Ltd");
   EXPECT_EQ(again.customer.site, "Plant 2\nhall B");
   EXPECT_EQ(again.devices.size(), 4u);
-  EXPECT_EQ(again.device_for("material")->request, "?\r");
-  EXPECT_EQ(again.device_for("material")->pattern, "T=([-0-9.]+)");
-  EXPECT_EQ(again.device_for("laser")->axes, (std::vector<int>{0, 2}));
+  // The drivers' own options (their registry tables) come through with the values given.
+  EXPECT_EQ(again.device_for("material")->options.text("request"), "?\r");
+  EXPECT_EQ(again.device_for("material")->options.text("pattern"), "T=([-0-9.]+)");
+  EXPECT_EQ(again.device_for("laser")->options.integers("axes"), (std::vector<std::int64_t>{0, 2}));
   EXPECT_EQ(again.linear->count, 11);
   EXPECT_FALSE(again.linear->interval_mm);
   EXPECT_EQ(again.linear->cycle, "pendulum");
@@ -195,7 +196,7 @@ TEST(SetupForm, TestsNeedTheirDevicesAndTransportsMustParse) {
   const auto c = check_setup(s);
   ASSERT_EQ(c.problems.size(), 1u);
   EXPECT_EQ(c.problems[0].key, "devices.laser.transport");
-  EXPECT_NE(c.problems[0].message.find("1 .. 65535"), std::string::npos);
+  EXPECT_NE(c.problems[0].message.find("65535"), std::string::npos) << c.problems[0].message;
   s["devices"]["laser"]["transport"] = "tcp 10.0.0.5:9090";
   const auto d = check_setup(s);
   EXPECT_TRUE(d.problems.empty());

@@ -145,6 +145,8 @@ try:
         ok(abs(float(env["p"].split()[0]) - 1006.5) < 2, f"idle: pressure {env['p']}")
         ok(abs(float(env["n"]) - 1.000269) < 5e-6, f"idle: n {env['n']}")
         ok(abs(float(env["material"].split()[0]) - 21.5) < 0.1, f"idle: material {env['material']}")
+        src = b.js("return document.getElementById('env-source').textContent;")
+        ok(src.endswith(" air (ptu300)"), f"idle: the air values' source is named: {src!r}")
         states = b.js("return [...document.querySelectorAll('#devices li')].map(l => l.dataset.state);")
         ok(states.count("streaming") == 3 and "open" in states,
            f"idle: laser, air, material streaming, the ballbar's port open: {states}")
@@ -179,6 +181,30 @@ try:
         # The whole form, instruments included (generated from the drivers' settings).
         ok(b.js("return document.querySelectorAll('.device-card').length;") == 4,
            "the instrument form has the four configured devices")
+        # Each card's fields are the common keys and its driver's option table, as the drivers'
+        # registry gives them (`daq devices --options --json`, run here as the reference).
+        table = json.loads(subprocess.run([DAQ, "devices", "--options", "--json"],
+                                          capture_output=True, text=True, check=True).stdout)
+        common = [o["name"] for o in table["common"]]
+        options = {d["name"]: [o["name"] for o in d["options"]] for d in table["drivers"]}
+        cards = b.js("""return [...document.querySelectorAll('.device-card')].map(c => ({
+            driver: c.querySelector('[data-device-driver]').value,
+            choices: [...c.querySelectorAll('[data-device-driver] option')].map(o => o.value),
+            fields: [...c.querySelectorAll('[data-option]')].map(f => f.dataset.option)}));""")
+        ok(all(c["fields"] == common + options[c["driver"]] for c in cards),
+           "each instrument card: the common keys and its driver's option table "
+           f"{[(c['driver'], c['fields'][len(common):]) for c in cards]}")
+        ok(all(c["choices"] == list(options) for c in cards),
+           f"the driver choices are the registry's drivers: {cards[0]['choices']}")
+        # Another driver chosen: the card's fields follow its table (then back).
+        other = next(n for n in options if options[n] != options[cards[0]["driver"]])
+        switch = """const c = document.querySelectorAll('.device-card')[0], s = c.querySelector('[data-device-driver]');
+            s.value = arguments[0]; s.dispatchEvent(new Event('change', {bubbles: true}));
+            return [...c.querySelectorAll('[data-option]')].map(f => f.dataset.option);"""
+        ok(b.js(switch, other) == common + options[other],
+           f"another driver ({other}) chosen: the card shows its options {options[other]}")
+        b.js(switch, cards[0]["driver"])
+        wait_valid(b)
         b.set_size(1280, 3400)
         time.sleep(0.3)
         shot(b, "02b-setup-whole-form.png")
@@ -213,14 +239,17 @@ try:
                what="the set-up to be applied")
 
         # --- 4. dead devices -------------------------------------------------------------------
-        # The air station's and the ballbar's ports gone (the issue's ballbar run on a vanished
-        # port showed 0.00 um and "running" for a minute).
+        # The air station's, the laser's and the ballbar's ports gone (the issue's ballbar run on
+        # a vanished port showed 0.00 um and "running" for a minute). The laser too: its
+        # environment unit reports air as well, which the panel (and a run) would use.
         transport = """return [...document.querySelectorAll('[data-key]')]
             .find(i => i.dataset.key === arguments[0]).value;"""
         good_air = b.js(transport, "devices.air.transport")
         good_bar = b.js(transport, "devices.ballbar.transport")
+        good_laser = b.js(transport, "devices.laser.transport")
         set_field(b, "devices.air.transport", f"serial {TMP}/no-such-port 4800 8N1")
         set_field(b, "devices.ballbar.transport", f"serial {TMP}/no-such-bar 115200 8N1")
+        set_field(b, "devices.laser.transport", "tcp 127.0.0.1:1")
         wait_valid(b)
         b.js("document.getElementById('apply').click();")
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent) && "
@@ -249,8 +278,8 @@ try:
            "dead air station: air and n are dashes, not the last values")
         ok("no-such-port" in dead["text"] and "No such file" in dead["text"],
            f"dead air station: its state and the reason shown ({dead['state']})")
-        ok(dead["disabled"] and "air" in dead["why"],
-           f"Start linear refused with the reason: {dead['why']}")
+        ok(dead["disabled"] and "no-such-port" in dead["why"] and "127.0.0.1:1" in dead["why"],
+           f"Start linear refused naming both devices that are not ready: {dead['why']}")
         status, body = post(url + "api/runs/start", {"test": "linear"})
         ok(status == 409 and "air" in body["error"], f"the API refuses it too: {status} {body}")
         ok(dead["bar_value"] == "—" and "no-such-bar" in dead["bar"],
@@ -265,6 +294,7 @@ try:
         b.js("document.getElementById('tab-setup').click();")
         set_field(b, "devices.air.transport", good_air)
         set_field(b, "devices.ballbar.transport", good_bar)
+        set_field(b, "devices.laser.transport", good_laser)
         wait_valid(b)
         b.js("document.getElementById('apply').click();")
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent);",

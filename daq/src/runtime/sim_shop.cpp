@@ -7,7 +7,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "cal/drivers/sim/twins.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/twin.hpp"
+#include "shdr/twin.hpp"
 
 namespace daq {
 
@@ -116,6 +119,52 @@ const std::string& SimulatedShop::material_device() const { return impl_->materi
 const std::string& SimulatedShop::ballbar_device() const { return impl_->ballbar.device_path(); }
 std::uint16_t SimulatedShop::position_port() const { return impl_->position.port(); }
 
+std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
+                                        bool serial_numbers) const {
+  // Serial numbers as a real set-up has them for its report (daq serve --simulate).
+  const auto serial = [&](std::string_view number) {
+    return serial_numbers ? fmt::format("serial_number = \"{}\"\n", number) : std::string{};
+  };
+  std::string position;
+  if (position_feed)
+    position = fmt::format(
+        "[devices.position]      # the control's commanded position\n"
+        "driver = \"shdr\"\ntransport = \"{}\"\nkey = \"Xcom\"\nrole = \"position\"\n\n",
+        impl_->position.transport());
+  return fmt::format(
+      R"TOML([devices.laser]
+driver = "ids3010"
+transport = "{laser}"
+role = "laser"
+poll_s = {laser_poll}
+{laser_sn}
+[devices.air]
+driver = "ptu300"
+transport = "{air}"
+role = "air"
+{air_sn}
+[devices.material]
+driver = "gauge"
+transport = "serial {material} 9600 8N1"
+request = "?\r"
+unit = "degC"
+role = "material"
+{material_sn}
+{position}[devices.ballbar]
+driver = "gauge"
+transport = "{ballbar}"
+unit = "mm"
+min_si = -0.1           # the bar's travel: +/- 100 mm about its zero length
+max_si = 0.1
+role = "ballbar"
+{ballbar_sn})TOML",
+      fmt::arg("laser_sn", serial("SIM-IDS-0001")), fmt::arg("air_sn", serial("SIM-PTU-0001")),
+      fmt::arg("material_sn", serial("SIM-TH-0001")), fmt::arg("ballbar_sn", serial("SIM-BB-0001")),
+      fmt::arg("laser", impl_->ids.transport()), fmt::arg("laser_poll", laser_poll_s),
+      fmt::arg("air", impl_->ptu.transport()), fmt::arg("material", impl_->material.device_path()),
+      fmt::arg("position", position), fmt::arg("ballbar", impl_->ballbar.transport()));
+}
+
 void SimulatedShop::run_linear(const cal::iso230_2::Plan& plan, double feed, double dwell_s) {
   std::vector<sim::Move> program;
   for (const auto& m : plan.moves) {
@@ -189,13 +238,6 @@ std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOpt
                 "# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {}x\n"
                 "# faster than real time). Valid while that process runs.\n",
                 o.speed);
-  const std::string position =
-      o.position_feed ? fmt::format(
-                            "[devices.position]      # the control's commanded position\n"
-                            "driver = \"shdr\"\ntransport = \"tcp 127.0.0.1:{}\"\n"
-                            "key = \"Xcom\"\nrole = \"position\"\n\n",
-                            shop.position_port())
-                      : std::string{};
   return header + fmt::format(
                       R"TOML(campaign = "simulated"
 
@@ -203,34 +245,7 @@ std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOpt
 name = "SIMULATED VMC"
 description = "built-in simulated 3-axis machine with injected errors ({who})"
 
-[devices.laser]
-driver = "ids3010"
-transport = "tcp 127.0.0.1:{laser}"
-role = "laser"
-poll_s = {laser_poll}
-serial_number = "SIM-IDS-0001"
-
-[devices.air]
-driver = "ptu300"
-transport = "serial {air} 4800 {air_frame}"
-role = "air"
-{air_poll}serial_number = "SIM-PTU-0001"
-
-[devices.material]
-driver = "gauge"
-transport = "serial {material} 9600 8N1"
-request = "?\r"
-unit = "degC"
-role = "material"
-{material_poll}serial_number = "SIM-TH-0001"
-
-{position}[devices.ballbar]
-driver = "gauge"
-transport = "serial {ballbar} 115200 8N1"
-unit = "mm"
-role = "ballbar"
-serial_number = "SIM-BB-0001"
-
+{devices}
 [environment]
 equation = "ciddor"
 expansion_ppm_per_k = {alpha}
@@ -275,13 +290,10 @@ squareness = 30
 backlash_X = 3
 )TOML",
                       fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
-                      fmt::arg("position", position), fmt::arg("laser", shop.laser_port()),
-                      fmt::arg("laser_poll", 0.05 * wall), fmt::arg("air", shop.air_device()),
-                      fmt::arg("air_frame", o.in_process ? "8N1" : "7E1"),
-                      fmt::arg("air_poll", o.in_process ? "poll_s = 1\n" : ""),
-                      fmt::arg("material", shop.material_device()),
-                      fmt::arg("material_poll", o.in_process ? "poll_s = 1\n" : ""),
-                      fmt::arg("ballbar", shop.ballbar_device()),
+                      // In process the instruments read the shop's clock: every time is
+                      // simulated time; the poll periods of the drivers' defaults too.
+                      fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
+                                                            /*serial_numbers=*/true)),
                       fmt::arg("alpha", t.expansion_ppm_per_k),
                       // Simulated seconds: at a high speed the wall-clock timers' jitter is
                       // magnified, as in daq demo.

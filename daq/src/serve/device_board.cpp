@@ -2,6 +2,7 @@
 #include "serve/device_board.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -172,12 +173,21 @@ json DeviceBoard::device_json(const Device& d) const {
 // device that reports it (the air station, or a laser's environment unit), material as the
 // mean of the material thermometers.
 json DeviceBoard::environment_json() const {
+  // The page names where the air values come from: with the air station silent, a laser's
+  // environment unit may still give them (and a run would use them).
+  std::string source;
   const auto air = [&](Quantity q) -> std::optional<double> {
     const auto* preferred = config_.device_for("air");
     if (preferred)
-      if (auto v = value(devices_.at(preferred->id), q)) return v;
+      if (auto v = value(devices_.at(preferred->id), q)) {
+        if (source.empty()) source = preferred->id;
+        return v;
+      }
     for (const auto& [id, d] : devices_)
-      if (auto v = value(d, q)) return v;
+      if (auto v = value(d, q)) {
+        if (source.empty()) source = id;
+        return v;
+      }
     return std::nullopt;
   };
   const auto t = air(Quantity::air_temperature_degc), p = air(Quantity::air_pressure_pa),
@@ -192,7 +202,8 @@ json DeviceBoard::environment_json() const {
     if (v) sum += *v, ++count;
   }
   const auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
-  json j{{"air_temperature_degc", opt(t)},
+  json j{{"air_source", source.empty() ? json(nullptr) : json(source)},
+         {"air_temperature_degc", opt(t)},
          {"pressure_pa", opt(p)},
          {"humidity_pct", opt(rh)},
          {"material_degc", count ? json(sum / count) : json(nullptr)},
@@ -246,15 +257,17 @@ std::optional<std::string> DeviceBoard::not_ready(const Device& d, bool may_be_s
 }
 
 std::optional<std::string> DeviceBoard::refusal(std::string_view test) const {
+  std::vector<std::string> reasons;
   for (const auto& c : config_.devices) {
     const bool used = test == "circle" ? c.role == "ballbar"
                                        : (c.role == "laser" || c.role == "air" ||
                                           c.role == "material" || c.role == "position");
     if (!used) continue;
-    if (auto why = not_ready(devices_.at(c.id), test == "circle"))
-      return fmt::format("not ready: {}", *why);
+    if (auto why = not_ready(devices_.at(c.id), test == "circle")) reasons.push_back(*why);
   }
-  return std::nullopt;
+  // Every device that is not ready is named: the operator fixes them all at once.
+  if (reasons.empty()) return std::nullopt;
+  return fmt::format("not ready: {}", fmt::join(reasons, "; "));
 }
 
 namespace {

@@ -148,6 +148,7 @@ class Service {
       use_config(cal::daq::parse_config(text, "simulated shop"));
     } else {
       use_config(cal::daq::load_config(o_.run.config));
+      check_devices_at_start();
     }
     try {
       make_server();
@@ -187,6 +188,21 @@ class Service {
 
  private:
   bool running() const { return linear_ || circle_; }
+
+  // --check-s S > 0: the devices of the configured tests open and speak before the service
+  // starts, or it is refused naming the device (as daq run checks before a run).
+  void check_devices_at_start() {
+    if (o_.run.check_s <= 0) return;
+    std::vector<InstrumentSpec> specs;
+    if (config_.linear) specs = linear_specs(config_);
+    if (config_.circle && config_.device_for("ballbar"))
+      specs.push_back(spec_of(need(config_, "ballbar"), static_cast<std::uint16_t>(specs.size())));
+    if (specs.empty()) return;
+    fmt::print("Checking the devices (up to {} s):\n", o_.run.check_s);
+    check_devices(config_, specs, std::chrono::duration<double>(o_.run.check_s),
+                  [](const std::string& line) { fmt::print("{}\n", line); });
+    std::fflush(stdout);
+  }
 
   void make_server() {
     web::Api api{.page = [] { return web::operator_page(); },
@@ -256,17 +272,11 @@ class Service {
         continue;
       }
       try {
-        auto spec = spec_of(dc, n++);
-        spec.feed_axis = axis;
-        if (spec.feed_key.empty()) spec.feed_key = std::string(1, "XYZ"[axis]) + "act";
-        auto opt = instrument_options(dc, o_.run, nullptr);
+        const auto spec = spec_of(dc, n++, axis);
+        auto opt = instrument_options(dc, spec, o_.run, nullptr);
         opt.backoff.max_attempts = -1;  // idle: wait for the device however long it takes
-        if (dc.poll_s <= 0)
-          opt.poll_period =
-              dc.driver == "shdr" ? std::chrono::microseconds(5s) : scaled_poll(1.0, o_.run);
         // The page needs about 10 values a second, not the run's rate.
-        if (dc.role == "laser")
-          opt.poll_period = std::max(opt.poll_period, std::chrono::microseconds(100ms));
+        opt.poll_period = std::max(opt.poll_period, std::chrono::microseconds(100ms));
         // A ballbar sends nothing until it is mounted and moving: silence is no fault here.
         if (dc.role == "ballbar") opt.silence_timeout = 24h;
         board_->expect(dc.id,
@@ -678,9 +688,9 @@ class Service {
         .program = program,
         .analysis = analysis,
         .database = database_path(o_.run.db),
-        .ballbar = options.wrap(
-            dc, make_instrument(io_, specs[0], make_transport(io_, dc),
-                                instrument_options(dc, options, capture_->recorder.get()))),
+        .ballbar = options.wrap(dc, make_instrument(io_, specs[0], make_transport(io_, dc),
+                                                    instrument_options(dc, specs[0], options,
+                                                                       capture_->recorder.get()))),
         .capture_path = capture_->absolute_path(path)};
     setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };

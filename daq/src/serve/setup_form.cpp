@@ -7,8 +7,11 @@
 #include <cctype>
 #include <regex>
 #include <sstream>
+#include <type_traits>
+#include <variant>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
 #include "run_setup.hpp"
 
 namespace daq::serve {
@@ -26,18 +29,25 @@ void put_text(json& j, const char* key, const std::string& value) {
   if (!value.empty()) j[key] = value;
 }
 
+json option_json(const cal::drivers::OptionValue& v) {
+  return std::visit(
+      [](const auto& x) -> json {
+        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, std::monostate>)
+          return nullptr;
+        else
+          return x;
+      },
+      v);
+}
+
 json device_json(const cal::daq::DeviceConfig& d) {
   const cal::daq::DeviceConfig def;
   json j{{"driver", d.driver}, {"transport", d.transport}};
   put_text(j, "role", d.role);
   put(j, "poll_s", d.poll_s, def.poll_s);
-  if (!d.axes.empty()) j["axes"] = d.axes;
-  put_text(j, "request", d.request);
-  put_text(j, "pattern", d.pattern);
-  put(j, "unit", d.unit, def.unit);
-  put(j, "family", d.family, def.family);
-  put_text(j, "key", d.key);
-  put(j, "column", d.column, def.column);
+  // The driver's own options as the file gave them (the others keep the table's defaults).
+  for (const auto& [name, value] : d.options.values())
+    if (d.options.is_set(name)) j[name] = option_json(value);
   put_text(j, "serial_number", d.serial_number);
   put_text(j, "certificate", d.certificate);
   put_text(j, "calibration_due", d.calibration_due);
@@ -183,14 +193,7 @@ const std::vector<std::string_view>& key_order() {
                                                    "load",
                                                    "state",
                                                    "notes",
-                                                   "axes",
                                                    "poll_s",
-                                                   "request",
-                                                   "pattern",
-                                                   "unit",
-                                                   "family",
-                                                   "key",
-                                                   "column",
                                                    "equation",
                                                    "stale_after_s",
                                                    "on_stale",
@@ -249,12 +252,28 @@ const std::vector<std::string_view>& key_order() {
   return order;
 }
 
-std::vector<std::string> ordered_keys(const json& j) {
+// A device's keys: the common ones, then its driver's options in the order of its table.
+std::vector<std::string> device_key_order(const json& device) {
+  std::vector<std::string> order(cal::drivers::common_device_keys().begin(),
+                                 cal::drivers::common_device_keys().end());
+  const auto driver = device.find("driver");
+  if (driver != device.end() && driver->is_string())
+    if (const auto* d = cal::drivers::find_driver(driver->get<std::string>()))
+      for (const auto& o : d->options()) order.push_back(o.name);
+  return order;
+}
+
+std::vector<std::string> ordered_keys(const json& j, bool device = false) {
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
-  const auto rank = [](const std::string& k) {
+  const auto own = device ? device_key_order(j) : std::vector<std::string>{};
+  const auto rank = [&](const std::string& k) {
+    if (device) {
+      const auto at = std::find(own.begin(), own.end(), k);
+      if (at != own.end()) return static_cast<std::size_t>(at - own.begin());
+    }
     const auto& o = key_order();
-    return static_cast<std::size_t>(std::find(o.begin(), o.end(), k) - o.begin());
+    return own.size() + static_cast<std::size_t>(std::find(o.begin(), o.end(), k) - o.begin());
   };
   std::stable_sort(keys.begin(), keys.end(),
                    [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
@@ -300,7 +319,8 @@ void write_table(std::ostringstream& out, const json& j, const std::string& path
                  bool array_entry = false) {
   if (!j.is_object()) cannot(path, fmt::format("expected an object, not {}", j.type_name()));
   std::ostringstream own;
-  for (const auto& k : ordered_keys(j)) {
+  const bool device = path.starts_with("devices.");
+  for (const auto& k : ordered_keys(j, device)) {
     const auto& v = j[k];
     if (v.is_null() || v.is_object() || is_table_array(v)) continue;
     own << toml_key(k) << " = " << toml_value(v, path.empty() ? k : path + "." + k) << "\n";
@@ -345,14 +365,8 @@ bool erase_path(json& j, const std::string& path) {
 
 // The checks a run makes when it starts, beyond the loader's: the roles a test needs, each
 // device's driver and transport.
+// (The loader itself checks each transport's text and each option against its driver's table.)
 void check_tests(const cal::daq::Config& c, SetupCheck& out) {
-  for (const auto& d : c.devices) {
-    try {
-      check_transport(d);
-    } catch (const cal::InputError& e) {
-      out.problems.push_back({"devices." + d.id + ".transport", e.what()});
-    }
-  }
   const auto readiness = [](bool configured, auto check) {
     TestReadiness r{.configured = configured};
     if (!configured) return r;
@@ -436,6 +450,10 @@ SetupCheck check_setup(const json& setup, std::string_view source_name) {
       return out;
     } catch (const cal::InputError& e) {
       auto p = problem_of(e.what());
+      // A required key taken out is then "missing": that is the first problem again.
+      const bool again = std::any_of(out.problems.begin(), out.problems.end(),
+                                     [&](const SetupProblem& q) { return q.key == p.key; });
+      if (again) return out;
       out.problems.push_back(p);
       // Read the rest without the key at fault; a table's own error, or a key that is not
       // there (a required key missing), ends the search.

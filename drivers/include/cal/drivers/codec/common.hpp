@@ -3,6 +3,7 @@
 // typed frames out; no I/O, no clock, no threads, no exceptions on bad bytes. Each bad input
 // is counted in CodecStats and reported as a CodecError event (kind, stream offset, text) so
 // the instrument layer can log it; the codec then resynchronises and carries on.
+#include <charconv>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -148,6 +149,16 @@ bool is_printable_ascii(std::string_view line);
 // Parses the whole of `s` as a decimal number (a leading '+' is allowed, as gauges print it);
 // nullopt if anything is left over or nothing is a number.
 std::optional<double> parse_number(std::string_view s);
+
+// Parses the whole of `s` as an integer of type Int (no leading '+'); nullopt if anything is
+// left over, nothing is a number, or it does not fit.
+template <class Int>
+std::optional<Int> parse_integer(std::string_view s) {
+  Int v{};
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || p != s.data() + s.size()) return std::nullopt;
+  return v;
+}
 
 // Splits at runs of spaces and tabs; no empty tokens.
 std::vector<std::string_view> split_whitespace(std::string_view s);
