@@ -63,6 +63,21 @@ TEST(MotionIndicator, AStepOfMoreThanTwoTolerancesRestartsTheStillness) {
   EXPECT_DOUBLE_EQ(m.stable_fraction(), 0.0);
 }
 
+// A slow drift within the band is still for as long as the band holds, as the trigger's sliding
+// window judges it: 1 um/s for 3 s at 1 kHz with a band of 2 um (tolerance 1 um). At 3 s the
+// readings from 1 s on (1.0 .. 3.0 um) are within 2 um: still for 2.0 s, 2/3 of a 3 s dwell (a
+// band restarted at the newest reading when exceeded, at 2 s, would say 1.0 s).
+TEST(MotionIndicator, ASlowDriftWithinTheBandIsStillAsTheTriggerSeesIt) {
+  MotionIndicator m({.tolerance_um = 1.0, .dwell_s = 3.0, .window_mm = 0.5, .still_s = 0.2});
+  for (int i = 0; i <= 3000; ++i) m.add(i * ms, 50.0 + i * 1e-6, true, targets);
+  EXPECT_EQ(m.motion(), Motion::stable);
+  EXPECT_NEAR(m.stable_fraction(), 2.0 / 3.0, 0.002);
+  // Captured at 3 s: stable from 1 s (where the band that holds now begins) to 3 s.
+  m.captured(50.002, 50.0, 3000 * ms);
+  ASSERT_TRUE(m.last_stop());
+  EXPECT_NEAR(m.last_stop()->stable_s, 2.0, 0.002);
+}
+
 TEST(MotionIndicator, SignalLostBreaksTheStillness) {
   auto m = indicator();
   for (int k = 0; k <= 30; ++k) m.add(k * 10 * ms, 0.0001, true, targets);

@@ -49,22 +49,32 @@ void MotionIndicator::add(std::int64_t time_ns, double position_mm, bool valid,
   if (target_mm_ && !entered_ns_) entered_ns_ = time_ns;
   if (!target_mm_ || !valid) {
     motion_ = target_mm_ ? Motion::settling : Motion::moving;
-    still_since_ns_.reset();
+    reset_stillness();
     stable_fraction_ = 0.0;
     return;
   }
-  // Still: every reading since still_since within +/- tolerance of their middle (a band of
-  // 2 tolerances, as the trigger's).
-  const double lo = std::min(band_min_mm_, position_mm), hi = std::max(band_max_mm_, position_mm);
-  if (!still_since_ns_ || hi - lo > 2 * tol_mm) {
-    still_since_ns_ = time_ns;
-    band_min_mm_ = band_max_mm_ = position_mm;
-  } else {
-    band_min_mm_ = lo, band_max_mm_ = hi;
-  }
+  // Still: the readings since still_since within a band of 2 tolerances, as the trigger's
+  // window: a reading outside the band drops the oldest ones until it holds again (so a slow
+  // drift within the band is still, as the trigger sees it).
+  const Sample sample{seq_++, time_ns, position_mm};
+  window_.push_back(sample);
+  while (!min_.empty() && min_.back().x_mm >= position_mm) min_.pop_back();
+  min_.push_back(sample);
+  while (!max_.empty() && max_.back().x_mm <= position_mm) max_.pop_back();
+  max_.push_back(sample);
+  const auto drop_oldest = [&] {
+    if (min_.front().seq == window_.front().seq) min_.pop_front();
+    if (max_.front().seq == window_.front().seq) max_.pop_front();
+    window_.pop_front();
+  };
+  bool broke = false;
+  while (max_.front().x_mm - min_.front().x_mm > 2 * tol_mm) drop_oldest(), broke = true;
+  if (broke || !still_since_ns_) still_since_ns_ = window_.front().time_ns;
+  const auto keep_ns = static_cast<std::int64_t>(2 * s_.dwell_s * 1e9);
+  while (window_.size() > 1 && time_ns - window_.front().time_ns > keep_ns) drop_oldest();
   const double still_s = static_cast<double>(time_ns - *still_since_ns_) * 1e-9;
   motion_ = still_s >= std::min(s_.still_s, s_.dwell_s) ? Motion::stable : Motion::settling;
-  if (motion_ == Motion::stable && !stable_ns_) stable_ns_ = *still_since_ns_;
+  if (motion_ == Motion::stable && (!stable_ns_ || broke)) stable_ns_ = *still_since_ns_;
   if (motion_ != Motion::stable) stable_ns_.reset();
   stable_fraction_ = std::clamp(still_s / s_.dwell_s, 0.0, 1.0);
 }
@@ -82,6 +92,11 @@ void MotionIndicator::captured(double mean_mm, double target_mm, std::int64_t ti
   motion_ = Motion::captured;
   target_mm_ = target_mm;
   stable_fraction_ = 1.0;
+  reset_stillness();
+}
+
+void MotionIndicator::reset_stillness() {
+  window_.clear(), min_.clear(), max_.clear();
   still_since_ns_.reset();
 }
 

@@ -15,6 +15,7 @@
 //
 // The indicator only describes; the StabilityTrigger alone decides what is captured.
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -66,9 +67,20 @@ class MotionIndicator {
   // This stop's times: entering the window, and first stable.
   std::optional<std::int64_t> entered_ns_, stable_ns_;
   std::optional<Timeline> last_stop_;
-  // The band of the current stillness: min and max since `still_since_ns_`.
+  // The current stillness as the trigger judges it: a sliding window of the readings within
+  // +/- tolerance of each other (the oldest dropped while the band is exceeded), with
+  // monotonic deques of its minimum and maximum (O(1) per reading at 10 kHz). Readings older
+  // than twice the dwell are dropped too (memory stays bounded while the axis rests);
+  // `still_since_ns_` keeps the start of the stillness across that.
+  struct Sample {
+    std::uint64_t seq;
+    std::int64_t time_ns;
+    double x_mm;
+  };
+  std::deque<Sample> window_, min_, max_;
+  std::uint64_t seq_ = 0;
   std::optional<std::int64_t> still_since_ns_;
-  double band_min_mm_ = 0.0, band_max_mm_ = 0.0;
+  void reset_stillness();
 };
 
 }  // namespace cal::daq
