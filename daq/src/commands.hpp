@@ -33,6 +33,8 @@ void add_compensate_commands(CLI::App& app, CLI::App& analyse);
 void add_serve_command(CLI::App& app);
 // report: HTML/PDF reports of stored runs
 void add_report_command(CLI::App& app);
+// bench ingest: throughput against the storage ceilings, measured on this machine
+void add_bench_commands(CLI::App& app);
 // model show|map|compensate|testpiece: the machine model file
 void add_model_commands(CLI::App& app);
 

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 
 #include "cal/analysis/error.hpp"
@@ -10,11 +11,12 @@
 namespace cal::drivers::codec {
 namespace {
 
+bool blank(char c) { return c == ' ' || c == '\t'; }
+
 std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string_view::npos) return {};
-  const auto e = s.find_last_not_of(" \t");
-  return s.substr(b, e - b + 1);
+  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+  return s;
 }
 
 std::optional<GaugeUnit> unit_word(std::string_view w) {
@@ -53,11 +55,16 @@ void GaugeCodec::do_feed(std::span<const std::byte> bytes, std::vector<GaugeFram
                          std::vector<CodecError>& errors) {
   splitter_.feed(
       bytes,
-      [&](std::string_view line, std::uint64_t off) { decode_line(line, off, frames, errors); },
-      [&](std::uint64_t off) {
-        report(errors, ErrorKind::overlong_line, off,
-               fmt::format("gauge: line longer than {} bytes", config_.max_line_bytes));
-      });
+      [&](std::string_view line, std::uint64_t off) {
+        if (const auto v = decode_line(line, off, errors))
+          emit(frames, GaugeFrame{*v, std::string(line)});
+      },
+      [&](std::uint64_t off) { report_overlong(off, errors); });
+}
+
+void GaugeCodec::report_overlong(std::uint64_t off, std::vector<CodecError>& errors) {
+  report(errors, ErrorKind::overlong_line, off,
+         fmt::format("gauge: line longer than {} bytes", config_.max_line_bytes));
 }
 
 std::optional<double> GaugeCodec::to_si(double printed,
@@ -79,11 +86,11 @@ std::optional<double> GaugeCodec::to_si(double printed,
   return std::nullopt;
 }
 
-void GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
-                             std::vector<GaugeFrame>& frames, std::vector<CodecError>& errors) {
+std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
+                                              std::vector<CodecError>& errors) {
   if (!is_printable_ascii(line)) {
     report(errors, ErrorKind::garbage, off, "gauge: non-printable bytes in a line");
-    return;
+    return std::nullopt;
   }
   std::optional<double> number;
   std::optional<GaugeUnit> printed_unit;
@@ -92,10 +99,11 @@ void GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
     if (std::regex_search(line.begin(), line.end(), m, *regex_))
       number = parse_number(trim(m[1].str()));
   } else {
-    const auto tokens = split_whitespace(trim(line));
-    if (tokens.size() == 1 || tokens.size() == 2) {
+    std::array<std::string_view, 2> tokens;
+    const std::size_t count = split_whitespace(line, tokens);
+    if (count == 1 || count == 2) {
       number = parse_number(tokens[0]);
-      if (tokens.size() == 2) {
+      if (count == 2) {
         printed_unit = unit_word(tokens[1]);
         if (!printed_unit) number.reset();
       }
@@ -104,16 +112,16 @@ void GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
   if (!number || !std::isfinite(*number)) {
     report(errors, ErrorKind::malformed, off,
            fmt::format("gauge: no value in '{}'", line.substr(0, 40)));
-    return;
+    return std::nullopt;
   }
   const auto si = to_si(*number, printed_unit);
   if (!si || *si < config_.min_si || *si > config_.max_si) {
     report(
         errors, ErrorKind::out_of_range, off,
         fmt::format("gauge: value {} outside [{}, {}]", *number, config_.min_si, config_.max_si));
-    return;
+    return std::nullopt;
   }
-  emit(frames, GaugeFrame{*si, std::string(line)});
+  return si;
 }
 
 }  // namespace cal::drivers::codec

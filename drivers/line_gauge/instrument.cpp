@@ -25,19 +25,24 @@ class Gauge final : public detail::InstrumentCore {
   }
   void on_poll() override { send(config_.request); }
   void on_bytes(std::span<const std::byte> bytes) override {
-    decode(codec_, bytes, frames_);
-    if (frames_.empty()) return;
+    errors_.clear();
     // A streaming gauge delivers several lines per read; they get the read's time. The
     // spacing within a chunk is unknown here (the pipeline assigns sample times from the
     // sample rate where it matters, e.g. the ballbar).
     const std::int64_t t = now_ns();
-    for (const auto& f : frames_) emit({.time_ns = t, .quantity = quantity_, .value = f.value_si});
+    codec_.feed_values(
+        bytes,
+        [&](double value_si, std::string_view) {
+          emit({.time_ns = t, .quantity = quantity_, .value = value_si});
+        },
+        errors_);
+    report_codec_errors(errors_);
   }
 
   codec::GaugeConfig config_;
   codec::GaugeCodec codec_;
   Quantity quantity_;
-  std::vector<codec::GaugeFrame> frames_;
+  std::vector<codec::CodecError> errors_;
 };
 
 }  // namespace
