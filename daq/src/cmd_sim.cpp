@@ -60,12 +60,11 @@ void run_sim(const SimOptions& o) {
     throw cal::InputError(fmt::format("--test '{}' (expected linear or circle)", o.test));
   boost::asio::io_context io;
   SimulatedShop shop(io, ShopTruth{}, o.speed);
-  const std::string text = simulated_shop_config(
-      shop, {.speed = o.speed,
-             .position_feed = o.position_feed,
-             .in_process = false,
-             .runs = o.runs,
-             .targets = o.targets});
+  const std::string text = simulated_shop_config(shop, {.speed = o.speed,
+                                                        .position_feed = o.position_feed,
+                                                        .in_process = false,
+                                                        .runs = o.runs,
+                                                        .targets = o.targets});
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));

@@ -64,6 +64,12 @@ Clock loop_clock(asio::io_context& io) {
   return steady_clock_ns();
 }
 
+void VirtualTime::pace(double speed) {
+  pace_ = speed > 0 ? speed : 0.0;
+  pace_origin_ns_ = now_ns_;
+  pace_origin_wall_ = std::chrono::steady_clock::now();
+}
+
 bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t until_ns) {
   const auto finished = [&] { return done && done(); };
   auto settle_left = kSettle;
@@ -95,13 +101,24 @@ bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t unti
       // Nothing simulated is pending: only wall-clock work (a socket of a client in another
       // process, a real timer) can make something happen.
       if (io_.stopped()) io_.restart();
-      if (io_.run_one_for(std::chrono::milliseconds(10)) == 0) return finished();
+      if (io_.run_one_for(std::chrono::milliseconds(10)) == 0 && pace_ == 0.0) return finished();
       continue;
     }
     const std::int64_t next = waits.begin()->first.first;
     if (next > until_ns) {
       now_ns_ = std::max(now_ns_, until_ns);
       return finished();
+    }
+    if (pace_ > 0.0) {  // not before its time on the wall clock: serve wall-clock work meanwhile
+      const auto due =
+          pace_origin_wall_ + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::duration<double, std::nano>(
+                                      static_cast<double>(next - pace_origin_ns_) / pace_));
+      if (std::chrono::steady_clock::now() < due) {
+        if (io_.stopped()) io_.restart();
+        io_.run_one_until(due);
+        continue;
+      }
     }
     if (next > now_ns_) {
       now_ns_ = next;

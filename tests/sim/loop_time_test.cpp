@@ -87,6 +87,24 @@ TEST(VirtualTime, StopsAtTheLimitAndWhenDone) {
   EXPECT_THROW(d::VirtualTime::install(io), std::logic_error);
 }
 
+// Paced (daq serve --simulate): simulated time never runs ahead of speed x wall time, and still
+// moves from deadline to deadline (a lower bound on the wall time only: load may add to it).
+TEST(VirtualTime, PacedItWaitsForTheWallClockAndStillLandsOnTheDeadlines) {
+  boost::asio::io_context io;
+  auto& time = d::VirtualTime::install(io);
+  time.pace(10.0);
+  d::Timer timer(io);
+  std::int64_t fired_at = -1;
+  timer.expires_after(500ms);  // 50 ms of wall time at 10x
+  timer.async_wait([&](const boost::system::error_code& ec) {
+    if (!ec) fired_at = time.now_ns();
+  });
+  const std::int64_t start = steady_now_ns();
+  EXPECT_TRUE(time.run_for(10s, [&] { return fired_at >= 0; }));
+  EXPECT_GE(steady_now_ns() - start, 50'000'000);
+  EXPECT_EQ(fired_at, 500'000'000);
+}
+
 TEST(VirtualTime, AnInstrumentPollsItsTwinOnSimulatedTimeAndStampsItsReadingsWithIt) {
   boost::asio::io_context io;
   auto& time = d::VirtualTime::install(io);

@@ -99,8 +99,9 @@ class SimulatedShop {
 //   clock and sees the program `speed` times faster than the program's own times, so the
 //   trigger's dwell and the laser's poll period are divided by the speed;
 // - in_process true (`daq serve --simulate`): its instruments read the shop's clock, every
-//   time in the file is simulated time (poll periods too: the service divides them by the
-//   speed), so the file reads as it would for a real machine. The air is opened as 8N1: a
+//   time in the file is simulated time (poll periods too: the service runs on a paced
+//   VirtualTime, whose timers wait in simulated time), so the file reads as it would for a
+//   real machine. The air is opened as 8N1: a
 //   pseudo-terminal refuses to have 7E1 applied a second time (EINVAL), and the service opens
 //   each device again for every run (a real PTU300 port is 4800 7E1).
 // Both carry the machine specification of `daq demo` ([tolerances.X], [tolerances.XY]), so

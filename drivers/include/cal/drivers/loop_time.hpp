@@ -47,6 +47,12 @@ class VirtualTime {
   // The simulated time of `ctx`; nullptr in real mode.
   static VirtualTime* of(boost::asio::execution_context& ctx);
 
+  // Paced (speed > 0): simulated time runs no faster than `speed` times the wall clock, for a
+  // simulated shop a person watches (`daq serve --simulate`); it still only moves from event
+  // to event, so the order of events stays that of the unpaced run. While it waits for the
+  // wall clock the loop serves wall-clock work (HTTP clients, steady timers). 0: unpaced.
+  void pace(double speed);
+
   std::int64_t now_ns() const { return now_ns_; }
   double now_s() const { return static_cast<double>(now_ns_) * 1e-9; }
 
@@ -90,6 +96,9 @@ class VirtualTime {
   boost::asio::io_context& io_;
   std::int64_t now_ns_;
   std::int64_t in_flight_ = 0;
+  double pace_ = 0.0;
+  std::int64_t pace_origin_ns_ = 0;
+  std::chrono::steady_clock::time_point pace_origin_wall_{};
   int operations_ = 0;
   std::unique_ptr<Queue> queue_;
   Stats stats_;
