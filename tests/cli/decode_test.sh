@@ -29,6 +29,12 @@ check temper_stick 0 "ch 0  material_temperature_degc +23\.5 degC" -- bash -c "p
 check temper_probe 0 "ch 1  material_temperature_degc +19\.5 degC" -- bash -c "printf '%s' '$TEMPER' | '$DAQ' decode temper -"
 check temper_unknown 0 "error \(malformed\): TEMPer firmware 'TEMPerGold_V9.9' is not in the detection table" -- \
   bash -c "printf 'firmware: TEMPerGold_V9.9\n80 80 09 2e 00 00 00 00\n' | '$DAQ' decode temper -"
+# ugold.c's DS75 catch-all (0c45:7401 only) is not applied: an undocumented TEMPer1F is refused,
+# naming the string and --set family, and its data report gives no reading (no phantom sensor).
+check temper_1f_unknown 0 "error \(malformed\): TEMPer firmware 'TEMPer1F_V9.9' is not in the detection table.*--set family" -- \
+  bash -c "printf 'firmware: TEMPer1F_V9.9\n80 04 09 2e 07 9e 00 00\n' | '$DAQ' decode temper -"
+check temper_1f_no_reading 0 "^temper: 0 bytes, 0 frames, 0 readings, 2 errors" -- \
+  bash -c "printf 'firmware: TEMPer1F_V9.9\n80 04 09 2e 07 9e 00 00\n' | '$DAQ' decode temper -"
 # IDS3010: a transcript (request, answer); 1e11 pm = 0.1 m; a warning number is a note.
 IDS='{"jsonrpc":"2.0","method":"com.attocube.sen.displacement.getAxesDisplacement","params":[],"id":7,"api":2}
 {"jsonrpc":"2.0","result":[0,100000000000,0,0],"id":7}
