@@ -174,11 +174,14 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
     if (!relative_origin_ms_) relative_origin_ms_ = *ms;
     f.relative_time_ms = *ms - *relative_origin_ms_;
   }
+  // key|value pairs by position, as the agent walks a line (shdr_token_mapper.cpp): a key it
+  // does not know skips itself and one value, so a value that happens to equal a key name
+  // ("program|Xact") is never taken for a key.
   bool any = false;
-  for (std::size_t i = 1; i + 1 < tokens.size(); ++i) {
+  for (std::size_t i = 1; i + 1 < tokens.size(); i += 2) {
     const auto it = config_.keys.find(tokens[i]);
     if (it == config_.keys.end()) continue;
-    const std::string_view value = tokens[++i];
+    const std::string_view value = tokens[i + 1];
     if (value == "UNAVAILABLE") continue;  // the control has no value: not a position
     const auto v = parse_number(value);
     if (!v || !std::isfinite(*v))

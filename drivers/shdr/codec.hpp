@@ -13,10 +13,16 @@
 //  - the first token is the timestamp: ISO 8601 ("2022-08-08T13:51:34.7167146Z"), empty (the
 //    agent stamps it on arrival), or a number without 'T' (relative time, ms); either form may
 //    end with "@<duration>";
-//  - then key|value pairs. Data items take more tokens than one value (conditions five,
-//    messages two) and only the agent's device model says which; positions are found by their
-//    configured keys wherever they stand, the next token being the value. "UNAVAILABLE" is no
-//    value.
+//  - then key|value pairs, walked by position as the agent's ShdrTokenMapper
+//    (pipeline/shdr_token_mapper.cpp) walks them: each item is a key and its values, and a key
+//    it does not know is skipped with one value (legacy SHDR, before shdrVersion 2), so a
+//    value equal to a key name ("program|Xact|Xact|3": program = "Xact", X = 3) is a value.
+//    Items with more values (a condition five, an alarm four, a time series three, a message
+//    two) stand on a line of their own in SHDR, and the legacy agent stops reading a line after
+//    one of them. This codec has no device model and reads every line as pairs: items after
+//    an odd-valued one on the same line (a message, an alarm) would be misaligned, where the
+//    legacy agent reads none of them; SHDR adapters do not send such lines (the Okuma
+//    recording has none: every line is a timestamp and pairs). "UNAVAILABLE" is no value.
 // Where this codec differs from the agent: a timestamp with 'T' that does not parse (a 13th
 // month) or a first token that is neither a time nor a number is refused as malformed; the
 // agent silently uses its own clock.
