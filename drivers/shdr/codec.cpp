@@ -180,7 +180,10 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
   bool any = false;
   for (std::size_t i = 1; i + 1 < tokens.size(); i += 2) {
     const auto it = config_.keys.find(tokens[i]);
-    if (it == config_.keys.end()) continue;
+    if (it == config_.keys.end()) {
+      if (config_.census) count_key(tokens[i], tokens[i + 1]);
+      continue;
+    }
     const std::string_view value = tokens[i + 1];
     if (value == "UNAVAILABLE") continue;  // the control has no value: not a position
     const auto v = parse_number(value);
@@ -195,6 +198,14 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
     any = true;
   }
   if (any) emit(frames, std::move(f));
+}
+
+void ShdrCodec::count_key(std::string_view key, std::string_view value) {
+  if (key.empty() || numeric_key_set_.contains(key)) return;
+  if (const auto v = parse_number(value); !v || !std::isfinite(*v)) return;
+  if (numeric_key_set_.size() >= census_limit) return;  // bounded: a hostile stream
+  numeric_key_set_.emplace(key);
+  numeric_keys_.emplace_back(key);
 }
 
 }  // namespace cal::drivers::codec

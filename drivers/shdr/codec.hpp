@@ -28,6 +28,7 @@
 // agent silently uses its own clock.
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "cal/drivers/codec/common.hpp"
@@ -41,6 +42,9 @@ struct ShdrConfig {
   double metres_per_unit = 1e-3;  // MTConnect positions are in millimetres
   double max_abs_m = 100.0;       // plausibility: beyond it, out_of_range
   std::size_t max_line_bytes = 8192;
+  // daq decode: note the keys of the other items whose values are numbers (a hint for a user
+  // whose control names its positions otherwise); off in runs.
+  bool census = false;
 };
 
 class ShdrCodec : public CodecBase<ShdrCodec, PositionFrame> {
@@ -56,7 +60,12 @@ class ShdrCodec : public CodecBase<ShdrCodec, PositionFrame> {
   std::uint64_t commands() const { return commands_; }  // other '*' lines
   const std::string& last_command() const { return last_command_; }
   std::uint64_t assets() const { return assets_; }  // multi-line values skipped
+  // With config.census: the keys not configured whose values were numbers, in the order first
+  // seen (the first census_limit of them: a hostile stream cannot grow it).
+  static constexpr std::size_t census_limit = 256;
+  const std::vector<std::string>& numeric_keys_seen() const { return numeric_keys_; }
 
+  const ShdrConfig& config() const { return config_; }
   static std::string ping() { return "* PING\n"; }
 
  private:
@@ -70,6 +79,9 @@ class ShdrCodec : public CodecBase<ShdrCodec, PositionFrame> {
   std::string last_command_;
   std::optional<std::int64_t> pong_timeout_ms_;
   std::optional<double> relative_origin_ms_;  // the first relative timestamp
+  std::vector<std::string> numeric_keys_;
+  std::set<std::string, std::less<>> numeric_key_set_;
+  void count_key(std::string_view key, std::string_view value);
 };
 
 // "2024-01-01T12:00:00.123456Z" (fraction optional, Z optional) as Unix ns; nullopt if not.

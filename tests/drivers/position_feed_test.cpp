@@ -214,6 +214,24 @@ TEST(ShdrCodec, AValueEqualToAKeyNameIsAValue) {
   EXPECT_DOUBLE_EQ(*d.frames[1].position_m[0], 0.003);
 }
 
+TEST(ShdrCodec, TheCensusOfNumericKeysIsForDecodeOnlyAndBounded) {
+  const std::string lines = "2024-01-01T00:00:00Z|X1actw|1.5|mode|AUTO|Xact|2|S1load|0\n";
+  EXPECT_TRUE(codec_test::feed_whole(ShdrCodec{}, lines).frames.size() == 1u);
+  ShdrCodec off;
+  std::vector<PositionFrame> frames;
+  std::vector<CodecError> errors;
+  off.feed(lines, frames, errors);
+  EXPECT_TRUE(off.numeric_keys_seen().empty());  // runs keep no census
+  ShdrCodec on({.census = true});
+  on.feed(lines + lines, frames, errors);
+  // The configured Xact is not listed, nor mode (AUTO is no number); each key once.
+  EXPECT_EQ(on.numeric_keys_seen(), (std::vector<std::string>{"X1actw", "S1load"}));
+  std::string many;
+  for (int k = 0; k < 1000; ++k) many += "|k" + std::to_string(k) + "|1\n";
+  on.feed(many, frames, errors);
+  EXPECT_EQ(on.numeric_keys_seen().size(), ShdrCodec::census_limit);
+}
+
 TEST(PositionFeeds, SplitAtAnyByteGivesTheSameFrames) {
   const std::string hal = "1 12.5 -3.25 0\n2 12.6 -3.25 0\n5 x\n6 1 2 3\n";
   const std::string shdr =
