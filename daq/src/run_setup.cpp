@@ -143,6 +143,14 @@ void check_devices(const cal::daq::Config& config, const std::vector<InstrumentS
                                if (st == d::InstrumentState::configuring) c.opened = true;
                                if (st == d::InstrumentState::closed) c.closed = true;
                                if (!why.empty()) c.why = std::string(why);
+                             },
+                         // What the device says in its own words (e.g. the IDS3010's number
+                         // and errorNumberToString text), warnings told apart from errors.
+                         .message =
+                             [&c, &print](const d::DeviceMessage& m) {
+                               print(fmt::format("  devices.{} ({}): {}{}: {}", c.device->id,
+                                                 c.device->transport, d::to_string(m.severity),
+                                                 m.code ? fmt::format(" {}", m.code) : "", m.text));
                              }});
   }
   const auto deadline = std::chrono::steady_clock::now() +
