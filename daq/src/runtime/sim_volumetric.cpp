@@ -67,7 +67,7 @@ cal::daq::LinearTestConfig base_test(std::size_t axis) {
   l.bidirectional = true;
   l.overrun_mm = 3.0;
   l.feed_mm_per_min = 6000.0;
-  l.dwell_s = 2.0;
+  l.dwell_s = 4.0;  // a gauge answering late still finds the machine standing
   l.measure.stationary_mm = kStationaryMm;
   l.measure.probe_offset_mm = {0.0, 0.0, kProbeZMm};
   return l;
@@ -172,7 +172,7 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   if (a.truth.geometry)
     c.machine_topology = std::string(kin::to_string(a.truth.geometry->topology));
   c.environment.stale_after_s = 60.0;
-  c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.0, .window_mm = 0.5};
+  c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5};
   c.linear = test;
   const auto clock = shop.clock_ns();
   const auto poll = [&](double sim_s) {

@@ -43,7 +43,7 @@ struct SimulatedAcquisition {
   ShopTruth truth;
   std::filesystem::path database;
   std::string machine = "SIMULATED volumetric";
-  double speed = 60.0;
+  double speed = 30.0;
   std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> compensation;
 };
 LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
