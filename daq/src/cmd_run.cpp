@@ -24,6 +24,7 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
+#include "part_program.hpp"
 #include "provenance.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
@@ -252,29 +253,8 @@ struct GcodeOptions {
 };
 
 void gcode(const GcodeOptions& o, bool circle) {
-  const auto config = cal::daq::load_config(o.config);
-  const auto dialect = cal::daq::dialect_from_string(o.dialect);
-  std::string text;
-  if (circle) {
-    if (!config.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", o.config));
-    const auto& c = *config.circle;
-    text = cal::daq::circle_program({.radius_mm = c.radius_mm,
-                                     .feed_mm_per_min = c.feed_mm_per_min,
-                                     .sample_rate_hz = c.sample_rate_hz,
-                                     .overshoot_deg = c.overshoot_deg},
-                                    {.centre_x_mm = c.centre_mm[0],
-                                     .centre_y_mm = c.centre_mm[1],
-                                     .centre_z_mm = c.centre_mm[2],
-                                     .plane = cal::daq::plane_from_string(c.plane)},
-                                    dialect);
-  } else {
-    if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
-    const auto& l = *config.linear;
-    const auto plan = linear_plan(l);
-    text = cal::daq::linear_program(
-        plan, {.axis = l.axis[0], .feed_mm_per_min = l.feed_mm_per_min, .dwell_s = l.dwell_s},
-        dialect);
-  }
+  const auto text =
+      part_program(cal::daq::load_config(o.config), circle ? "circle" : "linear", o.dialect);
   if (o.output.empty()) return fmt::print("{}", text);
   std::ofstream out(o.output);
   if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));
