@@ -26,14 +26,17 @@ json circle_json(const cal::circle::Result& r, double radius_mm, std::string_vie
          {"notes", r.notes}};
   if (r.cyclic_period_mm) j["cyclic_period_mm"] = *r.cyclic_period_mm;
   j["diagnostics"] = json::array();
-  for (const auto& d : r.diagnostics)
-    j["diagnostics"].push_back({{"key", d.key},
-                                {"name", d.name},
-                                {"value", d.value},
-                                {"unit", d.unit},
-                                {"pv_um", d.pv_um},
-                                {"share_pct", d.share_pct},
-                                {"g_reduction_um", d.g_reduction_um}});
+  for (const auto& d : r.diagnostics) {
+    json dj{{"key", d.key},
+            {"name", d.name},
+            {"value", d.value},
+            {"unit", d.unit},
+            {"pv_um", d.pv_um},
+            {"share_pct", d.share_pct},
+            {"g_reduction_um", d.g_reduction_um}};
+    if (d.frequency_hz) dj["frequency_hz"] = *d.frequency_hz;
+    j["diagnostics"].push_back(std::move(dj));
+  }
   j["centre"] = {{r.centre_u.key, r.centre_u.value}, {r.centre_v.key, r.centre_v.value}};
   return j;
 }
@@ -49,9 +52,10 @@ void print_circle(const cal::circle::Result& r, double radius_mm, std::string_vi
   fmt::print("  F max / min        {:8.3f} / {:.3f} um\n", r.iso.F_max_um, r.iso.F_min_um);
   fmt::print("  LSQ centre         {:8.3f}, {:.3f} um\n\n", r.iso.centre_u_um, r.iso.centre_v_um);
   fmt::print(
-      "Diagnostics (ranked by their share of G; PV of the fitted contribution, its % of G,\n"
-      "and the reduction of G when it alone is removed):\n");
-  fmt::print("  {:<40} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "% of G",
+      "Diagnostics, ranked by PV (the peak-to-valley of the error's own pattern on the traces),\n"
+      "with PV / G (the share of G; caldaq's own figure, can exceed 100 %) and G gain (how much\n"
+      "G falls when that error alone is removed; docs/circle.md):\n");
+  fmt::print("  {:<40} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "PV / G",
              "G gain");
   for (const auto& d : r.diagnostics)
     fmt::print("  {:<40} {:+9.3f} {:<5} {:7.3f} um {:5.1f} % {:7.3f} um\n", d.name, d.value, d.unit,

@@ -35,6 +35,7 @@ struct CircleOptions {
   double arc_deg = 360.0;
   double overshoot_deg = 0.0;
   double spike_decay_deg = 6.0;
+  double stick_slip_window_deg = 10.0;
   std::optional<double> cyclic_period_mm;
   std::optional<double> calibrated_radius_mm;
   bool uncalibrated = false;
@@ -47,6 +48,7 @@ struct CircleOptions {
             .feed_mm_per_min = feed_mm_per_min,
             .cyclic_period_mm = cyclic_period_mm,
             .spike_decay_deg = spike_decay_deg,
+            .stick_slip_window_deg = stick_slip_window_deg,
             .radius_calibrated = !uncalibrated,
             .calibrated_radius_mm = calibrated_radius_mm,
             .start_deg = start_deg,
@@ -162,6 +164,9 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
                   "With time_s: overshoot arc before and after the measured arc (trimmed)")
       ->capture_default_str();
   cmd->add_option("--spike-decay-deg", o->spike_decay_deg, "Decay angle of a reversal spike")
+      ->capture_default_str();
+  cmd->add_option("--stick-slip-window-deg", o->stick_slip_window_deg,
+                  "Stick-slip: window about each reversal of an axis (1 < W <= 45)")
       ->capture_default_str();
   cmd->add_option("--cyclic-period-mm", o->cyclic_period_mm,
                   "Cyclic-error period (default: searched)");

@@ -175,6 +175,8 @@ G_um = 15
 [tolerances.XY.diagnostics]
 squareness = 20
 backlash_X = 3
+stick_slip_Y = 0.5
+vibration = 0.3
 )",
                               "m.toml");
   EXPECT_EQ(c.operator_name, "J. Smith");
@@ -198,6 +200,8 @@ backlash_X = 3
   const auto& xy = c.plane_tolerances.at("XY");
   EXPECT_EQ(xy.G_um, 15.0);
   EXPECT_EQ(xy.diagnostics.at("backlash_X"), 3.0);
+  EXPECT_EQ(xy.diagnostics.at("stick_slip_Y"), 0.5);
+  EXPECT_EQ(xy.diagnostics.at("vibration"), 0.3);
 }
 
 TEST(Config, RefusesBadLimitsDatesAndNames) {
@@ -216,6 +220,9 @@ TEST(Config, RefusesBadLimitsDatesAndNames) {
       error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
           .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),
       std::string::npos);
+  EXPECT_NE(error_of("[tolerances.ZX.diagnostics]\nstick_slip_Y = 3\n")
+                .find("not a diagnostic of a circle in ZX"),
+            std::string::npos);
   EXPECT_NE(error_of("[[tolerances.X.by_length]]\nup_to_mm = 500\nA_um = 8\n"
                      "[[tolerances.X.by_length]]\nup_to_mm = 300\nA_um = 6\n")
                 .find("entries must ascend in up_to_mm"),

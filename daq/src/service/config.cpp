@@ -280,10 +280,11 @@ AxisTolerance read_axis_tolerance(Table& t) {
 
 // The diagnostics a circle in plane UV can report (cal::circle: Diagnostic::key).
 bool circle_diagnostic(std::string_view plane, std::string_view key) {
-  for (const char* k : {"radius_error", "scale_mismatch", "squareness", "servo_mismatch"})
+  for (const char* k :
+       {"radius_error", "scale_mismatch", "squareness", "servo_mismatch", "vibration"})
     if (key == k) return true;
-  for (const char* prefix :
-       {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_", "straightness_"}) {
+  for (const char* prefix : {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_",
+                             "straightness_", "stick_slip_"}) {
     const std::string_view p(prefix);
     if (key.size() == p.size() + 1 && key.substr(0, p.size()) == p &&
         plane.find(key.back()) != std::string_view::npos)
@@ -301,8 +302,9 @@ CircleTolerance read_circle_tolerance(Table& t, std::string_view plane) {
       if (!circle_diagnostic(plane, k.str()))
         dt.fail(&v, k.str(),
                 fmt::format("not a diagnostic of a circle in {} (radius_error, scale_mismatch, "
-                            "squareness, servo_mismatch, backlash_{}, cyclic_{}, ...)",
-                            plane, plane.substr(0, 1), plane.substr(0, 1)));
+                            "squareness, servo_mismatch, vibration, backlash_{}, cyclic_{}, "
+                            "stick_slip_{}, ...)",
+                            plane, plane.substr(0, 1), plane.substr(0, 1), plane.substr(0, 1)));
       c.diagnostics[std::string(k.str())] = *limit(dt, k.str());
     }
     dt.check_unknown();
