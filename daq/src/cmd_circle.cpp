@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cal/analysis/circle.hpp"
+#include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
 #include "circle_output.hpp"
 #include "commands.hpp"
@@ -39,6 +40,7 @@ struct CircleOptions {
   std::optional<double> cyclic_period_mm;
   std::optional<double> calibrated_radius_mm;
   bool uncalibrated = false;
+  std::string standard = "iso230-4:2005";
   bool json = false;
   bool has_lengths = false;  // the CSV gives length_mm (set by read_traces)
 
@@ -131,11 +133,13 @@ std::vector<ci::Trace> read_traces(CircleOptions& o) {
 }
 
 json to_json(const ci::Result& r, const CircleOptions& o) {
-  return circle_json(r, o.radius_mm, o.plane, o.feed_mm_per_min);
+  return circle_json(r, o.radius_mm, o.plane, o.feed_mm_per_min,
+                     ci::circular_standard_from_key(o.standard));
 }
 
 void print(const ci::Result& r, const CircleOptions& o) {
-  print_circle(r, o.radius_mm, o.plane, o.feed_mm_per_min);
+  print_circle(r, o.radius_mm, o.plane, o.feed_mm_per_min,
+               ci::circular_standard_from_key(o.standard));
 }
 
 }  // namespace
@@ -174,8 +178,13 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
                   "Bar length at which deviation_um reads 0 (default: the nominal radius)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--uncalibrated", o->uncalibrated, "The bar was not calibrated: no radius error");
-  cmd->add_flag("--json", o->json, "Print caldaq.circle.v1 JSON");
+  cmd->add_option("-s,--standard", o->standard,
+                  "iso230-4:2005, gb/t17421.4-2016 (identical) or iso230-4:1996 (docs/circle.md, "
+                  "\"Standards\")")
+      ->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print caldaq.circle.v2 JSON");
   cmd->callback([o] {
+    ci::circular_standard_from_key(o->standard);  // an unknown standard before reading the file
     const auto traces = read_traces(*o);
     auto setup = o->setup();
     if (o->has_lengths) setup.calibrated_radius_mm.reset();  // lengths are absolute

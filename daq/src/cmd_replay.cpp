@@ -109,12 +109,12 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
                                       out.run_id, out.reason));
   if (o.json) {
-    json j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+    json j = circle_document(*out.result, program, analysis);
     j["run_id"] = out.run_id;
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-  print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  print_circle_result(*out.result, program, analysis);
 }
 
 void replay_linear(ReplaySession& s, const ReplayOptions& o) {
@@ -184,7 +184,7 @@ void add_replay_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", o->json,
-                "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v1)");
+                "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
   cmd->callback([o] { run_replay(*o); });
 }
 

@@ -193,7 +193,7 @@ void run_circle(const RunOptions& o) {
       "stops.",
       o.config));
   const auto& out = run_to_end(io, run, capture);
-  auto j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  auto j = circle_document(*out.result, program, analysis);
   const auto v = verdict_circle(config, analysis.plane, j);
   if (o.json) {
     j["run_id"] = out.run_id;
@@ -202,7 +202,7 @@ void run_circle(const RunOptions& o) {
     return fmt::print("{}\n", j.dump(2));
   }
   fmt::print("\nrun {}: {} readings\n", out.run_id, out.readings);
-  print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  print_circle_result(*out.result, program, analysis);
   print_verdict(v);
 }
 
@@ -262,7 +262,7 @@ void add_run_commands(CLI::App& app) {
                    "Reconnection attempts before the ballbar is given up")
       ->capture_default_str();
   circ->add_flag("--json", o->json,
-                 "Print the result as caldaq.circle.v1 JSON with run_id and verdict (progress "
+                 "Print the result as caldaq.circle.v2 JSON with run_id and verdict (progress "
                  "goes to stderr)");
   circ->callback([o] { run_circle(*o); });
 

@@ -36,7 +36,7 @@ st::RunRecord linear_run(const st::Store& store, std::int64_t id) {
 struct AnalyseRunOptions {
   std::string db;
   std::int64_t run = 0;
-  std::string standard = "iso230-2:2014";
+  std::string standard;  // empty: ISO 230-2:2014 (linear), the run's own (circle)
   bool store = false;
   bool json = false;
   // Circle runs: what may be corrected after the fact.
@@ -54,6 +54,10 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   if (o.calibrated_radius_mm) analysis.calibrated_radius_mm = o.calibrated_radius_mm;
   if (o.cyclic_period_mm) analysis.cyclic_period_mm = o.cyclic_period_mm;
   if (o.uncalibrated) analysis.uncalibrated = true;
+  if (!o.standard.empty()) {
+    cal::circle::circular_standard_from_key(o.standard);  // refused here if unknown
+    analysis.standard = o.standard;
+  }
   std::vector<double> bar_mm;
   for (const auto& r : store.readings(o.run))
     if (r.quantity == static_cast<std::uint8_t>(cal::drivers::Quantity::length_m))
@@ -65,12 +69,12 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
     throw cal::InputError(
         fmt::format("run {} ({} bar readings stored): {}", o.run, bar_mm.size(), e.what()));
   }
-  auto j = circle_json(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  auto j = circle_document(result, program, analysis);
   if (o.store) {
     json prov = provenance("reanalysed", software_version);
     prov["analysis"] = circle_settings_json(program, analysis);
     const auto id = store.add_result({.run_id = o.run,
-                                      .standard = "ISO 230-4:2005",
+                                      .standard = standard_label(analysis),
                                       .json = j.dump(),
                                       .provenance_json = prov.dump()});
     j["result_id"] = id;
@@ -78,14 +82,15 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   const auto v = verdict_of(settings, j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", j.dump(2));
-  print_circle(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  print_circle_result(result, program, analysis);
   print_verdict(v);
 }
 
-void analyse_run(const AnalyseRunOptions& o) {
+void analyse_run(AnalyseRunOptions o) {
   st::Store store(database_path(o.db));
   const auto run = store.run(o.run);
   if (run && run->kind == "circle") return analyse_circle_run(store, *run, o);
+  if (o.standard.empty()) o.standard = "iso230-2:2014";
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
   if (targets.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
@@ -257,8 +262,10 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   analyse.require_subcommand(0, 1);
   analyse.add_option("RUN", a->run, "A stored run to evaluate again (see daq runs)");
   add_db_option(analyse, a->db);
-  analyse.add_option("-s,--standard", a->standard, "Standard for a stored run")
-      ->capture_default_str();
+  analyse.add_option("-s,--standard", a->standard,
+                     "Standard for a stored run: a linear run iso230-2:2014 (default), ...; a "
+                     "circle run iso230-4:2005, gb/t17421.4-2016 or iso230-4:1996 (default: as "
+                     "run)");
   analyse.add_flag("--store", a->store, "Store the result with the run");
   analyse
       .add_option("--calibrated-radius-mm", a->calibrated_radius_mm,
@@ -269,7 +276,7 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
                   "Circle runs: the cyclic-error period (default: as run, else searched)")
       ->check(CLI::PositiveNumber);
   analyse.add_flag("--uncalibrated", a->uncalibrated, "Circle runs: no radius error");
-  analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v1)");
+  analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
   analyse.callback([a, &analyse] {
     if (!analyse.get_subcommands().empty()) return;
     if (a->run <= 0)

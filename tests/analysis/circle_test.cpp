@@ -13,6 +13,7 @@
 #include <random>
 #include <tuple>
 
+#include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace {
@@ -587,6 +588,47 @@ TEST(CircleDynamics, RefusesABadStickSlipWindow) {
   const Trace t = simulate({}, Direction::ccw, 360, 1);
   EXPECT_THROW(analyse({.stick_slip_window_deg = 1.0}, std::span(&t, 1)), cal::InputError);
   EXPECT_THROW(analyse({.stick_slip_window_deg = 50.0}, std::span(&t, 1)), cal::InputError);
+}
+
+TEST(CircularStandards, WhatEachReportsAndWhatIsRefused) {
+  // ISO 230-4:2005 replaced H by G(b) (its foreword): G(b) is a 2005 value, H only informative;
+  // the 1996 edition the other way round; GB/T 17421.4-2016 is ISO 230-4:2005 (IDT).
+  const auto keys = [](const std::vector<StandardValue>& v) {
+    std::vector<std::string> out;
+    for (const auto& x : v) out.push_back(x.key);
+    return out;
+  };
+  using V = std::vector<std::string>;
+  const auto& iso2005 = info(circular_standard_from_key("iso230-4:2005"));
+  EXPECT_EQ(iso2005.label, "ISO 230-4:2005");
+  EXPECT_EQ(keys(iso2005.values), (V{"G_bi_um", "G_ccw_um", "G_cw_um", "F_max_um", "F_min_um"}));
+  EXPECT_EQ(keys(iso2005.informative), V{"H_um"});
+  ASSERT_EQ(iso2005.not_evaluated.size(), 1u);
+  EXPECT_NE(iso2005.not_evaluated[0].find("mean bi-directional radial deviation"),
+            std::string::npos);
+  const auto& gbt = info(circular_standard_from_key("GB/T 17421.4-2016"));
+  EXPECT_EQ(gbt.label, "GB/T 17421.4-2016");
+  EXPECT_EQ(keys(gbt.values), keys(iso2005.values));
+  EXPECT_EQ(gbt.identical, V{"ISO 230-4:2005"});
+  const auto& iso1996 = info(circular_standard_from_key("iso230-4:1996"));
+  EXPECT_EQ(keys(iso1996.values), (V{"G_ccw_um", "G_cw_um", "H_um", "F_max_um", "F_min_um"}));
+  EXPECT_EQ(keys(iso1996.informative), V{"G_bi_um"});
+  EXPECT_EQ(circular_standard_from_key("iso230-4"), CircularStandard::iso230_4_2005);
+  EXPECT_EQ(circular_standards().size(), 3u);
+  // Known but not established from public material: refused with the reason.
+  for (const auto& [key, why] :
+       {std::pair{"iso230-4:2022", "whether the definitions changed could not be established"},
+        {"jis-b6190-4", "no public text of JIS B 6190-4"},
+        {"asme-b5.54", "only the scopes of ASME B5.54-2005 and B5.57-2012 are public"},
+        {"ASME B5.57", "only the scopes"},
+        {"vdi3441", "expected iso230-4:2005, gb/t17421.4-2016 or iso230-4:1996"}}) {
+    try {
+      circular_standard_from_key(key);
+      ADD_FAILURE() << key << " accepted";
+    } catch (const cal::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

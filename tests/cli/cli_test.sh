@@ -49,7 +49,7 @@ check targets_feed_analyse 0 "^  E +$E um" -- "$DAQ" analyse iso230-2 --input "$
 G=$("$DAQ" analyse 2 --db "$TMP/demo.sqlite" --json | python3 -c "import json,sys; print(format(json.load(sys.stdin)['iso230_4']['G_bi_um'], '.3f'))")
 "$DAQ" export 2 --what circle -o "$TMP/ballbar.csv" --db "$TMP/demo.sqlite"
 opts=$(sed -nE 's/^# .*daq analyse circle --input FILE (.*)$/\1/p' "$TMP/ballbar.csv")
-check circle_feed_analyse 0 "G \(bidirectional\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
+check circle_feed_analyse 0 "G\(b\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
 check circle_no_targets 2 "run 2 is a circle test and has no captured stops: use --what circle" -- "$DAQ" export 2 --what targets --db "$TMP/demo.sqlite"
 check linear_no_circle 2 "run 1 is a linear test, not a circle" -- "$DAQ" export 1 --what circle --db "$TMP/demo.sqlite"
 # Readings: one timestamp per sample (the ballbar's lines delivered together are spread by its

@@ -32,7 +32,7 @@ check squareness 0 "Squareness XY +\+(19\.9[5-9]|20\.0[0-5])[0-9]* um/m" -- echo
 check servo 0 "Servo mismatch \(Y lags X\) +\+0\.3[3-5][0-9]* ms" -- echo "$RUN"
 check backlash 0 "Backlash X +\+(3\.9[0-9]|4\.[01][0-9])[0-9]* um" -- echo "$RUN"
 check cyclic 0 "Cyclic error X \(40\.00 mm period\) +\+(0\.9[7-9]|1\.0[0-3])[0-9]* um" -- echo "$RUN"
-G1=$(grep -E "G \(bidirectional\)" <<<"$RUN")
+G1=$(grep -E "^  G\(b\) " <<<"$RUN")
 
 # The capture replays into run 2 with the same G to the last printed digit; the stored raw
 # readings analysed again give it too; a corrected calibrated length (+2 um) moves the radius

@@ -220,6 +220,10 @@ TEST(Config, RefusesBadLimitsDatesAndNames) {
       error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
           .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),
       std::string::npos);
+  EXPECT_NE(
+      error_of("[test.circle]\nstandard = \"asme-b5.54\"\n")
+          .find("key 'test.circle.standard': circular standard 'asme-b5.54': only the scopes"),
+      std::string::npos);
   EXPECT_NE(error_of("[tolerances.ZX.diagnostics]\nstick_slip_Y = 3\n")
                 .find("not a diagnostic of a circle in ZX"),
             std::string::npos);

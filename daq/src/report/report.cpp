@@ -774,11 +774,24 @@ struct Circle {
   cal::circle::Result result;
 };
 
-Circle analyse_circle(const st::Store& store, const RunView& v) {
+// A circular standard asked for in the options (a key of daq analyse --standard) replaces the
+// run's own; a linear standard there is for the linear runs of a campaign and is ignored here.
+std::string circular_key(const Options& o, std::string fallback) {
+  if (o.standard.empty()) return fallback;
+  try {
+    cal::circle::circular_standard_from_key(o.standard);
+    return o.standard;
+  } catch (const cal::InputError&) {
+    return fallback;
+  }
+}
+
+Circle analyse_circle(const st::Store& store, const RunView& v, const Options& o) {
   if (!v.settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("{}: run {}: its circle settings are missing",
                                       store.path().string(), v.run.id));
   auto [program, analysis] = ::daq::circle_settings_from_json(v.settings);
+  analysis.standard = circular_key(o, analysis.standard);
   static constexpr std::uint8_t bar[] = {static_cast<std::uint8_t>(Q::length_m)};
   std::vector<double> bar_mm;
   for (const auto& r : store.readings(v.run.id, bar)) bar_mm.push_back(r.value * 1e3);
@@ -822,34 +835,50 @@ PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_
   return p;
 }
 
-std::string circle_section(const st::Store& store, const RunView& v, Headline& headline) {
-  const auto c = analyse_circle(store, v);
+// The values of the run's circular standard, as (key, symbol, value).
+std::vector<std::tuple<std::string, std::string, double>> standard_values(const Circle& c) {
+  std::vector<std::tuple<std::string, std::string, double>> out;
+  const auto& st = cal::circle::info(cal::circle::circular_standard_from_key(c.analysis.standard));
+  for (const auto& x : st.values)
+    out.emplace_back(x.key, x.symbol, ::daq::iso_value(c.result.iso, x.key));
+  return out;
+}
+
+std::string circle_section(const st::Store& store, const RunView& v, const Options& o,
+                           Headline& headline) {
+  const auto c = analyse_circle(store, v, o);
   const auto& r = c.result;
-  headline.standard = "ISO 230-4:2005";
+  const auto& st = cal::circle::info(cal::circle::circular_standard_from_key(c.analysis.standard));
+  headline.standard = st.label;
   std::string h = fmt::format(
-      "<h3>Results: ISO 230-4:2005</h3>\n<p class=\"standard\">Evaluated by <strong>ISO "
-      "230-4:2005</strong> (circular tests for numerically controlled machine tools); radius "
-      "{:g} mm, feed {:g} mm/min, plane {}, both directions from the stored bar readings.</p>\n",
+      "<h3>Results: {0}</h3>\n<p class=\"standard\">Evaluated by <strong>{0}</strong> ({1}){2}; "
+      "radius {3:g} mm, feed {4:g} mm/min, plane {5}, both directions from the stored bar "
+      "readings.</p>\n",
+      esc(st.label), esc(st.title),
+      st.identical.empty() ? std::string()
+                           : fmt::format(", the same values as {}", esc(st.identical.front())),
       c.program.radius_mm, c.program.feed_mm_per_min, esc(c.analysis.plane));
-  const auto doc =
-      ::daq::circle_json(r, c.program.radius_mm, c.analysis.plane, c.program.feed_mm_per_min);
+  const auto doc = ::daq::circle_document(r, c.program, c.analysis);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
-  const auto* g_check = ::daq::find_check(verdict, "G_bi_um");
-  const std::vector<std::vector<std::string>> iso = {
-      {"G", um(r.iso.G_bi_um), "circular deviation, both directions", limit_cell(g_check),
-       verdict_cell(g_check)},
-      {"G (cw)", um(r.iso.G_cw_um), "circular deviation, clockwise", "", ""},
-      {"G (ccw)", um(r.iso.G_ccw_um), "circular deviation, counter-clockwise", "", ""},
-      {"H", um(r.iso.H_um), "circular hysteresis", "", ""},
-      {"F max", um(r.iso.F_max_um), "largest radial deviation from the nominal radius", "", ""},
-      {"F min", um(r.iso.F_min_um), "smallest radial deviation from the nominal radius", "", ""},
-      {"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
-       "least-squares centre relative to the pivot (set-up)", "", ""}};
-  headline.values_um = {{"G", r.iso.G_bi_um}, {"H", r.iso.H_um}};
+  std::vector<std::vector<std::string>> iso;
+  for (const auto& x : st.values) {
+    const auto* check = ::daq::find_check(verdict, x.key);
+    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)), esc(x.meaning),
+                   limit_cell(check), check ? verdict_cell(check) : ""});
+    if (x.key.starts_with("G"))
+      headline.values_um.push_back({x.symbol, ::daq::iso_value(r.iso, x.key)});
+  }
+  iso.push_back({"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
+                 "least-squares centre relative to the pivot (set-up)", "", ""});
+  for (const auto& x : st.informative)
+    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
+                   "<em>informative</em>: " + esc(x.meaning), "", ""});
   h += verdict_banner(verdict);
   h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
              "lrlrl");
+  for (const auto& n : st.not_evaluated)
+    h += "<p class=\"note\">Not evaluated: " + esc(n) + "</p>\n";
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
   polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
   h += figure(svg(polar),
@@ -1040,7 +1069,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
   h += conditions_section(v);
   h += instruments_section(v);
   if (v.run.kind == "linear" || v.run.kind == "circle")
-    h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v1");
+    h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v2");
   h += setup_section(v);
   // An aborted or interrupted run may hold too little to evaluate: the report still shows what
   // was stored, and says why there are no results.
@@ -1048,7 +1077,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
     if (v.run.kind == "linear")
       h += linear_section(store, v, o, hl);
     else if (v.run.kind == "circle")
-      h += circle_section(store, v, hl);
+      h += circle_section(store, v, o, hl);
     else
       h += generic_section(store, v);
   } catch (const cal::InputError& e) {
@@ -1168,18 +1197,17 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
       for (const auto& a : l.e.axis) values.push_back({a.key, a.symbol, "µm", a.value_um});
       doc = ::daq::to_json(l.e);
     } else {
-      const auto c = analyse_circle(store, v);
+      const auto c = analyse_circle(store, v, o);
       polars.push_back(polar_of(c, "", 2 * i, label + " "));
-      values = {{"G_bi_um", "G", "µm", c.result.iso.G_bi_um},
-                {"H_um", "H", "µm", c.result.iso.H_um}};
+      for (const auto& [key, symbol, value] : standard_values(c))
+        if (key.starts_with("G")) values.push_back({key, symbol, "µm", value});
       for (const auto& d : c.result.diagnostics)
         values.push_back({d.key, d.name,
                           d.unit == "um"     ? "µm"
                           : d.unit == "um/m" ? "µm/m"
                                              : d.unit,
                           d.value});
-      doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
-                               c.program.feed_mm_per_min);
+      doc = ::daq::circle_document(c.result, c.program, c.analysis);
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
     // A re-compensated run is compared with the values it has now, and says so.
@@ -1309,14 +1337,14 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
       for (const auto& a : l.e.axis) sd.values.emplace_back(a.key, a.symbol, a.value_um);
       sd.doc = ::daq::to_json(l.e);
     } else {
-      const auto c = analyse_circle(store, v);
+      const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
       polar.first_axis = p.first_axis, polar.second_axis = p.second_axis;
       for (auto& t : p.traces) polar.traces.push_back(std::move(t));
-      sd.values = {{"G_bi_um", "G", c.result.iso.G_bi_um}, {"H_um", "H", c.result.iso.H_um}};
+      for (const auto& [key, symbol, value] : standard_values(c))
+        if (key.starts_with("G")) sd.values.emplace_back(key, symbol, value);
       for (const auto& d : c.result.diagnostics) sd.values.emplace_back(d.key, d.name, d.value);
-      sd.doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
-                                  c.program.feed_mm_per_min);
+      sd.doc = ::daq::circle_document(c.result, c.program, c.analysis);
     }
     sd.verdict = ::daq::verdict_of(v.settings, sd.doc);
     return sd;

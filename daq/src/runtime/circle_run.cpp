@@ -52,6 +52,22 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                               traces);
 }
 
+json circle_document(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
+                     const BallbarAnalysis& analysis) {
+  return circle_json(r, program.radius_mm, analysis.plane, program.feed_mm_per_min,
+                     cal::circle::circular_standard_from_key(analysis.standard));
+}
+
+void print_circle_result(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
+                         const BallbarAnalysis& analysis) {
+  print_circle(r, program.radius_mm, analysis.plane, program.feed_mm_per_min,
+               cal::circle::circular_standard_from_key(analysis.standard));
+}
+
+std::string standard_label(const BallbarAnalysis& analysis) {
+  return cal::circle::info(cal::circle::circular_standard_from_key(analysis.standard)).label;
+}
+
 json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalysis& a) {
   json j{{"radius_mm", p.radius_mm},
          {"feed_mm_per_min", p.feed_mm_per_min},
@@ -61,7 +77,8 @@ json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalys
          {"overshoot_deg", p.overshoot_deg},
          {"start_deg", p.start_deg},
          {"plane", a.plane},
-         {"uncalibrated", a.uncalibrated}};
+         {"uncalibrated", a.uncalibrated},
+         {"standard", a.standard}};
   if (a.calibrated_radius_mm) j["calibrated_radius_mm"] = *a.calibrated_radius_mm;
   if (a.cyclic_period_mm) j["cyclic_period_mm"] = *a.cyclic_period_mm;
   return j;
@@ -75,8 +92,10 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(c
                              .dwell_s = j.at("dwell_s"),
                              .overshoot_deg = j.at("overshoot_deg"),
                              .start_deg = j.value("start_deg", 0.0)};
+  // Runs stored before issue 18 have no standard: they were evaluated by ISO 230-4:2005.
   BallbarAnalysis a{.plane = j.value("plane", std::string("XY")),
-                    .uncalibrated = j.value("uncalibrated", false)};
+                    .uncalibrated = j.value("uncalibrated", false),
+                    .standard = j.value("standard", std::string("iso230-4:2005"))};
   if (j.contains("calibrated_radius_mm")) a.calibrated_radius_mm = j["calibrated_radius_mm"];
   if (j.contains("cyclic_period_mm")) a.cyclic_period_mm = j["cyclic_period_mm"];
   return {p, a};
@@ -85,7 +104,7 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(c
 std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c) {
   if (!c.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", c.source.string()));
   const auto& t = *c.circle;
-  BallbarAnalysis a{.plane = t.plane};
+  BallbarAnalysis a{.plane = t.plane, .standard = t.standard};
   if (t.calibrated_radius_mm > 0) a.calibrated_radius_mm = t.calibrated_radius_mm;
   return {cal::daq::BallbarProgram{.radius_mm = t.radius_mm,
                                    .feed_mm_per_min = t.feed_mm_per_min,
@@ -225,12 +244,11 @@ struct CircleRun::Impl {
       prov["capture"] = setup.capture_path;
       prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
     }
-    store->add_result({.run_id = outcome.run_id,
-                       .standard = "ISO 230-4:2005",
-                       .json = circle_json(*outcome.result, setup.program.radius_mm,
-                                           setup.analysis.plane, setup.program.feed_mm_per_min)
-                                   .dump(),
-                       .provenance_json = prov.dump()});
+    store->add_result(
+        {.run_id = outcome.run_id,
+         .standard = standard_label(setup.analysis),
+         .json = circle_document(*outcome.result, setup.program, setup.analysis).dump(),
+         .provenance_json = prov.dump()});
     store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
     outcome.complete = true;
     publish_end("complete");

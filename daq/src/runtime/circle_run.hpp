@@ -27,6 +27,7 @@ struct BallbarAnalysis {
   std::optional<double> calibrated_radius_mm;  // the bar's calibrated length; unset: nominal
   std::optional<double> cyclic_period_mm;      // unset: searched
   bool uncalibrated = false;                   // no calibrator: no radius error
+  std::string standard = "iso230-4:2005";      // cal::circle::circular_standard_from_key
 };
 
 // The ISO 230-4 result and diagnostics of a ballbar stream (one deviation per sample, in mm
@@ -36,6 +37,16 @@ struct BallbarAnalysis {
 cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                                     const BallbarAnalysis& analysis,
                                     std::span<const double> deviation_mm);
+
+// The result document (caldaq.circle.v2) of a ballbar test by the analysis' standard, and the
+// same for a terminal.
+nlohmann::json circle_document(const cal::circle::Result& r,
+                               const cal::daq::BallbarProgram& program,
+                               const BallbarAnalysis& analysis);
+void print_circle_result(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
+                         const BallbarAnalysis& analysis);
+// The label a result is stored under ("ISO 230-4:2005", "GB/T 17421.4-2016", ...).
+std::string standard_label(const BallbarAnalysis& analysis);
 
 // The program and analysis settings stored with a circle run (runs.settings_json), and back.
 nlohmann::json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalysis& a);

@@ -10,6 +10,7 @@
 #include <initializer_list>
 #include <sstream>
 
+#include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
 
@@ -249,6 +250,12 @@ CircleTestConfig read_circle(Table& t) {
     c.centre_mm = centre;
   }
   t.read("calibrated_radius_mm", c.calibrated_radius_mm);
+  t.read("standard", c.standard);
+  try {
+    cal::circle::circular_standard_from_key(c.standard);
+  } catch (const InputError& e) {
+    t.fail(t.node("standard"), "standard", e.what());
+  }
   t.check_unknown();
   return c;
 }

@@ -77,7 +77,8 @@ struct CircleTestConfig {
   double sample_rate_hz = 1000.0;
   double overshoot_deg = 45.0;
   std::vector<double> centre_mm{0.0, 0.0, 0.0};
-  double calibrated_radius_mm = 0.0;  // 0: the nominal
+  double calibrated_radius_mm = 0.0;       // 0: the nominal
+  std::string standard = "iso230-4:2005";  // cal::circle::circular_standard_from_key
 };
 
 // Who the test is for and where ([customer]).
