@@ -208,6 +208,8 @@ void run_circle(const RunOptions& o) {
 
 struct GcodeOptions {
   std::string config, dialect = "fanuc", output;
+  bool set = false;  // circle: the standard set (XY, ZX, YZ) even for a single-test configuration
+  bool by_radius = false;
 };
 
 void gcode(const GcodeOptions& o, bool circle) {
@@ -215,14 +217,11 @@ void gcode(const GcodeOptions& o, bool circle) {
   const auto dialect = cal::daq::dialect_from_string(o.dialect);
   std::string text;
   if (circle) {
-    if (!config.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", o.config));
-    const auto& c = *config.circle;
-    text = cal::daq::circle_program({.radius_mm = c.radius_mm,
-                                     .feed_mm_per_min = c.feed_mm_per_min,
-                                     .sample_rate_hz = c.sample_rate_hz,
-                                     .overshoot_deg = c.overshoot_deg},
-                                    {.centre_x_mm = c.centre_mm[0], .centre_y_mm = c.centre_mm[1]},
-                                    dialect);
+    std::vector<cal::daq::BallbarSetTest> set;
+    for (const auto& t : circle_tests(config, o.set)) set.push_back({t.plane, t.program});
+    auto setup = circle_program_setup(config);
+    if (o.by_radius) setup.arcs = cal::daq::ArcForm::radius;
+    text = cal::daq::circle_set_program(set, setup, dialect);
   } else {
     if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
     const auto& l = *config.linear;
@@ -276,6 +275,13 @@ void add_run_commands(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("-o,--output", g->output, "Write to a file instead of stdout");
     const bool circle = std::string(kind) == "circle";
+    if (circle) {
+      sub->add_flag("--set", g->set,
+                    "The standard set: XY 360 deg, ZX and YZ partial arcs, at each configured "
+                    "feed and radius (docs/circle.md)");
+      sub->add_flag("--by-radius", g->by_radius,
+                    "Arcs by radius (R / CR=) in pieces of at most 90 deg instead of by centre");
+    }
     sub->callback([g, circle] { gcode(*g, circle); });
   }
 }

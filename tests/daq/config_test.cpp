@@ -250,4 +250,38 @@ TEST(Config, MissingFileIsNamed) {
   }
 }
 
+TEST(Config, BallbarSetKeys) {
+  const auto c = cal::daq::parse_config(R"(
+[test.circle]
+planes = ["XY", "ZX", "YZ"]
+feeds_mm_per_min = [500, 2000]
+radii_mm = [100, 150]
+partial_arc_deg = 200
+partial_overshoot_deg = 5
+bar = "QC20-1234"
+)",
+                                        "m.toml");
+  ASSERT_TRUE(c.circle);
+  EXPECT_EQ(c.circle->planes, (std::vector<std::string>{"XY", "ZX", "YZ"}));
+  EXPECT_EQ(c.circle->feeds_mm_per_min, (std::vector<double>{500, 2000}));
+  EXPECT_EQ(c.circle->radii_mm, (std::vector<double>{100, 150}));
+  EXPECT_EQ(c.circle->partial_arc_deg, 200);
+  EXPECT_EQ(c.circle->partial_overshoot_deg, 5);
+  EXPECT_EQ(c.circle->bar, "QC20-1234");
+  EXPECT_NE(error_of("[test.circle]\nplanes = [\"XY\", \"XZ\"]\n")
+                .find("each plane is \"XY\", \"ZX\" or \"YZ\""),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nplanes = [\"XY\", \"XY\"]\n").find("plane XY given twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nplane = \"XY\"\nplanes = [\"XY\"]\n").find("not both"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nfeeds_mm_per_min = [500, -1]\n").find("-1 must be > 0"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\npartial_arc_deg = 170\n").find("170 must be 180..360"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nradii_mm = [100, 150]\ncalibrated_radius_mm = 100.001\n")
+                .find("one calibrated length cannot serve several radii"),
+            std::string::npos);
+}
+
 }  // namespace

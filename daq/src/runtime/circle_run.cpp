@@ -48,7 +48,9 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                                .radius_calibrated = !analysis.uncalibrated,
                                .calibrated_radius_mm = analysis.calibrated_radius_mm,
                                .sample_rate_hz = program.sample_rate_hz,
-                               .start_deg = program.start_deg},
+                               .start_deg = program.start_deg,
+                               .arc_deg = program.arc_deg,
+                               .overshoot_deg = program.overshoot_deg},
                               traces);
 }
 
@@ -76,6 +78,7 @@ json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalys
          {"dwell_s", p.dwell_s},
          {"overshoot_deg", p.overshoot_deg},
          {"start_deg", p.start_deg},
+         {"arc_deg", p.arc_deg},
          {"plane", a.plane},
          {"uncalibrated", a.uncalibrated},
          {"standard", a.standard}};
@@ -91,7 +94,8 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(c
                              .feed_in_mm = j.at("feed_in_mm"),
                              .dwell_s = j.at("dwell_s"),
                              .overshoot_deg = j.at("overshoot_deg"),
-                             .start_deg = j.value("start_deg", 0.0)};
+                             .start_deg = j.value("start_deg", 0.0),
+                             .arc_deg = j.value("arc_deg", 360.0)};
   // Runs stored before issue 18 have no standard: they were evaluated by ISO 230-4:2005.
   BallbarAnalysis a{.plane = j.value("plane", std::string("XY")),
                     .uncalibrated = j.value("uncalibrated", false),
@@ -101,16 +105,52 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(c
   return {p, a};
 }
 
-std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c) {
+std::vector<CircleTest> circle_tests(const cal::daq::Config& c, bool standard_set) {
   if (!c.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", c.source.string()));
   const auto& t = *c.circle;
-  BallbarAnalysis a{.plane = t.plane, .standard = t.standard};
-  if (t.calibrated_radius_mm > 0) a.calibrated_radius_mm = t.calibrated_radius_mm;
-  return {cal::daq::BallbarProgram{.radius_mm = t.radius_mm,
-                                   .feed_mm_per_min = t.feed_mm_per_min,
-                                   .sample_rate_hz = t.sample_rate_hz,
-                                   .overshoot_deg = t.overshoot_deg},
-          a};
+  cal::daq::BallbarSetConfig set{
+      .feeds_mm_per_min =
+          t.feeds_mm_per_min.empty() ? std::vector<double>{t.feed_mm_per_min} : t.feeds_mm_per_min,
+      .radii_mm = t.radii_mm.empty() ? std::vector<double>{t.radius_mm} : t.radii_mm,
+      .partial_arc_deg = t.partial_arc_deg,
+      .overshoot_deg = t.overshoot_deg,
+      .partial_overshoot_deg = t.partial_overshoot_deg,
+      .sample_rate_hz = t.sample_rate_hz,
+      .feed_in_mm = t.feed_in_mm,
+      .dwell_s = t.dwell_s};
+  set.planes.clear();
+  if (!t.planes.empty())
+    for (const auto& p : t.planes) set.planes.push_back(cal::daq::plane_from_string(p));
+  else if (standard_set)
+    set.planes = {cal::daq::Plane::xy, cal::daq::Plane::zx, cal::daq::Plane::yz};
+  const bool single = set.planes.empty();
+  if (single) {
+    // One full circle in `plane`, as before sets existed (also in ZX and YZ: the operator's
+    // choice, e.g. on a machine where the spindle allows it).
+    set.planes = {cal::daq::plane_from_string(t.plane)};
+    set.partial_arc_deg = 360.0;
+  }
+  std::vector<CircleTest> out;
+  for (const auto& s : cal::daq::ballbar_set(set)) {
+    BallbarAnalysis a{.plane = cal::daq::plane_name(s.plane), .standard = t.standard};
+    if (t.calibrated_radius_mm > 0) a.calibrated_radius_mm = t.calibrated_radius_mm;
+    out.push_back({s.plane, s.program, a});
+  }
+  return out;
+}
+
+cal::daq::CircleProgramSetup circle_program_setup(const cal::daq::Config& c) {
+  if (!c.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", c.source.string()));
+  const auto& t = *c.circle;
+  return {.centre_x_mm = t.centre_mm[0],
+          .centre_y_mm = t.centre_mm[1],
+          .centre_z_mm = t.centre_mm[2],
+          .plane = cal::daq::plane_from_string(t.plane)};
+}
+
+std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c) {
+  const auto tests = circle_tests(c);
+  return {tests.front().program, tests.front().analysis};
 }
 
 std::string to_json_text(const CircleLive& s) {

@@ -13,6 +13,7 @@
 #include "cal/analysis/circle.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/daq/config.hpp"
+#include "cal/daq/gcode.hpp"
 #include "cal/drivers/instrument.hpp"
 
 namespace boost::asio {
@@ -53,8 +54,21 @@ nlohmann::json circle_settings_json(const cal::daq::BallbarProgram& p, const Bal
 std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(
     const nlohmann::json& j);
 
-// The ballbar program and analysis of a configuration's [test.circle] (the same program that
-// `daq gcode circle` writes: feed-in and dwell at their defaults).
+// One test of a configuration's [test.circle]: its plane, program and analysis.
+struct CircleTest {
+  cal::daq::Plane plane = cal::daq::Plane::xy;
+  cal::daq::BallbarProgram program;
+  BallbarAnalysis analysis;
+};
+// Every test of [test.circle] in the order of its program: one for a single test (`plane`), the
+// set for `planes` (each plane at each feed, for each radius: cal::daq::ballbar_set); with
+// `standard_set`, the set of XY, ZX, YZ even for a single-test configuration. The same programs
+// `daq gcode circle` writes.
+std::vector<CircleTest> circle_tests(const cal::daq::Config& c, bool standard_set = false);
+// The centre (the table ball) and plane of the configuration, for the part program.
+cal::daq::CircleProgramSetup circle_program_setup(const cal::daq::Config& c);
+
+// The ballbar program and analysis of a configuration's single [test.circle] (its first test).
 std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c);
 
 // The live state of a circle run for the operator's display (about 10 Hz).

@@ -250,6 +250,49 @@ CircleTestConfig read_circle(Table& t) {
     c.centre_mm = centre;
   }
   t.read("calibrated_radius_mm", c.calibrated_radius_mm);
+  if (c.calibrated_radius_mm < 0 || !std::isfinite(c.calibrated_radius_mm))
+    t.fail(t.node("calibrated_radius_mm"), "calibrated_radius_mm",
+           fmt::format("{} must be > 0 (or 0: not given)", c.calibrated_radius_mm));
+  if (const auto* n = t.node("planes")) {
+    t.known("planes");
+    const auto* arr = n->as_array();
+    if (!arr || arr->empty())
+      t.fail(n, "planes", "expected an array of planes, e.g. [\"XY\", \"ZX\", \"YZ\"]");
+    for (const auto& e : *arr) {
+      const auto v = e.value<std::string>();
+      if (!v || (*v != "XY" && *v != "ZX" && *v != "YZ"))
+        t.fail(&e, "planes", "each plane is \"XY\", \"ZX\" or \"YZ\" (G17, G18, G19)");
+      if (std::find(c.planes.begin(), c.planes.end(), *v) != c.planes.end())
+        t.fail(&e, "planes", fmt::format("plane {} given twice", *v));
+      c.planes.push_back(*v);
+    }
+  }
+  for (const char* key : {"feeds_mm_per_min", "radii_mm"}) {
+    auto values = t.numbers(key);
+    for (double v : values)
+      if (!(v > 0) || !std::isfinite(v)) t.fail(t.node(key), key, fmt::format("{} must be > 0", v));
+    (std::string_view(key) == "radii_mm" ? c.radii_mm : c.feeds_mm_per_min) = std::move(values);
+  }
+  t.read("partial_arc_deg", c.partial_arc_deg);
+  if (!(c.partial_arc_deg >= 180 && c.partial_arc_deg <= 360))
+    t.fail(t.node("partial_arc_deg"), "partial_arc_deg",
+           fmt::format("{} must be 180..360", c.partial_arc_deg));
+  t.read("partial_overshoot_deg", c.partial_overshoot_deg);
+  if (!(c.partial_overshoot_deg >= 0 && c.partial_overshoot_deg <= 45))
+    t.fail(t.node("partial_overshoot_deg"), "partial_overshoot_deg",
+           fmt::format("{} must be 0..45", c.partial_overshoot_deg));
+  if (!(c.overshoot_deg >= 0 && c.overshoot_deg <= 180))
+    t.fail(t.node("overshoot_deg"), "overshoot_deg",
+           fmt::format("{} must be 0..180", c.overshoot_deg));
+  t.positive("feed_in_mm", c.feed_in_mm);
+  t.positive("dwell_s", c.dwell_s);
+  t.read("bar", c.bar);
+  if (!c.planes.empty() && t.node("plane"))
+    t.fail(t.node("plane"), "plane", "give plane (one test) or planes (a set), not both");
+  if (c.radii_mm.size() > 1 && c.calibrated_radius_mm > 0)
+    t.fail(t.node("calibrated_radius_mm"), "calibrated_radius_mm",
+           "one calibrated length cannot serve several radii: store a calibration per bar and "
+           "radius (daq ballbar calibrate) and name the bar");
   t.read("standard", c.standard);
   try {
     cal::circle::circular_standard_from_key(c.standard);
