@@ -188,6 +188,9 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
     const auto traces = read_traces(*o);
     auto setup = o->setup();
     if (o->has_lengths) setup.calibrated_radius_mm.reset();  // lengths are absolute
+    // The radius error needs the bar's absolute length: absolute lengths in the file, or the
+    // calibrated length given; otherwise only changes of length are known.
+    setup.radius_calibrated = !o->uncalibrated && (o->has_lengths || o->calibrated_radius_mm);
     const auto r = ci::analyse(setup, traces);
     if (o->json) return fmt::print("{}\n", to_json(r, *o).dump(2));
     print(r, *o);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
+#include <chrono>
 #include <filesystem>
 
 #include "cal/analysis/error.hpp"
@@ -49,6 +50,7 @@ struct ReplaySession {
   // (customer, instruments, tolerances) the replay keeps, as the capture header lacks it.
   std::optional<std::int64_t> original_run;
   std::string original_context;
+  json original_settings;
   void find_original(const ReplayOptions& o) {
     const auto capture = std::filesystem::absolute(o.capture).string();
     cal::storage::Store store(database_path(o.db));
@@ -56,6 +58,7 @@ struct ReplaySession {
       if (r.capture_path != capture) continue;
       original_run = r.id;
       const json settings = json::parse(r.settings_json, nullptr, false);
+      original_settings = settings;
       if (settings.is_object() && settings.contains("context"))
         original_context = settings["context"].dump();
       return;
@@ -90,7 +93,27 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                                [](const auto& x) { return x.role == "ballbar"; });
   if (it == s.specs.end())
     throw cal::InputError(fmt::format("{}: the session has no ballbar instrument", o.capture));
-  const auto [program, analysis] = circle_test(s.config);
+  auto [program, analysis] = circle_test(s.config);
+  // The bar calibration the original run used, not whatever is newest now.
+  if (s.original_settings.is_object() && s.original_settings.contains("radius_mm")) {
+    const auto original = circle_settings_from_json(s.original_settings).second;
+    analysis.calibrated_radius_mm = original.calibrated_radius_mm;
+    analysis.uncalibrated = original.uncalibrated;
+    analysis.calibration_source = original.calibration_source;
+    analysis.calibration = original.calibration;
+    analysis.uncalibrated_reason = original.uncalibrated_reason;
+    if (analysis.calibration_source.empty() && !analysis.uncalibrated &&
+        analysis.calibrated_radius_mm)  // stored before issue 18
+      analysis.calibration_source = "configuration";
+  } else {
+    // No original run in this store: the capture header holds no wall-clock start, so the
+    // bar's calibration is the newest one now (docs/circle.md, "Bar calibration"). Resolved
+    // here so that the printed result says what the stored run used.
+    cal::storage::Store store(database_path(o.db));
+    const auto now = std::chrono::system_clock::now().time_since_epoch();
+    resolve_calibration(analysis, s.config, program.radius_mm, store,
+                        std::chrono::duration_cast<std::chrono::milliseconds>(now).count());
+  }
   CircleRunSetup setup{.config = s.config,
                        .program = program,
                        .analysis = analysis,

@@ -92,6 +92,7 @@ feed_mm_per_min = 1000
 sample_rate_hz = 1000
 overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
+calibrated_radius_mm = {radius}  # the simulated bar's exact length (simulation)
 )TOML",
       fmt::arg("position",
                position_feed

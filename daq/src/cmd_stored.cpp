@@ -51,9 +51,18 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   if (settings.is_discarded() || !settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("run {}: its circle settings are missing", o.run));
   auto [program, analysis] = circle_settings_from_json(settings);
-  if (o.calibrated_radius_mm) analysis.calibrated_radius_mm = o.calibrated_radius_mm;
+  if (o.calibrated_radius_mm) {
+    analysis.calibrated_radius_mm = o.calibrated_radius_mm;
+    analysis.uncalibrated = false;
+    analysis.calibration_source = "option";
+    analysis.calibration.reset();
+    analysis.uncalibrated_reason.clear();
+  }
   if (o.cyclic_period_mm) analysis.cyclic_period_mm = o.cyclic_period_mm;
-  if (o.uncalibrated) analysis.uncalibrated = true;
+  if (o.uncalibrated) {
+    analysis.uncalibrated = true;
+    analysis.uncalibrated_reason = "daq analyse --uncalibrated";
+  }
   if (!o.standard.empty()) {
     cal::circle::circular_standard_from_key(o.standard);  // refused here if unknown
     analysis.standard = o.standard;

@@ -51,6 +51,8 @@ check time_json 0 '"g_reduction_um"' -- "$DAQ" "${T[@]}" --json
 # The bar read 0 at 50.002 mm: every deviation is 2 um more than it says (radius error +2; the
 # backlash step sampled every 0.25 degrees moves the constant term by up to 0.01 um).
 check calibrated 0 "Radius error +\+(1\.99|2\.00)[0-9]* um" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10 --calibrated-radius-mm 50.002
+check no_calibration_no_radius 0 "note: uncalibrated bar: the radius error is fitted but not reported" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --cyclic-period-mm 10
+check lengths_are_absolute 0 "Radius error" -- "$DAQ" "${T[@]}"
 check too_much_overshoot 2 "keeps 0 samples after trimming the 500 degree overshoot" -- "$DAQ" analyse circle -i "$DATA/model_time.csv" -R 50 --overshoot-deg 500
 check bad_plane 2 "plane 'XZ' \(expected XY, YZ or ZX\)" -- "$DAQ" analyse circle -i "$DATA/model.csv" -R 50 --plane XZ
 finish

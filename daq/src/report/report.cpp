@@ -835,6 +835,48 @@ PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_
   return p;
 }
 
+// Where the absolute radius came from: the stored calibration (bar, calibrator, reading, date,
+// its age at the test), a length given in the configuration or on the command line, or none:
+// then the radius error is not evaluated and F is relative to the bar's assumed length.
+std::string bar_calibration_section(const Circle& c, const RunView& v) {
+  const auto& a = c.analysis;
+  std::string h = "<h3>Bar calibration</h3>\n";
+  if (a.uncalibrated || !a.calibrated_radius_mm)
+    return h + fmt::format(
+                   "<p class=\"warning\"><strong>The radius error is not evaluated</strong>: {}. "
+                   "G, the diagnostics and the squareness do not need the bar's absolute length; "
+                   "F max and F min are deviations from the bar's assumed length, not from an "
+                   "absolute radius.</p>\n",
+                   esc(a.uncalibrated_reason.empty() ? std::string("the bar was not calibrated")
+                                                     : a.uncalibrated_reason));
+  if (!a.calibration)
+    return h + fmt::format(
+                   "<p>The bar's calibrated length {:.4f} mm (it reads 0 at that length) was "
+                   "given {}: no calibration record (calibrator, date) is stored with it.</p>\n",
+                   *a.calibrated_radius_mm,
+                   a.calibration_source == "option" ? "on the command line (daq analyse "
+                                                      "--calibrated-radius-mm)"
+                                                    : "in the configuration");
+  const auto& k = *a.calibration;
+  const double age_days =
+      static_cast<double>(v.run.started_unix_ms - k.calibrated_unix_ms) / 86'400'000.0;
+  const std::vector<std::vector<std::string>> rows = {
+      {"bar", esc(k.bar) + (k.extensions.empty() ? "" : " with " + esc(k.extensions))},
+      {"nominal length", fmt::format("{:.3f} mm", k.nominal_mm)},
+      {"calibrator", (k.calibrator.empty() ? std::string("not stated") : esc(k.calibrator)) +
+                         fmt::format(", {:.4f} mm", k.calibrator_length_mm)},
+      {"reading in the calibrator", fmt::format("{:+.4f} mm", k.reading_mm)},
+      {"calibrated length (reads 0 at)", fmt::format("{:.4f} mm", k.zero_length_mm)},
+      {"temperature", k.temperature_degc ? fmt::format("{:.2f} °C (recorded, not corrected for)",
+                                                       *k.temperature_degc)
+                                         : std::string("not recorded")},
+      {"date", fmt::format("{} ({:.0f} days before the test)", iso_time(k.calibrated_unix_ms),
+                           std::max(0.0, age_days))},
+      {"record", fmt::format("calibration {} (daq ballbar calibrations)", k.id)}};
+  return h + "<p>The absolute radius (the radius error, F) uses this stored calibration:</p>\n" +
+         table({"", ""}, rows, "kv");
+}
+
 // The values of the run's circular standard, as (key, symbol, value).
 std::vector<std::tuple<std::string, std::string, double>> standard_values(const Circle& c) {
   std::vector<std::tuple<std::string, std::string, double>> out;
@@ -912,17 +954,13 @@ std::string circle_section(const st::Store& store, const RunView& v, const Optio
       "magnitude of the value, in its unit.</p>\n",
       r.iso.G_bi_um);
   for (const auto& n : r.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+  h += bar_calibration_section(c, v);
   h += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>The error model leaves a residual of {:.3f} µm rms "
-      "(noise and what the model does not describe). The ballbar's calibration (its "
-      "calibrated length and transducer certificate) is not recorded with the run, so an "
-      "expanded uncertainty of G is not evaluated here; {}.</p>\n",
-      r.residual_rms_um,
-      c.analysis.calibrated_radius_mm ? fmt::format("the calibrated length {:.4f} mm was used",
-                                                    *c.analysis.calibrated_radius_mm)
-      : c.analysis.uncalibrated
-          ? "the radius was not calibrated: F and the radius error are not valid"
-          : "the nominal radius was taken as the bar length");
+      "(noise and what the model does not describe). The transducer's own certificate and the "
+      "calibrator's uncertainty are not recorded with the run, so an expanded uncertainty of G "
+      "is not evaluated here.</p>\n",
+      r.residual_rms_um);
   return h;
 }
 

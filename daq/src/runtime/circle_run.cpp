@@ -54,10 +54,88 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                               traces);
 }
 
+namespace {
+
+json calibration_json(const cal::storage::BarCalibration& c) {
+  json j{{"id", c.id},
+         {"bar", c.bar},
+         {"nominal_mm", c.nominal_mm},
+         {"extensions", c.extensions},
+         {"calibrator", c.calibrator},
+         {"calibrator_length_mm", c.calibrator_length_mm},
+         {"reading_mm", c.reading_mm},
+         {"zero_length_mm", c.zero_length_mm},
+         {"calibrated_unix_ms", c.calibrated_unix_ms},
+         {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
+         {"note", c.note}};
+  j["temperature_degc"] = c.temperature_degc ? json(*c.temperature_degc) : json(nullptr);
+  return j;
+}
+
+cal::storage::BarCalibration calibration_from_json(const json& j) {
+  cal::storage::BarCalibration c{
+      .id = j.value("id", std::int64_t{0}),
+      .bar = j.value("bar", std::string()),
+      .nominal_mm = j.value("nominal_mm", 0.0),
+      .extensions = j.value("extensions", std::string()),
+      .calibrator = j.value("calibrator", std::string()),
+      .calibrator_length_mm = j.value("calibrator_length_mm", 0.0),
+      .reading_mm = j.value("reading_mm", 0.0),
+      .zero_length_mm = j.value("zero_length_mm", 0.0),
+      .calibrated_unix_ms = j.value("calibrated_unix_ms", std::int64_t{0}),
+      .note = j.value("note", std::string())};
+  if (j.contains("temperature_degc") && j["temperature_degc"].is_number())
+    c.temperature_degc = j["temperature_degc"].get<double>();
+  return c;
+}
+
+// What the result says about the absolute radius (the "calibration" block of caldaq.circle.v2).
+json calibration_block(const BallbarAnalysis& a) {
+  if (a.uncalibrated || !a.calibrated_radius_mm)
+    return {{"evaluated", false},
+            {"reason", a.uncalibrated_reason.empty() ? std::string("the bar was not calibrated")
+                                                     : a.uncalibrated_reason}};
+  json j{{"evaluated", true},
+         {"source",
+          a.calibration_source.empty() ? std::string("configuration") : a.calibration_source},
+         {"zero_length_mm", *a.calibrated_radius_mm}};
+  if (a.calibration) j["record"] = calibration_json(*a.calibration);
+  return j;
+}
+
+}  // namespace
+
+void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double radius_mm,
+                         const cal::storage::Store& store, std::int64_t at_unix_ms) {
+  if (a.uncalibrated || !a.calibration_source.empty()) return;
+  if (a.calibrated_radius_mm) {
+    a.calibration_source = "configuration";
+    return;
+  }
+  const std::string bar = c.circle ? c.circle->bar : std::string();
+  if (bar.empty()) {
+    a.uncalibrated = true;
+    a.uncalibrated_reason =
+        "no bar is named ([test.circle] bar) and no calibrated_radius_mm is given";
+    return;
+  }
+  if (auto cal = store.bar_calibration(bar, radius_mm, at_unix_ms)) {
+    a.calibrated_radius_mm = cal->zero_length_mm;
+    a.calibration_source = "stored";
+    a.calibration = std::move(cal);
+    return;
+  }
+  a.uncalibrated = true;
+  a.uncalibrated_reason = fmt::format(
+      "no calibration of bar '{}' at {:g} mm is stored (daq ballbar calibrate)", bar, radius_mm);
+}
+
 json circle_document(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
                      const BallbarAnalysis& analysis) {
-  return circle_json(r, program.radius_mm, analysis.plane, program.feed_mm_per_min,
-                     cal::circle::circular_standard_from_key(analysis.standard));
+  json j = circle_json(r, program.radius_mm, analysis.plane, program.feed_mm_per_min,
+                       cal::circle::circular_standard_from_key(analysis.standard));
+  j["calibration"] = calibration_block(analysis);
+  return j;
 }
 
 void print_circle_result(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
@@ -82,6 +160,9 @@ json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalys
          {"plane", a.plane},
          {"uncalibrated", a.uncalibrated},
          {"standard", a.standard}};
+  if (!a.calibration_source.empty()) j["calibration_source"] = a.calibration_source;
+  if (a.calibration) j["calibration"] = calibration_json(*a.calibration);
+  if (!a.uncalibrated_reason.empty()) j["uncalibrated_reason"] = a.uncalibrated_reason;
   if (a.calibrated_radius_mm) j["calibrated_radius_mm"] = *a.calibrated_radius_mm;
   if (a.cyclic_period_mm) j["cyclic_period_mm"] = *a.cyclic_period_mm;
   return j;
@@ -101,6 +182,21 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(c
                     .uncalibrated = j.value("uncalibrated", false),
                     .standard = j.value("standard", std::string("iso230-4:2005"))};
   if (j.contains("calibrated_radius_mm")) a.calibrated_radius_mm = j["calibrated_radius_mm"];
+  a.calibration_source = j.value("calibration_source", std::string());
+  if (j.contains("calibration") && j["calibration"].is_object())
+    a.calibration = calibration_from_json(j["calibration"]);
+  a.uncalibrated_reason = j.value("uncalibrated_reason", std::string());
+  // Runs stored before bar calibrations were recorded (issue 18): a length given in the
+  // configuration counts as such; none means the nominal was assumed, which is no calibration.
+  if (a.calibration_source.empty() && !a.uncalibrated) {
+    if (a.calibrated_radius_mm) {
+      a.calibration_source = "configuration";
+    } else {
+      a.uncalibrated = true;
+      a.uncalibrated_reason =
+          "stored without a calibrated length (the nominal was assumed): not a calibration";
+    }
+  }
   if (j.contains("cyclic_period_mm")) a.cyclic_period_mm = j["cyclic_period_mm"];
   return {p, a};
 }
@@ -184,6 +280,12 @@ struct CircleRun::Impl {
 
   void start() {
     store.emplace(setup.database);
+    resolve_calibration(setup.analysis, setup.config, setup.program.radius_mm, *store,
+                        setup.calibration_at_unix_ms
+                            ? setup.calibration_at_unix_ms
+                            : std::chrono::duration_cast<std::chrono::milliseconds>(
+                                  std::chrono::system_clock::now().time_since_epoch())
+                                  .count());
     const auto& c = setup.config;
     std::int64_t machine = 0;
     if (auto m = store->machine_by_name(c.machine_name))

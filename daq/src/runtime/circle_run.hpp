@@ -15,6 +15,7 @@
 #include "cal/daq/config.hpp"
 #include "cal/daq/gcode.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -29,7 +30,22 @@ struct BallbarAnalysis {
   std::optional<double> cyclic_period_mm;      // unset: searched
   bool uncalibrated = false;                   // no calibrator: no radius error
   std::string standard = "iso230-4:2005";      // cal::circle::circular_standard_from_key
+  // Where calibrated_radius_mm came from (docs/circle.md, "Bar calibration"): "stored" (a
+  // calibration of the bar in the run store, `calibration`), "configuration"
+  // (calibrated_radius_mm in [test.circle]), "option" (daq analyse RUN --calibrated-radius-mm);
+  // empty with `uncalibrated` and the reason.
+  std::string calibration_source;
+  std::optional<cal::storage::BarCalibration> calibration;
+  std::string uncalibrated_reason;
 };
+
+// Where a test's absolute radius comes from, once, when its run starts: the configuration's
+// calibrated_radius_mm; else the newest stored calibration of the configuration's bar at the
+// test's radius made at or before `at_unix_ms`; else none, and the analysis is uncalibrated
+// with the reason (the radius error is then not evaluated). An analysis already decided (a
+// length or uncalibrated set) is left as it is.
+void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double radius_mm,
+                         const cal::storage::Store& store, std::int64_t at_unix_ms);
 
 // The ISO 230-4 result and diagnostics of a ballbar stream (one deviation per sample, in mm
 // from the calibrated length, from before the feed-in): segmentation by the program's timing,
@@ -96,6 +112,9 @@ struct CircleRunSetup {
   std::string context_json;
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
+  // The time the bar's calibration is looked up at (unix ms; 0: now). A replay decides the
+  // calibration before (the original run's, or the newest), so that this lookup does nothing.
+  std::int64_t calibration_at_unix_ms = 0;
   std::function<void(const std::string&)> on_event;
   std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading
