@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "cal/analysis/error.hpp"
@@ -12,13 +13,43 @@
 namespace cal::comptable {
 namespace {
 
+// What a controller table can hold (see comp_table.hpp): an axis name of letters and digits
+// (it is written into the table's text), a grid within +-100 m, at most max_points points, a
+// resolution of 0 (none) or 1e-9 .. 1 in the table's units.
 void validate(const Spec& s) {
-  if (!(s.interval_mm > 0) || !std::isfinite(s.interval_mm))
-    throw InputError(fmt::format("compensation table: interval {} mm must be > 0", s.interval_mm));
-  if (s.points < 2)
-    throw InputError(fmt::format("compensation table: {} points, at least 2", s.points));
-  if (!(s.resolution >= 0))
-    throw InputError(fmt::format("compensation table: resolution {} must be >= 0", s.resolution));
+  const bool axis_ok =
+      !s.axis.empty() && s.axis.size() <= 8 &&
+      std::isalpha(static_cast<unsigned char>(s.axis[0])) &&
+      std::all_of(s.axis.begin(), s.axis.end(), [](unsigned char c) { return std::isalnum(c); });
+  if (!axis_ok)
+    throw InputError(fmt::format(
+        "compensation table: axis name '{}': letters and digits only, a letter first, at most 8",
+        s.axis));
+  if (!(s.interval_mm > 0) || !(s.interval_mm <= max_position_mm))
+    throw InputError(fmt::format("compensation table: interval {} mm must be > 0 and at most {}",
+                                 s.interval_mm, max_position_mm));
+  if (s.points < 2 || s.points > max_points)
+    throw InputError(
+        fmt::format("compensation table: {} points, expected 2 .. {}", s.points, max_points));
+  const double end_mm = s.start_mm + (s.points - 1) * s.interval_mm;
+  if (!(std::abs(s.start_mm) <= max_position_mm) || !(std::abs(end_mm) <= max_position_mm))
+    throw InputError(fmt::format("compensation table: the grid {} .. {} mm must lie within +-{} mm",
+                                 s.start_mm, end_mm, max_position_mm));
+  if (!(s.resolution == 0 || (s.resolution >= 1e-9 && s.resolution <= 1)))
+    throw InputError(fmt::format(
+        "compensation table: resolution {} must be 0 (none) or within 1e-9 .. 1", s.resolution));
+}
+
+// The last guard before a writer: every number finite (an inf from an absurd input never
+// reaches a controller).
+void check_finite(const Table& t) {
+  auto bad = [](const std::vector<double>& v) {
+    return std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); });
+  };
+  if (bad(t.position_mm) || bad(t.forward) || bad(t.reverse) || !std::isfinite(t.backlash))
+    throw InputError(
+        "compensation table: a value is not a finite number; nothing is written (check the "
+        "input's units and the resolution)");
 }
 
 double to_units(double um, Units u) {
@@ -156,6 +187,8 @@ int decimals(const Spec& s) {
 }  // namespace
 
 std::string write_csv(const Table& t) {
+  validate(t.spec);
+  check_finite(t);
   const int d = decimals(t.spec);
   std::string out = fmt::format(
       "# caldaq compensation table: axis {}, {} values in {}, {}, {}\n", t.spec.axis,
@@ -190,6 +223,8 @@ std::string write_linuxcnc(const Table& t) {
     throw InputError(
         "LinuxCNC compensation files hold absolute corrections: use --sign correction, no "
         "--incremental");
+  validate(t.spec);
+  check_finite(t);
   const int d = decimals(t.spec);
   std::string out;
   for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
@@ -212,6 +247,10 @@ std::string write_siemens(const Table& t, int axis_number) {
     throw InputError("SINUMERIK LEC tables hold absolute values: no --incremental");
   if (t.spec.bidirectional)
     throw InputError("one SINUMERIK LEC table per measuring system: use a table plus backlash");
+  validate(t.spec);
+  check_finite(t);
+  if (axis_number < 1 || axis_number > 99)
+    throw InputError(fmt::format("SINUMERIK axis number {}: expected 1 .. 99", axis_number));
   const int d = std::min(decimals(t.spec), 6);
   std::string out =
       fmt::format("; LEC for axis {} ({}), written by caldaq\n; backlash (MD32450) {:.{}f} mm\n",
@@ -233,6 +272,8 @@ std::string write_siemens(const Table& t, int axis_number) {
 // list only by number here (see docs/compensation-tables.md).
 std::string write_isg(const Table& t) {
   if (t.spec.incremental) throw InputError("ISG SSFK lists hold absolute values: no --incremental");
+  validate(t.spec);
+  check_finite(t);
   auto tenth_um = [&](double v) {  // table units -> 0.1 um
     const double um = t.spec.units == Units::mm     ? v * 1e3
                       : t.spec.units == Units::inch ? v * 25400.0

@@ -99,7 +99,11 @@ bool is_long_axis(double first_mm, double last_mm) { return last_mm - first_mm >
 
 int long_axis_target_count(double first_mm, double last_mm) {
   // A hair of slack so that 3000 mm gives 12 intervals of 250, not 13.
-  return static_cast<int>(std::ceil((last_mm - first_mm) / kLongAxisIntervalMm - 1e-9)) + 1;
+  const double intervals = std::ceil((last_mm - first_mm) / kLongAxisIntervalMm - 1e-9);
+  if (!(intervals < max_plan_targets))  // before the cast, which would overflow
+    throw InputError(fmt::format("targets: {} .. {} mm at {} mm intervals is more than {} targets",
+                                 first_mm, last_mm, kLongAxisIntervalMm, max_plan_targets));
+  return static_cast<int>(intervals) + 1;
 }
 
 std::vector<double> generate_targets(const TargetSpec& s) {
@@ -123,17 +127,28 @@ std::vector<double> generate_targets(const TargetSpec& s) {
     count = long_axis_target_count(s.first_mm, s.last_mm);
   } else if (s.count) {
     count = *s.count;
-    if (count < 2) throw InputError(fmt::format("targets: count = {} must be >= 2", count));
+    if (count < 2 || count > max_plan_targets)
+      throw InputError(
+          fmt::format("targets: count = {} must be in 2 .. {}", count, max_plan_targets));
   } else {
     const double iv = *s.interval_mm;
-    if (!(iv > 0)) throw InputError(fmt::format("targets: interval = {} mm must be > 0", iv));
+    if (!(iv > 0) || !std::isfinite(iv))
+      throw InputError(fmt::format("targets: interval = {} mm must be finite and > 0", iv));
     const double steps = length / iv;
+    if (!(steps < max_plan_targets))  // before the cast below, which would overflow
+      throw InputError(
+          fmt::format("targets: interval {} mm gives {:.0f} targets over {} .. {} mm, more than {}",
+                      iv, steps + 1, s.first_mm, s.last_mm, max_plan_targets));
     if (std::abs(steps - std::round(steps)) > 1e-6 * std::max(1.0, steps)) {
       throw InputError(fmt::format(
           "targets: interval {} mm does not divide the travel {} .. {} mm into whole steps", iv,
           s.first_mm, s.last_mm));
     }
     count = static_cast<int>(std::round(steps)) + 1;
+  }
+  if (!(s.round_to_mm >= 0) || !std::isfinite(s.round_to_mm)) {
+    throw InputError(
+        fmt::format("targets: rounding step {} mm must be finite and >= 0", s.round_to_mm));
   }
   if (!(s.random_fraction >= 0 && s.random_fraction < 0.5)) {
     throw InputError(
@@ -158,8 +173,9 @@ std::vector<double> generate_targets(const TargetSpec& s) {
 }
 
 Plan make_plan(const TargetSpec& ts, const CycleSpec& cs) {
-  if (cs.runs < 1) throw InputError(fmt::format("cycle: runs = {} must be >= 1", cs.runs));
-  if (!(cs.overrun_mm >= 0)) {
+  if (cs.runs < 1 || cs.runs > max_plan_runs)
+    throw InputError(fmt::format("cycle: runs = {} must be in 1 .. {}", cs.runs, max_plan_runs));
+  if (!(cs.overrun_mm >= 0) || !std::isfinite(cs.overrun_mm)) {
     throw InputError(fmt::format("cycle: over-run = {} mm must be >= 0", cs.overrun_mm));
   }
   if (cs.cycle == Cycle::pilgrim_step && !cs.bidirectional) {

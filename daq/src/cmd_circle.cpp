@@ -12,7 +12,9 @@
 #include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
 #include "circle_output.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
+#include "csv_table.hpp"
 
 namespace daq {
 namespace {
@@ -42,6 +44,7 @@ struct CircleOptions {
   bool uncalibrated = false;
   std::string standard = "iso230-4:2005";
   bool json = false;
+  CsvOptions csv;
   bool has_lengths = false;  // the CSV gives length_mm (set by read_traces)
 
   ci::Setup setup() const {
@@ -59,68 +62,33 @@ struct CircleOptions {
   }
 };
 
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) {
-    const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
-    out.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-  }
-  return out;
-}
-
 // Columns (docs/circle.md): direction (cw|ccw), angle_deg or time_s, deviation_um or length_mm.
 std::vector<ci::Trace> read_traces(CircleOptions& o) {
-  std::ifstream in(o.input);
-  if (!in) throw cal::InputError(fmt::format("{}: cannot open", o.input));
-  std::string line;
-  int n = 0;
-  std::map<std::string, std::size_t> col;
+  const auto csv = CsvTable::read(o.input, o.csv);
+  const bool angles = csv.has("angle_deg"), deviations = csv.has("deviation_um");
+  o.has_lengths = !deviations && csv.has("length_mm");
+  if (!csv.has("direction") || (!angles && !csv.has("time_s")) || (!deviations && !o.has_lengths))
+    throw cal::InputError(
+        fmt::format("{}:{}: the header needs direction, angle_deg or time_s, and "
+                    "deviation_um or length_mm",
+                    o.input, csv.header_line()));
   std::map<ci::Direction, ci::Trace> traces;
   std::map<ci::Direction, std::vector<double>> times;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty() || line[0] == '#') continue;
-    const auto cells = split_csv(line);
-    if (col.empty()) {
-      for (std::size_t i = 0; i < cells.size(); ++i) col[cells[i]] = i;
-      o.has_lengths = !col.count("deviation_um") && col.count("length_mm");
-      if (!col.count("direction") || (!col.count("angle_deg") && !col.count("time_s")) ||
-          (!col.count("deviation_um") && !col.count("length_mm")))
-        throw cal::InputError(
-            fmt::format("{}:{}: the header needs direction, angle_deg or time_s, and "
-                        "deviation_um or length_mm",
-                        o.input, n));
-      continue;
-    }
-    auto cell = [&](const char* name) -> double {
-      const auto& text = cells.at(col.at(name));
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || *end != '\0' || !std::isfinite(v))
-        throw cal::InputError(
-            fmt::format("{}:{}: column {}: '{}' is not a number", o.input, n, name, text));
-      return v;
-    };
-    if (cells.size() < col.size())
-      throw cal::InputError(
-          fmt::format("{}:{}: {} columns, {} expected", o.input, n, cells.size(), col.size()));
-    const auto& d = cells[col.at("direction")];
+  for (std::size_t row = 0; row < csv.rows(); ++row) {
+    const auto d = csv.text(row, "direction");
     if (d != "cw" && d != "ccw")
-      throw cal::InputError(
-          fmt::format("{}:{}: column direction: '{}' (expected cw or ccw)", o.input, n, d));
+      csv.fail(row, fmt::format("column direction: '{}' (expected cw or ccw)", d.substr(0, 40)));
     const auto dir = d == "cw" ? ci::Direction::cw : ci::Direction::ccw;
     auto& t = traces[dir];
     t.direction = dir;
-    if (col.count("angle_deg"))
-      t.angle_deg.push_back(cell("angle_deg"));
+    if (angles)
+      t.angle_deg.push_back(csv.number(row, "angle_deg"));
     else
-      times[dir].push_back(cell("time_s"));
+      times[dir].push_back(csv.number(row, "time_s"));
     // length_mm: the absolute bar length, so the deviation is from the nominal radius (and
     // --calibrated-radius-mm must not shift it again: read_traces' caller clears it).
-    t.deviation_um.push_back(col.count("deviation_um") ? cell("deviation_um")
-                                                       : (cell("length_mm") - o.radius_mm) * 1e3);
+    t.deviation_um.push_back(deviations ? csv.number(row, "deviation_um")
+                                        : (csv.number(row, "length_mm") - o.radius_mm) * 1e3);
   }
   if (traces.empty()) throw cal::InputError(fmt::format("{}: no data rows", o.input));
   std::vector<ci::Trace> out;
@@ -182,6 +150,7 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
                   "iso230-4:2005, gb/t17421.4-2016 (identical) or iso230-4:1996 (docs/circle.md, "
                   "\"Standards\")")
       ->capture_default_str();
+  add_decimal_comma_flag(*cmd, o->csv);
   cmd->add_flag("--json", o->json, "Print caldaq.circle.v2 JSON");
   cmd->callback([o] {
     ci::circular_standard_from_key(o->standard);  // an unknown standard before reading the file

@@ -11,6 +11,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "csv_columns.hpp"
 #include "database.hpp"
@@ -29,6 +30,7 @@ struct CompensateOptions {
   std::optional<double> resolution;  // unset: by unit (default_resolution)
   int points = 0, axis_number = 1, output_axis_number = 2;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
+  CsvOptions csv;
   ct::FanucOptions fanuc;
   std::optional<double> fanuc_reference_mm;  // default: --start-mm
 };
@@ -40,7 +42,7 @@ std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
 }
 
 std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o) {
-  if (!o.input.empty()) return read_measurements(o.input);
+  if (!o.input.empty()) return read_measurements(o.input, o.csv);
   cal::storage::Store store(database_path(o.db));
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
@@ -63,7 +65,7 @@ std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) 
   if (o.units != "mm" || o.incremental || o.sign != "correction")
     throw cal::InputError(
         "--straightness writes absolute corrections in mm: no --units, --incremental or --sign");
-  const auto csv = read_csv_columns(o.straightness, {"position_mm", "deviation_um"});
+  const auto csv = read_csv_columns(o.straightness, {"position_mm", "deviation_um"}, {}, o.csv);
   const ct::CrossAxisTable t =
       ct::from_straightness(o.axis, o.output_axis, spec, csv.numbers.at("position_mm"),
                             csv.numbers.at("deviation_um"), o.remove_slope);
@@ -206,6 +208,7 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   cmd->add_option("--fanuc-magnification", o->fanuc.magnification, "fanuc: parameter 3623")
       ->capture_default_str();
   cmd->add_option("-o,--output", o->output, "Write to a file instead of stdout");
+  add_decimal_comma_flag(*cmd, o->csv);
   cmd->add_flag("--json", o->json,
                 "Print caldaq.comp-table.v1 JSON (caldaq.cross-table.v1 with --straightness)");
   cmd->callback([o] { run(*o); });

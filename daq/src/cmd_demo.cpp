@@ -8,10 +8,12 @@
 
 #include <array>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <map>
 
+#include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instruments.hpp"
@@ -234,6 +236,12 @@ int run_demo(const DemoOptions& o) {
   cal::replay::CaptureWriter capture(o.capture,
                                      capture_header(config, specs, "daq 0.1.0 demo (simulated)"));
   cal::replay::CaptureRecorder recorder(capture);
+  LinearRun* running = nullptr;  // a capture that cannot be written aborts the run
+  recorder.on_failure([&io, &running](const std::string& e) {
+    boost::asio::post(io, [&running, e] {
+      if (running) running->stop("capture failed: " + e);
+    });
+  });
   const auto options = [&](std::string name, double poll_s) {
     return d::InstrumentOptions{.name = std::move(name),
                                 .poll_period = poll(poll_s),
@@ -269,6 +277,7 @@ int run_demo(const DemoOptions& o) {
       read[r.device] = true;
   };
   LinearRun run(io, std::move(setup));
+  running = &run;
   run.start();
   if (!shop.wait_until([&] { return read[0] && read[1] && read[2]; })) {
     run.stop("the simulated instruments did not all answer within 10 s");
@@ -277,17 +286,25 @@ int run_demo(const DemoOptions& o) {
   }
   shop.run_linear(run.plan(), config.linear->feed_mm_per_min, config.linear->dwell_s);
   // What is flushed survives a crash of this process.
-  shop.run_program([&] { return run.finished(); }, 20.0, [&] { capture.flush(); });
+  shop.run_program([&] { return run.finished(); }, 20.0, [&] { recorder.flush(); });
   if (!run.finished()) run.stop("the simulated program ended without all stops captured");
   if (tty) fmt::print("\r\033[K");
-  capture.close();
+  recorder.close();
+  running = nullptr;
   const auto& out = run.outcome();
   fmt::print("\nrun {} stored in {} ({} readings)\n", out.run_id,
              std::filesystem::absolute(o.db).string(), out.readings);
+  // A full disk (store or capture) is the user's to fix: status 2, the file named.
+  if (!out.complete &&
+      (out.reason.starts_with("storage failed") || out.reason.starts_with("capture failed")))
+    throw cal::InputError(fmt::format("run {} aborted: {}", out.run_id, out.reason));
   if (!out.complete) {
     fmt::print(stderr, "daq demo: the run did not complete: {}\n", out.reason);
     return 1;
   }
+  if (recorder.failure())
+    throw cal::InputError(fmt::format("run {} is complete and stored, but its capture failed: {}",
+                                      out.run_id, *recorder.failure()));
   if (!out.missed.empty()) {
     fmt::print("INCOMPLETE: {}; evaluated from the stops captured:\n", out.reason);
     for (const auto& m : out.missed)

@@ -12,6 +12,7 @@
 #include "cal/analysis/kinematics.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "csv_columns.hpp"
 #include "report/report.hpp"
@@ -21,10 +22,12 @@ namespace {
 
 using nlohmann::json;
 
-// Named numeric columns of a CSV with a header line (csv_columns.hpp).
+// Named numeric columns of a CSV with a header line (csv_columns.hpp, the strict reader).
 std::map<std::string, std::vector<double>> read_columns(const std::string& path,
-                                                        std::initializer_list<const char*> names) {
-  return read_csv_columns(path, std::vector<std::string>(names.begin(), names.end())).numbers;
+                                                        std::initializer_list<const char*> names,
+                                                        const CsvOptions& options) {
+  return read_csv_columns(path, std::vector<std::string>(names.begin(), names.end()), {}, options)
+      .numbers;
 }
 
 struct StraightnessOptions {
@@ -32,6 +35,7 @@ struct StraightnessOptions {
   std::string reference = "lsq";
   std::string report;
   bool json = false;
+  CsvOptions csv;
 };
 
 void write_report(const std::string& path, const std::string& html) {
@@ -42,7 +46,7 @@ void write_report(const std::string& path, const std::string& html) {
 }
 
 void run_straightness(const StraightnessOptions& o) {
-  auto cols = read_columns(o.input, {"position_mm", "deviation_um"});
+  auto cols = read_columns(o.input, {"position_mm", "deviation_um"}, o.csv);
   const auto ref = cal::straightness::reference_from_string(o.reference);
   const auto r = cal::straightness::evaluate(cols["position_mm"], cols["deviation_um"], ref);
   if (!o.report.empty())
@@ -77,6 +81,7 @@ struct SquarenessOptions {
   std::string report;
   std::string plane;  // XY, XZ or YZ: also give the model's location error
   bool json = false;
+  CsvOptions csv;
 };
 
 void run_squareness(const SquarenessOptions& o) {
@@ -85,8 +90,8 @@ void run_squareness(const SquarenessOptions& o) {
   if (o.method == "straightness") {
     if (o.along_a.empty() || o.along_b.empty())
       throw cal::InputError("squareness --method straightness needs --along-a and --along-b");
-    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"});
-    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"});
+    auto a = read_columns(o.along_a, {"position_mm", "deviation_um"}, o.csv);
+    auto b = read_columns(o.along_b, {"position_mm", "deviation_um"}, o.csv);
     r = cal::squareness::from_straightness({a["position_mm"], a["deviation_um"]},
                                            {b["position_mm"], b["deviation_um"]}, o.square_error);
     how = "two straightness runs (least-squares lines)";
@@ -103,7 +108,7 @@ void run_squareness(const SquarenessOptions& o) {
   } else if (o.method == "circle") {
     if (o.circle.empty() || !(o.radius_mm > 0))
       throw cal::InputError("squareness --method circle needs --circle FILE and --radius-mm");
-    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"});
+    auto c = read_columns(o.circle, {"angle_deg", "deviation_um"}, o.csv);
     const cal::squareness::CircleTrace t{c["angle_deg"], c["deviation_um"]};
     r = cal::squareness::from_circle(o.radius_mm, std::span(&t, 1));
     how = "circular test (sin 2t term)";
@@ -152,6 +157,7 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   st->add_option("-r,--reference", s->reference, "lsq, endpoint or minzone")->capture_default_str();
   st->add_option("--report", s->report,
                  "Also write an HTML report with the deviations and all three reference lines");
+  add_decimal_comma_flag(*st, s->csv);
   st->add_flag("--json", s->json, "Print caldaq.straightness.v1 JSON");
   st->callback([s] { run_straightness(*s); });
 
@@ -174,6 +180,7 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
   sq->add_option("--plane", q->plane,
                  "XY, XZ or YZ: also print the model's location error (E_C0Y, E_B0Z, E_A0Z; "
                  "E_B0Z has the opposite sign)");
+  add_decimal_comma_flag(*sq, q->csv);
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
   sq->callback([q] { run_squareness(*q); });
 }

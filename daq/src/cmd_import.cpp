@@ -20,16 +20,41 @@ using nlohmann::json;
 namespace st = cal::storage;
 
 struct ImportOptions {
-  std::string file, db, unit = "mm", axis, machine, campaign;
+  std::string file, db, unit, axis, machine, campaign;
   bool json = false;
 };
 
-double metres_per_unit(const std::string& unit) {
-  if (unit == "mm") return 1e-3;
-  if (unit == "um") return 1e-6;
-  if (unit == "m") return 1.0;
-  if (unit == "in") return 25.4e-3;
-  throw cal::InputError(fmt::format("--unit '{}' (expected mm, um, m or in)", unit));
+// What the samples are, from the header's File Type, and their unit from --unit (the .rtx
+// header does not state it): a linear capture is a displacement (default unit mm), an angular
+// one an angle (no default: the unit must be given).
+struct Interpretation {
+  cal::drivers::Quantity quantity;
+  std::string unit;    // as given or defaulted
+  double si_per_unit;  // metres or radians per unit
+  std::string si;      // "m" or "rad"
+};
+
+Interpretation interpret(cal::replay::RtxKind kind, const std::string& unit,
+                         const std::string& file) {
+  using Q = cal::drivers::Quantity;
+  constexpr double pi = 3.14159265358979323846;
+  if (kind == cal::replay::RtxKind::linear) {
+    const std::string u = unit.empty() ? "mm" : unit;
+    if (u == "mm") return {Q::displacement_m, u, 1e-3, "m"};
+    if (u == "um") return {Q::displacement_m, u, 1e-6, "m"};
+    if (u == "m") return {Q::displacement_m, u, 1.0, "m"};
+    if (u == "in") return {Q::displacement_m, u, 25.4e-3, "m"};
+    throw cal::InputError(
+        fmt::format("{}: a Linear capture: --unit '{}' (expected mm, um, m or in)", file, u));
+  }
+  if (unit == "arcsec") return {Q::angle_rad, unit, pi / (180.0 * 3600.0), "rad"};
+  if (unit == "urad" || unit == "um/m") return {Q::angle_rad, unit, 1e-6, "rad"};
+  if (unit == "mrad" || unit == "mm/m") return {Q::angle_rad, unit, 1e-3, "rad"};
+  if (unit == "deg") return {Q::angle_rad, unit, pi / 180.0, "rad"};
+  throw cal::InputError(fmt::format(
+      "{}: an Angular capture: give --unit arcsec, urad, um/m, mrad, mm/m or deg (the .rtx "
+      "header does not state the unit{})",
+      file, unit.empty() ? "" : fmt::format("; '{}' is not an angle unit", unit)));
 }
 
 struct ImportSummary {
@@ -39,7 +64,9 @@ struct ImportSummary {
 };
 
 // Streams the samples into the run in chunks: a 50 kHz capture of an hour is 180 M samples.
-void copy_samples(cal::replay::RtxReader& r, st::Store& store, double scale, ImportSummary& s) {
+void copy_samples(cal::replay::RtxReader& r, st::Store& store, const Interpretation& how,
+                  ImportSummary& s) {
+  const double scale = how.si_per_unit;
   const double rate = r.header().sample_rate_hz;
   std::vector<double> buf(1 << 16);
   std::vector<st::RawReading> rows;
@@ -52,7 +79,7 @@ void copy_samples(cal::replay::RtxReader& r, st::Store& store, double scale, Imp
       s.invalid += ok ? 0 : 1;
       rows.push_back(
           {.time_ns = std::llround(static_cast<double>(s.samples) * 1e9 / rate),
-           .quantity = static_cast<std::uint8_t>(cal::drivers::Quantity::displacement_m),
+           .quantity = static_cast<std::uint8_t>(how.quantity),
            .status = static_cast<std::uint8_t>(ok ? cal::drivers::ReadingStatus::ok
                                                   : cal::drivers::ReadingStatus::out_of_range),
            .value = ok ? v : 0.0});
@@ -62,9 +89,9 @@ void copy_samples(cal::replay::RtxReader& r, st::Store& store, double scale, Imp
 }
 
 void import_rtx(const ImportOptions& o) {
-  const double scale = metres_per_unit(o.unit);
   cal::replay::RtxReader reader(o.file);
   const auto& h = reader.header();
+  const Interpretation how = interpret(h.kind, o.unit, o.file);
   json header = json::object();
   for (const auto& [k, v] : h.fields) header[k] = v;
   const auto field = [&](const char* key) {
@@ -75,7 +102,7 @@ void import_rtx(const ImportOptions& o) {
   if (h.trailing_bytes)
     notes.push_back(
         fmt::format("the file ends inside a sample ({} bytes dropped)", h.trailing_bytes));
-  if (!h.eof_marker) notes.push_back("no EOF:: marker: the file may be truncated");
+  if (!h.eof_marker) notes.push_back("no end marker (\\r\\nEOF): the file may be truncated");
   if (h.declared_samples && *h.declared_samples != h.samples)
     notes.push_back(fmt::format("the header declares {} samples, the file holds {}",
                                 *h.declared_samples, h.samples));
@@ -92,8 +119,13 @@ void import_rtx(const ImportOptions& o) {
   const json settings{{"source", std::filesystem::absolute(o.file).string()},
                       {"format", "renishaw-rtx"},
                       {"sample_rate_hz", h.sample_rate_hz},
-                      {"unit", o.unit},
-                      {"unit_from", "the --unit option (the .rtx header does not state it)"},
+                      {"file_type", h.kind == cal::replay::RtxKind::linear ? "linear" : "angular"},
+                      {"quantity", cal::drivers::to_string(how.quantity)},
+                      {"unit", how.unit},
+                      {"unit_from", o.unit.empty() ? "the default of a linear capture (the .rtx "
+                                                     "header does not state it)"
+                                                   : "the --unit option (the .rtx header does "
+                                                     "not state it)"},
                       {"header", header},
                       {"notes", notes}};
   ImportSummary s;
@@ -110,7 +142,7 @@ void import_rtx(const ImportOptions& o) {
        .transport = "file " + o.file,
        .settings_json = json{{"serial", field("Serial No")}}.dump()});
   try {
-    copy_samples(reader, store, scale, s);
+    copy_samples(reader, store, how, s);
   } catch (const std::exception& e) {
     store.finish_run(s.run_id, st::RunStatus::incomplete, e.what());
     throw;
@@ -126,15 +158,23 @@ void import_rtx(const ImportOptions& o) {
            {"invalid", s.invalid},
            {"sample_rate_hz", h.sample_rate_hz},
            {"duration_s", static_cast<double>(s.samples) / h.sample_rate_hz},
+           {"quantity", cal::drivers::to_string(how.quantity)},
            {"notes", notes}};
-    if (s.samples > s.invalid) j["min_m"] = s.min_m, j["max_m"] = s.max_m;
+    if (s.samples > s.invalid) {
+      j[fmt::format("min_{}", how.si)] = s.min_m;
+      j[fmt::format("max_{}", how.si)] = s.max_m;
+    }
     return fmt::print("{}\n", j.dump(2));
   }
-  fmt::print("imported {} into run {}: {} samples at {} Hz ({:.3f} s), unit {} (from --unit)\n",
-             o.file, s.run_id, s.samples, h.sample_rate_hz,
-             static_cast<double>(s.samples) / h.sample_rate_hz, o.unit);
-  if (s.samples > s.invalid)
+  fmt::print("imported {} into run {}: {} {} samples at {} Hz ({:.3f} s), unit {}{}\n", o.file,
+             s.run_id, s.samples, h.kind == cal::replay::RtxKind::linear ? "linear" : "angular",
+             h.sample_rate_hz, static_cast<double>(s.samples) / h.sample_rate_hz, how.unit,
+             o.unit.empty() ? " (the default; the header does not state it)" : " (from --unit)");
+  if (s.samples > s.invalid && how.si == "m")
     fmt::print("  range {:.6f} .. {:.6f} mm\n", s.min_m * 1e3, s.max_m * 1e3);
+  else if (s.samples > s.invalid)
+    fmt::print("  range {:.3f} .. {:.3f} arcsec\n", s.min_m * 180 * 3600 / 3.14159265358979323846,
+               s.max_m * 180 * 3600 / 3.14159265358979323846);
   if (s.invalid)
     fmt::print("  {} samples are not finite numbers: stored as out of range\n", s.invalid);
   for (const auto& n : notes) fmt::print("  note: {}\n", n);
@@ -149,7 +189,9 @@ void add_import_commands(CLI::App& app) {
   auto* rtx = imp->add_subcommand("rtx", "Renishaw dynamic capture (.rtx) as a stored run");
   rtx->add_option("FILE", o->file, "The .rtx file")->required();
   add_db_option(*rtx, o->db);
-  rtx->add_option("--unit", o->unit, "Unit of the samples: mm, um, m or in")->capture_default_str();
+  rtx->add_option("--unit", o->unit,
+                  "Unit of the samples: mm (default), um, m or in for a Linear capture; arcsec, "
+                  "urad, um/m, mrad, mm/m or deg for an Angular one (required)");
   rtx->add_option("--axis", o->axis, "Axis name (default: the header's Axis)");
   rtx->add_option("--machine", o->machine, "Machine name (default: the header's Machine)");
   rtx->add_option("--campaign", o->campaign, "Campaign to file the run under");

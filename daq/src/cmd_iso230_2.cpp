@@ -8,6 +8,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/analysis/uncertainty.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "iso230_2_output.hpp"
 #include "measurement_csv.hpp"
@@ -18,12 +19,13 @@ namespace {
 struct AnalyseOptions {
   std::string input;
   std::string standard = "iso230-2:2014";
+  CsvOptions csv;
   bool json = false;
 };
 
 void run_analyse(const AnalyseOptions& o) {
   const auto standard = cal::iso230_2::standard_from_string(o.standard);
-  const auto data = read_measurements(o.input);
+  const auto data = read_measurements(o.input, o.csv);
   const auto e = cal::iso230_2::evaluate(data, standard);
   if (o.json) {
     auto j = to_json(e);
@@ -116,6 +118,7 @@ void add_analyse(CLI::App& analyse) {
                   "CSV with columns target_mm,run,direction,deviation_um (docs/cli.md)")
       ->required();
   cmd->add_option("-s,--standard", o->standard, standards_help())->capture_default_str();
+  add_decimal_comma_flag(*cmd, o->csv);
   cmd->add_flag("--json", o->json, "Print JSON (schema caldaq.iso230-2.v1)");
   cmd->callback([o] { run_analyse(*o); });
 }

@@ -71,22 +71,43 @@ struct ReplaySession {
     return make_instrument(io, spec, bus.transport(spec.device, spec.transport),
                            {.name = spec.role, .clock = bus.clock(), .replay = true});
   }
-  // Runs the bus until the run finishes or the capture ends; returns why it ended early.
+  // Runs the bus until the run finishes or the capture ends (an incomplete run is stopped
+  // with the reason), then reads the rest of the capture: how it ends, damaged or not.
   template <class Run>
-  void play(Run& run, const char* incomplete) {
+  cal::replay::ReplayEnd play(Run& run, const char* incomplete) {
     std::optional<cal::replay::ReplayEnd> end;
     bus.start([&](const cal::replay::ReplayEnd& e) { end = e; });
     while (!run.finished() && !end) io.run_for(50ms);
     // Readings the instruments still hold are delivered before the run is judged incomplete.
     if (!run.finished()) io.run_for(10ms);
-    if (run.finished()) return;
-    std::string why = incomplete;
-    if (end && end->damage)
-      why = fmt::format("the capture is damaged at byte {} (block {}): {}", end->damage->offset,
-                        end->damage->block, end->damage->what);
-    run.stop(why);
+    if (!run.finished()) {
+      std::string why = incomplete;
+      if (end && end->damage) why = "the capture is " + damage_text(*end->damage);
+      run.stop(why);
+    }
+    return end ? *end : bus.read_to_end();
+  }
+  static std::string damage_text(const cal::replay::Damage& d) {
+    return fmt::format("damaged at byte {} (block {}): {}", d.offset, d.block, d.what);
   }
 };
+
+// A complete run from a capture damaged further on: the results stand (printed), and the
+// damage is an error (status 2) so that no script takes the file for a sound one.
+void report_damage(const cal::replay::ReplayEnd& end, const ReplayOptions& o, std::int64_t run_id) {
+  if (!end.damage) return;
+  throw cal::InputError(
+      fmt::format("{}: the capture is {}; run {} was replayed from the {} records before it",
+                  o.capture, ReplaySession::damage_text(*end.damage), run_id, end.records));
+}
+
+json damage_json(const cal::replay::ReplayEnd& end) {
+  if (!end.damage) return nullptr;
+  return {{"offset", end.damage->offset},
+          {"block", end.damage->block},
+          {"what", end.damage->what},
+          {"records_replayed", end.records}};
+}
 
 void replay_circle(ReplaySession& s, const ReplayOptions& o) {
   const auto it = std::find_if(s.specs.begin(), s.specs.end(),
@@ -126,7 +147,7 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                        .replay_of_run = s.original_run};
   CircleRun run(s.io, std::move(setup));
   run.start();
-  s.play(run, "the capture ended before both arcs were recorded");
+  const auto end = s.play(run, "the capture ended before both arcs were recorded");
   const auto& out = run.outcome();
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
@@ -134,10 +155,13 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
   if (o.json) {
     json j = circle_document(*out.result, program, analysis);
     j["run_id"] = out.run_id;
-    return fmt::print("{}\n", j.dump(2));
+    j["capture_damage"] = damage_json(end);
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+    print_circle_result(*out.result, program, analysis);
   }
-  fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-  print_circle_result(*out.result, program, analysis);
+  report_damage(end, o, out.run_id);
 }
 
 void replay_linear(ReplaySession& s, const ReplayOptions& o) {
@@ -164,7 +188,7 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
         fmt::format("{}: the session has no laser or no air instrument", o.capture));
   LinearRun run(s.io, std::move(setup));
   run.start();
-  s.play(run, "the capture ended before every stop was captured");
+  const auto end = s.play(run, "the capture ended before every stop was captured");
   const auto& out = run.outcome();
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
@@ -173,12 +197,15 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
     json j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
     j["status"] = cal::storage::to_string(out.status);
-    return fmt::print("{}\n", j.dump(2));
+    j["capture_damage"] = damage_json(end);
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
+    if (!out.missed.empty())
+      fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
+    print(*out.evaluation);
   }
-  fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-  if (!out.missed.empty())
-    fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
-  print(*out.evaluation);
+  report_damage(end, o, out.run_id);
 }
 
 // A session is replayed as the test it recorded: a ballbar session as a circle, else linear.

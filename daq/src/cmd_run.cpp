@@ -5,6 +5,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/read_until.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/streambuf.hpp>
@@ -55,18 +56,27 @@ void watch_keyboard(boost::asio::io_context& io, std::function<void()> on_enter)
 }
 
 // Runs the event loop until the run ends (Ctrl-C or SIGTERM stop it as the operator's
-// abort), closes the capture, and throws with the reason if the run did not complete.
+// abort), closes the capture, and throws with the reason if the run did not complete. A
+// capture that cannot be written (a full disk) aborts the run, naming the file; what was
+// written before stays readable in both the store and the capture.
 template <class Run>
 const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& capture) {
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](auto ec, int) {
     if (!ec) run.stop("stopped by the operator");
   });
+  if (capture.recorder)  // posted: the failure is seen inside an instrument's handler
+    capture.recorder->on_failure([&io, &run](const std::string& e) {
+      boost::asio::post(io, [&run, e] { run.stop("capture failed: " + e); });
+    });
   while (!run.finished()) io.run_for(100ms);
-  if (capture.writer) capture.writer->close();
+  if (capture.recorder) capture.recorder->close();
   const auto& out = run.outcome();
   if (!out.complete)
-    throw cal::InputError(fmt::format("run {} stopped: {}", out.run_id, out.reason));
+    throw cal::InputError(fmt::format("run {} aborted: {}", out.run_id, out.reason));
+  if (capture.recorder && capture.recorder->failure())
+    throw cal::InputError(fmt::format("run {} is complete and stored, but its capture failed: {}",
+                                      out.run_id, *capture.recorder->failure()));
   return out;
 }
 

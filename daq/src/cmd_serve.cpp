@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <chrono>
@@ -31,7 +32,32 @@ struct ServeOptions {
   RunOptions run;  // config, db, give_up_after
   std::string address = "127.0.0.1", token, capture_dir;
   std::uint16_t port = 8080;
+  std::vector<std::string> allowed_hosts;
+  std::size_t max_connections = 256;
+  double request_timeout_s = 10.0;
 };
+
+// Error bodies: JSON even when a message carries bytes that are not UTF-8 (a path, a device).
+web::Response error(int status, const std::string& message) {
+  return {status, nlohmann::json{{"error", message}}.dump(
+                      -1, ' ', false, nlohmann::json::error_handler_t::replace)};
+}
+
+// The body of POST /api/runs/start: exactly {"test": "linear"} or {"test": "circle"}.
+std::optional<std::string> requested_test(const std::string& body, std::string& why) {
+  const auto req = nlohmann::json::parse(body, nullptr, false);
+  const char* expected = R"(give {"test": "linear"} or {"test": "circle"})";
+  if (req.is_discarded()) {
+    why = fmt::format("the body is not JSON: {}", expected);
+  } else if (!req.is_object() || req.size() != 1 || !req.contains("test")) {
+    why = fmt::format("the body must be one object with the key \"test\": {}", expected);
+  } else if (!req["test"].is_string()) {
+    why = fmt::format("\"test\" must be a string, not {}: {}", req["test"].type_name(), expected);
+  } else {
+    return req["test"].get<std::string>();
+  }
+  return std::nullopt;
+}
 
 // One run at a time on the service's event loop; its live state is pushed to the page (about
 // 10 Hz, the latest state only, so a 10 kHz stream cannot make it fall behind).
@@ -50,12 +76,21 @@ class Service {
 
   void make_server() {
     server_ = std::make_unique<web::LiveServer>(
-        io_, web::ServerOptions{.address = o_.address, .port = o_.port, .token = o_.token},
+        io_,
+        web::ServerOptions{
+            .address = o_.address,
+            .port = o_.port,
+            .token = o_.token,
+            .allowed_hosts = o_.allowed_hosts,
+            .max_connections = o_.max_connections,
+            .request_timeout =
+                std::chrono::milliseconds(std::llround(o_.request_timeout_s * 1000.0)),
+            .log = [](std::string_view text) { fmt::print(stderr, "daq serve: {}\n", text); }},
         web::Api{.page = [] { return web::live_page(); },
                  .runs = [this] { return runs(); },
                  .status = [this] { return web::Response{.body = status().dump()}; },
                  .start = [this](const std::string& body) { return start(body); },
-                 .stop = [this] { return stop("stopped from the web page"); }});
+                 .stop = [this](const std::string& body) { return stop_request(body); }});
   }
 
   // The page shows this between runs.
@@ -69,6 +104,20 @@ class Service {
     if (running()) stop("the service was stopped");
     check_.cancel();
     server_.reset();
+  }
+
+  // An exception escaped a handler of the event loop (e.g. the store failed under a run):
+  // the run ends as aborted with the reason, the service goes on.
+  void failed(const std::string& what) {
+    fmt::print(stderr, "daq serve: error: {} (the service goes on)\n", what);
+    if (!running()) return;
+    try {
+      stop("aborted: " + what);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "daq serve: error: the run could not be ended cleanly: {}\n", e.what());
+      linear_.reset(), circle_.reset(), capture_.reset();
+      publish_idle(fmt::format("run {} aborted: {}", run_id_, what));
+    }
   }
 
  private:
@@ -100,29 +149,42 @@ class Service {
     return j;
   }
 
+  // 400 for what the client got wrong (the body, a test the configuration lacks, a device
+  // that cannot be opened); 500 for the store or the capture failing.
   web::Response start(const std::string& body) {
-    if (running())
-      return {409,
-              nlohmann::json{{"error", fmt::format("run {} is still running", run_id_)}}.dump()};
-    const auto req = nlohmann::json::parse(body.empty() ? "{}" : body, nullptr, false);
-    const std::string test = req.is_object() ? req.value("test", "linear") : "";
+    std::string why;
+    const auto test = requested_test(body, why);
+    if (!test) return error(400, why);
+    if (*test != "linear" && *test != "circle")
+      return error(400, fmt::format("no test '{}': give {{\"test\": \"linear\"}} or "
+                                    "{{\"test\": \"circle\"}}",
+                                    *test));
+    if (running()) return error(409, fmt::format("run {} is still running", run_id_));
     try {
-      if (test == "linear")
+      if (*test == "linear")
         start_linear();
-      else if (test == "circle")
-        start_circle();
       else
-        return {400, nlohmann::json{{"error", "give {\"test\": \"linear\"} or \"circle\""}}.dump()};
+        start_circle();
+    } catch (const cal::InputError& e) {
+      linear_.reset(), circle_.reset(), capture_.reset();
+      return error(400, e.what());
     } catch (const std::exception& e) {
       linear_.reset(), circle_.reset(), capture_.reset();
-      return {400, nlohmann::json{{"error", e.what()}}.dump()};
+      return error(500, e.what());
     }
-    test_ = test;
-    return {202, nlohmann::json{{"run", run_id_}, {"test", test}}.dump()};
+    test_ = *test;
+    return {202, nlohmann::json{{"run", run_id_}, {"test", *test}}.dump()};
+  }
+
+  // POST /api/runs/stop: an empty body or a JSON object (the page sends {}).
+  web::Response stop_request(const std::string& body) {
+    if (!body.empty() && !nlohmann::json::parse(body, nullptr, false).is_object())
+      return error(400, "the body of a stop must be empty or a JSON object");
+    return stop("stopped from the web page");
   }
 
   web::Response stop(const std::string& why) {
-    if (!running()) return {409, nlohmann::json{{"error", "no run is running"}}.dump()};
+    if (!running()) return error(409, "no run is running");
     if (linear_) linear_->stop(why);
     if (circle_) circle_->stop(why);
     finish();
@@ -137,10 +199,21 @@ class Service {
     return (std::filesystem::path(o_.capture_dir) / fmt::format("serve-{}.cdq", ms)).string();
   }
 
+  // A capture that cannot be written (a full disk) aborts the run, naming the file.
+  void watch_capture() {
+    if (!capture_->recorder) return;
+    capture_->recorder->on_failure([this](const std::string& e) {
+      boost::asio::post(io_, [this, e] {
+        if (running()) stop("capture failed: " + e);
+      });
+    });
+  }
+
   void start_linear() {
     const auto specs = linear_specs(config_);
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
+    watch_capture();
     LinearRunSetup setup;
     setup.config = config_;
     setup.database = database_path(o_.run.db);
@@ -161,6 +234,7 @@ class Service {
     const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
+    watch_capture();
     CircleRunSetup setup{
         .config = config_,
         .program = program,
@@ -188,7 +262,7 @@ class Service {
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
     last_ = nlohmann::json{
         {"run", run_id_}, {"test", test_}, {"complete", complete}, {"reason", reason}};
-    if (capture_ && capture_->writer) capture_->writer->close();
+    if (capture_ && capture_->recorder) capture_->recorder->close();
     const char* how = complete ? "complete" : evaluated ? "incomplete: " : "stopped: ";
     fmt::print("run {} {}{}\n", run_id_, how, reason);
     std::fflush(stdout);
@@ -201,7 +275,7 @@ class Service {
     check_.async_wait([this](const boost::system::error_code& ec) {
       if (ec) return;
       if ((linear_ && linear_->finished()) || (circle_ && circle_->finished())) finish();
-      if (capture_ && capture_->writer) capture_->writer->flush();
+      if (capture_ && capture_->recorder) capture_->recorder->flush();
       tick();
     });
   }
@@ -231,7 +305,16 @@ void serve(const ServeOptions& o) {
     service.shutdown();
     io.stop();
   });
-  io.run();
+  // Nothing a handler throws ends the service: the loop is run again after the run in
+  // progress (if any) is ended with the reason (asio allows run() again after an exception).
+  for (;;) {
+    try {
+      io.run();
+      return;
+    } catch (const std::exception& e) {
+      service.failed(e.what());
+    }
+  }
 }
 
 }  // namespace
@@ -249,6 +332,17 @@ void add_serve_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--port", o->port, "TCP port (0: any free port)")->capture_default_str();
   cmd->add_option("--token", o->token, "Required from every client (Bearer or ?token=)");
+  cmd->add_option("--allow-host", o->allowed_hosts,
+                  "A Host name accepted beside localhost and the address (repeatable), e.g. the "
+                  "machine's name when serving beyond loopback");
+  cmd->add_option("--max-connections", o->max_connections,
+                  "Open connections at most (at the cap the one idle longest is closed)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{4}, std::size_t{100000}));
+  cmd->add_option("--request-timeout-s", o->request_timeout_s,
+                  "A request must arrive within this (idle and slow connections are closed)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--capture-dir", o->capture_dir, "Record each run's capture in this directory");
   cmd->add_option("--give-up-after", o->run.give_up_after,
                   "Reconnection attempts before a device is given up")

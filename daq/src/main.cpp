@@ -8,6 +8,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/storage/store.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
@@ -38,11 +39,14 @@ int main(int argc, char** argv) {
   daq::add_model_commands(app);
   daq::add_ballbar_commands(app);
   daq::add_serve_command(app);
+  daq::check_numbers(app);
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version are "parse errors" with status 0; every usage error is status 2,
+    // as for any other bad input (CLI11's own codes are 104-109).
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const cal::InputError& e) {
     std::fprintf(stderr, "daq: error: %s\n", e.what());
     return 2;

@@ -27,6 +27,8 @@ std::string_view to_string(Quantity q) {
       return "material_temperature_degc";
     case Quantity::machine_position_m:
       return "machine_position_m";
+    case Quantity::angle_rad:
+      return "angle_rad";
   }
   return "unknown";
 }

@@ -2,6 +2,7 @@
 #include "cal/replay/capture.hpp"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
@@ -87,6 +88,10 @@ struct CaptureWriter::Impl {
     if (!file) throw CaptureError(fmt::format("{}: write after close", path.string()));
   }
   void write(std::span<const std::byte> bytes) {
+    if (limits.max_file_bytes > 0 && written + bytes.size() > limits.max_file_bytes) {
+      errno = ENOSPC;
+      fail("write failed");
+    }
     if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) fail("write failed");
     written += bytes.size();
   }
@@ -239,6 +244,13 @@ struct CaptureReader::Impl {
     offset += got;
     return got;
   }
+  // Bytes after the read position now (a file still being written may have grown).
+  std::uint64_t bytes_left() const {
+    struct stat st {};
+    if (::fstat(::fileno(file.get()), &st) != 0) return UINT64_MAX;  // let the read tell
+    const auto size = static_cast<std::uint64_t>(st.st_size);
+    return size > offset ? size - offset : 0;
+  }
   [[noreturn]] void bad_header(std::string_view what) const {
     throw CaptureError(fmt::format("{}: {}", path.string(), what));
   }
@@ -279,6 +291,11 @@ struct CaptureReader::Impl {
     const auto count = get<std::uint32_t>(h.data() + 8);
     const auto crc = get<std::uint32_t>(h.data() + 12);
     if (size > kMaxPayload) return damaged(fmt::format("block length {} is implausible", size));
+    // A length beyond the end of the file is a cut (or a damaged length): said without
+    // allocating it, so a 30-byte file claiming a 64 MiB block costs nothing (found by
+    // fuzz_capture).
+    if (const std::uint64_t there = bytes_left(); size > there)
+      return damaged(fmt::format("truncated block ({} of {} payload bytes)", there, size));
     payload.resize(size);
     if (const std::size_t n = read(payload.data(), size); n < size)
       return damaged(fmt::format("truncated block ({} of {} payload bytes)", n, size));
@@ -316,6 +333,9 @@ CaptureReader::CaptureReader(const std::filesystem::path& path) : impl_(std::mak
                              capture_major_version));
   if (length > kMaxHeader)
     m.bad_header(fmt::format("header length {} at byte 12 is over the 1 MiB limit", length));
+  if (std::uint64_t{length} + 4 > m.bytes_left())  // said without allocating the length
+    m.bad_header(fmt::format("truncated header at byte {} (the header ends at byte {})",
+                             m.offset + m.bytes_left(), 20 + std::uint64_t{length}));
   m.header.resize(length);
   std::array<std::byte, 4> crc{};
   if (m.read(m.header.data(), length) != length || m.read(crc.data(), 4) != 4)

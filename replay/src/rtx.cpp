@@ -5,14 +5,21 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 namespace cal::replay {
 namespace {
 
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
-constexpr std::string_view kEofMarker = "EOF::\r\n";
+constexpr std::string_view kMarker = "\r\nEOF";     // RTX2CSV-Converter's check
+constexpr std::string_view kBareMarker = "EOF::";   // rtx2csv's "EOF::\r\n" stub
+constexpr std::uint64_t kMarkerSearch = 24;         // the marker starts this close to the end
+constexpr double kMaxSamples = 9007199254740992.0;  // 2^53: every count exact in a double
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -21,12 +28,25 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (auto& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// A header value for messages: printable, at most 60 characters.
+std::string shown(std::string_view s) {
+  std::string out;
+  for (unsigned char c : s.substr(0, 60)) out += std::isprint(c) ? static_cast<char>(c) : '?';
+  return out;
+}
+
 std::optional<double> number(const std::string* s) {
   if (!s) return std::nullopt;
   double v = 0;
   const auto t = trim(*s);
   const auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc{} || p != t.data() + t.size()) return std::nullopt;
+  if (ec != std::errc{} || p != t.data() + t.size() || t.empty()) return std::nullopt;
   return v;
 }
 
@@ -45,14 +65,26 @@ const std::string* RtxHeader::find(std::string_view key) const {
   return nullptr;
 }
 
-RtxReader::RtxReader(const std::filesystem::path& path) : path_(path), in_(path, std::ios::binary) {
-  const std::string file = path.string();
-  if (!in_) throw RtxError(fmt::format("{}: cannot open", file));
+RtxReader::RtxReader(const std::filesystem::path& path) : name_(path.string()) {
+  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*file) throw RtxError(fmt::format("{}: cannot open", name_));
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw RtxError(fmt::format("{}: {}", file, ec.message()));
+  if (ec) throw RtxError(fmt::format("{}: {}", name_, ec.message()));
+  in_ = std::move(file);
+  read_header(size);
+}
+
+RtxReader::RtxReader(std::string bytes, std::string name) : name_(std::move(name)) {
+  const std::uint64_t size = bytes.size();
+  in_ = std::make_unique<std::istringstream>(std::move(bytes));
+  read_header(size);
+}
+
+void RtxReader::read_header(std::uint64_t size) {
+  const std::string& file = name_;
   std::string head(std::min<std::uint64_t>(size, kMaxHeaderBytes), '\0');
-  in_.read(head.data(), static_cast<std::streamsize>(head.size()));
+  in_->read(head.data(), static_cast<std::streamsize>(head.size()));
   if (!head.starts_with("HEADER::"))
     throw RtxError(fmt::format("{}: byte 0: not a Renishaw .rtx file (no HEADER:: line)", file));
   // "Key: value" lines up to the "Data:" line; CR-LF as written, a bare LF accepted.
@@ -72,7 +104,7 @@ RtxReader::RtxReader(const std::filesystem::path& path) : path_(path), in_(path,
     const auto colon = line.find(':');
     if (colon == std::string_view::npos)
       throw RtxError(fmt::format("{}: byte {}: header line '{}' is not 'Key: value'", file, start,
-                                 std::string(line.substr(0, 60))));
+                                 shown(line)));
     header_.fields.emplace_back(std::string(trim(line.substr(0, colon))),
                                 std::string(trim(line.substr(colon + 1))));
   }
@@ -81,26 +113,80 @@ RtxReader::RtxReader(const std::filesystem::path& path) : path_(path), in_(path,
         fmt::format("{}: no 'Data:' line within the first {} bytes (a truncated "
                     "header?)",
                     file, head.size()));
-  auto rate = number(header_.find("Actual sample rate"));
-  if (!rate || !(*rate > 0)) rate = number(header_.find("Sample rate"));
-  if (!rate || !(*rate > 0))
+
+  // The file type decides what the samples are; only the two known ones are read.
+  const std::string* type = header_.find("File Type");
+  if (!type || trim(*type).empty())
+    throw RtxError(fmt::format(
+        "{}: header: no 'File Type' (linear or angular): the samples cannot be interpreted", file));
+  const std::string t = lower(trim(*type));
+  if (t == "linear")
+    header_.kind = RtxKind::linear;
+  else if (t == "angular")
+    header_.kind = RtxKind::angular;
+  else
+    throw RtxError(fmt::format(
+        "{}: header: File Type '{}' is not supported (only Linear and Angular captures are "
+        "imported)",
+        file, shown(*type)));
+
+  // The rate: the actual one, else the nominal; 0 or empty counts as not stated, anything
+  // else must be a finite rate in range (an infinite or 1e-300 Hz rate would put every
+  // sample at time 0 or beyond the clock).
+  auto rate_field = [&](const char* key) -> std::optional<double> {
+    const std::string* text = header_.find(key);
+    if (!text || trim(*text).empty()) return std::nullopt;
+    const auto v = number(text);
+    if (v && *v == 0) return std::nullopt;
+    if (!v || !(*v >= rtx_min_rate_hz && *v <= rtx_max_rate_hz))
+      throw RtxError(fmt::format("{}: header: {} '{}' is not a rate within {} .. {} Hz", file, key,
+                                 shown(*text), rtx_min_rate_hz, rtx_max_rate_hz));
+    return v;
+  };
+  auto rate = rate_field("Actual sample rate");
+  if (!rate) rate = rate_field("Sample rate");
+  if (!rate)
     throw RtxError(
         fmt::format("{}: header: no usable 'Actual sample rate' or 'Sample rate'", file));
   header_.sample_rate_hz = *rate;
-  if (const auto n = number(header_.find("Sample no")); n && *n >= 0)
-    header_.declared_samples = static_cast<std::uint64_t>(*n);
-  std::uint64_t end = size;
-  if (size >= header_.data_offset + kEofMarker.size()) {
-    std::string tail(kEofMarker.size(), '\0');
-    in_.seekg(static_cast<std::streamoff>(size - kEofMarker.size()));
-    in_.read(tail.data(), static_cast<std::streamsize>(tail.size()));
-    if (tail == kEofMarker) header_.eof_marker = true, end -= kEofMarker.size();
+  if (const std::string* n = header_.find("Sample no"); n && !trim(*n).empty()) {
+    const auto v = number(n);
+    if (!v || !(*v >= 0 && *v <= kMaxSamples) || *v != std::floor(*v))
+      throw RtxError(
+          fmt::format("{}: header: Sample no '{}' is not a whole number of samples "
+                      "(0 .. 2^53)",
+                      file, shown(*n)));
+    header_.declared_samples = static_cast<std::uint64_t>(*v);
   }
-  const std::uint64_t data_bytes = end - header_.data_offset;
+
+  // The end marker starts on a sample boundary near the end of the file.
+  std::uint64_t end = size;
+  if (size > header_.data_offset) {
+    const std::uint64_t from = size > kMarkerSearch ? size - kMarkerSearch : 0;
+    std::string tail(size - std::max(from, header_.data_offset), '\0');
+    const std::uint64_t tail_at = size - tail.size();
+    in_->clear();
+    in_->seekg(static_cast<std::streamoff>(tail_at));
+    in_->read(tail.data(), static_cast<std::streamsize>(tail.size()));
+    for (std::uint64_t at = tail_at; at < size; ++at) {
+      if ((at - header_.data_offset) % 8 != 0) continue;
+      const auto rest = std::string_view(tail).substr(at - tail_at);
+      if (rest.starts_with(kMarker) || rest.starts_with(kBareMarker)) {
+        header_.eof_marker = true;
+        header_.eof_offset = at;
+        end = at;
+        break;
+      }
+    }
+  }
+  const std::uint64_t data_bytes = end - std::min(end, header_.data_offset);
   header_.samples = data_bytes / 8;
   header_.trailing_bytes = data_bytes % 8;
-  in_.clear();
-  in_.seekg(static_cast<std::streamoff>(header_.data_offset));
+  if (static_cast<double>(header_.samples) / header_.sample_rate_hz > 9e9)
+    throw RtxError(fmt::format("{}: {} samples at {} Hz last longer than the clock can count", file,
+                               header_.samples, header_.sample_rate_hz));
+  in_->clear();
+  in_->seekg(static_cast<std::streamoff>(header_.data_offset));
 }
 
 std::size_t RtxReader::read(std::span<double> out) {
@@ -108,10 +194,9 @@ std::size_t RtxReader::read(std::span<double> out) {
       static_cast<std::size_t>(std::min<std::uint64_t>(out.size(), header_.samples - next_));
   if (n == 0) return 0;
   std::vector<char> buf(n * 8);
-  in_.read(buf.data(), static_cast<std::streamsize>(buf.size()));
-  if (static_cast<std::size_t>(in_.gcount()) != buf.size())
-    throw RtxError(
-        fmt::format("{}: byte {}: read error", path_.string(), header_.data_offset + next_ * 8));
+  in_->read(buf.data(), static_cast<std::streamsize>(buf.size()));
+  if (static_cast<std::size_t>(in_->gcount()) != buf.size())
+    throw RtxError(fmt::format("{}: byte {}: read error", name_, header_.data_offset + next_ * 8));
   for (std::size_t i = 0; i < n; ++i) out[i] = from_le(buf.data() + 8 * i);
   next_ += n;
   return n;

@@ -127,6 +127,14 @@ class ReplayTransport final : public t::Transport {
 
 }  // namespace
 
+ReplayEnd ReplayBus::read_to_end() {
+  impl_->pending.reset();
+  while (impl_->reader.next()) {
+  }
+  impl_->done = nullptr;  // the end is told here, not again from the loop
+  return ReplayEnd{impl_->reader.records_read(), impl_->reader.damage()};
+}
+
 ReplayBus::ReplayBus(boost::asio::io_context& io, const std::filesystem::path& capture,
                      double speed)
     : impl_(std::make_shared<Impl>(io, capture, speed)) {}

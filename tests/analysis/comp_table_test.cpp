@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "cal/analysis/error.hpp"
 
 namespace {
@@ -139,6 +141,42 @@ TEST(CompTableWriters, IsgSsfk) {
       << out;
   EXPECT_NE(out.find("kw.ssfk.table[4].pos -40\nkw.ssfk.table[4].neg -80\n"), std::string::npos)
       << out;
+}
+
+// Issue 15: nothing non-finite, absurd or outside the table's syntax reaches a controller.
+TEST(CompTable, RefusesWhatNoControllerTableCanHold) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  auto with = [](auto change) {
+    auto s = grid();
+    change(s);
+    return s;
+  };
+  // --start-mm nan wrote "nan" positions; --resolution 1e-320 wrote $AA_ENC_COMP[...]=inf.
+  EXPECT_THROW(positioning(with([&](Spec& s) { s.start_mm = nan; }), measured()), cal::InputError);
+  EXPECT_THROW(positioning(with([](Spec& s) { s.resolution = 1e-320; }), measured()),
+               cal::InputError);
+  EXPECT_THROW(positioning(with([](Spec& s) { s.resolution = 2; }), measured()), cal::InputError);
+  EXPECT_THROW(positioning(with([](Spec& s) { s.interval_mm = 1e300; }), measured()),
+               cal::InputError);
+  EXPECT_THROW(positioning(with([](Spec& s) { s.points = 2'000'000'000; }), measured()),
+               cal::InputError);  // --points 2e9: gigabytes, now refused before any allocation
+  EXPECT_THROW(positioning(with([](Spec& s) { s.start_mm = 1e9; }), measured()), cal::InputError);
+  // Axis names are written into the tables' text: "X\nM30" would add a block.
+  for (const char* axis : {"X\nM30", "", "X Y", "1X", "X;", "XYZXYZXYZ", "X\r"})
+    EXPECT_THROW(positioning(with([&](Spec& s) { s.axis = axis; }), measured()), cal::InputError)
+        << axis;
+  EXPECT_NO_THROW(positioning(with([](Spec& s) { s.axis = "AX2"; }), measured()));
+  // A table built by hand with a non-finite value is refused by every writer.
+  auto t = positioning(grid(), measured());
+  t.forward[2] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(write_csv(t), cal::InputError);
+  EXPECT_THROW(write_linuxcnc(t), cal::InputError);
+  EXPECT_THROW(write_siemens(t), cal::InputError);
+  EXPECT_THROW(write_isg(t), cal::InputError);
+  t = positioning(grid(), measured());
+  t.spec.axis = "X\nM30";
+  EXPECT_THROW(write_siemens(t), cal::InputError);
+  EXPECT_THROW(write_siemens(positioning(grid(), measured()), 0), cal::InputError);
 }
 
 }  // namespace

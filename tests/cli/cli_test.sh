@@ -80,7 +80,7 @@ check recompensate_circle 2 "no run 9" -- "$DAQ" recompensate 9 --db "$TMP/demo.
 check analyse_needs_run 2 "give a stored RUN number" -- "$DAQ" analyse --db "$TMP/demo.sqlite"
 # Runs against configured devices: a device that cannot be reached is given up, named, and
 # the run is stored as aborted. Part programs from the same configuration.
-check run_refused 2 "stopped: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2
+check run_refused 2 "aborted: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2
 check run_stored_aborted 0 "aborted" -- "$DAQ" runs --db "$TMP/run.sqlite"
 check gcode_siemens 0 "^G4 F3\\.0000$" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d siemens
 check gcode_circle 0 "^G03 X-10\\.0000 Y0\\.0000 I-10\\.0000 J0\\.0000 F1000$" -- "$DAQ" gcode circle -c "$DATA/run/refused.toml"
@@ -105,9 +105,9 @@ check devices_probe_bad_settings 2 "parity 'X'" -- "$DAQ" devices --probe-serial
 # Import of a Renishaw dynamic capture (.rtx): a header and three little-endian float64
 # samples written byte by byte (1.0, -2.5, 0.125 mm at 1 kHz); then the same cut inside the
 # third sample, which is stored as an incomplete run with the two whole samples.
-RTX_HEAD='HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n'
+RTX_HEAD='HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nFile Type: Linear\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n'
 RTX_DATA='\x00\x00\x00\x00\x00\x00\xf0\x3f\x00\x00\x00\x00\x00\x00\x04\xc0\x00\x00\x00\x00\x00\x00\xc0\x3f'
-{ printf "$RTX_HEAD"; printf "$RTX_DATA"; printf 'EOF::\r\n'; } >"$TMP/t.rtx"
+{ printf "$RTX_HEAD"; printf "$RTX_DATA"; printf '\r\nEOF::\r\n'; } >"$TMP/t.rtx"
 { printf "$RTX_HEAD"; printf "$RTX_DATA" | head -c 20; } >"$TMP/cut.rtx"
 check import_rtx 0 "^  range -2\.500000 \.\. 1\.000000 mm" -- "$DAQ" import rtx "$TMP/t.rtx" --db "$TMP/rtx.sqlite"
 check import_rtx_export 0 "^0\.001,,0,renishaw-rtx \(CARTO-Dynamic 4\.13\),0,displacement_m,0,-0\.0025,1000000$" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"

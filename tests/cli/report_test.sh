@@ -162,5 +162,5 @@ check show_values 0 "^      E +[0-9]+\.[0-9]{3} um" -- "$DAQ" show 1 --db demo.s
 # A second correction keeps the first: the offset is added, 12 ppm/K stays.
 check recomp_keeps 0 "material_offset_k: 0(\.0)? -> 0\.1" -- "$DAQ" recompensate 1 --material-offset 0.1 --db demo.sqlite
 check recomp_keeps_alpha 0 "ciddor, 12 ppm/K; offsets material \+0.1 K" -- "$DAQ" show 1 --db demo.sqlite
-check recomp_nan 2 "--alpha-ppm nan: not a finite number" -- "$DAQ" recompensate 1 --alpha-ppm nan --db demo.sqlite
+check recomp_nan 2 "--alpha-ppm: 'nan' is not a finite decimal number" -- "$DAQ" recompensate 1 --alpha-ppm nan --db demo.sqlite
 finish

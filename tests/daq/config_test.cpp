@@ -93,7 +93,7 @@ TEST(Config, NamesFileLineColumnAndKey) {
   EXPECT_EQ(error_of("[test.linear]\nfirst_mm = 0\nfeed_mm_min = 100\ncount = 5\n"),
             "machine.toml:3:15: key 'test.linear.feed_mm_min': unknown key (a typo?)");
   EXPECT_EQ(error_of("[trigger]\ndwell_s = -1\n"),
-            "machine.toml:2:11: key 'trigger.dwell_s': -1 must be > 0");
+            "machine.toml:2:11: key 'trigger.dwell_s': -1 must be > 0 and at most 3600 s");
   EXPECT_EQ(error_of("[test.linear]\ncount = 5\ndwell_s = 1\n"),
             "machine.toml:3:11: key 'test.linear.dwell_s': the programmed dwell 1 s must exceed "
             "the trigger dwell 1.5 s");
@@ -116,6 +116,92 @@ TEST(Config, NamesFileLineColumnAndKey) {
             "ds75");
   EXPECT_EQ(error_of("[machine]\nname = 3\n"),
             "machine.toml:2:8: key 'machine.name': expected a string");
+}
+
+// Issue 15: every value of the non-device tables is checked at load for its type and range,
+// with the file, line, column and key: nothing absurd reaches a part program or a run.
+TEST(Config, RefusesNonFiniteAbsurdAndOverflowingValues) {
+  const std::string lin = "[test.linear]\ncount = 5\n";
+  // TOML has nan and inf: refused for every number.
+  EXPECT_EQ(error_of("[test.circle]\nradius_mm = inf\n"),
+            "machine.toml:2:13: key 'test.circle.radius_mm': inf is not a finite number");
+  EXPECT_EQ(error_of("[test.circle]\ncentre_mm = [nan, 0, 0]\n"),
+            "machine.toml:2:13: key 'test.circle.centre_mm': nan is not a finite position within "
+            "+-100000 mm");
+  EXPECT_EQ(error_of("[environment]\nfallback_temperature_degc = -nan\n"),
+            "machine.toml:2:29: key 'environment.fallback_temperature_degc': nan is not a finite "
+            "number");
+  // 4294967297 = 2^32 + 1 would wrap to 1 run in a 32-bit int.
+  EXPECT_EQ(error_of(lin + "runs = 4294967297\n"),
+            "machine.toml:3:8: key 'test.linear.runs': 4294967297 is out of range");
+  EXPECT_EQ(error_of(lin + "runs = 0\n"),
+            "machine.toml:3:8: key 'test.linear.runs': 0 must be within 1 .. 1000");
+  EXPECT_EQ(error_of(lin + "overrun_mm = 1e9\n"),
+            "machine.toml:3:14: key 'test.linear.overrun_mm': 1000000000 must be within 0 .. "
+            "1000 mm");
+  EXPECT_EQ(error_of(lin + "overrun_mm = -1\n"),
+            "machine.toml:3:14: key 'test.linear.overrun_mm': -1 must be within 0 .. 1000 mm");
+  EXPECT_EQ(error_of("[test.linear]\ncount = 1000000000\n"),
+            "machine.toml:2:9: key 'test.linear.count': 1000000000 must be within 2 .. 10000");
+  EXPECT_EQ(error_of("[test.linear]\ninterval_mm = 1e-9\nlast_mm = 1000\n"),
+            "machine.toml:1:1: table [test.linear]: targets: interval 1e-09 mm gives "
+            "1000000000001 targets over 0 .. 1000 mm, more than 10000");
+  EXPECT_EQ(error_of(lin + "feed_mm_per_min = 1e12\n"),
+            "machine.toml:3:19: key 'test.linear.feed_mm_per_min': 1000000000000 must be > 0 and "
+            "at most 200000 mm/min");
+  EXPECT_EQ(error_of(lin + "first_mm = 500\nlast_mm = 100\n"),
+            "machine.toml:1:1: table [test.linear]: targets: last (100 mm) must be greater than "
+            "first (500 mm)");
+  EXPECT_EQ(error_of(lin + "random_fraction = 0.5\n"),
+            "machine.toml:3:19: key 'test.linear.random_fraction': 0.5 must be >= 0 and < 0.5");
+  EXPECT_EQ(error_of("[test.circle]\novershoot_deg = 720\n"),
+            "machine.toml:2:17: key 'test.circle.overshoot_deg': 720 must be within 0 .. 180 deg");
+  EXPECT_EQ(error_of("[test.circle]\ncentre_mm = [0, 1e9, 0]\n"),
+            "machine.toml:2:13: key 'test.circle.centre_mm': 1000000000 is not a finite position "
+            "within +-100000 mm");
+  EXPECT_EQ(error_of("[test.circle]\ncalibrated_radius_mm = -5\n"),
+            "machine.toml:2:24: key 'test.circle.calibrated_radius_mm': -5 must be within 0 .. "
+            "5000 mm");
+  EXPECT_EQ(error_of("[trigger]\nwindow_mm = 1e300\n"),
+            "machine.toml:2:13: key 'trigger.window_mm': 1e+300 must be > 0 and at most 1000 mm");
+  EXPECT_EQ(error_of("[environment]\nfallback_humidity_pct = 150\n"),
+            "machine.toml:2:25: key 'environment.fallback_humidity_pct': 150 must be within 0 .. "
+            "100 %");
+  EXPECT_EQ(error_of("[environment]\nwavelength_nm = 10\n"),
+            "machine.toml:2:17: key 'environment.wavelength_nm': 10 must be within 300 .. 1700 nm");
+  // The fallback air must suit the equation chosen (shop-floor is for 633 nm only).
+  EXPECT_NE(error_of("[environment]\nequation = \"shop-floor\"\nwavelength_nm = 532\n")
+                .find("machine.toml:2:12: key 'environment.equation': with the fallback air: "),
+            std::string::npos);
+  // A type error is named as before; a float is not an integer, however whole (3.3e49 was
+  // converted to int64 inside toml++ without a range check: found by fuzz_config).
+  EXPECT_EQ(error_of(lin + "runs = 2.5\n"),
+            "machine.toml:3:8: key 'test.linear.runs': expected an integer");
+  EXPECT_EQ(
+      error_of("[test.linear]\ncount = 33333333333333333333333333333333333333333333333332.0\n"),
+      "machine.toml:2:9: key 'test.linear.count': expected an integer");
+}
+
+TEST(Config, StandardNamesAreCheckedAtLoad) {
+  // Misspelt, this was accepted and thrown only after every stop had been captured.
+  const auto e = error_of("[test.linear]\ncount = 5\nstandard = \"iso230-2:2041\"\n");
+  EXPECT_EQ(e.rfind("machine.toml:3:12: key 'test.linear.standard': ", 0), 0u) << e;
+  EXPECT_NE(e.find("iso230-2:2041"), std::string::npos) << e;
+  EXPECT_EQ(
+      parse_config("[test.linear]\ncount = 5\nstandard = \"vdi3441\"\n", "m.toml").linear->standard,
+      "vdi3441");
+}
+
+TEST(Config, NamesHaveNoControlCharacters) {
+  EXPECT_EQ(error_of("[machine]\nname = \"VMC\\nM30\"\n"),
+            "machine.toml:2:8: key 'machine.name': control characters are not allowed");
+  EXPECT_EQ(error_of("campaign = \"a\\u0000b\"\n"),
+            "machine.toml:1:12: key 'campaign': control characters are not allowed");
+  EXPECT_EQ(error_of("[machine]\nname = \"\"\n"),
+            "machine.toml:2:8: key 'machine.name': must not be empty");
+  EXPECT_EQ(parse_config("[machine]\nname = \"M\"\ndescription = \"two\\nlines\"\n", "m.toml")
+                .machine_description,
+            "two\nlines");
 }
 
 // An axis over 2000 mm may leave out interval_mm and count (ISO 230-2's 250 mm average is
@@ -205,10 +291,11 @@ vibration = 0.3
 }
 
 TEST(Config, RefusesBadLimitsDatesAndNames) {
+  // nan and inf are refused where every number of the file is read (issue 15).
   EXPECT_EQ(error_of("[tolerances.X]\nE_um = nan\n"),
-            "machine.toml:2:8: key 'tolerances.X.E_um': a limit is a finite number > 0, not nan");
+            "machine.toml:2:8: key 'tolerances.X.E_um': nan is not a finite number");
   EXPECT_EQ(error_of("[tolerances.X]\nA_um = inf\n"),
-            "machine.toml:2:8: key 'tolerances.X.A_um': a limit is a finite number > 0, not inf");
+            "machine.toml:2:8: key 'tolerances.X.A_um': inf is not a finite number");
   EXPECT_EQ(error_of("[tolerances.X]\nR_um = 0\n"),
             "machine.toml:2:8: key 'tolerances.X.R_um': a limit is a finite number > 0, not 0");
   EXPECT_EQ(error_of("[tolerances.X]\nF_um = 3\n"),
@@ -277,7 +364,11 @@ bar = "QC20-1234"
             std::string::npos);
   EXPECT_NE(error_of("[test.circle]\nfeeds_mm_per_min = [500, -1]\n").find("-1 must be > 0"),
             std::string::npos);
-  EXPECT_NE(error_of("[test.circle]\npartial_arc_deg = 170\n").find("170 must be 180..360"),
+  EXPECT_NE(
+      error_of("[test.circle]\npartial_arc_deg = 170\n").find("170 must be within 180 .. 360 deg"),
+      std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nfeed_in_mm = nan\n").find("feed_in_mm"), std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nbar = \"A\\u0007\"\n").find("control characters"),
             std::string::npos);
   EXPECT_NE(error_of("[test.circle]\nradii_mm = [100, 150]\ncalibrated_radius_mm = 100.001\n")
                 .find("one calibrated length cannot serve several radii"),

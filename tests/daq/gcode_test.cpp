@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "cal/analysis/error.hpp"
 
 namespace {
@@ -71,11 +73,11 @@ TEST(Gcode, CircleInHalfCircleArcs) {
 
 TEST(Gcode, LinearFanucDwellInSecondsWithX) {
   // The same program with G04 X (seconds, decimal point) instead of G04 P (ms).
-  EXPECT_EQ(linear_program(tiny(), {.dwell_s = 2.5, .fanuc_dwell = FanucDwell::x_s},
-                           Dialect::fanuc),
-            "%\nO1000 (ISO 230-2 test of X: 2 targets, 4 moves)\nG21 G90 G17 G94\n"
-            "G01 X-2.0000 F2000\nG01 X0.0000 F2000\nG04 X2.500\nG01 X10.0000 F2000\nG04 X2.500\n"
-            "G01 X12.0000 F2000\nM30\n%\n");
+  EXPECT_EQ(
+      linear_program(tiny(), {.dwell_s = 2.5, .fanuc_dwell = FanucDwell::x_s}, Dialect::fanuc),
+      "%\nO1000 (ISO 230-2 test of X: 2 targets, 4 moves)\nG21 G90 G17 G94\n"
+      "G01 X-2.0000 F2000\nG01 X0.0000 F2000\nG04 X2.500\nG01 X10.0000 F2000\nG04 X2.500\n"
+      "G01 X12.0000 F2000\nM30\n%\n");
 }
 
 TEST(Gcode, DwellMustOutlastTheTriggerDwellPlusSettling) {
@@ -99,15 +101,10 @@ TEST(Gcode, DwellMustOutlastTheTriggerDwellPlusSettling) {
 // Without overshoot, 360 deg in 4 quarter arcs: ccw through (X 15, Z -20), (X 5, Z -30),
 // (X -5, Z -20), back to (X 5, Z -10); cw back the other way.
 TEST(Gcode, CircleInTheZxPlaneByRadiusInQuarterArcs) {
-  const BallbarProgram b{.radius_mm = 10,
-                         .feed_mm_per_min = 500,
-                         .feed_in_mm = 2,
-                         .dwell_s = 2,
-                         .overshoot_deg = 0};
-  const CircleProgramSetup zx{.centre_x_mm = 5,
-                              .centre_z_mm = -20,
-                              .plane = Plane::zx,
-                              .arcs = ArcForm::radius};
+  const BallbarProgram b{
+      .radius_mm = 10, .feed_mm_per_min = 500, .feed_in_mm = 2, .dwell_s = 2, .overshoot_deg = 0};
+  const CircleProgramSetup zx{
+      .centre_x_mm = 5, .centre_z_mm = -20, .plane = Plane::zx, .arcs = ArcForm::radius};
   EXPECT_EQ(circle_program(b, zx, Dialect::fanuc),
             "%\nO1000 (ballbar circle R 10.0000 mm at F500, overshoot 0.0000 deg)\n"
             "G21 G90 G18 G94\n"
@@ -118,17 +115,18 @@ TEST(Gcode, CircleInTheZxPlaneByRadiusInQuarterArcs) {
             "G02 X-5.0000 Z-20.0000 R10.0000 F500\nG02 X5.0000 Z-30.0000 R10.0000 F500\n"
             "G02 X15.0000 Z-20.0000 R10.0000 F500\nG02 X5.0000 Z-10.0000 R10.0000 F500\n"
             "G01 X5.0000 Z-8.0000 F500\nM30\n%\n");
-  EXPECT_EQ(circle_program(b, zx, Dialect::heidenhain),
-            "0 BEGIN PGM BALLBAR MM\n"
-            "1 ; ballbar circle R 10.0000 mm at F500, overshoot 0.0000 deg\n"
-            "2 L X+5.0000 Z-8.0000 F500\n3 L X+5.0000 Z-10.0000 F500\n"
-            "4 CYCL DEF 9.0 DWELL TIME\n5 CYCL DEF 9.1 DWELL 2.0000\n"
-            "6 CR X+15.0000 Z-20.0000 R+10.0000 DR+ F500\n7 CR X+5.0000 Z-30.0000 R+10.0000 DR+ F500\n"
-            "8 CR X-5.0000 Z-20.0000 R+10.0000 DR+ F500\n9 CR X+5.0000 Z-10.0000 R+10.0000 DR+ F500\n"
-            "10 CYCL DEF 9.0 DWELL TIME\n11 CYCL DEF 9.1 DWELL 2.0000\n"
-            "12 CR X-5.0000 Z-20.0000 R+10.0000 DR- F500\n13 CR X+5.0000 Z-30.0000 R+10.0000 DR- F500\n"
-            "14 CR X+15.0000 Z-20.0000 R+10.0000 DR- F500\n15 CR X+5.0000 Z-10.0000 R+10.0000 DR- F500\n"
-            "16 L X+5.0000 Z-8.0000 F500\n17 END PGM BALLBAR MM\n");
+  EXPECT_EQ(
+      circle_program(b, zx, Dialect::heidenhain),
+      "0 BEGIN PGM BALLBAR MM\n"
+      "1 ; ballbar circle R 10.0000 mm at F500, overshoot 0.0000 deg\n"
+      "2 L X+5.0000 Z-8.0000 F500\n3 L X+5.0000 Z-10.0000 F500\n"
+      "4 CYCL DEF 9.0 DWELL TIME\n5 CYCL DEF 9.1 DWELL 2.0000\n"
+      "6 CR X+15.0000 Z-20.0000 R+10.0000 DR+ F500\n7 CR X+5.0000 Z-30.0000 R+10.0000 DR+ F500\n"
+      "8 CR X-5.0000 Z-20.0000 R+10.0000 DR+ F500\n9 CR X+5.0000 Z-10.0000 R+10.0000 DR+ F500\n"
+      "10 CYCL DEF 9.0 DWELL TIME\n11 CYCL DEF 9.1 DWELL 2.0000\n"
+      "12 CR X-5.0000 Z-20.0000 R+10.0000 DR- F500\n13 CR X+5.0000 Z-30.0000 R+10.0000 DR- F500\n"
+      "14 CR X+15.0000 Z-20.0000 R+10.0000 DR- F500\n15 CR X+5.0000 Z-10.0000 R+10.0000 DR- F500\n"
+      "16 L X+5.0000 Z-8.0000 F500\n17 END PGM BALLBAR MM\n");
   // By centre, Heidenhain states the centre once, in the plane's two axes.
   const std::string h = circle_program(
       b, {.centre_x_mm = 5, .centre_z_mm = -20, .plane = Plane::zx}, Dialect::heidenhain);
@@ -189,6 +187,46 @@ TEST(Gcode, RefusesBadSettings) {
   EXPECT_THROW(linear_program(tiny(), {.axis = 'Q'}, Dialect::fanuc), cal::InputError);
   EXPECT_THROW(linear_program(tiny(), {.feed_mm_per_min = 0}, Dialect::fanuc), cal::InputError);
   EXPECT_THROW(linear_program({}, {}, Dialect::fanuc), cal::InputError);  // no moves
+}
+
+// Issue 15: nothing non-finite, absurd or outside the dialect's syntax reaches a program,
+// whatever the caller checked before.
+TEST(Gcode, NeverWritesNonFiniteOrAbsurdNumbers) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  for (const auto d : {Dialect::fanuc, Dialect::heidenhain, Dialect::siemens}) {
+    EXPECT_THROW(circle_program({.radius_mm = inf}, {}, d), cal::InputError);
+    EXPECT_THROW(circle_program({.radius_mm = 10}, {.centre_x_mm = nan}, d), cal::InputError);
+    EXPECT_THROW(circle_program({.radius_mm = 10}, {.centre_y_mm = inf}, d), cal::InputError);
+    EXPECT_THROW(circle_program({.radius_mm = 10, .feed_mm_per_min = inf}, {}, d), cal::InputError);
+    EXPECT_THROW(circle_program({.radius_mm = 10, .overshoot_deg = 1e9}, {}, d), cal::InputError);
+    EXPECT_THROW(linear_program(tiny(), {.feed_mm_per_min = nan}, d), cal::InputError);
+    EXPECT_THROW(linear_program(tiny(), {.dwell_s = inf}, d), cal::InputError);
+    cal::iso230_2::Plan far = tiny();
+    far.moves.front().position_mm = -1e9;  // what overrun_mm = 1e9 gave: G01 X-1000000000
+    EXPECT_THROW(linear_program(far, {}, d), cal::InputError);
+    far.moves.front().position_mm = nan;
+    EXPECT_THROW(linear_program(far, {}, d), cal::InputError);
+  }
+  // A refused program is refused whole: no partial text with "nan" or "inf" comes back.
+  try {
+    circle_program({.radius_mm = 10}, {.centre_x_mm = nan}, Dialect::fanuc);
+    FAIL();
+  } catch (const cal::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a finite value"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Gcode, ProgramNamesStayWithinTheSyntax) {
+  // Heidenhain writes the name into BEGIN PGM; a line break would start a new block.
+  EXPECT_THROW(linear_program(tiny(), {.name = "A\nM30"}, Dialect::heidenhain), cal::InputError);
+  EXPECT_THROW(linear_program(tiny(), {.name = "A B"}, Dialect::heidenhain), cal::InputError);
+  EXPECT_THROW(linear_program(tiny(), {.name = ""}, Dialect::fanuc), cal::InputError);
+  EXPECT_THROW(circle_program({.radius_mm = 10}, {.name = "X)M30("}, Dialect::fanuc),
+               cal::InputError);
+  EXPECT_NE(linear_program(tiny(), {.name = "AXIS_X2"}, Dialect::heidenhain)
+                .find("0 BEGIN PGM AXIS_X2 MM"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/air.hpp"
@@ -193,6 +195,69 @@ TEST(CheckedInCapture, TruncatedCopyKeepsEverythingBeforeTheCut) {
   ASSERT_LT(part.readings.size(), full.readings.size());
   for (std::size_t i = 0; i < part.readings.size(); ++i)
     ASSERT_TRUE(same(part.readings[i], full.readings[i])) << "reading " << i;
+}
+
+// Issue 15: a capture cut exactly between two blocks (a writer killed, a copy cut) loses its
+// end block: at every block boundary the replay reports it with that byte offset, and every
+// record before it is replayed: exactly the first readings of the whole capture.
+TEST(CheckedInCapture, CutsAtEveryBlockBoundaryAreReportedWithTheirOffset) {
+  const auto full = replay(checked_in());
+  ASSERT_FALSE(full.end.damage) << cal::replay::describe(*full.end.damage);
+  // The boundaries, from the documented layout: header 20 + H bytes, then blocks of 16 + L.
+  std::ifstream in(checked_in(), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+  };
+  std::vector<std::size_t> boundaries{20 + u32(12)};
+  while (u32(boundaries.back()) == 0x4B4C4243)  // CBLK; the last boundary is before CEND
+    boundaries.push_back(boundaries.back() + 16 + u32(boundaries.back() + 4));
+  ASSERT_GT(boundaries.size(), 5u);
+  std::size_t previous = 0;
+  for (std::size_t b = 0; b < boundaries.size(); ++b) {
+    SCOPED_TRACE("cut at byte " + std::to_string(boundaries[b]));
+    const auto cut = fs::temp_directory_path() / "caldaq_twin_session_boundary.cdq";
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, boundaries[b]);
+    const auto part = replay(cut);
+    fs::remove(cut);
+    ASSERT_TRUE(part.end.damage.has_value());
+    EXPECT_EQ(part.end.damage->offset, boundaries[b]);
+    EXPECT_EQ(part.end.damage->block, b);
+    EXPECT_NE(part.end.damage->what.find("no end block"), std::string::npos)
+        << part.end.damage->what;
+    ASSERT_LE(part.readings.size(), full.readings.size());
+    for (std::size_t i = 0; i < part.readings.size(); ++i)
+      ASSERT_TRUE(same(part.readings[i], full.readings[i])) << "reading " << i;
+    EXPECT_GE(part.readings.size(), previous);  // each cut keeps at least what the last kept
+    previous = part.readings.size();
+  }
+}
+
+// What `daq replay` does after a run that ends before the capture does: the rest is read
+// without delivering it, so damage further on is still found.
+TEST(CheckedInCapture, ReadingToTheEndFindsDamageAfterTheRun) {
+  const auto cut = fs::temp_directory_path() / "caldaq_twin_session_tail.cdq";
+  fs::copy_file(checked_in(), cut, fs::copy_options::overwrite_existing);
+  fs::resize_file(cut, fs::file_size(cut) - 3);  // into the end block
+  for (const auto& [file, damaged] : {std::pair{checked_in(), false}, std::pair{cut, true}}) {
+    boost::asio::io_context io;
+    cal::replay::ReplayBus bus(io, file);
+    bool done = false;
+    bus.start([&](const cal::replay::ReplayEnd&) { done = true; });
+    io.run_one();  // one batch delivered (to nobody), as if the run ended there
+    const auto end = bus.read_to_end();
+    EXPECT_FALSE(done);
+    EXPECT_EQ(end.damage.has_value(), damaged) << file;
+    if (damaged) {
+      EXPECT_EQ(end.damage->what, "truncated end block");
+    }
+    EXPECT_GT(end.records, 1000u);
+    io.run();  // the loop's own end is not reported again
+    EXPECT_FALSE(done);
+  }
+  fs::remove(cut);
 }
 
 // A fresh recording from the twins (record_captures, run by ctest before this test with

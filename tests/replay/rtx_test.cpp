@@ -7,6 +7,7 @@
 #include <array>
 #include <cstring>
 #include <fstream>
+#include <tuple>
 
 namespace {
 
@@ -73,7 +74,7 @@ TEST(Rtx, APartialLastSampleAndNoEofMarkerAreReportedAndTheRestRead) {
 }
 
 TEST(Rtx, FallsBackToTheNominalRateAndAcceptsBareLineFeeds) {
-  std::string h = "HEADER::\nSample rate: 50000\nActual sample rate: 0\nData:\n";
+  std::string h = "HEADER::\nFile Type: Linear\nSample rate: 50000\nActual sample rate: 0\nData:\n";
   RtxReader r(write("lf.rtx", h + samples()));
   EXPECT_EQ(r.header().sample_rate_hz, 50000.0);
   EXPECT_EQ(r.header().samples, 4u);
@@ -93,10 +94,98 @@ void expect_error(const std::string& name, const std::string& bytes, const std::
 TEST(Rtx, RefusesWhatIsNotAnRtxFileNamingFileAndPlace) {
   expect_error("csv.rtx", "time,value\n0,1\n", "byte 0: not a Renishaw .rtx file");
   expect_error("nodata.rtx", "HEADER::\r\nSample rate: 50000\r\n", "no 'Data:' line");
-  expect_error("norate.rtx", "HEADER::\r\nOwner: x\r\nData:\r\n" + samples(),
+  expect_error("norate.rtx", "HEADER::\r\nOwner: x\r\nFile Type: Linear\r\nData:\r\n" + samples(),
                "no usable 'Actual sample rate' or 'Sample rate'");
   expect_error("badline.rtx", "HEADER::\r\nOwner x\r\nData:\r\n", "byte 10: header line 'Owner x'");
   EXPECT_THROW(RtxReader(std::filesystem::path("/nonexistent/x.rtx")), RtxError);
+}
+
+// Issue 13: the end marker as real files have it. RTX2CSV-Converter (travdt, RTXFileProcessor.cs,
+// EOFCheck) stops at the 8-byte sample whose bytes start 0D 0A 45 4F 46, i.e. the file ends
+// "\r\nEOF::\r\n" where the next sample would start. A complete file gets no damage note.
+TEST(Rtx, TheRealEndMarkerEndsACompleteFile) {
+  const std::string bytes = kHeader + samples() + "\r\nEOF::\r\n";
+  RtxReader r(bytes, "real.rtx");
+  const auto& h = r.header();
+  EXPECT_TRUE(h.eof_marker);
+  EXPECT_EQ(h.eof_offset, kHeader.size() + 32);
+  EXPECT_EQ(h.samples, 4u);
+  EXPECT_EQ(h.trailing_bytes, 0u);  // before: "ends inside a sample (2 bytes dropped)"
+  EXPECT_EQ(h.declared_samples, h.samples);
+  EXPECT_EQ(all(r), (std::vector<double>{1.0, -2.5, 0.125, 1000.0}));
+  EXPECT_EQ(h.kind, cal::replay::RtxKind::linear);
+}
+
+TEST(Rtx, AMarkerCutOrOffTheSampleGridIsDamage) {
+  // Cut inside the marker: four whole samples and four bytes of the marker, no end.
+  RtxReader cut(kHeader + samples() + "\r\nEO", "cut.rtx");
+  EXPECT_FALSE(cut.header().eof_marker);
+  EXPECT_EQ(cut.header().samples, 4u);
+  EXPECT_EQ(cut.header().trailing_bytes, 4u);
+  // One stray byte before the marker: the marker is not where a sample starts.
+  RtxReader stray(kHeader + samples() + "x\r\nEOF::\r\n", "stray.rtx");
+  EXPECT_FALSE(stray.header().eof_marker);
+  EXPECT_EQ(stray.header().samples, 5u);  // 32 + 10 bytes: five "samples", two left over
+  EXPECT_EQ(stray.header().trailing_bytes, 2u);
+}
+
+TEST(Rtx, TheFileTypeDecidesWhatTheSamplesAre) {
+  auto with_type = [](const std::string& type) {
+    std::string h = kHeader;
+    h.replace(h.find("File Type: Linear"), 17, "File Type: " + type);
+    return h + samples() + "\r\nEOF::\r\n";
+  };
+  EXPECT_EQ(RtxReader(with_type("Angular"), "a.rtx").header().kind, cal::replay::RtxKind::angular);
+  EXPECT_EQ(RtxReader(with_type("LINEAR"), "l.rtx").header().kind, cal::replay::RtxKind::linear);
+  for (const std::string type : {"Straightness", "Flatness", "Rotary", "Linear2", "csv"}) {
+    try {
+      RtxReader r(with_type(type), "t.rtx");
+      FAIL() << type << " was accepted";
+    } catch (const RtxError& e) {
+      EXPECT_NE(std::string(e.what()).find("File Type '" + type + "' is not supported"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  std::string none = kHeader;
+  none.erase(none.find("File Type: Linear\r\n"), 19);
+  EXPECT_THROW(RtxReader(none + samples(), "none.rtx"), RtxError);
+}
+
+// Issue 15: nonsense header values are refused with the field and the value, never stored
+// (an infinite or 1e-300 Hz rate put every sample at time 0 or INT64_MIN; Sample no 1e300 was
+// undefined behaviour in the conversion to an integer).
+TEST(Rtx, RefusesNonsenseHeaderValues) {
+  auto with = [](std::string h, const std::string& field, const std::string& value) {
+    const auto at = h.find(field + ": ");
+    const auto eol = h.find("\r\n", at);
+    h.replace(at, eol - at, field + ": " + value);
+    return h;
+  };
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases{
+      {"Actual sample rate", "inf", "Actual sample rate 'inf' is not a rate within"},
+      {"Actual sample rate", "1e-300", "Actual sample rate '1e-300' is not a rate within"},
+      {"Actual sample rate", "nan", "Actual sample rate 'nan' is not a rate within"},
+      {"Actual sample rate", "-50000", "Actual sample rate '-50000' is not a rate within"},
+      {"Actual sample rate", "fast", "Actual sample rate 'fast' is not a rate within"},
+      {"Sample rate", "1e308", "Sample rate '1e308' is not a rate within"},
+      {"Sample no", "1e300", "Sample no '1e300' is not a whole number of samples"},
+      {"Sample no", "-4", "Sample no '-4' is not a whole number of samples"},
+      {"Sample no", "3.5", "Sample no '3.5' is not a whole number of samples"},
+      {"Sample no", "nan", "Sample no 'nan' is not a whole number of samples"}};
+  for (const auto& [field, value, what] : cases) {
+    std::string h = with(kHeader, field, value);
+    // The nominal rate is only read when the actual rate is not stated (0).
+    if (field == "Sample rate") h = with(h, "Actual sample rate", "0");
+    const std::string bytes = h + samples() + "\r\nEOF::\r\n";
+    try {
+      RtxReader r(bytes, "nonsense.rtx");
+      FAIL() << field << ": " << value << " was accepted";
+    } catch (const RtxError& e) {
+      EXPECT_NE(std::string(e.what()).find("nonsense.rtx: header: " + what), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 }  // namespace

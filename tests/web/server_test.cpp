@@ -2,8 +2,6 @@
 // the WebSocket pushing only the latest state at its period.
 #include "server.hpp"
 
-#include "assets.hpp"
-
 #include <gtest/gtest.h>
 
 #include <boost/asio.hpp>
@@ -11,6 +9,9 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <thread>
+
+#include "assets.hpp"
+#include "http_policy.hpp"
 
 namespace {
 
@@ -56,6 +57,7 @@ http::response<http::string_body> request(std::uint16_t port, http::verb verb, s
   socket.connect({asio::ip::address_v4::loopback(), port});
   http::request<http::string_body> req{verb, target, 11};
   req.set(http::field::host, "localhost");
+  if (verb == http::verb::post) req.set(http::field::content_type, "application/json");
   if (!auth.empty()) req.set(http::field::authorization, auth);
   req.body() = std::move(body);
   req.prepare_payload();
@@ -130,6 +132,111 @@ TEST(LivePage, IsOneSelfContainedDocument) {
   EXPECT_EQ(page.find("<script src="), std::string::npos);
   EXPECT_EQ(page.find("<link"), std::string::npos);
   EXPECT_NE(page.find("new WebSocket"), std::string::npos);
+}
+
+// The request rules (http_policy.hpp) apart from the sockets; the hostile-client suite
+// (hostile_serve_test.py) checks them again against a real daq serve.
+namespace web = cal::daq::web;
+
+web::Header header(http::verb verb, const std::string& target,
+                   std::initializer_list<std::pair<http::field, std::string>> fields) {
+  web::Header h;
+  h.method(verb);
+  h.target(target);
+  h.version(11);
+  for (const auto& [f, v] : fields) h.set(f, v);
+  return h;
+}
+
+int screened(const web::Header& h, const web::Policy& p = {}) {
+  const auto r = web::screen(h, "127.0.0.1", p);
+  return r ? r->status : 0;
+}
+
+TEST(HttpPolicy, TokensCompareWhateverTheirLengths) {
+  EXPECT_TRUE(web::same_token("s3cret", "s3cret"));
+  EXPECT_FALSE(web::same_token("s3creT", "s3cret"));
+  EXPECT_FALSE(web::same_token("s3cre", "s3cret"));         // a prefix
+  EXPECT_FALSE(web::same_token("s3crets3cret", "s3cret"));  // the token twice
+  EXPECT_FALSE(web::same_token("", "s3cret"));
+  EXPECT_FALSE(web::same_token("", ""));  // an empty token never authorises
+  EXPECT_FALSE(web::same_token(std::string("s3cret\0", 7), "s3cret"));
+}
+
+TEST(HttpPolicy, QueryParameterIsTheWholeNameAndDecoded) {
+  EXPECT_EQ(web::query_parameter("/ws?token=a%2Bb%20c", "token"), "a+b c");
+  EXPECT_EQ(web::query_parameter("/?x=1&token=t&y=2", "token"), "t");
+  EXPECT_EQ(web::query_parameter("/?xtoken=t", "token"), std::nullopt);
+  EXPECT_EQ(web::query_parameter("/?token", "token"), "");
+  EXPECT_EQ(web::query_parameter("/token=t", "token"), std::nullopt);  // no query at all
+  EXPECT_EQ(web::query_parameter("/?token=%zz%4", "token"), "%zz%4");  // bad escapes kept
+}
+
+TEST(HttpPolicy, HostMustBeThisServer) {
+  const web::Policy p{.allowed_hosts = {"Machine.Local"}};
+  for (const char* ok :
+       {"127.0.0.1", "127.0.0.1:8080", "localhost", "LOCALHOST:1", "machine.local:8080"})
+    EXPECT_TRUE(web::host_allowed(ok, "127.0.0.1", p)) << ok;
+  for (const char* bad : {"evil.example", "127.0.0.1.evil.example", "localhost.", "", ":8080",
+                          "127.0.0.1:80a", "127.0.0.1:", "[::1]", "localhost:123456", "127.0.0.2"})
+    EXPECT_FALSE(web::host_allowed(bad, "127.0.0.1", p)) << bad;
+  EXPECT_TRUE(web::host_allowed("[::1]:8080", "::1", p));
+}
+
+TEST(HttpPolicy, ScreensCrossSiteAndMistypedRequests) {
+  using F = http::field;
+  const std::string host = "127.0.0.1:8080";
+  EXPECT_EQ(screened(header(http::verb::get, "/api/runs", {{F::host, host}})), 0);
+  EXPECT_EQ(screened(header(http::verb::get, "/api/runs", {{F::host, "evil.example"}})), 403);
+  EXPECT_EQ(screened(header(http::verb::get, "/api/runs", {})), 403);  // no Host
+  // A foreign Origin on anything, "null" included; the page's own is fine.
+  EXPECT_EQ(
+      screened(header(http::verb::get, "/", {{F::host, host}, {F::origin, "http://evil.example"}})),
+      403);
+  EXPECT_EQ(screened(header(
+                http::verb::post, "/api/runs/stop",
+                {{F::host, host}, {F::origin, "null"}, {F::content_type, "application/json"}})),
+            403);
+  EXPECT_EQ(screened(header(http::verb::post, "/api/runs/stop",
+                            {{F::host, host},
+                             {F::origin, "http://127.0.0.1:8080"},
+                             {F::content_type, "Application/JSON; charset=utf-8"}})),
+            0);
+  // A CORS "simple request" (text/plain, form types, none) is refused: 415.
+  for (const char* type : {"text/plain", "application/x-www-form-urlencoded",
+                           "multipart/form-data; boundary=x", "application/jsonx", ""})
+    EXPECT_EQ(screened(header(http::verb::post, "/api/runs/start",
+                              {{F::host, host}, {F::content_type, type}})),
+              415)
+        << type;
+  // Sizes are decided from the header: 413 before a body byte is read.
+  EXPECT_EQ(screened(header(http::verb::post, "/api/runs/start",
+                            {{F::host, host},
+                             {F::content_type, "application/json"},
+                             {F::content_length, "100000000"}})),
+            413);
+  // With a token: 401 without it, whatever else the request has right.
+  const web::Policy tok{.token = "t0k"};
+  EXPECT_EQ(screened(header(http::verb::get, "/", {{F::host, host}}), tok), 401);
+  EXPECT_EQ(
+      screened(header(http::verb::get, "/", {{F::host, host}, {F::authorization, "bEaReR t0k"}}),
+               tok),
+      0);
+  EXPECT_EQ(screened(header(http::verb::get, "/?token=t0k", {{F::host, host}}), tok), 0);
+  EXPECT_EQ(
+      screened(header(http::verb::get, "/", {{F::host, host}, {F::authorization, "Basic t0k"}}),
+               tok),
+      401);
+}
+
+TEST(HttpPolicy, HandlersThatThrowGive500NotACrash) {
+  const web::Api api{
+      .runs = []() -> web::Response { throw std::runtime_error("db.sqlite: locked"); }};
+  web::Request req{http::verb::get, "/api/runs", 11};
+  const auto r = web::route(req, api);
+  EXPECT_EQ(r.status, 500);
+  EXPECT_EQ(r.body, R"({"error": "db.sqlite: locked"})");
+  EXPECT_EQ(web::json_error("a\"b\\c\n\x01"), R"({"error": "a\"b\\c\u000a\u0001"})");
 }
 
 }  // namespace

@@ -270,16 +270,19 @@ struct CircleRun::Impl {
   CircleRunOutcome outcome;
   CircleLive live;
   bool running = false, done = false;
+  // Handlers posted from the writer's thread run only while the run exists.
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
   Impl(boost::asio::io_context& i, CircleRunSetup s)
       : io(i), setup(std::move(s)), segmenter(setup.program) {}
+  ~Impl() { *alive = false; }
 
   void event(const std::string& e) {
     if (setup.on_event) setup.on_event(e);
   }
 
   void start() {
-    store.emplace(setup.database);
+    store.emplace(setup.database, setup.store_options);
     resolve_calibration(setup.analysis, setup.config, setup.program.radius_mm, *store,
                         setup.calibration_at_unix_ms
                             ? setup.calibration_at_unix_ms
@@ -310,7 +313,13 @@ struct CircleRun::Impl {
                            .device = 3,
                            .driver = "ballbar",
                            .transport = setup.ballbar->describe()});
-    writer = std::make_unique<cal::storage::BatchWriter>(setup.database, outcome.run_id);
+    writer = std::make_unique<cal::storage::BatchWriter>(
+        setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
+        [this, alive = alive](const std::string& e) {
+          boost::asio::post(io, [this, alive, e] {
+            if (*alive) abort("storage failed: " + e);
+          });
+        });
     running = true;
     setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
                           .state =
@@ -337,11 +346,15 @@ struct CircleRun::Impl {
                                  std::chrono::system_clock::now().time_since_epoch())
                                  .count());
     ++outcome.readings;
-    writer->push({.time_ns = r.time_ns,
-                  .device = 3,
-                  .quantity = static_cast<std::uint8_t>(r.quantity),
-                  .status = static_cast<std::uint8_t>(r.status),
-                  .value = r.value});
+    try {
+      writer->push({.time_ns = r.time_ns,
+                    .device = 3,
+                    .quantity = static_cast<std::uint8_t>(r.quantity),
+                    .status = static_cast<std::uint8_t>(r.status),
+                    .value = r.value});
+    } catch (const std::exception& e) {  // the writer failed earlier (a full disk)
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     const bool had = segmenter.feed_in_end().has_value();
     segmenter.add(r.value * 1e3);
     if (!had && segmenter.feed_in_end()) event("feed-in found: the circle starts after the dwell");
@@ -374,7 +387,11 @@ struct CircleRun::Impl {
   void finish() {
     if (done) return;
     running = false;
-    writer->flush();
+    try {
+      writer->flush();
+    } catch (const std::exception& e) {
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     try {
       outcome.result = analyse_ballbar(setup.program, setup.analysis, segmenter.values());
     } catch (const std::exception& e) {
@@ -386,12 +403,17 @@ struct CircleRun::Impl {
       prov["capture"] = setup.capture_path;
       prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
     }
-    store->add_result(
-        {.run_id = outcome.run_id,
-         .standard = standard_label(setup.analysis),
-         .json = circle_document(*outcome.result, setup.program, setup.analysis).dump(),
-         .provenance_json = prov.dump()});
-    store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    try {
+      store->add_result(
+          {.run_id = outcome.run_id,
+           .standard = standard_label(setup.analysis),
+           .json = circle_document(*outcome.result, setup.program, setup.analysis).dump(),
+           .provenance_json = prov.dump()});
+      store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
+    } catch (const std::exception& e) {
+      outcome.result.reset();
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     outcome.complete = true;
     publish_end("complete");
     end();
@@ -401,8 +423,18 @@ struct CircleRun::Impl {
     if (done) return;
     running = false;
     outcome.reason = reason;
-    if (writer) writer->flush();
-    if (store) store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, reason);
+    try {
+      if (writer) writer->flush();
+    } catch (const std::exception& e) {
+      if (reason.find(e.what()) == std::string::npos)
+        outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
+    }
+    try {
+      if (store)
+        store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    } catch (const std::exception& e) {
+      outcome.reason += fmt::format(" (and the run's end could not be stored: {})", e.what());
+    }
     publish_end("aborted");
     end();
   }
@@ -417,7 +449,11 @@ struct CircleRun::Impl {
 CircleRun::CircleRun(boost::asio::io_context& io, CircleRunSetup setup)
     : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
 CircleRun::~CircleRun() {
-  if (!impl_->done && impl_->running) impl_->abort("stopped");
+  try {
+    if (!impl_->done && impl_->running) impl_->abort("stopped");
+  } catch (...) {
+    // abort() does not throw; a display callback might: not through a destructor.
+  }
 }
 void CircleRun::start() { impl_->start(); }
 void CircleRun::stop(const std::string& reason) { impl_->abort(reason); }

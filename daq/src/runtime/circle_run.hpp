@@ -115,6 +115,7 @@ struct CircleRunSetup {
   // The time the bar's calibration is looked up at (unix ms; 0: now). A replay decides the
   // calibration before (the original run's, or the newest), so that this lookup does nothing.
   std::int64_t calibration_at_unix_ms = 0;
+  cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
   std::function<void(const std::string&)> on_event;
   std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading

@@ -119,6 +119,8 @@ struct LinearRun::Impl {
   bool running = false, done = false;
   std::int64_t first_ns = -1;
   double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
+  // Handlers posted from the writer's thread run only while the run exists.
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
   Impl(boost::asio::io_context& i, LinearRunSetup s)
       : io(i),
@@ -135,6 +137,7 @@ struct LinearRun::Impl {
           cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
                                             .dwell_s = setup.config.trigger.dwell_s});
   }
+  ~Impl() { *alive = false; }
 
   std::uint16_t position_device() const {
     return static_cast<std::uint16_t>(2 + setup.material.size());
@@ -159,7 +162,7 @@ struct LinearRun::Impl {
   }
 
   void start() {
-    store.emplace(setup.database);
+    store.emplace(setup.database, setup.store_options);
     const auto& c = setup.config;
     std::int64_t machine = 0;
     if (auto m = store->machine_by_name(c.machine_name))
@@ -186,9 +189,11 @@ struct LinearRun::Impl {
       add(static_cast<int>(2 + k), *setup.material[k], "material");
     if (setup.position) add(position_device(), *setup.position, "position");
     writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id, cal::storage::WriterOptions{},
-        [this](const std::string& e) {
-          boost::asio::post(io, [this, e] { abort("storage failed: " + e); });
+        setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
+        [this, alive = alive](const std::string& e) {
+          boost::asio::post(io, [this, alive, e] {
+            if (*alive) abort("storage failed: " + e);
+          });
         });
     running = true;
     live.state = "waiting";
@@ -229,12 +234,16 @@ struct LinearRun::Impl {
     if (!running) return;
     r.device = device;
     ++outcome.readings;
-    writer->push({.time_ns = r.time_ns,
-                  .device = r.device,
-                  .channel = r.channel,
-                  .quantity = static_cast<std::uint8_t>(r.quantity),
-                  .status = static_cast<std::uint8_t>(r.status),
-                  .value = r.value});
+    try {
+      writer->push({.time_ns = r.time_ns,
+                    .device = r.device,
+                    .channel = r.channel,
+                    .quantity = static_cast<std::uint8_t>(r.quantity),
+                    .status = static_cast<std::uint8_t>(r.status),
+                    .value = r.value});
+    } catch (const std::exception& e) {  // the writer failed earlier (a full disk)
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     if (setup.on_reading) setup.on_reading(r);
     if (first_ns < 0) {
       // The run's time origin: this reading's session time is now in UTC (to the delivery
@@ -314,7 +323,11 @@ struct LinearRun::Impl {
             .deviation_um = s.deviation_um,
             .refractive_index = c.n,
             .material_temperature_degc = c.material_degc};
-        store->add_targets(std::span(&t, 1));
+        try {
+          store->add_targets(std::span(&t, 1));
+        } catch (const std::exception& err) {
+          return abort(fmt::format("storage failed: {}", err.what()));
+        }
       }
     }
     expect_next();
@@ -325,65 +338,79 @@ struct LinearRun::Impl {
   // with missed stops is stored incomplete with them listed, and evaluated from what it has.
   void finish() {
     running = false;
-    writer->flush();
-    for (const auto i : sequencer.missed()) {
-      const auto& s = sequencer.stops()[i];
-      outcome.missed.push_back(
-          {.run_id = outcome.run_id,
-           .run_number = s.run,
-           .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
-           .target_index = s.target_index - 1,
-           .nominal_mm = s.position_mm});
-    }
-    store->set_missed_stops(outcome.run_id, outcome.missed);
-    outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
-                                            : cal::storage::RunStatus::incomplete;
-    if (!outcome.missed.empty())
-      outcome.reason = fmt::format("{} of {} planned stops missed", outcome.missed.size(),
-                                   sequencer.stops().size());
-    const auto& l = *setup.config.linear;
-    const auto standard = cal::iso230_2::standard_from_string(l.standard);
     try {
-      outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
-    } catch (const std::exception& e) {
-      // Too little was captured to evaluate: stored as it is, and said why.
-      outcome.status = cal::storage::RunStatus::incomplete;
-      outcome.reason +=
-          (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
+      writer->flush();
+      for (const auto i : sequencer.missed()) {
+        const auto& s = sequencer.stops()[i];
+        outcome.missed.push_back(
+            {.run_id = outcome.run_id,
+             .run_number = s.run,
+             .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+             .target_index = s.target_index - 1,
+             .nominal_mm = s.position_mm});
+      }
+      store->set_missed_stops(outcome.run_id, outcome.missed);
+      outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
+                                              : cal::storage::RunStatus::incomplete;
+      if (!outcome.missed.empty())
+        outcome.reason = fmt::format("{} of {} planned stops missed", outcome.missed.size(),
+                                     sequencer.stops().size());
+      const auto& l = *setup.config.linear;
+      const auto standard = cal::iso230_2::standard_from_string(l.standard);
+      try {
+        outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
+      } catch (const std::exception& e) {
+        // Too little was captured to evaluate: stored as it is, and said why.
+        outcome.status = cal::storage::RunStatus::incomplete;
+        outcome.reason +=
+            (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
+        store->finish_run(outcome.run_id, outcome.status, outcome.reason);
+        live.state = "incomplete";
+        return end();
+      }
+      json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+      prov["standard"] = l.standard;
+      prov["coefficients"] = compensation_json(setup.config.environment);
+      prov["sensor_offsets"] = to_json(SensorOffsets{});
+      if (setup.replay) {
+        prov["capture"] = setup.capture_path;
+        prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
+      }
+      store->add_result({.run_id = outcome.run_id,
+                         .standard = std::string(outcome.evaluation->standard.title),
+                         .json = to_json(*outcome.evaluation).dump(),
+                         .provenance_json = prov.dump()});
       store->finish_run(outcome.run_id, outcome.status, outcome.reason);
-      live.state = "incomplete";
-      return end();
+    } catch (const cal::storage::StoreError& e) {  // a full disk: the run ends as aborted
+      outcome.evaluation.reset();
+      return abort(fmt::format("storage failed: {}", e.what()));
     }
-    json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
-    prov["standard"] = l.standard;
-    prov["coefficients"] = compensation_json(setup.config.environment);
-    prov["sensor_offsets"] = to_json(SensorOffsets{});
-    if (setup.replay) {
-      prov["capture"] = setup.capture_path;
-      prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
-    }
-    store->add_result({.run_id = outcome.run_id,
-                       .standard = std::string(outcome.evaluation->standard.title),
-                       .json = to_json(*outcome.evaluation).dump(),
-                       .provenance_json = prov.dump()});
-    store->finish_run(outcome.run_id, outcome.status, outcome.reason);
     outcome.complete = true;
     live.state = outcome.missed.empty() ? "complete" : "incomplete";
     end();
   }
 
+  // Never throws: a store that fails here too is named in the reason, which the caller
+  // reports (the run then stays "running" in the file, shown as incomplete).
   void abort(const std::string& reason) {
     if (done) return;
     running = false;
     outcome.reason = reason;
+    outcome.status = cal::storage::RunStatus::aborted;
     live.state = "aborted";
     live.message = reason;
     try {
       if (writer) writer->flush();
     } catch (const std::exception& e) {
-      outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
+      if (reason.find(e.what()) == std::string::npos)
+        outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
     }
-    if (store) store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    try {
+      if (store)
+        store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
+    } catch (const std::exception& e) {
+      outcome.reason += fmt::format(" (and the run's end could not be stored: {})", e.what());
+    }
     end();
   }
 
@@ -418,7 +445,12 @@ struct LinearRun::Impl {
 LinearRun::LinearRun(boost::asio::io_context& io, LinearRunSetup setup)
     : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
 LinearRun::~LinearRun() {
-  if (!impl_->done && impl_->running) impl_->abort("stopped");
+  try {
+    if (!impl_->done && impl_->running) impl_->abort("stopped");
+  } catch (...) {
+    // abort() does not throw; a display callback (on_live, on_event) might: a destructor
+    // must not let it through (std::terminate).
+  }
 }
 void LinearRun::start() { impl_->start(); }
 void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }

@@ -61,7 +61,8 @@ struct LinearRunSetup {
   // A replay of a capture: the results record it, and the original run when it is known.
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
-  std::function<void(const LiveState&)> on_live;     // about 10 Hz
+  cal::storage::StoreOptions store_options;       // the run's and the writer's (tests: max_pages)
+  std::function<void(const LiveState&)> on_live;  // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
 };
@@ -78,6 +79,9 @@ struct LinearRunOutcome {
   std::size_t readings = 0;
 };
 
+// A store or capture that fails (a full disk) ends the run as aborted with the reason
+// ("storage failed: FILE: ..."), keeping what was written; nothing is thrown out of the
+// instruments' handlers or the destructor.
 class LinearRun {
  public:
   LinearRun(boost::asio::io_context& io, LinearRunSetup setup);

@@ -8,10 +8,13 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <sstream>
 
+#include "cal/analysis/air.hpp"
 #include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
 
 namespace cal::daq {
@@ -27,8 +30,11 @@ class Table {
   [[noreturn]] void fail(const toml::node* node, std::string_view key,
                          const std::string& what) const {
     const auto& src = node ? node->source() : table_.source();
-    throw InputError(fmt::format("{}:{}:{}: key '{}{}': {}", file_.string(), src.begin.line,
-                                 src.begin.column, path_.empty() ? "" : path_ + ".", key, what));
+    const std::string where =
+        key.empty() ? fmt::format("table [{}]", path_)
+                    : fmt::format("key '{}{}'", path_.empty() ? "" : path_ + ".", key);
+    throw InputError(fmt::format("{}:{}:{}: {}: {}", file_.string(), src.begin.line,
+                                 src.begin.column, where, what));
   }
 
   template <class T>
@@ -37,10 +43,20 @@ class Table {
     const toml::node* node = table_.get(key);
     if (!node) return std::nullopt;
     if constexpr (std::is_same_v<T, double>) {
-      if (auto v = node->value<double>()) return *v;  // integers convert to double
+      if (auto v = node->value<double>()) {  // integers convert to double
+        if (!std::isfinite(*v)) fail(node, key, fmt::format("{} is not a finite number", *v));
+        return *v;
+      }
       fail(node, key, "expected a number");
     } else if constexpr (std::is_same_v<T, int>) {
-      if (auto v = node->value<std::int64_t>()) return static_cast<int>(*v);
+      // TOML integers are 64-bit: 4294967297 must not wrap to 1. Only integer nodes: toml++
+      // converts a float such as 3.3e49 to int64 without a range check (undefined
+      // behaviour, found by fuzz_config).
+      if (auto v = node->is_integer() ? node->value<std::int64_t>() : std::nullopt) {
+        if (*v < std::numeric_limits<int>::min() || *v > std::numeric_limits<int>::max())
+          fail(node, key, fmt::format("{} is out of range", *v));
+        return static_cast<int>(*v);
+      }
       fail(node, key, "expected an integer");
     } else if constexpr (std::is_same_v<T, bool>) {
       if (auto v = node->value<bool>()) return *v;
@@ -59,6 +75,35 @@ class Table {
   void positive(std::string_view key, double& target) {
     read(key, target);
     if (!(target > 0.0)) fail(table_.get(key), key, fmt::format("{} must be > 0", target));
+  }
+
+  // A number within [lo, hi] (lo excluded when `open_low`), the unit named in the message.
+  void in_range(std::string_view key, double& target, double lo, double hi,
+                std::string_view unit = "", bool open_low = false) {
+    read(key, target);
+    check_range(key, target, lo, hi, unit, open_low);
+  }
+  void check_range(std::string_view key, double value, double lo, double hi,
+                   std::string_view unit = "", bool open_low = false) const {
+    if ((open_low ? value > lo : value >= lo) && value <= hi) return;
+    const std::string u = unit.empty() ? "" : " " + std::string(unit);
+    fail(table_.get(key), key,
+         open_low ? fmt::format("{} must be > {} and at most {}{}", value, lo, hi, u)
+                  : fmt::format("{} must be within {} .. {}{}", value, lo, hi, u));
+  }
+  void whole_in_range(std::string_view key, int& target, int lo, int hi) {
+    read(key, target);
+    if (target < lo || target > hi)
+      fail(table_.get(key), key, fmt::format("{} must be within {} .. {}", target, lo, hi));
+  }
+  // A name: no control characters (it reaches logs, reports and exports), at most 200 bytes.
+  void name(std::string_view key, std::string& target, bool lines_allowed = false) {
+    read(key, target);
+    for (unsigned char c : target)
+      if ((c < 0x20 && !(lines_allowed && (c == '\n' || c == '\t'))) || c == 0x7f)
+        fail(table_.get(key), key, "control characters are not allowed");
+    if (target.size() > (lines_allowed ? 4000u : 200u))
+      fail(table_.get(key), key, fmt::format("{} bytes is too long", target.size()));
   }
 
   std::vector<double> numbers(std::string_view key) {
@@ -188,34 +233,55 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   return d;
 }
 
+// Ranges (docs/config.md): the air values are those the refractive-index equations accept
+// (NIST's calculator: -40 .. 100 degC, 10 .. 140 kPa, 0 .. 100 %RH, 0 .. 2000 umol/mol,
+// 300 .. 1700 nm); the fallback air is then checked against the chosen equation itself.
 EnvironmentConfig read_environment(Table& t) {
   EnvironmentConfig e;
   t.read("equation", e.equation);
   one_of(t, "equation", e.equation, {"ciddor", "edlen", "shop-floor"});
-  t.positive("stale_after_s", e.stale_after_s);
+  t.in_range("stale_after_s", e.stale_after_s, 0, 86400, "s", true);
   std::string on_stale = "stop";
   t.read("on_stale", on_stale);
   one_of(t, "on_stale", on_stale, {"stop", "fallback"});
   e.on_stale = on_stale == "stop" ? StalePolicy::stop : StalePolicy::fallback;
-  t.read("fallback_temperature_degc", e.fallback_temperature_degc);
-  t.positive("fallback_pressure_pa", e.fallback_pressure_pa);
-  t.read("fallback_humidity_pct", e.fallback_humidity_pct);
-  t.read("fallback_material_degc", e.fallback_material_degc);
-  t.read("co2_umol_per_mol", e.co2_umol_per_mol);
-  t.positive("wavelength_nm", e.wavelength_nm);
-  t.read("expansion_ppm_per_k", e.expansion_ppm_per_k);
+  t.in_range("fallback_temperature_degc", e.fallback_temperature_degc, -40, 100, "degC");
+  t.in_range("fallback_pressure_pa", e.fallback_pressure_pa, 10e3, 140e3, "Pa");
+  t.in_range("fallback_humidity_pct", e.fallback_humidity_pct, 0, 100, "%");
+  t.in_range("fallback_material_degc", e.fallback_material_degc, -50, 150, "degC");
+  t.in_range("co2_umol_per_mol", e.co2_umol_per_mol, 0, 2000, "umol/mol");
+  t.in_range("wavelength_nm", e.wavelength_nm, 300, 1700, "nm");
+  t.in_range("expansion_ppm_per_k", e.expansion_ppm_per_k, -100, 300, "ppm/K");
+  try {
+    air::refractive_index({.temperature_degc = e.fallback_temperature_degc,
+                           .pressure_pa = e.fallback_pressure_pa,
+                           .humidity = air::Humidity::relative_pct(e.fallback_humidity_pct),
+                           .co2_umol_per_mol = e.co2_umol_per_mol,
+                           .wavelength_vacuum_nm = e.wavelength_nm},
+                          air::equation_from_string(e.equation));
+  } catch (const InputError& err) {
+    t.fail(t.node("equation"), "equation", fmt::format("with the fallback air: {}", err.what()));
+  }
   t.check_unknown();
   return e;
 }
+
+// Positions within +-100 m, feeds up to 200 m/min, dwells up to an hour: beyond any machine
+// this calibrates, and small enough that nothing written into a part program overflows.
+constexpr double kMaxPositionMm = 100'000, kMaxFeedMmPerMin = 200'000, kMaxDwellS = 3600;
 
 LinearTestConfig read_linear(Table& t) {
   LinearTestConfig l;
   t.read("axis", l.axis);
   one_of(t, "axis", l.axis, {"X", "Y", "Z"});
-  t.read("first_mm", l.first_mm);
-  t.read("last_mm", l.last_mm);
+  t.in_range("first_mm", l.first_mm, -kMaxPositionMm, kMaxPositionMm, "mm");
+  t.in_range("last_mm", l.last_mm, -kMaxPositionMm, kMaxPositionMm, "mm");
   l.interval_mm = t.get<double>("interval_mm");
+  if (l.interval_mm) t.check_range("interval_mm", *l.interval_mm, 0, kMaxPositionMm, "mm", true);
   l.count = t.get<int>("count");
+  if (l.count && (*l.count < 2 || *l.count > iso230_2::max_plan_targets))
+    t.fail(t.node("count"), "count",
+           fmt::format("{} must be within 2 .. {}", *l.count, iso230_2::max_plan_targets));
   // Neither is allowed on an axis over 2000 mm: ISO 230-2's average interval of 250 mm.
   const bool long_axis = cal::iso230_2::is_long_axis(l.first_mm, l.last_mm);
   if ((l.interval_mm && l.count) || (!l.interval_mm && !l.count && !long_axis))
@@ -223,16 +289,36 @@ LinearTestConfig read_linear(Table& t) {
            "give exactly one of interval_mm and count (or neither on an axis over 2000 mm: "
            "targets an average of 250 mm apart, ISO 230-2)");
   t.read("random_fraction", l.random_fraction);
+  if (!(l.random_fraction >= 0 && l.random_fraction < 0.5))
+    t.fail(t.node("random_fraction"), "random_fraction",
+           fmt::format("{} must be >= 0 and < 0.5", l.random_fraction));
   t.read("cycle", l.cycle);
   one_of(t, "cycle", l.cycle, {"linear", "pendulum", "pilgrim-step"});
-  t.read("runs", l.runs);
-  if (l.runs < 1) t.fail(t.node("runs"), "runs", "must be >= 1");
+  t.whole_in_range("runs", l.runs, 1, iso230_2::max_plan_runs);
   t.read("bidirectional", l.bidirectional);
-  t.read("overrun_mm", l.overrun_mm);
-  t.positive("feed_mm_per_min", l.feed_mm_per_min);
-  t.positive("dwell_s", l.dwell_s);
-  t.read("dead_path_mm", l.dead_path_mm);
+  t.in_range("overrun_mm", l.overrun_mm, 0, 1000, "mm");
+  t.in_range("feed_mm_per_min", l.feed_mm_per_min, 0, kMaxFeedMmPerMin, "mm/min", true);
+  t.in_range("dwell_s", l.dwell_s, 0, kMaxDwellS, "s", true);
+  t.in_range("dead_path_mm", l.dead_path_mm, 0, kMaxPositionMm, "mm");
   t.read("standard", l.standard);
+  try {  // a misspelt standard is refused now, not after every stop has been captured
+    iso230_2::standard_from_string(l.standard);
+  } catch (const InputError& e) {
+    t.fail(t.node("standard"), "standard", e.what());
+  }
+  try {  // the combination: travel, interval or count, cycle
+    iso230_2::make_plan({.first_mm = l.first_mm,
+                         .last_mm = l.last_mm,
+                         .interval_mm = l.interval_mm,
+                         .count = l.count,
+                         .random_fraction = l.random_fraction},
+                        {.cycle = iso230_2::cycle_from_string(l.cycle),
+                         .bidirectional = l.bidirectional,
+                         .runs = l.runs,
+                         .overrun_mm = l.overrun_mm});
+  } catch (const InputError& e) {
+    t.fail(nullptr, "", e.what());
+  }
   t.check_unknown();
   return l;
 }
@@ -241,18 +327,19 @@ CircleTestConfig read_circle(Table& t) {
   CircleTestConfig c;
   t.read("plane", c.plane);
   one_of(t, "plane", c.plane, {"XY", "YZ", "ZX"});
-  t.positive("radius_mm", c.radius_mm);
-  t.positive("feed_mm_per_min", c.feed_mm_per_min);
-  t.positive("sample_rate_hz", c.sample_rate_hz);
-  t.read("overshoot_deg", c.overshoot_deg);
+  t.in_range("radius_mm", c.radius_mm, 0, 5000, "mm", true);
+  t.in_range("feed_mm_per_min", c.feed_mm_per_min, 0, kMaxFeedMmPerMin, "mm/min", true);
+  t.in_range("sample_rate_hz", c.sample_rate_hz, 0, 1e6, "Hz", true);
+  t.in_range("overshoot_deg", c.overshoot_deg, 0, 180, "deg");
   if (auto centre = t.numbers("centre_mm"); !centre.empty()) {
     if (centre.size() != 3) t.fail(t.node("centre_mm"), "centre_mm", "expected [x, y, z]");
+    for (double v : centre)
+      if (!std::isfinite(v) || std::abs(v) > kMaxPositionMm)
+        t.fail(t.node("centre_mm"), "centre_mm",
+               fmt::format("{} is not a finite position within +-{} mm", v, kMaxPositionMm));
     c.centre_mm = centre;
   }
-  t.read("calibrated_radius_mm", c.calibrated_radius_mm);
-  if (c.calibrated_radius_mm < 0 || !std::isfinite(c.calibrated_radius_mm))
-    t.fail(t.node("calibrated_radius_mm"), "calibrated_radius_mm",
-           fmt::format("{} must be > 0 (or 0: not given)", c.calibrated_radius_mm));
+  t.in_range("calibrated_radius_mm", c.calibrated_radius_mm, 0, 5000, "mm");  // 0: not given
   if (const auto* n = t.node("planes")) {
     t.known("planes");
     const auto* arr = n->as_array();
@@ -269,24 +356,16 @@ CircleTestConfig read_circle(Table& t) {
   }
   for (const char* key : {"feeds_mm_per_min", "radii_mm"}) {
     auto values = t.numbers(key);
+    const bool radii = std::string_view(key) == "radii_mm";
     for (double v : values)
-      if (!(v > 0) || !std::isfinite(v)) t.fail(t.node(key), key, fmt::format("{} must be > 0", v));
-    (std::string_view(key) == "radii_mm" ? c.radii_mm : c.feeds_mm_per_min) = std::move(values);
+      t.check_range(key, v, 0, radii ? 5000 : kMaxFeedMmPerMin, radii ? "mm" : "mm/min", true);
+    (radii ? c.radii_mm : c.feeds_mm_per_min) = std::move(values);
   }
-  t.read("partial_arc_deg", c.partial_arc_deg);
-  if (!(c.partial_arc_deg >= 180 && c.partial_arc_deg <= 360))
-    t.fail(t.node("partial_arc_deg"), "partial_arc_deg",
-           fmt::format("{} must be 180..360", c.partial_arc_deg));
-  t.read("partial_overshoot_deg", c.partial_overshoot_deg);
-  if (!(c.partial_overshoot_deg >= 0 && c.partial_overshoot_deg <= 45))
-    t.fail(t.node("partial_overshoot_deg"), "partial_overshoot_deg",
-           fmt::format("{} must be 0..45", c.partial_overshoot_deg));
-  if (!(c.overshoot_deg >= 0 && c.overshoot_deg <= 180))
-    t.fail(t.node("overshoot_deg"), "overshoot_deg",
-           fmt::format("{} must be 0..180", c.overshoot_deg));
-  t.positive("feed_in_mm", c.feed_in_mm);
-  t.positive("dwell_s", c.dwell_s);
-  t.read("bar", c.bar);
+  t.in_range("partial_arc_deg", c.partial_arc_deg, 180, 360, "deg");
+  t.in_range("partial_overshoot_deg", c.partial_overshoot_deg, 0, 45, "deg");
+  t.in_range("feed_in_mm", c.feed_in_mm, 0, 100, "mm", true);
+  t.in_range("dwell_s", c.dwell_s, 0, kMaxDwellS, "s", true);
+  t.name("bar", c.bar);
   if (!c.planes.empty() && t.node("plane"))
     t.fail(t.node("plane"), "plane", "give plane (one test) or planes (a set), not both");
   if (c.radii_mm.size() > 1 && c.calibrated_radius_mm > 0)
@@ -403,31 +482,32 @@ Config parse_config(std::string_view text, const std::filesystem::path& file) {
   Table top(root, "", file);
   if (const auto* m = top.subtable("machine")) {
     Table t(*m, "machine", file);
-    t.read("name", c.machine_name);
-    t.read("description", c.machine_description);
-    t.read("make", c.machine_make);
-    t.read("model", c.machine_model);
-    t.read("serial_number", c.machine_serial);
+    t.name("name", c.machine_name);
+    if (c.machine_name.empty()) t.fail(t.node("name"), "name", "must not be empty");
+    t.name("description", c.machine_description, true);
+    t.name("make", c.machine_make);
+    t.name("model", c.machine_model);
+    t.name("serial_number", c.machine_serial);
     t.check_unknown();
   }
-  top.read("campaign", c.campaign);
-  top.read("operator", c.operator_name);
+  top.name("campaign", c.campaign);
+  top.name("operator", c.operator_name);
   if (const auto* cu = top.subtable("customer")) {
     Table t(*cu, "customer", file);
-    t.read("name", c.customer.name);
-    t.read("site", c.customer.site);
-    t.read("contact", c.customer.contact);
+    t.name("name", c.customer.name);
+    t.name("site", c.customer.site, true);
+    t.name("contact", c.customer.contact, true);
     t.check_unknown();
   }
   if (const auto* co = top.subtable("conditions")) {
     Table t(*co, "conditions", file);
     c.conditions.controller_compensation = t.get<bool>("controller_compensation");
-    t.read("warm_up", c.conditions.warm_up);
-    t.read("load", c.conditions.load);
+    t.name("warm_up", c.conditions.warm_up, true);
+    t.name("load", c.conditions.load, true);
     t.read("state", c.conditions.state);
     if (!c.conditions.state.empty())
       one_of(t, "state", c.conditions.state, {"as found", "as left"});
-    t.read("notes", c.conditions.notes);
+    t.name("notes", c.conditions.notes, true);
     t.check_unknown();
   }
   read_tolerances(c, top);
@@ -445,9 +525,9 @@ Config parse_config(std::string_view text, const std::filesystem::path& file) {
   }
   if (const auto* tr = top.subtable("trigger")) {
     Table t(*tr, "trigger", file);
-    t.positive("tolerance_um", c.trigger.tolerance_um);
-    t.positive("dwell_s", c.trigger.dwell_s);
-    t.positive("window_mm", c.trigger.window_mm);
+    t.in_range("tolerance_um", c.trigger.tolerance_um, 0, 10'000, "um", true);
+    t.in_range("dwell_s", c.trigger.dwell_s, 0, kMaxDwellS, "s", true);
+    t.in_range("window_mm", c.trigger.window_mm, 0, 1000, "mm", true);
     t.check_unknown();
   }
   if (const auto* tests = top.subtable("test")) {

@@ -17,13 +17,38 @@
 namespace cal::daq {
 namespace {
 
+// The last guard before a number reaches the controller: whatever the caller checked, a
+// non-finite or absurd value (beyond +-1 km, where 4 decimals no longer fit the 8 + 4 digits
+// of the controls' words) is refused, never written as "nan", "inf" or 1e+09.
+constexpr double kMaxWordValue = 1e6;
+double checked(double v, std::string_view what) {
+  if (!std::isfinite(v) || std::abs(v) > kMaxWordValue)
+    throw InputError(
+        fmt::format("program: {} {} is not a finite value within +-{}", what, v, kMaxWordValue));
+  return v;
+}
 std::string num(double v) {  // 4 decimals, no "-0.0000"
+  checked(v, "value");
   if (std::abs(v) < 5e-5) v = 0.0;
   return fmt::format("{:.4f}", v);
 }
 std::string signed_num(double v) {  // Heidenhain writes the sign: X+12.5000
+  checked(v, "value");
   if (std::abs(v) < 5e-5) v = 0.0;
   return fmt::format("{:+.4f}", v);
+}
+
+// A program name every dialect takes: letters, digits and '_', a letter first, at most 24
+// (Heidenhain's BEGIN PGM allows letters, digits and '_'; Fanuc and SINUMERIK only show it in
+// a comment, where a ')' or a line break would end the comment or the block).
+void check_name(const std::string& name) {
+  const bool ok = !name.empty() && name.size() <= 24 &&
+                  std::isalpha(static_cast<unsigned char>(name[0])) &&
+                  std::all_of(name.begin(), name.end(),
+                              [](unsigned char c) { return std::isalnum(c) || c == '_'; });
+  if (!ok)
+    throw InputError(fmt::format(
+        "program name '{}': letters, digits and '_' only, a letter first, at most 24", name));
 }
 
 const char* plane_word(Dialect d, Plane p) {
@@ -58,7 +83,7 @@ struct Writer {
       add(fmt::format("G71 G90 {} G94", plane_word(d, plane)));  // G71: metric on SINUMERIK
     }
   }
-  std::string feed(double f) const { return fmt::format("F{}", std::lround(f)); }
+  std::string feed(double f) const { return fmt::format("F{}", std::lround(checked(f, "feed"))); }
   void line_to(std::string_view axes, double f) {
     if (d == Dialect::heidenhain)
       add(fmt::format("L {} {}", axes, feed(f)));
@@ -73,9 +98,9 @@ struct Writer {
       add(fmt::format("CYCL DEF 9.1 DWELL {}", num(s)));
     } else if (d == Dialect::fanuc) {
       if (fanuc_dwell == FanucDwell::p_ms)
-        add(fmt::format("G04 P{}", std::lround(s * 1000)));  // P: ms, no decimal point
+        add(fmt::format("G04 P{}", std::lround(checked(s, "dwell") * 1000)));  // ms, no point
       else
-        add(fmt::format("G04 X{:.3f}", s));  // X: s; 3 decimals fit IS-B (0.001 s) and IS-C
+        add(fmt::format("G04 X{:.3f}", checked(s, "dwell")));  // s; 3 decimals fit IS-B, IS-C
     } else {
       add(fmt::format("G4 F{}", num(s)));  // F: seconds in a G4 block
     }
@@ -135,10 +160,10 @@ std::string centre_words(Dialect d, char a, double va, char b, double vb) {
 }
 
 void check_feed_dwell(double feed_mm_per_min, double dwell_s) {
-  if (!(feed_mm_per_min > 0) || !std::isfinite(feed_mm_per_min) || !(dwell_s > 0) ||
-      !std::isfinite(dwell_s))
-    throw InputError(fmt::format("program: feed {} mm/min and dwell {} s must be finite and > 0",
-                                 feed_mm_per_min, dwell_s));
+  if (!(feed_mm_per_min > 0) || !(feed_mm_per_min <= 1e6) || !(dwell_s > 0) || !(dwell_s <= 3600))
+    throw InputError(fmt::format(
+        "program: feed {} mm/min and dwell {} s must be > 0 and at most 1e6 mm/min and 3600 s",
+        feed_mm_per_min, dwell_s));
 }
 
 }  // namespace
@@ -171,6 +196,7 @@ std::string linear_program(const iso230_2::Plan& plan, const LinearProgram& p, D
         "(the machine would leave before the stop is recognised); program at least {} s",
         p.dwell_s, p.trigger_dwell_s, p.settle_s, p.trigger_dwell_s + p.settle_s));
   if (plan.moves.empty()) throw InputError("program: the plan has no moves");
+  check_name(p.name);
   Writer w{d, p.fanuc_dwell, Plane::xy, {}, 0};
   w.begin(p.name, fmt::format("ISO 230-2 test of {}: {} targets, {} moves", p.axis,
                               plan.targets_mm.size(), plan.moves.size()));
@@ -387,7 +413,15 @@ std::vector<BallbarSetTest> ballbar_set(const BallbarSetConfig& c) {
 std::string circle_set_program(std::span<const BallbarSetTest> tests, const CircleProgramSetup& s,
                                Dialect d) {
   if (tests.empty()) throw InputError("program: the ballbar set has no test");
-  for (const auto& t : tests) BallbarSegmenter check(t.program);  // validates the numbers
+  check_name(s.name);
+  for (const auto& t : tests) {
+    const auto& b = t.program;
+    BallbarSegmenter check(b);  // validates the numbers
+    check_feed_dwell(b.feed_mm_per_min, std::max(b.dwell_s, 1e-3));
+    checked(b.radius_mm + b.feed_in_mm, "radius");
+    if (!(b.overshoot_deg <= 180))
+      throw InputError(fmt::format("program: overshoot {} deg is over 180", b.overshoot_deg));
+  }
   const bool set = tests.size() > 1;
   Writer w{d, s.fanuc_dwell, tests.front().plane, {}, 0};
   const auto& b0 = tests.front().program;

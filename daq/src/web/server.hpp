@@ -1,9 +1,14 @@
 #pragma once
 // The local HTTP + WebSocket service (Boost.Beast) behind `daq serve`: serves the live
 // readout page, a small JSON API (runs, start, stop, status) and a WebSocket that pushes the
-// live state. Bound to 127.0.0.1 by default; any other address only with a token, which
-// every request must then carry (Authorization: Bearer TOKEN, or ?token=TOKEN for the page
-// and the WebSocket, which browsers cannot give headers).
+// live state. Bound to 127.0.0.1 by default; any other address only with a token.
+//
+// Safe by default against the web pages the operator visits and against hostile clients
+// (the rules: http_policy.hpp; docs/web.md, "Security"): Host and Origin are checked, POST
+// bodies must be JSON, the token (if any) is checked before a body is read, headers and
+// bodies have size limits, a request must arrive within request_timeout, connections are
+// capped (at the cap the connection waiting longest for a request is closed to make room),
+// and the accept loop survives every error (e.g. EMFILE: it waits and retries).
 //
 // The WebSocket sends the latest state at a fixed period (default 10 Hz), never a queue of
 // every reading: a 10 kHz stream can never make it fall behind, and a slow client only
@@ -13,6 +18,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace boost::asio {
 class io_context;
@@ -25,20 +32,32 @@ struct ServerOptions {
   std::uint16_t port = 8080;  // 0: an ephemeral port (see port())
   std::string token;          // required when address is not a loopback address
   std::chrono::milliseconds push_period{100};
+  std::vector<std::string> allowed_hosts;  // Host names accepted beside localhost and the address
+  std::size_t max_header_bytes = 8 * 1024;
+  std::size_t max_body_bytes = 64 * 1024;
+  std::size_t max_connections = 256;  // HTTP and WebSocket together
+  // A request (header and body) must arrive within this after the connection opens or the
+  // previous answer was sent; an idle keep-alive connection is closed after it too.
+  std::chrono::milliseconds request_timeout{10'000};
+  // A WebSocket client is pinged after half of this without data and closed after all of it.
+  std::chrono::milliseconds websocket_idle_timeout{60'000};
+  std::function<void(std::string_view)> log;  // accept errors and the like (may be empty)
 };
 
 struct Response {
   int status = 200;
-  std::string body;  // JSON
+  std::string body;  // JSON unless content_type says otherwise
+  std::string content_type = "application/json";
 };
 
-// The service's side of the API; every handler runs on the io_context's thread.
+// The service's side of the API; every handler runs on the io_context's thread. A handler
+// that throws gives a 500 with the exception's text; the server goes on.
 struct Api {
   std::function<std::string()> page;                       // GET /
   std::function<Response()> runs;                          // GET /api/runs
   std::function<Response()> status;                        // GET /api/status
   std::function<Response(const std::string& body)> start;  // POST /api/runs/start (JSON body)
-  std::function<Response()> stop;                          // POST /api/runs/stop
+  std::function<Response(const std::string& body)> stop;   // POST /api/runs/stop (JSON body)
 };
 
 class LiveServer {
@@ -56,6 +75,7 @@ class LiveServer {
   void publish(std::string state_json);
   std::size_t websocket_clients() const;
   std::uint64_t messages_sent() const;
+  std::size_t connections() const;  // open HTTP and WebSocket connections
 
  private:
   struct Impl;

@@ -14,6 +14,10 @@
 namespace cal::comptable {
 
 enum class Sign { correction, error };  // correction = -error (what the control adds)
+
+// Bounds of a table (see positioning()): a grid within +-100 m of at most 100 000 points.
+inline constexpr double max_position_mm = 100'000;
+inline constexpr int max_points = 100'000;
 enum class Units { mm, um, inch };
 enum class Outside { refuse, hold };  // grid points beyond the measured targets
 
@@ -43,7 +47,10 @@ struct Table {
 // bidirectional mean x-bar with backlash = mean(x-bar-down - x-bar-up) (lost motion makes the
 // down approach stop higher). Linear interpolation between targets. Throws cal::InputError
 // for interval <= 0, points < 2, resolution < 0, fewer than 2 targets, or a grid point
-// outside the measured range under Outside::refuse.
+// outside the measured range under Outside::refuse; also for an axis name that is not letters
+// and digits (a letter first, at most 8), a grid beyond the bounds above, a resolution other
+// than 0 or 1e-9 .. 1. Every writer validates again and refuses a table holding a number that
+// is not finite.
 Table positioning(const Spec& spec, std::span<const iso230_2::TargetStats> targets);
 
 // A straightness cross-compensation: the correction of axis `slave` as a function of the

@@ -19,6 +19,11 @@ enum class Cycle {
 std::string_view to_string(Cycle c);
 Cycle cycle_from_string(std::string_view name);  // linear | pendulum | pilgrim-step
 
+// Bounds on a plan's size: far beyond any real test (ISO 230-2 asks for 5 targets per metre
+// and 5 runs), small enough that a typo (count = 1e9) is an error, not gigabytes of moves.
+inline constexpr int max_plan_targets = 10'000;
+inline constexpr int max_plan_runs = 1'000;
+
 // ISO 230-2 for linear axes over 2000 mm (ISO 230-2:2014, 6.2; the test over the whole travel):
 // one approach in each direction is enough, at targets an average of 250 mm apart; the
 // repeatability and the accuracy A are then not evaluated (they need two or more runs).
@@ -68,10 +73,12 @@ struct Plan {
 };
 
 // Targets in increasing order; throws InputError for an empty or inverted range, a bad
-// interval or count, or a random fraction outside [0, 0.5).
+// interval or count (more than max_plan_targets included), a random fraction outside [0, 0.5),
+// or a rounding step that is not finite and >= 0.
 std::vector<double> generate_targets(const TargetSpec& spec);
 
-// The full plan. Throws InputError on bad specs (runs < 1, overrun < 0, ...); ISO 230-2
+// The full plan. Throws InputError on bad specs (runs outside 1 .. max_plan_runs, overrun < 0 or
+// not finite, ...); ISO 230-2
 // recommendations not met (fewer than 5 runs per direction, fewer than 5 targets or than
 // 5 per metre; over 2000 mm: an average interval over 250 mm) are warnings.
 Plan make_plan(const TargetSpec& targets, const CycleSpec& cycle);

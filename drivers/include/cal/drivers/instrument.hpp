@@ -26,6 +26,7 @@ enum class Quantity : std::uint8_t {
   refractive_index,  // as computed by the instrument (e.g. the IDS ECU)
   material_temperature_degc,
   machine_position_m,  // a machine position feed (actual or commanded)
+  angle_rad,           // an angular measurement (e.g. an imported angular laser capture)
 };
 std::string_view to_string(Quantity q);
 
@@ -85,6 +86,8 @@ Clock steady_clock_ns();
 // clock: the capture file (replay/) implements it. Recording at the instrument boundary,
 // right after the transport, gives the readings and the recorded bytes one timestamp, so a
 // replay reproduces the readings exactly.
+// Must not throw: instruments record from their stop(), which runs in destructors (a failing
+// recorder keeps its error and reports it another way; see cal::replay::CaptureRecorder).
 class WireRecorder {
  public:
   virtual ~WireRecorder() = default;

@@ -55,6 +55,9 @@ inline constexpr std::size_t max_block_bytes = 32u << 20;
 
 struct WriterLimits {
   std::size_t block_bytes = 64 * 1024;  // a block is written when its payload reaches this
+  // A cap on the file size (0: none): a write that would pass it fails as on a full disk
+  // (ENOSPC), which is how the tests exercise that path (as StoreOptions::max_pages does).
+  std::uint64_t max_file_bytes = 0;
 };
 
 class CaptureWriter {
