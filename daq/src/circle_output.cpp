@@ -78,13 +78,13 @@ void print_circle(const ci::Result& r, double radius_mm, std::string_view plane,
       "\nDiagnostics, ranked by PV (the peak-to-valley of the error's own pattern on the traces),\n"
       "with PV / G (the share of G; caldaq's own figure, can exceed 100 %) and G gain (how much\n"
       "G falls when that error alone is removed; docs/circle.md):\n");
-  fmt::print("  {:<40} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "PV / G",
+  fmt::print("  {:<48} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "PV / G",
              "G gain");
   for (const auto& d : r.diagnostics)
-    fmt::print("  {:<40} {:+9.3f} {:<5} {:7.3f} um {:5.1f} % {:7.3f} um\n", d.name, d.value, d.unit,
+    fmt::print("  {:<48} {:+9.3f} {:<5} {:7.3f} um {:5.1f} % {:7.3f} um\n", d.name, d.value, d.unit,
                d.pv_um, d.share_pct, d.g_reduction_um);
-  fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_u.name, r.centre_u.value);
-  fmt::print("  {:<40} {:+9.3f} um (set-up)\n", r.centre_v.name, r.centre_v.value);
+  fmt::print("  {:<48} {:+9.3f} um (set-up)\n", r.centre_u.name, r.centre_u.value);
+  fmt::print("  {:<48} {:+9.3f} um (set-up)\n", r.centre_v.name, r.centre_v.value);
   fmt::print("  residual rms {:.3f} um\n", r.residual_rms_um);
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
 }

@@ -1,5 +1,7 @@
 // daq ballbar calibrate|calibrations: the bar's calibration against a calibrator, stored with
 // its date, used for the absolute radius of later tests (docs/circle.md, "Bar calibration").
+// daq ballbar volumetric|history: the three-plane table of a campaign's tests and a machine's
+// tests over time (docs/circle.md, "The three-plane table", "History").
 #include <fmt/format.h>
 
 #include <cmath>
@@ -7,10 +9,12 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "ballbar_campaign.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/storage/store.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "model/model_file.hpp"
 #include "provenance.hpp"
 
 namespace daq {
@@ -128,6 +132,78 @@ void list(const std::string& db, const std::string& bar, bool as_json) {
                c.zero_length_mm, utc_iso(c.calibrated_unix_ms).substr(0, 16));
 }
 
+struct SetOptions {
+  std::string db, machine, campaign, model_in, model_out;
+  std::vector<std::int64_t> runs;
+  bool json = false;
+};
+
+std::vector<BallbarTest> tests_of(const st::Store& store, const SetOptions& o) {
+  if (!o.runs.empty() && !o.machine.empty())
+    throw cal::InputError("give --runs or --machine, not both");
+  if (o.runs.empty() && o.machine.empty())
+    throw cal::InputError("give the tests: --machine NAME [--campaign C] or --runs N,N,...");
+  const auto runs = o.runs.empty() ? ballbar_runs(store, o.machine, o.campaign) : o.runs;
+  if (runs.empty())
+    throw cal::InputError(
+        fmt::format("{}: machine '{}' has no complete ballbar test{}", store.path().string(),
+                    o.machine, o.campaign.empty() ? "" : " in campaign '" + o.campaign + "'"));
+  return ballbar_tests(store, runs);
+}
+
+// The model file with the table's squareness in place of its own (the rest as it was).
+void write_model(const VolumetricTable& v, const SetOptions& o) {
+  namespace md = cal::daq::model;
+  auto m = md::read(o.model_in);
+  const json block = model_squareness(v);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& pv = v.combined.planes[i];
+    if (!pv) continue;
+    const auto p = cal::circle::model_plane(pv->plane);
+    const json& e = block[std::string(cal::kinematics::location_error_name(p))];
+    auto& entry = m.squareness[static_cast<std::size_t>(p)];
+    m.machine.squareness.of(p) = cal::circle::location_error_urad(*pv);
+    entry.given = true;
+    entry.stated_as = "iso230_1_urad";
+    entry.method = e["method"].get<std::string>();
+    entry.placement = e.value("placement", std::string());
+    entry.position_mm.reset();
+    if (e.contains("position_mm"))
+      entry.position_mm = cal::kinematics::Vec3{e["position_mm"][0].get<double>(),
+                                                e["position_mm"][1].get<double>(),
+                                                e["position_mm"][2].get<double>()};
+    entry.source.json = e["source"].dump();
+  }
+  md::write(m, o.model_out);
+}
+
+void volumetric(const SetOptions& o) {
+  if (o.model_in.empty() != o.model_out.empty())
+    throw cal::InputError("--model and --write-model go together (read one, write the other)");
+  st::Store store(database_path(o.db));
+  const auto tests = tests_of(store, o);
+  const auto v = volumetric_table(tests);
+  if (!o.model_in.empty()) write_model(v, o);
+  if (o.json) return fmt::print("{}\n", to_json(v, tests).dump(2));
+  print_volumetric(v, tests);
+  if (!o.model_in.empty())
+    fmt::print("\nwrote {} (the squareness of {} with the table's)\n", o.model_out, o.model_in);
+}
+
+void history(const SetOptions& o) {
+  st::Store store(database_path(o.db));
+  const auto tests = tests_of(store, o);
+  if (o.json) return fmt::print("{}\n", history_json(tests).dump(2));
+  print_history(tests);
+}
+
+void add_set_options(CLI::App& cmd, SetOptions& o) {
+  add_db_option(cmd, o.db);
+  cmd.add_option("--machine", o.machine, "The machine's ballbar tests (its complete circle runs)");
+  cmd.add_option("--campaign", o.campaign, "Only this campaign's");
+  cmd.add_option("--runs", o.runs, "These circle runs instead")->delimiter(',');
+}
+
 }  // namespace
 
 void add_ballbar_commands(CLI::App& app) {
@@ -167,6 +243,24 @@ void add_ballbar_commands(CLI::App& app) {
   ls->add_option("--bar", l->second, "Only this bar's");
   ls->add_flag("--json", *as_json, "Print caldaq.bar-calibrations.v1");
   ls->callback([l, as_json] { list(l->first, l->second, *as_json); });
+
+  auto vo = std::make_shared<SetOptions>();
+  auto* vol = bb->add_subcommand(
+      "volumetric",
+      "The three-plane table: squareness XY, ZX, YZ as the model's E_C0Y, E_B0Z, E_A0Z and the "
+      "axis scales, from a campaign's ballbar tests");
+  add_set_options(*vol, *vo);
+  vol->add_option("--model", vo->model_in, "A caldaq.model.v1 file to take the squareness");
+  vol->add_option("--write-model", vo->model_out, "Where to write it with the table's squareness");
+  vol->add_flag("--json", vo->json, "Print caldaq.ballbar-volumetric.v1");
+  vol->callback([vo] { volumetric(*vo); });
+
+  auto ho = std::make_shared<SetOptions>();
+  auto* his = bb->add_subcommand(
+      "history", "A machine's ballbar tests over time, per plane, feed and radius, with verdicts");
+  add_set_options(*his, *ho);
+  his->add_flag("--json", ho->json, "Print caldaq.ballbar-history.v1");
+  his->callback([ho] { history(*ho); });
 }
 
 }  // namespace daq

@@ -62,6 +62,14 @@ check uncalibrated_no_radius 1 "^0$" -- bash -c "\"$DAQ\" analyse 1 --db \"$TMP/
 check report_calibration 0 "<td>calibrator</td><td>simulated calibrator, 100.0000 mm</td>" -- cat "$TMP/r1.html"
 check report_calibration_record 0 "calibration 1 \(daq ballbar calibrations\)" -- cat "$TMP/r1.html"
 check runs_listed 0 "circle +XY.*complete" -- "$DAQ" runs --db "$TMP/run.sqlite"
+# The three-plane table of the stored tests (the run and its replay, both XY at one feed:
+# averaged) and the history (docs/circle.md).
+check volumetric 0 "XY +1,2 +1000 +\+(19\.9[5-9]|20\.0[0-5])[0-9]* +E_C0Y = +\+(19\.9[5-9]|20\.0[0-5])" -- "$DAQ" ballbar volumetric --db "$TMP/run.sqlite" --machine "SIMULATED VMC"
+check volumetric_missing_planes 0 "no test in ZX" -- "$DAQ" ballbar volumetric --db "$TMP/run.sqlite" --runs 1
+check volumetric_json 0 '"location_error": "E_C0Y"' -- "$DAQ" ballbar volumetric --db "$TMP/run.sqlite" --runs 1 --json
+check history 0 "XY at 1000 mm/min, R 100 mm" -- "$DAQ" ballbar history --db "$TMP/run.sqlite" --machine "SIMULATED VMC"
+check history_unknown_machine 2 "no machine named 'NOPE'" -- "$DAQ" ballbar history --db "$TMP/run.sqlite" --machine NOPE
+check volumetric_both 2 "--runs or --machine, not both" -- "$DAQ" ballbar volumetric --db "$TMP/run.sqlite" --machine X --runs 1
 
 # Refusals name what is missing.
 check no_ballbar 2 "no device with role = \"ballbar\"" -- "$DAQ" run circle -c "$DATA/run/refused.toml" --db "$TMP/x.sqlite"

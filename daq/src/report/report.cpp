@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "ballbar_campaign.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/squareness.hpp"
@@ -260,7 +261,12 @@ std::string setup_section(const RunView& v) {
   };
   std::vector<std::vector<std::string>> settings;
   for (const auto& [k, val] : v.settings.items()) {
-    if (k == "context") continue;  // shown in its own sections
+    if (k == "context") continue;                        // shown in its own sections
+    if (k == "calibration" && v.run.kind == "circle") {  // the section "Bar calibration"
+      settings.push_back({"calibration", fmt::format("record {} (see Bar calibration)",
+                                                     val.value("id", std::int64_t{0}))});
+      continue;
+    }
     if (val.is_object()) {
       for (const auto& [k2, v2] : val.items())
         settings.push_back(
@@ -1138,6 +1144,88 @@ std::string run_report(const st::Store& store, std::int64_t run, const Options& 
   return page(run_title(v), run_body(store, v, o, hl), o, who_of(v));
 }
 
+// The campaign's ballbar tests side by side and the three-plane table (docs/circle.md, "The
+// three-plane table"); empty when the campaign has no circle run with a result.
+std::string volumetric_section(const st::Store& store, std::span<const std::int64_t> runs) {
+  std::vector<std::int64_t> circles;
+  for (const auto id : runs)
+    if (const auto r = store.run(id);
+        r && r->kind == "circle" && r->status == st::RunStatus::complete)
+      circles.push_back(id);
+  if (circles.empty()) return {};
+  const auto tests = ::daq::ballbar_tests(store, circles);
+  const auto v = ::daq::volumetric_table(tests);
+  const auto opt = [](const std::optional<double>& x) {
+    return x ? fmt::format("{:+.3f}", *x) : std::string("&ndash;");
+  };
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& t : tests)
+    rows.push_back({fmt::format("<a href=\"#run-{}\">{}</a>", t.run, t.run), esc(t.plane_name),
+                    fmt::format("{:g}", t.radius_mm), fmt::format("{:g}", t.feed_mm_per_min),
+                    fmt::format("{:.0f}°", t.arc_deg), um(t.G_bi_um), opt(t.squareness_um_per_m),
+                    opt(t.scale_mismatch_um_per_m), opt(t.servo_ms),
+                    esc(::daq::summary(t.verdict))});
+  std::string h =
+      "<h2 id=\"three-planes\">Ballbar tests and the three-plane table</h2>\n" +
+      table({"run", "plane", "R (mm)", "feed (mm/min)", "arc", "G(b) (µm)", "squareness (µm/m)",
+             "scale mismatch (µm/m)", "servo mismatch (ms)", "verdict"},
+            rows, "num", "rlrrrrrrrl") +
+      "<p class=\"note\">Scale mismatch in the plane's order: XY X − Y, ZX Z − X, YZ Y − Z. "
+      "Servo mismatch: the plane's second axis lags its first (positive); it grows with the "
+      "feed, squareness does not.</p>\n";
+  std::vector<std::vector<std::string>> planes;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& pv = v.combined.planes[i];
+    if (!pv) continue;
+    std::string used;
+    for (auto r : v.used[i].runs) used += (used.empty() ? "" : ", ") + std::to_string(r);
+    const auto mp = cal::circle::model_plane(pv->plane);
+    planes.push_back({i == 0   ? "XY"
+                      : i == 1 ? "YZ"
+                               : "ZX",
+                      used, fmt::format("{:g}", v.used[i].feed_mm_per_min),
+                      fmt::format("{:+.3f}", pv->squareness_um_per_m),
+                      fmt::format("{} = {:+.3f}", cal::kinematics::location_error_name(mp),
+                                  cal::circle::location_error_urad(*pv)),
+                      fmt::format("{} {:+.3f}",
+                                  i == 0   ? "X − Y"
+                                  : i == 1 ? "Y − Z"
+                                           : "Z − X",
+                                  pv->scale_mismatch_um_per_m),
+                      opt(pv->mean_scale_um_per_m)});
+  }
+  h += "<h3>Three-plane table</h3>\n";
+  if (!planes.empty())
+    h += table({"plane", "runs", "feed (mm/min)", "squareness α (µm/m)",
+                "model location error (µrad)", "scale mismatch (µm/m)", "mean scale (µm/m)"},
+               planes, "num", "llrrrrr");
+  h += "<p>Each plane at its slowest feed (servo errors grow with the feed, geometric errors do "
+       "not), its tests averaged. α is positive when the angle between the positive axes exceeds "
+       "90°; the machine model's ISO 230-1 location errors are E_C0Y = +α<sub>XY</sub>, "
+       "E_B0Z = −α<sub>ZX</sub>, E_A0Z = +α<sub>YZ</sub> (docs/kinematics.md). A circle "
+       "measures squareness where it was run. The mean scale (s<sub>u</sub> + s<sub>v</sub>)/2 "
+       "comes from a calibrated bar's radius error only.</p>\n";
+  if (const auto& sc = v.combined.scale_um_per_m)
+    h += fmt::format(
+        "<p>Axis scales: X {:+.3f}, Y {:+.3f}, Z {:+.3f} µm/m, <strong>{}</strong>{}.</p>\n",
+        (*sc)[0], (*sc)[1], (*sc)[2],
+        v.combined.scale_absolute ? "absolute (calibrated bar)"
+                                  : "relative: their mean is set to 0; the absolute scale is "
+                                    "not evaluated without a calibrated bar",
+        v.combined.scale_residual_um_per_m ? fmt::format(", least-squares residual {:.3f} µm/m",
+                                                         *v.combined.scale_residual_um_per_m)
+                                           : std::string());
+  else
+    h += "<p>Axis scales: not evaluated (they need the scale mismatches of two planes).</p>\n";
+  if (v.combined.closure_um_per_m)
+    h += fmt::format(
+        "<p>Closure (X − Y) + (Y − Z) + (Z − X) = {:+.3f} µm/m (0 for a consistent set: noise, "
+        "drift between the tests and the local errors of each position move it).</p>\n",
+        *v.combined.closure_um_per_m);
+  for (const auto& n : v.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+  return h;
+}
+
 std::string campaign_report(const st::Store& store, std::span<const std::int64_t> runs,
                             std::string_view title, const Options& o) {
   if (runs.empty()) throw cal::InputError("campaign report: no runs to report");
@@ -1169,7 +1257,7 @@ std::string campaign_report(const st::Store& store, std::span<const std::int64_t
       fmt::format("<p>{} runs.</p>\n", runs.size()) +
       table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
             "summary", "r") +
-      sections;
+      volumetric_section(store, runs) + sections;
   return page(title, body, o, who);
 }
 

@@ -302,6 +302,8 @@ struct CircleRun::Impl {
                               : json::parse(setup.context_json, nullptr, false);
     if (!settings["context"].is_object())
       settings["context"] = run_context(c, "circle", setup.analysis.plane);
+    // Where the table ball was: a circle's squareness is local to it (the three-plane table).
+    if (c.circle && c.circle->centre_mm.size() == 3) settings["centre_mm"] = c.circle->centre_mm;
     outcome.run_id = store->begin_run({.machine_id = machine,
                                        .campaign = c.campaign,
                                        .kind = "circle",
