@@ -113,7 +113,7 @@ void calibrate(const CalibrateOptions& o) {
 }
 
 void list(const std::string& db, const std::string& bar, bool as_json) {
-  st::Store store(database_path(db));
+  const auto store = open_database_read_only(db);
   const auto all = store.bar_calibrations(bar);
   if (as_json) {
     json j{{"schema", "caldaq.bar-calibrations.v1"}, {"calibrations", json::array()}};
@@ -180,7 +180,7 @@ void write_model(const VolumetricTable& v, const SetOptions& o) {
 void volumetric(const SetOptions& o) {
   if (o.model_in.empty() != o.model_out.empty())
     throw cal::InputError("--model and --write-model go together (read one, write the other)");
-  st::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);  // only reads
   const auto tests = tests_of(store, o);
   const auto v = volumetric_table(tests);
   if (!o.model_in.empty()) write_model(v, o);
@@ -191,7 +191,7 @@ void volumetric(const SetOptions& o) {
 }
 
 void history(const SetOptions& o) {
-  st::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);  // only reads
   const auto tests = tests_of(store, o);
   if (o.json) return fmt::print("{}\n", history_json(tests).dump(2));
   print_history(tests);

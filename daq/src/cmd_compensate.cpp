@@ -43,7 +43,7 @@ std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
 
 std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o) {
   if (!o.input.empty()) return read_measurements(o.input, o.csv);
-  cal::storage::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
     out.push_back(

@@ -16,8 +16,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/daq/config.hpp"
-#include "cal/drivers/instruments.hpp"
-#include "cal/drivers/transport/transport.hpp"
+#include "cal/drivers/instrument.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "circle_output.hpp"
@@ -26,6 +25,7 @@
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
 #include "provenance.hpp"
+#include "run_setup.hpp"
 #include "session_spec.hpp"
 #include "sim_shop.hpp"
 #include "verdict.hpp"
@@ -33,7 +33,6 @@
 namespace daq {
 namespace {
 
-namespace t = cal::drivers::transport;
 namespace d = cal::drivers;
 using namespace std::chrono_literals;
 
@@ -147,14 +146,14 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
                                          .overshoot_deg = 45};
   fmt::print("\ndaq demo: ballbar circle in XY, R {} mm at {} mm/min, on {} (simulated)\n",
              program.radius_mm, program.feed_mm_per_min, shop.ballbar_device());
+  const auto& dc = need(config, "ballbar");
+  const auto spec = spec_of(dc, 0);
   CircleRunSetup setup{
       .config = config,
       .program = program,
       .database = o.db,
-      .ballbar =
-          d::make_gauge(io, t::make_serial(io, {.device = shop.ballbar_device(), .baud = 115200}),
-                        {.name = "ballbar (simulated)", .clock = shop.clock_ns()},
-                        {.min_si = -0.1, .max_si = 0.1}),
+      .ballbar = make_instrument(io, spec, make_transport(io, dc),
+                                 {.name = "ballbar (simulated)", .clock = shop.clock_ns()}),
       .on_event = [&o](const std::string& e) {
         if (!o.quiet) fmt::print("  {}\n", e);
       }};
@@ -204,7 +203,6 @@ int run_demo(const DemoOptions& o) {
   const bool tty = !o.quiet && ::isatty(STDOUT_FILENO);
   boost::asio::io_context io;
   SimulatedShop shop(io, ShopTruth{}, o.speed);
-  const auto config = demo_config();
   fmt::print("daq demo: ISO 230-2 test of the X axis of a SIMULATED machine (0 .. 500 mm)\n");
   fmt::print("  laser: simulated IDS3010 on tcp 127.0.0.1:{}\n", shop.laser_port());
   fmt::print("  air: simulated PTU300 on {} (4800 7E1)\n", shop.air_device());
@@ -215,24 +213,20 @@ int run_demo(const DemoOptions& o) {
   const auto poll = [&](double sim_s) {
     return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / o.speed * 1e6));
   };
-  // The instruments as the capture header records them, so `daq replay` rebuilds them.
-  const std::vector<InstrumentSpec> specs{
-      {.device = 0,
-       .driver = "ids3010",
-       .role = "laser",
-       .transport = fmt::format("tcp 127.0.0.1:{}", shop.laser_port())},
-      {.device = 1,
-       .driver = "ptu300",
-       .role = "air",
-       .transport = "serial " + shop.air_device() + " 4800 7E1"},
-      {.device = 2,
-       .driver = "gauge",
-       .role = "material",
-       .transport = "serial " + shop.material_device() + " 9600 8N1",
-       .gauge = {.request = "?\r",
-                 .unit = cal::drivers::codec::GaugeUnit::degc,
-                 .min_si = -40,
-                 .max_si = 150}}};
+  // The shop's devices, configured as `daq sim` writes them; the instruments as the capture
+  // header records them, so `daq replay` rebuilds them.
+  auto config = demo_config();
+  // The shop's devices (transports, drivers' options), with the demo's records of them.
+  auto devices = cal::daq::parse_config(shop.devices_toml(0.01, false), "(simulated shop)").devices;
+  for (auto& dc : devices)
+    for (const auto& record : config.devices)
+      if (record.id == dc.id) {
+        dc.serial_number = record.serial_number;
+        dc.certificate = record.certificate;
+        dc.calibration_due = record.calibration_due;
+      }
+  config.devices = std::move(devices);
+  const auto specs = linear_specs(config);
   cal::replay::CaptureWriter capture(o.capture,
                                      capture_header(config, specs, "daq 0.1.0 demo (simulated)"));
   cal::replay::CaptureRecorder recorder(capture);
@@ -242,8 +236,10 @@ int run_demo(const DemoOptions& o) {
       if (running) running->stop("capture failed: " + e);
     });
   });
-  const auto options = [&](std::string name, double poll_s) {
-    return d::InstrumentOptions{.name = std::move(name),
+  // Poll periods in simulated seconds: the laser 0.01 s, the air and material sensors 1 s.
+  const auto options = [&](const InstrumentSpec& s) {
+    const double poll_s = s.role == "laser" ? 0.01 : 1.0;
+    return d::InstrumentOptions{.name = s.role + " (simulated)",
                                 .poll_period = poll(poll_s),
                                 .clock = clock,
                                 .recorder = &recorder};
@@ -252,16 +248,11 @@ int run_demo(const DemoOptions& o) {
   setup.config = config;
   setup.database = o.db;
   setup.capture_path = std::filesystem::absolute(o.capture).string();
-  setup.laser = make_instrument(io, specs[0],
-                                t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                                options("laser (simulated IDS3010)", 0.01));
-  setup.air = make_instrument(
-      io, specs[1],
-      t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
-      options("air (simulated PTU300)", 1.0));
-  setup.material.push_back(make_instrument(io, specs[2],
-                                           t::make_serial(io, {.device = shop.material_device()}),
-                                           options("material (simulated thermometer)", 1.0)));
+  for (const auto& s : specs) {
+    const auto& dc = *std::find_if(config.devices.begin(), config.devices.end(),
+                                   [&](const auto& x) { return x.role == s.role; });
+    place_linear_instrument(s, make_instrument(io, s, make_transport(io, dc), options(s)), setup);
+  }
   setup.on_live = [tty](const LiveState& s) { progress_line(s, tty); };
   setup.on_event = [tty, &o](const std::string& e) {
     if (o.quiet) return;

@@ -9,8 +9,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/catalog.hpp"
-#include "cal/drivers/codec/attocube_ids.hpp"
-#include "cal/drivers/codec/vaisala_ptu300.hpp"
+#include "cal/drivers/registry.hpp"
 #include "cal/drivers/transport/hid.hpp"
 #include "cal/drivers/transport/transport.hpp"
 #include "cal/drivers/transport/usb.hpp"
@@ -26,6 +25,8 @@ struct DevicesOptions {
   std::vector<std::string> tcp_probes;     // HOST[:PORT]
   std::vector<std::string> serial_probes;  // DEVICE[@SETTINGS]
   bool json = false;
+  bool options = false;   // the drivers and their option tables instead of the attached devices
+  bool markdown = false;  // with options: the Markdown of docs/drivers.md
 };
 
 std::vector<std::string> serial_ports() {
@@ -46,71 +47,76 @@ std::vector<std::string> serial_ports() {
   return out;
 }
 
-// Runs the loop until a reply line arrives or the deadline passes; returns the bytes.
-std::string exchange(boost::asio::io_context& io, t::Transport& tr, std::string request,
-                     std::chrono::milliseconds deadline, std::string& error) {
+// Sends the probe's request and runs the loop until the probe decides or the deadline passes.
+cal::drivers::ProbeSpec::Answer exchange(boost::asio::io_context& io, t::Transport& tr,
+                                         const cal::drivers::ProbeSpec& p,
+                                         std::chrono::milliseconds deadline, std::string& error) {
   std::string received;
-  tr.open({.opened = [&] { tr.write(std::as_bytes(std::span(request.data(), request.size()))); },
-           .data =
-               [&](std::span<const std::byte> b) {
-                 received.append(reinterpret_cast<const char*>(b.data()), b.size());
-               },
-           .error = [&](const t::Error& e) { error = e.message; }});
+  tr.open(
+      {.opened = [&] { tr.write(std::as_bytes(std::span(p.request.data(), p.request.size()))); },
+       .data =
+           [&](std::span<const std::byte> b) {
+             received.append(reinterpret_cast<const char*>(b.data()), b.size());
+           },
+       .error = [&](const t::Error& e) { error = e.message; }});
+  cal::drivers::ProbeSpec::Answer answer;
   const auto end = std::chrono::steady_clock::now() + deadline;
-  while (received.find('\n') == std::string::npos && error.empty() &&
+  while (answer.verdict == cal::drivers::ProbeSpec::Verdict::more && error.empty() &&
          std::chrono::steady_clock::now() < end) {
     io.run_for(std::chrono::milliseconds(10));
     io.restart();
+    answer = p.recognise(received);
   }
   tr.close();
-  return received;
+  if (answer.verdict == cal::drivers::ProbeSpec::Verdict::more) {
+    answer.verdict = cal::drivers::ProbeSpec::Verdict::no;
+    if (answer.detail.empty())
+      answer.detail = received.empty() ? "no answer" : "no complete answer";
+  }
+  return answer;
 }
 
-json probe_tcp(const std::string& spec) {
-  const auto colon = spec.rfind(':');
-  const std::string host = colon == std::string::npos ? spec : spec.substr(0, colon);
-  const auto port = colon == std::string::npos ? 9090 : std::stoi(spec.substr(colon + 1));
-  boost::asio::io_context io;
-  auto tcp = t::make_tcp(io, {.host = host,
-                              .port = static_cast<std::uint16_t>(port),
-                              .connect_timeout = std::chrono::milliseconds(1500)});
-  cal::drivers::codec::IdsCodec codec;
-  const std::string request = codec.encode(cal::drivers::codec::IdsMethod::get_current_mode);
-  std::string error;
-  const std::string reply = exchange(io, *tcp, request, std::chrono::milliseconds(2000), error);
-  std::vector<cal::drivers::codec::IdsResponse> frames;
-  codec.feed(reply, frames);
-  json j{{"transport", tcp->describe()}};
-  if (!frames.empty()) {
-    j["driver"] = "ids3010";
-    j["detail"] = "mode: " + frames[0].mode;
-  } else {
-    j["driver"] = nullptr;
-    j["detail"] = error.empty() ? "no IDS3010 JSON-RPC answer" : error;
+// Asks `transport` with each driver's probe of that transport kind, in registry order; the
+// first that recognises the answer names the device.
+json probe(std::string_view kind, const std::string& spec) {
+  std::vector<std::string> tried;
+  json j{{"driver", nullptr}};
+  for (const auto* drv : cal::drivers::device_drivers()) {
+    const auto p = drv->probe();
+    if (!p || p->transport_kind != kind) continue;
+    boost::asio::io_context io;
+    std::unique_ptr<t::Transport> tr;
+    if (kind == "tcp") {
+      const auto colon = spec.rfind(':');
+      const std::string host = colon == std::string::npos ? spec : spec.substr(0, colon);
+      const auto port =
+          colon == std::string::npos ? p->default_port : std::stoi(spec.substr(colon + 1));
+      tr = t::make_tcp(io, {.host = host,
+                            .port = static_cast<std::uint16_t>(port),
+                            .connect_timeout = std::chrono::milliseconds(1500)});
+    } else {
+      const auto at = spec.find('@');
+      t::SerialSettings s{.device = spec.substr(0, at)};
+      tr = t::make_serial(
+          io, t::parse_serial_settings(
+                  at == std::string::npos ? p->default_serial : spec.substr(at + 1), s));
+    }
+    std::string error;
+    const auto answer = exchange(io, *tr, *p, std::chrono::milliseconds(2000), error);
+    j["transport"] = tr->describe();
+    if (answer.verdict == cal::drivers::ProbeSpec::Verdict::yes) {
+      j["driver"] = drv->name();
+      j["detail"] = answer.detail;
+      return j;
+    }
+    tried.push_back(fmt::format("{}: {}", drv->name(),
+                                !error.empty()          ? error
+                                : answer.detail.empty() ? std::string("no answer")
+                                                        : answer.detail));
   }
-  return j;
-}
-
-json probe_serial(const std::string& spec) {
-  const auto at = spec.find('@');
-  t::SerialSettings s{.device = spec.substr(0, at)};
-  s = t::parse_serial_settings(at == std::string::npos ? "4800 7E1" : spec.substr(at + 1), s);
-  boost::asio::io_context io;
-  auto port = t::make_serial(io, s);
-  std::string error;
-  const std::string reply = exchange(io, *port, cal::drivers::codec::ptu300_send(),
-                                     std::chrono::milliseconds(2000), error);
-  cal::drivers::codec::Ptu300Codec codec;
-  std::vector<cal::drivers::codec::Ptu300Frame> frames;
-  codec.feed(reply, frames);
-  json j{{"transport", port->describe()}};
-  if (!frames.empty() && (frames[0].pressure_pa || frames[0].temperature_degc)) {
-    j["driver"] = "ptu300";
-    j["detail"] = "answered SEND";
-  } else {
-    j["driver"] = nullptr;
-    j["detail"] = error.empty() ? "no PTU300 answer to SEND" : error;
-  }
+  j["detail"] = tried.empty() ? std::string("no driver probes this kind of transport")
+                              : fmt::format("{}", fmt::join(tried, "; "));
+  if (!j.contains("transport")) j["transport"] = spec;
   return j;
 }
 
@@ -146,12 +152,101 @@ json list_devices(const DevicesOptions& o) {
   }
   for (const auto& p : serial_ports())
     out["serial"].push_back(
-        {{"device", p},
-         {"driver", nullptr},
-         {"detail", "serial port: try --probe-serial " + p + " (PTU300 at 4800 7E1)"}});
-  for (const auto& p : o.tcp_probes) out["probes"].push_back(probe_tcp(p));
-  for (const auto& p : o.serial_probes) out["probes"].push_back(probe_serial(p));
+        {{"device", p}, {"driver", nullptr}, {"detail", "serial port: try --probe-serial " + p}});
+  for (const auto& p : o.tcp_probes) out["probes"].push_back(probe("tcp", p));
+  for (const auto& p : o.serial_probes) out["probes"].push_back(probe("serial", p));
   return out;
+}
+
+// ---- the drivers and their options (daq devices --options) ------------------------------------
+
+std::string range_text(const cal::drivers::OptionSpec& o) {
+  if (!o.choices.empty()) return fmt::format("{}", fmt::join(o.choices, ", "));
+  if (o.min && o.max) return fmt::format("{} .. {}", *o.min, *o.max);
+  if (o.min) return fmt::format(">= {}", *o.min);
+  if (o.max) return fmt::format("<= {}", *o.max);
+  return "";
+}
+
+json drivers_json() {
+  json out{{"schema", "caldaq.drivers.v1"},
+           {"common_keys", cal::drivers::common_device_keys()},
+           {"drivers", json::array()}};
+  for (const auto* d : cal::drivers::device_drivers()) {
+    json options = json::array();
+    for (const auto& o : d->options()) {
+      json e{{"name", o.name},
+             {"type", cal::drivers::to_string(o.type)},
+             {"unit", o.unit},
+             {"default", cal::drivers::format_option_value(o.default_value)},
+             {"help", o.help}};
+      if (o.min) e["min"] = *o.min;
+      if (o.max) e["max"] = *o.max;
+      if (!o.choices.empty()) e["choices"] = o.choices;
+      options.push_back(e);
+    }
+    json usb = json::array();
+    for (const auto& k : d->usb_ids())
+      usb.push_back({{"vid_pid", fmt::format("{:04x}:{:04x}", k.vendor_id, k.product_id)},
+                     {"description", k.description}});
+    out["drivers"].push_back({{"name", d->name()},
+                              {"description", d->description()},
+                              {"transport", d->transport_example()},
+                              {"decode_input", d->decode_input()},
+                              {"options", options},
+                              {"usb", usb}});
+  }
+  return out;
+}
+
+void print_options_text() {
+  fmt::print("Keys of every [devices.ID] table: {}\n",
+             fmt::join(cal::drivers::common_device_keys(), ", "));
+  for (const auto* d : cal::drivers::device_drivers()) {
+    fmt::print("\n{}  {}\n  transport: {}\n", d->name(), d->description(), d->transport_example());
+    if (d->options().empty()) fmt::print("  (no options of its own)\n");
+    for (const auto& o : d->options()) {
+      const auto def = cal::drivers::format_option_value(o.default_value);
+      fmt::print("  {:<22} {:<13} {:<18} default {:<12} {}\n", o.name,
+                 cal::drivers::to_string(o.type),
+                 range_text(o) + (o.unit.empty() ? "" : " " + o.unit),
+                 def.empty() ? "(derived)" : def, o.help);
+    }
+  }
+}
+
+// The table cells may hold '|': escaped for Markdown.
+std::string cell(std::string s) {
+  for (std::size_t at = 0; (at = s.find('|', at)) != std::string::npos; at += 2) s.insert(at, "\\");
+  return s;
+}
+
+void print_options_markdown() {
+  fmt::print("Every `[devices.ID]` table takes the common keys {}; each driver adds its own:\n",
+             fmt::join(cal::drivers::common_device_keys(), ", "));
+  for (const auto* d : cal::drivers::device_drivers()) {
+    fmt::print("\n### `{}`: {}\n\n", d->name(), d->description());
+    fmt::print("Transport: `{}`. `daq decode {}` reads {}.\n\n", d->transport_example(), d->name(),
+               d->decode_input());
+    if (d->options().empty()) {
+      fmt::print("No options of its own.\n");
+      continue;
+    }
+    fmt::print("| key | type | unit | values | default | meaning |\n");
+    fmt::print("| --- | --- | --- | --- | --- | --- |\n");
+    for (const auto& o : d->options()) {
+      const auto def = cal::drivers::format_option_value(o.default_value);
+      fmt::print("| `{}` | {} | {} | {} | {} | {} |\n", o.name, cal::drivers::to_string(o.type),
+                 o.unit, cell(range_text(o)), def.empty() ? "(derived)" : "`" + cell(def) + "`",
+                 cell(o.help));
+    }
+    if (!d->usb_ids().empty()) {
+      std::vector<std::string> ids;
+      for (const auto& k : d->usb_ids())
+        ids.push_back(fmt::format("`{:04x}:{:04x}` {}", k.vendor_id, k.product_id, k.description));
+      fmt::print("\nUSB ids: {}.\n", fmt::join(ids, "; "));
+    }
+  }
 }
 
 void print_text(const json& j) {
@@ -185,12 +280,31 @@ void add_devices_command(CLI::App& app) {
       "devices",
       "List attached USB/HID instruments and serial ports, and probe networked or serial "
       "instruments");
-  cmd->add_option("--probe", opts->tcp_probes,
-                  "Ask HOST[:PORT] (default port 9090) for an IDS3010 JSON-RPC answer");
+  // The probes' help names the drivers that probe each kind of transport (from the registry).
+  std::vector<std::string> tcp, serial;
+  for (const auto* d : cal::drivers::device_drivers())
+    if (const auto p = d->probe()) {
+      if (p->transport_kind == "tcp")
+        tcp.push_back(fmt::format("{} on port {}", d->name(), p->default_port));
+      else
+        serial.push_back(fmt::format("{} at {}", d->name(), p->default_serial));
+    }
+  cmd->add_option(
+      "--probe", opts->tcp_probes,
+      fmt::format("Ask HOST[:PORT] with each network driver's probe ({})", fmt::join(tcp, ", ")));
   cmd->add_option("--probe-serial", opts->serial_probes,
-                  "Ask DEVICE[@SETTINGS] (default 4800 7E1) for a PTU300 answer to SEND");
-  cmd->add_flag("--json", opts->json, "Print caldaq.devices.v1 JSON");
+                  fmt::format("Ask DEVICE[@SETTINGS] with each serial driver's probe ({})",
+                              fmt::join(serial, ", ")));
+  cmd->add_flag("--options", opts->options,
+                "List the drivers and the options of each ([devices.ID] keys, daq decode --set)");
+  cmd->add_flag("--markdown", opts->markdown, "With --options: as the Markdown of docs/drivers.md");
+  cmd->add_flag("--json", opts->json,
+                "Print caldaq.devices.v1 JSON (with --options: caldaq.drivers.v1)");
   cmd->callback([opts] {
+    if (opts->options) {
+      if (opts->json) return fmt::print("{}\n", drivers_json().dump(2));
+      return opts->markdown ? print_options_markdown() : print_options_text();
+    }
     const json j = list_devices(*opts);
     if (opts->json)
       fmt::print("{}\n", j.dump(2));

@@ -16,6 +16,7 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
+#include "run_setup.hpp"
 #include "session_spec.hpp"
 
 namespace daq {
@@ -173,16 +174,10 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   setup.context_json = s.original_context;
   setup.replay = true;
   setup.replay_of_run = s.original_run;
-  for (const auto& spec : s.specs) {
-    if (spec.role == "laser")
-      setup.laser = s.instrument(spec);
-    else if (spec.role == "air")
-      setup.air = s.instrument(spec);
-    else if (spec.role == "material")
-      setup.material.push_back(s.instrument(spec));
-    else if (spec.role == "position")
-      setup.position = s.instrument(spec), setup.position_channel = spec.feed_axis;
-  }
+  for (const auto& spec : s.specs)
+    if (spec.role == "laser" || spec.role == "air" || spec.role == "material" ||
+        spec.role == "position")
+      place_linear_instrument(spec, s.instrument(spec), setup);
   if (!setup.laser || !setup.air)
     throw cal::InputError(
         fmt::format("{}: the session has no laser or no air instrument", o.capture));

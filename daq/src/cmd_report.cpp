@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -78,7 +79,7 @@ void write_file(const fs::path& path, const std::string& text) {
 void run_report_command(ReportOptions o) {
   if (o.format != "html" && o.format != "pdf")
     throw cal::InputError(fmt::format("report: --format {}: use html or pdf", o.format));
-  cal::storage::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);
   if (!o.campaign.empty()) {
     for (const auto& r : store.runs())
       if (r.campaign == o.campaign) o.runs.push_back(r.id);
@@ -115,31 +116,55 @@ void run_report_command(ReportOptions o) {
                               : "campaign-report";
   }
   const fs::path out = o.output.empty() ? fs::path(stem + "." + o.format) : fs::path(o.output);
+  std::uintmax_t streamed_bytes = html.size();  // what went to a stream, which has no size
   if (o.format == "html") {
     write_file(out, html);
   } else {
-    const auto tmp = fs::path(out).replace_extension(".tmp.html");
+    // Chromium prints to a file; a stream (-o /dev/stdout, a pipe) gets the printed file's bytes.
+    std::error_code ec;
+    const bool to_stream = fs::exists(out, ec) && !fs::is_regular_file(out, ec);
+    const auto stem_tmp =
+        to_stream ? fs::temp_directory_path() / fmt::format("caldaq-report-{}", ::getpid())
+                  : fs::path(out).replace_extension("");
+    const auto tmp = fs::path(stem_tmp.string() + ".tmp.html");
+    const auto pdf = to_stream ? fs::path(stem_tmp.string() + ".tmp.pdf") : out;
     write_file(tmp, html);
     try {
-      print_pdf(tmp, out);
+      print_pdf(tmp, pdf);
+      if (to_stream) {
+        std::ifstream in(pdf, std::ios::binary);
+        write_file(out, std::string(std::istreambuf_iterator<char>(in), {}));
+      }
     } catch (...) {
-      fs::remove(tmp);
+      fs::remove(tmp, ec);
+      if (to_stream) fs::remove(pdf, ec);
       throw;
     }
-    fs::remove(tmp);
+    fs::remove(tmp, ec);
+    if (to_stream) {
+      streamed_bytes = fs::file_size(pdf, ec);
+      fs::remove(pdf, ec);
+    }
   }
+  // The size written: a pipe or a terminal (-o /dev/stdout) has none to ask the file system for.
+  std::error_code size_error;
+  const auto file_bytes = fs::file_size(out, size_error);
+  const std::uintmax_t bytes = size_error ? streamed_bytes : file_bytes;
   if (o.json) {
     fmt::print("{}\n", nlohmann::json{{"schema", "caldaq.report.v1"},
                                       {"kind", kind},
                                       {"format", o.format},
                                       {"file", out.string()},
-                                      {"bytes", fs::file_size(out)},
+                                      {"bytes", bytes},
                                       {"runs", o.runs}}
                            .dump(2));
     return;
   }
-  fmt::print("{} report of run{} {} written to {} ({} bytes)\n", kind, o.runs.size() > 1 ? "s" : "",
-             fmt::join(o.runs, ", "), out.string(), fs::file_size(out));
+  // The status line goes to stderr when the report itself went to a stream (e.g. stdout).
+  std::error_code ec;
+  std::FILE* status = fs::is_regular_file(out, ec) ? stdout : stderr;
+  fmt::print(status, "{} report of run{} {} written to {} ({} bytes)\n", kind,
+             o.runs.size() > 1 ? "s" : "", fmt::join(o.runs, ", "), out.string(), bytes);
 }
 
 }  // namespace

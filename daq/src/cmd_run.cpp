@@ -16,7 +16,6 @@
 #include "cal/analysis/error.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/daq/gcode.hpp"
-#include "cal/drivers/instruments.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "circle_output.hpp"
@@ -80,6 +79,17 @@ const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& ca
   return out;
 }
 
+// Every device opens and speaks before the run starts, or the run is refused naming it.
+void check_at_start(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
+                    const RunOptions& o) {
+  if (o.check_s <= 0) return;
+  std::FILE* out = o.json ? stderr : stdout;  // stdout carries only the JSON then
+  fmt::print(out, "Checking the devices (up to {} s):\n", o.check_s);
+  check_devices(config, specs, std::chrono::duration<double>(o.check_s),
+                [out](const std::string& line) { fmt::print(out, "{}\n", line); });
+  std::fflush(out);
+}
+
 // Where progress and events go: stdout, or stderr when stdout carries --json. On a terminal
 // the live line is rewritten in place; into a file or a pipe each line is written whole and
 // flushed as it happens (a log that is read while the run goes on).
@@ -115,6 +125,7 @@ void run_linear(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   boost::asio::io_context io;
   const auto specs = linear_specs(config);
+  check_at_start(config, specs, o);
   SessionCapture capture(o.capture, config, specs);
   LinearRunSetup setup;
   setup.config = config;
@@ -176,11 +187,9 @@ void run_circle(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   const auto [program, analysis] = circle_test(config);
   const auto& dc = need(config, "ballbar");
-  if (dc.driver != "gauge")
-    throw cal::InputError(
-        fmt::format("{}: devices.{}: the ballbar needs driver = \"gauge\"", o.config, dc.id));
   boost::asio::io_context io;
   const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
+  check_at_start(config, specs, o);
   SessionCapture capture(o.capture, config, specs);
   CircleRunSetup setup{
       .config = config,
@@ -188,7 +197,7 @@ void run_circle(const RunOptions& o) {
       .analysis = analysis,
       .database = database_path(o.db),
       .ballbar = make_instrument(io, specs[0], make_transport(io, dc),
-                                 instrument_options(dc, o, capture.recorder.get())),
+                                 instrument_options(dc, specs[0], o, capture.recorder.get())),
       .capture_path = capture.absolute_path(o.capture)};
   auto progress = std::make_shared<ProgressOut>(o.json);
   setup.on_event = [progress](const std::string& e) { progress->event(e); };
@@ -258,6 +267,11 @@ void add_run_commands(CLI::App& app) {
   lin->add_option("--give-up-after", o->give_up_after,
                   "Reconnection attempts before a device is given up")
       ->capture_default_str();
+  lin->add_option("--check-s", o->check_s,
+                  "Before the run, every device must open and speak within this time (0: no "
+                  "check)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   lin->add_flag("--json", o->json,
                 "Print the result as caldaq.iso230-2.v1 JSON with run_id, status, missed_stops "
                 "and verdict (progress goes to stderr)");
@@ -270,6 +284,10 @@ void add_run_commands(CLI::App& app) {
   circ->add_option("--give-up-after", o->give_up_after,
                    "Reconnection attempts before the ballbar is given up")
       ->capture_default_str();
+  circ->add_option("--check-s", o->check_s,
+                   "Before the run, the ballbar must open within this time (0: no check)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   circ->add_flag("--json", o->json,
                  "Print the result as caldaq.circle.v2 JSON with run_id and verdict (progress "
                  "goes to stderr)");

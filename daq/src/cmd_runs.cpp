@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -9,6 +10,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <tuple>
 
 #include "cal/analysis/error.hpp"
@@ -62,7 +64,7 @@ st::RunRecord need_run(const st::Store& store, std::int64_t id) {
 }
 
 void cmd_runs(const std::string& db, bool as_json) {
-  st::Store store(database_path(db));
+  const auto store = open_database_read_only(db);
   const auto runs = store.runs();
   if (as_json) {
     json j{
@@ -143,7 +145,7 @@ void print_result_values(const json& doc) {
 }
 
 void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
-  st::Store store(database_path(db));
+  const auto store = open_database_read_only(db);
   const auto r = need_run(store, id);
   json j = run_json(r);
   j["schema"] = "caldaq.run.v1";
@@ -215,11 +217,16 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
 // Numbers in the shortest form that reads back to the same double (fmt's "{}").
 std::string num(double v) { return fmt::format("{}", v); }
 
-// Every reading of the run, in time order: the one place the export reads them, so that it can
-// move to a streaming read without touching the formats.
+// Every reading of the run (or of these quantities), in time order: the one place the export
+// reads them. Streamed from the store a batch at a time, so an export's memory does not grow
+// with the run (docs/benchmarks.md, daq bench export).
 template <class F>
-void each_reading(const st::Store& store, std::int64_t run, F&& f) {
-  for (const auto& r : store.readings(run)) f(r);
+void each_reading(const st::Store& store, std::int64_t run, F&& f,
+                  std::span<const std::uint8_t> quantities = {}) {
+  auto stream = store.stream_readings(run, quantities);
+  std::vector<st::RawReading> batch;
+  while (stream.next(batch))
+    for (const auto& r : batch) f(r);
 }
 
 using StreamKey = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;
@@ -396,10 +403,10 @@ void export_circle_csv(const st::Store& store, const st::RunRecord& run, const j
     throw cal::InputError(fmt::format("run {}: its circle settings are missing", run.id));
   const auto [program, analysis] = circle_settings_from_json(settings);
   cal::daq::BallbarSegmenter segmenter(program);
-  each_reading(store, run.id, [&](const st::RawReading& r) {
-    if (r.quantity == static_cast<std::uint8_t>(cal::drivers::Quantity::length_m))
-      segmenter.add(r.value * 1e3);
-  });
+  static constexpr std::uint8_t bar[] = {
+      static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
+  each_reading(
+      store, run.id, [&](const st::RawReading& r) { segmenter.add(r.value * 1e3); }, bar);
   const auto traces = segmenter.traces();
   if (traces.empty())
     throw cal::InputError(
@@ -423,23 +430,22 @@ void export_circle_csv(const st::Store& store, const st::RunRecord& run, const j
   }
 }
 
+// A JSON number as nlohmann writes it for a double (shortest form that reads back the same;
+// null for what JSON cannot hold).
+std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
+
+// caldaq.export.v1. Everything but the readings is built as one document; the readings, which
+// grow with the run, are written row by row into its place as they stream from the store.
 void export_json(const st::Store& store, const st::RunRecord& run, const json& settings,
                  std::FILE* out) {
   json j = run_json(run);
   j["schema"] = "caldaq.export.v1";
   ExportClock clock(store, run, settings);
-  const auto names = device_names(store, run.id);
-  json readings = json::array();
-  each_export_row(store, run.id, clock, [&](const ExportRow& x) {
-    const auto it = names.find(x.r.device);
-    readings.push_back({clock.seconds(x.session_ns), clock.utc(x.session_ns), x.r.device,
-                        it == names.end() ? "" : it->second, x.r.channel,
-                        cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
-                        x.r.status, x.r.value, x.r.time_ns});
-  });
+  std::map<int, std::string> names;  // JSON strings, quoted and escaped
+  for (const auto& [device, name] : device_names(store, run.id)) names[device] = json(name).dump();
   j["reading_columns"] = {"time_s",   "utc",    "device", "device_name", "channel",
                           "quantity", "status", "value",  "time_ns"};
-  j["readings"] = std::move(readings);
+  j["readings"] = nullptr;  // the place of the rows, found in the text below
   json targets = json::array();
   for (const auto& t : store.targets(run.id))
     targets.push_back({{"target_mm", t.nominal_mm},
@@ -462,7 +468,23 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
                             {"current", res.current()},
                             {"provenance", json::parse(res.provenance_json, nullptr, false)},
                             {"result", json::parse(res.json, nullptr, false)}});
-  fmt::print(out, "{}\n", j.dump(1));
+  const std::string text = j.dump(1);
+  // Top-level keys are indented by one space; nothing nested is.
+  const std::string marker = "\n \"readings\": null";
+  const auto at = text.find(marker);
+  if (at == std::string::npos) throw std::logic_error("export_json: no place for the readings");
+  fmt::print(out, "{}\n \"readings\": [", std::string_view(text).substr(0, at));
+  bool first = true;
+  each_export_row(store, run.id, clock, [&](const ExportRow& x) {
+    const auto it = names.find(x.r.device);
+    fmt::print(out, "{}\n  [{},\"{}\",{},{},{},\"{}\",{},{},{}]", first ? "" : ",",
+               json_num(clock.seconds(x.session_ns)), clock.utc(x.session_ns), x.r.device,
+               it == names.end() ? std::string("\"\"") : it->second, x.r.channel,
+               cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
+               x.r.status, json_num(x.r.value), x.r.time_ns);
+    first = false;
+  });
+  fmt::print(out, "{}]{}\n", first ? "" : "\n ", std::string_view(text).substr(at + marker.size()));
 }
 
 struct ExportOptions {
@@ -474,7 +496,7 @@ struct ExportOptions {
 };
 
 void cmd_export(const ExportOptions& o) {
-  st::Store store(database_path(o.db));
+  const auto store = open_database_read_only(o.db);
   need_run(store, o.run);  // before a file is created
   std::FILE* out = stdout;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);

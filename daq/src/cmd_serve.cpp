@@ -65,6 +65,7 @@ class Service {
  public:
   Service(boost::asio::io_context& io, ServeOptions o)
       : io_(io), o_(std::move(o)), config_(cal::daq::load_config(o_.run.config)), check_(io) {
+    check_devices_at_start();
     try {
       make_server();
     } catch (const std::invalid_argument& e) {
@@ -91,6 +92,21 @@ class Service {
                  .status = [this] { return web::Response{.body = status().dump()}; },
                  .start = [this](const std::string& body) { return start(body); },
                  .stop = [this](const std::string& body) { return stop_request(body); }});
+  }
+
+  // The devices of the configured tests open and speak before the service starts, or it is
+  // refused naming the device (as daq run does before a run).
+  void check_devices_at_start() {
+    if (o_.run.check_s <= 0) return;
+    std::vector<InstrumentSpec> specs;
+    if (config_.linear) specs = linear_specs(config_);
+    if (config_.circle && config_.device_for("ballbar"))
+      specs.push_back(spec_of(need(config_, "ballbar"), static_cast<std::uint16_t>(specs.size())));
+    if (specs.empty()) return;
+    fmt::print("Checking the devices (up to {} s):\n", o_.run.check_s);
+    check_devices(config_, specs, std::chrono::duration<double>(o_.run.check_s),
+                  [](const std::string& line) { fmt::print("{}\n", line); });
+    std::fflush(stdout);
   }
 
   // The page shows this between runs.
@@ -235,14 +251,14 @@ class Service {
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
     watch_capture();
-    CircleRunSetup setup{
-        .config = config_,
-        .program = program,
-        .analysis = analysis,
-        .database = database_path(o_.run.db),
-        .ballbar = make_instrument(io_, specs[0], make_transport(io_, dc),
-                                   instrument_options(dc, o_.run, capture_->recorder.get())),
-        .capture_path = capture_->absolute_path(path)};
+    CircleRunSetup setup{.config = config_,
+                         .program = program,
+                         .analysis = analysis,
+                         .database = database_path(o_.run.db),
+                         .ballbar = make_instrument(
+                             io_, specs[0], make_transport(io_, dc),
+                             instrument_options(dc, specs[0], o_.run, capture_->recorder.get())),
+                         .capture_path = capture_->absolute_path(path)};
     setup.on_live = [this](const CircleLive& s) { server_->publish(to_json_text(s)); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
@@ -347,6 +363,11 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--give-up-after", o->run.give_up_after,
                   "Reconnection attempts before a device is given up")
       ->capture_default_str();
+  cmd->add_option("--check-s", o->run.check_s,
+                  "At start, every configured device must open and speak within this time (0: "
+                  "no check)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([o] { serve(*o); });
 }
 

@@ -41,30 +41,7 @@ campaign = "simulated"
 name = "SIMULATED VMC"
 description = "built-in simulated 3-axis machine with injected errors (daq sim)"
 
-[devices.laser]
-driver = "ids3010"
-transport = "tcp 127.0.0.1:{laser}"
-role = "laser"
-poll_s = {laser_poll}
-
-[devices.air]
-driver = "ptu300"
-transport = "serial {air} 4800 7E1"
-role = "air"
-
-[devices.material]
-driver = "gauge"
-transport = "serial {material} 9600 8N1"
-request = "?\r"
-unit = "degC"
-role = "material"
-
-{position}[devices.ballbar]
-driver = "gauge"
-transport = "serial {ballbar} 115200 8N1"
-unit = "mm"
-role = "ballbar"
-
+{devices}
 [environment]
 equation = "ciddor"
 expansion_ppm_per_k = {alpha}
@@ -94,16 +71,7 @@ overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
 calibrated_radius_mm = {radius}  # the simulated bar's exact length (simulation)
 )TOML",
-      fmt::arg("position",
-               position_feed
-                   ? fmt::format("[devices.position]      # the control's commanded position\n"
-                                 "driver = \"shdr\"\ntransport = \"tcp 127.0.0.1:{}\"\n"
-                                 "key = \"Xcom\"\nrole = \"position\"\n\n",
-                                 shop.position_port())
-                   : std::string{}),
-      fmt::arg("speed", speed), fmt::arg("laser", shop.laser_port()),
-      fmt::arg("laser_poll", 0.05 / speed), fmt::arg("air", shop.air_device()),
-      fmt::arg("material", shop.material_device()), fmt::arg("ballbar", shop.ballbar_device()),
+      fmt::arg("devices", shop.devices_toml(0.05 / speed, position_feed)), fmt::arg("speed", speed),
       fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
       fmt::arg("radius", t.ballbar_mm), fmt::arg("cx", t.pivot_mm[0]),
       fmt::arg("cy", t.pivot_mm[1]), fmt::arg("cz", t.pivot_mm[2]));

@@ -67,10 +67,14 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
     cal::circle::circular_standard_from_key(o.standard);  // refused here if unknown
     analysis.standard = o.standard;
   }
+  // Only the bar's series is read (streamed; the analysis needs its values in memory).
+  static constexpr std::uint8_t bar[] = {
+      static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
   std::vector<double> bar_mm;
-  for (const auto& r : store.readings(o.run))
-    if (r.quantity == static_cast<std::uint8_t>(cal::drivers::Quantity::length_m))
-      bar_mm.push_back(r.value * 1e3);
+  auto stream = store.stream_readings(o.run, bar);
+  std::vector<st::RawReading> batch;
+  while (stream.next(batch))
+    for (const auto& r : batch) bar_mm.push_back(r.value * 1e3);
   cal::circle::Result result;
   try {
     result = analyse_ballbar(program, analysis, bar_mm);
@@ -95,23 +99,24 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   print_verdict(v);
 }
 
-void analyse_run(AnalyseRunOptions o) {
-  st::Store store(database_path(o.db));
+void analyse_run(const AnalyseRunOptions& o) {
+  // Only --store writes; without it the database is opened read-only.
+  auto store = o.store ? st::Store(database_path(o.db)) : open_database_read_only(o.db);
   const auto run = store.run(o.run);
   if (run && run->kind == "circle") return analyse_circle_run(store, *run, o);
-  if (o.standard.empty()) o.standard = "iso230-2:2014";
+  const std::string standard = o.standard.empty() ? "iso230-2:2014" : o.standard;
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
   if (targets.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
-  const auto e = cal::iso230_2::evaluate(measurements(targets),
-                                         cal::iso230_2::standard_from_string(o.standard));
+  const auto e =
+      cal::iso230_2::evaluate(measurements(targets), cal::iso230_2::standard_from_string(standard));
   json j = to_json(e);
   if (o.store) {
     // The stops' deviations are as compensated for the current result: the same coefficients.
     const json settings = json::parse(run->settings_json, nullptr, false);
     const auto used = compensation_used(settings, store.results(o.run));
     json prov = provenance("reanalysed", software_version);
-    prov["standard"] = o.standard;
+    prov["standard"] = standard;
     prov["coefficients"] = used.coefficients;
     prov["sensor_offsets"] = to_json(used.offsets);
     if (used.result_id) prov["of_result"] = *used.result_id;
@@ -174,16 +179,27 @@ void recompensate(const RecompensateOptions& o) {
       .humidity_pct = o.humidity_offset_pct.value_or(used.offsets.humidity_pct)};
   const double datum_mm = settings.value("datum_mm", 0.0);
 
-  // The environment as recorded, with the sensor corrections.
-  const auto readings = store.readings(o.run);
+  // The environment as recorded, with the sensor corrections: only its series are read (the
+  // laser's millions of readings are not needed here).
+  using Q = cal::drivers::Quantity;
+  static constexpr std::uint8_t environment[] = {
+      static_cast<std::uint8_t>(Q::air_temperature_degc),
+      static_cast<std::uint8_t>(Q::air_pressure_pa), static_cast<std::uint8_t>(Q::air_humidity_pct),
+      static_cast<std::uint8_t>(Q::material_temperature_degc)};
+  const auto readings = store.readings(o.run, environment);
   int material_sensors = 0;
   for (const auto& r : readings)
     if (static_cast<cal::drivers::Quantity>(r.quantity) ==
         cal::drivers::Quantity::material_temperature_degc)
       material_sensors = std::max(material_sensors, r.device - 1);
-  cal::daq::EnvStage stage(cfg, std::max(material_sensors, 1));
+  // Every sample is kept: the stops are compensated after all samples were given, each with
+  // the environment at its own time (the stage otherwise keeps the last 2 minutes, and a long
+  // run's early stops would get the air of its end).
+  cal::daq::EnvStage stage(
+      cfg, cal::daq::EnvSensors{.material_enabled = std::vector<bool>(
+                                    static_cast<std::size_t>(std::max(material_sensors, 1)), true),
+                                .keep_all_samples = true});
   for (const auto& r : readings) {
-    using Q = cal::drivers::Quantity;
     switch (static_cast<Q>(r.quantity)) {
       case Q::air_temperature_degc:
         stage.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc,

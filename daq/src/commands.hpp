@@ -7,8 +7,10 @@ namespace daq {
 void add_env_command(CLI::App& app);
 void add_iso230_2_commands(CLI::App& app, CLI::App& analyse);
 void add_demo_command(CLI::App& app);
-// devices: attached and reachable instruments
+// devices: attached and reachable instruments, the drivers and their options
 void add_devices_command(CLI::App& app);
+// decode DRIVER FILE: what a driver makes of a dump of bytes
+void add_decode_command(CLI::App& app);
 // runs, show, export: stored runs
 void add_runs_commands(CLI::App& app);
 // analyse RUN, recompensate RUN: stored runs
@@ -31,6 +33,8 @@ void add_compensate_commands(CLI::App& app, CLI::App& analyse);
 void add_serve_command(CLI::App& app);
 // report: HTML/PDF reports of stored runs
 void add_report_command(CLI::App& app);
+// bench ingest: throughput against the storage ceilings, measured on this machine
+void add_bench_commands(CLI::App& app);
 // model show|map|compensate|testpiece: the machine model file
 void add_model_commands(CLI::App& app);
 // ballbar calibrate|calibrations|volumetric|history

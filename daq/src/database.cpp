@@ -3,19 +3,33 @@
 #include <cstdlib>
 
 namespace daq {
+namespace {
 
-std::filesystem::path database_path(const std::string& option) {
+std::filesystem::path default_directory() {
+  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg)
+    return std::filesystem::path(xdg) / "caldaq";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return std::filesystem::path(home) / ".local" / "share" / "caldaq";
+  return std::filesystem::path(".") / "caldaq";
+}
+
+std::filesystem::path chosen_path(const std::string& option) {
   if (!option.empty()) return option;
   if (const char* env = std::getenv("CALDAQ_DB"); env && *env) return env;
-  std::filesystem::path base;
-  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg)
-    base = xdg;
-  else if (const char* home = std::getenv("HOME"); home && *home)
-    base = std::filesystem::path(home) / ".local" / "share";
-  else
-    base = ".";
-  std::filesystem::create_directories(base / "caldaq");
-  return base / "caldaq" / "site.sqlite";
+  return default_directory() / "site.sqlite";
+}
+
+}  // namespace
+
+std::filesystem::path database_path(const std::string& option) {
+  const auto path = chosen_path(option);
+  if (option.empty() && path.parent_path() == default_directory())
+    std::filesystem::create_directories(path.parent_path());
+  return path;
+}
+
+cal::storage::Store open_database_read_only(const std::string& option) {
+  return cal::storage::Store(chosen_path(option), {.read_only = true});
 }
 
 void add_db_option(CLI::App& cmd, std::string& target) {

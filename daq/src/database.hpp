@@ -4,11 +4,19 @@
 #include <filesystem>
 #include <string>
 
+#include "cal/storage/store.hpp"
+
 namespace daq {
 
 // --db PATH, else $CALDAQ_DB, else $XDG_DATA_HOME/caldaq/site.sqlite (default
-// ~/.local/share/caldaq/site.sqlite). The directory is created when writing.
+// ~/.local/share/caldaq/site.sqlite). The default directory is created: for commands that
+// write.
 std::filesystem::path database_path(const std::string& option);
+// The run store for a command that only reads (runs, show, export, report, analyse RUN,
+// compensate --run): the same path without creating anything, opened read-only, so the
+// database must exist and be caldaq's and is never created, migrated or changed; it works on
+// a full disk and a read-only medium (see docs/storage.md).
+cal::storage::Store open_database_read_only(const std::string& option);
 // Adds the --db option to a command.
 void add_db_option(CLI::App& cmd, std::string& target);
 

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   daq::add_iso230_2_commands(app, *analyse);
   daq::add_demo_command(app);
   daq::add_devices_command(app);
+  daq::add_decode_command(app);
   daq::add_runs_commands(app);
   daq::add_stored_run_commands(app, *analyse);
   daq::add_replay_command(app);
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   daq::add_model_commands(app);
   daq::add_ballbar_commands(app);
   daq::add_serve_command(app);
+  daq::add_bench_commands(app);
   daq::check_numbers(app);
 
   try {

@@ -1,98 +1,165 @@
-// The instruments of a configuration's devices (shared by daq run and daq serve).
+// The instruments of a configuration's devices (shared by daq run, daq serve and daq replay).
+// Every device is built through the registry: nothing here names a device.
 #include "run_setup.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cstdio>
+#include <boost/asio/io_context.hpp>
 
 #include "cal/analysis/error.hpp"
-#include "cal/drivers/instruments.hpp"
-#include "cal/drivers/transport/hid.hpp"
+#include "cal/drivers/registry.hpp"
 
 namespace daq {
 
 namespace d = cal::drivers;
 namespace t = cal::drivers::transport;
-using namespace std::chrono_literals;
 
 namespace {
-// "hid VID:PID" (hex, as lsusb prints them), or "hid /dev/hidrawN".
-t::HidSettings hid_settings(const cal::daq::DeviceConfig& c, const std::string& rest) {
-  if (rest.starts_with("/")) return {.path = rest};
-  unsigned vid = 0, pid = 0;
-  char extra = 0;
-  if (std::sscanf(rest.c_str(), "%4x:%4x%c", &vid, &pid, &extra) != 2)
-    throw cal::InputError(
-        fmt::format("devices.{}.transport '{}': expected hid VID:PID (hex) or hid /dev/hidrawN",
-                    c.id, c.transport));
-  // TEMPer sticks expose a keyboard interface too; the sensor answers on interface 1.
-  return {.vendor_id = static_cast<std::uint16_t>(vid),
-          .product_id = static_cast<std::uint16_t>(pid),
-          .interface_number = c.driver == "temper" ? 1 : -1};
+
+// The readings a role needs from its device (one of them suffices).
+std::vector<d::Quantity> needed(std::string_view role) {
+  using Q = d::Quantity;
+  if (role == "laser") return {Q::displacement_m};
+  if (role == "air") return {Q::air_temperature_degc, Q::air_pressure_pa};
+  if (role == "material") return {Q::material_temperature_degc};
+  if (role == "ballbar") return {Q::length_m};
+  if (role == "position") return {Q::machine_position_m};
+  return {};
+}
+
+// The drivers whose readings can fill the role (with their default options), for the message.
+std::string drivers_for(std::string_view role) {
+  std::vector<std::string_view> names;
+  const auto want = needed(role);
+  for (const auto* drv : d::device_drivers()) {
+    const auto q = drv->quantities(d::Options(drv->options()), {std::string(role), 0});
+    if (std::any_of(want.begin(), want.end(),
+                    [&](d::Quantity w) { return std::find(q.begin(), q.end(), w) != q.end(); }))
+      names.push_back(drv->name());
+  }
+  return fmt::format("{}", fmt::join(names, ", "));
 }
 
 }  // namespace
 
 std::unique_ptr<t::Transport> make_transport(boost::asio::io_context& io,
                                              const cal::daq::DeviceConfig& c) {
-  const auto space = c.transport.find(' ');
-  const std::string kind = c.transport.substr(0, space),
-                    rest = space == std::string::npos ? "" : c.transport.substr(space + 1);
-  if (kind == "tcp") {
-    const auto colon = rest.rfind(':');
-    if (colon == std::string::npos)
-      throw cal::InputError(
-          fmt::format("devices.{}.transport '{}': expected tcp HOST:PORT", c.id, c.transport));
-    return t::make_tcp(io, {.host = rest.substr(0, colon),
-                            .port = static_cast<std::uint16_t>(std::stoi(rest.substr(colon + 1)))});
+  try {
+    return t::make_transport(io, c.transport, d::driver(c.driver).hid_interface());
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("devices.{}.transport {}", c.id, e.what()));
   }
-  if (kind == "serial") {
-    const auto sp = rest.find(' ');
-    if (sp == std::string::npos)
-      throw cal::InputError(fmt::format(
-          "devices.{}.transport '{}': expected serial DEVICE BAUD FRAME", c.id, c.transport));
-    return t::make_serial(
-        io, t::parse_serial_settings(rest.substr(sp + 1), {.device = rest.substr(0, sp)}));
-  }
-  if (kind == "hid") return t::make_hid(io, hid_settings(c, rest));
-  throw cal::InputError(
-      fmt::format("devices.{}: transport '{}' has no driver here yet", c.id, c.transport));
 }
 
-InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device) {
-  InstrumentSpec s{.device = device, .driver = c.driver, .role = c.role, .transport = c.transport};
-  if (!c.axes.empty()) {
-    s.ids_axes = {false, false, false};
-    for (int a : c.axes) s.ids_axes[static_cast<std::size_t>(a)] = true;
-  }
-  s.gauge = {
-      .request = c.request, .pattern = c.pattern, .unit = d::codec::gauge_unit_from_string(c.unit)};
-  if (s.gauge.unit == d::codec::GaugeUnit::degc) s.gauge.min_si = -40, s.gauge.max_si = 150;
-  s.temper_family = c.family;
-  s.feed_key = c.key;
-  s.feed_column = c.column;
-  s.feed_unit = c.unit == "in" ? "in" : "mm";
-  static constexpr std::string_view drivers[] = {"ids3010", "ptu300",     "gauge",
-                                                 "temper",  "halsampler", "shdr"};
-  if (std::find(std::begin(drivers), std::end(drivers), c.driver) == std::end(drivers))
-    throw cal::InputError(
-        fmt::format("devices.{}: driver '{}' is not available for runs yet", c.id, c.driver));
+InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device, int test_axis) {
+  const auto& drv = d::driver(c.driver);
+  InstrumentSpec s{.device = device,
+                   .driver = c.driver,
+                   .role = c.role,
+                   .transport = c.transport,
+                   .options = c.options,
+                   .test_axis = test_axis,
+                   .serial_number = c.serial_number,
+                   .certificate = c.certificate,
+                   .calibration_due = c.calibration_due};
+  const auto want = needed(c.role);
+  const auto have = drv.quantities(s.options, s.context());
+  if (!want.empty() && std::none_of(want.begin(), want.end(), [&](d::Quantity w) {
+        return std::find(have.begin(), have.end(), w) != have.end();
+      }))
+    throw cal::InputError(fmt::format(
+        "devices.{}: driver '{}' (as configured) gives no {} readings, which role \"{}\" needs "
+        "(drivers that do: {})",
+        c.id, c.driver, d::to_string(want.front()), c.role, drivers_for(c.role)));
   return s;
 }
 
 const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role) {
-  if (const auto* d = c.device_for(role)) return *d;
+  if (const auto* dc = c.device_for(role)) return *dc;
   throw cal::InputError(fmt::format("{}: no device with role = \"{}\"", c.source.string(), role));
 }
 
-d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const RunOptions& o,
+d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const InstrumentSpec& s,
+                                        const RunOptions& o,
                                         cal::replay::CaptureRecorder* recorder) {
   d::InstrumentOptions opt{
       .name = dc.id, .backoff = {.max_attempts = o.give_up_after}, .recorder = recorder};
-  if (dc.poll_s > 0)
-    opt.poll_period = std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6));
+  opt.poll_period = dc.poll_s > 0
+                        ? std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6))
+                        : d::driver(s.driver).default_poll(s.options, s.context());
   return opt;
+}
+
+namespace {
+
+const cal::daq::DeviceConfig& device_of(const cal::daq::Config& config, const InstrumentSpec& s) {
+  return *std::find_if(config.devices.begin(), config.devices.end(), [&](const auto& x) {
+    return x.transport == s.transport && x.role == s.role;
+  });
+}
+
+// What the check saw of one device.
+struct Checked {
+  const cal::daq::DeviceConfig* device = nullptr;
+  std::unique_ptr<d::Instrument> instrument;
+  bool may_be_silent = false;
+  bool opened = false, spoke = false, closed = false;
+  std::string why;  // the last state's reason (the transport's error text)
+  bool done() const { return spoke || closed || (may_be_silent && opened); }
+};
+
+}  // namespace
+
+void check_devices(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
+                   std::chrono::duration<double> within,
+                   const std::function<void(const std::string&)>& print) {
+  boost::asio::io_context io;
+  std::vector<Checked> checked(specs.size());
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    const auto& s = specs[k];
+    auto& c = checked[k];
+    c.device = &device_of(config, s);
+    c.may_be_silent = d::driver(s.driver).may_be_silent(s.options);
+    auto options = instrument_options(*c.device, s, RunOptions{.give_up_after = 1}, nullptr);
+    c.instrument = make_instrument(io, s, make_transport(io, *c.device), std::move(options));
+    c.instrument->start({.reading = [&c](const d::Reading&) { c.spoke = true; },
+                         .state =
+                             [&c](d::InstrumentState st, std::string_view why) {
+                               if (st == d::InstrumentState::configuring) c.opened = true;
+                               if (st == d::InstrumentState::closed) c.closed = true;
+                               if (!why.empty()) c.why = std::string(why);
+                             }});
+  }
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::nanoseconds>(within);
+  while (std::chrono::steady_clock::now() < deadline &&
+         !std::all_of(checked.begin(), checked.end(), [](const Checked& c) { return c.done(); }))
+    io.run_for(std::chrono::milliseconds(20));
+  std::vector<std::string> failed;
+  for (auto& c : checked) {
+    const std::string who = fmt::format("devices.{} ({})", c.device->id, c.device->transport);
+    std::string state;
+    if (c.spoke) {
+      state = "speaks";
+    } else if (c.may_be_silent && c.opened && !c.closed) {
+      state = "open (it may be silent until it streams)";
+    } else {
+      // A closed instrument gave up after its one attempt: the reason is what follows.
+      if (const auto at = c.why.find("attempts: "); c.closed && at != std::string::npos)
+        c.why = c.why.substr(at + 10);
+      state = c.closed   ? fmt::format("failed: {}", c.why)
+              : c.opened ? fmt::format("opened but said nothing within {:.0f} s", within.count())
+                         : fmt::format("did not open within {:.0f} s{}", within.count(),
+                                       c.why.empty() ? "" : ": " + c.why);
+      failed.push_back(who + ": " + state);
+    }
+    print(fmt::format("  {}: {}", who, state));
+    c.instrument->stop();
+  }
+  io.poll();
+  if (!failed.empty())
+    throw cal::InputError(fmt::format("device check: {}", fmt::join(failed, "; ")));
 }
 
 // The instruments of a linear run (laser, air, material sensors, optional position feed).
@@ -101,39 +168,45 @@ std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
     throw cal::InputError(fmt::format("{}: no [test.linear]", config.source.string()));
   std::vector<InstrumentSpec> specs;
   std::uint16_t n = 0;
-  // The position feed reports the test axis: its channel is the axis' index.
   const int axis = config.linear->axis == "Y" ? 1 : config.linear->axis == "Z" ? 2 : 0;
   for (const auto& dc : config.devices) {
     if (dc.role != "laser" && dc.role != "air" && dc.role != "material" && dc.role != "position")
       continue;
-    specs.push_back(spec_of(dc, n++));
-    specs.back().feed_axis = axis;
-    if (specs.back().feed_key.empty()) specs.back().feed_key = config.linear->axis + "act";
+    specs.push_back(spec_of(dc, n++, axis));
   }
   need(config, "laser"), need(config, "air");
   return specs;
+}
+
+void place_linear_instrument(const InstrumentSpec& s, std::unique_ptr<d::Instrument> inst,
+                             LinearRunSetup& setup) {
+  const auto& drv = d::driver(s.driver);
+  const auto channels = drv.channels(s.options, s.context());
+  const int first = channels.empty() ? 0 : channels.front();
+  if (s.role == "laser") {
+    setup.laser = std::move(inst);
+    setup.laser_channel = first;
+  } else if (s.role == "air") {
+    setup.air = std::move(inst);
+  } else if (s.role == "position") {
+    setup.position = std::move(inst);
+    setup.position_channel = first;
+    setup.position_on_change = drv.sends_on_change();
+  } else {
+    setup.material.push_back(std::move(inst));
+    setup.material_channels.resize(setup.material.size() - 1);
+    setup.material_channels.push_back(channels);  // each channel its own material sensor
+  }
 }
 
 void add_linear_instruments(boost::asio::io_context& io, const cal::daq::Config& config,
                             const std::vector<InstrumentSpec>& specs, const RunOptions& o,
                             cal::replay::CaptureRecorder* recorder, LinearRunSetup& setup) {
   for (const auto& s : specs) {
-    const auto& dc = *std::find_if(
-        config.devices.begin(), config.devices.end(),
-        [&](const auto& x) { return x.transport == s.transport && x.role == s.role; });
-    auto opt = instrument_options(dc, o, recorder);
-    if (dc.poll_s <= 0 && (s.driver == "ptu300" || s.driver == "temper" || s.role == "material"))
-      opt.poll_period = 1000ms;
-    if (dc.poll_s <= 0 && s.driver == "shdr") opt.poll_period = 5000ms;  // "* PING" heartbeats
-    auto inst = make_instrument(io, s, make_transport(io, dc), opt);
-    if (s.role == "laser")
-      setup.laser = std::move(inst);
-    else if (s.role == "air")
-      setup.air = std::move(inst);
-    else if (s.role == "position")
-      setup.position = std::move(inst), setup.position_channel = s.feed_axis;
-    else
-      setup.material.push_back(std::move(inst));
+    const auto& dc = device_of(config, s);
+    place_linear_instrument(
+        s, make_instrument(io, s, make_transport(io, dc), instrument_options(dc, s, o, recorder)),
+        setup);
   }
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 // What `daq run` and `daq serve` share: the instruments of a configuration's devices, their
 // options, and the session capture. Boost.Asio stays out (io_context is forward-declared).
+#include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,13 +21,16 @@ struct RunOptions {
   std::string config, db, capture;
   int give_up_after = 20;
   bool json = false;
+  double check_s = 10.0;  // the start-up device check's limit; 0: no check
 };
 
-// "tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or "hid /dev/hidrawN"; throws
-// cal::InputError naming the device and its transport text.
+// The transport of a device ("tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or
+// "hid /dev/hidrawN"); throws cal::InputError naming the device and its transport text.
 std::unique_ptr<cal::drivers::transport::Transport> make_transport(boost::asio::io_context& io,
                                                                    const cal::daq::DeviceConfig& c);
-InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device);
+// The instrument spec of a configured device; throws cal::InputError when its driver's readings
+// cannot fill its role (a PTU300 as the ballbar).
+InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device, int test_axis = 0);
 // The device of a role, or cal::InputError naming the configuration file.
 const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role);
 
@@ -45,13 +50,26 @@ struct SessionCapture {
   }
 };
 
-// The options of a configured device: its name, poll period and the run's reconnection limit.
+// The options of a configured device: its name, poll period (the driver's default when the
+// configuration gives none) and the run's reconnection limit.
 cal::drivers::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc,
-                                                   const RunOptions& o,
+                                                   const InstrumentSpec& s, const RunOptions& o,
                                                    cal::replay::CaptureRecorder* recorder);
+
+// The start-up check of `daq run` and `daq serve`: every device of `specs` is opened once (no
+// reconnection) and must speak (a reading) within `within`; a device that may be silent until
+// something happens (a ballbar gauge before it is mounted) must open. Prints each device's
+// state through `print`; throws cal::InputError naming every device that failed and why.
+void check_devices(const cal::daq::Config& config, const std::vector<InstrumentSpec>& specs,
+                   std::chrono::duration<double> within,
+                   const std::function<void(const std::string&)>& print);
 
 // The instruments of a linear run (laser, air, material sensors, optional position feed).
 std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config);
+// Puts an instrument in its role's place in a linear run (the laser's and the position feed's
+// channel from the driver); live and in replay.
+void place_linear_instrument(const InstrumentSpec& s,
+                             std::unique_ptr<cal::drivers::Instrument> inst, LinearRunSetup& setup);
 void add_linear_instruments(boost::asio::io_context& io, const cal::daq::Config& config,
                             const std::vector<InstrumentSpec>& specs, const RunOptions& o,
                             cal::replay::CaptureRecorder* recorder, LinearRunSetup& setup);

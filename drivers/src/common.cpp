@@ -83,16 +83,29 @@ std::optional<double> parse_number(std::string_view s) {
   return v;
 }
 
-std::vector<std::string_view> split_whitespace(std::string_view s) {
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
+namespace {
+// A plain test per byte: string_view::find_first_of with a set calls memchr on the set for
+// every byte of the line, which costs more than the parsing on a 10 kHz stream.
+bool blank(char c) { return c == ' ' || c == '\t'; }
+}  // namespace
+
+std::size_t split_whitespace(std::string_view s, std::span<std::string_view> out) {
+  std::size_t count = 0, i = 0;
+  const std::size_t n = s.size();
   while (true) {
-    i = s.find_first_not_of(" \t", i);
-    if (i == std::string_view::npos) break;
-    const std::size_t end = std::min(s.find_first_of(" \t", i), s.size());
-    out.push_back(s.substr(i, end - i));
-    i = end;
+    while (i < n && blank(s[i])) ++i;
+    if (i == n) break;
+    const std::size_t start = i;
+    while (i < n && !blank(s[i])) ++i;
+    if (count < out.size()) out[count] = s.substr(start, i - start);
+    ++count;
   }
+  return count;
+}
+
+std::vector<std::string_view> split_whitespace(std::string_view s) {
+  std::vector<std::string_view> out(split_whitespace(s, {}));
+  split_whitespace(s, out);
   return out;
 }
 

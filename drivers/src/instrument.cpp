@@ -51,6 +51,18 @@ std::string_view to_string(InstrumentState s) {
   return "unknown";
 }
 
+std::string_view to_string(DeviceMessage::Severity s) {
+  switch (s) {
+    case DeviceMessage::Severity::info:
+      return "info";
+    case DeviceMessage::Severity::warning:
+      return "warning";
+    case DeviceMessage::Severity::error:
+      return "error";
+  }
+  return "unknown";
+}
+
 Clock steady_clock_ns() {
   return [] {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -71,7 +83,9 @@ InstrumentCore::InstrumentCore(boost::asio::io_context& io,
       reconnect_timer_(io),
       poll_timer_(io),
       watchdog_(io),
-      next_delay_(options_.backoff.initial) {}
+      next_delay_(options_.backoff.initial),
+      poll_period_(options_.poll_period),
+      silence_timeout_(options_.silence_timeout) {}
 
 InstrumentCore::~InstrumentCore() {
   *alive_ = false;
@@ -136,6 +150,9 @@ void InstrumentCore::on_opened() {
   record_event("opened");
   set_state(InstrumentState::configuring);
   last_bytes_ns_ = now_ns();
+  // Each connection starts from the configured period and watchdog (a device may change them).
+  poll_period_ = options_.poll_period;
+  silence_timeout_ = options_.silence_timeout;
   arm_watchdog();
   on_connected();
 }
@@ -196,15 +213,22 @@ void InstrumentCore::schedule_reconnect() {
 // A silent device is a dropped connection (a TCP peer that vanished without a FIN, a serial
 // adapter whose instrument was switched off): without this, the gap would never be seen.
 void InstrumentCore::arm_watchdog() {
-  if (options_.replay) return;
-  watchdog_.expires_after(options_.silence_timeout);
-  watchdog_.async_wait([this, alive = alive_](const boost::system::error_code& ec) {
+  if (options_.replay || !silence_timeout_) return;
+  const auto timeout = *silence_timeout_;
+  watchdog_.expires_after(timeout);
+  watchdog_.async_wait([this, alive = alive_, timeout](const boost::system::error_code& ec) {
     if (ec || !*alive || !running_) return;
     const auto silent_ns = now_ns() - last_bytes_ns_;
-    if (silent_ns >= std::chrono::nanoseconds(options_.silence_timeout).count())
-      return fail(fmt::format("no data for {} ms", options_.silence_timeout.count()));
+    if (silent_ns >= std::chrono::nanoseconds(timeout).count())
+      return fail(fmt::format("no data for {} ms", timeout.count()));
     arm_watchdog();
   });
+}
+
+void InstrumentCore::set_silence_timeout(std::optional<std::chrono::milliseconds> timeout) {
+  silence_timeout_ = timeout;
+  watchdog_.cancel();
+  if (running_) arm_watchdog();
 }
 
 void InstrumentCore::send(std::string_view text) {
@@ -246,10 +270,21 @@ void InstrumentCore::start_polling() {
 void InstrumentCore::poll_tick() {
   if (!polling_ || !running_) return;
   on_poll();
-  poll_timer_.expires_after(options_.poll_period);
+  poll_timer_.expires_after(poll_period_);
   poll_timer_.async_wait([this, alive = alive_](const boost::system::error_code& ec) {
     if (!ec && *alive) poll_tick();
   });
+}
+
+void InstrumentCore::report_gap(const Gap& gap) {
+  record_event("gap: " + gap.reason);
+  if (events_.gap) events_.gap(gap);
+}
+
+void InstrumentCore::report_message(const DeviceMessage& message) {
+  record_event(fmt::format("{}{}: {}", to_string(message.severity),
+                           message.code ? fmt::format(" {}", message.code) : "", message.text));
+  if (events_.message) events_.message(message);
 }
 
 void InstrumentCore::report_codec_errors(std::span<const codec::CodecError> errors) {

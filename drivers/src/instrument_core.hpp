@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "cal/drivers/instrument.hpp"
 
@@ -39,8 +40,29 @@ class InstrumentCore : public Instrument {
   void set_state(InstrumentState s, std::string_view why = {});
   // Ends the connection and schedules a reconnection (reason recorded in the gap).
   void fail(const std::string& reason);
+  // A period without readings while connected (samples the device says it lost), reported at
+  // once; `start_ns` may equal `end_ns` when the device does not say how long.
+  void report_gap(const Gap& gap);
+  // What the device said that is not a reading: a warning or an error with its own text.
+  void report_message(const DeviceMessage& message);
   void start_polling();
+  // The poll period from now on (the device said how often it wants to be asked).
+  void set_poll_period(std::chrono::microseconds period) { poll_period_ = period; }
+  // How long a connected device may be silent before the connection counts as lost; nullopt:
+  // never (a feed that sends only on change is silent while nothing changes). Re-arms the
+  // watchdog from now.
+  void set_silence_timeout(std::optional<std::chrono::milliseconds> timeout);
   void report_codec_errors(std::span<const codec::CodecError> errors);
+  // Feeds the bytes to the codec: `frames` holds the frames they completed (cleared first), and
+  // each codec error is reported through the events.
+  template <class Codec>
+  void decode(Codec& codec, std::span<const std::byte> bytes,
+              std::vector<typename Codec::Frame>& frames) {
+    frames.clear();
+    codec_errors_.clear();
+    codec.feed(bytes, frames, codec_errors_);
+    report_codec_errors(codec_errors_);
+  }
   // The time of the event being handled: inside a data handler the arrival time of the bytes
   // (one value for the whole chunk, the one recorded), else the clock.
   std::int64_t now_ns() const { return latched_ns_ ? *latched_ns_ : clock_(); }
@@ -67,8 +89,11 @@ class InstrumentCore : public Instrument {
   bool running_ = false;
   bool polling_ = false;
   std::int64_t last_bytes_ns_ = 0;
+  std::chrono::microseconds poll_period_;
+  std::optional<std::chrono::milliseconds> silence_timeout_;
   std::optional<Gap> gap_;  // open while the connection is down
   std::optional<std::int64_t> latched_ns_;
+  std::vector<codec::CodecError> codec_errors_;
   std::int64_t last_sent_ns_ = 0;
   void record_event(std::string_view text);
   void on_opened();

@@ -70,10 +70,15 @@ bool is_pseudo_terminal(int fd) {
 
 // Sets the whole line discipline in one tcsetattr (raw mode, speed, framing, flow control)
 // and reads it back: termios reports success even when a driver ignores a flag, so the read
-// back is the only way to know. Pseudo-terminals always carry 8-bit bytes (the kernel forces
-// CS8 and clears PARENB), which is harmless for the ASCII protocols the twins speak, so the
-// framing check is skipped for them. Done with termios directly rather than Asio's
-// serial_port options, which set one flag per call (Boost 1.74 refuses CS7 on a pty).
+// back is the only way to know. Done with termios directly rather than Asio's serial_port
+// options, which set one flag per call (Boost 1.74 refuses CS7 on a pty).
+//
+// Pseudo-terminals carry whole bytes: the kernel forces CS8 and clears PARENB on them, and on
+// current kernels (seen on 6.x) a second tcsetattr asking for 7E1 again fails with EINVAL, so
+// the PTU300's 4800 7E1 worked on the first open of a twin's pty and failed on every reopen
+// (the next run, every reconnection). On a pty the framing is therefore asked as what the pty
+// carries (8 data bits, no parity); the speed and flow control as configured. Real ports get
+// exactly the configured framing, read back and checked as before.
 std::string configure(int fd, const SerialSettings& s) {
   const speed_t speed = speed_code(s.baud);
   if (speed == B0) return fmt::format("baud rate {} is not a standard rate", s.baud);
@@ -81,13 +86,14 @@ std::string configure(int fd, const SerialSettings& s) {
     return "1.5 stop bits cannot be set through POSIX termios";
   termios tio{};
   if (tcgetattr(fd, &tio) != 0) return fmt::format("not a serial port: {}", std::strerror(errno));
+  const bool pty = is_pseudo_terminal(fd);
   cfmakeraw(&tio);
   cfsetispeed(&tio, speed);
   cfsetospeed(&tio, speed);
   tio.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | PARODD | CSTOPB | CRTSCTS);
-  tio.c_cflag |= size_flag(s.data_bits) | CREAD | CLOCAL;
-  if (s.parity != Parity::none) tio.c_cflag |= PARENB;
-  if (s.parity == Parity::odd) tio.c_cflag |= PARODD;
+  tio.c_cflag |= (pty ? CS8 : size_flag(s.data_bits)) | CREAD | CLOCAL;
+  if (!pty && s.parity != Parity::none) tio.c_cflag |= PARENB;
+  if (!pty && s.parity == Parity::odd) tio.c_cflag |= PARODD;
   if (s.stop_bits == StopBits::two) tio.c_cflag |= CSTOPB;
   if (s.flow == FlowControl::hardware) tio.c_cflag |= CRTSCTS;
   tio.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF | IXANY);
@@ -100,7 +106,7 @@ std::string configure(int fd, const SerialSettings& s) {
   tcgetattr(fd, &back);
   if (cfgetispeed(&back) != speed) return fmt::format("the port refused baud rate {}", s.baud);
   const tcflag_t framing = CSIZE | PARENB | PARODD | CSTOPB;
-  if (!is_pseudo_terminal(fd) && (back.c_cflag & framing) != (tio.c_cflag & framing))
+  if (!pty && (back.c_cflag & framing) != (tio.c_cflag & framing))
     return fmt::format("the port refused framing {}", format_serial_settings(s));
   return {};
 }

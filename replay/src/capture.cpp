@@ -14,6 +14,8 @@
 #include <thread>
 #include <utility>
 
+#include "cal/analysis/crc32c.hpp"
+
 namespace cal::replay {
 namespace {
 
@@ -24,18 +26,6 @@ constexpr std::size_t kBlockHeader = 16;           // magic, payload length, rec
 constexpr std::size_t kRecordHeader = 16;          // time, device, kind, reserved, length
 constexpr std::uint32_t kMaxHeader = 1 << 20;
 constexpr std::uint32_t kMaxPayload = 64 << 20;
-
-// The table of the reflected CRC-32C polynomial, built at compile time.
-constexpr std::array<std::uint32_t, 256> make_table() {
-  std::array<std::uint32_t, 256> t{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1) ? (c >> 1) ^ 0x82F63B78u : c >> 1;
-    t[i] = c;
-  }
-  return t;
-}
-constexpr auto kTable = make_table();
 
 template <class T>
 void put(std::vector<std::byte>& out, T v) {  // little-endian (the host is; static_assert)
@@ -53,9 +43,7 @@ T get(const std::byte* p) {
 }  // namespace
 
 std::uint32_t crc32c(std::span<const std::byte> data, std::uint32_t crc) {
-  crc = ~crc;
-  for (std::byte b : data) crc = kTable[(crc ^ static_cast<std::uint8_t>(b)) & 0xff] ^ (crc >> 8);
-  return ~crc;
+  return cal::crc32c(data, crc);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -361,6 +349,12 @@ std::string describe(const Damage& d) {
 std::uint64_t CaptureReader::records_read() const { return impl_->records; }
 
 std::optional<Record> CaptureReader::next() {
+  const auto v = next_view();
+  if (!v) return std::nullopt;
+  return Record{v->time_ns, v->device, v->kind, {v->bytes.begin(), v->bytes.end()}};
+}
+
+std::optional<RecordView> CaptureReader::next_view() {
   Impl& m = *impl_;
   if (m.damage) return std::nullopt;
   while (m.left == 0)
@@ -372,7 +366,7 @@ std::optional<Record> CaptureReader::next() {
     return std::nullopt;
   }
   const std::byte* p = m.payload.data() + m.pos;
-  Record r;
+  RecordView r;
   r.time_ns = get<std::int64_t>(p);
   r.device = get<std::uint16_t>(p + 8);
   r.kind = static_cast<RecordKind>(get<std::uint8_t>(p + 10));
@@ -381,7 +375,7 @@ std::optional<Record> CaptureReader::next() {
     m.damage = Damage{m.block_start, m.block - 1, "record longer than its block"};
     return std::nullopt;
   }
-  r.bytes.assign(p + kRecordHeader, p + kRecordHeader + length);
+  r.bytes = std::span(p + kRecordHeader, length);
   m.pos += kRecordHeader + length;
   --m.left;
   ++m.records;

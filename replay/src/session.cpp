@@ -27,9 +27,9 @@ struct ReplayBus::Impl : std::enable_shared_from_this<ReplayBus::Impl> {
   std::map<std::uint16_t, Port> ports;
   std::function<void(const ReplayEnd&)> done;
   std::optional<std::int64_t> wall_start_ns, first_ns;
-  std::optional<Record> pending;
+  std::optional<RecordView> pending;  // valid until the next reader.next_view()
 
-  void deliver(const Record& r) {
+  void deliver(const RecordView& r) {
     now_ns = r.time_ns;
     auto it = ports.find(r.device);
     if (it == ports.end()) return;  // a device nobody replays
@@ -66,7 +66,7 @@ struct ReplayBus::Impl : std::enable_shared_from_this<ReplayBus::Impl> {
   // with them, and a paced replay sleeps on a timer rather than blocking the loop).
   void pump() {
     for (int n = 0; n < 512; ++n) {
-      if (!pending) pending = reader.next();
+      if (!pending) pending = reader.next_view();
       if (!pending) return finish();
       if (speed > 0) {
         if (!wall_start_ns) wall_start_ns = wall_ns(), first_ns = pending->time_ns;

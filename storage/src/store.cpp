@@ -1,17 +1,17 @@
 // The SQLite run store (see store.hpp; schema and chunk format in docs/storage.md).
 #include "cal/storage/store.hpp"
 
-#include <fmt/format.h>
 #include <signal.h>
-#include <sqlite3.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <map>
-#include <tuple>
+
+#include "store_impl.hpp"
 
 namespace cal::storage {
 
@@ -31,19 +31,14 @@ std::string_view to_string(RunStatus s) {
 
 namespace {
 
+using detail::Stmt;
+
 RunStatus status_from(std::string_view s) {
   if (s == "complete") return RunStatus::complete;
   if (s == "incomplete") return RunStatus::incomplete;
   if (s == "aborted") return RunStatus::aborted;
   return RunStatus::running;
 }
-
-struct DbCloser {
-  void operator()(sqlite3* db) const { sqlite3_close_v2(db); }
-};
-struct StmtFinalizer {
-  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-};
 
 // The schema, one entry per version: entry k migrates from version k to k + 1. A migration
 // runs in one transaction with the user_version update, so a crash mid-migration leaves the
@@ -128,7 +123,18 @@ CREATE TABLE missed_stops(
 ALTER TABLE runs ADD COLUMN origin_session_ns INTEGER;
 ALTER TABLE runs ADD COLUMN origin_unix_ns INTEGER;
 )sql",
-    // 2 -> 3 (issue 18): ballbar calibrations against a calibrator, with their date, so that a
+    // 2 -> 3: reading chunks carry their encoding (1: the 17-byte records of schemas 1 and 2, kept
+    // as they are; 2: chunk.hpp), their sequence number in the run and a CRC-32C over their
+    // row and BLOB (NULL for the chunks written before), checked on every read; the file says
+    // it is caldaq's (application id "CALD").
+    R"sql(
+ALTER TABLE reading_chunks ADD COLUMN encoding INTEGER NOT NULL DEFAULT 1;
+ALTER TABLE reading_chunks ADD COLUMN seq INTEGER;
+ALTER TABLE reading_chunks ADD COLUMN crc INTEGER;
+CREATE UNIQUE INDEX reading_chunks_by_seq ON reading_chunks(run_id, seq);
+PRAGMA application_id = 1128352836;
+)sql",
+    // 3 -> 4 (issue 18): ballbar calibrations against a calibrator, with their date, so that a
     // test's absolute radius names the calibration it used.
     R"sql(
 CREATE TABLE ballbar_calibrations(
@@ -149,9 +155,7 @@ CREATE INDEX ballbar_calibrations_by_bar
 };
 static_assert(std::size(kMigrations) == schema_version);
 
-// Chunk BLOB: per reading 8 bytes time_ns (int64), 1 byte status, 8 bytes value (IEEE-754
-// double), all little-endian, packed (17 bytes). The host is little-endian (x86-64, arm64).
-constexpr std::size_t kRecordBytes = 17;
+constexpr std::int64_t kApplicationId = 0x43414C44;  // "CALD"
 
 std::int64_t unix_ms_now() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -160,55 +164,6 @@ std::int64_t unix_ms_now() {
 }
 
 }  // namespace
-
-struct Store::Impl {
-  std::filesystem::path path;
-  std::unique_ptr<sqlite3, DbCloser> db;
-  int version = 0;
-
-  [[noreturn]] void fail(std::string_view what) const {
-    throw StoreError(fmt::format("{}: {}: {}", path.string(), what, sqlite3_errmsg(db.get())));
-  }
-
-  void exec(const char* sql, std::string_view what) {
-    char* err = nullptr;
-    if (sqlite3_exec(db.get(), sql, nullptr, nullptr, &err) != SQLITE_OK) {
-      const std::string text = err ? err : "unknown error";
-      sqlite3_free(err);
-      throw StoreError(fmt::format("{}: {}: {}", path.string(), what, text));
-    }
-  }
-
-  using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalizer>;
-  Stmt prepare(const char* sql) const {
-    sqlite3_stmt* s = nullptr;
-    if (sqlite3_prepare_v2(db.get(), sql, -1, &s, nullptr) != SQLITE_OK) fail("prepare");
-    return Stmt(s);
-  }
-
-  void step_done(sqlite3_stmt* s, std::string_view what) const {
-    if (sqlite3_step(s) != SQLITE_DONE) fail(what);
-    sqlite3_reset(s);
-  }
-
-  void insert_targets(std::span<const CapturedTarget> targets);
-  std::int64_t insert_result(const ResultRecord& r, Supersede how);
-
-  // A transaction that rolls back unless committed (RAII), so a failed batch leaves the
-  // database as it was before the batch, never half-written.
-  struct Transaction {
-    Impl& impl;
-    bool done = false;
-    explicit Transaction(Impl& i) : impl(i) { impl.exec("BEGIN IMMEDIATE", "begin transaction"); }
-    void commit() {
-      impl.exec("COMMIT", "commit");
-      done = true;
-    }
-    ~Transaction() {
-      if (!done) sqlite3_exec(impl.db.get(), "ROLLBACK", nullptr, nullptr, nullptr);
-    }
-  };
-};
 
 namespace {
 
@@ -226,41 +181,175 @@ bool process_alive(std::int64_t pid) {
   return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
 }
 
+std::int64_t query_int(const Store::Impl& m, const char* sql, std::string_view what) {
+  auto s = m.prepare(sql);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) m.fail(what);
+  return sqlite3_column_int64(s.get(), 0);
+}
+
+// "file:" URI of a path, for SQLite's URI parameters: everything but unreserved characters
+// and '/' percent-encoded.
+std::string file_uri(const std::filesystem::path& path) {
+  std::string uri = "file:";
+  for (unsigned char c : std::filesystem::absolute(path).string()) {
+    if (std::isalnum(c) || c == '/' || c == '-' || c == '_' || c == '.' || c == '~')
+      uri += static_cast<char>(c);
+    else
+      uri += fmt::format("%{:02X}", c);
+  }
+  return uri;
+}
+
+constexpr std::string_view kInterrupted =
+    "interrupted: the writing process ended without finishing the run";
+
 }  // namespace
+
+// A caldaq database, or a new empty one; refuses a file that is not a database, another
+// program's SQLite database, and a newer schema. Reads only.
+void Store::Impl::check_caldaq_database() {
+  // The first statement reads the header: a file that is not a database fails here.
+  auto s = prepare(
+      "SELECT (SELECT count(*) FROM sqlite_master), "
+      "(SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name IN ('runs', "
+      "'reading_chunks')), "
+      "(SELECT group_concat(name, ', ') FROM (SELECT name FROM sqlite_master WHERE type = "
+      "'table' ORDER BY name LIMIT 4))");
+  if (sqlite3_step(s.get()) != SQLITE_ROW) fail("not a caldaq database");
+  const auto objects = sqlite3_column_int64(s.get(), 0);
+  const bool ours = sqlite3_column_int64(s.get(), 1) == 2;
+  const auto* names_text = sqlite3_column_text(s.get(), 2);
+  const std::string names = names_text ? reinterpret_cast<const char*>(names_text) : "";
+  const auto app = query_int(*this, "PRAGMA application_id", "read the application id");
+  version = static_cast<int>(query_int(*this, "PRAGMA user_version", "read schema version"));
+  if (app != 0 && app != kApplicationId)
+    throw StoreError(fmt::format(
+        "{}: not a caldaq database: its SQLite application id is 0x{:08X} (another program's "
+        "file); nothing was changed",
+        path.string(), static_cast<std::uint32_t>(app)));
+  if (objects > 0 && (!ours || version < 1))
+    throw StoreError(fmt::format(
+        "{}: not a caldaq database: an SQLite database with other tables ({}{}); nothing was "
+        "changed",
+        path.string(), names, objects > 4 ? ", ..." : ""));
+  if (objects == 0 && read_only)
+    throw StoreError(fmt::format(
+        "{}: an empty SQLite database, not a caldaq one: there is nothing to read", path.string()));
+  if (version > schema_version)
+    throw StoreError(fmt::format(
+        "{}: schema version {} is newer than this daq understands ({}); use a newer daq",
+        path.string(), version, schema_version));
+}
+
+void Store::Impl::open_read_write(const StoreOptions& options) {
+  sqlite3* raw = nullptr;
+  const int rc =
+      sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  db.reset(raw);
+  if (rc != SQLITE_OK) fail("cannot open");
+  sqlite3_busy_timeout(raw, 5000);  // a reader (daq runs) and the writer share the file
+  check_caldaq_database();          // before anything is written to it
+  exec("PRAGMA journal_mode=WAL", "set WAL mode");
+  exec(options.full_sync ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL",
+       "set synchronous");
+  exec("PRAGMA foreign_keys=ON", "enable foreign keys");
+  if (options.max_pages > 0)
+    exec(fmt::format("PRAGMA max_page_count={}", options.max_pages).c_str(), "set max pages");
+  for (int v = version; v < schema_version; ++v) {
+    Transaction tx(*this);
+    exec(kMigrations[v], fmt::format("migrate schema {} -> {}", v, v + 1).c_str());
+    exec(fmt::format("PRAGMA user_version={}", v + 1).c_str(), "set schema version");
+    tx.commit();
+    version = v + 1;
+  }
+}
+
+// Read-only: SQLite's read-only mode, which writes nothing to the database. Reading a WAL
+// database normally needs its -shm index; where that cannot be created (a read-only medium,
+// a full disk) and no -wal file holds changes, the file is opened as immutable instead (no
+// locks, no index: nothing else can be writing it then). With a non-empty -wal that cannot
+// be read, the open fails rather than showing the database without those changes.
+void Store::Impl::open_read_only() {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw StoreError(fmt::format(
+        "{}: no such database (a command that only reads does not create one; see --db and "
+        "$CALDAQ_DB)",
+        path.string()));
+  const auto open = [&](const std::string& name, int flags) {
+    sqlite3* raw = nullptr;
+    const int rc = sqlite3_open_v2(name.c_str(), &raw, flags, nullptr);
+    db.reset(raw);
+    if (rc != SQLITE_OK) fail("cannot open for reading");
+    sqlite3_busy_timeout(raw, 5000);
+    sqlite3_extended_result_codes(raw, 1);
+  };
+  open(path.string(), SQLITE_OPEN_READONLY);
+  // Probe: the first read (at prepare: the schema) opens the WAL index if there is one.
+  {
+    sqlite3_stmt* probe = nullptr;
+    int rc =
+        sqlite3_prepare_v2(db.get(), "SELECT count(*) FROM sqlite_master", -1, &probe, nullptr);
+    if (rc == SQLITE_OK) rc = sqlite3_step(probe);
+    sqlite3_finalize(probe);
+    rc &= 0xff;
+    if (rc != SQLITE_ROW && rc != SQLITE_CANTOPEN && rc != SQLITE_READONLY && rc != SQLITE_IOERR)
+      fail("not a caldaq database");
+    if (rc != SQLITE_ROW) {
+      const std::filesystem::path wal = path.string() + "-wal";
+      if (std::filesystem::exists(wal, ec) && std::filesystem::file_size(wal, ec) > 0)
+        fail(fmt::format(
+            "cannot read it here: {} holds changes not yet in the database (the writing "
+            "program did not close it) and its index cannot be created (read-only or full "
+            "disk); copy the database with its -wal file to a writable disk, or open it once "
+            "with a command that writes",
+            wal.string()));
+      open(file_uri(path) + "?mode=ro&immutable=1", SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
+    }
+  }
+  check_caldaq_database();
+  if (version < 2) {
+    // Schema 1 read as it is: what schema 2 added is presented by TEMP views and an empty TEMP
+    // table, which live in the connection's temporary database (unqualified names find them
+    // first), so the queries of today's schema read it and nothing is written to the file.
+    // The superseded results are those migration 1 -> 2 would mark.
+    exec(R"sql(
+CREATE TEMP VIEW runs AS SELECT *, NULL AS origin_session_ns, NULL AS origin_unix_ns
+  FROM main.runs;
+CREATE TEMP VIEW results AS SELECT r.*, '{}' AS provenance_json,
+  (SELECT MIN(later.id) FROM main.results AS later
+   WHERE later.run_id = r.run_id AND later.id > r.id
+     AND (later.standard = r.standard OR later.standard LIKE '%(recompensated)'))
+  AS superseded_by FROM main.results AS r;
+CREATE TEMP TABLE missed_stops(run_id INTEGER, run_number INTEGER, direction TEXT,
+  target_index INTEGER, nominal_mm REAL);
+)sql",
+         "present schema 1 as schema 2 (read-only)");
+  }
+  if (version < 4)  // before the ballbar calibrations: none (an empty TEMP table, as above)
+    exec(R"sql(
+CREATE TEMP TABLE ballbar_calibrations(id INTEGER PRIMARY KEY, bar TEXT, nominal_mm REAL,
+  extensions TEXT, calibrator TEXT, calibrator_length_mm REAL, reading_mm REAL,
+  zero_length_mm REAL, temperature_degc REAL, calibrated_unix_ms INTEGER, note TEXT);
+)sql",
+         "present an older schema without ballbar calibrations (read-only)");
+  auto has = prepare(
+      "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
+      "('encoding', 'seq', 'crc')");
+  chunk_checksums =
+      sqlite3_step(has.get()) == SQLITE_ROW && sqlite3_column_int64(has.get(), 0) == 3;
+}
 
 Store::Store(const std::filesystem::path& path, StoreOptions options)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.path = path;
-  sqlite3* raw = nullptr;
-  const int rc =
-      sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
-  m.db.reset(raw);
-  if (rc != SQLITE_OK) m.fail("cannot open");
-  sqlite3_busy_timeout(raw, 5000);  // a reader (daq runs) and the writer share the file
-  // The first statement reads the header: a file that is not a database fails here.
-  m.exec("PRAGMA journal_mode=WAL", "not a caldaq database (cannot set WAL mode)");
-  m.exec(options.full_sync ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL",
-         "set synchronous");
-  m.exec("PRAGMA foreign_keys=ON", "enable foreign keys");
-  if (options.max_pages > 0)
-    m.exec(fmt::format("PRAGMA max_page_count={}", options.max_pages).c_str(), "set max pages");
-  {
-    auto s = m.prepare("PRAGMA user_version");
-    if (sqlite3_step(s.get()) != SQLITE_ROW) m.fail("read schema version");
-    m.version = sqlite3_column_int(s.get(), 0);
+  m.read_only = options.read_only;
+  if (m.read_only) {
+    m.open_read_only();
+    return;
   }
-  if (m.version > schema_version)
-    throw StoreError(fmt::format(
-        "{}: schema version {} is newer than this daq understands ({}); use a newer daq",
-        path.string(), m.version, schema_version));
-  for (int v = m.version; v < schema_version; ++v) {
-    Impl::Transaction tx(m);
-    m.exec(kMigrations[v], fmt::format("migrate schema {} -> {}", v, v + 1).c_str());
-    m.exec(fmt::format("PRAGMA user_version={}", v + 1).c_str(), "set schema version");
-    tx.commit();
-    m.version = v + 1;
-  }
+  m.open_read_write(options);
   // Runs whose writing process is gone were interrupted (kill -9, power loss, crash).
   std::vector<std::int64_t> orphans;
   {
@@ -269,9 +358,7 @@ Store::Store(const std::filesystem::path& path, StoreOptions options)
       if (!process_alive(sqlite3_column_int64(s.get(), 1)))
         orphans.push_back(sqlite3_column_int64(s.get(), 0));
   }
-  for (auto id : orphans)
-    finish_run(id, RunStatus::incomplete,
-               "interrupted: the writing process ended without finishing the run");
+  for (auto id : orphans) finish_run(id, RunStatus::incomplete, kInterrupted);
 }
 
 Store::~Store() = default;
@@ -280,8 +367,10 @@ Store& Store::operator=(Store&&) noexcept = default;
 
 const std::filesystem::path& Store::path() const { return impl_->path; }
 int Store::version() const { return impl_->version; }
+bool Store::read_only() const { return impl_->read_only; }
 
 std::int64_t Store::add_machine(const MachineRecord& r) {
+  impl_->need_writable("add machine");
   auto s = impl_->prepare("INSERT INTO machines(name, description, config_json) VALUES(?, ?, ?)");
   bind_text(s.get(), 1, r.name);
   bind_text(s.get(), 2, r.description);
@@ -307,6 +396,7 @@ std::optional<MachineRecord> Store::machine(std::int64_t id) const {
 }
 
 std::int64_t Store::begin_run(const RunRecord& r) {
+  impl_->need_writable("begin run");
   auto s = impl_->prepare(
       "INSERT INTO runs(machine_id, campaign, kind, axis, settings_json, capture_path, "
       "software_version, started_unix_ms, status, note, owner_pid) "
@@ -326,6 +416,7 @@ std::int64_t Store::begin_run(const RunRecord& r) {
 }
 
 void Store::add_instrument(const InstrumentRecord& i) {
+  impl_->need_writable("add instrument");
   auto s = impl_->prepare(
       "INSERT INTO instruments(run_id, device, driver, transport, settings_json) "
       "VALUES(?, ?, ?, ?, ?)");
@@ -338,6 +429,7 @@ void Store::add_instrument(const InstrumentRecord& i) {
 }
 
 void Store::finish_run(std::int64_t run_id, RunStatus status, std::string_view note) {
+  impl_->need_writable("finish run");
   auto s = impl_->prepare(
       "UPDATE runs SET status = ?, ended_unix_ms = ?, note = CASE WHEN ? = '' THEN note ELSE ? "
       "END WHERE id = ?");
@@ -352,6 +444,7 @@ void Store::finish_run(std::int64_t run_id, RunStatus status, std::string_view n
 }
 
 void Store::set_capture_path(std::int64_t run_id, std::string_view path) {
+  impl_->need_writable("set capture path");
   auto s = impl_->prepare("UPDATE runs SET capture_path = ? WHERE id = ?");
   bind_text(s.get(), 1, path);
   sqlite3_bind_int64(s.get(), 2, run_id);
@@ -361,10 +454,12 @@ void Store::set_capture_path(std::int64_t run_id, std::string_view path) {
 namespace {
 constexpr const char* kRunColumns =
     "SELECT id, IFNULL(machine_id, 0), campaign, kind, axis, settings_json, capture_path, "
-    "software_version, started_unix_ms, ended_unix_ms, status, note, origin_session_ns, "
-    "origin_unix_ns FROM runs";
+    "software_version, started_unix_ms, ended_unix_ms, status, note, owner_pid, "
+    "origin_session_ns, origin_unix_ns FROM runs";
 
-RunRecord read_run(sqlite3_stmt* s) {
+// A read-only store cannot mark an interrupted run, so it shows it as the writing open would
+// have marked it, and says so.
+RunRecord read_run(sqlite3_stmt* s, bool read_only) {
   RunRecord r;
   r.id = sqlite3_column_int64(s, 0);
   r.machine_id = sqlite3_column_int64(s, 1);
@@ -378,8 +473,13 @@ RunRecord read_run(sqlite3_stmt* s) {
   if (sqlite3_column_type(s, 9) != SQLITE_NULL) r.ended_unix_ms = sqlite3_column_int64(s, 9);
   r.status = status_from(column_text(s, 10));
   r.note = column_text(s, 11);
-  if (sqlite3_column_type(s, 12) != SQLITE_NULL) r.origin_session_ns = sqlite3_column_int64(s, 12);
-  if (sqlite3_column_type(s, 13) != SQLITE_NULL) r.origin_unix_ns = sqlite3_column_int64(s, 13);
+  if (read_only && r.status == RunStatus::running && !process_alive(sqlite3_column_int64(s, 12))) {
+    r.status = RunStatus::incomplete;
+    r.note = fmt::format("{} (not yet marked so in the database, which was opened read-only)",
+                         kInterrupted);
+  }
+  if (sqlite3_column_type(s, 13) != SQLITE_NULL) r.origin_session_ns = sqlite3_column_int64(s, 13);
+  if (sqlite3_column_type(s, 14) != SQLITE_NULL) r.origin_unix_ns = sqlite3_column_int64(s, 14);
   return r;
 }
 }  // namespace
@@ -387,7 +487,7 @@ RunRecord read_run(sqlite3_stmt* s) {
 std::vector<RunRecord> Store::runs() const {
   auto s = impl_->prepare((std::string(kRunColumns) + " ORDER BY id").c_str());
   std::vector<RunRecord> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) out.push_back(read_run(s.get()));
+  while (sqlite3_step(s.get()) == SQLITE_ROW) out.push_back(read_run(s.get(), impl_->read_only));
   return out;
 }
 
@@ -395,7 +495,7 @@ std::optional<RunRecord> Store::run(std::int64_t run_id) const {
   auto s = impl_->prepare((std::string(kRunColumns) + " WHERE id = ?").c_str());
   sqlite3_bind_int64(s.get(), 1, run_id);
   if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
-  return read_run(s.get());
+  return read_run(s.get(), impl_->read_only);
 }
 
 std::vector<InstrumentRecord> Store::instruments(std::int64_t run_id) const {
@@ -411,37 +511,71 @@ std::vector<InstrumentRecord> Store::instruments(std::int64_t run_id) const {
 }
 
 void Store::append_readings(std::int64_t run_id, std::span<const RawReading> readings) {
+  Impl& m = *impl_;
+  m.need_writable("store readings");
   if (readings.empty()) return;
-  // Group by (device, channel, quantity), keeping each group's order: one chunk per group.
-  using Key = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;
-  std::map<Key, std::vector<const RawReading*>> groups;
-  for (const auto& r : readings) groups[{r.device, r.channel, r.quantity}].push_back(&r);
-  Impl::Transaction tx(*impl_);
-  auto s = impl_->prepare(
-      "INSERT INTO reading_chunks(run_id, device, channel, quantity, first_ns, last_ns, count, "
-      "data) VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
-  std::vector<unsigned char> blob;
-  for (const auto& [key, group] : groups) {
-    blob.resize(group.size() * kRecordBytes);
-    unsigned char* p = blob.data();
-    std::int64_t first = group.front()->time_ns, last = first;
-    for (const RawReading* r : group) {
-      std::memcpy(p, &r->time_ns, 8);
-      p[8] = r->status;
-      std::memcpy(p + 9, &r->value, 8);
-      p += kRecordBytes;
-      first = std::min(first, r->time_ns);
-      last = std::max(last, r->time_ns);
+  // Group by series (device, channel, quantity), keeping each series' order: one chunk each.
+  // Batches hold a few series, interleaved: a linear search from the last hit is enough.
+  std::vector<std::uint32_t> keys;
+  std::size_t g = 0;
+  for (auto& c : m.columns) c.clear();
+  for (const auto& r : readings) {
+    const std::uint32_t key =
+        (std::uint32_t{r.device} << 16) | (std::uint32_t{r.channel} << 8) | r.quantity;
+    if (g >= keys.size() || keys[g] != key) {
+      g = static_cast<std::size_t>(std::find(keys.begin(), keys.end(), key) - keys.begin());
+      if (g == keys.size()) {
+        keys.push_back(key);
+        if (m.columns.size() < keys.size()) m.columns.emplace_back();
+      }
     }
-    sqlite3_bind_int64(s.get(), 1, run_id);
-    sqlite3_bind_int(s.get(), 2, std::get<0>(key));
-    sqlite3_bind_int(s.get(), 3, std::get<1>(key));
-    sqlite3_bind_int(s.get(), 4, std::get<2>(key));
-    sqlite3_bind_int64(s.get(), 5, first);
-    sqlite3_bind_int64(s.get(), 6, last);
-    sqlite3_bind_int64(s.get(), 7, static_cast<std::int64_t>(group.size()));
-    sqlite3_bind_blob64(s.get(), 8, blob.data(), blob.size(), SQLITE_STATIC);
-    impl_->step_done(s.get(), fmt::format("store {} readings of run {}", group.size(), run_id));
+    m.columns[g].push(r);
+  }
+  Impl::Transaction tx(m);
+  if (!m.next_seq)
+    m.next_seq = m.prepare(
+        "SELECT IFNULL(MAX(seq), -1) + 1 FROM reading_chunks INDEXED BY reading_chunks_by_seq "
+        "WHERE run_id = ?");
+  if (!m.insert_chunk)
+    m.insert_chunk = m.prepare(
+        "INSERT INTO reading_chunks(run_id, device, channel, quantity, first_ns, last_ns, count, "
+        "data, encoding, seq, crc) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  sqlite3_bind_int64(m.next_seq.get(), 1, run_id);
+  if (sqlite3_step(m.next_seq.get()) != SQLITE_ROW) m.fail("number the reading chunks");
+  std::int64_t seq = sqlite3_column_int64(m.next_seq.get(), 0);
+  sqlite3_reset(m.next_seq.get());
+  sqlite3_stmt* s = m.insert_chunk.get();
+  for (std::size_t k = 0; k < keys.size(); ++k, ++seq) {
+    const auto& c = m.columns[k];
+    chunk::encode(c, m.blob);
+    const auto [lo, hi] = std::minmax_element(c.time_ns.begin(), c.time_ns.end());
+    const chunk::Key key{.run_id = run_id,
+                         .seq = seq,
+                         .device = keys[k] >> 16,
+                         .channel = (keys[k] >> 8) & 0xff,
+                         .quantity = keys[k] & 0xff,
+                         .first_ns = *lo,
+                         .last_ns = *hi,
+                         .count = static_cast<std::int64_t>(c.size()),
+                         .encoding = chunk::columns_v2};
+    sqlite3_bind_int64(s, 1, run_id);
+    sqlite3_bind_int64(s, 2, key.device);
+    sqlite3_bind_int64(s, 3, key.channel);
+    sqlite3_bind_int64(s, 4, key.quantity);
+    sqlite3_bind_int64(s, 5, key.first_ns);
+    sqlite3_bind_int64(s, 6, key.last_ns);
+    sqlite3_bind_int64(s, 7, key.count);
+    sqlite3_bind_blob64(s, 8, m.blob.data(), m.blob.size(), SQLITE_STATIC);
+    sqlite3_bind_int64(s, 9, key.encoding);
+    sqlite3_bind_int64(s, 10, key.seq);
+    sqlite3_bind_int64(s, 11, chunk::checksum(key, m.blob));
+    if (sqlite3_step(s) != SQLITE_DONE) {
+      const std::string what = fmt::format("{}: store {} readings of run {}: {}", m.path.string(),
+                                           c.size(), run_id, sqlite3_errmsg(m.db.get()));
+      sqlite3_reset(s);  // the cached statement is used again by the next batch
+      throw StoreError(what);
+    }
+    sqlite3_reset(s);
   }
   tx.commit();
 }
@@ -450,45 +584,26 @@ std::vector<RawReading> Store::readings(std::int64_t run_id) const { return read
 
 std::vector<RawReading> Store::readings(std::int64_t run_id,
                                         std::span<const std::uint8_t> quantities) const {
-  // The chunks hold one device/channel/quantity each: the filter skips whole chunks.
-  std::string sql =
-      "SELECT device, channel, quantity, count, data FROM reading_chunks WHERE run_id = ?";
-  if (!quantities.empty()) {
-    sql += " AND quantity IN (";
-    for (std::size_t i = 0; i < quantities.size(); ++i) sql += i ? ", ?" : "?";
-    sql += ")";
-  }
-  sql += " ORDER BY id";
-  auto s = impl_->prepare(sql.c_str());
+  std::vector<RawReading> out, batch;
+  auto stream = stream_readings(run_id, quantities);
+  while (stream.next(batch, std::size_t{1} << 20))
+    out.insert(out.end(), batch.begin(), batch.end());
+  return out;
+}
+
+std::vector<Store::Series> Store::series(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT device, channel, quantity, SUM(count), MIN(first_ns), MAX(last_ns) FROM "
+      "reading_chunks WHERE run_id = ? GROUP BY device, channel, quantity ORDER BY device, "
+      "channel, quantity");
   sqlite3_bind_int64(s.get(), 1, run_id);
-  for (std::size_t i = 0; i < quantities.size(); ++i)
-    sqlite3_bind_int(s.get(), static_cast<int>(i + 2), quantities[i]);
-  std::vector<RawReading> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    const auto count = static_cast<std::size_t>(sqlite3_column_int64(s.get(), 3));
-    const auto* p = static_cast<const unsigned char*>(sqlite3_column_blob(s.get(), 4));
-    const auto bytes = static_cast<std::size_t>(sqlite3_column_bytes(s.get(), 4));
-    if (bytes != count * kRecordBytes)
-      throw StoreError(fmt::format("{}: run {}: a reading chunk holds {} bytes for {} readings",
-                                   impl_->path.string(), run_id, bytes, count));
-    for (std::size_t i = 0; i < count; ++i, p += kRecordBytes) {
-      RawReading r;
-      std::memcpy(&r.time_ns, p, 8);
-      r.status = p[8];
-      std::memcpy(&r.value, p + 9, 8);
-      r.device = static_cast<std::uint16_t>(sqlite3_column_int(s.get(), 0));
-      r.channel = static_cast<std::uint8_t>(sqlite3_column_int(s.get(), 1));
-      r.quantity = static_cast<std::uint8_t>(sqlite3_column_int(s.get(), 2));
-      out.push_back(r);
-    }
-  }
-  // Time order; simultaneous readings of different devices/quantities in a fixed order, so the
-  // result does not depend on where the writer's batch boundaries fell (they differ between a
-  // live run and its replay). Within one device/channel/quantity the stored order is kept.
-  std::stable_sort(out.begin(), out.end(), [](const RawReading& a, const RawReading& b) {
-    return std::tie(a.time_ns, a.device, a.channel, a.quantity) <
-           std::tie(b.time_ns, b.device, b.channel, b.quantity);
-  });
+  std::vector<Series> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW)
+    out.push_back({static_cast<std::uint16_t>(sqlite3_column_int(s.get(), 0)),
+                   static_cast<std::uint8_t>(sqlite3_column_int(s.get(), 1)),
+                   static_cast<std::uint8_t>(sqlite3_column_int(s.get(), 2)),
+                   sqlite3_column_int64(s.get(), 3), sqlite3_column_int64(s.get(), 4),
+                   sqlite3_column_int64(s.get(), 5)});
   return out;
 }
 
@@ -659,6 +774,7 @@ std::vector<MissedStop> Store::missed_stops(std::int64_t run_id) const {
 }
 
 void Store::set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns) {
+  impl_->need_writable("set the time origin");
   auto s = impl_->prepare("UPDATE runs SET origin_session_ns = ?, origin_unix_ns = ? WHERE id = ?");
   sqlite3_bind_int64(s.get(), 1, session_ns);
   sqlite3_bind_int64(s.get(), 2, unix_ns);

@@ -80,7 +80,10 @@ check recompensate_circle 2 "no run 9" -- "$DAQ" recompensate 9 --db "$TMP/demo.
 check analyse_needs_run 2 "give a stored RUN number" -- "$DAQ" analyse --db "$TMP/demo.sqlite"
 # Runs against configured devices: a device that cannot be reached is given up, named, and
 # the run is stored as aborted. Part programs from the same configuration.
-check run_refused 2 "aborted: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2
+check run_refused 2 "aborted: .*closed: gave up after 2 attempts" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --give-up-after 2 --check-s 0
+# The start-up check (issue 13): the run is refused at once, naming every device that failed.
+check run_device_check_laser 2 "daq: error: device check: .*devices.laser \(tcp 127.0.0.1:1\): failed: .*Connection refused" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --check-s 5
+check run_device_check_air 2 "daq: error: device check: .*devices.air \(serial /dev/null 4800 7E1\): failed: .*not a serial port" -- "$DAQ" run linear -c "$DATA/run/refused.toml" --db "$TMP/run.sqlite" --check-s 5
 check run_stored_aborted 0 "aborted" -- "$DAQ" runs --db "$TMP/run.sqlite"
 check gcode_siemens 0 "^G4 F3\\.0000$" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d siemens
 check gcode_circle 0 "^G03 X-10\\.0000 Y0\\.0000 I-10\\.0000 J0\\.0000 F1000$" -- "$DAQ" gcode circle -c "$DATA/run/refused.toml"

@@ -93,5 +93,7 @@ rtx "$TMP/tiny.rtx" Linear 1e-300 2 '\r\nEOF::\r\n'
 check rtx_rate_tiny 2 "Actual sample rate '1e-300' is not a rate within" -- "$DAQ" import rtx "$TMP/tiny.rtx" --db "$TMP/bad.sqlite"
 rtx "$TMP/huge.rtx" Linear 1000 1e300 '\r\nEOF::\r\n'
 check rtx_count_huge 2 "Sample no '1e300' is not a whole number of samples" -- "$DAQ" import rtx "$TMP/huge.rtx" --db "$TMP/bad.sqlite"
-check rtx_nothing_stored_on_refusal 0 "\(0 runs\)" -- "$DAQ" runs --db "$TMP/bad.sqlite"
+# Nothing stored on refusal: not even a database was created (daq runs only reads, so a
+# missing database is an error naming it).
+check rtx_nothing_stored_on_refusal 2 "bad.sqlite: no such database" -- "$DAQ" runs --db "$TMP/bad.sqlite"
 finish

@@ -10,8 +10,8 @@ How the block is run:
 - HOME and XDG_DATA_HOME point into the directory, so the default database is a fresh one;
 - a command ending in `&` runs in the background until the end (`daq sim`: the next command
   starts once it has written its configuration);
-- `daq serve` runs until it says it listens, then is stopped; it gets `--port 0` (any free
-  port) so that a port in use on the test machine cannot fail it.
+- `daq serve` runs until it says it listens (after its device check's lines), then is stopped;
+  it gets `--port 0` (any free port) so that a port in use on the test machine cannot fail it.
 """
 import os
 import re
@@ -78,13 +78,19 @@ try:
             argv += ["--port", "0"]
             p = subprocess.Popen(argv, cwd=work, env=env, stdout=subprocess.PIPE,
                                  stderr=subprocess.STDOUT, text=True)
-            line = p.stdout.readline()
+            lines = []  # the device check's lines come first
+            while not (lines and lines[-1].startswith("daq serve: http://")):
+                line = p.stdout.readline()
+                if not line:
+                    break
+                lines.append(line)
+            line = lines[-1] if lines else ""
             stop(p)
             if line.startswith("daq serve: http://"):
                 print(f"ok {code}  ->  {line.strip()}")
                 passed += 1
             else:
-                print(f"FAIL {code}: {line}{p.stdout.read()}")
+                print(f"FAIL {code}: {''.join(lines)}{p.stdout.read()}")
                 failed += 1
             continue
         r = subprocess.run(argv, cwd=work, env=env, stdout=subprocess.PIPE,

@@ -131,6 +131,10 @@ check rendered_compare 0 "rendered [0-9]+ plots" -- python3 "$TESTS/../web/repor
 check rendered_as_found 0 "rendered [0-9]+ plots" -- python3 "$TESTS/../web/report_render_test.py" "$TMP/af.html" "$TMP/af.png" "As found"
 check pdf 0 "written to r1.pdf" -- "$DAQ" report 1 --db demo.sqlite --format pdf -o r1.pdf
 check pdf_magic 0 "^%PDF-1" -- head -c 8 r1.pdf
+# To a stream: the report's bytes on stdout (the status line on stderr), HTML and PDF alike.
+check html_to_stdout 0 "^<!doctype html>" -- bash -c "\"\$1\" report 1 --db demo.sqlite -o /dev/stdout 2>/dev/null | head -c 15" _ "$DAQ"
+check html_to_stdout_status 0 "written to /dev/stdout \([0-9]{4,} bytes\)" -- bash -c "\"\$1\" report 1 --db demo.sqlite -o /dev/stdout 2>&1 >/dev/null" _ "$DAQ"
+check pdf_to_pipe 0 "^%PDF-1" -- bash -c "\"\$1\" report 1 --db demo.sqlite --format pdf -o /dev/stdout 2>/dev/null | head -c 8 | tr -d '\\0'" _ "$DAQ"
 check pdf_pages 0 "/Type */Page($|[^s])" -- cat r1.pdf
 # Printed: "page n of m" and the running header on every page; no page with only a heading or
 # only the footer (each page holds at least 8 lines of text besides its header and number).

@@ -70,7 +70,7 @@ TEST(Config, ParsesTheFullExample) {
   EXPECT_EQ(c.machine_name, "VMC-1");
   ASSERT_EQ(c.devices.size(), 2u);
   EXPECT_EQ(c.device_for("laser")->transport, "tcp 192.168.1.5:9090");
-  EXPECT_EQ(c.device_for("laser")->axes, std::vector<int>{0});
+  EXPECT_EQ(c.device_for("laser")->options.integers("axes"), std::vector<std::int64_t>{0});
   EXPECT_EQ(c.device_for("air")->poll_s, 1.0);  // an integer in TOML is accepted as a number
   EXPECT_EQ(c.device_for("material"), nullptr);
   EXPECT_EQ(c.environment.equation, "edlen");
@@ -107,15 +107,65 @@ TEST(Config, NamesFileLineColumnAndKey) {
   EXPECT_EQ(error_of("[devices.t]\ndriver = \"temper\"\ntransport = \"hid 413d:2107\"\n"
                      "family = \"silver\"\n"),
             "machine.toml:4:10: key 'devices.t.family': 'silver' is not one of: ds75, gold, "
-            "temperx");
+            "temperx, sht2x, si7005, si7006");
   EXPECT_EQ(parse_config("[devices.t]\ndriver = \"temper\"\ntransport = \"hid 0c45:7401\"\n"
                          "family = \"ds75\"\nrole = \"material\"\n",
                          "m.toml")
                 .device_for("material")
-                ->family,
+                ->options.text("family"),
             "ds75");
   EXPECT_EQ(error_of("[machine]\nname = 3\n"),
             "machine.toml:2:8: key 'machine.name': expected a string");
+}
+
+TEST(Config, DeviceKeysAreCheckedAgainstTheDriversOptionTable) {
+  const std::string laser =
+      "[devices.laser]\ndriver = \"ids3010\"\ntransport = \"tcp 10.0.0.5:9090\"\n";
+  // Types, ranges and choices of the driver's own keys, at the value's position.
+  EXPECT_EQ(error_of(laser + "axes = [3]\n"),
+            "machine.toml:4:8: key 'devices.laser.axes': 3 must be within [0, 2]");
+  EXPECT_EQ(error_of(laser + "axes = [0.5]\n"),
+            "machine.toml:4:8: key 'devices.laser.axes': expected an array of integers");
+  EXPECT_EQ(error_of(laser + "environment = \"yes\"\n"),
+            "machine.toml:4:15: key 'devices.laser.environment': expected true or false");
+  // A key of another driver is unknown to this one, and the message lists this one's keys.
+  EXPECT_EQ(error_of(laser + "family = \"gold\"\n"),
+            "machine.toml:4:10: key 'devices.laser.family': unknown key (a typo?); driver "
+            "'ids3010' takes driver, transport, role, poll_s, serial_number, certificate, "
+            "calibration_due, axes, start_measurement, environment, api, environment_period_s");
+  // Checks between options (a gauge pattern without a capture group) name the driver.
+  EXPECT_NE(error_of("[devices.bar]\ndriver = \"gauge\"\ntransport = \"serial /dev/x 9600 8N1\"\n"
+                     "pattern = \"[0-9]+\"\n")
+                .find("machine.toml:1:1: key 'devices.bar.driver': driver 'gauge': gauge pattern"),
+            std::string::npos);
+  // The transport text is checked when the file is read, not when the run starts.
+  EXPECT_EQ(error_of("[devices.laser]\ndriver = \"ids3010\"\ntransport = \"tcp 10.0.0.5\"\n"),
+            "machine.toml:3:13: key 'devices.laser.transport': 'tcp 10.0.0.5': expected tcp "
+            "HOST:PORT");
+  EXPECT_EQ(
+      error_of(
+          "[devices.air]\ndriver = \"ptu300\"\ntransport = \"serial /dev/ttyUSB0 4800 7X1\"\n"),
+      "machine.toml:3:13: key 'devices.air.transport': 'serial /dev/ttyUSB0 4800 7X1': "
+      "serial settings '4800 7X1': parity 'X' (expected N, E or O)");
+  // The instrument's records: a calibration date must be a real date.
+  const auto c = parse_config(laser +
+                                  "serial_number = \"IDS-1234\"\ncertificate = \"DKD 0815\"\n"
+                                  "calibration_due = \"2028-02-29\"\n",
+                              "m.toml");
+  EXPECT_EQ(c.devices[0].serial_number, "IDS-1234");
+  EXPECT_EQ(c.devices[0].certificate, "DKD 0815");
+  EXPECT_EQ(c.devices[0].calibration_due, "2028-02-29");
+  EXPECT_EQ(error_of(laser + "calibration_due = \"2027-02-29\"\n"),
+            "machine.toml:4:19: key 'devices.laser.calibration_due': '2027-02-29' is not a date "
+            "YYYY-MM-DD");
+  // Defaults fill the keys not given; a gauge's "\r" written as two characters is a CR.
+  const auto g = parse_config(
+      "[devices.t]\ndriver = \"gauge\"\ntransport = \"serial /dev/x 9600 8N1\"\n"
+      "request = '?\\r'\nunit = \"degC\"\n",
+      "m.toml");
+  EXPECT_EQ(g.devices[0].options.text("request"), "?\r");
+  EXPECT_EQ(g.devices[0].options.number("scale"), 1.0);
+  EXPECT_FALSE(g.devices[0].options.has_value("min_si"));
 }
 
 // Issue 15: every value of the non-device tables is checked at load for its type and range,

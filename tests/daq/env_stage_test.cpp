@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "cal/analysis/error.hpp"
 
@@ -171,8 +173,9 @@ TEST(EnvStage, DisabledMaterialSensorIsNeitherAveragedNorChecked) {
   // Enabled again (silent since 0 s): stale, reported once; disabling it again is fine, but the
   // last enabled sensor cannot be disabled.
   e.set_material_enabled(1, true);
-  EXPECT_EQ(e.check(12 * s).messages,
-            std::vector<std::string>{"material sensor 2 is stale (last sample 12.0 s ago): stopping"});
+  EXPECT_EQ(
+      e.check(12 * s).messages,
+      std::vector<std::string>{"material sensor 2 is stale (last sample 12.0 s ago): stopping"});
   e.set_material_enabled(1, false);
   e.set_material_enabled(0, false);
   EXPECT_THROW(e.set_material_enabled(2, false), cal::InputError);
@@ -222,3 +225,104 @@ TEST(EnvStage, RefusesBadConfiguration) {
 }
 
 }  // namespace
+
+namespace cached {
+
+struct Sample {
+  std::int64_t t;
+  int what;  // 0..2 air quantities, 3 material
+  double v;
+};
+
+void feed(EnvStage& e, const Sample& x) {
+  if (x.what == 3)
+    e.add_material(x.t, 0, x.v);
+  else
+    e.add_air(x.t, static_cast<AirQuantity>(x.what), x.v);
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace cached
+
+// The environment is computed once per held sample and the refractive index again only when
+// the air changes (env_stage.hpp). The proof that this changes nothing: every compensation of a
+// long stage (its cache warm, hit and missed in every way: held samples, interpolation between
+// samples, samples arriving between readings, a stale sensor on its fallback and back) equals bit
+// for bit the compensation of a fresh stage given the same samples, whose cache is empty, and its n
+// is the equation's own for the air it reports.
+TEST(EnvStage, CachedIndexGivesTheEquationsResultBitForBit) {
+  auto cfg = edlen(cal::daq::StalePolicy::fallback);
+  cfg.equation = "ciddor";
+  std::vector<cached::Sample> samples;
+  for (int k = 0; k < 12; ++k) {  // a 1 Hz station, with a 15 s silence of the air after 6 s
+    const std::int64_t t = k < 6 ? k * s : (k + 15) * s;
+    samples.push_back({t, 0, 20.0 + 0.013 * k});
+    samples.push_back({t, 1, 101325.0 - 1.7 * k});
+    samples.push_back({t, 2, 45.0 + 0.21 * k});
+    samples.push_back({t, 3, 20.5 + 0.007 * k});
+  }
+  EnvStage warm(cfg, 1);
+  std::size_t next = 0, compared = 0, held = 0, fallback = 0;
+  for (std::int64_t t = 0; t < 28 * s; t += s / 37) {  // readings between and on the samples
+    // Samples up to 1.5 s ahead of the reading (a laser with more latency than the station):
+    // readings between two samples are interpolated, readings past the newest are held.
+    for (; next < samples.size() && samples[next].t <= t + 3 * s / 2; ++next)
+      cached::feed(warm, samples[next]);
+    EnvStage fresh(cfg, 1);
+    for (std::size_t i = 0; i < next; ++i) cached::feed(fresh, samples[i]);
+    // Twice from the warm stage: a miss, then a hit on the same air.
+    for (int twice = 0; twice < 2; ++twice) {
+      const auto a = warm.compensate(t, 0.25), b = fresh.compensate(t, 0.25);
+      ASSERT_TRUE(cached::same_bits(a.n, b.n)) << t;
+      ASSERT_TRUE(cached::same_bits(a.length_m, b.length_m)) << t;
+      ASSERT_TRUE(cached::same_bits(a.factor_ppm, b.factor_ppm)) << t;
+      ASSERT_TRUE(cached::same_bits(a.air_temperature_degc, b.air_temperature_degc)) << t;
+      ASSERT_TRUE(cached::same_bits(a.pressure_pa, b.pressure_pa)) << t;
+      ASSERT_TRUE(cached::same_bits(a.humidity_pct, b.humidity_pct)) << t;
+      ASSERT_TRUE(cached::same_bits(a.material_degc, b.material_degc)) << t;
+      ASSERT_EQ(a.time_ns, t);
+      ASSERT_EQ(a.held, b.held);
+      ASSERT_EQ(a.fallback_air, b.fallback_air);
+      ASSERT_EQ(a.fallback_material, b.fallback_material);
+      cal::air::Conditions air;
+      air.temperature_degc = a.air_temperature_degc;
+      air.pressure_pa = a.pressure_pa;
+      air.humidity = cal::air::Humidity::relative_pct(a.humidity_pct);
+      air.co2_umol_per_mol = a.co2_umol_per_mol;
+      air.wavelength_vacuum_nm = cfg.wavelength_nm;
+      ASSERT_TRUE(
+          cached::same_bits(a.n, cal::air::refractive_index(air, cal::air::Equation::ciddor).n));
+      ++compared;
+      held += a.held;
+      fallback += a.fallback_air;
+    }
+  }
+  // The sequence did go through every case.
+  EXPECT_GT(compared, 2000u);
+  EXPECT_GT(held, 100u);
+  EXPECT_GT(fallback, 100u);
+  EXPECT_GT(compared - held - fallback, 100u);  // interpolated
+}
+
+// After the run (daq recompensate) all samples are given first and the stops compensated
+// afterwards: with keep_all_samples a stop early in an hour-long run gets the air of its own
+// time. The live stage keeps 2 minutes, so there the same query would get the air of the end.
+TEST(EnvStage, KeepingAllSamplesCompensatesAnEarlyStopOfALongRunWithItsOwnAir) {
+  cal::daq::EnvSensors sensors{.material_enabled = {true}};
+  EnvStage live(edlen(), sensors);
+  sensors.keep_all_samples = true;
+  EnvStage after(edlen(), sensors);
+  for (std::int64_t k = 0; k <= 3600; ++k)  // 1 Hz for an hour, 20 -> 21 degC
+    for (EnvStage* e : {&live, &after}) {
+      e->add_air(k * s, AirQuantity::temperature_degc, 20.0 + static_cast<double>(k) / 3600.0);
+      e->add_air(k * s, AirQuantity::pressure_pa, 101325.0);
+      e->add_air(k * s, AirQuantity::humidity_pct, 50.0);
+      e->add_material(k * s, 0, 20.0);
+    }
+  // At 5 min: 20 + 300/3600 degC exactly (a sample's time), and halfway to the next at 5.5 s.
+  EXPECT_DOUBLE_EQ(after.compensate(300 * s, 0.1).air_temperature_degc, 20.0 + 300.0 / 3600.0);
+  EXPECT_NEAR(after.compensate(300 * s + s / 2, 0.1).air_temperature_degc, 20.0 + 300.5 / 3600.0,
+              1e-12);
+  EXPECT_GT(live.compensate(300 * s, 0.1).air_temperature_degc, 20.9);  // the end's air
+}

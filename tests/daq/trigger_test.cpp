@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -131,7 +132,7 @@ TEST(StabilityTrigger, NaNReadingsBreakTheWindowLikeALostBeam) {
   StabilityTrigger t({.tolerance_um = 1.0, .dwell_s = 1.0, .window_mm = 0.5});
   std::int64_t now = 0;
   for (int i = 0; i < 900; ++i) EXPECT_FALSE(t.add(now += ms, 10.0));
-  EXPECT_FALSE(t.add(now += ms, std::nan("")));  // a NaN marked valid
+  EXPECT_FALSE(t.add(now += ms, std::nan("")));                             // a NaN marked valid
   for (int i = 0; i < 900; ++i) EXPECT_FALSE(t.add(now += ms, 10.0)) << i;  // 0.9 s since
   std::optional<Capture> c;
   for (int i = 0; i < 200 && !c; ++i) c = t.add(now += ms, 10.0);
@@ -149,10 +150,15 @@ struct FedMachine {
   std::int64_t t = 0;
   double x = 0.0, error_mm = 0.0;
   std::vector<Capture> captures;
-  explicit FedMachine(PositionTriggerSettings s) : trigger(s) {}
+  bool on_change = false;  // an MTConnect adapter: a sample only when the position changed
+  double last_sent = std::numeric_limits<double>::quiet_NaN();
+  explicit FedMachine(PositionTriggerSettings s, bool changes_only = false)
+      : trigger(s), on_change(changes_only) {}
   void tick(bool laser_valid = true) {  // 1 ms
-    if (t % (10 * ms) == 0)
+    if (t % (10 * ms) == 0 && (!on_change || x != last_sent)) {
+      last_sent = x;
       if (auto c = trigger.add_position(t, x)) captures.push_back(*c);
+    }
     if (auto c = trigger.add_reading(t, x + error_mm + noise(rng), laser_valid))
       captures.push_back(*c);
     t += ms;
@@ -198,6 +204,32 @@ TEST(PositionTrigger, CapturesTheLaserWhileTheFeedIsStillAtATarget) {
     EXPECT_GE(c.count, 740u);
     EXPECT_GE(c.end_ns - c.start_ns, 1'500 * ms);
     EXPECT_LE(c.end_ns - c.start_ns, 1'510 * ms);  // one feed period at most beyond the dwell
+  }
+}
+
+TEST(PositionTrigger, AFeedThatSendsOnlyOnChangeHoldsItsLastPosition) {
+  // An MTConnect adapter is silent while the machine dwells: its last sample holds. With
+  // feed_holds the stop lasts as long as the laser reads; the same silent feed taken as a
+  // periodic one never sees the dwell (its newest sample is where the axis arrived).
+  for (const bool holds : {true, false}) {
+    FedMachine m({.tolerance_um = 1.0, .dwell_s = 1.5, .feed_holds = holds}, true);
+    m.trigger.expect_any(std::vector<double>{50.0, 100.0});
+    m.move_to(50.0, -2e-3);
+    m.dwell(4.0);
+    m.move_to(100.0, 1e-3);
+    m.dwell(4.0);
+    if (!holds) {
+      EXPECT_TRUE(m.captures.empty());
+      continue;
+    }
+    ASSERT_EQ(m.captures.size(), 2u);
+    EXPECT_NEAR(m.captures[0].mean_mm, 50.0 - 0.002, 0.05e-3);
+    EXPECT_NEAR(m.captures[1].mean_mm, 100.0 + 0.001, 0.05e-3);
+    for (const auto& c : m.captures) {
+      EXPECT_GE(c.end_ns - c.start_ns, 1'500 * ms);  // the dwell, measured on the laser
+      EXPECT_LE(c.end_ns - c.start_ns, 1'501 * ms);
+      EXPECT_EQ(c.approach, Approach::from_below);
+    }
   }
 }
 

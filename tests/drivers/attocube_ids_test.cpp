@@ -1,14 +1,13 @@
 // Attocube IDS3010 JSON-RPC codec: requests as attocube's own wrappers write them, answers as
 // the device sends them (result[0] the error code, displacements in picometres), then every
 // kind of bad answer. Expected values by hand in the comments.
-#include "cal/drivers/codec/attocube_ids.hpp"
-
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "ids3010/codec.hpp"
 
 namespace {
 

@@ -6,11 +6,12 @@
 
 #include <string>
 
-#include "cal/drivers/codec/attocube_ids.hpp"
-#include "cal/drivers/codec/line_gauge.hpp"
-#include "cal/drivers/codec/position_feed.hpp"
-#include "cal/drivers/codec/temper.hpp"
-#include "cal/drivers/codec/vaisala_ptu300.hpp"
+#include "halsampler/codec.hpp"
+#include "ids3010/codec.hpp"
+#include "line_gauge/codec.hpp"
+#include "ptu300/codec.hpp"
+#include "shdr/codec.hpp"
+#include "temper/codec.hpp"
 
 namespace {
 
@@ -100,7 +101,7 @@ void BM_Halsampler(benchmark::State& state) {
   for (int i = 0; i < kFrames; ++i)
     stream += fmt::format("{} {:.6f} {:.6f} {:.6f}\n", i, 0.01 * i, -3.25, 100.0);
   run(
-      state, stream, [] { return HalsamplerCodec{}; }, kFrames);
+      state, stream, [] { return HalsamplerCodec({.sample_numbers = true}); }, kFrames);
 }
 
 void BM_Shdr(benchmark::State& state) {

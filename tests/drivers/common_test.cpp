@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -76,6 +78,63 @@ TEST(CodecCommon, StatsCountEachKind) {
   EXPECT_EQ(s.count(ErrorKind::malformed), 0u);
   EXPECT_EQ(s.errors(), 3u);
   EXPECT_EQ(cal::drivers::codec::to_string(ErrorKind::overlong_line), "overlong_line");
+}
+
+}  // namespace
+
+namespace {
+
+// The memchr splitter against a byte-at-a-time reference written from the rules (any CR or LF
+// ends a line, empty lines skipped, a line over the limit reported once at its start and
+// dropped to its terminator), on random streams rich in terminators cut at random places.
+Collected reference_split(std::string_view stream, std::size_t max) {
+  Collected c;
+  std::string line;
+  std::uint64_t start = 0;
+  bool over = false;
+  for (std::size_t i = 0; i < stream.size(); ++i) {
+    const char ch = stream[i];
+    if (ch == '\r' || ch == '\n') {
+      if (!over && !line.empty()) c.lines.emplace_back(line, start);
+      line.clear();
+      over = false;
+      start = i + 1;
+      continue;
+    }
+    if (over) continue;
+    if (line.size() + 1 > max) {
+      over = true;
+      line.clear();
+      c.overlong.push_back(start);
+      continue;
+    }
+    line += ch;
+  }
+  return c;
+}
+
+TEST(CodecLineSplitter, EqualsAByteAtATimeReferenceOnRandomStreamsAndCuts) {
+  std::mt19937 rng(42);
+  const char alphabet[] = {'a', 'b', '\r', '\n', ' ', '\0', '\xff'};
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::string stream(rng() % 200, 'x');
+    for (auto& ch : stream) ch = alphabet[rng() % sizeof alphabet];
+    const std::size_t max = 1 + rng() % 12;
+    LineSplitter s(max);
+    Collected got;
+    for (std::size_t i = 0; i < stream.size();) {
+      const std::size_t n = std::min<std::size_t>(1 + rng() % 40, stream.size() - i);
+      s.feed(
+          cal::drivers::codec::as_bytes(std::string_view(stream).substr(i, n)),
+          [&](std::string_view line, std::uint64_t off) { got.lines.emplace_back(line, off); },
+          [&](std::uint64_t off) { got.overlong.push_back(off); });
+      i += n;
+    }
+    // The reference ends lines only at terminators; a pending last line is not handed out.
+    const auto want = reference_split(stream, max);
+    ASSERT_EQ(got.lines, want.lines) << trial;
+    ASSERT_EQ(got.overlong, want.overlong) << trial;
+  }
 }
 
 }  // namespace

@@ -1,11 +1,10 @@
 // The configurable line gauge codec: values in SI converted by hand, units printed or
 // configured, a custom pattern, and every error kind counted, whatever the chunking.
-#include "cal/drivers/codec/line_gauge.hpp"
-
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "line_gauge/codec.hpp"
 
 namespace {
 

@@ -1,19 +1,21 @@
 // Machine position feeds: LinuxCNC halsampler and MTConnect SHDR lines written by hand from
-// their documented formats (codec/position_feed.hpp); expected values worked out beside them.
-#include "cal/drivers/codec/position_feed.hpp"
-
+// their documented formats (halsampler/codec.hpp, shdr/codec.hpp); expected values worked out
+// beside them.
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "halsampler/codec.hpp"
+#include "shdr/codec.hpp"
 
 namespace {
 
 using namespace cal::drivers::codec;
 
 TEST(HalsamplerCodec, SampleNumbersColumnsAndLostSamples) {
-  // Machine units mm: 12.5 mm = 0.0125 m, -3.25 mm = -0.00325 m. Sample 5 after 2: 3 and 4 lost.
-  const auto d = codec_test::feed_whole(HalsamplerCodec{},
+  // halsampler -t. Machine units mm: 12.5 mm = 0.0125 m, -3.25 mm = -0.00325 m. Sample 5
+  // after 2: 3 and 4 lost.
+  const auto d = codec_test::feed_whole(HalsamplerCodec({.sample_numbers = true}),
                                         "1 12.500000 -3.250000 0.000000\n"
                                         "2 12.600000 -3.250000 0.000000\n"
                                         "5 12.900000 -3.250000 0.100000\n");
@@ -28,7 +30,7 @@ TEST(HalsamplerCodec, SampleNumbersColumnsAndLostSamples) {
 }
 
 TEST(HalsamplerCodec, NoSampleNumbersOtherColumnsAndInches) {
-  // halsampler -t, pins in the order Z, spindle, X; inch machine: 1.25 in = 0.03175 m,
+  // halsampler without -t, pins in the order Z, spindle, X; inch machine: 1.25 in = 0.03175 m,
   // 0.5 in = 0.0127 m; Y not fed.
   const auto d = codec_test::feed_whole(
       HalsamplerCodec({.sample_numbers = false, .column = {2, -1, 0}, .metres_per_unit = 0.0254}),
@@ -41,7 +43,7 @@ TEST(HalsamplerCodec, NoSampleNumbersOtherColumnsAndInches) {
 }
 
 TEST(HalsamplerCodec, BadLinesAreCountedAndTheNextOneRead) {
-  const auto d = codec_test::feed_whole(HalsamplerCodec{},
+  const auto d = codec_test::feed_whole(HalsamplerCodec({.sample_numbers = true}),
                                         "abc 1 2 3\n"        // no sample number
                                         "3 1.0\n"            // too few values
                                         "4 1.0 x 2.0\n"      // not a number
@@ -52,6 +54,31 @@ TEST(HalsamplerCodec, BadLinesAreCountedAndTheNextOneRead) {
   ASSERT_EQ(d.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(*d.frames[0].position_m[2], 0.003);
   EXPECT_THROW(HalsamplerCodec({.metres_per_unit = 0}), cal::InputError);
+}
+
+TEST(HalsamplerCodec, UntaggedByDefaultAndOverrunIsAGapNotAnError) {
+  // halsampler's default (no -t): no sample number, column 0 is a pin; a bit pin there ("1")
+  // is a value. "overrun" lines (sampler_usr.c) say samples were lost: the next frame carries
+  // it, and it is not a codec error. Column 1: 0.25 mm = 0.00025 m; 0.5 mm.
+  const auto d = codec_test::feed_whole(HalsamplerCodec({.column = {1, 0, -1}}),
+                                        "1 0.250000 \n"
+                                        "overrun\n"
+                                        "0 0.500000 \n");
+  EXPECT_EQ(d.stats.errors(), 0u);
+  ASSERT_EQ(d.frames.size(), 2u);
+  EXPECT_FALSE(d.frames[0].sample);
+  EXPECT_DOUBLE_EQ(*d.frames[0].position_m[0], 0.00025);
+  EXPECT_DOUBLE_EQ(*d.frames[0].position_m[1], 0.001);  // the bit pin, as a value (1 mm)
+  EXPECT_FALSE(d.frames[0].overrun);
+  EXPECT_TRUE(d.frames[1].overrun);
+  EXPECT_EQ(d.frames[1].lost_before, 0u);  // how many: only -t says
+  // Tagged, the numbers say how many were lost across the overrun: 4 after 1, so 2 and 3.
+  const auto t = codec_test::feed_whole(HalsamplerCodec({.sample_numbers = true}),
+                                        "1 1.0 2.0 3.0 \noverrun\n4 1.0 2.0 3.0 \n");
+  ASSERT_EQ(t.frames.size(), 2u);
+  EXPECT_TRUE(t.frames[1].overrun);
+  EXPECT_EQ(t.frames[1].lost_before, 2u);
+  EXPECT_EQ(t.stats.errors(), 0u);
 }
 
 TEST(ShdrCodec, PositionsTimestampAndOtherItemsIgnored) {
@@ -107,12 +134,76 @@ TEST(ShdrCodec, BadTimestampsValuesAndRanges) {
   EXPECT_FALSE(parse_iso8601_utc_ns("2024-01-01T12:00:00.-5Z"));
 }
 
+TEST(ShdrCodec, TokensAsTheAgentsTokenizerMakesThem) {
+  // cppagent's ShdrTokenizer: tokens trimmed, a terminal '|' gives an empty token, quoted
+  // tokens may hold '|' escaped with a backslash; an unterminated quote is plain text.
+  using V = std::vector<std::string>;
+  EXPECT_EQ(shdr_tokens("  |x1 |  12.5 | "), (V{"", "x1", "12.5", ""}));
+  EXPECT_EQ(shdr_tokens("a|b|"), (V{"a", "b", ""}));
+  EXPECT_EQ(shdr_tokens(R"(t|msg|"left\|right"|Xact|1)"),
+            (V{"t", "msg", "left|right", "Xact", "1"}));
+  EXPECT_EQ(shdr_tokens(R"(t|"say \"hi\""|z)"), (V{"t", "say \"hi\"", "z"}));
+  EXPECT_EQ(shdr_tokens(R"(t|"open|z)"), (V{"t", "\"open", "z"}));
+}
+
+TEST(ShdrCodec, EveryTimestampFormOfTheAgent) {
+  // @duration suffixes are cut off (kept as the frame's duration); a number without 'T' is a
+  // relative time in ms (from the first); empty: the agent's own time. Spaces are trimmed.
+  ShdrCodec c({.keys = {{"Xact", 0}}});
+  std::vector<PositionFrame> frames;
+  std::vector<CodecError> errors;
+  c.feed(
+      "2024-01-01T12:00:00.5Z@100.0|Xact| 1.5 \n"
+      "1000.5|Xact|2\n"
+      "1250.5@10|Xact|3\n"
+      "|Xact|4\n",
+      frames, errors);
+  EXPECT_TRUE(errors.empty());
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_EQ(*frames[0].time_unix_ns, 1'704'110'400'500'000'000);
+  EXPECT_DOUBLE_EQ(*frames[0].duration_s, 100.0);
+  EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.0015);
+  EXPECT_FALSE(frames[1].time_unix_ns);
+  EXPECT_DOUBLE_EQ(*frames[1].relative_time_ms, 0.0);    // the first relative time
+  EXPECT_DOUBLE_EQ(*frames[2].relative_time_ms, 250.0);  // 250 ms after it
+  EXPECT_DOUBLE_EQ(*frames[2].duration_s, 10.0);
+  EXPECT_FALSE(frames[3].time_unix_ns);
+  EXPECT_FALSE(frames[3].relative_time_ms);
+}
+
+TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
+  // A message takes two tokens and a condition five: a pairwise walk would be misaligned by
+  // them; keys are found wherever they stand. Commands with or without a space after '*' are
+  // not data; an asset's body is skipped up to a line equal to its terminator.
+  ShdrCodec c({.keys = {{"Xact", 0}, {"Zact", 2}}});
+  std::vector<PositionFrame> frames;
+  std::vector<CodecError> errors;
+  c.feed(
+      "2024-01-01T00:00:00Z|msg|CODE1|some text|Xact|10\n"
+      "2024-01-01T00:00:01Z|Xcond|WARNING|42|HIGH||too close|Zact|-5\n"
+      "*adapterVersion:1.0\n"
+      "* shdrVersion: 2\n"
+      "2024-01-01T00:00:02Z|@ASSET@|T1|CuttingTool|--multiline--0FF1CE\n"
+      "<CuttingTool>|Xact|99|</CuttingTool>\n"
+      "--multiline--0FF1CE\r\n"
+      "2024-01-01T00:00:03Z|Xact|UNAVAILABLE|Zact|7\n",
+      frames, errors);
+  EXPECT_TRUE(errors.empty());
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.010);
+  EXPECT_DOUBLE_EQ(*frames[1].position_m[2], -0.005);
+  EXPECT_FALSE(frames[2].position_m[0]);
+  EXPECT_DOUBLE_EQ(*frames[2].position_m[2], 0.007);
+  EXPECT_EQ(c.commands(), 2u);
+  EXPECT_EQ(c.assets(), 1u);
+}
+
 TEST(PositionFeeds, SplitAtAnyByteGivesTheSameFrames) {
   const std::string hal = "1 12.5 -3.25 0\n2 12.6 -3.25 0\n5 x\n6 1 2 3\n";
   const std::string shdr =
       "* PING\n2024-01-01T12:00:00Z|Xact|1.5|Yact|2\n2024-01-01T12:00:00Z|Xact|bad\n";
-  const auto hw = codec_test::feed_whole(HalsamplerCodec{}, hal);
-  const auto hb = codec_test::feed_bytewise(HalsamplerCodec{}, hal);
+  const auto hw = codec_test::feed_whole(HalsamplerCodec({.sample_numbers = true}), hal);
+  const auto hb = codec_test::feed_bytewise(HalsamplerCodec({.sample_numbers = true}), hal);
   EXPECT_EQ(hw.stats, hb.stats);
   ASSERT_EQ(hb.frames.size(), 3u);
   // Sample 6 after 2: 3 and 4 were skipped by halsampler (lost); 5 came but is malformed.

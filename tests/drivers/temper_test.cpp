@@ -1,11 +1,10 @@
 // TEMPer codec on reports written by hand from the layouts of OpenBSD's ugold(4) (see
-// codec/temper.hpp); every expected temperature is worked out in the comment beside it.
-#include "cal/drivers/codec/temper.hpp"
-
+// temper/codec.hpp); every expected temperature is worked out in the comment beside it.
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "temper/codec.hpp"
 
 namespace {
 
@@ -125,6 +124,92 @@ TEST(TemperCodec, CommandsAreTheDocumentedReports) {
   EXPECT_EQ(TemperCodec::init_command(), std::string("\x00\x01\x82\x77\x01\x00\x00\x00\x00", 9));
   EXPECT_EQ(TemperCodec::model_command(), std::string("\x00\x01\x86\xff\x01\x00\x00\x00\x00", 9));
   EXPECT_THROW(temper_family_from_string("silver"), cal::InputError);
+}
+
+TEST(TemperModels, DetectedFromTheFirmwareStringsThePublicProjectsShow) {
+  // Firmware strings as the projects print them (with their padding), and what they say:
+  struct Case {
+    std::string firmware;
+    TemperFamily family;
+    bool inner, probe, humidity;
+  };
+  const Case cases[] = {
+      // OpenBSD ugold.c: "TEMPerGold_" + "V3.5 "; ccwienk/temper lists it on 3553:a001.
+      {"TEMPerGold_V3.5 ", TemperFamily::gold, true, false, false},
+      // urwen/temper: TEMPer2_V3.7, inner at offset 2, external at 10 (the second report).
+      {"TEMPer2_V3.7    ", TemperFamily::gold, true, true, false},
+      // ugold.c: "TEMPer2_V4.1\0\0\0\0" and "TEMPer1F_V4.1\0\0\0" (TEMPer1F: no inner sensor).
+      {std::string("TEMPer2_V4.1\0\0\0\0", 16), TemperFamily::gold, true, true, false},
+      {std::string("TEMPer1F_V4.1\0\0\0", 16), TemperFamily::gold, false, true, false},
+      // ccwienk/temper: TEMPer1F_V3.9, one value, the external probe (README: "E").
+      {"TEMPer1F_V3.9 ", TemperFamily::gold, false, true, false},
+      // padelt/temper-python 1.5.1: TEMPer1F_V1.3 "has only 1 sensor at offset 4".
+      {"TEMPer1F_V1.3", TemperFamily::ds75, false, true, false},
+      // urwen/temper: TEMPer1F_H1V1.5F, temperature and humidity with SHT2x equations.
+      {"TEMPer1F_H1V1.5F", TemperFamily::sht2x, true, false, true},
+      // ugold.c: "TEMPerX_" + "V3.3    " and "TEMPerHUM" + "_V3.9  ": temperx.
+      {"TEMPerX_V3.3    ", TemperFamily::temperx, true, false, true},
+      {"TEMPerHUM_V3.9  ", TemperFamily::temperx, true, false, true},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.firmware);
+    const auto* m = temper_model_of(c.firmware);
+    ASSERT_NE(m, nullptr);
+    EXPECT_EQ(m->family, c.family);
+    EXPECT_EQ(m->inner, c.inner);
+    EXPECT_EQ(m->probe, c.probe);
+    EXPECT_EQ(m->humidity, c.humidity);
+    EXPECT_FALSE(m->source.empty());
+  }
+  // Unknown firmware is refused, never guessed: a serial TEMPerX232, a made-up one.
+  EXPECT_EQ(temper_model_of("TEMPerX232_V2.0"), nullptr);
+  EXPECT_EQ(temper_model_of("TEMPerGold_V9.9"), nullptr);
+  EXPECT_EQ(temper_model_of(""), nullptr);
+}
+
+TEST(TemperCodec, AProbeOnlyModelGivesNoPhantomInnerSensor) {
+  // TEMPer1F_V1.3 (ds75): the one sensor is the second value; 0x0B40 = 2880 -> 11.25 degC.
+  TemperConfig v13{
+      .family = TemperFamily::ds75, .inner = false, .probe = true, .ds75_slots = {-1, 1}};
+  const auto a =
+      codec_test::feed_whole(TemperCodec(v13), report({0x80, 0x04, 0x17, 0x00, 0x0B, 0x40}));
+  ASSERT_EQ(a.frames.size(), 1u);
+  EXPECT_EQ(a.frames[0].sensor, 1);
+  EXPECT_DOUBLE_EQ(a.frames[0].temperature_degc, 11.25);
+  // TEMPer1F_V3.9 (gold, probe only): 0x09C4 = 2500 -> 25.00 degC on channel 1; a report of an
+  // inner sensor it does not have is malformed, not a reading.
+  TemperConfig v39{.family = TemperFamily::gold, .inner = false, .probe = true};
+  const auto b = codec_test::feed_whole(
+      TemperCodec(v39), report({0x80, 0x01, 0x09, 0xC4}) + report({0x80, 0x80, 0x08, 0x00}));
+  ASSERT_EQ(b.frames.size(), 1u);
+  EXPECT_EQ(b.frames[0].sensor, 1);
+  EXPECT_DOUBLE_EQ(b.frames[0].temperature_degc, 25.0);
+  EXPECT_EQ(b.stats.malformed, 1u);
+}
+
+TEST(TemperCodec, Sht2xSi7005AndSi7006Equations) {
+  // sht2x (urwen/temper): t = 6700: -46.85 + 175.72 * 26800 / 65536 = 25.00815 degC;
+  // h = 1835: -6 + 125 * 29360 / 65536 = 49.99976 %RH.
+  const auto s = codec_test::feed_whole(TemperCodec({.family = TemperFamily::sht2x}),
+                                        report({0x80, 0x80, 0x1A, 0x2C, 0x07, 0x2B}));
+  ASSERT_EQ(s.frames.size(), 1u);
+  EXPECT_NEAR(s.frames[0].temperature_degc, 25.00815, 1e-5);
+  EXPECT_NEAR(*s.frames[0].humidity_pct, 49.99976, 1e-5);
+  // si7005 (OpenBSD ugold): t = 0x0960 = 2400: 2400 / 32 - 50 = 25 degC; h = 0x0480 = 1152:
+  // 1152 / 16 - 24 = 48 %RH.
+  const auto a = codec_test::feed_whole(TemperCodec({.family = TemperFamily::si7005}),
+                                        report({0x80, 0x80, 0x09, 0x60, 0x04, 0x80}));
+  ASSERT_EQ(a.frames.size(), 1u);
+  EXPECT_DOUBLE_EQ(a.frames[0].temperature_degc, 25.0);
+  EXPECT_DOUBLE_EQ(*a.frames[0].humidity_pct, 48.0);
+  // si7006 (ugold): t = 0x6A02 (status bits 02 cleared -> 27136): 27136 * 175.72 / 65536 -
+  // 46.85 = 25.90906 degC; h = 0x7000 = 28672: 28672 * 125 / 65536 - 6 = 48.6875 %RH.
+  const auto b = codec_test::feed_whole(TemperCodec({.family = TemperFamily::si7006}),
+                                        report({0x80, 0x80, 0x6A, 0x02, 0x70, 0x00}));
+  ASSERT_EQ(b.frames.size(), 1u);
+  EXPECT_NEAR(b.frames[0].temperature_degc, 25.90906, 1e-5);
+  EXPECT_DOUBLE_EQ(*b.frames[0].humidity_pct, 48.6875);
+  EXPECT_EQ(temper_family_from_string("sht2x"), TemperFamily::sht2x);
 }
 
 }  // namespace

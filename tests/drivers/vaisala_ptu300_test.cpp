@@ -1,11 +1,10 @@
 // Vaisala PTU300 codec: output lines as the User's Guide prints them, custom FORM lines with
 // other units, the CS2/CS4/CSX checksums worked out by hand, and every bad line.
-#include "cal/drivers/codec/vaisala_ptu300.hpp"
-
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
+#include "ptu300/codec.hpp"
 
 namespace {
 
@@ -72,9 +71,49 @@ TEST(Ptu300Codec, TextLinesStarsUnitsAndRanges) {
   EXPECT_EQ(d.frames[0].text, "SEND");
   EXPECT_FALSE(d.frames[1].pressure_pa);                  // the stars are no value ...
   EXPECT_DOUBLE_EQ(*d.frames[1].temperature_degc, 22.2);  // ... the rest of the line is
-  EXPECT_EQ(d.stats.out_of_range, 3u);                    // stars, 1500 hPa, 104 %RH
+  // Stars are the device saying "no value" (issue 13): an unavailable field, not a codec error.
+  ASSERT_EQ(d.frames[1].fields.size(), 2u);
+  EXPECT_EQ(d.frames[1].fields[0].label, "P");
+  EXPECT_FALSE(d.frames[1].fields[0].available);
+  EXPECT_EQ(d.stats.out_of_range, 2u);  // 1500 hPa, 104 %RH
   EXPECT_EQ(d.stats.malformed, 1u);
   EXPECT_EQ(d.stats.garbage, 1u);
+}
+
+TEST(Ptu300Codec, EveryPressureUnitOfTheUsersGuideDewPointAndTrend) {
+  // The user's guide lists hPa, psia, inHg, torr, bara, barg, psig, mbar, mmHg, kPa, Pa, mmH2O
+  // and inH2O. By hand (NIST SP 811): 1.0132 bara = 101320 Pa; 10332.3 mmH2O * 9.80665 Pa =
+  // 101325.2 Pa; 14.6959 psia * 6894.757 = 101324.66 Pa; 0.5 barg = 50000 Pa gauge; 2.0 psig =
+  // 13789.514 Pa gauge.
+  const auto d = codec_test::feed_whole(Ptu300Codec{},
+                                        "P= 1.0132 bara\r\n"
+                                        "P= 10332.3 mmH2O\r\n"
+                                        "P= 14.6959 psia\r\n"
+                                        "P= 0.5 barg T= 21.0 'C\r\n"
+                                        "P= 2.0 psig\r\n"
+                                        "Td= 4.5 'C Tdp= 4.6 'C\r\n"
+                                        "P= 1013.2 hPa P3H= -0.4 hPa A3H= 5\r\n"
+                                        "P3H= ****.* hPa A3H= *\r\n");
+  EXPECT_EQ(d.stats.errors(), 0u);
+  ASSERT_EQ(d.frames.size(), 8u);
+  EXPECT_NEAR(*d.frames[0].pressure_pa, 101320.0, 1e-6);
+  EXPECT_NEAR(*d.frames[1].pressure_pa, 101325.2, 0.1);
+  EXPECT_NEAR(*d.frames[2].pressure_pa, 101324.66, 0.01);
+  // Gauge pressures are decoded but never taken for the air's absolute pressure.
+  EXPECT_FALSE(d.frames[3].pressure_pa);
+  EXPECT_EQ(d.frames[3].fields[0].quantity, Ptu300Quantity::gauge_pressure);
+  EXPECT_DOUBLE_EQ(d.frames[3].fields[0].value_si, 50000.0);
+  EXPECT_DOUBLE_EQ(*d.frames[3].temperature_degc, 21.0);
+  EXPECT_NEAR(d.frames[4].fields[0].value_si, 13789.514, 1e-6);
+  // Td and Tdp are the dew point.
+  EXPECT_DOUBLE_EQ(*d.frames[5].dew_point_degc, 4.5);
+  EXPECT_EQ(d.frames[5].fields[1].quantity, Ptu300Quantity::dew_point);
+  // The 3-hour trend in Pa and the tendency code; before 3 h both print stars.
+  EXPECT_EQ(d.frames[6].fields[1].quantity, Ptu300Quantity::pressure_tendency);
+  EXPECT_DOUBLE_EQ(d.frames[6].fields[1].value_si, -40.0);
+  EXPECT_DOUBLE_EQ(d.frames[6].fields[2].value_si, 5.0);
+  EXPECT_FALSE(d.frames[7].fields[0].available);
+  EXPECT_FALSE(d.frames[7].fields[1].available);
 }
 
 TEST(Ptu300Codec, CommandsAsTheManualWritesThem) {

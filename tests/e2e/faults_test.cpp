@@ -12,12 +12,14 @@
 #include <filesystem>
 #include <random>
 
-#include "cal/drivers/instruments.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
+#include "ids3010/instrument.hpp"
+#include "line_gauge/instrument.hpp"
 #include "linear_run.hpp"
+#include "ptu300/instrument.hpp"
 #include "sim_shop.hpp"
 
 namespace {

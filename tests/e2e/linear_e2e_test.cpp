@@ -17,12 +17,14 @@
 #include <random>
 #include <thread>
 
-#include "cal/drivers/instruments.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "ids3010/instrument.hpp"
 #include "iso230_2_output.hpp"
+#include "line_gauge/instrument.hpp"
 #include "linear_run.hpp"
+#include "ptu300/instrument.hpp"
 #include "sim_shop.hpp"
 #include "verdict.hpp"
 

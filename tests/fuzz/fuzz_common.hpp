@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "cal/drivers/codec/common.hpp"
+
 template <class Codec>
 void fuzz_codec(Codec whole, Codec split, const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);

@@ -148,9 +148,11 @@ void expect_truth(const Replayed& r) {
   EXPECT_NEAR(bar.back().value, (ts::end_x_mm - ts::start_x_mm) * 1e-3, 1e-8);
   for (std::size_t i = 1; i < bar.size(); ++i) ASSERT_GE(bar[i].value, bar[i - 1].value) << i;
 
-  // SHDR commanded position: Xcom from 250 to 260 mm, Y and Z at 0.
+  // SHDR commanded position: Xcom from 250 to 260 mm, Y and Z at 0. The checked-in capture's
+  // twin sent a line every 5 ms; an adapter (and today's twin) sends a value only when it
+  // changes: a few tens of lines while X moves for 1 s, one while it is parked.
   const auto px = r.of(ts::position, d::Quantity::machine_position_m, 0);
-  ASSERT_GT(px.size(), 100u);
+  ASSERT_GT(px.size(), 20u);
   EXPECT_DOUBLE_EQ(px.front().value, 0.250);
   EXPECT_DOUBLE_EQ(px.back().value, 0.260);
   for (const auto& v : px) {

@@ -4,9 +4,9 @@
 
 #include <boost/asio/io_context.hpp>
 
-#include "cal/drivers/instruments.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
+#include "temper/instrument.hpp"
 
 namespace {
 

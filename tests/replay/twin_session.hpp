@@ -17,8 +17,14 @@
 #include <memory>
 #include <vector>
 
-#include "cal/drivers/instruments.hpp"
-#include "cal/drivers/sim/twins.hpp"
+#include "ids3010/instrument.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/instrument.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/instrument.hpp"
+#include "ptu300/twin.hpp"
+#include "shdr/instrument.hpp"
+#include "shdr/twin.hpp"
 
 namespace twin_session {
 
@@ -57,16 +63,18 @@ inline d::InstrumentOptions options(Device device, const char* name) {
   return {.device = device,
           .name = name,
           .backoff = {.initial = 50ms, .max = 200ms},
-          .poll_period = device == laser    ? 20ms
+          // The laser at 10 ms (the checked-in capture was recorded at 20 ms): since issue 13
+          // a warning costs the IDS3010 a mode check and, once, its text, and a loaded machine
+          // polls late, so 20 ms left as few as 2 readings in the 0.2 s of a blocked beam.
+          .poll_period = device == laser    ? 10ms
                          : device == ptu300 ? 250ms
                                             : 1000ms};
 }
 
 inline d::Ids3010Options ids_options() { return {.environment_period = 500ms}; }
 inline d::codec::GaugeConfig gauge_config() { return {}; }
-inline d::PositionFeedOptions feed_options() {
-  return {.kind = d::PositionFeedKind::shdr,
-          .shdr = {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}}};
+inline d::codec::ShdrConfig feed_options() {
+  return {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}};
 }
 
 // The four instruments on the given transports (real ones when recording, the replay bus's
@@ -81,11 +89,11 @@ std::array<std::unique_ptr<d::Instrument>, 4> instruments(boost::asio::io_contex
     o.replay = base.replay;
     return o;
   };
-  return {d::make_ids3010(io, transport(laser), with(options(laser, "laser")), ids_options()),
-          d::make_ptu300(io, transport(ptu300), with(options(ptu300, "PTU300"))),
-          d::make_gauge(io, transport(ballbar), with(options(ballbar, "ballbar")), gauge_config()),
-          d::make_position_feed(io, transport(position), with(options(position, "position")),
-                                feed_options())};
+  return {
+      d::make_ids3010(io, transport(laser), with(options(laser, "laser")), ids_options()),
+      d::make_ptu300(io, transport(ptu300), with(options(ptu300, "PTU300"))),
+      d::make_gauge(io, transport(ballbar), with(options(ballbar, "ballbar")), gauge_config()),
+      d::make_shdr(io, transport(position), with(options(position, "position")), feed_options())};
 }
 
 }  // namespace twin_session

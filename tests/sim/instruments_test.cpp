@@ -1,16 +1,30 @@
 // The real instruments (transport + codec + state machine) against the simulated twins:
 // values in SI equal the simulated truth, the states follow the device, and a dropped
 // connection is reconnected with the gap reported.
-#include "cal/drivers/instruments.hpp"
-
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/read_until.hpp>
+#include <boost/asio/streambuf.hpp>
+#include <boost/asio/write.hpp>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <vector>
 
-#include "cal/drivers/sim/twins.hpp"
+#include "ids3010/instrument.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/instrument.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/instrument.hpp"
+#include "ptu300/twin.hpp"
+#include "shdr/instrument.hpp"
+#include "shdr/twin.hpp"
+#include "temper/instrument.hpp"
+#include "temper/twin.hpp"
 
 namespace {
 
@@ -179,21 +193,24 @@ namespace {
 // The SHDR twin streams the simulated control's commanded position; the real position feed
 // instrument (SHDR codec over TCP, "* PING" heartbeats) turns it into machine_position_m.
 TEST(PositionFeedInstrument, ShdrAdapterPositionAndHeartbeats) {
+  // The twin, as an adapter, sends every item to a new agent, then only what changes: parked,
+  // it is silent. The instrument pings once on connecting; the twin's "* PONG 40" makes it ping
+  // every 40 ms from then on (cppagent's connector does the same).
   boost::asio::io_context io;
   double now_s = 1.0;
   sim::World world = parked_at_100mm();
-  sim::ShdrTwin twin(io, world, [&] { return now_s; }, {.period = 2ms});
-  auto feed = d::make_position_feed(
-      io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
-      {.device = 4, .name = "position", .poll_period = 20ms},
-      {.kind = d::PositionFeedKind::shdr,
-       .shdr = {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}}});
+  sim::ShdrTwin twin(io, world, [&] { return now_s; }, {.period = 2ms, .pong_timeout_ms = 40});
+  auto feed = d::make_shdr(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+                           {.device = 4, .name = "position", .poll_period = 20ms},
+                           {.keys = {{"Xcom", 0}, {"Ycom", 1}, {"Zcom", 2}}});
   Recorder rec;
-  feed->start(rec.events());
-  ASSERT_TRUE(run_until(io, [&] {
-    return rec.count(d::Quantity::machine_position_m) >= 30 && twin.pings_answered() >= 2;
-  }));
-  // Parked at X = 100 mm: 0.1 m on channel 0, 0 on Y and Z.
+  std::vector<std::string> messages;
+  auto events = rec.events();
+  events.message = [&](const d::DeviceMessage& m) { messages.push_back(m.text); };
+  feed->start(events);
+  ASSERT_TRUE(run_until(io, [&] { return twin.pings_answered() >= 4; }));
+  // Parked at X = 100 mm: one line with the three items, 0.1 m on channel 0, 0 on Y and Z.
+  ASSERT_EQ(rec.count(d::Quantity::machine_position_m), 3u);
   for (const auto& r : rec.readings) {
     ASSERT_EQ(r.quantity, d::Quantity::machine_position_m);
     EXPECT_EQ(r.device, 4);
@@ -201,7 +218,165 @@ TEST(PositionFeedInstrument, ShdrAdapterPositionAndHeartbeats) {
   }
   EXPECT_EQ(rec.codec_errors, 0u);  // the "* PONG" answers are heartbeats, not errors
   EXPECT_EQ(feed->state(), d::InstrumentState::streaming);
+  ASSERT_FALSE(messages.empty());
+  EXPECT_EQ(messages.front(), "adapter answered * PONG 40: heartbeat every 40 ms");
+  // Silent for much longer than the 3 s default watchdog? No: the PONG's heartbeats keep the
+  // connection alive (measured here in pings, each answered), and no reconnection happened.
+  EXPECT_EQ(std::count(rec.states.begin(), rec.states.end(), d::InstrumentState::reconnecting), 0);
   feed->stop();
+}
+
+TEST(PositionFeedInstrument, ShdrWithoutPongIsNeverTimedOutForSilence) {
+  // A loopback adapter that replays the Okuma OSP-P300 recording (../shared/realdata) in three
+  // parts with quiet periods between them and never answers "* PING" (the agent then uses no
+  // heartbeat). The quiet periods are 10 times the instrument's silence timeout (30 ms here,
+  // 3 s by default: the logic does not depend on the length, and the suite does not wait 30 s
+  // of wall time): no reconnection, and every frame of the recording arrives.
+  std::ifstream in(CALDAQ_REALDATA_DIR "/shdr_okuma_osp_p300.txt", std::ios::binary);
+  ASSERT_TRUE(in) << CALDAQ_REALDATA_DIR << ": the real recordings are expected in "
+                  << "../shared/realdata beside the checkout";
+  const std::string okuma((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::string> parts;
+  for (std::size_t at = 0, k = 1; k <= 3; ++k) {
+    const std::size_t end = k == 3 ? okuma.size() : okuma.find('\n', okuma.size() * k / 3) + 1;
+    parts.push_back(okuma.substr(at, end - at));
+    at = end;
+  }
+  boost::asio::io_context io;
+  boost::asio::ip::tcp::acceptor acceptor(io, {boost::asio::ip::address_v4::loopback(), 0});
+  boost::asio::ip::tcp::socket peer(io);
+  acceptor.async_accept(peer, [](const boost::system::error_code&) {});
+  auto feed = d::make_shdr(
+      io, t::make_tcp(io, {.host = "127.0.0.1", .port = acceptor.local_endpoint().port()}),
+      {.device = 4, .name = "position", .silence_timeout = 30ms},
+      {.keys = {{"X1actw", 0}, {"YI1actw", 1}, {"Z1actw", 2}}});
+  Recorder rec;
+  feed->start(rec.events());
+  ASSERT_TRUE(run_until(io, [&] { return peer.is_open(); }));
+  for (const auto& part : parts) {
+    boost::asio::write(peer, boost::asio::buffer(part));
+    run_until(
+        io, [] { return false; }, 300ms);  // quiet: 10 x the silence timeout
+  }
+  EXPECT_EQ(rec.count(d::Quantity::machine_position_m), 4905u);  // the file's 3,989 frames
+  EXPECT_EQ(rec.codec_errors, 0u);
+  EXPECT_EQ(std::count(rec.states.begin(), rec.states.end(), d::InstrumentState::reconnecting), 0);
+  EXPECT_EQ(feed->state(), d::InstrumentState::streaming);
+  feed->stop();
+}
+
+TEST(PositionFeedInstrument, ShdrSilenceBeyondTwiceThePongPeriodDropsTheConnection) {
+  // The adapter answers "* PONG 20", then stops answering anything: after 2 x 20 ms of
+  // silence the connection counts as lost (reconnecting), as in the agent.
+  boost::asio::io_context io;
+  boost::asio::ip::tcp::acceptor acceptor(io, {boost::asio::ip::address_v4::loopback(), 0});
+  boost::asio::ip::tcp::socket peer(io);
+  boost::asio::streambuf in;
+  acceptor.async_accept(peer, [&](const boost::system::error_code& ec) {
+    if (ec) return;
+    boost::asio::async_read_until(
+        peer, in, '\n', [&](const boost::system::error_code& e, std::size_t) {
+          if (!e)
+            boost::asio::write(peer, boost::asio::buffer(std::string("* PONG 20\n|Xact|1\n")));
+        });
+  });
+  auto feed = d::make_shdr(
+      io, t::make_tcp(io, {.host = "127.0.0.1", .port = acceptor.local_endpoint().port()}),
+      {.device = 4, .name = "position", .backoff = {.initial = 10s}}, {});
+  Recorder rec;
+  feed->start(rec.events());
+  ASSERT_TRUE(run_until(
+      io,
+      [&] {
+        return std::count(rec.states.begin(), rec.states.end(), d::InstrumentState::reconnecting) >
+               0;
+      },
+      2s));
+  EXPECT_EQ(rec.reasons.back(), "no data for 40 ms");
+  feed->stop();
+}
+
+// The TEMPer twin speaks hidapi's way in this process (USB-HID cannot be offered here).
+struct TemperBench {
+  boost::asio::io_context io;
+  sim::World world = [] {
+    sim::MachineConfig m;
+    m.thermal.start_degc = 19.5;  // the probe on the structure
+    sim::AirConfig a;
+    a.temperature_degc.start = 21.25;  // the stick in the air
+    return sim::World(m, a);
+  }();
+  double now_s = 1.0;
+  std::unique_ptr<sim::TemperTwin> twin;
+  Recorder rec;
+  std::vector<std::string> messages;
+  std::unique_ptr<d::Instrument> start(std::string firmware, d::TemperOptions options) {
+    twin = std::make_unique<sim::TemperTwin>(
+        io, world, [this] { return now_s; }, sim::TemperTwinConfig{.firmware = firmware});
+    auto inst = d::make_temper(
+        io, twin->connect(io),
+        {.device = 2, .name = "table", .backoff = {.max_attempts = 1}, .poll_period = 5ms},
+        std::move(options));
+    auto events = rec.events();
+    events.message = [this](const d::DeviceMessage& m) { messages.push_back(m.text); };
+    inst->start(events);
+    return inst;
+  }
+};
+
+TEST(TemperInstrument, ATemper2GivesItsTwoSensorsAsTwoChannelsFoundFromItsFirmware) {
+  // Family and sensors from the firmware string (TEMPer2_V3.7: gold, stick and probe): the
+  // stick reads the air (21.25 degC), the probe the structure (19.5 degC), each on its channel,
+  // never one interleaved series.
+  TemperBench b;
+  auto t = b.start("TEMPer2_V3.7    ", {.family = std::nullopt});
+  ASSERT_TRUE(run_until(b.io, [&] { return b.rec.readings.size() >= 10; }));
+  for (const auto& r : b.rec.readings) {
+    ASSERT_EQ(r.quantity, d::Quantity::material_temperature_degc);
+    EXPECT_DOUBLE_EQ(r.value, r.channel == 0 ? 21.25 : 19.5) << int(r.channel);
+  }
+  const auto on = [&](int c) {
+    return std::count_if(b.rec.readings.begin(), b.rec.readings.end(),
+                         [&](const auto& r) { return r.channel == c; });
+  };
+  EXPECT_GE(on(0), 4);
+  EXPECT_GE(on(1), 4);
+  ASSERT_FALSE(b.messages.empty());
+  EXPECT_EQ(b.messages.front(),
+            "firmware 'TEMPer2_V3.7    ': gold family, sensors 0 (the stick), 1 (the probe)");
+  t->stop();
+}
+
+TEST(TemperInstrument, TheConfigurationChoosesTheChannelsAndAMissingOneIsRefused) {
+  {  // the probe only: no reading of the stick
+    TemperBench b;
+    auto t = b.start("TEMPer2_V3.7    ", {.family = std::nullopt, .channels = {1}});
+    ASSERT_TRUE(run_until(b.io, [&] { return b.rec.readings.size() >= 5; }));
+    for (const auto& r : b.rec.readings) EXPECT_EQ(r.channel, 1);
+    t->stop();
+  }
+  {  // a probe-only TEMPer1F_V3.9 asked for the stick: refused, saying what it has
+    TemperBench b;
+    auto t = b.start("TEMPer1F_V3.9   ", {.family = std::nullopt, .channels = {0}});
+    ASSERT_TRUE(run_until(b.io, [&] { return t->state() == d::InstrumentState::closed; }));
+    EXPECT_TRUE(b.rec.readings.empty());
+    EXPECT_NE(b.rec.reasons.back().find("TEMPer 'TEMPer1F_V3.9   ' has no channel 0; its sensors: "
+                                        "1 (the probe)"),
+              std::string::npos)
+        << b.rec.reasons.back();
+  }
+}
+
+TEST(TemperInstrument, AnUnknownFirmwareIsRefusedNamingItNeverGuessed) {
+  TemperBench b;
+  auto t = b.start("TEMPerGold_V9.9 ", {.family = std::nullopt});
+  ASSERT_TRUE(run_until(b.io, [&] { return t->state() == d::InstrumentState::closed; }));
+  EXPECT_TRUE(b.rec.readings.empty());
+  EXPECT_NE(b.rec.reasons.back().find("TEMPer firmware 'TEMPerGold_V9.9 ' is not in the "
+                                      "detection table (docs/drivers.md); if you know its report "
+                                      "layout, set family = "),
+            std::string::npos)
+      << b.rec.reasons.back();
 }
 
 }  // namespace

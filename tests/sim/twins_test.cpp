@@ -1,7 +1,5 @@
 // The real transports against the simulated twins: the bytes on the wire are those of the
 // protocols, and the values are the simulated truth converted by hand.
-#include "cal/drivers/sim/twins.hpp"
-
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -11,6 +9,9 @@
 #include <string>
 
 #include "cal/drivers/transport/transport.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/twin.hpp"
 
 namespace {
 
@@ -95,6 +96,10 @@ TEST(IdsTwin, AnswersJsonRpcWithTheOpticalPathInPicometres) {
   EXPECT_NEAR(r["result"][1].get<double>(), 100027137400.0, 1000.0);
   EXPECT_EQ(r["result"][2], 0);  // axis 2 measures nothing
 
+  // The ECU reports once its interface is enabled (attocube's ecu.py), as the device.
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ecu.getPressureInHPa", 15)["result"][0],
+            sim::IdsTwin::error_ecu_disabled);
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ecu.enable", 16)["result"][0], 0);
   r = call(b, *tcp, "com.attocube.ecu.getPressureInHPa", 12);
   EXPECT_NEAR(r["result"][1].get<double>(), 1013.25, 1e-9);
 
@@ -105,12 +110,28 @@ TEST(IdsTwin, AnswersJsonRpcWithTheOpticalPathInPicometres) {
   r = call(b, *tcp, "com.attocube.ids.no.suchMethod", 14);
   EXPECT_EQ(r["error"]["code"], -32601);
   EXPECT_EQ(r["id"], 14);
-  EXPECT_EQ(twin.requests_served(), 8u);
+  EXPECT_EQ(twin.requests_served(), 10u);  // with the two ECU-enable requests
 
   twin.drop_connections();
   run_until(b.io, [&] { return b.error.has_value(); });
   ASSERT_TRUE(b.error);
   EXPECT_EQ(b.error->kind, t::ErrorKind::closed_by_peer);
+}
+
+TEST(IdsTwin, SpeaksTheConfiguredApiGenerationOnly) {
+  // Firmware 1.9.1 renamed com.attocube.ids.* to com.attocube.sen.* (attocube-systems/IDS-APIs);
+  // a twin of either generation does not know the other's names, as the device does not.
+  Bench b;
+  sim::IdsTwin twin(b.io, b.world, b.clock, {.api = cal::drivers::codec::IdsApi::sen});
+  auto tcp = t::make_tcp(b.io, {.host = "127.0.0.1", .port = twin.port()});
+  b.open(*tcp);
+  run_until(b.io, [&] { return tcp->is_open(); });
+  EXPECT_EQ(call(b, *tcp, "com.attocube.sen.system.getCurrentMode", 1)["result"][1], "system idle");
+  EXPECT_EQ(call(b, *tcp, "com.attocube.ids.system.getCurrentMode", 2)["error"]["code"], -32601);
+  EXPECT_EQ(call(b, *tcp, "com.attocube.system.getFirmwareVersion", 3)["result"][1],
+            "1.9.1 (simulated)");
+  const auto text = call(b, *tcp, "com.attocube.system.errorNumberToString", 4);
+  EXPECT_EQ(text["result"][0], 0);  // (no params: the twin's text for an unknown number)
 }
 
 TEST(Ptu300Twin, AnswersSendAt4800SevenEvenOne) {

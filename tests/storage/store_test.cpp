@@ -461,3 +461,28 @@ TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
                              .calibrated_unix_ms = 1});
   EXPECT_EQ(store.bar_calibration("A", 100.0, 2)->zero_length_mm, 99.999);
 }
+
+// Read-only, a database of the previous version is read as it is: no calibrations, nothing
+// written (the version stays).
+TEST(Store, ReadOnlyThePreviousVersionHasNoBallbarCalibrations) {
+  TempDir dir;
+  const auto file = dir.path / "prev.sqlite";
+  { Store store(file); }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    const auto undo =
+        "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
+        "PRAGMA user_version = " +
+        std::to_string(cal::storage::schema_version - 1) + ";";
+    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_TRUE(ro.bar_calibrations().empty());
+    EXPECT_FALSE(ro.bar_calibration("A", 100.0, 1));
+  }
+  Store rw(file);  // the next writing open migrates it
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
+}

@@ -1,11 +1,10 @@
 // The serial transport against a pseudo-terminal pair: the test holds the master side and
 // plays the instrument; the transport opens the slave path like a /dev/ttyUSB0.
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <pty.h>
 #include <termios.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
@@ -120,6 +119,26 @@ TEST(SerialTransport, OpensAt4800SevenEvenOne) {
   EXPECT_FALSE(tio.c_lflag & ICANON);  // raw: bytes are passed as they come, no line editing
   EXPECT_FALSE(tio.c_lflag & ECHO);
   EXPECT_EQ(port->describe(), "serial " + pty.path + " 4800 7E1");
+}
+
+TEST(SerialTransport, ReopensAPtyAt4800SevenEvenOne) {
+  // Re-applying 7E1 to a pty failed with EINVAL on current kernels (the kernel forces CS8), so
+  // every open after the first failed: the PTU300 twin was lost on the next run and on every
+  // reconnection. Five opens in a row, each sending a byte through.
+  Pty pty;
+  for (int i = 0; i < 5; ++i) {
+    boost::asio::io_context io;
+    auto port = t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = pty.path}));
+    std::string failure;
+    bool opened = false;
+    port->open({.opened = [&] { opened = true; },
+                .data = [](auto) {},
+                .error = [&](const t::Error& e) { failure = e.message; }});
+    io.run_for(20ms);
+    ASSERT_TRUE(opened) << "open " << i + 1 << ": " << failure;
+    ASSERT_TRUE(port->is_open());
+    port->close();
+  }
 }
 
 std::string open_error(const t::SerialSettings& settings) {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Static checks of the udev rules in udev/, and `udevadm verify` where udevadm has it.
-# Usage: check_rules.sh UDEV_DIR [CATALOG]   (CATALOG: drivers/src/catalog.cpp by default)
+# Usage: check_rules.sh UDEV_DIR [CATALOG]   (CATALOG: a file or a folder; by default drivers/,
+# whose drivers/<device>/device.cpp files hold the devices' USB ids)
 #
 # Checked for every *.rules file:
 #  - the name sorts before 73-seat-late.rules (TAG+="uaccess" is applied there);
@@ -15,7 +16,7 @@
 # each must be refused, or the checker is broken.
 set -u
 UDEV_DIR=$1
-CATALOG=${2:-$UDEV_DIR/../drivers/src/catalog.cpp}
+CATALOG=${2:-$UDEV_DIR/../drivers}
 export LC_ALL=C
 passes=0
 fails=0
@@ -67,6 +68,11 @@ check_line() {
   return $problems
 }
 
+# catalog_text CATALOG: the catalog file, or every drivers/<device>/device.cpp below a folder.
+catalog_text() {
+  if [ -d "$1" ]; then find "$1" -name device.cpp -exec cat {} +; else cat "$1"; fi
+}
+
 # check_dir DIR CATALOG: prints each problem; succeeds when there is none.
 check_dir() {
   local dir=$1 catalog=$2 problems=0 file name n line
@@ -100,7 +106,8 @@ check_dir() {
     vid=${vid,,} pid=${pid,,}
     grep -h 'SUBSYSTEM=="hidraw"' "${files[@]}" | grep "ATTRS{idVendor}==\"$vid\"" | grep -q "ATTRS{idProduct}==\"$pid\"" ||
       { echo "$dir: the catalog's $vid:$pid has no hidraw rule"; problems=$((problems + 1)); }
-  done < <(grep -oE 'KnownDevice\{0x[0-9a-fA-F]{4}, *0x[0-9a-fA-F]{4}' "$catalog" | sed -E 's/.*0x([0-9a-fA-F]{4}), *0x([0-9a-fA-F]{4})/\1 \2/')
+  done < <(catalog_text "$catalog" | grep -oE '\{0x[0-9a-fA-F]{4}, *0x[0-9a-fA-F]{4}, *"' |
+           sed -E 's/.*0x([0-9a-fA-F]{4}), *0x([0-9a-fA-F]{4}).*/\1 \2/')
   if [ "$found" -eq 0 ]; then echo "$catalog: no KnownDevice entries found"; problems=$((problems + 1)); fi
   [ "$problems" -eq 0 ]
 }

@@ -974,28 +974,52 @@ std::string circle_section(const st::Store& store, const RunView& v, const Optio
 // --------------------------------------------------
 
 std::string generic_section(const st::Store& store, const RunView& v) {
-  const auto readings = store.readings(v.run.id);
-  std::map<std::tuple<int, int, int>, Series> by;
-  const std::int64_t t0 = readings.empty() ? 0 : readings.front().time_ns;
-  for (const auto& r : readings) {
-    auto& s = by[{r.quantity, r.device, r.channel}];
-    s.label = fmt::format("{} {} ch {}", instrument_name(v, r.device),
-                          cal::drivers::to_string(static_cast<Q>(r.quantity)), r.channel);
-    s.t_min.push_back(static_cast<double>(r.time_ns - t0) / 60e9);
-    s.value.push_back(r.value);
+  // Streamed: every series is thinned to about 4000 points for its plot (every step-th
+  // reading, the step from the series' count), so the memory does not grow with the run.
+  const auto series = store.series(v.run.id);
+  std::int64_t t0 = 0, count = 0;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    t0 = i == 0 ? series[i].first_ns : std::min(t0, series[i].first_ns);
+    count += series[i].count;
   }
-  std::string h = fmt::format("<h3>Readings</h3>\n<p>{} readings stored.</p>\n", readings.size());
-  std::size_t i = 0;
-  for (auto& [key, s] : by) {
-    const auto q = static_cast<Q>(std::get<0>(key));
+  struct Thinned {
+    Series s;
+    std::size_t step = 1, seen = 0;
+  };
+  std::map<std::tuple<int, int, int>, Thinned> by;
+  std::vector<std::uint8_t> plotted;
+  for (const auto& x : series) {
+    const auto q = static_cast<Q>(x.quantity);
     if (q == Q::air_temperature_degc || q == Q::air_pressure_pa || q == Q::air_humidity_pct ||
         q == Q::material_temperature_degc || q == Q::refractive_index)
       continue;
-    h += figure(svg(XyChart{.title = s.label,
+    auto& t = by[{x.quantity, x.device, x.channel}];
+    t.step = std::max<std::size_t>(1, static_cast<std::size_t>(x.count) / 4000);
+    t.s.label = fmt::format("{} {} ch {}", instrument_name(v, x.device), cal::drivers::to_string(q),
+                            x.channel);
+    if (std::find(plotted.begin(), plotted.end(), x.quantity) == plotted.end())
+      plotted.push_back(x.quantity);
+  }
+  if (!plotted.empty()) {
+    auto stream = store.stream_readings(v.run.id, plotted);
+    std::vector<st::RawReading> batch;
+    while (stream.next(batch))
+      for (const auto& r : batch) {
+        auto& t = by[{r.quantity, r.device, r.channel}];
+        if (t.seen++ % t.step != 0) continue;
+        t.s.t_min.push_back(static_cast<double>(r.time_ns - t0) / 60e9);
+        t.s.value.push_back(r.value);
+      }
+  }
+  std::string h = fmt::format("<h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
+  std::size_t i = 0;
+  for (auto& [key, t] : by) {
+    const auto q = static_cast<Q>(std::get<0>(key));
+    h += figure(svg(XyChart{.title = t.s.label,
                             .x_label = "time (min)",
                             .y_label = std::string(cal::drivers::to_string(q)),
-                            .lines = lines_of({s}, i++, 4000)}),
-                s.label + " over the run.");
+                            .lines = lines_of({t.s}, i++, 4000)}),
+                t.s.label + " over the run.");
   }
   return h;
 }

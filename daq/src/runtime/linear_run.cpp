@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -103,10 +104,28 @@ json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, d
 
 }  // namespace
 
+MaterialSensors::MaterialSensors(std::size_t instruments,
+                                 const std::vector<std::vector<std::uint8_t>>& channels) {
+  for (std::size_t k = 0; k < instruments; ++k) {
+    first_.push_back(count_);
+    channels_.push_back(k < channels.size() ? channels[k] : std::vector<std::uint8_t>{});
+    count_ += channels_.back().empty() ? 1 : static_cast<int>(channels_.back().size());
+  }
+}
+
+int MaterialSensors::sensor(std::size_t k, std::uint8_t channel) const {
+  if (k >= channels_.size()) return -1;
+  const auto& c = channels_[k];
+  if (c.empty()) return first_[k];
+  const auto it = std::find(c.begin(), c.end(), channel);
+  return it == c.end() ? -1 : first_[k] + static_cast<int>(it - c.begin());
+}
+
 struct LinearRun::Impl {
   boost::asio::io_context& io;
   LinearRunSetup setup;
   cal::iso230_2::Plan plan;
+  MaterialSensors materials;
   cal::daq::EnvStage env;
   cal::daq::StabilityTrigger trigger;
   std::optional<cal::daq::PositionTrigger> position_trigger;  // with a position feed
@@ -126,7 +145,8 @@ struct LinearRun::Impl {
       : io(i),
         setup(std::move(s)),
         plan(linear_plan(*setup.config.linear)),
-        env(setup.config.environment, static_cast<int>(setup.material.size())),
+        materials(setup.material.size(), setup.material_channels),
+        env(setup.config.environment, materials.count()),
         trigger({.tolerance_um = setup.config.trigger.tolerance_um,
                  .dwell_s = setup.config.trigger.dwell_s,
                  .window_mm = setup.config.trigger.window_mm}),
@@ -135,7 +155,8 @@ struct LinearRun::Impl {
     if (setup.position)
       position_trigger.emplace(
           cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
-                                            .dwell_s = setup.config.trigger.dwell_s});
+                                            .dwell_s = setup.config.trigger.dwell_s,
+                                            .feed_holds = setup.position_on_change});
   }
   ~Impl() { *alive = false; }
 
@@ -227,7 +248,12 @@ struct LinearRun::Impl {
                                         static_cast<double>(g.end_ns - g.start_ns) * 1e-9,
                                         g.reason));
                     },
-                .codec_error = {}});
+                .codec_error = {},
+                .message =
+                    [this, &inst](const cal::drivers::DeviceMessage& m) {
+                      event(fmt::format("{}: {}{}: {}", inst.describe(), to_string(m.severity),
+                                        m.code ? fmt::format(" {}", m.code) : "", m.text));
+                    }});
   }
 
   void on_reading(Reading r, std::uint16_t device) {
@@ -259,11 +285,14 @@ struct LinearRun::Impl {
         return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
       case Quantity::air_pressure_pa:
         return env.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa, r.value);
-      case Quantity::air_humidity_pct:
+      case Quantity::air_humidity_pct:  // not of a material thermometer: a TEMPerX on the table
+        if (device >= 2) return;        // measures the humidity there, not in the beam
         return env.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value);
       case Quantity::material_temperature_degc:
       case Quantity::length_m:  // a line thermometer reports through the gauge codec
-        if (device >= 2) env.add_material(r.time_ns, device - 2, r.value);
+        if (device >= 2 && device < position_device())
+          if (const int sensor = materials.sensor(device - 2u, r.channel); sensor >= 0)
+            env.add_material(r.time_ns, sensor, r.value);
         return;
       case Quantity::displacement_m:
         if (device == 0 && r.channel == setup.laser_channel) return on_laser(r);

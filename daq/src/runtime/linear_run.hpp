@@ -46,11 +46,17 @@ struct LinearRunSetup {
   std::filesystem::path database;
   std::unique_ptr<cal::drivers::Instrument> laser;
   std::unique_ptr<cal::drivers::Instrument> air;
-  std::vector<std::unique_ptr<cal::drivers::Instrument>> material;  // one per sensor
+  std::vector<std::unique_ptr<cal::drivers::Instrument>> material;  // material thermometers
+  // The channels of each material instrument that are material sensors (each its own series:
+  // a TEMPer2's stick and probe are two sensors, never one). Missing or empty for an
+  // instrument: one sensor, whatever its channel.
+  std::vector<std::vector<std::uint8_t>> material_channels;
   // A machine position feed (optional): with one, stops are recognised from the control's
   // position (PositionTrigger) instead of the laser's stability; its channel is the test axis.
   std::unique_ptr<cal::drivers::Instrument> position;
   int position_channel = 0;
+  // The feed sends a position only when it changes (MTConnect SHDR): its last sample holds.
+  bool position_on_change = false;
   int laser_channel = 0;
   double datum_mm = 0.0;  // axis position where the laser reads 0
   std::string software_version = "daq 0.1.0";
@@ -65,6 +71,22 @@ struct LinearRunSetup {
   std::function<void(const LiveState&)> on_live;  // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
+};
+
+// The material sensors of a run: one per used channel of each material instrument (a TEMPer2's
+// stick and probe are two sensors, two series); an instrument with no channels listed is one
+// sensor, whatever its channel.
+class MaterialSensors {
+ public:
+  MaterialSensors(std::size_t instruments, const std::vector<std::vector<std::uint8_t>>& channels);
+  int count() const { return count_; }
+  // The sensor of a reading of material instrument `k` on `channel`; -1: not a used channel.
+  int sensor(std::size_t k, std::uint8_t channel) const;
+
+ private:
+  std::vector<int> first_;  // the first sensor of each instrument
+  std::vector<std::vector<std::uint8_t>> channels_;
+  int count_ = 0;
 };
 
 struct LinearRunOutcome {

@@ -1,10 +1,12 @@
 #include "session_spec.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 
 #include "cal/analysis/error.hpp"
-#include "cal/drivers/instruments.hpp"
 
 namespace daq {
 
@@ -16,99 +18,127 @@ std::unique_ptr<cal::drivers::Instrument> make_instrument(
     std::unique_ptr<cal::drivers::transport::Transport> transport,
     cal::drivers::InstrumentOptions options) {
   options.device = spec.device;
-  if (spec.driver == "ids3010")
-    return cal::drivers::make_ids3010(io, std::move(transport), std::move(options),
-                                      {.axes = spec.ids_axes});
-  if (spec.driver == "ptu300")
-    return cal::drivers::make_ptu300(io, std::move(transport), std::move(options));
-  if (spec.driver == "gauge")
-    return cal::drivers::make_gauge(io, std::move(transport), std::move(options), spec.gauge);
-  if (spec.driver == "temper")
-    return cal::drivers::make_temper(
-        io, std::move(transport), std::move(options),
-        {.family = codec::temper_family_from_string(spec.temper_family),
-         .quantity = spec.role == "air" ? cal::drivers::Quantity::air_temperature_degc
-                                        : cal::drivers::Quantity::material_temperature_degc});
-  if (spec.driver == "shdr" || spec.driver == "halsampler") {
-    const double m_per_unit = spec.feed_unit == "in" ? 0.0254 : 1e-3;
-    cal::drivers::PositionFeedOptions f{.kind = spec.driver == "shdr"
-                                                    ? cal::drivers::PositionFeedKind::shdr
-                                                    : cal::drivers::PositionFeedKind::halsampler};
-    f.shdr.keys = {{spec.feed_key, spec.feed_axis}};
-    f.shdr.metres_per_unit = m_per_unit;
-    f.halsampler.column = {-1, -1, -1};
-    f.halsampler.column[static_cast<std::size_t>(spec.feed_axis)] = spec.feed_column;
-    f.halsampler.metres_per_unit = m_per_unit;
-    return cal::drivers::make_position_feed(io, std::move(transport), std::move(options), f);
-  }
-  throw cal::InputError("instrument driver '" + spec.driver + "' cannot be built here");
+  return cal::drivers::driver(spec.driver)
+      .make_instrument(io, std::move(transport), std::move(options), spec.options, spec.context());
 }
 
 namespace {
-std::string unit_name(codec::GaugeUnit u) {
-  switch (u) {
-    case codec::GaugeUnit::mm:
-      return "mm";
-    case codec::GaugeUnit::um:
-      return "um";
-    case codec::GaugeUnit::inch:
-      return "in";
-    case codec::GaugeUnit::m:
-      return "m";
-    case codec::GaugeUnit::degc:
-      return "degC";
-    case codec::GaugeUnit::none:
-      return "none";
-  }
-  return "none";
+
+using cal::drivers::OptionType;
+using cal::drivers::OptionValue;
+
+json option_json(const OptionValue& v) {
+  return std::visit(
+      [](const auto& x) -> json {
+        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, std::monostate>)
+          return nullptr;
+        else
+          return x;
+      },
+      v);
 }
+
+// A JSON value as an option value of the spec's type; the table's check follows.
+OptionValue option_value(const json& v, const cal::drivers::OptionSpec& spec) {
+  switch (spec.type) {
+    case OptionType::boolean:
+      if (v.is_boolean()) return v.get<bool>();
+      break;
+    case OptionType::integer:
+      if (v.is_number_integer()) return v.get<std::int64_t>();
+      break;
+    case OptionType::number:
+      if (v.is_number()) return v.get<double>();
+      break;
+    case OptionType::string:
+    case OptionType::choice:
+      if (v.is_string()) return v.get<std::string>();
+      break;
+    case OptionType::integer_list:
+      if (v.is_array() &&
+          std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_number_integer(); }))
+        return v.get<std::vector<std::int64_t>>();
+      break;
+  }
+  return std::monostate{};
+}
+
+void set_option(cal::drivers::Options& options, const cal::drivers::OptionSpec& spec, const json& v,
+                const InstrumentSpec& s) {
+  if (v.is_null()) return;  // no value: the table's derived default
+  auto checked = cal::drivers::check_option(spec, option_value(v, spec));
+  if (!checked.error.empty())
+    throw cal::InputError(fmt::format("capture header: instrument {} ({}): option '{}' = {}: {}",
+                                      s.device, s.driver, spec.name, v.dump(), checked.error));
+  options.set(spec.name, std::move(checked.value));
+}
+
+// Entries written before the option tables: each driver says where its settings were.
+void read_legacy_options(const json& j, const cal::drivers::DeviceDriver& d, InstrumentSpec& s) {
+  for (const auto& key : d.legacy_keys()) {
+    const auto* spec = cal::drivers::find_option(d.options(), key.option);
+    if (!spec) continue;
+    if (key.pointer.empty()) {
+      s.options.set(spec->name, cal::drivers::parse_option_text(*spec, key.literal));
+      continue;
+    }
+    const json::json_pointer ptr{std::string(key.pointer)};
+    if (!j.contains(ptr)) continue;
+    json v = j.at(ptr);
+    if (key.form == cal::drivers::LegacyKey::Form::bool_mask_to_indices && v.is_array()) {
+      json indices = json::array();
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (v[i].is_boolean() && v[i].get<bool>()) indices.push_back(i);
+      v = indices;
+    }
+    set_option(s.options, *spec, v, s);
+  }
+  if (const auto f = j.find("feed"); f != j.end()) s.test_axis = f->value("axis", 0);
+}
+
 }  // namespace
 
 json to_json(const InstrumentSpec& s) {
-  return {{"device", s.device},
-          {"driver", s.driver},
-          {"role", s.role},
-          {"transport", s.transport},
-          {"ids_axes", s.ids_axes},
-          {"gauge",
-           {{"request", s.gauge.request},
-            {"pattern", s.gauge.pattern},
-            {"unit", unit_name(s.gauge.unit)},
-            {"scale", s.gauge.scale},
-            {"offset", s.gauge.offset},
-            {"min_si", s.gauge.min_si},
-            {"max_si", s.gauge.max_si}}},
-          {"temper_family", s.temper_family},
-          {"feed",
-           {{"axis", s.feed_axis},
-            {"key", s.feed_key},
-            {"column", s.feed_column},
-            {"unit", s.feed_unit}}}};
+  json options = json::object();
+  for (const auto& [name, value] : s.options.values())
+    if (!std::holds_alternative<std::monostate>(value)) options[name] = option_json(value);
+  json j{{"device", s.device},       {"driver", s.driver},       {"role", s.role},
+         {"transport", s.transport}, {"test_axis", s.test_axis}, {"options", options}};
+  if (!s.serial_number.empty()) j["serial_number"] = s.serial_number;
+  if (!s.certificate.empty()) j["certificate"] = s.certificate;
+  if (!s.calibration_due.empty()) j["calibration_due"] = s.calibration_due;
+  return j;
 }
 
 InstrumentSpec instrument_spec_from_json(const json& j) {
   InstrumentSpec s;
   s.device = j.at("device").get<std::uint16_t>();
   s.driver = j.at("driver").get<std::string>();
+  const auto* d = cal::drivers::find_driver(s.driver);
+  if (!d)
+    throw cal::InputError(
+        fmt::format("capture header: instrument {}: driver '{}' is not in this build (it has: {})",
+                    s.device, s.driver, fmt::join(cal::drivers::driver_names(), ", ")));
   s.role = j.value("role", "");
   s.transport = j.value("transport", "");
-  if (j.contains("ids_axes")) s.ids_axes = j["ids_axes"].get<std::array<bool, 3>>();
-  if (const auto g = j.find("gauge"); g != j.end()) {
-    s.gauge.request = g->value("request", "");
-    s.gauge.pattern = g->value("pattern", "");
-    s.gauge.unit = codec::gauge_unit_from_string(g->value("unit", "mm"));
-    s.gauge.scale = g->value("scale", 1.0);
-    s.gauge.offset = g->value("offset", 0.0);
-    s.gauge.min_si = g->value("min_si", -10.0);
-    s.gauge.max_si = g->value("max_si", 10.0);
+  s.serial_number = j.value("serial_number", "");
+  s.certificate = j.value("certificate", "");
+  s.calibration_due = j.value("calibration_due", "");
+  s.options = cal::drivers::Options(d->options());
+  if (const auto o = j.find("options"); o != j.end() && o->is_object()) {
+    s.test_axis = j.value("test_axis", 0);
+    for (const auto& [name, v] : o->items()) {
+      const auto* spec = cal::drivers::find_option(d->options(), name);
+      if (!spec)
+        throw cal::InputError(fmt::format(
+            "capture header: instrument {} ({}): option '{}' is not known to this build", s.device,
+            s.driver, name));
+      set_option(s.options, *spec, v, s);
+    }
+  } else {
+    read_legacy_options(j, *d, s);
   }
-  s.temper_family = j.value("temper_family", s.temper_family);
-  if (const auto f = j.find("feed"); f != j.end()) {
-    s.feed_axis = f->value("axis", 0);
-    s.feed_key = f->value("key", s.feed_key);
-    s.feed_column = f->value("column", 0);
-    s.feed_unit = f->value("unit", s.feed_unit);
-  }
+  d->validate(s.options);
   return s;
 }
 

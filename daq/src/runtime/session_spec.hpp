@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "cal/daq/config.hpp"
-#include "cal/drivers/codec/line_gauge.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/drivers/registry.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -20,18 +20,13 @@ namespace daq {
 
 struct InstrumentSpec {
   std::uint16_t device = 0;
-  std::string driver;     // ids3010 | ptu300 | gauge | temper | shdr | halsampler
-  std::string role;       // laser | air | material | ballbar
-  std::string transport;  // as described live, e.g. "tcp 127.0.0.1:9090"
-  std::array<bool, 3> ids_axes{true, false, false};
-  cal::drivers::codec::GaugeConfig gauge;
-  std::string temper_family = "gold";  // temper: ds75 | gold | temperx
-  // shdr | halsampler: the test axis (0 X, 1 Y, 2 Z), its SHDR key or halsampler column, and
-  // the machine unit (mm | in).
-  int feed_axis = 0;
-  std::string feed_key = "Xact";
-  int feed_column = 0;
-  std::string feed_unit = "mm";
+  std::string driver;             // a registered driver (cal::drivers::device_drivers())
+  std::string role;               // laser | air | material | ballbar | position
+  std::string transport;          // as configured, e.g. "tcp 127.0.0.1:9090"
+  cal::drivers::Options options;  // the driver's options, every one with its value
+  int test_axis = 0;              // the axis under test (0 X, 1 Y, 2 Z)
+  std::string serial_number, certificate, calibration_due;  // the instrument's records
+  cal::drivers::InstrumentContext context() const { return {role, test_axis}; }
 };
 
 std::unique_ptr<cal::drivers::Instrument> make_instrument(
@@ -40,6 +35,9 @@ std::unique_ptr<cal::drivers::Instrument> make_instrument(
     cal::drivers::InstrumentOptions options);
 
 nlohmann::json to_json(const InstrumentSpec& s);
+// Reads today's entries ({"options": {...}}) and those of captures recorded before the option
+// tables (each driver's legacy keys); throws cal::InputError naming the instrument and what is
+// wrong (an unknown driver or option, a value its table refuses).
 InstrumentSpec instrument_spec_from_json(const nlohmann::json& j);
 nlohmann::json to_json(const cal::daq::Config& c);
 cal::daq::Config config_from_json(const nlohmann::json& j);

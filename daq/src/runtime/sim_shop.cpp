@@ -1,11 +1,16 @@
 // The simulated shop (see sim_shop.hpp).
 #include "sim_shop.hpp"
 
+#include <fmt/format.h>
+
 #include <boost/asio/io_context.hpp>
 #include <cmath>
 #include <numbers>
 
-#include "cal/drivers/sim/twins.hpp"
+#include "ids3010/twin.hpp"
+#include "line_gauge/twin.hpp"
+#include "ptu300/twin.hpp"
+#include "shdr/twin.hpp"
 
 namespace daq {
 
@@ -113,6 +118,45 @@ const std::string& SimulatedShop::air_device() const { return impl_->ptu.device_
 const std::string& SimulatedShop::material_device() const { return impl_->material.device_path(); }
 const std::string& SimulatedShop::ballbar_device() const { return impl_->ballbar.device_path(); }
 std::uint16_t SimulatedShop::position_port() const { return impl_->position.port(); }
+
+std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed) const {
+  std::string position;
+  if (position_feed)
+    position = fmt::format(
+        "[devices.position]      # the control's commanded position\n"
+        "driver = \"shdr\"\ntransport = \"{}\"\nkey = \"Xcom\"\nrole = \"position\"\n\n",
+        impl_->position.transport());
+  return fmt::format(
+      R"TOML([devices.laser]
+driver = "ids3010"
+transport = "{laser}"
+role = "laser"
+poll_s = {laser_poll}
+
+[devices.air]
+driver = "ptu300"
+transport = "{air}"
+role = "air"
+
+[devices.material]
+driver = "gauge"
+transport = "serial {material} 9600 8N1"
+request = "?\r"
+unit = "degC"
+role = "material"
+
+{position}[devices.ballbar]
+driver = "gauge"
+transport = "{ballbar}"
+unit = "mm"
+min_si = -0.1           # the bar's travel: +/- 100 mm about its zero length
+max_si = 0.1
+role = "ballbar"
+)TOML",
+      fmt::arg("laser", impl_->ids.transport()), fmt::arg("laser_poll", laser_poll_s),
+      fmt::arg("air", impl_->ptu.transport()), fmt::arg("material", impl_->material.device_path()),
+      fmt::arg("position", position), fmt::arg("ballbar", impl_->ballbar.transport()));
+}
 
 void SimulatedShop::run_linear(const cal::iso230_2::Plan& plan, double feed, double dwell_s) {
   std::vector<sim::Move> program;

@@ -56,6 +56,10 @@ class SimulatedShop {
   const std::string& material_device() const;
   const std::string& ballbar_device() const;
   std::uint16_t position_port() const;  // MTConnect SHDR adapter: Xcom|Ycom|Zcom, commanded mm
+  // The [devices.*] tables (TOML, docs/config.md) of the shop's twins: laser, air, material,
+  // ballbar and, with position_feed, the SHDR position feed. `daq sim` writes them; the demo
+  // reads them, so the twins the shop starts are named here only.
+  std::string devices_toml(double laser_poll_s, bool position_feed) const;
 
   // The machine program for an ISO 230-2 plan on X: every move at the feed, a dwell at each
   // measure move.

@@ -16,6 +16,8 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
+#include "cal/drivers/registry.hpp"
+#include "cal/drivers/transport/transport.hpp"
 
 namespace cal::daq {
 namespace {
@@ -131,12 +133,12 @@ class Table {
     return node->as_table();
   }
 
-  void check_unknown() const {
+  void check_unknown(const std::string& what = "unknown key (a typo?)") const {
     for (const auto& [k, v] : table_) {
-      if (std::find(used_.begin(), used_.end(), k.str()) == used_.end())
-        fail(&v, k.str(), "unknown key (a typo?)");
+      if (std::find(used_.begin(), used_.end(), k.str()) == used_.end()) fail(&v, k.str(), what);
     }
   }
+  void mark_used(std::string_view key) { used_.emplace_back(key); }
 
   const std::string& path() const { return path_; }
   const std::filesystem::path& file() const { return file_; }
@@ -187,6 +189,47 @@ void one_of(Table& t, std::string_view key, const std::string& value,
            fmt::format("'{}' is not one of: {}", value, fmt::join(allowed, ", ")));
 }
 
+// A TOML value as an option value of the spec's type (the check against the spec follows).
+cal::drivers::OptionValue option_value(const toml::node& node, cal::drivers::OptionType type) {
+  using cal::drivers::OptionType;
+  switch (type) {
+    case OptionType::boolean:
+      if (auto v = node.value_exact<bool>()) return *v;
+      break;
+    case OptionType::integer:
+      if (auto v = node.value_exact<std::int64_t>()) return *v;
+      break;
+    case OptionType::number:
+      if (auto v = node.value_exact<std::int64_t>()) return *v;
+      if (auto v = node.value_exact<double>()) return *v;
+      break;
+    case OptionType::string:
+    case OptionType::choice:
+      if (auto v = node.value_exact<std::string>()) return *v;
+      break;
+    case OptionType::integer_list:
+      if (const auto* arr = node.as_array()) {
+        std::vector<std::int64_t> list;
+        for (const auto& e : *arr) {
+          const auto v = e.value_exact<std::int64_t>();
+          if (!v) return std::string("(not an integer)");  // refused by the check
+          list.push_back(*v);
+        }
+        return list;
+      }
+      break;
+  }
+  return std::monostate{};  // refused by the check with the type expected
+}
+
+// "request, pattern, unit", or "no keys of its own" (for the unknown-key message).
+std::string option_names(const cal::drivers::DeviceDriver& d) {
+  std::vector<std::string_view> names{cal::drivers::common_device_keys().begin(),
+                                      cal::drivers::common_device_keys().end()};
+  for (const auto& o : d.options()) names.push_back(o.name);
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
 DeviceConfig read_device(const std::string& id, const toml::table& tbl,
                          const std::filesystem::path& file) {
   Table t(tbl, "devices." + id, file);
@@ -194,42 +237,48 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   d.id = id;
   if (!t.get<std::string>("driver")) t.fail(nullptr, "driver", "missing");
   d.driver = *t.get<std::string>("driver");
-  one_of(t, "driver", d.driver, {"ids3010", "ptu300", "gauge", "temper", "halsampler", "shdr"});
+  const auto names = cal::drivers::driver_names();
+  if (std::find(names.begin(), names.end(), d.driver) == names.end())
+    t.fail(t.node("driver"), "driver",
+           fmt::format("'{}' is not one of: {}", d.driver, fmt::join(names, ", ")));
+  const auto& driver = cal::drivers::driver(d.driver);
   if (!t.get<std::string>("transport")) t.fail(nullptr, "transport", "missing");
   d.transport = *t.get<std::string>("transport");
   const std::string kind = d.transport.substr(0, d.transport.find(' '));
   one_of(t, "transport", kind, {"tcp", "serial", "hid"});
+  try {
+    cal::drivers::transport::check_transport_text(d.transport);
+  } catch (const InputError& e) {
+    t.fail(t.node("transport"), "transport", e.what());
+  }
   t.read("poll_s", d.poll_s);
   if (d.poll_s < 0) t.fail(t.node("poll_s"), "poll_s", "must be >= 0");
-  for (double a : t.numbers("axes")) {
-    if (a != 0 && a != 1 && a != 2) t.fail(t.node("axes"), "axes", "axes are 0, 1 or 2");
-    d.axes.push_back(static_cast<int>(a));
-  }
   t.read("role", d.role);
-  t.read("request", d.request);
-  t.read("pattern", d.pattern);
-  t.read("unit", d.unit);
-  one_of(t, "unit", d.unit, {"mm", "um", "in", "m", "degC"});
-  t.read("family", d.family);
-  one_of(t, "family", d.family, {"ds75", "gold", "temperx"});
-  t.read("key", d.key);
+  if (!d.role.empty())
+    one_of(t, "role", d.role, {"laser", "air", "material", "ballbar", "position"});
   t.read("serial_number", d.serial_number);
   t.read("certificate", d.certificate);
   t.read("calibration_due", d.calibration_due);
   if (!d.calibration_due.empty() && !iso_date(d.calibration_due))
     t.fail(t.node("calibration_due"), "calibration_due",
            fmt::format("'{}' is not a date YYYY-MM-DD", d.calibration_due));
-  double column = 0;
-  t.read("column", column);
-  if (column < 0 || column != std::floor(column))
-    t.fail(t.node("column"), "column", "a value column is an integer >= 0");
-  d.column = static_cast<int>(column);
-  // TOML has no escapes in literal strings: allow "\r" written as the two characters.
-  for (std::size_t at; (at = d.request.find("\\r")) != std::string::npos;)
-    d.request.replace(at, 2, "\r");
-  if (!d.role.empty())
-    one_of(t, "role", d.role, {"laser", "air", "material", "ballbar", "position"});
-  t.check_unknown();
+  // The driver's own keys, each checked against its option table.
+  d.options = cal::drivers::Options(driver.options());
+  for (const auto& spec : driver.options()) {
+    const toml::node* node = t.node(spec.name);
+    t.mark_used(spec.name);
+    if (!node) continue;
+    auto checked = cal::drivers::check_option(spec, option_value(*node, spec.type));
+    if (!checked.error.empty()) t.fail(node, spec.name, checked.error);
+    d.options.set(spec.name, std::move(checked.value));
+  }
+  try {
+    driver.validate(d.options);
+  } catch (const InputError& e) {
+    t.fail(nullptr, "driver", fmt::format("driver '{}': {}", d.driver, e.what()));
+  }
+  t.check_unknown(
+      fmt::format("unknown key (a typo?); driver '{}' takes {}", d.driver, option_names(driver)));
   return d;
 }
 

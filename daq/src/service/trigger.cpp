@@ -211,7 +211,7 @@ std::optional<Capture> PositionTrigger::add_reading(std::int64_t t, double x_mm,
   // The feed says how long the axis has been still: the stop ends at its newest sample (the
   // laser may be ahead of a slower feed, and the axis may start moving after that sample).
   if (!armed_ || !still_since_ns_ || feed_.empty()) return std::nullopt;
-  return try_capture(feed_.back().first);
+  return try_capture(s_.feed_holds ? std::max(t, feed_.back().first) : feed_.back().first);
 }
 
 std::optional<Capture> PositionTrigger::try_capture(std::int64_t now_ns) {
@@ -239,8 +239,7 @@ std::optional<Capture> PositionTrigger::capture_now() {
     at_mm = feed_.back().second;
     const double tol_mm = s_.tolerance_um * 1e-3;
     auto it = feed_.rbegin();
-    while (std::next(it) != feed_.rend() && std::abs(std::next(it)->second - at_mm) <= tol_mm)
-      ++it;
+    while (std::next(it) != feed_.rend() && std::abs(std::next(it)->second - at_mm) <= tol_mm) ++it;
     from = std::max(from, it->first);
   }
   auto c = make_capture(from, to, true, at_mm);

@@ -9,28 +9,24 @@
 #include <string_view>
 #include <vector>
 
+#include "cal/drivers/options.hpp"
+
 namespace cal::daq {
 
+// One [devices.ID] table: the keys every device has, and the device's own options, checked
+// against its option table in the registry (drivers/include/cal/drivers/registry.hpp; listed
+// by `daq devices --options` and docs/drivers.md).
 struct DeviceConfig {
   std::string id;         // the table name, e.g. "laser" in [devices.laser]
-  std::string driver;     // ids3010 | ptu300 | gauge | temper | halsampler | shdr
+  std::string driver;     // a registered driver: ids3010 | ptu300 | gauge | temper | ...
   std::string transport;  // "tcp HOST:PORT", "serial DEVICE BAUD FRAME [FLOW]", "hid VID:PID"
-  double poll_s = 0.0;    // 0: the driver's default
-  std::vector<int> axes;  // ids3010: interferometer axes to read (0..2)
   std::string role;       // laser | air | material | ballbar | position (what the run uses it for)
-  // gauge: the line codec's settings (docs/codecs.md)
-  std::string request;          // sent to poll, e.g. "?\r"; empty: the gauge streams
-  std::string pattern;          // regex with one capture group; empty: a bare number (+unit)
-  std::string unit = "mm";      // mm | um | in | m | degC
-  std::string family = "gold";  // temper: report family ds75 | gold | temperx (docs/codecs)
-  // Position feeds: the SHDR data item of the test axis (default "<axis>act"), or the
-  // halsampler value column (0-based, after the sample number) of the test axis.
-  std::string key;
-  int column = 0;
-  // The instrument's identity for the report (docs/config.md): common to every driver.
+  double poll_s = 0.0;    // 0: the driver's default
+  // The instrument's identity and calibration, for the records and reports.
   std::string serial_number;
-  std::string certificate;      // calibration certificate number
-  std::string calibration_due;  // ISO date YYYY-MM-DD; empty: not given
+  std::string certificate;        // calibration certificate number
+  std::string calibration_due;    // ISO 8601 date, YYYY-MM-DD (checked to be a real date)
+  cal::drivers::Options options;  // the driver's own keys, every one with its value
 };
 
 enum class StalePolicy { fallback, stop };

@@ -16,8 +16,14 @@
 // with one, it is interpolated and checked like the other air quantities. Material sensors may
 // be disabled (a broken or badly placed probe): they are then neither averaged nor checked.
 //
-// Cost per laser reading: a binary search per quantity (samples are kept for 2 minutes) and
-// one evaluation of the refractive-index equation.
+// Cost per laser reading: while the reading is newer than every sample (the live case: the
+// newest samples are held), the environment is computed once per air sample and each reading
+// costs two divisions. Otherwise a binary search per quantity (samples are kept for 2
+// minutes), and the refractive-index equation only when the air it is given changes (the
+// index of the last air state, bit for bit, is kept): once per reading while interpolating
+// between two samples. The results are those of the full computation, bit for bit
+// (tests/daq/env_stage_test.cpp). The caches make compensate() unsafe to call from two
+// threads at once on one stage (one stage per event loop).
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -48,6 +54,10 @@ struct Compensated {
 struct EnvSensors {
   std::vector<bool> material_enabled;  // one per material thermometer; false: disabled
   bool co2 = false;                    // a CO2 sensor feeds AirQuantity::co2_umol_per_mol
+  // Keep every sample instead of the last 2 minutes: for compensating after the run, when all
+  // of a run's samples are given first and the stops are compensated afterwards at their own
+  // times (the memory is then the run's environment samples).
+  bool keep_all_samples = false;
 };
 
 struct EnvHealth {
@@ -88,14 +98,43 @@ class EnvStage {
     bool stale_reported = false;
     bool required = true;  // checked for staleness (the optional CO2 without a sensor is not)
     bool enabled = true;   // a disabled material sensor is ignored
-    // The value at t: interpolated, held (newest), or nullopt (none / stale).
-    std::optional<double> at(std::int64_t t, std::int64_t stale_ns, bool& held) const;
+    // The value at t: interpolated, held (newest), or false (none / stale). Out-parameters
+    // rather than an optional: this runs several times per 10 kHz reading.
+    bool at(std::int64_t t, std::int64_t stale_ns, bool& held, double& value) const;
   };
   void add(Series& s, std::int64_t t, double v);
   void check_series(Series& s, std::int64_t t, EnvHealth& h);
 
+  // The refractive index of the last air state (see the cost note above).
+  struct IndexCache {
+    bool valid = false;
+    double key[4] = {};  // temperature, pressure, humidity, CO2 as given to the equation
+    double n = 1.0;
+  };
+  double refractive_index(const double (&air)[4]) const;
+  // The same for the combined factor, which depends on n and the material temperature only.
+  struct FactorCache {
+    bool valid = false;
+    double n = 0.0, material_degc = 0.0;
+    double total_ppm = 0.0;
+  };
+  double factor_ppm(double n, double material_degc) const;
+  // While a reading is newer than every sensor's newest sample and no sensor goes stale, the
+  // environment is held: constant. It is then computed once and kept for that time interval
+  // (until the next sample or a staleness), and each reading only divides by it.
+  struct HeldCache {
+    bool valid = false;
+    std::int64_t after_ns = 0, until_ns = 0;  // valid for after_ns < t <= until_ns
+    Compensated environment;                  // everything but time, raw and length
+  };
+  Compensated environment_at(std::int64_t t) const;
+
   EnvironmentConfig config_;
   air::Equation equation_;
+  bool keep_all_ = false;
+  mutable IndexCache index_cache_;
+  mutable FactorCache factor_cache_;
+  mutable HeldCache held_cache_;
   std::int64_t stale_ns_;
   Series air_[4];
   std::vector<Series> material_;

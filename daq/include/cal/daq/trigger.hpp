@@ -73,7 +73,7 @@ class StabilityTrigger {
 
   TriggerSettings s_;
   std::int64_t dwell_ns_, approach_ns_;
-  std::vector<double> expected_mm_;  // sorted; empty: any position
+  std::vector<double> expected_mm_;                      // sorted; empty: any position
   std::deque<std::pair<std::int64_t, double>> window_;   // the current candidate window
   std::deque<std::pair<std::int64_t, double>> history_;  // approach_s of past positions
   // Monotonic deques of the window's min and max (O(1) per reading at 10 kHz), keyed by the
@@ -98,10 +98,15 @@ Approach approach_from(const std::deque<std::pair<std::int64_t, double>>& histor
 // says when the axis is at a target and still; the laser readings of that time make the
 // capture. Feed and laser carry timestamps of the same clock (the service's).
 struct PositionTriggerSettings {
-  double tolerance_um = 1.0;  // |fed position - target| and the stillness band of the feed
-  double dwell_s = 1.5;       // how long the feed must be still at the target
-  double approach_s = 10.0;   // how far back the approach direction is looked for
+  double tolerance_um = 1.0;      // |fed position - target| and the stillness band of the feed
+  double dwell_s = 1.5;           // how long the feed must be still at the target
+  double approach_s = 10.0;       // how far back the approach direction is looked for
   double average_fraction = 0.5;  // as TriggerSettings: the newest part of the window only
+  // The feed sends a position only when it changes (an MTConnect adapter): its last sample
+  // holds until the next, so a machine dwelling at a target is still for as long as the
+  // laser reads, not only until the feed's last sample. False for a periodic feed
+  // (halsampler), whose newest sample bounds the stop (the axis may move after it).
+  bool feed_holds = false;
 };
 
 class PositionTrigger {

@@ -70,11 +70,22 @@ struct Backoff {
   int max_attempts = -1;  // -1: forever; otherwise give up (state closed) after that many
 };
 
+// What a device says that is not a reading, with its own number and text where it has them
+// (an IDS3010's error or warning number and errorNumberToString text, a TEMPer's firmware).
+struct DeviceMessage {
+  enum class Severity : std::uint8_t { info, warning, error };
+  Severity severity = Severity::info;
+  std::int64_t code = 0;  // the device's number; 0 when it has none
+  std::string text;
+};
+std::string_view to_string(DeviceMessage::Severity s);
+
 struct InstrumentEvents {
   std::function<void(const Reading&)> reading;
   std::function<void(InstrumentState, std::string_view why)> state;
   std::function<void(const Gap&)> gap;
   std::function<void(const codec::CodecError&)> codec_error;
+  std::function<void(const DeviceMessage&)> message;
 };
 
 // Monotonic nanoseconds. The default is the steady clock; replay substitutes the recorded

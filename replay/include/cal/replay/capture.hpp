@@ -28,7 +28,8 @@ class CaptureError : public std::runtime_error {
 };
 
 // CRC-32C (Castagnoli, reflected, poly 0x82F63B78), as used by iSCSI and ext4; the check
-// value of "123456789" is 0xE3069283.
+// value of "123456789" is 0xE3069283. The implementation is cal::crc32c
+// (cal/analysis/crc32c.hpp: the CPU's CRC32 instruction where there is one).
 std::uint32_t crc32c(std::span<const std::byte> data, std::uint32_t crc = 0);
 
 enum class RecordKind : std::uint8_t {
@@ -42,6 +43,18 @@ struct Record {
   std::uint16_t device = 0;
   RecordKind kind = RecordKind::received;
   std::vector<std::byte> bytes;
+  std::string_view text() const {
+    return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+  }
+};
+
+// A record read in place: `bytes` points into the reader's current block and stays valid
+// until the reader's next call of next() or next_view(). No allocation per record.
+struct RecordView {
+  std::int64_t time_ns = 0;
+  std::uint16_t device = 0;
+  RecordKind kind = RecordKind::received;
+  std::span<const std::byte> bytes;
   std::string_view text() const {
     return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
   }
@@ -117,6 +130,8 @@ class CaptureReader {
   // The next record, or nullopt at the end of the file or at damage (then damage() says
   // what and where; every record before it has been returned).
   std::optional<Record> next();
+  // The same without copying the bytes (see RecordView for how long they stay valid).
+  std::optional<RecordView> next_view();
   const std::optional<Damage>& damage() const;
   std::uint64_t records_read() const;
   const std::filesystem::path& path() const;

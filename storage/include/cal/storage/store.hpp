@@ -26,7 +26,10 @@ class StoreError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-inline constexpr int schema_version = 3;
+// 1: the first schema. 2: results carry their provenance; missed stops; the runs' time origin.
+// 3: reading chunks carry an encoding, a sequence number in their run and a checksum
+// (docs/storage.md). 4: ballbar calibrations (issue 18).
+inline constexpr int schema_version = 4;
 
 enum class RunStatus { running, complete, incomplete, aborted };
 std::string_view to_string(RunStatus s);
@@ -141,13 +144,25 @@ struct StoreOptions {
   // A cap on the file size in pages (0: none). SQLite then fails a write exactly as on a full
   // disk ("database or disk is full"), which is how the tests exercise that path.
   std::int64_t max_pages = 0;
+  // Open for reading only: the file must exist and be a caldaq database; nothing is written
+  // at open or after (no migration, no marking of interrupted runs, no journal mode change),
+  // so it works on a full disk and on a read-only medium. An older schema is read as it is.
+  // Every writing method then throws StoreError.
+  bool read_only = false;
 };
+
+class ReadingStream;
 
 class Store {
  public:
   // Opens or creates the database, migrates it to schema_version, and marks runs left
   // `running` by a crashed session as `incomplete`. Throws StoreError (file named) when the
-  // file is not a database, is from a newer version, or cannot be written.
+  // file is not a database, is another program's SQLite database, is from a newer version,
+  // or cannot be written.
+  //
+  // With options.read_only: opens an existing caldaq database without writing anything (see
+  // StoreOptions::read_only); a missing file is an error naming the path. Runs whose writing
+  // process is gone are shown `incomplete` without being marked so in the file.
   explicit Store(const std::filesystem::path& path, StoreOptions options = {});
   ~Store();
   Store(Store&&) noexcept;
@@ -155,6 +170,7 @@ class Store {
 
   const std::filesystem::path& path() const;
   int version() const;  // the schema version found on disk after migration
+  bool read_only() const;
 
   std::int64_t add_machine(const MachineRecord& m);
   std::optional<MachineRecord> machine_by_name(std::string_view name) const;
@@ -168,15 +184,33 @@ class Store {
   std::optional<RunRecord> run(std::int64_t run_id) const;
   std::vector<InstrumentRecord> instruments(std::int64_t run_id) const;
 
-  // Appends readings in one transaction (chunked by device/channel/quantity).
+  // Appends readings in one transaction: one chunk per device/channel/quantity, each with its
+  // sequence number in the run and its checksum (chunk.hpp).
   void append_readings(std::int64_t run_id, std::span<const RawReading> readings);
-  // All readings of a run in time order (stable for equal times).
+
+  // A run's readings in order, a batch at a time, in bounded memory (see ReadingStream): the
+  // way to read a long run. Order: time, then device, channel, quantity; readings of one
+  // series with equal times in the order they were stored. `quantities` (cal::drivers::Quantity
+  // values; empty: all) selects whole series, e.g. the environment of a long laser run.
+  // Every chunk's checksum is verified as it is read; a damaged chunk throws StoreError naming
+  // the run and the chunk. The stream uses this store's connection: it must not outlive it.
+  ReadingStream stream_readings(std::int64_t run_id,
+                                std::span<const std::uint8_t> quantities = {}) const;
+  // All readings of a run (or of these quantities) at once, in the same order: for runs known
+  // to be short. The memory is the run's size; prefer stream_readings.
   std::vector<RawReading> readings(std::int64_t run_id) const;
-  // Only the readings of these quantities (cal::drivers::Quantity values), in time order: the
-  // environment of a long laser run without loading its millions of laser readings.
   std::vector<RawReading> readings(std::int64_t run_id,
                                    std::span<const std::uint8_t> quantities) const;
   std::int64_t reading_count(std::int64_t run_id) const;
+  // The series of a run (one per device, channel and quantity) with their counts and time
+  // spans, from the chunks' rows alone (no reading is decoded): what a reader needs to know
+  // before it streams, e.g. how far to thin a series for a plot.
+  struct Series {
+    std::uint16_t device = 0;
+    std::uint8_t channel = 0, quantity = 0;
+    std::int64_t count = 0, first_ns = 0, last_ns = 0;
+  };
+  std::vector<Series> series(std::int64_t run_id) const;
 
   void add_targets(std::span<const CapturedTarget> targets);
   std::vector<CapturedTarget> targets(std::int64_t run_id) const;
@@ -208,8 +242,31 @@ class Store {
   std::optional<BarCalibration> bar_calibration(std::string_view bar, double nominal_mm,
                                                 std::int64_t at_unix_ms) const;
 
+  struct Impl;  // implementation, shared with ReadingStream (store.cpp)
+
  private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// A run's readings in order (see Store::stream_readings). The chunks are merged in the order
+// of their first times, so only the chunks that overlap the current time are held: for a run
+// written by the batch writer, one chunk per series (16384 readings each at most), whatever
+// the run's length.
+class ReadingStream {
+ public:
+  ~ReadingStream();
+  ReadingStream(ReadingStream&&) noexcept;
+  ReadingStream& operator=(ReadingStream&&) noexcept;
+
+  // Replaces `out` with the next readings, at most max_readings (> 0); false when none are
+  // left (out is then empty). Throws StoreError when a chunk is damaged or missing.
+  bool next(std::vector<RawReading>& out, std::size_t max_readings = 65536);
+  std::uint64_t chunks_read() const;
+
+ private:
+  friend class Store;
   struct Impl;
+  explicit ReadingStream(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

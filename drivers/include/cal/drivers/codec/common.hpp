@@ -3,8 +3,11 @@
 // typed frames out; no I/O, no clock, no threads, no exceptions on bad bytes. Each bad input
 // is counted in CodecStats and reported as a CodecError event (kind, stream offset, text) so
 // the instrument layer can log it; the codec then resynchronises and carries on.
+#include <algorithm>
+#include <charconv>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <span>
 #include <string>
@@ -86,6 +89,9 @@ class CodecBase {
     ++stats_.frames;
     frames.push_back(std::move(frame));
   }
+  // For a codec's own frame-less fast path (bytes in, values to a callback).
+  void count_bytes(std::size_t n) { stats_.bytes += n; }
+  void count_frame() { ++stats_.frames; }
 
  private:
   CodecStats stats_;
@@ -96,6 +102,10 @@ class CodecBase {
 // CR-LF and CR-only devices all work) and empty lines are skipped. A line longer than
 // max_line_bytes is reported once through on_overlong(start_offset) and discarded up to the
 // next terminator, where the splitter resynchronises.
+//
+// Cost: the terminators are found with memchr over the chunk (each byte is scanned at most
+// once for CR and once for LF), and a line that lies wholly inside one chunk is handed to
+// on_line in place; only a line split across chunks is copied into the buffer.
 class LineSplitter {
  public:
   static constexpr std::size_t default_max_line_bytes = 4096;
@@ -104,25 +114,43 @@ class LineSplitter {
   template <class OnLine, class OnOverlong>
   void feed(std::span<const std::byte> bytes, OnLine&& on_line, OnOverlong&& on_overlong) {
     const std::string_view chars = as_chars(bytes);
-    std::size_t i = 0;
-    while (i < chars.size()) {
-      const std::size_t eol = chars.find_first_of("\r\n", i);
-      const std::size_t end = eol == std::string_view::npos ? chars.size() : eol;
-      append(chars.substr(i, end - i), on_overlong);
-      if (eol == std::string_view::npos) {
-        offset_ += end - i;
+    const std::size_t n = chars.size();
+    std::size_t i = 0, cr = 0, lf = 0;
+    bool searched = false;
+    while (i < n) {
+      // The next CR and the next LF at or after i (n: none in the rest of the chunk).
+      if (!searched || cr < i) cr = find_from(chars, i, '\r');
+      if (!searched || lf < i) lf = find_from(chars, i, '\n');
+      searched = true;
+      const std::size_t eol = std::min(cr, lf);
+      if (eol == n) {  // no terminator: the line continues in the next chunk
+        append(chars.substr(i), on_overlong);
+        offset_ += n - i;
         break;
       }
-      offset_ += end - i + 1;
-      i = end + 1;
-      if (!discarding_ && !buffer_.empty()) on_line(std::string_view(buffer_), line_start_);
+      const std::string_view piece = chars.substr(i, eol - i);
+      if (buffer_.empty() && !discarding_) {
+        if (piece.size() > max_line_bytes_)
+          on_overlong(line_start_);
+        else if (!piece.empty())
+          on_line(piece, line_start_);
+      } else {
+        append(piece, on_overlong);
+        if (!discarding_ && !buffer_.empty()) on_line(std::string_view(buffer_), line_start_);
+      }
       buffer_.clear();
       discarding_ = false;
+      offset_ += eol - i + 1;
       line_start_ = offset_;
+      i = eol + 1;
     }
   }
 
  private:
+  static std::size_t find_from(std::string_view s, std::size_t from, char c) {
+    const void* hit = std::memchr(s.data() + from, c, s.size() - from);
+    return hit ? static_cast<std::size_t>(static_cast<const char*>(hit) - s.data()) : s.size();
+  }
   template <class OnOverlong>
   void append(std::string_view piece, OnOverlong& on_overlong) {
     if (discarding_) return;
@@ -149,7 +177,20 @@ bool is_printable_ascii(std::string_view line);
 // nullopt if anything is left over or nothing is a number.
 std::optional<double> parse_number(std::string_view s);
 
+// Parses the whole of `s` as an integer of type Int (no leading '+'); nullopt if anything is
+// left over, nothing is a number, or it does not fit.
+template <class Int>
+std::optional<Int> parse_integer(std::string_view s) {
+  Int v{};
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || p != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
 // Splits at runs of spaces and tabs; no empty tokens.
 std::vector<std::string_view> split_whitespace(std::string_view s);
+// The same without allocating: the first out.size() tokens go to `out`; returns how many
+// tokens there are in all (more than out.size() when some did not fit).
+std::size_t split_whitespace(std::string_view s, std::span<std::string_view> out);
 
 }  // namespace cal::drivers::codec

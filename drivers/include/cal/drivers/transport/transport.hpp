@@ -105,4 +105,15 @@ struct TcpSettings {
 
 std::unique_ptr<Transport> make_tcp(boost::asio::io_context& io, TcpSettings settings);
 
+// --- Transport text, as configurations and capture headers write it ---------------------------
+
+// "tcp HOST:PORT", "serial DEVICE BAUD FRAME [FLOW]", "hid VID:PID" (hex, as lsusb prints it) or
+// "hid /dev/hidrawN". Checks the text without opening anything; throws cal::InputError
+// "'TEXT': expected ..." naming what is wrong.
+void check_transport_text(std::string_view text);
+// The transport the text names (checked as above). hid_interface picks the interface of a
+// VID:PID device (-1: any).
+std::unique_ptr<Transport> make_transport(boost::asio::io_context& io, std::string_view text,
+                                          int hid_interface = -1);
+
 }  // namespace cal::drivers::transport

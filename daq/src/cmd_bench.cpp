@@ -1,0 +1,627 @@
+// daq bench: benchmarks of this machine (method in docs/benchmarks.md).
+//
+// daq bench ingest: the end-to-end ingest benchmark with its ceilings measured in the same run.
+//
+//   1. A capture of `seconds` of a 10 kHz length stream (ten 13-byte gauge lines per 1 ms
+//      record, as a USB-serial gauge or interferometer delivers them) plus 1 Hz PTU300 air
+//      lines is written once.
+//   2. Each round replays it as fast as possible through the real replay bus, the real gauge
+//      and PTU300 instruments (codecs, state machines), the environmental compensation of every
+//      length reading and the batch writer into a fresh SQLite store (WAL, synchronous=FULL).
+//   3. In the same round, the two ceilings for the bytes that ingest stored:
+//      - blob insert: the very rows ingest wrote (every column, the chunk BLOBs as stored) are
+//        inserted into a fresh store with the same schema and settings, committing at the same
+//        points (one transaction per writer batch), with nothing else to do: what SQLite
+//        itself costs for those bytes;
+//      - raw write: the same BLOB bytes written to a plain file with one fdatasync per commit.
+//      The rows are read from the ingest database untimed, one commit's worth at a time.
+//   4. Also the pipeline alone (no storage) for where the time goes.
+// Rounds alternate ingest and ceilings so that a change of load on the machine touches both;
+// the fraction is the median of the per-round ratios.
+//
+// daq bench export: memory and time after the run. A store is filled with runs of a 10 kHz
+// length stream plus 1 Hz air (temperature, pressure, humidity), written as the batch writer
+// writes them, of 1/k ... k/k of the given length; `daq export` (CSV and JSON) and `daq report`
+// are run on each as child processes of this same binary, and each child's peak RSS (wait4)
+// and wall time are reported: flat memory and linear time are what is asked.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sqlite3.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <boost/asio/io_context.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/error.hpp"
+#include "cal/daq/env_stage.hpp"
+#include "cal/drivers/registry.hpp"
+#include "cal/replay/capture.hpp"
+#include "cal/replay/session.hpp"
+#include "cal/storage/chunk.hpp"
+#include "cal/storage/store.hpp"
+#include "cal/storage/writer.hpp"
+#include "commands.hpp"
+
+namespace daq {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+long peak_rss_kib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+long current_rss_kib() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * (::sysconf(_SC_PAGESIZE) / 1024);
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void remove_db(const fs::path& p) {
+  for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
+}
+
+// Removes the benchmark's files when it ends, also by an error (they can be hundreds of MB).
+struct Cleanup {
+  std::vector<fs::path> files;
+  explicit Cleanup(std::vector<fs::path> f) : files(std::move(f)) {}
+  Cleanup(const Cleanup&) = delete;
+  Cleanup& operator=(const Cleanup&) = delete;
+  ~Cleanup() {
+    std::error_code ec;
+    for (const auto& f : files)
+      for (const char* s : {"", "-wal", "-shm"}) fs::remove(f.string() + s, ec);
+  }
+};
+
+void write_capture(const fs::path& path, int seconds) {
+  cal::replay::CaptureWriter w(path, R"({"format": "daq bench ingest"})");
+  const auto bytes = [](const std::string& s) {
+    return std::as_bytes(std::span(s.data(), s.size()));
+  };
+  w.event(0, 0, "opened");
+  w.event(0, 1, "opened");
+  std::string chunk;
+  char line[32];
+  for (std::int64_t ms = 0; ms < seconds * 1000LL; ++ms) {
+    chunk.clear();
+    for (int k = 0; k < 10; ++k) {
+      std::snprintf(line, sizeof line, "%+011.6f\r\n",
+                    100.0 + 1e-6 * static_cast<double>((ms * 10 + k) % 977));
+      chunk += line;
+    }
+    w.record(ms * 1'000'000, 0, cal::replay::RecordKind::received, bytes(chunk));
+    if (ms % 1000 == 0)
+      w.record(ms * 1'000'000, 1, cal::replay::RecordKind::received,
+               bytes("P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n"));
+  }
+  w.close();
+}
+
+struct IngestResult {
+  std::uint64_t readings = 0;
+  double wall_s = 0.0, cpu_s = 0.0;
+  double checksum = 0.0;  // sum of the compensated lengths: the same in every round and version
+  cal::storage::WriterStats writer;
+  std::vector<std::pair<int, long>> rss_marks;  // (recorded minute, current RSS KiB)
+};
+
+// The ingest pipeline; `db` empty: the pipeline alone, readings go nowhere.
+IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t batch_readings) {
+  IngestResult res;
+  std::int64_t run = 0;
+  std::unique_ptr<cal::storage::BatchWriter> writer;
+  if (!db.empty()) {
+    run = cal::storage::Store(db).begin_run({.kind = "bench"});
+    writer = std::make_unique<cal::storage::BatchWriter>(
+        db, run, cal::storage::WriterOptions{.batch_readings = batch_readings});
+  }
+  boost::asio::io_context io;
+  cal::replay::ReplayBus bus(io, capture, 0.0);
+  cal::daq::EnvStage env({}, 0);
+  std::int64_t next_mark_ns = 600'000'000'000;
+  const auto on_reading = [&](const cal::drivers::Reading& r) {
+    ++res.readings;
+    if (writer)
+      writer->push({.time_ns = r.time_ns,
+                    .device = r.device,
+                    .channel = r.channel,
+                    .quantity = static_cast<std::uint8_t>(r.quantity),
+                    .status = static_cast<std::uint8_t>(r.status),
+                    .value = r.value});
+    switch (r.quantity) {
+      case cal::drivers::Quantity::air_temperature_degc:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
+      case cal::drivers::Quantity::air_pressure_pa:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa, r.value);
+      case cal::drivers::Quantity::air_humidity_pct:
+        return env.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value);
+      case cal::drivers::Quantity::length_m:
+        res.checksum += env.compensate(r.time_ns, r.value).length_m;
+        if (r.time_ns >= next_mark_ns) {
+          res.rss_marks.emplace_back(static_cast<int>(r.time_ns / 60'000'000'000),
+                                     current_rss_kib());
+          next_mark_ns += 600'000'000'000;
+        }
+        return;
+      default:
+        return;
+    }
+  };
+  // The benchmark's workload is a line gauge and a PTU300 with their default options, made by
+  // the registry as a run makes them.
+  const auto instrument = [&](std::string_view driver, std::uint16_t device, const char* role) {
+    const auto& d = cal::drivers::driver(driver);
+    return d.make_instrument(io, bus.transport(device, role),
+                             {.device = device, .clock = bus.clock(), .replay = true},
+                             cal::drivers::options_from_text(d, {}), {.role = role});
+  };
+  auto laser = instrument("gauge", std::uint16_t{0}, "laser");
+  auto air = instrument("ptu300", std::uint16_t{1}, "air");
+  laser->start({.reading = on_reading});
+  air->start({.reading = on_reading});
+  bool done = false;
+  const double cpu0 = cpu_seconds();
+  const auto t0 = Clock::now();
+  bus.start([&](const cal::replay::ReplayEnd&) { done = true; });
+  while (!done) io.run_one();
+  if (writer) {
+    writer->flush();
+    res.writer = writer->stats();
+  }
+  res.wall_s = seconds_since(t0);
+  res.cpu_s = cpu_seconds() - cpu0;
+  return res;
+}
+
+struct SqliteDb {
+  sqlite3* db = nullptr;
+  explicit SqliteDb(const fs::path& p) {
+    if (sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK)
+      throw cal::InputError(fmt::format("{}: cannot open: {}", p.string(), sqlite3_errmsg(db)));
+    sqlite3_busy_timeout(db, 5000);
+  }
+  ~SqliteDb() { sqlite3_close_v2(db); }
+  SqliteDb(const SqliteDb&) = delete;
+  SqliteDb& operator=(const SqliteDb&) = delete;
+  void exec(const char* sql) const {
+    if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) != SQLITE_OK)
+      throw cal::InputError(fmt::format("bench: {}: {}", sql, sqlite3_errmsg(db)));
+  }
+};
+
+struct Stmt {
+  sqlite3_stmt* s = nullptr;
+  Stmt(const SqliteDb& db, const std::string& sql) {
+    if (sqlite3_prepare_v2(db.db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK)
+      throw cal::InputError(fmt::format("bench: {}: {}", sql, sqlite3_errmsg(db.db)));
+  }
+  ~Stmt() { sqlite3_finalize(s); }
+  Stmt(const Stmt&) = delete;
+  Stmt& operator=(const Stmt&) = delete;
+};
+
+// One stored chunk row, every column as SQLite holds it.
+struct Row {
+  std::vector<sqlite3_value*> values;
+  Row() = default;
+  Row(const Row&) = delete;
+  Row& operator=(const Row&) = delete;
+  Row(Row&& o) noexcept : values(std::move(o.values)) {}
+  ~Row() {
+    for (auto* v : values) sqlite3_value_free(v);
+  }
+};
+
+// Reads the chunk rows of the ingest database in the order they were written, one commit's
+// worth (`batch_readings` readings, as the writer cut them) per call.
+class ChunkSource {
+ public:
+  ChunkSource(const fs::path& db, std::size_t batch_readings)
+      : db_(db), batch_(batch_readings), stmt_(db_, "SELECT * FROM reading_chunks ORDER BY id") {
+    columns_ = sqlite3_column_count(stmt_.s);
+    for (int i = 0; i < columns_; ++i) {
+      names_.push_back(sqlite3_column_name(stmt_.s, i));
+      if (names_.back() == "count") count_column_ = i;
+      if (names_.back() == "data") data_column_ = i;
+    }
+  }
+  const std::vector<std::string>& names() const { return names_; }
+  int data_column() const { return data_column_; }
+  bool next_commit(std::vector<Row>& rows) {
+    rows.clear();
+    std::size_t readings = 0;
+    // (A statement stepped after SQLITE_DONE starts again from the first row.)
+    while (!done_ && readings < batch_) {
+      if (sqlite3_step(stmt_.s) != SQLITE_ROW) {
+        done_ = true;
+        break;
+      }
+      Row r;
+      for (int i = 0; i < columns_; ++i)
+        r.values.push_back(sqlite3_value_dup(sqlite3_column_value(stmt_.s, i)));
+      readings += static_cast<std::size_t>(sqlite3_column_int64(stmt_.s, count_column_));
+      rows.push_back(std::move(r));
+    }
+    return !rows.empty();
+  }
+
+ private:
+  SqliteDb db_;
+  std::size_t batch_;
+  Stmt stmt_;
+  int columns_ = 0, count_column_ = 0, data_column_ = 0;
+  bool done_ = false;
+  std::vector<std::string> names_;
+};
+
+struct CeilingResult {
+  double seconds = 0.0;
+  std::uint64_t commits = 0, bytes = 0;
+};
+
+// The same rows into a fresh store (same schema and settings), same commits, nothing else.
+// The schema-1 form of a stored chunk: its readings as 17-byte records (for the comparison
+// of what the denser encoding does to the ceiling).
+std::vector<unsigned char> as_schema1(const ChunkSource& src, const Row& r) {
+  const auto value = [&](const char* name) {
+    const auto& names = src.names();
+    const auto i =
+        static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+    return r.values.at(i);
+  };
+  auto* data = value("data");
+  std::vector<cal::storage::RawReading> readings;
+  cal::storage::chunk::decode(sqlite3_value_int(value("encoding")),
+                              {static_cast<const unsigned char*>(sqlite3_value_blob(data)),
+                               static_cast<std::size_t>(sqlite3_value_bytes(data))},
+                              static_cast<std::size_t>(sqlite3_value_int64(value("count"))), 0, 0,
+                              0, readings);
+  std::vector<unsigned char> out(readings.size() * 17);
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    std::memcpy(&out[17 * i], &readings[i].time_ns, 8);
+    out[17 * i + 8] = readings[i].status;
+    std::memcpy(&out[17 * i + 9], &readings[i].value, 8);
+  }
+  return out;
+}
+
+// schema1: the chunks' BLOBs replaced by the 17-byte records of schemas 1 and 2 (prepared untimed).
+CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t batch,
+                           bool schema1 = false) {
+  { cal::storage::Store(to).begin_run({.kind = "bench"}); }
+  ChunkSource src(from, batch);
+  SqliteDb dst(to);
+  dst.exec("PRAGMA synchronous=FULL");
+  std::string sql = "INSERT INTO reading_chunks VALUES(";
+  for (std::size_t i = 0; i < src.names().size(); ++i) sql += i ? ", ?" : "?";
+  sql += ")";
+  Stmt insert(dst, sql);
+  Stmt begin(dst, "BEGIN IMMEDIATE"), commit(dst, "COMMIT");
+  CeilingResult res;
+  std::vector<Row> rows;
+  std::vector<std::vector<unsigned char>> old_blobs;
+  const auto data_column = static_cast<std::size_t>(src.data_column());
+  while (src.next_commit(rows)) {
+    old_blobs.clear();
+    if (schema1)
+      for (const auto& r : rows) old_blobs.push_back(as_schema1(src, r));
+    const auto t0 = Clock::now();
+    sqlite3_step(begin.s);
+    sqlite3_reset(begin.s);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const auto& r = rows[k];
+      for (std::size_t i = 0; i < r.values.size(); ++i) {
+        if (schema1 && i == data_column) {
+          sqlite3_bind_blob64(insert.s, static_cast<int>(i + 1), old_blobs[k].data(),
+                              old_blobs[k].size(), SQLITE_STATIC);
+          res.bytes += old_blobs[k].size();
+        } else {
+          sqlite3_bind_value(insert.s, static_cast<int>(i + 1), r.values[i]);
+        }
+      }
+      if (sqlite3_step(insert.s) != SQLITE_DONE)
+        throw cal::InputError(
+            fmt::format("bench: blob ceiling insert: {}", sqlite3_errmsg(dst.db)));
+      sqlite3_reset(insert.s);
+    }
+    if (sqlite3_step(commit.s) != SQLITE_DONE)
+      throw cal::InputError(fmt::format("bench: blob ceiling commit: {}", sqlite3_errmsg(dst.db)));
+    sqlite3_reset(commit.s);
+    res.seconds += seconds_since(t0);
+    ++res.commits;
+  }
+  return res;
+}
+
+// The chunk BLOB bytes to a plain file, one fdatasync per commit.
+CeilingResult raw_ceiling(const fs::path& from, const fs::path& to, std::size_t batch) {
+  ChunkSource src(from, batch);
+  const int fd = ::open(to.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw cal::InputError(fmt::format("{}: cannot create", to.string()));
+  CeilingResult res;
+  std::vector<Row> rows;
+  while (src.next_commit(rows)) {
+    const auto t0 = Clock::now();
+    for (const auto& r : rows) {
+      auto* v = r.values[static_cast<std::size_t>(src.data_column())];
+      const auto n = static_cast<std::size_t>(sqlite3_value_bytes(v));
+      if (::write(fd, sqlite3_value_blob(v), n) != static_cast<ssize_t>(n)) {
+        ::close(fd);
+        throw cal::InputError(fmt::format("{}: write failed", to.string()));
+      }
+      res.bytes += n;
+    }
+    ::fdatasync(fd);
+    res.seconds += seconds_since(t0);
+    ++res.commits;
+  }
+  ::close(fd);
+  return res;
+}
+
+struct BenchOptions {
+  int seconds = 600;
+  int rounds = 3;
+  std::string dir;
+  std::size_t batch_readings = 16384;
+};
+
+void bench_ingest(const BenchOptions& o) {
+  if (o.seconds < 1 || o.rounds < 1)
+    throw cal::InputError("bench ingest: --seconds and --rounds must be at least 1");
+  if (o.batch_readings < 1 || o.batch_readings > 10'000'000)
+    throw cal::InputError(
+        fmt::format("bench ingest: --batch {}: expected 1 to 10000000 readings", o.batch_readings));
+  const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
+  const auto tag = std::to_string(::getpid());
+  const fs::path capture = dir / ("caldaq-bench-" + tag + ".cdq");
+  const fs::path db = dir / ("caldaq-bench-" + tag + ".sqlite");
+  const fs::path copy = dir / ("caldaq-bench-ceiling-" + tag + ".sqlite");
+  const fs::path raw = dir / ("caldaq-bench-raw-" + tag + ".bin");
+  const Cleanup cleanup({capture, db, copy, raw});
+
+  auto t0 = Clock::now();
+  write_capture(capture, o.seconds);
+  fmt::print(
+      "capture: {} s of a 10 kHz gauge stream and 1 Hz PTU300 lines, {:.1f} MB, written "
+      "in {:.2f} s\n",
+      o.seconds, static_cast<double>(fs::file_size(capture)) / 1e6, seconds_since(t0));
+
+  std::vector<double> ingest_rate, blob_rate, raw_rate, pipeline_rate, ratio_blob, ratio_raw;
+  std::vector<double> blob17_rate;
+  double bytes_per_reading = 0.0, file_bytes_per_reading = 0.0;
+  std::vector<double> per_core;
+  for (int round = 1; round <= o.rounds; ++round) {
+    remove_db(db);
+    const auto in = ingest(capture, db, o.batch_readings);
+    const auto n = static_cast<double>(in.readings);
+    remove_db(copy);
+    const auto blob = blob_ceiling(db, copy, o.batch_readings);
+    remove_db(copy);
+    const auto blob17 = blob_ceiling(db, copy, o.batch_readings, true);
+    const auto bare = raw_ceiling(db, raw, o.batch_readings);
+    const auto alone = ingest(capture, {}, o.batch_readings);
+    bytes_per_reading = static_cast<double>(bare.bytes) / n;
+    file_bytes_per_reading =
+        static_cast<double>(fs::file_size(db) + (fs::exists(db.string() + "-wal")
+                                                     ? fs::file_size(db.string() + "-wal")
+                                                     : 0)) /
+        n;
+    ingest_rate.push_back(n / in.wall_s);
+    blob_rate.push_back(n / blob.seconds);
+    blob17_rate.push_back(n / blob17.seconds);
+    raw_rate.push_back(n / bare.seconds);
+    pipeline_rate.push_back(n / alone.wall_s);
+    ratio_blob.push_back(blob.seconds / in.wall_s);
+    ratio_raw.push_back(bare.seconds / in.wall_s);
+    per_core.push_back(n / in.cpu_s);
+    fmt::print(
+        "round {}: ingest {:.0f} readings/s ({} readings in {:.2f} s, CPU {:.2f} s, {} commits, "
+        "producer waits {}); blob-insert ceiling {:.0f}/s ({} commits; {:.0f}/s with schema-1 "
+        "records); raw write ceiling {:.0f}/s; pipeline without storage {:.0f}/s; checksum "
+        "{:.6f}\n",
+        round, n / in.wall_s, in.readings, in.wall_s, in.cpu_s, in.writer.batches_committed,
+        in.writer.overload_waits, n / blob.seconds, blob.commits, n / blob17.seconds,
+        n / bare.seconds, n / alone.wall_s, in.checksum);
+    if (in.writer.readings_committed != in.readings)
+      throw cal::InputError(fmt::format("bench: {} readings ingested but {} committed", in.readings,
+                                        in.writer.readings_committed));
+    if (round == 1) {
+      std::string marks;
+      for (const auto& [minute, kib] : in.rss_marks)
+        marks += fmt::format("{}{} min: {} KiB", marks.empty() ? "" : ", ", minute, kib);
+      fmt::print("  RSS at each 10 minutes of recorded time: {}; peak RSS {} KiB\n",
+                 marks.empty() ? "(run shorter than 10 min)" : marks, peak_rss_kib());
+    }
+  }
+  fmt::print(
+      "\nmedians over {} rounds:\n"
+      "  ingest                    {:>12.0f} readings/s\n"
+      "  blob-insert ceiling       {:>12.0f} readings/s  ingest reaches {:.0f} % of it\n"
+      "  raw write ceiling         {:>12.0f} readings/s  ingest reaches {:.0f} % of it\n"
+      "  pipeline without storage  {:>12.0f} readings/s\n"
+      "  (blob-insert ceiling of the same readings as schema-1 17-byte records: {:.0f} "
+      "readings/s)\n"
+      "  stored                    {:.2f} bytes/reading in the chunk BLOBs, {:.2f} in the "
+      "file: {:.0f} MB per hour of a 10 kHz channel\n"
+      "  one core (process CPU time, producer and writer threads) ingests {:.0f} readings/s: "
+      "{:.0f} channels at 10 kHz, {:.1f} at 100 kHz\n",
+      o.rounds, median(ingest_rate), median(blob_rate), 100.0 * median(ratio_blob),
+      median(raw_rate), 100.0 * median(ratio_raw), median(pipeline_rate), median(blob17_rate),
+      bytes_per_reading, file_bytes_per_reading, file_bytes_per_reading * 36e6 / 1e6,
+      median(per_core), median(per_core) / 1e4, median(per_core) / 1e5);
+}
+
+// A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
+// batches of 16384 readings as the batch writer stores them. Not timed: this is the input.
+std::int64_t generate_run(cal::storage::Store& store, int seconds) {
+  const auto run = store.begin_run({.campaign = "daq bench export",
+                                    .kind = "bench",
+                                    .axis = "X",
+                                    .settings_json = R"({"generated": "daq bench export"})"});
+  store.add_instrument({.run_id = run, .device = 0, .driver = "gauge", .transport = "generated"});
+  store.add_instrument({.run_id = run, .device = 1, .driver = "ptu300", .transport = "generated"});
+  std::vector<cal::storage::RawReading> batch;
+  batch.reserve(16384 + 3);
+  const std::int64_t n = static_cast<std::int64_t>(seconds) * 10'000;
+  for (std::int64_t i = 0; i < n; ++i) {
+    const std::int64_t t = i * 100'000;
+    batch.push_back({.time_ns = t,
+                     .quantity = 1,
+                     .value = 0.1 + 1e-6 * std::sin(1e-4 * static_cast<double>(i)) +
+                              1e-9 * static_cast<double>(i % 977)});
+    if (i % 10'000 == 0) {
+      const double s = static_cast<double>(i / 10'000);
+      batch.push_back({.time_ns = t, .device = 1, .quantity = 2, .value = 20.0 + 1e-3 * s});
+      batch.push_back({.time_ns = t, .device = 1, .quantity = 3, .value = 101325.0 - 0.1 * s});
+      batch.push_back({.time_ns = t, .device = 1, .quantity = 4, .value = 45.0 + 1e-2 * s});
+    }
+    if (batch.size() >= 16384) {
+      store.append_readings(run, batch);
+      batch.clear();
+    }
+  }
+  store.append_readings(run, batch);
+  store.finish_run(run, cal::storage::RunStatus::complete);
+  return run;
+}
+
+struct ChildResult {
+  double seconds = 0.0;
+  long peak_rss_kib = 0;
+};
+
+// Runs this daq binary with `args`, its output to /dev/null; throws unless it exits with 0.
+ChildResult run_child(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  std::string self = "/proc/self/exe";
+  argv.push_back(self.data());
+  std::vector<std::string> copy = args;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  const auto t0 = Clock::now();
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw cal::InputError(fmt::format("bench: cannot start daq: {}", std::strerror(rc)));
+  int status = 0;
+  rusage usage{};
+  if (::wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw cal::InputError(
+        fmt::format("bench: daq {} failed (status {})", fmt::join(args, " "), status));
+  return {seconds_since(t0), usage.ru_maxrss};
+}
+
+struct ExportBenchOptions {
+  int minutes = 60;
+  int steps = 4;
+  std::string dir;
+};
+
+void bench_export(const ExportBenchOptions& o) {
+  if (o.minutes < 1 || o.steps < 1)
+    throw cal::InputError("bench export: --minutes and --steps must be at least 1");
+  const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
+  const fs::path db = dir / ("caldaq-bench-export-" + std::to_string(::getpid()) + ".sqlite");
+  const fs::path html = dir / ("caldaq-bench-report-" + std::to_string(::getpid()) + ".html");
+  const Cleanup cleanup({db, html});
+  remove_db(db);
+  fmt::print("{:>8} {:>11} {:>9}  {:>16} {:>16} {:>16}\n", "minutes", "readings", "stored MB",
+             "export csv", "export json", "report (html)");
+  for (int k = 1; k <= o.steps; ++k) {
+    const int seconds = o.minutes * 60 * k / o.steps;
+    std::int64_t run = 0, count = 0;
+    const auto size_before = fs::exists(db) ? fs::file_size(db) : 0;
+    {
+      cal::storage::Store store(db, {.full_sync = false});
+      run = generate_run(store, seconds);
+      count = store.reading_count(run);
+    }
+    const double stored_mb = static_cast<double>(fs::file_size(db) - size_before) / 1e6;
+    const auto id = std::to_string(run);
+    const auto csv = run_child({"export", id, "--db", db.string(), "-o", "/dev/null"});
+    const auto json =
+        run_child({"export", id, "--db", db.string(), "--format", "json", "-o", "/dev/null"});
+    const auto report = run_child({"report", id, "--db", db.string(), "-o", html.string()});
+    const auto cell = [](const ChildResult& r) {
+      return fmt::format("{:6.2f} s {:5.0f} MB", r.seconds,
+                         static_cast<double>(r.peak_rss_kib) / 1024);
+    };
+    fmt::print("{:>8.1f} {:>11} {:>9.1f}  {:>16} {:>16} {:>16}\n", seconds / 60.0, count, stored_mb,
+               cell(csv), cell(json), cell(report));
+  }
+  fmt::print(
+      "(wall time and peak RSS of each daq process; readings per second of export: the "
+      "readings column over the time)\n");
+}
+
+}  // namespace
+
+void add_bench_commands(CLI::App& app) {
+  auto* bench = app.add_subcommand("bench", "Measure this machine: ingest throughput and ceilings");
+  bench->require_subcommand(1);
+  auto o = std::make_shared<BenchOptions>();
+  auto* in = bench->add_subcommand(
+      "ingest",
+      "Replay a generated 10 kHz capture through the real instruments, compensation and store; "
+      "measure the SQLite blob-insert and raw-write ceilings for the same bytes in the same run");
+  in->add_option("--seconds", o->seconds, "Recorded seconds of the 10 kHz stream")
+      ->capture_default_str();
+  in->add_option("--rounds", o->rounds, "Rounds (ingest then ceilings); medians are reported")
+      ->capture_default_str();
+  in->add_option("--dir", o->dir, "Directory for the capture and databases (default: $TMPDIR)");
+  in->add_option("--batch", o->batch_readings, "Readings per committed batch")
+      ->capture_default_str();
+  in->callback([o] { bench_ingest(*o); });
+
+  auto e = std::make_shared<ExportBenchOptions>();
+  auto* ex = bench->add_subcommand(
+      "export",
+      "Store generated runs of a 10 kHz stream (up to --minutes long) and measure the peak RSS "
+      "and time of daq export (CSV, JSON) and daq report on each");
+  ex->add_option("--minutes", e->minutes, "Length of the longest run")->capture_default_str();
+  ex->add_option("--steps", e->steps, "Runs of 1/steps ... steps/steps of that length")
+      ->capture_default_str();
+  ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
+  ex->callback([e] { bench_export(*e); });
+}
+
+}  // namespace daq

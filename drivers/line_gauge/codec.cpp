@@ -1,0 +1,127 @@
+// Configurable line gauge codec (see line_gauge/codec.hpp).
+#include "line_gauge/codec.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+
+#include "cal/analysis/error.hpp"
+
+namespace cal::drivers::codec {
+namespace {
+
+bool blank(char c) { return c == ' ' || c == '\t'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::optional<GaugeUnit> unit_word(std::string_view w) {
+  std::string lower;
+  for (char c : w) lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+  if (lower == "mm") return GaugeUnit::mm;
+  if (lower == "um" || lower == "µm") return GaugeUnit::um;
+  if (lower == "in" || lower == "inch" || lower == "\"") return GaugeUnit::inch;
+  if (lower == "m") return GaugeUnit::m;
+  return std::nullopt;
+}
+
+}  // namespace
+
+GaugeUnit gauge_unit_from_string(std::string_view s) {
+  if (s == "degC" || s == "degc") return GaugeUnit::degc;
+  if (s == "none") return GaugeUnit::none;
+  if (auto u = unit_word(s)) return *u;
+  throw InputError(fmt::format("gauge unit '{}' (expected mm, um, in, m, degC or none)", s));
+}
+
+GaugeCodec::GaugeCodec(GaugeConfig config)
+    : config_(std::move(config)), splitter_(config_.max_line_bytes) {
+  if (config_.pattern.empty()) return;
+  try {
+    regex_.emplace(config_.pattern, std::regex::ECMAScript | std::regex::optimize);
+  } catch (const std::regex_error& e) {
+    throw InputError(fmt::format("gauge pattern '{}': {}", config_.pattern, e.what()));
+  }
+  if (regex_->mark_count() < 1)
+    throw InputError(
+        fmt::format("gauge pattern '{}' has no capture group for the value", config_.pattern));
+}
+
+void GaugeCodec::do_feed(std::span<const std::byte> bytes, std::vector<GaugeFrame>& frames,
+                         std::vector<CodecError>& errors) {
+  splitter_.feed(
+      bytes,
+      [&](std::string_view line, std::uint64_t off) {
+        if (const auto v = decode_line(line, off, errors))
+          emit(frames, GaugeFrame{*v, std::string(line)});
+      },
+      [&](std::uint64_t off) { report_overlong(off, errors); });
+}
+
+void GaugeCodec::report_overlong(std::uint64_t off, std::vector<CodecError>& errors) {
+  report(errors, ErrorKind::overlong_line, off,
+         fmt::format("gauge: line longer than {} bytes", config_.max_line_bytes));
+}
+
+std::optional<double> GaugeCodec::to_si(double printed,
+                                        std::optional<GaugeUnit> printed_unit) const {
+  const double v = printed * config_.scale + config_.offset;
+  switch (printed_unit.value_or(config_.unit)) {
+    case GaugeUnit::mm:
+      return v * 1e-3;
+    case GaugeUnit::um:
+      return v * 1e-6;
+    case GaugeUnit::inch:
+      return v * 0.0254;  // exact, by definition (1959)
+    case GaugeUnit::m:
+      return v;
+    case GaugeUnit::degc:
+    case GaugeUnit::none:
+      return v;
+  }
+  return std::nullopt;
+}
+
+std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
+                                              std::vector<CodecError>& errors) {
+  if (!is_printable_ascii(line)) {
+    report(errors, ErrorKind::garbage, off, "gauge: non-printable bytes in a line");
+    return std::nullopt;
+  }
+  std::optional<double> number;
+  std::optional<GaugeUnit> printed_unit;
+  if (regex_) {
+    std::match_results<std::string_view::const_iterator> m;
+    if (std::regex_search(line.begin(), line.end(), m, *regex_))
+      number = parse_number(trim(m[1].str()));
+  } else {
+    std::array<std::string_view, 2> tokens;
+    const std::size_t count = split_whitespace(line, tokens);
+    if (count == 1 || count == 2) {
+      number = parse_number(tokens[0]);
+      if (count == 2) {
+        printed_unit = unit_word(tokens[1]);
+        if (!printed_unit) number.reset();
+      }
+    }
+  }
+  if (!number || !std::isfinite(*number)) {
+    report(errors, ErrorKind::malformed, off,
+           fmt::format("gauge: no value in '{}'", line.substr(0, 40)));
+    return std::nullopt;
+  }
+  const auto si = to_si(*number, printed_unit);
+  if (!si || *si < config_.min_si || *si > config_.max_si) {
+    report(
+        errors, ErrorKind::out_of_range, off,
+        fmt::format("gauge: value {} outside [{}, {}]", *number, config_.min_si, config_.max_si));
+    return std::nullopt;
+  }
+  return si;
+}
+
+}  // namespace cal::drivers::codec

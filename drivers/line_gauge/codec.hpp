@@ -1,0 +1,74 @@
+#pragma once
+// A configurable line-oriented gauge codec for digital length gauges with a serial output
+// (the transducer of a telescoping ballbar, a linear gauge, a serial thermometer): one value
+// per line, e.g. "+012.3456", "-0.00125 mm", "12.3456 MM", "T=+020.125". The request string
+// (for polled gauges), the value pattern, the unit and a scale are configuration, because
+// every maker's format differs; docs/codecs.md lists the formats this was checked on.
+#include <optional>
+#include <regex>
+#include <string>
+
+#include "cal/drivers/codec/common.hpp"
+
+namespace cal::drivers::codec {
+
+enum class GaugeUnit { mm, um, inch, m, degc, none };
+GaugeUnit gauge_unit_from_string(std::string_view s);  // mm | um | in | m | degC | none
+
+struct GaugeConfig {
+  // Sent to poll a gauge ("?\r", "PRINT\r"); empty for a gauge that streams by itself.
+  std::string request;
+  // ECMAScript regex with one capture group for the number; empty: the whole line, trimmed,
+  // optionally followed by a unit word (mm, um, in, inch), is the number.
+  std::string pattern;
+  GaugeUnit unit = GaugeUnit::mm;  // the unit of the printed number (a printed unit wins)
+  double scale = 1.0;              // applied to the printed number before the unit
+  double offset = 0.0;             // added after scaling, in the printed unit
+  // Plausible range of the value in SI (m, or degC for temperatures); outside: out_of_range.
+  double min_si = -10.0, max_si = 10.0;
+  std::size_t max_line_bytes = 256;
+};
+
+struct GaugeFrame {
+  double value_si = 0.0;  // metres (degC for temperature gauges, as printed for `none`)
+  std::string text;       // the line as received
+};
+
+class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
+ public:
+  // Throws cal::InputError for an invalid regex or one without a capture group.
+  explicit GaugeCodec(GaugeConfig config = {});
+  const GaugeConfig& config() const { return config_; }
+  void do_feed(std::span<const std::byte> bytes, std::vector<GaugeFrame>& frames,
+               std::vector<CodecError>& errors);
+  // The fast path of the instrument: each value goes to on_value(value_si, line) with the line
+  // in place (valid during the call), so a 10 kHz stream costs no frame, copy or allocation
+  // per line. Same decoding, errors and stats as feed().
+  template <class OnValue>
+  void feed_values(std::span<const std::byte> bytes, OnValue&& on_value,
+                   std::vector<CodecError>& errors) {
+    count_bytes(bytes.size());
+    splitter_.feed(
+        bytes,
+        [&](std::string_view line, std::uint64_t off) {
+          if (const auto v = decode_line(line, off, errors)) {
+            count_frame();
+            on_value(*v, line);
+          }
+        },
+        [&](std::uint64_t off) { report_overlong(off, errors); });
+  }
+
+ private:
+  // The value of one line in SI, or nullopt after reporting why not.
+  std::optional<double> decode_line(std::string_view line, std::uint64_t offset,
+                                    std::vector<CodecError>& errors);
+  void report_overlong(std::uint64_t offset, std::vector<CodecError>& errors);
+  std::optional<double> to_si(double printed, std::optional<GaugeUnit> printed_unit) const;
+
+  GaugeConfig config_;
+  std::optional<std::regex> regex_;
+  LineSplitter splitter_;
+};
+
+}  // namespace cal::drivers::codec

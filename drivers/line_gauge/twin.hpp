@@ -1,0 +1,41 @@
+#pragma once
+// SIMULATED line-oriented serial sensor on a pseudo-terminal: by default the length gauge of a
+// telescoping ballbar; with a value function, any scalar (a material thermometer). See
+// sim/twin.hpp.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "cal/drivers/sim/twin.hpp"
+
+namespace cal::drivers::sim {
+
+struct GaugeTwinConfig {
+  Vec3 pivot_mm{};                 // centre of the table ball, workpiece coordinates
+  double zero_length_mm = 100.0;   // the bar length at which the gauge reads 0
+  double sample_rate_hz = 1000.0;  // continuous output rate (simulated time)
+  bool continuous = true;          // false: one reading per request line
+  std::string request = "?";       // the request line (without its CR) in polled mode
+  int decimals = 5;                // "+000.12345": 10 nm resolution
+  // What the line carries; empty: the ballbar, length(tool, pivot) - zero_length_mm. Another
+  // function makes a serial thermometer on the structure, e.g. the machine temperature.
+  std::function<double(const World&)> value;
+};
+
+// transport(): "serial PATH 115200 8N1".
+class GaugeTwin final : public PtyTwin {
+ public:
+  GaugeTwin(boost::asio::io_context& io, World& world, Clock clock, GaugeTwinConfig config = {});
+
+  // Starts (from the current simulated time) or stops the continuous output: a bar is only
+  // mounted, and a stream only read, for its test.
+  void set_streaming(bool on);
+
+ private:
+  struct Impl;
+  explicit GaugeTwin(std::shared_ptr<Impl> impl);
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace cal::drivers::sim

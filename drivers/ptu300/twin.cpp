@@ -1,0 +1,97 @@
+// SIMULATED PTU300 (see twin.hpp): commands end with CR; answers and RUN-mode lines end with
+// CR LF. Output in the default FORM of the user's guide ("P= 1033.7 hPa T= 22.2 'C RH= 38.3
+// %RH"), with one more decimal on P and T than that example, as a FORM such as 4.2 P would print.
+#include "ptu300/twin.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+
+#include "sim/twin_io.hpp"
+
+namespace cal::drivers::sim {
+
+struct Ptu300Twin::Impl : detail::PtyChannel, std::enable_shared_from_this<Ptu300Twin::Impl> {
+  Impl(boost::asio::io_context& io, World& w, Clock c, Ptu300TwinConfig cfg)
+      : PtyChannel(io),
+        world(w),
+        clock(std::move(c)),
+        config(cfg),
+        running(cfg.start_in_run_mode) {}
+
+  std::string reading() {
+    const double now = clock();
+    world.advance_to(now);
+    const AirSample a = world.air().sample(now);
+    return fmt::format("P= {:7.2f} hPa T= {:6.2f} 'C RH= {:5.1f} %RH\r\n", a.pressure_pa / 100.0,
+                       a.temperature_degc, a.humidity_pct);
+  }
+
+  void on_command(const std::string& raw) {
+    std::string cmd;
+    for (char ch : raw)
+      cmd.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(ch))));
+    auto self = shared_from_this();
+    if (cmd == "SEND" || cmd.rfind("SEND ", 0) == 0) return pty.send(reading(), self);
+    if (cmd == "R") {
+      running = true;
+      return tick();
+    }
+    if (cmd == "S") {
+      running = false;
+      return;
+    }
+    if (cmd.rfind("SMODE", 0) == 0) {
+      const std::string mode = cmd.size() > 6 ? cmd.substr(6) : "";
+      if (!mode.empty()) running = mode == "RUN";
+      return pty.send(
+          fmt::format("Output mode   : {}\r\n", mode.empty() ? (running ? "RUN" : "STOP") : mode),
+          self);
+    }
+    if (cmd.rfind("INTV", 0) == 0) {
+      int n = 0;
+      char unit[8] = "S";
+      if (std::sscanf(cmd.c_str(), "INTV %d %7s", &n, unit) >= 1 && n >= 0 && n <= 255) {
+        const double scale = std::string(unit) == "MIN" ? 60.0
+                             : std::string(unit) == "H" ? 3600.0
+                                                        : 1.0;
+        config.interval_s = std::max(n * scale, 0.0);
+      }
+      return pty.send(fmt::format("Output intrv. : {} s\r\n", config.interval_s), self);
+    }
+    if (cmd.rfind("FORM", 0) == 0) return pty.send("OK\r\n", self);  // formats are not simulated
+    if (!cmd.empty()) pty.send("Unknown command\r\n", self);
+  }
+
+  // RUN mode: a reading every INTV (simulated time), scheduled on the wall clock through the
+  // clock's speed, measured rather than assumed.
+  void tick() {
+    if (!running || !pty.master.is_open()) return;
+    const double now = clock();
+    if (now >= next_output_s) {
+      pty.send(reading(), shared_from_this());
+      next_output_s = now + std::max(config.interval_s, 0.01);
+    }
+    timer.expires_after(std::chrono::milliseconds(5));
+    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (!ec) self->tick();
+    });
+  }
+
+  World& world;
+  Clock clock;
+  Ptu300TwinConfig config;
+  bool running = false;
+  double next_output_s = 0.0;
+};
+
+Ptu300Twin::Ptu300Twin(boost::asio::io_context& io, World& world, Clock clock,
+                       Ptu300TwinConfig config)
+    : Ptu300Twin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+Ptu300Twin::Ptu300Twin(std::shared_ptr<Impl> impl)
+    : PtyTwin(impl, "4800 7E1"), impl_(std::move(impl)) {
+  detail::read_commands(impl_);
+  impl_->tick();
+}
+
+}  // namespace cal::drivers::sim

@@ -1,0 +1,86 @@
+// SIMULATED MTConnect SHDR adapter (see twin.hpp): position lines on change, a full dump to a
+// new client, "* PONG" to "* PING".
+#include "shdr/twin.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <ctime>
+
+#include "sim/twin_io.hpp"
+
+namespace cal::drivers::sim {
+
+struct ShdrTwin::Impl : detail::TcpChannel, std::enable_shared_from_this<ShdrTwin::Impl> {
+  Impl(boost::asio::io_context& io, World& w, Clock c, ShdrTwinConfig cfg)
+      : TcpChannel(io, cfg.port), world(w), clock(std::move(c)), config(cfg) {}
+
+  void on_line(const detail::LineServer::ClientPtr& client, const std::string& line) {
+    if (!line.starts_with("* PING")) return;
+    ++pongs;
+    server->send(client, fmt::format("* PONG {}\n", config.pong_timeout_ms));
+  }
+
+  // The items as the adapter prints them now: a line of those that differ from `last` (all
+  // of them when `all`), or "" when none does.
+  std::string line(bool all) {
+    world.advance_to(clock());
+    const auto& c = world.state().commanded_mm;
+    std::string items;
+    for (std::size_t a = 0; a < 3; ++a) {
+      std::string value = fmt::format("{:.4f}", c[a]);
+      if (all || value != last[a]) items += fmt::format("|{}|{}", config.keys[a], value);
+      last[a] = std::move(value);
+    }
+    if (items.empty()) return {};
+    return timestamp() + items + "\n";
+  }
+
+  static std::string timestamp() {
+    const auto now = std::chrono::system_clock::now();
+    const auto us = std::chrono::duration_cast<std::chrono::microseconds>(now.time_since_epoch());
+    const std::time_t s = static_cast<std::time_t>(us.count() / 1'000'000);
+    std::tm tm{};
+    gmtime_r(&s, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+    return fmt::format("{}.{:06}Z", buf, us.count() % 1'000'000);
+  }
+
+  void tick() {
+    timer.expires_after(config.period);
+    timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (ec) return;
+      if (self->server->has_clients())
+        if (auto l = self->line(false); !l.empty()) {
+          self->server->broadcast(l);
+          self->sent += self->server->clients();
+        }
+      self->tick();
+    });
+  }
+
+  World& world;
+  Clock clock;
+  ShdrTwinConfig config;
+  std::uint64_t sent = 0, pongs = 0;
+  std::array<std::string, 3> last;  // the values last sent
+};
+
+ShdrTwin::ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config)
+    : ShdrTwin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+ShdrTwin::ShdrTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(impl)) {
+  impl_->server->start(
+      [impl = impl_.get()](const detail::LineServer::ClientPtr& client, const std::string& line) {
+        impl->on_line(client, line);
+      },
+      [impl = impl_.get()](const detail::LineServer::ClientPtr& client) {
+        impl->server->send(client, impl->line(true));  // a new agent first gets every item
+        ++impl->sent;
+      });
+  impl_->tick();
+}
+std::uint64_t ShdrTwin::lines_sent() const { return impl_->sent; }
+std::uint64_t ShdrTwin::pings_answered() const { return impl_->pongs; }
+
+}  // namespace cal::drivers::sim

@@ -1,0 +1,39 @@
+#pragma once
+// SIMULATED MTConnect SHDR adapter (a machine position feed) on a loopback TCP port, streaming
+// the simulated control's commanded position (see sim/twin.hpp).
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "cal/drivers/sim/twin.hpp"
+
+namespace cal::drivers::sim {
+
+struct ShdrTwinConfig {
+  std::uint16_t port = 0;  // 0: an ephemeral port on 127.0.0.1
+  // Wall-clock period at which the control's commanded position (mm, 4 decimals) is looked
+  // at. As an adapter does, a line goes out only when a value changed, with only the items
+  // that changed ("2024-01-01T12:00:00.123456Z|Xcom|12.5000"); a new client first gets every
+  // item. So the feed is silent while the machine dwells.
+  std::chrono::milliseconds period{5};
+  std::int64_t pong_timeout_ms = 10000;  // the answer to "* PING": "* PONG 10000"
+  std::array<std::string, 3> keys{"Xcom", "Ycom", "Zcom"};  // the data items of X, Y, Z
+};
+
+// Sends the simulated control's commanded position to every connected agent on change and
+// answers its heartbeats ("* PING" -> "* PONG <ms>"), as an MTConnect adapter does.
+class ShdrTwin final : public TcpTwin {
+ public:
+  ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});
+  std::uint64_t lines_sent() const;
+  std::uint64_t pings_answered() const;
+
+ private:
+  struct Impl;
+  explicit ShdrTwin(std::shared_ptr<Impl> impl);
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace cal::drivers::sim

@@ -1,0 +1,150 @@
+// The simulated World and the channels the twins speak over (see twin_io.hpp, sim/world.hpp).
+#include "sim/twin_io.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <pty.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+#include "cal/drivers/sim/world.hpp"
+
+namespace cal::drivers::sim {
+
+World::World(MachineConfig machine, AirConfig air, double step_s)
+    : machine_(std::move(machine)), air_(std::move(air)), step_s_(step_s) {}
+
+void World::advance_to(double t_s) {
+  while (machine_.state().time_s < t_s - 1e-12)
+    machine_.step(std::min(step_s_, t_s - machine_.state().time_s));
+}
+
+Clock steady_clock(double speed) {
+  const auto start = std::chrono::steady_clock::now();
+  return [start, speed] {
+    return speed * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+}
+
+namespace detail {
+
+LineServer::LineServer(asio::io_context& io, std::uint16_t port)
+    : acceptor_(io, tcp::endpoint(asio::ip::address_v4::loopback(), port)) {}
+
+void LineServer::start(std::function<void(const ClientPtr&, const std::string&)> on_line,
+                       std::function<void(const ClientPtr&)> on_connect) {
+  on_line_ = std::move(on_line);
+  on_connect_ = std::move(on_connect);
+  accept();
+}
+
+void LineServer::accept() {
+  acceptor_.async_accept(
+      [self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
+        if (ec || self->closed_) return;  // acceptor closed
+        auto client = std::make_shared<Client>(std::move(socket));
+        self->clients_.push_back(client);
+        if (self->on_connect_) self->on_connect_(client);
+        self->read(client);
+        self->accept();
+      });
+}
+
+void LineServer::read(const ClientPtr& client) {
+  asio::async_read_until(
+      client->socket, client->input, '\n',
+      [self = shared_from_this(), client](const boost::system::error_code& ec, std::size_t n) {
+        if (ec || self->closed_) {
+          self->clients_.remove(client);
+          return;
+        }
+        std::string line(asio::buffers_begin(client->input.data()),
+                         asio::buffers_begin(client->input.data()) + static_cast<long>(n));
+        client->input.consume(n);
+        while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+        if (self->on_line_) self->on_line_(client, line);
+        if (!self->closed_) self->read(client);
+      });
+}
+
+void LineServer::send(const ClientPtr& client, std::string text) {
+  client->writer.send(client->socket, std::move(text), client);
+}
+
+void LineServer::broadcast(const std::string& text) {
+  for (const auto& c : clients_) send(c, text);
+}
+
+void LineServer::drop_clients() {
+  for (auto& c : clients_) {
+    boost::system::error_code ignored;
+    c->socket.shutdown(tcp::socket::shutdown_both, ignored);
+    c->socket.close(ignored);
+  }
+  clients_.clear();
+}
+
+void LineServer::close() {
+  closed_ = true;
+  boost::system::error_code ignored;
+  acceptor_.close(ignored);
+  drop_clients();
+}
+
+PtyDevice::PtyDevice(asio::io_context& io) : master(io) {
+  int m = -1;
+  std::array<char, 128> name{};
+  if (openpty(&m, &slave_fd, name.data(), nullptr, nullptr) != 0)
+    throw std::runtime_error(
+        fmt::format("simulated twin: openpty failed: {}", std::strerror(errno)));
+  termios raw{};
+  tcgetattr(m, &raw);
+  cfmakeraw(&raw);
+  tcsetattr(m, TCSANOW, &raw);
+  master.assign(m);
+  path = name.data();
+}
+
+PtyDevice::~PtyDevice() { unplug(); }
+
+void PtyDevice::unplug() {
+  boost::system::error_code ignored;
+  master.close(ignored);
+  if (slave_fd >= 0) ::close(slave_fd);
+  slave_fd = -1;
+}
+
+void PtyDevice::send(std::string line, std::shared_ptr<void> keep_alive, std::uint64_t count) {
+  if (!master.is_open()) return;
+  lines += count;
+  writer.send(master, std::move(line), std::move(keep_alive));
+}
+
+}  // namespace detail
+
+PtyTwin::PtyTwin(std::shared_ptr<detail::PtyChannel> channel, std::string settings)
+    : channel_(std::move(channel)), settings_(std::move(settings)) {}
+PtyTwin::~PtyTwin() { unplug(); }
+const std::string& PtyTwin::device_path() const { return channel_->pty.path; }
+std::string PtyTwin::transport() const { return "serial " + device_path() + " " + settings_; }
+void PtyTwin::unplug() {
+  channel_->timer.cancel();
+  channel_->pty.unplug();
+}
+std::uint64_t PtyTwin::lines_sent() const { return channel_->pty.lines; }
+
+TcpTwin::TcpTwin(std::shared_ptr<detail::TcpChannel> channel) : channel_(std::move(channel)) {}
+TcpTwin::~TcpTwin() {
+  channel_->timer.cancel();
+  channel_->server->close();
+}
+std::uint16_t TcpTwin::port() const { return channel_->server->port(); }
+std::string TcpTwin::transport() const { return fmt::format("tcp 127.0.0.1:{}", port()); }
+void TcpTwin::unplug() { channel_->server->drop_clients(); }
+
+}  // namespace cal::drivers::sim

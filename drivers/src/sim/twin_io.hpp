@@ -1,0 +1,136 @@
+#pragma once
+// Private to drivers/: the channels the simulated twins speak over (a loopback TCP line server,
+// a pseudo-terminal) and the ordered writer they share. Includes Boost.Asio: only twin .cpp
+// files include it.
+#include <boost/asio.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <list>
+#include <memory>
+#include <string>
+
+#include "cal/drivers/sim/twin.hpp"
+
+namespace cal::drivers::sim::detail {
+
+namespace asio = boost::asio;
+using asio::ip::tcp;
+
+// Writes queued strings to an Asio stream in order.
+template <class Stream>
+struct LineWriter {
+  // A device sends whether or not anyone listens; with nobody reading the pty, its buffer
+  // fills and a real device's output is lost. Beyond this much queued, new output is dropped
+  // (and counted) instead of growing without bound.
+  static constexpr std::size_t max_queued = 1 << 16;
+  std::deque<std::string> queue;
+  std::uint64_t dropped = 0;
+  void send(Stream& s, std::string line, std::shared_ptr<void> keep_alive) {
+    if (queue.size() >= max_queued) {
+      ++dropped;
+      return;
+    }
+    queue.push_back(std::move(line));
+    if (queue.size() == 1) next(s, std::move(keep_alive));
+  }
+  void next(Stream& s, std::shared_ptr<void> keep_alive) {
+    asio::async_write(s, asio::buffer(queue.front()),
+                      [this, &s, keep_alive](const boost::system::error_code& ec, std::size_t) {
+                        if (ec) return queue.clear();
+                        queue.pop_front();
+                        if (!queue.empty()) next(s, keep_alive);
+                      });
+  }
+};
+
+// A TCP server on 127.0.0.1 that hands every line a client sends (with its terminator
+// removed) to on_line, and lets the twin answer that client or write to all of them.
+class LineServer : public std::enable_shared_from_this<LineServer> {
+ public:
+  struct Client {
+    explicit Client(tcp::socket s) : socket(std::move(s)) {}
+    tcp::socket socket;
+    asio::streambuf input;
+    LineWriter<tcp::socket> writer;
+  };
+  using ClientPtr = std::shared_ptr<Client>;
+
+  // port 0: an ephemeral port. on_line(client, line); on_connect(client) when one arrives.
+  LineServer(asio::io_context& io, std::uint16_t port);
+  void start(std::function<void(const ClientPtr&, const std::string&)> on_line,
+             std::function<void(const ClientPtr&)> on_connect = {});
+  std::uint16_t port() const { return acceptor_.local_endpoint().port(); }
+  void send(const ClientPtr& client, std::string text);
+  void broadcast(const std::string& text);  // to every connected client
+  bool has_clients() const { return !clients_.empty(); }
+  std::size_t clients() const { return clients_.size(); }
+  void drop_clients();
+  void close();  // stops accepting and drops every client
+
+ private:
+  void accept();
+  void read(const ClientPtr& client);
+
+  tcp::acceptor acceptor_;
+  std::list<ClientPtr> clients_;
+  std::function<void(const ClientPtr&, const std::string&)> on_line_;
+  std::function<void(const ClientPtr&)> on_connect_;
+  bool closed_ = false;  // after close() no handler calls back into the twin
+};
+
+// A pseudo-terminal: the twin holds the master side (and keeps the slave open so the master
+// does not see EIO before the driver opens it); the driver opens path like a /dev/ttyUSB0.
+struct PtyDevice {
+  asio::posix::stream_descriptor master;
+  int slave_fd = -1;
+  std::string path;
+  asio::streambuf input;
+  LineWriter<asio::posix::stream_descriptor> writer;
+  std::uint64_t lines = 0;
+
+  explicit PtyDevice(asio::io_context& io);
+  ~PtyDevice();
+  PtyDevice(const PtyDevice&) = delete;
+  PtyDevice& operator=(const PtyDevice&) = delete;
+  void unplug();
+  void send(std::string line, std::shared_ptr<void> keep_alive, std::uint64_t count = 1);
+};
+
+// What a PtyTwin's Impl is built on: the pty and the timer that paces the twin's output.
+struct PtyChannel {
+  explicit PtyChannel(asio::io_context& io) : pty(io), timer(io) {}
+  PtyDevice pty;
+  asio::steady_timer timer;
+};
+
+// What a TcpTwin's Impl is built on: the line server and the timer that paces what the twin
+// sends unasked (idle in a twin that only answers).
+struct TcpChannel {
+  TcpChannel(asio::io_context& io, std::uint16_t port)
+      : server(std::make_shared<LineServer>(io, port)), timer(io) {}
+  std::shared_ptr<LineServer> server;
+  asio::steady_timer timer;
+};
+
+// Reads CR- or LF-terminated command lines from self->pty's master and hands each (without
+// its terminator) to self->on_command.
+template <class Self>
+void read_commands(const std::shared_ptr<Self>& self) {
+  asio::async_read_until(self->pty.master, self->pty.input, '\r',
+                         [self](const boost::system::error_code& ec, std::size_t n) {
+                           if (ec) return;
+                           std::string line(
+                               asio::buffers_begin(self->pty.input.data()),
+                               asio::buffers_begin(self->pty.input.data()) + static_cast<long>(n));
+                           self->pty.input.consume(n);
+                           while (!line.empty() && (line.back() == '\r' || line.back() == '\n'))
+                             line.pop_back();
+                           while (!line.empty() && line.front() == '\n') line.erase(0, 1);
+                           self->on_command(line);
+                           read_commands(self);
+                         });
+}
+
+}  // namespace cal::drivers::sim::detail

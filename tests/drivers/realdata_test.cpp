@@ -1,0 +1,244 @@
+// The real recordings of ../shared/realdata (see its README.md: the sources, and what the
+// project must get from each), read through the drivers' own decoders and codecs. Expected
+// values are read from the files here with a parser of the test's own (split at '|' or
+// whitespace), not with the codecs under test.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cal/drivers/registry.hpp"
+#include "halsampler/codec.hpp"
+
+namespace {
+
+namespace d = cal::drivers;
+namespace fs = std::filesystem;
+
+fs::path realdata() { return fs::path(CALDAQ_REALDATA_DIR); }
+
+std::string read(const std::string& name) {
+  const auto path = realdata() / name;
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw std::runtime_error(
+        "cannot read " + path.string() +
+        ": the real recordings are expected in ../shared/realdata beside the checkout");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) {
+    while (!l.empty() && (l.back() == '\r' || l.back() == ' ')) l.pop_back();
+    if (!l.empty()) out.push_back(l);
+  }
+  return out;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const auto at = s.find(sep, start);
+    out.push_back(s.substr(start, at == std::string::npos ? at : at - start));
+    if (at == std::string::npos) return out;
+    start = at + 1;
+  }
+}
+
+std::vector<double> numbers_of(const std::string& line) {
+  std::vector<double> out;
+  std::istringstream in(line);
+  for (double v; in >> v;) out.push_back(v);
+  return out;
+}
+
+// Decodes a whole file line by line, as `daq decode` does.
+std::vector<d::DecodedItem> decode(const std::string& driver, const std::string& text,
+                                   std::vector<std::pair<std::string, std::string>> set,
+                                   cal::drivers::codec::CodecStats* stats = nullptr) {
+  const auto& drv = d::driver(driver);
+  auto decoder = drv.make_decoder(d::options_from_text(drv, set));
+  std::vector<d::DecodedItem> items;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const auto eol = text.find('\n', at);
+    const auto end = eol == std::string::npos ? text.size() : eol + 1;
+    decoder->feed(std::as_bytes(std::span(text.data() + at, end - at)), items);
+    at = end;
+  }
+  decoder->finish(items);
+  if (stats) *stats = decoder->stats();
+  return items;
+}
+
+std::size_t count(const std::vector<d::DecodedItem>& items, d::DecodedItem::Kind k) {
+  return static_cast<std::size_t>(
+      std::count_if(items.begin(), items.end(), [&](const auto& i) { return i.kind == k; }));
+}
+
+// "2022-08-08T13:51:34.7167146Z" as Unix ns, with timegm and the digits read here.
+std::int64_t unix_ns(const std::string& ts) {
+  std::tm tm{};
+  int frac_start = 0;
+  std::sscanf(ts.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d.%n", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+              &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &frac_start);
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  std::int64_t ns = static_cast<std::int64_t>(timegm(&tm)) * 1'000'000'000;
+  std::int64_t scale = 100'000'000;
+  for (std::size_t i = static_cast<std::size_t>(frac_start); i < ts.size() && ts[i] != 'Z'; ++i) {
+    ns += (ts[i] - '0') * scale;
+    scale /= 10;
+  }
+  return ns;
+}
+
+TEST(RealData, TheRecordingsAreThere) {
+  ASSERT_TRUE(fs::is_directory(realdata()))
+      << realdata()
+      << ": the real recordings are expected in ../shared/realdata beside the "
+         "checkout (CI has ../shared/ there)";
+  for (const char* f : {"shdr_okuma_osp_p300.txt", "halsampler_tagged_limit3.txt",
+                        "halsampler_tagged_timedelay0.txt", "halsampler_untagged_near0.txt",
+                        "halsampler_untagged_abs0.txt", "halsampler_untagged_biquad.txt"})
+    EXPECT_TRUE(fs::is_regular_file(realdata() / f)) << f;
+}
+
+TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
+  // README: 3,989 position frames for X1actw, YI1actw, Z1actw, every one with the file's time
+  // and value, no codec error. Expected: lines outside the --multiline-- asset blocks and not
+  // '*' commands, with one of the keys at a key position (1, 3, 5, ...).
+  const std::string text = read("shdr_okuma_osp_p300.txt");
+  const std::map<std::string, std::uint8_t> keys{{"X1actw", 0}, {"YI1actw", 1}, {"Z1actw", 2}};
+  struct Expected {
+    std::int64_t time_ns;
+    std::uint8_t axis;
+    double value_m;
+  };
+  std::vector<Expected> expected;
+  std::size_t frames = 0;
+  std::string terminator;
+  for (const auto& line : lines_of(text)) {
+    if (!terminator.empty()) {
+      if (line == terminator) terminator.clear();
+      continue;
+    }
+    if (const auto at = line.find("--multiline--"); at != std::string::npos) {
+      terminator = line.substr(at);
+      continue;
+    }
+    if (line[0] == '*') continue;
+    const auto tokens = split(line, '|');
+    std::vector<Expected> of_line;  // a frame's readings come X, Y, Z whatever the line's order
+    for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
+      if (const auto k = keys.find(tokens[i]); k != keys.end())
+        of_line.push_back({unix_ns(tokens[0]), k->second, std::stod(tokens[i + 1]) * 1e-3});
+    std::sort(of_line.begin(), of_line.end(),
+              [](const Expected& a, const Expected& b) { return a.axis < b.axis; });
+    expected.insert(expected.end(), of_line.begin(), of_line.end());
+    frames += !of_line.empty();
+  }
+  EXPECT_EQ(frames, 3989u);
+  cal::drivers::codec::CodecStats stats;
+  const auto items = decode("shdr", text, {{"keys", "X1actw,YI1actw,Z1actw"}}, &stats);
+  EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
+  EXPECT_EQ(stats.errors(), 0u);
+  EXPECT_EQ(stats.frames, 3989u);
+  std::vector<d::DecodedItem> readings;
+  for (const auto& i : items)
+    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
+  ASSERT_EQ(readings.size(), expected.size());
+  EXPECT_EQ(readings.size(), 4905u);  // 1330 X1actw + 607 YI1actw + 2968 Z1actw
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    SCOPED_TRACE(k);
+    ASSERT_TRUE(readings[k].device_time_unix_ns);
+    EXPECT_EQ(*readings[k].device_time_unix_ns, expected[k].time_ns);
+    EXPECT_EQ(readings[k].channel, expected[k].axis);
+    EXPECT_EQ(readings[k].quantity, d::Quantity::machine_position_m);
+    EXPECT_DOUBLE_EQ(readings[k].value, expected[k].value_m);
+  }
+  // The '*' command lines ("*adapterVersion:UNAVAILABLE") and the assets are notes, not errors.
+  EXPECT_GT(count(items, d::DecodedItem::Kind::note), 0u);
+}
+
+// Frames of a halsampler file through the codec (its sample numbers are in the frames).
+std::vector<cal::drivers::codec::PositionFrame> halsampler(const std::string& name, bool tagged,
+                                                           int column,
+                                                           cal::drivers::codec::CodecStats& st) {
+  cal::drivers::codec::HalsamplerCodec c({.sample_numbers = tagged, .column = {column, -1, -1}});
+  std::vector<cal::drivers::codec::PositionFrame> frames;
+  c.feed(read(name), frames);
+  st = c.stats();
+  return frames;
+}
+
+TEST(RealData, HalsamplerTaggedFilesGiveEverySampleInOrder) {
+  // limit3: halsampler -t, cfg=f: 800 frames, samples 0..799, one float each.
+  cal::drivers::codec::CodecStats st;
+  const auto lines = lines_of(read("halsampler_tagged_limit3.txt"));
+  const auto f = halsampler("halsampler_tagged_limit3.txt", true, 0, st);
+  EXPECT_EQ(st.errors(), 0u);
+  ASSERT_EQ(f.size(), 800u);
+  ASSERT_EQ(lines.size(), 800u);
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    ASSERT_TRUE(f[k].sample);
+    EXPECT_EQ(*f[k].sample, k);
+    EXPECT_EQ(f[k].lost_before, 0u);
+    EXPECT_DOUBLE_EQ(*f[k].position_m[0], numbers_of(lines[k]).at(1) * 1e-3);
+  }
+  // timedelay.0: -t, cfg=bb: 64 frames of two bit pins.
+  const auto t = halsampler("halsampler_tagged_timedelay0.txt", true, 1, st);
+  EXPECT_EQ(st.errors(), 0u);
+  ASSERT_EQ(t.size(), 64u);
+  EXPECT_EQ(*t.front().sample, 0u);
+  EXPECT_EQ(*t.back().sample, 63u);
+}
+
+TEST(RealData, HalsamplerUntaggedFilesReadEveryLineAndColumnZeroIsAPin) {
+  // The default configuration is untagged, as halsampler's own default: through the decoder.
+  const struct {
+    const char* file;
+    std::size_t lines;
+    int column;
+  } files[] = {{"halsampler_untagged_near0.txt", 122, 1},   // cfg=ffbb, four columns
+               {"halsampler_untagged_abs0.txt", 7, 1},      // cfg=ff
+               {"halsampler_untagged_biquad.txt", 10, 0}};  // cfg=bff: column 0 is a bit pin
+  for (const auto& f : files) {
+    SCOPED_TRACE(f.file);
+    const std::string text = read(f.file);
+    const auto lines = lines_of(text);
+    ASSERT_EQ(lines.size(), f.lines);
+    cal::drivers::codec::CodecStats stats;
+    const auto items = decode("halsampler", text, {{"column", std::to_string(f.column)}}, &stats);
+    EXPECT_EQ(stats.errors(), 0u);
+    EXPECT_EQ(stats.frames, f.lines);
+    ASSERT_EQ(count(items, d::DecodedItem::Kind::reading), f.lines);
+    std::size_t k = 0;
+    for (const auto& i : items) {
+      if (i.kind != d::DecodedItem::Kind::reading) continue;
+      EXPECT_DOUBLE_EQ(i.value, numbers_of(lines[k]).at(static_cast<std::size_t>(f.column)) * 1e-3);
+      ++k;
+    }
+  }
+  // biquad's column 0 is a bit: a value 0 or 1, never a sample number (the codec has none).
+  cal::drivers::codec::CodecStats st;
+  for (const auto& frame : halsampler("halsampler_untagged_biquad.txt", false, 0, st)) {
+    EXPECT_FALSE(frame.sample);
+    EXPECT_TRUE(*frame.position_m[0] == 0.0 || *frame.position_m[0] == 1e-3);
+  }
+}
+
+}  // namespace
