@@ -115,7 +115,9 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                                [](const auto& x) { return x.role == "ballbar"; });
   if (it == s.specs.end())
     throw cal::InputError(fmt::format("{}: the session has no ballbar instrument", o.capture));
-  auto [program, analysis] = circle_test(s.config);
+  const auto tests = circle_tests(s.config);  // a set's tests follow the first
+  auto program = tests.front().program;
+  auto analysis = tests.front().analysis;
   // The bar calibration the original run used, not whatever is newest now.
   if (s.original_settings.is_object() && s.original_settings.contains("radius_mm")) {
     const auto original = circle_settings_from_json(s.original_settings).second;
@@ -145,7 +147,8 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                        .software_version = s.software(),
                        .context_json = s.original_context,
                        .replay = true,
-                       .replay_of_run = s.original_run};
+                       .replay_of_run = s.original_run,
+                       .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   CircleRun run(s.io, std::move(setup));
   run.start();
   const auto end = s.play(run, "the capture ended before both arcs were recorded");
@@ -153,14 +156,24 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
                                       out.run_id, out.reason));
+  std::vector<const CircleRunOutcome*> outs;
+  for (const auto& c : run.completed()) outs.push_back(&c);
+  outs.push_back(&out);
+  json all = json::array();
+  for (const auto* x : outs) {
+    json j = circle_document(*x->result, x->program, x->analysis);
+    j["run_id"] = x->run_id;
+    if (!o.json) {
+      fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, x->run_id, x->readings);
+      print_circle_result(*x->result, x->program, x->analysis);
+    }
+    all.push_back(std::move(j));
+  }
   if (o.json) {
-    json j = circle_document(*out.result, program, analysis);
-    j["run_id"] = out.run_id;
+    json j =
+        outs.size() == 1 ? all.front() : json{{"schema", "caldaq.circle-set.v1"}, {"runs", all}};
     j["capture_damage"] = damage_json(end);
     fmt::print("{}\n", j.dump(2));
-  } else {
-    fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-    print_circle_result(*out.result, program, analysis);
   }
   report_damage(end, o, out.run_id);
 }

@@ -30,8 +30,13 @@ struct SimOptions {
 // The configuration of the shop's devices and tests. Times the acquiring process measures on
 // its own clock (the trigger's dwell) are divided by the speed: it sees the program `speed`
 // times faster than the program's own times.
-std::string sim_config(const SimulatedShop& shop, double speed, bool position_feed) {
+std::string sim_config(const SimulatedShop& shop, double speed, bool position_feed, bool set) {
   const auto& t = shop.truth();
+  // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220 deg over the top,
+  // each at a slow and a fast feed (docs/circle.md, "The standard set").
+  const std::string tests =
+      set ? "planes = [\"XY\", \"ZX\", \"YZ\"]\nfeeds_mm_per_min = [1000, 3000]\n"
+          : "plane = \"XY\"\nfeed_mm_per_min = 1000\n";
   return fmt::format(
       R"TOML(# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {speed}x
 # faster than real time). Valid while that process runs.
@@ -63,9 +68,7 @@ feed_mm_per_min = 6000
 dwell_s = 3
 
 [test.circle]
-plane = "XY"
-radius_mm = {radius}
-feed_mm_per_min = 1000
+{tests}radius_mm = {radius}
 sample_rate_hz = 1000
 overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
@@ -74,15 +77,17 @@ calibrated_radius_mm = {radius}  # the simulated bar's exact length (simulation)
       fmt::arg("devices", shop.devices_toml(0.05 / speed, position_feed)), fmt::arg("speed", speed),
       fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
       fmt::arg("radius", t.ballbar_mm), fmt::arg("cx", t.pivot_mm[0]),
-      fmt::arg("cy", t.pivot_mm[1]), fmt::arg("cz", t.pivot_mm[2]));
+      fmt::arg("cy", t.pivot_mm[1]), fmt::arg("cz", t.pivot_mm[2]), fmt::arg("tests", tests));
 }
 
 void run_sim(const SimOptions& o) {
-  if (o.test != "linear" && o.test != "circle")
-    throw cal::InputError(fmt::format("--test '{}' (expected linear or circle)", o.test));
+  if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
+    throw cal::InputError(
+        fmt::format("--test '{}' (expected linear, circle or circle-set)", o.test));
+  const bool set = o.test == "circle-set";
   boost::asio::io_context io;
-  SimulatedShop shop(io, ShopTruth{}, o.speed);
-  const std::string text = sim_config(shop, o.speed, o.position_feed);
+  SimulatedShop shop(io, set ? ShopTruth::three_planes() : ShopTruth{}, o.speed);
+  const std::string text = sim_config(shop, o.speed, o.position_feed, set);
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -91,7 +96,7 @@ void run_sim(const SimOptions& o) {
   fmt::print(
       "daq sim: SIMULATED shop running {}x faster than real time; devices in {}\n"
       "  start `daq run {} --config {}` now: the machine starts the program in {} s\n",
-      o.speed, o.config_out, o.test, o.config_out, o.start_after_s);
+      o.speed, o.config_out, set ? "circle" : o.test, o.config_out, o.start_after_s);
   std::fflush(stdout);
   // The shop's clock advances when it is read (a starved process slows the simulation down
   // rather than skipping it), so the loop reads it every few milliseconds itself: the twins
@@ -101,7 +106,11 @@ void run_sim(const SimOptions& o) {
   };
   run_until(shop.now_s() + o.start_after_s * o.speed);
   const double t0_s = shop.now_s();
-  if (o.test == "circle") {
+  if (set) {
+    std::vector<cal::daq::BallbarSetTest> program;
+    for (const auto& t : circle_tests(config)) program.push_back({t.plane, t.program});
+    shop.run_circle_set(program);
+  } else if (o.test == "circle") {
     shop.run_circle(circle_test(config).first);
   } else {
     const auto& l = *config.linear;
@@ -121,7 +130,9 @@ void add_sim_command(CLI::App& app) {
   auto o = std::make_shared<SimOptions>();
   auto* cmd = app.add_subcommand(
       "sim", "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
-  cmd->add_option("--test", o->test, "linear or circle: the program the machine runs")
+  cmd->add_option("--test", o->test,
+                  "linear, circle (XY) or circle-set (XY, ZX, YZ at two feeds): the program the "
+                  "machine runs")
       ->capture_default_str();
   cmd->add_option("-o,--config-out", o->config_out, "Where to write the devices' configuration")
       ->capture_default_str();

@@ -1195,8 +1195,8 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
              "scale mismatch (µm/m)", "servo mismatch (ms)", "verdict"},
             rows, "num", "rlrrrrrrrl") +
       "<p class=\"note\">Scale mismatch in the plane's order: XY X − Y, ZX Z − X, YZ Y − Z. "
-      "Servo mismatch: the plane's second axis lags its first (positive); it grows with the "
-      "feed, squareness does not.</p>\n";
+      "Servo mismatch: the plane's second axis lags its first (positive); the ellipse it "
+      "makes grows with the feed, a squareness's does not.</p>\n";
   std::vector<std::vector<std::string>> planes;
   for (std::size_t i = 0; i < 3; ++i) {
     const auto& pv = v.combined.planes[i];

@@ -270,6 +270,8 @@ struct CircleRun::Impl {
   CircleRunOutcome outcome;
   CircleLive live;
   bool running = false, done = false;
+  std::vector<CircleRunOutcome> completed;  // a set's tests before the current one
+  std::size_t next_test = 0;                // into setup.following
   // Handlers posted from the writer's thread run only while the run exists.
   std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
@@ -283,6 +285,18 @@ struct CircleRun::Impl {
 
   void start() {
     store.emplace(setup.database, setup.store_options);
+    begin_test();
+    running = true;
+    setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
+                          .state =
+                              [this](cal::drivers::InstrumentState s, std::string_view why) {
+                                if (s == cal::drivers::InstrumentState::closed && running)
+                                  abort(fmt::format("ballbar closed: {}", why));
+                              }});
+  }
+
+  // The stored run of the current test (setup.program, setup.analysis) and its writer.
+  void begin_test() {
     resolve_calibration(setup.analysis, setup.config, setup.program.radius_mm, *store,
                         setup.calibration_at_unix_ms
                             ? setup.calibration_at_unix_ms
@@ -322,15 +336,13 @@ struct CircleRun::Impl {
             if (*alive) abort("storage failed: " + e);
           });
         });
-    running = true;
-    setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
-                          .state =
-                              [this](cal::drivers::InstrumentState s, std::string_view why) {
-                                if (s == cal::drivers::InstrumentState::closed && running)
-                                  abort(fmt::format("ballbar closed: {}", why));
-                              }});
-    event(fmt::format("run {}: ballbar circle R {} mm at {} mm/min, waiting for the feed-in",
-                      outcome.run_id, p.radius_mm, p.feed_mm_per_min));
+    outcome.program = setup.program;
+    outcome.analysis = setup.analysis;
+    const std::size_t tests = completed.size() + 1 + (setup.following.size() - next_test);
+    event(fmt::format("run {}: {}ballbar {} R {} mm at {} mm/min, waiting for the feed-in",
+                      outcome.run_id,
+                      tests > 1 ? fmt::format("test {} of {}: ", completed.size() + 1, tests) : "",
+                      setup.analysis.plane, p.radius_mm, p.feed_mm_per_min));
     // The live readout says the run waits even before the bar sends anything.
     if (setup.on_live) {
       live.state = "waiting";
@@ -387,7 +399,9 @@ struct CircleRun::Impl {
   }
 
   void finish() {
-    if (done) return;
+    // Posted once per reading after the arcs: the first one finishes (a set's next test is
+    // not complete when the others arrive).
+    if (done || !segmenter.complete()) return;
     running = false;
     try {
       writer->flush();
@@ -417,8 +431,27 @@ struct CircleRun::Impl {
       return abort(fmt::format("storage failed: {}", e.what()));
     }
     outcome.complete = true;
+    if (next_test < setup.following.size()) return next();
     publish_end("complete");
     end();
+  }
+
+  // A set's next test: a new run on the same bar stream, waiting for its feed-in.
+  void next() {
+    completed.push_back(std::move(outcome));
+    outcome = {};
+    auto& t = setup.following[next_test++];
+    setup.program = t.program;
+    setup.analysis = t.analysis;
+    segmenter = cal::daq::BallbarSegmenter(setup.program);
+    live = {};
+    writer.reset();
+    try {
+      begin_test();
+    } catch (const std::exception& e) {
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
+    running = true;
   }
 
   void abort(const std::string& reason) {
@@ -461,5 +494,6 @@ void CircleRun::start() { impl_->start(); }
 void CircleRun::stop(const std::string& reason) { impl_->abort(reason); }
 bool CircleRun::finished() const { return impl_->done; }
 const CircleRunOutcome& CircleRun::outcome() const { return impl_->outcome; }
+const std::vector<CircleRunOutcome>& CircleRun::completed() const { return impl_->completed; }
 
 }  // namespace daq

@@ -116,12 +116,18 @@ struct CircleRunSetup {
   // calibration before (the original run's, or the newest), so that this lookup does nothing.
   std::int64_t calibration_at_unix_ms = 0;
   cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
+  // A ballbar set (docs/circle.md, "The standard set"): the tests after the first, in the
+  // order of the program. Each is recognised in turn on the same bar stream (its feed-in after
+  // the previous test's cw arc) and stored as its own run of the configuration's campaign.
+  std::vector<CircleTest> following;
   std::function<void(const std::string&)> on_event;
   std::function<void(const CircleLive&)> on_live;                // about 10 Hz of the bar's time
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading
 };
 
 struct CircleRunOutcome {
+  cal::daq::BallbarProgram program;
+  BallbarAnalysis analysis;  // as used: the bar calibration resolved
   std::int64_t run_id = 0;
   bool complete = false;
   std::string reason;
@@ -136,7 +142,9 @@ class CircleRun {
   void start();
   void stop(const std::string& reason);
   bool finished() const;
-  const CircleRunOutcome& outcome() const;
+  const CircleRunOutcome& outcome() const;  // the current (last) test's
+  // The tests of a set completed before the current one, in order.
+  const std::vector<CircleRunOutcome>& completed() const;
 
  private:
   struct Impl;

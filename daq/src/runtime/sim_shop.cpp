@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cal/analysis/error.hpp"
 #include "ids3010/twin.hpp"
 #include "line_gauge/twin.hpp"
 #include "ptu300/twin.hpp"
@@ -61,10 +62,20 @@ struct SimulatedShop::Impl {
                   .cyclic_amplitude_um = t.cyclic_amplitude_um,
                   .cyclic_period_mm = t.cyclic_period_mm,
                   .noise_um = t.noise_um};
-    c.servo[1].kv_per_s = t.kv_y_per_s;
-    c.servo[2].kv_per_s = 30.0;
+    c.servo[1] = {.kv_per_s = t.kv_y_per_s,
+                  .backlash_um = t.backlash_y_um,
+                  .cyclic_amplitude_um = t.cyclic_y_amplitude_um,
+                  .cyclic_period_mm = t.cyclic_y_period_mm,
+                  .noise_um = t.noise_yz_um};
+    c.servo[2] = {.kv_per_s = t.kv_z_per_s,
+                  .backlash_um = t.backlash_z_um,
+                  .cyclic_amplitude_um = t.cyclic_z_amplitude_um,
+                  .cyclic_period_mm = t.cyclic_z_period_mm,
+                  .noise_um = t.noise_yz_um};
     c.servo[0].kv_per_s = t.kv_x_per_s;
     c.geometry.squareness.c0y_urad = t.squareness_um_per_m;
+    c.geometry.squareness.b0z_urad = t.b0z_urad;
+    c.geometry.squareness.a0z_urad = t.a0z_urad;
     c.thermal = {.start_degc = t.machine_degc, .expansion_ppm_per_k = t.expansion_ppm_per_k};
     c.acceleration_mm_per_s2 = 2000.0;
     return c;
@@ -184,6 +195,63 @@ void SimulatedShop::run_circle(const cal::daq::BallbarProgram& p) {
   impl_->world.advance_to(now_s());
   impl_->world.machine().load(program);
   impl_->ballbar.set_streaming(true);  // the bar is mounted now
+}
+
+ShopTruth ShopTruth::three_planes() {
+  ShopTruth t;
+  t.b0z_urad = 15.0;    // alpha_ZX = -15 um/m
+  t.a0z_urad = -10.0;   // alpha_YZ = -10 um/m
+  t.kv_z_per_s = 29.4;  // Z lags X by 1/29.4 - 1/30 s = 0.680 ms, Z lags Y by 0.343 ms
+  t.backlash_y_um = 3.0, t.backlash_z_um = 2.0;
+  t.cyclic_y_amplitude_um = 0.8, t.cyclic_z_amplitude_um = 0.6;
+  t.noise_yz_um = t.noise_um;
+  return t;
+}
+
+void SimulatedShop::run_circle_set(std::span<const cal::daq::BallbarSetTest> tests) {
+  if (tests.empty()) throw cal::InputError("simulated ballbar set: no test");
+  const auto& c = impl_->truth.pivot_mm;
+  const sim::Vec3 centre{c[0], c[1], c[2]};
+  const auto sim_plane = [](cal::daq::Plane p) {
+    return p == cal::daq::Plane::zx   ? sim::Plane::zx
+           : p == cal::daq::Plane::yz ? sim::Plane::yz
+                                      : sim::Plane::xy;
+  };
+  // caldaq's angle in the plane: from its first axis towards the second (ZX: Z first).
+  const auto point = [&](cal::daq::Plane p, double deg, double r) {
+    const double a = deg * std::numbers::pi / 180, u = r * std::cos(a), v = r * std::sin(a);
+    if (p == cal::daq::Plane::zx) return sim::Vec3{c[0] + v, c[1], c[2] + u};
+    if (p == cal::daq::Plane::yz) return sim::Vec3{c[0], c[1] + u, c[2] + v};
+    return sim::Vec3{c[0] + u, c[1] + v, c[2]};
+  };
+  std::vector<sim::Move> program;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    const auto& [p, b] = tests[i];
+    const double out = b.radius_mm + b.feed_in_mm, feed = b.feed_mm_per_min;
+    if (i == 0) {
+      program.push_back(sim::Move::linear(point(p, b.start_deg, out), 3000.0));
+      program.push_back(sim::Move::dwell(0.5));
+    } else {
+      const auto& prev = tests[i - 1];
+      if (std::abs(prev.program.radius_mm + prev.program.feed_in_mm - out) > 1e-9)
+        throw cal::InputError("simulated ballbar set: one radius and feed-in only");
+      for (const auto& a :
+           cal::daq::ballbar_transition(prev.plane, prev.program.start_deg, p, b.start_deg))
+        if (std::abs(a.sweep_deg) > 1e-9)
+          program.push_back(sim::Move::arc(a.sweep_deg < 0, centre, sim_plane(a.plane),
+                                           std::abs(a.sweep_deg), feed));
+    }
+    const double sweep = b.arc_deg + 2 * b.overshoot_deg;
+    program.push_back(sim::Move::linear(point(p, b.start_deg, b.radius_mm), feed));  // feed-in
+    program.push_back(sim::Move::dwell(b.dwell_s));
+    program.push_back(sim::Move::arc(false, centre, sim_plane(p), sweep, feed));
+    program.push_back(sim::Move::dwell(b.dwell_s));
+    program.push_back(sim::Move::arc(true, centre, sim_plane(p), sweep, feed));
+    program.push_back(sim::Move::linear(point(p, b.start_deg, out), feed));  // feed-out
+  }
+  impl_->world.advance_to(now_s());
+  impl_->world.machine().load(program);
+  impl_->ballbar.set_streaming(true);
 }
 
 double SimulatedShop::program_end_s() const { return impl_->world.machine().program_duration_s(); }

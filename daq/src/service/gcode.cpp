@@ -376,6 +376,13 @@ std::string upper(std::string s) {
 
 }  // namespace
 
+std::vector<SetArc> ballbar_transition(Plane p1, double a1_deg, Plane p2, double a2_deg) {
+  std::vector<SetArc> out;
+  for (const auto& m : transition(p1, a1_deg, p2, a2_deg))
+    out.push_back({m.plane, m.from_deg, m.sweep_deg});
+  return out;
+}
+
 std::string plane_name(Plane p) { return p == Plane::zx ? "ZX" : p == Plane::yz ? "YZ" : "XY"; }
 
 std::vector<BallbarSetTest> ballbar_set(const BallbarSetConfig& c) {

@@ -108,4 +108,14 @@ std::vector<BallbarSetTest> ballbar_set(const BallbarSetConfig& c);  // throws I
 std::string circle_set_program(std::span<const BallbarSetTest> tests, const CircleProgramSetup& s,
                                Dialect d);
 
+// One arc of the path between two tests on the sphere about the ball: in `plane`, from an
+// angle (caldaq's, from the plane's first axis towards the second) by a signed sweep (+ ccw).
+struct SetArc {
+  Plane plane = Plane::xy;
+  double from_deg = 0.0, sweep_deg = 0.0;
+};
+// The arcs circle_set_program writes from (p1, a1) to (p2, a2) on the sphere (the same path, so
+// that the simulated machine runs what the program says).
+std::vector<SetArc> ballbar_transition(Plane p1, double a1_deg, Plane p2, double a2_deg);
+
 }  // namespace cal::daq
