@@ -20,7 +20,7 @@ SIM_PID=$!
 for _ in $(seq 100); do [ -s "$TMP/sim.toml" ] && break; sleep 0.1; done
 [ -s "$TMP/sim.toml" ] || { echo "FAIL: daq sim wrote no configuration"; cat "$TMP/sim.log"; exit 1; }
 
-"$DAQ" run circle -c "$TMP/sim.toml" --db "$TMP/run.sqlite" >"$TMP/run.log" 2>&1
+"$DAQ" run circle -c "$TMP/sim.toml" --db "$TMP/run.sqlite" --capture "$TMP/set.cdq" >"$TMP/run.log" 2>&1
 rc=$?
 RUN=$(cat "$TMP/run.log")
 [ "$rc" -eq 0 ] || { echo "FAIL run: exit $rc"; echo "$RUN" | tail -30; fails=$((fails + 1)); }
@@ -47,5 +47,10 @@ check history 0 "ZX at 3000 mm/min, R 100 mm" -- "$DAQ" ballbar history --db "$T
 "$DAQ" report --campaign simulated --db "$TMP/run.sqlite" -o "$TMP/campaign.html" >/dev/null
 check report_table 0 "<h3>Three-plane table</h3>" -- cat "$TMP/campaign.html"
 check report_b0z 0 "E_B0Z = \+1[45]\.[0-9]{3}" -- cat "$TMP/campaign.html"
+# The capture replayed: the whole set again, as runs 7..12, with the same squareness.
+REP=$("$DAQ" replay "$TMP/set.cdq" --db "$TMP/run.sqlite" 2>&1)
+check replay_all 0 "replayed .* into run 12 " -- echo "$REP"
+SQ=$("$DAQ" analyse 3 --db "$TMP/run.sqlite" | grep 'Squareness ZX')
+check replay_same_squareness 0 "$(sed 's/[()]/\\&/g' <<<"$SQ")" -- "$DAQ" analyse 9 --db "$TMP/run.sqlite"
 [ -n "${KEEP_REPORT:-}" ] && cp "$TMP/campaign.html" "$KEEP_REPORT"
 finish
