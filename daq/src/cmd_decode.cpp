@@ -97,6 +97,7 @@ json item_json(const d::DecodedItem& i) {
       j["device_time"] = t.empty() ? json(nullptr) : json(t);
       if (i.device_time_unix_ns) j["device_time_unix_ns"] = *i.device_time_unix_ns;
       if (i.device_time_relative_s) j["device_time_relative_s"] = *i.device_time_relative_s;
+      if (i.sample) j["sample"] = *i.sample;
       j["channel"] = i.channel;
       j["quantity"] = d::to_string(i.quantity);
       j["value"] = i.value;
@@ -122,7 +123,9 @@ json item_json(const d::DecodedItem& i) {
 void print_item(const d::DecodedItem& i) {
   switch (i.kind) {
     case d::DecodedItem::Kind::reading: {
-      const auto t = time_text(i);
+      // The device's time, else its sample number (halsampler -t), else "-".
+      auto t = time_text(i);
+      if (t.empty() && i.sample) t = fmt::format("sample {}", *i.sample);
       fmt::print("{:>9}  {:<31} ch {}  {:<26} {:>16.9g} {:<4} {}\n", i.offset, t.empty() ? "-" : t,
                  i.channel, d::to_string(i.quantity), i.value, unit_of(i.quantity),
                  status_text(i.status));

@@ -14,20 +14,14 @@
 #include "cal/drivers/transport/transport.hpp"
 #include "cal/drivers/transport/usb.hpp"
 #include "commands.hpp"
+#include "devices_list.hpp"
+#include "serve/instrument_form.hpp"
 
 namespace daq {
 namespace {
 
 namespace t = cal::drivers::transport;
 using nlohmann::json;
-
-struct DevicesOptions {
-  std::vector<std::string> tcp_probes;     // HOST[:PORT]
-  std::vector<std::string> serial_probes;  // DEVICE[@SETTINGS]
-  bool json = false;
-  bool options = false;   // the drivers and their option tables instead of the attached devices
-  bool markdown = false;  // with options: the Markdown of docs/drivers.md
-};
 
 std::vector<std::string> serial_ports() {
   namespace fs = std::filesystem;
@@ -120,6 +114,8 @@ json probe(std::string_view kind, const std::string& spec) {
   return j;
 }
 
+}  // namespace
+
 json list_devices(const DevicesOptions& o) {
   json out{{"schema", "caldaq.devices.v1"},
            {"usb", json::array()},
@@ -158,7 +154,9 @@ json list_devices(const DevicesOptions& o) {
   return out;
 }
 
-// ---- the drivers and their options (daq devices --options) ------------------------------------
+namespace {
+
+// ---- the drivers and their options (daq devices --options; the JSON is the set-up page's too) --
 
 std::string range_text(const cal::drivers::OptionSpec& o) {
   if (!o.choices.empty()) return fmt::format("{}", fmt::join(o.choices, ", "));
@@ -166,37 +164,6 @@ std::string range_text(const cal::drivers::OptionSpec& o) {
   if (o.min) return fmt::format(">= {}", *o.min);
   if (o.max) return fmt::format("<= {}", *o.max);
   return "";
-}
-
-json drivers_json() {
-  json out{{"schema", "caldaq.drivers.v1"},
-           {"common_keys", cal::drivers::common_device_keys()},
-           {"drivers", json::array()}};
-  for (const auto* d : cal::drivers::device_drivers()) {
-    json options = json::array();
-    for (const auto& o : d->options()) {
-      json e{{"name", o.name},
-             {"type", cal::drivers::to_string(o.type)},
-             {"unit", o.unit},
-             {"default", cal::drivers::format_option_value(o.default_value)},
-             {"help", o.help}};
-      if (o.min) e["min"] = *o.min;
-      if (o.max) e["max"] = *o.max;
-      if (!o.choices.empty()) e["choices"] = o.choices;
-      options.push_back(e);
-    }
-    json usb = json::array();
-    for (const auto& k : d->usb_ids())
-      usb.push_back({{"vid_pid", fmt::format("{:04x}:{:04x}", k.vendor_id, k.product_id)},
-                     {"description", k.description}});
-    out["drivers"].push_back({{"name", d->name()},
-                              {"description", d->description()},
-                              {"transport", d->transport_example()},
-                              {"decode_input", d->decode_input()},
-                              {"options", options},
-                              {"usb", usb}});
-  }
-  return out;
 }
 
 void print_options_text() {
@@ -302,7 +269,7 @@ void add_devices_command(CLI::App& app) {
                 "Print caldaq.devices.v1 JSON (with --options: caldaq.drivers.v1)");
   cmd->callback([opts] {
     if (opts->options) {
-      if (opts->json) return fmt::print("{}\n", drivers_json().dump(2));
+      if (opts->json) return fmt::print("{}\n", serve::driver_descriptions().dump(2));
       return opts->markdown ? print_options_markdown() : print_options_text();
     }
     const json j = list_devices(*opts);

@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "database.hpp"
 #include "report/report.hpp"
+#include "report_pdf.hpp"
 
 namespace daq {
 namespace {
@@ -47,6 +48,8 @@ std::string find_chromium() {
       "(install Debian's chromium package, or set CALDAQ_CHROMIUM to the browser)");
 }
 
+}  // namespace
+
 // Prints html_file to pdf with headless Chromium; the PDF is checked, not assumed.
 void print_pdf(const fs::path& html_file, const fs::path& pdf) {
   const auto browser = find_chromium();
@@ -68,6 +71,8 @@ void print_pdf(const fs::path& html_file, const fs::path& pdf) {
                     pdf.string(), browser, WEXITSTATUS(status), log.string()));
   fs::remove(log, ec);
 }
+
+namespace {
 
 void write_file(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

@@ -24,6 +24,7 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
+#include "part_program.hpp"
 #include "provenance.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
@@ -251,23 +252,8 @@ struct GcodeOptions {
 };
 
 void gcode(const GcodeOptions& o, bool circle) {
-  const auto config = cal::daq::load_config(o.config);
-  const auto dialect = cal::daq::dialect_from_string(o.dialect);
-  std::string text;
-  if (circle) {
-    std::vector<cal::daq::BallbarSetTest> set;
-    for (const auto& t : circle_tests(config, o.set)) set.push_back({t.plane, t.program});
-    auto setup = circle_program_setup(config);
-    if (o.by_radius) setup.arcs = cal::daq::ArcForm::radius;
-    text = cal::daq::circle_set_program(set, setup, dialect);
-  } else {
-    if (!config.linear) throw cal::InputError(fmt::format("{}: no [test.linear]", o.config));
-    const auto& l = *config.linear;
-    const auto plan = linear_plan(l);
-    text = cal::daq::linear_program(
-        plan, {.axis = l.axis[0], .feed_mm_per_min = l.feed_mm_per_min, .dwell_s = l.dwell_s},
-        dialect);
-  }
+  const auto text = part_program(cal::daq::load_config(o.config), circle ? "circle" : "linear",
+                                 o.dialect, {.standard_set = o.set, .by_radius = o.by_radius});
   if (o.output.empty()) return fmt::print("{}", text);
   std::ofstream out(o.output);
   if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));

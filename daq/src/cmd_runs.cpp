@@ -23,6 +23,7 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "provenance.hpp"
+#include "run_document.hpp"
 #include "verdict.hpp"
 
 namespace daq {
@@ -144,8 +145,9 @@ void print_result_values(const json& doc) {
   }
 }
 
-void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
-  const auto store = open_database_read_only(db);
+}  // namespace
+
+json run_document(const st::Store& store, std::int64_t id) {
   const auto r = need_run(store, id);
   json j = run_json(r);
   j["schema"] = "caldaq.run.v1";
@@ -173,6 +175,16 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     if (!doc.is_discarded()) one["verdict"] = to_json(verdict_of(settings, doc));
     j["results"].push_back(std::move(one));
   }
+  return j;
+}
+
+namespace {
+
+void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
+  const auto store = open_database_read_only(db);
+  const auto r = need_run(store, id);
+  const json j = run_document(store, id);
+  const auto missed = store.missed_stops(id);
   if (as_json) return fmt::print("{}\n", j.dump(2));
   fmt::print("run {}: {} {} ({}), started {}{}\n", r.id, r.kind, r.axis, st::to_string(r.status),
              iso_time(r.started_unix_ms), r.note.empty() ? "" : " - " + r.note);

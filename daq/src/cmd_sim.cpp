@@ -1,16 +1,22 @@
 // daq sim: the built-in SIMULATED shop as a separate process, for practising and for testing
-// `daq run linear|circle` end to end: the twins listen on a loopback TCP port and on
-// pseudo-terminals, a configuration file naming them is written, and after a delay the
-// simulated machine runs the test's program. The acquiring process only sees devices.
+// `daq run linear|circle` and `daq serve` end to end: the twins listen on a loopback TCP port
+// and on pseudo-terminals, and a configuration file naming them is written. The simulated
+// machine runs a test's program when a run of that test starts in the run database (as an
+// operator presses Cycle Start once the acquisition waits), or once after --start-after-s. The
+// acquiring process only sees devices.
 #include <fmt/format.h>
 
 #include <boost/asio/io_context.hpp>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "cal/analysis/error.hpp"
+#include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
+#include "database.hpp"
 #include "linear_run.hpp"
 #include "sim_shop.hpp"
 
@@ -23,105 +29,109 @@ struct SimOptions {
   std::string config_out = "caldaq-sim.toml";
   std::string test = "circle";
   double speed = 1.0;
-  double start_after_s = 5.0;
+  std::optional<double> start_after_s;  // unset: wait for a run in the database
+  std::string db;
   bool position_feed = false;
 };
 
-// The configuration of the shop's devices and tests. Times the acquiring process measures on
-// its own clock (the trigger's dwell) are divided by the speed: it sees the program `speed`
-// times faster than the program's own times.
-std::string sim_config(const SimulatedShop& shop, double speed, bool position_feed, bool set) {
-  const auto& t = shop.truth();
-  // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220 deg over the top,
-  // each at a slow and a fast feed (docs/circle.md, "The standard set").
-  const std::string tests =
-      set ? "planes = [\"XY\", \"ZX\", \"YZ\"]\nfeeds_mm_per_min = [1000, 3000]\n"
-          : "plane = \"XY\"\nfeed_mm_per_min = 1000\n";
-  return fmt::format(
-      R"TOML(# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {speed}x
-# faster than real time). Valid while that process runs.
-campaign = "simulated"
+// A run that has started in the database since `after` (its id), or nullopt. The database may
+// be busy with the acquiring process's writes: a failed look is retried at the next poll.
+std::optional<cal::storage::RunRecord> new_run(const std::filesystem::path& db,
+                                               std::int64_t after) {
+  try {
+    cal::storage::Store store(db);
+    for (const auto& r : store.runs())
+      if (r.id > after && r.status == cal::storage::RunStatus::running) return r;
+  } catch (const cal::storage::StoreError&) {
+  }
+  return std::nullopt;
+}
 
-[machine]
-name = "SIMULATED VMC"
-description = "built-in simulated 3-axis machine with injected errors (daq sim)"
-
-{devices}
-[environment]
-equation = "ciddor"
-expansion_ppm_per_k = {alpha}
-
-[trigger]
-tolerance_um = 1
-dwell_s = {trigger_dwell}
-window_mm = 0.5
-
-[test.linear]
-axis = "X"
-first_mm = 0
-last_mm = 500
-interval_mm = 50
-random_fraction = 0.2
-runs = 5
-overrun_mm = 3
-feed_mm_per_min = 6000
-dwell_s = 3
-
-[test.circle]
-{tests}radius_mm = {radius}
-sample_rate_hz = 1000
-overshoot_deg = 45
-centre_mm = [{cx}, {cy}, {cz}]
-calibrated_radius_mm = {radius}  # the simulated bar's exact length (simulation)
-)TOML",
-      fmt::arg("devices", shop.devices_toml(0.05 / speed, position_feed)), fmt::arg("speed", speed),
-      fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
-      fmt::arg("radius", t.ballbar_mm), fmt::arg("cx", t.pivot_mm[0]),
-      fmt::arg("cy", t.pivot_mm[1]), fmt::arg("cz", t.pivot_mm[2]), fmt::arg("tests", tests));
+std::int64_t newest_run(const std::filesystem::path& db) {
+  cal::storage::Store store(db);
+  std::int64_t id = 0;
+  for (const auto& r : store.runs()) id = std::max(id, r.id);
+  return id;
 }
 
 void run_sim(const SimOptions& o) {
   if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
     throw cal::InputError(
         fmt::format("--test '{}' (expected linear, circle or circle-set)", o.test));
-  const bool set = o.test == "circle-set";
+  const bool set = o.test == "circle-set";  // the standard set on the three-plane machine
   boost::asio::io_context io;
   SimulatedShop shop(io, set ? ShopTruth::three_planes() : ShopTruth{}, o.speed);
-  const std::string text = sim_config(shop, o.speed, o.position_feed, set);
+  const std::string text = simulated_shop_config(
+      shop,
+      {.speed = o.speed, .position_feed = o.position_feed, .in_process = false, .circle_set = set});
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
   }
   const auto config = cal::daq::parse_config(text, o.config_out);
-  fmt::print(
-      "daq sim: SIMULATED shop running {}x faster than real time; devices in {}\n"
-      "  start `daq run {} --config {}` now: the machine starts the program in {} s\n",
-      o.speed, o.config_out, set ? "circle" : o.test, o.config_out, o.start_after_s);
-  std::fflush(stdout);
   // The shop's clock advances when it is read (a starved process slows the simulation down
   // rather than skipping it), so the loop reads it every few milliseconds itself: the twins
   // alone read it only when a client asks.
   const auto run_until = [&](double sim_s) {
     while (shop.now_s() < sim_s) io.run_for(2ms);
   };
-  run_until(shop.now_s() + o.start_after_s * o.speed);
-  const double t0_s = shop.now_s();
-  if (set) {
-    std::vector<cal::daq::BallbarSetTest> program;
-    for (const auto& t : circle_tests(config)) program.push_back({t.plane, t.program});
-    shop.run_circle_set(program);
-  } else if (o.test == "circle") {
-    shop.run_circle(circle_test(config).first);
-  } else {
-    const auto& l = *config.linear;
-    shop.run_linear(linear_plan(l), l.feed_mm_per_min, l.dwell_s);
+  const auto run_program = [&](const std::string& test) {
+    const double t0_s = shop.now_s();
+    if (test == "circle" && set) {  // the whole set in one program, as daq gcode writes it
+      std::vector<cal::daq::BallbarSetTest> program;
+      for (const auto& t : circle_tests(config)) program.push_back({t.plane, t.program});
+      shop.run_circle_set(program);
+    } else if (test == "circle") {
+      shop.run_circle(circle_test(config).first);
+    } else {
+      const auto& l = *config.linear;
+      shop.run_linear(linear_plan(l), l.feed_mm_per_min, l.dwell_s);
+    }
+    fmt::print("daq sim: {} program started ({:.0f} s of simulated time)\n", test,
+               shop.program_end_s() - t0_s);
+    std::fflush(stdout);
+    // The program, then a little more so the acquiring side can finish reading.
+    run_until(shop.program_end_s() + 3.0 * o.speed);
+    fmt::print("daq sim: program ended\n");
+    std::fflush(stdout);
+  };
+  if (o.start_after_s) {
+    fmt::print(
+        "daq sim: SIMULATED shop running {}x faster than real time; devices in {}\n"
+        "  start `daq run {} --config {}` now: the machine starts the program in {} s\n",
+        o.speed, o.config_out, o.test, o.config_out, *o.start_after_s);
+    std::fflush(stdout);
+    run_until(shop.now_s() + *o.start_after_s * o.speed);
+    return run_program(set ? "circle" : o.test);
   }
-  fmt::print("daq sim: program started ({:.0f} s of simulated time)\n",
-             shop.program_end_s() - t0_s);
+  // As an operator would: the program is started once the acquisition waits for it (a run has
+  // begun in the database), and it is the program of that run's test.
+  const auto db = database_path(o.db);
+  std::int64_t seen = newest_run(db);
+  fmt::print(
+      "daq sim: SIMULATED shop running {}x faster than real time; devices in {}\n"
+      "  start a run (`daq run linear|circle --config {}`, or from `daq serve`) with the run\n"
+      "  database {}: the machine runs that test's program once the run has started\n",
+      o.speed, o.config_out, o.config_out, db.string());
   std::fflush(stdout);
-  // The program, then a little more so the acquiring side can finish reading.
-  run_until(shop.program_end_s() + 3.0 * o.speed);
-  fmt::print("daq sim: program ended\n");
+  for (;;) {
+    std::optional<cal::storage::RunRecord> run;
+    while (!(run = new_run(db, seen))) {
+      const auto until = std::chrono::steady_clock::now() + 200ms;
+      while (std::chrono::steady_clock::now() < until) io.run_for(2ms), shop.now_s();
+    }
+    seen = run->id;
+    const std::string test = run->kind == "circle" ? "circle" : "linear";
+    if ((test == "linear" && !config.linear) || (test == "circle" && !config.circle)) continue;
+    // The instruments of the run connect first (a program started while the laser still
+    // connects would lose its first approach): a second of simulated settling.
+    fmt::print("daq sim: run {} ({}) started\n", run->id, test);
+    run_until(shop.now_s() + 1.0 * o.speed);
+    run_program(test);
+    // A set's later tests are runs of their own, started while its one program ran: not
+    // programs to start again.
+    if (set) seen = newest_run(db);
+  }
 }
 
 }  // namespace
@@ -131,17 +141,20 @@ void add_sim_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "sim", "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
   cmd->add_option("--test", o->test,
-                  "linear, circle (XY) or circle-set (XY, ZX, YZ at two feeds): the program the "
-                  "machine runs")
+                  "linear, circle or circle-set (the ballbar set on a machine with errors in all "
+                  "three planes): the program run after --start-after-s (waiting for runs, the "
+                  "run's own test is run)")
       ->capture_default_str();
   cmd->add_option("-o,--config-out", o->config_out, "Where to write the devices' configuration")
       ->capture_default_str();
   cmd->add_option("--speed", o->speed, "Simulated time per real time")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
-  cmd->add_option("--start-after-s", o->start_after_s, "Wall-clock delay before the program")
-      ->capture_default_str()
+  cmd->add_option("--start-after-s", o->start_after_s,
+                  "Run the --test program once, this many wall-clock seconds after the start "
+                  "(default: wait for each run to start in the database, and run its test)")
       ->check(CLI::NonNegativeNumber);
+  add_db_option(*cmd, o->db);
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->callback([o] { run_sim(*o); });

@@ -80,14 +80,28 @@ const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role) 
   throw cal::InputError(fmt::format("{}: no device with role = \"{}\"", c.source.string(), role));
 }
 
+const cal::daq::DeviceConfig& ballbar_device(const cal::daq::Config& c) {
+  const auto& dc = need(c, "ballbar");
+  spec_of(dc, 0);  // its driver must give lengths
+  return dc;
+}
+
+std::chrono::microseconds scaled_poll(std::chrono::microseconds period, const RunOptions& o) {
+  return std::chrono::microseconds(std::max<std::int64_t>(
+      100, static_cast<std::int64_t>(static_cast<double>(period.count()) * o.poll_scale)));
+}
+
 d::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc, const InstrumentSpec& s,
                                         const RunOptions& o,
                                         cal::replay::CaptureRecorder* recorder) {
-  d::InstrumentOptions opt{
-      .name = dc.id, .backoff = {.max_attempts = o.give_up_after}, .recorder = recorder};
-  opt.poll_period = dc.poll_s > 0
-                        ? std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6))
-                        : d::driver(s.driver).default_poll(s.options, s.context());
+  d::InstrumentOptions opt{.name = dc.id,
+                           .backoff = {.max_attempts = o.give_up_after},
+                           .clock = o.clock,
+                           .recorder = recorder};
+  opt.poll_period = scaled_poll(
+      dc.poll_s > 0 ? std::chrono::microseconds(static_cast<std::int64_t>(dc.poll_s * 1e6))
+                    : d::driver(s.driver).default_poll(s.options, s.context()),
+      o);
   return opt;
 }
 
@@ -129,6 +143,14 @@ void check_devices(const cal::daq::Config& config, const std::vector<InstrumentS
                                if (st == d::InstrumentState::configuring) c.opened = true;
                                if (st == d::InstrumentState::closed) c.closed = true;
                                if (!why.empty()) c.why = std::string(why);
+                             },
+                         // What the device says in its own words (e.g. the IDS3010's number
+                         // and errorNumberToString text), warnings told apart from errors.
+                         .message =
+                             [&c, &print](const d::DeviceMessage& m) {
+                               print(fmt::format("  devices.{} ({}): {}{}: {}", c.device->id,
+                                                 c.device->transport, d::to_string(m.severity),
+                                                 m.code ? fmt::format(" {}", m.code) : "", m.text));
                              }});
   }
   const auto deadline = std::chrono::steady_clock::now() +
@@ -204,9 +226,10 @@ void add_linear_instruments(boost::asio::io_context& io, const cal::daq::Config&
                             cal::replay::CaptureRecorder* recorder, LinearRunSetup& setup) {
   for (const auto& s : specs) {
     const auto& dc = device_of(config, s);
-    place_linear_instrument(
-        s, make_instrument(io, s, make_transport(io, dc), instrument_options(dc, s, o, recorder)),
-        setup);
+    auto inst =
+        make_instrument(io, s, make_transport(io, dc), instrument_options(dc, s, o, recorder));
+    if (o.wrap) inst = o.wrap(dc, std::move(inst));
+    place_linear_instrument(s, std::move(inst), setup);
   }
 }
 

@@ -22,6 +22,16 @@ struct RunOptions {
   int give_up_after = 20;
   bool json = false;
   double check_s = 10.0;  // the start-up device check's limit; 0: no check
+  // The simulated shop in the same process (daq serve --simulate): the instruments read the
+  // shop's clock, and poll periods are in simulated seconds (multiplied by poll_scale =
+  // 1 / speed for the wall-clock timers). Empty / 1: the steady clock, real time.
+  cal::drivers::Clock clock;
+  double poll_scale = 1.0;
+  // Wraps each instrument a run makes (daq serve: the device board watches their states and
+  // readings); empty: none.
+  std::function<std::unique_ptr<cal::drivers::Instrument>(
+      const cal::daq::DeviceConfig&, std::unique_ptr<cal::drivers::Instrument>)>
+      wrap;
 };
 
 // The transport of a device ("tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or
@@ -31,6 +41,9 @@ std::unique_ptr<cal::drivers::transport::Transport> make_transport(boost::asio::
 // The instrument spec of a configured device; throws cal::InputError when its driver's readings
 // cannot fill its role (a PTU300 as the ballbar).
 InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device, int test_axis = 0);
+// The ballbar of a circle test: the device with role "ballbar" whose driver gives lengths;
+// else cal::InputError naming the configuration.
+const cal::daq::DeviceConfig& ballbar_device(const cal::daq::Config& c);
 // The device of a role, or cal::InputError naming the configuration file.
 const cal::daq::DeviceConfig& need(const cal::daq::Config& c, const char* role);
 
@@ -50,8 +63,10 @@ struct SessionCapture {
   }
 };
 
+// A poll period (seconds of the run's clock) as the wall-clock timer's period (see RunOptions).
+std::chrono::microseconds scaled_poll(std::chrono::microseconds period, const RunOptions& o);
 // The options of a configured device: its name, poll period (the driver's default when the
-// configuration gives none) and the run's reconnection limit.
+// configuration gives none), the run's clock and reconnection limit.
 cal::drivers::InstrumentOptions instrument_options(const cal::daq::DeviceConfig& dc,
                                                    const InstrumentSpec& s, const RunOptions& o,
                                                    cal::replay::CaptureRecorder* recorder);

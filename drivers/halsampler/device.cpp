@@ -85,9 +85,11 @@ class Driver final : public DeviceDriver {
             out.push_back(gap);
           }
           for (std::uint8_t axis = 0; axis < 3; ++axis)
-            if (f.position_m[axis])
+            if (f.position_m[axis]) {
               out.push_back(detail::reading_item(offset, axis, Quantity::machine_position_m,
                                                  *f.position_m[axis]));
+              out.back().sample = f.sample;  // with tagged: halsampler -t's number
+            }
         });
   }
   std::unique_ptr<sim::Twin> make_twin(boost::asio::io_context& io, sim::World& world,

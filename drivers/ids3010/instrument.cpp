@@ -7,6 +7,7 @@
 #include <array>
 #include <deque>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "ids3010/codec.hpp"
@@ -35,6 +36,7 @@ class Ids3010 final : public detail::InstrumentCore {
     start_refusals_ = 0;
     lookups_.clear();
     last_code_.clear();
+    failing_.reset();
     if (ids_.api == IdsApiChoice::automatic) {
       codec_.set_api(codec::IdsApi::sen);  // the newer first; an old firmware answers -32601
       request(IdsMethod::get_current_mode);
@@ -60,12 +62,16 @@ class Ids3010 final : public detail::InstrumentCore {
   }
 
   void on_poll() override {
+    if (failing_ && now_ns() >= failing_->deadline_ns)  // the text did not come: the number
+      return fail(fmt::format("{} (error {}; the device gave no text for it)", failing_->what,
+                              failing_->code));
     if (in_flight_ || !detected_) return;  // one request at a time: answers arrive in order
     if (!lookups_.empty()) {               // the device's text for a number it reported
       const codec::IdsParam params[] = {std::int64_t{1}, lookups_.front()};
       lookups_.pop_front();
       return request(IdsMethod::error_number_to_string, params);
     }
+    if (failing_) return;  // nothing else while the device explains why it refused
     if (!running_) return request(IdsMethod::get_current_mode);
     if (ecu_ready_ && now_ns() >= next_environment_ns_) {
       request(environment_[environment_index_]);
@@ -110,14 +116,13 @@ class Ids3010 final : public detail::InstrumentCore {
       case IdsMethod::ecu_enable:
         ecu_ready_ = r.error_code == 0;
         if (!ecu_ready_)
-          return fail(fmt::format("ECU interface not enabled (com.attocube.ecu.enable: {})",
-                                  describe_code(r)));
+          return fail_with_text(r, "ECU interface not enabled (com.attocube.ecu.enable)");
         if (ids_.start_measurement) request(IdsMethod::start_measurement);
         return;
       case IdsMethod::start_measurement:
         if (r.error_code != 0 && ++start_refusals_ >= 3)
-          return fail(fmt::format("startMeasurement refused {} times ({})", start_refusals_,
-                                  describe_code(r)));
+          return fail_with_text(r,
+                                fmt::format("startMeasurement refused {} times", start_refusals_));
         return;
       case IdsMethod::get_axes_displacement:
         return displacement(r, t);
@@ -170,6 +175,21 @@ class Ids3010 final : public detail::InstrumentCore {
       lookups_.push_back(r.error_code);
   }
 
+  // Ends the connection for a refusal, saying the device's number and its own text: a
+  // JSON-RPC error carries its text; a result[0] number's text is asked of the device first
+  // (errorNumberToString), waiting at most kTextWait before failing with the number alone.
+  void fail_with_text(const codec::IdsResponse& r, std::string what) {
+    if (r.rpc_error)
+      return fail(fmt::format("{} (JSON-RPC error {}: {})", what, r.error_code, r.error_message));
+    if (const auto known = texts_.find(r.error_code); known != texts_.end())
+      return fail(fmt::format("{} (error {}: {})", what, r.error_code, known->second));
+    if (replaying()) return fail(fmt::format("{} (error {})", what, r.error_code));
+    failing_ = Failing{r.error_code, std::move(what),
+                       now_ns() + std::chrono::nanoseconds(kTextWait).count()};
+    if (std::find(lookups_.begin(), lookups_.end(), r.error_code) == lookups_.end())
+      lookups_.push_back(r.error_code);
+  }
+
   // The device's text for a number (errorNumberToString [language 1, number]).
   void explained(const codec::IdsResponse& r) {
     if (r.params.size() < 2) return;
@@ -179,6 +199,14 @@ class Ids3010 final : public detail::InstrumentCore {
             ? r.text
             : fmt::format("(no text: errorNumberToString answered {})", describe_code(r));
     if (r.error_code == 0) texts_[code] = text;
+    if (failing_ && failing_->code == code) {  // the refusal that ends the connection
+      const std::string reason = fmt::format("{} (error {}: {})", failing_->what, code, text);
+      if (const auto it = pending_.find(code); it != pending_.end()) {
+        report_message({it->second.first, code, fmt::format("{}: {}", it->second.second, text)});
+        pending_.erase(it);
+      }
+      return fail(reason);
+    }
     const auto it = pending_.find(code);
     if (it == pending_.end()) return;
     report_message({it->second.first, code, fmt::format("{}: {}", it->second.second, text)});
@@ -225,6 +253,13 @@ class Ids3010 final : public detail::InstrumentCore {
   std::map<std::int64_t, std::string> texts_;  // the device's texts of numbers, once asked
   std::map<std::int64_t, std::pair<DeviceMessage::Severity, std::string>> pending_;
   std::deque<std::int64_t> lookups_;
+  struct Failing {
+    std::int64_t code;
+    std::string what;
+    std::int64_t deadline_ns;
+  };
+  std::optional<Failing> failing_;  // a refusal waiting for the device's text
+  static constexpr std::chrono::seconds kTextWait{2};
   static constexpr std::array<IdsMethod, 4> environment_{
       IdsMethod::ecu_get_temperature, IdsMethod::ecu_get_pressure, IdsMethod::ecu_get_humidity,
       IdsMethod::ecu_get_refractive_index};

@@ -74,6 +74,8 @@ struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's time
       if (n == error_not_measuring) return json::array({0, "measurement not running (simulated)"});
       if (n == error_beam_lost) return json::array({0, "signal lost on an axis (simulated)"});
       if (n == error_ecu_disabled) return json::array({0, "ECU interface not enabled (simulated)"});
+      if (n == error_start_refused) return json::array({0, "laser not ready (simulated)"});
+      if (n == error_ecu_refused) return json::array({0, "ECU interface refused (simulated)"});
       return json::array({0, "unknown error (simulated)"});
     }
     if (method == ids + "displacement.getAxesDisplacement" ||
@@ -93,6 +95,7 @@ struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's time
     if (method == ids + "displacement.getMeasurementEnabled")
       return json::array({0, measuring_since >= 0});
     if (method == ids + "system.startMeasurement") {
+      if (config.refuse_start) return json::array({error_start_refused});
       if (measuring_since < 0) measuring_since = now;
       aligning = false;
       return json::array({0});
@@ -120,6 +123,7 @@ struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's time
       return json::array({0});
     }
     if (method == ecu + "enable") {
+      if (config.refuse_ecu_enable) return json::array({error_ecu_refused});
       ecu_enabled = true;
       return json::array({0});
     }

@@ -18,6 +18,10 @@ struct IdsTwinConfig {
   std::array<double, 3> datum_mm{0.0, 0.0, 0.0};
   double starting_s = 0.2;  // "measurement starting" lasts this long after startMeasurement
   bool ecu_connected = true;
+  // startMeasurement answers error_start_refused instead of starting (a laser not ready).
+  bool refuse_start = false;
+  // com.attocube.ecu.enable answers error_ecu_refused (a stand-in for a refusing ECU).
+  bool refuse_ecu_enable = false;
   // The API generation it speaks (com.attocube.ids before firmware 1.9.1, com.attocube.sen
   // from it); methods of the other one are unknown to it (JSON-RPC -32601), as on the device.
   codec::IdsApi api = codec::IdsApi::ids;
@@ -39,6 +43,8 @@ class IdsTwin final : public TcpTwin {
   static constexpr std::int64_t error_not_measuring = 1;  // twin's code: not in measurement
   static constexpr std::int64_t error_beam_lost = 2;      // twin's code: signal lost on axis
   static constexpr std::int64_t error_ecu_disabled = 3;   // twin's code: ECU not enabled
+  static constexpr std::int64_t error_start_refused = 4;  // twin's code: start refused
+  static constexpr std::int64_t error_ecu_refused = 5;    // twin's code: ECU enable refused
 
  private:
   struct Impl;

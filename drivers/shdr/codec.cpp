@@ -174,11 +174,17 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
     if (!relative_origin_ms_) relative_origin_ms_ = *ms;
     f.relative_time_ms = *ms - *relative_origin_ms_;
   }
+  // key|value pairs by position, as the agent walks a line (shdr_token_mapper.cpp): a key it
+  // does not know skips itself and one value, so a value that happens to equal a key name
+  // ("program|Xact") is never taken for a key.
   bool any = false;
-  for (std::size_t i = 1; i + 1 < tokens.size(); ++i) {
+  for (std::size_t i = 1; i + 1 < tokens.size(); i += 2) {
     const auto it = config_.keys.find(tokens[i]);
-    if (it == config_.keys.end()) continue;
-    const std::string_view value = tokens[++i];
+    if (it == config_.keys.end()) {
+      if (config_.census) count_key(tokens[i], tokens[i + 1]);
+      continue;
+    }
+    const std::string_view value = tokens[i + 1];
     if (value == "UNAVAILABLE") continue;  // the control has no value: not a position
     const auto v = parse_number(value);
     if (!v || !std::isfinite(*v))
@@ -192,6 +198,14 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
     any = true;
   }
   if (any) emit(frames, std::move(f));
+}
+
+void ShdrCodec::count_key(std::string_view key, std::string_view value) {
+  if (key.empty() || numeric_key_set_.contains(key)) return;
+  if (const auto v = parse_number(value); !v || !std::isfinite(*v)) return;
+  if (numeric_key_set_.size() >= census_limit) return;  // bounded: a hostile stream
+  numeric_key_set_.emplace(key);
+  numeric_keys_.emplace_back(key);
 }
 
 }  // namespace cal::drivers::codec

@@ -13,15 +13,22 @@
 //  - the first token is the timestamp: ISO 8601 ("2022-08-08T13:51:34.7167146Z"), empty (the
 //    agent stamps it on arrival), or a number without 'T' (relative time, ms); either form may
 //    end with "@<duration>";
-//  - then key|value pairs. Data items take more tokens than one value (conditions five,
-//    messages two) and only the agent's device model says which; positions are found by their
-//    configured keys wherever they stand, the next token being the value. "UNAVAILABLE" is no
-//    value.
+//  - then key|value pairs, walked by position as the agent's ShdrTokenMapper
+//    (pipeline/shdr_token_mapper.cpp) walks them: each item is a key and its values, and a key
+//    it does not know is skipped with one value (legacy SHDR, before shdrVersion 2), so a
+//    value equal to a key name ("program|Xact|Xact|3": program = "Xact", X = 3) is a value.
+//    Items with more values (a condition five, an alarm four, a time series three, a message
+//    two) stand on a line of their own in SHDR, and the legacy agent stops reading a line after
+//    one of them. This codec has no device model and reads every line as pairs: items after
+//    an odd-valued one on the same line (a message, an alarm) would be misaligned, where the
+//    legacy agent reads none of them; SHDR adapters do not send such lines (the Okuma
+//    recording has none: every line is a timestamp and pairs). "UNAVAILABLE" is no value.
 // Where this codec differs from the agent: a timestamp with 'T' that does not parse (a 13th
 // month) or a first token that is neither a time nor a number is refused as malformed; the
 // agent silently uses its own clock.
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "cal/drivers/codec/common.hpp"
@@ -35,6 +42,9 @@ struct ShdrConfig {
   double metres_per_unit = 1e-3;  // MTConnect positions are in millimetres
   double max_abs_m = 100.0;       // plausibility: beyond it, out_of_range
   std::size_t max_line_bytes = 8192;
+  // daq decode: note the keys of the other items whose values are numbers (a hint for a user
+  // whose control names its positions otherwise); off in runs.
+  bool census = false;
 };
 
 class ShdrCodec : public CodecBase<ShdrCodec, PositionFrame> {
@@ -50,7 +60,12 @@ class ShdrCodec : public CodecBase<ShdrCodec, PositionFrame> {
   std::uint64_t commands() const { return commands_; }  // other '*' lines
   const std::string& last_command() const { return last_command_; }
   std::uint64_t assets() const { return assets_; }  // multi-line values skipped
+  // With config.census: the keys not configured whose values were numbers, in the order first
+  // seen (the first census_limit of them: a hostile stream cannot grow it).
+  static constexpr std::size_t census_limit = 256;
+  const std::vector<std::string>& numeric_keys_seen() const { return numeric_keys_; }
 
+  const ShdrConfig& config() const { return config_; }
   static std::string ping() { return "* PING\n"; }
 
  private:
@@ -64,6 +79,9 @@ class ShdrCodec : public CodecBase<ShdrCodec, PositionFrame> {
   std::string last_command_;
   std::optional<std::int64_t> pong_timeout_ms_;
   std::optional<double> relative_origin_ms_;  // the first relative timestamp
+  std::vector<std::string> numeric_keys_;
+  std::set<std::string, std::less<>> numeric_key_set_;
+  void count_key(std::string_view key, std::string_view value);
 };
 
 // "2024-01-01T12:00:00.123456Z" (fraction optional, Z optional) as Unix ns; nullopt if not.

@@ -1,5 +1,9 @@
 // MTConnect SHDR adapters (machine position feeds) in the device registry.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cctype>
+#include <span>
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/registry.hpp"
@@ -75,7 +79,7 @@ codec::ShdrConfig run_config(const Options& o, int axis) {
 
 // daq decode: every axis of `keys`, and `key` as X when given.
 codec::ShdrConfig decode_config(const Options& o) {
-  codec::ShdrConfig c{.keys = {}, .metres_per_unit = metres_per_unit(o)};
+  codec::ShdrConfig c{.keys = {}, .metres_per_unit = metres_per_unit(o), .census = true};
   const auto keys = axis_keys(o);
   for (int axis = 0; axis < 3; ++axis)
     if (!keys[static_cast<std::size_t>(axis)].empty())
@@ -111,13 +115,48 @@ class ShdrDecoder final : public Decoder {
         auto item =
             detail::reading_item(offset, axis, Quantity::machine_position_m, *f.position_m[axis]);
         item.device_time_unix_ns = f.time_unix_ns;
+        ++positions_;
         if (f.relative_time_ms) item.device_time_relative_s = *f.relative_time_ms * 1e-3;
         out.push_back(item);
       }
   }
+  // No position at all: most likely the control names its items otherwise (the Okuma
+  // OSP-P300 says X1actw, not Xact). Name the numeric items seen and how to choose them.
+  void finish(std::vector<DecodedItem>& out) override {
+    if (positions_ > 0) return;
+    const auto& seen = codec_.numeric_keys_seen();
+    const auto position_like = [](std::string_view k) {
+      std::string l(k);
+      for (auto& c : l) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      return l.find("act") != std::string::npos || l.find("pos") != std::string::npos;
+    };
+    std::vector<std::string_view> shown;  // position-like names first, then the others
+    for (const bool first : {true, false})
+      for (const auto& k : seen)
+        if (position_like(k) == first && shown.size() < kShown) shown.push_back(k);
+    std::vector<std::string_view> configured;
+    for (const auto& [key, axis] : codec_.config().keys) configured.push_back(key);
+    out.push_back(
+        {.kind = DecodedItem::Kind::note,
+         .offset = codec_.stats().bytes,
+         .text = seen.empty()
+                     ? fmt::format("no position: none of the keys {} is in the input, and no other "
+                                   "item has a numeric value; choose the keys with --set "
+                                   "keys=KEY_X,KEY_Y,KEY_Z",
+                                   fmt::join(configured, ", "))
+                     : fmt::format("no position: none of the keys {} is in the input; data item "
+                                   "keys with numeric values seen: {}{}; choose yours with --set "
+                                   "keys=KEY_X,KEY_Y,KEY_Z",
+                                   fmt::join(configured, ", "), fmt::join(shown, ", "),
+                                   seen.size() > shown.size()
+                                       ? fmt::format(" and {} more", seen.size() - shown.size())
+                                       : "")});
+  }
   const codec::CodecStats& stats() const override { return codec_.stats(); }
 
  private:
+  static constexpr std::size_t kShown = 16;
+  std::size_t positions_ = 0;
   codec::ShdrCodec codec_;
   std::vector<codec::PositionFrame> frames_;
   std::vector<codec::CodecError> errors_;

@@ -212,17 +212,23 @@ void InstrumentCore::schedule_reconnect() {
 
 // A silent device is a dropped connection (a TCP peer that vanished without a FIN, a serial
 // adapter whose instrument was switched off): without this, the gap would never be seen.
-void InstrumentCore::arm_watchdog() {
+void InstrumentCore::arm_watchdog(std::optional<std::chrono::nanoseconds> after) {
   if (options_.replay || !silence_timeout_) return;
   const auto timeout = *silence_timeout_;
-  watchdog_.expires_after(timeout);
+  watchdog_.expires_after(after.value_or(timeout));
   watchdog_.async_wait([this, alive = alive_, timeout](const boost::system::error_code& ec) {
     if (ec || !*alive || !running_) return;
-    const auto silent_ns = now_ns() - last_bytes_ns_;
-    if (silent_ns >= std::chrono::nanoseconds(timeout).count())
-      return fail(fmt::format("no data for {} ms", timeout.count()));
-    arm_watchdog();
+    const auto wait = silence_wait(timeout, std::chrono::nanoseconds(now_ns() - last_bytes_ns_));
+    if (!wait) return fail(fmt::format("no data for {} ms", timeout.count()));
+    arm_watchdog(*wait);  // the time remaining, not a whole timeout more
   });
+}
+
+std::optional<std::chrono::nanoseconds> silence_wait(std::chrono::nanoseconds timeout,
+                                                     std::chrono::nanoseconds silent) {
+  if (silent >= timeout) return std::nullopt;
+  if (silent < std::chrono::nanoseconds::zero()) return timeout;
+  return timeout - silent;
 }
 
 void InstrumentCore::set_silence_timeout(std::optional<std::chrono::milliseconds> timeout) {

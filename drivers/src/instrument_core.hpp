@@ -4,6 +4,7 @@
 // Boost.Asio, so only instrument .cpp files include it.
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,6 +13,14 @@
 #include "cal/drivers/instrument.hpp"
 
 namespace cal::drivers::detail {
+
+// The silence watchdog's decision when its timer fires: nullopt when the device has been
+// silent for `timeout` or longer (the connection is lost), else how long to wait before the
+// next check: the time remaining until `timeout` of silence, so that a lost connection is
+// seen at `timeout`, not up to twice that (a silence shorter than zero, a clock stepped back,
+// waits the whole timeout).
+std::optional<std::chrono::nanoseconds> silence_wait(std::chrono::nanoseconds timeout,
+                                                     std::chrono::nanoseconds silent);
 
 class InstrumentCore : public Instrument {
  public:
@@ -74,7 +83,8 @@ class InstrumentCore : public Instrument {
  private:
   void connect();
   void schedule_reconnect();
-  void arm_watchdog();
+  // Arms the silence watchdog to check again after `after` (the whole timeout by default).
+  void arm_watchdog(std::optional<std::chrono::nanoseconds> after = std::nullopt);
   void poll_tick();
 
   boost::asio::io_context& io_;

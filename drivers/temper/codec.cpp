@@ -33,19 +33,27 @@ constexpr std::pair<std::string_view, TemperFamily> kFamilies[] = {
     {"si7005", TemperFamily::si7005},   {"si7006", TemperFamily::si7006}};
 
 // The models the public projects document (docs/drivers.md has the table with its sources),
-// one per line (firmware prefix, family, inner, probe, humidity, ds75 slots, source).
+// one per line (firmware prefix, family, inner, probe, humidity, ds75 slots, source). Each
+// prefix is as long as its source compares (urwen/temper compares firmware[:N] for a fixed N;
+// ugold.c compares the whole 16 bytes): a firmware no source names is refused, never guessed.
+// OpenBSD's ugold.c also reads any "TEMPer1F*", "TEMPer2F*" or "TEMPerF1*" as DS75, but only on
+// Microdia 0c45:7401 and with the sensors found by the report's length; the codec does not know
+// the USB id, and the probe's slot differs between the TEMPer1F models that are documented
+// (first value on TEMPer1F1.1, second on TEMPer1F_V1.3), so those catch-alls are not applied:
+// an undocumented model there is read only with an explicit `family` (docs/drivers.md).
 // clang-format off
 constexpr TemperModel kModels[] = {
     // DS75 family, 0c45:7401 (Microdia).
-    {"TEMPerF1.", TemperFamily::ds75, true, false, false, {0, -1}, "urwen/temper (TEMPerF1.2, TEMPerF1.4: one inner sensor, /256)"},
+    {"TEMPerF1.2", TemperFamily::ds75, true, false, false, {0, -1}, "urwen/temper (TEMPerF1.2: one inner sensor, /256)"},
+    {"TEMPerF1.4", TemperFamily::ds75, true, false, false, {0, -1}, "urwen/temper (TEMPerF1.4: one inner sensor, /256)"},
     {"TEMPer1F1.", TemperFamily::ds75, false, true, false, {1, -1}, "urwen/temper README (TEMPer1F1.1Per1F: external sensor only, first value)"},
     {"TEMPer1F_V1.3", TemperFamily::ds75, false, true, false, {-1, 1}, "padelt/temper-python 1.5.1 (TEMPer1F_V1.3: one sensor, at offset 4)"},
-    {"TEMPer1F", TemperFamily::ds75, true, true, false, {0, 1}, "OpenBSD ugold.c (TEMPer1F*, TEMPer2F*, TEMPerF1*: DS75, sensors by length)"},
-    {"TEMPer2F", TemperFamily::ds75, true, true, false, {0, 1}, "OpenBSD ugold.c"},
-    {"TEMPerF1", TemperFamily::ds75, true, false, false, {0, 1}, "OpenBSD ugold.c"},
     {"TEMPer2_M12_V1.3", TemperFamily::ds75, true, true, false, {0, 1}, "urwen/temper (/256 at offsets 2 and 4, 1a86:e025)"},
     // Gold family: a report per sensor, 80 inner, 01 probe, /100.
-    {"TEMPerGold_V3.", TemperFamily::gold, true, false, false, {0, 1}, "OpenBSD ugold.c (V3.1, V3.4, V3.5), urwen/temper (V3.1, V3.3, V3.4), ccwienk/temper (V3.5 on 3553:a001)"},
+    {"TEMPerGold_V3.1", TemperFamily::gold, true, false, false, {0, 1}, "OpenBSD ugold.c, urwen/temper"},
+    {"TEMPerGold_V3.3", TemperFamily::gold, true, false, false, {0, 1}, "urwen/temper"},
+    {"TEMPerGold_V3.4", TemperFamily::gold, true, false, false, {0, 1}, "OpenBSD ugold.c, urwen/temper"},
+    {"TEMPerGold_V3.5", TemperFamily::gold, true, false, false, {0, 1}, "OpenBSD ugold.c, ccwienk/temper (3553:a001)"},
     {"TEMPer2_V3.7", TemperFamily::gold, true, true, false, {0, 1}, "urwen/temper (inner at offset 2, probe at 10: the second report)"},
     {"TEMPer2_V3.9", TemperFamily::gold, true, true, false, {0, 1}, "urwen/temper"},
     {"TEMPer2_V4.1", TemperFamily::gold, true, true, false, {0, 1}, "OpenBSD ugold.c, ccwienk/temper (3553:a001)"},

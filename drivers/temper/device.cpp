@@ -33,7 +33,7 @@ const std::vector<OptionSpec>& table() {
 // several models share a pair: the firmware string read at open tells them apart.
 constexpr KnownDevice kUsb[] = {
     {0x0c45, 0x7401, "temper",
-     "Microdia TEMPer: TEMPerF1.x, TEMPer1F_V1.3, TEMPer1F1.1, TEMPer2F (DS75)", "hid"},
+     "Microdia TEMPer: TEMPerF1.2/F1.4, TEMPer1F_V1.3, TEMPer1F1.1 (DS75)", "hid"},
     {0x0c45, 0x7402, "temper", "Microdia TEMPerHUM: TEMPer1F_H1V1.5F, TEMPerHum M12", "hid"},
     {0x413d, 0x2107, "temper", "PCsensor TEMPerGold_V3.1, TEMPerX_V3.1/V3.3", "hid"},
     {0x1a86, 0xe025, "temper",

@@ -22,7 +22,7 @@ for _ in $(seq 100); do [ -s "$TMP/sim.toml" ] && break; sleep 0.1; done
 # configuration names the bar instead of giving its length; in the calibrator of 100.0000 mm it
 # read -0.0030 mm, so it reads 0 at 100.0030 mm (the simulated bar is exactly 100 mm: the
 # radius error then comes out 3 um larger than the simulated machine's).
-sed -i 's/^calibrated_radius_mm = .*/bar = "SIM-BAR"/' "$TMP/sim.toml"
+sed -i 's/^centre_mm = .*/&\nbar = "SIM-BAR"/' "$TMP/sim.toml"
 check calibrate 0 "calibration 1 of bar 'SIM-BAR' at 100 mm stored .* reads 0 at 100\.0030 mm" -- "$DAQ" ballbar calibrate --db "$TMP/run.sqlite" --bar SIM-BAR --nominal-mm 100 --calibrator-mm 100 --reading-mm -0.003 --calibrator "simulated calibrator"
 
 # The injected truth (daq/src/runtime/sim_shop.hpp ShopTruth): squareness +20 um/m, Y lags X by

@@ -172,15 +172,18 @@ TEST(ShdrCodec, EveryTimestampFormOfTheAgent) {
 }
 
 TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
-  // A message takes two tokens and a condition five: a pairwise walk would be misaligned by
-  // them; keys are found wherever they stand. Commands with or without a space after '*' are
-  // not data; an asset's body is skipped up to a line equal to its terminator.
+  // Items are walked key|value by position as cppagent's ShdrTokenMapper does (a key it does not
+  // know skips one value). A condition (five values) stands on its own line, as SHDR has it:
+  // with an even count of values the pairs after it stay aligned. Commands with or without a
+  // space after '*' are not data; an asset's body is skipped up to a line equal to its
+  // terminator.
   ShdrCodec c({.keys = {{"Xact", 0}, {"Zact", 2}}});
   std::vector<PositionFrame> frames;
   std::vector<CodecError> errors;
   c.feed(
-      "2024-01-01T00:00:00Z|msg|CODE1|some text|Xact|10\n"
-      "2024-01-01T00:00:01Z|Xcond|WARNING|42|HIGH||too close|Zact|-5\n"
+      "2024-01-01T00:00:00.5Z|Xact|10\n"
+      "2024-01-01T00:00:01Z|Xcond|WARNING|42|HIGH||too close\n"
+      "2024-01-01T00:00:01.5Z|Zact|-5\n"
       "*adapterVersion:1.0\n"
       "* shdrVersion: 2\n"
       "2024-01-01T00:00:02Z|@ASSET@|T1|CuttingTool|--multiline--0FF1CE\n"
@@ -196,6 +199,37 @@ TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
   EXPECT_DOUBLE_EQ(*frames[2].position_m[2], 0.007);
   EXPECT_EQ(c.commands(), 2u);
   EXPECT_EQ(c.assets(), 1u);
+}
+
+TEST(ShdrCodec, AValueEqualToAKeyNameIsAValue) {
+  // Pairs by position (cppagent's ShdrTokenMapper): "msg|Xact" is the item msg with the value
+  // "Xact", so the 12.5 after it is no X position; "program|Xact" likewise, then X = 3 mm.
+  const auto d = codec_test::feed_whole(ShdrCodec{},
+                                        "2024-01-01T00:00:00Z|Yact|1|msg|Xact|12.5\n"
+                                        "2024-01-01T00:00:01Z|program|Xact|Xact|3\n");
+  EXPECT_EQ(d.stats.errors(), 0u);  // before: "program|Xact|Xact" made X = "Xact", an error
+  ASSERT_EQ(d.frames.size(), 2u);
+  EXPECT_DOUBLE_EQ(*d.frames[0].position_m[1], 0.001);
+  EXPECT_FALSE(d.frames[0].position_m[0]);
+  EXPECT_DOUBLE_EQ(*d.frames[1].position_m[0], 0.003);
+}
+
+TEST(ShdrCodec, TheCensusOfNumericKeysIsForDecodeOnlyAndBounded) {
+  const std::string lines = "2024-01-01T00:00:00Z|X1actw|1.5|mode|AUTO|Xact|2|S1load|0\n";
+  EXPECT_TRUE(codec_test::feed_whole(ShdrCodec{}, lines).frames.size() == 1u);
+  ShdrCodec off;
+  std::vector<PositionFrame> frames;
+  std::vector<CodecError> errors;
+  off.feed(lines, frames, errors);
+  EXPECT_TRUE(off.numeric_keys_seen().empty());  // runs keep no census
+  ShdrCodec on({.census = true});
+  on.feed(lines + lines, frames, errors);
+  // The configured Xact is not listed, nor mode (AUTO is no number); each key once.
+  EXPECT_EQ(on.numeric_keys_seen(), (std::vector<std::string>{"X1actw", "S1load"}));
+  std::string many;
+  for (int k = 0; k < 1000; ++k) many += "|k" + std::to_string(k) + "|1\n";
+  on.feed(many, frames, errors);
+  EXPECT_EQ(on.numeric_keys_seen().size(), ShdrCodec::census_limit);
 }
 
 TEST(PositionFeeds, SplitAtAnyByteGivesTheSameFrames) {

@@ -167,6 +167,30 @@ TEST(TemperModels, DetectedFromTheFirmwareStringsThePublicProjectsShow) {
   EXPECT_EQ(temper_model_of(""), nullptr);
 }
 
+TEST(TemperModels, OnlyTheVersionsTheSourcesNameAreDetected) {
+  // ugold.c reads "TEMPer1F*", "TEMPer2F*", "TEMPerF1*" as DS75 only on Microdia 0c45:7401; no
+  // source names these strings, so they are refused rather than read with a phantom sensor.
+  EXPECT_EQ(temper_model_of("TEMPer1F_V9.9"), nullptr);
+  EXPECT_EQ(temper_model_of("TEMPer2F_V1.0"), nullptr);
+  EXPECT_EQ(temper_model_of("TEMPerF1.9"), nullptr);
+  // ugold.c lists TEMPerGold V3.1, V3.4, V3.5 and urwen/temper V3.1, V3.3, V3.4: not V3.2 or V3.9.
+  EXPECT_EQ(temper_model_of("TEMPerGold_V3.2 "), nullptr);
+  EXPECT_EQ(temper_model_of("TEMPerGold_V3.9 "), nullptr);
+  for (const char* fw : {"TEMPerGold_V3.1 ", "TEMPerGold_V3.3 ", "TEMPerGold_V3.4 "}) {
+    SCOPED_TRACE(fw);
+    ASSERT_NE(temper_model_of(fw), nullptr);
+    EXPECT_EQ(temper_model_of(fw)->family, TemperFamily::gold);
+  }
+  // urwen/temper's documented DS75 strings stay: TEMPerF1.2/1.4 the stick only, TEMPer1F1.1
+  // (the ugold.c comment's 'TEMPer1F' + '1.1Per1F') the probe only, as the first value.
+  ASSERT_NE(temper_model_of("TEMPerF1.4"), nullptr);
+  EXPECT_FALSE(temper_model_of("TEMPerF1.4")->probe);
+  const auto* f11 = temper_model_of("TEMPer1F1.1Per1F");
+  ASSERT_NE(f11, nullptr);
+  EXPECT_FALSE(f11->inner);
+  EXPECT_EQ(f11->ds75_slots[0], 1);
+}
+
 TEST(TemperCodec, AProbeOnlyModelGivesNoPhantomInnerSensor) {
   // TEMPer1F_V1.3 (ds75): the one sensor is the second value; 0x0B40 = 2880 -> 11.25 degC.
   TemperConfig v13{

@@ -49,6 +49,7 @@ struct Recorder {
   std::vector<std::string> reasons;
   std::vector<d::Gap> gaps;
   std::size_t codec_errors = 0;
+  std::vector<d::DeviceMessage> messages;
   d::InstrumentEvents events() {
     return {.reading = [this](const d::Reading& r) { readings.push_back(r); },
             .state =
@@ -57,7 +58,12 @@ struct Recorder {
                   reasons.emplace_back(why);
                 },
             .gap = [this](const d::Gap& g) { gaps.push_back(g); },
-            .codec_error = [this](const auto&) { ++codec_errors; }};
+            .codec_error = [this](const auto&) { ++codec_errors; },
+            .message = [this](const d::DeviceMessage& m) { messages.push_back(m); }};
+  }
+  bool failed_with(std::string_view text) const {
+    return std::any_of(reasons.begin(), reasons.end(),
+                       [&](const auto& r) { return r.find(text) != std::string::npos; });
   }
   std::size_t count(d::Quantity q, d::ReadingStatus s = d::ReadingStatus::ok) const {
     return static_cast<std::size_t>(
@@ -123,6 +129,75 @@ TEST(Ids3010Instrument, StreamsTheRawDisplacementAndTheEcuAir) {
   ASSERT_TRUE(run_until(io, [&] { return ids->state() == d::InstrumentState::streaming; }));
   ids->stop();
   EXPECT_EQ(ids->state(), d::InstrumentState::closed);
+}
+
+// The device's own number and text (errorNumberToString) reach the user: in the reason that
+// ends the connection, and as messages, warnings told apart from errors.
+TEST(Ids3010Instrument, RefusalsAndWarningsCarryTheDevicesNumberAndText) {
+  boost::asio::io_context io;
+  sim::World world = parked_at_100mm();
+  {  // startMeasurement refused three times (its text known from the first refusal)
+    sim::IdsTwin twin(io, world, [] { return 1.0; }, {.refuse_start = true});
+    auto ids = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+                               {.name = "laser", .poll_period = 2ms}, {.read_environment = false});
+    Recorder rec;
+    ids->start(rec.events());
+    ASSERT_TRUE(run_until(io, [&] { return rec.failed_with("startMeasurement refused"); }));
+    ids->stop();
+    EXPECT_TRUE(
+        rec.failed_with("startMeasurement refused 3 times (error 4: laser not ready "
+                        "(simulated))"))
+        << rec.reasons.back();
+    const auto m = std::find_if(rec.messages.begin(), rec.messages.end(), [](const auto& x) {
+      return x.code == sim::IdsTwin::error_start_refused;
+    });
+    ASSERT_NE(m, rec.messages.end());
+    EXPECT_EQ(m->severity, d::DeviceMessage::Severity::error);
+    EXPECT_NE(m->text.find("startMeasurement: laser not ready (simulated)"), std::string::npos)
+        << m->text;
+  }
+  {  // the ECU refuses at its first answer: the text is asked of the device before failing
+    sim::IdsTwin twin(io, world, [] { return 1.0; }, {.refuse_ecu_enable = true});
+    auto ids = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+                               {.name = "laser", .poll_period = 2ms});
+    Recorder rec;
+    ids->start(rec.events());
+    ASSERT_TRUE(run_until(io, [&] { return rec.failed_with("ECU interface not enabled"); }));
+    ids->stop();
+    EXPECT_TRUE(
+        rec.failed_with("ECU interface not enabled (com.attocube.ecu.enable) (error 5: "
+                        "ECU interface refused (simulated))"))
+        << rec.reasons.back();
+    ASSERT_EQ(rec.messages.size(), 2u);  // the API generation (info), then the refusal
+    EXPECT_EQ(rec.messages[1].severity, d::DeviceMessage::Severity::error);
+    EXPECT_EQ(rec.messages[1].code, sim::IdsTwin::error_ecu_refused);
+  }
+  {  // a blocked beam: a warning with the device's number and text, readings flagged
+    double now_s = 1.0;
+    sim::IdsTwin twin(io, world, [&] { return now_s; });
+    auto ids = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+                               {.name = "laser", .poll_period = 2ms}, {.read_environment = false});
+    Recorder rec;
+    ids->start(rec.events());
+    ASSERT_TRUE(run_until(io, [&] { return ids->state() == d::InstrumentState::configuring; }));
+    run_until(
+        io, [] { return false; }, 50ms);  // startMeasurement sent at the twin's 1.0 s
+    now_s = 2.0;                          // past the twin's "measurement starting"
+    ASSERT_TRUE(run_until(io, [&] { return rec.count(d::Quantity::displacement_m) >= 3; }));
+    twin.set_beam_lost(0, true);
+    const auto warned = [&] {
+      return std::any_of(rec.messages.begin(), rec.messages.end(),
+                         [](const auto& m) { return m.code == sim::IdsTwin::error_beam_lost; });
+    };
+    ASSERT_TRUE(run_until(io, warned));
+    ids->stop();
+    const auto m = std::find_if(rec.messages.begin(), rec.messages.end(), [](const auto& x) {
+      return x.code == sim::IdsTwin::error_beam_lost;
+    });
+    EXPECT_EQ(m->severity, d::DeviceMessage::Severity::warning);
+    EXPECT_NE(m->text.find("signal lost on an axis (simulated)"), std::string::npos) << m->text;
+    EXPECT_FALSE(rec.failed_with("signal lost"));  // a warning does not end the connection
+  }
 }
 
 TEST(Ptu300Instrument, PollsAt4800SevenEvenOneAndGivesUpOnAVanishedPort) {

@@ -121,12 +121,14 @@ TEST(LiveServer, WebSocketGetsTheLatestStateNotAQueue) {
   ws.close(websocket::close_code::normal);
 }
 
-TEST(LivePage, IsOneSelfContainedDocument) {
-  // The chart library and its style are inlined: no external script, style or font, so the
-  // page works on a machine-shop PC without internet.
-  const std::string page = cal::daq::web::live_page();
+TEST(OperatorPage, IsOneSelfContainedDocument) {
+  // The chart library, its style and the page's strings are inlined: no external script,
+  // style or font, so the page works on a machine-shop PC without internet.
+  const std::string page = cal::daq::web::operator_page();
   EXPECT_EQ(page.find("/*UPLOT_JS*/"), std::string::npos);
   EXPECT_EQ(page.find("/*UPLOT_CSS*/"), std::string::npos);
+  EXPECT_EQ(page.find("/*STRINGS*/"), std::string::npos);
+  EXPECT_NE(page.find(R"("tab.setup": "Set-up")"), std::string::npos);
   EXPECT_NE(page.find("uPlot"), std::string::npos);
   EXPECT_GT(page.size(), 50'000u);  // uPlot.iife.min.js alone is 51 kB
   EXPECT_EQ(page.find("<script src="), std::string::npos);

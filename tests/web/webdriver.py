@@ -1,7 +1,8 @@
 """A minimal W3C WebDriver client (standard library only) for Debian's chromium-driver.
 
-Used by the report rendering test and the live page end-to-end test: start chromedriver,
-open a headless Chromium session, load pages, run scripts, take screenshots.
+Used by the report rendering test and the operator's page end-to-end test: start
+chromedriver, open a headless Chromium session, load pages, run scripts (synchronous and
+asynchronous), resize the window, take screenshots.
 """
 import base64
 import json
@@ -63,20 +64,33 @@ class Browser:
         return self._call("POST", f"/session/{self.session}/execute/sync",
                           {"script": script, "args": list(args)})
 
+    def js_async(self, script, *args):
+        """Runs `script` with a callback as its last argument (arguments[arguments.length-1])
+        and returns what the script passes to it (e.g. the text of a fetched blob URL)."""
+        return self._call("POST", f"/session/{self.session}/execute/async",
+                          {"script": script, "args": list(args)})
+
+    def set_size(self, width, height):
+        self._call("POST", f"/session/{self.session}/window/rect",
+                   {"width": width, "height": height})
+
     def screenshot(self, path):
         png = base64.b64decode(self._call("GET", f"/session/{self.session}/screenshot"))
         with open(path, "wb") as f:
             f.write(png)
         return png
 
-    def wait(self, script, timeout_s=20, what="condition"):
+    def wait(self, script, timeout_s=20, what="condition", explain=None):
+        """Polls `script` until it returns a true value; on time-out, `explain` (a script)
+        says what the page showed instead."""
         deadline = time.time() + timeout_s
         while time.time() < deadline:
             value = self.js(script)
             if value:
                 return value
             time.sleep(0.1)
-        raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+        detail = f": {self.js(explain)}" if explain else ""
+        raise AssertionError(f"timed out after {timeout_s} s waiting for {what}{detail}")
 
     def close(self):
         try:

@@ -6,6 +6,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <chrono>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -250,14 +251,21 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq:
 }
 
 std::string to_json_text(const CircleLive& s) {
+  const auto trace = [](const std::vector<std::pair<double, double>>& points) {
+    json a = json::array();
+    for (const auto& [angle, dev] : points) a.push_back({angle, dev});
+    return a;
+  };
+  // Before the bar's first sample there is no deviation: null, never a 0 that looks measured.
   return json{{"schema", "caldaq.live-circle.v1"},
               {"time_s", s.time_s},
               {"state", s.state},
               {"phase", s.phase},
               {"angle_deg", s.angle_deg},
-              {"deviation_um", s.deviation_um},
+              {"deviation_um", s.samples ? json(s.deviation_um) : json(nullptr)},
               {"fraction", s.fraction},
-              {"samples", s.samples}}
+              {"samples", s.samples},
+              {"trace", {{"ccw", trace(s.ccw)}, {"cw", trace(s.cw)}}}}
       .dump();
 }
 
@@ -371,6 +379,7 @@ struct CircleRun::Impl {
     }
     const bool had = segmenter.feed_in_end().has_value();
     segmenter.add(r.value * 1e3);
+    trace(r.value * 1e6);
     if (!had && segmenter.feed_in_end()) event("feed-in found: the circle starts after the dwell");
     publish_live(r);
     if (!segmenter.complete()) return;
@@ -381,6 +390,18 @@ struct CircleRun::Impl {
       finish();
     else
       boost::asio::post(io, [this] { finish(); });
+  }
+
+  // The live polar trace: a point per degree of each arc (the page draws it; the analysis
+  // uses every sample).
+  void trace(double deviation_um) {
+    if (!setup.on_live) return;
+    const auto pr = segmenter.progress();
+    auto* arc = pr.phase == cal::daq::BallbarPhase::ccw_arc  ? &live.ccw
+                : pr.phase == cal::daq::BallbarPhase::cw_arc ? &live.cw
+                                                             : nullptr;
+    if (arc && (arc->empty() || std::abs(pr.angle_deg - arc->back().first) >= 1.0))
+      arc->emplace_back(pr.angle_deg, deviation_um);
   }
 
   // At most every 0.1 s of the bar's own clock, so a replay at full speed is not slowed down.

@@ -95,7 +95,10 @@ struct CircleLive {
   double angle_deg = 0.0;     // programmed angle of the latest sample
   double deviation_um = 0.0;  // the bar's latest deviation
   double fraction = 0.0;      // of the test after the feed-in
-  std::size_t samples = 0;
+  std::size_t samples = 0;    // 0: the bar has sent nothing (no deviation is shown)
+  // The live polar trace: (programmed angle in deg, deviation in um) of each arc, a point
+  // every degree or more (about 900 points for a whole test).
+  std::vector<std::pair<double, double>> ccw, cw;
 };
 std::string to_json_text(const CircleLive& s);  // schema caldaq.live-circle.v1 (docs/cli.md)
 

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/daq/env_stage.hpp"
+#include "cal/daq/motion.hpp"
 #include "cal/daq/trigger.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
@@ -55,6 +56,35 @@ std::string to_json_text(const LiveState& s) {
   }
   j["captured"] = s.progress.captured;
   j["expected"] = s.progress.expected;
+  j["valid"] = s.valid;
+  j["motion"] = {{"state", s.motion}, {"stable_fraction", s.stable_fraction}};
+  if (s.last_settling_s)
+    j["motion"]["last_stop"] = {{"settling_s", *s.last_settling_s},
+                                {"stable_s", s.last_stable_s.value_or(0.0)}};
+  // The number the page shows: a deviation within a target's capture window, else the
+  // position; none before the first laser reading.
+  if (!s.has_reading)
+    j["display"] = nullptr;
+  else if (s.at_target_mm)
+    j["display"] = {{"mode", "deviation"},
+                    {"value", s.at_target_deviation_um},
+                    {"unit", "µm"},
+                    {"decimals", 2},
+                    {"target_mm", *s.at_target_mm}};
+  else
+    j["display"] = {
+        {"mode", "position"}, {"value", s.position_mm}, {"unit", "mm"}, {"decimals", 3}};
+  j["stop"] = {{"number", s.stop_number}, {"count", s.stop_count}};
+  json stops = json::array();
+  for (const auto& x : s.stops)
+    stops.push_back({{"number", x.number},
+                     {"run", x.run},
+                     {"direction", x.up ? "up" : "down"},
+                     {"target", x.target},
+                     {"nominal_mm", x.nominal_mm},
+                     {"deviation_um", x.missed ? json(nullptr) : json(x.deviation_um)},
+                     {"missed", x.missed}});
+  j["stops"] = std::move(stops);
   return j.dump();
 }
 
@@ -130,6 +160,8 @@ struct LinearRun::Impl {
   cal::daq::StabilityTrigger trigger;
   std::optional<cal::daq::PositionTrigger> position_trigger;  // with a position feed
   cal::daq::Sequencer sequencer;
+  cal::daq::MotionIndicator motion;
+  std::vector<double> acceptable;  // sorted: the positions a stop could be at now
   std::optional<cal::storage::Store> store;
   std::unique_ptr<cal::storage::BatchWriter> writer;
   boost::asio::steady_timer timer;
@@ -151,6 +183,9 @@ struct LinearRun::Impl {
                  .dwell_s = setup.config.trigger.dwell_s,
                  .window_mm = setup.config.trigger.window_mm}),
         sequencer(plan, setup.config.trigger.window_mm),
+        motion({.tolerance_um = setup.config.trigger.tolerance_um,
+                .dwell_s = setup.config.trigger.dwell_s,
+                .window_mm = setup.config.trigger.window_mm}),
         timer(i) {
     if (setup.position)
       position_trigger.emplace(
@@ -168,6 +203,7 @@ struct LinearRun::Impl {
   // after a missed stop they must still see the following ones.
   void expect_next() {
     const auto positions = sequencer.acceptable_mm();
+    acceptable = positions;
     if (positions.empty()) {
       trigger.expect(std::nullopt);
       if (position_trigger) position_trigger->expect(std::nullopt);
@@ -327,6 +363,7 @@ struct LinearRun::Impl {
     live.state = "measuring";
     const bool valid = r.status == ReadingStatus::ok;
     last_raw_m = r.value;
+    show_motion(r.time_ns, position_mm, valid);
     if (position_trigger) {
       if (auto cap = position_trigger->add_reading(r.time_ns, position_mm, valid))
         on_capture(*cap, c);
@@ -335,12 +372,27 @@ struct LinearRun::Impl {
     }
   }
 
+  // The page's indicator and number (motion.hpp): the deviation from the target whose window
+  // holds the position, else the position.
+  void show_motion(std::int64_t time_ns, double position_mm, bool valid) {
+    motion.add(time_ns, position_mm, valid, acceptable);
+    live.has_reading = true;
+    live.valid = valid;
+    live.motion = std::string(cal::daq::to_string(motion.motion()));
+    live.stable_fraction = motion.stable_fraction();
+    live.at_target_mm = motion.target_mm();
+    if (live.at_target_mm) live.at_target_deviation_um = (position_mm - *live.at_target_mm) * 1e3;
+  }
+
   void on_capture(const cal::daq::Capture& cap, const cal::daq::Compensated& c) {
     for (const auto& e : sequencer.on_capture(cap)) {
       event(e.message);
       using Kind = cal::daq::SequenceEvent::Kind;
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
         const auto& s = sequencer.stops()[e.stop];
+        motion.captured(cap.mean_mm, s.position_mm, cap.end_ns);
+        if (const auto t = motion.last_stop())
+          live.last_settling_s = t->settling_s, live.last_stable_s = t->stable_s;
         const cal::storage::CapturedTarget t{
             .run_id = outcome.run_id,
             .target_index = s.target_index - 1,
@@ -455,8 +507,24 @@ struct LinearRun::Impl {
   }
 
   void publish() {
+    if (!setup.on_live) return;
     live.progress = sequencer.progress();
-    if (setup.on_live) setup.on_live(live);
+    const auto& stops = sequencer.stops();
+    live.stop_count = stops.size();
+    live.stop_number = sequencer.next_index() + 1;
+    live.stops.clear();
+    for (std::size_t i = 0; i < stops.size(); ++i) {
+      const auto& s = stops[i];
+      if (!s.captured && !s.missed) continue;
+      live.stops.push_back({.number = i + 1,
+                            .run = s.run,
+                            .target = s.target_index,
+                            .up = s.direction == cal::iso230_2::Direction::up,
+                            .nominal_mm = s.position_mm,
+                            .deviation_um = s.deviation_um,
+                            .missed = s.missed && !s.captured});
+    }
+    setup.on_live(live);
   }
 
   // 10 Hz: live state, and the writer's age-based flush so a slow stream is still committed.

@@ -34,6 +34,27 @@ struct LiveState {
   double air_temperature_degc = 0.0, pressure_pa = 0.0, humidity_pct = 0.0, n = 1.0;
   double material_degc = 20.0, factor_ppm = 0.0;
   bool fallback = false;
+  // What the operator's page shows (cal/daq/motion.hpp): the axis moving, settling, stable or
+  // captured; while the position is within the capture window of a target, the deviation from
+  // that target (not from the next expected one, which is meaningless while the axis moves).
+  bool has_reading = false;  // a laser reading arrived (until then: no number at all)
+  bool valid = true;         // the newest laser reading was valid (not signal lost)
+  std::string motion = "moving";
+  double stable_fraction = 0.0;
+  std::optional<double> at_target_mm;
+  double at_target_deviation_um = 0.0;
+  // The last captured stop: how long it settled, and was stable before the capture.
+  std::optional<double> last_settling_s, last_stable_s;
+  // Stop k of N: the next expected stop in plan order (k = N + 1 when complete).
+  std::size_t stop_number = 0, stop_count = 0;
+  struct Stop {
+    std::size_t number = 0;  // 1-based, in plan order
+    int run = 0, target = 0;
+    bool up = true;
+    double nominal_mm = 0.0, deviation_um = 0.0;
+    bool missed = false;
+  };
+  std::vector<Stop> stops;  // captured or missed so far, in plan order
 };
 std::string to_json_text(const LiveState& s);
 

@@ -130,7 +130,12 @@ const std::string& SimulatedShop::material_device() const { return impl_->materi
 const std::string& SimulatedShop::ballbar_device() const { return impl_->ballbar.device_path(); }
 std::uint16_t SimulatedShop::position_port() const { return impl_->position.port(); }
 
-std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed) const {
+std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
+                                        bool serial_numbers) const {
+  // Serial numbers as a real set-up has them for its report (daq serve --simulate).
+  const auto serial = [&](std::string_view number) {
+    return serial_numbers ? fmt::format("serial_number = \"{}\"\n", number) : std::string{};
+  };
   std::string position;
   if (position_feed)
     position = fmt::format(
@@ -143,19 +148,19 @@ driver = "ids3010"
 transport = "{laser}"
 role = "laser"
 poll_s = {laser_poll}
-
+{laser_sn}
 [devices.air]
 driver = "ptu300"
 transport = "{air}"
 role = "air"
-
+{air_sn}
 [devices.material]
 driver = "gauge"
 transport = "serial {material} 9600 8N1"
 request = "?\r"
 unit = "degC"
 role = "material"
-
+{material_sn}
 {position}[devices.ballbar]
 driver = "gauge"
 transport = "{ballbar}"
@@ -163,7 +168,9 @@ unit = "mm"
 min_si = -0.1           # the bar's travel: +/- 100 mm about its zero length
 max_si = 0.1
 role = "ballbar"
-)TOML",
+{ballbar_sn})TOML",
+      fmt::arg("laser_sn", serial("SIM-IDS-0001")), fmt::arg("air_sn", serial("SIM-PTU-0001")),
+      fmt::arg("material_sn", serial("SIM-TH-0001")), fmt::arg("ballbar_sn", serial("SIM-BB-0001")),
       fmt::arg("laser", impl_->ids.transport()), fmt::arg("laser_poll", laser_poll_s),
       fmt::arg("air", impl_->ptu.transport()), fmt::arg("material", impl_->material.device_path()),
       fmt::arg("position", position), fmt::arg("ballbar", impl_->ballbar.transport()));
@@ -283,6 +290,89 @@ std::vector<cal::iso230_2::Measurement> SimulatedShop::true_measurements(
       out.push_back({m.position_mm, m.run, m.direction,
                      impl_->truth.deviation_um(m.position_mm, m.direction)});
   return out;
+}
+
+std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o) {
+  const auto& t = shop.truth();
+  const double wall = o.in_process ? 1.0 : 1.0 / o.speed;  // simulated s -> the reader's s
+  const std::string header =
+      o.in_process
+          ? fmt::format(
+                "# The devices of the built-in SIMULATED shop of `daq serve --simulate` (running\n"
+                "# {}x faster than real time; every time here is simulated time). Valid while\n"
+                "# that process runs.\n",
+                o.speed)
+          : fmt::format(
+                "# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {}x\n"
+                "# faster than real time). Valid while that process runs.\n",
+                o.speed);
+  return header +
+         fmt::format(
+             R"TOML(campaign = "simulated"
+
+[machine]
+name = "SIMULATED VMC"
+description = "built-in simulated 3-axis machine with injected errors ({who})"
+
+{devices}
+[environment]
+equation = "ciddor"
+expansion_ppm_per_k = {alpha}
+{stale}
+[trigger]
+tolerance_um = 1
+dwell_s = {trigger_dwell}
+window_mm = 0.5
+
+[test.linear]
+axis = "X"
+first_mm = 0
+last_mm = 500
+interval_mm = 50
+random_fraction = 0.2
+runs = 5
+overrun_mm = 3
+feed_mm_per_min = 6000
+dwell_s = 3
+
+[test.circle]
+{circle_tests}radius_mm = {radius}
+sample_rate_hz = 1000
+overshoot_deg = 45
+centre_mm = [{cx}, {cy}, {cz}]
+
+# The machine's specification (as in `daq demo`): the injected backlash (4 um) and servo
+# mismatch exceed it, the rest is within.
+[tolerances.X]
+E_um = 10
+R_um = 6
+B_um = 3
+A_um = 12
+M_um = 8
+
+[tolerances.XY]
+G_um = 10
+[tolerances.XY.diagnostics]
+squareness = 30
+backlash_X = 3
+)TOML",
+             fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
+             // In process the instruments read the shop's clock: every time is
+             // simulated time; the poll periods of the drivers' defaults too.
+             fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
+                                                   /*serial_numbers=*/true)),
+             fmt::arg("alpha", t.expansion_ppm_per_k),
+             // Simulated seconds: at a high speed the wall-clock timers' jitter is
+             // magnified, as in daq demo.
+             fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
+             fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
+             fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
+             fmt::arg("cz", t.pivot_mm[2]),
+             // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220
+             // deg over the top, each at a slow and a fast feed (docs/circle.md).
+             fmt::arg("circle_tests", o.circle_set ? "planes = [\"XY\", \"ZX\", \"YZ\"]\n"
+                                                     "feeds_mm_per_min = [1000, 3000]\n"
+                                                   : "plane = \"XY\"\nfeed_mm_per_min = 1000\n"));
 }
 
 }  // namespace daq

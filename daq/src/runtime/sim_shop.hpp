@@ -73,7 +73,8 @@ class SimulatedShop {
   // The [devices.*] tables (TOML, docs/config.md) of the shop's twins: laser, air, material,
   // ballbar and, with position_feed, the SHDR position feed. `daq sim` writes them; the demo
   // reads them, so the twins the shop starts are named here only.
-  std::string devices_toml(double laser_poll_s, bool position_feed) const;
+  std::string devices_toml(double laser_poll_s, bool position_feed,
+                           bool serial_numbers = false) const;
 
   // The machine program for an ISO 230-2 plan on X: every move at the feed, a dwell at each
   // measure move.
@@ -105,5 +106,24 @@ class SimulatedShop {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The configuration (TOML) of the shop's devices and tests, for an acquiring process:
+// - in_process false (`daq sim`, another process): that process measures on its own wall
+//   clock and sees the program `speed` times faster than the program's own times, so the
+//   trigger's dwell and the laser's poll period are divided by the speed;
+// - in_process true (`daq serve --simulate`): its instruments read the shop's clock, every
+//   time in the file is simulated time (poll periods too: the service divides them by the
+//   speed), so the file reads as it would for a real machine. The air is opened as 8N1: a
+//   pseudo-terminal refuses to have 7E1 applied a second time (EINVAL), and the service opens
+//   each device again for every run (a real PTU300 port is 4800 7E1).
+// Both carry the machine specification of `daq demo` ([tolerances.X], [tolerances.XY]), so
+// the results show verdicts.
+struct ShopConfigOptions {
+  double speed = 1.0;
+  bool position_feed = false;  // the MTConnect SHDR feed of the commanded position
+  bool in_process = false;
+  bool circle_set = false;  // [test.circle] is the standard set (daq sim --test circle-set)
+};
+std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o);
 
 }  // namespace daq

@@ -3,7 +3,8 @@
 #include <string_view>
 
 namespace caldaq_assets {
-extern const std::string_view live_html;
+extern const std::string_view page_html;
+extern const std::string_view strings_en;
 extern const std::string_view uplot_js;
 extern const std::string_view uplot_css;
 }  // namespace caldaq_assets
@@ -15,8 +16,10 @@ void replace(std::string& s, std::string_view marker, std::string_view with) {
 }
 }  // namespace
 
-std::string live_page() {
-  std::string page(caldaq_assets::live_html);
+std::string operator_page() {
+  std::string page(caldaq_assets::page_html);
+  // The strings first: the chart library's code is inserted after, and is not searched.
+  replace(page, "/*STRINGS*/", caldaq_assets::strings_en);
   replace(page, "/*UPLOT_CSS*/", caldaq_assets::uplot_css);
   replace(page, "/*UPLOT_JS*/", caldaq_assets::uplot_js);
   return page;

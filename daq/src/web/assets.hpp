@@ -1,7 +1,8 @@
 #pragma once
-// The live page with its chart library inlined (one self-contained document, works offline).
+// The operator's page with its strings (daq/web/strings.en.json) and chart library inlined:
+// one self-contained document that works offline.
 #include <string>
 
 namespace cal::daq::web {
-std::string live_page();
+std::string operator_page();
 }

@@ -193,6 +193,12 @@ Response route(const Request& req, const Api& api) {
     if (get && path == "/api/status" && api.status) return api.status();
     if (post && path == "/api/runs/start" && api.start) return api.start(req.body());
     if (post && path == "/api/runs/stop" && api.stop) return api.stop(req.body());
+    for (const auto& r : api.routes) {
+      const bool method = (get && r.method == "GET") || (post && r.method == "POST");
+      const bool under =
+          r.path.ends_with('/') && path.starts_with(r.path) && path.size() > r.path.size();
+      if (method && r.handle && (path == r.path || under)) return r.handle(path, req.body());
+    }
   } catch (const std::exception& e) {
     return refuse(500, e.what());
   } catch (...) {

@@ -60,8 +60,13 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   };
   using SessionPtr = std::shared_ptr<Session>;
 
-  Impl(asio::io_context& io, ServerOptions o, Api a)
-      : acceptor(io), timer(io), retry(io), options(std::move(o)), api(std::move(a)) {
+  Impl(asio::io_context& context, ServerOptions o, Api a)
+      : io(context),
+        acceptor(context),
+        timer(context),
+        retry(context),
+        options(std::move(o)),
+        api(std::move(a)) {
     policy.token = options.token;
     policy.allowed_hosts = options.allowed_hosts;
     policy.max_body_bytes = options.max_body_bytes;
@@ -214,8 +219,26 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
                        if (s->closed) return;
                        if (ec) return self->read_failed(s, ec);
                        const auto req = s->body->release();
-                       self->reply(s, route(req, self->api), req.keep_alive());
+                       auto r = route(req, self->api);
+                       if (r.deferred) return self->defer(s, std::move(r), req.keep_alive());
+                       self->reply(s, std::move(r), req.keep_alive());
                      });
+  }
+
+  // The answer comes later, maybe from another thread: it is posted to the event loop, and
+  // dropped if the connection was closed meanwhile (the server shutting down, make_room never
+  // picks it: it waits for no request).
+  void defer(const SessionPtr& s, Response r, bool keep_alive) {
+    auto work = std::move(r.deferred);
+    try {
+      work([self = shared_from_this(), s, keep_alive](Response answer) {
+        asio::post(self->io, [self, s, keep_alive, answer = std::move(answer)]() mutable {
+          if (!s->closed) self->reply(s, std::move(answer), keep_alive);
+        });
+      });
+    } catch (const std::exception& e) {
+      reply(s, {500, json_error(e.what())}, false);
+    }
   }
 
   // keep_alive false: the connection is closed after the answer (always so for a refusal,
@@ -231,6 +254,7 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     res.set("Content-Security-Policy", "frame-ancestors 'none'");
     res.set("X-Frame-Options", "DENY");
     res.set("Referrer-Policy", "no-referrer");
+    if (!r.disposition.empty()) res.set(http::field::content_disposition, r.disposition);
     res.keep_alive(keep_alive);
     res.body() = std::move(r.body);
     res.prepare_payload();
@@ -338,6 +362,7 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     clients.clear();
   }
 
+  asio::io_context& io;
   tcp::acceptor acceptor;
   asio::steady_timer timer, retry;
   ServerOptions options;

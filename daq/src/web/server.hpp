@@ -48,6 +48,21 @@ struct Response {
   int status = 200;
   std::string body;  // JSON unless content_type says otherwise
   std::string content_type = "application/json";
+  // Content-Disposition, e.g. "attachment; filename=\"report-run-3.pdf\"" (empty: none).
+  std::string disposition;
+  // Work that must not hold up the event loop (printing a PDF): the handler returns at once
+  // with `deferred` set; the server calls it with a completion that may be called from any
+  // thread, once, with the real answer (the connection waits for it). The work must be done
+  // (or abandoned without calling it) before the io_context is destroyed.
+  std::function<void(std::function<void(Response)> done)> deferred;
+};
+
+// A handler for a path (exact, or every path under a prefix ending in '/'), given the path and
+// the body (empty for GET).
+struct Route {
+  std::string method;  // "GET" or "POST"
+  std::string path;    // "/api/setup/check", or "/reports/" for every path under it
+  std::function<Response(std::string_view path, const std::string& body)> handle;
 };
 
 // The service's side of the API; every handler runs on the io_context's thread. A handler
@@ -58,6 +73,7 @@ struct Api {
   std::function<Response()> status;                        // GET /api/status
   std::function<Response(const std::string& body)> start;  // POST /api/runs/start (JSON body)
   std::function<Response(const std::string& body)> stop;   // POST /api/runs/stop (JSON body)
+  std::vector<Route> routes;  // every other resource (the first that matches answers)
 };
 
 class LiveServer {

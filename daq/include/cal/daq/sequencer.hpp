@@ -56,6 +56,9 @@ class Sequencer {
   std::vector<double> acceptable_mm() const;
   std::vector<SequenceEvent> on_capture(const Capture& c);
   bool complete() const { return next_ >= stops_.size(); }
+  // The index into stops() of the next expected stop (stops().size() when complete): the
+  // operator's "stop k of N" is next_index() + 1 of stops().size().
+  std::size_t next_index() const { return next_; }
   Progress progress() const;
   const std::vector<ExpectedStop>& stops() const { return stops_; }
   // The stops passed without a capture (marked missed and not captured late), in plan order.

@@ -50,6 +50,7 @@ struct DecodedItem {
   std::optional<std::int64_t> device_time_unix_ns;
   std::optional<double> device_time_relative_s;
   std::string time_text;
+  std::optional<std::uint64_t> sample;  // readings: the device's sample number (halsampler -t)
   std::uint8_t channel = 0;
   Quantity quantity = Quantity::displacement_m;
   ReadingStatus status = ReadingStatus::ok;

@@ -1,0 +1,820 @@
+// daq serve: the operator's page, its API and the runs (see service.hpp and docs/web.md).
+#include "serve/service.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "cal/analysis/error.hpp"
+#include "cal/analysis/iso230_2.hpp"
+#include "cal/storage/store.hpp"
+#include "circle_run.hpp"
+#include "database.hpp"
+#include "devices_list.hpp"
+#include "linear_run.hpp"
+#include "part_program.hpp"
+#include "provenance.hpp"
+#include "report/report.hpp"
+#include "report_pdf.hpp"
+#include "run_document.hpp"
+#include "serve/device_board.hpp"
+#include "serve/instrument_form.hpp"
+#include "serve/setup_form.hpp"
+#include "sim_shop.hpp"
+#include "web/assets.hpp"
+#include "web/server.hpp"
+
+namespace daq::serve {
+namespace {
+
+namespace web = cal::daq::web;
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+// Error bodies: JSON even when a message carries bytes that are not UTF-8 (a path, a device).
+web::Response error(int status, const std::string& message, json extra = json::object()) {
+  extra["error"] = message;
+  return {status, extra.dump(-1, ' ', false, json::error_handler_t::replace)};
+}
+web::Response ok(const json& j, int status = 200) {
+  return {status, j.dump(-1, ' ', false, json::error_handler_t::replace)};
+}
+
+// The body of POST /api/runs/start: exactly {"test": "linear"} or {"test": "circle"}.
+std::optional<std::string> requested_test(const std::string& body, std::string& why) {
+  const auto req = json::parse(body, nullptr, false);
+  const char* expected = R"(give {"test": "linear"} or {"test": "circle"})";
+  if (req.is_discarded()) {
+    why = fmt::format("the body is not JSON: {}", expected);
+  } else if (!req.is_object() || req.size() != 1 || !req.contains("test")) {
+    why = fmt::format("the body must be one object with the key \"test\": {}", expected);
+  } else if (!req["test"].is_string()) {
+    why = fmt::format("\"test\" must be a string, not {}: {}", req["test"].type_name(), expected);
+  } else {
+    return req["test"].get<std::string>();
+  }
+  return std::nullopt;
+}
+
+// The set-up of a POST body {"setup": {...}, ...}; the other keys allowed are named.
+std::optional<json> setup_body(const std::string& body, std::initializer_list<const char*> others,
+                               std::string& why) {
+  const auto req = json::parse(body, nullptr, false);
+  if (req.is_discarded() || !req.is_object()) {
+    why = "the body must be a JSON object {\"setup\": {...}}";
+    return std::nullopt;
+  }
+  for (const auto& [key, v] : req.items()) {
+    const bool known = key == "setup" || std::any_of(others.begin(), others.end(),
+                                                     [&](const char* k) { return key == k; });
+    if (!known) {
+      why = fmt::format("unknown key \"{}\"", key);
+      return std::nullopt;
+    }
+  }
+  if (!req.contains("setup") || !req["setup"].is_object()) {
+    why = "\"setup\" must be an object (the set-up, caldaq.setup.v1)";
+    return std::nullopt;
+  }
+  return req["setup"];
+}
+
+std::string text_of(const json& req, const char* key, const std::string& fallback) {
+  const auto it = req.find(key);
+  return it != req.end() && it->is_string() ? it->get<std::string>() : fallback;
+}
+
+// "run-12.html" -> 12 with the extension; nullopt for anything else.
+std::optional<std::pair<std::int64_t, std::string>> report_name(std::string_view name) {
+  if (!name.starts_with("run-")) return std::nullopt;
+  const auto dot = name.rfind('.');
+  if (dot == std::string_view::npos) return std::nullopt;
+  const auto ext = name.substr(dot + 1);
+  if (ext != "html" && ext != "pdf") return std::nullopt;
+  std::int64_t id = 0;
+  const auto digits = name.substr(4, dot - 4);
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), id);
+  if (ec != std::errc{} || end != digits.data() + digits.size() || id < 1) return std::nullopt;
+  return std::pair{id, std::string(ext)};
+}
+
+// The capture directory, created at start; refused (naming it and why) when it cannot be
+// created or written.
+void prepare_capture_dir(const std::string& dir) {
+  if (dir.empty()) return;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw cal::InputError(fmt::format("--capture-dir {}: cannot be created: {}", dir,
+                                      ec ? ec.message() : "not a directory"));
+  const auto probe = fs::path(dir) / fmt::format(".caldaq-write-test-{}", ::getpid());
+  {
+    std::ofstream out(probe);
+    if (!(out << "x") || !(out.flush()))
+      throw cal::InputError(fmt::format("--capture-dir {}: cannot be written", dir));
+  }
+  fs::remove(probe, ec);
+}
+
+class Service {
+ public:
+  Service(boost::asio::io_context& io, ServeOptions o)
+      : io_(io), o_(std::move(o)), tick_(io), publish_timer_(io), program_timer_(io) {
+    prepare_capture_dir(o_.capture_dir);
+    if (o_.simulate) {
+      shop_ = std::make_unique<SimulatedShop>(io_, ShopTruth{}, o_.speed);
+      o_.run.clock = shop_->clock_ns();
+      o_.run.poll_scale = 1.0 / o_.speed;
+      const auto text = simulated_shop_config(*shop_, {.speed = o_.speed, .in_process = true});
+      use_config(cal::daq::parse_config(text, "simulated shop"));
+    } else {
+      use_config(cal::daq::load_config(o_.run.config));
+      check_devices_at_start();
+    }
+    try {
+      make_server();
+    } catch (const std::invalid_argument& e) {
+      throw cal::InputError(fmt::format("daq serve: {}", e.what()));
+    }
+    tick();
+    publish_loop();
+  }
+
+  std::uint16_t port() const { return server_->port(); }
+  std::string source() const { return o_.simulate ? "the simulated shop" : o_.run.config; }
+
+  void shutdown() {
+    if (running()) stop("the service was stopped");
+    tick_.cancel();
+    publish_timer_.cancel();
+    program_timer_.cancel();
+    monitors_.clear();
+    join_workers();
+    server_.reset();
+  }
+
+  // An exception escaped a handler of the event loop (e.g. the store failed under a run):
+  // the run ends as aborted with the reason, the service goes on.
+  void failed(const std::string& what) {
+    fmt::print(stderr, "daq serve: error: {} (the service goes on)\n", what);
+    if (!running()) return;
+    try {
+      stop("aborted: " + what);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "daq serve: error: the run could not be ended cleanly: {}\n", e.what());
+      linear_.reset(), circle_.reset(), capture_.reset();
+      start_monitors();
+    }
+  }
+
+ private:
+  bool running() const { return linear_ || circle_; }
+
+  // --check-s S > 0: the devices of the configured tests open and speak before the service
+  // starts, or it is refused naming the device (as daq run checks before a run).
+  void check_devices_at_start() {
+    if (o_.run.check_s <= 0) return;
+    std::vector<InstrumentSpec> specs;
+    if (config_.linear) specs = linear_specs(config_);
+    if (config_.circle && config_.device_for("ballbar"))
+      specs.push_back(spec_of(need(config_, "ballbar"), static_cast<std::uint16_t>(specs.size())));
+    if (specs.empty()) return;
+    fmt::print("Checking the devices (up to {} s):\n", o_.run.check_s);
+    check_devices(config_, specs, std::chrono::duration<double>(o_.run.check_s),
+                  [](const std::string& line) { fmt::print("{}\n", line); });
+    std::fflush(stdout);
+  }
+
+  void make_server() {
+    web::Api api{.page = [] { return web::operator_page(); },
+                 .runs = [this] { return runs(); },
+                 .status = [this] { return ok(status()); },
+                 .start = [this](const std::string& body) { return start(body); },
+                 .stop = [this](const std::string& body) { return stop_request(body); }};
+    const auto get = [&](std::string path, auto handler) {
+      api.routes.push_back(
+          {"GET", std::move(path), [this, handler](std::string_view p, const std::string&) {
+             return (this->*handler)(p);
+           }});
+    };
+    const auto post = [&](std::string path, auto handler) {
+      api.routes.push_back(
+          {"POST", std::move(path), [this, handler](std::string_view, const std::string& body) {
+             return (this->*handler)(body);
+           }});
+    };
+    get("/api/setup", &Service::setup_get);
+    get("/api/devices", &Service::devices);
+    get("/api/drivers", &Service::drivers);
+    get("/api/detected", &Service::detected);
+    get("/api/machines", &Service::machines);
+    get("/api/runs/", &Service::run_doc);
+    get("/reports/", &Service::report);
+    post("/api/setup/check", &Service::setup_check);
+    post("/api/setup/program", &Service::setup_program);
+    post("/api/setup/apply", &Service::setup_apply);
+    server_ = std::make_unique<web::LiveServer>(
+        io_,
+        web::ServerOptions{
+            .address = o_.address,
+            .port = o_.port,
+            .token = o_.token,
+            .allowed_hosts = o_.allowed_hosts,
+            .max_connections = o_.max_connections,
+            .request_timeout =
+                std::chrono::milliseconds(std::llround(o_.request_timeout_s * 1000.0)),
+            .log = [](std::string_view text) { fmt::print(stderr, "daq serve: {}\n", text); }},
+        std::move(api));
+  }
+
+  // --- the set-up and the idle instruments --------------------------------------------------
+
+  // A new set-up: a new board, and its devices watched while no run is running.
+  void use_config(cal::daq::Config c) {
+    monitors_.clear();
+    config_ = std::move(c);
+    board_ = std::make_shared<DeviceBoard>(config_);
+    start_monitors();
+  }
+
+  // Every configured device is opened while idle, so the page shows its state and values and
+  // the environment settles in view; a run closes those it uses and opens its own (its capture
+  // holds each device's bytes from the connection on, as `daq replay` needs), and they are
+  // watched again when it ends (only_of_test: the devices of that test; empty: all, anew).
+  void start_monitors(std::string_view only_of_test = {}) {
+    if (only_of_test.empty()) monitors_.clear();
+    const int axis = config_.linear && config_.linear->axis == "Y"   ? 1
+                     : config_.linear && config_.linear->axis == "Z" ? 2
+                                                                     : 0;
+    std::uint16_t n = 0;
+    for (const auto& dc : config_.devices) {
+      if (!only_of_test.empty() && !uses(only_of_test, dc)) {
+        ++n;
+        continue;
+      }
+      try {
+        const auto spec = spec_of(dc, n++, axis);
+        auto opt = instrument_options(dc, spec, o_.run, nullptr);
+        opt.backoff.max_attempts = -1;  // idle: wait for the device however long it takes
+        // The page needs about 10 values a second, not the run's rate.
+        opt.poll_period = std::max(opt.poll_period, std::chrono::microseconds(100ms));
+        // A ballbar sends nothing until it is mounted and moving: silence is no fault here.
+        if (dc.role == "ballbar") opt.silence_timeout = 24h;
+        board_->expect(dc.id,
+                       std::chrono::duration_cast<std::chrono::milliseconds>(opt.poll_period), -1);
+        auto inst =
+            watched(make_instrument(io_, spec, make_transport(io_, dc), opt), dc.id, board_);
+        inst->start({});
+        monitors_[dc.id] = std::move(inst);
+      } catch (const std::exception& e) {
+        board_->on_failed(dc.id, e.what());
+      }
+    }
+  }
+
+  // The devices a test's run opens itself: the ballbar for a circle, the rest for a linear run.
+  static bool uses(std::string_view test, const cal::daq::DeviceConfig& dc) {
+    return test == "circle" ? dc.role == "ballbar"
+                            : (dc.role == "laser" || dc.role == "air" || dc.role == "material" ||
+                               dc.role == "position");
+  }
+
+  // Closes the idle monitors of the devices the run opens; the others stay watched.
+  void stop_monitors_of(std::string_view test) {
+    for (const auto& dc : config_.devices)
+      if (uses(test, dc)) monitors_.erase(dc.id);
+  }
+
+  web::Response setup_get(std::string_view) {
+    const auto setup = setup_of(config_);
+    auto check = check_setup(setup);
+    json standards = json::array();
+    for (const auto& s : cal::iso230_2::standards())
+      standards.push_back({{"key", s.key}, {"title", s.title}});
+    return ok({{"schema", "caldaq.setup-state.v1"},
+               {"setup", setup},
+               {"toml", check.toml},
+               {"check", to_json(check)},
+               {"source", source()},
+               {"simulated", o_.simulate},
+               {"choices",
+                {{"standards", standards},
+                 {"dialects", {"fanuc", "heidenhain", "siemens"}},
+                 {"cycles", {"linear", "pendulum", "pilgrim-step"}},
+                 {"equations", {"ciddor", "edlen", "shop-floor"}},
+                 {"axes", {"X", "Y", "Z"}},
+                 {"planes", {"XY", "YZ", "ZX"}}}}});
+  }
+
+  web::Response setup_check(const std::string& body) {
+    std::string why;
+    const auto setup = setup_body(body, {}, why);
+    if (!setup) return error(400, why);
+    const auto check = check_setup(*setup);
+    auto j = to_json(check);
+    j["toml"] = check.toml;
+    return ok(j);
+  }
+
+  // POST {"setup", "test": "linear" | "circle", "dialect": "fanuc" | ...}: the part program
+  // (text/plain), the same text `daq gcode` writes for the set-up's TOML.
+  web::Response setup_program(const std::string& body) {
+    std::string why;
+    const auto setup = setup_body(body, {"test", "dialect"}, why);
+    if (!setup) return error(400, why);
+    const auto req = json::parse(body);
+    const auto check = check_setup(*setup);
+    if (!check.config) return error(400, "the set-up has problems: fix them first", to_json(check));
+    try {
+      return {.body = part_program(*check.config, text_of(req, "test", "linear"),
+                                   text_of(req, "dialect", "fanuc")),
+              .content_type = "text/plain; charset=utf-8"};
+    } catch (const cal::InputError& e) {
+      return error(400, e.what());
+    }
+  }
+
+  // POST {"setup"}: the set-up becomes the service's (its devices are opened, the page's runs
+  // use it). Refused while a run is running.
+  web::Response setup_apply(const std::string& body) {
+    std::string why;
+    const auto setup = setup_body(body, {}, why);
+    if (!setup) return error(400, why);
+    if (running())
+      return error(409, fmt::format("run {} is running: the set-up can change after it", run_id_));
+    auto check = check_setup(*setup);
+    if (!check.config) return error(400, "the set-up has problems: fix them first", to_json(check));
+    use_config(std::move(*check.config));
+    fmt::print("set-up applied from the web page\n");
+    std::fflush(stdout);
+    auto j = to_json(check);
+    j["toml"] = check.toml;
+    return ok(j);
+  }
+
+  web::Response devices(std::string_view) { return ok(board_->to_json()); }
+  web::Response drivers(std::string_view) { return ok(driver_descriptions()); }
+  web::Response detected(std::string_view) { return ok(list_devices({})); }
+
+  // The machines of the stored runs, newest first, as their runs recorded them.
+  web::Response machines(std::string_view) {
+    cal::storage::Store store(database_path(o_.run.db));
+    json list = json::array();
+    std::map<std::string, bool> seen;
+    auto runs = store.runs();
+    for (auto it = runs.rbegin(); it != runs.rend(); ++it) {
+      const auto settings = json::parse(it->settings_json, nullptr, false);
+      json m = settings.is_object() && settings.contains("context")
+                   ? settings["context"].value("machine", json::object())
+                   : json::object();
+      if (!m.is_object() || !m.contains("name")) {
+        const auto rec = store.machine(it->machine_id);
+        if (!rec) continue;
+        m = {{"name", rec->name}, {"description", rec->description}};
+      }
+      const auto name = m.value("name", std::string());
+      if (name.empty() || seen[name]) continue;
+      seen[name] = true;
+      m["last_run"] = it->id;
+      list.push_back(m);
+    }
+    return ok({{"schema", "caldaq.machines.v1"}, {"machines", list}});
+  }
+
+  // --- stored runs and reports -----------------------------------------------------------
+
+  web::Response runs() {
+    cal::storage::Store store(database_path(o_.run.db));
+    json list = json::array();
+    for (const auto& r : store.runs())
+      list.push_back({{"id", r.id},
+                      {"kind", r.kind},
+                      {"axis", r.axis},
+                      {"campaign", r.campaign},
+                      {"status", cal::storage::to_string(r.status)},
+                      {"started_unix_ms", r.started_unix_ms},
+                      {"note", r.note}});
+    return ok({{"schema", "caldaq.runs.v1"}, {"runs", list}});
+  }
+
+  // GET /api/runs/N: the run as `daq show N --json` gives it, with its report links.
+  web::Response run_doc(std::string_view path) {
+    const auto digits = path.substr(std::string_view("/api/runs/").size());
+    std::int64_t id = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), id);
+    if (ec != std::errc{} || end != digits.data() + digits.size() || id < 1)
+      return error(404, "no such resource: runs are /api/runs/N");
+    cal::storage::Store store(database_path(o_.run.db));
+    if (!store.run(id)) return error(404, fmt::format("no run {}", id));
+    auto j = run_document(store, id);
+    j["reports"] = {{"html", fmt::format("/reports/run-{}.html", id)},
+                    {"pdf", fmt::format("/reports/run-{}.pdf", id)}};
+    return ok(j);
+  }
+
+  // GET /reports/run-N.html | .pdf: the run's report as `daq report N` writes it. The HTML is
+  // made here (PLplot is not thread-safe); the PDF is printed by headless Chromium on a worker
+  // thread, so the event loop (and a run) goes on meanwhile.
+  web::Response report(std::string_view path) {
+    const auto name = report_name(path.substr(std::string_view("/reports/").size()));
+    if (!name) return error(404, "no such report: reports are /reports/run-N.html or .pdf");
+    const auto [id, ext] = *name;
+    cal::storage::Store store(database_path(o_.run.db));
+    if (!store.run(id)) return error(404, fmt::format("no run {}", id));
+    auto html =
+        cal::daq::report::run_report(store, id, {.software = std::string(daq::software_version)});
+    if (ext == "html")
+      return {.body = std::move(html),
+              .content_type = "text/html; charset=utf-8",
+              .disposition = fmt::format("inline; filename=\"report-run-{}.html\"", id)};
+    if (printing_ >= 2) return error(503, "two PDFs are being printed: try again in a moment");
+    if (printing_ == 0) join_workers();  // the threads of earlier PDFs have all ended
+    web::Response r;
+    r.deferred = [this, id, html = std::move(html)](std::function<void(web::Response)> done) {
+      ++printing_;
+      std::lock_guard lock(workers_mutex_);
+      workers_.emplace_back([this, id, html, done] {  // NOLINT: the thread owns its copies
+        done(print_report(id, html));
+        --printing_;
+      });
+    };
+    return r;
+  }
+
+  static web::Response print_report(std::int64_t id, const std::string& html) {
+    char dir_template[] = "/tmp/caldaq-report-XXXXXX";
+    const char* dir = ::mkdtemp(dir_template);
+    if (!dir) return error(500, "cannot make a temporary directory for the PDF");
+    const fs::path html_file = fs::path(dir) / fmt::format("report-run-{}.html", id);
+    const fs::path pdf = fs::path(dir) / fmt::format("report-run-{}.pdf", id);
+    web::Response r;
+    try {
+      std::ofstream(html_file, std::ios::binary) << html;
+      print_pdf(html_file, pdf);
+      std::ifstream in(pdf, std::ios::binary);
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      r = {.body = bytes.str(),
+           .content_type = "application/pdf",
+           .disposition = fmt::format("inline; filename=\"report-run-{}.pdf\"", id)};
+    } catch (const std::exception& e) {
+      r = error(500, e.what());
+    }
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    return r;
+  }
+
+  void join_workers() {
+    std::lock_guard lock(workers_mutex_);
+    for (auto& w : workers_)
+      if (w.joinable()) w.join();
+    workers_.clear();
+  }
+
+  // --- runs -------------------------------------------------------------------------------
+
+  // Whether each test could start now, and why not.
+  json readiness() const {
+    json j = json::object();
+    for (const char* test : {"linear", "circle"}) {
+      std::optional<std::string> why;
+      try {
+        if (std::string_view(test) == "linear")
+          linear_specs(config_);
+        else
+          ballbar_device(config_), circle_test(config_);
+        why = simulation_limits(test);
+        if (!why) why = board_->refusal(test);
+      } catch (const cal::InputError& e) {
+        why = e.what();
+      }
+      if (running()) why = fmt::format("run {} is running", run_id_);
+      j[test] = {{"ready", !why}, {"why", why ? json(*why) : json(nullptr)}};
+    }
+    return j;
+  }
+
+  // What the simulated shop cannot do: its laser measures X, its bar is 100 mm long.
+  std::optional<std::string> simulation_limits(std::string_view test) const {
+    if (!shop_) return std::nullopt;
+    if (test == "linear" && config_.linear && config_.linear->axis != "X")
+      return "the simulated laser measures the X axis: set the linear test's axis to X";
+    if (test == "circle" && config_.circle &&
+        (std::abs(config_.circle->radius_mm - shop_->truth().ballbar_mm) > 1e-9 ||
+         config_.circle->plane != "XY"))
+      return fmt::format(
+          "the simulated ballbar is {} mm long in the XY plane: set the circle's "
+          "radius to {} mm and its plane to XY",
+          shop_->truth().ballbar_mm, shop_->truth().ballbar_mm);
+    return std::nullopt;
+  }
+
+  json status() const {
+    json j{{"schema", "caldaq.status.v1"}, {"running", running()},   {"config", source()},
+           {"simulated", o_.simulate},     {"tests", json::array()}, {"start", readiness()}};
+    if (o_.simulate) j["speed"] = o_.speed;
+    if (config_.linear) j["tests"].push_back("linear");
+    if (config_.circle) j["tests"].push_back("circle");
+    if (running()) j["run"] = {{"id", run_id_}, {"test", test_}};
+    if (last_) j["last"] = *last_;
+    return j;
+  }
+
+  // 400 for what the client got wrong (the body, a test the set-up lacks, a device that cannot
+  // be opened); 409 while a run runs or a device it needs is not ready (the reason named);
+  // 500 for the store or the capture failing.
+  web::Response start(const std::string& body) {
+    std::string why;
+    const auto test = requested_test(body, why);
+    if (!test) return error(400, why);
+    if (*test != "linear" && *test != "circle")
+      return error(400, fmt::format("no test '{}': give {{\"test\": \"linear\"}} or "
+                                    "{{\"test\": \"circle\"}}",
+                                    *test));
+    if (running()) return error(409, fmt::format("run {} is still running", run_id_));
+    try {
+      if (*test == "linear")
+        linear_specs(config_);
+      else
+        ballbar_device(config_), circle_test(config_);
+    } catch (const cal::InputError& e) {
+      return error(400, e.what());
+    }
+    if (const auto limit = simulation_limits(*test))
+      return error(409, fmt::format("Start refused: {}", *limit));
+    if (const auto refusal = board_->refusal(*test))
+      return error(409, fmt::format("Start refused: {}", *refusal));
+    stop_monitors_of(*test);  // the run opens them itself (its capture starts at the connection)
+    run_live_.clear();
+    try {
+      if (*test == "linear")
+        start_linear();
+      else
+        start_circle();
+    } catch (const cal::InputError& e) {
+      abandon_start();
+      return error(400, e.what());
+    } catch (const std::exception& e) {
+      abandon_start();
+      return error(500, e.what());
+    }
+    test_ = *test;
+    name_capture();
+    if (shop_) start_program_when_ready(0);
+    return {202, json{{"run", run_id_}, {"test", *test}}.dump()};
+  }
+
+  void abandon_start() {
+    linear_.reset(), circle_.reset(), capture_.reset();
+    capture_pending_.clear();
+    start_monitors();
+  }
+
+  // POST /api/runs/stop: an empty body or a JSON object (the page sends {}).
+  web::Response stop_request(const std::string& body) {
+    if (!body.empty() && !json::parse(body, nullptr, false).is_object())
+      return error(400, "the body of a stop must be empty or a JSON object");
+    return stop("stopped from the web page");
+  }
+
+  web::Response stop(const std::string& why) {
+    if (!running()) return error(409, "no run is running");
+    if (linear_) linear_->stop(why);
+    if (circle_) circle_->stop(why);
+    finish();
+    return {.body = json{{"stopped", last_->at("run")}}.dump()};
+  }
+
+  // The capture of a run is written under a temporary name (the run's number is known only
+  // once it has begun) and renamed run-N.cdq at once; the run record names the final file.
+  std::string capture_path() {
+    if (o_.capture_dir.empty()) return {};
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count();
+    capture_pending_ =
+        (fs::absolute(o_.capture_dir) / fmt::format(".run-starting-{}.cdq", ms)).string();
+    return capture_pending_;
+  }
+
+  void name_capture() {
+    if (capture_pending_.empty()) return;
+    const auto dir = fs::path(capture_pending_).parent_path();
+    auto target = dir / fmt::format("run-{}.cdq", run_id_);
+    if (fs::exists(target))  // another database's run N wrote here before
+      target = dir / fmt::format("run-{}-{}.cdq", run_id_,
+                                 fs::path(capture_pending_).stem().string().substr(14));
+    std::error_code ec;
+    fs::rename(capture_pending_, target, ec);
+    if (!ec) {
+      try {
+        cal::storage::Store(database_path(o_.run.db)).set_capture_path(run_id_, target.string());
+      } catch (const std::exception& e) {
+        fmt::print(stderr, "daq serve: run {}: capture {}: {}\n", run_id_, target.string(),
+                   e.what());
+      }
+    }
+    capture_pending_.clear();
+  }
+
+  // A capture that cannot be written (a full disk) aborts the run, naming the file.
+  void watch_capture() {
+    if (!capture_->recorder) return;
+    capture_->recorder->on_failure([this](const std::string& e) {
+      boost::asio::post(io_, [this, e] {
+        if (running()) stop("capture failed: " + e);
+      });
+    });
+  }
+
+  RunOptions run_options() {
+    RunOptions r = o_.run;
+    r.wrap = [board = board_](const cal::daq::DeviceConfig& dc,
+                              std::unique_ptr<cal::drivers::Instrument> inst) {
+      return watched(std::move(inst), dc.id, board);
+    };
+    return r;
+  }
+
+  void start_linear() {
+    const auto specs = linear_specs(config_);
+    const auto path = capture_path();
+    capture_ = std::make_unique<SessionCapture>(path, config_, specs);
+    watch_capture();
+    LinearRunSetup setup;
+    setup.config = config_;
+    setup.database = database_path(o_.run.db);
+    setup.capture_path = capture_->absolute_path(path);
+    add_linear_instruments(io_, config_, specs, run_options(), capture_->recorder.get(), setup);
+    setup.on_live = [this](const LiveState& s) { run_live_ = to_json_text(s); };
+    setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
+    linear_ = std::make_unique<LinearRun>(io_, std::move(setup));
+    linear_->start();
+    run_id_ = linear_->outcome().run_id;
+    fmt::print("run {} (linear) started from the web page\n", run_id_);
+    std::fflush(stdout);
+  }
+
+  void start_circle() {
+    const auto [program, analysis] = circle_test(config_);
+    const auto& dc = ballbar_device(config_);
+    const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
+    const auto path = capture_path();
+    capture_ = std::make_unique<SessionCapture>(path, config_, specs);
+    watch_capture();
+    const auto options = run_options();
+    CircleRunSetup setup{
+        .config = config_,
+        .program = program,
+        .analysis = analysis,
+        .database = database_path(o_.run.db),
+        .ballbar = options.wrap(dc, make_instrument(io_, specs[0], make_transport(io_, dc),
+                                                    instrument_options(dc, specs[0], options,
+                                                                       capture_->recorder.get()))),
+        .capture_path = capture_->absolute_path(path)};
+    setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
+    setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
+    circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
+    circle_->start();
+    run_id_ = circle_->outcome().run_id;
+    fmt::print("run {} (circle) started from the web page\n", run_id_);
+    std::fflush(stdout);
+  }
+
+  // The simulated machine starts the test's program once the run's instruments are ready, as
+  // an operator presses Cycle Start once the acquisition waits (a program started while the
+  // laser still connects would lose its first approach).
+  void start_program_when_ready(int waited_ms) {
+    program_timer_.expires_after(50ms);
+    program_timer_.async_wait([this, waited_ms](const boost::system::error_code& ec) {
+      if (ec || !running() || !shop_) return;
+      const auto not_ready = board_->refusal(test_);
+      if (not_ready && waited_ms < 15'000) return start_program_when_ready(waited_ms + 50);
+      if (not_ready)
+        fmt::print("  simulated machine: starting the program although {}\n", *not_ready);
+      if (linear_) {
+        const auto& l = *config_.linear;
+        shop_->run_linear(linear_->plan(), l.feed_mm_per_min, l.dwell_s);
+      } else {
+        shop_->run_circle(circle_test(config_).first);
+      }
+      fmt::print("  simulated machine: {} program started\n", test_);
+      std::fflush(stdout);
+    });
+  }
+
+  // A run ends by itself (all stops, both arcs) or is stopped: keep its outcome, close its
+  // capture, watch the devices again, and accept the next start.
+  void finish() {
+    program_timer_.cancel();
+    // A linear run that reached its end with stops missed is evaluated but not complete.
+    const bool complete = linear_ ? linear_->outcome().status == cal::storage::RunStatus::complete
+                                  : circle_->outcome().complete;
+    const bool evaluated = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
+    const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
+    const char* status = complete ? "complete" : evaluated ? "incomplete" : "aborted";
+    last_ = json{{"run", run_id_},   {"test", test_},    {"complete", complete},
+                 {"status", status}, {"reason", reason}, {"evaluated", evaluated}};
+    if (capture_ && capture_->recorder) capture_->recorder->close();
+    const char* how = complete ? "complete" : evaluated ? "incomplete: " : "stopped: ";
+    fmt::print("run {} {}{}\n", run_id_, how, reason);
+    std::fflush(stdout);
+    linear_.reset(), circle_.reset(), capture_.reset();
+    start_monitors(test_);
+  }
+
+  void tick() {
+    tick_.expires_after(200ms);
+    tick_.async_wait([this](const boost::system::error_code& ec) {
+      if (ec) return;
+      if ((linear_ && linear_->finished()) || (circle_ && circle_->finished())) finish();
+      if (capture_ && capture_->recorder) capture_->recorder->flush();
+      tick();
+    });
+  }
+
+  // The page's state, 10 times a second (the server sends only the latest, and only when it
+  // changed): the status, every device, and the run's live state (kept after it ends, so the
+  // page still shows its last table).
+  void publish_loop() {
+    std::string page = R"({"schema":"caldaq.page.v1","status":)" + status().dump() +
+                       R"(,"devices":)" +
+                       board_->to_json().dump(-1, ' ', false, json::error_handler_t::replace) +
+                       R"(,"run":)" + (run_live_.empty() ? "null" : run_live_) + "}";
+    server_->publish(std::move(page));
+    publish_timer_.expires_after(100ms);
+    publish_timer_.async_wait([this](const boost::system::error_code& ec) {
+      if (!ec) publish_loop();
+    });
+  }
+
+  boost::asio::io_context& io_;
+  ServeOptions o_;
+  boost::asio::steady_timer tick_, publish_timer_, program_timer_;
+  std::unique_ptr<SimulatedShop> shop_;
+  cal::daq::Config config_;
+  std::shared_ptr<DeviceBoard> board_;
+  std::map<std::string, std::unique_ptr<cal::drivers::Instrument>> monitors_;  // by device id
+  std::unique_ptr<web::LiveServer> server_;
+  std::unique_ptr<SessionCapture> capture_;
+  std::string capture_pending_;
+  std::unique_ptr<LinearRun> linear_;
+  std::unique_ptr<CircleRun> circle_;
+  std::int64_t run_id_ = 0;
+  std::string test_;
+  std::string run_live_;
+  std::optional<json> last_;
+  std::atomic<int> printing_{0};
+  std::mutex workers_mutex_;
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace
+
+void serve(const ServeOptions& o) {
+  boost::asio::io_context io;
+  Service service(io, o);
+  fmt::print("daq serve: http://{}:{}/ ({}), runs in {}; Ctrl-C stops\n", o.address, service.port(),
+             service.source(), database_path(o.run.db).string());
+  if (o.simulate)
+    fmt::print("daq serve: SIMULATED shop in this process, {}x faster than real time\n", o.speed);
+  std::fflush(stdout);
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](auto ec, int) {
+    if (ec) return;
+    service.shutdown();
+    io.stop();
+  });
+  // Nothing a handler throws ends the service: the loop is run again after the run in
+  // progress (if any) is ended with the reason (asio allows run() again after an exception).
+  for (;;) {
+    try {
+      io.run();
+      return;
+    } catch (const std::exception& e) {
+      service.failed(e.what());
+    }
+  }
+}
+
+}  // namespace daq::serve

@@ -1,0 +1,478 @@
+// The set-up of the operator's page (see setup_form.hpp).
+#include "serve/setup_form.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <regex>
+#include <sstream>
+#include <type_traits>
+#include <variant>
+
+#include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
+#include "run_setup.hpp"
+
+namespace daq::serve {
+
+using nlohmann::json;
+
+namespace {
+
+// Adds key = value when the value differs from the default (the file's own choices).
+template <class T>
+void put(json& j, const char* key, const T& value, const T& default_value) {
+  if (!(value == default_value)) j[key] = value;
+}
+void put_text(json& j, const char* key, const std::string& value) {
+  if (!value.empty()) j[key] = value;
+}
+
+json option_json(const cal::drivers::OptionValue& v) {
+  return std::visit(
+      [](const auto& x) -> json {
+        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, std::monostate>)
+          return nullptr;
+        else
+          return x;
+      },
+      v);
+}
+
+json device_json(const cal::daq::DeviceConfig& d) {
+  const cal::daq::DeviceConfig def;
+  json j{{"driver", d.driver}, {"transport", d.transport}};
+  put_text(j, "role", d.role);
+  put(j, "poll_s", d.poll_s, def.poll_s);
+  // The driver's own options as the file gave them (the others keep the table's defaults).
+  for (const auto& [name, value] : d.options.values())
+    if (d.options.is_set(name)) j[name] = option_json(value);
+  put_text(j, "serial_number", d.serial_number);
+  put_text(j, "certificate", d.certificate);
+  put_text(j, "calibration_due", d.calibration_due);
+  return j;
+}
+
+json environment_json(const cal::daq::EnvironmentConfig& e) {
+  const cal::daq::EnvironmentConfig d;
+  json j = json::object();
+  put(j, "equation", e.equation, d.equation);
+  put(j, "stale_after_s", e.stale_after_s, d.stale_after_s);
+  if (e.on_stale != d.on_stale)
+    j["on_stale"] = e.on_stale == cal::daq::StalePolicy::stop ? "stop" : "fallback";
+  put(j, "fallback_temperature_degc", e.fallback_temperature_degc, d.fallback_temperature_degc);
+  put(j, "fallback_pressure_pa", e.fallback_pressure_pa, d.fallback_pressure_pa);
+  put(j, "fallback_humidity_pct", e.fallback_humidity_pct, d.fallback_humidity_pct);
+  put(j, "fallback_material_degc", e.fallback_material_degc, d.fallback_material_degc);
+  put(j, "co2_umol_per_mol", e.co2_umol_per_mol, d.co2_umol_per_mol);
+  put(j, "wavelength_nm", e.wavelength_nm, d.wavelength_nm);
+  put(j, "expansion_ppm_per_k", e.expansion_ppm_per_k, d.expansion_ppm_per_k);
+  return j;
+}
+
+json linear_json(const cal::daq::LinearTestConfig& l) {
+  const cal::daq::LinearTestConfig d;
+  json j{{"axis", l.axis}, {"first_mm", l.first_mm}, {"last_mm", l.last_mm}};
+  if (l.interval_mm) j["interval_mm"] = *l.interval_mm;
+  if (l.count) j["count"] = *l.count;
+  put(j, "random_fraction", l.random_fraction, d.random_fraction);
+  put(j, "cycle", l.cycle, d.cycle);
+  j["runs"] = l.runs;
+  put(j, "bidirectional", l.bidirectional, d.bidirectional);
+  j["overrun_mm"] = l.overrun_mm;
+  j["feed_mm_per_min"] = l.feed_mm_per_min;
+  j["dwell_s"] = l.dwell_s;
+  put(j, "dead_path_mm", l.dead_path_mm, d.dead_path_mm);
+  j["standard"] = l.standard;
+  return j;
+}
+
+json circle_json(const cal::daq::CircleTestConfig& c) {
+  const cal::daq::CircleTestConfig d;
+  json j{{"plane", c.plane},
+         {"radius_mm", c.radius_mm},
+         {"feed_mm_per_min", c.feed_mm_per_min},
+         {"overshoot_deg", c.overshoot_deg}};
+  put(j, "sample_rate_hz", c.sample_rate_hz, d.sample_rate_hz);
+  put(j, "centre_mm", c.centre_mm, d.centre_mm);
+  put(j, "calibrated_radius_mm", c.calibrated_radius_mm, d.calibrated_radius_mm);
+  return j;
+}
+
+json limits_json(const cal::daq::PositioningLimits& l) {
+  json j = json::object();
+  const auto lim = [&](const char* k, const std::optional<double>& v) {
+    if (v) j[k] = *v;
+  };
+  lim("E_um", l.E_um), lim("R_um", l.R_um), lim("B_um", l.B_um), lim("A_um", l.A_um),
+      lim("M_um", l.M_um);
+  return j;
+}
+
+json tolerances_json(const cal::daq::Config& c) {
+  json j = json::object();
+  for (const auto& [axis, t] : c.axis_tolerances) {
+    json a = limits_json(t.limits);
+    for (const auto& [up_to, limits] : t.by_length) {
+      json b = limits_json(limits);
+      b["up_to_mm"] = up_to;
+      a["by_length"].push_back(b);
+    }
+    j[axis] = a;
+  }
+  for (const auto& [plane, t] : c.plane_tolerances) {
+    json p = json::object();
+    if (t.G_um) p["G_um"] = *t.G_um;
+    if (!t.diagnostics.empty()) p["diagnostics"] = t.diagnostics;
+    j[plane] = p;
+  }
+  return j;
+}
+
+// A TOML basic string: quotes, backslashes and control characters escaped (any text the
+// operator types stays one string).
+std::string toml_string(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        if (c < 0x20 || c == 0x7f)
+          out += fmt::format("\\u{:04X}", c);
+        else
+          out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+// --- JSON -> TOML -------------------------------------------------------------------------------
+// Written here rather than by toml++'s formatter: numbers in their shortest exact form (0.05,
+// not 0.050000000000000003) and keys in the order docs/config.md gives them. Whatever is
+// written is read back by the loader before it is used or offered, so a mistake here shows as
+// a problem, never as a wrong file.
+
+[[noreturn]] void cannot(const std::string& path, const std::string& what) {
+  throw cal::InputError(fmt::format("set-up: '{}': {}", path.empty() ? "(top)" : path, what));
+}
+
+// The keys of a table in the order of docs/config.md; others follow in alphabetical order.
+const std::vector<std::string_view>& key_order() {
+  static const std::vector<std::string_view> order{"schema",
+                                                   "campaign",
+                                                   "operator",
+                                                   "name",
+                                                   "driver",
+                                                   "transport",
+                                                   "role",
+                                                   "site",
+                                                   "contact",
+                                                   "description",
+                                                   "make",
+                                                   "model",
+                                                   "serial_number",
+                                                   "certificate",
+                                                   "calibration_due",
+                                                   "controller_compensation",
+                                                   "warm_up",
+                                                   "load",
+                                                   "state",
+                                                   "notes",
+                                                   "poll_s",
+                                                   "equation",
+                                                   "stale_after_s",
+                                                   "on_stale",
+                                                   "fallback_temperature_degc",
+                                                   "fallback_pressure_pa",
+                                                   "fallback_humidity_pct",
+                                                   "fallback_material_degc",
+                                                   "co2_umol_per_mol",
+                                                   "wavelength_nm",
+                                                   "expansion_ppm_per_k",
+                                                   "tolerance_um",
+                                                   "window_mm",
+                                                   "axis",
+                                                   "plane",
+                                                   "first_mm",
+                                                   "last_mm",
+                                                   "interval_mm",
+                                                   "count",
+                                                   "random_fraction",
+                                                   "cycle",
+                                                   "runs",
+                                                   "bidirectional",
+                                                   "overrun_mm",
+                                                   "radius_mm",
+                                                   "feed_mm_per_min",
+                                                   "dwell_s",
+                                                   "sample_rate_hz",
+                                                   "overshoot_deg",
+                                                   "centre_mm",
+                                                   "calibrated_radius_mm",
+                                                   "dead_path_mm",
+                                                   "standard",
+                                                   "up_to_mm",
+                                                   "E_um",
+                                                   "R_um",
+                                                   "B_um",
+                                                   "A_um",
+                                                   "M_um",
+                                                   "G_um",
+                                                   "machine",
+                                                   "customer",
+                                                   "conditions",
+                                                   "devices",
+                                                   "environment",
+                                                   "trigger",
+                                                   "test",
+                                                   "linear",
+                                                   "circle",
+                                                   "tolerances",
+                                                   "X",
+                                                   "Y",
+                                                   "Z",
+                                                   "XY",
+                                                   "YZ",
+                                                   "ZX"};
+  return order;
+}
+
+// A device's keys: the common ones, then its driver's options in the order of its table.
+std::vector<std::string> device_key_order(const json& device) {
+  std::vector<std::string> order(cal::drivers::common_device_keys().begin(),
+                                 cal::drivers::common_device_keys().end());
+  const auto driver = device.find("driver");
+  if (driver != device.end() && driver->is_string())
+    if (const auto* d = cal::drivers::find_driver(driver->get<std::string>()))
+      for (const auto& o : d->options()) order.push_back(o.name);
+  return order;
+}
+
+std::vector<std::string> ordered_keys(const json& j, bool device = false) {
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : j.items()) keys.push_back(k);
+  const auto own = device ? device_key_order(j) : std::vector<std::string>{};
+  const auto rank = [&](const std::string& k) {
+    if (device) {
+      const auto at = std::find(own.begin(), own.end(), k);
+      if (at != own.end()) return static_cast<std::size_t>(at - own.begin());
+    }
+    const auto& o = key_order();
+    return own.size() + static_cast<std::size_t>(std::find(o.begin(), o.end(), k) - o.begin());
+  };
+  std::stable_sort(keys.begin(), keys.end(),
+                   [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
+  return keys;
+}
+
+std::string toml_key(const std::string& k) {
+  const bool bare = !k.empty() && std::all_of(k.begin(), k.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '_' || c == '-';
+  });
+  return bare ? k : toml_string(k);
+}
+
+std::string toml_value(const json& v, const std::string& path) {
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (v.is_number_integer()) return fmt::format("{}", v.get<std::int64_t>());
+  if (v.is_number_unsigned()) return fmt::format("{}", v.get<std::uint64_t>());
+  if (v.is_number()) {
+    auto s = fmt::format("{}", v.get<double>());  // the shortest text that reads back exactly
+    if (s.find_first_of(".en") == std::string::npos) s += ".0";
+    return s;
+  }
+  if (v.is_string()) return toml_string(v.get<std::string>());
+  if (v.is_array()) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i].is_object() || v[i].is_array() || v[i].is_null())
+        cannot(path, "a list may hold only numbers, text and true/false here");
+      out += (i ? ", " : "") + toml_value(v[i], path);
+    }
+    return out + "]";
+  }
+  cannot(path, fmt::format("{} cannot be written", v.type_name()));
+}
+
+bool is_table_array(const json& v) {
+  return v.is_array() && !v.empty() &&
+         std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_object(); });
+}
+
+// Writes the table `j` at `path`: its plain keys under its header, then its sub-tables.
+void write_table(std::ostringstream& out, const json& j, const std::string& path,
+                 bool array_entry = false) {
+  if (!j.is_object()) cannot(path, fmt::format("expected an object, not {}", j.type_name()));
+  std::ostringstream own;
+  const bool device = path.starts_with("devices.");
+  for (const auto& k : ordered_keys(j, device)) {
+    const auto& v = j[k];
+    if (v.is_null() || v.is_object() || is_table_array(v)) continue;
+    own << toml_key(k) << " = " << toml_value(v, path.empty() ? k : path + "." + k) << "\n";
+  }
+  if (array_entry)
+    out << "\n[[" << path << "]]\n" << own.str();
+  else if (!own.str().empty())
+    out << (path.empty() ? "" : "\n[" + path + "]\n") << own.str();
+  for (const auto& k : ordered_keys(j)) {
+    const auto& v = j[k];
+    const std::string p = path.empty() ? toml_key(k) : path + "." + toml_key(k);
+    if (v.is_object()) write_table(out, v, p);
+    if (is_table_array(v))
+      for (const auto& e : v) write_table(out, e, p, true);
+  }
+}
+
+// "FILE:LINE:COL: key 'test.linear.first_mm': -5 must be ..." -> {key, message}; a table's own
+// error ("table [test.linear]: ...") is keyed by the table.
+SetupProblem problem_of(const std::string& what) {
+  static const std::regex keyed(R"(^.*?:\d+:\d+: key '([^']*)': (.*)$)");
+  static const std::regex table(R"(^.*?:\d+:\d+: table \[([^\]]*)\]: (.*)$)");
+  std::smatch m;
+  if (std::regex_match(what, m, keyed) || std::regex_match(what, m, table))
+    return {m[1].str(), m[2].str()};
+  return {"", what};
+}
+
+// Removes a key path from the set-up; false if it was not there.
+bool erase_path(json& j, const std::string& path) {
+  json* at = &j;
+  std::stringstream parts(path);
+  std::vector<std::string> keys;
+  for (std::string k; std::getline(parts, k, '.');) keys.push_back(k);
+  if (keys.empty()) return false;
+  for (std::size_t i = 0; i + 1 < keys.size(); ++i) {
+    if (!at->is_object() || !at->contains(keys[i])) return false;
+    at = &(*at)[keys[i]];
+  }
+  return at->is_object() && at->erase(keys.back()) > 0;
+}
+
+// The checks a run makes when it starts, beyond the loader's: the roles a test needs, each
+// device's driver and transport.
+// (The loader itself checks each transport's text and each option against its driver's table.)
+void check_tests(const cal::daq::Config& c, SetupCheck& out) {
+  const auto readiness = [](bool configured, auto check) {
+    TestReadiness r{.configured = configured};
+    if (!configured) return r;
+    try {
+      check();
+    } catch (const cal::InputError& e) {
+      r.problem = e.what();
+    }
+    return r;
+  };
+  out.linear = readiness(c.linear.has_value(), [&] { linear_specs(c); });
+  out.circle = readiness(c.circle.has_value(), [&] { ballbar_device(c); });
+}
+
+}  // namespace
+
+json setup_of(const cal::daq::Config& c) {
+  json j{{"schema", "caldaq.setup.v1"}};
+  put_text(j, "campaign", c.campaign);
+  put_text(j, "operator", c.operator_name);
+  json m{{"name", c.machine_name}};
+  put_text(m, "description", c.machine_description);
+  put_text(m, "make", c.machine_make);
+  put_text(m, "model", c.machine_model);
+  put_text(m, "serial_number", c.machine_serial);
+  j["machine"] = m;
+  json cu = json::object();
+  put_text(cu, "name", c.customer.name);
+  put_text(cu, "site", c.customer.site);
+  put_text(cu, "contact", c.customer.contact);
+  if (!cu.empty()) j["customer"] = cu;
+  json co = json::object();
+  if (c.conditions.controller_compensation)
+    co["controller_compensation"] = *c.conditions.controller_compensation;
+  put_text(co, "warm_up", c.conditions.warm_up);
+  put_text(co, "load", c.conditions.load);
+  put_text(co, "state", c.conditions.state);
+  put_text(co, "notes", c.conditions.notes);
+  if (!co.empty()) j["conditions"] = co;
+  j["devices"] = json::object();
+  for (const auto& d : c.devices) j["devices"][d.id] = device_json(d);
+  j["environment"] = environment_json(c.environment);
+  j["trigger"] = {{"tolerance_um", c.trigger.tolerance_um},
+                  {"dwell_s", c.trigger.dwell_s},
+                  {"window_mm", c.trigger.window_mm}};
+  j["test"] = json::object();
+  if (c.linear) j["test"]["linear"] = linear_json(*c.linear);
+  if (c.circle) j["test"]["circle"] = circle_json(*c.circle);
+  if (auto t = tolerances_json(c); !t.empty()) j["tolerances"] = t;
+  return j;
+}
+
+std::string setup_toml(const json& setup) {
+  json s = setup;
+  if (s.is_object()) s.erase("schema");  // the page's, not the file's
+  std::ostringstream out;
+  out << "# Written by the caldaq operator's page (daq serve): a set-up that `daq run -c` reads\n"
+         "# (docs/config.md).\n";
+  write_table(out, s, "");
+  return out.str();
+}
+
+SetupCheck check_setup(const json& setup, std::string_view source_name) {
+  SetupCheck out;
+  json current = setup;
+  for (int round = 0; round < 50; ++round) {
+    std::string text;
+    try {
+      text = setup_toml(current);
+    } catch (const cal::InputError& e) {
+      out.problems.push_back({"", e.what()});
+      return out;
+    }
+    if (round == 0) out.toml = text;
+    try {
+      auto config = cal::daq::parse_config(text, std::string(source_name));
+      if (out.problems.empty()) {
+        check_tests(config, out);
+        if (out.problems.empty()) out.config = std::move(config);
+      }
+      return out;
+    } catch (const cal::InputError& e) {
+      auto p = problem_of(e.what());
+      // A required key taken out is then "missing": that is the first problem again.
+      const bool again = std::any_of(out.problems.begin(), out.problems.end(),
+                                     [&](const SetupProblem& q) { return q.key == p.key; });
+      if (again) return out;
+      out.problems.push_back(p);
+      // Read the rest without the key at fault; a table's own error, or a key that is not
+      // there (a required key missing), ends the search.
+      if (p.key.empty() || !erase_path(current, p.key)) return out;
+    }
+  }
+  return out;
+}
+
+json to_json(const SetupCheck& c) {
+  json problems = json::array();
+  for (const auto& p : c.problems) problems.push_back({{"key", p.key}, {"message", p.message}});
+  const auto test = [](const TestReadiness& r) {
+    return json{{"configured", r.configured},
+                {"problem", r.problem ? json(*r.problem) : json(nullptr)}};
+  };
+  return {{"ok", c.problems.empty()},
+          {"problems", problems},
+          {"tests", {{"linear", test(c.linear)}, {"circle", test(c.circle)}}}};
+}
+
+}  // namespace daq::serve
