@@ -330,6 +330,7 @@ void add_model_commands(CLI::App& app) {
   map->add_flag("--json", o->json, "Print caldaq.volumetric-map.v1 JSON");
   map->callback([o] { run_map(*o); });
 
+  add_model_build_command(*model);
   add_model_compensate_command(*model);
   add_model_testpiece_command(*model);
 }

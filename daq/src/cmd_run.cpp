@@ -122,6 +122,27 @@ Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
   return circle_verdict(run_context(c, "circle", plane)["tolerances"], result);
 }
 
+// The result of a straightness, angular or roll run (kinds/kind.hpp): its profile.
+void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
+  auto j = *out.profile;
+  j["run_id"] = out.run_id;
+  j["status"] = cal::storage::to_string(out.status);
+  if (json) return fmt::print("{}\n", j.dump(2));
+  fmt::print("{}\nrun {} stored ({}): {} readings\n\n", tty ? "\r\033[K" : "", out.run_id,
+             cal::storage::to_string(out.status), out.readings);
+  const std::string unit = j.value("unit", "");
+  fmt::print("{} {} (mean of the stops at each target, {})\n", j.value("kind", ""),
+             out.component, unit);
+  for (const auto& t : j["targets"])
+    fmt::print("  {:10.3f} mm  {:+10.3f}  (spread {:.3f}, {} stops)\n",
+               t["position_mm"].get<double>(), t["mean"].get<double>(),
+               t["spread"].get<double>(), t["count"].get<int>());
+  fmt::print("range {:.3f} {}\n", j["range"].get<double>(), unit);
+  if (j.contains("straightness_um"))
+    fmt::print("straightness {:.3f} um about the least-squares line (slope {:+.3f} um/m)\n",
+               j["straightness_um"].get<double>(), j["slope_um_per_m"].get<double>());
+}
+
 void run_linear(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
   boost::asio::io_context io;
@@ -153,6 +174,7 @@ void run_linear(const RunOptions& o) {
       o.config));
   watch_keyboard(io, [&] { run.manual_capture(); });
   const auto& out = run_to_end(io, run, capture);
+  if (out.profile) return print_profile(out, o.json, progress->tty);
   const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
   const auto v = verdict_of(
       settings ? nlohmann::json::parse(settings->settings_json, nullptr, false) : nlohmann::json(),
@@ -265,7 +287,10 @@ void add_run_commands(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   auto* run = app.add_subcommand("run", "Acquire a test with the configured instruments");
   run->require_subcommand(1);
-  auto* lin = run->add_subcommand("linear", "ISO 230-2 positioning test (laser, air, material)");
+  auto* lin = run->add_subcommand(
+      "linear",
+      "Linear test: ISO 230-2 positioning (laser, air, material), or by [test.linear] measure a "
+      "straightness (indicator), pitch or yaw (two laser axes) or roll (level) run");
   lin->add_option("-c,--config", o->config, "Machine/campaign TOML (docs/config.md)")->required();
   add_db_option(*lin, o->db);
   lin->add_option("--capture", o->capture, "Record the wire-level capture to this file");

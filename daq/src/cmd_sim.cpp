@@ -6,6 +6,7 @@
 // acquiring process only sees devices.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <chrono>
 #include <filesystem>
@@ -13,12 +14,15 @@
 #include <optional>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/volumetric_comp.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "linear_run.hpp"
+#include "model/model_file.hpp"
 #include "sim_shop.hpp"
+#include "sim_volumetric.hpp"
 
 namespace daq {
 namespace {
@@ -32,7 +36,62 @@ struct SimOptions {
   std::optional<double> start_after_s;  // unset: wait for a run in the database
   std::string db;
   bool position_feed = false;
+  std::string measure;  // a component of the volumetric campaign, e.g. E_YX
+  std::string topology = "YFXZ";
+  std::string compensate;  // a model file whose volumetric correction the control applies
 };
+
+std::string numbers(const std::array<double, 3>& v) {
+  return fmt::format("[{}, {}, {}]", v[0], v[1], v[2]);
+}
+
+// The [test.linear] of a volumetric campaign test (kinds/kind.hpp; docs/config.md).
+std::string linear_toml(const cal::daq::LinearTestConfig& l) {
+  const auto& m = l.measure;
+  std::string t = fmt::format(
+      "[test.linear]\naxis = \"{}\"\nfirst_mm = {}\nlast_mm = {}\ncount = {}\nruns = {}\n"
+      "overrun_mm = {}\nfeed_mm_per_min = {}\ndwell_s = {}\nmeasure = \"{}\"\n"
+      "stationary_mm = {}\nprobe_offset_mm = {}\n",
+      l.axis, l.first_mm, l.last_mm, l.count.value_or(6), l.runs, l.overrun_mm, l.feed_mm_per_min,
+      l.dwell_s, m.kind, numbers(m.stationary_mm), numbers(m.probe_offset_mm));
+  if (!m.direction.empty()) t += fmt::format("direction = \"{}\"\n", m.direction);
+  if (m.kind == "angular")
+    t += fmt::format("beams = [{}, {}]\nseparation_mm = {}\n", m.beams[0], m.beams[1],
+                     numbers(m.separation_mm));
+  if (m.square) t += "square = true\n";
+  return t;
+}
+
+// The configuration of a volumetric campaign test: the shop's devices and the test of one
+// component on the machine with all 21 errors (times divided by the speed as for the others).
+std::string volumetric_config(const SimulatedShop& shop, double speed,
+                              const cal::daq::LinearTestConfig& test) {
+  return fmt::format(
+      R"TOML(# Written by `daq sim --measure`: the devices of the built-in SIMULATED shop (running
+# {speed}x faster than real time) and the test of one component. Valid while that process runs.
+campaign = "volumetric (simulated)"
+
+[machine]
+name = "SIMULATED {topology}"
+description = "built-in simulated machine with all 21 geometric errors injected (daq sim)"
+topology = "{topology}"
+
+{devices}
+[environment]
+equation = "ciddor"
+expansion_ppm_per_k = {alpha}
+
+[trigger]
+tolerance_um = 1
+dwell_s = {trigger_dwell}
+window_mm = 0.5
+
+{linear})TOML",
+      fmt::arg("devices", shop.devices_toml(0.01 / speed, false, false)), fmt::arg("speed", speed),
+      fmt::arg("alpha", shop.truth().expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
+      fmt::arg("topology", cal::kinematics::to_string(shop.truth().geometry->topology)),
+      fmt::arg("linear", linear_toml(test)));
+}
 
 // A run that has started in the database since `after` (its id), or nullopt. The database may
 // be busy with the acquiring process's writes: a failed look is retried at the next poll.
@@ -54,16 +113,41 @@ std::int64_t newest_run(const std::filesystem::path& db) {
   return id;
 }
 
-void run_sim(const SimOptions& o) {
+void run_sim(SimOptions o) {
+  if (!o.measure.empty()) o.test = "linear";  // a component's test is a linear one
   if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
     throw cal::InputError(
         fmt::format("--test '{}' (expected linear, circle or circle-set)", o.test));
   const bool set = o.test == "circle-set";  // the standard set on the three-plane machine
+  std::optional<cal::daq::LinearTestConfig> volumetric;
+  ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
+  if (!o.measure.empty()) {
+    volumetric = volumetric_test(o.measure);
+    truth = volumetric_truth(cal::kinematics::topology_from_string(o.topology), 0.02);
+  } else if (!o.compensate.empty()) {
+    throw cal::InputError("--compensate applies to the volumetric machine: give --measure too");
+  }
   boost::asio::io_context io;
-  SimulatedShop shop(io, set ? ShopTruth::three_planes() : ShopTruth{}, o.speed);
-  const std::string text = simulated_shop_config(
-      shop,
-      {.speed = o.speed, .position_feed = o.position_feed, .in_process = false, .circle_set = set});
+  SimulatedShop shop(io, truth, o.speed, volumetric.value_or(cal::daq::LinearTestConfig{}));
+  if (!o.compensate.empty()) {
+    // The control applies the model's full volumetric correction (cal::volcomp::correction_um,
+    // what `daq model compensate -f isg-volumetric` writes for a controller), with each
+    // position held within the model's tables (the overrun moves go a few mm past them).
+    const auto model = cal::daq::model::read(o.compensate);
+    if (!model.travel_mm) throw cal::InputError(fmt::format("{}: no travel_mm", o.compensate));
+    shop.set_compensation([model](const cal::kinematics::Vec3& p) {
+      cal::kinematics::Vec3 q = p;
+      for (std::size_t k = 0; k < 3; ++k)
+        q[k] = std::clamp(q[k], (*model.travel_mm)[k][0], (*model.travel_mm)[k][1]);
+      return cal::volcomp::correction_um(model.machine, q, model.carriers);
+    });
+  }
+  const std::string text = volumetric
+                               ? volumetric_config(shop, o.speed, *volumetric)
+                               : simulated_shop_config(shop, {.speed = o.speed,
+                                                              .position_feed = o.position_feed,
+                                                              .in_process = false,
+                                                              .circle_set = set});
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -128,6 +212,7 @@ void run_sim(const SimOptions& o) {
     fmt::print("daq sim: run {} ({}) started\n", run->id, test);
     run_until(shop.now_s() + 1.0 * o.speed);
     run_program(test);
+    if (volumetric) return;  // set up for one component's test: one run
     // A set's later tests are runs of their own, started while its one program ran: not
     // programs to start again.
     if (set) seen = newest_run(db);
@@ -157,6 +242,14 @@ void add_sim_command(CLI::App& app) {
   add_db_option(*cmd, o->db);
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
+  cmd->add_option("--measure", o->measure,
+                  "A component of the SIMULATED volumetric campaign (E_XX ... E_CZ): the machine "
+                  "with all 21 errors, set up to measure it, for one run "
+                  "(docs/volumetric-walkthrough.md)");
+  cmd->add_option("--topology", o->topology, "The simulated machine's chain with --measure")
+      ->capture_default_str();
+  cmd->add_option("--compensate", o->compensate,
+                  "With --measure: the control applies this model's volumetric correction");
   cmd->callback([o] { run_sim(*o); });
 }
 

@@ -9,6 +9,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/registry.hpp"
+#include "kinds/kind.hpp"
 
 namespace daq {
 
@@ -25,6 +26,8 @@ std::vector<d::Quantity> needed(std::string_view role) {
   if (role == "material") return {Q::material_temperature_degc};
   if (role == "ballbar") return {Q::length_m};
   if (role == "position") return {Q::machine_position_m};
+  if (role == "indicator") return {Q::length_m};  // a straightness run's transducer
+  if (role == "level") return {Q::angle_rad};     // a roll run's electronic level
   return {};
 }
 
@@ -191,12 +194,33 @@ std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
   std::vector<InstrumentSpec> specs;
   std::uint16_t n = 0;
   const int axis = config.linear->axis == "Y" ? 1 : config.linear->axis == "Z" ? 2 : 0;
+  const auto& kind = kinds::kind(config.linear->measure.kind);
+  try {
+    kind.validate(*config.linear);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("{}: {}", config.source.string(), e.what()));
+  }
+  const std::string probe(kind.probe_role());
   for (const auto& dc : config.devices) {
-    if (dc.role != "laser" && dc.role != "air" && dc.role != "material" && dc.role != "position")
+    if (dc.role != "laser" && dc.role != "air" && dc.role != "material" && dc.role != "position" &&
+        (probe.empty() || dc.role != probe))
       continue;
     specs.push_back(spec_of(dc, n++, axis));
   }
   need(config, "laser"), need(config, "air");
+  if (!probe.empty()) need(config, probe.c_str());
+  // An angular run reads two more laser axes: the laser must read them.
+  if (const auto beams = kind.laser_channels(*config.linear); !beams.empty()) {
+    const auto& laser = *std::find_if(specs.begin(), specs.end(),
+                                      [](const InstrumentSpec& s) { return s.role == "laser"; });
+    const auto have = d::driver(laser.driver).channels(laser.options, laser.context());
+    for (const int b : beams)
+      if (std::find(have.begin(), have.end(), b) == have.end())
+        throw cal::InputError(fmt::format(
+            "{}: test.linear.beams: the laser (driver '{}') does not read axis {}: add it to its "
+            "axes",
+            config.source.string(), laser.driver, b));
+  }
   return specs;
 }
 
@@ -210,6 +234,8 @@ void place_linear_instrument(const InstrumentSpec& s, std::unique_ptr<d::Instrum
     setup.laser_channel = first;
   } else if (s.role == "air") {
     setup.air = std::move(inst);
+  } else if (s.role == "indicator" || s.role == "level") {
+    setup.probe = std::move(inst);
   } else if (s.role == "position") {
     setup.position = std::move(inst);
     setup.position_channel = first;

@@ -47,12 +47,25 @@ struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's time
     return json{{"jsonrpc", "2.0"}, {"result", result}, {"id", id}}.dump();
   }
 
+  // The machine state with the tool at the reflector of interferometer axis `a`: the axes plus
+  // the error of that point (its nominal offset is constant and cancels against the datum).
+  MachineState reflector_state(std::size_t a) const {
+    MachineState state = world.state();
+    if (const auto& r = config.reflector_mm[a]) {
+      const auto e = world.machine().error_at(*r);
+      for (std::size_t k = 0; k < 3; ++k)
+        state.tool_mm[k] = state.axes_mm[k] + 1e-3 * e.translation_um[k];
+    }
+    return state;
+  }
+
   std::int64_t displacement_pm(int axis) {
     const int machine_axis = config.machine_axis[static_cast<std::size_t>(axis)];
     if (machine_axis < 0) return 0;
     const double n = world.air().sample(world.time_s()).refractive_index;
-    const double m = laser_reading_m(world.state(), static_cast<kinematics::Axis>(machine_axis),
-                                     config.datum_mm[static_cast<std::size_t>(axis)], n);
+    const auto a = static_cast<std::size_t>(axis);
+    const double m = laser_reading_m(
+        reflector_state(a), static_cast<kinematics::Axis>(machine_axis), config.datum_mm[a], n);
     return std::llround(m * 1e12);
   }
 
@@ -119,7 +132,7 @@ struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's time
       for (std::size_t a = 0; a < 3; ++a)
         if (config.machine_axis[a] >= 0)
           config.datum_mm[a] =
-              world.state().tool_mm[static_cast<std::size_t>(config.machine_axis[a])];
+              reflector_state(a).tool_mm[static_cast<std::size_t>(config.machine_axis[a])];
       return json::array({0});
     }
     if (method == ecu + "enable") {

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "cal/drivers/sim/twin.hpp"
 #include "ids3010/codec.hpp"
@@ -16,6 +17,11 @@ struct IdsTwinConfig {
   // and the tool position (mm along that axis) where its displacement was reset to zero.
   std::array<int, 3> machine_axis{0, -1, -1};
   std::array<double, 3> datum_mm{0.0, 0.0, 0.0};
+  // Where each axis's reflector sits relative to the tool reference point (mm), when set: the
+  // axis then reads the displacement of that point, with the machine's angular errors acting
+  // on the offset (two axes with reflectors apart measure an angle, as angular optics do).
+  // Unset: the tool tip of the machine's geometry.
+  std::array<std::optional<Vec3>, 3> reflector_mm{};
   double starting_s = 0.2;  // "measurement starting" lasts this long after startMeasurement
   bool ecu_connected = true;
   // startMeasurement answers error_start_refused instead of starting (a laser not ready).

@@ -26,6 +26,9 @@ std::optional<GaugeUnit> unit_word(std::string_view w) {
   if (lower == "um" || lower == "µm") return GaugeUnit::um;
   if (lower == "in" || lower == "inch" || lower == "\"") return GaugeUnit::inch;
   if (lower == "m") return GaugeUnit::m;
+  if (lower == "urad" || lower == "µrad") return GaugeUnit::urad;
+  if (lower == "mrad" || lower == "mm/m") return GaugeUnit::mrad;
+  if (lower == "arcsec") return GaugeUnit::arcsec;
   return std::nullopt;
 }
 
@@ -35,7 +38,12 @@ GaugeUnit gauge_unit_from_string(std::string_view s) {
   if (s == "degC" || s == "degc") return GaugeUnit::degc;
   if (s == "none") return GaugeUnit::none;
   if (auto u = unit_word(s)) return *u;
-  throw InputError(fmt::format("gauge unit '{}' (expected mm, um, in, m, degC or none)", s));
+  throw InputError(fmt::format(
+      "gauge unit '{}' (expected mm, um, in, m, degC, none, urad, mrad, mm/m or arcsec)", s));
+}
+
+bool is_angle(GaugeUnit u) {
+  return u == GaugeUnit::urad || u == GaugeUnit::mrad || u == GaugeUnit::arcsec;
 }
 
 GaugeCodec::GaugeCodec(GaugeConfig config)
@@ -82,6 +90,12 @@ std::optional<double> GaugeCodec::to_si(double printed,
     case GaugeUnit::degc:
     case GaugeUnit::none:
       return v;
+    case GaugeUnit::urad:
+      return v * 1e-6;
+    case GaugeUnit::mrad:
+      return v * 1e-3;
+    case GaugeUnit::arcsec:
+      return v * (3.14159265358979323846 / 648000.0);  // pi / (180 * 3600)
   }
   return std::nullopt;
 }
@@ -105,7 +119,8 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
       number = parse_number(tokens[0]);
       if (count == 2) {
         printed_unit = unit_word(tokens[1]);
-        if (!printed_unit) number.reset();
+        // A printed unit of the other kind (an angle on a length gauge) is not this gauge's.
+        if (!printed_unit || is_angle(*printed_unit) != is_angle(config_.unit)) number.reset();
       }
     }
   }

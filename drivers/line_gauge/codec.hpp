@@ -12,8 +12,13 @@
 
 namespace cal::drivers::codec {
 
-enum class GaugeUnit { mm, um, inch, m, degc, none };
-GaugeUnit gauge_unit_from_string(std::string_view s);  // mm | um | in | m | degC | none
+// Lengths (mm, um, in, m), a temperature (degC), angles (urad, mrad = mm/m, arcsec: an
+// electronic level) or a bare number (none).
+enum class GaugeUnit { mm, um, inch, m, degc, none, urad, mrad, arcsec };
+// mm | um | in | m | degC | none | urad | mrad | mm/m | arcsec
+GaugeUnit gauge_unit_from_string(std::string_view s);
+// True for the angle units: the gauge is then a level and its readings are angles (rad).
+bool is_angle(GaugeUnit u);
 
 struct GaugeConfig {
   // Sent to poll a gauge ("?\r", "PRINT\r"); empty for a gauge that streams by itself.
@@ -30,7 +35,8 @@ struct GaugeConfig {
 };
 
 struct GaugeFrame {
-  double value_si = 0.0;  // metres (degC for temperature gauges, as printed for `none`)
+  // metres (degC for temperature gauges, rad for levels, as printed for `none`)
+  double value_si = 0.0;
   std::string text;       // the line as received
 };
 

@@ -27,10 +27,11 @@ const std::vector<OptionSpec>& table() {
                "a number, optionally followed by a unit word (mm, um, in, m)"},
       {.name = "unit",
        .type = OptionType::choice,
-       .choices = {"mm", "um", "in", "m", "degC"},
+       .choices = {"mm", "um", "in", "m", "degC", "urad", "mrad", "mm/m", "arcsec"},
        .default_value = std::string("mm"),
        .help = "the unit of the printed number (a unit printed on the line wins); degC makes a "
-               "serial thermometer"},
+               "serial thermometer, an angle unit (urad, mrad = mm/m, arcsec) an electronic "
+               "level"},
       {.name = "scale",
        .type = OptionType::number,
        .default_value = 1.0,
@@ -41,10 +42,12 @@ const std::vector<OptionSpec>& table() {
        .help = "added after scaling, in the printed unit"},
       {.name = "min_si",
        .type = OptionType::number,
-       .help = "plausible minimum in SI (m, or degC for a thermometer); default -10 m or -40 degC"},
+       .help = "plausible minimum in SI (m, degC for a thermometer, rad for a level); default "
+               "-10 m, -40 degC or -0.01 rad"},
       {.name = "max_si",
        .type = OptionType::number,
-       .help = "plausible maximum in SI (m, or degC for a thermometer); default 10 m or 150 degC"},
+       .help = "plausible maximum in SI (m, degC for a thermometer, rad for a level); default "
+               "10 m, 150 degC or 0.01 rad"},
   };
   return t;
 }
@@ -56,18 +59,28 @@ codec::GaugeConfig config_of(const Options& o) {
                        .scale = o.number("scale"),
                        .offset = o.number("offset")};
   if (c.unit == codec::GaugeUnit::degc) c.min_si = -40, c.max_si = 150;
+  if (codec::is_angle(c.unit)) c.min_si = -0.01, c.max_si = 0.01;  // +-10 mm/m: beyond any level
   if (o.has_value("min_si")) c.min_si = o.number("min_si");
   if (o.has_value("max_si")) c.max_si = o.number("max_si");
   return c;
 }
 
 bool thermometer(const Options& o) { return o.text("unit") == "degC"; }
+bool level(const Options& o) {
+  return codec::is_angle(codec::gauge_unit_from_string(o.text("unit")));
+}
+Quantity quantity_of(const Options& o) {
+  return thermometer(o) ? Quantity::material_temperature_degc
+         : level(o)     ? Quantity::angle_rad
+                        : Quantity::length_m;
+}
 
 class Driver final : public DeviceDriver {
  public:
   std::string_view name() const override { return "gauge"; }
   std::string_view description() const override {
-    return "line-oriented serial gauge: the length transducer of a ballbar, a linear gauge, or a "
+    return "line-oriented serial gauge: the length transducer of a ballbar, a linear gauge, an "
+           "electronic level (angle units), or a "
            "serial thermometer (configurable request, pattern and unit)";
   }
   std::string_view transport_example() const override { return "serial /dev/ttyUSB1 9600 8N1"; }
@@ -80,7 +93,7 @@ class Driver final : public DeviceDriver {
                                    c.min_si, c.max_si));
   }
   std::vector<Quantity> quantities(const Options& o, const InstrumentContext&) const override {
-    return {thermometer(o) ? Quantity::material_temperature_degc : Quantity::length_m};
+    return {quantity_of(o)};
   }
   bool may_be_silent(const Options& o) const override { return o.text("request").empty(); }
   std::chrono::microseconds default_poll(const Options&,
@@ -103,7 +116,7 @@ class Driver final : public DeviceDriver {
     return make_gauge(io, std::move(t), std::move(instrument), config_of(o));
   }
   std::unique_ptr<Decoder> make_decoder(const Options& o) const override {
-    const Quantity q = thermometer(o) ? Quantity::material_temperature_degc : Quantity::length_m;
+    const Quantity q = quantity_of(o);
     return detail::make_codec_decoder(
         codec::GaugeCodec(config_of(o)),
         [q](const codec::GaugeFrame& f, std::uint64_t offset, std::vector<DecodedItem>& out) {

@@ -14,6 +14,7 @@ class Gauge final : public detail::InstrumentCore {
         config_(std::move(config)),
         codec_(config_) {
     quantity_ = config_.unit == codec::GaugeUnit::degc ? Quantity::material_temperature_degc
+                : codec::is_angle(config_.unit)        ? Quantity::angle_rad
                                                        : Quantity::length_m;
   }
   const codec::CodecStats& codec_stats() const override { return codec_.stats(); }

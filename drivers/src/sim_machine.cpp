@@ -189,6 +189,14 @@ struct Machine::Impl {
     const Vec3 c0 = state.commanded_mm;
     const double t = state.time_s + dt;
     const Vec3 c1 = commanded(t);
+    // The set-points the position loops follow: the command plus the control's compensation.
+    const auto compensated = [this](Vec3 c) {
+      if (!config.compensation_um) return c;
+      const Vec3 d = config.compensation_um(c);
+      for (std::size_t k = 0; k < 3; ++k) c[k] += 1e-3 * d[k];
+      return c;
+    };
+    const Vec3 s0 = compensated(c0), s1 = compensated(c1);
     const double temperature = config.thermal.temperature_degc(t);
     const double scale = 1.0 + config.thermal.expansion_ppm_per_k * 1e-6 * (temperature - 20.0);
     Vec3 axes{};
@@ -196,9 +204,9 @@ struct Machine::Impl {
       const ServoAxis& s = config.servo[k];
       // dx/dt = Kv (c - x) with c linear over the step (rate r): exact solution
       // x(dt) = c1 - r/Kv + (x0 - c0 + r/Kv) exp(-Kv dt).
-      const double r = (c1[k] - c0[k]) / dt;
-      servo_mm[k] = c1[k] - r / s.kv_per_s +
-                    (servo_mm[k] - c0[k] + r / s.kv_per_s) * std::exp(-s.kv_per_s * dt);
+      const double r = (s1[k] - s0[k]) / dt;
+      servo_mm[k] = s1[k] - r / s.kv_per_s +
+                    (servo_mm[k] - s0[k] + r / s.kv_per_s) * std::exp(-s.kv_per_s * dt);
       // Lost motion: the driven part follows only once the play of width b is taken up.
       const double half = 0.5e-3 * s.backlash_um;
       played_mm[k] = std::clamp(played_mm[k], servo_mm[k] - half, servo_mm[k] + half);
@@ -269,5 +277,15 @@ double Machine::program_duration_s() const {
 }
 
 const MachineConfig& Machine::config() const { return impl_->config; }
+
+void Machine::set_compensation(std::function<Vec3(const Vec3&)> compensation_um) {
+  impl_->config.compensation_um = std::move(compensation_um);
+}
+
+kinematics::VolumetricError Machine::error_at(const Vec3& offset_mm) const {
+  kinematics::Machine g = impl_->config.geometry;
+  g.tool_offset_mm = offset_mm;
+  return kinematics::volumetric_error(g, impl_->state.axes_mm, kinematics::Method::htm);
+}
 
 }  // namespace cal::drivers::sim

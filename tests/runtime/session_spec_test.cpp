@@ -79,7 +79,7 @@ TEST(SessionSpec, AHeaderThisBuildCannotHonourIsRefusedByName) {
             "capture header: instrument 2 (gauge): option 'dither' is not known to this build");
   EXPECT_EQ(error_of({{"device", 2}, {"driver", "gauge"}, {"options", {{"unit", "furlong"}}}}),
             "capture header: instrument 2 (gauge): option 'unit' = \"furlong\": 'furlong' is not "
-            "one of: mm, um, in, m, degC");
+            "one of: mm, um, in, m, degC, urad, mrad, mm/m, arcsec");
 }
 
 TEST(MaterialSensors, EachUsedChannelIsItsOwnSensorNeverMerged) {

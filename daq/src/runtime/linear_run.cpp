@@ -8,15 +8,19 @@
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <chrono>
+#include <deque>
 #include <nlohmann/json.hpp>
 
+#include "cal/analysis/error.hpp"
 #include "cal/daq/env_stage.hpp"
 #include "cal/daq/motion.hpp"
 #include "cal/daq/trigger.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "iso230_2_output.hpp"
+#include "kinds/kind.hpp"
 #include "provenance.hpp"
+#include "session_spec.hpp"
 
 namespace daq {
 
@@ -107,7 +111,16 @@ json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, d
   const auto& l = *c.linear;
   json context = context_json.empty() ? json(nullptr) : json::parse(context_json, nullptr, false);
   if (!context.is_object()) context = run_context(c, "linear", l.axis);
+  const auto& kind = kinds::kind(l.measure.kind);
+  json measure = measure_json(l.measure);
+  measure["component"] = kind.component(l);
+  measure["unit"] = kind.unit();
   return {
+      {"measure", measure},
+      {"machine_model",
+       {{"topology", c.machine_topology},
+        {"tool_offset_mm", c.machine_tool_offset_mm},
+        {"table_offset_mm", c.machine_table_offset_mm}}},
       {"context", context},
       {"machine", c.machine_name},
       {"axis", l.axis},
@@ -160,6 +173,19 @@ struct LinearRun::Impl {
   cal::daq::StabilityTrigger trigger;
   std::optional<cal::daq::PositionTrigger> position_trigger;  // with a position feed
   cal::daq::Sequencer sequencer;
+  const kinds::TestKind& kind;
+  std::unique_ptr<kinds::SampleReader> reader;  // null for positioning
+  std::deque<std::pair<std::int64_t, double>> samples;  // the kind's value, newest last
+  std::vector<kinds::StopValue> values;                 // at the captured stops
+  // Stops captured before any sample of the kind's instrument arrived in their window (a
+  // polled gauge a little behind the laser): they take the first sample that follows within
+  // half the trigger's dwell (the machine still stands), else the run ends saying so.
+  struct Pending {
+    std::size_t stop;
+    cal::daq::Capture cap;
+    cal::daq::Compensated comp;
+  };
+  std::vector<Pending> pending;
   cal::daq::MotionIndicator motion;
   std::vector<double> acceptable;  // sorted: the positions a stop could be at now
   std::optional<cal::storage::Store> store;
@@ -183,10 +209,16 @@ struct LinearRun::Impl {
                  .dwell_s = setup.config.trigger.dwell_s,
                  .window_mm = setup.config.trigger.window_mm}),
         sequencer(plan, setup.config.trigger.window_mm),
+        kind(kinds::kind(setup.config.linear->measure.kind)),
         motion({.tolerance_um = setup.config.trigger.tolerance_um,
                 .dwell_s = setup.config.trigger.dwell_s,
                 .window_mm = setup.config.trigger.window_mm}),
         timer(i) {
+    kind.validate(*setup.config.linear);
+    reader = kind.reader(*setup.config.linear);
+    if (!kind.probe_role().empty() && !setup.probe)
+      throw cal::InputError(fmt::format("a {} test needs a device with role = \"{}\"",
+                                        kind.name(), kind.probe_role()));
     if (setup.position)
       position_trigger.emplace(
           cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
@@ -198,6 +230,7 @@ struct LinearRun::Impl {
   std::uint16_t position_device() const {
     return static_cast<std::uint16_t>(2 + setup.material.size());
   }
+  std::uint16_t probe_device() const { return static_cast<std::uint16_t>(position_device() + 1); }
 
   // The triggers watch every position the sequencer could accept now (see acceptable_mm):
   // after a missed stop they must still see the following ones.
@@ -229,7 +262,7 @@ struct LinearRun::Impl {
     outcome.run_id = store->begin_run(
         {.machine_id = machine,
          .campaign = c.campaign,
-         .kind = "linear",
+         .kind = std::string(kind.run_kind()),
          .axis = c.linear->axis,
          .settings_json = settings_json(c, plan, setup.datum_mm, setup.context_json).dump(),
          .capture_path = setup.capture_path,
@@ -245,6 +278,8 @@ struct LinearRun::Impl {
     for (std::size_t k = 0; k < setup.material.size(); ++k)
       add(static_cast<int>(2 + k), *setup.material[k], "material");
     if (setup.position) add(position_device(), *setup.position, "position");
+    if (setup.probe) add(probe_device(), *setup.probe, kind.probe_role());
+    outcome.component = kind.component(*setup.config.linear);
     writer = std::make_unique<cal::storage::BatchWriter>(
         setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
         [this, alive = alive](const std::string& e) {
@@ -264,6 +299,8 @@ struct LinearRun::Impl {
       event("stops are recognised from the machine position feed (" + setup.position->describe() +
             ")");
     }
+    if (setup.probe) start_instrument(*setup.probe, probe_device());
+    if (reader) event(fmt::format("measuring {} ({})", outcome.component, kind.name()));
     event(fmt::format("run {}: {} targets x {} runs, {} stops expected", outcome.run_id,
                       plan.targets_mm.size(), c.linear->runs, sequencer.stops().size()));
     tick();
@@ -316,6 +353,9 @@ struct LinearRun::Impl {
                                  std::chrono::system_clock::now().time_since_epoch())
                                  .count());
     }
+    if (reader && device == probe_device() && r.status == ReadingStatus::ok &&
+        (r.quantity == Quantity::length_m || r.quantity == Quantity::angle_rad))
+      return add_sample(kinds::Source::probe, r);
     switch (r.quantity) {
       case Quantity::air_temperature_degc:
         return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
@@ -332,6 +372,11 @@ struct LinearRun::Impl {
         return;
       case Quantity::displacement_m:
         if (device == 0 && r.channel == setup.laser_channel) return on_laser(r);
+        if (device == 0 && reader && r.status == ReadingStatus::ok) {
+          Reading c = r;
+          c.value = env.compensate(r.time_ns, r.value).length_m;
+          add_sample(kinds::Source::laser, c);
+        }
         return;
       case Quantity::machine_position_m:
         if (position_trigger && device == position_device() && r.channel == setup.position_channel)
@@ -341,6 +386,50 @@ struct LinearRun::Impl {
       default:
         return;
     }
+  }
+
+  // A sample of the kind's value; the newest few minutes are kept for the stops' windows.
+  void add_sample(kinds::Source source, const Reading& r) {
+    if (const auto v = reader->add(source, r.channel, r.time_ns, r.value)) {
+      samples.emplace_back(r.time_ns, *v);
+      while (samples.size() > 1'000'000) samples.pop_front();  // bounded, whatever the rate
+      resolve_pending(r.time_ns, *v);
+    }
+  }
+
+  void resolve_pending(std::int64_t time_ns, double value) {
+    if (pending.empty()) return;
+    // The machine stands the program's dwell; the trigger captured after its own dwell of it.
+    const double trigger_s = setup.config.trigger.dwell_s;
+    const auto limit_ns = static_cast<std::int64_t>(
+        1e9 * std::min(trigger_s, setup.config.linear->dwell_s - trigger_s));
+    auto waiting = std::move(pending);
+    pending.clear();
+    for (const auto& p : waiting) {
+      if (time_ns < p.cap.end_ns) {
+        pending.push_back(p);
+      } else if (time_ns <= p.cap.end_ns + limit_ns) {
+        store_stop(p.stop, p.cap, p.comp, value);
+      } else {
+        const auto& s = sequencer.stops()[p.stop];
+        return abort(fmt::format(
+            "no {} reading during the stop at {:.3f} mm (run {}): is the {} reading?",
+            kind.name(), s.position_mm, s.run,
+            kind.probe_role().empty() ? "laser's beam pair" : kind.probe_role()));
+      }
+    }
+    if (!done && pending.empty() && sequencer.complete()) finish();
+  }
+
+  // The kind's value at a stop: the mean of its samples within the stop's window.
+  std::optional<double> stop_value(const cal::daq::Capture& cap) {
+    double sum = 0;
+    std::size_t n = 0;
+    for (const auto& [t, v] : samples)
+      if (t >= cap.start_ns && t <= cap.end_ns) sum += v, ++n;
+    while (!samples.empty() && samples.front().first < cap.start_ns) samples.pop_front();
+    if (n == 0) return std::nullopt;
+    return sum / static_cast<double>(n);
   }
 
   void on_laser(const Reading& r) {
@@ -389,30 +478,55 @@ struct LinearRun::Impl {
       event(e.message);
       using Kind = cal::daq::SequenceEvent::Kind;
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
-        const auto& s = sequencer.stops()[e.stop];
-        motion.captured(cap.mean_mm, s.position_mm, cap.end_ns);
-        if (const auto t = motion.last_stop())
-          live.last_settling_s = t->settling_s, live.last_stable_s = t->stable_s;
-        const cal::storage::CapturedTarget t{
-            .run_id = outcome.run_id,
-            .target_index = s.target_index - 1,
-            .run_number = s.run,
-            .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
-            .nominal_mm = s.position_mm,
-            .time_ns = cap.end_ns,
-            .raw_m = (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
-            .deviation_um = s.deviation_um,
-            .refractive_index = c.n,
-            .material_temperature_degc = c.material_degc};
-        try {
-          store->add_targets(std::span(&t, 1));
-        } catch (const std::exception& err) {
-          return abort(fmt::format("storage failed: {}", err.what()));
+        {
+          const auto& s = sequencer.stops()[e.stop];
+          motion.captured(cap.mean_mm, s.position_mm, cap.end_ns);
+          if (const auto t = motion.last_stop())
+            live.last_settling_s = t->settling_s, live.last_stable_s = t->stable_s;
         }
+        double value = sequencer.stops()[e.stop].deviation_um;
+        if (reader) {
+          const auto v = stop_value(cap);
+          if (!v) {
+            pending.push_back({e.stop, cap, c});
+            continue;
+          }
+          value = *v;
+        }
+        if (!store_stop(e.stop, cap, c, value)) return;
       }
     }
     expect_next();
-    if (sequencer.complete()) finish();
+    if (sequencer.complete() && pending.empty()) finish();
+  }
+
+  // Stores a captured stop with the kind's value; false when the store failed (run aborted).
+  bool store_stop(std::size_t stop, const cal::daq::Capture& cap, const cal::daq::Compensated& c,
+                  double value) {
+    const auto& s = sequencer.stops()[stop];
+    values.push_back({.position_mm = s.position_mm,
+                      .target_index = s.target_index - 1,
+                      .run = s.run,
+                      .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+                      .value = value});
+    const cal::storage::CapturedTarget t{
+        .run_id = outcome.run_id,
+        .target_index = s.target_index - 1,
+        .run_number = s.run,
+        .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+        .nominal_mm = s.position_mm,
+        .time_ns = cap.end_ns,
+        .raw_m = (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
+        .deviation_um = value,  // the kind's value (um or urad: settings.measure.unit)
+        .refractive_index = c.n,
+        .material_temperature_degc = c.material_degc};
+    try {
+      store->add_targets(std::span(&t, 1));
+    } catch (const std::exception& err) {
+      abort(fmt::format("storage failed: {}", err.what()));
+      return false;
+    }
+    return true;
   }
 
   // The end of the plan. A run is complete only when every planned stop was captured; one
@@ -437,6 +551,7 @@ struct LinearRun::Impl {
         outcome.reason = fmt::format("{} of {} planned stops missed", outcome.missed.size(),
                                      sequencer.stops().size());
       const auto& l = *setup.config.linear;
+      if (reader) return finish_profile(l);
       const auto standard = cal::iso230_2::standard_from_string(l.standard);
       try {
         outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
@@ -466,6 +581,36 @@ struct LinearRun::Impl {
       outcome.evaluation.reset();
       return abort(fmt::format("storage failed: {}", e.what()));
     }
+    outcome.complete = true;
+    live.state = outcome.missed.empty() ? "complete" : "incomplete";
+    end();
+  }
+
+  // The end of a run of another kind than positioning: its profile is its result.
+  void finish_profile(const cal::daq::LinearTestConfig& l) {
+    try {
+      auto e = kind.evaluate(values, l);
+      json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+      prov["measure"] = kind.name();
+      prov["coefficients"] = compensation_json(setup.config.environment);
+      if (setup.replay) {
+        prov["capture"] = setup.capture_path;
+        prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
+      }
+      store->add_result({.run_id = outcome.run_id,
+                         .standard = e.title,
+                         .json = e.json.dump(),
+                         .provenance_json = prov.dump()});
+      outcome.profile = std::move(e.json);
+    } catch (const cal::InputError& e) {
+      outcome.status = cal::storage::RunStatus::incomplete;
+      outcome.reason +=
+          (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
+      store->finish_run(outcome.run_id, outcome.status, outcome.reason);
+      live.state = "incomplete";
+      return end();
+    }
+    store->finish_run(outcome.run_id, outcome.status, outcome.reason);
     outcome.complete = true;
     live.state = outcome.missed.empty() ? "complete" : "incomplete";
     end();
@@ -502,6 +647,7 @@ struct LinearRun::Impl {
     setup.air->stop();
     for (auto& m : setup.material) m->stop();
     if (setup.position) setup.position->stop();
+    if (setup.probe) setup.probe->stop();
     writer.reset();
     publish();
   }

@@ -1,13 +1,17 @@
 #pragma once
-// One ISO 230-2 linear positioning run, acquired: the laser, air and material instruments
+// One linear run of any test kind (kinds/kind.hpp: positioning, straightness, angular, roll),
+// acquired. For positioning, an ISO 230-2 run: the laser, air and material instruments
 // feed the pipeline stages on one io_context (environment compensation -> stability trigger
 // -> sequencer), every raw reading goes to the run store through the batch writer, captured
 // targets are stored as they come, and at the end the run is evaluated by its standard and
-// the result stored. A stale sensor under the stop policy, or an instrument that gives up,
-// aborts the run with the reason recorded; what was stored stays.
+// the result stored. The other kinds read their instrument at the same stops (recognised by
+// the laser's or the position feed's stability) and store their profile. A stale sensor under
+// the stop policy, or an instrument that gives up, aborts the run with the reason recorded;
+// what was stored stays.
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
@@ -79,6 +83,9 @@ struct LinearRunSetup {
   // The feed sends a position only when it changes (MTConnect SHDR): its last sample holds.
   bool position_on_change = false;
   int laser_channel = 0;
+  // The instrument of a test kind that reads besides the laser (kinds/kind.hpp): the
+  // straightness indicator, the electronic level; null for positioning and angular runs.
+  std::unique_ptr<cal::drivers::Instrument> probe;
   double datum_mm = 0.0;  // axis position where the laser reads 0
   std::string software_version = "daq 0.1.0";
   std::string capture_path;
@@ -118,7 +125,9 @@ struct LinearRunOutcome {
   cal::storage::RunStatus status = cal::storage::RunStatus::running;
   std::vector<cal::storage::MissedStop> missed;
   std::string reason;  // why it stopped, when not complete; the missed stops when incomplete
-  std::optional<cal::iso230_2::Evaluation> evaluation;
+  std::optional<cal::iso230_2::Evaluation> evaluation;  // positioning
+  std::optional<nlohmann::json> profile;  // the other kinds: caldaq.profile.v1 (kinds/kind.hpp)
+  std::string component;                  // the ISO 230-1 component measured, e.g. "E_YX"
   std::size_t readings = 0;
 };
 

@@ -145,6 +145,9 @@ InstrumentSpec instrument_spec_from_json(const json& j) {
 json to_json(const cal::daq::Config& c) {
   json j{{"machine", c.machine_name},
          {"description", c.machine_description},
+         {"topology", c.machine_topology},
+         {"tool_offset_mm", c.machine_tool_offset_mm},
+         {"table_offset_mm", c.machine_table_offset_mm},
          {"campaign", c.campaign}};
   const auto& e = c.environment;
   j["environment"] = {{"equation", e.equation},
@@ -176,6 +179,7 @@ json to_json(const cal::daq::Config& c) {
                    {"standard", l.standard}};
     if (l.interval_mm) j["linear"]["interval_mm"] = *l.interval_mm;
     if (l.count) j["linear"]["count"] = *l.count;
+    j["linear"]["measure"] = measure_json(l.measure);
   }
   if (c.circle) {
     const auto& ci = *c.circle;
@@ -199,10 +203,38 @@ json to_json(const cal::daq::Config& c) {
   return j;
 }
 
+json measure_json(const cal::daq::MeasureConfig& m) {
+  return {{"kind", m.kind},
+          {"direction", m.direction},
+          {"stationary_mm", m.stationary_mm},
+          {"probe_offset_mm", m.probe_offset_mm},
+          {"beams", m.beams},
+          {"separation_mm", m.separation_mm},
+          {"sign", m.sign},
+          {"square", m.square}};
+}
+
+cal::daq::MeasureConfig measure_from_json(const json& j) {
+  cal::daq::MeasureConfig m;
+  if (!j.is_object()) return m;
+  m.kind = j.value("kind", m.kind);
+  m.direction = j.value("direction", m.direction);
+  m.stationary_mm = j.value("stationary_mm", m.stationary_mm);
+  m.probe_offset_mm = j.value("probe_offset_mm", m.probe_offset_mm);
+  m.beams = j.value("beams", m.beams);
+  m.separation_mm = j.value("separation_mm", m.separation_mm);
+  m.sign = j.value("sign", m.sign);
+  m.square = j.value("square", m.square);
+  return m;
+}
+
 cal::daq::Config config_from_json(const json& j) {
   cal::daq::Config c;
   c.machine_name = j.value("machine", "machine");
   c.machine_description = j.value("description", "");
+  c.machine_topology = j.value("topology", "");
+  c.machine_tool_offset_mm = j.value("tool_offset_mm", c.machine_tool_offset_mm);
+  c.machine_table_offset_mm = j.value("table_offset_mm", c.machine_table_offset_mm);
   c.campaign = j.value("campaign", "");
   if (const auto e = j.find("environment"); e != j.end()) {
     auto& x = c.environment;
@@ -240,6 +272,7 @@ cal::daq::Config config_from_json(const json& j) {
     x.dwell_s = l->value("dwell_s", x.dwell_s);
     x.dead_path_mm = l->value("dead_path_mm", x.dead_path_mm);
     x.standard = l->value("standard", x.standard);
+    if (const auto m = l->find("measure"); m != l->end()) x.measure = measure_from_json(*m);
     c.linear = x;
   }
   if (const auto ci = j.find("circle"); ci != j.end()) {

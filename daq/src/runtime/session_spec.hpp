@@ -40,6 +40,9 @@ nlohmann::json to_json(const InstrumentSpec& s);
 // wrong (an unknown driver or option, a value its table refuses).
 InstrumentSpec instrument_spec_from_json(const nlohmann::json& j);
 nlohmann::json to_json(const cal::daq::Config& c);
+// The measure keys of a linear test as JSON (stored in a run's settings and a capture header).
+nlohmann::json measure_json(const cal::daq::MeasureConfig& m);
+cal::daq::MeasureConfig measure_from_json(const nlohmann::json& j);
 cal::daq::Config config_from_json(const nlohmann::json& j);
 
 // The capture header of a session: {"format": "caldaq.capture-header.v1", "software",

@@ -52,6 +52,9 @@ struct SimulatedShop::Impl {
   sim::GaugeTwin material;
   sim::GaugeTwin ballbar;
   sim::ShdrTwin position;
+  cal::daq::LinearTestConfig test;
+  sim::GaugeTwin indicator;  // SIMULATED: the straightness indicator of a straightness test
+  sim::GaugeTwin level;      // SIMULATED: the differential electronic level of a roll test
 
   static sim::MachineConfig machine(const ShopTruth& t) {
     sim::MachineConfig c;
@@ -76,6 +79,7 @@ struct SimulatedShop::Impl {
     c.geometry.squareness.c0y_urad = t.squareness_um_per_m;
     c.geometry.squareness.b0z_urad = t.b0z_urad;
     c.geometry.squareness.a0z_urad = t.a0z_urad;
+    if (t.geometry) c.geometry = *t.geometry;
     c.thermal = {.start_degc = t.machine_degc, .expansion_ppm_per_k = t.expansion_ppm_per_k};
     c.acceleration_mm_per_s2 = 2000.0;
     return c;
@@ -90,13 +94,33 @@ struct SimulatedShop::Impl {
     return a;
   }
 
-  Impl(boost::asio::io_context& ctx, ShopTruth t, double s)
+  // The laser of a test: axis 0 reads the test axis; at the probe offset when one is set (or
+  // for another kind than positioning), an angular test's beams at probe +- separation / 2.
+  static sim::IdsTwinConfig laser(const cal::daq::LinearTestConfig& l) {
+    sim::IdsTwinConfig c;
+    const int axis = l.axis == "Y" ? 1 : l.axis == "Z" ? 2 : 0;
+    c.machine_axis = {axis, -1, -1};
+    const auto& m = l.measure;
+    const sim::Vec3 probe{m.probe_offset_mm[0], m.probe_offset_mm[1], m.probe_offset_mm[2]};
+    if (m.kind != "positioning" || probe != sim::Vec3{}) c.reflector_mm[0] = probe;
+    if (m.kind == "angular")
+      for (std::size_t b = 0; b < 2; ++b) {
+        const auto a = static_cast<std::size_t>(m.beams[b]);
+        sim::Vec3 r = probe;
+        for (std::size_t k = 0; k < 3; ++k) r[k] += (b == 0 ? 0.5 : -0.5) * m.separation_mm[k];
+        c.machine_axis[a] = axis;
+        c.reflector_mm[a] = r;
+      }
+    return c;
+  }
+
+  Impl(boost::asio::io_context& ctx, ShopTruth t, double s, const cal::daq::LinearTestConfig& l)
       : io(ctx),
         truth(t),
         speed(s),
         clock([this] { return now(); }),
         world(machine(t), air(t)),
-        ids(ctx, world, clock, {.machine_axis = {0, -1, -1}}),
+        ids(ctx, world, clock, laser(l)),
         ptu(ctx, world, clock),
         material(ctx, world, clock,
                  {.continuous = false,
@@ -105,7 +129,37 @@ struct SimulatedShop::Impl {
                   .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
         ballbar(ctx, world, clock,
                 {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}),
-        position(ctx, world, clock) {}
+        position(ctx, world, clock),
+        test(l),
+        indicator(ctx, world, clock,
+                  {.continuous = false,
+                   .request = "?",
+                   .decimals = 5,  // mm: 10 nm digits
+                   // The probe point's deviation from the nominal line it is commanded on:
+                   // where the axes stand off the command across the travel (a control's
+                   // compensation moves them) plus the geometric error there.
+                   .value =
+                       [this](const sim::World& w) {
+                         const auto& st = w.state();
+                         return st.axes_mm[dir()] - st.commanded_mm[dir()] +
+                                probe_error().translation_um[dir()] * 1e-3;
+                       }}),
+        level(
+            ctx, world, clock,
+            {.continuous = false,
+             .request = "?",
+             .decimals = 3,  // urad: 1 nrad digits
+             .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}) {}
+
+  std::size_t axis() const { return test.axis == "Y" ? 1 : test.axis == "Z" ? 2 : 0; }
+  std::size_t dir() const {
+    const auto& d = test.measure.direction;
+    return d == "Y" ? 1 : d == "Z" ? 2 : 0;
+  }
+  cal::kinematics::VolumetricError probe_error() {
+    const auto& p = test.measure.probe_offset_mm;
+    return world.machine().error_at({p[0], p[1], p[2]});
+  }
 
   double now() const {
     const auto wall = std::chrono::steady_clock::now();
@@ -115,8 +169,9 @@ struct SimulatedShop::Impl {
   }
 };
 
-SimulatedShop::SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed)
-    : impl_(std::make_unique<Impl>(io, truth, speed)) {}
+SimulatedShop::SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed,
+                             const cal::daq::LinearTestConfig& test)
+    : impl_(std::make_unique<Impl>(io, std::move(truth), speed, test)) {}
 SimulatedShop::~SimulatedShop() = default;
 
 const ShopTruth& SimulatedShop::truth() const { return impl_->truth; }
@@ -129,6 +184,14 @@ const std::string& SimulatedShop::air_device() const { return impl_->ptu.device_
 const std::string& SimulatedShop::material_device() const { return impl_->material.device_path(); }
 const std::string& SimulatedShop::ballbar_device() const { return impl_->ballbar.device_path(); }
 std::uint16_t SimulatedShop::position_port() const { return impl_->position.port(); }
+const std::string& SimulatedShop::indicator_device() const {
+  return impl_->indicator.device_path();
+}
+const std::string& SimulatedShop::level_device() const { return impl_->level.device_path(); }
+void SimulatedShop::set_compensation(
+    std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> f) {
+  impl_->world.machine().set_compensation(std::move(f));
+}
 
 std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
                                         bool serial_numbers) const {
@@ -142,13 +205,31 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
         "[devices.position]      # the control's commanded position\n"
         "driver = \"shdr\"\ntransport = \"{}\"\nkey = \"Xcom\"\nrole = \"position\"\n\n",
         impl_->position.transport());
+  // The instruments of the shop's test besides the laser (kinds/kind.hpp), SIMULATED.
+  const auto& m = impl_->test.measure;
+  std::string probe, axes;
+  if (m.kind == "angular")
+    axes = fmt::format("axes = [0, {}, {}]  # 0: position; the angular beams a, b\n", m.beams[0],
+                       m.beams[1]);
+  if (m.kind == "straightness")
+    probe = fmt::format(
+        "[devices.indicator]     # SIMULATED straightness indicator against a straightedge\n"
+        "driver = \"gauge\"\ntransport = \"serial {} 9600 8N1\"\nrequest = \"?\\r\"\n"
+        "unit = \"mm\"\nmin_si = -0.01\nmax_si = 0.01\nrole = \"indicator\"\npoll_s = {}\n\n",
+        impl_->indicator.device_path(), 4 * laser_poll_s);
+  if (m.kind == "roll")
+    probe = fmt::format(
+        "[devices.level]         # SIMULATED electronic level against a reference level\n"
+        "driver = \"gauge\"\ntransport = \"serial {} 9600 8N1\"\nrequest = \"?\\r\"\n"
+        "unit = \"urad\"\nrole = \"level\"\npoll_s = {}\n\n",
+        impl_->level.device_path(), 4 * laser_poll_s);
   return fmt::format(
       R"TOML([devices.laser]
 driver = "ids3010"
 transport = "{laser}"
 role = "laser"
 poll_s = {laser_poll}
-{laser_sn}
+{axes}{laser_sn}
 [devices.air]
 driver = "ptu300"
 transport = "{air}"
@@ -161,7 +242,7 @@ request = "?\r"
 unit = "degC"
 role = "material"
 {material_sn}
-{position}[devices.ballbar]
+{position}{probe}[devices.ballbar]
 driver = "gauge"
 transport = "{ballbar}"
 unit = "mm"
@@ -173,13 +254,18 @@ role = "ballbar"
       fmt::arg("material_sn", serial("SIM-TH-0001")), fmt::arg("ballbar_sn", serial("SIM-BB-0001")),
       fmt::arg("laser", impl_->ids.transport()), fmt::arg("laser_poll", laser_poll_s),
       fmt::arg("air", impl_->ptu.transport()), fmt::arg("material", impl_->material.device_path()),
-      fmt::arg("position", position), fmt::arg("ballbar", impl_->ballbar.transport()));
+      fmt::arg("position", position), fmt::arg("ballbar", impl_->ballbar.transport()),
+      fmt::arg("axes", axes), fmt::arg("probe", probe));
 }
 
 void SimulatedShop::run_linear(const cal::iso230_2::Plan& plan, double feed, double dwell_s) {
   std::vector<sim::Move> program;
+  const auto& st = impl_->test.measure.stationary_mm;
+  const std::size_t axis = impl_->axis();
   for (const auto& m : plan.moves) {
-    program.push_back(sim::Move::linear({m.position_mm, 0, 0}, feed));
+    sim::Vec3 p{st[0], st[1], st[2]};
+    p[axis] = m.position_mm;
+    program.push_back(sim::Move::linear(p, feed));
     if (m.kind == cal::iso230_2::MoveKind::measure) program.push_back(sim::Move::dwell(dwell_s));
   }
   impl_->world.advance_to(now_s());

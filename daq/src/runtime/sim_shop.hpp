@@ -6,6 +6,7 @@
 // connect to the twins exactly as to hardware.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/daq/ballbar.hpp"
+#include "cal/daq/config.hpp"
 #include "cal/daq/gcode.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/drivers/sim/machine.hpp"
@@ -53,13 +55,21 @@ struct ShopTruth {
   // share X's 40 mm period (screws of one pitch): the circle analysis fits one period per
   // plane (docs/circle.md).
   static ShopTruth three_planes();
+  // All 21 geometric errors (sim_volumetric.hpp): when set, the machine's geometry is this
+  // instead of the E_XX scale and E_C0Y above (the servo, thermal and air settings stay).
+  std::optional<cal::kinematics::Machine> geometry;
   // The deviation at 20 degC of a stop at x approached from below (up) or above.
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
 };
 
 class SimulatedShop {
  public:
-  SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed);
+  // `test`: the linear test the shop is set up for (kinds/kind.hpp): which axis the program
+  // moves, where the other axes stand, and the simulated instruments it reads: the laser's
+  // axis 0 on the test axis at the probe offset, angular runs' two beams at probe +- half the
+  // separation, a simulated indicator (straightness) and a simulated electronic level (roll).
+  SimulatedShop(boost::asio::io_context& io, ShopTruth truth, double speed,
+                const cal::daq::LinearTestConfig& test = {});
   ~SimulatedShop();
 
   const ShopTruth& truth() const;
@@ -70,14 +80,19 @@ class SimulatedShop {
   const std::string& material_device() const;
   const std::string& ballbar_device() const;
   std::uint16_t position_port() const;  // MTConnect SHDR adapter: Xcom|Ycom|Zcom, commanded mm
+  const std::string& indicator_device() const;  // SIMULATED straightness indicator (mm lines)
+  const std::string& level_device() const;      // SIMULATED electronic level (urad lines)
+  // The controller's compensation (um added to the command), e.g. from a model: see
+  // cal::drivers::sim::MachineConfig::compensation_um. Set before a program is loaded.
+  void set_compensation(std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> f);
   // The [devices.*] tables (TOML, docs/config.md) of the shop's twins: laser, air, material,
   // ballbar and, with position_feed, the SHDR position feed. `daq sim` writes them; the demo
   // reads them, so the twins the shop starts are named here only.
   std::string devices_toml(double laser_poll_s, bool position_feed,
                            bool serial_numbers = false) const;
 
-  // The machine program for an ISO 230-2 plan on X: every move at the feed, a dwell at each
-  // measure move.
+  // The machine program for an ISO 230-2 plan on the test's axis (the other axes at their
+  // stationary positions): every move at the feed, a dwell at each measure move.
   void run_linear(const cal::iso230_2::Plan& plan, double feed_mm_per_min, double dwell_s);
   // The ballbar program in XY about the pivot: start feed_in_mm outside the radius at 0 deg,
   // move in, dwell, ccw arc of 360 + 2 overshoot, dwell, cw arc back, move out.

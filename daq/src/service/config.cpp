@@ -16,6 +16,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
+#include "cal/analysis/kinematics.hpp"
 #include "cal/drivers/registry.hpp"
 #include "cal/drivers/transport/transport.hpp"
 
@@ -255,7 +256,8 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   if (d.poll_s < 0) t.fail(t.node("poll_s"), "poll_s", "must be >= 0");
   t.read("role", d.role);
   if (!d.role.empty())
-    one_of(t, "role", d.role, {"laser", "air", "material", "ballbar", "position"});
+    one_of(t, "role", d.role,
+           {"laser", "air", "material", "ballbar", "position", "indicator", "level"});
   t.read("serial_number", d.serial_number);
   t.read("certificate", d.certificate);
   t.read("calibration_due", d.calibration_due);
@@ -319,6 +321,65 @@ EnvironmentConfig read_environment(Table& t) {
 // this calibrates, and small enough that nothing written into a part program overflows.
 constexpr double kMaxPositionMm = 100'000, kMaxFeedMmPerMin = 200'000, kMaxDwellS = 3600;
 
+std::array<double, 3> read_vector(Table& t, std::string_view key, std::array<double, 3> v) {
+  if (!t.node(key)) {
+    t.numbers(key);  // marks it used
+    return v;
+  }
+  const auto x = t.numbers(key);
+  if (x.size() != 3) t.fail(t.node(key), key, "expected [x, y, z]");
+  for (std::size_t k = 0; k < 3; ++k) {
+    t.check_range(key, x[k], -kMaxPositionMm, kMaxPositionMm, "mm");
+    v[k] = x[k];
+  }
+  return v;
+}
+
+// The measure keys of [test.linear]: what is read at each stop (MeasureConfig). The kinds'
+// own checks of the set-up (a separation across the beams, a direction that is not the axis)
+// are the kinds' (daq/src/runtime/kinds/), run before a run starts.
+void read_measure(Table& t, LinearTestConfig& l) {
+  auto& m = l.measure;
+  t.read("measure", m.kind);
+  one_of(t, "measure", m.kind, {"positioning", "straightness", "angular", "roll"});
+  t.read("direction", m.direction);
+  if (m.kind == "straightness") {
+    one_of(t, "direction", m.direction, {"X", "Y", "Z"});
+    if (m.direction == l.axis)
+      t.fail(t.node("direction"), "direction",
+             fmt::format("a straightness of {} is read across it, not along {}", l.axis,
+                         m.direction));
+  } else if (m.kind == "angular") {
+    one_of(t, "direction", m.direction, {"A", "B", "C"});
+    if (m.direction == std::string(1, static_cast<char>('A' + (l.axis[0] - 'X'))))
+      t.fail(t.node("direction"), "direction",
+             fmt::format("{} about {} is the roll of {}: measure = \"roll\"", m.direction,
+                         l.axis, l.axis));
+  } else if (!m.direction.empty()) {
+    t.fail(t.node("direction"), "direction",
+           fmt::format("a {} test has no direction (straightness: X, Y, Z; angular: A, B, C)",
+                       m.kind));
+  }
+  m.stationary_mm = read_vector(t, "stationary_mm", m.stationary_mm);
+  m.probe_offset_mm = read_vector(t, "probe_offset_mm", m.probe_offset_mm);
+  m.separation_mm = read_vector(t, "separation_mm", m.separation_mm);
+  if (auto b = t.numbers("beams"); !b.empty()) {
+    if (b.size() != 2 || b[0] == b[1] || b[0] < 0 || b[0] > 2 || b[1] < 0 || b[1] > 2 ||
+        b[0] != std::floor(b[0]) || b[1] != std::floor(b[1]))
+      t.fail(t.node("beams"), "beams", "expected two different laser axes [a, b] of 0, 1, 2");
+    m.beams = {static_cast<int>(b[0]), static_cast<int>(b[1])};
+  }
+  t.read("sign", m.sign);
+  if (m.sign != 1.0 && m.sign != -1.0)
+    t.fail(t.node("sign"), "sign", fmt::format("{} must be 1 or -1", m.sign));
+  t.read("square", m.square);
+  if (m.square && m.kind != "straightness")
+    t.fail(t.node("square"), "square", "only a straightness run is read against a square");
+  if (m.kind == "angular" && m.separation_mm == std::array<double, 3>{})
+    t.fail(nullptr, "separation_mm",
+           "an angular test needs the separation of its two beams' reflectors [x, y, z]");
+}
+
 LinearTestConfig read_linear(Table& t) {
   LinearTestConfig l;
   t.read("axis", l.axis);
@@ -368,6 +429,7 @@ LinearTestConfig read_linear(Table& t) {
   } catch (const InputError& e) {
     t.fail(nullptr, "", e.what());
   }
+  read_measure(t, l);
   t.check_unknown();
   return l;
 }
@@ -537,6 +599,17 @@ Config parse_config(std::string_view text, const std::filesystem::path& file) {
     t.name("make", c.machine_make);
     t.name("model", c.machine_model);
     t.name("serial_number", c.machine_serial);
+    t.read("topology", c.machine_topology);
+    if (!c.machine_topology.empty()) {
+      try {
+        const auto topology = kinematics::topology_from_string(c.machine_topology);
+        c.machine_topology = std::string(kinematics::to_string(topology));
+      } catch (const InputError& e) {
+        t.fail(t.node("topology"), "topology", e.what());
+      }
+    }
+    c.machine_tool_offset_mm = read_vector(t, "tool_offset_mm", c.machine_tool_offset_mm);
+    c.machine_table_offset_mm = read_vector(t, "table_offset_mm", c.machine_table_offset_mm);
     t.check_unknown();
   }
   top.name("campaign", c.campaign);

@@ -2,6 +2,7 @@
 // Machine and campaign configuration files (TOML): the machine, the instruments and how to
 // reach them, the environment policy, and the tests. Documented with a full example in
 // docs/config.md. Every error names the file, the line and column, and the key.
+#include <array>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -50,6 +51,22 @@ struct TriggerConfig {
   double window_mm = 0.5;     // and within this of an expected target
 };
 
+// What a linear test reads at each stop (the measure keys of [test.linear], docs/config.md and
+// docs/volumetric-walkthrough.md): the test kind and its set-up, stored with the run so that
+// `daq model build` can use it. The kinds are daq/src/runtime/kinds/.
+struct MeasureConfig {
+  std::string kind = "positioning";  // positioning | straightness | angular | roll
+  // straightness: the direction read (X, Y or Z, not the axis); angular: the rotation axis
+  // (A, B or C, not the axis's own: that is roll); positioning and roll: empty.
+  std::string direction;
+  std::array<double, 3> stationary_mm{};     // where the other axes stand (the axis's entry unused)
+  std::array<double, 3> probe_offset_mm{};   // the measured point from the tool reference point
+  std::array<int, 2> beams{1, 2};            // angular: the laser axes of beam a and beam b
+  std::array<double, 3> separation_mm{};     // angular: from beam b's reflector to beam a's
+  double sign = 1.0;  // straightness, roll: -1 when the instrument reads the other way round
+  bool square = false;  // straightness read against a square's edge: one of a squareness pair
+};
+
 struct LinearTestConfig {
   std::string axis = "X";
   double first_mm = 0.0, last_mm = 500.0;
@@ -64,6 +81,7 @@ struct LinearTestConfig {
   double dwell_s = 4.0;
   double dead_path_mm = 0.0;
   std::string standard = "iso230-2:2014";
+  MeasureConfig measure;
 };
 
 // One ballbar test ([test.circle] with `plane`), or a set of them (`planes`, and optionally
@@ -126,6 +144,10 @@ struct Config {
   std::string machine_name = "machine";
   std::string machine_description;
   std::string machine_make, machine_model, machine_serial;
+  // The kinematic chain and offsets ([machine] topology, tool_offset_mm, table_offset_mm),
+  // stored with each run for `daq model build`; empty topology: not said.
+  std::string machine_topology;
+  std::array<double, 3> machine_tool_offset_mm{}, machine_table_offset_mm{};
   std::string campaign;
   std::string operator_name;  // the top-level key `operator`
   CustomerConfig customer;

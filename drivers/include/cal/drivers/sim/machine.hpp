@@ -8,6 +8,7 @@
 // checked against this truth. Simulated, and named so: nothing here talks to a real machine.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -63,6 +64,11 @@ struct MachineConfig {
   Thermal thermal;
   Vec3 start_mm{};
   std::uint64_t seed = 1;
+  // The controller's compensation (e.g. cross-axis tables written from a model): the correction
+  // in um added to the interpolated command before the position loops, as a controller adds
+  // its compensation to the set-point. Empty: none. The state's commanded_mm stays the
+  // programmed position (what the control displays).
+  std::function<Vec3(const Vec3& commanded_mm)> compensation_um;
 };
 
 struct MachineState {
@@ -87,6 +93,8 @@ class Machine {
   // Appends moves to the program. Throws cal::InputError (naming the move's index) for a
   // non-positive feed, a negative dwell, or an arc whose end is not on its circle.
   void load(std::span<const Move> program);
+  // Replaces the controller's compensation (MachineConfig::compensation_um) from now on.
+  void set_compensation(std::function<Vec3(const Vec3&)> compensation_um);
   // Advances simulated time by dt_s (> 0) and returns the new state.
   const MachineState& step(double dt_s);
   const MachineState& state() const;
@@ -95,6 +103,10 @@ class Machine {
   // Duration of the program as interpolated (without the settling of the servo).
   double program_duration_s() const;
   const MachineConfig& config() const;
+  // The error (HTM, um and urad) of a point `offset_mm` from the tool reference point (the
+  // geometry's tool offset replaced by it) at the current axis positions: what an instrument
+  // whose probe, reflector or level sits there reads.
+  kinematics::VolumetricError error_at(const Vec3& offset_mm) const;
 
  private:
   struct Impl;

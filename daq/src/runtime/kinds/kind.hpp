@@ -1,0 +1,95 @@
+#pragma once
+// Test kinds of the one linear runner (linear_run.hpp). A kind says what is read at each stop
+// of an ISO 230-2 plan and how the stops are evaluated: positioning (the laser's deviation from
+// the target), straightness (an indicator or transducer across the axis), angular (pitch or yaw
+// from two laser axes over their separation) and roll (an electronic level against a reference
+// level). The runner does everything else (instruments, stop recognition by the laser or the
+// position feed, sequencing, storage) the same for every kind; a kind is one small file here.
+// Conventions (ISO 230-1 names, signs of the tool relative to the workpiece): docs/kinematics.md;
+// the set-up keys: docs/config.md; the whole procedure: docs/volumetric-walkthrough.md.
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cal/daq/config.hpp"
+
+namespace daq::kinds {
+
+// Where a reading comes from, as the runner sees it.
+enum class Source {
+  laser,  // the laser's axes: value = the length compensated for air and material, m
+  probe,  // the kind's own instrument (indicator: m; level: rad)
+};
+
+// Turns a run's readings into samples of the measured value (um or urad), one per reading
+// or pair of readings; stateful (an angle pairs the two beams of one laser answer).
+class SampleReader {
+ public:
+  virtual ~SampleReader() = default;
+  virtual std::optional<double> add(Source source, std::uint8_t channel, std::int64_t time_ns,
+                                    double value_si) = 0;
+};
+
+// One captured stop's value: the target, run, direction and the kind's value at it.
+struct StopValue {
+  double position_mm = 0.0;
+  int target_index = 0;  // 0-based
+  int run = 1;
+  char direction = '+';
+  double value = 0.0;  // in the kind's unit
+};
+
+// What a kind's evaluation gives: the result's title and JSON (schema caldaq.profile.v1).
+struct Evaluation {
+  std::string title;
+  nlohmann::json json;
+};
+
+class TestKind {
+ public:
+  virtual ~TestKind() = default;
+  virtual std::string_view name() const = 0;      // the `measure` key: "straightness"
+  virtual std::string_view run_kind() const = 0;  // the stored run's kind ("linear" positioning)
+  virtual std::string_view unit() const = 0;      // of the values: "um" or "urad"
+  // The ISO 230-1 component it measures ("E_YX"), from the axis and direction.
+  virtual std::string component(const cal::daq::LinearTestConfig& l) const = 0;
+  // The role of the instrument it reads besides the laser ("indicator", "level"; "" none).
+  virtual std::string_view probe_role() const { return ""; }
+  // The set-up checks beyond the configuration's syntax; throws cal::InputError naming the key.
+  virtual void validate(const cal::daq::LinearTestConfig& /*l*/) const {}
+  // Every laser axis the kind reads (positioning: none beyond the position channel).
+  virtual std::vector<int> laser_channels(const cal::daq::LinearTestConfig& /*l*/) const {
+    return {};
+  }
+  // nullptr for positioning: its value is the sequencer's deviation of the laser position.
+  virtual std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const = 0;
+  // The stops evaluated (not called for positioning: ISO 230-2 evaluates those).
+  virtual Evaluation evaluate(std::span<const StopValue> stops,
+                              const cal::daq::LinearTestConfig& l) const;
+};
+
+// The kind of a `measure` name; throws cal::InputError listing the kinds.
+const TestKind& kind(std::string_view name);
+std::span<const TestKind* const> all_kinds();
+
+// The kinds' files register here (one function each, so the linker keeps them).
+const TestKind& positioning();
+const TestKind& straightness();
+const TestKind& angular();
+const TestKind& roll();
+
+// The profile of a run: per target, the mean of all its stops, of the stops up and down, and
+// the spread; for straightness also the least-squares line and the straightness about it.
+// JSON schema caldaq.profile.v1 (docs/volumetric-walkthrough.md).
+nlohmann::json profile_json(std::span<const StopValue> stops, std::string_view kind,
+                            std::string_view component, std::string_view unit);
+
+// The axis index (0, 1, 2) of "X", "Y", "Z".
+int axis_index(std::string_view axis);
+
+}  // namespace daq::kinds

@@ -1,0 +1,52 @@
+#pragma once
+// The SIMULATED volumetric campaign: a machine of any of the 24 chain orders with all 21
+// geometric errors injected as known functions, and the 18 linear tests (positioning,
+// straightness against a square, pitch and yaw with two laser beams, roll with a level) that
+// measure them on the simulated shop (sim_shop.hpp). The truth follows the conventions the
+// model build uses (docs/volumetric-walkthrough.md): straightness with a zero least-squares
+// line over the test's targets (its slope is squareness), positioning and angular errors zero
+// at the first target (where the laser and the angular optics are zeroed).
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cal/analysis/kinematics.hpp"
+#include "cal/daq/config.hpp"
+#include "linear_run.hpp"
+#include "sim_shop.hpp"
+
+namespace daq {
+
+// Travel of the simulated machine, mm: X 0..500, Y 0..400, Z 0..300.
+inline constexpr std::array<double, 3> kSimTravelMm{500.0, 400.0, 300.0};
+
+// The injected geometry (tool offset 0: the instruments read at their own offsets).
+cal::kinematics::Machine volumetric_geometry(cal::kinematics::Topology t);
+// The shop truth around it: no backlash, cyclic error or scale expansion (the machine at
+// 20 degC), `noise_um` of position noise.
+ShopTruth volumetric_truth(cal::kinematics::Topology t, double noise_um = 0.0);
+
+// The 18 tests, in the order they are best measured (angular first: the model build uses them
+// to correct the others' Abbe terms, but any order works).
+std::vector<cal::daq::LinearTestConfig> volumetric_tests();
+// The test of one component ("E_YX"); throws cal::InputError for an unknown name.
+cal::daq::LinearTestConfig volumetric_test(std::string_view component);
+
+// One test acquired in this process on a fresh simulated shop with `truth`, through the real
+// drivers (IDS3010, PTU300, gauge codecs) against the twins, stored in `database` under
+// machine `machine` with the machine's topology; `compensation` (optional) is the control's
+// (sim_shop.hpp). The simulated time runs `speed` times faster than the wall clock and the
+// loop is bounded by simulated time. Throws cal::InputError for a bad test.
+struct SimulatedAcquisition {
+  ShopTruth truth;
+  std::filesystem::path database;
+  std::string machine = "SIMULATED volumetric";
+  double speed = 30.0;
+  std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> compensation;
+};
+LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
+                                   const cal::daq::LinearTestConfig& test);
+
+}  // namespace daq
