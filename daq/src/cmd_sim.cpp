@@ -6,9 +6,9 @@
 // acquiring process only sees devices.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <chrono>
-#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -36,7 +36,7 @@ struct SimOptions {
   std::optional<double> start_after_s;  // unset: wait for a run in the database
   std::string db;
   bool position_feed = false;
-  std::string measure;     // a component of the volumetric campaign, e.g. E_YX
+  std::string measure;  // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
   std::string compensate;  // a model file whose volumetric correction the control applies
 };
@@ -52,8 +52,8 @@ std::string linear_toml(const cal::daq::LinearTestConfig& l) {
       "[test.linear]\naxis = \"{}\"\nfirst_mm = {}\nlast_mm = {}\ncount = {}\nruns = {}\n"
       "overrun_mm = {}\nfeed_mm_per_min = {}\ndwell_s = {}\nmeasure = \"{}\"\n"
       "stationary_mm = {}\nprobe_offset_mm = {}\n",
-      l.axis, l.first_mm, l.last_mm, l.count.value_or(6), l.runs, l.overrun_mm,
-      l.feed_mm_per_min, l.dwell_s, m.kind, numbers(m.stationary_mm), numbers(m.probe_offset_mm));
+      l.axis, l.first_mm, l.last_mm, l.count.value_or(6), l.runs, l.overrun_mm, l.feed_mm_per_min,
+      l.dwell_s, m.kind, numbers(m.stationary_mm), numbers(m.probe_offset_mm));
   if (!m.direction.empty()) t += fmt::format("direction = \"{}\"\n", m.direction);
   if (m.kind == "angular")
     t += fmt::format("beams = [{}, {}]\nseparation_mm = {}\n", m.beams[0], m.beams[1],
@@ -87,9 +87,8 @@ dwell_s = {trigger_dwell}
 window_mm = 0.5
 
 {linear})TOML",
-      fmt::arg("devices", shop.devices_toml(0.01 / speed, false, false)),
-      fmt::arg("speed", speed), fmt::arg("alpha", shop.truth().expansion_ppm_per_k),
-      fmt::arg("trigger_dwell", 1.5 / speed),
+      fmt::arg("devices", shop.devices_toml(0.01 / speed, false, false)), fmt::arg("speed", speed),
+      fmt::arg("alpha", shop.truth().expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
       fmt::arg("topology", cal::kinematics::to_string(shop.truth().geometry->topology)),
       fmt::arg("linear", linear_toml(test)));
 }
@@ -116,10 +115,12 @@ std::int64_t newest_run(const std::filesystem::path& db) {
 
 void run_sim(SimOptions o) {
   if (!o.measure.empty()) o.test = "linear";  // a component's test is a linear one
-  if (o.test != "linear" && o.test != "circle")
-    throw cal::InputError(fmt::format("--test '{}' (expected linear or circle)", o.test));
+  if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
+    throw cal::InputError(
+        fmt::format("--test '{}' (expected linear, circle or circle-set)", o.test));
+  const bool set = o.test == "circle-set";  // the standard set on the three-plane machine
   std::optional<cal::daq::LinearTestConfig> volumetric;
-  ShopTruth truth;
+  ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
   if (!o.measure.empty()) {
     volumetric = volumetric_test(o.measure);
     truth = volumetric_truth(cal::kinematics::topology_from_string(o.topology), 0.02);
@@ -141,10 +142,12 @@ void run_sim(SimOptions o) {
       return cal::volcomp::correction_um(model.machine, q, model.carriers);
     });
   }
-  const std::string text =
-      volumetric ? volumetric_config(shop, o.speed, *volumetric)
-                 : simulated_shop_config(
-                       shop, {.speed = o.speed, .position_feed = o.position_feed, .in_process = false});
+  const std::string text = volumetric
+                               ? volumetric_config(shop, o.speed, *volumetric)
+                               : simulated_shop_config(shop, {.speed = o.speed,
+                                                              .position_feed = o.position_feed,
+                                                              .in_process = false,
+                                                              .circle_set = set});
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -158,7 +161,11 @@ void run_sim(SimOptions o) {
   };
   const auto run_program = [&](const std::string& test) {
     const double t0_s = shop.now_s();
-    if (test == "circle") {
+    if (test == "circle" && set) {  // the whole set in one program, as daq gcode writes it
+      std::vector<cal::daq::BallbarSetTest> program;
+      for (const auto& t : circle_tests(config)) program.push_back({t.plane, t.program});
+      shop.run_circle_set(program);
+    } else if (test == "circle") {
       shop.run_circle(circle_test(config).first);
     } else {
       const auto& l = *config.linear;
@@ -179,7 +186,7 @@ void run_sim(SimOptions o) {
         o.speed, o.config_out, o.test, o.config_out, *o.start_after_s);
     std::fflush(stdout);
     run_until(shop.now_s() + *o.start_after_s * o.speed);
-    return run_program(o.test);
+    return run_program(set ? "circle" : o.test);
   }
   // As an operator would: the program is started once the acquisition waits for it (a run has
   // begun in the database), and it is the program of that run's test.
@@ -206,6 +213,9 @@ void run_sim(SimOptions o) {
     run_until(shop.now_s() + 1.0 * o.speed);
     run_program(test);
     if (volumetric) return;  // set up for one component's test: one run
+    // A set's later tests are runs of their own, started while its one program ran: not
+    // programs to start again.
+    if (set) seen = newest_run(db);
   }
 }
 
@@ -216,7 +226,8 @@ void add_sim_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "sim", "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
   cmd->add_option("--test", o->test,
-                  "linear or circle: the program run after --start-after-s (waiting for runs, the "
+                  "linear, circle or circle-set (the ballbar set on a machine with errors in all "
+                  "three planes): the program run after --start-after-s (waiting for runs, the "
                   "run's own test is run)")
       ->capture_default_str();
   cmd->add_option("-o,--config-out", o->config_out, "Where to write the devices' configuration")
