@@ -46,6 +46,7 @@
 #include <numbers>
 
 #include "cal/analysis/error.hpp"
+#include "circle_dynamics.hpp"
 
 namespace cal::circle {
 namespace {
@@ -332,6 +333,9 @@ void validate_setup(const Setup& setup) {
   if (!(setup.spike_decay_deg > 0))
     throw InputError(
         fmt::format("circle: spike decay {} degrees must be > 0", setup.spike_decay_deg));
+  if (!(setup.stick_slip_window_deg > 1.0 && setup.stick_slip_window_deg <= 45.0))
+    throw InputError(fmt::format("circle: stick-slip window {} degrees must be > 1 and <= 45",
+                                 setup.stick_slip_window_deg));
 }
 
 void validate_trace(const Trace& t) {
@@ -483,12 +487,12 @@ Model choose_terms(const Setup& setup, bool both, double arc_deg, std::vector<st
         "from squareness and radius, and are not reported");
   }
   if (arc_deg < 359.0) {
-    for (int k : {cyclic_u_a, cyclic_u_b, cyclic_v_a, cyclic_v_b, bow_u, bow_v, spike_u, spike_v})
-      m.on[static_cast<std::size_t>(k)] = false;
-    notes.push_back(fmt::format(
-        "partial arc ({:.0f} degrees): cyclic error, straightness and reversal spikes are not "
-        "fitted",
-        arc_deg));
+    // A simple bow needs the whole diameter (as in the usual ballbar software, which shows no
+    // straightness for a partial arc). The cyclic and spike terms stay: they are local to the
+    // axis' position and reversals, and the separability check drops one the arc cannot carry.
+    for (int k : {bow_u, bow_v}) m.on[static_cast<std::size_t>(k)] = false;
+    notes.push_back(
+        fmt::format("partial arc ({:.0f} degrees): straightness is not fitted", arc_deg));
   }
   if (!setup.radius_calibrated)
     notes.push_back("uncalibrated bar: the radius error is fitted but not reported");
@@ -508,17 +512,13 @@ class Reporter {
       if (!on(k)) return;  // off, or dropped as not separable
     Eigen::VectorXd contrib = Eigen::VectorXd::Zero(d_.matrix().rows());
     for (int k : terms) contrib += c_[k] * d_.matrix().col(k);
-    Diagnostic dg{std::move(key),
-                  std::move(name),
-                  value,
-                  std::move(unit),
-                  contrib.maxCoeff() - contrib.minCoeff(),
-                  0.0,
-                  0.0};
-    const double g_bi = res_.iso.G_bi_um;
-    dg.share_pct = g_bi > 0 ? 100.0 * dg.pv_um / g_bi : 0.0;
-    dg.g_reduction_um = g_bi - g_(y_ - contrib);
-    res_.diagnostics.push_back(std::move(dg));
+    push({std::move(key), std::move(name), value, std::move(unit), 0.0, 0.0, 0.0, {}}, contrib);
+  }
+  // A diagnostic found in the residual (stick-slip, vibration): its contribution is given.
+  void add(const dynamics::Found& f) {
+    const Eigen::Map<const Eigen::VectorXd> contrib(
+        f.contribution.data(), static_cast<Eigen::Index>(f.contribution.size()));
+    push({f.key, f.name, f.value, f.unit, 0.0, 0.0, 0.0, f.frequency_hz}, contrib);
   }
   bool on(int k) const { return m_.on[static_cast<std::size_t>(k)]; }
   double c(int k) const { return c_[k]; }
@@ -530,6 +530,15 @@ class Reporter {
   const Eigen::VectorXd& c_;
   const CircularDeviation& g_;
   Eigen::VectorXd y_;
+
+  // PV of the contribution, its share of G, and what G would be without it (docs/circle.md).
+  void push(Diagnostic dg, const Eigen::Ref<const Eigen::VectorXd>& contrib) {
+    dg.pv_um = contrib.maxCoeff() - contrib.minCoeff();
+    const double g_bi = res_.iso.G_bi_um;
+    dg.share_pct = g_bi > 0 ? 100.0 * dg.pv_um / g_bi : 0.0;
+    dg.g_reduction_um = g_bi - g_(y_ - contrib);
+    res_.diagnostics.push_back(std::move(dg));
+  }
 };
 
 void report(Reporter& r, const Setup& setup, const std::string& ax, double period_mm) {
@@ -650,17 +659,40 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
                       term_names[static_cast<std::size_t>(k)]));
   if (reported.on[cyclic_first]) res.cyclic_period_mm = period_mm;
   const Eigen::VectorXd resid = full.y() - full.matrix() * sol.coef;
-  res.residual_rms_um = std::sqrt(resid.squaredNorm() / static_cast<double>(samples.size()));
+  const std::string ax = axis_names(setup.plane);
+
+  // Stick-slip and vibration live in what the geometric model leaves.
+  std::vector<dynamics::TraceResidual> residuals;
+  for (Eigen::Index at = 0; const auto& t : traces) {
+    dynamics::TraceResidual tr{.s = sign_of(t.direction)};
+    for (std::size_t i = 0; i < t.angle_deg.size(); ++i, ++at) {
+      tr.theta_rad.push_back(t.angle_deg[i] * deg);
+      tr.r_um.push_back(resid[at]);
+    }
+    residuals.push_back(std::move(tr));
+  }
+  const dynamics::Settings dyn{.radius_mm = setup.radius_mm,
+                               .feed_mm_per_min = setup.feed_mm_per_min,
+                               .window_deg = setup.stick_slip_window_deg,
+                               .u = ax[0],
+                               .v = ax[1]};
+  const auto vibration = dynamics::vibration(dyn, residuals, res.notes);
+  const auto stick_slip = dynamics::stick_slip(dyn, residuals, res.notes);
+  double ss = 0.0;  // what is left after the geometric model and a vibration
+  for (const auto& tr : residuals)
+    for (double x : tr.r_um) ss += x * x;
+  res.residual_rms_um = std::sqrt(ss / static_cast<double>(samples.size()));
 
   const CircularDeviation g(full.matrix());
   Reporter rep(res, reported, full, sol.coef, g);
-  const std::string ax = axis_names(setup.plane);
   report(rep, setup, ax, period_mm);
+  if (vibration) rep.add(*vibration);
+  for (const auto& f : stick_slip) rep.add(f);
   std::stable_sort(res.diagnostics.begin(), res.diagnostics.end(),
                    [](const Diagnostic& a, const Diagnostic& b) { return a.pv_um > b.pv_um; });
   const std::string u(1, ax[0]), v(1, ax[1]);
-  res.centre_u = {"centre_" + u, "Centre offset " + u, sol.coef[centre_u], "um", 0, 0, 0};
-  res.centre_v = {"centre_" + v, "Centre offset " + v, sol.coef[centre_v], "um", 0, 0, 0};
+  res.centre_u = {"centre_" + u, "Centre offset " + u, sol.coef[centre_u], "um", 0, 0, 0, {}};
+  res.centre_v = {"centre_" + v, "Centre offset " + v, sol.coef[centre_v], "um", 0, 0, 0, {}};
   return res;
 }
 

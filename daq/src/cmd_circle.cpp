@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cal/analysis/circle.hpp"
+#include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
 #include "circle_output.hpp"
 #include "cli_checks.hpp"
@@ -37,9 +38,11 @@ struct CircleOptions {
   double arc_deg = 360.0;
   double overshoot_deg = 0.0;
   double spike_decay_deg = 6.0;
+  double stick_slip_window_deg = 10.0;
   std::optional<double> cyclic_period_mm;
   std::optional<double> calibrated_radius_mm;
   bool uncalibrated = false;
+  std::string standard = "iso230-4:2005";
   bool json = false;
   CsvOptions csv;
   bool has_lengths = false;  // the CSV gives length_mm (set by read_traces)
@@ -50,6 +53,7 @@ struct CircleOptions {
             .feed_mm_per_min = feed_mm_per_min,
             .cyclic_period_mm = cyclic_period_mm,
             .spike_decay_deg = spike_decay_deg,
+            .stick_slip_window_deg = stick_slip_window_deg,
             .radius_calibrated = !uncalibrated,
             .calibrated_radius_mm = calibrated_radius_mm,
             .start_deg = start_deg,
@@ -97,11 +101,13 @@ std::vector<ci::Trace> read_traces(CircleOptions& o) {
 }
 
 json to_json(const ci::Result& r, const CircleOptions& o) {
-  return circle_json(r, o.radius_mm, o.plane, o.feed_mm_per_min);
+  return circle_json(r, o.radius_mm, o.plane, o.feed_mm_per_min,
+                     ci::circular_standard_from_key(o.standard));
 }
 
 void print(const ci::Result& r, const CircleOptions& o) {
-  print_circle(r, o.radius_mm, o.plane, o.feed_mm_per_min);
+  print_circle(r, o.radius_mm, o.plane, o.feed_mm_per_min,
+               ci::circular_standard_from_key(o.standard));
 }
 
 }  // namespace
@@ -131,18 +137,29 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
       ->capture_default_str();
   cmd->add_option("--spike-decay-deg", o->spike_decay_deg, "Decay angle of a reversal spike")
       ->capture_default_str();
+  cmd->add_option("--stick-slip-window-deg", o->stick_slip_window_deg,
+                  "Stick-slip: window about each reversal of an axis (1 < W <= 45)")
+      ->capture_default_str();
   cmd->add_option("--cyclic-period-mm", o->cyclic_period_mm,
                   "Cyclic-error period (default: searched)");
   cmd->add_option("--calibrated-radius-mm,--calibrated-length-mm", o->calibrated_radius_mm,
                   "Bar length at which deviation_um reads 0 (default: the nominal radius)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--uncalibrated", o->uncalibrated, "The bar was not calibrated: no radius error");
+  cmd->add_option("-s,--standard", o->standard,
+                  "iso230-4:2005, gb/t17421.4-2016 (identical) or iso230-4:1996 (docs/circle.md, "
+                  "\"Standards\")")
+      ->capture_default_str();
   add_decimal_comma_flag(*cmd, o->csv);
-  cmd->add_flag("--json", o->json, "Print caldaq.circle.v1 JSON");
+  cmd->add_flag("--json", o->json, "Print caldaq.circle.v2 JSON");
   cmd->callback([o] {
+    ci::circular_standard_from_key(o->standard);  // an unknown standard before reading the file
     const auto traces = read_traces(*o);
     auto setup = o->setup();
     if (o->has_lengths) setup.calibrated_radius_mm.reset();  // lengths are absolute
+    // The radius error needs the bar's absolute length: absolute lengths in the file, or the
+    // calibrated length given; otherwise only changes of length are known.
+    setup.radius_calibrated = !o->uncalibrated && (o->has_lengths || o->calibrated_radius_mm);
     const auto r = ci::analyse(setup, traces);
     if (o->json) return fmt::print("{}\n", to_json(r, *o).dump(2));
     print(r, *o);

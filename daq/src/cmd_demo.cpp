@@ -170,9 +170,8 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
   }
   const auto& r = *out.result;
   fmt::print("run {} stored ({} readings)\n", out.run_id, out.readings);
-  fmt::print(
-      "  ISO 230-4: G {:.2f} um (ccw {:.2f}, cw {:.2f}), H {:.2f} um, F {:+.2f} / {:+.2f} um\n",
-      r.iso.G_bi_um, r.iso.G_ccw_um, r.iso.G_cw_um, r.iso.H_um, r.iso.F_max_um, r.iso.F_min_um);
+  fmt::print("  ISO 230-4:2005: G(b) {:.2f} um (G ccw {:.2f}, cw {:.2f}), F {:+.2f} / {:+.2f} um\n",
+             r.iso.G_bi_um, r.iso.G_ccw_um, r.iso.G_cw_um, r.iso.F_max_um, r.iso.F_min_um);
   std::map<std::string, double> found;
   fmt::print("  Diagnostics (ranked):\n");
   for (const auto& dg : r.diagnostics) {

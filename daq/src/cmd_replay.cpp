@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
+#include <chrono>
 #include <filesystem>
 
 #include "cal/analysis/error.hpp"
@@ -50,6 +51,7 @@ struct ReplaySession {
   // (customer, instruments, tolerances) the replay keeps, as the capture header lacks it.
   std::optional<std::int64_t> original_run;
   std::string original_context;
+  json original_settings;
   void find_original(const ReplayOptions& o) {
     const auto capture = std::filesystem::absolute(o.capture).string();
     cal::storage::Store store(database_path(o.db));
@@ -57,6 +59,7 @@ struct ReplaySession {
       if (r.capture_path != capture) continue;
       original_run = r.id;
       const json settings = json::parse(r.settings_json, nullptr, false);
+      original_settings = settings;
       if (settings.is_object() && settings.contains("context"))
         original_context = settings["context"].dump();
       return;
@@ -112,7 +115,29 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                                [](const auto& x) { return x.role == "ballbar"; });
   if (it == s.specs.end())
     throw cal::InputError(fmt::format("{}: the session has no ballbar instrument", o.capture));
-  const auto [program, analysis] = circle_test(s.config);
+  const auto tests = circle_tests(s.config);  // a set's tests follow the first
+  auto program = tests.front().program;
+  auto analysis = tests.front().analysis;
+  // The bar calibration the original run used, not whatever is newest now.
+  if (s.original_settings.is_object() && s.original_settings.contains("radius_mm")) {
+    const auto original = circle_settings_from_json(s.original_settings).second;
+    analysis.calibrated_radius_mm = original.calibrated_radius_mm;
+    analysis.uncalibrated = original.uncalibrated;
+    analysis.calibration_source = original.calibration_source;
+    analysis.calibration = original.calibration;
+    analysis.uncalibrated_reason = original.uncalibrated_reason;
+    if (analysis.calibration_source.empty() && !analysis.uncalibrated &&
+        analysis.calibrated_radius_mm)  // stored before issue 18
+      analysis.calibration_source = "configuration";
+  } else {
+    // No original run in this store: the capture header holds no wall-clock start, so the
+    // bar's calibration is the newest one now (docs/circle.md, "Bar calibration"). Resolved
+    // here so that the printed result says what the stored run used.
+    cal::storage::Store store(database_path(o.db));
+    const auto now = std::chrono::system_clock::now().time_since_epoch();
+    resolve_calibration(analysis, s.config, program.radius_mm, store,
+                        std::chrono::duration_cast<std::chrono::milliseconds>(now).count());
+  }
   CircleRunSetup setup{.config = s.config,
                        .program = program,
                        .analysis = analysis,
@@ -122,7 +147,8 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                        .software_version = s.software(),
                        .context_json = s.original_context,
                        .replay = true,
-                       .replay_of_run = s.original_run};
+                       .replay_of_run = s.original_run,
+                       .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   CircleRun run(s.io, std::move(setup));
   run.start();
   const auto end = s.play(run, "the capture ended before both arcs were recorded");
@@ -130,14 +156,24 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
   if (!out.complete)
     throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
                                       out.run_id, out.reason));
+  std::vector<const CircleRunOutcome*> outs;
+  for (const auto& c : run.completed()) outs.push_back(&c);
+  outs.push_back(&out);
+  json all = json::array();
+  for (const auto* x : outs) {
+    json j = circle_document(*x->result, x->program, x->analysis);
+    j["run_id"] = x->run_id;
+    if (!o.json) {
+      fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, x->run_id, x->readings);
+      print_circle_result(*x->result, x->program, x->analysis);
+    }
+    all.push_back(std::move(j));
+  }
   if (o.json) {
-    json j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
-    j["run_id"] = out.run_id;
+    json j =
+        outs.size() == 1 ? all.front() : json{{"schema", "caldaq.circle-set.v1"}, {"runs", all}};
     j["capture_damage"] = damage_json(end);
     fmt::print("{}\n", j.dump(2));
-  } else {
-    fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
-    print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
   }
   report_damage(end, o, out.run_id);
 }
@@ -206,7 +242,7 @@ void add_replay_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", o->json,
-                "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v1)");
+                "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
   cmd->callback([o] { run_replay(*o); });
 }
 

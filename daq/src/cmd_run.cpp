@@ -208,7 +208,7 @@ void run_linear(const RunOptions& o) {
 // daq run circle: the ballbar streams; the run waits for the feed-in, then records both arcs.
 void run_circle(const RunOptions& o) {
   const auto config = cal::daq::load_config(o.config);
-  const auto [program, analysis] = circle_test(config);
+  const auto tests = circle_tests(config);  // one test, or the set of [test.circle] planes
   const auto& dc = need(config, "ballbar");
   boost::asio::io_context io;
   const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
@@ -216,12 +216,13 @@ void run_circle(const RunOptions& o) {
   SessionCapture capture(o.capture, config, specs);
   CircleRunSetup setup{
       .config = config,
-      .program = program,
-      .analysis = analysis,
+      .program = tests.front().program,
+      .analysis = tests.front().analysis,
       .database = database_path(o.db),
       .ballbar = make_instrument(io, specs[0], make_transport(io, dc),
                                  instrument_options(dc, specs[0], o, capture.recorder.get())),
-      .capture_path = capture.absolute_path(o.capture)};
+      .capture_path = capture.absolute_path(o.capture),
+      .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   auto progress = std::make_shared<ProgressOut>(o.json);
   setup.on_event = [progress](const std::string& e) { progress->event(e); };
   setup.on_live = [progress](const CircleLive& s) {
@@ -231,30 +232,50 @@ void run_circle(const RunOptions& o) {
   CircleRun run(io, std::move(setup));
   run.start();
   progress->event(fmt::format(
-      "Waiting for the feed-in: run the program from `daq gcode circle --config {}`; Ctrl-C "
+      "Waiting for the feed-in{}: run the program from `daq gcode circle --config {}`; Ctrl-C "
       "stops.",
-      o.config));
-  const auto& out = run_to_end(io, run, capture);
-  auto j = circle_json(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
-  const auto v = verdict_circle(config, analysis.plane, j);
-  if (o.json) {
-    j["run_id"] = out.run_id;
+      tests.size() > 1 ? fmt::format(" of the first of {} tests", tests.size()) : "", o.config));
+  const auto& last = run_to_end(io, run, capture);
+  std::vector<const CircleRunOutcome*> outs;
+  for (const auto& c : run.completed()) outs.push_back(&c);
+  outs.push_back(&last);
+  auto all = nlohmann::json::array();
+  for (const auto* out : outs) {
+    auto j = circle_document(*out->result, out->program, out->analysis);
+    const auto v = verdict_circle(config, out->analysis.plane, j);
+    j["run_id"] = out->run_id;
     j["status"] = "complete";
     j["verdict"] = to_json(v);
-    return fmt::print("{}\n", j.dump(2));
+    if (!o.json) {
+      fmt::print("\nrun {}: {} readings\n", out->run_id, out->readings);
+      print_circle_result(*out->result, out->program, out->analysis);
+      print_verdict(v);
+    }
+    all.push_back(std::move(j));
   }
-  fmt::print("\nrun {}: {} readings\n", out.run_id, out.readings);
-  print_circle(*out.result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
-  print_verdict(v);
+  if (o.json) {
+    if (outs.size() == 1) return fmt::print("{}\n", all.front().dump(2));
+    return fmt::print("{}\n", nlohmann::json{{"schema", "caldaq.circle-set.v1"},
+                                             {"campaign", config.campaign},
+                                             {"runs", all}}
+                                  .dump(2));
+  }
+  if (outs.size() > 1)
+    fmt::print(
+        "\n{} tests stored as runs {}..{} of campaign '{}': `daq ballbar volumetric "
+        "--runs ...` or `daq report --campaign` for the three-plane table\n",
+        outs.size(), outs.front()->run_id, outs.back()->run_id, config.campaign);
 }
 
 struct GcodeOptions {
   std::string config, dialect = "fanuc", output;
+  bool set = false;  // circle: the standard set (XY, ZX, YZ) even for a single-test configuration
+  bool by_radius = false;
 };
 
 void gcode(const GcodeOptions& o, bool circle) {
-  const auto text =
-      part_program(cal::daq::load_config(o.config), circle ? "circle" : "linear", o.dialect);
+  const auto text = part_program(cal::daq::load_config(o.config), circle ? "circle" : "linear",
+                                 o.dialect, {.standard_set = o.set, .by_radius = o.by_radius});
   if (o.output.empty()) return fmt::print("{}", text);
   std::ofstream out(o.output);
   if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));
@@ -298,7 +319,7 @@ void add_run_commands(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   circ->add_flag("--json", o->json,
-                 "Print the result as caldaq.circle.v1 JSON with run_id and verdict (progress "
+                 "Print the result as caldaq.circle.v2 JSON with run_id and verdict (progress "
                  "goes to stderr)");
   circ->callback([o] { run_circle(*o); });
 
@@ -312,6 +333,13 @@ void add_run_commands(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("-o,--output", g->output, "Write to a file instead of stdout");
     const bool circle = std::string(kind) == "circle";
+    if (circle) {
+      sub->add_flag("--set", g->set,
+                    "The standard set: XY 360 deg, ZX and YZ partial arcs, at each configured "
+                    "feed and radius (docs/circle.md)");
+      sub->add_flag("--by-radius", g->by_radius,
+                    "Arcs by radius (R / CR=) in pieces of at most 90 deg instead of by centre");
+    }
     sub->callback([g, circle] { gcode(*g, circle); });
   }
 }

@@ -17,6 +17,7 @@
 #include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
+#include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
@@ -130,11 +131,14 @@ void print_result_values(const json& doc) {
     for (const auto& [key, a] : axis.items())
       fmt::print("      {:<8} {:>10.3f} um   {}\n", a.value("symbol", key),
                  a.value("value_um", 0.0), a.value("description", ""));
-  } else if (doc.value("schema", "") == "caldaq.circle.v1") {
-    const auto iso = doc.value("iso230_4", json::object());
-    fmt::print("      G {:.3f} um (ccw {:.3f}, cw {:.3f}), H {:.3f} um, F {:+.3f} / {:+.3f} um\n",
-               iso.value("G_bi_um", 0.0), iso.value("G_ccw_um", 0.0), iso.value("G_cw_um", 0.0),
-               iso.value("H_um", 0.0), iso.value("F_max_um", 0.0), iso.value("F_min_um", 0.0));
+  } else if (is_circle_schema(doc.value("schema", ""))) {
+    // The values of the result's standard, as stored (v1: ISO 230-4:2005 with H among them).
+    std::string line;
+    for (const auto& [key, value] : doc.value("iso230_4", json::object()).items())
+      if (value.is_number())
+        line += fmt::format("{}{} {:.3f} um", line.empty() ? "" : ", ",
+                            key.substr(0, key.size() - 3), value.get<double>());
+    fmt::print("      {}: {}\n", doc.value("standard", std::string("ISO 230-4")), line);
     for (const auto& d : doc.value("diagnostics", json::array()))
       fmt::print("      {:<40} {:+9.3f} {:<5} PV {:.3f} um\n", d.value("name", ""),
                  d.value("value", 0.0), d.value("unit", ""), d.value("pv_um", 0.0));

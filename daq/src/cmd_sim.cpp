@@ -116,10 +116,12 @@ std::int64_t newest_run(const std::filesystem::path& db) {
 
 void run_sim(SimOptions o) {
   if (!o.measure.empty()) o.test = "linear";  // a component's test is a linear one
-  if (o.test != "linear" && o.test != "circle")
-    throw cal::InputError(fmt::format("--test '{}' (expected linear or circle)", o.test));
+  if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
+    throw cal::InputError(
+        fmt::format("--test '{}' (expected linear, circle or circle-set)", o.test));
+  const bool set = o.test == "circle-set";  // the standard set on the three-plane machine
   std::optional<cal::daq::LinearTestConfig> volumetric;
-  ShopTruth truth;
+  ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
   if (!o.measure.empty()) {
     volumetric = volumetric_test(o.measure);
     truth = volumetric_truth(cal::kinematics::topology_from_string(o.topology), 0.02);
@@ -147,7 +149,8 @@ void run_sim(SimOptions o) {
                                                               .position_feed = o.position_feed,
                                                               .in_process = false,
                                                               .runs = o.runs,
-                                                              .targets = o.targets});
+                                                              .targets = o.targets,
+                                                              .circle_set = set});
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -161,7 +164,11 @@ void run_sim(SimOptions o) {
   };
   const auto run_program = [&](const std::string& test) {
     const double t0_s = shop.now_s();
-    if (test == "circle") {
+    if (test == "circle" && set) {  // the whole set in one program, as daq gcode writes it
+      std::vector<cal::daq::BallbarSetTest> program;
+      for (const auto& t : circle_tests(config)) program.push_back({t.plane, t.program});
+      shop.run_circle_set(program);
+    } else if (test == "circle") {
       shop.run_circle(circle_test(config).first);
     } else {
       const auto& l = *config.linear;
@@ -182,7 +189,7 @@ void run_sim(SimOptions o) {
         o.speed, o.config_out, o.test, o.config_out, *o.start_after_s);
     std::fflush(stdout);
     run_until(shop.now_s() + *o.start_after_s * o.speed);
-    return run_program(o.test);
+    return run_program(set ? "circle" : o.test);
   }
   // As an operator would: the program is started once the acquisition waits for it (a run has
   // begun in the database), and it is the program of that run's test.
@@ -209,6 +216,9 @@ void run_sim(SimOptions o) {
     run_until(shop.now_s() + 1.0 * o.speed);
     run_program(test);
     if (volumetric) return;  // set up for one component's test: one run
+    // A set's later tests are runs of their own, started while its one program ran: not
+    // programs to start again.
+    if (set) seen = newest_run(db);
   }
 }
 
@@ -219,7 +229,8 @@ void add_sim_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "sim", "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
   cmd->add_option("--test", o->test,
-                  "linear or circle: the program run after --start-after-s (waiting for runs, the "
+                  "linear, circle or circle-set (the ballbar set on a machine with errors in all "
+                  "three planes): the program run after --start-after-s (waiting for runs, the "
                   "run's own test is run)")
       ->capture_default_str();
   cmd->add_option("-o,--config-out", o->config_out, "Where to write the devices' configuration")

@@ -36,7 +36,7 @@ st::RunRecord linear_run(const st::Store& store, std::int64_t id) {
 struct AnalyseRunOptions {
   std::string db;
   std::int64_t run = 0;
-  std::string standard = "iso230-2:2014";
+  std::string standard;  // empty: ISO 230-2:2014 (linear), the run's own (circle)
   bool store = false;
   bool json = false;
   // Circle runs: what may be corrected after the fact.
@@ -51,9 +51,22 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   if (settings.is_discarded() || !settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("run {}: its circle settings are missing", o.run));
   auto [program, analysis] = circle_settings_from_json(settings);
-  if (o.calibrated_radius_mm) analysis.calibrated_radius_mm = o.calibrated_radius_mm;
+  if (o.calibrated_radius_mm) {
+    analysis.calibrated_radius_mm = o.calibrated_radius_mm;
+    analysis.uncalibrated = false;
+    analysis.calibration_source = "option";
+    analysis.calibration.reset();
+    analysis.uncalibrated_reason.clear();
+  }
   if (o.cyclic_period_mm) analysis.cyclic_period_mm = o.cyclic_period_mm;
-  if (o.uncalibrated) analysis.uncalibrated = true;
+  if (o.uncalibrated) {
+    analysis.uncalibrated = true;
+    analysis.uncalibrated_reason = "daq analyse --uncalibrated";
+  }
+  if (!o.standard.empty()) {
+    cal::circle::circular_standard_from_key(o.standard);  // refused here if unknown
+    analysis.standard = o.standard;
+  }
   // Only the bar's series is read (streamed; the analysis needs its values in memory).
   static constexpr std::uint8_t bar[] = {
       static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
@@ -69,12 +82,12 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
     throw cal::InputError(
         fmt::format("run {} ({} bar readings stored): {}", o.run, bar_mm.size(), e.what()));
   }
-  auto j = circle_json(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  auto j = circle_document(result, program, analysis);
   if (o.store) {
     json prov = provenance("reanalysed", software_version);
     prov["analysis"] = circle_settings_json(program, analysis);
     const auto id = store.add_result({.run_id = o.run,
-                                      .standard = "ISO 230-4:2005",
+                                      .standard = standard_label(analysis),
                                       .json = j.dump(),
                                       .provenance_json = prov.dump()});
     j["result_id"] = id;
@@ -82,7 +95,7 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   const auto v = verdict_of(settings, j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", j.dump(2));
-  print_circle(result, program.radius_mm, analysis.plane, program.feed_mm_per_min);
+  print_circle_result(result, program, analysis);
   print_verdict(v);
 }
 
@@ -91,18 +104,19 @@ void analyse_run(const AnalyseRunOptions& o) {
   auto store = o.store ? st::Store(database_path(o.db)) : open_database_read_only(o.db);
   const auto run = store.run(o.run);
   if (run && run->kind == "circle") return analyse_circle_run(store, *run, o);
+  const std::string standard = o.standard.empty() ? "iso230-2:2014" : o.standard;
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
   if (targets.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
-  const auto e = cal::iso230_2::evaluate(measurements(targets),
-                                         cal::iso230_2::standard_from_string(o.standard));
+  const auto e =
+      cal::iso230_2::evaluate(measurements(targets), cal::iso230_2::standard_from_string(standard));
   json j = to_json(e);
   if (o.store) {
     // The stops' deviations are as compensated for the current result: the same coefficients.
     const json settings = json::parse(run->settings_json, nullptr, false);
     const auto used = compensation_used(settings, store.results(o.run));
     json prov = provenance("reanalysed", software_version);
-    prov["standard"] = o.standard;
+    prov["standard"] = standard;
     prov["coefficients"] = used.coefficients;
     prov["sensor_offsets"] = to_json(used.offsets);
     if (used.result_id) prov["of_result"] = *used.result_id;
@@ -273,8 +287,10 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   analyse.require_subcommand(0, 1);
   analyse.add_option("RUN", a->run, "A stored run to evaluate again (see daq runs)");
   add_db_option(analyse, a->db);
-  analyse.add_option("-s,--standard", a->standard, "Standard for a stored run")
-      ->capture_default_str();
+  analyse.add_option("-s,--standard", a->standard,
+                     "Standard for a stored run: a linear run iso230-2:2014 (default), ...; a "
+                     "circle run iso230-4:2005, gb/t17421.4-2016 or iso230-4:1996 (default: as "
+                     "run)");
   analyse.add_flag("--store", a->store, "Store the result with the run");
   analyse
       .add_option("--calibrated-radius-mm", a->calibrated_radius_mm,
@@ -285,7 +301,7 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
                   "Circle runs: the cyclic-error period (default: as run, else searched)")
       ->check(CLI::PositiveNumber);
   analyse.add_flag("--uncalibrated", a->uncalibrated, "Circle runs: no radius error");
-  analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v1)");
+  analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
   analyse.callback([a, &analyse] {
     if (!analyse.get_subcommands().empty()) return;
     if (a->run <= 0)

@@ -37,5 +37,7 @@ void add_report_command(CLI::App& app);
 void add_bench_commands(CLI::App& app);
 // model show|map|compensate|testpiece: the machine model file
 void add_model_commands(CLI::App& app);
+// ballbar calibrate|calibrations|volumetric|history
+void add_ballbar_commands(CLI::App& app);
 
 }  // namespace daq

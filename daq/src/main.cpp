@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   daq::add_compensate_commands(app, *analyse);
   daq::add_report_command(app);
   daq::add_model_commands(app);
+  daq::add_ballbar_commands(app);
   daq::add_serve_command(app);
   daq::add_bench_commands(app);
   daq::check_numbers(app);

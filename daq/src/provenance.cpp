@@ -117,10 +117,12 @@ json provenance(std::string_view how, std::string_view software) {
 
 std::optional<cal::storage::ResultRecord> current_result(
     const std::vector<cal::storage::ResultRecord>& results, std::string_view schema) {
+  // Any version of the schema ("caldaq.circle.v1" results stored before issue 18 count).
+  const auto family = [](std::string_view s) { return s.substr(0, s.rfind('.')); };
   for (auto it = results.rbegin(); it != results.rend(); ++it) {
     if (!it->current()) continue;
     const json doc = json::parse(it->json, nullptr, false);
-    if (doc.is_object() && doc.value("schema", "") == schema) return *it;
+    if (doc.is_object() && family(doc.value("schema", "")) == family(schema)) return *it;
   }
   return std::nullopt;
 }

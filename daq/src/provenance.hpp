@@ -38,8 +38,8 @@ nlohmann::json provenance(std::string_view how, std::string_view software);
 std::string utc_iso(std::int64_t unix_ms);
 std::string utc_now_iso();
 
-// The newest current result of a run whose document has this schema ("caldaq.iso230-2.v1",
-// "caldaq.circle.v1"), or nullopt.
+// The newest current result of a run whose document has this schema, any version
+// ("caldaq.iso230-2.v1", "caldaq.circle.v2" also finds a caldaq.circle.v1 result), or nullopt.
 std::optional<cal::storage::ResultRecord> current_result(
     const std::vector<cal::storage::ResultRecord>& results, std::string_view schema);
 

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "circle_output.hpp"
+
 namespace daq {
 
 using nlohmann::json;
@@ -81,8 +83,17 @@ Verdict circle_verdict(const json& tolerances, const json& result) {
   v.basis = tolerances.value("source", std::string("tolerances"));
   const auto& iso = result.value("iso230_4", json::object());
   if (tolerances.contains("G_um")) {
-    const double lim = tolerances["G_um"].get<double>(), g = iso.value("G_bi_um", 0.0);
-    v.checks.push_back({"G_bi_um", "G", g, lim, "um", within(g, lim)});
+    const double lim = tolerances["G_um"].get<double>();
+    if (iso.contains("G_bi_um")) {
+      const double g = iso.value("G_bi_um", 0.0);
+      v.checks.push_back({"G_bi_um", "G", g, lim, "um", within(g, lim)});
+    } else {  // ISO 230-4:1996 has no G(b): the limit applies to each direction's G
+      for (const auto& [key, symbol] : {std::pair{"G_ccw_um", "G (ccw)"}, {"G_cw_um", "G (cw)"}})
+        if (iso.value(key, 0.0) > 0) {
+          const double g = iso.value(key, 0.0);
+          v.checks.push_back({key, symbol, g, lim, "um", within(g, lim)});
+        }
+    }
   }
   const json diagnostics = tolerances.value("diagnostics", json::object());
   const json reported = result.value("diagnostics", json::array());
@@ -113,7 +124,7 @@ Verdict verdict_of(const json& settings, const json& result) {
                             settings["context"].contains("tolerances")
                         ? settings["context"]["tolerances"]
                         : none;
-  if (result.value("schema", "") == "caldaq.circle.v1") return circle_verdict(tol, result);
+  if (is_circle_schema(result.value("schema", ""))) return circle_verdict(tol, result);
   return linear_verdict(tol, result);
 }
 

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 
 #include "store_impl.hpp"
@@ -132,6 +133,24 @@ ALTER TABLE reading_chunks ADD COLUMN seq INTEGER;
 ALTER TABLE reading_chunks ADD COLUMN crc INTEGER;
 CREATE UNIQUE INDEX reading_chunks_by_seq ON reading_chunks(run_id, seq);
 PRAGMA application_id = 1128352836;
+)sql",
+    // 3 -> 4 (issue 18): ballbar calibrations against a calibrator, with their date, so that a
+    // test's absolute radius names the calibration it used.
+    R"sql(
+CREATE TABLE ballbar_calibrations(
+  id INTEGER PRIMARY KEY,
+  bar TEXT NOT NULL CHECK(bar <> ''),
+  nominal_mm REAL NOT NULL CHECK(nominal_mm > 0),
+  extensions TEXT NOT NULL DEFAULT '',
+  calibrator TEXT NOT NULL DEFAULT '',
+  calibrator_length_mm REAL NOT NULL CHECK(calibrator_length_mm > 0),
+  reading_mm REAL NOT NULL,
+  zero_length_mm REAL NOT NULL CHECK(zero_length_mm > 0),
+  temperature_degc REAL,
+  calibrated_unix_ms INTEGER NOT NULL,
+  note TEXT NOT NULL DEFAULT '');
+CREATE INDEX ballbar_calibrations_by_bar
+  ON ballbar_calibrations(bar, nominal_mm, calibrated_unix_ms);
 )sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
@@ -307,6 +326,13 @@ CREATE TEMP TABLE missed_stops(run_id INTEGER, run_number INTEGER, direction TEX
 )sql",
          "present schema 1 as schema 2 (read-only)");
   }
+  if (version < 4)  // before the ballbar calibrations: none (an empty TEMP table, as above)
+    exec(R"sql(
+CREATE TEMP TABLE ballbar_calibrations(id INTEGER PRIMARY KEY, bar TEXT, nominal_mm REAL,
+  extensions TEXT, calibrator TEXT, calibrator_length_mm REAL, reading_mm REAL,
+  zero_length_mm REAL, temperature_degc REAL, calibrated_unix_ms INTEGER, note TEXT);
+)sql",
+         "present an older schema without ballbar calibrations (read-only)");
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
       "('encoding', 'seq', 'crc')");
@@ -754,6 +780,83 @@ void Store::set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::i
   sqlite3_bind_int64(s.get(), 2, unix_ns);
   sqlite3_bind_int64(s.get(), 3, run_id);
   impl_->step_done(s.get(), fmt::format("set the time origin of run {}", run_id));
+}
+
+namespace {
+
+constexpr const char* kCalibrationColumns =
+    "id, bar, nominal_mm, extensions, calibrator, calibrator_length_mm, reading_mm, "
+    "zero_length_mm, temperature_degc, calibrated_unix_ms, note";
+
+BarCalibration calibration_row(sqlite3_stmt* s) {
+  BarCalibration c{.id = sqlite3_column_int64(s, 0),
+                   .bar = column_text(s, 1),
+                   .nominal_mm = sqlite3_column_double(s, 2),
+                   .extensions = column_text(s, 3),
+                   .calibrator = column_text(s, 4),
+                   .calibrator_length_mm = sqlite3_column_double(s, 5),
+                   .reading_mm = sqlite3_column_double(s, 6),
+                   .zero_length_mm = sqlite3_column_double(s, 7),
+                   .calibrated_unix_ms = sqlite3_column_int64(s, 9),
+                   .note = column_text(s, 10)};
+  if (sqlite3_column_type(s, 8) != SQLITE_NULL) c.temperature_degc = sqlite3_column_double(s, 8);
+  return c;
+}
+
+}  // namespace
+
+std::int64_t Store::add_bar_calibration(const BarCalibration& c) {
+  const auto bad = [](double v) { return !std::isfinite(v) || !(v > 0); };
+  if (c.bar.empty() || bad(c.nominal_mm) || bad(c.calibrator_length_mm) || bad(c.zero_length_mm) ||
+      !std::isfinite(c.reading_mm) || (c.temperature_degc && !std::isfinite(*c.temperature_degc)))
+    throw StoreError(fmt::format(
+        "{}: ballbar calibration of '{}': the bar must be named and the lengths finite and > 0 "
+        "(nominal {} mm, calibrator {} mm, zero length {} mm, reading {} mm)",
+        impl_->path.string(), c.bar, c.nominal_mm, c.calibrator_length_mm, c.zero_length_mm,
+        c.reading_mm));
+  auto s = impl_->prepare(
+      "INSERT INTO ballbar_calibrations(bar, nominal_mm, extensions, calibrator, "
+      "calibrator_length_mm, reading_mm, zero_length_mm, temperature_degc, calibrated_unix_ms, "
+      "note) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  bind_text(s.get(), 1, c.bar);
+  sqlite3_bind_double(s.get(), 2, c.nominal_mm);
+  bind_text(s.get(), 3, c.extensions);
+  bind_text(s.get(), 4, c.calibrator);
+  sqlite3_bind_double(s.get(), 5, c.calibrator_length_mm);
+  sqlite3_bind_double(s.get(), 6, c.reading_mm);
+  sqlite3_bind_double(s.get(), 7, c.zero_length_mm);
+  if (c.temperature_degc) sqlite3_bind_double(s.get(), 8, *c.temperature_degc);
+  sqlite3_bind_int64(s.get(), 9, c.calibrated_unix_ms ? c.calibrated_unix_ms : unix_ms_now());
+  bind_text(s.get(), 10, c.note);
+  impl_->step_done(s.get(), fmt::format("add a calibration of ballbar '{}'", c.bar));
+  return sqlite3_last_insert_rowid(impl_->db.get());
+}
+
+std::vector<BarCalibration> Store::bar_calibrations(std::string_view bar) const {
+  auto s = impl_->prepare(fmt::format("SELECT {} FROM ballbar_calibrations WHERE ? = '' OR bar = ? "
+                                      "ORDER BY calibrated_unix_ms, id",
+                                      kCalibrationColumns)
+                              .c_str());
+  bind_text(s.get(), 1, bar);
+  bind_text(s.get(), 2, bar);
+  std::vector<BarCalibration> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) out.push_back(calibration_row(s.get()));
+  return out;
+}
+
+std::optional<BarCalibration> Store::bar_calibration(std::string_view bar, double nominal_mm,
+                                                     std::int64_t at_unix_ms) const {
+  auto s = impl_->prepare(
+      fmt::format("SELECT {} FROM ballbar_calibrations WHERE bar = ? AND abs(nominal_mm - ?) < "
+                  "1e-3 AND calibrated_unix_ms <= ? ORDER BY calibrated_unix_ms DESC, id DESC "
+                  "LIMIT 1",
+                  kCalibrationColumns)
+          .c_str());
+  bind_text(s.get(), 1, bar);
+  sqlite3_bind_double(s.get(), 2, nominal_mm);
+  sqlite3_bind_int64(s.get(), 3, at_unix_ms);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
+  return calibration_row(s.get());
 }
 
 }  // namespace cal::storage

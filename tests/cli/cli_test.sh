@@ -49,7 +49,7 @@ check targets_feed_analyse 0 "^  E +$E um" -- "$DAQ" analyse iso230-2 --input "$
 G=$("$DAQ" analyse 2 --db "$TMP/demo.sqlite" --json | python3 -c "import json,sys; print(format(json.load(sys.stdin)['iso230_4']['G_bi_um'], '.3f'))")
 "$DAQ" export 2 --what circle -o "$TMP/ballbar.csv" --db "$TMP/demo.sqlite"
 opts=$(sed -nE 's/^# .*daq analyse circle --input FILE (.*)$/\1/p' "$TMP/ballbar.csv")
-check circle_feed_analyse 0 "G \(bidirectional\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
+check circle_feed_analyse 0 "G\(b\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
 check circle_no_targets 2 "run 2 is a circle test and has no captured stops: use --what circle" -- "$DAQ" export 2 --what targets --db "$TMP/demo.sqlite"
 check linear_no_circle 2 "run 1 is a linear test, not a circle" -- "$DAQ" export 1 --what circle --db "$TMP/demo.sqlite"
 # Readings: one timestamp per sample (the ballbar's lines delivered together are spread by its
@@ -87,6 +87,14 @@ check run_device_check_air 2 "daq: error: device check: .*devices.air \(serial /
 check run_stored_aborted 0 "aborted" -- "$DAQ" runs --db "$TMP/run.sqlite"
 check gcode_siemens 0 "^G4 F3\\.0000$" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d siemens
 check gcode_circle 0 "^G03 X-10\\.0000 Y0\\.0000 I-10\\.0000 J0\\.0000 F1000$" -- "$DAQ" gcode circle -c "$DATA/run/refused.toml"
+# The standard set in one program: six tests (three planes at two feeds), G18 for ZX with its
+# K/I words; the ZX feed-in ends at Z = -350 + 100 cos(-120) = -400, X = 250 + 100 sin(-120) =
+# 163.3975 (caldaq's angles: Z first in ZX, the 220 deg arc symmetric about +Z, 10 deg overshoot).
+check gcode_set_tests 0 "^6$" -- bash -c "\"$DAQ\" gcode circle -c \"$DATA/run/ballbar_set.toml\" | grep -c '^(TEST '"
+check gcode_set_zx 0 "^G01 X163\\.3975 Z-400\\.0000 F500$" -- "$DAQ" gcode circle -c "$DATA/run/ballbar_set.toml"
+check gcode_set_g18 0 "^G18$" -- "$DAQ" gcode circle -c "$DATA/run/ballbar_set.toml"
+check gcode_set_heidenhain 0 "CC X\\+250\\.0000 Z-350\\.0000" -- "$DAQ" gcode circle -c "$DATA/run/ballbar_set.toml" -d heidenhain
+check gcode_set_flag 0 "^3$" -- bash -c "\"$DAQ\" gcode circle --set -c \"$DATA/run/refused.toml\" | grep -c '^(TEST '"
 check gcode_dialect 2 "dialect 'mazak'" -- "$DAQ" gcode linear -c "$DATA/run/refused.toml" -d mazak
 check config_error 2 "no_such.toml: cannot open" -- "$DAQ" gcode linear -c "$DATA/run/no_such.toml"
 check show_missing 2 "no run 7" -- "$DAQ" show 7 --db "$TMP/demo.sqlite"

@@ -51,11 +51,17 @@ check vdi_content 0 "Evaluated by <strong>VDI/DGQ 3441" -- cat vdi.html
 # --- one circle run ----------------------------------------------------------------------------
 "$DAQ" analyse 2 --db demo.sqlite --json >circ.json
 check circle_report 0 "written to r2.html" -- "$DAQ" report 2 --db demo.sqlite -o r2.html
-for key in G_bi_um H_um F_max_um; do
+for key in G_bi_um F_max_um; do
   v=$(json_value circ.json "d['iso230_4']['$key']")
   number "$v"
   check "circle_value_$key" 0 ">$v<" -- cat r2.html
 done
+# H is a 1996 quantity: shown apart as informative, not as an ISO 230-4:2005 value.
+v=$(json_value circ.json "d['informative']['H_um']['value']")
+number "$v"
+check circle_value_H_informative 0 ">$v</td><td><em>informative</em>: circular hysteresis of ISO 230-4:1996" -- cat r2.html
+check circle_standard 0 "Evaluated by <strong>ISO 230-4:2005</strong>" -- cat r2.html
+check circle_not_evaluated 0 "Not evaluated: mean bi-directional radial deviation" -- cat r2.html
 top=$(python3 -c "import json,re; print(re.escape(json.load(open('circ.json'))['diagnostics'][0]['name']))")
 check circle_top_diagnostic 0 "<td class=\"r\">1</td><td>$top</td>" -- cat r2.html
 check circle_polar 0 "Polar plot, least-squares centre removed" -- cat r2.html

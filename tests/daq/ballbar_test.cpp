@@ -130,4 +130,41 @@ TEST(BallbarSegmenter, RefusesABadProgram) {
   EXPECT_THROW(BallbarSegmenter{bad}, cal::InputError);
 }
 
+TEST(BallbarSegmenter, APartialArcOverTheTop) {
+  // The ZX test of the standard set: the ccw move starts at -120 deg, runs 10 deg of overshoot,
+  // the 220 deg arc and 10 more (240 deg, 25.133 s at 9.5493 deg/s), dwells 1 s, and runs back.
+  // The traces hold the measured -110 .. 110 deg only: 220 / 9.5493 x 100 Hz = 2303.8 samples.
+  BallbarProgram p = kProgram;
+  p.start_deg = -120.0, p.overshoot_deg = 10.0, p.arc_deg = 220.0;
+  const double arc_s = 240.0 / kRateDegS;
+  std::vector<double> v(30, 0.0);
+  for (int i = 0; i < 20; ++i) v.push_back(1.5);
+  for (int i = 0; i < static_cast<int>((2.0 + 2 * arc_s) * 100) + 5; ++i) {
+    const double t = i / 100.0;
+    double a = -120.0;
+    if (t >= 1.0 && t < 1.0 + arc_s) a = -120.0 + kRateDegS * (t - 1.0);
+    if (t >= 1.0 + arc_s) a = 120.0;
+    if (t >= 2.0 + arc_s) a = 120.0 - kRateDegS * (t - 2.0 - arc_s);
+    v.push_back(bar_mm(a));
+  }
+  BallbarSegmenter seg(p);
+  for (double x : v) seg.add(x);
+  ASSERT_TRUE(seg.complete());
+  EXPECT_NEAR(seg.arc_duration_s(), arc_s, 1e-9);
+  const auto traces = seg.traces();
+  for (const auto& t : traces) {
+    EXPECT_NEAR(static_cast<double>(t.angle_deg.size()), 2304, 1);
+    for (std::size_t i = 0; i < t.angle_deg.size(); ++i) {
+      ASSERT_GE(t.angle_deg[i], -110.0 - 1e-9);
+      ASSERT_LE(t.angle_deg[i], 110.0 + 1e-9);
+      ASSERT_NEAR(t.deviation_um[i], 1e3 * bar_mm(t.angle_deg[i]), 1e-9) << i;
+    }
+  }
+  EXPECT_NEAR(traces[0].angle_deg.front(), -110.0, kRateDegS / 100);
+  EXPECT_NEAR(traces[1].angle_deg.front(), 110.0, kRateDegS / 100);
+  BallbarProgram bad = kProgram;
+  bad.arc_deg = 170.0;
+  EXPECT_THROW(BallbarSegmenter{bad}, cal::InputError);
+}
+
 }  // namespace

@@ -311,6 +311,8 @@ G_um = 15
 [tolerances.XY.diagnostics]
 squareness = 20
 backlash_X = 3
+stick_slip_Y = 0.5
+vibration = 0.3
 )",
                               "m.toml");
   EXPECT_EQ(c.operator_name, "J. Smith");
@@ -334,6 +336,8 @@ backlash_X = 3
   const auto& xy = c.plane_tolerances.at("XY");
   EXPECT_EQ(xy.G_um, 15.0);
   EXPECT_EQ(xy.diagnostics.at("backlash_X"), 3.0);
+  EXPECT_EQ(xy.diagnostics.at("stick_slip_Y"), 0.5);
+  EXPECT_EQ(xy.diagnostics.at("vibration"), 0.3);
 }
 
 TEST(Config, RefusesBadLimitsDatesAndNames) {
@@ -353,6 +357,13 @@ TEST(Config, RefusesBadLimitsDatesAndNames) {
       error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
           .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),
       std::string::npos);
+  EXPECT_NE(
+      error_of("[test.circle]\nstandard = \"asme-b5.54\"\n")
+          .find("key 'test.circle.standard': circular standard 'asme-b5.54': only the scopes"),
+      std::string::npos);
+  EXPECT_NE(error_of("[tolerances.ZX.diagnostics]\nstick_slip_Y = 3\n")
+                .find("not a diagnostic of a circle in ZX"),
+            std::string::npos);
   EXPECT_NE(error_of("[[tolerances.X.by_length]]\nup_to_mm = 500\nA_um = 8\n"
                      "[[tolerances.X.by_length]]\nup_to_mm = 300\nA_um = 6\n")
                 .find("entries must ascend in up_to_mm"),
@@ -374,6 +385,44 @@ TEST(Config, MissingFileIsNamed) {
   } catch (const cal::InputError& e) {
     EXPECT_STREQ(e.what(), "/nonexistent/machine.toml: cannot open");
   }
+}
+
+TEST(Config, BallbarSetKeys) {
+  const auto c = cal::daq::parse_config(R"(
+[test.circle]
+planes = ["XY", "ZX", "YZ"]
+feeds_mm_per_min = [500, 2000]
+radii_mm = [100, 150]
+partial_arc_deg = 200
+partial_overshoot_deg = 5
+bar = "QC20-1234"
+)",
+                                        "m.toml");
+  ASSERT_TRUE(c.circle);
+  EXPECT_EQ(c.circle->planes, (std::vector<std::string>{"XY", "ZX", "YZ"}));
+  EXPECT_EQ(c.circle->feeds_mm_per_min, (std::vector<double>{500, 2000}));
+  EXPECT_EQ(c.circle->radii_mm, (std::vector<double>{100, 150}));
+  EXPECT_EQ(c.circle->partial_arc_deg, 200);
+  EXPECT_EQ(c.circle->partial_overshoot_deg, 5);
+  EXPECT_EQ(c.circle->bar, "QC20-1234");
+  EXPECT_NE(error_of("[test.circle]\nplanes = [\"XY\", \"XZ\"]\n")
+                .find("each plane is \"XY\", \"ZX\" or \"YZ\""),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nplanes = [\"XY\", \"XY\"]\n").find("plane XY given twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nplane = \"XY\"\nplanes = [\"XY\"]\n").find("not both"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nfeeds_mm_per_min = [500, -1]\n").find("-1 must be > 0"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of("[test.circle]\npartial_arc_deg = 170\n").find("170 must be within 180 .. 360 deg"),
+      std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nfeed_in_mm = nan\n").find("feed_in_mm"), std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nbar = \"A\\u0007\"\n").find("control characters"),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.circle]\nradii_mm = [100, 150]\ncalibrated_radius_mm = 100.001\n")
+                .find("one calibrated length cannot serve several radii"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -367,3 +367,122 @@ PRAGMA user_version = 1;
   EXPECT_EQ(rs[3].provenance_json, "{}");
   EXPECT_TRUE(store.missed_stops(1).empty());
 }
+
+TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
+  // Two bars; bar A calibrated at 100 mm twice (day 1 and day 10) and at 150 mm (day 5). A test
+  // on day 7 at 100 mm uses day 1's; on day 12, day 10's; at 150 mm on day 3, none yet.
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  constexpr std::int64_t day = 86'400'000;
+  const auto a1 = store.add_bar_calibration({.bar = "A",
+                                             .nominal_mm = 100,
+                                             .calibrator = "Zerodur 7",
+                                             .calibrator_length_mm = 100.0021,
+                                             .reading_mm = 0.0012,
+                                             .zero_length_mm = 100.0009,
+                                             .temperature_degc = 20.4,
+                                             .calibrated_unix_ms = 1 * day});
+  store.add_bar_calibration({.bar = "A",
+                             .nominal_mm = 100,
+                             .calibrator_length_mm = 100.0021,
+                             .reading_mm = -0.0030,
+                             .zero_length_mm = 100.0051,
+                             .calibrated_unix_ms = 10 * day});
+  store.add_bar_calibration({.bar = "A",
+                             .nominal_mm = 150,
+                             .extensions = "50 mm",
+                             .calibrator_length_mm = 150.0,
+                             .reading_mm = 0.0,
+                             .zero_length_mm = 150.0,
+                             .calibrated_unix_ms = 5 * day});
+  store.add_bar_calibration({.bar = "B",
+                             .nominal_mm = 100,
+                             .calibrator_length_mm = 100.0,
+                             .reading_mm = 0.0,
+                             .zero_length_mm = 100.0,
+                             .calibrated_unix_ms = 2 * day});
+  const auto d7 = store.bar_calibration("A", 100.0, 7 * day);
+  ASSERT_TRUE(d7);
+  EXPECT_EQ(d7->id, a1);
+  EXPECT_EQ(d7->zero_length_mm, 100.0009);
+  EXPECT_EQ(d7->calibrator, "Zerodur 7");
+  EXPECT_EQ(d7->temperature_degc, 20.4);
+  EXPECT_EQ(store.bar_calibration("A", 100.0, 12 * day)->zero_length_mm, 100.0051);
+  EXPECT_FALSE(store.bar_calibration("A", 150.0, 3 * day));
+  EXPECT_EQ(store.bar_calibration("A", 150.0, 6 * day)->extensions, "50 mm");
+  EXPECT_FALSE(store.bar_calibration("A", 120.0, 12 * day));  // no such length
+  EXPECT_FALSE(store.bar_calibration("C", 100.0, 12 * day));  // no such bar
+  EXPECT_FALSE(store.bar_calibration("A", 100.0, 12 * day)->temperature_degc);
+  EXPECT_EQ(store.bar_calibrations("A").size(), 3u);
+  EXPECT_EQ(store.bar_calibrations().size(), 4u);
+  EXPECT_EQ(store.bar_calibrations().front().bar, "A");  // oldest first
+  // Refused: no bar, a length that is not finite and > 0; nothing is stored then.
+  EXPECT_THROW(store.add_bar_calibration(
+                   {.nominal_mm = 100, .calibrator_length_mm = 100, .zero_length_mm = 100}),
+               cal::storage::StoreError);
+  EXPECT_THROW(store.add_bar_calibration({.bar = "A",
+                                          .nominal_mm = 100,
+                                          .calibrator_length_mm = std::nan(""),
+                                          .zero_length_mm = 100}),
+               cal::storage::StoreError);
+  EXPECT_EQ(store.bar_calibrations().size(), 4u);
+}
+
+// A database at the version before the ballbar calibrations (the previous schema with a run in
+// it): opened, it gains the table by the last migration, keeps its run, and stores a
+// calibration.
+TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
+  TempDir dir;
+  const auto file = dir.path / "prev.sqlite";
+  std::int64_t run = 0;
+  {
+    Store store(file);
+    run = a_run(store);
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    const auto undo =
+        "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
+        "PRAGMA user_version = " +
+        std::to_string(cal::storage::schema_version - 1) + ";";
+    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  Store store(file);
+  EXPECT_EQ(store.version(), cal::storage::schema_version);
+  EXPECT_TRUE(store.run(run).has_value());
+  EXPECT_TRUE(store.bar_calibrations().empty());
+  store.add_bar_calibration({.bar = "A",
+                             .nominal_mm = 100,
+                             .calibrator_length_mm = 100.0,
+                             .reading_mm = 0.001,
+                             .zero_length_mm = 99.999,
+                             .calibrated_unix_ms = 1});
+  EXPECT_EQ(store.bar_calibration("A", 100.0, 2)->zero_length_mm, 99.999);
+}
+
+// Read-only, a database of the previous version is read as it is: no calibrations, nothing
+// written (the version stays).
+TEST(Store, ReadOnlyThePreviousVersionHasNoBallbarCalibrations) {
+  TempDir dir;
+  const auto file = dir.path / "prev.sqlite";
+  { Store store(file); }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    const auto undo =
+        "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
+        "PRAGMA user_version = " +
+        std::to_string(cal::storage::schema_version - 1) + ";";
+    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_TRUE(ro.bar_calibrations().empty());
+    EXPECT_FALSE(ro.bar_calibration("A", 100.0, 1));
+  }
+  Store rw(file);  // the next writing open migrates it
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
+}

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "ballbar_campaign.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/squareness.hpp"
@@ -260,7 +261,12 @@ std::string setup_section(const RunView& v) {
   };
   std::vector<std::vector<std::string>> settings;
   for (const auto& [k, val] : v.settings.items()) {
-    if (k == "context") continue;  // shown in its own sections
+    if (k == "context") continue;                        // shown in its own sections
+    if (k == "calibration" && v.run.kind == "circle") {  // the section "Bar calibration"
+      settings.push_back({"calibration", fmt::format("record {} (see Bar calibration)",
+                                                     val.value("id", std::int64_t{0}))});
+      continue;
+    }
     if (val.is_object()) {
       for (const auto& [k2, v2] : val.items())
         settings.push_back(
@@ -774,11 +780,24 @@ struct Circle {
   cal::circle::Result result;
 };
 
-Circle analyse_circle(const st::Store& store, const RunView& v) {
+// A circular standard asked for in the options (a key of daq analyse --standard) replaces the
+// run's own; a linear standard there is for the linear runs of a campaign and is ignored here.
+std::string circular_key(const Options& o, std::string fallback) {
+  if (o.standard.empty()) return fallback;
+  try {
+    cal::circle::circular_standard_from_key(o.standard);
+    return o.standard;
+  } catch (const cal::InputError&) {
+    return fallback;
+  }
+}
+
+Circle analyse_circle(const st::Store& store, const RunView& v, const Options& o) {
   if (!v.settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("{}: run {}: its circle settings are missing",
                                       store.path().string(), v.run.id));
   auto [program, analysis] = ::daq::circle_settings_from_json(v.settings);
+  analysis.standard = circular_key(o, analysis.standard);
   static constexpr std::uint8_t bar[] = {static_cast<std::uint8_t>(Q::length_m)};
   std::vector<double> bar_mm;
   for (const auto& r : store.readings(v.run.id, bar)) bar_mm.push_back(r.value * 1e3);
@@ -822,34 +841,92 @@ PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_
   return p;
 }
 
-std::string circle_section(const st::Store& store, const RunView& v, Headline& headline) {
-  const auto c = analyse_circle(store, v);
+// Where the absolute radius came from: the stored calibration (bar, calibrator, reading, date,
+// its age at the test), a length given in the configuration or on the command line, or none:
+// then the radius error is not evaluated and F is relative to the bar's assumed length.
+std::string bar_calibration_section(const Circle& c, const RunView& v) {
+  const auto& a = c.analysis;
+  std::string h = "<h3>Bar calibration</h3>\n";
+  if (a.uncalibrated || !a.calibrated_radius_mm)
+    return h + fmt::format(
+                   "<p class=\"warning\"><strong>The radius error is not evaluated</strong>: {}. "
+                   "G, the diagnostics and the squareness do not need the bar's absolute length; "
+                   "F max and F min are deviations from the bar's assumed length, not from an "
+                   "absolute radius.</p>\n",
+                   esc(a.uncalibrated_reason.empty() ? std::string("the bar was not calibrated")
+                                                     : a.uncalibrated_reason));
+  if (!a.calibration)
+    return h + fmt::format(
+                   "<p>The bar's calibrated length {:.4f} mm (it reads 0 at that length) was "
+                   "given {}: no calibration record (calibrator, date) is stored with it.</p>\n",
+                   *a.calibrated_radius_mm,
+                   a.calibration_source == "option" ? "on the command line (daq analyse "
+                                                      "--calibrated-radius-mm)"
+                                                    : "in the configuration");
+  const auto& k = *a.calibration;
+  const double age_days =
+      static_cast<double>(v.run.started_unix_ms - k.calibrated_unix_ms) / 86'400'000.0;
+  const std::vector<std::vector<std::string>> rows = {
+      {"bar", esc(k.bar) + (k.extensions.empty() ? "" : " with " + esc(k.extensions))},
+      {"nominal length", fmt::format("{:.3f} mm", k.nominal_mm)},
+      {"calibrator", (k.calibrator.empty() ? std::string("not stated") : esc(k.calibrator)) +
+                         fmt::format(", {:.4f} mm", k.calibrator_length_mm)},
+      {"reading in the calibrator", fmt::format("{:+.4f} mm", k.reading_mm)},
+      {"calibrated length (reads 0 at)", fmt::format("{:.4f} mm", k.zero_length_mm)},
+      {"temperature", k.temperature_degc ? fmt::format("{:.2f} °C (recorded, not corrected for)",
+                                                       *k.temperature_degc)
+                                         : std::string("not recorded")},
+      {"date", fmt::format("{} ({:.0f} days before the test)", iso_time(k.calibrated_unix_ms),
+                           std::max(0.0, age_days))},
+      {"record", fmt::format("calibration {} (daq ballbar calibrations)", k.id)}};
+  return h + "<p>The absolute radius (the radius error, F) uses this stored calibration:</p>\n" +
+         table({"", ""}, rows, "kv");
+}
+
+// The values of the run's circular standard, as (key, symbol, value).
+std::vector<std::tuple<std::string, std::string, double>> standard_values(const Circle& c) {
+  std::vector<std::tuple<std::string, std::string, double>> out;
+  const auto& st = cal::circle::info(cal::circle::circular_standard_from_key(c.analysis.standard));
+  for (const auto& x : st.values)
+    out.emplace_back(x.key, x.symbol, ::daq::iso_value(c.result.iso, x.key));
+  return out;
+}
+
+std::string circle_section(const st::Store& store, const RunView& v, const Options& o,
+                           Headline& headline) {
+  const auto c = analyse_circle(store, v, o);
   const auto& r = c.result;
-  headline.standard = "ISO 230-4:2005";
+  const auto& st = cal::circle::info(cal::circle::circular_standard_from_key(c.analysis.standard));
+  headline.standard = st.label;
   std::string h = fmt::format(
-      "<h3>Results: ISO 230-4:2005</h3>\n<p class=\"standard\">Evaluated by <strong>ISO "
-      "230-4:2005</strong> (circular tests for numerically controlled machine tools); radius "
-      "{:g} mm, feed {:g} mm/min, plane {}, both directions from the stored bar readings.</p>\n",
+      "<h3>Results: {0}</h3>\n<p class=\"standard\">Evaluated by <strong>{0}</strong> ({1}){2}; "
+      "radius {3:g} mm, feed {4:g} mm/min, plane {5}, both directions from the stored bar "
+      "readings.</p>\n",
+      esc(st.label), esc(st.title),
+      st.identical.empty() ? std::string()
+                           : fmt::format(", the same values as {}", esc(st.identical.front())),
       c.program.radius_mm, c.program.feed_mm_per_min, esc(c.analysis.plane));
-  const auto doc =
-      ::daq::circle_json(r, c.program.radius_mm, c.analysis.plane, c.program.feed_mm_per_min);
+  const auto doc = ::daq::circle_document(r, c.program, c.analysis);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
-  const auto* g_check = ::daq::find_check(verdict, "G_bi_um");
-  const std::vector<std::vector<std::string>> iso = {
-      {"G", um(r.iso.G_bi_um), "circular deviation, both directions", limit_cell(g_check),
-       verdict_cell(g_check)},
-      {"G (cw)", um(r.iso.G_cw_um), "circular deviation, clockwise", "", ""},
-      {"G (ccw)", um(r.iso.G_ccw_um), "circular deviation, counter-clockwise", "", ""},
-      {"H", um(r.iso.H_um), "circular hysteresis", "", ""},
-      {"F max", um(r.iso.F_max_um), "largest radial deviation from the nominal radius", "", ""},
-      {"F min", um(r.iso.F_min_um), "smallest radial deviation from the nominal radius", "", ""},
-      {"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
-       "least-squares centre relative to the pivot (set-up)", "", ""}};
-  headline.values_um = {{"G", r.iso.G_bi_um}, {"H", r.iso.H_um}};
+  std::vector<std::vector<std::string>> iso;
+  for (const auto& x : st.values) {
+    const auto* check = ::daq::find_check(verdict, x.key);
+    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)), esc(x.meaning),
+                   limit_cell(check), check ? verdict_cell(check) : ""});
+    if (x.key.starts_with("G"))
+      headline.values_um.push_back({x.symbol, ::daq::iso_value(r.iso, x.key)});
+  }
+  iso.push_back({"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
+                 "least-squares centre relative to the pivot (set-up)", "", ""});
+  for (const auto& x : st.informative)
+    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
+                   "<em>informative</em>: " + esc(x.meaning), "", ""});
   h += verdict_banner(verdict);
   h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
              "lrlrl");
+  for (const auto& n : st.not_evaluated)
+    h += "<p class=\"note\">Not evaluated: " + esc(n) + "</p>\n";
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
   polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
   h += figure(svg(polar),
@@ -883,17 +960,13 @@ std::string circle_section(const st::Store& store, const RunView& v, Headline& h
       "magnitude of the value, in its unit.</p>\n",
       r.iso.G_bi_um);
   for (const auto& n : r.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+  h += bar_calibration_section(c, v);
   h += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>The error model leaves a residual of {:.3f} µm rms "
-      "(noise and what the model does not describe). The ballbar's calibration (its "
-      "calibrated length and transducer certificate) is not recorded with the run, so an "
-      "expanded uncertainty of G is not evaluated here; {}.</p>\n",
-      r.residual_rms_um,
-      c.analysis.calibrated_radius_mm ? fmt::format("the calibrated length {:.4f} mm was used",
-                                                    *c.analysis.calibrated_radius_mm)
-      : c.analysis.uncalibrated
-          ? "the radius was not calibrated: F and the radius error are not valid"
-          : "the nominal radius was taken as the bar length");
+      "(noise and what the model does not describe). The transducer's own certificate and the "
+      "calibrator's uncertainty are not recorded with the run, so an expanded uncertainty of G "
+      "is not evaluated here.</p>\n",
+      r.residual_rms_um);
   return h;
 }
 
@@ -1064,7 +1137,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
   h += conditions_section(v);
   h += instruments_section(v);
   if (v.run.kind == "linear" || v.run.kind == "circle")
-    h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v1");
+    h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v2");
   h += setup_section(v);
   // An aborted or interrupted run may hold too little to evaluate: the report still shows what
   // was stored, and says why there are no results.
@@ -1072,7 +1145,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
     if (v.run.kind == "linear")
       h += linear_section(store, v, o, hl);
     else if (v.run.kind == "circle")
-      h += circle_section(store, v, hl);
+      h += circle_section(store, v, o, hl);
     else
       h += generic_section(store, v);
   } catch (const cal::InputError& e) {
@@ -1093,6 +1166,88 @@ std::string run_report(const st::Store& store, std::int64_t run, const Options& 
   const auto v = load(store, run);
   Headline hl;
   return page(run_title(v), run_body(store, v, o, hl), o, who_of(v));
+}
+
+// The campaign's ballbar tests side by side and the three-plane table (docs/circle.md, "The
+// three-plane table"); empty when the campaign has no circle run with a result.
+std::string volumetric_section(const st::Store& store, std::span<const std::int64_t> runs) {
+  std::vector<std::int64_t> circles;
+  for (const auto id : runs)
+    if (const auto r = store.run(id);
+        r && r->kind == "circle" && r->status == st::RunStatus::complete)
+      circles.push_back(id);
+  if (circles.empty()) return {};
+  const auto tests = ::daq::ballbar_tests(store, circles);
+  const auto v = ::daq::volumetric_table(tests);
+  const auto opt = [](const std::optional<double>& x) {
+    return x ? fmt::format("{:+.3f}", *x) : std::string("&ndash;");
+  };
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& t : tests)
+    rows.push_back({fmt::format("<a href=\"#run-{}\">{}</a>", t.run, t.run), esc(t.plane_name),
+                    fmt::format("{:g}", t.radius_mm), fmt::format("{:g}", t.feed_mm_per_min),
+                    fmt::format("{:.0f}°", t.arc_deg), um(t.G_bi_um), opt(t.squareness_um_per_m),
+                    opt(t.scale_mismatch_um_per_m), opt(t.servo_ms),
+                    esc(::daq::summary(t.verdict))});
+  std::string h =
+      "<h2 id=\"three-planes\">Ballbar tests and the three-plane table</h2>\n" +
+      table({"run", "plane", "R (mm)", "feed (mm/min)", "arc", "G(b) (µm)", "squareness (µm/m)",
+             "scale mismatch (µm/m)", "servo mismatch (ms)", "verdict"},
+            rows, "num", "rlrrrrrrrl") +
+      "<p class=\"note\">Scale mismatch in the plane's order: XY X − Y, ZX Z − X, YZ Y − Z. "
+      "Servo mismatch: the plane's second axis lags its first (positive); the ellipse it "
+      "makes grows with the feed, a squareness's does not.</p>\n";
+  std::vector<std::vector<std::string>> planes;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& pv = v.combined.planes[i];
+    if (!pv) continue;
+    std::string used;
+    for (auto r : v.used[i].runs) used += (used.empty() ? "" : ", ") + std::to_string(r);
+    const auto mp = cal::circle::model_plane(pv->plane);
+    planes.push_back({i == 0   ? "XY"
+                      : i == 1 ? "YZ"
+                               : "ZX",
+                      used, fmt::format("{:g}", v.used[i].feed_mm_per_min),
+                      fmt::format("{:+.3f}", pv->squareness_um_per_m),
+                      fmt::format("{} = {:+.3f}", cal::kinematics::location_error_name(mp),
+                                  cal::circle::location_error_urad(*pv)),
+                      fmt::format("{} {:+.3f}",
+                                  i == 0   ? "X − Y"
+                                  : i == 1 ? "Y − Z"
+                                           : "Z − X",
+                                  pv->scale_mismatch_um_per_m),
+                      opt(pv->mean_scale_um_per_m)});
+  }
+  h += "<h3>Three-plane table</h3>\n";
+  if (!planes.empty())
+    h += table({"plane", "runs", "feed (mm/min)", "squareness α (µm/m)",
+                "model location error (µrad)", "scale mismatch (µm/m)", "mean scale (µm/m)"},
+               planes, "num", "llrrrrr");
+  h += "<p>Each plane at its slowest feed (servo errors grow with the feed, geometric errors do "
+       "not), its tests averaged. α is positive when the angle between the positive axes exceeds "
+       "90°; the machine model's ISO 230-1 location errors are E_C0Y = +α<sub>XY</sub>, "
+       "E_B0Z = −α<sub>ZX</sub>, E_A0Z = +α<sub>YZ</sub> (docs/kinematics.md). A circle "
+       "measures squareness where it was run. The mean scale (s<sub>u</sub> + s<sub>v</sub>)/2 "
+       "comes from a calibrated bar's radius error only.</p>\n";
+  if (const auto& sc = v.combined.scale_um_per_m)
+    h += fmt::format(
+        "<p>Axis scales: X {:+.3f}, Y {:+.3f}, Z {:+.3f} µm/m, <strong>{}</strong>{}.</p>\n",
+        (*sc)[0], (*sc)[1], (*sc)[2],
+        v.combined.scale_absolute ? "absolute (calibrated bar)"
+                                  : "relative: their mean is set to 0; the absolute scale is "
+                                    "not evaluated without a calibrated bar",
+        v.combined.scale_residual_um_per_m ? fmt::format(", least-squares residual {:.3f} µm/m",
+                                                         *v.combined.scale_residual_um_per_m)
+                                           : std::string());
+  else
+    h += "<p>Axis scales: not evaluated (they need the scale mismatches of two planes).</p>\n";
+  if (v.combined.closure_um_per_m)
+    h += fmt::format(
+        "<p>Closure (X − Y) + (Y − Z) + (Z − X) = {:+.3f} µm/m (0 for a consistent set: noise, "
+        "drift between the tests and the local errors of each position move it).</p>\n",
+        *v.combined.closure_um_per_m);
+  for (const auto& n : v.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+  return h;
 }
 
 std::string campaign_report(const st::Store& store, std::span<const std::int64_t> runs,
@@ -1126,7 +1281,7 @@ std::string campaign_report(const st::Store& store, std::span<const std::int64_t
       fmt::format("<p>{} runs.</p>\n", runs.size()) +
       table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
             "summary", "r") +
-      sections;
+      volumetric_section(store, runs) + sections;
   return page(title, body, o, who);
 }
 
@@ -1192,18 +1347,17 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
       for (const auto& a : l.e.axis) values.push_back({a.key, a.symbol, "µm", a.value_um});
       doc = ::daq::to_json(l.e);
     } else {
-      const auto c = analyse_circle(store, v);
+      const auto c = analyse_circle(store, v, o);
       polars.push_back(polar_of(c, "", 2 * i, label + " "));
-      values = {{"G_bi_um", "G", "µm", c.result.iso.G_bi_um},
-                {"H_um", "H", "µm", c.result.iso.H_um}};
+      for (const auto& [key, symbol, value] : standard_values(c))
+        if (key.starts_with("G")) values.push_back({key, symbol, "µm", value});
       for (const auto& d : c.result.diagnostics)
         values.push_back({d.key, d.name,
                           d.unit == "um"     ? "µm"
                           : d.unit == "um/m" ? "µm/m"
                                              : d.unit,
                           d.value});
-      doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
-                               c.program.feed_mm_per_min);
+      doc = ::daq::circle_document(c.result, c.program, c.analysis);
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
     // A re-compensated run is compared with the values it has now, and says so.
@@ -1333,14 +1487,14 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
       for (const auto& a : l.e.axis) sd.values.emplace_back(a.key, a.symbol, a.value_um);
       sd.doc = ::daq::to_json(l.e);
     } else {
-      const auto c = analyse_circle(store, v);
+      const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
       polar.first_axis = p.first_axis, polar.second_axis = p.second_axis;
       for (auto& t : p.traces) polar.traces.push_back(std::move(t));
-      sd.values = {{"G_bi_um", "G", c.result.iso.G_bi_um}, {"H_um", "H", c.result.iso.H_um}};
+      for (const auto& [key, symbol, value] : standard_values(c))
+        if (key.starts_with("G")) sd.values.emplace_back(key, symbol, value);
       for (const auto& d : c.result.diagnostics) sd.values.emplace_back(d.key, d.name, d.value);
-      sd.doc = ::daq::circle_json(c.result, c.program.radius_mm, c.analysis.plane,
-                                  c.program.feed_mm_per_min);
+      sd.doc = ::daq::circle_document(c.result, c.program, c.analysis);
     }
     sd.verdict = ::daq::verdict_of(v.settings, sd.doc);
     return sd;

@@ -49,8 +49,104 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                                .radius_calibrated = !analysis.uncalibrated,
                                .calibrated_radius_mm = analysis.calibrated_radius_mm,
                                .sample_rate_hz = program.sample_rate_hz,
-                               .start_deg = program.start_deg},
+                               .start_deg = program.start_deg,
+                               .arc_deg = program.arc_deg,
+                               .overshoot_deg = program.overshoot_deg},
                               traces);
+}
+
+namespace {
+
+json calibration_json(const cal::storage::BarCalibration& c) {
+  json j{{"id", c.id},
+         {"bar", c.bar},
+         {"nominal_mm", c.nominal_mm},
+         {"extensions", c.extensions},
+         {"calibrator", c.calibrator},
+         {"calibrator_length_mm", c.calibrator_length_mm},
+         {"reading_mm", c.reading_mm},
+         {"zero_length_mm", c.zero_length_mm},
+         {"calibrated_unix_ms", c.calibrated_unix_ms},
+         {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
+         {"note", c.note}};
+  j["temperature_degc"] = c.temperature_degc ? json(*c.temperature_degc) : json(nullptr);
+  return j;
+}
+
+cal::storage::BarCalibration calibration_from_json(const json& j) {
+  cal::storage::BarCalibration c{
+      .id = j.value("id", std::int64_t{0}),
+      .bar = j.value("bar", std::string()),
+      .nominal_mm = j.value("nominal_mm", 0.0),
+      .extensions = j.value("extensions", std::string()),
+      .calibrator = j.value("calibrator", std::string()),
+      .calibrator_length_mm = j.value("calibrator_length_mm", 0.0),
+      .reading_mm = j.value("reading_mm", 0.0),
+      .zero_length_mm = j.value("zero_length_mm", 0.0),
+      .calibrated_unix_ms = j.value("calibrated_unix_ms", std::int64_t{0}),
+      .note = j.value("note", std::string())};
+  if (j.contains("temperature_degc") && j["temperature_degc"].is_number())
+    c.temperature_degc = j["temperature_degc"].get<double>();
+  return c;
+}
+
+// What the result says about the absolute radius (the "calibration" block of caldaq.circle.v2).
+json calibration_block(const BallbarAnalysis& a) {
+  if (a.uncalibrated || !a.calibrated_radius_mm)
+    return {{"evaluated", false},
+            {"reason", a.uncalibrated_reason.empty() ? std::string("the bar was not calibrated")
+                                                     : a.uncalibrated_reason}};
+  json j{{"evaluated", true},
+         {"source",
+          a.calibration_source.empty() ? std::string("configuration") : a.calibration_source},
+         {"zero_length_mm", *a.calibrated_radius_mm}};
+  if (a.calibration) j["record"] = calibration_json(*a.calibration);
+  return j;
+}
+
+}  // namespace
+
+void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double radius_mm,
+                         const cal::storage::Store& store, std::int64_t at_unix_ms) {
+  if (a.uncalibrated || !a.calibration_source.empty()) return;
+  if (a.calibrated_radius_mm) {
+    a.calibration_source = "configuration";
+    return;
+  }
+  const std::string bar = c.circle ? c.circle->bar : std::string();
+  if (bar.empty()) {
+    a.uncalibrated = true;
+    a.uncalibrated_reason =
+        "no bar is named ([test.circle] bar) and no calibrated_radius_mm is given";
+    return;
+  }
+  if (auto cal = store.bar_calibration(bar, radius_mm, at_unix_ms)) {
+    a.calibrated_radius_mm = cal->zero_length_mm;
+    a.calibration_source = "stored";
+    a.calibration = std::move(cal);
+    return;
+  }
+  a.uncalibrated = true;
+  a.uncalibrated_reason = fmt::format(
+      "no calibration of bar '{}' at {:g} mm is stored (daq ballbar calibrate)", bar, radius_mm);
+}
+
+json circle_document(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
+                     const BallbarAnalysis& analysis) {
+  json j = circle_json(r, program.radius_mm, analysis.plane, program.feed_mm_per_min,
+                       cal::circle::circular_standard_from_key(analysis.standard));
+  j["calibration"] = calibration_block(analysis);
+  return j;
+}
+
+void print_circle_result(const cal::circle::Result& r, const cal::daq::BallbarProgram& program,
+                         const BallbarAnalysis& analysis) {
+  print_circle(r, program.radius_mm, analysis.plane, program.feed_mm_per_min,
+               cal::circle::circular_standard_from_key(analysis.standard));
+}
+
+std::string standard_label(const BallbarAnalysis& analysis) {
+  return cal::circle::info(cal::circle::circular_standard_from_key(analysis.standard)).label;
 }
 
 json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalysis& a) {
@@ -61,8 +157,13 @@ json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalys
          {"dwell_s", p.dwell_s},
          {"overshoot_deg", p.overshoot_deg},
          {"start_deg", p.start_deg},
+         {"arc_deg", p.arc_deg},
          {"plane", a.plane},
-         {"uncalibrated", a.uncalibrated}};
+         {"uncalibrated", a.uncalibrated},
+         {"standard", a.standard}};
+  if (!a.calibration_source.empty()) j["calibration_source"] = a.calibration_source;
+  if (a.calibration) j["calibration"] = calibration_json(*a.calibration);
+  if (!a.uncalibrated_reason.empty()) j["uncalibrated_reason"] = a.uncalibrated_reason;
   if (a.calibrated_radius_mm) j["calibrated_radius_mm"] = *a.calibrated_radius_mm;
   if (a.cyclic_period_mm) j["cyclic_period_mm"] = *a.cyclic_period_mm;
   return j;
@@ -75,24 +176,78 @@ std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(c
                              .feed_in_mm = j.at("feed_in_mm"),
                              .dwell_s = j.at("dwell_s"),
                              .overshoot_deg = j.at("overshoot_deg"),
-                             .start_deg = j.value("start_deg", 0.0)};
+                             .start_deg = j.value("start_deg", 0.0),
+                             .arc_deg = j.value("arc_deg", 360.0)};
+  // Runs stored before issue 18 have no standard: they were evaluated by ISO 230-4:2005.
   BallbarAnalysis a{.plane = j.value("plane", std::string("XY")),
-                    .uncalibrated = j.value("uncalibrated", false)};
+                    .uncalibrated = j.value("uncalibrated", false),
+                    .standard = j.value("standard", std::string("iso230-4:2005"))};
   if (j.contains("calibrated_radius_mm")) a.calibrated_radius_mm = j["calibrated_radius_mm"];
+  a.calibration_source = j.value("calibration_source", std::string());
+  if (j.contains("calibration") && j["calibration"].is_object())
+    a.calibration = calibration_from_json(j["calibration"]);
+  a.uncalibrated_reason = j.value("uncalibrated_reason", std::string());
+  // Runs stored before bar calibrations were recorded (issue 18): a length given in the
+  // configuration counts as such; none means the nominal was assumed, which is no calibration.
+  if (a.calibration_source.empty() && !a.uncalibrated) {
+    if (a.calibrated_radius_mm) {
+      a.calibration_source = "configuration";
+    } else {
+      a.uncalibrated = true;
+      a.uncalibrated_reason =
+          "stored without a calibrated length (the nominal was assumed): not a calibration";
+    }
+  }
   if (j.contains("cyclic_period_mm")) a.cyclic_period_mm = j["cyclic_period_mm"];
   return {p, a};
 }
 
-std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c) {
+std::vector<CircleTest> circle_tests(const cal::daq::Config& c, bool standard_set) {
   if (!c.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", c.source.string()));
   const auto& t = *c.circle;
-  BallbarAnalysis a{.plane = t.plane};
-  if (t.calibrated_radius_mm > 0) a.calibrated_radius_mm = t.calibrated_radius_mm;
-  return {cal::daq::BallbarProgram{.radius_mm = t.radius_mm,
-                                   .feed_mm_per_min = t.feed_mm_per_min,
-                                   .sample_rate_hz = t.sample_rate_hz,
-                                   .overshoot_deg = t.overshoot_deg},
-          a};
+  cal::daq::BallbarSetConfig set{
+      .feeds_mm_per_min =
+          t.feeds_mm_per_min.empty() ? std::vector<double>{t.feed_mm_per_min} : t.feeds_mm_per_min,
+      .radii_mm = t.radii_mm.empty() ? std::vector<double>{t.radius_mm} : t.radii_mm,
+      .partial_arc_deg = t.partial_arc_deg,
+      .overshoot_deg = t.overshoot_deg,
+      .partial_overshoot_deg = t.partial_overshoot_deg,
+      .sample_rate_hz = t.sample_rate_hz,
+      .feed_in_mm = t.feed_in_mm,
+      .dwell_s = t.dwell_s};
+  set.planes.clear();
+  if (!t.planes.empty())
+    for (const auto& p : t.planes) set.planes.push_back(cal::daq::plane_from_string(p));
+  else if (standard_set)
+    set.planes = {cal::daq::Plane::xy, cal::daq::Plane::zx, cal::daq::Plane::yz};
+  const bool single = set.planes.empty();
+  if (single) {
+    // One full circle in `plane`, as before sets existed (also in ZX and YZ: the operator's
+    // choice, e.g. on a machine where the spindle allows it).
+    set.planes = {cal::daq::plane_from_string(t.plane)};
+    set.partial_arc_deg = 360.0;
+  }
+  std::vector<CircleTest> out;
+  for (const auto& s : cal::daq::ballbar_set(set)) {
+    BallbarAnalysis a{.plane = cal::daq::plane_name(s.plane), .standard = t.standard};
+    if (t.calibrated_radius_mm > 0) a.calibrated_radius_mm = t.calibrated_radius_mm;
+    out.push_back({s.plane, s.program, a});
+  }
+  return out;
+}
+
+cal::daq::CircleProgramSetup circle_program_setup(const cal::daq::Config& c) {
+  if (!c.circle) throw cal::InputError(fmt::format("{}: no [test.circle]", c.source.string()));
+  const auto& t = *c.circle;
+  return {.centre_x_mm = t.centre_mm[0],
+          .centre_y_mm = t.centre_mm[1],
+          .centre_z_mm = t.centre_mm[2],
+          .plane = cal::daq::plane_from_string(t.plane)};
+}
+
+std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_test(const cal::daq::Config& c) {
+  const auto tests = circle_tests(c);
+  return {tests.front().program, tests.front().analysis};
 }
 
 std::string to_json_text(const CircleLive& s) {
@@ -123,6 +278,8 @@ struct CircleRun::Impl {
   CircleRunOutcome outcome;
   CircleLive live;
   bool running = false, done = false;
+  std::vector<CircleRunOutcome> completed;  // a set's tests before the current one
+  std::size_t next_test = 0;                // into setup.following
   // Handlers posted from the writer's thread run only while the run exists.
   std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
@@ -136,6 +293,24 @@ struct CircleRun::Impl {
 
   void start() {
     store.emplace(setup.database, setup.store_options);
+    begin_test();
+    running = true;
+    setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
+                          .state =
+                              [this](cal::drivers::InstrumentState s, std::string_view why) {
+                                if (s == cal::drivers::InstrumentState::closed && running)
+                                  abort(fmt::format("ballbar closed: {}", why));
+                              }});
+  }
+
+  // The stored run of the current test (setup.program, setup.analysis) and its writer.
+  void begin_test() {
+    resolve_calibration(setup.analysis, setup.config, setup.program.radius_mm, *store,
+                        setup.calibration_at_unix_ms
+                            ? setup.calibration_at_unix_ms
+                            : std::chrono::duration_cast<std::chrono::milliseconds>(
+                                  std::chrono::system_clock::now().time_since_epoch())
+                                  .count());
     const auto& c = setup.config;
     std::int64_t machine = 0;
     if (auto m = store->machine_by_name(c.machine_name))
@@ -149,6 +324,8 @@ struct CircleRun::Impl {
                               : json::parse(setup.context_json, nullptr, false);
     if (!settings["context"].is_object())
       settings["context"] = run_context(c, "circle", setup.analysis.plane);
+    // Where the table ball was: a circle's squareness is local to it (the three-plane table).
+    if (c.circle && c.circle->centre_mm.size() == 3) settings["centre_mm"] = c.circle->centre_mm;
     outcome.run_id = store->begin_run({.machine_id = machine,
                                        .campaign = c.campaign,
                                        .kind = "circle",
@@ -167,15 +344,13 @@ struct CircleRun::Impl {
             if (*alive) abort("storage failed: " + e);
           });
         });
-    running = true;
-    setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
-                          .state =
-                              [this](cal::drivers::InstrumentState s, std::string_view why) {
-                                if (s == cal::drivers::InstrumentState::closed && running)
-                                  abort(fmt::format("ballbar closed: {}", why));
-                              }});
-    event(fmt::format("run {}: ballbar circle R {} mm at {} mm/min, waiting for the feed-in",
-                      outcome.run_id, p.radius_mm, p.feed_mm_per_min));
+    outcome.program = setup.program;
+    outcome.analysis = setup.analysis;
+    const std::size_t tests = completed.size() + 1 + (setup.following.size() - next_test);
+    event(fmt::format("run {}: {}ballbar {} R {} mm at {} mm/min, waiting for the feed-in",
+                      outcome.run_id,
+                      tests > 1 ? fmt::format("test {} of {}: ", completed.size() + 1, tests) : "",
+                      setup.analysis.plane, p.radius_mm, p.feed_mm_per_min));
     // The live readout says the run waits even before the bar sends anything.
     if (setup.on_live) {
       live.state = "waiting";
@@ -207,7 +382,14 @@ struct CircleRun::Impl {
     trace(r.value * 1e6);
     if (!had && segmenter.feed_in_end()) event("feed-in found: the circle starts after the dwell");
     publish_live(r);
-    if (segmenter.complete()) boost::asio::post(io, [this] { finish(); });
+    if (!segmenter.complete()) return;
+    // A set's next test must see every reading after this one (a replay delivers them in
+    // bursts, the next feed-in may be among them): the switch is made now. The last test
+    // finishes from the loop, outside the instrument's handler.
+    if (next_test < setup.following.size())
+      finish();
+    else
+      boost::asio::post(io, [this] { finish(); });
   }
 
   // The live polar trace: a point per degree of each arc (the page draws it; the analysis
@@ -245,7 +427,9 @@ struct CircleRun::Impl {
   }
 
   void finish() {
-    if (done) return;
+    // Posted once per reading after the arcs: the first one finishes (a set's next test is
+    // not complete when the others arrive).
+    if (done || !segmenter.complete()) return;
     running = false;
     try {
       writer->flush();
@@ -264,20 +448,38 @@ struct CircleRun::Impl {
       prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
     }
     try {
-      store->add_result({.run_id = outcome.run_id,
-                         .standard = "ISO 230-4:2005",
-                         .json = circle_json(*outcome.result, setup.program.radius_mm,
-                                             setup.analysis.plane, setup.program.feed_mm_per_min)
-                                     .dump(),
-                         .provenance_json = prov.dump()});
+      store->add_result(
+          {.run_id = outcome.run_id,
+           .standard = standard_label(setup.analysis),
+           .json = circle_document(*outcome.result, setup.program, setup.analysis).dump(),
+           .provenance_json = prov.dump()});
       store->finish_run(outcome.run_id, cal::storage::RunStatus::complete);
     } catch (const std::exception& e) {
       outcome.result.reset();
       return abort(fmt::format("storage failed: {}", e.what()));
     }
     outcome.complete = true;
+    if (next_test < setup.following.size()) return next();
     publish_end("complete");
     end();
+  }
+
+  // A set's next test: a new run on the same bar stream, waiting for its feed-in.
+  void next() {
+    completed.push_back(std::move(outcome));
+    outcome = {};
+    auto& t = setup.following[next_test++];
+    setup.program = t.program;
+    setup.analysis = t.analysis;
+    segmenter = cal::daq::BallbarSegmenter(setup.program);
+    live = {};
+    writer.reset();
+    try {
+      begin_test();
+    } catch (const std::exception& e) {
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
+    running = true;
   }
 
   void abort(const std::string& reason) {
@@ -320,5 +522,6 @@ void CircleRun::start() { impl_->start(); }
 void CircleRun::stop(const std::string& reason) { impl_->abort(reason); }
 bool CircleRun::finished() const { return impl_->done; }
 const CircleRunOutcome& CircleRun::outcome() const { return impl_->outcome; }
+const std::vector<CircleRunOutcome>& CircleRun::completed() const { return impl_->completed; }
 
 }  // namespace daq

@@ -5,26 +5,22 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/daq/gcode.hpp"
+#include "circle_run.hpp"
 #include "linear_run.hpp"
 
 namespace daq {
 
 std::string part_program(const cal::daq::Config& config, std::string_view test,
-                         std::string_view dialect_name) {
+                         std::string_view dialect_name, const PartProgramOptions& o) {
   const auto dialect = cal::daq::dialect_from_string(dialect_name);
   if (test == "circle") {
     if (!config.circle)
       throw cal::InputError(fmt::format("{}: no [test.circle]", config.source.string()));
-    const auto& c = *config.circle;
-    return cal::daq::circle_program({.radius_mm = c.radius_mm,
-                                     .feed_mm_per_min = c.feed_mm_per_min,
-                                     .sample_rate_hz = c.sample_rate_hz,
-                                     .overshoot_deg = c.overshoot_deg},
-                                    {.centre_x_mm = c.centre_mm[0],
-                                     .centre_y_mm = c.centre_mm[1],
-                                     .centre_z_mm = c.centre_mm[2],
-                                     .plane = cal::daq::plane_from_string(c.plane)},
-                                    dialect);
+    std::vector<cal::daq::BallbarSetTest> set;
+    for (const auto& t : circle_tests(config, o.standard_set)) set.push_back({t.plane, t.program});
+    auto setup = circle_program_setup(config);
+    if (o.by_radius) setup.arcs = cal::daq::ArcForm::radius;
+    return cal::daq::circle_set_program(set, setup, dialect);
   }
   if (test == "linear") {
     if (!config.linear)

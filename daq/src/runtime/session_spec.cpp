@@ -189,7 +189,16 @@ json to_json(const cal::daq::Config& c) {
                    {"sample_rate_hz", ci.sample_rate_hz},
                    {"overshoot_deg", ci.overshoot_deg},
                    {"centre_mm", ci.centre_mm},
-                   {"calibrated_radius_mm", ci.calibrated_radius_mm}};
+                   {"calibrated_radius_mm", ci.calibrated_radius_mm},
+                   {"standard", ci.standard},
+                   {"planes", ci.planes},
+                   {"feeds_mm_per_min", ci.feeds_mm_per_min},
+                   {"radii_mm", ci.radii_mm},
+                   {"partial_arc_deg", ci.partial_arc_deg},
+                   {"partial_overshoot_deg", ci.partial_overshoot_deg},
+                   {"feed_in_mm", ci.feed_in_mm},
+                   {"dwell_s", ci.dwell_s},
+                   {"bar", ci.bar}};
   }
   return j;
 }
@@ -275,6 +284,17 @@ cal::daq::Config config_from_json(const json& j) {
     x.overshoot_deg = ci->value("overshoot_deg", x.overshoot_deg);
     x.centre_mm = ci->value("centre_mm", x.centre_mm);
     x.calibrated_radius_mm = ci->value("calibrated_radius_mm", x.calibrated_radius_mm);
+    // The ballbar set and the program's feed-in and dwell (captures since issue 18; older ones
+    // have the defaults their runs used).
+    x.standard = ci->value("standard", x.standard);
+    x.planes = ci->value("planes", x.planes);
+    x.feeds_mm_per_min = ci->value("feeds_mm_per_min", x.feeds_mm_per_min);
+    x.radii_mm = ci->value("radii_mm", x.radii_mm);
+    x.partial_arc_deg = ci->value("partial_arc_deg", x.partial_arc_deg);
+    x.partial_overshoot_deg = ci->value("partial_overshoot_deg", x.partial_overshoot_deg);
+    x.feed_in_mm = ci->value("feed_in_mm", x.feed_in_mm);
+    x.dwell_s = ci->value("dwell_s", x.dwell_s);
+    x.bar = ci->value("bar", x.bar);
     c.circle = x;
   }
   return c;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cal/analysis/error.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "ids3010/twin.hpp"
 #include "line_gauge/twin.hpp"
@@ -68,10 +69,20 @@ struct SimulatedShop::Impl {
                   .cyclic_amplitude_um = t.cyclic_amplitude_um,
                   .cyclic_period_mm = t.cyclic_period_mm,
                   .noise_um = t.noise_um};
-    c.servo[1].kv_per_s = t.kv_y_per_s;
-    c.servo[2].kv_per_s = 30.0;
+    c.servo[1] = {.kv_per_s = t.kv_y_per_s,
+                  .backlash_um = t.backlash_y_um,
+                  .cyclic_amplitude_um = t.cyclic_y_amplitude_um,
+                  .cyclic_period_mm = t.cyclic_y_period_mm,
+                  .noise_um = t.noise_yz_um};
+    c.servo[2] = {.kv_per_s = t.kv_z_per_s,
+                  .backlash_um = t.backlash_z_um,
+                  .cyclic_amplitude_um = t.cyclic_z_amplitude_um,
+                  .cyclic_period_mm = t.cyclic_z_period_mm,
+                  .noise_um = t.noise_yz_um};
     c.servo[0].kv_per_s = t.kv_x_per_s;
     c.geometry.squareness.c0y_urad = t.squareness_um_per_m;
+    c.geometry.squareness.b0z_urad = t.b0z_urad;
+    c.geometry.squareness.a0z_urad = t.a0z_urad;
     if (t.geometry) c.geometry = *t.geometry;
     c.thermal = {.start_degc = t.machine_degc, .expansion_ppm_per_k = t.expansion_ppm_per_k};
     c.acceleration_mm_per_s2 = 2000.0;
@@ -132,18 +143,18 @@ struct SimulatedShop::Impl {
                    // The probe point's deviation from the nominal line it is commanded on:
                    // where the axes stand off the command across the travel (a control's
                    // compensation moves them) plus the geometric error there.
-                   .value = [this](const sim::World& w) {
-                     const auto& st = w.state();
-                     return st.axes_mm[dir()] - st.commanded_mm[dir()] +
-                            probe_error().translation_um[dir()] * 1e-3;
-                   }}),
-        level(ctx, world, clock,
-              {.continuous = false,
-               .request = "?",
-               .decimals = 3,  // urad: 1 nrad digits
-               .value = [this](const sim::World&) {
-                 return probe_error().rotation_urad[axis()];
-               }}) {}
+                   .value =
+                       [this](const sim::World& w) {
+                         const auto& st = w.state();
+                         return st.axes_mm[dir()] - st.commanded_mm[dir()] +
+                                probe_error().translation_um[dir()] * 1e-3;
+                       }}),
+        level(
+            ctx, world, clock,
+            {.continuous = false,
+             .request = "?",
+             .decimals = 3,  // urad: 1 nrad digits
+             .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}) {}
 
   std::size_t axis() const { return test.axis == "Y" ? 1 : test.axis == "Z" ? 2 : 0; }
   std::size_t dir() const {
@@ -287,6 +298,63 @@ void SimulatedShop::run_circle(const cal::daq::BallbarProgram& p) {
   impl_->ballbar.set_streaming(true);  // the bar is mounted now
 }
 
+ShopTruth ShopTruth::three_planes() {
+  ShopTruth t;
+  t.b0z_urad = 15.0;    // alpha_ZX = -15 um/m
+  t.a0z_urad = -10.0;   // alpha_YZ = -10 um/m
+  t.kv_z_per_s = 29.4;  // Z lags X by 1/29.4 - 1/30 s = 0.680 ms, Z lags Y by 0.343 ms
+  t.backlash_y_um = 3.0, t.backlash_z_um = 2.0;
+  t.cyclic_y_amplitude_um = 0.8, t.cyclic_z_amplitude_um = 0.6;
+  t.noise_yz_um = t.noise_um;
+  return t;
+}
+
+void SimulatedShop::run_circle_set(std::span<const cal::daq::BallbarSetTest> tests) {
+  if (tests.empty()) throw cal::InputError("simulated ballbar set: no test");
+  const auto& c = impl_->truth.pivot_mm;
+  const sim::Vec3 centre{c[0], c[1], c[2]};
+  const auto sim_plane = [](cal::daq::Plane p) {
+    return p == cal::daq::Plane::zx   ? sim::Plane::zx
+           : p == cal::daq::Plane::yz ? sim::Plane::yz
+                                      : sim::Plane::xy;
+  };
+  // caldaq's angle in the plane: from its first axis towards the second (ZX: Z first).
+  const auto point = [&](cal::daq::Plane p, double deg, double r) {
+    const double a = deg * std::numbers::pi / 180, u = r * std::cos(a), v = r * std::sin(a);
+    if (p == cal::daq::Plane::zx) return sim::Vec3{c[0] + v, c[1], c[2] + u};
+    if (p == cal::daq::Plane::yz) return sim::Vec3{c[0], c[1] + u, c[2] + v};
+    return sim::Vec3{c[0] + u, c[1] + v, c[2]};
+  };
+  std::vector<sim::Move> program;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    const auto& [p, b] = tests[i];
+    const double out = b.radius_mm + b.feed_in_mm, feed = b.feed_mm_per_min;
+    if (i == 0) {
+      program.push_back(sim::Move::linear(point(p, b.start_deg, out), 3000.0));
+      program.push_back(sim::Move::dwell(0.5));
+    } else {
+      const auto& prev = tests[i - 1];
+      if (std::abs(prev.program.radius_mm + prev.program.feed_in_mm - out) > 1e-9)
+        throw cal::InputError("simulated ballbar set: one radius and feed-in only");
+      for (const auto& a :
+           cal::daq::ballbar_transition(prev.plane, prev.program.start_deg, p, b.start_deg))
+        if (std::abs(a.sweep_deg) > 1e-9)
+          program.push_back(sim::Move::arc(a.sweep_deg < 0, centre, sim_plane(a.plane),
+                                           std::abs(a.sweep_deg), feed));
+    }
+    const double sweep = b.arc_deg + 2 * b.overshoot_deg;
+    program.push_back(sim::Move::linear(point(p, b.start_deg, b.radius_mm), feed));  // feed-in
+    program.push_back(sim::Move::dwell(b.dwell_s));
+    program.push_back(sim::Move::arc(false, centre, sim_plane(p), sweep, feed));
+    program.push_back(sim::Move::dwell(b.dwell_s));
+    program.push_back(sim::Move::arc(true, centre, sim_plane(p), sweep, feed));
+    program.push_back(sim::Move::linear(point(p, b.start_deg, out), feed));  // feed-out
+  }
+  impl_->world.advance_to(now_s());
+  impl_->world.machine().load(program);
+  impl_->ballbar.set_streaming(true);
+}
+
 double SimulatedShop::program_end_s() const { return impl_->world.machine().program_duration_s(); }
 
 bool SimulatedShop::run_program(const std::function<bool()>& done, double margin_wall_s,
@@ -346,8 +414,9 @@ std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOpt
                 "# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {}x\n"
                 "# faster than real time). Valid while that process runs.\n",
                 o.speed);
-  return header + fmt::format(
-                      R"TOML(campaign = "simulated"
+  return header +
+         fmt::format(
+             R"TOML(campaign = "simulated"
 
 [machine]
 name = "SIMULATED VMC"
@@ -375,9 +444,7 @@ feed_mm_per_min = 6000
 dwell_s = 3
 
 [test.circle]
-plane = "XY"
-radius_mm = {radius}
-feed_mm_per_min = 1000
+{circle_tests}radius_mm = {radius}
 sample_rate_hz = 1000
 overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
@@ -397,19 +464,24 @@ G_um = 10
 squareness = 30
 backlash_X = 3
 )TOML",
-                      fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
-                      // In process the instruments read the shop's clock: every time is
-                      // simulated time; the poll periods of the drivers' defaults too.
-                      fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
-                                                            /*serial_numbers=*/true)),
-                      fmt::arg("alpha", t.expansion_ppm_per_k),
-                      fmt::arg("last_mm", 50 * (o.targets - 1)), fmt::arg("runs", o.runs),
-                      // Simulated seconds: at a high speed the wall-clock timers' jitter is
-                      // magnified, as in daq demo.
-                      fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
-                      fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
-                      fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
-                      fmt::arg("cz", t.pivot_mm[2]));
+             fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
+             // In process the instruments read the shop's clock: every time is
+             // simulated time; the poll periods of the drivers' defaults too.
+             fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
+                                                   /*serial_numbers=*/true)),
+             fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("last_mm", 50 * (o.targets - 1)),
+             fmt::arg("runs", o.runs),
+             // Simulated seconds: at a high speed the wall-clock timers' jitter is
+             // magnified, as in daq demo.
+             fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
+             fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
+             fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
+             fmt::arg("cz", t.pivot_mm[2]),
+             // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220
+             // deg over the top, each at a slow and a fast feed (docs/circle.md).
+             fmt::arg("circle_tests", o.circle_set ? "planes = [\"XY\", \"ZX\", \"YZ\"]\n"
+                                                     "feeds_mm_per_min = [1000, 3000]\n"
+                                                   : "plane = \"XY\"\nfeed_mm_per_min = 1000\n"));
 }
 
 }  // namespace daq

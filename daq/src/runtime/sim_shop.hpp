@@ -5,8 +5,8 @@
 // simulated time line running `speed` times faster than the wall clock. The real drivers
 // connect to the twins exactly as to hardware.
 #include <functional>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -15,6 +15,7 @@
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/daq/config.hpp"
+#include "cal/daq/gcode.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/drivers/sim/machine.hpp"
 
@@ -41,6 +42,19 @@ struct ShopTruth {
   double kv_x_per_s = 30.0, kv_y_per_s = 29.7;  // Y lags X by 0.337 ms
   std::array<double, 3> pivot_mm{150.0, 0.0, 0.0};
   double ballbar_mm = 100.0;
+  // The vertical planes (three_planes()): E_B0Z and E_A0Z (urad; the ballbar's alpha_ZX =
+  // -E_B0Z, alpha_YZ = +E_A0Z), Z's position loop, backlash and cyclic error of Y and Z.
+  double b0z_urad = 0.0, a0z_urad = 0.0;
+  double kv_z_per_s = 30.0;
+  double noise_yz_um = 0.0;  // Y's and Z's position noise (X's is noise_um)
+  double backlash_y_um = 0.0, backlash_z_um = 0.0;
+  double cyclic_y_amplitude_um = 0.0, cyclic_y_period_mm = 40.0;
+  double cyclic_z_amplitude_um = 0.0, cyclic_z_period_mm = 40.0;
+  // The truth of the three-plane set (`daq sim --test circle-set`): the above plus squareness
+  // in ZX and YZ, a slower Z loop, backlash and cyclic error on every axis. The cyclic errors
+  // share X's 40 mm period (screws of one pitch): the circle analysis fits one period per
+  // plane (docs/circle.md).
+  static ShopTruth three_planes();
   // All 21 geometric errors (sim_volumetric.hpp): when set, the machine's geometry is this
   // instead of the E_XX scale and E_C0Y above (the servo, thermal and air settings stay).
   std::optional<cal::kinematics::Machine> geometry;
@@ -88,6 +102,10 @@ class SimulatedShop {
   // The ballbar program in XY about the pivot: start feed_in_mm outside the radius at 0 deg,
   // move in, dwell, ccw arc of 360 + 2 overshoot, dwell, cw arc back, move out.
   void run_circle(const cal::daq::BallbarProgram& p);
+  // The ballbar set about the pivot (cal::daq::circle_set_program's moves: each test's feed-in,
+  // dwell, ccw and cw arcs and feed-out, and between tests the arcs on the sphere of
+  // R + feed-in). One radius only (a bar change needs an operator). Throws cal::InputError.
+  void run_circle_set(std::span<const cal::daq::BallbarSetTest> tests);
   double program_end_s() const;  // simulated time at which the loaded program ends
   // Runs the event loop until `done()` or until simulated time passes the program's end plus
   // `margin_wall_s` seconds of wall time (times the speed). Bounded by simulated, not wall,
@@ -129,6 +147,7 @@ struct ShopConfigOptions {
   // seconds; the full ISO 230-2 program (5 runs over 11 targets, 50 mm apart) takes minutes.
   int runs = 5;
   int targets = 11;
+  bool circle_set = false;  // [test.circle] is the standard set (daq sim --test circle-set)
 };
 std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o);
 

@@ -13,16 +13,20 @@ namespace cal::daq {
 
 BallbarSegmenter::BallbarSegmenter(BallbarProgram p) : p_(p) {
   if (!(p.radius_mm > 0) || !(p.feed_mm_per_min > 0) || !(p.sample_rate_hz > 0) ||
-      !(p.feed_in_mm > 0) || !(p.dwell_s >= 0) || !(p.overshoot_deg >= 0))
+      !(p.feed_in_mm > 0) || !(p.dwell_s >= 0) || !(p.overshoot_deg >= 0) ||
+      !std::isfinite(p.radius_mm + p.feed_mm_per_min + p.sample_rate_hz + p.feed_in_mm + p.dwell_s +
+                     p.overshoot_deg + p.start_deg + p.arc_deg))
     throw InputError(fmt::format(
         "ballbar program: radius {} mm, feed {} mm/min, rate {} Hz and feed-in {} mm must be > 0, "
-        "dwell {} s and overshoot {} deg >= 0",
+        "dwell {} s and overshoot {} deg >= 0, all finite",
         p.radius_mm, p.feed_mm_per_min, p.sample_rate_hz, p.feed_in_mm, p.dwell_s,
         p.overshoot_deg));
+  if (!(p.arc_deg >= 180.0 && p.arc_deg <= 360.0))
+    throw InputError(fmt::format("ballbar program: arc {} degrees must be 180..360", p.arc_deg));
 }
 
 double BallbarSegmenter::arc_duration_s() const {
-  const double sweep_rad = (360.0 + 2 * p_.overshoot_deg) * std::numbers::pi / 180.0;
+  const double sweep_rad = (p_.arc_deg + 2 * p_.overshoot_deg) * std::numbers::pi / 180.0;
   return sweep_rad * p_.radius_mm / (p_.feed_mm_per_min / 60.0);
 }
 
@@ -61,12 +65,12 @@ std::vector<circle::Trace> BallbarSegmenter::traces() const {
     const double s = k == 0 ? 1.0 : -1.0;
     circle::Trace t{k == 0 ? circle::Direction::ccw : circle::Direction::cw, {}, {}};
     const double first = arc_start_s + p_.overshoot_deg / rate_deg_s;
-    const double last = arc_start_s + (p_.overshoot_deg + 360.0) / rate_deg_s;
+    const double last = arc_start_s + (p_.overshoot_deg + p_.arc_deg) / rate_deg_s;
     for (auto i = static_cast<std::size_t>(std::ceil(first * p_.sample_rate_hz));
          static_cast<double>(i) < last * p_.sample_rate_hz; ++i) {
       const double t_s = static_cast<double>(i) / p_.sample_rate_hz;
-      // ccw starts at start_deg; cw starts where ccw ended (start + 360 + 2 overshoot).
-      const double start = k == 0 ? p_.start_deg : p_.start_deg + 360.0 + 2 * p_.overshoot_deg;
+      // ccw starts at start_deg; cw starts where ccw ended (start + arc + 2 overshoot).
+      const double start = k == 0 ? p_.start_deg : p_.start_deg + p_.arc_deg + 2 * p_.overshoot_deg;
       t.angle_deg.push_back(start + s * rate_deg_s * (t_s - arc_start_s));
       t.deviation_um.push_back(values_[*feed_in_end_ + i] * 1e3);
     }
@@ -107,11 +111,11 @@ BallbarProgress BallbarSegmenter::progress() const {
     out.angle_deg = p_.start_deg + rate_deg_s * (t_s - p_.dwell_s);
   } else if (t_s < 2 * p_.dwell_s + arc_s) {
     out.phase = BallbarPhase::dwell;
-    out.angle_deg = p_.start_deg + 360.0 + 2 * p_.overshoot_deg;
+    out.angle_deg = p_.start_deg + p_.arc_deg + 2 * p_.overshoot_deg;
   } else {
     out.phase = BallbarPhase::cw_arc;
-    out.angle_deg =
-        p_.start_deg + 360.0 + 2 * p_.overshoot_deg - rate_deg_s * (t_s - 2 * p_.dwell_s - arc_s);
+    out.angle_deg = p_.start_deg + p_.arc_deg + 2 * p_.overshoot_deg -
+                    rate_deg_s * (t_s - 2 * p_.dwell_s - arc_s);
   }
   return out;
 }

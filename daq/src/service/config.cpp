@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cal/analysis/air.hpp"
+#include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
@@ -449,7 +450,45 @@ CircleTestConfig read_circle(Table& t) {
                fmt::format("{} is not a finite position within +-{} mm", v, kMaxPositionMm));
     c.centre_mm = centre;
   }
-  t.in_range("calibrated_radius_mm", c.calibrated_radius_mm, 0, 5000, "mm");
+  t.in_range("calibrated_radius_mm", c.calibrated_radius_mm, 0, 5000, "mm");  // 0: not given
+  if (const auto* n = t.node("planes")) {
+    t.known("planes");
+    const auto* arr = n->as_array();
+    if (!arr || arr->empty())
+      t.fail(n, "planes", "expected an array of planes, e.g. [\"XY\", \"ZX\", \"YZ\"]");
+    for (const auto& e : *arr) {
+      const auto v = e.value<std::string>();
+      if (!v || (*v != "XY" && *v != "ZX" && *v != "YZ"))
+        t.fail(&e, "planes", "each plane is \"XY\", \"ZX\" or \"YZ\" (G17, G18, G19)");
+      if (std::find(c.planes.begin(), c.planes.end(), *v) != c.planes.end())
+        t.fail(&e, "planes", fmt::format("plane {} given twice", *v));
+      c.planes.push_back(*v);
+    }
+  }
+  for (const char* key : {"feeds_mm_per_min", "radii_mm"}) {
+    auto values = t.numbers(key);
+    const bool radii = std::string_view(key) == "radii_mm";
+    for (double v : values)
+      t.check_range(key, v, 0, radii ? 5000 : kMaxFeedMmPerMin, radii ? "mm" : "mm/min", true);
+    (radii ? c.radii_mm : c.feeds_mm_per_min) = std::move(values);
+  }
+  t.in_range("partial_arc_deg", c.partial_arc_deg, 180, 360, "deg");
+  t.in_range("partial_overshoot_deg", c.partial_overshoot_deg, 0, 45, "deg");
+  t.in_range("feed_in_mm", c.feed_in_mm, 0, 100, "mm", true);
+  t.in_range("dwell_s", c.dwell_s, 0, kMaxDwellS, "s", true);
+  t.name("bar", c.bar);
+  if (!c.planes.empty() && t.node("plane"))
+    t.fail(t.node("plane"), "plane", "give plane (one test) or planes (a set), not both");
+  if (c.radii_mm.size() > 1 && c.calibrated_radius_mm > 0)
+    t.fail(t.node("calibrated_radius_mm"), "calibrated_radius_mm",
+           "one calibrated length cannot serve several radii: store a calibration per bar and "
+           "radius (daq ballbar calibrate) and name the bar");
+  t.read("standard", c.standard);
+  try {
+    cal::circle::circular_standard_from_key(c.standard);
+  } catch (const InputError& e) {
+    t.fail(t.node("standard"), "standard", e.what());
+  }
   t.check_unknown();
   return c;
 }
@@ -481,10 +520,11 @@ AxisTolerance read_axis_tolerance(Table& t) {
 
 // The diagnostics a circle in plane UV can report (cal::circle: Diagnostic::key).
 bool circle_diagnostic(std::string_view plane, std::string_view key) {
-  for (const char* k : {"radius_error", "scale_mismatch", "squareness", "servo_mismatch"})
+  for (const char* k :
+       {"radius_error", "scale_mismatch", "squareness", "servo_mismatch", "vibration"})
     if (key == k) return true;
-  for (const char* prefix :
-       {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_", "straightness_"}) {
+  for (const char* prefix : {"backlash_", "lateral_play_", "reversal_spike_", "cyclic_",
+                             "straightness_", "stick_slip_"}) {
     const std::string_view p(prefix);
     if (key.size() == p.size() + 1 && key.substr(0, p.size()) == p &&
         plane.find(key.back()) != std::string_view::npos)
@@ -502,8 +542,9 @@ CircleTolerance read_circle_tolerance(Table& t, std::string_view plane) {
       if (!circle_diagnostic(plane, k.str()))
         dt.fail(&v, k.str(),
                 fmt::format("not a diagnostic of a circle in {} (radius_error, scale_mismatch, "
-                            "squareness, servo_mismatch, backlash_{}, cyclic_{}, ...)",
-                            plane, plane.substr(0, 1), plane.substr(0, 1)));
+                            "squareness, servo_mismatch, vibration, backlash_{}, cyclic_{}, "
+                            "stick_slip_{}, ...)",
+                            plane, plane.substr(0, 1), plane.substr(0, 1), plane.substr(0, 1)));
       c.diagnostics[std::string(k.str())] = *limit(dt, k.str());
     }
     dt.check_unknown();

@@ -1,4 +1,4 @@
-// Part programs (see gcode.hpp; the syntax of each dialect and its sources: docs/acquisition.md).
+// Part programs (see gcode.hpp; the syntax of each dialect and its sources: docs/circle.md).
 #include "cal/daq/gcode.hpp"
 
 #include <fmt/format.h>
@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -207,64 +208,279 @@ std::string linear_program(const iso230_2::Plan& plan, const LinearProgram& p, D
   return w.text();
 }
 
-std::string circle_program(const BallbarProgram& b, const CircleProgramSetup& s, Dialect d) {
-  BallbarSegmenter check(b);  // the same validation of the program's numbers
-  check_name(s.name);
-  check_feed_dwell(b.feed_mm_per_min, std::max(b.dwell_s, 1e-3));
-  checked(b.radius_mm + b.feed_in_mm, "radius");
-  if (!(b.overshoot_deg <= 180))
-    throw InputError(fmt::format("program: overshoot {} deg is over 180", b.overshoot_deg));
-  const PlaneFrame f = frame(s);
-  Writer w{d, s.fanuc_dwell, s.plane, {}, 0};
-  w.begin(s.name, fmt::format("ballbar circle R {} mm at F{}, overshoot {} deg", num(b.radius_mm),
-                              std::lround(b.feed_mm_per_min), num(b.overshoot_deg)));
-  // A point of the circle (or of the feed-in line) at an angle from the plane's first axis.
-  auto point = [&](double angle_deg, double r) {
-    const double a = angle_deg * std::numbers::pi / 180.0;
-    return std::pair{f.cu + r * std::cos(a), f.cv + r * std::sin(a)};
-  };
-  auto words = [&](std::pair<double, double> p) {
-    return pair_words(d, f.u, p.first, f.v, p.second);
-  };
-  const auto outside = point(b.start_deg, b.radius_mm + b.feed_in_mm);
-  w.line_to(words(outside), b.feed_mm_per_min);
-  w.line_to(words(point(b.start_deg, b.radius_mm)), b.feed_mm_per_min);  // feed-in
-  w.dwell(b.dwell_s);
-  const bool by_centre = s.arcs == ArcForm::centre;
-  if (d == Dialect::heidenhain && by_centre)
-    w.add(fmt::format("CC {}", pair_words(d, f.u, f.cu, f.v, f.cv)));
-  const double sweep = 360.0 + 2 * b.overshoot_deg;
-  const double max_piece_deg = by_centre ? 180.0 : 90.0;
-  const std::string feed = w.feed(b.feed_mm_per_min);
-  auto arcs = [&](bool ccw, double from_deg) {
-    const int pieces = static_cast<int>(std::ceil(sweep / max_piece_deg - 1e-9));
+namespace {
+
+constexpr double deg = std::numbers::pi / 180.0;
+
+// The plane's frame in 3D: the unit vectors of its first and second axis (x, y, z).
+using V3 = std::array<double, 3>;
+std::pair<V3, V3> axes_of(Plane p) {
+  switch (p) {
+    case Plane::zx:
+      return {V3{0, 0, 1}, V3{1, 0, 0}};
+    case Plane::yz:
+      return {V3{0, 1, 0}, V3{0, 0, 1}};
+    case Plane::xy:
+    default:
+      return {V3{1, 0, 0}, V3{0, 1, 0}};
+  }
+}
+V3 direction(Plane p, double angle_deg) {
+  const auto [eu, ev] = axes_of(p);
+  const double c = std::cos(angle_deg * deg), n = std::sin(angle_deg * deg);
+  return {c * eu[0] + n * ev[0], c * eu[1] + n * ev[1], c * eu[2] + n * ev[2]};
+}
+double angle_in(Plane p, const V3& dir) {
+  const auto [eu, ev] = axes_of(p);
+  const auto dot = [](const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  return std::atan2(dot(dir, ev), dot(dir, eu)) / deg;
+}
+// The angle of -Z in a vertical plane (the bottom of its circle, under the table ball), or
+// none for XY.
+std::optional<double> bottom_deg(Plane p) {
+  if (p == Plane::zx) return 180.0;
+  if (p == Plane::yz) return -90.0;
+  return std::nullopt;
+}
+double wrap360(double a) { return std::fmod(std::fmod(a, 360.0) + 360.0, 360.0); }
+
+// One arc of a transition: in `plane`, from one angle, by a signed sweep (+ ccw).
+struct ArcMove {
+  Plane plane;
+  double from_deg, sweep_deg;
+};
+
+// The arc from a to b in a plane that does not pass under the ball (vertical planes), else the
+// shorter way round.
+ArcMove arc_between(Plane p, double a, double b) {
+  const double ccw = wrap360(b - a), cw = ccw - 360.0;
+  if (ccw < 1e-9) return {p, a, 0.0};
+  if (const auto bottom = bottom_deg(p)) {
+    const bool ccw_passes = wrap360(*bottom - a) > 1e-9 && wrap360(*bottom - a) < ccw - 1e-9;
+    return {p, a, ccw_passes ? cw : ccw};
+  }
+  return {p, a, ccw <= 180.0 ? ccw : cw};
+}
+
+// From (p1, a1) to (p2, a2) on the sphere about the ball: one arc in a shared plane, or two
+// through a pole on the axis the planes share (+X or -X for XY/ZX, +Y or -Y for XY/YZ, +Z for
+// ZX/YZ: -Z is under the ball), the pair with the smaller total sweep.
+std::vector<ArcMove> transition(Plane p1, double a1, Plane p2, double a2) {
+  if (p1 == p2) return {arc_between(p1, a1, a2)};
+  const V3 target = direction(p2, a2);
+  const auto [u1, v1] = axes_of(p1);
+  const auto [u2, v2] = axes_of(p2);
+  // The target on p1's circle already (e.g. a pole): one arc.
+  const double along = std::abs(target[0] * (u1[1] * v1[2] - u1[2] * v1[1]) +
+                                target[1] * (u1[2] * v1[0] - u1[0] * v1[2]) +
+                                target[2] * (u1[0] * v1[1] - u1[1] * v1[0]));
+  if (along < 1e-12) return {arc_between(p1, a1, angle_in(p1, target))};
+  V3 shared{};
+  for (int k = 0; k < 3; ++k)
+    shared[static_cast<std::size_t>(k)] =
+        (u1[static_cast<std::size_t>(k)] + v1[static_cast<std::size_t>(k)]) *
+                    (u2[static_cast<std::size_t>(k)] + v2[static_cast<std::size_t>(k)]) >
+                0
+            ? 1.0
+            : 0.0;
+  std::vector<ArcMove> best;
+  double best_cost = 1e300;
+  for (double sign : {1.0, -1.0}) {
+    const V3 pole{sign * shared[0], sign * shared[1], sign * shared[2]};
+    if (pole[2] < 0) continue;  // under the ball
+    const ArcMove first = arc_between(p1, a1, angle_in(p1, pole));
+    const ArcMove second = arc_between(p2, angle_in(p2, pole), a2);
+    const double cost = std::abs(first.sweep_deg) + std::abs(second.sweep_deg);
+    if (cost < best_cost) best_cost = cost, best = {first, second};
+  }
+  return best;
+}
+
+class CircleWriter {
+ public:
+  CircleWriter(Writer& w, const CircleProgramSetup& s) : w_(w), s_(s) {}
+
+  // A point at an angle of a plane at a distance from the table ball, as the plane's two words.
+  std::string words(Plane p, double angle_deg, double r) const {
+    const PlaneFrame f = frame_of(p);
+    const double a = angle_deg * deg;
+    return pair_words(w_.d, f.u, f.cu + r * std::cos(a), f.v, f.cv + r * std::sin(a));
+  }
+
+  void plane(Plane p) {
+    if (w_.d != Dialect::heidenhain && p != w_.plane) w_.add(plane_word(w_.d, p));
+    w_.plane = p;
+  }
+
+  // Arcs of radius r in plane p from an angle by a signed sweep, in pieces of at most 180 deg
+  // (by centre) or 90 deg (by radius). Returns the end angle.
+  double arcs(Plane p, double from_deg, double sweep_deg, double r, double feed) {
+    if (std::abs(sweep_deg) < 1e-9) return from_deg;
+    plane(p);
+    const PlaneFrame f = frame_of(p);
+    const bool by_centre = s_.arcs == ArcForm::centre, ccw = sweep_deg > 0;
+    if (w_.d == Dialect::heidenhain && by_centre && (!cc_ || *cc_ != p)) {
+      w_.add(fmt::format("CC {}", pair_words(w_.d, f.u, f.cu, f.v, f.cv)));
+      cc_ = p;
+    }
+    const double max_piece_deg = by_centre ? 180.0 : 90.0;
+    const int pieces = static_cast<int>(std::ceil(std::abs(sweep_deg) / max_piece_deg - 1e-9));
+    const std::string fw = w_.feed(feed);
     double at = from_deg;
     for (int k = 0; k < pieces; ++k) {
-      const double next = at + (ccw ? 1 : -1) * sweep / pieces;
-      const auto [fu, fv] = point(at, b.radius_mm);
-      const std::string end = words(point(next, b.radius_mm));
-      const std::string g = d == Dialect::fanuc ? (ccw ? "G03" : "G02") : (ccw ? "G3" : "G2");
+      const double next = at + sweep_deg / pieces;
+      const double a = at * deg;
+      const double fu = f.cu + r * std::cos(a), fv = f.cv + r * std::sin(a);
+      const std::string end = words(p, next, r);
+      const std::string g = w_.d == Dialect::fanuc ? (ccw ? "G03" : "G02") : (ccw ? "G3" : "G2");
       const std::string dr = ccw ? "DR+" : "DR-";
       // Every piece is at most 180 degrees: the radius is written positive in all dialects.
-      if (d == Dialect::heidenhain)
-        w.add(by_centre ? fmt::format("C {} {} {}", end, dr, feed)
-                        : fmt::format("CR {} R{} {} {}", end, signed_num(b.radius_mm), dr, feed));
+      if (w_.d == Dialect::heidenhain)
+        w_.add(by_centre ? fmt::format("C {} {} {}", end, dr, fw)
+                         : fmt::format("CR {} R{} {} {}", end, signed_num(r), dr, fw));
       else if (!by_centre)
-        w.add(fmt::format("{} {} {}{} {}", g, end,
-                          d == Dialect::fanuc ? "R" : "CR=", num(b.radius_mm), feed));
+        w_.add(
+            fmt::format("{} {} {}{} {}", g, end, w_.d == Dialect::fanuc ? "R" : "CR=", num(r), fw));
       else
-        w.add(fmt::format("{} {} {} {}", g, end, centre_words(d, f.u, f.cu - fu, f.v, f.cv - fv),
-                          feed));
+        w_.add(fmt::format("{} {} {} {}", g, end,
+                           centre_words(w_.d, f.u, f.cu - fu, f.v, f.cv - fv), fw));
       at = next;
     }
     return at;
-  };
-  const double end_ccw = arcs(true, b.start_deg);
-  w.dwell(b.dwell_s);
-  arcs(false, end_ccw);
-  w.line_to(words(outside), b.feed_mm_per_min);  // feed-out
+  }
+
+  void comment(const std::string& text) {
+    if (w_.d == Dialect::fanuc)
+      w_.add("(" + text + ")");
+    else
+      w_.add("; " + text);
+  }
+
+  void stop() { w_.add(w_.d == Dialect::fanuc ? "M00" : w_.d == Dialect::siemens ? "M0" : "STOP"); }
+
+ private:
+  PlaneFrame frame_of(Plane p) const {
+    CircleProgramSetup s = s_;
+    s.plane = p;
+    return frame(s);
+  }
+  Writer& w_;
+  const CircleProgramSetup& s_;
+  std::optional<Plane> cc_;
+};
+
+std::string upper(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+std::vector<SetArc> ballbar_transition(Plane p1, double a1_deg, Plane p2, double a2_deg) {
+  std::vector<SetArc> out;
+  for (const auto& m : transition(p1, a1_deg, p2, a2_deg))
+    out.push_back({m.plane, m.from_deg, m.sweep_deg});
+  return out;
+}
+
+std::string plane_name(Plane p) { return p == Plane::zx ? "ZX" : p == Plane::yz ? "YZ" : "XY"; }
+
+std::vector<BallbarSetTest> ballbar_set(const BallbarSetConfig& c) {
+  if (c.planes.empty() || c.feeds_mm_per_min.empty() || c.radii_mm.empty())
+    throw InputError("ballbar set: give at least one plane, one feed and one radius");
+  if (!(c.partial_arc_deg >= 180.0 && c.partial_arc_deg <= 360.0))
+    throw InputError(
+        fmt::format("ballbar set: partial arc {} degrees must be 180..360", c.partial_arc_deg));
+  std::vector<BallbarSetTest> out;
+  for (double r : c.radii_mm)
+    for (Plane p : c.planes)
+      for (double f : c.feeds_mm_per_min) {
+        BallbarProgram b{.radius_mm = r,
+                         .feed_mm_per_min = f,
+                         .sample_rate_hz = c.sample_rate_hz,
+                         .feed_in_mm = c.feed_in_mm,
+                         .dwell_s = c.dwell_s};
+        if (p == Plane::xy || c.partial_arc_deg >= 360.0) {
+          b.overshoot_deg = c.overshoot_deg;
+          b.start_deg = 0.0;
+          b.arc_deg = 360.0;
+        } else {
+          // Symmetric about +Z, which is at 0 deg in ZX (Z first) and 90 deg in YZ.
+          const double top = p == Plane::zx ? 0.0 : 90.0;
+          b.overshoot_deg = c.partial_overshoot_deg;
+          b.arc_deg = c.partial_arc_deg;
+          b.start_deg = top - c.partial_arc_deg / 2 - c.partial_overshoot_deg;
+        }
+        BallbarSegmenter check(b);  // the same validation as a single test
+        out.push_back({p, b});
+      }
+  return out;
+}
+
+std::string circle_set_program(std::span<const BallbarSetTest> tests, const CircleProgramSetup& s,
+                               Dialect d) {
+  if (tests.empty()) throw InputError("program: the ballbar set has no test");
+  check_name(s.name);
+  for (const auto& t : tests) {
+    const auto& b = t.program;
+    BallbarSegmenter check(b);  // validates the numbers
+    check_feed_dwell(b.feed_mm_per_min, std::max(b.dwell_s, 1e-3));
+    checked(b.radius_mm + b.feed_in_mm, "radius");
+    if (!(b.overshoot_deg <= 180))
+      throw InputError(fmt::format("program: overshoot {} deg is over 180", b.overshoot_deg));
+  }
+  const bool set = tests.size() > 1;
+  Writer w{d, s.fanuc_dwell, tests.front().plane, {}, 0};
+  const auto& b0 = tests.front().program;
+  w.begin(
+      s.name,
+      set ? fmt::format("ballbar set of {} tests (docs/circle.md, the standard set)", tests.size())
+          : fmt::format("ballbar circle R {} mm at F{}, overshoot {} deg", num(b0.radius_mm),
+                        std::lround(b0.feed_mm_per_min), num(b0.overshoot_deg)));
+  CircleWriter c(w, s);
+  // Where the tool is: plane, angle and distance from the ball (after the first move).
+  Plane at_plane = tests.front().plane;
+  double at_deg = b0.start_deg, at_r = 0.0;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    const auto& [p, b] = tests[i];
+    const double out_r = b.radius_mm + b.feed_in_mm;
+    if (set)
+      c.comment(upper(fmt::format("test {} of {}: {} {:g} deg R{} F{}", i + 1, tests.size(),
+                                  plane_name(p), b.arc_deg, num(b.radius_mm),
+                                  std::lround(b.feed_mm_per_min))));
+    if (i == 0) {
+      w.line_to(c.words(p, b.start_deg, out_r), b.feed_mm_per_min);
+    } else {
+      if (std::abs(out_r - at_r) > 1e-9) {  // another bar: off, out along the radius, on
+        c.comment(
+            upper(fmt::format("remove the R{} bar", num(at_r - tests[i - 1].program.feed_in_mm))));
+        c.stop();
+        c.plane(at_plane);
+        w.line_to(c.words(at_plane, at_deg, out_r), b.feed_mm_per_min);
+        c.comment(upper(fmt::format("fit the R{} bar", num(b.radius_mm))));
+        c.stop();
+      }
+      // On the sphere of the feed-in distance about the ball: the bar stays on.
+      for (const auto& m : transition(at_plane, at_deg, p, b.start_deg))
+        c.arcs(m.plane, m.from_deg, m.sweep_deg, out_r, b.feed_mm_per_min);
+    }
+    c.plane(p);
+    w.line_to(c.words(p, b.start_deg, b.radius_mm), b.feed_mm_per_min);  // feed-in
+    w.dwell(b.dwell_s);
+    const double sweep = b.arc_deg + 2 * b.overshoot_deg;
+    const double end_ccw = c.arcs(p, b.start_deg, sweep, b.radius_mm, b.feed_mm_per_min);
+    w.dwell(b.dwell_s);
+    c.arcs(p, end_ccw, -sweep, b.radius_mm, b.feed_mm_per_min);
+    w.line_to(c.words(p, b.start_deg, out_r), b.feed_mm_per_min);  // feed-out
+    at_plane = p, at_deg = b.start_deg, at_r = out_r;
+  }
   w.end(s.name);
   return w.text();
+}
+
+std::string circle_program(const BallbarProgram& b, const CircleProgramSetup& s, Dialect d) {
+  const BallbarSetTest one{s.plane, b};
+  return circle_set_program(std::span(&one, 1), s, d);
 }
 
 }  // namespace cal::daq

@@ -16,8 +16,9 @@
 //   machine (each term derived in circle.cpp): centre offset, radius error, scale mismatch,
 //   squareness, servo mismatch (a time lag between the axes), backlash and lateral play per
 //   axis, reversal spikes per axis, cyclic error per axis, straightness (a bow of each axis
-//   along the other). Each is reported with the peak-to-valley of its fitted contribution
-//   and its share of the circularity, ranked.
+//   along the other); and from the residual of that model, stick-slip per axis and a vibration
+//   (caldaq's own definitions, circle_dynamics.cpp). Each is reported with the peak-to-valley
+//   of its fitted contribution and its share of the circularity, ranked.
 //
 // Units: angles in degrees in the interface, lengths mm (radius) and um (deviations).
 #include <optional>
@@ -43,7 +44,10 @@ struct Setup {
   // Cyclic-error period along the axes: fixed, or searched over [min, max] when unset.
   std::optional<double> cyclic_period_mm;
   double cyclic_search_min_mm = 2.0, cyclic_search_max_mm = 40.0;
-  double spike_decay_deg = 6.0;   // decay angle of a reversal spike
+  double spike_decay_deg = 6.0;  // decay angle of a reversal spike
+  // Stick-slip: the window about each reversal of an axis, in degrees (the axis moves slower
+  // than feed * sin(window) there); 1 < window <= 45.
+  double stick_slip_window_deg = 10.0;
   bool radius_calibrated = true;  // the bar length is known (calibrator): radius error valid
   // The bar length at which deviation_um reads 0 (the calibrated length of the bar); unset: the
   // nominal radius. The deviation from the nominal radius is deviation_um + (this - radius_mm).
@@ -90,6 +94,7 @@ struct Diagnostic {
   // G_bi minus the G_bi of the traces with this contribution removed (LSQ circle refitted):
   // what correcting this error alone would gain. Can be negative.
   double g_reduction_um = 0;
+  std::optional<double> frequency_hz;  // a vibration's frequency
 };
 
 struct Result {

@@ -5,8 +5,9 @@
 // A ballbar has no angle sensor, so the test program's timing is the reference, as in the
 // usual ballbar procedure: the machine starts `feed_in_mm` outside the radius, moves in along
 // the radius (the bar shortens by feed_in_mm), dwells `dwell_s`, runs the counter-clockwise
-// arc (overshoot + 360 + overshoot degrees) at the feed, dwells again, runs the clockwise arc
-// back, and moves out. The stage finds the end of the feed-in (the reading settles near zero
+// arc (overshoot + arc + overshoot degrees; the arc is 360 for a full circle, e.g. 220 for the
+// partial arcs of the vertical planes) at the feed, dwells again, runs the clockwise arc back,
+// and moves out. The stage finds the end of the feed-in (the reading settles near zero
 // after having been near +feed_in), then every later sample's angle follows from the sample
 // rate, the dwell, the feed and the radius; the overshoot arcs (acceleration, reversal) are
 // trimmed. Samples are timed by their index at the gauge's fixed rate, not by the arrival of
@@ -27,7 +28,8 @@ struct BallbarProgram {
   double feed_in_mm = 1.5;
   double dwell_s = 1.0;
   double overshoot_deg = 45.0;
-  double start_deg = 0.0;  // angle of the start point, from the first axis
+  double start_deg = 0.0;  // angle of the start point (the ccw move's start), from the first axis
+  double arc_deg = 360.0;  // the measured arc, 180..360; the moves add the overshoot both sides
 };
 
 // Where the stream is in the program, for the operator's display.

@@ -84,6 +84,8 @@ struct LinearTestConfig {
   MeasureConfig measure;
 };
 
+// One ballbar test ([test.circle] with `plane`), or a set of them (`planes`, and optionally
+// several feeds and radii: docs/config.md, docs/circle.md "The standard set").
 struct CircleTestConfig {
   std::string plane = "XY";
   double radius_mm = 100.0;
@@ -91,7 +93,17 @@ struct CircleTestConfig {
   double sample_rate_hz = 1000.0;
   double overshoot_deg = 45.0;
   std::vector<double> centre_mm{0.0, 0.0, 0.0};
-  double calibrated_radius_mm = 0.0;  // 0: the nominal
+  double calibrated_radius_mm = 0.0;       // 0: from a stored calibration of `bar`, else none
+  std::string standard = "iso230-4:2005";  // cal::circle::circular_standard_from_key
+  // The set: planes in order (empty: the single test of `plane`), feeds and radii (empty: the
+  // single feed_mm_per_min and radius_mm), the partial arc of ZX and YZ and its overshoot.
+  std::vector<std::string> planes;
+  std::vector<double> feeds_mm_per_min, radii_mm;
+  double partial_arc_deg = 220.0;
+  double partial_overshoot_deg = 10.0;
+  double feed_in_mm = 1.5;
+  double dwell_s = 1.0;
+  std::string bar;  // the bar's identity, for its stored calibrations (daq ballbar calibrate)
 };
 
 // Who the test is for and where ([customer]).

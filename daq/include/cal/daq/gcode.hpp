@@ -1,6 +1,6 @@
 #pragma once
-// Part programs for the tests, in the dialects of the common controls (docs/acquisition.md has
-// the syntax of each and where it comes from):
+// Part programs for the tests, in the dialects of the common controls (docs/circle.md, "The
+// standard set and its part program", has the syntax of each and where it comes from):
 // - Fanuc / ISO 6983: G90 G01 X.. F..; dwell G04 P<ms> (P counts ms, no decimal point) or
 //   G04 X<s> (seconds, decimal point); arcs G02 (cw) / G03 (ccw) with the incremental centre
 //   I J (G17), I K (G18) or J K (G19), or with R (+ for arcs up to 180 degrees); M30.
@@ -14,8 +14,10 @@
 // dwells, runs the ccw circle with its overshoot arcs before and after, dwells, runs the cw
 // circle back, and feeds out, matching BallbarSegmenter. Numbers are written with 4 decimals
 // (0.1 um: below any machine's programming resolution, so nothing is rounded twice).
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/daq/ballbar.hpp"
@@ -67,5 +69,53 @@ struct CircleProgramSetup {
 // By centre, arcs are split into pieces of at most 180 degrees (a full circle in one block is
 // not portable between controls); by radius, at most 90 degrees (see ArcForm).
 std::string circle_program(const BallbarProgram& b, const CircleProgramSetup& s, Dialect d);
+
+std::string plane_name(Plane p);  // "XY", "ZX", "YZ"
+
+// One test of a ballbar set: its plane and its program (radius, feed, arc, start, overshoot).
+struct BallbarSetTest {
+  Plane plane = Plane::xy;
+  BallbarProgram program;
+};
+
+// The standard set (docs/circle.md, "The standard set"; the numbers are caldaq's defaults, not a
+// standard's: public material gives no template): for each radius, each plane, each feed in
+// that order. XY is a full circle measured from 0 deg (the ccw move starts there, as a single
+// test's); ZX and YZ are partial arcs of partial_arc_deg symmetric about +Z (the spindle is in
+// the way of a full circle below the ball): ZX (Z first) measures -110..110 deg, YZ -20..200
+// deg for 220 deg, each with partial_overshoot_deg before and after.
+struct BallbarSetConfig {
+  std::vector<Plane> planes{Plane::xy, Plane::zx, Plane::yz};
+  std::vector<double> feeds_mm_per_min{1000.0};
+  std::vector<double> radii_mm{100.0};
+  double partial_arc_deg = 220.0;
+  double overshoot_deg = 45.0;          // full circles
+  double partial_overshoot_deg = 10.0;  // partial arcs: the tool stays above 30 deg below the ball
+  double sample_rate_hz = 1000.0;
+  double feed_in_mm = 1.5;
+  double dwell_s = 1.0;
+};
+std::vector<BallbarSetTest> ballbar_set(const BallbarSetConfig& c);  // throws InputError
+
+// The whole set in one program. Each test as circle_program writes one (feed-in, dwell, ccw
+// arc with its overshoots, dwell, cw arc back, feed-out), with a comment naming it. Between
+// tests the tool moves on the sphere of radius R + feed-in about the ball, so the bar stays
+// on (the bar reads +feed-in throughout; the next feed-in starts the next test): one arc when
+// both lie in one plane, else two through a pole on the axis the planes share (+-X between XY
+// and ZX, +-Y between XY and YZ, +Z between ZX and YZ), never under the ball. Where the radius
+// changes, the program stops (M00 / M0 / STOP) for the bar to come off, moves out along the
+// radius to the new R + feed-in, and stops again for the new bar.
+std::string circle_set_program(std::span<const BallbarSetTest> tests, const CircleProgramSetup& s,
+                               Dialect d);
+
+// One arc of the path between two tests on the sphere about the ball: in `plane`, from an
+// angle (caldaq's, from the plane's first axis towards the second) by a signed sweep (+ ccw).
+struct SetArc {
+  Plane plane = Plane::xy;
+  double from_deg = 0.0, sweep_deg = 0.0;
+};
+// The arcs circle_set_program writes from (p1, a1) to (p2, a2) on the sphere (the same path, so
+// that the simulated machine runs what the program says).
+std::vector<SetArc> ballbar_transition(Plane p1, double a1_deg, Plane p2, double a2_deg);
 
 }  // namespace cal::daq

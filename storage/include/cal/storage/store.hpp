@@ -28,8 +28,8 @@ class StoreError : public std::runtime_error {
 
 // 1: the first schema. 2: results carry their provenance; missed stops; the runs' time origin.
 // 3: reading chunks carry an encoding, a sequence number in their run and a checksum
-// (docs/storage.md).
-inline constexpr int schema_version = 3;
+// (docs/storage.md). 4: ballbar calibrations (issue 18).
+inline constexpr int schema_version = 4;
 
 enum class RunStatus { running, complete, incomplete, aborted };
 std::string_view to_string(RunStatus s);
@@ -119,6 +119,24 @@ struct MissedStop {
   char direction = '+';  // '+' or '-'
   int target_index = 0;  // 0-based, as in the plan
   double nominal_mm = 0.0;
+};
+
+// A ballbar's calibration against a calibrator of known length (a Zerodur jig, a known ring):
+// the bar (with its extensions) in the calibrator reads `reading_mm`, so it reads 0 at
+// zero_length_mm = calibrator_length_mm - reading_mm, its calibrated length. Used for the
+// absolute radius of later tests of that bar at that nominal length (docs/circle.md).
+struct BarCalibration {
+  std::int64_t id = 0;                // set when stored
+  std::string bar;                    // the bar's identity (serial number)
+  double nominal_mm = 0.0;            // the nominal length of bar + extensions (the test radius)
+  std::string extensions;             // which extensions, as the operator names them ("" none)
+  std::string calibrator;             // the calibrator's identity
+  double calibrator_length_mm = 0.0;  // its certified length
+  double reading_mm = 0.0;            // the bar's reading in the calibrator
+  double zero_length_mm = 0.0;        // calibrator_length_mm - reading_mm
+  std::optional<double> temperature_degc;  // as recorded (not used to correct: docs/circle.md)
+  std::int64_t calibrated_unix_ms = 0;     // when
+  std::string note;
 };
 
 struct StoreOptions {
@@ -213,6 +231,16 @@ class Store {
   std::vector<MissedStop> missed_stops(std::int64_t run_id) const;
   // The session clock reading at a UTC instant (ns since the Unix epoch), see RunRecord.
   void set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns);
+
+  // Ballbar calibrations (returns the new id). Throws StoreError for a non-finite or
+  // non-positive length, or an empty bar identity.
+  std::int64_t add_bar_calibration(const BarCalibration& c);
+  // Every calibration, or those of one bar, oldest first.
+  std::vector<BarCalibration> bar_calibrations(std::string_view bar = {}) const;
+  // The newest calibration of the bar at this nominal length (within 1 um) made at or before
+  // the time, or nullopt.
+  std::optional<BarCalibration> bar_calibration(std::string_view bar, double nominal_mm,
+                                                std::int64_t at_unix_ms) const;
 
   struct Impl;  // implementation, shared with ReadingStream (store.cpp)
 

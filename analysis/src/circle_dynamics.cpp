@@ -1,0 +1,411 @@
+// Stick-slip and vibration from the residual of the geometric model (see circle_dynamics.hpp
+// and docs/circle.md). Both are caldaq's own definitions: the public material found says what
+// they look like on a trace, not how a ballbar program measures them.
+//
+// Vibration. A machine vibrating at f Hz along a fixed direction at angle phi of the plane moves
+// the tool by A sin(2 pi f t) (cos phi, sin phi); the bar sees the radial part,
+// A sin(2 pi f t) cos(theta - phi), and theta = theta_0 + s 2 pi f0 t runs at the feed, so the
+// trace holds the two lines f - f0 and f + f0 (A / 2 each); a radial vibration (the bar, the
+// spindle) holds the line f itself. So the residual is fitted, per trace, by sines and cosines at
+// f - f0, f and f + f0, with f found from the spectrum: the Hann-windowed periodogram of the
+// residual (resampled to an even time step, zero-padded to a power of two at least twice its
+// length), averaged over the traces, its largest bin between 10 f0 and 0.9 times the Nyquist
+// frequency, the band of +-(f0 + 2.5 / T) about it (T the trace's duration: the window's main
+// lobe is +-2 / T), its power centroid as the first estimate, then the fit's best frequency
+// within +-1 / T of it. It is reported when the band holds at least 10 times the power that the
+// rest of the band's noise would put there (the median bin power / ln 2 per bin: the median of
+// an exponential variable) in the average, and at least 4 times in every trace (a vibration does
+// not depend on the direction of travel); when its mean power per bin is at least 10 times that
+// of its neighbourhood (three band widths each side: a local error locked to the position, such
+// as the mean lag of a stick-slip about the reversals, puts a comb of harmonics of f0 there, a
+// vibration one line); and when its rms is at least 0.01 um.
+//
+// Stick-slip. Friction makes an axis stick and jump when it moves slowly (Ballbar plot-analysis
+// texts: "when [an axis] is fed at a very low rate"): on a circle, where it reverses. The
+// residual is high-passed (minus its centred moving median over 4 degrees of travel, so the
+// geometric terms and the smooth leftovers of a reversal are gone, and a single outlying sample
+// at a reversal, e.g. a backlash step the fit puts a sample late, stays where it is instead of
+// spreading over its neighbours) and its mean square is
+// compared between the samples 1 to W degrees from a reversal of the axis (the axis' speed is
+// below F sin W there; the first degree, where a backlash step or a reversal spike leaves what
+// the model did not take, is not counted) and the samples more than W degrees from every
+// reversal: the stick-slip is the rms in excess, sqrt(ms_in - ms_out), reported when ms_in is at
+// least twice ms_out and the excess at least 0.01 um. Noise has the same mean square in and out,
+// so it does not count.
+#include "circle_dynamics.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <numeric>
+#include <unsupported/Eigen/FFT>
+
+namespace cal::circle::dynamics {
+namespace {
+
+constexpr double pi = std::numbers::pi;
+constexpr double deg = pi / 180.0;
+constexpr std::size_t min_window_samples = 20;
+
+double omega_rad_s(const Settings& s) { return s.feed_mm_per_min / 60.0 / s.radius_mm; }
+
+// One trace ordered by travel (s theta rising), with its sample times.
+struct Timed {
+  std::vector<std::size_t> order;  // travel order -> index in the trace
+  std::vector<double> time_s;      // per sample, in the trace's order; 0 at the first in travel
+  double duration_s = 0.0, step_s = 0.0;
+};
+
+Timed timed(const TraceResidual& t, double w) {
+  Timed out;
+  const std::size_t n = t.theta_rad.size();
+  out.order.resize(n);
+  std::iota(out.order.begin(), out.order.end(), std::size_t{0});
+  std::stable_sort(out.order.begin(), out.order.end(), [&](std::size_t a, std::size_t b) {
+    return t.s * t.theta_rad[a] < t.s * t.theta_rad[b];
+  });
+  out.time_s.resize(n);
+  if (n == 0) return out;
+  const double first = t.s * t.theta_rad[out.order.front()];
+  for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad[i] - first) / w;
+  out.duration_s = out.time_s[out.order.back()];
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < n; ++i) {
+    const double d = out.time_s[out.order[i]] - out.time_s[out.order[i - 1]];
+    if (d > 0) steps.push_back(d);
+  }
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    out.step_s = steps[steps.size() / 2];
+  }
+  return out;
+}
+
+// The residual at the times k dt, k = 0 .. n - 1, linearly interpolated in travel order.
+std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt) {
+  const auto n = static_cast<std::size_t>(std::floor(tm.duration_s / dt)) + 1;
+  std::vector<double> out(n);
+  std::size_t j = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double at = static_cast<double>(k) * dt;
+    while (j + 2 < tm.order.size() && tm.time_s[tm.order[j + 1]] < at) ++j;
+    const std::size_t a = tm.order[j], b = tm.order[std::min(j + 1, tm.order.size() - 1)];
+    const double ta = tm.time_s[a], tb = tm.time_s[b];
+    const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
+    out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
+  }
+  return out;
+}
+
+// |X_k|^2 of the Hann-windowed, mean-removed series zero-padded to npad, k = 0 .. npad / 2.
+std::vector<double> periodogram(std::vector<double> x, std::size_t npad) {
+  const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+  const auto n = x.size();
+  for (std::size_t i = 0; i < n; ++i)
+    x[i] = (x[i] - mean) *
+           (0.5 - 0.5 * std::cos(2 * pi * static_cast<double>(i) /
+                                 static_cast<double>(std::max<std::size_t>(1, n - 1))));
+  x.resize(npad, 0.0);
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> spec;
+  fft.fwd(spec, x);
+  std::vector<double> p(npad / 2 + 1);
+  for (std::size_t k = 0; k < p.size(); ++k) p[k] = std::norm(spec[k]);
+  return p;
+}
+
+struct BandTest {
+  double snr = 0.0;  // band power over what the noise floor would put in the band
+  double centroid_hz = 0.0;
+};
+
+BandTest band_test(const std::vector<double>& p, std::size_t lo, std::size_t hi, std::size_t b0,
+                   std::size_t b1, double df) {
+  std::vector<double> rest;
+  double band = 0.0, moment = 0.0;
+  for (std::size_t k = lo; k <= hi; ++k) {
+    if (k >= b0 && k <= b1) {
+      band += p[k];
+      moment += p[k] * static_cast<double>(k) * df;
+    } else {
+      rest.push_back(p[k]);
+    }
+  }
+  BandTest out;
+  if (rest.empty() || !(band > 0)) return out;
+  std::nth_element(rest.begin(), rest.begin() + rest.size() / 2, rest.end());
+  const double per_bin = rest[rest.size() / 2] / std::log(2.0);
+  const double expected = per_bin * static_cast<double>(b1 - b0 + 1);
+  out.snr = expected > 0 ? band / expected : 1e300;
+  out.centroid_hz = moment / band;
+  return out;
+}
+
+// Sines and cosines at f - f0, f, f + f0 fitted per trace: the explained sum of squares, and
+// (when asked) the fitted contribution in each trace's order and the fitted power of each of the
+// three lines, summed over the traces. The lines at f -+ f0 come from the line at f and the
+// rotation by f0 (angle sums), so an evaluation costs one sine and cosine per sample.
+struct LineFit {
+  const std::vector<TraceResidual>& traces;
+  const std::vector<Timed>& tms;
+  double f0_hz;
+  std::vector<std::vector<double>> c0, s0;  // cos, sin of 2 pi f0 t per sample
+
+  LineFit(const std::vector<TraceResidual>& t, const std::vector<Timed>& tm, double f0)
+      : traces(t), tms(tm), f0_hz(f0) {
+    for (const auto& x : tms) {
+      c0.emplace_back(), s0.emplace_back();
+      for (double ts : x.time_s) {
+        c0.back().push_back(std::cos(2 * pi * f0 * ts));
+        s0.back().push_back(std::sin(2 * pi * f0 * ts));
+      }
+    }
+  }
+
+  using Row = Eigen::Matrix<double, 6, 1>;
+  Row row(std::size_t i, std::size_t j, double f_hz) const {
+    const double ph = 2 * pi * f_hz * tms[i].time_s[j];
+    const double sa = std::sin(ph), ca = std::cos(ph), sb = s0[i][j], cb = c0[i][j];
+    Row r;
+    r << sa * cb - ca * sb, ca * cb + sa * sb, sa, ca, sa * cb + ca * sb, ca * cb - sa * sb;
+    return r;
+  }
+
+  double operator()(double f_hz, std::vector<std::vector<double>>* contribution = nullptr,
+                    std::array<double, 3>* line_power = nullptr) const {
+    double explained = 0.0;
+    for (std::size_t i = 0; i < traces.size(); ++i) {
+      const auto& y = traces[i].r_um;
+      Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
+      Row aty = Row::Zero();
+      for (std::size_t j = 0; j < y.size(); ++j) {
+        const Row r = row(i, j, f_hz);
+        ata.selfadjointView<Eigen::Lower>().rankUpdate(r);
+        aty += r * y[j];
+      }
+      ata.triangularView<Eigen::StrictlyUpper>() = ata.transpose();
+      const Row x = ata.ldlt().solve(aty);
+      explained += x.dot(aty);
+      if (line_power)
+        for (int k = 0; k < 3; ++k)
+          (*line_power)[static_cast<std::size_t>(k)] +=
+              x[2 * k] * x[2 * k] + x[2 * k + 1] * x[2 * k + 1];
+      if (contribution) {
+        contribution->emplace_back();
+        for (std::size_t j = 0; j < y.size(); ++j)
+          contribution->back().push_back(row(i, j, f_hz).dot(x));
+      }
+    }
+    return explained;
+  }
+};
+
+// Mean power per bin in [a, b] (clipped to [lo, hi]); 0 when empty.
+double mean_power(const std::vector<double>& p, std::ptrdiff_t a, std::ptrdiff_t b, std::size_t lo,
+                  std::size_t hi) {
+  a = std::max<std::ptrdiff_t>(a, static_cast<std::ptrdiff_t>(lo));
+  b = std::min<std::ptrdiff_t>(b, static_cast<std::ptrdiff_t>(hi));
+  if (b < a) return 0.0;
+  double sum = 0.0;
+  for (auto k = a; k <= b; ++k) sum += p[static_cast<std::size_t>(k)];
+  return sum / static_cast<double>(b - a + 1);
+}
+
+}  // namespace
+
+std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& traces,
+                               std::vector<std::string>& notes) {
+  const double w = omega_rad_s(s), f0 = w / (2 * pi);
+  std::vector<Timed> tms;
+  double dt = 1e300, duration = 1e300;
+  std::size_t longest = 0;
+  for (const auto& t : traces) {
+    tms.push_back(timed(t, w));
+    if (!(tms.back().step_s > 0)) return std::nullopt;
+    dt = std::min(dt, tms.back().step_s);
+    duration = std::min(duration, tms.back().duration_s);
+  }
+  std::vector<std::vector<double>> series;
+  for (std::size_t i = 0; i < traces.size(); ++i) {
+    series.push_back(resample(traces[i], tms[i], dt));
+    longest = std::max(longest, series.back().size());
+  }
+  std::size_t npad = 1;
+  while (npad < 2 * longest) npad *= 2;
+  const double df = 1.0 / (static_cast<double>(npad) * dt);
+  const auto lo = static_cast<std::size_t>(std::ceil(10 * f0 / df));
+  const auto hi = static_cast<std::size_t>(std::floor(0.45 / dt / df));
+  if (hi < lo + 32) {
+    notes.push_back(fmt::format(
+        "vibration: the band from 10 times the feed's frequency ({:.3f} Hz) to 0.9 times the "
+        "Nyquist frequency ({:.1f} Hz) is too narrow to search",
+        10 * f0, 0.45 / dt));
+    return std::nullopt;
+  }
+  std::vector<std::vector<double>> ps;
+  std::vector<double> mean(npad / 2 + 1, 0.0);
+  for (const auto& x : series) {
+    ps.push_back(periodogram(x, npad));
+    for (std::size_t k = 0; k < mean.size(); ++k)
+      mean[k] += ps.back()[k] / static_cast<double>(series.size());
+  }
+  const auto peak = static_cast<std::size_t>(
+      std::max_element(mean.begin() + static_cast<std::ptrdiff_t>(lo),
+                       mean.begin() + static_cast<std::ptrdiff_t>(hi) + 1) -
+      mean.begin());
+  const auto half = static_cast<std::size_t>(std::ceil((f0 + 2.5 / duration) / df));
+  const std::size_t b0 = std::max(lo, peak > half ? peak - half : 0),
+                    b1 = std::min(hi, peak + half);
+  const BandTest all = band_test(mean, lo, hi, b0, b1, df);
+  if (all.snr < 10.0) return std::nullopt;
+  // Narrow: the band stands out of its neighbourhood (three band widths each side). An error
+  // that is locked to the position but local (steps, a stick-slip's mean lag about the
+  // reversals) puts a comb of harmonics of f0 over the whole band instead of one line.
+  const auto width = static_cast<std::ptrdiff_t>(b1 - b0 + 1);
+  const auto sb0 = static_cast<std::ptrdiff_t>(b0), sb1 = static_cast<std::ptrdiff_t>(b1);
+  const double around = 0.5 * (mean_power(mean, sb0 - 3 * width, sb0 - 1, lo, hi) +
+                               mean_power(mean, sb1 + 1, sb1 + 3 * width, lo, hi));
+  if (mean_power(mean, sb0, sb1, lo, hi) < 10.0 * around) {
+    notes.push_back(fmt::format(
+        "vibration: the strongest component above 10 f0, near {:.2f} Hz, is one of a comb of "
+        "harmonics of the feed's frequency (an error locked to the position, not a vibration); "
+        "not reported",
+        all.centroid_hz));
+    return std::nullopt;
+  }
+  for (std::size_t i = 0; i < ps.size(); ++i)
+    if (band_test(ps[i], lo, hi, b0, b1, df).snr < 4.0) {
+      // Trace i lacks it, so (two traces) the other direction has it.
+      notes.push_back(fmt::format(
+          "vibration: a narrow-band component near {:.2f} Hz stands out in the {} trace only; "
+          "not reported (a vibration does not depend on the direction of travel)",
+          all.centroid_hz, traces[i].s > 0 ? "cw" : "ccw"));
+      return std::nullopt;
+    }
+  // The frequency that explains most, on a grid over +-1 / T, refined about the best point.
+  const LineFit fit(traces, tms, f0);
+  double best_f = all.centroid_hz, best = -1.0, step = 0.1 / duration;
+  for (int k = -10; k <= 10; ++k) {
+    const double f = all.centroid_hz + k * step;
+    if (const double e = fit(f); e > best) best = e, best_f = f;
+  }
+  for (int round = 0; round < 3; ++round) {
+    step /= 4;
+    const double centre = best_f;
+    for (int k : {-3, -2, -1, 1, 2, 3}) {
+      const double f = centre + k * step;
+      if (const double e = fit(f); e > best) best = e, best_f = f;
+    }
+  }
+  std::vector<std::vector<double>> parts;
+  std::array<double, 3> power{};
+  fit(best_f, &parts, &power);
+  if (parts.size() == 1) {
+    notes.push_back(
+        "vibration: one direction only, so a vibration cannot be told from an error locked to "
+        "the position");
+  }
+  // One line (radial) or two (along a direction: f -+ f0) fit equally well with f shifted by f0;
+  // the power-weighted mean of the three lines' frequencies is the vibration's either way.
+  const double total = power[0] + power[1] + power[2];
+  const double f_hz =
+      total > 0 ? (power[0] * (best_f - f0) + power[1] * best_f + power[2] * (best_f + f0)) / total
+                : best_f;
+  Found out{.key = "vibration",
+            .name = fmt::format("Vibration ({:.1f} Hz)", f_hz),
+            .unit = "um",
+            .frequency_hz = f_hz};
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    for (std::size_t j = 0; j < parts[i].size(); ++j) {
+      ss += parts[i][j] * parts[i][j];
+      ++n;
+      out.contribution.push_back(parts[i][j]);
+      traces[i].r_um[j] -= parts[i][j];
+    }
+  out.value = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, n)));
+  if (out.value < 0.01) {
+    for (std::size_t i = 0; i < parts.size(); ++i)  // too small to matter: put it back
+      for (std::size_t j = 0; j < parts[i].size(); ++j) traces[i].r_um[j] += parts[i][j];
+    return std::nullopt;
+  }
+  return out;
+}
+
+std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual>& traces,
+                              std::vector<std::string>& notes) {
+  const double w = omega_rad_s(s), core = 1.0 * deg, window = s.window_deg * deg;
+  // The high-passed residual, per trace in its own order.
+  std::vector<std::vector<double>> hp;
+  for (const auto& t : traces) {
+    const Timed tm = timed(t, w);
+    const double step_rad = tm.step_s * w;
+    const std::size_t m =
+        step_rad > 0
+            ? std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(2.0 * deg / step_rad)))
+            : 1;
+    const std::size_t n = t.r_um.size();
+    // At most 41 samples of the window (every stride-th): the median of the local level needs
+    // no more, and 2 x 36,000 samples at 0.01 degrees would otherwise cost 401 per sample.
+    const std::size_t stride = std::max<std::size_t>(1, (2 * m + 1) / 41);
+    std::vector<double> h(n), win;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
+      win.clear();
+      for (std::size_t k = a; k < b; k += stride) win.push_back(t.r_um[tm.order[k]]);
+      std::nth_element(win.begin(), win.begin() + static_cast<std::ptrdiff_t>(win.size() / 2),
+                       win.end());
+      h[tm.order[i]] = t.r_um[tm.order[i]] - win[win.size() / 2];
+    }
+    hp.push_back(std::move(h));
+  }
+  // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2).
+  const auto from_u = [](double th) { return std::abs(std::remainder(th, pi)); };
+  const auto from_v = [](double th) { return std::abs(std::remainder(th - pi / 2, pi)); };
+  double out_ss = 0.0;
+  std::size_t out_n = 0;
+  for (std::size_t i = 0; i < traces.size(); ++i)
+    for (std::size_t j = 0; j < hp[i].size(); ++j) {
+      const double th = traces[i].theta_rad[j];
+      if (from_u(th) > window && from_v(th) > window) out_ss += hp[i][j] * hp[i][j], ++out_n;
+    }
+  std::vector<Found> found;
+  if (out_n < min_window_samples) return found;
+  const double ms_out = out_ss / static_cast<double>(out_n);
+  for (const bool axis_u : {true, false}) {
+    const char axis = axis_u ? s.u : s.v;
+    Found f{.key = fmt::format("stick_slip_{}", axis),
+            .name = fmt::format("Stick-slip {} (rms, 1-{:g} deg from its reversals)", axis,
+                                s.window_deg),
+            .unit = "um"};
+    double in_ss = 0.0;
+    std::size_t in_n = 0;
+    for (std::size_t i = 0; i < traces.size(); ++i)
+      for (std::size_t j = 0; j < hp[i].size(); ++j) {
+        const double th = traces[i].theta_rad[j], d = axis_u ? from_u(th) : from_v(th);
+        const bool in = d >= core && d <= window;
+        if (in) in_ss += hp[i][j] * hp[i][j], ++in_n;
+        f.contribution.push_back(in ? hp[i][j] : 0.0);
+      }
+    if (in_n < min_window_samples) continue;  // the arc does not pass a reversal of this axis
+    const double ms_in = in_ss / static_cast<double>(in_n);
+    if (ms_in < 2.0 * ms_out) continue;
+    f.value = std::sqrt(ms_in - ms_out);
+    if (f.value < 0.01) continue;
+    found.push_back(std::move(f));
+  }
+  if (!found.empty())
+    notes.push_back(
+        "stick-slip is measured at one feed here: it grows as the feed falls, so compare a slow "
+        "and a fast feed before blaming friction (an error locked to the position does not "
+        "change with the feed)");
+  return found;
+}
+
+}  // namespace cal::circle::dynamics

@@ -1,0 +1,48 @@
+#pragma once
+// Stick-slip and vibration from the residual of the circle's geometric model (circle.cpp):
+// caldaq's own definitions, since no public source says how ballbar software detects them
+// (docs/circle.md, "Stick-slip and vibration"). Private to the analysis library.
+//
+// Time along a trace: the tool runs at the feed F along the circle of radius R, so a sample at
+// angle theta is t = s (theta - theta_first) R / F after the first one (s = +1 ccw, -1 cw). One
+// revolution lasts 2 pi R / F; its frequency f0 = F / (2 pi R) is "the frequency of the feed":
+// the geometric terms sit at 1 and 2 f0 (and a few more harmonics), so only the band above
+// 10 f0 is searched for a vibration.
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cal::circle::dynamics {
+
+struct TraceResidual {
+  double s = 1.0;                 // +1 ccw, -1 cw
+  std::vector<double> theta_rad;  // in the trace's own sample order
+  std::vector<double> r_um;       // what the geometric model left
+};
+
+struct Settings {
+  double radius_mm = 100.0;
+  double feed_mm_per_min = 1000.0;
+  double window_deg = 10.0;  // stick-slip: the low-speed window about each reversal of an axis
+  char u = 'X', v = 'Y';     // the plane's axes, for the names
+};
+
+struct Found {
+  std::string key, name, unit;
+  double value = 0.0;
+  std::optional<double> frequency_hz;
+  std::vector<double> contribution;  // every sample of every trace, traces in the given order
+};
+
+// The strongest narrow-band component above 10 f0 when it stands out of the residual's noise in
+// every trace; its fitted contribution is subtracted from `traces`. Notes say what was searched
+// and why nothing was reported when a candidate was refused.
+std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& traces,
+                               std::vector<std::string>& notes);
+
+// Per axis, the high-frequency residual concentrated where that axis moves slowly (about its
+// reversals), in excess of the rest of the circle.
+std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual>& traces,
+                              std::vector<std::string>& notes);
+
+}  // namespace cal::circle::dynamics

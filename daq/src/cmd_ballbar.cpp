@@ -1,0 +1,266 @@
+// daq ballbar calibrate|calibrations: the bar's calibration against a calibrator, stored with
+// its date, used for the absolute radius of later tests (docs/circle.md, "Bar calibration").
+// daq ballbar volumetric|history: the three-plane table of a campaign's tests and a machine's
+// tests over time (docs/circle.md, "The three-plane table", "History").
+#include <fmt/format.h>
+
+#include <cmath>
+#include <ctime>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "ballbar_campaign.hpp"
+#include "cal/analysis/error.hpp"
+#include "cal/storage/store.hpp"
+#include "commands.hpp"
+#include "database.hpp"
+#include "model/model_file.hpp"
+#include "provenance.hpp"
+
+namespace daq {
+namespace {
+
+using nlohmann::json;
+namespace st = cal::storage;
+
+// "YYYY-MM-DD" or "YYYY-MM-DDTHH:MM[:SS]" (UTC) as unix ms; InputError naming the option.
+std::int64_t parse_utc(const std::string& text) {
+  std::tm tm{};
+  int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0;
+  char rest = 0;
+  const int n =
+      std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d%c", &y, &mo, &d, &h, &mi, &s, &rest);
+  const bool date_only = n == 3 && text.size() == 10;
+  const bool with_time = (n == 5 && text.size() == 16) || (n == 6 && text.size() == 19);
+  if (!(date_only || with_time) || mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 ||
+      s > 59)
+    throw cal::InputError(
+        fmt::format("--date '{}': expected YYYY-MM-DD or YYYY-MM-DDTHH:MM[:SS] (UTC)", text));
+  tm.tm_year = y - 1900, tm.tm_mon = mo - 1, tm.tm_mday = d;
+  tm.tm_hour = h, tm.tm_min = mi, tm.tm_sec = s;
+  const std::time_t t = timegm(&tm);
+  std::tm back{};
+  gmtime_r(&t, &back);
+  if (back.tm_mday != d || back.tm_mon != mo - 1)
+    throw cal::InputError(fmt::format("--date '{}': no such day", text));
+  return static_cast<std::int64_t>(t) * 1000;
+}
+
+json to_json(const st::BarCalibration& c) {
+  return {{"id", c.id},
+          {"bar", c.bar},
+          {"nominal_mm", c.nominal_mm},
+          {"extensions", c.extensions},
+          {"calibrator", c.calibrator},
+          {"calibrator_length_mm", c.calibrator_length_mm},
+          {"reading_mm", c.reading_mm},
+          {"zero_length_mm", c.zero_length_mm},
+          {"temperature_degc", c.temperature_degc ? json(*c.temperature_degc) : json(nullptr)},
+          {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
+          {"note", c.note}};
+}
+
+struct CalibrateOptions {
+  std::string db, bar, calibrator, extensions, date, note;
+  double nominal_mm = 0.0, calibrator_mm = 0.0, reading_mm = 0.0;
+  std::optional<double> temperature_degc;
+  bool json = false;
+};
+
+void calibrate(const CalibrateOptions& o) {
+  for (double v : {o.nominal_mm, o.calibrator_mm, o.reading_mm})
+    if (!std::isfinite(v)) throw cal::InputError("ballbar calibrate: the lengths must be finite");
+  if (o.temperature_degc && !std::isfinite(*o.temperature_degc))
+    throw cal::InputError("ballbar calibrate: --temperature-degc must be finite");
+  // Sanity, not physics: a calibrator fits the bar it calibrates, and a ballbar's transducer
+  // travels a few mm at most.
+  if (std::abs(o.calibrator_mm - o.nominal_mm) > 5.0)
+    throw cal::InputError(fmt::format(
+        "ballbar calibrate: a calibrator of {} mm does not fit a {} mm bar (--calibrator-mm is "
+        "the calibrator's certified length, --nominal-mm the bar's with its extensions)",
+        o.calibrator_mm, o.nominal_mm));
+  if (std::abs(o.reading_mm) > 5.0)
+    throw cal::InputError(
+        fmt::format("ballbar calibrate: a reading of {} mm is beyond a ballbar transducer's travel "
+                    "(--reading-mm "
+                    "is the bar's reading in the calibrator, in mm)",
+                    o.reading_mm));
+  st::BarCalibration c{.bar = o.bar,
+                       .nominal_mm = o.nominal_mm,
+                       .extensions = o.extensions,
+                       .calibrator = o.calibrator,
+                       .calibrator_length_mm = o.calibrator_mm,
+                       .reading_mm = o.reading_mm,
+                       .zero_length_mm = o.calibrator_mm - o.reading_mm,
+                       .temperature_degc = o.temperature_degc,
+                       .calibrated_unix_ms = o.date.empty() ? 0 : parse_utc(o.date),
+                       .note = o.note};
+  st::Store store(database_path(o.db));
+  c.id = store.add_bar_calibration(c);
+  const auto stored = store.bar_calibrations(c.bar);
+  for (const auto& x : stored)
+    if (x.id == c.id) c = x;
+  if (o.json) {
+    json j{{"schema", "caldaq.bar-calibration.v1"}};
+    j.update(to_json(c));
+    return fmt::print("{}\n", j.dump(2));
+  }
+  fmt::print(
+      "calibration {} of bar '{}' at {:g} mm stored ({}): reads 0 at {:.4f} mm (calibrator {:.4f} "
+      "mm, reading {:+.4f} mm)\n",
+      c.id, c.bar, c.nominal_mm, utc_iso(c.calibrated_unix_ms), c.zero_length_mm,
+      c.calibrator_length_mm, c.reading_mm);
+}
+
+void list(const std::string& db, const std::string& bar, bool as_json) {
+  const auto store = open_database_read_only(db);
+  const auto all = store.bar_calibrations(bar);
+  if (as_json) {
+    json j{{"schema", "caldaq.bar-calibrations.v1"}, {"calibrations", json::array()}};
+    for (const auto& c : all) j["calibrations"].push_back(to_json(c));
+    return fmt::print("{}\n", j.dump(2));
+  }
+  if (all.empty())
+    return fmt::print("no ballbar calibration stored{}\n",
+                      bar.empty() ? std::string() : fmt::format(" for bar '{}'", bar));
+  fmt::print("{:>4}  {:<16} {:>9} {:<10} {:<24} {:>12} {:>10} {:>12}  {}\n", "id", "bar", "nominal",
+             "extensions", "calibrator", "calibrator", "reading", "zero at", "date (UTC)");
+  for (const auto& c : all)
+    fmt::print("{:>4}  {:<16} {:>9.3f} {:<10} {:<24} {:>12.4f} {:>+10.4f} {:>12.4f}  {}\n", c.id,
+               c.bar, c.nominal_mm, c.extensions.empty() ? "-" : c.extensions,
+               c.calibrator.empty() ? "-" : c.calibrator, c.calibrator_length_mm, c.reading_mm,
+               c.zero_length_mm, utc_iso(c.calibrated_unix_ms).substr(0, 16));
+}
+
+struct SetOptions {
+  std::string db, machine, campaign, model_in, model_out;
+  std::vector<std::int64_t> runs;
+  bool json = false;
+};
+
+std::vector<BallbarTest> tests_of(const st::Store& store, const SetOptions& o) {
+  if (!o.runs.empty() && !o.machine.empty())
+    throw cal::InputError("give --runs or --machine, not both");
+  if (o.runs.empty() && o.machine.empty())
+    throw cal::InputError("give the tests: --machine NAME [--campaign C] or --runs N,N,...");
+  const auto runs = o.runs.empty() ? ballbar_runs(store, o.machine, o.campaign) : o.runs;
+  if (runs.empty())
+    throw cal::InputError(
+        fmt::format("{}: machine '{}' has no complete ballbar test{}", store.path().string(),
+                    o.machine, o.campaign.empty() ? "" : " in campaign '" + o.campaign + "'"));
+  return ballbar_tests(store, runs);
+}
+
+// The model file with the table's squareness in place of its own (the rest as it was).
+void write_model(const VolumetricTable& v, const SetOptions& o) {
+  namespace md = cal::daq::model;
+  auto m = md::read(o.model_in);
+  const json block = model_squareness(v);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& pv = v.combined.planes[i];
+    if (!pv) continue;
+    const auto p = cal::circle::model_plane(pv->plane);
+    const json& e = block[std::string(cal::kinematics::location_error_name(p))];
+    auto& entry = m.squareness[static_cast<std::size_t>(p)];
+    m.machine.squareness.of(p) = cal::circle::location_error_urad(*pv);
+    entry.given = true;
+    entry.stated_as = "iso230_1_urad";
+    entry.method = e["method"].get<std::string>();
+    entry.placement = e.value("placement", std::string());
+    entry.position_mm.reset();
+    if (e.contains("position_mm"))
+      entry.position_mm = cal::kinematics::Vec3{e["position_mm"][0].get<double>(),
+                                                e["position_mm"][1].get<double>(),
+                                                e["position_mm"][2].get<double>()};
+    entry.source.json = e["source"].dump();
+  }
+  md::write(m, o.model_out);
+}
+
+void volumetric(const SetOptions& o) {
+  if (o.model_in.empty() != o.model_out.empty())
+    throw cal::InputError("--model and --write-model go together (read one, write the other)");
+  const auto store = open_database_read_only(o.db);  // only reads
+  const auto tests = tests_of(store, o);
+  const auto v = volumetric_table(tests);
+  if (!o.model_in.empty()) write_model(v, o);
+  if (o.json) return fmt::print("{}\n", to_json(v, tests).dump(2));
+  print_volumetric(v, tests);
+  if (!o.model_in.empty())
+    fmt::print("\nwrote {} (the squareness of {} with the table's)\n", o.model_out, o.model_in);
+}
+
+void history(const SetOptions& o) {
+  const auto store = open_database_read_only(o.db);  // only reads
+  const auto tests = tests_of(store, o);
+  if (o.json) return fmt::print("{}\n", history_json(tests).dump(2));
+  print_history(tests);
+}
+
+void add_set_options(CLI::App& cmd, SetOptions& o) {
+  add_db_option(cmd, o.db);
+  cmd.add_option("--machine", o.machine, "The machine's ballbar tests (its complete circle runs)");
+  cmd.add_option("--campaign", o.campaign, "Only this campaign's");
+  cmd.add_option("--runs", o.runs, "These circle runs instead")->delimiter(',');
+}
+
+}  // namespace
+
+void add_ballbar_commands(CLI::App& app) {
+  auto* bb = app.add_subcommand("ballbar", "Ballbar calibrations (docs/circle.md)");
+  bb->require_subcommand(1);
+  auto o = std::make_shared<CalibrateOptions>();
+  auto* cal = bb->add_subcommand(
+      "calibrate",
+      "Store a calibration of the bar against a calibrator: the bar reads 0 at the calibrator's "
+      "length minus the reading");
+  add_db_option(*cal, o->db);
+  cal->add_option("--bar", o->bar, "The bar's identity (serial number), as [test.circle] bar")
+      ->required();
+  cal->add_option("--nominal-mm", o->nominal_mm,
+                  "Nominal length of the bar with its extensions (the test radius)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  cal->add_option("--calibrator-mm", o->calibrator_mm,
+                  "The calibrator's certified length (Zerodur jig, known ring)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  cal->add_option("--reading-mm", o->reading_mm, "The bar's reading in the calibrator, mm")
+      ->required();
+  cal->add_option("--calibrator", o->calibrator, "The calibrator's identity");
+  cal->add_option("--extensions", o->extensions, "The extensions fitted, e.g. \"50 mm\"");
+  cal->add_option("--temperature-degc", o->temperature_degc,
+                  "Temperature at the calibration (recorded, not corrected for)");
+  cal->add_option("--date", o->date, "When, YYYY-MM-DD[THH:MM[:SS]] UTC (default: now)");
+  cal->add_option("--note", o->note, "Free text");
+  cal->add_flag("--json", o->json, "Print caldaq.bar-calibration.v1");
+  cal->callback([o] { calibrate(*o); });
+
+  auto l = std::make_shared<std::pair<std::string, std::string>>();
+  auto as_json = std::make_shared<bool>(false);
+  auto* ls = bb->add_subcommand("calibrations", "The stored calibrations, oldest first");
+  add_db_option(*ls, l->first);
+  ls->add_option("--bar", l->second, "Only this bar's");
+  ls->add_flag("--json", *as_json, "Print caldaq.bar-calibrations.v1");
+  ls->callback([l, as_json] { list(l->first, l->second, *as_json); });
+
+  auto vo = std::make_shared<SetOptions>();
+  auto* vol = bb->add_subcommand(
+      "volumetric",
+      "The three-plane table: squareness XY, ZX, YZ as the model's E_C0Y, E_B0Z, E_A0Z and the "
+      "axis scales, from a campaign's ballbar tests");
+  add_set_options(*vol, *vo);
+  vol->add_option("--model", vo->model_in, "A caldaq.model.v1 file to take the squareness");
+  vol->add_option("--write-model", vo->model_out, "Where to write it with the table's squareness");
+  vol->add_flag("--json", vo->json, "Print caldaq.ballbar-volumetric.v1");
+  vol->callback([vo] { volumetric(*vo); });
+
+  auto ho = std::make_shared<SetOptions>();
+  auto* his = bb->add_subcommand(
+      "history", "A machine's ballbar tests over time, per plane, feed and radius, with verdicts");
+  add_set_options(*his, *ho);
+  his->add_flag("--json", ho->json, "Print caldaq.ballbar-history.v1");
+  his->callback([ho] { history(*ho); });
+}
+
+}  // namespace daq
