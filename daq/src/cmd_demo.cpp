@@ -17,6 +17,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "circle_output.hpp"
@@ -39,7 +40,7 @@ using namespace std::chrono_literals;
 struct DemoOptions {
   std::string db = "caldaq-demo.sqlite";
   std::string capture = "caldaq-demo.cdq";
-  double speed = 60.0;
+  double speed = 0.0;  // 0: simulated time that jumps from event to event (loop_time.hpp)
   bool quiet = false;
 };
 
@@ -202,16 +203,24 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
 int run_demo(const DemoOptions& o) {
   const bool tty = !o.quiet && ::isatty(STDOUT_FILENO);
   boost::asio::io_context io;
-  SimulatedShop shop(io, ShopTruth{}, o.speed);
+  // By default the shop and every timer of the session run on simulated time that jumps to
+  // the next event: as fast as the CPU allows, and the same readings on a loaded machine.
+  // --speed N paces it by the wall clock instead (N times faster), as `daq sim` does.
+  if (o.speed == 0) d::VirtualTime::install(io);
+  const double pace = o.speed > 0 ? o.speed : 1.0;  // simulated seconds per loop second
+  SimulatedShop shop(io, ShopTruth{}, pace);
   fmt::print("daq demo: ISO 230-2 test of the X axis of a SIMULATED machine (0 .. 500 mm)\n");
   fmt::print("  laser: simulated IDS3010 on tcp 127.0.0.1:{}\n", shop.laser_port());
   fmt::print("  air: simulated PTU300 on {} (4800 7E1)\n", shop.air_device());
   fmt::print("  material: simulated serial thermometer on {}\n", shop.material_device());
-  fmt::print("  simulated time runs {}x faster than real time\n\n", o.speed);
+  if (o.speed > 0)
+    fmt::print("  simulated time runs {}x faster than real time\n\n", o.speed);
+  else
+    fmt::print("  simulated time jumps from event to event (as fast as the CPU allows)\n\n");
 
   const auto clock = shop.clock_ns();
   const auto poll = [&](double sim_s) {
-    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / o.speed * 1e6));
+    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / pace * 1e6));
   };
   // The shop's devices, configured as `daq sim` writes them; the instruments as the capture
   // header records them, so `daq replay` rebuilds them.
@@ -312,6 +321,11 @@ int run_demo(const DemoOptions& o) {
   fmt::print("\nSee it again: daq runs --db {0}; daq show {1} --db {0}; daq export {1} --db {0}\n",
              o.db, out.run_id);
   fmt::print("Replay the wire-level capture: daq replay {} --db {}\n", o.capture, o.db);
+  if (const auto* vt = d::VirtualTime::of(io))
+    fmt::print(
+        "Simulated time: {:.1f} s in {} jumps, {} timer events; {} waits for bytes that never "
+        "came\n",
+        vt->now_s(), vt->stats().jumps, vt->stats().timers, vt->stats().settle_timeouts);
   return 0;
 }
 
@@ -324,11 +338,15 @@ void add_demo_command(CLI::App& app) {
   cmd->add_option("--db", o->db, "Run database for the demo runs")->capture_default_str();
   cmd->add_option("--capture", o->capture, "Wire-level capture file of the run")
       ->capture_default_str();
-  cmd->add_option("--speed", o->speed, "Simulated time per real time")
+  cmd->add_option("--speed", o->speed,
+                  "Simulated time per real time (1 .. 200); 0: simulated time jumps from event "
+                  "to event, as fast as the CPU allows")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 200.0));
+      ->check(CLI::Range(0.0, 200.0));
   cmd->add_flag("--quiet", o->quiet, "Print only the results");
   cmd->callback([o] {
+    if (o->speed > 0 && o->speed < 1)
+      throw CLI::ValidationError("--speed", "must be 0 (simulated time) or 1 .. 200");
     if (const int rc = run_demo(*o); rc != 0) throw CLI::RuntimeError(rc);
   });
 }

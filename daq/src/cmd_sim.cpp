@@ -36,7 +36,8 @@ struct SimOptions {
   std::optional<double> start_after_s;  // unset: wait for a run in the database
   std::string db;
   bool position_feed = false;
-  std::string measure;  // a component of the volumetric campaign, e.g. E_YX
+  int runs = 5, targets = 11;  // the linear program's size (ShopConfigOptions)
+  std::string measure;         // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
   std::string compensate;  // a model file whose volumetric correction the control applies
 };
@@ -147,6 +148,8 @@ void run_sim(SimOptions o) {
                                : simulated_shop_config(shop, {.speed = o.speed,
                                                               .position_feed = o.position_feed,
                                                               .in_process = false,
+                                                              .runs = o.runs,
+                                                              .targets = o.targets,
                                                               .circle_set = set});
   {
     std::ofstream out(o.config_out);
@@ -240,6 +243,13 @@ void add_sim_command(CLI::App& app) {
                   "(default: wait for each run to start in the database, and run its test)")
       ->check(CLI::NonNegativeNumber);
   add_db_option(*cmd, o->db);
+  cmd->add_option("--runs", o->runs, "Runs of the linear program (ISO 230-2: 5)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 10));
+  cmd->add_option("--targets", o->targets,
+                  "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 11));
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->add_option("--measure", o->measure,

@@ -72,7 +72,11 @@ struct Ptu300Twin::Impl : detail::PtyChannel, std::enable_shared_from_this<Ptu30
       pty.send(reading(), shared_from_this());
       next_output_s = now + std::max(config.interval_s, 0.01);
     }
-    timer.expires_after(std::chrono::milliseconds(5));
+    if (simulated_time)  // the clock is the loop's: sleep until the next output is due
+      timer.expires_after(std::chrono::nanoseconds(
+          static_cast<std::int64_t>(std::max(next_output_s - clock(), 0.0) * 1e9)));
+    else
+      timer.expires_after(std::chrono::milliseconds(5));
     timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
       if (!ec) self->tick();
     });

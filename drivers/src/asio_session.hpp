@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/transport/transport.hpp"
 
 namespace cal::drivers::transport::detail {
@@ -21,7 +22,9 @@ template <class Stream>
 class Session : public std::enable_shared_from_this<Session<Stream>> {
  public:
   Session(Stream stream, std::string description)
-      : stream_(std::move(stream)), description_(std::move(description)) {}
+      : stream_(std::move(stream)),
+        description_(std::move(description)),
+        time_(VirtualTime::of(stream_.get_executor().context())) {}
 
   Stream& stream() { return stream_; }
   const std::string& description() const { return description_; }
@@ -43,6 +46,8 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
     if (!active()) return;
     const auto* p = reinterpret_cast<const char*>(bytes.data());
     queue_.emplace_back(p, p + bytes.size());
+    // Simulated time waits for these bytes to reach their reader (a twin in this process).
+    if (time_) time_->bytes_written(bytes.size());
     if (queue_.size() == 1) write_next();
   }
 
@@ -71,6 +76,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   }
 
   void on_read(const boost::system::error_code& ec, std::size_t n) {
+    if (time_) time_->bytes_read(n);
     if (!active()) return;  // closed while the read was in flight
     if (n > 0) on_data_(std::span<const std::byte>(buffer_.data(), n));
     if (!active()) return;  // the data handler closed us
@@ -96,6 +102,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   Transport::ErrorHandler on_error_;
   std::array<std::byte, 4096> buffer_{};
   std::deque<std::vector<char>> queue_;
+  VirtualTime* time_;  // simulated mode only (see loop_time.hpp)
 };
 
 }  // namespace cal::drivers::transport::detail

@@ -63,14 +63,6 @@ std::string_view to_string(DeviceMessage::Severity s) {
   return "unknown";
 }
 
-Clock steady_clock_ns() {
-  return [] {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  };
-}
-
 namespace detail {
 
 InstrumentCore::InstrumentCore(boost::asio::io_context& io,
@@ -79,7 +71,7 @@ InstrumentCore::InstrumentCore(boost::asio::io_context& io,
     : io_(io),
       transport_(std::move(transport)),
       options_(std::move(options)),
-      clock_(options_.clock ? options_.clock : steady_clock_ns()),
+      clock_(options_.clock ? options_.clock : loop_clock(io)),
       reconnect_timer_(io),
       poll_timer_(io),
       watchdog_(io),

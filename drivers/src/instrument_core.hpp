@@ -3,7 +3,6 @@
 // signal lost, reconnect with backoff and gap reporting, silence watchdog). Includes
 // Boost.Asio, so only instrument .cpp files include it.
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -93,7 +92,7 @@ class InstrumentCore : public Instrument {
   Clock clock_;
   InstrumentEvents events_;
   InstrumentState state_ = InstrumentState::closed;
-  boost::asio::steady_timer reconnect_timer_, poll_timer_, watchdog_;
+  Timer reconnect_timer_, poll_timer_, watchdog_;  // on the loop's time (loop_time.hpp)
   std::chrono::milliseconds next_delay_{};
   int attempts_ = 0;
   bool running_ = false;

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "asio_session.hpp"
+#include "cal/drivers/loop_time.hpp"
 
 namespace cal::drivers::transport {
 namespace {
@@ -14,9 +15,17 @@ using asio::ip::tcp;
 struct Connect : std::enable_shared_from_this<Connect> {
   Connect(asio::io_context& io, std::shared_ptr<detail::Session<tcp::socket>> s,
           Transport::Handlers h)
-      : resolver(io), timer(io), session(std::move(s)), handlers(std::move(h)) {}
+      : resolver(io),
+        timer(io),
+        session(std::move(s)),
+        handlers(std::move(h)),
+        time(VirtualTime::of(io)) {}
+  ~Connect() { settle(); }
 
   void start(const TcpSettings& settings) {
+    // In simulated time a connection is made at once: the clock waits for it (the resolver
+    // runs on a thread of its own, the loop would otherwise see nothing to do).
+    if (time) time->begin_operation();
     timer.expires_after(settings.connect_timeout);
     timer.async_wait([self = shared_from_this(),
                       ms = settings.connect_timeout.count()](const boost::system::error_code& ec) {
@@ -36,7 +45,13 @@ struct Connect : std::enable_shared_from_this<Connect> {
         });
   }
 
+  void settle() {
+    if (time && !settled) time->end_operation();
+    settled = true;
+  }
+
   void connected(const boost::system::error_code& ec) {
+    settle();
     if (done) return;
     if (ec) return finish(ErrorKind::open_failed, "cannot connect: " + ec.message());
     done = true;
@@ -48,6 +63,7 @@ struct Connect : std::enable_shared_from_this<Connect> {
   }
 
   void finish(ErrorKind kind, const std::string& what) {
+    settle();
     done = true;
     timer.cancel();
     resolver.cancel();
@@ -57,11 +73,13 @@ struct Connect : std::enable_shared_from_this<Connect> {
   }
 
   tcp::resolver resolver;
-  asio::steady_timer timer;
+  Timer timer;  // the connect timeout, on the loop's time
   std::shared_ptr<detail::Session<tcp::socket>> session;
   Transport::Handlers handlers;
   bool done = false;
   bool cancelled = false;
+  VirtualTime* time;
+  bool settled = false;
 };
 
 class TcpTransport final : public Transport {

@@ -33,7 +33,7 @@ check targets_short_default 2 "give an interval or a count" -- "$DAQ" targets --
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --speed 30 --db "$TMP/demo.sqlite" --capture "$TMP/demo.cdq"
+check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/demo.sqlite" --capture "$TMP/demo.cdq"
 # A capture cut in half: the replay says where the damage is and stores nothing as complete.
 head -c 300000 "$TMP/demo.cdq" > "$TMP/cut.cdq"
 check replay_damaged 2 "cut.cdq: replay stored as run [0-9]+ but incomplete: the capture is damaged at byte [0-9]+" -- "$DAQ" replay "$TMP/cut.cdq" --db "$TMP/replay.sqlite"

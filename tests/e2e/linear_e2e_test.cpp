@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <boost/asio/io_context.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -17,6 +19,7 @@
 #include <random>
 #include <thread>
 
+#include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
@@ -46,8 +49,11 @@ void remove_db(const fs::path& p) {
 
 TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   const auto db = temp_db("linear");
-  constexpr double speed = 30.0;
+  // Simulated time that jumps from event to event (loop_time.hpp): loop seconds are simulated
+  // seconds, and the run takes as long as the CPU needs.
+  constexpr double speed = 1.0;
   boost::asio::io_context io;
+  d::VirtualTime::install(io);
   daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
   cal::daq::Config c;
   c.machine_name = "e2e";
@@ -146,8 +152,11 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
 // the evaluation says that target has one run fewer up.
 TEST(LinearEndToEnd, ADroppedStopIsStoredIncompleteWithTheStopListed) {
   const auto db = temp_db("dropped");
-  constexpr double speed = 30.0;
+  // Simulated time that jumps from event to event (loop_time.hpp): loop seconds are simulated
+  // seconds, and the run takes as long as the CPU needs.
+  constexpr double speed = 1.0;
   boost::asio::io_context io;
+  d::VirtualTime::install(io);
   daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
   cal::daq::Config c;
   c.machine_name = "e2e";
@@ -236,8 +245,11 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   // backlash shared with the reversal-spike term (~2 %), and the feed-in timing (a few ms of
   // angle offset).
   const auto db = temp_db("circle");
-  constexpr double speed = 30.0;
+  // Simulated time that jumps from event to event (loop_time.hpp): loop seconds are simulated
+  // seconds, and the run takes as long as the CPU needs.
+  constexpr double speed = 1.0;
   boost::asio::io_context io;
+  d::VirtualTime::install(io);
   daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
   const cal::daq::BallbarProgram program{
       .radius_mm = 100, .feed_mm_per_min = 1000, .sample_rate_hz = 1000};
@@ -275,6 +287,98 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   remove_db(db);
 }
 
+// One short linear run (2 runs over 3 targets) of the simulated shop on simulated time; what
+// it stored: every reading and every captured stop's deviation.
+struct StoredRun {
+  std::vector<cal::storage::RawReading> readings;
+  std::vector<double> deviations_um;
+  std::uint64_t settle_timeouts = 0;
+};
+StoredRun short_simulated_run() {
+  const auto db = temp_db("determinism");
+  boost::asio::io_context io;
+  auto& time = d::VirtualTime::install(io);
+  daq::SimulatedShop shop(io, daq::ShopTruth{}, 1.0);
+  cal::daq::Config c;
+  c.machine_name = "e2e";
+  c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5};
+  c.linear = cal::daq::LinearTestConfig{
+      .first_mm = 0, .last_mm = 100, .count = 3, .runs = 2, .overrun_mm = 3, .dwell_s = 3};
+  daq::LinearRunSetup setup;
+  setup.config = c;
+  setup.database = db;
+  // No clock given: the instruments read the loop's (simulated) time.
+  setup.laser = d::make_ids3010(
+      io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}), {.poll_period = 10ms});
+  setup.air = d::make_ptu300(
+      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
+      {.poll_period = 1s});
+  setup.material.push_back(d::make_gauge(
+      io, t::make_serial(io, {.device = shop.material_device()}), {.poll_period = 1s},
+      {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
+  std::array<bool, 3> read{};
+  setup.on_reading = [&read](const d::Reading& r) {
+    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
+      read[r.device] = true;
+  };
+  daq::LinearRun run(io, std::move(setup));
+  run.start();
+  EXPECT_TRUE(shop.wait_until([&] { return read[0] && read[1] && read[2]; }));
+  shop.run_linear(run.plan(), c.linear->feed_mm_per_min, c.linear->dwell_s);
+  shop.run_program([&] { return run.finished(); }, 30.0);
+  EXPECT_TRUE(run.finished());
+  EXPECT_TRUE(run.outcome().complete) << run.outcome().reason;
+  StoredRun out;
+  {
+    cal::storage::Store store(db);
+    out.readings = store.readings(run.outcome().run_id);
+    for (const auto& target : store.targets(run.outcome().run_id))
+      out.deviations_um.push_back(target.deviation_um);
+  }
+  out.settle_timeouts = time.stats().settle_timeouts;
+  remove_db(db);
+  return out;
+}
+
+// Simulated time makes a run a function of its inputs alone: run twice, the second time with
+// both cores of a 2-core machine kept busy by two spinning threads, it stores the same readings
+// bit for bit (times, devices, channels, quantities, statuses, values) and the same stops. With
+// the shop paced by the wall clock, the readings' times and values would differ run to run.
+TEST(LinearEndToEnd, TheSameSimulatedRunTwiceStoresTheSameReadingsBitForBitUnderLoad) {
+  const StoredRun quiet = short_simulated_run();
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> load;
+  for (int i = 0; i < 2; ++i)
+    load.emplace_back([&stop] {
+      volatile std::uint64_t n = 0;
+      while (!stop.load(std::memory_order_relaxed)) n = n + 1;
+    });
+  const StoredRun loaded = short_simulated_run();
+  stop = true;
+  for (auto& th : load) th.join();
+
+  // About 45 s of simulated time: a 100 Hz laser, the air and material sensors at 1 Hz.
+  ASSERT_GT(quiet.readings.size(), 4'000u);
+  ASSERT_EQ(quiet.readings.size(), loaded.readings.size());
+  for (std::size_t i = 0; i < quiet.readings.size(); ++i) {
+    const auto &a = quiet.readings[i], &b = loaded.readings[i];
+    ASSERT_EQ(a.time_ns, b.time_ns) << i;
+    ASSERT_EQ(a.device, b.device) << i;
+    ASSERT_EQ(a.channel, b.channel) << i;
+    ASSERT_EQ(a.quantity, b.quantity) << i;
+    ASSERT_EQ(a.status, b.status) << i;
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(a.value), std::bit_cast<std::uint64_t>(b.value)) << i;
+  }
+  ASSERT_EQ(quiet.deviations_um.size(), 12u);  // 2 runs x 3 targets x 2 directions
+  ASSERT_EQ(quiet.deviations_um.size(), loaded.deviations_um.size());
+  for (std::size_t i = 0; i < quiet.deviations_um.size(); ++i)
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(quiet.deviations_um[i]),
+              std::bit_cast<std::uint64_t>(loaded.deviations_um[i]))
+        << i;
+  EXPECT_EQ(quiet.settle_timeouts, 0u);
+  EXPECT_EQ(loaded.settle_timeouts, 0u);
+}
+
 TEST(LinearEndToEnd, KillDashNineMidRunLeavesAReadableIncompleteRun) {
   const auto db = temp_db("kill");
   const pid_t child = ::fork();
@@ -283,8 +387,9 @@ TEST(LinearEndToEnd, KillDashNineMidRunLeavesAReadableIncompleteRun) {
     const int devnull = ::open("/dev/null", O_WRONLY);
     ::dup2(devnull, STDOUT_FILENO);
     const std::string capture = db.string() + ".cdq";
-    ::execl(CALDAQ_DAQ_BINARY, "daq", "demo", "--quiet", "--db", db.c_str(), "--capture",
-            capture.c_str(), nullptr);
+    // Paced by the wall clock (60x), so that it is still running when it is killed.
+    ::execl(CALDAQ_DAQ_BINARY, "daq", "demo", "--quiet", "--speed", "60", "--db", db.c_str(),
+            "--capture", capture.c_str(), nullptr);
     ::_exit(127);
   }
   // Wait until the run has stored some readings (committed batches), then kill.
@@ -319,7 +424,7 @@ TEST(LinearEndToEnd, ReplayingTheCaptureGivesIdenticalStoredResults) {
   const auto db = temp_db("replay");
   const auto capture = fs::path(db.string() + ".cdq");
   const std::string daq = CALDAQ_DAQ_BINARY;
-  ASSERT_EQ(std::system((daq + " demo --quiet --speed 30 --db '" + db.string() + "' --capture '" +
+  ASSERT_EQ(std::system((daq + " demo --quiet --db '" + db.string() + "' --capture '" +
                          capture.string() + "' > /dev/null")
                             .c_str()),
             0);

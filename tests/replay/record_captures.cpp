@@ -1,7 +1,9 @@
 // Records the checked-in capture tests/data/captures/twin_session.cdq: the real laser,
 // PTU300, ballbar and position-feed instruments against the SIMULATED twins (session and
-// truth in twin_session.hpp), for 4.5 s of wall time, with the disturbances injected at fixed
-// simulated times. Usage: record_captures OUTPUT.cdq
+// truth in twin_session.hpp), for 4.5 s of simulated time (it jumps from event to event, see
+// cal/drivers/loop_time.hpp: the recording takes as long as the CPU needs, and the same on a
+// loaded machine), with the disturbances injected at fixed simulated times.
+// Usage: record_captures OUTPUT.cdq
 // Re-record only when the capture format or a protocol changes; the test checks every
 // reading against the simulated truth, not against an earlier recording.
 #include <boost/asio/io_context.hpp>
@@ -9,6 +11,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cal/drivers/loop_time.hpp"
 #include "cal/replay/session.hpp"
 #include "twin_session.hpp"
 
@@ -44,10 +47,11 @@ int main(int argc, char** argv) {
     return 2;
   }
   boost::asio::io_context io;
+  auto& time = cal::drivers::VirtualTime::install(io);
   sim::World world(ts::machine(), ts::air());
   const auto program = ts::program();
   world.machine().load(program);
-  const auto sim_clock = sim::steady_clock(1.0);
+  const sim::Clock sim_clock = [&time] { return time.now_s(); };
   sim::IdsTwin ids(io, world, sim_clock);
   sim::Ptu300Twin ptu(io, world, sim_clock);
   sim::GaugeTwin bar(io, world, sim_clock,
@@ -60,12 +64,7 @@ int main(int argc, char** argv) {
   cal::replay::CaptureWriter writer(argv[1], header(ids.port(), shdr.port()),
                                     {.block_bytes = 8 * 1024});
   cal::replay::CaptureRecorder recorder(writer);
-  const auto start = std::chrono::steady_clock::now();
-  const cal::drivers::Clock clock = [start] {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() -
-                                                                start)
-        .count();
-  };
+  const cal::drivers::Clock clock = cal::drivers::loop_clock(io);  // the simulated time
   const auto transport = [&](std::uint16_t device) -> std::unique_ptr<t::Transport> {
     switch (device) {
       case ts::laser:
@@ -83,18 +82,16 @@ int main(int argc, char** argv) {
   std::size_t readings = 0;
   for (auto& i : instruments) i->start({.reading = [&](const auto&) { ++readings; }});
 
-  bool blocked = false, unblocked = false, dropped = false;
-  while (sim_clock() < ts::session_s) {
-    io.run_for(std::chrono::milliseconds(2));
-    io.restart();
-    const double now = sim_clock();
-    if (!blocked && now >= 0.6) ids.set_beam_lost(0, blocked = true);
-    if (!unblocked && now >= 0.8) ids.set_beam_lost(0, !(unblocked = true));
-    if (!dropped && now >= 3.2) {
-      ids.drop_connections();
-      dropped = true;
-    }
-  }
+  const auto run_until = [&](double t_s) {
+    time.run_until({}, static_cast<std::int64_t>(t_s * 1e9));
+  };
+  run_until(0.6);
+  ids.set_beam_lost(0, true);
+  run_until(0.8);
+  ids.set_beam_lost(0, false);
+  run_until(3.2);
+  ids.drop_connections();
+  run_until(ts::session_s);
   for (auto& i : instruments) i->stop();
   io.poll();
   writer.close();

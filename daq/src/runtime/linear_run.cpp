@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
-#include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <deque>
 #include <nlohmann/json.hpp>
@@ -15,6 +14,7 @@
 #include "cal/daq/env_stage.hpp"
 #include "cal/daq/motion.hpp"
 #include "cal/daq/trigger.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "iso230_2_output.hpp"
@@ -190,7 +190,7 @@ struct LinearRun::Impl {
   std::vector<double> acceptable;  // sorted: the positions a stop could be at now
   std::optional<cal::storage::Store> store;
   std::unique_ptr<cal::storage::BatchWriter> writer;
-  boost::asio::steady_timer timer;
+  cal::drivers::Timer timer;  // on the loop's time: simulated in a simulated session
   LinearRunOutcome outcome;
   LiveState live;
   bool running = false, done = false;

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "ids3010/twin.hpp"
 #include "line_gauge/twin.hpp"
 #include "ptu300/twin.hpp"
@@ -45,6 +46,9 @@ struct SimulatedShop::Impl {
   // before any twin's constructor can read the time.
   mutable double sim_s = 0.0;
   mutable std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+  // Simulated mode: the loop's VirtualTime is the shop's clock, and the speed only converts
+  // the callers' margins (given in wall seconds at that speed) to simulated seconds.
+  cal::drivers::VirtualTime* virtual_time;
   sim::Clock clock;
   sim::World world;
   sim::IdsTwin ids;
@@ -118,6 +122,7 @@ struct SimulatedShop::Impl {
       : io(ctx),
         truth(t),
         speed(s),
+        virtual_time(cal::drivers::VirtualTime::of(ctx)),
         clock([this] { return now(); }),
         world(machine(t), air(t)),
         ids(ctx, world, clock, laser(l)),
@@ -162,6 +167,7 @@ struct SimulatedShop::Impl {
   }
 
   double now() const {
+    if (virtual_time) return virtual_time->now_s();
     const auto wall = std::chrono::steady_clock::now();
     sim_s += std::min(speed * std::chrono::duration<double>(wall - last).count(), kMaxStep_s);
     last = wall;
@@ -177,8 +183,10 @@ SimulatedShop::~SimulatedShop() = default;
 const ShopTruth& SimulatedShop::truth() const { return impl_->truth; }
 double SimulatedShop::now_s() const { return impl_->now(); }
 cal::drivers::Clock SimulatedShop::clock_ns() const {
+  if (auto* vt = impl_->virtual_time) return [vt] { return vt->now_ns(); };
   return [impl = impl_.get()] { return static_cast<std::int64_t>(impl->now() * 1e9); };
 }
+bool SimulatedShop::simulated_time() const { return impl_->virtual_time != nullptr; }
 std::uint16_t SimulatedShop::laser_port() const { return impl_->ids.port(); }
 const std::string& SimulatedShop::air_device() const { return impl_->ptu.device_path(); }
 const std::string& SimulatedShop::material_device() const { return impl_->material.device_path(); }
@@ -352,6 +360,17 @@ double SimulatedShop::program_end_s() const { return impl_->world.machine().prog
 bool SimulatedShop::run_program(const std::function<bool()>& done, double margin_wall_s,
                                 const std::function<void()>& each) {
   const double end_s = program_end_s() + margin_wall_s * impl_->speed;
+  if (auto* vt = impl_->virtual_time) {
+    // Slices of 0.1 s of simulated time, so that `each` runs as often as it would live.
+    const auto end_ns = static_cast<std::int64_t>(end_s * 1e9);
+    while (!done() && vt->now_ns() < end_ns) {
+      const std::int64_t slice_end = std::min(end_ns, vt->now_ns() + 100'000'000);
+      const bool finished = vt->run_until(done, slice_end);
+      if (each) each();
+      if (!finished && vt->now_ns() < slice_end) break;  // nothing can happen any more
+    }
+    return done();
+  }
   // A last resort against a stalled clock: an hour of wall time.
   const auto hard = std::chrono::steady_clock::now() + std::chrono::hours(1);
   while (!done() && now_s() < end_s && std::chrono::steady_clock::now() < hard) {
@@ -362,6 +381,9 @@ bool SimulatedShop::run_program(const std::function<bool()>& done, double margin
 }
 
 bool SimulatedShop::wait_until(const std::function<bool()>& ready, double wall_s) {
+  if (auto* vt = impl_->virtual_time)  // wall_s at the shop's speed, in simulated time
+    return vt->run_for(
+        std::chrono::nanoseconds(static_cast<std::int64_t>(wall_s * impl_->speed * 1e9)), ready);
   const auto limit = std::chrono::steady_clock::now() + std::chrono::duration<double>(wall_s);
   while (!ready() && std::chrono::steady_clock::now() < limit)
     impl_->io.run_for(std::chrono::milliseconds(5));
@@ -413,10 +435,10 @@ window_mm = 0.5
 [test.linear]
 axis = "X"
 first_mm = 0
-last_mm = 500
+last_mm = {last_mm}
 interval_mm = 50
 random_fraction = 0.2
-runs = 5
+runs = {runs}
 overrun_mm = 3
 feed_mm_per_min = 6000
 dwell_s = 3
@@ -447,7 +469,8 @@ backlash_X = 3
              // simulated time; the poll periods of the drivers' defaults too.
              fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
                                                    /*serial_numbers=*/true)),
-             fmt::arg("alpha", t.expansion_ppm_per_k),
+             fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("last_mm", 50 * (o.targets - 1)),
+             fmt::arg("runs", o.runs),
              // Simulated seconds: at a high speed the wall-clock timers' jitter is
              // magnified, as in daq demo.
              fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),

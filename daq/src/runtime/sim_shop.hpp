@@ -62,6 +62,10 @@ struct ShopTruth {
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
 };
 
+// On an io_context with cal::drivers::VirtualTime installed (loop_time.hpp), the shop runs on
+// that simulated time, which jumps from event to event: run_program and wait_until then take
+// as long as the CPU needs, not the wall clock. Without it, simulated time follows the wall
+// clock times `speed` (the live mode of `daq sim`).
 class SimulatedShop {
  public:
   // `test`: the linear test the shop is set up for (kinds/kind.hpp): which axis the program
@@ -75,6 +79,7 @@ class SimulatedShop {
   const ShopTruth& truth() const;
   double now_s() const;  // simulated time
   cal::drivers::Clock clock_ns() const;
+  bool simulated_time() const;  // on the loop's VirtualTime (see above)
   std::uint16_t laser_port() const;
   const std::string& air_device() const;
   const std::string& material_device() const;
@@ -127,8 +132,9 @@ class SimulatedShop {
 //   clock and sees the program `speed` times faster than the program's own times, so the
 //   trigger's dwell and the laser's poll period are divided by the speed;
 // - in_process true (`daq serve --simulate`): its instruments read the shop's clock, every
-//   time in the file is simulated time (poll periods too: the service divides them by the
-//   speed), so the file reads as it would for a real machine. The air is opened as 8N1: a
+//   time in the file is simulated time (poll periods too: the service runs on a paced
+//   VirtualTime, whose timers wait in simulated time), so the file reads as it would for a
+//   real machine. The air is opened as 8N1: a
 //   pseudo-terminal refuses to have 7E1 applied a second time (EINVAL), and the service opens
 //   each device again for every run (a real PTU300 port is 4800 7E1).
 // Both carry the machine specification of `daq demo` ([tolerances.X], [tolerances.XY]), so
@@ -137,6 +143,10 @@ struct ShopConfigOptions {
   double speed = 1.0;
   bool position_feed = false;  // the MTConnect SHDR feed of the commanded position
   bool in_process = false;
+  // The linear program's size: a short one (e.g. 2 runs over 3 targets) tries the wiring in
+  // seconds; the full ISO 230-2 program (5 runs over 11 targets, 50 mm apart) takes minutes.
+  int runs = 5;
+  int targets = 11;
   bool circle_set = false;  // [test.circle] is the standard set (daq sim --test circle-set)
 };
 std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o);

@@ -9,6 +9,7 @@
 #include <cstdlib>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/transport/transport.hpp"
 #include "ids3010/instrument.hpp"
 #include "kinds/kind.hpp"
@@ -163,7 +164,12 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   namespace d = cal::drivers;
   namespace t = cal::drivers::transport;
   boost::asio::io_context io;
-  SimulatedShop shop(io, a.truth, a.speed, test);
+  // speed 0: simulated time that jumps from event to event (cal/drivers/loop_time.hpp), as
+  // fast as the CPU allows and the same readings on a loaded machine; loop seconds are then
+  // simulated seconds.
+  if (a.speed == 0) cal::drivers::VirtualTime::install(io);
+  const double pace = a.speed > 0 ? a.speed : 1.0;
+  SimulatedShop shop(io, a.truth, pace, test);
   if (a.compensation) shop.set_compensation(a.compensation);
   cal::daq::Config c;
   c.machine_name = a.machine;
@@ -176,7 +182,7 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   c.linear = test;
   const auto clock = shop.clock_ns();
   const auto poll = [&](double sim_s) {
-    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / a.speed * 1e6));
+    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / pace * 1e6));
   };
   LinearRunSetup setup;
   setup.config = c;

@@ -37,13 +37,14 @@ cal::daq::LinearTestConfig volumetric_test(std::string_view component);
 // One test acquired in this process on a fresh simulated shop with `truth`, through the real
 // drivers (IDS3010, PTU300, gauge codecs) against the twins, stored in `database` under
 // machine `machine` with the machine's topology; `compensation` (optional) is the control's
-// (sim_shop.hpp). The simulated time runs `speed` times faster than the wall clock and the
+// (sim_shop.hpp). speed 0 (default): simulated time that jumps from event to event
+// (cal/drivers/loop_time.hpp); speed > 0: it runs `speed` times faster than the wall clock. The
 // loop is bounded by simulated time. Throws cal::InputError for a bad test.
 struct SimulatedAcquisition {
   ShopTruth truth;
   std::filesystem::path database;
   std::string machine = "SIMULATED volumetric";
-  double speed = 30.0;
+  double speed = 0.0;
   std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> compensation;
 };
 LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -25,6 +26,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "database.hpp"
@@ -141,9 +143,13 @@ class Service {
       : io_(io), o_(std::move(o)), tick_(io), publish_timer_(io), program_timer_(io) {
     prepare_capture_dir(o_.capture_dir);
     if (o_.simulate) {
+      // The shop, the instruments' timers and the runs' timers on one simulated time line
+      // (cal/drivers/loop_time.hpp), paced at `speed` times the wall clock for the person
+      // watching; the page's own timers stay on the wall clock.
+      cal::drivers::VirtualTime::install(io_).pace(o_.speed);
       shop_ = std::make_unique<SimulatedShop>(io_, ShopTruth{}, o_.speed);
       o_.run.clock = shop_->clock_ns();
-      o_.run.poll_scale = 1.0 / o_.speed;
+      o_.run.poll_scale = 1.0;  // the instruments' timers wait in simulated time
       const auto text = simulated_shop_config(*shop_, {.speed = o_.speed, .in_process = true});
       use_config(cal::daq::parse_config(text, "simulated shop"));
     } else {
@@ -800,16 +806,23 @@ void serve(const ServeOptions& o) {
     fmt::print("daq serve: SIMULATED shop in this process, {}x faster than real time\n", o.speed);
   std::fflush(stdout);
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  bool stopping = false;
   signals.async_wait([&](auto ec, int) {
     if (ec) return;
     service.shutdown();
+    stopping = true;
     io.stop();
   });
   // Nothing a handler throws ends the service: the loop is run again after the run in
   // progress (if any) is ended with the reason (asio allows run() again after an exception).
+  // --simulate: the loop is driven by its simulated time (paced), which also serves the page.
+  auto* simulated = cal::drivers::VirtualTime::of(io);
   for (;;) {
     try {
-      io.run();
+      if (simulated)
+        simulated->run_until([&] { return stopping; }, std::numeric_limits<std::int64_t>::max());
+      else
+        io.run();
       return;
     } catch (const std::exception& e) {
       service.failed(e.what());

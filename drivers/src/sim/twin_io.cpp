@@ -56,9 +56,13 @@ void LineServer::accept() {
 }
 
 void LineServer::read(const ClientPtr& client) {
+  const std::size_t buffered = client->input.size();
   asio::async_read_until(
       client->socket, client->input, '\n',
-      [self = shared_from_this(), client](const boost::system::error_code& ec, std::size_t n) {
+      [self = shared_from_this(), client, buffered](const boost::system::error_code& ec,
+                                                    std::size_t n) {
+        if (auto* time = VirtualTime::of(client->socket.get_executor().context()))
+          time->bytes_read(client->input.size() - buffered);
         if (ec || self->closed_) {
           self->clients_.remove(client);
           return;

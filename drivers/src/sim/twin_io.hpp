@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/sim/twin.hpp"
 
 namespace cal::drivers::sim::detail {
@@ -27,18 +28,28 @@ struct LineWriter {
   static constexpr std::size_t max_queued = 1 << 16;
   std::deque<std::string> queue;
   std::uint64_t dropped = 0;
+  // Simulated mode: the bytes count as in flight until the driver reads them (loop_time.hpp).
+  VirtualTime* time = nullptr;
+  bool looked_up = false;
   void send(Stream& s, std::string line, std::shared_ptr<void> keep_alive) {
     if (queue.size() >= max_queued) {
       ++dropped;
       return;
     }
+    if (!looked_up) time = VirtualTime::of(s.get_executor().context());
+    looked_up = true;
+    if (time) time->bytes_written(line.size());
     queue.push_back(std::move(line));
     if (queue.size() == 1) next(s, std::move(keep_alive));
   }
   void next(Stream& s, std::shared_ptr<void> keep_alive) {
     asio::async_write(s, asio::buffer(queue.front()),
                       [this, &s, keep_alive](const boost::system::error_code& ec, std::size_t) {
-                        if (ec) return queue.clear();
+                        if (ec) {  // what was not written never arrives
+                          if (time)
+                            for (const auto& q : queue) time->bytes_read(q.size());
+                          return queue.clear();
+                        }
                         queue.pop_front();
                         if (!queue.empty()) next(s, keep_alive);
                       });
@@ -100,9 +111,14 @@ struct PtyDevice {
 
 // What a PtyTwin's Impl is built on: the pty and the timer that paces the twin's output.
 struct PtyChannel {
-  explicit PtyChannel(asio::io_context& io) : pty(io), timer(io) {}
+  explicit PtyChannel(asio::io_context& io)
+      : pty(io), timer(io), simulated_time(VirtualTime::of(io) != nullptr) {}
   PtyDevice pty;
-  asio::steady_timer timer;
+  Timer timer;  // on the loop's time (loop_time.hpp)
+  // On simulated time (the twin's clock is then the loop's): the twin may sleep until its next
+  // output is due instead of waking every few milliseconds to look, and batches a stream more
+  // coarsely, since each wake-up costs CPU instead of wall time.
+  bool simulated_time;
 };
 
 // What a TcpTwin's Impl is built on: the line server and the timer that paces what the twin
@@ -111,26 +127,28 @@ struct TcpChannel {
   TcpChannel(asio::io_context& io, std::uint16_t port)
       : server(std::make_shared<LineServer>(io, port)), timer(io) {}
   std::shared_ptr<LineServer> server;
-  asio::steady_timer timer;
+  Timer timer;  // on the loop's time (loop_time.hpp)
 };
 
 // Reads CR- or LF-terminated command lines from self->pty's master and hands each (without
 // its terminator) to self->on_command.
 template <class Self>
 void read_commands(const std::shared_ptr<Self>& self) {
-  asio::async_read_until(self->pty.master, self->pty.input, '\r',
-                         [self](const boost::system::error_code& ec, std::size_t n) {
-                           if (ec) return;
-                           std::string line(
-                               asio::buffers_begin(self->pty.input.data()),
-                               asio::buffers_begin(self->pty.input.data()) + static_cast<long>(n));
-                           self->pty.input.consume(n);
-                           while (!line.empty() && (line.back() == '\r' || line.back() == '\n'))
-                             line.pop_back();
-                           while (!line.empty() && line.front() == '\n') line.erase(0, 1);
-                           self->on_command(line);
-                           read_commands(self);
-                         });
+  const std::size_t buffered = self->pty.input.size();
+  asio::async_read_until(
+      self->pty.master, self->pty.input, '\r',
+      [self, buffered](const boost::system::error_code& ec, std::size_t n) {
+        if (auto* time = VirtualTime::of(self->pty.master.get_executor().context()))
+          time->bytes_read(self->pty.input.size() - buffered);
+        if (ec) return;
+        std::string line(asio::buffers_begin(self->pty.input.data()),
+                         asio::buffers_begin(self->pty.input.data()) + static_cast<long>(n));
+        self->pty.input.consume(n);
+        while (!line.empty() && (line.back() == '\r' || line.back() == '\n')) line.pop_back();
+        while (!line.empty() && line.front() == '\n') line.erase(0, 1);
+        self->on_command(line);
+        read_commands(self);
+      });
 }
 
 }  // namespace cal::drivers::sim::detail

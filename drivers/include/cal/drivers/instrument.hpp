@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "cal/drivers/codec/common.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/transport/transport.hpp"
 
 namespace cal::drivers {
@@ -88,11 +89,6 @@ struct InstrumentEvents {
   std::function<void(const DeviceMessage&)> message;
 };
 
-// Monotonic nanoseconds. The default is the steady clock; replay substitutes the recorded
-// time of the bytes being delivered, so replayed readings carry their original timestamps.
-using Clock = std::function<std::int64_t()>;
-Clock steady_clock_ns();
-
 // Receives the exact bytes an instrument exchanged with its device, with the instrument's
 // clock: the capture file (replay/) implements it. Recording at the instrument boundary,
 // right after the transport, gives the readings and the recorded bytes one timestamp, so a
@@ -117,7 +113,7 @@ struct InstrumentOptions {
   std::chrono::microseconds poll_period{10'000};
   // A connected device that sends nothing for this long is treated as a dropped connection.
   std::chrono::milliseconds silence_timeout{3000};
-  Clock clock;                       // empty: steady_clock_ns()
+  Clock clock;                       // empty: loop_clock(io), the steady clock in real mode
   WireRecorder* recorder = nullptr;  // not owned; must outlive the instrument
   // Replay: the transport is a replay transport and the clock its recorded time. The
   // instrument then sends nothing and starts no timer (no polling, watchdog or reconnection

@@ -44,7 +44,10 @@ class Air {
  public:
   explicit Air(AirConfig config);  // throws cal::InputError for a period <= 0
   // The air at time t: the sensor values carry the configured noise, the refractive index is
-  // that of the noise-free air (the beam sees the true air; sensors see it with noise).
+  // that of the noise-free air (the beam sees the true air; sensors see it with noise). The
+  // noise is a function of (seed, quantity, t) alone, not of how many samples were taken
+  // before: two twins asking at the same simulated instant, in either order, get the same
+  // values, so a simulated session is reproducible bit for bit (cal/drivers/loop_time.hpp).
   AirSample sample(double t_s);
   // The noise-free air at t.
   air::Conditions conditions(double t_s) const;
@@ -52,8 +55,6 @@ class Air {
 
  private:
   AirConfig config_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
 };
 
 // What a fringe-counting laser aligned with `axis` reads, in metres of vacuum wavelength:
