@@ -10,6 +10,7 @@
 
 #include <filesystem>
 
+#include "../support/temp_dir.hpp"
 #include "cal/analysis/error.hpp"
 #include "model/model_file.hpp"
 
@@ -18,18 +19,8 @@ namespace {
 using nlohmann::json;
 namespace st = cal::storage;
 
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    path = std::filesystem::temp_directory_path() /
-           ("caldaq_bb_" + std::to_string(::getpid()) + "_" + std::to_string(counter()++));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  static int& counter() {
-    static int c = 0;
-    return c;
-  }
+struct TempDir : cal::test::TempDir {
+  TempDir() : cal::test::TempDir("caldaq-bb") {}
 };
 
 struct Stored {

@@ -16,6 +16,7 @@
 #include <random>
 #include <tuple>
 
+#include "../support/temp_dir.hpp"
 #include "cal/storage/chunk.hpp"
 #include "cal/storage/store.hpp"
 
@@ -26,14 +27,8 @@ namespace chunk = cal::storage::chunk;
 using cal::storage::RawReading;
 using cal::storage::Store;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("caldaq-stream-" + std::to_string(::getpid()) + "-" +
-                                        std::to_string(std::random_device{}()));
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
+struct TempDir : cal::test::TempDir {
+  TempDir() : cal::test::TempDir("caldaq-stream") {}
 };
 
 bool same(const RawReading& a, const RawReading& b) {

@@ -15,6 +15,7 @@
 #include <random>
 #include <string>
 
+#include "../support/temp_dir.hpp"
 #include "cal/storage/store.hpp"
 
 namespace {
@@ -25,14 +26,8 @@ using cal::storage::RunStatus;
 using cal::storage::Store;
 using cal::storage::StoreError;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("caldaq-integrity-" + std::to_string(::getpid()) + "-" +
-                                        std::to_string(std::random_device{}()));
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
+struct TempDir : cal::test::TempDir {
+  TempDir() : cal::test::TempDir("caldaq-integrity") {}
 };
 
 std::string bytes_of(const fs::path& p) {

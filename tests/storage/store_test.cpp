@@ -15,6 +15,8 @@
 #include <fstream>
 #include <random>
 
+#include "../support/temp_dir.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -23,14 +25,8 @@ using cal::storage::RunStatus;
 using cal::storage::Store;
 using cal::storage::StoreError;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("caldaq-store-" + std::to_string(::getpid()) + "-" +
-                                        std::to_string(std::random_device{}()));
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
+struct TempDir : cal::test::TempDir {
+  TempDir() : cal::test::TempDir("caldaq-store") {}
 };
 
 std::vector<RawReading> make_readings(std::size_t n, std::uint64_t seed) {
