@@ -16,9 +16,16 @@ struct BatchWriter::Impl {
   WriterOptions options;
   std::function<void(const std::string&)> on_error;
 
-  std::vector<RawReading> current;  // producer side only
-  std::uint64_t pushed = 0;         // producer side only
-  std::chrono::steady_clock::time_point current_started{};
+  std::vector<RawReading> current;      // producer side only
+  std::uint64_t pushed = 0;             // producer side only
+  std::int64_t current_started_ns = 0;  // on options.clock_ns
+
+  std::int64_t now_ns() const {
+    if (options.clock_ns) return options.clock_ns();
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
 
   mutable std::mutex mutex;
   std::condition_variable changed;
@@ -125,16 +132,18 @@ void BatchWriter::push(const RawReading& r) {
   Impl& m = *impl_;
   if (m.current.empty()) {
     m.check_error();
-    m.current_started = std::chrono::steady_clock::now();
+    m.current_started_ns = m.now_ns();
   }
   m.current.push_back(r);
   ++m.pushed;  // producer-side only; stats() is called from the producer's thread
   if (m.current.size() >= m.options.batch_readings) m.hand_over();
 }
 
-void BatchWriter::flush_if_old(std::chrono::steady_clock::time_point now) {
-  if (!impl_->current.empty() && now - impl_->current_started >= impl_->options.batch_age)
-    impl_->hand_over();
+void BatchWriter::flush_if_old() {
+  Impl& m = *impl_;
+  if (m.current.empty()) return;
+  const std::chrono::nanoseconds age{m.now_ns() - m.current_started_ns};
+  if (age >= m.options.batch_age) m.hand_over();
 }
 
 void BatchWriter::flush() {

@@ -73,4 +73,36 @@ TEST(BatchWriter, AFullDiskStopsTheProducerAndKeepsCommittedBatches) {
   EXPECT_EQ(store.reading_count(run), static_cast<std::int64_t>(committed));
 }
 
+// The age of a batch is read on the clock it is given (a simulated session's loop time), not
+// the wall clock: the batches a simulated run commits do not depend on how fast the machine is
+// (a fast machine made the first batch of `daq demo` large enough not to fit beside the schema
+// on cli_full_disk's small disk, a loaded one did not).
+TEST(BatchWriter, TheBatchAgeIsReadOnTheGivenClock) {
+  TempFile file;
+  std::int64_t run = 0;
+  { run = Store(file.path).begin_run({.kind = "linear"}); }
+  std::int64_t now_ns = 0;
+  {
+    BatchWriter writer(file.path, run,
+                       {.batch_readings = 1000,
+                        .batch_age = std::chrono::milliseconds(200),
+                        .clock_ns = [&now_ns] { return now_ns; }});
+    writer.push(reading(0));
+    now_ns = 199'999'999;  // 1 ns short of the age: kept
+    writer.push(reading(1));
+    writer.flush_if_old();
+    // max_queue_depth is set as a batch is handed over (on this thread, not the writer's).
+    EXPECT_EQ(writer.stats().max_queue_depth, 0u);
+    // The oldest reading is 200 ms old on the given clock, though only microseconds passed on
+    // the wall clock: handed over.
+    now_ns = 200'000'000;
+    writer.flush_if_old();
+    EXPECT_EQ(writer.stats().max_queue_depth, 1u);
+    writer.flush();
+    EXPECT_EQ(writer.stats().batches_committed, 1u);
+    EXPECT_EQ(writer.stats().readings_committed, 2u);
+  }
+  EXPECT_EQ(Store(file.path).reading_count(run), 2);
+}
+
 }  // namespace
