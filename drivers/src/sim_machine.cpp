@@ -182,6 +182,7 @@ struct Machine::Impl {
   // machine's command does not change, so the compensation (a model's volumetric correction
   // can be costly) is evaluated once per new command, with the same result.
   std::optional<std::pair<Vec3, Vec3>> last_setpoint;
+  std::optional<kinematics::Machine> probe_geometry;  // error_at's (see there)
 
   // The set-point the position loops follow: the command plus the control's compensation.
   Vec3 compensated(const Vec3& c) {
@@ -315,9 +316,15 @@ void Machine::set_compensation(std::function<Vec3(const Vec3&)> compensation_um)
 }
 
 kinematics::VolumetricError Machine::error_at(const Vec3& offset_mm) const {
-  kinematics::Machine g = impl_->config.geometry;
-  g.tool_offset_mm = offset_mm;
-  return kinematics::volumetric_error(g, impl_->state.axes_mm, kinematics::Method::htm);
+  // The geometry with the probe's offset, copied once per offset (the geometry itself never
+  // changes): an instrument asks at every reading, and a copy of the 18 error functions costs
+  // more than the HTM chain.
+  auto& g = impl_->probe_geometry;
+  if (!g || g->tool_offset_mm != offset_mm) {
+    g = impl_->config.geometry;
+    g->tool_offset_mm = offset_mm;
+  }
+  return kinematics::volumetric_error(*g, impl_->state.axes_mm, kinematics::Method::htm);
 }
 
 }  // namespace cal::drivers::sim
