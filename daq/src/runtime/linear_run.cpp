@@ -687,7 +687,11 @@ struct LinearRun::Impl {
   void tick() {
     if (done) return;
     publish();
-    if (writer) writer->flush_if_old();
+    try {
+      if (writer) writer->flush_if_old();
+    } catch (const std::exception& e) {  // the writer failed (a full disk), its abort not run yet
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     timer.expires_after(std::chrono::milliseconds(100));
     timer.async_wait([this](const boost::system::error_code& ec) {
       if (!ec) tick();
