@@ -16,15 +16,11 @@ struct BatchWriter::Impl {
   WriterOptions options;
   std::function<void(const std::string&)> on_error;
 
-  std::vector<RawReading> current;      // producer side only
-  std::uint64_t pushed = 0;             // producer side only
-  std::int64_t current_started_ns = 0;  // on options.clock_ns
-
-  std::int64_t now_ns() const {
-    if (options.clock_ns) return options.clock_ns();
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
+  std::vector<RawReading> current;  // producer side only
+  std::uint64_t pushed = 0;         // producer side only
+  std::chrono::steady_clock::time_point current_started{};
+  std::chrono::steady_clock::time_point now() const {
+    return options.clock ? options.clock() : std::chrono::steady_clock::now();
   }
 
   mutable std::mutex mutex;
@@ -132,7 +128,7 @@ void BatchWriter::push(const RawReading& r) {
   Impl& m = *impl_;
   if (m.current.empty()) {
     m.check_error();
-    m.current_started_ns = m.now_ns();
+    m.current_started = m.now();
   }
   m.current.push_back(r);
   ++m.pushed;  // producer-side only; stats() is called from the producer's thread
@@ -140,10 +136,8 @@ void BatchWriter::push(const RawReading& r) {
 }
 
 void BatchWriter::flush_if_old() {
-  Impl& m = *impl_;
-  if (m.current.empty()) return;
-  const std::chrono::nanoseconds age{m.now_ns() - m.current_started_ns};
-  if (age >= m.options.batch_age) m.hand_over();
+  if (!impl_->current.empty() && impl_->now() - impl_->current_started >= impl_->options.batch_age)
+    impl_->hand_over();
 }
 
 void BatchWriter::flush() {

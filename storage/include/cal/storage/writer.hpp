@@ -20,10 +20,10 @@ struct WriterOptions {
   std::chrono::milliseconds batch_age{200};  // when its oldest reading is this old
   std::size_t max_queued_batches = 8;        // then the producer waits
   StoreOptions store;                        // for the writer's own connection
-  // The clock the batch age is measured on (monotonic ns), read on the producer's thread; empty:
-  // the steady clock. A simulated session passes its loop's simulated time, so its batches (and
-  // what a full disk or a crash leaves committed) do not depend on how fast the machine is.
-  std::function<std::int64_t()> clock_ns;
+  // The clock a batch's age is measured on (empty: the steady clock). A session on simulated
+  // time passes its loop's clock, so that its batches (what each commit holds) are the same
+  // on a fast or a loaded machine instead of depending on how fast the CPU runs it.
+  std::function<std::chrono::steady_clock::time_point()> clock;
 };
 
 struct WriterStats {
@@ -47,8 +47,8 @@ class BatchWriter {
   BatchWriter& operator=(const BatchWriter&) = delete;
 
   void push(const RawReading& r);
-  // Hands the current batch over (even if small) when its oldest reading is batch_age old on
-  // options.clock_ns, e.g. from a periodic timer on the loop.
+  // Hands the current batch over (even if small) when it is batch_age old by the options'
+  // clock, e.g. from a periodic timer on the loop.
   void flush_if_old();
   // Hands over the current batch and waits until everything pushed so far is committed.
   void flush();
