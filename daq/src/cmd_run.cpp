@@ -60,7 +60,8 @@ void watch_keyboard(boost::asio::io_context& io, std::function<void()> on_enter)
 // capture that cannot be written (a full disk) aborts the run, naming the file; what was
 // written before stays readable in both the store and the capture.
 template <class Run>
-const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& capture) {
+const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& capture,
+                       const RunDriver& drive) {
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](auto ec, int) {
     if (!ec) run.stop("stopped by the operator");
@@ -69,7 +70,12 @@ const auto& run_to_end(boost::asio::io_context& io, Run& run, SessionCapture& ca
     capture.recorder->on_failure([&io, &run](const std::string& e) {
       boost::asio::post(io, [&run, e] { run.stop("capture failed: " + e); });
     });
-  while (!run.finished()) io.run_for(100ms);
+  if (drive) {
+    drive([&run] { return run.finished(); });
+    if (!run.finished()) run.stop("the simulated program ended before the run was complete");
+  } else {
+    while (!run.finished()) io.run_for(100ms);
+  }
   if (capture.recorder) capture.recorder->close();
   const auto& out = run.outcome();
   if (!out.complete)
@@ -131,21 +137,22 @@ void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
   fmt::print("{}\nrun {} stored ({}): {} readings\n\n", tty ? "\r\033[K" : "", out.run_id,
              cal::storage::to_string(out.status), out.readings);
   const std::string unit = j.value("unit", "");
-  fmt::print("{} {} (mean of the stops at each target, {})\n", j.value("kind", ""),
-             out.component, unit);
+  fmt::print("{} {} (mean of the stops at each target, {})\n", j.value("kind", ""), out.component,
+             unit);
   for (const auto& t : j["targets"])
     fmt::print("  {:10.3f} mm  {:+10.3f}  (spread {:.3f}, {} stops)\n",
-               t["position_mm"].get<double>(), t["mean"].get<double>(),
-               t["spread"].get<double>(), t["count"].get<int>());
+               t["position_mm"].get<double>(), t["mean"].get<double>(), t["spread"].get<double>(),
+               t["count"].get<int>());
   fmt::print("range {:.3f} {}\n", j["range"].get<double>(), unit);
   if (j.contains("straightness_um"))
     fmt::print("straightness {:.3f} um about the least-squares line (slope {:+.3f} um/m)\n",
                j["straightness_um"].get<double>(), j["slope_um_per_m"].get<double>());
 }
 
-void run_linear(const RunOptions& o) {
+}  // namespace
+
+void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const RunDriver& drive) {
   const auto config = cal::daq::load_config(o.config);
-  boost::asio::io_context io;
   const auto specs = linear_specs(config);
   check_at_start(config, specs, o);
   SessionCapture capture(o.capture, config, specs);
@@ -173,7 +180,7 @@ void run_linear(const RunOptions& o) {
       "captures the current stop by hand; Ctrl-C stops.",
       o.config));
   watch_keyboard(io, [&] { run.manual_capture(); });
-  const auto& out = run_to_end(io, run, capture);
+  const auto& out = run_to_end(io, run, capture, drive);
   if (out.profile) return print_profile(out, o.json, progress->tty);
   const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
   const auto v = verdict_of(
@@ -206,11 +213,10 @@ void run_linear(const RunOptions& o) {
 }
 
 // daq run circle: the ballbar streams; the run waits for the feed-in, then records both arcs.
-void run_circle(const RunOptions& o) {
+void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const RunDriver& drive) {
   const auto config = cal::daq::load_config(o.config);
   const auto tests = circle_tests(config);  // one test, or the set of [test.circle] planes
   const auto& dc = need(config, "ballbar");
-  boost::asio::io_context io;
   const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
   check_at_start(config, specs, o);
   SessionCapture capture(o.capture, config, specs);
@@ -235,7 +241,7 @@ void run_circle(const RunOptions& o) {
       "Waiting for the feed-in{}: run the program from `daq gcode circle --config {}`; Ctrl-C "
       "stops.",
       tests.size() > 1 ? fmt::format(" of the first of {} tests", tests.size()) : "", o.config));
-  const auto& last = run_to_end(io, run, capture);
+  const auto& last = run_to_end(io, run, capture, drive);
   std::vector<const CircleRunOutcome*> outs;
   for (const auto& c : run.completed()) outs.push_back(&c);
   outs.push_back(&last);
@@ -265,6 +271,18 @@ void run_circle(const RunOptions& o) {
         "\n{} tests stored as runs {}..{} of campaign '{}': `daq ballbar volumetric "
         "--runs ...` or `daq report --campaign` for the three-plane table\n",
         outs.size(), outs.front()->run_id, outs.back()->run_id, config.campaign);
+}
+
+namespace {
+
+void run_linear(const RunOptions& o) {
+  boost::asio::io_context io;
+  run_linear_test(o, io, {});
+}
+
+void run_circle(const RunOptions& o) {
+  boost::asio::io_context io;
+  run_circle_test(o, io, {});
 }
 
 struct GcodeOptions {

@@ -15,12 +15,14 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/volumetric_comp.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "linear_run.hpp"
 #include "model/model_file.hpp"
+#include "run_setup.hpp"
 #include "sim_shop.hpp"
 #include "sim_volumetric.hpp"
 
@@ -36,10 +38,14 @@ struct SimOptions {
   std::optional<double> start_after_s;  // unset: wait for a run in the database
   std::string db;
   bool position_feed = false;
-  int runs = 5, targets = 11;  // the linear program's size (ShopConfigOptions)
-  std::string measure;         // a component of the volumetric campaign, e.g. E_YX
+  int runs = 5, targets = 11;     // the linear program's size (ShopConfigOptions)
+  double feed_mm_per_min = 1000;  // the circle's
+  std::string measure;            // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
   std::string compensate;  // a model file whose volumetric correction the control applies
+  bool acquire = false;    // run the acquisition in this process, on simulated time
+  std::string capture;     // with acquire: the run's capture file
+  bool json = false;       // with acquire: the result as JSON on stdout (as daq run --json)
 };
 
 std::string numbers(const std::array<double, 3>& v) {
@@ -128,7 +134,14 @@ void run_sim(SimOptions o) {
   } else if (!o.compensate.empty()) {
     throw cal::InputError("--compensate applies to the volumetric machine: give --measure too");
   }
+  if (o.acquire && (o.start_after_s || o.speed != 1.0 || volumetric))
+    throw cal::InputError(
+        "--acquire runs the program when its own run starts, on simulated time: without "
+        "--start-after-s, --speed or --measure");
   boost::asio::io_context io;
+  // --acquire: the shop, the instruments and the run on one simulated time line that jumps
+  // from event to event (cal/drivers/loop_time.hpp), as in daq demo.
+  if (o.acquire) cal::drivers::VirtualTime::install(io);
   SimulatedShop shop(io, truth, o.speed, volumetric.value_or(cal::daq::LinearTestConfig{}));
   if (!o.compensate.empty()) {
     // The control applies the model's full volumetric correction (cal::volcomp::correction_um,
@@ -143,14 +156,15 @@ void run_sim(SimOptions o) {
       return cal::volcomp::correction_um(model.machine, q, model.carriers);
     });
   }
-  const std::string text = volumetric
-                               ? volumetric_config(shop, o.speed, *volumetric)
-                               : simulated_shop_config(shop, {.speed = o.speed,
-                                                              .position_feed = o.position_feed,
-                                                              .in_process = false,
-                                                              .runs = o.runs,
-                                                              .targets = o.targets,
-                                                              .circle_set = set});
+  const std::string text =
+      volumetric ? volumetric_config(shop, o.speed, *volumetric)
+                 : simulated_shop_config(shop, {.speed = o.speed,
+                                                .position_feed = o.position_feed,
+                                                .in_process = false,
+                                                .runs = o.runs,
+                                                .targets = o.targets,
+                                                .circle_set = set,
+                                                .circle_feed_mm_per_min = o.feed_mm_per_min});
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -162,8 +176,8 @@ void run_sim(SimOptions o) {
   const auto run_until = [&](double sim_s) {
     while (shop.now_s() < sim_s) io.run_for(2ms);
   };
-  const auto run_program = [&](const std::string& test) {
-    const double t0_s = shop.now_s();
+  // The machine starts the test's program (it ends at shop.program_end_s()).
+  const auto start_program = [&](const std::string& test) {
     if (test == "circle" && set) {  // the whole set in one program, as daq gcode writes it
       std::vector<cal::daq::BallbarSetTest> program;
       for (const auto& t : circle_tests(config)) program.push_back({t.plane, t.program});
@@ -174,6 +188,33 @@ void run_sim(SimOptions o) {
       const auto& l = *config.linear;
       shop.run_linear(linear_plan(l), l.feed_mm_per_min, l.dwell_s);
     }
+  };
+  if (o.acquire) {
+    // `daq run TEST --config FILE` in this process: the same configuration, instruments, run,
+    // output and capture.
+    const std::string test = o.test == "linear" ? "linear" : "circle";
+    std::FILE* out = o.json ? stderr : stdout;  // stdout carries only the JSON then
+    fmt::print(out,
+               "daq sim: SIMULATED shop on simulated time in this process; acquiring as `daq run "
+               "{} --config {}` does\n",
+               test, o.config_out);
+    std::fflush(out);
+    RunOptions ro{
+        .config = o.config_out, .db = o.db, .capture = o.capture, .json = o.json, .check_s = 0};
+    ro.clock = shop.clock_ns();
+    auto& vt = *cal::drivers::VirtualTime::of(io);
+    const RunDriver drive = [&](const std::function<bool()>& finished) {
+      // The instruments connect and the machine rests on its first target (a rest is no stop)
+      // for 5 simulated seconds before the program starts, as after an operator's Cycle Start.
+      vt.run_for(5s, finished);
+      start_program(test);
+      shop.run_program(finished, 3.0);
+    };
+    return test == "linear" ? run_linear_test(ro, io, drive) : run_circle_test(ro, io, drive);
+  }
+  const auto run_program = [&](const std::string& test) {
+    const double t0_s = shop.now_s();
+    start_program(test);
     fmt::print("daq sim: {} program started ({:.0f} s of simulated time)\n", test,
                shop.program_end_s() - t0_s);
     std::fflush(stdout);
@@ -250,6 +291,10 @@ void add_sim_command(CLI::App& app) {
                   "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11)")
       ->capture_default_str()
       ->check(CLI::Range(2, 11));
+  cmd->add_option("--feed-mm-per-min", o->feed_mm_per_min,
+                  "The circle test's feed (--test circle; the set has its own two)")
+      ->capture_default_str()
+      ->check(CLI::Range(100.0, 10000.0));
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->add_option("--measure", o->measure,
@@ -260,6 +305,15 @@ void add_sim_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--compensate", o->compensate,
                   "With --measure: the control applies this model's volumetric correction");
+  cmd->add_flag("--acquire", o->acquire,
+                "Acquire the --test here instead of waiting for `daq run` in another process: "
+                "`daq run TEST --config FILE` runs in this process on SIMULATED time (as fast as "
+                "the CPU allows, the same on a loaded machine), prints what it prints and stores "
+                "into --db");
+  cmd->add_option("--capture", o->capture, "--acquire: record the run's wire-level capture here");
+  cmd->add_flag(
+      "--json", o->json,
+      "--acquire: the result as JSON on stdout, as `daq run --json` (progress on stderr)");
   cmd->callback([o] { run_sim(*o); });
 }
 

@@ -34,6 +34,15 @@ struct RunOptions {
       wrap;
 };
 
+// How `daq run` drives its event loop until the run has finished: empty, by the wall clock
+// until the run ends (Ctrl-C stops it); `daq sim --acquire` runs the simulated shop's program on
+// simulated time instead, then the run is stopped if it has not finished.
+using RunDriver = std::function<void(const std::function<bool()>& finished)>;
+// `daq run linear` and `daq run circle` on `io` (o.config names the configuration); print the
+// results; throw cal::InputError when the run did not complete.
+void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const RunDriver& drive);
+void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const RunDriver& drive);
+
 // The transport of a device ("tcp HOST:PORT", "serial DEVICE BAUD FRAME", "hid VID:PID" or
 // "hid /dev/hidrawN"); throws cal::InputError naming the device and its transport text.
 std::unique_ptr<cal::drivers::transport::Transport> make_transport(boost::asio::io_context& io,

@@ -28,3 +28,22 @@ finish() {
   echo "$passes passed, $fails failed"
   [ "$fails" -eq 0 ]
 }
+
+# The Python interpreter itself, not a version manager's shim (pyenv's costs ~0.07 s a call).
+PY=$(python3 -c 'import sys; print(sys.executable)')
+
+# demo_runs DIR: DIR/demo.sqlite and demo.log of one `daq demo --quiet`, and DEMO_CDQ its
+# capture: copied from (the capture read in) the ctest fixture "demo" (CALDAQ_DEMO_FIXTURE,
+# tests/CMakeLists.txt), else made here. The capture stays where the demo wrote it: the runs
+# record its absolute path, by which `daq replay` finds the run it replays.
+demo_runs() {
+  if [ -n "${CALDAQ_DEMO_FIXTURE:-}" ]; then
+    cp "$CALDAQ_DEMO_FIXTURE"/demo.sqlite* "$CALDAQ_DEMO_FIXTURE"/demo.log "$1/" ||
+      { echo "FAIL: no demo fixture in $CALDAQ_DEMO_FIXTURE"; exit 1; }
+    DEMO_CDQ=$CALDAQ_DEMO_FIXTURE/demo.cdq
+  else
+    (cd "$1" && "$DAQ" demo --quiet --db demo.sqlite --capture demo.cdq >demo.log 2>&1) ||
+      { cat "$1/demo.log"; exit 1; }
+    DEMO_CDQ=$1/demo.cdq
+  fi
+}

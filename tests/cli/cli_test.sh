@@ -33,9 +33,10 @@ check targets_short_default 2 "give an interval or a count" -- "$DAQ" targets --
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-check demo 0 "Simulated truth vs measured" -- "$DAQ" demo --quiet --db "$TMP/demo.sqlite" --capture "$TMP/demo.cdq"
+demo_runs "$TMP"  # `daq demo --quiet` (the ctest fixture "demo", or run here)
+check demo 0 "Simulated truth vs measured" -- cat "$TMP/demo.log"
 # A capture cut in half: the replay says where the damage is and stores nothing as complete.
-head -c 300000 "$TMP/demo.cdq" > "$TMP/cut.cdq"
+head -c 300000 "$DEMO_CDQ" > "$TMP/cut.cdq"
 check replay_damaged 2 "cut.cdq: replay stored as run [0-9]+ but incomplete: the capture is damaged at byte [0-9]+" -- "$DAQ" replay "$TMP/cut.cdq" --db "$TMP/replay.sqlite"
 check replay_not_capture 2 "not a caldaq capture file" -- "$DAQ" replay "$DATA/hand.csv" --db "$TMP/replay.sqlite"
 check demo_stored 0 "complete" -- "$DAQ" runs --db "$TMP/demo.sqlite"
@@ -43,10 +44,10 @@ check demo_export 0 "^time_s,utc,device,device_name,channel,quantity,status,valu
 check demo_targets 0 "^0,1,up,-?[0-9.e-]+,1,[0-9.e-]+,20[0-9-]+T[0-9:.]+Z," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"
 # Exports loaded back: the targets feed `daq analyse iso230-2` and give the stored run's E; the
 # circle traces feed `daq analyse circle` and give its G; a circle has no targets.
-E=$("$DAQ" analyse 1 --db "$TMP/demo.sqlite" --json | python3 -c "import json,sys; print(format(json.load(sys.stdin)['axis']['E_bi']['value_um'], '.3f'))")
+E=$("$DAQ" analyse 1 --db "$TMP/demo.sqlite" --json | "$PY" -c "import json,sys; print(format(json.load(sys.stdin)['axis']['E_bi']['value_um'], '.3f'))")
 "$DAQ" export 1 --what targets -o "$TMP/deviations.csv" --db "$TMP/demo.sqlite"
 check targets_feed_analyse 0 "^  E +$E um" -- "$DAQ" analyse iso230-2 --input "$TMP/deviations.csv"
-G=$("$DAQ" analyse 2 --db "$TMP/demo.sqlite" --json | python3 -c "import json,sys; print(format(json.load(sys.stdin)['iso230_4']['G_bi_um'], '.3f'))")
+G=$("$DAQ" analyse 2 --db "$TMP/demo.sqlite" --json | "$PY" -c "import json,sys; print(format(json.load(sys.stdin)['iso230_4']['G_bi_um'], '.3f'))")
 "$DAQ" export 2 --what circle -o "$TMP/ballbar.csv" --db "$TMP/demo.sqlite"
 opts=$(sed -nE 's/^# .*daq analyse circle --input FILE (.*)$/\1/p' "$TMP/ballbar.csv")
 check circle_feed_analyse 0 "G\(b\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
@@ -56,7 +57,7 @@ check linear_no_circle 2 "run 1 is a linear test, not a circle" -- "$DAQ" export
 # 1 ms period), seconds from the start rising, UTC sub-second, device names, values that read
 # back exactly (the shortest round-trip form).
 "$DAQ" export 2 -o "$TMP/bar.csv" --db "$TMP/demo.sqlite"
-check readings_times 0 "^ok" -- python3 -c "
+check readings_times 0 "^ok" -- "$PY" -c "
 import csv, re, sys
 rows = list(csv.DictReader(open('$TMP/bar.csv')))
 t = [float(r['time_s']) for r in rows if r['device_name'] == 'ballbar']

@@ -417,9 +417,8 @@ std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOpt
                 "# Written by `daq sim`: the devices of the built-in SIMULATED shop (running {}x\n"
                 "# faster than real time). Valid while that process runs.\n",
                 o.speed);
-  return header +
-         fmt::format(
-             R"TOML(campaign = "simulated"
+  return header + fmt::format(
+                      R"TOML(campaign = "simulated"
 
 [machine]
 name = "SIMULATED VMC"
@@ -467,24 +466,26 @@ G_um = 10
 squareness = 30
 backlash_X = 3
 )TOML",
-             fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
-             // In process the instruments read the shop's clock: every time is
-             // simulated time; the poll periods of the drivers' defaults too.
-             fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
-                                                   /*serial_numbers=*/true)),
-             fmt::arg("alpha", t.expansion_ppm_per_k), fmt::arg("last_mm", 50 * (o.targets - 1)),
-             fmt::arg("runs", o.runs),
-             // Simulated seconds: at a high speed the wall-clock timers' jitter is
-             // magnified, as in daq demo.
-             fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
-             fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
-             fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
-             fmt::arg("cz", t.pivot_mm[2]),
-             // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220
-             // deg over the top, each at a slow and a fast feed (docs/circle.md).
-             fmt::arg("circle_tests", o.circle_set ? "planes = [\"XY\", \"ZX\", \"YZ\"]\n"
-                                                     "feeds_mm_per_min = [1000, 3000]\n"
-                                                   : "plane = \"XY\"\nfeed_mm_per_min = 1000\n"));
+                      fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
+                      // In process the instruments read the shop's clock: every time is
+                      // simulated time; the poll periods of the drivers' defaults too.
+                      fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
+                                                            /*serial_numbers=*/true)),
+                      fmt::arg("alpha", t.expansion_ppm_per_k),
+                      fmt::arg("last_mm", 50 * (o.targets - 1)), fmt::arg("runs", o.runs),
+                      // Simulated seconds: at a high speed the wall-clock timers' jitter is
+                      // magnified, as in daq demo.
+                      fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
+                      fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
+                      fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
+                      fmt::arg("cz", t.pivot_mm[2]),
+                      // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220
+                      // deg over the top, each at a slow and a fast feed (docs/circle.md).
+                      fmt::arg("circle_tests",
+                               o.circle_set ? "planes = [\"XY\", \"ZX\", \"YZ\"]\n"
+                                              "feeds_mm_per_min = [1000, 3000]\n"
+                                            : fmt::format("plane = \"XY\"\nfeed_mm_per_min = {}\n",
+                                                          o.circle_feed_mm_per_min)));
 }
 
 }  // namespace daq

@@ -148,6 +148,8 @@ struct ShopConfigOptions {
   int runs = 5;
   int targets = 11;
   bool circle_set = false;  // [test.circle] is the standard set (daq sim --test circle-set)
+  // The single circle's feed: 1000 mm/min; a faster one is a shorter live run (fewer samples).
+  double circle_feed_mm_per_min = 1000;
 };
 std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o);
 
