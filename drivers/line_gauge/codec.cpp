@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/codec/decimal.hpp"
 
 namespace cal::drivers::codec {
 namespace {
@@ -102,6 +103,14 @@ std::optional<double> GaugeCodec::to_si(double printed,
 
 std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
                                               std::vector<CodecError>& errors) {
+  // The common line of a streaming gauge, a bare number between blanks ("+100.000123"), in one
+  // pass: a line of blanks, a sign, digits and a point is printable and one token, so the
+  // general path below would take the same number (parse_number has the same exact fast path)
+  // and the same unit; only the scanning is saved.
+  if (double printed; !regex_ && parse_plain_decimal(trim(line), printed)) {
+    const auto si = to_si(printed, std::nullopt);
+    if (si && *si >= config_.min_si && *si <= config_.max_si) return si;
+  }
   if (!is_printable_ascii(line)) {
     report(errors, ErrorKind::garbage, off, "gauge: non-printable bytes in a line");
     return std::nullopt;

@@ -23,6 +23,9 @@ struct BatchWriter::Impl {
   mutable std::mutex mutex;
   std::condition_variable changed;
   std::deque<std::vector<RawReading>> queue;
+  // Committed batches' vectors, emptied, for the producer to fill again: no allocation (and no
+  // fresh pages to fault in) per batch.
+  std::vector<std::vector<RawReading>> spare;
   bool closing = false;
   bool busy = false;  // the writer holds a batch it has not committed yet
   std::string error;
@@ -56,6 +59,10 @@ struct BatchWriter::Impl {
       busy = false;
       stats.readings_committed += batch.size();
       ++stats.batches_committed;
+      if (spare.size() < 2) {
+        batch.clear();
+        spare.push_back(std::move(batch));
+      }
       changed.notify_all();
     }
   }
@@ -89,9 +96,14 @@ struct BatchWriter::Impl {
     if (!error.empty()) throw StoreError(error);
     queue.push_back(std::move(current));
     stats.max_queue_depth = std::max(stats.max_queue_depth, queue.size());
-    current = {};
-    current.reserve(options.batch_readings);
+    if (spare.empty()) {
+      current = {};
+    } else {
+      current = std::move(spare.back());
+      spare.pop_back();
+    }
     lock.unlock();
+    current.reserve(options.batch_readings);
     changed.notify_all();
   }
 };
@@ -130,6 +142,24 @@ void BatchWriter::push(const RawReading& r) {
   m.current.push_back(r);
   ++m.pushed;  // producer-side only; stats() is called from the producer's thread
   if (m.current.size() >= m.options.batch_readings) m.hand_over();
+}
+
+void BatchWriter::push(std::span<const RawReading> readings) {
+  Impl& m = *impl_;
+  while (!readings.empty()) {
+    if (m.current.empty()) {
+      m.check_error();
+      m.current_started = std::chrono::steady_clock::now();
+    }
+    // Up to the end of the current batch (at least one reading, as push(r) does).
+    const std::size_t limit = m.options.batch_readings;
+    const std::size_t room = m.current.size() < limit ? limit - m.current.size() : 1;
+    const auto take = readings.first(std::min(readings.size(), room));
+    m.current.insert(m.current.end(), take.begin(), take.end());
+    m.pushed += take.size();
+    readings = readings.subspan(take.size());
+    if (m.current.size() >= m.options.batch_readings) m.hand_over();
+  }
 }
 
 void BatchWriter::flush_if_old(std::chrono::steady_clock::time_point now) {

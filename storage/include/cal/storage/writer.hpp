@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "cal/storage/store.hpp"
@@ -43,6 +44,9 @@ class BatchWriter {
   BatchWriter& operator=(const BatchWriter&) = delete;
 
   void push(const RawReading& r);
+  // The same for several readings in order (one call per chunk of a high-rate stream); the
+  // batches are cut at the very same readings as by pushing them one by one.
+  void push(std::span<const RawReading> readings);
   // Hands the current batch over (even if small), e.g. from a periodic timer on the loop.
   void flush_if_old(std::chrono::steady_clock::time_point now);
   // Hands over the current batch and waits until everything pushed so far is committed.
