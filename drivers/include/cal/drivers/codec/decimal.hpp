@@ -17,19 +17,18 @@
 
 namespace cal::drivers::codec {
 
-// Parses the whole of `s` as [+-]digits[.digits] (at least one digit, either side of the point
-// may be empty) into `out`; false (out untouched) when `s` is not of that form or outside the
-// exact range above, in which case the caller must use the general parser.
-inline bool parse_plain_decimal(std::string_view s, double& out) {
-  // 10^0 .. 10^22: every one an exact double (10^22 = 2^22 * 5^22 and 5^22 < 2^53).
-  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-  constexpr std::uint64_t kMaxExact = std::uint64_t{1} << 53;
-  const char* p = s.data();
-  const char* const end = p + s.size();
-  bool negative = false;
-  if (p != end && (*p == '+' || *p == '-')) negative = *p++ == '-';
+namespace detail {
+
+// 10^0 .. 10^22: every one an exact double (10^22 = 2^22 * 5^22 and 5^22 < 2^53).
+inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                    1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                    1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+inline constexpr std::uint64_t kMaxExact = std::uint64_t{1} << 53;
+
+inline bool is_digit(char c) { return static_cast<unsigned>(c) - '0' < 10; }
+
+// The general loop, a digit at a time, counting significant digits (long strings).
+inline bool parse_plain_decimal_long(const char* p, const char* end, bool negative, double& out) {
   std::uint64_t m = 0;
   int significant = 0, fraction = 0;
   bool any_digit = false, point = false;
@@ -49,6 +48,37 @@ inline bool parse_plain_decimal(std::string_view s, double& out) {
   }
   if (!any_digit || m > kMaxExact || fraction > 22) return false;
   const double v = static_cast<double>(m) / kPow10[fraction];
+  out = negative ? -v : v;
+  return true;
+}
+
+}  // namespace detail
+
+// Parses the whole of `s` as [+-]digits[.digits] (at least one digit, either side of the point
+// may be empty) into `out`; false (out untouched) when `s` is not of that form or outside the
+// exact range above, in which case the caller must use the general parser.
+inline bool parse_plain_decimal(std::string_view s, double& out) {
+  const char* p = s.data();
+  const char* const end = p + s.size();
+  bool negative = false;
+  if (p != end && (*p == '+' || *p == '-')) negative = *p++ == '-';
+  // At most 19 characters: at most 19 digits, which always fit in 64 bits, so the digits need
+  // no counting; two plain loops (integer digits, fraction digits) with one multiply-add each.
+  if (end - p > 19) return detail::parse_plain_decimal_long(p, end, negative, out);
+  const char* const int_begin = p;
+  std::uint64_t m = 0;
+  for (; p != end && detail::is_digit(*p); ++p) m = m * 10 + static_cast<unsigned>(*p - '0');
+  const auto n_int = p - int_begin;
+  std::ptrdiff_t n_frac = 0;
+  if (p != end) {
+    if (*p != '.') return false;
+    const char* const frac_begin = ++p;
+    for (; p != end && detail::is_digit(*p); ++p) m = m * 10 + static_cast<unsigned>(*p - '0');
+    if (p != end) return false;
+    n_frac = p - frac_begin;
+  }
+  if (n_int + n_frac == 0 || m > detail::kMaxExact) return false;
+  const double v = static_cast<double>(m) / detail::kPow10[n_frac];
   out = negative ? -v : v;
   return true;
 }
