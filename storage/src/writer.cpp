@@ -50,12 +50,15 @@ struct BatchWriter::Impl {
         busy = true;
       }
       changed.notify_all();  // a producer waiting for room may go on
+      const auto start = std::chrono::steady_clock::now();
       try {
         store->append_readings(run_id, batch);
       } catch (const std::exception& e) {
         return fail(e.what());
       }
+      const auto took = std::chrono::steady_clock::now() - start;
       std::lock_guard lock(mutex);
+      stats.store_time += took;
       busy = false;
       stats.readings_committed += batch.size();
       ++stats.batches_committed;

@@ -30,6 +30,9 @@ struct WriterStats {
   std::size_t max_queue_depth = 0;
   std::uint64_t overload_waits = 0;           // times the producer found the queue full
   std::chrono::nanoseconds overload_time{0};  // total time it waited
+  // Time the writer thread spent storing batches (encoding, checksums, SQLite, the commits'
+  // fsyncs): near the wall time of a run, the writer is what limits it.
+  std::chrono::nanoseconds store_time{0};
 };
 
 class BatchWriter {
