@@ -62,7 +62,7 @@ name = "hostile"
 EOF
 conf() { { cat "$TMP/base.toml"; printf '%s\n' "$@"; } >"$TMP/c.toml"; echo "$TMP/c.toml"; }
 check conf_radius_inf 2 "c.toml:4:13: key 'test.circle.radius_mm': inf is not a finite number" -- "$DAQ" gcode circle -c "$(conf '[test.circle]' 'radius_mm = inf')"
-check conf_centre_nan 2 "c.toml:4:13: key 'test.circle.centre_mm': nan is not a finite position" -- "$DAQ" gcode circle -c "$(conf '[test.circle]' 'centre_mm = [nan, 0, 0]')"
+check conf_centre_nan 2 "c.toml:4:13: key 'test.circle.centre_mm': nan is not a finite number" -- "$DAQ" gcode circle -c "$(conf '[test.circle]' 'centre_mm = [nan, 0, 0]')"
 check conf_overrun 2 "key 'test.linear.overrun_mm': 1000000000 must be within 0 .. 1000 mm" -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' 'overrun_mm = 1e9')"
 check conf_runs_overflow 2 "key 'test.linear.runs': 4294967297 is out of range" -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' 'runs = 4294967297')"
 check conf_standard 2 "key 'test.linear.standard': .*iso230-2:2041" -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' 'standard = "iso230-2:2041"')"

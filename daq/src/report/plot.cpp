@@ -161,7 +161,9 @@ struct LegendEntry {
   double width = 1.5;
 };
 
-void draw_legend(const std::vector<LegendEntry>& entries, PLINT position) {
+// `columns` 0: one column; `y` the offset from the position, in the viewport's height.
+void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
+                 PLFLT y = 0.0) {
   if (entries.empty()) return;
   const auto n = static_cast<PLINT>(entries.size());
   std::vector<PLINT> opt, colours, text_colours, styles, box_patterns, symbol_numbers;
@@ -180,8 +182,9 @@ void draw_legend(const std::vector<LegendEntry>& entries, PLINT position) {
     symbols.push_back("");
   }
   PLFLT w = 0, h = 0;
-  pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, 0.0, 0.05, 0,
-           axes_colour, 1, 0, 0, n, opt.data(), 0.6, 0.85, 1.8, 0.0, text_colours.data(),
+  const PLINT rows = columns > 0 ? (n + columns - 1) / columns : 0;
+  pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, y, 0.05, 0,
+           axes_colour, 1, rows, columns, n, opt.data(), 0.6, 0.85, 1.8, 0.0, text_colours.data(),
            texts.data(), colours.data(), box_patterns.data(), scales.data(), widths.data(),
            colours.data(), styles.data(), widths.data(), colours.data(), scales.data(),
            symbol_numbers.data(), symbols.data());
@@ -349,8 +352,23 @@ std::string svg(const PolarChart& chart) {
     return std::clamp(1.0 + 0.2 * dev_um / div_um, 0.05, 1.55);
   };
 
-  SvgStream s(chart.size_pt, chart.size_pt);
-  plvpor(0.02, 0.98, 0.04, 0.92);
+  // The legend goes below the plot in up to three columns, and the page grows by its rows: the
+  // plot itself stays square (a circle drawn as a circle, not an ellipse) and no legend sits
+  // on the angle labels.
+  const auto labelled = std::count_if(chart.traces.begin(), chart.traces.end(),
+                                      [](const Line& l) { return !l.label.empty(); });
+  // As many columns of the longest label as fit the width (about 60 characters), up to 3.
+  std::size_t longest = 0;
+  for (const auto& t : chart.traces) longest = std::max(longest, t.label.size());
+  const auto fit = static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(60 / (longest + 6), 1, 3));
+  const PLINT columns = static_cast<PLINT>(std::min<std::ptrdiff_t>(labelled, fit));
+  const int rows = columns > 0 ? static_cast<int>((labelled + columns - 1) / columns) : 0;
+  const double width = chart.size_pt, side = 0.88 * width, top = 0.07 * width;
+  const double height = width + (rows > 0 ? 16.0 * rows + 14.0 : 0.0);
+  SvgStream s(chart.size_pt, static_cast<int>(height));
+  const double left = (width - side) / 2;
+  plvpor(left / width, (left + side) / width, (height - top - side) / height,
+         (height - top) / height);
   plwind(-1.7, 1.7, -1.7, 1.7);
   plcol0(axes_colour);
   plmtex("t", 1.5, 0.5, 0.5, chart.title.c_str());
@@ -379,8 +397,9 @@ std::string svg(const PolarChart& chart) {
     plptex(1.6 * std::cos(t), 1.6 * std::sin(t) - 0.03, 1, 0, 0.5, fmt::format("{}°", a).c_str());
   }
   plcol0(axes_colour);
-  plptex(1.52, 0.06, 1, 0, 0.5, ("+" + chart.first_axis).c_str());
-  plptex(0.08, 1.52, 1, 0, 0.5, ("+" + chart.second_axis).c_str());
+  // The axes' names inside the angle labels, beside their spokes.
+  plptex(1.42, 0.07, 1, 0, 0, ("+" + chart.first_axis).c_str());
+  plptex(0.06, 1.42, 1, 0, 0, ("+" + chart.second_axis).c_str());
   std::vector<LegendEntry> legend;
   for (const auto& t : chart.traces) {
     Line l = t;
@@ -402,7 +421,9 @@ std::string svg(const PolarChart& chart) {
   if (chart.mark_start)
     plmtex("b", 1.0, 1.0, 1.0, "○ start of each trace, arrow: direction of travel");
   if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
-  draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_RIGHT | PL_POSITION_INSIDE);
+  // Below the scale's line.
+  draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
+              0.06);
   return s.finish(chart.title);
 }
 

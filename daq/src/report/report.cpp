@@ -1335,7 +1335,8 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
   std::vector<PolarChart> polars;
   for (std::size_t i = 0; i < views.size(); ++i) {
     const auto& v = views[i];
-    const std::string label = fmt::format("run {} ({})", v.run.id, dates[i]);
+    // (With runs on one day the date label already names the run.)
+    const std::string label = same_day ? dates[i] : fmt::format("run {} ({})", v.run.id, dates[i]);
     std::vector<Value> values;
     json doc;
     if (v.run.kind == "linear") {
@@ -1348,7 +1349,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
       doc = ::daq::to_json(l.e);
     } else {
       const auto c = analyse_circle(store, v, o);
-      polars.push_back(polar_of(c, "", 2 * i, label + " "));
+      polars.push_back(polar_of(c, "", 2 * i, label + ", "));
       for (const auto& [key, symbol, value] : standard_values(c))
         if (key.starts_with("G")) values.push_back({key, symbol, "µm", value});
       for (const auto& d : c.result.diagnostics)

@@ -700,6 +700,8 @@ void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }
 void LinearRun::manual_capture() {
   auto& i = *impl_;
   if (auto c = i.position_trigger ? i.position_trigger->capture_now() : i.trigger.capture_now()) {
+    // on_capture uses only the ratio length / raw, a pure factor (refraction and material
+    // temperature): any non-zero raw length gives it, 0 would give 0 / 0.
     const auto comp = impl_->env.compensate(c->end_ns, 0.1);
     impl_->on_capture(*c, comp);
   }

@@ -7,6 +7,8 @@
 #include <ctime>
 
 #include "cal/analysis/error.hpp"
+#include "cal/daq/config_fields.hpp"
+#include "config_json.hpp"
 
 namespace daq {
 
@@ -26,17 +28,6 @@ namespace {
 
 using cal::drivers::OptionType;
 using cal::drivers::OptionValue;
-
-json option_json(const OptionValue& v) {
-  return std::visit(
-      [](const auto& x) -> json {
-        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, std::monostate>)
-          return nullptr;
-        else
-          return x;
-      },
-      v);
-}
 
 // A JSON value as an option value of the spec's type; the table's check follows.
 OptionValue option_value(const json& v, const cal::drivers::OptionSpec& spec) {
@@ -149,82 +140,24 @@ json to_json(const cal::daq::Config& c) {
          {"tool_offset_mm", c.machine_tool_offset_mm},
          {"table_offset_mm", c.machine_table_offset_mm},
          {"campaign", c.campaign}};
-  const auto& e = c.environment;
-  j["environment"] = {{"equation", e.equation},
-                      {"stale_after_s", e.stale_after_s},
-                      {"on_stale", e.on_stale == cal::daq::StalePolicy::stop ? "stop" : "fallback"},
-                      {"fallback_temperature_degc", e.fallback_temperature_degc},
-                      {"fallback_pressure_pa", e.fallback_pressure_pa},
-                      {"fallback_humidity_pct", e.fallback_humidity_pct},
-                      {"fallback_material_degc", e.fallback_material_degc},
-                      {"co2_umol_per_mol", e.co2_umol_per_mol},
-                      {"wavelength_nm", e.wavelength_nm},
-                      {"expansion_ppm_per_k", e.expansion_ppm_per_k}};
-  j["trigger"] = {{"tolerance_um", c.trigger.tolerance_um},
-                  {"dwell_s", c.trigger.dwell_s},
-                  {"window_mm", c.trigger.window_mm}};
+  namespace fd = cal::daq::fields;
+  j["environment"] = fields_json(c.environment, fd::environment());
+  j["trigger"] = fields_json(c.trigger, fd::trigger());
   if (c.linear) {
-    const auto& l = *c.linear;
-    j["linear"] = {{"axis", l.axis},
-                   {"first_mm", l.first_mm},
-                   {"last_mm", l.last_mm},
-                   {"random_fraction", l.random_fraction},
-                   {"cycle", l.cycle},
-                   {"runs", l.runs},
-                   {"bidirectional", l.bidirectional},
-                   {"overrun_mm", l.overrun_mm},
-                   {"feed_mm_per_min", l.feed_mm_per_min},
-                   {"dwell_s", l.dwell_s},
-                   {"dead_path_mm", l.dead_path_mm},
-                   {"standard", l.standard}};
-    if (l.interval_mm) j["linear"]["interval_mm"] = *l.interval_mm;
-    if (l.count) j["linear"]["count"] = *l.count;
-    j["linear"]["measure"] = measure_json(l.measure);
+    j["linear"] = fields_json(*c.linear, fd::linear());
+    j["linear"]["measure"] = measure_json(c.linear->measure);
   }
-  if (c.circle) {
-    const auto& ci = *c.circle;
-    j["circle"] = {{"plane", ci.plane},
-                   {"radius_mm", ci.radius_mm},
-                   {"feed_mm_per_min", ci.feed_mm_per_min},
-                   {"sample_rate_hz", ci.sample_rate_hz},
-                   {"overshoot_deg", ci.overshoot_deg},
-                   {"centre_mm", ci.centre_mm},
-                   {"calibrated_radius_mm", ci.calibrated_radius_mm},
-                   {"standard", ci.standard},
-                   {"planes", ci.planes},
-                   {"feeds_mm_per_min", ci.feeds_mm_per_min},
-                   {"radii_mm", ci.radii_mm},
-                   {"partial_arc_deg", ci.partial_arc_deg},
-                   {"partial_overshoot_deg", ci.partial_overshoot_deg},
-                   {"feed_in_mm", ci.feed_in_mm},
-                   {"dwell_s", ci.dwell_s},
-                   {"bar", ci.bar}};
-  }
+  if (c.circle) j["circle"] = fields_json(*c.circle, fd::circle());
   return j;
 }
 
 json measure_json(const cal::daq::MeasureConfig& m) {
-  return {{"kind", m.kind},
-          {"direction", m.direction},
-          {"stationary_mm", m.stationary_mm},
-          {"probe_offset_mm", m.probe_offset_mm},
-          {"beams", m.beams},
-          {"separation_mm", m.separation_mm},
-          {"sign", m.sign},
-          {"square", m.square}};
+  return fields_json(m, cal::daq::fields::measure());
 }
 
 cal::daq::MeasureConfig measure_from_json(const json& j) {
   cal::daq::MeasureConfig m;
-  if (!j.is_object()) return m;
-  m.kind = j.value("kind", m.kind);
-  m.direction = j.value("direction", m.direction);
-  m.stationary_mm = j.value("stationary_mm", m.stationary_mm);
-  m.probe_offset_mm = j.value("probe_offset_mm", m.probe_offset_mm);
-  m.beams = j.value("beams", m.beams);
-  m.separation_mm = j.value("separation_mm", m.separation_mm);
-  m.sign = j.value("sign", m.sign);
-  m.square = j.value("square", m.square);
+  if (j.is_object()) fields_from_json(j, cal::daq::fields::measure(), m, "capture header: measure");
   return m;
 }
 
@@ -236,67 +169,20 @@ cal::daq::Config config_from_json(const json& j) {
   c.machine_tool_offset_mm = j.value("tool_offset_mm", c.machine_tool_offset_mm);
   c.machine_table_offset_mm = j.value("table_offset_mm", c.machine_table_offset_mm);
   c.campaign = j.value("campaign", "");
-  if (const auto e = j.find("environment"); e != j.end()) {
-    auto& x = c.environment;
-    x.equation = e->value("equation", x.equation);
-    x.stale_after_s = e->value("stale_after_s", x.stale_after_s);
-    x.on_stale = e->value("on_stale", "stop") == "stop" ? cal::daq::StalePolicy::stop
-                                                        : cal::daq::StalePolicy::fallback;
-    x.fallback_temperature_degc =
-        e->value("fallback_temperature_degc", x.fallback_temperature_degc);
-    x.fallback_pressure_pa = e->value("fallback_pressure_pa", x.fallback_pressure_pa);
-    x.fallback_humidity_pct = e->value("fallback_humidity_pct", x.fallback_humidity_pct);
-    x.fallback_material_degc = e->value("fallback_material_degc", x.fallback_material_degc);
-    x.co2_umol_per_mol = e->value("co2_umol_per_mol", x.co2_umol_per_mol);
-    x.wavelength_nm = e->value("wavelength_nm", x.wavelength_nm);
-    x.expansion_ppm_per_k = e->value("expansion_ppm_per_k", x.expansion_ppm_per_k);
-  }
-  if (const auto t = j.find("trigger"); t != j.end()) {
-    c.trigger.tolerance_um = t->value("tolerance_um", c.trigger.tolerance_um);
-    c.trigger.dwell_s = t->value("dwell_s", c.trigger.dwell_s);
-    c.trigger.window_mm = t->value("window_mm", c.trigger.window_mm);
-  }
+  // Sections a capture does not have keep the defaults its run used (older captures).
+  namespace fd = cal::daq::fields;
+  const auto section = [&](const char* key, auto fields, auto& out) {
+    if (const auto at = j.find(key); at != j.end())
+      fields_from_json(*at, fields, out, fmt::format("capture header: {}", key));
+  };
+  section("environment", fd::environment(), c.environment);
+  section("trigger", fd::trigger(), c.trigger);
   if (const auto l = j.find("linear"); l != j.end()) {
-    cal::daq::LinearTestConfig x;
-    x.axis = l->value("axis", x.axis);
-    x.first_mm = l->value("first_mm", x.first_mm);
-    x.last_mm = l->value("last_mm", x.last_mm);
-    if (l->contains("interval_mm")) x.interval_mm = (*l)["interval_mm"].get<double>();
-    if (l->contains("count")) x.count = (*l)["count"].get<int>();
-    x.random_fraction = l->value("random_fraction", x.random_fraction);
-    x.cycle = l->value("cycle", x.cycle);
-    x.runs = l->value("runs", x.runs);
-    x.bidirectional = l->value("bidirectional", x.bidirectional);
-    x.overrun_mm = l->value("overrun_mm", x.overrun_mm);
-    x.feed_mm_per_min = l->value("feed_mm_per_min", x.feed_mm_per_min);
-    x.dwell_s = l->value("dwell_s", x.dwell_s);
-    x.dead_path_mm = l->value("dead_path_mm", x.dead_path_mm);
-    x.standard = l->value("standard", x.standard);
-    if (const auto m = l->find("measure"); m != l->end()) x.measure = measure_from_json(*m);
-    c.linear = x;
+    c.linear.emplace();
+    section("linear", fd::linear(), *c.linear);
+    if (const auto m = l->find("measure"); m != l->end()) c.linear->measure = measure_from_json(*m);
   }
-  if (const auto ci = j.find("circle"); ci != j.end()) {
-    cal::daq::CircleTestConfig x;
-    x.plane = ci->value("plane", x.plane);
-    x.radius_mm = ci->value("radius_mm", x.radius_mm);
-    x.feed_mm_per_min = ci->value("feed_mm_per_min", x.feed_mm_per_min);
-    x.sample_rate_hz = ci->value("sample_rate_hz", x.sample_rate_hz);
-    x.overshoot_deg = ci->value("overshoot_deg", x.overshoot_deg);
-    x.centre_mm = ci->value("centre_mm", x.centre_mm);
-    x.calibrated_radius_mm = ci->value("calibrated_radius_mm", x.calibrated_radius_mm);
-    // The ballbar set and the program's feed-in and dwell (captures since issue 18; older ones
-    // have the defaults their runs used).
-    x.standard = ci->value("standard", x.standard);
-    x.planes = ci->value("planes", x.planes);
-    x.feeds_mm_per_min = ci->value("feeds_mm_per_min", x.feeds_mm_per_min);
-    x.radii_mm = ci->value("radii_mm", x.radii_mm);
-    x.partial_arc_deg = ci->value("partial_arc_deg", x.partial_arc_deg);
-    x.partial_overshoot_deg = ci->value("partial_overshoot_deg", x.partial_overshoot_deg);
-    x.feed_in_mm = ci->value("feed_in_mm", x.feed_in_mm);
-    x.dwell_s = ci->value("dwell_s", x.dwell_s);
-    x.bar = ci->value("bar", x.bar);
-    c.circle = x;
-  }
+  if (j.contains("circle")) section("circle", fd::circle(), c.circle.emplace());
   return c;
 }
 

@@ -219,18 +219,21 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
   if (m.kind == "angular")
     axes = fmt::format("axes = [0, {}, {}]  # 0: position; the angular beams a, b\n", m.beams[0],
                        m.beams[1]);
+  // The probe of a straightness or roll test: a gauge twin on a pseudo-terminal.
+  const auto gauge = [&](std::string_view role, std::string_view what, const std::string& path,
+                         std::string_view unit_and_range) {
+    return fmt::format(
+        "[devices.{0}]{1:<{2}}# SIMULATED {3}\n"
+        "driver = \"gauge\"\ntransport = \"serial {4} 9600 8N1\"\nrequest = \"?\\r\"\n"
+        "{5}role = \"{0}\"\npoll_s = {6}\n\n",
+        role, "", 14 - role.size(), what, path, unit_and_range, 4 * laser_poll_s);
+  };
   if (m.kind == "straightness")
-    probe = fmt::format(
-        "[devices.indicator]     # SIMULATED straightness indicator against a straightedge\n"
-        "driver = \"gauge\"\ntransport = \"serial {} 9600 8N1\"\nrequest = \"?\\r\"\n"
-        "unit = \"mm\"\nmin_si = -0.01\nmax_si = 0.01\nrole = \"indicator\"\npoll_s = {}\n\n",
-        impl_->indicator.device_path(), 4 * laser_poll_s);
+    probe = gauge("indicator", "straightness indicator against a straightedge",
+                  impl_->indicator.device_path(), "unit = \"mm\"\nmin_si = -0.01\nmax_si = 0.01\n");
   if (m.kind == "roll")
-    probe = fmt::format(
-        "[devices.level]         # SIMULATED electronic level against a reference level\n"
-        "driver = \"gauge\"\ntransport = \"serial {} 9600 8N1\"\nrequest = \"?\\r\"\n"
-        "unit = \"urad\"\nrole = \"level\"\npoll_s = {}\n\n",
-        impl_->level.device_path(), 4 * laser_poll_s);
+    probe = gauge("level", "electronic level against a reference level", impl_->level.device_path(),
+                  "unit = \"urad\"\n");
   return fmt::format(
       R"TOML([devices.laser]
 driver = "ids3010"

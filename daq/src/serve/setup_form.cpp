@@ -11,7 +11,9 @@
 #include <variant>
 
 #include "cal/analysis/error.hpp"
+#include "cal/daq/config_fields.hpp"
 #include "cal/drivers/registry.hpp"
+#include "config_json.hpp"
 #include "run_setup.hpp"
 
 namespace daq::serve {
@@ -29,17 +31,6 @@ void put_text(json& j, const char* key, const std::string& value) {
   if (!value.empty()) j[key] = value;
 }
 
-json option_json(const cal::drivers::OptionValue& v) {
-  return std::visit(
-      [](const auto& x) -> json {
-        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, std::monostate>)
-          return nullptr;
-        else
-          return x;
-      },
-      v);
-}
-
 json device_json(const cal::daq::DeviceConfig& d) {
   const cal::daq::DeviceConfig def;
   json j{{"driver", d.driver}, {"transport", d.transport}};
@@ -54,49 +45,22 @@ json device_json(const cal::daq::DeviceConfig& d) {
   return j;
 }
 
-json environment_json(const cal::daq::EnvironmentConfig& e) {
-  const cal::daq::EnvironmentConfig d;
-  json j = json::object();
-  put(j, "equation", e.equation, d.equation);
-  put(j, "stale_after_s", e.stale_after_s, d.stale_after_s);
-  if (e.on_stale != d.on_stale)
-    j["on_stale"] = e.on_stale == cal::daq::StalePolicy::stop ? "stop" : "fallback";
-  put(j, "fallback_temperature_degc", e.fallback_temperature_degc, d.fallback_temperature_degc);
-  put(j, "fallback_pressure_pa", e.fallback_pressure_pa, d.fallback_pressure_pa);
-  put(j, "fallback_humidity_pct", e.fallback_humidity_pct, d.fallback_humidity_pct);
-  put(j, "fallback_material_degc", e.fallback_material_degc, d.fallback_material_degc);
-  put(j, "co2_umol_per_mol", e.co2_umol_per_mol, d.co2_umol_per_mol);
-  put(j, "wavelength_nm", e.wavelength_nm, d.wavelength_nm);
-  put(j, "expansion_ppm_per_k", e.expansion_ppm_per_k, d.expansion_ppm_per_k);
-  return j;
+// A section's keys as a file would write them (config_fields.hpp): those the form always shows
+// and those not at their default.
+template <class S>
+json section_json(const S& s, std::span<const cal::daq::fields::Field<S>> fields) {
+  return fields_json(s, fields, FieldKeys::file, FieldValues::set);
 }
 
 json linear_json(const cal::daq::LinearTestConfig& l) {
-  const cal::daq::LinearTestConfig d;
-  json j{{"axis", l.axis}, {"first_mm", l.first_mm}, {"last_mm", l.last_mm}};
-  if (l.interval_mm) j["interval_mm"] = *l.interval_mm;
-  if (l.count) j["count"] = *l.count;
-  put(j, "random_fraction", l.random_fraction, d.random_fraction);
-  put(j, "cycle", l.cycle, d.cycle);
-  j["runs"] = l.runs;
-  put(j, "bidirectional", l.bidirectional, d.bidirectional);
-  j["overrun_mm"] = l.overrun_mm;
-  j["feed_mm_per_min"] = l.feed_mm_per_min;
-  j["dwell_s"] = l.dwell_s;
-  put(j, "dead_path_mm", l.dead_path_mm, d.dead_path_mm);
-  j["standard"] = l.standard;
+  json j = section_json(l, cal::daq::fields::linear());
+  j.update(section_json(l.measure, cal::daq::fields::measure()));  // flat in [test.linear]
   return j;
 }
 
 json circle_json(const cal::daq::CircleTestConfig& c) {
-  const cal::daq::CircleTestConfig d;
-  json j{{"plane", c.plane},
-         {"radius_mm", c.radius_mm},
-         {"feed_mm_per_min", c.feed_mm_per_min},
-         {"overshoot_deg", c.overshoot_deg}};
-  put(j, "sample_rate_hz", c.sample_rate_hz, d.sample_rate_hz);
-  put(j, "centre_mm", c.centre_mm, d.centre_mm);
-  put(j, "calibrated_radius_mm", c.calibrated_radius_mm, d.calibrated_radius_mm);
+  json j = section_json(c, cal::daq::fields::circle());
+  if (!c.planes.empty()) j.erase("plane");  // a set names its planes; the loader takes one
   return j;
 }
 
@@ -172,6 +136,7 @@ std::string toml_string(const std::string& text) {
 }
 
 // The keys of a table in the order of docs/config.md; others follow in alphabetical order.
+// (The sections with a field table, and devices, are in their table's order: own_key_order.)
 const std::vector<std::string_view>& key_order() {
   static const std::vector<std::string_view> order{"schema",
                                                    "campaign",
@@ -194,38 +159,6 @@ const std::vector<std::string_view>& key_order() {
                                                    "state",
                                                    "notes",
                                                    "poll_s",
-                                                   "equation",
-                                                   "stale_after_s",
-                                                   "on_stale",
-                                                   "fallback_temperature_degc",
-                                                   "fallback_pressure_pa",
-                                                   "fallback_humidity_pct",
-                                                   "fallback_material_degc",
-                                                   "co2_umol_per_mol",
-                                                   "wavelength_nm",
-                                                   "expansion_ppm_per_k",
-                                                   "tolerance_um",
-                                                   "window_mm",
-                                                   "axis",
-                                                   "plane",
-                                                   "first_mm",
-                                                   "last_mm",
-                                                   "interval_mm",
-                                                   "count",
-                                                   "random_fraction",
-                                                   "cycle",
-                                                   "runs",
-                                                   "bidirectional",
-                                                   "overrun_mm",
-                                                   "radius_mm",
-                                                   "feed_mm_per_min",
-                                                   "dwell_s",
-                                                   "sample_rate_hz",
-                                                   "overshoot_deg",
-                                                   "centre_mm",
-                                                   "calibrated_radius_mm",
-                                                   "dead_path_mm",
-                                                   "standard",
                                                    "up_to_mm",
                                                    "E_um",
                                                    "R_um",
@@ -263,15 +196,32 @@ std::vector<std::string> device_key_order(const json& device) {
   return order;
 }
 
-std::vector<std::string> ordered_keys(const json& j, bool device = false) {
+template <class S>
+void append_keys(std::vector<std::string>& order,
+                 std::span<const cal::daq::fields::Field<S>> fields) {
+  for (const auto& f : fields) order.emplace_back(f.key);
+}
+
+// The order of a table's own keys where a table says it (a device's driver, a section's
+// fields), else none.
+std::vector<std::string> own_key_order(const json& j, const std::string& path) {
+  namespace fd = cal::daq::fields;
+  std::vector<std::string> order;
+  if (path.starts_with("devices.")) return device_key_order(j);
+  if (path == "environment") append_keys(order, fd::environment());
+  if (path == "trigger") append_keys(order, fd::trigger());
+  if (path == "test.linear") append_keys(order, fd::linear()), append_keys(order, fd::measure());
+  if (path == "test.circle") append_keys(order, fd::circle());
+  return order;
+}
+
+std::vector<std::string> ordered_keys(const json& j, const std::string& path = "") {
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
-  const auto own = device ? device_key_order(j) : std::vector<std::string>{};
+  const auto own = own_key_order(j, path);
   const auto rank = [&](const std::string& k) {
-    if (device) {
-      const auto at = std::find(own.begin(), own.end(), k);
-      if (at != own.end()) return static_cast<std::size_t>(at - own.begin());
-    }
+    const auto at = std::find(own.begin(), own.end(), k);
+    if (at != own.end()) return static_cast<std::size_t>(at - own.begin());
     const auto& o = key_order();
     return own.size() + static_cast<std::size_t>(std::find(o.begin(), o.end(), k) - o.begin());
   };
@@ -319,8 +269,7 @@ void write_table(std::ostringstream& out, const json& j, const std::string& path
                  bool array_entry = false) {
   if (!j.is_object()) cannot(path, fmt::format("expected an object, not {}", j.type_name()));
   std::ostringstream own;
-  const bool device = path.starts_with("devices.");
-  for (const auto& k : ordered_keys(j, device)) {
+  for (const auto& k : ordered_keys(j, path)) {
     const auto& v = j[k];
     if (v.is_null() || v.is_object() || is_table_array(v)) continue;
     own << toml_key(k) << " = " << toml_value(v, path.empty() ? k : path + "." + k) << "\n";
@@ -408,10 +357,8 @@ json setup_of(const cal::daq::Config& c) {
   if (!co.empty()) j["conditions"] = co;
   j["devices"] = json::object();
   for (const auto& d : c.devices) j["devices"][d.id] = device_json(d);
-  j["environment"] = environment_json(c.environment);
-  j["trigger"] = {{"tolerance_um", c.trigger.tolerance_um},
-                  {"dwell_s", c.trigger.dwell_s},
-                  {"window_mm", c.trigger.window_mm}};
+  j["environment"] = section_json(c.environment, cal::daq::fields::environment());
+  j["trigger"] = section_json(c.trigger, cal::daq::fields::trigger());
   j["test"] = json::object();
   if (c.linear) j["test"]["linear"] = linear_json(*c.linear);
   if (c.circle) j["test"]["circle"] = circle_json(*c.circle);

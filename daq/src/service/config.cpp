@@ -17,6 +17,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/analysis/kinematics.hpp"
+#include "cal/daq/config_fields.hpp"
 #include "cal/drivers/registry.hpp"
 #include "cal/drivers/transport/transport.hpp"
 
@@ -75,29 +76,9 @@ class Table {
     if (auto v = get<T>(key)) target = *v;
   }
 
-  void positive(std::string_view key, double& target) {
-    read(key, target);
-    if (!(target > 0.0)) fail(table_.get(key), key, fmt::format("{} must be > 0", target));
-  }
-
-  // A number within [lo, hi] (lo excluded when `open_low`), the unit named in the message.
-  void in_range(std::string_view key, double& target, double lo, double hi,
-                std::string_view unit = "", bool open_low = false) {
-    read(key, target);
-    check_range(key, target, lo, hi, unit, open_low);
-  }
-  void check_range(std::string_view key, double value, double lo, double hi,
-                   std::string_view unit = "", bool open_low = false) const {
-    if ((open_low ? value > lo : value >= lo) && value <= hi) return;
-    const std::string u = unit.empty() ? "" : " " + std::string(unit);
-    fail(table_.get(key), key,
-         open_low ? fmt::format("{} must be > {} and at most {}{}", value, lo, hi, u)
-                  : fmt::format("{} must be within {} .. {}{}", value, lo, hi, u));
-  }
-  void whole_in_range(std::string_view key, int& target, int lo, int hi) {
-    read(key, target);
-    if (target < lo || target > hi)
-      fail(table_.get(key), key, fmt::format("{} must be within {} .. {}", target, lo, hi));
+  // A number within a range (config_fields.hpp), the unit named in the message.
+  void check_range(std::string_view key, double value, const fields::Range& range) const {
+    if (auto e = fields::range_error(range, value)) fail(table_.get(key), key, *e);
   }
   // A name: no control characters (it reaches logs, reports and exports), at most 200 bytes.
   void name(std::string_view key, std::string& target, bool lines_allowed = false) {
@@ -188,6 +169,95 @@ void one_of(Table& t, std::string_view key, const std::string& value,
   if (std::find(allowed.begin(), allowed.end(), value) == allowed.end())
     t.fail(t.node(key), key,
            fmt::format("'{}' is not one of: {}", value, fmt::join(allowed, ", ")));
+}
+
+template <class S>
+void check_number(Table& t, const fields::Field<S>& f, const toml::node& node, double v) {
+  if (!f.range) return;
+  if (auto e = fields::range_error(*f.range, v)) t.fail(&node, f.key, *e);
+}
+
+template <class S>
+void check_word(Table& t, const fields::Field<S>& f, const toml::node& node, std::string_view v) {
+  if (auto e = fields::word_error(f.words, v)) t.fail(&node, f.key, *e);
+  if (auto e = f.name ? fields::name_error(v) : std::nullopt) t.fail(&node, f.key, *e);
+}
+
+template <class S, class V>
+void read_list(Table& t, const fields::Field<S>& f, const toml::node& node, V& target) {
+  const auto* arr = node.as_array();
+  using E = std::decay_t<decltype(target[0])>;
+  constexpr bool words = std::is_same_v<E, std::string>;
+  const char* expected = words                    ? "expected an array of strings"
+                         : std::is_same_v<E, int> ? "expected an array of integers"
+                                                  : "expected an array of numbers";
+  if (!arr) t.fail(&node, f.key, expected);
+  std::vector<E> values;
+  for (const auto& e : *arr) {
+    if constexpr (words) {
+      const auto v = e.value_exact<std::string>();
+      if (!v) t.fail(&e, f.key, expected);
+      check_word(t, f, e, *v);
+      if (std::find(values.begin(), values.end(), *v) != values.end())
+        t.fail(&e, f.key, fmt::format("'{}' given twice", *v));
+      values.push_back(*v);
+    } else {
+      std::optional<double> v;
+      if constexpr (std::is_same_v<E, int>) {
+        if (const auto i = e.value_exact<std::int64_t>()) v = static_cast<double>(*i);
+      } else {
+        v = e.value<double>();
+      }
+      if (!v) t.fail(&e, f.key, expected);
+      check_number(t, f, node, *v);  // the position of the list, as for its other checks
+      values.push_back(static_cast<E>(*v));
+    }
+  }
+  if constexpr (std::is_same_v<V, std::vector<E>>) {
+    target = std::move(values);
+  } else {  // std::array: exactly its size
+    if (values.size() != target.size())
+      t.fail(&node, f.key,
+             target.size() == 3 ? std::string("expected [x, y, z]")
+                                : fmt::format("expected {} values", target.size()));
+    std::copy(values.begin(), values.end(), target.begin());
+  }
+}
+
+template <class S, class V>
+void read_field(Table& t, const fields::Field<S>& f, const toml::node& node, V& target) {
+  if constexpr (std::is_same_v<V, double> || std::is_same_v<V, int>) {
+    target = *t.get<V>(f.key);
+    check_number(t, f, node, target);
+  } else if constexpr (std::is_same_v<V, bool>) {
+    target = *t.get<bool>(f.key);
+  } else if constexpr (std::is_same_v<V, std::string>) {
+    target = *t.get<std::string>(f.key);
+    check_word(t, f, node, target);
+  } else if constexpr (std::is_same_v<V, StalePolicy>) {
+    const auto word = *t.get<std::string>(f.key);
+    check_word(t, f, node, word);
+    target = *fields::stale_policy(word);
+  } else if constexpr (std::is_same_v<V, std::optional<double>> ||
+                       std::is_same_v<V, std::optional<int>>) {
+    typename V::value_type v{};
+    read_field(t, f, node, v);
+    target = v;
+  } else {  // lists: of numbers, words, or a fixed count of numbers
+    read_list(t, f, node, target);
+  }
+}
+
+// Reads the keys of a section's field table (config_fields.hpp): each present key with its
+// type, range or words checked; absent keys keep their defaults.
+template <class S>
+void read_fields(Table& t, std::span<const fields::Field<S>> table, S& out) {
+  for (const auto& f : table) {
+    t.mark_used(f.key);
+    const toml::node* node = t.node(f.key);
+    if (!node) continue;
+    std::visit([&](auto member) { read_field(t, f, *node, out.*member); }, f.member);
+  }
 }
 
 // A TOML value as an option value of the spec's type (the check against the spec follows).
@@ -284,25 +354,11 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   return d;
 }
 
-// Ranges (docs/config.md): the air values are those the refractive-index equations accept
-// (NIST's calculator: -40 .. 100 degC, 10 .. 140 kPa, 0 .. 100 %RH, 0 .. 2000 umol/mol,
-// 300 .. 1700 nm); the fallback air is then checked against the chosen equation itself.
+// The keys and their ranges are the field table's (config_fields.cpp); the fallback air is
+// then checked against the chosen equation itself.
 EnvironmentConfig read_environment(Table& t) {
   EnvironmentConfig e;
-  t.read("equation", e.equation);
-  one_of(t, "equation", e.equation, {"ciddor", "edlen", "shop-floor"});
-  t.in_range("stale_after_s", e.stale_after_s, 0, 86400, "s", true);
-  std::string on_stale = "stop";
-  t.read("on_stale", on_stale);
-  one_of(t, "on_stale", on_stale, {"stop", "fallback"});
-  e.on_stale = on_stale == "stop" ? StalePolicy::stop : StalePolicy::fallback;
-  t.in_range("fallback_temperature_degc", e.fallback_temperature_degc, -40, 100, "degC");
-  t.in_range("fallback_pressure_pa", e.fallback_pressure_pa, 10e3, 140e3, "Pa");
-  t.in_range("fallback_humidity_pct", e.fallback_humidity_pct, 0, 100, "%");
-  t.in_range("fallback_material_degc", e.fallback_material_degc, -50, 150, "degC");
-  t.in_range("co2_umol_per_mol", e.co2_umol_per_mol, 0, 2000, "umol/mol");
-  t.in_range("wavelength_nm", e.wavelength_nm, 300, 1700, "nm");
-  t.in_range("expansion_ppm_per_k", e.expansion_ppm_per_k, -100, 300, "ppm/K");
+  read_fields(t, fields::environment(), e);
   try {
     air::refractive_index({.temperature_degc = e.fallback_temperature_degc,
                            .pressure_pa = e.fallback_pressure_pa,
@@ -317,9 +373,8 @@ EnvironmentConfig read_environment(Table& t) {
   return e;
 }
 
-// Positions within +-100 m, feeds up to 200 m/min, dwells up to an hour: beyond any machine
-// this calibrates, and small enough that nothing written into a part program overflows.
-constexpr double kMaxPositionMm = 100'000, kMaxFeedMmPerMin = 200'000, kMaxDwellS = 3600;
+// The machine's offsets: positions within +-100 m (as the tests' positions, config_fields.cpp).
+constexpr double kMaxPositionMm = 100'000;
 
 std::array<double, 3> read_vector(Table& t, std::string_view key, std::array<double, 3> v) {
   if (!t.node(key)) {
@@ -329,7 +384,7 @@ std::array<double, 3> read_vector(Table& t, std::string_view key, std::array<dou
   const auto x = t.numbers(key);
   if (x.size() != 3) t.fail(t.node(key), key, "expected [x, y, z]");
   for (std::size_t k = 0; k < 3; ++k) {
-    t.check_range(key, x[k], -kMaxPositionMm, kMaxPositionMm, "mm");
+    t.check_range(key, x[k], {-kMaxPositionMm, kMaxPositionMm, "mm"});
     v[k] = x[k];
   }
   return v;
@@ -340,39 +395,28 @@ std::array<double, 3> read_vector(Table& t, std::string_view key, std::array<dou
 // are the kinds' (daq/src/runtime/kinds/), run before a run starts.
 void read_measure(Table& t, LinearTestConfig& l) {
   auto& m = l.measure;
-  t.read("measure", m.kind);
-  one_of(t, "measure", m.kind, {"positioning", "straightness", "angular", "roll"});
-  t.read("direction", m.direction);
+  read_fields(t, fields::measure(), m);
   if (m.kind == "straightness") {
     one_of(t, "direction", m.direction, {"X", "Y", "Z"});
     if (m.direction == l.axis)
-      t.fail(t.node("direction"), "direction",
-             fmt::format("a straightness of {} is read across it, not along {}", l.axis,
-                         m.direction));
+      t.fail(
+          t.node("direction"), "direction",
+          fmt::format("a straightness of {} is read across it, not along {}", l.axis, m.direction));
   } else if (m.kind == "angular") {
     one_of(t, "direction", m.direction, {"A", "B", "C"});
     if (m.direction == std::string(1, static_cast<char>('A' + (l.axis[0] - 'X'))))
       t.fail(t.node("direction"), "direction",
-             fmt::format("{} about {} is the roll of {}: measure = \"roll\"", m.direction,
-                         l.axis, l.axis));
+             fmt::format("{} about {} is the roll of {}: measure = \"roll\"", m.direction, l.axis,
+                         l.axis));
   } else if (!m.direction.empty()) {
     t.fail(t.node("direction"), "direction",
            fmt::format("a {} test has no direction (straightness: X, Y, Z; angular: A, B, C)",
                        m.kind));
   }
-  m.stationary_mm = read_vector(t, "stationary_mm", m.stationary_mm);
-  m.probe_offset_mm = read_vector(t, "probe_offset_mm", m.probe_offset_mm);
-  m.separation_mm = read_vector(t, "separation_mm", m.separation_mm);
-  if (auto b = t.numbers("beams"); !b.empty()) {
-    if (b.size() != 2 || b[0] == b[1] || b[0] < 0 || b[0] > 2 || b[1] < 0 || b[1] > 2 ||
-        b[0] != std::floor(b[0]) || b[1] != std::floor(b[1]))
-      t.fail(t.node("beams"), "beams", "expected two different laser axes [a, b] of 0, 1, 2");
-    m.beams = {static_cast<int>(b[0]), static_cast<int>(b[1])};
-  }
-  t.read("sign", m.sign);
+  if (m.beams[0] == m.beams[1])
+    t.fail(t.node("beams"), "beams", "expected two different laser axes [a, b] of 0, 1, 2");
   if (m.sign != 1.0 && m.sign != -1.0)
     t.fail(t.node("sign"), "sign", fmt::format("{} must be 1 or -1", m.sign));
-  t.read("square", m.square);
   if (m.square && m.kind != "straightness")
     t.fail(t.node("square"), "square", "only a straightness run is read against a square");
   if (m.kind == "angular" && m.separation_mm == std::array<double, 3>{})
@@ -382,35 +426,13 @@ void read_measure(Table& t, LinearTestConfig& l) {
 
 LinearTestConfig read_linear(Table& t) {
   LinearTestConfig l;
-  t.read("axis", l.axis);
-  one_of(t, "axis", l.axis, {"X", "Y", "Z"});
-  t.in_range("first_mm", l.first_mm, -kMaxPositionMm, kMaxPositionMm, "mm");
-  t.in_range("last_mm", l.last_mm, -kMaxPositionMm, kMaxPositionMm, "mm");
-  l.interval_mm = t.get<double>("interval_mm");
-  if (l.interval_mm) t.check_range("interval_mm", *l.interval_mm, 0, kMaxPositionMm, "mm", true);
-  l.count = t.get<int>("count");
-  if (l.count && (*l.count < 2 || *l.count > iso230_2::max_plan_targets))
-    t.fail(t.node("count"), "count",
-           fmt::format("{} must be within 2 .. {}", *l.count, iso230_2::max_plan_targets));
+  read_fields(t, fields::linear(), l);
   // Neither is allowed on an axis over 2000 mm: ISO 230-2's average interval of 250 mm.
   const bool long_axis = cal::iso230_2::is_long_axis(l.first_mm, l.last_mm);
   if ((l.interval_mm && l.count) || (!l.interval_mm && !l.count && !long_axis))
     t.fail(nullptr, "interval_mm",
            "give exactly one of interval_mm and count (or neither on an axis over 2000 mm: "
            "targets an average of 250 mm apart, ISO 230-2)");
-  t.read("random_fraction", l.random_fraction);
-  if (!(l.random_fraction >= 0 && l.random_fraction < 0.5))
-    t.fail(t.node("random_fraction"), "random_fraction",
-           fmt::format("{} must be >= 0 and < 0.5", l.random_fraction));
-  t.read("cycle", l.cycle);
-  one_of(t, "cycle", l.cycle, {"linear", "pendulum", "pilgrim-step"});
-  t.whole_in_range("runs", l.runs, 1, iso230_2::max_plan_runs);
-  t.read("bidirectional", l.bidirectional);
-  t.in_range("overrun_mm", l.overrun_mm, 0, 1000, "mm");
-  t.in_range("feed_mm_per_min", l.feed_mm_per_min, 0, kMaxFeedMmPerMin, "mm/min", true);
-  t.in_range("dwell_s", l.dwell_s, 0, kMaxDwellS, "s", true);
-  t.in_range("dead_path_mm", l.dead_path_mm, 0, kMaxPositionMm, "mm");
-  t.read("standard", l.standard);
   try {  // a misspelt standard is refused now, not after every stop has been captured
     iso230_2::standard_from_string(l.standard);
   } catch (const InputError& e) {
@@ -436,54 +458,18 @@ LinearTestConfig read_linear(Table& t) {
 
 CircleTestConfig read_circle(Table& t) {
   CircleTestConfig c;
-  t.read("plane", c.plane);
-  one_of(t, "plane", c.plane, {"XY", "YZ", "ZX"});
-  t.in_range("radius_mm", c.radius_mm, 0, 5000, "mm", true);
-  t.in_range("feed_mm_per_min", c.feed_mm_per_min, 0, kMaxFeedMmPerMin, "mm/min", true);
-  t.in_range("sample_rate_hz", c.sample_rate_hz, 0, 1e6, "Hz", true);
-  t.in_range("overshoot_deg", c.overshoot_deg, 0, 180, "deg");
-  if (auto centre = t.numbers("centre_mm"); !centre.empty()) {
-    if (centre.size() != 3) t.fail(t.node("centre_mm"), "centre_mm", "expected [x, y, z]");
-    for (double v : centre)
-      if (!std::isfinite(v) || std::abs(v) > kMaxPositionMm)
-        t.fail(t.node("centre_mm"), "centre_mm",
-               fmt::format("{} is not a finite position within +-{} mm", v, kMaxPositionMm));
-    c.centre_mm = centre;
-  }
-  t.in_range("calibrated_radius_mm", c.calibrated_radius_mm, 0, 5000, "mm");  // 0: not given
-  if (const auto* n = t.node("planes")) {
-    t.known("planes");
-    const auto* arr = n->as_array();
-    if (!arr || arr->empty())
-      t.fail(n, "planes", "expected an array of planes, e.g. [\"XY\", \"ZX\", \"YZ\"]");
-    for (const auto& e : *arr) {
-      const auto v = e.value<std::string>();
-      if (!v || (*v != "XY" && *v != "ZX" && *v != "YZ"))
-        t.fail(&e, "planes", "each plane is \"XY\", \"ZX\" or \"YZ\" (G17, G18, G19)");
-      if (std::find(c.planes.begin(), c.planes.end(), *v) != c.planes.end())
-        t.fail(&e, "planes", fmt::format("plane {} given twice", *v));
-      c.planes.push_back(*v);
-    }
-  }
-  for (const char* key : {"feeds_mm_per_min", "radii_mm"}) {
-    auto values = t.numbers(key);
-    const bool radii = std::string_view(key) == "radii_mm";
-    for (double v : values)
-      t.check_range(key, v, 0, radii ? 5000 : kMaxFeedMmPerMin, radii ? "mm" : "mm/min", true);
-    (radii ? c.radii_mm : c.feeds_mm_per_min) = std::move(values);
-  }
-  t.in_range("partial_arc_deg", c.partial_arc_deg, 180, 360, "deg");
-  t.in_range("partial_overshoot_deg", c.partial_overshoot_deg, 0, 45, "deg");
-  t.in_range("feed_in_mm", c.feed_in_mm, 0, 100, "mm", true);
-  t.in_range("dwell_s", c.dwell_s, 0, kMaxDwellS, "s", true);
-  t.name("bar", c.bar);
+  read_fields(t, fields::circle(), c);
+  if (t.node("centre_mm") && c.centre_mm.size() != 3)
+    t.fail(t.node("centre_mm"), "centre_mm", "expected [x, y, z]");
+  if (t.node("planes") && c.planes.empty())
+    t.fail(t.node("planes"), "planes",
+           "expected an array of planes, e.g. [\"XY\", \"ZX\", \"YZ\"]");
   if (!c.planes.empty() && t.node("plane"))
     t.fail(t.node("plane"), "plane", "give plane (one test) or planes (a set), not both");
   if (c.radii_mm.size() > 1 && c.calibrated_radius_mm > 0)
     t.fail(t.node("calibrated_radius_mm"), "calibrated_radius_mm",
            "one calibrated length cannot serve several radii: store a calibration per bar and "
            "radius (daq ballbar calibrate) and name the bar");
-  t.read("standard", c.standard);
   try {
     cal::circle::circular_standard_from_key(c.standard);
   } catch (const InputError& e) {
@@ -647,9 +633,7 @@ Config parse_config(std::string_view text, const std::filesystem::path& file) {
   }
   if (const auto* tr = top.subtable("trigger")) {
     Table t(*tr, "trigger", file);
-    t.in_range("tolerance_um", c.trigger.tolerance_um, 0, 10'000, "um", true);
-    t.in_range("dwell_s", c.trigger.dwell_s, 0, kMaxDwellS, "s", true);
-    t.in_range("window_mm", c.trigger.window_mm, 0, 1000, "mm", true);
+    read_fields(t, fields::trigger(), c.trigger);
     t.check_unknown();
   }
   if (const auto* tests = top.subtable("test")) {
