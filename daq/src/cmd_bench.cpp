@@ -485,13 +485,13 @@ void bench_ingest(const BenchOptions& o) {
     per_core.push_back(n / in.cpu_s);
     fmt::print(
         "round {}: ingest {:.0f} readings/s ({} readings in {:.2f} s, CPU {:.2f} s, {} gauge "
-        "hand-overs, {} commits, writer storing {:.2f} s, producer waits {}); blob-insert ceiling "
-        "{:.0f}/s ({} commits; "
-        "{:.0f}/s with schema-1 "
-        "records); raw write ceiling {:.0f}/s; pipeline without storage {:.0f}/s; checksum "
+        "hand-overs, {} commits, encoder {:.2f} s and writer {:.2f} s busy, producer waits {}); "
+        "blob-insert ceiling {:.0f}/s ({} commits; {:.0f}/s with schema-1 records); raw write "
+        "ceiling {:.0f}/s; pipeline without storage {:.0f}/s; checksum "
         "{:.6f}\n",
         round, n / in.wall_s, in.readings, in.wall_s, in.cpu_s, in.handovers,
-        in.writer.batches_committed, std::chrono::duration<double>(in.writer.store_time).count(),
+        in.writer.batches_committed, std::chrono::duration<double>(in.writer.encode_time).count(),
+        std::chrono::duration<double>(in.writer.store_time).count(),
         in.writer.overload_waits, n / blob.seconds, blob.commits, n / blob17.seconds,
         n / bare.seconds, n / alone.wall_s, in.checksum);
     if (in.writer.readings_committed != in.readings)
