@@ -21,7 +21,9 @@ void add_serve_command(CLI::App& app) {
       "Run the built-in SIMULATED shop (machine and instrument twins) in this process and start "
       "with its set-up; its machine runs each test's program when the run starts");
   config->excludes(simulate);
-  cmd->add_option("--speed", o->speed, "--simulate: simulated time per real time")
+  cmd->add_option("--speed", o->speed,
+                  "--simulate: SIMULATED time per real time (POST /api/simulation/speed "
+                  "changes it while serving)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
   add_db_option(*cmd, o->run.db);

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
+#include <utility>
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/sim/machine.hpp"
@@ -176,6 +178,22 @@ struct Machine::Impl {
   MachineState state;
   std::mt19937_64 rng;
   std::normal_distribution<double> normal{0.0, 1.0};
+  // The last set-point computed: a step's start is the previous step's end, and a standing
+  // machine's command does not change, so the compensation (a model's volumetric correction
+  // can be costly) is evaluated once per new command, with the same result.
+  std::optional<std::pair<Vec3, Vec3>> last_setpoint;
+  std::optional<kinematics::Machine> probe_geometry;  // error_at's (see there)
+
+  // The set-point the position loops follow: the command plus the control's compensation.
+  Vec3 compensated(const Vec3& c) {
+    if (!config.compensation_um) return c;
+    if (last_setpoint && last_setpoint->first == c) return last_setpoint->second;
+    const Vec3 d = config.compensation_um(c);
+    Vec3 s = c;
+    for (std::size_t k = 0; k < 3; ++k) s[k] += 1e-3 * d[k];
+    last_setpoint.emplace(c, s);
+    return s;
+  }
 
   Vec3 commanded(double t) {
     while (current < program.size() && t >= program[current].t0 + program[current].duration)
@@ -185,17 +203,12 @@ struct Machine::Impl {
     return s.at(t - s.t0);
   }
 
-  void advance(double dt) {
+  // `geometry` false: the axes only (state.tool_mm is left stale); for the intermediate steps
+  // of advance_to, where nobody reads the tool's position.
+  void advance(double dt, bool geometry = true) {
     const Vec3 c0 = state.commanded_mm;
     const double t = state.time_s + dt;
     const Vec3 c1 = commanded(t);
-    // The set-points the position loops follow: the command plus the control's compensation.
-    const auto compensated = [this](Vec3 c) {
-      if (!config.compensation_um) return c;
-      const Vec3 d = config.compensation_um(c);
-      for (std::size_t k = 0; k < 3; ++k) c[k] += 1e-3 * d[k];
-      return c;
-    };
     const Vec3 s0 = compensated(c0), s1 = compensated(c1);
     const double temperature = config.thermal.temperature_degc(t);
     const double scale = 1.0 + config.thermal.expansion_ppm_per_k * 1e-6 * (temperature - 20.0);
@@ -215,15 +228,21 @@ struct Machine::Impl {
       if (s.noise_um > 0.0) q += 1e-3 * s.noise_um * normal(rng);
       axes[k] = q * scale;
     }
-    const Vec3 e_um =
-        kinematics::volumetric_error_um(config.geometry, axes, kinematics::Method::htm);
     state.time_s = t;
     state.commanded_mm = c1;
     state.axes_mm = axes;
-    for (std::size_t k = 0; k < 3; ++k) state.tool_mm[k] = axes[k] + 1e-3 * e_um[k];
+    if (geometry) tool();
     state.machine_temperature_degc = temperature;
     state.block = current;
     state.in_motion = current < program.size() && program[current].move.kind != Move::Kind::dwell;
+  }
+
+  // The tool's position from the axes' through the geometric errors (the HTM chain: about
+  // half of a step's cost with all 21 errors).
+  void tool() {
+    const Vec3 e_um =
+        kinematics::volumetric_error_um(config.geometry, state.axes_mm, kinematics::Method::htm);
+    for (std::size_t k = 0; k < 3; ++k) state.tool_mm[k] = state.axes_mm[k] + 1e-3 * e_um[k];
   }
 };
 
@@ -261,6 +280,19 @@ const MachineState& Machine::step(double dt_s) {
   return impl_->state;
 }
 
+const MachineState& Machine::advance_to(double t_s, double max_step_s) {
+  if (!(max_step_s > 0.0) || !std::isfinite(max_step_s))
+    throw InputError(fmt::format("simulation step {} s must be > 0", max_step_s));
+  Impl& m = *impl_;
+  bool stepped = false;
+  while (m.state.time_s < t_s - 1e-12) {
+    m.advance(std::min(max_step_s, t_s - m.state.time_s), false);
+    stepped = true;
+  }
+  if (stepped) m.tool();
+  return m.state;
+}
+
 const MachineState& Machine::state() const { return impl_->state; }
 
 bool Machine::finished() const {
@@ -280,12 +312,19 @@ const MachineConfig& Machine::config() const { return impl_->config; }
 
 void Machine::set_compensation(std::function<Vec3(const Vec3&)> compensation_um) {
   impl_->config.compensation_um = std::move(compensation_um);
+  impl_->last_setpoint.reset();
 }
 
 kinematics::VolumetricError Machine::error_at(const Vec3& offset_mm) const {
-  kinematics::Machine g = impl_->config.geometry;
-  g.tool_offset_mm = offset_mm;
-  return kinematics::volumetric_error(g, impl_->state.axes_mm, kinematics::Method::htm);
+  // The geometry with the probe's offset, copied once per offset (the geometry itself never
+  // changes): an instrument asks at every reading, and a copy of the 18 error functions costs
+  // more than the HTM chain.
+  auto& g = impl_->probe_geometry;
+  if (!g || g->tool_offset_mm != offset_mm) {
+    g = impl_->config.geometry;
+    g->tool_offset_mm = offset_mm;
+  }
+  return kinematics::volumetric_error(*g, impl_->state.axes_mm, kinematics::Method::htm);
 }
 
 }  // namespace cal::drivers::sim

@@ -19,6 +19,9 @@ struct BatchWriter::Impl {
   std::vector<RawReading> current;  // producer side only
   std::uint64_t pushed = 0;         // producer side only
   std::chrono::steady_clock::time_point current_started{};
+  std::chrono::steady_clock::time_point now() const {
+    return options.clock ? options.clock() : std::chrono::steady_clock::now();
+  }
 
   mutable std::mutex mutex;
   std::condition_variable changed;
@@ -193,7 +196,7 @@ void BatchWriter::push(const RawReading& r) {
   Impl& m = *impl_;
   if (m.current.empty()) {
     m.check_error();
-    m.current_started = std::chrono::steady_clock::now();
+    m.current_started = m.now();
   }
   m.current.push_back(r);
   ++m.pushed;  // producer-side only; stats() is called from the producer's thread
@@ -205,7 +208,7 @@ void BatchWriter::push(std::span<const RawReading> readings) {
   while (!readings.empty()) {
     if (m.current.empty()) {
       m.check_error();
-      m.current_started = std::chrono::steady_clock::now();
+      m.current_started = m.now();
     }
     // Up to the end of the current batch (at least one reading, as push(r) does).
     const std::size_t limit = m.options.batch_readings;
@@ -218,8 +221,8 @@ void BatchWriter::push(std::span<const RawReading> readings) {
   }
 }
 
-void BatchWriter::flush_if_old(std::chrono::steady_clock::time_point now) {
-  if (!impl_->current.empty() && now - impl_->current_started >= impl_->options.batch_age)
+void BatchWriter::flush_if_old() {
+  if (!impl_->current.empty() && impl_->now() - impl_->current_started >= impl_->options.batch_age)
     impl_->hand_over();
 }
 

@@ -110,6 +110,43 @@ TEST(SimMachine, GeometricAndThermalErrorsAtRest) {
   EXPECT_NEAR(m.state().tool_mm[1], 100.00115, 1e-6);
 }
 
+// advance_to skips the geometric error of the intermediate steps (nothing reads them): the
+// state it reaches must be the step-by-step one bit for bit, errors, noise and backlash
+// included, and the tool's position must carry the geometric error of the last step.
+TEST(SimMachine, AdvanceToIsStepByStepBitForBit) {
+  auto c = ideal();
+  c.servo[0] = {.kv_per_s = 30.0, .backlash_um = 4.0, .cyclic_amplitude_um = 1.0, .noise_um = 0.2};
+  c.geometry.axes[0].ex_um = cal::kinematics::ErrorFunction::polynomial({0.0, 0.01});
+  c.geometry.axes[0].ey_um = cal::kinematics::ErrorFunction::polynomial({0.0, 0.0, 1e-4});
+  c.geometry.axes[0].ec_urad = cal::kinematics::ErrorFunction::polynomial({0.0, 0.05});
+  c.geometry.tool_offset_mm = {0.0, 0.0, -100.0};
+  sim::Machine a(c), b(c);
+  const Move program[] = {Move::linear({100, 0, 0}, 6000), Move::dwell(1.0),
+                          Move::linear({0, 20, 0}, 3000)};
+  a.load(program);
+  b.load(program);
+  for (const double t : {0.0371, 0.5, 0.5, 1.234, 2.0, 3.5, 4.5}) {
+    const auto& sa = run_to(a, t);
+    const auto& sb = b.advance_to(t, 1e-3);
+    EXPECT_EQ(sa.time_s, sb.time_s) << t;
+    EXPECT_EQ(sa.block, sb.block) << t;
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_EQ(sa.axes_mm[k], sb.axes_mm[k]) << t;
+      EXPECT_EQ(sa.tool_mm[k], sb.tool_mm[k]) << t;
+      EXPECT_EQ(sa.commanded_mm[k], sb.commanded_mm[k]) << t;
+    }
+  }
+  // At 100 mm on X: E_XX = 1 um and E_YX = 1 um, and the 5 urad roll about Z does not move a
+  // probe on the Z axis: the tool is 1 um off in X and Y from the axes' position.
+  sim::Machine m(c);
+  m.load(program);
+  const auto& s = m.advance_to(2.0, 1e-3);  // the end of the dwell at x = 100: settled
+  EXPECT_NEAR(s.axes_mm[0], 100.0, 0.01);
+  EXPECT_NEAR((s.tool_mm[1] - s.axes_mm[1]) * 1e3, 1.0, 0.001);
+  EXPECT_NEAR((s.tool_mm[0] - s.axes_mm[0]) * 1e3, 1.0, 0.001);
+  EXPECT_THROW(b.advance_to(5.0, 0.0), cal::InputError);
+}
+
 TEST(SimMachine, ArcEndMustLieOnTheCircle) {
   auto c = ideal();
   c.start_mm = {50, 0, 0};

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <random>
 #include <span>
@@ -83,6 +84,29 @@ TEST(BatchWriter, PushingSpansCutsTheSameBatchesAsPushingOneByOne) {
     ASSERT_EQ(back[static_cast<std::size_t>(i)].time_ns, all[static_cast<std::size_t>(i)].time_ns);
     ASSERT_EQ(back[static_cast<std::size_t>(i)].value, all[static_cast<std::size_t>(i)].value);
   }
+}
+
+// A batch's age is read on the options' clock (a simulated session's time): it is handed over
+// when that clock says 200 ms have passed since its first reading, however much wall time did.
+TEST(BatchWriter, ABatchAgesOnTheGivenClock) {
+  TempFile file;
+  std::int64_t run = 0;
+  { run = Store(file.path).begin_run({.kind = "linear"}); }
+  std::chrono::steady_clock::time_point now{};  // a clock that moves only when told
+  BatchWriter writer(file.path, run, {.batch_age = std::chrono::milliseconds(200), .clock = [&now] {
+                                        return now;
+                                      }});
+  for (std::int64_t i = 0; i < 10; ++i) writer.push(reading(i));
+  now += std::chrono::milliseconds(199);
+  writer.flush_if_old();
+  EXPECT_EQ(writer.stats().batches_committed, 0u);  // 199 ms old: kept
+  now += std::chrono::milliseconds(1);
+  writer.flush_if_old();
+  writer.push(reading(10));  // opens the next batch at t = 200 ms
+  writer.flush();            // waits for what was handed over, and hands over the second
+  const auto s = writer.stats();
+  EXPECT_EQ(s.batches_committed, 2u);  // the 10 aged ones, then the one read after
+  EXPECT_EQ(s.readings_committed, 11u);
 }
 
 TEST(BatchWriter, AFullDiskStopsTheProducerAndKeepsCommittedBatches) {

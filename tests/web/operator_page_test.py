@@ -14,8 +14,12 @@
 8. Stop asks for confirmation; the page reflows at 600 px.
 
 Screenshots of every phase are written to the artefact directory (in the build tree) for a
-person to look at. Usage: operator_page_test.py DAQ_BINARY ARTEFACT_DIR
+person to look at. The shop runs 10 times faster than real time while the set-up is typed and a
+run is stopped, 20 times during the linear run (the page still shows every phase) and 50 times
+during the ballbar run (POST /api/simulation/speed; the simulated time line, and so every
+reading, is the same at any pace). Usage: operator_page_test.py DAQ_BINARY ARTEFACT_DIR
 """
+import concurrent.futures
 import json
 import math
 import os
@@ -35,7 +39,7 @@ from webdriver import Browser, png_size  # noqa: E402
 DAQ, SHOTS = sys.argv[1], sys.argv[2]
 os.makedirs(SHOTS, exist_ok=True)
 TMP = tempfile.mkdtemp(prefix="operator-page-")
-SPEED = 10
+SPEED = 100
 passes = 0
 
 
@@ -108,6 +112,13 @@ def page_state(b):
     return b.js("return window.caldaq.page;")
 
 
+def simulation_speed(url, speed):
+    status, body = post(url + "api/simulation/speed", {"speed": speed})
+    ok(status == 200 and body["speed"] == speed, f"the SIMULATED shop now runs {speed}x: {body}")
+
+
+# Chromium starts (about a second) while the service does.
+browser = concurrent.futures.ThreadPoolExecutor(max_workers=1).submit(Browser, 1280, 1400)
 serve_log = open(os.path.join(TMP, "serve.log"), "w+")
 serve = subprocess.Popen([DAQ, "serve", "--simulate", "--speed", str(SPEED), "--port", "0",
                           "--db", os.path.join(TMP, "runs.sqlite"),
@@ -123,11 +134,11 @@ try:
             break
         if serve.poll() is not None:
             break
-        time.sleep(0.1)
+        time.sleep(0.02)
     serve_log.seek(0)
     ok(url, "daq serve --simulate started: " + (url or serve_log.read()))
 
-    with Browser(width=1280, height=1400) as b:
+    with browser.result() as b:
         # --- 1. idle ------------------------------------------------------------------------
         b.get(url)
         b.wait("return window.caldaq && window.caldaq.page && "
@@ -304,6 +315,11 @@ try:
                what="the air station back (Start ready)", explain=WHY)
 
         # --- 5. the linear test --------------------------------------------------------------
+        status, body = post(url + "api/simulation/speed", {"speed": 0})
+        ok(status == 400 and "1 to 100" in body["error"], f"speed 0 is refused: {status} {body}")
+        # 20x: the page (10 updates/s) sees the shop every 2 s of simulated time, so each of the
+        # 12 stops (1 s moving, 4 s standing) is seen moving and standing.
+        simulation_speed(url, 20)
         b.js("document.getElementById('start-linear').click();")
         b.wait("return window.caldaq.page.status.running;", what="the run to start")
         shots = {}
@@ -326,7 +342,7 @@ try:
                 at_stop = s
             if not s["running"] and s["last"]:
                 break
-            time.sleep(0.05)
+            time.sleep(0.02)
         seen = set(b.js("return [...window.caldaq.seen];"))
         print("indicator states seen:", sorted(seen))
         ok({"moving", "captured"} <= seen and (seen & {"settling", "stable"}),
@@ -370,9 +386,9 @@ try:
         status, ctype, body = fetch(html_link)
         ok(status == 200 and ctype.startswith("text/html") and b"<svg" in body,
            f"the HTML report link serves the report ({len(body)} bytes)")
-        status, ctype, body = fetch(pdf_link, timeout=120)
-        ok(status == 200 and ctype == "application/pdf" and body.startswith(b"%PDF"),
-           f"the PDF link serves a PDF ({len(body)} bytes)")
+        # The PDF is rendered by Chromium on the server (about 2 s): fetched meanwhile, checked
+        # after the ballbar run.
+        pdf = concurrent.futures.ThreadPoolExecutor(max_workers=1).submit(fetch, pdf_link, 120)
         listed = b.js("return [...document.querySelectorAll('#runs tbody tr')].map(r => r.textContent);")
         ok(listed and "complete" in listed[0], f"the stored runs list: {listed}")
         no_raw_keys(b, "results")
@@ -381,6 +397,7 @@ try:
         ok(caps == [f"run-{last_run['run']}.cdq"], f"the capture is named by its run: {caps}")
 
         # --- 7. the ballbar test --------------------------------------------------------------
+        simulation_speed(url, 50)
         b.js("document.getElementById('tab-run').click();")
         b.wait("return window.caldaq.page.status.start.circle.ready;", timeout_s=30,
                what="Start ballbar ready")
@@ -391,7 +408,7 @@ try:
         # Measured, not asserted (a timing assert has no place in a test): the page's update
         # rate and the size of its state with the polar trace, while the bar streams.
         c0, t0 = b.js("return window.caldaq.messages;"), time.time()
-        time.sleep(2.0)
+        time.sleep(1.0)
         c1, t1 = b.js("return window.caldaq.messages;"), time.time()
         print(f"measured: {(c1 - c0) / (t1 - t0):.1f} page updates/s during the ballbar run, "
               f"{b.js('return window.caldaq.bytes;')} bytes per update")
@@ -405,8 +422,12 @@ try:
         g = b.js("return [...document.querySelectorAll('#result-values tr')].map(r => r.textContent);")
         ok(g and g[0].startswith("G"), f"ballbar results: {g[:3]}")
         shot(b, "11-results-ballbar.png")
+        status, ctype, body = pdf.result()
+        ok(status == 200 and ctype == "application/pdf" and body.startswith(b"%PDF"),
+           f"the PDF link (of the linear run) serves a PDF ({len(body)} bytes)")
 
         # --- 8. Stop asks for confirmation; the layout at 600 px -----------------------------
+        simulation_speed(url, 10)  # the run goes on for the 5 s these checks may take
         b.js("document.getElementById('tab-run').click();")
         b.wait("return window.caldaq.page.status.start.linear.ready;", timeout_s=30,
                what="Start linear ready again")
@@ -457,6 +478,10 @@ try:
         ok(b.js("return JSON.stringify(window.__errors);") == "[]", "no script error on the page")
     print(f"operator page: {passes} checks passed; screenshots in {SHOTS}")
 finally:
+    try:
+        browser.result(timeout=30).close()  # closed already unless the service failed to start
+    except Exception:
+        pass
     serve.send_signal(signal.SIGTERM)
     try:
         serve.wait(timeout=30)

@@ -174,7 +174,7 @@ struct LinearRun::Impl {
   std::optional<cal::daq::PositionTrigger> position_trigger;  // with a position feed
   cal::daq::Sequencer sequencer;
   const kinds::TestKind& kind;
-  std::unique_ptr<kinds::SampleReader> reader;  // null for positioning
+  std::unique_ptr<kinds::SampleReader> reader;          // null for positioning
   std::deque<std::pair<std::int64_t, double>> samples;  // the kind's value, newest last
   std::vector<kinds::StopValue> values;                 // at the captured stops
   // Stops captured before any sample of the kind's instrument arrived in their window (a
@@ -217,8 +217,8 @@ struct LinearRun::Impl {
     kind.validate(*setup.config.linear);
     reader = kind.reader(*setup.config.linear);
     if (!kind.probe_role().empty() && !setup.probe)
-      throw cal::InputError(fmt::format("a {} test needs a device with role = \"{}\"",
-                                        kind.name(), kind.probe_role()));
+      throw cal::InputError(fmt::format("a {} test needs a device with role = \"{}\"", kind.name(),
+                                        kind.probe_role()));
     if (setup.position)
       position_trigger.emplace(
           cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
@@ -281,7 +281,9 @@ struct LinearRun::Impl {
     if (setup.probe) add(probe_device(), *setup.probe, kind.probe_role());
     outcome.component = kind.component(*setup.config.linear);
     writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
+        setup.database, outcome.run_id,
+        cal::storage::WriterOptions{
+            .batch_age = batch_age(), .store = setup.store_options, .clock = batch_clock()},
         [this, alive = alive](const std::string& e) {
           boost::asio::post(io, [this, alive, e] {
             if (*alive) abort("storage failed: " + e);
@@ -412,10 +414,10 @@ struct LinearRun::Impl {
         store_stop(p.stop, p.cap, p.comp, value);
       } else {
         const auto& s = sequencer.stops()[p.stop];
-        return abort(fmt::format(
-            "no {} reading during the stop at {:.3f} mm (run {}): is the {} reading?",
-            kind.name(), s.position_mm, s.run,
-            kind.probe_role().empty() ? "laser's beam pair" : kind.probe_role()));
+        return abort(
+            fmt::format("no {} reading during the stop at {:.3f} mm (run {}): is the {} reading?",
+                        kind.name(), s.position_mm, s.run,
+                        kind.probe_role().empty() ? "laser's beam pair" : kind.probe_role()));
       }
     }
     if (!done && pending.empty() && sequencer.complete()) finish();
@@ -673,11 +675,32 @@ struct LinearRun::Impl {
     setup.on_live(live);
   }
 
+  // A simulated session runs some 100 times faster than real time: 5 s of its time between
+  // commits is about what 200 ms (the default) are on hardware, where a commit costs an fsync.
+  // (200 ms of simulated time gave 2,100 fsyncs to `daq demo` instead of 240.)
+  std::chrono::milliseconds batch_age() const {
+    return cal::drivers::VirtualTime::of(io) ? std::chrono::milliseconds(5000)
+                                             : cal::storage::WriterOptions{}.batch_age;
+  }
+
+  // The writer's batches age on the loop's time: the steady clock on hardware, simulated time
+  // in a simulated session (a batch then holds the same readings however fast the CPU is).
+  std::function<std::chrono::steady_clock::time_point()> batch_clock() {
+    if (!cal::drivers::VirtualTime::of(io)) return {};
+    return [clock = cal::drivers::loop_clock(io)] {
+      return std::chrono::steady_clock::time_point(std::chrono::nanoseconds(clock()));
+    };
+  }
+
   // 10 Hz: live state, and the writer's age-based flush so a slow stream is still committed.
   void tick() {
     if (done) return;
     publish();
-    if (writer) writer->flush_if_old(std::chrono::steady_clock::now());
+    try {
+      if (writer) writer->flush_if_old();
+    } catch (const std::exception& e) {  // the writer failed (a full disk), its abort not run yet
+      return abort(fmt::format("storage failed: {}", e.what()));
+    }
     timer.expires_after(std::chrono::milliseconds(100));
     timer.async_wait([this](const boost::system::error_code& ec) {
       if (!ec) tick();

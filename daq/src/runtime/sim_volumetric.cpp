@@ -187,13 +187,14 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   LinearRunSetup setup;
   setup.config = c;
   setup.database = a.database;
+  setup.store_options = a.store_options;
   d::Ids3010Options ids;
   if (test.measure.kind == "angular")
     for (const int b : test.measure.beams) ids.axes[static_cast<std::size_t>(b)] = true;
-  // 100 Hz of simulated time: the overrun excursions must be seen (the approach direction).
+  // The overrun excursions must be seen (the approach direction): 100 Hz by default.
   setup.laser =
       d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                      {.poll_period = poll(0.01), .clock = clock}, ids);
+                      {.poll_period = poll(a.laser_poll_s), .clock = clock}, ids);
   setup.air = d::make_ptu300(
       io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
       {.poll_period = poll(1.0), .clock = clock});

@@ -46,6 +46,10 @@ struct SimulatedAcquisition {
   std::string machine = "SIMULATED volumetric";
   double speed = 0.0;
   std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> compensation;
+  // The laser's poll period in simulated seconds (100 Hz: a 3 mm overrun excursion at
+  // 6000 mm/min, about 0.1 s, is seen by several readings).
+  double laser_poll_s = 0.01;
+  cal::storage::StoreOptions store_options;  // the run's store (tests: full_sync off)
 };
 LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
                                    const cal::daq::LinearTestConfig& test);

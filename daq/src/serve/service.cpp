@@ -238,6 +238,7 @@ class Service {
     post("/api/setup/check", &Service::setup_check);
     post("/api/setup/program", &Service::setup_program);
     post("/api/setup/apply", &Service::setup_apply);
+    if (o_.simulate) post("/api/simulation/speed", &Service::simulation_speed);
     server_ = std::make_unique<web::LiveServer>(
         io_,
         web::ServerOptions{
@@ -375,6 +376,25 @@ class Service {
     auto j = to_json(check);
     j["toml"] = check.toml;
     return ok(j);
+  }
+
+  // POST /api/simulation/speed {"speed": N} (--simulate only): the SIMULATED shop's pace from
+  // now on, 1 .. 100 times the wall clock as --speed. The simulated time line is unchanged (it
+  // only moves from event to event): a run's readings and results do not depend on it.
+  web::Response simulation_speed(const std::string& body) {
+    const auto j = json::parse(body, nullptr, false);
+    if (!j.is_object() || j.size() != 1 || !j.contains("speed") || !j["speed"].is_number())
+      return error(400, "the body must be {\"speed\": N} with N from 1 to 100");
+    const double speed = j["speed"].get<double>();
+    if (!(speed >= 1.0 && speed <= 100.0))
+      return error(400, fmt::format("speed {}: the SIMULATED shop runs 1 to 100 times faster "
+                                    "than real time",
+                                    speed));
+    o_.speed = speed;
+    cal::drivers::VirtualTime::of(io_)->pace(speed);
+    fmt::print("daq serve: SIMULATED shop now {}x faster than real time\n", speed);
+    std::fflush(stdout);
+    return ok(json{{"speed", speed}});
   }
 
   web::Response devices(std::string_view) { return ok(board_->to_json()); }

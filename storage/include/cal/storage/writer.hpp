@@ -22,6 +22,10 @@ struct WriterOptions {
   std::chrono::milliseconds batch_age{200};  // when its oldest reading is this old
   std::size_t max_queued_batches = 8;        // then the producer waits
   StoreOptions store;                        // for the writer's own connection
+  // The clock a batch's age is measured on (empty: the steady clock). A session on simulated
+  // time passes its loop's clock, so that its batches (what each commit holds) are the same
+  // on a fast or a loaded machine instead of depending on how fast the CPU runs it.
+  std::function<std::chrono::steady_clock::time_point()> clock;
 };
 
 struct WriterStats {
@@ -53,8 +57,9 @@ class BatchWriter {
   // The same for several readings in order (one call per chunk of a high-rate stream); the
   // batches are cut at the very same readings as by pushing them one by one.
   void push(std::span<const RawReading> readings);
-  // Hands the current batch over (even if small), e.g. from a periodic timer on the loop.
-  void flush_if_old(std::chrono::steady_clock::time_point now);
+  // Hands the current batch over (even if small) when it is batch_age old by the options'
+  // clock, e.g. from a periodic timer on the loop.
+  void flush_if_old();
   // Hands over the current batch and waits until everything pushed so far is committed.
   void flush();
   // Call from the producer's thread (the event loop).

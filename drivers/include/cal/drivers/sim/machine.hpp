@@ -97,6 +97,10 @@ class Machine {
   void set_compensation(std::function<Vec3(const Vec3&)> compensation_um);
   // Advances simulated time by dt_s (> 0) and returns the new state.
   const MachineState& step(double dt_s);
+  // Steps of at most max_step_s up to t_s (an earlier t_s is a no-op); the same state as
+  // calling step() that often, bit for bit, but the geometric (HTM) error, which nothing can
+  // read between the steps, is evaluated at the last step only.
+  const MachineState& advance_to(double t_s, double max_step_s);
   const MachineState& state() const;
   // True when every move is done and the axes have settled (following error < 1 nm).
   bool finished() const;
