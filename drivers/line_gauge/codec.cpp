@@ -42,13 +42,38 @@ GaugeUnit gauge_unit_from_string(std::string_view s) {
       "gauge unit '{}' (expected mm, um, in, m, degC, none, urad, mrad, mm/m or arcsec)", s));
 }
 
+double unit_factor(GaugeUnit u) {
+  switch (u) {
+    case GaugeUnit::mm:
+      return 1e-3;
+    case GaugeUnit::um:
+      return 1e-6;
+    case GaugeUnit::inch:
+      return 0.0254;  // exact, by definition (1959)
+    case GaugeUnit::m:
+    case GaugeUnit::degc:
+    case GaugeUnit::none:
+      return 1.0;
+    case GaugeUnit::urad:
+      return 1e-6;
+    case GaugeUnit::mrad:
+      return 1e-3;
+    case GaugeUnit::arcsec:
+      return 3.14159265358979323846 / 648000.0;  // pi / (180 * 3600)
+  }
+  return 1.0;
+}
+
 bool is_angle(GaugeUnit u) {
   return u == GaugeUnit::urad || u == GaugeUnit::mrad || u == GaugeUnit::arcsec;
 }
 
 GaugeCodec::GaugeCodec(GaugeConfig config)
     : config_(std::move(config)), splitter_(config_.max_line_bytes) {
-  if (config_.pattern.empty()) return;
+  if (config_.pattern.empty()) {
+    fast_factor_ = unit_factor(config_.unit);
+    return;
+  }
   try {
     regex_.emplace(config_.pattern, std::regex::ECMAScript | std::regex::optimize);
   } catch (const std::regex_error& e) {
@@ -77,27 +102,8 @@ void GaugeCodec::report_overlong(std::uint64_t off, std::vector<CodecError>& err
 
 std::optional<double> GaugeCodec::to_si(double printed,
                                         std::optional<GaugeUnit> printed_unit) const {
-  const double v = printed * config_.scale + config_.offset;
-  switch (printed_unit.value_or(config_.unit)) {
-    case GaugeUnit::mm:
-      return v * 1e-3;
-    case GaugeUnit::um:
-      return v * 1e-6;
-    case GaugeUnit::inch:
-      return v * 0.0254;  // exact, by definition (1959)
-    case GaugeUnit::m:
-      return v;
-    case GaugeUnit::degc:
-    case GaugeUnit::none:
-      return v;
-    case GaugeUnit::urad:
-      return v * 1e-6;
-    case GaugeUnit::mrad:
-      return v * 1e-3;
-    case GaugeUnit::arcsec:
-      return v * (3.14159265358979323846 / 648000.0);  // pi / (180 * 3600)
-  }
-  return std::nullopt;
+  return (printed * config_.scale + config_.offset) *
+         unit_factor(printed_unit.value_or(config_.unit));
 }
 
 std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64_t off,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cal/drivers/codec/common.hpp"
+#include "cal/drivers/codec/decimal.hpp"
 
 namespace cal::drivers::codec {
 
@@ -19,6 +20,8 @@ enum class GaugeUnit { mm, um, inch, m, degc, none, urad, mrad, arcsec };
 GaugeUnit gauge_unit_from_string(std::string_view s);
 // True for the angle units: the gauge is then a level and its readings are angles (rad).
 bool is_angle(GaugeUnit u);
+// The factor from the unit to SI (m, rad; 1 for degC and none).
+double unit_factor(GaugeUnit u);
 
 struct GaugeConfig {
   // Sent to poll a gauge ("?\r", "PRINT\r"); empty for a gauge that streams by itself.
@@ -37,7 +40,7 @@ struct GaugeConfig {
 struct GaugeFrame {
   // metres (degC for temperature gauges, rad for levels, as printed for `none`)
   double value_si = 0.0;
-  std::string text;       // the line as received
+  std::string text;  // the line as received
 };
 
 class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
@@ -57,7 +60,10 @@ class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
     splitter_.feed(
         bytes,
         [&](std::string_view line, std::uint64_t off) {
-          if (const auto v = decode_line(line, off, errors)) {
+          if (double si; fast_value(line, si)) {
+            count_frame();
+            on_value(si, line);
+          } else if (const auto v = decode_line(line, off, errors)) {
             count_frame();
             on_value(*v, line);
           }
@@ -66,6 +72,19 @@ class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
   }
 
  private:
+  // The common line of a streaming gauge, a bare number between blanks ("+100.000123") in
+  // range, decoded in one pass, inline: such a line is printable and one token, so
+  // decode_line() would give the very same value (parse_number has the same exact fast path,
+  // the same arithmetic follows). False: anything else, for decode_line() to decide.
+  bool fast_value(std::string_view line, double& si) const {
+    if (fast_factor_ == 0.0) return false;  // a pattern: decode_line() only
+    while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+    double printed;
+    if (!parse_plain_decimal(line, printed)) return false;
+    si = (printed * config_.scale + config_.offset) * fast_factor_;  // to_si() without a unit
+    return si >= config_.min_si && si <= config_.max_si;
+  }
   // The value of one line in SI, or nullopt after reporting why not.
   std::optional<double> decode_line(std::string_view line, std::uint64_t offset,
                                     std::vector<CodecError>& errors);
@@ -73,6 +92,7 @@ class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
   std::optional<double> to_si(double printed, std::optional<GaugeUnit> printed_unit) const;
 
   GaugeConfig config_;
+  double fast_factor_ = 0.0;  // the configured unit's factor to SI; 0 when there is a pattern
   std::optional<std::regex> regex_;
   LineSplitter splitter_;
 };

@@ -31,12 +31,16 @@ class Gauge final : public detail::InstrumentCore {
     // spacing within a chunk is unknown here (the pipeline assigns sample times from the
     // sample rate where it matters, e.g. the ballbar).
     const std::int64_t t = now_ns();
+    // The chunk's readings go out together (one call for a batch consumer), then its errors,
+    // as before.
+    readings_.clear();
     codec_.feed_values(
         bytes,
         [&](double value_si, std::string_view) {
-          emit({.time_ns = t, .quantity = quantity_, .value = value_si});
+          readings_.push_back({.time_ns = t, .quantity = quantity_, .value = value_si});
         },
         errors_);
+    emit_all(readings_);
     report_codec_errors(errors_);
   }
 
@@ -44,6 +48,7 @@ class Gauge final : public detail::InstrumentCore {
   codec::GaugeCodec codec_;
   Quantity quantity_;
   std::vector<codec::CodecError> errors_;
+  std::vector<Reading> readings_;  // one chunk's, reused
 };
 
 }  // namespace

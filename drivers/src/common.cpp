@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <charconv>
 
+#include "cal/drivers/codec/decimal.hpp"
+
 namespace cal::drivers::codec {
 
 std::string_view to_string(ErrorKind kind) {
@@ -71,6 +73,9 @@ bool is_printable_ascii(std::string_view line) {
 }
 
 std::optional<double> parse_number(std::string_view s) {
+  // The exact fast path (decimal.hpp) for the plain numbers instruments print: the same double
+  // as from_chars, at a fraction of its cost on a 10 kHz stream.
+  if (double v; parse_plain_decimal(s, v)) return v;
   // from_chars refuses a leading '+'; a second sign after it ("+-1") must stay an error.
   if (!s.empty() && s.front() == '+') {
     s.remove_prefix(1);

@@ -237,8 +237,7 @@ void InstrumentCore::send(std::string_view text) {
   transport_->write(bytes);
 }
 
-void InstrumentCore::emit(Reading r) {
-  r.device = options_.device;
+void InstrumentCore::note_reading(const Reading& r) {
   if (gap_) {  // the first reading after a reconnection closes the gap
     gap_->end_ns = r.time_ns;
     if (events_.gap) events_.gap(*gap_);
@@ -251,7 +250,25 @@ void InstrumentCore::emit(Reading r) {
   } else if (state_ != InstrumentState::streaming) {
     set_state(InstrumentState::streaming);
   }
+}
+
+void InstrumentCore::emit(Reading r) {
+  r.device = options_.device;
+  note_reading(r);
   if (events_.reading) events_.reading(r);
+}
+
+void InstrumentCore::emit_all(std::span<Reading> readings) {
+  if (readings.empty()) return;
+  if (!events_.readings) {
+    for (const auto& r : readings) emit(r);
+    return;
+  }
+  for (auto& r : readings) {
+    r.device = options_.device;
+    note_reading(r);
+  }
+  events_.readings(readings);
 }
 
 void InstrumentCore::set_state(InstrumentState s, std::string_view why) {

@@ -45,6 +45,9 @@ class InstrumentCore : public Instrument {
 
   void send(std::string_view text);
   void emit(Reading r);
+  // The readings decoded from one chunk of bytes, in order: one events.readings call when the
+  // consumer takes batches, else emit() each. Sets their device.
+  void emit_all(std::span<Reading> readings);
   void set_state(InstrumentState s, std::string_view why = {});
   // Ends the connection and schedules a reconnection (reason recorded in the gap).
   void fail(const std::string& reason);
@@ -104,6 +107,8 @@ class InstrumentCore : public Instrument {
   std::optional<std::int64_t> latched_ns_;
   std::vector<codec::CodecError> codec_errors_;
   std::int64_t last_sent_ns_ = 0;
+  // The gap and state bookkeeping of one reading (before it is handed over).
+  void note_reading(const Reading& r);
   void record_event(std::string_view text);
   void on_opened();
   void on_data(std::span<const std::byte> bytes);

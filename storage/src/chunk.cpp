@@ -34,19 +34,13 @@ std::uint64_t unzigzag(std::uint64_t z) { return (z >> 1) ^ (0 - (z & 1)); }
 std::size_t varint_size(std::uint64_t v) {
   return (static_cast<std::size_t>(std::bit_width(v | 1)) + 6) / 7;
 }
-void put_varint(std::vector<unsigned char>& out, std::uint64_t v) {
+unsigned char* put_varint(unsigned char* w, std::uint64_t v) {
   while (v >= 0x80) {
-    out.push_back(static_cast<unsigned char>(v | 0x80));
+    *w++ = static_cast<unsigned char>(v | 0x80);
     v >>= 7;
   }
-  out.push_back(static_cast<unsigned char>(v));
-}
-
-template <class T>
-void put_raw(std::vector<unsigned char>& out, T v) {
-  unsigned char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  out.insert(out.end(), b, b + sizeof(T));
+  *w++ = static_cast<unsigned char>(v);
+  return w;
 }
 
 std::uint64_t bits_of(double v) { return std::bit_cast<std::uint64_t>(v); }
@@ -191,44 +185,56 @@ void encode(const Columns& c, std::vector<unsigned char>& out) {
   const bool dod = dod_bytes < delta_bytes, xored = xor_bytes < 8 * n;
   const unsigned char flags = static_cast<unsigned char>(
       (dod ? kDeltaOfDelta : 0) | (statuses ? kStatuses : 0) | (xored ? kXorValues : 0));
-  out.clear();
-  out.reserve(1 + 10 + 8 + (dod ? dod_bytes : delta_bytes) + (statuses ? n : 0) +
-              (xored ? xor_bytes : 8 * n));
-  out.push_back(flags);
-  put_varint(out, n);
-  put_raw(out, c.time_ns[0]);
+  // The exact size is known: write through a pointer into the sized buffer (16 bytes of slack
+  // for the 8-byte stores of the values), no capacity check per byte; trimmed at the end.
+  const std::size_t size = 1 + varint_size(n) + 8 + (dod ? dod_bytes : delta_bytes) +
+                           (statuses ? n : 0) + (xored ? xor_bytes : 8 * n);
+  out.resize(size + 16);
+  unsigned char* w = out.data();
+  *w++ = flags;
+  w = put_varint(w, n);
+  std::memcpy(w, &c.time_ns[0], 8);
+  w += 8;
   prev_d = 0;
   for (std::size_t i = 1; i < n; ++i) {
     const std::uint64_t d =
         static_cast<std::uint64_t>(c.time_ns[i]) - static_cast<std::uint64_t>(c.time_ns[i - 1]);
-    put_varint(out, zigzag(dod ? d - prev_d : d));
+    w = put_varint(w, zigzag(dod ? d - prev_d : d));
     prev_d = d;
   }
-  if (statuses) out.insert(out.end(), c.status.begin(), c.status.end());
+  if (statuses) {
+    std::memcpy(w, c.status.data(), n);
+    w += n;
+  }
   if (!xored) {
-    for (double v : c.value) put_raw(out, v);
-    return;
-  }
-  prev_bits = 0;
-  for (std::size_t i = 0; i < n; i += 2) {
-    const std::uint64_t x0 = bits_of(c.value[i]) ^ prev_bits;
-    prev_bits = bits_of(c.value[i]);
-    std::uint64_t x1 = 0;
-    unsigned b1 = 0;
-    if (i + 1 < n) {
-      x1 = bits_of(c.value[i + 1]) ^ prev_bits;
-      prev_bits = bits_of(c.value[i + 1]);
-      b1 = significant_bytes(x1);
+    std::memcpy(w, c.value.data(), 8 * n);
+    w += 8 * n;
+  } else {
+    prev_bits = 0;
+    for (std::size_t i = 0; i < n; i += 2) {
+      const std::uint64_t x0 = bits_of(c.value[i]) ^ prev_bits;
+      prev_bits = bits_of(c.value[i]);
+      std::uint64_t x1 = 0;
+      unsigned b1 = 0;
+      if (i + 1 < n) {
+        x1 = bits_of(c.value[i + 1]) ^ prev_bits;
+        prev_bits = bits_of(c.value[i + 1]);
+        b1 = significant_bytes(x1);
+      }
+      const unsigned b0 = significant_bytes(x0);
+      // The header holds the leading zero bytes (8 - significant), two values per byte; the
+      // high nibble of an odd count's last header is 0. Each value is stored as 8 bytes and
+      // the pointer advanced by its significant ones (little-endian: the low bytes first).
+      *w++ = static_cast<unsigned char>((8 - b0) | (i + 1 < n ? (8 - b1) << 4 : 0));
+      std::memcpy(w, &x0, 8);
+      w += b0;
+      std::memcpy(w, &x1, 8);
+      w += b1;
     }
-    const unsigned b0 = significant_bytes(x0);
-    // The header holds the leading zero bytes (8 - significant), two values per byte; the
-    // high nibble of an odd count's last header is 0.
-    out.push_back(static_cast<unsigned char>((8 - b0) | (i + 1 < n ? (8 - b1) << 4 : 0)));
-    unsigned char tmp[16];
-    std::memcpy(tmp, &x0, 8);
-    std::memcpy(tmp + b0, &x1, 8);
-    out.insert(out.end(), tmp, tmp + b0 + b1);
   }
+  if (static_cast<std::size_t>(w - out.data()) != size)
+    throw std::logic_error("chunk::encode: size pass and write pass disagree");
+  out.resize(size);
 }
 
 void decode(int encoding, std::span<const unsigned char> blob, std::size_t count,

@@ -510,15 +510,14 @@ std::vector<InstrumentRecord> Store::instruments(std::int64_t run_id) const {
   return out;
 }
 
-void Store::append_readings(std::int64_t run_id, std::span<const RawReading> readings) {
-  Impl& m = *impl_;
-  m.need_writable("store readings");
-  if (readings.empty()) return;
+void PreparedBatch::prepare(std::span<const RawReading> readings) {
   // Group by series (device, channel, quantity), keeping each series' order: one chunk each.
   // Batches hold a few series, interleaved: a linear search from the last hit is enough.
+  // The columns are scratch kept per thread (a writer thread reuses them batch after batch).
+  thread_local std::vector<chunk::Columns> columns;
   std::vector<std::uint32_t> keys;
   std::size_t g = 0;
-  for (auto& c : m.columns) c.clear();
+  for (auto& c : columns) c.clear();
   for (const auto& r : readings) {
     const std::uint32_t key =
         (std::uint32_t{r.device} << 16) | (std::uint32_t{r.channel} << 8) | r.quantity;
@@ -526,11 +525,37 @@ void Store::append_readings(std::int64_t run_id, std::span<const RawReading> rea
       g = static_cast<std::size_t>(std::find(keys.begin(), keys.end(), key) - keys.begin());
       if (g == keys.size()) {
         keys.push_back(key);
-        if (m.columns.size() < keys.size()) m.columns.emplace_back();
+        if (columns.size() < keys.size()) columns.emplace_back();
       }
     }
-    m.columns[g].push(r);
+    columns[g].push(r);
   }
+  used = keys.size();
+  reading_count = readings.size();
+  if (chunks.size() < used) chunks.resize(used);
+  for (std::size_t k = 0; k < used; ++k) {
+    const auto& c = columns[k];
+    auto& out = chunks[k];
+    chunk::encode(c, out.blob);
+    const auto [lo, hi] = std::minmax_element(c.time_ns.begin(), c.time_ns.end());
+    out.series = keys[k];
+    out.first_ns = *lo;
+    out.last_ns = *hi;
+    out.count = static_cast<std::int64_t>(c.size());
+  }
+}
+
+void Store::append_readings(std::int64_t run_id, std::span<const RawReading> readings) {
+  impl_->need_writable("store readings");
+  if (readings.empty()) return;
+  impl_->prepared.prepare(readings);
+  append_prepared(run_id, impl_->prepared);
+}
+
+void Store::append_prepared(std::int64_t run_id, const PreparedBatch& batch) {
+  Impl& m = *impl_;
+  m.need_writable("store readings");
+  if (batch.used == 0) return;
   Impl::Transaction tx(m);
   if (!m.next_seq)
     m.next_seq = m.prepare(
@@ -545,18 +570,16 @@ void Store::append_readings(std::int64_t run_id, std::span<const RawReading> rea
   std::int64_t seq = sqlite3_column_int64(m.next_seq.get(), 0);
   sqlite3_reset(m.next_seq.get());
   sqlite3_stmt* s = m.insert_chunk.get();
-  for (std::size_t k = 0; k < keys.size(); ++k, ++seq) {
-    const auto& c = m.columns[k];
-    chunk::encode(c, m.blob);
-    const auto [lo, hi] = std::minmax_element(c.time_ns.begin(), c.time_ns.end());
+  for (std::size_t k = 0; k < batch.used; ++k, ++seq) {
+    const auto& c = batch.chunks[k];
     const chunk::Key key{.run_id = run_id,
                          .seq = seq,
-                         .device = keys[k] >> 16,
-                         .channel = (keys[k] >> 8) & 0xff,
-                         .quantity = keys[k] & 0xff,
-                         .first_ns = *lo,
-                         .last_ns = *hi,
-                         .count = static_cast<std::int64_t>(c.size()),
+                         .device = c.series >> 16,
+                         .channel = (c.series >> 8) & 0xff,
+                         .quantity = c.series & 0xff,
+                         .first_ns = c.first_ns,
+                         .last_ns = c.last_ns,
+                         .count = c.count,
                          .encoding = chunk::columns_v2};
     sqlite3_bind_int64(s, 1, run_id);
     sqlite3_bind_int64(s, 2, key.device);
@@ -565,13 +588,13 @@ void Store::append_readings(std::int64_t run_id, std::span<const RawReading> rea
     sqlite3_bind_int64(s, 5, key.first_ns);
     sqlite3_bind_int64(s, 6, key.last_ns);
     sqlite3_bind_int64(s, 7, key.count);
-    sqlite3_bind_blob64(s, 8, m.blob.data(), m.blob.size(), SQLITE_STATIC);
+    sqlite3_bind_blob64(s, 8, c.blob.data(), c.blob.size(), SQLITE_STATIC);
     sqlite3_bind_int64(s, 9, key.encoding);
     sqlite3_bind_int64(s, 10, key.seq);
-    sqlite3_bind_int64(s, 11, chunk::checksum(key, m.blob));
+    sqlite3_bind_int64(s, 11, chunk::checksum(key, c.blob));
     if (sqlite3_step(s) != SQLITE_DONE) {
       const std::string what = fmt::format("{}: store {} readings of run {}: {}", m.path.string(),
-                                           c.size(), run_id, sqlite3_errmsg(m.db.get()));
+                                           c.count, run_id, sqlite3_errmsg(m.db.get()));
       sqlite3_reset(s);  // the cached statement is used again by the next batch
       throw StoreError(what);
     }

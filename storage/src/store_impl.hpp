@@ -35,8 +35,7 @@ struct Store::Impl {
   bool chunk_checksums = true;
 
   // The writer's scratch, kept between batches so that a batch allocates nothing.
-  std::vector<chunk::Columns> columns;
-  std::vector<unsigned char> blob;
+  PreparedBatch prepared;  // append_readings' scratch, reused between batches
   detail::Stmt insert_chunk, next_seq;
 
   [[noreturn]] void fail(std::string_view what) const {

@@ -26,11 +26,67 @@ struct BatchWriter::Impl {
   mutable std::mutex mutex;
   std::condition_variable changed;
   std::deque<std::vector<RawReading>> queue;
+  // Committed batches' vectors, emptied, for the producer to fill again: no allocation (and no
+  // fresh pages to fault in) per batch.
+  std::vector<std::vector<RawReading>> spare;
+  // Encoded batches waiting for the writer: the encoder thread groups and encodes batch k + 1
+  // while the writer thread commits batch k (its fsync leaves the CPU idle), so storing costs
+  // about what SQLite alone costs for the bytes.
+  std::deque<PreparedBatch> prepared;
+  std::vector<PreparedBatch> spare_prepared;
+  static constexpr std::size_t max_prepared = 2;
   bool closing = false;
-  bool busy = false;  // the writer holds a batch it has not committed yet
+  bool encoding = false;      // the encoder holds a batch it has not handed on yet
+  bool encoder_done = false;  // closing and everything encoded
+  bool busy = false;          // the writer holds a batch it has not committed yet
   std::string error;
   WriterStats stats;
-  std::thread thread;
+  std::thread encoder, thread;
+
+  void encode_loop() {
+    for (;;) {
+      std::vector<RawReading> batch;
+      PreparedBatch out;
+      {
+        std::unique_lock lock(mutex);
+        changed.wait(lock, [&] { return closing || !queue.empty() || !error.empty(); });
+        if (!error.empty()) return;
+        if (queue.empty()) {
+          encoder_done = true;
+          lock.unlock();
+          changed.notify_all();
+          return;
+        }
+        batch = std::move(queue.front());
+        queue.pop_front();
+        encoding = true;
+        if (!spare_prepared.empty()) {
+          out = std::move(spare_prepared.back());
+          spare_prepared.pop_back();
+        }
+      }
+      changed.notify_all();  // a producer waiting for room may go on
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        out.prepare(batch);
+      } catch (const std::exception& e) {
+        return fail(std::string("encode a batch of readings: ") + e.what());
+      }
+      const auto took = std::chrono::steady_clock::now() - start;
+      std::unique_lock lock(mutex);
+      stats.encode_time += took;
+      changed.wait(lock, [&] { return prepared.size() < max_prepared || !error.empty(); });
+      encoding = false;
+      if (!error.empty()) return;
+      prepared.push_back(std::move(out));
+      if (spare.size() < 2) {
+        batch.clear();
+        spare.push_back(std::move(batch));
+      }
+      lock.unlock();
+      changed.notify_all();
+    }
+  }
 
   void run() {
     std::optional<Store> store;
@@ -40,25 +96,29 @@ struct BatchWriter::Impl {
       return fail(e.what());
     }
     for (;;) {
-      std::vector<RawReading> batch;
+      PreparedBatch batch;
       {
         std::unique_lock lock(mutex);
-        changed.wait(lock, [&] { return closing || !queue.empty(); });
-        if (queue.empty()) return;
-        batch = std::move(queue.front());
-        queue.pop_front();
+        changed.wait(lock, [&] { return encoder_done || !prepared.empty() || !error.empty(); });
+        if (!error.empty() || prepared.empty()) return;
+        batch = std::move(prepared.front());
+        prepared.pop_front();
         busy = true;
       }
-      changed.notify_all();  // a producer waiting for room may go on
+      changed.notify_all();  // the encoder may hand on its next batch
+      const auto start = std::chrono::steady_clock::now();
       try {
-        store->append_readings(run_id, batch);
+        store->append_prepared(run_id, batch);
       } catch (const std::exception& e) {
         return fail(e.what());
       }
+      const auto took = std::chrono::steady_clock::now() - start;
       std::lock_guard lock(mutex);
+      stats.store_time += took;
       busy = false;
-      stats.readings_committed += batch.size();
+      stats.readings_committed += batch.reading_count;
       ++stats.batches_committed;
+      if (spare_prepared.size() < 2) spare_prepared.push_back(std::move(batch));
       changed.notify_all();
     }
   }
@@ -69,6 +129,7 @@ struct BatchWriter::Impl {
       error = what;
       busy = false;
       queue.clear();
+      prepared.clear();
     }
     changed.notify_all();
     if (on_error) on_error(what);
@@ -92,9 +153,14 @@ struct BatchWriter::Impl {
     if (!error.empty()) throw StoreError(error);
     queue.push_back(std::move(current));
     stats.max_queue_depth = std::max(stats.max_queue_depth, queue.size());
-    current = {};
-    current.reserve(options.batch_readings);
+    if (spare.empty()) {
+      current = {};
+    } else {
+      current = std::move(spare.back());
+      spare.pop_back();
+    }
     lock.unlock();
+    current.reserve(options.batch_readings);
     changed.notify_all();
   }
 };
@@ -107,6 +173,7 @@ BatchWriter::BatchWriter(std::filesystem::path path, std::int64_t run_id, Writer
   impl_->options = options;
   impl_->on_error = std::move(on_error);
   impl_->current.reserve(options.batch_readings);
+  impl_->encoder = std::thread([impl = impl_.get()] { impl->encode_loop(); });
   impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });
 }
 
@@ -121,6 +188,7 @@ BatchWriter::~BatchWriter() {
     impl_->closing = true;
   }
   impl_->changed.notify_all();
+  impl_->encoder.join();
   impl_->thread.join();
 }
 
@@ -135,6 +203,24 @@ void BatchWriter::push(const RawReading& r) {
   if (m.current.size() >= m.options.batch_readings) m.hand_over();
 }
 
+void BatchWriter::push(std::span<const RawReading> readings) {
+  Impl& m = *impl_;
+  while (!readings.empty()) {
+    if (m.current.empty()) {
+      m.check_error();
+      m.current_started = m.now();
+    }
+    // Up to the end of the current batch (at least one reading, as push(r) does).
+    const std::size_t limit = m.options.batch_readings;
+    const std::size_t room = m.current.size() < limit ? limit - m.current.size() : 1;
+    const auto take = readings.first(std::min(readings.size(), room));
+    m.current.insert(m.current.end(), take.begin(), take.end());
+    m.pushed += take.size();
+    readings = readings.subspan(take.size());
+    if (m.current.size() >= m.options.batch_readings) m.hand_over();
+  }
+}
+
 void BatchWriter::flush_if_old() {
   if (!impl_->current.empty() && impl_->now() - impl_->current_started >= impl_->options.batch_age)
     impl_->hand_over();
@@ -144,7 +230,9 @@ void BatchWriter::flush() {
   Impl& m = *impl_;
   m.hand_over();
   std::unique_lock lock(m.mutex);
-  m.changed.wait(lock, [&] { return (m.queue.empty() && !m.busy) || !m.error.empty(); });
+  m.changed.wait(lock, [&] {
+    return (m.queue.empty() && !m.encoding && m.prepared.empty() && !m.busy) || !m.error.empty();
+  });
   if (!m.error.empty()) throw StoreError(m.error);
 }
 

@@ -3,14 +3,23 @@
 // table look-up per byte, kept here as the reference), and the environmental compensation of
 // a 10 kHz stream while the newest air sample is held (the live case: computed once per
 // sample) and while every reading falls between two samples (the equation per reading).
+// The gauge stage of `daq bench ingest` (its 13-byte lines "+100.000123\r\n", ten per chunk):
+// the number alone by std::from_chars (the parser before) and by parse_number (its exact fast
+// path), and the whole line decode; and the writer's chunk encoding and checksum of a batch.
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <charconv>
+#include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "cal/analysis/crc32c.hpp"
 #include "cal/daq/env_stage.hpp"
+#include "cal/drivers/codec/common.hpp"
+#include "cal/storage/chunk.hpp"
+#include "line_gauge/codec.hpp"
 
 namespace {
 
@@ -91,6 +100,77 @@ void BM_EnvStageCompensate(benchmark::State& state) {
                       : "between two samples (per reading)");
 }
 BENCHMARK(BM_EnvStageCompensate)->Arg(0)->Arg(1);
+
+// The benchmark's gauge lines, as daq bench ingest writes them (daq/src/cmd_bench.cpp).
+std::string gauge_lines(int n) {
+  std::string out;
+  char line[32];
+  for (int k = 0; k < n; ++k) {
+    std::snprintf(line, sizeof line, "%+011.6f\r\n", 100.0 + 1e-6 * static_cast<double>(k % 977));
+    out += line;
+  }
+  return out;
+}
+
+// Arg 0: std::from_chars after the '+' (parse_number before issue 20); 1: parse_number.
+void BM_GaugeNumber(benchmark::State& state) {
+  const std::string text = gauge_lines(1000);
+  std::vector<std::string_view> numbers;
+  for (std::size_t i = 0; i + 13 <= text.size(); i += 13) numbers.push_back({text.data() + i, 11});
+  for (auto _ : state) {
+    double sum = 0.0;
+    for (auto s : numbers) {
+      if (state.range(0) == 0) {
+        double v = 0.0;
+        s.remove_prefix(1);
+        std::from_chars(s.data(), s.data() + s.size(), v);
+        sum += v;
+      } else {
+        sum += *cal::drivers::codec::parse_number(s);
+      }
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * numbers.size()));
+}
+BENCHMARK(BM_GaugeNumber)->Arg(0)->Arg(1);
+
+// The gauge codec's whole decode (split, parse, unit, range) of chunks of ten lines.
+void BM_GaugeDecode(benchmark::State& state) {
+  const std::string text = gauge_lines(1000);
+  cal::drivers::codec::GaugeCodec codec;
+  std::vector<cal::drivers::codec::CodecError> errors;
+  for (auto _ : state) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < text.size(); i += 130)
+      codec.feed_values(
+          cal::drivers::codec::as_bytes(std::string_view(text).substr(i, 130)),
+          [&](double v, std::string_view) { sum += v; }, errors);
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * 1000));
+}
+BENCHMARK(BM_GaugeDecode);
+
+// A writer batch of the bench's series (16384 readings, ten per 1 ms): arg 0 encoding only,
+// 1 encoding and the chunk checksum.
+void BM_ChunkEncode(benchmark::State& state) {
+  cal::storage::chunk::Columns c;
+  for (std::int64_t i = 0; i < 16384; ++i)
+    c.push({.time_ns = (i / 10) * 1'000'000,
+            .value = 1e-3 * (100.0 + 1e-6 * static_cast<double>(i % 977))});
+  std::vector<unsigned char> blob;
+  for (auto _ : state) {
+    cal::storage::chunk::encode(c, blob);
+    if (state.range(0) == 1)
+      benchmark::DoNotOptimize(cal::storage::chunk::checksum({.count = 16384}, blob));
+    benchmark::DoNotOptimize(blob.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * c.size()));
+  state.counters["bytes/reading"] =
+      static_cast<double>(blob.size()) / static_cast<double>(c.size());
+}
+BENCHMARK(BM_ChunkEncode)->Arg(0)->Arg(1);
 
 }  // namespace
 

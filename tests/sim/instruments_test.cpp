@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <span>
 #include <vector>
 
 #include "ids3010/instrument.hpp"
@@ -258,6 +259,42 @@ TEST(GaugeInstrument, StreamsTheBallbarAndPollsAThermometer) {
   EXPECT_EQ(rec.count(d::Quantity::length_m), 501u);
   EXPECT_DOUBLE_EQ(rec.last(d::Quantity::length_m)->value, 1e-5);
   EXPECT_DOUBLE_EQ(rec.last(d::Quantity::material_temperature_degc)->value, 20.0);
+  EXPECT_EQ(rec.codec_errors, 0u);
+}
+
+TEST(GaugeInstrument, HandsAChunksReadingsOverInOneCallToABatchConsumer) {
+  // The same ballbar stream with events.readings set: every reading arrives through it, in
+  // order, with its device, after the state change to streaming; none through `reading`.
+  boost::asio::io_context io;
+  double now_s = 0.0;
+  sim::World world = parked_at_100mm();
+  sim::GaugeTwin bar(io, world, [&] { return now_s; }, {.zero_length_mm = 99.99});
+  auto gauge = d::make_gauge(io, t::make_serial(io, {.device = bar.device_path(), .baud = 115200}),
+                             {.device = 4});
+  Recorder rec;
+  std::size_t calls = 0, single = 0;
+  bool streaming_first = true;
+  auto events = rec.events();
+  events.reading = [&](const d::Reading&) { ++single; };
+  events.readings = [&](std::span<const d::Reading> rs) {
+    ++calls;
+    EXPECT_FALSE(rs.empty());
+    streaming_first = streaming_first && !rec.states.empty() &&
+                      rec.states.back() == d::InstrumentState::streaming;
+    rec.readings.insert(rec.readings.end(), rs.begin(), rs.end());
+  };
+  gauge->start(events);
+  now_s = 0.5;  // samples 0..500
+  ASSERT_TRUE(run_until(io, [&] { return rec.count(d::Quantity::length_m) >= 501; }));
+  EXPECT_EQ(rec.count(d::Quantity::length_m), 501u);
+  EXPECT_EQ(single, 0u);
+  EXPECT_GE(calls, 1u);
+  EXPECT_LE(calls, 501u);
+  EXPECT_TRUE(streaming_first);
+  for (const auto& r : rec.readings) {
+    EXPECT_EQ(r.device, 4);
+    EXPECT_DOUBLE_EQ(r.value, 1e-5);
+  }
   EXPECT_EQ(rec.codec_errors, 0u);
 }
 

@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <random>
+#include <span>
+#include <vector>
 
 namespace {
 
@@ -47,6 +50,40 @@ TEST(BatchWriter, KeepsEveryReadingInOrderAcrossBatches) {
   ASSERT_EQ(static_cast<std::int64_t>(back.size()), n);
   for (std::int64_t i = 0; i < n; i += 997)
     EXPECT_EQ(back[static_cast<std::size_t>(i)].value, reading(i).value);
+}
+
+TEST(BatchWriter, PushingSpansCutsTheSameBatchesAsPushingOneByOne) {
+  // Spans of random sizes (empty, smaller than, across and larger than a batch): every batch
+  // but the tail must still be full (100 of 1000 readings and the tail of 3, as one by one
+  // above), so the chunks stored are the same, and every reading comes back in order.
+  TempFile file;
+  std::int64_t run = 0;
+  { run = Store(file.path).begin_run({.kind = "linear"}); }
+  constexpr std::int64_t n = 100'003;
+  std::vector<RawReading> all;
+  for (std::int64_t i = 0; i < n; ++i) all.push_back(reading(i));
+  {
+    BatchWriter writer(file.path, run, {.batch_readings = 1000, .max_queued_batches = 2});
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<std::size_t> size(0, 2500);
+    for (std::size_t at = 0; at < all.size();) {
+      const std::size_t k = std::min(size(rng), all.size() - at);
+      writer.push(std::span<const RawReading>(all).subspan(at, k));
+      at += k;
+    }
+    writer.flush();
+    const auto s = writer.stats();
+    EXPECT_EQ(s.readings_in, static_cast<std::uint64_t>(n));
+    EXPECT_EQ(s.readings_committed, static_cast<std::uint64_t>(n));
+    EXPECT_EQ(s.batches_committed, 101u);
+  }
+  Store store(file.path);
+  const auto back = store.readings(run);
+  ASSERT_EQ(static_cast<std::int64_t>(back.size()), n);
+  for (std::int64_t i = 0; i < n; ++i) {
+    ASSERT_EQ(back[static_cast<std::size_t>(i)].time_ns, all[static_cast<std::size_t>(i)].time_ns);
+    ASSERT_EQ(back[static_cast<std::size_t>(i)].value, all[static_cast<std::size_t>(i)].value);
+  }
 }
 
 // A batch's age is read on the options' clock (a simulated session's time): it is handed over

@@ -83,6 +83,11 @@ std::string_view to_string(DeviceMessage::Severity s);
 
 struct InstrumentEvents {
   std::function<void(const Reading&)> reading;
+  // Optional, for high-rate consumers: when set, an instrument that decodes several readings
+  // from one chunk of bytes (a streaming gauge: ten lines per USB read at 10 kHz) hands them
+  // over in one call, in order, instead of one `reading` call each (`reading` is then not
+  // called for them). Any state change or gap they cause is reported before the call.
+  std::function<void(std::span<const Reading>)> readings;
   std::function<void(InstrumentState, std::string_view why)> state;
   std::function<void(const Gap&)> gap;
   std::function<void(const codec::CodecError&)> codec_error;

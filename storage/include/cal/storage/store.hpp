@@ -153,6 +153,22 @@ struct StoreOptions {
 
 class ReadingStream;
 
+// A batch of readings grouped into its chunks (one per device/channel/quantity, in order of
+// first appearance) and encoded: what Store::append_readings stores, prepared apart so that a
+// writer can encode one batch while the store commits the previous one.
+struct PreparedBatch {
+  struct Chunk {
+    std::uint32_t series = 0;  // device << 16 | channel << 8 | quantity
+    std::int64_t first_ns = 0, last_ns = 0, count = 0;
+    std::vector<unsigned char> blob;  // encoding 2 (chunk.hpp)
+  };
+  std::vector<Chunk> chunks;  // the first `used` are this batch's (the rest reused storage)
+  std::size_t used = 0;
+  std::size_t reading_count = 0;
+  // Groups and encodes `readings` (replacing what was held); pure, any thread.
+  void prepare(std::span<const RawReading> readings);
+};
+
 class Store {
  public:
   // Opens or creates the database, migrates it to schema_version, and marks runs left
@@ -187,6 +203,8 @@ class Store {
   // Appends readings in one transaction: one chunk per device/channel/quantity, each with its
   // sequence number in the run and its checksum (chunk.hpp).
   void append_readings(std::int64_t run_id, std::span<const RawReading> readings);
+  // The same for a batch prepared beforehand (append_readings = prepare + this): the same rows.
+  void append_prepared(std::int64_t run_id, const PreparedBatch& batch);
 
   // A run's readings in order, a batch at a time, in bounded memory (see ReadingStream): the
   // way to read a long run. Order: time, then device, channel, quantity; readings of one

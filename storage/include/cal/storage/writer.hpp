@@ -1,7 +1,8 @@
 #pragma once
 // Batched writes off the event loop: the loop appends readings to the current batch (cheap,
-// no I/O); full batches go through a bounded queue to a writer thread that owns the Store's
-// connection and commits each batch in one transaction. When the queue is full the loop
+// no I/O); full batches go through a bounded queue to an encoder thread (grouping into chunks,
+// encoding) and on to a writer thread that owns the Store's connection and commits each batch
+// in one transaction, while the next one is encoded. When the queue is full the loop
 // waits (back-pressure) rather than dropping: no reading is ever silently lost, and the time
 // spent waiting is measured and reported as overload.
 #include <chrono>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "cal/storage/store.hpp"
@@ -33,6 +35,11 @@ struct WriterStats {
   std::size_t max_queue_depth = 0;
   std::uint64_t overload_waits = 0;           // times the producer found the queue full
   std::chrono::nanoseconds overload_time{0};  // total time it waited
+  // Time the encoder thread spent grouping and encoding batches, and the writer thread storing
+  // them (checksums, SQLite, the commits' fsyncs); the two overlap. A store time near the wall
+  // time of a run: the commits are what limits it.
+  std::chrono::nanoseconds encode_time{0};
+  std::chrono::nanoseconds store_time{0};
 };
 
 class BatchWriter {
@@ -47,6 +54,9 @@ class BatchWriter {
   BatchWriter& operator=(const BatchWriter&) = delete;
 
   void push(const RawReading& r);
+  // The same for several readings in order (one call per chunk of a high-rate stream); the
+  // batches are cut at the very same readings as by pushing them one by one.
+  void push(std::span<const RawReading> readings);
   // Hands the current batch over (even if small) when it is batch_age old by the options'
   // clock, e.g. from a periodic timer on the loop.
   void flush_if_old();
