@@ -5,6 +5,10 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-"$ROOT/build"}
 JOBS=${JOBS:-2}
+# Tests at a time: twice the build's jobs. About half of the suite's wall time is waiting, not
+# computing (Chromium rendering, live runs paced in real time between two processes), so two
+# tests per core keep the cores busy (docs/benchmarks.md, "Test suite and demo").
+TEST_JOBS=${TEST_JOBS:-$((2 * JOBS))}
 
 PACKAGES=(
   build-essential cmake pkg-config

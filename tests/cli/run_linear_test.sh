@@ -43,7 +43,9 @@ check stored_complete 0 "^run 1 stored \(complete\)" -- echo "$RUN"
 # daq sim's configuration carries the machine specification of daq demo: the injected 4 um
 # backlash exceeds its B limit of 3 um, the rest is within.
 check verdict 0 "^verdict against tolerances.X.*: FAIL" -- echo "$RUN"
-check verdict_on_b 0 "^  B +4\.[0-9]+ um +limit +3\.000 um +FAIL" -- echo "$RUN"
+# B within 0.1 um of the injected 4 um (3.9 .. 4.1): the live run's stops are means of a few noisy readings
+# (3.995 um was seen under load; "4.x" alone failed it).
+check verdict_on_b 0 "^  B +(3\.9|4\.0)[0-9]* um +limit +3\.000 um +FAIL" -- echo "$RUN"
 check verdict_e_passes 0 "^  E +[0-9.]+ um +limit +10\.000 um +pass" -- echo "$RUN"
 # The machine rests on the first target while the program has not started: that is no stop.
 check rest_is_no_stop 0 "stop at .* without an approach move .*: ignored" -- echo "$RUN"
