@@ -7,8 +7,8 @@ BUILD_DIR=${BUILD_DIR:-"$ROOT/build"}
 JOBS=${JOBS:-2}
 # Tests at a time (ctest -j). About a third of the suite's wall time is waiting, not computing
 # (Chromium, live runs paced in real time between two processes): TEST_JOBS=4 takes the suite
-# from ~55 s to ~40 s on 2 cores, but the live runs then see more load (cli_run_linear failed
-# 2 runs in 8 at -j4), so the default stays one test per core (docs/benchmarks.md).
+# from ~55 s to ~40 s on 2 cores, but the live runs then see more load (cli_run_linear failed in
+# one of four whole suites at -j4), so the default stays one test per core (docs/benchmarks.md).
 TEST_JOBS=${TEST_JOBS:-$JOBS}
 
 PACKAGES=(
