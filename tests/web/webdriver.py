@@ -5,6 +5,7 @@ chromedriver, open a headless Chromium session, load pages, run scripts (synchro
 asynchronous), resize the window, take screenshots.
 """
 import base64
+import http.client
 import json
 import os
 import shutil
@@ -27,25 +28,44 @@ class Browser:
         browser = os.environ.get("CALDAQ_CHROMIUM") or shutil.which("chromium")
         if not os.path.exists(driver) or not browser:
             raise RuntimeError("chromium and chromium-driver are needed (Debian packages)")
-        self.port = _free_port()
-        self.proc = subprocess.Popen([driver, f"--port={self.port}"],
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        self.base = f"http://127.0.0.1:{self.port}"
-        deadline = time.time() + 20
-        while True:
-            try:
-                self._call("GET", "/status")
+        # A free port is only free until someone takes it: between _free_port() and
+        # chromedriver's bind, another test's server (a simulated MTConnect agent, seen in a
+        # parallel ctest) can get it, and /status then answers in its protocol. So the port is
+        # checked to be chromedriver's, and another is tried if it is not.
+        for attempt in range(5):
+            self.port = _free_port()
+            self.proc = subprocess.Popen([driver, f"--port={self.port}"],
+                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            self.base = f"http://127.0.0.1:{self.port}"
+            if self._wait_for_driver():
                 break
-            except (urllib.error.URLError, ConnectionError):
-                if time.time() > deadline:
-                    raise RuntimeError("chromedriver did not start")
-                time.sleep(0.1)
+            self.proc.kill()
+            self.proc.wait()
+        else:
+            raise RuntimeError("chromedriver did not start on any of 5 ports")
         args = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
                 f"--window-size={width},{height}"]
         caps = {"capabilities": {"alwaysMatch": {
             "browserName": "chrome",
             "goog:chromeOptions": {"binary": browser, "args": args}}}}
         self.session = self._call("POST", "/session", caps)["sessionId"]
+
+    def _wait_for_driver(self):
+        """True once chromedriver answers /status on self.port; False if something else holds
+        the port or chromedriver exited; raises after 20 s without an answer."""
+        deadline = time.time() + 20
+        while True:
+            if self.proc.poll() is not None:
+                return False  # it could not bind: the port was taken
+            try:
+                status = self._call("GET", "/status")
+                return isinstance(status, dict) and "ready" in status
+            except (http.client.HTTPException, ValueError, RuntimeError):
+                return False  # an answer, but not chromedriver's
+            except (urllib.error.URLError, ConnectionError):
+                if time.time() > deadline:
+                    raise RuntimeError("chromedriver did not start")
+                time.sleep(0.1)
 
     def _call(self, method, path, body=None):
         data = None if body is None else json.dumps(body).encode()
