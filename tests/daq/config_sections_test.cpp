@@ -30,15 +30,15 @@ fallback_humidity_pct = 40
 fallback_material_degc = 20.5
 co2_umol_per_mol = 420
 wavelength_nm = 633.0
-expansion_ppm_per_k = 11.7
+expansion_ppm_per_k = 11.8
 [trigger]
-tolerance_um = 2
-dwell_s = 1.2
-window_mm = 0.3
+tolerance_um = 2.5
+dwell_s = 1.1
+window_mm = 0.4
 [test.linear]
 axis = "Y"
-first_mm = -10
-last_mm = 490
+first_mm = -20
+last_mm = 480
 interval_mm = 50
 random_fraction = 0.25
 cycle = "pendulum"
