@@ -7,8 +7,8 @@ BUILD_DIR=${BUILD_DIR:-"$ROOT/build"}
 JOBS=${JOBS:-2}
 # Tests at a time (ctest -j): one more than the cores. About a third of the suite's wall time is
 # waiting, not computing (Chromium, live runs paced in real time between two processes); the
-# extra slot fills it. On the 2-core machine: -j2 55-62 s, -j3 40-48 s (5 suites, all passed
-# once a port race of the page test was fixed), -j4 39-49 s but the live cross-process runs
+# extra slot fills it. On the 2-core machine: -j2 55-62 s, -j3 40-48 s (5 suites; the first failed on
+# a port race of the page test, since fixed), -j4 39-49 s but the live cross-process runs
 # then failed in 1 of 4 suites (docs/benchmarks.md, "Test suite and demo").
 TEST_JOBS=${TEST_JOBS:-$((JOBS + 1))}
 
