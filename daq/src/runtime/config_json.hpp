@@ -62,13 +62,10 @@ template <class S>
 void check(const cal::daq::fields::Field<S>& f, std::string_view where, std::string_view key,
            const nlohmann::json& v) {
   namespace fd = cal::daq::fields;
-  if (v.is_number() && f.range)
-    if (auto e = fd::range_error(*f.range, v.get<double>())) refuse(where, key, *e);
-  if (v.is_string()) {
-    const auto s = v.get<std::string>();
-    if (auto e = fd::word_error(f.words, s)) refuse(where, key, *e);
-    if (auto e = f.name ? fd::name_error(s) : std::nullopt) refuse(where, key, *e);
-  }
+  const auto e = v.is_number()   ? fd::number_error(f, v.get<double>())
+                 : v.is_string() ? fd::text_error(f, v.get<std::string>())
+                                 : std::nullopt;
+  if (e) refuse(where, key, *e);
 }
 
 template <class V>

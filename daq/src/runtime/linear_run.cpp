@@ -558,22 +558,11 @@ struct LinearRun::Impl {
       try {
         outcome.evaluation = cal::iso230_2::evaluate(sequencer.measurements(), standard);
       } catch (const std::exception& e) {
-        // Too little was captured to evaluate: stored as it is, and said why.
-        outcome.status = cal::storage::RunStatus::incomplete;
-        outcome.reason +=
-            (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
-        store->finish_run(outcome.run_id, outcome.status, outcome.reason);
-        live.state = "incomplete";
-        return end();
+        return not_evaluated(e.what());
       }
-      json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+      json prov = result_provenance();
       prov["standard"] = l.standard;
-      prov["coefficients"] = compensation_json(setup.config.environment);
       prov["sensor_offsets"] = to_json(SensorOffsets{});
-      if (setup.replay) {
-        prov["capture"] = setup.capture_path;
-        prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
-      }
       store->add_result({.run_id = outcome.run_id,
                          .standard = std::string(outcome.evaluation->standard.title),
                          .json = to_json(*outcome.evaluation).dump(),
@@ -588,29 +577,39 @@ struct LinearRun::Impl {
     end();
   }
 
+  // What every stored result of the run says of how it was obtained (provenance.hpp).
+  json result_provenance() const {
+    json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+    prov["coefficients"] = compensation_json(setup.config.environment);
+    if (setup.replay) {
+      prov["capture"] = setup.capture_path;
+      prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
+    }
+    return prov;
+  }
+
+  // Too little was captured to evaluate: the run is stored as it is, and says why.
+  void not_evaluated(const std::string& why) {
+    outcome.status = cal::storage::RunStatus::incomplete;
+    outcome.reason += (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + why;
+    store->finish_run(outcome.run_id, outcome.status, outcome.reason);
+    live.state = "incomplete";
+    end();
+  }
+
   // The end of a run of another kind than positioning: its profile is its result.
   void finish_profile(const cal::daq::LinearTestConfig& l) {
     try {
       auto e = kind.evaluate(values, l);
-      json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
+      json prov = result_provenance();
       prov["measure"] = kind.name();
-      prov["coefficients"] = compensation_json(setup.config.environment);
-      if (setup.replay) {
-        prov["capture"] = setup.capture_path;
-        prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
-      }
       store->add_result({.run_id = outcome.run_id,
                          .standard = e.title,
                          .json = e.json.dump(),
                          .provenance_json = prov.dump()});
       outcome.profile = std::move(e.json);
     } catch (const cal::InputError& e) {
-      outcome.status = cal::storage::RunStatus::incomplete;
-      outcome.reason +=
-          (outcome.reason.empty() ? "" : "; ") + std::string("not evaluated: ") + e.what();
-      store->finish_run(outcome.run_id, outcome.status, outcome.reason);
-      live.state = "incomplete";
-      return end();
+      return not_evaluated(e.what());
     }
     store->finish_run(outcome.run_id, outcome.status, outcome.reason);
     outcome.complete = true;

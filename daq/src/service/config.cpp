@@ -173,14 +173,12 @@ void one_of(Table& t, std::string_view key, const std::string& value,
 
 template <class S>
 void check_number(Table& t, const fields::Field<S>& f, const toml::node& node, double v) {
-  if (!f.range) return;
-  if (auto e = fields::range_error(*f.range, v)) t.fail(&node, f.key, *e);
+  if (auto e = fields::number_error(f, v)) t.fail(&node, f.key, *e);
 }
 
 template <class S>
 void check_word(Table& t, const fields::Field<S>& f, const toml::node& node, std::string_view v) {
-  if (auto e = fields::word_error(f.words, v)) t.fail(&node, f.key, *e);
-  if (auto e = f.name ? fields::name_error(v) : std::nullopt) t.fail(&node, f.key, *e);
+  if (auto e = fields::text_error(f, v)) t.fail(&node, f.key, *e);
 }
 
 template <class S, class V>

@@ -62,6 +62,18 @@ std::optional<std::string> word_error(std::span<const std::string_view> words,
 // Why a free text is refused (control characters, over 200 bytes), or nothing.
 std::optional<std::string> name_error(std::string_view value);
 
+// Why a field refuses a number (its range) or a text (its words, a free text's rules), or
+// nothing: the one check every reader of the tables applies.
+template <class S>
+std::optional<std::string> number_error(const Field<S>& f, double value) {
+  return f.range ? range_error(*f.range, value) : std::nullopt;
+}
+template <class S>
+std::optional<std::string> text_error(const Field<S>& f, std::string_view value) {
+  if (auto e = word_error(f.words, value)) return e;
+  return f.name ? name_error(value) : std::nullopt;
+}
+
 // The words of a StalePolicy, and back (nullopt: not a policy).
 std::string_view to_string(StalePolicy p);
 std::optional<StalePolicy> stale_policy(std::string_view word);
