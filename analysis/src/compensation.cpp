@@ -43,10 +43,6 @@ double material_temperature_degc(std::span<const MaterialSensor> sensors) {
   return sum / used;
 }
 
-double normalise_to_20c_m(double length_m, double alpha_per_k, double material_degc) {
-  return length_m / (1.0 + alpha_per_k * (material_degc - kReferenceTemperatureDegc));
-}
-
 Factor combined_factor(double n_air, double alpha_per_k, double material_degc) {
   if (!(n_air >= 1.0 && n_air < 1.01)) {
     throw InputError(fmt::format("refractive index n = {} is not that of air", n_air));

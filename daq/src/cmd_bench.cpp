@@ -26,6 +26,8 @@
 // and wall time are reported: flat memory and linear time are what is asked.
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <pthread.h>
+#include <sched.h>
 #include <spawn.h>
 #include <sqlite3.h>
 #include <sys/resource.h>
@@ -67,6 +69,14 @@ double seconds_since(Clock::time_point t0) {
 double cpu_seconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// This thread's CPU time (user and system), for the ceilings' own CPU.
+double thread_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_THREAD, &u);
   return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
@@ -149,16 +159,53 @@ struct IngestResult {
   std::vector<std::pair<int, long>> rss_marks;  // (recorded minute, current RSS KiB)
 };
 
+// Where the threads of one ingest run (-1: the OS decides): the event loop and the batch
+// encoder on one CPU, the SQLite writer on another.
+struct Placement {
+  int loop_cpu = -1, writer_cpu = -1;
+  bool pinned() const { return loop_cpu >= 0; }
+};
+
+// Runs this thread on `cpu` until destroyed, then where it ran before.
+class PinThisThread {
+ public:
+  explicit PinThisThread(int cpu) {
+    if (cpu < 0) return;
+    pthread_getaffinity_np(pthread_self(), sizeof before_, &before_);
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    if (pthread_setaffinity_np(pthread_self(), sizeof set, &set) != 0)
+      throw cal::InputError(fmt::format("bench: cannot run the event loop on CPU {}", cpu));
+    active_ = true;
+  }
+  ~PinThisThread() {
+    if (active_) pthread_setaffinity_np(pthread_self(), sizeof before_, &before_);
+  }
+  PinThisThread(const PinThisThread&) = delete;
+  PinThisThread& operator=(const PinThisThread&) = delete;
+
+ private:
+  cpu_set_t before_{};
+  bool active_ = false;
+};
+
 // The ingest pipeline; `db` empty: the pipeline alone, readings go nowhere.
-IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t batch_readings) {
+IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t batch_readings,
+                    Placement where = {}) {
   IngestResult res;
   std::int64_t run = 0;
   std::unique_ptr<cal::storage::BatchWriter> writer;
   if (!db.empty()) {
     run = cal::storage::Store(db).begin_run({.kind = "bench"});
-    writer = std::make_unique<cal::storage::BatchWriter>(
-        db, run, cal::storage::WriterOptions{.batch_readings = batch_readings});
+    cal::storage::WriterOptions options{.batch_readings = batch_readings};
+    if (where.pinned()) {
+      options.writer_cpus = {where.writer_cpu};
+      options.encoder_cpus = {where.loop_cpu};
+    }
+    writer = std::make_unique<cal::storage::BatchWriter>(db, run, options);
   }
+  const PinThisThread pin(where.loop_cpu);
   boost::asio::io_context io;
   cal::replay::ReplayBus bus(io, capture, 0.0);
   cal::daq::EnvStage env({}, 0);
@@ -206,17 +253,17 @@ IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t bat
     ++res.handovers;
     res.readings += rs.size();
     if (writer) {
-      raw.clear();
-      for (const auto& r : rs)
-        raw.push_back({.time_ns = r.time_ns,
-                       .device = r.device,
-                       .channel = r.channel,
-                       .quantity = static_cast<std::uint8_t>(r.quantity),
-                       .status = static_cast<std::uint8_t>(r.status),
-                       .value = r.value});
+      raw.resize(rs.size());  // capacity kept: no allocation, no per-reading call
+      for (std::size_t i = 0; i < rs.size(); ++i)
+        raw[i] = {.time_ns = rs[i].time_ns,
+                  .device = rs[i].device,
+                  .channel = rs[i].channel,
+                  .quantity = static_cast<std::uint8_t>(rs[i].quantity),
+                  .status = static_cast<std::uint8_t>(rs[i].status),
+                  .value = rs[i].value};
       writer->push(raw);
     }
-    for (const auto& r : rs) res.checksum += env.compensate(r.time_ns, r.value).length_m;
+    for (const auto& r : rs) res.checksum += env.compensated_length_m(r.time_ns, r.value);
     if (!rs.empty() && rs.back().time_ns >= next_mark_ns) {
       res.rss_marks.emplace_back(static_cast<int>(rs.back().time_ns / 60'000'000'000),
                                  current_rss_kib());
@@ -324,6 +371,7 @@ class ChunkSource {
 
 struct CeilingResult {
   double seconds = 0.0;
+  double cpu_s = 0.0;  // of the timed parts (SQLite's or the kernel's own work, user and system)
   std::uint64_t commits = 0, bytes = 0;
 };
 
@@ -374,6 +422,7 @@ CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t
     if (schema1)
       for (const auto& r : rows) old_blobs.push_back(as_schema1(src, r));
     const auto t0 = Clock::now();
+    const double cpu0 = thread_cpu_seconds();
     sqlite3_step(begin.s);
     sqlite3_reset(begin.s);
     for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -396,6 +445,7 @@ CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t
       throw cal::InputError(fmt::format("bench: blob ceiling commit: {}", sqlite3_errmsg(dst.db)));
     sqlite3_reset(commit.s);
     res.seconds += seconds_since(t0);
+    res.cpu_s += thread_cpu_seconds() - cpu0;
     ++res.commits;
   }
   return res;
@@ -432,6 +482,7 @@ struct BenchOptions {
   int rounds = 3;
   std::string dir;
   std::size_t batch_readings = 16384;
+  int loop_cpu = -1, writer_cpu = -1;  // both set: each round also ingests with them pinned
 };
 
 void bench_ingest(const BenchOptions& o) {
@@ -456,7 +507,10 @@ void bench_ingest(const BenchOptions& o) {
       o.seconds, static_cast<double>(fs::file_size(capture)) / 1e6, seconds_since(t0));
 
   std::vector<double> ingest_rate, blob_rate, raw_rate, pipeline_rate, ratio_blob, ratio_raw;
-  std::vector<double> blob17_rate;
+  std::vector<double> blob17_rate, pinned_rate, ratio_pinned;
+  if ((o.loop_cpu < 0) != (o.writer_cpu < 0))
+    throw cal::InputError("bench ingest: give both --loop-cpu and --writer-cpu, or neither");
+  const Placement where{.loop_cpu = o.loop_cpu, .writer_cpu = o.writer_cpu};
   double bytes_per_reading = 0.0, file_bytes_per_reading = 0.0;
   std::vector<double> per_core;
   for (int round = 1; round <= o.rounds; ++round) {
@@ -486,14 +540,30 @@ void bench_ingest(const BenchOptions& o) {
     fmt::print(
         "round {}: ingest {:.0f} readings/s ({} readings in {:.2f} s, CPU {:.2f} s, {} gauge "
         "hand-overs, {} commits, encoder {:.2f} s and writer {:.2f} s busy, producer waits {}); "
-        "blob-insert ceiling {:.0f}/s ({} commits; {:.0f}/s with schema-1 records); raw write "
-        "ceiling {:.0f}/s; pipeline without storage {:.0f}/s; checksum "
-        "{:.6f}\n",
+        "blob-insert ceiling {:.0f}/s ({} commits, {:.2f} s, CPU {:.2f} s; {:.0f}/s with schema-1 "
+        "records); raw write ceiling {:.0f}/s; pipeline without storage {:.0f}/s (CPU {:.2f} s); "
+        "checksum {:.6f}\n",
         round, n / in.wall_s, in.readings, in.wall_s, in.cpu_s, in.handovers,
         in.writer.batches_committed, std::chrono::duration<double>(in.writer.encode_time).count(),
-        std::chrono::duration<double>(in.writer.store_time).count(),
-        in.writer.overload_waits, n / blob.seconds, blob.commits, n / blob17.seconds,
-        n / bare.seconds, n / alone.wall_s, in.checksum);
+        std::chrono::duration<double>(in.writer.store_time).count(), in.writer.overload_waits,
+        n / blob.seconds, blob.commits, blob.seconds, blob.cpu_s, n / blob17.seconds,
+        n / bare.seconds, n / alone.wall_s, alone.cpu_s, in.checksum);
+    if (where.pinned()) {  // the same ingest, its threads placed; the same ceiling
+      remove_db(db);
+      const auto p = ingest(capture, db, o.batch_readings, where);
+      if (p.readings != in.readings || p.checksum != in.checksum)
+        throw cal::InputError("bench: the pinned ingest did not give the same readings");
+      pinned_rate.push_back(n / p.wall_s);
+      ratio_pinned.push_back(blob.seconds / p.wall_s);
+      fmt::print(
+          "round {}: pinned (event loop and encoder on CPU {}, writer on CPU {}): ingest {:.0f} "
+          "readings/s ({:.2f} s, CPU {:.2f} s, encoder {:.2f} s and writer {:.2f} s busy, "
+          "producer waits {}): {:.0f} % of the blob-insert ceiling\n",
+          round, where.loop_cpu, where.writer_cpu, n / p.wall_s, p.wall_s, p.cpu_s,
+          std::chrono::duration<double>(p.writer.encode_time).count(),
+          std::chrono::duration<double>(p.writer.store_time).count(), p.writer.overload_waits,
+          100.0 * blob.seconds / p.wall_s);
+    }
     if (in.writer.readings_committed != in.readings)
       throw cal::InputError(fmt::format("bench: {} readings ingested but {} committed", in.readings,
                                         in.writer.readings_committed));
@@ -521,6 +591,11 @@ void bench_ingest(const BenchOptions& o) {
       median(raw_rate), 100.0 * median(ratio_raw), median(pipeline_rate), median(blob17_rate),
       bytes_per_reading, file_bytes_per_reading, file_bytes_per_reading * 36e6 / 1e6,
       median(per_core), median(per_core) / 1e4, median(per_core) / 1e5);
+  if (where.pinned())
+    fmt::print(
+        "  pinned (event loop and encoder on CPU {}, writer on CPU {}): ingest {:.0f} "
+        "readings/s, {:.0f} % of the blob-insert ceiling\n",
+        where.loop_cpu, where.writer_cpu, median(pinned_rate), 100.0 * median(ratio_pinned));
 }
 
 // A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
@@ -646,6 +721,13 @@ void add_bench_commands(CLI::App& app) {
   in->add_option("--dir", o->dir, "Directory for the capture and databases (default: $TMPDIR)");
   in->add_option("--batch", o->batch_readings, "Readings per committed batch")
       ->capture_default_str();
+  in->add_option("--loop-cpu", o->loop_cpu,
+                 "With --writer-cpu: each round also ingests with the event loop and the batch "
+                 "encoder on this CPU")
+      ->check(CLI::NonNegativeNumber);
+  in->add_option("--writer-cpu", o->writer_cpu,
+                 "With --loop-cpu: ... and the SQLite writer thread on this one")
+      ->check(CLI::NonNegativeNumber);
   in->callback([o] { bench_ingest(*o); });
 
   auto e = std::make_shared<ExportBenchOptions>();

@@ -37,6 +37,9 @@ struct Store::Impl {
   // The writer's scratch, kept between batches so that a batch allocates nothing.
   PreparedBatch prepared;  // append_readings' scratch, reused between batches
   detail::Stmt insert_chunk, next_seq;
+  // BEGIN IMMEDIATE and COMMIT, prepared once: a batch of a 10 kHz stream commits every 1.6 s,
+  // and parsing the two statements each time cost about 2 % of the writer's time (issue 20).
+  detail::Stmt begin_tx, commit_tx;
 
   [[noreturn]] void fail(std::string_view what) const {
     throw StoreError(fmt::format("{}: {}: {}", path.string(), what, sqlite3_errmsg(db.get())));
@@ -55,6 +58,18 @@ struct Store::Impl {
     sqlite3_stmt* s = nullptr;
     if (sqlite3_prepare_v2(db.get(), sql, -1, &s, nullptr) != SQLITE_OK) fail("prepare");
     return detail::Stmt(s);
+  }
+
+  // Steps a cached statement without bindings (prepared on first use) to its end; the
+  // message of a failure is read before the statement is reset for its next use.
+  void step_cached(detail::Stmt& s, const char* sql, std::string_view what) {
+    if (!s) s = prepare(sql);
+    if (sqlite3_step(s.get()) != SQLITE_DONE) {
+      const std::string text = sqlite3_errmsg(db.get());
+      sqlite3_reset(s.get());
+      throw StoreError(fmt::format("{}: {}: {}", path.string(), what, text));
+    }
+    sqlite3_reset(s.get());
   }
 
   void step_done(sqlite3_stmt* s, std::string_view what) const {
@@ -82,10 +97,10 @@ struct Store::Impl {
     bool done = false;
     explicit Transaction(Impl& i) : impl(i) {
       impl.need_writable("write");
-      impl.exec("BEGIN IMMEDIATE", "begin transaction");
+      impl.step_cached(impl.begin_tx, "BEGIN IMMEDIATE", "begin transaction");
     }
     void commit() {
-      impl.exec("COMMIT", "commit");
+      impl.step_cached(impl.commit_tx, "COMMIT", "commit");
       done = true;
     }
     ~Transaction() {

@@ -1,5 +1,9 @@
 #include "cal/storage/writer.hpp"
 
+#include <fmt/format.h>
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <condition_variable>
 #include <deque>
@@ -8,7 +12,29 @@
 #include <thread>
 #include <vector>
 
+#include "cal/analysis/error.hpp"
+
 namespace cal::storage {
+namespace {
+
+// The CPU set of `cpus`, each checked against the CPUs this process may run on.
+cpu_set_t cpu_set_of(const std::vector<int>& cpus) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0)
+    throw InputError("storage CPUs: cannot read this process's CPU affinity");
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (const int cpu : cpus) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &allowed))
+      throw InputError(fmt::format(
+          "storage thread CPU {}: not one this process may run on (taskset -p shows which)", cpu));
+    CPU_SET(cpu, &set);
+  }
+  return set;
+}
+
+}  // namespace
 
 struct BatchWriter::Impl {
   std::filesystem::path path;
@@ -42,8 +68,17 @@ struct BatchWriter::Impl {
   std::string error;
   WriterStats stats;
   std::thread encoder, thread;
+  // Where the two threads run; none: the OS decides.
+  std::optional<cpu_set_t> writer_cpus, encoder_cpus;
+
+  // Called first in each storage thread. The set was checked in the constructor, so this
+  // cannot fail for a reason the caller could act on; the thread then runs unpinned.
+  static void place_this_thread(const std::optional<cpu_set_t>& cpus) {
+    if (cpus) pthread_setaffinity_np(pthread_self(), sizeof *cpus, &*cpus);
+  }
 
   void encode_loop() {
+    place_this_thread(encoder_cpus);
     for (;;) {
       std::vector<RawReading> batch;
       PreparedBatch out;
@@ -89,6 +124,7 @@ struct BatchWriter::Impl {
   }
 
   void run() {
+    place_this_thread(writer_cpus);
     std::optional<Store> store;
     try {
       store.emplace(path, options.store);
@@ -172,6 +208,8 @@ BatchWriter::BatchWriter(std::filesystem::path path, std::int64_t run_id, Writer
   impl_->run_id = run_id;
   impl_->options = options;
   impl_->on_error = std::move(on_error);
+  if (!options.writer_cpus.empty()) impl_->writer_cpus = cpu_set_of(options.writer_cpus);
+  if (!options.encoder_cpus.empty()) impl_->encoder_cpus = cpu_set_of(options.encoder_cpus);
   impl_->current.reserve(options.batch_readings);
   impl_->encoder = std::thread([impl = impl_.get()] { impl->encode_loop(); });
   impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });

@@ -84,7 +84,7 @@ TEST(CodecCommon, StatsCountEachKind) {
 
 namespace {
 
-// The memchr splitter against a byte-at-a-time reference written from the rules (any CR or LF
+// The splitter against a byte-at-a-time reference written from the rules (any CR or LF
 // ends a line, empty lines skipped, a line over the limit reported once at its start and
 // dropped to its terminator), on random streams rich in terminators cut at random places.
 Collected reference_split(std::string_view stream, std::size_t max) {
@@ -135,6 +135,40 @@ TEST(CodecLineSplitter, EqualsAByteAtATimeReferenceOnRandomStreamsAndCuts) {
     ASSERT_EQ(got.lines, want.lines) << trial;
     ASSERT_EQ(got.overlong, want.overlong) << trial;
   }
+}
+
+TEST(CodecLineSplitter, EqualsTheReferenceWithLongLinesAcrossTheSixteenByteBlocks) {
+  // The terminators are searched 16 bytes at a time: lines of 0 to 70 bytes (so a terminator
+  // falls at every position of a block, and in the byte loop of a chunk's tail), every kind of
+  // terminator (CR, LF, CR-LF, LF-CR, CR-CR), chunks of 1 to 300 bytes (a CR-LF pair cut
+  // between two chunks included), limits below and above the line lengths.
+  std::mt19937 rng(20261127);
+  const char* const terminators[] = {"\r", "\n", "\r\n", "\n\r", "\r\r"};
+  std::size_t lines_seen = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string stream;
+    while (stream.size() < 600) {
+      const std::size_t len = rng() % 71;
+      for (std::size_t k = 0; k < len; ++k) stream += static_cast<char>('0' + rng() % 10);
+      stream += terminators[rng() % 5];
+    }
+    const std::size_t max = 20 + rng() % 60;
+    LineSplitter s(max);
+    Collected got;
+    for (std::size_t i = 0; i < stream.size();) {
+      const std::size_t n = std::min<std::size_t>(1 + rng() % 300, stream.size() - i);
+      s.feed(
+          cal::drivers::codec::as_bytes(std::string_view(stream).substr(i, n)),
+          [&](std::string_view line, std::uint64_t off) { got.lines.emplace_back(line, off); },
+          [&](std::uint64_t off) { got.overlong.push_back(off); });
+      i += n;
+    }
+    const auto want = reference_split(stream, max);
+    ASSERT_EQ(got.lines, want.lines) << trial;
+    ASSERT_EQ(got.overlong, want.overlong) << trial;
+    lines_seen += want.lines.size();
+  }
+  EXPECT_GT(lines_seen, 3000u * 10);  // the streams did hold lines
 }
 
 }  // namespace

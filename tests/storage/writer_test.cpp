@@ -3,14 +3,19 @@
 #include "cal/storage/writer.hpp"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
+
+#include "cal/analysis/error.hpp"
 
 namespace {
 
@@ -50,6 +55,62 @@ TEST(BatchWriter, KeepsEveryReadingInOrderAcrossBatches) {
   ASSERT_EQ(static_cast<std::int64_t>(back.size()), n);
   for (std::int64_t i = 0; i < n; i += 997)
     EXPECT_EQ(back[static_cast<std::size_t>(i)].value, reading(i).value);
+}
+
+// The CPUs each thread of this process may run on, as the kernel lists them
+// (/proc/self/task/<tid>/status, "Cpus_allowed_list:"), one entry per thread.
+std::vector<std::string> threads_cpu_lists() {
+  std::vector<std::string> lists;
+  for (const auto& task : fs::directory_iterator("/proc/self/task")) {
+    std::ifstream status(task.path() / "status");
+    for (std::string line; std::getline(status, line);)
+      if (line.starts_with("Cpus_allowed_list:")) lists.push_back(line.substr(line.find(':') + 1));
+  }
+  for (auto& l : lists) l.erase(0, l.find_first_not_of(" \t"));
+  return lists;
+}
+
+TEST(BatchWriter, StorageThreadsRunOnTheGivenCpusAndStoreTheSame) {
+  cpu_set_t allowed;
+  ASSERT_EQ(sched_getaffinity(0, sizeof allowed, &allowed), 0);
+  int last = -1;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &allowed)) last = cpu;
+  ASSERT_GE(last, 0);
+  const auto before = threads_cpu_lists();
+  const auto pinned_before = std::count(before.begin(), before.end(), std::to_string(last));
+  TempFile file;
+  std::int64_t run = 0;
+  { run = Store(file.path).begin_run({.kind = "linear"}); }
+  {
+    BatchWriter writer(file.path, run,
+                       {.batch_readings = 1000, .writer_cpus = {last}, .encoder_cpus = {last}});
+    for (std::int64_t i = 0; i < 5000; ++i) writer.push(reading(i));
+    writer.flush();  // both threads have run (and placed themselves) by now
+    const auto during = threads_cpu_lists();
+    // The encoder and the writer, and nothing else of this process, were moved to `last` (on a
+    // one-CPU machine every thread lists it anyway).
+    if (CPU_COUNT(&allowed) > 1) {
+      EXPECT_EQ(std::count(during.begin(), during.end(), std::to_string(last)), pinned_before + 2);
+    }
+    EXPECT_EQ(writer.stats().readings_committed, 5000u);
+  }
+  EXPECT_EQ(Store(file.path).readings(run).size(), 5000u);
+}
+
+TEST(BatchWriter, ACpuThisProcessMayNotUseIsRefusedBeforeAnyThreadStarts) {
+  TempFile file;
+  std::int64_t run = 0;
+  { run = Store(file.path).begin_run({.kind = "linear"}); }
+  for (const int cpu : {-1, CPU_SETSIZE, CPU_SETSIZE - 1}) {
+    try {
+      BatchWriter writer(file.path, run, {.writer_cpus = {cpu}});
+      ADD_FAILURE() << "CPU " << cpu << " accepted";
+    } catch (const cal::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("CPU " + std::to_string(cpu)), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(BatchWriter, PushingSpansCutsTheSameBatchesAsPushingOneByOne) {

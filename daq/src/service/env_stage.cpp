@@ -219,16 +219,30 @@ Compensated EnvStage::environment_at(std::int64_t t) const {
   return c;
 }
 
+namespace {
+// L20 = raw / (n (1 + alpha (T - 20))): cal::comp (ISO 1 reference temperature). The one
+// formula of both compensate() and compensated_length_m().
+double length_at_20c_m(double raw_m, double n, double expansion_ppm_per_k, double material_degc) {
+  return comp::normalise_to_20c_m(comp::air_length_m(raw_m, n), expansion_ppm_per_k * 1e-6,
+                                  material_degc);
+}
+}  // namespace
+
 Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
   Compensated c = held_cache_.valid && t > held_cache_.after_ns && t <= held_cache_.until_ns
                       ? held_cache_.environment
                       : environment_at(t);
   c.time_ns = t;
   c.raw_m = raw_m;
-  const double alpha = config_.expansion_ppm_per_k * 1e-6;
-  // L20 = raw / (n (1 + alpha (T - 20))): cal::comp (ISO 1 reference temperature).
-  c.length_m = comp::normalise_to_20c_m(comp::air_length_m(raw_m, c.n), alpha, c.material_degc);
+  c.length_m = length_at_20c_m(raw_m, c.n, config_.expansion_ppm_per_k, c.material_degc);
   return c;
+}
+
+double EnvStage::compensated_length_m(std::int64_t t, double raw_m) const {
+  if (held_cache_.valid && t > held_cache_.after_ns && t <= held_cache_.until_ns)
+    return length_at_20c_m(raw_m, held_cache_.environment.n, config_.expansion_ppm_per_k,
+                           held_cache_.environment.material_degc);
+  return compensate(t, raw_m).length_m;
 }
 
 }  // namespace cal::daq

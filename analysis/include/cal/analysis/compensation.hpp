@@ -43,7 +43,10 @@ double material_temperature_degc(std::span<const MaterialSensor> sensors);
 
 // Length at 20 degC of a length measured with the material at `material_degc`:
 // L20 = L / (1 + alpha (T - 20)). `alpha_per_k` is the linear expansion coefficient (1/K).
-double normalise_to_20c_m(double length_m, double alpha_per_k, double material_degc);
+// Inline: it is applied to every reading of a 10 kHz stream.
+inline double normalise_to_20c_m(double length_m, double alpha_per_k, double material_degc) {
+  return length_m / (1.0 + alpha_per_k * (material_degc - kReferenceTemperatureDegc));
+}
 
 // The whole factor that turns a vacuum length into a length at 20 degC:
 // k = 1 / (n (1 + alpha (T - 20))). Reported in ppm as (k - 1) 1e6.

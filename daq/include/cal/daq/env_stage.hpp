@@ -89,6 +89,10 @@ class EnvStage {
   // Throws cal::InputError when the environment at t is outside the equation's range (a
   // sensor fault such as a pressure of 0): such a reading cannot be compensated.
   Compensated compensate(std::int64_t time_ns, double raw_m) const;
+  // compensate(time_ns, raw_m).length_m, the very same arithmetic (so the same bits), without
+  // the record: for a stream that needs only the length (10 kHz; the held environment is
+  // looked up once per air sample, not copied per reading).
+  double compensated_length_m(std::int64_t time_ns, double raw_m) const;
 
  private:
   struct Series {
