@@ -227,7 +227,7 @@ IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t bat
       case cal::drivers::Quantity::air_humidity_pct:
         return env.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value);
       case cal::drivers::Quantity::length_m:
-        res.checksum += env.compensate(r.time_ns, r.value).length_m;
+        res.checksum += env.compensated_length_m(r.time_ns, r.value);
         if (r.time_ns >= next_mark_ns) {
           res.rss_marks.emplace_back(static_cast<int>(r.time_ns / 60'000'000'000),
                                      current_rss_kib());

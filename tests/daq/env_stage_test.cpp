@@ -48,6 +48,33 @@ TEST(EnvStage, CompensatesWithTheReferenceIndexAndMaterialNormalisation) {
   EXPECT_FALSE(c.held);
 }
 
+TEST(EnvStage, TheLengthAloneHasTheBitsOfTheWholeCompensation) {
+  // compensated_length_m() serves 10 kHz streams from the held environment without building
+  // the record; it must give compensate()'s length bit for bit, held or interpolated, on a
+  // changing environment, and the same hand value as the whole record for standard air.
+  EnvStage e(edlen(), 1);
+  standard_air(e, 0);
+  e.add_material(0, 0, 21.0);
+  EXPECT_NEAR(e.compensated_length_m(0, 0.1), 0.0999717202876, 6e-11);  // the hand value above
+  for (int k = 1; k <= 5; ++k) {  // air and material change every second
+    e.add_air(k * s, AirQuantity::temperature_degc, 20.0 + 0.1 * k);
+    e.add_air(k * s, AirQuantity::pressure_pa, 101325.0 - 30.0 * k);
+    e.add_air(k * s, AirQuantity::humidity_pct, 50.0 + k);
+    e.add_material(k * s, 0, 21.0 + 0.05 * k);
+  }
+  int held = 0;
+  for (std::int64_t t = 0; t <= 8 * s; t += s / 7) {  // between samples, on them, after them
+    for (int i = -100; i <= 100; ++i) {  // raw lengths from -1 m to 1 m, none a round number
+      const double raw = 0.01 * i + 1.234567e-7 * i * i;
+      const double whole = e.compensate(t, raw).length_m;
+      const double alone = e.compensated_length_m(t, raw);
+      ASSERT_EQ(std::memcmp(&whole, &alone, sizeof whole), 0) << t << " " << raw;
+    }
+    held += e.compensate(t, 0.1).held;
+  }
+  EXPECT_GT(held, 10);  // the held path (after 5 s) was taken as well as the interpolated one
+}
+
 TEST(EnvStage, InterpolatesLinearlyInTimeAndFlagsAHeldValue) {
   EnvStage e(edlen(), 2);
   standard_air(e, 0);

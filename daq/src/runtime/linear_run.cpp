@@ -376,7 +376,7 @@ struct LinearRun::Impl {
         if (device == 0 && r.channel == setup.laser_channel) return on_laser(r);
         if (device == 0 && reader && r.status == ReadingStatus::ok) {
           Reading c = r;
-          c.value = env.compensate(r.time_ns, r.value).length_m;
+          c.value = env.compensated_length_m(r.time_ns, r.value);
           add_sample(kinds::Source::laser, c);
         }
         return;
