@@ -29,11 +29,11 @@ struct WriterOptions {
   std::function<std::chrono::steady_clock::time_point()> clock;
   // CPUs (Linux numbers) the writer thread (SQLite, the commits and their fsyncs) and the
   // encoder thread run on; empty: wherever the OS schedules them. Where ingest competes for few
-  // cores, a CPU of its own for the writer (the one that takes the disk's interrupts) keeps the
-  // scheduler from placing it behind the event loop; on the 2-core benchmark machine ingest went
-  // from about 60 % to about 80 % of the SQLite ceiling with the writer on CPU 1 and the loop
-  // and the encoder on CPU 0 (docs/benchmarks.md). The constructor throws cal::InputError for a
-  // CPU this process may not run on.
+  // cores, a CPU for the storage threads apart from the event loop's (the one that takes the
+  // disk's interrupts) keeps the scheduler from placing the writer behind the loop: on the
+  // 2-core benchmark machine ingest went from about 60 % to about 75 % of the SQLite ceiling
+  // (docs/benchmarks.md). The constructor throws cal::InputError for a CPU this process may not
+  // run on.
   std::vector<int> writer_cpus, encoder_cpus;
 };
 
