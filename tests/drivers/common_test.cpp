@@ -113,6 +113,22 @@ Collected reference_split(std::string_view stream, std::size_t max) {
   return c;
 }
 
+// The splitter's lines and overlong reports for `stream` fed in chunks of 1 to max_chunk bytes.
+Collected split_in_random_chunks(std::string_view stream, std::size_t max, std::size_t max_chunk,
+                                 std::mt19937& rng) {
+  LineSplitter s(max);
+  Collected got;
+  for (std::size_t i = 0; i < stream.size();) {
+    const std::size_t n = std::min<std::size_t>(1 + rng() % max_chunk, stream.size() - i);
+    s.feed(
+        cal::drivers::codec::as_bytes(stream.substr(i, n)),
+        [&](std::string_view line, std::uint64_t off) { got.lines.emplace_back(line, off); },
+        [&](std::uint64_t off) { got.overlong.push_back(off); });
+    i += n;
+  }
+  return got;
+}
+
 TEST(CodecLineSplitter, EqualsAByteAtATimeReferenceOnRandomStreamsAndCuts) {
   std::mt19937 rng(42);
   const char alphabet[] = {'a', 'b', '\r', '\n', ' ', '\0', '\xff'};
@@ -120,16 +136,7 @@ TEST(CodecLineSplitter, EqualsAByteAtATimeReferenceOnRandomStreamsAndCuts) {
     std::string stream(rng() % 200, 'x');
     for (auto& ch : stream) ch = alphabet[rng() % sizeof alphabet];
     const std::size_t max = 1 + rng() % 12;
-    LineSplitter s(max);
-    Collected got;
-    for (std::size_t i = 0; i < stream.size();) {
-      const std::size_t n = std::min<std::size_t>(1 + rng() % 40, stream.size() - i);
-      s.feed(
-          cal::drivers::codec::as_bytes(std::string_view(stream).substr(i, n)),
-          [&](std::string_view line, std::uint64_t off) { got.lines.emplace_back(line, off); },
-          [&](std::uint64_t off) { got.overlong.push_back(off); });
-      i += n;
-    }
+    const auto got = split_in_random_chunks(stream, max, 40, rng);
     // The reference ends lines only at terminators; a pending last line is not handed out.
     const auto want = reference_split(stream, max);
     ASSERT_EQ(got.lines, want.lines) << trial;
@@ -153,16 +160,7 @@ TEST(CodecLineSplitter, EqualsTheReferenceWithLongLinesAcrossTheSixteenByteBlock
       stream += terminators[rng() % 5];
     }
     const std::size_t max = 20 + rng() % 60;
-    LineSplitter s(max);
-    Collected got;
-    for (std::size_t i = 0; i < stream.size();) {
-      const std::size_t n = std::min<std::size_t>(1 + rng() % 300, stream.size() - i);
-      s.feed(
-          cal::drivers::codec::as_bytes(std::string_view(stream).substr(i, n)),
-          [&](std::string_view line, std::uint64_t off) { got.lines.emplace_back(line, off); },
-          [&](std::uint64_t off) { got.overlong.push_back(off); });
-      i += n;
-    }
+    const auto got = split_in_random_chunks(stream, max, 300, rng);
     const auto want = reference_split(stream, max);
     ASSERT_EQ(got.lines, want.lines) << trial;
     ASSERT_EQ(got.overlong, want.overlong) << trial;
