@@ -492,6 +492,12 @@ void bench_ingest(const BenchOptions& o) {
   if (o.batch_readings < 1 || o.batch_readings > 10'000'000)
     throw cal::InputError(
         fmt::format("bench ingest: --batch {}: expected 1 to 10000000 readings", o.batch_readings));
+  if ((o.loop_cpu < 0) != (o.storage_cpu < 0))
+    throw cal::InputError("bench ingest: give both --loop-cpu and --storage-cpu, or neither");
+  if (o.loop_cpu >= 0) {  // before the capture is written: a wrong CPU fails at once
+    cal::storage::check_cpus(std::vector<int>{o.loop_cpu, o.storage_cpu});
+    const PinThisThread trial(o.loop_cpu);
+  }
   const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
   const auto tag = std::to_string(::getpid());
   const fs::path capture = dir / ("caldaq-bench-" + tag + ".cdq");
@@ -509,8 +515,6 @@ void bench_ingest(const BenchOptions& o) {
 
   std::vector<double> ingest_rate, blob_rate, raw_rate, pipeline_rate, ratio_blob, ratio_raw;
   std::vector<double> blob17_rate, pinned_rate, ratio_pinned;
-  if ((o.loop_cpu < 0) != (o.storage_cpu < 0))
-    throw cal::InputError("bench ingest: give both --loop-cpu and --storage-cpu, or neither");
   const Placement where{.loop_cpu = o.loop_cpu, .storage_cpu = o.storage_cpu};
   double bytes_per_reading = 0.0, file_bytes_per_reading = 0.0;
   std::vector<double> per_core;

@@ -27,14 +27,18 @@ cpu_set_t cpu_set_of(const std::vector<int>& cpus) {
   CPU_ZERO(&set);
   for (const int cpu : cpus) {
     if (cpu < 0 || cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &allowed))
-      throw InputError(fmt::format(
-          "storage thread CPU {}: not one this process may run on (taskset -p shows which)", cpu));
+      throw InputError(
+          fmt::format("CPU {}: not one this process may run on (taskset -p shows which)", cpu));
     CPU_SET(cpu, &set);
   }
   return set;
 }
 
 }  // namespace
+
+void check_cpus(std::span<const int> cpus) {
+  cpu_set_of(std::vector<int>(cpus.begin(), cpus.end()));
+}
 
 struct BatchWriter::Impl {
   std::filesystem::path path;

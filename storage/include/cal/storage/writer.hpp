@@ -51,6 +51,10 @@ struct WriterStats {
   std::chrono::nanoseconds store_time{0};
 };
 
+// Throws cal::InputError, naming the CPU, unless this process may run on every one of `cpus`
+// (what BatchWriter checks of WriterOptions::writer_cpus and encoder_cpus).
+void check_cpus(std::span<const int> cpus);
+
 class BatchWriter {
  public:
   // Opens its own connection to the store at `path` on the writer thread. Errors (e.g. a full
