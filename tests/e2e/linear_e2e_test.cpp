@@ -236,6 +236,20 @@ TEST(LinearEndToEnd, ADroppedStopIsStoredIncompleteWithTheStopListed) {
   remove_db(db);
 }
 
+// The circle of the ballbar tests: R 100 mm at 1000 mm/min, the bar sampled at 1 kHz, on the
+// simulated shop's bar (a line gauge on its serial port), stored in `db`.
+constexpr cal::daq::BallbarProgram kShopCircle{
+    .radius_mm = 100, .feed_mm_per_min = 1000, .sample_rate_hz = 1000};
+
+daq::CircleRunSetup shop_circle_setup(boost::asio::io_context& io, daq::SimulatedShop& shop,
+                                      const fs::path& db) {
+  return {.program = kShopCircle,
+          .database = db,
+          .ballbar = d::make_gauge(
+              io, t::make_serial(io, {.device = shop.ballbar_device(), .baud = 115200}),
+              {.clock = shop.clock_ns()}, {.min_si = -0.1, .max_si = 0.1})};
+}
+
 TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   // The shop's injected errors: squareness +20 um/m, Y lagging X by 1/29.7 - 1/30 s =
   // 0.3367 ms, backlash X 4 um, scale +8 um/m on X, pitch error 1 um / 40 mm on X, noise
@@ -247,19 +261,11 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   const auto db = temp_db("circle");
   // Simulated time that jumps from event to event (loop_time.hpp): loop seconds are simulated
   // seconds, and the run takes as long as the CPU needs.
-  constexpr double speed = 1.0;
   boost::asio::io_context io;
   d::VirtualTime::install(io);
-  daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
-  const cal::daq::BallbarProgram program{
-      .radius_mm = 100, .feed_mm_per_min = 1000, .sample_rate_hz = 1000};
-  daq::CircleRunSetup setup{
-      .program = program,
-      .database = db,
-      .ballbar =
-          d::make_gauge(io, t::make_serial(io, {.device = shop.ballbar_device(), .baud = 115200}),
-                        {.clock = shop.clock_ns()}, {.min_si = -0.1, .max_si = 0.1})};
-  daq::CircleRun run(io, std::move(setup));
+  daq::SimulatedShop shop(io, daq::ShopTruth{}, 1.0);
+  const auto program = kShopCircle;
+  daq::CircleRun run(io, shop_circle_setup(io, shop, db));
   run.start();
   shop.run_circle(program);
   shop.run_program([&] { return run.finished(); }, 30.0);
@@ -284,6 +290,36 @@ TEST(CircleEndToEnd, BallbarDiagnosticsAgreeWithTheInjectedErrors) {
   EXPECT_TRUE(daq::find_check(verdict, "squareness")->pass);
   EXPECT_FALSE(daq::find_check(verdict, "backlash_X")->pass);
   EXPECT_EQ(daq::summary(verdict), "FAIL");
+  remove_db(db);
+}
+
+TEST(CircleEndToEnd, ABallbarRunCommitsItsReadingsAsItGoesNotOnlyWhenABatchIsFull) {
+  // A bar at 1 kHz fills a batch (16,384 readings) in 16 s; on a crash or a power loss what is
+  // not committed is lost. The run offers its batch to the writer's age check every 100 ms
+  // (simulated sessions: 5 s of simulated time), as the linear run does: 12 s into the program,
+  // before any batch is full, most of the readings so far must be in the database, read by
+  // another connection while the run goes on.
+  const auto db = temp_db("circle-age");
+  boost::asio::io_context io;
+  auto& time = d::VirtualTime::install(io);
+  daq::SimulatedShop shop(io, daq::ShopTruth{}, 1.0);
+  const auto program = kShopCircle;
+  daq::CircleRun run(io, shop_circle_setup(io, shop, db));
+  run.start();
+  const double t0 = time.now_s();
+  shop.run_circle(program);
+  shop.run_program([&] { return time.now_s() - t0 >= 12.0; }, 30.0);
+  ASSERT_FALSE(run.finished());
+  const auto read = run.outcome().readings;
+  ASSERT_GT(read, 8'000u);   // the bar has been sending for most of the 12 s
+  ASSERT_LT(read, 16'384u);  // no batch is full yet
+  const cal::storage::Store other(db, {.read_only = true});
+  const auto stored = other.reading_count(run.outcome().run_id);
+  // Batches older than 5 s (simulated) are committed within a tick: at least the readings
+  // older than 5.1 s, at most all of them.
+  EXPECT_GE(stored, static_cast<std::int64_t>(read) - 5'100);
+  EXPECT_LE(stored, static_cast<std::int64_t>(read));
+  run.stop("test over");
   remove_db(db);
 }
 

@@ -11,10 +11,12 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/daq/gcode.hpp"
+#include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "circle_output.hpp"
 #include "provenance.hpp"
+#include "run_writer.hpp"
 
 namespace daq {
 
@@ -275,6 +277,7 @@ struct CircleRun::Impl {
   cal::daq::BallbarSegmenter segmenter;
   std::optional<cal::storage::Store> store;
   std::unique_ptr<cal::storage::BatchWriter> writer;
+  cal::drivers::Timer timer;  // the writer's age check, on the loop's time
   CircleRunOutcome outcome;
   CircleLive live;
   bool running = false, done = false;
@@ -284,7 +287,7 @@ struct CircleRun::Impl {
   std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
   Impl(boost::asio::io_context& i, CircleRunSetup s)
-      : io(i), setup(std::move(s)), segmenter(setup.program) {}
+      : io(i), setup(std::move(s)), segmenter(setup.program), timer(i) {}
   ~Impl() { *alive = false; }
 
   void event(const std::string& e) {
@@ -301,6 +304,15 @@ struct CircleRun::Impl {
                                 if (s == cal::drivers::InstrumentState::closed && running)
                                   abort(fmt::format("ballbar closed: {}", why));
                               }});
+    tick();
+  }
+
+  // The writer's age-based flush, as the linear run's: a bar that stops sending still has its
+  // last readings committed (a full batch is 16,384 readings, 16 s of a 1 kHz bar).
+  void tick() {
+    if (done) return;
+    if (const auto failed = offer_old_batch(writer.get())) return abort(*failed);
+    arm_tick(timer, [this] { tick(); });
   }
 
   // The stored run of the current test (setup.program, setup.analysis) and its writer.
@@ -338,7 +350,7 @@ struct CircleRun::Impl {
                            .driver = "ballbar",
                            .transport = setup.ballbar->describe()});
     writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id, cal::storage::WriterOptions{.store = setup.store_options},
+        setup.database, outcome.run_id, run_writer_options(io, setup.store_options),
         [this, alive = alive](const std::string& e) {
           boost::asio::post(io, [this, alive, e] {
             if (*alive) abort("storage failed: " + e);
@@ -504,6 +516,7 @@ struct CircleRun::Impl {
 
   void end() {
     done = true;
+    timer.cancel();
     setup.ballbar->stop();
     writer.reset();
   }

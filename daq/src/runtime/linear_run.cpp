@@ -20,6 +20,7 @@
 #include "iso230_2_output.hpp"
 #include "kinds/kind.hpp"
 #include "provenance.hpp"
+#include "run_writer.hpp"
 #include "session_spec.hpp"
 
 namespace daq {
@@ -281,9 +282,7 @@ struct LinearRun::Impl {
     if (setup.probe) add(probe_device(), *setup.probe, kind.probe_role());
     outcome.component = kind.component(*setup.config.linear);
     writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id,
-        cal::storage::WriterOptions{
-            .batch_age = batch_age(), .store = setup.store_options, .clock = batch_clock()},
+        setup.database, outcome.run_id, run_writer_options(io, setup.store_options),
         [this, alive = alive](const std::string& e) {
           boost::asio::post(io, [this, alive, e] {
             if (*alive) abort("storage failed: " + e);
@@ -674,36 +673,12 @@ struct LinearRun::Impl {
     setup.on_live(live);
   }
 
-  // A simulated session runs some 100 times faster than real time: 5 s of its time between
-  // commits is about what 200 ms (the default) are on hardware, where a commit costs an fsync.
-  // (200 ms of simulated time gave 2,100 fsyncs to `daq demo` instead of 240.)
-  std::chrono::milliseconds batch_age() const {
-    return cal::drivers::VirtualTime::of(io) ? std::chrono::milliseconds(5000)
-                                             : cal::storage::WriterOptions{}.batch_age;
-  }
-
-  // The writer's batches age on the loop's time: the steady clock on hardware, simulated time
-  // in a simulated session (a batch then holds the same readings however fast the CPU is).
-  std::function<std::chrono::steady_clock::time_point()> batch_clock() {
-    if (!cal::drivers::VirtualTime::of(io)) return {};
-    return [clock = cal::drivers::loop_clock(io)] {
-      return std::chrono::steady_clock::time_point(std::chrono::nanoseconds(clock()));
-    };
-  }
-
   // 10 Hz: live state, and the writer's age-based flush so a slow stream is still committed.
   void tick() {
     if (done) return;
     publish();
-    try {
-      if (writer) writer->flush_if_old();
-    } catch (const std::exception& e) {  // the writer failed (a full disk), its abort not run yet
-      return abort(fmt::format("storage failed: {}", e.what()));
-    }
-    timer.expires_after(std::chrono::milliseconds(100));
-    timer.async_wait([this](const boost::system::error_code& ec) {
-      if (!ec) tick();
-    });
+    if (const auto failed = offer_old_batch(writer.get())) return abort(*failed);
+    arm_tick(timer, [this] { tick(); });
   }
 };
 
