@@ -18,7 +18,7 @@ namespace cal::storage {
 namespace {
 
 // The CPU set of `cpus`, each checked against the CPUs this process may run on.
-cpu_set_t cpu_set_of(const std::vector<int>& cpus) {
+cpu_set_t cpu_set_of(std::span<const int> cpus) {
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
   if (sched_getaffinity(0, sizeof allowed, &allowed) != 0)
@@ -36,9 +36,7 @@ cpu_set_t cpu_set_of(const std::vector<int>& cpus) {
 
 }  // namespace
 
-void check_cpus(std::span<const int> cpus) {
-  cpu_set_of(std::vector<int>(cpus.begin(), cpus.end()));
-}
+void check_cpus(std::span<const int> cpus) { cpu_set_of(cpus); }
 
 struct BatchWriter::Impl {
   std::filesystem::path path;
