@@ -254,6 +254,7 @@ void run_sim(SimOptions o) {
     // The instruments of the run connect first (a program started while the laser still
     // connects would lose its first approach): a second of simulated settling.
     fmt::print("daq sim: run {} ({}) started\n", run->id, test);
+    std::fflush(stdout);  // seen at once by whoever watches the log (a pipe is block-buffered)
     run_until(shop.now_s() + 1.0 * o.speed);
     run_program(test);
     if (volumetric) return;  // set up for one component's test: one run
