@@ -172,7 +172,8 @@ class PinThisThread {
  public:
   explicit PinThisThread(int cpu) {
     if (cpu < 0) return;
-    pthread_getaffinity_np(pthread_self(), sizeof before_, &before_);
+    if (pthread_getaffinity_np(pthread_self(), sizeof before_, &before_) != 0)
+      throw cal::InputError("bench: cannot read the event loop's CPU affinity");
     cpu_set_t set;
     CPU_ZERO(&set);
     CPU_SET(cpu, &set);

@@ -17,12 +17,12 @@
 namespace cal::storage {
 namespace {
 
-// The CPU set of `cpus`, each checked against the CPUs this process may run on.
+// The CPU set of `cpus`, each checked against the CPUs the calling thread may run on.
 cpu_set_t cpu_set_of(std::span<const int> cpus) {
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
   if (sched_getaffinity(0, sizeof allowed, &allowed) != 0)
-    throw InputError("storage CPUs: cannot read this process's CPU affinity");
+    throw InputError("storage CPUs: cannot read this thread's CPU affinity");
   cpu_set_t set;
   CPU_ZERO(&set);
   for (const int cpu : cpus) {

@@ -17,11 +17,13 @@ check usage_missing_required 2 "--last is required" -- "$DAQ" targets --first 0
 check usage_not_a_number 2 "'abc' is not a finite decimal number" -- "$DAQ" env -t abc
 check help_is_success 0 "Usage:" -- "$DAQ" --help
 check version_is_success 0 "daq 0.1.0" -- "$DAQ" --version
-# daq bench ingest's thread placement: a CPU this process may not use is refused before the
-# capture is written and a round run, and both CPUs or neither.
-check bench_cpu_not_ours 2 "CPU 4096: not one this process may run on" -- "$DAQ" bench ingest --seconds 1 --rounds 1 --dir "$TMP" --loop-cpu 0 --storage-cpu 4096
-check bench_cpu_half 2 "give both --loop-cpu and --storage-cpu" -- "$DAQ" bench ingest --seconds 1 --rounds 1 --dir "$TMP" --loop-cpu 0
-check bench_cpu_before_the_capture 0 "^0$" -- sh -c "\"$DAQ\" bench ingest --seconds 1 --rounds 1 --dir \"$TMP\" --loop-cpu 4096 --storage-cpu 0 2>&1 | grep -c '^capture:'; true"
+# daq bench ingest's thread placement: a CPU this process may not use is refused (exit 2, the CPU
+# named) before the capture is written and a round run, and both CPUs or neither. CPU0: the
+# first CPU this test may use.
+CPU0=$(python3 -c 'import os; print(min(os.sched_getaffinity(0)))')
+check bench_cpu_not_ours 2 "CPU 4096: not one this process may run on" -- "$DAQ" bench ingest --seconds 1 --rounds 1 --dir "$TMP" --loop-cpu "$CPU0" --storage-cpu 4096
+check bench_cpu_half 2 "give both --loop-cpu and --storage-cpu" -- "$DAQ" bench ingest --seconds 1 --rounds 1 --dir "$TMP" --loop-cpu "$CPU0"
+check bench_cpu_before_the_capture 0 "^refused, 0 capture lines$" -- sh -c "out=\$(\"$DAQ\" bench ingest --seconds 1 --rounds 1 --dir \"$TMP\" --loop-cpu 4096 --storage-cpu $CPU0 2>&1); test \$? -eq 2 && echo \"\$out\" | grep -q 'CPU 4096' && echo \"refused, \$(echo \"\$out\" | grep -c '^capture:') capture lines\""
 
 # Command-line numbers: finite, plain, in range, sizes bounded.
 check cli_nan 2 "--temperature: 'nan' is not a finite decimal number" -- "$DAQ" env -t nan

@@ -313,11 +313,17 @@ TEST(CircleEndToEnd, ABallbarRunCommitsItsReadingsAsItGoesNotOnlyWhenABatchIsFul
   const auto read = run.outcome().readings;
   ASSERT_GT(read, 8'000u);   // the bar has been sending for most of the 12 s
   ASSERT_LT(read, 16'384u);  // no batch is full yet
+  // Batches older than 5 s (simulated) are handed over within a tick: at least the readings
+  // older than 5.1 s, at most all of them. The writer thread commits them in wall time: wait
+  // for that (up to 10 s; without the run's age check nothing would come).
   const cal::storage::Store other(db, {.read_only = true});
-  const auto stored = other.reading_count(run.outcome().run_id);
-  // Batches older than 5 s (simulated) are committed within a tick: at least the readings
-  // older than 5.1 s, at most all of them.
-  EXPECT_GE(stored, static_cast<std::int64_t>(read) - 5'100);
+  const auto least = static_cast<std::int64_t>(read) - 5'100;
+  std::int64_t stored = 0;
+  for (const auto until = std::chrono::steady_clock::now() + 10s;
+       (stored = other.reading_count(run.outcome().run_id)) < least &&
+       std::chrono::steady_clock::now() < until;)
+    std::this_thread::sleep_for(10ms);
+  EXPECT_GE(stored, least);
   EXPECT_LE(stored, static_cast<std::int64_t>(read));
   run.stop("test over");
   remove_db(db);

@@ -98,7 +98,7 @@ TEST(BatchWriter, StorageThreadsRunOnTheGivenCpusAndStoreTheSame) {
   EXPECT_EQ(Store(file.path).readings(run).size(), 5000u);
 }
 
-TEST(BatchWriter, ACpuThisProcessMayNotUseIsRefusedBeforeAnyThreadStarts) {
+TEST(BatchWriter, ACpuThisThreadMayNotUseIsRefusedWithTheCpuNamed) {
   TempFile file;
   std::int64_t run = 0;
   { run = Store(file.path).begin_run({.kind = "linear"}); }

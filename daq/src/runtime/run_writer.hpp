@@ -48,7 +48,9 @@ inline std::optional<std::string> offer_old_batch(cal::storage::BatchWriter* wri
   return std::nullopt;
 }
 
-// Arms the run's next tick, kRunTick from now on the loop's time.
+// Arms the run's next tick, kRunTick from now on the loop's time. A wait that has already fired
+// still runs its handler with success after cancel() or the timer's end: `tick` must check
+// that its run still exists (the runs' `alive` flag).
 inline void arm_tick(cal::drivers::Timer& timer, std::function<void()> tick) {
   timer.expires_after(kRunTick);
   timer.async_wait([tick = std::move(tick)](const boost::system::error_code& ec) {

@@ -28,12 +28,13 @@ struct WriterOptions {
   // on a fast or a loaded machine instead of depending on how fast the CPU runs it.
   std::function<std::chrono::steady_clock::time_point()> clock;
   // CPUs (Linux numbers) the writer thread (SQLite, the commits and their fsyncs) and the
-  // encoder thread run on; empty: wherever the OS schedules them. Where ingest competes for few
-  // cores, a CPU for the storage threads apart from the event loop's (the one that takes the
-  // disk's interrupts) keeps the scheduler from placing the writer behind the loop: on the
+  // encoder thread run on; empty: wherever the OS schedules them (a thread left unplaced runs
+  // where the thread that made the writer may run). Where ingest competes for few cores,
+  // placing the storage threads on a CPU apart from the event loop's, the one that takes the
+  // disk's interrupts, keeps the scheduler from placing the writer behind the loop: on the
   // 2-core benchmark machine ingest went from about 60 % to about 75 % of the SQLite ceiling
-  // (docs/benchmarks.md). The constructor throws cal::InputError for a CPU this process may not
-  // run on.
+  // (docs/benchmarks.md). The constructor throws cal::InputError for a CPU the calling thread
+  // may not run on (make the writer before pinning the calling thread elsewhere).
   std::vector<int> writer_cpus, encoder_cpus;
 };
 
@@ -51,8 +52,8 @@ struct WriterStats {
   std::chrono::nanoseconds store_time{0};
 };
 
-// Throws cal::InputError, naming the CPU, unless this process may run on every one of `cpus`
-// (what BatchWriter checks of WriterOptions::writer_cpus and encoder_cpus).
+// Throws cal::InputError, naming the CPU, unless the calling thread may run on every one of
+// `cpus` (what BatchWriter checks of WriterOptions::writer_cpus and encoder_cpus).
 void check_cpus(std::span<const int> cpus);
 
 class BatchWriter {

@@ -108,8 +108,9 @@ class CodecBase {
 // max_line_bytes is reported once through on_overlong(start_offset) and discarded up to the
 // next terminator, where the splitter resynchronises.
 //
-// Cost: the terminators (CR or LF) are found 16 bytes at a time (SSE2 compares; a byte loop
-// elsewhere), each byte scanned once; a CR-LF pair ends its line in one step; a line that lies
+// Cost: the terminators (CR or LF) are found 16 bytes per compare (SSE2; a byte loop for a
+// chunk's tail and without SSE2), each search starting after the last terminator; a CR-LF pair
+// ends its line in one step; a line that lies
 // wholly inside one chunk is handed to on_line in place; only a line split across chunks is
 // copied into the buffer.
 class LineSplitter {
