@@ -66,17 +66,10 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-double cpu_seconds() {
+// CPU time (user and system) of the process, or of this thread (RUSAGE_THREAD: the ceilings').
+double cpu_seconds(int who = RUSAGE_SELF) {
   rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-// This thread's CPU time (user and system), for the ceilings' own CPU.
-double thread_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_THREAD, &u);
+  getrusage(who, &u);
   return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
@@ -424,7 +417,7 @@ CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t
     if (schema1)
       for (const auto& r : rows) old_blobs.push_back(as_schema1(src, r));
     const auto t0 = Clock::now();
-    const double cpu0 = thread_cpu_seconds();
+    const double cpu0 = cpu_seconds(RUSAGE_THREAD);
     sqlite3_step(begin.s);
     sqlite3_reset(begin.s);
     for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -447,7 +440,7 @@ CeilingResult blob_ceiling(const fs::path& from, const fs::path& to, std::size_t
       throw cal::InputError(fmt::format("bench: blob ceiling commit: {}", sqlite3_errmsg(dst.db)));
     sqlite3_reset(commit.s);
     res.seconds += seconds_since(t0);
-    res.cpu_s += thread_cpu_seconds() - cpu0;
+    res.cpu_s += cpu_seconds(RUSAGE_THREAD) - cpu0;
     ++res.commits;
   }
   return res;

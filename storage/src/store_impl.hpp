@@ -54,20 +54,16 @@ struct Store::Impl {
     }
   }
 
-  detail::Stmt prepare(const char* sql) const {
+  detail::Stmt prepare(const char* sql, std::string_view what = "prepare") const {
     sqlite3_stmt* s = nullptr;
-    if (sqlite3_prepare_v2(db.get(), sql, -1, &s, nullptr) != SQLITE_OK) fail("prepare");
+    if (sqlite3_prepare_v2(db.get(), sql, -1, &s, nullptr) != SQLITE_OK) fail(what);
     return detail::Stmt(s);
   }
 
   // Steps a cached statement without bindings (prepared on first use) to its end; the
   // message of a failure is read before the statement is reset for its next use.
   void step_cached(detail::Stmt& s, const char* sql, std::string_view what) {
-    if (!s) {  // a failure to prepare says what it was for, as a failed step does
-      sqlite3_stmt* raw = nullptr;
-      if (sqlite3_prepare_v2(db.get(), sql, -1, &raw, nullptr) != SQLITE_OK) fail(what);
-      s.reset(raw);
-    }
+    if (!s) s = prepare(sql, what);  // a failure to prepare says what it was for
     if (sqlite3_step(s.get()) != SQLITE_DONE) {
       const std::string text = sqlite3_errmsg(db.get());
       sqlite3_reset(s.get());

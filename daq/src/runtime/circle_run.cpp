@@ -312,9 +312,7 @@ struct CircleRun::Impl {
   void tick() {
     if (done) return;
     if (const auto failed = offer_old_batch(writer.get())) return abort(*failed);
-    arm_tick(timer, [this, alive = alive] {
-      if (*alive) tick();  // a tick already due when the run was destroyed
-    });
+    arm_tick(timer, alive, [this] { tick(); });
   }
 
   // The stored run of the current test (setup.program, setup.analysis) and its writer.

@@ -678,9 +678,7 @@ struct LinearRun::Impl {
     if (done) return;
     publish();
     if (const auto failed = offer_old_batch(writer.get())) return abort(*failed);
-    arm_tick(timer, [this, alive = alive] {
-      if (*alive) tick();  // a tick already due when the run was destroyed
-    });
+    arm_tick(timer, alive, [this] { tick(); });
   }
 };
 

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -48,14 +49,16 @@ inline std::optional<std::string> offer_old_batch(cal::storage::BatchWriter* wri
   return std::nullopt;
 }
 
-// Arms the run's next tick, kRunTick from now on the loop's time. A wait that has already fired
-// still runs its handler with success after cancel() or the timer's end: `tick` must check
-// that its run still exists (the runs' `alive` flag).
-inline void arm_tick(cal::drivers::Timer& timer, std::function<void()> tick) {
+// Arms the run's next tick, kRunTick from now on the loop's time; `tick` runs only while the
+// run's `alive` flag holds: a wait that has already fired still runs its handler with success
+// after cancel() or the timer's end, when the run may be gone.
+inline void arm_tick(cal::drivers::Timer& timer, std::shared_ptr<const bool> alive,
+                     std::function<void()> tick) {
   timer.expires_after(kRunTick);
-  timer.async_wait([tick = std::move(tick)](const boost::system::error_code& ec) {
-    if (!ec) tick();
-  });
+  timer.async_wait(
+      [alive = std::move(alive), tick = std::move(tick)](const boost::system::error_code& ec) {
+        if (!ec && *alive) tick();
+      });
 }
 
 }  // namespace daq

@@ -229,9 +229,8 @@ double length_at_20c_m(double raw_m, double n, double expansion_ppm_per_k, doubl
 }  // namespace
 
 Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
-  Compensated c = held_cache_.valid && t > held_cache_.after_ns && t <= held_cache_.until_ns
-                      ? held_cache_.environment
-                      : environment_at(t);
+  const Compensated* held = held_at(t);
+  Compensated c = held ? *held : environment_at(t);
   c.time_ns = t;
   c.raw_m = raw_m;
   c.length_m = length_at_20c_m(raw_m, c.n, config_.expansion_ppm_per_k, c.material_degc);
@@ -239,9 +238,8 @@ Compensated EnvStage::compensate(std::int64_t t, double raw_m) const {
 }
 
 double EnvStage::compensated_length_m(std::int64_t t, double raw_m) const {
-  if (held_cache_.valid && t > held_cache_.after_ns && t <= held_cache_.until_ns)
-    return length_at_20c_m(raw_m, held_cache_.environment.n, config_.expansion_ppm_per_k,
-                           held_cache_.environment.material_degc);
+  if (const Compensated* held = held_at(t))
+    return length_at_20c_m(raw_m, held->n, config_.expansion_ppm_per_k, held->material_degc);
   return compensate(t, raw_m).length_m;
 }
 

@@ -132,6 +132,12 @@ class EnvStage {
     Compensated environment;                  // everything but time, raw and length
   };
   Compensated environment_at(std::int64_t t) const;
+  // The held environment when it serves time t (newer than the newest sample), else nullptr.
+  const Compensated* held_at(std::int64_t t) const {
+    return held_cache_.valid && t > held_cache_.after_ns && t <= held_cache_.until_ns
+               ? &held_cache_.environment
+               : nullptr;
+  }
 
   EnvironmentConfig config_;
   air::Equation equation_;

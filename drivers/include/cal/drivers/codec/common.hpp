@@ -110,9 +110,8 @@ class CodecBase {
 //
 // Cost: the terminators (CR or LF) are found 16 bytes per compare (SSE2; a byte loop for a
 // chunk's tail and without SSE2), each search starting after the last terminator; a CR-LF pair
-// ends its line in one step; a line that lies
-// wholly inside one chunk is handed to on_line in place; only a line split across chunks is
-// copied into the buffer.
+// ends its line in one step; a line that lies wholly inside one chunk is handed to on_line in
+// place; only a line split across chunks is copied into the buffer.
 class LineSplitter {
  public:
   static constexpr std::size_t default_max_line_bytes = 4096;
