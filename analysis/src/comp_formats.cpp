@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::comptable {
@@ -14,14 +15,6 @@ namespace {
 
 namespace kin = cal::kinematics;
 constexpr std::array kAxisNames{"X", "Y", "Z"};
-
-// A value rounded to `decimals` in fixed notation, never "-0.000".
-std::string fixed(double v, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  double r = std::round(v * scale) / scale;
-  if (r == 0.0) r = 0.0;
-  return fmt::format("{:.{}f}", r, decimals);
-}
 
 std::string where(const CrossAxisTable& t) {
   return fmt::format("compensation table {} -> {}", t.input, t.output);
@@ -97,9 +90,11 @@ std::vector<CrossAxisTable> from_model(const volcomp::CrossTables& t, double res
   return out;
 }
 
-Table own_axis_table(const volcomp::CrossTables& t, kin::Axis axis, double resolution_mm) {
+Table own_axis_table(const volcomp::CrossTables& t, kin::Axis axis, double resolution_mm,
+                     Sign sign) {
   const auto& m = t.at(axis, axis);
   Table out;
+  out.spec.sign = sign;
   out.spec.axis = kAxisNames[axis];
   out.spec.start_mm = m.start_mm;
   out.spec.interval_mm = m.interval_mm;
@@ -108,7 +103,7 @@ Table own_axis_table(const volcomp::CrossTables& t, kin::Axis axis, double resol
   out.spec.resolution = resolution_mm;
   for (std::size_t i = 0; i < m.correction_um.size(); ++i) {
     out.position_mm.push_back(m.position_mm(i));
-    const double mm = m.correction_um[i] * 1e-3;
+    const double mm = (sign == Sign::correction ? 1e-3 : -1e-3) * m.correction_um[i];
     out.forward.push_back(resolution_mm > 0 ? std::round(mm / resolution_mm) * resolution_mm : mm);
   }
   return out;
@@ -154,6 +149,7 @@ std::string write_sinumerik_cec(std::span<const CrossAxisTable> tables,
   out +=
       "; cross-axis compensation (SINUMERIK sag/angularity compensation, CEC), written by "
       "caldaq\n";
+  out += meaning_header(format_meaning("siemens-cec"), "; ");
   out += "; values: compensation of the output axis in mm, at the input axis positions\n";
   std::string setup;
   int t = first_table;
@@ -198,8 +194,8 @@ std::string write_isg_cross(const CrossAxisTable& t, int slave_axis_number,
   const auto tenth_um = [](double mm) { return std::llround(mm * 1e4); };
   std::string out = fmt::format(
       "# ISG/TwinCAT CNC cross compensation of axis {} as a function of axis {}, written by "
-      "caldaq\n",
-      t.output, t.input);
+      "caldaq\n{}",
+      t.output, t.input, meaning_header(format_meaning("isg-cross"), "# "));
   out += fmt::format("kopf.achs_nr {}\nkopf.log_achs_name {}\n", slave_axis_number, t.output);
   out += fmt::format("kw.crosscomp.last_index {}\n", t.correction_mm.size() - 1);
   out += fmt::format("kw.crosscomp.master_ax_nr {}\n", master_axis_number);
@@ -286,7 +282,8 @@ std::string write_heidenhain_com(std::span<const CrossAxisTable> same_input) {
   out += "\n";
   for (std::size_t i = 0; i < first.correction_mm.size(); ++i) {
     out += fixed(first.position_mm(i), 4);
-    for (const auto& t : same_input) out += " " + fixed(t.correction_mm[i], 4);
+    // The columns hold the error (comp_meaning.cpp, "heidenhain"): minus the correction.
+    for (const auto& t : same_input) out += " " + fixed(-t.correction_mm[i], 4);
     out += "\n";
   }
   return out;
@@ -298,6 +295,10 @@ std::string write_heidenhain_com(const Table& t) {
     throw InputError("HEIDENHAIN .COM tables are in mm: use --units mm");
   if (t.spec.incremental)
     throw InputError("HEIDENHAIN .COM tables hold absolute values: no --incremental");
+  if (t.spec.sign != format_meaning("heidenhain").written)
+    throw InputError(
+        "HEIDENHAIN .COM columns hold the measured error curve: the table given "
+        "holds corrections");
   if (!axis_name_ok(t.spec.axis))
     throw InputError("HEIDENHAIN .COM: the axis name must be one letter");
   const bool two = t.spec.bidirectional || t.backlash != 0.0;
@@ -313,7 +314,7 @@ std::string write_heidenhain_com(const Table& t) {
   return out;
 }
 
-std::string write_fanuc_pitch(const Table& t, const FanucOptions& o) {
+FanucSteps fanuc_steps(const Table& t, const FanucOptions& o) {
   check_positioning(t, "FANUC pitch error compensation");
   if (t.spec.incremental)
     throw InputError(
@@ -323,9 +324,10 @@ std::string write_fanuc_pitch(const Table& t, const FanucOptions& o) {
     throw InputError(
         "FANUC pitch error compensation: one table per axis here (the bidirectional "
         "option, parameter 3605, is not written): use a table plus backlash");
-  if (t.spec.sign != Sign::correction)
+  if (t.spec.sign != format_meaning("fanuc").written)
     throw InputError(
-        "FANUC pitch error compensation values are corrections: use --sign correction");
+        "FANUC pitch error compensation values are corrections (compensation values): the table "
+        "given holds errors");
   if (!(o.detection_unit_um > 0) || !std::isfinite(o.detection_unit_um) || o.magnification < 1 ||
       o.first_point < 0 || o.max_step < 1)
     throw InputError(
@@ -339,33 +341,16 @@ std::string write_fanuc_pitch(const Table& t, const FanucOptions& o) {
         fmt::format("FANUC pitch error compensation: the reference position {} mm is "
                     "not a point of the grid {} + k * {} mm",
                     o.reference_mm, start, interval));
-  const auto ref = static_cast<std::size_t>(std::llround(at));
-  const double unit_um = o.detection_unit_um * o.magnification;
+  FanucSteps f;
+  f.reference_index = static_cast<std::size_t>(std::llround(at));
+  f.unit_um = o.detection_unit_um * o.magnification;
   // Absolute compensation relative to the reference position, rounded to the unit; the
   // increments are differences of the rounded values, so their sums never drift.
   std::vector<long long> rounded;
   for (double v : t.forward)
-    rounded.push_back(
-        std::llround((to_um(v, t.spec.units) - to_um(t.forward[ref], t.spec.units)) / unit_um));
-  const auto n = t.position_mm.size();
-  std::string out = fmt::format(
-      "FANUC stored pitch error compensation, axis {}, written by caldaq\n"
-      "Parameters of the axis:\n"
-      "  3620 = {}   number of the compensation point of the reference position ({} mm)\n"
-      "  3621 = {}   number of the farthest compensation point in the negative direction\n"
-      "  3622 = {}   number of the farthest compensation point in the positive direction\n"
-      "  3623 = {}   magnification\n"
-      "  3624 = {}   interval between compensation points (mm)\n",
-      t.spec.axis, o.first_point + static_cast<int>(ref), fixed(o.reference_mm, 4), o.first_point,
-      o.first_point + static_cast<int>(n) - 1, o.magnification, fixed(interval, 4));
-  if (t.backlash != 0.0)
-    out += fmt::format("Backlash (the control's backlash compensation): {} {}\n",
-                       fixed(t.backlash, 4), units_name(t.spec.units));
-  out += fmt::format(
-      "Compensation values: detection units of {} um; each point's value is what it adds over "
-      "the section ending at it, moving in the positive direction\npoint position_mm value\n",
-      fixed(o.detection_unit_um, 4));
-  for (std::size_t i = 0; i < n; ++i) {
+    rounded.push_back(std::llround(
+        (to_um(v, t.spec.units) - to_um(t.forward[f.reference_index], t.spec.units)) / f.unit_um));
+  for (std::size_t i = 0; i < rounded.size(); ++i) {
     const long long step = i == 0 ? 0 : rounded[i] - rounded[i - 1];
     if (std::llabs(step) > o.max_step)
       throw InputError(
@@ -373,9 +358,59 @@ std::string write_fanuc_pitch(const Table& t, const FanucOptions& o) {
                       "of {} units, beyond {}: raise the magnification (3623) or "
                       "use a finer interval",
                       o.first_point + static_cast<int>(i), t.position_mm[i], step, o.max_step));
-    out += fmt::format("{} {} {}\n", o.first_point + static_cast<int>(i),
-                       fixed(t.position_mm[i], 4), step);
+    f.steps.push_back(step);
   }
+  return f;
+}
+
+Applied fanuc_applied(const Table& t, const FanucOptions& o) {
+  const FanucSteps f = fanuc_steps(t, o);
+  Applied a{.position_mm = t.position_mm, .forward_um = {}, .reverse_um = {}};
+  long long sum = 0, at_reference = 0;
+  std::vector<long long> sums;
+  for (std::size_t i = 0; i < f.steps.size(); ++i) {
+    sum += f.steps[i];
+    sums.push_back(sum);
+    if (i == f.reference_index) at_reference = sum;
+  }
+  for (long long s : sums)
+    a.forward_um.push_back(static_cast<double>(s - at_reference) * f.unit_um);
+  a.reverse_um = a.forward_um;
+  return a;
+}
+
+std::string write_fanuc_pitch(const Table& t, const FanucOptions& o) {
+  const FanucSteps f = fanuc_steps(t, o);
+  const auto n = t.position_mm.size();
+  const auto ref = f.reference_index;
+  const double constant_um = to_um(t.forward[ref], t.spec.units);
+  std::string out = fmt::format(
+      "FANUC stored pitch error compensation, axis {}, written by caldaq\n{}"
+      "Parameters of the axis:\n"
+      "  3620 = {}   number of the compensation point of the reference position ({} mm)\n"
+      "  3621 = {}   number of the farthest compensation point in the negative direction\n"
+      "  3622 = {}   number of the farthest compensation point in the positive direction\n"
+      "  3623 = {}   magnification\n"
+      "  3624 = {}   interval between compensation points (mm)\n",
+      t.spec.axis, meaning_header(format_meaning("fanuc"), ""),
+      o.first_point + static_cast<int>(ref), fixed(o.reference_mm, 4), o.first_point,
+      o.first_point + static_cast<int>(n) - 1, o.magnification, fixed(t.spec.interval_mm, 4));
+  if (std::abs(constant_um) >= 0.5 * f.unit_um)
+    out += fmt::format(
+        "Not in this table: the correction at the reference position, {} um (the table is zero "
+        "there by FANUC's rule); it stays in the residual unless the reference position is "
+        "shifted by it\n",
+        fixed(constant_um, 3));
+  if (t.backlash != 0.0)
+    out += fmt::format("Backlash (the control's backlash compensation): {} {}\n",
+                       fixed(t.backlash, 4), units_name(t.spec.units));
+  out += fmt::format(
+      "Compensation values: detection units of {} um; each point's value is what it adds over "
+      "the section ending at it, moving in the positive direction\npoint position_mm value\n",
+      fixed(o.detection_unit_um, 4));
+  for (std::size_t i = 0; i < n; ++i)
+    out += fmt::format("{} {} {}\n", o.first_point + static_cast<int>(i),
+                       fixed(t.position_mm[i], 4), f.steps[i]);
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/straightness.hpp"
 
@@ -106,6 +107,13 @@ std::vector<double> grid(const Spec& s) {
 
 }  // namespace
 
+std::string fixed(double v, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  double r = std::round(v * scale) / scale;
+  if (r == 0.0) r = 0.0;  // -0 and values that round to zero print as 0
+  return fmt::format("{:.{}f}", r, decimals);
+}
+
 std::string units_name(Units u) { return u == Units::mm ? "mm" : u == Units::um ? "um" : "inch"; }
 
 Units units_from_string(const std::string& s) {
@@ -190,11 +198,11 @@ std::string write_csv(const Table& t) {
   validate(t.spec);
   check_finite(t);
   const int d = decimals(t.spec);
-  std::string out = fmt::format(
-      "# caldaq compensation table: axis {}, {} values in {}, {}, {}\n", t.spec.axis,
-      t.spec.sign == Sign::correction ? "correction" : "error", units_name(t.spec.units),
-      t.spec.incremental ? "incremental" : "absolute",
-      t.spec.bidirectional ? "forward/reverse" : fmt::format("backlash {:.{}f}", t.backlash, d));
+  std::string out =
+      fmt::format("# caldaq compensation table: axis {}, {} values in {}, {}, {}\n", t.spec.axis,
+                  t.spec.sign == Sign::correction ? "correction" : "error",
+                  units_name(t.spec.units), t.spec.incremental ? "incremental" : "absolute",
+                  t.spec.bidirectional ? "forward/reverse" : "backlash " + fixed(t.backlash, d));
   // An inch table names its columns in inch and gives the positions in inch too (a control in
   // inch mode reads both in its unit); mm and um tables keep positions in mm.
   const bool inch = t.spec.units == Units::inch;
@@ -206,23 +214,35 @@ std::string write_csv(const Table& t) {
         t.spec.bidirectional ? "point,position_mm,forward,reverse\n" : "point,position_mm,value\n";
   for (std::size_t i = 0; i < t.position_mm.size(); ++i) {
     if (inch)
-      out += fmt::format("{},{:.5f},{:.{}f}", i, t.position_mm[i] / 25.4, t.forward[i], d);
+      out += fmt::format("{},{},{}", i, fixed(t.position_mm[i] / 25.4, 5), fixed(t.forward[i], d));
     else
-      out += fmt::format("{},{:.4f},{:.{}f}", i, t.position_mm[i], t.forward[i], d);
-    if (t.spec.bidirectional) out += fmt::format(",{:.{}f}", t.reverse[i], d);
+      out += fmt::format("{},{},{}", i, fixed(t.position_mm[i], 4), fixed(t.forward[i], d));
+    if (t.spec.bidirectional) out += "," + fixed(t.reverse[i], d);
     out += "\n";
   }
   return out;
 }
 
+namespace {
+// A writer's table must carry its format's sign (comp_meaning.hpp): the sign is the vendor's,
+// never a choice.
+void check_sign(const Table& t, std::string_view format) {
+  const auto& m = format_meaning(format);
+  if (t.spec.sign != m.written)
+    throw InputError(
+        fmt::format("{} values are {} (the vendor's meaning, comp_meaning): the "
+                    "table given holds the other sign",
+                    m.name, m.written == Sign::error ? "errors" : "corrections"));
+}
+}  // namespace
+
 // LinuxCNC, [JOINT_n] COMP_FILE with COMP_FILE_TYPE = 1: one line per point, "nominal
 // forward-trim reverse-trim" in machine units; a trim is added to the commanded position, so
 // the values are corrections (docs/compensation-tables.md). Absolute values only.
 std::string write_linuxcnc(const Table& t) {
-  if (t.spec.incremental || t.spec.sign != Sign::correction)
-    throw InputError(
-        "LinuxCNC compensation files hold absolute corrections: use --sign correction, no "
-        "--incremental");
+  if (t.spec.incremental)
+    throw InputError("LinuxCNC compensation files hold absolute corrections: no --incremental");
+  check_sign(t, "linuxcnc");
   validate(t.spec);
   check_finite(t);
   const int d = decimals(t.spec);
@@ -231,8 +251,8 @@ std::string write_linuxcnc(const Table& t) {
     const double nominal = t.spec.units == Units::inch ? t.position_mm[i] / 25.4
                            : t.spec.units == Units::um ? t.position_mm[i] * 1e3
                                                        : t.position_mm[i];
-    out += fmt::format("{:.4f} {:.{}f} {:.{}f}\n", nominal, directional(t, i, true), d,
-                       directional(t, i, false), d);
+    out += fmt::format("{} {} {}\n", fixed(nominal, 4), fixed(directional(t, i, true), d),
+                       fixed(directional(t, i, false), d));
   }
   return out;
 }
@@ -241,7 +261,10 @@ std::string write_linuxcnc(const Table& t) {
 // variables $AA_ENC_COMP (values in mm), $AA_ENC_COMP_STEP, _MIN, _MAX and _IS_MODULO of the
 // first measuring system, as in Siemens' function manual "Extended Functions", K3
 // Compensation. One table (the controller's backlash is a machine datum, given as a comment).
+// The values are the measured errors: "A positive compensation value causes the corresponding
+// machine axis to move in the negative direction" (comp_meaning.cpp).
 std::string write_siemens(const Table& t, int axis_number) {
+  check_sign(t, "siemens");
   if (t.spec.units != Units::mm) throw InputError("SINUMERIK LEC tables are in mm: use --units mm");
   if (t.spec.incremental)
     throw InputError("SINUMERIK LEC tables hold absolute values: no --incremental");
@@ -252,15 +275,15 @@ std::string write_siemens(const Table& t, int axis_number) {
   if (axis_number < 1 || axis_number > 99)
     throw InputError(fmt::format("SINUMERIK axis number {}: expected 1 .. 99", axis_number));
   const int d = std::min(decimals(t.spec), 6);
-  std::string out =
-      fmt::format("; LEC for axis {} ({}), written by caldaq\n; backlash (MD32450) {:.{}f} mm\n",
-                  t.spec.axis, axis_number, t.backlash, d);
+  std::string out = fmt::format(
+      "; LEC for axis {} ({}), written by caldaq\n{}; backlash (MD32450) {} mm\n", t.spec.axis,
+      axis_number, meaning_header(format_meaning("siemens"), "; "), fixed(t.backlash, d));
   out += "CHANDATA(1)\n";
   for (std::size_t i = 0; i < t.forward.size(); ++i)
-    out += fmt::format("$AA_ENC_COMP[0,{},AX{}]={:.{}f}\n", i, axis_number, t.forward[i], d);
-  out += fmt::format("$AA_ENC_COMP_STEP[0,AX{}]={:.4f}\n", axis_number, t.spec.interval_mm);
-  out += fmt::format("$AA_ENC_COMP_MIN[0,AX{}]={:.4f}\n", axis_number, t.position_mm.front());
-  out += fmt::format("$AA_ENC_COMP_MAX[0,AX{}]={:.4f}\n", axis_number, t.position_mm.back());
+    out += fmt::format("$AA_ENC_COMP[0,{},AX{}]={}\n", i, axis_number, fixed(t.forward[i], d));
+  out += fmt::format("$AA_ENC_COMP_STEP[0,AX{}]={}\n", axis_number, fixed(t.spec.interval_mm, 4));
+  out += fmt::format("$AA_ENC_COMP_MIN[0,AX{}]={}\n", axis_number, fixed(t.position_mm.front(), 4));
+  out += fmt::format("$AA_ENC_COMP_MAX[0,AX{}]={}\n", axis_number, fixed(t.position_mm.back(), 4));
   out += fmt::format("$AA_ENC_COMP_IS_MODULO[0,AX{}]=0\n", axis_number);
   out += "M17\n";
   return out;
@@ -272,6 +295,7 @@ std::string write_siemens(const Table& t, int axis_number) {
 // list only by number here (see docs/compensation-tables.md).
 std::string write_isg(const Table& t) {
   if (t.spec.incremental) throw InputError("ISG SSFK lists hold absolute values: no --incremental");
+  check_sign(t, "isg");
   validate(t.spec);
   check_finite(t);
   auto tenth_um = [&](double v) {  // table units -> 0.1 um
@@ -280,8 +304,9 @@ std::string write_isg(const Table& t) {
                                                     : v;
     return static_cast<long long>(std::llround(um * 10.0));
   };
-  std::string out = fmt::format(
-      "# ISG/TwinCAT CNC leadscrew error compensation, axis {}, written by caldaq\n", t.spec.axis);
+  std::string out =
+      fmt::format("# ISG/TwinCAT CNC leadscrew error compensation, axis {}, written by caldaq\n{}",
+                  t.spec.axis, meaning_header(format_meaning("isg"), "# "));
   out += "# set P-COMP-00019 (start), P-COMP-00020 (number of values) and P-COMP-00021 (mode:\n";
   out += fmt::format("# bilateral) for this list: start {:.4f} mm, {} values\n",
                      t.position_mm.front(), t.position_mm.size());
@@ -292,6 +317,58 @@ std::string write_isg(const Table& t) {
     out += fmt::format("kw.ssfk.table[{}].neg {}\n", i, tenth_um(directional(t, i, false)));
   }
   return out;
+}
+
+double correction_at_um(const std::vector<double>& position_mm, const std::vector<double>& um,
+                        double x_mm) {
+  return interpolate(position_mm, um, x_mm, Outside::hold);
+}
+
+Applied applied(const Table& t, bool backlash_in_table) {
+  validate(t.spec);
+  check_finite(t);
+  const double to_um = t.spec.units == Units::mm     ? 1e3
+                       : t.spec.units == Units::inch ? 25400.0
+                                                     : 1.0;
+  const double sign = t.spec.sign == Sign::correction ? 1.0 : -1.0;
+  // The values as the control holds them: increments summed back to absolute values.
+  auto absolute = [&](std::vector<double> v) {
+    if (t.spec.incremental)
+      for (std::size_t i = 1; i < v.size(); ++i) v[i] += v[i - 1];
+    for (auto& x : v) x *= sign * to_um;
+    return v;
+  };
+  Applied a{.position_mm = t.position_mm, .forward_um = {}, .reverse_um = {}};
+  if (t.spec.bidirectional) {
+    a.forward_um = absolute(t.forward);
+    a.reverse_um = absolute(t.reverse);
+  } else if (backlash_in_table && !t.spec.incremental) {
+    std::vector<double> f, r;
+    for (std::size_t i = 0; i < t.position_mm.size(); ++i)
+      f.push_back(directional(t, i, true)), r.push_back(directional(t, i, false));
+    a.forward_um = absolute(f);
+    a.reverse_um = absolute(r);
+  } else {
+    a.forward_um = a.reverse_um = absolute(t.forward);
+  }
+  return a;
+}
+
+PredictedResidual predict(const Applied& a, std::span<const iso230_2::TargetStats> targets) {
+  PredictedResidual p;
+  for (const auto& t : targets) {
+    const double up = t.runs_up > 0 ? t.mean_up_um : t.mean_down_um;
+    const double down = t.runs_down > 0 ? t.mean_down_um : t.mean_up_um;
+    p.target_mm.push_back(t.target_mm);
+    p.before_up_um.push_back(up);
+    p.before_down_um.push_back(down);
+    p.up_um.push_back(up + correction_at_um(a.position_mm, a.forward_um, t.target_mm));
+    p.down_um.push_back(down + correction_at_um(a.position_mm, a.reverse_um, t.target_mm));
+    p.before_max_um = std::max({p.before_max_um, std::abs(up), std::abs(down)});
+    p.after_max_um =
+        std::max({p.after_max_um, std::abs(p.up_um.back()), std::abs(p.down_um.back())});
+  }
+  return p;
 }
 
 }  // namespace cal::comptable

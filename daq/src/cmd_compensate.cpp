@@ -7,15 +7,18 @@
 #include <optional>
 
 #include "cal/analysis/comp_formats.hpp"
+#include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
+#include "compensation/compensation_check.hpp"
 #include "csv_columns.hpp"
 #include "database.hpp"
 #include "measurement_csv.hpp"
+#include "provenance.hpp"
 
 namespace daq {
 namespace {
@@ -25,7 +28,8 @@ namespace ct = cal::comptable;
 struct CompensateOptions {
   std::string input, straightness, db, output, output_axis;
   std::int64_t run = 0;
-  std::string axis = "X", format = "csv", sign = "correction", units = "mm", outside = "refuse";
+  std::string axis = "X", format = "csv", units = "mm", outside = "refuse";
+  std::optional<std::string> sign;  // csv and --json only: the other formats' sign is the vendor's
   double start_mm = 0, interval_mm = 0;
   std::optional<double> resolution;  // unset: by unit (default_resolution)
   int points = 0, axis_number = 1, output_axis_number = 2;
@@ -62,7 +66,7 @@ std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) 
     throw cal::InputError(
         "--straightness: name the corrected axis with --output-axis (the straightness of --axis "
         "measured in that axis, e.g. --axis X --output-axis Y for E_YX)");
-  if (o.units != "mm" || o.incremental || o.sign != "correction")
+  if (o.units != "mm" || o.incremental || o.sign)
     throw cal::InputError(
         "--straightness writes absolute corrections in mm: no --units, --incremental or --sign");
   const auto csv = read_csv_columns(o.straightness, {"position_mm", "deviation_um"}, {}, o.csv);
@@ -94,12 +98,18 @@ std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) 
                   o.format == "linuxcnc" ? "; LinuxCNC documents no cross-axis table" : ""));
 }
 
+TableWriter writer_of(const CompensateOptions& o) {
+  TableWriter w{.format = o.format, .axis_number = o.axis_number, .fanuc = o.fanuc};
+  w.fanuc.reference_mm = o.fanuc_reference_mm.value_or(o.start_mm);
+  return w;
+}
+
 std::string positioning_text(const CompensateOptions& o, const ct::Table& table) {
   if (o.json) {
     nlohmann::json j{{"schema", "caldaq.comp-table.v1"},
                      {"axis", o.axis},
                      {"units", o.units},
-                     {"sign", o.sign},
+                     {"sign", table.spec.sign == ct::Sign::error ? "error" : "correction"},
                      {"incremental", o.incremental},
                      {"position_mm", table.position_mm},
                      {"forward", table.forward}};
@@ -109,20 +119,7 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
       j["backlash"] = table.backlash;
     return j.dump(2) + "\n";
   }
-  if (o.format == "csv") return ct::write_csv(table);
-  if (o.format == "linuxcnc") return ct::write_linuxcnc(table);
-  if (o.format == "siemens") return ct::write_siemens(table, o.axis_number);
-  if (o.format == "isg") return ct::write_isg(table);
-  if (o.format == "heidenhain") return ct::write_heidenhain_com(table);
-  if (o.format == "fanuc") {
-    ct::FanucOptions f = o.fanuc;
-    f.reference_mm = o.fanuc_reference_mm.value_or(o.start_mm);
-    return ct::write_fanuc_pitch(table, f);
-  }
-  throw cal::InputError(fmt::format(
-      "format '{}' (expected csv, linuxcnc, siemens, isg, heidenhain or fanuc; siemens-cec for "
-      "--straightness)",
-      o.format));
+  return write_table(writer_of(o), table);
 }
 
 // A resolution that suits each unit when none is given: 0.1 um in mm or um tables, 0.00001 in
@@ -130,6 +127,91 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
 double default_resolution(const std::string& units) {
   const auto u = ct::units_from_string(units);
   return u == ct::Units::inch ? 0.00001 : u == ct::Units::um ? 0.1 : 0.0001;
+}
+
+// The meaning of the chosen format's values (comp_meaning.hpp): -f isg with --straightness is
+// ISG's cross compensation.
+const ct::FormatMeaning& meaning_of(const CompensateOptions& o) {
+  if (o.format == "isg" && !o.straightness.empty()) return ct::format_meaning("isg-cross");
+  return ct::format_meaning(o.format);
+}
+
+// The sign of the table: the vendor's for a controller format; the user's (default
+// correction) only for caldaq's own CSV and JSON.
+ct::Sign table_sign(const CompensateOptions& o) {
+  if (o.format == "csv" || o.json)
+    return o.sign.value_or("correction") == "error" ? ct::Sign::error : ct::Sign::correction;
+  const auto& m = meaning_of(o);
+  if (o.sign)
+    throw cal::InputError(fmt::format(
+        "--sign is for csv and --json only: the values of {} are {} by the vendor's own rule, "
+        "which caldaq follows ({}; docs/compensation-tables.md)",
+        m.name, m.written == ct::Sign::error ? "the measured errors" : "corrections", m.source));
+  return m.written;
+}
+
+nlohmann::json predicted_json(const ct::PredictedResidual& p) {
+  return {{"target_mm", p.target_mm},
+          {"before_up_um", p.before_up_um},
+          {"before_down_um", p.before_down_um},
+          {"up_um", p.up_um},
+          {"down_um", p.down_um},
+          {"before_max_um", p.before_max_um},
+          {"after_max_um", p.after_max_um}};
+}
+
+// Kept with the run (schema 5) so that the next measurement of the axis can be compared with
+// what this table was predicted to leave (daq verify). A store that cannot be written (a
+// read-only medium) is said, not fatal: the table is still written.
+void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct::Applied& a,
+                        const ct::PredictedResidual& p, const std::string& text) {
+  try {
+    cal::storage::Store store(database_path(o.db));
+    const auto run = store.run(o.run);
+    if (!run) throw cal::InputError(fmt::format("no run {}", o.run));
+    const auto origin = run_origin(*run, store.instruments(o.run), "");
+    if (!origin.label().empty())
+      fmt::print(stderr,
+                 "note: run {} is {} ({}): this table comes from no measurement of a real "
+                 "machine\n",
+                 o.run, origin.label(), origin.text);
+    const auto& m = meaning_of(o);
+    const nlohmann::json doc{{"schema", "caldaq.compensation.v1"},
+                             {"format", o.format},
+                             {"writer", to_json(writer_of(o))},
+                             {"meaning",
+                              {{"values", m.written == ct::Sign::error ? "error" : "correction"},
+                               {"evidence", ct::to_string(m.evidence)},
+                               {"source", m.source}}},
+                             {"table",
+                              {{"units", ct::units_name(t.spec.units)},
+                               {"position_mm", t.position_mm},
+                               {"forward", t.forward},
+                               {"reverse", t.reverse},
+                               {"backlash", t.backlash}}},
+                             {"applied",
+                              {{"position_mm", a.position_mm},
+                               {"forward_um", a.forward_um},
+                               {"reverse_um", a.reverse_um}}},
+                             {"predicted", predicted_json(p)},
+                             {"origin", to_json(origin)},
+                             {"text", text}};
+    const auto id = store.add_compensation({.machine_id = run->machine_id,
+                                            .source_run_id = o.run,
+                                            .source = fmt::format("run {}", o.run),
+                                            .axis = o.axis,
+                                            .format = o.format,
+                                            .json = doc.dump()});
+    fmt::print(stderr,
+               "stored as compensation {}: the next run of axis {} on this machine is compared "
+               "with its prediction (daq verify RUN)\n",
+               id, o.axis);
+  } catch (const std::exception& e) {
+    fmt::print(stderr,
+               "note: the compensation was not stored with run {} ({}); daq verify will "
+               "not find it\n",
+               o.run, e.what());
+  }
 }
 
 void run(const CompensateOptions& o) {
@@ -142,20 +224,35 @@ void run(const CompensateOptions& o) {
                       .points = o.points,
                       .bidirectional = o.bidirectional,
                       .incremental = o.incremental,
-                      .sign = o.sign == "error" ? ct::Sign::error : ct::Sign::correction,
+                      .sign = table_sign(o),
                       .units = ct::units_from_string(o.units),
                       .resolution = o.resolution.value_or(default_resolution(o.units)),
                       .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
   std::string text;
+  std::optional<ct::PredictedResidual> predicted;
   if (!o.straightness.empty()) {
     text = straightness_text(o, spec);
   } else {
     const auto m = measurements(o);
-    text = positioning_text(o, ct::positioning(spec, cal::iso230_2::target_stats(m)));
+    const auto stats = cal::iso230_2::target_stats(m);
+    const auto table = ct::positioning(spec, stats);
+    text = positioning_text(o, table);
+    const auto a = applied_of(writer_of(o), table);
+    predicted = ct::predict(a, stats);
+    if (o.run != 0 && !o.json) store_compensation(o, table, a, *predicted, text);
   }
-  if (o.output.empty()) return fmt::print("{}", text);
-  std::ofstream out(o.output);
-  if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));
+  if (o.output.empty())
+    fmt::print("{}", text);
+  else if (std::ofstream out(o.output); !(out << text))
+    throw cal::InputError(fmt::format("{}: cannot write", o.output));
+  if (o.json) return;
+  if (!o.output.empty()) fmt::print(stderr, "written {}\n", o.output);
+  fmt::print(stderr, "{}\n", ct::meaning_text(meaning_of(o)));
+  if (predicted)
+    fmt::print(stderr,
+               "predicted: largest |mean deviation| {} um before, {} um left by this table as "
+               "written (its rounding, sign and reference applied to the measured means)\n",
+               ct::fixed(predicted->before_max_um, 3), ct::fixed(predicted->after_max_um, 3));
 }
 
 }  // namespace
@@ -183,8 +280,9 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   cmd->add_flag("--bidirectional", o->bidirectional,
                 "Separate forward and reverse tables (else one + backlash)");
   cmd->add_flag("--incremental", o->incremental, "Each value relative to the previous point");
-  cmd->add_option("--sign", o->sign, "correction or error")
-      ->capture_default_str()
+  cmd->add_option("--sign", o->sign,
+                  "csv and --json only: correction (default) or error; every controller format "
+                  "has its vendor's sign (docs/compensation-tables.md)")
       ->check(CLI::IsMember({"correction", "error"}));
   cmd->add_option("--units", o->units, "mm, um or inch")->capture_default_str();
   cmd->add_option("--resolution", o->resolution,

@@ -11,8 +11,11 @@
 #include <boost/asio/post.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/daq/config.hpp"
@@ -42,6 +45,11 @@ struct DemoOptions {
   std::string capture = "caldaq-demo.cdq";
   double speed = 0.0;  // 0: simulated time that jumps from event to event (loop_time.hpp)
   bool quiet = false;
+  bool linear_only = false;
+  // A compensation table the simulated control loads for the X axis (docs/compensation-
+  // tables.md, "Verification"): read as its vendor says, or with the other sign (inverted).
+  std::string control_table, control_format;
+  bool control_inverted = false;
 };
 
 cal::daq::Config demo_config() {
@@ -70,6 +78,7 @@ cal::daq::Config demo_config() {
     d.serial_number = std::move(serial);
     d.certificate = "none (simulated instrument)";
     d.calibration_due = std::move(due);
+    d.origin = "simulated";
     return d;
   };
   c.devices = {device("laser", "ids3010", "laser", "SIM-IDS-0001", "2099-12-31"),
@@ -98,6 +107,28 @@ cal::daq::Config demo_config() {
                                         .feed_mm_per_min = 6000,
                                         .dwell_s = 3};
   return c;
+}
+
+// The simulated control loads a table for X: it adds the correction the file holds as its
+// vendor's text says (or with the other sign), forward values only (the demo's tables carry the
+// reversal in the control's backlash parameter, which the simulated control does not have).
+void load_control_table(SimulatedShop& shop, const DemoOptions& o) {
+  if (o.control_table.empty()) return;
+  std::ifstream in(o.control_table, std::ios::binary);
+  if (!in) throw cal::InputError(fmt::format("{}: cannot read", o.control_table));
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  cal::comptable::Applied a;
+  try {
+    a = cal::comptable::read_applied(o.control_format, text, o.control_inverted);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("{}: {}", o.control_table, e.what()));
+  }
+  shop.set_compensation([a](const cal::kinematics::Vec3& p) {
+    return cal::kinematics::Vec3{
+        cal::comptable::correction_at_um(a.position_mm, a.forward_um, p[0]), 0.0, 0.0};
+  });
+  fmt::print("daq demo: the SIMULATED control applies {} ({} table{})\n", o.control_table,
+             o.control_format, o.control_inverted ? ", read with the other sign" : "");
 }
 
 // One line of progress, rewritten in place on a terminal.
@@ -155,6 +186,7 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
       .database = o.db,
       .ballbar = make_instrument(io, spec, make_transport(io, dc),
                                  {.name = "ballbar (simulated)", .clock = shop.clock_ns()}),
+      .origins = {{"ballbar", origin_of(spec.origin, "")}},
       .on_event = [&o](const std::string& e) {
         if (!o.quiet) fmt::print("  {}\n", e);
       }};
@@ -284,6 +316,7 @@ int run_demo(const DemoOptions& o) {
     fmt::print(stderr, "daq demo: the simulated instruments did not all answer within 10 s\n");
     return 1;
   }
+  load_control_table(shop, o);
   shop.run_linear(run.plan(), config.linear->feed_mm_per_min, config.linear->dwell_s);
   // What is flushed survives a crash of this process.
   shop.run_program([&] { return run.finished(); }, 20.0, [&] { recorder.flush(); });
@@ -317,6 +350,7 @@ int run_demo(const DemoOptions& o) {
   const auto truth =
       cal::iso230_2::evaluate(shop.true_measurements(run.plan()), out.evaluation->standard.id);
   print_comparison(*out.evaluation, truth, shop.truth());
+  if (o.linear_only) return 0;
   if (const int rc = run_circle_demo(io, shop, config, o); rc != 0) return rc;
   fmt::print("\nSee it again: daq runs --db {0}; daq show {1} --db {0}; daq export {1} --db {0}\n",
              o.db, out.run_id);
@@ -344,6 +378,15 @@ void add_demo_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 200.0));
   cmd->add_flag("--quiet", o->quiet, "Print only the results");
+  cmd->add_flag("--linear-only", o->linear_only, "Run the linear test only (no ballbar circle)");
+  cmd->add_option("--control-table", o->control_table,
+                  "A compensation table (daq compensate) the simulated control applies to X");
+  cmd->add_option("--control-format", o->control_format,
+                  "Its format: siemens, linuxcnc, isg, heidenhain or fanuc")
+      ->check(CLI::IsMember({"siemens", "linuxcnc", "isg", "heidenhain", "fanuc"}));
+  cmd->add_flag("--control-inverted", o->control_inverted,
+                "The simulated control reads the table with the other sign than its vendor "
+                "states (to see daq verify diagnose it)");
   cmd->callback([o] {
     if (o->speed > 0 && o->speed < 1)
       throw CLI::ValidationError("--speed", "must be 0 (simulated time) or 1 .. 200");

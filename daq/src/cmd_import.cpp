@@ -140,7 +140,10 @@ void import_rtx(const ImportOptions& o) {
        .device = 0,
        .driver = "renishaw-rtx (" + field("Owner") + " " + field("Version no") + ")",
        .transport = "file " + o.file,
-       .settings_json = json{{"serial", field("Serial No")}}.dump()});
+       .settings_json = json{{"serial", field("Serial No")}}.dump(),
+       .origin = "imported",
+       .origin_detail = "Renishaw .rtx file " + o.file + " (the file does not say whether the "
+                        "instrument was real)"});
   try {
     copy_samples(reader, store, how, s);
   } catch (const std::exception& e) {

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "cal/analysis/comp_formats.hpp"
+#include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/volumetric_comp.hpp"
 #include "model_cli.hpp"
@@ -81,19 +82,32 @@ std::map<std::string, int> numbers_of(const Options& o) {
   return {{"X", o.axis_numbers[0]}, {"Y", o.axis_numbers[1]}, {"Z", o.axis_numbers[2]}};
 }
 
-// What the written tables add at p (um): the own-axis tables only, or all nine.
-kin::Vec3 own_tables_um(const vc::CrossTables& t, const kin::Vec3& p) {
-  kin::Vec3 c{};
-  for (std::size_t i = 0; i < 3; ++i) {
-    const auto a = static_cast<kin::Axis>(i);
-    vc::CrossTables one;
-    one.tables = t.tables;
-    for (auto& table : one.tables)
-      if (table.input != a || table.output != a)
-        std::fill(table.correction_um.begin(), table.correction_um.end(), 0.0);
-    c[i] = vc::table_correction_um(one, p)[i];
+// The tables as written: every value rounded to what the writers keep (0.1 um), and with
+// own_only the cross tables left out (formats that correct an axis along itself only).
+vc::CrossTables as_written(const vc::CrossTables& t, bool own_only) {
+  vc::CrossTables w = t;
+  for (auto& table : w.tables)
+    for (auto& um : table.correction_um)
+      um = (own_only && table.input != table.output)
+               ? 0.0
+               : std::round(um * 1e-3 / kResolutionMm) * kResolutionMm * 1e3;
+  return w;
+}
+
+// FANUC's own-axis tables as the control applies them: the steps summed from the reference
+// position (zero there: the correction's constant at the reference position is not in the
+// table), rounded to the detection unit (comp_formats.hpp, fanuc_applied).
+vc::CrossTables fanuc_as_written(const vc::CrossTables& t,
+                                 const std::array<ct::FanucOptions, 3>& f) {
+  vc::CrossTables w = as_written(t, true);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto axis = static_cast<kin::Axis>(a);
+    const auto applied =
+        ct::fanuc_applied(ct::own_axis_table(t, axis, kResolutionMm), f[a]).forward_um;
+    auto& table = w.tables.at(3 * a + a);
+    table.correction_um = applied;
   }
-  return c;
+  return w;
 }
 
 struct Written {
@@ -106,8 +120,14 @@ struct Written {
 Written write_format(const Options& o, const mdl::Model& m, const std::array<vc::AxisGrid, 3>& g,
                      const vc::CrossTables& tables) {
   Written w;
-  const auto all = [tables](const kin::Vec3& p) { return vc::table_correction_um(tables, p); };
-  const auto own = [tables](const kin::Vec3& p) { return own_tables_um(tables, p); };
+  // What the written files add at p (um): computed from the values as written, so that the
+  // residual is what the files leave (rounding, FANUC's reference, what a format cannot hold).
+  const auto all = [w = as_written(tables, false)](const kin::Vec3& p) {
+    return vc::table_correction_um(w, p);
+  };
+  const auto own = [w = as_written(tables, true)](const kin::Vec3& p) {
+    return vc::table_correction_um(w, p);
+  };
   const auto numbers = numbers_of(o);
   const std::string frozen = fmt::format(
       "One-dimensional tables cannot hold the products of an angular error with the travel of an "
@@ -141,7 +161,8 @@ Written write_format(const Options& o, const mdl::Model& m, const std::array<vc:
         w.files.push_back({fmt::format("crosscomp_{}.lis", kAxis[out]),
                            ct::write_isg_cross(*masters[0], numbers.at(kAxis[out]),
                                                numbers.at(masters[0]->input))});
-      ct::Table pitch = ct::own_axis_table(tables, static_cast<kin::Axis>(out), kResolutionMm);
+      ct::Table pitch = ct::own_axis_table(tables, static_cast<kin::Axis>(out), kResolutionMm,
+                                           ct::format_meaning("isg").written);
       w.files.push_back({fmt::format("ssfk_{}.lis", kAxis[out]), ct::write_isg(pitch)});
     }
     w.what = "ISG cross compensation lists and leadscrew error compensation lists";
@@ -175,8 +196,9 @@ Written write_format(const Options& o, const mdl::Model& m, const std::array<vc:
     w.notes.push_back(frozen);
   } else if (o.format == "fanuc") {
     std::string text;
+    std::array<ct::FanucOptions, 3> fanuc;
     for (std::size_t a = 0; a < 3; ++a) {
-      ct::FanucOptions fo;
+      ct::FanucOptions& fo = fanuc[a];
       fo.reference_mm = o.fanuc_reference_mm.value_or(g[a].start_mm);
       fo.first_point = o.fanuc_first_point;
       fo.detection_unit_um = o.fanuc_unit_um;
@@ -187,7 +209,13 @@ Written write_format(const Options& o, const mdl::Model& m, const std::array<vc:
     }
     w.files.push_back({"", text});
     w.what = "FANUC pitch error compensation of X, Y and Z";
-    w.correction_um = own;
+    w.correction_um = [f = fanuc_as_written(tables, fanuc)](const kin::Vec3& p) {
+      return vc::table_correction_um(f, p);
+    };
+    w.notes.push_back(
+        "FANUC's table is zero at the reference position: the correction's value there is not "
+        "in it and stays in the residual (shift the reference position by it, or choose the "
+        "reference where the error is small).");
     w.notes.push_back(
         "Pitch error compensation corrects each axis along itself: straightness, "
         "squareness and the Abbe terms of other axes stay (they need cross-axis "
@@ -217,6 +245,27 @@ Written write_format(const Options& o, const mdl::Model& m, const std::array<vc:
         o.format));
   }
   return w;
+}
+
+// The controller functions a format's files are for (comp_meaning.hpp): what their values mean.
+std::vector<const ct::FormatMeaning*> meanings_of(const std::string& format) {
+  std::vector<const ct::FormatMeaning*> m{&ct::format_meaning(format)};
+  if (format == "isg-cross") m.push_back(&ct::format_meaning("isg"));
+  if (format == "linuxcnc") m.push_back(&ct::format_meaning("linuxcnc-matrixkins"));
+  return m;
+}
+
+json meaning_json(const std::vector<const ct::FormatMeaning*>& meanings) {
+  json j = json::array();
+  for (const auto* m : meanings)
+    j.push_back({{"function", m->name},
+                 {"values", m->written == ct::Sign::error ? "error" : "correction"},
+                 {"applied", m->applied},
+                 {"reference", m->reference},
+                 {"evidence", ct::to_string(m->evidence)},
+                 {"source", m->source},
+                 {"quote", m->quote}});
+  return j;
 }
 
 void put(const std::string& path, const std::string& text) {
@@ -310,7 +359,8 @@ void run(const Options& o) {
                             {"before_max_at_mm", {b.at[0], b.at[1], b.at[2]}},
                             {"after_max_um", a.max_um},
                             {"after_max_at_mm", {a.at[0], a.at[1], a.at[2]}},
-                            {"notes", w.notes}}
+                            {"notes", w.notes},
+                            {"meaning", meaning_json(meanings_of(o.format))}}
                            .dump(2));
     return;
   }
@@ -321,6 +371,8 @@ void run(const Options& o) {
              w.what, eval[0].points, eval[1].points, eval[2].points, b.max_um, a.max_um, a.at[0],
              a.at[1], a.at[2]);
   for (const auto& n : w.notes) fmt::print(stderr, "note: {}\n", n);
+  for (const auto* meaning : meanings_of(o.format))
+    fmt::print(stderr, "{}\n", ct::meaning_text(*meaning));
 }
 
 }  // namespace

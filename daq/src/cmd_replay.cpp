@@ -148,6 +148,9 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                        .context_json = s.original_context,
                        .replay = true,
                        .replay_of_run = s.original_run,
+                       .origins = {{"ballbar", origin_of(it->origin, std::filesystem::absolute(
+                                                                         o.capture)
+                                                                         .string())}},
                        .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   CircleRun run(s.io, std::move(setup));
   run.start();

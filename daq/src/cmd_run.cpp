@@ -228,6 +228,7 @@ void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const Run
       .ballbar = make_instrument(io, specs[0], make_transport(io, dc),
                                  instrument_options(dc, specs[0], o, capture.recorder.get())),
       .capture_path = capture.absolute_path(o.capture),
+      .origins = {{"ballbar", origin_of(specs[0].origin, "")}},
       .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   auto progress = std::make_shared<ProgressOut>(o.json);
   setup.on_event = [progress](const std::string& e) { progress->event(e); };

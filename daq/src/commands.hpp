@@ -29,6 +29,8 @@ void add_geometry_commands(CLI::App& app, CLI::App& analyse);
 void add_circle_commands(CLI::App& app, CLI::App& analyse);
 // compensate
 void add_compensate_commands(CLI::App& app, CLI::App& analyse);
+// daq verify: an as-left run against the compensation written before it (cmd_verify.cpp).
+void add_verify_command(CLI::App& app);
 // serve: the live web readout and its API
 void add_serve_command(CLI::App& app);
 // report: HTML/PDF reports of stored runs

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   daq::add_geometry_commands(app, *analyse);
   daq::add_circle_commands(app, *analyse);
   daq::add_compensate_commands(app, *analyse);
+  daq::add_verify_command(app);
   daq::add_report_command(app);
   daq::add_model_commands(app);
   daq::add_ballbar_commands(app);

@@ -1,6 +1,7 @@
 #include "provenance.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <ctime>
@@ -176,6 +177,52 @@ std::string utc_now_iso() {
   return utc_iso(std::chrono::duration_cast<std::chrono::milliseconds>(
                      std::chrono::system_clock::now().time_since_epoch())
                      .count());
+}
+
+std::string RunOrigin::label() const {
+  std::string l;
+  const auto add = [&](std::string_view w) { l += (l.empty() ? "" : ", ") + std::string(w); };
+  if (simulated) add("SIMULATED");
+  if (replayed) add("REPLAYED");
+  if (imported) add("IMPORTED");
+  return l;
+}
+
+RunOrigin run_origin(const cal::storage::RunRecord& run,
+                     const std::vector<cal::storage::InstrumentRecord>& instruments,
+                     std::string_view machine_name) {
+  RunOrigin o;
+  const auto by_name = [](std::string_view s) {
+    return s.find("SIMULATED") != std::string_view::npos ||
+           s.find("simulated") != std::string_view::npos;
+  };
+  std::vector<std::string> parts;
+  for (const auto& i : instruments) {
+    if (i.origin.empty()) {
+      o.unrecorded = true;
+      o.simulated = o.simulated || by_name(i.driver) || by_name(i.transport);
+      continue;
+    }
+    o.simulated = o.simulated || i.origin == "simulated" ||
+                  (i.origin == "replay" && i.origin_detail.find("simulated") != std::string::npos);
+    o.replayed = o.replayed || i.origin == "replay";
+    o.imported = o.imported || i.origin == "imported";
+    parts.push_back(fmt::format("{} {}{}", i.driver, i.origin,
+                                i.origin_detail.empty() ? "" : " (" + i.origin_detail + ")"));
+  }
+  if (instruments.empty()) o.unrecorded = true;
+  if (o.unrecorded) o.simulated = o.simulated || by_name(machine_name) || by_name(run.campaign);
+  o.text = parts.empty() ? std::string(
+                               "the origin of the readings was not recorded (stored "
+                               "before caldaq recorded it)")
+                         : fmt::format("{}", fmt::join(parts, "; "));
+  if (o.unrecorded && !parts.empty()) o.text += "; the other instruments' origin was not recorded";
+  return o;
+}
+
+nlohmann::json to_json(const RunOrigin& o) {
+  return {{"label", o.label()},     {"simulated", o.simulated},  {"replayed", o.replayed},
+          {"imported", o.imported}, {"recorded", !o.unrecorded}, {"text", o.text}};
 }
 
 }  // namespace daq

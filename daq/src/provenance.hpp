@@ -56,6 +56,25 @@ struct CompensationUsed {
 CompensationUsed compensation_used(const nlohmann::json& settings,
                                    const std::vector<cal::storage::ResultRecord>& results);
 
+// Where a run's readings came from (schema 5 stores it per instrument; docs/storage.md,
+// "Origin"). Everything derived from a run (results, reports, exports, models, compensation
+// tables, the page) shows label() prominently when it is not empty; no name can remove it.
+struct RunOrigin {
+  bool simulated = false;   // an instrument was a simulated twin (live, or recorded in a replay)
+  bool replayed = false;    // readings pushed again through the drivers from a capture
+  bool imported = false;    // another tool's file
+  bool unrecorded = false;  // stored before origins were: judged by the names (below)
+  std::string text;         // one sentence saying which instruments were what
+  // "SIMULATED", "REPLAYED", "SIMULATED, REPLAYED", "IMPORTED", or "" for real instruments.
+  std::string label() const;
+};
+// From the run's instruments; for runs stored before schema 5 (origin ""), by the old rule:
+// "simulated" in the machine's name, the campaign, a driver or a transport, and `unrecorded`.
+RunOrigin run_origin(const cal::storage::RunRecord& run,
+                     const std::vector<cal::storage::InstrumentRecord>& instruments,
+                     std::string_view machine_name);
+nlohmann::json to_json(const RunOrigin& o);
+
 // The software that writes results (the same string runs record).
 inline constexpr std::string_view software_version = "daq 0.1.0";
 

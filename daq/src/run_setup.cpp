@@ -65,7 +65,8 @@ InstrumentSpec spec_of(const cal::daq::DeviceConfig& c, std::uint16_t device, in
                    .test_axis = test_axis,
                    .serial_number = c.serial_number,
                    .certificate = c.certificate,
-                   .calibration_due = c.calibration_due};
+                   .calibration_due = c.calibration_due,
+                   .origin = c.origin};
   const auto want = needed(c.role);
   const auto have = drv.quantities(s.options, s.context());
   if (!want.empty() && std::none_of(want.begin(), want.end(), [&](d::Quantity w) {
@@ -224,8 +225,18 @@ std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
   return specs;
 }
 
+InstrumentOrigin origin_of(const std::string& configured, const std::string& replay_capture) {
+  const std::string what = configured.empty() ? "a device whose origin the capture does not record"
+                           : configured == "simulated" ? "a twin of the built-in simulated shop"
+                                                       : "a " + configured + " device";
+  if (!replay_capture.empty())
+    return {"replay", fmt::format("capture {}, recorded from {}", replay_capture, what)};
+  return {configured, configured == "simulated" ? what : ""};
+}
+
 void place_linear_instrument(const InstrumentSpec& s, std::unique_ptr<d::Instrument> inst,
                              LinearRunSetup& setup) {
+  setup.origins[s.role] = origin_of(s.origin, setup.replay ? setup.capture_path : "");
   const auto& drv = d::driver(s.driver);
   const auto channels = drv.channels(s.options, s.context());
   const int first = channels.empty() ? 0 : channels.front();

@@ -133,6 +133,26 @@ void TemperCodec::emit_temperature(int sensor, double t, std::optional<double> r
   emit(frames, {.sensor = sensor, .temperature_degc = t, .humidity_pct = rh});
 }
 
+// A DS75's temperature register holds 12 bits left-aligned: "the four least significant bits
+// ... are always 0" (Maxim DS75 data sheet, temperature register format). A register with any of
+// them set did not come from the sensor: ff ff is what a TEMPer1F_V1.3 sends when its probe does
+// not answer (edorfaus/TEMPered#32), which masking the nibble used to read as -0.0625 degC.
+void TemperCodec::emit_ds75(int sensor, const std::uint8_t* reg, std::vector<TemperFrame>& frames,
+                            std::vector<CodecError>& errors) {
+  const auto raw = static_cast<std::uint16_t>(reg[0] << 8 | reg[1]);
+  if (raw == 0xffff)
+    return report(errors, ErrorKind::out_of_range, offset_,
+                  fmt::format("sensor {}: ff ff: the sensor did not answer (probe unplugged or "
+                              "broken); no temperature",
+                              sensor));
+  if ((raw & 0xf) != 0)
+    return report(errors, ErrorKind::malformed, offset_,
+                  fmt::format("sensor {}: register {:02x} {:02x} cannot come from a DS75 (its "
+                              "low 4 bits are always 0); no temperature",
+                              sensor, reg[0], reg[1]));
+  emit_temperature(sensor, be16(reg) / 256.0, std::nullopt, frames, errors);
+}
+
 void TemperCodec::on_report(const std::uint8_t* r, std::vector<TemperFrame>& frames,
                             std::vector<CodecError>& errors) {
   if (r[0] == kInit) {
@@ -160,8 +180,7 @@ void TemperCodec::on_report(const std::uint8_t* r, std::vector<TemperFrame>& fra
                       fmt::format("ds75 data length {} (expected 2 or 4)", r[1]));
       for (int slot = 0; slot < (r[1] == 4 ? 2 : 1); ++slot)
         if (const int channel = config_.ds75_slots[static_cast<std::size_t>(slot)]; channel >= 0)
-          emit_temperature(channel, (be16(r + 2 + 2 * slot) & ~0xf) / 256.0, std::nullopt, frames,
-                           errors);
+          emit_ds75(channel, r + 2 + 2 * slot, frames, errors);
       return;
     case TemperFamily::gold: {
       if (r[1] != 0x80 && r[1] != 0x01)

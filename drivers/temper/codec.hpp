@@ -94,6 +94,8 @@ class TemperCodec : public CodecBase<TemperCodec, TemperFrame> {
                  std::vector<CodecError>& errors);
   void emit_temperature(int sensor, double t_degc, std::optional<double> rh,
                         std::vector<TemperFrame>& frames, std::vector<CodecError>& errors);
+  void emit_ds75(int sensor, const std::uint8_t* reg, std::vector<TemperFrame>& frames,
+                 std::vector<CodecError>& errors);
 
   TemperConfig config_;
   std::uint8_t buf_[report_bytes] = {};

@@ -152,6 +152,24 @@ CREATE TABLE ballbar_calibrations(
 CREATE INDEX ballbar_calibrations_by_bar
   ON ballbar_calibrations(bar, nominal_mm, calibrated_unix_ms);
 )sql",
+    // 4 -> 5 (issue 26): where each instrument's readings came from (a real device, a simulated
+    // twin, a replay of which capture; '' before this schema: not recorded), and the
+    // compensation tables written from runs or models, with what they were predicted to leave,
+    // so that the next measurement of the axis can be compared with the prediction.
+    R"sql(
+ALTER TABLE instruments ADD COLUMN origin TEXT NOT NULL DEFAULT '';
+ALTER TABLE instruments ADD COLUMN origin_detail TEXT NOT NULL DEFAULT '';
+CREATE TABLE compensations(
+  id INTEGER PRIMARY KEY,
+  machine_id INTEGER REFERENCES machines(id),
+  source_run_id INTEGER REFERENCES runs(id) ON DELETE SET NULL,
+  source TEXT NOT NULL DEFAULT '',
+  axis TEXT NOT NULL,
+  format TEXT NOT NULL,
+  created_unix_ms INTEGER NOT NULL,
+  json TEXT NOT NULL);
+CREATE INDEX compensations_by_machine ON compensations(machine_id, axis, created_unix_ms);
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -333,6 +351,13 @@ CREATE TEMP TABLE ballbar_calibrations(id INTEGER PRIMARY KEY, bar TEXT, nominal
   zero_length_mm REAL, temperature_degc REAL, calibrated_unix_ms INTEGER, note TEXT);
 )sql",
          "present an older schema without ballbar calibrations (read-only)");
+  if (version < 5)  // before origins and compensations: not recorded, none
+    exec(R"sql(
+CREATE TEMP VIEW instruments AS SELECT *, '' AS origin, '' AS origin_detail FROM main.instruments;
+CREATE TEMP TABLE compensations(id INTEGER PRIMARY KEY, machine_id INTEGER, source_run_id INTEGER,
+  source TEXT, axis TEXT, format TEXT, created_unix_ms INTEGER, json TEXT);
+)sql",
+         "present an older schema without origins and compensations (read-only)");
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
       "('encoding', 'seq', 'crc')");
@@ -418,13 +443,15 @@ std::int64_t Store::begin_run(const RunRecord& r) {
 void Store::add_instrument(const InstrumentRecord& i) {
   impl_->need_writable("add instrument");
   auto s = impl_->prepare(
-      "INSERT INTO instruments(run_id, device, driver, transport, settings_json) "
-      "VALUES(?, ?, ?, ?, ?)");
+      "INSERT INTO instruments(run_id, device, driver, transport, settings_json, origin, "
+      "origin_detail) VALUES(?, ?, ?, ?, ?, ?, ?)");
   sqlite3_bind_int64(s.get(), 1, i.run_id);
   sqlite3_bind_int(s.get(), 2, i.device);
   bind_text(s.get(), 3, i.driver);
   bind_text(s.get(), 4, i.transport);
   bind_text(s.get(), 5, i.settings_json);
+  bind_text(s.get(), 6, i.origin);
+  bind_text(s.get(), 7, i.origin_detail);
   impl_->step_done(s.get(), fmt::format("add instrument {} to run {}", i.device, i.run_id));
 }
 
@@ -500,13 +527,53 @@ std::optional<RunRecord> Store::run(std::int64_t run_id) const {
 
 std::vector<InstrumentRecord> Store::instruments(std::int64_t run_id) const {
   auto s = impl_->prepare(
-      "SELECT run_id, device, driver, transport, settings_json FROM instruments WHERE run_id = ? "
-      "ORDER BY device");
+      "SELECT run_id, device, driver, transport, settings_json, origin, origin_detail FROM "
+      "instruments WHERE run_id = ? ORDER BY device");
   sqlite3_bind_int64(s.get(), 1, run_id);
   std::vector<InstrumentRecord> out;
   while (sqlite3_step(s.get()) == SQLITE_ROW)
     out.push_back({sqlite3_column_int64(s.get(), 0), sqlite3_column_int(s.get(), 1),
-                   column_text(s.get(), 2), column_text(s.get(), 3), column_text(s.get(), 4)});
+                   column_text(s.get(), 2), column_text(s.get(), 3), column_text(s.get(), 4),
+                   column_text(s.get(), 5), column_text(s.get(), 6)});
+  return out;
+}
+
+std::int64_t Store::add_compensation(const CompensationRecord& c) {
+  impl_->need_writable("add compensation");
+  auto s = impl_->prepare(
+      "INSERT INTO compensations(machine_id, source_run_id, source, axis, format, "
+      "created_unix_ms, json) VALUES(?, ?, ?, ?, ?, ?, ?)");
+  if (c.machine_id > 0) sqlite3_bind_int64(s.get(), 1, c.machine_id);
+  if (c.source_run_id > 0) sqlite3_bind_int64(s.get(), 2, c.source_run_id);
+  bind_text(s.get(), 3, c.source);
+  bind_text(s.get(), 4, c.axis);
+  bind_text(s.get(), 5, c.format);
+  sqlite3_bind_int64(s.get(), 6, c.created_unix_ms ? c.created_unix_ms : unix_ms_now());
+  bind_text(s.get(), 7, c.json);
+  impl_->step_done(s.get(), fmt::format("add the compensation of axis {} ({})", c.axis, c.format));
+  return sqlite3_last_insert_rowid(impl_->db.get());
+}
+
+std::vector<CompensationRecord> Store::compensations(std::int64_t machine_id,
+                                                     std::string_view axis) const {
+  auto s = impl_->prepare(
+      "SELECT id, IFNULL(machine_id, 0), IFNULL(source_run_id, 0), source, axis, format, "
+      "created_unix_ms, json FROM compensations WHERE (? = 0 OR machine_id = ?) AND (? = '' OR "
+      "axis = ?) ORDER BY created_unix_ms, id");
+  sqlite3_bind_int64(s.get(), 1, machine_id);
+  sqlite3_bind_int64(s.get(), 2, machine_id);
+  bind_text(s.get(), 3, axis);
+  bind_text(s.get(), 4, axis);
+  std::vector<CompensationRecord> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW)
+    out.push_back({.id = sqlite3_column_int64(s.get(), 0),
+                   .machine_id = sqlite3_column_int64(s.get(), 1),
+                   .source_run_id = sqlite3_column_int64(s.get(), 2),
+                   .source = column_text(s.get(), 3),
+                   .axis = column_text(s.get(), 4),
+                   .format = column_text(s.get(), 5),
+                   .created_unix_ms = sqlite3_column_int64(s.get(), 6),
+                   .json = column_text(s.get(), 7)});
   return out;
 }
 

@@ -57,9 +57,14 @@ TEST(CrossFormats, SinumerikCec) {
 // ISG cross compensation list of the slave axis Y (logical number 2) on master X (1), in
 // 0.1 um: X at 0, 1000000 (100 mm), 2000000; corrections 0, 12, -25.
 TEST(CrossFormats, IsgCrossCompensation) {
-  EXPECT_EQ(write_isg_cross(x_to_y(), 2, 1),
-            "# ISG/TwinCAT CNC cross compensation of axis Y as a function of axis X, written by "
-            "caldaq\nkopf.achs_nr 2\nkopf.log_achs_name Y\nkw.crosscomp.last_index 2\n"
+  const std::string isg = write_isg_cross(x_to_y(), 2, 1);
+  EXPECT_TRUE(
+      isg.starts_with("# ISG/TwinCAT CNC cross compensation of axis Y as a function of "
+                      "axis X, written by caldaq\n# TwinCAT CNC (ISG) cross"))
+      << isg;
+  EXPECT_NE(isg.find("# VERIFY BEFORE TRUSTING"), std::string::npos) << isg;  // sign not stated
+  EXPECT_EQ(isg.substr(isg.find("kopf.achs_nr")),
+            "kopf.achs_nr 2\nkopf.log_achs_name Y\nkw.crosscomp.last_index 2\n"
             "kw.crosscomp.master_ax_nr 1\nkw.crosscomp.unit 1\n"
             "kw.crosscomp.table[0].setpoint 0\nkw.crosscomp.table[0].correction 0\n"
             "kw.crosscomp.table[1].setpoint 1000000\nkw.crosscomp.table[1].correction 12\n"
@@ -67,13 +72,14 @@ TEST(CrossFormats, IsgCrossCompensation) {
   EXPECT_THROW(write_isg_cross(x_to_y(), 1, 1), InputError);
 }
 
-// HEIDENHAIN: one .COM per input axis, AXISPOS then a column per dependent axis.
+// HEIDENHAIN: one .COM per input axis, AXISPOS then a column per dependent axis. The columns
+// hold the error curve (comp_meaning.cpp): minus the corrections given.
 TEST(CrossFormats, HeidenhainComOfOneInputAxis) {
   const std::vector<CrossAxisTable> t{{"Y", "Y", -90.0, 5.0, {0.001, 0.0, -0.0015}},
                                       {"Y", "Z", -90.0, 5.0, {0.0, 0.002, 0.004}}};
   EXPECT_EQ(write_heidenhain_com(t),
-            "AXISPOS Y Z\n-90.0000 0.0010 0.0000\n-85.0000 0.0000 0.0020\n"
-            "-80.0000 -0.0015 0.0040\n");
+            "AXISPOS Y Z\n-90.0000 -0.0010 0.0000\n-85.0000 0.0000 -0.0020\n"
+            "-80.0000 0.0015 -0.0040\n");
   const std::vector<CrossAxisTable> mixed{{"Y", "Y", -90.0, 5.0, {0.0, 0.0}},
                                           {"X", "Z", -90.0, 5.0, {0.0, 0.0}}};
   EXPECT_THROW(write_heidenhain_com(mixed), InputError);
@@ -91,11 +97,17 @@ Table measured_axis() {
   return t;
 }
 
+// The same axis as errors (HEIDENHAIN's columns hold the error curve): 2 .. 6 um, each direction
+// -+ half the backlash: positive direction 0.000 .. 0.004, negative (BACKLASH) 0.004 .. 0.008.
 TEST(PositioningFormats, HeidenhainCom) {
-  EXPECT_EQ(write_heidenhain_com(measured_axis()),
-            "AXISPOS X BACKLASH\n0.0000 0.0000 -0.0040\n50.0000 -0.0010 -0.0050\n"
-            "100.0000 -0.0020 -0.0060\n150.0000 -0.0030 -0.0070\n200.0000 -0.0040 -0.0080\n");
-  Table um = measured_axis();
+  Table e = measured_axis();
+  e.spec.sign = Sign::error;
+  for (auto& v : e.forward) v = -v;
+  EXPECT_EQ(write_heidenhain_com(e),
+            "AXISPOS X BACKLASH\n0.0000 0.0000 0.0040\n50.0000 0.0010 0.0050\n"
+            "100.0000 0.0020 0.0060\n150.0000 0.0030 0.0070\n200.0000 0.0040 0.0080\n");
+  EXPECT_THROW(write_heidenhain_com(measured_axis()), InputError);  // corrections: refused
+  Table um = e;
   um.spec.units = Units::um;
   EXPECT_THROW(write_heidenhain_com(um), InputError);
 }

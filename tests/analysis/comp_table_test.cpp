@@ -120,27 +120,41 @@ TEST(CompTableWriters, LinuxCncType1) {
   EXPECT_THROW(write_linuxcnc(positioning(s, measured())), cal::InputError);
 }
 
+// SINUMERIK LEC values are the measured errors (comp_meaning.cpp: "A positive compensation value
+// causes the corresponding machine axis to move in the negative direction"): the bidirectional
+// mean 2 .. 6 um is written +0.0020 .. +0.0060 mm.
 TEST(CompTableWriters, SiemensLec) {
-  EXPECT_EQ(write_siemens(positioning(grid(), measured()), 1),
-            "; LEC for axis X (1), written by caldaq\n; backlash (MD32450) 0.0040 mm\nCHANDATA(1)\n"
-            "$AA_ENC_COMP[0,0,AX1]=-0.0020\n$AA_ENC_COMP[0,1,AX1]=-0.0030\n$AA_ENC_COMP[0,2,AX1]=-"
-            "0.0040\n"
-            "$AA_ENC_COMP[0,3,AX1]=-0.0050\n$AA_ENC_COMP[0,4,AX1]=-0.0060\n"
-            "$AA_ENC_COMP_STEP[0,AX1]=50.0000\n$AA_ENC_COMP_MIN[0,AX1]=0.0000\n"
-            "$AA_ENC_COMP_MAX[0,AX1]=200.0000\n$AA_ENC_COMP_IS_MODULO[0,AX1]=0\nM17\n");
+  auto s = grid();
+  s.sign = Sign::error;
+  const std::string out = write_siemens(positioning(s, measured()), 1);
+  EXPECT_TRUE(out.starts_with("; LEC for axis X (1), written by caldaq\n; SINUMERIK")) << out;
+  EXPECT_NE(out.find("; backlash (MD32450) 0.0040 mm\nCHANDATA(1)\n"
+                     "$AA_ENC_COMP[0,0,AX1]=0.0020\n$AA_ENC_COMP[0,1,AX1]=0.0030\n"
+                     "$AA_ENC_COMP[0,2,AX1]=0.0040\n$AA_ENC_COMP[0,3,AX1]=0.0050\n"
+                     "$AA_ENC_COMP[0,4,AX1]=0.0060\n$AA_ENC_COMP_STEP[0,AX1]=50.0000\n"
+                     "$AA_ENC_COMP_MIN[0,AX1]=0.0000\n$AA_ENC_COMP_MAX[0,AX1]=200.0000\n"
+                     "$AA_ENC_COMP_IS_MODULO[0,AX1]=0\nM17\n"),
+            std::string::npos)
+      << out;
+  // A table of corrections is refused: the sign is Siemens', not a choice.
+  EXPECT_THROW(write_siemens(positioning(grid(), measured()), 1), cal::InputError);
 }
 
+// ISG leadscrew lists hold errors (actual - set), per direction, in 0.1 um: forward (up)
+// 0, 1, 2, 3, 4 um, reverse (down) 4 .. 8 um from the single table +- half the backlash.
 TEST(CompTableWriters, IsgSsfk) {
-  // 0.1 um units: the interval 50 mm = 500000; forward corrections 0, -10, ... (0.1 um).
-  const std::string out = write_isg(positioning(grid(), measured()));
+  auto s = grid();
+  s.sign = Sign::error;
+  const std::string out = write_isg(positioning(s, measured()));
   EXPECT_NE(out.find("kw.ssfk.interval 500000\n"), std::string::npos) << out;
   EXPECT_NE(
       out.find(
-          "kw.ssfk.table[1].setpoint 500000\nkw.ssfk.table[1].pos -10\nkw.ssfk.table[1].neg -50\n"),
+          "kw.ssfk.table[1].setpoint 500000\nkw.ssfk.table[1].pos 10\nkw.ssfk.table[1].neg 50\n"),
       std::string::npos)
       << out;
-  EXPECT_NE(out.find("kw.ssfk.table[4].pos -40\nkw.ssfk.table[4].neg -80\n"), std::string::npos)
+  EXPECT_NE(out.find("kw.ssfk.table[4].pos 40\nkw.ssfk.table[4].neg 80\n"), std::string::npos)
       << out;
+  EXPECT_THROW(write_isg(positioning(grid(), measured())), cal::InputError);
 }
 
 // Issue 15: nothing non-finite, absurd or outside the table's syntax reaches a controller.
@@ -171,12 +185,15 @@ TEST(CompTable, RefusesWhatNoControllerTableCanHold) {
   t.forward[2] = std::numeric_limits<double>::infinity();
   EXPECT_THROW(write_csv(t), cal::InputError);
   EXPECT_THROW(write_linuxcnc(t), cal::InputError);
+  t.spec.sign = Sign::error;
   EXPECT_THROW(write_siemens(t), cal::InputError);
   EXPECT_THROW(write_isg(t), cal::InputError);
-  t = positioning(grid(), measured());
+  auto e = grid();
+  e.sign = Sign::error;
+  t = positioning(e, measured());
   t.spec.axis = "X\nM30";
   EXPECT_THROW(write_siemens(t), cal::InputError);
-  EXPECT_THROW(write_siemens(positioning(grid(), measured()), 0), cal::InputError);
+  EXPECT_THROW(write_siemens(positioning(e, measured()), 0), cal::InputError);
 }
 
 }  // namespace

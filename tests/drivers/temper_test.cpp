@@ -43,15 +43,34 @@ TEST(TemperCodec, GoldProbeMissingIsOutOfRangeNotATemperature) {
 
 TEST(TemperCodec, Ds75TwelveBitTwoSensors) {
   // Length 4: two sensors. 0x1780 = 6016 / 256 = 23.5 degC; 0xE840 = -6080 / 256 = -23.75 degC.
-  // Length 2 with the low nibble set: 0x190F -> 0x1900 = 6400 / 256 = 25.0 degC (12 bits).
+  // Length 2: 0x1900 = 6400 / 256 = 25.0 degC (12 bits).
   const auto d = codec_test::feed_whole(
       TemperCodec({.family = TemperFamily::ds75}),
-      report({0x80, 0x04, 0x17, 0x80, 0xE8, 0x40}) + report({0x80, 0x02, 0x19, 0x0F}));
+      report({0x80, 0x04, 0x17, 0x80, 0xE8, 0x40}) + report({0x80, 0x02, 0x19, 0x00}));
   ASSERT_EQ(d.frames.size(), 3u);
   EXPECT_DOUBLE_EQ(d.frames[0].temperature_degc, 23.5);
   EXPECT_EQ(d.frames[1].sensor, 1);
   EXPECT_DOUBLE_EQ(d.frames[1].temperature_degc, -23.75);
   EXPECT_DOUBLE_EQ(d.frames[2].temperature_degc, 25.0);
+}
+
+TEST(TemperCodec, Ds75RegistersThatCannotOccurAreNotTemperatures) {
+  // Issue 26: a TEMPer1F_V1.3 whose probe does not answer sends 80 04 ff ff ff ff 00 00
+  // (edorfaus/TEMPered#32). Masked to 0xFFF0 that was -16 / 256 = -0.0625 degC, a valid-looking
+  // material temperature ~20 K off. A DS75 register's low nibble is always 0, so 0x190F is no
+  // reading either. Neither may become a frame; each is an error with its reason.
+  TemperConfig v13{
+      .family = TemperFamily::ds75, .inner = false, .probe = true, .ds75_slots = {-1, 1}};
+  const auto a =
+      codec_test::feed_whole(TemperCodec(v13), report({0x80, 0x04, 0xff, 0xff, 0xff, 0xff}));
+  EXPECT_TRUE(a.frames.empty());
+  ASSERT_EQ(a.errors.size(), 1u);
+  EXPECT_NE(a.errors[0].description.find("did not answer"), std::string::npos);
+  const auto b = codec_test::feed_whole(TemperCodec({.family = TemperFamily::ds75}),
+                                        report({0x80, 0x02, 0x19, 0x0F}));
+  EXPECT_TRUE(b.frames.empty());
+  ASSERT_EQ(b.errors.size(), 1u);
+  EXPECT_NE(b.errors[0].description.find("19 0f cannot come from a DS75"), std::string::npos);
 }
 
 TEST(TemperCodec, TemperxTemperatureAndHumidity) {

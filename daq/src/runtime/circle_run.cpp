@@ -345,10 +345,14 @@ struct CircleRun::Impl {
                                        .settings_json = settings.dump(),
                                        .capture_path = setup.capture_path,
                                        .software_version = setup.software_version});
-    store->add_instrument({.run_id = outcome.run_id,
-                           .device = 3,
-                           .driver = "ballbar",
-                           .transport = setup.ballbar->describe()});
+    const auto origin = setup.origins.find("ballbar");
+    store->add_instrument(
+        {.run_id = outcome.run_id,
+         .device = 3,
+         .driver = "ballbar",
+         .transport = setup.ballbar->describe(),
+         .origin = origin == setup.origins.end() ? "" : origin->second.kind,
+         .origin_detail = origin == setup.origins.end() ? "" : origin->second.detail});
     writer = std::make_unique<cal::storage::BatchWriter>(
         setup.database, outcome.run_id, run_writer_options(io, setup.store_options),
         [this, alive = alive](const std::string& e) {

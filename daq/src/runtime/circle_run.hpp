@@ -13,6 +13,7 @@
 #include "cal/analysis/circle.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/daq/config.hpp"
+#include "origin.hpp"
 #include "cal/daq/gcode.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
@@ -115,6 +116,7 @@ struct CircleRunSetup {
   std::string context_json;
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
+  Origins origins;  // the ballbar's by its role (origin.hpp), stored with the run
   // The time the bar's calibration is looked up at (unix ms; 0: now). A replay decides the
   // calibration before (the original run's, or the newest), so that this lookup does nothing.
   std::int64_t calibration_at_unix_ms = 0;

@@ -268,11 +268,15 @@ struct LinearRun::Impl {
          .settings_json = settings_json(c, plan, setup.datum_mm, setup.context_json).dump(),
          .capture_path = setup.capture_path,
          .software_version = setup.software_version});
-    auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view driver) {
+    auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view role) {
+      const auto origin = setup.origins.find(std::string(role));
       store->add_instrument({.run_id = outcome.run_id,
                              .device = device,
-                             .driver = std::string(driver),
-                             .transport = i.describe()});
+                             .driver = std::string(role),
+                             .transport = i.describe(),
+                             .origin = origin == setup.origins.end() ? "" : origin->second.kind,
+                             .origin_detail =
+                                 origin == setup.origins.end() ? "" : origin->second.detail});
     };
     add(0, *setup.laser, "laser");
     add(1, *setup.air, "air");

@@ -21,6 +21,7 @@
 #include "cal/daq/sequencer.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
+#include "origin.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -95,6 +96,7 @@ struct LinearRunSetup {
   // A replay of a capture: the results record it, and the original run when it is known.
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
+  Origins origins;  // by role: stored with each instrument (origin.hpp)
   cal::storage::StoreOptions store_options;       // the run's and the writer's (tests: max_pages)
   std::function<void(const LiveState&)> on_live;  // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors

@@ -98,6 +98,7 @@ json to_json(const InstrumentSpec& s) {
   if (!s.serial_number.empty()) j["serial_number"] = s.serial_number;
   if (!s.certificate.empty()) j["certificate"] = s.certificate;
   if (!s.calibration_due.empty()) j["calibration_due"] = s.calibration_due;
+  j["origin"] = s.origin;
   return j;
 }
 
@@ -115,6 +116,8 @@ InstrumentSpec instrument_spec_from_json(const json& j) {
   s.serial_number = j.value("serial_number", "");
   s.certificate = j.value("certificate", "");
   s.calibration_due = j.value("calibration_due", "");
+  // Captures recorded before origins were stored do not say: not recorded, never "real".
+  s.origin = j.contains("origin") && j["origin"].is_string() ? j["origin"].get<std::string>() : "";
   s.options = cal::drivers::Options(d->options());
   if (const auto o = j.find("options"); o != j.end() && o->is_object()) {
     s.test_axis = j.value("test_axis", 0);

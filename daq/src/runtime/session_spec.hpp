@@ -26,6 +26,7 @@ struct InstrumentSpec {
   cal::drivers::Options options;  // the driver's options, every one with its value
   int test_axis = 0;              // the axis under test (0 X, 1 Y, 2 Z)
   std::string serial_number, certificate, calibration_due;  // the instrument's records
+  std::string origin = "real";  // or "simulated" (DeviceConfig::origin)
   cal::drivers::InstrumentContext context() const { return {role, test_axis}; }
 };
 

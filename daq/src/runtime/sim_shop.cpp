@@ -211,7 +211,8 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
   if (position_feed)
     position = fmt::format(
         "[devices.position]      # the control's commanded position\n"
-        "driver = \"shdr\"\ntransport = \"{}\"\nkey = \"Xcom\"\nrole = \"position\"\n\n",
+        "driver = \"shdr\"\ntransport = \"{}\"\nkey = \"Xcom\"\nrole = \"position\"\n"
+        "origin = \"simulated\"\n\n",
         impl_->position.transport());
   // The instruments of the shop's test besides the laser (kinds/kind.hpp), SIMULATED.
   const auto& m = impl_->test.measure;
@@ -225,7 +226,7 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
     return fmt::format(
         "[devices.{0}]{1:<{2}}# SIMULATED {3}\n"
         "driver = \"gauge\"\ntransport = \"serial {4} 9600 8N1\"\nrequest = \"?\\r\"\n"
-        "{5}role = \"{0}\"\npoll_s = {6}\n\n",
+        "{5}role = \"{0}\"\npoll_s = {6}\norigin = \"simulated\"\n\n",
         role, "", 14 - role.size(), what, path, unit_and_range, 4 * laser_poll_s);
   };
   if (m.kind == "straightness")
@@ -239,12 +240,14 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
 driver = "ids3010"
 transport = "{laser}"
 role = "laser"
+origin = "simulated"
 poll_s = {laser_poll}
 {axes}{laser_sn}
 [devices.air]
 driver = "ptu300"
 transport = "{air}"
 role = "air"
+origin = "simulated"
 {air_sn}
 [devices.material]
 driver = "gauge"
@@ -252,6 +255,7 @@ transport = "serial {material} 9600 8N1"
 request = "?\r"
 unit = "degC"
 role = "material"
+origin = "simulated"
 {material_sn}
 {position}{probe}[devices.ballbar]
 driver = "gauge"
@@ -260,6 +264,7 @@ unit = "mm"
 min_si = -0.1           # the bar's travel: +/- 100 mm about its zero length
 max_si = 0.1
 role = "ballbar"
+origin = "simulated"
 {ballbar_sn})TOML",
       fmt::arg("laser_sn", serial("SIM-IDS-0001")), fmt::arg("air_sn", serial("SIM-PTU-0001")),
       fmt::arg("material_sn", serial("SIM-TH-0001")), fmt::arg("ballbar_sn", serial("SIM-BB-0001")),

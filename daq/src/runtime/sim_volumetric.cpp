@@ -186,6 +186,8 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   };
   LinearRunSetup setup;
   setup.config = c;
+  for (const char* role : {"laser", "air", "material", "indicator", "level"})
+    setup.origins[role] = {"simulated", "a twin of the built-in simulated shop (volumetric)"};
   setup.database = a.database;
   setup.store_options = a.store_options;
   d::Ids3010Options ids;

@@ -682,6 +682,14 @@ class Service {
     return r;
   }
 
+  // With --simulate every instrument is a twin of the shop, whatever a set-up applied from the
+  // page says of its devices: stored so, no renaming can make the run pass for a real one.
+  void mark_simulated(Origins& origins) const {
+    if (!o_.simulate) return;
+    for (auto& [role, origin] : origins)
+      origin = {"simulated", "a twin of the built-in simulated shop (daq serve --simulate)"};
+  }
+
   void start_linear() {
     const auto specs = linear_specs(config_);
     const auto path = capture_path();
@@ -692,6 +700,7 @@ class Service {
     setup.database = database_path(o_.run.db);
     setup.capture_path = capture_->absolute_path(path);
     add_linear_instruments(io_, config_, specs, run_options(), capture_->recorder.get(), setup);
+    mark_simulated(setup.origins);
     setup.on_live = [this](const LiveState& s) { run_live_ = to_json_text(s); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     linear_ = std::make_unique<LinearRun>(io_, std::move(setup));
@@ -717,7 +726,9 @@ class Service {
         .ballbar = options.wrap(dc, make_instrument(io_, specs[0], make_transport(io_, dc),
                                                     instrument_options(dc, specs[0], options,
                                                                        capture_->recorder.get()))),
-        .capture_path = capture_->absolute_path(path)};
+        .capture_path = capture_->absolute_path(path),
+        .origins = {{"ballbar", origin_of(specs[0].origin, "")}}};
+    mark_simulated(setup.origins);
     setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));

@@ -326,6 +326,8 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   if (!d.role.empty())
     one_of(t, "role", d.role,
            {"laser", "air", "material", "ballbar", "position", "indicator", "level"});
+  t.read("origin", d.origin);
+  one_of(t, "origin", d.origin, {"real", "simulated"});
   t.read("serial_number", d.serial_number);
   t.read("certificate", d.certificate);
   t.read("calibration_due", d.calibration_due);

@@ -45,7 +45,8 @@ std::vector<CrossAxisTable> from_model(const volcomp::CrossTables& t, double res
                                        bool skip_zero);
 // The model's own-axis table of `axis` as a positioning Table (correction sign, mm, absolute,
 // one table without backlash) for the per-axis formats.
-Table own_axis_table(const volcomp::CrossTables& t, kinematics::Axis axis, double resolution_mm);
+Table own_axis_table(const volcomp::CrossTables& t, kinematics::Axis axis, double resolution_mm,
+                     Sign sign = Sign::correction);
 // A straightness run (deviation of `output` in um along `input`) as the correction table of
 // `output` over the grid (interpolated; the slope kept unless remove_slope): the fix of
 // `daq compensate --straightness`, which belongs in a cross-axis table, not in the input axis's
@@ -105,6 +106,20 @@ struct FanucOptions {
   int max_step = 127;            // largest |value| per point accepted
 };
 std::string write_fanuc_pitch(const Table& t, const FanucOptions& o);
+// What the FANUC table holds: the point of the reference position and, per point, the step in
+// units of detection unit x magnification (what write_fanuc_pitch lists). The absolute
+// correction is the steps summed from the reference position, so it is zero there: a constant
+// in the correction at the reference position is not in the table (it stays in the residual).
+struct FanucSteps {
+  std::size_t reference_index = 0;
+  double unit_um = 1.0;          // detection unit x magnification
+  std::vector<long long> steps;  // steps[0] = 0 (the farthest negative point)
+};
+FanucSteps fanuc_steps(const Table& t, const FanucOptions& o);
+// The correction the control applies at each grid point from those steps (um, both directions
+// alike: the bidirectional option is not written). Between points linear: how FANUC spreads a
+// step over its section is not in the pages read (at most one step per section).
+Applied fanuc_applied(const Table& t, const FanucOptions& o);
 
 // LinuxCNC matrixkins (HAL component, LinuxCNC 2.9+: X_joint = C_xx X + C_xy Y + C_xz Z, ...):
 // setp lines for the squareness corrections on their carriers (E_C0Y by Y: C_xy = +E_C0Y;

@@ -13,7 +13,10 @@
 
 namespace cal::comptable {
 
-enum class Sign { correction, error };  // correction = -error (what the control adds)
+// What a table's values are: the correction (-error, what the control adds to the position) or
+// the measured error (measured - target). Each controller format has its vendor's own
+// (comp_meaning.hpp); only caldaq's CSV lets the user choose.
+enum class Sign { correction, error };
 
 // Bounds of a table (see positioning()): a grid within +-100 m of at most 100 000 points.
 inline constexpr double max_position_mm = 100'000;
@@ -62,10 +65,39 @@ Table cross(const Spec& spec, std::span<const double> position_mm,
 std::string units_name(Units u);
 Units units_from_string(const std::string& s);
 
-// Writers.
+// A number in fixed notation with `decimals` places, rounded, never "-0.000" (a controller or a
+// reader could take the sign for a direction).
+std::string fixed(double v, int decimals);
+
+// Writers. Each refuses a table whose sign is not its format's (comp_meaning.hpp: LinuxCNC
+// corrections; SINUMERIK LEC and the ISG list errors); every value in fixed notation, no -0.
 std::string write_csv(const Table& t);       // caldaq comp-table CSV (documented columns)
 std::string write_linuxcnc(const Table& t);  // LinuxCNC COMP_FILE, COMP_FILE_TYPE = 1
 std::string write_siemens(const Table& t, int axis_number = 1);  // 840D LEC, $AA_ENC_COMP
 std::string write_isg(const Table& t);  // Beckhoff TwinCAT CNC / ISG SSFK list
+
+// What a written table does on the machine: the correction the control adds (um) at each grid
+// point moving in the positive (forward) and negative (reverse) direction, computed from the
+// values as written (rounded, in the format's sign and units, increments summed), so that a
+// residual computed with it is what the file leaves, not what was meant. backlash_in_table:
+// the format carries both directions (LinuxCNC, the ISG list, HEIDENHAIN's BACKLASH column);
+// else both directions get the one table and the reversal is left to the control's backlash
+// parameter (it then shows in the residual).
+struct Applied {
+  std::vector<double> position_mm, forward_um, reverse_um;
+};
+Applied applied(const Table& t, bool backlash_in_table);
+// The correction at x (um): linear between grid points, the end values held beyond them (as
+// the controls named here do outside a table).
+double correction_at_um(const std::vector<double>& position_mm, const std::vector<double>& um,
+                        double x_mm);
+
+// Per target: what the measured mean deviations become with the applied table (um), and the
+// largest before and after.
+struct PredictedResidual {
+  std::vector<double> target_mm, before_up_um, before_down_um, up_um, down_um;
+  double before_max_um = 0.0, after_max_um = 0.0;
+};
+PredictedResidual predict(const Applied& a, std::span<const iso230_2::TargetStats> targets);
 
 }  // namespace cal::comptable

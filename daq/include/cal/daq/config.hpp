@@ -28,6 +28,10 @@ struct DeviceConfig {
   std::string certificate;        // calibration certificate number
   std::string calibration_due;    // ISO 8601 date, YYYY-MM-DD (checked to be a real date)
   cal::drivers::Options options;  // the driver's own keys, every one with its value
+  // "real", or "simulated" for a twin of the built-in simulated shop (`daq sim` and `daq serve
+  // --simulate` write it): stored with each run so that nothing derived from it can pass for a
+  // measurement of a real machine (docs/storage.md, "Origin").
+  std::string origin = "real";
 };
 
 enum class StalePolicy { fallback, stop };

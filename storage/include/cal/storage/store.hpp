@@ -28,8 +28,9 @@ class StoreError : public std::runtime_error {
 
 // 1: the first schema. 2: results carry their provenance; missed stops; the runs' time origin.
 // 3: reading chunks carry an encoding, a sequence number in their run and a checksum
-// (docs/storage.md). 4: ballbar calibrations (issue 18).
-inline constexpr int schema_version = 4;
+// (docs/storage.md). 4: ballbar calibrations (issue 18). 5: the instruments' origin (real,
+// simulated, replay) and the compensation tables written, with their predicted residual.
+inline constexpr int schema_version = 5;
 
 enum class RunStatus { running, complete, incomplete, aborted };
 std::string_view to_string(RunStatus s);
@@ -65,6 +66,24 @@ struct InstrumentRecord {
   std::string driver;     // "ids3010", "ptu300", ...
   std::string transport;  // "tcp 192.168.1.5:9090", "serial /dev/ttyUSB0 4800 7E1"
   std::string settings_json = "{}";
+  // Where the readings came from: "real" (a device), "simulated" (a twin of the simulated
+  // shop), "replay" (a capture pushed through the driver again), "imported" (a file of another
+  // tool), "" (not recorded: stored before schema 5). origin_detail says which capture, which
+  // simulated shop, which file.
+  std::string origin;
+  std::string origin_detail;
+};
+// A compensation table written for the controller (daq compensate, daq model compensate), kept
+// so that the next measurement of the axis can be compared with what it was predicted to leave.
+struct CompensationRecord {
+  std::int64_t id = 0;  // set when stored
+  std::int64_t machine_id = 0;
+  std::int64_t source_run_id = 0;  // 0: from a model or a file
+  std::string source;              // e.g. "run 7", "model yfxz.json"
+  std::string axis;
+  std::string format;
+  std::int64_t created_unix_ms = 0;  // 0: now
+  std::string json;                  // caldaq.compensation.v1 (docs/compensation-tables.md)
 };
 
 // One raw reading (the storage's own POD, so storage does not depend on drivers).
@@ -260,6 +279,11 @@ class Store {
   std::optional<BarCalibration> bar_calibration(std::string_view bar, double nominal_mm,
                                                 std::int64_t at_unix_ms) const;
 
+  // Compensation tables written (returns the new id), and those of a machine's axis, oldest
+  // first (machine_id 0 / axis "": any).
+  std::int64_t add_compensation(const CompensationRecord& c);
+  std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
+                                                std::string_view axis = {}) const;
   struct Impl;  // implementation, shared with ReadingStream (store.cpp)
 
  private:

@@ -1,0 +1,84 @@
+// daq verify: the as-left run of an axis against the compensation table written before it.
+#include <fmt/format.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "cal/analysis/error.hpp"
+#include "commands.hpp"
+#include "compensation/compensation_check.hpp"
+#include "database.hpp"
+
+namespace daq {
+namespace {
+
+struct VerifyOptions {
+  std::string db, corrected;
+  std::int64_t run = 0;
+  std::optional<std::int64_t> compensation;
+  bool json = false, list = false;
+};
+
+void list_compensations(const cal::storage::Store& store) {
+  const auto all = store.compensations();
+  if (all.empty())
+    fmt::print("no compensation tables stored (daq compensate --run RUN stores one)\n");
+  for (const auto& c : all)
+    fmt::print("compensation {}: axis {}, {} from {}, machine {}\n", c.id, c.axis, c.format,
+               c.source, c.machine_id);
+}
+
+void run(const VerifyOptions& o) {
+  const auto store = open_database_read_only(o.db);
+  if (o.list) return list_compensations(store);
+  if (o.run == 0) throw cal::InputError("verify: give the as-left RUN (or --list)");
+  const auto check = check_run(store, o.run, o.compensation);
+  if (!check)
+    throw cal::InputError(fmt::format(
+        "{}: run {}: no compensation of its axis on its machine was stored before it (or none "
+        "of its stops lies where the table was made): nothing to verify",
+        store.path().string(), o.run));
+  if (o.json) {
+    auto j = to_json(*check);
+    j["schema"] = "caldaq.verification.v1";
+    j["run"] = o.run;
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("run {}: {}\n", o.run, loop_text(*check));
+    const auto& v = check->verification;
+    fmt::print(
+        "  largest |deviation|: predicted {:.3f} um, measured {:.3f} um ({} points; "
+        "agreement within {:.3f} um rms, found {:.3f})\n",
+        v.predicted_max_um, v.measured_max_um, check->points, v.tolerance_um, v.mismatch_rms_um);
+  }
+  if (o.corrected.empty()) return;
+  const std::string text = corrected_table(*check);
+  std::ofstream out(o.corrected, std::ios::binary);
+  if (!(out << text) || !(out.close(), out))
+    throw cal::InputError(fmt::format("{}: cannot write the corrected table", o.corrected));
+  fmt::print(stderr, "written {}: the corrected table ({})\n", o.corrected,
+             check->compensation.format);
+}
+
+}  // namespace
+
+void add_verify_command(CLI::App& app) {
+  auto o = std::make_shared<VerifyOptions>();
+  auto* cmd = app.add_subcommand(
+      "verify",
+      "Compare an as-left run with the compensation table written before it: as predicted, or "
+      "an inverted sign, a unit or a reference-point error (docs/compensation-tables.md)");
+  cmd->add_option("run", o->run, "The as-left run (measured with the table loaded)");
+  add_db_option(*cmd, o->db);
+  cmd->add_option("--compensation", o->compensation,
+                  "The stored compensation to compare with (default: the newest of the run's "
+                  "machine and axis stored before the run)");
+  cmd->add_option("--corrected", o->corrected,
+                  "Write the table corrected for what was found (sign, units, reference point)");
+  cmd->add_flag("--list", o->list, "List the stored compensation tables");
+  cmd->add_flag("--json", o->json, "Print caldaq.verification.v1 JSON");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace daq

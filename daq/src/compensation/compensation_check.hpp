@@ -1,0 +1,52 @@
+#pragma once
+// The compensation loop at the machine (docs/compensation-tables.md, "Verification"): a table
+// written from a run is stored with what it was predicted to leave; the next run of the same
+// axis on the same machine is compared with that prediction (cal/analysis/comp_verify.hpp),
+// and a table that the control applied otherwise than meant is diagnosed (sign, units,
+// reference point) with the corrected table on offer.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "cal/analysis/comp_formats.hpp"
+#include "cal/analysis/comp_table.hpp"
+#include "cal/analysis/comp_verify.hpp"
+#include "cal/storage/store.hpp"
+
+namespace daq {
+
+// How a positioning table is written in a format (the options a writer takes besides the
+// table), stored with the compensation so that a corrected table can be written the same way.
+struct TableWriter {
+  std::string format;  // csv, linuxcnc, siemens, isg, heidenhain, fanuc
+  int axis_number = 1;
+  cal::comptable::FanucOptions fanuc;
+};
+nlohmann::json to_json(const TableWriter& w);
+TableWriter table_writer_from_json(const nlohmann::json& j);
+// The file's text; throws cal::InputError for an unknown format (naming the known ones).
+std::string write_table(const TableWriter& w, const cal::comptable::Table& t);
+// What the written table does on the machine (comp_table.hpp, Applied).
+cal::comptable::Applied applied_of(const TableWriter& w, const cal::comptable::Table& t);
+
+struct LoopCheck {
+  cal::storage::CompensationRecord compensation;  // the table the as-left run is checked against
+  cal::comptable::Verification verification;
+  std::size_t points = 0;  // targets and directions compared
+};
+// The newest compensation stored for the run's machine and axis before the run started (or the
+// one given), checked against the run's captured stops. nullopt when there is none, or the run
+// has no stops where the table was made; cal::InputError for a given id that does not exist or
+// is of another axis.
+std::optional<LoopCheck> check_run(const cal::storage::Store& store, std::int64_t run_id,
+                                   std::optional<std::int64_t> compensation_id = std::nullopt);
+// The table with the finding's fix applied (negated, rescaled, offset, shifted), in the
+// compensation's format; cal::InputError when there is nothing to correct (as predicted, too
+// small, unexplained) or the format cannot hold the fix (FANUC's constant).
+std::string corrected_table(const LoopCheck& c);
+nlohmann::json to_json(const LoopCheck& c);
+// A line or two for the terminal: the finding and what to do.
+std::string loop_text(const LoopCheck& c);
+
+}  // namespace daq

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Issue 26, the compensation loop on the simulated shop (a known truth): measure X, write a
+# SINUMERIK LEC table (stored with the run), let the simulated control load it as Siemens states
+# ("A positive compensation value causes the corresponding machine axis to move in the negative
+# direction") and measure again: daq verify finds the residual as predicted. A control that
+# reads the table with the other sign doubles the error, and daq verify says so and writes the
+# corrected table, which that control then applies as predicted.
+# Usage: compensation_loop_test.sh DAQ_BINARY
+set -u
+DAQ=$1
+source "$(dirname "$0")/check.sh"
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+DB=$T/loop.sqlite
+demo() { "$DAQ" demo --db "$DB" --capture "$T/c$1.cdq" --linear-only --quiet "${@:2}"; }
+G=(--start-mm 0 --interval-mm 50 --points 11 --outside hold)
+check measure 0 "run 1 stored" -- demo 1
+check table 0 "stored as compensation 1" -- "$DAQ" compensate --run 1 --db "$DB" -f siemens "${G[@]}" -o "$T/lec.mpf"
+check table_value 0 '^\$AA_ENC_COMP\[0,10,AX1\]=0\.0' -- cat "$T/lec.mpf"
+check as_siemens 0 "run 2 stored" -- demo 2 --control-table "$T/lec.mpf" --control-format siemens
+check verify_ok 0 "compensation 1 \(siemens, run 1 of axis X\): as predicted" -- "$DAQ" verify 2 --db "$DB"
+check as_inverted 0 "run 3 stored" -- demo 3 --control-table "$T/lec.mpf" --control-format siemens --control-inverted
+check verify_inverted 0 "inverted sign: the error got about twice as large" -- "$DAQ" verify 3 --db "$DB" --corrected "$T/fixed.mpf"
+check verify_json 0 '"finding": "inverted sign"' -- "$DAQ" verify 3 --db "$DB" --json
+# The corrected table holds the values negated; the control that reads them the other way then
+# removes the error as predicted.
+check fixed_value 0 '^\$AA_ENC_COMP\[0,10,AX1\]=-0\.0' -- cat "$T/fixed.mpf"
+check as_fixed 0 "run 4 stored" -- demo 4 --control-table "$T/fixed.mpf" --control-format siemens --control-inverted
+check verify_fixed 0 ": as predicted" -- "$DAQ" verify 4 --db "$DB"
+check none_before 2 "no compensation of its axis on its machine was stored before it" -- "$DAQ" verify 1 --db "$DB"
+check list 0 "^compensation 1: axis X, siemens from run 1" -- "$DAQ" verify --list --db "$DB"
+finish
