@@ -32,7 +32,7 @@ constexpr FormatMeaning kMeanings[] = {
     {"siemens", "SINUMERIK leadscrew / measuring system error compensation (LEC, $AA_ENC_COMP)",
      Sign::error,
      "the value modifies the position actual value; a positive value moves the axis in the "
-     "negative direction, so the value is the measured error (measured - target)",
+     "negative direction",
      "machine axis positions, absolute per point ($AA_ENC_COMP_MIN .. _MAX); Siemens advises "
      "zero at the reference point", Evidence::stated,
      "SINUMERIK 840D sl/828D function manual Extended Functions 03/2013 (6FC5397-1BP40-3BA1) "

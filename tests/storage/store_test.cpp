@@ -427,6 +427,55 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 // A database at the version before the ballbar calibrations (the previous schema with a run in
 // it): opened, it gains the table by the last migration, keeps its run, and stores a
 // calibration.
+// What schema 5 added (origins, compensations), taken off a new file to make a version 4 one.
+constexpr const char* kUndoSchema5 =
+    "DROP INDEX compensations_by_machine; DROP TABLE compensations; "
+    "ALTER TABLE instruments DROP COLUMN origin; ALTER TABLE instruments DROP COLUMN "
+    "origin_detail; ";
+
+// Issue 26: the instruments' origin and the compensations written. A version 4 database reads
+// read-only as not recorded / none, and the next writing open migrates it.
+TEST(Store, OriginsAndCompensationsAndTheVersionBefore) {
+  TempDir dir;
+  const auto file = dir.path / "v4.sqlite";
+  std::int64_t run = 0;
+  {
+    Store store(file);
+    run = a_run(store);
+    store.add_instrument({.run_id = run, .device = 7, .driver = "laser", .transport = "tcp x",
+                          .origin = "simulated", .origin_detail = "a twin"});
+    const auto id = store.add_compensation(
+        {.machine_id = 0, .source_run_id = run, .source = "run 1", .axis = "X",
+         .format = "siemens", .json = "{}"});
+    const auto all = store.compensations(0, "X");
+    ASSERT_EQ(all.size(), 1u);
+    EXPECT_EQ(all[0].id, id);
+    EXPECT_EQ(all[0].source_run_id, run);
+    EXPECT_TRUE(store.compensations(0, "Y").empty());
+    const auto inst = store.instruments(run);
+    ASSERT_FALSE(inst.empty());
+    EXPECT_EQ(inst.back().origin, "simulated");
+    EXPECT_EQ(inst.back().origin_detail, "a twin");
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    const auto undo = std::string(kUndoSchema5) + "PRAGMA user_version = 4;";
+    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 4);
+    EXPECT_TRUE(ro.compensations().empty());
+    EXPECT_EQ(ro.instruments(run).back().origin, "");  // not recorded, never "real"
+  }
+  Store rw(file);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
+  EXPECT_EQ(rw.instruments(run).back().origin, "");
+  EXPECT_TRUE(rw.compensations().empty());
+}
+
 TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
   TempDir dir;
   const auto file = dir.path / "prev.sqlite";
@@ -439,9 +488,9 @@ TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
     const auto undo =
+        std::string(kUndoSchema5) +
         "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
-        "PRAGMA user_version = " +
-        std::to_string(cal::storage::schema_version - 1) + ";";
+        "PRAGMA user_version = 3;";
     ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
     sqlite3_close(db);
   }
@@ -468,9 +517,9 @@ TEST(Store, ReadOnlyThePreviousVersionHasNoBallbarCalibrations) {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
     const auto undo =
+        std::string(kUndoSchema5) +
         "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
-        "PRAGMA user_version = " +
-        std::to_string(cal::storage::schema_version - 1) + ";";
+        "PRAGMA user_version = 3;";
     ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
     sqlite3_close(db);
   }
