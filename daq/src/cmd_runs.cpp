@@ -20,6 +20,7 @@
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "commands.hpp"
+#include "compensation/compensation_check.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "provenance.hpp"
@@ -153,9 +154,18 @@ json run_document(const st::Store& store, std::int64_t id) {
   j["schema"] = "caldaq.run.v1";
   j["readings"] = store.reading_count(id);
   j["instruments"] = json::array();
-  for (const auto& i : store.instruments(id))
-    j["instruments"].push_back(
-        {{"device", i.device}, {"driver", i.driver}, {"transport", i.transport}});
+  const auto instruments = store.instruments(id);
+  for (const auto& i : instruments)
+    j["instruments"].push_back({{"device", i.device},
+                                {"driver", i.driver},
+                                {"transport", i.transport},
+                                {"origin", i.origin},
+                                {"origin_detail", i.origin_detail}});
+  const std::string machine = [&] {
+    const auto m = store.machine(r.machine_id);
+    return m ? m->name : std::string{};
+  }();
+  j["origin"] = to_json(run_origin(r, instruments, machine));
   j["targets"] = store.targets(id).size();
   const auto missed = store.missed_stops(id);
   j["missed_stops"] = json::array();
@@ -198,6 +208,17 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     fmt::print("  device {}: {} on {}\n", i["device"].get<int>(), i["driver"].get<std::string>(),
                i["transport"].get<std::string>());
   if (!r.capture_path.empty()) fmt::print("  capture: {}\n", r.capture_path);
+  if (const auto& origin = j["origin"]; !origin["label"].get<std::string>().empty())
+    fmt::print("  {}: {}\n", origin["label"].get<std::string>(), origin["text"].get<std::string>());
+  else if (!origin["recorded"].get<bool>())
+    fmt::print("  origin: {}\n", origin["text"].get<std::string>());
+  if (r.kind == "linear") {
+    try {
+      if (const auto check = check_run(store, id)) fmt::print("  {}\n", loop_text(*check));
+    } catch (const cal::InputError& e) {
+      fmt::print("  compensation check: {}\n", e.what());
+    }
+  }
   if (j["results"].empty()) fmt::print("  no results stored\n");
   for (const auto& res : j["results"]) {
     const bool current = res["current"].get<bool>();
@@ -452,6 +473,10 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
                  std::FILE* out) {
   json j = run_json(run);
   j["schema"] = "caldaq.export.v1";
+  {
+    const auto m = store.machine(run.machine_id);
+    j["origin"] = to_json(run_origin(run, store.instruments(run.id), m ? m->name : ""));
+  }
   ExportClock clock(store, run, settings);
   std::map<int, std::string> names;  // JSON strings, quoted and escaped
   for (const auto& [device, name] : device_names(store, run.id)) names[device] = json(name).dump();

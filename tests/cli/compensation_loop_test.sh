@@ -29,4 +29,21 @@ check as_fixed 0 "run 4 stored" -- demo 4 --control-table "$T/fixed.mpf" --contr
 check verify_fixed 0 ": as predicted" -- "$DAQ" verify 4 --db "$DB"
 check none_before 2 "no compensation of its axis on its machine was stored before it" -- "$DAQ" verify 1 --db "$DB"
 check list 0 "^compensation 1: axis X, siemens from run 1" -- "$DAQ" verify --list --db "$DB"
+# A simulated run renamed to look real (machine, campaign, every instrument's transport) keeps
+# its SIMULATED banner in the report, show and the export: the origin is stored, not read from
+# names (before, the banner went with the word "simulated").
+"$PY" - "$DB" <<'PYEOF'
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+db.execute("UPDATE machines SET name = 'Customer Mill 7'")
+db.execute("UPDATE runs SET campaign = 'annual calibration'")
+db.execute("UPDATE instruments SET transport = 'tcp 192.0.2.5:9090'")
+db.commit()
+PYEOF
+check renamed_show 0 "^  SIMULATED: laser simulated" -- "$DAQ" show 1 --db "$DB"
+check renamed_report 0 "report of run 1 written" -- "$DAQ" report 1 --db "$DB" -o "$T/r1.html"
+check renamed_banner 0 "<strong>SIMULATED</strong>: this run was made on the simulated" -- cat "$T/r1.html"
+check renamed_title 0 "<h1>SIMULATED — Run 1" -- cat "$T/r1.html"
+check renamed_export 0 '"label": "SIMULATED"' -- "$DAQ" export 1 --db "$DB" --format json
+check renamed_json 0 '"simulated": true' -- "$DAQ" show 1 --db "$DB" --json
 finish

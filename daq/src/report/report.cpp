@@ -20,6 +20,7 @@
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "compensation/compensation_check.hpp"
 #include "iso230_2_output.hpp"
 #include "plot.hpp"
 #include "provenance.hpp"
@@ -208,7 +209,10 @@ std::string run_title(const RunView& v) {
                            : v.run.kind == "circle"  ? "Circular test (ISO 230-4, ballbar)"
                            : v.run.kind == "dynamic" ? "Dynamic capture"
                                                      : v.run.kind + " test";
-  return fmt::format("Run {}: {}, axis {}", v.run.id, what, v.run.axis);
+  // The origin leads the title, so it is on every printed page's running header too.
+  const auto label = ::daq::run_origin(v.run, v.instruments, v.machine).label();
+  return fmt::format("{}Run {}: {}, axis {}", label.empty() ? "" : label + " — ", v.run.id, what,
+                     v.run.axis);
 }
 
 // A setting as an engineer reads it: strings without quotes, numbers without binary noise
@@ -1105,20 +1109,44 @@ std::string who_of(const RunView& v) {
   return customer.empty() ? v.machine : customer + " — " + v.machine;
 }
 
-bool simulated(const RunView& v) {
-  const auto has = [](std::string_view s) {
-    return s.find("SIMULATED") != std::string::npos || s.find("simulated") != std::string::npos;
-  };
-  if (has(v.machine) || has(v.run.campaign)) return true;
-  return std::any_of(v.instruments.begin(), v.instruments.end(),
-                     [&](const auto& i) { return has(i.driver) || has(i.transport); });
+// Where the readings came from, stored with the run (provenance.hpp, run_origin): a simulated,
+// replayed or imported run says so first, whatever its names; a run stored before origins were
+// recorded says that too.
+std::string origin_banner(const RunView& v) {
+  const auto o = ::daq::run_origin(v.run, v.instruments, v.machine);
+  std::string h;
+  if (o.simulated)
+    h += "<p class=\"simulated\"><strong>SIMULATED</strong>: this run was made on the simulated "
+         "machine and instruments: the numbers show what the software measures, not a real "
+         "machine.</p>\n";
+  if (o.replayed)
+    h += "<p class=\"simulated\"><strong>REPLAYED</strong>: these readings were pushed through "
+         "the drivers again from a recorded capture, not measured now.</p>\n";
+  if (o.imported)
+    h += "<p class=\"simulated\"><strong>IMPORTED</strong> from another tool's file.</p>\n";
+  if (!o.label().empty() || o.unrecorded)
+    h += "<p class=\"note\">Origin of the readings: " + esc(o.text) + ".</p>\n";
+  return h;
+}
+
+// The as-left check of a compensation written before this run (compensation_check.hpp).
+std::string compensation_check(const st::Store& store, const RunView& v) {
+  if (v.run.kind != "linear") return "";
+  std::optional<::daq::LoopCheck> c;
+  try {
+    c = ::daq::check_run(store, v.run.id);
+  } catch (const std::exception& e) {
+    return "<p class=\"warning\">Compensation check: " + esc(e.what()) + "</p>\n";
+  }
+  if (!c) return "";
+  const bool ok = c->verification.finding == cal::comptable::Finding::as_predicted;
+  return fmt::format(
+      "<p class=\"verdict {}\"><strong>Compensation check</strong>: {}</p>\n", ok ? "pass" : "fail",
+      esc(::daq::loop_text(*c)));
 }
 
 std::string run_body(const st::Store& store, const RunView& v, const Options& o, Headline& hl) {
-  std::string h;
-  if (simulated(v))
-    h += "<p class=\"simulated\">This run was made on the <strong>simulated</strong> machine "
-         "and instruments: the numbers show what the software measures, not a real machine.</p>\n";
+  std::string h = origin_banner(v) + compensation_check(store, v);
   if (v.run.status != st::RunStatus::complete) {
     h += fmt::format(
         "<p class=\"warning\">This run is {}{}: the results cover only what was "
