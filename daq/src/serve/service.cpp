@@ -26,6 +26,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
+#include "cal/daq/gcode.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
@@ -101,23 +102,22 @@ std::optional<json> setup_body(const std::string& body, std::initializer_list<co
   return req["setup"];
 }
 
-// A field of a request that is one of `choices` (a string), or `fallback` when absent; a
-// value of another type or not among the choices is refused naming the field.
-std::optional<std::string> choice(const json& req, const char* key,
-                                  std::initializer_list<const char*> choices, const char* fallback,
-                                  std::string& why) {
+// A string field of a request, or `fallback` when absent; a value of another type, or one
+// `valid` refuses (cal::InputError), is refused naming the field.
+template <typename Check>
+std::optional<std::string> string_field(const json& req, const char* key, const char* fallback,
+                                        Check valid, std::string& why) {
   const auto it = req.find(key);
   if (it == req.end()) return fallback;
-  std::string list;
-  for (const char* c : choices) list += fmt::format("{}\"{}\"", list.empty() ? "" : ", ", c);
   if (!it->is_string()) {
-    why = fmt::format("\"{}\" must be a string, one of {}; not {}", key, list, it->type_name());
+    why = fmt::format("\"{}\" must be a string, not {}", key, it->type_name());
     return std::nullopt;
   }
   const auto value = it->get<std::string>();
-  if (std::none_of(choices.begin(), choices.end(), [&](const char* c) { return value == c; })) {
-    why = fmt::format("\"{}\": '{}' is not one of {}", key,
-                      json(value).dump(-1, ' ', false, json::error_handler_t::replace), list);
+  try {
+    valid(value);
+  } catch (const cal::InputError& e) {
+    why = fmt::format("\"{}\": {}", key, e.what());
     return std::nullopt;
   }
   return value;
@@ -398,9 +398,17 @@ class Service {
     const auto setup = setup_body(body, {"test", "dialect"}, why);
     if (!setup) return error(400, why);
     const auto req = json::parse(body);
-    const auto test = choice(req, "test", {"linear", "circle"}, "linear", why);
+    const auto test = string_field(
+        req, "test", "linear",
+        [](const std::string& t) {
+          if (t != "linear" && t != "circle")
+            throw cal::InputError(fmt::format("no test '{}': give \"linear\" or \"circle\"", t));
+        },
+        why);
     if (!test) return error(400, why);
-    const auto dialect = choice(req, "dialect", {"fanuc", "heidenhain", "siemens"}, "fanuc", why);
+    const auto dialect = string_field(
+        req, "dialect", "fanuc", [](const std::string& d) { cal::daq::dialect_from_string(d); },
+        why);
     if (!dialect) return error(400, why);
     const auto check = check_setup(*setup);
     if (!check.config) return error(400, "the set-up has problems: fix them first", to_json(check));
