@@ -105,7 +105,7 @@ std::string page_policy(std::string_view nonce) {
   // The page's own script (by its nonce) and nothing else; its style is inline; it talks to
   // its own server only (fetch and the WebSocket); nothing may frame it.
   return "default-src 'none'; script-src 'nonce-" + std::string(nonce) +
-         "'; style-src 'unsafe-inline'; img-src data: blob:; connect-src 'self'; "
+         "'; style-src 'unsafe-inline'; img-src data: blob:; connect-src 'self' blob:; "
          "base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 }
 
