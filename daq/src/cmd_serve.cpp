@@ -34,12 +34,23 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--allow-host", o->allowed_hosts,
                   "A Host name accepted beside localhost and the address (repeatable), e.g. the "
                   "machine's name when serving beyond loopback");
+  cmd->add_option("--allow-device", o->allowed_devices,
+                  "A device a set-up applied from the page may open beside the configuration's "
+                  "own (repeatable; anything else is refused with 403 before it is opened): a "
+                  "path glob (/dev/ttyUSB*), HOST:PORT or HOST:LOW-HIGH, or 'hid VID:PID'");
   cmd->add_option("--max-connections", o->max_connections,
-                  "Open connections at most (at the cap the one idle longest is closed)")
+                  "Open connections at most (at the cap the stalest is closed: one refused, then "
+                  "the HTTP connection without progress for longest, WebSockets last)")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{4}, std::size_t{100000}));
+  cmd->add_option("--max-connections-per-client", o->max_connections_per_client,
+                  "Open connections from one address at most (its own stalest is closed for a "
+                  "new one)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{2}, std::size_t{100000}));
   cmd->add_option("--request-timeout-s", o->request_timeout_s,
-                  "A request must arrive within this (idle and slow connections are closed)")
+                  "A request, header and body, must arrive within this (idle connections, slow "
+                  "headers and slow bodies are closed)")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--capture-dir", o->capture_dir,

@@ -122,7 +122,9 @@ browser = concurrent.futures.ThreadPoolExecutor(max_workers=1).submit(Browser, 1
 serve_log = open(os.path.join(TMP, "serve.log"), "w+")
 serve = subprocess.Popen([DAQ, "serve", "--simulate", "--speed", str(SPEED), "--port", "0",
                           "--db", os.path.join(TMP, "runs.sqlite"),
-                          "--capture-dir", os.path.join(TMP, "captures")],
+                          "--capture-dir", os.path.join(TMP, "captures"),
+                          # the dead devices of part 4, allowed as an operator would
+                          "--allow-device", f"{TMP}/no-such-*", "--allow-device", "127.0.0.1:1"],
                          stdout=serve_log, stderr=subprocess.STDOUT)
 try:
     url = None

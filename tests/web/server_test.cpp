@@ -31,7 +31,10 @@ struct Running {
   asio::executor_work_guard<asio::io_context::executor_type> work = asio::make_work_guard(io);
   explicit Running(cal::daq::web::ServerOptions options, cal::daq::web::Api api = {}) {
     if (!api.runs) api.runs = [] { return cal::daq::web::Response{200, R"({"runs": [1, 2]})"}; };
-    if (!api.page) api.page = [] { return std::string("<html>live</html>"); };
+    if (!api.page)
+      api.page = [](std::string_view nonce) {
+        return "<html><script nonce=\"" + std::string(nonce) + "\">live</script></html>";
+      };
     if (!api.start)
       api.start = [](const std::string& body) {
         return cal::daq::web::Response{202, R"({"started": )" + body + "}"};
@@ -73,7 +76,7 @@ TEST(LiveServer, ServesThePageAndTheApi) {
   const auto port = r.server->port();
   auto page = request(port, http::verb::get, "/");
   EXPECT_EQ(page.result_int(), 200);
-  EXPECT_EQ(page.body(), "<html>live</html>");
+  EXPECT_TRUE(page.body().starts_with("<html><script nonce=\"")) << page.body();
   EXPECT_EQ(page[http::field::content_type], "text/html; charset=utf-8");
   EXPECT_EQ(request(port, http::verb::get, "/api/runs").body(), R"({"runs": [1, 2]})");
   auto started = request(port, http::verb::post, "/api/runs/start", {}, R"({"kind": "linear"})");
@@ -83,9 +86,69 @@ TEST(LiveServer, ServesThePageAndTheApi) {
   EXPECT_EQ(request(port, http::verb::get, "/api/runs/start").result_int(), 404);  // GET != POST
 }
 
+// The page's policy allows its own script by a nonce that is new for every answer; the nonce
+// in the policy is the one the page's script elements carry.
+TEST(LiveServer, ThePageRunsOnlyItsOwnScript) {
+  Running r({.port = 0});
+  const auto port = r.server->port();
+  const auto nonce_of = [&] {
+    const auto page = request(port, http::verb::get, "/");
+    const std::string csp(page["Content-Security-Policy"]);
+    EXPECT_NE(csp.find("default-src 'none'"), std::string::npos) << csp;
+    EXPECT_NE(csp.find("frame-ancestors 'none'"), std::string::npos) << csp;
+    EXPECT_EQ(csp.find("unsafe-eval"), std::string::npos) << csp;
+    const auto at = csp.find("script-src 'nonce-");
+    EXPECT_NE(at, std::string::npos) << csp;
+    const auto start = at + std::string_view("script-src 'nonce-").size();
+    const auto nonce = csp.substr(start, csp.find('\'', start) - start);
+    EXPECT_GE(nonce.size(), 22u);
+    EXPECT_NE(page.body().find("<script nonce=\"" + nonce + "\">"), std::string::npos);
+    return nonce;
+  };
+  EXPECT_NE(nonce_of(), nonce_of());
+  // The page itself: every script element carries it.
+  const auto page = cal::daq::web::operator_page("N0NCE");
+  EXPECT_EQ(page.find("<script>"), std::string::npos);
+  EXPECT_NE(page.find("<script nonce=\"N0NCE\">"), std::string::npos);
+}
+
+// HEAD answers as GET without the body: the same status and Content-Length.
+TEST(LiveServer, HeadIsGetWithoutTheBody) {
+  Running r({.port = 0});
+  const auto port = r.server->port();
+  asio::io_context io;
+  tcp::socket socket(io);
+  socket.connect({asio::ip::address_v4::loopback(), port});
+  http::request<http::empty_body> req{http::verb::head, "/api/runs", 11};
+  req.set(http::field::host, "localhost");
+  http::write(socket, req);
+  beast::flat_buffer buffer;
+  http::response_parser<http::string_body> parser;
+  parser.skip(true);  // a HEAD answer has no body whatever its Content-Length says
+  http::read(socket, buffer, parser);
+  EXPECT_EQ(parser.get().result_int(), 200);
+  EXPECT_EQ(parser.get()[http::field::content_length], "16");  // {"runs": [1, 2]}
+  EXPECT_TRUE(parser.get().body().empty());
+  // The connection goes on: the next request is answered whole.
+  http::request<http::empty_body> get{http::verb::get, "/api/runs", 11};
+  get.set(http::field::host, "localhost");
+  http::write(socket, get);
+  http::response<http::string_body> res;
+  http::read(socket, buffer, res);
+  EXPECT_EQ(res.body(), R"({"runs": [1, 2]})");
+}
+
 TEST(LiveServer, AnotherAddressNeedsAToken) {
   asio::io_context io;
   EXPECT_THROW(LiveServer(io, {.address = "0.0.0.0", .port = 0}, {}), std::invalid_argument);
+  try {
+    LiveServer(io, {.address = "0.0.0.0", .port = 0}, {});
+  } catch (const std::invalid_argument& e) {
+    // The command adds its own name; the server does not (no "daq serve: daq serve:").
+    EXPECT_EQ(std::string(e.what()).find("daq serve"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(cal::daq::web::host_port("::1", 8080), "[::1]:8080");
+  EXPECT_EQ(cal::daq::web::host_port("127.0.0.1", 8080), "127.0.0.1:8080");
 }
 
 TEST(LiveServer, TokenIsRequiredWhenSet) {

@@ -26,6 +26,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
+#include "cal/daq/gcode.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
@@ -37,6 +38,7 @@
 #include "report/report.hpp"
 #include "report_pdf.hpp"
 #include "run_document.hpp"
+#include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
 #include "serve/setup_form.hpp"
@@ -100,9 +102,43 @@ std::optional<json> setup_body(const std::string& body, std::initializer_list<co
   return req["setup"];
 }
 
-std::string text_of(const json& req, const char* key, const std::string& fallback) {
+// A string field of a request, or `fallback` when absent; a value of another type, or one
+// `valid` refuses (cal::InputError), is refused naming the field.
+template <typename Check>
+std::optional<std::string> string_field(const json& req, const char* key, const char* fallback,
+                                        Check valid, std::string& why) {
   const auto it = req.find(key);
-  return it != req.end() && it->is_string() ? it->get<std::string>() : fallback;
+  if (it == req.end()) return fallback;
+  if (!it->is_string()) {
+    why = fmt::format("\"{}\" must be a string, not {}", key, it->type_name());
+    return std::nullopt;
+  }
+  const auto value = it->get<std::string>();
+  try {
+    valid(value);
+  } catch (const cal::InputError& e) {
+    why = fmt::format("\"{}\": {}", key, e.what());
+    return std::nullopt;
+  }
+  return value;
+}
+
+// The (id, transport) of each device of a set-up as the page sends it; entries that are not
+// objects with a string transport are the loader's to refuse.
+std::vector<std::pair<std::string, std::string>> devices_in_setup(const json& setup) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const auto devices = setup.find("devices");
+  if (devices == setup.end() || !devices->is_object()) return out;
+  for (const auto& [id, d] : devices->items())
+    if (d.is_object() && d.contains("transport") && d["transport"].is_string())
+      out.emplace_back(id, d["transport"].get<std::string>());
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> devices_of(const cal::daq::Config& c) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& d : c.devices) out.emplace_back(d.id, d.transport);
+  return out;
 }
 
 // "run-12.html" -> 12 with the extension; nullopt for anything else.
@@ -140,7 +176,12 @@ void prepare_capture_dir(const std::string& dir) {
 class Service {
  public:
   Service(boost::asio::io_context& io, ServeOptions o)
-      : io_(io), o_(std::move(o)), tick_(io), publish_timer_(io), program_timer_(io) {
+      : io_(io),
+        o_(std::move(o)),
+        tick_(io),
+        publish_timer_(io),
+        program_timer_(io),
+        allowed_(o_.allowed_devices) {
     prepare_capture_dir(o_.capture_dir);
     if (o_.simulate) {
       // The shop, the instruments' timers and the runs' timers on one simulated time line
@@ -156,10 +197,13 @@ class Service {
       use_config(cal::daq::load_config(o_.run.config));
       check_devices_at_start();
     }
+    allowed_.allow_devices_of(config_);  // the devices it started with, and no others
     try {
       make_server();
     } catch (const std::invalid_argument& e) {
       throw cal::InputError(fmt::format("daq serve: {}", e.what()));
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(fmt::format("daq serve: {}", e.what()));
     }
     tick();
     publish_loop();
@@ -211,7 +255,7 @@ class Service {
   }
 
   void make_server() {
-    web::Api api{.page = [] { return web::operator_page(); },
+    web::Api api{.page = [](std::string_view nonce) { return web::operator_page(nonce); },
                  .runs = [this] { return runs(); },
                  .status = [this] { return ok(status()); },
                  .start = [this](const std::string& body) { return start(body); },
@@ -247,6 +291,7 @@ class Service {
             .token = o_.token,
             .allowed_hosts = o_.allowed_hosts,
             .max_connections = o_.max_connections,
+            .max_connections_per_client = o_.max_connections_per_client,
             .request_timeout =
                 std::chrono::milliseconds(std::llround(o_.request_timeout_s * 1000.0)),
             .log = [](std::string_view text) { fmt::print(stderr, "daq serve: {}\n", text); }},
@@ -336,7 +381,11 @@ class Service {
     std::string why;
     const auto setup = setup_body(body, {}, why);
     if (!setup) return error(400, why);
-    const auto check = check_setup(*setup);
+    auto check = check_setup(*setup);
+    // A device the service may not open is a problem at its field, as the loader's are.
+    for (const auto& [id, transport] : devices_in_setup(*setup))
+      if (const auto refused = allowed_.refusal({{id, transport}}))
+        check.problems.push_back({refused->device + ".transport", refused->message});
     auto j = to_json(check);
     j["toml"] = check.toml;
     return ok(j);
@@ -349,11 +398,22 @@ class Service {
     const auto setup = setup_body(body, {"test", "dialect"}, why);
     if (!setup) return error(400, why);
     const auto req = json::parse(body);
+    const auto test = string_field(
+        req, "test", "linear",
+        [](const std::string& t) {
+          if (t != "linear" && t != "circle")
+            throw cal::InputError(fmt::format("no test '{}': give \"linear\" or \"circle\"", t));
+        },
+        why);
+    if (!test) return error(400, why);
+    const auto dialect = string_field(
+        req, "dialect", "fanuc", [](const std::string& d) { cal::daq::dialect_from_string(d); },
+        why);
+    if (!dialect) return error(400, why);
     const auto check = check_setup(*setup);
     if (!check.config) return error(400, "the set-up has problems: fix them first", to_json(check));
     try {
-      return {.body = part_program(*check.config, text_of(req, "test", "linear"),
-                                   text_of(req, "dialect", "fanuc")),
+      return {.body = part_program(*check.config, *test, *dialect),
               .content_type = "text/plain; charset=utf-8"};
     } catch (const cal::InputError& e) {
       return error(400, e.what());
@@ -361,21 +421,47 @@ class Service {
   }
 
   // POST {"setup"}: the set-up becomes the service's (its devices are opened, the page's runs
-  // use it). Refused while a run is running.
+  // use it). Refused while a run is running, and (403, before anything is opened) when it
+  // names a device the service may not open (device_allow.hpp).
   web::Response setup_apply(const std::string& body) {
     std::string why;
     const auto setup = setup_body(body, {}, why);
     if (!setup) return error(400, why);
+    if (const auto refused = allowed_.refusal(devices_in_setup(*setup)))
+      return device_refused(*refused);
     if (running())
       return error(409, fmt::format("run {} is running: the set-up can change after it", run_id_));
     auto check = check_setup(*setup);
     if (!check.config) return error(400, "the set-up has problems: fix them first", to_json(check));
+    // The loader's devices, as they would be opened (the same texts; checked again all the same).
+    if (const auto refused = allowed_.refusal(devices_of(*check.config)))
+      return device_refused(*refused);
     use_config(std::move(*check.config));
     fmt::print("set-up applied from the web page\n");
     std::fflush(stdout);
     auto j = to_json(check);
     j["toml"] = check.toml;
     return ok(j);
+  }
+
+  static web::Response device_refused(const DeviceRefusal& r) {
+    fmt::print(stderr, "daq serve: set-up refused: {}\n", r.message);
+    return error(403, r.message,
+                 {{"device", r.device}, {"transport", r.transport}, {"allow", r.allow}});
+  }
+
+  // The run database for a read: opened read-only (never created, migrated or changed: a
+  // mistyped --db creates nothing, and a read-only medium works); nullopt while there is no
+  // database yet (no run stored).
+  std::optional<cal::storage::Store> read_store() const {
+    std::error_code ec;
+    if (!fs::exists(database_path(o_.run.db), ec)) return std::nullopt;
+    return open_database_read_only(o_.run.db);
+  }
+
+  std::string no_database() const {
+    return fmt::format("no database at {} yet (the first run creates it)",
+                       database_path(o_.run.db).string());
   }
 
   // POST /api/simulation/speed {"speed": N} (--simulate only): the SIMULATED shop's pace from
@@ -403,8 +489,10 @@ class Service {
 
   // The machines of the stored runs, newest first, as their runs recorded them.
   web::Response machines(std::string_view) {
-    cal::storage::Store store(database_path(o_.run.db));
     json list = json::array();
+    const auto db = read_store();
+    if (!db) return ok({{"schema", "caldaq.machines.v1"}, {"machines", list}});
+    const auto& store = *db;
     std::map<std::string, bool> seen;
     auto runs = store.runs();
     for (auto it = runs.rbegin(); it != runs.rend(); ++it) {
@@ -429,16 +517,17 @@ class Service {
   // --- stored runs and reports -----------------------------------------------------------
 
   web::Response runs() {
-    cal::storage::Store store(database_path(o_.run.db));
     json list = json::array();
-    for (const auto& r : store.runs())
-      list.push_back({{"id", r.id},
-                      {"kind", r.kind},
-                      {"axis", r.axis},
-                      {"campaign", r.campaign},
-                      {"status", cal::storage::to_string(r.status)},
-                      {"started_unix_ms", r.started_unix_ms},
-                      {"note", r.note}});
+    const auto db = read_store();
+    if (db)
+      for (const auto& r : db->runs())
+        list.push_back({{"id", r.id},
+                        {"kind", r.kind},
+                        {"axis", r.axis},
+                        {"campaign", r.campaign},
+                        {"status", cal::storage::to_string(r.status)},
+                        {"started_unix_ms", r.started_unix_ms},
+                        {"note", r.note}});
     return ok({{"schema", "caldaq.runs.v1"}, {"runs", list}});
   }
 
@@ -449,7 +538,9 @@ class Service {
     const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), id);
     if (ec != std::errc{} || end != digits.data() + digits.size() || id < 1)
       return error(404, "no such resource: runs are /api/runs/N");
-    cal::storage::Store store(database_path(o_.run.db));
+    const auto db = read_store();
+    if (!db) return error(404, fmt::format("no run {}: {}", id, no_database()));
+    const auto& store = *db;
     if (!store.run(id)) return error(404, fmt::format("no run {}", id));
     auto j = run_document(store, id);
     j["reports"] = {{"html", fmt::format("/reports/run-{}.html", id)},
@@ -464,14 +555,18 @@ class Service {
     const auto name = report_name(path.substr(std::string_view("/reports/").size()));
     if (!name) return error(404, "no such report: reports are /reports/run-N.html or .pdf");
     const auto [id, ext] = *name;
-    cal::storage::Store store(database_path(o_.run.db));
+    const auto db = read_store();
+    if (!db) return error(404, fmt::format("no run {}: {}", id, no_database()));
+    const auto& store = *db;
     if (!store.run(id)) return error(404, fmt::format("no run {}", id));
     auto html =
         cal::daq::report::run_report(store, id, {.software = std::string(daq::software_version)});
     if (ext == "html")
       return {.body = std::move(html),
               .content_type = "text/html; charset=utf-8",
-              .disposition = fmt::format("inline; filename=\"report-run-{}.html\"", id)};
+              .disposition = fmt::format("inline; filename=\"report-run-{}.html\"", id),
+              // An inert document (docs/web.md): no script runs in it whatever a name holds.
+              .content_security_policy = std::string(web::inert_document_policy)};
     if (printing_ >= 2) return error(503, "two PDFs are being printed: try again in a moment");
     if (printing_ == 0) join_workers();  // the threads of earlier PDFs have all ended
     web::Response r;
@@ -821,6 +916,7 @@ class Service {
   std::string test_;
   std::string run_live_;
   std::optional<json> last_;
+  DeviceAllowList allowed_;
   std::atomic<int> printing_{0};
   std::mutex workers_mutex_;
   std::vector<std::thread> workers_;
@@ -831,8 +927,9 @@ class Service {
 void serve(const ServeOptions& o) {
   boost::asio::io_context io;
   Service service(io, o);
-  fmt::print("daq serve: http://{}:{}/ ({}), runs in {}; Ctrl-C stops\n", o.address, service.port(),
-             service.source(), database_path(o.run.db).string());
+  fmt::print("daq serve: http://{}/ ({}), runs in {}; Ctrl-C stops\n",
+             web::host_port(o.address, service.port()), service.source(),
+             database_path(o.run.db).string());
   if (o.simulate)
     fmt::print("daq serve: SIMULATED shop in this process, {}x faster than real time\n", o.speed);
   std::fflush(stdout);

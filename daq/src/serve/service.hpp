@@ -16,7 +16,9 @@ struct ServeOptions {
   std::string address = "127.0.0.1", token, capture_dir;
   std::uint16_t port = 8080;
   std::vector<std::string> allowed_hosts;
+  std::vector<std::string> allowed_devices;  // --allow-device patterns (serve/device_allow.hpp)
   std::size_t max_connections = 256;
+  std::size_t max_connections_per_client = 64;
   double request_timeout_s = 10.0;
   bool simulate = false;  // the SIMULATED shop in this process, its configuration as set-up
   double speed = 10.0;    // of the simulated shop

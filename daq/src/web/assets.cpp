@@ -14,10 +14,18 @@ namespace {
 void replace(std::string& s, std::string_view marker, std::string_view with) {
   if (const auto at = s.find(marker); at != std::string::npos) s.replace(at, marker.size(), with);
 }
+void replace_all(std::string& s, std::string_view marker, std::string_view with) {
+  for (auto at = s.find(marker); at != std::string::npos; at = s.find(marker, at + with.size()))
+    s.replace(at, marker.size(), with);
+}
 }  // namespace
 
-std::string operator_page() {
+std::string operator_page(std::string_view nonce) {
   std::string page(caldaq_assets::page_html);
+  // The page's own script elements, before anything is inserted (the nonce is base64: no
+  // character of it needs escaping in an attribute).
+  if (!nonce.empty())
+    replace_all(page, "<script>", "<script nonce=\"" + std::string(nonce) + "\">");
   // The strings first: the chart library's code is inserted after, and is not searched.
   replace(page, "/*STRINGS*/", caldaq_assets::strings_en);
   replace(page, "/*UPLOT_CSS*/", caldaq_assets::uplot_css);

@@ -2,7 +2,10 @@
 // The operator's page with its strings (daq/web/strings.en.json) and chart library inlined:
 // one self-contained document that works offline.
 #include <string>
+#include <string_view>
 
 namespace cal::daq::web {
-std::string operator_page();
-}
+// Every script element of the page carries `nonce` (its Content-Security-Policy allows only
+// those, so markup that came from elsewhere cannot run script); empty: no nonce attribute.
+std::string operator_page(std::string_view nonce = {});
+}  // namespace cal::daq::web

@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cstdint>
 #include <exception>
+#include <random>
 
 namespace cal::daq::web {
 namespace {
@@ -82,7 +83,31 @@ bool authorised(const Header& h, const Policy& p) {
   return ok;
 }
 
+// 128 random bits in base64, for the page's script nonce.
+std::string make_nonce() {
+  static constexpr char digits[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::random_device random;
+  std::string out;
+  std::uint32_t bits = 0;
+  int have = 0;
+  for (int i = 0; i < 22; ++i) {  // 22 digits of 6 bits: 132 bits
+    if (have < 6) bits = random(), have = 32;
+    out += digits[bits & 63];
+    bits >>= 6, have -= 6;
+  }
+  return out;
+}
+
 }  // namespace
+
+std::string page_policy(std::string_view nonce) {
+  // The page's own script (by its nonce) and nothing else; its style is inline; it talks to
+  // its own server only (fetch and the WebSocket); nothing may frame it.
+  return "default-src 'none'; script-src 'nonce-" + std::string(nonce) +
+         "'; style-src 'unsafe-inline'; img-src data: blob:; connect-src 'self' blob:; "
+         "base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
+}
 
 bool same_token(std::string_view given, std::string_view expected) {
   // Every byte of `expected` is visited once; `given` is indexed modulo its length (or a
@@ -185,10 +210,17 @@ std::optional<Response> screen(const Header& h, std::string_view local_address, 
 Response route(const Request& req, const Api& api) {
   const std::string_view target = sv(req.target());
   const std::string_view path = target.substr(0, target.find('?'));
-  const bool get = req.method() == http::verb::get, post = req.method() == http::verb::post;
+  // HEAD is answered as GET; the server sends the header alone.
+  const bool get = req.method() == http::verb::get || req.method() == http::verb::head,
+             post = req.method() == http::verb::post;
   try {
-    if (get && path == "/" && api.page)
-      return {.status = 200, .body = api.page(), .content_type = "text/html; charset=utf-8"};
+    if (get && path == "/" && api.page) {
+      const auto nonce = make_nonce();
+      return {.status = 200,
+              .body = api.page(nonce),
+              .content_type = "text/html; charset=utf-8",
+              .content_security_policy = page_policy(nonce)};
+    }
     if (get && path == "/api/runs" && api.runs) return api.runs();
     if (get && path == "/api/status" && api.status) return api.status();
     if (post && path == "/api/runs/start" && api.start) return api.start(req.body());

@@ -49,8 +49,11 @@ using Request = boost::beast::http::request<boost::beast::http::string_body>;
 // routed, else the refusal to send (after which the connection is closed, the body unread).
 std::optional<Response> screen(const Header& h, std::string_view local_address, const Policy& p);
 
-// Routes a screened, complete request to the API. Never throws: a handler's exception is a
-// 500 naming it.
+// The page's Content-Security-Policy: only script elements carrying `nonce` run.
+std::string page_policy(std::string_view nonce);
+
+// Routes a screened, complete request to the API (HEAD as GET). Never throws: a handler's exception
+// is a 500 naming it.
 Response route(const Request& req, const Api& api);
 
 // Whether the request asks for the WebSocket (GET /ws with an Upgrade).

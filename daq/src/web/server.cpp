@@ -2,6 +2,7 @@
 // http_policy.cpp).
 #include "server.hpp"
 
+#include <algorithm>
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -10,6 +11,7 @@
 #include <list>
 #include <optional>
 #include <stdexcept>
+#include <tuple>
 
 #include "http_policy.hpp"
 
@@ -38,27 +40,45 @@ bool is_parse_error(const beast::error_code& ec) {
 
 struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   struct WsClient {
-    explicit WsClient(beast::tcp_stream s) : ws(std::move(s)) {}
+    WsClient(beast::tcp_stream s, std::string from, bool origin)
+        : ws(std::move(s)), remote(std::move(from)), page_origin(origin) {}
     websocket::stream<beast::tcp_stream> ws;
     std::string outgoing;
     bool writing = false;
+    std::string remote;        // the peer's address
+    bool page_origin = false;  // the handshake carried the page's Origin (as browsers send)
+    Clock::time_point opened = Clock::now(), write_started;
   };
+  using ClientPtr = std::shared_ptr<WsClient>;
 
   // One HTTP connection; several requests one after the other (keep-alive).
   struct Session {
-    explicit Session(tcp::socket s) : stream(std::move(s)) {}
+    Session(tcp::socket s, std::string from) : stream(std::move(s)), remote(std::move(from)) {}
     beast::tcp_stream stream;
     beast::flat_buffer buffer;
     std::optional<http::request_parser<http::empty_body>> header;
     std::optional<http::request_parser<http::string_body>> body;
     http::response<http::string_body> response;
     std::string local_address;
-    bool waiting = false;  // for a request header: such a connection may be closed for room
-    Clock::time_point waiting_since;
+    std::string remote;  // the peer's address
+    // What it waits for, and since when: the order in which connections are closed for room.
+    enum class Phase { request, answer, closing } phase = Phase::request;
+    Clock::time_point since = Clock::now();
     bool closed = false;
     std::array<char, 4096> discard{};
   };
   using SessionPtr = std::shared_ptr<Session>;
+
+  // A connection that may be closed to make room, ranked: the lowest rank goes first, and
+  // within a rank the lowest order (the time since which it has made no progress; for a
+  // WebSocket that reads and has the page's Origin, the newest first, so an established page
+  // keeps its live view).
+  struct Victim {
+    int rank = 0;
+    Clock::rep order = 0;
+    SessionPtr session;
+    ClientPtr client;
+  };
 
   Impl(asio::io_context& context, ServerOptions o, Api a)
       : io(context),
@@ -74,18 +94,18 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
 
   void listen() {
     if (!is_loopback(options.address) && options.token.empty())
-      throw std::invalid_argument("daq serve: binding to " + options.address +
+      throw std::invalid_argument("binding to " + options.address +
                                   " (not loopback) needs --token");
     boost::system::error_code ec;
     const tcp::endpoint ep(asio::ip::make_address(options.address, ec), options.port);
-    if (ec) throw std::invalid_argument("daq serve: bad address '" + options.address + "'");
+    if (ec) throw std::invalid_argument("bad address '" + options.address + "'");
     acceptor.open(ep.protocol(), ec);
     if (!ec) acceptor.set_option(asio::socket_base::reuse_address(true), ec);
     if (!ec) acceptor.bind(ep, ec);
     if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
     if (ec)
-      throw std::runtime_error("daq serve: cannot listen on " + options.address + ":" +
-                               std::to_string(options.port) + ": " + ec.message());
+      throw std::runtime_error("cannot listen on " + host_port(options.address, options.port) +
+                               ": " + ec.message());
     accept();
     tick();
   }
@@ -96,22 +116,50 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
 
   std::size_t connections() const { return sessions.size() + clients.size(); }
 
+  // Connections (HTTP and WebSocket) and WebSockets from one address.
+  std::size_t connections_from(std::string_view remote) const {
+    return static_cast<std::size_t>(
+               std::count_if(sessions.begin(), sessions.end(),
+                             [&](const SessionPtr& s) { return s->remote == remote; })) +
+           websockets_from(remote);
+  }
+  std::size_t websockets_from(std::string_view remote) const {
+    return static_cast<std::size_t>(std::count_if(
+        clients.begin(), clients.end(), [&](const ClientPtr& c) { return c->remote == remote; }));
+  }
+  std::size_t max_websockets() const {
+    return std::max<std::size_t>(1, options.max_connections / 2);
+  }
+
   // The accept loop is re-armed after every error. Out of descriptors (EMFILE, ENFILE) or
-  // buffers, it closes the connection waiting longest for a request and retries after a
-  // pause, rather than spinning on an error the kernel repeats at once.
+  // buffers, it closes the stalest connection and retries after a pause, rather than spinning
+  // on an error the kernel repeats at once.
   void accept() {
     acceptor.async_accept([self = shared_from_this()](boost::system::error_code ec, tcp::socket s) {
       if (!self->acceptor.is_open() || ec == asio::error::operation_aborted) return;
       if (ec) return self->accept_failed(ec);
-      if (self->connections() >= self->options.max_connections && !self->make_room()) {
-        boost::system::error_code ignored;
-        s.close(ignored);  // every connection is busy: refuse this one
-        ++self->refused;
-      } else {
-        self->start_session(std::move(s));
-      }
+      self->admit(std::move(s));
       self->accept();
     });
+  }
+
+  // A new connection gets room: its address' stalest connection is closed when the address
+  // is at its own cap, and the stalest of all at the overall cap.
+  void admit(tcp::socket s) {
+    boost::system::error_code ec;
+    const auto peer = s.remote_endpoint(ec);
+    if (ec) return;  // the peer is already gone
+    const auto remote = peer.address().to_string();
+    bool room = true;
+    if (connections_from(remote) >= options.max_connections_per_client)
+      room = make_room(remote, false);
+    if (room && connections() >= options.max_connections) room = make_room({}, false);
+    if (!room) {
+      s.close(ec);  // nothing can be closed for it (cannot happen with the caps above 0)
+      ++refused;
+      return;
+    }
+    start_session(std::move(s), remote);
   }
 
   void accept_failed(const boost::system::error_code& ec) {
@@ -122,25 +170,56 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
           " accept errors so far)");
       last_accept_log = now;
     }
-    make_room();
+    make_room({}, false);
     retry.expires_after(std::chrono::milliseconds(50));
     retry.async_wait([self = shared_from_this()](boost::system::error_code e) {
       if (!e) self->accept();
     });
   }
 
-  // Closes the connection that has waited longest for a request header; false if none waits.
-  bool make_room() {
-    SessionPtr oldest;
-    for (const auto& s : sessions)
-      if (s->waiting && (!oldest || s->waiting_since < oldest->waiting_since)) oldest = s;
-    if (!oldest) return false;
-    close(oldest);
+  // Closes the stalest connection (of `from`, if given; WebSockets only, if asked); false if
+  // there is none. The order (server.hpp): being closed after a refusal; an HTTP connection
+  // waiting for (the rest of) a request; one whose answer is pending or not read; then a
+  // WebSocket that does not read its messages, one without the page's Origin, the newest.
+  bool make_room(std::string_view from, bool websockets_only) {
+    std::optional<Victim> worst;
+    const auto consider = [&](Victim v) {
+      if (!worst || std::tie(v.rank, v.order) < std::tie(worst->rank, worst->order)) worst = v;
+    };
+    const auto ticks = [](Clock::time_point t) { return t.time_since_epoch().count(); };
+    if (!websockets_only)
+      for (const auto& s : sessions)
+        if (from.empty() || s->remote == from) consider({rank_of(*s), ticks(s->since), s, {}});
+    const auto now = Clock::now();
+    for (const auto& c : clients) {
+      if (!from.empty() && c->remote != from) continue;
+      if (c->writing && now - c->write_started > stall_after)
+        consider({3, ticks(c->write_started), {}, c});
+      else
+        consider(
+            {c->page_origin ? 5 : 4, c->page_origin ? -ticks(c->opened) : ticks(c->opened), {}, c});
+    }
+    if (!worst) return false;
+    if (worst->session) close(worst->session);
+    if (worst->client) drop(worst->client);
+    ++evicted;
     return true;
   }
 
-  void start_session(tcp::socket socket) {
-    auto s = std::make_shared<Session>(std::move(socket));
+  static int rank_of(const Session& s) {
+    switch (s.phase) {
+      case Session::Phase::closing:
+        return 0;
+      case Session::Phase::request:
+        return 1;
+      case Session::Phase::answer:
+        return 2;
+    }
+    return 2;
+  }
+
+  void start_session(tcp::socket socket, std::string remote) {
+    auto s = std::make_shared<Session>(std::move(socket), std::move(remote));
     boost::system::error_code ec;
     const auto local = s->stream.socket().local_endpoint(ec);
     if (ec) return;  // the peer is already gone
@@ -152,7 +231,6 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   void close(const SessionPtr& s) {
     if (s->closed) return;
     s->closed = true;
-    s->waiting = false;
     boost::system::error_code ignored;
     s->stream.socket().shutdown(tcp::socket::shutdown_both, ignored);
     s->stream.close();
@@ -167,12 +245,13 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     // compares the length with the optional itself, and any length is "over" an empty one.)
     s->header->body_limit(std::numeric_limits<std::uint64_t>::max());
     s->body.reset();
-    s->waiting = true;
-    s->waiting_since = Clock::now();
+    s->phase = Session::Phase::request;
+    s->since = Clock::now();
+    // The header and the body together must arrive within this: a slow body is cut off as a
+    // slow header is (the body is read under the same expiry).
     s->stream.expires_after(options.request_timeout);
     http::async_read_header(s->stream, s->buffer, *s->header,
                             [self = shared_from_this(), s](beast::error_code ec, std::size_t) {
-                              s->waiting = false;
                               if (s->closed) return;
                               if (ec) return self->read_failed(s, ec);
                               self->on_header(s);
@@ -219,15 +298,17 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
                        if (s->closed) return;
                        if (ec) return self->read_failed(s, ec);
                        const auto req = s->body->release();
+                       s->phase = Session::Phase::answer;
                        auto r = route(req, self->api);
                        if (r.deferred) return self->defer(s, std::move(r), req.keep_alive());
-                       self->reply(s, std::move(r), req.keep_alive());
+                       self->reply(s, std::move(r), req.keep_alive(),
+                                   req.method() == http::verb::head);
                      });
   }
 
   // The answer comes later, maybe from another thread: it is posted to the event loop, and
-  // dropped if the connection was closed meanwhile (the server shutting down, make_room never
-  // picks it: it waits for no request).
+  // dropped if the connection was closed meanwhile (the server shutting down, or the
+  // connection closed for room).
   void defer(const SessionPtr& s, Response r, bool keep_alive) {
     auto work = std::move(r.deferred);
     try {
@@ -242,8 +323,9 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   }
 
   // keep_alive false: the connection is closed after the answer (always so for a refusal,
-  // whose body, if any, was not read).
-  void reply(const SessionPtr& s, Response r, bool keep_alive) {
+  // whose body, if any, was not read). head: the header alone (its Content-Length as GET's).
+  void reply(const SessionPtr& s, Response r, bool keep_alive, bool head = false) {
+    s->phase = Session::Phase::answer;
     auto& res = s->response;
     res = {};
     res.version(11);
@@ -251,13 +333,20 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     res.set(http::field::content_type, r.content_type);
     res.set(http::field::cache_control, "no-store");
     res.set("X-Content-Type-Options", "nosniff");
-    res.set("Content-Security-Policy", "frame-ancestors 'none'");
+    res.set("Content-Security-Policy", r.content_security_policy.empty()
+                                           ? std::string("frame-ancestors 'none'")
+                                           : r.content_security_policy);
     res.set("X-Frame-Options", "DENY");
     res.set("Referrer-Policy", "no-referrer");
     if (!r.disposition.empty()) res.set(http::field::content_disposition, r.disposition);
     res.keep_alive(keep_alive);
     res.body() = std::move(r.body);
     res.prepare_payload();
+    if (head) {
+      const auto length = res.body().size();
+      res.body().clear();
+      res.content_length(length);
+    }
     s->stream.expires_after(options.request_timeout);  // a client that does not read
     http::async_write(s->stream, res,
                       [self = shared_from_this(), s](beast::error_code ec, std::size_t) {
@@ -270,8 +359,12 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
 
   // Closing a socket with unread data makes the kernel reset the connection, which can
   // destroy the answer before the client reads it: stop sending, then read and drop what the
-  // client still sends (at most until the request timeout) before closing.
+  // client still sends (at most 2 s, or the request timeout if shorter) before closing. Such
+  // a connection is the first closed for room.
   void linger(const SessionPtr& s) {
+    s->phase = Session::Phase::closing;
+    s->since = Clock::now();
+    s->stream.expires_after(std::min<Clock::duration>(options.request_timeout, max_linger));
     boost::system::error_code ignored;
     s->stream.socket().shutdown(tcp::socket::shutdown_send, ignored);
     s->stream.async_read_some(asio::buffer(s->discard),
@@ -290,10 +383,17 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
                               });
   }
 
+  // A WebSocket from an address at its WebSocket cap replaces that address' stalest one, and
+  // at the overall WebSocket cap the stalest of all: WebSockets never take more than half of
+  // the connections, and a new page always gets its live view.
   void upgrade(const SessionPtr& s) {
     sessions.remove(s);
     s->closed = true;  // the connection now belongs to the WebSocket client
-    auto client = std::make_shared<WsClient>(std::move(s->stream));
+    if (websockets_from(s->remote) >= options.max_websockets_per_client) make_room(s->remote, true);
+    if (clients.size() >= max_websockets()) make_room({}, true);
+    const auto& h = s->header->get();
+    auto client = std::make_shared<WsClient>(std::move(s->stream), s->remote,
+                                             h.find(http::field::origin) != h.end());
     beast::get_lowest_layer(client->ws).expires_never();  // the WebSocket times out by itself
     client->ws.set_option(
         websocket::stream_base::timeout{.handshake_timeout = options.request_timeout,
@@ -303,7 +403,7 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     clients.push_back(client);
     client->ws.async_accept(s->header->get(),
                             [self = shared_from_this(), client, s](beast::error_code ec) {
-                              if (ec) return self->clients.remove(client), void();
+                              if (ec) return self->drop(client);
                               self->drain(client);
                               if (!self->latest.empty()) self->send(client);
                             });
@@ -329,6 +429,7 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   void send(const std::shared_ptr<WsClient>& c) {
     if (c->writing) return;  // at most one message in flight per client
     c->writing = true;
+    c->write_started = Clock::now();
     c->outgoing = latest;
     c->ws.text(true);
     c->ws.async_write(asio::buffer(c->outgoing),
@@ -372,9 +473,17 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   std::list<std::shared_ptr<WsClient>> clients;
   std::string latest;
   bool changed = false;
-  std::uint64_t sent = 0, refused = 0, accept_errors = 0;
+  std::uint64_t sent = 0, refused = 0, accept_errors = 0, evicted = 0;
+  // A WebSocket whose message has been in flight this long does not read: the first closed.
+  static constexpr auto stall_after = std::chrono::seconds(1);
+  static constexpr auto max_linger = std::chrono::seconds(2);
   Clock::time_point last_accept_log{};
 };
+
+std::string host_port(std::string_view address, std::uint16_t port) {
+  const std::string a(address);
+  return (a.find(':') != std::string::npos ? "[" + a + "]" : a) + ":" + std::to_string(port);
+}
 
 LiveServer::LiveServer(asio::io_context& io, ServerOptions options, Api api)
     : impl_(std::make_shared<Impl>(io, std::move(options), std::move(api))) {
@@ -390,5 +499,6 @@ void LiveServer::publish(std::string state_json) {
 std::size_t LiveServer::websocket_clients() const { return impl_->clients.size(); }
 std::uint64_t LiveServer::messages_sent() const { return impl_->sent; }
 std::size_t LiveServer::connections() const { return impl_->connections(); }
+std::uint64_t LiveServer::evicted() const { return impl_->evicted; }
 
 }  // namespace cal::daq::web
