@@ -1,11 +1,12 @@
 """Reports are inert documents (issue 27): hostile names reach every report by the ways a name
 really gets into the database, and no report can run script or carry a local file.
 
-The names: a replayed capture whose header's configuration (docs/capture-format.md) names the
-machine, customer, site, operator, notes, campaign and instruments' serial numbers with markup
-(`</style><script>`, `"><img onerror>`, `<iframe src=file://...>`, `</title>`), and an imported
-Renishaw .rtx whose `Machine:` and `Owner:` lines (the latter a plot legend) do the same; a
-machine model file with a hostile name. Each report (run, campaign, comparison, as found / as
+The names: a run made with a configuration (daq sim's shop) whose machine, make, customer,
+site, operator, notes, campaign and instruments' serial numbers and certificates are markup
+(`</style><script>`, `"><img onerror>`, `<iframe src=file://...>`, `</title>`); a replayed
+capture whose header's configuration (docs/capture-format.md) names the machine and campaign so;
+an imported Renishaw .rtx whose `Machine:` and `Owner:` lines (the latter a plot's title and
+legend) do the same; a machine model file with a hostile name. Each report (run, campaign, comparison, as found / as
 left, the model's page) is then
   (a) parsed with html.parser: only the report's own elements, no event-handler attribute, the
       Content-Security-Policy first in <head>, one <style> block with no `<` in it, and the

@@ -28,7 +28,9 @@ TEST(ReportMarkup, CssStringEscapesAllButLettersDigitsAndSpaces) {
 }
 
 TEST(ReportMarkup, CssStringEscapesUtf8ByCodePoint) {
-  EXPECT_EQ(r::css_string("ACME — Müller"), "\"ACME \\002014 M\\0000FCller\"");
+  EXPECT_EQ(r::css_string("ACME — Müller"), "\"ACME \\002014\\000020M\\0000FCller\"");
+  // A space after an escape would be read as its end and lost ("Run 1:Positioning").
+  EXPECT_EQ(r::css_string("Run 1: X, Y"), "\"Run 1\\00003A\\000020X\\00002C\\000020Y\"");
   EXPECT_EQ(r::css_string("\xF0\x9F\x94\xA7"), "\"\\01F527\"");  // U+1F527, four bytes
   // Not UTF-8 (a stray byte, an overlong '/', a truncated sequence, NUL): U+FFFD, never the
   // byte's own character.

@@ -69,11 +69,16 @@ std::string html_attribute(std::string_view s) { return html_text(s); }
 
 std::string css_string(std::string_view s) {
   std::string out = "\"";
+  bool after_escape = false;
   for (std::size_t at = 0; at < s.size();) {
-    if (plain(s[at])) {
+    // CSS takes one white space after a hex escape as the escape's end (even after six
+    // digits), so a space there is escaped too, or it would vanish.
+    if (plain(s[at]) && !(after_escape && s[at] == ' ')) {
       out += s[at++];
+      after_escape = false;
       continue;
     }
+    after_escape = true;
     char32_t cp = next_code_point(s, at);
     if (cp == 0) cp = replacement;  // CSS reads \0 as U+FFFD too; say so
     // Six digits: the escape ends there, whatever follows (no terminating space needed).

@@ -15,7 +15,8 @@ std::string html_text(std::string_view s);
 std::string html_attribute(std::string_view s);
 // A quoted CSS string ("..."): every character but ASCII letters, digits and space as a
 // six-digit hex escape (\0000HH), so no quote, backslash, newline, `<`, `>` or `/` can end the
-// string or the <style> block; UTF-8 is escaped by code point (an invalid byte gives U+FFFD).
+// string or the <style> block; UTF-8 is escaped by code point (an invalid byte gives U+FFFD); a
+// space right after an escape is escaped too (CSS would read it as the escape's end).
 std::string css_string(std::string_view s);
 // Text handed to PLplot, which reads `#` as its escape character (`#<...>` changes the font,
 // `#[0x...]` is a code point): `#` doubled (PLplot's literal `#`), control characters dropped.
