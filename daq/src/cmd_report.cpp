@@ -1,14 +1,21 @@
 // daq report: self-contained HTML (or PDF, printed by headless Chromium) reports of stored
 // runs: one run, a campaign, or a comparison of the same test over time.
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "cal/analysis/error.hpp"
 #include "cal/storage/store.hpp"
@@ -48,28 +55,158 @@ std::string find_chromium() {
       "(install Debian's chromium package, or set CALDAQ_CHROMIUM to the browser)");
 }
 
+// A private directory for one printing (0700, made by mkdtemp), removed with what is in it.
+class PrivateDir {
+ public:
+  PrivateDir() {
+    std::string name = (fs::temp_directory_path() / "caldaq-pdf-XXXXXX").string();
+    if (::mkdtemp(name.data()) == nullptr)
+      throw cal::InputError(fmt::format("{}: cannot make a private directory to print in: {}", name,
+                                        std::strerror(errno)));
+    path_ = name;
+  }
+  ~PrivateDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  PrivateDir(const PrivateDir&) = delete;
+  PrivateDir& operator=(const PrivateDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// The browser's environment: ours, with its home and XDG directories in the private directory
+// (nothing of the service's own profile, cache or settings is read or written).
+std::vector<std::string> browser_environment(const fs::path& home) {
+  std::vector<std::string> env;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string_view v(*e);
+    if (!v.starts_with("HOME=") && !v.starts_with("XDG_")) env.emplace_back(v);
+  }
+  env.push_back("HOME=" + home.string());
+  for (const char* xdg : {"XDG_CONFIG_HOME", "XDG_CACHE_HOME", "XDG_DATA_HOME"})
+    env.push_back(fmt::format("{}={}", xdg, home.string()));
+  return env;
+}
+
+struct Exit {
+  int status = 0;
+  bool timed_out = false;
+};
+
+// Runs argv[0] (no shell: a path with a quote is just a path) with stdin from /dev/null and its
+// output into `log`, in a process group of its own, and waits up to `limit`; a browser still
+// running then is killed with its helpers.
+Exit run_browser(const std::vector<std::string>& args, const fs::path& log, const fs::path& home,
+                 std::chrono::seconds limit) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  auto env_text = browser_environment(home);
+  std::vector<char*> envp;
+  for (auto& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attr, 0);
+  pid_t pid = 0;
+  const bool bare = args.front().find('/') == std::string::npos;  // a name: searched on PATH
+  const int rc = bare ? ::posix_spawnp(&pid, argv[0], &actions, &attr, argv.data(), envp.data())
+                      : ::posix_spawn(&pid, argv[0], &actions, &attr, argv.data(), envp.data());
+  posix_spawnattr_destroy(&attr);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0)
+    throw cal::InputError(
+        fmt::format("cannot start the browser {}: {}", args.front(), std::strerror(rc)));
+  Exit e;
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (::waitpid(pid, &e.status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      e.timed_out = true;
+      ::kill(-pid, SIGKILL);
+      ::waitpid(pid, &e.status, 0);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(-pid, SIGKILL);  // helpers the browser left behind, if any
+  return e;
+}
+
+// Copies the browser's output to where the error message says it is (not following a link put
+// there in its place).
+void keep_log(const fs::path& from, const fs::path& to) {
+  std::ifstream in(from, std::ios::binary);
+  const std::string text(std::istreambuf_iterator<char>(in), {});
+  const int fd = ::open(to.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0600);
+  if (fd < 0) return;
+  [[maybe_unused]] const auto written = ::write(fd, text.data(), text.size());
+  ::close(fd);
+}
+
 }  // namespace
 
-// Prints html_file to pdf with headless Chromium; the PDF is checked, not assumed.
-void print_pdf(const fs::path& html_file, const fs::path& pdf) {
+// Prints the report to pdf with headless Chromium, which sees only a private directory holding
+// the report (a copy of it, a fresh profile) and has no network: with the report's
+// Content-Security-Policy, nothing outside the report can come into the PDF.
+std::size_t print_pdf_text(std::string_view html, const fs::path& pdf, const fs::path& log) {
   const auto browser = find_chromium();
-  const auto log = fs::path(pdf).concat(".log");
-  const std::string cmd = fmt::format(
-      "'{}' --headless --no-sandbox --disable-gpu --no-pdf-header-footer "
-      "--print-to-pdf-no-header --print-to-pdf='{}' 'file://{}' >'{}' 2>&1",
-      browser, pdf.string(), fs::absolute(html_file).string(), log.string());
-  std::error_code ec;
-  fs::remove(pdf, ec);
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(pdf, std::ios::binary);
-  char magic[5] = {};
-  in.read(magic, 4);
-  if (status != 0 || std::string_view(magic, 4) != "%PDF")
+  const PrivateDir dir;
+  // The page alone in its directory; the profile, the PDF and the browser's output beside it.
+  const auto page = dir.path() / "page" / "report.html";
+  if (std::error_code ec; !fs::create_directory(page.parent_path(), ec))
     throw cal::InputError(
-        fmt::format("{}: Chromium ({}) did not print the report (exit status "
-                    "{}); its output is in {}",
-                    pdf.string(), browser, WEXITSTATUS(status), log.string()));
-  fs::remove(log, ec);
+        fmt::format("{}: cannot make the directory to print in", page.parent_path().string()));
+  const auto printed = dir.path() / "report.pdf";
+  const auto output = dir.path() / "chromium.log";
+  {
+    std::ofstream out(page, std::ios::binary);
+    if (!(out << html) || !(out.close(), out))
+      throw cal::InputError(fmt::format("{}: cannot write the report to print", page.string()));
+  }
+  const std::vector<std::string> args{
+      browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+      "--print-to-pdf-no-header", "--user-data-dir=" + (dir.path() / "profile").string(),
+      "--no-first-run", "--no-default-browser-check", "--disable-extensions", "--disable-sync",
+      "--disable-background-networking", "--disable-component-update",
+      // No network: every request goes to a closed local port, loopback included (Chromium
+      // otherwise bypasses a proxy for it), and no name resolves.
+      "--proxy-server=127.0.0.1:9", "--proxy-bypass-list=<-loopback>",
+      "--host-resolver-rules=MAP * ~NOTFOUND", "--print-to-pdf=" + printed.string(),
+      "file://" + page.string()};
+  const auto e = run_browser(args, output, dir.path(), std::chrono::seconds(180));
+  std::ifstream in(printed, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(in), {});
+  const bool exited = !e.timed_out && WIFEXITED(e.status);
+  if (!exited || WEXITSTATUS(e.status) != 0 || !bytes.starts_with("%PDF")) {
+    keep_log(output, log);
+    throw cal::InputError(
+        fmt::format("{}: Chromium ({}) did not print the report ({}); its output is in {}",
+                    pdf.string(), browser,
+                    e.timed_out ? "it did not finish within 180 s"
+                    : exited    ? fmt::format("exit status {}", WEXITSTATUS(e.status))
+                                : fmt::format("killed by signal {}", WTERMSIG(e.status)),
+                    log.string()));
+  }
+  std::ofstream out(pdf, std::ios::binary);
+  if (!(out << bytes) || !(out.close(), out))
+    throw cal::InputError(fmt::format("{}: cannot write the PDF", pdf.string()));
+  return bytes.size();
+}
+
+void print_pdf(const fs::path& html_file, const fs::path& pdf) {
+  std::ifstream in(html_file, std::ios::binary);
+  if (!in) throw cal::InputError(fmt::format("{}: cannot read the report", html_file.string()));
+  const std::string html(std::istreambuf_iterator<char>(in), {});
+  print_pdf_text(html, pdf, fs::path(pdf).concat(".log"));
 }
 
 namespace {
@@ -125,31 +262,14 @@ void run_report_command(ReportOptions o) {
   if (o.format == "html") {
     write_file(out, html);
   } else {
-    // Chromium prints to a file; a stream (-o /dev/stdout, a pipe) gets the printed file's bytes.
+    // Chromium's output, if it fails, beside the PDF; a stream (-o /dev/stdout, a pipe) has no
+    // "beside", so in the temporary directory.
     std::error_code ec;
     const bool to_stream = fs::exists(out, ec) && !fs::is_regular_file(out, ec);
-    const auto stem_tmp =
-        to_stream ? fs::temp_directory_path() / fmt::format("caldaq-report-{}", ::getpid())
-                  : fs::path(out).replace_extension("");
-    const auto tmp = fs::path(stem_tmp.string() + ".tmp.html");
-    const auto pdf = to_stream ? fs::path(stem_tmp.string() + ".tmp.pdf") : out;
-    write_file(tmp, html);
-    try {
-      print_pdf(tmp, pdf);
-      if (to_stream) {
-        std::ifstream in(pdf, std::ios::binary);
-        write_file(out, std::string(std::istreambuf_iterator<char>(in), {}));
-      }
-    } catch (...) {
-      fs::remove(tmp, ec);
-      if (to_stream) fs::remove(pdf, ec);
-      throw;
-    }
-    fs::remove(tmp, ec);
-    if (to_stream) {
-      streamed_bytes = fs::file_size(pdf, ec);
-      fs::remove(pdf, ec);
-    }
+    const auto log =
+        to_stream ? fs::temp_directory_path() / fmt::format("caldaq-report-{}.pdf.log", ::getpid())
+                  : fs::path(out).concat(".log");
+    streamed_bytes = print_pdf_text(html, out, log);
   }
   // The size written: a pipe or a terminal (-o /dev/stdout) has none to ask the file system for.
   std::error_code size_error;

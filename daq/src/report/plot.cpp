@@ -13,31 +13,9 @@
 #include <numbers>
 #include <stdexcept>
 
-namespace cal::daq::report {
+#include "markup.hpp"
 
-std::string html_escape(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+namespace cal::daq::report {
 
 Rgb palette(std::size_t i) {
   static constexpr Rgb colours[] = {blue, vermilion, green, orange, purple, sky, black, grey};
@@ -97,7 +75,8 @@ class SvgStream {
       const auto end = a == std::string::npos ? a : s.find('"', a + std::strlen(attr));
       if (end != std::string::npos) s.erase(a, end + 1 - a);
     }
-    s.insert(4, fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", html_escape(title)));
+    s.insert(4,
+             fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", html_attribute(title)));
     return unique_ids(std::move(s));
   }
 
@@ -154,7 +133,7 @@ struct Range {
 };
 
 struct LegendEntry {
-  std::string text;
+  std::string text;  // as PLplot reads it (plot_text)
   PLINT colour = 1;
   PLINT opt = PL_LEGEND_LINE;
   PLINT style = 1;
@@ -200,7 +179,8 @@ void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
   plline(n, l.x.data(), l.y.data());
   if (l.markers) plpoin(n, l.x.data(), l.y.data(), 17);
   pllsty(1);
-  if (!l.label.empty()) legend.push_back({l.label, c, PL_LEGEND_LINE, l.dashed ? 2 : 1, l.width});
+  if (!l.label.empty())
+    legend.push_back({plot_text(l.label), c, PL_LEGEND_LINE, l.dashed ? 2 : 1, l.width});
 }
 
 // A tick interval of 1, 2 or 5 times a power of ten giving about `ticks` intervals over a
@@ -226,7 +206,7 @@ void category_label(PLINT axis, PLFLT value, char* out, PLINT length, PLPointer 
   std::string text;
   if (axis == PL_X_AXIS && k >= 0 && static_cast<std::size_t>(k) < labels.size() &&
       std::abs(value - static_cast<double>(k)) < 1e-6)
-    text = labels[static_cast<std::size_t>(k)];
+    text = plot_text(labels[static_cast<std::size_t>(k)]);
   std::snprintf(out, static_cast<std::size_t>(length), "%s", text.c_str());
 }
 
@@ -281,7 +261,7 @@ std::string svg(const XyChart& chart) {
     const PLINT c = s.colour(b.colour, b.alpha);
     plcol0(c);
     plfill(static_cast<PLINT>(px.size()), px.data(), py.data());
-    if (!b.label.empty()) entries.push_back({b.label, c, PL_LEGEND_COLOR_BOX});
+    if (!b.label.empty()) entries.push_back({plot_text(b.label), c, PL_LEGEND_COLOR_BOX});
   }
   if (chart.zero_line) {
     plcol0(reference_colour);
@@ -300,7 +280,8 @@ std::string svg(const XyChart& chart) {
   plbox("", 0, 0, "bcnstv", ystep, 0);
   plprec(0, 0);
   if (categories) plslabelfunc(nullptr, nullptr);
-  pllab(chart.x_label.c_str(), chart.y_label.c_str(), chart.title.c_str());
+  pllab(plot_text(chart.x_label).c_str(), plot_text(chart.y_label).c_str(),
+        plot_text(chart.title).c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
   if (legend) draw_legend(entries, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
   return s.finish(chart.title);
@@ -371,7 +352,7 @@ std::string svg(const PolarChart& chart) {
          (height - top) / height);
   plwind(-1.7, 1.7, -1.7, 1.7);
   plcol0(axes_colour);
-  plmtex("t", 1.5, 0.5, 0.5, chart.title.c_str());
+  plmtex("t", 1.5, 0.5, 0.5, plot_text(chart.title).c_str());
   // Rings every division, the nominal circle darker; spokes every 30 degrees.
   for (int k = -2; k <= 2; ++k) {
     const double r = 1.0 + 0.2 * k;
@@ -398,8 +379,8 @@ std::string svg(const PolarChart& chart) {
   }
   plcol0(axes_colour);
   // The axes' names inside the angle labels, beside their spokes.
-  plptex(1.42, 0.07, 1, 0, 0, ("+" + chart.first_axis).c_str());
-  plptex(0.06, 1.42, 1, 0, 0, ("+" + chart.second_axis).c_str());
+  plptex(1.42, 0.07, 1, 0, 0, plot_text("+" + chart.first_axis).c_str());
+  plptex(0.06, 1.42, 1, 0, 0, plot_text("+" + chart.second_axis).c_str());
   std::vector<LegendEntry> legend;
   for (const auto& t : chart.traces) {
     Line l = t;
@@ -416,7 +397,7 @@ std::string svg(const PolarChart& chart) {
     if (chart.mark_start && l.x.size() > 2) mark_start(l, t.x.front() < t.x.back());
   }
   plcol0(axes_colour);
-  if (!chart.centre_text.empty()) plptex(0, -0.03, 1, 0, 0.5, chart.centre_text.c_str());
+  if (!chart.centre_text.empty()) plptex(0, -0.03, 1, 0, 0.5, plot_text(chart.centre_text).c_str());
   plmtex("b", 1.0, 0.0, 0.0, fmt::format("scale {:g} µm per ring", div_um).c_str());
   if (chart.mark_start)
     plmtex("b", 1.0, 1.0, 1.0, "○ start of each trace, arrow: direction of travel");

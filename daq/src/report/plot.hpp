@@ -62,9 +62,8 @@ struct PolarChart {
   bool mark_start = true;   // each trace's first point marked, an arrow in its direction
 };
 
-// Text for HTML and SVG: < > & " escaped.
-std::string html_escape(std::string_view s);
-
+// Every text of a chart (titles, axis labels, legends, category labels) is data-safe: it is
+// passed through plot_text (markup.hpp) here, and PLplot writes it as SVG text.
 // Every SVG gets its own prefix on the element ids PLplot writes (its text clip paths are
 // always "text-clipping0", "text-clipping1"...): several plots inlined in one HTML page would
 // otherwise share the first plot's clip path, and lose their text outside it.
