@@ -16,6 +16,7 @@
 #include "csv_columns.hpp"
 #include "database.hpp"
 #include "measurement_csv.hpp"
+#include "run_quality.hpp"
 
 namespace daq {
 namespace {
@@ -25,6 +26,8 @@ namespace ct = cal::comptable;
 struct CompensateOptions {
   std::string input, straightness, db, output, output_axis;
   std::int64_t run = 0;
+  std::vector<std::int64_t> accept_suspect;  // suspect runs used knowingly (run_quality.hpp)
+  std::vector<std::int64_t> accepted;        // ... of which --run is one: said in the output
   std::string axis = "X", format = "csv", sign = "correction", units = "mm", outside = "refuse";
   double start_mm = 0, interval_mm = 0;
   std::optional<double> resolution;  // unset: by unit (default_resolution)
@@ -41,9 +44,11 @@ std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
   return p;
 }
 
-std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o) {
+std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
   if (!o.input.empty()) return read_measurements(o.input, o.csv);
   const auto store = open_database_read_only(o.db);
+  const std::int64_t runs[] = {o.run};
+  o.accepted = refuse_suspect_runs(store, runs, o.accept_suspect, "daq compensate");
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
     out.push_back(
@@ -94,6 +99,17 @@ std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) 
                   o.format == "linuxcnc" ? "; LinuxCNC documents no cross-axis table" : ""));
 }
 
+// A table from a suspect run used as told (--accept-suspect) says so in its header.
+std::string suspect_note(const CompensateOptions& o, std::string_view comment) {
+  std::string out;
+  for (const auto id : o.accepted)
+    out += fmt::format(
+        "{}SUSPECT run {}: a stop far outside its repeatability, used as told "
+        "(--accept-suspect)\n",
+        comment, id);
+  return out;
+}
+
 std::string positioning_text(const CompensateOptions& o, const ct::Table& table) {
   if (o.json) {
     nlohmann::json j{{"schema", "caldaq.comp-table.v1"},
@@ -107,9 +123,10 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
       j["reverse"] = table.reverse;
     else
       j["backlash"] = table.backlash;
+    if (!o.accepted.empty()) j["accepted_suspect_runs"] = o.accepted;
     return j.dump(2) + "\n";
   }
-  if (o.format == "csv") return ct::write_csv(table);
+  if (o.format == "csv") return suspect_note(o, "# ") + ct::write_csv(table);
   if (o.format == "linuxcnc") return ct::write_linuxcnc(table);
   if (o.format == "siemens") return ct::write_siemens(table, o.axis_number);
   if (o.format == "isg") return ct::write_isg(table);
@@ -132,7 +149,7 @@ double default_resolution(const std::string& units) {
   return u == ct::Units::inch ? 0.00001 : u == ct::Units::um ? 0.1 : 0.0001;
 }
 
-void run(const CompensateOptions& o) {
+void run(CompensateOptions& o) {
   if (o.input.empty() && o.run == 0 && o.straightness.empty())
     throw cal::InputError(
         "compensate: give --input MEAS.csv, --run RUN or --straightness FILE.csv");
@@ -153,6 +170,8 @@ void run(const CompensateOptions& o) {
     const auto m = measurements(o);
     text = positioning_text(o, ct::positioning(spec, cal::iso230_2::target_stats(m)));
   }
+  if (!o.accepted.empty() && o.format != "csv" && !o.json)  // the vendor formats: here
+    fmt::print(stderr, "{}", suspect_note(o, "note: "));
   if (o.output.empty()) return fmt::print("{}", text);
   std::ofstream out(o.output);
   if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));
@@ -166,6 +185,10 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
       app.add_subcommand("compensate", "Compensation table for the controller from a measured run");
   cmd->add_option("-i,--input", o->input, "ISO 230-2 measurement CSV (see docs/cli.md)");
   cmd->add_option("--run", o->run, "A stored linear run instead of --input");
+  cmd->add_option("--accept-suspect", o->accept_suspect,
+                  "Use --run although it is suspect (a stop far outside its repeatability; "
+                  "refused otherwise); said in the table's header")
+      ->take_all();
   add_db_option(*cmd, o->db);
   cmd->add_option("--straightness", o->straightness,
                   "Cross compensation from a straightness CSV (position_mm, deviation_um)");

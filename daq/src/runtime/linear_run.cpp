@@ -20,6 +20,7 @@
 #include "iso230_2_output.hpp"
 #include "kinds/kind.hpp"
 #include "provenance.hpp"
+#include "run_quality.hpp"
 #include "run_writer.hpp"
 #include "session_spec.hpp"
 
@@ -178,9 +179,11 @@ struct LinearRun::Impl {
   std::unique_ptr<kinds::SampleReader> reader;          // null for positioning
   std::deque<std::pair<std::int64_t, double>> samples;  // the kind's value, newest last
   std::vector<kinds::StopValue> values;                 // at the captured stops
-  // Stops captured before any sample of the kind's instrument arrived in their window (a
-  // polled gauge a little behind the laser): they take the first sample that follows within
-  // half the trigger's dwell (the machine still stands), else the run ends saying so.
+  // Stops captured before any sample of the kind's instrument measured in their window had
+  // arrived (a polled gauge behind the laser; its samples carry the time of their request):
+  // they take the first sample measured from the window's start (the machine had arrived) to
+  // half the trigger's dwell after its end (the machine still stands), never one measured
+  // before; a sample measured later than that ends the run saying so.
   struct Pending {
     std::size_t stop;
     cal::daq::Capture cap;
@@ -407,7 +410,7 @@ struct LinearRun::Impl {
     auto waiting = std::move(pending);
     pending.clear();
     for (const auto& p : waiting) {
-      if (time_ns < p.cap.end_ns) {
+      if (time_ns < p.cap.start_ns) {  // measured before the machine had arrived: not this stop's
         pending.push_back(p);
       } else if (time_ns <= p.cap.end_ns + limit_ns) {
         store_stop(p.stop, p.cap, p.comp, value);
@@ -534,6 +537,7 @@ struct LinearRun::Impl {
   // with missed stops is stored incomplete with them listed, and evaluated from what it has.
   void finish() {
     running = false;
+    report_probe_latency();
     try {
       writer->flush();
       for (const auto i : sequencer.missed()) {
@@ -546,6 +550,7 @@ struct LinearRun::Impl {
              .nominal_mm = s.position_mm});
       }
       store->set_missed_stops(outcome.run_id, outcome.missed);
+      check_quality();
       outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
                                               : cal::storage::RunStatus::incomplete;
       if (!outcome.missed.empty())
@@ -576,10 +581,41 @@ struct LinearRun::Impl {
     end();
   }
 
+  // The stops against the run's own repeatability (run_quality.hpp): stored with the run and
+  // said, each suspect stop by name.
+  void check_quality() {
+    outcome.quality = assess_stops(store->targets(outcome.run_id), kind.unit());
+    store->set_quality(outcome.run_id, outcome.quality);
+    event(fmt::format("stop quality: {}", outcome.quality.summary));
+    for (const auto& s : outcome.quality.suspects) event("SUSPECT stop: " + s.reason);
+  }
+
+  // A polled probe's answers: how late they came after their requests (each value carries its
+  // request's time), stated in the run's events and its results' provenance.
+  std::optional<cal::drivers::AnswerLatency> probe_latency() const {
+    return setup.probe ? setup.probe->answer_latency() : std::nullopt;
+  }
+  void report_probe_latency() {
+    if (const auto a = probe_latency(); a && a->answers > 0)
+      event(fmt::format(
+          "{}: answers {:.1f} ms after their request (median), at most {:.1f} ms, over {} "
+          "answers; each value is taken at its request's time{}",
+          setup.probe->describe(), static_cast<double>(a->median_ns) * 1e-6,
+          static_cast<double>(a->max_ns) * 1e-6, a->answers,
+          a->unmatched ? fmt::format(" ({} answers without a request: at arrival)", a->unmatched)
+                       : ""));
+  }
+
   // What every stored result of the run says of how it was obtained (provenance.hpp).
   json result_provenance() const {
     json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
     prov["coefficients"] = compensation_json(setup.config.environment);
+    if (const auto a = probe_latency())
+      prov["probe_answer_latency"] = {{"answers", a->answers},
+                                      {"unmatched", a->unmatched},
+                                      {"median_ms", static_cast<double>(a->median_ns) * 1e-6},
+                                      {"max_ms", static_cast<double>(a->max_ns) * 1e-6},
+                                      {"stamped", "request"}};
     if (setup.replay) {
       prov["capture"] = setup.capture_path;
       prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);
