@@ -54,7 +54,7 @@ daq::LinearRunOutcome acquire(const fs::path& db, double probe_delay_s) {
 // capture window to the next's (4 s standing, 1 s moving), so what arrives during a stop's
 // window was measured at the stop before. Stamped with their requests' times, each stop still
 // gets the value measured while the machine stood there: the same as with answers on time
-// (to the indicator's 10 nm digit; the truth has no noise). Stamped on arrival (before issue
+// (the mean of the same samples). Stamped on arrival (before issue
 // 26), the stops took the previous target's values, microns off.
 TEST(LateProbe, EachStopGetsTheValueMeasuredWhileTheMachineStoodThere) {
   const auto db = temp_db("late");
@@ -72,7 +72,7 @@ TEST(LateProbe, EachStopGetsTheValueMeasuredWhileTheMachineStoodThere) {
   double spread = 0;  // how different the targets are: what a wrong match would show
   for (const auto& [key, value] : expected) {
     ASSERT_TRUE(got.count(key));
-    EXPECT_NEAR(got.at(key), value, 0.011)
+    EXPECT_NEAR(got.at(key), value, 1e-9)
         << "run " << std::get<0>(key) << std::get<1>(key) << " target " << std::get<2>(key);
     spread = std::max(spread, std::abs(value - expected.begin()->second));
   }

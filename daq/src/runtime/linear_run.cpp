@@ -179,11 +179,12 @@ struct LinearRun::Impl {
   std::unique_ptr<kinds::SampleReader> reader;          // null for positioning
   std::deque<std::pair<std::int64_t, double>> samples;  // the kind's value, newest last
   std::vector<kinds::StopValue> values;                 // at the captured stops
-  // Stops captured before any sample of the kind's instrument measured in their window had
+  // Stops captured before a sample of the kind's instrument measured after their window had
   // arrived (a polled gauge behind the laser; its samples carry the time of their request):
-  // they take the first sample measured from the window's start (the machine had arrived) to
-  // half the trigger's dwell after its end (the machine still stands), never one measured
-  // before; a sample measured later than that ends the run saying so.
+  // when one arrives, they take the mean of the samples measured in the window (from its start,
+  // the machine had arrived, never before); with none in it, that first sample when it was
+  // measured within half the trigger's dwell after the window (the machine still stands), else
+  // the run ends saying so.
   struct Pending {
     std::size_t stop;
     cal::daq::Capture cap;
@@ -410,9 +411,11 @@ struct LinearRun::Impl {
     auto waiting = std::move(pending);
     pending.clear();
     for (const auto& p : waiting) {
-      if (time_ns < p.cap.start_ns) {  // measured before the machine had arrived: not this stop's
-        pending.push_back(p);
-      } else if (time_ns <= p.cap.end_ns + limit_ns) {
+      if (time_ns <= p.cap.end_ns) {  // in the window (kept in `samples`), or measured before
+        pending.push_back(p);         // the machine had arrived: not this stop's
+      } else if (const auto v = window_mean(p.cap)) {  // every sample of the window is in
+        store_stop(p.stop, p.cap, p.comp, *v);
+      } else if (time_ns <= p.cap.end_ns + limit_ns) {  // none in the window: the machine stands
         store_stop(p.stop, p.cap, p.comp, value);
       } else {
         const auto& s = sequencer.stops()[p.stop];
@@ -425,15 +428,25 @@ struct LinearRun::Impl {
     if (!done && pending.empty() && sequencer.complete()) finish();
   }
 
-  // The kind's value at a stop: the mean of its samples within the stop's window.
-  std::optional<double> stop_value(const cal::daq::Capture& cap) {
+  // The kind's value at a stop: the mean of its samples measured within the stop's window.
+  std::optional<double> window_mean(const cal::daq::Capture& cap) const {
     double sum = 0;
     std::size_t n = 0;
     for (const auto& [t, v] : samples)
       if (t >= cap.start_ns && t <= cap.end_ns) sum += v, ++n;
-    while (!samples.empty() && samples.front().first < cap.start_ns) samples.pop_front();
     if (n == 0) return std::nullopt;
     return sum / static_cast<double>(n);
+  }
+  // ... once every sample measured in the window is in: when one measured after it has arrived
+  // (a source's samples arrive in the order they were measured); else nullopt (pending).
+  std::optional<double> stop_value(const cal::daq::Capture& cap) const {
+    if (samples.empty() || samples.back().first <= cap.end_ns) return std::nullopt;
+    return window_mean(cap);
+  }
+  // Samples older than every window still to be valued are not needed any more.
+  void trim_samples(std::int64_t from_ns) {
+    for (const auto& p : pending) from_ns = std::min(from_ns, p.cap.start_ns);
+    while (!samples.empty() && samples.front().first < from_ns) samples.pop_front();
   }
 
   void on_laser(const Reading& r) {
@@ -493,9 +506,11 @@ struct LinearRun::Impl {
           const auto v = stop_value(cap);
           if (!v) {
             pending.push_back({e.stop, cap, c});
+            trim_samples(cap.start_ns);
             continue;
           }
           value = *v;
+          trim_samples(cap.start_ns);
         }
         if (!store_stop(e.stop, cap, c, value)) return;
       }
