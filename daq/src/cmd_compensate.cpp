@@ -19,6 +19,7 @@
 #include "database.hpp"
 #include "measurement_csv.hpp"
 #include "provenance.hpp"
+#include "run_quality.hpp"
 
 namespace daq {
 namespace {
@@ -28,6 +29,8 @@ namespace ct = cal::comptable;
 struct CompensateOptions {
   std::string input, straightness, db, output, output_axis;
   std::int64_t run = 0;
+  std::vector<std::int64_t> accept_suspect;  // suspect runs used knowingly (run_quality.hpp)
+  std::vector<std::int64_t> accepted;        // ... of which --run is one: said in the output
   std::string axis = "X", format = "csv", units = "mm", outside = "refuse";
   std::optional<std::string> sign;  // csv and --json only: the other formats' sign is the vendor's
   double start_mm = 0, interval_mm = 0;
@@ -45,9 +48,11 @@ std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
   return p;
 }
 
-std::vector<cal::iso230_2::Measurement> measurements(const CompensateOptions& o) {
+std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
   if (!o.input.empty()) return read_measurements(o.input, o.csv);
   const auto store = open_database_read_only(o.db);
+  const std::int64_t runs[] = {o.run};
+  o.accepted = refuse_suspect_runs(store, runs, o.accept_suspect, "daq compensate");
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
     out.push_back(
@@ -104,6 +109,17 @@ TableWriter writer_of(const CompensateOptions& o) {
   return w;
 }
 
+// A table from a suspect run used as told (--accept-suspect) says so in its header.
+std::string suspect_note(const CompensateOptions& o, std::string_view comment) {
+  std::string out;
+  for (const auto id : o.accepted)
+    out += fmt::format(
+        "{}SUSPECT run {}: a stop far outside its repeatability, used as told "
+        "(--accept-suspect)\n",
+        comment, id);
+  return out;
+}
+
 std::string positioning_text(const CompensateOptions& o, const ct::Table& table) {
   if (o.json) {
     nlohmann::json j{{"schema", "caldaq.comp-table.v1"},
@@ -117,9 +133,16 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
       j["reverse"] = table.reverse;
     else
       j["backlash"] = table.backlash;
+    if (!o.accepted.empty()) j["accepted_suspect_runs"] = o.accepted;
     return j.dump(2) + "\n";
   }
-  return write_table(writer_of(o), table);
+  // A table from a suspect run used as told says so in its header, where the format has comments
+  // (LinuxCNC and HEIDENHAIN tables have none: the command's output says it).
+  const std::string text = write_table(writer_of(o), table);
+  if (o.format == "csv" || o.format == "isg") return suspect_note(o, "# ") + text;
+  if (o.format == "siemens") return suspect_note(o, "; ") + text;
+  if (o.format == "fanuc") return suspect_note(o, "") + text;
+  return text;
 }
 
 // A resolution that suits each unit when none is given: 0.1 um in mm or um tables, 0.00001 in
@@ -195,6 +218,7 @@ void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct
                                {"reverse_um", a.reverse_um}}},
                              {"predicted", predicted_json(p)},
                              {"origin", to_json(origin)},
+                             {"accepted_suspect_runs", o.accepted},
                              {"text", text}};
     const auto id = store.add_compensation({.machine_id = run->machine_id,
                                             .source_run_id = o.run,
@@ -214,7 +238,7 @@ void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct
   }
 }
 
-void run(const CompensateOptions& o) {
+void run(CompensateOptions& o) {
   if (o.input.empty() && o.run == 0 && o.straightness.empty())
     throw cal::InputError(
         "compensate: give --input MEAS.csv, --run RUN or --straightness FILE.csv");
@@ -241,6 +265,8 @@ void run(const CompensateOptions& o) {
     predicted = ct::predict(a, stats);
     if (o.run != 0 && !o.json) store_compensation(o, table, a, *predicted, text);
   }
+  if (!o.accepted.empty() && o.format != "csv" && !o.json)  // the vendor formats: here too
+    fmt::print(stderr, "{}", suspect_note(o, "note: "));
   if (o.output.empty())
     fmt::print("{}", text);
   else if (std::ofstream out(o.output); !(out << text))
@@ -263,6 +289,10 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
       app.add_subcommand("compensate", "Compensation table for the controller from a measured run");
   cmd->add_option("-i,--input", o->input, "ISO 230-2 measurement CSV (see docs/cli.md)");
   cmd->add_option("--run", o->run, "A stored linear run instead of --input");
+  cmd->add_option("--accept-suspect", o->accept_suspect,
+                  "Use --run although it is suspect (a stop far outside its repeatability; "
+                  "refused otherwise); said in the table's header")
+      ->take_all();
   add_db_option(*cmd, o->db);
   cmd->add_option("--straightness", o->straightness,
                   "Cross compensation from a straightness CSV (position_mm, deviation_um)");

@@ -10,6 +10,7 @@
 #include "model/model_build.hpp"
 #include "model/model_file.hpp"
 #include "model_cli.hpp"
+#include "run_quality.hpp"
 #include "stored_model.hpp"
 
 namespace daq {
@@ -24,12 +25,16 @@ struct BuildCliOptions {
   std::string machine, db, output;
   std::string topology;
   std::vector<double> tool_offset_mm;
+  std::vector<std::int64_t> accept_suspect;  // suspect runs used knowingly (run_quality.hpp)
   bool allow_missing = false, json = false;
 };
 
 void run_build(const BuildCliOptions& o) {
   const auto store = open_database_read_only(o.db);
   const auto stored = stored_profiles(store, o.machine);
+  std::vector<std::int64_t> used_runs;
+  for (const auto& p : stored.profiles) used_runs.push_back(p.run_id);
+  const auto accepted = refuse_suspect_runs(store, used_runs, o.accept_suspect, "daq model build");
   mdl::BuildOptions b{.machine = o.machine, .allow_missing = o.allow_missing};
   if (!o.topology.empty())
     b.topology = kin::topology_from_string(o.topology);
@@ -44,7 +49,12 @@ void run_build(const BuildCliOptions& o) {
   b.table_offset_mm = stored.table_offset_mm;
   if (!o.tool_offset_mm.empty())
     b.tool_offset_mm = {o.tool_offset_mm[0], o.tool_offset_mm[1], o.tool_offset_mm[2]};
-  const auto r = mdl::build(stored.profiles, b);
+  auto r = mdl::build(stored.profiles, b);
+  if (!accepted.empty()) {  // the model says it was built from suspect runs, knowingly
+    auto prov = json::parse(r.model.provenance.json);
+    prov["accepted_suspect_runs"] = accepted;
+    r.model.provenance.json = prov.dump();
+  }
   mdl::write(r.model, o.output);
   if (o.json) {
     json used = json::object();
@@ -56,6 +66,7 @@ void run_build(const BuildCliOptions& o) {
                             {"used", used},
                             {"missing", r.missing},
                             {"skipped", stored.skipped},
+                            {"accepted_suspect_runs", accepted},
                             {"notes", r.notes}}
                            .dump(2));
     return;
@@ -68,6 +79,11 @@ void run_build(const BuildCliOptions& o) {
   if (!r.missing.empty())
     fmt::print("Missing, taken as zero (--allow-missing): {}\n", fmt::join(r.missing, ", "));
   for (const auto& s : stored.skipped) fmt::print("  not used: {}\n", s);
+  for (const auto id : accepted)
+    fmt::print(
+        "  SUSPECT run {} used as told (--accept-suspect; recorded in the model's "
+        "provenance): {}\n",
+        id, run_quality(store, id).summary);
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
 }
 
@@ -87,6 +103,10 @@ void add_model_build_command(CLI::App& model) {
       ->expected(3);
   cmd->add_flag("--allow-missing", o->allow_missing,
                 "Write a partial model: errors without a run are zero, and listed");
+  cmd->add_option("--accept-suspect", o->accept_suspect,
+                  "Use this suspect run anyway (repeatable; recorded in the model's provenance): "
+                  "runs with a stop far outside their repeatability are refused otherwise")
+      ->take_all();
   cmd->add_flag("--json", o->json, "Print caldaq.model-build.v1 JSON (runs used, missing)");
   add_db_option(*cmd, o->db);
   cmd->callback([o] { run_build(*o); });

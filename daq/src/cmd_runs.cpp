@@ -25,6 +25,7 @@
 #include "iso230_2_output.hpp"
 #include "provenance.hpp"
 #include "run_document.hpp"
+#include "run_quality.hpp"
 #include "verdict.hpp"
 
 namespace daq {
@@ -170,6 +171,7 @@ json run_document(const st::Store& store, std::int64_t id) {
   const auto missed = store.missed_stops(id);
   j["missed_stops"] = json::array();
   for (const auto& m : missed) j["missed_stops"].push_back(missed_json(m));
+  j["quality"] = quality_json(run_quality(store, id));  // suspect stops (issue 26)
   j["results"] = json::array();
   const json& settings = j["settings"];
   for (const auto& res : store.results(id)) {
@@ -204,6 +206,10 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     fmt::print("  missed stops ({}):\n", missed.size());
     for (const auto& m : missed) fmt::print("    {}\n", missed_text(m));
   }
+  // The stop quality (run_quality.hpp): the verdict, each suspect stop by name.
+  fmt::print("  stop quality: {}\n", j["quality"]["summary"].get<std::string>());
+  for (const auto& q : j["quality"]["suspect_stops"])
+    fmt::print("    SUSPECT {}\n", q["reason"].get<std::string>());
   for (const auto& i : j["instruments"])
     fmt::print("  device {}: {} on {}\n", i["device"].get<int>(), i["driver"].get<std::string>(),
                i["transport"].get<std::string>());
@@ -498,6 +504,7 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
   j["targets"] = std::move(targets);
   j["missed_stops"] = json::array();
   for (const auto& m : store.missed_stops(run.id)) j["missed_stops"].push_back(missed_json(m));
+  j["quality"] = quality_json(run_quality(store, run.id));  // suspect stops (issue 26)
   j["results"] = json::array();
   for (const auto& res : store.results(run.id))
     j["results"].push_back({{"id", res.id},

@@ -4,7 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <stdexcept>
 
 #include "sim/twin_io.hpp"
@@ -13,7 +15,7 @@ namespace cal::drivers::sim {
 
 struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeTwin::Impl> {
   Impl(boost::asio::io_context& io, World& w, Clock c, GaugeTwinConfig cfg)
-      : PtyChannel(io), world(w), clock(std::move(c)), config(std::move(cfg)) {}
+      : PtyChannel(io), ctx(io), world(w), clock(std::move(c)), config(std::move(cfg)) {}
 
   std::string line_at(double t) {
     world.advance_to(t);
@@ -24,7 +26,29 @@ struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeT
   }
 
   void on_command(const std::string& cmd) {
-    if (!config.continuous && cmd == config.request) pty.send(line_at(clock()), shared_from_this());
+    if (config.continuous || cmd != config.request) return;
+    auto line = line_at(clock());  // measured now, whenever it is sent
+    if (config.answer_delay <= std::chrono::nanoseconds::zero())
+      return pty.send(std::move(line), shared_from_this());
+    answers.emplace_back(loop_now() + config.answer_delay.count(), std::move(line));
+    if (answers.size() == 1) arm_answer();
+  }
+
+  // The delayed answers go out in the order of their requests, each when it is due.
+  void arm_answer() {
+    answer_timer.expires_after(
+        std::chrono::nanoseconds(std::max<std::int64_t>(0, answers.front().first - loop_now())));
+    answer_timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (!ec) self->send_due();
+    });
+  }
+  void send_due() {
+    const std::int64_t now = loop_now();
+    while (!answers.empty() && answers.front().first <= now) {
+      if (pty.master.is_open()) pty.send(std::move(answers.front().second), shared_from_this());
+      answers.pop_front();
+    }
+    if (!answers.empty()) arm_answer();
   }
 
   // Emits every sample that is due (k / rate <= now) in one batch per wake-up, so the stream
@@ -48,6 +72,11 @@ struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeT
     });
   }
 
+  std::int64_t loop_now() const { return loop_clock(ctx)(); }
+
+  boost::asio::io_context& ctx;
+  Timer answer_timer{ctx};
+  std::deque<std::pair<std::int64_t, std::string>> answers;  // (due, loop ns), delayed answers
   World& world;
   Clock clock;
   GaugeTwinConfig config;

@@ -2,6 +2,7 @@
 // SIMULATED line-oriented serial sensor on a pseudo-terminal: by default the length gauge of a
 // telescoping ballbar; with a value function, any scalar (a material thermometer). See
 // sim/twin.hpp.
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -18,6 +19,10 @@ struct GaugeTwinConfig {
   bool continuous = true;          // false: one reading per request line
   std::string request = "?";       // the request line (without its CR) in polled mode
   int decimals = 5;                // "+000.12345": 10 nm resolution
+  // Polled mode: each answer is sent this long (on the loop's time) after its request, with the
+  // value measured at the request: a slow adapter or a loaded host, for the tests of a run
+  // that must match a late answer to the stop where it was measured.
+  std::chrono::nanoseconds answer_delay{0};
   // What the line carries; empty: the ballbar, length(tool, pivot) - zero_length_mm. Another
   // function makes a serial thermometer on the structure, e.g. the machine temperature.
   std::function<double(const World&)> value;

@@ -152,10 +152,13 @@ CREATE TABLE ballbar_calibrations(
 CREATE INDEX ballbar_calibrations_by_bar
   ON ballbar_calibrations(bar, nominal_mm, calibrated_unix_ms);
 )sql",
-    // 4 -> 5 (issue 26): where each instrument's readings came from (a real device, a simulated
-    // twin, a replay of which capture; '' before this schema: not recorded), and the
-    // compensation tables written from runs or models, with what they were predicted to leave,
-    // so that the next measurement of the axis can be compared with the prediction.
+    // 4 -> 5 (issue 26): what is acted on must be traceable and sound. Where each instrument's
+    // readings came from (a real device, a simulated twin, a replay of which capture; '' before
+    // this schema: not recorded); the compensation tables written from runs or models, with
+    // what they were predicted to leave, so that the next measurement of the axis can be
+    // compared with the prediction; and the quality gate of a run's stops (docs/iso230-2.md,
+    // "Suspect stops"): why a stop is suspect (NULL: it is not), the run's verdict ('ok',
+    // 'suspect', 'not checked'; NULL: stored before the gate, assessed when read) and its summary.
     R"sql(
 ALTER TABLE instruments ADD COLUMN origin TEXT NOT NULL DEFAULT '';
 ALTER TABLE instruments ADD COLUMN origin_detail TEXT NOT NULL DEFAULT '';
@@ -169,6 +172,10 @@ CREATE TABLE compensations(
   created_unix_ms INTEGER NOT NULL,
   json TEXT NOT NULL);
 CREATE INDEX compensations_by_machine ON compensations(machine_id, axis, created_unix_ms);
+ALTER TABLE captured_targets ADD COLUMN suspect TEXT;
+ALTER TABLE runs ADD COLUMN quality TEXT
+  CHECK(quality IS NULL OR quality IN ('ok', 'suspect', 'not checked'));
+ALTER TABLE runs ADD COLUMN quality_note TEXT NOT NULL DEFAULT '';
 )sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
@@ -358,6 +365,7 @@ CREATE TEMP TABLE compensations(id INTEGER PRIMARY KEY, machine_id INTEGER, sour
   source TEXT, axis TEXT, format TEXT, created_unix_ms INTEGER, json TEXT);
 )sql",
          "present an older schema without origins and compensations (read-only)");
+  has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
       "('encoding', 'seq', 'crc')");
@@ -846,6 +854,52 @@ void Store::set_missed_stops(std::int64_t run_id, std::span<const MissedStop> st
     impl_->step_done(s.get(), fmt::format("store a missed stop of run {}", run_id));
   }
   tx.commit();
+}
+
+void Store::set_quality(std::int64_t run_id, const RunQuality& q) {
+  if (q.state != "ok" && q.state != "suspect" && q.state != "not checked")
+    throw StoreError(
+        fmt::format("{}: run {}: unknown quality '{}'", impl_->path.string(), run_id, q.state));
+  Impl::Transaction tx(*impl_);
+  auto r = impl_->prepare("UPDATE runs SET quality = ?, quality_note = ? WHERE id = ?");
+  bind_text(r.get(), 1, q.state);
+  bind_text(r.get(), 2, q.summary);
+  sqlite3_bind_int64(r.get(), 3, run_id);
+  impl_->step_done(r.get(), fmt::format("store the quality of run {}", run_id));
+  auto clear = impl_->prepare("UPDATE captured_targets SET suspect = NULL WHERE run_id = ?");
+  sqlite3_bind_int64(clear.get(), 1, run_id);
+  impl_->step_done(clear.get(), fmt::format("clear the suspect stops of run {}", run_id));
+  auto mark = impl_->prepare(
+      "UPDATE captured_targets SET suspect = ? WHERE run_id = ? AND run_number = ? AND "
+      "direction = ? AND target_index = ?");
+  for (const auto& m : q.suspects) {
+    bind_text(mark.get(), 1, m.reason);
+    sqlite3_bind_int64(mark.get(), 2, run_id);
+    sqlite3_bind_int(mark.get(), 3, m.run_number);
+    bind_text(mark.get(), 4, std::string_view(&m.direction, 1));
+    sqlite3_bind_int(mark.get(), 5, m.target_index);
+    impl_->step_done(mark.get(), fmt::format("mark a suspect stop of run {}", run_id));
+  }
+  tx.commit();
+}
+
+std::optional<RunQuality> Store::quality(std::int64_t run_id) const {
+  if (!impl_->has_quality) return std::nullopt;
+  auto r = impl_->prepare("SELECT quality, quality_note FROM runs WHERE id = ?");
+  sqlite3_bind_int64(r.get(), 1, run_id);
+  if (sqlite3_step(r.get()) != SQLITE_ROW || sqlite3_column_type(r.get(), 0) == SQLITE_NULL)
+    return std::nullopt;
+  RunQuality q{.state = column_text(r.get(), 0), .summary = column_text(r.get(), 1)};
+  auto s = impl_->prepare(
+      "SELECT run_number, direction, target_index, suspect FROM captured_targets "
+      "WHERE run_id = ? AND suspect IS NOT NULL ORDER BY time_ns, run_number, target_index");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  while (sqlite3_step(s.get()) == SQLITE_ROW)
+    q.suspects.push_back({.run_number = sqlite3_column_int(s.get(), 0),
+                          .direction = column_text(s.get(), 1).front(),
+                          .target_index = sqlite3_column_int(s.get(), 2),
+                          .reason = column_text(s.get(), 3)});
+  return q;
 }
 
 std::vector<MissedStop> Store::missed_stops(std::int64_t run_id) const {

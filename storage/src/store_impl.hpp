@@ -33,6 +33,9 @@ struct Store::Impl {
   // The chunk columns of schema 3 (encoding, seq, crc) are there: false only for an older
   // database opened read-only (read as it is, without checksums).
   bool chunk_checksums = true;
+  // The stop-quality columns of schema 5 (runs.quality, captured_targets.suspect) are there:
+  // false only for an older database opened read-only (its runs read as never checked).
+  bool has_quality = true;
 
   // The writer's scratch, kept between batches so that a batch allocates nothing.
   PreparedBatch prepared;  // append_readings' scratch, reused between batches

@@ -424,14 +424,14 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
   EXPECT_EQ(store.bar_calibrations().size(), 4u);
 }
 
-// A database at the version before the ballbar calibrations (the previous schema with a run in
-// it): opened, it gains the table by the last migration, keeps its run, and stores a
-// calibration.
-// What schema 5 added (origins, compensations), taken off a new file to make a version 4 one.
+// What schema 5 added (origins, compensations, the stop quality), taken off a new file to
+// make a version 4 one.
 constexpr const char* kUndoSchema5 =
     "DROP INDEX compensations_by_machine; DROP TABLE compensations; "
     "ALTER TABLE instruments DROP COLUMN origin; ALTER TABLE instruments DROP COLUMN "
-    "origin_detail; ";
+    "origin_detail; ALTER TABLE captured_targets DROP COLUMN suspect; ALTER TABLE runs DROP "
+    "COLUMN quality; ALTER TABLE runs DROP COLUMN quality_note; ";
+constexpr const char* kUndoQuality = kUndoSchema5;
 
 // Issue 26: the instruments' origin and the compensations written. A version 4 database reads
 // read-only as not recorded / none, and the next writing open migrates it.
@@ -476,6 +476,8 @@ TEST(Store, OriginsAndCompensationsAndTheVersionBefore) {
   EXPECT_TRUE(rw.compensations().empty());
 }
 
+// A database at the version before the ballbar calibrations (schema 3 with a run in it):
+// opened, it gains the table by the migrations, keeps its run, and stores a calibration.
 TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
   TempDir dir;
   const auto file = dir.path / "prev.sqlite";
@@ -507,8 +509,7 @@ TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
   EXPECT_EQ(store.bar_calibration("A", 100.0, 2)->zero_length_mm, 99.999);
 }
 
-// Read-only, a database of the previous version is read as it is: no calibrations, nothing
-// written (the version stays).
+// Read-only, a database of schema 3 is read as it is: no calibrations, nothing written.
 TEST(Store, ReadOnlyThePreviousVersionHasNoBallbarCalibrations) {
   TempDir dir;
   const auto file = dir.path / "prev.sqlite";
@@ -530,4 +531,72 @@ TEST(Store, ReadOnlyThePreviousVersionHasNoBallbarCalibrations) {
   }
   Store rw(file);  // the next writing open migrates it
   EXPECT_EQ(rw.version(), cal::storage::schema_version);
+}
+
+// A stored run's stop quality (issue 26): stored and read back with its suspect stops; set
+// again, it replaces what was there.
+TEST(Store, StoresARunsStopQuality) {
+  TempDir dir;
+  Store store(dir.path / "q.sqlite");
+  const auto run = a_run(store);
+  EXPECT_FALSE(store.quality(run));  // never checked
+  std::vector<cal::storage::CapturedTarget> stops;
+  for (int k = 0; k < 3; ++k)
+    for (const char d : {'+', '-'})
+      stops.push_back({.run_id = run,
+                       .target_index = k,
+                       .run_number = 1,
+                       .direction = d,
+                       .nominal_mm = 100.0 * k,
+                       .time_ns = k * 10 + (d == '-')});
+  store.add_targets(stops);
+  store.set_quality(run, {.state = "suspect",
+                          .summary = "suspect: 1 stop",
+                          .suspects = {{.run_number = 1,
+                                        .direction = '-',
+                                        .target_index = 2,
+                                        .reason = "run 1 down at 200 mm: far off"}}});
+  const auto q = store.quality(run);
+  ASSERT_TRUE(q);
+  EXPECT_EQ(q->state, "suspect");
+  EXPECT_EQ(q->summary, "suspect: 1 stop");
+  ASSERT_EQ(q->suspects.size(), 1u);
+  EXPECT_EQ(q->suspects[0].target_index, 2);
+  EXPECT_EQ(q->suspects[0].direction, '-');
+  EXPECT_EQ(q->suspects[0].reason, "run 1 down at 200 mm: far off");
+  store.set_quality(run, {.state = "ok", .summary = "ok"});
+  EXPECT_EQ(store.quality(run)->state, "ok");
+  EXPECT_TRUE(store.quality(run)->suspects.empty());
+  EXPECT_THROW(store.set_quality(run, {.state = "fine"}), cal::storage::StoreError);
+}
+
+// A schema 4 database: read-only, read as it is (its runs never checked, nothing written);
+// opened for writing, migrated to 5, its run still unchecked until a quality is stored.
+TEST(Store, ASchema4DatabaseReadsItsRunsAsNeverChecked) {
+  TempDir dir;
+  const auto file = dir.path / "v4.sqlite";
+  std::int64_t run = 0;
+  {
+    Store store(file);
+    run = a_run(store);
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    const auto undo = std::string(kUndoQuality) + "PRAGMA user_version = 4;";
+    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 4);
+    EXPECT_TRUE(ro.run(run).has_value());
+    EXPECT_FALSE(ro.quality(run));
+    EXPECT_TRUE(ro.targets(run).empty());
+  }
+  Store rw(file);
+  EXPECT_EQ(rw.version(), 5);
+  EXPECT_FALSE(rw.quality(run));
+  rw.set_quality(run, {.state = "ok", .summary = "ok"});
+  EXPECT_EQ(rw.quality(run)->state, "ok");
 }

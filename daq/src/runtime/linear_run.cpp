@@ -20,6 +20,7 @@
 #include "iso230_2_output.hpp"
 #include "kinds/kind.hpp"
 #include "provenance.hpp"
+#include "run_quality.hpp"
 #include "run_writer.hpp"
 #include "session_spec.hpp"
 
@@ -178,9 +179,12 @@ struct LinearRun::Impl {
   std::unique_ptr<kinds::SampleReader> reader;          // null for positioning
   std::deque<std::pair<std::int64_t, double>> samples;  // the kind's value, newest last
   std::vector<kinds::StopValue> values;                 // at the captured stops
-  // Stops captured before any sample of the kind's instrument arrived in their window (a
-  // polled gauge a little behind the laser): they take the first sample that follows within
-  // half the trigger's dwell (the machine still stands), else the run ends saying so.
+  // Stops captured before a sample of the kind's instrument measured after their window had
+  // arrived (a polled gauge behind the laser; its samples carry the time of their request):
+  // when one arrives, they take the mean of the samples measured in the window (from its start,
+  // the machine had arrived, never before); with none in it, that first sample when it was
+  // measured within half the trigger's dwell after the window (the machine still stands), else
+  // the run ends saying so.
   struct Pending {
     std::size_t stop;
     cal::daq::Capture cap;
@@ -411,9 +415,11 @@ struct LinearRun::Impl {
     auto waiting = std::move(pending);
     pending.clear();
     for (const auto& p : waiting) {
-      if (time_ns < p.cap.end_ns) {
-        pending.push_back(p);
-      } else if (time_ns <= p.cap.end_ns + limit_ns) {
+      if (time_ns <= p.cap.end_ns) {  // in the window (kept in `samples`), or measured before
+        pending.push_back(p);         // the machine had arrived: not this stop's
+      } else if (const auto v = window_mean(p.cap)) {  // every sample of the window is in
+        store_stop(p.stop, p.cap, p.comp, *v);
+      } else if (time_ns <= p.cap.end_ns + limit_ns) {  // none in the window: the machine stands
         store_stop(p.stop, p.cap, p.comp, value);
       } else {
         const auto& s = sequencer.stops()[p.stop];
@@ -426,15 +432,25 @@ struct LinearRun::Impl {
     if (!done && pending.empty() && sequencer.complete()) finish();
   }
 
-  // The kind's value at a stop: the mean of its samples within the stop's window.
-  std::optional<double> stop_value(const cal::daq::Capture& cap) {
+  // The kind's value at a stop: the mean of its samples measured within the stop's window.
+  std::optional<double> window_mean(const cal::daq::Capture& cap) const {
     double sum = 0;
     std::size_t n = 0;
     for (const auto& [t, v] : samples)
       if (t >= cap.start_ns && t <= cap.end_ns) sum += v, ++n;
-    while (!samples.empty() && samples.front().first < cap.start_ns) samples.pop_front();
     if (n == 0) return std::nullopt;
     return sum / static_cast<double>(n);
+  }
+  // ... once every sample measured in the window is in: when one measured after it has arrived
+  // (a source's samples arrive in the order they were measured); else nullopt (pending).
+  std::optional<double> stop_value(const cal::daq::Capture& cap) const {
+    if (samples.empty() || samples.back().first <= cap.end_ns) return std::nullopt;
+    return window_mean(cap);
+  }
+  // Samples older than every window still to be valued are not needed any more.
+  void trim_samples(std::int64_t from_ns) {
+    for (const auto& p : pending) from_ns = std::min(from_ns, p.cap.start_ns);
+    while (!samples.empty() && samples.front().first < from_ns) samples.pop_front();
   }
 
   void on_laser(const Reading& r) {
@@ -494,9 +510,11 @@ struct LinearRun::Impl {
           const auto v = stop_value(cap);
           if (!v) {
             pending.push_back({e.stop, cap, c});
+            trim_samples(cap.start_ns);
             continue;
           }
           value = *v;
+          trim_samples(cap.start_ns);
         }
         if (!store_stop(e.stop, cap, c, value)) return;
       }
@@ -538,6 +556,7 @@ struct LinearRun::Impl {
   // with missed stops is stored incomplete with them listed, and evaluated from what it has.
   void finish() {
     running = false;
+    report_probe_latency();
     try {
       writer->flush();
       for (const auto i : sequencer.missed()) {
@@ -550,6 +569,7 @@ struct LinearRun::Impl {
              .nominal_mm = s.position_mm});
       }
       store->set_missed_stops(outcome.run_id, outcome.missed);
+      check_quality();
       outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
                                               : cal::storage::RunStatus::incomplete;
       if (!outcome.missed.empty())
@@ -580,10 +600,41 @@ struct LinearRun::Impl {
     end();
   }
 
+  // The stops against the run's own repeatability (run_quality.hpp): stored with the run and
+  // said, each suspect stop by name.
+  void check_quality() {
+    outcome.quality = assess_stops(store->targets(outcome.run_id), kind.unit());
+    store->set_quality(outcome.run_id, outcome.quality);
+    event(fmt::format("stop quality: {}", outcome.quality.summary));
+    for (const auto& s : outcome.quality.suspects) event("SUSPECT stop: " + s.reason);
+  }
+
+  // A polled probe's answers: how late they came after their requests (each value carries its
+  // request's time), stated in the run's events and its results' provenance.
+  std::optional<cal::drivers::AnswerLatency> probe_latency() const {
+    return setup.probe ? setup.probe->answer_latency() : std::nullopt;
+  }
+  void report_probe_latency() {
+    if (const auto a = probe_latency(); a && a->answers > 0)
+      event(fmt::format(
+          "{}: answers {:.1f} ms after their request (median), at most {:.1f} ms, over {} "
+          "answers; each value is taken at its request's time{}",
+          setup.probe->describe(), static_cast<double>(a->median_ns) * 1e-6,
+          static_cast<double>(a->max_ns) * 1e-6, a->answers,
+          a->unmatched ? fmt::format(" ({} answers without a request: at arrival)", a->unmatched)
+                       : ""));
+  }
+
   // What every stored result of the run says of how it was obtained (provenance.hpp).
   json result_provenance() const {
     json prov = provenance(setup.replay ? "replayed" : "acquired", setup.software_version);
     prov["coefficients"] = compensation_json(setup.config.environment);
+    if (const auto a = probe_latency())
+      prov["probe_answer_latency"] = {{"answers", a->answers},
+                                      {"unmatched", a->unmatched},
+                                      {"median_ms", static_cast<double>(a->median_ns) * 1e-6},
+                                      {"max_ms", static_cast<double>(a->max_ns) * 1e-6},
+                                      {"stamped", "request"}};
     if (setup.replay) {
       prov["capture"] = setup.capture_path;
       prov["replay_of_run"] = setup.replay_of_run ? json(*setup.replay_of_run) : json(nullptr);

@@ -131,6 +131,8 @@ struct LinearRunOutcome {
   std::optional<nlohmann::json> profile;  // the other kinds: caldaq.profile.v1 (kinds/kind.hpp)
   std::string component;                  // the ISO 230-1 component measured, e.g. "E_YX"
   std::size_t readings = 0;
+  // The stops against the run's own repeatability (run_quality.hpp), as stored with the run.
+  cal::storage::RunQuality quality;
 };
 
 // A store or capture that fails (a full disk) ends the run as aborted with the reason

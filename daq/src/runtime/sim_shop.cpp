@@ -140,6 +140,7 @@ struct SimulatedShop::Impl {
                   {.continuous = false,
                    .request = "?",
                    .decimals = 5,  // mm: 10 nm digits
+                   .answer_delay = answer_delay(t, s, ctx),
                    // The probe point's deviation from the nominal line it is commanded on:
                    // where the axes stand off the command across the travel (a control's
                    // compensation moves them) plus the geometric error there.
@@ -154,7 +155,17 @@ struct SimulatedShop::Impl {
             {.continuous = false,
              .request = "?",
              .decimals = 3,  // urad: 1 nrad digits
+             .answer_delay = answer_delay(t, s, ctx),
              .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}) {}
+
+  // The probes' answer delay on the loop's time: simulated, or the wall clock at the speed.
+  static std::chrono::nanoseconds answer_delay(const ShopTruth& shop_truth, double shop_speed,
+                                               boost::asio::io_context& loop) {
+    const double loop_s = cal::drivers::VirtualTime::of(loop) || shop_speed <= 0
+                              ? shop_truth.probe_answer_delay_s
+                              : shop_truth.probe_answer_delay_s / shop_speed;
+    return std::chrono::nanoseconds(static_cast<std::int64_t>(loop_s * 1e9));
+  }
 
   std::size_t axis() const { return test.axis == "Y" ? 1 : test.axis == "Z" ? 2 : 0; }
   std::size_t dir() const {

@@ -58,6 +58,9 @@ struct ShopTruth {
   // All 21 geometric errors (sim_volumetric.hpp): when set, the machine's geometry is this
   // instead of the E_XX scale and E_C0Y above (the servo, thermal and air settings stay).
   std::optional<cal::kinematics::Machine> geometry;
+  // Simulated seconds between a request to the indicator or the level and its answer (the
+  // value is of the request's time): a loaded host or a slow adapter, injected by the tests.
+  double probe_answer_delay_s = 0.0;
   // The deviation at 20 degC of a stop at x approached from below (up) or above.
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
 };

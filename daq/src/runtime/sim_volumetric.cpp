@@ -204,15 +204,19 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
       io, t::make_serial(io, {.device = shop.material_device()}),
       {.poll_period = poll(1.0), .clock = clock},
       {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
+  // A probe injected to answer late (ShopTruth::probe_answer_delay_s) is silent that much
+  // longer at first: not a lost connection.
+  const auto probe_silence = std::chrono::milliseconds(
+      3000 + static_cast<std::int64_t>(a.truth.probe_answer_delay_s / pace * 1e3));
   if (test.measure.kind == "straightness")
     setup.probe = d::make_gauge(
         io, t::make_serial(io, {.device = shop.indicator_device()}),
-        {.poll_period = poll(0.1), .clock = clock},
+        {.poll_period = poll(0.1), .silence_timeout = probe_silence, .clock = clock},
         {.request = "?\r", .unit = d::codec::GaugeUnit::mm, .min_si = -0.01, .max_si = 0.01});
   if (test.measure.kind == "roll")
     setup.probe = d::make_gauge(
         io, t::make_serial(io, {.device = shop.level_device()}),
-        {.poll_period = poll(0.1), .clock = clock},
+        {.poll_period = poll(0.1), .silence_timeout = probe_silence, .clock = clock},
         {.request = "?\r", .unit = d::codec::GaugeUnit::urad, .min_si = -0.01, .max_si = 0.01});
   std::array<bool, 4> read{};
   setup.on_reading = [&read](const d::Reading& r) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -127,6 +128,15 @@ struct InstrumentOptions {
   bool replay = false;
 };
 
+// How late a polled device's answers came after their requests (answer time - request time),
+// over the answers of the session so far; the median and max are of the last kLatencyWindow.
+struct AnswerLatency {
+  static constexpr std::size_t kLatencyWindow = 4096;
+  std::uint64_t answers = 0;    // answers matched to a request
+  std::uint64_t unmatched = 0;  // answers with no request outstanding (stamped on arrival)
+  std::int64_t median_ns = 0, max_ns = 0;
+};
+
 class Instrument {
  public:
   virtual ~Instrument() = default;
@@ -139,6 +149,9 @@ class Instrument {
   virtual InstrumentState state() const = 0;
   virtual const codec::CodecStats& codec_stats() const = 0;
   virtual std::string describe() const = 0;
+  // A polled device whose readings are stamped with their request's time: how late its
+  // answers came. nullopt for a device that streams, or stamps its readings otherwise.
+  virtual std::optional<AnswerLatency> answer_latency() const { return std::nullopt; }
 };
 
 }  // namespace cal::drivers

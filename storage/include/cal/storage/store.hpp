@@ -28,8 +28,9 @@ class StoreError : public std::runtime_error {
 
 // 1: the first schema. 2: results carry their provenance; missed stops; the runs' time origin.
 // 3: reading chunks carry an encoding, a sequence number in their run and a checksum
-// (docs/storage.md). 4: ballbar calibrations (issue 18). 5: the instruments' origin (real,
-// simulated, replay) and the compensation tables written, with their predicted residual.
+// (docs/storage.md). 4: ballbar calibrations (issue 18). 5 (issue 26): the instruments' origin
+// (real, simulated, replay), the compensation tables written with their predicted residual, and
+// the quality of a run's stops (suspect stops, the run's verdict).
 inline constexpr int schema_version = 5;
 
 enum class RunStatus { running, complete, incomplete, aborted };
@@ -107,6 +108,20 @@ struct CapturedTarget {
   double deviation_um = 0.0;  // compensated actual minus nominal, at 20 degC
   double refractive_index = 1.0;
   double material_temperature_degc = 20.0;
+};
+
+// A run's stops checked against the run's own repeatability (cal::quality::assess;
+// docs/iso230-2.md, "Suspect stops"): the verdict, its summary in words and the suspect stops.
+struct StopMark {
+  int run_number = 0;
+  char direction = '+';
+  int target_index = 0;
+  std::string reason;
+};
+struct RunQuality {
+  std::string state;    // "ok", "suspect" or "not checked"
+  std::string summary;  // the verdict in words, with the rule's numbers
+  std::vector<StopMark> suspects;
 };
 
 struct ResultRecord {
@@ -265,6 +280,11 @@ class Store {
 
   // The planned stops a linear run never captured (replaces what was stored).
   void set_missed_stops(std::int64_t run_id, std::span<const MissedStop> stops);
+  // The run's stop quality, replacing what was stored; throws StoreError for an unknown state.
+  void set_quality(std::int64_t run_id, const RunQuality& q);
+  // nullopt: never stored (a run stored before schema 5, an import; an older database opened
+  // read-only): assess it from its stops (daq's run_quality()).
+  std::optional<RunQuality> quality(std::int64_t run_id) const;
   std::vector<MissedStop> missed_stops(std::int64_t run_id) const;
   // The session clock reading at a UTC instant (ns since the Unix epoch), see RunRecord.
   void set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns);
