@@ -82,6 +82,11 @@ class TemperCodec : public CodecBase<TemperCodec, TemperFrame> {
   // reports it came in (the firmware answer is two).
   const std::string& model() const { return model_; }
   int model_reports() const { return model_reports_; }
+  // Forgets the model string received so far (the firmware query is being asked again).
+  void reset_model() {
+    model_.clear();
+    model_reports_ = 0;
+  }
   // The sensor count from the last init answer (0x82), 0 before one.
   int sensor_count() const { return sensor_count_; }
 
