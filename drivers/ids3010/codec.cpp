@@ -157,6 +157,42 @@ std::string IdsCodec::encode(IdsMethod method, std::span<const IdsParam> params)
   return j.dump() + "\n";
 }
 
+std::vector<std::string_view> json_objects(std::string_view text) {
+  std::vector<std::string_view> out;
+  std::size_t start = std::string_view::npos;  // of the object (or stray text) being read
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (depth == 0 && c != '{') {
+      if (c != ' ' && c != '\t' && c != '\r' && c != '\n' && start == std::string_view::npos)
+        start = i;  // stray text: kept until the next object
+      continue;
+    }
+    if (depth == 0) {
+      if (start != std::string_view::npos) out.push_back(text.substr(start, i - start));
+      start = i;
+    }
+    if (c == '"') in_string = true;
+    if (c == '{') ++depth;
+    if (c == '}' && --depth == 0) {
+      out.push_back(text.substr(start, i + 1 - start));
+      start = std::string_view::npos;
+    }
+  }
+  if (start != std::string_view::npos) out.push_back(text.substr(start));
+  return out;
+}
+
 void IdsCodec::note_requests(std::span<const std::byte> bytes) {
   sent_splitter_.feed(
       bytes,

@@ -25,6 +25,12 @@
 
 namespace cal::drivers::codec {
 
+// The top-level JSON objects of `text` in order ({...}, braces inside strings ignored), as
+// views into it; text outside them that is not white space, and an object left open, are
+// returned as pieces of their own (so that parsing them reports them). ACS.py writes requests
+// unterminated, so one line of a capture may hold a request and its answer.
+std::vector<std::string_view> json_objects(std::string_view text);
+
 // The generation of the displacement and system interfaces (see above).
 enum class IdsApi { ids, sen };
 std::string_view to_string(IdsApi api);  // "com.attocube.ids", "com.attocube.sen"

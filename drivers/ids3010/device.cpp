@@ -66,18 +66,23 @@ class TranscriptDecoder final : public detail::LineDecoder {
   const codec::CodecStats& stats() const override { return codec_.stats(); }
 
  private:
+  // attocube's own client (IDS-APIs python/ACS.py) writes each request with no terminator and
+  // reads the answer up to CR LF, so a capture of both directions has each request and its
+  // answer on one line: each JSON object of a line is taken on its own.
   void on_line(std::string_view line, std::uint64_t offset,
                std::vector<DecodedItem>& out) override {
-    const std::string with_eol = std::string(line) + "\n";
-    if (line.find("\"method\"") != std::string_view::npos) {
-      codec_.note_requests(codec::as_bytes(with_eol));
-      return;
+    for (const auto object : codec::json_objects(line)) {
+      const std::string with_eol = std::string(object) + "\n";
+      if (object.find("\"method\"") != std::string_view::npos) {
+        codec_.note_requests(codec::as_bytes(with_eol));
+        continue;
+      }
+      frames_.clear();
+      errors_.clear();
+      codec_.feed(with_eol, frames_, errors_);
+      add_errors_at(offset, errors_, out);
+      for (const auto& r : frames_) on_response(r, offset, out);
     }
-    frames_.clear();
-    errors_.clear();
-    codec_.feed(with_eol, frames_, errors_);
-    add_errors_at(offset, errors_, out);
-    for (const auto& r : frames_) on_response(r, offset, out);
   }
 
   void on_response(const codec::IdsResponse& r, std::uint64_t offset,

@@ -61,7 +61,8 @@ constexpr TemperModel kModels[] = {
     {"TEMPer1F_V4.1", TemperFamily::gold, false, true, false, {0, 1}, "OpenBSD ugold.c (TEMPer1F lacks the inner sensor), ccwienk/temper"},
     // TEMPerX family: the stick's temperature and humidity.
     {"TEMPerX_V3.1", TemperFamily::temperx, true, false, true, {0, 1}, "OpenBSD ugold.c, urwen/temper"},
-    {"TEMPerX_V3.3", TemperFamily::temperx, true, false, true, {0, 1}, "OpenBSD ugold.c, urwen/temper (its external sensor's report id is undocumented: not read)"},
+    {"TEMPerX_V3.3", TemperFamily::temperx, true, true, true, {0, 1}, "OpenBSD ugold.c, urwen/temper; the probe (id 01) from urwen/temper PR #16's usbmon trace of a TEMPer1F"},
+    {"TEMPerHUM_V3.8", TemperFamily::temperx, true, false, true, {0, 1}, "ccwienk/temper PR #45, urwen/temper #29 and #34 (as TEMPerHUM_V3.9)"},
     {"TEMPerHUM_V3.9", TemperFamily::temperx, true, false, true, {0, 1}, "OpenBSD ugold.c, urwen/temper"},
     {"TEMPerHUM_V4.0", TemperFamily::temperx, true, false, true, {0, 1}, "OpenBSD ugold.c"},
     {"TEMPerHUM_V4.1", TemperFamily::temperx, true, false, true, {0, 1}, "OpenBSD ugold.c"},
@@ -153,6 +154,18 @@ void TemperCodec::emit_ds75(int sensor, const std::uint8_t* reg, std::vector<Tem
   emit_temperature(sensor, be16(reg) / 256.0, std::nullopt, frames, errors);
 }
 
+// A TEMPerX_V3.3 firmware also runs sticks with a probe (TEMPer1F, TEMPer2): urwen/temper PR
+// #16's usbmon trace of a TEMPer1F shows 80 01 08 dc 4e 20, the probe at 22.68 degC with 4e 20
+// (200.00, the value urwen/temper's _parse_bytes skips as "no value") where a stick reports
+// humidity. The probe measures no humidity, so those two bytes are never read as one.
+void TemperCodec::emit_temperx_probe(const std::uint8_t* r, std::vector<TemperFrame>& frames,
+                                     std::vector<CodecError>& errors) {
+  if (!config_.probe)
+    return report(errors, ErrorKind::malformed, offset_,
+                  "temperx sensor id 01 (the probe): the model has no probe");
+  emit_temperature(1, be16(r + 2) / 100.0, std::nullopt, frames, errors);
+}
+
 void TemperCodec::on_report(const std::uint8_t* r, std::vector<TemperFrame>& frames,
                             std::vector<CodecError>& errors) {
   if (r[0] == kInit) {
@@ -196,7 +209,9 @@ void TemperCodec::on_report(const std::uint8_t* r, std::vector<TemperFrame>& fra
     default:
       break;
   }
-  if (!inner_id)  // temperx, sht2x, si700x: the stick's sensor only
+  if (config_.family == TemperFamily::temperx && r[1] == 0x01)
+    return emit_temperx_probe(r, frames, errors);
+  if (!inner_id)  // temperx (but its probe), sht2x, si700x: the stick's sensor only
     return report(errors, ErrorKind::malformed, offset_,
                   fmt::format("{} sensor id {:02x} (expected 04, 20, 40 or 80)",
                               to_string(config_.family), r[1]));

@@ -15,7 +15,8 @@
 //           each value is depends on the model (TEMPer1F_V1.3 has only the second, its probe).
 //   gold  : 80 SS th tl ..; SS = 0x80 inner sensor, 0x01 outer (probe), a report per sensor;
 //           T = int16(th<<8 | tl) / 100 degC; 200.00 degC means "probe missing".
-//   temperx: 80 SS th tl hh hl ..; SS in {04, 20, 40, 80} (inner); T as gold, RH = (hh hl)/100.
+//   temperx: 80 SS th tl hh hl ..; SS in {04, 20, 40, 80} (inner); T as gold, RH = (hh hl)/100;
+//           SS = 01: the probe of a TEMPer1F/TEMPer2 on TEMPerX firmware, hh hl the 4e 20 filler.
 //   sht2x : 80 SS th tl hh hl ..; Sensirion SHT2x equations on the raw counts (urwen/temper):
 //           T = -46.85 + 175.72 * 4 t / 65536, RH = -6 + 125 * 16 h / 65536.
 //   si7005, si7006: as OpenBSD's ugold (Silicon Labs equations), SS as temperx.
@@ -81,6 +82,11 @@ class TemperCodec : public CodecBase<TemperCodec, TemperFrame> {
   // reports it came in (the firmware answer is two).
   const std::string& model() const { return model_; }
   int model_reports() const { return model_reports_; }
+  // Forgets the model string received so far (the firmware query is being asked again).
+  void reset_model() {
+    model_.clear();
+    model_reports_ = 0;
+  }
   // The sensor count from the last init answer (0x82), 0 before one.
   int sensor_count() const { return sensor_count_; }
 
@@ -94,6 +100,8 @@ class TemperCodec : public CodecBase<TemperCodec, TemperFrame> {
                  std::vector<CodecError>& errors);
   void emit_temperature(int sensor, double t_degc, std::optional<double> rh,
                         std::vector<TemperFrame>& frames, std::vector<CodecError>& errors);
+  void emit_temperx_probe(const std::uint8_t* r, std::vector<TemperFrame>& frames,
+                          std::vector<CodecError>& errors);
   void emit_ds75(int sensor, const std::uint8_t* reg, std::vector<TemperFrame>& frames,
                  std::vector<CodecError>& errors);
 

@@ -35,9 +35,12 @@ constexpr KnownDevice kUsb[] = {
     {0x0c45, 0x7401, "temper",
      "Microdia TEMPer: TEMPerF1.2/F1.4, TEMPer1F_V1.3, TEMPer1F1.1 (DS75)", "hid"},
     {0x0c45, 0x7402, "temper", "Microdia TEMPerHUM: TEMPer1F_H1V1.5F, TEMPerHum M12", "hid"},
-    {0x413d, 0x2107, "temper", "PCsensor TEMPerGold_V3.1, TEMPerX_V3.1/V3.3", "hid"},
+    {0x413d, 0x2107, "temper",
+     "PCsensor TEMPerGold_V3.1, TEMPerX_V3.1/V3.3 (also a TEMPer1F on TEMPerX_V3.3)", "hid"},
     {0x1a86, 0xe025, "temper",
-     "WCH (QinHeng) TEMPerGold_V3.3/V3.4, TEMPer2_V3.7/V3.9, TEMPer1F_V3.9, TEMPerHUM_V3.9", "hid"},
+     "WCH (QinHeng) TEMPerGold_V3.3/V3.4, TEMPer2_V3.7/V3.9, TEMPer1F_V3.9, "
+     "TEMPerHUM_V3.8/V3.9",
+     "hid"},
     {0x3553, 0xa001, "temper", "PCsensor TEMPerGold_V3.5, TEMPer2_V4.1", "hid"},
 };
 

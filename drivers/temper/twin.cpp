@@ -42,6 +42,7 @@ struct TemperTwin::Impl {
         a[i] = static_cast<std::uint8_t>(s[i]);
         b[i] = static_cast<std::uint8_t>(s[8 + i]);
       }
+      if (++firmware_queries <= config.half_firmware_answers) return {b};
       return {a, b};
     }
     if (cmd != 0x80) return {};
@@ -79,6 +80,12 @@ struct TemperTwin::Impl {
         put16(r, 2, std::llround(inner_degc * 100.0));
         put16(r, 4, std::llround(air.humidity_pct * 100.0));
         out_reports.push_back(r);
+        if (model.probe) {  // TEMPerX_V3.3 on a stick with a probe: 80 01 th tl 4e 20
+          Report p{0x80, 0x01};
+          put16(p, 2, std::llround(probe_degc * 100.0));
+          put16(p, 4, 20000);  // the 200.00 filler of urwen/temper PR #16's trace
+          out_reports.push_back(p);
+        }
         break;
       }
     }
@@ -91,6 +98,7 @@ struct TemperTwin::Impl {
   // Unknown firmware: a two-sensor gold stick.
   codec::TemperModel model{"", codec::TemperFamily::gold, true, true, false, {0, 1}, ""};
   std::uint64_t sent = 0;
+  int firmware_queries = 0;
   std::uint64_t generation = 0;  // unplug() ends the transports of earlier generations
 };
 
@@ -153,5 +161,6 @@ std::unique_ptr<transport::Transport> TemperTwin::connect(boost::asio::io_contex
 }
 void TemperTwin::unplug() { ++impl_->generation; }
 std::uint64_t TemperTwin::reports_sent() const { return impl_->sent; }
+int TemperTwin::firmware_queries() const { return impl_->firmware_queries; }
 
 }  // namespace cal::drivers::sim

@@ -21,6 +21,9 @@ struct TemperTwinConfig {
   bool inner = true;      // the sensor in the stick (the air around it)
   bool probe = true;      // the probe on its cable (the machine structure)
   bool humidity = false;  // temperx: the stick's humidity
+  // The first this many firmware queries are answered with the second report only ("V3.3    "),
+  // as a real TEMPer1F sometimes does (urwen/temper #9, PR #16's usbmon trace).
+  int half_firmware_answers = 0;
 };
 
 class TemperTwin final : public Twin {
@@ -32,6 +35,7 @@ class TemperTwin final : public Twin {
   std::unique_ptr<transport::Transport> connect(boost::asio::io_context& io) override;
   void unplug() override;
   std::uint64_t reports_sent() const;
+  int firmware_queries() const;  // how many 01 86 ff 01 it was sent
 
   struct Impl;  // (public so that the in-process transport can hold it weakly)
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
 #include "ids3010/codec.hpp"
 
@@ -174,6 +175,49 @@ TEST(IdsCodec, PendingRequestsAreBounded) {
          frames);  // the oldest were forgotten: id 1 no longer matches
   EXPECT_TRUE(frames.empty());
   EXPECT_EQ(c.stats().malformed, 1u);
+}
+
+TEST(IdsDecode, ACaptureOfBothDirectionsAsAttocubesClientWritesThem) {
+  // IDS-APIs python/ACS.py writes json.dumps(request) with no terminator and reads each answer
+  // with readline() on a socket file opened with newline='\r\n': a TCP stream capture has
+  // each request and its answer on one line, the line ending CR LF. 1e12 pm = 1 m; the
+  // displacements here: 1,500,000 pm = 1.5e-6 m, -250 pm, 0. Nothing is left out or misread:
+  // three readings from the first answer, the ECU temperature from the second.
+  const std::string capture =
+      R"({"jsonrpc": "2.0", "method": "com.attocube.ids.displacement.getAxesDisplacement", )"
+      R"("api": 2, "id": 7})"
+      R"({"jsonrpc":"2.0","result":[0,1500000,-250,0],"id":7})"
+      "\r\n"
+      R"({"jsonrpc": "2.0", "method": "com.attocube.ecu.getTemperatureInDegrees", "api": 2, )"
+      R"("id": 8}{"jsonrpc":"2.0","result":[0,20.5],"id":8})"
+      "\r\n";
+  namespace d = cal::drivers;
+  const auto& drv = d::driver("ids3010");
+  auto decoder = drv.make_decoder(d::options_from_text(drv, {}));
+  std::vector<d::DecodedItem> items;
+  decoder->feed(std::as_bytes(std::span(capture)), items);
+  decoder->finish(items);
+  std::vector<d::DecodedItem> readings;
+  for (const auto& i : items) {
+    EXPECT_NE(i.kind, d::DecodedItem::Kind::error) << i.text;
+    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
+  }
+  ASSERT_EQ(readings.size(), 4u);
+  EXPECT_DOUBLE_EQ(readings[0].value, 1.5e-6);
+  EXPECT_DOUBLE_EQ(readings[1].value, -250e-12);
+  EXPECT_EQ(readings[1].channel, 1);
+  EXPECT_EQ(readings[3].quantity, d::Quantity::air_temperature_degc);
+  EXPECT_DOUBLE_EQ(readings[3].value, 20.5);
+  EXPECT_EQ(decoder->stats().errors(), 0u);
+}
+
+TEST(IdsCodec, JsonObjectsOfALineBracesInStringsAndStrayText) {
+  using cal::drivers::codec::json_objects;
+  EXPECT_EQ(json_objects(R"({"a":"}{"} {"b":{"c":1}})"),
+            (std::vector<std::string_view>{R"({"a":"}{"})", R"({"b":{"c":1}})"}));
+  EXPECT_EQ(json_objects(R"(junk{"a":1}{"b":)"),
+            (std::vector<std::string_view>{"junk", R"({"a":1})", R"({"b":)"}));
+  EXPECT_TRUE(json_objects(" \t").empty());
 }
 
 }  // namespace

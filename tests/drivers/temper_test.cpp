@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
 #include "temper/codec.hpp"
 
@@ -167,7 +168,11 @@ TEST(TemperModels, DetectedFromTheFirmwareStringsThePublicProjectsShow) {
       // urwen/temper: TEMPer1F_H1V1.5F, temperature and humidity with SHT2x equations.
       {"TEMPer1F_H1V1.5F", TemperFamily::sht2x, true, false, true},
       // ugold.c: "TEMPerX_" + "V3.3    " and "TEMPerHUM" + "_V3.9  ": temperx.
-      {"TEMPerX_V3.3    ", TemperFamily::temperx, true, false, true},
+      // urwen/temper PR #16: a TEMPer1F on TEMPerX_V3.3 sends its probe (id 01), so the
+      // firmware allows one (a TEMPerX stick of that firmware never sends 01).
+      {"TEMPerX_V3.3    ", TemperFamily::temperx, true, true, true},
+      // ccwienk/temper PR #45 (urwen/temper #29, #34): "TEMPerHUM_V3.8  ", as V3.9.
+      {"TEMPerHUM_V3.8  ", TemperFamily::temperx, true, false, true},
       {"TEMPerHUM_V3.9  ", TemperFamily::temperx, true, false, true},
   };
   for (const auto& c : cases) {
@@ -253,6 +258,85 @@ TEST(TemperCodec, Sht2xSi7005AndSi7006Equations) {
   EXPECT_NEAR(b.frames[0].temperature_degc, 25.90906, 1e-5);
   EXPECT_DOUBLE_EQ(*b.frames[0].humidity_pct, 48.6875);
   EXPECT_EQ(temper_family_from_string("sht2x"), TemperFamily::sht2x);
+}
+
+// `daq decode temper` on a text of hex reports (one per line), as the command feeds it.
+std::vector<cal::drivers::DecodedItem> decode_temper(const std::string& text) {
+  namespace d = cal::drivers;
+  const auto& drv = d::driver("temper");
+  auto decoder = drv.make_decoder(d::options_from_text(drv, {}));
+  std::vector<d::DecodedItem> items;
+  decoder->feed(std::as_bytes(std::span(text)), items);
+  decoder->finish(items);
+  return items;
+}
+
+std::vector<cal::drivers::DecodedItem> of_kind(const std::vector<cal::drivers::DecodedItem>& all,
+                                               cal::drivers::DecodedItem::Kind kind) {
+  std::vector<cal::drivers::DecodedItem> out;
+  for (const auto& i : all)
+    if (i.kind == kind) out.push_back(i);
+  return out;
+}
+
+TEST(TemperModels, ATemper1FOnTemperXV33FirmwareIsReadAsItsProbe) {
+  // urwen/temper PR #16's usbmon trace (TEMPer1F, 413d:2107, firmware "TEMPerX_" "V3.3    "):
+  // data 80 01 08 dc 4e 20 00 00: 0x08DC = 2268 -> 22.68 degC on the probe; 4e 20 (200.00) is
+  // the filler where a stick has humidity, never a humidity. The same PR's title shows
+  // 80 01 08 98 4e 20: 0x0898 = 2200 -> 22.00 degC.
+  const auto* m = temper_model_of("TEMPerX_V3.3    ");
+  ASSERT_NE(m, nullptr);
+  const auto d = codec_test::feed_whole(
+      TemperCodec({.family = m->family, .inner = m->inner, .probe = m->probe}),
+      report({0x80, 0x01, 0x08, 0xDC, 0x4E, 0x20}) + report({0x80, 0x01, 0x08, 0x98, 0x4E, 0x20}));
+  ASSERT_EQ(d.frames.size(), 2u);
+  for (const auto& f : d.frames) {
+    EXPECT_EQ(f.sensor, 1);
+    EXPECT_FALSE(f.humidity_pct);
+  }
+  EXPECT_DOUBLE_EQ(d.frames[0].temperature_degc, 22.68);
+  EXPECT_DOUBLE_EQ(d.frames[1].temperature_degc, 22.0);
+  EXPECT_EQ(d.stats.malformed, 0u);
+
+  // The same through `daq decode temper`: one reading, channel 1, no error.
+  const auto items = decode_temper("firmware: TEMPerX_V3.3    \n80 01 08 dc 4e 20 00 00\n");
+  const auto readings = of_kind(items, cal::drivers::DecodedItem::Kind::reading);
+  EXPECT_TRUE(of_kind(items, cal::drivers::DecodedItem::Kind::error).empty());
+  ASSERT_EQ(readings.size(), 1u);
+  EXPECT_EQ(readings[0].channel, 1);
+  EXPECT_DOUBLE_EQ(readings[0].value, 22.68);
+
+  // A probe report on a temperx model without a probe (TEMPerX_V3.1) stays malformed.
+  const auto* x31 = temper_model_of("TEMPerX_V3.1    ");
+  ASSERT_NE(x31, nullptr);
+  const auto none = codec_test::feed_whole(
+      TemperCodec({.family = x31->family, .inner = x31->inner, .probe = x31->probe}),
+      report({0x80, 0x01, 0x08, 0xDC, 0x4E, 0x20}));
+  EXPECT_TRUE(none.frames.empty());
+  EXPECT_EQ(none.stats.malformed, 1u);
+}
+
+TEST(TemperModels, TemperHumV38IsReadAsV39AndAnUnknownVersionIsRefusedByName) {
+  // ccwienk/temper PR #45's verbose output: firmware 54454d50657248554d5f56332e382020
+  // ("TEMPerHUM_V3.8  "), data 80 20 09 01 11 93: 0x0901 = 2305 -> 23.05 degC, 0x1193 = 4499
+  // -> 44.99 %RH.
+  const auto items = decode_temper("firmware: TEMPerHUM_V3.8  \n80 20 09 01 11 93 00 00\n");
+  EXPECT_TRUE(of_kind(items, cal::drivers::DecodedItem::Kind::error).empty());
+  const auto readings = of_kind(items, cal::drivers::DecodedItem::Kind::reading);
+  ASSERT_EQ(readings.size(), 2u);
+  EXPECT_DOUBLE_EQ(readings[0].value, 23.05);
+  EXPECT_EQ(readings[1].quantity, cal::drivers::Quantity::air_humidity_pct);
+  EXPECT_DOUBLE_EQ(readings[1].value, 44.99);
+
+  // A version no source shows is still refused, naming it.
+  EXPECT_EQ(temper_model_of("TEMPerHUM_V3.7  "), nullptr);
+  const auto refused = decode_temper("firmware: TEMPerHUM_V3.7  \n80 20 09 01 11 93 00 00\n");
+  EXPECT_TRUE(of_kind(refused, cal::drivers::DecodedItem::Kind::reading).empty());
+  const auto errors = of_kind(refused, cal::drivers::DecodedItem::Kind::error);
+  ASSERT_FALSE(errors.empty());
+  EXPECT_NE(errors[0].text.find("TEMPer firmware 'TEMPerHUM_V3.7  ' is not in the detection table"),
+            std::string::npos)
+      << errors[0].text;
 }
 
 }  // namespace

@@ -422,9 +422,12 @@ struct TemperBench {
   std::unique_ptr<sim::TemperTwin> twin;
   Recorder rec;
   std::vector<std::string> messages;
-  std::unique_ptr<d::Instrument> start(std::string firmware, d::TemperOptions options) {
+  std::unique_ptr<d::Instrument> start(std::string firmware, d::TemperOptions options,
+                                       int half_firmware_answers = 0) {
     twin = std::make_unique<sim::TemperTwin>(
-        io, world, [this] { return now_s; }, sim::TemperTwinConfig{.firmware = firmware});
+        io, world, [this] { return now_s; },
+        sim::TemperTwinConfig{.firmware = firmware,
+                              .half_firmware_answers = half_firmware_answers});
     auto inst = d::make_temper(
         io, twin->connect(io),
         {.device = 2, .name = "table", .backoff = {.max_attempts = 1}, .poll_period = 5ms},
@@ -487,6 +490,50 @@ TEST(TemperInstrument, AnUnknownFirmwareIsRefusedNamingItNeverGuessed) {
   EXPECT_NE(b.rec.reasons.back().find("TEMPer firmware 'TEMPerGold_V9.9 ' is not in the "
                                       "detection table (docs/drivers.md); if you know its report "
                                       "layout, set family = "),
+            std::string::npos)
+      << b.rec.reasons.back();
+}
+
+TEST(TemperInstrument, AHalfAnsweredFirmwareQueryIsAskedAgainAndTheProbeRead) {
+  // A TEMPer1F on TEMPerX_V3.3 answers the first query with its second half only ("V3.3    ",
+  // urwen/temper PR #16's usbmon trace); asked again, it answers whole. The probe (id 01) is
+  // then read, without waiting for the silence watchdog to reconnect.
+  TemperBench b;
+  auto t = b.start("TEMPerX_V3.3    ", {.family = std::nullopt, .channels = {1}}, 1);
+  ASSERT_TRUE(run_until(b.io, [&] { return b.rec.readings.size() >= 3; }))
+      << (b.rec.reasons.empty() ? "" : b.rec.reasons.back());
+  std::size_t probe = 0;
+  for (const auto& r : b.rec.readings) {
+    if (r.quantity != d::Quantity::material_temperature_degc) continue;  // the stick's humidity
+    EXPECT_EQ(r.channel, 1);
+    EXPECT_DOUBLE_EQ(r.value, 19.5);  // the probe on the structure
+    ++probe;
+  }
+  EXPECT_GE(probe, 1u);
+  EXPECT_EQ(b.twin->firmware_queries(), 2);
+  EXPECT_EQ(std::count(b.rec.states.begin(), b.rec.states.end(), d::InstrumentState::reconnecting),
+            0);
+  ASSERT_GE(b.messages.size(), 2u);
+  EXPECT_EQ(b.messages[0],
+            "TEMPer firmware query 1 of 10: 'V3.3    ' (1 report of the 2, the second half only); "
+            "asking again");
+  EXPECT_EQ(b.messages[1].rfind("firmware 'TEMPerX_V3.3    ': temperx family", 0), 0u)
+      << b.messages[1];
+  t->stop();
+}
+
+TEST(TemperInstrument, TheFirmwareQueryIsAskedABoundedNumberOfTimes) {
+  // A stick that never answers whole: asked firmware_tries times, then the connection ends
+  // naming what came (never a model guessed from half a string).
+  TemperBench b;
+  auto t = b.start("TEMPerX_V3.3    ",
+                   {.family = std::nullopt, .firmware_tries = 3, .firmware_quiet = 10ms}, 1000);
+  ASSERT_TRUE(run_until(b.io, [&] { return t->state() == d::InstrumentState::closed; }));
+  EXPECT_TRUE(b.rec.readings.empty());
+  EXPECT_EQ(b.twin->firmware_queries(), 3);
+  EXPECT_NE(b.rec.reasons.back().find("TEMPer: no whole answer to the firmware query (01 86 ff "
+                                      "01) in 3 tries; the last: 'V3.3    ' (1 report of the 2, "
+                                      "the second half only)"),
             std::string::npos)
       << b.rec.reasons.back();
 }
