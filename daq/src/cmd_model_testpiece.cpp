@@ -93,8 +93,10 @@ void run(const Options& o) {
   tp::Cutting cut;
   cut.origin_mm = {o.origin_mm[0], o.origin_mm[1], o.origin_mm[2]};
   cut.tool_radius_mm = o.tool_radius_mm;
-  const tp::Result predicted =
-      tp::evaluate(o.layout, tp::predict_profiles(model.machine, o.layout, cut));
+  const auto profiles = tp::predict_profiles(model.machine, o.layout, cut);
+  for (const auto& p : profiles)  // before the fits, which refuse them without naming the model
+    require_finite(p.deviation_um, fmt::format("{}: the predicted profile of {}", o.file, p.feature));
+  const tp::Result predicted = tp::evaluate(o.layout, profiles);
   std::optional<tp::Result> measured;
   if (!o.cmm.empty()) {
     const auto csv = read_csv_columns(o.cmm, {"x_mm", "y_mm"}, {"feature"});

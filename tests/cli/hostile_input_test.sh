@@ -4,7 +4,7 @@
 # non-finite or out of syntax is written into a part program or a controller table.
 # Usage: hostile_input_test.sh DAQ_BINARY DATA_DIR
 set -u
-DAQ=$1
+DAQ=$(realpath "$1")  # absolute: the numeric options are tried from $TMP
 DATA=$2
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
@@ -161,7 +161,7 @@ check rtx_odd_tail_noted 0 "ends inside a sample \(3 bytes dropped\)" -- "$DAQ" 
 # and byte, or read as Windows-1252 when asked.
 { printf 'HEADER::\r\nOwner: CARTO-Dynamic\r\nFile Type: Linear\r\nActual sample rate: 1000\r\nBy: M\xfcller\r\nData:\r\n'
   printf '\x00\x00\x00\x00\x00\x00\xf0\x3f\r\nEOF::\r\n'; } >"$TMP/cp1252.rtx"
-check rtx_not_utf8 2 "cp1252.rtx: line 5, byte 80: the header is not UTF-8 text \(byte 0xFC\).*--header-encoding windows-1252" -- "$DAQ" import rtx "$TMP/cp1252.rtx" --db "$TMP/enc.sqlite"
+check rtx_not_utf8 2 "cp1252.rtx: line 5, byte 82: the header is not UTF-8 text \(byte 0xFC\).*--header-encoding windows-1252" -- "$DAQ" import rtx "$TMP/cp1252.rtx" --db "$TMP/enc.sqlite"
 check rtx_windows_1252 0 "imported .* into run 1" -- "$DAQ" import rtx "$TMP/cp1252.rtx" --db "$TMP/enc.sqlite" --header-encoding windows-1252
 check rtx_windows_1252_stored 0 '"By": "Müller"' -- "$DAQ" show 1 --db "$TMP/enc.sqlite" --json
 { printf 'HEADER::\r\nFile Type: Linear\r\nActual sample rate: 1000\r\nMachine: VMC\x1b]0;owned\x07\r\nData:\r\n'
@@ -175,8 +175,8 @@ check stored_axis_import 0 "into run 2" -- "$DAQ" import rtx "$TMP/real.rtx" --d
 check stored_axis_runs_escaped 0 'X\\x1B\[2J\\x1B\]52;c;aGk=\\x07' -- "$DAQ" runs --db "$TMP/enc.sqlite"
 check stored_axis_show_escaped 0 'dynamic X\\x1B\[2J' -- "$DAQ" show 2 --db "$TMP/enc.sqlite"
 check stored_no_raw_escape 0 "^no ESC$" -- bash -c "('$DAQ' runs --db '$TMP/enc.sqlite'; '$DAQ' show 2 --db '$TMP/enc.sqlite') | grep -q \$'\\e' || echo 'no ESC'"
-check device_id_control 2 "c.toml:.*device id 'la\\x1B\[2Jser': use 1 to 64 letters" -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' '[devices."la\u001b[2Jser"]' 'driver = "ptu300"' 'transport = "serial /dev/null"')"
-check device_serial_control 2 "key 'devices.air.serial_number': control characters are not allowed" -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' '[devices.air]' 'driver = "ptu300"' 'transport = "serial /dev/null"' 'serial_number = "A\u001b[2J"')"
+check device_id_control 2 'c.toml:5:1: table \[devices\]: device id .la\\x1B\[2Jser.: use 1 to 64 letters' -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' '[devices."la\u001b[2Jser"]' 'driver = "ptu300"' 'transport = "serial /dev/null 4800 7E1"')"
+check device_serial_control 2 "key 'devices.air.serial_number': control characters are not allowed" -- "$DAQ" gcode linear -c "$(conf '[test.linear]' 'count = 5' '[devices.air]' 'driver = "ptu300"' 'transport = "serial /dev/null 4800 7E1"' 'serial_number = "A\u001b[2J"')"
 
 # JSON nested 100 000 deep in a model's provenance or a component's source crashed all four
 # `daq model` commands (a recursive dump): refused with the file and the byte.
@@ -198,7 +198,7 @@ M='"schema": "caldaq.model.v1", "units": {"position": "mm", "translation": "um",
 printf '{%s, "components": {"E_XX": {"table": {"position_mm": [0, 100], "value": [0, 1e300]}}}}' "$M" >"$TMP/huge_table.json"
 check model_huge_value 2 "huge_table.json: components.E_XX.table.value\[1\]: 1e\+300 um is beyond 1e\+08 um" -- "$DAQ" model show "$TMP/huge_table.json"
 printf '{%s, "tool_offset_mm": [0, 0, 1e9]}' "$M" >"$TMP/far.json"
-check model_far_offset 2 "far.json: tool_offset_mm\[2\]: 1e\+09 mm is beyond 100000 mm" -- "$DAQ" model show "$TMP/far.json"
+check model_far_offset 2 "far.json: tool_offset_mm\[2\]: 1000000000 mm is beyond 100000 mm" -- "$DAQ" model show "$TMP/far.json"
 printf '{%s, "travel_mm": {"X": [0, 1000], "Y": [0, 1000], "Z": [-500, 0]}, "components": {"E_XX": {"polynomial": [0, 0, 0, 1e300]}}}' "$M" >"$TMP/steep.json"
 check model_polynomial_over_travel 2 "steep.json: components.E_XX.polynomial: .* um at .* mm of the X travel, beyond" -- "$DAQ" model show "$TMP/steep.json"
 printf '{%s, "components": {"E_XX": {"polynomial": [0, 0, 0, 1e300]}}}' "$M" >"$TMP/overflow.json"
