@@ -69,6 +69,8 @@ Vec3 cut_error_um(const kin::Machine& m, const Vec3& centre_mm, double edge_x, d
   return kin::volumetric_error_um(cutting, centre_mm, kin::Method::htm);
 }
 
+constexpr double kMaxPointMm = 100e3;
+
 struct Circle {
   double d0 = 0, a = 0, b = 0, circularity = 0;
 };
@@ -87,6 +89,17 @@ Circle fit_circle(const Profile& p) {
         fmt::format("{}: the points do not spread around the bore (a circle needs "
                     "points at three or more distinct angles)",
                     p.feature));
+  // Points in one half of the circle (a straight line of points, an arc of one side) fit a
+  // "circle" whose centre and circularity mean nothing: they must surround the centre.
+  std::vector<double> angles(p.position.begin(), p.position.end());
+  std::sort(angles.begin(), angles.end());
+  double gap = angles.front() + 360.0 - angles.back();
+  for (std::size_t i = 1; i < angles.size(); ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
+  if (gap >= 180.0)
+    throw InputError(
+        fmt::format("{}: the points lie within half of the bore (a gap of {:.1f} deg between "
+                    "them): probe it all round",
+                    p.feature, gap));
   const Eigen::Vector3d x = ata.ldlt().solve(aty);
   Circle c{x[0], x[1], x[2], 0.0};
   double lo = INFINITY, hi = -INFINITY;
@@ -182,6 +195,12 @@ std::vector<Profile> measured_profiles(const Layout& l, std::span<const Point> p
   for (const Point& q : points) {
     if (!std::isfinite(q.x_mm) || !std::isfinite(q.y_mm))
       throw InputError(fmt::format("{}: a point is not finite", q.feature));
+    // A part's point 100 m from its origin is a typing error (and 1e300 would overflow the
+    // fits to inf).
+    if (std::abs(q.x_mm) > kMaxPointMm || std::abs(q.y_mm) > kMaxPointMm)
+      throw InputError(
+          fmt::format("{}: the point ({}, {}) mm is beyond {:g} m of the part's origin", q.feature,
+                      q.x_mm, q.y_mm, kMaxPointMm / 1e3));
     Profile& p = by_name[q.feature];
     p.feature = q.feature;
     if (const Face* f = face_named(q.feature)) {

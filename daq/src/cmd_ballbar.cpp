@@ -10,41 +10,22 @@
 #include <optional>
 
 #include "ballbar_campaign.hpp"
+#include "bar_calibration_input.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/storage/store.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "json_input.hpp"
 #include "model/model_file.hpp"
 #include "provenance.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 namespace {
 
 using nlohmann::json;
 namespace st = cal::storage;
-
-// "YYYY-MM-DD" or "YYYY-MM-DDTHH:MM[:SS]" (UTC) as unix ms; InputError naming the option.
-std::int64_t parse_utc(const std::string& text) {
-  std::tm tm{};
-  int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0;
-  char rest = 0;
-  const int n =
-      std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d%c", &y, &mo, &d, &h, &mi, &s, &rest);
-  const bool date_only = n == 3 && text.size() == 10;
-  const bool with_time = (n == 5 && text.size() == 16) || (n == 6 && text.size() == 19);
-  if (!(date_only || with_time) || mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 ||
-      s > 59)
-    throw cal::InputError(
-        fmt::format("--date '{}': expected YYYY-MM-DD or YYYY-MM-DDTHH:MM[:SS] (UTC)", text));
-  tm.tm_year = y - 1900, tm.tm_mon = mo - 1, tm.tm_mday = d;
-  tm.tm_hour = h, tm.tm_min = mi, tm.tm_sec = s;
-  const std::time_t t = timegm(&tm);
-  std::tm back{};
-  gmtime_r(&t, &back);
-  if (back.tm_mday != d || back.tm_mon != mo - 1)
-    throw cal::InputError(fmt::format("--date '{}': no such day", text));
-  return static_cast<std::int64_t>(t) * 1000;
-}
 
 json to_json(const st::BarCalibration& c) {
   return {{"id", c.id},
@@ -61,39 +42,24 @@ json to_json(const st::BarCalibration& c) {
 }
 
 struct CalibrateOptions {
-  std::string db, bar, calibrator, extensions, date, note;
-  double nominal_mm = 0.0, calibrator_mm = 0.0, reading_mm = 0.0;
-  std::optional<double> temperature_degc;
+  std::string db, bar, calibrator, extensions, note;
+  BarCalibrationInput values;
   bool json = false;
 };
 
 void calibrate(const CalibrateOptions& o) {
-  for (double v : {o.nominal_mm, o.calibrator_mm, o.reading_mm})
-    if (!std::isfinite(v)) throw cal::InputError("ballbar calibrate: the lengths must be finite");
-  if (o.temperature_degc && !std::isfinite(*o.temperature_degc))
-    throw cal::InputError("ballbar calibrate: --temperature-degc must be finite");
-  // Sanity, not physics: a calibrator fits the bar it calibrates, and a ballbar's transducer
-  // travels a few mm at most.
-  if (std::abs(o.calibrator_mm - o.nominal_mm) > 5.0)
-    throw cal::InputError(fmt::format(
-        "ballbar calibrate: a calibrator of {} mm does not fit a {} mm bar (--calibrator-mm is "
-        "the calibrator's certified length, --nominal-mm the bar's with its extensions)",
-        o.calibrator_mm, o.nominal_mm));
-  if (std::abs(o.reading_mm) > 5.0)
-    throw cal::InputError(
-        fmt::format("ballbar calibrate: a reading of {} mm is beyond a ballbar transducer's travel "
-                    "(--reading-mm "
-                    "is the bar's reading in the calibrator, in mm)",
-                    o.reading_mm));
+  const auto& v = o.values;
+  const std::int64_t calibrated_unix_ms =
+      check_bar_calibration(v, static_cast<std::int64_t>(std::time(nullptr)));
   st::BarCalibration c{.bar = o.bar,
-                       .nominal_mm = o.nominal_mm,
+                       .nominal_mm = v.nominal_mm,
                        .extensions = o.extensions,
                        .calibrator = o.calibrator,
-                       .calibrator_length_mm = o.calibrator_mm,
-                       .reading_mm = o.reading_mm,
-                       .zero_length_mm = o.calibrator_mm - o.reading_mm,
-                       .temperature_degc = o.temperature_degc,
-                       .calibrated_unix_ms = o.date.empty() ? 0 : parse_utc(o.date),
+                       .calibrator_length_mm = v.calibrator_mm,
+                       .reading_mm = v.reading_mm,
+                       .zero_length_mm = v.calibrator_mm - v.reading_mm,
+                       .temperature_degc = v.temperature_degc,
+                       .calibrated_unix_ms = calibrated_unix_ms,
                        .note = o.note};
   st::Store store(database_path(o.db));
   c.id = store.add_bar_calibration(c);
@@ -103,11 +69,11 @@ void calibrate(const CalibrateOptions& o) {
   if (o.json) {
     json j{{"schema", "caldaq.bar-calibration.v1"}};
     j.update(to_json(c));
-    return fmt::print("{}\n", j.dump(2));
+    return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
-  fmt::print(
+  print_line(
       "calibration {} of bar '{}' at {:g} mm stored ({}): reads 0 at {:.4f} mm (calibrator {:.4f} "
-      "mm, reading {:+.4f} mm)\n",
+      "mm, reading {:+.4f} mm)",
       c.id, c.bar, c.nominal_mm, utc_iso(c.calibrated_unix_ms), c.zero_length_mm,
       c.calibrator_length_mm, c.reading_mm);
 }
@@ -118,15 +84,15 @@ void list(const std::string& db, const std::string& bar, bool as_json) {
   if (as_json) {
     json j{{"schema", "caldaq.bar-calibrations.v1"}, {"calibrations", json::array()}};
     for (const auto& c : all) j["calibrations"].push_back(to_json(c));
-    return fmt::print("{}\n", j.dump(2));
+    return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
   if (all.empty())
-    return fmt::print("no ballbar calibration stored{}\n",
+    return print_line("no ballbar calibration stored{}",
                       bar.empty() ? std::string() : fmt::format(" for bar '{}'", bar));
-  fmt::print("{:>4}  {:<16} {:>9} {:<10} {:<24} {:>12} {:>10} {:>12}  {}\n", "id", "bar", "nominal",
+  print_line("{:>4}  {:<16} {:>9} {:<10} {:<24} {:>12} {:>10} {:>12}  {}", "id", "bar", "nominal",
              "extensions", "calibrator", "calibrator", "reading", "zero at", "date (UTC)");
   for (const auto& c : all)
-    fmt::print("{:>4}  {:<16} {:>9.3f} {:<10} {:<24} {:>12.4f} {:>+10.4f} {:>12.4f}  {}\n", c.id,
+    print_line("{:>4}  {:<16} {:>9.3f} {:<10} {:<24} {:>12.4f} {:>+10.4f} {:>12.4f}  {}", c.id,
                c.bar, c.nominal_mm, c.extensions.empty() ? "-" : c.extensions,
                c.calibrator.empty() ? "-" : c.calibrator, c.calibrator_length_mm, c.reading_mm,
                c.zero_length_mm, utc_iso(c.calibrated_unix_ms).substr(0, 16));
@@ -184,7 +150,7 @@ void volumetric(const SetOptions& o) {
   const auto tests = tests_of(store, o);
   const auto v = volumetric_table(tests);
   if (!o.model_in.empty()) write_model(v, o);
-  if (o.json) return fmt::print("{}\n", to_json(v, tests).dump(2));
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(to_json(v, tests), 2));
   print_volumetric(v, tests);
   if (!o.model_in.empty())
     fmt::print("\nwrote {} (the squareness of {} with the table's)\n", o.model_out, o.model_in);
@@ -193,7 +159,7 @@ void volumetric(const SetOptions& o) {
 void history(const SetOptions& o) {
   const auto store = open_database_read_only(o.db);  // only reads
   const auto tests = tests_of(store, o);
-  if (o.json) return fmt::print("{}\n", history_json(tests).dump(2));
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(history_json(tests), 2));
   print_history(tests);
 }
 
@@ -217,21 +183,21 @@ void add_ballbar_commands(CLI::App& app) {
   add_db_option(*cal, o->db);
   cal->add_option("--bar", o->bar, "The bar's identity (serial number), as [test.circle] bar")
       ->required();
-  cal->add_option("--nominal-mm", o->nominal_mm,
+  cal->add_option("--nominal-mm", o->values.nominal_mm,
                   "Nominal length of the bar with its extensions (the test radius)")
       ->required()
-      ->check(CLI::PositiveNumber);
-  cal->add_option("--calibrator-mm", o->calibrator_mm,
+      ->check(finite_positive());
+  cal->add_option("--calibrator-mm", o->values.calibrator_mm,
                   "The calibrator's certified length (Zerodur jig, known ring)")
       ->required()
-      ->check(CLI::PositiveNumber);
-  cal->add_option("--reading-mm", o->reading_mm, "The bar's reading in the calibrator, mm")
+      ->check(finite_positive());
+  cal->add_option("--reading-mm", o->values.reading_mm, "The bar's reading in the calibrator, mm")
       ->required();
   cal->add_option("--calibrator", o->calibrator, "The calibrator's identity");
   cal->add_option("--extensions", o->extensions, "The extensions fitted, e.g. \"50 mm\"");
-  cal->add_option("--temperature-degc", o->temperature_degc,
+  cal->add_option("--temperature-degc", o->values.temperature_degc,
                   "Temperature at the calibration (recorded, not corrected for)");
-  cal->add_option("--date", o->date, "When, YYYY-MM-DD[THH:MM[:SS]] UTC (default: now)");
+  cal->add_option("--date", o->values.date, "When, YYYY-MM-DD[THH:MM[:SS]] UTC (default: now)");
   cal->add_option("--note", o->note, "Free text");
   cal->add_flag("--json", o->json, "Print caldaq.bar-calibration.v1");
   cal->callback([o] { calibrate(*o); });

@@ -54,6 +54,7 @@
 #include "cal/storage/chunk.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 
 namespace daq {
@@ -722,10 +723,10 @@ void add_bench_commands(CLI::App& app) {
       ->capture_default_str();
   in->add_option("--loop-cpu", o->loop_cpu,
                  "With --storage-cpu: each round also ingests with the event loop on this CPU")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_in(0, 1 << 20));
   in->add_option("--storage-cpu", o->storage_cpu,
                  "With --loop-cpu: ... and the batch encoder and SQLite writer threads on this one")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_in(0, 1 << 20));
   in->callback([o] { bench_ingest(*o); });
 
   auto e = std::make_shared<ExportBenchOptions>();

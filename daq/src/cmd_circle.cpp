@@ -121,11 +121,11 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
       ->required();
   cmd->add_option("-R,--radius-mm", o->radius_mm, "Nominal radius")
       ->required()
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   cmd->add_option("--feed-mm-min", o->feed_mm_per_min,
                   "Feed (for time-based angles and the servo lag)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   cmd->add_option("--plane", o->plane, "XY, YZ or ZX")->capture_default_str();
   cmd->add_option("--start-deg", o->start_deg,
                   "With time_s: angle where the ccw arc move starts (time 0 of each move)")
@@ -144,7 +144,7 @@ void add_circle_commands(CLI::App& /*app*/, CLI::App& analyse) {
                   "Cyclic-error period (default: searched)");
   cmd->add_option("--calibrated-radius-mm,--calibrated-length-mm", o->calibrated_radius_mm,
                   "Bar length at which deviation_um reads 0 (default: the nominal radius)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   cmd->add_flag("--uncalibrated", o->uncalibrated, "The bar was not calibrated: no radius error");
   cmd->add_option("-s,--standard", o->standard,
                   "iso230-4:2005, gb/t17421.4-2016 (identical) or iso230-4:1996 (docs/circle.md, "

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/drivers/registry.hpp"
 #include "commands.hpp"
 
@@ -17,6 +18,7 @@ namespace daq {
 namespace {
 
 namespace d = cal::drivers;
+using cal::text::terminal_safe;
 using nlohmann::json;
 
 struct DecodeOptions {
@@ -126,19 +128,20 @@ void print_item(const d::DecodedItem& i) {
       // The device's time, else its sample number (halsampler -t), else "-".
       auto t = time_text(i);
       if (t.empty() && i.sample) t = fmt::format("sample {}", *i.sample);
-      fmt::print("{:>9}  {:<31} ch {}  {:<26} {:>16.9g} {:<4} {}\n", i.offset, t.empty() ? "-" : t,
-                 i.channel, d::to_string(i.quantity), i.value, unit_of(i.quantity),
-                 status_text(i.status));
+      fmt::print("{:>9}  {:<31} ch {}  {:<26} {:>16.9g} {:<4} {}\n", i.offset,
+                 t.empty() ? "-" : terminal_safe(t), i.channel, d::to_string(i.quantity), i.value,
+                 unit_of(i.quantity), status_text(i.status));
       return;
     }
     case d::DecodedItem::Kind::error:
-      fmt::print("{:>9}  error ({}): {}\n", i.offset, i.error_kind, i.text);
+      fmt::print("{:>9}  error ({}): {}\n", i.offset, terminal_safe(i.error_kind),
+                 terminal_safe(i.text));
       return;
     case d::DecodedItem::Kind::gap:
-      fmt::print("{:>9}  gap: {}\n", i.offset, i.text);
+      fmt::print("{:>9}  gap: {}\n", i.offset, terminal_safe(i.text));
       return;
     case d::DecodedItem::Kind::note:
-      fmt::print("{:>9}  note: {}\n", i.offset, i.text);
+      fmt::print("{:>9}  note: {}\n", i.offset, terminal_safe(i.text));
       return;
   }
 }
@@ -169,8 +172,11 @@ void run_decode(const DecodeOptions& o) {
       readings += i.kind == d::DecodedItem::Kind::reading;
       errors += i.kind == d::DecodedItem::Kind::error;
       gaps += i.kind == d::DecodedItem::Kind::gap;
+      // The codec quotes the bytes it could not read; where they are not UTF-8 they are shown
+      // as U+FFFD (not \u00XX, which would claim they were Latin-1): the item's offset says
+      // where the exact bytes are in the dump.
       if (o.json)
-        fmt::print("{}\n", item_json(i).dump());
+        fmt::print("{}\n", item_json(i).dump(-1, ' ', false, json::error_handler_t::replace));
       else
         print_item(i);
     }

@@ -25,6 +25,7 @@
 #include "cal/replay/session.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
@@ -376,7 +377,7 @@ void add_demo_command(CLI::App& app) {
                   "Simulated time per real time (1 .. 200); 0: simulated time jumps from event "
                   "to event, as fast as the CPU allows")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 200.0));
+      ->check(finite_in(0.0, 200.0));
   cmd->add_flag("--quiet", o->quiet, "Print only the results");
   cmd->add_flag("--linear-only", o->linear_only, "Run the linear test only (no ballbar circle)");
   cmd->add_option("--control-table", o->control_table,

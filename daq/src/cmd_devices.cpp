@@ -15,7 +15,9 @@
 #include "cal/drivers/transport/usb.hpp"
 #include "commands.hpp"
 #include "devices_list.hpp"
+#include "json_input.hpp"
 #include "serve/instrument_form.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 namespace {
@@ -220,22 +222,22 @@ void print_text(const json& j) {
   const auto driver = [](const json& d) {
     return d.is_null() ? std::string("-") : d.get<std::string>();
   };
-  fmt::print("USB devices ({}):\n", j["usb"].size());
+  print_line("USB devices ({}):", j["usb"].size());
   for (const auto& d : j["usb"])
-    fmt::print("  {}  port {:<10} driver {:<8} {}\n", d["vid_pid"].get<std::string>(),
+    print_line("  {}  port {:<10} driver {:<8} {}", d["vid_pid"].get<std::string>(),
                d["port"].get<std::string>(), driver(d["driver"]),
                d["description"].get<std::string>());
   if (j.contains("usb_error"))
-    fmt::print("  (cannot enumerate: {})\n", j["usb_error"].get<std::string>());
-  fmt::print("HID instruments ({}):\n", j["hid"].size());
+    print_line("  (cannot enumerate: {})", j["usb_error"].get<std::string>());
+  print_line("HID instruments ({}):", j["hid"].size());
   for (const auto& d : j["hid"])
-    fmt::print("  {}  {}  interface {}  driver {}\n", d["vid_pid"].get<std::string>(),
+    print_line("  {}  {}  interface {}  driver {}", d["vid_pid"].get<std::string>(),
                d["path"].get<std::string>(), d["interface"].get<int>(), driver(d["driver"]));
-  fmt::print("Serial ports ({}):\n", j["serial"].size());
-  for (const auto& d : j["serial"]) fmt::print("  {}\n", d["device"].get<std::string>());
-  if (!j["probes"].empty()) fmt::print("Probes:\n");
+  print_line("Serial ports ({}):", j["serial"].size());
+  for (const auto& d : j["serial"]) print_line("  {}", d["device"].get<std::string>());
+  if (!j["probes"].empty()) print_line("Probes:");
   for (const auto& d : j["probes"])
-    fmt::print("  {:<40} driver {:<8} {}\n", d["transport"].get<std::string>(), driver(d["driver"]),
+    print_line("  {:<40} driver {:<8} {}", d["transport"].get<std::string>(), driver(d["driver"]),
                d["detail"].get<std::string>());
 }
 
@@ -269,12 +271,13 @@ void add_devices_command(CLI::App& app) {
                 "Print caldaq.devices.v1 JSON (with --options: caldaq.drivers.v1)");
   cmd->callback([opts] {
     if (opts->options) {
-      if (opts->json) return fmt::print("{}\n", serve::driver_descriptions().dump(2));
+      if (opts->json)
+        return fmt::print("{}\n", cal::daq::dump_output(serve::driver_descriptions(), 2));
       return opts->markdown ? print_options_markdown() : print_options_text();
     }
     const json j = list_devices(*opts);
     if (opts->json)
-      fmt::print("{}\n", j.dump(2));
+      fmt::print("{}\n", cal::daq::dump_output(j, 2));
     else
       print_text(j);
   });

@@ -7,11 +7,14 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/replay/rtx.hpp"
 #include "cal/storage/store.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "json_input.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 namespace {
@@ -20,7 +23,7 @@ using nlohmann::json;
 namespace st = cal::storage;
 
 struct ImportOptions {
-  std::string file, db, unit, axis, machine, campaign;
+  std::string file, db, unit, axis, machine, campaign, header_encoding = "utf-8";
   bool json = false;
 };
 
@@ -89,9 +92,14 @@ void copy_samples(cal::replay::RtxReader& r, st::Store& store, const Interpretat
 }
 
 void import_rtx(const ImportOptions& o) {
-  cal::replay::RtxReader reader(o.file);
+  cal::replay::RtxReader reader(o.file, o.header_encoding == "windows-1252"
+                                            ? cal::replay::RtxHeaderEncoding::windows1252
+                                            : cal::replay::RtxHeaderEncoding::utf8);
   const auto& h = reader.header();
   const Interpretation how = interpret(h.kind, o.unit, o.file);
+  for (const auto& [text, option] :
+       {std::pair{&o.machine, "--machine"}, {&o.axis, "--axis"}, {&o.campaign, "--campaign"}})
+    cal::text::require_utf8(*text, option);
   json header = json::object();
   for (const auto& [k, v] : h.fields) header[k] = v;
   const auto field = [&](const char* key) {
@@ -127,13 +135,16 @@ void import_rtx(const ImportOptions& o) {
                                                    : "the --unit option (the .rtx header does "
                                                      "not state it)"},
                       {"header", header},
+                      {"header_encoding", o.header_encoding},
                       {"notes", notes}};
   ImportSummary s;
   s.run_id = store.begin_run({.machine_id = machine_id,
                               .campaign = o.campaign,
                               .kind = "dynamic",
                               .axis = o.axis.empty() ? field("Axis") : o.axis,
-                              .settings_json = settings.dump(),
+                              // The path as the file system has it may not be UTF-8: shown
+                              // with U+FFFD there (the header itself is UTF-8 by now).
+                              .settings_json = cal::daq::dump_output(settings),
                               .software_version = "daq 0.1.0 import rtx"});
   store.add_instrument(
       {.run_id = s.run_id,
@@ -167,20 +178,20 @@ void import_rtx(const ImportOptions& o) {
       j[fmt::format("min_{}", how.si)] = s.min_m;
       j[fmt::format("max_{}", how.si)] = s.max_m;
     }
-    return fmt::print("{}\n", j.dump(2));
+    return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
-  fmt::print("imported {} into run {}: {} {} samples at {} Hz ({:.3f} s), unit {}{}\n", o.file,
+  print_line("imported {} into run {}: {} {} samples at {} Hz ({:.3f} s), unit {}{}", o.file,
              s.run_id, s.samples, h.kind == cal::replay::RtxKind::linear ? "linear" : "angular",
              h.sample_rate_hz, static_cast<double>(s.samples) / h.sample_rate_hz, how.unit,
              o.unit.empty() ? " (the default; the header does not state it)" : " (from --unit)");
   if (s.samples > s.invalid && how.si == "m")
-    fmt::print("  range {:.6f} .. {:.6f} mm\n", s.min_m * 1e3, s.max_m * 1e3);
+    print_line("  range {:.6f} .. {:.6f} mm", s.min_m * 1e3, s.max_m * 1e3);
   else if (s.samples > s.invalid)
-    fmt::print("  range {:.3f} .. {:.3f} arcsec\n", s.min_m * 180 * 3600 / 3.14159265358979323846,
+    print_line("  range {:.3f} .. {:.3f} arcsec", s.min_m * 180 * 3600 / 3.14159265358979323846,
                s.max_m * 180 * 3600 / 3.14159265358979323846);
   if (s.invalid)
-    fmt::print("  {} samples are not finite numbers: stored as out of range\n", s.invalid);
-  for (const auto& n : notes) fmt::print("  note: {}\n", n);
+    print_line("  {} samples are not finite numbers: stored as out of range", s.invalid);
+  for (const auto& n : notes) print_line("  note: {}", n);
 }
 
 }  // namespace
@@ -198,6 +209,10 @@ void add_import_commands(CLI::App& app) {
   rtx->add_option("--axis", o->axis, "Axis name (default: the header's Axis)");
   rtx->add_option("--machine", o->machine, "Machine name (default: the header's Machine)");
   rtx->add_option("--campaign", o->campaign, "Campaign to file the run under");
+  rtx->add_option("--header-encoding", o->header_encoding,
+                  "utf-8 (default: other bytes are refused) or windows-1252 (a header written "
+                  "in the Western Windows code page, converted to UTF-8)")
+      ->check(CLI::IsMember({"utf-8", "windows-1252"}));
   rtx->add_flag("--json", o->json, "Print caldaq.import.v1 JSON");
   rtx->callback([o] {
     try {

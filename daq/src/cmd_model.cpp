@@ -7,9 +7,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 
@@ -124,6 +126,14 @@ void write_page(const std::string& path, const std::string& html) {
   fmt::print(stderr, "report written to {}\n", path);
 }
 
+void require_finite(std::span<const double> values, std::string_view what) {
+  for (double v : values)
+    if (!std::isfinite(v))
+      throw cal::InputError(fmt::format(
+          "{}: {} is not a finite number (the model's values or coefficients overflow here)", what,
+          v));
+}
+
 kin::Method method_from_string(const std::string& s) {
   if (s == "htm" || s == "exact") return kin::Method::htm;
   if (s == "first-order" || s == "first_order") return kin::Method::first_order;
@@ -142,27 +152,26 @@ struct ShowOptions {
 void run_show(const ShowOptions& o) {
   const mdl::Model m = mdl::read(o.file);
   if (o.json) return fmt::print("{}", mdl::to_json(m));
-  fmt::print("Model {}{}\n", m.name.empty() ? "(unnamed)" : m.name, " (" + o.file + ")");
-  fmt::print("  topology      {}\n", describe_topology(m.machine.topology));
+  print_line("Model {}{}", m.name.empty() ? "(unnamed)" : m.name, " (" + o.file + ")");
+  print_line("  topology      {}", describe_topology(m.machine.topology));
   const auto& t = m.machine.tool_offset_mm;
   const auto& w = m.machine.table_offset_mm;
   fmt::print("  tool offset   ({:g}, {:g}, {:g}) mm\n  table offset  ({:g}, {:g}, {:g}) mm\n", t[0],
              t[1], t[2], w[0], w[1], w[2]);
   if (m.travel_mm)
-    fmt::print("  travel        X {:g} .. {:g}, Y {:g} .. {:g}, Z {:g} .. {:g} mm\n",
+    print_line("  travel        X {:g} .. {:g}, Y {:g} .. {:g}, Z {:g} .. {:g} mm",
                (*m.travel_mm)[0][0], (*m.travel_mm)[0][1], (*m.travel_mm)[1][0],
                (*m.travel_mm)[1][1], (*m.travel_mm)[2][0], (*m.travel_mm)[2][1]);
   else
-    fmt::print("  travel        not given (maps need --min-mm and --max-mm)\n");
-  fmt::print("Errors (translations in um, angles in urad):\n");
+    print_line("  travel        not given (maps need --min-mm and --max-mm)");
+  print_line("Errors (translations in um, angles in urad):");
   std::vector<std::string> missing;
   for (const auto& r : describe_components(m, false)) {
-    fmt::print("  {:6} {:44} {}\n", r[0], r[1], r[2]);
+    print_line("  {:6} {:44} {}", r[0], r[1], r[2]);
     if (r[1].rfind("not given", 0) == 0) missing.push_back(r[0]);
   }
   if (!missing.empty())
-    fmt::print("Not given ({} of 21, taken as zero): {}\n", missing.size(),
-               fmt::join(missing, ", "));
+    print_line("Not given ({} of 21, taken as zero): {}", missing.size(), fmt::join(missing, ", "));
 }
 
 // --- map -------------------------------------------------------------------------------------
@@ -225,6 +234,10 @@ void run_map(const MapOptions& o) {
         throw cal::InputError(fmt::format("{}:{}: {}", o.points, csv.line[r], err.what()));
       }
       const auto& t = e.translation_um;
+      require_finite(
+          std::array{t[0], t[1], t[2], e.rotation_urad[0], e.rotation_urad[1], e.rotation_urad[2]},
+          fmt::format("{}:{}: the error at ({}, {}, {}) mm", o.points, csv.line[r], p[0], p[1],
+                      p[2]));
       if (o.json)
         pts.push_back({{"position_mm", vec_json(p)},
                        {"error_um", vec_json(t)},
@@ -246,6 +259,10 @@ void run_map(const MapOptions& o) {
   const auto map = kin::volumetric_error_map(m.machine, g, method);
   const auto s = kin::summarize(map);
   const auto contributions = kin::contributions(m.machine, g);
+  require_finite(map.errors_um, "the volumetric error over the grid");
+  require_finite(map.rotations_urad, "the rotation over the grid");
+  for (const auto& c : contributions)
+    require_finite(std::array{c.max_norm_um, c.rms_um}, "the contribution of " + c.name);
   if (!o.report.empty())
     write_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
   if (o.json) {
@@ -320,8 +337,12 @@ void add_model_commands(CLI::App& app) {
   auto* map = model->add_subcommand(
       "map", "Volumetric error over a grid (default: the model's travel, 5 x 5 x 5) or at points");
   map->add_option("file", o->file, "Model file")->required();
-  map->add_option("--min-mm", o->min_mm, "Grid corner X Y Z (with --max-mm)")->expected(3);
-  map->add_option("--max-mm", o->max_mm, "Grid corner X Y Z")->expected(3);
+  map->add_option("--min-mm", o->min_mm, "Grid corner X Y Z (with --max-mm)")
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
+  map->add_option("--max-mm", o->max_mm, "Grid corner X Y Z")
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
   map->add_option("--count", o->count, "Points per axis X Y Z")->expected(3)->capture_default_str();
   map->add_option("--points", o->points, "CSV of points to evaluate: x_mm,y_mm,z_mm");
   map->add_option("--method", o->method, "htm (exact) or first-order")->capture_default_str();

@@ -9,6 +9,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/testpiece.hpp"
+#include "cli_checks.hpp"
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
 
@@ -92,8 +93,10 @@ void run(const Options& o) {
   tp::Cutting cut;
   cut.origin_mm = {o.origin_mm[0], o.origin_mm[1], o.origin_mm[2]};
   cut.tool_radius_mm = o.tool_radius_mm;
-  const tp::Result predicted =
-      tp::evaluate(o.layout, tp::predict_profiles(model.machine, o.layout, cut));
+  const auto profiles = tp::predict_profiles(model.machine, o.layout, cut);
+  for (const auto& p : profiles)  // before the fits, which refuse them without naming the model
+    require_finite(p.deviation_um, fmt::format("{}: the predicted profile of {}", o.file, p.feature));
+  const tp::Result predicted = tp::evaluate(o.layout, profiles);
   std::optional<tp::Result> measured;
   if (!o.cmm.empty()) {
     const auto csv = read_csv_columns(o.cmm, {"x_mm", "y_mm"}, {"feature"});
@@ -108,6 +111,9 @@ void run(const Options& o) {
     }
   }
   const auto rows = rows_of(predicted, measured);
+  for (const auto& r : rows)
+    require_finite(std::array{r.predicted, r.measured.value_or(0.0)},
+                   fmt::format("{} {}", r.feature, r.quantity));
   if (o.json) {
     json out = json::array();
     for (const auto& r : rows) {
@@ -155,16 +161,24 @@ void add_model_testpiece_command(CLI::App& model) {
   cmd->add_option("--origin-mm", o->origin_mm,
                   "Machine position of the part's centre X Y and the cutting height Z")
       ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm))
       ->required();
-  cmd->add_option("--tool-radius-mm", o->tool_radius_mm, "Radius of the end mill")->required();
-  cmd->add_option("--side-mm", o->layout.side_mm, "Side of the square")->capture_default_str();
+  cmd->add_option("--tool-radius-mm", o->tool_radius_mm, "Radius of the end mill")
+      ->required()
+      ->check(finite_in(0, kMaxPositionMm));
+  cmd->add_option("--side-mm", o->layout.side_mm, "Side of the square")
+      ->check(finite_in(0, kMaxPositionMm))
+      ->capture_default_str();
   cmd->add_option("--centre-bore-mm", o->layout.centre_bore_diameter_mm, "Diameter of bore0")
+      ->check(finite_in(0, kMaxPositionMm))
       ->capture_default_str();
   cmd->add_option("--corner-bore-mm", o->layout.corner_bore_diameter_mm,
                   "Diameter of bore1 .. bore4")
+      ->check(finite_in(0, kMaxPositionMm))
       ->capture_default_str();
   cmd->add_option("--corner-offset-mm", o->layout.corner_bore_offset_mm,
                   "Corner bores at (+-offset, +-offset)")
+      ->check(finite_in(0, kMaxPositionMm))
       ->capture_default_str();
   cmd->add_option("--cmm", o->cmm, "CMM points, CSV feature,x_mm,y_mm in the part's frame");
   cmd->add_flag("--json", o->json, "Print caldaq.testpiece.v1 JSON");

@@ -12,12 +12,15 @@
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
+#include "json_input.hpp"
 #include "linear_run.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 namespace {
@@ -40,12 +43,27 @@ struct ReplaySession {
   std::vector<InstrumentSpec> specs;
 
   ReplaySession(const ReplayOptions& o) : bus(io, o.capture, o.speed) {
-    header = json::parse(bus.header_json(), nullptr, false);
-    if (header.is_discarded() || header.value("format", "") != "caldaq.capture-header.v1")
+    try {
+      read_header();
+    } catch (const cal::InputError& e) {  // "capture header: key ...": which file
+      throw cal::InputError(fmt::format("{}: {}", o.capture, e.what()));
+    }
+  }
+  void read_header() {
+    header = cal::daq::parse_json_input(bus.header_json(), "capture header");
+    if (!header.is_object() || !header.contains("format") || !header["format"].is_string() ||
+        header["format"] != "caldaq.capture-header.v1")
       throw cal::InputError(
-          fmt::format("{}: the capture header is not a caldaq session header", o.capture));
-    config = config_from_json(header.at("config"));
-    for (const auto& j : header.at("instruments")) specs.push_back(instrument_spec_from_json(j));
+          "the capture header is not a caldaq session header (no format "
+          "\"caldaq.capture-header.v1\")");
+    if (!header.contains("config")) throw cal::InputError("capture header: no key 'config'");
+    config = config_from_json(header["config"]);
+    const auto instruments = header.find("instruments");
+    if (instruments == header.end() || !instruments->is_array())
+      throw cal::InputError("capture header: key 'instruments': expected an array");
+    for (const auto& j : *instruments) specs.push_back(instrument_spec_from_json(j));
+    if (header.contains("software") && !header["software"].is_string())
+      throw cal::InputError("capture header: key 'software': expected a string");
   }
   // The run this capture was first stored as (the earliest run recording it), whose context
   // (customer, instruments, tolerances) the replay keeps, as the capture header lacks it.
@@ -58,7 +76,7 @@ struct ReplaySession {
     for (const auto& r : store.runs()) {
       if (r.capture_path != capture) continue;
       original_run = r.id;
-      const json settings = json::parse(r.settings_json, nullptr, false);
+      const json settings = cal::daq::parse_stored_json(r.settings_json);
       original_settings = settings;
       if (settings.is_object() && settings.contains("context"))
         original_context = settings["context"].dump();
@@ -176,7 +194,7 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
     json j =
         outs.size() == 1 ? all.front() : json{{"schema", "caldaq.circle-set.v1"}, {"runs", all}};
     j["capture_damage"] = damage_json(end);
-    fmt::print("{}\n", j.dump(2));
+    fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
   report_damage(end, o, out.run_id);
 }
@@ -209,7 +227,7 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
     j["run_id"] = out.run_id;
     j["status"] = cal::storage::to_string(out.status);
     j["capture_damage"] = damage_json(end);
-    fmt::print("{}\n", j.dump(2));
+    fmt::print("{}\n", cal::daq::dump_output(j, 2));
   } else {
     fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
     if (!out.missed.empty())
@@ -243,7 +261,7 @@ void add_replay_command(CLI::App& app) {
   add_db_option(*cmd, o->db);
   cmd->add_option("--speed", o->speed, "0: as fast as possible; 1: real time; 2: twice ...")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   cmd->add_flag("--json", o->json,
                 "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
   cmd->callback([o] { run_replay(*o); });

@@ -20,9 +20,11 @@
 #include "cal/replay/session.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
+#include "json_input.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
 #include "provenance.hpp"
@@ -183,9 +185,9 @@ void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const Run
   const auto& out = run_to_end(io, run, capture, drive);
   if (out.profile) return print_profile(out, o.json, progress->tty);
   const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
-  const auto v = verdict_of(
-      settings ? nlohmann::json::parse(settings->settings_json, nullptr, false) : nlohmann::json(),
-      to_json(*out.evaluation));
+  const auto v =
+      verdict_of(settings ? cal::daq::parse_stored_json(settings->settings_json) : nlohmann::json(),
+                 to_json(*out.evaluation));
   if (o.json) {
     auto j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
@@ -320,7 +322,7 @@ void add_run_commands(CLI::App& app) {
                   "Before the run, every device must open and speak within this time (0: no "
                   "check)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   lin->add_flag("--json", o->json,
                 "Print the result as caldaq.iso230-2.v1 JSON with run_id, status, missed_stops "
                 "and verdict (progress goes to stderr)");
@@ -336,7 +338,7 @@ void add_run_commands(CLI::App& app) {
   circ->add_option("--check-s", o->check_s,
                    "Before the run, the ballbar must open within this time (0: no check)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   circ->add_flag("--json", o->json,
                  "Print the result as caldaq.circle.v2 JSON with run_id and verdict (progress "
                  "goes to stderr)");

@@ -23,9 +23,11 @@
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
+#include "json_input.hpp"
 #include "provenance.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
+#include "terminal.hpp"
 #include "verdict.hpp"
 
 namespace daq {
@@ -54,7 +56,7 @@ json run_json(const st::RunRecord& r) {
          {"note", r.note},
          {"capture_path", r.capture_path},
          {"software_version", r.software_version}};
-  j["settings"] = json::parse(r.settings_json, nullptr, false);
+  j["settings"] = cal::daq::parse_stored_json(r.settings_json);
   if (j["settings"].is_discarded()) j["settings"] = r.settings_json;
   return j;
 }
@@ -77,13 +79,13 @@ void cmd_runs(const std::string& db, bool as_json) {
       one["readings"] = store.reading_count(r.id);
       j["runs"].push_back(one);
     }
-    return fmt::print("{}\n", j.dump(2));
+    return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
-  fmt::print("{} ({} runs)\n", store.path().string(), runs.size());
-  fmt::print("{:>5}  {:<20}  {:<12} {:<5} {:<10} {:>10}  {}\n", "run", "started (UTC)", "kind",
+  print_line("{} ({} runs)", store.path().string(), runs.size());
+  print_line("{:>5}  {:<20}  {:<12} {:<5} {:<10} {:>10}  {}", "run", "started (UTC)", "kind",
              "axis", "status", "readings", "campaign");
   for (const auto& r : runs)
-    fmt::print("{:>5}  {:<20}  {:<12} {:<5} {:<10} {:>10}  {}\n", r.id, iso_time(r.started_unix_ms),
+    print_line("{:>5}  {:<20}  {:<12} {:<5} {:<10} {:>10}  {}", r.id, iso_time(r.started_unix_ms),
                r.kind, r.axis, st::to_string(r.status), store.reading_count(r.id), r.campaign);
 }
 
@@ -127,22 +129,24 @@ std::string provenance_text(const json& p) {
 // The values of a result document, as `daq analyse` prints their headline.
 void print_result_values(const json& doc) {
   if (doc.value("schema", "") == "caldaq.iso230-2.v1") {
-    fmt::print("      {} targets, {}\n", doc.value("targets", json::array()).size(),
-               runs_text(doc));
+    print_line("      {} targets, {}", doc.value("targets", json::array()).size(), runs_text(doc));
     const json axis = doc.value("axis", json::object());
     for (const auto& [key, a] : axis.items())
-      fmt::print("      {:<8} {:>10.3f} um   {}\n", a.value("symbol", key),
-                 a.value("value_um", 0.0), a.value("description", ""));
+      print_line("      {:<8} {:>10.3f} um   {}", a.value("symbol", key), a.value("value_um", 0.0),
+                 a.value("description", ""));
   } else if (is_circle_schema(doc.value("schema", ""))) {
     // The values of the result's standard, as stored (v1: ISO 230-4:2005 with H among them).
+    // A named copy: items() of the temporary `doc.value(...)` dangles in the range-for (C++20
+    // extends the lifetime of the range's outermost temporary only).
+    const json values = doc.value("iso230_4", json::object());
     std::string line;
-    for (const auto& [key, value] : doc.value("iso230_4", json::object()).items())
+    for (const auto& [key, value] : values.items())
       if (value.is_number())
         line += fmt::format("{}{} {:.3f} um", line.empty() ? "" : ", ",
                             key.substr(0, key.size() - 3), value.get<double>());
-    fmt::print("      {}: {}\n", doc.value("standard", std::string("ISO 230-4")), line);
+    print_line("      {}: {}", doc.value("standard", std::string("ISO 230-4")), line);
     for (const auto& d : doc.value("diagnostics", json::array()))
-      fmt::print("      {:<40} {:+9.3f} {:<5} PV {:.3f} um\n", d.value("name", ""),
+      print_line("      {:<40} {:+9.3f} {:<5} PV {:.3f} um", d.value("name", ""),
                  d.value("value", 0.0), d.value("unit", ""), d.value("pv_um", 0.0));
   }
 }
@@ -175,13 +179,13 @@ json run_document(const st::Store& store, std::int64_t id) {
   j["results"] = json::array();
   const json& settings = j["settings"];
   for (const auto& res : store.results(id)) {
-    json doc = json::parse(res.json, nullptr, false);
+    json doc = cal::daq::parse_stored_json(res.json);
     json one{{"id", res.id},
              {"standard", res.standard},
              {"created", iso_time(res.created_unix_ms)},
              {"current", res.current()},
              {"superseded_by", res.superseded_by ? json(*res.superseded_by) : json(nullptr)},
-             {"provenance", json::parse(res.provenance_json, nullptr, false)},
+             {"provenance", cal::daq::parse_stored_json(res.provenance_json)},
              {"result", doc.is_discarded() ? json(res.json) : doc}};
     if (one["provenance"].is_discarded()) one["provenance"] = json::object();
     if (!doc.is_discarded()) one["verdict"] = to_json(verdict_of(settings, doc));
@@ -197,56 +201,55 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
   const auto r = need_run(store, id);
   const json j = run_document(store, id);
   const auto missed = store.missed_stops(id);
-  if (as_json) return fmt::print("{}\n", j.dump(2));
-  fmt::print("run {}: {} {} ({}), started {}{}\n", r.id, r.kind, r.axis, st::to_string(r.status),
+  if (as_json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
+  print_line("run {}: {} {} ({}), started {}{}", r.id, r.kind, r.axis, st::to_string(r.status),
              iso_time(r.started_unix_ms), r.note.empty() ? "" : " - " + r.note);
-  fmt::print("  readings: {}, captured targets: {}\n", j["readings"].get<std::int64_t>(),
+  print_line("  readings: {}, captured targets: {}", j["readings"].get<std::int64_t>(),
              j["targets"].get<std::size_t>());
   if (!missed.empty()) {
-    fmt::print("  missed stops ({}):\n", missed.size());
-    for (const auto& m : missed) fmt::print("    {}\n", missed_text(m));
+    print_line("  missed stops ({}):", missed.size());
+    for (const auto& m : missed) print_line("    {}", missed_text(m));
   }
   // The stop quality (run_quality.hpp): the verdict, each suspect stop by name.
-  fmt::print("  stop quality: {}\n", j["quality"]["summary"].get<std::string>());
+  print_line("  stop quality: {}", j["quality"]["summary"].get<std::string>());
   for (const auto& q : j["quality"]["suspect_stops"])
-    fmt::print("    SUSPECT {}\n", q["reason"].get<std::string>());
+    print_line("    SUSPECT {}", q["reason"].get<std::string>());
   for (const auto& i : j["instruments"])
-    fmt::print("  device {}: {} on {}\n", i["device"].get<int>(), i["driver"].get<std::string>(),
+    print_line("  device {}: {} on {}", i["device"].get<int>(), i["driver"].get<std::string>(),
                i["transport"].get<std::string>());
-  if (!r.capture_path.empty()) fmt::print("  capture: {}\n", r.capture_path);
+  if (!r.capture_path.empty()) print_line("  capture: {}", r.capture_path);
   if (const auto& origin = j["origin"]; !origin["label"].get<std::string>().empty())
-    fmt::print("  {}: {}\n", origin["label"].get<std::string>(), origin["text"].get<std::string>());
+    print_line("  {}: {}", origin["label"].get<std::string>(), origin["text"].get<std::string>());
   else if (!origin["recorded"].get<bool>())
-    fmt::print("  origin: {}\n", origin["text"].get<std::string>());
+    print_line("  origin: {}", origin["text"].get<std::string>());
   if (r.kind == "linear") {
     try {
-      if (const auto check = check_run(store, id)) fmt::print("  {}\n", loop_text(*check));
+      if (const auto check = check_run(store, id)) print_line("  {}", loop_text(*check));
     } catch (const cal::InputError& e) {
-      fmt::print("  compensation check: {}\n", e.what());
+      print_line("  compensation check: {}", e.what());
     }
   }
-  if (j["results"].empty()) fmt::print("  no results stored\n");
+  if (j["results"].empty()) print_line("  no results stored");
   for (const auto& res : j["results"]) {
     const bool current = res["current"].get<bool>();
-    fmt::print(
-        "  result {}: {} ({}){}\n", res["id"].get<std::int64_t>(),
-        res["standard"].get<std::string>(),
+    print_line(
+        "  result {}: {} ({}){}", res["id"].get<std::int64_t>(), res["standard"].get<std::string>(),
         current ? "current"
                 : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
         "");
-    fmt::print("    {}\n", provenance_text(res["provenance"]));
+    print_line("    {}", provenance_text(res["provenance"]));
     if (!current) continue;  // the old values stay in --json
     print_result_values(res["result"]);
     if (res.contains("verdict")) {
       const auto& v = res["verdict"];
-      fmt::print("      verdict: {}{}\n", v.value("summary", ""),
+      print_line("      verdict: {}{}", v.value("summary", ""),
                  v.value("basis", "").empty() ? "" : " (" + v.value("basis", "") + ")");
       for (const auto& c : v.value("checks", json::array()))
-        fmt::print("        {:<26} {:>10.3f} limit {:>8.3f} {:<5} {}\n", c.value("symbol", ""),
+        print_line("        {:<26} {:>10.3f} limit {:>8.3f} {:<5} {}", c.value("symbol", ""),
                    c.value("value", 0.0), c.value("limit", 0.0), c.value("unit", ""),
                    c.value("pass", false) ? "pass" : "FAIL");
       for (const auto& n : v.value("notes", json::array()))
-        fmt::print("        note: {}\n", n.get<std::string>());
+        print_line("        note: {}", n.get<std::string>());
     }
   }
 }
@@ -510,9 +513,9 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
     j["results"].push_back({{"id", res.id},
                             {"standard", res.standard},
                             {"current", res.current()},
-                            {"provenance", json::parse(res.provenance_json, nullptr, false)},
-                            {"result", json::parse(res.json, nullptr, false)}});
-  const std::string text = j.dump(1);
+                            {"provenance", cal::daq::parse_stored_json(res.provenance_json)},
+                            {"result", cal::daq::parse_stored_json(res.json)}});
+  const std::string text = cal::daq::dump_output(j, 1);
   // Top-level keys are indented by one space; nothing nested is.
   const std::string marker = "\n \"readings\": null";
   const auto at = text.find(marker);
@@ -551,7 +554,7 @@ void cmd_export(const ExportOptions& o) {
     out = file.get();
   }
   const auto run = need_run(store, o.run);
-  const json settings = json::parse(run.settings_json, nullptr, false);
+  const json settings = cal::daq::parse_stored_json(run.settings_json);
   if (o.format == "json")
     export_json(store, run, settings, out);
   else if (o.what == "targets")

@@ -1,6 +1,7 @@
 // daq serve: the operator's page and an HTTP/WebSocket API (docs/web.md); the service itself is
 // in serve/service.cpp.
 #include "cal/analysis/error.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "serve/service.hpp"
@@ -25,7 +26,7 @@ void add_serve_command(CLI::App& app) {
                   "--simulate: SIMULATED time per real time (POST /api/simulation/speed "
                   "changes it while serving)")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 100.0));
+      ->check(finite_in(1.0, 100.0));
   add_db_option(*cmd, o->run.db);
   cmd->add_option("--address", o->address, "Listen address; not loopback only with --token")
       ->capture_default_str();
@@ -42,17 +43,17 @@ void add_serve_command(CLI::App& app) {
                   "Open connections at most (at the cap the stalest is closed: one refused, then "
                   "the HTTP connection without progress for longest, WebSockets last)")
       ->capture_default_str()
-      ->check(CLI::Range(std::size_t{4}, std::size_t{100000}));
+      ->check(whole_in(4, 100000));
   cmd->add_option("--max-connections-per-client", o->max_connections_per_client,
                   "Open connections from one address at most (its own stalest is closed for a "
                   "new one)")
       ->capture_default_str()
-      ->check(CLI::Range(std::size_t{2}, std::size_t{100000}));
+      ->check(whole_in(2, 100000));
   cmd->add_option("--request-timeout-s", o->request_timeout_s,
                   "A request, header and body, must arrive within this (idle connections, slow "
                   "headers and slow bodies are closed)")
       ->capture_default_str()
-      ->check(CLI::Range(0.1, 3600.0));
+      ->check(finite_in(0.1, 3600.0));
   cmd->add_option("--capture-dir", o->capture_dir,
                   "Record each run's capture in this directory as run-N.cdq (created at start; "
                   "refused at start if it cannot be created or written)");
@@ -67,7 +68,7 @@ void add_serve_command(CLI::App& app) {
                   "Before serving, every configured device must open and speak within this time, "
                   "as daq run checks (0: no check; the page shows each device's state anyway)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   cmd->callback([o] {
     if (!o->simulate && o->run.config.empty())
       throw cal::InputError("daq serve: give -c FILE (a configuration) or --simulate");

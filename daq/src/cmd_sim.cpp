@@ -18,6 +18,7 @@
 #include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "linear_run.hpp"
@@ -279,23 +280,23 @@ void add_sim_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--speed", o->speed, "Simulated time per real time")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 100.0));
+      ->check(finite_in(1.0, 100.0));
   cmd->add_option("--start-after-s", o->start_after_s,
                   "Run the --test program once, this many wall-clock seconds after the start "
                   "(default: wait for each run to start in the database, and run its test)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   add_db_option(*cmd, o->db);
   cmd->add_option("--runs", o->runs, "Runs of the linear program (ISO 230-2: 5)")
       ->capture_default_str()
-      ->check(CLI::Range(2, 10));
+      ->check(whole_in(2, 10));
   cmd->add_option("--targets", o->targets,
                   "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11)")
       ->capture_default_str()
-      ->check(CLI::Range(2, 11));
+      ->check(whole_in(2, 11));
   cmd->add_option("--feed-mm-per-min", o->feed_mm_per_min,
                   "The circle test's feed (--test circle; the set has its own two)")
       ->capture_default_str()
-      ->check(CLI::Range(100.0, 10000.0));
+      ->check(finite_in(100.0, 10000.0));
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->add_option("--measure", o->measure,

@@ -11,10 +11,13 @@
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
+#include "json_input.hpp"
 #include "provenance.hpp"
+#include "terminal.hpp"
 #include "verdict.hpp"
 
 namespace daq {
@@ -47,7 +50,7 @@ struct AnalyseRunOptions {
 // A stored ballbar run again from its raw bar readings, with the analysis settings it was
 // run with unless corrected here (the calibrated length of the bar, the cyclic period).
 void analyse_circle_run(st::Store& store, const st::RunRecord& run, const AnalyseRunOptions& o) {
-  json settings = json::parse(run.settings_json, nullptr, false);
+  json settings = cal::daq::parse_stored_json(run.settings_json);
   if (settings.is_discarded() || !settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("run {}: its circle settings are missing", o.run));
   auto [program, analysis] = circle_settings_from_json(settings);
@@ -94,7 +97,7 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   }
   const auto v = verdict_of(settings, j);
   j["verdict"] = to_json(v);
-  if (o.json) return fmt::print("{}\n", j.dump(2));
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print_circle_result(result, program, analysis);
   print_verdict(v);
 }
@@ -113,7 +116,7 @@ void analyse_run(const AnalyseRunOptions& o) {
   json j = to_json(e);
   if (o.store) {
     // The stops' deviations are as compensated for the current result: the same coefficients.
-    const json settings = json::parse(run->settings_json, nullptr, false);
+    const json settings = cal::daq::parse_stored_json(run->settings_json);
     const auto used = compensation_used(settings, store.results(o.run));
     json prov = provenance("reanalysed", software_version);
     prov["standard"] = standard;
@@ -125,9 +128,9 @@ void analyse_run(const AnalyseRunOptions& o) {
                                        .json = j.dump(),
                                        .provenance_json = prov.dump()});
   }
-  const auto v = verdict_of(json::parse(run->settings_json, nullptr, false), j);
+  const auto v = verdict_of(cal::daq::parse_stored_json(run->settings_json), j);
   j["verdict"] = to_json(v);
-  if (o.json) return fmt::print("{}\n", j.dump(2));
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print(e);
   print_verdict(v);
 }
@@ -161,7 +164,7 @@ void recompensate(const RecompensateOptions& o) {
       throw cal::InputError(fmt::format("recompensate: {} {}: not a finite number", name, *value));
   st::Store store(database_path(o.db));
   const auto run = linear_run(store, o.run);
-  json settings = json::parse(run.settings_json, nullptr, false);
+  json settings = cal::daq::parse_stored_json(run.settings_json);
   if (settings.is_discarded() || !settings.contains("environment"))
     throw cal::InputError(fmt::format("run {}: its stored settings lack the environment", o.run));
   const auto used = compensation_used(settings, store.results(o.run));
@@ -267,15 +270,15 @@ void recompensate(const RecompensateOptions& o) {
   doc["provenance"] = prov;
   const auto v = verdict_of(settings, doc);
   doc["verdict"] = to_json(v);
-  if (o.json) return fmt::print("{}\n", doc.dump(2));
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(doc, 2));
   fmt::print("run {}: {} stops recompensated (largest change {:.3f} um), stored as result {}",
              o.run, targets.size(), max_change_um, id);
   if (used.result_id) fmt::print(", superseding result {}", *used.result_id);
-  fmt::print("\n");
-  if (changed.empty()) fmt::print("  nothing changed: the same coefficients and offsets again\n");
+  print_line("");
+  if (changed.empty()) print_line("  nothing changed: the same coefficients and offsets again");
   for (const auto& c : changed)
     fmt::print("  {}: {} -> {}\n", c["name"].get<std::string>(), c["from"].dump(), c["to"].dump());
-  fmt::print("\n");
+  print_line("");
   print(e);
   print_verdict(v);
 }
@@ -295,11 +298,11 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   analyse
       .add_option("--calibrated-radius-mm", a->calibrated_radius_mm,
                   "Circle runs: the bar's corrected calibrated length")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   analyse
       .add_option("--cyclic-period-mm", a->cyclic_period_mm,
                   "Circle runs: the cyclic-error period (default: as run, else searched)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   analyse.add_flag("--uncalibrated", a->uncalibrated, "Circle runs: no radius error");
   analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
   analyse.callback([a, &analyse] {

@@ -1,6 +1,10 @@
 // Named CSV columns (see csv_columns.hpp), on the strict reader of csv_table.hpp.
 #include "csv_columns.hpp"
 
+#include <fmt/format.h>
+
+#include "cal/analysis/error.hpp"
+
 namespace daq {
 namespace {
 
@@ -8,6 +12,10 @@ CsvColumns columns(const CsvTable& t, const std::vector<std::string>& numeric,
                    const std::vector<std::string>& text) {
   for (const auto* names : {&numeric, &text})
     for (const auto& name : *names) t.require({name});
+  // A header and nothing else is an empty measurement, not one that passes every check.
+  if (t.rows() == 0)
+    throw cal::InputError(
+        fmt::format("{}:{}: a header and no rows of data", t.source(), t.header_line()));
   CsvColumns out;
   for (const auto& name : numeric) out.numbers[name] = t.numbers(name);
   for (const auto& name : text) {

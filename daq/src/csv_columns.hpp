@@ -21,8 +21,8 @@ struct CsvColumns {
 };
 
 // Throws cal::InputError naming the file, the line and the column at fault (a missing column,
-// a cell that is not a finite number, a row with another number of cells than the header, an
-// unreadable or oversized file).
+// no rows of data, a cell that is not a finite number, a row with another number of cells than
+// the header, an unreadable or oversized file).
 CsvColumns read_csv_columns(const std::string& path, const std::vector<std::string>& numeric,
                             const std::vector<std::string>& text = {},
                             const CsvOptions& options = {});

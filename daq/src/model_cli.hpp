@@ -1,7 +1,9 @@
 #pragma once
 // What the `daq model` subcommands share (cmd_model*.cpp): reading the model and describing it.
 #include <CLI/CLI.hpp>
+#include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -21,6 +23,10 @@ cal::daq::report::ModelPage model_page_of(const cal::daq::model::Model& m, const
                                           cal::kinematics::Method method);
 // Writes an HTML page, saying where on stderr; InputError if it cannot.
 void write_page(const std::string& path, const std::string& html);
+
+// InputError "WHAT: not a finite number (...)" unless every value is finite: checked before
+// anything is printed, so that no map or prediction shows inf or nan.
+void require_finite(std::span<const double> values, std::string_view what);
 
 // --method htm|first-order
 cal::kinematics::Method method_from_string(const std::string& s);

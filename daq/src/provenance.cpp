@@ -6,6 +6,8 @@
 #include <chrono>
 #include <ctime>
 
+#include "json_input.hpp"
+
 namespace daq {
 
 using nlohmann::json;
@@ -122,7 +124,7 @@ std::optional<cal::storage::ResultRecord> current_result(
   const auto family = [](std::string_view s) { return s.substr(0, s.rfind('.')); };
   for (auto it = results.rbegin(); it != results.rend(); ++it) {
     if (!it->current()) continue;
-    const json doc = json::parse(it->json, nullptr, false);
+    const json doc = cal::daq::parse_stored_json(it->json);
     if (doc.is_object() && family(doc.value("schema", "")) == family(schema)) return *it;
   }
   return std::nullopt;
@@ -140,8 +142,8 @@ CompensationUsed compensation_used(const json& settings,
   const auto current = current_result(results, "caldaq.iso230-2.v1");
   if (!current) return u;
   u.result_id = current->id;
-  const json doc = json::parse(current->json, nullptr, false);
-  const json prov = json::parse(current->provenance_json, nullptr, false);
+  const json doc = cal::daq::parse_stored_json(current->json);
+  const json prov = cal::daq::parse_stored_json(current->provenance_json);
   if (prov.is_object() && prov.contains("coefficients")) {
     for (const auto& [k, v] : prov["coefficients"].items()) u.coefficients[k] = v;
     u.offsets = sensor_offsets_from_json(prov.value("sensor_offsets", json::object()));

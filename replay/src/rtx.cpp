@@ -10,7 +10,10 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
+
+#include "cal/analysis/text.hpp"
 
 namespace cal::replay {
 namespace {
@@ -18,6 +21,7 @@ namespace {
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
 constexpr std::string_view kMarker = "\r\nEOF";     // RTX2CSV-Converter's check
 constexpr std::string_view kBareMarker = "EOF::";   // rtx2csv's "EOF::\r\n" stub
+constexpr std::string_view kFullMarker = "\r\nEOF::\r\n";  // as CARTO writes it
 constexpr std::uint64_t kMarkerSearch = 24;         // the marker starts this close to the end
 constexpr double kMaxSamples = 9007199254740992.0;  // 2^53: every count exact in a double
 
@@ -65,7 +69,8 @@ const std::string* RtxHeader::find(std::string_view key) const {
   return nullptr;
 }
 
-RtxReader::RtxReader(const std::filesystem::path& path) : name_(path.string()) {
+RtxReader::RtxReader(const std::filesystem::path& path, RtxHeaderEncoding encoding)
+    : name_(path.string()), encoding_(encoding) {
   auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
   if (!*file) throw RtxError(fmt::format("{}: cannot open", name_));
   std::error_code ec;
@@ -75,7 +80,8 @@ RtxReader::RtxReader(const std::filesystem::path& path) : name_(path.string()) {
   read_header(size);
 }
 
-RtxReader::RtxReader(std::string bytes, std::string name) : name_(std::move(name)) {
+RtxReader::RtxReader(std::string bytes, std::string name, RtxHeaderEncoding encoding)
+    : name_(std::move(name)), encoding_(encoding) {
   const std::uint64_t size = bytes.size();
   in_ = std::make_unique<std::istringstream>(std::move(bytes));
   read_header(size);
@@ -90,10 +96,13 @@ void RtxReader::read_header(std::uint64_t size) {
   // "Key: value" lines up to the "Data:" line; CR-LF as written, a bare LF accepted.
   std::size_t pos = head.find('\n');
   bool data_found = false;
+  std::size_t line_number = 1;  // "HEADER::"
   while (pos != std::string::npos && pos + 1 < head.size()) {
     const std::size_t start = pos + 1, eol = head.find('\n', start);
     if (eol == std::string::npos) break;
-    const auto line = trim(std::string_view(head).substr(start, eol - start));
+    const std::string text =
+        header_text(trim(std::string_view(head).substr(start, eol - start)), ++line_number, start);
+    const std::string_view line = text;
     pos = eol;
     if (line == "Data:") {
       header_.data_offset = eol + 1;
@@ -159,7 +168,41 @@ void RtxReader::read_header(std::uint64_t size) {
     header_.declared_samples = static_cast<std::uint64_t>(*v);
   }
 
-  // The end marker starts on a sample boundary near the end of the file.
+  find_end_marker(size);
+  if (static_cast<double>(header_.samples) / header_.sample_rate_hz > 9e9)
+    throw RtxError(fmt::format("{}: {} samples at {} Hz last longer than the clock can count", file,
+                               header_.samples, header_.sample_rate_hz));
+  in_->clear();
+  in_->seekg(static_cast<std::streamoff>(header_.data_offset));
+}
+
+// A header line as UTF-8 (see rtx.hpp): checked, or converted from Windows-1252.
+std::string RtxReader::header_text(std::string_view line, std::size_t line_number,
+                                   std::size_t at) const {
+  std::string out(line);
+  if (const auto bad = text::invalid_utf8_at(line)) {
+    if (encoding_ != RtxHeaderEncoding::windows1252)
+      throw RtxError(fmt::format(
+          "{}: line {}, byte {}: the header is not UTF-8 text (byte 0x{:02X}); if the file was "
+          "written on a Western Windows, give --header-encoding windows-1252",
+          name_, line_number, at + *bad, static_cast<unsigned char>(line[*bad])));
+    out = text::windows1252_to_utf8(line);
+  }
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const auto c = static_cast<unsigned char>(line[i]);
+    if ((c < 0x20 && c != '\t') || c == 0x7F)
+      throw RtxError(
+          fmt::format("{}: line {}, byte {}: a control character (0x{:02X}) in the "
+                      "header",
+                      name_, line_number, at + i, c));
+  }
+  return out;
+}
+
+// The end marker starts near the end of the file: on a sample boundary, or (a damaged last
+// sample) anywhere if it runs to the end, so that it is never read as a sample (its bytes
+// "\r\nEOF::\r" are 4.95e27 as a double).
+void RtxReader::find_end_marker(std::uint64_t size) {
   std::uint64_t end = size;
   if (size > header_.data_offset) {
     const std::uint64_t from = size > kMarkerSearch ? size - kMarkerSearch : 0;
@@ -168,25 +211,27 @@ void RtxReader::read_header(std::uint64_t size) {
     in_->clear();
     in_->seekg(static_cast<std::streamoff>(tail_at));
     in_->read(tail.data(), static_cast<std::streamsize>(tail.size()));
-    for (std::uint64_t at = tail_at; at < size; ++at) {
-      if ((at - header_.data_offset) % 8 != 0) continue;
-      const auto rest = std::string_view(tail).substr(at - tail_at);
-      if (rest.starts_with(kMarker) || rest.starts_with(kBareMarker)) {
-        header_.eof_marker = true;
-        header_.eof_offset = at;
-        end = at;
-        break;
+    const auto marker_at = [&](bool aligned) -> std::optional<std::uint64_t> {
+      for (std::uint64_t at = tail_at; at < size; ++at) {
+        const auto rest = std::string_view(tail).substr(at - tail_at);
+        if (aligned ? (at - header_.data_offset) % 8 == 0 &&
+                          (rest.starts_with(kMarker) || rest.starts_with(kBareMarker))
+                    : rest.starts_with(kMarker) && kFullMarker.starts_with(rest))
+          return at;
       }
+      return std::nullopt;
+    };
+    auto at = marker_at(true);
+    if (!at) at = marker_at(false);
+    if (at) {
+      header_.eof_marker = true;
+      header_.eof_offset = *at;
+      end = *at;
     }
   }
   const std::uint64_t data_bytes = end - std::min(end, header_.data_offset);
   header_.samples = data_bytes / 8;
   header_.trailing_bytes = data_bytes % 8;
-  if (static_cast<double>(header_.samples) / header_.sample_rate_hz > 9e9)
-    throw RtxError(fmt::format("{}: {} samples at {} Hz last longer than the clock can count", file,
-                               header_.samples, header_.sample_rate_hz));
-  in_->clear();
-  in_->seekg(static_cast<std::streamoff>(header_.data_offset));
 }
 
 std::size_t RtxReader::read(std::span<double> out) {

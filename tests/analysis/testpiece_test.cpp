@@ -132,4 +132,19 @@ TEST(TestPiece, BadInputIsRefused) {
   EXPECT_THROW(predict_profiles(kin::Machine{}, l, s), InputError);
 }
 
+// Issue 27: points on a straight line beside bore1 (centre (30, 30)) were fitted as a circle.
+TEST(TestPiece, BorePointsOnOneSideAreRefused) {
+  const Layout l;
+  const std::vector<Point> line{{"bore1", 38, 26}, {"bore1", 38, 30}, {"bore1", 38, 34}};
+  const auto profiles = measured_profiles(l, line);
+  try {
+    evaluate(l, profiles);
+    FAIL() << "a line of points was fitted as a bore";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bore1: the points lie within half of the bore"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace

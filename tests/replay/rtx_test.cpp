@@ -122,11 +122,31 @@ TEST(Rtx, AMarkerCutOrOffTheSampleGridIsDamage) {
   EXPECT_FALSE(cut.header().eof_marker);
   EXPECT_EQ(cut.header().samples, 4u);
   EXPECT_EQ(cut.header().trailing_bytes, 4u);
-  // One stray byte before the marker: the marker is not where a sample starts.
+  // One stray byte before the marker: the marker is not where a sample starts, but it runs to
+  // the end of the file, so it is the end; the stray byte is a partial sample (damage). Read
+  // as samples (before issue 27), "x\r\nEOF::\r" was a fifth sample of 4.95e27.
   RtxReader stray(kHeader + samples() + "x\r\nEOF::\r\n", "stray.rtx");
-  EXPECT_FALSE(stray.header().eof_marker);
-  EXPECT_EQ(stray.header().samples, 5u);  // 32 + 10 bytes: five "samples", two left over
-  EXPECT_EQ(stray.header().trailing_bytes, 2u);
+  EXPECT_TRUE(stray.header().eof_marker);
+  EXPECT_EQ(stray.header().eof_offset, kHeader.size() + 33);
+  EXPECT_EQ(stray.header().samples, 4u);
+  EXPECT_EQ(stray.header().trailing_bytes, 1u);
+  EXPECT_EQ(all(stray), (std::vector<double>{1.0, -2.5, 0.125, 1000.0}));
+}
+
+TEST(Rtx, AHeaderThatIsNotUtf8IsRefusedOrReadAsWindows1252) {
+  const std::string header = "HEADER::\r\nFile Type: Linear\r\nActual sample rate: 1000\r\n"
+                             "By: M\xFCller\r\nData:\r\n";
+  try {
+    RtxReader(header + samples() + "\r\nEOF::\r\n", "w.rtx");
+    FAIL() << "accepted";
+  } catch (const RtxError& e) {
+    EXPECT_NE(std::string(e.what()).find("w.rtx: line 4, byte 60: the header is not UTF-8 text"),
+              std::string::npos)
+        << e.what();
+  }
+  RtxReader r(header + samples() + "\r\nEOF::\r\n", "w.rtx",
+              cal::replay::RtxHeaderEncoding::windows1252);
+  EXPECT_EQ(*r.header().find("By"), "M\xC3\xBCller");
 }
 
 TEST(Rtx, TheFileTypeDecidesWhatTheSamplesAre) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cal/analysis/error.hpp"
+#include "json_input.hpp"
 
 namespace cal::daq::model {
 namespace {
@@ -32,6 +33,7 @@ class Context {
   [[noreturn]] void fail(std::string_view what) const {
     throw InputError(fmt::format("{}: {}", where_, what));
   }
+  const std::string& where() const { return where_; }
 
  private:
   std::string where_;
@@ -82,8 +84,29 @@ std::vector<double> numbers(const Context& cx, const Json& j, std::string_view k
   return v;
 }
 
+// Physical sense: no machine's position is beyond 100 m, no error beyond 100 m (1e8 um) or
+// 1 rad (1e6 urad). Values past these are typing errors, and the maps and predictions made
+// from them would print inf or nan.
+constexpr double kMaxPositionMm = 100e3, kMaxTranslationUm = 1e8, kMaxAngleUrad = 1e6;
+
+double bounded(const Context& cx, double v, std::string_view key, double limit,
+               std::string_view unit) {
+  if (std::abs(v) > limit)
+    cx.fail(key, fmt::format("{} {} is beyond {:g} {} (a typing error?)", v, unit, limit, unit));
+  return v;
+}
+
+// Positions in mm, each within kMaxPositionMm.
+std::vector<double> positions_mm(const Context& cx, const Json& j, std::string_view key,
+                                 std::size_t min_size) {
+  auto v = numbers(cx, j, key, min_size);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    bounded(cx, v[i], fmt::format("{}[{}]", key, i), kMaxPositionMm, "mm");
+  return v;
+}
+
 kin::Vec3 vec3(const Context& cx, const Json& j, std::string_view key) {
-  const auto v = numbers(cx, j, key, 3);
+  const auto v = positions_mm(cx, j, key, 3);
   if (v.size() != 3) cx.fail(key, fmt::format("{} values, expected 3 (x, y, z)", v.size()));
   return {v[0], v[1], v[2]};
 }
@@ -107,12 +130,9 @@ Json parse_json(const Context& cx, std::string_view text_in) {
       duplicate = parsed.get<std::string>();
     return true;
   };
-  Json j;
-  try {
-    j = Json::parse(text_in.begin(), text_in.end(), callback);
-  } catch (const Json::exception& e) {  // syntax, or a number out of range (1e999)
-    cx.fail(fmt::format("not valid JSON ({})", e.what()));
-  }
+  // Syntax, a number out of range (1e999), bytes that are not UTF-8, nesting too deep (a
+  // source or provenance 100 000 levels down would crash every dump of it).
+  const Json j = parse_json_input<Json>(text_in, cx.where(), callback);
   if (!duplicate.empty()) cx.fail(duplicate, "key given twice (only one value per key)");
   return j;
 }
@@ -127,7 +147,10 @@ Source source_of(const Json& entry) {
   return it == entry.end() ? Source{} : Source{it->dump()};
 }
 
-kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key) {
+kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key,
+                               bool angle) {
+  const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
+  const std::string_view unit = angle ? "urad" : "um";
   object_at(cx, e, key);
   only_keys(cx, e, key, {"polynomial", "table", "source", "note"});
   check_note(cx, e, key);
@@ -147,8 +170,10 @@ kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::stri
   only_keys(cx, t, tk, {"position_mm", "value"});
   if (!t.contains("position_mm") || !t.contains("value"))
     cx.fail(tk, "expected \"position_mm\" and \"value\" arrays");
-  const auto q = numbers(cx, t["position_mm"], tk + ".position_mm", 2);
+  const auto q = positions_mm(cx, t["position_mm"], tk + ".position_mm", 2);
   const auto v = numbers(cx, t["value"], tk + ".value", 2);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    bounded(cx, v[i], fmt::format("{}.value[{}]", tk, i), limit, unit);
   try {
     return kin::ErrorFunction::table(q, v);
   } catch (const InputError& err) {
@@ -170,7 +195,8 @@ void read_components(const Context& cx, const Json& comps, Model& m) {
     }
     if (std::string(kin::to_string(c)) != it.key())
       cx.fail(key, fmt::format("write the name as {}", kin::to_string(c)));
-    kin::component(m.machine, c) = function_of(cx, it.value(), key);
+    const bool angle = static_cast<std::size_t>(c) % 6 >= 3;  // E_A.., E_B.., E_C..
+    kin::component(m.machine, c) = function_of(cx, it.value(), key, angle);
     m.components[static_cast<std::size_t>(c)] = {true, source_of(it.value())};
   }
 }
@@ -197,7 +223,8 @@ void read_squareness(const Context& cx, const Json& sq, Model& m) {
     SquarenessEntry& s = m.squareness[static_cast<std::size_t>(*plane)];
     s.given = true;
     s.stated_as = iso ? "iso230_1_urad" : "angle_over_90_urad";
-    const double v = number(cx, e[s.stated_as], key + "." + s.stated_as);
+    const double v = bounded(cx, number(cx, e[s.stated_as], key + "." + s.stated_as),
+                             key + "." + s.stated_as, kMaxAngleUrad, "urad");
     m.machine.squareness.of(*plane) = iso ? v : kin::location_error_from_angle_over_90(*plane, v);
     if (e.contains("method")) {
       s.method = text(cx, e["method"], key + ".method");
@@ -236,7 +263,7 @@ void read_travel(const Context& cx, const Json& t, Model& m) {
   for (std::size_t i = 0; i < 3; ++i) {
     const std::string key = fmt::format("travel_mm.{}", kAxisNames[i]);
     if (!t.contains(kAxisNames[i])) cx.fail(key, "missing (give [min, max] for X, Y and Z)");
-    const auto v = numbers(cx, t[kAxisNames[i]], key, 2);
+    const auto v = positions_mm(cx, t[kAxisNames[i]], key, 2);
     if (v.size() != 2 || !(v[1] > v[0])) cx.fail(key, "expected [min, max] with max > min");
     travel[i] = {v[0], v[1]};
   }
@@ -258,6 +285,28 @@ void check_tables_cover_travel(const Context& cx, const Model& m) {
               fmt::format("covers {} .. {} mm but the {} travel is {} .. {} mm (tables are not "
                           "extrapolated)",
                           q.front(), q.back(), kAxisNames[axis], lo, hi));
+  }
+}
+
+// A polynomial stays within the limits over the travel of its axis (sampled at 101 points):
+// coefficients that are each finite can still overflow to inf where the model is evaluated.
+void check_polynomials_over_travel(const Context& cx, const Model& m) {
+  if (!m.travel_mm) return;
+  for (kin::Component c : kin::all_components()) {
+    const auto& f = kin::component(m.machine, c);
+    if (f.is_table() || f.is_zero()) continue;
+    const auto axis = static_cast<std::size_t>(c) / 6;
+    const bool angle = static_cast<std::size_t>(c) % 6 >= 3;
+    const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
+    const auto [lo, hi] = (*m.travel_mm)[axis];
+    for (int i = 0; i <= 100; ++i) {
+      const double q = lo + (hi - lo) * i / 100.0, v = f(q);
+      if (!(std::abs(v) <= limit))
+        cx.fail(
+            fmt::format("components.{}.polynomial", kin::to_string(c)),
+            fmt::format("{} {} at {} mm of the {} travel, beyond {:g} {} (a typing error?)", v,
+                        angle ? "urad" : "um", q, kAxisNames[axis], limit, angle ? "urad" : "um"));
+    }
   }
 }
 
@@ -326,6 +375,7 @@ Model parse(std::string_view text_in, std::string_view where) {
   if (j.contains("squareness")) read_squareness(cx, j["squareness"], m);
   if (j.contains("provenance")) m.provenance = {j["provenance"].dump()};
   check_tables_cover_travel(cx, m);
+  check_polynomials_over_travel(cx, m);
   return m;
 }
 

@@ -9,6 +9,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "circle_output.hpp"
+#include "json_input.hpp"
 #include "provenance.hpp"
 
 namespace daq {
@@ -31,7 +32,7 @@ std::optional<json> current_circle_result(const st::Store& store, std::int64_t r
   std::optional<json> out;
   for (const auto& r : store.results(run)) {
     if (!r.current()) continue;
-    json j = json::parse(r.json, nullptr, false);
+    json j = cal::daq::parse_stored_json(r.json);
     if (j.is_object() && is_circle_schema(j.value("schema", ""))) out = std::move(j);
   }
   return out;
@@ -43,7 +44,7 @@ BallbarTest test_of(const st::Store& store, const st::RunRecord& run) {
     throw cal::InputError(fmt::format("{} is a {} run, not a ballbar test", where, run.kind));
   const auto result = current_circle_result(store, run.id);
   if (!result) throw cal::InputError(fmt::format("{} has no circle result", where));
-  const json settings = json::parse(run.settings_json, nullptr, false);
+  const json settings = cal::daq::parse_stored_json(run.settings_json);
   BallbarTest t{.run = run.id,
                 .started_unix_ms = run.started_unix_ms,
                 .campaign = run.campaign,

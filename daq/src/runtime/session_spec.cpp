@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cstdint>
 #include <ctime>
 
 #include "cal/analysis/error.hpp"
@@ -28,6 +30,46 @@ namespace {
 
 using cal::drivers::OptionType;
 using cal::drivers::OptionValue;
+
+[[noreturn]] void wrong_shape(std::string_view where, std::string_view key, std::string_view want,
+                              const json& found) {
+  throw cal::InputError(
+      fmt::format("{}: key '{}': expected {}, found {}", where, key, want, found.type_name()));
+}
+
+// The string at `key`, or `fallback` when it is absent; InputError naming the key otherwise.
+std::string text_at(const json& j, const char* key, std::string fallback, std::string_view where) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return fallback;
+  if (!it->is_string()) wrong_shape(where, key, "a string", *it);
+  return it->get<std::string>();
+}
+
+// The integer at `key` within [lo, hi], or `fallback` when it is absent.
+std::int64_t integer_at(const json& j, const char* key, std::int64_t fallback, std::int64_t lo,
+                        std::int64_t hi, std::string_view where) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return fallback;
+  if (!it->is_number_integer()) wrong_shape(where, key, "a whole number", *it);
+  const bool huge =
+      it->is_number_unsigned() && it->get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX);
+  const std::int64_t v = huge ? 0 : it->get<std::int64_t>();
+  if (huge || v < lo || v > hi)
+    throw cal::InputError(
+        fmt::format("{}: key '{}': {} is not within {} .. {}", where, key, it->dump(), lo, hi));
+  return v;
+}
+
+// Three finite numbers at `key`, or `fallback` when it is absent.
+std::array<double, 3> vec3_at(const json& j, const char* key, std::array<double, 3> fallback,
+                              std::string_view where) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return fallback;
+  if (!it->is_array() || it->size() != 3 ||
+      !std::all_of(it->begin(), it->end(), [](const json& e) { return e.is_number(); }))
+    wrong_shape(where, key, "an array of 3 numbers", *it);
+  return it->get<std::array<double, 3>>();
+}
 
 // A JSON value as an option value of the spec's type; the table's check follows.
 OptionValue option_value(const json& v, const cal::drivers::OptionSpec& spec) {
@@ -84,7 +126,8 @@ void read_legacy_options(const json& j, const cal::drivers::DeviceDriver& d, Ins
     }
     set_option(s.options, *spec, v, s);
   }
-  if (const auto f = j.find("feed"); f != j.end()) s.test_axis = f->value("axis", 0);
+  if (const auto f = j.find("feed"); f != j.end() && f->is_object())
+    s.test_axis = static_cast<int>(integer_at(*f, "axis", 0, 0, 2, "capture header: feed"));
 }
 
 }  // namespace
@@ -103,24 +146,28 @@ json to_json(const InstrumentSpec& s) {
 }
 
 InstrumentSpec instrument_spec_from_json(const json& j) {
+  constexpr std::string_view where = "capture header: instruments[]";
+  if (!j.is_object()) wrong_shape("capture header", "instruments[]", "an object", j);
   InstrumentSpec s;
-  s.device = j.at("device").get<std::uint16_t>();
-  s.driver = j.at("driver").get<std::string>();
+  if (!j.contains("device") || !j.contains("driver"))
+    throw cal::InputError(fmt::format("{}: needs the keys 'device' and 'driver'", where));
+  s.device = static_cast<std::uint16_t>(integer_at(j, "device", 0, 0, 65535, where));
+  s.driver = text_at(j, "driver", "", where);
   const auto* d = cal::drivers::find_driver(s.driver);
   if (!d)
     throw cal::InputError(
         fmt::format("capture header: instrument {}: driver '{}' is not in this build (it has: {})",
                     s.device, s.driver, fmt::join(cal::drivers::driver_names(), ", ")));
-  s.role = j.value("role", "");
-  s.transport = j.value("transport", "");
-  s.serial_number = j.value("serial_number", "");
-  s.certificate = j.value("certificate", "");
-  s.calibration_due = j.value("calibration_due", "");
+  s.role = text_at(j, "role", "", where);
+  s.transport = text_at(j, "transport", "", where);
+  s.serial_number = text_at(j, "serial_number", "", where);
+  s.certificate = text_at(j, "certificate", "", where);
+  s.calibration_due = text_at(j, "calibration_due", "", where);
   // Captures recorded before origins were stored do not say: not recorded, never "real".
-  s.origin = j.contains("origin") && j["origin"].is_string() ? j["origin"].get<std::string>() : "";
+  s.origin = j.contains("origin") ? text_at(j, "origin", "", where) : "";
   s.options = cal::drivers::Options(d->options());
   if (const auto o = j.find("options"); o != j.end() && o->is_object()) {
-    s.test_axis = j.value("test_axis", 0);
+    s.test_axis = static_cast<int>(integer_at(j, "test_axis", 0, 0, 2, where));
     for (const auto& [name, v] : o->items()) {
       const auto* spec = cal::drivers::find_option(d->options(), name);
       if (!spec)
@@ -165,13 +212,15 @@ cal::daq::MeasureConfig measure_from_json(const json& j) {
 }
 
 cal::daq::Config config_from_json(const json& j) {
+  constexpr std::string_view where = "capture header: config";
+  if (!j.is_object()) wrong_shape("capture header", "config", "an object", j);
   cal::daq::Config c;
-  c.machine_name = j.value("machine", "machine");
-  c.machine_description = j.value("description", "");
-  c.machine_topology = j.value("topology", "");
-  c.machine_tool_offset_mm = j.value("tool_offset_mm", c.machine_tool_offset_mm);
-  c.machine_table_offset_mm = j.value("table_offset_mm", c.machine_table_offset_mm);
-  c.campaign = j.value("campaign", "");
+  c.machine_name = text_at(j, "machine", "machine", where);
+  c.machine_description = text_at(j, "description", "", where);
+  c.machine_topology = text_at(j, "topology", "", where);
+  c.machine_tool_offset_mm = vec3_at(j, "tool_offset_mm", c.machine_tool_offset_mm, where);
+  c.machine_table_offset_mm = vec3_at(j, "table_offset_mm", c.machine_table_offset_mm, where);
+  c.campaign = text_at(j, "campaign", "", where);
   // Sections a capture does not have keep the defaults its run used (older captures).
   namespace fd = cal::daq::fields;
   const auto section = [&](const char* key, auto fields, auto& out) {

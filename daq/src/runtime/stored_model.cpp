@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "json_input.hpp"
 
 namespace daq {
 
@@ -45,7 +46,7 @@ StoredProfiles stored_profiles(const cal::storage::Store& store, const std::stri
   bool any = false;
   for (const auto& r : runs) {
     if (r.machine_id != m->id) continue;
-    const json s = json::parse(r.settings_json, nullptr, false);
+    const json s = cal::daq::parse_stored_json(r.settings_json);
     if (!s.is_object()) continue;
     const auto measure = s.find("measure");
     // Positioning runs stored before the test kinds have no "measure": E_XX of their axis.

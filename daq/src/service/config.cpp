@@ -17,6 +17,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/analysis/kinematics.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/daq/config_fields.hpp"
 #include "cal/drivers/registry.hpp"
 #include "cal/drivers/transport/transport.hpp"
@@ -328,8 +329,8 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
            {"laser", "air", "material", "ballbar", "position", "indicator", "level"});
   t.read("origin", d.origin);
   one_of(t, "origin", d.origin, {"real", "simulated"});
-  t.read("serial_number", d.serial_number);
-  t.read("certificate", d.certificate);
+  t.name("serial_number", d.serial_number);
+  t.name("certificate", d.certificate);
   t.read("calibration_due", d.calibration_due);
   if (!d.calibration_due.empty() && !iso_date(d.calibration_due))
     t.fail(t.node("calibration_due"), "calibration_due",
@@ -621,6 +622,16 @@ Config parse_config(std::string_view text, const std::filesystem::path& file) {
   read_tolerances(c, top);
   if (const auto* devs = top.subtable("devices")) {
     for (const auto& [k, v] : *devs) {
+      // The id names the device in every message, log and report: a plain word.
+      const std::string_view id = k.str();
+      if (id.empty() || id.size() > 64 ||
+          id.find_first_not_of(
+              "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-.") !=
+              std::string_view::npos)
+        Table(*devs, "devices", file)
+            .fail(&v, "",
+                  fmt::format("device id '{}': use 1 to 64 letters, digits, '_', '-' or '.'",
+                              cal::text::terminal_safe(id)));
       if (!v.is_table())
         Table(*devs, "devices", file)
             .fail(&v, k.str(), "expected a table [devices." + std::string(k.str()) + "]");

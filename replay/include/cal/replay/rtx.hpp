@@ -20,6 +20,12 @@
 // importer takes the unit as an option and accepts the types "Linear" and "Angular" (any
 // case), refusing every other type by name.
 //
+// The header's text: no public source states its encoding. UTF-8 (and so ASCII) is read as
+// it is; any other byte is refused with the line and byte, unless the caller says the file
+// was written in the Windows-1252 code page (CARTO runs on Windows, whose Western code page
+// writes "By: Müller" as 4D FC 6C ...), in which case the header is converted to UTF-8.
+// Control characters in a header line are refused (they would reach terminals and reports).
+//
 // Damage is reported, never hidden: a partial last sample or a missing end marker is noted
 // in the header (trailing_bytes, eof_marker) and every complete sample before it is read.
 // Nonsense in the header (a sample rate that is not finite or outside 0.001 Hz .. 10 MHz, a
@@ -59,6 +65,9 @@ struct RtxHeader {
   const std::string* find(std::string_view key) const;
 };
 
+// How the header's bytes are read (see above).
+enum class RtxHeaderEncoding { utf8, windows1252 };
+
 // Limits of the header values (see above).
 inline constexpr double rtx_min_rate_hz = 1e-3, rtx_max_rate_hz = 1e7;
 
@@ -67,16 +76,21 @@ class RtxReader {
   // Throws RtxError naming the file and the byte offset: not an .rtx header, no "Data:" line
   // within the first 64 KiB, no usable sample rate, a File Type that is missing or not
   // supported (named), nonsense header values (named, with the value).
-  explicit RtxReader(const std::filesystem::path& path);
+  explicit RtxReader(const std::filesystem::path& path,
+                     RtxHeaderEncoding encoding = RtxHeaderEncoding::utf8);
   // The same from bytes in memory (tests, fuzzing); `name` stands for the file in messages.
-  RtxReader(std::string bytes, std::string name);
+  RtxReader(std::string bytes, std::string name,
+            RtxHeaderEncoding encoding = RtxHeaderEncoding::utf8);
   const RtxHeader& header() const { return header_; }
   // Reads up to out.size() samples in order; returns how many (0 at the end).
   std::size_t read(std::span<double> out);
 
  private:
   void read_header(std::uint64_t size);
+  std::string header_text(std::string_view line, std::size_t line_number, std::size_t at) const;
+  void find_end_marker(std::uint64_t size);
   std::string name_;
+  RtxHeaderEncoding encoding_ = RtxHeaderEncoding::utf8;
   std::unique_ptr<std::istream> in_;
   RtxHeader header_;
   std::uint64_t next_ = 0;  // next sample index
