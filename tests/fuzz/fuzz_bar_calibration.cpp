@@ -14,8 +14,12 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::vector<std::string> lines(1);
-  for (std::size_t i = 0; i < size && lines.size() <= 5; ++i)
-    data[i] == '\n' ? lines.emplace_back() : lines.back().push_back(static_cast<char>(data[i]));
+  for (std::size_t i = 0; i < size && lines.size() <= 5; ++i) {
+    if (data[i] == '\n')
+      lines.emplace_back();
+    else
+      lines.back().push_back(static_cast<char>(data[i]));
+  }
   lines.resize(5);
   const auto number = [](const std::string& s) { return std::strtod(s.c_str(), nullptr); };
   daq::BarCalibrationInput in{
