@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 namespace {
@@ -25,7 +26,7 @@ void list_compensations(const cal::storage::Store& store) {
   if (all.empty())
     fmt::print("no compensation tables stored (daq compensate --run RUN stores one)\n");
   for (const auto& c : all)
-    fmt::print("compensation {}: axis {}, {} from {}, machine {}\n", c.id, c.axis, c.format,
+    print_line("compensation {}: axis {}, {} from {}, machine {}", c.id, c.axis, c.format,
                c.source, c.machine_id);
 }
 
@@ -45,7 +46,7 @@ void run(const VerifyOptions& o) {
     j["run"] = o.run;
     fmt::print("{}\n", j.dump(2));
   } else {
-    fmt::print("run {}: {}\n", o.run, loop_text(*check));
+    print_line("run {}: {}", o.run, loop_text(*check));
     const auto& v = check->verification;
     fmt::print(
         "  largest |deviation|: predicted {:.3f} um, measured {:.3f} um ({} points; "

@@ -691,6 +691,14 @@ try:
     setup = json.loads(body)["setup"]
     own = json.loads(json.dumps(setup))
     setup["devices"]["laser"]["transport"] = f"tcp 127.0.0.1:{lport}"
+    # A body nested 100 000 deep is refused (400) before anything recurses into it, on every
+    # endpoint that reads JSON, and the server still answers (it crashed on a dump before).
+    deep = b'{"setup": ' + b'[' * 100000 + b']' * 100000 + b'}'
+    for path in ("/api/setup/apply", "/api/setup/check", "/api/setup/program", "/api/runs/start"):
+        status, headers, body = json_post(p, path, deep)
+        check(f"a body nested 100 000 deep at {path} is refused", status == 400, f"{status} {body[:200]!r}")
+    status, _, _ = request(p, "GET", "/api/status")
+    check("the server answers after the deep bodies", status == 200, f"{status}")
     status, headers, body = json_post(p, "/api/setup/apply", json.dumps({"setup": setup}).encode())
     is_json_error("set-up naming another TCP port", status, headers, body, 403)
     j = json.loads(body) if status == 403 else {}

@@ -34,6 +34,7 @@
 #include "devices_list.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
+#include "json_input.hpp"
 #include "provenance.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
@@ -63,9 +64,21 @@ web::Response ok(const json& j, int status = 200) {
   return {status, j.dump(-1, ' ', false, json::error_handler_t::replace)};
 }
 
+// A request body as JSON, its nesting bounded before anything recurses into it (json_input.hpp:
+// a body nested 100 000 deep would crash whatever dumps or copies it); discarded when it is
+// not JSON or too deep, so each endpoint answers 400 with its own reason.
+json parse_body(const std::string& body) {
+  try {
+    cal::daq::check_json_depth(body, "request body");
+  } catch (const cal::InputError&) {
+    return json(json::value_t::discarded);
+  }
+  return json::parse(body, nullptr, false);
+}
+
 // The body of POST /api/runs/start: exactly {"test": "linear"} or {"test": "circle"}.
 std::optional<std::string> requested_test(const std::string& body, std::string& why) {
-  const auto req = json::parse(body, nullptr, false);
+  const auto req = parse_body(body);
   const char* expected = R"(give {"test": "linear"} or {"test": "circle"})";
   if (req.is_discarded()) {
     why = fmt::format("the body is not JSON: {}", expected);
@@ -82,7 +95,7 @@ std::optional<std::string> requested_test(const std::string& body, std::string& 
 // The set-up of a POST body {"setup": {...}, ...}; the other keys allowed are named.
 std::optional<json> setup_body(const std::string& body, std::initializer_list<const char*> others,
                                std::string& why) {
-  const auto req = json::parse(body, nullptr, false);
+  const auto req = parse_body(body);
   if (req.is_discarded() || !req.is_object()) {
     why = "the body must be a JSON object {\"setup\": {...}}";
     return std::nullopt;
@@ -397,7 +410,7 @@ class Service {
     std::string why;
     const auto setup = setup_body(body, {"test", "dialect"}, why);
     if (!setup) return error(400, why);
-    const auto req = json::parse(body);
+    const auto req = parse_body(body);  // setup_body accepted it: an object
     const auto test = string_field(
         req, "test", "linear",
         [](const std::string& t) {
@@ -468,7 +481,7 @@ class Service {
   // now on, 1 .. 100 times the wall clock as --speed. The simulated time line is unchanged (it
   // only moves from event to event): a run's readings and results do not depend on it.
   web::Response simulation_speed(const std::string& body) {
-    const auto j = json::parse(body, nullptr, false);
+    const auto j = parse_body(body);
     if (!j.is_object() || j.size() != 1 || !j.contains("speed") || !j["speed"].is_number())
       return error(400, "the body must be {\"speed\": N} with N from 1 to 100");
     const double speed = j["speed"].get<double>();
@@ -713,7 +726,7 @@ class Service {
 
   // POST /api/runs/stop: an empty body or a JSON object (the page sends {}).
   web::Response stop_request(const std::string& body) {
-    if (!body.empty() && !json::parse(body, nullptr, false).is_object())
+    if (!body.empty() && !parse_body(body).is_object())
       return error(400, "the body of a stop must be empty or a JSON object");
     return stop("stopped from the web page");
   }
