@@ -40,7 +40,7 @@ check linear_targets 0 "<td class=\"r\">500.000</td>" -- cat r1.html
 # Two ISO 230-2 plots (means with bands, run by run) and three environment plots.
 check linear_plots 0 "^5$" -- count r1.html "<svg class=\"plot\""
 check linear_band 0 "x̄ ± 2s" -- cat r1.html
-check simulated_said 0 "made on the <strong>simulated</strong> machine" -- cat r1.html
+check simulated_said 0 "<strong>SIMULATED</strong>: this run was made on the simulated machine" -- cat r1.html
 check environment 0 "Air temperature</td>" -- cat r1.html
 # Self-contained: nothing is loaded from elsewhere (the SVG namespaces are names, not loads).
 check no_external 1 "^0$" -- grep -cE "(src|href)=\"(https?:)?//" r1.html
@@ -126,7 +126,7 @@ check as_found_mixed 2 "give the same test before and after" -- "$DAQ" report --
 # --- rendered by Chromium ------------------------------------------------------------------------
 # All five in one Chromium (render_reports.py runs report_render_test.py on each, its checks
 # unchanged; a browser's start-up costs about 1 s).
-"$PY" "$TESTS/../cli/render_reports.py" "r1=$TMP/r1.html:$TMP/r1.png" "r2=$TMP/r2.html:$TMP/r2.png" \
+"$PY" "$TESTS/../cli/render_reports.py" "r1=$TMP/r1.html:$TMP/r1.png:SIMULATED — Run " "r2=$TMP/r2.html:$TMP/r2.png:SIMULATED — Run " \
   "camp=$TMP/camp.html:$TMP/camp.png:Campaign" "cmp=$TMP/cmp.html:$TMP/cmp.png:Comparison" \
   "af=$TMP/af.html:$TMP/af.png:As found" >rendered.txt 2>&1
 check rendered 0 "^r1: rendered 5 plots" -- cat rendered.txt

@@ -691,12 +691,12 @@ try:
     setup = json.loads(body)["setup"]
     own = json.loads(json.dumps(setup))
     setup["devices"]["laser"]["transport"] = f"tcp 127.0.0.1:{lport}"
-    # A body nested 100 000 deep is refused (400) before anything recurses into it, on every
-    # endpoint that reads JSON, and the server still answers (it crashed on a dump before).
-    deep = b'{"setup": ' + b'[' * 100000 + b']' * 100000 + b'}'
+    # A body nested 30 000 deep (under the 64 KiB body limit) is refused (400) before anything
+    # recurses into it, at every endpoint that reads JSON, and the server still answers.
+    deep = b'{"setup": ' + b'[' * 30000 + b']' * 30000 + b'}'
     for path in ("/api/setup/apply", "/api/setup/check", "/api/setup/program", "/api/runs/start"):
         status, headers, body = json_post(p, path, deep)
-        check(f"a body nested 100 000 deep at {path} is refused", status == 400, f"{status} {body[:200]!r}")
+        check(f"a body nested 30 000 deep at {path} is refused", status == 400, f"{status} {body[:200]!r}")
     status, _, _ = request(p, "GET", "/api/status")
     check("the server answers after the deep bodies", status == 200, f"{status}")
     status, headers, body = json_post(p, "/api/setup/apply", json.dumps({"setup": setup}).encode())
