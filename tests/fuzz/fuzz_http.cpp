@@ -16,7 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       .token = "s3cret", .allowed_hosts = {"machine.local"}, .max_body_bytes = 1024};
   bool reached = false;
   const cal::daq::web::Api api{
-      .page = [&] { return reached = true, std::string("<html></html>"); },
+      .page = [&](std::string_view) { return reached = true, std::string("<html></html>"); },
       .runs =
           [&] {
             return reached = true, Response{200, "{}"};
