@@ -29,9 +29,7 @@ int axis_number(const std::map<std::string, int>& numbers, const std::string& ax
   return it->second;
 }
 
-double to_um(double v, Units u) {
-  return u == Units::mm ? v * 1e3 : u == Units::inch ? v * 25400.0 : v;
-}
+double to_um(double v, Units u) { return v * um_per_unit(u); }
 
 void check_positioning(const Table& t, std::string_view format) {
   if (t.forward.size() != t.position_mm.size() || t.position_mm.size() < 2)

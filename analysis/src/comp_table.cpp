@@ -114,6 +114,8 @@ std::string fixed(double v, int decimals) {
   return fmt::format("{:.{}f}", r, decimals);
 }
 
+double um_per_unit(Units u) { return u == Units::mm ? 1e3 : u == Units::inch ? 25400.0 : 1.0; }
+
 std::string units_name(Units u) { return u == Units::mm ? "mm" : u == Units::um ? "um" : "inch"; }
 
 Units units_from_string(const std::string& s) {
@@ -299,9 +301,7 @@ std::string write_isg(const Table& t) {
   validate(t.spec);
   check_finite(t);
   auto tenth_um = [&](double v) {  // table units -> 0.1 um
-    const double um = t.spec.units == Units::mm     ? v * 1e3
-                      : t.spec.units == Units::inch ? v * 25400.0
-                                                    : v;
+    const double um = v * um_per_unit(t.spec.units);
     return static_cast<long long>(std::llround(um * 10.0));
   };
   std::string out =
@@ -327,9 +327,7 @@ double correction_at_um(const std::vector<double>& position_mm, const std::vecto
 Applied applied(const Table& t, bool backlash_in_table) {
   validate(t.spec);
   check_finite(t);
-  const double to_um = t.spec.units == Units::mm     ? 1e3
-                       : t.spec.units == Units::inch ? 25400.0
-                                                     : 1.0;
+  const double to_um = um_per_unit(t.spec.units);
   const double sign = t.spec.sign == Sign::correction ? 1.0 : -1.0;
   // The values as the control holds them: increments summed back to absolute values.
   auto absolute = [&](std::vector<double> v) {

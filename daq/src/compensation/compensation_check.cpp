@@ -172,9 +172,7 @@ std::string corrected_table(const LoopCheck& c) {
                            ? ct::Sign::error
                            : ct::Sign::correction)
                     : ct::format_meaning(w.format).written;
-  const double unit_um = t.spec.units == ct::Units::mm     ? 1e3
-                         : t.spec.units == ct::Units::inch ? 25400.0
-                                                           : 1.0;
+  const double unit_um = ct::um_per_unit(t.spec.units);
   const auto each = [&](auto f) {
     for (auto* v2 : {&t.forward, &t.reverse})
       for (auto& x : *v2) x = f(x);

@@ -63,6 +63,8 @@ Table cross(const Spec& spec, std::span<const double> position_mm,
             std::span<const double> deviation_um, bool remove_slope);
 
 std::string units_name(Units u);
+// Micrometres in one of the table's units (1000 per mm, 25400 per inch exactly, 1 per um).
+double um_per_unit(Units u);
 Units units_from_string(const std::string& s);
 
 // A number in fixed notation with `decimals` places, rounded, never "-0.000" (a controller or a
