@@ -352,6 +352,7 @@ void add_model_commands(CLI::App& app) {
   map->callback([o] { run_map(*o); });
 
   add_model_build_command(*model);
+  add_model_compare_command(*model);
   add_model_compensate_command(*model);
   add_model_testpiece_command(*model);
 }

@@ -47,6 +47,8 @@ struct SimOptions {
   bool acquire = false;    // run the acquisition in this process, on simulated time
   std::string capture;     // with acquire: the run's capture file
   bool json = false;       // with acquire: the result as JSON on stdout (as daq run --json)
+  std::string truth_out;   // write the volumetric machine's injected errors as a model, exit
+  std::vector<double> truth_tool_offset_mm;  // with truth_out: the tool the model is for
 };
 
 std::string numbers(const std::array<double, 3>& v) {
@@ -122,6 +124,15 @@ std::int64_t newest_run(const std::filesystem::path& db) {
 }
 
 void run_sim(SimOptions o) {
+  if (!o.truth_out.empty()) {
+    auto truth = volumetric_truth_model(cal::kinematics::topology_from_string(o.topology));
+    if (!o.truth_tool_offset_mm.empty())
+      truth.machine.tool_offset_mm = {o.truth_tool_offset_mm[0], o.truth_tool_offset_mm[1],
+                                      o.truth_tool_offset_mm[2]};
+    cal::daq::model::write(truth, o.truth_out);
+    return fmt::print("The SIMULATED volumetric machine's injected errors ({}) written to {}\n",
+                      o.topology, o.truth_out);
+  }
   if (!o.measure.empty()) o.test = "linear";  // a component's test is a linear one
   if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
     throw cal::InputError(
@@ -312,6 +323,14 @@ void add_sim_command(CLI::App& app) {
                 "`daq run TEST --config FILE` runs in this process on SIMULATED time (as fast as "
                 "the CPU allows, the same on a loaded machine), prints what it prints and stores "
                 "into --db");
+  cmd->add_option("--truth-out", o->truth_out,
+                  "Write the SIMULATED volumetric machine's injected errors (of --topology) as a "
+                  "model file and exit: compare a built model with it (`daq model compare`)");
+  cmd->add_option("--tool-offset-mm", o->truth_tool_offset_mm,
+                  "--truth-out: the tool tip the truth is for, from the tool reference point (as "
+                  "`daq model build --tool-offset-mm`)")
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
   cmd->add_option("--capture", o->capture, "--acquire: record the run's wire-level capture here");
   cmd->add_flag(
       "--json", o->json,

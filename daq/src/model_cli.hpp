@@ -35,5 +35,6 @@ cal::kinematics::Method method_from_string(const std::string& s);
 void add_model_compensate_command(CLI::App& model);
 void add_model_testpiece_command(CLI::App& model);
 void add_model_build_command(CLI::App& model);
+void add_model_compare_command(CLI::App& model);
 
 }  // namespace daq

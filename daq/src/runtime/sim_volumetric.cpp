@@ -118,6 +118,20 @@ ShopTruth volumetric_truth(kin::Topology t, double noise_um) {
   return truth;
 }
 
+cal::daq::model::Model volumetric_truth_model(kin::Topology t) {
+  cal::daq::model::Model m;
+  m.name = fmt::format("SIMULATED truth ({})", kin::to_string(t));
+  m.machine = volumetric_geometry(t);
+  m.travel_mm = {{{0.0, kSimTravelMm[0]}, {0.0, kSimTravelMm[1]}, {0.0, kSimTravelMm[2]}}};
+  const std::string injected = R"({"origin": "simulated", "what": "injected"})";
+  for (auto& c : m.components) c = {.given = true, .source = {injected}};
+  for (auto& s : m.squareness) s.given = true, s.source = {injected};
+  m.provenance = {
+      "{\"origin\": \"simulated\", \"what\": \"the errors injected into the SIMULATED shop's "
+      "volumetric machine (daq/src/runtime/sim_volumetric.cpp)\"}"};
+  return m;
+}
+
 std::vector<cal::daq::LinearTestConfig> volumetric_tests() {
   std::vector<cal::daq::LinearTestConfig> out;
   for (std::size_t axis = 0; axis < 3; ++axis) {

@@ -14,6 +14,7 @@
 
 #include "cal/analysis/kinematics.hpp"
 #include "cal/daq/config.hpp"
+#include "model/model_file.hpp"
 #include "linear_run.hpp"
 #include "sim_shop.hpp"
 
@@ -27,6 +28,11 @@ cal::kinematics::Machine volumetric_geometry(cal::kinematics::Topology t);
 // The shop truth around it: no backlash, cyclic error or scale expansion (the machine at
 // 20 degC), `noise_um` of position noise.
 ShopTruth volumetric_truth(cal::kinematics::Topology t, double noise_um = 0.0);
+// The injected geometry as a model file (caldaq.model.v1, named "SIMULATED truth (YFXZ)", the
+// travel of kSimTravelMm, every error given with the source "injected"), for comparing a model
+// built from the simulated campaign with what it should have found (`daq sim --truth-out`,
+// `daq model compare`).
+cal::daq::model::Model volumetric_truth_model(cal::kinematics::Topology t);
 
 // The 18 tests, in the order they are best measured (angular first: the model build uses them
 // to correct the others' Abbe terms, but any order works).
