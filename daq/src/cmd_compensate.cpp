@@ -11,6 +11,7 @@
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
@@ -31,6 +32,7 @@ struct CompensateOptions {
   std::int64_t run = 0;
   std::vector<std::int64_t> accept_suspect;  // suspect runs used knowingly (run_quality.hpp)
   std::vector<std::int64_t> accepted;        // ... of which --run is one: said in the output
+  std::string origin_label, origin_text;     // --run not measured on real instruments: said
   std::string axis = "X", format = "csv", units = "mm", outside = "refuse";
   std::optional<std::string> sign;  // csv and --json only: the other formats' sign is the vendor's
   double start_mm = 0, interval_mm = 0;
@@ -53,6 +55,11 @@ std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
   const auto store = open_database_read_only(o.db);
   const std::int64_t runs[] = {o.run};
   o.accepted = refuse_suspect_runs(store, runs, o.accept_suspect, "daq compensate");
+  if (const auto run = store.run(o.run)) {
+    const auto origin = run_origin(*run, store.instruments(o.run), "");
+    o.origin_label = origin.label();
+    o.origin_text = origin.text;
+  }
   std::vector<cal::iso230_2::Measurement> out;
   for (const auto& t : store.targets(o.run))
     out.push_back(
@@ -109,9 +116,13 @@ TableWriter writer_of(const CompensateOptions& o) {
   return w;
 }
 
-// A table from a suspect run used as told (--accept-suspect) says so in its header.
+// A table from a suspect run used as told (--accept-suspect), or from a run not measured on
+// real instruments, says so in its header.
 std::string suspect_note(const CompensateOptions& o, std::string_view comment) {
   std::string out;
+  if (!o.origin_label.empty())
+    out += fmt::format("{}{}: from run {}, not a measurement of a real machine ({})\n", comment,
+                       o.origin_label, o.run, cal::text::terminal_safe(o.origin_text));
   for (const auto id : o.accepted)
     out += fmt::format(
         "{}SUSPECT run {}: a stop far outside its repeatability, used as told "
@@ -134,6 +145,7 @@ std::string positioning_text(const CompensateOptions& o, const ct::Table& table)
     else
       j["backlash"] = table.backlash;
     if (!o.accepted.empty()) j["accepted_suspect_runs"] = o.accepted;
+    if (!o.origin_label.empty()) j["origin"] = o.origin_label;
     return j.dump(2) + "\n";
   }
   // A table from a suspect run used as told says so in its header, where the format has comments
@@ -265,7 +277,8 @@ void run(CompensateOptions& o) {
     predicted = ct::predict(a, stats);
     if (o.run != 0 && !o.json) store_compensation(o, table, a, *predicted, text);
   }
-  if (!o.accepted.empty() && o.format != "csv" && !o.json)  // the vendor formats: here too
+  if ((!o.accepted.empty() || !o.origin_label.empty()) && o.format != "csv" &&
+      !o.json)  // the vendor formats: here too
     fmt::print(stderr, "{}", suspect_note(o, "note: "));
   if (o.output.empty())
     fmt::print("{}", text);

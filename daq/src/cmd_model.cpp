@@ -103,7 +103,11 @@ cal::daq::report::ModelPage model_page_of(const mdl::Model& m, const std::string
   cal::daq::report::ModelPage page;
   page.title = m.name;
   page.source = path;
-  page.simulated = m.name.find("simulated") != std::string::npos ||
+  // Stored in the model's provenance (by daq model build, from the runs' origins); a file
+  // without it (written before, or by hand) by its name, as before.
+  page.origin = model_origin(m);
+  page.simulated = page.origin.find("SIMULATED") != std::string::npos ||
+                   m.name.find("simulated") != std::string::npos ||
                    m.name.find("SIMULATED") != std::string::npos;
   page.machine = m.machine;
   page.grid = g;
@@ -114,6 +118,8 @@ cal::daq::report::ModelPage model_page_of(const mdl::Model& m, const std::string
                                   m.machine.tool_offset_mm[1], m.machine.tool_offset_mm[2])},
       {"table offset", fmt::format("({:g}, {:g}, {:g}) mm", m.machine.table_offset_mm[0],
                                    m.machine.table_offset_mm[1], m.machine.table_offset_mm[2])}};
+  if (!page.origin.empty())
+    page.facts.push_back({"origin", page.origin + " (the model's provenance: not a real machine)"});
   for (auto& r : describe_components(m, true)) page.components.push_back(std::move(r));
   page.software = "daq 0.1.0";
   return page;
@@ -132,6 +138,16 @@ void require_finite(std::span<const double> values, std::string_view what) {
       throw cal::InputError(fmt::format(
           "{}: {} is not a finite number (the model's values or coefficients overflow here)", what,
           v));
+}
+
+std::string model_origin(const mdl::Model& m) {
+  if (m.provenance.json.empty()) return "";
+  const auto j = json::parse(m.provenance.json, nullptr, false);
+  if (!j.is_object() || !j.contains("origin") || !j["origin"].is_string()) return "";
+  std::string out;
+  for (const char c : j["origin"].get<std::string>())
+    if ((c >= 'A' && c <= 'Z') || c == ',' || c == ' ') out += c;
+  return out.substr(0, 40);
 }
 
 kin::Method method_from_string(const std::string& s) {
@@ -153,6 +169,13 @@ void run_show(const ShowOptions& o) {
   const mdl::Model m = mdl::read(o.file);
   if (o.json) return fmt::print("{}", mdl::to_json(m));
   print_line("Model {}{}", m.name.empty() ? "(unnamed)" : m.name, " (" + o.file + ")");
+  if (const auto origin = model_origin(m); !origin.empty()) {
+    print_line("  {}: not measured on a real machine (the model's provenance)", origin);
+    const auto j = json::parse(m.provenance.json, nullptr, false);
+    if (origin == "MIXED" && j.contains("origins") && j["origins"].is_object())
+      for (const auto& [name, label] : j["origins"].items())
+        if (label.is_string()) print_line("    {} from a {} run", name, label.get<std::string>());
+  }
   print_line("  topology      {}", describe_topology(m.machine.topology));
   const auto& t = m.machine.tool_offset_mm;
   const auto& w = m.machine.table_offset_mm;

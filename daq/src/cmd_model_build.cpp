@@ -3,13 +3,16 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "cal/analysis/error.hpp"
 #include "database.hpp"
 #include "model/model_build.hpp"
 #include "model/model_file.hpp"
 #include "model_cli.hpp"
+#include "provenance.hpp"
 #include "run_quality.hpp"
 #include "stored_model.hpp"
 
@@ -20,6 +23,41 @@ namespace mdl = cal::daq::model;
 using nlohmann::json;
 
 namespace {
+
+// Where the runs of a model came from (provenance.hpp): "" when every run was measured on real
+// instruments, the label when all share one ("SIMULATED"), else "MIXED"; and each error whose
+// run was not real, with its run's label. Stored in the model's provenance, so that the model,
+// its map and its compensation say it whatever the machine is called.
+struct ModelOrigin {
+  std::string label;
+  std::map<std::string, std::string> errors;  // E_XX -> "SIMULATED"
+  std::size_t real = 0, other = 0;
+};
+
+ModelOrigin model_origin(const cal::storage::Store& store,
+                         const std::vector<std::pair<std::string, std::vector<std::int64_t>>>& used,
+                         const std::string& machine) {
+  ModelOrigin o;
+  std::map<std::int64_t, std::string> of_run;
+  std::set<std::string> labels;
+  for (const auto& [name, ids] : used) {
+    std::string error_label;
+    for (const auto id : ids) {
+      if (!of_run.count(id)) {
+        const auto run = store.run(id);
+        of_run[id] = run ? run_origin(*run, store.instruments(id), machine).label() : "";
+      }
+      if (!of_run[id].empty()) error_label = of_run[id];
+    }
+    labels.insert(error_label);
+    if (error_label.empty())
+      ++o.real;
+    else
+      ++o.other, o.errors[name] = error_label;
+  }
+  if (o.other > 0) o.label = labels.size() == 1 ? *labels.begin() : "MIXED";
+  return o;
+}
 
 struct BuildCliOptions {
   std::string machine, db, output;
@@ -50,9 +88,12 @@ void run_build(const BuildCliOptions& o) {
   if (!o.tool_offset_mm.empty())
     b.tool_offset_mm = {o.tool_offset_mm[0], o.tool_offset_mm[1], o.tool_offset_mm[2]};
   auto r = mdl::build(stored.profiles, b);
-  if (!accepted.empty()) {  // the model says it was built from suspect runs, knowingly
+  const auto origin = model_origin(store, r.used, o.machine);
+  {
     auto prov = json::parse(r.model.provenance.json);
-    prov["accepted_suspect_runs"] = accepted;
+    // the model says it was built from suspect runs, knowingly
+    if (!accepted.empty()) prov["accepted_suspect_runs"] = accepted;
+    if (!origin.label.empty()) prov["origin"] = origin.label, prov["origins"] = origin.errors;
     r.model.provenance.json = prov.dump();
   }
   mdl::write(r.model, o.output);
@@ -67,6 +108,8 @@ void run_build(const BuildCliOptions& o) {
                             {"missing", r.missing},
                             {"skipped", stored.skipped},
                             {"accepted_suspect_runs", accepted},
+                            {"origin", origin.label},
+                            {"origins", origin.errors},
                             {"notes", r.notes}}
                            .dump(2));
     return;
@@ -85,6 +128,18 @@ void run_build(const BuildCliOptions& o) {
         "provenance): {}\n",
         id, run_quality(store, id).summary);
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
+  if (origin.label == "MIXED") {
+    std::vector<std::string> parts;
+    for (const auto& [name, label] : origin.errors) parts.push_back(name + " " + label);
+    fmt::print("MIXED: {} of the 21 errors come from runs not measured on real instruments: {}\n",
+               origin.other, fmt::join(parts, ", "));
+  } else if (!origin.label.empty()) {
+    fmt::print(
+        "{}: every run of this model was {} (stored with it): not a model of a real "
+        "machine\n",
+        origin.label,
+        origin.label == "SIMULATED" ? "measured on simulated instruments" : "of that origin");
+  }
 }
 
 }  // namespace

@@ -49,9 +49,7 @@ json to_json(const CompareOptions& o, const mdl::Comparison& c) {
           {"range_mm", c.range_mm},
           {"errors", errors},
           {"volumetric",
-           {{"max_um", c.volumetric_max_um},
-            {"at_mm", c.volumetric_at_mm},
-            {"count", g.count}}}};
+           {{"max_um", c.volumetric_max_um}, {"at_mm", c.volumetric_at_mm}, {"count", g.count}}}};
 }
 
 void print_text(const CompareOptions& o, const mdl::Model& ref, const mdl::Comparison& c) {
@@ -69,8 +67,8 @@ void print_text(const CompareOptions& o, const mdl::Model& ref, const mdl::Compa
     if (d->squareness)
       print_line("  largest {:22} {:9.4f} {:4} ({})", what, d->max_abs, d->unit, d->name);
     else
-      print_line("  largest {:22} {:9.4f} {:4} ({} at {:g} mm)", what, d->max_abs, d->unit,
-                 d->name, d->at_mm);
+      print_line("  largest {:22} {:9.4f} {:4} ({} at {:g} mm)", what, d->max_abs, d->unit, d->name,
+                 d->at_mm);
   };
   show("translation difference", largest(c, [](const auto& d) { return d.unit == "um"; }));
   show("angle difference",

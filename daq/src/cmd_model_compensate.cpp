@@ -295,12 +295,37 @@ Extremes largest(const std::array<vc::AxisGrid, 3>& g,
   return e;
 }
 
+// The comment that starts a line of a written file, where the format has one (nullopt: none;
+// the command's output says what the file cannot).
+std::optional<std::string> comment_of(const std::string& format, const std::string& name,
+                                      const std::string& text) {
+  if (format == "fanuc") return "";  // a listing of parameters to enter, not a file to load
+  if (text.starts_with("#") || name.starts_with("ssfk_")) return "# ";
+  if (text.starts_with(";") || text.starts_with("%_N_")) return "; ";
+  return std::nullopt;
+}
+
+// A model not measured on real instruments says so at the top of every file that can hold it.
+void say_origin(Written& w, const std::string& format, const std::string& origin) {
+  if (origin.empty()) return;
+  for (auto& [name, text] : w.files)
+    if (const auto c = comment_of(format, name, text)) {
+      const auto line = fmt::format(
+          "{}{}: from a model not measured on a real machine (its provenance)\n", *c, origin);
+      // A SINUMERIK file's first line names it (%_N_..._INI): the comment goes after it.
+      const auto at = text.starts_with("%_N_") ? text.find('\n') + 1 : 0;
+      text.insert(at, line);
+    }
+}
+
 void run(const Options& o) {
   const mdl::Model m = mdl::read(o.file);
   const auto g = grid_of(o, m);
   const kin::Vec3 ref = reference_of(o, g);
   const auto tables = vc::cross_tables(m.machine, g, ref, m.carriers);
-  const Written w = write_format(o, m, g, tables);
+  Written w = write_format(o, m, g, tables);
+  const std::string origin = model_origin(m);
+  say_origin(w, o.format, origin);
   const auto machine = m.machine;
   const auto before = [machine](const kin::Vec3& p) {
     return kin::volumetric_error_um(machine, p, kin::Method::htm);
@@ -360,11 +385,15 @@ void run(const Options& o) {
                             {"after_max_um", a.max_um},
                             {"after_max_at_mm", {a.at[0], a.at[1], a.at[2]}},
                             {"notes", w.notes},
+                            {"origin", origin},
                             {"meaning", meaning_json(meanings_of(o.format))}}
                            .dump(2));
     return;
   }
   for (const auto& f : written) fmt::print(stderr, "written {}\n", f);
+  if (!origin.empty())
+    fmt::print(stderr, "{}: this model was not measured on a real machine (its provenance)\n",
+               origin);
   fmt::print(stderr,
              "{}: largest |e| over the travel ({} x {} x {} points) {:.3f} um before, {:.3f} um "
              "with the compensation applied to the model (at {:g}, {:g}, {:g} mm)\n",

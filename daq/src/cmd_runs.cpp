@@ -397,8 +397,23 @@ std::string csv_field(const std::string& s) {
 constexpr const char* kReadingColumns =
     "time_s,utc,device,device_name,channel,quantity,status,value,time_ns";
 constexpr const char* kTargetColumns =
-    "target_mm,run,direction,deviation_um,target_index,time_s,utc,raw_m,refractive_index,"
+    "target_mm,run,direction,{},target_index,time_s,utc,raw_m,refractive_index,"
     "material_temperature_degc";
+
+// The column of a stop's value: a positioning run's deviation (what `daq analyse iso230-2`
+// reads); the other linear kinds' value in their unit (straightness um; angular and roll urad).
+std::optional<std::string> stop_value_column(const st::RunRecord& run, const json& settings) {
+  if (run.kind == "linear") return "deviation_um";
+  if (run.kind != "straightness" && run.kind != "angular" && run.kind != "roll")
+    return std::nullopt;
+  std::string unit = run.kind == "straightness" ? "um" : "urad";
+  if (settings.is_object() && settings.contains("measure") && settings["measure"].is_object() &&
+      settings["measure"].contains("unit") && settings["measure"]["unit"].is_string()) {
+    const auto u = settings["measure"]["unit"].get<std::string>();
+    if (u == "um" || u == "urad") unit = u;
+  }
+  return "value_" + unit;
+}
 
 void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
                          std::FILE* out) {
@@ -417,14 +432,15 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
 
 void export_targets_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
                         std::FILE* out) {
-  if (run.kind != "linear")
+  const auto value_column = stop_value_column(run, settings);
+  if (!value_column)
     throw cal::InputError(
         fmt::format("run {} is a {} test and has no captured stops: use --what {} (or readings)",
                     run.id, run.kind, run.kind == "circle" ? "circle" : "readings"));
   const ExportClock clock(store, run, settings);
-  // The header is what `daq analyse iso230-2 --input` reads (target_mm, run, direction,
-  // deviation_um); the rest it ignores.
-  fmt::print(out, "{}\n", kTargetColumns);
+  // The header of a positioning run is what `daq analyse iso230-2 --input` reads (target_mm,
+  // run, direction, deviation_um); the rest it ignores.
+  fmt::print(out, "{}\n", fmt::format(fmt::runtime(kTargetColumns), *value_column));
   for (const auto& t : store.targets(run.id)) {
     const auto at = static_cast<double>(t.time_ns);
     fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,

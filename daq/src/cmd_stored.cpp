@@ -17,6 +17,7 @@
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "provenance.hpp"
+#include "run_quality.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
 
@@ -268,6 +269,11 @@ void recompensate(const RecompensateOptions& o) {
                                          .provenance_json = prov.dump()});
   doc["result_id"] = id;
   doc["provenance"] = prov;
+  // The stops changed: their quality against the run's repeatability is assessed again and
+  // stored (a recompensation can make a stop suspect, or clear one).
+  const auto quality = assess_stops(store.targets(o.run), "um");
+  store.set_quality(o.run, quality);
+  doc["quality"] = quality_json(quality);
   const auto v = verdict_of(settings, doc);
   doc["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(doc, 2));
@@ -276,6 +282,8 @@ void recompensate(const RecompensateOptions& o) {
   if (used.result_id) fmt::print(", superseding result {}", *used.result_id);
   print_line("");
   if (changed.empty()) print_line("  nothing changed: the same coefficients and offsets again");
+  print_line("  stop quality: {}", quality.summary);
+  for (const auto& s : quality.suspects) print_line("    SUSPECT {}", s.reason);
   for (const auto& c : changed)
     fmt::print("  {}: {} -> {}\n", c["name"].get<std::string>(), c["from"].dump(), c["to"].dump());
   print_line("");

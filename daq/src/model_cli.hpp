@@ -28,6 +28,12 @@ void write_page(const std::string& path, const std::string& html);
 // anything is printed, so that no map or prediction shows inf or nan.
 void require_finite(std::span<const double> values, std::string_view what);
 
+// Where the model's measurements came from, from its provenance ("origin", written by `daq
+// model build` and `daq sim --truth-out`): "SIMULATED", "REPLAYED", "IMPORTED", "MIXED", ...;
+// "" for real instruments or when the file does not say. Only capitals, commas and spaces are
+// kept (it is printed into controller files).
+std::string model_origin(const cal::daq::model::Model& m);
+
 // --method htm|first-order
 cal::kinematics::Method method_from_string(const std::string& s);
 

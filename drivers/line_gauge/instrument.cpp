@@ -53,15 +53,21 @@ class Gauge final : public detail::InstrumentCore {
     if (requests_.size() > kMaxOutstanding) requests_.pop_front();  // never answered
   }
   // When a value was measured. A polled gauge measures between the request and the answer:
-  // the request's time, the earliest it can be, so a late answer is never taken for a stop
-  // the machine reached after the request (docs/iso230-2.md, "Which samples make a stop's
-  // value"). The answers come in the order of the requests (one line each). A streaming gauge,
-  // or an answer with no request outstanding: the arrival time.
-  std::int64_t measured_ns(std::int64_t arrival_ns) {
-    if (config_.request.empty()) return arrival_ns;
+  // the reading carries the request's time (the earliest it can be, so a late answer is never
+  // taken for a stop the machine reached after the request) and the answer's delay after it
+  // (the latest it can be, so a late answer is never taken for a stop the machine had left by
+  // then): docs/iso230-2.md, "Which samples make a stop's value". The answers come in the order
+  // of the requests (one line each). A streaming gauge, or an answer with no request
+  // outstanding: the arrival time.
+  struct Measured {
+    std::int64_t time_ns;
+    std::uint16_t within_ms = 0;
+  };
+  Measured measured(std::int64_t arrival_ns) {
+    if (config_.request.empty()) return {arrival_ns};
     if (requests_.empty()) {
       ++unmatched_;
-      return arrival_ns;
+      return {arrival_ns};
     }
     const std::int64_t t = requests_.front();
     requests_.pop_front();
@@ -70,7 +76,8 @@ class Gauge final : public detail::InstrumentCore {
     max_latency_ns_ = std::max(max_latency_ns_, latency);
     latencies_.push_back(latency);
     if (latencies_.size() > AnswerLatency::kLatencyWindow) latencies_.pop_front();
-    return t;
+    const std::int64_t ms = (std::max<std::int64_t>(latency, 0) + 999'999) / 1'000'000;
+    return {t, static_cast<std::uint16_t>(std::min<std::int64_t>(ms, 65535))};
   }
   void on_bytes(std::span<const std::byte> bytes) override {
     errors_.clear();
@@ -84,8 +91,11 @@ class Gauge final : public detail::InstrumentCore {
     codec_.feed_values(
         bytes,
         [&](double value_si, std::string_view) {
-          readings_.push_back(
-              {.time_ns = measured_ns(t), .quantity = quantity_, .value = value_si});
+          const auto m = measured(t);
+          readings_.push_back({.time_ns = m.time_ns,
+                               .quantity = quantity_,
+                               .measured_within_ms = m.within_ms,
+                               .value = value_si});
         },
         errors_);
     // A line that gave no value answered a request too (its place among the chunk's lines is

@@ -27,10 +27,11 @@ struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeT
 
   void on_command(const std::string& cmd) {
     if (config.continuous || cmd != config.request) return;
-    auto line = line_at(clock());  // measured now, whenever it is sent
     if (config.answer_delay <= std::chrono::nanoseconds::zero())
-      return pty.send(std::move(line), shared_from_this());
-    answers.emplace_back(loop_now() + config.answer_delay.count(), std::move(line));
+      return pty.send(line_at(clock()), shared_from_this());
+    // Measured now, whenever it is sent; or when it is sent (an empty line: measured then).
+    answers.emplace_back(loop_now() + config.answer_delay.count(),
+                         config.measure_on_answer ? std::string() : line_at(clock()));
     if (answers.size() == 1) arm_answer();
   }
 
@@ -45,7 +46,9 @@ struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeT
   void send_due() {
     const std::int64_t now = loop_now();
     while (!answers.empty() && answers.front().first <= now) {
-      if (pty.master.is_open()) pty.send(std::move(answers.front().second), shared_from_this());
+      auto& line = answers.front().second;
+      if (line.empty()) line = line_at(clock());
+      if (pty.master.is_open()) pty.send(std::move(line), shared_from_this());
       answers.pop_front();
     }
     if (!answers.empty()) arm_answer();

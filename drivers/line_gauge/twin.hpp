@@ -23,6 +23,10 @@ struct GaugeTwinConfig {
   // value measured at the request: a slow adapter or a loaded host, for the tests of a run
   // that must match a late answer to the stop where it was measured.
   std::chrono::nanoseconds answer_delay{0};
+  // With answer_delay: the value is measured when the answer is sent, not at the request (a
+  // device or adapter that queues requests and measures when it gets to them; a starved twin
+  // process behaves so), so a late answer carries a value from after its request.
+  bool measure_on_answer = false;
   // What the line carries; empty: the ballbar, length(tool, pivot) - zero_length_mm. Another
   // function makes a serial thermometer on the structure, e.g. the machine temperature.
   std::function<double(const World&)> value;

@@ -90,6 +90,11 @@ measure() {  # measure COMPONENT
 measure E_YX  # straightness
 measure E_BX  # angular (pitch)
 measure E_AX  # roll
+# A straightness run's stops export with their value in its unit (it said "no captured stops").
+STRAIGHT=$("$DAQ" runs --db "$DB" | awk '$3 == "straightness" { id = $1 } END { print id }')
+check export_straightness_targets 0 "^target_mm,run,direction,value_um,.*" -- "$DAQ" export "$STRAIGHT" --what targets --db "$DB"
+ROLL=$("$DAQ" runs --db "$DB" | awk '$3 == "roll" { id = $1 } END { print id }')
+check export_roll_targets 0 "^target_mm,run,direction,value_urad,.*" -- "$DAQ" export "$ROLL" --what targets --db "$DB"
 
 # A linear run killed with kill -9 once it runs, and one aborted because its laser went away.
 live_run() {  # live_run NAME: starts the shop and the run, returns once the run is stored running
@@ -165,6 +170,9 @@ import json, sys
 print(" ".join(sorted({r["settings"].get("machine", {}).get("name", "") if isinstance(r["settings"], dict) and isinstance(r["settings"].get("machine"), dict) else "" for r in json.load(sys.stdin)["runs"]}) - {""}))' 2>/dev/null); do
   survives "model_build_$m" -- "$DAQ" model build --machine "$m" --allow-missing -o "$TMP/model-$m.json" --db "$DB"
 done
+# A model of simulated runs says so, whatever its name (issue 26: stored, not inferred).
+check model_origin 0 "^SIMULATED: every run of this model was measured on simulated instruments" -- "$DAQ" model build --machine "SIMULATED YFXZ" --allow-missing -o "$TMP/vol-model.json" --db "$DB"
+check model_show_origin 0 "SIMULATED: not measured on a real machine" -- "$DAQ" model show "$TMP/vol-model.json"
 survives ballbar_history -- "$DAQ" ballbar history --db "$DB" --machine "SIMULATED VMC"
 survives ballbar_volumetric -- "$DAQ" ballbar volumetric --db "$DB" --machine "SIMULATED VMC"
 echo "$survived commands ended with 0, $refused refused cleanly"

@@ -1,8 +1,9 @@
 // daq model compare (model/model_compare.hpp) against hand calculations.
+#include "model/model_compare.hpp"
+
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
-#include "model/model_compare.hpp"
 #include "sim_volumetric.hpp"
 
 namespace {

@@ -12,10 +12,10 @@
 namespace cal::daq::model {
 
 struct ComponentDifference {
-  std::string name;       // "E_YX", "E_C0Y"
-  std::string unit;       // "um" or "urad"
-  double max_abs = 0.0;   // largest |other - reference| over the compared positions
-  double at_mm = 0.0;     // where (0 for a squareness)
+  std::string name;      // "E_YX", "E_C0Y"
+  std::string unit;      // "um" or "urad"
+  double max_abs = 0.0;  // largest |other - reference| over the compared positions
+  double at_mm = 0.0;    // where (0 for a squareness)
   bool squareness = false;
 };
 

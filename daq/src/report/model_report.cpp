@@ -253,7 +253,12 @@ std::string model_page(const ModelPage& p) {
     return kin::volumetric_error_um(p.machine, q, method);
   };
   std::string body;
-  if (p.simulated)
+  if (p.origin == "MIXED")
+    body +=
+        "<p class=\"simulated\"><strong>MIXED</strong>: some errors of this model come from "
+        "runs not measured on real instruments (see each error's source): it is not a model "
+        "of a real machine.</p>\n";
+  else if (p.simulated)
     body +=
         "<p class=\"simulated\">This model describes the <strong>simulated</strong> machine: "
         "the numbers show what the software computes, not a real machine.</p>\n";

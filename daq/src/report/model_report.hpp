@@ -17,6 +17,7 @@ struct ModelPage {
   std::string title;   // e.g. the machine's name
   std::string source;  // the model file
   bool simulated = false;
+  std::string origin;  // the model's provenance's origin ("SIMULATED", "MIXED", ...), if any
   kinematics::Machine machine;
   kinematics::Grid grid;  // the volume (a map over it; slices through its middle)
   kinematics::Method method = kinematics::Method::htm;

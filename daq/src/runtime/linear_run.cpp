@@ -176,15 +176,21 @@ struct LinearRun::Impl {
   std::optional<cal::daq::PositionTrigger> position_trigger;  // with a position feed
   cal::daq::Sequencer sequencer;
   const kinds::TestKind& kind;
-  std::unique_ptr<kinds::SampleReader> reader;          // null for positioning
-  std::deque<std::pair<std::int64_t, double>> samples;  // the kind's value, newest last
-  std::vector<kinds::StopValue> values;                 // at the captured stops
+  std::unique_ptr<kinds::SampleReader> reader;  // null for positioning
+  // The kind's value, newest last: measured somewhere in [time_ns, latest_ns] (a polled
+  // gauge: its request and its answer; cal::drivers::Reading::measured_within_ms).
+  struct Sample {
+    std::int64_t time_ns, latest_ns;
+    double value;
+  };
+  std::deque<Sample> samples;
+  std::vector<kinds::StopValue> values;  // at the captured stops
   // Stops captured before a sample of the kind's instrument measured after their window had
-  // arrived (a polled gauge behind the laser; its samples carry the time of their request):
-  // when one arrives, they take the mean of the samples measured in the window (from its start,
-  // the machine had arrived, never before); with none in it, that first sample when it was
-  // measured within half the trigger's dwell after the window (the machine still stands), else
-  // the run ends saying so.
+  // arrived (a polled gauge behind the laser; its samples carry the time of their request and
+  // of their answer): when one arrives, they take the mean of the samples measured in the
+  // window (requested from its start, the machine had arrived, never before; answered while
+  // the machine still stood); with none in it, that first sample when it was requested and
+  // answered while the machine still stood after the window, else the run ends saying so.
   struct Pending {
     std::size_t stop;
     cal::daq::Capture cap;
@@ -274,13 +280,13 @@ struct LinearRun::Impl {
          .software_version = setup.software_version});
     auto add = [&](int device, const cal::drivers::Instrument& i, std::string_view role) {
       const auto origin = setup.origins.find(std::string(role));
-      store->add_instrument({.run_id = outcome.run_id,
-                             .device = device,
-                             .driver = std::string(role),
-                             .transport = i.describe(),
-                             .origin = origin == setup.origins.end() ? "" : origin->second.kind,
-                             .origin_detail =
-                                 origin == setup.origins.end() ? "" : origin->second.detail});
+      store->add_instrument(
+          {.run_id = outcome.run_id,
+           .device = device,
+           .driver = std::string(role),
+           .transport = i.describe(),
+           .origin = origin == setup.origins.end() ? "" : origin->second.kind,
+           .origin_detail = origin == setup.origins.end() ? "" : origin->second.detail});
     };
     add(0, *setup.laser, "laser");
     add(1, *setup.air, "air");
@@ -400,57 +406,77 @@ struct LinearRun::Impl {
   // A sample of the kind's value; the newest few minutes are kept for the stops' windows.
   void add_sample(kinds::Source source, const Reading& r) {
     if (const auto v = reader->add(source, r.channel, r.time_ns, r.value)) {
-      samples.emplace_back(r.time_ns, *v);
+      const Sample s{r.time_ns, r.time_ns + std::int64_t{r.measured_within_ms} * 1'000'000, *v};
+      samples.push_back(s);
       while (samples.size() > 1'000'000) samples.pop_front();  // bounded, whatever the rate
-      resolve_pending(r.time_ns, *v);
+      resolve_pending(s);
     }
   }
 
-  void resolve_pending(std::int64_t time_ns, double value) {
-    if (pending.empty()) return;
-    // The machine stands the program's dwell; the trigger captured after its own dwell of it.
+  // Until when the machine surely still stands at a captured stop: it stands the program's
+  // dwell, and the trigger captured after its own dwell of it.
+  std::int64_t standing_until_ns(const cal::daq::Capture& cap) const {
     const double trigger_s = setup.config.trigger.dwell_s;
-    const auto limit_ns = static_cast<std::int64_t>(
-        1e9 * std::min(trigger_s, setup.config.linear->dwell_s - trigger_s));
+    return cap.end_ns + static_cast<std::int64_t>(
+                            1e9 * std::min(trigger_s, setup.config.linear->dwell_s - trigger_s));
+  }
+
+  void resolve_pending(const Sample& sample) {
+    if (pending.empty()) return;
     auto waiting = std::move(pending);
     pending.clear();
     for (const auto& p : waiting) {
-      if (time_ns <= p.cap.end_ns) {  // in the window (kept in `samples`), or measured before
-        pending.push_back(p);         // the machine had arrived: not this stop's
+      if (sample.time_ns <= p.cap.end_ns) {  // in the window (kept in `samples`), or measured
+        pending.push_back(p);                // before the machine had arrived: not this stop's
       } else if (const auto v = window_mean(p.cap)) {  // every sample of the window is in
         store_stop(p.stop, p.cap, p.comp, *v);
-      } else if (time_ns <= p.cap.end_ns + limit_ns) {  // none in the window: the machine stands
-        store_stop(p.stop, p.cap, p.comp, value);
+      } else if (sample.latest_ns <= standing_until_ns(p.cap)) {  // none in the window: the
+        store_stop(p.stop, p.cap, p.comp, sample.value);          // machine still stood
       } else {
-        const auto& s = sequencer.stops()[p.stop];
-        return abort(
-            fmt::format("no {} reading during the stop at {:.3f} mm (run {}): is the {} reading?",
-                        kind.name(), s.position_mm, s.run,
-                        kind.probe_role().empty() ? "laser's beam pair" : kind.probe_role()));
+        return abort(no_reading_at(p.stop));
       }
     }
     if (!done && pending.empty() && sequencer.complete()) finish();
   }
 
-  // The kind's value at a stop: the mean of its samples measured within the stop's window.
+  std::string no_reading_at(std::size_t stop) const {
+    const auto& s = sequencer.stops()[stop];
+    const std::string role =
+        kind.probe_role().empty() ? "laser's beam pair" : std::string(kind.probe_role());
+    std::string text = fmt::format(
+        "no {} reading measured while the machine stood at {:.3f} mm "
+        "(run {}): is the {} reading?",
+        kind.name(), s.position_mm, s.run, role);
+    if (const auto a = probe_latency(); a && a->answers > 0)
+      text += fmt::format(
+          " Its answers came up to {:.0f} ms after their requests (median {:.0f} ms); a value "
+          "answered after the machine has left cannot be told from the next target's",
+          static_cast<double>(a->max_ns) / 1e6, static_cast<double>(a->median_ns) / 1e6);
+    return text;
+  }
+
+  // The kind's value at a stop: the mean of its samples measured within the stop's window
+  // (requested in it, answered while the machine still stood).
   std::optional<double> window_mean(const cal::daq::Capture& cap) const {
+    const std::int64_t until = standing_until_ns(cap);
     double sum = 0;
     std::size_t n = 0;
-    for (const auto& [t, v] : samples)
-      if (t >= cap.start_ns && t <= cap.end_ns) sum += v, ++n;
+    for (const auto& s : samples)
+      if (s.time_ns >= cap.start_ns && s.time_ns <= cap.end_ns && s.latest_ns <= until)
+        sum += s.value, ++n;
     if (n == 0) return std::nullopt;
     return sum / static_cast<double>(n);
   }
   // ... once every sample measured in the window is in: when one measured after it has arrived
   // (a source's samples arrive in the order they were measured); else nullopt (pending).
   std::optional<double> stop_value(const cal::daq::Capture& cap) const {
-    if (samples.empty() || samples.back().first <= cap.end_ns) return std::nullopt;
+    if (samples.empty() || samples.back().time_ns <= cap.end_ns) return std::nullopt;
     return window_mean(cap);
   }
   // Samples older than every window still to be valued are not needed any more.
   void trim_samples(std::int64_t from_ns) {
     for (const auto& p : pending) from_ns = std::min(from_ns, p.cap.start_ns);
-    while (!samples.empty() && samples.front().first < from_ns) samples.pop_front();
+    while (!samples.empty() && samples.front().time_ns < from_ns) samples.pop_front();
   }
 
   void on_laser(const Reading& r) {

@@ -141,6 +141,7 @@ struct SimulatedShop::Impl {
                    .request = "?",
                    .decimals = 5,  // mm: 10 nm digits
                    .answer_delay = answer_delay(t, s, ctx),
+                   .measure_on_answer = t.probe_measures_on_answer,
                    // The probe point's deviation from the nominal line it is commanded on:
                    // where the axes stand off the command across the travel (a control's
                    // compensation moves them) plus the geometric error there.
@@ -156,6 +157,7 @@ struct SimulatedShop::Impl {
              .request = "?",
              .decimals = 3,  // urad: 1 nrad digits
              .answer_delay = answer_delay(t, s, ctx),
+             .measure_on_answer = t.probe_measures_on_answer,
              .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}) {}
 
   // The probes' answer delay on the loop's time: simulated, or the wall clock at the speed.

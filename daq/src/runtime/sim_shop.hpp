@@ -61,6 +61,9 @@ struct ShopTruth {
   // Simulated seconds between a request to the indicator or the level and its answer (the
   // value is of the request's time): a loaded host or a slow adapter, injected by the tests.
   double probe_answer_delay_s = 0.0;
+  // ... and the probe measures when it answers, not at the request (a device that queues
+  // requests; what a starved twin process does): a late answer's value is of its answer time.
+  bool probe_measures_on_answer = false;
   // The deviation at 20 degC of a stop at x approached from below (up) or above.
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
 };

@@ -127,7 +127,7 @@ cal::daq::model::Model volumetric_truth_model(kin::Topology t) {
   for (auto& c : m.components) c = {.given = true, .source = {injected}};
   for (auto& s : m.squareness) s.given = true, s.source = {injected};
   m.provenance = {
-      "{\"origin\": \"simulated\", \"what\": \"the errors injected into the SIMULATED shop's "
+      "{\"origin\": \"SIMULATED\", \"what\": \"the errors injected into the SIMULATED shop's "
       "volumetric machine (daq/src/runtime/sim_volumetric.cpp)\"}"};
   return m;
 }

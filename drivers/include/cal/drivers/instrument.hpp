@@ -44,6 +44,12 @@ struct Reading {
   std::uint8_t channel = 0;  // axis or sensor number on the device
   Quantity quantity = Quantity::displacement_m;
   ReadingStatus status = ReadingStatus::ok;
+  // When the value was measured is known only to within [time_ns, time_ns + this]: a polled
+  // device's answer came this many milliseconds (rounded up, at most 65535) after its request,
+  // and the device measured somewhere in between. 0: at time_ns. A run takes a sample for a
+  // stop only when the whole interval lies where the machine stood (docs/iso230-2.md, "Which
+  // samples make a stop's value").
+  std::uint16_t measured_within_ms = 0;
   double value = 0.0;  // SI (m, Pa, degC, %RH)
 };
 
