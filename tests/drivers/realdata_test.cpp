@@ -121,18 +121,58 @@ TEST(RealData, TheRecordingsAreThere) {
     EXPECT_TRUE(fs::is_regular_file(realdata() / f)) << f;
 }
 
+// The readings of `keys` (X, Y, Z) expected from SHDR lines, read with the test's own split:
+// each line's keys at key positions (1, 3, 5, ...), in axis order within a line.
+struct ShdrExpected {
+  std::int64_t time_ns;
+  std::uint8_t axis;
+  double value_m;
+};
+std::vector<ShdrExpected> shdr_expected(const std::vector<std::string>& lines,
+                                        const std::vector<std::string>& keys,
+                                        std::array<std::size_t, 3>& per_axis) {
+  std::vector<ShdrExpected> expected;
+  per_axis = {};
+  for (const auto& line : lines) {
+    if (line[0] == '*') continue;
+    const auto tokens = split(line, '|');
+    std::vector<ShdrExpected> of_line;
+    for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
+      for (std::uint8_t a = 0; a < keys.size(); ++a)
+        if (tokens[i] == keys[a]) {
+          of_line.push_back({unix_ns(tokens[0]), a, std::stod(tokens[i + 1]) * 1e-3});
+          ++per_axis[a];
+        }
+    std::sort(of_line.begin(), of_line.end(),
+              [](const auto& x, const auto& y) { return x.axis < y.axis; });
+    expected.insert(expected.end(), of_line.begin(), of_line.end());
+  }
+  return expected;
+}
+
+void expect_readings(const std::vector<d::DecodedItem>& items,
+                     const std::vector<ShdrExpected>& expected) {
+  std::vector<d::DecodedItem> readings;
+  for (const auto& i : items)
+    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
+  ASSERT_EQ(readings.size(), expected.size());
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    SCOPED_TRACE(k);
+    ASSERT_TRUE(readings[k].device_time_unix_ns);
+    EXPECT_EQ(*readings[k].device_time_unix_ns, expected[k].time_ns);
+    EXPECT_EQ(readings[k].channel, expected[k].axis);
+    EXPECT_EQ(readings[k].quantity, d::Quantity::machine_position_m);
+    EXPECT_DOUBLE_EQ(readings[k].value, expected[k].value_m);
+  }
+}
+
 TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
   // README: 3,989 position frames for X1actw, YI1actw, Z1actw, every one with the file's time
   // and value, no codec error. Expected: lines outside the --multiline-- asset blocks and not
   // '*' commands, with one of the keys at a key position (1, 3, 5, ...).
   const std::string text = read("shdr_okuma_osp_p300.txt");
   const std::map<std::string, std::uint8_t> keys{{"X1actw", 0}, {"YI1actw", 1}, {"Z1actw", 2}};
-  struct Expected {
-    std::int64_t time_ns;
-    std::uint8_t axis;
-    double value_m;
-  };
-  std::vector<Expected> expected;
+  std::vector<ShdrExpected> expected;
   std::size_t frames = 0;
   std::string terminator;
   for (const auto& line : lines_of(text)) {
@@ -146,12 +186,12 @@ TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
     }
     if (line[0] == '*') continue;
     const auto tokens = split(line, '|');
-    std::vector<Expected> of_line;  // a frame's readings come X, Y, Z whatever the line's order
+    std::vector<ShdrExpected> of_line;  // a frame's readings come X, Y, Z whatever the line's order
     for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
       if (const auto k = keys.find(tokens[i]); k != keys.end())
         of_line.push_back({unix_ns(tokens[0]), k->second, std::stod(tokens[i + 1]) * 1e-3});
     std::sort(of_line.begin(), of_line.end(),
-              [](const Expected& a, const Expected& b) { return a.axis < b.axis; });
+              [](const ShdrExpected& a, const ShdrExpected& b) { return a.axis < b.axis; });
     expected.insert(expected.end(), of_line.begin(), of_line.end());
     frames += !of_line.empty();
   }
@@ -161,19 +201,8 @@ TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
   EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
   EXPECT_EQ(stats.errors(), 0u);
   EXPECT_EQ(stats.frames, 3989u);
-  std::vector<d::DecodedItem> readings;
-  for (const auto& i : items)
-    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
-  ASSERT_EQ(readings.size(), expected.size());
-  EXPECT_EQ(readings.size(), 4905u);  // 1330 X1actw + 607 YI1actw + 2968 Z1actw
-  for (std::size_t k = 0; k < readings.size(); ++k) {
-    SCOPED_TRACE(k);
-    ASSERT_TRUE(readings[k].device_time_unix_ns);
-    EXPECT_EQ(*readings[k].device_time_unix_ns, expected[k].time_ns);
-    EXPECT_EQ(readings[k].channel, expected[k].axis);
-    EXPECT_EQ(readings[k].quantity, d::Quantity::machine_position_m);
-    EXPECT_DOUBLE_EQ(readings[k].value, expected[k].value_m);
-  }
+  EXPECT_EQ(expected.size(), 4905u);  // 1330 X1actw + 607 YI1actw + 2968 Z1actw
+  expect_readings(items, expected);
   // The '*' command lines ("*adapterVersion:UNAVAILABLE") and the assets are notes, not errors.
   EXPECT_GT(count(items, d::DecodedItem::Kind::note), 0u);
 }
@@ -242,51 +271,6 @@ TEST(RealData, HalsamplerUntaggedFilesReadEveryLineAndColumnZeroIsAPin) {
   for (const auto& frame : halsampler("halsampler_untagged_biquad.txt", false, 0, st)) {
     EXPECT_FALSE(frame.sample);
     EXPECT_TRUE(*frame.position_m[0] == 0.0 || *frame.position_m[0] == 1e-3);
-  }
-}
-
-// The readings of `keys` (X, Y, Z) expected from SHDR lines, read with the test's own split:
-// each line's keys at key positions (1, 3, 5, ...), in axis order within a line.
-struct ShdrExpected {
-  std::int64_t time_ns;
-  std::uint8_t axis;
-  double value_m;
-};
-std::vector<ShdrExpected> shdr_expected(const std::vector<std::string>& lines,
-                                        const std::vector<std::string>& keys,
-                                        std::array<std::size_t, 3>& per_axis) {
-  std::vector<ShdrExpected> expected;
-  per_axis = {};
-  for (const auto& line : lines) {
-    if (line[0] == '*') continue;
-    const auto tokens = split(line, '|');
-    std::vector<ShdrExpected> of_line;
-    for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
-      for (std::uint8_t a = 0; a < keys.size(); ++a)
-        if (tokens[i] == keys[a]) {
-          of_line.push_back({unix_ns(tokens[0]), a, std::stod(tokens[i + 1]) * 1e-3});
-          ++per_axis[a];
-        }
-    std::sort(of_line.begin(), of_line.end(),
-              [](const auto& x, const auto& y) { return x.axis < y.axis; });
-    expected.insert(expected.end(), of_line.begin(), of_line.end());
-  }
-  return expected;
-}
-
-void expect_readings(const std::vector<d::DecodedItem>& items,
-                     const std::vector<ShdrExpected>& expected) {
-  std::vector<d::DecodedItem> readings;
-  for (const auto& i : items)
-    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
-  ASSERT_EQ(readings.size(), expected.size());
-  for (std::size_t k = 0; k < readings.size(); ++k) {
-    SCOPED_TRACE(k);
-    ASSERT_TRUE(readings[k].device_time_unix_ns);
-    EXPECT_EQ(*readings[k].device_time_unix_ns, expected[k].time_ns);
-    EXPECT_EQ(readings[k].channel, expected[k].axis);
-    EXPECT_EQ(readings[k].quantity, d::Quantity::machine_position_m);
-    EXPECT_DOUBLE_EQ(readings[k].value, expected[k].value_m);
   }
 }
 

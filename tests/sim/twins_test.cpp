@@ -54,6 +54,13 @@ struct Bench {
         },
         [this](const t::Error& e) { error = e; });
   }
+  // A serial port on a PTU300 twin, opened at 4800 7E1 as the device's settings ask.
+  std::unique_ptr<t::Transport> open_ptu300(const sim::Ptu300Twin& twin) {
+    auto port =
+        t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = twin.device_path()}));
+    open(*port);
+    return port;
+  }
   std::string next_line() {
     run_until(io, [&] { return received.find('\n') != std::string::npos; });
     const auto eol = received.find('\n');
@@ -172,9 +179,7 @@ TEST(IdsTwin, AnswersUnterminatedRequestsAndEndsItsAnswersWithCrLf) {
 TEST(Ptu300Twin, AnswersSendAt4800SevenEvenOne) {
   Bench b;
   sim::Ptu300Twin twin(b.io, b.world, b.clock);
-  auto port =
-      t::make_serial(b.io, t::parse_serial_settings("4800 7E1", {.device = twin.device_path()}));
-  b.open(*port);
+  auto port = b.open_ptu300(twin);
   port->write(bytes("SEND\r"));
   EXPECT_EQ(b.next_line(), "P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n");
   port->write(bytes("INTV 2 S\r"));
@@ -202,9 +207,7 @@ TEST(Ptu300Twin, TakesCommandsEndedByLfOrCrLfAndAnswersTheInformationalCommands)
   // 300-series guides show them (no "Unknown command").
   Bench b;
   sim::Ptu300Twin twin(b.io, b.world, b.clock);
-  auto port =
-      t::make_serial(b.io, t::parse_serial_settings("4800 7E1", {.device = twin.device_path()}));
-  b.open(*port);
+  auto port = b.open_ptu300(twin);
   port->write(bytes("SEND\n"));
   EXPECT_EQ(b.next_line(), "P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n");
   port->write(bytes("send\r\nVERS\n"));  // one answer each: the LF of CR LF is no command
