@@ -157,12 +157,10 @@ std::string IdsCodec::encode(IdsMethod method, std::span<const IdsParam> params)
   return j.dump() + "\n";
 }
 
-std::vector<std::string_view> json_objects(std::string_view text) {
-  std::vector<std::string_view> out;
-  std::size_t start = std::string_view::npos;  // of the object (or stray text) being read
+std::size_t json_object_end(std::string_view text, std::size_t open) {
   int depth = 0;
   bool in_string = false, escaped = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
+  for (std::size_t i = open; i < text.size(); ++i) {
     const char c = text[i];
     if (in_string) {
       if (escaped)
@@ -171,25 +169,30 @@ std::vector<std::string_view> json_objects(std::string_view text) {
         escaped = true;
       else if (c == '"')
         in_string = false;
-      continue;
-    }
-    if (depth == 0 && c != '{') {
-      if (c != ' ' && c != '\t' && c != '\r' && c != '\n' && start == std::string_view::npos)
-        start = i;  // stray text: kept until the next object
-      continue;
-    }
-    if (depth == 0) {
-      if (start != std::string_view::npos) out.push_back(text.substr(start, i - start));
-      start = i;
-    }
-    if (c == '"') in_string = true;
-    if (c == '{') ++depth;
-    if (c == '}' && --depth == 0) {
-      out.push_back(text.substr(start, i + 1 - start));
-      start = std::string_view::npos;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '{') {
+      ++depth;
+    } else if (c == '}' && --depth == 0) {
+      return i + 1;
     }
   }
-  if (start != std::string_view::npos) out.push_back(text.substr(start));
+  return std::string_view::npos;
+}
+
+std::vector<std::string_view> json_objects(std::string_view text) {
+  std::vector<std::string_view> out;
+  constexpr std::string_view blank = " \t\r\n";
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t open = text.find('{', at);
+    // Stray text before the next object (from its first non-blank character) is a piece too.
+    const std::size_t stray = text.find_first_not_of(blank, at);
+    if (stray < open) out.push_back(text.substr(stray, open == text.npos ? open : open - stray));
+    if (open == text.npos) break;
+    const std::size_t end = json_object_end(text, open);
+    out.push_back(text.substr(open, end == text.npos ? end : end - open));
+    at = end;
+  }
   return out;
 }
 

@@ -30,6 +30,9 @@ namespace cal::drivers::codec {
 // returned as pieces of their own (so that parsing them reports them). ACS.py writes requests
 // unterminated, so one line of a capture may hold a request and its answer.
 std::vector<std::string_view> json_objects(std::string_view text);
+// One past the '}' that closes the JSON object opening at text[open] (strings respected), or
+// npos when the text ends first: where an unterminated request ends (the twin's framing).
+std::size_t json_object_end(std::string_view text, std::size_t open);
 
 // The generation of the displacement and system interfaces (see above).
 enum class IdsApi { ids, sen };

@@ -1,5 +1,6 @@
-// SIMULATED IDS3010 (see twin.hpp): newline-terminated JSON-RPC 2.0, one object per line,
-// results [error, values...], displacements in integer picometres.
+// SIMULATED IDS3010 (see twin.hpp): JSON-RPC 2.0, requests taken as whole JSON objects whether
+// or not a line ending follows, answers ended with CR LF; results [error, values...],
+// displacements in integer picometres.
 #include "ids3010/twin.hpp"
 
 #include <fmt/format.h>
@@ -165,10 +166,28 @@ struct IdsTwin::Impl : detail::TcpChannel {  // answers only: the channel's time
 
 IdsTwin::IdsTwin(boost::asio::io_context& io, World& world, Clock clock, IdsTwinConfig config)
     : IdsTwin(std::make_shared<Impl>(io, world, std::move(clock), config)) {}
+namespace {
+// A request is a whole JSON object, terminated or not: attocube's ACS.py (IDS-APIs) and the
+// EPICS driver nmarks99/attocubeIDS write it with no terminator, the MATLAB wrappers' writeline
+// with LF. Text that is not an object is a request when its line ends (answered "Parse error").
+std::size_t request_end(std::string_view buffered) {
+  const std::size_t first = buffered.find_first_not_of(" \t\r\n");
+  if (first == buffered.npos) return 0;
+  if (buffered[first] != '{') {
+    const std::size_t eol = buffered.find('\n', first);
+    return eol == buffered.npos ? 0 : eol + 1;
+  }
+  const std::size_t end = codec::json_object_end(buffered, first);
+  return end == buffered.npos ? 0 : end;
+}
+}  // namespace
+
 IdsTwin::IdsTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(impl)) {
+  impl_->server->set_framing(request_end);
   impl_->server->start([impl = impl_.get(), server = impl_->server.get()](
                            const detail::LineServer::ClientPtr& client, const std::string& line) {
-    server->send(client, impl->answer(line) + "\n");
+    // The device ends its answers with CR LF (ACS.py reads them with newline='\r\n').
+    server->send(client, impl->answer(line) + "\r\n");
   });
 }
 void IdsTwin::set_beam_lost(int axis, bool lost) {

@@ -34,6 +34,33 @@ std::optional<GaugeUnit> unit_word(std::string_view w) {
 
 }  // namespace
 
+std::span<const GaugePreset> gauge_presets() {
+  static constexpr GaugePreset presets[] = {
+      // Mitutoyo's Digimatic data format: "0", channel "1", item "A", sign, 8 characters of
+      // digits with a floating point, CR (QM-Height manual 99MAF600B, "USB Data Output
+      // Specifications": 01A+0000.123[CR]); read out with "1" + CR (rabryan/pytuyo, the USB-ITN
+      // reader: request_read sends '1', answers end with CR, data answers start with '0').
+      {"mitutoyo_digimatic", "1\r", R"(^0[0-9]A([+-][0-9.]+)$)", "01A+0000.123", 0.123,
+       "Mitutoyo QM-Height manual 99MAF600B (USB data output); rabryan/pytuyo (USB-ITN)"},
+      // Sylvac's OPTO-RS cable (duplex): "?" + CR requests the displayed value, sent as sign
+      // ("+", "-" or a space), integer, ".", fraction, CR; errors as "ERR" + number + CR;
+      // in tolerance mode '<', '=' or '>' follows the value (Sylvac Opto/UniCal manuals).
+      {"sylvac", "?\r", R"(^ ?([+-]?[0-9]+\.[0-9]+) *[<=>]?$)", "-12.345", -12.345,
+       "Sylvac OPTO-RS cable manual (Bowers Group Sylvac Opto Instruments); UniCal manual VIII.5"},
+      // Mahr Millimar C1208 over OPTORSD: "?" + CR, answer "xxx.xxx<unit>" CR LF in the unit of
+      // the display (mm, in or um: UNI?).
+      {"mahr_millimar", "?\r", R"(^ *([+-]?[0-9]*\.?[0-9]+) *(mm|in|um)? *$)", "0.0123mm", 0.0123,
+       "Mahr Millimar C1208 manual, OPTORSD interface protocol"},
+  };
+  return presets;
+}
+
+const GaugePreset* gauge_preset(std::string_view name) {
+  for (const auto& p : gauge_presets())
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
 GaugeUnit gauge_unit_from_string(std::string_view s) {
   if (s == "degC" || s == "degc") return GaugeUnit::degc;
   if (s == "none") return GaugeUnit::none;
@@ -116,8 +143,13 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
   std::optional<GaugeUnit> printed_unit;
   if (regex_) {
     std::match_results<std::string_view::const_iterator> m;
-    if (std::regex_search(line.begin(), line.end(), m, *regex_))
+    if (std::regex_search(line.begin(), line.end(), m, *regex_)) {
       number = parse_number(trim(m[1].str()));
+      if (m.size() > 2 && m[2].matched) {  // a printed unit word
+        printed_unit = unit_word(m[2].str());
+        if (!printed_unit || is_angle(*printed_unit) != is_angle(config_.unit)) number.reset();
+      }
+    }
   } else {
     std::array<std::string_view, 2> tokens;
     const std::size_t count = split_whitespace(line, tokens);

@@ -6,7 +6,9 @@
 // every maker's format differs; docs/codecs.md lists the formats this was checked on.
 #include <optional>
 #include <regex>
+#include <span>
 #include <string>
+#include <string_view>
 
 #include "cal/drivers/codec/common.hpp"
 #include "cal/drivers/codec/decimal.hpp"
@@ -23,11 +25,26 @@ bool is_angle(GaugeUnit u);
 // The factor from the unit to SI (m, rad; 1 for degC and none).
 double unit_factor(GaugeUnit u);
 
+// The output formats of common gauge families, each from its maker's public documentation
+// (docs/drivers.md, "Gauge presets"): the request that polls it, the pattern of its line and the
+// unit it prints in when the line carries none.
+struct GaugePreset {
+  std::string_view name;     // the `preset` option's value
+  std::string_view request;  // sent to poll (as sent, terminator included)
+  std::string_view pattern;  // ECMAScript: group 1 the number, group 2 (if any) a unit word
+  std::string_view example;  // a line as the documentation prints it (without terminator)
+  double example_mm;         // what that line reads, in mm
+  std::string_view source;   // where the format is documented
+};
+std::span<const GaugePreset> gauge_presets();
+const GaugePreset* gauge_preset(std::string_view name);  // nullptr: no such preset
+
 struct GaugeConfig {
   // Sent to poll a gauge ("?\r", "PRINT\r"); empty for a gauge that streams by itself.
   std::string request;
-  // ECMAScript regex with one capture group for the number; empty: the whole line, trimmed,
-  // optionally followed by a unit word (mm, um, in, inch), is the number.
+  // ECMAScript regex with one capture group for the number (and optionally a second one for a
+  // printed unit word, which then wins over `unit`); empty: the whole line, trimmed, optionally
+  // followed by a unit word (mm, um, in, inch), is the number.
   std::string pattern;
   GaugeUnit unit = GaugeUnit::mm;  // the unit of the printed number (a printed unit wins)
   double scale = 1.0;              // applied to the printed number before the unit

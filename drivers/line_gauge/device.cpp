@@ -12,8 +12,21 @@
 namespace cal::drivers::line_gauge {
 namespace {
 
+std::vector<std::string> preset_names() {
+  std::vector<std::string> names{"none"};
+  for (const auto& p : codec::gauge_presets()) names.emplace_back(p.name);
+  return names;
+}
+
 const std::vector<OptionSpec>& table() {
   static const std::vector<OptionSpec> t{
+      {.name = "preset",
+       .type = OptionType::choice,
+       .choices = preset_names(),
+       .default_value = std::string("none"),
+       .help = "a gauge family's documented output (docs/drivers.md, Gauge presets): its request "
+               "and pattern, unless request or pattern is given; unit stays yours (the lines "
+               "print none, except mahr_millimar's)"},
       {.name = "request",
        .type = OptionType::string,
        .default_value = std::string(),
@@ -52,9 +65,23 @@ const std::vector<OptionSpec>& table() {
   return t;
 }
 
+const codec::GaugePreset* preset_of(const Options& o) {
+  return codec::gauge_preset(o.text("preset"));  // nullptr for "none"
+}
+
+// A key given explicitly wins over the preset's value.
+std::string request_of(const Options& o) {
+  const auto* p = preset_of(o);
+  return p && !o.is_set("request") ? std::string(p->request) : o.text("request");
+}
+std::string pattern_of(const Options& o) {
+  const auto* p = preset_of(o);
+  return p && !o.is_set("pattern") ? std::string(p->pattern) : o.text("pattern");
+}
+
 codec::GaugeConfig config_of(const Options& o) {
-  codec::GaugeConfig c{.request = o.text("request"),
-                       .pattern = o.text("pattern"),
+  codec::GaugeConfig c{.request = request_of(o),
+                       .pattern = pattern_of(o),
                        .unit = codec::gauge_unit_from_string(o.text("unit")),
                        .scale = o.number("scale"),
                        .offset = o.number("offset")};
@@ -95,7 +122,7 @@ class Driver final : public DeviceDriver {
   std::vector<Quantity> quantities(const Options& o, const InstrumentContext&) const override {
     return {quantity_of(o)};
   }
-  bool may_be_silent(const Options& o) const override { return o.text("request").empty(); }
+  bool may_be_silent(const Options& o) const override { return request_of(o).empty(); }
   std::chrono::microseconds default_poll(const Options&,
                                          const InstrumentContext& c) const override {
     if (c.role == "material") return std::chrono::seconds(1);  // a thermometer on the structure
@@ -104,8 +131,8 @@ class Driver final : public DeviceDriver {
   std::span<const LegacyKey> legacy_keys() const override {
     static constexpr LegacyKey keys[] = {
         {"/gauge/request", "request"}, {"/gauge/pattern", "pattern"}, {"/gauge/unit", "unit"},
-        {"/gauge/scale", "scale"},     {"/gauge/offset", "offset"},   {"/gauge/min_si", "min_si"},
-        {"/gauge/max_si", "max_si"}};
+        {"/gauge/preset", "preset"},   {"/gauge/scale", "scale"},     {"/gauge/offset", "offset"},
+        {"/gauge/min_si", "min_si"},   {"/gauge/max_si", "max_si"}};
     return keys;
   }
   std::string_view decode_input() const override { return "the bytes the gauge sends"; }
@@ -125,10 +152,12 @@ class Driver final : public DeviceDriver {
   }
   std::unique_ptr<sim::Twin> make_twin(boost::asio::io_context& io, sim::World& world,
                                        sim::Clock clock, const Options& o) const override {
-    std::string request = o.text("request");
+    std::string request = request_of(o);
     while (!request.empty() && (request.back() == '\r' || request.back() == '\n'))
       request.pop_back();
     sim::GaugeTwinConfig c{.continuous = request.empty(), .request = request};
+    // The twin prints the family's lines (its terminator, prefix and unit word).
+    if (const auto* p = preset_of(o)) c.style = sim::gauge_line_style(p->name);
     if (thermometer(o)) {
       c.decimals = 3;
       c.value = [](const sim::World& w) { return w.state().machine_temperature_degc; };

@@ -22,7 +22,18 @@ struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeT
     const double value =
         config.value ? config.value(world)
                      : ballbar_length_mm(world.state(), config.pivot_mm) - config.zero_length_mm;
-    return fmt::format("{:+0{}.{}f}\r\n", value, config.decimals + 5, config.decimals);
+    const int d = config.decimals;
+    switch (config.style) {
+      case GaugeLineStyle::mitutoyo_digimatic:  // 8 characters of digits and point, CR only
+        return fmt::format("01A{:+0{}.{}f}\r", value, std::max(9, d + 3), d);
+      case GaugeLineStyle::sylvac:
+        return fmt::format("{:+.{}f}\r", value, d);
+      case GaugeLineStyle::mahr_millimar:
+        return fmt::format("{:.{}f}mm\r\n", value, d);
+      case GaugeLineStyle::plain:
+        break;
+    }
+    return fmt::format("{:+0{}.{}f}\r\n", value, d + 5, d);
   }
 
   void on_command(const std::string& cmd) {
@@ -85,6 +96,13 @@ struct GaugeTwin::Impl : detail::PtyChannel, std::enable_shared_from_this<GaugeT
   GaugeTwinConfig config;
   std::uint64_t next_sample = 0;
 };
+
+GaugeLineStyle gauge_line_style(std::string_view preset) {
+  if (preset == "mitutoyo_digimatic") return GaugeLineStyle::mitutoyo_digimatic;
+  if (preset == "sylvac") return GaugeLineStyle::sylvac;
+  if (preset == "mahr_millimar") return GaugeLineStyle::mahr_millimar;
+  return GaugeLineStyle::plain;
+}
 
 GaugeTwin::GaugeTwin(boost::asio::io_context& io, World& world, Clock clock, GaugeTwinConfig config)
     : GaugeTwin(std::make_shared<Impl>(io, world, std::move(clock), std::move(config))) {}

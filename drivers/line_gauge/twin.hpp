@@ -7,10 +7,17 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "cal/drivers/sim/twin.hpp"
 
 namespace cal::drivers::sim {
+
+// How the twin prints a value v: plain "+000.01000" CR LF (caldaq's own format); the documented
+// lines of the gauge presets (docs/drivers.md): Mitutoyo Digimatic "01A+0000.01000" CR, Sylvac
+// "+0.01000" CR, Mahr Millimar "0.01000mm" CR LF.
+enum class GaugeLineStyle { plain, mitutoyo_digimatic, sylvac, mahr_millimar };
+GaugeLineStyle gauge_line_style(std::string_view preset);  // plain for an unknown name
 
 struct GaugeTwinConfig {
   Vec3 pivot_mm{};                 // centre of the table ball, workpiece coordinates
@@ -19,6 +26,7 @@ struct GaugeTwinConfig {
   bool continuous = true;          // false: one reading per request line
   std::string request = "?";       // the request line (without its CR) in polled mode
   int decimals = 5;                // "+000.12345": 10 nm resolution
+  GaugeLineStyle style = GaugeLineStyle::plain;
   // Polled mode: each answer is sent this long (on the loop's time) after its request, with the
   // value measured at the request: a slow adapter or a loaded host, for the tests of a run
   // that must match a late answer to the stop where it was measured.

@@ -1,6 +1,8 @@
-// SIMULATED PTU300 (see twin.hpp): commands end with CR; answers and RUN-mode lines end with
-// CR LF. Output in the default FORM of the user's guide ("P= 1033.7 hPa T= 22.2 'C RH= 38.3
-// %RH"), with one more decimal on P and T than that example, as a FORM such as 4.2 P would print.
+// SIMULATED PTU300 (see twin.hpp): commands end with CR, LF or CR LF; answers and RUN-mode
+// lines end with CR LF. The informational commands ?, ??, VERS, ERRS and UNIT answer in the
+// shape of the Vaisala 300-series guides (docs/drivers.md); their texts are the twin's own. Output
+// in the default FORM of the user's guide ("P= 1033.7 hPa T= 22.2 'C RH= 38.3 %RH"), with one more
+// decimal on P and T than that example, as a FORM such as 4.2 P would print.
 #include "ptu300/twin.hpp"
 
 #include <fmt/format.h>
@@ -23,8 +25,31 @@ struct Ptu300Twin::Impl : detail::PtyChannel, std::enable_shared_from_this<Ptu30
     const double now = clock();
     world.advance_to(now);
     const AirSample a = world.air().sample(now);
-    return fmt::format("P= {:7.2f} hPa T= {:6.2f} 'C RH= {:5.1f} %RH\r\n", a.pressure_pa / 100.0,
-                       a.temperature_degc, a.humidity_pct);
+    // UNIT N (non-metric) prints the temperature in 'F, as a unit left so would.
+    const double t = metric ? a.temperature_degc : a.temperature_degc * 9.0 / 5.0 + 32.0;
+    return fmt::format("P= {:7.2f} hPa T= {:6.2f} '{} RH= {:5.1f} %RH\r\n", a.pressure_pa / 100.0,
+                       t, metric ? 'C' : 'F', a.humidity_pct);
+  }
+
+  static constexpr const char* version = "PTU300 / 5.10 (simulated)";
+
+  // ? and ??: the settings, in the layout of the 300-series guides' example.
+  std::string information() const {
+    return fmt::format(
+        "{}\r\nSerial number  : SIMULATED\r\nOutput format  : (default)\r\n"
+        "Start mode     : {}\r\nBaud P D S     : 4800 E 7 1\r\nOutput interval: {} s\r\n"
+        "Address        : 0\r\nEcho           : OFF\r\nOutput units   : {}\r\n",
+        version, running ? "RUN" : "STOP", config.interval_s, metric ? "metric" : "non metric");
+  }
+
+  // UNIT, UNIT M, UNIT N: the output units (metric: 'C; non metric: 'F).
+  std::string units(const std::string& cmd) {
+    const std::string arg = cmd.size() > 5 ? cmd.substr(5) : "";
+    if (arg == "M" || arg == "N")
+      metric = arg == "M";
+    else if (!arg.empty())
+      return "Unknown unit\r\n";
+    return fmt::format("Output units   : {}\r\n", metric ? "metric" : "non metric");
   }
 
   void on_command(const std::string& raw) {
@@ -60,6 +85,10 @@ struct Ptu300Twin::Impl : detail::PtyChannel, std::enable_shared_from_this<Ptu30
       return pty.send(fmt::format("Output intrv. : {} s\r\n", config.interval_s), self);
     }
     if (cmd.rfind("FORM", 0) == 0) return pty.send("OK\r\n", self);  // formats are not simulated
+    if (cmd == "?" || cmd == "??") return pty.send(information(), self);
+    if (cmd == "VERS") return pty.send(fmt::format("{}\r\n", version), self);
+    if (cmd == "ERRS") return pty.send("No errors\r\n", self);
+    if (cmd == "UNIT" || cmd.rfind("UNIT ", 0) == 0) return pty.send(units(cmd), self);
     if (!cmd.empty()) pty.send("Unknown command\r\n", self);
   }
 
@@ -86,6 +115,7 @@ struct Ptu300Twin::Impl : detail::PtyChannel, std::enable_shared_from_this<Ptu30
   Clock clock;
   Ptu300TwinConfig config;
   bool running = false;
+  bool metric = true;  // UNIT M (the factory setting) or UNIT N
   double next_output_s = 0.0;
 };
 

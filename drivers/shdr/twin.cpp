@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <ctime>
+#include <random>
 
 #include "sim/twin_io.hpp"
 
@@ -24,16 +25,36 @@ struct ShdrTwin::Impl : detail::TcpChannel, std::enable_shared_from_this<ShdrTwi
   // The items as the adapter prints them now: a line of those that differ from `last` (all
   // of them when `all`), or "" when none does.
   std::string line(bool all) {
-    world.advance_to(clock());
-    const auto& c = world.state().commanded_mm;
+    const double now = clock();
+    world.advance_to(now);
+    const auto& state = world.state();
+    const auto& p =
+        config.position == ShdrTwinConfig::Position::actual ? state.axes_mm : state.commanded_mm;
+    chatter(now);
     std::string items;
     for (std::size_t a = 0; a < 3; ++a) {
-      std::string value = fmt::format("{:.4f}", c[a]);
+      std::string value =
+          fmt::format("{:.{}f}", p[a] + (dithered[a] ? config.dither_mm : 0.0), config.decimals);
       if (all || value != last[a]) items += fmt::format("|{}|{}", config.keys[a], value);
       last[a] = std::move(value);
     }
     if (items.empty()) return {};
     return timestamp() + items + "\n";
+  }
+
+  // Flips each axis's dither offset when its next chatter time has come (at most one flip per
+  // look, as an adapter's scan sees one value).
+  void chatter(double now_s) {
+    if (!(config.dither_mm > 0.0)) return;
+    std::uniform_real_distribution<double> interval(config.chatter_interval_s[0],
+                                                    config.chatter_interval_s[1]);
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (next_flip_s[a] < 0.0) next_flip_s[a] = now_s + interval(random);
+      if (now_s < next_flip_s[a]) continue;
+      dithered[a] = !dithered[a];
+      ++flips;
+      next_flip_s[a] = now_s + interval(random);
+    }
   }
 
   static std::string timestamp() {
@@ -63,8 +84,11 @@ struct ShdrTwin::Impl : detail::TcpChannel, std::enable_shared_from_this<ShdrTwi
   World& world;
   Clock clock;
   ShdrTwinConfig config;
-  std::uint64_t sent = 0, pongs = 0;
+  std::uint64_t sent = 0, pongs = 0, flips = 0;
   std::array<std::string, 3> last;  // the values last sent
+  std::mt19937_64 random{config.seed};
+  std::array<double, 3> next_flip_s{-1.0, -1.0, -1.0};  // per axis, the twin's time
+  std::array<bool, 3> dithered{};
 };
 
 ShdrTwin::ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config)
@@ -82,5 +106,6 @@ ShdrTwin::ShdrTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(
 }
 std::uint64_t ShdrTwin::lines_sent() const { return impl_->sent; }
 std::uint64_t ShdrTwin::pings_answered() const { return impl_->pongs; }
+std::uint64_t ShdrTwin::chatter_flips() const { return impl_->flips; }
 
 }  // namespace cal::drivers::sim

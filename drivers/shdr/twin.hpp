@@ -1,6 +1,7 @@
 #pragma once
 // SIMULATED MTConnect SHDR adapter (a machine position feed) on a loopback TCP port, streaming
-// the simulated control's commanded position (see sim/twin.hpp).
+// the simulated control's commanded position, or its actual position with the chatter of a
+// real adapter at rest (see sim/twin.hpp).
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -20,6 +21,19 @@ struct ShdrTwinConfig {
   std::chrono::milliseconds period{5};
   std::int64_t pong_timeout_ms = 10000;  // the answer to "* PING": "* PONG 10000"
   std::array<std::string, 3> keys{"Xcom", "Ycom", "Zcom"};  // the data items of X, Y, Z
+  // What the adapter reports: the commanded position (silent while parked), or the actual one
+  // (the axes after their servo loops), as the GF Agie HPM600U's adapter does.
+  enum class Position { commanded, actual };
+  Position position = Position::commanded;
+  int decimals = 4;  // printed with this many decimals (the GF Agie log: 5, i.e. 10 nm)
+  // A real adapter's actual position chatters at rest: in the GF Agie HPM600U log of
+  // ../shared/realdata an axis standing still moves by one count (10 nm) and back every
+  // 0.14-1 s (e.g. 19.5072, 19.50719, 19.5072). When dither_mm > 0, each axis's printed value is
+  // offset by dither_mm and back at intervals drawn uniformly from chatter_interval_s (the
+  // twin's time, seeded), in motion as at rest. 0: no chatter.
+  double dither_mm = 0.0;
+  std::array<double, 2> chatter_interval_s{0.14, 1.0};
+  std::uint64_t seed = 1;
 };
 
 // Sends the simulated control's commanded position to every connected agent on change and
@@ -28,6 +42,7 @@ class ShdrTwin final : public TcpTwin {
  public:
   ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});
   std::uint64_t lines_sent() const;
+  std::uint64_t chatter_flips() const;  // times an axis's dither offset changed
   std::uint64_t pings_answered() const;
 
  private:

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
 #include "line_gauge/codec.hpp"
 
@@ -67,6 +68,87 @@ TEST(GaugeCodec, RefusesABadPattern) {
   EXPECT_THROW(GaugeCodec({.pattern = "[0-9]+"}), cal::InputError);  // no capture group
   EXPECT_EQ(gauge_unit_from_string("um"), GaugeUnit::um);
   EXPECT_THROW(gauge_unit_from_string("furlong"), cal::InputError);
+}
+
+// The readings (in SI) and error count of `bytes` through the registry's gauge decoder, as
+// `daq decode gauge` reads them, configured with `options`.
+struct Decoded {
+  std::vector<double> values;
+  std::size_t errors = 0;
+};
+Decoded decode_gauge(std::string_view bytes,
+                     std::vector<std::pair<std::string, std::string>> options) {
+  namespace dr = cal::drivers;
+  const auto& gauge = dr::driver("gauge");
+  auto decoder = gauge.make_decoder(dr::options_from_text(gauge, options));
+  std::vector<dr::DecodedItem> items;
+  decoder->feed(std::as_bytes(std::span(bytes.data(), bytes.size())), items);
+  decoder->finish(items);
+  Decoded out;
+  for (const auto& i : items) {
+    if (i.kind == dr::DecodedItem::Kind::reading) out.values.push_back(i.value);
+    if (i.kind == dr::DecodedItem::Kind::error) ++out.errors;
+  }
+  return out;
+}
+
+TEST(GaugePresets, MitutoyoDigimaticLinesEndWithCrAndCarry01A) {
+  // Mitutoyo manual 99MAF600B, USB data output: 0.123 (mm, 0.001) -> "01A+0000.123[CR]";
+  // 0.1234 (inch, 0.0001) -> "01A+000.1234[CR]". CR only: each line still counts.
+  auto d = decode_gauge("01A+0000.123\r01A-0012.500\r", {{"preset", "mitutoyo_digimatic"}});
+  EXPECT_EQ(d.errors, 0u);
+  ASSERT_EQ(d.values.size(), 2u);
+  EXPECT_DOUBLE_EQ(d.values[0], 0.123e-3);
+  EXPECT_DOUBLE_EQ(d.values[1], -12.5e-3);
+  d = decode_gauge("01A+000.1234\r", {{"preset", "mitutoyo_digimatic"}, {"unit", "in"}});
+  ASSERT_EQ(d.values.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.values[0], 0.1234 * 0.0254);
+  // Without the preset the prefix is no number: the default pattern refuses the line.
+  EXPECT_EQ(decode_gauge("01A+0000.123\r", {}).errors, 1u);
+  // pytuyo (the USB-ITN reader) asks with "1" and CR.
+  const auto* p = gauge_preset("mitutoyo_digimatic");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->request, "1\r");
+}
+
+TEST(GaugePresets, SylvacLinesSignOrSpaceThenTheValueAndCr) {
+  // Sylvac OPTO-RS: [sign ("+", "-" or space) | integer | "." | fraction | CR]; in tolerance
+  // mode '<', '=' or '>' follows; errors are "ERR" and a number.
+  const auto d = decode_gauge("+12.345\r-0.004\r 7.500\r12.345=\rERR3\r", {{"preset", "sylvac"}});
+  ASSERT_EQ(d.values.size(), 4u);
+  EXPECT_DOUBLE_EQ(d.values[0], 12.345e-3);
+  EXPECT_DOUBLE_EQ(d.values[1], -0.004e-3);
+  EXPECT_DOUBLE_EQ(d.values[2], 7.5e-3);
+  EXPECT_DOUBLE_EQ(d.values[3], 12.345e-3);
+  EXPECT_EQ(d.errors, 1u);  // ERR3: exceeded measurement range, an error, never a value
+  EXPECT_EQ(gauge_preset("sylvac")->request, "?\r");
+}
+
+TEST(GaugePresets, MahrMillimarPrintsItsUnitAfterTheValue) {
+  // Millimar C1208 OPTORSD: "?" CR -> "xxx.xxx<unit>" CR LF, the unit mm, in or um (UNI?).
+  const auto d = decode_gauge("0.0123mm\r\n-1.5um\r\n0.5in\r\n", {{"preset", "mahr_millimar"}});
+  EXPECT_EQ(d.errors, 0u);
+  ASSERT_EQ(d.values.size(), 3u);
+  EXPECT_DOUBLE_EQ(d.values[0], 0.0123e-3);
+  EXPECT_DOUBLE_EQ(d.values[1], -1.5e-6);
+  EXPECT_DOUBLE_EQ(d.values[2], 0.0127);
+}
+
+TEST(GaugePresets, EveryPresetReadsItsOwnDocumentedExampleAndAGivenKeyWins) {
+  for (const auto& p : gauge_presets()) {
+    SCOPED_TRACE(std::string(p.name));
+    const auto d = decode_gauge(std::string(p.example) + "\r", {{"preset", std::string(p.name)}});
+    ASSERT_EQ(d.values.size(), 1u);
+    EXPECT_DOUBLE_EQ(d.values[0], p.example_mm * 1e-3);
+    EXPECT_FALSE(p.source.empty());
+  }
+  // A pattern given with the preset is the user's: the preset's is not used (here it takes
+  // the first fraction digit only).
+  const auto d = decode_gauge("01A+0000.123\r",
+                              {{"preset", "mitutoyo_digimatic"}, {"pattern", R"(\.([0-9]))"}});
+  ASSERT_EQ(d.values.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.values[0], 1e-3);
+  EXPECT_EQ(decode_gauge("+1.0\r", {{"preset", "mitutoyo_digimatic"}}).errors, 1u);
 }
 
 }  // namespace

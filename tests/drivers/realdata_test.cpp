@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -113,8 +114,56 @@ TEST(RealData, TheRecordingsAreThere) {
          "checkout (CI has ../shared/ there)";
   for (const char* f : {"shdr_okuma_osp_p300.txt", "halsampler_tagged_limit3.txt",
                         "halsampler_tagged_timedelay0.txt", "halsampler_untagged_near0.txt",
-                        "halsampler_untagged_abs0.txt", "halsampler_untagged_biquad.txt"})
+                        "halsampler_untagged_abs0.txt", "halsampler_untagged_biquad.txt",
+                        "shdr_gf_agie_hpm600u_2015.txt", "shdr_handtmann482_840d_telnet.txt",
+                        "halsampler_untagged_mux.txt", "halsampler_untagged_and_or_not_mux.txt",
+                        "halsampler_tagged_limit_max_velocity.txt"})
     EXPECT_TRUE(fs::is_regular_file(realdata() / f)) << f;
+}
+
+// The readings of `keys` (X, Y, Z) expected from SHDR lines, read with the test's own split:
+// each line's keys at key positions (1, 3, 5, ...), in axis order within a line.
+struct ShdrExpected {
+  std::int64_t time_ns;
+  std::uint8_t axis;
+  double value_m;
+};
+std::vector<ShdrExpected> shdr_expected(const std::vector<std::string>& lines,
+                                        const std::vector<std::string>& keys,
+                                        std::array<std::size_t, 3>& per_axis) {
+  std::vector<ShdrExpected> expected;
+  per_axis = {};
+  for (const auto& line : lines) {
+    if (line[0] == '*') continue;
+    const auto tokens = split(line, '|');
+    std::vector<ShdrExpected> of_line;
+    for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
+      for (std::uint8_t a = 0; a < keys.size(); ++a)
+        if (tokens[i] == keys[a]) {
+          of_line.push_back({unix_ns(tokens[0]), a, std::stod(tokens[i + 1]) * 1e-3});
+          ++per_axis[a];
+        }
+    std::sort(of_line.begin(), of_line.end(),
+              [](const auto& x, const auto& y) { return x.axis < y.axis; });
+    expected.insert(expected.end(), of_line.begin(), of_line.end());
+  }
+  return expected;
+}
+
+void expect_readings(const std::vector<d::DecodedItem>& items,
+                     const std::vector<ShdrExpected>& expected) {
+  std::vector<d::DecodedItem> readings;
+  for (const auto& i : items)
+    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
+  ASSERT_EQ(readings.size(), expected.size());
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    SCOPED_TRACE(k);
+    ASSERT_TRUE(readings[k].device_time_unix_ns);
+    EXPECT_EQ(*readings[k].device_time_unix_ns, expected[k].time_ns);
+    EXPECT_EQ(readings[k].channel, expected[k].axis);
+    EXPECT_EQ(readings[k].quantity, d::Quantity::machine_position_m);
+    EXPECT_DOUBLE_EQ(readings[k].value, expected[k].value_m);
+  }
 }
 
 TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
@@ -123,12 +172,7 @@ TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
   // '*' commands, with one of the keys at a key position (1, 3, 5, ...).
   const std::string text = read("shdr_okuma_osp_p300.txt");
   const std::map<std::string, std::uint8_t> keys{{"X1actw", 0}, {"YI1actw", 1}, {"Z1actw", 2}};
-  struct Expected {
-    std::int64_t time_ns;
-    std::uint8_t axis;
-    double value_m;
-  };
-  std::vector<Expected> expected;
+  std::vector<ShdrExpected> expected;
   std::size_t frames = 0;
   std::string terminator;
   for (const auto& line : lines_of(text)) {
@@ -142,12 +186,12 @@ TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
     }
     if (line[0] == '*') continue;
     const auto tokens = split(line, '|');
-    std::vector<Expected> of_line;  // a frame's readings come X, Y, Z whatever the line's order
+    std::vector<ShdrExpected> of_line;  // a frame's readings come X, Y, Z whatever the line's order
     for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
       if (const auto k = keys.find(tokens[i]); k != keys.end())
         of_line.push_back({unix_ns(tokens[0]), k->second, std::stod(tokens[i + 1]) * 1e-3});
     std::sort(of_line.begin(), of_line.end(),
-              [](const Expected& a, const Expected& b) { return a.axis < b.axis; });
+              [](const ShdrExpected& a, const ShdrExpected& b) { return a.axis < b.axis; });
     expected.insert(expected.end(), of_line.begin(), of_line.end());
     frames += !of_line.empty();
   }
@@ -157,19 +201,8 @@ TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
   EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
   EXPECT_EQ(stats.errors(), 0u);
   EXPECT_EQ(stats.frames, 3989u);
-  std::vector<d::DecodedItem> readings;
-  for (const auto& i : items)
-    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
-  ASSERT_EQ(readings.size(), expected.size());
-  EXPECT_EQ(readings.size(), 4905u);  // 1330 X1actw + 607 YI1actw + 2968 Z1actw
-  for (std::size_t k = 0; k < readings.size(); ++k) {
-    SCOPED_TRACE(k);
-    ASSERT_TRUE(readings[k].device_time_unix_ns);
-    EXPECT_EQ(*readings[k].device_time_unix_ns, expected[k].time_ns);
-    EXPECT_EQ(readings[k].channel, expected[k].axis);
-    EXPECT_EQ(readings[k].quantity, d::Quantity::machine_position_m);
-    EXPECT_DOUBLE_EQ(readings[k].value, expected[k].value_m);
-  }
+  EXPECT_EQ(expected.size(), 4905u);  // 1330 X1actw + 607 YI1actw + 2968 Z1actw
+  expect_readings(items, expected);
   // The '*' command lines ("*adapterVersion:UNAVAILABLE") and the assets are notes, not errors.
   EXPECT_GT(count(items, d::DecodedItem::Kind::note), 0u);
 }
@@ -238,6 +271,114 @@ TEST(RealData, HalsamplerUntaggedFilesReadEveryLineAndColumnZeroIsAPin) {
   for (const auto& frame : halsampler("halsampler_untagged_biquad.txt", false, 0, st)) {
     EXPECT_FALSE(frame.sample);
     EXPECT_TRUE(*frame.position_m[0] == 0.0 || *frame.position_m[0] == 1e-3);
+  }
+}
+
+TEST(RealData, GfAgieShdrGivesEveryPositionWithTheFilesTime) {
+  // README: every Xposition, Yposition, Zposition value with the file's time (3,825 / 3,484 /
+  // 2,288), no codec error. LF lines, 6-digit fractions, conditions, assets, a THREE_SPACE
+  // path_pos (three numbers in one value: not a position item here).
+  const std::string text = read("shdr_gf_agie_hpm600u_2015.txt");
+  std::array<std::size_t, 3> per_axis{};
+  const auto expected =
+      shdr_expected(lines_of(text), {"Xposition", "Yposition", "Zposition"}, per_axis);
+  EXPECT_EQ(per_axis, (std::array<std::size_t, 3>{3825, 3484, 2288}));
+  cal::drivers::codec::CodecStats stats;
+  const auto items = decode("shdr", text, {{"keys", "Xposition,Yposition,Zposition"}}, &stats);
+  EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
+  EXPECT_EQ(stats.errors(), 0u);
+  expect_readings(items, expected);
+}
+
+TEST(RealData, HandtmannTelnetCaptureGivesTheActualPositionsOfItsFirstNineLines) {
+  // README: CR LF lines, millisecond times without a zone (read as UTC, as the agent does), a
+  // 1,438-byte line of ~90 items; only lines 1-9 are the adapter's bytes (the telnet console
+  // wrapped the rest at 120 columns). X11_actual, Y11_actual, Z11_actual of lines 1-9.
+  const std::string text = read("shdr_handtmann482_840d_telnet.txt");
+  std::string first9;
+  std::size_t at = 0;
+  for (int k = 0; k < 9; ++k) at = text.find('\n', at) + 1;
+  first9 = text.substr(0, at);
+  ASSERT_NE(first9.find("\r\n"), std::string::npos);  // the capture's CR LF
+  std::array<std::size_t, 3> per_axis{};
+  const auto lines = lines_of(first9);
+  ASSERT_EQ(lines.size(), 9u);
+  EXPECT_EQ(std::max_element(lines.begin(), lines.end(),
+                             [](const auto& a, const auto& b) { return a.size() < b.size(); })
+                ->size(),
+            1437u);  // 1,438 bytes with its CR
+  const auto expected = shdr_expected(lines, {"X11_actual", "Y11_actual", "Z11_actual"}, per_axis);
+  EXPECT_GE(per_axis[0], 1u);
+  EXPECT_GE(per_axis[1], 1u);
+  EXPECT_GE(per_axis[2], 1u);
+  cal::drivers::codec::CodecStats stats;
+  const auto items = decode("shdr", first9, {{"keys", "X11_actual,Y11_actual,Z11_actual"}}, &stats);
+  EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
+  EXPECT_EQ(stats.errors(), 0u);
+  expect_readings(items, expected);
+  // The first reading is the long line's X11_actual, 1536.595860 mm.
+  ASSERT_FALSE(expected.empty());
+  EXPECT_DOUBLE_EQ(expected.front().value_m, 1.536595860);
+}
+
+TEST(RealData, HalsamplerMuxAndAndOrNotMuxGiveTheConfiguredColumnOnEveryLine) {
+  // mux: 20 pins of all four HAL types (cfg=bfsubfsubfsubfsubfbu), untagged: column 17 holds
+  // 1.11 ... 5.55; every column reads as printed, 5000000000.001000 and 4294967295 included.
+  // and-or-not-mux (cfg=bbbff): three bit pins first; column 3 and 4 the floats.
+  const struct {
+    const char* file;
+    std::size_t lines;
+    int columns;
+  } files[] = {{"halsampler_untagged_mux.txt", 105, 20},
+               {"halsampler_untagged_and_or_not_mux.txt", 16, 5}};
+  for (const auto& f : files) {
+    const std::string text = read(f.file);
+    const auto lines = lines_of(text);
+    ASSERT_EQ(lines.size(), f.lines) << f.file;
+    for (int column = 0; column < f.columns; ++column) {
+      SCOPED_TRACE(std::string(f.file) + " column " + std::to_string(column));
+      cal::drivers::codec::CodecStats stats;
+      const auto items = decode("halsampler", text, {{"column", std::to_string(column)}}, &stats);
+      EXPECT_EQ(stats.errors(), 0u);
+      ASSERT_EQ(count(items, d::DecodedItem::Kind::reading), f.lines);
+      std::size_t k = 0;
+      for (const auto& i : items) {
+        if (i.kind != d::DecodedItem::Kind::reading) continue;
+        EXPECT_DOUBLE_EQ(i.value, numbers_of(lines[k]).at(static_cast<std::size_t>(column)) * 1e-3);
+        ++k;
+      }
+    }
+  }
+  cal::drivers::codec::CodecStats st;
+  const auto mux = halsampler("halsampler_untagged_mux.txt", false, 17, st);
+  ASSERT_EQ(mux.size(), 105u);
+  std::set<double> seen;
+  for (const auto& frame : mux) {
+    EXPECT_FALSE(frame.sample);
+    seen.insert(*frame.position_m[0] * 1e3);
+  }
+  EXPECT_EQ(seen.size(), 5u);
+  EXPECT_DOUBLE_EQ(*seen.begin(), 1.11);
+  EXPECT_DOUBLE_EQ(*seen.rbegin(), 5.55);
+  // and-or-not-mux: no bit read as a sample number, no gap invented from the bits' jumps.
+  for (const auto& frame : halsampler("halsampler_untagged_and_or_not_mux.txt", false, 0, st)) {
+    EXPECT_FALSE(frame.sample);
+    EXPECT_EQ(frame.lost_before, 0u);
+  }
+}
+
+TEST(RealData, HalsamplerLimitMaxVelocityGivesSamples0To799WithNoGap) {
+  // limit3/limit-max-velocity: halsampler -t, cfg=f: sample N, then 0.5 (N + 1).
+  cal::drivers::codec::CodecStats st;
+  const auto f = halsampler("halsampler_tagged_limit_max_velocity.txt", true, 0, st);
+  EXPECT_EQ(st.errors(), 0u);
+  ASSERT_EQ(f.size(), 800u);
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    SCOPED_TRACE(k);
+    ASSERT_TRUE(f[k].sample);
+    EXPECT_EQ(*f[k].sample, k);
+    EXPECT_EQ(f[k].lost_before, 0u);
+    EXPECT_DOUBLE_EQ(*f[k].position_m[0], 0.5 * static_cast<double>(k + 1) * 1e-3);
   }
 }
 

@@ -126,9 +126,10 @@ TEST(Options, FromTextNamesAnUnknownOptionAndTheDriversOwn) {
     d::options_from_text(gauge, std::span(&typo, 1));
     FAIL();
   } catch (const cal::InputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "driver 'gauge' has no option 'units' (its options: request, pattern, unit, "
-                 "scale, offset, min_si, max_si)");
+    EXPECT_STREQ(
+        e.what(),
+        "driver 'gauge' has no option 'units' (its options: preset, request, pattern, unit, "
+        "scale, offset, min_si, max_si)");
   }
   // Checks between options: a gauge pattern without a capture group.
   const std::pair<std::string, std::string> pattern{"pattern", "[0-9.]+"};

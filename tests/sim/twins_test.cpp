@@ -11,6 +11,7 @@
 #include "cal/drivers/transport/transport.hpp"
 #include "ids3010/twin.hpp"
 #include "line_gauge/twin.hpp"
+#include "ptu300/codec.hpp"
 #include "ptu300/twin.hpp"
 
 namespace {
@@ -52,6 +53,13 @@ struct Bench {
           received.append(reinterpret_cast<const char*>(b.data()), b.size());
         },
         [this](const t::Error& e) { error = e; });
+  }
+  // A serial port on a PTU300 twin, opened at 4800 7E1 as the device's settings ask.
+  std::unique_ptr<t::Transport> open_ptu300(const sim::Ptu300Twin& twin) {
+    auto port =
+        t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = twin.device_path()}));
+    open(*port);
+    return port;
   }
   std::string next_line() {
     run_until(io, [&] { return received.find('\n') != std::string::npos; });
@@ -134,12 +142,44 @@ TEST(IdsTwin, SpeaksTheConfiguredApiGenerationOnly) {
   EXPECT_EQ(text["result"][0], 0);  // (no params: the twin's text for an unknown number)
 }
 
+TEST(IdsTwin, AnswersUnterminatedRequestsAndEndsItsAnswersWithCrLf) {
+  // attocube's ACS.py (IDS-APIs) and the EPICS driver nmarks99/attocubeIDS write each request
+  // with no terminator; ACS.py reads answers up to CR LF. Two requests in one write, one split
+  // inside a string, one ended by LF (MATLAB's writeline): each answered once, with CR LF.
+  Bench b;
+  sim::IdsTwin twin(b.io, b.world, b.clock);
+  auto tcp = t::make_tcp(b.io, {.host = "127.0.0.1", .port = twin.port()});
+  b.open(*tcp);
+  run_until(b.io, [&] { return tcp->is_open(); });
+  const auto request = [](int id) {
+    return fmt::format(
+        R"({{"jsonrpc": "2.0", "method": "com.attocube.ids.system.getCurrentMode", "params": [], "id": {}, "api": 2}})",
+        id);
+  };
+  tcp->write(bytes(request(1) + request(2)));
+  const std::string third = request(3);
+  tcp->write(bytes(third.substr(0, 40)));  // inside the method's string
+  for (const int id : {1, 2}) {
+    const std::string line = b.next_line();
+    ASSERT_TRUE(line.ends_with("}\r\n")) << line;
+    EXPECT_EQ(nlohmann::json::parse(line)["id"], id);
+    EXPECT_EQ(nlohmann::json::parse(line)["result"][1], "system idle");
+  }
+  EXPECT_EQ(b.next_line(), "(nothing)");  // half a request is not answered
+  tcp->write(bytes(third.substr(40)));
+  EXPECT_EQ(nlohmann::json::parse(b.next_line())["id"], 3);
+  tcp->write(bytes(request(4) + "\n"));
+  EXPECT_EQ(nlohmann::json::parse(b.next_line())["id"], 4);
+  tcp->write(bytes("not json\n"));  // a line that is no object: JSON-RPC's parse error
+  EXPECT_EQ(nlohmann::json::parse(b.next_line())["error"]["code"], -32700);
+  EXPECT_EQ(twin.requests_served(), 5u);
+  EXPECT_TRUE(b.received.empty());
+}
+
 TEST(Ptu300Twin, AnswersSendAt4800SevenEvenOne) {
   Bench b;
   sim::Ptu300Twin twin(b.io, b.world, b.clock);
-  auto port =
-      t::make_serial(b.io, t::parse_serial_settings("4800 7E1", {.device = twin.device_path()}));
-  b.open(*port);
+  auto port = b.open_ptu300(twin);
   port->write(bytes("SEND\r"));
   EXPECT_EQ(b.next_line(), "P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n");
   port->write(bytes("INTV 2 S\r"));
@@ -159,6 +199,47 @@ TEST(Ptu300Twin, AnswersSendAt4800SevenEvenOne) {
   twin.unplug();
   run_until(b.io, [&] { return b.error.has_value(); });
   ASSERT_TRUE(b.error);
+}
+
+TEST(Ptu300Twin, TakesCommandsEndedByLfOrCrLfAndAnswersTheInformationalCommands) {
+  // The PTU300 user's guide (M210796EN) ends commands with <cr>; a terminal or a program may
+  // send LF or CR LF: each command is answered once. ?, VERS, ERRS and UNIT answer as the
+  // 300-series guides show them (no "Unknown command").
+  Bench b;
+  sim::Ptu300Twin twin(b.io, b.world, b.clock);
+  auto port = b.open_ptu300(twin);
+  port->write(bytes("SEND\n"));
+  EXPECT_EQ(b.next_line(), "P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH\r\n");
+  port->write(bytes("send\r\nVERS\n"));  // one answer each: the LF of CR LF is no command
+  EXPECT_EQ(b.next_line().substr(0, 3), "P= ");
+  EXPECT_EQ(b.next_line(), "PTU300 / 5.10 (simulated)\r\n");
+  port->write(bytes("ERRS\r"));
+  EXPECT_EQ(b.next_line(), "No errors\r\n");
+  port->write(bytes("?\r"));
+  EXPECT_EQ(b.next_line(), "PTU300 / 5.10 (simulated)\r\n");
+  std::string settings;
+  for (std::string line; (line = b.next_line()) != "(nothing)";) settings += line;
+  EXPECT_NE(settings.find("Baud P D S     : 4800 E 7 1\r\n"), std::string::npos) << settings;
+  EXPECT_NE(settings.find("Output units   : metric\r\n"), std::string::npos) << settings;
+  EXPECT_EQ(settings.find("Unknown"), std::string::npos) << settings;
+  // UNIT N: the temperature in 'F, as a unit left non-metric prints it; the real codec reads
+  // it back to degC.
+  port->write(bytes("UNIT N\r"));
+  EXPECT_EQ(b.next_line(), "Output units   : non metric\r\n");
+  port->write(bytes("SEND\r"));
+  const std::string fahrenheit = b.next_line();
+  EXPECT_EQ(fahrenheit, "P= 1013.25 hPa T=  68.00 'F RH=  50.0 %RH\r\n");
+  cal::drivers::codec::Ptu300Codec codec;
+  std::vector<cal::drivers::codec::Ptu300Frame> frames;
+  std::vector<cal::drivers::codec::CodecError> errors;
+  codec.feed(fahrenheit, frames, errors);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_TRUE(errors.empty());
+  EXPECT_NEAR(*frames[0].temperature_degc, 20.0, 1e-9);
+  port->write(bytes("UNIT\r"));
+  EXPECT_EQ(b.next_line(), "Output units   : non metric\r\n");
+  port->write(bytes("XYZZY\n"));
+  EXPECT_EQ(b.next_line(), "Unknown command\r\n");
 }
 
 TEST(GaugeTwin, StreamsTheBarLengthAtItsSampleRate) {

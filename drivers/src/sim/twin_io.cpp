@@ -53,24 +53,43 @@ void LineServer::accept() {
 }
 
 void LineServer::read(const ClientPtr& client) {
-  const std::size_t buffered = client->input.size();
-  asio::async_read_until(
-      client->socket, client->input, '\n',
-      [self = shared_from_this(), client, buffered](const boost::system::error_code& ec,
-                                                    std::size_t n) {
+  client->socket.async_read_some(
+      asio::buffer(client->chunk),
+      [self = shared_from_this(), client](const boost::system::error_code& ec, std::size_t n) {
         if (auto* time = VirtualTime::of(client->socket.get_executor().context()))
-          time->bytes_read(client->input.size() - buffered);
+          time->bytes_read(n);
         if (ec || self->closed_) {
           self->clients_.remove(client);
           return;
         }
-        std::string line(asio::buffers_begin(client->input.data()),
-                         asio::buffers_begin(client->input.data()) + static_cast<long>(n));
-        client->input.consume(n);
-        while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
-        if (self->on_line_) self->on_line_(client, line);
-        if (!self->closed_) self->read(client);
+        client->input.append(client->chunk.data(), n);
+        self->hand_on_requests(client);
+        if (self->closed_) return;
+        if (client->input.size() > max_request_bytes) {
+          boost::system::error_code ignored;
+          client->socket.close(ignored);
+          self->clients_.remove(client);
+          return;
+        }
+        self->read(client);
       });
+}
+
+void LineServer::hand_on_requests(const ClientPtr& client) {
+  while (!closed_) {
+    std::size_t end = 0;
+    if (framing_) {
+      end = framing_(client->input);
+    } else if (const auto eol = client->input.find('\n'); eol != std::string::npos) {
+      end = eol + 1;
+    }
+    if (end == 0) return;
+    std::string request = client->input.substr(0, end);
+    client->input.erase(0, end);
+    while (!request.empty() && (request.back() == '\n' || request.back() == '\r'))
+      request.pop_back();
+    if (on_line_) on_line_(client, request);
+  }
 }
 
 void LineServer::send(const ClientPtr& client, std::string text) {

@@ -2,6 +2,7 @@
 // Private to drivers/: the channels the simulated twins speak over (a loopback TCP line server,
 // a pseudo-terminal) and the ordered writer they share. Includes Boost.Asio: only twin .cpp
 // files include it.
+#include <array>
 #include <boost/asio.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <list>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/sim/twin.hpp"
@@ -56,22 +58,31 @@ struct LineWriter {
   }
 };
 
-// A TCP server on 127.0.0.1 that hands every line a client sends (with its terminator
-// removed) to on_line, and lets the twin answer that client or write to all of them.
+// A TCP server on 127.0.0.1 that hands every request a client sends to on_line (by default a
+// line, its CR LF or LF removed; a twin whose device takes unterminated requests sets its own
+// framing), and lets the twin answer that client or write to all of them.
 class LineServer : public std::enable_shared_from_this<LineServer> {
  public:
   struct Client {
     explicit Client(tcp::socket s) : socket(std::move(s)) {}
     tcp::socket socket;
-    asio::streambuf input;
+    std::string input;  // received, not yet a whole request
+    std::array<char, 4096> chunk{};
     LineWriter<tcp::socket> writer;
   };
   using ClientPtr = std::shared_ptr<Client>;
+  // Where the first whole request of `buffered` ends (one past its last byte), or 0 while none
+  // is whole yet. The request is handed on with trailing CR and LF removed.
+  using Framing = std::function<std::size_t(std::string_view buffered)>;
+  // A client that sends this much without one whole request is dropped (a device's input
+  // buffer is finite too).
+  static constexpr std::size_t max_request_bytes = 1 << 20;
 
   // port 0: an ephemeral port. on_line(client, line); on_connect(client) when one arrives.
   LineServer(asio::io_context& io, std::uint16_t port);
   void start(std::function<void(const ClientPtr&, const std::string&)> on_line,
              std::function<void(const ClientPtr&)> on_connect = {});
+  void set_framing(Framing framing) { framing_ = std::move(framing); }  // before start()
   std::uint16_t port() const { return acceptor_.local_endpoint().port(); }
   void send(const ClientPtr& client, std::string text);
   void broadcast(const std::string& text);  // to every connected client
@@ -83,11 +94,13 @@ class LineServer : public std::enable_shared_from_this<LineServer> {
  private:
   void accept();
   void read(const ClientPtr& client);
+  void hand_on_requests(const ClientPtr& client);  // every whole request of client->input
 
   tcp::acceptor acceptor_;
   std::list<ClientPtr> clients_;
   std::function<void(const ClientPtr&, const std::string&)> on_line_;
   std::function<void(const ClientPtr&)> on_connect_;
+  Framing framing_;
   bool closed_ = false;  // after close() no handler calls back into the twin
 };
 
@@ -130,25 +143,39 @@ struct TcpChannel {
   Timer timer;  // on the loop's time (loop_time.hpp)
 };
 
-// Reads CR- or LF-terminated command lines from self->pty's master and hands each (without
-// its terminator) to self->on_command.
+// Where a command line ends: at its CR or its LF, whichever comes first (a terminal, or a
+// program, may end commands with CR, LF or CR LF; the LF of a CR LF is then an empty line).
+struct EndOfCommand {
+  template <class Iterator>
+  std::pair<Iterator, bool> operator()(Iterator begin, Iterator end) const {
+    for (Iterator i = begin; i != end; ++i)
+      if (*i == '\r' || *i == '\n') return {std::next(i), true};
+    return {end, false};
+  }
+};
+
+// Reads command lines ended by CR, LF or CR LF from self->pty's master and hands each non-empty
+// one (without its terminator) to self->on_command.
 template <class Self>
 void read_commands(const std::shared_ptr<Self>& self) {
   const std::size_t buffered = self->pty.input.size();
   asio::async_read_until(
-      self->pty.master, self->pty.input, '\r',
+      self->pty.master, self->pty.input, EndOfCommand{},
       [self, buffered](const boost::system::error_code& ec, std::size_t n) {
         if (auto* time = VirtualTime::of(self->pty.master.get_executor().context()))
           time->bytes_read(self->pty.input.size() - buffered);
         if (ec) return;
         std::string line(asio::buffers_begin(self->pty.input.data()),
-                         asio::buffers_begin(self->pty.input.data()) + static_cast<long>(n));
+                         asio::buffers_begin(self->pty.input.data()) + static_cast<long>(n) - 1);
         self->pty.input.consume(n);
-        while (!line.empty() && (line.back() == '\r' || line.back() == '\n')) line.pop_back();
-        while (!line.empty() && line.front() == '\n') line.erase(0, 1);
-        self->on_command(line);
+        if (!line.empty()) self->on_command(line);
         read_commands(self);
       });
 }
 
 }  // namespace cal::drivers::sim::detail
+
+namespace boost::asio {
+template <>
+struct is_match_condition<cal::drivers::sim::detail::EndOfCommand> : std::true_type {};
+}  // namespace boost::asio
