@@ -39,6 +39,14 @@ def shot(b, name):
     page_checks.shot(b, SHOTS, name)
 
 
+def settle_machine(url):
+    """The simulated machine finishes a stopped run's program (as a machine left in Cycle Start
+    would) before the next run."""
+    post(url + "api/simulation/speed", {"speed": 100})
+    time.sleep(2.0)
+    post(url + "api/simulation/speed", {"speed": 20})
+
+
 def start_serve():
     log = open(os.path.join(TMP, "serve.log"), "w+")
     proc = subprocess.Popen([DAQ, "serve", "--simulate", "--speed", "20", "--port", "0",
@@ -69,6 +77,14 @@ SEEN = """const g = id => document.getElementById(id);
           start: g('start-linear').disabled, stop: g('stop').disabled,
           run: window.caldaq.page && window.caldaq.page.run, status: window.caldaq.page && window.caldaq.page.status};"""
 DASH = "—"
+# Sets a form field as typing would; the value of a form field.
+TYPE = """const [key, value] = arguments;
+  const input = [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === key);
+  if (!input) return 'no field ' + key;
+  input.value = value;
+  input.dispatchEvent(new Event('input', {bubbles: true}));
+  return 'ok';"""
+FIELD = "return [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === arguments[0]).value;"
 
 
 def no_live_values(s, where):
@@ -178,11 +194,7 @@ try:
     ok(b.js("return document.getElementById('conn').textContent;") == "live",
        "the connection shown live again after the hang")
     shot(b, "s04-aborted-1366x768.png")
-    # The simulated machine finishes the stopped run's program (as a machine left in Cycle
-    # Start would) before the next run.
-    post(url + "api/simulation/speed", {"speed": 100})
-    time.sleep(2.0)
-    post(url + "api/simulation/speed", {"speed": 20})
+    settle_machine(url)
 
     b.wait("return window.caldaq.page.status.start.linear.ready;", timeout_s=30, what="ready again")
     b.js("document.getElementById('start-linear').click();")
@@ -198,9 +210,52 @@ try:
     ok(m and m.group(1) == m.group(2), f"all its stops: {s['progress']!r}")
     shot(b, "s05-complete-1366x768.png")
 
-    # --- 4. the service killed mid-run -------------------------------------------------------
-    b.wait("return window.caldaq.page.status.start.linear.ready;", timeout_s=30, what="ready again")
+    # --- 4. Start runs what the operator sees: an unapplied edit is named, Start asks ---------
+    b.js("document.getElementById('tab-setup').click();")
+    b.wait("return !!document.querySelector('[data-key=\"test.linear.last_mm\"]') && "
+           "document.getElementById('setup-status').className === 'ok';", what="the set-up form")
+    ok(b.js(TYPE, "test.linear.last_mm", "50") == "ok", "typed: last target 50 mm (not applied)")
+    b.js("document.getElementById('tab-run').click();")
+    b.wait("return !document.getElementById('pending-edits').hidden;", what="the edit named")
+    seen = b.js("return [document.getElementById('plan').textContent, "
+                "document.getElementById('pending-edits').textContent];")
+    ok("axis X: 0.000 → 100.000 mm, 3 targets × 2 runs ↑↓ = 12 stops" in seen[0] and "laser (ids3010)" in seen[0],
+       f"the Run view shows the test Start runs: {seen[0]!r}")
+    ok("Last target 100 → 50" in seen[1], f"and the edit that is not in use: {seen[1]!r}")
+    shot(b, "s06-unapplied-edit-1366x768.png")
     b.js("document.getElementById('start-linear').click();")
+    ok(b.js("return document.getElementById('confirm-edits').open;"), "Start asks first")
+    ok("Last target 100 → 50" in b.js("return document.getElementById('confirm-edits-list').textContent;"),
+       "naming the edit")
+    shot(b, "s07-start-asks-1366x768.png")
+    b.js("document.getElementById('edits-cancel').click();")
+    time.sleep(0.5)
+    ok(not b.js("return window.caldaq.page.status.running;"), "Cancel starts nothing")
+    # Discard: the form is the service's set-up again, and Start runs it (12 stops).
+    b.js("document.getElementById('start-linear').click();")
+    b.js("document.getElementById('edits-discard').click();")
+    b.wait("return window.caldaq.page.status.running && window.caldaq.page.run && "
+           "window.caldaq.page.run.stop;", what="the run with the discarded edit")
+    ok(b.js("return window.caldaq.page.run.stop.count;") == 12, "discarded: the run has the 12 stops in use")
+    ok(b.js(FIELD, "test.linear.last_mm") == "100" and b.js("return document.getElementById('pending-edits').hidden;"),
+       "the form shows the set-up in use again, no edit pending")
+    status, _ = post(url + "api/runs/stop", {})
+    ok(status == 200, "that run stopped")
+    settle_machine(url)
+    # Apply: Start runs the edited test (2 targets: 8 stops).
+    b.js("document.getElementById('tab-setup').click();")
+    ok(b.js(TYPE, "test.linear.last_mm", "50") == "ok", "typed again: last target 50 mm")
+    b.js("document.getElementById('tab-run').click();")
+    b.wait("return window.caldaq.page.status.start.linear.ready && "
+           "!document.getElementById('pending-edits').hidden;", timeout_s=30, what="ready, the edit named")
+    b.js("document.getElementById('start-linear').click();")
+    b.js("document.getElementById('edits-apply').click();")
+    b.wait("return window.caldaq.page.status.running && window.caldaq.page.run && "
+           "window.caldaq.page.run.stop;", what="the run with the applied edit")
+    ok(b.js("return window.caldaq.page.run.stop.count;") == 8, "applied: the run has the edited 8 stops")
+    ok(b.js("return window.caldaq.page.status.setup.linear.last_mm;") == 50, "the service's set-up is the edited one")
+
+    # --- 5. the service killed mid-run -------------------------------------------------------
     b.wait("const r = window.caldaq.page.run; return window.caldaq.page.status.running && r && "
            "r.motion && r.motion.state === 'stable';", timeout_s=60, what="the axis still at a stop")
     before = b.js(SEEN)
@@ -211,10 +266,10 @@ try:
     time.sleep(0.3)
     s = b.js(SEEN)
     no_live_values(s, "killed service")
-    shot(b, "s06-killed-1366x768.png")
+    shot(b, "s08-killed-1366x768.png")
     b.set_size(560, 900)
     time.sleep(0.4)
-    shot(b, "s07-killed-560px.png")
+    shot(b, "s09-killed-560px.png")
     time.sleep(1.5)
     s2 = b.js(SEEN)
     ok(s2["banner"] and s2["big"] == DASH, f"still dashes later: {s2['since']!r}")

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
@@ -32,9 +33,9 @@
 #include "circle_run.hpp"
 #include "database.hpp"
 #include "devices_list.hpp"
+#include "json_input.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
-#include "json_input.hpp"
 #include "provenance.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
@@ -318,7 +319,51 @@ class Service {
     monitors_.clear();
     config_ = std::move(c);
     board_ = std::make_shared<DeviceBoard>(config_);
+    setup_summary_ = summary_of(config_, ++setup_version_);
     start_monitors();
+  }
+
+  // What Start runs, for the page's Run view (in every status: a set-up applied from another
+  // page shows at once): each test's axis or plane, range, targets, runs and instruments; the
+  // version counts the set-ups applied, so a page knows its form's base is outdated.
+  static json summary_of(const cal::daq::Config& c, int version) {
+    json j{{"version", version}, {"instruments", json::array()}};
+    for (const auto& d : c.devices)
+      j["instruments"].push_back(
+          {{"id", d.id}, {"driver", d.driver}, {"role", d.role}, {"origin", d.origin}});
+    const auto instruments_of = [&](std::string_view test) {
+      json ids = json::array();
+      for (const auto& d : c.devices)
+        if (uses(test, d)) ids.push_back(d.id);
+      return ids;
+    };
+    if (c.linear) {
+      const auto& l = *c.linear;
+      json t{{"axis", l.axis},
+             {"first_mm", l.first_mm},
+             {"last_mm", l.last_mm},
+             {"runs", l.runs},
+             {"bidirectional", l.bidirectional},
+             {"cycle", l.cycle},
+             {"feed_mm_per_min", l.feed_mm_per_min},
+             {"instruments", instruments_of("linear")}};
+      try {
+        const auto plan = linear_plan(l);
+        t["targets"] = plan.targets_mm.size();
+        t["stops"] = std::count_if(plan.moves.begin(), plan.moves.end(), [](const auto& m) {
+          return m.kind == cal::iso230_2::MoveKind::measure;
+        });
+      } catch (const cal::InputError& e) {
+        t["problem"] = e.what();  // Start names it too
+      }
+      j["linear"] = std::move(t);
+    }
+    if (c.circle)
+      j["circle"] = {{"plane", c.circle->plane},
+                     {"radius_mm", c.circle->radius_mm},
+                     {"feed_mm_per_min", c.circle->feed_mm_per_min},
+                     {"instruments", instruments_of("circle")}};
+    return j;
   }
 
   // Every configured device is opened while idle, so the page shows its state and values and
@@ -380,6 +425,7 @@ class Service {
                {"toml", check.toml},
                {"check", to_json(check)},
                {"source", source()},
+               {"version", setup_version_},
                {"simulated", o_.simulate},
                {"choices",
                 {{"standards", standards},
@@ -454,6 +500,7 @@ class Service {
     std::fflush(stdout);
     auto j = to_json(check);
     j["toml"] = check.toml;
+    j["version"] = setup_version_;
     return ok(j);
   }
 
@@ -671,6 +718,7 @@ class Service {
     if (config_.circle) j["tests"].push_back("circle");
     if (running()) j["run"] = {{"id", run_id_}, {"test", test_}};
     if (last_) j["last"] = *last_;
+    j["setup"] = setup_summary_;
     return j;
   }
 
@@ -928,6 +976,8 @@ class Service {
   std::int64_t run_id_ = 0;
   std::string test_;
   std::string run_live_;
+  json setup_summary_;  // summary_of(config_): what Start runs
+  int setup_version_ = 0;
   std::optional<json> last_;
   DeviceAllowList allowed_;
   std::atomic<int> printing_{0};
