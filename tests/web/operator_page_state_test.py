@@ -69,6 +69,7 @@ SEEN = """const g = id => document.getElementById(id);
   return {big: g('reading').textContent, unit: g('reading-unit').textContent,
           label: g('reading-label').textContent, progress: g('progress').textContent,
           line: g('run-line').textContent, banner: !g('stale').hidden,
+          origin: g('run-origin').hidden ? '' : g('run-origin').textContent,
           since: g('stale-since').textContent,
           lit: [...document.querySelectorAll('#indicator span.on')].map(e => e.dataset.motion),
           env: ['env-air', 'env-p', 'env-rh', 'env-n', 'env-material', 'env-factor'].map(i => g(i).textContent),
@@ -208,7 +209,32 @@ try:
        f"a finished run: COMPLETE ({s['label']}: {s['big']}, {s['progress']}, {s['line']})")
     m = re.fullmatch(r"(\d+) of (\d+) stops captured", s["progress"])
     ok(m and m.group(1) == m.group(2), f"all its stops: {s['progress']!r}")
+    ok(s["origin"].startswith("SIMULATED INSTRUMENTS: ") and "laser" in s["origin"],
+       f"the Run view says the instruments are simulated: {s['origin']!r}")
     shot(b, "s05-complete-1366x768.png")
+
+    # Its results: SIMULATED before anything else, the stops' check, the origin in the list.
+    b.js("document.getElementById('tab-results').click();")
+    b.wait("return document.getElementById('result-quality').textContent !== '' && "
+           "document.querySelectorAll('#runs tbody tr').length >= 2;", what="the results")
+    res = b.js("""const g = id => document.getElementById(id);
+        return {origin: g('result-origin').hidden ? null : g('result-origin').textContent,
+                quality: g('result-quality').textContent,
+                runs: [...document.querySelectorAll('#runs tbody tr')].map(r => r.cells[5].textContent)};""")
+    ok(res["origin"] and res["origin"].startswith("SIMULATED"), f"the results say SIMULATED: {res['origin']!r}")
+    ok(res["quality"].startswith("Stops checked: ok"), f"and the stops' check: {res['quality']!r}")
+    ok(res["runs"] and all(x == "SIMULATED" for x in res["runs"]), f"every stored run's origin listed: {res['runs']}")
+    time.sleep(1.0)  # the results view opened by the run's end has rendered too
+    # A suspect run (the simulated shop repeats to 0.001 um: none of its runs is suspect), on a
+    # hand-made document through the page's own rendering: each suspect stop named by its target.
+    suspect = b.js("""showQuality({id: 7, quality: {state: 'suspect', summary: 'suspect: 1 stop',
+            suspect_stops: [{run: 2, direction: 'up', target_index: 1,
+                             reason: 'run 2 up at 50 mm: +1.200 µm from the median of its target\\'s runs (limit 0.3)'}]}});
+        return document.getElementById('result-quality').textContent;""")
+    ok("SUSPECT STOPS: 1" in suspect and "target 2: run 2 up at 50 mm" in suspect and "--accept-suspect 7" in suspect,
+       f"a suspect run names its stops: {suspect!r}")
+    shot(b, "s05b-suspect-results-1366x768.png")
+    b.js("document.getElementById('tab-run').click();")
 
     # --- 4. Start runs what the operator sees: an unapplied edit is named, Start asks ---------
     b.js("document.getElementById('tab-setup').click();")

@@ -207,6 +207,7 @@ class Service {
       o_.run.poll_scale = 1.0;  // the instruments' timers wait in simulated time
       const auto text = simulated_shop_config(*shop_, {.speed = o_.speed, .in_process = true});
       use_config(cal::daq::parse_config(text, "simulated shop"));
+      for (const auto& d : config_.devices) twins_.push_back(device_address(d.transport));
     } else {
       use_config(cal::daq::load_config(o_.run.config));
       check_devices_at_start();
@@ -495,6 +496,7 @@ class Service {
     // The loader's devices, as they would be opened (the same texts; checked again all the same).
     if (const auto refused = allowed_.refusal(devices_of(*check.config)))
       return device_refused(*refused);
+    keep_twins_simulated(*check.config);
     use_config(std::move(*check.config));
     fmt::print("set-up applied from the web page\n");
     std::fflush(stdout);
@@ -502,6 +504,21 @@ class Service {
     j["toml"] = check.toml;
     j["version"] = setup_version_;
     return ok(j);
+  }
+
+  // "serial /dev/pts/3 4800 7E1" -> "serial /dev/pts/3": the device whatever its line settings.
+  static std::string device_address(std::string_view transport) {
+    const auto kind = transport.find(' ');
+    const auto end = kind == std::string_view::npos ? kind : transport.find(' ', kind + 1);
+    return std::string(transport.substr(0, end));
+  }
+
+  // A set-up applied from the page that names the simulated shop's twins reads simulated
+  // instruments, whatever the page sent: its runs must not be stored as real measurements.
+  void keep_twins_simulated(cal::daq::Config& c) const {
+    for (auto& d : c.devices)
+      if (std::find(twins_.begin(), twins_.end(), device_address(d.transport)) != twins_.end())
+        d.origin = "simulated";
   }
 
   static web::Response device_refused(const DeviceRefusal& r) {
@@ -580,14 +597,20 @@ class Service {
     json list = json::array();
     const auto db = read_store();
     if (db)
-      for (const auto& r : db->runs())
+      for (const auto& r : db->runs()) {
+        // Where its readings came from ("SIMULATED", "REPLAYED", ...; "" for real instruments):
+        // the list shows it beside every run, as everything derived from a run does.
+        const auto machine = db->machine(r.machine_id);
+        const auto origin = run_origin(r, db->instruments(r.id), machine ? machine->name : "");
         list.push_back({{"id", r.id},
                         {"kind", r.kind},
                         {"axis", r.axis},
                         {"campaign", r.campaign},
                         {"status", cal::storage::to_string(r.status)},
                         {"started_unix_ms", r.started_unix_ms},
-                        {"note", r.note}});
+                        {"note", r.note},
+                        {"origin", origin.label()}});
+      }
     return ok({{"schema", "caldaq.runs.v1"}, {"runs", list}});
   }
 
@@ -976,7 +999,8 @@ class Service {
   std::int64_t run_id_ = 0;
   std::string test_;
   std::string run_live_;
-  json setup_summary_;  // summary_of(config_): what Start runs
+  json setup_summary_;              // summary_of(config_): what Start runs
+  std::vector<std::string> twins_;  // --simulate: the shop's devices (device_address)
   int setup_version_ = 0;
   std::optional<json> last_;
   DeviceAllowList allowed_;
