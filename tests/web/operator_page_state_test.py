@@ -240,9 +240,23 @@ try:
     b.js("document.getElementById('tab-setup').click();")
     b.wait("return !!document.querySelector('[data-key=\"test.linear.last_mm\"]') && "
            "document.getElementById('setup-status').className === 'ok';", what="the set-up form")
+    # The test conditions the report states, in the form (checked by the loader, in the TOML).
+    ok(b.js(TYPE, "conditions.warm_up", "20 min at 50 % rapid") == "ok", "typed: the warm-up")
+    ok(b.js(TYPE, "conditions.controller_compensation", "off") == "ok", "chosen: controller compensation off")
+    toml = b.wait("return document.getElementById('setup-status').className === 'ok' && "
+                  "/controller_compensation = false/.test(window.caldaq.toml || '') && window.caldaq.toml;",
+                  what="the conditions in the TOML")
+    ok('warm_up = "20 min at 50 % rapid"' in toml, "the warm-up in the TOML the loader read")
+    labels = b.js("return ['conditions.warm_up', 'conditions.controller_compensation'].map(k => "
+                  "document.querySelector(`[data-field='${k}'] label`).textContent);")
+    ok(labels == ["Warm-up (what and how long)", "Controller compensation"], f"labelled in words: {labels}")
+    b.js(TYPE, "conditions.warm_up", "")
+    b.js(TYPE, "conditions.controller_compensation", "")
     ok(b.js(TYPE, "test.linear.last_mm", "50") == "ok", "typed: last target 50 mm (not applied)")
     b.js("document.getElementById('tab-run').click();")
-    b.wait("return !document.getElementById('pending-edits').hidden;", what="the edit named")
+    b.wait("const t = document.getElementById('pending-edits'); return !t.hidden && "
+           "/Last target/.test(t.textContent) && !/Warm-up/.test(t.textContent);",
+           what="the edit named (the conditions typed back to empty are no edit)")
     seen = b.js("return [document.getElementById('plan').textContent, "
                 "document.getElementById('pending-edits').textContent];")
     ok("axis X: 0.000 → 100.000 mm, 3 targets × 2 runs ↑↓ = 12 stops" in seen[0] and "laser (ids3010)" in seen[0],
