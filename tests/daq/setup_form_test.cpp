@@ -57,6 +57,7 @@ driver = "shdr"
 transport = "tcp 192.168.1.20:7878"
 key = "Xact"
 role = "position"
+origin = "simulated"
 [environment]
 equation = "edlen"
 stale_after_s = 20
@@ -111,6 +112,10 @@ TEST(SetupForm, AConfigurationSurvivesTheTripThroughTheForm) {
   EXPECT_EQ(again.customer.name, "ACME \"Precision\" Ltd");
   EXPECT_EQ(again.customer.site, "Plant 2\nhall B");
   EXPECT_EQ(again.devices.size(), 4u);
+  // A simulated twin stays one through the page's form (else a run of the simulated shop set
+  // up on the page would be stored as measured on real instruments).
+  EXPECT_EQ(again.device_for("position")->origin, "simulated");
+  EXPECT_EQ(again.device_for("laser")->origin, "real");
   // The drivers' own options (their registry tables) come through with the values given.
   EXPECT_EQ(again.device_for("material")->options.text("request"), "?\r");
   EXPECT_EQ(again.device_for("material")->options.text("pattern"), "T=([-0-9.]+)");

@@ -30,47 +30,26 @@ import subprocess
 import sys
 import tempfile
 import time
-import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(__file__))
-from webdriver import Browser, png_size  # noqa: E402
+import page_checks  # noqa: E402
+from page_checks import ok, post  # noqa: E402
+from webdriver import Browser  # noqa: E402
 
 DAQ, SHOTS = sys.argv[1], sys.argv[2]
 os.makedirs(SHOTS, exist_ok=True)
 TMP = tempfile.mkdtemp(prefix="operator-page-")
 SPEED = 100
-passes = 0
-
-
-def ok(cond, what):
-    global passes
-    if not cond:
-        raise AssertionError(what)
-    passes += 1
-    print("ok", what, flush=True)
 
 
 def shot(b, name):
-    path = os.path.join(SHOTS, name)
-    png = b.screenshot(path)
-    w, h = png_size(png)
-    ok(len(png) > 10000, f"screenshot {name} ({w}x{h})")
+    page_checks.shot(b, SHOTS, name)
 
 
 def fetch(url, timeout=60):
     with urllib.request.urlopen(url, timeout=timeout) as r:
         return r.status, r.headers.get("Content-Type", ""), r.read()
-
-
-def post(url, body):
-    req = urllib.request.Request(url, data=json.dumps(body).encode(), method="POST",
-                                 headers={"Content-Type": "application/json"})
-    try:
-        with urllib.request.urlopen(req, timeout=30) as r:
-            return r.status, json.load(r)
-    except urllib.error.HTTPError as e:
-        return e.code, json.load(e)
 
 
 # Sets a form field as typing would (the page checks the set-up on each input event).
@@ -331,6 +310,7 @@ try:
             s = b.js("""const p = window.caldaq.page, r = p.run || {};
                 return {running: p.status.running, last: p.status.last || null,
                         motion: r.motion ? r.motion.state : null, display: r.display || null,
+                        captured: (r.stops || []).filter(x => !x.missed).map(x => x.deviation_um).pop(),
                         big: document.getElementById('reading').textContent,
                         label: document.getElementById('reading-label').textContent,
                         fits: document.getElementById('big').scrollWidth <= document.getElementById('big').clientWidth,
@@ -359,11 +339,14 @@ try:
         d = at_stop["display"]
         value = float(at_stop["big"])
         # The simulated truth at 0 .. 100 mm: 8 um/m scale, 1 um pitch error, 4 um backlash:
-        # every stop within +-4 um.
-        ok(d["mode"] == "deviation" and at_stop["label"].startswith("Deviation from")
+        # every stop within +-4 um. STABLE shows the live deviation from the target; CAPTURED
+        # the captured stop's value with its target (issue 29).
+        label = "Captured at" if at_stop["motion"] == "captured" else "Deviation from"
+        ok(d["mode"] == "deviation" and at_stop["label"].startswith(label)
            and abs(value) < 5.0, f"at a stop the number is a deviation: {at_stop['label']}: "
            f"{at_stop['big']} µm")
-        ok(abs(value - d["value"]) < 0.006, "the number shown is the live value")
+        shown = at_stop["captured"] if at_stop["motion"] == "captured" else d["value"]
+        ok(abs(value - shown) < 0.006, "the number shown is the live value or, at CAPTURED, the captured one")
         ok(all(x["fits"] for x in shots.values()),
            f"the number and its unit fit the panel: {[(k, x['big'], x['fits']) for k, x in shots.items()]}")
         moving = shots.get("moving")
@@ -478,15 +461,11 @@ try:
         ok(dying["before"] == "1.23" and dying["after"] == "—" and "silent" in dying["label"],
            f"a laser that falls silent during a run: dashes and why, not its last value: {dying}")
         ok(b.js("return JSON.stringify(window.__errors);") == "[]", "no script error on the page")
-    print(f"operator page: {passes} checks passed; screenshots in {SHOTS}")
+    print(f"operator page: {page_checks.passes} checks passed; screenshots in {SHOTS}")
 finally:
     try:
         browser.result(timeout=30).close()  # closed already unless the service failed to start
     except Exception:
         pass
-    serve.send_signal(signal.SIGTERM)
-    try:
-        serve.wait(timeout=30)
-    except subprocess.TimeoutExpired:
-        serve.kill()
+    page_checks.stop_service(serve)
     shutil.rmtree(TMP, ignore_errors=True)

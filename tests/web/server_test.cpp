@@ -8,6 +8,7 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <functional>
 #include <thread>
 
 #include "assets.hpp"
@@ -182,6 +183,35 @@ TEST(LiveServer, WebSocketGetsTheLatestStateNotAQueue) {
   }
   EXPECT_LE(messages, 4);
   ws.close(websocket::close_code::normal);
+}
+
+// A state that does not change is sent again at the keep-alive period: the page turns its values
+// into dashes after 2 s without a message, so silence must mean a dead or hung service, never
+// an idle one.
+TEST(LiveServer, UnchangedStateIsResentAtTheKeepAlivePeriod) {
+  Running r({.port = 0, .push_period = 20ms, .keepalive_period = 200ms});
+  asio::io_context io;
+  websocket::stream<tcp::socket> ws(io);
+  ws.next_layer().connect({asio::ip::address_v4::loopback(), r.server->port()});
+  ws.handshake("localhost", "/ws");
+  r.publish(R"({"same": 1})");
+  int messages = 0;
+  std::string last;
+  const auto start = std::chrono::steady_clock::now();
+  beast::flat_buffer buffer;
+  std::function<void(beast::error_code, std::size_t)> on_read = [&](beast::error_code ec,
+                                                                    std::size_t) {
+    if (ec) return;
+    last = beast::buffers_to_string(buffer.data());
+    buffer.consume(buffer.size());
+    if (++messages < 3) ws.async_read(buffer, on_read);
+  };
+  ws.async_read(buffer, on_read);
+  io.run_for(2s);  // three messages at 200 ms need about 0.4 s; none after the first before
+  const auto took = std::chrono::steady_clock::now() - start;
+  EXPECT_EQ(messages, 3) << "the unchanged state was not sent again";
+  EXPECT_EQ(last, R"({"same": 1})");
+  EXPECT_LT(took, 1500ms);
 }
 
 TEST(OperatorPage, IsOneSelfContainedDocument) {

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
@@ -32,9 +33,9 @@
 #include "circle_run.hpp"
 #include "database.hpp"
 #include "devices_list.hpp"
+#include "json_input.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
-#include "json_input.hpp"
 #include "provenance.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
@@ -206,6 +207,7 @@ class Service {
       o_.run.poll_scale = 1.0;  // the instruments' timers wait in simulated time
       const auto text = simulated_shop_config(*shop_, {.speed = o_.speed, .in_process = true});
       use_config(cal::daq::parse_config(text, "simulated shop"));
+      for (const auto& d : config_.devices) twins_.push_back(device_address(d.transport));
     } else {
       use_config(cal::daq::load_config(o_.run.config));
       check_devices_at_start();
@@ -318,7 +320,51 @@ class Service {
     monitors_.clear();
     config_ = std::move(c);
     board_ = std::make_shared<DeviceBoard>(config_);
+    setup_summary_ = summary_of(config_, ++setup_version_);
     start_monitors();
+  }
+
+  // What Start runs, for the page's Run view (in every status: a set-up applied from another
+  // page shows at once): each test's axis or plane, range, targets, runs and instruments; the
+  // version counts the set-ups applied, so a page knows its form's base is outdated.
+  static json summary_of(const cal::daq::Config& c, int version) {
+    json j{{"version", version}, {"instruments", json::array()}};
+    for (const auto& d : c.devices)
+      j["instruments"].push_back(
+          {{"id", d.id}, {"driver", d.driver}, {"role", d.role}, {"origin", d.origin}});
+    const auto instruments_of = [&](std::string_view test) {
+      json ids = json::array();
+      for (const auto& d : c.devices)
+        if (uses(test, d)) ids.push_back(d.id);
+      return ids;
+    };
+    if (c.linear) {
+      const auto& l = *c.linear;
+      json t{{"axis", l.axis},
+             {"first_mm", l.first_mm},
+             {"last_mm", l.last_mm},
+             {"runs", l.runs},
+             {"bidirectional", l.bidirectional},
+             {"cycle", l.cycle},
+             {"feed_mm_per_min", l.feed_mm_per_min},
+             {"instruments", instruments_of("linear")}};
+      try {
+        const auto plan = linear_plan(l);
+        t["targets"] = plan.targets_mm.size();
+        t["stops"] = std::count_if(plan.moves.begin(), plan.moves.end(), [](const auto& m) {
+          return m.kind == cal::iso230_2::MoveKind::measure;
+        });
+      } catch (const cal::InputError& e) {
+        t["problem"] = e.what();  // Start names it too
+      }
+      j["linear"] = std::move(t);
+    }
+    if (c.circle)
+      j["circle"] = {{"plane", c.circle->plane},
+                     {"radius_mm", c.circle->radius_mm},
+                     {"feed_mm_per_min", c.circle->feed_mm_per_min},
+                     {"instruments", instruments_of("circle")}};
+    return j;
   }
 
   // Every configured device is opened while idle, so the page shows its state and values and
@@ -380,6 +426,7 @@ class Service {
                {"toml", check.toml},
                {"check", to_json(check)},
                {"source", source()},
+               {"version", setup_version_},
                {"simulated", o_.simulate},
                {"choices",
                 {{"standards", standards},
@@ -449,12 +496,29 @@ class Service {
     // The loader's devices, as they would be opened (the same texts; checked again all the same).
     if (const auto refused = allowed_.refusal(devices_of(*check.config)))
       return device_refused(*refused);
+    keep_twins_simulated(*check.config);
     use_config(std::move(*check.config));
     fmt::print("set-up applied from the web page\n");
     std::fflush(stdout);
     auto j = to_json(check);
     j["toml"] = check.toml;
+    j["version"] = setup_version_;
     return ok(j);
+  }
+
+  // "serial /dev/pts/3 4800 7E1" -> "serial /dev/pts/3": the device whatever its line settings.
+  static std::string device_address(std::string_view transport) {
+    const auto kind = transport.find(' ');
+    const auto end = kind == std::string_view::npos ? kind : transport.find(' ', kind + 1);
+    return std::string(transport.substr(0, end));
+  }
+
+  // A set-up applied from the page that names the simulated shop's twins reads simulated
+  // instruments, whatever the page sent: its runs must not be stored as real measurements.
+  void keep_twins_simulated(cal::daq::Config& c) const {
+    for (auto& d : c.devices)
+      if (std::find(twins_.begin(), twins_.end(), device_address(d.transport)) != twins_.end())
+        d.origin = "simulated";
   }
 
   static web::Response device_refused(const DeviceRefusal& r) {
@@ -533,14 +597,20 @@ class Service {
     json list = json::array();
     const auto db = read_store();
     if (db)
-      for (const auto& r : db->runs())
+      for (const auto& r : db->runs()) {
+        // Where its readings came from ("SIMULATED", "REPLAYED", ...; "" for real instruments):
+        // the list shows it beside every run, as everything derived from a run does.
+        const auto machine = db->machine(r.machine_id);
+        const auto origin = run_origin(r, db->instruments(r.id), machine ? machine->name : "");
         list.push_back({{"id", r.id},
                         {"kind", r.kind},
                         {"axis", r.axis},
                         {"campaign", r.campaign},
                         {"status", cal::storage::to_string(r.status)},
                         {"started_unix_ms", r.started_unix_ms},
-                        {"note", r.note}});
+                        {"note", r.note},
+                        {"origin", origin.label()}});
+      }
     return ok({{"schema", "caldaq.runs.v1"}, {"runs", list}});
   }
 
@@ -671,6 +741,7 @@ class Service {
     if (config_.circle) j["tests"].push_back("circle");
     if (running()) j["run"] = {{"id", run_id_}, {"test", test_}};
     if (last_) j["last"] = *last_;
+    j["setup"] = setup_summary_;
     return j;
   }
 
@@ -928,6 +999,9 @@ class Service {
   std::int64_t run_id_ = 0;
   std::string test_;
   std::string run_live_;
+  json setup_summary_;              // summary_of(config_): what Start runs
+  std::vector<std::string> twins_;  // --simulate: the shop's devices (device_address)
+  int setup_version_ = 0;
   std::optional<json> last_;
   DeviceAllowList allowed_;
   std::atomic<int> printing_{0};

@@ -35,6 +35,8 @@ json device_json(const cal::daq::DeviceConfig& d) {
   const cal::daq::DeviceConfig def;
   json j{{"driver", d.driver}, {"transport", d.transport}};
   put_text(j, "role", d.role);
+  // A simulated twin's origin goes through the form (a run records it: docs/storage.md "Origin").
+  put(j, "origin", d.origin, def.origin);
   put(j, "poll_s", d.poll_s, def.poll_s);
   // The driver's own options as the file gave them (the others keep the table's defaults).
   for (const auto& [name, value] : d.options.values())

@@ -444,8 +444,12 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     timer.expires_after(options.push_period);
     timer.async_wait([self = shared_from_this()](boost::system::error_code ec) {
       if (ec) return;
-      if (self->changed) {
+      const auto now = Clock::now();
+      const bool keepalive =
+          !self->latest.empty() && now - self->last_push >= self->options.keepalive_period;
+      if (self->changed || keepalive) {
         self->changed = false;
+        self->last_push = now;
         for (auto& c : self->clients)
           if (c->ws.is_open()) self->send(c);
       }
@@ -473,6 +477,7 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
   std::list<std::shared_ptr<WsClient>> clients;
   std::string latest;
   bool changed = false;
+  Clock::time_point last_push{};  // the latest state's last push to the clients
   std::uint64_t sent = 0, refused = 0, accept_errors = 0, evicted = 0;
   // A WebSocket whose message has been in flight this long does not read: the first closed.
   static constexpr auto stall_after = std::chrono::seconds(1);

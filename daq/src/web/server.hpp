@@ -48,6 +48,9 @@ struct ServerOptions {
   std::uint16_t port = 8080;  // 0: an ephemeral port (see port())
   std::string token;          // required when address is not a loopback address
   std::chrono::milliseconds push_period{100};
+  // The latest state is sent again after this without a change: a page that hears nothing for
+  // longer knows the service is gone or hung, not idle (docs/web.md, "Updates").
+  std::chrono::milliseconds keepalive_period{1000};
   std::vector<std::string> allowed_hosts;  // Host names accepted beside localhost and the address
   std::size_t max_header_bytes = 8 * 1024;
   std::size_t max_body_bytes = 64 * 1024;

@@ -1,0 +1,48 @@
+"""What the operator-page tests share: a counted check, a screenshot that must not be blank, and a
+JSON POST that returns (status, body) for errors too."""
+import json
+import os
+import signal
+import subprocess
+import urllib.error
+import urllib.request
+
+from webdriver import png_size
+
+passes = 0
+
+
+def ok(cond, what):
+    global passes
+    if not cond:
+        raise AssertionError(what)
+    passes += 1
+    print("ok", what, flush=True)
+
+
+def shot(b, directory, name):
+    png = b.screenshot(os.path.join(directory, name))
+    w, h = png_size(png)
+    ok(len(png) > 10000, f"screenshot {name} ({w}x{h})")
+
+
+def post(url, body):
+    req = urllib.request.Request(url, data=json.dumps(body).encode(), method="POST",
+                                 headers={"Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=30) as r:
+            return r.status, json.load(r)
+    except urllib.error.HTTPError as e:
+        return e.code, json.load(e)
+
+
+def stop_service(proc):
+    """Ends a `daq serve` the test started (continued first, in case a test stopped it)."""
+    if proc.poll() is not None:
+        return
+    proc.send_signal(signal.SIGCONT)
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
