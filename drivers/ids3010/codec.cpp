@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -106,6 +107,180 @@ bool has_control_bytes(std::string_view line) {
   return false;
 }
 
+// Every request name of kMethods in both generations, built once: replay recognises a recorded
+// request by comparing its method with these (the order is that of kMethods, ids before sen).
+struct KnownRequest {
+  std::string name;
+  const MethodInfo* method;
+  IdsApi api;
+};
+
+const KnownRequest* find_request(std::string_view name) {
+  static const std::vector<KnownRequest> table = [] {
+    std::vector<KnownRequest> t;
+    for (const auto& m : kMethods)
+      for (const IdsApi api : {IdsApi::ids, IdsApi::sen})
+        if (api == IdsApi::ids || m.interface == Interface::generation)
+          t.push_back({full_name(m, api), &m, api});
+    return t;
+  }();
+  for (const auto& k : table)
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+// The one-pass reader of the lines caldaq and the device write: a JSON object whose members
+// are strings of printable ASCII without escapes, numbers, or arrays of numbers, no key twice.
+// Anything else (escapes, nesting, booleans, null, numbers needing more than an int64 or that
+// from_chars will not round, a BOM) is not taken, and the line goes to the full JSON parser:
+// what the fast path takes, the parser reads to the same values, so its result is the parser's.
+struct FlatNumber {
+  bool integer = false;  // no fraction or exponent and at most 18 digits (exact in int64)
+  std::int64_t i = 0;
+  double d = 0;  // as nlohmann's get<double>() gives it (strtod and from_chars both round)
+};
+
+struct FlatValue {
+  enum class Type { string, number, array } type = Type::string;
+  std::string_view text;             // a string's characters
+  FlatNumber number;                 // a number
+  std::size_t first = 0, count = 0;  // an array's elements in FlatObject::elements
+};
+
+struct FlatObject {
+  static constexpr std::size_t max_members = 6, max_elements = 8;
+  std::array<std::string_view, max_members> keys{};
+  std::array<FlatValue, max_members> values{};
+  std::size_t members = 0;
+  std::array<FlatNumber, max_elements> elements{};
+  std::size_t element_count = 0;
+
+  const FlatValue* find(std::string_view key) const {
+    for (std::size_t m = 0; m < members; ++m)
+      if (keys[m] == key) return &values[m];
+    return nullptr;
+  }
+  std::span<const FlatNumber> elements_of(const FlatValue& array) const {
+    return std::span(elements).subspan(array.first, array.count);
+  }
+};
+
+class FlatScanner {
+ public:
+  explicit FlatScanner(std::string_view s) : s_(s) {}
+
+  // True if the whole of s is such an object (with JSON white space around and inside).
+  bool object(FlatObject& o) {
+    if (!eat('{')) return false;
+    if (eat('}')) return at_end();
+    do {
+      if (o.members == FlatObject::max_members) return false;
+      std::string_view key;
+      if (!peek('"') || !string(key) || o.find(key) != nullptr || !eat(':')) return false;
+      FlatValue& v = o.values[o.members];
+      if (!value(o, v)) return false;
+      o.keys[o.members++] = key;
+    } while (eat(','));
+    return eat('}') && at_end();
+  }
+
+ private:
+  void space() {
+    while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\n' || s_[i_] == '\r'))
+      ++i_;
+  }
+  bool peek(char c) {
+    space();
+    return i_ < s_.size() && s_[i_] == c;
+  }
+  bool eat(char c) {
+    if (!peek(c)) return false;
+    ++i_;
+    return true;
+  }
+  bool at_end() {
+    space();
+    return i_ == s_.size();
+  }
+  bool digit() const { return i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9'; }
+
+  bool value(FlatObject& o, FlatValue& v) {
+    if (peek('"')) {
+      v.type = FlatValue::Type::string;
+      return string(v.text);
+    }
+    if (eat('[')) {
+      v.type = FlatValue::Type::array;
+      v.first = o.element_count;
+      if (!eat(']')) {
+        do {
+          if (o.element_count == FlatObject::max_elements) return false;
+          if (!number(o.elements[o.element_count++])) return false;
+        } while (eat(','));
+        if (!eat(']')) return false;
+      }
+      v.count = o.element_count - v.first;
+      return true;
+    }
+    v.type = FlatValue::Type::number;
+    return number(v.number);
+  }
+
+  // At the opening quote: printable ASCII up to the closing one, no escapes.
+  bool string(std::string_view& out) {
+    const std::size_t start = ++i_;
+    while (i_ < s_.size() && s_[i_] != '"') {
+      const auto u = static_cast<unsigned char>(s_[i_]);
+      if (u < 0x20 || u > 0x7e || u == '\\') return false;
+      ++i_;
+    }
+    if (i_ == s_.size()) return false;
+    out = s_.substr(start, i_++ - start);
+    return true;
+  }
+
+  // A JSON number (RFC 8259 section 6): -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)?
+  bool number(FlatNumber& n) {
+    space();
+    const std::size_t start = i_;
+    if (i_ < s_.size() && s_[i_] == '-') ++i_;
+    const std::size_t int_start = i_;
+    if (!digit()) return false;
+    if (s_[i_++] != '0')
+      while (digit()) ++i_;
+    const std::size_t int_digits = i_ - int_start;
+    bool fraction_or_exponent = false;
+    if (i_ < s_.size() && s_[i_] == '.') {
+      ++i_;
+      if (!digit()) return false;
+      while (digit()) ++i_;
+      fraction_or_exponent = true;
+    }
+    if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
+      ++i_;
+      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
+      if (!digit()) return false;
+      while (digit()) ++i_;
+      fraction_or_exponent = true;
+    }
+    const char* first = s_.data() + start;
+    const char* last = s_.data() + i_;
+    if (!fraction_or_exponent) {
+      if (int_digits > 18) return false;  // the parser's uint64 or double: left to it
+      n.integer = true;
+      std::from_chars(first, last, n.i);  // cannot fail: at most 18 digits
+      n.d = static_cast<double>(n.i);
+      return true;
+    }
+    n.integer = false;
+    const auto [end, ec] = std::from_chars(first, last, n.d);
+    return ec == std::errc{} && end == last;  // out of range: the parser decides
+  }
+
+  std::string_view s_;
+  std::size_t i_ = 0;
+};
+
 }  // namespace
 
 std::string_view to_string(IdsApi api) {
@@ -198,28 +373,41 @@ std::vector<std::string_view> json_objects(std::string_view text) {
 
 void IdsCodec::note_requests(std::span<const std::byte> bytes) {
   sent_splitter_.feed(
-      bytes,
-      [&](std::string_view line, std::uint64_t) {
-        const auto j = nlohmann::json::parse(line, nullptr, false);
-        if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j.contains("method"))
-          return;
-        if (!j["id"].is_number_integer() || !j["method"].is_string()) return;
-        const auto name = j["method"].get<std::string>();
-        for (const auto& m : kMethods)
-          for (const IdsApi api : {IdsApi::ids, IdsApi::sen}) {
-            if (full_name(m, api) != name) continue;
-            const auto id = j["id"].get<std::int64_t>();
-            Pending p{m.method, api, {}};
-            if (const auto params = j.find("params"); params != j.end() && params->is_array())
-              for (const auto& e : *params)
-                if (e.is_number_integer()) p.params.push_back(e.get<std::int64_t>());
-            remember(id, std::move(p));
-            next_id_ = std::max(next_id_, id + 1);
-            if (m.interface == Interface::generation) api_ = api;  // the session's generation
-            break;
-          }
-      },
+      bytes, [&](std::string_view line, std::uint64_t) { note_request(line); },
       [](std::uint64_t) {});
+}
+
+void IdsCodec::note_request(std::string_view line) {
+  // The request lines encode() writes are taken in one pass; others (attocube's client puts
+  // spaces and "api" before "id") go through the JSON parser, with the same result.
+  if (FlatObject o; FlatScanner(line).object(o)) {
+    const FlatValue* id = o.find("id");
+    const FlatValue* method = o.find("method");
+    if (id == nullptr || method == nullptr || id->type != FlatValue::Type::number ||
+        !id->number.integer || method->type != FlatValue::Type::string)
+      return;
+    std::vector<std::int64_t> params;
+    if (const FlatValue* p = o.find("params"); p != nullptr && p->type == FlatValue::Type::array)
+      for (const FlatNumber& e : o.elements_of(*p))
+        if (e.integer) params.push_back(e.i);
+    return learn(id->number.i, method->text, std::move(params));
+  }
+  const auto j = nlohmann::json::parse(line, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j.contains("method")) return;
+  if (!j["id"].is_number_integer() || !j["method"].is_string()) return;
+  std::vector<std::int64_t> params;
+  if (const auto p = j.find("params"); p != j.end() && p->is_array())
+    for (const auto& e : *p)
+      if (e.is_number_integer()) params.push_back(e.get<std::int64_t>());
+  learn(j["id"].get<std::int64_t>(), j["method"].get_ref<const std::string&>(), std::move(params));
+}
+
+void IdsCodec::learn(std::int64_t id, std::string_view method, std::vector<std::int64_t> params) {
+  const KnownRequest* known = find_request(method);
+  if (known == nullptr) return;  // not a request of ours: ignored
+  remember(id, Pending{known->method->method, known->api, std::move(params)});
+  next_id_ = std::max(next_id_, id + 1);
+  if (known->method->interface == Interface::generation) api_ = known->api;  // the session's
 }
 
 void IdsCodec::do_feed(std::span<const std::byte> bytes, std::vector<IdsResponse>& frames,
@@ -234,8 +422,49 @@ void IdsCodec::do_feed(std::span<const std::byte> bytes, std::vector<IdsResponse
       });
 }
 
+// result[] of an answer, read by the fast path (numbers only) or by the JSON parser.
+class IdsCodec::ResultView {
+ public:
+  explicit ResultView(const nlohmann::json& array) : json_(&array) {}
+  explicit ResultView(std::span<const FlatNumber> numbers) : numbers_(numbers) {}
+
+  std::size_t size() const { return json_ != nullptr ? json_->size() : numbers_.size(); }
+  bool is_integer(std::size_t i) const {
+    return json_ != nullptr ? (*json_)[i].is_number_integer() : numbers_[i].integer;
+  }
+  std::int64_t integer(std::size_t i) const {
+    return json_ != nullptr ? (*json_)[i].get<std::int64_t>() : numbers_[i].i;
+  }
+  bool is_number(std::size_t i) const { return json_ == nullptr || (*json_)[i].is_number(); }
+  double number(std::size_t i) const {
+    return json_ != nullptr ? (*json_)[i].get<double>() : numbers_[i].d;
+  }
+  bool is_boolean(std::size_t i) const { return json_ != nullptr && (*json_)[i].is_boolean(); }
+  bool boolean(std::size_t i) const { return (*json_)[i].get<bool>(); }
+  bool is_string(std::size_t i) const { return json_ != nullptr && (*json_)[i].is_string(); }
+  std::string string(std::size_t i) const { return (*json_)[i].get<std::string>(); }
+  std::string dump(std::size_t i) const { return json_ != nullptr ? (*json_)[i].dump() : ""; }
+
+ private:
+  const nlohmann::json* json_ = nullptr;
+  std::span<const FlatNumber> numbers_;
+};
+
 void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
                            std::vector<IdsResponse>& frames, std::vector<CodecError>& errors) {
+  // The answers the device writes ({"jsonrpc":"2.0","result":[0,...],"id":n}, members in any
+  // order) in one pass; everything else through the JSON parser. A line the fast path takes
+  // has no control bytes (its strings are printable, its white space cannot be in a line).
+  if (FlatObject o; FlatScanner(line).object(o)) {
+    const FlatValue* id = o.find("id");
+    const FlatValue* res = o.find("result");
+    if (id != nullptr && id->type == FlatValue::Type::number && id->number.integer &&
+        res != nullptr && res->type == FlatValue::Type::array) {
+      if (auto r = take_pending(id->number.i, offset, errors))
+        decode_result(std::move(*r), ResultView(o.elements_of(*res)), offset, frames, errors);
+      return;
+    }
+  }
   if (has_control_bytes(line)) {
     report(errors, ErrorKind::garbage, offset, "IDS: control bytes in a JSON line");
     return;
@@ -250,18 +479,9 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
     report(errors, ErrorKind::malformed, offset, "IDS: response without an integer id");
     return;
   }
-  IdsResponse r;
-  r.id = id_it->get<std::int64_t>();
-  const auto pending = pending_.find(r.id);
-  if (pending == pending_.end()) {
-    report(errors, ErrorKind::malformed, offset,
-           fmt::format("IDS: response id {} matches no pending request", r.id));
-    return;
-  }
-  r.method = pending->second.method;
-  r.api = pending->second.api;
-  r.params = std::move(pending->second.params);
-  pending_.erase(pending);
+  auto pending = take_pending(id_it->get<std::int64_t>(), offset, errors);
+  if (!pending) return;
+  IdsResponse& r = *pending;
 
   // A JSON-RPC 2.0 error object (jsonrpc.org/specification, 5.1) instead of a result.
   if (const auto e = j.find("error"); e != j.end() && e->is_object()) {
@@ -274,21 +494,49 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
     return;
   }
   const auto res = j.find("result");
-  if (res == j.end() || !res->is_array() || res->empty() || !(*res)[0].is_number_integer()) {
-    report(errors, ErrorKind::malformed, offset,
-           fmt::format("IDS: response id {} has no result array with an error code", r.id));
+  if (res == j.end() || !res->is_array()) {
+    report_no_result(r.id, offset, errors);
     return;
   }
-  r.error_code = (*res)[0].get<std::int64_t>();
+  decode_result(std::move(r), ResultView(*res), offset, frames, errors);
+}
+
+std::optional<IdsResponse> IdsCodec::take_pending(std::int64_t id, std::uint64_t offset,
+                                                  std::vector<CodecError>& errors) {
+  const auto pending = pending_.find(id);
+  if (pending == pending_.end()) {
+    report(errors, ErrorKind::malformed, offset,
+           fmt::format("IDS: response id {} matches no pending request", id));
+    return std::nullopt;
+  }
+  IdsResponse r;
+  r.id = id;
+  r.method = pending->second.method;
+  r.api = pending->second.api;
+  r.params = std::move(pending->second.params);
+  pending_.erase(pending);
+  return r;
+}
+
+void IdsCodec::report_no_result(std::int64_t id, std::uint64_t offset,
+                                std::vector<CodecError>& errors) {
+  report(errors, ErrorKind::malformed, offset,
+         fmt::format("IDS: response id {} has no result array with an error code", id));
+}
+
+void IdsCodec::decode_result(IdsResponse r, const ResultView& res, std::uint64_t offset,
+                             std::vector<IdsResponse>& frames, std::vector<CodecError>& errors) {
+  if (res.size() == 0 || !res.is_integer(0)) return report_no_result(r.id, offset, errors);
+  r.error_code = res.integer(0);
   const ResultKind kind = info(r.method).result;
   const std::size_t needed = kind == ResultKind::none ? 0 : kind == ResultKind::three_pm ? 3 : 1;
   // With a non-zero code the device may leave the values out; that is its answer, not ours
   // to reject.
-  if (res->size() < needed + 1) {
+  if (res.size() < needed + 1) {
     if (r.error_code == 0) {
       report(errors, ErrorKind::malformed, offset,
              fmt::format("IDS: {} result has {} values, {} expected", method_name(r.method, r.api),
-                         res->size() - 1, needed));
+                         res.size() - 1, needed));
       return;
     }
     emit(frames, std::move(r));
@@ -296,13 +544,12 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
   }
   auto number = [&](std::size_t i, std::string_view what, double scale, double lo,
                     double hi) -> std::optional<double> {
-    const auto& v = (*res)[i];
-    if (!v.is_number()) {
+    if (!res.is_number(i)) {
       report(errors, ErrorKind::malformed, offset,
-             fmt::format("IDS: {} is not a number: {}", what, v.dump()));
+             fmt::format("IDS: {} is not a number: {}", what, res.dump(i)));
       return std::nullopt;
     }
-    const double x = v.get<double>() * scale;
+    const double x = res.number(i) * scale;
     if (!std::isfinite(x) || x < lo || x > hi) {
       report(errors, ErrorKind::out_of_range, offset,
              fmt::format("IDS: {} = {} outside [{}, {}]", what, x, lo, hi));
@@ -316,8 +563,10 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
       break;
     case ResultKind::three_pm:
       for (std::size_t a = 0; a < 3; ++a) {
-        r.displacement_m[a] = number(a + 1, fmt::format("axis {} displacement (m)", a),
-                                     kMetresPerPicometre, -dmax, dmax);
+        // Named without formatting: this runs for every reading.
+        static constexpr std::string_view kWhat[] = {
+            "axis 0 displacement (m)", "axis 1 displacement (m)", "axis 2 displacement (m)"};
+        r.displacement_m[a] = number(a + 1, kWhat[a], kMetresPerPicometre, -dmax, dmax);
       }
       break;
     case ResultKind::one_pm:
@@ -340,15 +589,15 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
                                   limits_.max_refractive_index);
       break;
     case ResultKind::flag:
-      if ((*res)[1].is_boolean()) {
-        r.flag = (*res)[1].get<bool>();
+      if (res.is_boolean(1)) {
+        r.flag = res.boolean(1);
       } else {
         report(errors, ErrorKind::malformed, offset, "IDS: flag result is not a boolean");
       }
       break;
     case ResultKind::text:
-      if ((*res)[1].is_string()) {
-        r.text = (*res)[1].get<std::string>();
+      if (res.is_string(1)) {
+        r.text = res.string(1);
         if (r.method == IdsMethod::get_current_mode) r.mode = r.text;
       } else {
         report(errors, ErrorKind::malformed, offset, "IDS: text result is not a string");

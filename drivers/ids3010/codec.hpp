@@ -121,7 +121,8 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
   std::int64_t last_id() const { return next_id_ - 1; }
   // Replay: learns the requests of a recorded session from the bytes that were sent (request
   // lines as encode() writes them, of either generation), so that their answers match.
-  // Unknown lines are ignored.
+  // Unknown lines are ignored. The lines encode() writes are recognised in one pass (their
+  // method compared with a table built once), others through the JSON parser.
   void note_requests(std::span<const std::byte> bytes);
   std::size_t pending() const { return pending_.size(); }
 
@@ -129,8 +130,18 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
                std::vector<CodecError>& errors);
 
  private:
+  class ResultView;  // result[] as the one-pass reader or the JSON parser gives it (codec.cpp)
+
+  void note_request(std::string_view line);
+  void learn(std::int64_t id, std::string_view method, std::vector<std::int64_t> params);
   void decode_line(std::string_view line, std::uint64_t offset, std::vector<IdsResponse>& frames,
                    std::vector<CodecError>& errors);
+  // The pending request answered by `id`, forgotten; nullopt (and an error) if there is none.
+  std::optional<IdsResponse> take_pending(std::int64_t id, std::uint64_t offset,
+                                          std::vector<CodecError>& errors);
+  void report_no_result(std::int64_t id, std::uint64_t offset, std::vector<CodecError>& errors);
+  void decode_result(IdsResponse r, const ResultView& res, std::uint64_t offset,
+                     std::vector<IdsResponse>& frames, std::vector<CodecError>& errors);
 
   IdsLimits limits_;
   LineSplitter splitter_;

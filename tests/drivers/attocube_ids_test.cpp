@@ -1,9 +1,15 @@
 // Attocube IDS3010 JSON-RPC codec: requests as attocube's own wrappers write them, answers as
 // the device sends them (result[0] the error code, displacements in picometres), then every
 // kind of bad answer. Expected values by hand in the comments.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/registry.hpp"
@@ -218,6 +224,185 @@ TEST(IdsCodec, JsonObjectsOfALineBracesInStringsAndStrayText) {
   EXPECT_EQ(json_objects(R"(junk{"a":1}{"b":)"),
             (std::vector<std::string_view>{"junk", R"({"a":1})", R"({"b":)"}));
   EXPECT_TRUE(json_objects(" \t").empty());
+}
+
+// The requests replay learns are recognised in one pass where they are as encode() writes them
+// and through the JSON parser otherwise; every form must be learnt exactly as the parser reads
+// it (the reference below is the parser and every method's full name, as before the fast path).
+struct Learnt {
+  bool known = false;
+  std::int64_t id = 0;
+  IdsMethod method{};
+  IdsApi api{};
+  std::vector<std::int64_t> params;
+};
+
+Learnt reference_request(std::string_view line) {
+  const auto j = nlohmann::json::parse(line, nullptr, false);
+  Learnt l;
+  if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j.contains("method") ||
+      !j["id"].is_number_integer() || !j["method"].is_string())
+    return l;
+  for (int m = 0; m <= static_cast<int>(IdsMethod::error_number_to_string) && !l.known; ++m)
+    for (const IdsApi api : {IdsApi::ids, IdsApi::sen})
+      if (method_name(static_cast<IdsMethod>(m), api) == j["method"].get<std::string>()) {
+        l = {true, j["id"].get<std::int64_t>(), static_cast<IdsMethod>(m), api, {}};
+        if (j.contains("params") && j["params"].is_array())
+          for (const auto& e : j["params"])
+            if (e.is_number_integer()) l.params.push_back(e.get<std::int64_t>());
+        break;
+      }
+  return l;
+}
+
+TEST(IdsCodec, RecordedRequestsAreLearntAsTheJsonParserReadsThem) {
+  const std::string_view lines[] = {
+      // As encode() writes them, both generations, the ECU, params.
+      R"({"jsonrpc":"2.0","method":"com.attocube.sen.displacement.getAxesDisplacement","params":[],"id":41,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ids.displacement.getAxisDisplacement","params":[2],"id":42,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.system.errorNumberToString","params":[1,-7],"id":43,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.getPressureInHPa","params":[],"id":44,"api":2})",
+      // attocube's client (spaces, "api" before "id", no params), members in any order.
+      R"({"jsonrpc": "2.0", "method": "com.attocube.ecu.getTemperatureInDegrees", "api": 2, "id": 45})",
+      R"( { "id" : 46 , "method" : "com.attocube.sen.system.getCurrentMode" } )",
+      // Params the parser does not count: a fraction, an exponent, a boolean, a string.
+      R"({"method":"com.attocube.system.errorNumberToString","params":[1.0,2e0,3],"id":47})",
+      R"({"method":"com.attocube.system.errorNumberToString","params":[true,"x",5],"id":48})",
+      // Only the parser can read these: an escape in the name, a nested value, a BOM.
+      R"({"method":"com.attocube.ecu.get\u0045nabled","id":49})",
+      R"({"method":"com.attocube.ecu.getConnected","id":50,"extra":{"a":[1]}})",
+      "\xEF\xBB\xBF{\"method\":\"com.attocube.ecu.enable\",\"id\":51}",
+      // Duplicate keys: the parser keeps the last.
+      R"({"method":"nothing.known","id":52,"method":"com.attocube.ecu.getHumidityInPercent"})",
+      // Ids: 18 and 19 digits (int64), negative, a fraction, an exponent, too large for int64.
+      R"({"method":"com.attocube.ecu.getRefractiveIndex","id":123456789012345678})",
+      R"({"method":"com.attocube.ecu.getRefractiveIndex","id":1234567890123456789})",
+      R"({"method":"com.attocube.ecu.getRefractiveIndex","id":-5})",
+      R"({"method":"com.attocube.ecu.getRefractiveIndex","id":53.0})",
+      R"({"method":"com.attocube.ecu.getRefractiveIndex","id":1e2})",
+      R"({"method":"com.attocube.ecu.getRefractiveIndex","id":99999999999999999999})",
+      // Not requests of ours, or not JSON: ignored.
+      R"({"jsonrpc":"2.0","method":"com.attocube.ids.displacement.getAxesDisplacementX","id":54})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","id":"55"})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable"})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","id":56} trailing)",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","id":057})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","id":58,})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.en\u0000able","id":59})",
+      "{\"method\":\"com.attocube.ecu.enable\",\"id\":60,\"x\":\"\xC3\x28\"}",  // bad UTF-8
+      R"([{"method":"com.attocube.ecu.enable","id":61}])",
+  };
+  for (const std::string_view line : lines) {
+    SCOPED_TRACE(line);
+    const Learnt expected = reference_request(line);
+    IdsCodec c;
+    const std::string sent = std::string(line) + "\n";
+    c.note_requests(std::as_bytes(std::span(sent)));
+    ASSERT_EQ(c.pending(), expected.known ? 1u : 0u);
+    if (!expected.known) continue;
+    EXPECT_EQ(c.last_id(), std::max<std::int64_t>(0, expected.id));
+    std::vector<IdsResponse> frames;
+    c.feed(fmt::format(R"({{"jsonrpc":"2.0","result":[3],"id":{}}})"
+                       "\n",
+                       expected.id),
+           frames);
+    ASSERT_EQ(frames.size(), 1u);
+    EXPECT_EQ(frames[0].method, expected.method);
+    EXPECT_EQ(frames[0].api, expected.api);
+    EXPECT_EQ(frames[0].params, expected.params);
+    EXPECT_EQ(frames[0].error_code, 3);
+  }
+}
+
+// The answers are read in one pass where they are as the device and the twin write them, and
+// through the JSON parser otherwise: each value must come out as the parser reads it.
+TEST(IdsCodec, AnswersReadInOnePassGiveTheParsersValues) {
+  // Picometres within the 10 m bound: integers, fractions, exponents, a subnormal product.
+  const std::string_view values[] = {"0",
+                                     "-0",
+                                     "1500000",
+                                     "-250",
+                                     "0.5",
+                                     "-0.0",
+                                     "1.5e3",
+                                     "2E-2",
+                                     "9999999999999",
+                                     "4503599627370497.5e-3",
+                                     "0.30000000000000004",
+                                     "1e-300"};
+  for (const std::string_view v : values) {
+    SCOPED_TRACE(v);
+    const double expected_m = nlohmann::json::parse(v).get<double>() * 1e-12;
+    for (const auto* form :
+         {R"({{"jsonrpc":"2.0","result":[0,{},0,0],"id":1}})",
+          R"({{"id":1,"jsonrpc":"2.0","result":[0,{},0,0]}})",
+          R"( {{ "jsonrpc" : "2.0" , "result" : [ 0 , {} , 0 , 0 ] , "id" : 1 }} )"}) {
+      IdsCodec c;
+      c.encode(IdsMethod::get_axes_displacement);
+      std::vector<IdsResponse> frames;
+      std::vector<CodecError> errors;
+      c.feed(fmt::format(fmt::runtime(form), v) + "\n", frames, errors);
+      ASSERT_EQ(frames.size(), 1u) << form;
+      ASSERT_TRUE(frames[0].displacement_m[0].has_value());
+      EXPECT_EQ(*frames[0].displacement_m[0], expected_m) << form;  // bit for bit
+      EXPECT_TRUE(errors.empty());
+    }
+  }
+  // result[0] with 18 digits (read in one pass) and more (left to the parser).
+  for (const std::string_view code :
+       {"123456789012345678", "-123456789012345678", "1234567890123456789", "9223372036854775807",
+        "-9223372036854775808"}) {
+    SCOPED_TRACE(code);
+    IdsCodec c;
+    c.encode(IdsMethod::get_axes_displacement);
+    std::vector<IdsResponse> frames;
+    c.feed(fmt::format(R"({{"jsonrpc":"2.0","result":[{},1,2,3],"id":1}})"
+                       "\n",
+                       code),
+           frames);
+    ASSERT_EQ(frames.size(), 1u);
+    EXPECT_EQ(frames[0].error_code, nlohmann::json::parse(code).get<std::int64_t>());
+  }
+  // The error paths are those of the parser, with its texts.
+  const std::pair<std::string_view, std::string_view> bad[] = {
+      {R"({"jsonrpc":"2.0","result":[0,1e400,0,0],"id":1})", "not a JSON object"},
+      {R"({"jsonrpc":"2.0","result":[0,01,0,0],"id":1})", "not a JSON object"},
+      {R"({"jsonrpc":"2.0","result":[0,1,0,0],"id":1,})", "not a JSON object"},
+      {R"({"jsonrpc":"2.0","result":[0,1,0,0],"id":2})", "response id 2 matches no pending"},
+      {R"({"jsonrpc":"2.0","result":[],"id":1})", "has no result array with an error code"},
+      {R"({"jsonrpc":"2.0","result":[0.0,1,2,3],"id":1})", "has no result array"},
+      {R"({"jsonrpc":"2.0","result":[0,1,2],"id":1})", "result has 2 values, 3 expected"},
+      {R"({"jsonrpc":"2.0","result":[0,1,2,3e13],"id":1})", "axis 2 displacement (m) = 30"},
+      {R"({"jsonrpc":"2.0","result":[0,1,"2",3],"id":1})",
+       "axis 1 displacement (m) is not a number"},
+      {"{\"jsonrpc\":\"2.0\",\"result\":[0,1,2,3],\"id\":1}\x01", "control bytes"},
+      {R"({"jsonrpc":"2.0","result":[0,1,2,3],"id":1.0})", "without an integer id"},
+  };
+  for (const auto& [line, text] : bad) {
+    SCOPED_TRACE(line);
+    IdsCodec c;
+    c.encode(IdsMethod::get_axes_displacement);
+    std::vector<IdsResponse> frames;
+    std::vector<CodecError> errors;
+    c.feed(std::string(line) + "\n", frames, errors);
+    ASSERT_FALSE(errors.empty());
+    EXPECT_NE(errors[0].description.find(text), std::string::npos) << errors[0].description;
+  }
+  // A flag and a text answered with numbers: the parser's errors, the frame still emitted.
+  IdsCodec c;
+  c.encode(IdsMethod::ecu_get_connected);
+  c.encode(IdsMethod::get_current_mode);
+  std::vector<IdsResponse> frames;
+  std::vector<CodecError> errors;
+  c.feed(
+      "{\"jsonrpc\":\"2.0\",\"result\":[0,1],\"id\":1}\n"
+      "{\"jsonrpc\":\"2.0\",\"result\":[0,2],\"id\":2}\n",
+      frames, errors);
+  ASSERT_EQ(frames.size(), 2u);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].description, "IDS: flag result is not a boolean");
+  EXPECT_EQ(errors[1].description, "IDS: text result is not a string");
+  EXPECT_FALSE(frames[0].flag.has_value());
 }
 
 }  // namespace

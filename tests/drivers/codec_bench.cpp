@@ -4,7 +4,10 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
+#include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "halsampler/codec.hpp"
 #include "ids3010/codec.hpp"
@@ -69,6 +72,66 @@ void BM_Ids3010(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kFrames));
 }
 
+// Replay of a recorded IDS3010 session: each request line as the instrument sent it
+// (note_requests learns its id from the bytes), then the device's answer (feed). This is the
+// codec's share of `daq replay` of an IDS3010 capture (docs/benchmarks.md, IDS3010 replay).
+struct RecordedSession {
+  std::vector<std::string> requests;  // one line each, as the instrument sent it
+  std::vector<std::string> answers;   // one line each, as the device answered
+  std::size_t bytes = 0;              // of both directions
+};
+
+RecordedSession recorded_session() {
+  IdsCodec live;
+  live.set_api(IdsApi::sen);  // firmware 1.9.1 and later
+  RecordedSession s;
+  for (int i = 1; i <= kFrames; ++i) {
+    s.requests.push_back(live.encode(IdsMethod::get_axes_displacement));
+    s.answers.push_back(fmt::format(R"({{"jsonrpc":"2.0","result":[0,{},{},0],"id":{}}})"
+                                    "\n",
+                                    123456789012 + i * 37, -4567890 + i, i));
+    s.bytes += s.requests.back().size() + s.answers.back().size();
+  }
+  return s;
+}
+
+void BM_Ids3010Replay(benchmark::State& state) {
+  const auto [requests, answers, bytes] = recorded_session();
+  for (auto _ : state) {
+    IdsCodec codec;
+    std::vector<IdsResponse> frames;
+    std::vector<CodecError> errors;
+    frames.reserve(kFrames);
+    for (std::size_t i = 0; i < answers.size(); ++i) {
+      codec.note_requests(std::as_bytes(std::span(requests[i])));
+      codec.feed(answers[i], frames, errors);
+    }
+    if (frames.size() != kFrames || !errors.empty()) state.SkipWithError("frames lost");
+    benchmark::DoNotOptimize(frames.data());
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes));
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kFrames));
+}
+
+// The floor under BM_Ids3010Replay: the same bytes in the same pieces through the line
+// splitter alone (one memchr pass, no decoding). No decoder of these lines can beat it.
+void BM_Ids3010ReplayFloor(benchmark::State& state) {
+  const auto [requests, answers, bytes] = recorded_session();
+  for (auto _ : state) {
+    LineSplitter sent, received;
+    std::size_t lines = 0;
+    auto count = [&](std::string_view line, std::uint64_t) { lines += line.size() > 2; };
+    for (std::size_t i = 0; i < answers.size(); ++i) {
+      sent.feed(std::as_bytes(std::span(requests[i])), count, [](std::uint64_t) {});
+      received.feed(std::as_bytes(std::span(answers[i])), count, [](std::uint64_t) {});
+    }
+    if (lines != 2 * kFrames) state.SkipWithError("lines lost");
+    benchmark::DoNotOptimize(lines);
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes));
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kFrames));
+}
+
 void BM_Ptu300(benchmark::State& state) {
   std::string stream;
   for (int i = 0; i < kFrames; ++i)
@@ -114,6 +177,8 @@ void BM_Shdr(benchmark::State& state) {
 }
 
 BENCHMARK(BM_Ids3010)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Ids3010Replay)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Ids3010ReplayFloor)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Ptu300)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LineGauge)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Temper)->Unit(benchmark::kMillisecond);
