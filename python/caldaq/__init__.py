@@ -25,6 +25,7 @@ from ._caldaq import (  # noqa: F401  (re-exported)
     CaptureError,
     Error,
     InputError,
+    Model,
     StoreError,
     circle_analyse,
     circular_standards,
@@ -34,6 +35,7 @@ from ._caldaq import (  # noqa: F401  (re-exported)
     equation_standard_uncertainty,
     iso230_2_evaluate,
     iso230_2_standards,
+    model_build,
     refractive_index,
     squareness_from_circle,
     squareness_from_diagonals,
@@ -49,7 +51,7 @@ __all__ = [
     "iso230_2_evaluate", "iso230_2_standards", "circle_analyse", "circular_standards",
     "straightness", "squareness_from_straightness", "squareness_from_diagonals",
     "squareness_from_circle", "uncertainty_budget", "compensation_factor",
-    "equation_standard_uncertainty", "decode", "driver_names", "verdict",
+    "equation_standard_uncertainty", "decode", "driver_names", "verdict", "Model", "model_build",
 ]
 
 STATUS = ("ok", "signal_lost", "out_of_range")

@@ -6,4 +6,5 @@ namespace caldaq_py {
 void bind_store(pybind11::module_& m);
 void bind_analysis(pybind11::module_& m);
 void bind_capture(pybind11::module_& m);
+void bind_model(pybind11::module_& m);
 }  // namespace caldaq_py

@@ -34,4 +34,5 @@ PYBIND11_MODULE(_caldaq, m) {
   caldaq_py::bind_store(m);
   caldaq_py::bind_analysis(m);
   caldaq_py::bind_capture(m);
+  caldaq_py::bind_model(m);
 }

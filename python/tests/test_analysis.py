@@ -110,8 +110,14 @@ def _circle_export(daq_bin, demo, tmp_path):
     path = tmp_path / "circle.csv"
     path.write_text(out)
     comment = next(line for line in out.splitlines() if line.startswith("#"))
-    args = shlex.split(comment[comment.index("--"):])
-    opts = dict(zip(args[::2], args[1::2]))
+    words = shlex.split(comment[comment.index("--"):])
+    opts, args, k = {}, [], 0
+    while k < len(words):  # "--input FILE --radius-mm 100 ... --uncalibrated"
+        flag = k + 1 == len(words) or words[k + 1].startswith("--")
+        opts[words[k]] = True if flag else words[k + 1]
+        if words[k] != "--input":
+            args += words[k:k + (1 if flag else 2)]
+        k += 1 if flag else 2
     rows = list(csv.DictReader(line for line in out.splitlines() if not line.startswith("#")))
     return path, args, opts, rows
 
@@ -127,11 +133,13 @@ def test_circle_matches_daq_analyse_circle(demo, cli, daq_bin, tmp_path):
     mine = caldaq.circle_analyse(traces, plane=opts.get("--plane", "XY"),
                                  radius_mm=float(opts["--radius-mm"]),
                                  feed_mm_per_min=float(opts["--feed-mm-min"]),
-                                 cyclic_period_mm=float(opts["--cyclic-period-mm"]) if "--cyclic-period-mm" in opts else None)
+                                 cyclic_period_mm=float(opts["--cyclic-period-mm"]) if "--cyclic-period-mm" in opts else None,
+                                 radius_calibrated="--uncalibrated" not in opts)
     assert mine == doc and mine["iso230_4"]["G_bi_um"] > 0 and len(mine["diagnostics"]) > 5
     other = caldaq.circle_analyse(traces, plane=opts.get("--plane", "XY"),
                                   radius_mm=float(opts["--radius-mm"]),
-                                  feed_mm_per_min=float(opts["--feed-mm-min"]), standard="iso230-4:1996")
+                                  feed_mm_per_min=float(opts["--feed-mm-min"]),
+                                  radius_calibrated="--uncalibrated" not in opts, standard="iso230-4:1996")
     assert other == cli("analyse", "circle", "--input", path, *args, "--standard", "iso230-4:1996", "--json")
     assert "H_um" in other["iso230_4"]
 

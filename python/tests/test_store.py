@@ -34,7 +34,7 @@ def test_show_matches_instruments_results_provenance(db, demo, cli):
         assert [i.device for i in inst] == [i["device"] for i in doc["instruments"]]
         assert [i.origin for i in inst] == [i["origin"] for i in doc["instruments"]]
         assert [i.origin_detail for i in inst] == [i["origin_detail"] for i in doc["instruments"]]
-        assert db.origin(run.id) == doc["origin"] == "simulated"
+        assert db.origin(run.id) == doc["origin"]["label"].lower() == "simulated"
         assert len(db.targets(run.id)) == doc["targets"]
         assert db.missed_stops(run.id) == [
             dict(m, target_index=m["target_index"] - 1) for m in doc["missed_stops"]]
@@ -75,7 +75,8 @@ def test_streamed_readings_equal_the_csv_export(db, demo, daq_bin):
         key = got["time_ns"] * 65536 + got["device"].astype(np.int64) * 256 + got["quantity"]
         _, inv, counts = np.unique(key, return_inverse=True, return_counts=True)
         single = counts[inv] == 1
-        assert single.sum() > len(rows) // 2
+        # A linear run's readings come one per read; a ballbar's mostly several per read.
+        assert single.sum() > (len(rows) // 2 if run.kind == "linear" else 0)
         assert np.array_equal(got["time_s"][single], t_export[single])
         utc = np.array([np.datetime64(r["utc"].rstrip("Z"), "us") for r in rows])
         assert np.array_equal(got["utc"][single].astype("datetime64[us]"), utc[single])
