@@ -9,7 +9,6 @@ Each step runs in its own process so that its peak RSS (ru_maxrss) is its own.
 """
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -23,7 +22,13 @@ RATE_HZ = 10_000
 
 
 def peak_rss_mb() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    """This process's peak resident memory (VmHWM). Not getrusage's ru_maxrss: Linux keeps that
+    across exec, so a child of a large process (pytest) would report its parent's peak."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
+    raise RuntimeError("no VmHWM in /proc/self/status")
 
 
 def write(db: str, seconds: int) -> None:
