@@ -55,3 +55,31 @@ def test_build_from_profiles():
     assert e[0] == pytest.approx(3.0) and e[1] == 0.0 and e[2] == 0.0
     with pytest.raises(caldaq.InputError):
         caldaq.model_build([], machine="test")
+
+
+def test_long_calls_release_the_gil():
+    """A map of 216 000 points computed in a thread while this thread keeps running: held, the
+    GIL would stop this loop for the whole call."""
+    import threading
+    import time
+    model = caldaq.Model.load(str(MODELS / "yfxz.json"))
+    start = time.perf_counter()
+    model.map_grid([60, 60, 60])
+    alone = time.perf_counter() - start
+    done = threading.Event()
+
+    def work():
+        model.map_grid([60, 60, 60])
+        done.set()
+
+    t = threading.Thread(target=work)
+    last = time.perf_counter()
+    gap = 0.0
+    t.start()
+    while not done.is_set():
+        now = time.perf_counter()
+        gap = max(gap, now - last)
+        last = now
+    t.join()
+    assert alone > 0.05, alone  # long enough for a held GIL to show
+    assert gap < alone / 2, (gap, alone)
