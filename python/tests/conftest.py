@@ -14,7 +14,7 @@ import pytest
 def daq_bin() -> str:
     path = os.environ.get("CALDAQ_DAQ") or shutil.which("daq")
     assert path and Path(path).exists(), "set CALDAQ_DAQ to the daq binary"
-    return path
+    return str(Path(path).resolve())  # the demo runs in its own directory
 
 
 @pytest.fixture(scope="session")
