@@ -175,29 +175,37 @@ class Stream {
         locked(*store_, [&](st::Store& st) { return st.stream_readings(run_id, quantities); }));
   }
   // The next chunk as a dict of numpy arrays, or None at the end.
+  // The stream is touched only under the store's lock, and each call fills its own batch, so
+  // two threads calling next() on one stream get whole, distinct chunks.
   py::object next() {
-    if (!stream_) return py::none();
-    const bool more = locked(*store_, [&](st::Store&) { return stream_->next(batch_, chunk_); });
-    if (!more) {
+    std::vector<st::RawReading> batch;
+    const bool more = locked(*store_, [&](st::Store&) {
+      if (!stream_) return false;
+      if (stream_->next(batch, chunk_)) return true;
+      chunks_done_ = stream_->chunks_read();
       stream_.reset();
-      return py::none();
-    }
+      return false;
+    });
+    if (!more) return py::none();
     py::dict d;
-    d["time_ns"] = column<std::int64_t>(batch_, [](const auto& r) { return r.time_ns; });
-    d["device"] = column<std::uint16_t>(batch_, [](const auto& r) { return r.device; });
-    d["channel"] = column<std::uint8_t>(batch_, [](const auto& r) { return r.channel; });
-    d["quantity"] = column<std::uint8_t>(batch_, [](const auto& r) { return r.quantity; });
-    d["status"] = column<std::uint8_t>(batch_, [](const auto& r) { return r.status; });
-    d["value"] = column<double>(batch_, [](const auto& r) { return r.value; });
+    d["time_ns"] = column<std::int64_t>(batch, [](const auto& r) { return r.time_ns; });
+    d["device"] = column<std::uint16_t>(batch, [](const auto& r) { return r.device; });
+    d["channel"] = column<std::uint8_t>(batch, [](const auto& r) { return r.channel; });
+    d["quantity"] = column<std::uint8_t>(batch, [](const auto& r) { return r.quantity; });
+    d["status"] = column<std::uint8_t>(batch, [](const auto& r) { return r.status; });
+    d["value"] = column<double>(batch, [](const auto& r) { return r.value; });
     return d;
   }
-  std::uint64_t chunks_read() const { return stream_ ? stream_->chunks_read() : 0; }
+  std::uint64_t chunks_read() {
+    return locked(*store_,
+                  [&](st::Store&) { return stream_ ? stream_->chunks_read() : chunks_done_; });
+  }
 
  private:
   std::shared_ptr<SharedStore> store_;
   std::unique_ptr<st::ReadingStream> stream_;
-  std::vector<st::RawReading> batch_;
   std::size_t chunk_;
+  std::uint64_t chunks_done_ = 0;
 };
 
 template <class T>

@@ -127,3 +127,27 @@ def test_unknown_quantity_and_bad_chunk_are_input_errors(db):
         next(db.iter_readings(run.id, quantities=["speed"]))
     with pytest.raises(caldaq.InputError, match="chunk"):
         next(db.iter_readings(run.id, chunk=0))
+
+
+def test_threads_share_a_store_and_a_stream(db):
+    """Four threads draw chunks from one stream of one store: every reading once, none torn."""
+    import threading
+    run = next(r for r in db.runs() if r.kind == "circle")
+    stream = db._c.stream(run.id, [], 997)
+    got, lock = [], threading.Lock()
+
+    def drain():
+        while (c := stream.next()) is not None:
+            assert len(c["time_ns"]) == len(c["value"]) <= 997
+            with lock:
+                got.append(c)
+
+    threads = [threading.Thread(target=drain) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert sum(len(c["value"]) for c in got) == db.reading_count(run.id)
+    whole = np.concatenate([c["time_ns"] for c in db.iter_readings(run.id)])
+    assert np.array_equal(np.sort(np.concatenate([c["time_ns"] for c in got])), np.sort(whole))
+    assert stream.chunks_read > 0
