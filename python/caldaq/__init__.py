@@ -151,7 +151,7 @@ class Store:
     def run(self, run_id: int) -> Run:
         r = self._c.run(run_id)
         if r is None:
-            raise StoreError(f"{self.path}: no run {run_id}")
+            raise InputError(f"{self.path}: no run {run_id} (see daq runs)")
         return _run(r)
 
     def instruments(self, run_id: int) -> List[Instrument]:

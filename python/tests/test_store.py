@@ -121,6 +121,14 @@ def test_read_only_store_refuses_writes_and_missing_files(demo, tmp_path, cli_er
     assert not missing.exists()
 
 
+def test_an_unknown_run_has_the_cli_message(db, demo, cli_error):
+    with pytest.raises(caldaq.InputError) as e:
+        db.run(99)
+    assert str(e.value) == cli_error("show", 99, "--db", demo / "demo.sqlite")
+    with pytest.raises(caldaq.InputError):
+        next(db.iter_readings(99))
+
+
 def test_unknown_quantity_and_bad_chunk_are_input_errors(db):
     run = db.runs()[0]
     with pytest.raises(caldaq.InputError, match="quantity 'speed'"):
