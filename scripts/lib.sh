@@ -19,7 +19,11 @@ PACKAGES=(
   libplplot-dev
 )
 # The headless browser of the report and live-page tests (and of daq report --format pdf).
-TEST_PACKAGES=(chromium chromium-driver python3 poppler-utils)
+# The Python package (python/, docs/python.md): pybind11 and Python's headers to build it; numpy,
+# pytest, pandas and matplotlib for its tests (pytest in ctest) and the notebook walk-through.
+TEST_PACKAGES=(chromium chromium-driver python3 poppler-utils
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-pandas
+  python3-matplotlib)
 
 install_packages() {
   local missing=()
@@ -36,7 +40,11 @@ install_packages() {
 
 configure_and_build() {
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
-    cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo
+    # Debian's interpreter, where the python3-* packages above are (not a pyenv or venv python
+    # first on PATH).
+    local python=()
+    if [ -x /usr/bin/python3 ]; then python=(-DPython3_EXECUTABLE=/usr/bin/python3); fi
+    cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${python[@]}"
   fi
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }

@@ -1,0 +1,411 @@
+// caldaq.Store: a run store opened from Python (read-only by default). Records come out as
+// plain dicts (the JSON documents as text, parsed on the Python side); readings as chunks of
+// numpy arrays, streamed in bounded memory.
+//
+// One Store is one SQLite connection: every call on it, and on the streams reading through
+// it, holds the store's own mutex with the GIL released, so Python threads may share it.
+#include "cal/storage/store.hpp"
+
+#include <fmt/format.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <mutex>
+
+#include "bindings.hpp"
+#include "cal/analysis/error.hpp"
+#include "cal/drivers/instrument.hpp"
+
+namespace py = pybind11;
+namespace st = cal::storage;
+
+namespace caldaq_py {
+namespace {
+
+struct SharedStore {
+  SharedStore(const std::string& path, st::StoreOptions o) : store(path, o) {}
+  st::Store store;
+  std::mutex mutex;
+};
+
+// Runs f on the store with the GIL released and the store's mutex held.
+template <class F>
+auto locked(SharedStore& s, F&& f) {
+  py::gil_scoped_release release;
+  std::lock_guard lock(s.mutex);
+  return f(s.store);
+}
+
+template <class T>
+py::object optional_value(const std::optional<T>& v) {
+  return v ? py::cast(*v) : py::none();
+}
+
+py::dict run_dict(const st::RunRecord& r) {
+  py::dict d;
+  d["id"] = r.id;
+  d["machine_id"] = r.machine_id;
+  d["campaign"] = r.campaign;
+  d["kind"] = r.kind;
+  d["axis"] = r.axis;
+  d["settings_json"] = r.settings_json;
+  d["capture_path"] = r.capture_path;
+  d["software_version"] = r.software_version;
+  d["started_unix_ms"] = r.started_unix_ms;
+  d["ended_unix_ms"] = optional_value(r.ended_unix_ms);
+  d["status"] = std::string(st::to_string(r.status));
+  d["note"] = r.note;
+  d["origin_session_ns"] = optional_value(r.origin_session_ns);
+  d["origin_unix_ns"] = optional_value(r.origin_unix_ns);
+  return d;
+}
+
+py::dict instrument_dict(const st::InstrumentRecord& i) {
+  py::dict d;
+  d["device"] = i.device;
+  d["driver"] = i.driver;
+  d["transport"] = i.transport;
+  d["settings_json"] = i.settings_json;
+  d["origin"] = i.origin;
+  d["origin_detail"] = i.origin_detail;
+  return d;
+}
+
+py::dict target_dict(const st::CapturedTarget& t) {
+  py::dict d;
+  d["target_index"] = t.target_index;
+  d["run"] = t.run_number;
+  d["direction"] = t.direction == '+' ? "up" : "down";
+  d["nominal_mm"] = t.nominal_mm;
+  d["time_ns"] = t.time_ns;
+  d["raw_m"] = t.raw_m;
+  d["deviation_um"] = t.deviation_um;
+  d["refractive_index"] = t.refractive_index;
+  d["material_temperature_degc"] = t.material_temperature_degc;
+  return d;
+}
+
+py::dict result_dict(const st::ResultRecord& r) {
+  py::dict d;
+  d["id"] = r.id;
+  d["standard"] = r.standard;
+  d["json"] = r.json;
+  d["created_unix_ms"] = r.created_unix_ms;
+  d["provenance_json"] = r.provenance_json;
+  d["superseded_by"] = optional_value(r.superseded_by);
+  d["current"] = r.current();
+  return d;
+}
+
+py::dict missed_dict(const st::MissedStop& m) {
+  py::dict d;
+  d["run"] = m.run_number;
+  d["direction"] = m.direction == '+' ? "up" : "down";
+  d["target_index"] = m.target_index;
+  d["nominal_mm"] = m.nominal_mm;
+  return d;
+}
+
+py::object quality_obj(const std::optional<st::RunQuality>& q) {
+  if (!q) return py::none();
+  py::dict d;
+  d["state"] = q->state;
+  d["summary"] = q->summary;
+  py::list suspects;
+  for (const auto& s : q->suspects) {
+    py::dict m;
+    m["run"] = s.run_number;
+    m["direction"] = s.direction == '+' ? "up" : "down";
+    m["target_index"] = s.target_index;
+    m["reason"] = s.reason;
+    suspects.append(m);
+  }
+  d["suspects"] = suspects;
+  return d;
+}
+
+py::dict compensation_dict(const st::CompensationRecord& c) {
+  py::dict d;
+  d["id"] = c.id;
+  d["machine_id"] = c.machine_id;
+  d["source_run_id"] = c.source_run_id;
+  d["source"] = c.source;
+  d["axis"] = c.axis;
+  d["format"] = c.format;
+  d["created_unix_ms"] = c.created_unix_ms;
+  d["json"] = c.json;
+  return d;
+}
+
+py::dict machine_dict(const st::MachineRecord& m) {
+  py::dict d;
+  d["id"] = m.id;
+  d["name"] = m.name;
+  d["description"] = m.description;
+  d["config_json"] = m.config_json;
+  return d;
+}
+
+template <class T, class F>
+py::list list_of(const std::vector<T>& v, F&& f) {
+  py::list out;
+  for (const auto& x : v) out.append(f(x));
+  return out;
+}
+
+// A column of a chunk as a new numpy array.
+template <class T, class Get>
+py::array_t<T> column(const std::vector<st::RawReading>& rs, Get get) {
+  py::array_t<T> a(static_cast<py::ssize_t>(rs.size()));
+  T* p = a.mutable_data();
+  for (std::size_t k = 0; k < rs.size(); ++k) p[k] = get(rs[k]);
+  return a;
+}
+
+// A run's readings a chunk at a time; holds its store (and so its connection) alive.
+class Stream {
+ public:
+  Stream(std::shared_ptr<SharedStore> s, std::int64_t run_id, std::vector<std::uint8_t> quantities,
+         std::size_t chunk)
+      : store_(std::move(s)), chunk_(chunk) {
+    if (chunk_ == 0) throw cal::InputError("chunk: expected a number of readings > 0, got 0");
+    stream_ = std::make_unique<st::ReadingStream>(
+        locked(*store_, [&](st::Store& st) { return st.stream_readings(run_id, quantities); }));
+  }
+  // The next chunk as a dict of numpy arrays, or None at the end.
+  // The stream is touched only under the store's lock, and each call fills its own batch, so
+  // two threads calling next() on one stream get whole, distinct chunks.
+  py::object next() {
+    std::vector<st::RawReading> batch;
+    const bool more = locked(*store_, [&](st::Store&) {
+      if (!stream_) return false;
+      if (stream_->next(batch, chunk_)) return true;
+      chunks_done_ = stream_->chunks_read();
+      stream_.reset();
+      return false;
+    });
+    if (!more) return py::none();
+    py::dict d;
+    d["time_ns"] = column<std::int64_t>(batch, [](const auto& r) { return r.time_ns; });
+    d["device"] = column<std::uint16_t>(batch, [](const auto& r) { return r.device; });
+    d["channel"] = column<std::uint8_t>(batch, [](const auto& r) { return r.channel; });
+    d["quantity"] = column<std::uint8_t>(batch, [](const auto& r) { return r.quantity; });
+    d["status"] = column<std::uint8_t>(batch, [](const auto& r) { return r.status; });
+    d["value"] = column<double>(batch, [](const auto& r) { return r.value; });
+    return d;
+  }
+  std::uint64_t chunks_read() {
+    return locked(*store_,
+                  [&](st::Store&) { return stream_ ? stream_->chunks_read() : chunks_done_; });
+  }
+
+ private:
+  std::shared_ptr<SharedStore> store_;
+  std::unique_ptr<st::ReadingStream> stream_;
+  std::size_t chunk_;
+  std::uint64_t chunks_done_ = 0;
+};
+
+template <class T>
+using Column = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+// Readings from equal-length columns, stored in one transaction (Store::append_readings).
+void append_readings(SharedStore& s, std::int64_t run_id, const Column<std::int64_t>& time_ns,
+                     const Column<std::uint16_t>& device, const Column<std::uint8_t>& channel,
+                     const Column<std::uint8_t>& quantity, const Column<std::uint8_t>& status,
+                     const Column<double>& value) {
+  const auto n = time_ns.size();
+  for (const auto* a :
+       {static_cast<const py::array*>(&device), static_cast<const py::array*>(&channel),
+        static_cast<const py::array*>(&quantity), static_cast<const py::array*>(&status),
+        static_cast<const py::array*>(&value)})
+    if (a->ndim() != 1 || a->size() != n)
+      throw cal::InputError(fmt::format(
+          "append_readings: expected 1-D columns of {} readings (as time_ns), got one of {}", n,
+          a->size()));
+  std::vector<st::RawReading> rs(static_cast<std::size_t>(n));
+  for (py::ssize_t k = 0; k < n; ++k)
+    rs[static_cast<std::size_t>(k)] = {time_ns.data()[k],  device.data()[k], channel.data()[k],
+                                       quantity.data()[k], status.data()[k], value.data()[k]};
+  locked(s, [&](st::Store& st) { st.append_readings(run_id, rs); });
+}
+
+std::shared_ptr<SharedStore> open_store(const std::string& path, bool read_only) {
+  py::gil_scoped_release release;
+  st::StoreOptions o;
+  o.read_only = read_only;
+  return std::make_shared<SharedStore>(path, o);
+}
+
+}  // namespace
+
+void bind_store(py::module_& m) {
+  py::list quantity_names;
+  for (int q = 0; q <= static_cast<int>(cal::drivers::Quantity::angle_rad); ++q)
+    quantity_names.append(
+        std::string(cal::drivers::to_string(static_cast<cal::drivers::Quantity>(q))));
+  m.attr("QUANTITIES") = py::tuple(quantity_names);
+  m.attr("SCHEMA_VERSION") = st::schema_version;
+
+  py::class_<Stream>(m, "ReadingStream")
+      .def("next", &Stream::next)
+      .def_property_readonly("chunks_read", &Stream::chunks_read);
+
+  py::class_<SharedStore, std::shared_ptr<SharedStore>>(m, "Store")
+      .def(py::init(&open_store), py::arg("path"), py::arg("read_only") = true)
+      .def_property_readonly("path", [](SharedStore& s) { return s.store.path().string(); })
+      .def_property_readonly("version", [](SharedStore& s) { return s.store.version(); })
+      .def_property_readonly("read_only", [](SharedStore& s) { return s.store.read_only(); })
+      .def("runs",
+           [](SharedStore& s) {
+             return list_of(locked(s, [](st::Store& st) { return st.runs(); }), run_dict);
+           })
+      .def("run",
+           [](SharedStore& s, std::int64_t id) -> py::object {
+             const auto r = locked(s, [&](st::Store& st) { return st.run(id); });
+             return r ? py::object(run_dict(*r)) : py::none();
+           })
+      .def("machine",
+           [](SharedStore& s, std::int64_t id) -> py::object {
+             const auto r = locked(s, [&](st::Store& st) { return st.machine(id); });
+             return r ? py::object(machine_dict(*r)) : py::none();
+           })
+      .def("instruments",
+           [](SharedStore& s, std::int64_t id) {
+             return list_of(locked(s, [&](st::Store& st) { return st.instruments(id); }),
+                            instrument_dict);
+           })
+      .def("series",
+           [](SharedStore& s, std::int64_t id) {
+             return list_of(locked(s, [&](st::Store& st) { return st.series(id); }),
+                            [](const st::Store::Series& x) {
+                              py::dict d;
+                              d["device"] = x.device;
+                              d["channel"] = x.channel;
+                              d["quantity"] = x.quantity;
+                              d["count"] = x.count;
+                              d["first_ns"] = x.first_ns;
+                              d["last_ns"] = x.last_ns;
+                              return d;
+                            });
+           })
+      .def("reading_count",
+           [](SharedStore& s, std::int64_t id) {
+             return locked(s, [&](st::Store& st) { return st.reading_count(id); });
+           })
+      .def("targets",
+           [](SharedStore& s, std::int64_t id) {
+             return list_of(locked(s, [&](st::Store& st) { return st.targets(id); }), target_dict);
+           })
+      .def("results",
+           [](SharedStore& s, std::int64_t id) {
+             return list_of(locked(s, [&](st::Store& st) { return st.results(id); }), result_dict);
+           })
+      .def("missed_stops",
+           [](SharedStore& s, std::int64_t id) {
+             return list_of(locked(s, [&](st::Store& st) { return st.missed_stops(id); }),
+                            missed_dict);
+           })
+      .def("quality",
+           [](SharedStore& s, std::int64_t id) {
+             return quality_obj(locked(s, [&](st::Store& st) { return st.quality(id); }));
+           })
+      .def(
+          "compensations",
+          [](SharedStore& s, std::int64_t machine_id, const std::string& axis) {
+            return list_of(
+                locked(s, [&](st::Store& st) { return st.compensations(machine_id, axis); }),
+                compensation_dict);
+          },
+          py::arg("machine_id") = 0, py::arg("axis") = "")
+      .def(
+          "add_compensation",
+          [](SharedStore& s, std::int64_t machine_id, const std::string& axis,
+             const std::string& format, const std::string& json, const std::string& source,
+             std::int64_t source_run_id) {
+            st::CompensationRecord c{.machine_id = machine_id,
+                                     .source_run_id = source_run_id,
+                                     .source = source,
+                                     .axis = axis,
+                                     .format = format,
+                                     .json = json};
+            return locked(s, [&](st::Store& st) { return st.add_compensation(c); });
+          },
+          py::arg("machine_id"), py::arg("axis"), py::arg("format"), py::arg("json"),
+          py::arg("source") = "", py::arg("source_run_id") = 0)
+      // Writing (read_only=False): what an import or a test needs to store a run.
+      .def(
+          "add_machine",
+          [](SharedStore& s, const std::string& name, const std::string& description) {
+            return locked(s, [&](st::Store& st) {
+              return st.add_machine({.name = name, .description = description});
+            });
+          },
+          py::arg("name"), py::arg("description") = "")
+      .def(
+          "begin_run",
+          [](SharedStore& s, std::int64_t machine_id, const std::string& kind,
+             const std::string& axis, const std::string& campaign,
+             const std::string& settings_json) {
+            st::RunRecord r{.machine_id = machine_id,
+                            .campaign = campaign,
+                            .kind = kind,
+                            .axis = axis,
+                            .settings_json = settings_json,
+                            .software_version = "caldaq python"};
+            return locked(s, [&](st::Store& st) { return st.begin_run(r); });
+          },
+          py::arg("machine_id"), py::arg("kind"), py::arg("axis") = "", py::arg("campaign") = "",
+          py::arg("settings_json") = "{}")
+      .def(
+          "add_instrument",
+          [](SharedStore& s, std::int64_t run_id, int device, const std::string& driver,
+             const std::string& transport, const std::string& origin,
+             const std::string& origin_detail) {
+            st::InstrumentRecord i{.run_id = run_id,
+                                   .device = device,
+                                   .driver = driver,
+                                   .transport = transport,
+                                   .origin = origin,
+                                   .origin_detail = origin_detail};
+            locked(s, [&](st::Store& st) { st.add_instrument(i); });
+          },
+          py::arg("run_id"), py::arg("device"), py::arg("driver"), py::arg("transport") = "",
+          py::arg("origin") = "imported", py::arg("origin_detail") = "")
+      .def("append_readings", &append_readings, py::arg("run_id"), py::arg("time_ns"),
+           py::arg("device"), py::arg("channel"), py::arg("quantity"), py::arg("status"),
+           py::arg("value"))
+      .def(
+          "set_time_origin",
+          [](SharedStore& s, std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns) {
+            locked(s, [&](st::Store& st) { st.set_time_origin(run_id, session_ns, unix_ns); });
+          },
+          py::arg("run_id"), py::arg("session_ns"), py::arg("unix_ns"))
+      .def(
+          "finish_run",
+          [](SharedStore& s, std::int64_t run_id, const std::string& status,
+             const std::string& note) {
+            const auto v =
+                status == "complete"  ? st::RunStatus::complete
+                : status == "aborted" ? st::RunStatus::aborted
+                : status == "incomplete"
+                    ? st::RunStatus::incomplete
+                    : throw cal::InputError(fmt::format("status '{}': expected complete, "
+                                                        "aborted or incomplete",
+                                                        status));
+            locked(s, [&](st::Store& st) { st.finish_run(run_id, v, note); });
+          },
+          py::arg("run_id"), py::arg("status") = "complete", py::arg("note") = "")
+      .def(
+          "stream",
+          [](std::shared_ptr<SharedStore> s, std::int64_t run_id,
+             std::vector<std::uint8_t> quantities, std::size_t chunk) {
+            return Stream(std::move(s), run_id, std::move(quantities), chunk);
+          },
+          py::arg("run_id"), py::arg("quantities") = std::vector<std::uint8_t>{},
+          py::arg("chunk") = 65536);
+}
+
+}  // namespace caldaq_py
