@@ -224,13 +224,30 @@ std::string svg(const XyChart& chart) {
     for (double v : l.y) y.add(v);
   }
   if (chart.zero_line) y.add(0.0);
-  SvgStream s(chart.width_pt, chart.height_pt);
   // The legend goes to the right of the plot, outside the data.
   const bool has_legend = std::any_of(chart.lines.begin(), chart.lines.end(),
                                       [](const Line& l) { return !l.label.empty(); }) ||
                           std::any_of(chart.bands.begin(), chart.bands.end(),
                                       [](const Band& b) { return !b.label.empty(); });
   const bool legend = chart.legend && has_legend;
+  // The legend goes below the plot, in as many columns of the longest label as fit the width:
+  // to the right it took a quarter of the width and clipped long instrument names. The page
+  // grows by its rows, so the plot keeps its height.
+  std::size_t labelled = 0, longest = 0;
+  for (const auto& l : chart.lines)
+    if (!l.label.empty()) ++labelled, longest = std::max(longest, l.label.size());
+  for (const auto& b : chart.bands)
+    if (!b.label.empty()) ++labelled, longest = std::max(longest, b.label.size());
+  const double char_pt = 13.0 * chart.text_scale;
+  const auto columns = static_cast<PLINT>(
+      legend ? std::clamp<std::size_t>(static_cast<std::size_t>(chart.width_pt / (char_pt * 0.62) /
+                                                                static_cast<double>(longest + 8)),
+                                       1, std::min<std::size_t>(labelled, 4))
+             : 0);
+  const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
+  const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
+  const double total_pt = chart.height_pt + legend_pt;
+  SvgStream s(chart.width_pt, static_cast<int>(total_pt));
   plschr(0, 1.05 * chart.text_scale);
   // Room on every side: no point or marker sits on the frame.
   const Range xr = x.empty() ? Range{0, 1}
@@ -245,9 +262,10 @@ std::string svg(const XyChart& chart) {
   const std::size_t tick_chars = std::max(fmt::format("{:.{}f}", yr.lo, ydigits).size(),
                                           fmt::format("{:.{}f}", yr.hi, ydigits).size());
   const double label_disp = 0.8 * static_cast<double>(tick_chars) + 1.6;  // character heights
-  const double char_pt = 13.0 * chart.text_scale;
   const double left = std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
-  plvpor(left, legend ? 0.72 : 0.97, 0.15, 0.9);
+  const double bottom = (4.0 * char_pt + legend_pt) / total_pt,
+               top = 1.0 - 2.2 * char_pt / total_pt;
+  plvpor(left, 0.97, bottom, top);
   plwind(xr.lo, xr.hi, yr.lo, yr.hi);
   const bool categories = !chart.x_labels.empty();
   if (categories)
@@ -290,7 +308,9 @@ std::string svg(const XyChart& chart) {
   plmtex("l", label_disp, 0.5, 0.5, plot_text(chart.y_label).c_str());
   plmtex("t", 1.5, 0.5, 0.5, plot_text(chart.title).c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
-  if (legend) draw_legend(entries, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
+  if (legend)
+    draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
+                3.7 * char_pt / ((top - bottom) * total_pt));
   return s.finish(chart.title);
 }
 

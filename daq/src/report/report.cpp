@@ -857,7 +857,7 @@ std::string means_plot(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
-                .height_pt = 300,
+                .height_pt = 230,
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
   means.bands.push_back(
@@ -1781,7 +1781,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
                   .height_pt = 200,
                   .x_labels = dates,
                   .legend = false,
-                  .text_scale = 2.0};
+                  .text_scale = 1.65};
     small.lines.push_back(trends[k]);
     if (limits.count(k)) {
       const double n = static_cast<double>(views.size()) - 1;
