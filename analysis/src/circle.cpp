@@ -688,8 +688,14 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   report(rep, setup, ax, period_mm);
   if (vibration) rep.add(*vibration);
   for (const auto& f : stick_slip) rep.add(f);
+  // Ranked by what correcting each would gain (G with its term removed), as a ballbar user
+  // reads the list: the first is the one to fix first. Equal gains (terms absent) by PV.
   std::stable_sort(res.diagnostics.begin(), res.diagnostics.end(),
-                   [](const Diagnostic& a, const Diagnostic& b) { return a.pv_um > b.pv_um; });
+                   [](const Diagnostic& a, const Diagnostic& b) {
+                     const double ga = std::round(a.g_reduction_um * 1e3);
+                     const double gb = std::round(b.g_reduction_um * 1e3);
+                     return ga != gb ? ga > gb : a.pv_um > b.pv_um;
+                   });
   const std::string u(1, ax[0]), v(1, ax[1]);
   res.centre_u = {"centre_" + u, "Centre offset " + u, sol.coef[centre_u], "um", 0, 0, 0, {}};
   res.centre_v = {"centre_" + v, "Centre offset " + v, sol.coef[centre_v], "um", 0, 0, 0, {}};

@@ -61,6 +61,35 @@ json circle_json(const ci::Result& r, double radius_mm, std::string_view plane,
   return j;
 }
 
+std::string diagnostic_advice(std::string_view key) {
+  // The axis is the key's last letter where the term belongs to one axis.
+  const std::string axis =
+      key.size() > 2 && key[key.size() - 2] == '_' ? std::string(1, key.back()) : std::string();
+  const auto starts = [&](std::string_view p) { return key.substr(0, p.size()) == p; };
+  if (starts("backlash_"))
+    return "check the " + axis + " axis' backlash compensation and its drive (ball screw, nut)";
+  if (starts("lateral_play_"))
+    return "check the " + axis + " axis' guideway gibs and preload: it shifts sideways at reversal";
+  if (starts("reversal_spike_"))
+    return "tune the " + axis + " axis' reversal (friction) compensation and its servo gains";
+  if (starts("cyclic_"))
+    return "check the " + axis + " axis' ball screw and encoder for a periodic (pitch) error";
+  if (starts("straightness_"))
+    return "check the straightness of the " + axis + " axis' guideways (level, wear)";
+  if (starts("stick_slip_"))
+    return "check the " + axis + " axis' lubrication and friction compensation";
+  if (key == "squareness")
+    return "check the squareness of the plane's axes (alignment, or the control's squareness "
+           "compensation)";
+  if (key == "scale_mismatch")
+    return "check the axes' pitch (scale) compensation and thermal growth of the screws";
+  if (key == "servo_mismatch")
+    return "match the two axes' servo gains (position loop, feed-forward)";
+  if (key == "radius_error") return "check the bar's calibration and the axes' scale";
+  if (key == "vibration") return "look for the source of the vibration (spindle, fan, floor)";
+  return "";  // not a diagnostic (a value of the standard, e.g. G)
+}
+
 void print_circle(const ci::Result& r, double radius_mm, std::string_view plane,
                   double feed_mm_per_min, ci::CircularStandard standard) {
   const auto& st = ci::info(standard);
@@ -75,9 +104,9 @@ void print_circle(const ci::Result& r, double radius_mm, std::string_view plane,
                v.meaning);
   for (const auto& n : st.not_evaluated) fmt::print("  not evaluated: {}\n", n);
   fmt::print(
-      "\nDiagnostics, ranked by PV (the peak-to-valley of the error's own pattern on the traces),\n"
-      "with PV / G (the share of G; caldaq's own figure, can exceed 100 %) and G gain (how much\n"
-      "G falls when that error alone is removed; docs/circle.md):\n");
+      "\nDiagnostics, ranked by G gain (how much G falls when that error alone is removed: the\n"
+      "first is what to fix first), with PV (the peak-to-valley of the error's own pattern on\n"
+      "the traces) and PV / G (caldaq's own figure, can exceed 100 %; docs/circle.md):\n");
   fmt::print("  {:<48} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "PV / G",
              "G gain");
   for (const auto& d : r.diagnostics)

@@ -4,6 +4,7 @@
 // standard chooses which ISO 230-4 values are reported and how they are named
 // (cal::circle::StandardInfo); caldaq's other values of the same trace are "informative".
 #include <nlohmann/json.hpp>
+#include <string>
 #include <string_view>
 
 #include "cal/analysis/circle.hpp"
@@ -21,6 +22,10 @@ double iso_value(const cal::circle::Iso230_4& iso, std::string_view key);
 nlohmann::json circle_json(
     const cal::circle::Result& r, double radius_mm, std::string_view plane, double feed_mm_per_min,
     cal::circle::CircularStandard standard = cal::circle::CircularStandard::iso230_4_2005);
+
+// One line of what to check on the machine for a diagnostic, by its key ("backlash_X",
+// "squareness", "stick_slip_Y"...); empty for a key that is not a diagnostic.
+std::string diagnostic_advice(std::string_view key);
 
 // The same for a terminal: the standard's values, then the diagnostics ranked.
 void print_circle(

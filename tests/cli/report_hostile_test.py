@@ -77,7 +77,7 @@ for k, v in names.items():
 EXPECTED_TAGS = {
     "html", "head", "meta", "title", "style", "body", "h1", "h2", "h3", "h4", "p", "table",
     "thead", "tbody", "tr", "th", "td", "span", "strong", "em", "sub", "sup", "code", "figure",
-    "figcaption", "footer", "div", "a", "br",
+    "figcaption", "footer", "div", "a", "br", "ul", "li",
     "svg", "g", "path", "polyline", "polygon", "text", "tspan", "clippath", "defs", "rect", "line",
     "circle", "ellipse", "desc"}
 

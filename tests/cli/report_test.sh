@@ -116,7 +116,7 @@ G2=$("$PY" -c "import json; print(format(json.load(open('circ.json'))['iso230_4'
 check circle_g_on_plot 0 "^G = $G2 µm$" -- svgtext r2.html
 check circle_start_marked 0 "start of each trace, arrow: direction of travel" -- svgtext r2.html
 check circle_rings_off_traces 0 "^rings: -[0-9.]+ to \+[0-9.]+ µm$" -- svgtext r2.html
-check circle_percent_explained 0 "one share can exceed 100 %" -- cat r2.html
+check circle_gain_explained 0 "a negative gain means the error partly cancels another" -- cat r2.html
 check campaign_nowrap 0 "<span class=\"nw\">E [0-9.]+ µm</span>" -- cat camp.html
 check campaign_verdict 0 "<span class=\"fail\">FAIL</span></td>" -- cat camp.html
 check as_found 0 "as-found-as-left report of runs 1, 3 written to af.html" -- "$DAQ" report --as-found 1 --as-left 3 --db demo.sqlite -o af.html
@@ -168,7 +168,7 @@ done
 check budget_before 0 "<td>material temperature</td><td class=\"r\">0.5750</td>" -- cat r1.html
 check recompensate 0 "stored as result [0-9]+, superseding result 1" -- "$DAQ" recompensate 1 --alpha-ppm 12 --db demo.sqlite
 "$DAQ" report 1 --db demo.sqlite -o r1b.html >/dev/null
-check recomp_setting 0 "11.5 <span class=\"changed\">\(as acquired; the current result uses 12\)</span>" -- cat r1b.html
+check recomp_setting 0 "11.5 ppm/K <span class=\"changed\">\(as acquired; the current result uses 12\)</span>" -- cat r1b.html
 check recomp_coefficients 0 "Expansion coefficient \(ppm/K\)</td><td class=\"r\">11.5</td><td class=\"r\"><span class=\"changed\">12</span>" -- cat r1b.html
 check recomp_values 0 "Original \(result 1\) and re-compensated \(result [0-9]+\) values" -- cat r1b.html
 check recomp_budget 0 "<td>material temperature</td><td class=\"r\">0.6000</td>" -- cat r1b.html

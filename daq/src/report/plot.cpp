@@ -46,7 +46,7 @@ class SvgStream {
     plscol0(reference_colour, 140, 140, 140);
     plinit();
     pladv(0);
-    plschr(0, 0.85);
+    plschr(0, 1.05);
   }
   ~SvgStream() {
     if (!ended_) plend1();
@@ -63,7 +63,7 @@ class SvgStream {
 
   // The <svg> element only (no XML prolog or DOCTYPE, which cannot sit inside HTML), sized
   // by the page's CSS through its viewBox.
-  std::string finish(std::string_view title) {
+  std::string finish(std::string_view title, std::string_view cls = "plot") {
     plend1();
     ended_ = true;
     std::string s(buffer_, length_);
@@ -75,8 +75,8 @@ class SvgStream {
       const auto end = a == std::string::npos ? a : s.find('"', a + std::strlen(attr));
       if (end != std::string::npos) s.erase(a, end + 1 - a);
     }
-    s.insert(4,
-             fmt::format(" class=\"plot\" role=\"img\" aria-label=\"{}\"", html_attribute(title)));
+    s.insert(
+        4, fmt::format(" class=\"{}\" role=\"img\" aria-label=\"{}\"", cls, html_attribute(title)));
     return unique_ids(std::move(s));
   }
 
@@ -163,7 +163,7 @@ void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT 
   PLFLT w = 0, h = 0;
   const PLINT rows = columns > 0 ? (n + columns - 1) / columns : 0;
   pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, y, 0.05, 0,
-           axes_colour, 1, rows, columns, n, opt.data(), 0.6, 0.85, 1.8, 0.0, text_colours.data(),
+           axes_colour, 1, rows, columns, n, opt.data(), 0.6, 1.0, 1.8, 0.0, text_colours.data(),
            texts.data(), colours.data(), box_patterns.data(), scales.data(), widths.data(),
            colours.data(), styles.data(), widths.data(), colours.data(), scales.data(),
            symbol_numbers.data(), symbols.data());
@@ -224,28 +224,52 @@ std::string svg(const XyChart& chart) {
     for (double v : l.y) y.add(v);
   }
   if (chart.zero_line) y.add(0.0);
-  SvgStream s(chart.width_pt, chart.height_pt);
   // The legend goes to the right of the plot, outside the data.
   const bool has_legend = std::any_of(chart.lines.begin(), chart.lines.end(),
                                       [](const Line& l) { return !l.label.empty(); }) ||
                           std::any_of(chart.bands.begin(), chart.bands.end(),
                                       [](const Band& b) { return !b.label.empty(); });
   const bool legend = chart.legend && has_legend;
-  plschr(0, 0.85 * chart.text_scale);
-  // Room on the left for the tick labels, more when the text is scaled up.
-  plvpor(0.04 + 0.07 * chart.text_scale, legend ? 0.72 : 0.97, 0.13, 0.9);
+  // The legend goes below the plot, in as many columns of the longest label as fit the width:
+  // to the right it took a quarter of the width and clipped long instrument names. The page
+  // grows by its rows, so the plot keeps its height.
+  std::size_t labelled = 0, longest = 0;
+  for (const auto& l : chart.lines)
+    if (!l.label.empty()) ++labelled, longest = std::max(longest, l.label.size());
+  for (const auto& b : chart.bands)
+    if (!b.label.empty()) ++labelled, longest = std::max(longest, b.label.size());
+  const double char_pt = 13.0 * chart.text_scale;
+  const auto columns = static_cast<PLINT>(
+      legend ? std::clamp<std::size_t>(static_cast<std::size_t>(chart.width_pt / (char_pt * 0.62) /
+                                                                static_cast<double>(longest + 8)),
+                                       1, std::min<std::size_t>(labelled, 4))
+             : 0);
+  const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
+  const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
+  const double total_pt = chart.height_pt + legend_pt;
+  SvgStream s(chart.width_pt, static_cast<int>(total_pt));
+  plschr(0, 1.05 * chart.text_scale);
   // Room on every side: no point or marker sits on the frame.
   const Range xr = x.empty() ? Range{0, 1}
                    : !chart.x_labels.empty()
                        ? Range{-0.5, static_cast<double>(chart.x_labels.size()) - 0.5}
                        : x.padded(0.04);
   const Range yr = y.padded(0.08);
+  const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
+  const auto [ystep, ydigits] = ticks_for(yr.hi - yr.lo, 6);
+  // Room on the left for the widest tick label and the axis label beyond it ("1006.8" needs
+  // more than "2"): the label is placed past the ticks, never over them.
+  const std::size_t tick_chars = std::max(fmt::format("{:.{}f}", yr.lo, ydigits).size(),
+                                          fmt::format("{:.{}f}", yr.hi, ydigits).size());
+  const double label_disp = 0.8 * static_cast<double>(tick_chars) + 1.6;  // character heights
+  const double left = std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
+  const double bottom = (4.0 * char_pt + legend_pt) / total_pt,
+               top = 1.0 - 2.2 * char_pt / total_pt;
+  plvpor(left, 0.97, bottom, top);
   plwind(xr.lo, xr.hi, yr.lo, yr.hi);
   const bool categories = !chart.x_labels.empty();
   if (categories)
     plslabelfunc(category_label, const_cast<std::vector<std::string>*>(&chart.x_labels));
-  const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
-  const auto [ystep, ydigits] = ticks_for(yr.hi - yr.lo, 6);
   const double xtick = categories ? 1.0 : xstep;
   const PLINT nxsub = categories ? 1 : 0;
   plcol0(grid_colour);
@@ -280,10 +304,13 @@ std::string svg(const XyChart& chart) {
   plbox("", 0, 0, "bcnstv", ystep, 0);
   plprec(0, 0);
   if (categories) plslabelfunc(nullptr, nullptr);
-  pllab(plot_text(chart.x_label).c_str(), plot_text(chart.y_label).c_str(),
-        plot_text(chart.title).c_str());
+  plmtex("b", 3.0, 0.5, 0.5, plot_text(chart.x_label).c_str());
+  plmtex("l", label_disp, 0.5, 0.5, plot_text(chart.y_label).c_str());
+  plmtex("t", 1.5, 0.5, 0.5, plot_text(chart.title).c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
-  if (legend) draw_legend(entries, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT);
+  if (legend)
+    draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
+                3.7 * char_pt / ((top - bottom) * total_pt));
   return s.finish(chart.title);
 }
 
@@ -345,7 +372,7 @@ std::string svg(const PolarChart& chart) {
   const PLINT columns = static_cast<PLINT>(std::min<std::ptrdiff_t>(labelled, fit));
   const int rows = columns > 0 ? static_cast<int>((labelled + columns - 1) / columns) : 0;
   const double width = chart.size_pt, side = 0.88 * width, top = 0.07 * width;
-  const double height = width + (rows > 0 ? 16.0 * rows + 14.0 : 0.0);
+  const double height = width + (rows > 0 ? 18.0 * rows + 34.0 : 20.0);
   SvgStream s(chart.size_pt, static_cast<int>(height));
   const double left = (width - side) / 2;
   plvpor(left / width, (left + side) / width, (height - top - side) / height,
@@ -362,11 +389,11 @@ std::string svg(const PolarChart& chart) {
   }
   // The rings' values in the corner, outside the traces (a label on a ring would sit on them).
   plcol0(reference_colour);
-  plschr(0, 0.75);
+  plschr(0, 1.0);
   plptex(-1.68, 1.62, 1, 0, 0,
          fmt::format("rings: {:+g} to {:+g} µm", -2 * div_um, 2 * div_um).c_str());
   plptex(-1.68, 1.50, 1, 0, 0, "dark ring: nominal radius");
-  plschr(0, 0.85);
+  plschr(0, 1.05);
   for (int a = 0; a < 360; a += 30) {
     const double t = a * std::numbers::pi / 180.0;
     const PLFLT sx[] = {0.5 * std::cos(t), 1.5 * std::cos(t)},
@@ -400,12 +427,12 @@ std::string svg(const PolarChart& chart) {
   if (!chart.centre_text.empty()) plptex(0, -0.03, 1, 0, 0.5, plot_text(chart.centre_text).c_str());
   plmtex("b", 1.0, 0.0, 0.0, fmt::format("scale {:g} µm per ring", div_um).c_str());
   if (chart.mark_start)
-    plmtex("b", 1.0, 1.0, 1.0, "○ start of each trace, arrow: direction of travel");
+    plmtex("b", 2.3, 0.0, 0.0, "○ start of each trace, arrow: direction of travel");
   if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
   // Below the scale's line.
   draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
-              0.06);
-  return s.finish(chart.title);
+              0.11);
+  return s.finish(chart.title, "plot polar");
 }
 
 }  // namespace cal::daq::report

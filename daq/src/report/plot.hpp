@@ -41,7 +41,7 @@ struct XyChart {
   std::string title, x_label, y_label;
   std::vector<Band> bands;
   std::vector<Line> lines;
-  int width_pt = 760, height_pt = 380;
+  int width_pt = 600, height_pt = 300;
   bool zero_line = false;  // a grey line at y = 0
   // Categories instead of numbers on x: the lines' x are 0, 1, ... and tick k is labelled
   // x_labels[k] (e.g. the dates of runs).
@@ -57,7 +57,7 @@ struct PolarChart {
   std::string title;
   std::string first_axis = "X", second_axis = "Y";
   std::vector<Line> traces;
-  int size_pt = 520;
+  int size_pt = 400;
   std::string centre_text;  // written at the centre, e.g. "G = 6.96 µm"
   bool mark_start = true;   // each trace's first point marked, an arrow in its direction
 };

@@ -25,6 +25,7 @@
 #include "markup.hpp"
 #include "plot.hpp"
 #include "provenance.hpp"
+#include "run_quality.hpp"
 #include "verdict.hpp"
 
 namespace cal::daq::report {
@@ -39,7 +40,22 @@ using Q = cal::drivers::Quantity;
 // Every value from outside that goes into the HTML goes through this (markup.hpp).
 std::string esc(std::string_view s) { return html_text(s); }
 
-std::string um(double v) { return fmt::format("{:.3f}", v); }
+// A value to `decimals` places that never reads "-0.000": a value that rounds to zero is 0.
+std::string fixed(double v, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  if (std::round(std::abs(v) * scale) == 0) v = 0.0;
+  return fmt::format("{:.{}f}", v, decimals);
+}
+std::string signed_text(double v, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  if (std::round(std::abs(v) * scale) == 0) return fmt::format("{:.{}f}", 0.0, decimals);
+  return fmt::format("{:+.{}f}", v, decimals);
+}
+std::string um(double v) { return fixed(v, 3); }
+// A result's unit as printed: "um" is µm.
+std::string unit_text(std::string_view u) {
+  return u == "um" ? std::string("µm") : u == "um/m" ? std::string("µm/m") : std::string(u);
+}
 
 std::string iso_time(std::int64_t unix_ms) {
   const std::time_t s = unix_ms / 1000;
@@ -109,6 +125,20 @@ std::string instrument_name(const RunView& v, int device) {
   return fmt::format("device {}", device);
 }
 
+// An instrument as a legend names it: its driver and serial number from the run's context
+// ("ptu300 SIM-PTU-0001"), else the name it was given in the configuration.
+std::string instrument_label(const RunView& v, int device) {
+  const std::string name = instrument_name(v, device);
+  const auto list = v.context.value("instruments", json::array());
+  if (list.is_array())
+    for (const auto& i : list)
+      if (i.is_object() && i.value("id", "") == name && i.value("driver", "") != "") {
+        const std::string serial = i.value("serial_number", "");
+        return i.value("driver", "") + (serial.empty() ? "" : " " + serial);
+      }
+  return name;
+}
+
 Environment load_environment(const st::Store& store, const RunView& v) {
   static constexpr std::uint8_t wanted[] = {
       static_cast<std::uint8_t>(Q::air_temperature_degc),
@@ -128,7 +158,7 @@ Environment load_environment(const st::Store& store, const RunView& v) {
   }
   for (auto& [key, s] : by_source) {
     const auto [q, device, channel] = key;
-    s.label = fmt::format("{} ch {}", instrument_name(v, device), channel);
+    s.label = instrument_label(v, device) + (channel ? fmt::format(" channel {}", channel) : "");
     switch (static_cast<Q>(q)) {
       case Q::air_temperature_degc:
         env.air_temperature.push_back(std::move(s));
@@ -206,15 +236,19 @@ std::vector<Line> lines_of(const std::vector<Series>& series, std::size_t first_
 
 // --- sections shared by every kind ---------------------------------------------------------------
 
-std::string run_title(const RunView& v) {
+// "Positioning test (ISO 230-2), axis X".
+std::string test_name(const RunView& v) {
   const std::string what = v.run.kind == "linear"    ? "Positioning test (ISO 230-2)"
                            : v.run.kind == "circle"  ? "Circular test (ISO 230-4, ballbar)"
                            : v.run.kind == "dynamic" ? "Dynamic capture"
                                                      : v.run.kind + " test";
+  return fmt::format("{}, axis {}", what, v.run.axis);
+}
+
+std::string run_title(const RunView& v) {
   // The origin leads the title, so it is on every printed page's running header too.
   const auto label = ::daq::run_origin(v.run, v.instruments, v.machine).label();
-  return fmt::format("{}Run {}: {}, axis {}", label.empty() ? "" : label + " — ", v.run.id, what,
-                     v.run.axis);
+  return fmt::format("{}Run {}: {}", label.empty() ? "" : label + " — ", v.run.id, test_name(v));
 }
 
 // A setting as an engineer reads it: strings without quotes, numbers without binary noise
@@ -235,6 +269,8 @@ std::string missed_text(const st::MissedStop& m) {
                      m.direction == '+' ? "↑" : "↓", m.target_index + 1, m.nominal_mm);
 }
 
+std::string connections_table(const RunView& v);
+
 std::string setup_section(const RunView& v) {
   std::vector<std::vector<std::string>> rows = {
       {"Machine", esc(v.machine.empty() ? "(not recorded)" : v.machine)},
@@ -243,6 +279,7 @@ std::string setup_section(const RunView& v) {
       {"Ended", v.run.ended_unix_ms ? iso_time(*v.run.ended_unix_ms) : "(not ended)"},
       {"Status", std::string(st::to_string(v.run.status)) +
                      (v.run.note.empty() ? "" : " &mdash; " + esc(v.run.note))},
+      {"Origin of the readings", esc(::daq::run_origin(v.run, v.instruments, v.machine).text)},
       {"Software", esc(v.run.software_version)},
       {"Capture file", "<span class=\"path\">" +
                            esc(v.run.capture_path.empty() ? "(none)" : v.run.capture_path) +
@@ -250,13 +287,90 @@ std::string setup_section(const RunView& v) {
   if (!v.missed.empty()) {
     std::string list;
     for (const auto& m : v.missed) list += (list.empty() ? "" : "; ") + missed_text(m);
-    rows.insert(rows.begin() + 5, {"Missed stops", fmt::format("<span class=\"fail\">{} never "
+    rows.insert(rows.begin() + 6, {"Missed stops", fmt::format("<span class=\"fail\">{} never "
                                                                "captured:</span> {}",
                                                                v.missed.size(), esc(list))});
   }
-  std::string h = "<h3>Test set-up</h3>\n" + table({"", ""}, rows, "kv");
-  // The settings as recorded at the start; a coefficient the current result used differently
-  // (re-compensation) is shown with both values.
+  return "<h3>Test set-up</h3>\n" + table({"", ""}, rows, "kv") + connections_table(v);
+}
+
+// A setting's label and unit as an engineer reads it (docs/reports.md, "Settings"); a key not
+// listed here is shown by its name.
+struct SettingLabel {
+  std::string_view key, label, unit;
+};
+constexpr SettingLabel setting_labels[] = {
+    {"axis", "Axis", ""},
+    {"standard", "Standard", ""},
+    {"cycle", "Cycle", ""},
+    {"bidirectional", "Approach in both directions", ""},
+    {"runs", "Runs per target", ""},
+    {"targets_mm", "Targets", "mm"},
+    {"datum_mm", "Datum", "mm"},
+    {"feed_mm_per_min", "Feed", "mm/min"},
+    {"dwell_s", "Dwell at each target", "s"},
+    {"machine", "Machine", ""},
+    {"trigger.dwell_s", "Stop detection: still for", "s"},
+    {"trigger.tolerance_um", "Stop detection: within", "µm"},
+    {"trigger.window_mm", "Stop detection: window around the target", "mm"},
+    {"environment.equation", "Refractive index equation", ""},
+    {"environment.expansion_ppm_per_k", "Expansion coefficient", "ppm/K"},
+    {"environment.co2_umol_per_mol", "CO2 content of the air", "µmol/mol"},
+    {"environment.wavelength_nm", "Laser vacuum wavelength", "nm"},
+    {"environment.stale_after_s", "Environment readings stale after", "s"},
+    {"environment.on_stale", "When they go stale", ""},
+    {"measure.kind", "Measurement", ""},
+    {"measure.component", "Error component", ""},
+    {"measure.unit", "Unit of the result", ""},
+    {"measure.direction", "Direction of the deviation", ""},
+    {"measure.beams", "Interferometer beams", ""},
+    {"measure.separation_mm", "Beam separation", "mm"},
+    {"measure.sign", "Sign of the reading", ""},
+    {"measure.square", "Against a square", ""},
+    {"measure.stationary_mm", "Stationary position", "mm"},
+    {"measure.probe_offset_mm", "Probe offset", "mm"},
+    {"machine_model.topology", "Machine model: kinematic chain", ""},
+    {"machine_model.table_offset_mm", "Machine model: table offset", "mm"},
+    {"machine_model.tool_offset_mm", "Machine model: tool offset", "mm"},
+    {"plane", "Plane", ""},
+    {"radius_mm", "Radius (bar length)", "mm"},
+    {"arc_deg", "Arc", "°"},
+    {"start_deg", "Start angle", "°"},
+    {"overshoot_deg", "Overshoot arc", "°"},
+    {"feed_in_mm", "Feed-in", "mm"},
+    {"sample_rate_hz", "Sample rate", "Hz"},
+    {"uncalibrated", "Bar uncalibrated", ""},
+    {"uncalibrated_reason", "Why uncalibrated", ""},
+    {"calibrated_radius_mm", "Calibrated bar length", "mm"},
+};
+
+// Whether a setting says anything for this run: not an empty text or list, not an offset of
+// zero, not a positioning run's angular-only keys.
+bool setting_applies(const RunView& v, const std::string& key, const json& val) {
+  if (val.is_null() || (val.is_string() && val.get<std::string>().empty())) return false;
+  if (val.is_array() && val.empty()) return false;
+  if (val.is_array() && key.ends_with("_mm") && key != "targets_mm" &&
+      std::all_of(val.begin(), val.end(),
+                  [](const json& x) { return x.is_number() && x.get<double>() == 0.0; }))
+    return false;
+  const json measure = v.settings.value("measure", json::object());
+  const bool positioning = measure.is_object() && measure.value("kind", "") == "positioning";
+  if (positioning && (key == "measure.beams" || key == "measure.separation_mm" ||
+                      key == "measure.square" || key == "measure.sign"))
+    return false;
+  if (key == "uncalibrated" && val.is_boolean() && !val.get<bool>()) return false;
+  return true;
+}
+
+std::string setting_value(const json& val, std::string_view unit) {
+  if (val.is_boolean()) return val.get<bool>() ? "yes" : "no";
+  const std::string text = esc(setting_text(val));
+  return unit.empty() ? text : text + " " + esc(unit);
+}
+
+// The settings as recorded at the start, as an appendix: labels and units, only the keys that
+// apply; a coefficient the current result used differently (re-compensation) is shown with both.
+std::string settings_appendix(const RunView& v) {
   const auto used_note = [&](const std::string& key, const json& value) -> std::string {
     if (v.run.kind != "linear" || !v.used.recompensated) return "";
     const std::string name = key.substr(key.find('.') + 1);
@@ -265,23 +379,45 @@ std::string setup_section(const RunView& v) {
     return fmt::format(" <span class=\"changed\">(as acquired; the current result uses {})</span>",
                        esc(setting_text(v.used.coefficients[name])));
   };
-  std::vector<std::vector<std::string>> settings;
+  std::vector<std::pair<std::string, json>> flat;
   for (const auto& [k, val] : v.settings.items()) {
-    if (k == "context") continue;                        // shown in its own sections
-    if (k == "calibration" && v.run.kind == "circle") {  // the section "Bar calibration"
-      settings.push_back({"calibration", fmt::format("record {} (see Bar calibration)",
+    if (k == "context") continue;  // shown in its own sections
+    if (val.is_object() && !(k == "calibration" && v.run.kind == "circle")) {
+      for (const auto& [k2, v2] : val.items()) flat.emplace_back(k + "." + k2, v2);
+    } else {
+      flat.emplace_back(k, val);
+    }
+  }
+  // Known keys in their reading order, then the others by name.
+  const auto rank = [](const std::string& key) {
+    for (std::size_t i = 0; i < std::size(setting_labels); ++i)
+      if (setting_labels[i].key == key) return i;
+    return std::size(setting_labels);
+  };
+  std::stable_sort(flat.begin(), flat.end(),
+                   [&](const auto& a, const auto& b) { return rank(a.first) < rank(b.first); });
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& [key, val] : flat) {
+    if (key == "calibration") {  // the section "Bar calibration"
+      rows.push_back({"Bar calibration", fmt::format("record {} (see Bar calibration)",
                                                      val.value("id", std::int64_t{0}))});
       continue;
     }
-    if (val.is_object()) {
-      for (const auto& [k2, v2] : val.items())
-        settings.push_back(
-            {esc(k + "." + k2), esc(setting_text(v2)) + used_note(k + "." + k2, v2)});
-    } else {
-      settings.push_back({esc(k), esc(setting_text(val))});
-    }
+    if (!setting_applies(v, key, val)) continue;
+    const auto i = rank(key);
+    const bool known = i < std::size(setting_labels);
+    rows.push_back({known ? esc(setting_labels[i].label) : "<code>" + esc(key) + "</code>",
+                    setting_value(val, known ? setting_labels[i].unit : "") + used_note(key, val)});
   }
-  if (!settings.empty()) h += "<h4>Settings</h4>\n" + table({"setting", "value"}, settings, "kv");
+  if (rows.empty()) return "";
+  return "<h3>Appendix: settings of the run</h3>\n<p class=\"note\">As recorded at the start "
+         "of the run; settings that do not apply to this test are left out.</p>\n" +
+         table({"setting", "value"}, rows, "kv");
+}
+
+// The instruments and their connections.
+std::string connections_table(const RunView& v) {
+  std::string h;
   std::vector<std::vector<std::string>> inst;
   for (const auto& i : v.instruments)
     inst.push_back({std::to_string(i.device), esc(i.driver), esc(i.transport)});
@@ -307,32 +443,31 @@ std::string environment_section(const Environment& env) {
   row("Refractive index (instrument)", env.index, "", 9);
   h += table({"quantity", "min", "mean", "max", "unit", "samples"}, rows, "num", "lrrrlr");
   auto temps = lines_of(env.air_temperature, 0);
-  for (auto& l : lines_of(env.material_temperature, 1)) {
-    l.label = "material " + l.label;
+  for (auto& l : temps) l.label = "air: " + l.label;
+  for (auto& l : lines_of(env.material_temperature, env.air_temperature.size())) {
+    l.label = "material: " + l.label;
     l.dashed = true;
     temps.push_back(std::move(l));
   }
-  for (auto& l : temps)
-    if (!l.dashed) l.label = "air " + l.label;
   h += figure(svg(XyChart{.title = "Temperatures",
                           .x_label = "time (min)",
                           .y_label = "temperature (°C)",
                           .lines = temps,
-                          .height_pt = 300}),
+                          .height_pt = 240}),
               "Air and material temperature during the run.");
   if (!env.pressure_hpa.empty())
     h += figure(svg(XyChart{.title = "Air pressure",
                             .x_label = "time (min)",
                             .y_label = "pressure (hPa)",
                             .lines = lines_of(env.pressure_hpa, 2),
-                            .height_pt = 260}),
+                            .height_pt = 240}),
                 "Air pressure during the run.");
   if (!env.humidity.empty())
     h += figure(svg(XyChart{.title = "Relative humidity",
                             .x_label = "time (min)",
                             .y_label = "humidity (%RH)",
                             .lines = lines_of(env.humidity, 5),
-                            .height_pt = 260}),
+                            .height_pt = 240}),
                 "Relative humidity during the run.");
   return h;
 }
@@ -367,7 +502,8 @@ std::string customer_section(const RunView& v) {
 std::string ymd(std::int64_t unix_ms) { return iso_time(unix_ms).substr(0, 10); }
 
 // The instruments with their serial numbers and calibration; a due date before the test is
-// flagged (the instrument was out of calibration when it measured).
+// flagged (the instrument was out of calibration when it measured). The warnings themselves
+// are on page one (traceability_warnings).
 std::string instruments_section(const RunView& v) {
   const auto list = v.context.value("instruments", json::array());
   std::string h = "<h3>Instruments and calibration</h3>\n";
@@ -377,26 +513,100 @@ std::string instruments_section(const RunView& v) {
            "certificates were not recorded with this run (give serial_number, certificate "
            "and calibration_due of each device in the configuration).</p>\n";
   std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> past;
   const std::string test_day = ymd(v.run.started_unix_ms);
   for (const auto& i : list) {
     const std::string due = ctx(i, "calibration_due");
     std::string due_cell = stated(due);
-    if (!due.empty() && due < test_day) {
+    if (!due.empty() && due < test_day)
       due_cell = "<span class=\"fail\">" + esc(due) + " &mdash; PAST DUE</span>";
-      past.push_back(ctx(i, "id"));
-    }
     rows.push_back({esc(ctx(i, "role")), esc(ctx(i, "id")), esc(ctx(i, "driver")),
                     stated(ctx(i, "serial_number")), stated(ctx(i, "certificate")), due_cell});
   }
-  h += table({"role", "device", "instrument", "serial number", "certificate", "calibration due"},
-             rows);
-  if (!past.empty())
-    h += fmt::format(
-        "<p class=\"warning\">Warning: the calibration of {} was past due on the test date "
-        "({}): its readings are not traceable to a valid certificate.</p>\n",
-        esc(fmt::format("{}", fmt::join(past, ", "))), test_day);
+  return h +
+         table({"role", "device", "instrument", "serial number", "certificate", "calibration due"},
+               rows);
+}
+
+// The gaps in the traceability of the readings, one warning per instrument: a calibration due
+// before the test day, or a serial number, certificate or due date not stated. Without them a
+// reader cannot tell whether the instrument was calibrated when it measured.
+std::vector<std::string> traceability_gaps(const RunView& v) {
+  const auto list = v.context.value("instruments", json::array());
+  if (!list.is_array() || list.empty())
+    return {
+        "the instruments' serial numbers, certificates and calibration due dates were not "
+        "recorded with this run"};
+  std::vector<std::string> out;
+  const std::string test_day = ymd(v.run.started_unix_ms);
+  for (const auto& i : list) {
+    const std::string name = ctx(i, "id").empty() ? ctx(i, "role") : ctx(i, "id");
+    const std::string due = ctx(i, "calibration_due");
+    if (!due.empty() && due < test_day)
+      out.push_back(
+          fmt::format("the calibration of {} was past due on the test date ({} < {}): "
+                      "its readings are not traceable to a valid certificate",
+                      name, due, test_day));
+    std::vector<std::string> missing;
+    if (ctx(i, "serial_number").empty()) missing.push_back("serial number");
+    if (ctx(i, "certificate").empty()) missing.push_back("certificate");
+    if (due.empty()) missing.push_back("calibration due date");
+    if (!missing.empty())
+      out.push_back(fmt::format("{}: no {} stated", name, fmt::join(missing, ", ")));
+  }
+  return out;
+}
+
+std::string traceability_warnings(const RunView& v) {
+  std::string h;
+  for (const auto& g : traceability_gaps(v))
+    h += "<p class=\"warning\">Traceability: " + esc(g) + ".</p>\n";
   return h;
+}
+
+// The quality of the run's stops (run_quality.hpp, docs/iso230-2.md "Suspect stops"): a suspect
+// run says so on page one, with its stops named.
+std::string quality_banner(const st::Store& store, const RunView& v) {
+  if (v.run.kind == "circle" || v.run.kind == "dynamic") return "";
+  cal::storage::RunQuality q;
+  try {
+    q = ::daq::run_quality(store, v.run.id);
+  } catch (const std::exception& e) {
+    return "<p class=\"warning\">Run quality: " + esc(e.what()) + "</p>\n";
+  }
+  if (q.state != "suspect")
+    return q.state.empty() ? ""
+                           : fmt::format("<p class=\"note\">Run quality: {}{}</p>\n", esc(q.state),
+                                         q.summary.empty() ? "" : " &mdash; " + esc(q.summary));
+  std::string stops;
+  for (const auto& m : q.suspects)
+    stops += fmt::format("<li>run {} {} target {}: {}</li>", m.run_number,
+                         m.direction == '+' ? "↑" : "↓", m.target_index + 1, esc(m.reason));
+  return fmt::format(
+      "<div class=\"verdict suspect\"><strong>SUSPECT RUN</strong>: {} The results below "
+      "include these stops; repeat them or the run before relying on it.<ul>{}</ul></div>\n",
+      esc(q.summary), stops);
+}
+
+// Page one's heading block: who, what machine, which test, when.
+std::string summary_block(const RunView& v, std::string_view test) {
+  const json c = v.context.value("customer", json::object());
+  const json m = v.context.value("machine", json::object());
+  std::string machine = esc(v.machine.empty() ? ctx(m, "name") : v.machine);
+  std::string make_model = ctx(m, "make");
+  if (!ctx(m, "model").empty()) make_model += (make_model.empty() ? "" : " ") + ctx(m, "model");
+  if (!make_model.empty()) machine += ", " + esc(make_model);
+  if (!ctx(m, "serial_number").empty()) machine += ", s/n " + esc(ctx(m, "serial_number"));
+  std::string customer = stated(ctx(c, "name"));
+  if (!ctx(c, "site").empty()) customer += ", " + esc(ctx(c, "site"));
+  return fmt::format(
+      "<table class=\"summary\"><tbody>"
+      "<tr><th>Customer</th><td>{}</td><th>Test</th><td>{}</td></tr>"
+      "<tr><th>Machine</th><td>{}</td><th>Date</th><td>{}</td></tr>"
+      "<tr><th>Operator</th><td>{}</td><th>Machine state</th><td>{}</td></tr>"
+      "</tbody></table>\n",
+      customer, esc(test), machine, iso_time(v.run.started_unix_ms),
+      stated(ctx(v.context, "operator")),
+      stated(ctx(v.context.value("conditions", json::object()), "state")));
 }
 
 // The state of the machine during the test, and what the sign of a deviation means.
@@ -448,6 +658,19 @@ std::string verdict_banner(const ::daq::Verdict& v) {
                            std::count_if(v.checks.begin(), v.checks.end(),
                                          [](const auto& c) { return !c.pass; }),
                            v.checks.size()));
+  if (!v.pass) {
+    // The failing values on page one, each with its limit: why the machine did not pass.
+    std::string items;
+    for (const auto& c : v.checks)
+      if (!c.pass) {
+        const auto advice = ::daq::diagnostic_advice(c.key);
+        items +=
+            fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {:.3f} {}){}</li>", esc(c.symbol),
+                        signed_text(c.value, 3), esc(unit_text(c.unit)), c.limit,
+                        esc(unit_text(c.unit)), advice.empty() ? "" : ": " + esc(advice));
+      }
+    h += "<ul class=\"failing\">" + items + "</ul>\n";
+  }
   for (const auto& n : v.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
   return h;
 }
@@ -544,9 +767,23 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
   return h;
 }
 
+// The order of the ISO 230-2 values on every page: as the results grid reads (E, R, A each up,
+// down, bidirectional; M, B, B̄), then any other value in its evaluation's order.
+std::size_t iso_order(std::string_view key) {
+  static constexpr std::string_view order[] = {"E_bi", "E_up", "E_down", "R_bi", "R_up", "R_down",
+                                               "A_bi", "A_up", "A_down", "M",    "B",    "B_mean"};
+  const auto* at = std::find(std::begin(order), std::end(order), key);
+  return static_cast<std::size_t>(at - std::begin(order));
+}
+
 // Headline numbers of a run, for the campaign summary and the comparison trends.
 struct Headline {
-  std::vector<std::pair<std::string, double>> values_um;  // symbol, value
+  struct Value {
+    std::string symbol;
+    double value = 0;
+    std::string unit;  // as printed: "µm", "µm/m", "ms"
+  };
+  std::vector<Value> values;
   std::string standard;
   std::string verdict;  // PASS, FAIL, no tolerance configured
 };
@@ -603,7 +840,8 @@ cal::unc::Budget linear_budget(const RunView& v, const Linear& l, double& length
   return cal::unc::positioning_budget(s);
 }
 
-std::string linear_plots(const Linear& l) {
+// The main plot of a linear run: the mean deviations with their ±2s bands.
+std::string means_plot(const Linear& l) {
   const auto& e = l.e;
   std::vector<double> x, up, down, bi, up_lo, up_hi, down_lo, down_hi;
   for (const auto& t : e.targets) {
@@ -619,7 +857,7 @@ std::string linear_plots(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
-                .height_pt = 430,
+                .height_pt = 230,
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
   means.bands.push_back(
@@ -647,10 +885,13 @@ std::string linear_plots(const Linear& l) {
                            .width = 1.0,
                            .dashed = true});
   }
-  std::string h = figure(svg(means),
-                         "Mean unidirectional positional deviations x̄i↑ and x̄i↓ at each target, "
-                         "with the bands x̄ ± 2s (s: the estimator of the unidirectional "
-                         "repeatability), and the mean bidirectional deviation.");
+  return figure(svg(means),
+                "Mean unidirectional positional deviations x̄i↑ and x̄i↓ at each target, "
+                "with the bands x̄ ± 2s (s: the estimator of the unidirectional "
+                "repeatability), and the mean bidirectional deviation.");
+}
+
+std::string runs_plot(const Linear& l) {
   // Run by run: one line per run and direction, in the order of the targets.
   std::map<std::pair<int, char>, std::vector<std::pair<double, double>>> runs;
   for (const auto& t : l.targets)
@@ -658,7 +899,7 @@ std::string linear_plots(const Linear& l) {
   XyChart traces{.title = "Run-by-run deviations",
                  .x_label = "target position (mm)",
                  .y_label = "deviation (µm)",
-                 .height_pt = 430,
+                 .height_pt = 300,
                  .zero_line = true};
   for (auto& [key, pts] : runs) {
     std::sort(pts.begin(), pts.end());
@@ -670,9 +911,9 @@ std::string linear_plots(const Linear& l) {
     for (const auto& [px, py] : pts) line.x.push_back(px), line.y.push_back(py);
     traces.lines.push_back(std::move(line));
   }
-  return h + figure(svg(traces),
-                    "Every captured deviation x_ij: solid lines approach in the "
-                    "positive direction (↑), dashed lines in the negative (↓).");
+  return figure(svg(traces),
+                "Every captured deviation x_ij: solid lines approach in the "
+                "positive direction (↑), dashed lines in the negative (↓).");
 }
 
 // The ISO 230-2 values as a grid: one row per kind of value, columns up, down and
@@ -720,12 +961,20 @@ std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdic
          "the limits apply to the bidirectional values (ISO 230-2).</p>\n";
 }
 
-std::string linear_section(const st::Store& store, const RunView& v, const Options& o,
-                           Headline& headline) {
+// A run's results in two parts: the answer (page one: verdict, main table, main plot) and the
+// details that support it.
+struct Sections {
+  std::string answer, details;
+};
+
+Sections linear_section(const st::Store& store, const RunView& v, const Options& o,
+                        Headline& headline) {
   const auto l = evaluate_linear(store, v, o);
   const auto& e = l.e;
   headline.standard = std::string(e.standard.title);
-  std::string h = fmt::format(
+  Sections out;
+  std::string& h = out.answer;
+  h = fmt::format(
       "<h3>Results: {}</h3>\n<p class=\"standard\">Evaluated by <strong>{}</strong> ({}). {} "
       "targets, {}, {}.</p>\n",
       esc(e.standard.title), esc(e.standard.title), esc(e.standard.note), e.targets.size(),
@@ -734,15 +983,17 @@ std::string linear_section(const st::Store& store, const RunView& v, const Optio
   // every value of a standard without them (VDI/DGQ 3441).
   for (const char* key : {"E_bi", "R_bi", "A_bi", "M", "B", "B_mean"})
     for (const auto& a : e.axis)
-      if (a.key == key) headline.values_um.push_back({a.symbol, a.value_um});
-  if (headline.values_um.empty())
-    for (const auto& a : e.axis) headline.values_um.push_back({a.symbol, a.value_um});
+      if (a.key == key) headline.values.push_back({a.symbol, a.value_um, "µm"});
+  if (headline.values.empty())
+    for (const auto& a : e.axis) headline.values.push_back({a.symbol, a.value_um, "µm"});
   const auto doc = ::daq::to_json(e);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
   h += verdict_banner(verdict);
   h += results_grid(e, verdict);
-  h += linear_plots(l);
+  h += means_plot(l);
+  std::string& d = out.details;
+  d = "<h3>Details of the results</h3>\n" + runs_plot(l);
   std::vector<std::string> head{"target (mm)"};
   for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (µm)");
   std::vector<std::vector<std::string>> rows;
@@ -751,29 +1002,29 @@ std::string linear_section(const st::Store& store, const RunView& v, const Optio
     for (const auto& p : e.per_target) r.push_back(um(p.values_um[i]));
     rows.push_back(std::move(r));
   }
-  h += "<h4>Per target</h4>\n" + table(head, rows, "num");
-  for (const auto& w : e.warnings) h += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
+  d += "<h4>Per target</h4>\n" + table(head, rows, "num");
+  for (const auto& w : e.warnings) d += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
 
   double length_m = 0;
   const auto b = linear_budget(v, l, length_m);
   std::vector<std::vector<std::string>> contrib;
   for (const auto& c : b.contributors)
     contrib.push_back({esc(c.name), fmt::format("{:.4f}", c.u_um), esc(c.model)});
-  h += fmt::format(
+  d += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>Of a positional deviation at the measured travel "
       "L = {:.3f} m (ISO 230-2 Annex A, ISO/TR 230-9): combined standard uncertainty "
       "u<sub>c</sub> = {:.4f} µm, <strong>expanded uncertainty U = {:.3f} µm (k = {:g})</strong>."
       "</p>\n",
       length_m, b.u_combined_um, b.expanded_um, b.k);
-  h += table({"contributor", "u (µm)", "model"}, contrib, "num", "lrl");
-  h += "<p class=\"note\">Air and material values are the means measured during this run. "
+  d += table({"contributor", "u (µm)", "model"}, contrib, "num", "lrl");
+  d += "<p class=\"note\">Air and material values are the means measured during this run. "
        "Assumed, not measured with the run: laser certificate 0.1 ppm (k = 2), sensor standard "
        "uncertainties 0.1 K, 10 Pa, 2 %RH, expansion coefficient ±1 ppm/K; no environmental "
        "variation (drift) test, misalignment or dead path was recorded, so they are not in the "
        "budget. Use <code>daq uncertainty</code> with the actual values to revise it.</p>\n";
-  for (const auto& w : b.warnings) h += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
-  headline.values_um.push_back({"U (k=2)", b.expanded_um});
-  return h;
+  for (const auto& w : b.warnings) d += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
+  headline.values.push_back({"U (k=2)", b.expanded_um, "µm"});
+  return out;
 }
 
 // --- ISO 230-4
@@ -898,13 +1149,59 @@ std::vector<std::tuple<std::string, std::string, double>> standard_values(const 
   return out;
 }
 
-std::string circle_section(const st::Store& store, const RunView& v, const Options& o,
-                           Headline& headline) {
+// The diagnostics as a table: rank, error, value in its own unit, what correcting it would
+// gain (µm and share of G), PV, limit and verdict, and what to check. `top`: only the first
+// rows with a positive gain (page one's "what to fix first").
+std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict& verdict,
+                              std::size_t top) {
+  std::vector<std::vector<std::string>> diag;
+  const double g = r.iso.G_bi_um;
+  for (std::size_t i = 0; i < r.diagnostics.size(); ++i) {
+    const auto& d = r.diagnostics[i];
+    if (top && (diag.size() >= top || std::round(d.g_reduction_um * 1e3) <= 0)) break;
+    const auto* check = ::daq::find_check(verdict, d.key);
+    std::vector<std::string> row{
+        std::to_string(i + 1), esc(d.name),
+        "<span class=\"nw\">" + signed_text(d.value, 3) + " " + esc(unit_text(d.unit)) + "</span>",
+        signed_text(d.g_reduction_um, 3),
+        g > 0 ? fixed(100.0 * d.g_reduction_um / g, 0) : std::string("&ndash;")};
+    if (!top) {
+      row.push_back(um(d.pv_um));
+      row.push_back(check ? fmt::format("≤ {:.3f}", check->limit) + " " + verdict_cell(check) : "");
+    }
+    const auto advice = ::daq::diagnostic_advice(d.key);
+    row.push_back(advice.empty() ? std::string("see docs/circle.md") : esc(advice));
+    diag.push_back(std::move(row));
+  }
+  if (diag.empty()) return "";
+  std::vector<std::string> head{"rank", "error", "value", "G gain (µm)", "gain / G (%)"};
+  if (!top) {
+    head.push_back("PV (µm)");
+    head.push_back("limit");
+  }
+  head.push_back("what to check");
+  return table(head, diag, "num diag", top ? "rlrrrl" : "rlrrrrll");
+}
+
+// What the ranking means, and a warning when no term would gain anything (the first gain is not
+// positive): the errors then cancel each other and none alone is worth correcting.
+std::string gain_notes(const cal::circle::Result& r) {
+  std::string h;
+  if (!r.diagnostics.empty() && std::round(r.diagnostics.front().g_reduction_um * 1e3) <= 0)
+    h += "<p class=\"warning\">No single error would make G smaller if corrected alone: the "
+         "errors partly cancel each other (every G gain is zero or negative).</p>\n";
+  return h;
+}
+
+Sections circle_section(const st::Store& store, const RunView& v, const Options& o,
+                        Headline& headline) {
   const auto c = analyse_circle(store, v, o);
   const auto& r = c.result;
   const auto& st = cal::circle::info(cal::circle::circular_standard_from_key(c.analysis.standard));
   headline.standard = st.label;
-  std::string h = fmt::format(
+  Sections out;
+  std::string& h = out.answer;
+  h = fmt::format(
       "<h3>Results: {0}</h3>\n<p class=\"standard\">Evaluated by <strong>{0}</strong> ({1}){2}; "
       "radius {3:g} mm, feed {4:g} mm/min, plane {5}, both directions from the stored bar "
       "readings.</p>\n",
@@ -921,7 +1218,7 @@ std::string circle_section(const st::Store& store, const RunView& v, const Optio
     iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)), esc(x.meaning),
                    limit_cell(check), check ? verdict_cell(check) : ""});
     if (x.key.starts_with("G"))
-      headline.values_um.push_back({x.symbol, ::daq::iso_value(r.iso, x.key)});
+      headline.values.push_back({x.symbol, ::daq::iso_value(r.iso, x.key), "µm"});
   }
   iso.push_back({"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
                  "least-squares centre relative to the pivot (set-up)", "", ""});
@@ -931,49 +1228,48 @@ std::string circle_section(const st::Store& store, const RunView& v, const Optio
   h += verdict_banner(verdict);
   h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
              "lrlrl");
-  for (const auto& n : st.not_evaluated)
-    h += "<p class=\"note\">Not evaluated: " + esc(n) + "</p>\n";
+  const auto first = diagnostics_table(r, verdict, 3);
+  h += "<h4>What to fix first</h4>\n" +
+       (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
+                      : first +
+                            "<p class=\"note\">The errors that would reduce G most if "
+                            "corrected alone, largest first (all of them under Details).</p>\n");
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
   polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
   h += figure(svg(polar),
               "Radial deviation of both directions around the nominal circle (magnified: the "
               "rings are the scale, the dark ring the nominal radius). The open circle marks "
               "where each trace starts, the arrow its direction of travel.");
-  std::vector<std::vector<std::string>> diag;
-  const auto unit_text = [](const std::string& u) {
-    return u == "um" ? std::string("µm") : u == "um/m" ? std::string("µm/m") : u;
-  };
-  for (std::size_t i = 0; i < r.diagnostics.size(); ++i) {
-    const auto& d = r.diagnostics[i];
-    const auto* check = ::daq::find_check(verdict, d.key);
-    diag.push_back({std::to_string(i + 1), esc(d.name), fmt::format("{:+.3f}", d.value),
-                    esc(unit_text(d.unit)), um(d.pv_um), fmt::format("{:.1f}", d.share_pct),
-                    um(d.g_reduction_um), check ? fmt::format("≤ {:.3f}", check->limit) : "",
-                    check ? verdict_cell(check) : ""});
-    if (i < 4) headline.values_um.push_back({d.name, d.pv_um});
-  }
-  h += "<h4>Diagnostics, ranked</h4>\n" + table({"rank", "error", "value", "unit", "PV (µm)",
-                                                 "PV / G (%)", "G gain (µm)", "limit", "verdict"},
-                                                diag, "num diag", "rlrlrrrrl");
-  h += fmt::format(
+  // The campaign summary's headline: the first diagnostics in their own units.
+  for (std::size_t i = 0; i < r.diagnostics.size() && i < 4; ++i)
+    headline.values.push_back(
+        {r.diagnostics[i].name, r.diagnostics[i].value, unit_text(r.diagnostics[i].unit)});
+
+  std::string& d = out.details;
+  d = "<h3>Details of the results</h3>\n<h4>Diagnostics, ranked by what correcting each would "
+      "gain</h4>\n" +
+      diagnostics_table(r, verdict, 0) + gain_notes(r);
+  for (const auto& n : st.not_evaluated)
+    d += "<p class=\"note\">Not evaluated: " + esc(n) + "</p>\n";
+  d += fmt::format(
       "<p class=\"note\">Each error is fitted to both traces together. <em>value</em> is the "
-      "error in its own unit (a backlash in µm, a squareness in µm/m, a servo mismatch in ms); "
-      "<em>PV</em> is the peak-to-valley, in µm, of the radial deviation that error alone "
-      "causes on this circle; <em>PV / G</em> compares it with G = {:.3f} µm. The errors add up "
-      "with their signs around the circle and partly cancel, so one share can exceed 100 % and "
-      "the shares do not sum to 100 %. <em>G gain</em> is how much G falls when that error "
-      "alone is corrected (negative: it partly cancels another). A limit applies to the "
-      "magnitude of the value, in its unit.</p>\n",
+      "error in its own unit (a backlash in µm, a squareness in µm/m, a servo mismatch in ms). "
+      "<em>G gain</em> is how much G = {:.3f} µm falls when that error alone is corrected (the "
+      "least-squares circle refitted), and <em>gain / G</em> the same as a share of G; the gains "
+      "do not add up, and a negative gain means the error partly cancels another (correcting it "
+      "alone would make G worse). <em>PV</em> is the peak-to-valley, in µm, of the radial "
+      "deviation that error alone causes on this circle. A limit applies to the magnitude of "
+      "the value, in its unit.</p>\n",
       r.iso.G_bi_um);
-  for (const auto& n : r.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
-  h += bar_calibration_section(c, v);
-  h += fmt::format(
+  for (const auto& n : r.notes) d += "<p class=\"note\">" + esc(n) + "</p>\n";
+  d += bar_calibration_section(c, v);
+  d += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>The error model leaves a residual of {:.3f} µm rms "
       "(noise and what the model does not describe). The transducer's own certificate and the "
       "calibrator's uncertainty are not recorded with the run, so an expanded uncertainty of G "
       "is not evaluated here.</p>\n",
       r.residual_rms_um);
-  return h;
+  return out;
 }
 
 // --- other runs (e.g. imported dynamic captures)
@@ -1065,9 +1361,20 @@ footer { margin-top: 2rem; font-size: .8rem; color: #666; border-top: 1px solid 
          break-before: avoid; page-break-before: avoid; }
 h3, h4 { break-after: avoid; page-break-after: avoid; }
 table { break-inside: auto; } tr { break-inside: avoid; }
-@media print { body { margin: 0; max-width: none; font-size: 10pt; }
+table.summary { width: 100%; margin: .3rem 0 .6rem; }
+table.summary th { width: 13%; background: none; color: #555; font-weight: normal; }
+table.summary td { width: 37%; }
+table.results td:first-child { white-space: nowrap; }
+.verdict.suspect { background: #fff0d9; border: 1px solid #d68000; }
+.verdict.suspect ul, ul.failing { margin: .2rem 0 .4rem; }
+.verdict.fail + ul.failing { background: #fde8e4; margin-top: -.6rem; padding: .2rem 1.5rem;
+  border: 1px solid #c0392b; border-top: none; }
+svg.plot.polar { max-width: 30rem; margin: 0 auto; }
+table.results, table.diag { width: 100%; }
+.details { break-before: page; page-break-before: always; }
+@media print { body { margin: 0; max-width: none; font-size: 10pt; } h1 { font-size: 14pt; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
-  svg.plot { max-width: 82%; margin: 0 auto; } .multiples svg.plot { max-width: 100%; } }
+  svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; } }
 )";
 
 // The printed page: a running header (the report's title and who it is for) and "page n of
@@ -1119,8 +1426,6 @@ std::string origin_banner(const RunView& v) {
          "the drivers again from a recorded capture, not measured now.</p>\n";
   if (o.imported)
     h += "<p class=\"simulated\"><strong>IMPORTED</strong> from another tool's file.</p>\n";
-  if (!o.label().empty() || o.unrecorded)
-    h += "<p class=\"note\">Origin of the readings: " + esc(o.text) + ".</p>\n";
   return h;
 }
 
@@ -1135,26 +1440,52 @@ std::string compensation_check(const st::Store& store, const RunView& v) {
   }
   if (!c) return "";
   const bool ok = c->verification.finding == cal::comptable::Finding::as_predicted;
-  return fmt::format(
-      "<p class=\"verdict {}\"><strong>Compensation check</strong>: {}</p>\n", ok ? "pass" : "fail",
-      esc(::daq::loop_text(*c)));
+  return fmt::format("<p class=\"verdict {}\"><strong>Compensation check</strong>: {}</p>\n",
+                     ok ? "pass" : "fail", esc(::daq::loop_text(*c)));
 }
 
+// Page one is the answer: who, which machine and test, when; where the readings came from and
+// how good they are; the verdict with the failing values, the main table and the main plot.
+// Then the details, the conditions and traceability, and the settings as an appendix.
 std::string run_body(const st::Store& store, const RunView& v, const Options& o, Headline& hl) {
-  std::string h = origin_banner(v) + compensation_check(store, v);
-  if (v.run.status != st::RunStatus::complete) {
+  std::string h = origin_banner(v);
+  h += summary_block(v, test_name(v));
+  if (v.run.status != st::RunStatus::complete)
     h += fmt::format(
-        "<p class=\"warning\">This run is {}{}: the results cover only what was "
-        "stored.</p>\n",
-        st::to_string(v.run.status), v.run.note.empty() ? "" : " (" + esc(v.run.note) + ")");
-    if (!v.missed.empty()) {
-      std::vector<std::vector<std::string>> rows;
-      for (const auto& m : v.missed)
-        rows.push_back({std::to_string(m.run_number), m.direction == '+' ? "↑ up" : "↓ down",
-                        std::to_string(m.target_index + 1), fmt::format("{:.3f}", m.nominal_mm)});
-      h += "<h4>Missed stops (never captured)</h4>\n" +
-           table({"run", "direction", "target", "nominal (mm)"}, rows, "num", "rlrr");
-    }
+        "<p class=\"warning\">This run is {}{}: the results cover only what was stored{}.</p>\n",
+        st::to_string(v.run.status), v.run.note.empty() ? "" : " (" + esc(v.run.note) + ")",
+        v.missed.empty() ? ""
+                         : fmt::format("; {} planned stops were never captured (listed under "
+                                       "Details)",
+                                       v.missed.size()));
+  h += quality_banner(store, v);
+  h += traceability_warnings(v);
+  h += compensation_check(store, v);
+  // An aborted or interrupted run may hold too little to evaluate: the report still shows what
+  // was stored, and says why there are no results.
+  Sections results;
+  try {
+    if (v.run.kind == "linear")
+      results = linear_section(store, v, o, hl);
+    else if (v.run.kind == "circle")
+      results = circle_section(store, v, o, hl);
+    else
+      results.answer = generic_section(store, v);
+  } catch (const cal::InputError& e) {
+    results.answer = fmt::format(
+        "<h3>Results</h3>\n<p class=\"warning\">The results cannot be evaluated: "
+        "{}</p>\n",
+        esc(e.what()));
+  }
+  h += results.answer;
+  h += "<div class=\"details\">\n" + results.details;
+  if (!v.missed.empty()) {
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& m : v.missed)
+      rows.push_back({std::to_string(m.run_number), m.direction == '+' ? "↑ up" : "↓ down",
+                      std::to_string(m.target_index + 1), fmt::format("{:.3f}", m.nominal_mm)});
+    h += "<h4>Missed stops (never captured)</h4>\n" +
+         table({"run", "direction", "target", "nominal (mm)"}, rows, "num", "rlrr");
   }
   h += customer_section(v);
   h += conditions_section(v);
@@ -1162,23 +1493,9 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
   if (v.run.kind == "linear" || v.run.kind == "circle")
     h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v2");
   h += setup_section(v);
-  // An aborted or interrupted run may hold too little to evaluate: the report still shows what
-  // was stored, and says why there are no results.
-  try {
-    if (v.run.kind == "linear")
-      h += linear_section(store, v, o, hl);
-    else if (v.run.kind == "circle")
-      h += circle_section(store, v, o, hl);
-    else
-      h += generic_section(store, v);
-  } catch (const cal::InputError& e) {
-    h += fmt::format(
-        "<h3>Results</h3>\n<p class=\"warning\">The results cannot be evaluated: "
-        "{}</p>\n",
-        esc(e.what()));
-  }
   h += environment_section(v.env);
-  return h;
+  h += settings_appendix(v);
+  return h + "</div>\n";
 }
 
 std::string date_of(const RunView& v) { return iso_time(v.run.started_unix_ms).substr(0, 10); }
@@ -1285,9 +1602,10 @@ std::string campaign_report(const st::Store& store, std::span<const std::int64_t
     // Each value kept whole on its line: "E 8.576 µm" never breaks inside.
     std::string numbers;
     std::size_t shown = 0;
-    for (const auto& [k, val] : hl.values_um)
+    for (const auto& x : hl.values)
       if (shown++ < 8)
-        numbers += fmt::format("<span class=\"nw\">{} {} µm</span>; ", esc(k), um(val));
+        numbers += fmt::format("<span class=\"nw\">{} {} {}</span>; ", esc(x.symbol),
+                               x.unit == "µm" ? um(x.value) : signed_text(x.value, 3), esc(x.unit));
     const std::string verdict = hl.verdict == "PASS"   ? "<span class=\"pass\">PASS</span>"
                                 : hl.verdict == "FAIL" ? "<span class=\"fail\">FAIL</span>"
                                 : hl.verdict.empty()
@@ -1353,7 +1671,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
                   .x_label = "target position (mm)",
                   .y_label = "deviation (µm)",
-                  .height_pt = 430,
+                  .height_pt = 300,
                   .zero_line = true};
   std::vector<PolarChart> polars;
   for (std::size_t i = 0; i < views.size(); ++i) {
@@ -1369,6 +1687,10 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
       for (const auto& a : l.e.axis) values.push_back({a.key, a.symbol, "µm", a.value_um});
+      // In the order of the results grid (E, R, A, M, B, B̄), as on every page.
+      std::stable_sort(values.begin(), values.end(), [](const Value& a, const Value& b) {
+        return iso_order(a.key) < iso_order(b.key);
+      });
       doc = ::daq::to_json(l.e);
     } else {
       const auto c = analyse_circle(store, v, o);
@@ -1455,11 +1777,11 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     XyChart small{.title = names[k],
                   .x_label = "",
                   .y_label = "",  // the title names it (a rotated label at this size was clipped)
-                  .width_pt = 420,
-                  .height_pt = 260,
+                  .width_pt = 300,
+                  .height_pt = 200,
                   .x_labels = dates,
                   .legend = false,
-                  .text_scale = 1.5};
+                  .text_scale = 1.65};
     small.lines.push_back(trends[k]);
     if (limits.count(k)) {
       const double n = static_cast<double>(views.size()) - 1;
@@ -1494,7 +1816,7 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
   XyChart overlay{.title = "Mean bidirectional deviation, as found and as left",
                   .x_label = "target position (mm)",
                   .y_label = "deviation (µm)",
-                  .height_pt = 430,
+                  .height_pt = 300,
                   .zero_line = true};
   PolarChart polar{.title = "As found and as left (least-squares centres removed)"};
   const auto side = [&](const RunView& v, std::size_t colour, const char* label) {
@@ -1509,6 +1831,9 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
       for (const auto& a : l.e.axis) sd.values.emplace_back(a.key, a.symbol, a.value_um);
+      std::stable_sort(sd.values.begin(), sd.values.end(), [](const auto& x, const auto& y) {
+        return iso_order(std::get<0>(x)) < iso_order(std::get<0>(y));
+      });
       sd.doc = ::daq::to_json(l.e);
     } else {
       const auto c = analyse_circle(store, v, o);

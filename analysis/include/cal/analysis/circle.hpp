@@ -99,7 +99,9 @@ struct Diagnostic {
 
 struct Result {
   Iso230_4 iso;
-  std::vector<Diagnostic> diagnostics;     // ranked by pv_um, largest first (centre excluded)
+  // Ranked by g_reduction_um, the largest gain first (centre excluded); a negative gain (a
+  // term that partly cancels another) comes last.
+  std::vector<Diagnostic> diagnostics;
   Diagnostic centre_u, centre_v;           // reported apart: set-up, not machine, errors
   double residual_rms_um = 0;              // what the model leaves unexplained
   std::optional<double> cyclic_period_mm;  // the period used (given or found)

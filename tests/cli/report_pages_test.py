@@ -1,0 +1,194 @@
+#!/usr/bin/env python3
+"""Issue 30: page one of every demo report is the answer. Each report of the demo's runs (the
+linear run, the circle run, the linear run by VDI/DGQ 3441, a suspect copy of the replayed run,
+the campaign, the comparison, as found / as left) is printed to PDF by `daq report --format pdf`
+(headless Chromium), its pages read back as text (pdftotext, poppler-utils) and checked: the
+verdict, the failing values and the main table on the first page of the report (for a campaign,
+on the first page of each run's section); a suspect run says so there, traceability gaps are
+warned there; the campaign summary gives each value in its own unit. Then the plots in the HTML:
+no text in them prints below 9 pt at the width the page gives them.
+Usage: report_pages_test.py DAQ_BINARY [OUT_DIR]  (CALDAQ_DEMO_FIXTURE: a `daq demo` to copy)"""
+import glob
+import html as html_mod
+import os
+import re
+import shutil
+import sqlite3
+import subprocess
+import sys
+import tempfile
+
+DAQ = os.path.abspath(sys.argv[1])
+fails = 0
+
+
+def check(name, ok, detail=""):
+    global fails
+    print(("ok   " if ok else "FAIL ") + name + ("" if ok else ": " + detail[:400]))
+    if not ok:
+        fails += 1
+
+
+def daq(*args):
+    r = subprocess.run([DAQ, *args], capture_output=True, text=True, timeout=400)
+    if r.returncode != 0:
+        raise SystemExit(f"daq {' '.join(args)} failed: {r.stdout}{r.stderr}")
+    return r.stdout
+
+
+def pages(pdf):
+    """The text of each page of a PDF."""
+    out = subprocess.run(["pdftotext", pdf, "-"], capture_output=True, text=True,
+                         check=True).stdout
+    return out.split("\f")
+
+
+def squash(text):
+    return re.sub(r"\s+", " ", text)
+
+
+work = sys.argv[2] if len(sys.argv) > 2 else tempfile.mkdtemp(prefix="report_pages.")
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+os.chdir(work)
+fixture = os.environ.get("CALDAQ_DEMO_FIXTURE")
+if fixture:
+    for f in glob.glob(os.path.join(fixture, "demo.sqlite*")):
+        shutil.copy(f, work)
+    capture = os.path.join(fixture, "demo.cdq")
+else:
+    daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq")
+    capture = os.path.join(work, "demo.cdq")
+db = ["--db", "demo.sqlite"]
+daq("replay", capture, *db)  # run 3: the linear run again (comparison, as found / as left)
+daq("replay", capture, *db)  # run 4: made suspect below
+# Run 4 made suspect: one stop 5 um off (the others repeat to about 0.01 um), and its stored
+# quality cleared so it is assessed from the stops when read.
+con = sqlite3.connect("demo.sqlite")
+con.execute("UPDATE captured_targets SET deviation_um = deviation_um + 5 WHERE run_id = 4 AND "
+            "run_number = 2 AND direction = '+' AND target_index = 3")
+con.execute("UPDATE runs SET quality = NULL, quality_note = '' WHERE id = 4")
+con.commit()
+con.close()
+
+reports = {
+    "linear": ["1"],
+    "circle": ["2"],
+    "vdi3441": ["1", "-s", "vdi3441"],
+    "suspect": ["4"],
+    "campaign": ["--campaign", "demo (simulated)"],
+    "comparison": ["--compare", "1", "3"],
+    "asfound": ["--as-found", "1", "--as-left", "3"],
+}
+text = {}
+for name, args in reports.items():
+    daq("report", *args, *db, "--format", "pdf", "-o", f"{name}.pdf")
+    daq("report", *args, *db, "-o", f"{name}.html")
+    text[name] = [squash(p) for p in pages(f"{name}.pdf")]
+
+# --- page one of a run report ---------------------------------------------------------------
+for name in ("linear", "vdi3441", "suspect", "circle"):
+    p1 = text[name][0]
+    check(f"{name}: SIMULATED on page one", "SIMULATED: this run was made" in p1, p1[:300])
+    check(f"{name}: customer and machine on page one",
+          "Demo customer (simulated)" in p1 and "SIMULATED VMC" in p1, p1[:400])
+    check(f"{name}: verdict on page one", re.search(r"Verdict against the machine specification|"
+                                                    r"No tolerance (configured|applies)", p1)
+          is not None, p1[:600])
+    if name != "circle":  # the demo's thermometer is past due; the ballbar's calibration is not
+        check(f"{name}: traceability warning on page one",
+              "Traceability: the calibration of material was past due" in p1, p1[:800])
+for name in ("linear", "suspect"):
+    p1 = text[name][0]
+    # The main table: the grid of E, R, A, M, B with up, down, bidirectional, limit, verdict.
+    check(f"{name}: main table on page one",
+          re.search(r"value \(µm\) ↑ up ↓ down bidirectional limit \(µm\) verdict", p1) is not None
+          and "E — systematic positional deviation" in p1 and "B̄ — mean reversal value" in p1, p1)
+    check(f"{name}: failing values named on page one",
+          re.search(r"FAIL.*limit ≤ [0-9.]+ µm\)", p1) is not None, p1)
+check("vdi3441: main table on page one",
+      re.search(r"symbol value \(µm\) meaning limit \(µm\) verdict", text["vdi3441"][0]) is not None,
+      text["vdi3441"][0])
+check("vdi3441: the configured limits apply (not 'no tolerance')",
+      "No tolerance" not in text["vdi3441"][0], text["vdi3441"][0])
+check("suspect: SUSPECT RUN on page one with its stop",
+      "SUSPECT RUN" in text["suspect"][0] and "run 2 ↑ target 4" in text["suspect"][0],
+      text["suspect"][0])
+check("linear (clean): no SUSPECT", all("SUSPECT RUN" not in p for p in text["linear"]), "")
+c1 = text["circle"][0]
+check("circle: main table on page one", "symbol value (µm) meaning limit (µm) verdict" in c1
+      and re.search(r"G\(b\) [0-9.]+", c1) is not None, c1)
+check("circle: what to fix first on page one", "What to fix first" in c1
+      and "what to check" in c1, c1)
+check("circle: failing value named on page one",
+      re.search(r"FAIL.*= [+-]?[0-9.]+ µm \(limit ≤", c1) is not None, c1)
+check("no -0.000 anywhere", all("-0.000" not in p for n in text for p in text[n]), "")
+# The settings: an appendix with labels and units, no raw keys, no empty values.
+lin = " ".join(text["linear"])
+check("settings appendix with labels",
+      "Appendix: settings of the run" in lin and "Expansion coefficient 11.5 ppm/K" in lin, lin[-2000:])
+check("no raw setting keys", "machine_model.topology" not in lin and "probe_offset_mm" not in lin,
+      "")
+check("appendix after the results",
+      lin.index("Appendix: settings") > lin.index("Measurement uncertainty"), "")
+
+# --- campaign: the summary on page one, each run's answer on its first page --------------------
+camp = text["campaign"]
+check("campaign: summary on page one", "run date test axis status standard results verdict"
+      in camp[0], camp[0])
+check("campaign: squareness in µm/m", re.search(r"Squareness XY [+-]?[0-9.]+ µm/m", camp[0])
+      is not None, camp[0])
+# Every diagnostic in the summary in its own unit: a squareness in µm/m, a servo mismatch in ms,
+# never the peak-to-valley in µm under the error's name.
+check("campaign: no squareness or servo mismatch in µm",
+      re.search(r"(Squareness XY|Servo mismatch \(Y lags X\)) [+-]?[0-9.]+ µm;", camp[0]) is None,
+      camp[0])
+check("campaign: squareness and scale mismatch in µm/m",
+      re.search(r"Squareness XY [+-]?[0-9.]+ µm/m;", camp[0]) is not None
+      and re.search(r"Scale mismatch X - Y [+-]?[0-9.]+ µm/m;", camp[0]) is not None, camp[0])
+for run in (1, 2):
+    first = next((p for p in camp if re.search(rf"SIMULATED — Run {run}: \w+ test", p)), "")
+    check(f"campaign: run {run}'s verdict and table on its first page",
+          "Verdict against the machine specification" in first
+          and re.search(r"(↑ up ↓ down bidirectional|symbol value \(µm\) meaning)", first)
+          is not None, first[:500])
+
+# --- comparison and as found / as left --------------------------------------------------------
+check("comparison: the table on page one", re.search(r"run date E \(µm\) R \(µm\) A \(µm\) M "
+                                                     r"\(µm\) B \(µm\) B̄ \(µm\).* verdict air", text[
+    "comparison"][0]) is not None, text["comparison"][0])
+a1 = text["asfound"][0]
+check("as found / as left: table and verdicts on page one",
+      "as found, run 1" in a1 and "as left, run 3" in a1 and "verdict" in a1, a1)
+
+# --- plots: text of at least 9 pt as printed --------------------------------------------------
+# Printed widths (pt): A4 less the 14 mm margins is 516 pt; a polar plot 72 % of it, a small
+# multiple half of it less the gap.
+content_pt = (210 - 28) / 25.4 * 72
+for name in reports:
+    html = open(f"{name}.html", encoding="utf-8").read()
+    for m in re.finditer(r"<svg class=\"([^\"]*)\"[^>]*aria-label=\"([^\"]*)\"[^>]*viewBox=\"0 0 "
+                         r"(\d+) (\d+)\"", html):
+        cls, title, width = m.group(1), m.group(2), float(m.group(3))
+        end = html.find("</svg>", m.end())
+        # Each text's size, but not the markers (PLplot draws a data point as a "•" glyph).
+        sizes = [float(size) for size, text in re.findall(
+            r'font-size="([0-9.]+)"[^<]*(?:<[^t][^>]*>[^<]*)*?<tspan[^>]*>(.*?)</tspan>',
+            html[m.end():end]) if html_mod.unescape(text).strip() not in ("•", "")]
+        if not sizes:
+            continue
+        inside_multiples = html.rfind('<div class="multiples">', 0, m.start()) > html.rfind(
+            "</div>", 0, m.start())
+        shown = content_pt * (0.72 if "polar" in cls else 0.48 if inside_multiples else 1.0)
+        printed = min(sizes) * min(1.0, shown / width)
+        check(f"{name}: plot '{title}' text >= 9 pt", printed >= 9.0,
+              f"{printed:.1f} pt (font {min(sizes)} in a {width:.0f} wide plot shown {shown:.0f} pt)")
+    # Legends name the instrument (driver and serial number), not "air air ch 0".
+    plot_text = " ".join(html_mod.unescape(t) for t in re.findall(r"<tspan[^>]*>(.*?)</tspan>",
+                                                                  html))
+    check(f"{name}: no 'air air ch' legend", " ch 0" not in plot_text, "")
+    if "Temperatures" in html:
+        check(f"{name}: legends name the instrument", "ptu300 SIM-PTU-0001" in plot_text, "")
+
+print(f"{fails} failed" if fails else "all passed")
+sys.exit(1 if fails else 0)
