@@ -1,0 +1,31 @@
+// Device numbers by role (see roles.hpp).
+#include "roles.hpp"
+
+namespace daq {
+
+std::string_view name(Role role) {
+  for (const auto& e : kRoles)
+    if (e.role == role) return e.name;
+  return "";
+}
+
+std::uint16_t RunDevices::device(Role role, std::size_t k) const {
+  std::size_t next = 0;
+  for (const auto& e : kRoles) {
+    if (e.role == role) return static_cast<std::uint16_t>(e.fixed ? *e.fixed + k : next + k);
+    if (!e.fixed) next += count(e);
+  }
+  return 0;  // every Role has its row
+}
+
+std::optional<std::size_t> RunDevices::index(Role role, std::uint16_t device) const {
+  for (const auto& e : kRoles)
+    if (e.role == role) {
+      const std::size_t first = this->device(role);
+      if (device < first || device - first >= count(e)) return std::nullopt;
+      return device - first;
+    }
+  return std::nullopt;
+}
+
+}  // namespace daq
