@@ -1,6 +1,8 @@
 // Device numbers by role (see roles.hpp).
 #include "roles.hpp"
 
+#include "cal/drivers/instrument.hpp"
+
 namespace daq {
 
 std::string_view name(Role role) {
@@ -26,6 +28,15 @@ std::optional<std::size_t> RunDevices::index(Role role, std::uint16_t device) co
       return device - first;
     }
   return std::nullopt;
+}
+
+void StartupReadings::add(const cal::drivers::Reading& r) {
+  if (devices_.is(Role::laser, r.device))
+    laser_ = laser_ || r.quantity == cal::drivers::Quantity::displacement_m;
+  else if (devices_.is(Role::air, r.device))
+    air_ = true;
+  else if (devices_.index(Role::material, r.device) == 0)
+    material_ = true;
 }
 
 }  // namespace daq

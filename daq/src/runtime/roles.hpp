@@ -7,6 +7,10 @@
 #include <optional>
 #include <string_view>
 
+namespace cal::drivers {
+struct Reading;
+}
+
 namespace daq {
 
 enum class Role : std::uint8_t { laser, air, material, position, probe, ballbar };
@@ -48,6 +52,20 @@ class RunDevices {
  private:
   std::size_t count(const RoleEntry& e) const { return e.many ? materials_ : 1; }
   std::size_t materials_;
+};
+
+// Whether the laser (once it measures: its environment unit reads before that), the air and the
+// first material thermometer of a run have each given a reading: what a simulated session
+// waits for before the machine moves. Readings carry their device number (LinearRun sets it).
+class StartupReadings {
+ public:
+  explicit StartupReadings(std::size_t materials) : devices_(materials) {}
+  void add(const cal::drivers::Reading& r);
+  bool all() const { return laser_ && air_ && material_; }
+
+ private:
+  RunDevices devices_;
+  bool laser_ = false, air_ = false, material_ = false;
 };
 
 }  // namespace daq
