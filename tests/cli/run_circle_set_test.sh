@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The standard ballbar set end to end: `daq sim --test circle-set` runs the SIMULATED shop with
 # squareness in all three planes, a slower Z loop, backlash and cyclic error on every axis
-# (daq/src/runtime/sim_shop.cpp ShopTruth::three_planes) through the ballbar twin; `daq run
+# (daq/src/sim/sim_shop.cpp ShopTruth::three_planes) through the ballbar twin; `daq run
 # circle` acquires the six tests (XY 360 deg, ZX and YZ 220 deg, each at 1000 and 3000 mm/min)
 # in one go through the real gauge driver, recognising each by its feed-in, and stores them as
 # one campaign; `daq ballbar volumetric` and `daq report --campaign` give the three-plane table.

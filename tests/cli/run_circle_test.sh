@@ -45,7 +45,7 @@ check analyse_stored_same_g 0 "$(sed 's/[()]/\\&/g' <<<"$G1")" -- echo "$A1"
 "$DAQ" sim --test circle --acquire -o "$TMP/acq.toml" --db "$TMP/acq.sqlite" --capture "$TMP/acq.cdq" >"$TMP/acq.log" 2>&1 ||
   { echo "FAIL acquire: exit $?"; tail -20 "$TMP/acq.log"; fails=$((fails + 1)); }
 ACQ=$(cat "$TMP/acq.log")
-# The injected truth (daq/src/runtime/sim_shop.hpp ShopTruth): squareness +20 um/m, Y lags X by
+# The injected truth (daq/src/sim/sim_shop.hpp ShopTruth): squareness +20 um/m, Y lags X by
 # 1/29.7 - 1/30 s = 0.337 ms, backlash X 4 um, pitch error of X 1 um over 40 mm, noise 0.15 um.
 # Tolerances: the bar's noise moves the fitted terms by ~0.01 of their unit over 2 x 37,700
 # samples; backlash shares its step with the reversal-spike term (~0.1 um) and the servo

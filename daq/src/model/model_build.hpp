@@ -1,6 +1,6 @@
 #pragma once
 // Building a machine model (caldaq.model.v1, model_file.hpp) from measured profiles: the stored
-// runs of the test kinds (daq/src/runtime/kinds/), one per component. Pure: the caller reads the
+// runs of the test kinds (daq/src/runner/kinds/), one per component. Pure: the caller reads the
 // runs (daq model build reads the run store). Method, conventions and what is verified:
 // docs/volumetric-walkthrough.md, "How the model is built".
 //

@@ -57,7 +57,7 @@ struct TriggerConfig {
 
 // What a linear test reads at each stop (the measure keys of [test.linear], docs/config.md and
 // docs/volumetric-walkthrough.md): the test kind and its set-up, stored with the run so that
-// `daq model build` can use it. The kinds are daq/src/runtime/kinds/.
+// `daq model build` can use it. The kinds are daq/src/runner/kinds/.
 struct MeasureConfig {
   std::string kind = "positioning";  // positioning | straightness | angular | roll
   // straightness: the direction read (X, Y or Z, not the axis); angular: the rotation axis

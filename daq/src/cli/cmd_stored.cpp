@@ -17,6 +17,7 @@
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "provenance.hpp"
+#include "roles.hpp"
 #include "run_quality.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
@@ -191,11 +192,17 @@ void recompensate(const RecompensateOptions& o) {
       static_cast<std::uint8_t>(Q::air_pressure_pa), static_cast<std::uint8_t>(Q::air_humidity_pct),
       static_cast<std::uint8_t>(Q::material_temperature_degc)};
   const auto readings = store.readings(o.run, environment);
+  // The run's material thermometers, by their stored role (roles.hpp).
+  const auto instruments = store.instruments(o.run);
+  const RunDevices devices(static_cast<std::size_t>(
+      std::count_if(instruments.begin(), instruments.end(),
+                    [](const auto& i) { return i.driver == name(Role::material); })));
   int material_sensors = 0;
   for (const auto& r : readings)
     if (static_cast<cal::drivers::Quantity>(r.quantity) ==
         cal::drivers::Quantity::material_temperature_degc)
-      material_sensors = std::max(material_sensors, r.device - 1);
+      if (const auto k = devices.index(Role::material, r.device))
+        material_sensors = std::max(material_sensors, static_cast<int>(*k) + 1);
   // Every sample is kept: the stops are compensated after all samples were given, each with
   // the environment at its own time (the stage otherwise keeps the last 2 minutes, and a long
   // run's early stops would get the air of its end).
@@ -216,7 +223,8 @@ void recompensate(const RecompensateOptions& o) {
         stage.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value + off.humidity_pct);
         break;
       case Q::material_temperature_degc:
-        if (r.device >= 2) stage.add_material(r.time_ns, r.device - 2, r.value + off.material_k);
+        if (const auto k = devices.index(Role::material, r.device))
+          stage.add_material(r.time_ns, static_cast<int>(*k), r.value + off.material_k);
         break;
       default:
         break;

@@ -10,7 +10,7 @@
 
 #include <filesystem>
 
-#include "../support/temp_dir.hpp"
+#include "../../support/temp_dir.hpp"
 #include "cal/analysis/error.hpp"
 #include "model/model_file.hpp"
 

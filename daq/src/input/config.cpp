@@ -393,7 +393,7 @@ std::array<double, 3> read_vector(Table& t, std::string_view key, std::array<dou
 
 // The measure keys of [test.linear]: what is read at each stop (MeasureConfig). The kinds'
 // own checks of the set-up (a separation across the beams, a direction that is not the axis)
-// are the kinds' (daq/src/runtime/kinds/), run before a run starts.
+// are the kinds' (daq/src/runner/kinds/), run before a run starts.
 void read_measure(Table& t, LinearTestConfig& l) {
   auto& m = l.measure;
   read_fields(t, fields::measure(), m);

@@ -16,7 +16,8 @@
 #include "cal/storage/writer.hpp"
 #include "circle_output.hpp"
 #include "provenance.hpp"
-#include "run_writer.hpp"
+#include "roles.hpp"
+#include "runner.hpp"
 
 namespace daq {
 
@@ -271,31 +272,24 @@ std::string to_json_text(const CircleLive& s) {
       .dump();
 }
 
-struct CircleRun::Impl {
-  boost::asio::io_context& io;
+struct CircleRun::Impl : Runner {
   CircleRunSetup setup;
   cal::daq::BallbarSegmenter segmenter;
-  std::optional<cal::storage::Store> store;
-  std::unique_ptr<cal::storage::BatchWriter> writer;
-  cal::drivers::Timer timer;  // the writer's age check, on the loop's time
   CircleRunOutcome outcome;
   CircleLive live;
-  bool running = false, done = false;
   std::vector<CircleRunOutcome> completed;  // a set's tests before the current one
   std::size_t next_test = 0;                // into setup.following
-  // Handlers posted from the writer's thread run only while the run exists.
-  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
+  const std::uint16_t ballbar_device = RunDevices().device(Role::ballbar);
 
   Impl(boost::asio::io_context& i, CircleRunSetup s)
-      : io(i), setup(std::move(s)), segmenter(setup.program), timer(i) {}
-  ~Impl() { *alive = false; }
+      : Runner(i, s.database, s.store_options), setup(std::move(s)), segmenter(setup.program) {}
 
   void event(const std::string& e) {
     if (setup.on_event) setup.on_event(e);
   }
 
   void start() {
-    store.emplace(setup.database, setup.store_options);
+    open_store();
     begin_test();
     running = true;
     setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
@@ -307,14 +301,6 @@ struct CircleRun::Impl {
     tick();
   }
 
-  // The writer's age-based flush, as the linear run's: a bar that stops sending still has its
-  // last readings committed (a full batch is 16,384 readings, 16 s of a 1 kHz bar).
-  void tick() {
-    if (done) return;
-    if (const auto failed = offer_old_batch(writer.get())) return abort(*failed);
-    arm_tick(timer, alive, [this] { tick(); });
-  }
-
   // The stored run of the current test (setup.program, setup.analysis) and its writer.
   void begin_test() {
     resolve_calibration(setup.analysis, setup.config, setup.program.radius_mm, *store,
@@ -324,11 +310,6 @@ struct CircleRun::Impl {
                                   std::chrono::system_clock::now().time_since_epoch())
                                   .count());
     const auto& c = setup.config;
-    std::int64_t machine = 0;
-    if (auto m = store->machine_by_name(c.machine_name))
-      machine = m->id;
-    else
-      machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
     const auto& p = setup.program;
     json settings = circle_settings_json(p, setup.analysis);
     settings["context"] = setup.context_json.empty()
@@ -338,7 +319,7 @@ struct CircleRun::Impl {
       settings["context"] = run_context(c, "circle", setup.analysis.plane);
     // Where the table ball was: a circle's squareness is local to it (the three-plane table).
     if (c.circle && c.circle->centre_mm.size() == 3) settings["centre_mm"] = c.circle->centre_mm;
-    outcome.run_id = store->begin_run({.machine_id = machine,
+    outcome.run_id = store->begin_run({.machine_id = machine_id(c),
                                        .campaign = c.campaign,
                                        .kind = "circle",
                                        .axis = setup.analysis.plane,
@@ -348,18 +329,12 @@ struct CircleRun::Impl {
     const auto origin = setup.origins.find("ballbar");
     store->add_instrument(
         {.run_id = outcome.run_id,
-         .device = 3,
-         .driver = "ballbar",
+         .device = ballbar_device,
+         .driver = std::string(name(Role::ballbar)),
          .transport = setup.ballbar->describe(),
          .origin = origin == setup.origins.end() ? "" : origin->second.kind,
          .origin_detail = origin == setup.origins.end() ? "" : origin->second.detail});
-    writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id, run_writer_options(io, setup.store_options),
-        [this, alive = alive](const std::string& e) {
-          boost::asio::post(io, [this, alive, e] {
-            if (*alive) abort("storage failed: " + e);
-          });
-        });
+    open_writer(outcome.run_id);
     outcome.program = setup.program;
     outcome.analysis = setup.analysis;
     const std::size_t tests = completed.size() + 1 + (setup.following.size() - next_test);
@@ -378,21 +353,14 @@ struct CircleRun::Impl {
   void on_reading(const cal::drivers::Reading& r) {
     if (setup.on_reading) setup.on_reading(r);
     if (!running || r.quantity != cal::drivers::Quantity::length_m) return;
-    if (outcome.readings == 0)  // the time origin for exports (see linear_run.cpp)
-      store->set_time_origin(outcome.run_id, r.time_ns,
-                             std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                 std::chrono::system_clock::now().time_since_epoch())
-                                 .count());
+    if (outcome.readings == 0) set_time_origin(outcome.run_id, r.time_ns);
     ++outcome.readings;
-    try {
-      writer->push({.time_ns = r.time_ns,
-                    .device = 3,
-                    .quantity = static_cast<std::uint8_t>(r.quantity),
-                    .status = static_cast<std::uint8_t>(r.status),
-                    .value = r.value});
-    } catch (const std::exception& e) {  // the writer failed earlier (a full disk)
-      return abort(fmt::format("storage failed: {}", e.what()));
-    }
+    if (!store_reading({.time_ns = r.time_ns,
+                        .device = ballbar_device,
+                        .quantity = static_cast<std::uint8_t>(r.quantity),
+                        .status = static_cast<std::uint8_t>(r.status),
+                        .value = r.value}))
+      return;
     const bool had = segmenter.feed_in_end().has_value();
     segmenter.add(r.value * 1e3);
     trace(r.value * 1e6);
@@ -498,43 +466,19 @@ struct CircleRun::Impl {
     running = true;
   }
 
-  void abort(const std::string& reason) {
-    if (done) return;
-    running = false;
+  // Runner's hooks: how a circle run records its abort and stops its bar.
+  std::int64_t current_run() const override { return outcome.run_id; }
+  void aborting(const std::string& reason) override { outcome.reason = reason; }
+  void aborted(const std::string& reason) override {
     outcome.reason = reason;
-    try {
-      if (writer) writer->flush();
-    } catch (const std::exception& e) {
-      if (reason.find(e.what()) == std::string::npos)
-        outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
-    }
-    try {
-      if (store)
-        store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
-    } catch (const std::exception& e) {
-      outcome.reason += fmt::format(" (and the run's end could not be stored: {})", e.what());
-    }
     publish_end("aborted");
-    end();
   }
-
-  void end() {
-    done = true;
-    timer.cancel();
-    setup.ballbar->stop();
-    writer.reset();
-  }
+  void stop_instruments() override { setup.ballbar->stop(); }
 };
 
 CircleRun::CircleRun(boost::asio::io_context& io, CircleRunSetup setup)
     : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
-CircleRun::~CircleRun() {
-  try {
-    if (!impl_->done && impl_->running) impl_->abort("stopped");
-  } catch (...) {
-    // abort() does not throw; a display callback might: not through a destructor.
-  }
-}
+CircleRun::~CircleRun() { impl_->stop_if_running(); }
 void CircleRun::start() { impl_->start(); }
 void CircleRun::stop(const std::string& reason) { impl_->abort(reason); }
 bool CircleRun::finished() const { return impl_->done; }

@@ -30,6 +30,7 @@
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
 #include "provenance.hpp"
+#include "roles.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
 #include "sim_shop.hpp"
@@ -302,17 +303,12 @@ int run_demo(const DemoOptions& o) {
     fmt::print("  {}\n", e);
     std::fflush(stdout);  // into a file or a pipe too, as it happens
   };
-  std::array<bool, 3> read{};  // laser, air, material have each given a reading
-  setup.on_reading = [&read](const cal::drivers::Reading& r) {
-    // The laser counts once it measures (its environment unit reads before that).
-    if (r.device < read.size() &&
-        (r.device != 0 || r.quantity == cal::drivers::Quantity::displacement_m))
-      read[r.device] = true;
-  };
+  StartupReadings read(setup.material.size());
+  setup.on_reading = [&read](const cal::drivers::Reading& r) { read.add(r); };
   LinearRun run(io, std::move(setup));
   running = &run;
   run.start();
-  if (!shop.wait_until([&] { return read[0] && read[1] && read[2]; })) {
+  if (!shop.wait_until([&] { return read.all(); })) {
     run.stop("the simulated instruments did not all answer within 10 s");
     fmt::print(stderr, "daq demo: the simulated instruments did not all answer within 10 s\n");
     return 1;

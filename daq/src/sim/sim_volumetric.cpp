@@ -16,6 +16,7 @@
 #include "line_gauge/instrument.hpp"
 #include "linear_run.hpp"
 #include "ptu300/instrument.hpp"
+#include "roles.hpp"
 
 namespace daq {
 
@@ -128,7 +129,7 @@ cal::daq::model::Model volumetric_truth_model(kin::Topology t) {
   for (auto& s : m.squareness) s.given = true, s.source = {injected};
   m.provenance = {
       "{\"origin\": \"SIMULATED\", \"what\": \"the errors injected into the SIMULATED shop's "
-      "volumetric machine (daq/src/runtime/sim_volumetric.cpp)\"}"};
+      "volumetric machine (daq/src/sim/sim_volumetric.cpp)\"}"};
   return m;
 }
 
@@ -232,17 +233,14 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
         io, t::make_serial(io, {.device = shop.level_device()}),
         {.poll_period = poll(0.1), .silence_timeout = probe_silence, .clock = clock},
         {.request = "?\r", .unit = d::codec::GaugeUnit::urad, .min_si = -0.01, .max_si = 0.01});
-  std::array<bool, 4> read{};
-  setup.on_reading = [&read](const d::Reading& r) {
-    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
-      read[r.device] = true;
-  };
+  StartupReadings read(setup.material.size());
+  setup.on_reading = [&read](const d::Reading& r) { read.add(r); };
   if (std::getenv("CALDAQ_SIM_EVENTS"))  // debugging aid: the run's events on stderr
     setup.on_event = [](const std::string& e) { std::fprintf(stderr, "  event: %s\n", e.c_str()); };
   LinearRun run(io, std::move(setup));
   run.start();
   // The probe is device 4 (laser 0, air 1, material 2, position 3 unused).
-  if (!shop.wait_until([&] { return read[0] && read[1] && read[2]; }, 30.0))
+  if (!shop.wait_until([&] { return read.all(); }, 30.0))
     throw cal::InputError("simulated acquisition: the instruments did not start reading");
   shop.run_linear(run.plan(), test.feed_mm_per_min, test.dwell_s);
   shop.run_program([&] { return run.finished(); }, 30.0);

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/post.hpp>
 #include <chrono>
 #include <deque>
 #include <nlohmann/json.hpp>
@@ -20,8 +19,9 @@
 #include "iso230_2_output.hpp"
 #include "kinds/kind.hpp"
 #include "provenance.hpp"
+#include "roles.hpp"
 #include "run_quality.hpp"
-#include "run_writer.hpp"
+#include "runner.hpp"
 #include "session_spec.hpp"
 
 namespace daq {
@@ -166,9 +166,9 @@ int MaterialSensors::sensor(std::size_t k, std::uint8_t channel) const {
   return it == c.end() ? -1 : first_[k] + static_cast<int>(it - c.begin());
 }
 
-struct LinearRun::Impl {
-  boost::asio::io_context& io;
+struct LinearRun::Impl : Runner {
   LinearRunSetup setup;
+  RunDevices devices;  // laser, air, material thermometers, position feed, probe
   cal::iso230_2::Plan plan;
   MaterialSensors materials;
   cal::daq::EnvStage env;
@@ -199,20 +199,15 @@ struct LinearRun::Impl {
   std::vector<Pending> pending;
   cal::daq::MotionIndicator motion;
   std::vector<double> acceptable;  // sorted: the positions a stop could be at now
-  std::optional<cal::storage::Store> store;
-  std::unique_ptr<cal::storage::BatchWriter> writer;
-  cal::drivers::Timer timer;  // on the loop's time: simulated in a simulated session
   LinearRunOutcome outcome;
   LiveState live;
-  bool running = false, done = false;
   std::int64_t first_ns = -1;
   double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
-  // Handlers posted from the writer's thread run only while the run exists.
-  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
   Impl(boost::asio::io_context& i, LinearRunSetup s)
-      : io(i),
+      : Runner(i, s.database, s.store_options),
         setup(std::move(s)),
+        devices(setup.material.size()),
         plan(linear_plan(*setup.config.linear)),
         materials(setup.material.size(), setup.material_channels),
         env(setup.config.environment, materials.count()),
@@ -223,8 +218,7 @@ struct LinearRun::Impl {
         kind(kinds::kind(setup.config.linear->measure.kind)),
         motion({.tolerance_um = setup.config.trigger.tolerance_um,
                 .dwell_s = setup.config.trigger.dwell_s,
-                .window_mm = setup.config.trigger.window_mm}),
-        timer(i) {
+                .window_mm = setup.config.trigger.window_mm}) {
     kind.validate(*setup.config.linear);
     reader = kind.reader(*setup.config.linear);
     if (!kind.probe_role().empty() && !setup.probe)
@@ -236,12 +230,6 @@ struct LinearRun::Impl {
                                             .dwell_s = setup.config.trigger.dwell_s,
                                             .feed_holds = setup.position_on_change});
   }
-  ~Impl() { *alive = false; }
-
-  std::uint16_t position_device() const {
-    return static_cast<std::uint16_t>(2 + setup.material.size());
-  }
-  std::uint16_t probe_device() const { return static_cast<std::uint16_t>(position_device() + 1); }
 
   // The triggers watch every position the sequencer could accept now (see acceptable_mm):
   // after a missed stop they must still see the following ones.
@@ -263,15 +251,10 @@ struct LinearRun::Impl {
   }
 
   void start() {
-    store.emplace(setup.database, setup.store_options);
+    open_store();
     const auto& c = setup.config;
-    std::int64_t machine = 0;
-    if (auto m = store->machine_by_name(c.machine_name))
-      machine = m->id;
-    else
-      machine = store->add_machine({.name = c.machine_name, .description = c.machine_description});
     outcome.run_id = store->begin_run(
-        {.machine_id = machine,
+        {.machine_id = machine_id(c),
          .campaign = c.campaign,
          .kind = std::string(kind.run_kind()),
          .axis = c.linear->axis,
@@ -288,33 +271,24 @@ struct LinearRun::Impl {
            .origin = origin == setup.origins.end() ? "" : origin->second.kind,
            .origin_detail = origin == setup.origins.end() ? "" : origin->second.detail});
     };
-    add(0, *setup.laser, "laser");
-    add(1, *setup.air, "air");
-    for (std::size_t k = 0; k < setup.material.size(); ++k)
-      add(static_cast<int>(2 + k), *setup.material[k], "material");
-    if (setup.position) add(position_device(), *setup.position, "position");
-    if (setup.probe) add(probe_device(), *setup.probe, kind.probe_role());
+    for_each_instrument([&](cal::drivers::Instrument& i, Role role, std::size_t k) {
+      add(devices.device(role, k), i, role == Role::probe ? kind.probe_role() : name(role));
+    });
     outcome.component = kind.component(*setup.config.linear);
-    writer = std::make_unique<cal::storage::BatchWriter>(
-        setup.database, outcome.run_id, run_writer_options(io, setup.store_options),
-        [this, alive = alive](const std::string& e) {
-          boost::asio::post(io, [this, alive, e] {
-            if (*alive) abort("storage failed: " + e);
-          });
-        });
+    open_writer(outcome.run_id);
     running = true;
     live.state = "waiting";
     expect_next();
-    start_instrument(*setup.laser, 0);
-    start_instrument(*setup.air, 1);
+    start_instrument(*setup.laser, devices.device(Role::laser));
+    start_instrument(*setup.air, devices.device(Role::air));
     for (std::size_t k = 0; k < setup.material.size(); ++k)
-      start_instrument(*setup.material[k], static_cast<std::uint16_t>(2 + k));
+      start_instrument(*setup.material[k], devices.device(Role::material, k));
     if (setup.position) {
-      start_instrument(*setup.position, position_device());
+      start_instrument(*setup.position, devices.device(Role::position));
       event("stops are recognised from the machine position feed (" + setup.position->describe() +
             ")");
     }
-    if (setup.probe) start_instrument(*setup.probe, probe_device());
+    if (setup.probe) start_instrument(*setup.probe, devices.device(Role::probe));
     if (reader) event(fmt::format("measuring {} ({})", outcome.component, kind.name()));
     event(fmt::format("run {}: {} targets x {} runs, {} stops expected", outcome.run_id,
                       plan.targets_mm.size(), c.linear->runs, sequencer.stops().size()));
@@ -348,27 +322,19 @@ struct LinearRun::Impl {
     if (!running) return;
     r.device = device;
     ++outcome.readings;
-    try {
-      writer->push({.time_ns = r.time_ns,
-                    .device = r.device,
-                    .channel = r.channel,
-                    .quantity = static_cast<std::uint8_t>(r.quantity),
-                    .status = static_cast<std::uint8_t>(r.status),
-                    .value = r.value});
-    } catch (const std::exception& e) {  // the writer failed earlier (a full disk)
-      return abort(fmt::format("storage failed: {}", e.what()));
-    }
+    if (!store_reading({.time_ns = r.time_ns,
+                        .device = r.device,
+                        .channel = r.channel,
+                        .quantity = static_cast<std::uint8_t>(r.quantity),
+                        .status = static_cast<std::uint8_t>(r.status),
+                        .value = r.value}))
+      return;
     if (setup.on_reading) setup.on_reading(r);
     if (first_ns < 0) {
-      // The run's time origin: this reading's session time is now in UTC (to the delivery
-      // delay), so exports can give absolute times.
       first_ns = r.time_ns;
-      store->set_time_origin(outcome.run_id, r.time_ns,
-                             std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                 std::chrono::system_clock::now().time_since_epoch())
-                                 .count());
+      set_time_origin(outcome.run_id, r.time_ns);
     }
-    if (reader && device == probe_device() && r.status == ReadingStatus::ok &&
+    if (reader && devices.is(Role::probe, device) && r.status == ReadingStatus::ok &&
         (r.quantity == Quantity::length_m || r.quantity == Quantity::angle_rad))
       return add_sample(kinds::Source::probe, r);
     switch (r.quantity) {
@@ -377,24 +343,27 @@ struct LinearRun::Impl {
       case Quantity::air_pressure_pa:
         return env.add_air(r.time_ns, cal::daq::AirQuantity::pressure_pa, r.value);
       case Quantity::air_humidity_pct:  // not of a material thermometer: a TEMPerX on the table
-        if (device >= 2) return;        // measures the humidity there, not in the beam
+        if (!devices.is(Role::laser, device) && !devices.is(Role::air, device))
+          return;  // measures the humidity there, not in the beam
         return env.add_air(r.time_ns, cal::daq::AirQuantity::humidity_pct, r.value);
       case Quantity::material_temperature_degc:
       case Quantity::length_m:  // a line thermometer reports through the gauge codec
-        if (device >= 2 && device < position_device())
-          if (const int sensor = materials.sensor(device - 2u, r.channel); sensor >= 0)
+        if (const auto k = devices.index(Role::material, device))
+          if (const int sensor = materials.sensor(*k, r.channel); sensor >= 0)
             env.add_material(r.time_ns, sensor, r.value);
         return;
       case Quantity::displacement_m:
-        if (device == 0 && r.channel == setup.laser_channel) return on_laser(r);
-        if (device == 0 && reader && r.status == ReadingStatus::ok) {
+        if (!devices.is(Role::laser, device)) return;
+        if (r.channel == setup.laser_channel) return on_laser(r);
+        if (reader && r.status == ReadingStatus::ok) {
           Reading c = r;
           c.value = env.compensated_length_m(r.time_ns, r.value);
           add_sample(kinds::Source::laser, c);
         }
         return;
       case Quantity::machine_position_m:
-        if (position_trigger && device == position_device() && r.channel == setup.position_channel)
+        if (position_trigger && devices.is(Role::position, device) &&
+            r.channel == setup.position_channel)
           if (auto cap = position_trigger->add_position(r.time_ns, r.value * 1e3))
             on_capture(*cap, env.compensate(r.time_ns, last_raw_m));
         return;
@@ -697,40 +666,30 @@ struct LinearRun::Impl {
     end();
   }
 
-  // Never throws: a store that fails here too is named in the reason, which the caller
-  // reports (the run then stays "running" in the file, shown as incomplete).
-  void abort(const std::string& reason) {
-    if (done) return;
-    running = false;
+  // Runner's hooks: how a linear run records its abort and stops its instruments.
+  std::int64_t current_run() const override { return outcome.run_id; }
+  void aborting(const std::string& reason) override {
     outcome.reason = reason;
     outcome.status = cal::storage::RunStatus::aborted;
     live.state = "aborted";
     live.message = reason;
-    try {
-      if (writer) writer->flush();
-    } catch (const std::exception& e) {
-      if (reason.find(e.what()) == std::string::npos)
-        outcome.reason += fmt::format(" (and the last batch could not be stored: {})", e.what());
-    }
-    try {
-      if (store)
-        store->finish_run(outcome.run_id, cal::storage::RunStatus::aborted, outcome.reason);
-    } catch (const std::exception& e) {
-      outcome.reason += fmt::format(" (and the run's end could not be stored: {})", e.what());
-    }
-    end();
   }
+  void aborted(const std::string& reason) override { outcome.reason = reason; }
+  void stop_instruments() override {
+    for_each_instrument([](cal::drivers::Instrument& i, Role, std::size_t) { i.stop(); });
+  }
+  void on_tick() override { publish(); }
+  void on_end() override { publish(); }
 
-  void end() {
-    done = true;
-    timer.cancel();
-    setup.laser->stop();
-    setup.air->stop();
-    for (auto& m : setup.material) m->stop();
-    if (setup.position) setup.position->stop();
-    if (setup.probe) setup.probe->stop();
-    writer.reset();
-    publish();
+  // Each instrument of the run with its role and its index in the role, in device order.
+  template <typename F>
+  void for_each_instrument(F&& f) {
+    f(*setup.laser, Role::laser, 0);
+    f(*setup.air, Role::air, 0);
+    for (std::size_t k = 0; k < setup.material.size(); ++k)
+      f(*setup.material[k], Role::material, k);
+    if (setup.position) f(*setup.position, Role::position, 0);
+    if (setup.probe) f(*setup.probe, Role::probe, 0);
   }
 
   void publish() {
@@ -753,26 +712,11 @@ struct LinearRun::Impl {
     }
     setup.on_live(live);
   }
-
-  // 10 Hz: live state, and the writer's age-based flush so a slow stream is still committed.
-  void tick() {
-    if (done) return;
-    publish();
-    if (const auto failed = offer_old_batch(writer.get())) return abort(*failed);
-    arm_tick(timer, alive, [this] { tick(); });
-  }
 };
 
 LinearRun::LinearRun(boost::asio::io_context& io, LinearRunSetup setup)
     : impl_(std::make_unique<Impl>(io, std::move(setup))) {}
-LinearRun::~LinearRun() {
-  try {
-    if (!impl_->done && impl_->running) impl_->abort("stopped");
-  } catch (...) {
-    // abort() does not throw; a display callback (on_live, on_event) might: a destructor
-    // must not let it through (std::terminate).
-  }
-}
+LinearRun::~LinearRun() { impl_->stop_if_running(); }
 void LinearRun::start() { impl_->start(); }
 void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }
 void LinearRun::manual_capture() {
