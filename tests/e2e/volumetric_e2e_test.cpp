@@ -61,10 +61,27 @@ daq::SimulatedAcquisition acquisition(kin::Topology t, const fs::path& db) {
           .store_options = {.full_sync = false}};
 }
 
+// One test acquired; measured once more when its run refused a stop because the probe's answer
+// came after the machine had left (docs/iso230-2.md, "Which samples make a stop's value"), as an
+// operator would. On simulated time that happens only when this process is starved: the clock
+// forgets bytes still in flight after VirtualTime::kSettle (200 ms of wall time) and jumps to
+// the probe's next deadline (seen once in a clean-clone scripts/test, ctest -j3 on 2 cores:
+// "answers came up to 3000 ms after their requests (median 0 ms)"); the old rule took the
+// value measured there. The refused run stays stored as aborted (the build takes the newer).
+daq::LinearRunOutcome acquire_measuring_again(const daq::SimulatedAcquisition& a,
+                                              const cal::daq::LinearTestConfig& test) {
+  auto out = daq::acquire_simulated(a, test);
+  if (!out.complete && out.reason.find("after their requests") != std::string::npos) {
+    std::printf("measured again: %s: %s\n", out.component.c_str(), out.reason.c_str());
+    out = daq::acquire_simulated(a, test);
+  }
+  return out;
+}
+
 // Every test of the campaign acquired and stored; the model built from the store.
 mdl::BuildReport measure_and_build(const daq::SimulatedAcquisition& a, kin::Topology t) {
   for (const auto& test : campaign()) {
-    const auto out = daq::acquire_simulated(a, test);
+    const auto out = acquire_measuring_again(a, test);
     EXPECT_TRUE(out.complete) << kin::to_string(t) << " " << out.component << ": " << out.reason;
   }
   cal::storage::Store store(a.database, {.read_only = true});
@@ -195,7 +212,7 @@ TEST(VolumetricLoop, CompensatedWithTheBuiltModelTheResidualIsSecondOrder) {
          {test.measure.stationary_mm, std::array<double, 3>{500, 400, 300}}) {
       auto l = test;
       l.measure.stationary_mm = stationary;
-      const auto out = daq::acquire_simulated(again, l);
+      const auto out = acquire_measuring_again(again, l);
       ASSERT_TRUE(out.complete) << out.component << ": " << out.reason;
       const double r = profile_range_um(db2, out.run_id);
       if (r > 0.1) {
