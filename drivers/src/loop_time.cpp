@@ -6,6 +6,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -72,13 +73,17 @@ void VirtualTime::pace(double speed) {
 
 bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t until_ns) {
   const auto finished = [&] { return done && done(); };
-  auto settle_left = kSettle;
+  // Bytes in flight are waited for until kSettle of wall time passes with no progress; a
+  // deadline on the wall clock, not a count of 1 ms polls: a starved process polls less often
+  // than that and would forget bytes still on their way (then jump past their answer).
+  const auto settle_deadline = [] { return std::chrono::steady_clock::now() + kSettle; };
+  auto settle_by = settle_deadline();
   while (!finished()) {
     if (io_.stopped()) io_.restart();
     // Everything runnable now, I/O the kernel has ready included (poll checks it without
     // blocking). The clock stands still meanwhile.
     if (io_.poll_one() > 0) {
-      settle_left = kSettle;
+      settle_by = settle_deadline();
       continue;
     }
     if (operations_ > 0 || in_flight_ > 0) {
@@ -86,16 +91,19 @@ bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t unti
       // time, then run what they complete, before any simulated time passes.
       if (io_.stopped()) io_.restart();
       if (io_.run_one_for(std::chrono::milliseconds(1)) > 0) {
-        settle_left = kSettle;
+        settle_by = settle_deadline();
         continue;
       }
-      settle_left -= std::chrono::milliseconds(1);
-      if (settle_left.count() > 0) continue;
+      if (std::chrono::steady_clock::now() < settle_by) continue;
       if (operations_ > 0) continue;  // a connection always ends (its own timeout)
       ++stats_.settle_timeouts;
+      std::fprintf(stderr,
+                   "simulated time: %lld byte(s) counted in flight did not arrive within %lld ms "
+                   "of wall time; forgotten, the clock moves on\n",
+                   static_cast<long long>(in_flight_), static_cast<long long>(kSettle.count()));
       in_flight_ = 0;
     }
-    settle_left = kSettle;
+    settle_by = settle_deadline();
     auto& waits = queue_->waits;
     if (waits.empty()) {
       // Nothing simulated is pending: only wall-clock work (a socket of a client in another

@@ -64,10 +64,10 @@ daq::SimulatedAcquisition acquisition(kin::Topology t, const fs::path& db) {
 // One test acquired; measured once more when its run refused a stop because the probe's answer
 // came after the machine had left (docs/iso230-2.md, "Which samples make a stop's value"), as an
 // operator would. On simulated time that happens only when this process is starved: the clock
-// forgets bytes still in flight after VirtualTime::kSettle (200 ms of wall time) and jumps to
-// the probe's next deadline (seen once in a clean-clone scripts/test, ctest -j3 on 2 cores:
-// "answers came up to 3000 ms after their requests (median 0 ms)"); the old rule took the
-// value measured there. The refused run stays stored as aborted (the build takes the newer).
+// forgets bytes still in flight after VirtualTime::kSettle of wall time and jumps to the
+// probe's next deadline (seen once in a clean-clone scripts/test, ctest -j3 on 2 cores, when
+// kSettle was 200 ms: "answers came up to 3000 ms after their requests (median 0 ms)"; now
+// 2 s); the old rule took the value measured there. The refused run stays stored as aborted (the build takes the newer).
 daq::LinearRunOutcome acquire_measuring_again(const daq::SimulatedAcquisition& a,
                                               const cal::daq::LinearTestConfig& test) {
   auto out = daq::acquire_simulated(a, test);

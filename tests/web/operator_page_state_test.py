@@ -291,7 +291,7 @@ try:
     b.js("document.getElementById('start-linear').click();")
     b.js("document.getElementById('edits-apply').click();")
     b.wait("return window.caldaq.page.status.running && window.caldaq.page.run && "
-           "window.caldaq.page.run.stop;", what="the run with the applied edit")
+           "window.caldaq.page.run.stop;", timeout_s=45, what="the run with the applied edit")
     ok(b.js("return window.caldaq.page.run.stop.count;") == 8, "applied: the run has the edited 8 stops")
     ok(b.js("return window.caldaq.page.status.setup.linear.last_mm;") == 50, "the service's set-up is the edited one")
 

@@ -80,8 +80,10 @@ class VirtualTime {
     std::uint64_t settle_timeouts = 0;
   };
   const Stats& stats() const { return stats_; }
-  // How long (wall time) the loop waits for bytes counted in flight before it forgets them.
-  static constexpr std::chrono::milliseconds kSettle{200};
+  // How long (wall time, with nothing arriving) the loop waits for bytes counted in flight
+  // before it forgets them. Long enough for a process starved on a loaded 2-core machine;
+  // paid in full only when a reader has gone (a twin writing to a closed port).
+  static constexpr std::chrono::milliseconds kSettle{2000};
 
   VirtualTime(const VirtualTime&) = delete;
   VirtualTime& operator=(const VirtualTime&) = delete;
