@@ -166,9 +166,10 @@ BuildReport build(const std::vector<MeasuredProfile>& profiles, const BuildOptio
     if (!m.squareness[k].given) r.missing.emplace_back(kSquareness[k]);
   if (!r.missing.empty() && !o.allow_missing)
     throw InputError(fmt::format(
-        "machine '{}': {} of the 21 errors have no stored run: {} (measure them, or allow a "
+        "machine '{}': {} of the 21 errors {} no stored run: {} (measure them, or allow a "
         "partial model where they are zero)",
-        o.machine, r.missing.size(), fmt::join(r.missing, ", ")));
+        o.machine, r.missing.size(), r.missing.size() == 1 ? "has" : "have",
+        fmt::join(r.missing, ", ")));
   json runs = json::object();
   for (const auto& [name, ids] : r.used) runs[name] = ids;
   m.provenance.json = json{
