@@ -1,0 +1,132 @@
+#pragma once
+// Rotary axes on top of the 3-axis model of kinematics.hpp: up to two rotary axes (A, B or C)
+// on the table side, the spindle side, or one on each, each with its four ISO 230-1 location
+// errors (position and orientation of its axis average line) and its six component errors as
+// functions of the angle; the tool tip's position and orientation error relative to the
+// workpiece by the exact HTM product or its first-order expansion; and the fit of an axis
+// average line to sphere centres probed at several angles of one table axis (the method of
+// HEIDENHAIN KinematicsOpt and SINUMERIK CYCLE996). Conventions, derivations and sources:
+// docs/kinematics.md, section "Rotary axes".
+//
+// Units as in kinematics.hpp: mm for positions, um for translational errors, urad for angular
+// errors; angles of the rotary axes in degrees.
+//
+// Coordinates. Every nominal point (pivots, the tool offset) is given in HOME coordinates:
+// machine coordinates of the tool reference point (spindle gauge point), with all linear and
+// rotary axes at 0; the workpiece frame coincides with them at home. A sphere centre probed at
+// a table angle is given in the same coordinates: the linear axes' positions plus the tool
+// offset, as a control reports the probed centre.
+//
+// Chain. FiveAxisMachine::rotary lists the rotary axes from the workpiece to the tool: table
+// axes first (the first one carries the workpiece: for an A/C trunnion, C then A), then
+// spindle axes (the last one carries the spindle: for a C/B fork head, C then B). Table axes
+// sit between the workpiece and the workpiece-side linear axes; spindle axes between the
+// tool-side linear axes and the tool.
+//
+// Angle. The commanded angle is the rotation of the axis's moving member relative to its
+// carrier, right-handed about the positive X (A), Y (B) or Z (C) direction. For a table axis
+// that is the table's own rotation (ISO 841's primed direction, opposite to the tool's
+// rotation relative to the workpiece).
+//
+// Errors of a rotary axis, all of its moving member relative to its carrier, in the carrier's
+// axes:
+// - Location errors (constant): the axis average line passes through pivot + position (the
+//   component along the axis's own direction must be 0: E_X0C and E_Y0C for C) and has the
+//   direction R(orientation) * nominal direction (the component about the axis itself must be
+//   0: E_A0C and E_B0C for C). The rotation is about that actual line, so at angle 0 the
+//   location errors move nothing: they show only when the axis turns (the workpiece and the
+//   tool are set up at the rotary zero).
+// - Component errors (functions of the angle in DEGREES; ErrorFunction's argument is the
+//   angle): translations ex_um, ey_um, ez_um (for C: E_XC, E_YC radial, E_ZC axial) and
+//   rotations ea_urad, eb_urad, ec_urad (E_AC, E_BC tilt, E_CC angular positioning) of the
+//   moving member, at the actual pivot, in the carrier's axes.
+#include <array>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cal/analysis/kinematics.hpp"
+
+namespace cal::kinematics {
+
+enum class RotaryLetter { a, b, c };                         // about X, Y, Z
+std::string_view to_string(RotaryLetter l);                  // "A", "B", "C"
+RotaryLetter rotary_letter_from_string(std::string_view s);  // case-insensitive; throws InputError
+// The index (0, 1, 2 = X, Y, Z) of the axis's nominal direction.
+std::size_t direction_index(RotaryLetter l);
+// The four location errors' ISO 230-1 names in the order position (two), orientation (two), by
+// increasing direction index: C -> E_X0C, E_Y0C, E_A0C, E_B0C; A -> E_Y0A, E_Z0A, E_B0A,
+// E_C0A; B -> E_X0B, E_Z0B, E_A0B, E_C0B.
+std::array<std::string, 4> location_error_names(RotaryLetter l);
+
+enum class Side { table, spindle };
+std::string_view to_string(Side s);  // "table", "spindle"
+
+struct RotaryAxis {
+  RotaryLetter letter = RotaryLetter::c;
+  Side side = Side::table;
+  Vec3 pivot_mm{};                   // a point of the nominal axis line, home coordinates
+  Vec3 location_position_um{};       // e.g. C: {E_X0C, E_Y0C, 0}
+  Vec3 location_orientation_urad{};  // e.g. C: {E_A0C, E_B0C, 0}
+  AxisErrors motion;                 // component errors; argument: the angle in degrees
+};
+
+struct FiveAxisMachine {
+  // The linear axes, their 21 errors, topology and offsets as in the 3-axis model. Its
+  // tool_offset_mm is the tool tip relative to the tool reference point with all rotary axes
+  // at 0 (a spindle axis turns it).
+  Machine linear;
+  std::vector<RotaryAxis> rotary;  // 0, 1 or 2; chain order, table axes first
+};
+
+// The error of the tool tip relative to the workpiece, in the workpiece frame (which turns with
+// the table axes): translation = actual minus nominal tip; rotation = rotation vector of
+// R_actual * R_nominal^T (the tool's orientation error). angles_deg has one angle per rotary
+// axis, in the order of machine.rotary. Throws InputError for a machine that breaks the rules
+// above, a wrong number of angles, a non-finite input, or an angle outside an error table.
+VolumetricError five_axis_error(const FiveAxisMachine& machine, const Vec3& linear_mm,
+                                std::span<const double> angles_deg, Method method);
+
+// The nominal tool tip in the workpiece frame, home coordinates (what the control believes).
+Vec3 five_axis_nominal_tip_mm(const FiveAxisMachine& machine, const Vec3& linear_mm,
+                              std::span<const double> angles_deg);
+
+// ---------------------------------------------------------------------------------------------
+// Sphere probing: the axis average line of one TABLE axis from sphere centres probed at
+// several of its angles (the other rotary axis at 0), fitted by least squares as a circle in
+// 3-D about a line (its position at the nominal pivot's plane, its orientation), the radius
+// and the height of the circle's plane.
+
+struct ProbedCentre {
+  double angle_deg = 0.0;
+  Vec3 centre_mm{};  // home (machine) coordinates
+};
+
+struct AxisLineFit {
+  RotaryLetter letter = RotaryLetter::c;
+  // The location errors in the layout of RotaryAxis (the entries along / about the axis are 0)
+  // and their standard uncertainties (NaN when they cannot be estimated: three angles and no
+  // probing uncertainty given).
+  Vec3 position_um{}, position_u_um{};
+  Vec3 orientation_urad{}, orientation_u_urad{};
+  double radius_mm = 0.0;        // of the circle the sphere centre described
+  double plane_offset_mm = 0.0;  // of the circle's plane along the axis, from the pivot
+  // Residuals per probed centre, in the input order: radial (outward from the line), axial
+  // (along the fitted direction) and tangential (arc length, after removing the mean angular
+  // offset between the fitted and the commanded angles): the axis's error motion as probed.
+  std::vector<double> radial_um, axial_um, tangential_um;
+  double rms_um = 0.0;    // RMS of the radial and axial residuals
+  double sigma_um = 0.0;  // the point standard deviation used for the uncertainties
+  int dof = 0;            // 2 N - 6: radial and axial residuals less the 6 parameters
+};
+
+// probe_u_um: the standard uncertainty of one probed centre per coordinate; 0 estimates it from
+// the residuals (needs 4 or more centres). Throws InputError for fewer than 3 distinct angles,
+// non-finite input, centres that are (nearly) collinear or coincident, a circle whose plane is
+// not (nearly) perpendicular to the nominal direction, or a negative probe_u_um.
+AxisLineFit fit_axis_line(RotaryLetter letter, const Vec3& nominal_pivot_mm,
+                          std::span<const ProbedCentre> centres, double probe_u_um = 0.0);
+
+}  // namespace cal::kinematics
