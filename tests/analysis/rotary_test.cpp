@@ -307,6 +307,55 @@ TEST(RotaryModel, SwivelHeadFirstOrderByHand) {
   expect_near(tip, {10 - 280, 20, 30 + 180}, 1e-9, "nominal tip at B = 90");
 }
 
+TEST(RotaryModel, ForkHeadHeadHeadByHand) {
+  // A C/B fork head (both axes on the spindle side; C carries B, B carries the spindle): the
+  // C pivot on the ram axis 400 mm up, the B pivot 150 mm up, tool 120 mm long. The tip is
+  // Jc(Jb(t)); to first order its displacement is
+  //   Rz(C) d_B(t - c_B) + d_C(Ry(B)(t - c_B) + c_B - c_C)
+  // with d from (I - R) o + e x (R v) - R (e x v), and the tool moves with the head, so e = +d.
+  // Exactly, each joint is Rodrigues' rotation about its actual line (n_C = Ry(b) Rx(a) z,
+  // n_B = Rz(c) Rx(a) y), composed: pC + oC + rod(nC, C, (pB + oB + rod(nB, B, t - pB - oB))
+  // - pC - oC).
+  FiveAxisMachine m;
+  m.linear.topology = Topology::fxyz;
+  m.linear.tool_offset_mm = {0, 0, -120};
+  RotaryAxis c, b;
+  c.letter = RotaryLetter::c;
+  c.side = Side::spindle;
+  c.pivot_mm = {0, 0, 400};
+  c.location_position_um = {15, -10, 0};
+  c.location_orientation_urad = {-30, 25, 0};
+  b.letter = RotaryLetter::b;
+  b.side = Side::spindle;
+  b.pivot_mm = {0, 0, 150};
+  b.location_position_um = {-8, 0, 12};
+  b.location_orientation_urad = {40, 0, -35};
+  m.rotary = {c, b};
+  const Vec3 t{0, 0, -120}, pc{0, 0, 400}, pb{0, 0, 150};
+  for (const auto& [cd, bd] :
+       std::vector<std::pair<double, double>>{{90, 30}, {-45, -60}, {170, 100}}) {
+    const Vec3 db = joint_displacement_um(rot_y(bd), {-8, 0, 12}, {40, 0, -35}, sub(t, pb));
+    const Vec3 dc = joint_displacement_um(rot_z(cd), {15, -10, 0}, {-30, 25, 0},
+                                          sub(add(mv(rot_y(bd), sub(t, pb)), pb), pc));
+    const Vec3 want = add(mv(rot_z(cd), db), dc);
+    const std::vector angles{cd, bd};
+    const auto fo = five_axis_error(m, {5, 6, 7}, angles, Method::first_order);
+    expect_near(fo.translation_um, want, 1e-9, "first order C " + std::to_string(cd));
+    const double ca = -30e-6, cb = 25e-6, ba = 40e-6, bc = -35e-6;
+    const Vec3 nc{std::cos(ca) * std::sin(cb), -std::sin(ca), std::cos(ca) * std::cos(cb)};
+    const Vec3 nb{-std::sin(bc) * std::cos(ba), std::cos(bc) * std::cos(ba), std::sin(ba)};
+    const Vec3 oc{0.015, -0.010, 0}, ob{-0.008, 0, 0.012};
+    const Vec3 after_b = add(add(pb, ob), rodrigues(nb, bd * kDeg, sub(sub(t, pb), ob)));
+    const Vec3 act = add(add(pc, oc), rodrigues(nc, cd * kDeg, sub(sub(after_b, pc), oc)));
+    const Vec3 nom = add(pc, mv(rot_z(cd), sub(add(pb, mv(rot_y(bd), sub(t, pb))), pc)));
+    const auto ex = five_axis_error(m, {5, 6, 7}, angles, Method::htm);
+    expect_near(ex.translation_um, scale(1e3, sub(act, nom)), 1e-7,
+                "exact C " + std::to_string(cd));
+    expect_near(five_axis_nominal_tip_mm(m, {5, 6, 7}, angles), add(nom, {5, 6, 7}), 1e-9,
+                "nominal");
+  }
+}
+
 TEST(RotaryModel, ExactModelIsTheRotationAboutTheActualLine) {
   // Large errors (0.3 mm, 2 mrad), where first order is visibly off: the exact model must equal
   // the rotation about the actual line written with Rodrigues' formula.
