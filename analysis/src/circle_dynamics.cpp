@@ -66,9 +66,12 @@ Timed timed(const TraceResidual& t, double w) {
   const std::size_t n = t.theta_rad.size();
   out.order.resize(n);
   std::iota(out.order.begin(), out.order.end(), std::size_t{0});
-  std::stable_sort(out.order.begin(), out.order.end(), [&](std::size_t a, std::size_t b) {
+  const auto before = [&](std::size_t a, std::size_t b) {
     return t.s * t.theta_rad[a] < t.s * t.theta_rad[b];
-  });
+  };
+  // A trace from time is in travel order already: checked in one pass, sorted only if not.
+  if (!std::is_sorted(out.order.begin(), out.order.end(), before))
+    std::stable_sort(out.order.begin(), out.order.end(), before);
   out.time_s.resize(n);
   if (n == 0) return out;
   const double first = t.s * t.theta_rad[out.order.front()];
@@ -216,6 +219,46 @@ double mean_power(const std::vector<double>& p, std::ptrdiff_t a, std::ptrdiff_t
   return sum / static_cast<double>(b - a + 1);
 }
 
+// The residual minus its centred moving median, in the trace's own order: at travel position i
+// the median of every stride-th sample from i - m to i + m (clipped at the ends). Away from the
+// ends the window of i + stride is that of i less its first sample plus one more, so each
+// residue class mod stride slides one sorted window along (an erase and an insert) instead of
+// selecting the median of every window anew; the median is the same element either way.
+std::vector<double> high_pass(const TraceResidual& t, const Timed& tm, std::size_t m,
+                              std::size_t stride) {
+  const std::size_t n = t.r_um.size();
+  const auto at = [&](std::size_t k) { return t.r_um[tm.order[k]]; };
+  std::vector<double> h(n), win;
+  const auto clipped = [&](std::size_t i) {  // the window selected anew
+    const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
+    win.clear();
+    for (std::size_t k = a; k < b; k += stride) win.push_back(at(k));
+    std::nth_element(win.begin(), win.begin() + static_cast<std::ptrdiff_t>(win.size() / 2),
+                     win.end());
+    return win[win.size() / 2];
+  };
+  const bool slides = n >= 2 * m + 1;  // some window lies wholly inside
+  for (std::size_t i = 0; i < n; ++i)
+    if (!slides || i < m || i + m + 1 > n) h[tm.order[i]] = at(i) - clipped(i);
+  if (!slides) return h;
+  const std::size_t count = (2 * m + 1 + stride - 1) / stride;  // samples in an inner window
+  for (std::size_t r = 0; r < stride && m + r + m + 1 <= n; ++r) {
+    std::size_t i = m + r;
+    win.clear();
+    for (std::size_t k = 0; k < count; ++k) win.push_back(at(i - m + k * stride));
+    std::sort(win.begin(), win.end());
+    for (;;) {
+      h[tm.order[i]] = at(i) - win[count / 2];
+      if (i + stride + m + 1 > n) break;
+      const double out = at(i - m), in = at(i - m + count * stride);
+      win.erase(std::lower_bound(win.begin(), win.end(), out));
+      win.insert(std::upper_bound(win.begin(), win.end(), in), in);
+      i += stride;
+    }
+  }
+  return h;
+}
+
 }  // namespace
 
 std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& traces,
@@ -350,20 +393,9 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
         step_rad > 0
             ? std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(2.0 * deg / step_rad)))
             : 1;
-    const std::size_t n = t.r_um.size();
     // At most 41 samples of the window (every stride-th): the median of the local level needs
     // no more, and 2 x 36,000 samples at 0.01 degrees would otherwise cost 401 per sample.
-    const std::size_t stride = std::max<std::size_t>(1, (2 * m + 1) / 41);
-    std::vector<double> h(n), win;
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
-      win.clear();
-      for (std::size_t k = a; k < b; k += stride) win.push_back(t.r_um[tm.order[k]]);
-      std::nth_element(win.begin(), win.begin() + static_cast<std::ptrdiff_t>(win.size() / 2),
-                       win.end());
-      h[tm.order[i]] = t.r_um[tm.order[i]] - win[win.size() / 2];
-    }
-    hp.push_back(std::move(h));
+    hp.push_back(high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41)));
   }
   // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2).
   const auto from_u = [](double th) { return std::abs(std::remainder(th, pi)); };
