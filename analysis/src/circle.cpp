@@ -545,10 +545,10 @@ Model choose_terms(const Setup& setup, bool both, double arc_deg, std::vector<st
 }
 
 // The ranked diagnostics from the fitted coefficients. Each one's peak-to-valley and the G of
-// the traces without it (the LSQ circle refitted) come from one pass over the samples for all
-// of them together (finish): the circle of y - contribution needs C'(y - contribution), C the
-// circle's columns (cos, sin, 1), and for a fitted term C' times its columns is in the Gram
-// matrix already.
+// the traces without it (the LSQ circle refitted) come from the pass over the samples that
+// makes the residual, for all of them together (observe; finish for those found in the
+// residual): the circle of y - contribution needs C'(y - contribution), C the circle's columns
+// (cos, sin, 1), and for a fitted term C' times its columns is in the Gram matrix already.
 class Reporter {
  public:
   Reporter(Result& res, const Model& reported, const Design& d, const Eigen::VectorXd& coef)
@@ -572,37 +572,47 @@ class Reporter {
   double c(int k) const { return c_[k]; }
 
   // PV of each contribution, its share of G, and what G would be without it (docs/circle.md).
+  // The fitted diagnostics' contributions, over one block of the design (the caller's pass
+  // over the samples: report() first, then every block once).
+  template <class B, class Y>
+  void observe(const B& b, const Y& y) {
+    if (!ldlt_) {
+      ldlt_.emplace(d_.ata().topLeftCorner<3, 3>());
+      for (auto& p : pending_) {
+        Eigen::Vector3d ct_contrib = Eigen::Vector3d::Zero();
+        for (int k : p.terms) ct_contrib += c_[k] * d_.ata().block<3, 1>(0, k);
+        p.centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib);  // circle without it
+      }
+    }
+    Eigen::VectorXd contrib(b.rows()), without(b.rows());
+    for (auto& p : pending_) {
+      if (p.found) continue;
+      contrib.setZero();
+      for (int k : p.terms) contrib += c_[k] * b.col(k);
+      without = y - contrib - p.centre[0] * b.col(centre_u) - p.centre[1] * b.col(centre_v);
+      p.contrib.add(contrib.minCoeff()), p.contrib.add(contrib.maxCoeff());
+      p.without.add(without.minCoeff()), p.without.add(without.maxCoeff());
+    }
+  }
+
+  // Those found in the residual (their contributions are given, no basis is needed), then all
+  // of them into the result.
   void finish() {
-    const Eigen::Matrix3d ctc = d_.ata().topLeftCorner<3, 3>();
-    const Eigen::Vector3d cty = d_.aty().head<3>();
-    const Eigen::LDLT<Eigen::Matrix3d> ldlt(ctc);
+    if (!ldlt_) ldlt_.emplace(d_.ata().topLeftCorner<3, 3>());
     const auto samples = d_.samples();
     for (auto& p : pending_) {
+      if (!p.found) continue;
+      const auto& contrib = p.found->contribution;
       Eigen::Vector3d ct_contrib = Eigen::Vector3d::Zero();
-      if (p.found) {
-        for (std::size_t i = 0; i < samples.size(); ++i)
-          ct_contrib += Eigen::Vector3d(samples[i].c, samples[i].n, 1.0) * p.found->contribution[i];
-      } else {
-        for (int k : p.terms) ct_contrib += c_[k] * d_.ata().block<3, 1>(0, k);
+      for (std::size_t i = 0; i < samples.size(); ++i)
+        ct_contrib += Eigen::Vector3d(samples[i].c, samples[i].n, 1.0) * contrib[i];
+      p.centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib);
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        const Sample& x = samples[i];
+        p.contrib.add(contrib[i]);
+        p.without.add(x.y - contrib[i] - p.centre[0] * x.c - p.centre[1] * x.n);
       }
-      p.centre = ldlt.solve(cty - ct_contrib);  // (cu, cv, r0) of the circle without it
     }
-    for_each_block(d_.model(), samples, 1, d_.k(),
-                   [&](const auto& b, const auto& y, std::size_t first) {
-                     for (Eigen::Index i = 0; i < b.rows(); ++i) {
-                       const double cu = b(i, centre_u), cv = b(i, centre_v);
-                       for (auto& p : pending_) {
-                         double contrib = 0.0;
-                         if (p.found) {
-                           contrib = p.found->contribution[first + static_cast<std::size_t>(i)];
-                         } else {
-                           for (int k : p.terms) contrib += c_[k] * b(i, k);
-                         }
-                         p.contrib.add(contrib);
-                         p.without.add(y[i] - contrib - p.centre[0] * cu - p.centre[1] * cv);
-                       }
-                     }
-                   });
     const double g_bi = res_.iso.G_bi_um;
     for (auto& p : pending_) {
       p.dg.pv_um = p.contrib.pv();
@@ -626,6 +636,7 @@ class Reporter {
   const Design& d_;
   const Eigen::VectorXd& c_;
   std::vector<Pending> pending_;
+  std::optional<Eigen::LDLT<Eigen::Matrix3d>> ldlt_;  // of the circle's columns C'C
 };
 
 void report(Reporter& r, const Setup& setup, const std::string& ax, double period_mm) {
@@ -758,7 +769,11 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
     tr.r_um.resize(sp.end - sp.begin);
     residuals.push_back(std::move(tr));
   }
+  // One pass: the residual, and the fitted diagnostics' contributions.
+  Reporter rep(res, reported, full, sol.coef);
+  report(rep, setup, ax, period_mm);
   for_each_block(m, samples, 1, full.k(), [&](const auto& b, const auto& y, std::size_t first) {
+    rep.observe(b, y);
     const Eigen::VectorXd r = y - b * sol.coef;
     for (Eigen::Index i = 0; i < r.size(); ++i) {
       const std::size_t at = first + static_cast<std::size_t>(i);
@@ -780,8 +795,6 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   residuals.clear();
   residuals.shrink_to_fit();
 
-  Reporter rep(res, reported, full, sol.coef);
-  report(rep, setup, ax, period_mm);
   if (vibration) rep.add(*vibration);
   for (const auto& f : stick_slip) rep.add(f);
   rep.finish();

@@ -115,6 +115,7 @@ std::vector<double> periodogram(std::vector<double> x, std::size_t npad) {
                                  static_cast<double>(std::max<std::size_t>(1, n - 1))));
   x.resize(npad, 0.0);
   Eigen::FFT<double> fft;
+  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
   std::vector<std::complex<double>> spec;
   fft.fwd(spec, x);
   std::vector<double> p(npad / 2 + 1);
@@ -400,36 +401,39 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
   // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2).
   const auto from_u = [](double th) { return std::abs(std::remainder(th, pi)); };
   const auto from_v = [](double th) { return std::abs(std::remainder(th - pi / 2, pi)); };
+  // One pass for the mean squares in and out of the windows; a contribution is made only for
+  // an axis that is reported.
   double out_ss = 0.0;
   std::size_t out_n = 0;
+  std::array<double, 2> in_ss{};
+  std::array<std::size_t, 2> in_n{};
   for (std::size_t i = 0; i < traces.size(); ++i)
     for (std::size_t j = 0; j < hp[i].size(); ++j) {
-      const double th = traces[i].theta_rad[j];
-      if (from_u(th) > window && from_v(th) > window) out_ss += hp[i][j] * hp[i][j], ++out_n;
+      const double th = traces[i].theta_rad[j], du = from_u(th), dv = from_v(th);
+      const double sq = hp[i][j] * hp[i][j];
+      if (du > window && dv > window) out_ss += sq, ++out_n;
+      if (du >= core && du <= window) in_ss[0] += sq, ++in_n[0];
+      if (dv >= core && dv <= window) in_ss[1] += sq, ++in_n[1];
     }
   std::vector<Found> found;
   if (out_n < min_window_samples) return found;
   const double ms_out = out_ss / static_cast<double>(out_n);
   for (const bool axis_u : {true, false}) {
+    const std::size_t a = axis_u ? 0 : 1;
+    if (in_n[a] < min_window_samples) continue;  // the arc does not pass a reversal of the axis
+    const double ms_in = in_ss[a] / static_cast<double>(in_n[a]);
+    if (ms_in < 2.0 * ms_out || std::sqrt(ms_in - ms_out) < 0.01) continue;
     const char axis = axis_u ? s.u : s.v;
     Found f{.key = fmt::format("stick_slip_{}", axis),
             .name = fmt::format("Stick-slip {} (rms, 1-{:g} deg from its reversals)", axis,
                                 s.window_deg),
-            .unit = "um"};
-    double in_ss = 0.0;
-    std::size_t in_n = 0;
+            .unit = "um",
+            .value = std::sqrt(ms_in - ms_out)};
     for (std::size_t i = 0; i < traces.size(); ++i)
       for (std::size_t j = 0; j < hp[i].size(); ++j) {
         const double th = traces[i].theta_rad[j], d = axis_u ? from_u(th) : from_v(th);
-        const bool in = d >= core && d <= window;
-        if (in) in_ss += hp[i][j] * hp[i][j], ++in_n;
-        f.contribution.push_back(in ? hp[i][j] : 0.0);
+        f.contribution.push_back(d >= core && d <= window ? hp[i][j] : 0.0);
       }
-    if (in_n < min_window_samples) continue;  // the arc does not pass a reversal of this axis
-    const double ms_in = in_ss / static_cast<double>(in_n);
-    if (ms_in < 2.0 * ms_out) continue;
-    f.value = std::sqrt(ms_in - ms_out);
-    if (f.value < 0.01) continue;
     found.push_back(std::move(f));
   }
   if (!found.empty())
