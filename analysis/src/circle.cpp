@@ -175,12 +175,12 @@ using Gram = Eigen::Matrix<double, term_count, term_count>;
 using TermVector = Eigen::Matrix<double, term_count, 1>;
 
 // The samples in blocks of rows of the design (every stride-th sample): f(block, y, first) with
-// the block's first row's index. A pass holds one block (some 70 kB), never the n x 18 design.
+// the block's first row's index. A pass holds one block (18 kB), never the n x 18 design.
 using Block = Eigen::Matrix<double, Eigen::Dynamic, term_count>;
 template <class F>
 void for_each_block(const Model& m, std::span<const Sample> samples, std::size_t stride, double k,
                     F&& f) {
-  constexpr std::size_t block_rows = 512;
+  constexpr std::size_t block_rows = 128;  // 18 kB: the rows are written where they are read
   const std::size_t n = (samples.size() + stride - 1) / stride;
   Block b(static_cast<Eigen::Index>(std::min(n, block_rows)), term_count);
   Eigen::VectorXd y(b.rows());
@@ -260,11 +260,21 @@ class Design {
       : m_(m), samples_(samples), stride_(stride), period_mm_(period_mm) {
     ata_.setZero();
     aty_.setZero();
-    for_each_block(m_, samples_, stride_, k(), [&](const auto& b, const auto& y, std::size_t) {
-      ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
-      aty_.noalias() += b.transpose() * y;
-      yty_ += y.squaredNorm();
-    });
+    const std::size_t rows = (samples_.size() + stride_ - 1) / stride_;
+    if (rows <= dense_max_rows) {
+      dense_.resize(static_cast<Eigen::Index>(rows), term_count);
+      dense_y_.resize(static_cast<Eigen::Index>(rows));
+    }
+    for_each_block(m_, samples_, stride_, k(),
+                   [&](const auto& b, const auto& y, std::size_t first) {
+                     ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
+                     aty_.noalias() += b.transpose() * y;
+                     yty_ += y.squaredNorm();
+                     if (dense_.rows() > 0) {
+                       dense_.middleRows(static_cast<Eigen::Index>(first), b.rows()) = b;
+                       dense_y_.segment(static_cast<Eigen::Index>(first), b.rows()) = y;
+                     }
+                   });
     ata_.triangularView<Eigen::StrictlyUpper>() = ata_.transpose();
   }
 
@@ -287,19 +297,40 @@ class Design {
     Eigen::Matrix<double, cyclic_count, term_count> cross =
         Eigen::Matrix<double, cyclic_count, term_count>::Zero();
     Eigen::Matrix<double, cyclic_count, 1> cty = Eigen::Matrix<double, cyclic_count, 1>::Zero();
-    for_each_block(m_, samples_, stride_, k(), [&](const auto& b, const auto& y, std::size_t) {
-      const auto cyc = b.template middleCols<cyclic_count>(cyclic_first);
-      cross.noalias() += cyc.transpose() * b;
-      cty.noalias() += cyc.transpose() * y;
-    });
+    if (dense_.rows() > 0) {  // only the cyclic columns change
+      const double kc = k();
+      for (Eigen::Index i = 0; i < dense_.rows(); ++i) {
+        const Sample& x = samples_[static_cast<std::size_t>(i) * stride_];
+        const double pu = kc * x.c, pv = kc * x.n;
+        dense_(i, cyclic_u_a) = x.c * std::sin(pu);
+        dense_(i, cyclic_u_b) = x.c * std::cos(pu);
+        dense_(i, cyclic_v_a) = x.n * std::sin(pv);
+        dense_(i, cyclic_v_b) = x.n * std::cos(pv);
+      }
+      const auto cyc = dense_.middleCols<cyclic_count>(cyclic_first);
+      cross.noalias() = cyc.transpose() * dense_;
+      cty.noalias() = cyc.transpose() * dense_y_;
+    } else {
+      for_each_block(m_, samples_, stride_, k(), [&](const auto& b, const auto& y, std::size_t) {
+        const auto cyc = b.template middleCols<cyclic_count>(cyclic_first);
+        cross.noalias() += cyc.transpose() * b;
+        cty.noalias() += cyc.transpose() * y;
+      });
+    }
     ata_.middleRows<cyclic_count>(cyclic_first) = cross;
     ata_.middleCols<cyclic_count>(cyclic_first) = cross.transpose();
     aty_.segment<cyclic_count>(cyclic_first) = cty;
   }
 
+  // A design of at most this many rows (the period search's decimated one: its size is set by
+  // the radius and the shortest period, not by the run's length) is also kept dense, so that a
+  // trial period recomputes only its four cyclic columns.
+  static constexpr std::size_t dense_max_rows = 8192;
   Model m_;
   std::span<const Sample> samples_;
   std::size_t stride_;
+  Block dense_;
+  Eigen::VectorXd dense_y_;
   double period_mm_;
   Gram ata_;
   TermVector aty_;
