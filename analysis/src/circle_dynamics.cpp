@@ -56,30 +56,36 @@ double omega_rad_s(const Settings& s) { return s.feed_mm_per_min / 60.0 / s.radi
 
 // One trace ordered by travel (s theta rising), with its sample times.
 struct Timed {
-  std::vector<std::size_t> order;  // travel order -> index in the trace
-  std::vector<double> time_s;      // per sample, in the trace's order; 0 at the first in travel
+  std::size_t n = 0;
+  std::vector<std::size_t> sorted;  // travel order -> index in the trace; empty: the identity
+  std::vector<double> time_s;       // per sample, in the trace's order; 0 at the first in travel
   double duration_s = 0.0, step_s = 0.0;
+  std::size_t order(std::size_t k) const { return sorted.empty() ? k : sorted[k]; }
 };
 
 Timed timed(const TraceResidual& t, double w) {
   Timed out;
-  const std::size_t n = t.theta_rad.size();
-  out.order.resize(n);
-  std::iota(out.order.begin(), out.order.end(), std::size_t{0});
+  const std::size_t n = out.n = t.theta_rad.size();
   const auto before = [&](std::size_t a, std::size_t b) {
     return t.s * t.theta_rad[a] < t.s * t.theta_rad[b];
   };
-  // A trace from time is in travel order already: checked in one pass, sorted only if not.
-  if (!std::is_sorted(out.order.begin(), out.order.end(), before))
-    std::stable_sort(out.order.begin(), out.order.end(), before);
+  // A trace from time is in travel order already: checked in one pass, and then no
+  // permutation is kept (8 bytes a sample); sorted only if not.
+  bool in_order = true;
+  for (std::size_t i = 1; i < n && in_order; ++i) in_order = !before(i, i - 1);
+  if (!in_order) {
+    out.sorted.resize(n);
+    std::iota(out.sorted.begin(), out.sorted.end(), std::size_t{0});
+    std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
+  }
   out.time_s.resize(n);
   if (n == 0) return out;
-  const double first = t.s * t.theta_rad[out.order.front()];
+  const double first = t.s * t.theta_rad[out.order(0)];
   for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad[i] - first) / w;
-  out.duration_s = out.time_s[out.order.back()];
+  out.duration_s = out.time_s[out.order(n - 1)];
   std::vector<double> steps;
   for (std::size_t i = 1; i < n; ++i) {
-    const double d = out.time_s[out.order[i]] - out.time_s[out.order[i - 1]];
+    const double d = out.time_s[out.order(i)] - out.time_s[out.order(i - 1)];
     if (d > 0) steps.push_back(d);
   }
   if (!steps.empty()) {
@@ -96,8 +102,8 @@ std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt)
   std::size_t j = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double at = static_cast<double>(k) * dt;
-    while (j + 2 < tm.order.size() && tm.time_s[tm.order[j + 1]] < at) ++j;
-    const std::size_t a = tm.order[j], b = tm.order[std::min(j + 1, tm.order.size() - 1)];
+    while (j + 2 < tm.n && tm.time_s[tm.order(j + 1)] < at) ++j;
+    const std::size_t a = tm.order(j), b = tm.order(std::min(j + 1, tm.n - 1));
     const double ta = tm.time_s[a], tb = tm.time_s[b];
     const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
     out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
@@ -228,7 +234,7 @@ double mean_power(const std::vector<double>& p, std::ptrdiff_t a, std::ptrdiff_t
 std::vector<double> high_pass(const TraceResidual& t, const Timed& tm, std::size_t m,
                               std::size_t stride) {
   const std::size_t n = t.r_um.size();
-  const auto at = [&](std::size_t k) { return t.r_um[tm.order[k]]; };
+  const auto at = [&](std::size_t k) { return t.r_um[tm.order(k)]; };
   std::vector<double> h(n), win;
   const auto clipped = [&](std::size_t i) {  // the window selected anew
     const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
@@ -240,7 +246,7 @@ std::vector<double> high_pass(const TraceResidual& t, const Timed& tm, std::size
   };
   const bool slides = n >= 2 * m + 1;  // some window lies wholly inside
   for (std::size_t i = 0; i < n; ++i)
-    if (!slides || i < m || i + m + 1 > n) h[tm.order[i]] = at(i) - clipped(i);
+    if (!slides || i < m || i + m + 1 > n) h[tm.order(i)] = at(i) - clipped(i);
   if (!slides) return h;
   const std::size_t count = (2 * m + 1 + stride - 1) / stride;  // samples in an inner window
   for (std::size_t r = 0; r < stride && m + r + m + 1 <= n; ++r) {
@@ -249,7 +255,7 @@ std::vector<double> high_pass(const TraceResidual& t, const Timed& tm, std::size
     for (std::size_t k = 0; k < count; ++k) win.push_back(at(i - m + k * stride));
     std::sort(win.begin(), win.end());
     for (;;) {
-      h[tm.order[i]] = at(i) - win[count / 2];
+      h[tm.order(i)] = at(i) - win[count / 2];
       if (i + stride + m + 1 > n) break;
       const double out = at(i - m), in = at(i - m + count * stride);
       win.erase(std::lower_bound(win.begin(), win.end(), out));
