@@ -55,6 +55,23 @@ void BM_BallbarDiagnosticsPeriodSearch_2x36000(benchmark::State& state) {
 }
 BENCHMARK(BM_BallbarDiagnosticsPeriodSearch_2x36000)->Unit(benchmark::kMillisecond);
 
+// The floor of any fit of this model: one pass over the samples, each angle's cos and sin
+// and the deviation summed against them (the least a fit must do with every sample once).
+void BM_BallbarOnePassFloor_2x36000(benchmark::State& state) {
+  const auto t = traces();
+  for (auto _ : state) {
+    double sy = 0, syc = 0, sys = 0;
+    for (const auto& tr : t)
+      for (std::size_t i = 0; i < tr.angle_deg.size(); ++i) {
+        const double a = tr.angle_deg[i] * std::numbers::pi / 180, y = tr.deviation_um[i];
+        sy += y, syc += y * std::cos(a), sys += y * std::sin(a);
+      }
+    benchmark::DoNotOptimize(sy + syc + sys);
+  }
+  state.SetItemsProcessed(state.iterations() * 72'000);
+}
+BENCHMARK(BM_BallbarOnePassFloor_2x36000)->Unit(benchmark::kMillisecond);
+
 // A field of /proc/self/status in kB ("VmRSS", "VmHWM"); -1 when absent.
 long status_kb(const std::string& key) {
   std::ifstream in("/proc/self/status");
