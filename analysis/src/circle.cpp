@@ -33,8 +33,10 @@
 //   straightness, a bow of u along v (du = k v^2 / R^2, k the bow at the ends of the travel):
 //                                  -> k sin^2 t cos t;  of v along u: k cos^2 t sin t
 // The coefficients are fitted by linear least squares over all samples of both directions,
-// by the normal equations (the basis is small and fixed; the data up to 2 x 36,000 samples),
-// with the columns scaled to unit norm before the LDLT solve.
+// by the normal equations, accumulated over blocks of samples (the basis is small and fixed, so
+// the fit holds an 18 x 18 Gram matrix, never the n x 18 design: issue 32), with the columns
+// scaled to unit norm before the Cholesky solve. The diagnostics' peak-to-valley and gains come
+// from one more pass over the samples (Reporter).
 #include "cal/analysis/circle.hpp"
 
 #include <fmt/format.h>
@@ -59,8 +61,11 @@ double sgn(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; }
 double sign_of(Direction d) { return d == Direction::ccw ? 1.0 : -1.0; }
 const char* name_of(Direction d) { return d == Direction::cw ? "cw" : "ccw"; }
 
+// What the fit keeps of a sample (48 bytes; a dense row of the design took 144 more): the
+// basis is rebuilt from it on every pass over the samples, except the two reversal-spike
+// columns (four exponentials), which cost more to rebuild than to keep.
 struct Sample {
-  double theta, s, y;
+  double c, n, y, s, spike_u, spike_v;  // cos, sin of the angle; deviation; direction
 };
 
 std::string axis_names(Plane p) {
@@ -76,7 +81,7 @@ std::string axis_names(Plane p) {
 }
 
 enum Term {
-  centre_u,
+  centre_u,  // the first three are the LSQ circle's columns (always on): CircularDeviation
   centre_v,
   radius,
   scale,
@@ -130,29 +135,65 @@ struct Model {
     return sum;
   }
 
-  // The terms that do not depend on the cyclic period (the cyclic ones are left at 0).
-  std::array<double, term_count> fixed_basis(double t, double s) const {
-    const double c = std::cos(t), n = std::sin(t);
-    return {c,
-            n,
-            1.0,
-            std::cos(2 * t),
-            std::sin(2 * t),
-            s * std::sin(2 * t),
-            s * sgn(n) * c,
-            -s * sgn(c) * n,
-            s * std::abs(c),
-            -s * std::abs(n),
-            spike(t, s, 0.0),
-            spike(t, s, pi / 2),
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            n * n * c,
-            c * c * n};
+  Sample sample(double theta, double s, double y) const {
+    return {std::cos(theta), std::sin(theta), y, s, spike(theta, s, 0.0), spike(theta, s, pi / 2)};
+  }
+
+  // k = 2 pi R / period: the cyclic columns' wave number along the axes.
+  double wave_number(double period_mm) const { return 2 * pi * r_mm / period_mm; }
+
+  // The basis row of a sample, the terms that are off left at 0.
+  template <class RowRef>
+  void row(const Sample& x, double k, RowRef&& out) const {
+    const double c = x.c, n = x.n, s = x.s;
+    const double c2 = c * c - n * n, s2 = 2 * c * n;  // cos 2t, sin 2t
+    const double pu = k * c, pv = k * n;
+    const std::array<double, term_count> b = {c,
+                                              n,
+                                              1.0,
+                                              c2,
+                                              s2,
+                                              s * s2,
+                                              s * sgn(n) * c,
+                                              -s * sgn(c) * n,
+                                              s * std::abs(c),
+                                              -s * std::abs(n),
+                                              x.spike_u,
+                                              x.spike_v,
+                                              c * std::sin(pu),
+                                              c * std::cos(pu),
+                                              n * std::sin(pv),
+                                              n * std::cos(pv),
+                                              n * n * c,
+                                              c * c * n};
+    for (int j = 0; j < term_count; ++j)
+      out(j) = on[static_cast<std::size_t>(j)] ? b[static_cast<std::size_t>(j)] : 0.0;
   }
 };
+
+using Gram = Eigen::Matrix<double, term_count, term_count>;
+using TermVector = Eigen::Matrix<double, term_count, 1>;
+
+// The samples in blocks of rows of the design (every stride-th sample): f(block, y, first) with
+// the block's first row's index. A pass holds one block (18 kB), never the n x 18 design.
+using Block = Eigen::Matrix<double, Eigen::Dynamic, term_count>;
+template <class F>
+void for_each_block(const Model& m, std::span<const Sample> samples, std::size_t stride, double k,
+                    F&& f) {
+  constexpr std::size_t block_rows = 128;  // 18 kB: the rows are written where they are read
+  const std::size_t n = (samples.size() + stride - 1) / stride;
+  Block b(static_cast<Eigen::Index>(std::min(n, block_rows)), term_count);
+  Eigen::VectorXd y(b.rows());
+  for (std::size_t first = 0; first < n; first += block_rows) {
+    const auto rows = static_cast<Eigen::Index>(std::min(block_rows, n - first));
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      const Sample& x = samples[(first + static_cast<std::size_t>(i)) * stride];
+      m.row(x, k, b.row(i));
+      y[i] = x.y;
+    }
+    f(b.topRows(rows), y.head(rows), first);
+  }
+}
 
 struct Solution {
   Eigen::VectorXd coef;                    // per term (0 where off or dropped)
@@ -165,15 +206,15 @@ struct Solution {
 // norm squared (a variance inflation above 100; on a full circle every term keeps 10 % or more):
 // the data cannot separate that term (e.g. the backlash of an axis that does not reverse within
 // a partial arc, which is then a centre shift), so it is dropped, not guessed.
-Solution solve_in_order(const Eigen::MatrixXd& ata, const Eigen::VectorXd& aty,
+Solution solve_in_order(const Gram& ata, const TermVector& aty,
                         const std::array<bool, term_count>& on) {
   constexpr int n = term_count;
-  const Eigen::VectorXd sc = ata.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-  const Eigen::MatrixXd a = sc.asDiagonal() * ata * sc.asDiagonal();
-  const Eigen::VectorXd b = sc.asDiagonal() * aty;
+  const TermVector sc = ata.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+  const Gram a = sc.asDiagonal() * ata * sc.asDiagonal();
+  const TermVector b = sc.asDiagonal() * aty;
   Solution out;
   std::array<bool, n> use{};
-  Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n, n);
+  Gram l = Gram::Zero();
   for (int j = 0; j < n; ++j) {
     if (!on[static_cast<std::size_t>(j)]) continue;
     double d = a(j, j);
@@ -190,7 +231,7 @@ Solution solve_in_order(const Eigen::MatrixXd& ata, const Eigen::VectorXd& aty,
       l(i, j) = x / l(j, j);
     }
   }
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(n), x = Eigen::VectorXd::Zero(n);
+  TermVector z = TermVector::Zero(), x = TermVector::Zero();
   for (int i = 0; i < n; ++i) {  // L z = b
     if (!use[static_cast<std::size_t>(i)]) continue;
     double t = b[i];
@@ -203,67 +244,96 @@ Solution solve_in_order(const Eigen::MatrixXd& ata, const Eigen::VectorXd& aty,
     for (int k = i + 1; k < n; ++k) t -= l(k, i) * x[k];
     x[i] = t / l(i, i);
   }
-  out.coef = sc.asDiagonal() * x;
+  const TermVector coef = sc.asDiagonal() * x;
+  out.coef = coef;
   // rss = |y - A c|^2 = y'y - 2 c'A'y + c'A'A c; the caller adds y'y.
-  out.rss = -2 * out.coef.dot(aty) + out.coef.dot(ata * out.coef);
+  out.rss = -2 * coef.dot(aty) + coef.dot(ata * coef);
   return out;
 }
 
-// The design matrix of one sample set, with the Gram matrix of the fixed columns computed once:
-// a trial cyclic period only recomputes the four cyclic columns and their Gram rows.
+// The normal equations of one sample set (every stride-th sample), accumulated block by block
+// (for_each_block): memory independent of the number of samples. A trial cyclic period
+// recomputes only the four cyclic columns' rows of the Gram matrix, in one more pass.
 class Design {
  public:
-  Design(const Model& m, std::span<const Sample> samples, std::size_t stride) : m_(m) {
-    const auto n = static_cast<Eigen::Index>((samples.size() + stride - 1) / stride);
-    a_.resize(n, term_count);
-    y_.resize(n);
-    cos_.resize(n);
-    sin_.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const auto& smp = samples[static_cast<std::size_t>(i) * stride];
-      const auto b = m.fixed_basis(smp.theta, smp.s);
-      for (int k = 0; k < term_count; ++k)
-        a_(i, k) = m.on[static_cast<std::size_t>(k)] ? b[static_cast<std::size_t>(k)] : 0.0;
-      y_[i] = smp.y;
-      cos_[i] = std::cos(smp.theta);
-      sin_[i] = std::sin(smp.theta);
+  Design(const Model& m, std::span<const Sample> samples, std::size_t stride, double period_mm)
+      : m_(m), samples_(samples), stride_(stride), period_mm_(period_mm) {
+    ata_.setZero();
+    aty_.setZero();
+    const std::size_t rows = (samples_.size() + stride_ - 1) / stride_;
+    if (rows <= dense_max_rows) {
+      dense_.resize(static_cast<Eigen::Index>(rows), term_count);
+      dense_y_.resize(static_cast<Eigen::Index>(rows));
     }
-    ata_ = a_.transpose() * a_;
-    aty_ = a_.transpose() * y_;
-    yty_ = y_.squaredNorm();
+    for_each_block(m_, samples_, stride_, k(),
+                   [&](const auto& b, const auto& y, std::size_t first) {
+                     ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
+                     aty_.noalias() += b.transpose() * y;
+                     yty_ += y.squaredNorm();
+                     if (dense_.rows() > 0) {
+                       dense_.middleRows(static_cast<Eigen::Index>(first), b.rows()) = b;
+                       dense_y_.segment(static_cast<Eigen::Index>(first), b.rows()) = y;
+                     }
+                   });
+    ata_.triangularView<Eigen::StrictlyUpper>() = ata_.transpose();
   }
 
   Solution solve(double period_mm) {
-    if (m_.on[cyclic_first]) set_cyclic(period_mm);
+    if (m_.on[cyclic_first] && period_mm != period_mm_) set_cyclic(period_mm);
     Solution out = solve_in_order(ata_, aty_, m_.on);
     out.rss += yty_;
     return out;
   }
 
-  const Eigen::MatrixXd& matrix() const { return a_; }
-  const Eigen::VectorXd& y() const { return y_; }
+  const Model& model() const { return m_; }
+  std::span<const Sample> samples() const { return samples_; }
+  double k() const { return m_.wave_number(period_mm_); }  // of the period last solved for
+  const Gram& ata() const { return ata_; }
+  const TermVector& aty() const { return aty_; }
 
  private:
   void set_cyclic(double period_mm) {
-    const double k = 2 * pi * m_.r_mm / period_mm;
-    for (Eigen::Index i = 0; i < a_.rows(); ++i) {
-      const double pu = k * cos_[i], pv = k * sin_[i];
-      a_(i, cyclic_u_a) = cos_[i] * std::sin(pu);
-      a_(i, cyclic_u_b) = cos_[i] * std::cos(pu);
-      a_(i, cyclic_v_a) = sin_[i] * std::sin(pv);
-      a_(i, cyclic_v_b) = sin_[i] * std::cos(pv);
+    period_mm_ = period_mm;
+    Eigen::Matrix<double, cyclic_count, term_count> cross =
+        Eigen::Matrix<double, cyclic_count, term_count>::Zero();
+    Eigen::Matrix<double, cyclic_count, 1> cty = Eigen::Matrix<double, cyclic_count, 1>::Zero();
+    if (dense_.rows() > 0) {  // only the cyclic columns change
+      const double kc = k();
+      for (Eigen::Index i = 0; i < dense_.rows(); ++i) {
+        const Sample& x = samples_[static_cast<std::size_t>(i) * stride_];
+        const double pu = kc * x.c, pv = kc * x.n;
+        dense_(i, cyclic_u_a) = x.c * std::sin(pu);
+        dense_(i, cyclic_u_b) = x.c * std::cos(pu);
+        dense_(i, cyclic_v_a) = x.n * std::sin(pv);
+        dense_(i, cyclic_v_b) = x.n * std::cos(pv);
+      }
+      const auto cyc = dense_.middleCols<cyclic_count>(cyclic_first);
+      cross.noalias() = cyc.transpose() * dense_;
+      cty.noalias() = cyc.transpose() * dense_y_;
+    } else {
+      for_each_block(m_, samples_, stride_, k(), [&](const auto& b, const auto& y, std::size_t) {
+        const auto cyc = b.template middleCols<cyclic_count>(cyclic_first);
+        cross.noalias() += cyc.transpose() * b;
+        cty.noalias() += cyc.transpose() * y;
+      });
     }
-    const auto cyc = a_.middleCols(cyclic_first, cyclic_count);
-    const Eigen::MatrixXd cross = cyc.transpose() * a_;  // 4 x terms
-    ata_.middleRows(cyclic_first, cyclic_count) = cross;
-    ata_.middleCols(cyclic_first, cyclic_count) = cross.transpose();
-    aty_.segment(cyclic_first, cyclic_count) = cyc.transpose() * y_;
+    ata_.middleRows<cyclic_count>(cyclic_first) = cross;
+    ata_.middleCols<cyclic_count>(cyclic_first) = cross.transpose();
+    aty_.segment<cyclic_count>(cyclic_first) = cty;
   }
 
+  // A design of at most this many rows (the period search's decimated one: its size is set by
+  // the radius and the shortest period, not by the run's length) is also kept dense, so that a
+  // trial period recomputes only its four cyclic columns.
+  static constexpr std::size_t dense_max_rows = 8192;
   Model m_;
-  Eigen::MatrixXd a_;
-  Eigen::VectorXd y_, cos_, sin_, aty_;
-  Eigen::MatrixXd ata_;
+  std::span<const Sample> samples_;
+  std::size_t stride_;
+  Block dense_;
+  Eigen::VectorXd dense_y_;
+  double period_mm_;
+  Gram ata_;
+  TermVector aty_;
   double yty_ = 0.0;
 };
 
@@ -280,7 +350,7 @@ double search_period(const Model& m, std::span<const Sample> samples, const Setu
   const auto stride = static_cast<std::size_t>(
       std::clamp(std::floor(p_min / (8 * path_per_sample_mm)), 1.0,
                  std::max(1.0, static_cast<double>(samples.size()) / 2000.0)));
-  Design coarse(m, samples, stride);
+  Design coarse(m, samples, stride, p_min);
   const double min_step = std::log(p_max / p_min) / 800.0;
   double best_p = p_min, best_rss = 1e300, best_step = min_step;
   for (double p = p_min, step = min_step; p <= p_max * (1 + 1e-12); p *= std::exp(step)) {
@@ -303,12 +373,30 @@ double search_period(const Model& m, std::span<const Sample> samples, const Setu
   return std::exp((lo + hi) / 2);
 }
 
+// Sorts v by key in linear time when it is a rotation of a strictly increasing sequence, or the
+// reverse of one: a trace that runs one way round the circle (ccw, or cw), the usual case.
+// Anything else is sorted by std::sort; the result is the same either way.
+template <class T, class Key>
+void sort_circular(std::vector<T>& v, Key key) {
+  const auto not_rising = [&](const T& a, const T& b) { return !(key(a) < key(b)); };
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) std::reverse(v.begin(), v.end());
+    const auto descent = std::adjacent_find(v.begin(), v.end(), not_rising);
+    if (descent == v.end()) return;
+    std::rotate(v.begin(), descent + 1, v.end());
+    if (std::adjacent_find(v.begin(), v.end(), not_rising) == v.end()) return;
+  }
+  std::sort(v.begin(), v.end());
+}
+
+double mod360(double x) { return std::fmod(std::fmod(x, 360.0) + 360.0, 360.0); }
+
 // The smallest arc covering the angles: 360 minus the largest gap between sorted angles.
 double coverage_deg(std::span<const double> angles) {
   std::vector<double> a;
   a.reserve(angles.size());
-  for (double x : angles) a.push_back(std::fmod(std::fmod(x, 360.0) + 360.0, 360.0));
-  std::sort(a.begin(), a.end());
+  for (double x : angles) a.push_back(mod360(x));
+  sort_circular(a, [](double x) { return x; });
   double gap = a.front() + 360.0 - a.back();
   for (std::size_t i = 1; i < a.size(); ++i) gap = std::max(gap, a[i] - a[i - 1]);
   return 360.0 - gap;
@@ -366,54 +454,54 @@ void validate(const Setup& setup, std::span<const Trace> traces) {
   for (const auto& t : traces) validate_trace(t);
 }
 
-// Least-squares circle, linearised as the bar length itself (dr = r0 + cu cos + cv sin, the
-// first-order form above; the exact circle differs by O(e^2 / R)), and the radial deviations
-// about its centre, from the nominal radius.
-struct Circle {
-  double cu = 0, cv = 0;
-  std::vector<std::vector<double>> residual;  // per trace, in the trace's order
+// The samples of each trace: [begin, end) in the flattened samples, and the trace itself.
+struct Span {
+  const Trace* trace;
+  std::size_t begin, end;
 };
 
-Circle lsq_circle(std::span<const Trace> traces, double offset_um) {
+// Least-squares circle, linearised as the bar length itself (dr = r0 + cu cos + cv sin, the
+// first-order form above; the exact circle differs by O(e^2 / R)); the radial deviations about
+// its centre, from the nominal radius, are y - cu cos - cv sin.
+struct Circle {
+  double cu = 0, cv = 0;
+  double residual(const Sample& x) const { return x.y - cu * x.c - cv * x.n; }
+};
+
+Circle lsq_circle(std::span<const Sample> samples) {
   Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
   Eigen::Vector3d aty = Eigen::Vector3d::Zero();
-  for (const auto& t : traces)
-    for (std::size_t i = 0; i < t.angle_deg.size(); ++i) {
-      const Eigen::Vector3d a(1.0, std::cos(t.angle_deg[i] * deg), std::sin(t.angle_deg[i] * deg));
-      ata += a * a.transpose();
-      aty += a * (t.deviation_um[i] + offset_um);
-    }
-  const Eigen::Vector3d x = ata.ldlt().solve(aty);
-  Circle c{x[1], x[2], {}};
-  for (const auto& t : traces) {
-    std::vector<double> r;
-    r.reserve(t.angle_deg.size());
-    for (std::size_t i = 0; i < t.angle_deg.size(); ++i)
-      r.push_back(t.deviation_um[i] + offset_um - x[1] * std::cos(t.angle_deg[i] * deg) -
-                  x[2] * std::sin(t.angle_deg[i] * deg));
-    c.residual.push_back(std::move(r));
+  for (const auto& x : samples) {
+    const Eigen::Vector3d a(1.0, x.c, x.n);
+    ata += a * a.transpose();
+    aty += a * x.y;
   }
-  return c;
+  const Eigen::Vector3d sol = ata.ldlt().solve(aty);
+  return {sol[1], sol[2]};
 }
 
-double pv(const std::vector<std::vector<double>>& vs) {
+struct Range {
   double lo = 1e300, hi = -1e300;
-  for (const auto& v : vs)
-    for (double x : v) lo = std::min(lo, x), hi = std::max(hi, x);
-  return hi - lo;
+  void add(double x) { lo = std::min(lo, x), hi = std::max(hi, x); }
+  double pv() const { return hi - lo; }
+};
+
+Range residual_range(const Circle& c, std::span<const Sample> samples) {
+  Range r;
+  for (const auto& x : samples) r.add(c.residual(x));
+  return r;
 }
 
 // Largest |r_a(theta) - r_b(theta)|, r_b interpolated (periodically) at the angles of a.
-double hysteresis(const Trace& a, const std::vector<double>& ra, const Trace& b,
-                  const std::vector<double>& rb) {
+double hysteresis(const Circle& c, std::span<const Sample> samples, const Span& a, const Span& b) {
   std::vector<std::pair<double, double>> pts;
-  pts.reserve(b.angle_deg.size());
-  for (std::size_t i = 0; i < b.angle_deg.size(); ++i)
-    pts.emplace_back(std::fmod(std::fmod(b.angle_deg[i], 360.0) + 360.0, 360.0), rb[i]);
-  std::sort(pts.begin(), pts.end());
+  pts.reserve(b.end - b.begin);
+  for (std::size_t i = b.begin; i < b.end; ++i)
+    pts.emplace_back(mod360(b.trace->angle_deg[i - b.begin]), c.residual(samples[i]));
+  sort_circular(pts, [](const auto& p) { return p.first; });
   double h = 0.0;
-  for (std::size_t i = 0; i < a.angle_deg.size(); ++i) {
-    const double t = std::fmod(std::fmod(a.angle_deg[i], 360.0) + 360.0, 360.0);
+  for (std::size_t i = a.begin; i < a.end; ++i) {
+    const double t = mod360(a.trace->angle_deg[i - a.begin]);
     auto hi = std::lower_bound(pts.begin(), pts.end(), std::make_pair(t, -1e300));
     const auto& p1 = hi == pts.end() ? pts.front() : *hi;
     const auto& p0 = hi == pts.begin() ? pts.back() : *std::prev(hi);
@@ -423,53 +511,41 @@ double hysteresis(const Trace& a, const std::vector<double>& ra, const Trace& b,
     if (off < 0) off += 360.0;
     if (span > 10.0) continue;  // outside the other trace's arc
     const double rbi = p0.second + (p1.second - p0.second) * (span > 0 ? off / span : 0.0);
-    h = std::max(h, std::abs(ra[i] - rbi));
+    h = std::max(h, std::abs(c.residual(samples[i]) - rbi));
   }
   return h;
 }
 
-Iso230_4 iso_values(std::span<const Trace> traces, double offset_um) {
+Iso230_4 iso_values(std::span<const Sample> samples, std::span<const Span> traces) {
   Iso230_4 iso;
   for (const auto& t : traces) {
-    const Circle own = lsq_circle(std::span(&t, 1), offset_um);
-    (t.direction == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) = pv(own.residual);
-    iso.arc_deg = std::min(iso.arc_deg, coverage_deg(t.angle_deg));
+    const auto own = samples.subspan(t.begin, t.end - t.begin);
+    (t.trace->direction == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) =
+        residual_range(lsq_circle(own), own).pv();
+    iso.arc_deg = std::min(iso.arc_deg, coverage_deg(t.trace->angle_deg));
   }
-  const Circle common = lsq_circle(traces, offset_um);
-  iso.G_bi_um = pv(common.residual);
+  const Circle common = lsq_circle(samples);
+  const Range f = residual_range(common, samples);
+  iso.G_bi_um = f.pv();
   iso.centre_u_um = common.cu;
   iso.centre_v_um = common.cv;
-  iso.F_max_um = -1e300, iso.F_min_um = 1e300;
-  for (const auto& r : common.residual)
-    for (double x : r)
-      iso.F_max_um = std::max(iso.F_max_um, x), iso.F_min_um = std::min(iso.F_min_um, x);
-  if (traces.size() == 2)
-    iso.H_um = hysteresis(traces[0], common.residual[0], traces[1], common.residual[1]);
+  iso.F_max_um = f.hi, iso.F_min_um = f.lo;
+  if (traces.size() == 2) iso.H_um = hysteresis(common, samples, traces[0], traces[1]);
   return iso;
 }
 
-// G of y (all samples, one common LSQ circle): the same as iso_values' G_bi, on a vector.
-class CircularDeviation {
- public:
-  explicit CircularDeviation(const Eigen::MatrixXd& a)
-      : a_(a.leftCols<3>()), ldlt_((a_.transpose() * a_).eval()) {}
-  double operator()(const Eigen::VectorXd& y) const {
-    const Eigen::Vector3d x = ldlt_.solve(a_.transpose() * y);
-    const Eigen::VectorXd r = y - a_.leftCols<2>() * x.head<2>();  // about the centre
-    return r.maxCoeff() - r.minCoeff();
-  }
-
- private:
-  Eigen::MatrixXd a_;  // the design's first columns: cos, sin, 1
-  Eigen::LDLT<Eigen::Matrix3d> ldlt_;
-};
-
-std::vector<Sample> flatten(std::span<const Trace> traces, double offset_um) {
+std::vector<Sample> flatten(const Model& m, std::span<const Trace> traces, double offset_um,
+                            std::vector<Span>& spans) {
   std::vector<Sample> samples;
+  std::size_t total = 0;
+  for (const auto& t : traces) total += t.angle_deg.size();
+  samples.reserve(total);
   for (const auto& t : traces) {
     const double s = sign_of(t.direction);
+    const std::size_t begin = samples.size();
     for (std::size_t i = 0; i < t.angle_deg.size(); ++i)
-      samples.push_back({t.angle_deg[i] * deg, s, t.deviation_um[i] + offset_um});
+      samples.push_back(m.sample(t.angle_deg[i] * deg, s, t.deviation_um[i] + offset_um));
+    spans.push_back({&t, begin, samples.size()});
   }
   return samples;
 }
@@ -499,46 +575,99 @@ Model choose_terms(const Setup& setup, bool both, double arc_deg, std::vector<st
   return m;
 }
 
-// The ranked diagnostics from the fitted coefficients.
+// The ranked diagnostics from the fitted coefficients. Each one's peak-to-valley and the G of
+// the traces without it (the LSQ circle refitted) come from the pass over the samples that
+// makes the residual, for all of them together (observe; finish for those found in the
+// residual): the circle of y - contribution needs C'(y - contribution), C the circle's columns
+// (cos, sin, 1), and for a fitted term C' times its columns is in the Gram matrix already.
 class Reporter {
  public:
-  Reporter(Result& res, const Model& m, const Design& d, const Eigen::VectorXd& coef,
-           const CircularDeviation& g)
-      : res_(res), m_(m), d_(d), c_(coef), g_(g), y_(d.y()) {}
+  Reporter(Result& res, const Model& reported, const Design& d, const Eigen::VectorXd& coef)
+      : res_(res), m_(reported), d_(d), c_(coef) {}
 
   void add(std::string key, std::string name, double value, std::string unit,
            std::initializer_list<int> terms) {
     for (int k : terms)
       if (!on(k)) return;  // off, or dropped as not separable
-    Eigen::VectorXd contrib = Eigen::VectorXd::Zero(d_.matrix().rows());
-    for (int k : terms) contrib += c_[k] * d_.matrix().col(k);
-    push({std::move(key), std::move(name), value, std::move(unit), 0.0, 0.0, 0.0, {}}, contrib);
+    pending_.push_back(
+        {{std::move(key), std::move(name), value, std::move(unit), 0.0, 0.0, 0.0, {}},
+         std::vector<int>(terms),
+         nullptr});
   }
-  // A diagnostic found in the residual (stick-slip, vibration): its contribution is given.
+  // A diagnostic found in the residual (stick-slip, vibration): its contribution is given, one
+  // value per sample (kept by the caller until finish).
   void add(const dynamics::Found& f) {
-    const Eigen::Map<const Eigen::VectorXd> contrib(
-        f.contribution.data(), static_cast<Eigen::Index>(f.contribution.size()));
-    push({f.key, f.name, f.value, f.unit, 0.0, 0.0, 0.0, f.frequency_hz}, contrib);
+    pending_.push_back({{f.key, f.name, f.value, f.unit, 0.0, 0.0, 0.0, f.frequency_hz}, {}, &f});
   }
   bool on(int k) const { return m_.on[static_cast<std::size_t>(k)]; }
   double c(int k) const { return c_[k]; }
 
+  // PV of each contribution, its share of G, and what G would be without it (docs/circle.md).
+  // The fitted diagnostics' contributions, over one block of the design (the caller's pass
+  // over the samples: report() first, then every block once).
+  template <class B, class Y>
+  void observe(const B& b, const Y& y) {
+    if (!ldlt_) {
+      ldlt_.emplace(d_.ata().topLeftCorner<3, 3>());
+      for (auto& p : pending_) {
+        Eigen::Vector3d ct_contrib = Eigen::Vector3d::Zero();
+        for (int k : p.terms) ct_contrib += c_[k] * d_.ata().block<3, 1>(0, k);
+        p.centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib);  // circle without it
+      }
+    }
+    Eigen::VectorXd contrib(b.rows()), without(b.rows());
+    for (auto& p : pending_) {
+      if (p.found) continue;
+      contrib.setZero();
+      for (int k : p.terms) contrib += c_[k] * b.col(k);
+      without = y - contrib - p.centre[0] * b.col(centre_u) - p.centre[1] * b.col(centre_v);
+      p.contrib.add(contrib.minCoeff()), p.contrib.add(contrib.maxCoeff());
+      p.without.add(without.minCoeff()), p.without.add(without.maxCoeff());
+    }
+  }
+
+  // Those found in the residual (their contributions are given, no basis is needed), then all
+  // of them into the result.
+  void finish() {
+    if (!ldlt_) ldlt_.emplace(d_.ata().topLeftCorner<3, 3>());
+    const auto samples = d_.samples();
+    for (auto& p : pending_) {
+      if (!p.found) continue;
+      const auto& contrib = p.found->contribution;
+      Eigen::Vector3d ct_contrib = Eigen::Vector3d::Zero();
+      for (std::size_t i = 0; i < samples.size(); ++i)
+        ct_contrib += Eigen::Vector3d(samples[i].c, samples[i].n, 1.0) * contrib[i];
+      p.centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib);
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        const Sample& x = samples[i];
+        p.contrib.add(contrib[i]);
+        p.without.add(x.y - contrib[i] - p.centre[0] * x.c - p.centre[1] * x.n);
+      }
+    }
+    const double g_bi = res_.iso.G_bi_um;
+    for (auto& p : pending_) {
+      p.dg.pv_um = p.contrib.pv();
+      p.dg.share_pct = g_bi > 0 ? 100.0 * p.dg.pv_um / g_bi : 0.0;
+      p.dg.g_reduction_um = g_bi - p.without.pv();
+      res_.diagnostics.push_back(std::move(p.dg));
+    }
+    pending_.clear();
+  }
+
  private:
+  struct Pending {
+    Diagnostic dg;
+    std::vector<int> terms;        // a fitted diagnostic's terms, or
+    const dynamics::Found* found;  // one found in the residual
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    Range contrib, without;  // of its contribution; of y without it about its circle
+  };
   Result& res_;
   const Model& m_;
   const Design& d_;
   const Eigen::VectorXd& c_;
-  const CircularDeviation& g_;
-  Eigen::VectorXd y_;
-
-  // PV of the contribution, its share of G, and what G would be without it (docs/circle.md).
-  void push(Diagnostic dg, const Eigen::Ref<const Eigen::VectorXd>& contrib) {
-    dg.pv_um = contrib.maxCoeff() - contrib.minCoeff();
-    const double g_bi = res_.iso.G_bi_um;
-    dg.share_pct = g_bi > 0 ? 100.0 * dg.pv_um / g_bi : 0.0;
-    dg.g_reduction_um = g_bi - g_(y_ - contrib);
-    res_.diagnostics.push_back(std::move(dg));
-  }
+  std::vector<Pending> pending_;
+  std::optional<Eigen::LDLT<Eigen::Matrix3d>> ldlt_;  // of the circle's columns C'C
 };
 
 void report(Reporter& r, const Setup& setup, const std::string& ax, double period_mm) {
@@ -640,12 +769,14 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   // Deviations from the nominal radius: the bar reads 0 at its calibrated length.
   const double offset_um =
       1e3 * (setup.calibrated_radius_mm.value_or(setup.radius_mm) - setup.radius_mm);
-  res.iso = iso_values(traces, offset_um);
+  std::vector<Span> spans;
+  const auto samples =
+      flatten(Model{setup.radius_mm, setup.spike_decay_deg * deg, {}}, traces, offset_um, spans);
+  res.iso = iso_values(samples, spans);
 
-  const auto samples = flatten(traces, offset_um);
   const Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
-  Design full(m, samples, 1);
   double period_mm = setup.cyclic_period_mm.value_or(10.0);
+  Design full(m, samples, 1, period_mm);
   if (m.on[cyclic_first] && !setup.cyclic_period_mm)
     period_mm = search_period(m, samples, setup, full);
   const Solution sol = full.solve(period_mm);
@@ -658,19 +789,29 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
           fmt::format("{}: not separable from the other terms on these traces, not reported",
                       term_names[static_cast<std::size_t>(k)]));
   if (reported.on[cyclic_first]) res.cyclic_period_mm = period_mm;
-  const Eigen::VectorXd resid = full.y() - full.matrix() * sol.coef;
   const std::string ax = axis_names(setup.plane);
 
   // Stick-slip and vibration live in what the geometric model leaves.
   std::vector<dynamics::TraceResidual> residuals;
-  for (Eigen::Index at = 0; const auto& t : traces) {
-    dynamics::TraceResidual tr{.s = sign_of(t.direction)};
-    for (std::size_t i = 0; i < t.angle_deg.size(); ++i, ++at) {
-      tr.theta_rad.push_back(t.angle_deg[i] * deg);
-      tr.r_um.push_back(resid[at]);
-    }
+  for (const auto& sp : spans) {
+    dynamics::TraceResidual tr{.s = sign_of(sp.trace->direction)};
+    tr.theta_rad.reserve(sp.end - sp.begin);
+    for (double a : sp.trace->angle_deg) tr.theta_rad.push_back(a * deg);
+    tr.r_um.resize(sp.end - sp.begin);
     residuals.push_back(std::move(tr));
   }
+  // One pass: the residual, and the fitted diagnostics' contributions.
+  Reporter rep(res, reported, full, sol.coef);
+  report(rep, setup, ax, period_mm);
+  for_each_block(m, samples, 1, full.k(), [&](const auto& b, const auto& y, std::size_t first) {
+    rep.observe(b, y);
+    const Eigen::VectorXd r = y - b * sol.coef;
+    for (Eigen::Index i = 0; i < r.size(); ++i) {
+      const std::size_t at = first + static_cast<std::size_t>(i);
+      const std::size_t t = at < spans[0].end ? 0 : 1;
+      residuals[t].r_um[at - spans[t].begin] = r[i];
+    }
+  });
   const dynamics::Settings dyn{.radius_mm = setup.radius_mm,
                                .feed_mm_per_min = setup.feed_mm_per_min,
                                .window_deg = setup.stick_slip_window_deg,
@@ -682,12 +823,12 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   for (const auto& tr : residuals)
     for (double x : tr.r_um) ss += x * x;
   res.residual_rms_um = std::sqrt(ss / static_cast<double>(samples.size()));
+  residuals.clear();
+  residuals.shrink_to_fit();
 
-  const CircularDeviation g(full.matrix());
-  Reporter rep(res, reported, full, sol.coef, g);
-  report(rep, setup, ax, period_mm);
   if (vibration) rep.add(*vibration);
   for (const auto& f : stick_slip) rep.add(f);
+  rep.finish();
   // Ranked by what correcting each would gain (G with its term removed), as a ballbar user
   // reads the list: the first is the one to fix first. Equal gains (terms absent) by PV.
   std::stable_sort(res.diagnostics.begin(), res.diagnostics.end(),

@@ -56,27 +56,36 @@ double omega_rad_s(const Settings& s) { return s.feed_mm_per_min / 60.0 / s.radi
 
 // One trace ordered by travel (s theta rising), with its sample times.
 struct Timed {
-  std::vector<std::size_t> order;  // travel order -> index in the trace
-  std::vector<double> time_s;      // per sample, in the trace's order; 0 at the first in travel
+  std::size_t n = 0;
+  std::vector<std::size_t> sorted;  // travel order -> index in the trace; empty: the identity
+  std::vector<double> time_s;       // per sample, in the trace's order; 0 at the first in travel
   double duration_s = 0.0, step_s = 0.0;
+  std::size_t order(std::size_t k) const { return sorted.empty() ? k : sorted[k]; }
 };
 
 Timed timed(const TraceResidual& t, double w) {
   Timed out;
-  const std::size_t n = t.theta_rad.size();
-  out.order.resize(n);
-  std::iota(out.order.begin(), out.order.end(), std::size_t{0});
-  std::stable_sort(out.order.begin(), out.order.end(), [&](std::size_t a, std::size_t b) {
+  const std::size_t n = out.n = t.theta_rad.size();
+  const auto before = [&](std::size_t a, std::size_t b) {
     return t.s * t.theta_rad[a] < t.s * t.theta_rad[b];
-  });
+  };
+  // A trace from time is in travel order already: checked in one pass, and then no
+  // permutation is kept (8 bytes a sample); sorted only if not.
+  bool in_order = true;
+  for (std::size_t i = 1; i < n && in_order; ++i) in_order = !before(i, i - 1);
+  if (!in_order) {
+    out.sorted.resize(n);
+    std::iota(out.sorted.begin(), out.sorted.end(), std::size_t{0});
+    std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
+  }
   out.time_s.resize(n);
   if (n == 0) return out;
-  const double first = t.s * t.theta_rad[out.order.front()];
+  const double first = t.s * t.theta_rad[out.order(0)];
   for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad[i] - first) / w;
-  out.duration_s = out.time_s[out.order.back()];
+  out.duration_s = out.time_s[out.order(n - 1)];
   std::vector<double> steps;
   for (std::size_t i = 1; i < n; ++i) {
-    const double d = out.time_s[out.order[i]] - out.time_s[out.order[i - 1]];
+    const double d = out.time_s[out.order(i)] - out.time_s[out.order(i - 1)];
     if (d > 0) steps.push_back(d);
   }
   if (!steps.empty()) {
@@ -93,8 +102,8 @@ std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt)
   std::size_t j = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double at = static_cast<double>(k) * dt;
-    while (j + 2 < tm.order.size() && tm.time_s[tm.order[j + 1]] < at) ++j;
-    const std::size_t a = tm.order[j], b = tm.order[std::min(j + 1, tm.order.size() - 1)];
+    while (j + 2 < tm.n && tm.time_s[tm.order(j + 1)] < at) ++j;
+    const std::size_t a = tm.order(j), b = tm.order(std::min(j + 1, tm.n - 1));
     const double ta = tm.time_s[a], tb = tm.time_s[b];
     const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
     out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
@@ -112,6 +121,7 @@ std::vector<double> periodogram(std::vector<double> x, std::size_t npad) {
                                  static_cast<double>(std::max<std::size_t>(1, n - 1))));
   x.resize(npad, 0.0);
   Eigen::FFT<double> fft;
+  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
   std::vector<std::complex<double>> spec;
   fft.fwd(spec, x);
   std::vector<double> p(npad / 2 + 1);
@@ -214,6 +224,46 @@ double mean_power(const std::vector<double>& p, std::ptrdiff_t a, std::ptrdiff_t
   double sum = 0.0;
   for (auto k = a; k <= b; ++k) sum += p[static_cast<std::size_t>(k)];
   return sum / static_cast<double>(b - a + 1);
+}
+
+// The residual minus its centred moving median, in the trace's own order: at travel position i
+// the median of every stride-th sample from i - m to i + m (clipped at the ends). Away from the
+// ends the window of i + stride is that of i less its first sample plus one more, so each
+// residue class mod stride slides one sorted window along (an erase and an insert) instead of
+// selecting the median of every window anew; the median is the same element either way.
+std::vector<double> high_pass(const TraceResidual& t, const Timed& tm, std::size_t m,
+                              std::size_t stride) {
+  const std::size_t n = t.r_um.size();
+  const auto at = [&](std::size_t k) { return t.r_um[tm.order(k)]; };
+  std::vector<double> h(n), win;
+  const auto clipped = [&](std::size_t i) {  // the window selected anew
+    const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
+    win.clear();
+    for (std::size_t k = a; k < b; k += stride) win.push_back(at(k));
+    std::nth_element(win.begin(), win.begin() + static_cast<std::ptrdiff_t>(win.size() / 2),
+                     win.end());
+    return win[win.size() / 2];
+  };
+  const bool slides = n >= 2 * m + 1;  // some window lies wholly inside
+  for (std::size_t i = 0; i < n; ++i)
+    if (!slides || i < m || i + m + 1 > n) h[tm.order(i)] = at(i) - clipped(i);
+  if (!slides) return h;
+  const std::size_t count = (2 * m + 1 + stride - 1) / stride;  // samples in an inner window
+  for (std::size_t r = 0; r < stride && m + r + m + 1 <= n; ++r) {
+    std::size_t i = m + r;
+    win.clear();
+    for (std::size_t k = 0; k < count; ++k) win.push_back(at(i - m + k * stride));
+    std::sort(win.begin(), win.end());
+    for (;;) {
+      h[tm.order(i)] = at(i) - win[count / 2];
+      if (i + stride + m + 1 > n) break;
+      const double out = at(i - m), in = at(i - m + count * stride);
+      win.erase(std::lower_bound(win.begin(), win.end(), out));
+      win.insert(std::upper_bound(win.begin(), win.end(), in), in);
+      i += stride;
+    }
+  }
+  return h;
 }
 
 }  // namespace
@@ -350,54 +400,46 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
         step_rad > 0
             ? std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(2.0 * deg / step_rad)))
             : 1;
-    const std::size_t n = t.r_um.size();
     // At most 41 samples of the window (every stride-th): the median of the local level needs
     // no more, and 2 x 36,000 samples at 0.01 degrees would otherwise cost 401 per sample.
-    const std::size_t stride = std::max<std::size_t>(1, (2 * m + 1) / 41);
-    std::vector<double> h(n), win;
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
-      win.clear();
-      for (std::size_t k = a; k < b; k += stride) win.push_back(t.r_um[tm.order[k]]);
-      std::nth_element(win.begin(), win.begin() + static_cast<std::ptrdiff_t>(win.size() / 2),
-                       win.end());
-      h[tm.order[i]] = t.r_um[tm.order[i]] - win[win.size() / 2];
-    }
-    hp.push_back(std::move(h));
+    hp.push_back(high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41)));
   }
   // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2).
   const auto from_u = [](double th) { return std::abs(std::remainder(th, pi)); };
   const auto from_v = [](double th) { return std::abs(std::remainder(th - pi / 2, pi)); };
+  // One pass for the mean squares in and out of the windows; a contribution is made only for
+  // an axis that is reported.
   double out_ss = 0.0;
   std::size_t out_n = 0;
+  std::array<double, 2> in_ss{};
+  std::array<std::size_t, 2> in_n{};
   for (std::size_t i = 0; i < traces.size(); ++i)
     for (std::size_t j = 0; j < hp[i].size(); ++j) {
-      const double th = traces[i].theta_rad[j];
-      if (from_u(th) > window && from_v(th) > window) out_ss += hp[i][j] * hp[i][j], ++out_n;
+      const double th = traces[i].theta_rad[j], du = from_u(th), dv = from_v(th);
+      const double sq = hp[i][j] * hp[i][j];
+      if (du > window && dv > window) out_ss += sq, ++out_n;
+      if (du >= core && du <= window) in_ss[0] += sq, ++in_n[0];
+      if (dv >= core && dv <= window) in_ss[1] += sq, ++in_n[1];
     }
   std::vector<Found> found;
   if (out_n < min_window_samples) return found;
   const double ms_out = out_ss / static_cast<double>(out_n);
   for (const bool axis_u : {true, false}) {
+    const std::size_t a = axis_u ? 0 : 1;
+    if (in_n[a] < min_window_samples) continue;  // the arc does not pass a reversal of the axis
+    const double ms_in = in_ss[a] / static_cast<double>(in_n[a]);
+    if (ms_in < 2.0 * ms_out || std::sqrt(ms_in - ms_out) < 0.01) continue;
     const char axis = axis_u ? s.u : s.v;
     Found f{.key = fmt::format("stick_slip_{}", axis),
             .name = fmt::format("Stick-slip {} (rms, 1-{:g} deg from its reversals)", axis,
                                 s.window_deg),
-            .unit = "um"};
-    double in_ss = 0.0;
-    std::size_t in_n = 0;
+            .unit = "um",
+            .value = std::sqrt(ms_in - ms_out)};
     for (std::size_t i = 0; i < traces.size(); ++i)
       for (std::size_t j = 0; j < hp[i].size(); ++j) {
         const double th = traces[i].theta_rad[j], d = axis_u ? from_u(th) : from_v(th);
-        const bool in = d >= core && d <= window;
-        if (in) in_ss += hp[i][j] * hp[i][j], ++in_n;
-        f.contribution.push_back(in ? hp[i][j] : 0.0);
+        f.contribution.push_back(d >= core && d <= window ? hp[i][j] : 0.0);
       }
-    if (in_n < min_window_samples) continue;  // the arc does not pass a reversal of this axis
-    const double ms_in = in_ss / static_cast<double>(in_n);
-    if (ms_in < 2.0 * ms_out) continue;
-    f.value = std::sqrt(ms_in - ms_out);
-    if (f.value < 0.01) continue;
     found.push_back(std::move(f));
   }
   if (!found.empty())

@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -686,6 +689,105 @@ TEST(CircleDiagnostics, EachGainIsGWithoutThatErrorAndTheRankingFollowsIt) {
     pv_order_differs = pv_order_differs || r.diagnostics[i - 1].pv_um < r.diagnostics[i].pv_um;
   }
   EXPECT_TRUE(pv_order_differs) << "the case must tell a ranking by gain from one by PV";
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 32: the fit is made from normal equations accumulated block by block over the samples
+// (no n x 18 design is held). Against the dense least-squares solution of the same model, built
+// here from docs/circle.md's basis and solved by a column-pivoted QR of the whole design (error
+// about kappa eps, kappa the condition number of the column-scaled design): the normal
+// equations lose kappa^2 eps, relative to the coefficients. The test computes kappa, checks that
+// this bound is below the stated tolerance of 1e-9 um, and that every coefficient, as reported,
+// agrees within it.
+TEST(CircleDiagnostics, StreamedFitEqualsTheDenseLeastSquaresSolution) {
+  const Machine m{.cu = 3,
+                  .cv = -2,
+                  .radius_error = 1.5,
+                  .su_ppm = 15,
+                  .sv_ppm = -5,
+                  .square_um_per_m = -30,
+                  .lag_v_ms = 0.6,
+                  .backlash_u = 6,
+                  .backlash_v = 2,
+                  .lateral_u = 1,
+                  .lateral_v = -1.5,
+                  .cyclic_u = 0.8,
+                  .cyclic_v = 0.5,
+                  .bow_u = 1,
+                  .bow_v = -0.7,
+                  .spike_u = 2,
+                  .spike_v = 1,
+                  .noise = 0.3};
+  const std::size_t n = 3600;
+  const Trace t[] = {simulate(m, Direction::ccw, n, 1), simulate(m, Direction::cw, n, 2)};
+  const Result r =
+      analyse({.radius_mm = R, .feed_mm_per_min = feed, .cyclic_period_mm = m.cyclic_period_mm}, t);
+
+  const double phi = 6.0 * pi / 180, k = 2 * pi * R / m.cyclic_period_mm;
+  const auto sgn = [](double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; };
+  const auto spike = [&](double th, double s, double first) {
+    double sum = 0;
+    for (double tr : {first, first + pi}) {
+      const double d = std::fmod(std::fmod(s * (th - tr), 2 * pi) + 2 * pi, 2 * pi);
+      sum += std::exp(-d / phi);
+    }
+    return sum;
+  };
+  Eigen::MatrixXd a(2 * n, 18);
+  Eigen::VectorXd y(2 * n);
+  for (std::size_t i = 0; i < 2 * n; ++i) {
+    const Trace& tr = t[i / n];
+    const double th = tr.angle_deg[i % n] * pi / 180, s = i < n ? 1.0 : -1.0;
+    const double c = std::cos(th), sn = std::sin(th);
+    a.row(static_cast<Eigen::Index>(i)) << c, sn, 1, std::cos(2 * th), std::sin(2 * th),
+        s * std::sin(2 * th), s * sgn(sn) * c, -s * sgn(c) * sn, s * std::abs(c), -s * std::abs(sn),
+        spike(th, s, 0), spike(th, s, pi / 2), c * std::sin(k * c), c * std::cos(k * c),
+        sn * std::sin(k * sn), sn * std::cos(k * sn), sn * sn * c, c * c * sn;
+    y[static_cast<Eigen::Index>(i)] = tr.deviation_um[i % n];
+  }
+  const Eigen::VectorXd scale = a.colwise().norm().cwiseInverse();
+  const Eigen::MatrixXd as = a * scale.asDiagonal();
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(as).singularValues();
+  const double kappa = sv[0] / sv[sv.size() - 1];
+  const Eigen::VectorXd x =
+      scale.asDiagonal() * Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(as).solve(y);
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double bound_um = 100 * kappa * kappa * eps * x.cwiseAbs().maxCoeff();
+  const double tol_um = 1e-9;
+  std::printf("kappa %.1f, normal-equation bound %.2e um, tolerance %.0e um\n", kappa, bound_um,
+              tol_um);
+  ASSERT_LT(bound_um, tol_um) << "the tolerance must cover the normal equations' rounding";
+
+  const double w_rad_s = feed / 60.0 / R;
+  const std::map<std::string, std::pair<double, double>> expected = {
+      // value, value per um
+      {"centre_X", {x[0], 1}},
+      {"centre_Y", {x[1], 1}},
+      {"radius_error", {x[2], 1}},
+      {"scale_mismatch", {2000 * x[3] / R, 2000 / R}},
+      {"squareness", {-2000 * x[4] / R, 2000 / R}},
+      {"servo_mismatch", {-2 * x[5] / (R * 1e3 * w_rad_s) * 1e3, 2 / (R * w_rad_s)}},
+      {"backlash_X", {2 * x[6], 2}},
+      {"backlash_Y", {2 * x[7], 2}},
+      {"lateral_play_X", {2 * x[8], 2}},
+      {"lateral_play_Y", {2 * x[9], 2}},
+      {"reversal_spike_X", {x[10], 1}},
+      {"reversal_spike_Y", {x[11], 1}},
+      {"cyclic_X", {std::hypot(x[12], x[13]), 1}},
+      {"cyclic_Y", {std::hypot(x[14], x[15]), 1}},
+      {"straightness_X", {x[16], 1}},
+      {"straightness_Y", {x[17], 1}}};
+  const auto got = values(r);
+  for (const auto& [key, want] : expected) {
+    ASSERT_TRUE(got.count(key)) << key;
+    EXPECT_NEAR(got.at(key), want.first, tol_um * want.second) << key;
+  }
+  // The case is not degenerate: what was injected is found (to the noise and linearisation).
+  EXPECT_NEAR(got.at("backlash_X"), 6.0, 0.1);
+  EXPECT_NEAR(got.at("squareness"), -30.0, 1.0);
 }
 
 }  // namespace

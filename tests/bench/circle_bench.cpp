@@ -1,11 +1,14 @@
 // Ballbar diagnostics fit of 2 x 36,000 samples: two 360 degree traces at 1 kHz, 36 s each
 // (R = 100 mm at 1047 mm/min), with the cyclic-error period given, and with it searched
-// (61 trial periods). BENCHMARK_MAIN is in analysis_bench.cpp.
+// (61 trial periods); and the peak resident memory of the analysis of longer runs.
+// BENCHMARK_MAIN is in analysis_bench.cpp.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "cal/analysis/circle.hpp"
@@ -14,15 +17,18 @@ namespace {
 
 using namespace cal::circle;
 
-std::vector<Trace> traces() {
+// Two traces of n samples each over 360 degrees: an ellipse, a squareness and noise.
+std::vector<Trace> traces(int n = 36'000) {
   std::mt19937_64 rng(1);
   std::normal_distribution<double> noise(0.0, 0.2);
   std::vector<Trace> out;
   for (auto d : {Direction::ccw, Direction::cw}) {
     Trace t{d, {}, {}};
+    t.angle_deg.reserve(static_cast<std::size_t>(n));
+    t.deviation_um.reserve(static_cast<std::size_t>(n));
     const double s = d == Direction::ccw ? 1.0 : -1.0;
-    for (int i = 0; i < 36'000; ++i) {
-      const double a = s * i * 0.01;  // degrees
+    for (int i = 0; i < n; ++i) {
+      const double a = s * i * 360.0 / n;  // degrees
       const double r = a * std::numbers::pi / 180;
       t.angle_deg.push_back(a);
       t.deviation_um.push_back(3 * std::cos(2 * r) - 2 * std::sin(2 * r) +
@@ -48,5 +54,63 @@ void BM_BallbarDiagnosticsPeriodSearch_2x36000(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 72'000);
 }
 BENCHMARK(BM_BallbarDiagnosticsPeriodSearch_2x36000)->Unit(benchmark::kMillisecond);
+
+// The floor of any fit of this model: one pass over the samples, each angle's cos and sin
+// and the deviation summed against them (the least a fit must do with every sample once).
+void BM_BallbarOnePassFloor_2x36000(benchmark::State& state) {
+  const auto t = traces();
+  for (auto _ : state) {
+    double sy = 0, syc = 0, sys = 0;
+    for (const auto& tr : t)
+      for (std::size_t i = 0; i < tr.angle_deg.size(); ++i) {
+        const double a = tr.angle_deg[i] * std::numbers::pi / 180, y = tr.deviation_um[i];
+        sy += y, syc += y * std::cos(a), sys += y * std::sin(a);
+      }
+    benchmark::DoNotOptimize(sy + syc + sys);
+  }
+  state.SetItemsProcessed(state.iterations() * 72'000);
+}
+BENCHMARK(BM_BallbarOnePassFloor_2x36000)->Unit(benchmark::kMillisecond);
+
+// A field of /proc/self/status in kB ("VmRSS", "VmHWM"); -1 when absent.
+long status_kb(const std::string& key) {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(key + ":", 0) == 0) return std::stol(line.substr(key.size() + 1));
+  return -1;
+}
+
+// Peak resident memory of one analysis of 2 x n samples (R = 100 mm, period given, 10 kHz:
+// the feed makes each trace last n / 10,000 s). The peak (VmHWM) is reset to the current RSS
+// (clear_refs 5) once the traces are made, so peak_MB is the process' whole footprint during
+// the analysis and analysis_B_per_sample what the analysis adds per sample beyond its input
+// (the traces, 16 bytes per sample).
+void BM_BallbarPeakRss(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const auto t = traces(n);
+  const double duration_s = n / 10'000.0;
+  const Setup setup{.radius_mm = 100,
+                    .feed_mm_per_min = 2 * std::numbers::pi * 100 / duration_s * 60,
+                    .cyclic_period_mm = 10.0};
+  long before_kb = 0, peak_kb = 0;
+  for (auto _ : state) {
+    std::ofstream("/proc/self/clear_refs") << "5";
+    before_kb = status_kb("VmRSS");
+    benchmark::DoNotOptimize(analyse(setup, t));
+    peak_kb = status_kb("VmHWM");
+  }
+  state.counters["peak_MB"] = static_cast<double>(peak_kb) / 1024.0;
+  state.counters["analysis_B_per_sample"] =
+      static_cast<double>(peak_kb - before_kb) * 1024.0 / (2.0 * n);
+  state.SetItemsProcessed(state.iterations() * 2 * n);
+}
+BENCHMARK(BM_BallbarPeakRss)
+    ->Arg(36'000)
+    ->Arg(360'000)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+// Six minutes of a 10 kHz circle (2 x 1.8 M samples): not in the suite's smoke run.
+void BM_BallbarPeakRssLong(benchmark::State& state) { BM_BallbarPeakRss(state); }
+BENCHMARK(BM_BallbarPeakRssLong)->Arg(1'800'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
