@@ -214,6 +214,14 @@ try:
                    "return r.captured === %d && s && !s.missed && s;" % (after["number"], captured1),
                    timeout_s=30, what="the stop captured anew", explain=EXPLAIN)
     ok(not again["manual"], f"captured anew by the trigger: {again['deviation_um']:+.4f} µm")
+    # The deviation-versus-target plot has every captured stop (none missed or skipped).
+    plotted, captured = b.wait("const r = window.caldaq.page.run; const n = r.stops.filter(s => !s.missed).length; "
+                               "return window.caldaq.dvt && window.caldaq.dvt.points === n && [window.caldaq.dvt.points, n];",
+                               what="the deviation-versus-target plot up to date")
+    ok(plotted == captured and plotted >= 2, f"the deviation-versus-target plot: {plotted} stops plotted")
+    b.js("document.getElementById('dvt').scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c03b-deviation-plot-1366x768.png")
+    b.js("window.scrollTo(0, 0);")
     page_checks.shot(b, SHOTS, "c03-skip-retry-1366x768.png")
     b.set_size(560, 900)
     time.sleep(0.5)
