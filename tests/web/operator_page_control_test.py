@@ -130,6 +130,26 @@ try:
        "560 px: the Align view fits")
     page_checks.shot(b, SHOTS, "c00b-align-560px.png")
     b.set_size(1366, 768)
+
+    # --- words an operator uses: the instruments' fields labelled from their option tables ------
+    b.js("document.getElementById('tab-setup').click();")
+    b.wait("return !!document.querySelector('[data-field=\"devices.laser.poll_s\"]');", timeout_s=20,
+           what="the instrument cards")
+    words = b.js("""const f = k => document.querySelector(`[data-field="${k}"]`);
+        const role = document.querySelector('[data-key="devices.material.role"]');
+        return {poll: f('devices.laser.poll_s').querySelector('label').textContent,
+                unit: f('devices.laser.poll_s').querySelector('.u').textContent,
+                help: f('devices.laser.poll_s').title,
+                role: role.options[role.selectedIndex].textContent, value: role.value,
+                roles: [...role.options].map(o => o.textContent)};""")
+    ok(words["poll"] == "Poll interval" and words["unit"] == "s" and words["help"].startswith("poll_s: poll period"),
+       f"an option labelled in words with its unit, its key and help on pointing: {words['poll']!r} ({words['unit']}), {words['help']!r}")
+    ok(words["role"] == "thermometer (material)" and words["value"] == "material" and
+       "air station (air)" in words["roles"], f"roles as names, their keys kept: {words['roles']}")
+    ok(b.js("return document.getElementById('setup-status').className;") == "ok", "the set-up still checks ok")
+    b.js("document.querySelector('[data-key=\"devices.material.role\"]').scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c00c-setup-labels-1366x768.png")
+    b.js("window.scrollTo(0, 0);")
     b.js("document.getElementById('tab-run').click();")
 
     post(url + "api/simulation/speed", {"speed": 2})
