@@ -279,7 +279,16 @@ try:
     ok(shown.returncode == 0 and "operator actions (5):" in shown.stdout and
        "capture from the web page by A. Operator: captured by hand" in shown.stdout,
        "`daq show` lists them: " + "; ".join(l.strip() for l in shown.stdout.splitlines() if "from the" in l)[:400])
+    report = os.path.join(TMP, "report.html")
+    made = subprocess.run([DAQ, "report", str(run_id), "--db", DB, "-o", report], capture_output=True, text=True)
+    html = open(report, encoding="utf-8").read() if made.returncode == 0 else made.stderr
+    ok("<h4>Operator actions (5)</h4>" in html and f"captured by hand: target {manual_stop['target']} " in html and
+       "skipped by the operator" in html and "web page (A. Operator)" in html,
+       "the run's report lists the operator's actions")
     ok(b.js("return JSON.stringify(window.__errors);") == "[]", "no script error on the page")
+    b.get("file://" + report)
+    b.js("[...document.querySelectorAll('h4')].find(h => h.textContent.startsWith('Operator actions')).scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c05-report-operator-actions.png")
     print(f"operator page control: {page_checks.passes} checks passed; screenshots in {SHOTS}")
 finally:
     b.close()
