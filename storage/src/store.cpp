@@ -177,6 +177,24 @@ ALTER TABLE runs ADD COLUMN quality TEXT
   CHECK(quality IS NULL OR quality IN ('ok', 'suspect', 'not checked'));
 ALTER TABLE runs ADD COLUMN quality_note TEXT NOT NULL DEFAULT '';
 )sql",
+    // 5 -> 6 (issue 29): what the operator did during a run (a stop captured by hand, a target
+    // skipped or measured again, the run paused and resumed), when, from where and by whom,
+    // written as it happens so a killed run keeps it.
+    R"sql(
+CREATE TABLE operator_actions(
+  id INTEGER PRIMARY KEY,
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  time_unix_ms INTEGER NOT NULL,
+  action TEXT NOT NULL CHECK(action IN ('capture', 'skip', 'retry', 'pause', 'resume')),
+  source TEXT NOT NULL DEFAULT '',
+  operator TEXT NOT NULL DEFAULT '',
+  run_number INTEGER,
+  direction TEXT CHECK(direction IS NULL OR direction IN ('+', '-')),
+  target_index INTEGER,
+  nominal_mm REAL,
+  detail TEXT NOT NULL DEFAULT '');
+CREATE INDEX operator_actions_by_run ON operator_actions(run_id, id);
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -365,6 +383,13 @@ CREATE TEMP TABLE compensations(id INTEGER PRIMARY KEY, machine_id INTEGER, sour
   source TEXT, axis TEXT, format TEXT, created_unix_ms INTEGER, json TEXT);
 )sql",
          "present an older schema without origins and compensations (read-only)");
+  if (version < 6)  // before the operator's actions were recorded: none
+    exec(R"sql(
+CREATE TEMP TABLE operator_actions(id INTEGER PRIMARY KEY, run_id INTEGER, time_unix_ms INTEGER,
+  action TEXT, source TEXT, operator TEXT, run_number INTEGER, direction TEXT,
+  target_index INTEGER, nominal_mm REAL, detail TEXT);
+)sql",
+         "present an older schema without operator actions (read-only)");
   has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
@@ -914,6 +939,52 @@ std::vector<MissedStop> Store::missed_stops(std::int64_t run_id) const {
                    .direction = column_text(s.get(), 2).front(),
                    .target_index = sqlite3_column_int(s.get(), 3),
                    .nominal_mm = sqlite3_column_double(s.get(), 4)});
+  return out;
+}
+
+void Store::add_operator_action(const OperatorAction& a) {
+  impl_->need_writable("store an operator action");
+  auto s = impl_->prepare(
+      "INSERT INTO operator_actions(run_id, time_unix_ms, action, source, operator, run_number, "
+      "direction, target_index, nominal_mm, detail) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  sqlite3_bind_int64(s.get(), 1, a.run_id);
+  sqlite3_bind_int64(s.get(), 2, a.time_unix_ms ? a.time_unix_ms : unix_ms_now());
+  bind_text(s.get(), 3, a.action);
+  bind_text(s.get(), 4, a.source);
+  bind_text(s.get(), 5, a.operator_name);
+  if (a.stop) {
+    sqlite3_bind_int(s.get(), 6, a.stop->run_number);
+    bind_text(s.get(), 7, std::string_view(&a.stop->direction, 1));
+    sqlite3_bind_int(s.get(), 8, a.stop->target_index);
+    sqlite3_bind_double(s.get(), 9, a.stop->nominal_mm);
+  }
+  bind_text(s.get(), 10, a.detail);
+  impl_->step_done(s.get(), fmt::format("store a {} action of run {}", a.action, a.run_id));
+}
+
+std::vector<OperatorAction> Store::operator_actions(std::int64_t run_id) const {
+  auto s = impl_->prepare(
+      "SELECT run_id, time_unix_ms, action, source, operator, run_number, direction, "
+      "target_index, nominal_mm, detail FROM operator_actions WHERE run_id = ? ORDER BY id");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  std::vector<OperatorAction> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    OperatorAction a{.run_id = sqlite3_column_int64(s.get(), 0),
+                     .time_unix_ms = sqlite3_column_int64(s.get(), 1),
+                     .action = column_text(s.get(), 2),
+                     .source = column_text(s.get(), 3),
+                     .operator_name = column_text(s.get(), 4),
+                     .detail = column_text(s.get(), 9)};
+    if (sqlite3_column_type(s.get(), 5) != SQLITE_NULL) {
+      const auto dir = column_text(s.get(), 6);
+      a.stop = MissedStop{.run_id = a.run_id,
+                          .run_number = sqlite3_column_int(s.get(), 5),
+                          .direction = dir.empty() ? '+' : dir.front(),
+                          .target_index = sqlite3_column_int(s.get(), 7),
+                          .nominal_mm = sqlite3_column_double(s.get(), 8)};
+    }
+    out.push_back(std::move(a));
+  }
   return out;
 }
 

@@ -425,9 +425,9 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 }
 
 // What schema 5 added (origins, compensations, the stop quality), taken off a new file to
-// make a version 4 one.
+// make a version 4 one (schema 6's table goes first).
 constexpr const char* kUndoSchema5 =
-    "DROP INDEX compensations_by_machine; DROP TABLE compensations; "
+    "DROP TABLE operator_actions; DROP INDEX compensations_by_machine; DROP TABLE compensations; "
     "ALTER TABLE instruments DROP COLUMN origin; ALTER TABLE instruments DROP COLUMN "
     "origin_detail; ALTER TABLE captured_targets DROP COLUMN suspect; ALTER TABLE runs DROP "
     "COLUMN quality; ALTER TABLE runs DROP COLUMN quality_note; ";
@@ -595,8 +595,63 @@ TEST(Store, ASchema4DatabaseReadsItsRunsAsNeverChecked) {
     EXPECT_TRUE(ro.targets(run).empty());
   }
   Store rw(file);
-  EXPECT_EQ(rw.version(), 5);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
   EXPECT_FALSE(rw.quality(run));
   rw.set_quality(run, {.state = "ok", .summary = "ok"});
   EXPECT_EQ(rw.quality(run)->state, "ok");
+}
+
+// Issue 29: the operator's actions of a run, stored as they happen and read back in order; an
+// unknown action is refused; a schema 5 file reads as none, and migrates.
+TEST(Store, OperatorActionsAreKeptInOrderAndAnOlderFileHasNone) {
+  TempDir dir;
+  const auto file = dir.path / "v5.sqlite";
+  std::int64_t run = 0;
+  {
+    Store store(file);
+    run = a_run(store);
+    store.add_operator_action({.run_id = run, .action = "pause", .source = "web page"});
+    store.add_operator_action(
+        {.run_id = run,
+         .time_unix_ms = 1700000000123,
+         .action = "capture",
+         .source = "web page",
+         .operator_name = "A. Operator",
+         .stop =
+             cal::storage::MissedStop{
+                 .run_number = 2, .direction = '-', .target_index = 3, .nominal_mm = 150.0},
+         .detail = "+1.250 um"});
+    EXPECT_THROW(store.add_operator_action({.run_id = run, .action = "dance"}),
+                 cal::storage::StoreError);
+    const auto a = store.operator_actions(run);
+    ASSERT_EQ(a.size(), 2u);
+    EXPECT_EQ(a[0].action, "pause");
+    EXPECT_FALSE(a[0].stop);
+    EXPECT_GT(a[0].time_unix_ms, 0);
+    EXPECT_EQ(a[1].action, "capture");
+    EXPECT_EQ(a[1].time_unix_ms, 1700000000123);
+    EXPECT_EQ(a[1].operator_name, "A. Operator");
+    ASSERT_TRUE(a[1].stop);
+    EXPECT_EQ(a[1].stop->run_number, 2);
+    EXPECT_EQ(a[1].stop->direction, '-');
+    EXPECT_EQ(a[1].stop->target_index, 3);
+    EXPECT_DOUBLE_EQ(a[1].stop->nominal_mm, 150.0);
+    EXPECT_EQ(a[1].detail, "+1.250 um");
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "DROP TABLE operator_actions; PRAGMA user_version = 5;", nullptr,
+                           nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 5);
+    EXPECT_TRUE(ro.operator_actions(run).empty());
+  }
+  Store rw(file);
+  EXPECT_EQ(rw.version(), 6);
+  EXPECT_TRUE(rw.operator_actions(run).empty());
 }

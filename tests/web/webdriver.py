@@ -90,6 +90,13 @@ class Browser:
         return self._call("POST", f"/session/{self.session}/execute/async",
                           {"script": script, "args": list(args)})
 
+    def press(self, key):
+        """Presses and releases one key on the focused element, as a keyboard (or a foot switch
+        that sends a key) does."""
+        self._call("POST", f"/session/{self.session}/actions", {"actions": [{
+            "type": "key", "id": "keyboard",
+            "actions": [{"type": "keyDown", "value": key}, {"type": "keyUp", "value": key}]}]})
+
     def set_size(self, width, height):
         self._call("POST", f"/session/{self.session}/window/rect",
                    {"width": width, "height": height})

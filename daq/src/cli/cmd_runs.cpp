@@ -176,6 +176,15 @@ json run_document(const st::Store& store, std::int64_t id) {
   j["missed_stops"] = json::array();
   for (const auto& m : missed) j["missed_stops"].push_back(missed_json(m));
   j["quality"] = quality_json(run_quality(store, id));  // suspect stops (issue 26)
+  // What the operator did during the run (issue 29): captures by hand, skips, pauses.
+  j["operator_actions"] = json::array();
+  for (const auto& a : store.operator_actions(id))
+    j["operator_actions"].push_back({{"time", iso_time(a.time_unix_ms)},
+                                     {"action", a.action},
+                                     {"source", a.source},
+                                     {"operator", a.operator_name},
+                                     {"stop", a.stop ? missed_json(*a.stop) : json(nullptr)},
+                                     {"detail", a.detail}});
   j["results"] = json::array();
   const json& settings = j["settings"];
   for (const auto& res : store.results(id)) {
@@ -209,6 +218,15 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
   if (!missed.empty()) {
     print_line("  missed stops ({}):", missed.size());
     for (const auto& m : missed) print_line("    {}", missed_text(m));
+  }
+  if (!j["operator_actions"].empty()) {
+    print_line("  operator actions ({}):", j["operator_actions"].size());
+    for (const auto& a : j["operator_actions"]) {
+      const auto who = a["operator"].get<std::string>();
+      print_line("    {} {} from the {}{}: {}", a["time"].get<std::string>(),
+                 a["action"].get<std::string>(), a["source"].get<std::string>(),
+                 who.empty() ? "" : " by " + who, a["detail"].get<std::string>());
+    }
   }
   // The stop quality (run_quality.hpp): the verdict, each suspect stop by name.
   print_line("  stop quality: {}", j["quality"]["summary"].get<std::string>());

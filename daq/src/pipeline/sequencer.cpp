@@ -51,7 +51,7 @@ std::vector<double> Sequencer::acceptable_mm() const {
   const std::size_t limit = pass_end(next_) < stops_.size() ? pass_end(next_) + 1 : stops_.size();
   for (std::size_t j = next_; j < limit; ++j) out.push_back(stops_[j].position_mm);
   for (std::size_t j = 0; j < next_; ++j)
-    if (stops_[j].missed) out.push_back(stops_[j].position_mm);
+    if (stops_[j].missed && !stops_[j].skipped) out.push_back(stops_[j].position_mm);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -96,7 +96,7 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
   }
   // A stop reported missed earlier, captured late.
   for (std::size_t j = 0; j < next_; ++j) {
-    if (stops_[j].missed && fits(stops_[j], c)) {
+    if (stops_[j].missed && !stops_[j].skipped && fits(stops_[j], c)) {
       take(j, SequenceEvent::Kind::out_of_order, "out of order: " + describe(stops_[j]));
       return events;
     }
@@ -122,6 +122,22 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
                     fmt::format("extra stop at {:.4f} mm: no expected stop within {} mm, ignored",
                                 c.mean_mm, window_mm_)});
   return events;
+}
+
+std::optional<std::size_t> Sequencer::skip() {
+  if (complete()) return std::nullopt;
+  auto& e = stops_[next_];
+  e.missed = e.skipped = true;
+  return next_++;
+}
+
+std::optional<std::size_t> Sequencer::reopen_last() {
+  if (next_ == 0) return std::nullopt;
+  auto& e = stops_[--next_];
+  e.captured = e.missed = e.skipped = false;
+  e.deviation_um = 0.0;
+  e.time_ns = 0;
+  return next_;
 }
 
 Progress Sequencer::progress() const {

@@ -85,14 +85,10 @@ std::optional<Capture> StabilityTrigger::add(std::int64_t t, double x_mm, bool v
   max_.emplace_back(seq, x_mm);
   // Shrink from the front until the window is within the band: a moving axis keeps only its
   // newest readings, a stopped one accumulates.
-  while (max_.front().second - min_.front().second > 2 * tol_mm) {
-    const double x0 = window_.front().second;
-    window_.pop_front();
-    sum_ -= x0;
-    sum2_ -= x0 * x0;
-    if (min_.front().first == front_seq_) min_.pop_front();
-    if (max_.front().first == front_seq_) max_.pop_front();
-    ++front_seq_;
+  while (max_.front().second - min_.front().second > 2 * tol_mm) drop_oldest();
+  if (held_) {  // paused: the newest dwell only, for a capture by hand; none of its own
+    while (window_.back().first - window_.front().first > dwell_ns_) drop_oldest();
+    return std::nullopt;
   }
   if (window_.back().first - window_.front().first < dwell_ns_) return std::nullopt;
   const double mean = sum_ / static_cast<double>(window_.size());
@@ -111,6 +107,21 @@ std::optional<Capture> StabilityTrigger::capture_now() {
   last_capture_mm_ = c.mean_mm;
   clear_window();
   return c;
+}
+
+void StabilityTrigger::drop_oldest() {
+  const double x0 = window_.front().second;
+  window_.pop_front();
+  sum_ -= x0;
+  sum2_ -= x0 * x0;
+  if (min_.front().first == front_seq_) min_.pop_front();
+  if (max_.front().first == front_seq_) max_.pop_front();
+  ++front_seq_;
+}
+
+void StabilityTrigger::rearm() {
+  armed_ = true;
+  clear_window();
 }
 
 void StabilityTrigger::clear_window() {
@@ -215,6 +226,7 @@ std::optional<Capture> PositionTrigger::add_reading(std::int64_t t, double x_mm,
 }
 
 std::optional<Capture> PositionTrigger::try_capture(std::int64_t now_ns) {
+  if (held_) return std::nullopt;
   const std::int64_t from = std::max(*still_since_ns_, last_invalid_ns_ + 1);
   if (now_ns - from < dwell_ns_) return std::nullopt;
   // Wait until the laser has caught up with the feed, so the window is not cut short.
@@ -225,6 +237,11 @@ std::optional<Capture> PositionTrigger::try_capture(std::int64_t now_ns) {
     still_since_ns_.reset();
   }
   return c;
+}
+
+void PositionTrigger::rearm() {
+  armed_ = true;
+  still_since_ns_.reset();
 }
 
 std::optional<Capture> PositionTrigger::capture_now() {

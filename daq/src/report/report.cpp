@@ -116,6 +116,7 @@ struct RunView {
   Environment env;
   std::vector<st::ResultRecord> results;
   std::vector<st::MissedStop> missed;
+  std::vector<st::OperatorAction> actions;  // what the operator did during the run (issue 29)
   ::daq::CompensationUsed used;  // linear runs: what the stored deviations were made with
 };
 
@@ -195,6 +196,7 @@ RunView load(const st::Store& store, std::int64_t id) {
   v.env = load_environment(store, v);
   v.results = store.results(id);
   v.missed = store.missed_stops(id);
+  v.actions = store.operator_actions(id);
   v.used = ::daq::compensation_used(v.settings, v.results);
   return v;
 }
@@ -270,6 +272,20 @@ std::string missed_text(const st::MissedStop& m) {
 }
 
 std::string connections_table(const RunView& v);
+
+// The operator's actions during the run (stops captured by hand, skipped, measured again, the
+// run paused): when, which stop, from where, by whom, and what happened.
+std::string operator_actions_section(const RunView& v) {
+  if (v.actions.empty()) return {};
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& a : v.actions)
+    rows.push_back(
+        {iso_time(a.time_unix_ms), esc(a.action), a.stop ? esc(missed_text(*a.stop)) : "",
+         esc(a.source) + (a.operator_name.empty() ? "" : " (" + esc(a.operator_name) + ")"),
+         esc(a.detail)});
+  return "<h4>Operator actions (" + std::to_string(v.actions.size()) + ")</h4>\n" +
+         table({"time (UTC)", "action", "stop", "from (by)", "what happened"}, rows, "", "lllll");
+}
 
 std::string setup_section(const RunView& v) {
   std::vector<std::vector<std::string>> rows = {
@@ -1492,6 +1508,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
     h += "<h4>Missed stops (never captured)</h4>\n" +
          table({"run", "direction", "target", "nominal (mm)"}, rows, "num", "rlrr");
   }
+  h += operator_actions_section(v);
   h += customer_section(v);
   h += conditions_section(v);
   h += instruments_section(v);

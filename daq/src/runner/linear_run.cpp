@@ -89,8 +89,11 @@ std::string to_json_text(const LiveState& s) {
                      {"target", x.target},
                      {"nominal_mm", x.nominal_mm},
                      {"deviation_um", x.missed ? json(nullptr) : json(x.deviation_um)},
-                     {"missed", x.missed}});
+                     {"missed", x.missed},
+                     {"skipped", x.skipped},
+                     {"manual", x.manual}});
   j["stops"] = std::move(stops);
+  j["paused"] = s.paused;
   return j.dump();
 }
 
@@ -203,6 +206,8 @@ struct LinearRun::Impl : Runner {
   LiveState live;
   std::int64_t first_ns = -1;
   double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
+  std::optional<std::size_t> last_taken;  // the stop the last capture was labelled as
+  std::vector<bool> manual;               // by stop: captured by hand
 
   Impl(boost::asio::io_context& i, LinearRunSetup s)
       : Runner(i, s.database, s.store_options),
@@ -494,6 +499,9 @@ struct LinearRun::Impl : Runner {
       event(e.message);
       using Kind = cal::daq::SequenceEvent::Kind;
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
+        last_taken = e.stop;
+        manual.resize(sequencer.stops().size());
+        manual[e.stop] = cap.manual;
         {
           const auto& s = sequencer.stops()[e.stop];
           motion.captured(cap.mean_mm, s.position_mm, cap.end_ns);
@@ -554,15 +562,7 @@ struct LinearRun::Impl : Runner {
     report_probe_latency();
     try {
       writer->flush();
-      for (const auto i : sequencer.missed()) {
-        const auto& s = sequencer.stops()[i];
-        outcome.missed.push_back(
-            {.run_id = outcome.run_id,
-             .run_number = s.run,
-             .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
-             .target_index = s.target_index - 1,
-             .nominal_mm = s.position_mm});
-      }
+      outcome.missed = missed_stops();
       store->set_missed_stops(outcome.run_id, outcome.missed);
       check_quality();
       outcome.status = outcome.missed.empty() ? cal::storage::RunStatus::complete
@@ -593,6 +593,31 @@ struct LinearRun::Impl : Runner {
     outcome.complete = true;
     live.state = outcome.missed.empty() ? "complete" : "incomplete";
     end();
+  }
+
+  // The missed stops stored as they are now; false when the store failed (the run aborted).
+  bool store_missed() {
+    try {
+      store->set_missed_stops(outcome.run_id, missed_stops());
+    } catch (const std::exception& e) {
+      abort(fmt::format("storage failed: {}", e.what()));
+      return false;
+    }
+    return true;
+  }
+
+  // The stops passed without a capture so far (skipped ones included), as the store keeps them.
+  std::vector<cal::storage::MissedStop> missed_stops() const {
+    std::vector<cal::storage::MissedStop> out;
+    for (const auto i : sequencer.missed()) {
+      const auto& s = sequencer.stops()[i];
+      out.push_back({.run_id = outcome.run_id,
+                     .run_number = s.run,
+                     .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+                     .target_index = s.target_index - 1,
+                     .nominal_mm = s.position_mm});
+    }
+    return out;
   }
 
   // The stops against the run's own repeatability (run_quality.hpp): stored with the run and
@@ -666,6 +691,153 @@ struct LinearRun::Impl : Runner {
     end();
   }
 
+  // --- the operator's control (issue 29) ---------------------------------------------------
+
+  ControlOutcome control(Control c, std::string_view source) {
+    if (!running) return {false, "the run has ended"};
+    ControlOutcome out;
+    std::optional<std::size_t> stop;
+    switch (c) {
+      case Control::capture:
+        out = capture_by_hand(stop);
+        break;
+      case Control::skip:
+        out = skip(stop);
+        break;
+      case Control::retry:
+        out = retry(stop);
+        break;
+      case Control::pause:
+      case Control::resume:
+        out = pause(c == Control::pause);
+        break;
+    }
+    if (!out.applied) return out;
+    record(c, source, stop, out.message);
+    event(out.message);
+    if (running && sequencer.complete() && pending.empty()) finish();
+    return out;
+  }
+
+  // The current window, whatever its spread, labelled by the sequencer as an automatic capture
+  // is; a capture it does not take (no target there) changes nothing.
+  ControlOutcome capture_by_hand(std::optional<std::size_t>& stop) {
+    auto cap = position_trigger ? position_trigger->capture_now() : trigger.capture_now();
+    if (!cap)
+      return {false, "nothing to capture: no laser reading since the last capture or the start"};
+    // on_capture uses only the ratio length / raw, a pure factor (refraction and material
+    // temperature): any non-zero raw length gives it, 0 would give 0 / 0.
+    const auto comp = env.compensate(cap->end_ns, 0.1);
+    last_taken.reset();
+    on_capture(*cap, comp);
+    if (!last_taken) {
+      rearm();  // the automatic trigger watches this stop again
+      return {false, fmt::format("not captured: {}", live.message)};
+    }
+    stop = last_taken;
+    const auto& s = sequencer.stops()[*stop];
+    return {true, fmt::format("captured by hand: {}: {:+.3f} um", describe(s),
+                              (cap->mean_mm - s.position_mm) * 1e3)};
+  }
+
+  ControlOutcome skip(std::optional<std::size_t>& stop) {
+    stop = sequencer.skip();
+    if (!stop) return {false, "no target left to skip: the plan is complete"};
+    expect_next();
+    // Stored at once among the missed stops, so a run stopped or killed later still lists it.
+    if (!store_missed()) return {false, "storage failed: the run was aborted"};
+    return {true, fmt::format("skipped by the operator: {}", describe(sequencer.stops()[*stop]))};
+  }
+
+  // The last stop passed is expected again: its value (if captured) is dropped from the run and
+  // the trigger measures it after a fresh dwell (or a capture by hand takes it).
+  ControlOutcome retry(std::optional<std::size_t>& stop) {
+    const auto before = sequencer.next_index() > 0
+                            ? std::optional(sequencer.stops()[sequencer.next_index() - 1])
+                            : std::nullopt;
+    stop = sequencer.reopen_last();
+    if (!stop || !before) return {false, "no stop passed yet: nothing to measure again"};
+    std::string dropped = before->skipped ? " (it was skipped)" : " (it was missed)";
+    if (before->captured) {
+      dropped = fmt::format(" (the value {:+.3f} um discarded)", before->deviation_um);
+      if (!forget_stop(*before)) return {false, "storage failed: the run was aborted"};
+    }
+    if (*stop < manual.size()) manual[*stop] = false;
+    if ((before->missed || before->skipped) && !store_missed())
+      return {false, "storage failed: the run was aborted"};
+    rearm();
+    expect_next();
+    return {true, fmt::format("measuring again: {}{}", describe(*before), dropped)};
+  }
+
+  ControlOutcome pause(bool on) {
+    if (live.paused == on)
+      return {false, on ? "the run is already paused" : "the run is not paused"};
+    live.paused = on;
+    trigger.hold(on);
+    if (position_trigger) position_trigger->hold(on);
+    return {true, on ? "paused: no automatic capture until resumed (capture by hand still works)"
+                     : "resumed: stops are captured again"};
+  }
+
+  void rearm() {
+    trigger.rearm();
+    if (position_trigger) position_trigger->rearm();
+  }
+
+  static std::string describe(const cal::daq::ExpectedStop& s) {
+    return fmt::format("target {} ({:.3f} mm) run {} {}", s.target_index, s.position_mm, s.run,
+                       s.direction == cal::iso230_2::Direction::up ? "up" : "down");
+  }
+
+  // A stop's value out of the run: the kind's values, a value still waiting for its probe, and
+  // the stored target. False when the store failed (the run is then aborted).
+  bool forget_stop(const cal::daq::ExpectedStop& s) {
+    const char dir = s.direction == cal::iso230_2::Direction::up ? '+' : '-';
+    std::erase_if(values, [&](const kinds::StopValue& v) {
+      return v.run == s.run && v.direction == dir && v.target_index == s.target_index - 1;
+    });
+    std::erase_if(pending, [&](const Pending& p) {
+      const auto& q = sequencer.stops()[p.stop];
+      return q.run == s.run && q.direction == s.direction && q.target_index == s.target_index;
+    });
+    try {
+      auto kept = store->targets(outcome.run_id);
+      std::erase_if(kept, [&](const cal::storage::CapturedTarget& t) {
+        return t.run_number == s.run && t.direction == dir && t.target_index == s.target_index - 1;
+      });
+      store->replace_targets(outcome.run_id, kept);
+    } catch (const std::exception& e) {
+      abort(fmt::format("storage failed: {}", e.what()));
+      return false;
+    }
+    return true;
+  }
+
+  // The action in the run's record, with the stop it acted on, as it happens.
+  void record(Control c, std::string_view source, std::optional<std::size_t> stop,
+              const std::string& detail) {
+    cal::storage::OperatorAction a{.run_id = outcome.run_id,
+                                   .action = std::string(to_string(c)),
+                                   .source = std::string(source),
+                                   .operator_name = setup.config.operator_name,
+                                   .detail = detail};
+    if (stop) {
+      const auto& s = sequencer.stops()[*stop];
+      a.stop = cal::storage::MissedStop{
+          .run_id = outcome.run_id,
+          .run_number = s.run,
+          .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
+          .target_index = s.target_index - 1,
+          .nominal_mm = s.position_mm};
+    }
+    try {
+      store->add_operator_action(a);
+    } catch (const std::exception& e) {
+      abort(fmt::format("storage failed: {}", e.what()));
+    }
+  }
+
   // Runner's hooks: how a linear run records its abort and stops its instruments.
   std::int64_t current_run() const override { return outcome.run_id; }
   void aborting(const std::string& reason) override {
@@ -708,7 +880,9 @@ struct LinearRun::Impl : Runner {
                             .up = s.direction == cal::iso230_2::Direction::up,
                             .nominal_mm = s.position_mm,
                             .deviation_um = s.deviation_um,
-                            .missed = s.missed && !s.captured});
+                            .missed = s.missed && !s.captured,
+                            .skipped = s.skipped,
+                            .manual = s.captured && i < manual.size() && manual[i]});
     }
     setup.on_live(live);
   }
@@ -720,13 +894,27 @@ LinearRun::~LinearRun() { impl_->stop_if_running(); }
 void LinearRun::start() { impl_->start(); }
 void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }
 void LinearRun::manual_capture() {
-  auto& i = *impl_;
-  if (auto c = i.position_trigger ? i.position_trigger->capture_now() : i.trigger.capture_now()) {
-    // on_capture uses only the ratio length / raw, a pure factor (refraction and material
-    // temperature): any non-zero raw length gives it, 0 would give 0 / 0.
-    const auto comp = impl_->env.compensate(c->end_ns, 0.1);
-    impl_->on_capture(*c, comp);
+  const auto out = impl_->control(Control::capture, "keyboard (daq run)");
+  if (!out.applied) impl_->event(out.message);
+}
+ControlOutcome LinearRun::control(Control c, std::string_view source) {
+  return impl_->control(c, source);
+}
+
+std::string_view to_string(Control c) {
+  switch (c) {
+    case Control::capture:
+      return "capture";
+    case Control::skip:
+      return "skip";
+    case Control::retry:
+      return "retry";
+    case Control::pause:
+      return "pause";
+    case Control::resume:
+      return "resume";
   }
+  return "?";
 }
 bool LinearRun::finished() const { return impl_->done; }
 const LinearRunOutcome& LinearRun::outcome() const { return impl_->outcome; }

@@ -58,7 +58,10 @@ struct LiveState {
     bool up = true;
     double nominal_mm = 0.0, deviation_um = 0.0;
     bool missed = false;
+    bool skipped = false;  // given up by the operator
+    bool manual = false;   // captured by hand
   };
+  bool paused = false;      // no automatic capture until resumed (the operator's pause)
   std::vector<Stop> stops;  // captured or missed so far, in plan order
 };
 std::string to_json_text(const LiveState& s);
@@ -135,6 +138,16 @@ struct LinearRunOutcome {
   cal::storage::RunQuality quality;
 };
 
+// The operator's control of a running linear run (issue 29; docs/web.md): capture the current
+// stop by hand, skip the next target, measure the last stop again, pause and resume automatic
+// capture. Each one applied is recorded in the run (cal::storage::OperatorAction) as it happens.
+enum class Control { capture, skip, retry, pause, resume };
+std::string_view to_string(Control c);
+struct ControlOutcome {
+  bool applied = false;  // false: not applicable now, `message` says why
+  std::string message;   // what happened, in words (the stop, its value)
+};
+
 // A store or capture that fails (a full disk) ends the run as aborted with the reason
 // ("storage failed: FILE: ..."), keeping what was written; nothing is thrown out of the
 // instruments' handlers or the destructor.
@@ -144,7 +157,9 @@ class LinearRun {
   ~LinearRun();
   void start();
   void stop(const std::string& reason);  // aborts
-  void manual_capture();                 // the operator's "capture now"
+  void manual_capture();                 // the operator's "capture now" (from the keyboard)
+  // `source` says where it came from ("web page", "keyboard (daq run)"), stored with it.
+  ControlOutcome control(Control c, std::string_view source);
   bool finished() const;
   const LinearRunOutcome& outcome() const;
   const cal::iso230_2::Plan& plan() const;

@@ -287,6 +287,13 @@ class Service {
              return (this->*handler)(body);
            }});
     };
+    // The operator's control of a linear run: POST /api/runs/capture, skip, retry, pause, resume.
+    for (const auto c :
+         {Control::capture, Control::skip, Control::retry, Control::pause, Control::resume})
+      api.routes.push_back({"POST", fmt::format("/api/runs/{}", to_string(c)),
+                            [this, c](std::string_view, const std::string& body) {
+                              return control_request(c, body);
+                            }});
     get("/api/setup", &Service::setup_get);
     get("/api/devices", &Service::devices);
     get("/api/drivers", &Service::drivers);
@@ -800,6 +807,28 @@ class Service {
     if (!body.empty() && !parse_body(body).is_object())
       return error(400, "the body of a stop must be empty or a JSON object");
     return stop("stopped from the web page");
+  }
+
+  // POST /api/runs/{capture,skip,retry,pause,resume} (docs/web.md): an empty body or {}; 409
+  // when there is no linear run or the action does not apply now (the reason named), else the
+  // action done, in words, as the run records it.
+  web::Response control_request(Control c, const std::string& body) {
+    if (!body.empty()) {
+      const auto req = parse_body(body);
+      if (!req.is_object() || !req.empty())
+        return error(400,
+                     fmt::format("the body of /api/runs/{} must be empty or {{}}", to_string(c)));
+    }
+    if (!running()) return error(409, "no run is running");
+    if (!linear_)
+      return error(409, fmt::format("run {} is a circle test: capture, skip, retry, pause and "
+                                    "resume are for linear runs (a circle has no stops)",
+                                    run_id_));
+    const auto out = linear_->control(c, "web page");
+    if (!out.applied) return error(409, out.message, {{"action", to_string(c)}});
+    fmt::print("  {} (from the web page)\n", out.message);
+    std::fflush(stdout);
+    return ok({{"run", run_id_}, {"action", to_string(c)}, {"message", out.message}});
   }
 
   web::Response stop(const std::string& why) {

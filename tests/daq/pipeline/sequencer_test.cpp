@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "cal/daq/trigger.hpp"
 
 namespace {
@@ -163,6 +165,41 @@ TEST(Sequencer, ADroppedStopIsListedAndTheEndDoesNotClaimEveryStop) {
   EXPECT_EQ(s.stops()[7].run, 2);
   EXPECT_EQ(s.stops()[7].position_mm, 50.0);
   EXPECT_EQ(s.measurements().size(), 11u);
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 29: the operator skips a target (missed, never taken late) and measures the last stop
+// again (its value dropped, expected anew).
+TEST(Sequencer, ASkippedStopIsNeverTakenAndTheLastStopCanBeMeasuredAgain) {
+  Sequencer s(plan(), 0.5);
+  EXPECT_FALSE(s.reopen_last());  // nothing passed yet
+  ASSERT_EQ(s.on_capture(at(0.001, up))[0].kind, Kind::captured);
+  const auto skipped = s.skip();  // 50 mm run 1 up
+  ASSERT_TRUE(skipped);
+  EXPECT_EQ(*skipped, 1u);
+  EXPECT_TRUE(s.stops()[1].skipped && s.stops()[1].missed);
+  // The machine stops at the skipped target anyway: not taken, not even out of order.
+  const auto there = s.on_capture(at(50.0, up));
+  EXPECT_NE(there[0].kind, Kind::captured);
+  EXPECT_NE(there[0].kind, Kind::out_of_order);
+  const auto acceptable = s.acceptable_mm();
+  EXPECT_EQ(std::count(acceptable.begin(), acceptable.end(), 50.0), 0) << "only the skipped one";
+  ASSERT_EQ(s.on_capture(at(100.002, up))[0].kind, Kind::captured);
+  EXPECT_EQ(s.next_index(), 3u);
+  // Measured again: 100 mm run 1 up is expected anew, its value dropped.
+  const auto again = s.reopen_last();
+  ASSERT_TRUE(again);
+  EXPECT_EQ(*again, 2u);
+  EXPECT_FALSE(s.stops()[2].captured);
+  EXPECT_EQ(s.next_expected_mm(), 100.0);
+  EXPECT_EQ(s.measurements().size(), 1u);
+  const auto anew = s.on_capture(at(100.004, up));
+  ASSERT_EQ(anew[0].kind, Kind::captured);
+  EXPECT_NEAR(s.stops()[2].deviation_um, 4.0, 1e-9);
+  EXPECT_EQ(s.missed(), std::vector<std::size_t>{1});
 }
 
 }  // namespace

@@ -278,3 +278,39 @@ TEST(PositionTrigger, RefusesBadSettings) {
 }
 
 }  // namespace
+
+// Issue 29: a held trigger (a paused run) captures nothing by itself, however long the stop,
+// and keeps only the newest dwell for a capture by hand; rearm() measures a stop anew.
+TEST(StabilityTrigger, HeldCapturesNothingButByHandAndRearmMeasuresAgain) {
+  Stream s({.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5}, 0.1);
+  s.trigger.hold(true);
+  s.move_to(20.0);
+  s.dwell(10.0);
+  EXPECT_TRUE(s.captures.empty());
+  const auto c = s.trigger.capture_now();
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(c->manual);
+  EXPECT_NEAR(c->mean_mm, 20.0, 0.05e-3);
+  EXPECT_NEAR(static_cast<double>(c->end_ns - c->start_ns) * 1e-9, 1.5, 0.01);  // the last dwell
+  s.trigger.hold(false);
+  s.dwell(3.0);
+  EXPECT_TRUE(s.captures.empty());  // captured by hand: this stop is not taken again...
+  s.trigger.rearm();                // ...unless the operator measures it again
+  s.dwell(3.0);
+  ASSERT_EQ(s.captures.size(), 1u);
+  EXPECT_FALSE(s.captures[0].manual);
+  EXPECT_NEAR(s.captures[0].mean_mm, 20.0, 0.05e-3);
+}
+
+TEST(PositionTrigger, HeldCapturesNothingButByHand) {
+  FedMachine m({.tolerance_um = 1.0, .dwell_s = 1.5});
+  m.trigger.hold(true);
+  m.move_to(10.0, 0.0);
+  m.dwell(10.0);
+  EXPECT_TRUE(m.captures.empty());
+  ASSERT_TRUE(m.trigger.capture_now());
+  m.trigger.hold(false);
+  m.trigger.rearm();
+  m.dwell(3.0);
+  EXPECT_EQ(m.captures.size(), 1u);
+}

@@ -23,6 +23,7 @@ struct ExpectedStop {
   double position_mm = 0.0;
   bool captured = false;
   bool missed = false;
+  bool skipped = false;  // given up by the operator: missed, and never taken late
   double deviation_um = 0.0;
   std::int64_t time_ns = 0;
 };
@@ -60,6 +61,13 @@ class Sequencer {
   // operator's "stop k of N" is next_index() + 1 of stops().size().
   std::size_t next_index() const { return next_; }
   Progress progress() const;
+  // The operator's actions (issue 29). skip(): the next expected stop is given up (missed, and
+  // not taken if the machine stops there later); nullopt when the plan is complete.
+  // reopen_last(): the last stop passed in plan order is expected again (its value, if it was
+  // captured, is dropped; a skipped or missed one is expected again); nullopt before the first.
+  // Both return the index of the stop acted on.
+  std::optional<std::size_t> skip();
+  std::optional<std::size_t> reopen_last();
   const std::vector<ExpectedStop>& stops() const { return stops_; }
   // The stops passed without a capture (marked missed and not captured late), in plan order.
   std::vector<std::size_t> missed() const;

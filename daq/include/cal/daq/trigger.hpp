@@ -65,6 +65,12 @@ class StabilityTrigger {
   std::optional<Capture> add(std::int64_t time_ns, double position_mm, bool valid = true);
   // Manual trigger: the current window (if it holds any reading), whatever its spread.
   std::optional<Capture> capture_now();
+  // Armed again at once with an empty window, wherever the axis is: the stop is measured anew
+  // after a fresh dwell (the operator's "measure again", the end of a pause).
+  void rearm();
+  // Held (a paused run): no automatic capture; the window keeps the newest dwell_s of stable
+  // readings for capture_now.
+  void hold(bool on) { held_ = on; }
   bool armed() const { return armed_; }
 
  private:
@@ -81,8 +87,9 @@ class StabilityTrigger {
   std::deque<std::pair<std::uint64_t, double>> min_, max_;
   std::uint64_t next_seq_ = 0, front_seq_ = 0;  // sequence numbers of the window's ends
   void clear_window();
+  void drop_oldest();  // the window's oldest reading out (sums and min/max deques kept)
   double sum_ = 0.0, sum2_ = 0.0;
-  bool armed_ = true;
+  bool armed_ = true, held_ = false;
   double last_capture_mm_ = 0.0;
 };
 
@@ -122,6 +129,9 @@ class PositionTrigger {
   std::optional<Capture> add_reading(std::int64_t time_ns, double laser_mm, bool valid = true);
   // Manual trigger: the laser readings of the last dwell_s, whatever the feed says.
   std::optional<Capture> capture_now();
+  // Armed again at once: the feed's stillness counts from its next sample (see StabilityTrigger).
+  void rearm();
+  void hold(bool on) { held_ = on; }  // no automatic capture while held (capture_now works)
   bool armed() const { return armed_; }
 
  private:
@@ -137,7 +147,7 @@ class PositionTrigger {
   std::optional<std::int64_t> still_since_ns_;         // the feed has been at a target since
   double still_mm_ = 0.0;                              // the fed position of that stop
   std::int64_t last_invalid_ns_ = std::numeric_limits<std::int64_t>::min();
-  bool armed_ = true;
+  bool armed_ = true, held_ = false;
 };
 
 }  // namespace cal::daq

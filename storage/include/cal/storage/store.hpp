@@ -30,8 +30,9 @@ class StoreError : public std::runtime_error {
 // 3: reading chunks carry an encoding, a sequence number in their run and a checksum
 // (docs/storage.md). 4: ballbar calibrations (issue 18). 5 (issue 26): the instruments' origin
 // (real, simulated, replay), the compensation tables written with their predicted residual, and
-// the quality of a run's stops (suspect stops, the run's verdict).
-inline constexpr int schema_version = 5;
+// the quality of a run's stops (suspect stops, the run's verdict). 6 (issue 29): the operator's
+// actions during a run (OperatorAction).
+inline constexpr int schema_version = 6;
 
 enum class RunStatus { running, complete, incomplete, aborted };
 std::string_view to_string(RunStatus s);
@@ -153,6 +154,19 @@ struct MissedStop {
   char direction = '+';  // '+' or '-'
   int target_index = 0;  // 0-based, as in the plan
   double nominal_mm = 0.0;
+};
+
+// What the operator did during a run, as it happened: "capture" (a stop captured by hand),
+// "skip" (a target given up), "retry" (the last stop measured again: its value discarded),
+// "pause", "resume". `stop` names the stop acted on (a stop of the plan; run_id as the action's).
+struct OperatorAction {
+  std::int64_t run_id = 0;
+  std::int64_t time_unix_ms = 0;  // 0 when stored: now
+  std::string action;
+  std::string source;         // where it came from: "web page", "keyboard (daq run)", ...
+  std::string operator_name;  // the configuration's operator, "" when not stated
+  std::optional<MissedStop> stop;
+  std::string detail;  // what happened, in words (the value captured, the value discarded)
 };
 
 // A ballbar's calibration against a calibrator of known length (a Zerodur jig, a known ring):
@@ -286,6 +300,10 @@ class Store {
   // read-only): assess it from its stops (daq's run_quality()).
   std::optional<RunQuality> quality(std::int64_t run_id) const;
   std::vector<MissedStop> missed_stops(std::int64_t run_id) const;
+  // The operator's actions of a run (OperatorAction), stored one by one as they happen, and read
+  // back in that order. An unknown action is refused by the schema (StoreError).
+  void add_operator_action(const OperatorAction& a);
+  std::vector<OperatorAction> operator_actions(std::int64_t run_id) const;
   // The session clock reading at a UTC instant (ns since the Unix epoch), see RunRecord.
   void set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns);
 

@@ -1,0 +1,296 @@
+#!/usr/bin/env python3
+"""The operator's control of a linear run from the page (issue 29), driven in headless Chromium
+against `daq serve --simulate` with the keys an operator (or a foot switch) presses:
+
+1. P pauses: PAUSED shown, the pause key now resumes, a stop the axis stands still at is not
+   captured automatically;
+2. C captures the stop by hand (paused or not): the page confirms it with the stop and value,
+   the stops table says "by hand";
+3. P resumes, S skips the next target (the table says "skipped", the machine's stop there is
+   not taken), R measures the last captured stop again (its value discarded, captured anew);
+4. the API answers 409 (with the reason) when an action does not apply, 400 for a bad body;
+5. the stored run lists every action in order, with its stop, source and operator
+   (/api/runs/N and `daq show N`), and the skipped stop among the missed ones.
+
+Usage: operator_page_control_test.py DAQ_BINARY ARTEFACT_DIR
+"""
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+
+sys.path.insert(0, os.path.dirname(__file__))
+import page_checks  # noqa: E402
+from page_checks import ok, post  # noqa: E402
+from webdriver import Browser  # noqa: E402
+
+DAQ, SHOTS = sys.argv[1], sys.argv[2]
+os.makedirs(SHOTS, exist_ok=True)
+TMP = tempfile.mkdtemp(prefix="operator-page-control-")
+DB = os.path.join(TMP, "runs.sqlite")
+
+
+def start_serve():
+    log = open(os.path.join(TMP, "serve.log"), "w+")
+    proc = subprocess.Popen([DAQ, "serve", "--simulate", "--speed", "20", "--port", "0", "--db", DB],
+                            stdout=log, stderr=subprocess.STDOUT)
+    for _ in range(500):
+        log.seek(0)
+        m = re.search(r"daq serve: (http://[0-9.]+:[0-9]+/)", log.read())
+        if m:
+            return proc, m.group(1)
+        if proc.poll() is not None:
+            break
+        time.sleep(0.02)
+    log.seek(0)
+    raise AssertionError("daq serve --simulate did not start: " + log.read())
+
+
+def get(url):
+    with urllib.request.urlopen(url, timeout=30) as r:
+        return json.load(r)
+
+
+RUN = "return window.caldaq.page && window.caldaq.page.run;"
+EXPLAIN = ("const r = window.caldaq.page.run || {}; return JSON.stringify({motion: r.motion, "
+           "display: r.display, captured: r.captured, stop: r.stop, message: r.message, "
+           "paused: r.paused, control: window.caldaq.lastControl});")
+
+
+def control(b, key, action):
+    """Presses `key`; returns the page's answer to it (what it confirmed on screen)."""
+    before = b.js("return window.caldaq.lastControl ? window.caldaq.lastControl.n : 0;")
+    b.press(key)
+    c = b.wait("const c = window.caldaq.lastControl; return c && c.n > %d && c;" % before,
+               timeout_s=20, what=f"the page's answer to {key!r}", explain=EXPLAIN)
+    ok(c["action"] == action and c["text"] == b.js("return document.getElementById('control-result').textContent;"),
+       f"{key!r}: {action}, answered on screen")
+    return c
+
+
+serve, url = start_serve()
+b = Browser(1366, 768)
+try:
+    setup = get(url + "api/setup")["setup"]
+    # 3 targets x 2 runs both ways = 12 stops; the machine stands 10 s at each (2.5 s of wall
+    # time at speed 4, 5 s at speed 2): time to see a stop, act on it and see the answer.
+    setup["test"]["linear"].update(first_mm=0, last_mm=100, interval_mm=50, runs=2, dwell_s=10)
+    setup["test"]["linear"].pop("count", None)
+    setup["operator"] = "A. Operator"
+    status, body = post(url + "api/setup/apply", {"setup": setup})
+    ok(status == 200, f"a short linear test applied: {status} {body.get('error', '')}")
+
+    # --- 4. the API before a run: 409 with the reason, 400 for a bad body --------------------
+    status, body = post(url + "api/runs/capture", {})
+    ok(status == 409 and body["error"] == "no run is running", f"capture with no run: {status} {body}")
+    status, body = post(url + "api/runs/skip", [1])
+    ok(status == 400 and "must be empty or {}" in body["error"], f"a bad body: {status} {body}")
+
+    b.get(url)
+    b.wait("return window.caldaq.page && window.caldaq.page.status.start.linear.ready;",
+           timeout_s=30, what="Start linear ready")
+    ok(b.js("return document.getElementById('manual').hidden;"), "no run: no manual control shown")
+
+    # --- 0. alignment while idle: the laser's reading live in big digits, dashes when stale -----
+    b.js("document.getElementById('tab-align').click();")
+    shown, data = b.wait("const t = document.getElementById('align-reading').textContent; "
+                         "const a = laserAxes(device('laser')); "
+                         "return /^-?\\d+\\.\\d{4}$/.test(t) && a.length && [t, a[0].mm.toFixed(4)];",
+                         timeout_s=20, what="the laser's reading on the Align view")
+    ok(shown == data, f"Align: the laser's current reading in mm: {shown} (its value {data})")
+    align = b.js("const g = id => document.getElementById(id); return {label: g('align-label').textContent, "
+                 "signal: g('align-signal').textContent, note: g('align-note').textContent, "
+                 "size: parseFloat(getComputedStyle(g('align-big')).fontSize), unit: g('align-unit').textContent};")
+    ok(align["label"] == "laser (ids3010), axis 1: raw reading, not compensated" and align["unit"] == "mm", f"which laser and axis: {align['label']!r}")
+    ok(align["signal"] == "Beam: streaming · valid readings 100 %", f"its beam: {align['signal']!r}")
+    ok("reports no signal strength" in align["note"], f"and that it gives no signal strength: {align['note']!r}")
+    ok(align["size"] >= 100, f"in digits readable from 2 m: {align['size']:.0f} px")
+    m0 = b.js("return window.caldaq.messages;")
+    b.wait("return window.caldaq.messages > %d + 5;" % m0, what="live updates on the Align view")
+    page_checks.shot(b, SHOTS, "c00-align-1366x768.png")
+    serve.send_signal(signal.SIGSTOP)
+    t0 = time.time()
+    b.wait("return document.getElementById('align-reading').textContent === '—' && "
+           "!document.getElementById('stale').hidden;", timeout_s=10, what="dashes on the Align view")
+    took = time.time() - t0
+    ok(took <= 3.0 and b.js("return document.getElementById('align-signal').textContent;").startswith("Beam: no data"),
+       f"a hung service: the Align view shows dashes and no data within 3 s ({took:.2f} s)")
+    serve.send_signal(signal.SIGCONT)
+    b.wait("return /\\d/.test(document.getElementById('align-reading').textContent);", timeout_s=10,
+           what="the reading back after SIGCONT")
+    b.set_size(560, 900)
+    time.sleep(0.5)
+    ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0,
+       "560 px: the Align view fits")
+    page_checks.shot(b, SHOTS, "c00b-align-560px.png")
+    b.set_size(1366, 768)
+
+    # --- words an operator uses: the instruments' fields labelled from their option tables ------
+    b.js("document.getElementById('tab-setup').click();")
+    b.wait("return !!document.querySelector('[data-field=\"devices.laser.poll_s\"]');", timeout_s=20,
+           what="the instrument cards")
+    words = b.js("""const f = k => document.querySelector(`[data-field="${k}"]`);
+        const role = document.querySelector('[data-key="devices.material.role"]');
+        return {poll: f('devices.laser.poll_s').querySelector('label').textContent,
+                unit: f('devices.laser.poll_s').querySelector('.u').textContent,
+                help: f('devices.laser.poll_s').title,
+                role: role.options[role.selectedIndex].textContent, value: role.value,
+                roles: [...role.options].map(o => o.textContent)};""")
+    ok(words["poll"] == "Poll interval" and words["unit"] == "s" and words["help"].startswith("poll_s: poll period"),
+       f"an option labelled in words with its unit, its key and help on pointing: {words['poll']!r} ({words['unit']}), {words['help']!r}")
+    ok(words["role"] == "thermometer (material)" and words["value"] == "material" and
+       "air station (air)" in words["roles"], f"roles as names, their keys kept: {words['roles']}")
+    ok(b.js("return document.getElementById('setup-status').className;") == "ok", "the set-up still checks ok")
+    b.js("document.querySelector('[data-key=\"devices.material.role\"]').scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c00c-setup-labels-1366x768.png")
+    b.js("window.scrollTo(0, 0);")
+    b.js("document.getElementById('tab-run').click();")
+
+    post(url + "api/simulation/speed", {"speed": 2})
+    b.js("document.getElementById('start-linear').click();")
+    b.wait("const r = window.caldaq.page.run; return window.caldaq.page.status.running && r && r.stop;",
+           timeout_s=30, what="the run to start")
+    run_id = b.js("return window.caldaq.page.status.run.id;")
+    labels = b.js("return [...document.querySelectorAll('#manual button')].map(b => b.textContent);")
+    ok(labels == ["Capture (C)", "Skip target (S)", "Measure again (R)", "Pause (P)"],
+       f"a linear run: the controls with their keys: {labels}")
+
+    # --- 1. pause: no automatic capture at a stop ----------------------------------------------
+    c = control(b, "p", "pause")
+    ok(c["ok"] and c["text"].startswith("Done: paused"), f"P pauses, confirmed: {c['text']!r}")
+    b.wait("return window.caldaq.page.run.paused && !document.getElementById('paused').hidden;",
+           what="PAUSED shown")
+    ok(b.js("return document.getElementById('ctl-pause').textContent;") == "Resume (P)",
+       "the pause key now resumes")
+    captured0 = b.js("return window.caldaq.page.run.captured;")
+    b.wait("const r = window.caldaq.page.run; return r.display && r.display.mode === 'deviation' && "
+           "r.motion.state === 'stable';", timeout_s=60, what="the axis still at a stop",
+           explain=EXPLAIN)
+    time.sleep(1.0)  # the trigger's dwell (1.5 s simulated) has passed: paused, it takes nothing
+    run = b.js(RUN)
+    ok(run["captured"] == captured0 and run["motion"]["state"] != "captured",
+       f"paused at a still stop: nothing captured ({run['captured']} of {captured0})")
+    page_checks.shot(b, SHOTS, "c01-paused-1366x768.png")
+
+    # --- 2. capture by hand -------------------------------------------------------------------
+    c = control(b, "c", "capture")
+    ok(c["ok"] and re.match(r"Done: captured by hand: target \d \(\d+\.000 mm\) run \d (up|down): [+-]\d+\.\d{3} µm$",
+                            c["text"]), f"C captures the stop, confirmed with its value: {c['text']!r}")
+    run = b.wait("const r = window.caldaq.page.run; return r.captured === arguments[0] + 1 && r;".replace(
+        "arguments[0]", str(captured0)), what="the captured stop in the live state")
+    manual = [s for s in run["stops"] if s["manual"]]
+    ok(len(manual) == 1 and not manual[0]["missed"], f"one stop captured by hand: {manual}")
+    manual_stop = manual[0]
+    b.wait("const r = document.querySelector(`#stops tbody tr[data-stop='%d']`); "
+           "return r && r.cells[6].textContent === 'by hand';" % manual_stop["number"],
+           what="the table row saying 'by hand'")
+    page_checks.shot(b, SHOTS, "c02-captured-by-hand-1366x768.png")
+
+    # --- 3. resume, skip, measure again --------------------------------------------------------
+    status, body = post(url + "api/runs/pause", {"why": 1})
+    ok(status == 400, f"pause with a body of keys: 400 ({body.get('error')})")
+    c = control(b, "p", "resume")
+    ok(c["ok"] and c["text"].startswith("Done: resumed"), f"P resumes: {c['text']!r}")
+    b.wait("return !window.caldaq.page.run.paused && document.getElementById('paused').hidden;",
+           what="PAUSED gone")
+    status, body = post(url + "api/runs/resume", {})
+    ok(status == 409 and body["error"] == "the run is not paused", f"resume when running: 409 {body}")
+
+    next_stop = b.js("return window.caldaq.page.run.stop.number;")
+    c = control(b, "s", "skip")
+    ok(c["ok"] and c["text"].startswith("Done: skipped by the operator: target "), f"S skips: {c['text']!r}")
+    run = b.wait("const r = window.caldaq.page.run; return r.stops.some(s => s.skipped) && r;",
+                 what="the skipped stop in the live state")
+    skipped = [s for s in run["stops"] if s["skipped"]]
+    ok(len(skipped) == 1 and skipped[0]["number"] == next_stop and skipped[0]["missed"],
+       f"the next stop ({next_stop}) skipped: {skipped}")
+    b.wait("const r = document.querySelector(`#stops tbody tr[data-stop='%d']`); "
+           "return r && r.cells[5].textContent === 'skipped';" % next_stop, what="the table row 'skipped'")
+
+    # The machine goes on: its stop at the skipped target is not taken; the one after is.
+    after = b.wait("const r = window.caldaq.page.run; const s = r.stops.filter(x => !x.missed); "
+                   "const last = s[s.length - 1]; return last && last.number > %d && "
+                   "r.motion.state === 'captured' && last;" % next_stop,
+                   timeout_s=90, what="an automatic capture after the skipped target", explain=EXPLAIN)
+    ok(after["number"] == next_stop + 1 and not after["manual"],
+       f"the stop after the skipped one captured by the trigger: stop {after['number']}")
+    ok(all(s["skipped"] for s in b.js(RUN)["stops"] if s["number"] == next_stop),
+       "the skipped stop stays skipped")
+    captured1 = b.js("return window.caldaq.page.run.captured;")
+    c = control(b, "r", "retry")
+    ok(c["ok"] and re.match(r"Done: measuring again: target \d .* \(the value [+-]\d+\.\d{3} µm discarded\)$", c["text"]),
+       f"R measures the last stop again: {c['text']!r}")
+    b.wait("return window.caldaq.page.run.captured === %d;" % (captured1 - 1),
+           what="its value out of the run")
+    ok(b.js("return window.caldaq.page.run.stop.number;") == after["number"],
+       "the stop is expected again")
+    again = b.wait("const r = window.caldaq.page.run; const s = r.stops.find(x => x.number === %d); "
+                   "return r.captured === %d && s && !s.missed && s;" % (after["number"], captured1),
+                   timeout_s=30, what="the stop captured anew", explain=EXPLAIN)
+    ok(not again["manual"], f"captured anew by the trigger: {again['deviation_um']:+.4f} µm")
+    # The deviation-versus-target plot has every captured stop (none missed or skipped).
+    plotted, captured = b.wait("const r = window.caldaq.page.run; const n = r.stops.filter(s => !s.missed).length; "
+                               "return window.caldaq.dvt && window.caldaq.dvt.points === n && [window.caldaq.dvt.points, n];",
+                               what="the deviation-versus-target plot up to date")
+    ok(plotted == captured and plotted >= 2, f"the deviation-versus-target plot: {plotted} stops plotted")
+    b.js("document.getElementById('dvt').scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c03b-deviation-plot-1366x768.png")
+    b.js("window.scrollTo(0, 0);")
+    page_checks.shot(b, SHOTS, "c03-skip-retry-1366x768.png")
+    b.set_size(560, 900)
+    time.sleep(0.5)
+    ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0,
+       "560 px: the controls fit")
+    page_checks.shot(b, SHOTS, "c04-controls-560px.png")
+    b.set_size(1366, 768)
+
+    # --- 5. the run's record ---------------------------------------------------------------------
+    status, body = post(url + "api/runs/stop", {})
+    ok(status == 200, "the run stopped")
+    b.wait("return !window.caldaq.page.status.running;", what="the run's end")
+    ok(b.js("return document.getElementById('manual').hidden;"), "no run: the controls go")
+    status, body = post(url + "api/runs/retry", {})
+    ok(status == 409, f"retry after the run: 409 ({body.get('error')})")
+    doc = get(url + f"api/runs/{run_id}")
+    actions = doc["operator_actions"]
+    ok([a["action"] for a in actions] == ["pause", "capture", "resume", "skip", "retry"],
+       f"every action recorded in order (none refused): {[a['action'] for a in actions]}")
+    ok(all(a["source"] == "web page" and a["operator"] == "A. Operator" and
+           re.match(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d", a["time"]) for a in actions),
+       "each with its time, source and operator")
+    cap, skip, retry = actions[1], actions[3], actions[4]
+    ok(cap["stop"]["nominal_mm"] == manual_stop["nominal_mm"] and cap["stop"]["run"] == manual_stop["run"]
+       and cap["stop"]["direction"] == manual_stop["direction"] and "captured by hand" in cap["detail"],
+       f"the capture names its stop: {cap}")
+    ok(skip["stop"]["target_index"] == skipped[0]["target"] and skip["stop"]["run"] == skipped[0]["run"],
+       f"the skip names its stop: {skip}")
+    ok(retry["stop"]["target_index"] == after["target"] and "discarded" in retry["detail"],
+       f"the retry names its stop and the value discarded: {retry}")
+    ok(any(m["target_index"] == skipped[0]["target"] and m["run"] == skipped[0]["run"] and
+           m["direction"] == skipped[0]["direction"] for m in doc["missed_stops"]),
+       "the skipped stop is among the run's missed stops")
+    shown = subprocess.run([DAQ, "show", str(run_id), "--db", DB], capture_output=True, text=True)
+    ok(shown.returncode == 0 and "operator actions (5):" in shown.stdout and
+       "capture from the web page by A. Operator: captured by hand" in shown.stdout,
+       "`daq show` lists them: " + "; ".join(l.strip() for l in shown.stdout.splitlines() if "from the" in l)[:400])
+    report = os.path.join(TMP, "report.html")
+    made = subprocess.run([DAQ, "report", str(run_id), "--db", DB, "-o", report], capture_output=True, text=True)
+    html = open(report, encoding="utf-8").read() if made.returncode == 0 else made.stderr
+    ok("<h4>Operator actions (5)</h4>" in html and f"captured by hand: target {manual_stop['target']} " in html and
+       "skipped by the operator" in html and "web page (A. Operator)" in html,
+       "the run's report lists the operator's actions")
+    ok(b.js("return JSON.stringify(window.__errors);") == "[]", "no script error on the page")
+    b.get("file://" + report)
+    b.js("[...document.querySelectorAll('h4')].find(h => h.textContent.startsWith('Operator actions')).scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c05-report-operator-actions.png")
+    print(f"operator page control: {page_checks.passes} checks passed; screenshots in {SHOTS}")
+finally:
+    b.close()
+    page_checks.stop_service(serve)
+    shutil.rmtree(TMP, ignore_errors=True)
