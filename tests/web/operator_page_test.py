@@ -301,6 +301,20 @@ try:
         # 20x: the page (10 updates/s) sees the shop every 2 s of simulated time, so each of the
         # 12 stops (1 s moving, 4 s standing) is seen moving and standing.
         simulation_speed(url, 20)
+        # The first page state of each lit indicator, recorded in the page as the indicator
+        # changes (a MutationObserver): this test's polls through WebDriver, slowed by the
+        # screenshots, can miss a 1 s move on a loaded machine; the page itself does not.
+        b.js("""window.__first = {};
+            const snap = () => { const p = window.caldaq.page, r = p.run || {};
+              const lit = [...document.querySelectorAll('#indicator span.on')].map(e => e.dataset.motion);
+              const m = r.motion ? r.motion.state : null;
+              if (!p.status.running || !m || lit.length !== 1 || lit[0] !== m || window.__first[m]) return;
+              window.__first[m] = {motion: m, display: r.display || null,
+                big: document.getElementById('reading').textContent,
+                label: document.getElementById('reading-label').textContent,
+                fits: document.getElementById('big').scrollWidth <= document.getElementById('big').clientWidth}; };
+            new MutationObserver(snap).observe(document.getElementById('indicator'),
+              {subtree: true, attributes: true, attributeFilter: ['class']});""")
         b.js("document.getElementById('start-linear').click();")
         b.wait("return window.caldaq.page.status.running;", what="the run to start")
         shots = {}
@@ -347,9 +361,10 @@ try:
            f"{at_stop['big']} µm")
         shown = at_stop["captured"] if at_stop["motion"] == "captured" else d["value"]
         ok(abs(value - shown) < 0.006, "the number shown is the live value or, at CAPTURED, the captured one")
-        ok(all(x["fits"] for x in shots.values()),
-           f"the number and its unit fit the panel: {[(k, x['big'], x['fits']) for k, x in shots.items()]}")
-        moving = shots.get("moving")
+        first = b.js("return window.__first;")
+        ok(all(x["fits"] for x in first.values()),
+           f"the number and its unit fit the panel: {[(k, x['big'], x['fits']) for k, x in first.items()]}")
+        moving = first.get("moving")
         ok(moving and moving["display"]["mode"] == "position" and moving["label"] == "Position",
            f"while moving the number is a position: {moving and moving['big']} mm")
         rows = b.js("return document.querySelectorAll('#stops tbody tr').length;")
