@@ -40,9 +40,21 @@ class CMakeBuild(build_ext):
         target.mkdir(parents=True, exist_ok=True)
         for f in built.iterdir():
             if f.name.startswith("_caldaq") and f.suffix == ".so":
-                shutil.copy(f, Path(self.get_ext_fullpath(ext.name)))
+                module = Path(self.get_ext_fullpath(ext.name))
+                shutil.copy(f, module)
+                strip_debug_info(module)
             elif f.suffix in (".pyi",) or f.name == "py.typed":
                 shutil.copy(f, target / f.name)
+
+
+def strip_debug_info(module: Path) -> None:
+    """The build's RelWithDebInfo module carries its debug information (about 90 % of the file);
+    the wheel's copy goes without it (binutils' strip, as `cmake --install --strip`)."""
+    strip = shutil.which(os.environ.get("STRIP", "strip"))
+    if strip is None:
+        print(f"caldaq: no strip found: {module.name} keeps its debug information", file=sys.stderr)
+        return
+    subprocess.run([strip, "--strip-debug", str(module)], check=True)
 
 
 setup(
