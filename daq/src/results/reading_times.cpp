@@ -17,34 +17,32 @@ ExportClock::ExportClock(const st::Store& store, const st::RunRecord& run,
   // A series' readings stream in time order, so its first and last are its rows' extremes.
   bool any = false;
   for (const auto& s : store.series(run.id)) {
-    period_ns_[{s.device, s.channel, s.quantity}] =
+    streams_[{s.device, s.channel, s.quantity}].period_ns =
         s.count > 1 ? static_cast<double>(s.last_ns - s.first_ns) / static_cast<double>(s.count - 1)
                     : 0.0;
     if (s.count > 0 && (!any || s.first_ns < t0_ns_)) t0_ns_ = s.first_ns, any = true;
   }
   // A ballbar's samples come at the programmed rate (device 3 of a circle run).
   if (run.kind == "circle" && settings.is_object() && settings.value("sample_rate_hz", 0.0) > 0)
-    for (auto& [k, p] : period_ns_)
-      if (std::get<0>(k) == 3) p = 1e9 / settings.value("sample_rate_hz", 1.0);
+    for (auto& [k, s] : streams_)
+      if (std::get<0>(k) == 3) s.period_ns = 1e9 / settings.value("sample_rate_hz", 1.0);
   if (run.origin_session_ns && run.origin_unix_ns) {
     t0_ns_ = *run.origin_session_ns;
     unix0_ns_ = *run.origin_unix_ns;
   }
 }
 
-std::vector<double> ExportClock::spread(const std::vector<st::RawReading>& group) {
-  const auto key = key_of(group.front());
+void ExportClock::spread(Stream& s, const std::vector<st::RawReading>& group,
+                         std::vector<double>& times) {
   const double read = static_cast<double>(group.front().time_ns);
   const auto n = group.size();
-  const auto it = period_ns_.find(key);
-  double p = it == period_ns_.end() ? 0.0 : it->second;
-  const auto prev = last_ns_.find(key);
-  if (prev != last_ns_.end() && read - static_cast<double>(n - 1) * p <= prev->second)
-    p = (read - prev->second) / static_cast<double>(n);
-  std::vector<double> out(n);
-  for (std::size_t k = 0; k < n; ++k) out[k] = read - static_cast<double>(n - 1 - k) * p;
-  last_ns_[key] = read;
-  return out;
+  double p = s.period_ns;
+  if (s.has_last && read - static_cast<double>(n - 1) * p <= s.last_ns)
+    p = (read - s.last_ns) / static_cast<double>(n);
+  times.resize(n);
+  for (std::size_t k = 0; k < n; ++k) times[k] = read - static_cast<double>(n - 1 - k) * p;
+  s.last_ns = read;
+  s.has_last = true;
 }
 
 std::optional<std::int64_t> ExportClock::unix_ns(double session_ns) const {
@@ -68,13 +66,13 @@ std::string ExportClock::utc(double session_ns) const {
 }
 
 void ExportRows::flush(std::vector<ExportRow>& out) {
-  for (auto& [k, group] : pending_) {
-    if (group.empty()) continue;
-    const auto times = clock_.spread(group);
-    auto& tags = tags_[k];
-    for (std::size_t i = 0; i < group.size(); ++i) out.push_back({group[i], times[i], tags[i]});
-    group.clear();
-    tags.clear();
+  for (auto& e : pending_) {
+    if (e.group.empty()) continue;
+    ExportClock::spread(*e.stream, e.group, times_);
+    for (std::size_t i = 0; i < e.group.size(); ++i)
+      out.push_back({e.group[i], times_[i], e.tags[i]});
+    e.group.clear();
+    e.tags.clear();
   }
 }
 
@@ -83,8 +81,18 @@ void ExportRows::add(const st::RawReading& r, std::vector<ExportRow>& out, std::
   if (!first_ && r.time_ns != current_) flush(out);
   first_ = false;
   current_ = r.time_ns;
-  pending_[key_of(r)].push_back(r);
-  tags_[key_of(r)].push_back(tag);
+  const StreamKey key = key_of(r);
+  if (last_ >= pending_.size() || pending_[last_].key != key) {
+    const auto it =
+        std::lower_bound(pending_.begin(), pending_.end(), key,
+                         [](const Pending& e, const StreamKey& k) { return e.key < k; });
+    const auto at = it == pending_.end() || it->key != key
+                        ? pending_.insert(it, Pending{key, &clock_.stream(key), {}, {}})
+                        : it;
+    last_ = static_cast<std::size_t>(at - pending_.begin());  // after the insertion
+  }
+  pending_[last_].group.push_back(r);
+  pending_[last_].tags.push_back(tag);
 }
 
 void ExportRows::finish(std::vector<ExportRow>& out) { flush(out); }

@@ -30,9 +30,19 @@ class ExportClock {
   // decoded); `settings` is the run's parsed settings (a circle run's sample_rate_hz).
   ExportClock(const cal::storage::Store& store, const cal::storage::RunRecord& run,
               const nlohmann::json& settings);
-  // Session times (ns, fractional) of a group of one stream's readings sharing one stored time,
-  // in order; remembers the group's time for the stream's next group.
-  std::vector<double> spread(const std::vector<cal::storage::RawReading>& group);
+  // What the spreading knows of one stream (device, channel, quantity).
+  struct Stream {
+    double period_ns = 0.0;
+    double last_ns = 0.0;  // the time of the stream's last group
+    bool has_last = false;
+  };
+  // The stream's state (a stream without stored series: period 0); stays valid as long as the
+  // clock.
+  Stream& stream(const StreamKey& key) { return streams_[key]; }
+  // Session times (ns, fractional) into `times` of a group of one stream's readings sharing one
+  // stored time, in order; remembers the group's time for the stream's next group.
+  static void spread(Stream& s, const std::vector<cal::storage::RawReading>& group,
+                     std::vector<double>& times);
   double seconds(double session_ns) const {
     return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
   }
@@ -44,8 +54,7 @@ class ExportClock {
   bool has_utc() const { return unix0_ns_.has_value(); }
 
  private:
-  std::map<StreamKey, double> period_ns_;
-  std::map<StreamKey, double> last_ns_;  // the time of each stream's last group
+  std::map<StreamKey, Stream> streams_;
   std::int64_t t0_ns_ = 0;
   std::optional<std::int64_t> unix0_ns_;
 };
@@ -71,10 +80,17 @@ class ExportRows {
   void finish(std::vector<ExportRow>& out);
 
  private:
+  struct Pending {
+    StreamKey key;
+    ExportClock::Stream* stream;
+    std::vector<cal::storage::RawReading> group;
+    std::vector<std::uint64_t> tags;
+  };
   void flush(std::vector<ExportRow>& out);
   ExportClock& clock_;
-  std::map<StreamKey, std::vector<cal::storage::RawReading>> pending_;
-  std::map<StreamKey, std::vector<std::uint64_t>> tags_;
+  std::vector<Pending> pending_;  // one per stream seen, by key (a handful: found by a scan)
+  std::size_t last_ = 0;          // the entry of the last reading (most follow their stream)
+  std::vector<double> times_;
   std::int64_t current_ = 0;
   bool first_ = true;
 };
