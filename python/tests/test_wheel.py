@@ -38,7 +38,8 @@ def test_the_wheel_installs_and_imports(demo, tmp_path):
     clean["PYTHONPATH"] = str(site)
     code = ("import caldaq, sys; db = caldaq.open(sys.argv[1]); "
             "print(caldaq.__file__); print(len(db.runs()))")
+    # From tmp_path: `python -c` looks in its working directory first (ctest's is build/python).
     out = subprocess.run([sys.executable, "-c", code, str(demo / "demo.sqlite")], env=clean,
-                         check=True, capture_output=True, text=True).stdout.split()
+                         cwd=tmp_path, check=True, capture_output=True, text=True).stdout.split()
     assert Path(out[0]).is_relative_to(site) and int(out[1]) == 2
     assert not (PYTHON_DIR / "caldaq.egg-info").exists()  # nothing written into the source tree
