@@ -12,7 +12,6 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
-#include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -245,37 +244,45 @@ class Stream {
   // Up to a chunk of rows (under the store's lock): reads on until that many are complete.
   void take(std::vector<daq::ExportRow>& rows,
             std::vector<std::optional<cal::daq::Compensated>>& comps) {
-    std::vector<daq::ExportRow> done;
-    while (ready_.size() < chunk_ && stream_) {
-      if (!stream_->next(batch_, chunk_)) {
-        rows_->finish(done);
-        chunks_done_ = stream_->chunks_read();
-        stream_.reset();
+    rows.reserve(chunk_);
+    while (rows.size() < chunk_) {
+      if (head_ == ready_.size()) {
+        ready_.clear();
+        head_ = 0;
+        if (!stream_) break;
+        fill();
+        continue;
       }
-      for (const auto& r : batch_) {
-        const std::uint64_t tag = next_tag_++;
-        if (compensation_)
-          if (const auto c = compensation_->add(r)) pending_[tag] = *c;
-        rows_->add(r, done, tag);
-      }
-      batch_.clear();
-      for (const auto& x : done)
-        if (wanted_.empty() || wanted_.count(x.r.quantity))
-          ready_.push_back(x);
-        else
-          pending_.erase(x.tag);
-      done.clear();
+      const auto& x = ready_[head_++];
+      if (wanted_.empty() || wanted_.count(x.r.quantity))
+        rows.push_back(x);
+      else if (compensation_)
+        pending_.erase(x.tag);  // an environment reading read along for the compensation
     }
-    const auto n = std::min(chunk_, ready_.size());
-    rows.assign(ready_.begin(), ready_.begin() + static_cast<std::ptrdiff_t>(n));
-    ready_.erase(ready_.begin(), ready_.begin() + static_cast<std::ptrdiff_t>(n));
     if (!compensation_) return;
-    comps.resize(n);
-    for (std::size_t k = 0; k < n; ++k)
+    comps.resize(rows.size());
+    for (std::size_t k = 0; k < rows.size(); ++k)
       if (const auto it = pending_.find(rows[k].tag); it != pending_.end()) {
         comps[k] = it->second;
         pending_.erase(it);
       }
+  }
+
+  // The rows that the next stored batch completes, into ready_ (all of them at the end).
+  void fill() {
+    if (!stream_->next(batch_, chunk_)) {
+      rows_->finish(ready_);
+      chunks_done_ = stream_->chunks_read();
+      stream_.reset();
+      return;
+    }
+    for (const auto& r : batch_) {
+      const std::uint64_t tag = next_tag_++;
+      if (compensation_)
+        if (const auto c = compensation_->add(r)) pending_[tag] = *c;
+      rows_->add(r, ready_, tag);
+    }
+    batch_.clear();
   }
 
   std::shared_ptr<SharedStore> store_;
@@ -286,7 +293,8 @@ class Stream {
   std::unique_ptr<daq::ExportRows> rows_;
   std::unique_ptr<daq::ReadingCompensation> compensation_;
   std::vector<st::RawReading> batch_;
-  std::deque<daq::ExportRow> ready_;
+  std::vector<daq::ExportRow> ready_;  // complete rows, from head_ on
+  std::size_t head_ = 0;
   std::unordered_map<std::uint64_t, cal::daq::Compensated> pending_;  // by the rows' tags
   std::uint64_t next_tag_ = 0;
   std::uint64_t chunks_done_ = 0;
