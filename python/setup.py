@@ -40,13 +40,32 @@ class CMakeBuild(build_ext):
         target.mkdir(parents=True, exist_ok=True)
         for f in built.iterdir():
             if f.name.startswith("_caldaq") and f.suffix == ".so":
-                shutil.copy(f, Path(self.get_ext_fullpath(ext.name)))
+                module = Path(self.get_ext_fullpath(ext.name))
+                shutil.copy(f, module)
+                strip_debug_info(module)
             elif f.suffix in (".pyi",) or f.name == "py.typed":
                 shutil.copy(f, target / f.name)
 
 
+def strip_debug_info(module: Path) -> None:
+    """The build's RelWithDebInfo module carries its debug information (93 of its 96 MB); the
+    wheel's copy goes without it (binutils' strip, as `cmake --install --strip`)."""
+    strip = shutil.which(os.environ.get("STRIP", "strip"))
+    if strip is None:
+        print(f"caldaq: no strip found: {module.name} keeps its debug information", file=sys.stderr)
+        return
+    subprocess.run([strip, "--strip-debug", str(module)], check=True)
+
+
+# Where setuptools works (its build/ and caldaq.egg-info/): python/ unless CALDAQ_WHEEL_WORK says
+# elsewhere (the test builds its wheel without writing into the source tree).
+WORK = os.environ.get("CALDAQ_WHEEL_WORK")
+OPTIONS = {"build": {"build_base": str(Path(WORK) / "build")},
+           "egg_info": {"egg_base": WORK}} if WORK else {}
+
 setup(
     name="caldaq",
+    options=OPTIONS,
     version=project_version(),
     description="caldaq's run store, analysis library and captures for Python",
     packages=["caldaq"],

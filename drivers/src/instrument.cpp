@@ -33,6 +33,18 @@ std::string_view to_string(Quantity q) {
   return "unknown";
 }
 
+std::string_view to_string(ReadingStatus s) {
+  switch (s) {
+    case ReadingStatus::ok:
+      return "ok";
+    case ReadingStatus::signal_lost:
+      return "signal_lost";
+    case ReadingStatus::out_of_range:
+      return "out_of_range";
+  }
+  return "unknown";
+}
+
 std::string_view to_string(InstrumentState s) {
   switch (s) {
     case InstrumentState::closed:

@@ -8,6 +8,20 @@
 
 namespace cal::drivers {
 
+std::string_view to_string(DecodedItem::Kind k) {
+  switch (k) {
+    case DecodedItem::Kind::reading:
+      return "reading";
+    case DecodedItem::Kind::error:
+      return "error";
+    case DecodedItem::Kind::gap:
+      return "gap";
+    case DecodedItem::Kind::note:
+      return "note";
+  }
+  return "unknown";
+}
+
 const DeviceDriver* find_driver(std::string_view name) {
   for (const auto* d : device_drivers())
     if (d->name() == name) return d;

@@ -254,62 +254,60 @@ class Store:
         self._c.finish_run(run_id, status, note)
 
     # -- readings -------------------------------------------------------------------------
-    def _time_origin(self, run: Run) -> tuple:
-        """(t0_ns, unix0_ns): the session time of the run's start and its UTC (None when the run
-        has no time origin), as `daq export` takes them."""
-        if run.origin_session_ns is not None and run.origin_unix_ns is not None:
-            return run.origin_session_ns, run.origin_unix_ns
-        first = [s["first_ns"] for s in self._c.series(run.id)]
-        return (min(first) if first else 0), None
+    def iter_readings(self, run_id: int, quantities: Sequence[str] = (), chunk: int = 65536,
+                      compensated: bool = False) -> Iterator[Dict[str, np.ndarray]]:
+        """The run's readings, `chunk` at a time, as dicts of numpy arrays, in the order and with
+        the times of `daq export`: time_ns (stored session time), time_s (seconds from the run's
+        start), utc (datetime64[ns], NaT without a time origin), device, channel, quantity (code;
+        QUANTITIES names it), status (0 ok, 1 signal lost, 2 out of range), value (SI, raw:
+        uncompensated). Readings that came in one transport read (a ballbar's lines) share their
+        time_ns; time_s and utc spread them back by the sample period, as the export does.
 
-    def iter_readings(self, run_id: int, quantities: Sequence[str] = (),
-                      chunk: int = 65536) -> Iterator[Dict[str, np.ndarray]]:
-        """The run's readings in time order, `chunk` at a time, as dicts of numpy arrays:
-        time_ns (stored session time), time_s (from the run's start), utc (datetime64[ns], NaT
-        without a time origin), device, channel, quantity (code; QUANTITIES names it), status
-        (0 ok, 1 signal lost, 2 out of range), value (SI, raw: uncompensated). Memory is bounded
-        by the chunk size whatever the run's length."""
-        run = self.run(run_id)
-        t0, unix0 = self._time_origin(run)
+        compensated=True (a linear run) adds compensated (the laser's displacement as a length
+        at 20 degC, m), refractive_index and material_temperature_degc: each laser reading
+        compensated as the acquisition's pipeline did it, NaN for the other readings. Memory is
+        bounded by the chunk size whatever the run's length."""
+        self.run(run_id)  # the CLI's message for an unknown run
         codes = [quantity_code(q) for q in quantities]
-        stream = self._c.stream(run_id, codes, chunk)
+        stream = self._c.stream(run_id, codes, chunk, compensated)
         while True:
             c = stream.next()
             if c is None:
                 return
-            rel = c["time_ns"] - t0
-            c["time_s"] = rel * 1e-9
-            if unix0 is None:
-                c["utc"] = np.full(rel.shape, np.datetime64("NaT"), dtype="datetime64[ns]")
-            else:
-                c["utc"] = (rel + unix0).astype("datetime64[ns]")
+            c["utc"] = c.pop("utc_ns").view("datetime64[ns]")  # int64 min is NaT
             yield c
 
-    def readings(self, run_id: int, quantities: Sequence[str] = ()) -> Dict[tuple, Dict[str, np.ndarray]]:
+    def readings(self, run_id: int, quantities: Sequence[str] = (),
+                 compensated: bool = False) -> Dict[tuple, Dict[str, np.ndarray]]:
         """Every reading of the run per series, {(device, channel, quantity name): arrays} (the
         arrays of iter_readings, less device/channel/quantity). Holds the whole run: for long
         runs, iterate with iter_readings."""
+        names = ["time_ns", "time_s", "utc", "status", "value"]
+        if compensated:
+            names += ["compensated", "refractive_index", "material_temperature_degc"]
         parts: Dict[tuple, Dict[str, list]] = {}
-        for c in self.iter_readings(run_id, quantities):
+        for c in self.iter_readings(run_id, quantities, compensated=compensated):
             keys = (c["device"].astype(np.int64) << 16) | (c["channel"].astype(np.int64) << 8) | c["quantity"]
             for k in np.unique(keys):
                 mask = keys == k
                 key = (int(k >> 16), int((k >> 8) & 0xFF), QUANTITIES[int(k & 0xFF)])
-                slot = parts.setdefault(key, {n: [] for n in ("time_ns", "time_s", "utc", "status", "value")})
+                slot = parts.setdefault(key, {n: [] for n in names})
                 for n in slot:
                     slot[n].append(c[n][mask])
         return {k: {n: np.concatenate(v) for n, v in s.items()} for k, s in parts.items()}
 
-    def dataframe(self, run_id: int, quantities: Sequence[str] = ()) -> Any:
+    def dataframe(self, run_id: int, quantities: Sequence[str] = (), compensated: bool = False) -> Any:
         """The run's readings as a pandas DataFrame (needs pandas), one row per reading, with
         the columns of iter_readings and quantity as its name."""
         try:
             import pandas as pd
         except ImportError as e:
             raise ImportError("caldaq.Store.dataframe needs pandas (Debian: python3-pandas)") from e
-        frames = [pd.DataFrame(c) for c in self.iter_readings(run_id, quantities)]
-        df = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(
-            columns=["time_ns", "device", "channel", "quantity", "status", "value", "time_s", "utc"])
+        frames = [pd.DataFrame(c) for c in self.iter_readings(run_id, quantities, compensated=compensated)]
+        columns = ["time_ns", "device", "channel", "quantity", "status", "value", "time_s", "utc"]
+        if compensated:
+            columns += ["compensated", "refractive_index", "material_temperature_degc"]
+        df = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=columns)
         df["quantity"] = pd.Categorical.from_codes(df["quantity"].astype(int), categories=list(QUANTITIES))
         return df
 

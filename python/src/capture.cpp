@@ -63,32 +63,6 @@ class Capture {
   cal::replay::CaptureReader reader_;
 };
 
-std::string_view status_text(d::ReadingStatus s) {
-  switch (s) {
-    case d::ReadingStatus::ok:
-      return "ok";
-    case d::ReadingStatus::signal_lost:
-      return "signal_lost";
-    case d::ReadingStatus::out_of_range:
-      return "out_of_range";
-  }
-  return "unknown";
-}
-
-std::string_view kind_text(d::DecodedItem::Kind k) {
-  switch (k) {
-    case d::DecodedItem::Kind::reading:
-      return "reading";
-    case d::DecodedItem::Kind::error:
-      return "error";
-    case d::DecodedItem::Kind::gap:
-      return "gap";
-    case d::DecodedItem::Kind::note:
-      return "note";
-  }
-  return "unknown";
-}
-
 template <class T>
 py::object opt(const std::optional<T>& v) {
   return v ? py::cast(*v) : py::none();
@@ -103,7 +77,7 @@ py::str text(const std::string& s) {
 // One item with the fields of `daq decode --json` (caldaq.decode.v1) for its type.
 py::dict item_dict(const d::DecodedItem& i) {
   py::dict j;
-  j["type"] = std::string(kind_text(i.kind));
+  j["type"] = std::string(d::to_string(i.kind));
   j["offset"] = i.offset;
   switch (i.kind) {
     case d::DecodedItem::Kind::reading:
@@ -114,7 +88,7 @@ py::dict item_dict(const d::DecodedItem& i) {
       j["channel"] = i.channel;
       j["quantity"] = std::string(d::to_string(i.quantity));
       j["value"] = i.value;
-      j["status"] = std::string(status_text(i.status));
+      j["status"] = std::string(d::to_string(i.status));
       break;
     case d::DecodedItem::Kind::error:
       j["kind"] = i.error_kind;

@@ -11,12 +11,19 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <mutex>
+#include <set>
+#include <unordered_map>
 
 #include "bindings.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "json_input.hpp"
+#include "reading_compensation.hpp"
+#include "reading_times.hpp"
 
 namespace py = pybind11;
 namespace st = cal::storage;
@@ -156,44 +163,76 @@ py::list list_of(const std::vector<T>& v, F&& f) {
 }
 
 // A column of a chunk as a new numpy array.
-template <class T, class Get>
-py::array_t<T> column(const std::vector<st::RawReading>& rs, Get get) {
-  py::array_t<T> a(static_cast<py::ssize_t>(rs.size()));
+template <class T, class Rows, class Get>
+py::array_t<T> column(const Rows& rows, Get get) {
+  py::array_t<T> a(static_cast<py::ssize_t>(rows.size()));
   T* p = a.mutable_data();
-  for (std::size_t k = 0; k < rs.size(); ++k) p[k] = get(rs[k]);
+  for (std::size_t k = 0; k < rows.size(); ++k) p[k] = get(rows[k]);
   return a;
 }
 
-// A run's readings a chunk at a time; holds its store (and so its connection) alive.
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// A run's readings a chunk at a time, in the order and with the times of `daq export`
+// (reading_times.hpp: a group of readings from one transport read spread back by the sample
+// period), optionally with each laser reading's compensation (reading_compensation.hpp); holds
+// its store (and so its connection) alive. Memory: a chunk, the readings of one stored time,
+// and the compensation stage's 2 minutes of environment.
 class Stream {
  public:
   Stream(std::shared_ptr<SharedStore> s, std::int64_t run_id, std::vector<std::uint8_t> quantities,
-         std::size_t chunk)
-      : store_(std::move(s)), chunk_(chunk) {
+         std::size_t chunk, bool compensated)
+      : store_(std::move(s)), chunk_(chunk), wanted_(quantities.begin(), quantities.end()) {
     if (chunk_ == 0) throw cal::InputError("chunk: expected a number of readings > 0, got 0");
-    stream_ = std::make_unique<st::ReadingStream>(
-        locked(*store_, [&](st::Store& st) { return st.stream_readings(run_id, quantities); }));
+    locked(*store_, [&](st::Store& st) {
+      const auto run = st.run(run_id);
+      if (!run)
+        throw cal::InputError(
+            fmt::format("{}: no run {} (see daq runs)", st.path().string(), run_id));
+      const auto settings = cal::daq::parse_stored_json(run->settings_json);
+      clock_ = std::make_unique<daq::ExportClock>(st, *run, settings);
+      rows_ = std::make_unique<daq::ExportRows>(*clock_);
+      if (compensated) {
+        compensation_ = std::make_unique<daq::ReadingCompensation>(st, *run, settings);
+        // The environment is read along even where only the laser's readings are asked for.
+        if (!quantities.empty())
+          for (const auto q : daq::ReadingCompensation::inputs())
+            if (std::find(quantities.begin(), quantities.end(), q) == quantities.end())
+              quantities.push_back(q);
+      }
+      stream_ = std::make_unique<st::ReadingStream>(st.stream_readings(run_id, quantities));
+    });
   }
+
   // The next chunk as a dict of numpy arrays, or None at the end.
-  // The stream is touched only under the store's lock, and each call fills its own batch, so
+  // The stream is touched only under the store's lock, and each call takes its own rows, so
   // two threads calling next() on one stream get whole, distinct chunks.
   py::object next() {
-    std::vector<st::RawReading> batch;
-    const bool more = locked(*store_, [&](st::Store&) {
-      if (!stream_) return false;
-      if (stream_->next(batch, chunk_)) return true;
-      chunks_done_ = stream_->chunks_read();
-      stream_.reset();
-      return false;
-    });
-    if (!more) return py::none();
+    std::vector<daq::ExportRow> rows;
+    std::vector<std::optional<cal::daq::Compensated>> comps;  // with compensation: one per row
+    locked(*store_, [&](st::Store&) { take(rows, comps); });
+    if (rows.empty()) return py::none();
     py::dict d;
-    d["time_ns"] = column<std::int64_t>(batch, [](const auto& r) { return r.time_ns; });
-    d["device"] = column<std::uint16_t>(batch, [](const auto& r) { return r.device; });
-    d["channel"] = column<std::uint8_t>(batch, [](const auto& r) { return r.channel; });
-    d["quantity"] = column<std::uint8_t>(batch, [](const auto& r) { return r.quantity; });
-    d["status"] = column<std::uint8_t>(batch, [](const auto& r) { return r.status; });
-    d["value"] = column<double>(batch, [](const auto& r) { return r.value; });
+    using Row = daq::ExportRow;
+    d["time_ns"] = column<std::int64_t>(rows, [](const Row& x) { return x.r.time_ns; });
+    d["device"] = column<std::uint16_t>(rows, [](const Row& x) { return x.r.device; });
+    d["channel"] = column<std::uint8_t>(rows, [](const Row& x) { return x.r.channel; });
+    d["quantity"] = column<std::uint8_t>(rows, [](const Row& x) { return x.r.quantity; });
+    d["status"] = column<std::uint8_t>(rows, [](const Row& x) { return x.r.status; });
+    d["value"] = column<double>(rows, [](const Row& x) { return x.r.value; });
+    d["time_s"] = column<double>(rows, [&](const Row& x) { return clock_->seconds(x.session_ns); });
+    // Unix ns as `daq export` rounds them (it prints them to the microsecond); -2^63 is NaT.
+    d["utc_ns"] = column<std::int64_t>(rows, [&](const Row& x) {
+      return clock_->unix_ns(x.session_ns).value_or(std::numeric_limits<std::int64_t>::min());
+    });
+    if (compensation_) {
+      // NaN where a reading has none (not the laser's displacement).
+      using C = std::optional<cal::daq::Compensated>;
+      d["compensated"] = column<double>(comps, [](const C& c) { return c ? c->length_m : kNaN; });
+      d["refractive_index"] = column<double>(comps, [](const C& c) { return c ? c->n : kNaN; });
+      d["material_temperature_degc"] =
+          column<double>(comps, [](const C& c) { return c ? c->material_degc : kNaN; });
+    }
     return d;
   }
   std::uint64_t chunks_read() {
@@ -202,9 +241,62 @@ class Stream {
   }
 
  private:
+  // Up to a chunk of rows (under the store's lock): reads on until that many are complete.
+  void take(std::vector<daq::ExportRow>& rows,
+            std::vector<std::optional<cal::daq::Compensated>>& comps) {
+    rows.reserve(chunk_);
+    while (rows.size() < chunk_) {
+      if (head_ == ready_.size()) {
+        ready_.clear();
+        head_ = 0;
+        if (!stream_) break;
+        fill();
+        continue;
+      }
+      const auto& x = ready_[head_++];
+      if (wanted_.empty() || wanted_.count(x.r.quantity))
+        rows.push_back(x);
+      else if (compensation_)
+        pending_.erase(x.tag);  // an environment reading read along for the compensation
+    }
+    if (!compensation_) return;
+    comps.resize(rows.size());
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      if (const auto it = pending_.find(rows[k].tag); it != pending_.end()) {
+        comps[k] = it->second;
+        pending_.erase(it);
+      }
+  }
+
+  // The rows that the next stored batch completes, into ready_ (all of them at the end).
+  void fill() {
+    if (!stream_->next(batch_, chunk_)) {
+      rows_->finish(ready_);
+      chunks_done_ = stream_->chunks_read();
+      stream_.reset();
+      return;
+    }
+    for (const auto& r : batch_) {
+      const std::uint64_t tag = next_tag_++;
+      if (compensation_)
+        if (const auto c = compensation_->add(r)) pending_[tag] = *c;
+      rows_->add(r, ready_, tag);
+    }
+    batch_.clear();
+  }
+
   std::shared_ptr<SharedStore> store_;
-  std::unique_ptr<st::ReadingStream> stream_;
   std::size_t chunk_;
+  std::set<std::uint8_t> wanted_;  // the quantities asked for (empty: all)
+  std::unique_ptr<st::ReadingStream> stream_;
+  std::unique_ptr<daq::ExportClock> clock_;
+  std::unique_ptr<daq::ExportRows> rows_;
+  std::unique_ptr<daq::ReadingCompensation> compensation_;
+  std::vector<st::RawReading> batch_;
+  std::vector<daq::ExportRow> ready_;  // complete rows, from head_ on
+  std::size_t head_ = 0;
+  std::unordered_map<std::uint64_t, cal::daq::Compensated> pending_;  // by the rows' tags
+  std::uint64_t next_tag_ = 0;
   std::uint64_t chunks_done_ = 0;
 };
 
@@ -401,11 +493,11 @@ void bind_store(py::module_& m) {
       .def(
           "stream",
           [](std::shared_ptr<SharedStore> s, std::int64_t run_id,
-             std::vector<std::uint8_t> quantities, std::size_t chunk) {
-            return Stream(std::move(s), run_id, std::move(quantities), chunk);
+             std::vector<std::uint8_t> quantities, std::size_t chunk, bool compensated) {
+            return Stream(std::move(s), run_id, std::move(quantities), chunk, compensated);
           },
           py::arg("run_id"), py::arg("quantities") = std::vector<std::uint8_t>{},
-          py::arg("chunk") = 65536);
+          py::arg("chunk") = 65536, py::arg("compensated") = false);
 }
 
 }  // namespace caldaq_py

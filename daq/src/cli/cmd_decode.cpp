@@ -49,32 +49,6 @@ std::string_view unit_of(d::Quantity q) {
   return "";
 }
 
-std::string_view status_text(d::ReadingStatus s) {
-  switch (s) {
-    case d::ReadingStatus::ok:
-      return "ok";
-    case d::ReadingStatus::signal_lost:
-      return "signal_lost";
-    case d::ReadingStatus::out_of_range:
-      return "out_of_range";
-  }
-  return "unknown";
-}
-
-std::string_view kind_text(d::DecodedItem::Kind k) {
-  switch (k) {
-    case d::DecodedItem::Kind::reading:
-      return "reading";
-    case d::DecodedItem::Kind::error:
-      return "error";
-    case d::DecodedItem::Kind::gap:
-      return "gap";
-    case d::DecodedItem::Kind::note:
-      return "note";
-  }
-  return "unknown";
-}
-
 // The device's time as printed: UTC with nanoseconds, or seconds since the stream's start.
 std::string time_text(const d::DecodedItem& i) {
   if (!i.time_text.empty()) return i.time_text;
@@ -92,7 +66,7 @@ std::string time_text(const d::DecodedItem& i) {
 }
 
 json item_json(const d::DecodedItem& i) {
-  json j{{"schema", "caldaq.decode.v1"}, {"type", kind_text(i.kind)}, {"offset", i.offset}};
+  json j{{"schema", "caldaq.decode.v1"}, {"type", d::to_string(i.kind)}, {"offset", i.offset}};
   switch (i.kind) {
     case d::DecodedItem::Kind::reading: {
       const auto t = time_text(i);
@@ -104,7 +78,7 @@ json item_json(const d::DecodedItem& i) {
       j["quantity"] = d::to_string(i.quantity);
       j["value"] = i.value;
       j["unit"] = unit_of(i.quantity);
-      j["status"] = status_text(i.status);
+      j["status"] = d::to_string(i.status);
       break;
     }
     case d::DecodedItem::Kind::error:
@@ -130,7 +104,7 @@ void print_item(const d::DecodedItem& i) {
       if (t.empty() && i.sample) t = fmt::format("sample {}", *i.sample);
       fmt::print("{:>9}  {:<31} ch {}  {:<26} {:>16.9g} {:<4} {}\n", i.offset,
                  t.empty() ? "-" : terminal_safe(t), i.channel, d::to_string(i.quantity), i.value,
-                 unit_of(i.quantity), status_text(i.status));
+                 unit_of(i.quantity), d::to_string(i.status));
       return;
     }
     case d::DecodedItem::Kind::error:

@@ -25,6 +25,7 @@
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "provenance.hpp"
+#include "reading_times.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
 #include "terminal.hpp"
@@ -289,113 +290,21 @@ void each_reading(const st::Store& store, std::int64_t run, F&& f,
     for (const auto& r : batch) f(r);
 }
 
-using StreamKey = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;
-StreamKey key_of(const st::RawReading& r) { return {r.device, r.channel, r.quantity}; }
-
-// Times of a run for the exports: seconds from the run's start and absolute UTC, one per
-// sample. Readings of one device that came in one transport read share the time of that read;
-// they are spread back from it by the device's sample period (the configured sample rate of a
-// ballbar, else the stream's mean interval over the run), the last keeping the read's time.
-// Where that would reach back to the previous read (the reads' own timing jitters), the group
-// is spread evenly over the time since the previous read instead: times always rise.
-class ExportClock {
- public:
-  ExportClock(const st::Store& store, const st::RunRecord& run, const json& settings) {
-    struct Span {
-      std::int64_t first = 0, last = 0;
-      std::size_t n = 0;
-    };
-    std::map<StreamKey, Span> spans;
-    bool any = false;
-    each_reading(store, run.id, [&](const st::RawReading& r) {
-      auto& sp = spans[key_of(r)];
-      if (sp.n++ == 0) sp.first = r.time_ns;
-      sp.last = r.time_ns;
-      if (!any) t0_ns_ = r.time_ns, any = true;
-    });
-    for (const auto& [k, sp] : spans)
-      period_ns_[k] =
-          sp.n > 1 ? static_cast<double>(sp.last - sp.first) / static_cast<double>(sp.n - 1) : 0.0;
-    // A ballbar's samples come at the programmed rate (device 3 of a circle run).
-    if (run.kind == "circle" && settings.is_object() && settings.value("sample_rate_hz", 0.0) > 0)
-      for (auto& [k, p] : period_ns_)
-        if (std::get<0>(k) == 3) p = 1e9 / settings.value("sample_rate_hz", 1.0);
-    if (run.origin_session_ns && run.origin_unix_ns) {
-      t0_ns_ = *run.origin_session_ns;
-      unix0_ns_ = *run.origin_unix_ns;
-    }
-  }
-  // Session times (ns, fractional) of a group of one stream's readings sharing one stored time,
-  // in order; remembers the group's time for the stream's next group.
-  std::vector<double> spread(const std::vector<st::RawReading>& group) {
-    const auto key = key_of(group.front());
-    const double read = static_cast<double>(group.front().time_ns);
-    const auto n = group.size();
-    const auto it = period_ns_.find(key);
-    double p = it == period_ns_.end() ? 0.0 : it->second;
-    const auto prev = last_ns_.find(key);
-    if (prev != last_ns_.end() && read - static_cast<double>(n - 1) * p <= prev->second)
-      p = (read - prev->second) / static_cast<double>(n);
-    std::vector<double> out(n);
-    for (std::size_t k = 0; k < n; ++k) out[k] = read - static_cast<double>(n - 1 - k) * p;
-    last_ns_[key] = read;
-    return out;
-  }
-  double seconds(double session_ns) const {
-    return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
-  }
-  // ISO 8601 UTC with microseconds, or "" when the run has no time origin (stored before it
-  // was recorded, or imported).
-  std::string utc(double session_ns) const {
-    if (!unix0_ns_) return "";
-    const auto ns = *unix0_ns_ + static_cast<std::int64_t>(
-                                     std::llround(session_ns - static_cast<double>(t0_ns_)));
-    const std::int64_t us = ns >= 0 ? ns / 1000 : (ns - 999) / 1000;
-    const std::time_t s =
-        static_cast<std::time_t>(us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000);
-    std::tm tm{};
-    gmtime_r(&s, &tm);
-    std::array<char, 32> buf{};
-    std::strftime(buf.data(), buf.size(), "%Y-%m-%dT%H:%M:%S", &tm);
-    return fmt::format("{}.{:06d}Z", buf.data(), us - static_cast<std::int64_t>(s) * 1'000'000);
-  }
-  bool has_utc() const { return unix0_ns_.has_value(); }
-
- private:
-  std::map<StreamKey, double> period_ns_;
-  std::map<StreamKey, double> last_ns_;  // the time of each stream's last group
-  std::int64_t t0_ns_ = 0;
-  std::optional<std::int64_t> unix0_ns_;
-};
-
-// One exported reading (after the time spreading).
-struct ExportRow {
-  st::RawReading r;
-  double session_ns = 0;
-};
-
-// Walks the readings and hands them on with their spread times; a group of one stream's
-// readings with one stored time is held until the stream's next time shows how many it has.
+// Walks the readings and hands them on with their spread times (reading_times.hpp).
 template <class F>
 void each_export_row(const st::Store& store, std::int64_t run, ExportClock& clock, F&& f) {
-  std::map<StreamKey, std::vector<st::RawReading>> pending;
-  const auto flush = [&](std::vector<st::RawReading>& group) {
-    if (group.empty()) return;
-    const auto times = clock.spread(group);
-    for (std::size_t k = 0; k < group.size(); ++k) f(ExportRow{group[k], times[k]});
-    group.clear();
+  ExportRows rows(clock);
+  std::vector<ExportRow> out;
+  const auto hand_on = [&] {
+    for (const auto& x : out) f(x);
+    out.clear();
   };
-  // Readings come in time order: a group is complete when any later time arrives.
-  std::int64_t current = 0;
-  bool first = true;
   each_reading(store, run, [&](const st::RawReading& r) {
-    if (!first && r.time_ns != current)
-      for (auto& [k, g] : pending) flush(g);
-    first = false;
-    current = r.time_ns;
-    pending[key_of(r)].push_back(r);
+    rows.add(r, out);
+    hand_on();
   });
-  for (auto& [k, g] : pending) flush(g);
+  rows.finish(out);
+  hand_on();
 }
 
 std::map<int, std::string> device_names(const st::Store& store, std::int64_t run) {

@@ -37,6 +37,8 @@ enum class ReadingStatus : std::uint8_t {
   signal_lost,   // beam interrupted / weak signal: the value is not a measurement
   out_of_range,  // the device flagged the value
 };
+// "ok", "signal_lost", "out_of_range": the words of `daq decode --json` and the Python package.
+std::string_view to_string(ReadingStatus s);
 
 struct Reading {
   std::int64_t time_ns = 0;  // monotonic, from the instrument's clock (see Instrument::Clock)

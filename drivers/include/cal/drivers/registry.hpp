@@ -59,6 +59,8 @@ struct DecodedItem {
   std::string text;                           // errors: the reason; gaps: why; notes: what
   std::optional<std::uint64_t> lost_samples;  // gaps: how many, when the protocol says
 };
+// "reading", "error", "gap", "note": an item's type in `daq decode --json` and in Python.
+std::string_view to_string(DecodedItem::Kind k);
 
 // Bytes in, decoded items out, for `daq decode` (and the tests of the real recordings). Pure:
 // the codec of the device plus the mapping of its frames to readings, no I/O.

@@ -1,0 +1,100 @@
+// The exported times of a run's readings (see reading_times.hpp).
+#include "reading_times.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <ctime>
+
+namespace daq {
+
+namespace st = cal::storage;
+
+ExportClock::ExportClock(const st::Store& store, const st::RunRecord& run,
+                         const nlohmann::json& settings) {
+  // A series' readings stream in time order, so its first and last are its rows' extremes.
+  bool any = false;
+  for (const auto& s : store.series(run.id)) {
+    streams_[{s.device, s.channel, s.quantity}].period_ns =
+        s.count > 1 ? static_cast<double>(s.last_ns - s.first_ns) / static_cast<double>(s.count - 1)
+                    : 0.0;
+    if (s.count > 0 && (!any || s.first_ns < t0_ns_)) t0_ns_ = s.first_ns, any = true;
+  }
+  // A ballbar's samples come at the programmed rate (device 3 of a circle run).
+  if (run.kind == "circle" && settings.is_object() && settings.value("sample_rate_hz", 0.0) > 0)
+    for (auto& [k, s] : streams_)
+      if (std::get<0>(k) == 3) s.period_ns = 1e9 / settings.value("sample_rate_hz", 1.0);
+  if (run.origin_session_ns && run.origin_unix_ns) {
+    t0_ns_ = *run.origin_session_ns;
+    unix0_ns_ = *run.origin_unix_ns;
+  }
+}
+
+void ExportClock::spread(Stream& s, const std::vector<st::RawReading>& group,
+                         std::vector<double>& times) {
+  const double read = static_cast<double>(group.front().time_ns);
+  const auto n = group.size();
+  double p = s.period_ns;
+  if (s.has_last && read - static_cast<double>(n - 1) * p <= s.last_ns)
+    p = (read - s.last_ns) / static_cast<double>(n);
+  times.resize(n);
+  for (std::size_t k = 0; k < n; ++k) times[k] = read - static_cast<double>(n - 1 - k) * p;
+  s.last_ns = read;
+  s.has_last = true;
+}
+
+std::optional<std::int64_t> ExportClock::unix_ns(double session_ns) const {
+  if (!unix0_ns_) return std::nullopt;
+  return *unix0_ns_ +
+         static_cast<std::int64_t>(std::llround(session_ns - static_cast<double>(t0_ns_)));
+}
+
+std::string ExportClock::utc(double session_ns) const {
+  const auto unix = unix_ns(session_ns);
+  if (!unix) return "";
+  const std::int64_t ns = *unix;
+  const std::int64_t us = ns >= 0 ? ns / 1000 : (ns - 999) / 1000;
+  const std::time_t s =
+      static_cast<std::time_t>(us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000);
+  std::tm tm{};
+  gmtime_r(&s, &tm);
+  std::array<char, 32> buf{};
+  std::strftime(buf.data(), buf.size(), "%Y-%m-%dT%H:%M:%S", &tm);
+  return fmt::format("{}.{:06d}Z", buf.data(), us - static_cast<std::int64_t>(s) * 1'000'000);
+}
+
+void ExportRows::flush(std::vector<ExportRow>& out) {
+  for (auto& e : pending_) {
+    if (e.group.empty()) continue;
+    ExportClock::spread(*e.stream, e.group, times_);
+    for (std::size_t i = 0; i < e.group.size(); ++i)
+      out.push_back({e.group[i], times_[i], e.tags[i]});
+    e.group.clear();
+    e.tags.clear();
+  }
+}
+
+void ExportRows::add(const st::RawReading& r, std::vector<ExportRow>& out, std::uint64_t tag) {
+  // Readings come in time order: the groups are complete when a later time arrives.
+  if (!first_ && r.time_ns != current_) flush(out);
+  first_ = false;
+  current_ = r.time_ns;
+  const StreamKey key = key_of(r);
+  if (last_ >= pending_.size() || pending_[last_].key != key) {
+    const auto it =
+        std::lower_bound(pending_.begin(), pending_.end(), key,
+                         [](const Pending& e, const StreamKey& k) { return e.key < k; });
+    const auto at = it == pending_.end() || it->key != key
+                        ? pending_.insert(it, Pending{key, &clock_.stream(key), {}, {}})
+                        : it;
+    last_ = static_cast<std::size_t>(at - pending_.begin());  // after the insertion
+  }
+  pending_[last_].group.push_back(r);
+  pending_[last_].tags.push_back(tag);
+}
+
+void ExportRows::finish(std::vector<ExportRow>& out) { flush(out); }
+
+}  // namespace daq

@@ -1,0 +1,98 @@
+#pragma once
+// The times of a stored run's readings as every export gives them (`daq export` CSV and JSON,
+// the Python package's iter_readings; docs/cli.md "daq export"): seconds from the run's start
+// and absolute UTC, one per sample. Readings of one device that came in one transport read
+// share the time of that read; they are spread back from it by the device's sample period (the
+// configured sample rate of a ballbar, else the stream's mean interval over the run), the last
+// keeping the read's time. Where that would reach back to the previous read (the reads' own
+// timing jitters), the group is spread evenly over the time since the previous read instead:
+// times always rise.
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "cal/storage/store.hpp"
+
+namespace daq {
+
+using StreamKey = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;  // device, channel, q
+inline StreamKey key_of(const cal::storage::RawReading& r) {
+  return {r.device, r.channel, r.quantity};
+}
+
+class ExportClock {
+ public:
+  // The periods and the run's start from the series' rows (Store::series: no reading is
+  // decoded); `settings` is the run's parsed settings (a circle run's sample_rate_hz).
+  ExportClock(const cal::storage::Store& store, const cal::storage::RunRecord& run,
+              const nlohmann::json& settings);
+  // What the spreading knows of one stream (device, channel, quantity).
+  struct Stream {
+    double period_ns = 0.0;
+    double last_ns = 0.0;  // the time of the stream's last group
+    bool has_last = false;
+  };
+  // The stream's state (a stream without stored series: period 0); stays valid as long as the
+  // clock.
+  Stream& stream(const StreamKey& key) { return streams_[key]; }
+  // Session times (ns, fractional) into `times` of a group of one stream's readings sharing one
+  // stored time, in order; remembers the group's time for the stream's next group.
+  static void spread(Stream& s, const std::vector<cal::storage::RawReading>& group,
+                     std::vector<double>& times);
+  double seconds(double session_ns) const {
+    return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
+  }
+  // Unix ns of a session time (rounded to the ns), or nullopt when the run has no time origin
+  // (stored before it was recorded, or imported).
+  std::optional<std::int64_t> unix_ns(double session_ns) const;
+  // ISO 8601 UTC with microseconds (unix_ns truncated), or "" without a time origin.
+  std::string utc(double session_ns) const;
+  bool has_utc() const { return unix0_ns_.has_value(); }
+
+ private:
+  std::map<StreamKey, Stream> streams_;
+  std::int64_t t0_ns_ = 0;
+  std::optional<std::int64_t> unix0_ns_;
+};
+
+// One exported reading (after the time spreading).
+struct ExportRow {
+  cal::storage::RawReading r;
+  double session_ns = 0;
+  std::uint64_t tag = 0;  // the caller's, given to ExportRows::add with the reading
+};
+
+// Readings in the store's order in, rows with their spread times out: a group of one stream's
+// readings with one stored time is held until a later time shows it is complete; then every
+// group of that time goes out, stream by stream (device, channel, quantity). The memory is one
+// stored time's readings.
+class ExportRows {
+ public:
+  explicit ExportRows(ExportClock& clock) : clock_(clock) {}
+  // Appends to `out` the rows that `r` completes; `tag` goes out with r's row (the caller's
+  // number for what it computed from r in the store's order, e.g. its compensation).
+  void add(const cal::storage::RawReading& r, std::vector<ExportRow>& out, std::uint64_t tag = 0);
+  // Appends the rows still held (after the last reading).
+  void finish(std::vector<ExportRow>& out);
+
+ private:
+  struct Pending {
+    StreamKey key;
+    ExportClock::Stream* stream;
+    std::vector<cal::storage::RawReading> group;
+    std::vector<std::uint64_t> tags;
+  };
+  void flush(std::vector<ExportRow>& out);
+  ExportClock& clock_;
+  std::vector<Pending> pending_;  // one per stream seen, by key (a handful: found by a scan)
+  std::size_t last_ = 0;          // the entry of the last reading (most follow their stream)
+  std::vector<double> times_;
+  std::int64_t current_ = 0;
+  bool first_ = true;
+};
+
+}  // namespace daq
