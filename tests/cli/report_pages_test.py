@@ -215,7 +215,7 @@ c1 = text["circle"][0]
 check("circle: main table on page one", "symbol value (µm) meaning limit (µm) verdict" in c1
       and re.search(r"G\(b\) [0-9.]+", c1) is not None, c1)
 check("circle: what to fix first on page one", "What to fix first" in c1
-      and re.search(r"rank error value G gain \(µm\) gain / G \(%\) what to check 1 ", c1)
+      and re.search(r"rank error, and what to check value G gain \(share of G\) 1 \w", c1)
       is not None, c1)
 check("circle: failing value named on page one",
       re.search(r"FAIL.*= [+-]?[0-9.]+ µm \(limit ≤", c1) is not None, c1)

@@ -233,15 +233,20 @@ std::string svg(const XyChart& chart) {
   // The legend goes below the plot, in as many columns of the longest label as fit the width:
   // to the right it took a quarter of the width and clipped long instrument names. The page
   // grows by its rows, so the plot keeps its height.
+  // Lengths in characters, not bytes: "x̄↑ ± 2s" is 7 characters in 12 bytes of UTF-8.
+  const auto characters = [](const std::string& s) {
+    return static_cast<std::size_t>(
+        std::count_if(s.begin(), s.end(), [](char c) { return (c & 0xC0) != 0x80; }));
+  };
   std::size_t labelled = 0, longest = 0;
   for (const auto& l : chart.lines)
-    if (!l.label.empty()) ++labelled, longest = std::max(longest, l.label.size());
+    if (!l.label.empty()) ++labelled, longest = std::max(longest, characters(l.label));
   for (const auto& b : chart.bands)
-    if (!b.label.empty()) ++labelled, longest = std::max(longest, b.label.size());
+    if (!b.label.empty()) ++labelled, longest = std::max(longest, characters(b.label));
   const double char_pt = 13.0 * chart.text_scale;
   const auto columns = static_cast<PLINT>(
       legend ? std::clamp<std::size_t>(static_cast<std::size_t>(chart.width_pt / (char_pt * 0.62) /
-                                                                static_cast<double>(longest + 8)),
+                                                                static_cast<double>(longest + 6)),
                                        1, std::min<std::size_t>(labelled, 4))
              : 0);
   const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;

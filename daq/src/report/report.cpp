@@ -745,15 +745,14 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
     }
   }
   if (!original || original->id == current->id) return h;
-  const json a = json::parse(original->json, nullptr, false).value("axis", json::object());
-  const json b = json::parse(current->json, nullptr, false).value("axis", json::object());
+  // In the order of every output (result_rows.hpp), not the stored object's (by key).
+  const auto a = ::daq::linear_rows(json::parse(original->json, nullptr, false));
+  const auto b = ::daq::linear_rows(json::parse(current->json, nullptr, false));
   std::vector<std::vector<std::string>> vals;
-  for (const auto& [key, x] : a.items()) {
-    if (!b.contains(key)) continue;
-    const double before = x.value("value_um", 0.0), after = b[key].value("value_um", 0.0);
-    vals.push_back({esc(x.value("symbol", key)), um(before), um(after),
-                    fmt::format("{:+.3f}", after - before)});
-  }
+  for (const auto& x : a)
+    for (const auto& y : b)
+      if (y.key == x.key)
+        vals.push_back({esc(x.symbol), um(x.value), um(y.value), signed_text(y.value - x.value, 3)});
   h += fmt::format("<h4>Original (result {}) and re-compensated (result {}) values</h4>\n",
                    original->id, current->id) +
        table({"value", "original (µm)", "re-compensated (µm)", "change (µm)"}, vals, "num", "lrrr");
@@ -841,7 +840,7 @@ std::string means_plot(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
-                .height_pt = 230,
+                .height_pt = 170,  // page one holds it below the verdict and the grid
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
   means.bands.push_back(
@@ -943,10 +942,9 @@ std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdic
     return table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, axis,
                  "num results", "lrlrl");
   }
-  return table({"value (µm)", "↑ up", "↓ down", "bidirectional", "limit (µm)", "verdict"}, rows,
-               "num results grid", "lrrrrl") +
-         "<p class=\"note\">Unidirectional values (↑, ↓) from the approaches in one direction; "
-         "the limits apply to the bidirectional values (ISO 230-2).</p>\n";
+  return table({"value (µm)", "↑&nbsp;up", "↓&nbsp;down", "bidirectional", "limit&nbsp;(µm)",
+                "verdict"},
+               rows, "num results grid", "lrrrrl");
 }
 
 // A run's results in two parts: the answer (page one: verdict, main table, main plot) and the
@@ -983,7 +981,12 @@ Sections linear_section(const st::Store& store, const RunView& v, const Options&
   h += results_grid(e, verdict);
   h += means_plot(l);
   std::string& d = out.details;
-  d = "<h3>Details of the results</h3>\n" + runs_plot(l);
+  d = "<h3>Details of the results</h3>\n";
+  if (e.axis.size() && e.axis.front().key.find('_') != std::string::npos)  // up, down, bi
+    d += "<p class=\"note\">Unidirectional values (↑, ↓) of the grid on page one come from the "
+         "approaches in one direction; the limits apply to the bidirectional values (ISO "
+         "230-2).</p>\n";
+  d += runs_plot(l);
   std::vector<std::string> head{"target (mm)"};
   for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (µm)");
   std::vector<std::vector<std::string>> rows;
@@ -1141,27 +1144,39 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
     const auto& d = r.diagnostics[i];
     if (top && (diag.size() >= top || std::round(d.g_reduction_um * 1e3) <= 0)) break;
     const auto* check = ::daq::find_check(verdict, d.key);
+    const std::string share = g > 0 ? fixed(100.0 * d.g_reduction_um / g, 0) : "&ndash;";
+    const auto advice = ::daq::diagnostic_advice(d.key);
+    const std::string check_text = advice.empty() ? std::string("see docs/circle.md") : esc(advice);
+    // Page one's rows: the error with what to check under it (a column of its own was squeezed
+    // to a word a line).
     std::vector<std::string> row{
-        std::to_string(i + 1), esc(d.name),
+        std::to_string(i + 1),
+        top ? "<strong>" + esc(d.name) + "</strong><br><span class=\"note\">" + check_text +
+                  "</span>"
+            : esc(d.name),
         "<span class=\"nw\">" + signed_text(d.value, 3) + " " + esc(unit_text(d.unit)) + "</span>",
-        signed_text(d.g_reduction_um, 3),
-        g > 0 ? fixed(100.0 * d.g_reduction_um / g, 0) : std::string("&ndash;")};
+        top ? fmt::format("<span class=\"nw\">{} µm ({} %)</span>",
+                          signed_text(d.g_reduction_um, 3), share)
+            : signed_text(d.g_reduction_um, 3)};
+    if (!top) row.push_back(share);
     if (!top) {
       row.push_back(um(d.pv_um));
       row.push_back(check ? fmt::format("≤ {:.3f}", check->limit) + " " + verdict_cell(check) : "");
     }
-    const auto advice = ::daq::diagnostic_advice(d.key);
-    row.push_back(advice.empty() ? std::string("see docs/circle.md") : esc(advice));
+    if (!top) row.push_back(check_text);
     diag.push_back(std::move(row));
   }
   if (diag.empty()) return "";
-  std::vector<std::string> head{"rank", "error", "value", "G gain (µm)", "gain / G (%)"};
+  std::vector<std::string> head{"rank", top ? "error, and what to check" : "error", "value"};
+  if (top) head.push_back("G gain (share of G)");
   if (!top) {
+    head.push_back("G gain (µm)");
+    head.push_back("gain / G (%)");
     head.push_back("PV (µm)");
     head.push_back("limit");
   }
-  head.push_back("what to check");
-  return table(head, diag, "num diag", top ? "rlrrrl" : "rlrrrrll");
+  if (!top) head.push_back("what to check");
+  return table(head, diag, "num diag", top ? "rlrr" : "rlrrrrll");
 }
 
 // What the ranking means, and a warning when no term would gain anything (the first gain is not
@@ -1200,20 +1215,22 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
                    check ? verdict_cell(check) : ""});
     if (x.key.starts_with("G")) headline.values.push_back({x.symbol, x.value, unit_text(x.unit)});
   }
-  iso.push_back({"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
-                 "least-squares centre relative to the pivot (set-up)", "", ""});
+  // The set-up's centre and the informative values follow under Details (page one holds the
+  // standard's values, what to fix first and the polar plot).
+  std::vector<std::vector<std::string>> other{
+      {"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
+       "least-squares centre relative to the pivot (set-up)"}};
   for (const auto& x : st.informative)
-    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
-                   "<em>informative</em>: " + esc(x.meaning), "", ""});
+    other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
+                     "<em>informative</em>: " + esc(x.meaning)});
   h += verdict_banner(verdict);
   h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
              "lrlrl");
   const auto first = diagnostics_table(r, verdict, 3);
   h += "<h4>What to fix first</h4>\n" +
        (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
-                      : first +
-                            "<p class=\"note\">The errors that would reduce G most if "
-                            "corrected alone, largest first (all of them under Details).</p>\n");
+                      : first + "<p class=\"note\">Largest gain in G first; every error under "
+                                "Details.</p>\n");
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
   polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
   h += figure(svg(polar),
@@ -1226,8 +1243,9 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
         {r.diagnostics[i].name, r.diagnostics[i].value, unit_text(r.diagnostics[i].unit)});
 
   std::string& d = out.details;
-  d = "<h3>Details of the results</h3>\n<h4>Diagnostics, ranked by what correcting each would "
-      "gain</h4>\n" +
+  d = "<h3>Details of the results</h3>\n" +
+      table({"symbol", "value (µm)", "meaning"}, other, "num results", "lrl") +
+      "<h4>Diagnostics, ranked by what correcting each would gain</h4>\n" +
       diagnostics_table(r, verdict, 0) + gain_notes(r);
   for (const auto& n : st.not_evaluated)
     d += "<p class=\"note\">Not evaluated: " + esc(n) + "</p>\n";
@@ -1353,6 +1371,8 @@ svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 @media print { body { margin: 0; max-width: none; font-size: 10pt; } h1 { font-size: 14pt; }
+  th, td { padding: .08rem .4rem; } h3 { margin: 1rem 0 .4rem; } h4 { margin: .6rem 0 .3rem; }
+  figure { margin: .4rem 0; } .verdict { margin: .4rem 0; } p { margin: .4rem 0; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
   svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; } }
 )";
@@ -1505,7 +1525,7 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
   const auto tests = ::daq::ballbar_tests(store, circles);
   const auto v = ::daq::volumetric_table(tests);
   const auto opt = [](const std::optional<double>& x) {
-    return x ? fmt::format("{:+.3f}", *x) : std::string("&ndash;");
+    return x ? signed_text(*x, 3) : std::string("&ndash;");
   };
   std::vector<std::vector<std::string>> rows;
   for (const auto& t : tests)
@@ -1533,7 +1553,7 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
                       : i == 1 ? "YZ"
                                : "ZX",
                       used, fmt::format("{:g}", v.used[i].feed_mm_per_min),
-                      fmt::format("{:+.3f}", pv->squareness_um_per_m),
+                      signed_text(pv->squareness_um_per_m, 3),
                       fmt::format("{} = {:+.3f}", cal::kinematics::location_error_name(mp),
                                   cal::circle::location_error_urad(*pv)),
                       fmt::format("{} {:+.3f}",
@@ -1861,7 +1881,7 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
     const auto* cb = ::daq::find_check(b.verdict, key);
     rows.push_back({esc(symbol), um(va) + " " + (ca ? verdict_cell(ca) : ""),
                     vb ? um(*vb) + " " + (cb ? verdict_cell(cb) : "") : "&ndash;",
-                    vb ? fmt::format("{:+.3f}", *vb - va) : "&ndash;", limit_cell(cb ? cb : ca)});
+                    vb ? signed_text(*vb - va, 3) : "&ndash;", limit_cell(cb ? cb : ca)});
   }
   const auto banner = [](const ::daq::Verdict& v) {
     return !v.configured ? std::string("<span class=\"unstated\">no tolerance configured</span>")
