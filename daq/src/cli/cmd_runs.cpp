@@ -214,7 +214,7 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
                 : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
         "");
     print_line("    {}", provenance_text(res["provenance"]));
-    if (!current) continue;  // the old values stay in --json
+    if (!current) continue;                 // the old values stay in --json
     print_result(res["result"], "      ");  // as daq run and daq analyse print it
     if (res.contains("verdict")) print_verdict(res["verdict"], "      ");
   }

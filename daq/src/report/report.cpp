@@ -567,8 +567,8 @@ std::string quality_banner(const st::Store& store, const RunView& v, bool page_o
   }
   if (q.state != "suspect")
     return q.state.empty() || page_one ? ""
-                           : fmt::format("<p class=\"note\">Run quality: {}</p>\n",
-                                         esc(::daq::quality_text(q)));
+                                       : fmt::format("<p class=\"note\">Run quality: {}</p>\n",
+                                                     esc(::daq::quality_text(q)));
   if (!page_one) return "";
   std::string stops;
   for (const auto& m : q.suspects)
@@ -752,7 +752,8 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
   for (const auto& x : a)
     for (const auto& y : b)
       if (y.key == x.key)
-        vals.push_back({esc(x.symbol), um(x.value), um(y.value), signed_text(y.value - x.value, 3)});
+        vals.push_back(
+            {esc(x.symbol), um(x.value), um(y.value), signed_text(y.value - x.value, 3)});
   h += fmt::format("<h4>Original (result {}) and re-compensated (result {}) values</h4>\n",
                    original->id, current->id) +
        table({"value", "original (µm)", "re-compensated (µm)", "change (µm)"}, vals, "num", "lrrr");
@@ -939,12 +940,12 @@ std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdic
       axis.push_back(
           {esc(r.symbol), um(r.value), esc(r.description), limit_cell(c), verdict_cell(c)});
     }
-    return table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, axis,
-                 "num results", "lrlrl");
+    return table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, axis, "num results",
+                 "lrlrl");
   }
-  return table({"value (µm)", "↑&nbsp;up", "↓&nbsp;down", "bidirectional", "limit&nbsp;(µm)",
-                "verdict"},
-               rows, "num results grid", "lrrrrl");
+  return table(
+      {"value (µm)", "↑&nbsp;up", "↓&nbsp;down", "bidirectional", "limit&nbsp;(µm)", "verdict"},
+      rows, "num results grid", "lrrrrl");
 }
 
 // A run's results in two parts: the answer (page one: verdict, main table, main plot) and the
@@ -1229,8 +1230,9 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
   const auto first = diagnostics_table(r, verdict, 3);
   h += "<h4>What to fix first</h4>\n" +
        (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
-                      : first + "<p class=\"note\">Largest gain in G first; every error under "
-                                "Details.</p>\n");
+                      : first +
+                            "<p class=\"note\">Largest gain in G first; every error under "
+                            "Details.</p>\n");
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
   polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
   h += figure(svg(polar),
@@ -1811,14 +1813,15 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     body += figure(svg(small), names[k] + (limits.count(k) ? " (dashed: the limit)" : ""));
   }
   body += "</div>\n";
-  body += u_max_um > 0
-              ? fmt::format(
-                    "<p class=\"note\">Each y axis spans at least {} µm, four times the largest "
-                    "expanded uncertainty U = {} µm of these runs (at least 1 of the value's unit): "
-                    "a change smaller than that is not drawn as a slope across the plot.</p>\n",
-                    fixed(std::max(4 * u_max_um, 1.0), 3), fixed(u_max_um, 3))
-              : "<p class=\"note\">Each y axis spans at least 1 of its value's unit (0.1 ms): a "
-                "smaller change is not drawn as a slope across the plot.</p>\n";
+  body +=
+      u_max_um > 0
+          ? fmt::format(
+                "<p class=\"note\">Each y axis spans at least {} µm, four times the largest "
+                "expanded uncertainty U = {} µm of these runs (at least 1 of the value's unit): "
+                "a change smaller than that is not drawn as a slope across the plot.</p>\n",
+                fixed(std::max(4 * u_max_um, 1.0), 3), fixed(u_max_um, 3))
+          : "<p class=\"note\">Each y axis spans at least 1 of its value's unit (0.1 ms): a "
+            "smaller change is not drawn as a slope across the plot.</p>\n";
   return page(fmt::format("Comparison: {} test of axis {}", first.run.kind, first.run.axis), body,
               o, who_of(first));
 }
@@ -1856,7 +1859,8 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
       sd.doc = ::daq::to_json(l.e);
-      for (const auto& r : ::daq::linear_rows(sd.doc)) sd.values.emplace_back(r.key, r.symbol, r.value);
+      for (const auto& r : ::daq::linear_rows(sd.doc))
+        sd.values.emplace_back(r.key, r.symbol, r.value);
     } else {
       const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");

@@ -80,14 +80,15 @@ void print_circle_doc(const json& doc, std::string_view in) {
         "pattern on\n{0}the traces) and PV / G (caldaq's own figure, can exceed 100 %; "
         "docs/circle.md):\n",
         in);
-    fmt::print("{}  {:<48} {:>9} {:<5} {:>10} {:>7} {:>10}\n", in, "", "value", "", "PV",
-               "PV / G", "G gain");
+    fmt::print("{}  {:<48} {:>9} {:<5} {:>10} {:>7} {:>10}\n", in, "", "value", "", "PV", "PV / G",
+               "G gain");
   }
   const json listed = doc.value("diagnostics", json::array());
   for (std::size_t i = 0; i < diagnostics.size() && i < listed.size(); ++i) {
     const auto& r = diagnostics[i];
     fmt::print("{}  {:<48} {:>9} {:<5} {:>7} um {:>5} % {:>7} um\n", in, safe(r.symbol),
-               signed_number_text(r.value), safe(r.unit), number_text(number_of(listed[i], "pv_um")),
+               signed_number_text(r.value), safe(r.unit),
+               number_text(number_of(listed[i], "pv_um")),
                number_text(number_of(listed[i], "share_pct"), 1),
                number_text(number_of(listed[i], "g_reduction_um")));
   }
@@ -123,8 +124,9 @@ std::string unit_html(std::string_view unit) {
 }
 
 std::size_t linear_order(std::string_view key) {
-  static constexpr std::string_view order[] = {"E_up", "E_down", "E_bi", "R_up", "R_down", "R_bi",
-                                               "A_up", "A_down", "A_bi", "M",    "B",      "B_mean"};
+  static constexpr std::string_view order[] = {"E_up",   "E_down", "E_bi", "R_up",
+                                               "R_down", "R_bi",   "A_up", "A_down",
+                                               "A_bi",   "M",      "B",    "B_mean"};
   const auto* at = std::find(std::begin(order), std::end(order), key);
   return static_cast<std::size_t>(at - std::begin(order));
 }
@@ -141,8 +143,8 @@ std::vector<ResultRow> linear_rows(const json& doc) {
     // A named copy: items() of a temporary dangles in the range-for.
     const json axis = doc.value("axis", json::object());
     for (const auto& [key, a] : axis.items())
-      rows.push_back({key, a.value("symbol", key), text_of(a, "description"),
-                      number_of(a, "value_um"), "um"});
+      rows.push_back(
+          {key, a.value("symbol", key), text_of(a, "description"), number_of(a, "value_um"), "um"});
   }
   std::stable_sort(rows.begin(), rows.end(), [](const ResultRow& a, const ResultRow& b) {
     return linear_order(a.key) < linear_order(b.key);

@@ -58,10 +58,10 @@ Verdict linear_verdict(const json& tolerances, const json& result) {
     const char* bi_key;
     const char* uni_key;
     bool vdi;
-  } map[] = {{"E_um", "E", "E_bi", "E_up", false},      {"R_um", "R", "R_bi", "R_up", false},
-             {"B_um", "B", "B", nullptr, false},        {"A_um", "A", "A_bi", "A_up", false},
-             {"M_um", "M", "M", nullptr, false},        {"P_um", "P", "P", nullptr, true},
-             {"Pa_um", "Pa", "Pa", nullptr, true},      {"Ps_um", "Ps max", "Ps_max", nullptr, true},
+  } map[] = {{"E_um", "E", "E_bi", "E_up", false},     {"R_um", "R", "R_bi", "R_up", false},
+             {"B_um", "B", "B", nullptr, false},       {"A_um", "A", "A_bi", "A_up", false},
+             {"M_um", "M", "M", nullptr, false},       {"P_um", "P", "P", nullptr, true},
+             {"Pa_um", "Pa", "Pa", nullptr, true},     {"Ps_um", "Ps max", "Ps_max", nullptr, true},
              {"U_um", "U max", "U_max", nullptr, true}};
   std::vector<std::string> other;  // limits of the other family
   for (const auto& m : map) {
@@ -78,8 +78,8 @@ Verdict linear_verdict(const json& tolerances, const json& result) {
       continue;
     }
     const double value = axis[key].value("value_um", 0.0), lim = limits[m.limit].get<double>();
-    v.checks.push_back(
-        {key, axis[key].value("symbol", std::string(m.name)), value, lim, "um", within(value, lim)});
+    v.checks.push_back({key, axis[key].value("symbol", std::string(m.name)), value, lim, "um",
+                        within(value, lim)});
   }
   // Limits only of the other family: none applies, and the note says which keys would.
   if (v.checks.empty() && !other.empty())
@@ -178,12 +178,13 @@ void print_verdict(const json& v, std::string_view in) {
     for (const auto& c : v.value("checks", json::array())) {
       const std::string unit = safe(c, "unit");
       fmt::print("{}  {:<28} {:>10} {:<5} limit {:>8} {:<5} {}\n", in, safe(c, "symbol"),
-                 number_text(c.value("value", 0.0)), unit, number_text(c.value("limit", 0.0)),
-                 unit, c.value("pass", false) ? "pass" : "FAIL");
+                 number_text(c.value("value", 0.0)), unit, number_text(c.value("limit", 0.0)), unit,
+                 c.value("pass", false) ? "pass" : "FAIL");
     }
   }
   for (const auto& n : notes)
-    if (n.is_string()) fmt::print("{}  note: {}\n", in, cal::text::terminal_safe(n.get<std::string>()));
+    if (n.is_string())
+      fmt::print("{}  note: {}\n", in, cal::text::terminal_safe(n.get<std::string>()));
 }
 
 const Check* find_check(const Verdict& v, const std::string& key) {

@@ -18,7 +18,8 @@ using cal::daq::report::XyChart;
 
 // The y coordinates (SVG units) of the polylines drawn in a colour.
 std::vector<double> ys_of(const std::string& svg, const std::string& stroke) {
-  static const std::regex element(R"re(<polyline[^>]*stroke="(#[0-9A-Fa-f]{6})"[^>]*points="([^"]*)")re");
+  static const std::regex element(
+      R"re(<polyline[^>]*stroke="(#[0-9A-Fa-f]{6})"[^>]*points="([^"]*)")re");
   std::vector<double> out;
   for (std::sregex_iterator it(svg.begin(), svg.end(), element), end; it != end; ++it) {
     if ((*it)[1].str() != stroke) continue;

@@ -1,6 +1,8 @@
 // One presentation of each result (daq/src/results/result_rows.hpp, issue 30): numbers that
 // never read "-0.000" on the terminal, ISO 230-2 values in the report grid's order, and the
 // verdict of a VDI/DGQ 3441 evaluation against its own configured limits.
+#include "result_rows.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "circle_output.hpp"
 #include "iso230_2_output.hpp"
-#include "result_rows.hpp"
 #include "verdict.hpp"
 
 namespace {
@@ -66,8 +67,7 @@ std::vector<iso::Measurement> bidirectional_data() {
 }
 
 TEST(ResultRows, LinearValuesInTheGridsOrder) {
-  const auto doc =
-      daq::to_json(iso::evaluate(bidirectional_data(), iso::Standard::iso230_2_2014));
+  const auto doc = daq::to_json(iso::evaluate(bidirectional_data(), iso::Standard::iso230_2_2014));
   std::vector<std::string> keys;
   for (const auto& r : daq::linear_rows(doc)) keys.push_back(r.key);
   const std::vector<std::string> grid{"E_up", "E_down", "E_bi", "R_up", "R_down", "R_bi",
