@@ -60,8 +60,11 @@ else:
     daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq")
     capture = os.path.join(work, "demo.cdq")
 db = ["--db", "demo.sqlite"]
-daq("replay", capture, *db)  # run 3: the linear run again (comparison, as found / as left)
+replay_out = daq("replay", capture, *db)  # run 3: the linear run again (comparison, as found...)
 daq("replay", capture, *db)  # run 4: made suspect below
+# Run 3 re-compensated with the coefficient it was acquired with: its terminal summary is one of
+# the outputs compared below (its values are run 1's, within what a re-compensation moves).
+recompensate_out = daq("recompensate", "3", "--alpha-ppm", "11.5", *db)
 # Run 4 made suspect: one stop 5 um off (the others repeat to about 0.01 um), and its stored
 # quality cleared so it is assessed from the stops when read.
 con = sqlite3.connect("demo.sqlite")
@@ -70,6 +73,67 @@ con.execute("UPDATE captured_targets SET deviation_um = deviation_um + 5 WHERE r
 con.execute("UPDATE runs SET quality = NULL, quality_note = '' WHERE id = 4")
 con.commit()
 con.close()
+
+# --- one presentation of each result (same values, order, names, units, rounding) ------------
+ROW = re.compile(r"^\s*(\S+(?: \S+)?)\s+(-?\d+\.\d{3})(?:, -?\d+\.\d{3})? um\s{3}(.*)$")
+
+
+def value_rows(out, first_title):
+    """The (symbol, value as printed) rows of the result block that begins with first_title."""
+    lines = out.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.strip().startswith(first_title))
+    rows = []
+    for line in lines[start + 1:]:
+        m = ROW.match(line)
+        if m:
+            rows.append((m.group(1), m.group(2)))
+        elif rows and not line.strip().startswith(("note", "warning", "not evaluated")):
+            break
+    return rows
+
+
+def printed(v):
+    """A JSON number as every output prints it: 3 decimals, never -0.000."""
+    t = f"{v:.3f}"
+    return "0.000" if t == "-0.000" else t
+
+
+def current(doc):
+    return next(r for r in doc["results"] if r["current"])
+
+
+import json  # noqa: E402
+
+lin_title = "ISO 230-2:2014 ("
+outputs = {
+    "daq replay (run 3)": value_rows(replay_out, lin_title),
+    "daq show 1": value_rows(daq("show", "1", *db), lin_title),
+    "daq analyse 1": value_rows(daq("analyse", "1", *db), lin_title),
+}
+show1 = json.loads(daq("show", "1", *db, "--json"))
+outputs["daq show 1 --json (values)"] = [(r["symbol"], printed(r["value"]))
+                                         for r in current(show1)["result"]["values"]]
+check("linear: the values in the grid's order (E↑ E↓ E R↑ ...)",
+      [s for s, _ in outputs["daq show 1"]][:6] == ["E↑", "E↓", "E", "R↑", "R↓", "R"],
+      str(outputs["daq show 1"]))
+for name, rows in outputs.items():
+    check(f"linear: {name} reads as daq show 1", rows == outputs["daq show 1"] and len(rows) >= 12,
+          f"{rows} != {outputs['daq show 1']}")
+check("daq recompensate 3 reads as daq show 3",
+      value_rows(recompensate_out, lin_title) == value_rows(daq("show", "3", *db), lin_title)
+      and len(value_rows(recompensate_out, lin_title)) >= 12, recompensate_out)
+circle_title = "ISO 230-4:2005 circular test"
+show2_text = daq("show", "2", *db)
+show2 = json.loads(daq("show", "2", *db, "--json"))
+circle_values = [(r["symbol"], printed(r["value"])) for r in current(show2)["result"]["values"]
+                 if r["unit"] == "um" and r["key"].endswith("_um")]
+check("circle: daq show 2 and daq analyse 2 print one block",
+      value_rows(show2_text, circle_title) == value_rows(daq("analyse", "2", *db), circle_title)
+      and len(value_rows(show2_text, circle_title)) >= 4, show2_text)
+check("circle: daq show 2 reads as its JSON values",
+      value_rows(show2_text, circle_title)[:len(circle_values)] == circle_values,
+      f"{value_rows(show2_text, circle_title)} / {circle_values}")
+check("no -0.000 on the terminal", "-0.000" not in show2_text + replay_out, show2_text)
 
 reports = {
     "linear": ["1"],
@@ -85,6 +149,30 @@ for name, args in reports.items():
     daq("report", *args, *db, "--format", "pdf", "-o", f"{name}.pdf")
     daq("report", *args, *db, "-o", f"{name}.html")
     text[name] = [squash(p) for p in pages(f"{name}.pdf")]
+
+# The report's tables hold the same numbers in the same order.
+def cells(html, cls):
+    """The text of each cell of the first table of this class, row by row."""
+    t = re.search(r'<table class="' + cls + r'">.*?</table>', html, re.S).group(0)
+    return [[html_mod.unescape(re.sub(r"<[^>]+>", "", c)).strip()
+             for c in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)]
+            for row in re.findall(r"<tr>(.*?)</tr>", t.split("<tbody>")[1], re.S)]
+
+
+grid = cells(open("linear.html", encoding="utf-8").read(), "num results grid")
+grid_values = [c for row in grid for c in row[1:4] if re.fullmatch(r"-?\d+\.\d{3}", c)]
+check("linear report: the grid reads as daq show 1, row by row",
+      grid_values == [v for _, v in outputs["daq show 1"]], f"{grid_values}")
+circle_html = open("circle.html", encoding="utf-8").read()
+circle_table = cells(circle_html, "num results")
+check("circle report: the standard's values as daq show 2",
+      [(r[0], r[1]) for r in circle_table[:len(circle_values)]] == circle_values,
+      f"{circle_table}")
+diag_json = [(r["symbol"], r["value"], r["unit"]) for r in current(show2)["result"]["values"]
+             if not r["key"].endswith("_um")]
+diag_report = [row[1] for row in cells(circle_html.split("Details of the results")[1], "num diag")]
+check("circle report: the diagnostics in the order of the JSON",
+      diag_report == [d[0] for d in diag_json], f"{diag_report} / {diag_json}")
 
 # --- page one of a run report ---------------------------------------------------------------
 for name in ("linear", "vdi3441", "suspect", "circle"):
@@ -106,11 +194,19 @@ for name in ("linear", "suspect"):
           and "E — systematic positional deviation" in p1 and "B̄ — mean reversal value" in p1, p1)
     check(f"{name}: failing values named on page one",
           re.search(r"FAIL.*limit ≤ [0-9.]+ µm\)", p1) is not None, p1)
-# The VDI 3441 main table is on page one (without limit and verdict columns: its configured
-# limits are not applied yet, "No tolerance": issue 30, left open).
-check("vdi3441: main table on page one",
-      re.search(r"symbol value \(µm\) meaning P [0-9.]+ position uncertainty", text["vdi3441"][0])
-      is not None, text["vdi3441"][0])
+    # The main plot on page one too (it was on page two).
+    check(f"{name}: main plot on page one", "Mean positional deviation with ±2s" in p1, p1)
+# The VDI 3441 main table is on page one, judged by its configured limits (the demo's P_um...;
+# the report said "No tolerance applies").
+v1 = text["vdi3441"][0]
+check("vdi3441: main table with limits on page one",
+      re.search(r"symbol value \(µm\) meaning limit \(µm\) verdict P [0-9.]+ position uncertainty "
+                r"≤ 15\.000 (pass|FAIL)", v1) is not None, v1)
+check("vdi3441: a verdict, not 'No tolerance'", "Verdict against the machine specification" in v1
+      and "No tolerance" not in v1, v1)
+check("vdi3441: main plot on page one", "Mean positional deviation with ±2s" in v1, v1)
+check("run quality says its state once",
+      all("ok — ok" not in p and "ok - ok" not in p for n in text for p in text[n]), "")
 check("suspect: SUSPECT RUN on page one with its stop",
       "SUSPECT RUN" in text["suspect"][0] and "run 2 ↑ target 4" in text["suspect"][0],
       text["suspect"][0])
@@ -118,10 +214,9 @@ check("linear (clean): no SUSPECT", all("SUSPECT RUN" not in p for p in text["li
 c1 = text["circle"][0]
 check("circle: main table on page one", "symbol value (µm) meaning limit (µm) verdict" in c1
       and re.search(r"G\(b\) [0-9.]+", c1) is not None, c1)
-# Not yet on page one (issue 30, left open): "What to fix first" lands on page two; the
-# failing value's advice is on page one (the next check).
-check("circle: what to fix first in the report", any("What to fix first" in p for p in text["circle"]),
-      c1)
+check("circle: what to fix first on page one", "What to fix first" in c1
+      and re.search(r"rank error, and what to check value G gain \(share of G\) 1 \w", c1)
+      is not None, c1)
 check("circle: failing value named on page one",
       re.search(r"FAIL.*= [+-]?[0-9.]+ µm \(limit ≤", c1) is not None, c1)
 check("no -0.000 anywhere", all("-0.000" not in p for n in text for p in text[n]), "")
@@ -162,6 +257,28 @@ check("comparison: the table on page one", re.search(r"run date E \(µm\) R \(µ
 a1 = text["asfound"][0]
 check("as found / as left: table and verdicts on page one",
       "as found, run 1" in a1 and "as left, run 3" in a1 and "verdict" in a1, a1)
+
+comparison_html = open("comparison.html", encoding="utf-8").read()
+check("comparison: the trends' minimum span is stated", "Each y axis spans at least" in
+      comparison_html, "")
+# The small multiples' labels under x (the runs) do not overlap: centred texts other than the
+# title and the markers, at least half a character height per character apart from centre to
+# centre on each side.
+multiples = comparison_html[comparison_html.index('<div class="multiples">'):]
+for m in re.finditer(r'<svg[^>]*aria-label="([^"]*)"(.*?)</svg>', multiples, re.S):
+    title, body = html_mod.unescape(m.group(1)), m.group(2)
+    labels = []
+    for t in re.finditer(r'<text([^>]*)>(.*?)</text>', body, re.S):
+        words = html_mod.unescape(re.sub(r"<[^>]+>", "", t.group(2))).strip()
+        if 'text-anchor="middle"' not in t.group(1) or words in ("•", "", title):
+            continue
+        x = float(re.search(r"matrix\(([^)]*)\)", t.group(1)).group(1).split()[4])
+        labels.append((x, float(re.search(r'font-size="([0-9.]+)"', t.group(1)).group(1)), words))
+    labels.sort()
+    overlap = [(a[2], b[2]) for a, b in zip(labels, labels[1:])
+               if b[0] - a[0] < 0.25 * a[1] * len(a[2]) + 0.25 * b[1] * len(b[2])]
+    check(f"comparison: '{title}' labels apart", len(labels) >= 2 and not overlap,
+          f"{labels} overlap: {overlap}")
 
 # --- plots: text of at least 9 pt as printed --------------------------------------------------
 # Printed widths (pt): A4 less the 14 mm margins is 516 pt; a polar plot 72 % of it, a small

@@ -109,8 +109,10 @@ check verdict_linear_B 0 ">$B</td><td class=\"r\">≤ 3.000</td><td><span class=
 check verdict_linear_E 0 "≤ 10.000</td><td><span class=\"pass\">pass</span>" -- cat r1.html
 check verdict_circle 0 "<strong>FAIL</strong> &mdash; 1 of 3 limited values outside" -- cat r2.html
 check verdict_circle_G 0 "≤ 10.000</td><td><span class=\"pass\">pass" -- cat r2.html
-check verdict_none_vdi 0 "No tolerance applies" -- cat vdi.html
-check grid 0 "<th>↑ up</th><th>↓ down</th><th>bidirectional</th>" -- cat r1.html
+# VDI/DGQ 3441 judged by its own limits (the demo's P_um, Pa_um, Ps_um, U_um), not "No tolerance".
+check verdict_vdi 0 "<td>P</td><td class=\"r\">[0-9.]+</td><td>position uncertainty</td><td class=\"r\">≤ 15.000</td>" -- cat vdi.html
+check verdict_vdi_not_none 0 "^judged$" -- bash -c 'grep -q "No tolerance" vdi.html || echo judged'
+check grid 0 "<th>↑&nbsp;up</th><th>↓&nbsp;down</th><th>bidirectional</th>" -- cat r1.html
 check two_s_lines 0 "^x̄↑ ± 2s$" -- svgtext r1.html
 G2=$("$PY" -c "import json; print(format(json.load(open('circ.json'))['iso230_4']['G_bi_um'], '.2f'))")
 check circle_g_on_plot 0 "^G = $G2 µm$" -- svgtext r2.html
@@ -177,7 +179,7 @@ check recomp_of 0 "<td>Re-compensation of</td><td>result 1</td>" -- cat r1b.html
 check compare_recompensated 0 "<td class=\"r\">1 <span class=\"changed\">re-compensated</span>" -- cat cmp2.html
 check show_superseded 0 "result 1: ISO 230-2:2014 \(superseded by result [0-9]+\)" -- "$DAQ" show 1 --db demo.sqlite
 check show_current 0 "recompensated .* of result 1; ciddor, 12 ppm/K; expansion_ppm_per_k 11.5 -> 12" -- "$DAQ" show 1 --db demo.sqlite
-check show_values 0 "^      E +[0-9]+\.[0-9]{3} um" -- "$DAQ" show 1 --db demo.sqlite
+check show_values 0 "^        E +[0-9]+\.[0-9]{3} um" -- "$DAQ" show 1 --db demo.sqlite
 # A second correction keeps the first: the offset is added, 12 ppm/K stays.
 check recomp_keeps 0 "material_offset_k: 0(\.0)? -> 0\.1" -- "$DAQ" recompensate 1 --material-offset 0.1 --db demo.sqlite
 check recomp_keeps_alpha 0 "ciddor, 12 ppm/K; offsets material \+0.1 K" -- "$DAQ" show 1 --db demo.sqlite

@@ -26,6 +26,7 @@
 #include "json_input.hpp"
 #include "provenance.hpp"
 #include "reading_times.hpp"
+#include "result_rows.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
 #include "terminal.hpp"
@@ -125,31 +126,6 @@ std::string provenance_text(const json& p) {
   for (const auto& c : p.value("changed", json::array()))
     s += fmt::format("; {} {} -> {}", c.value("name", "?"), c["from"].dump(), c["to"].dump());
   return s;
-}
-
-// The values of a result document, as `daq analyse` prints their headline.
-void print_result_values(const json& doc) {
-  if (doc.value("schema", "") == "caldaq.iso230-2.v1") {
-    print_line("      {} targets, {}", doc.value("targets", json::array()).size(), runs_text(doc));
-    const json axis = doc.value("axis", json::object());
-    for (const auto& [key, a] : axis.items())
-      print_line("      {:<8} {:>10.3f} um   {}", a.value("symbol", key), a.value("value_um", 0.0),
-                 a.value("description", ""));
-  } else if (is_circle_schema(doc.value("schema", ""))) {
-    // The values of the result's standard, as stored (v1: ISO 230-4:2005 with H among them).
-    // A named copy: items() of the temporary `doc.value(...)` dangles in the range-for (C++20
-    // extends the lifetime of the range's outermost temporary only).
-    const json values = doc.value("iso230_4", json::object());
-    std::string line;
-    for (const auto& [key, value] : values.items())
-      if (value.is_number())
-        line += fmt::format("{}{} {:.3f} um", line.empty() ? "" : ", ",
-                            key.substr(0, key.size() - 3), value.get<double>());
-    print_line("      {}: {}", doc.value("standard", std::string("ISO 230-4")), line);
-    for (const auto& d : doc.value("diagnostics", json::array()))
-      print_line("      {:<40} {:+9.3f} {:<5} PV {:.3f} um", d.value("name", ""),
-                 d.value("value", 0.0), d.value("unit", ""), d.value("pv_um", 0.0));
-  }
 }
 
 }  // namespace
@@ -257,19 +233,9 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
                 : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
         "");
     print_line("    {}", provenance_text(res["provenance"]));
-    if (!current) continue;  // the old values stay in --json
-    print_result_values(res["result"]);
-    if (res.contains("verdict")) {
-      const auto& v = res["verdict"];
-      print_line("      verdict: {}{}", v.value("summary", ""),
-                 v.value("basis", "").empty() ? "" : " (" + v.value("basis", "") + ")");
-      for (const auto& c : v.value("checks", json::array()))
-        print_line("        {:<26} {:>10.3f} limit {:>8.3f} {:<5} {}", c.value("symbol", ""),
-                   c.value("value", 0.0), c.value("limit", 0.0), c.value("unit", ""),
-                   c.value("pass", false) ? "pass" : "FAIL");
-      for (const auto& n : v.value("notes", json::array()))
-        print_line("        note: {}", n.get<std::string>());
-    }
+    if (!current) continue;                 // the old values stay in --json
+    print_result(res["result"], "      ");  // as daq run and daq analyse print it
+    if (res.contains("verdict")) print_verdict(res["verdict"], "      ");
   }
 }
 

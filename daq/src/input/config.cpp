@@ -157,11 +157,7 @@ std::optional<double> limit(Table& t, std::string_view key) {
 
 PositioningLimits read_limits(Table& t) {
   PositioningLimits l;
-  l.E_um = limit(t, "E_um");
-  l.R_um = limit(t, "R_um");
-  l.B_um = limit(t, "B_um");
-  l.A_um = limit(t, "A_um");
-  l.M_um = limit(t, "M_um");
+  for (const auto& k : cal::daq::positioning_limit_keys) l.*k.member = limit(t, k.key);
   return l;
 }
 

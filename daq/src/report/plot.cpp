@@ -233,15 +233,20 @@ std::string svg(const XyChart& chart) {
   // The legend goes below the plot, in as many columns of the longest label as fit the width:
   // to the right it took a quarter of the width and clipped long instrument names. The page
   // grows by its rows, so the plot keeps its height.
+  // Lengths in characters, not bytes: "x̄↑ ± 2s" is 7 characters in 12 bytes of UTF-8.
+  const auto characters = [](const std::string& s) {
+    return static_cast<std::size_t>(
+        std::count_if(s.begin(), s.end(), [](char c) { return (c & 0xC0) != 0x80; }));
+  };
   std::size_t labelled = 0, longest = 0;
   for (const auto& l : chart.lines)
-    if (!l.label.empty()) ++labelled, longest = std::max(longest, l.label.size());
+    if (!l.label.empty()) ++labelled, longest = std::max(longest, characters(l.label));
   for (const auto& b : chart.bands)
-    if (!b.label.empty()) ++labelled, longest = std::max(longest, b.label.size());
+    if (!b.label.empty()) ++labelled, longest = std::max(longest, characters(b.label));
   const double char_pt = 13.0 * chart.text_scale;
   const auto columns = static_cast<PLINT>(
       legend ? std::clamp<std::size_t>(static_cast<std::size_t>(chart.width_pt / (char_pt * 0.62) /
-                                                                static_cast<double>(longest + 8)),
+                                                                static_cast<double>(longest + 6)),
                                        1, std::min<std::size_t>(labelled, 4))
              : 0);
   const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
@@ -254,7 +259,11 @@ std::string svg(const XyChart& chart) {
                    : !chart.x_labels.empty()
                        ? Range{-0.5, static_cast<double>(chart.x_labels.size()) - 0.5}
                        : x.padded(0.04);
-  const Range yr = y.padded(0.08);
+  Range yr = y.padded(0.08);
+  if (chart.min_y_span > 0 && !y.empty() && yr.hi - yr.lo < chart.min_y_span) {
+    const double mid = (y.lo + y.hi) / 2;  // the data in the middle of the span asked for
+    yr = {mid - chart.min_y_span / 2, mid + chart.min_y_span / 2};
+  }
   const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
   const auto [ystep, ydigits] = ticks_for(yr.hi - yr.lo, 6);
   // Room on the left for the widest tick label and the axis label beyond it ("1006.8" needs
@@ -270,7 +279,18 @@ std::string svg(const XyChart& chart) {
   const bool categories = !chart.x_labels.empty();
   if (categories)
     plslabelfunc(category_label, const_cast<std::vector<std::string>*>(&chart.x_labels));
-  const double xtick = categories ? 1.0 : xstep;
+  // A category label every k-th category where they would overlap (their width estimated as
+  // the existing legend's: 0.62 of a character's height per character).
+  double category_step = 1.0;
+  if (categories) {
+    std::size_t widest = 0;
+    for (const auto& l : chart.x_labels) widest = std::max(widest, plot_text(l).size());
+    const double label_pt = 0.62 * char_pt * static_cast<double>(widest) + 0.5 * char_pt;
+    const double each_pt =
+        (0.97 - left) * chart.width_pt / static_cast<double>(chart.x_labels.size());
+    category_step = std::max(1.0, std::ceil(label_pt / each_pt));
+  }
+  const double xtick = categories ? category_step : xstep;
   const PLINT nxsub = categories ? 1 : 0;
   plcol0(grid_colour);
   plwidth(0.5);

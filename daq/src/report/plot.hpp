@@ -47,6 +47,9 @@ struct XyChart {
   // x_labels[k] (e.g. the dates of runs).
   std::vector<std::string> x_labels;
   bool legend = true;       // false: no legend even for labelled lines (small multiples)
+  // The y axis spans at least this much (0: as the data need): a trend of values that differ by
+  // 0.0001 um is drawn flat, not as a cliff across the whole plot.
+  double min_y_span = 0.0;
   double text_scale = 1.0;  // > 1 for a small plot shown small (its text stays readable)
 };
 

@@ -25,6 +25,7 @@
 #include "markup.hpp"
 #include "plot.hpp"
 #include "provenance.hpp"
+#include "result_rows.hpp"
 #include "run_quality.hpp"
 #include "verdict.hpp"
 
@@ -40,22 +41,11 @@ using Q = cal::drivers::Quantity;
 // Every value from outside that goes into the HTML goes through this (markup.hpp).
 std::string esc(std::string_view s) { return html_text(s); }
 
-// A value to `decimals` places that never reads "-0.000": a value that rounds to zero is 0.
-std::string fixed(double v, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  if (std::round(std::abs(v) * scale) == 0) v = 0.0;
-  return fmt::format("{:.{}f}", v, decimals);
-}
-std::string signed_text(double v, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  if (std::round(std::abs(v) * scale) == 0) return fmt::format("{:.{}f}", 0.0, decimals);
-  return fmt::format("{:+.{}f}", v, decimals);
-}
+// Numbers and units as every output prints them (result_rows.hpp): never "-0.000".
+std::string fixed(double v, int decimals) { return ::daq::number_text(v, decimals); }
+std::string signed_text(double v, int decimals) { return ::daq::signed_number_text(v, decimals); }
 std::string um(double v) { return fixed(v, 3); }
-// A result's unit as printed: "um" is µm.
-std::string unit_text(std::string_view u) {
-  return u == "um" ? std::string("µm") : u == "um/m" ? std::string("µm/m") : std::string(u);
-}
+std::string unit_text(std::string_view u) { return ::daq::unit_html(u); }
 
 std::string iso_time(std::int64_t unix_ms) {
   const std::time_t s = unix_ms / 1000;
@@ -581,18 +571,21 @@ std::string traceability_warnings(const RunView& v) {
 
 // The quality of the run's stops (run_quality.hpp, docs/iso230-2.md "Suspect stops"): a suspect
 // run says so on page one, with its stops named.
-std::string quality_banner(const st::Store& store, const RunView& v) {
+// `page_one`: the suspect box (or a failed check) for page one; otherwise the quality of a run
+// that is not suspect, for the details (page one keeps its room for the answer).
+std::string quality_banner(const st::Store& store, const RunView& v, bool page_one) {
   if (v.run.kind == "circle" || v.run.kind == "dynamic") return "";
   cal::storage::RunQuality q;
   try {
     q = ::daq::run_quality(store, v.run.id);
   } catch (const std::exception& e) {
-    return "<p class=\"warning\">Run quality: " + esc(e.what()) + "</p>\n";
+    return page_one ? "<p class=\"warning\">Run quality: " + esc(e.what()) + "</p>\n" : "";
   }
   if (q.state != "suspect")
-    return q.state.empty() ? ""
-                           : fmt::format("<p class=\"note\">Run quality: {}{}</p>\n", esc(q.state),
-                                         q.summary.empty() ? "" : " &mdash; " + esc(q.summary));
+    return q.state.empty() || page_one ? ""
+                                       : fmt::format("<p class=\"note\">Run quality: {}</p>\n",
+                                                     esc(::daq::quality_text(q)));
+  if (!page_one) return "";
   std::string stops;
   for (const auto& m : q.suspects)
     stops += fmt::format("<li>run {} {} target {}: {}</li>", m.run_number,
@@ -768,28 +761,19 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
     }
   }
   if (!original || original->id == current->id) return h;
-  const json a = json::parse(original->json, nullptr, false).value("axis", json::object());
-  const json b = json::parse(current->json, nullptr, false).value("axis", json::object());
+  // In the order of every output (result_rows.hpp), not the stored object's (by key).
+  const auto a = ::daq::linear_rows(json::parse(original->json, nullptr, false));
+  const auto b = ::daq::linear_rows(json::parse(current->json, nullptr, false));
   std::vector<std::vector<std::string>> vals;
-  for (const auto& [key, x] : a.items()) {
-    if (!b.contains(key)) continue;
-    const double before = x.value("value_um", 0.0), after = b[key].value("value_um", 0.0);
-    vals.push_back({esc(x.value("symbol", key)), um(before), um(after),
-                    fmt::format("{:+.3f}", after - before)});
-  }
+  for (const auto& x : a)
+    for (const auto& y : b)
+      if (y.key == x.key)
+        vals.push_back(
+            {esc(x.symbol), um(x.value), um(y.value), signed_text(y.value - x.value, 3)});
   h += fmt::format("<h4>Original (result {}) and re-compensated (result {}) values</h4>\n",
                    original->id, current->id) +
        table({"value", "original (µm)", "re-compensated (µm)", "change (µm)"}, vals, "num", "lrrr");
   return h;
-}
-
-// The order of the ISO 230-2 values on every page: as the results grid reads (E, R, A each up,
-// down, bidirectional; M, B, B̄), then any other value in its evaluation's order.
-std::size_t iso_order(std::string_view key) {
-  static constexpr std::string_view order[] = {"E_bi", "E_up", "E_down", "R_bi", "R_up", "R_down",
-                                               "A_bi", "A_up", "A_down", "M",    "B",    "B_mean"};
-  const auto* at = std::find(std::begin(order), std::end(order), key);
-  return static_cast<std::size_t>(at - std::begin(order));
 }
 
 // Headline numbers of a run, for the campaign summary and the comparison trends.
@@ -873,7 +857,7 @@ std::string means_plot(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
-                .height_pt = 230,
+                .height_pt = 170,  // page one holds it below the verdict and the grid
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
   means.bands.push_back(
@@ -965,16 +949,19 @@ std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdic
     rows.push_back({g.name, cell(g.up), cell(g.down), cell(g.bi), limit_cell(c), verdict_cell(c)});
     ++shown;
   }
-  if (shown == 0) {  // another standard's values
+  if (shown == 0) {  // another standard's values (VDI/DGQ 3441), with the limits it takes
     std::vector<std::vector<std::string>> axis;
-    for (const auto& a : e.axis)
-      axis.push_back({esc(a.symbol), um(a.value_um), esc(a.description)});
-    return table({"symbol", "value (µm)", "meaning"}, axis, "num results", "lrl");
+    for (const auto& r : ::daq::linear_rows(::daq::to_json(e))) {
+      const ::daq::Check* c = ::daq::find_check(verdict, r.key);
+      axis.push_back(
+          {esc(r.symbol), um(r.value), esc(r.description), limit_cell(c), verdict_cell(c)});
+    }
+    return table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, axis, "num results",
+                 "lrlrl");
   }
-  return table({"value (µm)", "↑ up", "↓ down", "bidirectional", "limit (µm)", "verdict"}, rows,
-               "num results grid", "lrrrrl") +
-         "<p class=\"note\">Unidirectional values (↑, ↓) from the approaches in one direction; "
-         "the limits apply to the bidirectional values (ISO 230-2).</p>\n";
+  return table(
+      {"value (µm)", "↑&nbsp;up", "↓&nbsp;down", "bidirectional", "limit&nbsp;(µm)", "verdict"},
+      rows, "num results grid", "lrrrrl");
 }
 
 // A run's results in two parts: the answer (page one: verdict, main table, main plot) and the
@@ -997,19 +984,26 @@ Sections linear_section(const st::Store& store, const RunView& v, const Options&
       esc(::daq::runs_text(e)), e.bidirectional ? "bidirectional" : "unidirectional");
   // The headline (campaign summary): the bidirectional values a specification limits, or
   // every value of a standard without them (VDI/DGQ 3441).
-  for (const char* key : {"E_bi", "R_bi", "A_bi", "M", "B", "B_mean"})
-    for (const auto& a : e.axis)
-      if (a.key == key) headline.values.push_back({a.symbol, a.value_um, "µm"});
-  if (headline.values.empty())
-    for (const auto& a : e.axis) headline.values.push_back({a.symbol, a.value_um, "µm"});
   const auto doc = ::daq::to_json(e);
+  const auto values = ::daq::linear_rows(doc);
+  for (const auto& r : values)
+    if (r.key == "E_bi" || r.key == "R_bi" || r.key == "A_bi" || r.key == "M" || r.key == "B" ||
+        r.key == "B_mean")
+      headline.values.push_back({r.symbol, r.value, unit_text(r.unit)});
+  if (headline.values.empty())
+    for (const auto& r : values) headline.values.push_back({r.symbol, r.value, unit_text(r.unit)});
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
   h += verdict_banner(verdict);
   h += results_grid(e, verdict);
   h += means_plot(l);
   std::string& d = out.details;
-  d = "<h3>Details of the results</h3>\n" + runs_plot(l);
+  d = "<h3>Details of the results</h3>\n";
+  if (e.axis.size() && e.axis.front().key.find('_') != std::string::npos)  // up, down, bi
+    d += "<p class=\"note\">Unidirectional values (↑, ↓) of the grid on page one come from the "
+         "approaches in one direction; the limits apply to the bidirectional values (ISO "
+         "230-2).</p>\n";
+  d += runs_plot(l);
   std::vector<std::string> head{"target (mm)"};
   for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (µm)");
   std::vector<std::vector<std::string>> rows;
@@ -1156,15 +1150,6 @@ std::string bar_calibration_section(const Circle& c, const RunView& v) {
          table({"", ""}, rows, "kv");
 }
 
-// The values of the run's circular standard, as (key, symbol, value).
-std::vector<std::tuple<std::string, std::string, double>> standard_values(const Circle& c) {
-  std::vector<std::tuple<std::string, std::string, double>> out;
-  const auto& st = cal::circle::info(cal::circle::circular_standard_from_key(c.analysis.standard));
-  for (const auto& x : st.values)
-    out.emplace_back(x.key, x.symbol, ::daq::iso_value(c.result.iso, x.key));
-  return out;
-}
-
 // The diagnostics as a table: rank, error, value in its own unit, what correcting it would
 // gain (µm and share of G), PV, limit and verdict, and what to check. `top`: only the first
 // rows with a positive gain (page one's "what to fix first").
@@ -1176,27 +1161,39 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
     const auto& d = r.diagnostics[i];
     if (top && (diag.size() >= top || std::round(d.g_reduction_um * 1e3) <= 0)) break;
     const auto* check = ::daq::find_check(verdict, d.key);
+    const std::string share = g > 0 ? fixed(100.0 * d.g_reduction_um / g, 0) : "&ndash;";
+    const auto advice = ::daq::diagnostic_advice(d.key);
+    const std::string check_text = advice.empty() ? std::string("see docs/circle.md") : esc(advice);
+    // Page one's rows: the error with what to check under it (a column of its own was squeezed
+    // to a word a line).
     std::vector<std::string> row{
-        std::to_string(i + 1), esc(d.name),
+        std::to_string(i + 1),
+        top ? "<strong>" + esc(d.name) + "</strong><br><span class=\"note\">" + check_text +
+                  "</span>"
+            : esc(d.name),
         "<span class=\"nw\">" + signed_text(d.value, 3) + " " + esc(unit_text(d.unit)) + "</span>",
-        signed_text(d.g_reduction_um, 3),
-        g > 0 ? fixed(100.0 * d.g_reduction_um / g, 0) : std::string("&ndash;")};
+        top ? fmt::format("<span class=\"nw\">{} µm ({} %)</span>",
+                          signed_text(d.g_reduction_um, 3), share)
+            : signed_text(d.g_reduction_um, 3)};
+    if (!top) row.push_back(share);
     if (!top) {
       row.push_back(um(d.pv_um));
       row.push_back(check ? fmt::format("≤ {:.3f}", check->limit) + " " + verdict_cell(check) : "");
     }
-    const auto advice = ::daq::diagnostic_advice(d.key);
-    row.push_back(advice.empty() ? std::string("see docs/circle.md") : esc(advice));
+    if (!top) row.push_back(check_text);
     diag.push_back(std::move(row));
   }
   if (diag.empty()) return "";
-  std::vector<std::string> head{"rank", "error", "value", "G gain (µm)", "gain / G (%)"};
+  std::vector<std::string> head{"rank", top ? "error, and what to check" : "error", "value"};
+  if (top) head.push_back("G gain (share of G)");
   if (!top) {
+    head.push_back("G gain (µm)");
+    head.push_back("gain / G (%)");
     head.push_back("PV (µm)");
     head.push_back("limit");
   }
-  head.push_back("what to check");
-  return table(head, diag, "num diag", top ? "rlrrrl" : "rlrrrrll");
+  if (!top) head.push_back("what to check");
+  return table(head, diag, "num diag", top ? "rlrr" : "rlrrrrll");
 }
 
 // What the ranking means, and a warning when no term would gain anything (the first gain is not
@@ -1229,18 +1226,20 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
   std::vector<std::vector<std::string>> iso;
-  for (const auto& x : st.values) {
+  for (const auto& x : ::daq::circle_rows(doc)) {  // as every output lists them
     const auto* check = ::daq::find_check(verdict, x.key);
-    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)), esc(x.meaning),
-                   limit_cell(check), check ? verdict_cell(check) : ""});
-    if (x.key.starts_with("G"))
-      headline.values.push_back({x.symbol, ::daq::iso_value(r.iso, x.key), "µm"});
+    iso.push_back({esc(x.symbol), um(x.value), esc(x.description), limit_cell(check),
+                   check ? verdict_cell(check) : ""});
+    if (x.key.starts_with("G")) headline.values.push_back({x.symbol, x.value, unit_text(x.unit)});
   }
-  iso.push_back({"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
-                 "least-squares centre relative to the pivot (set-up)", "", ""});
+  // The set-up's centre and the informative values follow under Details (page one holds the
+  // standard's values, what to fix first and the polar plot).
+  std::vector<std::vector<std::string>> other{
+      {"centre", fmt::format("{} / {}", um(r.iso.centre_u_um), um(r.iso.centre_v_um)),
+       "least-squares centre relative to the pivot (set-up)"}};
   for (const auto& x : st.informative)
-    iso.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
-                   "<em>informative</em>: " + esc(x.meaning), "", ""});
+    other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
+                     "<em>informative</em>: " + esc(x.meaning)});
   h += verdict_banner(verdict);
   h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
              "lrlrl");
@@ -1248,8 +1247,8 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
   h += "<h4>What to fix first</h4>\n" +
        (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
                       : first +
-                            "<p class=\"note\">The errors that would reduce G most if "
-                            "corrected alone, largest first (all of them under Details).</p>\n");
+                            "<p class=\"note\">Largest gain in G first; every error under "
+                            "Details.</p>\n");
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
   polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
   h += figure(svg(polar),
@@ -1262,8 +1261,9 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
         {r.diagnostics[i].name, r.diagnostics[i].value, unit_text(r.diagnostics[i].unit)});
 
   std::string& d = out.details;
-  d = "<h3>Details of the results</h3>\n<h4>Diagnostics, ranked by what correcting each would "
-      "gain</h4>\n" +
+  d = "<h3>Details of the results</h3>\n" +
+      table({"symbol", "value (µm)", "meaning"}, other, "num results", "lrl") +
+      "<h4>Diagnostics, ranked by what correcting each would gain</h4>\n" +
       diagnostics_table(r, verdict, 0) + gain_notes(r);
   for (const auto& n : st.not_evaluated)
     d += "<p class=\"note\">Not evaluated: " + esc(n) + "</p>\n";
@@ -1389,6 +1389,8 @@ svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 @media print { body { margin: 0; max-width: none; font-size: 10pt; } h1 { font-size: 14pt; }
+  th, td { padding: .08rem .4rem; } h3 { margin: 1rem 0 .4rem; } h4 { margin: .6rem 0 .3rem; }
+  figure { margin: .4rem 0; } .verdict { margin: .4rem 0; } p { margin: .4rem 0; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
   svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; } }
 )";
@@ -1479,7 +1481,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
                          : fmt::format("; {} planned stops were never captured (listed under "
                                        "Details)",
                                        v.missed.size()));
-  h += quality_banner(store, v);
+  h += quality_banner(store, v, true);
   h += traceability_warnings(v);
   h += compensation_check(store, v);
   // An aborted or interrupted run may hold too little to evaluate: the report still shows what
@@ -1499,7 +1501,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
         esc(e.what()));
   }
   h += results.answer;
-  h += "<div class=\"details\">\n" + results.details;
+  h += "<div class=\"details\">\n" + results.details + quality_banner(store, v, false);
   if (!v.missed.empty()) {
     std::vector<std::vector<std::string>> rows;
     for (const auto& m : v.missed)
@@ -1542,7 +1544,7 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
   const auto tests = ::daq::ballbar_tests(store, circles);
   const auto v = ::daq::volumetric_table(tests);
   const auto opt = [](const std::optional<double>& x) {
-    return x ? fmt::format("{:+.3f}", *x) : std::string("&ndash;");
+    return x ? signed_text(*x, 3) : std::string("&ndash;");
   };
   std::vector<std::vector<std::string>> rows;
   for (const auto& t : tests)
@@ -1570,7 +1572,7 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
                       : i == 1 ? "YZ"
                                : "ZX",
                       used, fmt::format("{:g}", v.used[i].feed_mm_per_min),
-                      fmt::format("{:+.3f}", pv->squareness_um_per_m),
+                      signed_text(pv->squareness_um_per_m, 3),
                       fmt::format("{} = {:+.3f}", cal::kinematics::location_error_name(mp),
                                   cal::circle::location_error_urad(*pv)),
                       fmt::format("{} {:+.3f}",
@@ -1675,10 +1677,22 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     dates.push_back(date_of(views[i]));
     if (i && dates[i] == dates[i - 1]) same_day = true;
   }
+  // The small plots' labels are short, or they overlap at that size: the run where two share a
+  // day, else the day (without the year when every run is in one year).
+  std::vector<std::string> short_dates;
+  const bool one_year = date_of(views.front()).substr(0, 4) == date_of(views.back()).substr(0, 4);
+  for (std::size_t i = 0; i < views.size(); ++i)
+    short_dates.push_back(same_day   ? fmt::format("run {}", views[i].run.id)
+                          : one_year ? dates[i].substr(5)
+                                     : dates[i]);
   if (same_day)
     for (std::size_t i = 0; i < views.size(); ++i)
       dates[i] = fmt::format("run {} {}", views[i].run.id,
                              iso_time(views[i].run.started_unix_ms).substr(5, 11));  // MM-DD HH:MM
+  // The smallest span of a trend's y axis: four expanded uncertainties of the runs' positional
+  // deviations (linear runs), at least 1 of the value's unit (0.1 ms): a change within it is not
+  // a change worth a slope across the whole plot.
+  double u_max_um = 0.0;
   struct Value {
     std::string key, symbol, unit;
     double value = 0;
@@ -1688,6 +1702,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
   std::map<std::string, Line> trends;        // key -> value run by run
   std::map<std::string, double> limits;      // key -> the limit of the newest run that has one
   std::map<std::string, std::string> names;  // key -> symbol (unit)
+  std::map<std::string, std::string> units;  // key -> unit as printed
   std::vector<std::string> trend_order;
   std::vector<std::vector<std::string>> rows;
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
@@ -1704,28 +1719,24 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     json doc;
     if (v.run.kind == "linear") {
       const auto l = evaluate_linear(store, v, o);
+      double length_m = 0;
+      u_max_um = std::max(u_max_um, linear_budget(v, l, length_m).expanded_um);
       Line line{.label = label, .colour = palette(i), .width = 1.4, .markers = true};
       for (const auto& t : l.e.targets)
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
-      for (const auto& a : l.e.axis) values.push_back({a.key, a.symbol, "µm", a.value_um});
-      // In the order of the results grid (E, R, A, M, B, B̄), as on every page.
-      std::stable_sort(values.begin(), values.end(), [](const Value& a, const Value& b) {
-        return iso_order(a.key) < iso_order(b.key);
-      });
       doc = ::daq::to_json(l.e);
+      // In the order of every output (result_rows.hpp).
+      for (const auto& r : ::daq::linear_rows(doc))
+        values.push_back({r.key, r.symbol, unit_text(r.unit), r.value});
     } else {
       const auto c = analyse_circle(store, v, o);
       polars.push_back(polar_of(c, "", 2 * i, label + ", "));
-      for (const auto& [key, symbol, value] : standard_values(c))
-        if (key.starts_with("G")) values.push_back({key, symbol, "µm", value});
-      for (const auto& d : c.result.diagnostics)
-        values.push_back({d.key, d.name,
-                          d.unit == "um"     ? "µm"
-                          : d.unit == "um/m" ? "µm/m"
-                                             : d.unit,
-                          d.value});
       doc = ::daq::circle_document(c.result, c.program, c.analysis);
+      for (const auto& r : ::daq::circle_rows(doc))
+        if (r.key.starts_with("G")) values.push_back({r.key, r.symbol, unit_text(r.unit), r.value});
+      for (const auto& r : ::daq::diagnostic_rows(doc))
+        values.push_back({r.key, r.symbol, unit_text(r.unit), r.value});
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
     // A re-compensated run is compared with the values it has now, and says so.
@@ -1744,6 +1755,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
       if (!trends.count(x.key)) {
         trend_order.push_back(x.key);
         names[x.key] = x.symbol + " (" + x.unit + ")";
+        units[x.key] = x.unit;
         trends[x.key] = Line{.colour = blue, .width = 1.4, .markers = true};
       }
       trends[x.key].x.push_back(static_cast<double>(i));
@@ -1801,9 +1813,11 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
                   .y_label = "",  // the title names it (a rotated label at this size was clipped)
                   .width_pt = 300,
                   .height_pt = 200,
-                  .x_labels = dates,
+                  .x_labels = short_dates,
                   .legend = false,
                   .text_scale = 1.65};
+    const bool in_um = units[k] == "µm";
+    small.min_y_span = std::max(in_um ? 4 * u_max_um : 0.0, units[k] == "ms" ? 0.1 : 1.0);
     small.lines.push_back(trends[k]);
     if (limits.count(k)) {
       const double n = static_cast<double>(views.size()) - 1;
@@ -1816,6 +1830,15 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     body += figure(svg(small), names[k] + (limits.count(k) ? " (dashed: the limit)" : ""));
   }
   body += "</div>\n";
+  body +=
+      u_max_um > 0
+          ? fmt::format(
+                "<p class=\"note\">Each y axis spans at least {} µm, four times the largest "
+                "expanded uncertainty U = {} µm of these runs (at least 1 of the value's unit): "
+                "a change smaller than that is not drawn as a slope across the plot.</p>\n",
+                fixed(std::max(4 * u_max_um, 1.0), 3), fixed(u_max_um, 3))
+          : "<p class=\"note\">Each y axis spans at least 1 of its value's unit (0.1 ms): a "
+            "smaller change is not drawn as a slope across the plot.</p>\n";
   return page(fmt::format("Comparison: {} test of axis {}", first.run.kind, first.run.axis), body,
               o, who_of(first));
 }
@@ -1852,20 +1875,19 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
       for (const auto& t : l.e.targets)
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
-      for (const auto& a : l.e.axis) sd.values.emplace_back(a.key, a.symbol, a.value_um);
-      std::stable_sort(sd.values.begin(), sd.values.end(), [](const auto& x, const auto& y) {
-        return iso_order(std::get<0>(x)) < iso_order(std::get<0>(y));
-      });
       sd.doc = ::daq::to_json(l.e);
+      for (const auto& r : ::daq::linear_rows(sd.doc))
+        sd.values.emplace_back(r.key, r.symbol, r.value);
     } else {
       const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
       polar.first_axis = p.first_axis, polar.second_axis = p.second_axis;
       for (auto& t : p.traces) polar.traces.push_back(std::move(t));
-      for (const auto& [key, symbol, value] : standard_values(c))
-        if (key.starts_with("G")) sd.values.emplace_back(key, symbol, value);
-      for (const auto& d : c.result.diagnostics) sd.values.emplace_back(d.key, d.name, d.value);
       sd.doc = ::daq::circle_document(c.result, c.program, c.analysis);
+      for (const auto& r : ::daq::circle_rows(sd.doc))
+        if (r.key.starts_with("G")) sd.values.emplace_back(r.key, r.symbol, r.value);
+      for (const auto& r : ::daq::diagnostic_rows(sd.doc))
+        sd.values.emplace_back(r.key, r.symbol, r.value);
     }
     sd.verdict = ::daq::verdict_of(v.settings, sd.doc);
     return sd;
@@ -1880,7 +1902,7 @@ std::string as_found_as_left_report(const st::Store& store, std::int64_t found_i
     const auto* cb = ::daq::find_check(b.verdict, key);
     rows.push_back({esc(symbol), um(va) + " " + (ca ? verdict_cell(ca) : ""),
                     vb ? um(*vb) + " " + (cb ? verdict_cell(cb) : "") : "&ndash;",
-                    vb ? fmt::format("{:+.3f}", *vb - va) : "&ndash;", limit_cell(cb ? cb : ca)});
+                    vb ? signed_text(*vb - va, 3) : "&ndash;", limit_cell(cb ? cb : ca)});
   }
   const auto banner = [](const ::daq::Verdict& v) {
     return !v.configured ? std::string("<span class=\"unstated\">no tolerance configured</span>")

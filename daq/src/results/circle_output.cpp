@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "result_rows.hpp"
+
 namespace daq {
 
 using nlohmann::json;
@@ -58,6 +60,7 @@ json circle_json(const ci::Result& r, double radius_mm, std::string_view plane,
     j["diagnostics"].push_back(std::move(dj));
   }
   j["centre"] = {{r.centre_u.key, r.centre_u.value}, {r.centre_v.key, r.centre_v.value}};
+  j["values"] = rows_json(result_rows(j));  // as every output lists them (result_rows.hpp)
   return j;
 }
 
@@ -92,30 +95,7 @@ std::string diagnostic_advice(std::string_view key) {
 
 void print_circle(const ci::Result& r, double radius_mm, std::string_view plane,
                   double feed_mm_per_min, ci::CircularStandard standard) {
-  const auto& st = ci::info(standard);
-  fmt::print("{} circular test, plane {}, R = {} mm, feed {} mm/min\n", st.label, plane, radius_mm,
-             feed_mm_per_min);
-  for (const auto& v : st.values)
-    fmt::print("  {:<18} {:8.3f} um   {}\n", v.symbol, iso_value(r.iso, v.key), v.meaning);
-  fmt::print("  {:<18} {:8.3f}, {:.3f} um   least-squares centre (set-up)\n", "centre",
-             r.iso.centre_u_um, r.iso.centre_v_um);
-  for (const auto& v : st.informative)
-    fmt::print("  {:<18} {:8.3f} um   informative: {}\n", v.symbol, iso_value(r.iso, v.key),
-               v.meaning);
-  for (const auto& n : st.not_evaluated) fmt::print("  not evaluated: {}\n", n);
-  fmt::print(
-      "\nDiagnostics, ranked by G gain (how much G falls when that error alone is removed: the\n"
-      "first is what to fix first), with PV (the peak-to-valley of the error's own pattern on\n"
-      "the traces) and PV / G (caldaq's own figure, can exceed 100 %; docs/circle.md):\n");
-  fmt::print("  {:<48} {:>9} {:<5} {:>10} {:>7} {:>10}\n", "", "value", "", "PV", "PV / G",
-             "G gain");
-  for (const auto& d : r.diagnostics)
-    fmt::print("  {:<48} {:+9.3f} {:<5} {:7.3f} um {:5.1f} % {:7.3f} um\n", d.name, d.value, d.unit,
-               d.pv_um, d.share_pct, d.g_reduction_um);
-  fmt::print("  {:<48} {:+9.3f} um (set-up)\n", r.centre_u.name, r.centre_u.value);
-  fmt::print("  {:<48} {:+9.3f} um (set-up)\n", r.centre_v.name, r.centre_v.value);
-  fmt::print("  residual rms {:.3f} um\n", r.residual_rms_um);
-  for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
+  print_result(circle_json(r, radius_mm, plane, feed_mm_per_min, standard));
 }
 
 }  // namespace daq

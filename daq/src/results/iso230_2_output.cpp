@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "result_rows.hpp"
+
 namespace daq {
 
 nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
@@ -36,6 +38,15 @@ nlohmann::json to_json(const cal::iso230_2::Evaluation& e) {
         {"symbol", a.symbol}, {"description", a.description}, {"value_um", a.value_um}};
   }
   j["runs_text"] = runs_text(e);
+  // The values as every output lists them (result_rows.hpp): "axis" is read by key.
+  nlohmann::json values = nlohmann::json::array();
+  for (const auto& a : e.axis)
+    values.push_back({{"key", a.key},
+                      {"symbol", a.symbol},
+                      {"description", a.description},
+                      {"value", a.value_um},
+                      {"unit", "um"}});
+  j["values"] = rows_json(linear_rows({{"values", values}}));
   j["warnings"] = e.warnings;
   j["notes"] = e.notes;
   return j;
@@ -112,23 +123,16 @@ nlohmann::json to_json(const cal::unc::Budget& b) {
 }
 
 void print(const cal::iso230_2::Evaluation& e) {
-  fmt::print("{} ({})\n", e.standard.title, e.standard.note);
-  fmt::print("{} targets, {}, {}\n\n", e.targets.size(), runs_text(e),
-             e.bidirectional ? "bidirectional" : "unidirectional");
-  fmt::print("{:>12}", "target/mm");
+  // The values first, as every output prints them (result_rows.hpp), then each target's.
+  print_result(to_json(e));
+  fmt::print("\n{:>12}", "target/mm");
   for (const auto& p : e.per_target) fmt::print(" {:>9}", p.symbol);
   fmt::print("   (um)\n");
   for (std::size_t i = 0; i < e.targets.size(); ++i) {
-    fmt::print("{:>12.3f}", e.targets[i].target_mm);
-    for (const auto& p : e.per_target) fmt::print(" {:>9.3f}", p.values_um[i]);
+    fmt::print("{:>12}", number_text(e.targets[i].target_mm));
+    for (const auto& p : e.per_target) fmt::print(" {:>9}", number_text(p.values_um[i]));
     fmt::print("\n");
   }
-  fmt::print("\n");
-  for (const auto& a : e.axis) {
-    fmt::print("  {:<8} {:>10.3f} um   {}\n", a.symbol, a.value_um, a.description);
-  }
-  for (const auto& w : e.warnings) fmt::print("warning: {}\n", w);
-  for (const auto& n : e.notes) fmt::print("note: {}\n", n);
 }
 
 void print(const cal::unc::Budget& b, double length_m) {

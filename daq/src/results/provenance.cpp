@@ -19,11 +19,7 @@ json limits_json(const cal::daq::PositioningLimits& l) {
   const auto put = [&](const char* key, const std::optional<double>& v) {
     if (v) j[key] = *v;
   };
-  put("E_um", l.E_um);
-  put("R_um", l.R_um);
-  put("B_um", l.B_um);
-  put("A_um", l.A_um);
-  put("M_um", l.M_um);
+  for (const auto& k : cal::daq::positioning_limit_keys) put(k.key, l.*k.member);
   return j;
 }
 

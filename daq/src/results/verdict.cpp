@@ -4,7 +4,9 @@
 
 #include <cmath>
 
+#include "cal/analysis/text.hpp"
 #include "circle_output.hpp"
+#include "result_rows.hpp"
 
 namespace daq {
 
@@ -47,30 +49,44 @@ Verdict linear_verdict(const json& tolerances, const json& result) {
   const std::string title = result.contains("standard")
                                 ? result["standard"].value("title", std::string("this standard"))
                                 : "this standard";
-  // Which value of the evaluation each limit applies to.
+  // Which value of the evaluation each limit applies to. ISO 230-2's limits apply to the ISO
+  // family (every edition, JIS, GB/T), VDI/DGQ 3441's to a VDI evaluation (it gives P).
+  const bool vdi = axis.contains("P");
   const struct {
     const char* limit;
+    const char* name;
     const char* bi_key;
     const char* uni_key;
-  } map[] = {{"E_um", "E_bi", "E_up"},
-             {"R_um", "R_bi", "R_up"},
-             {"B_um", "B", nullptr},
-             {"A_um", "A_bi", "A_up"},
-             {"M_um", "M", nullptr}};
+    bool vdi;
+  } map[] = {{"E_um", "E", "E_bi", "E_up", false},     {"R_um", "R", "R_bi", "R_up", false},
+             {"B_um", "B", "B", nullptr, false},       {"A_um", "A", "A_bi", "A_up", false},
+             {"M_um", "M", "M", nullptr, false},       {"P_um", "P", "P", nullptr, true},
+             {"Pa_um", "Pa", "Pa", nullptr, true},     {"Ps_um", "Ps max", "Ps_max", nullptr, true},
+             {"U_um", "U max", "U_max", nullptr, true}};
+  std::vector<std::string> other;  // limits of the other family
   for (const auto& m : map) {
     if (!limits.contains(m.limit)) continue;
+    if (m.vdi != vdi) {
+      other.push_back(m.limit);
+      continue;
+    }
     const char* key = bi ? m.bi_key : m.uni_key;
-    const std::string name(m.limit, 1);
     if (!key || !axis.contains(key)) {
-      v.notes.push_back(fmt::format("{} limit {:g} µm not applied: {} gives no {}{}", name,
-                                    limits[m.limit].get<double>(), title, name,
+      v.notes.push_back(fmt::format("{} limit {:g} µm not applied: {} gives no {}{}", m.name,
+                                    limits[m.limit].get<double>(), title, m.name,
                                     bi ? "" : " for a one-way test"));
       continue;
     }
     const double value = axis[key].value("value_um", 0.0), lim = limits[m.limit].get<double>();
-    v.checks.push_back(
-        {key, axis[key].value("symbol", name), value, lim, "um", within(value, lim)});
+    v.checks.push_back({key, axis[key].value("symbol", std::string(m.name)), value, lim, "um",
+                        within(value, lim)});
   }
+  // Limits only of the other family: none applies, and the note says which keys would.
+  if (v.checks.empty() && !other.empty())
+    v.notes.push_back(fmt::format(
+        "the limits configured ({}) are for {} values; {} is judged by {}", fmt::join(other, ", "),
+        vdi ? "ISO 230-2" : "VDI/DGQ 3441", title,
+        vdi ? "P_um, Pa_um, Ps_um, U_um (docs/config.md)" : "E_um, R_um, B_um, A_um, M_um"));
   v.configured = !v.checks.empty();
   v.pass = v.configured;
   for (const auto& c : v.checks) v.pass = v.pass && c.pass;
@@ -147,19 +163,28 @@ std::string summary(const Verdict& v) {
   return v.pass ? "PASS" : "FAIL";
 }
 
-void print_verdict(const Verdict& v) {
-  if (!v.configured) {
-    fmt::print("verdict: no tolerance configured{}\n",
-               v.notes.empty() ? " ([tolerances] in the configuration, docs/config.md)" : "");
+void print_verdict(const Verdict& v) { print_verdict(to_json(v)); }
+
+void print_verdict(const json& v, std::string_view in) {
+  const auto safe = [](const json& j, const char* key) {
+    return cal::text::terminal_safe(j.value(key, std::string()));
+  };
+  const json notes = v.value("notes", json::array());
+  if (!v.value("configured", false)) {
+    fmt::print("{}verdict: {}{}\n", in, safe(v, "summary"),
+               notes.empty() ? " ([tolerances] in the configuration, docs/config.md)" : "");
   } else {
-    fmt::print("verdict against {}: {}\n", v.basis, summary(v));
-    for (const auto& c : v.checks) {
-      const std::string unit = c.unit == "um" ? "um" : c.unit;
-      fmt::print("  {:<28} {:>10.3f} {:<5} limit {:>8.3f} {:<5} {}\n", c.symbol, c.value, unit,
-                 c.limit, unit, c.pass ? "pass" : "FAIL");
+    fmt::print("{}verdict against {}: {}\n", in, safe(v, "basis"), safe(v, "summary"));
+    for (const auto& c : v.value("checks", json::array())) {
+      const std::string unit = safe(c, "unit");
+      fmt::print("{}  {:<28} {:>10} {:<5} limit {:>8} {:<5} {}\n", in, safe(c, "symbol"),
+                 number_text(c.value("value", 0.0)), unit, number_text(c.value("limit", 0.0)), unit,
+                 c.value("pass", false) ? "pass" : "FAIL");
     }
   }
-  for (const auto& n : v.notes) fmt::print("  note: {}\n", n);
+  for (const auto& n : notes)
+    if (n.is_string())
+      fmt::print("{}  note: {}\n", in, cal::text::terminal_safe(n.get<std::string>()));
 }
 
 const Check* find_check(const Verdict& v, const std::string& key) {

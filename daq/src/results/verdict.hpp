@@ -6,6 +6,7 @@
 // Where no limit applies, the verdict says "no tolerance configured", never a pass.
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace daq {
@@ -40,6 +41,9 @@ nlohmann::json to_json(const Verdict& v);
 std::string summary(const Verdict& v);
 // For a terminal: the verdict, each check with its limit, and the notes.
 void print_verdict(const Verdict& v);
+// The same of a verdict's JSON (to_json; daq show prints a stored result's), each line led by
+// `indent`.
+void print_verdict(const nlohmann::json& verdict, std::string_view indent = "");
 // The check of a result key, or nullptr.
 const Check* find_check(const Verdict& v, const std::string& key);
 

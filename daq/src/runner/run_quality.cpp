@@ -58,6 +58,12 @@ cal::storage::RunQuality run_quality(const cal::storage::Store& store, std::int6
   return q;
 }
 
+std::string quality_text(const cal::storage::RunQuality& q) {
+  if (q.summary.empty()) return q.state;
+  if (q.state.empty() || q.summary.starts_with(q.state)) return q.summary;
+  return q.state + ": " + q.summary;
+}
+
 json quality_json(const cal::storage::RunQuality& q) {
   json stops = json::array();
   for (const auto& s : q.suspects)

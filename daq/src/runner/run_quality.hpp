@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -25,6 +26,9 @@ cal::storage::RunQuality run_quality(const cal::storage::Store& store, std::int6
 // {"state", "summary", "suspect_stops": [{"run", "direction": "up"|"down", "target_index",
 // "reason"}]}: the "quality" of a run's JSON.
 nlohmann::json quality_json(const cal::storage::RunQuality& q);
+// The quality in one line: "ok: every stop within ...", the state said once (the summary of an
+// assessment begins with it; a stored one may not).
+std::string quality_text(const cal::storage::RunQuality& q);
 
 // The builders' gate: throws cal::InputError naming every suspect run of `runs` that is not in
 // `accepted`, with its suspect stops and how to accept it. Returns the suspect runs that were

@@ -71,8 +71,7 @@ json limits_json(const cal::daq::PositioningLimits& l) {
   const auto lim = [&](const char* k, const std::optional<double>& v) {
     if (v) j[k] = *v;
   };
-  lim("E_um", l.E_um), lim("R_um", l.R_um), lim("B_um", l.B_um), lim("A_um", l.A_um),
-      lim("M_um", l.M_um);
+  for (const auto& k : cal::daq::positioning_limit_keys) lim(k.key, l.*k.member);
   return j;
 }
 
@@ -167,6 +166,10 @@ const std::vector<std::string_view>& key_order() {
                                                    "B_um",
                                                    "A_um",
                                                    "M_um",
+                                                   "P_um",
+                                                   "Pa_um",
+                                                   "Ps_um",
+                                                   "U_um",
                                                    "G_um",
                                                    "machine",
                                                    "customer",

@@ -298,6 +298,8 @@ calibration_due = "2027-02-28"
 [tolerances.X]
 E_um = 10
 A_um = 14.5
+P_um = 15
+Ps_um = 6
 [[tolerances.X.by_length]]
 up_to_mm = 500
 A_um = 8
@@ -329,6 +331,9 @@ vibration = 0.3
   EXPECT_EQ(x.limits.E_um, 10.0);
   EXPECT_EQ(x.limits.A_um, 14.5);
   EXPECT_FALSE(x.limits.R_um.has_value());
+  EXPECT_EQ(x.limits.P_um, 15.0);  // VDI/DGQ 3441's limits beside ISO 230-2's (issue 30)
+  EXPECT_EQ(x.limits.Ps_um, 6.0);
+  EXPECT_FALSE(x.limits.U_um.has_value());
   ASSERT_EQ(x.by_length.size(), 2u);
   EXPECT_EQ(x.by_length[0].first, 500.0);
   EXPECT_EQ(x.by_length[1].second.A_um, 12.0);

@@ -124,12 +124,30 @@ struct TestConditions {
   std::string notes;
 };
 
-// Limits of the ISO 230-2 values of one axis, in um ([tolerances.X]); applied to the
-// bidirectional values (E, R, A, M, B), or the unidirectional ones of a one-way test.
+// Limits of the positioning values of one axis, in um ([tolerances.X]): ISO 230-2's, applied to
+// the bidirectional values (E, R, A, M, B) or the unidirectional ones of a one-way test, and
+// VDI/DGQ 3441's (P, Pa, Ps max, U max), applied when a run is evaluated by that standard.
 struct PositioningLimits {
   std::optional<double> E_um, R_um, B_um, A_um, M_um;
-  bool empty() const { return !E_um && !R_um && !B_um && !A_um && !M_um; }
+  std::optional<double> P_um, Pa_um, Ps_um, U_um;
+  bool empty() const;
 };
+// Each limit's key in the configuration and the run's stored context, in docs/config.md's order.
+struct PositioningLimitKey {
+  const char* key;
+  std::optional<double> PositioningLimits::*member;
+};
+inline constexpr PositioningLimitKey positioning_limit_keys[] = {
+    {"E_um", &PositioningLimits::E_um},  {"R_um", &PositioningLimits::R_um},
+    {"B_um", &PositioningLimits::B_um},  {"A_um", &PositioningLimits::A_um},
+    {"M_um", &PositioningLimits::M_um},  {"P_um", &PositioningLimits::P_um},
+    {"Pa_um", &PositioningLimits::Pa_um}, {"Ps_um", &PositioningLimits::Ps_um},
+    {"U_um", &PositioningLimits::U_um}};
+inline bool PositioningLimits::empty() const {
+  for (const auto& k : positioning_limit_keys)
+    if (this->*k.member) return false;
+  return true;
+}
 struct AxisTolerance {
   PositioningLimits limits;  // for any measured length
   // Limits for a measured travel up to a length ([[tolerances.X.by_length]]), ascending: the

@@ -1,0 +1,99 @@
+// The comparison report's small trend plots (daq/src/report/plot.cpp), read back from their SVG
+// (issue 30): a change of 0.0001 um is drawn flat within the minimum span, not as a cliff from
+// the bottom of the plot to its top; category labels (the runs' dates) never overlap.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "report/plot.hpp"
+
+namespace {
+
+using cal::daq::report::Line;
+using cal::daq::report::XyChart;
+
+// The y coordinates (SVG units) of the polylines drawn in a colour.
+std::vector<double> ys_of(const std::string& svg, const std::string& stroke) {
+  static const std::regex element(
+      R"re(<polyline[^>]*stroke="(#[0-9A-Fa-f]{6})"[^>]*points="([^"]*)")re");
+  std::vector<double> out;
+  for (std::sregex_iterator it(svg.begin(), svg.end(), element), end; it != end; ++it) {
+    if ((*it)[1].str() != stroke) continue;
+    std::istringstream in((*it)[2].str());
+    for (std::string xy; in >> xy;) out.push_back(std::stod(xy.substr(xy.find(',') + 1)));
+  }
+  return out;
+}
+
+XyChart small(std::vector<std::string> labels, std::vector<double> y) {
+  XyChart c{.title = "E (µm)",
+            .width_pt = 300,
+            .height_pt = 200,
+            .x_labels = std::move(labels),
+            .legend = false,
+            .text_scale = 1.65};
+  Line l{.colour = cal::daq::report::blue, .markers = true};
+  for (std::size_t i = 0; i < y.size(); ++i) l.x.push_back(static_cast<double>(i));
+  l.y = std::move(y);
+  c.lines.push_back(l);
+  return c;
+}
+
+TEST(TrendPlot, AMinimumSpanDrawsATinyChangeFlat) {
+  auto c = small({"a", "b"}, {9.2, 9.2001});
+  const auto steep = ys_of(cal::daq::report::svg(c), "#0072B2");
+  ASSERT_GE(steep.size(), 2u);
+  // Without a minimum the 0.0001 um fill the plot's height (the old drawing).
+  EXPECT_GT(std::abs(steep[1] - steep[0]), 50.0);
+  c.min_y_span = 1.0;
+  const auto flat = ys_of(cal::daq::report::svg(c), "#0072B2");
+  ASSERT_GE(flat.size(), 2u);
+  EXPECT_LT(std::abs(flat[1] - flat[0]), 1.0);
+}
+
+struct Label {
+  std::string text;
+  double x = 0, font = 0;
+};
+
+// The texts drawn centred (PLplot's tick labels of x), with their x and font size.
+std::vector<Label> centred_texts(const std::string& svg) {
+  static const std::regex text(
+      R"re(<text[^>]*font-size="([0-9.]+)"[^>]*matrix\([-0-9. ]*? ([-0-9.]+) [-0-9.]+\)"[^>]*text-anchor="middle"[^>]*>([\s\S]*?)</text>)re");
+  static const std::regex tag("<[^>]+>");
+  std::vector<Label> out;
+  for (std::sregex_iterator it(svg.begin(), svg.end(), text), end; it != end; ++it) {
+    // Count characters: each is one character reference or one plain character.
+    const std::string inner = std::regex_replace((*it)[3].str(), tag, "");
+    std::size_t chars = 0;
+    for (std::size_t i = 0; i < inner.size(); ++i) {
+      if (inner[i] == '&') i = inner.find(';', i);
+      if (inner[i] != '\n' && inner[i] != ' ') ++chars;
+    }
+    out.push_back({std::to_string(chars), std::stod((*it)[2].str()), std::stod((*it)[1].str())});
+  }
+  return out;
+}
+
+TEST(TrendPlot, CategoryLabelsDoNotOverlap) {
+  // Two runs on one day, labelled with their time: each label wider than its category.
+  const auto svg =
+      cal::daq::report::svg(small({"run 1 11-27 21:24", "run 3 11-27 21:24"}, {9.2, 9.3}));
+  std::vector<Label> labels;
+  for (const auto& l : centred_texts(svg))
+    if (std::stoul(l.text) >= 12) labels.push_back(l);  // the dates, not the title
+  ASSERT_GE(labels.size(), 1u) << svg;
+  for (std::size_t i = 1; i < labels.size(); ++i) {
+    // Half a character height per character is the narrowest a digit is drawn.
+    const double half_widths = 0.25 * labels[i].font * std::stod(labels[i].text) +
+                               0.25 * labels[i - 1].font * std::stod(labels[i - 1].text);
+    EXPECT_GE(std::abs(labels[i].x - labels[i - 1].x), half_widths)
+        << "labels " << i - 1 << " and " << i << " overlap";
+  }
+}
+
+}  // namespace

@@ -1,0 +1,116 @@
+// One presentation of each result (daq/src/results/result_rows.hpp, issue 30): numbers that
+// never read "-0.000" on the terminal, ISO 230-2 values in the report grid's order, and the
+// verdict of a VDI/DGQ 3441 evaluation against its own configured limits.
+#include "result_rows.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "cal/analysis/circle.hpp"
+#include "cal/analysis/iso230_2.hpp"
+#include "circle_output.hpp"
+#include "iso230_2_output.hpp"
+#include "verdict.hpp"
+
+namespace {
+
+using nlohmann::json;
+namespace iso = cal::iso230_2;
+
+TEST(ResultRows, NumbersNeverReadMinusZero) {
+  EXPECT_EQ(daq::number_text(-0.0004), "0.000");
+  EXPECT_EQ(daq::number_text(-0.0), "0.000");
+  EXPECT_EQ(daq::number_text(-0.0006), "-0.001");
+  EXPECT_EQ(daq::number_text(2.5, 1), "2.5");
+  EXPECT_EQ(daq::signed_number_text(-0.0004), "0.000");
+  EXPECT_EQ(daq::signed_number_text(0.0004), "0.000");
+  EXPECT_EQ(daq::signed_number_text(1.5), "+1.500");
+  EXPECT_EQ(daq::signed_number_text(-1.5), "-1.500");
+}
+
+// print_circle wrote "{:+9.3f}": a diagnostic or centre of -0.0001 printed as "-0.000".
+TEST(ResultRows, PrintCircleNeverPrintsMinusZero) {
+  cal::circle::Result r;
+  r.iso.G_bi_um = 5.0;
+  r.diagnostics.push_back({.key = "backlash_X",
+                           .name = "Backlash X",
+                           .value = -0.0001,
+                           .unit = "um",
+                           .pv_um = 0.0002,
+                           .share_pct = -0.01,
+                           .g_reduction_um = -0.0002});
+  r.centre_u = {.key = "centre_X", .name = "Centre offset X", .value = -0.0003, .unit = "um"};
+  r.centre_v = {.key = "centre_Y", .name = "Centre offset Y", .value = 0.0, .unit = "um"};
+  r.iso.centre_u_um = -0.0003;
+  testing::internal::CaptureStdout();
+  daq::print_circle(r, 100.0, "XY", 1000.0);
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_EQ(out.find("-0.000"), std::string::npos) << out;
+  EXPECT_EQ(out.find("-0.0 %"), std::string::npos) << out;
+  EXPECT_NE(out.find("Backlash X"), std::string::npos) << out;
+}
+
+std::vector<iso::Measurement> bidirectional_data() {
+  std::vector<iso::Measurement> m;
+  for (int run = 1; run <= 5; ++run)
+    for (int t = 0; t <= 5; ++t)
+      for (auto d : {iso::Direction::up, iso::Direction::down})
+        m.push_back({.target_mm = 100.0 * t,
+                     .run = run,
+                     .direction = d,
+                     .deviation_um = 0.8 * t + (d == iso::Direction::up ? 1.0 : -1.0) +
+                                     0.1 * std::sin(run * 1.7 + t)});
+  return m;
+}
+
+TEST(ResultRows, LinearValuesInTheGridsOrder) {
+  const auto doc = daq::to_json(iso::evaluate(bidirectional_data(), iso::Standard::iso230_2_2014));
+  std::vector<std::string> keys;
+  for (const auto& r : daq::linear_rows(doc)) keys.push_back(r.key);
+  const std::vector<std::string> grid{"E_up", "E_down", "E_bi", "R_up", "R_down", "R_bi",
+                                      "A_up", "A_down", "A_bi", "M",    "B",      "B_mean"};
+  EXPECT_EQ(keys, grid);
+  // The JSON's "values" in the same order, and a document stored before it (no "values") too.
+  ASSERT_TRUE(doc.contains("values"));
+  ASSERT_EQ(doc["values"].size(), grid.size());
+  for (std::size_t i = 0; i < grid.size(); ++i) EXPECT_EQ(doc["values"][i]["key"], grid[i]);
+  json old = doc;
+  old.erase("values");
+  keys.clear();
+  for (const auto& r : daq::linear_rows(old)) keys.push_back(r.key);
+  EXPECT_EQ(keys, grid);
+}
+
+// VDI/DGQ 3441's configured limits are applied (the report said "No tolerance").
+TEST(Verdict, Vdi3441IsJudgedByItsOwnLimits) {
+  const auto doc = daq::to_json(iso::evaluate(bidirectional_data(), iso::Standard::vdi_3441_1977));
+  const json both = {{"E_um", 10.0}, {"P_um", 100.0}, {"Ps_um", 0.001}, {"U_um", 5.0}};
+  const auto v = daq::linear_verdict(both, doc);
+  EXPECT_TRUE(v.configured);
+  EXPECT_FALSE(v.pass);  // Ps max is above 0.001 um
+  ASSERT_EQ(v.checks.size(), 3u);
+  EXPECT_EQ(v.checks[0].key, "P");
+  EXPECT_TRUE(v.checks[0].pass);
+  EXPECT_EQ(v.checks[1].key, "Ps_max");
+  EXPECT_FALSE(v.checks[1].pass);
+  EXPECT_EQ(v.checks[2].key, "U_max");
+  EXPECT_EQ(daq::summary(v), "FAIL");
+  EXPECT_TRUE(v.notes.empty());  // E is ISO 230-2's, not a limit this evaluation missed
+  // Only ISO 230-2's limits: none applies, and the note says which keys would.
+  const auto iso_only = daq::linear_verdict(json{{"E_um", 10.0}, {"B_um", 3.0}}, doc);
+  EXPECT_FALSE(iso_only.configured);
+  EXPECT_EQ(daq::summary(iso_only), "no tolerance applies");
+  ASSERT_EQ(iso_only.notes.size(), 1u);
+  EXPECT_NE(iso_only.notes[0].find("P_um"), std::string::npos) << iso_only.notes[0];
+  // And ISO 230-2 is not judged by VDI limits.
+  const auto iso_doc =
+      daq::to_json(iso::evaluate(bidirectional_data(), iso::Standard::iso230_2_2014));
+  const auto v2 = daq::linear_verdict(both, iso_doc);
+  ASSERT_EQ(v2.checks.size(), 1u);
+  EXPECT_EQ(v2.checks[0].key, "E_bi");
+}
+
+}  // namespace
