@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -56,19 +57,30 @@ std::vector<const CLI::Option*> options_of(const CLI::App& app) {
   return out;
 }
 
-// Text for troff: backslashes and hyphens escaped, no line starting with a control character.
+// Text for troff: backslashes and hyphens escaped, no line starting with a control character,
+// and every character beyond ASCII as its code point (\[u00B5]), so that the page renders the
+// same whatever input encoding groff assumes.
 std::string roff(const std::string& text) {
   std::string out;
   bool line_start = true;
-  for (char c : text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
     if (line_start && (c == '.' || c == '\'')) out += "\\&";
-    if (c == '\\')
-      out += "\\e";
-    else if (c == '-')
-      out += "\\-";
-    else
-      out += c;
     line_start = c == '\n';
+    if (c == '\\') {
+      out += "\\e";
+    } else if (c == '-') {
+      out += "\\-";
+    } else if (c < 0x80) {
+      out += static_cast<char>(c);
+    } else {
+      // A UTF-8 sequence: its length from the lead byte, its bits from the rest.
+      const int extra = c >= 0xF0 ? 3 : c >= 0xE0 ? 2 : c >= 0xC0 ? 1 : 0;
+      std::uint32_t code = c & (0x3FU >> extra);
+      for (int k = 0; k < extra && i + 1 < text.size(); ++k)
+        code = (code << 6) | (static_cast<unsigned char>(text[++i]) & 0x3FU);
+      out += fmt::format("\\[u{:04X}]", code);
+    }
   }
   return out;
 }
@@ -100,17 +112,20 @@ std::string man_page(const CLI::App& app, const std::string& path,
   m += fmt::format(".SH SYNOPSIS\n.B {}\n[OPTIONS]{}{}\n", roff(line), roff(positionals),
                    has_subs ? " [COMMAND]" : "");
   m += fmt::format(".SH DESCRIPTION\n{}\n", roff(app.get_description()));
-  m += ".SH OPTIONS\n";
+  std::string arguments, options;
   for (const CLI::Option* o : options_of(app)) {
     const std::string type = o->get_type_name();
-    std::string names = o->get_name(true, true);
-    m += fmt::format(
-        ".TP\n.B {}{}\n{}\n", roff(names),
-        type.empty() || o->get_items_expected_max() == 0 ? "" : " \\fI" + roff(type) + "\\fR",
-        roff(o->get_description().empty() ? "(no description)" : o->get_description()));
+    const bool takes_value = !type.empty() && o->get_items_expected_max() > 0;
+    std::string entry =
+        fmt::format(".TP\n.B {}{}\n{}\n", roff(o->get_name(true, true)),
+                    takes_value && o->nonpositional() ? " \\fI" + roff(type) + "\\fR" : "",
+                    roff(o->get_description().empty() ? "(no description)" : o->get_description()));
     if (!o->get_default_str().empty())
-      m += fmt::format("Default: {}.\n", roff(o->get_default_str()));
+      entry += fmt::format(".br\nDefault: {}\n", roff(o->get_default_str()));
+    (o->nonpositional() ? options : arguments) += entry;
   }
+  if (!arguments.empty()) m += ".SH ARGUMENTS\n" + arguments;
+  m += ".SH OPTIONS\n" + options;
   std::string subs;
   for (const auto& [p, s] : all)
     if (s->get_parent() == &app)
@@ -203,7 +218,9 @@ void add_docs_commands(CLI::App& app) {
   completion->add_option("SHELL", *shell, "The shell: bash")
       ->required()
       ->check(CLI::IsMember({"bash"}));
-  completion->callback([completion] { fmt::print("{}", bash_completion(root_of(*completion))); });
+  completion->callback([completion, shell] {  // shell: alive while CLI11 writes into it
+    fmt::print("{}", bash_completion(root_of(*completion)));
+  });
 }
 
 }  // namespace daq
