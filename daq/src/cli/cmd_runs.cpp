@@ -1,11 +1,11 @@
 // daq runs / show / export: stored runs.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <unistd.h>
 #include <ctime>
 #include <filesystem>
 #include <map>
@@ -24,9 +24,9 @@
 #include "commands.hpp"
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
-#include "progress.hpp"
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
+#include "progress.hpp"
 #include "provenance.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
@@ -579,9 +579,10 @@ void cmd_export(const ExportOptions& o) {
   const bool readings = o.format == "json" || o.what == "readings";
   {
     // A long export shows how far it is on the terminal, unless its rows go to that terminal.
-    TerminalProgress progress(fmt::format("export run {}", run.id), "readings",
-                              readings ? static_cast<std::uint64_t>(store.reading_count(run.id)) : 0,
-                              readings && ::isatty(::fileno(out)) == 0);
+    TerminalProgress progress(
+        fmt::format("export run {}", run.id), "readings",
+        readings ? static_cast<std::uint64_t>(store.reading_count(run.id)) : 0,
+        readings && ::isatty(::fileno(out)) == 0);
     if (o.format == "json")
       export_json(store, run, settings, out, progress);
     else if (o.what == "targets")
@@ -599,7 +600,7 @@ void cmd_export(const ExportOptions& o) {
   std::error_code ec;
   std::FILE* status = std::filesystem::is_regular_file(o.output, ec) ? stdout : stderr;
   fmt::print(status, "{} of run {} written to {}{}\n",
-             o.format == "json"       ? "JSON export"
+             o.format == "json"     ? "JSON export"
              : o.what == "readings" ? "readings"
                                     : "CSV of the " + o.what,
              run.id, o.output, bytes >= 0 ? fmt::format(" ({} bytes)", bytes) : "");
