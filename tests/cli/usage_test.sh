@@ -30,7 +30,7 @@ check value_like_a_command 2 "no such database" -- "$DAQ" runs --db report
 # CLI11's own errors: one prefix, where to look, status 2 (they were "RUN: ...", then "Run with
 # --help for more information.", status 2 only by main's mapping).
 check cli11_error_one_line 0 "^1 lines, 1 prefixed, status 2$" -- bash -c 'out=$("$1" env -t abc 2>&1); rc=$?; echo "$(wc -l <<<"$out") lines, $(grep -c "^daq: error: --temperature: .abc. is not a finite decimal number (see daq env --help)$" <<<"$out") prefixed, status $rc"' _ "$DAQ"
-check no_doubled_prefix 2 "^daq: error: daq serve needs -c FILE" -- "$DAQ" serve
+check no_doubled_prefix 2 "^daq: error: daq serve needs a set-up: give -c FILE" -- "$DAQ" serve
 check no_doubled_prefix_only 0 "^ok$" -- bash -c '"$1" serve 2>&1 | grep -qE "error: daq [a-z]+:" && echo doubled || echo ok' _ "$DAQ"
 
 # A busy port is the user's to change: status 2 naming it (it was status 1).
