@@ -38,7 +38,7 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
-configure_and_build() {
+configure() {
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
     # Debian's interpreter, where the python3-* packages above are (not a pyenv or venv python
     # first on PATH).
@@ -46,5 +46,9 @@ configure_and_build() {
     if [ -x /usr/bin/python3 ]; then python=(-DPython3_EXECUTABLE=/usr/bin/python3); fi
     cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${python[@]}"
   fi
+}
+
+configure_and_build() {
+  configure
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }

@@ -11,7 +11,7 @@ trap 'rm -rf "$TMP"' EXIT
 source "$(dirname "$0")/check.sh"
 
 # Usage errors: status 2 as docs/cli.md says (CLI11's own codes were 104-109).
-check usage_unknown_option 2 "The following argument was not expected: --bogus" -- "$DAQ" runs --bogus
+check usage_unknown_option 2 "^daq: error: unknown option .--bogus. of daq runs" -- "$DAQ" runs --bogus
 check usage_no_command 2 "A subcommand is required" -- "$DAQ"
 check usage_missing_required 2 "--last is required" -- "$DAQ" targets --first 0
 check usage_not_a_number 2 "'abc' is not a finite decimal number" -- "$DAQ" env -t abc

@@ -23,6 +23,7 @@
 #include "cal/drivers/loop_time.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
+#include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "cli_checks.hpp"
@@ -252,14 +253,6 @@ int run_demo(const DemoOptions& o) {
   if (o.speed == 0) d::VirtualTime::install(io);
   const double pace = o.speed > 0 ? o.speed : 1.0;  // simulated seconds per loop second
   SimulatedShop shop(io, ShopTruth{}, pace);
-  fmt::print("daq demo: ISO 230-2 test of the X axis of a SIMULATED machine (0 .. 500 mm)\n");
-  fmt::print("  laser: simulated IDS3010 on tcp 127.0.0.1:{}\n", shop.laser_port());
-  fmt::print("  air: simulated PTU300 on {} (4800 7E1)\n", shop.air_device());
-  fmt::print("  material: simulated serial thermometer on {}\n", shop.material_device());
-  if (o.speed > 0)
-    fmt::print("  simulated time runs {}x faster than real time\n\n", o.speed);
-  else
-    fmt::print("  simulated time jumps from event to event (as fast as the CPU allows)\n\n");
 
   const auto clock = shop.clock_ns();
   const auto poll = [&](double sim_s) {
@@ -282,6 +275,17 @@ int run_demo(const DemoOptions& o) {
   cal::replay::CaptureWriter capture(o.capture,
                                      capture_header(config, specs, "daq 0.1.0 demo (simulated)"));
   cal::replay::CaptureRecorder recorder(capture);
+  // The database and the capture open before the banner: a bad --db or --capture is the only
+  // thing printed (the banner after the error read as if the demo had started).
+  cal::storage::Store{o.db};
+  fmt::print("daq demo: ISO 230-2 test of the X axis of a SIMULATED machine (0 .. 500 mm)\n");
+  fmt::print("  laser: simulated IDS3010 on tcp 127.0.0.1:{}\n", shop.laser_port());
+  fmt::print("  air: simulated PTU300 on {} (4800 7E1)\n", shop.air_device());
+  fmt::print("  material: simulated serial thermometer on {}\n", shop.material_device());
+  if (o.speed > 0)
+    fmt::print("  simulated time runs {}x faster than real time\n\n", o.speed);
+  else
+    fmt::print("  simulated time jumps from event to event (as fast as the CPU allows)\n\n");
   LinearRun* running = nullptr;  // a capture that cannot be written aborts the run
   recorder.on_failure([&io, &running](const std::string& e) {
     boost::asio::post(io, [&running, e] {

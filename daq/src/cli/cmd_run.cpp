@@ -23,6 +23,7 @@
 #include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "progress.hpp"
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "linear_run.hpp"
@@ -101,21 +102,30 @@ void check_at_start(const cal::daq::Config& config, const std::vector<Instrument
 
 // Where progress and events go: stdout, or stderr when stdout carries --json. On a terminal
 // the live line is rewritten in place; into a file or a pipe each line is written whole and
-// flushed as it happens (a log that is read while the run goes on).
+// flushed as it happens (a log that is read while the run goes on). With --json the progress
+// is JSON lines on stderr (caldaq.live.v1 and caldaq.event.v1, docs/cli.md), one at each change
+// of state, on a terminal too: a program reads them.
 struct ProgressOut {
   std::FILE* out;
+  bool json;
   bool tty;
-  std::string last;  // the last progress line written to a file or pipe
-  explicit ProgressOut(bool json)
-      : out(json ? stderr : stdout), tty(::isatty(::fileno(out)) != 0) {}
+  std::string last;  // the key of the last progress line written to a file or pipe
+  explicit ProgressOut(bool as_json)
+      : out(as_json ? stderr : stdout),
+        json(as_json),
+        tty(!as_json && ::isatty(::fileno(out)) != 0) {}
   void event(const std::string& e) {
-    fmt::print(out, "{}  {}\n", tty ? "\r\033[K" : "", e);
+    if (json)
+      fmt::print(out, "{}\n",
+                 nlohmann::json{{"schema", "caldaq.event.v1"}, {"message", e}}.dump());
+    else
+      fmt::print(out, "{}  {}\n", tty ? "\r\033[K" : "", e);
     std::fflush(out);
   }
   // `key` names the state: a file gets a line only when it changes (run, target, phase).
   void live(const std::string& key, const std::string& line) {
     if (tty) {
-      fmt::print(out, "\r{}", line);
+      fmt::print(out, "\r\033[K{}", line);
     } else {
       if (key == last) return;
       last = key;
@@ -124,6 +134,40 @@ struct ProgressOut {
     std::fflush(out);
   }
 };
+
+// A piped or logged run gets a line per stop, and one when the first laser reading arrives.
+std::string live_key(const LiveState& s) {
+  return fmt::format("{} {} {}", s.stop_number, s.has_reading, s.state);
+}
+
+// The live line of a linear run: where in the plan (run, target, stop k of N), the number the
+// page shows (the position while the axis moves, the deviation within a target's capture
+// window), the air and material once sampled, the time so far and left. No number before the
+// device has given one: a zero there would read as a measurement.
+std::string live_line(const LiveState& s) {
+  const auto& p = s.progress;
+  std::string line =
+      fmt::format("run {} of {} {}  target {} of {}  stop {} of {}", p.run, p.runs,
+                  p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target,
+                  p.targets, std::min(s.stop_number, s.stop_count), s.stop_count);
+  if (!s.has_reading) return line + "  waiting for the laser's first reading";
+  if (!s.valid)
+    line += "  laser signal lost";
+  else if (s.at_target_mm)
+    line += fmt::format("  {:<8} {:+8.2f} um at {:.3f} mm", s.motion, s.at_target_deviation_um,
+                        *s.at_target_mm);
+  else
+    line += fmt::format("  {:<8} at {:.3f} mm", s.motion, s.position_mm);
+  if (s.pressure_pa > 0)  // the first air sample has come (env_stage.hpp)
+    line += fmt::format("  air {:.2f} degC  material {:.2f} degC{}", s.air_temperature_degc,
+                        s.material_degc, s.fallback ? " (fallback)" : "");
+  line += fmt::format("  {} elapsed", clock_text(s.time_s));
+  const auto done =
+      static_cast<double>(std::max<std::size_t>(std::min(s.stop_number, s.stop_count + 1), 1) - 1);
+  if (const auto left = remaining_s(s.time_s, done, static_cast<double>(s.stop_count)))
+    line += fmt::format(", about {} left", clock_text(*left));
+  return line;
+}
 
 Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
                        const nlohmann::json& result) {
@@ -166,14 +210,9 @@ void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const Run
   auto progress = std::make_shared<ProgressOut>(o.json);
   setup.on_event = [progress](const std::string& e) { progress->event(e); };
   setup.on_live = [progress](const LiveState& s) {
+    if (progress->json) return progress->live(live_key(s), to_json_text(s));
     if (!s.progress.next_position_mm) return;
-    const char* dir = s.progress.direction == cal::iso230_2::Direction::up ? "up" : "down";
-    progress->live(
-        fmt::format("{} {} {}", s.progress.run, dir, s.progress.target),
-        fmt::format("run {} of {} {}  target {} of {}  {:+9.2f} um  air {:.2f} degC  material "
-                    "{:.2f} degC  ",
-                    s.progress.run, s.progress.runs, dir, s.progress.target, s.progress.targets,
-                    s.deviation_um, s.air_temperature_degc, s.material_degc));
+    progress->live(live_key(s), live_line(s));
   };
   LinearRun run(io, std::move(setup));
   run.start();
@@ -235,8 +274,17 @@ void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const Run
   auto progress = std::make_shared<ProgressOut>(o.json);
   setup.on_event = [progress](const std::string& e) { progress->event(e); };
   setup.on_live = [progress](const CircleLive& s) {
-    progress->live(s.phase, fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  ", s.phase,
-                                        s.angle_deg, s.deviation_um, 100 * s.fraction));
+    const std::string key = fmt::format("{} {}", s.phase, s.samples > 0);
+    if (progress->json) return progress->live(key, to_json_text(s));
+    if (s.samples == 0)  // no deviation before the bar has sent one
+      return progress->live(key, fmt::format("{:<24} waiting for the ballbar's first reading",
+                                             s.phase));
+    std::string line = fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed",
+                                   s.phase, s.angle_deg, s.deviation_um, 100 * s.fraction,
+                                   clock_text(s.time_s));
+    if (const auto left = remaining_s(s.time_s, s.fraction, 1.0))
+      line += fmt::format(", about {} left", clock_text(*left));
+    progress->live(key, line);
   };
   CircleRun run(io, std::move(setup));
   run.start();

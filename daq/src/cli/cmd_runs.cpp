@@ -1,11 +1,13 @@
 // daq runs / show / export: stored runs.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -24,6 +26,7 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
+#include "progress.hpp"
 #include "provenance.hpp"
 #include "reading_times.hpp"
 #include "result_rows.hpp"
@@ -309,7 +312,7 @@ std::optional<std::string> stop_value_column(const st::RunRecord& run, const jso
 }
 
 void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
-                         std::FILE* out) {
+                         std::FILE* out, TerminalProgress& progress) {
   ExportClock clock(store, run, settings);
   const auto names = device_names(store, run.id);
   fmt::print(out, "{}\n", kReadingColumns);
@@ -320,6 +323,7 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
                x.r.channel,
                cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
                x.r.status, num(x.r.value), x.r.time_ns);
+    progress.add();
   });
 }
 
@@ -388,7 +392,7 @@ std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{}", v) 
 // caldaq.export.v1. Everything but the readings is built as one document; the readings, which
 // grow with the run, are written row by row into its place as they stream from the store.
 void export_json(const st::Store& store, const st::RunRecord& run, const json& settings,
-                 std::FILE* out) {
+                 std::FILE* out, TerminalProgress& progress) {
   json j = run_json(run);
   j["schema"] = "caldaq.export.v1";
   {
@@ -439,6 +443,7 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
                cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
                x.r.status, json_num(x.r.value), x.r.time_ns);
     first = false;
+    progress.add();
   });
   fmt::print(out, "{}]{}\n", first ? "" : "\n ", std::string_view(text).substr(at + marker.size()));
 }
@@ -464,16 +469,34 @@ void cmd_export(const ExportOptions& o) {
   }
   const auto run = need_run(store, o.run);
   const json settings = cal::daq::parse_stored_json(run.settings_json);
-  if (o.format == "json")
-    export_json(store, run, settings, out);
-  else if (o.what == "targets")
-    export_targets_csv(store, run, settings, out);
-  else if (o.what == "circle")
-    export_circle_csv(store, run, settings, out);
-  else
-    export_readings_csv(store, run, settings, out);
-  if (std::ferror(out))
+  const bool readings = o.format == "json" || o.what == "readings";
+  {
+    // A long export shows how far it is on the terminal, unless its rows go to that terminal.
+    TerminalProgress progress(
+        fmt::format("export run {}", run.id), "readings",
+        readings ? static_cast<std::uint64_t>(store.reading_count(run.id)) : 0,
+        readings && ::isatty(::fileno(out)) == 0);
+    if (o.format == "json")
+      export_json(store, run, settings, out, progress);
+    else if (o.what == "targets")
+      export_targets_csv(store, run, settings, out);
+    else if (o.what == "circle")
+      export_circle_csv(store, run, settings, out);
+    else
+      export_readings_csv(store, run, settings, out, progress);
+  }
+  if (std::fflush(out) != 0 || std::ferror(out))
     throw cal::InputError(fmt::format("{}: write failed", o.output.empty() ? "stdout" : o.output));
+  // Into a file: say what was written; on stderr when the file is a stream (-o /dev/stdout).
+  if (o.output.empty()) return;
+  const long bytes = std::ftell(out);
+  std::error_code ec;
+  std::FILE* status = std::filesystem::is_regular_file(o.output, ec) ? stdout : stderr;
+  fmt::print(status, "{} of run {} written to {}{}\n",
+             o.format == "json"     ? "JSON export"
+             : o.what == "readings" ? "readings"
+                                    : "CSV of the " + o.what,
+             run.id, o.output, bytes >= 0 ? fmt::format(" ({} bytes)", bytes) : "");
 }
 
 }  // namespace

@@ -71,7 +71,8 @@ void add_serve_command(CLI::App& app) {
       ->check(finite_non_negative());
   cmd->callback([o] {
     if (!o->simulate && o->run.config.empty())
-      throw cal::InputError("daq serve: give -c FILE (a configuration) or --simulate");
+      throw cal::InputError(
+          "daq serve needs a set-up: give -c FILE (a configuration) or --simulate");
     serve::serve(*o);
   });
 }

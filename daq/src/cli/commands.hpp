@@ -42,4 +42,7 @@ void add_model_commands(CLI::App& app);
 // ballbar calibrate|calibrations|volumetric|history
 void add_ballbar_commands(CLI::App& app);
 
+// man-pages DIR, completion bash: the manual pages and shell completion from the command tree
+void add_docs_commands(CLI::App& app);
+
 }  // namespace daq

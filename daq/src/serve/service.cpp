@@ -216,9 +216,11 @@ class Service {
     try {
       make_server();
     } catch (const std::invalid_argument& e) {
-      throw cal::InputError(fmt::format("daq serve: {}", e.what()));
+      throw cal::InputError(e.what());
     } catch (const std::runtime_error& e) {
-      throw std::runtime_error(fmt::format("daq serve: {}", e.what()));
+      // The address or port given (or the default) is taken or not ours: the user's to
+      // change, a usage error (status 2) as a bad value is.
+      throw cal::InputError(fmt::format("{} (--address, --port)", e.what()));
     }
     tick();
     publish_loop();
