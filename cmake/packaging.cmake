@@ -40,6 +40,9 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_GENERATOR DEB)
+# Binaries without their debug information: the build type keeps it (RelWithDebInfo), and daq
+# with it is 300 MB; the shop-floor package needs the program, not its symbols.
+set(CPACK_STRIP_FILES ON)
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 # The Python package when it is built (python/CMakeLists.txt: pybind11 and Python's headers).
 if(TARGET _caldaq)
