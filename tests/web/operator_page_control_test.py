@@ -36,22 +36,6 @@ TMP = tempfile.mkdtemp(prefix="operator-page-control-")
 DB = os.path.join(TMP, "runs.sqlite")
 
 
-def start_serve():
-    log = open(os.path.join(TMP, "serve.log"), "w+")
-    proc = subprocess.Popen([DAQ, "serve", "--simulate", "--speed", "20", "--port", "0", "--db", DB],
-                            stdout=log, stderr=subprocess.STDOUT)
-    for _ in range(500):
-        log.seek(0)
-        m = re.search(r"daq serve: (http://[0-9.]+:[0-9]+/)", log.read())
-        if m:
-            return proc, m.group(1)
-        if proc.poll() is not None:
-            break
-        time.sleep(0.02)
-    log.seek(0)
-    raise AssertionError("daq serve --simulate did not start: " + log.read())
-
-
 def get(url):
     with urllib.request.urlopen(url, timeout=30) as r:
         return json.load(r)
@@ -74,7 +58,7 @@ def control(b, key, action):
     return c
 
 
-serve, url = start_serve()
+serve, url = page_checks.start_simulated_service(DAQ, TMP, DB)
 b = Browser(1366, 768)
 try:
     setup = get(url + "api/setup")["setup"]

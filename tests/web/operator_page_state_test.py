@@ -19,7 +19,6 @@ import os
 import re
 import shutil
 import signal
-import subprocess
 import sys
 import tempfile
 import time
@@ -45,23 +44,6 @@ def settle_machine(url):
     post(url + "api/simulation/speed", {"speed": 100})
     time.sleep(2.0)
     post(url + "api/simulation/speed", {"speed": 20})
-
-
-def start_serve():
-    log = open(os.path.join(TMP, "serve.log"), "w+")
-    proc = subprocess.Popen([DAQ, "serve", "--simulate", "--speed", "20", "--port", "0",
-                             "--db", os.path.join(TMP, "runs.sqlite")],
-                            stdout=log, stderr=subprocess.STDOUT)
-    for _ in range(500):
-        log.seek(0)
-        m = re.search(r"daq serve: (http://[0-9.]+:[0-9]+/)", log.read())
-        if m:
-            return proc, m.group(1)
-        if proc.poll() is not None:
-            break
-        time.sleep(0.02)
-    log.seek(0)
-    raise AssertionError("daq serve --simulate did not start: " + log.read())
 
 
 # What the operator sees of the live state.
@@ -109,7 +91,7 @@ def wait_stale(b, where):
     return took
 
 
-serve, url = start_serve()
+serve, url = page_checks.start_simulated_service(DAQ, TMP, os.path.join(TMP, "runs.sqlite"))
 b = Browser(1366, 768)
 try:
     # A short test (12 stops) so that a whole run completes in a few seconds.

@@ -2,8 +2,10 @@
 JSON POST that returns (status, body) for errors too."""
 import json
 import os
+import re
 import signal
 import subprocess
+import time
 import urllib.error
 import urllib.request
 
@@ -34,6 +36,24 @@ def post(url, body):
             return r.status, json.load(r)
     except urllib.error.HTTPError as e:
         return e.code, json.load(e)
+
+
+def start_simulated_service(daq, tmp, db):
+    """Starts `daq serve --simulate` at 20x on a free port with its log in tmp; returns the
+    process and the page's URL once the service prints it (or fails with the log)."""
+    log = open(os.path.join(tmp, "serve.log"), "w+")
+    proc = subprocess.Popen([daq, "serve", "--simulate", "--speed", "20", "--port", "0", "--db", db],
+                            stdout=log, stderr=subprocess.STDOUT)
+    for _ in range(500):
+        log.seek(0)
+        m = re.search(r"daq serve: (http://[0-9.]+:[0-9]+/)", log.read())
+        if m:
+            return proc, m.group(1)
+        if proc.poll() is not None:
+            break
+        time.sleep(0.02)
+    log.seek(0)
+    raise AssertionError("daq serve --simulate did not start: " + log.read())
 
 
 def stop_service(proc):
