@@ -230,6 +230,25 @@ try:
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent);",
                what="the set-up to be applied")
 
+        # --- 3b. a set-up applied elsewhere while the operator types ----------------------------
+        # The page reloads its form when another client applies a set-up; it must never wipe what
+        # the operator is typing (CI once lost the dead-device edits below to such a reload).
+        set_field(b, "test.linear.dwell_s", "3")
+        status, other = post(url + "api/setup/apply", {"setup": b.js("return window.caldaq.base;")})
+        ok(status == 200, f"a set-up applied from another client while the operator types: "
+           f"version {other.get('version')}")
+        b.wait(f"return window.caldaq.page.status.setup.version === {other.get('version')};",
+               what="the page to see the set-up applied elsewhere")
+        time.sleep(1.0)  # ten status messages: a reload, if any, would have come by now
+        dwell = b.js("""return [...document.querySelectorAll('[data-key]')]
+            .find(i => i.dataset.key === 'test.linear.dwell_s').value;""")
+        ok(dwell == "3", f"what the operator typed is kept when a set-up is applied elsewhere: {dwell!r}")
+        wait_valid(b)
+        b.js("document.getElementById('apply').click();")
+        b.wait("return /Applied/.test(document.getElementById('apply-result').textContent) && "
+               "window.caldaq.base.test.linear.dwell_s == 3;", what="the typed set-up applied",
+               explain="return document.getElementById('apply-result').textContent;")
+
         # --- 4. dead devices -------------------------------------------------------------------
         # The air station's, the laser's and the ballbar's ports gone (the issue's ballbar run on
         # a vanished port showed 0.00 um and "running" for a minute). The laser too: its
@@ -246,7 +265,9 @@ try:
         b.js("document.getElementById('apply').click();")
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent) && "
                "window.caldaq.page.devices.devices.find(d => d.id === 'air').transport.includes('no-such-port');",
-               what="the set-up with a dead air station")
+               what="the set-up with a dead air station",
+               explain="return [document.getElementById('apply-result').textContent, "
+                       "JSON.stringify(window.caldaq.page.devices.devices.map(d => [d.id, d.transport, d.state]))];")
         b.js("document.getElementById('tab-run').click();")
         b.wait("const d = window.caldaq.page.devices.devices.find(d => d.id === 'air');"
                "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=15,
@@ -427,18 +448,24 @@ try:
            f"the PDF link (of the linear run) serves a PDF ({len(body)} bytes)")
 
         # --- 8. Stop asks for confirmation; the layout at 600 px -----------------------------
-        simulation_speed(url, 10)  # the run goes on for the 5 s these checks may take
+        # The run must go on for the checks below (seconds on a starved machine): at 2x its twelve
+        # stops of 3 s dwell take over 20 s.
+        simulation_speed(url, 2)
         b.js("document.getElementById('tab-run').click();")
         b.wait("return window.caldaq.page.status.start.linear.ready;", timeout_s=30,
                what="Start linear ready again")
         b.js("document.getElementById('start-linear').click();")
-        b.wait("return window.caldaq.page.status.running;", what="the third run")
+        third = b.wait("return window.caldaq.page.status.running && window.caldaq.page.status.run.id;",
+                       timeout_s=45, what="the third run")
         b.js("document.getElementById('stop').click();")
         ok(b.js("return document.getElementById('confirm-stop').open;"), "Stop asks first")
         shot(b, "12-stop-confirmation.png")
         b.js("document.getElementById('confirm-no').click();")
         time.sleep(0.5)
-        ok(b.js("return window.caldaq.page.status.running;"), "Keep running keeps it running")
+        # Running still, or (on a starved machine) ended by itself, never aborted by this click.
+        kept = b.js("const s = window.caldaq.page.status; return s.running ? 'running' : "
+                    "(s.last && s.last.run === arguments[0] ? s.last.status : 'gone');", third)
+        ok(kept in ("running", "complete", "incomplete"), f"Keep running keeps it running: {kept}")
         b.set_size(560, 1000)
         time.sleep(0.5)
         overflow = b.js("return document.documentElement.scrollWidth - window.innerWidth;")
@@ -451,10 +478,15 @@ try:
         ok(others and others[0] in ("open", "streaming"),
            f"a linear run leaves the ballbar watched (not silent): {others}")
         shot(b, "13-narrow-560px.png")
-        b.js("document.getElementById('stop').click();")
-        b.js("document.getElementById('confirm-yes').click();")
-        b.wait("const l = window.caldaq.page.status.last; return l && l.status === 'aborted';",
-               what="the confirmed stop")
+        if kept == "running":
+            b.js("document.getElementById('stop').click();")
+            b.js("document.getElementById('confirm-yes').click();")
+            b.wait("const l = window.caldaq.page.status.last; return l && l.status === 'aborted';",
+                   timeout_s=45, what="the confirmed stop",
+                   explain="return JSON.stringify(window.caldaq.page.status.last);")
+        else:
+            print(f"note: the third run ended by itself ({kept}) before Stop could be confirmed "
+                  "(a starved machine); the confirmation was checked above")
         # The page's rule for a device that dies during a run, on hand-made states (the shop has
         # no switch to unplug the laser mid-run): the same run state shows the number while the
         # laser streams, and dashes with the laser's state once it is silent, never the value.
