@@ -84,7 +84,7 @@ def set_field(b, key, value):
 
 
 def wait_valid(b):
-    b.wait(VALID, timeout_s=15, what="the set-up to be valid")
+    b.wait(VALID, timeout_s=45, what="the set-up to be valid")
 
 
 def page_state(b):
@@ -125,7 +125,7 @@ try:
         b.wait("return window.caldaq && window.caldaq.page && "
                "window.caldaq.page.status.start.linear.ready;", timeout_s=30,
                what="the instruments to stream (Start linear ready)")
-        b.wait("return document.getElementById('env-n').textContent !== '—';", timeout_s=10,
+        b.wait("return document.getElementById('env-n').textContent !== '—';", timeout_s=30,
                what="the refractive index while idle")
         env = b.js("""const g = id => document.getElementById(id).textContent;
             return {air: g('env-air'), p: g('env-p'), rh: g('env-rh'), n: g('env-n'),
@@ -156,12 +156,12 @@ try:
                            ("test.linear.interval_mm", "50"), ("test.linear.random_fraction", ""),
                            ("test.linear.dwell_s", "4"), ("test.linear.runs", "0")):
             set_field(b, key, value)
-        err = b.wait(FIELD_ERROR.replace("arguments[0]", "'test.linear.runs'"), timeout_s=10,
+        err = b.wait(FIELD_ERROR.replace("arguments[0]", "'test.linear.runs'"), timeout_s=30,
                      what="the runs field's error")
         ok("1 .. 1000" in err, f"validation as typed: runs = 0 -> '{err}'")
         set_field(b, "test.linear.feed_mm_per_min", "-5")
         err = b.wait(FIELD_ERROR.replace("arguments[0]", "'test.linear.feed_mm_per_min'"),
-                     timeout_s=10, what="the feed field's error")
+                     timeout_s=30, what="the feed field's error")
         ok("-5" in err, f"a second problem shown at once: feed = -5 -> '{err}'")
         ok(b.js("return document.getElementById('apply').disabled;"),
            "Use this set-up is disabled while there are problems")
@@ -270,12 +270,12 @@ try:
                        "JSON.stringify(window.caldaq.page.devices.devices.map(d => [d.id, d.transport, d.state]))];")
         b.js("document.getElementById('tab-run').click();")
         b.wait("const d = window.caldaq.page.devices.devices.find(d => d.id === 'air');"
-               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=15,
+               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=30,
                what="the air station reported as reconnecting")
         b.wait("return document.getElementById('env-air').textContent === '—';",
                what="the air temperature shown as dashes")
         b.wait("const d = window.caldaq.page.devices.devices.find(d => d.id === 'ballbar');"
-               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=15,
+               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=30,
                what="the ballbar reported as reconnecting")
         dead = b.js("""const li = document.querySelector('#devices li[data-device=air]');
             return {state: li.dataset.state, text: li.textContent,
@@ -395,7 +395,7 @@ try:
 
         # --- 6. results ------------------------------------------------------------------------
         b.wait("return !document.getElementById('view-results').hidden && "
-               "document.getElementById('report-html');", timeout_s=15, what="the results view")
+               "document.getElementById('report-html');", timeout_s=45, what="the results view")
         verdict = b.wait("return document.getElementById('result-verdict').textContent;",
                          what="the verdict")
         checks = b.js("return [...document.querySelectorAll('#verdict-table tbody tr')].map(r => r.textContent);")
@@ -439,7 +439,7 @@ try:
            "the ballbar run completed")
         b.wait("return !document.getElementById('view-results').hidden && "
                "/circle/.test(document.getElementById('result-head').textContent) && "
-               "document.getElementById('result-values');", timeout_s=15, what="its results")
+               "document.getElementById('result-values');", timeout_s=45, what="its results")
         g = b.js("return [...document.querySelectorAll('#result-values tr')].map(r => r.textContent);")
         ok(g and g[0].startswith("G"), f"ballbar results: {g[:3]}")
         shot(b, "11-results-ballbar.png")
