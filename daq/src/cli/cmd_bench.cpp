@@ -634,6 +634,7 @@ std::int64_t generate_run(cal::storage::Store& store, int seconds) {
 
 struct ChildResult {
   double seconds = 0.0;
+  double cpu_s = 0.0;  // user and system
   long peak_rss_kib = 0;
 };
 
@@ -648,6 +649,7 @@ ChildResult run_child(const std::vector<std::string>& args) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
   const auto t0 = Clock::now();
   pid_t pid = 0;
   const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
@@ -658,25 +660,87 @@ ChildResult run_child(const std::vector<std::string>& args) {
   if (::wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw cal::InputError(
         fmt::format("bench: daq {} failed (status {})", fmt::join(args, " "), status));
-  return {seconds_since(t0), usage.ru_maxrss};
+  const auto tv = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
+  return {seconds_since(t0), tv(usage.ru_utime) + tv(usage.ru_stime), usage.ru_maxrss};
+}
+
+// The ceiling of an export, measured in this process beside it: what any export must do at the
+// least, read the run's readings from the store (every chunk decoded, nothing formatted) and
+// write as many bytes as the export wrote (its own first 64 KiB, repeated, to a file in the same
+// directory). CPU seconds (this thread) and wall seconds of each.
+struct ExportCeiling {
+  double read_s = 0.0, read_cpu_s = 0.0, write_s = 0.0, write_cpu_s = 0.0;
+};
+
+ExportCeiling export_ceiling(const fs::path& db, std::int64_t run, const fs::path& exported,
+                             const fs::path& scratch) {
+  ExportCeiling c;
+  {
+    auto t0 = Clock::now();
+    double cpu0 = cpu_seconds(RUSAGE_THREAD);
+    cal::storage::Store store(db, {.read_only = true});
+    auto stream = store.stream_readings(run);
+    std::vector<cal::storage::RawReading> batch;
+    double sum = 0.0;
+    while (stream.next(batch))
+      for (const auto& r : batch) sum += r.value;
+    c.read_s = seconds_since(t0);
+    c.read_cpu_s = cpu_seconds(RUSAGE_THREAD) - cpu0;
+    if (!std::isfinite(sum)) fmt::print("");  // keeps the sum (and the decoding) alive
+  }
+  const auto bytes = fs::file_size(exported);
+  std::vector<char> block(1 << 16);
+  {
+    std::FILE* in = std::fopen(exported.c_str(), "rb");
+    if (!in) throw cal::InputError(fmt::format("bench: cannot read {}", exported.string()));
+    block.resize(std::fread(block.data(), 1, block.size(), in));
+    std::fclose(in);
+  }
+  if (block.empty()) return c;
+  const auto t0 = Clock::now();
+  const double cpu0 = cpu_seconds(RUSAGE_THREAD);
+  std::FILE* out = std::fopen(scratch.c_str(), "wb");
+  if (!out) throw cal::InputError(fmt::format("bench: cannot write {}", scratch.string()));
+  for (std::uintmax_t left = bytes; left > 0;) {
+    const auto n = std::min<std::uintmax_t>(left, block.size());
+    std::fwrite(block.data(), 1, n, out);
+    left -= n;
+  }
+  std::fclose(out);
+  c.write_s = seconds_since(t0);
+  c.write_cpu_s = cpu_seconds(RUSAGE_THREAD) - cpu0;
+  return c;
 }
 
 struct ExportBenchOptions {
   int minutes = 60;
   int steps = 4;
   std::string dir;
+  std::string keep;  // the generated database, kept under this name
 };
 
 void bench_export(const ExportBenchOptions& o) {
   if (o.minutes < 1 || o.steps < 1)
     throw cal::InputError("bench export: --minutes and --steps must be at least 1");
   const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
-  const fs::path db = dir / ("caldaq-bench-export-" + std::to_string(::getpid()) + ".sqlite");
-  const fs::path html = dir / ("caldaq-bench-report-" + std::to_string(::getpid()) + ".html");
-  const Cleanup cleanup({db, html});
+  const auto tag = std::to_string(::getpid());
+  const fs::path db =
+      o.keep.empty() ? dir / ("caldaq-bench-export-" + tag + ".sqlite") : fs::path(o.keep);
+  const fs::path html = dir / ("caldaq-bench-report-" + tag + ".html");
+  const fs::path exported = dir / ("caldaq-bench-export-" + tag + ".out");
+  const fs::path scratch = dir / ("caldaq-bench-ceiling-" + tag + ".out");
+  const Cleanup cleanup(o.keep.empty() ? std::vector<fs::path>{db, html, exported, scratch}
+                                       : std::vector<fs::path>{html, exported, scratch});
+  if (!o.keep.empty() && fs::exists(db))
+    throw cal::InputError(fmt::format(
+        "bench export: --keep-db {}: the file exists; name a new one (nothing was written)",
+        db.string()));
   remove_db(db);
-  fmt::print("{:>8} {:>11} {:>9}  {:>16} {:>16} {:>16}\n", "minutes", "readings", "stored MB",
-             "export csv", "export json", "report (html)");
+  fmt::print("{:>7} {:>10} {:>7}  {:>31}  {:>31}  {:>16}\n", "minutes", "readings", "MB",
+             "export csv: wall, CPU, RSS, %", "export json: wall, CPU, RSS, %", "report (html)");
+  std::vector<std::string> ceilings;
   for (int k = 1; k <= o.steps; ++k) {
     const int seconds = o.minutes * 60 * k / o.steps;
     std::int64_t run = 0, count = 0;
@@ -688,20 +752,35 @@ void bench_export(const ExportBenchOptions& o) {
     }
     const double stored_mb = static_cast<double>(fs::file_size(db) - size_before) / 1e6;
     const auto id = std::to_string(run);
-    const auto csv = run_child({"export", id, "--db", db.string(), "-o", "/dev/null"});
-    const auto json =
-        run_child({"export", id, "--db", db.string(), "--format", "json", "-o", "/dev/null"});
-    const auto report = run_child({"report", id, "--db", db.string(), "-o", html.string()});
-    const auto cell = [](const ChildResult& r) {
-      return fmt::format("{:6.2f} s {:5.0f} MB", r.seconds,
-                         static_cast<double>(r.peak_rss_kib) / 1024);
+    // Each export to a file, then its ceiling for the same bytes (both on the same load).
+    const auto measure = [&](const char* format) {
+      const auto r = run_child(
+          {"export", id, "--db", db.string(), "--format", format, "-o", exported.string()});
+      const auto c = export_ceiling(db, run, exported, scratch);
+      const double mb = static_cast<double>(fs::file_size(exported)) / 1e6;
+      ceilings.push_back(fmt::format(
+          "  {:5.1f} min {:4}: {:6.0f} MB written; store read {:.2f} s (CPU {:.2f} s), writing "
+          "the same bytes {:.2f} s (CPU {:.2f} s): export at {:.0f} % of that ceiling by CPU, "
+          "{:.0f} % by wall time",
+          seconds / 60.0, format, mb, c.read_s, c.read_cpu_s, c.write_s, c.write_cpu_s,
+          100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s,
+          100.0 * (c.read_s + c.write_s) / r.seconds));
+      return fmt::format("{:6.2f} s {:6.2f} s {:4.0f} MB {:3.0f} %", r.seconds, r.cpu_s,
+                         static_cast<double>(r.peak_rss_kib) / 1024,
+                         100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s);
     };
-    fmt::print("{:>8.1f} {:>11} {:>9.1f}  {:>16} {:>16} {:>16}\n", seconds / 60.0, count, stored_mb,
-               cell(csv), cell(json), cell(report));
+    const auto csv = measure("csv");
+    const auto json = measure("json");
+    const auto report = run_child({"report", id, "--db", db.string(), "-o", html.string()});
+    fmt::print("{:>7.1f} {:>10} {:>7.1f}  {:>31}  {:>31}  {:6.2f} s {:4.0f} MB\n", seconds / 60.0,
+               count, stored_mb, csv, json, report.seconds,
+               static_cast<double>(report.peak_rss_kib) / 1024);
   }
   fmt::print(
-      "(wall time and peak RSS of each daq process; readings per second of export: the "
-      "readings column over the time)\n");
+      "(wall time, CPU time and peak RSS of each daq process; %: the export's CPU time against "
+      "its ceiling's, measured beside it: reading the run from the store and writing the same "
+      "number of bytes)\n{}\n",
+      fmt::join(ceilings, "\n"));
 }
 
 }  // namespace
@@ -738,6 +817,8 @@ void add_bench_commands(CLI::App& app) {
   ex->add_option("--steps", e->steps, "Runs of 1/steps ... steps/steps of that length")
       ->capture_default_str();
   ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
+  ex->add_option("--keep-db", e->keep,
+                 "Store the generated runs in this new file and keep it (to export or inspect)");
   ex->callback([e] { bench_export(*e); });
 }
 

@@ -1,4 +1,5 @@
 // daq runs / show / export: stored runs.
+#include <fmt/compile.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -247,6 +249,32 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
 // Numbers in the shortest form that reads back to the same double (fmt's "{}").
 std::string num(double v) { return fmt::format("{}", v); }
 
+// An export's rows are formatted into one buffer with formats compiled in (no string per value,
+// no format string parsed per row) and written 64 KiB at a time: per-value strings and a print
+// per row were most of an export's time (issue 32).
+class RowBuffer {
+ public:
+  explicit RowBuffer(std::FILE* out) : out_(out) {}
+  RowBuffer(const RowBuffer&) = delete;
+  RowBuffer& operator=(const RowBuffer&) = delete;
+  ~RowBuffer() { write(); }
+  fmt::appender it() { return fmt::appender(text_); }
+  void add(std::string_view s) { text_.append(s.data(), s.data() + s.size()); }
+  // Called after each row: writes the buffer once it is full.
+  void row_done() {
+    if (text_.size() >= kFlushAt) write();
+  }
+  void write() {
+    if (text_.size() != 0) std::fwrite(text_.data(), 1, text_.size(), out_);
+    text_.clear();
+  }
+
+ private:
+  static constexpr std::size_t kFlushAt = 1 << 16;
+  fmt::memory_buffer text_;
+  std::FILE* out_;
+};
+
 // Every reading of the run (or of these quantities), in time order: the one place the export
 // reads them. Streamed from the store a batch at a time, so an export's memory does not grow
 // with the run (docs/benchmarks.md, daq bench export).
@@ -314,15 +342,20 @@ std::optional<std::string> stop_value_column(const st::RunRecord& run, const jso
 void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
                          std::FILE* out, TerminalProgress& progress) {
   ExportClock clock(store, run, settings);
-  const auto names = device_names(store, run.id);
+  std::map<int, std::string> names;  // CSV fields, quoted where needed
+  for (const auto& [device, name] : device_names(store, run.id)) names[device] = csv_field(name);
   fmt::print(out, "{}\n", kReadingColumns);
+  RowBuffer b(out);
   each_export_row(store, run.id, clock, [&](const ExportRow& x) {
     const auto it = names.find(x.r.device);
-    fmt::print(out, "{},{},{},{},{},{},{},{},{}\n", num(clock.seconds(x.session_ns)),
-               clock.utc(x.session_ns), x.r.device, csv_field(it == names.end() ? "" : it->second),
-               x.r.channel,
-               cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
-               x.r.status, num(x.r.value), x.r.time_ns);
+    fmt::format_to(b.it(), FMT_COMPILE("{},"), clock.seconds(x.session_ns));
+    b.add(clock.utc_view(x.session_ns));
+    fmt::format_to(b.it(), FMT_COMPILE(",{},{},{},{},{},{},{}\n"), x.r.device,
+                   it == names.end() ? std::string_view() : std::string_view(it->second),
+                   x.r.channel,
+                   cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
+                   x.r.status, x.r.value, x.r.time_ns);
+    b.row_done();
     progress.add();
   });
 }
@@ -385,10 +418,6 @@ void export_circle_csv(const st::Store& store, const st::RunRecord& run, const j
   }
 }
 
-// A JSON number as nlohmann writes it for a double (shortest form that reads back the same;
-// null for what JSON cannot hold).
-std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
-
 // caldaq.export.v1. Everything but the readings is built as one document; the readings, which
 // grow with the run, are written row by row into its place as they stream from the store.
 void export_json(const st::Store& store, const st::RunRecord& run, const json& settings,
@@ -435,16 +464,31 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
   if (at == std::string::npos) throw std::logic_error("export_json: no place for the readings");
   fmt::print(out, "{}\n \"readings\": [", std::string_view(text).substr(0, at));
   bool first = true;
-  each_export_row(store, run.id, clock, [&](const ExportRow& x) {
-    const auto it = names.find(x.r.device);
-    fmt::print(out, "{}\n  [{},\"{}\",{},{},{},\"{}\",{},{},{}]", first ? "" : ",",
-               json_num(clock.seconds(x.session_ns)), clock.utc(x.session_ns), x.r.device,
-               it == names.end() ? std::string("\"\"") : it->second, x.r.channel,
-               cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
-               x.r.status, json_num(x.r.value), x.r.time_ns);
-    first = false;
-    progress.add();
-  });
+  {
+    RowBuffer b(out);
+    const auto number = [&b](double v) {
+      if (std::isfinite(v))
+        fmt::format_to(b.it(), FMT_COMPILE("{}"), v);
+      else
+        b.add("null");  // what JSON cannot hold, as nlohmann writes it
+    };
+    each_export_row(store, run.id, clock, [&](const ExportRow& x) {
+      const auto it = names.find(x.r.device);
+      b.add(first ? "\n  [" : ",\n  [");
+      number(clock.seconds(x.session_ns));
+      b.add(",\"");
+      b.add(clock.utc_view(x.session_ns));
+      fmt::format_to(
+          b.it(), FMT_COMPILE("\",{},{},{},\"{}\",{},"), x.r.device,
+          it == names.end() ? std::string_view("\"\"") : std::string_view(it->second), x.r.channel,
+          cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)), x.r.status);
+      number(x.r.value);
+      fmt::format_to(b.it(), FMT_COMPILE(",{}]"), x.r.time_ns);
+      b.row_done();
+      first = false;
+      progress.add();
+    });
+  }
   fmt::print(out, "{}]{}\n", first ? "" : "\n ", std::string_view(text).substr(at + marker.size()));
 }
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <ctime>
+#include <iterator>
 
 namespace daq {
 
@@ -51,18 +52,28 @@ std::optional<std::int64_t> ExportClock::unix_ns(double session_ns) const {
          static_cast<std::int64_t>(std::llround(session_ns - static_cast<double>(t0_ns_)));
 }
 
-std::string ExportClock::utc(double session_ns) const {
+std::string ExportClock::utc(double session_ns) const { return std::string(utc_view(session_ns)); }
+
+std::string_view ExportClock::utc_view(double session_ns) const {
   const auto unix = unix_ns(session_ns);
-  if (!unix) return "";
+  if (!unix) return {};
   const std::int64_t ns = *unix;
   const std::int64_t us = ns >= 0 ? ns / 1000 : (ns - 999) / 1000;
-  const std::time_t s =
-      static_cast<std::time_t>(us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000);
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  std::array<char, 32> buf{};
-  std::strftime(buf.data(), buf.size(), "%Y-%m-%dT%H:%M:%S", &tm);
-  return fmt::format("{}.{:06d}Z", buf.data(), us - static_cast<std::int64_t>(s) * 1'000'000);
+  const std::int64_t s = us >= 0 ? us / 1'000'000 : (us - 999'999) / 1'000'000;
+  if (s != cached_second_) {
+    const auto t = static_cast<std::time_t>(s);
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    cached_length_ = std::strftime(cached_text_.data(), 32, "%Y-%m-%dT%H:%M:%S", &tm);
+    cached_second_ = s;
+  }
+  // ".uuuuuuZ" after the cached part: six digits of the microseconds in the second.
+  char* p = cached_text_.data() + cached_length_;
+  p[0] = '.';
+  auto micro = us - s * 1'000'000;
+  for (int i = 6; i >= 1; --i, micro /= 10) p[i] = static_cast<char>('0' + micro % 10);
+  p[7] = 'Z';
+  return {cached_text_.data(), cached_length_ + 8};
 }
 
 void ExportRows::flush(std::vector<ExportRow>& out) {
