@@ -108,9 +108,15 @@ TEST(ShdrCodec, HeartbeatsUnavailableMultilineAndNoTimestamp) {
   EXPECT_EQ(c.pings(), 1u);
   EXPECT_EQ(c.pongs(), 1u);
   EXPECT_EQ(c.pong_timeout_ms(), 10000);
-  ASSERT_EQ(frames.size(), 1u);  // only the last line: 1 mm, stamped by the agent (none here)
-  EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.001);
-  EXPECT_FALSE(frames[0].time_unix_ns);
+  // UNAVAILABLE: a frame that says X is unknown (no position); then 1 mm, stamped by the agent
+  // (no time here).
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_FALSE(frames[0].position_m[0]);
+  EXPECT_TRUE(frames[0].unavailable[0]);
+  EXPECT_FALSE(frames[0].unavailable[1]);
+  EXPECT_DOUBLE_EQ(*frames[1].position_m[0], 0.001);
+  EXPECT_FALSE(frames[1].unavailable[0]);
+  EXPECT_FALSE(frames[1].time_unix_ns);
   EXPECT_EQ(ShdrCodec::ping(), "* PING\n");
 }
 
@@ -196,6 +202,7 @@ TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
   EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.010);
   EXPECT_DOUBLE_EQ(*frames[1].position_m[2], -0.005);
   EXPECT_FALSE(frames[2].position_m[0]);
+  EXPECT_TRUE(frames[2].unavailable[0]);
   EXPECT_DOUBLE_EQ(*frames[2].position_m[2], 0.007);
   EXPECT_EQ(c.commands(), 2u);
   EXPECT_EQ(c.assets(), 1u);
