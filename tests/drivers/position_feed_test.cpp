@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
 #include "halsampler/codec.hpp"
 #include "shdr/codec.hpp"
@@ -255,6 +256,30 @@ TEST(PositionFeeds, SplitAtAnyByteGivesTheSameFrames) {
   EXPECT_EQ(sw.stats, sb.stats);
   ASSERT_EQ(sb.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(*sb.frames[0].position_m[0], 0.0015);
+}
+
+TEST(ShdrDecoder, AnUnavailablePositionIsANoteNotAReading) {
+  // daq decode shdr: "Xposition|UNAVAILABLE" says the control has no position; the decoder
+  // says so (one note naming the item) and gives no reading for it.
+  const auto& shdr = cal::drivers::driver("shdr");
+  const std::vector<std::pair<std::string, std::string>> set{{"keys", "Xposition,Yposition,"}};
+  auto decoder = shdr.make_decoder(cal::drivers::options_from_text(shdr, set));
+  const std::string text =
+      "2015-10-27T17:38:06.715274Z|Xposition|16.50304\n"
+      "2015-10-27T17:38:07Z|Xposition|UNAVAILABLE|Yposition|-22.06068\n";
+  std::vector<cal::drivers::DecodedItem> items;
+  decoder->feed(std::as_bytes(std::span(text.data(), text.size())), items);
+  decoder->finish(items);
+  std::vector<std::string> notes;
+  std::size_t readings = 0;
+  for (const auto& i : items) {
+    if (i.kind == cal::drivers::DecodedItem::Kind::note) notes.push_back(i.text);
+    if (i.kind == cal::drivers::DecodedItem::Kind::reading) ++readings;
+    EXPECT_NE(i.kind, cal::drivers::DecodedItem::Kind::error) << i.text;
+  }
+  EXPECT_EQ(readings, 2u);  // X 16.50304 mm, Y -22.06068 mm
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0], "Xposition: UNAVAILABLE (no position)");
 }
 
 }  // namespace
