@@ -22,6 +22,8 @@ struct ShdrTwin::Impl : detail::TcpChannel, std::enable_shared_from_this<ShdrTwi
   void on_line(const detail::LineServer::ClientPtr& client, const std::string& line) {
     if (!line.starts_with("* PING")) return;
     ++pongs;
+    // An adapter writes whole lines: the rest of a split line goes out before the PONG.
+    if (!held.empty()) server->broadcast(std::exchange(held, {}));
     server->send(client, fmt::format("* PONG {}\n", config.pong_timeout_ms));
   }
 

@@ -120,11 +120,13 @@ TEST(ShdrChatter, AChatterWiderThanTheToleranceIsNoStop) {
 TEST(ShdrChatter, TheTriggerFindsEveryStopOnAnAdapterThatBurstsAndSplitsItsLines) {
   // As a real adapter talks: every item on a line of its own in bursts at one time, conditions
   // and a THREE_SPACE path_pos among the positions, lines split across writes (the instrument
-  // holds half a line between two reads), the chatter at rest, and the heartbeat answered.
-  const StopRun run = run_feed({.dither_mm = 1e-5, .bursts = true, .split_lines = true});
+  // holds half a line between two reads), the chatter at rest, and the heartbeat: PONG 200 ms,
+  // so the instrument pings every 200 ms (wall clock) and each PONG comes between whole lines.
+  const StopRun run =
+      run_feed({.pong_timeout_ms = 200, .dither_mm = 1e-5, .bursts = true, .split_lines = true});
   EXPECT_EQ(run.codec_errors, 0u);
   EXPECT_EQ(run.feed_unavailable, 0u);
-  EXPECT_GE(run.pings_answered, 1u);  // the instrument pinged once connected
+  EXPECT_GE(run.pings_answered, 3u);
   EXPECT_GE(run.flips, 8u);
   ASSERT_EQ(run.values_at_50_mm.size(), 2u);  // each value whole: no half line read as one
   EXPECT_NEAR(*run.values_at_50_mm.rbegin() - *run.values_at_50_mm.begin(), 1e-5, 1e-9);
