@@ -185,7 +185,11 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
       continue;
     }
     const std::string_view value = tokens[i + 1];
-    if (value == "UNAVAILABLE") continue;  // the control has no value: not a position
+    if (value == "UNAVAILABLE") {  // the control has no value: the position is unknown
+      f.unavailable[static_cast<std::size_t>(it->second)] = true;
+      any = true;
+      continue;
+    }
     const auto v = parse_number(value);
     if (!v || !std::isfinite(*v))
       return report(errors, ErrorKind::malformed, offset,

@@ -22,7 +22,8 @@
 //    one of them. This codec has no device model and reads every line as pairs: items after
 //    an odd-valued one on the same line (a message, an alarm) would be misaligned, where the
 //    legacy agent reads none of them; SHDR adapters do not send such lines (the Okuma
-//    recording has none: every line is a timestamp and pairs). "UNAVAILABLE" is no value.
+//    recording has none: every line is a timestamp and pairs). "UNAVAILABLE" is no value: the
+//    frame marks the axis unavailable (the position is unknown until a value comes).
 // Where this codec differs from the agent: a timestamp with 'T' that does not parse (a 13th
 // month) or a first token that is neither a time nor a number is refused as malformed; the
 // agent silently uses its own clock.

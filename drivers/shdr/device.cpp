@@ -111,6 +111,8 @@ class ShdrDecoder final : public Decoder {
     if (codec_.assets() != assets) note("multi-line asset (skipped)");
     for (const auto& f : frames_)
       for (std::uint8_t axis = 0; axis < 3; ++axis) {
+        // The adapter has no position for the axis (a run's trigger holds nothing through it).
+        if (f.unavailable[axis]) note(fmt::format("{}: UNAVAILABLE (no position)", key_of(axis)));
         if (!f.position_m[axis]) continue;
         auto item =
             detail::reading_item(offset, axis, Quantity::machine_position_m, *f.position_m[axis]);
@@ -119,6 +121,11 @@ class ShdrDecoder final : public Decoder {
         if (f.relative_time_ms) item.device_time_relative_s = *f.relative_time_ms * 1e-3;
         out.push_back(item);
       }
+  }
+  std::string_view key_of(std::uint8_t axis) const {
+    for (const auto& [key, a] : codec_.config().keys)
+      if (a == axis) return key;
+    return "?";
   }
   // No position at all: most likely the control names its items otherwise (the Okuma
   // OSP-P300 says X1actw, not Xact). Name the numeric items seen and how to choose them.

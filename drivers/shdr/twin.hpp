@@ -34,10 +34,24 @@ struct ShdrTwinConfig {
   double dither_mm = 0.0;
   std::array<double, 2> chatter_interval_s{0.14, 1.0};
   std::uint64_t seed = 1;
+  // What else a real adapter does on the wire (the GF Agie HPM600U log, the Handtmann 482
+  // telnet capture in ../shared/realdata), each off by default:
+  // bursts: every item on a line of its own, several lines at one time (the log's lines 1-30);
+  // a new client first gets the control's conditions ("|servo|Normal||||"), its execution
+  // state and a THREE_SPACE path_pos before the positions, and each change comes with an
+  // execution line.
+  bool bursts = false;
+  // split_lines: each look's text goes out in two writes, the second at the next look, so the
+  // agent holds a partial line in between (TCP keeps no line boundaries).
+  bool split_lines = false;
+  // While the twin's time lies in [from, to), the positions are "UNAVAILABLE" (the adapter
+  // lost its control); -1: never.
+  std::array<double, 2> unavailable_s{-1.0, -1.0};
 };
 
-// Sends the simulated control's commanded position to every connected agent on change and
-// answers its heartbeats ("* PING" -> "* PONG <ms>"), as an MTConnect adapter does.
+// Sends the simulated control's commanded (or actual) position to every connected agent on
+// change and answers its heartbeats ("* PING" -> "* PONG <ms>"), as an MTConnect adapter does;
+// with the config's bursts, split lines and UNAVAILABLE spans, as a chattering real one does.
 class ShdrTwin final : public TcpTwin {
  public:
   ShdrTwin(boost::asio::io_context& io, World& world, Clock clock, ShdrTwinConfig config = {});

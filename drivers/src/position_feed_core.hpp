@@ -1,6 +1,8 @@
 #pragma once
 // Private to drivers/: what the machine position feeds (halsampler, shdr) share: each fed axis
-// becomes a machine_position_m reading on its channel (0 X, 1 Y, 2 Z), timed on arrival.
+// becomes a machine_position_m reading on its channel (0 X, 1 Y, 2 Z), timed on arrival; an
+// axis the feed says it has no value for, a signal_lost reading of NaN.
+#include <limits>
 #include <vector>
 
 #include "cal/drivers/codec/position.hpp"
@@ -29,12 +31,21 @@ class PositionFeedCore : public InstrumentCore {
     const std::int64_t t = now_ns();
     for (const auto& f : frames_) {
       on_frame(f);
-      for (std::uint8_t axis = 0; axis < 3; ++axis)
+      for (std::uint8_t axis = 0; axis < 3; ++axis) {
         if (f.position_m[axis])
           emit({.time_ns = t,
                 .channel = axis,
                 .quantity = Quantity::machine_position_m,
                 .value = *f.position_m[axis]});
+        // An axis the adapter calls UNAVAILABLE: no position (NaN, signal_lost), so a feed that
+        // holds its last value (the position trigger's feed_holds) does not hold it on.
+        if (f.unavailable[axis])
+          emit({.time_ns = t,
+                .channel = axis,
+                .quantity = Quantity::machine_position_m,
+                .status = ReadingStatus::signal_lost,
+                .value = std::numeric_limits<double>::quiet_NaN()});
+      }
     }
   }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
+#include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
 #include "halsampler/codec.hpp"
 #include "shdr/codec.hpp"
@@ -108,9 +109,15 @@ TEST(ShdrCodec, HeartbeatsUnavailableMultilineAndNoTimestamp) {
   EXPECT_EQ(c.pings(), 1u);
   EXPECT_EQ(c.pongs(), 1u);
   EXPECT_EQ(c.pong_timeout_ms(), 10000);
-  ASSERT_EQ(frames.size(), 1u);  // only the last line: 1 mm, stamped by the agent (none here)
-  EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.001);
-  EXPECT_FALSE(frames[0].time_unix_ns);
+  // UNAVAILABLE: a frame that says X is unknown (no position); then 1 mm, stamped by the agent
+  // (no time here).
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_FALSE(frames[0].position_m[0]);
+  EXPECT_TRUE(frames[0].unavailable[0]);
+  EXPECT_FALSE(frames[0].unavailable[1]);
+  EXPECT_DOUBLE_EQ(*frames[1].position_m[0], 0.001);
+  EXPECT_FALSE(frames[1].unavailable[0]);
+  EXPECT_FALSE(frames[1].time_unix_ns);
   EXPECT_EQ(ShdrCodec::ping(), "* PING\n");
 }
 
@@ -196,6 +203,7 @@ TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
   EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.010);
   EXPECT_DOUBLE_EQ(*frames[1].position_m[2], -0.005);
   EXPECT_FALSE(frames[2].position_m[0]);
+  EXPECT_TRUE(frames[2].unavailable[0]);
   EXPECT_DOUBLE_EQ(*frames[2].position_m[2], 0.007);
   EXPECT_EQ(c.commands(), 2u);
   EXPECT_EQ(c.assets(), 1u);
@@ -248,6 +256,30 @@ TEST(PositionFeeds, SplitAtAnyByteGivesTheSameFrames) {
   EXPECT_EQ(sw.stats, sb.stats);
   ASSERT_EQ(sb.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(*sb.frames[0].position_m[0], 0.0015);
+}
+
+TEST(ShdrDecoder, AnUnavailablePositionIsANoteNotAReading) {
+  // daq decode shdr: "Xposition|UNAVAILABLE" says the control has no position; the decoder
+  // says so (one note naming the item) and gives no reading for it.
+  const auto& shdr = cal::drivers::driver("shdr");
+  const std::vector<std::pair<std::string, std::string>> set{{"keys", "Xposition,Yposition,"}};
+  auto decoder = shdr.make_decoder(cal::drivers::options_from_text(shdr, set));
+  const std::string text =
+      "2015-10-27T17:38:06.715274Z|Xposition|16.50304\n"
+      "2015-10-27T17:38:07Z|Xposition|UNAVAILABLE|Yposition|-22.06068\n";
+  std::vector<cal::drivers::DecodedItem> items;
+  decoder->feed(std::as_bytes(std::span(text.data(), text.size())), items);
+  decoder->finish(items);
+  std::vector<std::string> notes;
+  std::size_t readings = 0;
+  for (const auto& i : items) {
+    if (i.kind == cal::drivers::DecodedItem::Kind::note) notes.push_back(i.text);
+    if (i.kind == cal::drivers::DecodedItem::Kind::reading) ++readings;
+    EXPECT_NE(i.kind, cal::drivers::DecodedItem::Kind::error) << i.text;
+  }
+  EXPECT_EQ(readings, 2u);  // X 16.50304 mm, Y -22.06068 mm
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0], "Xposition: UNAVAILABLE (no position)");
 }
 
 }  // namespace

@@ -288,6 +288,19 @@ TEST(RealData, GfAgieShdrGivesEveryPositionWithTheFilesTime) {
   EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
   EXPECT_EQ(stats.errors(), 0u);
   expect_readings(items, expected);
+  // Pinned, not by the test's own split: the first reading is X 16.50304 mm at
+  // 2015-10-27T17:38:06.715274Z (line 26), the last Z 20.3753 mm at 19:00:12.077232Z (line
+  // 20,700).
+  std::vector<d::DecodedItem> readings;
+  for (const auto& i : items)
+    if (i.kind == d::DecodedItem::Kind::reading) readings.push_back(i);
+  ASSERT_EQ(readings.size(), 3825u + 3484u + 2288u);
+  EXPECT_EQ(readings.front().channel, 0);
+  EXPECT_DOUBLE_EQ(readings.front().value, 0.01650304);
+  EXPECT_EQ(readings.front().device_time_unix_ns, 1'445'967'486'715'274'000);
+  EXPECT_EQ(readings.back().channel, 2);
+  EXPECT_DOUBLE_EQ(readings.back().value, 0.0203753);
+  EXPECT_EQ(readings.back().device_time_unix_ns, 1'445'972'412'077'232'000);
 }
 
 TEST(RealData, HandtmannTelnetCaptureGivesTheActualPositionsOfItsFirstNineLines) {
@@ -308,17 +321,22 @@ TEST(RealData, HandtmannTelnetCaptureGivesTheActualPositionsOfItsFirstNineLines)
                 ->size(),
             1437u);  // 1,438 bytes with its CR
   const auto expected = shdr_expected(lines, {"X11_actual", "Y11_actual", "Z11_actual"}, per_axis);
-  EXPECT_GE(per_axis[0], 1u);
-  EXPECT_GE(per_axis[1], 1u);
-  EXPECT_GE(per_axis[2], 1u);
+  // Lines 1-9 carry 3 X11_actual, 2 Y11_actual and 4 Z11_actual (counted by hand).
+  EXPECT_EQ(per_axis, (std::array<std::size_t, 3>{3, 2, 4}));
   cal::drivers::codec::CodecStats stats;
   const auto items = decode("shdr", first9, {{"keys", "X11_actual,Y11_actual,Z11_actual"}}, &stats);
   EXPECT_EQ(count(items, d::DecodedItem::Kind::error), 0u);
   EXPECT_EQ(stats.errors(), 0u);
   expect_readings(items, expected);
-  // The first reading is the long line's X11_actual, 1536.595860 mm.
-  ASSERT_FALSE(expected.empty());
+  // The first reading is the long line's X11_actual, 1536.595860 mm at 2018-02-12T20:12:27.378
+  // (no zone: UTC, as the agent reads it); the last line 9's Z11_actual, 654.313830 mm at
+  // 20:12:30.002. Pinned here, not by the test's own split.
+  ASSERT_EQ(expected.size(), 9u);
   EXPECT_DOUBLE_EQ(expected.front().value_m, 1.536595860);
+  EXPECT_EQ(expected.front().time_ns, 1'518'466'347'378'000'000);
+  EXPECT_DOUBLE_EQ(expected.back().value_m, 0.654313830);
+  EXPECT_EQ(expected.back().axis, 2);
+  EXPECT_EQ(expected.back().time_ns, 1'518'466'350'002'000'000);
 }
 
 TEST(RealData, HalsamplerMuxAndAndOrNotMuxGiveTheConfiguredColumnOnEveryLine) {

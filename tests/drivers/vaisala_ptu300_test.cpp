@@ -138,4 +138,38 @@ TEST(Ptu300Codec, SplitAtAnyByteGivesTheSameFrames) {
   EXPECT_EQ(whole.frames.size(), 2u);
 }
 
+TEST(Ptu300Codec, TheInformationalAnswersAreNoMeasurement) {
+  // What the informational commands print, as the Vaisala guides show it: VERS ("PTB220 /
+  // 2.02", PTB220 guide ch. 8; the PTU300's "PTU300 / 5.10"), SNUM, ERRS, and "?" (PTU200
+  // M210195EN "? Basic information on the transmitter settings"; DMP248 appendix 1, whose
+  // analog output limits carry 'C). None of it is a pressure, temperature or humidity, and
+  // none of it is a codec error.
+  const auto d = codec_test::feed_whole(Ptu300Codec{},
+                                        ">vers\r\n"
+                                        "PTU300 / 5.10\r\n"
+                                        "PTB220 / 2.02\r\n"
+                                        "CPU serial no : P1234567\r\n"
+                                        "No errors\r\n"
+                                        ">?\r\n"
+                                        "Software version PTU200 / 1.02\r\n"
+                                        "Calibration date 1999-03-12\r\n"
+                                        "Baud Parity Data Stop Dpx 9600 E 7 1 F\r\n"
+                                        "Output interval 3 s\r\n"
+                                        "Pressure unit hPa\r\n"
+                                        "Temperature unit 'C\r\n"
+                                        "Baud P D S    : 4800 E 7 1 FDX\r\n"
+                                        "Pressure (hPa): 1013.25\r\n"
+                                        " Ch1  ( Td ) lo   -40.00 'C\r\n"
+                                        " Ch2  ( T  ) hi   160.00 'C\r\n"
+                                        "Output units   : metric\r\n");
+  EXPECT_EQ(d.stats.errors(), 0u);
+  for (const auto& f : d.frames) {
+    SCOPED_TRACE(f.text);
+    EXPECT_FALSE(f.pressure_pa);
+    EXPECT_FALSE(f.temperature_degc);
+    EXPECT_FALSE(f.relative_humidity_pct);
+    EXPECT_FALSE(f.dew_point_degc);
+  }
+}
+
 }  // namespace

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -31,25 +32,28 @@ struct StopRun {
   std::vector<cal::daq::Capture> captures;
   std::set<double> values_at_50_mm;  // the feed's values while the machine stood at 50 mm
   std::size_t feed_readings = 0;
+  std::size_t feed_unavailable = 0;  // readings without a position (UNAVAILABLE)
   std::uint64_t flips = 0;
+  std::uint64_t pings_answered = 0;
   std::size_t codec_errors = 0;
 };
 
-// X: 0 -> 50 mm, dwell 4 s, -> 100 mm, dwell 4 s; the twin's clock stepped by 40 ms, the laser
-// (the tool's true X) read at every step.
-StopRun run_with_dither(double dither_mm) {
+// X: 0 -> 50 mm (at about 1 s), dwell 4 s, -> 100 mm (at about 6 s), dwell 4 s; the twin's
+// clock stepped by 40 ms, the laser (the tool's true X) read at every step. `adapter` says how
+// the twin misbehaves (its feed keys, position and decimals are set here).
+StopRun run_feed(sim::ShdrTwinConfig adapter) {
   boost::asio::io_context io;
   double now_s = 0.0;
   sim::World world({}, sim::AirConfig{});
   const sim::Move program[] = {sim::Move::linear({50, 0, 0}, 3000), sim::Move::dwell(4),
                                sim::Move::linear({100, 0, 0}, 3000), sim::Move::dwell(4)};
   world.machine().load(program);
-  sim::ShdrTwin twin(io, world, [&] { return now_s; },
-                     {.period = 1ms,
-                      .keys = {"Xposition", "Yposition", "Zposition"},
-                      .position = sim::ShdrTwinConfig::Position::actual,
-                      .decimals = 5,
-                      .dither_mm = dither_mm});
+  adapter.period = 1ms;
+  adapter.keys = {"Xposition", "Yposition", "Zposition"};
+  adapter.position = sim::ShdrTwinConfig::Position::actual;
+  adapter.decimals = 5;
+  sim::ShdrTwin twin(
+      io, world, [&] { return now_s; }, adapter);
   auto feed = d::make_shdr(
       io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
       {.device = 4, .name = "position", .clock = [&] { return std::llround(now_s * 1e9); }},
@@ -64,6 +68,13 @@ StopRun run_with_dither(double dither_mm) {
                    [&](const d::Reading& r) {
                      if (r.channel != 0) return;
                      ++out.feed_readings;
+                     // As a linear run hands the feed on (linear_run.cpp): no position when
+                     // the reading is not ok.
+                     if (r.status != d::ReadingStatus::ok) {
+                       ++out.feed_unavailable;
+                       return add(trigger.add_position(r.time_ns,
+                                                       std::numeric_limits<double>::quiet_NaN()));
+                     }
                      if (now_s > 3.0 && now_s < 5.0) out.values_at_50_mm.insert(r.value * 1e3);
                      add(trigger.add_position(r.time_ns, r.value * 1e3));
                    },
@@ -77,8 +88,11 @@ StopRun run_with_dither(double dither_mm) {
   }
   feed->stop();
   out.flips = twin.chatter_flips();
+  out.pings_answered = twin.pings_answered();
   return out;
 }
+
+StopRun run_with_dither(double dither_mm) { return run_feed({.dither_mm = dither_mm}); }
 
 TEST(ShdrChatter, TheTriggerFindsEveryStopOnAFeedThatChattersBy10nm) {
   const StopRun run = run_with_dither(1e-5);
@@ -101,6 +115,42 @@ TEST(ShdrChatter, AChatterWiderThanTheToleranceIsNoStop) {
   EXPECT_EQ(run.codec_errors, 0u);
   EXPECT_GE(run.flips, 8u);
   EXPECT_TRUE(run.captures.empty());
+}
+
+TEST(ShdrChatter, TheTriggerFindsEveryStopOnAnAdapterThatBurstsAndSplitsItsLines) {
+  // As a real adapter talks: every item on a line of its own in bursts at one time, conditions
+  // and a THREE_SPACE path_pos among the positions, lines split across writes (the instrument
+  // holds half a line between two reads), the chatter at rest, and the heartbeat: PONG 200 ms,
+  // so the instrument pings every 200 ms (wall clock) and each PONG comes between whole lines.
+  const StopRun run =
+      run_feed({.pong_timeout_ms = 200, .dither_mm = 1e-5, .bursts = true, .split_lines = true});
+  EXPECT_EQ(run.codec_errors, 0u);
+  EXPECT_EQ(run.feed_unavailable, 0u);
+  EXPECT_GE(run.pings_answered, 3u);
+  EXPECT_GE(run.flips, 8u);
+  ASSERT_EQ(run.values_at_50_mm.size(), 2u);  // each value whole: no half line read as one
+  EXPECT_NEAR(*run.values_at_50_mm.rbegin() - *run.values_at_50_mm.begin(), 1e-5, 1e-9);
+  ASSERT_EQ(run.captures.size(), 2u);
+  EXPECT_NEAR(run.captures[0].mean_mm, 50.0, 1e-5);
+  EXPECT_NEAR(run.captures[1].mean_mm, 100.0, 1e-5);
+}
+
+TEST(ShdrChatter, APositionUnavailableAtAStopIsNotHeldAsStill) {
+  // The adapter loses its control from 2 s to 4 s, while the machine stands at 50 mm (from
+  // about 1.2 s to 5.2 s): "UNAVAILABLE" says the position is unknown, so the feed's last value
+  // is not held through it (feed_holds) and the stillness counts again from 4 s, too short for
+  // the 1.5 s dwell before the move. Only the stop at 100 mm is captured. (Before: UNAVAILABLE
+  // was skipped, the 50 mm of 1.2 s held, and a stop captured while the control said nothing.)
+  const StopRun run = run_feed(
+      {.dither_mm = 1e-5, .bursts = true, .split_lines = true, .unavailable_s = {2.0, 4.0}});
+  EXPECT_EQ(run.codec_errors, 0u);
+  EXPECT_GE(run.feed_unavailable, 1u);
+  ASSERT_EQ(run.captures.size(), 1u);
+  EXPECT_NEAR(run.captures[0].mean_mm, 100.0, 1e-5);
+  // The control back before the machine stops: both stops, as without the span.
+  const StopRun back = run_feed({.dither_mm = 1e-5, .unavailable_s = {0.2, 0.8}});
+  EXPECT_GE(back.feed_unavailable, 1u);
+  EXPECT_EQ(back.captures.size(), 2u);
 }
 
 // The GF Agie HPM600U log's Xposition (../shared/realdata), as `daq decode shdr` reads it:

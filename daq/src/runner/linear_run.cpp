@@ -7,6 +7,7 @@
 #include <boost/asio/io_context.hpp>
 #include <chrono>
 #include <deque>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -369,7 +370,11 @@ struct LinearRun::Impl : Runner {
       case Quantity::machine_position_m:
         if (position_trigger && devices.is(Role::position, device) &&
             r.channel == setup.position_channel)
-          if (auto cap = position_trigger->add_position(r.time_ns, r.value * 1e3))
+          // A feed without a position (SHDR UNAVAILABLE) ends the stillness it held.
+          if (auto cap = position_trigger->add_position(
+                  r.time_ns, r.status == ReadingStatus::ok
+                                 ? r.value * 1e3
+                                 : std::numeric_limits<double>::quiet_NaN()))
             on_capture(*cap, env.compensate(r.time_ns, last_raw_m));
         return;
       default:

@@ -96,8 +96,9 @@ void LineServer::send(const ClientPtr& client, std::string text) {
   client->writer.send(client->socket, std::move(text), client);
 }
 
-void LineServer::broadcast(const std::string& text) {
-  for (const auto& c : clients_) send(c, text);
+void LineServer::broadcast(const std::string& text, const ClientPtr& except) {
+  for (const auto& c : clients_)
+    if (c != except) send(c, text);
 }
 
 void LineServer::drop_clients() {

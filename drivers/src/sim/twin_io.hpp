@@ -85,7 +85,8 @@ class LineServer : public std::enable_shared_from_this<LineServer> {
   void set_framing(Framing framing) { framing_ = std::move(framing); }  // before start()
   std::uint16_t port() const { return acceptor_.local_endpoint().port(); }
   void send(const ClientPtr& client, std::string text);
-  void broadcast(const std::string& text);  // to every connected client
+  // To every connected client but `except` (nullptr: every one).
+  void broadcast(const std::string& text, const ClientPtr& except = nullptr);
   bool has_clients() const { return !clients_.empty(); }
   std::size_t clients() const { return clients_.size(); }
   void drop_clients();

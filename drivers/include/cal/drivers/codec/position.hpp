@@ -9,8 +9,11 @@ namespace cal::drivers::codec {
 
 struct PositionFrame {
   std::array<std::optional<double>, 3> position_m;  // X, Y, Z: those the line carried
-  std::optional<std::uint64_t> sample;              // halsampler's sample number (-t)
-  std::uint64_t lost_before = 0;                    // samples skipped before this one (-t)
+  // SHDR: the axis's item said UNAVAILABLE (the adapter has no value from the control, e.g.
+  // while the control is disconnected): its position is unknown from now on, not held.
+  std::array<bool, 3> unavailable{};
+  std::optional<std::uint64_t> sample;  // halsampler's sample number (-t)
+  std::uint64_t lost_before = 0;        // samples skipped before this one (-t)
   bool overrun = false;  // halsampler printed "overrun" before this sample: samples were lost
   // SHDR: the timestamp's @duration suffix (s), and a relative timestamp (ms since the first).
   std::optional<double> duration_s;
