@@ -81,7 +81,7 @@ StopRun run_feed(sim::ShdrTwinConfig adapter) {
                .codec_error = [&](const auto&) { ++out.codec_errors; }});
   const double end_s = world.machine().program_duration_s() + 1.0;
   for (; now_s < end_s; now_s += 0.04) {
-    io.run_for(4ms);  // the twin looks (every 1 ms), the instrument reads
+    io.run_for(6ms);  // the twin looks (every 1 ms), the instrument reads
     io.restart();
     world.advance_to(now_s);
     add(trigger.add_reading(std::llround(now_s * 1e9), world.state().tool_mm[0]));
@@ -120,10 +120,12 @@ TEST(ShdrChatter, AChatterWiderThanTheToleranceIsNoStop) {
 TEST(ShdrChatter, TheTriggerFindsEveryStopOnAnAdapterThatBurstsAndSplitsItsLines) {
   // As a real adapter talks: every item on a line of its own in bursts at one time, conditions
   // and a THREE_SPACE path_pos among the positions, lines split across writes (the instrument
-  // holds half a line between two reads), the chatter at rest, and the heartbeat: PONG 200 ms,
-  // so the instrument pings every 200 ms (wall clock) and each PONG comes between whole lines.
+  // holds half a line between two reads), the chatter at rest, and the heartbeat: PONG 300 ms,
+  // so the instrument pings every 300 ms (wall clock; the run takes about 1.5 s) and each PONG
+  // comes between whole lines. Not shorter: a starved ctest -j3 may stall the process for twice
+  // the heartbeat, and the instrument would rightly drop the adapter.
   const StopRun run =
-      run_feed({.pong_timeout_ms = 200, .dither_mm = 1e-5, .bursts = true, .split_lines = true});
+      run_feed({.pong_timeout_ms = 300, .dither_mm = 1e-5, .bursts = true, .split_lines = true});
   EXPECT_EQ(run.codec_errors, 0u);
   EXPECT_EQ(run.feed_unavailable, 0u);
   EXPECT_GE(run.pings_answered, 3u);
