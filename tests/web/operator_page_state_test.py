@@ -191,8 +191,8 @@ try:
        f"a finished run: COMPLETE ({s['label']}: {s['big']}, {s['progress']}, {s['line']})")
     m = re.fullmatch(r"(\d+) of (\d+) stops captured", s["progress"])
     ok(m and m.group(1) == m.group(2), f"all its stops: {s['progress']!r}")
-    ok(s["origin"].startswith("SIMULATED INSTRUMENTS: ") and "laser" in s["origin"],
-       f"the Run view says the instruments are simulated: {s['origin']!r}")
+    ok(s["origin"].startswith(f"SIMULATED Run {last['run']}, as stored: ") and "daq serve --simulate" in s["origin"],
+       f"the Run view says the run's instruments were simulated, as stored: {s['origin']!r}")
     shot(b, "s05-complete-1366x768.png")
 
     # Its results: SIMULATED before anything else, the stops' check, the origin in the list.
