@@ -106,7 +106,7 @@ try:
     ok(took <= 3.0 and b.js("return document.getElementById('align-signal').textContent;").startswith("Beam: no data"),
        f"a hung service: the Align view shows dashes and no data within 3 s ({took:.2f} s)")
     serve.send_signal(signal.SIGCONT)
-    b.wait("return /\\d/.test(document.getElementById('align-reading').textContent);", timeout_s=10,
+    b.wait("return /\\d/.test(document.getElementById('align-reading').textContent);", timeout_s=30,
            what="the reading back after SIGCONT")
     b.set_size(560, 900)
     time.sleep(0.5)

@@ -84,7 +84,7 @@ def set_field(b, key, value):
 
 
 def wait_valid(b):
-    b.wait(VALID, timeout_s=15, what="the set-up to be valid")
+    b.wait(VALID, timeout_s=45, what="the set-up to be valid")
 
 
 def page_state(b):
@@ -125,7 +125,7 @@ try:
         b.wait("return window.caldaq && window.caldaq.page && "
                "window.caldaq.page.status.start.linear.ready;", timeout_s=30,
                what="the instruments to stream (Start linear ready)")
-        b.wait("return document.getElementById('env-n').textContent !== '—';", timeout_s=10,
+        b.wait("return document.getElementById('env-n').textContent !== '—';", timeout_s=30,
                what="the refractive index while idle")
         env = b.js("""const g = id => document.getElementById(id).textContent;
             return {air: g('env-air'), p: g('env-p'), rh: g('env-rh'), n: g('env-n'),
@@ -156,12 +156,12 @@ try:
                            ("test.linear.interval_mm", "50"), ("test.linear.random_fraction", ""),
                            ("test.linear.dwell_s", "4"), ("test.linear.runs", "0")):
             set_field(b, key, value)
-        err = b.wait(FIELD_ERROR.replace("arguments[0]", "'test.linear.runs'"), timeout_s=10,
+        err = b.wait(FIELD_ERROR.replace("arguments[0]", "'test.linear.runs'"), timeout_s=30,
                      what="the runs field's error")
         ok("1 .. 1000" in err, f"validation as typed: runs = 0 -> '{err}'")
         set_field(b, "test.linear.feed_mm_per_min", "-5")
         err = b.wait(FIELD_ERROR.replace("arguments[0]", "'test.linear.feed_mm_per_min'"),
-                     timeout_s=10, what="the feed field's error")
+                     timeout_s=30, what="the feed field's error")
         ok("-5" in err, f"a second problem shown at once: feed = -5 -> '{err}'")
         ok(b.js("return document.getElementById('apply').disabled;"),
            "Use this set-up is disabled while there are problems")
@@ -230,6 +230,25 @@ try:
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent);",
                what="the set-up to be applied")
 
+        # --- 3b. a set-up applied elsewhere while the operator types ----------------------------
+        # The page reloads its form when another client applies a set-up; it must never wipe what
+        # the operator is typing (CI once lost the dead-device edits below to such a reload).
+        set_field(b, "test.linear.dwell_s", "3")
+        status, other = post(url + "api/setup/apply", {"setup": b.js("return window.caldaq.base;")})
+        ok(status == 200, f"a set-up applied from another client while the operator types: "
+           f"version {other.get('version')}")
+        b.wait(f"return window.caldaq.page.status.setup.version === {other.get('version')};",
+               what="the page to see the set-up applied elsewhere")
+        time.sleep(1.0)  # ten status messages: a reload, if any, would have come by now
+        dwell = b.js("""return [...document.querySelectorAll('[data-key]')]
+            .find(i => i.dataset.key === 'test.linear.dwell_s').value;""")
+        ok(dwell == "3", f"what the operator typed is kept when a set-up is applied elsewhere: {dwell!r}")
+        wait_valid(b)
+        b.js("document.getElementById('apply').click();")
+        b.wait("return /Applied/.test(document.getElementById('apply-result').textContent) && "
+               "window.caldaq.base.test.linear.dwell_s == 3;", what="the typed set-up applied",
+               explain="return document.getElementById('apply-result').textContent;")
+
         # --- 4. dead devices -------------------------------------------------------------------
         # The air station's, the laser's and the ballbar's ports gone (the issue's ballbar run on
         # a vanished port showed 0.00 um and "running" for a minute). The laser too: its
@@ -246,15 +265,17 @@ try:
         b.js("document.getElementById('apply').click();")
         b.wait("return /Applied/.test(document.getElementById('apply-result').textContent) && "
                "window.caldaq.page.devices.devices.find(d => d.id === 'air').transport.includes('no-such-port');",
-               what="the set-up with a dead air station")
+               what="the set-up with a dead air station",
+               explain="return [document.getElementById('apply-result').textContent, "
+                       "JSON.stringify(window.caldaq.page.devices.devices.map(d => [d.id, d.transport, d.state]))];")
         b.js("document.getElementById('tab-run').click();")
         b.wait("const d = window.caldaq.page.devices.devices.find(d => d.id === 'air');"
-               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=15,
+               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=30,
                what="the air station reported as reconnecting")
         b.wait("return document.getElementById('env-air').textContent === '—';",
                what="the air temperature shown as dashes")
         b.wait("const d = window.caldaq.page.devices.devices.find(d => d.id === 'ballbar');"
-               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=15,
+               "return d.state === 'reconnecting' || d.state === 'failed';", timeout_s=30,
                what="the ballbar reported as reconnecting")
         dead = b.js("""const li = document.querySelector('#devices li[data-device=air]');
             return {state: li.dataset.state, text: li.textContent,
@@ -374,7 +395,7 @@ try:
 
         # --- 6. results ------------------------------------------------------------------------
         b.wait("return !document.getElementById('view-results').hidden && "
-               "document.getElementById('report-html');", timeout_s=15, what="the results view")
+               "document.getElementById('report-html');", timeout_s=45, what="the results view")
         verdict = b.wait("return document.getElementById('result-verdict').textContent;",
                          what="the verdict")
         checks = b.js("return [...document.querySelectorAll('#verdict-table tbody tr')].map(r => r.textContent);")
@@ -418,7 +439,7 @@ try:
            "the ballbar run completed")
         b.wait("return !document.getElementById('view-results').hidden && "
                "/circle/.test(document.getElementById('result-head').textContent) && "
-               "document.getElementById('result-values');", timeout_s=15, what="its results")
+               "document.getElementById('result-values');", timeout_s=45, what="its results")
         g = b.js("return [...document.querySelectorAll('#result-values tr')].map(r => r.textContent);")
         ok(g and g[0].startswith("G"), f"ballbar results: {g[:3]}")
         shot(b, "11-results-ballbar.png")
@@ -427,18 +448,24 @@ try:
            f"the PDF link (of the linear run) serves a PDF ({len(body)} bytes)")
 
         # --- 8. Stop asks for confirmation; the layout at 600 px -----------------------------
-        simulation_speed(url, 10)  # the run goes on for the 5 s these checks may take
+        # The run must go on for the checks below (seconds on a starved machine): at 2x its twelve
+        # stops of 3 s dwell take over 20 s.
+        simulation_speed(url, 2)
         b.js("document.getElementById('tab-run').click();")
         b.wait("return window.caldaq.page.status.start.linear.ready;", timeout_s=30,
                what="Start linear ready again")
         b.js("document.getElementById('start-linear').click();")
-        b.wait("return window.caldaq.page.status.running;", what="the third run")
+        third = b.wait("return window.caldaq.page.status.running && window.caldaq.page.status.run.id;",
+                       timeout_s=45, what="the third run")
         b.js("document.getElementById('stop').click();")
         ok(b.js("return document.getElementById('confirm-stop').open;"), "Stop asks first")
         shot(b, "12-stop-confirmation.png")
         b.js("document.getElementById('confirm-no').click();")
         time.sleep(0.5)
-        ok(b.js("return window.caldaq.page.status.running;"), "Keep running keeps it running")
+        # Running still, or (on a starved machine) ended by itself, never aborted by this click.
+        kept = b.js("const s = window.caldaq.page.status; return s.running ? 'running' : "
+                    "(s.last && s.last.run === arguments[0] ? s.last.status : 'gone');", third)
+        ok(kept in ("running", "complete", "incomplete"), f"Keep running keeps it running: {kept}")
         b.set_size(560, 1000)
         time.sleep(0.5)
         overflow = b.js("return document.documentElement.scrollWidth - window.innerWidth;")
@@ -451,10 +478,15 @@ try:
         ok(others and others[0] in ("open", "streaming"),
            f"a linear run leaves the ballbar watched (not silent): {others}")
         shot(b, "13-narrow-560px.png")
-        b.js("document.getElementById('stop').click();")
-        b.js("document.getElementById('confirm-yes').click();")
-        b.wait("const l = window.caldaq.page.status.last; return l && l.status === 'aborted';",
-               what="the confirmed stop")
+        if kept == "running":
+            b.js("document.getElementById('stop').click();")
+            b.js("document.getElementById('confirm-yes').click();")
+            b.wait("const l = window.caldaq.page.status.last; return l && l.status === 'aborted';",
+                   timeout_s=45, what="the confirmed stop",
+                   explain="return JSON.stringify(window.caldaq.page.status.last);")
+        else:
+            print(f"note: the third run ended by itself ({kept}) before Stop could be confirmed "
+                  "(a starved machine); the confirmation was checked above")
         # The page's rule for a device that dies during a run, on hand-made states (the shop has
         # no switch to unplug the laser mid-run): the same run state shows the number while the
         # laser streams, and dashes with the laser's state once it is silent, never the value.

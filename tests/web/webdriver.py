@@ -107,7 +107,7 @@ class Browser:
             f.write(png)
         return png
 
-    def wait(self, script, timeout_s=20, what="condition", explain=None):
+    def wait(self, script, timeout_s=45, what="condition", explain=None):
         """Polls `script` until it returns a true value; on time-out, `explain` (a script)
         says what the page showed instead."""
         deadline = time.time() + timeout_s
