@@ -224,8 +224,45 @@ try:
     status, body = post(url + "api/compensation", {"run": 99, "format": "csv"})
     ok(status == 404, f"no such run: {status} {body}")
 
+    # --- 5. the diagnostic limits of the circle's plane in the set-up form --------------------
+    b.js("document.getElementById('tab-setup').click();")
+    wait("return !!document.querySelector('[data-diagnostics=\"XY\"]') && "
+         "document.getElementById('setup-status').className === 'ok';", "the set-up form with the XY diagnostics")
+    diag = b.js("""const d = document.querySelector('[data-diagnostics="XY"]');
+        const f = k => d.querySelector(`[data-field="tolerances.XY.diagnostics.${k}"]`);
+        return {open: d.open, summary: d.querySelector('summary').textContent,
+                fields: [...d.querySelectorAll('[data-field]')].map(x => x.dataset.field.split('.').pop()),
+                backlash: [f('backlash_X').querySelector('label').textContent, f('backlash_X').querySelector('input').value,
+                           f('backlash_X').querySelector('.u').textContent],
+                squareness: [f('squareness').querySelector('label').textContent, f('squareness').querySelector('input').value,
+                             f('squareness').querySelector('.u').textContent]};""")
+    ok(diag["open"] and "2 given" in diag["summary"], f"the plane's diagnostic limits shown, open: {diag['summary']!r}")
+    ok(diag["backlash"] == ["Backlash X", "3", "µm"] and diag["squareness"] == ["Squareness", "30", "µm/m"],
+       f"each in words with its unit and the set-up's value: {diag['backlash']} {diag['squareness']}")
+    ok({"radius_error", "servo_mismatch", "vibration", "backlash_Y", "stick_slip_X", "cyclic_Y"} <= set(diag["fields"]),
+       f"every diagnostic a limit can be given for: {diag['fields']}")
+    ok(b.js(page_checks.TYPE, "tolerances.XY.diagnostics.backlash_X", "-1") == "ok", "typed: backlash X limit -1")
+    bad = wait("const f = document.querySelector('[data-field=\"tolerances.XY.diagnostics.backlash_X\"]'); "
+               "return f.classList.contains('bad') && f.querySelector('.err').textContent;", "the refusal at the field")
+    ok("backlash_X" in bad or "limit" in bad, f"a negative limit refused at its field: {bad!r}")
+    ok(b.js(page_checks.TYPE, "tolerances.XY.diagnostics.backlash_X", "2") == "ok", "typed: backlash X limit 2")
+    toml = wait("return document.getElementById('setup-status').className === 'ok' && "
+                "/backlash_X = 2(\\.0)?\\b/.test(window.caldaq.toml || '') && window.caldaq.toml;", "the limit in the TOML")
+    ok(re.search(r"\[tolerances\.XY\.diagnostics\][^\[]*backlash_X = 2(\.0)?\b", toml), "under [tolerances.XY.diagnostics]")
+    b.js("document.getElementById('tab-run').click();")
+    pending = wait("const t = document.getElementById('pending-edits'); return !t.hidden && t.textContent;", "the edit named")
+    ok("Backlash X (XY) 3 → 2" in pending, f"the unapplied limit named on the Run view: {pending!r}")
+    b.js("document.getElementById('tab-setup').click();")
+    b.js("document.querySelector('[data-diagnostics=\"XY\"]').scrollIntoView();")
+    shot(b, "r07-diagnostic-limits-1366x768.png")
+    b.js("document.getElementById('apply').click();")
+    wait("return /applied/i.test(document.getElementById('apply-result').textContent);", "the set-up applied")
+    applied = get(url + "api/setup")["setup"]["tolerances"]["XY"]["diagnostics"]
+    ok(applied == {"squareness": 30, "backlash_X": 2}, f"applied: the service's set-up has the limit: {applied}")
+
     b.set_size(560, 900)
     time.sleep(0.5)
+    b.js("document.getElementById('tab-results').click();")
     b.js("window.scrollTo(0, 0);")
     wide = b.js("return [...document.querySelectorAll('#view-results *')].filter(e => e.getBoundingClientRect().right > "
                 "window.innerWidth + 1).slice(0, 5).map(e => e.tagName + '#' + e.id + '.' + e.className + ' ' + "

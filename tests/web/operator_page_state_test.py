@@ -61,13 +61,7 @@ SEEN = """const g = id => document.getElementById(id);
           run: window.caldaq.page && window.caldaq.page.run, status: window.caldaq.page && window.caldaq.page.status};"""
 DASH = "—"
 # Sets a form field as typing would; the value of a form field.
-TYPE = """const [key, value] = arguments;
-  const input = [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === key);
-  if (!input) return 'no field ' + key;
-  input.value = value;
-  input.dispatchEvent(new Event('input', {bubbles: true}));
-  return 'ok';"""
-FIELD = "return [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === arguments[0]).value;"
+from page_checks import TYPE, FIELD  # noqa: E402
 
 
 def no_live_values(s, where):

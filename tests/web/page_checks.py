@@ -13,6 +13,15 @@ from webdriver import png_size
 
 passes = 0
 
+# Types VALUE into the set-up form's field of KEY (arguments: key, value) as an operator does.
+TYPE = """const [key, value] = arguments;
+  const input = [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === key);
+  if (!input) return 'no field ' + key;
+  input.value = value;
+  input.dispatchEvent(new Event('input', {bubbles: true}));
+  return 'ok';"""
+FIELD = "return [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === arguments[0]).value;"
+
 
 def ok(cond, what):
     global passes
