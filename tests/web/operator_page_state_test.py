@@ -61,13 +61,7 @@ SEEN = """const g = id => document.getElementById(id);
           run: window.caldaq.page && window.caldaq.page.run, status: window.caldaq.page && window.caldaq.page.status};"""
 DASH = "—"
 # Sets a form field as typing would; the value of a form field.
-TYPE = """const [key, value] = arguments;
-  const input = [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === key);
-  if (!input) return 'no field ' + key;
-  input.value = value;
-  input.dispatchEvent(new Event('input', {bubbles: true}));
-  return 'ok';"""
-FIELD = "return [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === arguments[0]).value;"
+from page_checks import TYPE, FIELD  # noqa: E402
 
 
 def no_live_values(s, where):
@@ -191,8 +185,8 @@ try:
        f"a finished run: COMPLETE ({s['label']}: {s['big']}, {s['progress']}, {s['line']})")
     m = re.fullmatch(r"(\d+) of (\d+) stops captured", s["progress"])
     ok(m and m.group(1) == m.group(2), f"all its stops: {s['progress']!r}")
-    ok(s["origin"].startswith("SIMULATED INSTRUMENTS: ") and "laser" in s["origin"],
-       f"the Run view says the instruments are simulated: {s['origin']!r}")
+    ok(s["origin"].startswith(f"SIMULATED Run {last['run']}, as stored: ") and "daq serve --simulate" in s["origin"],
+       f"the Run view says the run's instruments were simulated, as stored: {s['origin']!r}")
     shot(b, "s05-complete-1366x768.png")
 
     # Its results: SIMULATED before anything else, the stops' check, the origin in the list.

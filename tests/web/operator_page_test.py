@@ -440,7 +440,7 @@ try:
         b.wait("return !document.getElementById('view-results').hidden && "
                "/circle/.test(document.getElementById('result-head').textContent) && "
                "document.getElementById('result-values');", timeout_s=45, what="its results")
-        g = b.js("return [...document.querySelectorAll('#result-values tr')].map(r => r.textContent);")
+        g = b.js("return [...document.querySelectorAll('#result-values tbody tr')].map(r => r.textContent);")
         ok(g and g[0].startswith("G"), f"ballbar results: {g[:3]}")
         shot(b, "11-results-ballbar.png")
         status, ctype, body = pdf.result()

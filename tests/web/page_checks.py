@@ -13,6 +13,15 @@ from webdriver import png_size
 
 passes = 0
 
+# Types VALUE into the set-up form's field of KEY (arguments: key, value) as an operator does.
+TYPE = """const [key, value] = arguments;
+  const input = [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === key);
+  if (!input) return 'no field ' + key;
+  input.value = value;
+  input.dispatchEvent(new Event('input', {bubbles: true}));
+  return 'ok';"""
+FIELD = "return [...document.querySelectorAll('[data-key]')].find(i => i.dataset.key === arguments[0]).value;"
+
 
 def ok(cond, what):
     global passes
@@ -41,10 +50,15 @@ def post(url, body):
 def start_simulated_service(daq, tmp, db):
     """Starts `daq serve --simulate` at 20x on a free port with its log in tmp; returns the
     process and the page's URL once the service prints it (or fails with the log)."""
+    return start_service(daq, tmp, ["--simulate", "--speed", "20", "--db", db])
+
+
+def start_service(daq, tmp, args):
+    """Starts `daq serve ARGS` on a free port with its log in tmp/serve.log; returns the process
+    and the page's URL once the service prints it (or fails with the log)."""
     log = open(os.path.join(tmp, "serve.log"), "w+")
-    proc = subprocess.Popen([daq, "serve", "--simulate", "--speed", "20", "--port", "0", "--db", db],
-                            stdout=log, stderr=subprocess.STDOUT)
-    for _ in range(500):
+    proc = subprocess.Popen([daq, "serve", "--port", "0", *args], stdout=log, stderr=subprocess.STDOUT)
+    for _ in range(1500):
         log.seek(0)
         m = re.search(r"daq serve: (http://[0-9.]+:[0-9]+/)", log.read())
         if m:
@@ -53,7 +67,16 @@ def start_simulated_service(daq, tmp, db):
             break
         time.sleep(0.02)
     log.seek(0)
-    raise AssertionError("daq serve --simulate did not start: " + log.read())
+    raise AssertionError(f"daq serve {' '.join(args)} did not start: " + log.read())
+
+
+def log_tail(tmp, name="serve.log", lines=30):
+    """The last lines of a log the test keeps in tmp (for a failure's message)."""
+    try:
+        with open(os.path.join(tmp, name), encoding="utf-8", errors="replace") as f:
+            return "".join(f.readlines()[-lines:])
+    except OSError as e:
+        return f"({name}: {e})"
 
 
 def stop_service(proc):

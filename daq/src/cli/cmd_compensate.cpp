@@ -1,6 +1,7 @@
 // daq compensate: compensation tables for the controller from a measured run.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
+#include "compensate_run.hpp"
 #include "compensation/compensation_check.hpp"
 #include "csv_columns.hpp"
 #include "database.hpp"
@@ -50,9 +52,9 @@ std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
   return p;
 }
 
-std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
-  if (!o.input.empty()) return read_measurements(o.input, o.csv);
-  const auto store = open_database_read_only(o.db);
+// The stops of --run, refused when it is suspect and not accepted; its origin noted.
+std::vector<cal::iso230_2::Measurement> run_measurements(CompensateOptions& o,
+                                                         const cal::storage::Store& store) {
   const std::int64_t runs[] = {o.run};
   o.accepted = refuse_suspect_runs(store, runs, o.accept_suspect, "daq compensate");
   if (const auto run = store.run(o.run)) {
@@ -68,6 +70,11 @@ std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
          t.deviation_um});
   if (out.empty()) throw cal::InputError(fmt::format("run {} has no captured targets", o.run));
   return out;
+}
+
+std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
+  if (!o.input.empty()) return read_measurements(o.input, o.csv);
+  return run_measurements(o, open_database_read_only(o.db));
 }
 
 // A straightness run is the error of another axis (--output-axis) along --axis: its correction
@@ -250,20 +257,24 @@ void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct
   }
 }
 
+ct::Spec spec_of(const CompensateOptions& o) {
+  return {.axis = o.axis,
+          .start_mm = o.start_mm,
+          .interval_mm = o.interval_mm,
+          .points = o.points,
+          .bidirectional = o.bidirectional,
+          .incremental = o.incremental,
+          .sign = table_sign(o),
+          .units = ct::units_from_string(o.units),
+          .resolution = o.resolution.value_or(default_resolution(o.units)),
+          .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
+}
+
 void run(CompensateOptions& o) {
   if (o.input.empty() && o.run == 0 && o.straightness.empty())
     throw cal::InputError(
         "compensate: give --input MEAS.csv, --run RUN or --straightness FILE.csv");
-  const ct::Spec spec{.axis = o.axis,
-                      .start_mm = o.start_mm,
-                      .interval_mm = o.interval_mm,
-                      .points = o.points,
-                      .bidirectional = o.bidirectional,
-                      .incremental = o.incremental,
-                      .sign = table_sign(o),
-                      .units = ct::units_from_string(o.units),
-                      .resolution = o.resolution.value_or(default_resolution(o.units)),
-                      .outside = o.outside == "hold" ? ct::Outside::hold : ct::Outside::refuse};
+  const ct::Spec spec = spec_of(o);
   std::string text;
   std::optional<ct::PredictedResidual> predicted;
   if (!o.straightness.empty()) {
@@ -295,6 +306,52 @@ void run(CompensateOptions& o) {
 }
 
 }  // namespace
+
+nlohmann::json run_compensation(const cal::storage::Store& store, std::int64_t run,
+                                const std::string& format) {
+  CompensateOptions o;
+  o.run = run;
+  o.format = format;
+  const auto record = store.run(run);
+  if (!record) throw cal::InputError(fmt::format("no run {}", run));
+  if (record->kind != "linear")
+    throw cal::InputError(fmt::format(
+        "run {} is a {} test: a compensation table is made from a linear one", run, record->kind));
+  o.axis = record->axis;
+  meaning_of(o);  // an unknown format is refused before anything is read
+  const auto m = run_measurements(o, store);
+  // The run's own grid: its first target, its spacing, its number of targets.
+  std::vector<double> nominal;
+  for (const auto& x : m) nominal.push_back(x.target_mm);
+  std::sort(nominal.begin(), nominal.end());
+  nominal.erase(std::unique(nominal.begin(), nominal.end()), nominal.end());
+  if (nominal.size() < 2)
+    throw cal::InputError(fmt::format("run {} has fewer than 2 targets: no table", run));
+  o.start_mm = nominal.front();
+  o.points = static_cast<int>(nominal.size());
+  o.interval_mm = (nominal.back() - nominal.front()) / (o.points - 1);
+  const auto stats = cal::iso230_2::target_stats(m);
+  const auto table = ct::positioning(spec_of(o), stats);
+  const auto text = positioning_text(o, table);
+  const auto predicted = ct::predict(applied_of(writer_of(o), table), stats);
+  const auto& meaning = meaning_of(o);
+  return {{"schema", "caldaq.run-compensation.v1"},
+          {"run", run},
+          {"axis", o.axis},
+          {"format", o.format},
+          {"command", fmt::format("daq compensate --run {} --axis {} --start-mm {} --interval-mm "
+                                  "{} --points {} -f {}",
+                                  run, o.axis, o.start_mm, o.interval_mm, o.points, o.format)},
+          {"meaning", ct::meaning_text(meaning)},
+          {"values", table.spec.sign == ct::Sign::error ? "error" : "correction"},
+          {"units", ct::units_name(table.spec.units)},
+          {"position_mm", table.position_mm},
+          {"forward", table.forward},
+          {"backlash", table.backlash},
+          {"predicted", predicted_json(predicted)},
+          {"origin", o.origin_label},
+          {"text", text}};
+}
 
 void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   auto o = std::make_shared<CompensateOptions>();

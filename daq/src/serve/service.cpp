@@ -25,12 +25,14 @@
 #include <sstream>
 #include <thread>
 
+#include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/daq/gcode.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
+#include "compensate_run.hpp"
 #include "database.hpp"
 #include "devices_list.hpp"
 #include "json_input.hpp"
@@ -39,6 +41,7 @@
 #include "provenance.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
+#include "result_rows.hpp"
 #include "run_document.hpp"
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
@@ -306,6 +309,7 @@ class Service {
     post("/api/setup/check", &Service::setup_check);
     post("/api/setup/program", &Service::setup_program);
     post("/api/setup/apply", &Service::setup_apply);
+    post("/api/compensation", &Service::compensation);
     if (o_.simulate) post("/api/simulation/speed", &Service::simulation_speed);
     server_ = std::make_unique<web::LiveServer>(
         io_,
@@ -545,6 +549,25 @@ class Service {
     return open_database_read_only(o_.run.db);
   }
 
+  static RunOrigin origin_in(const cal::storage::Store& db, const cal::storage::RunRecord& r) {
+    const auto machine = db.machine(r.machine_id);
+    return run_origin(r, db.instruments(r.id), machine ? machine->name : "");
+  }
+
+  // Where the run's readings come from, as stored with its instruments when it started
+  // (docs/storage.md, "Origin"): the page says SIMULATED or REPLAYED from this, not from
+  // --simulate or the set-up's names. {"label": "", ...} for real instruments.
+  json stored_origin(std::int64_t id) const {
+    try {
+      const auto db = read_store();
+      const auto run = db ? db->run(id) : std::nullopt;
+      return run ? to_json(origin_in(*db, *run)) : json(nullptr);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "daq serve: run {}: its origin could not be read: {}\n", id, e.what());
+      return nullptr;
+    }
+  }
+
   std::string no_database() const {
     return fmt::format("no database at {} yet (the first run creates it)",
                        database_path(o_.run.db).string());
@@ -609,8 +632,7 @@ class Service {
       for (const auto& r : db->runs()) {
         // Where its readings came from ("SIMULATED", "REPLAYED", ...; "" for real instruments):
         // the list shows it beside every run, as everything derived from a run does.
-        const auto machine = db->machine(r.machine_id);
-        const auto origin = run_origin(r, db->instruments(r.id), machine ? machine->name : "");
+        const auto origin = origin_in(*db, r);
         list.push_back({{"id", r.id},
                         {"kind", r.kind},
                         {"axis", r.axis},
@@ -635,9 +657,47 @@ class Service {
     const auto& store = *db;
     if (!store.run(id)) return error(404, fmt::format("no run {}", id));
     auto j = run_document(store, id);
+    // The page's plot of the stops and its tables: the stored stops, and each result's rows
+    // as the terminal and the report list them (result_rows.hpp).
+    j["stops"] = json::array();
+    for (const auto& t : store.targets(id))
+      j["stops"].push_back({{"target_index", t.target_index},
+                            {"run", t.run_number},
+                            {"direction", t.direction == '+' ? "up" : "down"},
+                            {"nominal_mm", t.nominal_mm},
+                            {"deviation_um", t.deviation_um}});
+    for (auto& r : j["results"])
+      if (r["result"].is_object()) r["values"] = rows_json(result_rows(r["result"]));
     j["reports"] = {{"html", fmt::format("/reports/run-{}.html", id)},
                     {"pdf", fmt::format("/reports/run-{}.pdf", id)}};
     return ok(j);
+  }
+
+  // POST /api/compensation {"run": N, "format": "fanuc"}: the compensation table of a stored
+  // linear run as `daq compensate` writes it, through the same code (compensate_run.hpp);
+  // nothing is stored. 400 for a bad body or format, 404 for no such run, 409 with the
+  // command's refusal (a suspect run, too few targets, not a linear run).
+  web::Response compensation(const std::string& body) {
+    const auto j = json::parse(body, nullptr, false);
+    const bool good = j.is_object() && j.size() == 2 && j.contains("run") &&
+                      j["run"].is_number_integer() && j.contains("format") &&
+                      j["format"].is_string();
+    if (!good) return error(400, R"(the body must be {"run": N, "format": "csv"})");
+    const auto id = j["run"].get<std::int64_t>();
+    const auto format = j["format"].get<std::string>();
+    try {
+      cal::comptable::format_meaning(format);
+    } catch (const cal::InputError& e) {
+      return error(400, e.what());
+    }
+    const auto db = read_store();
+    if (!db) return error(404, fmt::format("no run {}: {}", id, no_database()));
+    if (!db->run(id)) return error(404, fmt::format("no run {}", id));
+    try {
+      return ok(run_compensation(*db, id, format));
+    } catch (const cal::InputError& e) {
+      return error(409, e.what());
+    }
   }
 
   // GET /reports/run-N.html | .pdf: the run's report as `daq report N` writes it. The HTML is
@@ -748,7 +808,7 @@ class Service {
     if (o_.simulate) j["speed"] = o_.speed;
     if (config_.linear) j["tests"].push_back("linear");
     if (config_.circle) j["tests"].push_back("circle");
-    if (running()) j["run"] = {{"id", run_id_}, {"test", test_}};
+    if (running()) j["run"] = {{"id", run_id_}, {"test", test_}, {"origin", run_origin_}};
     if (last_) j["last"] = *last_;
     j["setup"] = setup_summary_;
     return j;
@@ -793,6 +853,7 @@ class Service {
       return error(500, e.what());
     }
     test_ = *test;
+    run_origin_ = stored_origin(run_id_);
     name_capture();
     if (shop_) start_program_when_ready(0);
     return {202, json{{"run", run_id_}, {"test", *test}}.dump()};
@@ -980,8 +1041,9 @@ class Service {
     const bool evaluated = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
     const char* status = complete ? "complete" : evaluated ? "incomplete" : "aborted";
-    last_ = json{{"run", run_id_},   {"test", test_},    {"complete", complete},
-                 {"status", status}, {"reason", reason}, {"evaluated", evaluated}};
+    last_ = json{{"run", run_id_},       {"test", test_},    {"complete", complete},
+                 {"status", status},     {"reason", reason}, {"evaluated", evaluated},
+                 {"origin", run_origin_}};
     if (capture_ && capture_->recorder) capture_->recorder->close();
     const char* how = complete ? "complete" : evaluated ? "incomplete: " : "stopped: ";
     fmt::print("run {} {}{}\n", run_id_, how, reason);
@@ -1030,6 +1092,7 @@ class Service {
   std::int64_t run_id_ = 0;
   std::string test_;
   std::string run_live_;
+  json run_origin_;                 // stored_origin(run_id_) of the run in progress
   json setup_summary_;              // summary_of(config_): what Start runs
   std::vector<std::string> twins_;  // --simulate: the shop's devices (device_address)
   int setup_version_ = 0;
