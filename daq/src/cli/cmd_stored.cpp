@@ -211,6 +211,8 @@ void recompensate(const RecompensateOptions& o) {
                                     static_cast<std::size_t>(std::max(material_sensors, 1)), true),
                                 .keep_all_samples = true});
   for (const auto& r : readings) {
+    // A sample the device flagged is no environment value, as in the live run.
+    if (r.status != static_cast<std::uint8_t>(cal::drivers::ReadingStatus::ok)) continue;
     switch (static_cast<Q>(r.quantity)) {
       case Q::air_temperature_degc:
         stage.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc,

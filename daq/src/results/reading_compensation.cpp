@@ -94,6 +94,11 @@ int ReadingCompensation::material_sensor(const st::RawReading& r) const {
 std::optional<cal::daq::Compensated> ReadingCompensation::add(const st::RawReading& r) {
   using cal::daq::AirQuantity;
   auto& s = *stage_;
+  // A sample the device flagged (out of range, no signal) is no air or material value, as in
+  // the live run (linear_run.cpp).
+  if (r.status != static_cast<std::uint8_t>(cal::drivers::ReadingStatus::ok) &&
+      r.quantity != static_cast<std::uint8_t>(Q::displacement_m))
+    return std::nullopt;
   switch (static_cast<Q>(r.quantity)) {
     case Q::air_temperature_degc:
       s.add_air(r.time_ns, AirQuantity::temperature_degc, r.value + offset_air_k_);

@@ -343,6 +343,11 @@ struct LinearRun::Impl : Runner {
     if (reader && devices.is(Role::probe, device) && r.status == ReadingStatus::ok &&
         (r.quantity == Quantity::length_m || r.quantity == Quantity::angle_rad))
       return add_sample(kinds::Source::probe, r);
+    // A sample the device flagged (out of range, no signal) is stored, never an air or
+    // material value: its value may be anything (a sensor's error code, a clipped reading).
+    if (r.status != ReadingStatus::ok && r.quantity != Quantity::displacement_m &&
+        r.quantity != Quantity::machine_position_m)
+      return;
     switch (r.quantity) {
       case Quantity::air_temperature_degc:
         return env.add_air(r.time_ns, cal::daq::AirQuantity::temperature_degc, r.value);
