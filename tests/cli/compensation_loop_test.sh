@@ -18,7 +18,8 @@ check measure 0 "run 1 stored" -- demo 1
 check table 0 "stored as compensation 1" -- "$DAQ" compensate --run 1 --db "$DB" -f siemens "${G[@]}" -o "$T/lec.mpf"
 check table_value 0 '^\$AA_ENC_COMP\[0,10,AX1\]=0\.0' -- cat "$T/lec.mpf"
 # The demo's run is simulated: its table says so in its header (a comment the control skips).
-check table_origin 0 '^; SIMULATED: from run 1, not a measurement of a real machine' -- cat "$T/lec.mpf"
+check table_origin 0 '^; SIMULATED data: do not load into a real control$' -- cat "$T/lec.mpf"
+check table_origin_run 0 '^; from run 1, not a measurement of a real machine \(' -- cat "$T/lec.mpf"
 check as_siemens 0 "run 2 stored" -- demo 2 --control-table "$T/lec.mpf" --control-format siemens
 check verify_ok 0 "compensation 1 \(siemens, run 1 of axis X\): as predicted" -- "$DAQ" verify 2 --db "$DB"
 check as_inverted 0 "run 3 stored" -- demo 3 --control-table "$T/lec.mpf" --control-format siemens --control-inverted
