@@ -127,13 +127,13 @@ class Ids3010 final : public detail::InstrumentCore {
       case IdsMethod::get_axes_displacement:
         return displacement(r, t);
       case IdsMethod::ecu_get_temperature:
-        return air(r.temperature_degc, Quantity::air_temperature_degc, t);
+        return air(r, r.temperature_degc, Quantity::air_temperature_degc, t);
       case IdsMethod::ecu_get_pressure:
-        return air(r.pressure_pa, Quantity::air_pressure_pa, t);
+        return air(r, r.pressure_pa, Quantity::air_pressure_pa, t);
       case IdsMethod::ecu_get_humidity:
-        return air(r.humidity_pct_rh, Quantity::air_humidity_pct, t);
+        return air(r, r.humidity_pct_rh, Quantity::air_humidity_pct, t);
       case IdsMethod::ecu_get_refractive_index:
-        return air(r.refractive_index, Quantity::refractive_index, t);
+        return air(r, r.refractive_index, Quantity::refractive_index, t);
       default:
         return;
     }
@@ -234,8 +234,11 @@ class Ids3010 final : public detail::InstrumentCore {
     }
   }
 
-  void air(const std::optional<double>& v, Quantity q, std::int64_t t) {
-    if (v) emit({.time_ns = t, .quantity = q, .value = *v});
+  // An ECU value answered with a non-zero error number (result[0], attocube's errNo) is not a
+  // measurement: no reading; the number and its text are reported (device_code).
+  void air(const codec::IdsResponse& r, const std::optional<double>& v, Quantity q,
+           std::int64_t t) {
+    if (v && r.error_code == 0) emit({.time_ns = t, .quantity = q, .value = *v});
   }
 
   Ids3010Options ids_;

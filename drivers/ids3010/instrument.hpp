@@ -27,10 +27,11 @@ struct Ids3010Options {
 // request in flight at a time; the reading's time is the midpoint between request and answer).
 // Readings: displacement_m per axis (raw: the IDS counts the vacuum wavelength), status
 // signal_lost while the device reports a warning number; with the ECU, air readings on
-// channel 0. Every non-zero result[0] and every JSON-RPC error is reported as a DeviceMessage
-// with the device's own number and its text (errorNumberToString), a warning for the
-// displacement getters, an error otherwise; startMeasurement refused three times, or the ECU
-// refusing to enable, ends the connection with that text instead of polling silently.
+// channel 0 (none for an answer with a non-zero error number: that value is no measurement). Every
+// non-zero result[0] and every JSON-RPC error is reported as a DeviceMessage with the device's own
+// number and its text (errorNumberToString), a warning for the displacement getters, an error
+// otherwise; startMeasurement refused three times, or the ECU refusing to enable, ends the
+// connection with that text instead of polling silently.
 std::unique_ptr<Instrument> make_ids3010(boost::asio::io_context& io,
                                          std::unique_ptr<transport::Transport> transport,
                                          InstrumentOptions options, Ids3010Options ids = {});

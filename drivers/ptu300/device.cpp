@@ -81,7 +81,9 @@ class Driver final : public DeviceDriver {
                 {.kind = DecodedItem::Kind::note, .offset = offset, .text = std::move(text)});
           };
           for (const auto& field : f.fields) {
-            if (!field.available)
+            if (const auto text = unavailable_text(field))
+              note(*text);
+            else if (!field.available)
               note(fmt::format("{}: not available (the device printed stars)", field.label));
             else if (field.quantity == codec::Ptu300Quantity::gauge_pressure)
               note(fmt::format("{} = {} Pa gauge ({}): not taken for the air pressure", field.label,

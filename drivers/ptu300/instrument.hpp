@@ -1,6 +1,8 @@
 #pragma once
 // The Vaisala PTU300 instrument (codec: ptu300/codec.hpp).
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "cal/drivers/instrument.hpp"
 #include "ptu300/codec.hpp"
@@ -22,6 +24,11 @@ void for_each_reading(const codec::Ptu300Frame& f, Emit&& emit) {
   put(f.relative_humidity_pct, Quantity::air_humidity_pct);
   put(f.dew_point_degc, Quantity::dew_point_degc);
 }
+
+// A field the device printed as stars, of a quantity caldaq takes (P, T, RH, dew point): the
+// sentence that says so, with the reason the user's guide gives (docs/drivers.md, "PTU300
+// stars"); nullopt for a value, or for a field caldaq does not read (A3H is "*" for 3 hours).
+std::optional<std::string> unavailable_text(const codec::Ptu300Field& field);
 }  // namespace ptu300
 
 std::unique_ptr<Instrument> make_ptu300(boost::asio::io_context& io,

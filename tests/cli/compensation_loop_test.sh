@@ -18,7 +18,8 @@ check measure 0 "run 1 stored" -- demo 1
 check table 0 "stored as compensation 1" -- "$DAQ" compensate --run 1 --db "$DB" -f siemens "${G[@]}" -o "$T/lec.mpf"
 check table_value 0 '^\$AA_ENC_COMP\[0,10,AX1\]=0\.0' -- cat "$T/lec.mpf"
 # The demo's run is simulated: its table says so in its header (a comment the control skips).
-check table_origin 0 '^; SIMULATED: from run 1, not a measurement of a real machine' -- cat "$T/lec.mpf"
+check table_origin 0 '^; SIMULATED data: do not load into a real control$' -- cat "$T/lec.mpf"
+check table_origin_run 0 '^; from run 1, not a measurement of a real machine \(' -- cat "$T/lec.mpf"
 check as_siemens 0 "run 2 stored" -- demo 2 --control-table "$T/lec.mpf" --control-format siemens
 check verify_ok 0 "compensation 1 \(siemens, run 1 of axis X\): as predicted" -- "$DAQ" verify 2 --db "$DB"
 check as_inverted 0 "run 3 stored" -- demo 3 --control-table "$T/lec.mpf" --control-format siemens --control-inverted
@@ -48,4 +49,18 @@ check renamed_banner 0 "<strong>SIMULATED</strong>: this run was made on the sim
 check renamed_title 0 "<h1>SIMULATED — Run 1" -- cat "$T/r1.html"
 check renamed_export 0 '"label": "SIMULATED"' -- "$DAQ" export 1 --db "$DB" --format json
 check renamed_json 0 '"simulated": true' -- "$DAQ" show 1 --db "$DB" --json
+# daq recompensate assesses the stops again and stores their quality (issue 26): a verdict
+# planted in the database (a suspect stop that is not) is replaced by what the stops say, in
+# the database, not only in the command's output.
+"$PY" - "$DB" <<'PYEOF'
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+db.execute("UPDATE runs SET quality = 'suspect', quality_note = 'planted verdict' WHERE id = 2")
+db.execute("UPDATE captured_targets SET suspect = 'planted stop' WHERE run_id = 2 AND target_index = 3")
+db.commit()
+PYEOF
+check planted 0 "stop quality: planted verdict" -- "$DAQ" show 2 --db "$DB"
+check recompensate_quality 0 "^  stop quality: ok" -- "$DAQ" recompensate 2 --alpha-ppm 11.6 --db "$DB"
+check quality_stored 0 "^  stop quality: ok" -- "$DAQ" show 2 --db "$DB"
+check planted_gone 0 '"suspect_stops": \[\]' -- "$DAQ" show 2 --db "$DB" --json
 finish

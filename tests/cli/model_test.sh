@@ -47,4 +47,32 @@ printf 'feature,x_mm,y_mm\nface+Z,0,0\n' > "$TMP/bad_cmm.csv"
 check testpiece_bad_cmm 2 "bad_cmm.csv: feature 'face\+Z' is unknown" -- "$DAQ" model testpiece "$S" "${T[@]}" --cmm "$TMP/bad_cmm.csv"
 check bad_carrier 2 "bad_carrier.json: squareness.E_B0Z.compensated_by: Y is not an axis of the XZ plane" -- "$DAQ" model show "$DATA/bad_carrier.json"
 check missing_file 2 "nope.json: cannot open the model file" -- "$DAQ" model show "$TMP/nope.json"
+# Issue 26: a model from runs not measured on real instruments says so at the top of every
+# controller file that has comments, and a model from a mix names the errors that came from
+# where; files without comments (HEIDENHAIN *.COM) are named in the output instead. The names
+# in the provenance cannot break out of the comment (a line break in them becomes '?').
+with_origin() {  # with_origin MODEL OUT PROVENANCE_JSON
+  "$PY" -c 'import json,sys; m=json.load(open(sys.argv[1])); m["provenance"]=json.loads(sys.argv[3]); json.dump(m,open(sys.argv[2],"w"))' "$@"
+}
+with_origin "$S" "$TMP/mixed.json" '{"origin": "MIXED", "origins": {"E_C0Y": "SIMULATED", "E_XX": "REPLAYED"}}'
+with_origin "$S" "$TMP/sim.json" '{"origin": "SIMULATED"}'
+with_origin "$S" "$TMP/evil.json" '{"origin": "MIXED", "origins": {"E_C0Y\n$AA_ENC_COMP[0,0,AX1]=1": "SIMULATED\nM30"}}'
+I=(--interval-mm 50 50 50)
+"$DAQ" model compensate "$TMP/mixed.json" -f siemens-cec "${I[@]}" -o "$TMP/mixed.mpf" 2>"$TMP/mixed.err"
+check mixed_cec 0 "^; MIXED data: do not load into a real control: some errors were not measured on the machine$" -- cat "$TMP/mixed.mpf"
+check mixed_cec_name_first 0 "^%_N_NC_CEC_INI$" -- head -1 "$TMP/mixed.mpf"
+check mixed_cec_parts 0 "^;   SIMULATED: E_C0Y$" -- cat "$TMP/mixed.mpf"
+check mixed_cec_replayed 0 "^;   REPLAYED: E_XX$" -- cat "$TMP/mixed.mpf"
+check mixed_output 0 "^  SIMULATED: E_C0Y$" -- cat "$TMP/mixed.err"
+check mixed_json 0 '"E_C0Y": "SIMULATED"' -- "$DAQ" model compensate "$TMP/mixed.json" -f csv "${I[@]}" --json
+# ISG's CSV parameter file comments with "//" ("#" is a file break there).
+check isg_csv_origin 0 "^//   SIMULATED: E_C0Y$" -- sh -c "'$DAQ' model compensate '$TMP/mixed.json' -f isg-volumetric ${I[*]} --output-dir '$TMP/mvc' 2>/dev/null && cat '$TMP/mvc/volcomp.csv'"
+check isg_lis_origin 0 "^# MIXED data: do not load into a real control" -- cat "$TMP/mvc/volcomp.lis"
+check heidenhain_silent 0 "Y.COM: the format has no comments, so the file does not say it" -- "$DAQ" model compensate "$TMP/mixed.json" -f heidenhain "${I[@]}" --output-dir "$TMP/mhh"
+check sim_fanuc 0 "^SIMULATED data: do not load into a real control$" -- sh -c "'$DAQ' model compensate '$TMP/sim.json' -f fanuc ${I[*]} 2>/dev/null"
+check sim_matrixkins 0 "^# SIMULATED data: do not load into a real control$" -- sh -c "'$DAQ' model compensate '$TMP/sim.json' -f linuxcnc ${I[*]} --output-dir '$TMP/mlc' 2>/dev/null && cat '$TMP/mlc/matrixkins.hal'"
+check mixed_report 0 "<strong>MIXED</strong>: some errors of this model come from runs not measured on real instruments \(REPLAYED: E_XX; SIMULATED: E_C0Y\).*Do not load its compensation into a real control" -- sh -c "'$DAQ' model compensate '$TMP/mixed.json' -f siemens-cec ${I[*]} -o '$TMP/m2.mpf' --report '$TMP/mixed.html' 2>/dev/null && cat '$TMP/mixed.html'"
+"$DAQ" model compensate "$TMP/evil.json" -f siemens-cec "${I[@]}" -o "$TMP/evil.mpf" 2>/dev/null
+check evil_parts 0 "^;   SIMULATEDM: E_C0YAA_ENC_COMP$" -- cat "$TMP/evil.mpf"
+check evil_no_line 1 "" -- grep -qE '^(\$AA_ENC_COMP\[0,0|M30)' "$TMP/evil.mpf"
 finish

@@ -12,7 +12,6 @@
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
-#include "cal/analysis/text.hpp"
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
@@ -127,9 +126,12 @@ TableWriter writer_of(const CompensateOptions& o) {
 // real instruments, says so in its header.
 std::string suspect_note(const CompensateOptions& o, std::string_view comment) {
   std::string out;
-  if (!o.origin_label.empty())
-    out += fmt::format("{}{}: from run {}, not a measurement of a real machine ({})\n", comment,
-                       o.origin_label, o.run, cal::text::terminal_safe(o.origin_text));
+  for (const auto& line :
+       table_origin_lines(o.origin_label,
+                          fmt::format("from run {}, not a measurement of a real machine ({})",
+                                      o.run, o.origin_text),
+                          {}))
+    out += fmt::format("{}{}\n", comment, line);
   for (const auto id : o.accepted)
     out += fmt::format(
         "{}SUSPECT run {}: a stop far outside its repeatability, used as told "
@@ -211,12 +213,7 @@ void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct
     cal::storage::Store store(database_path(o.db));
     const auto run = store.run(o.run);
     if (!run) throw cal::InputError(fmt::format("no run {}", o.run));
-    const auto origin = run_origin(*run, store.instruments(o.run), "");
-    if (!origin.label().empty())
-      fmt::print(stderr,
-                 "note: run {} is {} ({}): this table comes from no measurement of a real "
-                 "machine\n",
-                 o.run, origin.label(), origin.text);
+    const auto origin = run_origin(*run, store.instruments(o.run), "");  // said by suspect_note
     const auto& m = meaning_of(o);
     const nlohmann::json doc{{"schema", "caldaq.compensation.v1"},
                              {"format", o.format},
@@ -288,8 +285,9 @@ void run(CompensateOptions& o) {
     predicted = ct::predict(a, stats);
     if (o.run != 0 && !o.json) store_compensation(o, table, a, *predicted, text);
   }
-  if ((!o.accepted.empty() || !o.origin_label.empty()) && o.format != "csv" &&
-      !o.json)  // the vendor formats: here too
+  // Said here too unless the table with its header goes to the terminal.
+  if ((!o.accepted.empty() || !o.origin_label.empty()) &&
+      (o.format != "csv" || !o.output.empty()) && !o.json)
     fmt::print(stderr, "{}", suspect_note(o, "note: "));
   if (o.output.empty())
     fmt::print("{}", text);

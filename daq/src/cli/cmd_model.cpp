@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -118,8 +119,13 @@ cal::daq::report::ModelPage model_page_of(const mdl::Model& m, const std::string
                                   m.machine.tool_offset_mm[1], m.machine.tool_offset_mm[2])},
       {"table offset", fmt::format("({:g}, {:g}, {:g}) mm", m.machine.table_offset_mm[0],
                                    m.machine.table_offset_mm[1], m.machine.table_offset_mm[2])}};
+  page.origins = model_origin_parts(m);
   if (!page.origin.empty())
-    page.facts.push_back({"origin", page.origin + " (the model's provenance: not a real machine)"});
+    page.facts.push_back(
+        {"origin",
+         page.origin + (page.origin == "MIXED" ? " (the model's provenance: some errors were not "
+                                                 "measured on the machine)"
+                                               : " (the model's provenance: not a real machine)")});
   for (auto& r : describe_components(m, true)) page.components.push_back(std::move(r));
   page.software = "daq 0.1.0";
   return page;
@@ -140,14 +146,39 @@ void require_finite(std::span<const double> values, std::string_view what) {
           v));
 }
 
+namespace {
+
+// An origin's label as it may be printed into a controller file: capitals, commas and spaces.
+std::string label_text(const std::string& s) {
+  std::string out;
+  for (const char c : s)
+    if ((c >= 'A' && c <= 'Z') || c == ',' || c == ' ') out += c;
+  return out.substr(0, 40);
+}
+
+}  // namespace
+
 std::string model_origin(const mdl::Model& m) {
   if (m.provenance.json.empty()) return "";
   const auto j = json::parse(m.provenance.json, nullptr, false);
   if (!j.is_object() || !j.contains("origin") || !j["origin"].is_string()) return "";
-  std::string out;
-  for (const char c : j["origin"].get<std::string>())
-    if ((c >= 'A' && c <= 'Z') || c == ',' || c == ' ') out += c;
-  return out.substr(0, 40);
+  return label_text(j["origin"].get<std::string>());
+}
+
+std::map<std::string, std::string> model_origin_parts(const mdl::Model& m) {
+  std::map<std::string, std::string> parts;
+  if (m.provenance.json.empty()) return parts;
+  const auto j = json::parse(m.provenance.json, nullptr, false);
+  if (!j.is_object() || !j.contains("origins") || !j["origins"].is_object()) return parts;
+  for (const auto& [name, label] : j["origins"].items()) {
+    if (!label.is_string()) continue;
+    std::string error;  // an error's name: E_XX, E_C0Y
+    for (const char c : name)
+      if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') error += c;
+    if (const auto l = label_text(label.get<std::string>()); !error.empty() && !l.empty())
+      parts[error.substr(0, 16)] = l;
+  }
+  return parts;
 }
 
 kin::Method method_from_string(const std::string& s) {
@@ -171,10 +202,9 @@ void run_show(const ShowOptions& o) {
   print_line("Model {}{}", m.name.empty() ? "(unnamed)" : m.name, " (" + o.file + ")");
   if (const auto origin = model_origin(m); !origin.empty()) {
     print_line("  {}: not measured on a real machine (the model's provenance)", origin);
-    const auto j = json::parse(m.provenance.json, nullptr, false);
-    if (origin == "MIXED" && j.contains("origins") && j["origins"].is_object())
-      for (const auto& [name, label] : j["origins"].items())
-        if (label.is_string()) print_line("    {} from a {} run", name, label.get<std::string>());
+    if (origin == "MIXED")
+      for (const auto& [name, label] : model_origin_parts(m))
+        print_line("    {} from a {} run", name, label);
   }
   print_line("  topology      {}", describe_topology(m.machine.topology));
   const auto& t = m.machine.tool_offset_mm;

@@ -1,5 +1,6 @@
 // daq model compensate: the model's compensation in a controller's format, with what it leaves.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/volumetric_comp.hpp"
 #include "model_cli.hpp"
+#include "provenance.hpp"
 
 namespace daq {
 namespace {
@@ -296,26 +298,46 @@ Extremes largest(const std::array<vc::AxisGrid, 3>& g,
 }
 
 // The comment that starts a line of a written file, where the format has one (nullopt: none;
-// the command's output says what the file cannot).
+// the command's output says what the file cannot). ISG's CSV parameter file: "Row comments
+// start by a double slash" (Beckhoff Infosys TF5280, ISG CSV format), and a "#" line there is a
+// file break, not a comment.
 std::optional<std::string> comment_of(const std::string& format, const std::string& name,
                                       const std::string& text) {
   if (format == "fanuc") return "";  // a listing of parameters to enter, not a file to load
+  if (text.starts_with("//")) return "// ";
   if (text.starts_with("#") || name.starts_with("ssfk_")) return "# ";
   if (text.starts_with(";") || text.starts_with("%_N_")) return "; ";
   return std::nullopt;
 }
 
-// A model not measured on real instruments says so at the top of every file that can hold it.
-void say_origin(Written& w, const std::string& format, const std::string& origin) {
-  if (origin.empty()) return;
-  for (auto& [name, text] : w.files)
-    if (const auto c = comment_of(format, name, text)) {
-      const auto line = fmt::format(
-          "{}{}: from a model not measured on a real machine (its provenance)\n", *c, origin);
-      // A SINUMERIK file's first line names it (%_N_..._INI): the comment goes after it.
-      const auto at = text.starts_with("%_N_") ? text.find('\n') + 1 : 0;
-      text.insert(at, line);
+// A model not measured on real instruments says so at the top of every file that can hold it
+// (for a mixed model, which errors came from where); the files that cannot are returned.
+std::vector<std::string> say_origin(Written& w, const std::string& format,
+                                    const std::string& origin,
+                                    const std::map<std::string, std::string>& parts) {
+  std::vector<std::string> silent;
+  if (origin.empty()) return silent;
+  const auto lines = daq::table_origin_lines(
+      origin,
+      origin == "MIXED" && !parts.empty()
+          ? "the errors above came from runs not measured on real instruments (the model's "
+            "provenance)"
+          : "from a model built from runs not measured on real instruments (its provenance), "
+            "not a model of a real machine",
+      parts);
+  for (auto& [name, text] : w.files) {
+    const auto c = comment_of(format, name, text);
+    if (!c) {
+      silent.push_back(name.empty() ? "the table" : name);
+      continue;
     }
+    std::string header;
+    for (const auto& l : lines) header += *c + l + "\n";
+    // A SINUMERIK file's first line names it (%_N_..._INI): the comment goes after it.
+    const auto at = text.starts_with("%_N_") ? text.find('\n') + 1 : 0;
+    text.insert(at, header);
+  }
+  return silent;
 }
 
 void run(const Options& o) {
@@ -325,7 +347,8 @@ void run(const Options& o) {
   const auto tables = vc::cross_tables(m.machine, g, ref, m.carriers);
   Written w = write_format(o, m, g, tables);
   const std::string origin = model_origin(m);
-  say_origin(w, o.format, origin);
+  const auto parts = model_origin_parts(m);
+  const auto silent = say_origin(w, o.format, origin, parts);
   const auto machine = m.machine;
   const auto before = [machine](const kin::Vec3& p) {
     return kin::volumetric_error_um(machine, p, kin::Method::htm);
@@ -386,14 +409,16 @@ void run(const Options& o) {
                             {"after_max_at_mm", {a.at[0], a.at[1], a.at[2]}},
                             {"notes", w.notes},
                             {"origin", origin},
+                            {"origins", parts},
                             {"meaning", meaning_json(meanings_of(o.format))}}
                            .dump(2));
     return;
   }
   for (const auto& f : written) fmt::print(stderr, "written {}\n", f);
-  if (!origin.empty())
-    fmt::print(stderr, "{}: this model was not measured on a real machine (its provenance)\n",
-               origin);
+  for (const auto& l : daq::table_origin_lines(origin, "", parts)) fmt::print(stderr, "{}\n", l);
+  if (!silent.empty())
+    fmt::print(stderr, "{}: the format has no comments, so the file does not say it\n",
+               fmt::join(silent, ", "));
   fmt::print(stderr,
              "{}: largest |e| over the travel ({} x {} x {} points) {:.3f} um before, {:.3f} um "
              "with the compensation applied to the model (at {:g}, {:g}, {:g} mm)\n",

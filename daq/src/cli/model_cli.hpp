@@ -1,6 +1,7 @@
 #pragma once
 // What the `daq model` subcommands share (cmd_model*.cpp): reading the model and describing it.
 #include <CLI/CLI.hpp>
+#include <map>
 #include <span>
 #include <string>
 #include <string_view>
@@ -33,6 +34,10 @@ void require_finite(std::span<const double> values, std::string_view what);
 // "" for real instruments or when the file does not say. Only capitals, commas and spaces are
 // kept (it is printed into controller files).
 std::string model_origin(const cal::daq::model::Model& m);
+// A model built from runs of several origins: each error that came from runs not measured on
+// real instruments, with their origin ("E_XX" -> "SIMULATED"; the provenance's "origins"),
+// the names and labels reduced to letters, digits, '_' and capitals.
+std::map<std::string, std::string> model_origin_parts(const cal::daq::model::Model& m);
 
 // --method htm|first-order
 cal::kinematics::Method method_from_string(const std::string& s);

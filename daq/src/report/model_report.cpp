@@ -3,6 +3,7 @@
 #include "report/model_report.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <array>
@@ -253,15 +254,25 @@ std::string model_page(const ModelPage& p) {
     return kin::volumetric_error_um(p.machine, q, method);
   };
   std::string body;
-  if (p.origin == "MIXED")
-    body +=
+  // A compensation of a model not (all) measured on the machine must not reach a real control.
+  const std::string not_to_load =
+      p.compensated ? " Do not load its compensation into a real control." : "";
+  if (p.origin == "MIXED") {
+    std::map<std::string, std::vector<std::string>> by_origin;
+    for (const auto& [name, of] : p.origins) by_origin[of].push_back(esc(name));
+    std::string which;
+    for (const auto& [of, names] : by_origin)
+      which += fmt::format("{}{}: {}", which.empty() ? "" : "; ", esc(of), fmt::join(names, ", "));
+    body += fmt::format(
         "<p class=\"simulated\"><strong>MIXED</strong>: some errors of this model come from "
-        "runs not measured on real instruments (see each error's source): it is not a model "
-        "of a real machine.</p>\n";
-  else if (p.simulated)
-    body +=
+        "runs not measured on real instruments{}: it is not a model of a real machine.{}</p>\n",
+        which.empty() ? " (see each error's source)" : " (" + which + ")", not_to_load);
+  } else if (p.simulated) {
+    body += fmt::format(
         "<p class=\"simulated\">This model describes the <strong>simulated</strong> machine: "
-        "the numbers show what the software computes, not a real machine.</p>\n";
+        "the numbers show what the software computes, not a real machine.{}</p>\n",
+        not_to_load);
+  }
   body += "<h2>Model</h2>\n";
   std::vector<std::vector<std::string>> facts{{"file", esc(p.source)}};
   for (const auto& [k, v] : p.facts) facts.push_back({esc(k), esc(v)});

@@ -4,6 +4,7 @@
 // slices, the 21 errors' contributions ranked, and, after a compensation, what remains. Self-
 // contained HTML with PLplot SVG plots (plot.hpp). Content: docs/reports.md.
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -18,6 +19,8 @@ struct ModelPage {
   std::string source;  // the model file
   bool simulated = false;
   std::string origin;  // the model's provenance's origin ("SIMULATED", "MIXED", ...), if any
+  std::map<std::string, std::string>
+      origins;  // MIXED: each error not measured for real, its origin
   kinematics::Machine machine;
   kinematics::Grid grid;  // the volume (a map over it; slices through its middle)
   kinematics::Method method = kinematics::Method::htm;

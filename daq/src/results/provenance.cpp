@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 
@@ -216,6 +217,42 @@ RunOrigin run_origin(const cal::storage::RunRecord& run,
                          : fmt::format("{}", fmt::join(parts, "; "));
   if (o.unrecorded && !parts.empty()) o.text += "; the other instruments' origin was not recorded";
   return o;
+}
+
+namespace {
+
+// Printable ASCII on one line: a control's comment ends at the line, and some controls refuse
+// bytes outside ASCII even in comments.
+std::string comment_text(std::string_view s) {
+  std::string out;
+  for (const char c : s) out += c >= ' ' && c <= '~' ? c : '?';
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> table_origin_lines(std::string_view label, std::string_view source,
+                                            const std::map<std::string, std::string>& parts) {
+  if (label.empty()) return {};
+  std::vector<std::string> lines;
+  if (parts.empty() || label != "MIXED") {
+    lines.push_back(comment_text(label) + " data: do not load into a real control");
+  } else {
+    lines.push_back(comment_text(label) +
+                    " data: do not load into a real control: some errors were not measured on "
+                    "the machine");
+    // Per origin, the errors it gave, a few names a line (controls limit the line length).
+    std::map<std::string, std::vector<std::string>> by_label;
+    for (const auto& [name, of] : parts) by_label[comment_text(of)].push_back(comment_text(name));
+    for (const auto& [of, names] : by_label)
+      for (std::size_t i = 0; i < names.size(); i += 7) {
+        const auto end = names.begin() + static_cast<std::ptrdiff_t>(std::min(i + 7, names.size()));
+        lines.push_back(fmt::format(
+            "  {}: {}", of, fmt::join(names.begin() + static_cast<std::ptrdiff_t>(i), end, ", ")));
+      }
+  }
+  if (!source.empty()) lines.push_back(comment_text(source));
+  return lines;
 }
 
 nlohmann::json to_json(const RunOrigin& o) {

@@ -5,10 +5,12 @@
 // result's provenance (caldaq.provenance.v1): how it was obtained, with which coefficients and
 // sensor offsets, by which software, when.
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "cal/daq/config.hpp"
 #include "cal/storage/store.hpp"
@@ -74,6 +76,15 @@ RunOrigin run_origin(const cal::storage::RunRecord& run,
                      const std::vector<cal::storage::InstrumentRecord>& instruments,
                      std::string_view machine_name);
 nlohmann::json to_json(const RunOrigin& o);
+
+// The lines a controller file starts with when its data were not all measured on real
+// instruments (docs/compensation-tables.md, "Origin"), without their comment marker and in
+// printable ASCII only (a control reads these files; a stored text could hold a line break
+// that would end the comment): "SIMULATED data: do not load into a real control", where the data
+// came from (`source`), and for a model built from a mix which errors came from which origin
+// (`parts`: "E_XX" -> "SIMULATED"). None when `label` is "" (real instruments).
+std::vector<std::string> table_origin_lines(std::string_view label, std::string_view source,
+                                            const std::map<std::string, std::string>& parts);
 
 // The software that writes results (the same string runs record).
 inline constexpr std::string_view software_version = "daq 0.1.0";
