@@ -370,7 +370,9 @@ bool setting_applies(const RunView& v, const std::string& key, const json& val) 
 
 std::string setting_value(const json& val, std::string_view unit) {
   if (val.is_boolean()) return val.get<bool>() ? "yes" : "no";
-  const std::string text = esc(setting_text(val));
+  // A unit as a value (measure.unit = "um") as documents print it (µm).
+  const std::string text =
+      esc(val.is_string() ? ::daq::unit_html(val.get<std::string>()) : setting_text(val));
   return unit.empty() ? text : text + " " + esc(unit);
 }
 
