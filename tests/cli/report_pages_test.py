@@ -56,8 +56,9 @@ if fixture:
     for f in glob.glob(os.path.join(fixture, "demo.sqlite*")):
         shutil.copy(f, work)
     capture = os.path.join(fixture, "demo.cdq")
+    demo_out = open(os.path.join(fixture, "demo.log"), encoding="utf-8").read()
 else:
-    daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq")
+    demo_out = daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq")
     capture = os.path.join(work, "demo.cdq")
 db = ["--db", "demo.sqlite"]
 replay_out = daq("replay", capture, *db)  # run 3: the linear run again (comparison, as found...)
@@ -134,6 +135,13 @@ check("circle: daq show 2 reads as its JSON values",
       value_rows(show2_text, circle_title)[:len(circle_values)] == circle_values,
       f"{value_rows(show2_text, circle_title)} / {circle_values}")
 check("no -0.000 on the terminal", "-0.000" not in show2_text + replay_out, show2_text)
+# The demo's own circle summary is the same block (it printed G(b) to 2 decimals).
+check("circle: daq demo prints the block of daq show 2",
+      circle_title in demo_out
+      and value_rows(demo_out, circle_title) == value_rows(show2_text, circle_title),
+      demo_out[-3000:])
+check("daq demo: 3 decimals everywhere", re.search(r"\d\.\d\d um", demo_out.split(
+    "ballbar circle")[-1]) is None, demo_out[-3000:])
 
 reports = {
     "linear": ["1"],
@@ -219,7 +227,27 @@ check("circle: what to fix first on page one", "What to fix first" in c1
       is not None, c1)
 check("circle: failing value named on page one",
       re.search(r"FAIL.*= [+-]?[0-9.]+ µm \(limit ≤", c1) is not None, c1)
+# The failing diagnostic (the demo's backlash X, 4.084 µm against 3 µm) heads "What to fix
+# first" though correcting it alone would make G larger (it partly offsets the servo mismatch),
+# and the report says so; the others follow by their gain.
+check("circle: the failing error first in what to fix first",
+      re.search(r"What to fix first rank error, and what to check value G gain \(share of G\) "
+                r"1 Backlash X FAIL \(limit ≤ 3\.000 µm\)", c1) is not None, c1)
+circle_all = " ".join(text["circle"])
+check("circle: a failing error with a negative gain is explained",
+      re.search(r"Backlash X is outside its limit, but correcting it alone would make G [0-9.]+ "
+                r"µm larger: it partly offsets [^.]*Servo mismatch", circle_all) is not None,
+      circle_all[:3000])
+check("circle: then the largest gain", re.search(r"2 Cyclic error X", circle_all) is not None, "")
 check("no -0.000 anywhere", all("-0.000" not in p for n in text for p in text[n]), "")
+# Documents print µm, °C (the terminal keeps um, degC): no unit word of the terminal in any
+# report's text (the run quality, the uncertainty budget's models, the demo's warm-up).
+for name in reports:
+    body = re.sub(r"<style.*?</style>", "", open(f"{name}.html", encoding="utf-8").read(),
+                  flags=re.S)
+    words = html_mod.unescape(re.sub(r"<[^>]+>", " ", body))
+    found = re.findall(r".{30}\b(?:um|um/m|urad|degC)\b", words)
+    check(f"{name}: µm and °C, not um or degC", not found, str(found[:3]))
 # The settings: an appendix with labels and units, no raw keys, no empty values.
 lin = " ".join(text["linear"])
 check("settings appendix with labels",
@@ -279,6 +307,33 @@ for m in re.finditer(r'<svg[^>]*aria-label="([^"]*)"(.*?)</svg>', multiples, re.
                if b[0] - a[0] < 0.25 * a[1] * len(a[2]) + 0.25 * b[1] * len(b[2])]
     check(f"comparison: '{title}' labels apart", len(labels) >= 2 and not overlap,
           f"{labels} overlap: {overlap}")
+
+# --- traceability gaps: a missing certificate or due date warns on page one, not only a past one
+shutil.copy("demo.sqlite", "gaps.sqlite")
+con = sqlite3.connect("gaps.sqlite")
+settings = json.loads(con.execute("SELECT settings_json FROM runs WHERE id = 1").fetchone()[0])
+laser = next(i for i in settings["context"]["instruments"] if i["role"] == "laser")
+laser.pop("certificate")
+laser["calibration_due"] = ""
+con.execute("UPDATE runs SET settings_json = ? WHERE id = 1", (json.dumps(settings),))
+con.commit()
+con.close()
+daq("report", "1", "--db", "gaps.sqlite", "--format", "pdf", "-o", "gaps.pdf")
+g1 = squash(pages("gaps.pdf")[0])
+check("traceability: a missing certificate and due date warned on page one",
+      "Traceability: laser: no certificate, calibration due date stated" in g1, g1[:1500])
+
+# --- straightness and squareness: signed values through the shared formatter -----------------
+# Two profiles whose slopes differ by 1e-7 µm/m: the squareness printed "-0.000".
+with open("a.csv", "w") as f:
+    f.write("position_mm,deviation_um\n" + "".join(f"{x},0\n" for x in range(0, 500, 100)))
+with open("b.csv", "w") as f:
+    f.write("position_mm,deviation_um\n" + "".join(f"{x},{-1e-10 * x}\n" for x in range(0, 500, 100)))
+daq("analyse", "squareness", "-m", "straightness", "--along-a", "a.csv", "--along-b", "b.csv",
+    "--report", "square.html")
+square = html_mod.unescape(re.sub(r"<[^>]+>", " ", open("square.html", encoding="utf-8").read()))
+check("squareness report: no -0.000 or +0.000", "-0.000" not in square and "+0.000" not in square,
+      str(re.findall(r".{40}[+-]0\.000.{20}", square)[:3]))
 
 # --- plots: text of at least 9 pt as printed --------------------------------------------------
 # Printed widths (pt): A4 less the 14 mm margins is 516 pt; a polar plot 72 % of it, a small

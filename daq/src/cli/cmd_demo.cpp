@@ -31,6 +31,7 @@
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
 #include "provenance.hpp"
+#include "result_rows.hpp"
 #include "roles.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
@@ -68,7 +69,7 @@ cal::daq::Config demo_config() {
   c.operator_name = "demo operator";
   c.customer = {.name = "Demo customer (simulated)", .site = "caldaq built-in simulated shop"};
   c.conditions = {.controller_compensation = false,
-                  .warm_up = "none: the simulated machine is at a steady 21.5 degC",
+                  .warm_up = "none: the simulated machine is at a steady 21.5 °C",
                   .load = "no workpiece",
                   .state = "as found"};
   const auto device = [](std::string id, std::string driver, std::string role, std::string serial,
@@ -162,12 +163,14 @@ void print_comparison(const cal::iso230_2::Evaluation& measured,
   fmt::print("  {:<8} {:>10} {:>10} {:>9}\n", "", "truth um", "measured", "diff");
   for (const char* key : {"B_mean", "E_up", "E_down", "E_bi", "M"}) {
     const double a = truth.at(key).value_um, b = measured.at(key).value_um;
-    fmt::print("  {:<8} {:10.3f} {:10.3f} {:+9.3f}\n", measured.at(key).symbol, a, b, b - a);
+    fmt::print("  {:<8} {:>10} {:>10} {:>9}\n", measured.at(key).symbol, number_text(a),
+               number_text(b), signed_number_text(b - a));
   }
   fmt::print(
-      "  {:<8} {:>10} {:10.3f}   (repeatability: 4 s of the stop means; the noise-free\n"
+      "  {:<8} {:>10} {:>10}   (repeatability: 4 s of the stop means; the noise-free\n"
       "  {:<8} {:>10} {:>10}    truth has none, the {:.2f} um noise is averaged over each stop)\n",
-      measured.at("R_up").symbol, "-", measured.at("R_up").value_um, "", "", "", t.noise_um);
+      measured.at("R_up").symbol, "-", number_text(measured.at("R_up").value_um), "", "", "",
+      t.noise_um);
   fmt::print(
       "  Injected: scale {:+.1f} um/m, backlash {:.1f} um, pitch error {:.1f} um / {:.0f} mm,\n"
       "  noise {:.2f} um; machine at {:.1f} degC ({:.1f} ppm/K), so an uncompensated reading\n"
@@ -214,23 +217,17 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
   }
   const auto& r = *out.result;
   fmt::print("run {} stored ({} readings)\n", out.run_id, out.readings);
-  fmt::print("  ISO 230-4:2005: G(b) {:.2f} um (G ccw {:.2f}, cw {:.2f}), F {:+.2f} / {:+.2f} um\n",
-             r.iso.G_bi_um, r.iso.G_ccw_um, r.iso.G_cw_um, r.iso.F_max_um, r.iso.F_min_um);
+  // The same block as daq show and daq analyse print of it (one presentation of each result).
+  const auto doc = circle_json(r, program.radius_mm, "XY", program.feed_mm_per_min);
+  print_result(doc, "  ");
   std::map<std::string, double> found;
-  fmt::print("  Diagnostics (ranked):\n");
-  for (const auto& dg : r.diagnostics) {
-    found[dg.key] = dg.value;
-    if (dg.share_pct >= 1.0)
-      fmt::print("    {:<40} {:+9.3f} {:<5} {:5.1f} % of G\n", dg.name, dg.value, dg.unit,
-                 dg.share_pct);
-  }
-  print_verdict(circle_verdict(run_context(config, "circle", "XY")["tolerances"],
-                               circle_json(r, program.radius_mm, "XY", program.feed_mm_per_min)));
+  for (const auto& dg : r.diagnostics) found[dg.key] = dg.value;
+  print_verdict(circle_verdict(run_context(config, "circle", "XY")["tolerances"], doc));
   fmt::print("\nSimulated truth vs measured (ballbar):\n");
   const double lag_ms = (1.0 / t.kv_y_per_s - 1.0 / t.kv_x_per_s) * 1e3;
   const auto row = [&](const char* name, double truth, const char* key, const char* unit) {
-    fmt::print("  {:<26} {:9.3f} {:9.3f} {}\n", name, truth, found.count(key) ? found[key] : 0.0,
-               unit);
+    fmt::print("  {:<26} {:>9} {:>9} {}\n", name, number_text(truth),
+               number_text(found.count(key) ? found[key] : 0.0), unit);
   };
   row("squareness XY", t.squareness_um_per_m, "squareness", "um/m");
   row("servo mismatch (Y lags X)", lag_ms, "servo_mismatch", "ms");

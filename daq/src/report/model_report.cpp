@@ -14,6 +14,7 @@
 #include "cal/analysis/error.hpp"
 #include "report/markup.hpp"
 #include "report/plot.hpp"
+#include "result_rows.hpp"
 
 namespace cal::daq::report {
 namespace {
@@ -178,8 +179,9 @@ std::string stats_table(const Stats& s) {
       {"RMS |e| over the grid", fmt::format("{:.3f} µm", s.rms_um)}};
   for (std::size_t a = 0; a < 3; ++a)
     rows.push_back({fmt::format("e<sub>{}</sub> range", kAxis[a]),
-                    fmt::format("{:.3f} .. {:.3f} µm (span {:.3f})", s.min_um[a], s.max_um[a],
-                                s.max_um[a] - s.min_um[a])});
+                    fmt::format("{} .. {} µm (span {})", ::daq::number_text(s.min_um[a]),
+                                ::daq::number_text(s.max_um[a]),
+                                ::daq::number_text(s.max_um[a] - s.min_um[a]))});
   return table({"", ""}, rows, "kv");
 }
 

@@ -271,9 +271,16 @@ std::string svg(const XyChart& chart) {
   const std::size_t tick_chars = std::max(fmt::format("{:.{}f}", yr.lo, ydigits).size(),
                                           fmt::format("{:.{}f}", yr.hi, ydigits).size());
   const double label_disp = 0.8 * static_cast<double>(tick_chars) + 1.6;  // character heights
-  const double left = std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
-  const double bottom = (4.0 * char_pt + legend_pt) / total_pt,
-               top = 1.0 - 2.2 * char_pt / total_pt;
+  // Without an axis label only the tick labels need room (a small multiple): the room for the
+  // label left a third of the plot empty, and its caption far below it. PLplot draws a text
+  // about half char_pt high, the tick labels within 2.5 of those heights of the axis.
+  const double left =
+      chart.y_label.empty()
+          ? (0.62 * static_cast<double>(tick_chars) + 1.2) * 0.52 * char_pt / chart.width_pt + 0.01
+          : std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
+  const double bottom =
+      ((chart.x_label.empty() && !legend ? 1.35 : 4.0) * char_pt + legend_pt) / total_pt;
+  const double top = 1.0 - (chart.x_label.empty() && !legend ? 1.6 : 2.2) * char_pt / total_pt;
   plvpor(left, 0.97, bottom, top);
   plwind(xr.lo, xr.hi, yr.lo, yr.hi);
   const bool categories = !chart.x_labels.empty();

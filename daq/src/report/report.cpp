@@ -370,7 +370,9 @@ bool setting_applies(const RunView& v, const std::string& key, const json& val) 
 
 std::string setting_value(const json& val, std::string_view unit) {
   if (val.is_boolean()) return val.get<bool>() ? "yes" : "no";
-  const std::string text = esc(setting_text(val));
+  // A unit as a value (measure.unit = "um") as documents print it (µm).
+  const std::string text =
+      esc(val.is_string() ? ::daq::unit_html(val.get<std::string>()) : setting_text(val));
   return unit.empty() ? text : text + " " + esc(unit);
 }
 
@@ -582,18 +584,20 @@ std::string quality_banner(const st::Store& store, const RunView& v, bool page_o
     return page_one ? "<p class=\"warning\">Run quality: " + esc(e.what()) + "</p>\n" : "";
   }
   if (q.state != "suspect")
-    return q.state.empty() || page_one ? ""
-                                       : fmt::format("<p class=\"note\">Run quality: {}</p>\n",
-                                                     esc(::daq::quality_text(q)));
+    return q.state.empty() || page_one
+               ? ""
+               : fmt::format("<p class=\"note\">Run quality: {}</p>\n",
+                             esc(::daq::units_html(::daq::quality_text(q))));
   if (!page_one) return "";
   std::string stops;
   for (const auto& m : q.suspects)
     stops += fmt::format("<li>run {} {} target {}: {}</li>", m.run_number,
-                         m.direction == '+' ? "↑" : "↓", m.target_index + 1, esc(m.reason));
+                         m.direction == '+' ? "↑" : "↓", m.target_index + 1,
+                         esc(::daq::units_html(m.reason)));
   return fmt::format(
       "<div class=\"verdict suspect\"><strong>SUSPECT RUN</strong>: {} The results below "
       "include these stops; repeat them or the run before relying on it.<ul>{}</ul></div>\n",
-      esc(q.summary), stops);
+      esc(::daq::units_html(q.summary)), stops);
 }
 
 // Page one's heading block: who, what machine, which test, when.
@@ -674,8 +678,8 @@ std::string verdict_banner(const ::daq::Verdict& v) {
       if (!c.pass) {
         const auto advice = ::daq::diagnostic_advice(c.key);
         items +=
-            fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {:.3f} {}){}</li>", esc(c.symbol),
-                        signed_text(c.value, 3), esc(unit_text(c.unit)), c.limit,
+            fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {} {}){}</li>", esc(c.symbol),
+                        signed_text(c.value, 3), esc(unit_text(c.unit)), fixed(c.limit, 3),
                         esc(unit_text(c.unit)), advice.empty() ? "" : ": " + esc(advice));
       }
     h += "<ul class=\"failing\">" + items + "</ul>\n";
@@ -689,7 +693,7 @@ std::string verdict_cell(const ::daq::Check* c) {
   return c->pass ? "<span class=\"pass\">pass</span>" : "<span class=\"fail\">FAIL</span>";
 }
 std::string limit_cell(const ::daq::Check* c) {
-  return c ? fmt::format("≤ {:.3f}", c->limit) : "<span class=\"unstated\">&ndash;</span>";
+  return c ? "≤ " + fixed(c->limit, 3) : "<span class=\"unstated\">&ndash;</span>";
 }
 
 // How the results shown were obtained: the current result's provenance; for a re-compensated
@@ -1019,7 +1023,8 @@ Sections linear_section(const st::Store& store, const RunView& v, const Options&
   const auto b = linear_budget(v, l, length_m);
   std::vector<std::vector<std::string>> contrib;
   for (const auto& c : b.contributors)
-    contrib.push_back({esc(c.name), fmt::format("{:.4f}", c.u_um), esc(c.model)});
+    contrib.push_back(
+        {esc(c.name), fmt::format("{:.4f}", c.u_um), esc(::daq::units_html(c.model))});
   d += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>Of a positional deviation at the measured travel "
       "L = {:.3f} m (ISO 230-2 Annex A, ISO/TR 230-9): combined standard uncertainty "
@@ -1150,26 +1155,61 @@ std::string bar_calibration_section(const Circle& c, const RunView& v) {
          table({"", ""}, rows, "kv");
 }
 
+// The order of page one's "what to fix first": every error outside its configured limit (the
+// furthest over first), then the others whose correction alone would gain most in G (their
+// contribution to the circularity), up to `top` rows; indices into r.diagnostics.
+std::vector<std::size_t> fix_first_order(const cal::circle::Result& r,
+                                         const ::daq::Verdict& verdict, std::size_t top) {
+  std::vector<std::size_t> failing, gaining;
+  for (std::size_t i = 0; i < r.diagnostics.size(); ++i) {
+    const auto* check = ::daq::find_check(verdict, r.diagnostics[i].key);
+    if (check && !check->pass)
+      failing.push_back(i);
+    else if (std::round(r.diagnostics[i].g_reduction_um * 1e3) > 0)
+      gaining.push_back(i);
+  }
+  const auto over = [&](std::size_t i) {
+    const auto* c = ::daq::find_check(verdict, r.diagnostics[i].key);
+    return c->limit > 0 ? std::abs(c->value) / c->limit : std::abs(c->value);
+  };
+  std::stable_sort(failing.begin(), failing.end(),
+                   [&](std::size_t a, std::size_t b) { return over(a) > over(b); });
+  for (std::size_t i : gaining)
+    if (failing.size() < top) failing.push_back(i);
+  return failing;
+}
+
 // The diagnostics as a table: rank, error, value in its own unit, what correcting it would
-// gain (µm and share of G), PV, limit and verdict, and what to check. `top`: only the first
-// rows with a positive gain (page one's "what to fix first").
+// gain (µm and share of G), PV, limit and verdict, and what to check. `top`: page one's "what
+// to fix first" (fix_first_order), else every error in the ranking by gain.
 std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict& verdict,
                               std::size_t top) {
+  std::vector<std::size_t> order;
+  if (top)
+    order = fix_first_order(r, verdict, top);
+  else
+    for (std::size_t i = 0; i < r.diagnostics.size(); ++i) order.push_back(i);
   std::vector<std::vector<std::string>> diag;
   const double g = r.iso.G_bi_um;
-  for (std::size_t i = 0; i < r.diagnostics.size(); ++i) {
+  for (std::size_t i : order) {
     const auto& d = r.diagnostics[i];
-    if (top && (diag.size() >= top || std::round(d.g_reduction_um * 1e3) <= 0)) break;
     const auto* check = ::daq::find_check(verdict, d.key);
     const std::string share = g > 0 ? fixed(100.0 * d.g_reduction_um / g, 0) : "&ndash;";
     const auto advice = ::daq::diagnostic_advice(d.key);
     const std::string check_text = advice.empty() ? std::string("see docs/circle.md") : esc(advice);
+    const std::string failing =
+        check && !check->pass
+            ? fmt::format(
+                  " <span class=\"fail\">FAIL</span> <span class=\"nw\">(limit ≤ {} "
+                  "{})</span>",
+                  fixed(check->limit, 3), esc(unit_text(check->unit)))
+            : std::string();
     // Page one's rows: the error with what to check under it (a column of its own was squeezed
     // to a word a line).
     std::vector<std::string> row{
-        std::to_string(i + 1),
-        top ? "<strong>" + esc(d.name) + "</strong><br><span class=\"note\">" + check_text +
-                  "</span>"
+        std::to_string(diag.size() + 1),
+        top ? "<strong>" + esc(d.name) + "</strong>" + failing + "<br><span class=\"note\">" +
+                  check_text + "</span>"
             : esc(d.name),
         "<span class=\"nw\">" + signed_text(d.value, 3) + " " + esc(unit_text(d.unit)) + "</span>",
         top ? fmt::format("<span class=\"nw\">{} µm ({} %)</span>",
@@ -1178,7 +1218,8 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
     if (!top) row.push_back(share);
     if (!top) {
       row.push_back(um(d.pv_um));
-      row.push_back(check ? fmt::format("≤ {:.3f}", check->limit) + " " + verdict_cell(check) : "");
+      row.push_back(check ? fmt::format("≤ {}", fixed(check->limit, 3)) + " " + verdict_cell(check)
+                          : "");
     }
     if (!top) row.push_back(check_text);
     diag.push_back(std::move(row));
@@ -1194,6 +1235,31 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
   }
   if (!top) head.push_back("what to check");
   return table(head, diag, "num diag", top ? "rlrr" : "rlrrrrll");
+}
+
+// Under page one's list: how it is ordered, and for an error outside its limit whose correction
+// alone would make G larger, which errors it partly offsets (those whose correction alone would
+// also make G larger), so they are corrected together.
+std::string fix_first_notes(const cal::circle::Result& r, const ::daq::Verdict& verdict,
+                            std::size_t top) {
+  std::string h =
+      "<p class=\"note\">Errors outside their limit first, then the largest gain in G (what "
+      "correcting that error alone takes off the circularity); every error under Details.</p>\n";
+  for (std::size_t i : fix_first_order(r, verdict, top)) {
+    const auto& d = r.diagnostics[i];
+    if (std::round(d.g_reduction_um * 1e3) >= 0) continue;
+    std::vector<std::string> others;
+    for (const auto& o : r.diagnostics)
+      if (o.key != d.key && std::round(o.g_reduction_um * 1e1) < 0) others.push_back(esc(o.name));
+    h += fmt::format(
+        "<p class=\"warning\">{} is outside its limit, but correcting it alone would make G "
+        "{} µm larger: it partly offsets {}. Correct them together and measure again.</p>\n",
+        esc(d.name), fixed(-d.g_reduction_um, 3),
+        others.empty() ? std::string("other errors")
+                       : fmt::format("{} (each would also make G larger if corrected alone)",
+                                     fmt::join(others, ", ")));
+  }
+  return h;
 }
 
 // What the ranking means, and a warning when no term would gain anything (the first gain is not
@@ -1246,11 +1312,9 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
   const auto first = diagnostics_table(r, verdict, 3);
   h += "<h4>What to fix first</h4>\n" +
        (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
-                      : first +
-                            "<p class=\"note\">Largest gain in G first; every error under "
-                            "Details.</p>\n");
+                      : first + fix_first_notes(r, verdict, 3));
   auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
-  polar.centre_text = fmt::format("G = {:.2f} µm", r.iso.G_bi_um);
+  polar.centre_text = "G = " + um(r.iso.G_bi_um) + " µm";
   h += figure(svg(polar),
               "Radial deviation of both directions around the nominal circle (magnified: the "
               "rings are the scale, the dark ring the nominal radius). The open circle marks "
@@ -1573,13 +1637,13 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
                                : "ZX",
                       used, fmt::format("{:g}", v.used[i].feed_mm_per_min),
                       signed_text(pv->squareness_um_per_m, 3),
-                      fmt::format("{} = {:+.3f}", cal::kinematics::location_error_name(mp),
-                                  cal::circle::location_error_urad(*pv)),
-                      fmt::format("{} {:+.3f}",
+                      fmt::format("{} = {}", cal::kinematics::location_error_name(mp),
+                                  signed_text(cal::circle::location_error_urad(*pv), 3)),
+                      fmt::format("{} {}",
                                   i == 0   ? "X − Y"
                                   : i == 1 ? "Y − Z"
                                            : "Z − X",
-                                  pv->scale_mismatch_um_per_m),
+                                  signed_text(pv->scale_mismatch_um_per_m, 3)),
                       opt(pv->mean_scale_um_per_m)});
   }
   h += "<h3>Three-plane table</h3>\n";
@@ -1595,21 +1659,21 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
        "comes from a calibrated bar's radius error only.</p>\n";
   if (const auto& sc = v.combined.scale_um_per_m)
     h += fmt::format(
-        "<p>Axis scales: X {:+.3f}, Y {:+.3f}, Z {:+.3f} µm/m, <strong>{}</strong>{}.</p>\n",
-        (*sc)[0], (*sc)[1], (*sc)[2],
+        "<p>Axis scales: X {}, Y {}, Z {} µm/m, <strong>{}</strong>{}.</p>\n",
+        signed_text((*sc)[0], 3), signed_text((*sc)[1], 3), signed_text((*sc)[2], 3),
         v.combined.scale_absolute ? "absolute (calibrated bar)"
                                   : "relative: their mean is set to 0; the absolute scale is "
                                     "not evaluated without a calibrated bar",
-        v.combined.scale_residual_um_per_m ? fmt::format(", least-squares residual {:.3f} µm/m",
-                                                         *v.combined.scale_residual_um_per_m)
+        v.combined.scale_residual_um_per_m ? fmt::format(", least-squares residual {} µm/m",
+                                                         um(*v.combined.scale_residual_um_per_m))
                                            : std::string());
   else
     h += "<p>Axis scales: not evaluated (they need the scale mismatches of two planes).</p>\n";
   if (v.combined.closure_um_per_m)
     h += fmt::format(
-        "<p>Closure (X − Y) + (Y − Z) + (Z − X) = {:+.3f} µm/m (0 for a consistent set: noise, "
+        "<p>Closure (X − Y) + (Y − Z) + (Z − X) = {} µm/m (0 for a consistent set: noise, "
         "drift between the tests and the local errors of each position move it).</p>\n",
-        *v.combined.closure_um_per_m);
+        signed_text(*v.combined.closure_um_per_m, 3));
   for (const auto& n : v.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
   return h;
 }
@@ -1980,7 +2044,7 @@ Lines reference_lines(const Profile& p, std::size_t colour, std::string_view pre
                            .width = 1.0});
     }
     out.rows.push_back({std::string(prefix) + r.name, um(res.straightness_um),
-                        fmt::format("{:.3f}", res.slope_um_per_m), um(res.intercept_um)});
+                        signed_text(res.slope_um_per_m, 3), um(res.intercept_um)});
   }
   return out;
 }
@@ -2012,12 +2076,12 @@ std::string squareness_report(const Profile& a, const Profile& b, double square_
   std::string body = fmt::format(
       "<p class=\"standard\">Squareness by <strong>ISO 230-1:2012</strong> from two straightness "
       "runs against one square: <code>{}</code> moving A (deviation in +B) and <code>{}</code> "
-      "moving B (deviation in +A); the square's own error {:+.3f} µm/m is removed.</p>\n",
-      esc(a.source), esc(b.source), square_error);
+      "moving B (deviation in +A); the square's own error {} µm/m is removed.</p>\n",
+      esc(a.source), esc(b.source), signed_text(square_error, 3));
   body += table({"result", "value", ""},
-                {{"squareness", fmt::format("{:+.3f} µm/m", r.squareness_um_per_m),
+                {{"squareness", signed_text(r.squareness_um_per_m, 3) + " µm/m",
                   "positive: the angle between the positive axis directions exceeds 90°"},
-                 {"", fmt::format("{:+.3f}″", r.arcsec()), "arc seconds"}},
+                 {"", signed_text(r.arcsec(), 3) + "″", "arc seconds"}},
                 "num results", "lrl");
   auto rows = la.rows;
   rows.insert(rows.end(), lb.rows.begin(), lb.rows.end());

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <utility>
 
 #include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
@@ -75,10 +77,10 @@ void print_circle_doc(const json& doc, std::string_view in) {
   const auto diagnostics = diagnostic_rows(doc);
   if (!diagnostics.empty()) {
     fmt::print(
-        "\n{0}Diagnostics, ranked by G gain (how much G falls when that error alone is removed: "
-        "the\n{0}first is what to fix first), with PV (the peak-to-valley of the error's own "
-        "pattern on\n{0}the traces) and PV / G (caldaq's own figure, can exceed 100 %; "
-        "docs/circle.md):\n",
+        "\n{0}Diagnostics, ranked by G gain (how much G falls when that error alone is removed;\n"
+        "{0}fix an error outside its limit, in the verdict, first, then the first here), with PV\n"
+        "{0}(the peak-to-valley of the error's own pattern on the traces) and PV / G (caldaq's "
+        "own\n{0}figure, can exceed 100 %; docs/circle.md):\n",
         in);
     fmt::print("{}  {:<48} {:>9} {:<5} {:>10} {:>7} {:>10}\n", in, "", "value", "", "PV", "PV / G",
                "G gain");
@@ -121,6 +123,27 @@ std::string unit_html(std::string_view unit) {
   if (unit == "um") return "µm";
   if (unit == "um/m") return "µm/m";
   return std::string(unit);
+}
+
+std::string units_html(std::string_view text) {
+  static constexpr std::pair<std::string_view, std::string_view> units[] = {
+      {"um/m", "µm/m"}, {"um", "µm"}, {"urad", "µrad"}, {"degC", "°C"}};
+  const auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    const bool starts_word = i == 0 || !word_char(text[i - 1]);
+    bool replaced = false;
+    for (const auto& [from, to] : units) {
+      const std::size_t end = i + from.size();
+      if (starts_word && text.substr(i, from.size()) == from &&
+          (end == text.size() || !word_char(text[end]))) {
+        out += to, i = end, replaced = true;
+        break;
+      }
+    }
+    if (!replaced) out += text[i++];
+  }
+  return out;
 }
 
 std::size_t linear_order(std::string_view key) {

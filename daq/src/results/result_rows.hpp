@@ -26,6 +26,9 @@ std::string number_text(double value, int decimals = 3);
 std::string signed_number_text(double value, int decimals = 3);
 // A unit as a terminal prints it ("um") and as a page does ("µm").
 std::string unit_html(std::string_view unit);
+// A sentence of caldaq's own (a run's quality, an uncertainty's model) as a document prints
+// it: the terminal's unit words ("um", "um/m", "urad", "degC") as µm, µm/m, µrad, °C.
+std::string units_html(std::string_view text);
 
 // The rank of an ISO 230-2 value on every output: as the report's grid reads, row by row (E↑,
 // E↓, E; R↑, R↓, R; A↑, A↓, A; M, B, B̄), then any other in its evaluation's order.

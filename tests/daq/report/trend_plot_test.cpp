@@ -3,6 +3,7 @@
 // the bottom of the plot to its top; category labels (the runs' dates) never overlap.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <regex>
 #include <sstream>
@@ -94,6 +95,33 @@ TEST(TrendPlot, CategoryLabelsDoNotOverlap) {
     EXPECT_GE(std::abs(labels[i].x - labels[i - 1].x), half_widths)
         << "labels " << i - 1 << " and " << i << " overlap";
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The baselines (SVG units above the bottom edge: PLplot's group flips y) and font sizes of
+// every text of a plot.
+std::vector<std::pair<double, double>> text_baselines(const std::string& svg) {
+  static const std::regex text(
+      R"re(<text[^>]*font-size="([0-9.]+)"[^>]*matrix\([-0-9. ]*? ([-0-9.]+)\)")re");
+  std::vector<std::pair<double, double>> out;
+  for (std::sregex_iterator it(svg.begin(), svg.end(), text), end; it != end; ++it)
+    out.emplace_back(std::stod((*it)[2].str()), std::stod((*it)[1].str()));
+  return out;
+}
+
+TEST(TrendPlot, NoEmptyBandUnderTheLabels) {
+  // A small multiple has no x axis label: its lowest text (the runs under x) sits near the
+  // bottom edge, so the caption under the figure reads with its plot (it was 70 of 200 units
+  // below, a third of the plot empty).
+  const auto svg = cal::daq::report::svg(small({"run 1", "run 3"}, {9.2, 9.3}));
+  const auto texts = text_baselines(svg);
+  ASSERT_GE(texts.size(), 3u) << svg;
+  const auto lowest = *std::min_element(texts.begin(), texts.end());
+  EXPECT_GT(lowest.first, 0.2 * lowest.second) << "the lowest text is cut by the edge";
+  EXPECT_LT(lowest.first, 1.5 * lowest.second) << "an empty band under the lowest text";
 }
 
 }  // namespace

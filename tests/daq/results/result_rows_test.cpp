@@ -31,6 +31,17 @@ TEST(ResultRows, NumbersNeverReadMinusZero) {
   EXPECT_EQ(daq::signed_number_text(-1.5), "-1.500");
 }
 
+// A document prints µm and °C where the terminal prints um and degC (the run quality, the
+// uncertainty budget's models are caldaq's own sentences, written once for the terminal).
+TEST(ResultRows, DocumentsPrintTheUnitsSymbols) {
+  EXPECT_EQ(daq::units_html("ok: every stop within 0.168 um of its target's runs"),
+            "ok: every stop within 0.168 µm of its target's runs");
+  EXPECT_EQ(daq::units_html("L |T - 20 degC| u(alpha), 8 um/m, 3 urad"),
+            "L |T - 20 °C| u(alpha), 8 µm/m, 3 µrad");
+  // Only whole words: "umbra", "sum" and "drum/m" stay as they are.
+  EXPECT_EQ(daq::units_html("umbra sum drum/m um"), "umbra sum drum/m µm");
+}
+
 // print_circle wrote "{:+9.3f}": a diagnostic or centre of -0.0001 printed as "-0.000".
 TEST(ResultRows, PrintCircleNeverPrintsMinusZero) {
   cal::circle::Result r;
