@@ -9,7 +9,12 @@ set -u
 DAQ=$(realpath "$1")
 TMP=$(mktemp -d)
 HOLD_PID=
-cleanup() { [ -n "$HOLD_PID" ] && kill "$HOLD_PID" 2>/dev/null; rm -rf "$TMP"; }
+SIM_PID=
+cleanup() {
+  [ -n "$HOLD_PID" ] && kill "$HOLD_PID" 2>/dev/null
+  [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null
+  rm -rf "$TMP"
+}
 trap cleanup EXIT
 source "$(dirname "$0")/check.sh"
 
@@ -41,6 +46,21 @@ HOLD_PID=$!
 for _ in $(seq 50); do grep -q held "$TMP/hold.log" && break; sleep 0.1; done
 check busy_port 2 "^daq: error: cannot listen on 127\.0\.0\.1:$PORT: Address already in use \(--address, --port\)$" -- "$DAQ" serve --simulate --port "$PORT" --db "$TMP/serve.sqlite"
 kill "$HOLD_PID"; HOLD_PID=
+
+# A busy serial port too: two readers would each get part of its bytes. Another program holds
+# the simulated barometer's pty with an exclusive flock (as picocom, pyserial's exclusive mode
+# and a second daq do): daq run refuses with status 2, naming the port and the holder.
+(cd "$TMP" && exec "$DAQ" sim --test linear -o "$TMP/busy.toml" --db "$TMP/busy.sqlite" >"$TMP/busy-sim.log" 2>&1) &
+SIM_PID=$!
+for _ in $(seq 100); do grep -q "^transport = \"serial" "$TMP/busy.toml" 2>/dev/null && break; sleep 0.1; done
+AIR=$(grep -oE '"serial /dev/pts/[0-9]+ 4800' "$TMP/busy.toml" | cut -d' ' -f2)
+python3 -c 'import fcntl, os, sys, time
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_NOCTTY); fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+print("held", flush=True); time.sleep(120)' "$AIR" >"$TMP/hold-serial.log" &
+HOLD_PID=$!
+for _ in $(seq 50); do grep -q held "$TMP/hold-serial.log" && break; sleep 0.1; done
+check busy_serial_port 2 "^daq: error: device check: devices\.air \(serial $AIR 4800 7E1\): failed: serial $AIR 4800 7E1: busy: pid $HOLD_PID \(python3\) has the port open; close it first" -- "$DAQ" run linear -c "$TMP/busy.toml" --db "$TMP/busy.sqlite"
+kill "$HOLD_PID" "$SIM_PID"; HOLD_PID=; SIM_PID=
 
 # A database that cannot be opened: the error only, no demo banner after (or before) it.
 check demo_bad_db 0 "^refused, 0 banner lines$" -- bash -c 'out=$(cd "$2" && "$1" demo --db /nonexistent/dir/x.sqlite 2>&1); rc=$?; [ $rc -eq 2 ] && echo "refused, $(grep -c "daq demo: ISO 230-2" <<<"$out") banner lines"' _ "$DAQ" "$TMP"
