@@ -76,6 +76,16 @@ check export_piped_silent 0 "^0$" -- bash -c '"$1" export 1 --db "$2" -o "$3" 2>
 check export_progress_tty 0 "export run 1: +[0-9]+ % \([0-9]+ of [0-9]+ readings\)" -- script -qec "'$DAQ' export 1 --db '$DB' -o '$TMP/r3.csv'" /dev/null
 cmp -s "$TMP/r1.csv" "$TMP/r3.csv" && passes=$((passes + 1)) || { echo "FAIL export_same_on_tty"; fails=$((fails + 1)); }
 
+# daq report shows its progress on a terminal too: the readings a long run's plots read (a run
+# of another kind, here an imported dynamic capture of 3 samples), then the time Chromium has
+# taken printing; piped, nothing.
+printf 'HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nFile Type: Linear\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n\x00\x00\x00\x00\x00\x00\xf0\x3f\x00\x00\x00\x00\x00\x00\x04\xc0\x00\x00\x00\x00\x00\x00\xc0\x3f\r\nEOF::\r\n' >"$TMP/t.rtx"
+"$DAQ" import rtx "$TMP/t.rtx" --db "$TMP/rtx.sqlite" >/dev/null
+check report_progress_tty 0 "report of run 1: +[0-9]+ % \([0-9] of 3 readings\)" -- script -qec "'$DAQ' report 1 --db '$TMP/rtx.sqlite' -o '$TMP/rtx.html'" /dev/null
+check report_pdf_progress_tty 0 "report of run 1: printing the PDF with Chromium, 0:[0-9]{2} elapsed" -- script -qec "'$DAQ' report 1 --db '$DB' --format pdf -o '$TMP/r1.pdf'" /dev/null
+check report_pdf_written 0 "^%PDF" -- head -c 4 "$TMP/r1.pdf"
+check report_piped_silent 0 "^0$" -- bash -c '"$1" report 1 --db "$2" --format pdf -o "$3" 2>&1 >/dev/null | grep -c "elapsed"; true' _ "$DAQ" "$DB" "$TMP/r2.pdf"
+
 # daq run's progress, piped (a line per stop): the plan's place, no number before a reading,
 # the position while moving, the time so far and left.
 (cd "$TMP" && "$DAQ" sim --test linear --acquire --runs 2 --targets 2 --db "$TMP/run.sqlite" -o "$TMP/sim.toml" >"$TMP/run.log" 2>&1)
