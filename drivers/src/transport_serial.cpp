@@ -1,6 +1,9 @@
 // Serial transport on Boost.Asio's serial_port (termios on Linux). Works with USB-CDC and
 // USB-RS-232 adapters and with pseudo-terminals, which the tests and the simulated twins use.
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <termios.h>
@@ -8,9 +11,12 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "asio_session.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 
 namespace cal::drivers::transport {
 namespace {
@@ -66,6 +72,55 @@ bool is_pseudo_terminal(int fd) {
   struct stat st {};
   return fstat(fd, &st) == 0 && S_ISCHR(st.st_mode) && major(st.st_rdev) >= 136 &&
          major(st.st_rdev) <= 143;
+}
+
+// The process holding a flock(2) on the file `st` names, from /proc/locks, e.g.
+// "1: FLOCK  ADVISORY  WRITE 4242 00:18:3 0 EOF" (pid, then the file system's device in hex and
+// the inode); "pid 4242 (daq)", or empty when no process holds one (or /proc is not there).
+std::string lock_holder(const struct stat& st) {
+  const std::string file =
+      fmt::format("{:02x}:{:02x}:{}", major(st.st_dev), minor(st.st_dev), st.st_ino);
+  std::ifstream locks("/proc/locks");
+  for (std::string line; std::getline(locks, line);) {
+    std::istringstream in(line);
+    std::string number, kind, mode, access, pid, id;
+    in >> number >> kind >> mode >> access >> pid >> id;  // a waiter's line has "->": no match
+    if (kind != "FLOCK" || id != file) continue;
+    std::string name;
+    std::getline(std::ifstream("/proc/" + pid + "/comm"), name);
+    // The name is whatever the process chose to call itself: escaped for the terminal.
+    return name.empty() ? fmt::format("pid {}", pid)
+                        : fmt::format("pid {} ({})", pid, cal::text::terminal_safe(name));
+  }
+  return {};
+}
+
+std::string busy_text(const std::string& holder) {
+  // Two readers of one serial port each get part of its bytes: neither sees whole lines.
+  return fmt::format(
+      "busy: {} has the port open; close it first (two programs would each get "
+      "part of its bytes)",
+      holder.empty() ? "another program" : holder);
+}
+
+// Takes the port for this process alone, as picocom and pyserial's exclusive mode do: an
+// exclusive flock (which a second caldaq, picocom or pyserial asks for too, and which goes with
+// the holder's descriptor, even on a crash). Real ports are also set TIOCEXCL, so that a
+// program that does not ask for a lock (cat, screen, a modem manager's probe) cannot open the
+// port either; not pseudo-terminals, where the flag outlives the holder's descriptor (the
+// pair's terminal stays while the other side is open: a crash would leave a twin's port
+// refused to every later open). Returns what went wrong, empty when the port is ours.
+std::string lock_port(int fd, bool pty) {
+  // Asio opens without O_CLOEXEC: a program daq starts (Chromium printing a report) would
+  // inherit the port, and with it the lock, and keep both after daq closed the port.
+  ::fcntl(fd, F_SETFD, FD_CLOEXEC);
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    if (errno != EWOULDBLOCK) return fmt::format("cannot lock: {}", std::strerror(errno));
+    struct stat st {};
+    return busy_text(::fstat(fd, &st) == 0 ? lock_holder(st) : std::string());
+  }
+  if (!pty) ::ioctl(fd, TIOCEXCL);  // best effort: the flock is the lock caldaq relies on
+  return {};
 }
 
 // Sets the whole line discipline in one tcsetattr (raw mode, speed, framing, flow control)
@@ -125,13 +180,15 @@ class SerialTransport final : public Transport {
     std::string problem;
     if (ec == boost::system::errc::inappropriate_io_control_operation)
       problem = "not a serial port: " + ec.message();  // asio's open already asks termios
+    else if (ec == boost::system::errc::device_or_resource_busy)  // another holder's TIOCEXCL
+      problem = busy_text(holder_of(settings_.device));
     else if (ec)
       problem = "cannot open: " + ec.message();
     else
-      problem = configure(session_->stream().native_handle(), settings_);
+      problem = take(session_->stream().native_handle());
     if (problem.empty()) return session_->start(std::move(handlers));
     // Reported from the event loop, like every other error, so callers see one code path.
-    session_->close();
+    close();
     asio::post(io_, [on_error = std::move(handlers.error), message = describe() + ": " + problem] {
       on_error(Error{ErrorKind::open_failed, message});
     });
@@ -141,7 +198,11 @@ class SerialTransport final : public Transport {
     if (session_) session_->write(bytes);
   }
   void close() override {
-    if (session_) session_->close();
+    if (session_) {
+      // TIOCEXCL stays on a terminal while it is open anywhere; the flock goes with the fd.
+      if (session_->stream().is_open()) ::ioctl(session_->stream().native_handle(), TIOCNXCL);
+      session_->close();
+    }
     session_.reset();
   }
   bool is_open() const override { return session_ && session_->active(); }
@@ -150,6 +211,16 @@ class SerialTransport final : public Transport {
   }
 
  private:
+  // Locks the opened port, then sets its line discipline.
+  std::string take(int fd) const {
+    if (auto problem = lock_port(fd, is_pseudo_terminal(fd)); !problem.empty()) return problem;
+    return configure(fd, settings_);
+  }
+  static std::string holder_of(const std::string& device) {
+    struct stat st {};
+    return ::stat(device.c_str(), &st) == 0 ? lock_holder(st) : std::string();
+  }
+
   asio::io_context& io_;
   SerialSettings settings_;
   std::shared_ptr<detail::Session<Port>> session_;

@@ -9,7 +9,12 @@ set -u
 DAQ=$(realpath "$1")
 TMP=$(mktemp -d)
 HOLD_PID=
-cleanup() { [ -n "$HOLD_PID" ] && kill "$HOLD_PID" 2>/dev/null; rm -rf "$TMP"; }
+SIM_PID=
+cleanup() {
+  [ -n "$HOLD_PID" ] && kill "$HOLD_PID" 2>/dev/null
+  [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null
+  rm -rf "$TMP"
+}
 trap cleanup EXIT
 source "$(dirname "$0")/check.sh"
 
@@ -42,6 +47,21 @@ for _ in $(seq 50); do grep -q held "$TMP/hold.log" && break; sleep 0.1; done
 check busy_port 2 "^daq: error: cannot listen on 127\.0\.0\.1:$PORT: Address already in use \(--address, --port\)$" -- "$DAQ" serve --simulate --port "$PORT" --db "$TMP/serve.sqlite"
 kill "$HOLD_PID"; HOLD_PID=
 
+# A busy serial port too: two readers would each get part of its bytes. Another program holds
+# the simulated barometer's pty with an exclusive flock (as picocom, pyserial's exclusive mode
+# and a second daq do): daq run refuses with status 2, naming the port and the holder.
+(cd "$TMP" && exec "$DAQ" sim --test linear -o "$TMP/busy.toml" --db "$TMP/busy.sqlite" >"$TMP/busy-sim.log" 2>&1) &
+SIM_PID=$!
+for _ in $(seq 100); do grep -q "^transport = \"serial" "$TMP/busy.toml" 2>/dev/null && break; sleep 0.1; done
+AIR=$(grep -oE '"serial /dev/pts/[0-9]+ 4800' "$TMP/busy.toml" | cut -d' ' -f2)
+python3 -c 'import fcntl, os, sys, time
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_NOCTTY); fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+print("held", flush=True); time.sleep(120)' "$AIR" >"$TMP/hold-serial.log" &
+HOLD_PID=$!
+for _ in $(seq 50); do grep -q held "$TMP/hold-serial.log" && break; sleep 0.1; done
+check busy_serial_port 2 "^daq: error: device check: devices\.air \(serial $AIR 4800 7E1\): failed: serial $AIR 4800 7E1: busy: pid $HOLD_PID \(python3\) has the port open; close it first" -- "$DAQ" run linear -c "$TMP/busy.toml" --db "$TMP/busy.sqlite"
+kill "$HOLD_PID" "$SIM_PID"; HOLD_PID=; SIM_PID=
+
 # A database that cannot be opened: the error only, no demo banner after (or before) it.
 check demo_bad_db 0 "^refused, 0 banner lines$" -- bash -c 'out=$(cd "$2" && "$1" demo --db /nonexistent/dir/x.sqlite 2>&1); rc=$?; [ $rc -eq 2 ] && echo "refused, $(grep -c "daq demo: ISO 230-2" <<<"$out") banner lines"' _ "$DAQ" "$TMP"
 
@@ -55,6 +75,16 @@ check export_piped_silent 0 "^0$" -- bash -c '"$1" export 1 --db "$2" -o "$3" 2>
 # On a terminal (script(1) gives it one) the export shows how far it is, then clears the line.
 check export_progress_tty 0 "export run 1: +[0-9]+ % \([0-9]+ of [0-9]+ readings\)" -- script -qec "'$DAQ' export 1 --db '$DB' -o '$TMP/r3.csv'" /dev/null
 cmp -s "$TMP/r1.csv" "$TMP/r3.csv" && passes=$((passes + 1)) || { echo "FAIL export_same_on_tty"; fails=$((fails + 1)); }
+
+# daq report shows its progress on a terminal too: the readings a long run's plots read (a run
+# of another kind, here an imported dynamic capture of 3 samples), then the time Chromium has
+# taken printing; piped, nothing.
+printf 'HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nFile Type: Linear\r\nSample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nMachine: VMC-7\r\nSerial No: 99\r\nAxis: Y\r\nData:\r\n\x00\x00\x00\x00\x00\x00\xf0\x3f\x00\x00\x00\x00\x00\x00\x04\xc0\x00\x00\x00\x00\x00\x00\xc0\x3f\r\nEOF::\r\n' >"$TMP/t.rtx"
+"$DAQ" import rtx "$TMP/t.rtx" --db "$TMP/rtx.sqlite" >/dev/null
+check report_progress_tty 0 "report of run 1: +[0-9]+ % \([0-9] of 3 readings\)" -- script -qec "'$DAQ' report 1 --db '$TMP/rtx.sqlite' -o '$TMP/rtx.html'" /dev/null
+check report_pdf_progress_tty 0 "report of run 1: printing the PDF with Chromium, 0:[0-9]{2} elapsed" -- script -qec "'$DAQ' report 1 --db '$DB' --format pdf -o '$TMP/r1.pdf'" /dev/null
+check report_pdf_written 0 "^%PDF" -- head -c 4 "$TMP/r1.pdf"
+check report_piped_silent 0 "^0$" -- bash -c '"$1" report 1 --db "$2" --format pdf -o "$3" 2>&1 >/dev/null | grep -c "elapsed"; true' _ "$DAQ" "$DB" "$TMP/r2.pdf"
 
 # daq run's progress, piped (a line per stop): the plan's place, no number before a reading,
 # the position while moving, the time so far and left.

@@ -52,6 +52,9 @@ PAGES=$(ls "$ROOT/usr/share/man/man1" | wc -l)
 check man_pages_count 0 "^ok$" -- bash -c "[ $PAGES -ge 40 ] && echo ok || echo $PAGES"
 check man_renders 0 "^ +daq-serve +- +Serve +the +operator's +page" -- env MANWIDTH=100 man -l "$ROOT/usr/share/man/man1/daq-serve.1.gz"
 check man_options 0 "^ +--port" -- env MANWIDTH=100 man -l "$ROOT/usr/share/man/man1/daq-serve.1.gz"
+# NAME says daq once and the whole first sentence (whatis reads it): it was "daq - daq -
+# machine-tool calibration: laser interferometer, environment and ballbar".
+check man_name_once 0 "^ +daq +- +machine-tool +calibration: .* +and +ballbar +acquisition, +compensation +and +ISO +230 +analysis\.$" -- env MANWIDTH=300 man -l "$ROOT/usr/share/man/man1/daq.1.gz"
 check man_exit_status 0 "EXIT STATUS" -- env MANWIDTH=100 man -l "$ROOT/usr/share/man/man1/daq.1.gz"
 check man_no_warnings 0 "^$" -- bash -c "zcat '$ROOT'/usr/share/man/man1/*.1.gz | groff -man -Tutf8 -ww -z 2>&1 | head -5"
 

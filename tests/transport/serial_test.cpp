@@ -1,14 +1,19 @@
 // The serial transport against a pseudo-terminal pair: the test holds the master side and
 // plays the instrument; the transport opens the slave path like a /dev/ttyUSB0.
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <pty.h>
+#include <sys/file.h>
+#include <sys/wait.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
+#include <csignal>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <utility>
 
@@ -239,6 +244,82 @@ TEST(SerialTransport, CloseStopsHandlersEvenWithDataPending) {
   EXPECT_EQ(chunks, 0);
   port.reset();  // destroying with handlers still queued is safe
   io.run_for(10ms);
+}
+
+// Two readers of one port would each get part of its bytes (neither sees whole lines): the
+// second opener is refused while the first holds the port, told who holds it, and gets the
+// port once the first has closed it.
+TEST(SerialTransport, RefusesAPortAnotherOpenerHolds) {
+  Pty pty;
+  boost::asio::io_context io;
+  auto first = t::make_serial(io, {.device = pty.path});
+  std::string first_error;
+  first->open([](auto) {}, [&](const t::Error& e) { first_error = e.message; });
+  io.run_for(20ms);
+  ASSERT_TRUE(first->is_open()) << first_error;
+
+  std::string comm;
+  std::getline(std::ifstream("/proc/self/comm"), comm);
+  auto second = t::make_serial(io, {.device = pty.path});
+  std::optional<t::Error> error;
+  second->open([](auto) {}, [&](const t::Error& e) { error = e; });
+  io.run_for(20ms);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->kind, t::ErrorKind::open_failed);
+  EXPECT_EQ(error->message,
+            fmt::format("serial {} 9600 8N1: busy: pid {} ({}) has the port open; close it first "
+                        "(two programs would each get part of its bytes)",
+                        pty.path, ::getpid(), comm));
+  EXPECT_FALSE(second->is_open());
+
+  // The bytes go to the first opener only.
+  std::string received;
+  first->open(
+      [&](std::span<const std::byte> b) {
+        received.append(reinterpret_cast<const char*>(b.data()), b.size());
+      },
+      [](const t::Error&) {});
+  io.run_for(20ms);
+  pty.send("one line\n");
+  run_until(io, [&] { return received.size() >= 9; });
+  EXPECT_EQ(received, "one line\n");
+
+  first->close();
+  error.reset();
+  bool opened = false;
+  second->open({.opened = [&] { opened = true; },
+                .data = [](auto) {},
+                .error = [&](const t::Error& e) { error = e; }});
+  io.run_for(20ms);
+  EXPECT_TRUE(opened) << (error ? error->message : "");
+}
+
+// Another program's lock (picocom, pyserial's exclusive mode, a second daq) is named by its
+// process id; the port is not taken from it.
+TEST(SerialTransport, NamesAnotherProcessThatHoldsThePort) {
+  Pty pty;
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int fd = ::open(pty.path.c_str(), O_RDWR | O_NOCTTY);
+    const char ok = fd >= 0 && ::flock(fd, LOCK_EX | LOCK_NB) == 0 ? '1' : '0';
+    [[maybe_unused]] auto n = ::write(ready[1], &ok, 1);
+    ::pause();  // holds the lock until killed
+    ::_exit(0);
+  }
+  ::close(ready[1]);
+  char ok = 0;
+  ASSERT_EQ(::read(ready[0], &ok, 1), 1);
+  ::close(ready[0]);
+  const std::string message = open_error({.device = pty.path});
+  ::kill(child, SIGKILL);
+  ::waitpid(child, nullptr, 0);
+  ASSERT_EQ(ok, '1');
+  EXPECT_NE(message.find(fmt::format(": busy: pid {} (", child)), std::string::npos) << message;
+  // Once the holder is gone, so is its lock.
+  EXPECT_EQ(open_error({.device = pty.path}), "");
 }
 
 }  // namespace

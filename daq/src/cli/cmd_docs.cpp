@@ -3,6 +3,7 @@
 // with the executable: packaging/README.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdint>
 #include <filesystem>
@@ -103,8 +104,14 @@ std::string man_page(const CLI::App& app, const std::string& path,
                      const std::vector<std::pair<std::string, const CLI::App*>>& all) {
   const std::string name = page_name(path);
   const std::string line = path.empty() ? "daq" : "daq " + path;
+  // NAME is one line (whatis and apropos read it): the description's first paragraph, whose
+  // lines --help breaks; daq's own begins with its name ("daq - machine-tool ..."): said once.
+  const std::string description = app.get_description();
+  std::string summary = description.substr(0, description.find("\n\n"));
+  std::replace(summary.begin(), summary.end(), '\n', ' ');
+  if (const std::string own = name + " - "; summary.starts_with(own)) summary.erase(0, own.size());
   std::string m = fmt::format(".TH {} 1 \"\" \"{}\" \"caldaq\"\n.SH NAME\n{} \\- {}\n", upper(name),
-                              kVersion, roff(name), roff(first_line(app.get_description())));
+                              kVersion, roff(name), roff(summary));
   std::string positionals;
   for (const CLI::Option* o : options_of(app))
     if (o->get_positional()) positionals += " " + o->get_name(true);

@@ -12,8 +12,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -21,6 +23,7 @@
 #include "cal/storage/store.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "progress.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
 
@@ -100,7 +103,7 @@ struct Exit {
 // output into `log`, in a process group of its own, and waits up to `limit`; a browser still
 // running then is killed with its helpers.
 Exit run_browser(const std::vector<std::string>& args, const fs::path& log, const fs::path& home,
-                 std::chrono::seconds limit) {
+                 std::chrono::seconds limit, const std::function<void()>& waiting) {
   std::vector<char*> argv;
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -135,6 +138,7 @@ Exit run_browser(const std::vector<std::string>& args, const fs::path& log, cons
       ::waitpid(pid, &e.status, 0);
       break;
     }
+    if (waiting) waiting();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ::kill(-pid, SIGKILL);  // helpers the browser left behind, if any
@@ -157,7 +161,8 @@ void keep_log(const fs::path& from, const fs::path& to) {
 // Prints the report to pdf with headless Chromium, which sees only a private directory holding
 // the report (a copy of it, a fresh profile) and has no network: with the report's
 // Content-Security-Policy, nothing outside the report can come into the PDF.
-std::size_t print_pdf_text(std::string_view html, const fs::path& pdf, const fs::path& log) {
+std::size_t print_pdf_text(std::string_view html, const fs::path& pdf, const fs::path& log,
+                           const std::function<void()>& waiting) {
   const auto browser = find_chromium();
   const PrivateDir dir;
   // The page alone in its directory; the profile, the PDF and the browser's output beside it.
@@ -182,7 +187,7 @@ std::size_t print_pdf_text(std::string_view html, const fs::path& pdf, const fs:
       "--proxy-server=127.0.0.1:9", "--proxy-bypass-list=<-loopback>",
       "--host-resolver-rules=MAP * ~NOTFOUND", "--print-to-pdf=" + printed.string(),
       "file://" + page.string()};
-  const auto e = run_browser(args, output, dir.path(), std::chrono::seconds(180));
+  const auto e = run_browser(args, output, dir.path(), std::chrono::seconds(180), waiting);
   std::ifstream in(printed, std::ios::binary);
   const std::string bytes(std::istreambuf_iterator<char>(in), {});
   const bool exited = !e.timed_out && WIFEXITED(e.status);
@@ -232,7 +237,28 @@ void run_report_command(ReportOptions o) {
   if (o.runs.empty() && !o.as_found && !o.as_left)
     throw cal::InputError(
         "report: give one or more RUN numbers, --campaign, or --as-found and --as-left");
-  const cal::daq::report::Options ro{.standard = o.standard, .software = "daq 0.1.0"};
+  const fs::path named_output(o.output);
+  // How far a long report is, on the terminal (stderr) only, as daq export shows it; not when
+  // the report itself goes to a stream (-o /dev/stdout), which may be that terminal.
+  std::error_code stream_error;
+  const bool show_progress = o.output.empty() || !fs::exists(named_output, stream_error) ||
+                             fs::is_regular_file(named_output, stream_error);
+  const std::string job = o.as_found || o.as_left
+                              ? fmt::format("report of runs {} and {}", o.as_found, o.as_left)
+                              : fmt::format("report of run{} {}", o.runs.size() > 1 ? "s" : "",
+                                            fmt::join(o.runs, ", "));
+  // Made at the first batch: a report that reads no long stream (a linear or circle run's
+  // targets) shows no count.
+  std::optional<TerminalProgress> reading;
+  std::uint64_t shown = 0;
+  cal::daq::report::Options ro{.standard = o.standard, .software = "daq 0.1.0"};
+  ro.reading_progress = [&](std::uint64_t done, std::uint64_t total) {
+    if (done < shown) reading.reset(), shown = 0;  // the next run of a campaign: its own count
+    if (!reading) reading.emplace(job, "readings", total, show_progress);
+    reading->add(done - shown);
+    reading->tick();
+    shown = done;
+  };
   std::string html, kind, stem;
   if (o.as_found || o.as_left) {
     if (!o.as_found || !o.as_left)
@@ -257,7 +283,8 @@ void run_report_command(ReportOptions o) {
     stem = o.campaign.empty() ? fmt::format("report-runs-{}", fmt::join(o.runs, "-"))
                               : "campaign-report";
   }
-  const fs::path out = o.output.empty() ? fs::path(stem + "." + o.format) : fs::path(o.output);
+  reading.reset();  // clears its line
+  const fs::path out = o.output.empty() ? fs::path(stem + "." + o.format) : named_output;
   std::uintmax_t streamed_bytes = html.size();  // what went to a stream, which has no size
   if (o.format == "html") {
     write_file(out, html);
@@ -269,7 +296,9 @@ void run_report_command(ReportOptions o) {
     const auto log =
         to_stream ? fs::temp_directory_path() / fmt::format("caldaq-report-{}.pdf.log", ::getpid())
                   : fs::path(out).concat(".log");
-    streamed_bytes = print_pdf_text(html, out, log);
+    // Chromium counts nothing it tells: the time it has taken so far.
+    TerminalProgress printing(job + ": printing the PDF with Chromium", "", 0, show_progress);
+    streamed_bytes = print_pdf_text(html, out, log, [&printing] { printing.tick(); });
   }
   // The size written: a pipe or a terminal (-o /dev/stdout) has none to ask the file system for.
   std::error_code size_error;

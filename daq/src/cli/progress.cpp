@@ -40,8 +40,8 @@ void TerminalProgress::draw(bool force) {
   last_ = now;
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const auto done = static_cast<double>(done_), total = static_cast<double>(total_);
-  std::string line = fmt::format("{}: {} {}", what_, done_, unit_);
-  if (total_ > 0)
+  std::string line = unit_.empty() ? what_ : fmt::format("{}: {} {}", what_, done_, unit_);
+  if (total_ > 0 && !unit_.empty())
     line = fmt::format("{}: {:3.0f} % ({} of {} {})", what_, 100.0 * done / total, done_, total_,
                        unit_);
   line += fmt::format(", {} elapsed", clock_text(elapsed));

@@ -19,8 +19,9 @@ std::optional<double> remaining_s(double elapsed_s, double done, double total);
 
 class TerminalProgress {
  public:
-  // `what` names the job ("export run 1"), `unit` the counted things ("readings"); `total`
-  // 0 when not known. Shown only when `enabled` and stderr is a terminal.
+  // `what` names the job ("export run 1"), `unit` the counted things ("readings"; empty: a
+  // job that counts nothing, shown with its time alone); `total` 0 when not known. Shown only
+  // when `enabled` and stderr is a terminal.
   TerminalProgress(std::string what, std::string unit, std::uint64_t total, bool enabled);
   TerminalProgress(const TerminalProgress&) = delete;
   TerminalProgress& operator=(const TerminalProgress&) = delete;
@@ -31,6 +32,12 @@ class TerminalProgress {
   void add(std::uint64_t n = 1) {
     done_ += n;
     if (shown_ && (++calls_ & 4095U) == 0) draw(false);
+  }
+  // A job that learns its total as it goes (a report knows what it reads once it has looked).
+  void set_total(std::uint64_t total) { total_ = total; }
+  // Redraws (at most 5 times a second): for a job waiting on something it cannot count.
+  void tick() {
+    if (shown_) draw(false);
   }
 
  private:

@@ -1355,7 +1355,7 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
 // --- other runs (e.g. imported dynamic captures)
 // --------------------------------------------------
 
-std::string generic_section(const st::Store& store, const RunView& v) {
+std::string generic_section(const st::Store& store, const RunView& v, const Options& o) {
   // Streamed: every series is thinned to about 4000 points for its plot (every step-th
   // reading, the step from the series' count), so the memory does not grow with the run.
   const auto series = store.series(v.run.id);
@@ -1370,11 +1370,13 @@ std::string generic_section(const st::Store& store, const RunView& v) {
   };
   std::map<std::tuple<int, int, int>, Thinned> by;
   std::vector<std::uint8_t> plotted;
+  std::uint64_t to_read = 0, read = 0;
   for (const auto& x : series) {
     const auto q = static_cast<Q>(x.quantity);
     if (q == Q::air_temperature_degc || q == Q::air_pressure_pa || q == Q::air_humidity_pct ||
         q == Q::material_temperature_degc || q == Q::refractive_index)
       continue;
+    to_read += static_cast<std::uint64_t>(x.count);
     auto& t = by[{x.quantity, x.device, x.channel}];
     t.step = std::max<std::size_t>(1, static_cast<std::size_t>(x.count) / 4000);
     t.s.label = fmt::format("{} {} ch {}", instrument_name(v, x.device), cal::drivers::to_string(q),
@@ -1385,13 +1387,16 @@ std::string generic_section(const st::Store& store, const RunView& v) {
   if (!plotted.empty()) {
     auto stream = store.stream_readings(v.run.id, plotted);
     std::vector<st::RawReading> batch;
-    while (stream.next(batch))
+    while (stream.next(batch)) {
       for (const auto& r : batch) {
         auto& t = by[{r.quantity, r.device, r.channel}];
         if (t.seen++ % t.step != 0) continue;
         t.s.t_min.push_back(static_cast<double>(r.time_ns - t0) / 60e9);
         t.s.value.push_back(r.value);
       }
+      read += batch.size();
+      if (o.reading_progress) o.reading_progress(read, to_read);
+    }
   }
   std::string h = fmt::format("<h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
   std::size_t i = 0;
@@ -1557,7 +1562,7 @@ std::string run_body(const st::Store& store, const RunView& v, const Options& o,
     else if (v.run.kind == "circle")
       results = circle_section(store, v, o, hl);
     else
-      results.answer = generic_section(store, v);
+      results.answer = generic_section(store, v, o);
   } catch (const cal::InputError& e) {
     results.answer = fmt::format(
         "<h3>Results</h3>\n<p class=\"warning\">The results cannot be evaluated: "

@@ -3,6 +3,7 @@
 // the file opens offline and prints to PDF): one run, a campaign of runs, or a comparison of
 // the same test over time. Content and layout: docs/reports.md.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -19,6 +20,9 @@ struct Options {
   // standard the run was made for.
   std::string standard;
   std::string software = "daq";  // named in the footer
+  // Told, after each batch, how many of a long run's readings have been read for its plots
+  // and how many there are to read (daq report's progress on a terminal). Empty: not told.
+  std::function<void(std::uint64_t done, std::uint64_t total)> reading_progress;
 };
 
 // Each throws cal::InputError naming the database and run for an unknown run, a run without
