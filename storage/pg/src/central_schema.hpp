@@ -25,9 +25,16 @@ auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
     throw StoreError(fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what,
                                  std::string_view(e.what()), e.sqlstate()));
   } catch (const std::exception& e) {
-    // broken_connection and the like: libpq's text ends with a newline.
-    std::string text = e.what();
-    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+    // broken_connection and the like: libpq's text spans lines ("...failed: Connection
+    // refused\n\tIs the server running...?\n"): one line, as every daq error.
+    std::string text;
+    for (const char c : std::string_view(e.what())) {
+      if (c != '\n' && c != '\t')
+        text += c;
+      else if (!text.empty() && text.back() != ' ')
+        text += ' ';
+    }
+    while (!text.empty() && text.back() == ' ') text.pop_back();
     throw StoreError(fmt::format("{}: {}: {}", shown_url, what, text));
   }
 }
