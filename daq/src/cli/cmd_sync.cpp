@@ -9,6 +9,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/storage/pg/sync.hpp"
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "terminal.hpp"
@@ -96,7 +97,7 @@ void add_sync_command(CLI::App& app) {
                 "checksum over the server's bytes");
   cmd->add_option("--chunks-per-transaction", o->chunks_per_transaction,
                   "Reading chunks sent per transaction (what a cut sync sends again)")
-      ->check(CLI::Range(1, 100000));
+      ->check(whole_in(1, 100000));
   cmd->add_flag("--quiet", o->quiet, "Only the summary line");
   cmd->callback([o] { run_sync(*o); });
 }
