@@ -17,11 +17,13 @@ PACKAGES=(
   libusb-1.0-0-dev libhidapi-dev libeigen3-dev libboost-dev libsqlite3-dev libspdlog-dev
   libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev clang
   libplplot-dev
+  libpq-dev libpqxx-dev
 )
 # The headless browser of the report and live-page tests (and of daq report --format pdf).
 # The Python package (python/, docs/python.md): pybind11 and Python's headers to build it; numpy,
 # pytest, pandas and matplotlib for its tests (pytest in ctest) and the notebook walk-through.
-TEST_PACKAGES=(chromium chromium-driver python3 poppler-utils
+# PostgreSQL's server for the central-store tests (tests/cli/pg_server.sh starts a throwaway one).
+TEST_PACKAGES=(chromium chromium-driver python3 poppler-utils postgresql
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-pandas
   python3-matplotlib)
 

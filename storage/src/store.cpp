@@ -195,6 +195,15 @@ CREATE TABLE operator_actions(
   detail TEXT NOT NULL DEFAULT '');
 CREATE INDEX operator_actions_by_run ON operator_actions(run_id, id);
 )sql",
+    // 6 -> 7 (issue 35): a stable identity per run, a random UUID, by which the central store
+    // (daq sync) knows it whatever its local id; the runs already stored get theirs now.
+    R"sql(
+ALTER TABLE runs ADD COLUMN uuid TEXT;
+UPDATE runs SET uuid = lower(hex(randomblob(4)) || '-' || hex(randomblob(2)) || '-4' ||
+  substr(hex(randomblob(2)), 2) || '-' || substr('89AB', 1 + (abs(random()) % 4), 1) ||
+  substr(hex(randomblob(2)), 2) || '-' || hex(randomblob(6)));
+CREATE UNIQUE INDEX runs_by_uuid ON runs(uuid);
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -357,8 +366,8 @@ void Store::Impl::open_read_only() {
     // first), so the queries of today's schema read it and nothing is written to the file.
     // The superseded results are those migration 1 -> 2 would mark.
     exec(R"sql(
-CREATE TEMP VIEW runs AS SELECT *, NULL AS origin_session_ns, NULL AS origin_unix_ns
-  FROM main.runs;
+CREATE TEMP VIEW runs AS SELECT *, NULL AS origin_session_ns, NULL AS origin_unix_ns,
+  NULL AS uuid FROM main.runs;
 CREATE TEMP VIEW results AS SELECT r.*, '{}' AS provenance_json,
   (SELECT MIN(later.id) FROM main.results AS later
    WHERE later.run_id = r.run_id AND later.id > r.id
@@ -390,6 +399,9 @@ CREATE TEMP TABLE operator_actions(id INTEGER PRIMARY KEY, run_id INTEGER, time_
   target_index INTEGER, nominal_mm REAL, detail TEXT);
 )sql",
          "present an older schema without operator actions (read-only)");
+  if (version >= 2 && version < 7)  // before the runs' UUIDs: none (RunRecord::uuid "")
+    exec("CREATE TEMP VIEW runs AS SELECT *, NULL AS uuid FROM main.runs;",
+         "present an older schema without run UUIDs (read-only)");
   has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
@@ -424,6 +436,7 @@ Store::Store(Store&&) noexcept = default;
 Store& Store::operator=(Store&&) noexcept = default;
 
 const std::filesystem::path& Store::path() const { return impl_->path; }
+std::string Store::name() const { return impl_->path.string(); }
 int Store::version() const { return impl_->version; }
 bool Store::read_only() const { return impl_->read_only; }
 
@@ -457,8 +470,11 @@ std::int64_t Store::begin_run(const RunRecord& r) {
   impl_->need_writable("begin run");
   auto s = impl_->prepare(
       "INSERT INTO runs(machine_id, campaign, kind, axis, settings_json, capture_path, "
-      "software_version, started_unix_ms, status, note, owner_pid) "
-      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, 'running', ?, ?)");
+      "software_version, started_unix_ms, status, note, owner_pid, uuid) "
+      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?)");
+  if (!r.uuid.empty() && !is_uuid(r.uuid))
+    throw StoreError(fmt::format("{}: begin run: '{}' is not a UUID (8-4-4-4-12 lower-case hex)",
+                                 impl_->path.string(), r.uuid));
   if (r.machine_id > 0) sqlite3_bind_int64(s.get(), 1, r.machine_id);
   bind_text(s.get(), 2, r.campaign);
   bind_text(s.get(), 3, r.kind);
@@ -469,6 +485,7 @@ std::int64_t Store::begin_run(const RunRecord& r) {
   sqlite3_bind_int64(s.get(), 8, r.started_unix_ms ? r.started_unix_ms : unix_ms_now());
   bind_text(s.get(), 9, r.note);
   sqlite3_bind_int64(s.get(), 10, ::getpid());
+  bind_text(s.get(), 11, r.uuid.empty() ? new_uuid() : r.uuid);
   impl_->step_done(s.get(), "begin run");
   return sqlite3_last_insert_rowid(impl_->db.get());
 }
@@ -515,7 +532,7 @@ namespace {
 constexpr const char* kRunColumns =
     "SELECT id, IFNULL(machine_id, 0), campaign, kind, axis, settings_json, capture_path, "
     "software_version, started_unix_ms, ended_unix_ms, status, note, owner_pid, "
-    "origin_session_ns, origin_unix_ns FROM runs";
+    "origin_session_ns, origin_unix_ns, uuid FROM runs";
 
 // A read-only store cannot mark an interrupted run, so it shows it as the writing open would
 // have marked it, and says so.
@@ -540,6 +557,7 @@ RunRecord read_run(sqlite3_stmt* s, bool read_only) {
   }
   if (sqlite3_column_type(s, 13) != SQLITE_NULL) r.origin_session_ns = sqlite3_column_int64(s, 13);
   if (sqlite3_column_type(s, 14) != SQLITE_NULL) r.origin_unix_ns = sqlite3_column_int64(s, 14);
+  r.uuid = column_text(s, 15);
   return r;
 }
 }  // namespace
@@ -554,6 +572,13 @@ std::vector<RunRecord> Store::runs() const {
 std::optional<RunRecord> Store::run(std::int64_t run_id) const {
   auto s = impl_->prepare((std::string(kRunColumns) + " WHERE id = ?").c_str());
   sqlite3_bind_int64(s.get(), 1, run_id);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
+  return read_run(s.get(), impl_->read_only);
+}
+
+std::optional<RunRecord> Store::run_by_uuid(std::string_view uuid) const {
+  auto s = impl_->prepare((std::string(kRunColumns) + " WHERE uuid = ?").c_str());
+  bind_text(s.get(), 1, uuid);
   if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
   return read_run(s.get(), impl_->read_only);
 }
@@ -728,6 +753,71 @@ std::vector<Store::Series> Store::series(std::int64_t run_id) const {
                    sqlite3_column_int64(s.get(), 3), sqlite3_column_int64(s.get(), 4),
                    sqlite3_column_int64(s.get(), 5)});
   return out;
+}
+
+// In the order written: by seq; the chunks of schema 1 and 2 (unnumbered) by row, and first,
+// since a run's chunks are either all numbered or all unnumbered (schema 3 did not renumber).
+std::vector<Store::StoredChunk> Store::stored_chunks(std::int64_t run_id, std::int64_t first,
+                                                     std::size_t max_chunks) const {
+  const Impl& m = *impl_;
+  const std::string checks = m.chunk_checksums ? "encoding, seq, crc" : "1, NULL, NULL";
+  auto s =
+      m.prepare(("SELECT device, channel, quantity, first_ns, last_ns, count, data, " + checks +
+                 " FROM reading_chunks WHERE run_id = ? ORDER BY seq IS NOT NULL, seq, id "
+                 "LIMIT ? OFFSET ?")
+                    .c_str());
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  sqlite3_bind_int64(s.get(), 2, static_cast<std::int64_t>(max_chunks));
+  sqlite3_bind_int64(s.get(), 3, first);
+  std::vector<StoredChunk> out;
+  for (std::int64_t place = first;; ++place) {
+    const int rc = sqlite3_step(s.get());
+    if (rc == SQLITE_DONE) break;
+    if (rc != SQLITE_ROW) m.fail(fmt::format("read the reading chunks of run {}", run_id));
+    StoredChunk c;
+    c.device = sqlite3_column_int64(s.get(), 0);
+    c.channel = sqlite3_column_int64(s.get(), 1);
+    c.quantity = sqlite3_column_int64(s.get(), 2);
+    c.first_ns = sqlite3_column_int64(s.get(), 3);
+    c.last_ns = sqlite3_column_int64(s.get(), 4);
+    c.count = sqlite3_column_int64(s.get(), 5);
+    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(s.get(), 6));
+    c.data.assign(data, data + sqlite3_column_bytes(s.get(), 6));
+    c.encoding = sqlite3_column_int64(s.get(), 7);
+    c.stored_checksum = sqlite3_column_type(s.get(), 9) != SQLITE_NULL;
+    c.seq = c.stored_checksum ? sqlite3_column_int64(s.get(), 8) : place;
+    const chunk::Key key{.run_id = run_id,
+                         .seq = c.seq,
+                         .device = c.device,
+                         .channel = c.channel,
+                         .quantity = c.quantity,
+                         .first_ns = c.first_ns,
+                         .last_ns = c.last_ns,
+                         .count = c.count,
+                         .encoding = c.encoding};
+    c.crc = chunk::checksum(key, c.data);
+    const char* damage = nullptr;
+    if (c.stored_checksum && static_cast<std::uint32_t>(sqlite3_column_int64(s.get(), 9)) != c.crc)
+      damage = "its checksum does not match its contents";
+    else if (c.seq != place)
+      damage = "the run's chunks are not numbered 0, 1, 2, ... (one is missing or twice)";
+    if (damage)
+      throw StoreError(fmt::format(
+          "{}: run {}: reading chunk {} (device {}, channel {}, quantity {}; {} readings from {} "
+          "ns) is damaged: {}",
+          m.path.string(), run_id, c.seq, c.device, c.channel, c.quantity, c.count, c.first_ns,
+          damage));
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::int64_t Store::chunk_count(std::int64_t run_id) const {
+  auto s = impl_->prepare("SELECT count(*) FROM reading_chunks WHERE run_id = ?");
+  sqlite3_bind_int64(s.get(), 1, run_id);
+  if (sqlite3_step(s.get()) != SQLITE_ROW)
+    impl_->fail(fmt::format("count the reading chunks of run {}", run_id));
+  return sqlite3_column_int64(s.get(), 0);
 }
 
 std::int64_t Store::reading_count(std::int64_t run_id) const {

@@ -26,6 +26,8 @@ INFO=$(dpkg-deb -I "$DEB")
 check package_name 0 "^ Package: caldaq$" -- echo "$INFO"
 check depends_libs 0 "^ Depends: .*adduser.*" -- echo "$INFO"
 check depends_shlibs 0 "^ Depends: .*libc6 .*libsqlite3-0" -- echo "$INFO"
+# Issue 35: the central store's client library, found by dpkg-shlibdeps from daq's links.
+check depends_libpqxx 0 "^ Depends: .*libpqxx-6\.4" -- echo "$INFO"
 check recommends_chromium 0 "^ Recommends: chromium" -- echo "$INFO"
 check maintainer_scripts 0 "postinst.*" -- echo "$INFO"
 check conffile 0 "^/etc/caldaq/caldaq.conf$" -- bash -c 'dpkg-deb --ctrl-tarfile "$1" | tar -xO ./conffiles' _ "$DEB"

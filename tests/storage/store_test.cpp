@@ -14,8 +14,10 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 
 #include "../support/temp_dir.hpp"
+#include "cal/storage/chunk.hpp"
 
 namespace {
 
@@ -424,9 +426,12 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
   EXPECT_EQ(store.bar_calibrations().size(), 4u);
 }
 
+// What schema 7 added (the runs' UUIDs), taken off a new file to make a version 6 one; a macro so
+// that it prefixes the other undo strings as a literal.
+#define CALDAQ_UNDO_SCHEMA7 "DROP INDEX runs_by_uuid; ALTER TABLE runs DROP COLUMN uuid; "
 // What schema 5 added (origins, compensations, the stop quality), taken off a new file to
-// make a version 4 one (schema 6's table goes first).
-constexpr const char* kUndoSchema5 =
+// make a version 4 one (schema 7's and 6's go first).
+constexpr const char* kUndoSchema5 = CALDAQ_UNDO_SCHEMA7
     "DROP TABLE operator_actions; DROP INDEX compensations_by_machine; DROP TABLE compensations; "
     "ALTER TABLE instruments DROP COLUMN origin; ALTER TABLE instruments DROP COLUMN "
     "origin_detail; ALTER TABLE captured_targets DROP COLUMN suspect; ALTER TABLE runs DROP "
@@ -641,8 +646,9 @@ TEST(Store, OperatorActionsAreKeptInOrderAndAnOlderFileHasNone) {
   {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-    ASSERT_EQ(sqlite3_exec(db, "DROP TABLE operator_actions; PRAGMA user_version = 5;", nullptr,
-                           nullptr, nullptr),
+    ASSERT_EQ(sqlite3_exec(
+                  db, CALDAQ_UNDO_SCHEMA7 "DROP TABLE operator_actions; PRAGMA user_version = 5;",
+                  nullptr, nullptr, nullptr),
               SQLITE_OK);
     sqlite3_close(db);
   }
@@ -652,6 +658,120 @@ TEST(Store, OperatorActionsAreKeptInOrderAndAnOlderFileHasNone) {
     EXPECT_TRUE(ro.operator_actions(run).empty());
   }
   Store rw(file);
-  EXPECT_EQ(rw.version(), 6);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
   EXPECT_TRUE(rw.operator_actions(run).empty());
+}
+
+// Issue 35: every run has a stable identity, a random UUID: given at begin_run unless the run
+// brings its own, kept on reopening, found by run_by_uuid; a malformed one is refused.
+TEST(Store, EveryRunHasItsOwnUuid) {
+  TempDir dir;
+  const auto file = dir.path / "uuid.sqlite";
+  std::string first;
+  {
+    Store store(file);
+    const auto a = a_run(store);
+    const auto b = a_run(store);
+    first = store.run(a)->uuid;
+    EXPECT_TRUE(cal::storage::is_uuid(first)) << first;
+    EXPECT_EQ(first[14], '4');                                                   // version 4
+    EXPECT_NE(std::string("89ab").find(first[19]), std::string::npos) << first;  // variant 10
+    EXPECT_NE(store.run(b)->uuid, first);
+    const std::string given = "0d3c1a52-8e5f-4b7a-9c1d-2e3f4a5b6c7d";
+    const auto c = store.begin_run({.kind = "linear", .uuid = given});
+    EXPECT_EQ(store.run(c)->uuid, given);
+    EXPECT_EQ(store.run_by_uuid(given)->id, c);
+    EXPECT_FALSE(store.run_by_uuid("00000000-0000-4000-8000-000000000000"));
+    EXPECT_THROW(store.begin_run({.kind = "linear", .uuid = "not-a-uuid"}), StoreError);
+    EXPECT_THROW(store.begin_run({.kind = "linear", .uuid = given}), StoreError);  // unique
+  }
+  Store again(file);
+  EXPECT_EQ(again.runs().front().uuid, first);
+  std::set<std::string> seen;
+  for (int i = 0; i < 10000; ++i) EXPECT_TRUE(seen.insert(cal::storage::new_uuid()).second);
+  EXPECT_FALSE(cal::storage::is_uuid("0D3C1A52-8E5F-4B7A-9C1D-2E3F4A5B6C7D"));  // upper case
+  EXPECT_FALSE(cal::storage::is_uuid("0d3c1a528e5f4b7a9c1d2e3f4a5b6c7d"));
+}
+
+// Migration 6 -> 7 gives the runs already stored each their own UUID; read-only, a version 6
+// file shows none (and is not changed).
+TEST(Store, MigrationSevenGivesEveryStoredRunAUuid) {
+  TempDir dir;
+  const auto file = dir.path / "v6.sqlite";
+  {
+    Store store(file);
+    for (int i = 0; i < 50; ++i) a_run(store);
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(
+        sqlite3_exec(db, CALDAQ_UNDO_SCHEMA7 "PRAGMA user_version = 6;", nullptr, nullptr, nullptr),
+        SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 6);
+    EXPECT_EQ(ro.runs().front().uuid, "");
+  }
+  Store rw(file);
+  EXPECT_EQ(rw.version(), 7);
+  std::set<std::string> seen;
+  for (const auto& r : rw.runs()) {
+    EXPECT_TRUE(cal::storage::is_uuid(r.uuid)) << r.uuid;
+    EXPECT_EQ(r.uuid[14], '4') << r.uuid;
+    EXPECT_NE(std::string("89ab").find(r.uuid[19]), std::string::npos) << r.uuid;
+    seen.insert(r.uuid);
+  }
+  EXPECT_EQ(seen.size(), 50u);
+}
+
+// The chunks as stored, for daq sync: in the order written, paged, each checksum verified; a
+// damaged chunk is an error naming it.
+TEST(Store, StoredChunksComeInOrderWithTheirChecksumsVerified) {
+  TempDir dir;
+  const auto file = dir.path / "chunks.sqlite";
+  Store store(file);
+  const auto run = a_run(store);
+  for (int batch = 0; batch < 4; ++batch)
+    store.append_readings(run, make_readings(300, static_cast<std::uint64_t>(batch)));
+  const auto count = store.chunk_count(run);
+  EXPECT_EQ(count, 4 * 6);  // 6 series per batch (make_readings: device i % 3, channel i % 2)
+  std::vector<Store::StoredChunk> all;
+  for (std::int64_t first = 0; first < count; first += 7) {
+    auto page = store.stored_chunks(run, first, 7);
+    all.insert(all.end(), page.begin(), page.end());
+  }
+  ASSERT_EQ(static_cast<std::int64_t>(all.size()), count);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].seq, static_cast<std::int64_t>(i));
+    EXPECT_TRUE(all[i].stored_checksum);
+    const cal::storage::chunk::Key key{.run_id = run,
+                                       .seq = all[i].seq,
+                                       .device = all[i].device,
+                                       .channel = all[i].channel,
+                                       .quantity = all[i].quantity,
+                                       .first_ns = all[i].first_ns,
+                                       .last_ns = all[i].last_ns,
+                                       .count = all[i].count,
+                                       .encoding = all[i].encoding};
+    EXPECT_EQ(all[i].crc, cal::storage::chunk::checksum(key, all[i].data));
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "UPDATE reading_chunks SET count = count + 1 WHERE seq = 9", nullptr,
+                           nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  EXPECT_NO_THROW(store.stored_chunks(run, 0, 9));
+  try {
+    store.stored_chunks(run, 0, 20);
+    ADD_FAILURE() << "a damaged chunk was read";
+  } catch (const StoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("reading chunk 9 "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("checksum does not match"), std::string::npos) << e.what();
+  }
 }

@@ -75,25 +75,26 @@ st::RunRecord need_run(const st::Store& store, std::int64_t id) {
   return *r;
 }
 
+// From either store (RunReader): the local file or the central store (--db postgresql://...).
 void cmd_runs(const std::string& db, bool as_json) {
-  const auto store = open_database_read_only(db);
-  const auto runs = store.runs();
+  const auto store = open_run_reader(db);
+  const auto runs = store->runs();
   if (as_json) {
-    json j{
-        {"schema", "caldaq.runs.v1"}, {"database", store.path().string()}, {"runs", json::array()}};
+    json j{{"schema", "caldaq.runs.v1"}, {"database", store->name()}, {"runs", json::array()}};
     for (const auto& r : runs) {
       json one = run_json(r);
-      one["readings"] = store.reading_count(r.id);
+      one["uuid"] = r.uuid.empty() ? json(nullptr) : json(r.uuid);
+      one["readings"] = store->reading_count(r.id);
       j["runs"].push_back(one);
     }
     return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
-  print_line("{} ({} runs)", store.path().string(), runs.size());
+  print_line("{} ({} runs)", store->name(), runs.size());
   print_line("{:>5}  {:<20}  {:<12} {:<5} {:<10} {:>10}  {}", "run", "started (UTC)", "kind",
              "axis", "status", "readings", "campaign");
   for (const auto& r : runs)
     print_line("{:>5}  {:<20}  {:<12} {:<5} {:<10} {:>10}  {}", r.id, iso_time(r.started_unix_ms),
-               r.kind, r.axis, st::to_string(r.status), store.reading_count(r.id), r.campaign);
+               r.kind, r.axis, st::to_string(r.status), store->reading_count(r.id), r.campaign);
 }
 
 json missed_json(const st::MissedStop& m) {
@@ -549,7 +550,9 @@ void add_runs_commands(CLI::App& app) {
   auto db = std::make_shared<std::string>();
   auto as_json = std::make_shared<bool>(false);
   CLI::App* runs = app.add_subcommand("runs", "List the stored runs");
-  add_db_option(*runs, *db);
+  runs->add_option("--db", *db,
+                   "Run database (default: $CALDAQ_DB, else ~/.local/share/caldaq/site.sqlite), "
+                   "or the central store: postgresql://... (docs/storage.md, \"Central store\")");
   runs->add_flag("--json", *as_json, "Print caldaq.runs.v1 JSON");
   runs->callback([db, as_json] { cmd_runs(*db, *as_json); });
 

@@ -11,6 +11,8 @@ void add_demo_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
 // decode DRIVER FILE: what a driver makes of a dump of bytes
 void add_decode_command(CLI::App& app);
+// sync --to postgresql://...: the local runs copied to the central store
+void add_sync_command(CLI::App& app);
 // runs, show, export: stored runs
 void add_runs_commands(CLI::App& app);
 // analyse RUN, recompensate RUN: stored runs

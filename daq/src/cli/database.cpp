@@ -1,6 +1,12 @@
 #include "database.hpp"
 
+#include <fmt/format.h>
+
 #include <cstdlib>
+
+#include "cal/analysis/error.hpp"
+#include "cal/storage/pg/central.hpp"
+#include "cal/storage/pg/sync.hpp"
 
 namespace daq {
 namespace {
@@ -14,6 +20,11 @@ std::filesystem::path default_directory() {
 }
 
 std::filesystem::path chosen_path(const std::string& option) {
+  if (cal::storage::pg::is_postgresql_url(option))
+    throw cal::InputError(fmt::format(
+        "--db {}: only `daq runs` reads the central store so far; this command needs the local "
+        "SQLite file (docs/storage.md, \"Central store\")",
+        cal::storage::pg::redacted(option)));
   if (!option.empty()) return option;
   if (const char* env = std::getenv("CALDAQ_DB"); env && *env) return env;
   return default_directory() / "site.sqlite";
@@ -30,6 +41,11 @@ std::filesystem::path database_path(const std::string& option) {
 
 cal::storage::Store open_database_read_only(const std::string& option) {
   return cal::storage::Store(chosen_path(option), {.read_only = true});
+}
+
+std::unique_ptr<cal::storage::RunReader> open_run_reader(const std::string& option) {
+  if (cal::storage::pg::is_postgresql_url(option)) return cal::storage::pg::open_central(option);
+  return std::make_unique<cal::storage::Store>(open_database_read_only(option));
 }
 
 void add_db_option(CLI::App& cmd, std::string& target) {

@@ -17,6 +17,8 @@
 #include <string_view>
 #include <vector>
 
+#include "cal/storage/run_reader.hpp"
+
 namespace cal::storage {
 
 // Every storage failure: the message names the database file and what failed (SQLite's own
@@ -31,8 +33,14 @@ class StoreError : public std::runtime_error {
 // (docs/storage.md). 4: ballbar calibrations (issue 18). 5 (issue 26): the instruments' origin
 // (real, simulated, replay), the compensation tables written with their predicted residual, and
 // the quality of a run's stops (suspect stops, the run's verdict). 6 (issue 29): the operator's
-// actions during a run (OperatorAction).
-inline constexpr int schema_version = 6;
+// actions during a run (OperatorAction). 7 (issue 35): every run has a stable identity, a UUID
+// (RunRecord::uuid), by which the central store (daq sync) knows it.
+inline constexpr int schema_version = 7;
+
+// A new random (version 4) UUID in its canonical lower-case text form.
+std::string new_uuid();
+// Whether `text` is a UUID in canonical form (8-4-4-4-12 lower-case hex digits).
+bool is_uuid(std::string_view text);
 
 enum class RunStatus { running, complete, incomplete, aborted };
 std::string_view to_string(RunStatus s);
@@ -60,6 +68,10 @@ struct RunRecord {
   // The run's time origin: the session clock (the readings' time_ns) at a known UTC instant,
   // taken when the first reading arrived. Unset for runs stored before schema 2 and imports.
   std::optional<std::int64_t> origin_session_ns, origin_unix_ns;
+  // The run's stable identity (schema 7): given at begin_run (a new one when empty), never
+  // changed; the central store knows the run by it. "" only for an older database opened
+  // read-only.
+  std::string uuid;
 };
 
 struct InstrumentRecord {
@@ -217,7 +229,7 @@ struct PreparedBatch {
   void prepare(std::span<const RawReading> readings);
 };
 
-class Store {
+class Store : public RunReader {
  public:
   // Opens or creates the database, migrates it to schema_version, and marks runs left
   // `running` by a crashed session as `incomplete`. Throws StoreError (file named) when the
@@ -233,6 +245,7 @@ class Store {
   Store& operator=(Store&&) noexcept;
 
   const std::filesystem::path& path() const;
+  std::string name() const override;  // the path
   int version() const;  // the schema version found on disk after migration
   bool read_only() const;
 
@@ -244,8 +257,9 @@ class Store {
   void add_instrument(const InstrumentRecord& i);
   void finish_run(std::int64_t run_id, RunStatus status, std::string_view note = {});
   void set_capture_path(std::int64_t run_id, std::string_view path);
-  std::vector<RunRecord> runs() const;
+  std::vector<RunRecord> runs() const override;
   std::optional<RunRecord> run(std::int64_t run_id) const;
+  std::optional<RunRecord> run_by_uuid(std::string_view uuid) const;
   std::vector<InstrumentRecord> instruments(std::int64_t run_id) const;
 
   // Appends readings in one transaction: one chunk per device/channel/quantity, each with its
@@ -267,7 +281,7 @@ class Store {
   std::vector<RawReading> readings(std::int64_t run_id) const;
   std::vector<RawReading> readings(std::int64_t run_id,
                                    std::span<const std::uint8_t> quantities) const;
-  std::int64_t reading_count(std::int64_t run_id) const;
+  std::int64_t reading_count(std::int64_t run_id) const override;
   // The series of a run (one per device, channel and quantity) with their counts and time
   // spans, from the chunks' rows alone (no reading is decoded): what a reader needs to know
   // before it streams, e.g. how far to thin a series for a plot.
@@ -277,6 +291,24 @@ class Store {
     std::int64_t count = 0, first_ns = 0, last_ns = 0;
   };
   std::vector<Series> series(std::int64_t run_id) const;
+
+  // A reading chunk as stored, its BLOB not decoded: what daq sync copies to the central store.
+  struct StoredChunk {
+    std::int64_t seq = 0;  // its place in the run (0, 1, 2, ...)
+    std::int64_t device = 0, channel = 0, quantity = 0;
+    std::int64_t first_ns = 0, last_ns = 0, count = 0;
+    std::int64_t encoding = 0;
+    std::uint32_t crc = 0;  // chunk::checksum of the row (with the run's local id) and BLOB
+    // false for a chunk written before schema 3: it was unnumbered and had no checksum; seq is
+    // then its place in the order written and crc is computed now, at reading.
+    bool stored_checksum = true;
+    std::vector<unsigned char> data;
+  };
+  // The run's chunks in the order written, from the `first`-th (0-based), at most `max_chunks`.
+  // Every stored checksum is verified: a damaged chunk throws StoreError naming it.
+  std::vector<StoredChunk> stored_chunks(std::int64_t run_id, std::int64_t first,
+                                         std::size_t max_chunks) const;
+  std::int64_t chunk_count(std::int64_t run_id) const;
 
   void add_targets(std::span<const CapturedTarget> targets);
   std::vector<CapturedTarget> targets(std::int64_t run_id) const;

@@ -1,0 +1,376 @@
+// daq sync --to: the runs of a local store copied to the central store (sync.hpp).
+#include "cal/storage/pg/sync.hpp"
+
+#include <chrono>
+#include <map>
+#include <optional>
+
+#include "cal/storage/chunk.hpp"
+#include "central_schema.hpp"
+
+namespace cal::storage::pg {
+
+bool is_postgresql_url(std::string_view text) {
+  return text.starts_with("postgresql://") || text.starts_with("postgres://");
+}
+
+std::string redacted(std::string_view url) {
+  // scheme://user:password@host...: the password is between the first ':' after the scheme and
+  // the last '@' before the path (a password may hold '@' only percent-encoded, but be safe).
+  const auto scheme = url.find("://");
+  if (scheme == std::string_view::npos) return std::string(url);
+  const auto auth_start = scheme + 3;
+  const auto path = url.find('/', auth_start);
+  const auto authority =
+      url.substr(auth_start, path == std::string_view::npos ? url.npos : path - auth_start);
+  const auto at = authority.rfind('@');
+  if (at == std::string_view::npos) return std::string(url);
+  const auto colon = authority.find(':');
+  if (colon == std::string_view::npos || colon > at) return std::string(url);
+  return std::string(url.substr(0, auth_start + colon + 1)) + "***" +
+         std::string(url.substr(auth_start + at));
+}
+
+namespace {
+
+std::int64_t unix_ms_now() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// libpqxx 6 has no std::optional parameters: a nullable number goes as text, '' for NULL, and
+// the SQL says NULLIF($n, '')::type.
+std::string nullable(const std::optional<std::int64_t>& v) {
+  return v ? std::to_string(*v) : std::string();
+}
+
+std::string quality_json(const std::optional<RunQuality>& q) {
+  if (!q) return {};
+  // A small JSON document built by hand: storage/ does not depend on a JSON library.
+  const auto quoted = [](std::string_view s) {
+    std::string out = "\"";
+    for (const char c : s) {
+      if (c == '"' || c == '\\') {
+        out += '\\';
+        out += c;
+      } else if (static_cast<unsigned char>(c) < 0x20) {
+        out += fmt::format("\\u{:04x}", static_cast<int>(static_cast<unsigned char>(c)));
+      } else {
+        out += c;
+      }
+    }
+    return out + "\"";
+  };
+  std::string out =
+      "{\"state\":" + quoted(q->state) + ",\"summary\":" + quoted(q->summary) + ",\"suspects\":[";
+  for (std::size_t i = 0; i < q->suspects.size(); ++i) {
+    const auto& s = q->suspects[i];
+    out += fmt::format(
+        "{}{{\"run_number\":{},\"direction\":\"{}\",\"target_index\":{},\"reason\":{}}}",
+        i ? "," : "", s.run_number, s.direction, s.target_index, quoted(s.reason));
+  }
+  return out + "]}";
+}
+
+// What the server holds of one chunk, without its bytes.
+struct ServerChunk {
+  std::int64_t device = 0, channel = 0, quantity = 0, first_ns = 0, last_ns = 0, count = 0,
+               encoding = 0, length = 0;
+  std::uint32_t crc = 0;
+};
+
+class Sync {
+ public:
+  Sync(const Store& local, std::string_view url, const SyncOptions& options)
+      : local_(local),
+        shown_(redacted(url)),
+        options_(options),
+        conn_(guarded(shown_, "connect",
+                      [&] { return std::make_unique<pqxx::connection>(std::string(url)); })) {
+    if (options_.chunks_per_transaction == 0) options_.chunks_per_transaction = 1;
+  }
+
+  SyncReport run() {
+    report_.server_schema = migrate_schema(*conn_, shown_);
+    guarded(shown_, "prepare the statements", [&] { prepare(); });
+    std::vector<RunRecord> runs;
+    if (options_.run_ids.empty()) {
+      runs = local_.runs();
+    } else {
+      for (const auto id : options_.run_ids) {
+        auto r = local_.run(id);
+        if (!r) throw StoreError(fmt::format("{}: no run {} to sync", local_.path().string(), id));
+        runs.push_back(std::move(*r));
+      }
+    }
+    for (const auto& r : runs) sync_run(r);
+    return report_;
+  }
+
+ private:
+  const Store& local_;
+  std::string shown_;
+  SyncOptions options_;
+  std::unique_ptr<pqxx::connection> conn_;
+  SyncReport report_;
+
+  void prepare() {
+    conn_->prepare("insert_chunk",
+                   "INSERT INTO caldaq.reading_chunks(run_uuid, seq, device, channel, quantity, "
+                   "first_ns, last_ns, count, encoding, crc, stored_checksum, data) "
+                   "VALUES($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)");
+  }
+
+  std::string run_name(const RunRecord& r) const {
+    return fmt::format("run {} ({})", r.id, r.uuid);
+  }
+
+  void sync_run(const RunRecord& r) {
+    if (r.uuid.empty())
+      throw StoreError(fmt::format(
+          "{}: run {} has no UUID (the database was opened read-only at an older schema)",
+          local_.path().string(), r.id));
+    const auto source_id =
+        guarded(shown_, fmt::format("store {}", run_name(r)), [&] { return send_metadata(r); });
+    if (source_id != r.id)
+      throw StoreError(fmt::format(
+          "{}: {} is on the server as run {} of another store: its chunks (whose checksums "
+          "cover that id) were not sent",
+          shown_, run_name(r), source_id));
+    const auto before = report_.chunks_sent;
+    const auto already_before = report_.chunks_already;
+    guarded(shown_, fmt::format("send the reading chunks of {}", run_name(r)),
+            [&] { send_chunks(r); });
+    ++report_.runs;
+    if (options_.run_done)
+      options_.run_done(r, report_.chunks_sent - before, report_.chunks_already - already_before);
+  }
+
+  // The run's row and everything small of it, in one transaction; returns the run's id in the
+  // store the server's copy came from (this one's unless a copy of this database synced it).
+  std::int64_t send_metadata(const RunRecord& r) {
+    pqxx::work w(*conn_);
+    std::string machine_id;
+    if (r.machine_id > 0) {
+      if (const auto m = local_.machine(r.machine_id)) {
+        // Machines are known by name: a no-op update returns the id of an existing one.
+        const auto row = w.exec_params1(
+            "INSERT INTO caldaq.machines(name, description, config_json) VALUES($1, $2, $3) "
+            "ON CONFLICT (name) DO UPDATE SET name = EXCLUDED.name RETURNING id",
+            m->name, m->description, m->config_json);
+        machine_id = row[0].as<std::string>();
+      }
+    }
+    const auto existing =
+        w.exec_params("SELECT source_run_id FROM caldaq.runs WHERE uuid = $1 FOR UPDATE", r.uuid);
+    if (existing.empty()) ++report_.runs_new;
+    const std::int64_t source_id = existing.empty() ? r.id : existing[0][0].as<std::int64_t>();
+    if (source_id != r.id) return source_id;
+    const auto quality = quality_json(local_.quality(r.id));
+    if (existing.empty())
+      w.exec_params(
+          "INSERT INTO caldaq.runs(uuid, source_run_id, kind, axis, software_version, "
+          "started_unix_ms, machine_id, campaign, settings_json, capture_path, ended_unix_ms, "
+          "status, note, origin_session_ns, origin_unix_ns, quality_json, synced_unix_ms) "
+          "VALUES($1, $2, $3, $4, $5, $6, NULLIF($7, '')::bigint, $8, $9, $10, "
+          "NULLIF($11, '')::bigint, $12, $13, NULLIF($14, '')::bigint, NULLIF($15, '')::bigint, "
+          "NULLIF($16, ''), $17)",
+          r.uuid, r.id, r.kind, r.axis, r.software_version, r.started_unix_ms, machine_id,
+          r.campaign, r.settings_json, r.capture_path, nullable(r.ended_unix_ms),
+          std::string(to_string(r.status)), r.note, nullable(r.origin_session_ns),
+          nullable(r.origin_unix_ns), quality, unix_ms_now());
+    else  // what can change at the machine after the run began (its identity cannot)
+      w.exec_params(
+          "UPDATE caldaq.runs SET machine_id = NULLIF($2, '')::bigint, campaign = $3, "
+          "settings_json = $4, capture_path = $5, ended_unix_ms = NULLIF($6, '')::bigint, "
+          "status = $7, note = $8, origin_session_ns = NULLIF($9, '')::bigint, "
+          "origin_unix_ns = NULLIF($10, '')::bigint, quality_json = NULLIF($11, ''), "
+          "synced_unix_ms = $12 WHERE uuid = $1",
+          r.uuid, machine_id, r.campaign, r.settings_json, r.capture_path,
+          nullable(r.ended_unix_ms), std::string(to_string(r.status)), r.note,
+          nullable(r.origin_session_ns), nullable(r.origin_unix_ns), quality, unix_ms_now());
+    send_children(w, r);
+    w.commit();
+    return source_id;
+  }
+
+  // The run's instruments, stops, missed stops and operator's actions are replaced as a whole
+  // (they are small, and the local store may have replaced them: a re-compensation rewrites the
+  // stops); results are added by their local id and their superseded mark updated, so a result
+  // is stored once however often it is sent.
+  void send_children(pqxx::work& w, const RunRecord& r) {
+    for (const char* table :
+         {"instruments", "captured_targets", "missed_stops", "operator_actions"})
+      w.exec_params(fmt::format("DELETE FROM caldaq.{} WHERE run_uuid = $1", table), r.uuid);
+    for (const auto& i : local_.instruments(r.id))
+      w.exec_params(
+          "INSERT INTO caldaq.instruments(run_uuid, device, driver, transport, settings_json, "
+          "origin, origin_detail) VALUES($1, $2, $3, $4, $5, $6, $7)",
+          r.uuid, i.device, i.driver, i.transport, i.settings_json, i.origin, i.origin_detail);
+    for (const auto& t : local_.targets(r.id))
+      w.exec_params(
+          "INSERT INTO caldaq.captured_targets(run_uuid, target_index, run_number, direction, "
+          "nominal_mm, time_ns, raw_m, deviation_um, refractive_index, "
+          "material_temperature_degc) VALUES($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)",
+          r.uuid, t.target_index, t.run_number, std::string(1, t.direction), t.nominal_mm,
+          t.time_ns, t.raw_m, t.deviation_um, t.refractive_index, t.material_temperature_degc);
+    for (const auto& m : local_.missed_stops(r.id))
+      w.exec_params(
+          "INSERT INTO caldaq.missed_stops(run_uuid, run_number, direction, target_index, "
+          "nominal_mm) VALUES($1, $2, $3, $4, $5)",
+          r.uuid, m.run_number, std::string(1, m.direction), m.target_index, m.nominal_mm);
+    int ordinal = 0;
+    for (const auto& a : local_.operator_actions(r.id)) {
+      const bool has_stop = a.stop.has_value();
+      w.exec_params(
+          "INSERT INTO caldaq.operator_actions(run_uuid, ordinal, time_unix_ms, action, source, "
+          "operator, run_number, direction, target_index, nominal_mm, detail) "
+          "VALUES($1, $2, $3, $4, $5, $6, NULLIF($7, '')::integer, NULLIF($8, ''), "
+          "NULLIF($9, '')::integer, NULLIF($10, '')::double precision, $11)",
+          r.uuid, ordinal++, a.time_unix_ms, a.action, a.source, a.operator_name,
+          has_stop ? std::to_string(a.stop->run_number) : std::string(),
+          has_stop ? std::string(1, a.stop->direction) : std::string(),
+          has_stop ? std::to_string(a.stop->target_index) : std::string(),
+          has_stop ? fmt::format("{}", a.stop->nominal_mm) : std::string(), a.detail);
+    }
+    for (const auto& res : local_.results(r.id))
+      w.exec_params(
+          "INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, "
+          "created_unix_ms, provenance_json, superseded_by) "
+          "VALUES($1, $2, $3, $4, $5, $6, NULLIF($7, '')::bigint) "
+          "ON CONFLICT (run_uuid, source_result_id) DO UPDATE SET "
+          "superseded_by = EXCLUDED.superseded_by",
+          r.uuid, res.id, res.standard, res.json, res.created_unix_ms, res.provenance_json,
+          nullable(res.superseded_by));
+  }
+
+  std::map<std::int64_t, ServerChunk> server_chunks(const RunRecord& r) {
+    pqxx::nontransaction n(*conn_);
+    const auto rows = n.exec_params(
+        "SELECT seq, device, channel, quantity, first_ns, last_ns, count, encoding, crc, "
+        "octet_length(data) FROM caldaq.reading_chunks WHERE run_uuid = $1 ORDER BY seq",
+        r.uuid);
+    std::map<std::int64_t, ServerChunk> out;
+    for (const auto& row : rows)
+      out[row[0].as<std::int64_t>()] = {row[1].as<std::int64_t>(),
+                                        row[2].as<std::int64_t>(),
+                                        row[3].as<std::int64_t>(),
+                                        row[4].as<std::int64_t>(),
+                                        row[5].as<std::int64_t>(),
+                                        row[6].as<std::int64_t>(),
+                                        row[7].as<std::int64_t>(),
+                                        row[9].as<std::int64_t>(),
+                                        static_cast<std::uint32_t>(row[8].as<std::int64_t>())};
+    return out;
+  }
+
+  [[noreturn]] void differs(const RunRecord& r, std::int64_t seq, std::string_view how) const {
+    throw StoreError(fmt::format(
+        "{}: {}: the server's reading chunk {} differs from the local one ({}); nothing of it was "
+        "overwritten",
+        shown_, run_name(r), seq, how));
+  }
+
+  void check_same(const RunRecord& r, const Store::StoredChunk& c, const ServerChunk& s) const {
+    if (s.crc != c.crc)
+      differs(r, c.seq, fmt::format("checksum {:08x} there, {:08x} here", s.crc, c.crc));
+    if (s.device != c.device || s.channel != c.channel || s.quantity != c.quantity ||
+        s.first_ns != c.first_ns || s.last_ns != c.last_ns || s.count != c.count ||
+        s.encoding != c.encoding)
+      differs(r, c.seq, "its series, times, count or encoding");
+    if (s.length != static_cast<std::int64_t>(c.data.size()))
+      differs(r, c.seq, fmt::format("{} bytes there, {} here", s.length, c.data.size()));
+  }
+
+  // Pages of the local chunks: those the server has are checked, the others sent, one
+  // transaction per page (a cut loses at most that page, sent again next time).
+  void send_chunks(const RunRecord& r) {
+    const auto on_server = server_chunks(r);
+    const std::int64_t local_count = local_.chunk_count(r.id);
+    if (!on_server.empty() && on_server.rbegin()->first >= local_count)
+      differs(r, on_server.rbegin()->first,
+              fmt::format("the server has it, this store has {} chunks", local_count));
+    std::vector<std::uint32_t> local_crcs;
+    for (std::int64_t first = 0; first < local_count;) {
+      const auto page = local_.stored_chunks(r.id, first, options_.chunks_per_transaction);
+      if (page.empty()) break;
+      first += static_cast<std::int64_t>(page.size());
+      std::vector<const Store::StoredChunk*> missing;
+      for (const auto& c : page) {
+        local_crcs.push_back(c.crc);
+        if (const auto it = on_server.find(c.seq); it != on_server.end()) {
+          check_same(r, c, it->second);
+          ++report_.chunks_already;
+        } else {
+          missing.push_back(&c);
+        }
+      }
+      if (missing.empty()) continue;
+      pqxx::work w(*conn_);
+      for (const auto* c : missing) {
+        w.exec_prepared("insert_chunk", r.uuid, c->seq, c->device, c->channel, c->quantity,
+                        c->first_ns, c->last_ns, c->count, c->encoding,
+                        static_cast<std::int64_t>(c->crc), c->stored_checksum,
+                        pqxx::binarystring(c->data.data(), c->data.size()));
+        ++report_.chunks_sent;
+        report_.bytes_sent += static_cast<std::int64_t>(c->data.size());
+        if (options_.after_chunk) options_.after_chunk(report_.chunks_sent);
+      }
+      w.commit();
+    }
+    if (options_.verify_bytes) verify_bytes(r, local_crcs);
+  }
+
+  // Every chunk of the run read back from the server and its checksum recomputed over the
+  // server's bytes (with the run's id in its source store, which the checksum covers).
+  void verify_bytes(const RunRecord& r, const std::vector<std::uint32_t>& local_crcs) {
+    const auto page_size = static_cast<std::int64_t>(options_.chunks_per_transaction);
+    std::int64_t seen = 0;
+    for (std::int64_t first = 0;; first += page_size) {
+      pqxx::nontransaction n(*conn_);
+      const auto rows = n.exec_params(
+          "SELECT seq, device, channel, quantity, first_ns, last_ns, count, encoding, crc, data "
+          "FROM caldaq.reading_chunks WHERE run_uuid = $1 AND seq >= $2 ORDER BY seq LIMIT $3",
+          r.uuid, first, page_size);
+      if (rows.empty()) break;
+      for (const auto& row : rows) {
+        const chunk::Key key{.run_id = r.id,
+                             .seq = row[0].as<std::int64_t>(),
+                             .device = row[1].as<std::int64_t>(),
+                             .channel = row[2].as<std::int64_t>(),
+                             .quantity = row[3].as<std::int64_t>(),
+                             .first_ns = row[4].as<std::int64_t>(),
+                             .last_ns = row[5].as<std::int64_t>(),
+                             .count = row[6].as<std::int64_t>(),
+                             .encoding = row[7].as<std::int64_t>()};
+        const pqxx::binarystring data(row[9]);
+        const auto crc = chunk::checksum(key, {data.data(), data.size()});
+        if (key.seq != seen) differs(r, seen, "the server does not have it");
+        if (crc != static_cast<std::uint32_t>(row[8].as<std::int64_t>()))
+          differs(r, key.seq, "its bytes on the server do not match its checksum");
+        if (static_cast<std::size_t>(key.seq) >= local_crcs.size() || crc != local_crcs[key.seq])
+          differs(r, key.seq, "its checksum is not the local chunk's");
+        ++seen;
+        ++report_.chunks_verified_bytes;
+      }
+    }
+    if (seen != static_cast<std::int64_t>(local_crcs.size()))
+      differs(r, seen, "the server does not have it");
+  }
+};
+
+}  // namespace
+
+SyncReport sync_to(const Store& local, std::string_view url, const SyncOptions& options) {
+  return Sync(local, url, options).run();
+}
+
+int migrate(std::string_view url) {
+  const auto shown = redacted(url);
+  auto conn = guarded(shown, "connect",
+                      [&] { return std::make_unique<pqxx::connection>(std::string(url)); });
+  return migrate_schema(*conn, shown);
+}
+
+}  // namespace cal::storage::pg

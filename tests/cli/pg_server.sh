@@ -1,0 +1,41 @@
+# Sourced by tests that need a PostgreSQL server: pg_start DIR starts a throwaway one (initdb into
+# DIR/data, listening only on a unix socket in DIR, trust authentication for the user caldaq) and
+# sets PG_URL (database caldaq); pg_stop stops it. Run as root (CI, a container), the server runs as
+# the user nobody, which PostgreSQL requires: DIR is then made nobody's.
+PG_BIN=${PG_BIN:-$(ls -d /usr/lib/postgresql/*/bin 2>/dev/null | sort -V | tail -1)}
+
+pg_as_owner() {
+  if [ "$(id -u)" -eq 0 ]; then runuser -u nobody -- "$@"; else "$@"; fi
+}
+
+pg_start() {
+  PG_DIR=$1
+  if [ -z "$PG_BIN" ] || [ ! -x "$PG_BIN/initdb" ]; then
+    echo "FAIL: no PostgreSQL server binaries (/usr/lib/postgresql/*/bin; Debian package postgresql)"
+    exit 1
+  fi
+  if [ "$(id -u)" -eq 0 ]; then chown nobody "$PG_DIR"; fi
+  chmod 700 "$PG_DIR"
+  pg_as_owner "$PG_BIN/initdb" -D "$PG_DIR/data" -U caldaq -A trust --no-sync >"$PG_DIR/initdb.log" 2>&1 ||
+    { cat "$PG_DIR/initdb.log"; echo "FAIL: initdb"; exit 1; }
+  # -F: no fsync (a throwaway server); no TCP at all: the socket is in PG_DIR.
+  pg_as_owner "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -l "$PG_DIR/server.log" -w -t 60 \
+    -o "-k $PG_DIR -c listen_addresses= -F" start >/dev/null ||
+    { cat "$PG_DIR/server.log"; echo "FAIL: pg_ctl start"; exit 1; }
+  PG_STARTED=1
+  PG_URL="postgresql:///caldaq?host=$PG_DIR&user=caldaq"
+  "$PG_BIN/psql" -q -X "postgresql:///postgres?host=$PG_DIR&user=caldaq" -c "CREATE DATABASE caldaq" ||
+    { echo "FAIL: CREATE DATABASE"; exit 1; }
+}
+
+pg_stop() {
+  if [ -n "${PG_STARTED:-}" ]; then
+    pg_as_owner "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m immediate -w stop >/dev/null 2>&1
+    PG_STARTED=
+  fi
+}
+
+# psql_value SQL: one value from the test's database, unaligned.
+psql_value() {
+  "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
+}
