@@ -171,6 +171,20 @@ std::string utc_iso(std::int64_t unix_ms) {
                      static_cast<int>(unix_ms - static_cast<std::int64_t>(s) * 1000));
 }
 
+json bar_calibration_json(const cal::storage::BarCalibration& c) {
+  return {{"id", c.id},
+          {"bar", c.bar},
+          {"nominal_mm", c.nominal_mm},
+          {"extensions", c.extensions},
+          {"calibrator", c.calibrator},
+          {"calibrator_length_mm", c.calibrator_length_mm},
+          {"reading_mm", c.reading_mm},
+          {"zero_length_mm", c.zero_length_mm},
+          {"temperature_degc", c.temperature_degc ? json(*c.temperature_degc) : json(nullptr)},
+          {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
+          {"note", c.note}};
+}
+
 std::string utc_now_iso() {
   return utc_iso(std::chrono::duration_cast<std::chrono::milliseconds>(
                      std::chrono::system_clock::now().time_since_epoch())

@@ -60,19 +60,10 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
 
 namespace {
 
+// The stored record also keeps the exact time, which calibration_from_json reads back.
 json calibration_json(const cal::storage::BarCalibration& c) {
-  json j{{"id", c.id},
-         {"bar", c.bar},
-         {"nominal_mm", c.nominal_mm},
-         {"extensions", c.extensions},
-         {"calibrator", c.calibrator},
-         {"calibrator_length_mm", c.calibrator_length_mm},
-         {"reading_mm", c.reading_mm},
-         {"zero_length_mm", c.zero_length_mm},
-         {"calibrated_unix_ms", c.calibrated_unix_ms},
-         {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
-         {"note", c.note}};
-  j["temperature_degc"] = c.temperature_degc ? json(*c.temperature_degc) : json(nullptr);
+  json j = bar_calibration_json(c);
+  j["calibrated_unix_ms"] = c.calibrated_unix_ms;
   return j;
 }
 
