@@ -8,7 +8,6 @@ on the first page of each run's section); a suspect run says so there, traceabil
 warned there; the campaign summary gives each value in its own unit. Then the plots in the HTML:
 no text in them prints below 9 pt at the width the page gives them.
 Usage: report_pages_test.py DAQ_BINARY [OUT_DIR]  (CALDAQ_DEMO_FIXTURE: a `daq demo` to copy)"""
-import glob
 import html as html_mod
 import os
 import re
@@ -17,6 +16,8 @@ import sqlite3
 import subprocess
 import sys
 import tempfile
+
+from demo_runs import demo_runs
 
 DAQ = os.path.abspath(sys.argv[1])
 fails = 0
@@ -51,14 +52,7 @@ work = sys.argv[2] if len(sys.argv) > 2 else tempfile.mkdtemp(prefix="report_pag
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 os.chdir(work)
-fixture = os.environ.get("CALDAQ_DEMO_FIXTURE")
-if fixture:
-    for f in glob.glob(os.path.join(fixture, "demo.sqlite*")):
-        shutil.copy(f, work)
-    capture = os.path.join(fixture, "demo.cdq")
-else:
-    daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq")
-    capture = os.path.join(work, "demo.cdq")
+capture = demo_runs(work, lambda: daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq"))
 db = ["--db", "demo.sqlite"]
 replay_out = daq("replay", capture, *db)  # run 3: the linear run again (comparison, as found...)
 daq("replay", capture, *db)  # run 4: made suspect below
