@@ -6,24 +6,12 @@
 #include <chrono>
 #include <ctime>
 
+#include "config_json.hpp"
 #include "json_input.hpp"
 
 namespace daq {
 
 using nlohmann::json;
-
-namespace {
-
-json limits_json(const cal::daq::PositioningLimits& l) {
-  json j = json::object();
-  const auto put = [&](const char* key, const std::optional<double>& v) {
-    if (v) j[key] = *v;
-  };
-  for (const auto& k : cal::daq::positioning_limit_keys) put(k.key, l.*k.member);
-  return j;
-}
-
-}  // namespace
 
 json run_context(const cal::daq::Config& c, std::string_view kind, std::string_view where) {
   json j{{"customer",
