@@ -160,8 +160,7 @@ void add_set_options(CLI::App& cmd, SetOptions& o) {
 }  // namespace
 
 void add_ballbar_commands(CLI::App& app) {
-  auto* bb = app.add_subcommand("ballbar", "Ballbar calibrations (docs/circle.md)");
-  bb->require_subcommand(1);
+  auto* bb = add_group(app, "ballbar", "Ballbar calibrations (docs/circle.md)");
   const auto [cal, o] = add_command<CalibrateOptions>(
       *bb, "calibrate", calibrate,
       "Store a calibration of the bar against a calibrator: the bar reads 0 at the calibrator's "

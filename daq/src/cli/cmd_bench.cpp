@@ -708,8 +708,7 @@ void bench_export(const ExportBenchOptions& o) {
 }  // namespace
 
 void add_bench_commands(CLI::App& app) {
-  auto* bench = app.add_subcommand("bench", "Measure this machine: ingest throughput and ceilings");
-  bench->require_subcommand(1);
+  auto* bench = add_group(app, "bench", "Measure this machine: ingest throughput and ceilings");
   const auto [in, o] = add_command<BenchOptions>(
       *bench, "ingest", bench_ingest,
       "Replay a generated 10 kHz capture through the real instruments, compensation and store; "

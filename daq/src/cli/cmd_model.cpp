@@ -344,11 +344,10 @@ void run_map(const MapOptions& o) {
 }  // namespace
 
 void add_model_commands(CLI::App& app) {
-  auto* model = app.add_subcommand(
-      "model",
-      "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
-      "compensation, predict a test piece");
-  model->require_subcommand(1);
+  auto* model =
+      add_group(app, "model",
+                "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
+                "compensation, predict a test piece");
 
   const auto [show, s] = add_command<ShowOptions>(
       *model, "show", run_show, "Print a model file: chain, offsets, the 21 errors");

@@ -25,4 +25,12 @@ Command<Options> add_command(CLI::App& parent, std::string name, Run run, std::s
   return {cmd, options.get()};
 }
 
+// Adds the group NAME to PARENT: a command that does its work by one of its subcommands, which
+// must be given (never null).
+inline CLI::App* add_group(CLI::App& parent, std::string name, std::string help) {
+  auto* group = parent.add_subcommand(std::move(name), std::move(help));
+  group->require_subcommand(1);
+  return group;
+}
+
 }  // namespace daq
