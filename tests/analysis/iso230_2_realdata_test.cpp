@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/realdata.hpp"
 #include "cal/analysis/iso230_2.hpp"
 
 namespace {
@@ -30,17 +31,7 @@ using cal::iso230_2::Measurement;
 using cal::iso230_2::Standard;
 namespace fs = std::filesystem;
 
-std::string read(const std::string& name) {
-  const auto path = fs::path(CALDAQ_REALDATA_DIR) / name;
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw std::runtime_error(
-        "cannot read " + path.string() +
-        ": the real recordings are expected in ../shared/realdata beside the checkout");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read(const std::string& name) { return cal::test::read_realdata(name); }
 
 std::string trim(std::string s) {
   const auto b = s.find_first_not_of(" \t\r*");

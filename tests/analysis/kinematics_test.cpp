@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 
+#include "../support/random_machine.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/squareness.hpp"
 
@@ -470,32 +471,8 @@ TEST(KinematicsVolumetric, OrientationError) {
 // ---------------------------------------------------------------------------------------------
 // Second-order agreement of the two methods
 
-// A machine with cubic error functions of realistic size (translations up to ~10 um, angles up
-// to ~50 urad over 1 m, squareness ~30 urad), seeded.
-Machine random_machine(Topology t, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Machine m;
-  m.topology = t;
-  for (Component c : all_components()) {
-    const bool angle = static_cast<std::size_t>(c) % 6 >= 3;
-    const double size = angle ? 50.0 : 10.0;
-    // size * (a0 + a1 s + a2 s^2 + a3 s^3) with s = q / 1000 mm
-    component(m, c) = ErrorFunction::polynomial(
-        {size * u(rng), size * u(rng) / 1e3, size * u(rng) / 1e6, size * u(rng) / 1e9});
-  }
-  m.squareness = {30.0 * u(rng), 30.0 * u(rng), 30.0 * u(rng)};
-  m.tool_offset_mm = {10.0, -20.0, -150.0};
-  m.table_offset_mm = {-250.0, 100.0, -30.0};
-  return m;
-}
-
-Machine scaled(const Machine& m, double k) {
-  Machine s = m;
-  for (Component c : all_components()) component(s, c) = component(m, c).scaled(k);
-  s.squareness = {k * m.squareness.c0y_urad, k * m.squareness.b0z_urad, k * m.squareness.a0z_urad};
-  return s;
-}
+using cal::test::random_machine;  // all 21 errors as cubics of realistic size
+using cal::test::scaled;
 
 // Root-sum-square over the points of |htm - first order| (translation, and orientation).
 std::pair<double, double> rss_difference(const Machine& m, const std::vector<Vec3>& points) {

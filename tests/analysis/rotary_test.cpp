@@ -129,6 +129,21 @@ Vec3 joint_displacement_um(const M3& r, const Vec3& o_um, const Vec3& e_urad, co
 // ---------------------------------------------------------------------------------------------
 // Names
 
+// A spindle B axis (pivot 180 mm above the tool reference point, the tool 100 mm below it) with
+// its location errors: position (X, 0, Z) um and orientation (A, 0, C) urad.
+FiveAxisMachine spindle_b(const Vec3& location_position_um, const Vec3& location_orientation_urad) {
+  FiveAxisMachine m;
+  m.linear.tool_offset_mm = {0, 0, -100};
+  RotaryAxis b;
+  b.letter = RotaryLetter::b;
+  b.side = Side::spindle;
+  b.pivot_mm = {0, 0, 180};
+  b.location_position_um = location_position_um;
+  b.location_orientation_urad = location_orientation_urad;
+  m.rotary = {b};
+  return m;
+}
+
 TEST(RotaryNames, LocationErrorNamesFollowIso2301) {
   EXPECT_EQ(location_error_names(RotaryLetter::c),
             (std::array<std::string, 4>{"E_X0C", "E_Y0C", "E_A0C", "E_B0C"}));
@@ -280,16 +295,8 @@ TEST(RotaryModel, SwivelHeadFirstOrderByHand) {
   //         E_Z0B (1 - cos B) + E_X0B sin B );
   // orientation: e - R e = ( E_A0B (1 - cos B) - E_C0B sin B, 0, E_C0B (1 - cos B) + E_A0B sin B ).
   // Check of the first line: B = 180 mirrors the tip through the line at x = E_X0B: +2 E_X0B.
-  FiveAxisMachine m;
-  m.linear.tool_offset_mm = {0, 0, -100};
-  RotaryAxis b;
-  b.letter = RotaryLetter::b;
-  b.side = Side::spindle;
-  b.pivot_mm = {0, 0, 180};
   const double x0 = 10, z0 = -6, a0 = 30, c0 = -45, L = 280;
-  b.location_position_um = {x0, 0, z0};
-  b.location_orientation_urad = {a0, 0, c0};
-  m.rotary = {b};
+  const FiveAxisMachine m = spindle_b({x0, 0, z0}, {a0, 0, c0});
   for (double deg : {-90.0, -20.0, 60.0, 180.0}) {
     const double c = std::cos(deg * kDeg), s = std::sin(deg * kDeg);
     const Vec3 want{x0 * (1 - c) - z0 * s, -L * 1e-3 * (a0 * (1 - c) + c0 * s),
@@ -385,15 +392,7 @@ TEST(RotaryModel, ExactModelIsTheRotationAboutTheActualLine) {
   }
   // Spindle B: the tip is pivot + o + rod(n_B, B, tool - pivot - o) with
   // n_B = Rz(c) Rx(a) y = (-sin c cos a, cos c cos a, sin a); nominal pivot + Ry(B)(tool - pivot).
-  FiveAxisMachine h;
-  h.linear.tool_offset_mm = {0, 0, -100};
-  RotaryAxis bh;
-  bh.letter = RotaryLetter::b;
-  bh.side = Side::spindle;
-  bh.pivot_mm = {0, 0, 180};
-  bh.location_position_um = {250, 0, -400};
-  bh.location_orientation_urad = {1800, 0, -2500};
-  h.rotary = {bh};
+  const FiveAxisMachine h = spindle_b({250, 0, -400}, {1800, 0, -2500});
   const double ha = 1.8e-3, hc = -2.5e-3;
   const Vec3 nb{-std::sin(hc) * std::cos(ha), std::cos(hc) * std::cos(ha), std::sin(ha)};
   const Vec3 piv{0, 0, 180}, ob{0.25, 0, -0.4}, tool{0, 0, -100};

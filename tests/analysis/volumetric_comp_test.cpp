@@ -10,6 +10,7 @@
 #include <random>
 #include <string>
 
+#include "../support/random_machine.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace {
@@ -92,30 +93,8 @@ TEST(VolumetricCorrection, CarrierMustBeInItsPlane) {
   }
 }
 
-// A machine with all 21 errors as cubics of realistic size: translations to ~10 um, angles to
-// ~50 urad over 1 m, squareness to ~30 urad (as in kinematics_test.cpp).
-Machine random_machine(Topology t, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Machine m;
-  m.topology = t;
-  for (Component c : all_components()) {
-    const double size = static_cast<std::size_t>(c) % 6 >= 3 ? 50.0 : 10.0;
-    component(m, c) = ErrorFunction::polynomial(
-        {size * u(rng), size * u(rng) / 1e3, size * u(rng) / 1e6, size * u(rng) / 1e9});
-  }
-  m.squareness = {30.0 * u(rng), 30.0 * u(rng), 30.0 * u(rng)};
-  m.tool_offset_mm = {10.0, -20.0, -150.0};
-  m.table_offset_mm = {-250.0, 100.0, -30.0};
-  return m;
-}
-
-Machine scaled(const Machine& m, double k) {
-  Machine s = m;
-  for (Component c : all_components()) component(s, c) = component(m, c).scaled(k);
-  s.squareness = {k * m.squareness.c0y_urad, k * m.squareness.b0z_urad, k * m.squareness.a0z_urad};
-  return s;
-}
+using cal::test::random_machine;  // all 21 errors as cubics of realistic size
+using cal::test::scaled;
 
 struct LoopResult {
   double error_max_um = 0.0, residual_max_um = 0.0;

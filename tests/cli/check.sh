@@ -24,6 +24,14 @@ check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
   passes=$((passes + 1))
 }
 
+# scratch_dir: TMP, a new directory removed when the script exits, and SIM_PID (a `daq sim`
+# the script starts) killed then if it still runs.
+scratch_dir() {
+  TMP=$(mktemp -d)
+  SIM_PID=
+  trap '[ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null; rm -rf "$TMP"' EXIT
+}
+
 finish() {
   echo "$passes passed, $fails failed"
   [ "$fails" -eq 0 ]

@@ -6,6 +6,7 @@ DAQ=$1
 DATA=$2
 
 source "$(dirname "$0")/check.sh"
+scratch_dir
 
 check help 0 "analyse" -- "$DAQ" --help
 check analyse_help 0 "iso230-2" -- "$DAQ" analyse --help
@@ -31,8 +32,6 @@ check targets_long 0 "^13 targets \(mm\): 0\.000 250\.000 " -- "$DAQ" targets --
 check targets_long_note 0 "^note: axis over 2000 mm" -- "$DAQ" targets --first 0 --last 3000 --runs 1
 check targets_short_default 2 "give an interval or a count" -- "$DAQ" targets --first 0 --last 1000
 check uncertainty 0 "expanded uncertainty U \(k = 2\)" -- "$DAQ" uncertainty -L 1 -m 21
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
 demo_runs "$TMP"  # `daq demo --quiet` (the ctest fixture "demo", or run here)
 check demo 0 "Simulated truth vs measured" -- cat "$TMP/demo.log"
 # A capture cut in half: the replay says where the damage is and stores nothing as complete.

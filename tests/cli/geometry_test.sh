@@ -4,6 +4,7 @@ set -u
 DAQ=$1
 DATA=$2
 source "$(dirname "$0")/check.sh"
+scratch_dir
 # The hand set: LSQ 2.7 um at 7 um/m, end point 2.75 um, minimum zone 2.5 um at 5 um/m.
 check lsq 0 "straightness +2\.700 um" -- "$DAQ" analyse straightness -i "$DATA/hand.csv"
 check endpoint 0 "straightness +2\.750 um" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r endpoint
@@ -21,8 +22,6 @@ check square_plane_bad 2 "plane 'XX'" -- "$DAQ" analyse squareness -m diagonal -
 check bad_number 2 "bad.csv:3: column deviation_um: 'x' is not a number" -- "$DAQ" analyse straightness -i "$DATA/bad.csv"
 check bad_reference 2 "unknown reference line 'best'" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" -r best
 # Reports: the hand values of all three reference lines, the plot with its lines.
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
 check straightness_report 0 "report written to $TMP/s.html" -- "$DAQ" analyse straightness -i "$DATA/hand.csv" --report "$TMP/s.html"
 check report_lsq 0 "<td>least squares</td><td class=\"r\">2\.700</td><td class=\"r\">7\.000</td>" -- cat "$TMP/s.html"
 check report_endpoint 0 "<td>end point</td><td class=\"r\">2\.750</td>" -- cat "$TMP/s.html"

@@ -6,9 +6,8 @@
 set -u
 DAQ=$(realpath "$1")  # absolute: the numeric options are tried from $TMP
 DATA=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir
 
 # Usage errors: status 2 as docs/cli.md says (CLI11's own codes were 104-109).
 check usage_unknown_option 2 "^daq: error: unknown option .--bogus. of daq runs" -- "$DAQ" runs --bogus

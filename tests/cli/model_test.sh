@@ -5,8 +5,7 @@ set -u
 DAQ=$1
 DATA=$2
 source "$(dirname "$0")/check.sh"
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
+scratch_dir
 Y=$DATA/yfxz.json
 S=$DATA/square50.json
 check show 0 "topology +YFXZ: workpiece <- Y <- F -> X -> Z -> tool" -- "$DAQ" model show "$Y"

@@ -9,8 +9,7 @@ DAQ=$1
 DATA=$2
 
 source "$(dirname "$0")/check.sh"
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
+scratch_dir
 
 # A mistyped path: an error naming it, and nothing created.
 check missing_runs 2 "$TMP/typo/site.sqlite: no such database" -- "$DAQ" runs --db "$TMP/typo/site.sqlite"

@@ -19,7 +19,6 @@ Then how the PDF is printed: through a stand-in browser ($CALDAQ_CHROMIUM), whic
 it sees: a private directory (0700) holding only the report, no network, no shell (an output
 path with a quote and `$(...)` is only a path), the directory removed afterwards.
 Usage: report_hostile_test.py DAQ_BINARY"""
-import glob
 import html
 import html.parser
 import json
@@ -32,6 +31,8 @@ import sys
 import tempfile
 import time
 import uuid
+
+from demo_runs import demo_runs
 
 DAQ = os.path.abspath(sys.argv[1])
 TMP = tempfile.mkdtemp(prefix="caldaq-hostile-")
@@ -82,15 +83,12 @@ EXPECTED_TAGS = {
     "circle", "ellipse", "desc"}
 
 # --- the runs: a demo, a replayed capture with a hostile header, an imported .rtx ------------
-fixture = os.environ.get("CALDAQ_DEMO_FIXTURE")
-if fixture:
-    for f in glob.glob(os.path.join(fixture, "demo.sqlite*")):
-        shutil.copy(f, TMP)
-    demo_cdq = os.path.join(fixture, "demo.cdq")
-else:
+def make_demo():
     r = daq("demo", "--quiet", "--db", "demo.sqlite", "--capture", "demo.cdq")
     assert r.returncode == 0, r.stdout + r.stderr
-    demo_cdq = os.path.join(TMP, "demo.cdq")
+
+
+demo_cdq = demo_runs(TMP, make_demo)
 
 
 def crc32c(data, crc=0):

@@ -18,6 +18,7 @@ import subprocess
 import sys
 import tempfile
 
+
 DAQ = os.path.abspath(sys.argv[1])
 fails = 0
 

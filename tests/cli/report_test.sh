@@ -8,9 +8,8 @@
 set -u
 DAQ=$1
 TESTS=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir
 cd "$TMP"
 
 demo_runs "$TMP"  # runs 1 (linear) and 2 (circle) of `daq demo`

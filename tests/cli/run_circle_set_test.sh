@@ -8,9 +8,8 @@
 # Usage: run_circle_set_test.sh DAQ_BINARY DATA_DIR
 set -u
 DAQ=$1
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir
 
 # The whole set in SIMULATED time: `daq sim --acquire` runs `daq run circle` on the
 # configuration it writes, in its own process on simulated time (about 2 s instead of 16 s

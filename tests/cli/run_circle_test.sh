@@ -10,11 +10,8 @@
 set -u
 DAQ=$1
 DATA=$2
-TMP=$(mktemp -d)
-SIM_PID=
-cleanup() { [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null; rm -rf "$TMP"; }
-trap cleanup EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir
 
 # Live: 2 s for `daq run circle` to start before the program does; the circle at 3000 mm/min
 # (about 35,000 gauge lines through the pseudo-terminal, which keep both processes busy at

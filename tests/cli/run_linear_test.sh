@@ -6,11 +6,8 @@
 # Usage: run_linear_test.sh DAQ_BINARY DATA_DIR
 set -u
 DAQ=$1
-TMP=$(mktemp -d)
-SIM_PID=
-cleanup() { [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null; rm -rf "$TMP"; }
-trap cleanup EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir
 
 # Live across processes, a SHORT program for the wiring (2 runs over 3 targets, 0 .. 100 mm:
 # about 6 s of wall time); the accuracy over the full ISO 230-2 program is checked below on the

@@ -2,6 +2,8 @@
 // project must get from each), read through the drivers' own decoders and codecs. Expected
 // values are read from the files here with a parser of the test's own (split at '|' or
 // whitespace), not with the codecs under test.
+#include "../support/realdata.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,19 +26,9 @@ namespace {
 namespace d = cal::drivers;
 namespace fs = std::filesystem;
 
-fs::path realdata() { return fs::path(CALDAQ_REALDATA_DIR); }
+using cal::test::realdata;
 
-std::string read(const std::string& name) {
-  const auto path = realdata() / name;
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw std::runtime_error(
-        "cannot read " + path.string() +
-        ": the real recordings are expected in ../shared/realdata beside the checkout");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read(const std::string& name) { return cal::test::read_realdata(name); }
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <random>
 
+#include "../support/temp_db.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "cal/storage/store.hpp"
@@ -30,13 +31,9 @@ namespace t = cal::drivers::transport;
 using namespace std::chrono_literals;
 
 fs::path temp_path(const char* name, const char* ext) {
-  return fs::temp_directory_path() /
-         (std::string("caldaq-faults-") + name + "-" + std::to_string(::getpid()) + "-" +
-          std::to_string(std::random_device{}()) + ext);
+  return cal::test::temp_path("caldaq-faults", name, ext);
 }
-void remove_db(const fs::path& p) {
-  for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
-}
+using cal::test::remove_db;
 
 // Pages of an empty store: the schema. A cap a few pages above it fills within seconds.
 std::int64_t empty_store_pages() {
@@ -61,19 +58,10 @@ struct Shop {
     c.machine_name = "faults";
     c.environment.stale_after_s = 60.0;
     c.linear = cal::daq::LinearTestConfig{.first_mm = 0, .last_mm = 200, .count = 5, .runs = 3};
-    const auto clock = shop.clock_ns();
-    const auto poll = [&](double sim_s) {
-      return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / speed * 1e6));
-    };
     daq::LinearRunSetup s;
     s.config = c;
     s.database = db;
-    s.laser = d::make_ids3010(
-        io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-        {.device = 0, .poll_period = poll(0.01), .clock = clock, .recorder = recorder});
-    s.air = d::make_ptu300(
-        io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
-        {.device = 1, .poll_period = poll(1.0), .clock = clock, .recorder = recorder});
+    shop.connect_linear(s, {.material = false, .recorder = recorder});
     return s;
   }
   // Runs the loop until the run ends by itself (it must: the fault ends it) or 600 s of

@@ -19,6 +19,7 @@
 #include <random>
 #include <thread>
 
+#include "../support/temp_db.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
@@ -28,6 +29,7 @@
 #include "line_gauge/instrument.hpp"
 #include "linear_run.hpp"
 #include "ptu300/instrument.hpp"
+#include "roles.hpp"
 #include "sim_shop.hpp"
 #include "verdict.hpp"
 
@@ -38,23 +40,11 @@ namespace d = cal::drivers;
 namespace t = cal::drivers::transport;
 using namespace std::chrono_literals;
 
-fs::path temp_db(const char* name) {
-  return fs::temp_directory_path() /
-         (std::string("caldaq-e2e-") + name + "-" + std::to_string(::getpid()) + "-" +
-          std::to_string(std::random_device{}()) + ".sqlite");
-}
-void remove_db(const fs::path& p) {
-  for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
-}
+fs::path temp_db(const char* name) { return cal::test::temp_path("caldaq-e2e", name); }
+using cal::test::remove_db;
 
-TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
-  const auto db = temp_db("linear");
-  // Simulated time that jumps from event to event (loop_time.hpp): loop seconds are simulated
-  // seconds, and the run takes as long as the CPU needs.
-  constexpr double speed = 1.0;
-  boost::asio::io_context io;
-  d::VirtualTime::install(io);
-  daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
+// The linear test of the acquisitions below: 5 targets over 200 mm, 3 runs, 3 mm overruns.
+cal::daq::Config linear_config() {
   cal::daq::Config c;
   c.machine_name = "e2e";
   c.environment.stale_after_s = 60.0;  // simulated seconds at 40x: see cmd_demo.cpp
@@ -66,36 +56,42 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
                                         .overrun_mm = 3,
                                         .feed_mm_per_min = 6000,
                                         .dwell_s = 3};
-  const auto clock = shop.clock_ns();
-  const auto poll = [&](double sim_s) {
-    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / speed * 1e6));
-  };
-  daq::LinearRunSetup setup;
-  setup.config = c;
-  setup.database = db;
-  setup.laser =
-      // 100 Hz of simulated time: the 3 mm overrun excursions must be seen, or a stop's
-      // approach is unknown (and an automatic capture without one is refused).
-      d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                      {.poll_period = poll(0.01), .clock = clock});
-  setup.air = d::make_ptu300(
-      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
-      {.poll_period = poll(1.0), .clock = clock});
-  setup.material.push_back(d::make_gauge(
-      io, t::make_serial(io, {.device = shop.material_device()}),
-      {.poll_period = poll(1.0), .clock = clock},
-      {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
-  std::array<bool, 3> read{};
-  setup.on_reading = [&read](const d::Reading& r) {
-    // The laser counts once it measures (its environment unit reads before that).
-    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
-      read[r.device] = true;
-  };
-  daq::LinearRun run(io, std::move(setup));
+  return c;
+}
+
+// A linear run of the simulated shop on simulated time that jumps from event to event
+// (loop_time.hpp): loop seconds are simulated seconds, and the run takes as long as the CPU
+// needs.
+struct LinearShop {
+  boost::asio::io_context io;
+  d::VirtualTime& time = d::VirtualTime::install(io);
+  daq::SimulatedShop shop{io, daq::ShopTruth{}, 1.0};
+  const cal::daq::Config config = linear_config();
+  daq::StartupReadings read{1};
+
+  daq::LinearRunSetup setup(const fs::path& db) {
+    daq::LinearRunSetup s;
+    s.config = config;
+    s.database = db;
+    shop.connect_linear(s);  // the laser at 100 Hz of simulated time
+    s.on_reading = [this](const d::Reading& r) { read.add(r); };
+    return s;
+  }
+  // Every instrument has read once: the machine may move.
+  bool started() {
+    return shop.wait_until([&] { return read.all(); });
+  }
+};
+
+TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
+  const auto db = temp_db("linear");
+  LinearShop s;
+  auto setup = s.setup(db);
+  daq::LinearRun run(s.io, std::move(setup));
   run.start();
-  ASSERT_TRUE(shop.wait_until([&] { return read[0] && read[1] && read[2]; }));
-  shop.run_linear(run.plan(), c.linear->feed_mm_per_min, c.linear->dwell_s);
-  shop.run_program([&] { return run.finished(); }, 30.0);
+  ASSERT_TRUE(s.started());
+  s.shop.run_linear(run.plan(), s.config.linear->feed_mm_per_min, s.config.linear->dwell_s);
+  s.shop.run_program([&] { return run.finished(); }, 30.0);
   ASSERT_TRUE(run.finished());
   const auto& out = run.outcome();
   ASSERT_TRUE(out.complete) << out.reason;
@@ -107,7 +103,7 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
   // (0.01 degC, 0.01 hPa, 0.1 %RH: < 0.01 ppm, < 0.002 um at 200 mm). Without the air and
   // material compensation the error at 200 mm would be about 290 ppm = 58 um.
   const auto truth =
-      cal::iso230_2::evaluate(shop.true_measurements(run.plan()), out.evaluation->standard.id);
+      cal::iso230_2::evaluate(s.shop.true_measurements(run.plan()), out.evaluation->standard.id);
   for (const char* key : {"B_mean", "E_up", "E_down", "E_bi", "M"})
     EXPECT_NEAR(out.evaluation->at(key).value_um, truth.at(key).value_um, 0.15) << key;
   for (std::size_t i = 0; i < truth.targets.size(); ++i) {
@@ -152,50 +148,13 @@ TEST(LinearEndToEnd, MeasuredResultsAgreeWithTheSimulatedTruth) {
 // the evaluation says that target has one run fewer up.
 TEST(LinearEndToEnd, ADroppedStopIsStoredIncompleteWithTheStopListed) {
   const auto db = temp_db("dropped");
-  // Simulated time that jumps from event to event (loop_time.hpp): loop seconds are simulated
-  // seconds, and the run takes as long as the CPU needs.
-  constexpr double speed = 1.0;
-  boost::asio::io_context io;
-  d::VirtualTime::install(io);
-  daq::SimulatedShop shop(io, daq::ShopTruth{}, speed);
-  cal::daq::Config c;
-  c.machine_name = "e2e";
-  c.environment.stale_after_s = 60.0;
-  c.trigger = {.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5};
-  c.linear = cal::daq::LinearTestConfig{.first_mm = 0,
-                                        .last_mm = 200,
-                                        .count = 5,
-                                        .runs = 3,
-                                        .overrun_mm = 3,
-                                        .feed_mm_per_min = 6000,
-                                        .dwell_s = 3};
-  const auto clock = shop.clock_ns();
-  const auto poll = [&](double sim_s) {
-    return std::chrono::microseconds(static_cast<std::int64_t>(sim_s / speed * 1e6));
-  };
-  daq::LinearRunSetup setup;
-  setup.config = c;
-  setup.database = db;
-  setup.laser =
-      d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                      {.poll_period = poll(0.01), .clock = clock});
-  setup.air = d::make_ptu300(
-      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
-      {.poll_period = poll(1.0), .clock = clock});
-  setup.material.push_back(d::make_gauge(
-      io, t::make_serial(io, {.device = shop.material_device()}),
-      {.poll_period = poll(1.0), .clock = clock},
-      {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
-  std::array<bool, 3> read{};
-  setup.on_reading = [&read](const d::Reading& r) {
-    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
-      read[r.device] = true;
-  };
+  LinearShop s;
+  auto setup = s.setup(db);
   std::vector<std::string> events;
   setup.on_event = [&events](const std::string& e) { events.push_back(e); };
-  daq::LinearRun run(io, std::move(setup));
+  daq::LinearRun run(s.io, std::move(setup));
   run.start();
-  ASSERT_TRUE(shop.wait_until([&] { return read[0] && read[1] && read[2]; }));
+  ASSERT_TRUE(s.started());
   // The machine's program without the stop of run 2 up at target 3 (100 mm): it moves on.
   auto program = run.plan();
   const auto skipped = std::find_if(program.moves.begin(), program.moves.end(), [](const auto& m) {
@@ -204,8 +163,8 @@ TEST(LinearEndToEnd, ADroppedStopIsStoredIncompleteWithTheStopListed) {
   });
   ASSERT_NE(skipped, program.moves.end());
   program.moves.erase(skipped);
-  shop.run_linear(program, c.linear->feed_mm_per_min, c.linear->dwell_s);
-  shop.run_program([&] { return run.finished(); }, 30.0);
+  s.shop.run_linear(program, s.config.linear->feed_mm_per_min, s.config.linear->dwell_s);
+  s.shop.run_program([&] { return run.finished(); }, 30.0);
   ASSERT_TRUE(run.finished());
   const auto& out = run.outcome();
   ASSERT_TRUE(out.complete) << out.reason;  // the end of the plan was reached and evaluated
@@ -358,14 +317,11 @@ StoredRun short_simulated_run() {
   setup.material.push_back(d::make_gauge(
       io, t::make_serial(io, {.device = shop.material_device()}), {.poll_period = 1s},
       {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
-  std::array<bool, 3> read{};
-  setup.on_reading = [&read](const d::Reading& r) {
-    if (r.device < read.size() && (r.device != 0 || r.quantity == d::Quantity::displacement_m))
-      read[r.device] = true;
-  };
+  daq::StartupReadings read(1);
+  setup.on_reading = [&read](const d::Reading& r) { read.add(r); };
   daq::LinearRun run(io, std::move(setup));
   run.start();
-  EXPECT_TRUE(shop.wait_until([&] { return read[0] && read[1] && read[2]; }));
+  EXPECT_TRUE(shop.wait_until([&] { return read.all(); }));
   shop.run_linear(run.plan(), c.linear->feed_mm_per_min, c.linear->dwell_s);
   shop.run_program([&] { return run.finished(); }, 30.0);
   EXPECT_TRUE(run.finished());

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "../support/temp_db.hpp"
 #include "cal/storage/store.hpp"
 #include "run_quality.hpp"
 #include "sim_volumetric.hpp"
@@ -22,14 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 namespace kin = cal::kinematics;
 
-fs::path temp_db(const char* name) {
-  return fs::temp_directory_path() /
-         (std::string("caldaq-quality-") + name + "-" + std::to_string(::getpid()) + "-" +
-          std::to_string(std::random_device{}()) + ".sqlite");
-}
-void remove_db(const fs::path& p) {
-  for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
-}
+fs::path temp_db(const char* name) { return cal::test::temp_path("caldaq-quality", name); }
+using cal::test::remove_db;
 
 using StopKey = std::tuple<int, char, int>;  // run, direction, target
 

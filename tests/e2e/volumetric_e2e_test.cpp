@@ -14,6 +14,7 @@
 #include <map>
 #include <random>
 
+#include "../support/temp_db.hpp"
 #include "cal/analysis/volumetric_comp.hpp"
 #include "cal/storage/store.hpp"
 #include "kinds/kind.hpp"
@@ -27,14 +28,8 @@ namespace fs = std::filesystem;
 namespace kin = cal::kinematics;
 namespace mdl = cal::daq::model;
 
-fs::path temp_db(const char* name) {
-  return fs::temp_directory_path() /
-         (std::string("caldaq-vol-") + name + "-" + std::to_string(::getpid()) + "-" +
-          std::to_string(std::random_device{}()) + ".sqlite");
-}
-void remove_db(const fs::path& p) {
-  for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
-}
+fs::path temp_db(const char* name) { return cal::test::temp_path("caldaq-vol", name); }
+using cal::test::remove_db;
 
 // The campaign's tests as acquired here: the machine stands 2.5 s at each stop instead of 4 s
 // (the trigger's 1.5 s dwell after the servo has settled, about 0.3 s at Kv 30 from a 3 mm
@@ -67,7 +62,8 @@ daq::SimulatedAcquisition acquisition(kin::Topology t, const fs::path& db) {
 // forgets bytes still in flight after VirtualTime::kSettle of wall time and jumps to the
 // probe's next deadline (seen once in a clean-clone scripts/test, ctest -j3 on 2 cores, when
 // kSettle was 200 ms: "answers came up to 3000 ms after their requests (median 0 ms)"; now
-// 2 s); the old rule took the value measured there. The refused run stays stored as aborted (the build takes the newer).
+// 2 s); the old rule took the value measured there. The refused run stays stored as aborted (the
+// build takes the newer).
 daq::LinearRunOutcome acquire_measuring_again(const daq::SimulatedAcquisition& a,
                                               const cal::daq::LinearTestConfig& test) {
   auto out = daq::acquire_simulated(a, test);

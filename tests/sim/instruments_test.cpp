@@ -132,6 +132,18 @@ TEST(Ids3010Instrument, StreamsTheRawDisplacementAndTheEcuAir) {
   EXPECT_EQ(ids->state(), d::InstrumentState::closed);
 }
 
+// What an IDS3010 on `twin` told until it failed with `reason` (a test failure if it did not).
+Recorder ids_until_failed(boost::asio::io_context& io, sim::IdsTwin& twin,
+                          const d::Ids3010Options& options, std::string_view reason) {
+  auto ids = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
+                             {.name = "laser", .poll_period = 2ms}, options);
+  Recorder rec;
+  ids->start(rec.events());
+  EXPECT_TRUE(run_until(io, [&] { return rec.failed_with(reason); })) << reason;
+  ids->stop();
+  return rec;
+}
+
 // The device's own number and text (errorNumberToString) reach the user: in the reason that
 // ends the connection, and as messages, warnings told apart from errors.
 TEST(Ids3010Instrument, RefusalsAndWarningsCarryTheDevicesNumberAndText) {
@@ -139,12 +151,8 @@ TEST(Ids3010Instrument, RefusalsAndWarningsCarryTheDevicesNumberAndText) {
   sim::World world = parked_at_100mm();
   {  // startMeasurement refused three times (its text known from the first refusal)
     sim::IdsTwin twin(io, world, [] { return 1.0; }, {.refuse_start = true});
-    auto ids = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
-                               {.name = "laser", .poll_period = 2ms}, {.read_environment = false});
-    Recorder rec;
-    ids->start(rec.events());
-    ASSERT_TRUE(run_until(io, [&] { return rec.failed_with("startMeasurement refused"); }));
-    ids->stop();
+    const Recorder rec =
+        ids_until_failed(io, twin, {.read_environment = false}, "startMeasurement refused");
     EXPECT_TRUE(
         rec.failed_with("startMeasurement refused 3 times (error 4: laser not ready "
                         "(simulated))"))
@@ -159,12 +167,7 @@ TEST(Ids3010Instrument, RefusalsAndWarningsCarryTheDevicesNumberAndText) {
   }
   {  // the ECU refuses at its first answer: the text is asked of the device before failing
     sim::IdsTwin twin(io, world, [] { return 1.0; }, {.refuse_ecu_enable = true});
-    auto ids = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = twin.port()}),
-                               {.name = "laser", .poll_period = 2ms});
-    Recorder rec;
-    ids->start(rec.events());
-    ASSERT_TRUE(run_until(io, [&] { return rec.failed_with("ECU interface not enabled"); }));
-    ids->stop();
+    const Recorder rec = ids_until_failed(io, twin, {}, "ECU interface not enabled");
     EXPECT_TRUE(
         rec.failed_with("ECU interface not enabled (com.attocube.ecu.enable) (error 5: "
                         "ECU interface refused (simulated))"))

@@ -218,13 +218,27 @@ TEST(Store, RefusesAFileThatIsNotADatabase) {
   }
 }
 
+// Runs `sql` on the file through SQLite itself, as an older version's code would have left it
+// (to take a database back to an older schema); SQLite's error, or "" when it ran.
+std::string exec_sql(const fs::path& file, const std::string& sql) {
+  sqlite3* db = nullptr;
+  std::string error;
+  if (sqlite3_open(file.c_str(), &db) != SQLITE_OK) {
+    error = "cannot open " + file.string();
+  } else {
+    char* message = nullptr;
+    if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &message) != SQLITE_OK)
+      error = message ? message : "failed";
+    sqlite3_free(message);
+  }
+  sqlite3_close(db);
+  return error;
+}
+
 TEST(Store, RefusesANewerSchema) {
   TempDir dir;
   const auto file = dir.path / "future.sqlite";
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-  sqlite3_exec(db, "PRAGMA user_version=99", nullptr, nullptr, nullptr);
-  sqlite3_close(db);
+  ASSERT_EQ(exec_sql(file, "PRAGMA user_version=99"), "");
   try {
     Store store(file);
     FAIL() << "opened";
@@ -250,6 +264,13 @@ namespace {
 std::int64_t a_run(Store& store) {
   return store.begin_run({.campaign = "c", .kind = "linear", .axis = "X"});
 }
+
+// A new database file with one run in it; the run's id.
+std::int64_t a_run_in(const fs::path& file) {
+  Store store(file);
+  return a_run(store);
+}
+
 }  // namespace
 
 TEST(Store, ANewResultSupersedesTheSameStandardOnlyAndKeepsTheOldOne) {
@@ -447,11 +468,18 @@ TEST(Store, OriginsAndCompensationsAndTheVersionBefore) {
   {
     Store store(file);
     run = a_run(store);
-    store.add_instrument({.run_id = run, .device = 7, .driver = "laser", .transport = "tcp x",
-                          .origin = "simulated", .origin_detail = "a twin"});
-    const auto id = store.add_compensation(
-        {.machine_id = 0, .source_run_id = run, .source = "run 1", .axis = "X",
-         .format = "siemens", .json = "{}"});
+    store.add_instrument({.run_id = run,
+                          .device = 7,
+                          .driver = "laser",
+                          .transport = "tcp x",
+                          .origin = "simulated",
+                          .origin_detail = "a twin"});
+    const auto id = store.add_compensation({.machine_id = 0,
+                                            .source_run_id = run,
+                                            .source = "run 1",
+                                            .axis = "X",
+                                            .format = "siemens",
+                                            .json = "{}"});
     const auto all = store.compensations(0, "X");
     ASSERT_EQ(all.size(), 1u);
     EXPECT_EQ(all[0].id, id);
@@ -462,13 +490,8 @@ TEST(Store, OriginsAndCompensationsAndTheVersionBefore) {
     EXPECT_EQ(inst.back().origin, "simulated");
     EXPECT_EQ(inst.back().origin_detail, "a twin");
   }
-  {
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-    const auto undo = std::string(kUndoSchema5) + "PRAGMA user_version = 4;";
-    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
-    sqlite3_close(db);
-  }
+  const auto undo = std::string(kUndoSchema5) + "PRAGMA user_version = 4;";
+  ASSERT_EQ(exec_sql(file, undo), "");
   {
     Store ro(file, {.read_only = true});
     EXPECT_EQ(ro.version(), 4);
@@ -486,21 +509,11 @@ TEST(Store, OriginsAndCompensationsAndTheVersionBefore) {
 TEST(Store, MigratesTheVersionBeforeBallbarCalibrations) {
   TempDir dir;
   const auto file = dir.path / "prev.sqlite";
-  std::int64_t run = 0;
-  {
-    Store store(file);
-    run = a_run(store);
-  }
-  {
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-    const auto undo =
-        std::string(kUndoSchema5) +
-        "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
-        "PRAGMA user_version = 3;";
-    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
-    sqlite3_close(db);
-  }
+  const std::int64_t run = a_run_in(file);
+  const auto undo = std::string(kUndoSchema5) +
+                    "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
+                    "PRAGMA user_version = 3;";
+  ASSERT_EQ(exec_sql(file, undo), "");
   Store store(file);
   EXPECT_EQ(store.version(), cal::storage::schema_version);
   EXPECT_TRUE(store.run(run).has_value());
@@ -519,16 +532,10 @@ TEST(Store, ReadOnlyThePreviousVersionHasNoBallbarCalibrations) {
   TempDir dir;
   const auto file = dir.path / "prev.sqlite";
   { Store store(file); }
-  {
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-    const auto undo =
-        std::string(kUndoSchema5) +
-        "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
-        "PRAGMA user_version = 3;";
-    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
-    sqlite3_close(db);
-  }
+  const auto undo = std::string(kUndoSchema5) +
+                    "DROP INDEX ballbar_calibrations_by_bar; DROP TABLE ballbar_calibrations; "
+                    "PRAGMA user_version = 3;";
+  ASSERT_EQ(exec_sql(file, undo), "");
   {
     Store ro(file, {.read_only = true});
     EXPECT_TRUE(ro.bar_calibrations().empty());
@@ -580,18 +587,9 @@ TEST(Store, StoresARunsStopQuality) {
 TEST(Store, ASchema4DatabaseReadsItsRunsAsNeverChecked) {
   TempDir dir;
   const auto file = dir.path / "v4.sqlite";
-  std::int64_t run = 0;
-  {
-    Store store(file);
-    run = a_run(store);
-  }
-  {
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-    const auto undo = std::string(kUndoQuality) + "PRAGMA user_version = 4;";
-    ASSERT_EQ(sqlite3_exec(db, undo.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
-    sqlite3_close(db);
-  }
+  const std::int64_t run = a_run_in(file);
+  const auto undo = std::string(kUndoQuality) + "PRAGMA user_version = 4;";
+  ASSERT_EQ(exec_sql(file, undo), "");
   {
     Store ro(file, {.read_only = true});
     EXPECT_EQ(ro.version(), 4);
@@ -643,15 +641,9 @@ TEST(Store, OperatorActionsAreKeptInOrderAndAnOlderFileHasNone) {
     EXPECT_DOUBLE_EQ(a[1].stop->nominal_mm, 150.0);
     EXPECT_EQ(a[1].detail, "+1.250 um");
   }
-  {
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
-    ASSERT_EQ(sqlite3_exec(
-                  db, CALDAQ_UNDO_SCHEMA7 "DROP TABLE operator_actions; PRAGMA user_version = 5;",
-                  nullptr, nullptr, nullptr),
-              SQLITE_OK);
-    sqlite3_close(db);
-  }
+  ASSERT_EQ(
+      exec_sql(file, CALDAQ_UNDO_SCHEMA7 "DROP TABLE operator_actions; PRAGMA user_version = 5;"),
+      "");
   {
     Store ro(file, {.read_only = true});
     EXPECT_EQ(ro.version(), 5);

@@ -108,12 +108,7 @@ try:
     serve.send_signal(signal.SIGCONT)
     b.wait("return /\\d/.test(document.getElementById('align-reading').textContent);", timeout_s=30,
            what="the reading back after SIGCONT")
-    b.set_size(560, 900)
-    time.sleep(0.5)
-    ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0,
-       "560 px: the Align view fits")
-    page_checks.shot(b, SHOTS, "c00b-align-560px.png")
-    b.set_size(1366, 768)
+    page_checks.fits_narrow(b, SHOTS, "c00b-align-560px.png", "560 px: the Align view fits")
 
     # --- words an operator uses: the instruments' fields labelled from their option tables ------
     b.js("document.getElementById('tab-setup').click();")
@@ -227,12 +222,7 @@ try:
     page_checks.shot(b, SHOTS, "c03b-deviation-plot-1366x768.png")
     b.js("window.scrollTo(0, 0);")
     page_checks.shot(b, SHOTS, "c03-skip-retry-1366x768.png")
-    b.set_size(560, 900)
-    time.sleep(0.5)
-    ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0,
-       "560 px: the controls fit")
-    page_checks.shot(b, SHOTS, "c04-controls-560px.png")
-    b.set_size(1366, 768)
+    page_checks.fits_narrow(b, SHOTS, "c04-controls-560px.png", "560 px: the controls fit")
 
     # --- 5. the run's record ---------------------------------------------------------------------
     status, body = post(url + "api/runs/stop", {})

@@ -126,12 +126,7 @@ try:
        f"then the next target: {captured['progress']!r} / {captured['line']!r}")
     shot(b, "s01-captured-1366x768.png")
     post(url + "api/simulation/speed", {"speed": 2})  # the run lasts past the hang, to be stopped
-    b.set_size(560, 900)
-    time.sleep(0.4)
-    ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0,
-       "560 px: nothing wider than the screen")
-    shot(b, "s02-run-560px.png")
-    b.set_size(1366, 768)
+    page_checks.fits_narrow(b, SHOTS, "s02-run-560px.png", "560 px: nothing wider than the screen")
     time.sleep(1.0)
     c1, bytes1 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];")
     t1 = time.time()

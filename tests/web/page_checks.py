@@ -37,6 +37,16 @@ def shot(b, directory, name):
     ok(len(png) > 10000, f"screenshot {name} ({w}x{h})")
 
 
+def fits_narrow(b, directory, name, what):
+    """At 560 px wide nothing is wider than the screen (the check WHAT), shown in the screenshot
+    NAME; the window is 1366 x 768 again after."""
+    b.set_size(560, 900)
+    time.sleep(0.5)
+    ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0, what)
+    shot(b, directory, name)
+    b.set_size(1366, 768)
+
+
 def post(url, body):
     req = urllib.request.Request(url, data=json.dumps(body).encode(), method="POST",
                                  headers={"Content-Type": "application/json"})

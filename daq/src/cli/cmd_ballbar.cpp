@@ -14,6 +14,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "json_input.hpp"
@@ -26,20 +27,6 @@ namespace {
 
 using nlohmann::json;
 namespace st = cal::storage;
-
-json to_json(const st::BarCalibration& c) {
-  return {{"id", c.id},
-          {"bar", c.bar},
-          {"nominal_mm", c.nominal_mm},
-          {"extensions", c.extensions},
-          {"calibrator", c.calibrator},
-          {"calibrator_length_mm", c.calibrator_length_mm},
-          {"reading_mm", c.reading_mm},
-          {"zero_length_mm", c.zero_length_mm},
-          {"temperature_degc", c.temperature_degc ? json(*c.temperature_degc) : json(nullptr)},
-          {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
-          {"note", c.note}};
-}
 
 struct CalibrateOptions {
   std::string db, bar, calibrator, extensions, note;
@@ -68,7 +55,7 @@ void calibrate(const CalibrateOptions& o) {
     if (x.id == c.id) c = x;
   if (o.json) {
     json j{{"schema", "caldaq.bar-calibration.v1"}};
-    j.update(to_json(c));
+    j.update(bar_calibration_json(c));
     return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
   print_line(
@@ -83,7 +70,7 @@ void list(const std::string& db, const std::string& bar, bool as_json) {
   const auto all = store.bar_calibrations(bar);
   if (as_json) {
     json j{{"schema", "caldaq.bar-calibrations.v1"}, {"calibrations", json::array()}};
-    for (const auto& c : all) j["calibrations"].push_back(to_json(c));
+    for (const auto& c : all) j["calibrations"].push_back(bar_calibration_json(c));
     return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   }
   if (all.empty())
@@ -173,11 +160,9 @@ void add_set_options(CLI::App& cmd, SetOptions& o) {
 }  // namespace
 
 void add_ballbar_commands(CLI::App& app) {
-  auto* bb = app.add_subcommand("ballbar", "Ballbar calibrations (docs/circle.md)");
-  bb->require_subcommand(1);
-  auto o = std::make_shared<CalibrateOptions>();
-  auto* cal = bb->add_subcommand(
-      "calibrate",
+  auto* bb = add_group(app, "ballbar", "Ballbar calibrations (docs/circle.md)");
+  const auto [cal, o] = add_command<CalibrateOptions>(
+      *bb, "calibrate", calibrate,
       "Store a calibration of the bar against a calibrator: the bar reads 0 at the calibrator's "
       "length minus the reading");
   add_db_option(*cal, o->db);
@@ -200,7 +185,6 @@ void add_ballbar_commands(CLI::App& app) {
   cal->add_option("--date", o->values.date, "When, YYYY-MM-DD[THH:MM[:SS]] UTC (default: now)");
   cal->add_option("--note", o->note, "Free text");
   cal->add_flag("--json", o->json, "Print caldaq.bar-calibration.v1");
-  cal->callback([o] { calibrate(*o); });
 
   auto l = std::make_shared<std::pair<std::string, std::string>>();
   auto as_json = std::make_shared<bool>(false);
@@ -210,23 +194,20 @@ void add_ballbar_commands(CLI::App& app) {
   ls->add_flag("--json", *as_json, "Print caldaq.bar-calibrations.v1");
   ls->callback([l, as_json] { list(l->first, l->second, *as_json); });
 
-  auto vo = std::make_shared<SetOptions>();
-  auto* vol = bb->add_subcommand(
-      "volumetric",
+  const auto [vol, vo] = add_command<SetOptions>(
+      *bb, "volumetric", volumetric,
       "The three-plane table: squareness XY, ZX, YZ as the model's E_C0Y, E_B0Z, E_A0Z and the "
       "axis scales, from a campaign's ballbar tests");
   add_set_options(*vol, *vo);
   vol->add_option("--model", vo->model_in, "A caldaq.model.v1 file to take the squareness");
   vol->add_option("--write-model", vo->model_out, "Where to write it with the table's squareness");
   vol->add_flag("--json", vo->json, "Print caldaq.ballbar-volumetric.v1");
-  vol->callback([vo] { volumetric(*vo); });
 
-  auto ho = std::make_shared<SetOptions>();
-  auto* his = bb->add_subcommand(
-      "history", "A machine's ballbar tests over time, per plane, feed and radius, with verdicts");
+  const auto [his, ho] = add_command<SetOptions>(
+      *bb, "history", history,
+      "A machine's ballbar tests over time, per plane, feed and radius, with verdicts");
   add_set_options(*his, *ho);
   his->add_flag("--json", ho->json, "Print caldaq.ballbar-history.v1");
-  his->callback([ho] { history(*ho); });
 }
 
 }  // namespace daq

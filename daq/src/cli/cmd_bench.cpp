@@ -55,6 +55,7 @@
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 
 namespace daq {
@@ -786,11 +787,9 @@ void bench_export(const ExportBenchOptions& o) {
 }  // namespace
 
 void add_bench_commands(CLI::App& app) {
-  auto* bench = app.add_subcommand("bench", "Measure this machine: ingest throughput and ceilings");
-  bench->require_subcommand(1);
-  auto o = std::make_shared<BenchOptions>();
-  auto* in = bench->add_subcommand(
-      "ingest",
+  auto* bench = add_group(app, "bench", "Measure this machine: ingest throughput and ceilings");
+  const auto [in, o] = add_command<BenchOptions>(
+      *bench, "ingest", bench_ingest,
       "Replay a generated 10 kHz capture through the real instruments, compensation and store; "
       "measure the SQLite blob-insert and raw-write ceilings for the same bytes in the same run");
   in->add_option("--seconds", o->seconds, "Recorded seconds of the 10 kHz stream")
@@ -806,11 +805,9 @@ void add_bench_commands(CLI::App& app) {
   in->add_option("--storage-cpu", o->storage_cpu,
                  "With --loop-cpu: ... and the batch encoder and SQLite writer threads on this one")
       ->check(whole_in(0, 1 << 20));
-  in->callback([o] { bench_ingest(*o); });
 
-  auto e = std::make_shared<ExportBenchOptions>();
-  auto* ex = bench->add_subcommand(
-      "export",
+  const auto [ex, e] = add_command<ExportBenchOptions>(
+      *bench, "export", bench_export,
       "Store generated runs of a 10 kHz stream (up to --minutes long) and measure the peak RSS "
       "and time of daq export (CSV, JSON) and daq report on each");
   ex->add_option("--minutes", e->minutes, "Length of the longest run")->capture_default_str();
@@ -819,7 +816,6 @@ void add_bench_commands(CLI::App& app) {
   ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
   ex->add_option("--keep-db", e->keep,
                  "Store the generated runs in this new file and keep it (to export or inspect)");
-  ex->callback([e] { bench_export(*e); });
 }
 
 }  // namespace daq

@@ -14,6 +14,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "compensate_run.hpp"
 #include "compensation/compensation_check.hpp"
@@ -352,9 +353,8 @@ nlohmann::json run_compensation(const cal::storage::Store& store, std::int64_t r
 }
 
 void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
-  auto o = std::make_shared<CompensateOptions>();
-  auto* cmd =
-      app.add_subcommand("compensate", "Compensation table for the controller from a measured run");
+  const auto [cmd, o] = add_command<CompensateOptions>(
+      app, "compensate", run, "Compensation table for the controller from a measured run");
   cmd->add_option("-i,--input", o->input, "ISO 230-2 measurement CSV (see docs/cli.md)");
   cmd->add_option("--run", o->run, "A stored linear run instead of --input");
   cmd->add_option("--accept-suspect", o->accept_suspect,
@@ -407,7 +407,6 @@ void add_compensate_commands(CLI::App& app, CLI::App& /*analyse*/) {
   add_decimal_comma_flag(*cmd, o->csv);
   cmd->add_flag("--json", o->json,
                 "Print caldaq.comp-table.v1 JSON (caldaq.cross-table.v1 with --straightness)");
-  cmd->callback([o] { run(*o); });
 }
 
 }  // namespace daq

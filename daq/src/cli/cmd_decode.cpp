@@ -12,6 +12,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/text.hpp"
 #include "cal/drivers/registry.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 
 namespace daq {
@@ -184,9 +185,8 @@ void run_decode(const DecodeOptions& o) {
 }  // namespace
 
 void add_decode_command(CLI::App& app) {
-  auto o = std::make_shared<DecodeOptions>();
-  auto* cmd = app.add_subcommand(
-      "decode",
+  const auto [cmd, o] = add_command<DecodeOptions>(
+      app, "decode", run_decode,
       "Run a dump of a device's bytes through its driver's codec and print every reading and "
       "every codec error (docs/cli.md)");
   cmd->add_option("DRIVER", o->driver,
@@ -197,7 +197,6 @@ void add_decode_command(CLI::App& app) {
                   "KEY=VALUE: an option of the driver, as in its [devices.ID] table "
                   "(daq devices --options)");
   cmd->add_flag("--json", o->json, "One caldaq.decode.v1 JSON object per line");
-  cmd->callback([o] { run_decode(*o); });
 }
 
 }  // namespace daq

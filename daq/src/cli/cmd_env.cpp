@@ -9,6 +9,7 @@
 #include "cal/analysis/air.hpp"
 #include "cal/analysis/compensation.hpp"
 #include "cal/analysis/error.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 
 namespace daq {
@@ -122,9 +123,8 @@ void run_env(const EnvOptions& o) {
 }  // namespace
 
 void add_env_command(CLI::App& app) {
-  auto o = std::make_shared<EnvOptions>();
-  auto* cmd =
-      app.add_subcommand("env", "Refractive index of air and the length compensation factor (ppm)");
+  const auto [cmd, o] = add_command<EnvOptions>(
+      app, "env", run_env, "Refractive index of air and the length compensation factor (ppm)");
   cmd->add_option("-t,--temperature", o->temperature_degc, "Air temperature, degC")
       ->capture_default_str();
   auto* hpa =
@@ -150,7 +150,6 @@ void add_env_command(CLI::App& app) {
                   "Expansion coefficient of the machine/scale, ppm/K (e.g. 11.5 for steel)")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print JSON (schema caldaq.env.v1)");
-  cmd->callback([o] { run_env(*o); });
 }
 
 }  // namespace daq

@@ -13,6 +13,7 @@
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "csv_columns.hpp"
 #include "report/report.hpp"
@@ -150,19 +151,18 @@ void run_squareness(const SquarenessOptions& o) {
 }  // namespace
 
 void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
-  auto s = std::make_shared<StraightnessOptions>();
-  auto* st =
-      analyse.add_subcommand("straightness", "Straightness of an axis (ISO 230-1 reference lines)");
+  const auto [st, s] =
+      add_command<StraightnessOptions>(analyse, "straightness", run_straightness,
+                                       "Straightness of an axis (ISO 230-1 reference lines)");
   st->add_option("-i,--input", s->input, "CSV: position_mm, deviation_um")->required();
   st->add_option("-r,--reference", s->reference, "lsq, endpoint or minzone")->capture_default_str();
   st->add_option("--report", s->report,
                  "Also write an HTML report with the deviations and all three reference lines");
   add_decimal_comma_flag(*st, s->csv);
   st->add_flag("--json", s->json, "Print caldaq.straightness.v1 JSON");
-  st->callback([s] { run_straightness(*s); });
 
-  auto q = std::make_shared<SquarenessOptions>();
-  auto* sq = analyse.add_subcommand("squareness", "Squareness of two axes (ISO 230-1, ISO 230-6)");
+  const auto [sq, q] = add_command<SquarenessOptions>(
+      analyse, "squareness", run_squareness, "Squareness of two axes (ISO 230-1, ISO 230-6)");
   sq->add_option("-m,--method", q->method, "straightness, diagonal or circle")->required();
   sq->add_option("--along-a", q->along_a,
                  "straightness: run moving the reference axis (deviation in +B)");
@@ -182,7 +182,6 @@ void add_geometry_commands(CLI::App& /*app*/, CLI::App& analyse) {
                  "E_B0Z has the opposite sign)");
   add_decimal_comma_flag(*sq, q->csv);
   sq->add_flag("--json", q->json, "Print caldaq.squareness.v1 JSON");
-  sq->callback([q] { run_squareness(*q); });
 }
 
 }  // namespace daq

@@ -11,6 +11,7 @@
 #include "cal/drivers/instrument.hpp"
 #include "cal/replay/rtx.hpp"
 #include "cal/storage/store.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "json_input.hpp"
@@ -198,8 +199,7 @@ void import_rtx(const ImportOptions& o) {
 
 void add_import_commands(CLI::App& app) {
   auto o = std::make_shared<ImportOptions>();
-  auto* imp = app.add_subcommand("import", "Import a measurement made with other software");
-  imp->require_subcommand(1);
+  auto* imp = add_group(app, "import", "Import a measurement made with other software");
   auto* rtx = imp->add_subcommand("rtx", "Renishaw dynamic capture (.rtx) as a stored run");
   rtx->add_option("FILE", o->file, "The .rtx file")->required();
   add_db_option(*rtx, o->db);

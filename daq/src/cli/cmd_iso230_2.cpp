@@ -9,6 +9,7 @@
 #include "cal/analysis/iso230_2_targets.hpp"
 #include "cal/analysis/uncertainty.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "iso230_2_output.hpp"
 #include "measurement_csv.hpp"
@@ -111,21 +112,20 @@ void run_uncertainty(UncOptions o) {
 }
 
 void add_analyse(CLI::App& analyse) {
-  auto o = std::make_shared<AnalyseOptions>();
-  auto* cmd = analyse.add_subcommand(
-      "iso230-2", "Positioning test: ISO 230-2 (all editions), VDI/DGQ 3441, JIS, GB/T");
+  const auto [cmd, o] = add_command<AnalyseOptions>(
+      analyse, "iso230-2", run_analyse,
+      "Positioning test: ISO 230-2 (all editions), VDI/DGQ 3441, JIS, GB/T");
   cmd->add_option("-i,--input", o->input,
                   "CSV with columns target_mm,run,direction,deviation_um (docs/cli.md)")
       ->required();
   cmd->add_option("-s,--standard", o->standard, standards_help())->capture_default_str();
   add_decimal_comma_flag(*cmd, o->csv);
   cmd->add_flag("--json", o->json, "Print JSON (schema caldaq.iso230-2.v1)");
-  cmd->callback([o] { run_analyse(*o); });
 }
 
 void add_targets(CLI::App& app) {
-  auto o = std::make_shared<PlanOptions>();
-  auto* cmd = app.add_subcommand("targets", "ISO 230-2 targets and the ordered test moves");
+  const auto [cmd, o] = add_command<PlanOptions>(app, "targets", run_plan,
+                                                 "ISO 230-2 targets and the ordered test moves");
   cmd->add_option("--first", o->targets.first_mm, "First target, mm")->required();
   cmd->add_option("--last", o->targets.last_mm, "Last target, mm")->required();
   auto* iv = cmd->add_option("--interval", o->interval_mm, "Nominal target interval, mm");
@@ -143,14 +143,13 @@ void add_targets(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--unidirectional", o->unidirectional, "Approach every target from below only");
   cmd->add_flag("--json", o->json, "Print JSON (schema caldaq.plan.v1)");
-  cmd->callback([o] { run_plan(*o); });
 }
 
 void add_uncertainty(CLI::App& app) {
-  auto o = std::make_shared<UncOptions>();
+  const auto [cmd, o] =
+      add_command<UncOptions>(app, "uncertainty", run_uncertainty,
+                              "Uncertainty budget of a laser positioning test (U, k = 2)");
   auto& s = o->s;
-  auto* cmd = app.add_subcommand("uncertainty",
-                                 "Uncertainty budget of a laser positioning test (U, k = 2)");
   cmd->add_option("-L,--length-m", s.length_m, "Measured travel, m")->capture_default_str();
   cmd->add_option("--laser-ppm", s.laser_cert_expanded_ppm, "Laser certificate U, ppm")
       ->capture_default_str();
@@ -189,7 +188,6 @@ void add_uncertainty(CLI::App& app) {
                   "|Δn| during the test (for an uncorrected dead path)")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print JSON (schema caldaq.uncertainty.v1)");
-  cmd->callback([o] { run_uncertainty(*o); });
 }
 
 }  // namespace

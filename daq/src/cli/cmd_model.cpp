@@ -9,6 +9,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
@@ -373,22 +374,20 @@ void run_map(const MapOptions& o) {
 }  // namespace
 
 void add_model_commands(CLI::App& app) {
-  auto* model = app.add_subcommand(
-      "model",
-      "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
-      "compensation, predict a test piece");
-  model->require_subcommand(1);
+  auto* model =
+      add_group(app, "model",
+                "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
+                "compensation, predict a test piece");
 
-  auto s = std::make_shared<ShowOptions>();
-  auto* show = model->add_subcommand("show", "Print a model file: chain, offsets, the 21 errors");
+  const auto [show, s] = add_command<ShowOptions>(
+      *model, "show", run_show, "Print a model file: chain, offsets, the 21 errors");
   show->add_option("file", s->file, "Model file (caldaq.model.v1 JSON, docs/model-file.md)")
       ->required();
   show->add_flag("--json", s->json, "Print the model as normalised caldaq.model.v1 JSON");
-  show->callback([s] { run_show(*s); });
 
-  auto o = std::make_shared<MapOptions>();
-  auto* map = model->add_subcommand(
-      "map", "Volumetric error over a grid (default: the model's travel, 5 x 5 x 5) or at points");
+  const auto [map, o] = add_command<MapOptions>(
+      *model, "map", run_map,
+      "Volumetric error over a grid (default: the model's travel, 5 x 5 x 5) or at points");
   map->add_option("file", o->file, "Model file")->required();
   map->add_option("--min-mm", o->min_mm, "Grid corner X Y Z (with --max-mm)")
       ->expected(3)
@@ -402,7 +401,6 @@ void add_model_commands(CLI::App& app) {
   map->add_option("--report", o->report,
                   "Also write an HTML page: error vectors in three slices, contributions ranked");
   map->add_flag("--json", o->json, "Print caldaq.volumetric-map.v1 JSON");
-  map->callback([o] { run_map(*o); });
 
   add_model_build_command(*model);
   add_model_compare_command(*model);

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "cal/analysis/error.hpp"
+#include "command.hpp"
 #include "database.hpp"
 #include "model/model_build.hpp"
 #include "model/model_file.hpp"
@@ -145,9 +146,8 @@ void run_build(const BuildCliOptions& o) {
 }  // namespace
 
 void add_model_build_command(CLI::App& model) {
-  auto o = std::make_shared<BuildCliOptions>();
-  auto* cmd = model.add_subcommand(
-      "build",
+  const auto [cmd, o] = add_command<BuildCliOptions>(
+      model, "build", run_build,
       "Assemble the model from a machine's stored runs (the latest complete run of each of the "
       "21 errors); missing errors are refused unless --allow-missing");
   cmd->add_option("--machine", o->machine, "The machine's name ([machine] name)")->required();
@@ -164,7 +164,6 @@ void add_model_build_command(CLI::App& model) {
       ->take_all();
   cmd->add_flag("--json", o->json, "Print caldaq.model-build.v1 JSON (runs used, missing)");
   add_db_option(*cmd, o->db);
-  cmd->callback([o] { run_build(*o); });
 }
 
 }  // namespace daq

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "command.hpp"
 #include "model/model_compare.hpp"
 #include "model_cli.hpp"
 #include "terminal.hpp"
@@ -103,9 +104,8 @@ void run_compare(const CompareOptions& o) {
 }  // namespace
 
 void add_model_compare_command(CLI::App& model) {
-  auto o = std::make_shared<CompareOptions>();
-  auto* cmd = model.add_subcommand(
-      "compare",
+  const auto [cmd, o] = add_command<CompareOptions>(
+      model, "compare", run_compare,
       "How far each error of a model is from a reference model's (e.g. a built model against "
       "the SIMULATED shop's injected truth, `daq sim --truth-out`), and the volumetric "
       "difference");
@@ -115,7 +115,6 @@ void add_model_compare_command(CLI::App& model) {
       ->expected(3)
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print caldaq.model-compare.v1 JSON");
-  cmd->callback([o] { run_compare(*o); });
 }
 
 }  // namespace daq

@@ -12,6 +12,7 @@
 #include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/volumetric_comp.hpp"
+#include "command.hpp"
 #include "model_cli.hpp"
 #include "provenance.hpp"
 
@@ -432,9 +433,8 @@ void run(const Options& o) {
 }  // namespace
 
 void add_model_compensate_command(CLI::App& model) {
-  auto o = std::make_shared<Options>();
-  auto* cmd = model.add_subcommand(
-      "compensate",
+  const auto [cmd, o] = add_command<Options>(
+      model, "compensate", run,
       "The model's compensation in a controller format, with what remains when applied");
   cmd->add_option("file", o->file, "Model file (caldaq.model.v1)")->required();
   cmd->add_option("-f,--format", o->format,
@@ -468,7 +468,6 @@ void add_model_compensate_command(CLI::App& model) {
                   "Also write the volumetric error page with what remains after compensation");
   cmd->add_flag("--json", o->json,
                 "Print caldaq.model-compensation.v1 JSON (files via -o/--output-dir)");
-  cmd->callback([o] { run(*o); });
 }
 
 }  // namespace daq

@@ -10,6 +10,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/testpiece.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
 
@@ -95,7 +96,8 @@ void run(const Options& o) {
   cut.tool_radius_mm = o.tool_radius_mm;
   const auto profiles = tp::predict_profiles(model.machine, o.layout, cut);
   for (const auto& p : profiles)  // before the fits, which refuse them without naming the model
-    require_finite(p.deviation_um, fmt::format("{}: the predicted profile of {}", o.file, p.feature));
+    require_finite(p.deviation_um,
+                   fmt::format("{}: the predicted profile of {}", o.file, p.feature));
   const tp::Result predicted = tp::evaluate(o.layout, profiles);
   std::optional<tp::Result> measured;
   if (!o.cmm.empty()) {
@@ -152,9 +154,8 @@ void run(const Options& o) {
 }  // namespace
 
 void add_model_testpiece_command(CLI::App& model) {
-  auto o = std::make_shared<Options>();
-  auto* cmd = model.add_subcommand(
-      "testpiece",
+  const auto [cmd, o] = add_command<Options>(
+      model, "testpiece", run,
       "Predict the test piece (faces' straightness, squareness, parallelism; bores' circularity "
       "and position) and compare CMM points");
   cmd->add_option("file", o->file, "Model file (caldaq.model.v1)")->required();
@@ -182,7 +183,6 @@ void add_model_testpiece_command(CLI::App& model) {
       ->capture_default_str();
   cmd->add_option("--cmm", o->cmm, "CMM points, CSV feature,x_mm,y_mm in the part's frame");
   cmd->add_flag("--json", o->json, "Print caldaq.testpiece.v1 JSON");
-  cmd->callback([o] { run(*o); });
 }
 
 }  // namespace daq

@@ -13,6 +13,7 @@
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
@@ -90,10 +91,12 @@ struct ReplaySession {
     return make_instrument(io, spec, bus.transport(spec.device, spec.transport),
                            {.name = spec.role, .clock = bus.clock(), .replay = true});
   }
-  // Runs the bus until the run finishes or the capture ends (an incomplete run is stopped
-  // with the reason), then reads the rest of the capture: how it ends, damaged or not.
+  // Starts the run and runs the bus until the run finishes or the capture ends (an incomplete
+  // run is stopped with the reason), then reads the rest of the capture: how it ends, damaged
+  // or not. A run left incomplete is an error naming the capture, the stored run and why.
   template <class Run>
-  cal::replay::ReplayEnd play(Run& run, const char* incomplete) {
+  cal::replay::ReplayEnd play(Run& run, const std::string& capture, const char* incomplete) {
+    run.start();
     std::optional<cal::replay::ReplayEnd> end;
     bus.start([&](const cal::replay::ReplayEnd& e) { end = e; });
     while (!run.finished() && !end) io.run_for(50ms);
@@ -104,7 +107,12 @@ struct ReplaySession {
       if (end && end->damage) why = "the capture is " + damage_text(*end->damage);
       run.stop(why);
     }
-    return end ? *end : bus.read_to_end();
+    if (!end) end = bus.read_to_end();
+    const auto& out = run.outcome();
+    if (!out.complete)
+      throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", capture,
+                                        out.run_id, out.reason));
+    return *end;
   }
   static std::string damage_text(const cal::replay::Damage& d) {
     return fmt::format("damaged at byte {} (block {}): {}", d.offset, d.block, d.what);
@@ -171,12 +179,8 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
                                                                          .string())}},
                        .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   CircleRun run(s.io, std::move(setup));
-  run.start();
-  const auto end = s.play(run, "the capture ended before both arcs were recorded");
+  const auto end = s.play(run, o.capture, "the capture ended before both arcs were recorded");
   const auto& out = run.outcome();
-  if (!out.complete)
-    throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
-                                      out.run_id, out.reason));
   std::vector<const CircleRunOutcome*> outs;
   for (const auto& c : run.completed()) outs.push_back(&c);
   outs.push_back(&out);
@@ -216,12 +220,8 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
     throw cal::InputError(
         fmt::format("{}: the session has no laser or no air instrument", o.capture));
   LinearRun run(s.io, std::move(setup));
-  run.start();
-  const auto end = s.play(run, "the capture ended before every stop was captured");
+  const auto end = s.play(run, o.capture, "the capture ended before every stop was captured");
   const auto& out = run.outcome();
-  if (!out.complete)
-    throw cal::InputError(fmt::format("{}: replay stored as run {} but incomplete: {}", o.capture,
-                                      out.run_id, out.reason));
   if (o.json) {
     json j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
@@ -253,9 +253,8 @@ void run_replay(const ReplayOptions& o) {
 }  // namespace
 
 void add_replay_command(CLI::App& app) {
-  auto o = std::make_shared<ReplayOptions>();
-  auto* cmd = app.add_subcommand(
-      "replay",
+  const auto [cmd, o] = add_command<ReplayOptions>(
+      app, "replay", run_replay,
       "Replay a wire-level capture through the same instruments and pipeline into a new run");
   cmd->add_option("CAPTURE", o->capture, "Capture file (.cdq)")->required();
   add_db_option(*cmd, o->db);
@@ -264,7 +263,6 @@ void add_replay_command(CLI::App& app) {
       ->check(finite_non_negative());
   cmd->add_flag("--json", o->json,
                 "Print the result as JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
-  cmd->callback([o] { run_replay(*o); });
 }
 
 }  // namespace daq

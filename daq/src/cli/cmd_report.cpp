@@ -21,6 +21,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/storage/store.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "progress.hpp"
@@ -324,9 +325,8 @@ void run_report_command(ReportOptions o) {
 }  // namespace
 
 void add_report_command(CLI::App& app) {
-  auto o = std::make_shared<ReportOptions>();
-  auto* cmd = app.add_subcommand(
-      "report",
+  const auto [cmd, o] = add_command<ReportOptions>(
+      app, "report", run_report_command,
       "Write a self-contained report (HTML, or PDF through headless Chromium) of one stored run, "
       "of several runs or a campaign, or a comparison of the same test over time");
   cmd->add_option("RUN", o->runs, "Stored run numbers (see daq runs)");
@@ -344,7 +344,6 @@ void add_report_command(CLI::App& app) {
   cmd->add_option("-s,--standard", o->standard,
                   "Linear runs: evaluate by this standard (default: the run's)");
   cmd->add_flag("--json", o->json, "Print what was written as JSON (caldaq.report.v1)");
-  cmd->callback([o] { run_report_command(*o); });
 }
 
 }  // namespace daq

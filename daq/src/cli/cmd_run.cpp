@@ -21,6 +21,7 @@
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "progress.hpp"
@@ -354,8 +355,7 @@ void gcode(const GcodeOptions& o, bool circle) {
 
 void add_run_commands(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
-  auto* run = app.add_subcommand("run", "Acquire a test with the configured instruments");
-  run->require_subcommand(1);
+  auto* run = add_group(app, "run", "Acquire a test with the configured instruments");
   auto* lin = run->add_subcommand(
       "linear",
       "Linear test: ISO 230-2 positioning (laser, air, material), or by [test.linear] measure a "
@@ -393,8 +393,7 @@ void add_run_commands(CLI::App& app) {
   circ->callback([o] { run_circle(*o); });
 
   auto g = std::make_shared<GcodeOptions>();
-  auto* gc = app.add_subcommand("gcode", "Part program for a configured test");
-  gc->require_subcommand(1);
+  auto* gc = add_group(app, "gcode", "Part program for a configured test");
   for (const char* kind : {"linear", "circle"}) {
     auto* sub = gc->add_subcommand(kind, std::string("Program for [test.") + kind + "]");
     sub->add_option("-c,--config", g->config, "Machine/campaign TOML")->required();

@@ -23,6 +23,7 @@
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
 #include "circle_run.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
@@ -565,8 +566,8 @@ void add_runs_commands(CLI::App& app) {
   show->add_flag("--json", *show_json, "Print caldaq.run.v1 JSON");
   show->callback([=] { cmd_show(*show_db, *show_id, *show_json); });
 
-  auto ex = std::make_shared<ExportOptions>();
-  CLI::App* exp = app.add_subcommand("export", "Export a stored run as CSV or JSON");
+  const auto [exp, ex] =
+      add_command<ExportOptions>(app, "export", cmd_export, "Export a stored run as CSV or JSON");
   exp->add_option("RUN", ex->run, "Run number (see daq runs)")->required();
   add_db_option(*exp, ex->db);
   exp->add_option("--format", ex->format, "csv or json")->check(CLI::IsMember({"csv", "json"}));
@@ -576,7 +577,6 @@ void add_runs_commands(CLI::App& app) {
                   "circle reads them)")
       ->check(CLI::IsMember({"readings", "targets", "circle"}));
   exp->add_option("-o,--output", ex->output, "Write to this file instead of stdout");
-  exp->callback([ex] { cmd_export(*ex); });
 }
 
 }  // namespace daq

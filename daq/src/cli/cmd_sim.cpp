@@ -19,6 +19,7 @@
 #include "cal/storage/store.hpp"
 #include "circle_run.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "linear_run.hpp"
@@ -279,9 +280,9 @@ void run_sim(SimOptions o) {
 }  // namespace
 
 void add_sim_command(CLI::App& app) {
-  auto o = std::make_shared<SimOptions>();
-  auto* cmd = app.add_subcommand(
-      "sim", "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
+  const auto [cmd, o] = add_command<SimOptions>(
+      app, "sim", run_sim,
+      "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
   cmd->add_option("--test", o->test,
                   "linear, circle or circle-set (the ballbar set on a machine with errors in all "
                   "three planes): the program run after --start-after-s (waiting for runs, the "
@@ -335,7 +336,6 @@ void add_sim_command(CLI::App& app) {
   cmd->add_flag(
       "--json", o->json,
       "--acquire: the result as JSON on stdout, as `daq run --json` (progress on stderr)");
-  cmd->callback([o] { run_sim(*o); });
 }
 
 }  // namespace daq

@@ -12,6 +12,7 @@
 #include "circle_output.hpp"
 #include "circle_run.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "iso230_2_output.hpp"
@@ -331,9 +332,8 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
     analyse_run(*a);
   });
 
-  auto r = std::make_shared<RecompensateOptions>();
-  auto* cmd = app.add_subcommand(
-      "recompensate",
+  const auto [cmd, r] = add_command<RecompensateOptions>(
+      app, "recompensate", recompensate,
       "Recompute a stored linear run's compensation from its raw readings with corrected "
       "coefficients or sensor offsets, re-evaluate it and store the result");
   cmd->add_option("RUN", r->run, "Run number")->required();
@@ -351,7 +351,6 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   cmd->add_option("--equation", r->equation, "ciddor, edlen or shop-floor (default: as current)")
       ->check(CLI::IsMember({"ciddor", "edlen", "shop-floor"}));
   cmd->add_flag("--json", r->json, "Print the result JSON");
-  cmd->callback([r] { recompensate(*r); });
 }
 
 }  // namespace daq

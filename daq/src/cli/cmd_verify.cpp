@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "cal/analysis/error.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
@@ -26,8 +27,8 @@ void list_compensations(const cal::storage::Store& store) {
   if (all.empty())
     fmt::print("no compensation tables stored (daq compensate --run RUN stores one)\n");
   for (const auto& c : all)
-    print_line("compensation {}: axis {}, {} from {}, machine {}", c.id, c.axis, c.format,
-               c.source, c.machine_id);
+    print_line("compensation {}: axis {}, {} from {}, machine {}", c.id, c.axis, c.format, c.source,
+               c.machine_id);
 }
 
 void run(const VerifyOptions& o) {
@@ -65,9 +66,8 @@ void run(const VerifyOptions& o) {
 }  // namespace
 
 void add_verify_command(CLI::App& app) {
-  auto o = std::make_shared<VerifyOptions>();
-  auto* cmd = app.add_subcommand(
-      "verify",
+  const auto [cmd, o] = add_command<VerifyOptions>(
+      app, "verify", run,
       "Compare an as-left run with the compensation table written before it: as predicted, or "
       "an inverted sign, a unit or a reference-point error (docs/compensation-tables.md)");
   cmd->add_option("run", o->run, "The as-left run (measured with the table loaded)");
@@ -79,7 +79,6 @@ void add_verify_command(CLI::App& app) {
                   "Write the table corrected for what was found (sign, units, reference point)");
   cmd->add_flag("--list", o->list, "List the stored compensation tables");
   cmd->add_flag("--json", o->json, "Print caldaq.verification.v1 JSON");
-  cmd->callback([o] { run(*o); });
 }
 
 }  // namespace daq

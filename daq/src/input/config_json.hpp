@@ -30,6 +30,14 @@ inline nlohmann::json option_json(const cal::drivers::OptionValue& v) {
       v);
 }
 
+// A tolerance's limits as JSON: the limits given, by their keys (positioning_limit_keys).
+inline nlohmann::json limits_json(const cal::daq::PositioningLimits& l) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& k : cal::daq::positioning_limit_keys)
+    if (const auto& v = l.*k.member) j[k.key] = *v;
+  return j;
+}
+
 enum class FieldKeys {
   header,  // the capture header's keys (a field's header_key where it has one)
   file     // the configuration file's keys

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <utility>
+
 #include "result_rows.hpp"
 
 namespace daq {
@@ -65,31 +67,37 @@ json circle_json(const ci::Result& r, double radius_mm, std::string_view plane,
 }
 
 std::string diagnostic_advice(std::string_view key) {
-  // The axis is the key's last letter where the term belongs to one axis.
+  // A term of one axis: its key ends in the axis' letter ("backlash_X"); the advice names it.
+  struct AxisAdvice {
+    std::string_view prefix, before, after;
+  };
+  static constexpr AxisAdvice kAxisTerms[] = {
+      {"backlash_", "check the ", " axis' backlash compensation and its drive (ball screw, nut)"},
+      {"lateral_play_", "check the ",
+       " axis' guideway gibs and preload: it shifts sideways at reversal"},
+      {"reversal_spike_", "tune the ",
+       " axis' reversal (friction) compensation and its servo gains"},
+      {"cyclic_", "check the ", " axis' ball screw and encoder for a periodic (pitch) error"},
+      {"straightness_", "check the straightness of the ", " axis' guideways (level, wear)"},
+      {"stick_slip_", "check the ", " axis' lubrication and friction compensation"},
+  };
+  // The plane's terms.
+  static constexpr std::pair<std::string_view, std::string_view> kPlaneTerms[] = {
+      {"squareness",
+       "check the squareness of the plane's axes (alignment, or the control's squareness "
+       "compensation)"},
+      {"scale_mismatch",
+       "check the axes' pitch (scale) compensation and thermal growth of the screws"},
+      {"servo_mismatch", "match the two axes' servo gains (position loop, feed-forward)"},
+      {"radius_error", "check the bar's calibration and the axes' scale"},
+      {"vibration", "look for the source of the vibration (spindle, fan, floor)"},
+  };
   const std::string axis =
       key.size() > 2 && key[key.size() - 2] == '_' ? std::string(1, key.back()) : std::string();
-  const auto starts = [&](std::string_view p) { return key.substr(0, p.size()) == p; };
-  if (starts("backlash_"))
-    return "check the " + axis + " axis' backlash compensation and its drive (ball screw, nut)";
-  if (starts("lateral_play_"))
-    return "check the " + axis + " axis' guideway gibs and preload: it shifts sideways at reversal";
-  if (starts("reversal_spike_"))
-    return "tune the " + axis + " axis' reversal (friction) compensation and its servo gains";
-  if (starts("cyclic_"))
-    return "check the " + axis + " axis' ball screw and encoder for a periodic (pitch) error";
-  if (starts("straightness_"))
-    return "check the straightness of the " + axis + " axis' guideways (level, wear)";
-  if (starts("stick_slip_"))
-    return "check the " + axis + " axis' lubrication and friction compensation";
-  if (key == "squareness")
-    return "check the squareness of the plane's axes (alignment, or the control's squareness "
-           "compensation)";
-  if (key == "scale_mismatch")
-    return "check the axes' pitch (scale) compensation and thermal growth of the screws";
-  if (key == "servo_mismatch")
-    return "match the two axes' servo gains (position loop, feed-forward)";
-  if (key == "radius_error") return "check the bar's calibration and the axes' scale";
-  if (key == "vibration") return "look for the source of the vibration (spindle, fan, floor)";
+  for (const auto& t : kAxisTerms)
+    if (key.starts_with(t.prefix)) return std::string(t.before) + axis + std::string(t.after);
+  for (const auto& [term, advice] : kPlaneTerms)
+    if (key == term) return std::string(advice);
   return "";  // not a diagnostic (a value of the standard, e.g. G)
 }
 

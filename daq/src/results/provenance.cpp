@@ -7,24 +7,12 @@
 #include <chrono>
 #include <ctime>
 
+#include "config_json.hpp"
 #include "json_input.hpp"
 
 namespace daq {
 
 using nlohmann::json;
-
-namespace {
-
-json limits_json(const cal::daq::PositioningLimits& l) {
-  json j = json::object();
-  const auto put = [&](const char* key, const std::optional<double>& v) {
-    if (v) j[key] = *v;
-  };
-  for (const auto& k : cal::daq::positioning_limit_keys) put(k.key, l.*k.member);
-  return j;
-}
-
-}  // namespace
 
 json run_context(const cal::daq::Config& c, std::string_view kind, std::string_view where) {
   json j{{"customer",
@@ -170,6 +158,20 @@ std::string utc_iso(std::int64_t unix_ms) {
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
   return fmt::format("{}.{:03d}Z", buf,
                      static_cast<int>(unix_ms - static_cast<std::int64_t>(s) * 1000));
+}
+
+json bar_calibration_json(const cal::storage::BarCalibration& c) {
+  return {{"id", c.id},
+          {"bar", c.bar},
+          {"nominal_mm", c.nominal_mm},
+          {"extensions", c.extensions},
+          {"calibrator", c.calibrator},
+          {"calibrator_length_mm", c.calibrator_length_mm},
+          {"reading_mm", c.reading_mm},
+          {"zero_length_mm", c.zero_length_mm},
+          {"temperature_degc", c.temperature_degc ? json(*c.temperature_degc) : json(nullptr)},
+          {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
+          {"note", c.note}};
 }
 
 std::string utc_now_iso() {

@@ -40,6 +40,10 @@ nlohmann::json provenance(std::string_view how, std::string_view software);
 std::string utc_iso(std::int64_t unix_ms);
 std::string utc_now_iso();
 
+// A ballbar's calibration as every output shows it (`daq ballbar calibrations`, a circle
+// result's calibration record); temperature_degc null where none was given.
+nlohmann::json bar_calibration_json(const cal::storage::BarCalibration& c);
+
 // The newest current result of a run whose document has this schema, any version
 // ("caldaq.iso230-2.v1", "caldaq.circle.v2" also finds a caldaq.circle.v1 result), or nullopt.
 std::optional<cal::storage::ResultRecord> current_result(

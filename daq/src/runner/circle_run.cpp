@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cal/analysis/error.hpp"
 #include "cal/daq/gcode.hpp"
@@ -60,19 +61,10 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
 
 namespace {
 
+// The stored record also keeps the exact time, which calibration_from_json reads back.
 json calibration_json(const cal::storage::BarCalibration& c) {
-  json j{{"id", c.id},
-         {"bar", c.bar},
-         {"nominal_mm", c.nominal_mm},
-         {"extensions", c.extensions},
-         {"calibrator", c.calibrator},
-         {"calibrator_length_mm", c.calibrator_length_mm},
-         {"reading_mm", c.reading_mm},
-         {"zero_length_mm", c.zero_length_mm},
-         {"calibrated_unix_ms", c.calibrated_unix_ms},
-         {"calibrated_utc", utc_iso(c.calibrated_unix_ms)},
-         {"note", c.note}};
-  j["temperature_degc"] = c.temperature_degc ? json(*c.temperature_degc) : json(nullptr);
+  json j = bar_calibration_json(c);
+  j["calibrated_unix_ms"] = c.calibrated_unix_ms;
   return j;
 }
 
@@ -152,18 +144,27 @@ std::string standard_label(const BallbarAnalysis& analysis) {
   return cal::circle::info(cal::circle::circular_standard_from_key(analysis.standard)).label;
 }
 
+// The program's numbers in a circle run's settings, written and read by the one list: the key,
+// the member, and the value of a run stored before the key was (none: always stored).
+struct ProgramKey {
+  const char* key;
+  double cal::daq::BallbarProgram::*member;
+  std::optional<double> before;
+};
+constexpr ProgramKey kProgramKeys[] = {
+    {"radius_mm", &cal::daq::BallbarProgram::radius_mm, std::nullopt},
+    {"feed_mm_per_min", &cal::daq::BallbarProgram::feed_mm_per_min, std::nullopt},
+    {"sample_rate_hz", &cal::daq::BallbarProgram::sample_rate_hz, std::nullopt},
+    {"feed_in_mm", &cal::daq::BallbarProgram::feed_in_mm, std::nullopt},
+    {"dwell_s", &cal::daq::BallbarProgram::dwell_s, std::nullopt},
+    {"overshoot_deg", &cal::daq::BallbarProgram::overshoot_deg, std::nullopt},
+    {"start_deg", &cal::daq::BallbarProgram::start_deg, 0.0},
+    {"arc_deg", &cal::daq::BallbarProgram::arc_deg, 360.0},
+};
+
 json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalysis& a) {
-  json j{{"radius_mm", p.radius_mm},
-         {"feed_mm_per_min", p.feed_mm_per_min},
-         {"sample_rate_hz", p.sample_rate_hz},
-         {"feed_in_mm", p.feed_in_mm},
-         {"dwell_s", p.dwell_s},
-         {"overshoot_deg", p.overshoot_deg},
-         {"start_deg", p.start_deg},
-         {"arc_deg", p.arc_deg},
-         {"plane", a.plane},
-         {"uncalibrated", a.uncalibrated},
-         {"standard", a.standard}};
+  json j{{"plane", a.plane}, {"uncalibrated", a.uncalibrated}, {"standard", a.standard}};
+  for (const auto& k : kProgramKeys) j[k.key] = p.*k.member;
   if (!a.calibration_source.empty()) j["calibration_source"] = a.calibration_source;
   if (a.calibration) j["calibration"] = calibration_json(*a.calibration);
   if (!a.uncalibrated_reason.empty()) j["uncalibrated_reason"] = a.uncalibrated_reason;
@@ -173,14 +174,9 @@ json circle_settings_json(const cal::daq::BallbarProgram& p, const BallbarAnalys
 }
 
 std::pair<cal::daq::BallbarProgram, BallbarAnalysis> circle_settings_from_json(const json& j) {
-  cal::daq::BallbarProgram p{.radius_mm = j.at("radius_mm"),
-                             .feed_mm_per_min = j.at("feed_mm_per_min"),
-                             .sample_rate_hz = j.at("sample_rate_hz"),
-                             .feed_in_mm = j.at("feed_in_mm"),
-                             .dwell_s = j.at("dwell_s"),
-                             .overshoot_deg = j.at("overshoot_deg"),
-                             .start_deg = j.value("start_deg", 0.0),
-                             .arc_deg = j.value("arc_deg", 360.0)};
+  cal::daq::BallbarProgram p;
+  for (const auto& k : kProgramKeys)
+    p.*k.member = k.before ? j.value(k.key, *k.before) : j.at(k.key).get<double>();
   // Runs stored before issue 18 have no standard: they were evaluated by ISO 230-4:2005.
   BallbarAnalysis a{.plane = j.value("plane", std::string("XY")),
                     .uncalibrated = j.value("uncalibrated", false),

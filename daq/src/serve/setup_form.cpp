@@ -66,15 +66,6 @@ json circle_json(const cal::daq::CircleTestConfig& c) {
   return j;
 }
 
-json limits_json(const cal::daq::PositioningLimits& l) {
-  json j = json::object();
-  const auto lim = [&](const char* k, const std::optional<double>& v) {
-    if (v) j[k] = *v;
-  };
-  for (const auto& k : cal::daq::positioning_limit_keys) lim(k.key, l.*k.member);
-  return j;
-}
-
 json tolerances_json(const cal::daq::Config& c) {
   json j = json::object();
   for (const auto& [axis, t] : c.axis_tolerances) {

@@ -9,9 +9,15 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/loop_time.hpp"
+#include "cal/drivers/transport/transport.hpp"
+#include "ids3010/instrument.hpp"
 #include "ids3010/twin.hpp"
+#include "line_gauge/instrument.hpp"
 #include "line_gauge/twin.hpp"
+#include "linear_run.hpp"
+#include "ptu300/instrument.hpp"
 #include "ptu300/twin.hpp"
+#include "roles.hpp"
 #include "shdr/twin.hpp"
 
 namespace daq {
@@ -199,6 +205,29 @@ cal::drivers::Clock SimulatedShop::clock_ns() const {
   if (auto* vt = impl_->virtual_time) return [vt] { return vt->now_ns(); };
   return [impl = impl_.get()] { return static_cast<std::int64_t>(impl->now() * 1e9); };
 }
+void SimulatedShop::connect_linear(LinearRunSetup& setup, const ShopInstruments& o) const {
+  namespace d = cal::drivers;
+  namespace t = cal::drivers::transport;
+  auto& io = impl_->io;
+  const RunDevices devices(o.material ? 1 : 0);
+  const auto options = [&](Role role, double poll_s) {
+    return d::InstrumentOptions{.device = devices.device(role),
+                                .poll_period = std::chrono::microseconds(static_cast<std::int64_t>(
+                                    poll_s / impl_->speed * 1e6)),  // wall time at the speed
+                                .clock = clock_ns(),
+                                .recorder = o.recorder};
+  };
+  setup.laser = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = laser_port()}),
+                                options(Role::laser, o.laser_poll_s), {.axes = o.laser_axes});
+  setup.air = d::make_ptu300(
+      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = air_device()})),
+      options(Role::air, 1.0));
+  if (o.material)
+    setup.material.push_back(d::make_gauge(
+        io, t::make_serial(io, {.device = material_device()}), options(Role::material, 1.0),
+        {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
+}
+
 bool SimulatedShop::simulated_time() const { return impl_->virtual_time != nullptr; }
 std::uint16_t SimulatedShop::laser_port() const { return impl_->ids.port(); }
 const std::string& SimulatedShop::air_device() const { return impl_->ptu.device_path(); }

@@ -4,6 +4,7 @@
 // PTU300 and a material thermometer and a ballbar gauge on pseudo-terminals), all on one
 // simulated time line running `speed` times faster than the wall clock. The real drivers
 // connect to the twins exactly as to hardware.
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -24,6 +25,18 @@ class io_context;
 }
 
 namespace daq {
+
+struct LinearRunSetup;  // linear_run.hpp
+
+// How SimulatedShop::connect_linear connects a linear run's instruments to the shop's twins.
+struct ShopInstruments {
+  // Simulated seconds between laser polls: 100 Hz sees the 3 mm overrun excursions, without
+  // which a stop's approach is unknown (and an automatic capture without one is refused).
+  double laser_poll_s = 0.01;
+  std::array<bool, 3> laser_axes{true, false, false};  // the interferometer axes read
+  bool material = true;  // a material thermometer besides the laser and the air station
+  cal::drivers::WireRecorder* recorder = nullptr;  // records every instrument's bytes if set
+};
 
 // The injected errors: the truth the measured results are compared with.
 struct ShopTruth {
@@ -101,6 +114,11 @@ class SimulatedShop {
   // reads them, so the twins the shop starts are named here only.
   std::string devices_toml(double laser_poll_s, bool position_feed,
                            bool serial_numbers = false) const;
+
+  // A linear run's laser, air station and (o.material) material thermometer on this shop's
+  // twins, each under its role's device number, polled on the shop's clock (the air and the
+  // material once a simulated second).
+  void connect_linear(LinearRunSetup& setup, const ShopInstruments& o = {}) const;
 
   // The machine program for an ISO 230-2 plan on the test's axis (the other axes at their
   // stationary positions): every move at the feed, a dwell at each measure move.

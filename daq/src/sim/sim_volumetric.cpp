@@ -205,20 +205,11 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
     setup.origins[role] = {"simulated", "a twin of the built-in simulated shop (volumetric)"};
   setup.database = a.database;
   setup.store_options = a.store_options;
-  d::Ids3010Options ids;
+  ShopInstruments instruments{.laser_poll_s = a.laser_poll_s};
   if (test.measure.kind == "angular")
-    for (const int b : test.measure.beams) ids.axes[static_cast<std::size_t>(b)] = true;
-  // The overrun excursions must be seen (the approach direction): 100 Hz by default.
-  setup.laser =
-      d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = shop.laser_port()}),
-                      {.poll_period = poll(a.laser_poll_s), .clock = clock}, ids);
-  setup.air = d::make_ptu300(
-      io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = shop.air_device()})),
-      {.poll_period = poll(1.0), .clock = clock});
-  setup.material.push_back(d::make_gauge(
-      io, t::make_serial(io, {.device = shop.material_device()}),
-      {.poll_period = poll(1.0), .clock = clock},
-      {.request = "?\r", .unit = d::codec::GaugeUnit::degc, .min_si = -40, .max_si = 150}));
+    for (const int b : test.measure.beams)
+      instruments.laser_axes[static_cast<std::size_t>(b)] = true;
+  shop.connect_linear(setup, instruments);
   // A probe injected to answer late (ShopTruth::probe_answer_delay_s) is silent that much
   // longer at first: not a lost connection.
   const auto probe_silence = std::chrono::milliseconds(
@@ -239,7 +230,6 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
     setup.on_event = [](const std::string& e) { std::fprintf(stderr, "  event: %s\n", e.c_str()); };
   LinearRun run(io, std::move(setup));
   run.start();
-  // The probe is device 4 (laser 0, air 1, material 2, position 3 unused).
   if (!shop.wait_until([&] { return read.all(); }, 30.0))
     throw cal::InputError("simulated acquisition: the instruments did not start reading");
   shop.run_linear(run.plan(), test.feed_mm_per_min, test.dwell_s);

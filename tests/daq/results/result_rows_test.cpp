@@ -20,6 +20,37 @@ namespace {
 using nlohmann::json;
 namespace iso = cal::iso230_2;
 
+// The advice of each kind of diagnostic, word for word as the reports print it: a term of one
+// axis names the axis (its key's last letter), a term of the plane does not; a value of the
+// standard has none.
+TEST(ResultRows, DiagnosticAdviceNamesTheAxisOfItsTerm) {
+  EXPECT_EQ(daq::diagnostic_advice("backlash_X"),
+            "check the X axis' backlash compensation and its drive (ball screw, nut)");
+  EXPECT_EQ(daq::diagnostic_advice("lateral_play_Y"),
+            "check the Y axis' guideway gibs and preload: it shifts sideways at reversal");
+  EXPECT_EQ(daq::diagnostic_advice("reversal_spike_Z"),
+            "tune the Z axis' reversal (friction) compensation and its servo gains");
+  EXPECT_EQ(daq::diagnostic_advice("cyclic_X"),
+            "check the X axis' ball screw and encoder for a periodic (pitch) error");
+  EXPECT_EQ(daq::diagnostic_advice("straightness_Y"),
+            "check the straightness of the Y axis' guideways (level, wear)");
+  EXPECT_EQ(daq::diagnostic_advice("stick_slip_Z"),
+            "check the Z axis' lubrication and friction compensation");
+  EXPECT_EQ(daq::diagnostic_advice("squareness"),
+            "check the squareness of the plane's axes (alignment, or the control's squareness "
+            "compensation)");
+  EXPECT_EQ(daq::diagnostic_advice("scale_mismatch"),
+            "check the axes' pitch (scale) compensation and thermal growth of the screws");
+  EXPECT_EQ(daq::diagnostic_advice("servo_mismatch"),
+            "match the two axes' servo gains (position loop, feed-forward)");
+  EXPECT_EQ(daq::diagnostic_advice("radius_error"),
+            "check the bar's calibration and the axes' scale");
+  EXPECT_EQ(daq::diagnostic_advice("vibration"),
+            "look for the source of the vibration (spindle, fan, floor)");
+  EXPECT_EQ(daq::diagnostic_advice("G_bi_um"), "");
+  EXPECT_EQ(daq::diagnostic_advice("squareness_X"), "");  // no such term
+}
+
 TEST(ResultRows, NumbersNeverReadMinusZero) {
   EXPECT_EQ(daq::number_text(-0.0004), "0.000");
   EXPECT_EQ(daq::number_text(-0.0), "0.000");

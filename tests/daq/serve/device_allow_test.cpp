@@ -19,64 +19,56 @@ cal::daq::Config config_with(std::initializer_list<const char*> transports) {
   return c;
 }
 
+// What `list` allows and what it refuses: a failure names the transport text.
+void expect_allows(const DeviceAllowList& list, std::initializer_list<const char*> allowed,
+                   std::initializer_list<const char*> refused) {
+  for (const char* t : allowed) EXPECT_TRUE(list.allows(t)) << t;
+  for (const char* t : refused) EXPECT_FALSE(list.allows(t)) << t;
+}
+
 TEST(DeviceAllow, NothingIsAllowedByDefault) {
   const DeviceAllowList none;
-  EXPECT_FALSE(none.allows("serial /dev/tty0 9600 8N1"));
-  EXPECT_FALSE(none.allows("tcp 127.0.0.1:9090"));
-  EXPECT_FALSE(none.allows("hid 413d:2107"));
-  EXPECT_FALSE(none.allows("nonsense"));
+  expect_allows(none, {},
+                {"serial /dev/tty0 9600 8N1", "tcp 127.0.0.1:9090", "hid 413d:2107", "nonsense"});
 }
 
 TEST(DeviceAllow, TheConfigurationsDevicesWhateverTheLineSettings) {
   DeviceAllowList a;
   a.allow_devices_of(config_with({"serial /dev/ttyUSB0 4800 7E1", "tcp Laser.local:9090",
                                   "hid 413D:2107", "hid /dev/hidraw3"}));
-  EXPECT_TRUE(a.allows("serial /dev/ttyUSB0 9600 8N1 rtscts"));
-  EXPECT_FALSE(a.allows("serial /dev/ttyUSB1 4800 7E1"));
-  EXPECT_TRUE(a.allows("tcp laser.local:9090"));
-  EXPECT_FALSE(a.allows("tcp laser.local:9091"));
-  EXPECT_FALSE(a.allows("tcp 127.0.0.1:9090"));  // a name is not its address
-  EXPECT_TRUE(a.allows("hid 413d:2107"));
-  EXPECT_FALSE(a.allows("hid 413d:2108"));
-  EXPECT_TRUE(a.allows("hid /dev/hidraw3"));
-  EXPECT_FALSE(a.allows("serial /dev/hidraw3 9600 8N1"));  // another kind of device
+  // Refused: another device, another port, the address of an allowed name (a name is not its
+  // address), and an allowed path as another kind of device.
+  expect_allows(a,
+                {"serial /dev/ttyUSB0 9600 8N1 rtscts", "tcp laser.local:9090", "hid 413d:2107",
+                 "hid /dev/hidraw3"},
+                {"serial /dev/ttyUSB1 4800 7E1", "tcp laser.local:9091", "tcp 127.0.0.1:9090",
+                 "hid 413d:2108", "serial /dev/hidraw3 9600 8N1"});
 }
 
 TEST(DeviceAllow, PathGlobs) {
   const DeviceAllowList a({"/dev/ttyUSB*", "serial /dev/serial/by-id/usb-FTDI*"});
-  EXPECT_TRUE(a.allows("serial /dev/ttyUSB0 4800 7E1"));
-  EXPECT_TRUE(a.allows("serial /dev/ttyUSB12 4800 7E1"));
-  EXPECT_FALSE(a.allows("serial /dev/tty0 4800 7E1"));
-  EXPECT_FALSE(a.allows("serial /dev/ttyACM0 4800 7E1"));
-  // '*' does not cross '/', and ".." matches nothing.
-  EXPECT_FALSE(a.allows("serial /dev/ttyUSB0/../tty0 4800 7E1"));
-  EXPECT_FALSE(a.allows("serial /dev/ttyUSB../../dev/tty0 4800 7E1"));
-  EXPECT_TRUE(a.allows("serial /dev/serial/by-id/usb-FTDI_FT232R-if00 4800 7E1"));
-  EXPECT_FALSE(a.allows("hid /dev/serial/by-id/usb-FTDI_x"));  // "serial GLOB": serial only
+  // '*' does not cross '/', ".." matches nothing, and "serial GLOB" allows serial devices only.
+  expect_allows(a,
+                {"serial /dev/ttyUSB0 4800 7E1", "serial /dev/ttyUSB12 4800 7E1",
+                 "serial /dev/serial/by-id/usb-FTDI_FT232R-if00 4800 7E1"},
+                {"serial /dev/tty0 4800 7E1", "serial /dev/ttyACM0 4800 7E1",
+                 "serial /dev/ttyUSB0/../tty0 4800 7E1",
+                 "serial /dev/ttyUSB../../dev/tty0 4800 7E1", "hid /dev/serial/by-id/usb-FTDI_x"});
   const DeviceAllowList hidraw({"/dev/hidraw*"});
-  EXPECT_TRUE(hidraw.allows("hid /dev/hidraw0"));
+  expect_allows(hidraw, {"hid /dev/hidraw0"}, {});
 }
 
 TEST(DeviceAllow, TcpHostsAndPortRanges) {
   const DeviceAllowList a({"192.168.1.*:9090", "10.0.0.5:7000-7010", "tcp [::1]:9090"});
-  EXPECT_TRUE(a.allows("tcp 192.168.1.20:9090"));
-  EXPECT_FALSE(a.allows("tcp 192.168.1.20:9091"));
-  EXPECT_FALSE(a.allows("tcp 192.168.2.20:9090"));
-  EXPECT_TRUE(a.allows("tcp 10.0.0.5:7000"));
-  EXPECT_TRUE(a.allows("tcp 10.0.0.5:7010"));
-  EXPECT_FALSE(a.allows("tcp 10.0.0.5:7011"));
-  EXPECT_FALSE(a.allows("tcp 10.0.0.5:6999"));
-  EXPECT_TRUE(a.allows("tcp [::1]:9090"));
-  EXPECT_FALSE(a.allows("tcp [::2]:9090"));
-  EXPECT_FALSE(a.allows("serial 192.168.1.20:9090 4800 7E1"));
+  expect_allows(
+      a, {"tcp 192.168.1.20:9090", "tcp 10.0.0.5:7000", "tcp 10.0.0.5:7010", "tcp [::1]:9090"},
+      {"tcp 192.168.1.20:9091", "tcp 192.168.2.20:9090", "tcp 10.0.0.5:7011", "tcp 10.0.0.5:6999",
+       "tcp [::2]:9090", "serial 192.168.1.20:9090 4800 7E1"});
 }
 
 TEST(DeviceAllow, HidIds) {
   const DeviceAllowList a({"hid 413d:*", "hid 1A86:E025"});
-  EXPECT_TRUE(a.allows("hid 413d:2107"));
-  EXPECT_TRUE(a.allows("hid 1a86:e025"));
-  EXPECT_FALSE(a.allows("hid 1a86:e026"));
-  EXPECT_FALSE(a.allows("tcp 413d:2107"));
+  expect_allows(a, {"hid 413d:2107", "hid 1a86:e025"}, {"hid 1a86:e026", "tcp 413d:2107"});
 }
 
 TEST(DeviceAllow, MalformedPatternsAreRefusedNamingThem) {

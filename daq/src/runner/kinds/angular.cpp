@@ -74,9 +74,7 @@ class Reader final : public SampleReader {
 
 class Angular final : public TestKind {
  public:
-  std::string_view name() const override { return "angular"; }
-  std::string_view run_kind() const override { return "angular"; }
-  std::string_view unit() const override { return "urad"; }
+  Angular() : TestKind({.name = "angular", .run_kind = "angular", .unit = "urad"}) {}
   std::string component(const cal::daq::LinearTestConfig& l) const override {
     return "E_" + l.measure.direction + l.axis;
   }

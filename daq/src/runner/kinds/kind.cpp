@@ -17,6 +17,26 @@ using nlohmann::json;
 
 int axis_index(std::string_view axis) { return axis == "Y" ? 1 : axis == "Z" ? 2 : 0; }
 
+namespace {
+
+class ProbeReader final : public SampleReader {
+ public:
+  explicit ProbeReader(double sign) : sign_(sign) {}
+  std::optional<double> add(Source source, std::uint8_t, std::int64_t, double value_si) override {
+    if (source != Source::probe) return std::nullopt;
+    return sign_ * value_si * 1e6;  // m -> um, rad -> urad
+  }
+
+ private:
+  double sign_;
+};
+
+}  // namespace
+
+std::unique_ptr<SampleReader> ProbeKind::reader(const cal::daq::LinearTestConfig& l) const {
+  return std::make_unique<ProbeReader>(l.measure.sign);
+}
+
 std::span<const TestKind* const> all_kinds() {
   static const std::array<const TestKind*, 4> k{&positioning(), &straightness(), &angular(),
                                                 &roll()};

@@ -50,16 +50,24 @@ struct Evaluation {
   nlohmann::json json;
 };
 
+// What names a kind: the same four words for each, so they are data, not overrides.
+struct KindNames {
+  std::string_view name;        // the `measure` key: "straightness"
+  std::string_view run_kind;    // the stored run's kind ("linear" positioning)
+  std::string_view unit;        // of the values: "um" or "urad"
+  std::string_view probe_role;  // the instrument read besides the laser ("indicator"; "" none)
+};
+
 class TestKind {
  public:
+  explicit constexpr TestKind(KindNames names) : names_(names) {}
   virtual ~TestKind() = default;
-  virtual std::string_view name() const = 0;      // the `measure` key: "straightness"
-  virtual std::string_view run_kind() const = 0;  // the stored run's kind ("linear" positioning)
-  virtual std::string_view unit() const = 0;      // of the values: "um" or "urad"
+  std::string_view name() const { return names_.name; }
+  std::string_view run_kind() const { return names_.run_kind; }
+  std::string_view unit() const { return names_.unit; }
+  std::string_view probe_role() const { return names_.probe_role; }
   // The ISO 230-1 component it measures ("E_YX"), from the axis and direction.
   virtual std::string component(const cal::daq::LinearTestConfig& l) const = 0;
-  // The role of the instrument it reads besides the laser ("indicator", "level"; "" none).
-  virtual std::string_view probe_role() const { return ""; }
   // The set-up checks beyond the configuration's syntax; throws cal::InputError naming the key.
   virtual void validate(const cal::daq::LinearTestConfig& /*l*/) const {}
   // Every laser axis the kind reads (positioning: none beyond the position channel).
@@ -71,6 +79,17 @@ class TestKind {
   // The stops evaluated (not called for positioning: ISO 230-2 evaluates those).
   virtual Evaluation evaluate(std::span<const StopValue> stops,
                               const cal::daq::LinearTestConfig& l) const;
+
+ private:
+  KindNames names_;
+};
+
+// A kind that reads its own instrument (its probe role) besides the laser: the value is the
+// probe's SI value (m, rad) times `sign` in micro-units (um, urad). Straightness and roll.
+class ProbeKind : public TestKind {
+ public:
+  using TestKind::TestKind;
+  std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override;
 };
 
 // The kind of a `measure` name; throws cal::InputError listing the kinds.

@@ -7,9 +7,7 @@ namespace {
 
 class Positioning final : public TestKind {
  public:
-  std::string_view name() const override { return "positioning"; }
-  std::string_view run_kind() const override { return "linear"; }
-  std::string_view unit() const override { return "um"; }
+  Positioning() : TestKind({.name = "positioning", .run_kind = "linear", .unit = "um"}) {}
   std::string component(const cal::daq::LinearTestConfig& l) const override {
     return "E_" + l.axis + l.axis;
   }

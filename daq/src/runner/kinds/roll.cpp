@@ -10,29 +10,11 @@
 namespace daq::kinds {
 namespace {
 
-class Reader final : public SampleReader {
+class Roll final : public ProbeKind {
  public:
-  explicit Reader(double sign) : sign_(sign) {}
-  std::optional<double> add(Source source, std::uint8_t, std::int64_t, double value_rad) override {
-    if (source != Source::probe) return std::nullopt;
-    return sign_ * value_rad * 1e6;  // urad
-  }
-
- private:
-  double sign_;
-};
-
-class Roll final : public TestKind {
- public:
-  std::string_view name() const override { return "roll"; }
-  std::string_view run_kind() const override { return "roll"; }
-  std::string_view unit() const override { return "urad"; }
+  Roll() : ProbeKind({.name = "roll", .run_kind = "roll", .unit = "urad", .probe_role = "level"}) {}
   std::string component(const cal::daq::LinearTestConfig& l) const override {
     return fmt::format("E_{}{}", static_cast<char>('A' + axis_index(l.axis)), l.axis);
-  }
-  std::string_view probe_role() const override { return "level"; }
-  std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override {
-    return std::make_unique<Reader>(l.measure.sign);
   }
 };
 

@@ -12,27 +12,16 @@
 namespace daq::kinds {
 namespace {
 
-class Reader final : public SampleReader {
+class Straightness final : public ProbeKind {
  public:
-  explicit Reader(double sign) : sign_(sign) {}
-  std::optional<double> add(Source source, std::uint8_t, std::int64_t, double value_m) override {
-    if (source != Source::probe) return std::nullopt;
-    return sign_ * value_m * 1e6;  // um
-  }
-
- private:
-  double sign_;
-};
-
-class Straightness final : public TestKind {
- public:
-  std::string_view name() const override { return "straightness"; }
-  std::string_view run_kind() const override { return "straightness"; }
-  std::string_view unit() const override { return "um"; }
+  Straightness()
+      : ProbeKind({.name = "straightness",
+                   .run_kind = "straightness",
+                   .unit = "um",
+                   .probe_role = "indicator"}) {}
   std::string component(const cal::daq::LinearTestConfig& l) const override {
     return "E_" + l.measure.direction + l.axis;
   }
-  std::string_view probe_role() const override { return "indicator"; }
   void validate(const cal::daq::LinearTestConfig& l) const override {
     if (l.measure.direction.size() != 1 || l.measure.direction == l.axis ||
         std::string_view("XYZ").find(l.measure.direction) == std::string_view::npos)
@@ -40,9 +29,6 @@ class Straightness final : public TestKind {
           "test.linear.direction '{}': a straightness of {} is read in one of the other axes' "
           "directions",
           l.measure.direction, l.axis));
-  }
-  std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override {
-    return std::make_unique<Reader>(l.measure.sign);
   }
 };
 
