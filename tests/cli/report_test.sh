@@ -113,7 +113,7 @@ check verdict_vdi 0 "<td>P</td><td class=\"r\">[0-9.]+</td><td>position uncertai
 check verdict_vdi_not_none 0 "^judged$" -- bash -c 'grep -q "No tolerance" vdi.html || echo judged'
 check grid 0 "<th>↑&nbsp;up</th><th>↓&nbsp;down</th><th>bidirectional</th>" -- cat r1.html
 check two_s_lines 0 "^x̄↑ ± 2s$" -- svgtext r1.html
-G2=$("$PY" -c "import json; print(format(json.load(open('circ.json'))['iso230_4']['G_bi_um'], '.2f'))")
+G2=$("$PY" -c "import json; print(format(json.load(open('circ.json'))['iso230_4']['G_bi_um'], '.3f'))")
 check circle_g_on_plot 0 "^G = $G2 µm$" -- svgtext r2.html
 check circle_start_marked 0 "start of each trace, arrow: direction of travel" -- svgtext r2.html
 check circle_rings_off_traces 0 "^rings: -[0-9.]+ to \+[0-9.]+ µm$" -- svgtext r2.html

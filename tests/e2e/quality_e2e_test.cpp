@@ -177,6 +177,7 @@ TEST(SuspectRun, AnOutlierStopIsRefusedByModelBuildUnlessAccepted) {
   {
     cal::storage::Store store(db);
     auto record = *store.run(clean.run_id);
+    record.uuid.clear();  // a new run: its own identity (the copy would share the UUID)
     bad = store.begin_run(record);
     auto stops = store.targets(clean.run_id);
     for (auto& t : stops) {
