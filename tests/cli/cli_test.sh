@@ -40,6 +40,9 @@ check replay_damaged 2 "cut.cdq: replay stored as run [0-9]+ but incomplete: the
 check replay_not_capture 2 "not a caldaq capture file" -- "$DAQ" replay "$DATA/hand.csv" --db "$TMP/replay.sqlite"
 check demo_stored 0 "complete" -- "$DAQ" runs --db "$TMP/demo.sqlite"
 check demo_export 0 "^time_s,utc,device,device_name,channel,quantity,status,value,time_ns$" -- "$DAQ" export 1 --db "$TMP/demo.sqlite"
+# A full disk stops the export at once, naming why (the rows are written 64 KiB at a time).
+check export_full_disk 2 "export: cannot write: No space left on device" -- "$DAQ" export 1 --db "$TMP/demo.sqlite" -o /dev/full
+check export_json_full_disk 2 "export: cannot write: No space left on device" -- "$DAQ" export 1 --db "$TMP/demo.sqlite" --format json -o /dev/full
 check demo_targets 0 "^0,1,up,-?[0-9.e-]+,1,[0-9.e-]+,20[0-9-]+T[0-9:.]+Z," -- "$DAQ" export 1 --what targets --db "$TMP/demo.sqlite"
 # Exports loaded back: the targets feed `daq analyse iso230-2` and give the stored run's E; the
 # circle traces feed `daq analyse circle` and give its G; a circle has no targets.

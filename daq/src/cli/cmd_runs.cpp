@@ -259,15 +259,21 @@ class RowBuffer {
   explicit RowBuffer(std::FILE* out) : out_(out) {}
   RowBuffer(const RowBuffer&) = delete;
   RowBuffer& operator=(const RowBuffer&) = delete;
-  ~RowBuffer() { write(); }
+  // On an exception's way out: what is held, without a word (the exception says what failed).
+  ~RowBuffer() {
+    if (text_.size() != 0) std::fwrite(text_.data(), 1, text_.size(), out_);
+  }
   fmt::appender it() { return fmt::appender(text_); }
   void add(std::string_view s) { text_.append(s.data(), s.data() + s.size()); }
   // Called after each row: writes the buffer once it is full.
   void row_done() {
     if (text_.size() >= kFlushAt) write();
   }
+  // Writes what is held; a failed write (a full disk) stops the export at once, as a print
+  // per row did, rather than formatting the rest of the run for nothing.
   void write() {
-    if (text_.size() != 0) std::fwrite(text_.data(), 1, text_.size(), out_);
+    if (text_.size() != 0 && std::fwrite(text_.data(), 1, text_.size(), out_) != text_.size())
+      throw cal::InputError(fmt::format("export: cannot write: {}", std::strerror(errno)));
     text_.clear();
   }
 
@@ -360,6 +366,7 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
     b.row_done();
     progress.add();
   });
+  b.write();
 }
 
 void export_targets_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
@@ -490,6 +497,7 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
       first = false;
       progress.add();
     });
+    b.write();
   }
   fmt::print(out, "{}]{}\n", first ? "" : "\n ", std::string_view(text).substr(at + marker.size()));
 }
