@@ -288,12 +288,15 @@ struct CircleRun::Impl : Runner {
     open_store();
     begin_test();
     running = true;
-    setup.ballbar->start({.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
-                          .state =
-                              [this](cal::drivers::InstrumentState s, std::string_view why) {
-                                if (s == cal::drivers::InstrumentState::closed && running)
-                                  abort(fmt::format("ballbar closed: {}", why));
-                              }});
+    setup.ballbar->start(
+        {.reading = [this](const cal::drivers::Reading& r) { on_reading(r); },
+         .state =
+             [this](cal::drivers::InstrumentState s, std::string_view why) {
+               if (s == cal::drivers::InstrumentState::closed && running)
+                 abort(fmt::format("ballbar closed: {}", why));
+             },
+         .codec_error = codec_errors_as_events(setup.ballbar->describe(),
+                                               [this](const std::string& e) { event(e); })});
     tick();
   }
 

@@ -302,26 +302,27 @@ struct LinearRun::Impl : Runner {
   }
 
   void start_instrument(cal::drivers::Instrument& inst, std::uint16_t device) {
-    inst.start({.reading = [this, device](const Reading& r) { on_reading(r, device); },
-                .state =
-                    [this, &inst](cal::drivers::InstrumentState s, std::string_view why) {
-                      if (s == cal::drivers::InstrumentState::closed && running)
-                        abort(fmt::format("{} closed: {}", inst.describe(), why));
-                      else if (s == cal::drivers::InstrumentState::reconnecting)
-                        event(fmt::format("{}: reconnecting ({})", inst.describe(), why));
-                    },
-                .gap =
-                    [this, &inst](const cal::drivers::Gap& g) {
-                      event(fmt::format("{}: no data for {:.2f} s ({})", inst.describe(),
-                                        static_cast<double>(g.end_ns - g.start_ns) * 1e-9,
-                                        g.reason));
-                    },
-                .codec_error = {},
-                .message =
-                    [this, &inst](const cal::drivers::DeviceMessage& m) {
-                      event(fmt::format("{}: {}{}: {}", inst.describe(), to_string(m.severity),
-                                        m.code ? fmt::format(" {}", m.code) : "", m.text));
-                    }});
+    inst.start(
+        {.reading = [this, device](const Reading& r) { on_reading(r, device); },
+         .state =
+             [this, &inst](cal::drivers::InstrumentState s, std::string_view why) {
+               if (s == cal::drivers::InstrumentState::closed && running)
+                 abort(fmt::format("{} closed: {}", inst.describe(), why));
+               else if (s == cal::drivers::InstrumentState::reconnecting)
+                 event(fmt::format("{}: reconnecting ({})", inst.describe(), why));
+             },
+         .gap =
+             [this, &inst](const cal::drivers::Gap& g) {
+               event(fmt::format("{}: no data for {:.2f} s ({})", inst.describe(),
+                                 static_cast<double>(g.end_ns - g.start_ns) * 1e-9, g.reason));
+             },
+         .codec_error =
+             codec_errors_as_events(inst.describe(), [this](const std::string& e) { event(e); }),
+         .message =
+             [this, &inst](const cal::drivers::DeviceMessage& m) {
+               event(fmt::format("{}: {}{}: {}", inst.describe(), to_string(m.severity),
+                                 m.code ? fmt::format(" {}", m.code) : "", m.text));
+             }});
   }
 
   void on_reading(Reading r, std::uint16_t device) {

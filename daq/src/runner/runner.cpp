@@ -11,6 +11,19 @@
 
 namespace daq {
 
+std::function<void(const cal::drivers::codec::CodecError&)> codec_errors_as_events(
+    std::string instrument, std::function<void(const std::string&)> event) {
+  return [who = std::move(instrument), event = std::move(event),
+          told = 0](const cal::drivers::codec::CodecError& e) mutable {
+    if (!event || told > kListedCodecErrors) return;
+    if (told++ < kListedCodecErrors)
+      event(fmt::format("{}: refused at byte {}: {}", who, e.offset, e.description));
+    else
+      event(
+          fmt::format("{}: more refused data; further codec errors are counted, not listed", who));
+  };
+}
+
 Runner::Runner(boost::asio::io_context& i, std::filesystem::path db,
                cal::storage::StoreOptions options)
     : io(i), database(std::move(db)), store_options(options), timer(i) {}

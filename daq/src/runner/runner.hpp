@@ -6,11 +6,13 @@
 // hooks. Included only by the kinds' sources (Asio's timer, the store).
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "cal/daq/config.hpp"
+#include "cal/drivers/codec/common.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
@@ -20,6 +22,14 @@ class io_context;
 }
 
 namespace daq {
+
+// What an instrument's codec refused (a malformed frame, a sensor's "did not answer" code),
+// told to the run's events: an operator must see why a device gives no values, not only a
+// counter. The first kListedCodecErrors of an instrument are told in full; then one line says
+// the rest are only counted (a stream of garbage must not bury every other event).
+inline constexpr int kListedCodecErrors = 3;
+std::function<void(const cal::drivers::codec::CodecError&)> codec_errors_as_events(
+    std::string instrument, std::function<void(const std::string&)> event);
 
 class Runner {
  public:
