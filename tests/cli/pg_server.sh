@@ -28,6 +28,20 @@ pg_start() {
     { echo "FAIL: CREATE DATABASE"; exit 1; }
 }
 
+# pg_with_demo (after check.sh): TMP, a scratch directory; a throwaway server in PGTMP; the
+# demo's runs in DB ($TMP/local/demo.sqlite); the server stopped and both removed at exit.
+pg_with_demo() {
+  TMP=$(mktemp -d)
+  # The server's directory in /tmp whatever TMPDIR says: the user nobody must reach it, and the
+  # socket's path must stay short (107 bytes at most).
+  PGTMP=$(mktemp -d /tmp/caldaq-pg.XXXXXX)
+  trap 'pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
+  mkdir "$TMP/local"
+  pg_start "$PGTMP"
+  demo_runs "$TMP/local"
+  DB=$TMP/local/demo.sqlite
+}
+
 pg_stop() {
   if [ -n "${PG_STARTED:-}" ]; then
     pg_as_owner "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m immediate -w stop >/dev/null 2>&1

@@ -10,15 +10,7 @@ DAQ=$1
 
 source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
-TMP=$(mktemp -d)
-# The server's directory in /tmp whatever TMPDIR says: the user nobody must reach it, and the
-# socket's path must stay short (107 bytes at most).
-PGTMP=$(mktemp -d /tmp/caldaq-pg.XXXXXX)
-trap 'pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
-mkdir "$TMP/local"
-pg_start "$PGTMP"
-demo_runs "$TMP/local"
-DB=$TMP/local/demo.sqlite
+pg_with_demo
 
 # local_value SQL: one value from the local SQLite store.
 local_value() {

@@ -30,8 +30,13 @@ TerminalProgress::TerminalProgress(std::string what, std::string unit, std::uint
   if (shown_) draw(true);  // at once: the person sees what runs before the first rate
 }
 
-TerminalProgress::~TerminalProgress() {
-  if (shown_) fmt::print(stderr, "\r\033[K"), std::fflush(stderr);
+TerminalProgress::~TerminalProgress() { clear(); }
+
+void TerminalProgress::clear() {
+  if (!drawn_) return;
+  fmt::print(stderr, "\r\033[K");
+  std::fflush(stderr);
+  drawn_ = false;
 }
 
 void TerminalProgress::draw(bool force) {
@@ -49,6 +54,7 @@ void TerminalProgress::draw(bool force) {
     line += fmt::format(", about {} left", clock_text(*left));
   fmt::print(stderr, "\r\033[K{}", line);
   std::fflush(stderr);
+  drawn_ = true;
 }
 
 }  // namespace daq

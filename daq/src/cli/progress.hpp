@@ -39,9 +39,12 @@ class TerminalProgress {
   void tick() {
     if (shown_) draw(false);
   }
+  // Erases the line (the next draw brings it back), for a line of output printed in its place.
+  void clear();
 
  private:
   void draw(bool force);
+  bool drawn_ = false;  // a line is on the terminal now
   std::string what_, unit_;
   std::uint64_t total_ = 0, done_ = 0, calls_ = 0;
   bool shown_ = false;
