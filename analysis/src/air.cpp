@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::air {
@@ -115,27 +116,17 @@ double shop_floor(double t, double p_pa, double rh_pct) {
   return 1.0 + 7.86e-4 * (p_pa / 1000.0) / (273.0 + t) - 1.5e-11 * rh_pct * (t * t + 160.0);
 }
 
+// The shown name first; the other spellings are accepted on input.
+constexpr EnumName<Equation> kEquationNames[] = {
+    {Equation::edlen, "edlen"},           {Equation::edlen, "edlen-birch-downs"},
+    {Equation::ciddor, "ciddor"},         {Equation::shop_floor, "shop-floor"},
+    {Equation::shop_floor, "shop_floor"}, {Equation::shop_floor, "nist-shop-floor"}};
 }  // namespace
 
-std::string_view to_string(Equation e) {
-  switch (e) {
-    case Equation::edlen:
-      return "edlen";
-    case Equation::ciddor:
-      return "ciddor";
-    case Equation::shop_floor:
-      return "shop-floor";
-  }
-  return "?";
-}
+std::string_view to_string(Equation e) { return name_of(kEquationNames, e); }
 
 Equation equation_from_string(std::string_view name) {
-  if (name == "edlen" || name == "edlen-birch-downs") return Equation::edlen;
-  if (name == "ciddor") return Equation::ciddor;
-  if (name == "shop-floor" || name == "shop_floor" || name == "nist-shop-floor")
-    return Equation::shop_floor;
-  throw InputError(fmt::format(
-      "unknown refractive-index equation '{}': expected edlen, ciddor or shop-floor", name));
+  return parse_name(kEquationNames, name, "refractive-index equation");
 }
 
 double saturation_vapour_pressure_water_pa(double t_degc) {
@@ -204,8 +195,8 @@ namespace {
 // xv = f pv / p, with f at the temperature where the vapour is saturated: the dew point
 // when one is given, else the air temperature.
 double mole_fraction(const Conditions& c, double pv_pa) {
-  const double t_f = c.humidity.kind == Humidity::Kind::dew_point_degc ? c.humidity.value
-                                                                        : c.temperature_degc;
+  const double t_f =
+      c.humidity.kind == Humidity::Kind::dew_point_degc ? c.humidity.value : c.temperature_degc;
   return enhancement_factor(c.pressure_pa, t_f) * pv_pa / c.pressure_pa;
 }
 }  // namespace

@@ -47,6 +47,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "circle_dynamics.hpp"
 
@@ -69,15 +70,9 @@ struct Sample {
 };
 
 std::string axis_names(Plane p) {
-  switch (p) {
-    case Plane::xy:
-      return "XY";
-    case Plane::yz:
-      return "YZ";
-    case Plane::zx:
-      return "ZX";
-  }
-  return "XY";
+  using enum Plane;
+  static constexpr cal::EnumName<Plane> kNames[] = {{xy, "XY"}, {yz, "YZ"}, {zx, "ZX"}};
+  return std::string(cal::name_of(kNames, p, "XY"));
 }
 
 enum Term {

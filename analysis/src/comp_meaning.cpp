@@ -7,6 +7,7 @@
 
 #include <algorithm>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::comptable {
@@ -99,15 +100,12 @@ constexpr FormatMeaning kMeanings[] = {
 }  // namespace
 
 std::string_view to_string(Evidence e) {
-  switch (e) {
-    case Evidence::stated:
-      return "stated by the vendor";
-    case Evidence::best_reading:
-      return "the best reading of the vendor's text, not stated in so many words";
-    case Evidence::not_found:
-      return "NOT STATED in the public text read";
-  }
-  return "unknown";
+  using enum Evidence;
+  static constexpr EnumName<Evidence> kNames[] = {
+      {stated, "stated by the vendor"},
+      {best_reading, "the best reading of the vendor's text, not stated in so many words"},
+      {not_found, "NOT STATED in the public text read"}};
+  return name_of(kNames, e, "unknown");
 }
 
 std::span<const FormatMeaning> format_meanings() { return kMeanings; }

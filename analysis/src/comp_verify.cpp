@@ -7,30 +7,21 @@
 #include <cmath>
 
 #include "cal/analysis/comp_table.hpp"
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::comptable {
 
 std::string_view to_string(Finding f) {
-  switch (f) {
-    case Finding::as_predicted:
-      return "as predicted";
-    case Finding::inverted_sign:
-      return "inverted sign";
-    case Finding::not_applied:
-      return "not applied";
-    case Finding::unit_scale:
-      return "unit error";
-    case Finding::constant_shift:
-      return "reference-point error";
-    case Finding::position_shift:
-      return "position shift";
-    case Finding::too_small:
-      return "too small to tell";
-    case Finding::unexplained:
-      return "unexplained";
-  }
-  return "unknown";
+  using enum Finding;
+  // clang-format off
+  static constexpr EnumName<Finding> kNames[] = {
+      {as_predicted, "as predicted"}, {inverted_sign, "inverted sign"},
+      {not_applied, "not applied"}, {unit_scale, "unit error"},
+      {constant_shift, "reference-point error"}, {position_shift, "position shift"},
+      {too_small, "too small to tell"}, {unexplained, "unexplained"}};
+  // clang-format on
+  return name_of(kNames, f, "unknown");
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::iso230_2 {
@@ -70,29 +71,21 @@ void pilgrim_moves(const std::vector<double>& t, const CycleSpec& c, std::vector
   }
 }
 
+// The shown name first; the other spellings are accepted on input.
+constexpr EnumName<Cycle> kCycleNames[] = {{Cycle::linear, "linear"},
+                                           {Cycle::pendulum, "pendulum"},
+                                           {Cycle::pilgrim_step, "pilgrim-step"},
+                                           {Cycle::pilgrim_step, "pilgrim_step"},
+                                           {Cycle::pilgrim_step, "step"}};
+
 }  // namespace
 
 std::string_view to_string(Direction d) { return d == Direction::up ? "up" : "down"; }
 
-std::string_view to_string(Cycle c) {
-  switch (c) {
-    case Cycle::linear:
-      return "linear";
-    case Cycle::pendulum:
-      return "pendulum";
-    case Cycle::pilgrim_step:
-      return "pilgrim-step";
-  }
-  return "?";
-}
+std::string_view to_string(Cycle c) { return name_of(kCycleNames, c); }
 
 Cycle cycle_from_string(std::string_view name) {
-  if (name == "linear") return Cycle::linear;
-  if (name == "pendulum") return Cycle::pendulum;
-  if (name == "pilgrim-step" || name == "pilgrim_step" || name == "step")
-    return Cycle::pilgrim_step;
-  throw InputError(
-      fmt::format("unknown test cycle '{}': expected linear, pendulum or pilgrim-step", name));
+  return parse_name(kCycleNames, name, "test cycle");
 }
 
 bool is_long_axis(double first_mm, double last_mm) { return last_mm - first_mm > kLongAxisMm; }

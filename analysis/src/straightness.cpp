@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::straightness {
@@ -99,21 +100,19 @@ Line minimum_zone(std::span<const double> x, std::span<const double> y) {
 }  // namespace
 
 std::string_view to_string(Reference r) {
-  switch (r) {
-    case Reference::least_squares:
-      return "least squares";
-    case Reference::end_point:
-      return "end point";
-    case Reference::minimum_zone:
-      return "minimum zone";
-  }
-  return "?";
+  using enum Reference;
+  static constexpr EnumName<Reference> kNames[] = {
+      {least_squares, "least squares"}, {end_point, "end point"}, {minimum_zone, "minimum zone"}};
+  return name_of(kNames, r);
 }
 
 Reference reference_from_string(std::string_view s) {
-  if (s == "lsq" || s == "least-squares") return Reference::least_squares;
-  if (s == "endpoint" || s == "end-point") return Reference::end_point;
-  if (s == "minzone" || s == "minimum-zone") return Reference::minimum_zone;
+  using enum Reference;
+  // The words of the command line and the files (the shown names have a space).
+  static constexpr EnumName<Reference> kWords[] = {
+      {least_squares, "lsq"},   {least_squares, "least-squares"}, {end_point, "endpoint"},
+      {end_point, "end-point"}, {minimum_zone, "minzone"},        {minimum_zone, "minimum-zone"}};
+  if (const auto r = value_named(kWords, s)) return *r;
   throw InputError(
       fmt::format("unknown reference line '{}' (expected lsq, endpoint or minzone)", s));
 }

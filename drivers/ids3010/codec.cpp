@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/json_scan.hpp"
 
 namespace cal::drivers::codec {
 namespace {
@@ -334,25 +335,11 @@ std::string IdsCodec::encode(IdsMethod method, std::span<const IdsParam> params)
 
 std::size_t json_object_end(std::string_view text, std::size_t open) {
   int depth = 0;
-  bool in_string = false, escaped = false;
-  for (std::size_t i = open; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '{') {
-      ++depth;
-    } else if (c == '}' && --depth == 0) {
-      return i + 1;
-    }
-  }
-  return std::string_view::npos;
+  const auto close = cal::text::find_outside_json_strings(text, open, [&](char c) {
+    if (c == '{') ++depth;
+    return c == '}' && --depth == 0;
+  });
+  return close == std::string_view::npos ? close : close + 1;
 }
 
 std::vector<std::string_view> json_objects(std::string_view text) {

@@ -3,24 +3,19 @@
 #include <algorithm>
 #include <charconv>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/drivers/codec/decimal.hpp"
 
 namespace cal::drivers::codec {
 
 std::string_view to_string(ErrorKind kind) {
-  switch (kind) {
-    case ErrorKind::garbage:
-      return "garbage";
-    case ErrorKind::overlong_line:
-      return "overlong_line";
-    case ErrorKind::bad_checksum:
-      return "bad_checksum";
-    case ErrorKind::out_of_range:
-      return "out_of_range";
-    case ErrorKind::malformed:
-      return "malformed";
-  }
-  return "unknown";
+  using enum ErrorKind;
+  // clang-format off
+  static constexpr EnumName<ErrorKind> kNames[] = {
+      {garbage, "garbage"}, {overlong_line, "overlong_line"}, {bad_checksum, "bad_checksum"},
+      {out_of_range, "out_of_range"}, {malformed, "malformed"}};
+  // clang-format on
+  return name_of(kNames, kind, "unknown");
 }
 
 std::uint64_t CodecStats::count(ErrorKind kind) const {

@@ -3,76 +3,50 @@
 
 #include <algorithm>
 
+#include "cal/analysis/enum_names.hpp"
 #include "instrument_core.hpp"
 
 namespace cal::drivers {
 
 std::string_view to_string(Quantity q) {
-  switch (q) {
-    case Quantity::displacement_m:
-      return "displacement_m";
-    case Quantity::length_m:
-      return "length_m";
-    case Quantity::air_temperature_degc:
-      return "air_temperature_degc";
-    case Quantity::air_pressure_pa:
-      return "air_pressure_pa";
-    case Quantity::air_humidity_pct:
-      return "air_humidity_pct";
-    case Quantity::dew_point_degc:
-      return "dew_point_degc";
-    case Quantity::refractive_index:
-      return "refractive_index";
-    case Quantity::material_temperature_degc:
-      return "material_temperature_degc";
-    case Quantity::machine_position_m:
-      return "machine_position_m";
-    case Quantity::angle_rad:
-      return "angle_rad";
-  }
-  return "unknown";
+  using enum Quantity;
+  static constexpr EnumName<Quantity> kNames[] = {
+      {displacement_m, "displacement_m"},
+      {length_m, "length_m"},
+      {air_temperature_degc, "air_temperature_degc"},
+      {air_pressure_pa, "air_pressure_pa"},
+      {air_humidity_pct, "air_humidity_pct"},
+      {dew_point_degc, "dew_point_degc"},
+      {refractive_index, "refractive_index"},
+      {material_temperature_degc, "material_temperature_degc"},
+      {machine_position_m, "machine_position_m"},
+      {angle_rad, "angle_rad"}};
+  return name_of(kNames, q, "unknown");
 }
 
 std::string_view to_string(ReadingStatus s) {
-  switch (s) {
-    case ReadingStatus::ok:
-      return "ok";
-    case ReadingStatus::signal_lost:
-      return "signal_lost";
-    case ReadingStatus::out_of_range:
-      return "out_of_range";
-  }
-  return "unknown";
+  using enum ReadingStatus;
+  static constexpr EnumName<ReadingStatus> kNames[] = {
+      {ok, "ok"}, {signal_lost, "signal_lost"}, {out_of_range, "out_of_range"}};
+  return name_of(kNames, s, "unknown");
 }
+
+constexpr EnumName<InstrumentState> kInstrumentStateNames[] = {
+    {InstrumentState::closed, "closed"},           {InstrumentState::connecting, "connecting"},
+    {InstrumentState::configuring, "configuring"}, {InstrumentState::streaming, "streaming"},
+    {InstrumentState::signal_lost, "signal lost"}, {InstrumentState::reconnecting, "reconnecting"}};
 
 std::string_view to_string(InstrumentState s) {
-  switch (s) {
-    case InstrumentState::closed:
-      return "closed";
-    case InstrumentState::connecting:
-      return "connecting";
-    case InstrumentState::configuring:
-      return "configuring";
-    case InstrumentState::streaming:
-      return "streaming";
-    case InstrumentState::signal_lost:
-      return "signal lost";
-    case InstrumentState::reconnecting:
-      return "reconnecting";
-  }
-  return "unknown";
+  return name_of(kInstrumentStateNames, s, "unknown");
 }
 
+constexpr EnumName<DeviceMessage::Severity> kSeverityNames[] = {
+    {DeviceMessage::Severity::info, "info"},
+    {DeviceMessage::Severity::warning, "warning"},
+    {DeviceMessage::Severity::error, "error"}};
+
 std::string_view to_string(DeviceMessage::Severity s) {
-  switch (s) {
-    case DeviceMessage::Severity::info:
-      return "info";
-    case DeviceMessage::Severity::warning:
-      return "warning";
-    case DeviceMessage::Severity::error:
-      return "error";
-  }
-  return "unknown";
+  return name_of(kSeverityNames, s, "unknown");
 }
 
 namespace detail {

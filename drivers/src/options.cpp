@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::drivers {
@@ -67,21 +68,11 @@ std::optional<double> parse_double(std::string_view s) {
 }  // namespace
 
 std::string_view to_string(OptionType type) {
-  switch (type) {
-    case OptionType::boolean:
-      return "boolean";
-    case OptionType::integer:
-      return "integer";
-    case OptionType::number:
-      return "number";
-    case OptionType::string:
-      return "string";
-    case OptionType::choice:
-      return "choice";
-    case OptionType::integer_list:
-      return "integer list";
-  }
-  return "unknown";
+  using enum OptionType;
+  static constexpr EnumName<OptionType> kNames[] = {
+      {boolean, "boolean"}, {integer, "integer"}, {number, "number"},
+      {string, "string"},   {choice, "choice"},   {integer_list, "integer list"}};
+  return name_of(kNames, type, "unknown");
 }
 
 const OptionSpec* find_option(std::span<const OptionSpec> table, std::string_view name) {

@@ -4,22 +4,16 @@
 
 #include <fmt/format.h>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::drivers {
 
 std::string_view to_string(DecodedItem::Kind k) {
-  switch (k) {
-    case DecodedItem::Kind::reading:
-      return "reading";
-    case DecodedItem::Kind::error:
-      return "error";
-    case DecodedItem::Kind::gap:
-      return "gap";
-    case DecodedItem::Kind::note:
-      return "note";
-  }
-  return "unknown";
+  using enum DecodedItem::Kind;
+  static constexpr EnumName<DecodedItem::Kind> kNames[] = {
+      {reading, "reading"}, {error, "error"}, {gap, "gap"}, {note, "note"}};
+  return name_of(kNames, k, "unknown");
 }
 
 const DeviceDriver* find_driver(std::string_view name) {

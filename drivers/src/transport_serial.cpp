@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "asio_session.hpp"
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/text.hpp"
 
@@ -316,19 +317,13 @@ std::unique_ptr<Transport> make_serial(asio::io_context& io, SerialSettings sett
 }
 
 std::string_view to_string(ErrorKind kind) {
-  switch (kind) {
-    case ErrorKind::open_failed:
-      return "open failed";
-    case ErrorKind::read_failed:
-      return "read failed";
-    case ErrorKind::write_failed:
-      return "write failed";
-    case ErrorKind::closed_by_peer:
-      return "closed by peer";
-    case ErrorKind::timeout:
-      return "timeout";
-  }
-  return "unknown";
+  using enum ErrorKind;
+  // clang-format off
+  static constexpr EnumName<ErrorKind> kNames[] = {
+      {open_failed, "open failed"}, {read_failed, "read failed"}, {write_failed, "write failed"},
+      {closed_by_peer, "closed by peer"}, {timeout, "timeout"}};
+  // clang-format on
+  return name_of(kNames, kind, "unknown");
 }
 
 }  // namespace cal::drivers::transport

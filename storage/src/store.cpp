@@ -11,33 +11,27 @@
 #include <cmath>
 #include <cstring>
 
+#include "cal/analysis/enum_names.hpp"
 #include "store_impl.hpp"
 
 namespace cal::storage {
 
-std::string_view to_string(RunStatus s) {
-  switch (s) {
-    case RunStatus::running:
-      return "running";
-    case RunStatus::complete:
-      return "complete";
-    case RunStatus::incomplete:
-      return "incomplete";
-    case RunStatus::aborted:
-      return "aborted";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<RunStatus> kStatusNames[] = {{RunStatus::running, "running"},
+                                                {RunStatus::complete, "complete"},
+                                                {RunStatus::incomplete, "incomplete"},
+                                                {RunStatus::aborted, "aborted"}};
+}  // namespace
+
+std::string_view to_string(RunStatus s) { return name_of(kStatusNames, s, "unknown"); }
 
 namespace {
 
 using detail::Stmt;
 
+// The CHECK constraint admits only the four names; anything else reads as still running.
 RunStatus status_from(std::string_view s) {
-  if (s == "complete") return RunStatus::complete;
-  if (s == "incomplete") return RunStatus::incomplete;
-  if (s == "aborted") return RunStatus::aborted;
-  return RunStatus::running;
+  return value_named(kStatusNames, s).value_or(RunStatus::running);
 }
 
 // The schema, one entry per version: entry k migrates from version k to k + 1. A migration
@@ -219,14 +213,10 @@ std::int64_t unix_ms_now() {
 
 namespace {
 
-void bind_text(sqlite3_stmt* s, int i, std::string_view v) {
-  // An empty view may have a null data(), which SQLite would store as NULL, not ''.
-  sqlite3_bind_text(s, i, v.empty() ? "" : v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
-}
-std::string column_text(sqlite3_stmt* s, int i) {
-  const auto* p = sqlite3_column_text(s, i);
-  return p ? reinterpret_cast<const char*>(p) : "";
-}
+using detail::bind_all;
+using detail::read_all;
+
+void bind_text(sqlite3_stmt* s, int i, std::string_view v) { detail::bind_value(s, i, v); }
 
 bool process_alive(std::int64_t pid) {
   if (pid <= 0) return false;
@@ -250,6 +240,22 @@ std::string file_uri(const std::filesystem::path& path) {
       uri += fmt::format("%{:02X}", c);
   }
   return uri;
+}
+
+// A reference to another row: NULL for 0 (none).
+std::optional<std::int64_t> id_or_null(std::int64_t id) {
+  return id > 0 ? std::optional(id) : std::nullopt;
+}
+
+// Every row of `sql`, with `params` bound to its parameters, as a T read by `read(stmt, T&)`.
+template <class T, class Read, class... Params>
+std::vector<T> rows_of(const Store::Impl& m, const std::string& sql, Read read,
+                       const Params&... params) {
+  auto s = m.prepare(sql.c_str());
+  bind_all(s.get(), params...);
+  std::vector<T> out;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) read(s.get(), out.emplace_back());
+  return out;
 }
 
 constexpr std::string_view kInterrupted =
@@ -443,27 +449,30 @@ bool Store::read_only() const { return impl_->read_only; }
 std::int64_t Store::add_machine(const MachineRecord& r) {
   impl_->need_writable("add machine");
   auto s = impl_->prepare("INSERT INTO machines(name, description, config_json) VALUES(?, ?, ?)");
-  bind_text(s.get(), 1, r.name);
-  bind_text(s.get(), 2, r.description);
-  bind_text(s.get(), 3, r.config_json);
+  bind_all(s.get(), r.name, r.description, r.config_json);
   impl_->step_done(s.get(), fmt::format("add machine '{}'", r.name));
   return sqlite3_last_insert_rowid(impl_->db.get());
 }
 
+namespace {
+std::optional<MachineRecord> machine_row(sqlite3_stmt* s) {
+  if (sqlite3_step(s) != SQLITE_ROW) return std::nullopt;
+  MachineRecord r;
+  read_all(s, r.id, r.name, r.description, r.config_json);
+  return r;
+}
+}  // namespace
+
 std::optional<MachineRecord> Store::machine_by_name(std::string_view name) const {
   auto s = impl_->prepare("SELECT id, name, description, config_json FROM machines WHERE name = ?");
   bind_text(s.get(), 1, name);
-  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
-  return MachineRecord{sqlite3_column_int64(s.get(), 0), column_text(s.get(), 1),
-                       column_text(s.get(), 2), column_text(s.get(), 3)};
+  return machine_row(s.get());
 }
 
 std::optional<MachineRecord> Store::machine(std::int64_t id) const {
   auto s = impl_->prepare("SELECT id, name, description, config_json FROM machines WHERE id = ?");
   sqlite3_bind_int64(s.get(), 1, id);
-  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
-  return MachineRecord{sqlite3_column_int64(s.get(), 0), column_text(s.get(), 1),
-                       column_text(s.get(), 2), column_text(s.get(), 3)};
+  return machine_row(s.get());
 }
 
 std::int64_t Store::begin_run(const RunRecord& r) {
@@ -475,17 +484,10 @@ std::int64_t Store::begin_run(const RunRecord& r) {
   if (!r.uuid.empty() && !is_uuid(r.uuid))
     throw StoreError(fmt::format("{}: begin run: '{}' is not a UUID (8-4-4-4-12 lower-case hex)",
                                  impl_->path.string(), r.uuid));
-  if (r.machine_id > 0) sqlite3_bind_int64(s.get(), 1, r.machine_id);
-  bind_text(s.get(), 2, r.campaign);
-  bind_text(s.get(), 3, r.kind);
-  bind_text(s.get(), 4, r.axis);
-  bind_text(s.get(), 5, r.settings_json);
-  bind_text(s.get(), 6, r.capture_path);
-  bind_text(s.get(), 7, r.software_version);
-  sqlite3_bind_int64(s.get(), 8, r.started_unix_ms ? r.started_unix_ms : unix_ms_now());
-  bind_text(s.get(), 9, r.note);
-  sqlite3_bind_int64(s.get(), 10, ::getpid());
-  bind_text(s.get(), 11, r.uuid.empty() ? new_uuid() : r.uuid);
+  bind_all(s.get(), id_or_null(r.machine_id), r.campaign, r.kind, r.axis, r.settings_json,
+           r.capture_path, r.software_version,
+           r.started_unix_ms ? r.started_unix_ms : unix_ms_now(), r.note, std::int64_t{::getpid()},
+           r.uuid.empty() ? new_uuid() : r.uuid);
   impl_->step_done(s.get(), "begin run");
   return sqlite3_last_insert_rowid(impl_->db.get());
 }
@@ -495,13 +497,8 @@ void Store::add_instrument(const InstrumentRecord& i) {
   auto s = impl_->prepare(
       "INSERT INTO instruments(run_id, device, driver, transport, settings_json, origin, "
       "origin_detail) VALUES(?, ?, ?, ?, ?, ?, ?)");
-  sqlite3_bind_int64(s.get(), 1, i.run_id);
-  sqlite3_bind_int(s.get(), 2, i.device);
-  bind_text(s.get(), 3, i.driver);
-  bind_text(s.get(), 4, i.transport);
-  bind_text(s.get(), 5, i.settings_json);
-  bind_text(s.get(), 6, i.origin);
-  bind_text(s.get(), 7, i.origin_detail);
+  bind_all(s.get(), i.run_id, i.device, i.driver, i.transport, i.settings_json, i.origin,
+           i.origin_detail);
   impl_->step_done(s.get(), fmt::format("add instrument {} to run {}", i.device, i.run_id));
 }
 
@@ -538,35 +535,25 @@ constexpr const char* kRunColumns =
 // have marked it, and says so.
 RunRecord read_run(sqlite3_stmt* s, bool read_only) {
   RunRecord r;
-  r.id = sqlite3_column_int64(s, 0);
-  r.machine_id = sqlite3_column_int64(s, 1);
-  r.campaign = column_text(s, 2);
-  r.kind = column_text(s, 3);
-  r.axis = column_text(s, 4);
-  r.settings_json = column_text(s, 5);
-  r.capture_path = column_text(s, 6);
-  r.software_version = column_text(s, 7);
-  r.started_unix_ms = sqlite3_column_int64(s, 8);
-  if (sqlite3_column_type(s, 9) != SQLITE_NULL) r.ended_unix_ms = sqlite3_column_int64(s, 9);
-  r.status = status_from(column_text(s, 10));
-  r.note = column_text(s, 11);
-  if (read_only && r.status == RunStatus::running && !process_alive(sqlite3_column_int64(s, 12))) {
+  std::string status;
+  std::int64_t owner_pid = 0;
+  read_all(s, r.id, r.machine_id, r.campaign, r.kind, r.axis, r.settings_json, r.capture_path,
+           r.software_version, r.started_unix_ms, r.ended_unix_ms, status, r.note, owner_pid,
+           r.origin_session_ns, r.origin_unix_ns, r.uuid);
+  r.status = status_from(status);
+  if (read_only && r.status == RunStatus::running && !process_alive(owner_pid)) {
     r.status = RunStatus::incomplete;
     r.note = fmt::format("{} (not yet marked so in the database, which was opened read-only)",
                          kInterrupted);
   }
-  if (sqlite3_column_type(s, 13) != SQLITE_NULL) r.origin_session_ns = sqlite3_column_int64(s, 13);
-  if (sqlite3_column_type(s, 14) != SQLITE_NULL) r.origin_unix_ns = sqlite3_column_int64(s, 14);
-  r.uuid = column_text(s, 15);
   return r;
 }
 }  // namespace
 
 std::vector<RunRecord> Store::runs() const {
-  auto s = impl_->prepare((std::string(kRunColumns) + " ORDER BY id").c_str());
-  std::vector<RunRecord> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) out.push_back(read_run(s.get(), impl_->read_only));
-  return out;
+  return rows_of<RunRecord>(
+      *impl_, std::string(kRunColumns) + " ORDER BY id",
+      [&](sqlite3_stmt* s, RunRecord& r) { r = read_run(s, impl_->read_only); });
 }
 
 std::optional<RunRecord> Store::run(std::int64_t run_id) const {
@@ -584,16 +571,15 @@ std::optional<RunRecord> Store::run_by_uuid(std::string_view uuid) const {
 }
 
 std::vector<InstrumentRecord> Store::instruments(std::int64_t run_id) const {
-  auto s = impl_->prepare(
+  return rows_of<InstrumentRecord>(
+      *impl_,
       "SELECT run_id, device, driver, transport, settings_json, origin, origin_detail FROM "
-      "instruments WHERE run_id = ? ORDER BY device");
-  sqlite3_bind_int64(s.get(), 1, run_id);
-  std::vector<InstrumentRecord> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW)
-    out.push_back({sqlite3_column_int64(s.get(), 0), sqlite3_column_int(s.get(), 1),
-                   column_text(s.get(), 2), column_text(s.get(), 3), column_text(s.get(), 4),
-                   column_text(s.get(), 5), column_text(s.get(), 6)});
-  return out;
+      "instruments WHERE run_id = ? ORDER BY device",
+      [](sqlite3_stmt* s, InstrumentRecord& i) {
+        read_all(s, i.run_id, i.device, i.driver, i.transport, i.settings_json, i.origin,
+                 i.origin_detail);
+      },
+      run_id);
 }
 
 std::int64_t Store::add_compensation(const CompensationRecord& c) {
@@ -601,38 +587,24 @@ std::int64_t Store::add_compensation(const CompensationRecord& c) {
   auto s = impl_->prepare(
       "INSERT INTO compensations(machine_id, source_run_id, source, axis, format, "
       "created_unix_ms, json) VALUES(?, ?, ?, ?, ?, ?, ?)");
-  if (c.machine_id > 0) sqlite3_bind_int64(s.get(), 1, c.machine_id);
-  if (c.source_run_id > 0) sqlite3_bind_int64(s.get(), 2, c.source_run_id);
-  bind_text(s.get(), 3, c.source);
-  bind_text(s.get(), 4, c.axis);
-  bind_text(s.get(), 5, c.format);
-  sqlite3_bind_int64(s.get(), 6, c.created_unix_ms ? c.created_unix_ms : unix_ms_now());
-  bind_text(s.get(), 7, c.json);
+  bind_all(s.get(), id_or_null(c.machine_id), id_or_null(c.source_run_id), c.source, c.axis,
+           c.format, c.created_unix_ms ? c.created_unix_ms : unix_ms_now(), c.json);
   impl_->step_done(s.get(), fmt::format("add the compensation of axis {} ({})", c.axis, c.format));
   return sqlite3_last_insert_rowid(impl_->db.get());
 }
 
 std::vector<CompensationRecord> Store::compensations(std::int64_t machine_id,
                                                      std::string_view axis) const {
-  auto s = impl_->prepare(
+  return rows_of<CompensationRecord>(
+      *impl_,
       "SELECT id, IFNULL(machine_id, 0), IFNULL(source_run_id, 0), source, axis, format, "
       "created_unix_ms, json FROM compensations WHERE (? = 0 OR machine_id = ?) AND (? = '' OR "
-      "axis = ?) ORDER BY created_unix_ms, id");
-  sqlite3_bind_int64(s.get(), 1, machine_id);
-  sqlite3_bind_int64(s.get(), 2, machine_id);
-  bind_text(s.get(), 3, axis);
-  bind_text(s.get(), 4, axis);
-  std::vector<CompensationRecord> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW)
-    out.push_back({.id = sqlite3_column_int64(s.get(), 0),
-                   .machine_id = sqlite3_column_int64(s.get(), 1),
-                   .source_run_id = sqlite3_column_int64(s.get(), 2),
-                   .source = column_text(s.get(), 3),
-                   .axis = column_text(s.get(), 4),
-                   .format = column_text(s.get(), 5),
-                   .created_unix_ms = sqlite3_column_int64(s.get(), 6),
-                   .json = column_text(s.get(), 7)});
-  return out;
+      "axis = ?) ORDER BY created_unix_ms, id",
+      [](sqlite3_stmt* s, CompensationRecord& c) {
+        read_all(s, c.id, c.machine_id, c.source_run_id, c.source, c.axis, c.format,
+                 c.created_unix_ms, c.json);
+      },
+      machine_id, machine_id, axis, axis);
 }
 
 void PreparedBatch::prepare(std::span<const RawReading> readings) {
@@ -706,17 +678,8 @@ void Store::append_prepared(std::int64_t run_id, const PreparedBatch& batch) {
                          .last_ns = c.last_ns,
                          .count = c.count,
                          .encoding = chunk::columns_v2};
-    sqlite3_bind_int64(s, 1, run_id);
-    sqlite3_bind_int64(s, 2, key.device);
-    sqlite3_bind_int64(s, 3, key.channel);
-    sqlite3_bind_int64(s, 4, key.quantity);
-    sqlite3_bind_int64(s, 5, key.first_ns);
-    sqlite3_bind_int64(s, 6, key.last_ns);
-    sqlite3_bind_int64(s, 7, key.count);
-    sqlite3_bind_blob64(s, 8, c.blob.data(), c.blob.size(), SQLITE_STATIC);
-    sqlite3_bind_int64(s, 9, key.encoding);
-    sqlite3_bind_int64(s, 10, key.seq);
-    sqlite3_bind_int64(s, 11, chunk::checksum(key, c.blob));
+    bind_all(s, run_id, key.device, key.channel, key.quantity, key.first_ns, key.last_ns, key.count,
+             c.blob, key.encoding, key.seq, std::int64_t{chunk::checksum(key, c.blob)});
     if (sqlite3_step(s) != SQLITE_DONE) {
       const std::string what = fmt::format("{}: store {} readings of run {}: {}", m.path.string(),
                                            c.count, run_id, sqlite3_errmsg(m.db.get()));
@@ -775,17 +738,11 @@ std::vector<Store::StoredChunk> Store::stored_chunks(std::int64_t run_id, std::i
     if (rc == SQLITE_DONE) break;
     if (rc != SQLITE_ROW) m.fail(fmt::format("read the reading chunks of run {}", run_id));
     StoredChunk c;
-    c.device = sqlite3_column_int64(s.get(), 0);
-    c.channel = sqlite3_column_int64(s.get(), 1);
-    c.quantity = sqlite3_column_int64(s.get(), 2);
-    c.first_ns = sqlite3_column_int64(s.get(), 3);
-    c.last_ns = sqlite3_column_int64(s.get(), 4);
-    c.count = sqlite3_column_int64(s.get(), 5);
-    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(s.get(), 6));
-    c.data.assign(data, data + sqlite3_column_bytes(s.get(), 6));
-    c.encoding = sqlite3_column_int64(s.get(), 7);
-    c.stored_checksum = sqlite3_column_type(s.get(), 9) != SQLITE_NULL;
-    c.seq = c.stored_checksum ? sqlite3_column_int64(s.get(), 8) : place;
+    std::optional<std::int64_t> seq, crc;
+    read_all(s.get(), c.device, c.channel, c.quantity, c.first_ns, c.last_ns, c.count, c.data,
+             c.encoding, seq, crc);
+    c.stored_checksum = crc.has_value();
+    c.seq = c.stored_checksum ? seq.value_or(0) : place;
     const chunk::Key key{.run_id = run_id,
                          .seq = c.seq,
                          .device = c.device,
@@ -797,7 +754,7 @@ std::vector<Store::StoredChunk> Store::stored_chunks(std::int64_t run_id, std::i
                          .encoding = c.encoding};
     c.crc = chunk::checksum(key, c.data);
     const char* damage = nullptr;
-    if (c.stored_checksum && static_cast<std::uint32_t>(sqlite3_column_int64(s.get(), 9)) != c.crc)
+    if (c.stored_checksum && static_cast<std::uint32_t>(*crc) != c.crc)
       damage = "its checksum does not match its contents";
     else if (c.seq != place)
       damage = "the run's chunks are not numbered 0, 1, 2, ... (one is missing or twice)";
@@ -827,23 +784,22 @@ std::int64_t Store::reading_count(std::int64_t run_id) const {
   return sqlite3_column_int64(s.get(), 0);
 }
 
+namespace {
+// The columns of a captured target, in the order of CapturedTarget's fields.
+constexpr const char* kTargetColumns =
+    "run_id, target_index, run_number, direction, nominal_mm, time_ns, raw_m, deviation_um, "
+    "refractive_index, material_temperature_degc";
+}  // namespace
+
 void Store::Impl::insert_targets(std::span<const CapturedTarget> targets) {
   Impl& m = *this;
-  auto s = m.prepare(
-      "INSERT INTO captured_targets(run_id, target_index, run_number, direction, nominal_mm, "
-      "time_ns, raw_m, deviation_um, refractive_index, material_temperature_degc) "
-      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  auto s = m.prepare(fmt::format("INSERT INTO captured_targets({}) VALUES(?, ?, ?, ?, ?, ?, ?, ?, "
+                                 "?, ?)",
+                                 kTargetColumns)
+                         .c_str());
   for (const auto& t : targets) {
-    sqlite3_bind_int64(s.get(), 1, t.run_id);
-    sqlite3_bind_int(s.get(), 2, t.target_index);
-    sqlite3_bind_int(s.get(), 3, t.run_number);
-    bind_text(s.get(), 4, std::string_view(&t.direction, 1));
-    sqlite3_bind_double(s.get(), 5, t.nominal_mm);
-    sqlite3_bind_int64(s.get(), 6, t.time_ns);
-    sqlite3_bind_double(s.get(), 7, t.raw_m);
-    sqlite3_bind_double(s.get(), 8, t.deviation_um);
-    sqlite3_bind_double(s.get(), 9, t.refractive_index);
-    sqlite3_bind_double(s.get(), 10, t.material_temperature_degc);
+    bind_all(s.get(), t.run_id, t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns,
+             t.raw_m, t.deviation_um, t.refractive_index, t.material_temperature_degc);
     m.step_done(s.get(), fmt::format("store target {} run {} {} of run {}", t.target_index,
                                      t.run_number, t.direction, t.run_id));
   }
@@ -865,38 +821,25 @@ void Store::replace_targets(std::int64_t run_id, std::span<const CapturedTarget>
 }
 
 std::vector<CapturedTarget> Store::targets(std::int64_t run_id) const {
-  auto s = impl_->prepare(
-      "SELECT run_id, target_index, run_number, direction, nominal_mm, time_ns, raw_m, "
-      "deviation_um, refractive_index, material_temperature_degc FROM captured_targets "
-      "WHERE run_id = ? ORDER BY time_ns, run_number, target_index");
-  sqlite3_bind_int64(s.get(), 1, run_id);
-  std::vector<CapturedTarget> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    CapturedTarget t;
-    t.run_id = sqlite3_column_int64(s.get(), 0);
-    t.target_index = sqlite3_column_int(s.get(), 1);
-    t.run_number = sqlite3_column_int(s.get(), 2);
-    t.direction = column_text(s.get(), 3).front();
-    t.nominal_mm = sqlite3_column_double(s.get(), 4);
-    t.time_ns = sqlite3_column_int64(s.get(), 5);
-    t.raw_m = sqlite3_column_double(s.get(), 6);
-    t.deviation_um = sqlite3_column_double(s.get(), 7);
-    t.refractive_index = sqlite3_column_double(s.get(), 8);
-    t.material_temperature_degc = sqlite3_column_double(s.get(), 9);
-    out.push_back(t);
-  }
-  return out;
+  return rows_of<CapturedTarget>(
+      *impl_,
+      fmt::format("SELECT {} FROM captured_targets WHERE run_id = ? ORDER BY time_ns, run_number, "
+                  "target_index",
+                  kTargetColumns),
+      [](sqlite3_stmt* s, CapturedTarget& t) {
+        read_all(s, t.run_id, t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns,
+                 t.raw_m, t.deviation_um, t.refractive_index, t.material_temperature_degc);
+      },
+      run_id);
 }
 
 std::int64_t Store::Impl::insert_result(const ResultRecord& r, Supersede how) {
   auto s = prepare(
       "INSERT INTO results(run_id, standard, json, created_unix_ms, provenance_json) "
       "VALUES(?, ?, ?, ?, ?)");
-  sqlite3_bind_int64(s.get(), 1, r.run_id);
-  bind_text(s.get(), 2, r.standard);
-  bind_text(s.get(), 3, r.json);
-  sqlite3_bind_int64(s.get(), 4, r.created_unix_ms ? r.created_unix_ms : unix_ms_now());
-  bind_text(s.get(), 5, r.provenance_json.empty() ? std::string_view("{}") : r.provenance_json);
+  bind_all(s.get(), r.run_id, r.standard, r.json,
+           r.created_unix_ms ? r.created_unix_ms : unix_ms_now(),
+           r.provenance_json.empty() ? std::string_view("{}") : r.provenance_json);
   step_done(s.get(), fmt::format("store result of run {}", r.run_id));
   const std::int64_t id = sqlite3_last_insert_rowid(db.get());
   if (how == Supersede::none) return id;
@@ -905,9 +848,7 @@ std::int64_t Store::Impl::insert_result(const ResultRecord& r, Supersede how) {
                          "superseded_by IS NULL"
                        : "UPDATE results SET superseded_by = ? WHERE run_id = ? AND id <> ? AND "
                          "superseded_by IS NULL AND standard = ?");
-  sqlite3_bind_int64(u.get(), 1, id);
-  sqlite3_bind_int64(u.get(), 2, r.run_id);
-  sqlite3_bind_int64(u.get(), 3, id);
+  bind_all(u.get(), id, r.run_id, id);
   if (how == Supersede::same_standard) bind_text(u.get(), 4, r.standard);
   step_done(u.get(), fmt::format("mark the results of run {} superseded", r.run_id));
   return id;
@@ -933,23 +874,15 @@ std::int64_t Store::replace_targets(std::int64_t run_id, std::span<const Capture
 }
 
 std::vector<ResultRecord> Store::results(std::int64_t run_id) const {
-  auto s = impl_->prepare(
+  return rows_of<ResultRecord>(
+      *impl_,
       "SELECT run_id, standard, json, created_unix_ms, provenance_json, id, superseded_by "
-      "FROM results WHERE run_id = ? ORDER BY id");
-  sqlite3_bind_int64(s.get(), 1, run_id);
-  std::vector<ResultRecord> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    ResultRecord r{.run_id = sqlite3_column_int64(s.get(), 0),
-                   .standard = column_text(s.get(), 1),
-                   .json = column_text(s.get(), 2),
-                   .created_unix_ms = sqlite3_column_int64(s.get(), 3),
-                   .provenance_json = column_text(s.get(), 4),
-                   .id = sqlite3_column_int64(s.get(), 5)};
-    if (sqlite3_column_type(s.get(), 6) != SQLITE_NULL)
-      r.superseded_by = sqlite3_column_int64(s.get(), 6);
-    out.push_back(std::move(r));
-  }
-  return out;
+      "FROM results WHERE run_id = ? ORDER BY id",
+      [](sqlite3_stmt* s, ResultRecord& r) {
+        read_all(s, r.run_id, r.standard, r.json, r.created_unix_ms, r.provenance_json, r.id,
+                 r.superseded_by);
+      },
+      run_id);
 }
 
 void Store::set_missed_stops(std::int64_t run_id, std::span<const MissedStop> stops) {
@@ -961,11 +894,7 @@ void Store::set_missed_stops(std::int64_t run_id, std::span<const MissedStop> st
       "INSERT INTO missed_stops(run_id, run_number, direction, target_index, nominal_mm) "
       "VALUES(?, ?, ?, ?, ?)");
   for (const auto& m : stops) {
-    sqlite3_bind_int64(s.get(), 1, run_id);
-    sqlite3_bind_int(s.get(), 2, m.run_number);
-    bind_text(s.get(), 3, std::string_view(&m.direction, 1));
-    sqlite3_bind_int(s.get(), 4, m.target_index);
-    sqlite3_bind_double(s.get(), 5, m.nominal_mm);
+    bind_all(s.get(), run_id, m.run_number, m.direction, m.target_index, m.nominal_mm);
     impl_->step_done(s.get(), fmt::format("store a missed stop of run {}", run_id));
   }
   tx.commit();
@@ -977,9 +906,7 @@ void Store::set_quality(std::int64_t run_id, const RunQuality& q) {
         fmt::format("{}: run {}: unknown quality '{}'", impl_->path.string(), run_id, q.state));
   Impl::Transaction tx(*impl_);
   auto r = impl_->prepare("UPDATE runs SET quality = ?, quality_note = ? WHERE id = ?");
-  bind_text(r.get(), 1, q.state);
-  bind_text(r.get(), 2, q.summary);
-  sqlite3_bind_int64(r.get(), 3, run_id);
+  bind_all(r.get(), q.state, q.summary, run_id);
   impl_->step_done(r.get(), fmt::format("store the quality of run {}", run_id));
   auto clear = impl_->prepare("UPDATE captured_targets SET suspect = NULL WHERE run_id = ?");
   sqlite3_bind_int64(clear.get(), 1, run_id);
@@ -988,11 +915,7 @@ void Store::set_quality(std::int64_t run_id, const RunQuality& q) {
       "UPDATE captured_targets SET suspect = ? WHERE run_id = ? AND run_number = ? AND "
       "direction = ? AND target_index = ?");
   for (const auto& m : q.suspects) {
-    bind_text(mark.get(), 1, m.reason);
-    sqlite3_bind_int64(mark.get(), 2, run_id);
-    sqlite3_bind_int(mark.get(), 3, m.run_number);
-    bind_text(mark.get(), 4, std::string_view(&m.direction, 1));
-    sqlite3_bind_int(mark.get(), 5, m.target_index);
+    bind_all(mark.get(), m.reason, run_id, m.run_number, m.direction, m.target_index);
     impl_->step_done(mark.get(), fmt::format("mark a suspect stop of run {}", run_id));
   }
   tx.commit();
@@ -1004,32 +927,28 @@ std::optional<RunQuality> Store::quality(std::int64_t run_id) const {
   sqlite3_bind_int64(r.get(), 1, run_id);
   if (sqlite3_step(r.get()) != SQLITE_ROW || sqlite3_column_type(r.get(), 0) == SQLITE_NULL)
     return std::nullopt;
-  RunQuality q{.state = column_text(r.get(), 0), .summary = column_text(r.get(), 1)};
-  auto s = impl_->prepare(
+  RunQuality q;
+  read_all(r.get(), q.state, q.summary);
+  q.suspects = rows_of<StopMark>(
+      *impl_,
       "SELECT run_number, direction, target_index, suspect FROM captured_targets "
-      "WHERE run_id = ? AND suspect IS NOT NULL ORDER BY time_ns, run_number, target_index");
-  sqlite3_bind_int64(s.get(), 1, run_id);
-  while (sqlite3_step(s.get()) == SQLITE_ROW)
-    q.suspects.push_back({.run_number = sqlite3_column_int(s.get(), 0),
-                          .direction = column_text(s.get(), 1).front(),
-                          .target_index = sqlite3_column_int(s.get(), 2),
-                          .reason = column_text(s.get(), 3)});
+      "WHERE run_id = ? AND suspect IS NOT NULL ORDER BY time_ns, run_number, target_index",
+      [](sqlite3_stmt* s, StopMark& m) {
+        read_all(s, m.run_number, m.direction, m.target_index, m.reason);
+      },
+      run_id);
   return q;
 }
 
 std::vector<MissedStop> Store::missed_stops(std::int64_t run_id) const {
-  auto s = impl_->prepare(
+  return rows_of<MissedStop>(
+      *impl_,
       "SELECT run_id, run_number, direction, target_index, nominal_mm FROM missed_stops "
-      "WHERE run_id = ? ORDER BY run_number, direction, target_index");
-  sqlite3_bind_int64(s.get(), 1, run_id);
-  std::vector<MissedStop> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW)
-    out.push_back({.run_id = sqlite3_column_int64(s.get(), 0),
-                   .run_number = sqlite3_column_int(s.get(), 1),
-                   .direction = column_text(s.get(), 2).front(),
-                   .target_index = sqlite3_column_int(s.get(), 3),
-                   .nominal_mm = sqlite3_column_double(s.get(), 4)});
-  return out;
+      "WHERE run_id = ? ORDER BY run_number, direction, target_index",
+      [](sqlite3_stmt* s, MissedStop& m) {
+        read_all(s, m.run_id, m.run_number, m.direction, m.target_index, m.nominal_mm);
+      },
+      run_id);
 }
 
 void Store::add_operator_action(const OperatorAction& a) {
@@ -1037,53 +956,42 @@ void Store::add_operator_action(const OperatorAction& a) {
   auto s = impl_->prepare(
       "INSERT INTO operator_actions(run_id, time_unix_ms, action, source, operator, run_number, "
       "direction, target_index, nominal_mm, detail) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-  sqlite3_bind_int64(s.get(), 1, a.run_id);
-  sqlite3_bind_int64(s.get(), 2, a.time_unix_ms ? a.time_unix_ms : unix_ms_now());
-  bind_text(s.get(), 3, a.action);
-  bind_text(s.get(), 4, a.source);
-  bind_text(s.get(), 5, a.operator_name);
+  bind_all(s.get(), a.run_id, a.time_unix_ms ? a.time_unix_ms : unix_ms_now(), a.action, a.source,
+           a.operator_name);
   if (a.stop) {
-    sqlite3_bind_int(s.get(), 6, a.stop->run_number);
-    bind_text(s.get(), 7, std::string_view(&a.stop->direction, 1));
-    sqlite3_bind_int(s.get(), 8, a.stop->target_index);
-    sqlite3_bind_double(s.get(), 9, a.stop->nominal_mm);
+    const auto& m = *a.stop;
+    detail::bind_value(s.get(), 6, m.run_number);
+    detail::bind_value(s.get(), 7, m.direction);
+    detail::bind_value(s.get(), 8, m.target_index);
+    detail::bind_value(s.get(), 9, m.nominal_mm);
   }
   bind_text(s.get(), 10, a.detail);
   impl_->step_done(s.get(), fmt::format("store a {} action of run {}", a.action, a.run_id));
 }
 
 std::vector<OperatorAction> Store::operator_actions(std::int64_t run_id) const {
-  auto s = impl_->prepare(
+  return rows_of<OperatorAction>(
+      *impl_,
       "SELECT run_id, time_unix_ms, action, source, operator, run_number, direction, "
-      "target_index, nominal_mm, detail FROM operator_actions WHERE run_id = ? ORDER BY id");
-  sqlite3_bind_int64(s.get(), 1, run_id);
-  std::vector<OperatorAction> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    OperatorAction a{.run_id = sqlite3_column_int64(s.get(), 0),
-                     .time_unix_ms = sqlite3_column_int64(s.get(), 1),
-                     .action = column_text(s.get(), 2),
-                     .source = column_text(s.get(), 3),
-                     .operator_name = column_text(s.get(), 4),
-                     .detail = column_text(s.get(), 9)};
-    if (sqlite3_column_type(s.get(), 5) != SQLITE_NULL) {
-      const auto dir = column_text(s.get(), 6);
-      a.stop = MissedStop{.run_id = a.run_id,
-                          .run_number = sqlite3_column_int(s.get(), 5),
-                          .direction = dir.empty() ? '+' : dir.front(),
-                          .target_index = sqlite3_column_int(s.get(), 7),
-                          .nominal_mm = sqlite3_column_double(s.get(), 8)};
-    }
-    out.push_back(std::move(a));
-  }
-  return out;
+      "target_index, nominal_mm, detail FROM operator_actions WHERE run_id = ? ORDER BY id",
+      [](sqlite3_stmt* s, OperatorAction& a) {
+        std::optional<int> run_number;
+        MissedStop m;
+        read_all(s, a.run_id, a.time_unix_ms, a.action, a.source, a.operator_name, run_number,
+                 m.direction, m.target_index, m.nominal_mm, a.detail);
+        if (run_number) {  // an action on a stop
+          m.run_id = a.run_id;
+          m.run_number = *run_number;
+          a.stop = m;
+        }
+      },
+      run_id);
 }
 
 void Store::set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns) {
   impl_->need_writable("set the time origin");
   auto s = impl_->prepare("UPDATE runs SET origin_session_ns = ?, origin_unix_ns = ? WHERE id = ?");
-  sqlite3_bind_int64(s.get(), 1, session_ns);
-  sqlite3_bind_int64(s.get(), 2, unix_ns);
-  sqlite3_bind_int64(s.get(), 3, run_id);
+  bind_all(s.get(), session_ns, unix_ns, run_id);
   impl_->step_done(s.get(), fmt::format("set the time origin of run {}", run_id));
 }
 
@@ -1094,17 +1002,9 @@ constexpr const char* kCalibrationColumns =
     "zero_length_mm, temperature_degc, calibrated_unix_ms, note";
 
 BarCalibration calibration_row(sqlite3_stmt* s) {
-  BarCalibration c{.id = sqlite3_column_int64(s, 0),
-                   .bar = column_text(s, 1),
-                   .nominal_mm = sqlite3_column_double(s, 2),
-                   .extensions = column_text(s, 3),
-                   .calibrator = column_text(s, 4),
-                   .calibrator_length_mm = sqlite3_column_double(s, 5),
-                   .reading_mm = sqlite3_column_double(s, 6),
-                   .zero_length_mm = sqlite3_column_double(s, 7),
-                   .calibrated_unix_ms = sqlite3_column_int64(s, 9),
-                   .note = column_text(s, 10)};
-  if (sqlite3_column_type(s, 8) != SQLITE_NULL) c.temperature_degc = sqlite3_column_double(s, 8);
+  BarCalibration c;
+  read_all(s, c.id, c.bar, c.nominal_mm, c.extensions, c.calibrator, c.calibrator_length_mm,
+           c.reading_mm, c.zero_length_mm, c.temperature_degc, c.calibrated_unix_ms, c.note);
   return c;
 }
 
@@ -1123,30 +1023,20 @@ std::int64_t Store::add_bar_calibration(const BarCalibration& c) {
       "INSERT INTO ballbar_calibrations(bar, nominal_mm, extensions, calibrator, "
       "calibrator_length_mm, reading_mm, zero_length_mm, temperature_degc, calibrated_unix_ms, "
       "note) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-  bind_text(s.get(), 1, c.bar);
-  sqlite3_bind_double(s.get(), 2, c.nominal_mm);
-  bind_text(s.get(), 3, c.extensions);
-  bind_text(s.get(), 4, c.calibrator);
-  sqlite3_bind_double(s.get(), 5, c.calibrator_length_mm);
-  sqlite3_bind_double(s.get(), 6, c.reading_mm);
-  sqlite3_bind_double(s.get(), 7, c.zero_length_mm);
-  if (c.temperature_degc) sqlite3_bind_double(s.get(), 8, *c.temperature_degc);
-  sqlite3_bind_int64(s.get(), 9, c.calibrated_unix_ms ? c.calibrated_unix_ms : unix_ms_now());
-  bind_text(s.get(), 10, c.note);
+  bind_all(s.get(), c.bar, c.nominal_mm, c.extensions, c.calibrator, c.calibrator_length_mm,
+           c.reading_mm, c.zero_length_mm, c.temperature_degc,
+           c.calibrated_unix_ms ? c.calibrated_unix_ms : unix_ms_now(), c.note);
   impl_->step_done(s.get(), fmt::format("add a calibration of ballbar '{}'", c.bar));
   return sqlite3_last_insert_rowid(impl_->db.get());
 }
 
 std::vector<BarCalibration> Store::bar_calibrations(std::string_view bar) const {
-  auto s = impl_->prepare(fmt::format("SELECT {} FROM ballbar_calibrations WHERE ? = '' OR bar = ? "
-                                      "ORDER BY calibrated_unix_ms, id",
-                                      kCalibrationColumns)
-                              .c_str());
-  bind_text(s.get(), 1, bar);
-  bind_text(s.get(), 2, bar);
-  std::vector<BarCalibration> out;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) out.push_back(calibration_row(s.get()));
-  return out;
+  return rows_of<BarCalibration>(
+      *impl_,
+      fmt::format("SELECT {} FROM ballbar_calibrations WHERE ? = '' OR bar = ? ORDER BY "
+                  "calibrated_unix_ms, id",
+                  kCalibrationColumns),
+      [](sqlite3_stmt* s, BarCalibration& c) { c = calibration_row(s); }, bar, bar);
 }
 
 std::optional<BarCalibration> Store::bar_calibration(std::string_view bar, double nominal_mm,

@@ -6,6 +6,8 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +25,64 @@ struct StmtFinalizer {
   void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
 };
 using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalizer>;
+
+// One column or parameter of a record, by the type of its field: the row mapper that every
+// SELECT and INSERT of the store goes through, so that a record's columns are listed once per
+// statement (in the SQL) and once in the call, in the same order. A char is a one-character
+// text (a stop's direction: '+' where it is missing); an optional is NULL when empty.
+inline void bind_value(sqlite3_stmt* s, int i, std::int64_t v) { sqlite3_bind_int64(s, i, v); }
+inline void bind_value(sqlite3_stmt* s, int i, int v) { sqlite3_bind_int(s, i, v); }
+inline void bind_value(sqlite3_stmt* s, int i, double v) { sqlite3_bind_double(s, i, v); }
+inline void bind_value(sqlite3_stmt* s, int i, std::string_view v) {
+  // An empty view may have a null data(), which SQLite would store as NULL, not ''.
+  sqlite3_bind_text(s, i, v.empty() ? "" : v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+}
+inline void bind_value(sqlite3_stmt* s, int i, char v) {
+  bind_value(s, i, std::string_view(&v, 1));
+}
+// A BLOB is bound without a copy: its bytes must outlive the statement's step.
+inline void bind_value(sqlite3_stmt* s, int i, std::span<const unsigned char> v) {
+  sqlite3_bind_blob64(s, i, v.data(), v.size(), SQLITE_STATIC);
+}
+template <class T>
+void bind_value(sqlite3_stmt* s, int i, const std::optional<T>& v) {
+  if (v) bind_value(s, i, *v);  // unbound parameters are NULL
+}
+
+inline void read_value(sqlite3_stmt* s, int i, std::int64_t& v) { v = sqlite3_column_int64(s, i); }
+inline void read_value(sqlite3_stmt* s, int i, int& v) { v = sqlite3_column_int(s, i); }
+inline void read_value(sqlite3_stmt* s, int i, double& v) { v = sqlite3_column_double(s, i); }
+inline void read_value(sqlite3_stmt* s, int i, std::string& v) {
+  const auto* p = sqlite3_column_text(s, i);
+  v = p ? reinterpret_cast<const char*>(p) : "";
+}
+inline void read_value(sqlite3_stmt* s, int i, char& v) {
+  const auto* p = sqlite3_column_text(s, i);
+  v = p && *p ? static_cast<char>(*p) : '+';
+}
+inline void read_value(sqlite3_stmt* s, int i, std::vector<unsigned char>& v) {
+  const auto* p = static_cast<const unsigned char*>(sqlite3_column_blob(s, i));
+  v.assign(p, p + sqlite3_column_bytes(s, i));
+}
+template <class T>
+void read_value(sqlite3_stmt* s, int i, std::optional<T>& v) {
+  v.reset();
+  if (sqlite3_column_type(s, i) == SQLITE_NULL) return;
+  read_value(s, i, v.emplace());
+}
+
+// Binds `values` to the parameters 1, 2, ... of `s`, in order.
+template <class... T>
+void bind_all([[maybe_unused]] sqlite3_stmt* s, const T&... values) {
+  [[maybe_unused]] int i = 1;
+  (bind_value(s, i++, values), ...);
+}
+// Reads the columns 0, 1, ... of the current row of `s` into `fields`, in order.
+template <class... T>
+void read_all([[maybe_unused]] sqlite3_stmt* s, T&... fields) {
+  [[maybe_unused]] int i = 0;
+  (read_value(s, i++, fields), ...);
+}
 }  // namespace detail
 
 struct Store::Impl {

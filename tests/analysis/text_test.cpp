@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/json_scan.hpp"
 
 namespace {
 
@@ -50,3 +51,17 @@ TEST(Text, TerminalSafeEscapesControlsAndKeepsText) {
 }
 
 }  // namespace
+
+// JSON structure without parsing (json_scan.hpp): brackets and quotes inside strings, escaped
+// quotes included, are not structure.
+TEST(JsonScan, FindsTheFirstStructuralCharacterOutsideStrings) {
+  const std::string_view text = R"({"a": "}\"}", "b": [1]})";
+  const auto first_close = [&](std::size_t from) {
+    return cal::text::find_outside_json_strings(text, from, [](char c) { return c == '}'; });
+  };
+  EXPECT_EQ(first_close(0), text.size() - 1);
+  EXPECT_EQ(cal::text::find_outside_json_strings(text, 0, [](char c) { return c == '['; }), 19u);
+  EXPECT_EQ(cal::text::find_outside_json_strings(R"("[")", 0, [](char c) { return c == '['; }),
+            std::string_view::npos);
+  EXPECT_EQ(first_close(text.size()), std::string_view::npos);
+}

@@ -24,12 +24,20 @@ check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
   passes=$((passes + 1))
 }
 
-# scratch_dir: TMP, a new directory removed when the script exits, and SIM_PID (a `daq sim`
-# the script starts) killed then if it still runs.
+# scratch_dir [PID_VARIABLE...]: TMP, a new directory removed when the script exits, and SIM_PID
+# (a `daq sim` the script starts) and each named variable (other processes it starts, e.g.
+# RUN_PID) set empty now and, if they hold a process that still runs, killed then.
 scratch_dir() {
   TMP=$(mktemp -d)
-  SIM_PID=
-  trap '[ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null; rm -rf "$TMP"' EXIT
+  scratch_pids="SIM_PID $*"
+  local v
+  for v in $scratch_pids; do printf -v "$v" '%s' ''; done
+  trap scratch_cleanup EXIT
+}
+scratch_cleanup() {
+  local v
+  for v in $scratch_pids; do [ -n "${!v}" ] && kill "${!v}" 2>/dev/null; done
+  rm -rf "$TMP"
 }
 
 finish() {

@@ -16,16 +16,8 @@
 # Usage: every_command_test.sh DAQ_BINARY DATA_DIR
 set -u
 DAQ=$1
-TMP=$(mktemp -d)
-SIM_PID=
-RUN_PID=
-cleanup() {
-  [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null
-  [ -n "$RUN_PID" ] && kill "$RUN_PID" 2>/dev/null
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir RUN_PID
 DB=$TMP/demo.sqlite
 
 # survives NAME -- command...: exit 0, or 1/2 with a message on stderr; never a signal.

@@ -7,16 +7,8 @@
 # Usage: usage_test.sh DAQ_BINARY
 set -u
 DAQ=$(realpath "$1")
-TMP=$(mktemp -d)
-HOLD_PID=
-SIM_PID=
-cleanup() {
-  [ -n "$HOLD_PID" ] && kill "$HOLD_PID" 2>/dev/null
-  [ -n "$SIM_PID" ] && kill "$SIM_PID" 2>/dev/null
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
 source "$(dirname "$0")/check.sh"
+scratch_dir HOLD_PID
 
 # "Did you mean": commands, nested commands, aliases, long and short options.
 check mistyped_command 2 "^daq: error: unknown command 'analys' of daq; did you mean 'analyse'\?$" -- "$DAQ" analys 1

@@ -2,6 +2,7 @@
 // temper/codec.hpp); every expected temperature is worked out in the comment beside it.
 #include <gtest/gtest.h>
 
+#include "../support/temper_report.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
@@ -11,18 +12,13 @@ namespace {
 
 using namespace cal::drivers::codec;
 
-std::string report(std::initializer_list<int> bytes) {
-  std::string s;
-  for (int b : bytes) s.push_back(static_cast<char>(b));
-  s.resize(8, '\0');
-  return s;
-}
+using cal::test::temper_report;
 
 TEST(TemperCodec, GoldInnerOuterAndNegative) {
   // 0x092E = 2350 -> 23.50 degC (inner, id 80); 0xFE0C = -500 -> -5.00 degC (outer, id 01).
-  const auto d =
-      codec_test::feed_whole(TemperCodec({.family = TemperFamily::gold}),
-                             report({0x80, 0x80, 0x09, 0x2E}) + report({0x80, 0x01, 0xFE, 0x0C}));
+  const auto d = codec_test::feed_whole(
+      TemperCodec({.family = TemperFamily::gold}),
+      temper_report({0x80, 0x80, 0x09, 0x2E}) + temper_report({0x80, 0x01, 0xFE, 0x0C}));
   ASSERT_EQ(d.frames.size(), 2u);
   EXPECT_EQ(d.frames[0].sensor, 0);
   EXPECT_DOUBLE_EQ(d.frames[0].temperature_degc, 23.50);
@@ -35,7 +31,7 @@ TEST(TemperCodec, GoldInnerOuterAndNegative) {
 TEST(TemperCodec, GoldProbeMissingIsOutOfRangeNotATemperature) {
   // 0x4E20 = 20000 -> 200.00 degC: what TEMPer1F/TEMPer2 report without their probe.
   const auto d = codec_test::feed_whole(TemperCodec({.family = TemperFamily::gold}),
-                                        report({0x80, 0x01, 0x4E, 0x20}));
+                                        temper_report({0x80, 0x01, 0x4E, 0x20}));
   EXPECT_TRUE(d.frames.empty());
   ASSERT_EQ(d.errors.size(), 1u);
   EXPECT_EQ(d.errors[0].kind, ErrorKind::out_of_range);
@@ -45,9 +41,9 @@ TEST(TemperCodec, GoldProbeMissingIsOutOfRangeNotATemperature) {
 TEST(TemperCodec, Ds75TwelveBitTwoSensors) {
   // Length 4: two sensors. 0x1780 = 6016 / 256 = 23.5 degC; 0xE840 = -6080 / 256 = -23.75 degC.
   // Length 2: 0x1900 = 6400 / 256 = 25.0 degC (12 bits).
-  const auto d = codec_test::feed_whole(
-      TemperCodec({.family = TemperFamily::ds75}),
-      report({0x80, 0x04, 0x17, 0x80, 0xE8, 0x40}) + report({0x80, 0x02, 0x19, 0x00}));
+  const auto d = codec_test::feed_whole(TemperCodec({.family = TemperFamily::ds75}),
+                                        temper_report({0x80, 0x04, 0x17, 0x80, 0xE8, 0x40}) +
+                                            temper_report({0x80, 0x02, 0x19, 0x00}));
   ASSERT_EQ(d.frames.size(), 3u);
   EXPECT_DOUBLE_EQ(d.frames[0].temperature_degc, 23.5);
   EXPECT_EQ(d.frames[1].sensor, 1);
@@ -63,12 +59,12 @@ TEST(TemperCodec, Ds75RegistersThatCannotOccurAreNotTemperatures) {
   TemperConfig v13{
       .family = TemperFamily::ds75, .inner = false, .probe = true, .ds75_slots = {-1, 1}};
   const auto a =
-      codec_test::feed_whole(TemperCodec(v13), report({0x80, 0x04, 0xff, 0xff, 0xff, 0xff}));
+      codec_test::feed_whole(TemperCodec(v13), temper_report({0x80, 0x04, 0xff, 0xff, 0xff, 0xff}));
   EXPECT_TRUE(a.frames.empty());
   ASSERT_EQ(a.errors.size(), 1u);
   EXPECT_NE(a.errors[0].description.find("did not answer"), std::string::npos);
   const auto b = codec_test::feed_whole(TemperCodec({.family = TemperFamily::ds75}),
-                                        report({0x80, 0x02, 0x19, 0x0F}));
+                                        temper_report({0x80, 0x02, 0x19, 0x0F}));
   EXPECT_TRUE(b.frames.empty());
   ASSERT_EQ(b.errors.size(), 1u);
   EXPECT_NE(b.errors[0].description.find("19 0f cannot come from a DS75"), std::string::npos);
@@ -77,14 +73,14 @@ TEST(TemperCodec, Ds75RegistersThatCannotOccurAreNotTemperatures) {
 TEST(TemperCodec, TemperxTemperatureAndHumidity) {
   // 0x08FC = 2300 -> 23.00 degC; 0x1194 = 4500 -> 45.00 %RH.
   const auto d = codec_test::feed_whole(TemperCodec({.family = TemperFamily::temperx}),
-                                        report({0x80, 0x80, 0x08, 0xFC, 0x11, 0x94}));
+                                        temper_report({0x80, 0x80, 0x08, 0xFC, 0x11, 0x94}));
   ASSERT_EQ(d.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(d.frames[0].temperature_degc, 23.0);
   ASSERT_TRUE(d.frames[0].humidity_pct);
   EXPECT_DOUBLE_EQ(*d.frames[0].humidity_pct, 45.0);
   // 0x2AF8 = 11000 -> 110 %RH: impossible, refused.
   const auto bad = codec_test::feed_whole(TemperCodec({.family = TemperFamily::temperx}),
-                                          report({0x80, 0x80, 0x08, 0xFC, 0x2A, 0xF8}));
+                                          temper_report({0x80, 0x80, 0x08, 0xFC, 0x2A, 0xF8}));
   EXPECT_TRUE(bad.frames.empty());
   EXPECT_EQ(bad.stats.out_of_range, 1u);
 }
@@ -93,7 +89,7 @@ TEST(TemperCodec, InitAndModelAnswersAreNotReadings) {
   TemperCodec c({.family = TemperFamily::gold});
   std::vector<TemperFrame> frames;
   std::vector<CodecError> errors;
-  c.feed(report({0x82, 0x02}) + "TEMPerGo" + "ld_V3.1 ", frames, errors);
+  c.feed(temper_report({0x82, 0x02}) + "TEMPerGo" + "ld_V3.1 ", frames, errors);
   EXPECT_TRUE(frames.empty());
   EXPECT_TRUE(errors.empty());
   EXPECT_EQ(c.sensor_count(), 2);
@@ -106,9 +102,9 @@ TEST(TemperCodec, InitAndModelAnswersAreNotReadings) {
 }
 
 TEST(TemperCodec, GarbageWrongIdsAndLengthsAreCountedAndTheNextReportIsRead) {
-  const auto stream = report({0x07, 0x01, 0x02}) +        // control bytes: garbage
-                      report({0x80, 0x33, 0x09, 0x2E}) +  // gold: sensor id 33 unknown
-                      report({0x80, 0x80, 0x09, 0x2E});   // then a good one: 23.50
+  const auto stream = temper_report({0x07, 0x01, 0x02}) +        // control bytes: garbage
+                      temper_report({0x80, 0x33, 0x09, 0x2E}) +  // gold: sensor id 33 unknown
+                      temper_report({0x80, 0x80, 0x09, 0x2E});   // then a good one: 23.50
   const auto d = codec_test::feed_whole(TemperCodec({.family = TemperFamily::gold}), stream);
   EXPECT_EQ(d.stats.garbage, 1u);
   EXPECT_EQ(d.stats.malformed, 1u);
@@ -116,13 +112,14 @@ TEST(TemperCodec, GarbageWrongIdsAndLengthsAreCountedAndTheNextReportIsRead) {
   EXPECT_DOUBLE_EQ(d.frames[0].temperature_degc, 23.5);
   EXPECT_EQ(d.errors[1].offset, 8u);  // the second report starts at byte 8
   const auto ds = codec_test::feed_whole(TemperCodec({.family = TemperFamily::ds75}),
-                                         report({0x80, 0x03, 0x17, 0x80}));
+                                         temper_report({0x80, 0x03, 0x17, 0x80}));
   EXPECT_EQ(ds.stats.malformed, 1u);  // ds75 data length 3
 }
 
 TEST(TemperCodec, ReportsSplitAtAnyByteGiveTheSameFrames) {
-  const auto stream = report({0x80, 0x80, 0x09, 0x2E}) + report({0x82, 0x01}) +
-                      report({0x80, 0x01, 0xFE, 0x0C}) + report({0x80, 0x80, 0x4E, 0x20});
+  const auto stream = temper_report({0x80, 0x80, 0x09, 0x2E}) + temper_report({0x82, 0x01}) +
+                      temper_report({0x80, 0x01, 0xFE, 0x0C}) +
+                      temper_report({0x80, 0x80, 0x4E, 0x20});
   const auto whole = codec_test::feed_whole(TemperCodec({.family = TemperFamily::gold}), stream);
   const auto bytewise =
       codec_test::feed_bytewise(TemperCodec({.family = TemperFamily::gold}), stream);
@@ -220,15 +217,16 @@ TEST(TemperCodec, AProbeOnlyModelGivesNoPhantomInnerSensor) {
   TemperConfig v13{
       .family = TemperFamily::ds75, .inner = false, .probe = true, .ds75_slots = {-1, 1}};
   const auto a =
-      codec_test::feed_whole(TemperCodec(v13), report({0x80, 0x04, 0x17, 0x00, 0x0B, 0x40}));
+      codec_test::feed_whole(TemperCodec(v13), temper_report({0x80, 0x04, 0x17, 0x00, 0x0B, 0x40}));
   ASSERT_EQ(a.frames.size(), 1u);
   EXPECT_EQ(a.frames[0].sensor, 1);
   EXPECT_DOUBLE_EQ(a.frames[0].temperature_degc, 11.25);
   // TEMPer1F_V3.9 (gold, probe only): 0x09C4 = 2500 -> 25.00 degC on channel 1; a report of an
   // inner sensor it does not have is malformed, not a reading.
   TemperConfig v39{.family = TemperFamily::gold, .inner = false, .probe = true};
-  const auto b = codec_test::feed_whole(
-      TemperCodec(v39), report({0x80, 0x01, 0x09, 0xC4}) + report({0x80, 0x80, 0x08, 0x00}));
+  const auto b =
+      codec_test::feed_whole(TemperCodec(v39), temper_report({0x80, 0x01, 0x09, 0xC4}) +
+                                                   temper_report({0x80, 0x80, 0x08, 0x00}));
   ASSERT_EQ(b.frames.size(), 1u);
   EXPECT_EQ(b.frames[0].sensor, 1);
   EXPECT_DOUBLE_EQ(b.frames[0].temperature_degc, 25.0);
@@ -239,21 +237,21 @@ TEST(TemperCodec, Sht2xSi7005AndSi7006Equations) {
   // sht2x (urwen/temper): t = 6700: -46.85 + 175.72 * 26800 / 65536 = 25.00815 degC;
   // h = 1835: -6 + 125 * 29360 / 65536 = 49.99976 %RH.
   const auto s = codec_test::feed_whole(TemperCodec({.family = TemperFamily::sht2x}),
-                                        report({0x80, 0x80, 0x1A, 0x2C, 0x07, 0x2B}));
+                                        temper_report({0x80, 0x80, 0x1A, 0x2C, 0x07, 0x2B}));
   ASSERT_EQ(s.frames.size(), 1u);
   EXPECT_NEAR(s.frames[0].temperature_degc, 25.00815, 1e-5);
   EXPECT_NEAR(*s.frames[0].humidity_pct, 49.99976, 1e-5);
   // si7005 (OpenBSD ugold): t = 0x0960 = 2400: 2400 / 32 - 50 = 25 degC; h = 0x0480 = 1152:
   // 1152 / 16 - 24 = 48 %RH.
   const auto a = codec_test::feed_whole(TemperCodec({.family = TemperFamily::si7005}),
-                                        report({0x80, 0x80, 0x09, 0x60, 0x04, 0x80}));
+                                        temper_report({0x80, 0x80, 0x09, 0x60, 0x04, 0x80}));
   ASSERT_EQ(a.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(a.frames[0].temperature_degc, 25.0);
   EXPECT_DOUBLE_EQ(*a.frames[0].humidity_pct, 48.0);
   // si7006 (ugold): t = 0x6A02 (status bits 02 cleared -> 27136): 27136 * 175.72 / 65536 -
   // 46.85 = 25.90906 degC; h = 0x7000 = 28672: 28672 * 125 / 65536 - 6 = 48.6875 %RH.
   const auto b = codec_test::feed_whole(TemperCodec({.family = TemperFamily::si7006}),
-                                        report({0x80, 0x80, 0x6A, 0x02, 0x70, 0x00}));
+                                        temper_report({0x80, 0x80, 0x6A, 0x02, 0x70, 0x00}));
   ASSERT_EQ(b.frames.size(), 1u);
   EXPECT_NEAR(b.frames[0].temperature_degc, 25.90906, 1e-5);
   EXPECT_DOUBLE_EQ(*b.frames[0].humidity_pct, 48.6875);
@@ -288,7 +286,8 @@ TEST(TemperModels, ATemper1FOnTemperXV33FirmwareIsReadAsItsProbe) {
   ASSERT_NE(m, nullptr);
   const auto d = codec_test::feed_whole(
       TemperCodec({.family = m->family, .inner = m->inner, .probe = m->probe}),
-      report({0x80, 0x01, 0x08, 0xDC, 0x4E, 0x20}) + report({0x80, 0x01, 0x08, 0x98, 0x4E, 0x20}));
+      temper_report({0x80, 0x01, 0x08, 0xDC, 0x4E, 0x20}) +
+          temper_report({0x80, 0x01, 0x08, 0x98, 0x4E, 0x20}));
   ASSERT_EQ(d.frames.size(), 2u);
   for (const auto& f : d.frames) {
     EXPECT_EQ(f.sensor, 1);
@@ -311,7 +310,7 @@ TEST(TemperModels, ATemper1FOnTemperXV33FirmwareIsReadAsItsProbe) {
   ASSERT_NE(x31, nullptr);
   const auto none = codec_test::feed_whole(
       TemperCodec({.family = x31->family, .inner = x31->inner, .probe = x31->probe}),
-      report({0x80, 0x01, 0x08, 0xDC, 0x4E, 0x20}));
+      temper_report({0x80, 0x01, 0x08, 0xDC, 0x4E, 0x20}));
   EXPECT_TRUE(none.frames.empty());
   EXPECT_EQ(none.stats.malformed, 1u);
 }

@@ -4,6 +4,7 @@
 
 #include <boost/asio/io_context.hpp>
 
+#include "../support/temper_report.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "temper/instrument.hpp"
@@ -12,12 +13,7 @@ namespace {
 
 namespace d = cal::drivers;
 
-std::string report(std::initializer_list<int> bytes) {
-  std::string s;
-  for (int b : bytes) s.push_back(static_cast<char>(b));
-  s.resize(8, '\0');
-  return s;
-}
+using cal::test::temper_report;
 
 TEST(TemperReplay, RecordedReportsGiveTimedReadingsAndTheMissingProbeIsCounted) {
   const auto path = std::filesystem::temp_directory_path() / "caldaq_temper_replay.cdq";
@@ -27,10 +23,12 @@ TEST(TemperReplay, RecordedReportsGiveTimedReadingsAndTheMissingProbeIsCounted) 
       w.record(t_ns, 0, cal::replay::RecordKind::received, cal::drivers::codec::as_bytes(r));
     };
     w.event(0, 0, "opened");
-    rx(10'000'000, report({0x82, 0x02}));                 // init answer: 2 sensors
-    rx(1'000'000'000, report({0x80, 0x80, 0x09, 0x2E}));  // inner 0x092E = 2350 -> 23.50 degC
-    rx(1'000'500'000, report({0x80, 0x01, 0x4E, 0x20}));  // probe: 200.00 degC = missing
-    rx(2'000'000'000, report({0x80, 0x80, 0x09, 0x60}));  // inner 0x0960 = 2400 -> 24.00 degC
+    rx(10'000'000, temper_report({0x82, 0x02}));  // init answer: 2 sensors
+    rx(1'000'000'000,
+       temper_report({0x80, 0x80, 0x09, 0x2E}));  // inner 0x092E = 2350 -> 23.50 degC
+    rx(1'000'500'000, temper_report({0x80, 0x01, 0x4E, 0x20}));  // probe: 200.00 degC = missing
+    rx(2'000'000'000,
+       temper_report({0x80, 0x80, 0x09, 0x60}));  // inner 0x0960 = 2400 -> 24.00 degC
     w.close();
   }
   boost::asio::io_context io;

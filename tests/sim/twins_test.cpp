@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "../support/asio_loop.hpp"
 #include "cal/drivers/transport/transport.hpp"
 #include "ids3010/twin.hpp"
 #include "line_gauge/twin.hpp"
@@ -20,18 +21,9 @@ namespace sim = cal::drivers::sim;
 namespace t = cal::drivers::transport;
 using namespace std::chrono_literals;
 
-std::span<const std::byte> bytes(std::string_view s) {
-  return std::as_bytes(std::span(s.data(), s.size()));
-}
+using cal::test::bytes;
 
-template <class Pred>
-void run_until(boost::asio::io_context& io, Pred done) {
-  const auto deadline = std::chrono::steady_clock::now() + 3s;
-  while (!done() && std::chrono::steady_clock::now() < deadline) {
-    io.run_for(5ms);
-    io.restart();
-  }
-}
+using cal::test::run_until;
 
 // A machine parked at x = 100 mm (no errors), still air at 20 degC, 101325 Pa, 50 %RH.
 struct Bench {

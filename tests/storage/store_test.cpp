@@ -315,6 +315,32 @@ TEST(Store, ReplacingTheTargetsSupersedesEveryResultInOneTransaction) {
   EXPECT_EQ(store.targets(run).at(0).deviation_um, 2.5);
 }
 
+// The compensations of one machine and axis; a missing machine or source run reads as 0.
+TEST(Store, CompensationsByMachineAndAxis) {
+  TempDir dir;
+  Store store(dir.path / "site.sqlite");
+  const auto run = a_run(store);
+  const auto machine = store.add_machine({.name = "mill"});
+  store.add_compensation({.machine_id = machine,
+                          .source_run_id = run,
+                          .source = "run 1",
+                          .axis = "X",
+                          .format = "siemens",
+                          .created_unix_ms = 5,
+                          .json = "{}"});
+  store.add_compensation({.source = "model m.json", .axis = "Y", .format = "fanuc", .json = "[]"});
+  const auto all = store.compensations(0, "");
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0].machine_id, machine);
+  EXPECT_EQ(all[0].source_run_id, run);
+  EXPECT_EQ(all[0].format, "siemens");
+  EXPECT_EQ(all[1].machine_id, 0);
+  EXPECT_EQ(all[1].source_run_id, 0);
+  EXPECT_EQ(all[1].json, "[]");
+  EXPECT_EQ(store.compensations(machine, "X").size(), 1u);
+  EXPECT_TRUE(store.compensations(machine, "Y").empty());
+}
+
 TEST(Store, MissedStopsAndTheTimeOriginRoundTrip) {
   TempDir dir;
   Store store(dir.path / "site.sqlite");

@@ -17,6 +17,7 @@
 #include <string>
 #include <utility>
 
+#include "../support/asio_loop.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/transport/transport.hpp"
 
@@ -59,19 +60,9 @@ struct Pty {
   }
 };
 
-std::span<const std::byte> bytes(std::string_view s) {
-  return std::as_bytes(std::span(s.data(), s.size()));
-}
+using cal::test::bytes;
 
-// Runs the loop until `done` or a 2 s safety limit (a hang is a failure, not a stuck test).
-template <class Pred>
-void run_until(boost::asio::io_context& io, Pred done) {
-  const auto deadline = std::chrono::steady_clock::now() + 2s;
-  while (!done() && std::chrono::steady_clock::now() < deadline) {
-    io.run_for(10ms);
-    io.restart();
-  }
-}
+using cal::test::run_until;
 
 TEST(SerialSettings, ParsesTheShortForms) {
   const auto s = t::parse_serial_settings("4800 7E1", {.device = "/dev/ttyUSB0"});

@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "../support/asio_loop.hpp"
 #include "cal/drivers/transport/transport.hpp"
 
 namespace {
@@ -14,18 +15,9 @@ namespace asio = boost::asio;
 using asio::ip::tcp;
 using namespace std::chrono_literals;
 
-template <class Pred>
-void run_until(asio::io_context& io, Pred done) {
-  const auto deadline = std::chrono::steady_clock::now() + 3s;
-  while (!done() && std::chrono::steady_clock::now() < deadline) {
-    io.run_for(10ms);
-    io.restart();
-  }
-}
+using cal::test::run_until;
 
-std::span<const std::byte> bytes(std::string_view s) {
-  return std::as_bytes(std::span(s.data(), s.size()));
-}
+using cal::test::bytes;
 
 TEST(TcpTransport, ConnectsAndMovesBytesBothWays) {
   asio::io_context io;

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/text.hpp"
 #include "cal/drivers/registry.hpp"
@@ -29,25 +30,18 @@ struct DecodeOptions {
 };
 
 std::string_view unit_of(d::Quantity q) {
-  switch (q) {
-    case d::Quantity::displacement_m:
-    case d::Quantity::length_m:
-    case d::Quantity::machine_position_m:
-      return "m";
-    case d::Quantity::air_temperature_degc:
-    case d::Quantity::material_temperature_degc:
-    case d::Quantity::dew_point_degc:
-      return "degC";
-    case d::Quantity::air_pressure_pa:
-      return "Pa";
-    case d::Quantity::air_humidity_pct:
-      return "%RH";
-    case d::Quantity::angle_rad:
-      return "rad";
-    case d::Quantity::refractive_index:
-      return "";
-  }
-  return "";
+  using enum d::Quantity;
+  static constexpr cal::EnumName<d::Quantity> kNames[] = {{displacement_m, "m"},
+                                                          {length_m, "m"},
+                                                          {machine_position_m, "m"},
+                                                          {air_temperature_degc, "degC"},
+                                                          {material_temperature_degc, "degC"},
+                                                          {dew_point_degc, "degC"},
+                                                          {air_pressure_pa, "Pa"},
+                                                          {air_humidity_pct, "%RH"},
+                                                          {angle_rad, "rad"},
+                                                          {refractive_index, ""}};
+  return cal::name_of(kNames, q, "");
 }
 
 // The device's time as printed: UTC with nanoseconds, or seconds since the stream's start.

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/json_scan.hpp"
 
 namespace cal::daq {
 namespace {
@@ -14,25 +15,12 @@ namespace {
 // Where the text first nests deeper than max_depth (brackets outside strings), or nullopt.
 std::optional<std::size_t> too_deep_at(std::string_view text, std::size_t max_depth) {
   std::size_t depth = 0;
-  bool in_string = false, escaped = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > max_depth) return i;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return std::nullopt;
+  const auto at = cal::text::find_outside_json_strings(text, 0, [&](char c) {
+    if (c == '[' || c == '{') return ++depth > max_depth;
+    if ((c == ']' || c == '}') && depth > 0) --depth;
+    return false;
+  });
+  return at == std::string_view::npos ? std::nullopt : std::optional(at);
 }
 
 }  // namespace

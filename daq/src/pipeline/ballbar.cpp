@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::daq {
@@ -80,19 +81,13 @@ std::vector<circle::Trace> BallbarSegmenter::traces() const {
 }
 
 std::string_view to_string(BallbarPhase p) {
-  switch (p) {
-    case BallbarPhase::feed_in:
-      return "waiting for the feed-in";
-    case BallbarPhase::dwell:
-      return "dwell";
-    case BallbarPhase::ccw_arc:
-      return "ccw arc";
-    case BallbarPhase::cw_arc:
-      return "cw arc";
-    case BallbarPhase::complete:
-      return "complete";
-  }
-  return "?";
+  using enum BallbarPhase;
+  // clang-format off
+  static constexpr EnumName<BallbarPhase> kNames[] = {
+      {feed_in, "waiting for the feed-in"}, {dwell, "dwell"}, {ccw_arc, "ccw arc"},
+      {cw_arc, "cw arc"}, {complete, "complete"}};
+  // clang-format on
+  return name_of(kNames, p);
 }
 
 BallbarProgress BallbarSegmenter::progress() const {

@@ -4,22 +4,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::daq {
 
 std::string_view to_string(Motion m) {
-  switch (m) {
-    case Motion::moving:
-      return "moving";
-    case Motion::settling:
-      return "settling";
-    case Motion::stable:
-      return "stable";
-    case Motion::captured:
-      return "captured";
-  }
-  return "moving";
+  using enum Motion;
+  static constexpr EnumName<Motion> kNames[] = {
+      {moving, "moving"}, {settling, "settling"}, {stable, "stable"}, {captured, "captured"}};
+  return name_of(kNames, m, "moving");
 }
 
 MotionIndicator::MotionIndicator(MotionSettings s) : s_(s) {

@@ -10,6 +10,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/daq/env_stage.hpp"
 #include "cal/daq/motion.hpp"
@@ -913,19 +914,10 @@ ControlOutcome LinearRun::control(Control c, std::string_view source) {
 }
 
 std::string_view to_string(Control c) {
-  switch (c) {
-    case Control::capture:
-      return "capture";
-    case Control::skip:
-      return "skip";
-    case Control::retry:
-      return "retry";
-    case Control::pause:
-      return "pause";
-    case Control::resume:
-      return "resume";
-  }
-  return "?";
+  using enum Control;
+  static constexpr cal::EnumName<Control> kNames[] = {
+      {capture, "capture"}, {skip, "skip"}, {retry, "retry"}, {pause, "pause"}, {resume, "resume"}};
+  return cal::name_of(kNames, c);
 }
 bool LinearRun::finished() const { return impl_->done; }
 const LinearRunOutcome& LinearRun::outcome() const { return impl_->outcome; }
