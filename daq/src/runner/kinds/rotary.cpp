@@ -63,8 +63,9 @@ class Rotary final : public TestKind {
     // The runner recognises stops from the laser's or the control's position, not yet from
     // the angular reference's own stream: refused before any instrument is opened.
     throw cal::InputError(fmt::format(
-        "measure = \"rotary\" (axis {}): the runner does not acquire a rotary axis yet; its "
-        "stops are evaluated by daq::kinds::kind(\"rotary\") (docs/iso230-2.md, \"Rotary axes\")",
+        "measure = \"rotary\" (axis {}): the runner does not acquire a rotary axis yet (its "
+        "stops would be recognised from the angular reference's stream, which is not done); "
+        "the evaluation is ready (docs/iso230-2.md, \"Rotary axes\")",
         l.axis));
   }
   std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override {
