@@ -393,6 +393,14 @@ std::array<double, 3> read_vector(Table& t, std::string_view key, std::array<dou
 void read_measure(Table& t, LinearTestConfig& l) {
   auto& m = l.measure;
   read_fields(t, fields::measure(), m);
+  // A rotary axis (A, B, C) has its own kind; every other kind measures a linear axis.
+  const bool rotary_axis = l.axis == "A" || l.axis == "B" || l.axis == "C";
+  if (rotary_axis != (m.kind == "rotary"))
+    t.fail(
+        t.node("axis"), "axis",
+        rotary_axis
+            ? fmt::format("a rotary axis {} is measured by measure = \"rotary\"", l.axis)
+            : fmt::format("measure = \"rotary\" measures a rotary axis (A, B, C), not {}", l.axis));
   if (m.kind == "straightness") {
     one_of(t, "direction", m.direction, {"X", "Y", "Z"});
     if (m.direction == l.axis)

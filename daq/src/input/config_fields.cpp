@@ -25,9 +25,9 @@ constexpr Range dwell = above(0, kMaxDwellS, "s");
 
 constexpr std::string_view kEquations[] = {"ciddor", "edlen", "shop-floor"};
 constexpr std::string_view kPolicies[] = {"stop", "fallback"};
-constexpr std::string_view kAxes[] = {"X", "Y", "Z"};
+constexpr std::string_view kAxes[] = {"X", "Y", "Z", "A", "B", "C"};  // A, B, C: rotary
 constexpr std::string_view kCycles[] = {"linear", "pendulum", "pilgrim-step"};
-constexpr std::string_view kKinds[] = {"positioning", "straightness", "angular", "roll"};
+constexpr std::string_view kKinds[] = {"positioning", "straightness", "angular", "roll", "rotary"};
 constexpr std::string_view kPlanes[] = {"XY", "YZ", "ZX"};
 
 using E = EnvironmentConfig;

@@ -264,6 +264,26 @@ TEST(Config, LongAxisMayLeaveTheTargetsToTheStandard) {
             std::string::npos);
 }
 
+// Issue 36 (c): a rotary axis (A, B, C) is measured by measure = "rotary", its targets in
+// degrees; every other kind measures a linear axis, and a rotary axis no other kind.
+TEST(Config, RotaryAxisOnlyByTheRotaryKind) {
+  const auto c = parse_config(
+      "[test.linear]\naxis = \"C\"\nmeasure = \"rotary\"\nfirst_mm = 0\nlast_mm = 360\n"
+      "interval_mm = 30\n",
+      "m.toml");
+  ASSERT_TRUE(c.linear.has_value());
+  EXPECT_EQ(c.linear->axis, "C");
+  EXPECT_EQ(c.linear->measure.kind, "rotary");
+  const std::string targets = "first_mm = 0\nlast_mm = 360\ninterval_mm = 30\n";
+  EXPECT_NE(error_of("[test.linear]\naxis = \"B\"\n" + targets)
+                .find("a rotary axis B is measured by measure = \"rotary\""),
+            std::string::npos);
+  EXPECT_NE(error_of("[test.linear]\naxis = \"X\"\nmeasure = \"rotary\"\n" + targets)
+                .find("measure = \"rotary\" measures a rotary axis (A, B, C), not X"),
+            std::string::npos)
+      << error_of("[test.linear]\naxis = \"X\"\nmeasure = \"rotary\"\n" + targets);
+}
+
 // The report's identity tables and the machine specification: read as written, and every
 // mistake (a non-finite or non-positive limit, an unknown axis or diagnostic, a bad date, a
 // by_length table out of order) refused with its place.

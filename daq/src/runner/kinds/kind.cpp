@@ -38,16 +38,16 @@ std::unique_ptr<SampleReader> ProbeKind::reader(const cal::daq::LinearTestConfig
 }
 
 std::span<const TestKind* const> all_kinds() {
-  static const std::array<const TestKind*, 4> k{&positioning(), &straightness(), &angular(),
-                                                &roll()};
+  static const std::array<const TestKind*, 5> k{&positioning(), &straightness(), &angular(),
+                                                &roll(), &rotary()};
   return k;
 }
 
 const TestKind& kind(std::string_view name) {
   for (const auto* k : all_kinds())
     if (k->name() == name) return *k;
-  throw cal::InputError(
-      fmt::format("test kind '{}' (expected positioning, straightness, angular or roll)", name));
+  throw cal::InputError(fmt::format(
+      "test kind '{}' (expected positioning, straightness, angular, roll or rotary)", name));
 }
 
 Evaluation TestKind::evaluate(std::span<const StopValue> stops,

@@ -2,8 +2,9 @@
 // Test kinds of the one linear runner (linear_run.hpp). A kind says what is read at each stop
 // of an ISO 230-2 plan and how the stops are evaluated: positioning (the laser's deviation from
 // the target), straightness (an indicator or transducer across the axis), angular (pitch or yaw
-// from two laser axes over their separation) and roll (an electronic level against a reference
-// level). The runner does everything else (instruments, stop recognition by the laser or the
+// from two laser axes over their separation), roll (an electronic level against a reference
+// level) and rotary (a rotary axis's angular positioning against an angular reference). The
+// runner does everything else (instruments, stop recognition by the laser or the
 // position feed, sequencing, storage) the same for every kind; a kind is one small file here.
 // Conventions (ISO 230-1 names, signs of the tool relative to the workpiece): docs/kinematics.md;
 // the set-up keys: docs/config.md; the whole procedure: docs/volumetric-walkthrough.md.
@@ -101,6 +102,7 @@ const TestKind& positioning();
 const TestKind& straightness();
 const TestKind& angular();
 const TestKind& roll();
+const TestKind& rotary();  // a rotary axis's angular positioning (ISO 230-2 in deg, arcsec)
 
 // The profile of a run: per target, the mean of all its stops, of the stops up and down, and
 // the spread; for straightness also the least-squares line and the straightness about it.
