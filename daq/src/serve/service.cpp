@@ -43,6 +43,7 @@
 #include "report_pdf.hpp"
 #include "result_rows.hpp"
 #include "run_document.hpp"
+#include "serve/ballbar_set.hpp"
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
@@ -372,11 +373,17 @@ class Service {
       }
       j["linear"] = std::move(t);
     }
-    if (c.circle)
+    if (c.circle) {
       j["circle"] = {{"plane", c.circle->plane},
                      {"radius_mm", c.circle->radius_mm},
                      {"feed_mm_per_min", c.circle->feed_mm_per_min},
                      {"instruments", instruments_of("circle")}};
+      try {  // a set's tests in the order Start runs them (one for a single test)
+        j["circle"]["tests"] = set_plan_json(circle_tests(c));
+      } catch (const cal::InputError& e) {
+        j["circle"]["problem"] = e.what();
+      }
+    }
     return j;
   }
 
@@ -792,12 +799,17 @@ class Service {
     if (!shop_) return std::nullopt;
     if (test == "linear" && config_.linear && config_.linear->axis != "X")
       return "the simulated laser measures the X axis: set the linear test's axis to X";
-    if (test == "circle" && config_.circle &&
-        (std::abs(config_.circle->radius_mm - shop_->truth().ballbar_mm) > 1e-9 ||
-         config_.circle->plane != "XY"))
+    if (test != "circle" || !config_.circle) return std::nullopt;
+    // One circle: in XY only (the shop's single-test program); a set: any planes, over the
+    // sphere about the table ball as `daq sim --test circle-set` runs it.
+    const auto tests = circle_tests(config_);
+    const bool bar = std::all_of(tests.begin(), tests.end(), [&](const CircleTest& t) {
+      return std::abs(t.program.radius_mm - shop_->truth().ballbar_mm) <= 1e-9;
+    });
+    if (!bar || (tests.size() == 1 && config_.circle->plane != "XY"))
       return fmt::format(
-          "the simulated ballbar is {} mm long in the XY plane: set the circle's "
-          "radius to {} mm and its plane to XY",
+          "the simulated ballbar is {} mm long, a single test in the XY plane: set the "
+          "circle's radius to {} mm and its plane to XY (or planes for a set)",
           shop_->truth().ballbar_mm, shop_->truth().ballbar_mm);
     return std::nullopt;
   }
@@ -810,6 +822,7 @@ class Service {
     if (config_.circle) j["tests"].push_back("circle");
     if (running()) j["run"] = {{"id", run_id_}, {"test", test_}, {"origin", run_origin_}};
     if (last_) j["last"] = *last_;
+    if (set_) j["set"] = set_->to_json();
     j["setup"] = setup_summary_;
     return j;
   }
@@ -962,6 +975,7 @@ class Service {
   }
 
   void start_linear() {
+    set_.reset();
     const auto specs = linear_specs(config_);
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
@@ -981,8 +995,11 @@ class Service {
     std::fflush(stdout);
   }
 
+  // One test, or a set (planes, feeds, radii): the tests after the first follow on the same
+  // bar stream, each stored as its own run, as `daq run circle` runs a set.
   void start_circle() {
-    const auto [program, analysis] = circle_test(config_);
+    const auto tests = circle_tests(config_);
+    const auto& first = tests.front();
     const auto& dc = ballbar_device(config_);
     const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
     const auto path = capture_path();
@@ -991,20 +1008,25 @@ class Service {
     const auto options = run_options();
     CircleRunSetup setup{
         .config = config_,
-        .program = program,
-        .analysis = analysis,
+        .program = first.program,
+        .analysis = first.analysis,
         .database = database_path(o_.run.db),
         .ballbar = options.wrap(dc, make_instrument(io_, specs[0], make_transport(io_, dc),
                                                     instrument_options(dc, specs[0], options,
                                                                        capture_->recorder.get()))),
         .capture_path = capture_->absolute_path(path),
-        .origins = {{"ballbar", origin_of(specs[0].origin, "")}}};
+        .origins = {{"ballbar", origin_of(specs[0].origin, "")}},
+        .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
     mark_simulated(setup.origins);
     setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
     circle_->start();
     run_id_ = circle_->outcome().run_id;
+    set_.reset();
+    set_done_ = 0;
+    if (tests.size() > 1) set_.emplace(tests);
+    follow_set();
     fmt::print("run {} (circle) started from the web page\n", run_id_);
     std::fflush(stdout);
   }
@@ -1023,6 +1045,10 @@ class Service {
       if (linear_) {
         const auto& l = *config_.linear;
         shop_->run_linear(linear_->plan(), l.feed_mm_per_min, l.dwell_s);
+      } else if (set_) {  // the whole set in one program, the bar moved over the sphere
+        std::vector<cal::daq::BallbarSetTest> program;
+        for (const auto& t : circle_tests(config_)) program.push_back({t.plane, t.program});
+        shop_->run_circle_set(program);
       } else {
         shop_->run_circle(circle_test(config_).first);
       }
@@ -1041,6 +1067,11 @@ class Service {
     const bool evaluated = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
     const char* status = complete ? "complete" : evaluated ? "incomplete" : "aborted";
+    follow_set();
+    if (set_ && circle_) {
+      const auto db = read_store_quietly();
+      set_->end(status, reason, db ? &*db : nullptr);
+    }
     last_ = json{{"run", run_id_},       {"test", test_},    {"complete", complete},
                  {"status", status},     {"reason", reason}, {"evaluated", evaluated},
                  {"origin", run_origin_}};
@@ -1052,11 +1083,38 @@ class Service {
     start_monitors(test_);
   }
 
+  // A set's progress: the run of the test in progress is the run the page shows; each test
+  // done is read from the store once.
+  void follow_set() {
+    if (!circle_) return;
+    run_id_ = circle_->outcome().run_id;
+    if (!set_) return;
+    std::vector<std::int64_t> done;
+    for (const auto& c : circle_->completed()) done.push_back(c.run_id);
+    const bool last_done = circle_->outcome().complete;
+    if (last_done) done.push_back(circle_->outcome().run_id);
+    const std::int64_t current = last_done ? 0 : run_id_;
+    if (done.size() == set_done_) return set_->update(done, current, nullptr);
+    set_done_ = done.size();
+    const auto db = read_store_quietly();
+    set_->update(done, current, db ? &*db : nullptr);
+  }
+
+  std::optional<cal::storage::Store> read_store_quietly() const {
+    try {
+      return read_store();
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "daq serve: the ballbar set's runs could not be read: {}\n", e.what());
+      return std::nullopt;
+    }
+  }
+
   void tick() {
     tick_.expires_after(200ms);
     tick_.async_wait([this](const boost::system::error_code& ec) {
       if (ec) return;
       if ((linear_ && linear_->finished()) || (circle_ && circle_->finished())) finish();
+      if (circle_) follow_set();
       if (capture_ && capture_->recorder) capture_->recorder->flush();
       tick();
     });
@@ -1089,6 +1147,8 @@ class Service {
   std::string capture_pending_;
   std::unique_ptr<LinearRun> linear_;
   std::unique_ptr<CircleRun> circle_;
+  std::optional<BallbarSetProgress> set_;  // a ballbar set's progress (kept after it ends)
+  std::size_t set_done_ = 0;               // its tests whose stored values were read
   std::int64_t run_id_ = 0;
   std::string test_;
   std::string run_live_;
