@@ -120,7 +120,21 @@ try:
         want = f"{p['squareness_um_per_m']:+.1f}"
         ok(r[3] == want and r[1] == str(p["runs"][0]),
            f"{p['plane']}: squareness {r[3]} µm/m as `daq ballbar volumetric` ({want}), from run {r[1]}")
+    # The polar plot of the test shown (the last), from its stored readings, bounded in size.
+    trace = get(url + f"api/runs/{runs[2]}")["trace"]
+    n_ccw, n_cw, size = len(trace["ccw"]), len(trace["cw"]), len(json.dumps(trace))
+    ok(150 <= n_ccw <= 400 and 150 <= n_cw <= 400 and size < 30000,
+       f"/api/runs/N carries the circle's traces, a point per degree at most: {n_ccw} + {n_cw} points, {size} bytes")
+    ok(all(abs(p[1]) < 50 for p in trace["ccw"] + trace["cw"]), "deviations in µm about the centre")
+    painted = wait("const c = document.getElementById('result-polar'); if (c.closest('[hidden]')) return false; "
+                   "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; "
+                   "for (let i = 0; i < d.length; i += 4) if (d[i + 2] > 200 && d[i] < 120) n++; return n;",
+                   "the polar plot on the Results")
+    ok(painted > 500, f"the ccw trace is drawn on the Results ({painted} blue pixels)")
     shot(b, "s03-set-results-1366x768.png")
+    b.js("document.getElementById('result-polar').scrollIntoView();")
+    shot(b, "s03b-set-results-polar-1366x768.png")
+    b.js("window.scrollTo(0, 0);")
     b.js("document.getElementById('tab-run').click();")
     text = wait(NEXT + " && /complete/.test(n.textContent) && n.textContent;", "the set's end on the Run view")
     ok(f"Ballbar set complete: 3 of 3 tests stored (runs {runs[0]}, {runs[1]}, {runs[2]})" in text, f"the end in words: {text!r}")

@@ -1,7 +1,13 @@
 #include "serve/ballbar_set.hpp"
 
+#include <cmath>
+#include <numbers>
+
 #include "ballbar_campaign.hpp"
+#include "cal/daq/ballbar.hpp"
 #include "cal/daq/gcode.hpp"
+#include "cal/drivers/instrument.hpp"
+#include "cal/storage/store.hpp"
 
 namespace daq::serve {
 namespace {
@@ -19,6 +25,34 @@ json result_json(const BallbarTest& t) {
           {"pass", t.verdict.configured ? json(t.verdict.pass) : json(nullptr)}};
 }
 }  // namespace
+
+json circle_trace_json(const cal::storage::Store& store, std::int64_t run, const json& settings,
+                       const json& result) {
+  const auto [program, analysis] = circle_settings_from_json(settings);
+  static constexpr std::uint8_t bar[] = {
+      static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
+  cal::daq::BallbarSegmenter segmenter(program);
+  for (const auto& r : store.readings(run, bar)) segmenter.add(r.value * 1e3);
+  double cu = 0.0, cv = 0.0;
+  if (const auto c = result.value("/iso230_4/centre_um"_json_pointer, json());
+      c.is_array() && c.size() == 2 && c[0].is_number() && c[1].is_number())
+    cu = c[0].get<double>(), cv = c[1].get<double>();
+  const auto rounded = [](double x, double unit) { return std::round(x / unit) * unit; };
+  json out{{"schema", "caldaq.circle-trace.v1"}, {"ccw", json::array()}, {"cw", json::array()}};
+  for (const auto& t : segmenter.traces()) {
+    auto& points = out[t.direction == cal::circle::Direction::ccw ? "ccw" : "cw"];
+    double last = -1e9;
+    for (std::size_t i = 0; i < t.angle_deg.size(); ++i) {
+      const double a = t.angle_deg[i];
+      if (std::abs(a - last) < 1.0) continue;
+      last = a;
+      const double th = a * std::numbers::pi / 180.0;
+      points.push_back({rounded(a, 0.01),
+                        rounded(t.deviation_um[i] - cu * std::cos(th) - cv * std::sin(th), 0.001)});
+    }
+  }
+  return out;
+}
 
 json set_plan_json(std::span<const CircleTest> tests) {
   json list = json::array();

@@ -36,6 +36,14 @@ class BallbarSetProgress {
   std::vector<std::int64_t> done_;
 };
 
+// A stored circle run's two traces for the page's polar plot, caldaq.circle-trace.v1:
+// {"ccw": [[angle_deg, deviation_um], ...], "cw": [...]}, the least-squares centre of its result
+// removed (ISO 230-4 evaluates about it, as the report's plot does), a point per degree at most
+// (about 900 points for a whole test, some 20 KB). The segmentation is the analysis' own
+// (BallbarSegmenter on the stored bar readings). cal::InputError when it cannot be cut.
+nlohmann::json circle_trace_json(const cal::storage::Store& store, std::int64_t run,
+                                 const nlohmann::json& settings, const nlohmann::json& result);
+
 // The tests of a set for the Run view's plan: plane, arc, feed and radius of each.
 nlohmann::json set_plan_json(std::span<const CircleTest> tests);
 

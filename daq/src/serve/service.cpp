@@ -675,6 +675,19 @@ class Service {
                             {"deviation_um", t.deviation_um}});
     for (auto& r : j["results"])
       if (r["result"].is_object()) r["values"] = rows_json(result_rows(r["result"]));
+    // A circle's polar plot: its two traces, a point per degree (bounded, docs/web.md).
+    if (const auto run = store.run(id); run && run->kind == "circle") {
+      const json* current = nullptr;
+      for (const auto& r : j["results"])
+        if (r.value("current", false) && r["result"].is_object()) current = &r["result"];
+      try {
+        j["trace"] = current ? circle_trace_json(store, id, json::parse(run->settings_json),
+                                                 *current)
+                             : json(nullptr);
+      } catch (const std::exception& e) {
+        j["trace"] = {{"error", e.what()}};
+      }
+    }
     j["reports"] = {{"html", fmt::format("/reports/run-{}.html", id)},
                     {"pdf", fmt::format("/reports/run-{}.pdf", id)}};
     return ok(j);
