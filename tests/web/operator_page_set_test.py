@@ -50,7 +50,7 @@ try:
         try:
             return b.wait(script, timeout_s=timeout_s, what=what, explain=(
                 "return JSON.stringify({status: window.caldaq.page && window.caldaq.page.status, "
-                "next: document.getElementById('set-next').textContent, errors: window.__errors}).slice(0, 3000);"))
+                "next: (document.getElementById('set-next') || {}).textContent, errors: window.__errors}).slice(0, 3000);"))
         except AssertionError as e:
             raise AssertionError(f"{e}\n--- serve.log:\n{page_checks.log_tail(TMP)}") from None
 

@@ -48,6 +48,7 @@
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
 #include "serve/setup_form.hpp"
+#include "serve/volumetric_checklist.hpp"
 #include "sim_shop.hpp"
 #include "web/assets.hpp"
 #include "web/server.hpp"
@@ -305,6 +306,7 @@ class Service {
     get("/api/drivers", &Service::drivers);
     get("/api/detected", &Service::detected);
     get("/api/machines", &Service::machines);
+    get("/api/volumetric", &Service::volumetric);
     get("/api/runs/", &Service::run_doc);
     get("/reports/", &Service::report);
     post("/api/setup/check", &Service::setup_check);
@@ -630,6 +632,14 @@ class Service {
     return ok({{"schema", "caldaq.machines.v1"}, {"machines", list}});
   }
 
+  // GET /api/volumetric: the 21-error campaign of the set-up's machine as a checklist, from the
+  // store (volumetric_checklist.hpp): what is measured, by which run and when, what is left.
+  web::Response volumetric(std::string_view) {
+    const auto db = read_store();
+    return ok(volumetric_checklist(db ? &*db : nullptr, config_.machine_name,
+                                   database_path(o_.run.db).string()));
+  }
+
   // --- stored runs and reports -----------------------------------------------------------
 
   web::Response runs() {
@@ -681,9 +691,9 @@ class Service {
       for (const auto& r : j["results"])
         if (r.value("current", false) && r["result"].is_object()) current = &r["result"];
       try {
-        j["trace"] = current ? circle_trace_json(store, id, json::parse(run->settings_json),
-                                                 *current)
-                             : json(nullptr);
+        j["trace"] = current
+                         ? circle_trace_json(store, id, json::parse(run->settings_json), *current)
+                         : json(nullptr);
       } catch (const std::exception& e) {
         j["trace"] = {{"error", e.what()}};
       }
