@@ -705,14 +705,18 @@ class Service {
 
   // POST /api/compensation {"run": N, "format": "fanuc"}: the compensation table of a stored
   // linear run as `daq compensate` writes it, through the same code (compensate_run.hpp);
-  // nothing is stored. 400 for a bad body or format, 404 for no such run, 409 with the
-  // command's refusal (a suspect run, too few targets, not a linear run).
+  // with "store": true also stored with the run as the command stores it (for daq verify).
+  // 400 for a bad body or format, 404 for no such run, 409 with the command's refusal (a
+  // suspect run, too few targets, not a linear run), 500 when the store cannot be written.
   web::Response compensation(const std::string& body) {
     const auto j = json::parse(body, nullptr, false);
-    const bool good = j.is_object() && j.size() == 2 && j.contains("run") &&
+    const bool store = j.is_object() && j.contains("store");
+    const bool good = j.is_object() && j.size() == (store ? 3u : 2u) && j.contains("run") &&
                       j["run"].is_number_integer() && j.contains("format") &&
-                      j["format"].is_string();
-    if (!good) return error(400, R"(the body must be {"run": N, "format": "csv"})");
+                      j["format"].is_string() && (!store || j["store"].is_boolean());
+    if (!good)
+      return error(400,
+                   R"(the body must be {"run": N, "format": "csv"} and optionally "store": true)");
     const auto id = j["run"].get<std::int64_t>();
     const auto format = j["format"].get<std::string>();
     try {
@@ -724,9 +728,13 @@ class Service {
     if (!db) return error(404, fmt::format("no run {}: {}", id, no_database()));
     if (!db->run(id)) return error(404, fmt::format("no run {}", id));
     try {
-      return ok(run_compensation(*db, id, format));
+      // "store": true stores the table with the run as `daq compensate --run` does (daq verify).
+      return ok(run_compensation(*db, id, format,
+                                 store && j["store"].get<bool>() ? &o_.run.db : nullptr));
     } catch (const cal::InputError& e) {
       return error(409, e.what());
+    } catch (const std::exception& e) {
+      return error(500, fmt::format("the compensation could not be stored: {}", e.what()));
     }
   }
 
