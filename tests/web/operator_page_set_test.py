@@ -74,6 +74,8 @@ try:
     ok("Ballbar set of 3 tests, in this order: XY 360°, 3000 mm/min, R 100.0 mm; ZX 220°, 3000 mm/min, R 100.0 mm; "
        "YZ 220°, 3000 mm/min, R 100.0 mm" in plan, f"the Run view names the set's tests in order: {plan!r}")
     wait("return window.caldaq.page.status.start.circle.ready;", "Start ballbar ready with the set")
+    ok(b.js("return document.getElementById('start-circle').textContent;") == "Start ballbar set (3 tests)",
+       "Start says it starts the set")
 
     # --- 2. Start: what to do now and next ------------------------------------------------
     post(url + "api/simulation/speed", {"speed": 1})  # the wait for test 1's feed-in is seen
