@@ -152,9 +152,13 @@ try:
          "!!document.getElementById('quality-suspect');", "run 3's results")
     suspect = b.js("return document.getElementById('quality-suspect').textContent;")
     doc3 = get(url + "api/runs/3")
+    # The service's sentence says "um" (for terminals); the page says µm.
+    micro = lambda t: re.sub(r"(\d) um\b", r"\1 µm", t)  # noqa: E731
     ok(doc3["quality"]["state"] == "suspect" and "SUSPECT STOPS: " in suspect and
-       all(f"target {s['target_index'] + 1}: {s['reason']}" in suspect for s in doc3["quality"]["suspect_stops"]),
+       all(f"target {s['target_index'] + 1}: {micro(s['reason'])}" in suspect for s in doc3["quality"]["suspect_stops"]),
        f"run 3 suspect, each suspect stop named by its target: {suspect[:200]!r}")
+    ok(" um" in doc3["quality"]["summary"] and not re.search(r"\d um\b", suspect) and re.search(r"\d µm", suspect),
+       f"the page writes µm where the service's sentence says um: {suspect[:160]!r}")
     ok(any(s["target_index"] == 3 and s["run"] == 2 for s in doc3["quality"]["suspect_stops"]) and "target 4: run 2 " in suspect,
        "the stop made 5 µm off among them (run 2 up at target 4)")
     b.js("document.getElementById('comp-show').click();")
@@ -213,6 +217,24 @@ try:
     ok(re.match(r"Predicted: largest mean deviation \d+\.\d{3} µm before, \d+\.\d{3} µm left", page["predicted"]),
        f"what it is predicted to leave: {page['predicted']!r}")
     ok(page["download"] == "run-2-X-fanuc.nc", f"to download: {page['download']}")
+    # Stored from the page as the command stores it (the command above stored one too).
+    def stored():
+        with sqlite3.connect(DB) as c:
+            return c.execute("SELECT id, format, json FROM compensations WHERE source_run_id = 2 ORDER BY id").fetchall()
+    before = stored()
+    ok(len(before) == 1 and b.js("return !document.getElementById('comp-store').hidden;"),
+       f"the command stored one; the page offers to store it: {len(before)}")
+    b.js("document.getElementById('comp-store').click();")
+    said = wait("const t = document.getElementById('comp-stored').textContent; return /Stored as compensation/.test(t) && t;",
+                "the table stored from the page")
+    after = stored()
+    ok(len(after) == 2 and after[1][1] == "fanuc" and said.startswith(f"Stored as compensation {after[1][0]} (fanuc)"),
+       f"stored with the run from the page: {said!r}")
+    mine, cmd = json.loads(after[1][2]), json.loads(after[0][2])
+    ok(mine["text"] == page["text"] and mine["table"] == cmd["table"] and mine["predicted"] == cmd["predicted"]
+       and mine["origin"] == cmd["origin"], "the same record `daq compensate --run` stores (text, table, prediction, origin)")
+    status, body = post(url + "api/compensation", {"run": 2, "format": "csv", "store": "yes"})
+    ok(status == 400 and "store" in body["error"], f"store must be true or false: {status} {body}")
     b.js("document.getElementById('comp').scrollIntoView();")
     shot(b, "r05-compensation-fanuc-1366x768.png")
 

@@ -206,12 +206,13 @@ nlohmann::json predicted_json(const ct::PredictedResidual& p) {
 }
 
 // Kept with the run (schema 5) so that the next measurement of the axis can be compared with
-// what this table was predicted to leave (daq verify). A store that cannot be written (a
-// read-only medium) is said, not fatal: the table is still written.
-void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct::Applied& a,
-                        const ct::PredictedResidual& p, const std::string& text) {
-  try {
-    cal::storage::Store store(database_path(o.db));
+// what this table was predicted to leave (daq verify): the stored compensation's id. Throws
+// what the store throws (a read-only medium, no such run).
+std::int64_t store_compensation_record(const CompensateOptions& o, const ct::Table& t,
+                                       const ct::Applied& a, const ct::PredictedResidual& p,
+                                       const std::string& text) {
+  cal::storage::Store store(database_path(o.db));
+  {
     const auto run = store.run(o.run);
     if (!run) throw cal::InputError(fmt::format("no run {}", o.run));
     const auto origin = run_origin(*run, store.instruments(o.run), "");  // said by suspect_note
@@ -237,12 +238,21 @@ void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct
                              {"origin", to_json(origin)},
                              {"accepted_suspect_runs", o.accepted},
                              {"text", text}};
-    const auto id = store.add_compensation({.machine_id = run->machine_id,
-                                            .source_run_id = o.run,
-                                            .source = fmt::format("run {}", o.run),
-                                            .axis = o.axis,
-                                            .format = o.format,
-                                            .json = doc.dump()});
+    return store.add_compensation({.machine_id = run->machine_id,
+                                   .source_run_id = o.run,
+                                   .source = fmt::format("run {}", o.run),
+                                   .axis = o.axis,
+                                   .format = o.format,
+                                   .json = doc.dump()});
+  }
+}
+
+// The command's: a store that cannot be written (a read-only medium) is said, not fatal: the
+// table is still written.
+void store_compensation(const CompensateOptions& o, const ct::Table& t, const ct::Applied& a,
+                        const ct::PredictedResidual& p, const std::string& text) {
+  try {
+    const auto id = store_compensation_record(o, t, a, p, text);
     fmt::print(stderr,
                "stored as compensation {}: the next run of axis {} on this machine is compared "
                "with its prediction (daq verify RUN)\n",
@@ -307,10 +317,11 @@ void run(CompensateOptions& o) {
 }  // namespace
 
 nlohmann::json run_compensation(const cal::storage::Store& store, std::int64_t run,
-                                const std::string& format) {
+                                const std::string& format, const std::string* store_in) {
   CompensateOptions o;
   o.run = run;
   o.format = format;
+  if (store_in) o.db = *store_in;
   const auto record = store.run(run);
   if (!record) throw cal::InputError(fmt::format("no run {}", run));
   if (record->kind != "linear")
@@ -332,9 +343,14 @@ nlohmann::json run_compensation(const cal::storage::Store& store, std::int64_t r
   const auto stats = cal::iso230_2::target_stats(m);
   const auto table = ct::positioning(spec_of(o), stats);
   const auto text = positioning_text(o, table);
-  const auto predicted = ct::predict(applied_of(writer_of(o), table), stats);
+  const auto applied = applied_of(writer_of(o), table);
+  const auto predicted = ct::predict(applied, stats);
   const auto& meaning = meaning_of(o);
+  // Stored as `daq compensate --run` stores it (the same record), for daq verify.
+  nlohmann::json stored = nullptr;
+  if (store_in) stored = {{"id", store_compensation_record(o, table, applied, predicted, text)}};
   return {{"schema", "caldaq.run-compensation.v1"},
+          {"stored", stored},
           {"run", run},
           {"axis", o.axis},
           {"format", o.format},

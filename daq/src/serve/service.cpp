@@ -43,10 +43,12 @@
 #include "report_pdf.hpp"
 #include "result_rows.hpp"
 #include "run_document.hpp"
+#include "serve/ballbar_set.hpp"
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
 #include "serve/setup_form.hpp"
+#include "serve/volumetric_checklist.hpp"
 #include "sim_shop.hpp"
 #include "web/assets.hpp"
 #include "web/server.hpp"
@@ -304,6 +306,7 @@ class Service {
     get("/api/drivers", &Service::drivers);
     get("/api/detected", &Service::detected);
     get("/api/machines", &Service::machines);
+    get("/api/volumetric", &Service::volumetric);
     get("/api/runs/", &Service::run_doc);
     get("/reports/", &Service::report);
     post("/api/setup/check", &Service::setup_check);
@@ -372,11 +375,17 @@ class Service {
       }
       j["linear"] = std::move(t);
     }
-    if (c.circle)
+    if (c.circle) {
       j["circle"] = {{"plane", c.circle->plane},
                      {"radius_mm", c.circle->radius_mm},
                      {"feed_mm_per_min", c.circle->feed_mm_per_min},
                      {"instruments", instruments_of("circle")}};
+      try {  // a set's tests in the order Start runs them (one for a single test)
+        j["circle"]["tests"] = set_plan_json(circle_tests(c));
+      } catch (const cal::InputError& e) {
+        j["circle"]["problem"] = e.what();
+      }
+    }
     return j;
   }
 
@@ -623,6 +632,14 @@ class Service {
     return ok({{"schema", "caldaq.machines.v1"}, {"machines", list}});
   }
 
+  // GET /api/volumetric: the 21-error campaign of the set-up's machine as a checklist, from the
+  // store (volumetric_checklist.hpp): what is measured, by which run and when, what is left.
+  web::Response volumetric(std::string_view) {
+    const auto db = read_store();
+    return ok(volumetric_checklist(db ? &*db : nullptr, config_.machine_name,
+                                   database_path(o_.run.db).string()));
+  }
+
   // --- stored runs and reports -----------------------------------------------------------
 
   web::Response runs() {
@@ -668,6 +685,19 @@ class Service {
                             {"deviation_um", t.deviation_um}});
     for (auto& r : j["results"])
       if (r["result"].is_object()) r["values"] = rows_json(result_rows(r["result"]));
+    // A circle's polar plot: its two traces, a point per degree (bounded, docs/web.md).
+    if (const auto run = store.run(id); run && run->kind == "circle") {
+      const json* current = nullptr;
+      for (const auto& r : j["results"])
+        if (r.value("current", false) && r["result"].is_object()) current = &r["result"];
+      try {
+        j["trace"] = current
+                         ? circle_trace_json(store, id, json::parse(run->settings_json), *current)
+                         : json(nullptr);
+      } catch (const std::exception& e) {
+        j["trace"] = {{"error", e.what()}};
+      }
+    }
     j["reports"] = {{"html", fmt::format("/reports/run-{}.html", id)},
                     {"pdf", fmt::format("/reports/run-{}.pdf", id)}};
     return ok(j);
@@ -675,14 +705,18 @@ class Service {
 
   // POST /api/compensation {"run": N, "format": "fanuc"}: the compensation table of a stored
   // linear run as `daq compensate` writes it, through the same code (compensate_run.hpp);
-  // nothing is stored. 400 for a bad body or format, 404 for no such run, 409 with the
-  // command's refusal (a suspect run, too few targets, not a linear run).
+  // with "store": true also stored with the run as the command stores it (for daq verify).
+  // 400 for a bad body or format, 404 for no such run, 409 with the command's refusal (a
+  // suspect run, too few targets, not a linear run), 500 when the store cannot be written.
   web::Response compensation(const std::string& body) {
     const auto j = json::parse(body, nullptr, false);
-    const bool good = j.is_object() && j.size() == 2 && j.contains("run") &&
+    const bool store = j.is_object() && j.contains("store");
+    const bool good = j.is_object() && j.size() == (store ? 3u : 2u) && j.contains("run") &&
                       j["run"].is_number_integer() && j.contains("format") &&
-                      j["format"].is_string();
-    if (!good) return error(400, R"(the body must be {"run": N, "format": "csv"})");
+                      j["format"].is_string() && (!store || j["store"].is_boolean());
+    if (!good)
+      return error(400,
+                   R"(the body must be {"run": N, "format": "csv"} and optionally "store": true)");
     const auto id = j["run"].get<std::int64_t>();
     const auto format = j["format"].get<std::string>();
     try {
@@ -694,9 +728,13 @@ class Service {
     if (!db) return error(404, fmt::format("no run {}: {}", id, no_database()));
     if (!db->run(id)) return error(404, fmt::format("no run {}", id));
     try {
-      return ok(run_compensation(*db, id, format));
+      // "store": true stores the table with the run as `daq compensate --run` does (daq verify).
+      return ok(run_compensation(*db, id, format,
+                                 store && j["store"].get<bool>() ? &o_.run.db : nullptr));
     } catch (const cal::InputError& e) {
       return error(409, e.what());
+    } catch (const std::exception& e) {
+      return error(500, fmt::format("the compensation could not be stored: {}", e.what()));
     }
   }
 
@@ -792,12 +830,17 @@ class Service {
     if (!shop_) return std::nullopt;
     if (test == "linear" && config_.linear && config_.linear->axis != "X")
       return "the simulated laser measures the X axis: set the linear test's axis to X";
-    if (test == "circle" && config_.circle &&
-        (std::abs(config_.circle->radius_mm - shop_->truth().ballbar_mm) > 1e-9 ||
-         config_.circle->plane != "XY"))
+    if (test != "circle" || !config_.circle) return std::nullopt;
+    // One circle: in XY only (the shop's single-test program); a set: any planes, over the
+    // sphere about the table ball as `daq sim --test circle-set` runs it.
+    const auto tests = circle_tests(config_);
+    const bool bar = std::all_of(tests.begin(), tests.end(), [&](const CircleTest& t) {
+      return std::abs(t.program.radius_mm - shop_->truth().ballbar_mm) <= 1e-9;
+    });
+    if (!bar || (tests.size() == 1 && config_.circle->plane != "XY"))
       return fmt::format(
-          "the simulated ballbar is {} mm long in the XY plane: set the circle's "
-          "radius to {} mm and its plane to XY",
+          "the simulated ballbar is {} mm long, a single test in the XY plane: set the "
+          "circle's radius to {} mm and its plane to XY (or planes for a set)",
           shop_->truth().ballbar_mm, shop_->truth().ballbar_mm);
     return std::nullopt;
   }
@@ -810,6 +853,7 @@ class Service {
     if (config_.circle) j["tests"].push_back("circle");
     if (running()) j["run"] = {{"id", run_id_}, {"test", test_}, {"origin", run_origin_}};
     if (last_) j["last"] = *last_;
+    if (set_) j["set"] = set_->to_json();
     j["setup"] = setup_summary_;
     return j;
   }
@@ -962,6 +1006,7 @@ class Service {
   }
 
   void start_linear() {
+    set_.reset();
     const auto specs = linear_specs(config_);
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
@@ -981,8 +1026,11 @@ class Service {
     std::fflush(stdout);
   }
 
+  // One test, or a set (planes, feeds, radii): the tests after the first follow on the same
+  // bar stream, each stored as its own run, as `daq run circle` runs a set.
   void start_circle() {
-    const auto [program, analysis] = circle_test(config_);
+    const auto tests = circle_tests(config_);
+    const auto& first = tests.front();
     const auto& dc = ballbar_device(config_);
     const std::vector<InstrumentSpec> specs{spec_of(dc, 0)};
     const auto path = capture_path();
@@ -991,20 +1039,25 @@ class Service {
     const auto options = run_options();
     CircleRunSetup setup{
         .config = config_,
-        .program = program,
-        .analysis = analysis,
+        .program = first.program,
+        .analysis = first.analysis,
         .database = database_path(o_.run.db),
         .ballbar = options.wrap(dc, make_instrument(io_, specs[0], make_transport(io_, dc),
                                                     instrument_options(dc, specs[0], options,
                                                                        capture_->recorder.get()))),
         .capture_path = capture_->absolute_path(path),
-        .origins = {{"ballbar", origin_of(specs[0].origin, "")}}};
+        .origins = {{"ballbar", origin_of(specs[0].origin, "")}},
+        .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
     mark_simulated(setup.origins);
     setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
     circle_->start();
     run_id_ = circle_->outcome().run_id;
+    set_.reset();
+    set_done_ = 0;
+    if (tests.size() > 1) set_.emplace(tests);
+    follow_set();
     fmt::print("run {} (circle) started from the web page\n", run_id_);
     std::fflush(stdout);
   }
@@ -1023,6 +1076,10 @@ class Service {
       if (linear_) {
         const auto& l = *config_.linear;
         shop_->run_linear(linear_->plan(), l.feed_mm_per_min, l.dwell_s);
+      } else if (set_) {  // the whole set in one program, the bar moved over the sphere
+        std::vector<cal::daq::BallbarSetTest> program;
+        for (const auto& t : circle_tests(config_)) program.push_back({t.plane, t.program});
+        shop_->run_circle_set(program);
       } else {
         shop_->run_circle(circle_test(config_).first);
       }
@@ -1041,6 +1098,11 @@ class Service {
     const bool evaluated = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
     const char* status = complete ? "complete" : evaluated ? "incomplete" : "aborted";
+    follow_set();
+    if (set_ && circle_) {
+      const auto db = read_store_quietly();
+      set_->end(status, reason, db ? &*db : nullptr);
+    }
     last_ = json{{"run", run_id_},       {"test", test_},    {"complete", complete},
                  {"status", status},     {"reason", reason}, {"evaluated", evaluated},
                  {"origin", run_origin_}};
@@ -1052,11 +1114,38 @@ class Service {
     start_monitors(test_);
   }
 
+  // A set's progress: the run of the test in progress is the run the page shows; each test
+  // done is read from the store once.
+  void follow_set() {
+    if (!circle_) return;
+    run_id_ = circle_->outcome().run_id;
+    if (!set_) return;
+    std::vector<std::int64_t> done;
+    for (const auto& c : circle_->completed()) done.push_back(c.run_id);
+    const bool last_done = circle_->outcome().complete;
+    if (last_done) done.push_back(circle_->outcome().run_id);
+    const std::int64_t current = last_done ? 0 : run_id_;
+    if (done.size() == set_done_) return set_->update(done, current, nullptr);
+    set_done_ = done.size();
+    const auto db = read_store_quietly();
+    set_->update(done, current, db ? &*db : nullptr);
+  }
+
+  std::optional<cal::storage::Store> read_store_quietly() const {
+    try {
+      return read_store();
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "daq serve: the ballbar set's runs could not be read: {}\n", e.what());
+      return std::nullopt;
+    }
+  }
+
   void tick() {
     tick_.expires_after(200ms);
     tick_.async_wait([this](const boost::system::error_code& ec) {
       if (ec) return;
       if ((linear_ && linear_->finished()) || (circle_ && circle_->finished())) finish();
+      if (circle_) follow_set();
       if (capture_ && capture_->recorder) capture_->recorder->flush();
       tick();
     });
@@ -1089,6 +1178,8 @@ class Service {
   std::string capture_pending_;
   std::unique_ptr<LinearRun> linear_;
   std::unique_ptr<CircleRun> circle_;
+  std::optional<BallbarSetProgress> set_;  // a ballbar set's progress (kept after it ends)
+  std::size_t set_done_ = 0;               // its tests whose stored values were read
   std::int64_t run_id_ = 0;
   std::string test_;
   std::string run_live_;

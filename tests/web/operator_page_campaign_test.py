@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""The 21-error volumetric campaign on the operator's page (issue 29), driven in headless Chromium:
+
+a short campaign on the simulated shop (`daq sim --measure` and `daq run linear`, as
+docs/volumetric-walkthrough.md measures it): positioning E_XX and the two straightness runs of
+the XY plane (E_YX, E_XY, read against one square), the first of them dated a day earlier (a
+campaign over two days); then `daq serve -c` on that store. The Results view lists the 18
+component tests and the three squarenesses, each with its test and instrument; the measured
+ones with the run `daq model build` uses for them (its --json `used`, the CLI's own code), their
+day and where the other axes stood; the XY squareness measured from its two runs; the others
+"to do"; the days; and the commands that build the model and its map. Screenshots at
+1366 x 768 and 560 px.
+
+Waits: each simulated run about 15 s on a loaded 2-core machine; the page's load up to 60 s.
+Usage: operator_page_campaign_test.py DAQ_BINARY SHOT_DIR
+"""
+import datetime
+import json
+import os
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(__file__))
+import page_checks  # noqa: E402
+from page_checks import ok  # noqa: E402
+from webdriver import Browser  # noqa: E402
+
+DAQ, SHOTS = os.path.abspath(sys.argv[1]), sys.argv[2]
+os.makedirs(SHOTS, exist_ok=True)
+TMP = tempfile.mkdtemp(prefix="operator-page-campaign-")
+DB = os.path.join(TMP, "vol.sqlite")
+MACHINE = "SIMULATED YFXZ"
+
+
+def measure(component):
+    """One component's test on the simulated shop, as the walkthrough runs it: `daq sim` writes
+    the configuration, then waits for the run to start in the store."""
+    toml = os.path.join(TMP, "sim.toml")
+    if os.path.exists(toml):
+        os.remove(toml)
+    log = open(os.path.join(TMP, f"sim-{component}.log"), "w")
+    sim = subprocess.Popen([DAQ, "sim", "--measure", component, "--topology", "YFXZ", "--speed", "10",
+                            "--db", DB, "-o", "sim.toml"], stdout=log, stderr=subprocess.STDOUT, cwd=TMP)
+    try:
+        deadline = time.time() + 60
+        while not os.path.exists(toml) and sim.poll() is None and time.time() < deadline:
+            time.sleep(0.1)
+        r = subprocess.run([DAQ, "run", "linear", "-c", "sim.toml", "--db", DB], capture_output=True, text=True, cwd=TMP)
+        ok(r.returncode == 0, f"{component} measured on the simulated shop: {r.stderr[-500:]}")
+    finally:
+        sim.wait(timeout=120)
+
+
+for component in ("E_XX", "E_YX", "E_XY"):
+    measure(component)
+con = sqlite3.connect(DB)
+con.execute("UPDATE runs SET started_unix_ms = started_unix_ms - 86400000, ended_unix_ms = ended_unix_ms - 86400000 WHERE id = 1")
+con.commit()
+days = [datetime.datetime.fromtimestamp(ms / 1000, datetime.timezone.utc).strftime("%Y-%m-%d")
+        for (ms,) in con.execute("SELECT started_unix_ms FROM runs ORDER BY id")]
+con.close()
+cli = json.loads(subprocess.run([DAQ, "model", "build", "--machine", MACHINE, "--db", DB, "--allow-missing", "--json",
+                                 "-o", os.path.join(TMP, "model.json")], capture_output=True, text=True, check=True).stdout)
+
+serve, url = page_checks.start_service(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--db", DB])
+b = Browser(1366, 768)
+try:
+    b.get(url)
+    b.js("document.getElementById('tab-results').click();")
+    head = b.wait("const h = document.getElementById('vol-head').textContent; return /Volumetric/.test(h) && h;",
+                  timeout_s=60, what="the campaign's checklist")
+    ok(head == f"Volumetric campaign of {MACHINE}: 4 of 21 errors measured",
+       f"3 component tests and the XY squareness of 21: {head!r}")
+    rows = b.js("return Object.fromEntries([...document.querySelectorAll('#vol-table tbody tr')].map(r => "
+                "[r.dataset.component, [...r.cells].map(c => c.textContent)]));")
+    ok(len(rows) == 21, f"a row for each of the 18 components and 3 squarenesses: {len(rows)}")
+    for component, ids in cli["used"].items():
+        if component.startswith("E_") and len(component) == 4:
+            ok(rows[component][3] == str(ids[0]),
+               f"{component}: run {rows[component][3]}, the one `daq model build` uses ({ids})")
+    ok(rows["E_XX"][4] == days[0] and rows["E_YX"][4] == days[1],
+       f"each with its day: E_XX {rows['E_XX'][4]}, E_YX {rows['E_YX'][4]}")
+    ok(rows["E_XX"][1] == "Positioning of X: the laser along X" and rows["E_XX"][2] == "laser",
+       f"the test and its instrument in words: {rows['E_XX'][:3]}")
+    ok(rows["E_YX"][1].startswith("Straightness of X read in Y") and "against a square" in rows["E_YX"][5] and
+       rows["E_YX"][5].startswith("other axes at "), f"the set-up as measured: {rows['E_YX']}")
+    ok(rows["E_BX"][3] == "—" and rows["E_BX"][4] == "to do" and rows["E_BX"][1] == (
+        "Angle of X about B: two laser beams side by side, reflectors apart across the travel"),
+       f"what is left, with its set-up: {rows['E_BX']}")
+    ok(rows["E_C0Y"][3] == f"{cli['used']['E_YX'][0]}, {cli['used']['E_XY'][0]}" and rows["E_C0Y"][4] == "",
+       f"the XY squareness from its two straightness runs: {rows['E_C0Y']}")
+    ok(rows["E_B0Z"][4] == "to do", "the ZX squareness still to do")
+    text = b.js("return document.getElementById('vol-box').textContent;")
+    ok(f"{days[0]}: 1 measured: E_XX" in text and f"{days[1]}: 2 measured: E_YX, E_XY" in text,
+       "the campaign's progress by day")
+    ok(f"17 still to measure: then build the model with `daq model build --machine '{MACHINE}' --db '{DB}' -o model.json`"
+       in text and "daq model map model.json" in text, "the commands that build the model and its map")
+    b.js("document.getElementById('vol-panel').scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c01-campaign-1366x768.png")
+    page_checks.fits_narrow(b, SHOTS, "c02-campaign-560.png", "the checklist fits 560 px (its table scrolls)")
+    ok(not b.js("return window.__errors || null;"), "no script error")
+    print(f"{page_checks.passes} checks passed")
+finally:
+    b.close()
+    page_checks.stop_service(serve)

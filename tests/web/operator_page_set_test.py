@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""The ballbar set from the operator's page (issue 29), driven in headless Chromium against
+`daq serve --simulate`:
+
+1. the set typed in the Set-up form (planes XY, ZX, YZ) and applied: the Run view names the set's
+   three tests in the order Start runs them;
+2. Start: the page says what to do now (mount the bar, run the program; then leave it mounted
+   while the program moves it onto the next plane) and what comes next, test k of 3;
+3. each test done shows its stored run, G and verdict (the same G as /api/runs/N);
+4. at the end the three-plane table, the same numbers `daq ballbar volumetric --runs` prints
+   (the CLI's code), on the Run view and in the Results (opened by itself), at 1366 x 768 and
+   560 px; updates per second and bytes per update measured during the set.
+
+Waits: up to 60 s for each phase (a 2-core machine under ctest -j3; the whole set is about 250 s
+of simulated time, 5 s at the shop's 50x). Usage: operator_page_set_test.py DAQ_BINARY SHOT_DIR
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+
+sys.path.insert(0, os.path.dirname(__file__))
+import page_checks  # noqa: E402
+from page_checks import ok, post, TYPE  # noqa: E402
+from webdriver import Browser  # noqa: E402
+
+DAQ, SHOTS = os.path.abspath(sys.argv[1]), sys.argv[2]
+os.makedirs(SHOTS, exist_ok=True)
+TMP = tempfile.mkdtemp(prefix="operator-page-set-")
+DB = os.path.join(TMP, "runs.sqlite")
+WAIT_S = 60
+
+
+def get(url):
+    with urllib.request.urlopen(url, timeout=30) as r:
+        return json.load(r)
+
+
+def shot(b, name):
+    page_checks.shot(b, SHOTS, name)
+
+
+serve, url = page_checks.start_simulated_service(DAQ, TMP, DB)
+b = Browser(1366, 768)
+try:
+    def wait(script, what, timeout_s=WAIT_S):
+        try:
+            return b.wait(script, timeout_s=timeout_s, what=what, explain=(
+                "return JSON.stringify({status: window.caldaq.page && window.caldaq.page.status, "
+                "next: (document.getElementById('set-next') || {}).textContent, errors: window.__errors}).slice(0, 3000);"))
+        except AssertionError as e:
+            raise AssertionError(f"{e}\n--- serve.log:\n{page_checks.log_tail(TMP)}") from None
+
+    b.get(url)
+    wait("return window.caldaq.page && window.caldaq.page.status.start.circle.ready;", "Start ballbar ready")
+
+    # --- 1. the set typed in the form and applied ----------------------------------------
+    b.js("document.getElementById('tab-setup').click();")
+    wait("return [...document.querySelectorAll('[data-key]')].some(i => i.dataset.key === 'test.circle.planes');",
+         "the set's fields in the form")
+    ok(b.js(TYPE, "test.circle.planes", "XY, ZX, YZ") == "ok", "typed: planes XY, ZX, YZ")
+    ok(b.js(TYPE, "test.circle.feeds_mm_per_min", "3000") == "ok", "typed: feed 3000 mm/min")
+    wait("return window.caldaq.check && window.caldaq.check.ok && !document.querySelector('.field.bad');",
+         "the set accepted by the loader")
+    b.js("document.getElementById('apply').click();")
+    wait("const c = window.caldaq.page.status.setup.circle; return c.tests && c.tests.length === 3;",
+         "the set applied")
+    b.js("document.getElementById('tab-run').click();")
+    plan = wait("const p = document.getElementById('plan'); return !p.hidden && /Ballbar set/.test(p.textContent) && p.textContent;",
+                "the set on the Run view")
+    ok("Ballbar set of 3 tests, in this order: XY 360°, 3000 mm/min, R 100.0 mm; ZX 220°, 3000 mm/min, R 100.0 mm; "
+       "YZ 220°, 3000 mm/min, R 100.0 mm" in plan, f"the Run view names the set's tests in order: {plan!r}")
+    wait("return window.caldaq.page.status.start.circle.ready;", "Start ballbar ready with the set")
+    ok(b.js("return document.getElementById('start-circle').textContent;") == "Start ballbar set (3 tests)",
+       "Start says it starts the set")
+
+    # --- 2. Start: what to do now and next ------------------------------------------------
+    post(url + "api/simulation/speed", {"speed": 1})  # the wait for test 1's feed-in is seen
+    b.js("document.getElementById('start-circle').click();")
+    first = wait("const s = window.caldaq.page.status; return s.running && s.set && s.set.tests[0].run;", "the set to start")
+    NEXT = "const n = document.getElementById('set-next'); return !n.hidden"
+    text = wait(NEXT + " && /set: test 1 of 3/.test(n.textContent) && n.textContent;", "test 1's instruction")
+    ok("Ballbar set: test 1 of 3: XY 360°, 3000 mm/min, R 100.0 mm" in text and
+       "Mount the bar in the XY plane on the table ball and run the set's program" in text and
+       "Next: test 2 of 3, ZX 220°" in text, f"test 1: what to do and what comes next: {text!r}")
+    shot(b, "s01-set-test1-1366x768.png")
+    post(url + "api/simulation/speed", {"speed": 10})
+    c0, bytes0, t0 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];") + [time.time()]
+    text = wait(NEXT + " && /set: test 2 of 3/.test(n.textContent) && n.textContent;", "test 2's instruction")
+    ok("Next: test 3 of 3, YZ 220°" in text and
+       ("Leave the bar mounted: the set's program moves it from the XY plane onto the ZX plane" in text or
+        "Measuring" in text), f"test 2: the bar stays (the program moves it), then YZ: {text!r}")
+    c1, bytes1, t1 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];") + [time.time()]
+    print(f"measured during the set's first test: {(c1 - c0) / (t1 - t0):.1f} page updates per second, "
+          f"{(bytes1 - bytes0) / max(1, c1 - c0):.0f} bytes per update", flush=True)
+    ok((c1 - c0) / (t1 - t0) >= 2, "the page is updated at least twice a second during the set")
+    row = wait("const r = document.querySelector('#set-box tr[data-set-test=\"1\"]'); return r && "
+               "r.cells[3].textContent === 'done' && r.cells[4].textContent !== '—' && [...r.cells].map(c => c.textContent);",
+               "test 1 done in the set's table")
+    doc = get(url + f"api/runs/{first}")
+    g = [v for r in doc["results"] if r["current"] for v in r["values"] if v["symbol"] in ("G(b)", "G")]
+    ok(g and row[4] == f"{g[0]['value']:.2f}", f"test 1's G is its stored run's: {row} vs {g[:1]}")
+    ok(row[2] == str(first) and row[6] in ("PASS", "FAIL", "no tolerance configured"), f"with its run and verdict: {row}")
+    post(url + "api/simulation/speed", {"speed": 50})
+    shot(b, "s02-set-test2-1366x768.png")
+
+    # --- 3. the end: the three-plane table as the CLI prints it ---------------------------
+    wait("const s = window.caldaq.page.status.set; return s && s.state === 'complete' && s.table;", "the set's end")
+    runs = b.js("return window.caldaq.page.status.set.tests.map(t => t.run);")
+    ok(len(runs) == 3 and runs == sorted(runs) and runs[0] == first, f"three runs, one per test: {runs}")
+    cli = json.loads(subprocess.run([DAQ, "ballbar", "volumetric", "--db", DB, "--runs", ",".join(map(str, runs)), "--json"],
+                                    capture_output=True, text=True, check=True).stdout)
+    wait("return !document.getElementById('result-set').hidden;", "the Results with the set's table")
+    ok(b.js("return window.caldaq.view;") == "results", "the Results view opened by itself at the set's end")
+    shown = b.js("return [...document.querySelectorAll('#result-set-vol tbody tr')].map(r => [...r.cells].map(c => c.textContent));")
+    ok(len(shown) == 3 and sorted(r[0] for r in shown) == ["XY", "YZ", "ZX"], f"a row per plane: {shown}")
+    for p in cli["planes"]:
+        r = next(x for x in shown if x[0] == p["plane"])
+        want = f"{p['squareness_um_per_m']:+.1f}"
+        ok(r[3] == want and r[1] == str(p["runs"][0]),
+           f"{p['plane']}: squareness {r[3]} µm/m as `daq ballbar volumetric` ({want}), from run {r[1]}")
+    # The polar plot of the test shown (the last), from its stored readings, bounded in size.
+    trace = get(url + f"api/runs/{runs[2]}")["trace"]
+    n_ccw, n_cw, size = len(trace["ccw"]), len(trace["cw"]), len(json.dumps(trace))
+    ok(150 <= n_ccw <= 400 and 150 <= n_cw <= 400 and size < 30000,
+       f"/api/runs/N carries the circle's traces, a point per degree at most: {n_ccw} + {n_cw} points, {size} bytes")
+    ok(all(abs(p[1]) < 50 for p in trace["ccw"] + trace["cw"]), "deviations in µm about the centre")
+    painted = wait("const c = document.getElementById('result-polar'); if (c.closest('[hidden]')) return false; "
+                   "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; "
+                   "for (let i = 0; i < d.length; i += 4) if (d[i + 2] > 200 && d[i] < 120) n++; return n;",
+                   "the polar plot on the Results")
+    ok(painted > 500, f"the ccw trace is drawn on the Results ({painted} blue pixels)")
+    shot(b, "s03-set-results-1366x768.png")
+    b.js("document.getElementById('result-polar').scrollIntoView();")
+    shot(b, "s03b-set-results-polar-1366x768.png")
+    b.js("window.scrollTo(0, 0);")
+    b.js("document.getElementById('tab-run').click();")
+    text = wait(NEXT + " && /complete/.test(n.textContent) && n.textContent;", "the set's end on the Run view")
+    ok(f"Ballbar set complete: 3 of 3 tests stored (runs {runs[0]}, {runs[1]}, {runs[2]})" in text, f"the end in words: {text!r}")
+    ok(b.js("return document.querySelectorAll('#set-box-vol tbody tr').length;") == 3, "the table on the Run view too")
+    shot(b, "s04-set-end-run-1366x768.png")
+    page_checks.fits_narrow(b, SHOTS, "s05-set-end-run-560.png", "the set's table fits 560 px")
+    b.js("document.getElementById('tab-results').click();")
+    page_checks.fits_narrow(b, SHOTS, "s06-set-results-560.png", "the Results with the set fit 560 px")
+    ok(not b.js("return window.__errors || null;"), "no script error")
+    print(f"{page_checks.passes} checks passed")
+finally:
+    b.close()
+    page_checks.stop_service(serve)
