@@ -38,6 +38,7 @@
 #include "result_rows.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
+#include "shortest_number.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
 
@@ -396,13 +397,15 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
   RowBuffer b(out);
   each_export_row(store, run.id, clock, [&](const ExportRow& x) {
     char* p = b.room(row_max);
-    p = fmt::format_to(p, FMT_COMPILE("{},"), clock.seconds(x.session_ns));
+    p = write_shortest(p, clock.seconds(x.session_ns));
+    *p++ = ',';
     const auto utc = clock.utc_view(x.session_ns);
     p = std::copy(utc.begin(), utc.end(), p);
-    p = fmt::format_to(p, FMT_COMPILE(",{},{},{},{},{},{},{}\n"), x.r.device, names[x.r.device],
-                       x.r.channel,
-                       cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
-                       x.r.status, x.r.value, x.r.time_ns);
+    p = fmt::format_to(
+        p, FMT_COMPILE(",{},{},{},{},{},"), x.r.device, names[x.r.device], x.r.channel,
+        cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)), x.r.status);
+    p = write_shortest(p, x.r.value);
+    p = fmt::format_to(p, FMT_COMPILE(",{}\n"), x.r.time_ns);
     b.commit(p);
     b.row_done();
     progress.add();
@@ -519,7 +522,7 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
     RowBuffer b(out);
     // A number as JSON holds it: what it cannot hold (inf, nan) as null, as nlohmann writes it.
     const auto number = [](char* p, double v) {
-      if (std::isfinite(v)) return fmt::format_to(p, FMT_COMPILE("{}"), v);
+      if (std::isfinite(v)) return write_shortest(p, v);
       return std::copy_n("null", 4, p);
     };
     each_export_row(store, run.id, clock, [&](const ExportRow& x) {

@@ -48,8 +48,15 @@ void ExportClock::spread(Stream& s, const std::vector<st::RawReading>& group,
 
 std::optional<std::int64_t> ExportClock::unix_ns(double session_ns) const {
   if (!unix0_ns_) return std::nullopt;
-  return *unix0_ns_ +
-         static_cast<std::int64_t>(std::llround(session_ns - static_cast<double>(t0_ns_)));
+  // std::llround (half away from zero) without its libm call, which was 5 % of an export: the
+  // truncation and the fraction left are exact for a double, and above 2^52 a double is whole.
+  const double x = session_ns - static_cast<double>(t0_ns_);
+  if (!(std::abs(x) < 0x1p52)) return *unix0_ns_ + static_cast<std::int64_t>(std::llround(x));
+  auto whole = static_cast<std::int64_t>(x);
+  const double fraction = x - static_cast<double>(whole);
+  if (fraction >= 0.5) ++whole;
+  if (fraction <= -0.5) --whole;
+  return *unix0_ns_ + whole;
 }
 
 std::string ExportClock::utc(double session_ns) const { return std::string(utc_view(session_ns)); }
