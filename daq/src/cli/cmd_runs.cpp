@@ -405,7 +405,9 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
         p, FMT_COMPILE(",{},{},{},{},{},"), x.r.device, names[x.r.device], x.r.channel,
         cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)), x.r.status);
     p = write_shortest(p, x.r.value);
-    p = fmt::format_to(p, FMT_COMPILE(",{}\n"), x.r.time_ns);
+    *p++ = ',';
+    p = write_integer(p, x.r.time_ns);
+    *p++ = '\n';
     b.commit(p);
     b.row_done();
     progress.add();
@@ -536,7 +538,9 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
           p, FMT_COMPILE("\",{},{},{},\"{}\",{},"), x.r.device, names[x.r.device], x.r.channel,
           cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)), x.r.status);
       p = number(p, x.r.value);
-      p = fmt::format_to(p, FMT_COMPILE(",{}]"), x.r.time_ns);
+      *p++ = ',';
+      p = write_integer(p, x.r.time_ns);
+      *p++ = ']';
       b.commit(p);
       b.row_done();
       first = false;

@@ -86,6 +86,13 @@ std::string_view ExportClock::utc_view(double session_ns) const {
 void ExportRows::flush(std::vector<ExportRow>& out) {
   for (auto& e : pending_) {
     if (e.group.empty()) continue;
+    if (e.group.size() == 1) {
+      out.push_back(
+          {e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns), e.tags[0]});
+      e.group.clear();
+      e.tags.clear();
+      continue;
+    }
     ExportClock::spread(*e.stream, e.group, times_);
     for (std::size_t i = 0; i < e.group.size(); ++i)
       out.push_back({e.group[i], times_[i], e.tags[i]});

@@ -23,37 +23,55 @@ inline constexpr char kPairs[] =
     "4748495051525354555657585960616263646566676869707172737475767778798081828384858687888990919293"
     "949596979899";
 
-inline int count_digits(std::uint64_t v) {
-  int n = 1;
-  for (;;) {
-    if (v < 10) return n;
-    if (v < 100) return n + 1;
-    if (v < 1000) return n + 2;
-    if (v < 10000) return n + 3;
-    v /= 10000;
-    n += 4;
-  }
+inline void write_pair(char* p, std::uint32_t x) {  // x < 100
+  p[0] = kPairs[x * 2];
+  p[1] = kPairs[x * 2 + 1];
 }
 
-// The `size` decimal digits of v, written to [p, p + size).
+// Exactly 8 digits of x < 10^8, leading zeros included: two independent halves, so the
+// divisions do not wait on each other (a division chain per pair of digits was the writer's
+// largest cost).
+inline void write8(char* p, std::uint32_t x) {
+  const std::uint32_t hi = x / 10000, lo = x % 10000;
+  write_pair(p, hi / 100);
+  write_pair(p + 2, hi % 100);
+  write_pair(p + 4, lo / 100);
+  write_pair(p + 6, lo % 100);
+}
+
+// The `size` decimal digits of v (size = count_digits(v)), written to [p, p + size).
 inline void write_digits(char* p, std::uint64_t v, int size) {
   char* end = p + size;
-  while (v >= 100) {
-    const auto pair = static_cast<unsigned>(v % 100) * 2;
-    v /= 100;
-    *--end = kPairs[pair + 1];
-    *--end = kPairs[pair];
+  while (v >= 100'000'000) {
+    end -= 8;
+    write8(end, static_cast<std::uint32_t>(v % 100'000'000));
+    v /= 100'000'000;
   }
-  if (v >= 10) {
-    const auto pair = static_cast<unsigned>(v) * 2;
-    *--end = kPairs[pair + 1];
-    *--end = kPairs[pair];
-  } else {
-    *--end = static_cast<char>('0' + v);
+  auto x = static_cast<std::uint32_t>(v);
+  while (x >= 100) {
+    end -= 2;
+    write_pair(end, x % 100);
+    x /= 100;
   }
+  if (x >= 10)
+    write_pair(end - 2, x);
+  else
+    end[-1] = static_cast<char>('0' + x);
 }
 
 }  // namespace shortest_detail
+
+// An integer as fmt's "{}" writes it (at most 20 characters); returns the end.
+inline char* write_integer(char* p, std::int64_t v) {
+  std::uint64_t u = static_cast<std::uint64_t>(v);
+  if (v < 0) {
+    *p++ = '-';
+    u = 0 - u;
+  }
+  const int size = fmt::detail::count_digits(u);
+  shortest_detail::write_digits(p, u, size);
+  return p + size;
+}
 
 // Writes v at p (at most 24 characters) and returns the end.
 inline char* write_shortest(char* p, double v) {
@@ -65,10 +83,10 @@ inline char* write_shortest(char* p, double v) {
   }
   const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
   const std::uint64_t sig = dec.significand;
-  const int exponent = dec.exponent;  // v = sig x 10^exponent
-  const int size = count_digits(sig);
-  const int out_exp = exponent + size - 1;  // of the first digit
-  if (out_exp < -4 || out_exp >= 16) {      // d[.ddd]e[+-]XX
+  const int exponent = dec.exponent;                // v = sig x 10^exponent
+  const int size = fmt::detail::count_digits(sig);  // branch-free (a table by bit length)
+  const int out_exp = exponent + size - 1;          // of the first digit
+  if (out_exp < -4 || out_exp >= 16) {              // d[.ddd]e[+-]XX
     char digits[20];
     write_digits(digits, sig, size);
     *p++ = digits[0];

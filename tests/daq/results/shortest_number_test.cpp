@@ -104,4 +104,28 @@ TEST(ShortestNumber, ValuesLikeAnExportsNumbers) {
   EXPECT_EQ(first_difference(values), "");
 }
 
+TEST(ShortestNumber, IntegersAsFmtWritesThem) {
+  std::vector<std::int64_t> values = {0,
+                                      1,
+                                      -1,
+                                      9,
+                                      10,
+                                      99,
+                                      100,
+                                      99'999'999,
+                                      100'000'000,
+                                      std::numeric_limits<std::int64_t>::max(),
+                                      std::numeric_limits<std::int64_t>::min()};
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 1'000'000; ++i) {
+    const auto v = static_cast<std::int64_t>(rng());
+    values.push_back(v >> (rng() % 64));  // every length of digits, both signs
+  }
+  for (std::int64_t v : values) {
+    char buf[32];
+    const std::string got(buf, daq::write_integer(buf, v));
+    ASSERT_EQ(got, fmt::format("{}", v));
+  }
+}
+
 }  // namespace
