@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -16,6 +18,7 @@
 #include <optional>
 #include <span>
 #include <tuple>
+#include <vector>
 
 #include "cal/analysis/error.hpp"
 #include "cal/daq/ballbar.hpp"
@@ -35,6 +38,7 @@
 #include "result_rows.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
+#include "shortest_number.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
 
@@ -253,7 +257,9 @@ std::string num(double v) { return fmt::format("{}", v); }
 
 // An export's rows are formatted into one buffer with formats compiled in (no string per value,
 // no format string parsed per row) and written 64 KiB at a time: per-value strings and a print
-// per row were most of an export's time (issue 32).
+// per row were most of an export's time (issue 32). A row is written through a plain pointer
+// into room reserved for it (`room`, then `commit`): fmt's appender checks the capacity at
+// every character, which was a fifth of an export's time.
 class RowBuffer {
  public:
   explicit RowBuffer(std::FILE* out) : out_(out) {}
@@ -261,26 +267,67 @@ class RowBuffer {
   RowBuffer& operator=(const RowBuffer&) = delete;
   // On an exception's way out: what is held, without a word (the exception says what failed).
   ~RowBuffer() {
-    if (text_.size() != 0) std::fwrite(text_.data(), 1, text_.size(), out_);
+    if (size_ != 0) std::fwrite(text_.data(), 1, size_, out_);
   }
-  fmt::appender it() { return fmt::appender(text_); }
-  void add(std::string_view s) { text_.append(s.data(), s.data() + s.size()); }
+  // Where the next `n` characters go (at most n are written there before `commit`).
+  char* room(std::size_t n) {
+    if (size_ + n > text_.size()) text_.resize(std::max(kFlushAt, size_ + n) * 2);
+    return text_.data() + size_;
+  }
+  void commit(const char* end) { size_ = static_cast<std::size_t>(end - text_.data()); }
+  void add(std::string_view s) { commit(std::copy(s.begin(), s.end(), room(s.size()))); }
   // Called after each row: writes the buffer once it is full.
   void row_done() {
-    if (text_.size() >= kFlushAt) write();
+    if (size_ >= kFlushAt) write();
   }
   // Writes what is held; a failed write (a full disk) stops the export at once, as a print
   // per row did, rather than formatting the rest of the run for nothing.
   void write() {
-    if (text_.size() != 0 && std::fwrite(text_.data(), 1, text_.size(), out_) != text_.size())
+    if (size_ != 0 && std::fwrite(text_.data(), 1, size_, out_) != size_)
       throw cal::InputError(fmt::format("export: cannot write: {}", std::strerror(errno)));
-    text_.clear();
+    size_ = 0;
   }
 
  private:
   static constexpr std::size_t kFlushAt = 1 << 16;
-  fmt::memory_buffer text_;
+  std::vector<char> text_ = std::vector<char>(2 * kFlushAt);
+  std::size_t size_ = 0;
   std::FILE* out_;
+};
+
+// The most a row's numbers and fixed text take (a double in the shortest form is at most 24
+// characters, an int64 20); the names and the time of day are added to it.
+constexpr std::size_t kRowNumbersMax = 256;
+
+// Device names by device number (a handful, small numbers): a vector rather than a map lookup
+// per row; a device without an instrument row has an empty name.
+class DeviceNames {
+ public:
+  DeviceNames(const st::Store& store, std::int64_t run,
+              const std::function<std::string(const std::string&)>& quote,
+              std::string_view missing) {
+    for (const auto& i : store.instruments(run)) {
+      if (i.device < 0 || i.device > 0xffff) continue;  // no reading can name it
+      const auto d = static_cast<std::size_t>(i.device);
+      if (d >= names_.size()) names_.resize(d + 1, std::nullopt);
+      names_[d] = quote(i.driver);
+    }
+    missing_ = missing;
+  }
+  std::string_view operator[](std::uint16_t device) const {
+    return device < names_.size() && names_[device] ? std::string_view(*names_[device])
+                                                    : std::string_view(missing_);
+  }
+  std::size_t longest() const {
+    std::size_t n = missing_.size();
+    for (const auto& s : names_)
+      if (s) n = std::max(n, s->size());
+    return n;
+  }
+
+ private:
+  std::vector<std::optional<std::string>> names_;
+  std::string missing_;
 };
 
 // Every reading of the run (or of these quantities), in time order: the one place the export
@@ -310,12 +357,6 @@ void each_export_row(const st::Store& store, std::int64_t run, ExportClock& cloc
   });
   rows.finish(out);
   hand_on();
-}
-
-std::map<int, std::string> device_names(const st::Store& store, std::int64_t run) {
-  std::map<int, std::string> names;
-  for (const auto& i : store.instruments(run)) names[i.device] = i.driver;
-  return names;
 }
 
 // A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
@@ -350,19 +391,24 @@ std::optional<std::string> stop_value_column(const st::RunRecord& run, const jso
 void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
                          std::FILE* out, TerminalProgress& progress) {
   ExportClock clock(store, run, settings);
-  std::map<int, std::string> names;  // CSV fields, quoted where needed
-  for (const auto& [device, name] : device_names(store, run.id)) names[device] = csv_field(name);
+  const DeviceNames names(store, run.id, csv_field, "");  // CSV fields, quoted where needed
+  const std::size_t row_max = kRowNumbersMax + names.longest() + 40;
   fmt::print(out, "{}\n", kReadingColumns);
   RowBuffer b(out);
   each_export_row(store, run.id, clock, [&](const ExportRow& x) {
-    const auto it = names.find(x.r.device);
-    fmt::format_to(b.it(), FMT_COMPILE("{},"), clock.seconds(x.session_ns));
-    b.add(clock.utc_view(x.session_ns));
-    fmt::format_to(b.it(), FMT_COMPILE(",{},{},{},{},{},{},{}\n"), x.r.device,
-                   it == names.end() ? std::string_view() : std::string_view(it->second),
-                   x.r.channel,
-                   cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)),
-                   x.r.status, x.r.value, x.r.time_ns);
+    char* p = b.room(row_max);
+    p = write_shortest(p, clock.seconds(x.session_ns));
+    *p++ = ',';
+    const auto utc = clock.utc_view(x.session_ns);
+    p = std::copy(utc.begin(), utc.end(), p);
+    p = fmt::format_to(
+        p, FMT_COMPILE(",{},{},{},{},{},"), x.r.device, names[x.r.device], x.r.channel,
+        cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)), x.r.status);
+    p = write_shortest(p, x.r.value);
+    *p++ = ',';
+    p = write_integer(p, x.r.time_ns);
+    *p++ = '\n';
+    b.commit(p);
     b.row_done();
     progress.add();
   });
@@ -438,8 +484,9 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
     j["origin"] = to_json(run_origin(run, store.instruments(run.id), m ? m->name : ""));
   }
   ExportClock clock(store, run, settings);
-  std::map<int, std::string> names;  // JSON strings, quoted and escaped
-  for (const auto& [device, name] : device_names(store, run.id)) names[device] = json(name).dump();
+  const DeviceNames names(  // JSON strings, quoted and escaped
+      store, run.id, [](const std::string& name) { return json(name).dump(); }, "\"\"");
+  const std::size_t row_max = kRowNumbersMax + names.longest() + 40;
   j["reading_columns"] = {"time_s",   "utc",    "device", "device_name", "channel",
                           "quantity", "status", "value",  "time_ns"};
   j["readings"] = nullptr;  // the place of the rows, found in the text below
@@ -475,24 +522,26 @@ void export_json(const st::Store& store, const st::RunRecord& run, const json& s
   bool first = true;
   {
     RowBuffer b(out);
-    const auto number = [&b](double v) {
-      if (std::isfinite(v))
-        fmt::format_to(b.it(), FMT_COMPILE("{}"), v);
-      else
-        b.add("null");  // what JSON cannot hold, as nlohmann writes it
+    // A number as JSON holds it: what it cannot hold (inf, nan) as null, as nlohmann writes it.
+    const auto number = [](char* p, double v) {
+      if (std::isfinite(v)) return write_shortest(p, v);
+      return std::copy_n("null", 4, p);
     };
     each_export_row(store, run.id, clock, [&](const ExportRow& x) {
-      const auto it = names.find(x.r.device);
-      b.add(first ? "\n  [" : ",\n  [");
-      number(clock.seconds(x.session_ns));
-      b.add(",\"");
-      b.add(clock.utc_view(x.session_ns));
-      fmt::format_to(
-          b.it(), FMT_COMPILE("\",{},{},{},\"{}\",{},"), x.r.device,
-          it == names.end() ? std::string_view("\"\"") : std::string_view(it->second), x.r.channel,
+      char* p = b.room(row_max);
+      p = std::copy_n(first ? "\n  [" : ",\n  [", first ? 4 : 5, p);
+      p = number(p, clock.seconds(x.session_ns));
+      p = std::copy_n(",\"", 2, p);
+      const auto utc = clock.utc_view(x.session_ns);
+      p = std::copy(utc.begin(), utc.end(), p);
+      p = fmt::format_to(
+          p, FMT_COMPILE("\",{},{},{},\"{}\",{},"), x.r.device, names[x.r.device], x.r.channel,
           cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity)), x.r.status);
-      number(x.r.value);
-      fmt::format_to(b.it(), FMT_COMPILE(",{}]"), x.r.time_ns);
+      p = number(p, x.r.value);
+      *p++ = ',';
+      p = write_integer(p, x.r.time_ns);
+      *p++ = ']';
+      b.commit(p);
       b.row_done();
       first = false;
       progress.add();

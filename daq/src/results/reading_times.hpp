@@ -46,6 +46,13 @@ class ExportClock {
   // stored time, in order; remembers the group's time for the stream's next group.
   static void spread(Stream& s, const std::vector<cal::storage::RawReading>& group,
                      std::vector<double>& times);
+  // The same for a group of one reading (most groups: a reading per stored time), which keeps
+  // its stored time (read - 0 x period); returns it.
+  static double spread_one(Stream& s, std::int64_t time_ns) {
+    s.last_ns = static_cast<double>(time_ns);
+    s.has_last = true;
+    return s.last_ns;
+  }
   double seconds(double session_ns) const {
     return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
   }
