@@ -401,8 +401,13 @@ std::string scale_cross_values(std::string_view format, std::string_view text, d
       const auto dot = v.find('.');
       return dot == std::string_view::npos ? 0 : static_cast<int>(v.size() - dot - 1);
     };
+    // A value made smaller keeps what the control makes of it: a control that applies the
+    // file 25.4 times as large needs two more decimals (where the notation has decimals).
+    const int more =
+        std::abs(factor) < 1 ? static_cast<int>(std::ceil(-std::log10(std::abs(factor)))) : 0;
     const auto scaled = [&](std::string_view v) {
-      return fixed(number(format, 0, n, v) * factor, decimals(v));
+      const int d = decimals(v);
+      return fixed(number(format, 0, n, v) * factor, d > 0 ? d + more : 0);
     };
     if (part == Part::cec && l.starts_with("$AN_CEC[")) {
       const auto eq = l.find('=');
@@ -422,6 +427,63 @@ std::string scale_cross_values(std::string_view format, std::string_view text, d
       line = w.size() == 3 ? "" : std::string(w[0]);
       for (std::size_t k = w.size() == 3 ? 0 : 1; k < w.size(); ++k)
         line += (line.empty() ? "" : " ") + scaled(w[k]);
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+std::string shift_cross_values(std::string_view format, std::string_view text,
+                               const std::string& output, double add_um,
+                               const std::map<std::string, int>& axis_numbers, bool& with_table) {
+  if (format != "siemens-cec" && format != "isg-cross" && format != "csv")
+    throw InputError(fmt::format(
+        "a {} compensation cannot hold a constant of one axis: check the control's reference "
+        "point (or the workpiece datum) instead",
+        format));
+  const auto part = part_of(format, text);
+  const auto in = lines_of(text);
+  with_table = false;
+  // The table (CEC index) or rows of `output`.
+  std::optional<int> cec_table;
+  if (part == Part::cec) {
+    const auto it = axis_numbers.find(output);
+    const std::string ax = it == axis_numbers.end() ? "" : fmt::format("=(AX{})", it->second);
+    for (const auto& [n, l] : in)
+      if (!cec_table && !ax.empty() && l.starts_with("$AN_CEC_OUTPUT_AXIS[") && l.ends_with(ax))
+        cec_table = indices(format, 0, n, l).front();
+    with_table = cec_table.has_value();
+  }
+  if (part == Part::isg_cross)
+    for (const auto& [n, l] : in)
+      if (const auto w = words(l); w.size() == 2 && w[0] == "kopf.log_achs_name" && w[1] == output)
+        with_table = true;
+  if (part == Part::csv)
+    for (const auto& [n, l] : in)
+      if (const auto w = words(l); w.size() == 5 && w[1] == output && !l.starts_with("#"))
+        with_table = true;
+  const double sign = format_meaning(format).written == Sign::error ? -1.0 : 1.0;
+  std::string out;
+  for (const auto& [n, l] : in) {
+    std::string line = l;
+    const auto w = words(l);
+    const auto decimals = [](std::string_view v) {
+      const auto dot = v.find('.');
+      return dot == std::string_view::npos ? 0 : static_cast<int>(v.size() - dot - 1);
+    };
+    const auto moved = [&](std::string_view v, double unit_um) {
+      return fixed(number(format, 0, n, v) + sign * add_um / unit_um, decimals(v));
+    };
+    if (with_table && cec_table && l.starts_with("$AN_CEC[") &&
+        indices(format, 0, n, l).front() == *cec_table) {
+      const auto eq = l.find('=');
+      line = l.substr(0, eq + 1) + moved(std::string_view(l).substr(eq + 1), 1e3);
+    } else if (with_table && part == Part::isg_cross && w.size() == 2 &&
+               w[0].starts_with("kw.crosscomp.table[") && w[0].ends_with(".correction")) {
+      line = fmt::format("{} {}", w[0], moved(w[1], 0.1));
+    } else if (with_table && part == Part::csv && w.size() == 5 && w[1] == output &&
+               !l.starts_with("#")) {
+      line = fmt::format("{},{},{},{},{}", w[0], w[1], w[2], w[3], moved(w[4], 1e3));
     }
     out += line + "\n";
   }

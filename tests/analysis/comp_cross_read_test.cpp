@@ -108,6 +108,9 @@ TEST(CrossRead, ScaledFilesKeepTheirNotationAndNoNegativeZero) {
   EXPECT_NE(negated.find("$AN_CEC[0,4]=-0.0040\n"), std::string::npos) << negated;
   EXPECT_NE(negated.find("$AN_CEC[0,0]=0.0000\n"), std::string::npos);  // not -0.0000
   EXPECT_NE(negated.find("$AN_CEC_MIN[0]=0.0000\n"), std::string::npos);
+  // Undoing a unit error (a control that applies it 25.4 times as large) keeps the precision.
+  EXPECT_NE(scale_cross_values("siemens-cec", cec, 1 / 25.4).find("$AN_CEC[0,4]=0.000157\n"),
+            std::string::npos);
   const std::vector<std::string> one{negated};
   EXPECT_NEAR(y_at(read_cross_applied("siemens-cec", one, kNumbers), 400), -4.0, 1e-9);
   const std::string isg = scale_cross_values("isg-cross", write_isg_cross(y_over_x(), 2, 1), -1.0);

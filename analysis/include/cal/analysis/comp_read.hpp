@@ -55,8 +55,17 @@ CrossApplied read_cross_applied(std::string_view format, std::span<const std::st
 // The correction the control adds at the commanded position p (um, X Y Z).
 kinematics::Vec3 cross_correction_um(const CrossApplied& a, const kinematics::Vec3& p_mm);
 // The file with every compensation value multiplied by `factor` (-1: the other sign; 1/1000: a
-// unit error undone), everything else as it was, in the format's own notation (no -0). For a
+// unit error undone), everything else as it was, in the format's own notation (no -0; a value
+// made smaller gets the decimals the factor takes away, where the notation has decimals). For a
 // file that is not of the cross-axis function (see above) the text is returned unchanged.
 std::string scale_cross_values(std::string_view format, std::string_view text, double factor);
+// The file with `add_um` more added by the control to `output` everywhere (a reference-point
+// error undone): the values of the first table of that output axis moved by it, in the format's
+// units and sign (siemens-cec, isg-cross, csv). Throws cal::InputError for a format that cannot
+// hold a constant (matrixkins, volumetric: the error parameters) or a set with no table of
+// `output` (say so; `with_table` tells whether this file had one).
+std::string shift_cross_values(std::string_view format, std::string_view text,
+                               const std::string& output, double add_um,
+                               const std::map<std::string, int>& axis_numbers, bool& with_table);
 
 }  // namespace cal::comptable
