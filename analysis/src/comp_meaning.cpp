@@ -132,8 +132,9 @@ std::string meaning_header(const FormatMeaning& m, std::string_view c) {
   out += fmt::format("{}Sign: {} ({}).\n", c, to_string(m.evidence), m.source);
   if (m.evidence != Evidence::stated)
     out += fmt::format(
-        "{}VERIFY BEFORE TRUSTING: load the table, measure the axis again (daq verify) and check "
-        "that the error got smaller, not about twice as large.\n",
+        "{}VERIFY BEFORE TRUSTING: load the table, measure the axis again (a cross-axis table: "
+        "the straightness it corrects), run daq verify on that run and check that the error "
+        "got smaller, not about twice as large.\n",
         c);
   return out;
 }
@@ -146,8 +147,9 @@ std::string meaning_text(const FormatMeaning& m) {
   out += ".";
   if (m.evidence != Evidence::stated)
     out +=
-        " Verify before trusting it: load the table, measure the axis again and compare (daq "
-        "verify); an error about twice as large as before means the sign is the other way.";
+        " Verify before trusting it: load the table, measure the axis again (a cross-axis table: "
+        "the straightness it corrects) and compare (daq verify RUN); an error about twice as "
+        "large as before means the sign is the other way.";
   return out;
 }
 

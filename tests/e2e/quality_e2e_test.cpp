@@ -13,6 +13,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "../support/daq_cli.hpp"
 #include "../support/temp_db.hpp"
 #include "cal/storage/store.hpp"
 #include "run_quality.hpp"
@@ -151,18 +152,7 @@ TEST(LateProbe, AValueAnsweredWhileTheMachineStillStandsIsTaken) {
   remove_db(db);
 }
 
-struct Cli {
-  int status = 0;
-  std::string output;
-};
-Cli daq_cli(const std::string& args, const fs::path& out) {
-  const int rc = std::system(
-      (std::string(CALDAQ_DAQ_BINARY) + " " + args + " >'" + out.string() + "' 2>&1").c_str());
-  std::ifstream in(out);
-  std::stringstream text;
-  text << in.rdbuf();
-  return {rc, text.str()};
-}
+using cal::test::daq_cli;
 
 // A stored run with one stop 0.5 um off among stops repeatable to 0.003 um (the walkthrough's
 // wrong stop): suspect, with that stop named; `daq model build` refuses it naming the run, and

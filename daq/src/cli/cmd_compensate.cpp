@@ -9,6 +9,7 @@
 
 #include "cal/analysis/comp_formats.hpp"
 #include "cal/analysis/comp_meaning.hpp"
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
@@ -41,6 +42,7 @@ struct CompensateOptions {
   std::optional<double> resolution;  // unset: by unit (default_resolution)
   int points = 0, axis_number = 1, output_axis_number = 2;
   bool bidirectional = false, incremental = false, remove_slope = false, json = false;
+  bool straightness_run = false;  // --run is a straightness run: a cross-axis table
   CsvOptions csv;
   ct::FanucOptions fanuc;
   std::optional<double> fanuc_reference_mm;  // default: --start-mm
@@ -80,7 +82,9 @@ std::vector<cal::iso230_2::Measurement> measurements(CompensateOptions& o) {
 // A straightness run is the error of another axis (--output-axis) along --axis: its correction
 // belongs in a cross-axis table of the output axis, never in --axis's own pitch table (which
 // corrects --axis along itself: the wrong axis).
-std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) {
+ct::CrossAxisTable straightness_table(const CompensateOptions& o, const ct::Spec& spec,
+                                      std::span<const double> position_mm,
+                                      std::span<const double> deviation_um) {
   if (o.output_axis.empty())
     throw cal::InputError(
         "--straightness: name the corrected axis with --output-axis (the straightness of --axis "
@@ -88,10 +92,11 @@ std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) 
   if (o.units != "mm" || o.incremental || o.sign)
     throw cal::InputError(
         "--straightness writes absolute corrections in mm: no --units, --incremental or --sign");
-  const auto csv = read_csv_columns(o.straightness, {"position_mm", "deviation_um"}, {}, o.csv);
-  const ct::CrossAxisTable t =
-      ct::from_straightness(o.axis, o.output_axis, spec, csv.numbers.at("position_mm"),
-                            csv.numbers.at("deviation_um"), o.remove_slope);
+  return ct::from_straightness(o.axis, o.output_axis, spec, position_mm, deviation_um,
+                               o.remove_slope);
+}
+
+std::string straightness_text(const CompensateOptions& o, const ct::CrossAxisTable& t) {
   const std::vector<ct::CrossAxisTable> one{t};
   if (o.json)
     return nlohmann::json{{"schema", "caldaq.cross-table.v1"},
@@ -115,6 +120,71 @@ std::string straightness_text(const CompensateOptions& o, const ct::Spec& spec) 
                   "of {} corrects {} (use csv, siemens-cec, isg or heidenhain{})",
                   o.format, o.axis, o.output_axis,
                   o.format == "linuxcnc" ? "; LinuxCNC documents no cross-axis table" : ""));
+}
+
+std::string straightness_csv_text(const CompensateOptions& o, const ct::Spec& spec) {
+  const auto csv = read_csv_columns(o.straightness, {"position_mm", "deviation_um"}, {}, o.csv);
+  return straightness_text(o, straightness_table(o, spec, csv.numbers.at("position_mm"),
+                                                 csv.numbers.at("deviation_um")));
+}
+
+// A stored straightness run (--run): the mean of each target's stops is the straightness the
+// cross-axis table corrects (the run's axis and the direction it was read in unless given).
+struct StraightnessRun {
+  std::int64_t machine_id = 0;
+  std::vector<double> position_mm, deviation_um;
+};
+StraightnessRun straightness_of_run(CompensateOptions& o, const cal::storage::Store& store,
+                                    const cal::storage::RunRecord& run) {
+  const auto settings = nlohmann::json::parse(run.settings_json, nullptr, false);
+  const std::string direction =
+      settings.is_object()
+          ? settings.value("measure", nlohmann::json::object()).value("direction", "")
+          : "";
+  o.axis = run.axis;
+  if (o.output_axis.empty()) o.output_axis = direction;
+  if (o.output_axis != direction)
+    throw cal::InputError(fmt::format("run {} is the straightness of {} read in {}, not in {}",
+                                      run.id, run.axis, direction, o.output_axis));
+  StraightnessRun s{.machine_id = run.machine_id};
+  for (const auto& t : cal::iso230_2::target_stats(run_measurements(o, store), 1)) {
+    s.position_mm.push_back(t.target_mm);
+    s.deviation_um.push_back(t.runs_up && t.runs_down ? t.mean_bi_um
+                             : t.runs_up              ? t.mean_up_um
+                                                      : t.mean_down_um);
+  }
+  return s;
+}
+
+// The cross-axis table of a stored straightness run, stored with the run's machine so that the
+// next straightness run of the axis is compared with it (daq verify RUN).
+std::string straightness_run_text(CompensateOptions& o, const ct::Spec& spec,
+                                  const cal::storage::RunRecord& run) {
+  o.straightness_run = true;
+  const auto store = open_database_read_only(o.db);
+  const auto s = straightness_of_run(o, store, run);
+  const auto t = straightness_table(o, spec, s.position_mm, s.deviation_um);
+  const std::string text = straightness_text(o, t);
+  if (o.json) return text;
+  const std::string format = o.format == "isg" ? "isg-cross" : o.format;
+  if (!cal::comptable::is_cross_format(format)) return text;  // heidenhain: not read back
+  try {
+    cal::storage::Store rw(database_path(o.db));
+    CrossCompensation c{.format = format, .files = {{"", text}}};
+    c.axis_numbers = {{o.axis, o.axis_number}, {o.output_axis, o.output_axis_number}};
+    const auto id = store_cross_compensation(rw, s.machine_id, o.run, fmt::format("run {}", o.run),
+                                             c, {{"label", o.origin_label}});
+    fmt::print(stderr,
+               "stored as compensation {}: the next straightness run of {} in {} on this machine "
+               "is compared with it (daq verify RUN)\n",
+               id, o.axis, o.output_axis);
+  } catch (const std::exception& e) {
+    fmt::print(stderr,
+               "note: the compensation was not stored with run {} ({}); daq verify will "
+               "not find it\n",
+               o.run, e.what());
+  }
+  return text;
 }
 
 TableWriter writer_of(const CompensateOptions& o) {
@@ -177,7 +247,8 @@ double default_resolution(const std::string& units) {
 // The meaning of the chosen format's values (comp_meaning.hpp): -f isg with --straightness is
 // ISG's cross compensation.
 const ct::FormatMeaning& meaning_of(const CompensateOptions& o) {
-  if (o.format == "isg" && !o.straightness.empty()) return ct::format_meaning("isg-cross");
+  if (o.format == "isg" && (!o.straightness.empty() || o.straightness_run))
+    return ct::format_meaning("isg-cross");
   return ct::format_meaning(o.format);
 }
 
@@ -285,8 +356,12 @@ void run(CompensateOptions& o) {
   const ct::Spec spec = spec_of(o);
   std::string text;
   std::optional<ct::PredictedResidual> predicted;
+  const auto stored = o.run != 0 && o.input.empty() ? open_database_read_only(o.db).run(o.run)
+                                                    : std::optional<cal::storage::RunRecord>{};
   if (!o.straightness.empty()) {
-    text = straightness_text(o, spec);
+    text = straightness_csv_text(o, spec);
+  } else if (stored && stored->kind == "straightness") {
+    text = straightness_run_text(o, spec, *stored);
   } else {
     const auto m = measurements(o);
     const auto stats = cal::iso230_2::target_stats(m);

@@ -10,9 +10,13 @@
 
 #include "cal/analysis/comp_formats.hpp"
 #include "cal/analysis/comp_meaning.hpp"
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/volumetric_comp.hpp"
+#include "cal/storage/store.hpp"
 #include "command.hpp"
+#include "compensation/compensation_check.hpp"
+#include "database.hpp"
 #include "model_cli.hpp"
 #include "provenance.hpp"
 
@@ -30,6 +34,7 @@ constexpr double kResolutionMm = 0.0001;  // what the writers keep: 0.1 um
 
 struct Options {
   std::string file, format = "csv", output, output_dir, report, isg_csv_path = "volcomp.csv";
+  std::string db, machine;  // --machine: stored with that machine for daq verify
   std::vector<double> interval_mm, reference_mm;
   std::vector<int> axis_numbers{1, 2, 3};
   std::optional<double> fanuc_reference_mm;  // default: the start of each travel
@@ -341,6 +346,34 @@ std::vector<std::string> say_origin(Written& w, const std::string& format,
   return silent;
 }
 
+// The cross-axis part of what was written, stored with the machine (--machine) so that the next
+// straightness run of an axis it corrects is compared with it (daq verify RUN). LinuxCNC's
+// COMP_FILEs are positioning tables: only matrixkins.hal is kept; FANUC and HEIDENHAIN files
+// are not read back (docs/compensation-tables.md, "Verification").
+void store_with_machine(const Options& o, const Written& w, const std::string& origin) {
+  const std::string format = o.format == "linuxcnc" ? "linuxcnc-matrixkins" : o.format;
+  if (!ct::is_cross_format(format))
+    throw cal::InputError(
+        fmt::format("--machine: a {} compensation is not verified by daq verify yet (siemens-cec, "
+                    "isg-cross, isg-volumetric, linuxcnc, csv are)",
+                    o.format));
+  CrossCompensation c{.format = format, .files = {}, .axis_numbers = numbers_of(o)};
+  for (const auto& [name, text] : w.files)
+    if (format != "linuxcnc-matrixkins" || name == "matrixkins.hal")
+      c.files.push_back({name, text});
+  cal::storage::Store store(database_path(o.db));
+  const auto machine = store.machine_by_name(o.machine);
+  if (!machine)
+    throw cal::InputError(
+        fmt::format("{}: no machine '{}' (daq runs lists them)", store.path().string(), o.machine));
+  const auto id = store_cross_compensation(store, machine->id, 0, fmt::format("model {}", o.file),
+                                           c, {{"label", origin}});
+  fmt::print(stderr,
+             "stored as compensation {} of machine '{}': the next straightness run of an axis it "
+             "corrects is compared with it (daq verify RUN)\n",
+             id, o.machine);
+}
+
 void run(const Options& o) {
   const mdl::Model m = mdl::read(o.file);
   const auto g = grid_of(o, m);
@@ -386,6 +419,7 @@ void run(const Options& o) {
   } else if (!o.json) {
     fmt::print("{}", w.files.front().second);
   }
+  if (!o.machine.empty()) store_with_machine(o, w, origin);
   if (!o.report.empty()) {
     kin::Grid grid;
     for (std::size_t i = 0; i < 3; ++i) {
@@ -468,6 +502,10 @@ void add_model_compensate_command(CLI::App& model) {
                   "Also write the volumetric error page with what remains after compensation");
   cmd->add_flag("--json", o->json,
                 "Print caldaq.model-compensation.v1 JSON (files via -o/--output-dir)");
+  cmd->add_option("--machine", o->machine,
+                  "Store the written compensation with this machine of --db: the next "
+                  "straightness run of an axis it corrects is checked against it (daq verify)");
+  add_db_option(*cmd, o->db);
 }
 
 }  // namespace daq

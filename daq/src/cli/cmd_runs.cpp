@@ -228,7 +228,7 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     print_line("  {}: {}", origin["label"].get<std::string>(), origin["text"].get<std::string>());
   else if (!origin["recorded"].get<bool>())
     print_line("  origin: {}", origin["text"].get<std::string>());
-  if (r.kind == "linear") {
+  if (r.kind == "linear" || r.kind == "straightness") {
     try {
       if (const auto check = check_run(store, id)) print_line("  {}", loop_text(*check));
     } catch (const cal::InputError& e) {

@@ -5,12 +5,14 @@
 // operator presses Cycle Start once the acquisition waits), or once after --start-after-s. The
 // acquiring process only sees devices.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <optional>
 
 #include "cal/analysis/error.hpp"
@@ -45,10 +47,16 @@ struct SimOptions {
   std::string measure;            // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
   std::string compensate;  // a model file whose volumetric correction the control applies
-  bool acquire = false;    // run the acquisition in this process, on simulated time
-  std::string capture;     // with acquire: the run's capture file
-  bool json = false;       // with acquire: the result as JSON on stdout (as daq run --json)
-  std::string truth_out;   // write the volumetric machine's injected errors as a model, exit
+  // Or the files of a cross-axis or volumetric compensation the control loads (control_loads),
+  // read as its vendor says or with the other sign (docs/compensation-tables.md,
+  // "Verification").
+  std::vector<std::string> control_table;
+  std::string control_format;
+  bool control_inverted = false;
+  bool acquire = false;   // run the acquisition in this process, on simulated time
+  std::string capture;    // with acquire: the run's capture file
+  bool json = false;      // with acquire: the result as JSON on stdout (as daq run --json)
+  std::string truth_out;  // write the volumetric machine's injected errors as a model, exit
   std::vector<double> truth_tool_offset_mm;  // with truth_out: the tool the model is for
 };
 
@@ -144,9 +152,12 @@ void run_sim(SimOptions o) {
   if (!o.measure.empty()) {
     volumetric = volumetric_test(o.measure);
     truth = volumetric_truth(cal::kinematics::topology_from_string(o.topology), 0.02);
-  } else if (!o.compensate.empty()) {
-    throw cal::InputError("--compensate applies to the volumetric machine: give --measure too");
+  } else if (!o.compensate.empty() || !o.control_table.empty()) {
+    throw cal::InputError(
+        "--compensate and --control-table apply to the volumetric machine: give --measure too");
   }
+  if (!o.compensate.empty() && !o.control_table.empty())
+    throw cal::InputError("--compensate or --control-table: the control applies one of them");
   if (o.acquire && (o.start_after_s || o.speed != 1.0 || volumetric))
     throw cal::InputError(
         "--acquire runs the program when its own run starts, on simulated time: without "
@@ -168,6 +179,18 @@ void run_sim(SimOptions o) {
         q[k] = std::clamp(q[k], (*model.travel_mm)[k][0], (*model.travel_mm)[k][1]);
       return cal::volcomp::correction_um(model.machine, q, model.carriers);
     });
+  }
+  if (!o.control_table.empty()) {
+    std::vector<std::string> texts;
+    for (const auto& f : o.control_table) {
+      std::ifstream in(f, std::ios::binary);
+      if (!in) throw cal::InputError(fmt::format("{}: cannot read", f));
+      texts.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    shop.set_compensation(control_loads(o.control_format, texts, o.control_inverted));
+    fmt::print("daq sim: the SIMULATED control applies {} ({}{})\n",
+               fmt::join(o.control_table, ", "), o.control_format,
+               o.control_inverted ? ", read with the other sign" : "");
   }
   const std::string text =
       volumetric ? volumetric_config(shop, o.speed, *volumetric)
@@ -319,6 +342,19 @@ void add_sim_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--compensate", o->compensate,
                   "With --measure: the control applies this model's volumetric correction");
+  cmd->add_option("--control-table", o->control_table,
+                  "With --measure: the files of a cross-axis or volumetric compensation the "
+                  "control loads (daq compensate --run on a straightness run, daq model "
+                  "compensate)")
+      ->take_all();
+  cmd->add_option("--control-format", o->control_format,
+                  "Their format: siemens-cec, isg-cross, linuxcnc-matrixkins, isg-volumetric or "
+                  "csv")
+      ->check(CLI::IsMember(
+          {"siemens-cec", "isg-cross", "linuxcnc-matrixkins", "isg-volumetric", "csv"}));
+  cmd->add_flag("--control-inverted", o->control_inverted,
+                "The control reads the values with the other sign than caldaq's reading of the "
+                "vendor's text (to see daq verify diagnose it)");
   cmd->add_flag("--acquire", o->acquire,
                 "Acquire the --test here instead of waiting for `daq run` in another process: "
                 "`daq run TEST --config FILE` runs in this process on SIMULATED time (as fast as "

@@ -1,6 +1,7 @@
 // daq verify: the as-left run of an axis against the compensation table written before it.
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -55,12 +56,20 @@ void run(const VerifyOptions& o) {
         v.predicted_max_um, v.measured_max_um, check->points, v.tolerance_um, v.mismatch_rms_um);
   }
   if (o.corrected.empty()) return;
-  const std::string text = corrected_table(*check);
-  std::ofstream out(o.corrected, std::ios::binary);
-  if (!(out << text) || !(out.close(), out))
-    throw cal::InputError(fmt::format("{}: cannot write the corrected table", o.corrected));
-  fmt::print(stderr, "written {}: the corrected table ({})\n", o.corrected,
-             check->compensation.format);
+  // One file to --corrected; a compensation of several files (ISG lists, the volumetric list
+  // and its CSV) into --corrected as a directory, by their names.
+  const auto files = corrected_files(*check);
+  const bool one = files.size() == 1 && files.front().first.empty();
+  if (!one) std::filesystem::create_directories(o.corrected);
+  for (const auto& [name, text] : files) {
+    const auto path =
+        one ? std::filesystem::path(o.corrected) : std::filesystem::path(o.corrected) / name;
+    std::ofstream out(path, std::ios::binary);
+    if (!(out << text) || !(out.close(), out))
+      throw cal::InputError(fmt::format("{}: cannot write the corrected table", path.string()));
+    fmt::print(stderr, "written {}: the corrected table ({})\n", path.string(),
+               check->compensation.format);
+  }
 }
 
 }  // namespace
@@ -69,14 +78,16 @@ void add_verify_command(CLI::App& app) {
   const auto [cmd, o] = add_command<VerifyOptions>(
       app, "verify", run,
       "Compare an as-left run with the compensation table written before it: as predicted, or "
-      "an inverted sign, a unit or a reference-point error (docs/compensation-tables.md)");
+      "an inverted sign, a unit or a reference-point error; a straightness run against the "
+      "cross-axis compensation written before it (docs/compensation-tables.md)");
   cmd->add_option("run", o->run, "The as-left run (measured with the table loaded)");
   add_db_option(*cmd, o->db);
   cmd->add_option("--compensation", o->compensation,
                   "The stored compensation to compare with (default: the newest of the run's "
                   "machine and axis stored before the run)");
   cmd->add_option("--corrected", o->corrected,
-                  "Write the table corrected for what was found (sign, units, reference point)");
+                  "Write the table corrected for what was found (sign, units, reference point); "
+                  "a compensation of several files goes into this directory");
   cmd->add_flag("--list", o->list, "List the stored compensation tables");
   cmd->add_flag("--json", o->json, "Print caldaq.verification.v1 JSON");
 }

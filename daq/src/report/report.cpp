@@ -1523,7 +1523,7 @@ std::string origin_banner(const RunView& v) {
 
 // The as-left check of a compensation written before this run (compensation_check.hpp).
 std::string compensation_check(const st::Store& store, const RunView& v) {
-  if (v.run.kind != "linear") return "";
+  if (v.run.kind != "linear" && v.run.kind != "straightness") return "";
   std::optional<::daq::LoopCheck> c;
   try {
     c = ::daq::check_run(store, v.run.id);

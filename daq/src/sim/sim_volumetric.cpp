@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/transport/transport.hpp"
@@ -172,6 +173,13 @@ cal::daq::LinearTestConfig volumetric_test(std::string_view component) {
       "component '{}': the simulated campaign measures the 18 of ISO 230-1, E_XX ... E_CZ "
       "(squareness comes from the straightness pairs)",
       component));
+}
+
+std::function<kin::Vec3(const kin::Vec3&)> control_loads(
+    std::string_view format, std::span<const std::string> files, bool inverted,
+    const std::map<std::string, int>& axis_numbers) {
+  const auto applied = cal::comptable::read_cross_applied(format, files, axis_numbers, inverted);
+  return [applied](const kin::Vec3& p) { return cal::comptable::cross_correction_um(applied, p); };
 }
 
 LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,

@@ -8,14 +8,16 @@
 // at the first target (where the laser and the angular optics are zeroed).
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "cal/analysis/kinematics.hpp"
 #include "cal/daq/config.hpp"
-#include "model/model_file.hpp"
 #include "linear_run.hpp"
+#include "model/model_file.hpp"
 #include "sim_shop.hpp"
 
 namespace daq {
@@ -39,6 +41,15 @@ cal::daq::model::Model volumetric_truth_model(cal::kinematics::Topology t);
 std::vector<cal::daq::LinearTestConfig> volumetric_tests();
 // The test of one component ("E_YX"); throws cal::InputError for an unknown name.
 cal::daq::LinearTestConfig volumetric_test(std::string_view component);
+
+// What the simulated control adds (um) when it loads the files of a cross-axis or volumetric
+// compensation (SINUMERIK CEC, ISG cross or volumetric lists, LinuxCNC matrixkins, caldaq's cross
+// CSV; cal::comptable::read_cross_applied): as its vendor's text says, or with the other sign
+// (`inverted`), so that `daq verify` is tested against a known truth. For
+// SimulatedAcquisition::compensation and `daq sim --control-table`. Throws cal::InputError.
+std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> control_loads(
+    std::string_view format, std::span<const std::string> files, bool inverted,
+    const std::map<std::string, int>& axis_numbers = {{"X", 1}, {"Y", 2}, {"Z", 3}});
 
 // One test acquired in this process on a fresh simulated shop with `truth`, through the real
 // drivers (IDS3010, PTU300, gauge codecs) against the twins, stored in `database` under
