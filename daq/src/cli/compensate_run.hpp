@@ -15,7 +15,7 @@ namespace daq {
 // predicted to leave, the run's origin ("SIMULATED"...; "" for real instruments) and the command
 // that writes and stores it. Nothing is stored. Throws cal::InputError as the command refuses (a
 // suspect run not accepted, no stops, a run that is not linear, an unknown format).
-nlohmann::json run_compensation(const cal::storage::Store& store, std::int64_t run,
+nlohmann::json run_compensation(const cal::storage::RunReader& store, std::int64_t run,
                                 const std::string& format);
 
 }  // namespace daq

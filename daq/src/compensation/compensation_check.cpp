@@ -77,7 +77,7 @@ std::optional<double> before_at(const std::vector<double>& x, const std::vector<
 
 // The compensation the run is checked against: the one given, else the newest of the run's
 // machine and axis stored before the run started.
-std::optional<cal::storage::CompensationRecord> compensation_for(const cal::storage::Store& store,
+std::optional<cal::storage::CompensationRecord> compensation_for(const cal::storage::RunReader& store,
                                                                  const cal::storage::RunRecord& run,
                                                                  std::optional<std::int64_t> id) {
   if (id) {
@@ -89,7 +89,7 @@ std::optional<cal::storage::CompensationRecord> compensation_for(const cal::stor
         return c;
       }
     throw cal::InputError(fmt::format("{}: no compensation {} (daq verify lists them with --list)",
-                                      store.path().string(), *id));
+                                      store.name(), *id));
   }
   std::optional<cal::storage::CompensationRecord> found;
   for (const auto& c : store.compensations(run.machine_id, run.axis))
@@ -99,16 +99,16 @@ std::optional<cal::storage::CompensationRecord> compensation_for(const cal::stor
 
 }  // namespace
 
-std::optional<LoopCheck> check_run(const cal::storage::Store& store, std::int64_t run_id,
+std::optional<LoopCheck> check_run(const cal::storage::RunReader& store, std::int64_t run_id,
                                    std::optional<std::int64_t> compensation_id) {
   const auto run = store.run(run_id);
-  if (!run) throw cal::InputError(fmt::format("{}: no run {}", store.path().string(), run_id));
+  if (!run) throw cal::InputError(fmt::format("{}: no run {}", store.name(), run_id));
   const auto comp = compensation_for(store, *run, compensation_id);
   if (!comp) return std::nullopt;
   const json doc = json::parse(comp->json, nullptr, false);
   if (doc.is_discarded() || !doc.is_object())
     throw cal::InputError(
-        fmt::format("{}: compensation {} is not readable JSON", store.path().string(), comp->id));
+        fmt::format("{}: compensation {} is not readable JSON", store.name(), comp->id));
   const json predicted = doc.value("predicted", json::object());
   const json applied = doc.value("applied", json::object());
   const auto src_x = numbers(predicted, "target_mm");
@@ -119,7 +119,7 @@ std::optional<LoopCheck> check_run(const cal::storage::Store& store, std::int64_
   const auto rev = numbers(applied, "reverse_um");
   if (table_x.size() < 2 || fwd.size() != table_x.size() || rev.size() != table_x.size())
     throw cal::InputError(
-        fmt::format("{}: compensation {} holds no applied table", store.path().string(), comp->id));
+        fmt::format("{}: compensation {} holds no applied table", store.name(), comp->id));
   std::vector<cal::iso230_2::Measurement> m;
   for (const auto& t : store.targets(run_id))
     m.push_back({t.nominal_mm, t.run_number,
