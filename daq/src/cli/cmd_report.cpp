@@ -233,8 +233,8 @@ void run_report_command(ReportOptions o) {
     for (const auto& r : store.runs())
       if (r.campaign == o.campaign) o.runs.push_back(r.id);
     if (o.runs.empty())
-      throw cal::InputError(fmt::format("{}: no runs in campaign \"{}\" (see daq runs)",
-                                        store.name(), o.campaign));
+      throw cal::InputError(
+          fmt::format("{}: no runs in campaign \"{}\" (see daq runs)", store.name(), o.campaign));
   }
   if (o.runs.empty() && !o.as_found && !o.as_left)
     throw cal::InputError(

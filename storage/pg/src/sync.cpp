@@ -175,18 +175,21 @@ class Sync {
         if (const auto run = local_.run(c.source_run_id)) source_uuid = run->uuid;
       w.exec_params(
           "INSERT INTO caldaq.compensations(machine_id, source_run_uuid, source, axis, format, "
-          "created_unix_ms, json, fingerprint) VALUES(NULLIF($1, '')::bigint, NULLIF($2, "
-          "'')::uuid, $3, $4, $5, $6, $7, md5(concat_ws('|', $1, $2, $3, $4, $5, $6::text, $7))) "
-          "ON CONFLICT (fingerprint) DO NOTHING",
+          "created_unix_ms, json, fingerprint) VALUES(NULLIF($1::text, '')::bigint, "
+          "NULLIF($2::text, '')::uuid, $3::text, $4::text, $5::text, $6::bigint, $7::text, "
+          "md5(concat_ws('|', $1::text, $2::text, $3::text, $4::text, $5::text, "
+          "$6::bigint::text, $7::text))) ON CONFLICT (fingerprint) DO NOTHING",
           machine_id, source_uuid, c.source, c.axis, c.format, c.created_unix_ms, c.json);
     }
     for (const auto& c : local_.bar_calibrations())
       w.exec_params(
           "INSERT INTO caldaq.bar_calibrations(bar, nominal_mm, extensions, calibrator, "
           "calibrator_length_mm, reading_mm, zero_length_mm, temperature_degc, "
-          "calibrated_unix_ms, note, fingerprint) VALUES($1, $2, $3, $4, $5, $6, $7, "
-          "NULLIF($8, '')::double precision, $9, $10, md5(concat_ws('|', $1, $2::text, $3, $4, "
-          "$5::text, $6::text, $9::text))) ON CONFLICT (fingerprint) DO NOTHING",
+          "calibrated_unix_ms, note, fingerprint) VALUES($1::text, $2::float8, $3::text, "
+          "$4::text, $5::float8, $6::float8, $7::float8, NULLIF($8::text, '')::float8, "
+          "$9::bigint, $10::text, md5(concat_ws('|', $1::text, $2::float8::text, $3::text, "
+          "$4::text, $5::float8::text, $6::float8::text, $9::bigint::text))) "
+          "ON CONFLICT (fingerprint) DO NOTHING",
           c.bar, c.nominal_mm, c.extensions, c.calibrator, c.calibrator_length_mm, c.reading_mm,
           c.zero_length_mm, c.temperature_degc ? fmt::format("{}", *c.temperature_degc) : "",
           c.calibrated_unix_ms, c.note);
