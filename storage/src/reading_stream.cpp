@@ -9,6 +9,9 @@
 // is handed out, so no reading can come late, and only the chunks that overlap the current
 // time are in memory.
 //
+// The chunks come from a ChunkSource: this file's reads the SQLite store; storage/pg's reads the
+// central store. The merge and the checks are the same for both.
+//
 // Integrity: the checksum of every chunk (schema 3) is verified before it is decoded; its
 // first time must be its smallest; and at the end the chunks read must be exactly those the
 // other index (reading_chunks_by_seq) numbers, so a chunk that a damaged index hides from the
@@ -21,14 +24,86 @@
 #include "store_impl.hpp"
 
 namespace cal::storage {
+namespace {
+
+// The chunks of a run in the SQLite store, by the index reading_chunks_by_run.
+class SqliteChunks final : public ChunkSource {
+ public:
+  SqliteChunks(const Store::Impl& s, std::int64_t run, std::span<const std::uint8_t> q)
+      : store_(s), run_id_(run), quantities_(q.begin(), q.end()) {
+    const std::string checks = store_.chunk_checksums ? "encoding, seq, crc" : "1, NULL, NULL";
+    const std::string sql =
+        "SELECT id, device, channel, quantity, first_ns, last_ns, count, data, " + checks +
+        " FROM reading_chunks INDEXED BY reading_chunks_by_run WHERE run_id = ?" + filter_sql() +
+        " ORDER BY first_ns, id";
+    chunks_ = store_.prepare(sql.c_str());
+    bind_filter(chunks_.get());
+  }
+
+  bool next(SourceChunk& out) override {
+    sqlite3_stmt* s = chunks_.get();
+    const int rc = sqlite3_step(s);
+    if (rc == SQLITE_DONE) return false;
+    if (rc != SQLITE_ROW) store_.fail(fmt::format("read the reading chunks of run {}", run_id_));
+    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(s, 7));
+    out.order = sqlite3_column_int64(s, 0);
+    out.device = sqlite3_column_int64(s, 1);
+    out.channel = sqlite3_column_int64(s, 2);
+    out.quantity = sqlite3_column_int64(s, 3);
+    out.first_ns = sqlite3_column_int64(s, 4);
+    out.last_ns = sqlite3_column_int64(s, 5);
+    out.count = sqlite3_column_int64(s, 6);
+    out.data.assign(data, data + sqlite3_column_bytes(s, 7));
+    out.encoding = sqlite3_column_int64(s, 8);
+    out.seq.reset();
+    if (sqlite3_column_type(s, 9) != SQLITE_NULL) out.seq = sqlite3_column_int64(s, 9);
+    out.crc.reset();
+    if (sqlite3_column_type(s, 10) != SQLITE_NULL)
+      out.crc = static_cast<std::uint32_t>(sqlite3_column_int64(s, 10));
+    return true;
+  }
+
+  std::optional<Numbered> numbered() override {
+    if (!store_.chunk_checksums) return std::nullopt;
+    const std::string sql =
+        "SELECT count(*), IFNULL(MAX(seq), -1) FROM reading_chunks INDEXED BY "
+        "reading_chunks_by_seq WHERE run_id = ? AND seq IS NOT NULL" +
+        filter_sql();
+    auto s = store_.prepare(sql.c_str());
+    bind_filter(s.get());
+    if (sqlite3_step(s.get()) != SQLITE_ROW)
+      store_.fail(fmt::format("count the reading chunks of run {}", run_id_));
+    return Numbered{sqlite3_column_int64(s.get(), 0), sqlite3_column_int64(s.get(), 1)};
+  }
+
+ private:
+  const Store::Impl& store_;
+  std::int64_t run_id_ = 0;
+  std::vector<std::uint8_t> quantities_;
+  detail::Stmt chunks_;
+
+  std::string filter_sql() const {
+    if (quantities_.empty()) return {};
+    std::string sql = " AND quantity IN (";
+    for (std::size_t i = 0; i < quantities_.size(); ++i) sql += i ? ", ?" : "?";
+    return sql + ")";
+  }
+  void bind_filter(sqlite3_stmt* s) const {
+    sqlite3_bind_int64(s, 1, run_id_);
+    for (std::size_t i = 0; i < quantities_.size(); ++i)
+      sqlite3_bind_int(s, static_cast<int>(i + 2), quantities_[i]);
+  }
+};
+
+}  // namespace
 
 struct ReadingStream::Impl {
-  const Store::Impl& store;
-  std::int64_t run_id = 0;
-  std::vector<std::uint8_t> quantities;
-  detail::Stmt chunks;
-  bool have_next = false;  // `chunks` stands on the next chunk to open
-  std::int64_t next_first_ns = 0;
+  std::unique_ptr<ChunkSource> source;
+  std::string where;
+  std::int64_t run_id = 0, checksum_run_id = 0;
+  bool whole_run = true;  // no quantity filter: the numbers must be 0 .. n - 1
+  SourceChunk pending;    // the next chunk to open, when have_next
+  bool have_next = false;
   bool checked = false;
 
   struct Cursor {
@@ -42,105 +117,64 @@ struct ReadingStream::Impl {
   std::vector<std::int64_t> seqs;              // of the chunks read
   std::uint64_t chunks_read = 0;
 
-  Impl(const Store::Impl& s, std::int64_t run, std::span<const std::uint8_t> q)
-      : store(s), run_id(run), quantities(q.begin(), q.end()) {}
+  void step() { have_next = source->next(pending); }
 
-  std::string filter_sql() const {
-    if (quantities.empty()) return {};
-    std::string sql = " AND quantity IN (";
-    for (std::size_t i = 0; i < quantities.size(); ++i) sql += i ? ", ?" : "?";
-    return sql + ")";
-  }
-  void bind_filter(sqlite3_stmt* s) const {
-    sqlite3_bind_int64(s, 1, run_id);
-    for (std::size_t i = 0; i < quantities.size(); ++i)
-      sqlite3_bind_int(s, static_cast<int>(i + 2), quantities[i]);
-  }
-
-  void start() {
-    const std::string checks = store.chunk_checksums ? "encoding, seq, crc" : "1, NULL, NULL";
-    const std::string sql =
-        "SELECT id, device, channel, quantity, first_ns, last_ns, count, data, " + checks +
-        " FROM reading_chunks INDEXED BY reading_chunks_by_run WHERE run_id = ?" + filter_sql() +
-        " ORDER BY first_ns, id";
-    chunks = store.prepare(sql.c_str());
-    bind_filter(chunks.get());
-    step();
-  }
-
-  void step() {
-    const int rc = sqlite3_step(chunks.get());
-    if (rc == SQLITE_ROW) {
-      have_next = true;
-      next_first_ns = sqlite3_column_int64(chunks.get(), 4);
-    } else if (rc == SQLITE_DONE) {
-      have_next = false;
-    } else {
-      store.fail(fmt::format("read the reading chunks of run {}", run_id));
-    }
-  }
-
-  [[noreturn]] void damaged(sqlite3_stmt* s, std::string_view what) const {
-    const bool numbered = sqlite3_column_type(s, 9) != SQLITE_NULL;
+  [[noreturn]] void damaged(const SourceChunk& c, std::string_view what) const {
     throw StoreError(fmt::format(
         "{}: run {}: reading chunk {} (row {}; device {}, channel {}, quantity {}; {} readings "
         "from {} ns) is damaged: {}. The database file is corrupted; the run's other chunks "
         "and the other runs are not affected by this one",
-        store.path.string(), run_id,
-        numbered ? fmt::format("{}", sqlite3_column_int64(s, 9))
-                 : std::string("(unnumbered: written before schema 3)"),
-        sqlite3_column_int64(s, 0), sqlite3_column_int64(s, 1), sqlite3_column_int64(s, 2),
-        sqlite3_column_int64(s, 3), sqlite3_column_int64(s, 6), sqlite3_column_int64(s, 4), what));
+        where, run_id,
+        c.seq ? fmt::format("{}", *c.seq) : std::string("(unnumbered: written before schema 3)"),
+        c.order, c.device, c.channel, c.quantity, c.count, c.first_ns, what));
   }
 
-  // Verifies and decodes the chunk `chunks` stands on, then steps to the next one.
+  // Verifies and decodes the pending chunk, then steps to the next one.
   void open_next() {
-    sqlite3_stmt* s = chunks.get();
-    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(s, 7));
-    const auto blob =
-        std::span<const unsigned char>(data, static_cast<std::size_t>(sqlite3_column_bytes(s, 7)));
-    const std::int64_t count = sqlite3_column_int64(s, 6);
-    const chunk::Key key{.run_id = run_id,
-                         .seq = sqlite3_column_int64(s, 9),
-                         .device = sqlite3_column_int64(s, 1),
-                         .channel = sqlite3_column_int64(s, 2),
-                         .quantity = sqlite3_column_int64(s, 3),
-                         .first_ns = sqlite3_column_int64(s, 4),
-                         .last_ns = sqlite3_column_int64(s, 5),
-                         .count = count,
-                         .encoding = sqlite3_column_int64(s, 8)};
-    if (sqlite3_column_type(s, 10) != SQLITE_NULL) {
-      if (static_cast<std::uint32_t>(sqlite3_column_int64(s, 10)) != chunk::checksum(key, blob))
-        damaged(s, "its checksum does not match its contents");
+    const SourceChunk& c = pending;
+    const std::span<const unsigned char> blob(c.data);
+    const chunk::Key key{.run_id = checksum_run_id,
+                         .seq = c.seq.value_or(0),
+                         .device = c.device,
+                         .channel = c.channel,
+                         .quantity = c.quantity,
+                         .first_ns = c.first_ns,
+                         .last_ns = c.last_ns,
+                         .count = c.count,
+                         .encoding = c.encoding};
+    if (c.crc) {
+      if (*c.crc != chunk::checksum(key, blob))
+        damaged(c, "its checksum does not match its contents");
       seqs.push_back(key.seq);
     } else if (key.encoding != chunk::packed_v1) {
-      damaged(s, "it has no checksum");  // only the chunks written before schema 3 have none
+      damaged(c, "it has no checksum");  // only the chunks written before schema 3 have none
     }
-    if (count <= 0 || key.device < 0 || key.device > 0xffff || key.channel < 0 ||
+    if (c.count <= 0 || key.device < 0 || key.device > 0xffff || key.channel < 0 ||
         key.channel > 0xff || key.quantity < 0 || key.quantity > 0xff)
-      damaged(s, "its row is out of range");
-    Cursor c{.rowid = sqlite3_column_int64(s, 0)};
+      damaged(c, "its row is out of range");
+    Cursor cursor{.rowid = c.order};
     if (!spare.empty()) {
-      c.readings = std::move(spare.back());
+      cursor.readings = std::move(spare.back());
       spare.pop_back();
-      c.readings.clear();
+      cursor.readings.clear();
     }
     try {
-      chunk::decode(static_cast<int>(key.encoding), blob, static_cast<std::size_t>(count),
+      chunk::decode(static_cast<int>(key.encoding), blob, static_cast<std::size_t>(c.count),
                     static_cast<std::uint16_t>(key.device), static_cast<std::uint8_t>(key.channel),
-                    static_cast<std::uint8_t>(key.quantity), c.readings);
+                    static_cast<std::uint8_t>(key.quantity), cursor.readings);
     } catch (const chunk::ChunkError& e) {
-      damaged(s, e.what());
+      damaged(c, e.what());
     }
     const auto by_time = [](const RawReading& a, const RawReading& b) {
       return a.time_ns < b.time_ns;
     };
-    if (!std::is_sorted(c.readings.begin(), c.readings.end(), by_time))
-      std::stable_sort(c.readings.begin(), c.readings.end(), by_time);
-    if (c.readings.front().time_ns != key.first_ns || c.readings.back().time_ns > key.last_ns)
-      damaged(s, "its readings lie outside its time range");
+    if (!std::is_sorted(cursor.readings.begin(), cursor.readings.end(), by_time))
+      std::stable_sort(cursor.readings.begin(), cursor.readings.end(), by_time);
+    if (cursor.readings.front().time_ns != key.first_ns ||
+        cursor.readings.back().time_ns > key.last_ns)
+      damaged(c, "its readings lie outside its time range");
     ++chunks_read;
-    open.push_back(std::move(c));
+    open.push_back(std::move(cursor));
     step();
   }
 
@@ -153,35 +187,26 @@ struct ReadingStream::Impl {
   // The chunks read must be those numbered in the other index (schema 3 chunks only).
   void check_complete() {
     checked = true;
-    if (!store.chunk_checksums) return;
-    const std::string sql =
-        "SELECT count(*), IFNULL(MAX(seq), -1) FROM reading_chunks INDEXED BY "
-        "reading_chunks_by_seq WHERE run_id = ? AND seq IS NOT NULL" +
-        filter_sql();
-    auto s = store.prepare(sql.c_str());
-    bind_filter(s.get());
-    if (sqlite3_step(s.get()) != SQLITE_ROW)
-      store.fail(fmt::format("count the reading chunks of run {}", run_id));
-    const auto numbered = static_cast<std::size_t>(sqlite3_column_int64(s.get(), 0));
-    const auto max_seq = sqlite3_column_int64(s.get(), 1);
+    const auto numbered = source->numbered();
+    if (!numbered) return;
     std::sort(seqs.begin(), seqs.end());
     std::string missing;
-    if (quantities.empty()) {  // all chunks: the numbers are 0 .. n - 1, each once
+    if (whole_run) {  // all chunks: the numbers are 0 .. n - 1, each once
       for (std::size_t i = 0; i < seqs.size() && missing.empty(); ++i)
         if (seqs[i] != static_cast<std::int64_t>(i))
           missing = i > 0 && seqs[i] == seqs[i - 1] ? fmt::format("chunk {} appears twice", seqs[i])
                                                     : fmt::format("chunk {} is missing", i);
-      if (missing.empty() && max_seq >= static_cast<std::int64_t>(seqs.size()))
+      if (missing.empty() && numbered->max_seq >= static_cast<std::int64_t>(seqs.size()))
         missing = fmt::format("chunk {} is missing", seqs.size());
     }
-    if (missing.empty() && numbered != seqs.size())
-      missing =
-          fmt::format("{} chunks are numbered but {} were found by time", numbered, seqs.size());
+    if (missing.empty() && static_cast<std::size_t>(numbered->count) != seqs.size())
+      missing = fmt::format("{} chunks are numbered but {} were found by time", numbered->count,
+                            seqs.size());
     if (!missing.empty())
       throw StoreError(fmt::format(
           "{}: run {}: {}: the database file is corrupted (its indexes do not match its "
           "reading chunks)",
-          store.path.string(), run_id, missing));
+          where, run_id, missing));
   }
 
   bool next(std::vector<RawReading>& out, std::size_t max) {
@@ -200,7 +225,7 @@ struct ReadingStream::Impl {
           second = i;
         }
       }
-      if (have_next && (best == open.size() || next_first_ns <= open[best].front().time_ns)) {
+      if (have_next && (best == open.size() || pending.first_ns <= open[best].front().time_ns)) {
         open_next();
         continue;
       }
@@ -214,7 +239,7 @@ struct ReadingStream::Impl {
       Cursor& c = open[best];
       while (c.pos < c.readings.size() && out.size() < max) {
         const RawReading& r = c.readings[c.pos];
-        if (have_next && r.time_ns >= next_first_ns) break;
+        if (have_next && r.time_ns >= pending.first_ns) break;
         if (second != open.size() && !before(r, c.rowid, open[second].front(), open[second].rowid))
           break;
         out.push_back(r);
@@ -239,11 +264,36 @@ bool ReadingStream::next(std::vector<RawReading>& out, std::size_t max_readings)
 }
 std::uint64_t ReadingStream::chunks_read() const { return impl_->chunks_read; }
 
+ReadingStream ReadingStream::of(std::unique_ptr<ChunkSource> source, std::string where,
+                                std::int64_t run_id, std::int64_t checksum_run_id,
+                                bool whole_run) {
+  auto impl = std::make_unique<Impl>();
+  impl->whole_run = whole_run;
+  impl->source = std::move(source);
+  impl->where = std::move(where);
+  impl->run_id = run_id;
+  impl->checksum_run_id = checksum_run_id;
+  impl->step();
+  return ReadingStream(std::move(impl));
+}
+
 ReadingStream Store::stream_readings(std::int64_t run_id,
                                      std::span<const std::uint8_t> quantities) const {
-  auto impl = std::make_unique<ReadingStream::Impl>(*impl_, run_id, quantities);
-  impl->start();
-  return ReadingStream(std::move(impl));
+  return ReadingStream::of(std::make_unique<SqliteChunks>(*impl_, run_id, quantities),
+                           impl_->path.string(), run_id, run_id, quantities.empty());
+}
+
+std::vector<RawReading> RunReader::readings(std::int64_t run_id) const {
+  return readings(run_id, {});
+}
+
+std::vector<RawReading> RunReader::readings(std::int64_t run_id,
+                                            std::span<const std::uint8_t> quantities) const {
+  std::vector<RawReading> out, batch;
+  auto stream = stream_readings(run_id, quantities);
+  while (stream.next(batch, std::size_t{1} << 20))
+    out.insert(out.end(), batch.begin(), batch.end());
+  return out;
 }
 
 }  // namespace cal::storage

@@ -691,17 +691,6 @@ void Store::append_prepared(std::int64_t run_id, const PreparedBatch& batch) {
   tx.commit();
 }
 
-std::vector<RawReading> Store::readings(std::int64_t run_id) const { return readings(run_id, {}); }
-
-std::vector<RawReading> Store::readings(std::int64_t run_id,
-                                        std::span<const std::uint8_t> quantities) const {
-  std::vector<RawReading> out, batch;
-  auto stream = stream_readings(run_id, quantities);
-  while (stream.next(batch, std::size_t{1} << 20))
-    out.insert(out.end(), batch.begin(), batch.end());
-  return out;
-}
-
 std::vector<Store::Series> Store::series(std::int64_t run_id) const {
   auto s = impl_->prepare(
       "SELECT device, channel, quantity, SUM(count), MIN(first_ns), MAX(last_ns) FROM "

@@ -59,7 +59,7 @@ check local_schema 0 "^7$" -- local_value "PRAGMA user_version"
 check local_uuids 0 "^$RUNS$" -- local_value "SELECT count(DISTINCT uuid) FROM runs WHERE uuid LIKE '________-____-4___-____-____________'"
 CUT=$(psql_value "SELECT count(*) FROM caldaq.reading_chunks")
 check cut_left_committed_pages 0 "^8$" -- echo "$CUT"
-check cut_schema 0 "^1$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check cut_schema 0 "^2$" -- psql_value "SELECT version FROM caldaq.schema_version"
 
 # Resumed: the chunks there are checked, the rest sent; every chunk once, the same bytes.
 check resume 0 "$RUNS runs synced .* $((CHUNKS - CUT)) chunks sent .*, $CUT already there" -- \
@@ -84,8 +84,8 @@ check runs_central 0 "^postgresql:///caldaq\?host=.* \($RUNS runs\)$" -- bash -c
 check runs_same 0 "^same$" -- bash -c "diff <('$DAQ' runs --db '$PG_URL' | tail -n +2) <('$DAQ' runs --db '$DB' | tail -n +2) && echo same"
 check runs_json_uuids 0 "^same$" -- bash -c "diff <('$DAQ' runs --json --db '$PG_URL' | grep '\"uuid\"') <('$DAQ' runs --json --db '$DB' | grep '\"uuid\"') && echo same"
 check runs_json_has_uuids 0 "^$RUNS$" -- bash -c "'$DAQ' runs --json --db '$PG_URL' | grep -cE '\"uuid\": \"[0-9a-f-]{36}\"'"
-check show_central_refused 2 "--db postgresql:///caldaq\?host=.*: only .daq runs. reads the central store so far" -- \
-  "$DAQ" show 1 --db "$PG_URL"
+check write_central_refused 2 "--db postgresql:///caldaq\?host=.*: this command writes the local store" -- \
+  "$DAQ" recompensate 1 --alpha-ppm 12 --db "$PG_URL"
 check runs_no_central 2 "no caldaq central store in this database \(daq sync --to creates it\)" -- \
   "$DAQ" runs --db "postgresql:///postgres?host=$PG_DIR&user=caldaq"
 
@@ -109,6 +109,6 @@ check damaged_crc 2 "the server's reading chunk 0 differs from the local one \(c
 
 # A server of a newer central schema is refused.
 psql_value "UPDATE caldaq.schema_version SET version = 99" >/dev/null
-check newer_schema 2 "central schema version 99 is newer than this daq understands \(1\)" -- "$DAQ" sync --db "$DB" --to "$PG_URL"
+check newer_schema 2 "central schema version 99 is newer than this daq understands \(2\)" -- "$DAQ" sync --db "$DB" --to "$PG_URL"
 
 finish

@@ -66,7 +66,8 @@ void calibrate(const CalibrateOptions& o) {
 }
 
 void list(const std::string& db, const std::string& bar, bool as_json) {
-  const auto store = open_database_read_only(db);
+  const auto reader = open_run_reader(db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   const auto all = store.bar_calibrations(bar);
   if (as_json) {
     json j{{"schema", "caldaq.bar-calibrations.v1"}, {"calibrations", json::array()}};
@@ -91,7 +92,7 @@ struct SetOptions {
   bool json = false;
 };
 
-std::vector<BallbarTest> tests_of(const st::Store& store, const SetOptions& o) {
+std::vector<BallbarTest> tests_of(const st::RunReader& store, const SetOptions& o) {
   if (!o.runs.empty() && !o.machine.empty())
     throw cal::InputError("give --runs or --machine, not both");
   if (o.runs.empty() && o.machine.empty())
@@ -99,7 +100,7 @@ std::vector<BallbarTest> tests_of(const st::Store& store, const SetOptions& o) {
   const auto runs = o.runs.empty() ? ballbar_runs(store, o.machine, o.campaign) : o.runs;
   if (runs.empty())
     throw cal::InputError(
-        fmt::format("{}: machine '{}' has no complete ballbar test{}", store.path().string(),
+        fmt::format("{}: machine '{}' has no complete ballbar test{}", store.name(),
                     o.machine, o.campaign.empty() ? "" : " in campaign '" + o.campaign + "'"));
   return ballbar_tests(store, runs);
 }
@@ -133,7 +134,8 @@ void write_model(const VolumetricTable& v, const SetOptions& o) {
 void volumetric(const SetOptions& o) {
   if (o.model_in.empty() != o.model_out.empty())
     throw cal::InputError("--model and --write-model go together (read one, write the other)");
-  const auto store = open_database_read_only(o.db);  // only reads
+  const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   const auto tests = tests_of(store, o);
   const auto v = volumetric_table(tests);
   if (!o.model_in.empty()) write_model(v, o);
@@ -144,14 +146,15 @@ void volumetric(const SetOptions& o) {
 }
 
 void history(const SetOptions& o) {
-  const auto store = open_database_read_only(o.db);  // only reads
+  const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   const auto tests = tests_of(store, o);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(history_json(tests), 2));
   print_history(tests);
 }
 
 void add_set_options(CLI::App& cmd, SetOptions& o) {
-  add_db_option(cmd, o.db);
+  add_read_db_option(cmd, o.db);
   cmd.add_option("--machine", o.machine, "The machine's ballbar tests (its complete circle runs)");
   cmd.add_option("--campaign", o.campaign, "Only this campaign's");
   cmd.add_option("--runs", o.runs, "These circle runs instead")->delimiter(',');
@@ -189,7 +192,7 @@ void add_ballbar_commands(CLI::App& app) {
   auto l = std::make_shared<std::pair<std::string, std::string>>();
   auto as_json = std::make_shared<bool>(false);
   auto* ls = bb->add_subcommand("calibrations", "The stored calibrations, oldest first");
-  add_db_option(*ls, l->first);
+  add_read_db_option(*ls, l->first);
   ls->add_option("--bar", l->second, "Only this bar's");
   ls->add_flag("--json", *as_json, "Print caldaq.bar-calibrations.v1");
   ls->callback([l, as_json] { list(l->first, l->second, *as_json); });

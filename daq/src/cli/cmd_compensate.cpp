@@ -56,7 +56,7 @@ std::vector<double> spec_positions(const ct::CrossAxisTable& t) {
 
 // The stops of --run, refused when it is suspect and not accepted; its origin noted.
 std::vector<cal::iso230_2::Measurement> run_measurements(CompensateOptions& o,
-                                                         const cal::storage::Store& store) {
+                                                         const cal::storage::RunReader& store) {
   const std::int64_t runs[] = {o.run};
   o.accepted = refuse_suspect_runs(store, runs, o.accept_suspect, "daq compensate");
   if (const auto run = store.run(o.run)) {

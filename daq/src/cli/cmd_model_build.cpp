@@ -35,7 +35,7 @@ struct ModelOrigin {
   std::size_t real = 0, other = 0;
 };
 
-ModelOrigin model_origin(const cal::storage::Store& store,
+ModelOrigin model_origin(const cal::storage::RunReader& store,
                          const std::vector<std::pair<std::string, std::vector<std::int64_t>>>& used,
                          const std::string& machine) {
   ModelOrigin o;
@@ -69,7 +69,8 @@ struct BuildCliOptions {
 };
 
 void run_build(const BuildCliOptions& o) {
-  const auto store = open_database_read_only(o.db);
+  const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   const auto stored = stored_profiles(store, o.machine);
   std::vector<std::int64_t> used_runs;
   for (const auto& p : stored.profiles) used_runs.push_back(p.run_id);
@@ -163,7 +164,7 @@ void add_model_build_command(CLI::App& model) {
                   "runs with a stop far outside their repeatability are refused otherwise")
       ->take_all();
   cmd->add_flag("--json", o->json, "Print caldaq.model-build.v1 JSON (runs used, missing)");
-  add_db_option(*cmd, o->db);
+  add_read_db_option(*cmd, o->db);
 }
 
 }  // namespace daq

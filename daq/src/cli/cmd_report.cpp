@@ -227,13 +227,14 @@ void write_file(const fs::path& path, const std::string& text) {
 void run_report_command(ReportOptions o) {
   if (o.format != "html" && o.format != "pdf")
     throw cal::InputError(fmt::format("report: --format {}: use html or pdf", o.format));
-  const auto store = open_database_read_only(o.db);
+  const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   if (!o.campaign.empty()) {
     for (const auto& r : store.runs())
       if (r.campaign == o.campaign) o.runs.push_back(r.id);
     if (o.runs.empty())
-      throw cal::InputError(fmt::format("{}: no runs in campaign \"{}\" (see daq runs)",
-                                        store.path().string(), o.campaign));
+      throw cal::InputError(
+          fmt::format("{}: no runs in campaign \"{}\" (see daq runs)", store.name(), o.campaign));
   }
   if (o.runs.empty() && !o.as_found && !o.as_left)
     throw cal::InputError(
@@ -330,7 +331,7 @@ void add_report_command(CLI::App& app) {
       "Write a self-contained report (HTML, or PDF through headless Chromium) of one stored run, "
       "of several runs or a campaign, or a comparison of the same test over time");
   cmd->add_option("RUN", o->runs, "Stored run numbers (see daq runs)");
-  add_db_option(*cmd, o->db);
+  add_read_db_option(*cmd, o->db);
   cmd->add_option("--campaign", o->campaign, "Report every run of this campaign");
   cmd->add_flag("--compare", o->compare,
                 "Overlay the same test of several runs and show the results over time");

@@ -73,10 +73,10 @@ json run_json(const st::RunRecord& r) {
   return j;
 }
 
-st::RunRecord need_run(const st::Store& store, std::int64_t id) {
+st::RunRecord need_run(const st::RunReader& store, std::int64_t id) {
   auto r = store.run(id);
   if (!r)
-    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.path().string(), id));
+    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
   return *r;
 }
 
@@ -141,7 +141,7 @@ std::string provenance_text(const json& p) {
 
 }  // namespace
 
-json run_document(const st::Store& store, std::int64_t id) {
+json run_document(const st::RunReader& store, std::int64_t id) {
   const auto r = need_run(store, id);
   json j = run_json(r);
   j["schema"] = "caldaq.run.v1";
@@ -194,7 +194,8 @@ json run_document(const st::Store& store, std::int64_t id) {
 namespace {
 
 void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
-  const auto store = open_database_read_only(db);
+  const auto reader = open_run_reader(db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   const auto r = need_run(store, id);
   const json j = run_document(store, id);
   const auto missed = store.missed_stops(id);
@@ -303,7 +304,7 @@ constexpr std::size_t kRowNumbersMax = 256;
 // per row; a device without an instrument row has an empty name.
 class DeviceNames {
  public:
-  DeviceNames(const st::Store& store, std::int64_t run,
+  DeviceNames(const st::RunReader& store, std::int64_t run,
               const std::function<std::string(const std::string&)>& quote,
               std::string_view missing) {
     for (const auto& i : store.instruments(run)) {
@@ -334,7 +335,7 @@ class DeviceNames {
 // reads them. Streamed from the store a batch at a time, so an export's memory does not grow
 // with the run (docs/benchmarks.md, daq bench export).
 template <class F>
-void each_reading(const st::Store& store, std::int64_t run, F&& f,
+void each_reading(const st::RunReader& store, std::int64_t run, F&& f,
                   std::span<const std::uint8_t> quantities = {}) {
   auto stream = store.stream_readings(run, quantities);
   std::vector<st::RawReading> batch;
@@ -344,7 +345,7 @@ void each_reading(const st::Store& store, std::int64_t run, F&& f,
 
 // Walks the readings and hands them on with their spread times (reading_times.hpp).
 template <class F>
-void each_export_row(const st::Store& store, std::int64_t run, ExportClock& clock, F&& f) {
+void each_export_row(const st::RunReader& store, std::int64_t run, ExportClock& clock, F&& f) {
   ExportRows rows(clock);
   std::vector<ExportRow> out;
   const auto hand_on = [&] {
@@ -388,7 +389,7 @@ std::optional<std::string> stop_value_column(const st::RunRecord& run, const jso
   return "value_" + unit;
 }
 
-void export_readings_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
+void export_readings_csv(const st::RunReader& store, const st::RunRecord& run, const json& settings,
                          std::FILE* out, TerminalProgress& progress) {
   ExportClock clock(store, run, settings);
   const DeviceNames names(store, run.id, csv_field, "");  // CSV fields, quoted where needed
@@ -415,7 +416,7 @@ void export_readings_csv(const st::Store& store, const st::RunRecord& run, const
   b.write();
 }
 
-void export_targets_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
+void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, const json& settings,
                         std::FILE* out) {
   const auto value_column = stop_value_column(run, settings);
   if (!value_column)
@@ -437,7 +438,7 @@ void export_targets_csv(const st::Store& store, const st::RunRecord& run, const 
 
 // The two traces of a ballbar run as `daq analyse circle --input` reads them: direction,
 // angle_deg, deviation_um (from the bar's calibrated length), segmented by the run's program.
-void export_circle_csv(const st::Store& store, const st::RunRecord& run, const json& settings,
+void export_circle_csv(const st::RunReader& store, const st::RunRecord& run, const json& settings,
                        std::FILE* out) {
   if (run.kind != "circle")
     throw cal::InputError(fmt::format(
@@ -475,7 +476,7 @@ void export_circle_csv(const st::Store& store, const st::RunRecord& run, const j
 
 // caldaq.export.v1. Everything but the readings is built as one document; the readings, which
 // grow with the run, are written row by row into its place as they stream from the store.
-void export_json(const st::Store& store, const st::RunRecord& run, const json& settings,
+void export_json(const st::RunReader& store, const st::RunRecord& run, const json& settings,
                  std::FILE* out, TerminalProgress& progress) {
   json j = run_json(run);
   j["schema"] = "caldaq.export.v1";
@@ -560,7 +561,8 @@ struct ExportOptions {
 };
 
 void cmd_export(const ExportOptions& o) {
-  const auto store = open_database_read_only(o.db);
+  const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   need_run(store, o.run);  // before a file is created
   std::FILE* out = stdout;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
@@ -608,9 +610,7 @@ void add_runs_commands(CLI::App& app) {
   auto db = std::make_shared<std::string>();
   auto as_json = std::make_shared<bool>(false);
   CLI::App* runs = app.add_subcommand("runs", "List the stored runs");
-  runs->add_option("--db", *db,
-                   "Run database (default: $CALDAQ_DB, else ~/.local/share/caldaq/site.sqlite), "
-                   "or the central store: postgresql://... (docs/storage.md, \"Central store\")");
+  add_read_db_option(*runs, *db);
   runs->add_flag("--json", *as_json, "Print caldaq.runs.v1 JSON");
   runs->callback([db, as_json] { cmd_runs(*db, *as_json); });
 
@@ -619,14 +619,14 @@ void add_runs_commands(CLI::App& app) {
   auto show_id = std::make_shared<std::int64_t>(0);
   CLI::App* show = app.add_subcommand("show", "Show one stored run: set-up, instruments, results");
   show->add_option("RUN", *show_id, "Run number (see daq runs)")->required();
-  add_db_option(*show, *show_db);
+  add_read_db_option(*show, *show_db);
   show->add_flag("--json", *show_json, "Print caldaq.run.v1 JSON");
   show->callback([=] { cmd_show(*show_db, *show_id, *show_json); });
 
   const auto [exp, ex] =
       add_command<ExportOptions>(app, "export", cmd_export, "Export a stored run as CSV or JSON");
   exp->add_option("RUN", ex->run, "Run number (see daq runs)")->required();
-  add_db_option(*exp, ex->db);
+  add_read_db_option(*exp, ex->db);
   exp->add_option("--format", ex->format, "csv or json")->check(CLI::IsMember({"csv", "json"}));
   exp->add_option("--what", ex->what,
                   "CSV only: readings (raw, uncompensated), targets (a linear run's stops, as daq "

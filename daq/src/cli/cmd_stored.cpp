@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
@@ -29,10 +30,10 @@ namespace {
 namespace st = cal::storage;
 using nlohmann::json;
 
-st::RunRecord linear_run(const st::Store& store, std::int64_t id) {
+st::RunRecord linear_run(const st::RunReader& store, std::int64_t id) {
   const auto r = store.run(id);
   if (!r)
-    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.path().string(), id));
+    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
   if (r->kind != "linear")
     throw cal::InputError(
         fmt::format("run {} is a {} test; this needs a linear (ISO 230-2) run", id, r->kind));
@@ -52,7 +53,9 @@ struct AnalyseRunOptions {
 
 // A stored ballbar run again from its raw bar readings, with the analysis settings it was
 // run with unless corrected here (the calibrated length of the bar, the cyclic period).
-void analyse_circle_run(st::Store& store, const st::RunRecord& run, const AnalyseRunOptions& o) {
+// `writer`: the local store, for --store (null without it).
+void analyse_circle_run(const st::RunReader& store, st::Store* writer, const st::RunRecord& run,
+                        const AnalyseRunOptions& o) {
   json settings = cal::daq::parse_stored_json(run.settings_json);
   if (settings.is_discarded() || !settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("run {}: its circle settings are missing", o.run));
@@ -92,7 +95,7 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
   if (o.store) {
     json prov = provenance("reanalysed", software_version);
     prov["analysis"] = circle_settings_json(program, analysis);
-    const auto id = store.add_result({.run_id = o.run,
+    const auto id = writer->add_result({.run_id = o.run,
                                       .standard = standard_label(analysis),
                                       .json = j.dump(),
                                       .provenance_json = prov.dump()});
@@ -106,10 +109,14 @@ void analyse_circle_run(st::Store& store, const st::RunRecord& run, const Analys
 }
 
 void analyse_run(const AnalyseRunOptions& o) {
-  // Only --store writes; without it the database is opened read-only.
-  auto store = o.store ? st::Store(database_path(o.db)) : open_database_read_only(o.db);
+  // Only --store writes (the local file); without it the store is opened read-only, either.
+  std::optional<st::Store> writer;
+  if (o.store) writer.emplace(database_path(o.db));
+  const auto reader = writer ? nullptr : open_run_reader(o.db);
+  const st::RunReader& store = writer ? *writer : *reader;
   const auto run = store.run(o.run);
-  if (run && run->kind == "circle") return analyse_circle_run(store, *run, o);
+  if (run && run->kind == "circle")
+    return analyse_circle_run(store, writer ? &*writer : nullptr, *run, o);
   const std::string standard = o.standard.empty() ? "iso230-2:2014" : o.standard;
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
@@ -126,7 +133,7 @@ void analyse_run(const AnalyseRunOptions& o) {
     prov["coefficients"] = used.coefficients;
     prov["sensor_offsets"] = to_json(used.offsets);
     if (used.result_id) prov["of_result"] = *used.result_id;
-    j["result_id"] = store.add_result({.run_id = o.run,
+    j["result_id"] = writer->add_result({.run_id = o.run,
                                        .standard = std::string(e.standard.title),
                                        .json = j.dump(),
                                        .provenance_json = prov.dump()});
@@ -308,7 +315,7 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   auto a = std::make_shared<AnalyseRunOptions>();
   analyse.require_subcommand(0, 1);
   analyse.add_option("RUN", a->run, "A stored run to evaluate again (see daq runs)");
-  add_db_option(analyse, a->db);
+  add_read_db_option(analyse, a->db);
   analyse.add_option("-s,--standard", a->standard,
                      "Standard for a stored run: a linear run iso230-2:2014 (default), ...; a "
                      "circle run iso230-4:2005, gb/t17421.4-2016 or iso230-4:1996 (default: as "

@@ -23,7 +23,7 @@ struct VerifyOptions {
   bool json = false, list = false;
 };
 
-void list_compensations(const cal::storage::Store& store) {
+void list_compensations(const cal::storage::RunReader& store) {
   const auto all = store.compensations();
   if (all.empty())
     fmt::print("no compensation tables stored (daq compensate --run RUN stores one)\n");
@@ -33,7 +33,8 @@ void list_compensations(const cal::storage::Store& store) {
 }
 
 void run(const VerifyOptions& o) {
-  const auto store = open_database_read_only(o.db);
+  const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  const auto& store = *reader;
   if (o.list) return list_compensations(store);
   if (o.run == 0) throw cal::InputError("verify: give the as-left RUN (or --list)");
   const auto check = check_run(store, o.run, o.compensation);
@@ -41,7 +42,7 @@ void run(const VerifyOptions& o) {
     throw cal::InputError(fmt::format(
         "{}: run {}: no compensation of its axis on its machine was stored before it (or none "
         "of its stops lies where the table was made): nothing to verify",
-        store.path().string(), o.run));
+        store.name(), o.run));
   if (o.json) {
     auto j = to_json(*check);
     j["schema"] = "caldaq.verification.v1";
@@ -81,7 +82,7 @@ void add_verify_command(CLI::App& app) {
       "an inverted sign, a unit or a reference-point error; a straightness run against the "
       "cross-axis compensation written before it (docs/compensation-tables.md)");
   cmd->add_option("run", o->run, "The as-left run (measured with the table loaded)");
-  add_db_option(*cmd, o->db);
+  add_read_db_option(*cmd, o->db);
   cmd->add_option("--compensation", o->compensation,
                   "The stored compensation to compare with (default: the newest of the run's "
                   "machine and axis stored before the run)");

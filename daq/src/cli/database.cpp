@@ -22,8 +22,9 @@ std::filesystem::path default_directory() {
 std::filesystem::path chosen_path(const std::string& option) {
   if (cal::storage::pg::is_postgresql_url(option))
     throw cal::InputError(fmt::format(
-        "--db {}: only `daq runs` reads the central store so far; this command needs the local "
-        "SQLite file (docs/storage.md, \"Central store\")",
+        "--db {}: this command writes the local store (the SQLite file at the machine); the "
+        "read commands (runs, show, export, report, analyse RUN without --store, model build, "
+        "ballbar history, verify) read the central store (docs/storage.md, \"Central store\")",
         cal::storage::pg::redacted(option)));
   if (!option.empty()) return option;
   if (const char* env = std::getenv("CALDAQ_DB"); env && *env) return env;
@@ -51,6 +52,12 @@ std::unique_ptr<cal::storage::RunReader> open_run_reader(const std::string& opti
 void add_db_option(CLI::App& cmd, std::string& target) {
   cmd.add_option("--db", target,
                  "Run database (default: $CALDAQ_DB, else ~/.local/share/caldaq/site.sqlite)");
+}
+
+void add_read_db_option(CLI::App& cmd, std::string& target) {
+  cmd.add_option("--db", target,
+                 "Run database (default: $CALDAQ_DB, else ~/.local/share/caldaq/site.sqlite), "
+                 "or the central store: postgresql://... (docs/storage.md, \"Central store\")");
 }
 
 }  // namespace daq

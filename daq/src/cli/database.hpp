@@ -18,11 +18,13 @@ std::filesystem::path database_path(const std::string& option);
 // database must exist and be caldaq's and is never created, migrated or changed; it works on
 // a full disk and a read-only medium (see docs/storage.md).
 cal::storage::Store open_database_read_only(const std::string& option);
-// What `daq runs` reads: the run store opened read-only as above, or, when `option` is a
-// postgresql:// URI, the central store (storage/pg). The other commands refuse such a URI with
-// that reason (database_path, open_database_read_only).
+// What the read commands read (runs, show, export, report, analyse RUN, model build, ballbar
+// history, verify): the run store opened read-only as above, or, when `option` is a
+// postgresql:// URI, the central store (storage/pg), through one interface. The commands that
+// write refuse such a URI with that reason (database_path, open_database_read_only).
 std::unique_ptr<cal::storage::RunReader> open_run_reader(const std::string& option);
-// Adds the --db option to a command.
+// Adds the --db option to a command; add_read_db_option's help names the central store too.
 void add_db_option(CLI::App& cmd, std::string& target);
+void add_read_db_option(CLI::App& cmd, std::string& target);
 
 }  // namespace daq

@@ -76,11 +76,11 @@ std::optional<double> before_at(const std::vector<double>& x, const std::vector<
   return ct::correction_at_um(x, v, q);
 }
 
-json document(const cal::storage::Store& store, const cal::storage::CompensationRecord& c) {
+json document(const cal::storage::RunReader& store, const cal::storage::CompensationRecord& c) {
   const json doc = json::parse(c.json, nullptr, false);
   if (doc.is_discarded() || !doc.is_object())
     throw cal::InputError(
-        fmt::format("{}: compensation {} is not readable JSON", store.path().string(), c.id));
+        fmt::format("{}: compensation {} is not readable JSON", store.name(), c.id));
   return doc;
 }
 
@@ -92,7 +92,7 @@ bool is_cross(const cal::storage::CompensationRecord& c) {
 
 // The compensation the run is checked against: the one given, else the newest of the run's
 // machine and axis stored before the run started.
-std::optional<cal::storage::CompensationRecord> compensation_for(const cal::storage::Store& store,
+std::optional<cal::storage::CompensationRecord> compensation_for(const cal::storage::RunReader& store,
                                                                  const cal::storage::RunRecord& run,
                                                                  std::optional<std::int64_t> id) {
   if (id) {
@@ -104,7 +104,7 @@ std::optional<cal::storage::CompensationRecord> compensation_for(const cal::stor
         return c;
       }
     throw cal::InputError(fmt::format("{}: no compensation {} (daq verify lists them with --list)",
-                                      store.path().string(), *id));
+                                      store.name(), *id));
   }
   std::optional<cal::storage::CompensationRecord> found;
   for (const auto& c : store.compensations(run.machine_id, run.axis))
@@ -146,7 +146,7 @@ std::string component_of(const cal::storage::RunRecord& r) {
 }
 
 // Per target (nominal mm): the mean up and down of a run's stops.
-std::vector<cal::iso230_2::TargetStats> stats_of(const cal::storage::Store& store,
+std::vector<cal::iso230_2::TargetStats> stats_of(const cal::storage::RunReader& store,
                                                  std::int64_t run) {
   std::vector<cal::iso230_2::Measurement> m;
   for (const auto& t : store.targets(run))
@@ -160,7 +160,7 @@ std::vector<cal::iso230_2::TargetStats> stats_of(const cal::storage::Store& stor
 // The newest cross-axis compensation of the run's machine, stored before the run, that corrects
 // the axis the run reads (or the one given).
 std::optional<cal::storage::CompensationRecord> cross_compensation_for(
-    const cal::storage::Store& store, const cal::storage::RunRecord& run,
+    const cal::storage::RunReader& store, const cal::storage::RunRecord& run,
     const std::string& direction, std::optional<std::int64_t> id) {
   std::optional<cal::storage::CompensationRecord> found;
   for (const auto& c : store.compensations()) {
@@ -179,13 +179,13 @@ std::optional<cal::storage::CompensationRecord> cross_compensation_for(
   }
   if (id)
     throw cal::InputError(fmt::format("{}: no compensation {} (daq verify lists them with --list)",
-                                      store.path().string(), *id));
+                                      store.name(), *id));
   return found;
 }
 
 // The as-found run of the component: the compensation's source run when it measured the same
 // component, else the newest complete run of it on the machine started before the compensation.
-std::optional<cal::storage::RunRecord> as_found_for(const cal::storage::Store& store,
+std::optional<cal::storage::RunRecord> as_found_for(const cal::storage::RunReader& store,
                                                     const cal::storage::RunRecord& run,
                                                     const std::string& component,
                                                     const cal::storage::CompensationRecord& c) {
@@ -201,7 +201,7 @@ std::optional<cal::storage::RunRecord> as_found_for(const cal::storage::Store& s
   return found;
 }
 
-std::optional<LoopCheck> check_cross_run(const cal::storage::Store& store,
+std::optional<LoopCheck> check_cross_run(const cal::storage::RunReader& store,
                                          const cal::storage::RunRecord& run,
                                          std::optional<std::int64_t> compensation_id) {
   const json settings = settings_of(run);
@@ -329,10 +329,10 @@ std::vector<std::pair<std::string, std::string>> corrected_files(const LoopCheck
   return out;
 }
 
-std::optional<LoopCheck> check_run(const cal::storage::Store& store, std::int64_t run_id,
+std::optional<LoopCheck> check_run(const cal::storage::RunReader& store, std::int64_t run_id,
                                    std::optional<std::int64_t> compensation_id) {
   const auto run = store.run(run_id);
-  if (!run) throw cal::InputError(fmt::format("{}: no run {}", store.path().string(), run_id));
+  if (!run) throw cal::InputError(fmt::format("{}: no run {}", store.name(), run_id));
   if (run->kind == "straightness") return check_cross_run(store, *run, compensation_id);
   if (run->kind != "linear") return std::nullopt;  // angular, roll: no table checks them yet
   const auto comp = compensation_for(store, *run, compensation_id);
@@ -353,7 +353,7 @@ std::optional<LoopCheck> check_run(const cal::storage::Store& store, std::int64_
   const auto rev = numbers(applied, "reverse_um");
   if (table_x.size() < 2 || fwd.size() != table_x.size() || rev.size() != table_x.size())
     throw cal::InputError(
-        fmt::format("{}: compensation {} holds no applied table", store.path().string(), comp->id));
+        fmt::format("{}: compensation {} holds no applied table", store.name(), comp->id));
   std::vector<cal::iso230_2::Measurement> m;
   for (const auto& t : store.targets(run_id))
     m.push_back({t.nominal_mm, t.run_number,

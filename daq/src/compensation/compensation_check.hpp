@@ -67,7 +67,7 @@ struct LoopCheck {
 // from the as-found run of its component is compared with what the files add along the line.
 // nullopt when there is none, or the run has no stops where the table was made; cal::InputError for
 // a given id that does not exist or is of another axis.
-std::optional<LoopCheck> check_run(const cal::storage::Store& store, std::int64_t run_id,
+std::optional<LoopCheck> check_run(const cal::storage::RunReader& store, std::int64_t run_id,
                                    std::optional<std::int64_t> compensation_id = std::nullopt);
 // The table with the finding's fix applied (negated, rescaled, offset, shifted), in the
 // compensation's format; cal::InputError when there is nothing to correct (as predicted, too

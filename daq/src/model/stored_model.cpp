@@ -35,10 +35,10 @@ cal::kinematics::Vec3 vec(const json& j, const char* key) {
 
 }  // namespace
 
-StoredProfiles stored_profiles(const cal::storage::Store& store, const std::string& machine) {
+StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine) {
   const auto m = store.machine_by_name(machine);
   if (!m)
-    throw cal::InputError(fmt::format("no machine '{}' in {}", machine, store.path().string()));
+    throw cal::InputError(fmt::format("no machine '{}' in {}", machine, store.name()));
   StoredProfiles out;
   auto runs = store.runs();
   std::sort(runs.begin(), runs.end(), [](const auto& a, const auto& b) { return a.id > b.id; });

@@ -21,6 +21,6 @@ struct StoredProfiles {
 };
 
 // Throws cal::InputError when the machine is unknown or has no run of any test kind.
-StoredProfiles stored_profiles(const cal::storage::Store& store, const std::string& machine);
+StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine);
 
 }  // namespace daq

@@ -130,7 +130,7 @@ std::string instrument_label(const RunView& v, int device) {
   return name;
 }
 
-Environment load_environment(const st::Store& store, const RunView& v) {
+Environment load_environment(const st::RunReader& store, const RunView& v) {
   static constexpr std::uint8_t wanted[] = {
       static_cast<std::uint8_t>(Q::air_temperature_degc),
       static_cast<std::uint8_t>(Q::air_pressure_pa), static_cast<std::uint8_t>(Q::air_humidity_pct),
@@ -171,10 +171,10 @@ Environment load_environment(const st::Store& store, const RunView& v) {
   return env;
 }
 
-RunView load(const st::Store& store, std::int64_t id) {
+RunView load(const st::RunReader& store, std::int64_t id) {
   const auto run = store.run(id);
   if (!run)
-    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.path().string(), id));
+    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
   RunView v{.run = *run};
   if (run->machine_id > 0)
     if (const auto m = store.machine(run->machine_id)) v.machine = m->name;
@@ -575,7 +575,7 @@ std::string traceability_warnings(const RunView& v) {
 // run says so on page one, with its stops named.
 // `page_one`: the suspect box (or a failed check) for page one; otherwise the quality of a run
 // that is not suspect, for the details (page one keeps its room for the answer).
-std::string quality_banner(const st::Store& store, const RunView& v, bool page_one) {
+std::string quality_banner(const st::RunReader& store, const RunView& v, bool page_one) {
   if (v.run.kind == "circle" || v.run.kind == "dynamic") return "";
   cal::storage::RunQuality q;
   try {
@@ -800,18 +800,18 @@ struct Linear {
   cal::iso230_2::Evaluation e;
 };
 
-Linear evaluate_linear(const st::Store& store, const RunView& v, const Options& o) {
+Linear evaluate_linear(const st::RunReader& store, const RunView& v, const Options& o) {
   Linear l{.targets = store.targets(v.run.id)};
   if (l.targets.empty())
     throw cal::InputError(fmt::format("{}: run {} has no captured targets to report",
-                                      store.path().string(), v.run.id));
+                                      store.name(), v.run.id));
   const std::string key =
       !o.standard.empty() ? o.standard : v.settings.value("standard", "iso230-2:2014");
   try {
     l.e = cal::iso230_2::evaluate(::daq::measurements(l.targets),
                                   cal::iso230_2::standard_from_string(key));
   } catch (const cal::InputError& e) {
-    throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.path().string(),
+    throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.name(),
                                       v.run.id, l.targets.size(), e.what()));
   }
   return l;
@@ -974,7 +974,7 @@ struct Sections {
   std::string answer, details;
 };
 
-Sections linear_section(const st::Store& store, const RunView& v, const Options& o,
+Sections linear_section(const st::RunReader& store, const RunView& v, const Options& o,
                         Headline& headline) {
   const auto l = evaluate_linear(store, v, o);
   const auto& e = l.e;
@@ -1064,10 +1064,10 @@ std::string circular_key(const Options& o, std::string fallback) {
   }
 }
 
-Circle analyse_circle(const st::Store& store, const RunView& v, const Options& o) {
+Circle analyse_circle(const st::RunReader& store, const RunView& v, const Options& o) {
   if (!v.settings.contains("radius_mm"))
     throw cal::InputError(fmt::format("{}: run {}: its circle settings are missing",
-                                      store.path().string(), v.run.id));
+                                      store.name(), v.run.id));
   auto [program, analysis] = ::daq::circle_settings_from_json(v.settings);
   analysis.standard = circular_key(o, analysis.standard);
   static constexpr std::uint8_t bar[] = {static_cast<std::uint8_t>(Q::length_m)};
@@ -1080,7 +1080,7 @@ Circle analyse_circle(const st::Store& store, const RunView& v, const Options& o
     c.traces = segmenter.traces();
     c.result = ::daq::analyse_ballbar(program, analysis, bar_mm);
   } catch (const cal::InputError& e) {
-    throw cal::InputError(fmt::format("{}: run {} ({} bar readings): {}", store.path().string(),
+    throw cal::InputError(fmt::format("{}: run {} ({} bar readings): {}", store.name(),
                                       v.run.id, bar_mm.size(), e.what()));
   }
   return c;
@@ -1272,7 +1272,7 @@ std::string gain_notes(const cal::circle::Result& r) {
   return h;
 }
 
-Sections circle_section(const st::Store& store, const RunView& v, const Options& o,
+Sections circle_section(const st::RunReader& store, const RunView& v, const Options& o,
                         Headline& headline) {
   const auto c = analyse_circle(store, v, o);
   const auto& r = c.result;
@@ -1355,7 +1355,7 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
 // --- other runs (e.g. imported dynamic captures)
 // --------------------------------------------------
 
-std::string generic_section(const st::Store& store, const RunView& v, const Options& o) {
+std::string generic_section(const st::RunReader& store, const RunView& v, const Options& o) {
   // Streamed: every series is thinned to about 4000 points for its plot (every step-th
   // reading, the step from the series' count), so the memory does not grow with the run.
   const auto series = store.series(v.run.id);
@@ -1522,7 +1522,7 @@ std::string origin_banner(const RunView& v) {
 }
 
 // The as-left check of a compensation written before this run (compensation_check.hpp).
-std::string compensation_check(const st::Store& store, const RunView& v) {
+std::string compensation_check(const st::RunReader& store, const RunView& v) {
   if (v.run.kind != "linear" && v.run.kind != "straightness") return "";
   std::optional<::daq::LoopCheck> c;
   try {
@@ -1539,7 +1539,7 @@ std::string compensation_check(const st::Store& store, const RunView& v) {
 // Page one is the answer: who, which machine and test, when; where the readings came from and
 // how good they are; the verdict with the failing values, the main table and the main plot.
 // Then the details, the conditions and traceability, and the settings as an appendix.
-std::string run_body(const st::Store& store, const RunView& v, const Options& o, Headline& hl) {
+std::string run_body(const st::RunReader& store, const RunView& v, const Options& o, Headline& hl) {
   std::string h = origin_banner(v);
   h += summary_block(v, test_name(v));
   if (v.run.status != st::RunStatus::complete)
@@ -1595,7 +1595,7 @@ std::string date_of(const RunView& v) { return iso_time(v.run.started_unix_ms).s
 
 }  // namespace
 
-std::string run_report(const st::Store& store, std::int64_t run, const Options& o) {
+std::string run_report(const st::RunReader& store, std::int64_t run, const Options& o) {
   const auto v = load(store, run);
   Headline hl;
   return page(run_title(v), run_body(store, v, o, hl), o, who_of(v));
@@ -1603,7 +1603,7 @@ std::string run_report(const st::Store& store, std::int64_t run, const Options& 
 
 // The campaign's ballbar tests side by side and the three-plane table (docs/circle.md, "The
 // three-plane table"); empty when the campaign has no circle run with a result.
-std::string volumetric_section(const st::Store& store, std::span<const std::int64_t> runs) {
+std::string volumetric_section(const st::RunReader& store, std::span<const std::int64_t> runs) {
   std::vector<std::int64_t> circles;
   for (const auto id : runs)
     if (const auto r = store.run(id);
@@ -1683,7 +1683,7 @@ std::string volumetric_section(const st::Store& store, std::span<const std::int6
   return h;
 }
 
-std::string campaign_report(const st::Store& store, std::span<const std::int64_t> runs,
+std::string campaign_report(const st::RunReader& store, std::span<const std::int64_t> runs,
                             std::string_view title, const Options& o) {
   if (runs.empty()) throw cal::InputError("campaign report: no runs to report");
   std::vector<std::vector<std::string>> summary;
@@ -1719,7 +1719,7 @@ std::string campaign_report(const st::Store& store, std::span<const std::int64_t
   return page(title, body, o, who);
 }
 
-std::string comparison_report(const st::Store& store, std::span<const std::int64_t> runs,
+std::string comparison_report(const st::RunReader& store, std::span<const std::int64_t> runs,
                               const Options& o) {
   if (runs.size() < 2) throw cal::InputError("comparison report: give at least two runs");
   std::vector<RunView> views;
@@ -1912,7 +1912,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
               o, who_of(first));
 }
 
-std::string as_found_as_left_report(const st::Store& store, std::int64_t found_id,
+std::string as_found_as_left_report(const st::RunReader& store, std::int64_t found_id,
                                     std::int64_t left_id, const Options& o) {
   const auto found = load(store, found_id), left = load(store, left_id);
   if (found.run.kind != left.run.kind || found.run.axis != left.run.axis)

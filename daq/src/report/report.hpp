@@ -10,7 +10,7 @@
 #include <vector>
 
 namespace cal::storage {
-class Store;
+class RunReader;
 }
 
 namespace cal::daq::report {
@@ -27,14 +27,14 @@ struct Options {
 
 // Each throws cal::InputError naming the database and run for an unknown run, a run without
 // the data its report needs, or (comparison) runs of different tests.
-std::string run_report(const storage::Store& store, std::int64_t run, const Options& o = {});
-std::string campaign_report(const storage::Store& store, std::span<const std::int64_t> runs,
+std::string run_report(const storage::RunReader& store, std::int64_t run, const Options& o = {});
+std::string campaign_report(const storage::RunReader& store, std::span<const std::int64_t> runs,
                             std::string_view title, const Options& o = {});
-std::string comparison_report(const storage::Store& store, std::span<const std::int64_t> runs,
+std::string comparison_report(const storage::RunReader& store, std::span<const std::int64_t> runs,
                               const Options& o = {});
 // The same test before ("as found") and after ("as left") a compensation, side by side, then
 // both runs' reports.
-std::string as_found_as_left_report(const storage::Store& store, std::int64_t found,
+std::string as_found_as_left_report(const storage::RunReader& store, std::int64_t found,
                                     std::int64_t left, const Options& o = {});
 
 // Straightness and squareness are analysed from measured profiles (CSV files, not stored

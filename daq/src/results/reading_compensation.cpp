@@ -34,7 +34,7 @@ std::vector<std::uint8_t> ReadingCompensation::inputs() {
           static_cast<std::uint8_t>(Q::length_m)};
 }
 
-ReadingCompensation::ReadingCompensation(const st::Store& store, const st::RunRecord& run,
+ReadingCompensation::ReadingCompensation(const st::RunReader& store, const st::RunRecord& run,
                                          const json& settings) {
   if (run.kind == "circle" || !settings.is_object() || !settings.contains("environment") ||
       !settings["environment"].is_object())

@@ -25,7 +25,7 @@ class ReadingCompensation {
  public:
   // Throws cal::InputError for a run that is not a linear test or whose settings lack the
   // environment (an import, a circle run): its readings were never compensated.
-  ReadingCompensation(const cal::storage::Store& store, const cal::storage::RunRecord& run,
+  ReadingCompensation(const cal::storage::RunReader& store, const cal::storage::RunRecord& run,
                       const nlohmann::json& settings);
   // One reading, in the store's order. For a displacement reading of the laser, its
   // compensation (length_m at 20 degC, n, material_degc, ...); nullopt for every other reading,

@@ -13,7 +13,7 @@ namespace daq {
 
 namespace st = cal::storage;
 
-ExportClock::ExportClock(const st::Store& store, const st::RunRecord& run,
+ExportClock::ExportClock(const st::RunReader& store, const st::RunRecord& run,
                          const nlohmann::json& settings) {
   // A series' readings stream in time order, so its first and last are its rows' extremes.
   bool any = false;

@@ -31,7 +31,7 @@ class ExportClock {
  public:
   // The periods and the run's start from the series' rows (Store::series: no reading is
   // decoded); `settings` is the run's parsed settings (a circle run's sample_rate_hz).
-  ExportClock(const cal::storage::Store& store, const cal::storage::RunRecord& run,
+  ExportClock(const cal::storage::RunReader& store, const cal::storage::RunRecord& run,
               const nlohmann::json& settings);
   // What the spreading knows of one stream (device, channel, quantity).
   struct Stream {

@@ -6,12 +6,12 @@
 #include <nlohmann/json.hpp>
 
 namespace cal::storage {
-class Store;
+class RunReader;
 }
 
 namespace daq {
 
 // Throws cal::InputError naming the database for a run that does not exist.
-nlohmann::json run_document(const cal::storage::Store& store, std::int64_t run);
+nlohmann::json run_document(const cal::storage::RunReader& store, std::int64_t run);
 
 }  // namespace daq

@@ -28,7 +28,7 @@ std::optional<ci::Plane> plane_of(const std::string& name) {
 }
 
 // The newest current result of the run in a circle schema.
-std::optional<json> current_circle_result(const st::Store& store, std::int64_t run) {
+std::optional<json> current_circle_result(const st::RunReader& store, std::int64_t run) {
   std::optional<json> out;
   for (const auto& r : store.results(run)) {
     if (!r.current()) continue;
@@ -38,8 +38,8 @@ std::optional<json> current_circle_result(const st::Store& store, std::int64_t r
   return out;
 }
 
-BallbarTest test_of(const st::Store& store, const st::RunRecord& run) {
-  const auto where = fmt::format("{}: run {}", store.path().string(), run.id);
+BallbarTest test_of(const st::RunReader& store, const st::RunRecord& run) {
+  const auto where = fmt::format("{}: run {}", store.name(), run.id);
   if (run.kind != "circle")
     throw cal::InputError(fmt::format("{} is a {} run, not a ballbar test", where, run.kind));
   const auto result = current_circle_result(store, run.id);
@@ -86,22 +86,22 @@ std::string num_or_dash(const std::optional<double>& v, const char* format = "{:
 
 }  // namespace
 
-std::vector<BallbarTest> ballbar_tests(const st::Store& store, std::span<const std::int64_t> runs) {
+std::vector<BallbarTest> ballbar_tests(const st::RunReader& store, std::span<const std::int64_t> runs) {
   std::vector<BallbarTest> out;
   for (auto id : runs) {
     const auto run = store.run(id);
-    if (!run) throw cal::InputError(fmt::format("{}: no run {}", store.path().string(), id));
+    if (!run) throw cal::InputError(fmt::format("{}: no run {}", store.name(), id));
     out.push_back(test_of(store, *run));
   }
   return out;
 }
 
-std::vector<std::int64_t> ballbar_runs(const st::Store& store, std::string_view machine,
+std::vector<std::int64_t> ballbar_runs(const st::RunReader& store, std::string_view machine,
                                        std::string_view campaign) {
   const auto m = store.machine_by_name(machine);
   if (!m)
     throw cal::InputError(fmt::format("{}: no machine named '{}' (daq runs lists them)",
-                                      store.path().string(), machine));
+                                      store.name(), machine));
   std::vector<std::int64_t> out;
   for (const auto& r : store.runs())
     if (r.machine_id == m->id && r.kind == "circle" && r.status == st::RunStatus::complete &&

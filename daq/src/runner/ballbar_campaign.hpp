@@ -37,11 +37,11 @@ struct BallbarTest {
 
 // The runs given, in that order, each with its current circle result. cal::InputError naming
 // the database and run for an unknown run, a run that is not a circle, or one without a result.
-std::vector<BallbarTest> ballbar_tests(const cal::storage::Store& store,
+std::vector<BallbarTest> ballbar_tests(const cal::storage::RunReader& store,
                                        std::span<const std::int64_t> runs);
 // The complete circle runs of a machine (optionally of one campaign), oldest first.
 // cal::InputError for an unknown machine; empty when it has no such run.
-std::vector<std::int64_t> ballbar_runs(const cal::storage::Store& store, std::string_view machine,
+std::vector<std::int64_t> ballbar_runs(const cal::storage::RunReader& store, std::string_view machine,
                                        std::string_view campaign = {});
 
 // The three-plane table of a set of tests: per plane, the tests at its slowest feed (servo

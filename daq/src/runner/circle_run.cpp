@@ -107,7 +107,7 @@ json calibration_block(const BallbarAnalysis& a) {
 }  // namespace
 
 void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double radius_mm,
-                         const cal::storage::Store& store, std::int64_t at_unix_ms) {
+                         const cal::storage::RunReader& store, std::int64_t at_unix_ms) {
   if (a.uncalibrated || !a.calibration_source.empty()) return;
   if (a.calibrated_radius_mm) {
     a.calibration_source = "configuration";

@@ -46,7 +46,7 @@ struct BallbarAnalysis {
 // with the reason (the radius error is then not evaluated). An analysis already decided (a
 // length or uncalibrated set) is left as it is.
 void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double radius_mm,
-                         const cal::storage::Store& store, std::int64_t at_unix_ms);
+                         const cal::storage::RunReader& store, std::int64_t at_unix_ms);
 
 // The ISO 230-4 result and diagnostics of a ballbar stream (one deviation per sample, in mm
 // from the calibrated length, from before the feed-in): segmentation by the program's timing,

@@ -49,7 +49,7 @@ std::string run_unit(const cal::storage::RunRecord& r) {
 }
 }  // namespace
 
-cal::storage::RunQuality run_quality(const cal::storage::Store& store, std::int64_t run_id) {
+cal::storage::RunQuality run_quality(const cal::storage::RunReader& store, std::int64_t run_id) {
   if (auto q = store.quality(run_id)) return *q;
   const auto run = store.run(run_id);
   if (!run) return {.state = "not checked", .summary = fmt::format("no run {}", run_id)};
@@ -74,7 +74,7 @@ json quality_json(const cal::storage::RunQuality& q) {
   return {{"state", q.state}, {"summary", q.summary}, {"suspect_stops", std::move(stops)}};
 }
 
-std::vector<std::int64_t> refuse_suspect_runs(const cal::storage::Store& store,
+std::vector<std::int64_t> refuse_suspect_runs(const cal::storage::RunReader& store,
                                               std::span<const std::int64_t> runs,
                                               std::span<const std::int64_t> accepted,
                                               std::string_view what) {

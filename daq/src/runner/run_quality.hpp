@@ -21,7 +21,7 @@ cal::storage::RunQuality assess_stops(std::span<const cal::storage::CapturedTarg
 
 // A stored run's stop quality: as stored when it was acquired, else assessed now from its
 // stored stops (a run stored before schema 5, an import; nothing is written).
-cal::storage::RunQuality run_quality(const cal::storage::Store& store, std::int64_t run_id);
+cal::storage::RunQuality run_quality(const cal::storage::RunReader& store, std::int64_t run_id);
 
 // {"state", "summary", "suspect_stops": [{"run", "direction": "up"|"down", "target_index",
 // "reason"}]}: the "quality" of a run's JSON.
@@ -33,7 +33,7 @@ std::string quality_text(const cal::storage::RunQuality& q);
 // The builders' gate: throws cal::InputError naming every suspect run of `runs` that is not in
 // `accepted`, with its suspect stops and how to accept it. Returns the suspect runs that were
 // accepted, for the provenance of what is built ("accepted_suspect_runs").
-std::vector<std::int64_t> refuse_suspect_runs(const cal::storage::Store& store,
+std::vector<std::int64_t> refuse_suspect_runs(const cal::storage::RunReader& store,
                                               std::span<const std::int64_t> runs,
                                               std::span<const std::int64_t> accepted,
                                               std::string_view what);

@@ -558,7 +558,7 @@ class Service {
     return open_database_read_only(o_.run.db);
   }
 
-  static RunOrigin origin_in(const cal::storage::Store& db, const cal::storage::RunRecord& r) {
+  static RunOrigin origin_in(const cal::storage::RunReader& db, const cal::storage::RunRecord& r) {
     const auto machine = db.machine(r.machine_id);
     return run_origin(r, db.instruments(r.id), machine ? machine->name : "");
   }

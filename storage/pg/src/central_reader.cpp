@@ -1,4 +1,6 @@
-// The central store read through RunReader (central.hpp).
+// The central store read through RunReader (central.hpp): every read command's queries, on
+// PostgreSQL, giving what the SQLite Store gives for the same runs (ids are the server's; a
+// result keeps the id it had where it was made; text is ordered as SQLite orders it, by byte).
 #include <optional>
 
 #include "cal/storage/pg/central.hpp"
@@ -20,6 +22,151 @@ std::optional<std::int64_t> optional_int(const pqxx::field& f) {
   return f.as<std::int64_t>();
 }
 
+char direction_of(const pqxx::field& f) {
+  const auto s = f.as<std::string>();
+  return s.empty() ? '+' : s.front();
+}
+
+constexpr const char* kRunColumns =
+    "SELECT id, COALESCE(machine_id, 0), campaign, kind, axis, settings_json, capture_path, "
+    "software_version, started_unix_ms, ended_unix_ms, status, note, origin_session_ns, "
+    "origin_unix_ns, uuid FROM caldaq.runs";
+
+RunRecord run_row(const pqxx::row& row) {
+  RunRecord r;
+  r.id = row[0].as<std::int64_t>();
+  r.machine_id = row[1].as<std::int64_t>();
+  r.campaign = row[2].as<std::string>();
+  r.kind = row[3].as<std::string>();
+  r.axis = row[4].as<std::string>();
+  r.settings_json = row[5].as<std::string>();
+  r.capture_path = row[6].as<std::string>();
+  r.software_version = row[7].as<std::string>();
+  r.started_unix_ms = row[8].as<std::int64_t>();
+  r.ended_unix_ms = optional_int(row[9]);
+  r.status = status_from(row[10].as<std::string>());
+  r.note = row[11].as<std::string>();
+  r.origin_session_ns = optional_int(row[12]);
+  r.origin_unix_ns = optional_int(row[13]);
+  r.uuid = row[14].as<std::string>();
+  return r;
+}
+
+MachineRecord machine_row(const pqxx::row& row) {
+  return {.id = row[0].as<std::int64_t>(),
+          .name = row[1].as<std::string>(),
+          .description = row[2].as<std::string>(),
+          .config_json = row[3].as<std::string>()};
+}
+
+constexpr const char* kCalibrationColumns =
+    "SELECT id, bar, nominal_mm, extensions, calibrator, calibrator_length_mm, reading_mm, "
+    "zero_length_mm, temperature_degc, calibrated_unix_ms, note FROM caldaq.bar_calibrations";
+
+BarCalibration calibration_row(const pqxx::row& row) {
+  BarCalibration c{.id = row[0].as<std::int64_t>(),
+                   .bar = row[1].as<std::string>(),
+                   .nominal_mm = row[2].as<double>(),
+                   .extensions = row[3].as<std::string>(),
+                   .calibrator = row[4].as<std::string>(),
+                   .calibrator_length_mm = row[5].as<double>(),
+                   .reading_mm = row[6].as<double>(),
+                   .zero_length_mm = row[7].as<double>(),
+                   .calibrated_unix_ms = row[9].as<std::int64_t>(),
+                   .note = row[10].as<std::string>()};
+  if (!row[8].is_null()) c.temperature_degc = row[8].as<double>();
+  return c;
+}
+
+// " AND k.quantity IN (1, 2)": the quantities are small numbers, written into the SQL.
+std::string quantity_filter(std::span<const std::uint8_t> quantities) {
+  if (quantities.empty()) return {};
+  std::string sql = " AND k.quantity IN (";
+  for (std::size_t i = 0; i < quantities.size(); ++i)
+    sql += fmt::format("{}{}", i ? ", " : "", static_cast<int>(quantities[i]));
+  return sql + ")";
+}
+
+// The chunks of one run, a page at a time in the order of (first_ns, seq): the order written,
+// as SQLite's row order (seq numbers a run's chunks as they were written).
+class PgChunks final : public ChunkSource {
+ public:
+  PgChunks(pqxx::connection& conn, std::string shown, std::string uuid, std::int64_t run_id,
+           std::span<const std::uint8_t> quantities)
+      : conn_(conn),
+        shown_(std::move(shown)),
+        uuid_(std::move(uuid)),
+        run_id_(run_id),
+        filter_(quantity_filter(quantities)) {}
+
+  bool next(SourceChunk& out) override {
+    if (pos_ == page_.size()) fetch();
+    if (pos_ == page_.size()) return false;
+    out = std::move(page_[pos_++]);
+    return true;
+  }
+
+  std::optional<Numbered> numbered() override {
+    return guarded(shown_, fmt::format("count the reading chunks of run {}", run_id_), [&] {
+      pqxx::nontransaction n(conn_);
+      const auto row = n.exec_params1(
+          "SELECT count(*), COALESCE(MAX(seq), -1) FROM caldaq.reading_chunks AS k "
+          "WHERE k.run_uuid = $1" +
+              filter_,
+          uuid_);
+      return Numbered{row[0].as<std::int64_t>(), row[1].as<std::int64_t>()};
+    });
+  }
+
+ private:
+  static constexpr int kPage = 32;  // chunks per query: at most 32 x 16384 readings in memory
+  pqxx::connection& conn_;
+  std::string shown_, uuid_;
+  std::int64_t run_id_ = 0;
+  std::string filter_;
+  std::vector<SourceChunk> page_;
+  std::size_t pos_ = 0;
+  bool started_ = false, done_ = false;
+  std::int64_t last_first_ns_ = 0, last_seq_ = 0;
+
+  void fetch() {
+    page_.clear();
+    pos_ = 0;
+    if (done_) return;
+    guarded(shown_, fmt::format("read the reading chunks of run {}", run_id_), [&] {
+      pqxx::nontransaction n(conn_);
+      const auto rows = n.exec_params(
+          "SELECT seq, device, channel, quantity, first_ns, last_ns, count, encoding, crc, data "
+          "FROM caldaq.reading_chunks AS k WHERE k.run_uuid = $1 AND ($2 OR (k.first_ns, k.seq) > "
+          "($3, $4))" +
+              filter_ + fmt::format(" ORDER BY k.first_ns, k.seq LIMIT {}", kPage),
+          uuid_, !started_, last_first_ns_, last_seq_);
+      for (const auto& row : rows) {
+        SourceChunk c;
+        c.seq = row[0].as<std::int64_t>();
+        c.order = *c.seq;
+        c.device = row[1].as<std::int64_t>();
+        c.channel = row[2].as<std::int64_t>();
+        c.quantity = row[3].as<std::int64_t>();
+        c.first_ns = row[4].as<std::int64_t>();
+        c.last_ns = row[5].as<std::int64_t>();
+        c.count = row[6].as<std::int64_t>();
+        c.encoding = row[7].as<std::int64_t>();
+        c.crc = static_cast<std::uint32_t>(row[8].as<std::int64_t>());
+        const pqxx::binarystring data(row[9]);
+        c.data.assign(data.data(), data.data() + data.size());
+        page_.push_back(std::move(c));
+      }
+    });
+    started_ = true;
+    if (page_.size() < static_cast<std::size_t>(kPage)) done_ = true;
+    if (!page_.empty()) {
+      last_first_ns_ = page_.back().first_ns;
+      last_seq_ = *page_.back().seq;
+    }
+  }
+};
+
 class CentralReader final : public RunReader {
  public:
   explicit CentralReader(std::string_view url)
@@ -31,35 +178,44 @@ class CentralReader final : public RunReader {
 
   std::string name() const override { return shown_; }
 
+  std::optional<MachineRecord> machine_by_name(std::string_view name) const override {
+    return one<MachineRecord>(
+        fmt::format("read the machine '{}'", name),
+        "SELECT id, name, description, config_json FROM caldaq.machines WHERE name = $1 "
+        "ORDER BY id LIMIT 1",
+        machine_row, std::string(name));
+  }
+  std::optional<MachineRecord> machine(std::int64_t id) const override {
+    return one<MachineRecord>(
+        fmt::format("read machine {}", id),
+        "SELECT id, name, description, config_json FROM caldaq.machines WHERE id = $1",
+        machine_row, id);
+  }
+
   std::vector<RunRecord> runs() const override {
-    return guarded(shown_, "read the runs", [&] {
-      pqxx::nontransaction n(*conn_);
-      const auto rows = n.exec(
-          "SELECT id, COALESCE(machine_id, 0), campaign, kind, axis, settings_json, capture_path, "
-          "software_version, started_unix_ms, ended_unix_ms, status, note, origin_session_ns, "
-          "origin_unix_ns, uuid FROM caldaq.runs ORDER BY id");
-      std::vector<RunRecord> out;
-      for (const auto& row : rows) {
-        RunRecord r;
-        r.id = row[0].as<std::int64_t>();
-        r.machine_id = row[1].as<std::int64_t>();
-        r.campaign = row[2].as<std::string>();
-        r.kind = row[3].as<std::string>();
-        r.axis = row[4].as<std::string>();
-        r.settings_json = row[5].as<std::string>();
-        r.capture_path = row[6].as<std::string>();
-        r.software_version = row[7].as<std::string>();
-        r.started_unix_ms = row[8].as<std::int64_t>();
-        r.ended_unix_ms = optional_int(row[9]);
-        r.status = status_from(row[10].as<std::string>());
-        r.note = row[11].as<std::string>();
-        r.origin_session_ns = optional_int(row[12]);
-        r.origin_unix_ns = optional_int(row[13]);
-        r.uuid = row[14].as<std::string>();
-        out.push_back(std::move(r));
-      }
-      return out;
-    });
+    return all<RunRecord>("read the runs", std::string(kRunColumns) + " ORDER BY id", run_row);
+  }
+  std::optional<RunRecord> run(std::int64_t run_id) const override {
+    return one<RunRecord>(fmt::format("read run {}", run_id),
+                          std::string(kRunColumns) + " WHERE id = $1", run_row, run_id);
+  }
+
+  std::vector<InstrumentRecord> instruments(std::int64_t run_id) const override {
+    return all<InstrumentRecord>(
+        fmt::format("read the instruments of run {}", run_id),
+        "SELECT i.device, i.driver, i.transport, i.settings_json, i.origin, i.origin_detail FROM "
+        "caldaq.instruments AS i JOIN caldaq.runs AS r ON r.uuid = i.run_uuid WHERE r.id = $1 "
+        "ORDER BY i.device",
+        [&](const pqxx::row& row) {
+          return InstrumentRecord{.run_id = run_id,
+                                  .device = row[0].as<int>(),
+                                  .driver = row[1].as<std::string>(),
+                                  .transport = row[2].as<std::string>(),
+                                  .settings_json = row[3].as<std::string>(),
+                                  .origin = row[4].as<std::string>(),
+                                  .origin_detail = row[5].as<std::string>()};
+        },
+        run_id);
   }
 
   std::int64_t reading_count(std::int64_t run_id) const override {
@@ -74,9 +230,206 @@ class CentralReader final : public RunReader {
     });
   }
 
+  ReadingStream stream_readings(std::int64_t run_id,
+                                std::span<const std::uint8_t> quantities = {}) const override {
+    // The chunks' checksums cover the run's id in the store that wrote them.
+    const auto ids = guarded(shown_, fmt::format("read run {}", run_id), [&] {
+      pqxx::nontransaction n(*conn_);
+      return n.exec_params("SELECT uuid, source_run_id FROM caldaq.runs WHERE id = $1", run_id);
+    });
+    std::string uuid;
+    std::int64_t source_id = 0;
+    if (!ids.empty()) {
+      uuid = ids[0][0].as<std::string>();
+      source_id = ids[0][1].as<std::int64_t>();
+    }
+    return ReadingStream::of(std::make_unique<PgChunks>(*conn_, shown_, uuid, run_id, quantities),
+                             shown_, run_id, source_id, quantities.empty());
+  }
+
+  std::vector<SeriesInfo> series(std::int64_t run_id) const override {
+    return all<SeriesInfo>(
+        fmt::format("read the series of run {}", run_id),
+        "SELECT k.device, k.channel, k.quantity, SUM(k.count), MIN(k.first_ns), MAX(k.last_ns) "
+        "FROM caldaq.reading_chunks AS k JOIN caldaq.runs AS r ON r.uuid = k.run_uuid WHERE "
+        "r.id = $1 GROUP BY k.device, k.channel, k.quantity ORDER BY k.device, k.channel, "
+        "k.quantity",
+        [](const pqxx::row& row) {
+          return SeriesInfo{static_cast<std::uint16_t>(row[0].as<int>()),
+                            static_cast<std::uint8_t>(row[1].as<int>()),
+                            static_cast<std::uint8_t>(row[2].as<int>()),
+                            row[3].as<std::int64_t>(), row[4].as<std::int64_t>(),
+                            row[5].as<std::int64_t>()};
+        },
+        run_id);
+  }
+
+  std::vector<CapturedTarget> targets(std::int64_t run_id) const override {
+    return all<CapturedTarget>(
+        fmt::format("read the captured stops of run {}", run_id),
+        "SELECT t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns, t.raw_m, "
+        "t.deviation_um, t.refractive_index, t.material_temperature_degc FROM "
+        "caldaq.captured_targets AS t JOIN caldaq.runs AS r ON r.uuid = t.run_uuid WHERE r.id = "
+        "$1 ORDER BY t.time_ns, t.run_number, t.target_index",
+        [&](const pqxx::row& row) {
+          return CapturedTarget{.run_id = run_id,
+                                .target_index = row[0].as<int>(),
+                                .run_number = row[1].as<int>(),
+                                .direction = direction_of(row[2]),
+                                .nominal_mm = row[3].as<double>(),
+                                .time_ns = row[4].as<std::int64_t>(),
+                                .raw_m = row[5].as<double>(),
+                                .deviation_um = row[6].as<double>(),
+                                .refractive_index = row[7].as<double>(),
+                                .material_temperature_degc = row[8].as<double>()};
+        },
+        run_id);
+  }
+
+  std::vector<ResultRecord> results(std::int64_t run_id) const override {
+    return all<ResultRecord>(
+        fmt::format("read the results of run {}", run_id),
+        "SELECT s.standard, s.json, s.created_unix_ms, s.provenance_json, s.source_result_id, "
+        "s.superseded_by FROM caldaq.results AS s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid "
+        "WHERE r.id = $1 ORDER BY s.source_result_id",
+        [&](const pqxx::row& row) {
+          return ResultRecord{.run_id = run_id,
+                              .standard = row[0].as<std::string>(),
+                              .json = row[1].as<std::string>(),
+                              .created_unix_ms = row[2].as<std::int64_t>(),
+                              .provenance_json = row[3].as<std::string>(),
+                              .id = row[4].as<std::int64_t>(),
+                              .superseded_by = optional_int(row[5])};
+        },
+        run_id);
+  }
+
+  std::optional<RunQuality> quality(std::int64_t run_id) const override {
+    const auto head = one<RunQuality>(
+        fmt::format("read the stop quality of run {}", run_id),
+        "SELECT quality_state, quality_summary FROM caldaq.runs WHERE id = $1 AND "
+        "quality_state IS NOT NULL",
+        [](const pqxx::row& row) {
+          return RunQuality{.state = row[0].as<std::string>(), .summary = row[1].as<std::string>()};
+        },
+        run_id);
+    if (!head) return std::nullopt;
+    RunQuality q = *head;
+    q.suspects = all<StopMark>(
+        fmt::format("read the suspect stops of run {}", run_id),
+        "SELECT s.run_number, s.direction, s.target_index, s.reason FROM caldaq.suspect_stops AS "
+        "s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid WHERE r.id = $1 ORDER BY s.ordinal",
+        [](const pqxx::row& row) {
+          return StopMark{.run_number = row[0].as<int>(),
+                          .direction = direction_of(row[1]),
+                          .target_index = row[2].as<int>(),
+                          .reason = row[3].as<std::string>()};
+        },
+        run_id);
+    return q;
+  }
+
+  std::vector<MissedStop> missed_stops(std::int64_t run_id) const override {
+    return all<MissedStop>(
+        fmt::format("read the missed stops of run {}", run_id),
+        "SELECT m.run_number, m.direction, m.target_index, m.nominal_mm FROM caldaq.missed_stops "
+        "AS m JOIN caldaq.runs AS r ON r.uuid = m.run_uuid WHERE r.id = $1 ORDER BY "
+        "m.run_number, m.direction COLLATE \"C\", m.target_index",
+        [&](const pqxx::row& row) {
+          return MissedStop{.run_id = run_id,
+                            .run_number = row[0].as<int>(),
+                            .direction = direction_of(row[1]),
+                            .target_index = row[2].as<int>(),
+                            .nominal_mm = row[3].as<double>()};
+        },
+        run_id);
+  }
+
+  std::vector<OperatorAction> operator_actions(std::int64_t run_id) const override {
+    return all<OperatorAction>(
+        fmt::format("read the operator's actions of run {}", run_id),
+        "SELECT a.time_unix_ms, a.action, a.source, a.operator, a.run_number, a.direction, "
+        "a.target_index, a.nominal_mm, a.detail FROM caldaq.operator_actions AS a JOIN "
+        "caldaq.runs AS r ON r.uuid = a.run_uuid WHERE r.id = $1 ORDER BY a.ordinal",
+        [&](const pqxx::row& row) {
+          OperatorAction a{.run_id = run_id,
+                           .time_unix_ms = row[0].as<std::int64_t>(),
+                           .action = row[1].as<std::string>(),
+                           .source = row[2].as<std::string>(),
+                           .operator_name = row[3].as<std::string>(),
+                           .detail = row[8].as<std::string>()};
+          if (!row[4].is_null())
+            a.stop = MissedStop{.run_id = run_id,
+                                .run_number = row[4].as<int>(),
+                                .direction = direction_of(row[5]),
+                                .target_index = row[6].as<int>(),
+                                .nominal_mm = row[7].as<double>()};
+          return a;
+        },
+        run_id);
+  }
+
+  std::vector<BarCalibration> bar_calibrations(std::string_view bar = {}) const override {
+    return all<BarCalibration>("read the ballbar calibrations",
+                               std::string(kCalibrationColumns) +
+                                   " WHERE $1 = '' OR bar = $1 ORDER BY calibrated_unix_ms, id",
+                               calibration_row, std::string(bar));
+  }
+  std::optional<BarCalibration> bar_calibration(std::string_view bar, double nominal_mm,
+                                                std::int64_t at_unix_ms) const override {
+    return one<BarCalibration>(
+        fmt::format("read the calibration of ballbar '{}'", bar),
+        std::string(kCalibrationColumns) +
+            " WHERE bar = $1 AND abs(nominal_mm - $2) < 1e-3 AND calibrated_unix_ms <= $3 ORDER "
+            "BY calibrated_unix_ms DESC, id DESC LIMIT 1",
+        calibration_row, std::string(bar), nominal_mm, at_unix_ms);
+  }
+
+  std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
+                                                std::string_view axis = {}) const override {
+    return all<CompensationRecord>(
+        "read the compensation tables",
+        "SELECT c.id, COALESCE(c.machine_id, 0), COALESCE(r.id, 0), c.source, c.axis, c.format, "
+        "c.created_unix_ms, c.json FROM caldaq.compensations AS c LEFT JOIN caldaq.runs AS r ON "
+        "r.uuid = c.source_run_uuid WHERE ($1 = 0 OR c.machine_id = $1) AND ($2 = '' OR c.axis "
+        "= $2) ORDER BY c.created_unix_ms, c.id",
+        [](const pqxx::row& row) {
+          return CompensationRecord{.id = row[0].as<std::int64_t>(),
+                                    .machine_id = row[1].as<std::int64_t>(),
+                                    .source_run_id = row[2].as<std::int64_t>(),
+                                    .source = row[3].as<std::string>(),
+                                    .axis = row[4].as<std::string>(),
+                                    .format = row[5].as<std::string>(),
+                                    .created_unix_ms = row[6].as<std::int64_t>(),
+                                    .json = row[7].as<std::string>()};
+        },
+        machine_id, std::string(axis));
+  }
+
  private:
   std::string shown_;
   std::unique_ptr<pqxx::connection> conn_;
+
+  // The rows of a query, each made into a T; errors name the server and `what`.
+  template <class T, class F, class... Args>
+  std::vector<T> all(const std::string& what, const std::string& sql, F&& make,
+                     Args&&... args) const {
+    return guarded(shown_, what, [&] {
+      pqxx::nontransaction n(*conn_);
+      const auto rows = n.exec_params(sql, std::forward<Args>(args)...);
+      std::vector<T> out;
+      out.reserve(rows.size());
+      for (const auto& row : rows) out.push_back(make(row));
+      return out;
+    });
+  }
+  template <class T, class F, class... Args>
+  std::optional<T> one(const std::string& what, const std::string& sql, F&& make,
+                       Args&&... args) const {
+    auto rows = all<T>(what, sql, std::forward<F>(make), std::forward<Args>(args)...);
+    if (rows.empty()) return std::nullopt;
+    return std::move(rows.front());
+  }
 
   void check_schema() {
     pqxx::nontransaction n(*conn_);
@@ -85,10 +438,17 @@ class CentralReader final : public RunReader {
           "{}: no caldaq central store in this database (daq sync --to creates it)", shown_));
     const auto rows = n.exec("SELECT version FROM caldaq.schema_version");
     const int version = rows.size() == 1 ? rows[0][0].as<int>() : -1;
-    if (version < 1 || version > central_schema_version)
+    // Version 1 lacks what the read commands need beside the runs (the stop quality, the
+    // compensation tables, the ballbar calibrations): a sync by this daq migrates it.
+    if (version < central_schema_version)
       throw StoreError(fmt::format(
-          "{}: central schema version {} is not one this daq reads (1 to {}){}", shown_, version,
-          central_schema_version, version > central_schema_version ? "; use a newer daq" : ""));
+          "{}: central schema version {} is older than this daq reads ({}): a daq sync --to by "
+          "this daq migrates it",
+          shown_, version, central_schema_version));
+    if (version > central_schema_version)
+      throw StoreError(fmt::format(
+          "{}: central schema version {} is newer than this daq reads ({}); use a newer daq",
+          shown_, version, central_schema_version));
   }
 };
 

@@ -105,6 +105,43 @@ CREATE TABLE caldaq.operator_actions(
   detail text NOT NULL,
   PRIMARY KEY(run_uuid, ordinal));
 )sql",
+    // 2: what the read commands need beside the runs (daq show, export, report... with --db
+    // postgresql://): the stop quality as rows, the compensation tables written and the ballbar
+    // calibrations, each stored once (by a fingerprint of what identifies it).
+    R"sql(
+ALTER TABLE caldaq.runs ADD COLUMN quality_state text, ADD COLUMN quality_summary text;
+CREATE TABLE caldaq.suspect_stops(
+  run_uuid uuid NOT NULL REFERENCES caldaq.runs(uuid) ON DELETE CASCADE,
+  ordinal integer NOT NULL,
+  run_number integer NOT NULL,
+  direction text NOT NULL CHECK(direction IN ('+', '-')),
+  target_index integer NOT NULL,
+  reason text NOT NULL,
+  PRIMARY KEY(run_uuid, ordinal));
+CREATE TABLE caldaq.compensations(
+  id bigserial PRIMARY KEY,
+  machine_id bigint REFERENCES caldaq.machines(id),
+  source_run_uuid uuid,
+  source text NOT NULL,
+  axis text NOT NULL,
+  format text NOT NULL,
+  created_unix_ms bigint NOT NULL,
+  json text NOT NULL,
+  fingerprint text NOT NULL UNIQUE);
+CREATE TABLE caldaq.bar_calibrations(
+  id bigserial PRIMARY KEY,
+  bar text NOT NULL,
+  nominal_mm double precision NOT NULL,
+  extensions text NOT NULL,
+  calibrator text NOT NULL,
+  calibrator_length_mm double precision NOT NULL,
+  reading_mm double precision NOT NULL,
+  zero_length_mm double precision NOT NULL,
+  temperature_degc double precision,
+  calibrated_unix_ms bigint NOT NULL,
+  note text NOT NULL,
+  fingerprint text NOT NULL UNIQUE);
+)sql",
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 

@@ -105,6 +105,8 @@ class Sync {
       }
     }
     for (const auto& r : runs) sync_run(r);
+    guarded(shown_, "store the compensation tables and ballbar calibrations",
+            [&] { send_records(); });
     return report_;
   }
 
@@ -147,21 +149,58 @@ class Sync {
       options_.run_done(r, report_.chunks_sent - before, report_.chunks_already - already_before);
   }
 
+  // The server's id of a local machine ("" for none), adding it. Machines are known by name: a
+  // no-op update returns the id of an existing one.
+  std::string server_machine(pqxx::work& w, std::int64_t local_id) const {
+    if (local_id <= 0) return {};
+    const auto m = local_.machine(local_id);
+    if (!m) return {};
+    return w
+        .exec_params1(
+            "INSERT INTO caldaq.machines(name, description, config_json) VALUES($1, $2, $3) "
+            "ON CONFLICT (name) DO UPDATE SET name = EXCLUDED.name RETURNING id",
+            m->name, m->description, m->config_json)[0]
+        .as<std::string>();
+  }
+
+  // The compensation tables and ballbar calibrations of the local store, each stored once
+  // (identified by a fingerprint of its content), in the local order (so a server filled from
+  // one store numbers them as it does).
+  void send_records() {
+    pqxx::work w(*conn_);
+    for (const auto& c : local_.compensations()) {
+      const auto machine_id = server_machine(w, c.machine_id);
+      std::string source_uuid;
+      if (c.source_run_id > 0)
+        if (const auto run = local_.run(c.source_run_id)) source_uuid = run->uuid;
+      w.exec_params(
+          "INSERT INTO caldaq.compensations(machine_id, source_run_uuid, source, axis, format, "
+          "created_unix_ms, json, fingerprint) VALUES(NULLIF($1::text, '')::bigint, "
+          "NULLIF($2::text, '')::uuid, $3::text, $4::text, $5::text, $6::bigint, $7::text, "
+          "md5(concat_ws('|', $1::text, $2::text, $3::text, $4::text, $5::text, "
+          "$6::bigint::text, $7::text))) ON CONFLICT (fingerprint) DO NOTHING",
+          machine_id, source_uuid, c.source, c.axis, c.format, c.created_unix_ms, c.json);
+    }
+    for (const auto& c : local_.bar_calibrations())
+      w.exec_params(
+          "INSERT INTO caldaq.bar_calibrations(bar, nominal_mm, extensions, calibrator, "
+          "calibrator_length_mm, reading_mm, zero_length_mm, temperature_degc, "
+          "calibrated_unix_ms, note, fingerprint) VALUES($1::text, $2::float8, $3::text, "
+          "$4::text, $5::float8, $6::float8, $7::float8, NULLIF($8::text, '')::float8, "
+          "$9::bigint, $10::text, md5(concat_ws('|', $1::text, $2::float8::text, $3::text, "
+          "$4::text, $5::float8::text, $6::float8::text, $9::bigint::text))) "
+          "ON CONFLICT (fingerprint) DO NOTHING",
+          c.bar, c.nominal_mm, c.extensions, c.calibrator, c.calibrator_length_mm, c.reading_mm,
+          c.zero_length_mm, c.temperature_degc ? fmt::format("{}", *c.temperature_degc) : "",
+          c.calibrated_unix_ms, c.note);
+    w.commit();
+  }
+
   // The run's row and everything small of it, in one transaction; returns the run's id in the
   // store the server's copy came from (this one's unless a copy of this database synced it).
   std::int64_t send_metadata(const RunRecord& r) {
     pqxx::work w(*conn_);
-    std::string machine_id;
-    if (r.machine_id > 0) {
-      if (const auto m = local_.machine(r.machine_id)) {
-        // Machines are known by name: a no-op update returns the id of an existing one.
-        const auto row = w.exec_params1(
-            "INSERT INTO caldaq.machines(name, description, config_json) VALUES($1, $2, $3) "
-            "ON CONFLICT (name) DO UPDATE SET name = EXCLUDED.name RETURNING id",
-            m->name, m->description, m->config_json);
-        machine_id = row[0].as<std::string>();
-      }
-    }
+    const std::string machine_id = server_machine(w, r.machine_id);
     const auto existing =
         w.exec_params("SELECT source_run_id FROM caldaq.runs WHERE uuid = $1 FOR UPDATE", r.uuid);
     if (existing.empty()) ++report_.runs_new;
@@ -201,7 +240,7 @@ class Sync {
   // is stored once however often it is sent.
   void send_children(pqxx::work& w, const RunRecord& r) {
     for (const char* table :
-         {"instruments", "captured_targets", "missed_stops", "operator_actions"})
+         {"instruments", "captured_targets", "missed_stops", "operator_actions", "suspect_stops"})
       w.exec_params(fmt::format("DELETE FROM caldaq.{} WHERE run_uuid = $1", table), r.uuid);
     for (const auto& i : local_.instruments(r.id))
       w.exec_params(
@@ -220,7 +259,20 @@ class Sync {
           "INSERT INTO caldaq.missed_stops(run_uuid, run_number, direction, target_index, "
           "nominal_mm) VALUES($1, $2, $3, $4, $5)",
           r.uuid, m.run_number, std::string(1, m.direction), m.target_index, m.nominal_mm);
+    const auto quality = local_.quality(r.id);
+    w.exec_params(
+        "UPDATE caldaq.runs SET quality_state = NULLIF($2, ''), quality_summary = $3 "
+        "WHERE uuid = $1",
+        r.uuid, quality ? quality->state : "", quality ? quality->summary : "");
     int ordinal = 0;
+    if (quality)
+      for (const auto& m : quality->suspects)
+        w.exec_params(
+            "INSERT INTO caldaq.suspect_stops(run_uuid, ordinal, run_number, direction, "
+            "target_index, reason) VALUES($1, $2, $3, $4, $5, $6)",
+            r.uuid, ordinal++, m.run_number, std::string(1, m.direction), m.target_index,
+            m.reason);
+    ordinal = 0;
     for (const auto& a : local_.operator_actions(r.id)) {
       const bool has_stop = a.stop.has_value();
       w.exec_params(

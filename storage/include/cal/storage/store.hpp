@@ -17,8 +17,6 @@
 #include <string_view>
 #include <vector>
 
-#include "cal/storage/run_reader.hpp"
-
 namespace cal::storage {
 
 // Every storage failure: the message names the database file and what failed (SQLite's own
@@ -213,6 +211,86 @@ struct StoreOptions {
 
 class ReadingStream;
 
+// The series of a run (one per device, channel and quantity) with their counts and time spans,
+// from the chunks' rows alone (no reading is decoded).
+struct SeriesInfo {
+  std::uint16_t device = 0;
+  std::uint8_t channel = 0, quantity = 0;
+  std::int64_t count = 0, first_ns = 0, last_ns = 0;
+};
+
+// What every read command reads, from either store (issue 35): the local SQLite file (Store) or
+// the central store on PostgreSQL (cal::storage::pg::open_central). One interface, two
+// implementations; `daq runs`, `show`, `export`, `report`, `analyse RUN`, `model build` and
+// `ballbar history` read through it. Ids are those of the store read (the central store numbers
+// runs in the order it first saw them; a result keeps the id it had where it was made).
+class RunReader {
+ public:
+  virtual ~RunReader() = default;
+  // The file, or the server's URI with its password hidden: what listings and messages name.
+  virtual std::string name() const = 0;
+  virtual std::optional<MachineRecord> machine_by_name(std::string_view name) const = 0;
+  virtual std::optional<MachineRecord> machine(std::int64_t id) const = 0;
+  // Every run, by id.
+  virtual std::vector<RunRecord> runs() const = 0;
+  virtual std::optional<RunRecord> run(std::int64_t run_id) const = 0;
+  virtual std::vector<InstrumentRecord> instruments(std::int64_t run_id) const = 0;
+  virtual std::int64_t reading_count(std::int64_t run_id) const = 0;
+  // A run's readings in order, a batch at a time, in bounded memory (see ReadingStream). Order:
+  // time, then device, channel, quantity; readings of one series with equal times in the order
+  // they were stored. `quantities` (cal::drivers::Quantity values; empty: all) selects whole
+  // series. Every chunk's checksum is verified as it is read; a damaged chunk throws StoreError
+  // naming the run and the chunk. The stream must not outlive its reader.
+  virtual ReadingStream stream_readings(std::int64_t run_id,
+                                        std::span<const std::uint8_t> quantities = {}) const = 0;
+  // All readings of a run (or of these quantities) at once, in the same order: for runs known
+  // to be short. The memory is the run's size; prefer stream_readings.
+  std::vector<RawReading> readings(std::int64_t run_id) const;
+  std::vector<RawReading> readings(std::int64_t run_id,
+                                   std::span<const std::uint8_t> quantities) const;
+  virtual std::vector<SeriesInfo> series(std::int64_t run_id) const = 0;
+  virtual std::vector<CapturedTarget> targets(std::int64_t run_id) const = 0;
+  // Every result of the run, oldest first, with its provenance and whether it is current.
+  virtual std::vector<ResultRecord> results(std::int64_t run_id) const = 0;
+  // nullopt: never stored (see Store::quality).
+  virtual std::optional<RunQuality> quality(std::int64_t run_id) const = 0;
+  virtual std::vector<MissedStop> missed_stops(std::int64_t run_id) const = 0;
+  virtual std::vector<OperatorAction> operator_actions(std::int64_t run_id) const = 0;
+  // Ballbar calibrations: every one, or those of one bar, oldest first; the newest of the bar at
+  // this nominal length (within 1 um) made at or before the time.
+  virtual std::vector<BarCalibration> bar_calibrations(std::string_view bar = {}) const = 0;
+  virtual std::optional<BarCalibration> bar_calibration(std::string_view bar, double nominal_mm,
+                                                        std::int64_t at_unix_ms) const = 0;
+  // Compensation tables written, of a machine's axis, oldest first (machine_id 0 / axis "": any).
+  virtual std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
+                                                        std::string_view axis = {}) const = 0;
+};
+
+// A reading chunk as a store hands it to a ReadingStream: its row and its bytes.
+struct SourceChunk {
+  std::int64_t order = 0;  // the order written among chunks of equal first times (SQLite's row)
+  std::optional<std::int64_t> seq;  // its number in the run (unset: written before schema 3)
+  std::int64_t device = 0, channel = 0, quantity = 0;
+  std::int64_t first_ns = 0, last_ns = 0, count = 0, encoding = 0;
+  std::optional<std::uint32_t> crc;  // the stored checksum (unset: none, before schema 3)
+  std::vector<unsigned char> data;
+};
+
+// Where a ReadingStream gets its chunks from: one implementation per store.
+class ChunkSource {
+ public:
+  virtual ~ChunkSource() = default;
+  // The next chunk of the run (with the stream's quantities) in the order of (first_ns,
+  // order); false when none are left.
+  virtual bool next(SourceChunk& out) = 0;
+  // The numbered chunks of the run (with the stream's quantities) by the store's other index:
+  // their count and largest seq (-1: none). nullopt: the store does not number chunks.
+  struct Numbered {
+    std::int64_t count = 0, max_seq = -1;
+  };
+  virtual std::optional<Numbered> numbered() = 0;
+};
+
 // A batch of readings grouped into its chunks (one per device/channel/quantity, in order of
 // first appearance) and encoded: what Store::append_readings stores, prepared apart so that a
 // writer can encode one batch while the store commits the previous one.
@@ -250,17 +328,17 @@ class Store : public RunReader {
   bool read_only() const;
 
   std::int64_t add_machine(const MachineRecord& m);
-  std::optional<MachineRecord> machine_by_name(std::string_view name) const;
-  std::optional<MachineRecord> machine(std::int64_t id) const;
+  std::optional<MachineRecord> machine_by_name(std::string_view name) const override;
+  std::optional<MachineRecord> machine(std::int64_t id) const override;
 
   std::int64_t begin_run(const RunRecord& r);  // returns the new run id
   void add_instrument(const InstrumentRecord& i);
   void finish_run(std::int64_t run_id, RunStatus status, std::string_view note = {});
   void set_capture_path(std::int64_t run_id, std::string_view path);
   std::vector<RunRecord> runs() const override;
-  std::optional<RunRecord> run(std::int64_t run_id) const;
+  std::optional<RunRecord> run(std::int64_t run_id) const override;
   std::optional<RunRecord> run_by_uuid(std::string_view uuid) const;
-  std::vector<InstrumentRecord> instruments(std::int64_t run_id) const;
+  std::vector<InstrumentRecord> instruments(std::int64_t run_id) const override;
 
   // Appends readings in one transaction: one chunk per device/channel/quantity, each with its
   // sequence number in the run and its checksum (chunk.hpp).
@@ -275,22 +353,13 @@ class Store : public RunReader {
   // Every chunk's checksum is verified as it is read; a damaged chunk throws StoreError naming
   // the run and the chunk. The stream uses this store's connection: it must not outlive it.
   ReadingStream stream_readings(std::int64_t run_id,
-                                std::span<const std::uint8_t> quantities = {}) const;
-  // All readings of a run (or of these quantities) at once, in the same order: for runs known
-  // to be short. The memory is the run's size; prefer stream_readings.
-  std::vector<RawReading> readings(std::int64_t run_id) const;
-  std::vector<RawReading> readings(std::int64_t run_id,
-                                   std::span<const std::uint8_t> quantities) const;
+                                std::span<const std::uint8_t> quantities = {}) const override;
+  using RunReader::readings;  // all at once (RunReader::readings)
   std::int64_t reading_count(std::int64_t run_id) const override;
-  // The series of a run (one per device, channel and quantity) with their counts and time
-  // spans, from the chunks' rows alone (no reading is decoded): what a reader needs to know
-  // before it streams, e.g. how far to thin a series for a plot.
-  struct Series {
-    std::uint16_t device = 0;
-    std::uint8_t channel = 0, quantity = 0;
-    std::int64_t count = 0, first_ns = 0, last_ns = 0;
-  };
-  std::vector<Series> series(std::int64_t run_id) const;
+  // The series of a run from the chunks' rows alone (no reading is decoded): what a reader
+  // needs to know before it streams, e.g. how far to thin a series for a plot.
+  using Series = SeriesInfo;
+  std::vector<Series> series(std::int64_t run_id) const override;
 
   // A reading chunk as stored, its BLOB not decoded: what daq sync copies to the central store.
   struct StoredChunk {
@@ -311,14 +380,14 @@ class Store : public RunReader {
   std::int64_t chunk_count(std::int64_t run_id) const;
 
   void add_targets(std::span<const CapturedTarget> targets);
-  std::vector<CapturedTarget> targets(std::int64_t run_id) const;
+  std::vector<CapturedTarget> targets(std::int64_t run_id) const override;
   // Replaces the targets of a run (re-compensation keeps the raw values, changes deviations).
   void replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets);
 
   // Stores a result (returns its id) and marks the earlier ones it makes out of date.
   std::int64_t add_result(const ResultRecord& r, Supersede s = Supersede::same_standard);
   // Every result of the run, oldest first, with its provenance and whether it is current.
-  std::vector<ResultRecord> results(std::int64_t run_id) const;
+  std::vector<ResultRecord> results(std::int64_t run_id) const override;
   // Re-compensation in one transaction: the new deviations of the stops and the result made
   // from them, which supersedes every earlier result (a crash leaves the old pair intact).
   std::int64_t replace_targets(std::int64_t run_id, std::span<const CapturedTarget> targets,
@@ -330,12 +399,12 @@ class Store : public RunReader {
   void set_quality(std::int64_t run_id, const RunQuality& q);
   // nullopt: never stored (a run stored before schema 5, an import; an older database opened
   // read-only): assess it from its stops (daq's run_quality()).
-  std::optional<RunQuality> quality(std::int64_t run_id) const;
-  std::vector<MissedStop> missed_stops(std::int64_t run_id) const;
+  std::optional<RunQuality> quality(std::int64_t run_id) const override;
+  std::vector<MissedStop> missed_stops(std::int64_t run_id) const override;
   // The operator's actions of a run (OperatorAction), stored one by one as they happen, and read
   // back in that order. An unknown action is refused by the schema (StoreError).
   void add_operator_action(const OperatorAction& a);
-  std::vector<OperatorAction> operator_actions(std::int64_t run_id) const;
+  std::vector<OperatorAction> operator_actions(std::int64_t run_id) const override;
   // The session clock reading at a UTC instant (ns since the Unix epoch), see RunRecord.
   void set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::int64_t unix_ns);
 
@@ -343,17 +412,17 @@ class Store : public RunReader {
   // non-positive length, or an empty bar identity.
   std::int64_t add_bar_calibration(const BarCalibration& c);
   // Every calibration, or those of one bar, oldest first.
-  std::vector<BarCalibration> bar_calibrations(std::string_view bar = {}) const;
+  std::vector<BarCalibration> bar_calibrations(std::string_view bar = {}) const override;
   // The newest calibration of the bar at this nominal length (within 1 um) made at or before
   // the time, or nullopt.
   std::optional<BarCalibration> bar_calibration(std::string_view bar, double nominal_mm,
-                                                std::int64_t at_unix_ms) const;
+                                                std::int64_t at_unix_ms) const override;
 
   // Compensation tables written (returns the new id), and those of a machine's axis, oldest
   // first (machine_id 0 / axis "": any).
   std::int64_t add_compensation(const CompensationRecord& c);
   std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
-                                                std::string_view axis = {}) const;
+                                                std::string_view axis = {}) const override;
   struct Impl;  // implementation, shared with ReadingStream (store.cpp)
 
  private:
@@ -375,8 +444,15 @@ class ReadingStream {
   bool next(std::vector<RawReading>& out, std::size_t max_readings = 65536);
   std::uint64_t chunks_read() const;
 
+  // The stream of a run's chunks from `source`. `where` names the store and `run_id` the run in
+  // messages; the checksums cover `checksum_run_id`, the run's id in the store that wrote the
+  // chunks (the central store keeps the laptop's id of a run beside its own). `whole_run`: the
+  // source gives every series of the run (no quantity filter), so the chunks' numbers must be
+  // 0 .. n - 1.
+  static ReadingStream of(std::unique_ptr<ChunkSource> source, std::string where,
+                          std::int64_t run_id, std::int64_t checksum_run_id, bool whole_run);
+
  private:
-  friend class Store;
   struct Impl;
   explicit ReadingStream(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;

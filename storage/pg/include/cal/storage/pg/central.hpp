@@ -4,7 +4,7 @@
 #include <memory>
 #include <string_view>
 
-#include "cal/storage/run_reader.hpp"
+#include "cal/storage/store.hpp"
 
 namespace cal::storage::pg {
 

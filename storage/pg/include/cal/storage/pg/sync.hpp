@@ -18,7 +18,9 @@ namespace cal::storage::pg {
 // The central schema's version (table caldaq.schema_version), migrated by open/sync.
 // 1 (issue 35): machines, runs keyed by UUID, instruments, reading chunks with their checksums,
 // captured stops, missed stops, results with provenance, the operator's actions.
-inline constexpr int central_schema_version = 1;
+// 2: the stop quality as rows (suspect stops), compensation tables, ballbar calibrations: what
+// the read commands read from either store.
+inline constexpr int central_schema_version = 2;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
