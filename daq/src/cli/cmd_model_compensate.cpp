@@ -343,6 +343,7 @@ std::vector<std::string> say_origin(Written& w, const std::string& format,
 
 void run(const Options& o) {
   const mdl::Model m = mdl::read(o.file);
+  mdl::require_no_rotary(m, o.file, "daq model compensate (the linear axes' tables)");
   const auto g = grid_of(o, m);
   const kin::Vec3 ref = reference_of(o, g);
   const auto tables = vc::cross_tables(m.machine, g, ref, m.carriers);
