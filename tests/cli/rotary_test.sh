@@ -30,7 +30,8 @@ check map_grid 0 "largest \|e\| +24\.000 um at \([0-9.]+, [0-9.]+, -?[0-9.]+\) m
 check map_rank 0 "1\. E_X0C +24\.000 um" -- "$DAQ" model map "$TMP/x0c.json" --count 2 2 2
 check map_grid_trunnion 0 "Five-axis error of .*: 125 poses" -- "$DAQ" model map "$T" --count 5 1 1 --angle-count 5
 check map_json 0 '"schema": "caldaq.five-axis-map.v1"' -- "$DAQ" model map "$T" --count 2 2 2 --angle-count 2 --json
-check map_no_column 2 "c_deg" -- "$DAQ" model map "$T" --points "$DATA/../model/yfxz.json"
+printf 'x_mm,y_mm,z_mm\n0,0,0\n' >"$TMP/xyz.csv"
+check map_no_column 2 "xyz.csv.*c_deg" -- "$DAQ" model map "$T" --points "$TMP/xyz.csv"
 check map_report_refused 2 "rotary: --report does not draw" -- "$DAQ" model map "$T" --report "$TMP/m.html"
 check compensate_refused 2 "rotary: daq model compensate .* does not model rotary axes yet" -- "$DAQ" model compensate "$T" -f csv --interval-mm 50 50 50
 check v1_still_maps 0 "largest \|e\|" -- "$DAQ" model map "$DATA/yfxz.json" --count 2 2 2
@@ -85,7 +86,7 @@ check too_few 2 "two.csv: the C axis's 2 centres \(lines 2 \.\. 3\): .*3" -- "$D
 printf 'axis,angle_deg,x_mm,y_mm,z_mm\nB,0,1,2,3\n' >"$TMP/b.csv"
 check no_such_axis 2 "the model has no such rotary axis" -- "$DAQ" model probe "$TMP/b.csv" --model "$NOM"
 check no_pivot 2 "give --model .* or --axis and --pivot-mm" -- "$DAQ" model probe "$TMP/b.csv"
-check no_zero 2 "no centre of the C axis at 0 deg" -- "$DAQ" model probe-check <(grep -v ',0,' "$TMP/centres1.csv") --model "$NOM"
+check no_zero 2 "no centre of the [AC] axis at 0 deg" -- "$DAQ" model probe-check <(grep -v ',0,' "$TMP/centres1.csv") --model "$NOM"
 printf 'loadrt xyzac-trt-kins\n' >"$TMP/bad.hal"
 check bad_hal 2 "bad.hal:1: 'loadrt': expected setp" -- "$DAQ" model probe-check "$TMP/centres1.csv" --model "$NOM" --hal "$TMP/bad.hal"
 check kins_refused 2 "rotary: LinuxCNC's trunnion kinematics .* \[C table, A table\]" -- "$DAQ" model kinematics "$TMP/x0c.json"

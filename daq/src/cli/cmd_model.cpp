@@ -452,7 +452,7 @@ void add_model_commands(CLI::App& app) {
   map->add_option("--angle-count", o->angle_count,
                   "With rotary axes: angles per rotary axis over its range_deg")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+      ->check(whole_in(1, 1000));
   map->add_option("--method", o->method, "htm (exact) or first-order")->capture_default_str();
   map->add_option("--report", o->report,
                   "Also write an HTML page: error vectors in three slices, contributions ranked");
