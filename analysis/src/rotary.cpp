@@ -336,8 +336,8 @@ Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
   Vector3d p = solve.solve(s - b);
   for (int it = 0; it < 8; ++it) {
     const Vector3d actual =
-        tip(p) + kMmPerUm * vec(five_axis_error(machine, arr(p), angles_deg, Method::htm)
-                                    .translation_um);
+        tip(p) +
+        kMmPerUm * vec(five_axis_error(machine, arr(p), angles_deg, Method::htm).translation_um);
     const Vector3d miss = actual - s;
     p -= solve.solve(miss);
     if (miss.norm() < 1e-12) break;

@@ -69,7 +69,8 @@ std::string linuxcnc_trt_hal(const TrtPins& p, std::string_view origin_comment) 
       "# Per LinuxCNC src/emc/kinematics/trtfuncs.c: the C axis at (x-rot-point, y-rot-point);\n"
       "# {}\n"
       "# tool-offset is LinuxCNC's tool length (net to motion.tooloffset.z), not set here.\n"
-      "# If the configuration nets a pin to a signal, set the signal instead (sets SIGNAL VALUE).\n",
+      "# If the configuration nets a pin to a signal, set the signal instead (sets SIGNAL "
+      "VALUE).\n",
       p.module,
       p.module == "xyzac-trt-kins"
           ? "the A axis at (y-rot-point + y-offset, z-rot-point + z-offset + tool-offset)."
@@ -111,19 +112,20 @@ TrtPins parse_linuxcnc_trt_hal(std::string_view hal, std::string_view where) {
     std::string cmd, name, value, extra;
     in >> cmd;
     if (cmd.empty() || cmd[0] == '#') continue;
-    if (cmd != "setp") fail(fmt::format("'{}': expected setp MODULE.PIN VALUE", text::terminal_safe(cmd)));
+    if (cmd != "setp")
+      fail(fmt::format("'{}': expected setp MODULE.PIN VALUE", text::terminal_safe(cmd)));
     in >> name >> value;
-    if (value.empty() || (in >> extra && extra[0] != '#'))
-      fail("expected setp MODULE.PIN VALUE");
+    if (value.empty() || (in >> extra && extra[0] != '#')) fail("expected setp MODULE.PIN VALUE");
     const auto dot = name.find('.');
     const std::string module = name.substr(0, dot);
     if (module != "xyzac-trt-kins" && module != "xyzbc-trt-kins")
-      fail(fmt::format("'{}' is not xyzac-trt-kins or xyzbc-trt-kins", text::terminal_safe(module)));
+      fail(
+          fmt::format("'{}' is not xyzac-trt-kins or xyzbc-trt-kins", text::terminal_safe(module)));
     if (!p.module.empty() && module != p.module)
       fail(fmt::format("{} after {}: one module per file", module, p.module));
     p.module = module;
     const std::string pin = dot == std::string::npos ? "" : name.substr(dot + 1);
-    double* slot = pin == "x-rot-point" ? &p.x_rot_point_mm
+    double* slot = pin == "x-rot-point"   ? &p.x_rot_point_mm
                    : pin == "y-rot-point" ? &p.y_rot_point_mm
                    : pin == "z-rot-point" ? &p.z_rot_point_mm
                    : pin == "x-offset"    ? &p.x_offset_mm
@@ -131,9 +133,10 @@ TrtPins parse_linuxcnc_trt_hal(std::string_view hal, std::string_view where) {
                    : pin == "z-offset"    ? &p.z_offset_mm
                                           : nullptr;
     if (!slot)
-      fail(fmt::format("'{}' is not a pivot pin (x-rot-point, y-rot-point, z-rot-point, x-offset, "
-                       "y-offset, z-offset)",
-                       text::terminal_safe(pin)));
+      fail(
+          fmt::format("'{}' is not a pivot pin (x-rot-point, y-rot-point, z-rot-point, x-offset, "
+                      "y-offset, z-offset)",
+                      text::terminal_safe(pin)));
     if (std::find(seen.begin(), seen.end(), pin) != seen.end()) fail(pin + " given twice");
     seen.push_back(pin);
     char* end = nullptr;
@@ -142,15 +145,16 @@ TrtPins parse_linuxcnc_trt_hal(std::string_view hal, std::string_view where) {
       fail(fmt::format("'{}' is not a value in mm", text::terminal_safe(value)));
     *slot = v;
   }
-  if (p.module.empty()) throw InputError(fmt::format("{}: no setp line of a trunnion module", where));
+  if (p.module.empty())
+    throw InputError(fmt::format("{}: no setp line of a trunnion module", where));
   return p;
 }
 
 FiveAxisMachine trt_control_machine(const TrtPins& pins, const FiveAxisMachine& model) {
   const TrtPins shape = linuxcnc_trt_pins(model);  // checks the chain
   if (shape.module != pins.module)
-    throw InputError(fmt::format("the pins are {}'s, the model's trunnion is {}", pins.module,
-                                 shape.module));
+    throw InputError(
+        fmt::format("the pins are {}'s, the model's trunnion is {}", pins.module, shape.module));
   FiveAxisMachine m = model;
   for (RotaryAxis& r : m.rotary) {
     r.location_position_um = {};

@@ -577,8 +577,8 @@ TEST(RotarySphereProbing, SimulatedCentresAreTheRotationAboutTheActualLine) {
 // component and linear errors.
 TEST(RotarySphereProbing, TheLibrarysSimulatedProbeIsTheTestsOwn) {
   const FiveAxisMachine m = trunnion();
-  for (const auto& [c, a] : {std::pair{0.0, 0.0}, {75.0, 0.0}, {200.0, 0.0}, {0.0, -60.0},
-                             {120.0, 35.0}}) {
+  for (const auto& [c, a] :
+       {std::pair{0.0, 0.0}, {75.0, 0.0}, {200.0, 0.0}, {0.0, -60.0}, {120.0, 35.0}}) {
     const std::vector angles{c, a};
     expect_near(probed_centre_mm(m, kSphere, angles), probe(m, kSphere, c, a), 1e-9,
                 "C, A = " + std::to_string(c) + ", " + std::to_string(a));

@@ -40,11 +40,11 @@ FiveAxisMachine trunnion(RotaryLetter cradle, const Vec3& c_orient = {}) {
 TEST(TrtKins, XyzacPinsByHand) {
   const auto p = linuxcnc_trt_pins(trunnion(RotaryLetter::a, {20, -8, 0}));
   EXPECT_EQ(p.module, "xyzac-trt-kins");
-  EXPECT_NEAR(p.x_rot_point_mm, 10.012, 1e-12);   // 10 mm + E_X0C 12 um
-  EXPECT_NEAR(p.y_rot_point_mm, 19.995, 1e-12);   // 20 mm + E_Y0C -5 um
-  EXPECT_NEAR(p.z_rot_point_mm, -300.0, 1e-12);   // the C pivot's height
-  EXPECT_NEAR(p.y_offset_mm, 25.007 - 19.995, 1e-12);     // A at y = 25 mm + E_Y0A 7 um
-  EXPECT_NEAR(p.z_offset_mm, -280.015 + 300.0, 1e-12);    // A at z = -280 mm + E_Z0A -15 um
+  EXPECT_NEAR(p.x_rot_point_mm, 10.012, 1e-12);         // 10 mm + E_X0C 12 um
+  EXPECT_NEAR(p.y_rot_point_mm, 19.995, 1e-12);         // 20 mm + E_Y0C -5 um
+  EXPECT_NEAR(p.z_rot_point_mm, -300.0, 1e-12);         // the C pivot's height
+  EXPECT_NEAR(p.y_offset_mm, 25.007 - 19.995, 1e-12);   // A at y = 25 mm + E_Y0A 7 um
+  EXPECT_NEAR(p.z_offset_mm, -280.015 + 300.0, 1e-12);  // A at z = -280 mm + E_Z0A -15 um
   EXPECT_EQ(p.x_offset_mm, 0.0);
   ASSERT_EQ(p.not_represented.size(), 4u);
   EXPECT_EQ(p.not_represented[0], "E_A0C 20 urad");
@@ -85,15 +85,13 @@ TEST(TrtKins, ThePinsLinesAreTheModelsActualLines) {
     const FiveAxisMachine m = trunnion(cradle);  // position errors only: the module's freedom
     const auto p = linuxcnc_trt_pins(m);
     const Vec3 c_point{p.x_rot_point_mm, p.y_rot_point_mm, 0.0};
-    const Vec3 tilt_point = cradle == RotaryLetter::a
-                                ? Vec3{0.0, p.y_rot_point_mm + p.y_offset_mm,
-                                       p.z_rot_point_mm + p.z_offset_mm}
-                                : Vec3{p.x_rot_point_mm + p.x_offset_mm, 0.0,
-                                       p.z_rot_point_mm + p.z_offset_mm};
+    const Vec3 tilt_point =
+        cradle == RotaryLetter::a
+            ? Vec3{0.0, p.y_rot_point_mm + p.y_offset_mm, p.z_rot_point_mm + p.z_offset_mm}
+            : Vec3{p.x_rot_point_mm + p.x_offset_mm, 0.0, p.z_rot_point_mm + p.z_offset_mm};
     const Vec3 w{60, -40, -230};
     for (const auto& [c, t] : {std::pair{0.0, 0.0}, {90.0, 0.0}, {0.0, 45.0}, {215.0, -70.0}}) {
-      const Vec3 want =
-          turn(turn(w, c_point, 2, c), tilt_point, direction_index(cradle), t);
+      const Vec3 want = turn(turn(w, c_point, 2, c), tilt_point, direction_index(cradle), t);
       const std::vector angles{c, t};
       const Vec3 got = probed_centre_mm(m, w, angles);
       for (std::size_t k = 0; k < 3; ++k)

@@ -210,11 +210,13 @@ void print_rotary(const mdl::RotaryEntry& r) {
   std::size_t n = 0;
   for (std::size_t slot = 0; slot < 6; ++slot) {
     if (slot % 3 == own) continue;
-    const double v = slot < 3 ? a.location_position_um[slot] : a.location_orientation_urad[slot - 3];
+    const double v =
+        slot < 3 ? a.location_position_um[slot] : a.location_orientation_urad[slot - 3];
     const auto& e = r.location[n];
     const char* unit = slot < 3 ? "um" : "urad";
-    print_line("  {:6} {:44} {:+.3f} {}{}", names[n], e.given ? "location error" : "not given (zero)",
-               v, unit, e.uncertainty ? fmt::format(" (u = {:.3f} {})", *e.uncertainty, unit) : "");
+    print_line("  {:6} {:44} {:+.3f} {}{}", names[n],
+               e.given ? "location error" : "not given (zero)", v, unit,
+               e.uncertainty ? fmt::format(" (u = {:.3f} {})", *e.uncertainty, unit) : "");
     ++n;
   }
   for (std::size_t d = 0; d < 6; ++d) {
@@ -228,7 +230,7 @@ void print_rotary(const mdl::RotaryEntry& r) {
     }
     print_line("  {:6} {:44} {:.3f} .. {:.3f} {} over the range", name,
                f.is_table() ? fmt::format("table, {} points", f.positions_mm().size())
-                                : "polynomial in the angle (deg)",
+                            : "polynomial in the angle (deg)",
                lo, hi, d < 3 ? "um" : "urad");
   }
 }

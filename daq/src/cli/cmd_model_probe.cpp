@@ -49,9 +49,9 @@ struct AxisCentres {
 // its "axis" column says which (A, B or C).
 std::map<kin::RotaryLetter, AxisCentres> read_centres(const ProbeOptions& o) {
   const bool by_column = o.axis.empty();
-  const auto csv = read_csv_columns(o.centres, {"angle_deg", "x_mm", "y_mm", "z_mm"},
-                                    by_column ? std::vector<std::string>{"axis"}
-                                              : std::vector<std::string>{});
+  const auto csv =
+      read_csv_columns(o.centres, {"angle_deg", "x_mm", "y_mm", "z_mm"},
+                       by_column ? std::vector<std::string>{"axis"} : std::vector<std::string>{});
   std::map<kin::RotaryLetter, AxisCentres> out;
   const kin::RotaryLetter fixed =
       by_column ? kin::RotaryLetter::c : kin::rotary_letter_from_string(o.axis);
@@ -65,9 +65,9 @@ std::map<kin::RotaryLetter, AxisCentres> read_centres(const ProbeOptions& o) {
       letter = kin::rotary_letter_from_string(s);
     }
     auto& a = out[letter];
-    a.centres.push_back({csv.numbers.at("angle_deg")[r],
-                         {csv.numbers.at("x_mm")[r], csv.numbers.at("y_mm")[r],
-                          csv.numbers.at("z_mm")[r]}});
+    a.centres.push_back(
+        {csv.numbers.at("angle_deg")[r],
+         {csv.numbers.at("x_mm")[r], csv.numbers.at("y_mm")[r], csv.numbers.at("z_mm")[r]}});
     a.lines.push_back(csv.line[r]);
   }
   return out;
@@ -79,14 +79,16 @@ kin::Vec3 pivot_of(const ProbeOptions& o, const std::optional<mdl::Model>& m, ki
   for (const auto& r : m->rotary) {
     if (r.axis.letter != l) continue;
     if (r.axis.side != kin::Side::table)
-      throw cal::InputError(fmt::format("{}: the {} axis is on the spindle side: sphere probing "
-                                        "fits table axes only (docs/kinematics.md)",
-                                        o.model, kin::to_string(l)));
+      throw cal::InputError(
+          fmt::format("{}: the {} axis is on the spindle side: sphere probing "
+                      "fits table axes only (docs/kinematics.md)",
+                      o.model, kin::to_string(l)));
     return r.axis.pivot_mm;
   }
-  throw cal::InputError(fmt::format("{}: {} has centres of the {} axis, the model has no such "
-                                    "rotary axis",
-                                    o.centres, o.model, kin::to_string(l)));
+  throw cal::InputError(
+      fmt::format("{}: {} has centres of the {} axis, the model has no such "
+                  "rotary axis",
+                  o.centres, o.model, kin::to_string(l)));
 }
 
 json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
@@ -99,7 +101,8 @@ json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentr
     const bool pos = slot < 3;
     const double v = pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
     const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
-    loc[names[n++]] = {{"value", v}, {"uncertainty", std::isnan(u) ? json(nullptr) : json(u)},
+    loc[names[n++]] = {{"value", v},
+                       {"uncertainty", std::isnan(u) ? json(nullptr) : json(u)},
                        {"unit", pos ? "um" : "urad"}};
   }
   json res = json::array();
@@ -138,11 +141,12 @@ void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCent
   }
   fmt::print("  circle radius {:.4f} mm, its plane {:+.4f} mm from the pivot along the axis\n",
              f.radius_mm, f.plane_offset_mm);
-  fmt::print("  residuals (the axis's error motion at the sphere, and probing noise): RMS {:.3f} "
-             "um, sigma {:.3f} um, {} degrees of freedom\n",
-             f.rms_um, f.sigma_um, f.dof);
-  fmt::print("  {:>6} {:>10} {:>10} {:>10} {:>12}\n", "line", "angle_deg", "radial_um",
-             "axial_um", "tangential_um");
+  fmt::print(
+      "  residuals (the axis's error motion at the sphere, and probing noise): RMS {:.3f} "
+      "um, sigma {:.3f} um, {} degrees of freedom\n",
+      f.rms_um, f.sigma_um, f.dof);
+  fmt::print("  {:>6} {:>10} {:>10} {:>10} {:>12}\n", "line", "angle_deg", "radial_um", "axial_um",
+             "tangential_um");
   for (std::size_t k = 0; k < a.centres.size(); ++k)
     fmt::print("  {:6} {:10.3f} {:+10.3f} {:+10.3f} {:+12.3f}\n", a.lines[k],
                a.centres[k].angle_deg, f.radial_um[k], f.axial_um[k], f.tangential_um[k]);
@@ -163,11 +167,12 @@ void put_fit(mdl::RotaryEntry& r, const kin::AxisLineFit& f, const std::string& 
     auto& e = r.location[n++];
     e.given = true;
     e.uncertainty = std::isnan(u) ? std::optional<double>{} : std::optional<double>{u};
-    e.source = {json{{"kind", "sphere probing"},
-                     {"centres_file", centres},
-                     {"centres", count},
-                     {"rms_um", f.rms_um}}
-                    .dump()};
+    e.source = {json{
+        {"kind", "sphere probing"},
+        {"centres_file", centres},
+        {"centres", count},
+        {"rms_um",
+         f.rms_um}}.dump()};
   }
 }
 
@@ -259,9 +264,10 @@ void run_probe_check(const CheckOptions& o) {
       return std::abs(std::remainder(c.angle_deg, 360.0)) < 1e-9;
     });
     if (zero == a.centres.end())
-      throw cal::InputError(fmt::format("{}: no centre of the {} axis at 0 deg (the sphere's place "
-                                        "on the workpiece is taken there)",
-                                        o.centres, kin::to_string(letter)));
+      throw cal::InputError(
+          fmt::format("{}: no centre of the {} axis at 0 deg (the sphere's place "
+                      "on the workpiece is taken there)",
+                      o.centres, kin::to_string(letter)));
     kin::Vec3 sphere = zero->centre_mm;
     for (int it = 0; it < 6; ++it) {
       const auto at0 = kin::probed_centre_mm(control, sphere, angles_at(zero->angle_deg));
@@ -356,20 +362,24 @@ void add_model_probe_commands(CLI::App& model) {
       "Fit each rotary table axis's average line to probed sphere centres (a CSV: axis, "
       "angle_deg, x_mm, y_mm, z_mm): its location errors with their uncertainty and the "
       "residuals");
-  probe->add_option("centres", p->centres,
-                    "CSV of probed centres in machine coordinates: angle_deg, x_mm, y_mm, z_mm, "
-                    "and axis (A, B or C) unless --axis is given")
+  probe
+      ->add_option("centres", p->centres,
+                   "CSV of probed centres in machine coordinates: angle_deg, x_mm, y_mm, z_mm, "
+                   "and axis (A, B or C) unless --axis is given")
       ->required();
   probe->add_option("--model", p->model,
                     "Model file (caldaq.model.v2) giving each table axis's nominal pivot");
-  probe->add_option("--axis", p->axis, "The rotary axis of every centre (the file has no axis column)")
+  probe
+      ->add_option("--axis", p->axis,
+                   "The rotary axis of every centre (the file has no axis column)")
       ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
   probe->add_option("--pivot-mm", p->pivot_mm, "Nominal pivot X Y Z (with --axis, no --model)")
       ->expected(3)
       ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
-  probe->add_option("--probe-u-um", p->probe_u_um,
-                    "Standard uncertainty of one probed centre per coordinate (0: from the "
-                    "residuals, needs 4 or more angles)")
+  probe
+      ->add_option("--probe-u-um", p->probe_u_um,
+                   "Standard uncertainty of one probed centre per coordinate (0: from the "
+                   "residuals, needs 4 or more angles)")
       ->check(finite_in(0.0, 1e4));
   probe->add_option("--write", p->write,
                     "Write the model with the fitted location errors (and their uncertainty and "

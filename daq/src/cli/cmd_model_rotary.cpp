@@ -55,9 +55,10 @@ std::vector<Pose> grid_poses(const mdl::Model& m, const kin::Grid& g, std::size_
   for (std::size_t i = 0; i < m.rotary.size(); ++i) total *= static_cast<double>(angle_count);
   if (angle_count == 0) throw cal::InputError("--angle-count needs 1 or more");
   if (total > kMaxPoses)
-    throw cal::InputError(fmt::format("{:g} poses (the grid times --angle-count per rotary "
-                                      "axis): more than {:g}",
-                                      total, kMaxPoses));
+    throw cal::InputError(
+        fmt::format("{:g} poses (the grid times --angle-count per rotary "
+                    "axis): more than {:g}",
+                    total, kMaxPoses));
   std::vector<std::vector<double>> angles(1);
   for (const auto& r : m.rotary) {
     std::vector<std::vector<double>> next;
@@ -76,8 +77,7 @@ std::vector<Pose> grid_poses(const mdl::Model& m, const kin::Grid& g, std::size_
   return poses;
 }
 
-std::vector<Pose> csv_poses(const mdl::Model& m, const std::string& path,
-                            std::vector<int>& lines) {
+std::vector<Pose> csv_poses(const mdl::Model& m, const std::string& path, std::vector<int>& lines) {
   std::vector<std::string> columns{"x_mm", "y_mm", "z_mm"};
   for (const auto& r : m.rotary) {
     std::string c(kin::to_string(r.axis.letter));
@@ -88,7 +88,8 @@ std::vector<Pose> csv_poses(const mdl::Model& m, const std::string& path,
   std::vector<Pose> poses;
   for (std::size_t r = 0; r < csv.rows(); ++r) {
     Pose p{{csv.numbers.at("x_mm")[r], csv.numbers.at("y_mm")[r], csv.numbers.at("z_mm")[r]}, {}};
-    for (std::size_t i = 3; i < columns.size(); ++i) p.angles_deg.push_back(csv.numbers.at(columns[i])[r]);
+    for (std::size_t i = 3; i < columns.size(); ++i)
+      p.angles_deg.push_back(csv.numbers.at(columns[i])[r]);
     poses.push_back(std::move(p));
   }
   lines = csv.line;
@@ -185,9 +186,8 @@ std::vector<RotaryContribution> contributions(const mdl::Model& m, const std::ve
       out.push_back(contribution(mdl::rotary_component_name(full.letter, d), alone, poses));
     }
   }
-  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
-    return a.max_norm_um > b.max_norm_um;
-  });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const auto& a, const auto& b) { return a.max_norm_um > b.max_norm_um; });
   return out;
 }
 
@@ -206,7 +206,8 @@ json point_json(const mdl::Model& m, const PoseError& pe) {
 
 void print_points(const mdl::Model& m, const std::vector<PoseError>& errors) {
   fmt::print("{:>10} {:>10} {:>10}", "x_mm", "y_mm", "z_mm");
-  for (const auto& r : m.rotary) fmt::print(" {:>9}", fmt::format("{}_deg", kin::to_string(r.axis.letter)));
+  for (const auto& r : m.rotary)
+    fmt::print(" {:>9}", fmt::format("{}_deg", kin::to_string(r.axis.letter)));
   fmt::print(" {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "ex_um", "ey_um", "ez_um", "|e|_um",
              "ea_urad", "eb_urad", "ec_urad");
   for (const auto& pe : errors) {
@@ -240,12 +241,14 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
                            .dump(2));
     return;
   }
-  const auto largest = std::max_element(errors.begin(), errors.end(), [](const auto& a, const auto& b) {
-    return norm(a.e.translation_um) < norm(b.e.translation_um);
-  });
-  const auto turned = std::max_element(errors.begin(), errors.end(), [](const auto& a, const auto& b) {
-    return norm(a.e.rotation_urad) < norm(b.e.rotation_urad);
-  });
+  const auto largest =
+      std::max_element(errors.begin(), errors.end(), [](const auto& a, const auto& b) {
+        return norm(a.e.translation_um) < norm(b.e.translation_um);
+      });
+  const auto turned =
+      std::max_element(errors.begin(), errors.end(), [](const auto& a, const auto& b) {
+        return norm(a.e.rotation_urad) < norm(b.e.rotation_urad);
+      });
   kin::Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (const auto& pe : errors)
     for (std::size_t i = 0; i < 3; ++i) {
@@ -260,31 +263,30 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
     json ranges = json::object(), cs = json::array();
     for (const auto& r : m.rotary)
       ranges[std::string(kin::to_string(r.axis.letter))] = {{"range_deg", r.range_deg},
-                                                             {"count", q.angle_count}};
+                                                            {"count", q.angle_count}};
     for (const auto& c : ranked)
       cs.push_back({{"error", c.name},
                     {"max_norm_um", c.max_norm_um},
                     {"rms_um", c.rms_um},
                     {"max_rotation_urad", c.max_rotation_urad}});
-    fmt::print("{}\n",
-               json{{"schema", "caldaq.five-axis-map.v1"},
-                    {"model", q.file},
-                    {"method", method_name},
-                    {"grid",
-                     {{"min_mm", vec_json(g.min_mm)},
-                      {"max_mm", vec_json(g.max_mm)},
-                      {"count", {g.count[0], g.count[1], g.count[2]}},
-                      {"rotary", ranges}}},
-                    {"summary",
-                     {{"max_norm_um", norm(largest->e.translation_um)},
-                      {"max_norm_at", point_json(m, *largest)},
-                      {"max_rotation_urad", norm(turned->e.rotation_urad)},
-                      {"max_rotation_at", point_json(m, *turned)},
-                      {"min_um", vec_json(lo)},
-                      {"max_um", vec_json(hi)}}},
-                    {"contributions", cs},
-                    {"points", pts}}
-                   .dump(2));
+    fmt::print("{}\n", json{{"schema", "caldaq.five-axis-map.v1"},
+                            {"model", q.file},
+                            {"method", method_name},
+                            {"grid",
+                             {{"min_mm", vec_json(g.min_mm)},
+                              {"max_mm", vec_json(g.max_mm)},
+                              {"count", {g.count[0], g.count[1], g.count[2]}},
+                              {"rotary", ranges}}},
+                            {"summary",
+                             {{"max_norm_um", norm(largest->e.translation_um)},
+                              {"max_norm_at", point_json(m, *largest)},
+                              {"max_rotation_urad", norm(turned->e.rotation_urad)},
+                              {"max_rotation_at", point_json(m, *turned)},
+                              {"min_um", vec_json(lo)},
+                              {"max_um", vec_json(hi)}}},
+                            {"contributions", cs},
+                            {"points", pts}}
+                           .dump(2));
     return;
   }
   std::string rotary_grid;
@@ -308,7 +310,8 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
   for (std::size_t i = 0; i < 3; ++i)
     fmt::print("  e{}  {:9.3f} .. {:9.3f} um (range {:.3f})\n", static_cast<char>('x' + i),
                shown(lo[i]), shown(hi[i]), hi[i] - lo[i]);
-  fmt::print("Contributions, ranked (largest |e| of each error alone, first order; workpiece frame):\n");
+  fmt::print(
+      "Contributions, ranked (largest |e| of each error alone, first order; workpiece frame):\n");
   std::size_t k = 0;
   for (const auto& c : ranked) {
     if (c.max_norm_um == 0.0 && c.max_rotation_urad == 0.0) continue;

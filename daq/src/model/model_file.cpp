@@ -3,8 +3,8 @@
 
 #include <fmt/format.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -160,8 +160,8 @@ constexpr Argument kPosition{};
 constexpr double kMaxAngleDeg = 3600.0;
 constexpr Argument kAngle{"angle_deg", kMaxAngleDeg, "deg"};
 
-kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key,
-                               bool angle, const Argument& arg = kPosition) {
+kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key, bool angle,
+                               const Argument& arg = kPosition) {
   const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
   const std::string_view unit = angle ? "urad" : "um";
   object_at(cx, e, key);
@@ -329,9 +329,9 @@ void check_polynomials_over_travel(const Context& cx, const Model& m) {
 Json function_json(const kin::ErrorFunction& f, std::string_view argument = "position_mm") {
   Json j = Json::object();
   if (f.is_table()) {
-    j["table"] = {
-        {std::string(argument), std::vector<double>(f.positions_mm().begin(), f.positions_mm().end())},
-        {"value", std::vector<double>(f.values().begin(), f.values().end())}};
+    j["table"] = {{std::string(argument),
+                   std::vector<double>(f.positions_mm().begin(), f.positions_mm().end())},
+                  {"value", std::vector<double>(f.values().begin(), f.values().end())}};
   } else {
     const auto c = f.coefficients();
     j["polynomial"] =
@@ -381,9 +381,9 @@ void read_location(const Context& cx, const Json& loc, const std::string& key, R
     const std::string k = key + "." + it.key();
     const auto found = std::find(names.begin(), names.end(), it.key());
     if (found == names.end())
-      cx.fail(k, fmt::format("not a location error of the {} axis (expected {}, {}, {} or {})",
-                             kin::to_string(r.axis.letter), names[0], names[1], names[2],
-                             names[3]));
+      cx.fail(k,
+              fmt::format("not a location error of the {} axis (expected {}, {}, {} or {})",
+                          kin::to_string(r.axis.letter), names[0], names[1], names[2], names[3]));
     const auto n = static_cast<std::size_t>(found - names.begin());
     const bool angle = location_slot(r.axis.letter, n) >= 3;
     const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
@@ -400,8 +400,8 @@ void read_location(const Context& cx, const Json& loc, const std::string& key, R
     only_keys(cx, v, k, {"value", "uncertainty", "source", "note"});
     check_note(cx, v, k);
     if (!v.contains("value")) cx.fail(k + ".value", "missing");
-    location_value(r.axis, n) = bounded(cx, number(cx, v["value"], k + ".value"), k + ".value",
-                                        limit, unit);
+    location_value(r.axis, n) =
+        bounded(cx, number(cx, v["value"], k + ".value"), k + ".value", limit, unit);
     if (v.contains("uncertainty")) {
       const double u = bounded(cx, number(cx, v["uncertainty"], k + ".uncertainty"),
                                k + ".uncertainty", limit, unit);
@@ -435,8 +435,8 @@ void check_rotary_functions(const Context& cx, const std::string& key, const Rot
   const auto [lo, hi] = r.range_deg;
   for (std::size_t d = 0; d < 6; ++d) {
     const auto& f = rotary_component(r.axis, d);
-    const std::string k = fmt::format("{}.components.{}", key,
-                                      rotary_component_name(r.axis.letter, d));
+    const std::string k =
+        fmt::format("{}.components.{}", key, rotary_component_name(r.axis.letter, d));
     if (f.is_table()) {
       const auto q = f.positions_mm();
       if (q.front() > lo + 1e-9 || q.back() < hi - 1e-9)
@@ -482,8 +482,7 @@ RotaryEntry read_one_rotary(const Context& cx, const Json& e, const std::string&
     cx.fail(key + ".range_deg", "expected [min, max] in degrees with max > min");
   r.range_deg = {range[0], range[1]};
   if (e.contains("location")) read_location(cx, e["location"], key + ".location", r);
-  if (e.contains("components"))
-    read_rotary_components(cx, e["components"], key + ".components", r);
+  if (e.contains("components")) read_rotary_components(cx, e["components"], key + ".components", r);
   if (e.contains("note")) r.note = e["note"].get<std::string>();
   check_rotary_functions(cx, key, r);
   return r;
@@ -561,8 +560,8 @@ Model parse(std::string_view text_in, std::string_view where) {
     cx.fail("schema", fmt::format("missing (expected \"{}\" or \"{}\")", kSchema, kSchemaRotary));
   const std::string schema = text(cx, j["schema"], "schema");
   if (schema != kSchema && schema != kSchemaRotary)
-    cx.fail("schema", fmt::format("'{}' is neither {} nor {} (the versions this one reads)",
-                                  schema, kSchema, kSchemaRotary));
+    cx.fail("schema", fmt::format("'{}' is neither {} nor {} (the versions this one reads)", schema,
+                                  kSchema, kSchemaRotary));
   if (schema == kSchema && j.contains("rotary"))
     cx.fail("rotary", fmt::format("rotary axes need \"schema\": \"{}\"", kSchemaRotary));
   if (!j.contains("units"))

@@ -3,9 +3,9 @@
 // kinematic chain, the offsets, each of the 18 component errors as a table or a polynomial, the
 // three squareness errors with their stated convention, method, placement and carrier, and
 // where each came from; v2 adds up to two rotary axes (their pivots, range, four location
-// errors as constants and six component errors as functions of the angle). Reading validates everything and names the file and the key at fault;
-// writing gives the same model back when read. The maths is in cal::kinematics (analysis/);
-// this is its file form (analysis does no I/O).
+// errors as constants and six component errors as functions of the angle). Reading validates
+// everything and names the file and the key at fault; writing gives the same model back when read.
+// The maths is in cal::kinematics (analysis/); this is its file form (analysis does no I/O).
 #include <array>
 #include <optional>
 #include <string>
@@ -58,9 +58,9 @@ struct LocationEntry {
 // functions of the angle in degrees), the range of its angle and what the file said of each.
 struct RotaryEntry {
   kinematics::RotaryAxis axis;
-  std::array<double, 2> range_deg{};           // [min, max], the default range of maps
-  std::array<LocationEntry, 4> location;       // in the order of location_error_names
-  std::array<ComponentEntry, 6> components;    // E_X?, E_Y?, E_Z?, E_A?, E_B?, E_C?
+  std::array<double, 2> range_deg{};         // [min, max], the default range of maps
+  std::array<LocationEntry, 4> location;     // in the order of location_error_names
+  std::array<ComponentEntry, 6> components;  // E_X?, E_Y?, E_Z?, E_A?, E_B?, E_C?
   std::string note;
 };
 
@@ -84,8 +84,7 @@ kinematics::FiveAxisMachine five_axis(const Model& m);
 std::string rotary_component_name(kinematics::RotaryLetter l, std::size_t dir);
 // Component error `dir` (0..5: X, Y, Z, A, B, C) of a rotary axis's motion.
 kinematics::ErrorFunction& rotary_component(kinematics::RotaryAxis& r, std::size_t dir);
-const kinematics::ErrorFunction& rotary_component(const kinematics::RotaryAxis& r,
-                                                  std::size_t dir);
+const kinematics::ErrorFunction& rotary_component(const kinematics::RotaryAxis& r, std::size_t dir);
 // InputError "FILE: rotary: `what` does not model rotary axes yet" for the commands that use the
 // linear axes only, so that a five-axis model is never silently read as a 3-axis one.
 void require_no_rotary(const Model& m, std::string_view file, std::string_view what);
@@ -96,7 +95,8 @@ void require_no_rotary(const Model& m, std::string_view file, std::string_view w
 Model parse(std::string_view text, std::string_view where);
 Model read(const std::string& path);  // parse(file contents, path); InputError if unreadable
 
-// The model as caldaq.model.v1 JSON text (v2 when it has rotary axes) (pretty-printed, ends in a newline).
+// The model as caldaq.model.v1 JSON text (v2 when it has rotary axes) (pretty-printed, ends in a
+// newline).
 std::string to_json(const Model& m);
 // Writes to_json(m) to path; throws cal::InputError if it cannot (nothing partial is left).
 void write(const Model& m, const std::string& path);

@@ -118,22 +118,28 @@ TEST(ModelFileRotary, WritingAndReadingAgainGivesTheSameModel) {
 }
 
 TEST(ModelFileRotary, MalformedRotaryAxesAreRefused) {
-  const std::string c = R"("axis": "C", "side": "table", "pivot_mm": [0, 0, 0], "range_deg": [0, 360])";
+  const std::string c =
+      R"("axis": "C", "side": "table", "pivot_mm": [0, 0, 0], "range_deg": [0, 360])";
   expect_refused(file("[{" + c + "}]", "caldaq.model.v1"), "rotary", "caldaq.model.v2");
   expect_refused(file("{}"), "rotary", "expected an array");
   expect_refused(file("[{" + c + "}, {" + c + "}]"), "rotary[1].axis", "a second C axis");
   expect_refused(file("[{" + c + "}, {" + c + "}, {" + c + "}]"), "rotary", "at most 2");
-  expect_refused(file(R"([{"axis": "D", "side": "table", "pivot_mm": [0, 0, 0], "range_deg": [0, 1]}])"),
-                 "rotary[0].axis", "'D'");
-  expect_refused(file(R"([{"axis": "C", "side": "head", "pivot_mm": [0, 0, 0], "range_deg": [0, 1]}])"),
-                 "rotary[0].side", "table or spindle");
+  expect_refused(
+      file(R"([{"axis": "D", "side": "table", "pivot_mm": [0, 0, 0], "range_deg": [0, 1]}])"),
+      "rotary[0].axis", "'D'");
+  expect_refused(
+      file(R"([{"axis": "C", "side": "head", "pivot_mm": [0, 0, 0], "range_deg": [0, 1]}])"),
+      "rotary[0].side", "table or spindle");
   expect_refused(file(R"([{"axis": "C", "side": "table", "range_deg": [0, 1]}])"),
                  "rotary[0].pivot_mm", "missing");
-  expect_refused(file(R"([{"axis": "C", "side": "table", "pivot_mm": [0, 0, 0], "range_deg": [90, 0]}])"),
-                 "rotary[0].range_deg", "max > min");
-  expect_refused(file(R"([{"axis": "B", "side": "spindle", "pivot_mm": [0, 0, 0], "range_deg": [0, 90]},
-                          {)" + c + "}]"),
-                 "rotary[1].side", "table axes first");
+  expect_refused(
+      file(R"([{"axis": "C", "side": "table", "pivot_mm": [0, 0, 0], "range_deg": [90, 0]}])"),
+      "rotary[0].range_deg", "max > min");
+  expect_refused(
+      file(R"([{"axis": "B", "side": "spindle", "pivot_mm": [0, 0, 0], "range_deg": [0, 90]},
+                          {)" +
+           c + "}]"),
+      "rotary[1].side", "table axes first");
   // A location error along or about the axis's own direction is not one.
   expect_refused(file("[{" + c + R"(, "location": {"E_Z0C": 3}}])"), "rotary[0].location.E_Z0C",
                  "expected E_X0C, E_Y0C, E_A0C or E_B0C");
@@ -145,12 +151,17 @@ TEST(ModelFileRotary, MalformedRotaryAxesAreRefused) {
                  "beyond");
   expect_refused(file("[{" + c + R"(, "components": {"E_XA": {"polynomial": [1]}}}])"),
                  "rotary[0].components.E_XA", "not a component error of the C axis");
-  expect_refused(file("[{" + c + R"(, "components": {"E_CC": {"table": {"position_mm": [0, 360], "value": [0, 0]}}}}])"),
-                 "rotary[0].components.E_CC.table", "angle_deg");
-  expect_refused(file("[{" + c + R"(, "components": {"E_CC": {"table": {"angle_deg": [0, 180], "value": [0, 0]}}}}])"),
-                 "rotary[0].components.E_CC.table", "covers 0 .. 180 deg but the range is 0 .. 360");
-  expect_refused(file("[{" + c + R"(, "components": {"E_ZC": {"polynomial": [0, 0, 0, 0, 1e3]}}}])"),
-                 "rotary[0].components.E_ZC.polynomial", "beyond");
+  expect_refused(
+      file("[{" + c +
+           R"(, "components": {"E_CC": {"table": {"position_mm": [0, 360], "value": [0, 0]}}}}])"),
+      "rotary[0].components.E_CC.table", "angle_deg");
+  expect_refused(
+      file("[{" + c +
+           R"(, "components": {"E_CC": {"table": {"angle_deg": [0, 180], "value": [0, 0]}}}}])"),
+      "rotary[0].components.E_CC.table", "covers 0 .. 180 deg but the range is 0 .. 360");
+  expect_refused(
+      file("[{" + c + R"(, "components": {"E_ZC": {"polynomial": [0, 0, 0, 0, 1e3]}}}])"),
+      "rotary[0].components.E_ZC.polynomial", "beyond");
   expect_refused(file("[{" + c + R"(, "spin": 1}])"), "rotary[0].spin", "unknown key");
 }
 
