@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "cal/analysis/error.hpp"
 
@@ -26,14 +28,18 @@ RotaryAxis axis(RotaryLetter l, const Vec3& pivot, const Vec3& pos_um, const Vec
   return r;
 }
 
-FiveAxisMachine trunnion(RotaryLetter cradle, const Vec3& c_orient = {}) {
+// A C table on an A or B cradle with position errors on both axes, the C axis's orientation
+// errors `c_orient` and E_C0A (E_C0B) = `cradle_c0_urad`.
+FiveAxisMachine trunnion(RotaryLetter cradle, const Vec3& c_orient = {},
+                         double cradle_c0_urad = 30.0) {
   FiveAxisMachine m;
   m.linear.topology = Topology::fxyz;
   m.rotary.push_back(axis(RotaryLetter::c, {10, 20, -300}, {12, -5, 0}, c_orient));
+  const Vec3 cradle_orient{0, 0, cradle_c0_urad};
   if (cradle == RotaryLetter::a)
-    m.rotary.push_back(axis(RotaryLetter::a, {0, 25, -280}, {0, 7, -15}, {0, 0, 30}));
+    m.rotary.push_back(axis(RotaryLetter::a, {0, 25, -280}, {0, 7, -15}, cradle_orient));
   else
-    m.rotary.push_back(axis(RotaryLetter::b, {-4, 0, -280}, {9, 0, -15}, {0, 0, 30}));
+    m.rotary.push_back(axis(RotaryLetter::b, {-4, 0, -280}, {9, 0, -15}, cradle_orient));
   return m;
 }
 
@@ -82,7 +88,8 @@ Vec3 turn(const Vec3& v, const Vec3& q, std::size_t dir, double deg) {
 // about its own line) to where the model's actual machine must bring the tool to touch it.
 TEST(TrtKins, ThePinsLinesAreTheModelsActualLines) {
   for (RotaryLetter cradle : {RotaryLetter::a, RotaryLetter::b}) {
-    const FiveAxisMachine m = trunnion(cradle);  // position errors only: the module's freedom
+    // Position errors only: what the module can hold.
+    const FiveAxisMachine m = trunnion(cradle, {0, 0, 0}, 0.0);
     const auto p = linuxcnc_trt_pins(m);
     const Vec3 c_point{p.x_rot_point_mm, p.y_rot_point_mm, 0.0};
     const Vec3 tilt_point =
@@ -98,6 +105,55 @@ TEST(TrtKins, ThePinsLinesAreTheModelsActualLines) {
         EXPECT_NEAR(got[k], want[k], 1e-9) << to_string(cradle) << " " << c << ", " << t;
     }
   }
+}
+
+// The HAL lines read back give the pins (to their 6 decimals), and the simulated control made
+// from them predicts the probed centres of the truth (position errors only) to that rounding.
+TEST(TrtKins, TheHalReadBackMakesTheControl) {
+  const FiveAxisMachine truth = trunnion(RotaryLetter::a, {0, 0, 0}, 0.0);
+  const auto pins = linuxcnc_trt_pins(truth);
+  const auto back = parse_linuxcnc_trt_hal(linuxcnc_trt_hal(pins, "test"), "t.hal");
+  EXPECT_EQ(back.module, "xyzac-trt-kins");
+  EXPECT_NEAR(back.y_offset_mm, pins.y_offset_mm, 5e-7);
+  EXPECT_NEAR(back.z_offset_mm, pins.z_offset_mm, 5e-7);
+  FiveAxisMachine nominal = truth;
+  for (auto& r : nominal.rotary) r.location_position_um = {};
+  const FiveAxisMachine control = trt_control_machine(back, nominal);
+  const Vec3 w{60, -40, -230};
+  for (const auto& [c, t] : {std::pair{90.0, 0.0}, {0.0, 45.0}, {215.0, -70.0}}) {
+    const std::vector angles{c, t};
+    const Vec3 want = probed_centre_mm(truth, w, angles);
+    const Vec3 got = probed_centre_mm(control, w, angles);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 2e-6) << c << ", " << t;
+  }
+  // The nominal control (no pins) is off by the location errors: the test can fail.
+  const std::vector turned{180.0, 0.0};
+  EXPECT_GT(
+      std::abs(probed_centre_mm(nominal, w, turned)[0] - probed_centre_mm(truth, w, turned)[0]),
+      0.02);
+  // Refusals, with the file and the line.
+  const auto refused = [](const std::string& hal, const std::string& what) {
+    try {
+      parse_linuxcnc_trt_hal(hal, "t.hal");
+      ADD_FAILURE() << "not refused: " << hal;
+    } catch (const cal::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused("loadrt xyzac-trt-kins\n", "t.hal:1: 'loadrt'");
+  refused("# c\nsetp xyzac-trt-kins.x-rot-point 1\nsetp xyzbc-trt-kins.x-offset 1\n",
+          "t.hal:3: xyzbc-trt-kins after xyzac-trt-kins");
+  refused("setp xyzac-trt-kins.tool-offset 1\n", "'tool-offset' is not a pivot pin");
+  refused("setp xyzac-trt-kins.y-offset 1\nsetp xyzac-trt-kins.y-offset 2\n",
+          "t.hal:2: y-offset given twice");
+  refused("setp xyzac-trt-kins.y-offset 1mm\n", "'1mm' is not a value in mm");
+  refused("setp xyzac-trt-kins.y-offset nan\n", "'nan' is not a value in mm");
+  refused("setp xyzac-trt-kins.y-offset\n", "expected setp MODULE.PIN VALUE");
+  refused("# nothing\n", "no setp line");
+  // Pins of the other module than the model's trunnion.
+  auto b = back;
+  b.module = "xyzbc-trt-kins";
+  EXPECT_THROW(trt_control_machine(b, nominal), cal::InputError);
 }
 
 TEST(TrtKins, OtherMachinesAreRefused) {

@@ -426,8 +426,8 @@ void run_map(const MapOptions& o) {
 void add_model_commands(CLI::App& app) {
   auto* model =
       add_group(app, "model",
-                "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
-                "compensation, predict a test piece");
+                "The machine model (caldaq.model.v1, v2 with rotary axes): show it, map its error, "
+                "write a compensation, predict a test piece, probe and correct rotary axes");
 
   const auto [show, s] = add_command<ShowOptions>(
       *model, "show", run_show, "Print a model file: chain, offsets, the 21 errors");
