@@ -314,6 +314,37 @@ Vec3 five_axis_nominal_tip_mm(const FiveAxisMachine& machine, const Vec3& linear
   return arr(nominal_pose(f) * vec(machine.linear.tool_offset_mm));
 }
 
+Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
+                      std::span<const double> angles_deg) {
+  check_machine(machine, angles_deg);
+  check_finite(sphere_mm, "sphere_mm");
+  for (std::size_t i = 0; i < machine.rotary.size(); ++i) {
+    if (machine.rotary[i].side == Side::spindle && angles_deg[i] != 0.0) {
+      throw InputError(fmt::format("{} at {} deg: a simulated probe needs the spindle axes at 0",
+                                   rotary_name(machine.rotary[i], i), angles_deg[i]));
+    }
+  }
+  // The nominal tip is b + A p: A from unit steps (exact: it is affine).
+  const auto tip = [&](const Vector3d& p) {
+    return vec(five_axis_nominal_tip_mm(machine, arr(p), angles_deg));
+  };
+  const Vector3d b = tip(Vector3d::Zero());
+  Matrix3d a;
+  for (Eigen::Index i = 0; i < 3; ++i) a.col(i) = tip(Vector3d::Unit(i)) - b;
+  const auto solve = a.partialPivLu();
+  const Vector3d s = vec(sphere_mm);
+  Vector3d p = solve.solve(s - b);
+  for (int it = 0; it < 8; ++it) {
+    const Vector3d actual =
+        tip(p) +
+        kMmPerUm * vec(five_axis_error(machine, arr(p), angles_deg, Method::htm).translation_um);
+    const Vector3d miss = actual - s;
+    p -= solve.solve(miss);
+    if (miss.norm() < 1e-12) break;
+  }
+  return arr(p + vec(machine.linear.tool_offset_mm));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Sphere probing: the axis average line
 

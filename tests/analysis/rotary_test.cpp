@@ -572,6 +572,23 @@ TEST(RotarySphereProbing, SimulatedCentresAreTheRotationAboutTheActualLine) {
   }
 }
 
+// The library's simulated probe (probed_centre_mm, what the CLI's simulated touch probe uses)
+// is this file's: the centre turned about the actual line, both axes, with the trunnion's
+// component and linear errors.
+TEST(RotarySphereProbing, TheLibrarysSimulatedProbeIsTheTestsOwn) {
+  const FiveAxisMachine m = trunnion();
+  for (const auto& [c, a] :
+       {std::pair{0.0, 0.0}, {75.0, 0.0}, {200.0, 0.0}, {0.0, -60.0}, {120.0, 35.0}}) {
+    const std::vector angles{c, a};
+    expect_near(probed_centre_mm(m, kSphere, angles), probe(m, kSphere, c, a), 1e-9,
+                "C, A = " + std::to_string(c) + ", " + std::to_string(a));
+  }
+  // A spindle axis turned: refused (the control's own kinematics would add the tool).
+  const FiveAxisMachine head = spindle_b({0, 0, 0}, {0, 0, 0});
+  const std::vector turned{30.0};
+  EXPECT_THROW(probed_centre_mm(head, kSphere, turned), cal::InputError);
+}
+
 TEST(RotarySphereProbing, RecoversTheLocationErrorsWithoutNoise) {
   const FiveAxisMachine m = trunnion();
   const auto fit = fit_axis_line(RotaryLetter::c, kPivot, probe_c(m, 8, 0.0, 1));

@@ -1,4 +1,5 @@
-// daq model show | map: the machine model file (caldaq.model.v1) and its volumetric error.
+// daq model show | map: the machine model file (caldaq.model.v1/v2) and its volumetric error
+// (with rotary axes: cmd_model_rotary.cpp).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -197,6 +198,43 @@ struct ShowOptions {
   bool json = false;
 };
 
+// A rotary axis of a v2 model: where it is, its location errors (with their uncertainty) and
+// its component errors over its range.
+void print_rotary(const mdl::RotaryEntry& r) {
+  const auto& a = r.axis;
+  print_line("Rotary axis {} ({} side): pivot ({:g}, {:g}, {:g}) mm, range {:g} .. {:g} deg",
+             kin::to_string(a.letter), kin::to_string(a.side), a.pivot_mm[0], a.pivot_mm[1],
+             a.pivot_mm[2], r.range_deg[0], r.range_deg[1]);
+  const auto names = kin::location_error_names(a.letter);
+  const std::size_t own = kin::direction_index(a.letter);
+  std::size_t n = 0;
+  for (std::size_t slot = 0; slot < 6; ++slot) {
+    if (slot % 3 == own) continue;
+    const double v =
+        slot < 3 ? a.location_position_um[slot] : a.location_orientation_urad[slot - 3];
+    const auto& e = r.location[n];
+    const char* unit = slot < 3 ? "um" : "urad";
+    print_line("  {:6} {:44} {:+.3f} {}{}", names[n],
+               e.given ? "location error" : "not given (zero)", v, unit,
+               e.uncertainty ? fmt::format(" (u = {:.3f} {})", *e.uncertainty, unit) : "");
+    ++n;
+  }
+  for (std::size_t d = 0; d < 6; ++d) {
+    const auto name = mdl::rotary_component_name(a.letter, d);
+    const auto& f = mdl::rotary_component(a, d);
+    if (!r.components[d].given) continue;
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i <= 100; ++i) {
+      const double v = f(r.range_deg[0] + (r.range_deg[1] - r.range_deg[0]) * i / 100.0);
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    print_line("  {:6} {:44} {:.3f} .. {:.3f} {} over the range", name,
+               f.is_table() ? fmt::format("table, {} points", f.positions_mm().size())
+                            : "polynomial in the angle (deg)",
+               lo, hi, d < 3 ? "um" : "urad");
+  }
+}
+
 void run_show(const ShowOptions& o) {
   const mdl::Model m = mdl::read(o.file);
   if (o.json) return fmt::print("{}", mdl::to_json(m));
@@ -226,6 +264,7 @@ void run_show(const ShowOptions& o) {
   }
   if (!missing.empty())
     print_line("Not given ({} of 21, taken as zero): {}", missing.size(), fmt::join(missing, ", "));
+  for (const auto& r : m.rotary) print_rotary(r);
 }
 
 // --- map -------------------------------------------------------------------------------------
@@ -234,6 +273,7 @@ struct MapOptions {
   std::string file, points, report, method = "htm";
   std::vector<double> min_mm, max_mm;
   std::vector<std::size_t> count{5, 5, 5};
+  std::size_t angle_count = 5;
   bool json = false;
 };
 
@@ -270,6 +310,16 @@ void run_map(const MapOptions& o) {
   const mdl::Model m = mdl::read(o.file);
   const kin::Method method = method_from_string(o.method);
   const std::string method_name = method == kin::Method::htm ? "htm" : "first-order";
+  if (!m.rotary.empty()) {
+    if (!o.report.empty())
+      throw cal::InputError(fmt::format(
+          "{}: rotary: --report does not draw a model with rotary axes yet (use --json)", o.file));
+    if (!o.points.empty() && !o.min_mm.empty())
+      throw cal::InputError("--points maps the given poses: no grid options with it");
+    FiveAxisMapRequest q{o.file, o.points, {}, o.angle_count, method, o.json};
+    if (o.points.empty()) q.grid = grid_of(o, m);
+    return run_five_axis_map(m, q);
+  }
   if (!o.points.empty()) {
     if (!o.min_mm.empty() || !o.report.empty())
       throw cal::InputError("--points maps the given points: no grid options or --report with it");
@@ -376,8 +426,8 @@ void run_map(const MapOptions& o) {
 void add_model_commands(CLI::App& app) {
   auto* model =
       add_group(app, "model",
-                "The machine model (caldaq.model.v1): show it, map its volumetric error, write a "
-                "compensation, predict a test piece");
+                "The machine model (caldaq.model.v1, v2 with rotary axes): show it, map its error, "
+                "write a compensation, predict a test piece, probe and correct rotary axes");
 
   const auto [show, s] = add_command<ShowOptions>(
       *model, "show", run_show, "Print a model file: chain, offsets, the 21 errors");
@@ -387,7 +437,9 @@ void add_model_commands(CLI::App& app) {
 
   const auto [map, o] = add_command<MapOptions>(
       *model, "map", run_map,
-      "Volumetric error over a grid (default: the model's travel, 5 x 5 x 5) or at points");
+      "Volumetric error over a grid (default: the model's travel, 5 x 5 x 5) or at points; "
+      "with rotary axes (caldaq.model.v2) the tool tip's position and orientation error over "
+      "the travel and the rotary range");
   map->add_option("file", o->file, "Model file")->required();
   map->add_option("--min-mm", o->min_mm, "Grid corner X Y Z (with --max-mm)")
       ->expected(3)
@@ -396,7 +448,13 @@ void add_model_commands(CLI::App& app) {
       ->expected(3)
       ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
   map->add_option("--count", o->count, "Points per axis X Y Z")->expected(3)->capture_default_str();
-  map->add_option("--points", o->points, "CSV of points to evaluate: x_mm,y_mm,z_mm");
+  map->add_option("--points", o->points,
+                  "CSV of points to evaluate: x_mm,y_mm,z_mm (and with rotary axes one column "
+                  "per axis: c_deg, a_deg, ...)");
+  map->add_option("--angle-count", o->angle_count,
+                  "With rotary axes: angles per rotary axis over its range_deg")
+      ->capture_default_str()
+      ->check(whole_in(1, 1000));
   map->add_option("--method", o->method, "htm (exact) or first-order")->capture_default_str();
   map->add_option("--report", o->report,
                   "Also write an HTML page: error vectors in three slices, contributions ranked");
@@ -406,6 +464,8 @@ void add_model_commands(CLI::App& app) {
   add_model_compare_command(*model);
   add_model_compensate_command(*model);
   add_model_testpiece_command(*model);
+  add_model_probe_commands(*model);
+  add_model_kinematics_command(*model);
 }
 
 }  // namespace daq

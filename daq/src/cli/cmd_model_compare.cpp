@@ -96,6 +96,8 @@ void run_compare(const CompareOptions& o) {
     throw cal::InputError("--count needs three counts from 1 to 101 (X Y Z)");
   const auto ref = mdl::read(o.reference);
   const auto other = mdl::read(o.other);
+  mdl::require_no_rotary(ref, o.reference, "daq model compare");
+  mdl::require_no_rotary(other, o.other, "daq model compare");
   const auto c = mdl::compare(ref, other, {o.count[0], o.count[1], o.count[2]});
   if (o.json) return fmt::print("{}\n", to_json(o, c).dump(2));
   print_text(o, ref, c);

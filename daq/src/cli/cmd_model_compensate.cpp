@@ -376,6 +376,7 @@ void store_with_machine(const Options& o, const Written& w, const std::string& o
 
 void run(const Options& o) {
   const mdl::Model m = mdl::read(o.file);
+  mdl::require_no_rotary(m, o.file, "daq model compensate (the linear axes' tables)");
   const auto g = grid_of(o, m);
   const kin::Vec3 ref = reference_of(o, g);
   const auto tables = vc::cross_tables(m.machine, g, ref, m.carriers);

@@ -89,6 +89,7 @@ std::vector<Row> rows_of(const tp::Result& p, const std::optional<tp::Result>& m
 
 void run(const Options& o) {
   const mdl::Model model = mdl::read(o.file);
+  mdl::require_no_rotary(model, o.file, "daq model testpiece");
   if (o.origin_mm.size() != 3)
     throw cal::InputError("--origin-mm needs X Y Z (Z: the cutting height)");
   tp::Cutting cut;

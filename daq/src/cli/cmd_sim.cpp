@@ -172,6 +172,7 @@ void run_sim(SimOptions o) {
     // what `daq model compensate -f isg-volumetric` writes for a controller), with each
     // position held within the model's tables (the overrun moves go a few mm past them).
     const auto model = cal::daq::model::read(o.compensate);
+    cal::daq::model::require_no_rotary(model, o.compensate, "daq sim --compensate");
     if (!model.travel_mm) throw cal::InputError(fmt::format("{}: no travel_mm", o.compensate));
     shop.set_compensation([model](const cal::kinematics::Vec3& p) {
       cal::kinematics::Vec3 q = p;

@@ -42,10 +42,27 @@ std::map<std::string, std::string> model_origin_parts(const cal::daq::model::Mod
 // --method htm|first-order
 cal::kinematics::Method method_from_string(const std::string& s);
 
+// daq model map of a model with rotary axes (cmd_model_rotary.cpp): the grid (the linear
+// volume) times angle_count angles over each rotary axis's range, or the poses of a CSV
+// (x_mm, y_mm, z_mm and one column per rotary axis: c_deg, a_deg, ...).
+struct FiveAxisMapRequest {
+  std::string file;    // the model's path, for the output
+  std::string points;  // a CSV of poses, or "" for the grid
+  cal::kinematics::Grid grid;
+  std::size_t angle_count = 5;
+  cal::kinematics::Method method = cal::kinematics::Method::htm;
+  bool json = false;
+};
+void run_five_axis_map(const cal::daq::model::Model& m, const FiveAxisMapRequest& q);
+
 // daq model compensate / daq model testpiece (their own files).
 void add_model_compensate_command(CLI::App& model);
 void add_model_testpiece_command(CLI::App& model);
 void add_model_build_command(CLI::App& model);
 void add_model_compare_command(CLI::App& model);
+// daq model probe | probe-sim (cmd_model_probe.cpp), daq model kinematics
+// (cmd_model_kinematics.cpp): sphere probing of rotary axes and the controls' kinematics.
+void add_model_probe_commands(CLI::App& model);
+void add_model_kinematics_command(CLI::App& model);
 
 }  // namespace daq

@@ -1,12 +1,14 @@
-// caldaq.model.v1 reading and writing (see model_file.hpp and docs/model-file.md).
+// caldaq.model.v1/v2 reading and writing (see model_file.hpp and docs/model-file.md).
 #include "model/model_file.hpp"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -147,8 +149,19 @@ Source source_of(const Json& entry) {
   return it == entry.end() ? Source{} : Source{it->dump()};
 }
 
-kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key,
-                               bool angle) {
+// The argument of a table: a linear axis's position in mm, or a rotary axis's angle in degrees.
+struct Argument {
+  std::string_view key = "position_mm";
+  double limit = kMaxPositionMm;
+  std::string_view unit = "mm";
+};
+constexpr Argument kPosition{};
+// 10 turns either way: beyond that an angle is a typing error.
+constexpr double kMaxAngleDeg = 3600.0;
+constexpr Argument kAngle{"angle_deg", kMaxAngleDeg, "deg"};
+
+kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::string& key, bool angle,
+                               const Argument& arg = kPosition) {
   const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
   const std::string_view unit = angle ? "urad" : "um";
   object_at(cx, e, key);
@@ -167,10 +180,13 @@ kin::ErrorFunction function_of(const Context& cx, const Json& e, const std::stri
   }
   const std::string tk = key + ".table";
   const Json& t = object_at(cx, e["table"], tk);
-  only_keys(cx, t, tk, {"position_mm", "value"});
-  if (!t.contains("position_mm") || !t.contains("value"))
-    cx.fail(tk, "expected \"position_mm\" and \"value\" arrays");
-  const auto q = positions_mm(cx, t["position_mm"], tk + ".position_mm", 2);
+  only_keys(cx, t, tk, {arg.key, "value"});
+  if (!t.contains(arg.key) || !t.contains("value"))
+    cx.fail(tk, fmt::format("expected \"{}\" and \"value\" arrays", arg.key));
+  const std::string qk = fmt::format("{}.{}", tk, arg.key);
+  const auto q = numbers(cx, t[arg.key], qk, 2);
+  for (std::size_t i = 0; i < q.size(); ++i)
+    bounded(cx, q[i], fmt::format("{}[{}]", qk, i), arg.limit, arg.unit);
   const auto v = numbers(cx, t["value"], tk + ".value", 2);
   for (std::size_t i = 0; i < v.size(); ++i)
     bounded(cx, v[i], fmt::format("{}.value[{}]", tk, i), limit, unit);
@@ -310,12 +326,12 @@ void check_polynomials_over_travel(const Context& cx, const Model& m) {
   }
 }
 
-Json function_json(const kin::ErrorFunction& f) {
+Json function_json(const kin::ErrorFunction& f, std::string_view argument = "position_mm") {
   Json j = Json::object();
   if (f.is_table()) {
-    j["table"] = {
-        {"position_mm", std::vector<double>(f.positions_mm().begin(), f.positions_mm().end())},
-        {"value", std::vector<double>(f.values().begin(), f.values().end())}};
+    j["table"] = {{std::string(argument),
+                   std::vector<double>(f.positions_mm().begin(), f.positions_mm().end())},
+                  {"value", std::vector<double>(f.values().begin(), f.values().end())}};
   } else {
     const auto c = f.coefficients();
     j["polynomial"] =
@@ -328,6 +344,208 @@ void put_source(Json& j, const Source& s) {
   if (!s.json.empty()) j["source"] = Json::parse(s.json);
 }
 
+// --- rotary axes (v2) -------------------------------------------------------------------------
+
+constexpr std::array kRotaryDirections{'X', 'Y', 'Z', 'A', 'B', 'C'};
+
+// Component `dir` (X, Y, Z, A, B, C) of a rotary axis's motion; Axis is RotaryAxis, const or not.
+template <class Axis>
+auto& component_of(Axis& r, std::size_t dir) {
+  auto& m = r.motion;
+  const std::array f{&m.ex_um, &m.ey_um, &m.ez_um, &m.ea_urad, &m.eb_urad, &m.ec_urad};
+  return *f.at(dir);
+}
+
+// The slot of a location error in RotaryAxis: position (0..2) or orientation (3..5) index.
+std::size_t location_slot(kin::RotaryLetter l, std::size_t n) {
+  const std::size_t own = kin::direction_index(l);
+  std::size_t k = 0;
+  for (std::size_t slot = 0; slot < 6; ++slot) {
+    if (slot % 3 == own) continue;
+    if (k++ == n) return slot;
+  }
+  return 0;  // unreachable: n < 4
+}
+
+// Location error n (in the order of location_error_names) of a rotary axis, const or not.
+template <class Axis>
+auto& location_value(Axis& r, std::size_t n) {
+  const std::size_t slot = location_slot(r.letter, n);
+  return slot < 3 ? r.location_position_um[slot] : r.location_orientation_urad[slot - 3];
+}
+
+void read_location(const Context& cx, const Json& loc, const std::string& key, RotaryEntry& r) {
+  object_at(cx, loc, key);
+  const auto names = kin::location_error_names(r.axis.letter);
+  for (auto it = loc.begin(); it != loc.end(); ++it) {
+    const std::string k = key + "." + it.key();
+    const auto found = std::find(names.begin(), names.end(), it.key());
+    if (found == names.end())
+      cx.fail(k,
+              fmt::format("not a location error of the {} axis (expected {}, {}, {} or {})",
+                          kin::to_string(r.axis.letter), names[0], names[1], names[2], names[3]));
+    const auto n = static_cast<std::size_t>(found - names.begin());
+    const bool angle = location_slot(r.axis.letter, n) >= 3;
+    const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
+    const std::string_view unit = angle ? "urad" : "um";
+    LocationEntry& e = r.location[n];
+    e.given = true;
+    const Json& v = it.value();
+    if (v.is_number()) {
+      location_value(r.axis, n) = bounded(cx, number(cx, v, k), k, limit, unit);
+      continue;
+    }
+    if (!v.is_object())
+      cx.fail(k, fmt::format("expected a number or {{\"value\": ...}}, found {}", type_name(v)));
+    only_keys(cx, v, k, {"value", "uncertainty", "source", "note"});
+    check_note(cx, v, k);
+    if (!v.contains("value")) cx.fail(k + ".value", "missing");
+    location_value(r.axis, n) =
+        bounded(cx, number(cx, v["value"], k + ".value"), k + ".value", limit, unit);
+    if (v.contains("uncertainty")) {
+      const double u = bounded(cx, number(cx, v["uncertainty"], k + ".uncertainty"),
+                               k + ".uncertainty", limit, unit);
+      if (u < 0.0) cx.fail(k + ".uncertainty", "expected a standard uncertainty >= 0");
+      e.uncertainty = u;
+    }
+    e.source = source_of(v);
+  }
+}
+
+void read_rotary_components(const Context& cx, const Json& comps, const std::string& key,
+                            RotaryEntry& r) {
+  object_at(cx, comps, key);
+  const char own = kin::to_string(r.axis.letter)[0];
+  for (auto it = comps.begin(); it != comps.end(); ++it) {
+    const std::string k = key + "." + it.key();
+    std::optional<std::size_t> dir;
+    for (std::size_t d = 0; d < 6; ++d)
+      if (it.key() == fmt::format("E_{}{}", kRotaryDirections[d], own)) dir = d;
+    if (!dir)
+      cx.fail(k, fmt::format("not a component error of the {0} axis (expected E_X{0}, E_Y{0}, "
+                             "E_Z{0}, E_A{0}, E_B{0} or E_C{0}: functions of the angle)",
+                             own));
+    rotary_component(r.axis, *dir) = function_of(cx, it.value(), k, *dir >= 3, kAngle);
+    r.components[*dir] = {true, source_of(it.value())};
+  }
+}
+
+// Every table covers the axis's range and every polynomial stays within the limits over it.
+void check_rotary_functions(const Context& cx, const std::string& key, const RotaryEntry& r) {
+  const auto [lo, hi] = r.range_deg;
+  for (std::size_t d = 0; d < 6; ++d) {
+    const auto& f = rotary_component(r.axis, d);
+    const std::string k =
+        fmt::format("{}.components.{}", key, rotary_component_name(r.axis.letter, d));
+    if (f.is_table()) {
+      const auto q = f.positions_mm();
+      if (q.front() > lo + 1e-9 || q.back() < hi - 1e-9)
+        cx.fail(k + ".table", fmt::format("covers {} .. {} deg but the range is {} .. {} deg "
+                                          "(tables are not extrapolated)",
+                                          q.front(), q.back(), lo, hi));
+      continue;
+    }
+    if (f.is_zero()) continue;
+    const bool angle = d >= 3;
+    const double limit = angle ? kMaxAngleUrad : kMaxTranslationUm;
+    for (int i = 0; i <= 100; ++i) {
+      const double a = lo + (hi - lo) * i / 100.0, v = f(a);
+      if (!(std::abs(v) <= limit))
+        cx.fail(k + ".polynomial",
+                fmt::format("{} {} at {} deg, beyond {:g} {} (a typing error?)", v,
+                            angle ? "urad" : "um", a, limit, angle ? "urad" : "um"));
+    }
+  }
+}
+
+RotaryEntry read_one_rotary(const Context& cx, const Json& e, const std::string& key) {
+  object_at(cx, e, key);
+  only_keys(cx, e, key,
+            {"axis", "side", "pivot_mm", "range_deg", "location", "components", "note"});
+  check_note(cx, e, key);
+  RotaryEntry r;
+  for (const char* required : {"axis", "side", "pivot_mm", "range_deg"})
+    if (!e.contains(required)) cx.fail(key + "." + required, "missing");
+  const std::string letter = text(cx, e["axis"], key + ".axis");
+  if (letter != "A" && letter != "B" && letter != "C")
+    cx.fail(key + ".axis", fmt::format("'{}' (expected A, B or C)", letter));
+  r.axis.letter = kin::rotary_letter_from_string(letter);
+  const std::string side = text(cx, e["side"], key + ".side");
+  if (side != "table" && side != "spindle")
+    cx.fail(key + ".side", fmt::format("'{}' (expected table or spindle)", side));
+  r.axis.side = side == "table" ? kin::Side::table : kin::Side::spindle;
+  r.axis.pivot_mm = vec3(cx, e["pivot_mm"], key + ".pivot_mm");
+  const auto range = numbers(cx, e["range_deg"], key + ".range_deg", 2);
+  for (std::size_t i = 0; i < range.size(); ++i)
+    bounded(cx, range[i], fmt::format("{}.range_deg[{}]", key, i), kMaxAngleDeg, "deg");
+  if (range.size() != 2 || !(range[1] > range[0]))
+    cx.fail(key + ".range_deg", "expected [min, max] in degrees with max > min");
+  r.range_deg = {range[0], range[1]};
+  if (e.contains("location")) read_location(cx, e["location"], key + ".location", r);
+  if (e.contains("components")) read_rotary_components(cx, e["components"], key + ".components", r);
+  if (e.contains("note")) r.note = e["note"].get<std::string>();
+  check_rotary_functions(cx, key, r);
+  return r;
+}
+
+void read_rotary(const Context& cx, const Json& list, Model& m) {
+  if (!list.is_array())
+    cx.fail("rotary", fmt::format("expected an array of rotary axes, found {}", type_name(list)));
+  if (list.size() > 2)
+    cx.fail("rotary", fmt::format("{} rotary axes: at most 2 are modelled", list.size()));
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string key = fmt::format("rotary[{}]", i);
+    RotaryEntry r = read_one_rotary(cx, list[i], key);
+    for (const auto& before : m.rotary) {
+      if (before.axis.letter == r.axis.letter)
+        cx.fail(key + ".axis", fmt::format("a second {} axis (each letter once: the location "
+                                           "errors are named by it)",
+                                           kin::to_string(r.axis.letter)));
+      if (before.axis.side == kin::Side::spindle && r.axis.side == kin::Side::table)
+        cx.fail(key + ".side",
+                "a table axis after a spindle axis: list the rotary axes from the workpiece to "
+                "the tool, table axes first");
+    }
+    m.rotary.push_back(std::move(r));
+  }
+}
+
+Json rotary_json(const RotaryEntry& r) {
+  Json j;
+  j["axis"] = kin::to_string(r.axis.letter);
+  j["side"] = kin::to_string(r.axis.side);
+  j["pivot_mm"] = r.axis.pivot_mm;
+  j["range_deg"] = r.range_deg;
+  Json loc = Json::object();
+  const auto names = kin::location_error_names(r.axis.letter);
+  for (std::size_t n = 0; n < 4; ++n) {
+    const double v = location_value(r.axis, n);
+    const auto& e = r.location[n];
+    if (!e.given && v == 0.0) continue;
+    if (!e.uncertainty && e.source.json.empty()) {
+      loc[names[n]] = v;
+      continue;
+    }
+    Json o;
+    o["value"] = v;
+    if (e.uncertainty) o["uncertainty"] = *e.uncertainty;
+    put_source(o, e.source);
+    loc[names[n]] = o;
+  }
+  j["location"] = loc;
+  Json comps = Json::object();
+  for (std::size_t d = 0; d < 6; ++d) {
+    const auto& f = rotary_component(r.axis, d);
+    if (!r.components[d].given && f.is_zero()) continue;
+    Json e = function_json(f, kAngle.key);
+    put_source(e, r.components[d].source);
+    comps[rotary_component_name(r.axis.letter, d)] = e;
+  }
+  j["components"] = comps;
+  if (!r.note.empty()) j["note"] = r.note;
+  return j;
+}
+
 }  // namespace
 
 Model parse(std::string_view text_in, std::string_view where) {
@@ -336,11 +554,16 @@ Model parse(std::string_view text_in, std::string_view where) {
   if (!j.is_object()) cx.fail(fmt::format("expected a JSON object, found {}", type_name(j)));
   only_keys(cx, j, "",
             {"schema", "machine", "topology", "units", "tool_offset_mm", "table_offset_mm",
-             "travel_mm", "components", "squareness", "provenance", "note"});
+             "travel_mm", "components", "squareness", "rotary", "provenance", "note"});
   check_note(cx, j, "");
-  if (!j.contains("schema")) cx.fail("schema", fmt::format("missing (expected \"{}\")", kSchema));
-  if (const auto s = text(cx, j["schema"], "schema"); s != kSchema)
-    cx.fail("schema", fmt::format("'{}' is not {} (this version reads only that)", s, kSchema));
+  if (!j.contains("schema"))
+    cx.fail("schema", fmt::format("missing (expected \"{}\" or \"{}\")", kSchema, kSchemaRotary));
+  const std::string schema = text(cx, j["schema"], "schema");
+  if (schema != kSchema && schema != kSchemaRotary)
+    cx.fail("schema", fmt::format("'{}' is neither {} nor {} (the versions this one reads)", schema,
+                                  kSchema, kSchemaRotary));
+  if (schema == kSchema && j.contains("rotary"))
+    cx.fail("rotary", fmt::format("rotary axes need \"schema\": \"{}\"", kSchemaRotary));
   if (!j.contains("units"))
     cx.fail("units",
             "missing: state {\"position\": \"mm\", \"translation\": \"um\", \"angle\": "
@@ -354,7 +577,7 @@ Model parse(std::string_view text_in, std::string_view where) {
       const std::string key = std::string("units.") + k;
       if (!u.contains(k)) cx.fail(key, fmt::format("missing (expected \"{}\")", v));
       if (const auto s = text(cx, u[k], key); s != v)
-        cx.fail(key, fmt::format("'{}': caldaq.model.v1 is in {} (convert the values)", s, v));
+        cx.fail(key, fmt::format("'{}': {} is in {} (convert the values)", s, schema, v));
     }
   }
   Model m;
@@ -373,6 +596,7 @@ Model parse(std::string_view text_in, std::string_view where) {
   if (j.contains("travel_mm")) read_travel(cx, j["travel_mm"], m);
   if (j.contains("components")) read_components(cx, j["components"], m);
   if (j.contains("squareness")) read_squareness(cx, j["squareness"], m);
+  if (j.contains("rotary")) read_rotary(cx, j["rotary"], m);
   if (j.contains("provenance")) m.provenance = {j["provenance"].dump()};
   check_tables_cover_travel(cx, m);
   check_polynomials_over_travel(cx, m);
@@ -390,7 +614,7 @@ Model read(const std::string& path) {
 
 std::string to_json(const Model& m) {
   Json j;
-  j["schema"] = kSchema;
+  j["schema"] = m.rotary.empty() ? kSchema : kSchemaRotary;
   if (!m.name.empty()) j["machine"] = m.name;
   j["topology"] = kin::to_string(m.machine.topology);
   j["units"] = {{"position", "mm"}, {"translation", "um"}, {"angle", "urad"}};
@@ -426,6 +650,11 @@ std::string to_json(const Model& m) {
     sq[std::string(kin::location_error_name(p))] = e;
   }
   j["squareness"] = sq;
+  if (!m.rotary.empty()) {
+    Json rot = Json::array();
+    for (const auto& r : m.rotary) rot.push_back(rotary_json(r));
+    j["rotary"] = rot;
+  }
   if (!m.provenance.json.empty()) j["provenance"] = Json::parse(m.provenance.json);
   return j.dump(2) + "\n";
 }
@@ -447,6 +676,32 @@ void write(const Model& m, const std::string& path) {
     std::filesystem::remove(tmp, ec);
     throw InputError(fmt::format("{}: cannot write the model file", path));
   }
+}
+
+kinematics::FiveAxisMachine five_axis(const Model& m) {
+  kinematics::FiveAxisMachine f;
+  f.linear = m.machine;
+  for (const auto& r : m.rotary) f.rotary.push_back(r.axis);
+  return f;
+}
+
+kinematics::ErrorFunction& rotary_component(kinematics::RotaryAxis& r, std::size_t dir) {
+  return component_of(r, dir);
+}
+const kinematics::ErrorFunction& rotary_component(const kinematics::RotaryAxis& r,
+                                                  std::size_t dir) {
+  return component_of(r, dir);
+}
+
+std::string rotary_component_name(kinematics::RotaryLetter l, std::size_t dir) {
+  return fmt::format("E_{}{}", kRotaryDirections.at(dir), kinematics::to_string(l));
+}
+
+void require_no_rotary(const Model& m, std::string_view file, std::string_view what) {
+  if (m.rotary.empty()) return;
+  throw InputError(fmt::format(
+      "{}: rotary: {} does not model rotary axes yet (the model has {}); it would ignore them",
+      file, what, m.rotary.size() == 1 ? "one" : "two"));
 }
 
 kinematics::Grid travel_grid(const Model& m, std::array<std::size_t, 3> count) {

@@ -107,7 +107,7 @@ TEST(ModelFile, WritingAndReadingAgainGivesTheSameModel) {
 TEST(ModelFile, MalformedAndInconsistentFilesAreRefused) {
   expect_refused("{\"schema\": ", "not valid JSON");
   expect_refused("[1, 2]", "expected a JSON object");
-  expect_refused(R"({"schema": "caldaq.model.v2"})", "schema", "caldaq.model.v1");
+  expect_refused(R"({"schema": "caldaq.model.v3"})", "schema", "caldaq.model.v1 nor caldaq.model.v2");
   expect_refused(file(R"("topology": "FXYZ")"), "topology", "twice");  // duplicate key
   expect_refused(R"({"schema": "caldaq.model.v1", "topology": "FXYZ",
     "units": {"position": "mm", "translation": "nm", "angle": "urad"}})",

@@ -93,6 +93,15 @@ VolumetricError five_axis_error(const FiveAxisMachine& machine, const Vec3& line
 Vec3 five_axis_nominal_tip_mm(const FiveAxisMachine& machine, const Vec3& linear_mm,
                               std::span<const double> angles_deg);
 
+// A simulated touch probe: the centre of a sphere fixed at sphere_mm on the workpiece (home
+// coordinates) as the control reports it when the ACTUAL machine probes it at these angles: the
+// linear position at which the actual tool tip is on the centre, plus the tool offset (the
+// nominal tip is affine in the linear position, so Newton's steps on it converge to 1e-12 mm in
+// a few). Spindle axes must be at 0 (what a control adds for a turned tool is its own
+// kinematics). Throws InputError as five_axis_error, and for a spindle axis not at 0.
+Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
+                      std::span<const double> angles_deg);
+
 // ---------------------------------------------------------------------------------------------
 // Sphere probing: the axis average line of one TABLE axis from sphere centres probed at
 // several of its angles (the other rotary axis at 0), fitted by least squares as a circle in

@@ -1,0 +1,427 @@
+// daq model probe | probe-sim: sphere probing of the rotary table axes. probe fits each table
+// axis's average line (location errors with their uncertainty, the residuals as the axis's
+// error motion) to the sphere centres a control's probing cycle exported; probe-sim is the
+// simulated touch probe: the centres a model (the simulated machine's truth) gives, with noise.
+// The maths: cal::kinematics (rotary.hpp), docs/kinematics.md "Sphere probing".
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "cal/analysis/error.hpp"
+#include "cal/analysis/rotary.hpp"
+#include "cal/analysis/text.hpp"
+#include "cal/analysis/trt_kins.hpp"
+#include "cli_checks.hpp"
+#include "command.hpp"
+#include "csv_columns.hpp"
+#include "model_cli.hpp"
+
+namespace daq {
+
+namespace kin = cal::kinematics;
+namespace mdl = cal::daq::model;
+using nlohmann::json;
+
+namespace {
+
+// --- probe: the fit ---------------------------------------------------------------------------
+
+struct ProbeOptions {
+  std::string centres, model, write, axis;
+  std::vector<double> pivot_mm;
+  double probe_u_um = 0.0;
+  bool json = false;
+};
+
+struct AxisCentres {
+  std::vector<kin::ProbedCentre> centres;
+  std::vector<int> lines;
+};
+
+// The centres of each axis, in file order. With --axis the whole file is that axis; otherwise
+// its "axis" column says which (A, B or C).
+std::map<kin::RotaryLetter, AxisCentres> read_centres(const ProbeOptions& o) {
+  const bool by_column = o.axis.empty();
+  const auto csv =
+      read_csv_columns(o.centres, {"angle_deg", "x_mm", "y_mm", "z_mm"},
+                       by_column ? std::vector<std::string>{"axis"} : std::vector<std::string>{});
+  std::map<kin::RotaryLetter, AxisCentres> out;
+  const kin::RotaryLetter fixed =
+      by_column ? kin::RotaryLetter::c : kin::rotary_letter_from_string(o.axis);
+  for (std::size_t r = 0; r < csv.rows(); ++r) {
+    kin::RotaryLetter letter = fixed;
+    if (by_column) {
+      const std::string& s = csv.texts.at("axis")[r];
+      if (s != "A" && s != "B" && s != "C" && s != "a" && s != "b" && s != "c")
+        throw cal::InputError(fmt::format("{}:{}: axis: '{}' is not a rotary axis (A, B or C)",
+                                          o.centres, csv.line[r], cal::text::terminal_safe(s)));
+      letter = kin::rotary_letter_from_string(s);
+    }
+    auto& a = out[letter];
+    a.centres.push_back(
+        {csv.numbers.at("angle_deg")[r],
+         {csv.numbers.at("x_mm")[r], csv.numbers.at("y_mm")[r], csv.numbers.at("z_mm")[r]}});
+    a.lines.push_back(csv.line[r]);
+  }
+  return out;
+}
+
+// The nominal pivot of a table axis: from the model's rotary axis of that letter, or --pivot-mm.
+kin::Vec3 pivot_of(const ProbeOptions& o, const std::optional<mdl::Model>& m, kin::RotaryLetter l) {
+  if (!m) return {o.pivot_mm.at(0), o.pivot_mm.at(1), o.pivot_mm.at(2)};
+  for (const auto& r : m->rotary) {
+    if (r.axis.letter != l) continue;
+    if (r.axis.side != kin::Side::table)
+      throw cal::InputError(
+          fmt::format("{}: the {} axis is on the spindle side: sphere probing "
+                      "fits table axes only (docs/kinematics.md)",
+                      o.model, kin::to_string(l)));
+    return r.axis.pivot_mm;
+  }
+  throw cal::InputError(
+      fmt::format("{}: {} has centres of the {} axis, the model has no such "
+                  "rotary axis",
+                  o.centres, o.model, kin::to_string(l)));
+}
+
+json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
+  const auto names = kin::location_error_names(f.letter);
+  const std::size_t own = kin::direction_index(f.letter);
+  json loc = json::object();
+  std::size_t n = 0;
+  for (std::size_t slot = 0; slot < 6; ++slot) {
+    if (slot % 3 == own) continue;
+    const bool pos = slot < 3;
+    const double v = pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
+    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
+    loc[names[n++]] = {{"value", v},
+                       {"uncertainty", std::isnan(u) ? json(nullptr) : json(u)},
+                       {"unit", pos ? "um" : "urad"}};
+  }
+  json res = json::array();
+  for (std::size_t k = 0; k < a.centres.size(); ++k)
+    res.push_back({{"line", a.lines[k]},
+                   {"angle_deg", a.centres[k].angle_deg},
+                   {"radial_um", f.radial_um[k]},
+                   {"axial_um", f.axial_um[k]},
+                   {"tangential_um", f.tangential_um[k]}});
+  return {{"axis", kin::to_string(f.letter)},
+          {"nominal_pivot_mm", json::array({pivot[0], pivot[1], pivot[2]})},
+          {"centres", a.centres.size()},
+          {"location", loc},
+          {"radius_mm", f.radius_mm},
+          {"plane_offset_mm", f.plane_offset_mm},
+          {"rms_um", f.rms_um},
+          {"sigma_um", f.sigma_um},
+          {"dof", f.dof},
+          {"residuals", res}};
+}
+
+void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
+  fmt::print("Axis {}: {} probed centres, nominal pivot ({:g}, {:g}, {:g}) mm\n",
+             kin::to_string(f.letter), a.centres.size(), pivot[0], pivot[1], pivot[2]);
+  const auto names = kin::location_error_names(f.letter);
+  const std::size_t own = kin::direction_index(f.letter);
+  std::size_t n = 0;
+  for (std::size_t slot = 0; slot < 6; ++slot) {
+    if (slot % 3 == own) continue;
+    const bool pos = slot < 3;
+    const double v = pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
+    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
+    fmt::print("  {:6} {:+10.3f} {:4}  u = {}\n", names[n++], v, pos ? "um" : "urad",
+               std::isnan(u) ? std::string("not estimated (3 angles: give --probe-u-um)")
+                             : fmt::format("{:.3f} {}", u, pos ? "um" : "urad"));
+  }
+  fmt::print("  circle radius {:.4f} mm, its plane {:+.4f} mm from the pivot along the axis\n",
+             f.radius_mm, f.plane_offset_mm);
+  fmt::print(
+      "  residuals (the axis's error motion at the sphere, and probing noise): RMS {:.3f} "
+      "um, sigma {:.3f} um, {} degrees of freedom\n",
+      f.rms_um, f.sigma_um, f.dof);
+  fmt::print("  {:>6} {:>10} {:>10} {:>10} {:>12}\n", "line", "angle_deg", "radial_um", "axial_um",
+             "tangential_um");
+  for (std::size_t k = 0; k < a.centres.size(); ++k)
+    fmt::print("  {:6} {:10.3f} {:+10.3f} {:+10.3f} {:+12.3f}\n", a.lines[k],
+               a.centres[k].angle_deg, f.radial_um[k], f.axial_um[k], f.tangential_um[k]);
+}
+
+// The fitted location errors into the model's axis, with their uncertainty and where they came
+// from.
+void put_fit(mdl::RotaryEntry& r, const kin::AxisLineFit& f, const std::string& centres,
+             std::size_t count) {
+  const std::size_t own = kin::direction_index(f.letter);
+  std::size_t n = 0;
+  for (std::size_t slot = 0; slot < 6; ++slot) {
+    if (slot % 3 == own) continue;
+    const bool pos = slot < 3;
+    (pos ? r.axis.location_position_um[slot] : r.axis.location_orientation_urad[slot - 3]) =
+        pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
+    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
+    auto& e = r.location[n++];
+    e.given = true;
+    e.uncertainty = std::isnan(u) ? std::optional<double>{} : std::optional<double>{u};
+    e.source = {json{
+        {"kind", "sphere probing"},
+        {"centres_file", centres},
+        {"centres", count},
+        {"rms_um",
+         f.rms_um}}.dump()};
+  }
+}
+
+void run_probe(const ProbeOptions& o) {
+  if (o.model.empty() && (o.axis.empty() || o.pivot_mm.size() != 3))
+    throw cal::InputError("give --model (the pivots of its table axes) or --axis and --pivot-mm");
+  if (!o.model.empty() && !o.pivot_mm.empty())
+    throw cal::InputError("--pivot-mm is for a fit without --model (the model has the pivots)");
+  if (!o.write.empty() && o.model.empty())
+    throw cal::InputError("--write needs --model (the model the fitted errors go into)");
+  std::optional<mdl::Model> m;
+  if (!o.model.empty()) m = mdl::read(o.model);
+  const auto by_axis = read_centres(o);
+  json fits = json::array();
+  for (const auto& [letter, a] : by_axis) {
+    const kin::Vec3 pivot = pivot_of(o, m, letter);
+    kin::AxisLineFit f;
+    try {
+      f = kin::fit_axis_line(letter, pivot, a.centres, o.probe_u_um);
+    } catch (const cal::InputError& e) {
+      throw cal::InputError(fmt::format("{}: the {} axis's {} centres (lines {} .. {}): {}",
+                                        o.centres, kin::to_string(letter), a.centres.size(),
+                                        a.lines.front(), a.lines.back(), e.what()));
+    }
+    if (o.json)
+      fits.push_back(fit_json(f, pivot, a));
+    else
+      print_fit(f, pivot, a);
+    if (m)
+      for (auto& r : m->rotary)
+        if (r.axis.letter == letter) put_fit(r, f, o.centres, a.centres.size());
+  }
+  if (o.json)
+    fmt::print("{}\n", json{{"schema", "caldaq.axis-line-fit.v1"},
+                            {"centres_file", o.centres},
+                            {"probe_u_um", o.probe_u_um},
+                            {"axes", fits}}
+                           .dump(2));
+  if (!o.write.empty()) {
+    mdl::write(*m, o.write);
+    fmt::print(stderr, "model with the fitted location errors written to {}\n", o.write);
+  }
+}
+
+// --- probe-check: the centres against the control's kinematics --------------------------------
+
+struct CheckOptions {
+  std::string centres, model, hal, axis;
+  bool json = false;
+};
+
+std::string read_text(const std::string& path, std::string_view what) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  if (!in || !(ss << in.rdbuf()))
+    throw cal::InputError(fmt::format("{}: cannot read the {}", path, what));
+  return ss.str();
+}
+
+// The deviation of each probed centre from where the control's kinematics expects it: the
+// sphere's place on the workpiece is what the control saw at angle 0 (where location errors
+// move nothing), found so that the control's own prediction there is the centre probed there.
+void run_probe_check(const CheckOptions& o) {
+  const mdl::Model m = mdl::read(o.model);
+  kin::FiveAxisMachine control = mdl::five_axis(m);
+  if (!o.hal.empty()) {
+    try {
+      control = kin::trt_control_machine(
+          kin::parse_linuxcnc_trt_hal(read_text(o.hal, "HAL file"), o.hal), control);
+    } catch (const cal::InputError& e) {
+      throw cal::InputError(fmt::format("{} with {}: {}", o.hal, o.model, e.what()));
+    }
+  }
+  const ProbeOptions as_probe{o.centres, "", "", o.axis, {}, 0.0, false};
+  json axes = json::array();
+  for (const auto& [letter, a] : read_centres(as_probe)) {
+    std::size_t index = control.rotary.size();
+    for (std::size_t i = 0; i < control.rotary.size(); ++i)
+      if (control.rotary[i].letter == letter) index = i;
+    if (index == control.rotary.size())
+      throw cal::InputError(fmt::format("{}: centres of the {} axis, {} has no such axis",
+                                        o.centres, kin::to_string(letter), o.model));
+    const auto angles_at = [&](double deg) {
+      std::vector<double> v(control.rotary.size(), 0.0);
+      v[index] = deg;
+      return v;
+    };
+    const auto zero = std::find_if(a.centres.begin(), a.centres.end(), [](const auto& c) {
+      return std::abs(std::remainder(c.angle_deg, 360.0)) < 1e-9;
+    });
+    if (zero == a.centres.end())
+      throw cal::InputError(
+          fmt::format("{}: no centre of the {} axis at 0 deg (the sphere's place "
+                      "on the workpiece is taken there)",
+                      o.centres, kin::to_string(letter)));
+    kin::Vec3 sphere = zero->centre_mm;
+    for (int it = 0; it < 6; ++it) {
+      const auto at0 = kin::probed_centre_mm(control, sphere, angles_at(zero->angle_deg));
+      for (std::size_t k = 0; k < 3; ++k) sphere[k] += zero->centre_mm[k] - at0[k];
+    }
+    double sum = 0.0, worst = 0.0;
+    json rows = json::array();
+    if (!o.json)
+      fmt::print("Axis {}: {} centres against {}{}\n  {:>6} {:>10} {:>9} {:>9} {:>9} {:>9}\n",
+                 kin::to_string(letter), a.centres.size(), o.model,
+                 o.hal.empty() ? "" : " with " + o.hal, "line", "angle_deg", "dx_um", "dy_um",
+                 "dz_um", "|d|_um");
+    for (std::size_t k = 0; k < a.centres.size(); ++k) {
+      const auto want = kin::probed_centre_mm(control, sphere, angles_at(a.centres[k].angle_deg));
+      kin::Vec3 d;
+      for (std::size_t i = 0; i < 3; ++i) d[i] = 1e3 * (a.centres[k].centre_mm[i] - want[i]);
+      const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      sum += n * n;
+      worst = std::max(worst, n);
+      if (o.json)
+        rows.push_back({{"line", a.lines[k]},
+                        {"angle_deg", a.centres[k].angle_deg},
+                        {"deviation_um", json::array({d[0], d[1], d[2]})}});
+      else
+        fmt::print("  {:6} {:10.3f} {:+9.3f} {:+9.3f} {:+9.3f} {:9.3f}\n", a.lines[k],
+                   a.centres[k].angle_deg, d[0], d[1], d[2], n);
+    }
+    const double rms = std::sqrt(sum / static_cast<double>(a.centres.size()));
+    if (o.json)
+      axes.push_back({{"axis", kin::to_string(letter)},
+                      {"max_um", worst},
+                      {"rms_um", rms},
+                      {"centres", rows}});
+    else
+      fmt::print("  largest deviation {:.3f} um, RMS {:.3f} um\n", worst, rms);
+  }
+  if (o.json)
+    fmt::print("{}\n", json{{"schema", "caldaq.probe-check.v1"},
+                            {"centres_file", o.centres},
+                            {"model", o.model},
+                            {"hal", o.hal},
+                            {"axes", axes}}
+                           .dump(2));
+}
+
+// --- probe-sim: the simulated touch probe ----------------------------------------------------
+
+struct SimOptions {
+  std::string truth, axis, output;
+  std::vector<double> sphere_mm, angles_deg;
+  double noise_um = 0.0;
+  unsigned seed = 1;
+};
+
+void run_probe_sim(const SimOptions& o) {
+  const mdl::Model m = mdl::read(o.truth);
+  const kin::RotaryLetter letter = kin::rotary_letter_from_string(o.axis);
+  const auto machine = mdl::five_axis(m);
+  std::size_t index = machine.rotary.size();
+  for (std::size_t i = 0; i < machine.rotary.size(); ++i)
+    if (machine.rotary[i].letter == letter) index = i;
+  if (index == machine.rotary.size())
+    throw cal::InputError(
+        fmt::format("{}: no {} axis in the model", o.truth, kin::to_string(letter)));
+  const kin::Vec3 sphere{o.sphere_mm.at(0), o.sphere_mm.at(1), o.sphere_mm.at(2)};
+  std::mt19937 rng(o.seed);
+  std::normal_distribution<double> noise(0.0, o.noise_um * 1e-3);
+  std::string text = fmt::format(
+      "# simulated touch probe: sphere at ({:g}, {:g}, {:g}) mm on the workpiece, machine {}, "
+      "noise {:g} um per coordinate (seed {})\naxis,angle_deg,x_mm,y_mm,z_mm\n",
+      sphere[0], sphere[1], sphere[2], o.truth, o.noise_um, o.seed);
+  for (double deg : o.angles_deg) {
+    std::vector<double> angles(machine.rotary.size(), 0.0);
+    angles[index] = deg;
+    kin::Vec3 c = kin::probed_centre_mm(machine, sphere, angles);
+    for (double& x : c) x += o.noise_um > 0.0 ? noise(rng) : 0.0;
+    text += fmt::format("{},{:g},{:.6f},{:.6f},{:.6f}\n", kin::to_string(letter), deg, c[0], c[1],
+                        c[2]);
+  }
+  if (o.output.empty()) return fmt::print("{}", text);
+  std::ofstream out(o.output, std::ios::binary);
+  if (!(out << text) || !(out.close(), out))
+    throw cal::InputError(fmt::format("{}: cannot write the centres", o.output));
+  fmt::print(stderr, "{} probed centres written to {}\n", o.angles_deg.size(), o.output);
+}
+
+}  // namespace
+
+void add_model_probe_commands(CLI::App& model) {
+  const auto [probe, p] = add_command<ProbeOptions>(
+      model, "probe", run_probe,
+      "Fit each rotary table axis's average line to probed sphere centres (a CSV: axis, "
+      "angle_deg, x_mm, y_mm, z_mm): its location errors with their uncertainty and the "
+      "residuals");
+  probe
+      ->add_option("centres", p->centres,
+                   "CSV of probed centres in machine coordinates: angle_deg, x_mm, y_mm, z_mm, "
+                   "and axis (A, B or C) unless --axis is given")
+      ->required();
+  probe->add_option("--model", p->model,
+                    "Model file (caldaq.model.v2) giving each table axis's nominal pivot");
+  probe
+      ->add_option("--axis", p->axis,
+                   "The rotary axis of every centre (the file has no axis column)")
+      ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
+  probe->add_option("--pivot-mm", p->pivot_mm, "Nominal pivot X Y Z (with --axis, no --model)")
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
+  probe
+      ->add_option("--probe-u-um", p->probe_u_um,
+                   "Standard uncertainty of one probed centre per coordinate (0: from the "
+                   "residuals, needs 4 or more angles)")
+      ->check(finite_in(0.0, 1e4));
+  probe->add_option("--write", p->write,
+                    "Write the model with the fitted location errors (and their uncertainty and "
+                    "source) to this file");
+  probe->add_flag("--json", p->json, "Print caldaq.axis-line-fit.v1 JSON");
+
+  const auto [check, c] = add_command<CheckOptions>(
+      model, "probe-check", run_probe_check,
+      "Compare probed sphere centres with where the control's kinematics expects them (the "
+      "model's, or LinuxCNC trunnion pins from --hal): the residual before and after a "
+      "correction");
+  check->add_option("centres", c->centres, "CSV of probed centres, as for daq model probe")
+      ->required();
+  check->add_option("--model", c->model, "Model file: the machine as the control believes it")
+      ->required();
+  check->add_option("--hal", c->hal,
+                    "HAL file of xyzac-trt-kins / xyzbc-trt-kins pivot pins (setp lines, as daq "
+                    "model kinematics writes them): the control's rotary axes on those lines");
+  check->add_option("--axis", c->axis, "The rotary axis of every centre (no axis column)")
+      ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
+  check->add_flag("--json", c->json, "Print caldaq.probe-check.v1 JSON");
+
+  const auto [sim, s] = add_command<SimOptions>(
+      model, "probe-sim", run_probe_sim,
+      "Simulated touch probe: the sphere centres a model (the simulated machine's truth) reports "
+      "at the given angles of one table axis, the other at 0, as a CSV for daq model probe");
+  sim->add_option("truth", s->truth, "Model file of the simulated machine (its truth)")->required();
+  sim->add_option("--axis", s->axis, "The table axis turned")
+      ->required()
+      ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
+  sim->add_option("--sphere-mm", s->sphere_mm, "Sphere centre on the workpiece X Y Z (home)")
+      ->required()
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
+  sim->add_option("--angles-deg", s->angles_deg, "Angles of the axis at which to probe")
+      ->required()
+      ->check(finite_in(-3600.0, 3600.0));
+  sim->add_option("--noise-um", s->noise_um,
+                  "Gaussian noise per coordinate of each centre, standard deviation")
+      ->check(finite_in(0.0, 1e4));
+  sim->add_option("--seed", s->seed, "Seed of the noise")->capture_default_str();
+  sim->add_option("-o,--output", s->output, "Write the CSV here (default: standard output)");
+}
+
+}  // namespace daq
