@@ -63,6 +63,7 @@ struct PolarChart {
   int size_pt = 400;
   std::string centre_text;  // written at the centre, e.g. "G = 6.96 µm"
   bool mark_start = true;   // each trace's first point marked, an arrow in its direction
+  double text_scale = 1.0;  // > 1 for a plot shown narrow (beside a table: its text stays 9 pt)
 };
 
 // Every text of a chart (titles, axis labels, legends, category labels) is data-safe: it is

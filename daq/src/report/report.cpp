@@ -1086,6 +1086,10 @@ Circle analyse_circle(const st::Store& store, const RunView& v, const Options& o
   return c;
 }
 
+// The text of a polar plot shown beside a table (CSS .pair: half the page's width, 243 pt of
+// its 400): 11 pt times 1.4 prints at 9.4 pt.
+constexpr double polar_beside_text_scale = 1.4;
+
 PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_offset,
                     std::string_view label_prefix) {
   const std::string plane = c.analysis.plane.size() == 2 ? c.analysis.plane : "XY";
@@ -1243,8 +1247,8 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
 std::string fix_first_notes(const cal::circle::Result& r, const ::daq::Verdict& verdict,
                             std::size_t top) {
   std::string h =
-      "<p class=\"note\">Errors outside their limit first, then the largest gain in G (what "
-      "correcting that error alone takes off the circularity); every error under Details.</p>\n";
+      "<p class=\"note\">Errors outside their limit first, then by the gain in G (what "
+      "correcting that error alone takes off G); every error under Details.</p>\n";
   for (std::size_t i : fix_first_order(r, verdict, top)) {
     const auto& d = r.diagnostics[i];
     if (std::round(d.g_reduction_um * 1e3) >= 0) continue;
@@ -1280,22 +1284,28 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
   headline.standard = st.label;
   Sections out;
   std::string& h = out.answer;
+  // Page one names the standard and the test in one line; its full title under Details.
   h = fmt::format(
-      "<h3>Results: {0}</h3>\n<p class=\"standard\">Evaluated by <strong>{0}</strong> ({1}){2}; "
-      "radius {3:g} mm, feed {4:g} mm/min, plane {5}, both directions from the stored bar "
-      "readings.</p>\n",
-      esc(st.label), esc(st.title),
+      "<h3>Results: {0}</h3>\n<p class=\"standard\"><strong>{0}</strong>{1}: radius {2:g} mm, "
+      "feed {3:g} mm/min, plane {4}, both directions.</p>\n",
+      esc(st.label),
       st.identical.empty() ? std::string()
-                           : fmt::format(", the same values as {}", esc(st.identical.front())),
+                           : fmt::format(" (the same values as {})", esc(st.identical.front())),
       c.program.radius_mm, c.program.feed_mm_per_min, esc(c.analysis.plane));
+  const std::string evaluated = fmt::format(
+      "<p class=\"standard\">Evaluated by <strong>{}</strong> ({}) from the stored bar "
+      "readings.</p>\n",
+      esc(st.label), esc(st.title));
   const auto doc = ::daq::circle_document(r, c.program, c.analysis);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
   std::vector<std::vector<std::string>> iso;
   for (const auto& x : ::daq::circle_rows(doc)) {  // as every output lists them
     const auto* check = ::daq::find_check(verdict, x.key);
-    iso.push_back({esc(x.symbol), um(x.value), esc(x.description), limit_cell(check),
-                   check ? verdict_cell(check) : ""});
+    // What the symbol means under it: the table stands beside the polar plot, half the page
+    // wide, where a column of its own was squeezed to a word a line.
+    iso.push_back({esc(x.symbol) + "<br><span class=\"meaning\">" + esc(x.description) + "</span>",
+                   um(x.value), limit_cell(check), check ? verdict_cell(check) : ""});
     if (x.key.starts_with("G")) headline.values.push_back({x.symbol, x.value, unit_text(x.unit)});
   }
   // The set-up's centre and the informative values follow under Details (page one holds the
@@ -1307,25 +1317,29 @@ Sections circle_section(const st::Store& store, const RunView& v, const Options&
     other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
                      "<em>informative</em>: " + esc(x.meaning)});
   h += verdict_banner(verdict);
-  h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
-             "lrlrl");
+  // Page one holds the verdict, the values, the polar plot and what to fix first: the values
+  // beside the plot (one under the other pushed "what to fix first" onto page two). The plot's
+  // text is drawn larger so that, shown at half the page's width, it still prints at 9 pt.
+  auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
+  polar.centre_text = "G = " + um(r.iso.G_bi_um) + " µm";
+  polar.text_scale = polar_beside_text_scale;
+  h += "<div class=\"pair\"><div>" +
+       table({"symbol and meaning", "value (µm)", "limit (µm)", "verdict"}, iso,
+             "num results beside", "lrrl") +
+       "</div>" +
+       "<figure>" + svg(polar) + "</figure>" +
+       "</div>\n";
   const auto first = diagnostics_table(r, verdict, 3);
   h += "<h4>What to fix first</h4>\n" +
        (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
                       : first + fix_first_notes(r, verdict, 3));
-  auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
-  polar.centre_text = "G = " + um(r.iso.G_bi_um) + " µm";
-  h += figure(svg(polar),
-              "Radial deviation of both directions around the nominal circle (magnified: the "
-              "rings are the scale, the dark ring the nominal radius). The open circle marks "
-              "where each trace starts, the arrow its direction of travel.");
   // The campaign summary's headline: the first diagnostics in their own units.
   for (std::size_t i = 0; i < r.diagnostics.size() && i < 4; ++i)
     headline.values.push_back(
         {r.diagnostics[i].name, r.diagnostics[i].value, unit_text(r.diagnostics[i].unit)});
 
   std::string& d = out.details;
-  d = "<h3>Details of the results</h3>\n" +
+  d = "<h3>Details of the results</h3>\n" + evaluated +
       table({"symbol", "value (µm)", "meaning"}, other, "num results", "lrl") +
       "<h4>Diagnostics, ranked by what correcting each would gain</h4>\n" +
       diagnostics_table(r, verdict, 0) + gain_notes(r);
@@ -1439,7 +1453,7 @@ table.kv thead { display: none; }
 table.results td:first-child { font-weight: bold; }
 figure { margin: 1rem 0; page-break-inside: avoid; break-inside: avoid; }
 svg.plot { width: 100%; height: auto; max-width: 60rem; display: block; }
-figcaption { font-size: .85rem; color: #444; }
+figcaption { font-size: .9rem; color: #444; }
 .warning { color: #a40; } .note { color: #444; font-size: .9rem; }
 .simulated { background: #fff3cd; border: 1px solid #e0b000; padding: .5rem; }
 footer { margin-top: 2rem; font-size: .8rem; color: #666; border-top: 1px solid #ccc;
@@ -1447,9 +1461,12 @@ footer { margin-top: 2rem; font-size: .8rem; color: #666; border-top: 1px solid 
 h3, h4 { break-after: avoid; page-break-after: avoid; }
 table { break-inside: auto; } tr { break-inside: avoid; }
 table.summary { width: 100%; margin: .3rem 0 .6rem; }
-table.summary th { width: 13%; background: none; color: #555; font-weight: normal; }
-table.summary td { width: 37%; }
+table.summary th { width: 1%; white-space: nowrap; background: none; color: #555;
+                   font-weight: normal; }
+table.summary td { width: 49%; }
 table.results td:first-child { white-space: nowrap; }
+table.beside td:first-child { white-space: normal; } table.beside td.r, table.diag td.r { width: 1%; }
+.meaning { font-weight: normal; color: #444; }
 .verdict.suspect { background: #fff0d9; border: 1px solid #d68000; }
 .verdict.suspect ul, ul.failing { margin: .2rem 0 .4rem; }
 .verdict.fail + ul.failing { background: #fde8e4; margin-top: -.6rem; padding: .2rem 1.5rem;
@@ -1457,11 +1474,17 @@ table.results td:first-child { white-space: nowrap; }
 svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
-@media print { body { margin: 0; max-width: none; font-size: 10pt; } h1 { font-size: 14pt; }
+.pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
+        align-items: start; }
+.pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
+@media print { html { font-size: 10pt; }
+  body { margin: 0; max-width: none; font-size: 10pt; line-height: 1.3; } h1 { font-size: 14pt; }
   th, td { padding: .08rem .4rem; } h3 { margin: 1rem 0 .4rem; } h4 { margin: .6rem 0 .3rem; }
   figure { margin: .4rem 0; } .verdict { margin: .4rem 0; } p { margin: .4rem 0; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
-  svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; } }
+  svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; }
+  .pair svg.plot.polar { max-width: 100%; } }
+.pair svg.plot.polar { max-width: 100%; }
 )";
 
 // The printed page: a running header (the report's title and who it is for) and "page n of
