@@ -178,7 +178,7 @@ grid_values = [c for row in grid for c in row[1:4] if re.fullmatch(r"-?\d+\.\d{3
 check("linear report: the grid reads as daq show 1, row by row",
       grid_values == [v for _, v in outputs["daq show 1"]], f"{grid_values}")
 circle_html = open("circle.html", encoding="utf-8").read()
-circle_table = cells(circle_html, "num results")
+circle_table = cells(circle_html, "num results beside")
 # Page one's table gives the meaning under each symbol (it stands beside the polar plot).
 check("circle report: the standard's values as daq show 2",
       [(next((s for s, _ in circle_values if r[0].startswith(s)), r[0]), r[1])
@@ -205,9 +205,11 @@ for name in ("linear", "vdi3441", "suspect", "circle"):
 for name in ("linear", "suspect"):
     p1 = text[name][0]
     # The main table: the grid of E, R, A, M, B with up, down, bidirectional, limit, verdict.
+    # Its head and rows (pdftotext may read the head's last cells after the first row).
     check(f"{name}: main table on page one",
-          re.search(r"value \(µm\) ↑ up ↓ down bidirectional limit \(µm\) verdict", p1) is not None
-          and "E — systematic positional deviation" in p1 and "B̄ — mean reversal value" in p1, p1)
+          all(w in p1 for w in ("value (µm) ↑ up ↓ down bidirectional", "limit (µm) verdict",
+                                "E — systematic positional deviation", "B̄ — mean reversal value")),
+          p1)
     check(f"{name}: failing values named on page one",
           re.search(r"FAIL.*limit ≤ [0-9.]+ µm\)", p1) is not None, p1)
     # The main plot on page one too (it was on page two).
@@ -223,7 +225,7 @@ check("vdi3441: a verdict, not 'No tolerance'", "Verdict against the machine spe
 # The failing value in the verdict as in the table: "U max = 4.023 µm", not "+4.023".
 check("vdi3441: the failing value as the table prints it",
       re.search(r"U max = [0-9.]+ µm \(limit ≤", v1) is not None
-      and re.search(r"U max [0-9.]+ largest reversal span", v1) is not None, v1)
+      and re.search(r"[0-9.]+ largest reversal span", v1) is not None, v1)
 check("vdi3441: main plot on page one", "Mean positional deviation with ±2s" in v1, v1)
 check("run quality says its state once",
       all("ok — ok" not in p and "ok - ok" not in p for n in text for p in text[n]), "")
@@ -233,7 +235,8 @@ check("suspect: SUSPECT RUN on page one with its stop",
 check("linear (clean): no SUSPECT", all("SUSPECT RUN" not in p for p in text["linear"]), "")
 c1 = text["circle"][0]
 check("circle: main table on page one", "symbol and meaning value (µm) limit (µm) verdict" in c1
-      and re.search(r"G\(b\) bi-directional circular deviation [0-9.]+", c1) is not None, c1)
+      and "G(b) bi-directional circular deviation" in c1
+      and re.search(r"[0-9.]+ ≤ 10\.000 pass", c1) is not None, c1)
 # Page one holds all four: the verdict, the values, the polar plot and what to fix first with its
 # three rows (the plot under the values pushed what to fix first onto page two; before that the
 # plot was on page two).
@@ -299,7 +302,7 @@ for run in (1, 2):
     first = next((p for p in camp if re.search(rf"SIMULATED — Run {run}: \w+ test", p)), "")
     check(f"campaign: run {run}'s verdict and table on its first page",
           "Verdict against the machine specification" in first
-          and re.search(r"(↑ up ↓ down bidirectional|symbol value \(µm\) meaning)", first)
+          and re.search(r"(↑ up ↓ down bidirectional|symbol and meaning value \(µm\))", first)
           is not None, first[:500])
 
 # --- nothing past the right margin ------------------------------------------------------------

@@ -141,8 +141,9 @@ struct LegendEntry {
 };
 
 // `columns` 0: one column; `y` the offset from the position, in the viewport's height.
+// text_scale: the legend's text against PLplot's default size (pllegend does not follow plschr).
 void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
-                 PLFLT y = 0.0) {
+                 PLFLT y = 0.0, PLFLT text_scale = 1.0) {
   if (entries.empty()) return;
   const auto n = static_cast<PLINT>(entries.size());
   std::vector<PLINT> opt, colours, text_colours, styles, box_patterns, symbol_numbers;
@@ -163,10 +164,10 @@ void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT 
   PLFLT w = 0, h = 0;
   const PLINT rows = columns > 0 ? (n + columns - 1) / columns : 0;
   pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, y, 0.05, 0,
-           axes_colour, 1, rows, columns, n, opt.data(), 0.6, 1.0, 1.8, 0.0, text_colours.data(),
-           texts.data(), colours.data(), box_patterns.data(), scales.data(), widths.data(),
-           colours.data(), styles.data(), widths.data(), colours.data(), scales.data(),
-           symbol_numbers.data(), symbols.data());
+           axes_colour, 1, rows, columns, n, opt.data(), 0.6, text_scale, 1.8, 0.0,
+           text_colours.data(), texts.data(), colours.data(), box_patterns.data(), scales.data(),
+           widths.data(), colours.data(), styles.data(), widths.data(), colours.data(),
+           scales.data(), symbol_numbers.data(), symbols.data());
 }
 
 void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
@@ -467,7 +468,7 @@ std::string svg(const PolarChart& chart) {
   if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
   // Below the scale's line.
   draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
-              legend_top_pt / side);
+              legend_top_pt / side, chart.text_scale);
   return s.finish(chart.title, "plot polar");
 }
 

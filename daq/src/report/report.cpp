@@ -866,7 +866,7 @@ std::string means_plot(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
-                .height_pt = 170,  // page one holds it below the verdict and the grid
+                .height_pt = 150,  // page one holds it below the verdict and the grid
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
   means.bands.push_back(
@@ -894,10 +894,8 @@ std::string means_plot(const Linear& l) {
                            .width = 1.0,
                            .dashed = true});
   }
-  return figure(svg(means),
-                "Mean unidirectional positional deviations x̄i↑ and x̄i↓ at each target, "
-                "with the bands x̄ ± 2s (s: the estimator of the unidirectional "
-                "repeatability), and the mean bidirectional deviation.");
+  // One line of caption (the legend names the lines): a suspect run's page one holds it too.
+  return figure(svg(means), "Bands x̄ ± 2s, s: the estimator of the unidirectional repeatability.");
 }
 
 std::string runs_plot(const Linear& l) {
@@ -1803,7 +1801,9 @@ constexpr std::size_t max_run_columns = 11;
 std::string transposed(const std::vector<std::string>& head,
                        const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::string> runs{"value"};
-  for (const auto& r : rows) runs.push_back("run " + r.at(0) + "<br>" + r.at(1));
+  for (const auto& r : rows)
+    runs.push_back(r.at(1).find("run ") != std::string::npos ? r.at(1)
+                                                             : "run " + r.at(0) + "<br>" + r.at(1));
   std::vector<std::vector<std::string>> values;
   for (std::size_t j = 2; j < head.size(); ++j) {
     values.push_back({head[j]});
@@ -1868,6 +1868,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
   std::map<std::string, std::string> units;  // key -> unit as printed
   std::vector<std::string> trend_order;
   std::vector<std::vector<std::string>> rows;
+  std::vector<std::map<std::string, std::string>> cells;  // per run: key -> its value's cell
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
                   .x_label = "target position (mm)",
                   .y_label = "deviation (µm)",
@@ -1905,8 +1906,9 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     // A re-compensated run is compared with the values it has now, and says so.
     std::vector<std::string> row{
         std::to_string(v.run.id) +
-            (v.used.recompensated ? " <span class=\"changed\">re-compensated</span>" : ""),
+            (v.used.recompensated ? "<br><span class=\"changed\">re-compensated</span>" : ""),
         "<span class=\"nw\">" + dates[i] + "</span>"};
+    std::map<std::string, std::string> by_key;  // the value cells, placed by key below
     // A linear run's table keeps to the values a specification limits (the unidirectional ones
     // are in each run's report): all twelve would not fit a printed page.
     if (v.run.kind == "linear" &&
@@ -1925,9 +1927,9 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
       trends[x.key].y.push_back(x.value);
       const auto* check = ::daq::find_check(verdict, x.key);
       if (check) limits[x.key] = check->limit;
-      row.push_back(um(x.value) + (check ? (check->pass ? " <span class=\"pass\">✓</span>"
-                                                        : " <span class=\"fail\">✗</span>")
-                                         : ""));
+      by_key[x.key] = um(x.value) + (check ? (check->pass ? " <span class=\"pass\">✓</span>"
+                                                          : " <span class=\"fail\">✗</span>")
+                                           : "");
     }
     row.push_back(!verdict.configured ? "<span class=\"unstated\">no tolerance</span>"
                   : verdict.pass      ? "<span class=\"pass\">PASS</span>"
@@ -1936,6 +1938,17 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     row.push_back(air.n ? fmt::format("{:.2f}", air.mean) : "&ndash;");
     row.push_back(mat.n ? fmt::format("{:.2f}", mat.mean) : "&ndash;");
     rows.push_back(std::move(row));
+    cells.push_back(std::move(by_key));
+  }
+  // Each run's values under their own column: a circle's diagnostics come ranked by their gain,
+  // in another order in each run (run 5's squareness stood under "Backlash Y").
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::vector<std::string> value_cells;
+    for (const auto& k : trend_order) {
+      const auto it = cells[i].find(k);
+      value_cells.push_back(it == cells[i].end() ? "&ndash;" : it->second);
+    }
+    rows[i].insert(rows[i].begin() + 2, value_cells.begin(), value_cells.end());
   }
   std::vector<std::string> head{"run", "date"};
   for (const auto& k : trend_order) head.push_back(esc(names[k]));
