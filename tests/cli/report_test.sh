@@ -68,7 +68,7 @@ check circle_directions 0 "counter-clockwise" -- cat r2.html
 
 # --- campaign and comparison -------------------------------------------------------------------
 check campaign 0 "campaign report of runs 1, 2, 3" -- "$DAQ" report --campaign "demo (simulated)" --db demo.sqlite -o camp.html
-check campaign_sections 0 "^3$" -- count camp.html "<h2 id=\"run-"
+check campaign_sections 0 "^3$" -- count camp.html "<h2 class=\"run\" id=\"run-"
 check campaign_summary 0 "<a href=\"#run-2\">2</a>" -- cat camp.html
 check compare 0 "comparison report of runs 1, 3" -- "$DAQ" report --compare 1 3 --db demo.sqlite -o cmp.html
 check compare_overlay 0 "Mean bidirectional deviation, run by run" -- cat cmp.html

@@ -866,7 +866,7 @@ std::string means_plot(const Linear& l) {
   XyChart means{.title = "Mean positional deviation with ±2s",
                 .x_label = "target position (mm)",
                 .y_label = "deviation (µm)",
-                .height_pt = 150,  // page one holds it below the verdict and the grid
+                .height_pt = 170,  // page one holds it below the verdict and the grid
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
   means.bands.push_back(
@@ -1510,8 +1510,8 @@ table.results, table.diag { width: 100%; }
 .pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
 @media print { html { font-size: 10pt; }
   body { margin: 0; padding: 0; max-width: none; font-size: 10pt; line-height: 1.3; } h1 { font-size: 14pt; }
-  th, td { padding: .08rem .4rem; } h3 { margin: 1rem 0 .4rem; } h4 { margin: .6rem 0 .3rem; }
-  figure { margin: .4rem 0; } .verdict { margin: .4rem 0; } p { margin: .4rem 0; }
+  th, td { padding: .08rem .4rem; } h3 { margin: .8rem 0 .3rem; } h4 { margin: .5rem 0 .3rem; }
+  figure { margin: .3rem 0; } .verdict { margin: .3rem 0; } p { margin: .3rem 0; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
   svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; }
   .pair svg.plot.polar { max-width: 100%; }
@@ -1907,7 +1907,7 @@ std::string comparison_report(const st::Store& store, std::span<const std::int64
     std::vector<std::string> row{
         std::to_string(v.run.id) +
             (v.used.recompensated ? "<br><span class=\"changed\">re-compensated</span>" : ""),
-        "<span class=\"nw\">" + dates[i] + "</span>"};
+        dates[i]};  // may wrap: the table of a re-compensated run printed shrunk to fit
     std::map<std::string, std::string> by_key;  // the value cells, placed by key below
     // A linear run's table keeps to the values a specification limits (the unidirectional ones
     // are in each run's report): all twelve would not fit a printed page.
