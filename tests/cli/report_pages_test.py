@@ -5,7 +5,9 @@ the campaign, the comparison, as found / as left) is printed to PDF by `daq repo
 (headless Chromium), its pages read back as text (pdftotext, poppler-utils) and checked: the
 verdict, the failing values and the main table on the first page of the report (for a campaign,
 on the first page of each run's section); a suspect run says so there, traceability gaps are
-warned there; the campaign summary gives each value in its own unit. Then the plots in the HTML:
+warned there; the campaign summary gives each value in its own unit and every failing one. The
+circle's page one holds the verdict, the values, the polar plot and what to fix first; no page
+runs past the right margin or is printed shrunk; as found / as left start each run on a page. Then the plots in the HTML:
 no text in them prints below 9 pt at the width the page gives them.
 Usage: report_pages_test.py DAQ_BINARY [OUT_DIR]  (CALDAQ_DEMO_FIXTURE: a `daq demo` to copy)"""
 import glob
@@ -151,6 +153,9 @@ reports = {
     "suspect": ["4"],
     "campaign": ["--campaign", "demo (simulated)"],
     "comparison": ["--compare", "1", "3"],
+    # The demo's circle against itself: a circle's comparison table has the G values and every
+    # diagnostic (17 columns across the page printed it shrunk to about 5 pt).
+    "comparison-circle": ["--compare", "2", "2"],
     "asfound": ["--as-found", "1", "--as-left", "3"],
 }
 text = {}
@@ -173,9 +178,11 @@ grid_values = [c for row in grid for c in row[1:4] if re.fullmatch(r"-?\d+\.\d{3
 check("linear report: the grid reads as daq show 1, row by row",
       grid_values == [v for _, v in outputs["daq show 1"]], f"{grid_values}")
 circle_html = open("circle.html", encoding="utf-8").read()
-circle_table = cells(circle_html, "num results")
+circle_table = cells(circle_html, "num results beside")
+# Page one's table gives the meaning under each symbol (it stands beside the polar plot).
 check("circle report: the standard's values as daq show 2",
-      [(r[0], r[1]) for r in circle_table[:len(circle_values)]] == circle_values,
+      [(next((s for s, _ in circle_values if r[0].startswith(s)), r[0]), r[1])
+       for r in circle_table[:len(circle_values)]] == circle_values,
       f"{circle_table}")
 diag_json = [(r["symbol"], r["value"], r["unit"]) for r in current(show2)["result"]["values"]
              if not r["key"].endswith("_um")]
@@ -198,9 +205,11 @@ for name in ("linear", "vdi3441", "suspect", "circle"):
 for name in ("linear", "suspect"):
     p1 = text[name][0]
     # The main table: the grid of E, R, A, M, B with up, down, bidirectional, limit, verdict.
+    # Its head and rows (pdftotext may read the head's last cells after the first row).
     check(f"{name}: main table on page one",
-          re.search(r"value \(µm\) ↑ up ↓ down bidirectional limit \(µm\) verdict", p1) is not None
-          and "E — systematic positional deviation" in p1 and "B̄ — mean reversal value" in p1, p1)
+          all(w in p1 for w in ("value (µm)", "↑ up ↓ down bidirectional", "limit (µm)", "verdict",
+                                "E — systematic positional deviation", "B̄ — mean reversal value")),
+          p1)
     check(f"{name}: failing values named on page one",
           re.search(r"FAIL.*limit ≤ [0-9.]+ µm\)", p1) is not None, p1)
     # The main plot on page one too (it was on page two).
@@ -209,10 +218,14 @@ for name in ("linear", "suspect"):
 # the report said "No tolerance applies").
 v1 = text["vdi3441"][0]
 check("vdi3441: main table with limits on page one",
-      re.search(r"symbol value \(µm\) meaning limit \(µm\) verdict P [0-9.]+ position uncertainty "
-                r"≤ 15\.000 (pass|FAIL)", v1) is not None, v1)
+      "symbol value (µm) meaning limit (µm) verdict" in v1
+      and re.search(r"position uncertainty ≤ 15\.000 (pass|FAIL)", v1) is not None, v1)
 check("vdi3441: a verdict, not 'No tolerance'", "Verdict against the machine specification" in v1
       and "No tolerance" not in v1, v1)
+# The failing value in the verdict as in the table: "U max = 4.023 µm", not "+4.023".
+check("vdi3441: the failing value as the table prints it",
+      re.search(r"U max = [0-9.]+ µm \(limit ≤", v1) is not None
+      and re.search(r"[0-9.]+ largest reversal span", v1) is not None, v1)
 check("vdi3441: main plot on page one", "Mean positional deviation with ±2s" in v1, v1)
 check("run quality says its state once",
       all("ok — ok" not in p and "ok - ok" not in p for n in text for p in text[n]), "")
@@ -221,8 +234,16 @@ check("suspect: SUSPECT RUN on page one with its stop",
       text["suspect"][0])
 check("linear (clean): no SUSPECT", all("SUSPECT RUN" not in p for p in text["linear"]), "")
 c1 = text["circle"][0]
-check("circle: main table on page one", "symbol value (µm) meaning limit (µm) verdict" in c1
-      and re.search(r"G\(b\) [0-9.]+", c1) is not None, c1)
+check("circle: main table on page one", "symbol and meaning" in c1
+      and "G(b) bi-directional circular deviation" in c1
+      and re.search(r"[0-9.]+ ≤ 10\.000 pass", c1) is not None, c1)
+# Page one holds all four: the verdict, the values, the polar plot and what to fix first with its
+# three rows (the plot under the values pushed what to fix first onto page two; before that the
+# plot was on page two).
+check("circle: the polar plot on page one", "Polar plot, least-squares centre removed" in c1
+      and "G = " in c1, c1)
+check("circle: all of what to fix first on page one",
+      re.search(r"What to fix first .* 1 Backlash X .* 2 \w.* 3 \w", c1) is not None, c1)
 check("circle: what to fix first on page one", "What to fix first" in c1
       and re.search(r"rank error, and what to check value G gain \(share of G\) 1 \w", c1)
       is not None, c1)
@@ -272,12 +293,48 @@ check("campaign: no squareness or servo mismatch in µm",
 check("campaign: squareness and scale mismatch in µm/m",
       re.search(r"Squareness XY [+-]?[0-9.]+ µm/m;", camp[0]) is not None
       and re.search(r"Scale mismatch X - Y [+-]?[0-9.]+ µm/m;", camp[0]) is not None, camp[0])
+# Every value outside its limit is in the summary, marked: the circle's failing backlash X was left
+# out (the summary named the first four diagnostics by their gain in G, and it gains the least).
+check("campaign: the failing diagnostic in the summary, marked",
+      re.search(r"Backlash X \+[0-9.]+ µm FAIL;", camp[0]) is not None, camp[0])
+check("campaign: each run's failing values marked", camp[0].count(" FAIL;") >= 3, camp[0])
 for run in (1, 2):
     first = next((p for p in camp if re.search(rf"SIMULATED — Run {run}: \w+ test", p)), "")
     check(f"campaign: run {run}'s verdict and table on its first page",
           "Verdict against the machine specification" in first
-          and re.search(r"(↑ up ↓ down bidirectional|symbol value \(µm\) meaning)", first)
+          and re.search(r"(↑ up ↓ down bidirectional|symbol and meaning value \(µm\))", first)
           is not None, first[:500])
+
+# --- nothing past the right margin ------------------------------------------------------------
+# Each word of each page inside the printed area (A4 less the 14 mm margin on the right): the
+# campaign summary's table ran past it (it took the page summary's column widths).
+def words_beyond_margin(pdf):
+    out = subprocess.run(["pdftotext", "-bbox", pdf, "-"], capture_output=True, text=True,
+                         check=True).stdout
+    right_pt = (210 - 14) / 25.4 * 72 + 1.0
+    return [w for x, w in re.findall(r'<word xMin="[0-9.]+" yMin="[0-9.]+" xMax="([0-9.]+)"'
+                                     r'[^>]*>([^<]*)</word>', out) if float(x) > right_pt]
+
+
+def title_height_pt(pdf):
+    """The height of the first word of page one under the running header (which is in the 18 mm
+    top margin): the title, 14 pt, about 16 pt from its font's ascent to its descent."""
+    out = subprocess.run(["pdftotext", "-bbox", "-f", "1", "-l", "1", pdf, "-"],
+                         capture_output=True, text=True, check=True).stdout
+    return next(float(y1) - float(y0) for y0, y1 in re.findall(
+        r'<word xMin="[0-9.]+" yMin="([0-9.]+)" xMax="[0-9.]+" yMax="([0-9.]+)"', out)
+        if float(y0) > 18 / 25.4 * 72)
+
+
+for name in reports:
+    beyond = words_beyond_margin(f"{name}.pdf")
+    check(f"{name}: nothing past the right margin", not beyond, str(beyond[:10]))
+    # A page too wide is printed shrunk to fit (a circle comparison's table of 17 columns put
+    # the whole page at about 5 pt).
+    check(f"{name}: printed at full size", title_height_pt(f"{name}.pdf") > 15,
+          f"{title_height_pt(name + '.pdf'):.1f} pt")
+check("as found / as left: each run's report starts on a page of its own",
+      "As found: SIMULATED" not in text["asfound"][0], text["asfound"][0][-300:])
 
 # --- comparison and as found / as left --------------------------------------------------------
 check("comparison: the table on page one", re.search(r"run date E \(µm\) R \(µm\) A \(µm\) M "
@@ -324,6 +381,20 @@ g1 = squash(pages("gaps.pdf")[0])
 check("traceability: a missing certificate and due date warned on page one",
       "Traceability: laser: no certificate, calibration due date stated" in g1, g1[:1500])
 
+# --- other runs (an imported .rtx): the plots name the quantity and its unit, not its key -------
+with open("lin.rtx", "wb") as f:
+    f.write(b"HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nFile Type: Linear\r\n"
+            b"Sample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nAxis: X\r\n"
+            b"Data:\r\n" + b"\x00" * 6 + b"\xf0\x3f" + b"\x00" * 6 + b"\x04\xc0" + b"\x00" * 8
+            + b"\r\nEOF::\r\n")
+imported = re.search(r"run (\d+)", daq("import", "rtx", "lin.rtx", *db)).group(1)
+daq("report", imported, *db, "-o", "imported.html")
+imported_plot = " ".join(html_mod.unescape(t) for t in re.findall(
+    r"<tspan[^>]*>(.*?)</tspan>", open("imported.html", encoding="utf-8").read()))
+check("imported run: the plot says displacement (m), not displacement_m",
+      "displacement (m)" in imported_plot and "displacement_m" not in imported_plot
+      and " ch 0" not in imported_plot, imported_plot[:300])
+
 # --- straightness and squareness: signed values through the shared formatter -----------------
 # Two profiles whose slopes differ by 1e-7 µm/m: the squareness printed "-0.000".
 with open("a.csv", "w") as f:
@@ -354,7 +425,11 @@ for name in reports:
             continue
         inside_multiples = html.rfind('<div class="multiples">', 0, m.start()) > html.rfind(
             "</div>", 0, m.start())
-        shown = content_pt * (0.72 if "polar" in cls else 0.48 if inside_multiples else 1.0)
+        # A plot beside a table (class "pair"): half of the page less the gap (1 rem, 10 pt).
+        inside_pair = html.rfind('<div class="pair">', 0, m.start()) > html.rfind(
+            "</figure></div>", 0, m.start())
+        shown = ((content_pt - 10) / 2 if inside_pair else content_pt * 0.72 if "polar" in cls
+                 else 0.48 * content_pt if inside_multiples else content_pt)
         printed = min(sizes) * min(1.0, shown / width)
         check(f"{name}: plot '{title}' text >= 9 pt", printed >= 9.0,
               f"{printed:.1f} pt (font {min(sizes)} in a {width:.0f} wide plot shown {shown:.0f} pt)")

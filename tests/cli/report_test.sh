@@ -68,7 +68,7 @@ check circle_directions 0 "counter-clockwise" -- cat r2.html
 
 # --- campaign and comparison -------------------------------------------------------------------
 check campaign 0 "campaign report of runs 1, 2, 3" -- "$DAQ" report --campaign "demo (simulated)" --db demo.sqlite -o camp.html
-check campaign_sections 0 "^3$" -- count camp.html "<h2 id=\"run-"
+check campaign_sections 0 "^3$" -- count camp.html "<h2 class=\"run\" id=\"run-"
 check campaign_summary 0 "<a href=\"#run-2\">2</a>" -- cat camp.html
 check compare 0 "comparison report of runs 1, 3" -- "$DAQ" report --compare 1 3 --db demo.sqlite -o cmp.html
 check compare_overlay 0 "Mean bidirectional deviation, run by run" -- cat cmp.html
@@ -115,8 +115,10 @@ check grid 0 "<th>↑&nbsp;up</th><th>↓&nbsp;down</th><th>bidirectional</th>" 
 check two_s_lines 0 "^x̄↑ ± 2s$" -- svgtext r1.html
 G2=$("$PY" -c "import json; print(format(json.load(open('circ.json'))['iso230_4']['G_bi_um'], '.3f'))")
 check circle_g_on_plot 0 "^G = $G2 µm$" -- svgtext r2.html
-check circle_start_marked 0 "start of each trace, arrow: direction of travel" -- svgtext r2.html
-check circle_rings_off_traces 0 "^rings: -[0-9.]+ to \+[0-9.]+ µm$" -- svgtext r2.html
+check circle_start_marked 0 "^○ start, arrow: direction of travel$" -- svgtext r2.html
+# The rings' spacing under the plot, off the traces and the angle labels (in the corner it sat on
+# the 120° label once the plot stood beside the values).
+check circle_rings_off_traces 0 "^rings every [0-9.]+ µm, the dark one nominal$" -- svgtext r2.html
 check circle_gain_explained 0 "a negative gain means the error partly cancels another" -- cat r2.html
 check campaign_nowrap 0 "<span class=\"nw\">E [0-9.]+ µm</span>" -- cat camp.html
 check campaign_verdict 0 "<span class=\"fail\">FAIL</span></td>" -- cat camp.html
@@ -175,7 +177,7 @@ check recomp_values 0 "Original \(result 1\) and re-compensated \(result [0-9]+\
 check recomp_budget 0 "<td>material temperature</td><td class=\"r\">0.6000</td>" -- cat r1b.html
 check recomp_of 0 "<td>Re-compensation of</td><td>result 1</td>" -- cat r1b.html
 "$DAQ" report --compare 1 3 --db demo.sqlite -o cmp2.html >/dev/null
-check compare_recompensated 0 "<td class=\"r\">1 <span class=\"changed\">re-compensated</span>" -- cat cmp2.html
+check compare_recompensated 0 "<td class=\"r\">1<br><span class=\"changed\">re-compensated</span>" -- cat cmp2.html
 check show_superseded 0 "result 1: ISO 230-2:2014 \(superseded by result [0-9]+\)" -- "$DAQ" show 1 --db demo.sqlite
 check show_current 0 "recompensated .* of result 1; ciddor, 12 ppm/K; expansion_ppm_per_k 11.5 -> 12" -- "$DAQ" show 1 --db demo.sqlite
 check show_values 0 "^        E +[0-9]+\.[0-9]{3} um" -- "$DAQ" show 1 --db demo.sqlite

@@ -141,8 +141,9 @@ struct LegendEntry {
 };
 
 // `columns` 0: one column; `y` the offset from the position, in the viewport's height.
+// text_scale: the legend's text against PLplot's default size (pllegend does not follow plschr).
 void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
-                 PLFLT y = 0.0) {
+                 PLFLT y = 0.0, PLFLT text_scale = 1.0) {
   if (entries.empty()) return;
   const auto n = static_cast<PLINT>(entries.size());
   std::vector<PLINT> opt, colours, text_colours, styles, box_patterns, symbol_numbers;
@@ -163,10 +164,10 @@ void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT 
   PLFLT w = 0, h = 0;
   const PLINT rows = columns > 0 ? (n + columns - 1) / columns : 0;
   pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, y, 0.05, 0,
-           axes_colour, 1, rows, columns, n, opt.data(), 0.6, 1.0, 1.8, 0.0, text_colours.data(),
-           texts.data(), colours.data(), box_patterns.data(), scales.data(), widths.data(),
-           colours.data(), styles.data(), widths.data(), colours.data(), scales.data(),
-           symbol_numbers.data(), symbols.data());
+           axes_colour, 1, rows, columns, n, opt.data(), 0.6, text_scale, 1.8, 0.0,
+           text_colours.data(), texts.data(), colours.data(), box_patterns.data(), scales.data(),
+           widths.data(), colours.data(), styles.data(), widths.data(), colours.data(),
+           scales.data(), symbol_numbers.data(), symbols.data());
 }
 
 void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
@@ -395,16 +396,28 @@ std::string svg(const PolarChart& chart) {
   // As many columns of the longest label as fit the width (about 60 characters), up to 3.
   std::size_t longest = 0;
   for (const auto& t : chart.traces) longest = std::max(longest, t.label.size());
-  const auto fit = static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(60 / (longest + 6), 1, 3));
+  const auto fit = static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(
+      static_cast<std::size_t>(66 / chart.text_scale) / (longest + 6), 1, 3));
   const PLINT columns = static_cast<PLINT>(std::min<std::ptrdiff_t>(labelled, fit));
   const int rows = columns > 0 ? static_cast<int>((labelled + columns - 1) / columns) : 0;
-  const double width = chart.size_pt, side = 0.88 * width, top = 0.07 * width;
-  const double height = width + (rows > 0 ? 18.0 * rows + 34.0 : 20.0);
+  // PLplot's text grows with the canvas: about 11 pt on 400 pt, times text_scale.
+  const double char_pt = 11.0 * chart.size_pt / 400.0 * chart.text_scale;
+  const double width = chart.size_pt, side = 0.88 * width,
+               top = std::max(0.07 * width, 2.4 * char_pt);
+  // Under the plot: two lines (the rings' scale and the nominal one, the start marks), then the
+  // legend's rows.
+  const int notes = chart.mark_start ? 2 : 1;
+  const double legend_top_pt = (1.25 * notes + 0.6) * char_pt;
+  const double height =
+      top + side + legend_top_pt + (rows > 0 ? 1.7 * char_pt * rows + 0.6 * char_pt : 0.0);
   SvgStream s(chart.size_pt, static_cast<int>(height));
   const double left = (width - side) / 2;
   plvpor(left / width, (left + side) / width, (height - top - side) / height,
          (height - top) / height);
-  plwind(-1.7, 1.7, -1.7, 1.7);
+  // Room for the angle labels at radius 1.6: PLplot clips text at the window, and "180°" lost
+  // its "1" in a window of +-1.7.
+  plwind(-1.85, 1.85, -1.85, 1.85);
+  plschr(0, 1.05 * chart.text_scale);
   plcol0(axes_colour);
   plmtex("t", 1.5, 0.5, 0.5, plot_text(chart.title).c_str());
   // Rings every division, the nominal circle darker; spokes every 30 degrees.
@@ -414,13 +427,6 @@ std::string svg(const PolarChart& chart) {
     plwidth(k == 0 ? 1.2 : 0.6);
     plarc(0, 0, r, r, 0, 360, 0, 0);
   }
-  // The rings' values in the corner, outside the traces (a label on a ring would sit on them).
-  plcol0(reference_colour);
-  plschr(0, 1.0);
-  plptex(-1.68, 1.62, 1, 0, 0,
-         fmt::format("rings: {:+g} to {:+g} µm", -2 * div_um, 2 * div_um).c_str());
-  plptex(-1.68, 1.50, 1, 0, 0, "dark ring: nominal radius");
-  plschr(0, 1.05);
   for (int a = 0; a < 360; a += 30) {
     const double t = a * std::numbers::pi / 180.0;
     const PLFLT sx[] = {0.5 * std::cos(t), 1.5 * std::cos(t)},
@@ -432,9 +438,11 @@ std::string svg(const PolarChart& chart) {
     plptex(1.6 * std::cos(t), 1.6 * std::sin(t) - 0.03, 1, 0, 0.5, fmt::format("{}°", a).c_str());
   }
   plcol0(axes_colour);
-  // The axes' names inside the angle labels, beside their spokes.
-  plptex(1.42, 0.07, 1, 0, 0, plot_text("+" + chart.first_axis).c_str());
-  plptex(0.06, 1.42, 1, 0, 0, plot_text("+" + chart.second_axis).c_str());
+  // The axes' names beside their angle labels: under 0°, right of 90° (inside the labels they
+  // ran into "0°" once the text was drawn larger).
+  plptex(1.6, -0.03 - 0.16 * chart.text_scale, 1, 0, 0.5,
+         plot_text("+" + chart.first_axis).c_str());
+  plptex(0.14 + 0.06 * chart.text_scale, 1.57, 1, 0, 0, plot_text("+" + chart.second_axis).c_str());
   std::vector<LegendEntry> legend;
   for (const auto& t : chart.traces) {
     Line l = t;
@@ -452,13 +460,15 @@ std::string svg(const PolarChart& chart) {
   }
   plcol0(axes_colour);
   if (!chart.centre_text.empty()) plptex(0, -0.03, 1, 0, 0.5, plot_text(chart.centre_text).c_str());
-  plmtex("b", 1.0, 0.0, 0.0, fmt::format("scale {:g} µm per ring", div_um).c_str());
-  if (chart.mark_start)
-    plmtex("b", 2.3, 0.0, 0.0, "○ start of each trace, arrow: direction of travel");
+  // The rings' values under the plot, with the scale: in the corner they sat on the 120° label
+  // once the plot was drawn narrow enough to stand beside a table.
+  plmtex("b", 1.2, 0.0, 0.0,
+         fmt::format("rings every {:g} µm, the dark one nominal", div_um).c_str());
+  if (chart.mark_start) plmtex("b", 2.45, 0.0, 0.0, "○ start, arrow: direction of travel");
   if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
   // Below the scale's line.
   draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
-              0.11);
+              legend_top_pt / side, chart.text_scale);
   return s.finish(chart.title, "plot polar");
 }
 

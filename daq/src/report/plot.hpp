@@ -46,7 +46,7 @@ struct XyChart {
   // Categories instead of numbers on x: the lines' x are 0, 1, ... and tick k is labelled
   // x_labels[k] (e.g. the dates of runs).
   std::vector<std::string> x_labels;
-  bool legend = true;       // false: no legend even for labelled lines (small multiples)
+  bool legend = true;  // false: no legend even for labelled lines (small multiples)
   // The y axis spans at least this much (0: as the data need): a trend of values that differ by
   // 0.0001 um is drawn flat, not as a cliff across the whole plot.
   double min_y_span = 0.0;
@@ -63,6 +63,7 @@ struct PolarChart {
   int size_pt = 400;
   std::string centre_text;  // written at the centre, e.g. "G = 6.96 µm"
   bool mark_start = true;   // each trace's first point marked, an arrow in its direction
+  double text_scale = 1.0;  // > 1 for a plot shown narrow (beside a table: its text stays 9 pt)
 };
 
 // Every text of a chart (titles, axis labels, legends, category labels) is data-safe: it is

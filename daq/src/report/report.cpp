@@ -677,10 +677,13 @@ std::string verdict_banner(const ::daq::Verdict& v) {
     for (const auto& c : v.checks)
       if (!c.pass) {
         const auto advice = ::daq::diagnostic_advice(c.key);
-        items +=
-            fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {} {}){}</li>", esc(c.symbol),
-                        signed_text(c.value, 3), esc(unit_text(c.unit)), fixed(c.limit, 3),
-                        esc(unit_text(c.unit)), advice.empty() ? "" : ": " + esc(advice));
+        // As the tables print it: a diagnostic (an error with a direction, what to check) with
+        // its sign, a deviation or span (E, B, U max, G) without ("U max = +4.023" read as the
+        // table's 4.023 with a sign the value does not have).
+        items += fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {} {}){}</li>",
+                             esc(c.symbol), advice.empty() ? um(c.value) : signed_text(c.value, 3),
+                             esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)),
+                             advice.empty() ? "" : ": " + esc(advice));
       }
     h += "<ul class=\"failing\">" + items + "</ul>\n";
   }
@@ -785,7 +788,9 @@ struct Headline {
   struct Value {
     std::string symbol;
     double value = 0;
-    std::string unit;  // as printed: "µm", "µm/m", "ms"
+    std::string unit;        // as printed: "µm", "µm/m", "ms"
+    bool failing = false;    // outside its limit: the campaign summary always shows it, marked
+    bool is_signed = false;  // printed with its sign (a diagnostic), as the run's own tables do
   };
   std::vector<Value> values;
   std::string standard;
@@ -889,10 +894,8 @@ std::string means_plot(const Linear& l) {
                            .width = 1.0,
                            .dashed = true});
   }
-  return figure(svg(means),
-                "Mean unidirectional positional deviations x̄i↑ and x̄i↓ at each target, "
-                "with the bands x̄ ± 2s (s: the estimator of the unidirectional "
-                "repeatability), and the mean bidirectional deviation.");
+  // One line of caption (the legend names the lines): a suspect run's page one holds it too.
+  return figure(svg(means), "Bands x̄ ± 2s, s: the estimator of the unidirectional repeatability.");
 }
 
 std::string runs_plot(const Linear& l) {
@@ -990,13 +993,18 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
   // every value of a standard without them (VDI/DGQ 3441).
   const auto doc = ::daq::to_json(e);
   const auto values = ::daq::linear_rows(doc);
+  const auto verdict = ::daq::verdict_of(v.settings, doc);
+  const auto failing = [&](const auto& r) {
+    const auto* check = ::daq::find_check(verdict, r.key);
+    return check && !check->pass;
+  };
   for (const auto& r : values)
     if (r.key == "E_bi" || r.key == "R_bi" || r.key == "A_bi" || r.key == "M" || r.key == "B" ||
-        r.key == "B_mean")
-      headline.values.push_back({r.symbol, r.value, unit_text(r.unit)});
+        r.key == "B_mean" || failing(r))
+      headline.values.push_back({r.symbol, r.value, unit_text(r.unit), failing(r)});
   if (headline.values.empty())
-    for (const auto& r : values) headline.values.push_back({r.symbol, r.value, unit_text(r.unit)});
-  const auto verdict = ::daq::verdict_of(v.settings, doc);
+    for (const auto& r : values)
+      headline.values.push_back({r.symbol, r.value, unit_text(r.unit), failing(r)});
   headline.verdict = ::daq::summary(verdict);
   h += verdict_banner(verdict);
   h += results_grid(e, verdict);
@@ -1085,6 +1093,10 @@ Circle analyse_circle(const st::RunReader& store, const RunView& v, const Option
   }
   return c;
 }
+
+// The text of a polar plot shown beside a table (CSS .pair: half the page's width, 253 pt of
+// its 400): 11 pt times 1.4 prints at 9.7 pt.
+constexpr double polar_beside_text_scale = 1.4;
 
 PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_offset,
                     std::string_view label_prefix) {
@@ -1243,8 +1255,8 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
 std::string fix_first_notes(const cal::circle::Result& r, const ::daq::Verdict& verdict,
                             std::size_t top) {
   std::string h =
-      "<p class=\"note\">Errors outside their limit first, then the largest gain in G (what "
-      "correcting that error alone takes off the circularity); every error under Details.</p>\n";
+      "<p class=\"note\">Errors outside their limit first, then by the gain in G (what "
+      "correcting that error alone takes off G); every error under Details.</p>\n";
   for (std::size_t i : fix_first_order(r, verdict, top)) {
     const auto& d = r.diagnostics[i];
     if (std::round(d.g_reduction_um * 1e3) >= 0) continue;
@@ -1280,23 +1292,31 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
   headline.standard = st.label;
   Sections out;
   std::string& h = out.answer;
+  // Page one names the standard and the test in one line; its full title under Details.
   h = fmt::format(
-      "<h3>Results: {0}</h3>\n<p class=\"standard\">Evaluated by <strong>{0}</strong> ({1}){2}; "
-      "radius {3:g} mm, feed {4:g} mm/min, plane {5}, both directions from the stored bar "
-      "readings.</p>\n",
-      esc(st.label), esc(st.title),
+      "<h3>Results: {0}</h3>\n<p class=\"standard\"><strong>{0}</strong>{1}: radius {2:g} mm, "
+      "feed {3:g} mm/min, plane {4}, both directions.</p>\n",
+      esc(st.label),
       st.identical.empty() ? std::string()
-                           : fmt::format(", the same values as {}", esc(st.identical.front())),
+                           : fmt::format(" (the same values as {})", esc(st.identical.front())),
       c.program.radius_mm, c.program.feed_mm_per_min, esc(c.analysis.plane));
+  const std::string evaluated = fmt::format(
+      "<p class=\"standard\">Evaluated by <strong>{}</strong> ({}) from the stored bar "
+      "readings.</p>\n",
+      esc(st.label), esc(st.title));
   const auto doc = ::daq::circle_document(r, c.program, c.analysis);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   headline.verdict = ::daq::summary(verdict);
   std::vector<std::vector<std::string>> iso;
   for (const auto& x : ::daq::circle_rows(doc)) {  // as every output lists them
     const auto* check = ::daq::find_check(verdict, x.key);
-    iso.push_back({esc(x.symbol), um(x.value), esc(x.description), limit_cell(check),
-                   check ? verdict_cell(check) : ""});
-    if (x.key.starts_with("G")) headline.values.push_back({x.symbol, x.value, unit_text(x.unit)});
+    // What the symbol means under it: the table stands beside the polar plot, half the page
+    // wide, where a column of its own was squeezed to a word a line.
+    iso.push_back({esc(x.symbol) + "<br><span class=\"meaning\">" + esc(x.description) + "</span>",
+                   um(x.value), limit_cell(check), check ? verdict_cell(check) : ""});
+    const bool failing = check && !check->pass;
+    if (x.key.starts_with("G") || failing)
+      headline.values.push_back({x.symbol, x.value, unit_text(x.unit), failing});
   }
   // The set-up's centre and the informative values follow under Details (page one holds the
   // standard's values, what to fix first and the polar plot).
@@ -1307,25 +1327,30 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
     other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
                      "<em>informative</em>: " + esc(x.meaning)});
   h += verdict_banner(verdict);
-  h += table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, iso, "num results",
-             "lrlrl");
+  // Page one holds the verdict, the values, the polar plot and what to fix first: the values
+  // beside the plot (one under the other pushed "what to fix first" onto page two). The plot's
+  // text is drawn larger so that, shown at half the page's width, it still prints at 9 pt.
+  auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
+  polar.centre_text = "G = " + um(r.iso.G_bi_um) + " µm";
+  polar.text_scale = polar_beside_text_scale;
+  h += "<div class=\"pair\"><div>" +
+       table({"symbol and meaning", "value (µm)", "limit (µm)", "verdict"}, iso,
+             "num results beside", "lrrl") +
+       "</div>" + "<figure>" + svg(polar) + "</figure>" + "</div>\n";
   const auto first = diagnostics_table(r, verdict, 3);
   h += "<h4>What to fix first</h4>\n" +
        (first.empty() ? std::string("<p>No error would reduce G if corrected alone.</p>\n")
                       : first + fix_first_notes(r, verdict, 3));
-  auto polar = polar_of(c, "Polar plot, least-squares centre removed", 0, "");
-  polar.centre_text = "G = " + um(r.iso.G_bi_um) + " µm";
-  h += figure(svg(polar),
-              "Radial deviation of both directions around the nominal circle (magnified: the "
-              "rings are the scale, the dark ring the nominal radius). The open circle marks "
-              "where each trace starts, the arrow its direction of travel.");
-  // The campaign summary's headline: the first diagnostics in their own units.
-  for (std::size_t i = 0; i < r.diagnostics.size() && i < 4; ++i)
-    headline.values.push_back(
-        {r.diagnostics[i].name, r.diagnostics[i].value, unit_text(r.diagnostics[i].unit)});
+  // The campaign summary's headline: the diagnostics of "what to fix first" in their own units,
+  // every one outside its limit among them (the first four by gain once left one out).
+  for (std::size_t i : fix_first_order(r, verdict, 4)) {
+    const auto& x = r.diagnostics[i];
+    const auto* check = ::daq::find_check(verdict, x.key);
+    headline.values.push_back({x.name, x.value, unit_text(x.unit), check && !check->pass, true});
+  }
 
   std::string& d = out.details;
-  d = "<h3>Details of the results</h3>\n" +
+  d = "<h3>Details of the results</h3>\n" + evaluated +
       table({"symbol", "value (µm)", "meaning"}, other, "num results", "lrl") +
       "<h4>Diagnostics, ranked by what correcting each would gain</h4>\n" +
       diagnostics_table(r, verdict, 0) + gain_notes(r);
@@ -1355,6 +1380,25 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
 // --- other runs (e.g. imported dynamic captures)
 // --------------------------------------------------
 
+// A stored quantity as a plot reads it, its name and unit ("displacement (m)"), not its
+// storage key ("displacement_m", which the plots of these runs printed).
+std::string quantity_label(Q q) {
+  switch (q) {
+    case Q::displacement_m:
+      return "displacement (m)";
+    case Q::length_m:
+      return "length (m)";
+    case Q::machine_position_m:
+      return "machine position (m)";
+    case Q::angle_rad:
+      return "angle (rad)";
+    case Q::dew_point_degc:
+      return "dew point (°C)";
+    default:
+      return std::string(cal::drivers::to_string(q));
+  }
+}
+
 std::string generic_section(const st::RunReader& store, const RunView& v, const Options& o) {
   // Streamed: every series is thinned to about 4000 points for its plot (every step-th
   // reading, the step from the series' count), so the memory does not grow with the run.
@@ -1379,8 +1423,8 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     to_read += static_cast<std::uint64_t>(x.count);
     auto& t = by[{x.quantity, x.device, x.channel}];
     t.step = std::max<std::size_t>(1, static_cast<std::size_t>(x.count) / 4000);
-    t.s.label = fmt::format("{} {} ch {}", instrument_name(v, x.device), cal::drivers::to_string(q),
-                            x.channel);
+    t.s.label = fmt::format("{} {}{}", instrument_name(v, x.device), quantity_label(q),
+                            x.channel > 0 ? fmt::format(", channel {}", x.channel) : "");
     if (std::find(plotted.begin(), plotted.end(), x.quantity) == plotted.end())
       plotted.push_back(x.quantity);
   }
@@ -1404,7 +1448,7 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     const auto q = static_cast<Q>(std::get<0>(key));
     h += figure(svg(XyChart{.title = t.s.label,
                             .x_label = "time (min)",
-                            .y_label = std::string(cal::drivers::to_string(q)),
+                            .y_label = quantity_label(q),
                             .lines = lines_of({t.s}, i++, 4000)}),
                 t.s.label + " over the run.");
   }
@@ -1439,7 +1483,7 @@ table.kv thead { display: none; }
 table.results td:first-child { font-weight: bold; }
 figure { margin: 1rem 0; page-break-inside: avoid; break-inside: avoid; }
 svg.plot { width: 100%; height: auto; max-width: 60rem; display: block; }
-figcaption { font-size: .85rem; color: #444; }
+figcaption { font-size: .9rem; color: #444; }
 .warning { color: #a40; } .note { color: #444; font-size: .9rem; }
 .simulated { background: #fff3cd; border: 1px solid #e0b000; padding: .5rem; }
 footer { margin-top: 2rem; font-size: .8rem; color: #666; border-top: 1px solid #ccc;
@@ -1447,9 +1491,13 @@ footer { margin-top: 2rem; font-size: .8rem; color: #666; border-top: 1px solid 
 h3, h4 { break-after: avoid; page-break-after: avoid; }
 table { break-inside: auto; } tr { break-inside: avoid; }
 table.summary { width: 100%; margin: .3rem 0 .6rem; }
-table.summary th { width: 13%; background: none; color: #555; font-weight: normal; }
-table.summary td { width: 37%; }
+table.summary th { width: 1%; white-space: nowrap; background: none; color: #555;
+                   font-weight: normal; }
+table.summary td { width: 49%; }
+table.campaign { width: 100%; } table.campaign td:nth-child(7) { width: 100%; }
 table.results td:first-child { white-space: nowrap; }
+table.beside td:first-child { white-space: normal; } table.beside td.r, table.diag td.r { width: 1%; }
+.meaning { font-weight: normal; color: #444; }
 .verdict.suspect { background: #fff0d9; border: 1px solid #d68000; }
 .verdict.suspect ul, ul.failing { margin: .2rem 0 .4rem; }
 .verdict.fail + ul.failing { background: #fde8e4; margin-top: -.6rem; padding: .2rem 1.5rem;
@@ -1457,11 +1505,18 @@ table.results td:first-child { white-space: nowrap; }
 svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
-@media print { body { margin: 0; max-width: none; font-size: 10pt; } h1 { font-size: 14pt; }
-  th, td { padding: .08rem .4rem; } h3 { margin: 1rem 0 .4rem; } h4 { margin: .6rem 0 .3rem; }
-  figure { margin: .4rem 0; } .verdict { margin: .4rem 0; } p { margin: .4rem 0; }
+.pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
+        align-items: start; }
+.pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
+@media print { html { font-size: 10pt; }
+  body { margin: 0; padding: 0; max-width: none; font-size: 10pt; line-height: 1.3; } h1 { font-size: 14pt; }
+  th, td { padding: .08rem .4rem; } h3 { margin: .8rem 0 .3rem; } h4 { margin: .5rem 0 .3rem; }
+  figure { margin: .3rem 0; } .verdict { margin: .3rem 0; } p { margin: .3rem 0; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
-  svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; } }
+  svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; }
+  .pair svg.plot.polar { max-width: 100%; }
+  h2.run { break-before: page; page-break-before: always; } }
+.pair svg.plot.polar { max-width: 100%; }
 )";
 
 // The printed page: a running header (the report's title and who it is for) and "page n of
@@ -1683,6 +1738,16 @@ std::string volumetric_section(const st::RunReader& store, std::span<const std::
   return h;
 }
 
+namespace {
+// A value's name in a table cell that only breaks before its parenthesis ("Cyclic error X" /
+// "(40.01 mm period)"), the rest kept whole.
+std::string breakable_name(std::string_view name) {
+  const auto paren = name.find(" (");
+  if (paren == std::string_view::npos) return esc(name);
+  return esc(name.substr(0, paren)) + "</span> <span class=\"nw\">" + esc(name.substr(paren + 1));
+}
+}  // namespace
+
 std::string campaign_report(const st::RunReader& store, std::span<const std::int64_t> runs,
                             std::string_view title, const Options& o) {
   if (runs.empty()) throw cal::InputError("campaign report: no runs to report");
@@ -1692,13 +1757,20 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
     const auto v = load(store, id);
     Headline hl;
     const auto body = run_body(store, v, o, hl);
-    // Each value kept whole on its line: "E 8.576 µm" never breaks inside.
+    // Each value kept whole on its line with its name ("E 8.576 µm", "Backlash X +4.084 µm"),
+    // but a long name may break before its parenthesis: whole, "Cyclic error X (40.01 mm
+    // period) +0.997 µm" pushed the table past the page's margin. Up to eight, never leaving
+    // out a value outside its limit.
     std::string numbers;
     std::size_t shown = 0;
     for (const auto& x : hl.values)
-      if (shown++ < 8)
-        numbers += fmt::format("<span class=\"nw\">{} {} {}</span>; ", esc(x.symbol),
-                               x.unit == "µm" ? um(x.value) : signed_text(x.value, 3), esc(x.unit));
+      if (x.failing || shown < 8) {
+        ++shown;
+        numbers +=
+            fmt::format("<span class=\"nw\">{} {} {}{}</span>; ", breakable_name(x.symbol),
+                        x.is_signed || x.unit != "µm" ? signed_text(x.value, 3) : um(x.value),
+                        esc(x.unit), x.failing ? " <span class=\"fail\">FAIL</span>" : "");
+      }
     const std::string verdict = hl.verdict == "PASS"   ? "<span class=\"pass\">PASS</span>"
                                 : hl.verdict == "FAIL" ? "<span class=\"fail\">FAIL</span>"
                                 : hl.verdict.empty()
@@ -1708,16 +1780,38 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
                        "<span class=\"nw\">" + date_of(v) + "</span>", esc(v.run.kind),
                        esc(v.run.axis), std::string(st::to_string(v.run.status)), esc(hl.standard),
                        numbers, verdict});
-    sections += fmt::format("<h2 id=\"run-{}\">{}</h2>\n{}", id, esc(run_title(v)), body);
+    sections +=
+        fmt::format("<h2 class=\"run\" id=\"run-{}\">{}</h2>\n{}", id, esc(run_title(v)), body);
     if (who.empty()) who = who_of(v);
   }
   const std::string body =
       fmt::format("<p>{} runs.</p>\n", runs.size()) +
       table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
-            "summary", "r") +
+            "campaign", "r") +
       volumetric_section(store, runs) + sections;
   return page(title, body, o, who);
 }
+
+namespace {
+// A comparison with more values than fit across the page (a circle's G values and a dozen
+// diagnostics: printed, Chromium shrank the whole page to about 5 pt to fit the table) lists the
+// values down the page, one column per run.
+constexpr std::size_t max_run_columns = 11;
+
+std::string transposed(const std::vector<std::string>& head,
+                       const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::string> runs{"value"};
+  for (const auto& r : rows)
+    runs.push_back(r.at(1).find("run ") != std::string::npos ? r.at(1)
+                                                             : "run " + r.at(0) + "<br>" + r.at(1));
+  std::vector<std::vector<std::string>> values;
+  for (std::size_t j = 2; j < head.size(); ++j) {
+    values.push_back({head[j]});
+    for (const auto& r : rows) values.back().push_back(j < r.size() ? r[j] : "");
+  }
+  return table(runs, values, "num", "l");
+}
+}  // namespace
 
 std::string comparison_report(const st::RunReader& store, std::span<const std::int64_t> runs,
                               const Options& o) {
@@ -1774,6 +1868,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   std::map<std::string, std::string> units;  // key -> unit as printed
   std::vector<std::string> trend_order;
   std::vector<std::vector<std::string>> rows;
+  std::vector<std::map<std::string, std::string>> cells;  // per run: key -> its value's cell
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
                   .x_label = "target position (mm)",
                   .y_label = "deviation (µm)",
@@ -1811,8 +1906,9 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     // A re-compensated run is compared with the values it has now, and says so.
     std::vector<std::string> row{
         std::to_string(v.run.id) +
-            (v.used.recompensated ? " <span class=\"changed\">re-compensated</span>" : ""),
-        "<span class=\"nw\">" + dates[i] + "</span>"};
+            (v.used.recompensated ? "<br><span class=\"changed\">re-compensated</span>" : ""),
+        dates[i]};  // may wrap: the table of a re-compensated run printed shrunk to fit
+    std::map<std::string, std::string> by_key;  // the value cells, placed by key below
     // A linear run's table keeps to the values a specification limits (the unidirectional ones
     // are in each run's report): all twelve would not fit a printed page.
     if (v.run.kind == "linear" &&
@@ -1831,9 +1927,9 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       trends[x.key].y.push_back(x.value);
       const auto* check = ::daq::find_check(verdict, x.key);
       if (check) limits[x.key] = check->limit;
-      row.push_back(um(x.value) + (check ? (check->pass ? " <span class=\"pass\">✓</span>"
-                                                        : " <span class=\"fail\">✗</span>")
-                                         : ""));
+      by_key[x.key] = um(x.value) + (check ? (check->pass ? " <span class=\"pass\">✓</span>"
+                                                          : " <span class=\"fail\">✗</span>")
+                                           : "");
     }
     row.push_back(!verdict.configured ? "<span class=\"unstated\">no tolerance</span>"
                   : verdict.pass      ? "<span class=\"pass\">PASS</span>"
@@ -1842,6 +1938,17 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     row.push_back(air.n ? fmt::format("{:.2f}", air.mean) : "&ndash;");
     row.push_back(mat.n ? fmt::format("{:.2f}", mat.mean) : "&ndash;");
     rows.push_back(std::move(row));
+    cells.push_back(std::move(by_key));
+  }
+  // Each run's values under their own column: a circle's diagnostics come ranked by their gain,
+  // in another order in each run (run 5's squareness stood under "Backlash Y").
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::vector<std::string> value_cells;
+    for (const auto& k : trend_order) {
+      const auto it = cells[i].find(k);
+      value_cells.push_back(it == cells[i].end() ? "&ndash;" : it->second);
+    }
+    rows[i].insert(rows[i].begin() + 2, value_cells.begin(), value_cells.end());
   }
   std::vector<std::string> head{"run", "date"};
   for (const auto& k : trend_order) head.push_back(esc(names[k]));
@@ -1853,7 +1960,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       "the limit of that run's specification.</p>\n",
       esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
       date_of(views.back()));
-  body += table(head, rows, "num");
+  body += head.size() <= max_run_columns ? table(head, rows, "num") : transposed(head, rows);
   if (first.run.kind == "linear") {
     body += figure(svg(overlay),
                    "The mean bidirectional positional deviation x̄i of each run "
@@ -1991,9 +2098,11 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   else
     body += figure(svg(polar), "Both directions of both runs on one scale.");
   Headline hl;
-  body += fmt::format("<h2 id=\"run-{}\">As found: {}</h2>\n", found_id, esc(run_title(found))) +
+  body += fmt::format("<h2 class=\"run\" id=\"run-{}\">As found: {}</h2>\n", found_id,
+                      esc(run_title(found))) +
           run_body(store, found, o, hl);
-  body += fmt::format("<h2 id=\"run-{}\">As left: {}</h2>\n", left_id, esc(run_title(left))) +
+  body += fmt::format("<h2 class=\"run\" id=\"run-{}\">As left: {}</h2>\n", left_id,
+                      esc(run_title(left))) +
           run_body(store, left, o, hl);
   return page(fmt::format("As found and as left: {} test of {}", found.run.kind, found.run.axis),
               body, o, who_of(found));
