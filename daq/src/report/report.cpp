@@ -173,8 +173,7 @@ Environment load_environment(const st::RunReader& store, const RunView& v) {
 
 RunView load(const st::RunReader& store, std::int64_t id) {
   const auto run = store.run(id);
-  if (!run)
-    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
+  if (!run) throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
   RunView v{.run = *run};
   if (run->machine_id > 0)
     if (const auto m = store.machine(run->machine_id)) v.machine = m->name;
@@ -594,10 +593,19 @@ std::string quality_banner(const st::RunReader& store, const RunView& v, bool pa
     stops += fmt::format("<li>run {} {} target {}: {}</li>", m.run_number,
                          m.direction == '+' ? "↑" : "↓", m.target_index + 1,
                          esc(::daq::units_html(m.reason)));
+  // The stops, each with its reason and limit, are the message: the summary sentence repeats
+  // them (the box took page one's room for the main plot), so it is said only without a list.
+  if (q.suspects.empty())
+    return fmt::format(
+        "<div class=\"verdict suspect\"><strong>SUSPECT RUN</strong>: {} Repeat the run before "
+        "relying on it.</div>\n",
+        esc(::daq::units_html(q.summary)));
+  const auto n = q.suspects.size();
   return fmt::format(
-      "<div class=\"verdict suspect\"><strong>SUSPECT RUN</strong>: {} The results below "
-      "include these stops; repeat them or the run before relying on it.<ul>{}</ul></div>\n",
-      esc(::daq::units_html(q.summary)), stops);
+      "<div class=\"verdict suspect\"><strong>SUSPECT RUN</strong>: {} stop{} beyond the run's "
+      "repeatability, included in the results below; repeat {} or the run before relying on "
+      "it.<ul>{}</ul></div>\n",
+      n, n == 1 ? "" : "s", n == 1 ? "it" : "them", stops);
 }
 
 // Page one's heading block: who, what machine, which test, when.
@@ -808,16 +816,16 @@ struct Linear {
 Linear evaluate_linear(const st::RunReader& store, const RunView& v, const Options& o) {
   Linear l{.targets = store.targets(v.run.id)};
   if (l.targets.empty())
-    throw cal::InputError(fmt::format("{}: run {} has no captured targets to report",
-                                      store.name(), v.run.id));
+    throw cal::InputError(
+        fmt::format("{}: run {} has no captured targets to report", store.name(), v.run.id));
   const std::string key =
       !o.standard.empty() ? o.standard : v.settings.value("standard", "iso230-2:2014");
   try {
     l.e = cal::iso230_2::evaluate(::daq::measurements(l.targets),
                                   cal::iso230_2::standard_from_string(key));
   } catch (const cal::InputError& e) {
-    throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.name(),
-                                      v.run.id, l.targets.size(), e.what()));
+    throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.name(), v.run.id,
+                                      l.targets.size(), e.what()));
   }
   return l;
 }
@@ -1074,8 +1082,8 @@ std::string circular_key(const Options& o, std::string fallback) {
 
 Circle analyse_circle(const st::RunReader& store, const RunView& v, const Options& o) {
   if (!v.settings.contains("radius_mm"))
-    throw cal::InputError(fmt::format("{}: run {}: its circle settings are missing",
-                                      store.name(), v.run.id));
+    throw cal::InputError(
+        fmt::format("{}: run {}: its circle settings are missing", store.name(), v.run.id));
   auto [program, analysis] = ::daq::circle_settings_from_json(v.settings);
   analysis.standard = circular_key(o, analysis.standard);
   static constexpr std::uint8_t bar[] = {static_cast<std::uint8_t>(Q::length_m)};
@@ -1088,8 +1096,8 @@ Circle analyse_circle(const st::RunReader& store, const RunView& v, const Option
     c.traces = segmenter.traces();
     c.result = ::daq::analyse_ballbar(program, analysis, bar_mm);
   } catch (const cal::InputError& e) {
-    throw cal::InputError(fmt::format("{}: run {} ({} bar readings): {}", store.name(),
-                                      v.run.id, bar_mm.size(), e.what()));
+    throw cal::InputError(fmt::format("{}: run {} ({} bar readings): {}", store.name(), v.run.id,
+                                      bar_mm.size(), e.what()));
   }
   return c;
 }
@@ -1960,7 +1968,9 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       "the limit of that run's specification.</p>\n",
       esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
       date_of(views.back()));
-  body += head.size() <= max_run_columns ? table(head, rows, "num") : transposed(head, rows);
+  // The run and date cells are text that may wrap (a cell of class "r" does not: "3
+  // re-compensated" and "run 3 11-28 07:31" unbroken printed the page shrunk to 0.9).
+  body += head.size() <= max_run_columns ? table(head, rows, "num", "ll") : transposed(head, rows);
   if (first.run.kind == "linear") {
     body += figure(svg(overlay),
                    "The mean bidirectional positional deviation x̄i of each run "
