@@ -133,15 +133,7 @@ struct ReadingStream::Impl {
   void open_next() {
     const SourceChunk& c = pending;
     const std::span<const unsigned char> blob(c.data);
-    const chunk::Key key{.run_id = checksum_run_id,
-                         .seq = c.seq.value_or(0),
-                         .device = c.device,
-                         .channel = c.channel,
-                         .quantity = c.quantity,
-                         .first_ns = c.first_ns,
-                         .last_ns = c.last_ns,
-                         .count = c.count,
-                         .encoding = c.encoding};
+    const auto key = chunk::key_of(checksum_run_id, c.seq.value_or(0), c);
     if (c.crc) {
       if (*c.crc != chunk::checksum(key, blob))
         damaged(c, "its checksum does not match its contents");
@@ -265,8 +257,7 @@ bool ReadingStream::next(std::vector<RawReading>& out, std::size_t max_readings)
 std::uint64_t ReadingStream::chunks_read() const { return impl_->chunks_read; }
 
 ReadingStream ReadingStream::of(std::unique_ptr<ChunkSource> source, std::string where,
-                                std::int64_t run_id, std::int64_t checksum_run_id,
-                                bool whole_run) {
+                                std::int64_t run_id, std::int64_t checksum_run_id, bool whole_run) {
   auto impl = std::make_unique<Impl>();
   impl->whole_run = whole_run;
   impl->source = std::move(source);

@@ -732,16 +732,7 @@ std::vector<Store::StoredChunk> Store::stored_chunks(std::int64_t run_id, std::i
              c.encoding, seq, crc);
     c.stored_checksum = crc.has_value();
     c.seq = c.stored_checksum ? seq.value_or(0) : place;
-    const chunk::Key key{.run_id = run_id,
-                         .seq = c.seq,
-                         .device = c.device,
-                         .channel = c.channel,
-                         .quantity = c.quantity,
-                         .first_ns = c.first_ns,
-                         .last_ns = c.last_ns,
-                         .count = c.count,
-                         .encoding = c.encoding};
-    c.crc = chunk::checksum(key, c.data);
+    c.crc = chunk::checksum(chunk::key_of(run_id, c.seq, c), c.data);
     const char* damage = nullptr;
     if (c.stored_checksum && static_cast<std::uint32_t>(*crc) != c.crc)
       damage = "its checksum does not match its contents";

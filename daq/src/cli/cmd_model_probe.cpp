@@ -91,20 +91,35 @@ kin::Vec3 pivot_of(const ProbeOptions& o, const std::optional<mdl::Model>& m, ki
                   o.centres, o.model, kin::to_string(l)));
 }
 
-json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
+// The fit's four location errors (ISO 230-1 names, e.g. E_X0C, E_Y0C, E_A0C, E_B0C): the two
+// positions across the axis, then the two tilts; the slots along the axis are not errors of it.
+struct LocationValue {
+  std::string name;
+  double value = 0, uncertainty = 0;  // uncertainty NaN: not estimated
+  const char* unit = "um";
+};
+
+std::vector<LocationValue> location_values(const kin::AxisLineFit& f) {
   const auto names = kin::location_error_names(f.letter);
   const std::size_t own = kin::direction_index(f.letter);
-  json loc = json::object();
-  std::size_t n = 0;
+  std::vector<LocationValue> out;
   for (std::size_t slot = 0; slot < 6; ++slot) {
     if (slot % 3 == own) continue;
     const bool pos = slot < 3;
-    const double v = pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
-    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
-    loc[names[n++]] = {{"value", v},
-                       {"uncertainty", std::isnan(u) ? json(nullptr) : json(u)},
-                       {"unit", pos ? "um" : "urad"}};
+    out.push_back({.name = std::string(names[out.size()]),
+                   .value = pos ? f.position_um[slot] : f.orientation_urad[slot - 3],
+                   .uncertainty = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3],
+                   .unit = pos ? "um" : "urad"});
   }
+  return out;
+}
+
+json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
+  json loc = json::object();
+  for (const auto& l : location_values(f))
+    loc[l.name] = {{"value", l.value},
+                   {"uncertainty", std::isnan(l.uncertainty) ? json(nullptr) : json(l.uncertainty)},
+                   {"unit", l.unit}};
   json res = json::array();
   for (std::size_t k = 0; k < a.centres.size(); ++k)
     res.push_back({{"line", a.lines[k]},
@@ -127,18 +142,11 @@ json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentr
 void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
   fmt::print("Axis {}: {} probed centres, nominal pivot ({:g}, {:g}, {:g}) mm\n",
              kin::to_string(f.letter), a.centres.size(), pivot[0], pivot[1], pivot[2]);
-  const auto names = kin::location_error_names(f.letter);
-  const std::size_t own = kin::direction_index(f.letter);
-  std::size_t n = 0;
-  for (std::size_t slot = 0; slot < 6; ++slot) {
-    if (slot % 3 == own) continue;
-    const bool pos = slot < 3;
-    const double v = pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
-    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
-    fmt::print("  {:6} {:+10.3f} {:4}  u = {}\n", names[n++], v, pos ? "um" : "urad",
-               std::isnan(u) ? std::string("not estimated (3 angles: give --probe-u-um)")
-                             : fmt::format("{:.3f} {}", u, pos ? "um" : "urad"));
-  }
+  for (const auto& l : location_values(f))
+    fmt::print("  {:6} {:+10.3f} {:4}  u = {}\n", l.name, l.value, l.unit,
+               std::isnan(l.uncertainty)
+                   ? std::string("not estimated (3 angles: give --probe-u-um)")
+                   : fmt::format("{:.3f} {}", l.uncertainty, l.unit));
   fmt::print("  circle radius {:.4f} mm, its plane {:+.4f} mm from the pivot along the axis\n",
              f.radius_mm, f.plane_offset_mm);
   fmt::print(

@@ -68,6 +68,21 @@ struct Key {
   std::int64_t encoding = columns_v2;
 };
 
+// The key of a stored row (any record with the row's device, channel, quantity, times, count and
+// encoding) as run `run_id`'s chunk number `seq`: one place that lists what a checksum covers.
+template <class Row>
+Key key_of(std::int64_t run_id, std::int64_t seq, const Row& r) {
+  return {.run_id = run_id,
+          .seq = seq,
+          .device = r.device,
+          .channel = r.channel,
+          .quantity = r.quantity,
+          .first_ns = r.first_ns,
+          .last_ns = r.last_ns,
+          .count = r.count,
+          .encoding = r.encoding};
+}
+
 // CRC-32C of the key (nine little-endian int64s, in the order above) followed by the BLOB.
 std::uint32_t checksum(const Key& key, std::span<const unsigned char> blob);
 
