@@ -405,9 +405,10 @@ std::string scale_cross_values(std::string_view format, std::string_view text, d
     // file 25.4 times as large needs two more decimals (where the notation has decimals).
     const int more =
         std::abs(factor) < 1 ? static_cast<int>(std::ceil(-std::log10(std::abs(factor)))) : 0;
-    const auto scaled = [&](std::string_view v) {
+    // (a copy: clang before 16 cannot capture a structured binding)
+    const auto scaled = [&, line_no = n](std::string_view v) {
       const int d = decimals(v);
-      return fixed(number(format, 0, n, v) * factor, d > 0 ? d + more : 0);
+      return fixed(number(format, 0, line_no, v) * factor, d > 0 ? d + more : 0);
     };
     if (part == Part::cec && l.starts_with("$AN_CEC[")) {
       const auto eq = l.find('=');
@@ -471,8 +472,8 @@ std::string shift_cross_values(std::string_view format, std::string_view text,
       const auto dot = v.find('.');
       return dot == std::string_view::npos ? 0 : static_cast<int>(v.size() - dot - 1);
     };
-    const auto moved = [&](std::string_view v, double unit_um) {
-      return fixed(number(format, 0, n, v) + sign * add_um / unit_um, decimals(v));
+    const auto moved = [&, line_no = n](std::string_view v, double unit_um) {
+      return fixed(number(format, 0, line_no, v) + sign * add_um / unit_um, decimals(v));
     };
     if (with_table && cec_table && l.starts_with("$AN_CEC[") &&
         indices(format, 0, n, l).front() == *cec_table) {
