@@ -390,24 +390,27 @@ kin::Vec3 cross_correction_um(const CrossApplied& a, const kin::Vec3& p) {
   return c;
 }
 
+namespace {
+// A value's decimals as written, so a rewritten file keeps its notation.
+int decimals_written(std::string_view v) {
+  const auto dot = v.find('.');
+  return dot == std::string_view::npos ? 0 : static_cast<int>(v.size() - dot - 1);
+}
+}  // namespace
+
 std::string scale_cross_values(std::string_view format, std::string_view text, double factor) {
   const auto part = part_of(format, text);
   std::string out;
   for (const auto& [n, l] : lines_of(text)) {
     std::string line = l;
     const auto w = words(l);
-    // The value's decimals as written, so the file keeps its notation.
-    const auto decimals = [](std::string_view v) {
-      const auto dot = v.find('.');
-      return dot == std::string_view::npos ? 0 : static_cast<int>(v.size() - dot - 1);
-    };
     // A value made smaller keeps what the control makes of it: a control that applies the
     // file 25.4 times as large needs two more decimals (where the notation has decimals).
     const int more =
         std::abs(factor) < 1 ? static_cast<int>(std::ceil(-std::log10(std::abs(factor)))) : 0;
     // (a copy: clang before 16 cannot capture a structured binding)
     const auto scaled = [&, line_no = n](std::string_view v) {
-      const int d = decimals(v);
+      const int d = decimals_written(v);
       return fixed(number(format, 0, line_no, v) * factor, d > 0 ? d + more : 0);
     };
     if (part == Part::cec && l.starts_with("$AN_CEC[")) {
@@ -468,12 +471,8 @@ std::string shift_cross_values(std::string_view format, std::string_view text,
   for (const auto& [n, l] : in) {
     std::string line = l;
     const auto w = words(l);
-    const auto decimals = [](std::string_view v) {
-      const auto dot = v.find('.');
-      return dot == std::string_view::npos ? 0 : static_cast<int>(v.size() - dot - 1);
-    };
     const auto moved = [&, line_no = n](std::string_view v, double unit_um) {
-      return fixed(number(format, 0, line_no, v) + sign * add_um / unit_um, decimals(v));
+      return fixed(number(format, 0, line_no, v) + sign * add_um / unit_um, decimals_written(v));
     };
     if (with_table && cec_table && l.starts_with("$AN_CEC[") &&
         indices(format, 0, n, l).front() == *cec_table) {
