@@ -40,17 +40,22 @@ check stored_complete 0 "^run 1 stored \(complete\)" -- echo "$RUN"
 # daq sim's configuration carries the machine specification of daq demo: the injected 4 um
 # backlash exceeds its B limit of 3 um, the rest is within.
 check verdict 0 "^verdict against tolerances.X.*: FAIL" -- echo "$RUN"
-# B within 0.1 um of the injected 4 um (3.9 .. 4.1): the live run's stops are means of a few noisy readings
-# (3.995 um was seen under load; "4.x" alone failed it).
-check verdict_on_b 0 "^  B +(3\.9|4\.0)[0-9]* um +limit +3\.000 um +FAIL" -- echo "$RUN"
+# B (the largest of the three targets' reversal values) within 0.15 um of the injected 4 um:
+# the live run's stops are means of a few noisy readings, fewer under load (3.995 um and 4.100 um
+# were seen in CI; a pattern "3.9x|4.0x" failed the second). Compared as a number.
+check verdict_on_b 0 "^  B +[0-9.]+ um +limit +3\.000 um +FAIL" -- echo "$RUN"
+B_UM=$(sed -nE 's/^  B +([0-9.]+) um +limit.*/\1/p' <<<"$RUN")
+check b_near_injected 0 "^near$" -- awk -v b="${B_UM:-999}" 'BEGIN { d = b - 4; print (d <= 0.15 && d >= -0.15) ? "near" : "B " b " um is not within 0.15 um of 4 um" }'
 check verdict_e_passes 0 "^  E +[0-9.]+ um +limit +10\.000 um +pass" -- echo "$RUN"
 # The machine rests on the first target while the program has not started: that is no stop.
 check rest_is_no_stop 0 "stop at .* without an approach move .*: ignored" -- echo "$RUN"
 check all_stops 0 "all stops captured" -- echo "$RUN"
-# Injected (ShopTruth): backlash 4 um, so the mean reversal value is -4 um; the noise of 0.15 um
-# averaged over each stop (150 readings) leaves it within +/-0.05 um, here over 6 stops per
-# direction.
-check reversal 0 "B̄ +-(3\.9[5-9]|4\.0[0-5])[0-9]* um" -- echo "$RUN"
+# Injected (ShopTruth): backlash 4 um, so the mean reversal value is -4 um. Live, a stop is the
+# mean of however many readings the loaded machine's trigger took (one target's reversal was
+# 4.10 um in CI), so within +/-0.1 um here; +/-0.05 um on the simulated-time runs below.
+check reversal 0 "B̄ +-[0-9.]+ um" -- echo "$RUN"
+BMEAN_UM=$(sed -nE 's/^  B̄ +-([0-9.]+) um.*/\1/p' <<<"$RUN")
+check reversal_near_injected 0 "^near$" -- awk -v b="${BMEAN_UM:-999}" 'BEGIN { d = b - 4; print (d <= 0.1 && d >= -0.1) ? "near" : "B mean -" b " um is not within 0.1 um of -4 um" }'
 B1=$(sed -nE 's/^  B̄ +([-+0-9.]+) um.*/\1/p' <<<"$RUN" | sed 's/\./\\./')
 check replay 0 "replayed .* into run 2" -- "$DAQ" replay "$TMP/lin.cdq" --db "$TMP/run.sqlite"
 check replay_same_b 0 "^  B̄ +$B1 um" -- "$DAQ" analyse 2 --db "$TMP/run.sqlite"
