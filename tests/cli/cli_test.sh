@@ -53,6 +53,8 @@ G=$("$DAQ" analyse 2 --db "$TMP/demo.sqlite" --json | "$PY" -c "import json,sys;
 "$DAQ" export 2 --what circle -o "$TMP/ballbar.csv" --db "$TMP/demo.sqlite"
 opts=$(sed -nE 's/^# .*daq analyse circle --input FILE (.*)$/\1/p' "$TMP/ballbar.csv")
 check circle_feed_analyse 0 "G\(b\) +$G um" -- bash -c "\"$DAQ\" analyse circle --input \"$TMP/ballbar.csv\" $opts"
+# The demo's circle has its own capture beside the linear run's, and replays to the same G.
+check circle_capture_replays 0 "G\(b\) +$G um" -- "$DAQ" replay "${DEMO_CDQ%.cdq}-circle.cdq" --db "$TMP/circle-replay.sqlite"
 check circle_no_targets 2 "run 2 is a circle test and has no captured stops: use --what circle" -- "$DAQ" export 2 --what targets --db "$TMP/demo.sqlite"
 check linear_no_circle 2 "run 1 is a linear test, not a circle" -- "$DAQ" export 1 --what circle --db "$TMP/demo.sqlite"
 # Readings: one timestamp per sample (the ballbar's lines delivered together are spread by its

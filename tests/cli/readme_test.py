@@ -103,7 +103,7 @@ try:
     left = [p for p in recorded if alive(p)]
     check("no process left running", not left, f"{len(left)} still running")
     # What the README's commands say they produce is there.
-    for name in ["caldaq-demo.sqlite", "caldaq-demo.cdq", "deviations.csv", "ballbar.csv",
+    for name in ["caldaq-demo.sqlite", "caldaq-demo.cdq", "caldaq-demo-circle.cdq", "deviations.csv", "ballbar.csv",
                  "readings-1.csv", "report-run-1.html", "report-run-2.pdf",
                  "campaign-report.html", "comparison-runs-1-3.html", "sim.toml", "run.cdq",
                  "map.html", "cec.mpf"]:

@@ -179,11 +179,17 @@ void print_comparison(const cal::iso230_2::Evaluation& measured,
       t.machine_degc, t.expansion_ppm_per_k, 270.0, t.expansion_ppm_per_k * (t.machine_degc - 20));
 }
 
+// The circle's capture beside the linear run's: caldaq-demo.cdq -> caldaq-demo-circle.cdq.
+std::string circle_capture_path(const std::string& linear_capture) {
+  const std::filesystem::path p(linear_capture);
+  return (p.parent_path() / (p.stem().string() + "-circle" + p.extension().string())).string();
+}
+
 // The ballbar part of the demo: a circle in XY about the table ball, the bar streaming at
 // 1 kHz through the real gauge driver; the injected squareness, servo mismatch, backlash,
 // scale and pitch errors beside what the diagnostics find.
-int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
-                    const cal::daq::Config& config, const DemoOptions& o) {
+int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop, cal::daq::Config config,
+                    const DemoOptions& o) {
   const auto& t = shop.truth();
   const cal::daq::BallbarProgram program{.radius_mm = t.ballbar_mm,
                                          .feed_mm_per_min = 1000,
@@ -193,23 +199,42 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop,
                                          .overshoot_deg = 45};
   fmt::print("\ndaq demo: ballbar circle in XY, R {} mm at {} mm/min, on {} (simulated)\n",
              program.radius_mm, program.feed_mm_per_min, shop.ballbar_device());
+  // The test as [test.circle] would configure it, in the run's context and the capture's
+  // header: `daq replay` of the capture runs the same program.
+  config.circle = cal::daq::CircleTestConfig{.plane = "XY",
+                                             .radius_mm = program.radius_mm,
+                                             .feed_mm_per_min = program.feed_mm_per_min,
+                                             .sample_rate_hz = program.sample_rate_hz,
+                                             .overshoot_deg = program.overshoot_deg,
+                                             .feed_in_mm = program.feed_in_mm,
+                                             .dwell_s = program.dwell_s};
   const auto& dc = need(config, "ballbar");
   const auto spec = spec_of(dc, 0);
-  CircleRunSetup setup{
-      .config = config,
-      .program = program,
-      .database = o.db,
-      .ballbar = make_instrument(io, spec, make_transport(io, dc),
-                                 {.name = "ballbar (simulated)", .clock = shop.clock_ns()}),
-      .origins = {{"ballbar", origin_of(spec.origin, "")}},
-      .on_event = [&o](const std::string& e) {
-        if (!o.quiet) fmt::print("  {}\n", e);
-      }};
+  // The circle's bytes in a capture of their own (a capture holds one session's instruments),
+  // so the circle replays as the linear run does.
+  const auto capture_file = circle_capture_path(o.capture);
+  SessionCapture capture(capture_file, config, {spec});
+  CircleRunSetup setup{.config = config,
+                       .program = program,
+                       .database = o.db,
+                       .ballbar = make_instrument(io, spec, make_transport(io, dc),
+                                                  {.name = "ballbar (simulated)",
+                                                   .clock = shop.clock_ns(),
+                                                   .recorder = capture.recorder.get()}),
+                       .capture_path = capture.absolute_path(capture_file),
+                       .origins = {{"ballbar", origin_of(spec.origin, "")}},
+                       .on_event = [&o](const std::string& e) {
+                         if (!o.quiet) fmt::print("  {}\n", e);
+                       }};
   CircleRun run(io, std::move(setup));
   run.start();
   shop.run_circle(program);
   shop.run_program([&] { return run.finished(); }, 20.0);
   if (!run.finished()) run.stop("the simulated circle ended before both traces were complete");
+  capture.recorder->close();
+  if (const auto& failure = capture.recorder->failure())
+    throw cal::InputError(
+        fmt::format("the circle's capture {} failed: {}", capture_file, *failure));
   const auto& out = run.outcome();
   if (!out.complete) {
     fmt::print(stderr, "daq demo: the circle did not complete: {}\n", out.reason);
@@ -362,6 +387,8 @@ int run_demo(const DemoOptions& o) {
   fmt::print("\nSee it again: daq runs --db {0}; daq show {1} --db {0}; daq export {1} --db {0}\n",
              o.db, out.run_id);
   fmt::print("Replay the wire-level capture: daq replay {} --db {}\n", o.capture, o.db);
+  if (!o.linear_only)
+    fmt::print("  and the circle's: daq replay {} --db {}\n", circle_capture_path(o.capture), o.db);
   if (const auto* vt = d::VirtualTime::of(io))
     fmt::print(
         "Simulated time: {:.1f} s in {} jumps, {} timer events; {} waits for bytes that never "
@@ -377,7 +404,8 @@ void add_demo_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "demo", "Run the whole chain on the built-in SIMULATED machine and instrument twins");
   cmd->add_option("--db", o->db, "Run database for the demo runs")->capture_default_str();
-  cmd->add_option("--capture", o->capture, "Wire-level capture file of the run")
+  cmd->add_option("--capture", o->capture,
+                  "Wire-level capture file of the linear run (the circle's: NAME-circle.cdq)")
       ->capture_default_str();
   cmd->add_option("--speed", o->speed,
                   "Simulated time per real time (1 .. 200); 0: simulated time jumps from event "
