@@ -32,6 +32,12 @@ check matrixkins 0 "^setp matrixkins\.C_xy 0\.000050000000$" -- cat "$TMP/lc/mat
 check isg_volumetric 0 "^chain +YXZ$" -- sh -c "'$DAQ' model compensate '$Y' -f isg-volumetric --interval-mm 50 50 50 --output-dir '$TMP/vc' 2>/dev/null && cat '$TMP/vc/volcomp.lis'"
 check isg_cross_refused 2 "use -f isg-volumetric" -- "$DAQ" model compensate "$Y" -f isg-cross --interval-mm 50 50 50 --output-dir "$TMP/ic"
 check no_partial 1 "" -- test -e "$TMP/ic"
+# --machine with a format daq verify cannot read back is refused before anything is written
+# (it wrote the files, then refused).
+check fanuc_machine 2 "a FANUC compensation is not stored for daq verify: FANUC's pitch error tables correct each axis along itself.*nothing was written" -- "$DAQ" model compensate "$Y" -f fanuc --interval-mm 50 50 50 -o "$TMP/f.txt" --machine M --db "$TMP/m.sqlite"
+check fanuc_machine_no_file 1 "" -- test -e "$TMP/f.txt"
+check no_machine 2 "no machine 'M' .*nothing was written" -- "$DAQ" model compensate "$Y" -f siemens-cec --interval-mm 50 50 50 -o "$TMP/nm.mpf" --machine M --db "$TMP/m.sqlite"
+check no_machine_no_file 1 "" -- test -e "$TMP/nm.mpf"
 check several_files 2 "give --output-dir" -- "$DAQ" model compensate "$Y" -f heidenhain --interval-mm 50 50 50
 check bad_interval 2 "not a whole number of 30 mm intervals" -- "$DAQ" model compensate "$Y" -f csv --interval-mm 30 50 50
 check compensate_report 0 "report written" -- "$DAQ" model compensate "$Y" -f siemens-cec --interval-mm 50 50 50 -o "$TMP/y.mpf" --report "$TMP/comp.html"

@@ -22,6 +22,7 @@
 #include "../support/daq_cli.hpp"
 #include "../support/temp_db.hpp"
 #include "cal/analysis/comp_formats.hpp"
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
 #include "compensation/compensation_check.hpp"
@@ -233,6 +234,56 @@ TEST(CrossLoop, SinumerikCecUnitAndReferenceErrorsAreDiagnosed) {
       largest_um(db, unit_again), largest_um(db, shifted_run),
       std::string(ct::to_string(shifted.verification.finding)).c_str(),
       shifted.verification.offset_um, largest_um(db, shift_again));
+  cal::test::remove_db(db);
+}
+
+// A control that applies a CEC table at positions shifted by +50 mm (its X datum is not the
+// table's): a table with a bump (10 um at X 200 mm, not a line, which a shift would turn into a
+// constant) is stored and loaded there; daq verify names the position shift, and the corrected
+// file (the table's positions moved by -50 mm) in that control acts as predicted. Before, the
+// cross check had no table positions (no shift was ever found) and --corrected refused it.
+TEST(CrossLoop, SinumerikCecPositionShiftIsDiagnosedAndCorrected) {
+  const auto db = cal::test::temp_path("caldaq-crossloop", "cecshift");
+  auto a = acquisition(db);
+  const auto found = acquire(a, "E_YX");
+  const std::vector<ct::CrossAxisTable> t{{"X", "Y", 0.0, 100.0, {0.0, 0.0, 0.010, 0.0, 0.0, 0.0}}};
+  const std::map<std::string, int> numbers{{"X", 1}, {"Y", 2}, {"Z", 3}};
+  const std::string file = ct::write_sinumerik_cec(t, numbers);
+  {
+    cal::storage::Store store(db);
+    daq::store_cross_compensation(store, store.run(found)->machine_id, found, "run",
+                                  {.format = "siemens-cec", .files = {{"", file}}});
+  }
+  const auto check = [&](std::int64_t run) {
+    cal::storage::Store store(db, {.read_only = true});
+    return daq::check_run(store, run).value();
+  };
+  // The control reads the table's positions 50 mm further out than they are written.
+  const auto shifted_control = [&](const std::string& text) {
+    const std::vector<ct::CompFile> one{{"", text}};
+    return daq::control_loads(
+        "siemens-cec", ct::shift_cross_positions("siemens-cec", one, "X", "Y", -50.0, numbers),
+        false);
+  };
+  a.compensation = shifted_control(file);
+  const auto shifted_run = acquire(a, "E_YX");
+  const auto shifted = check(shifted_run);
+  ASSERT_EQ(shifted.verification.finding, ct::Finding::position_shift) << shifted.verification.text;
+  EXPECT_NEAR(shifted.verification.shift_mm, 50.0, 5.0);
+  const auto fixed = daq::corrected_files(shifted);
+  ASSERT_EQ(fixed.size(), 1u);
+  EXPECT_NE(fixed[0].second.find("$AN_CEC_MIN[0]=-50.0000"), std::string::npos) << fixed[0].second;
+  a.compensation = shifted_control(fixed[0].second);
+  const auto again = acquire(a, "E_YX");
+  const auto ok = check(again);
+  EXPECT_EQ(ok.verification.finding, ct::Finding::as_predicted) << ok.verification.text;
+  std::printf(
+      "cross loop siemens-cec (E_YX, a 10 um bump at X 200): as found %.3f um; the control 50 mm "
+      "off %.3f um (%s, %+.1f mm); corrected file there %.3f um (%s)\n",
+      largest_um(db, found), largest_um(db, shifted_run),
+      std::string(ct::to_string(shifted.verification.finding)).c_str(),
+      shifted.verification.shift_mm, largest_um(db, again),
+      std::string(ct::to_string(ok.verification.finding)).c_str());
   cal::test::remove_db(db);
 }
 
