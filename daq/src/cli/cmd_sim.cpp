@@ -359,7 +359,8 @@ void add_sim_command(CLI::App& app) {
                 "The control reads the values with the other sign than caldaq's reading of the "
                 "vendor's text (to see daq verify diagnose it)");
   cmd->add_flag("--acquire", o->acquire,
-                "Acquire the --test here instead of waiting for `daq run` in another process: "
+                "Acquire the --test (or the --measure component's test) here instead of waiting "
+                "for `daq run` in another process: "
                 "`daq run TEST --config FILE` runs in this process on SIMULATED time (as fast as "
                 "the CPU allows, the same on a loaded machine), prints what it prints and stores "
                 "into --db");
