@@ -141,6 +141,25 @@ LoopResult loop(const char* name, const std::string& component, const std::strin
   return r;
 }
 
+// An as-left E_YX run in a control that applies the stored file otherwise than meant: its check
+// must name `want`; the one corrected file daq verify --corrected writes.
+struct Diagnosed {
+  std::int64_t run = 0;
+  daq::LoopCheck check;
+  std::string corrected;
+};
+Diagnosed diagnose(const daq::SimulatedAcquisition& a, const fs::path& db, ct::Finding want) {
+  Diagnosed d;
+  d.run = acquire(a, "E_YX");
+  cal::storage::Store store(db, {.read_only = true});
+  d.check = daq::check_run(store, d.run).value();
+  EXPECT_EQ(d.check.verification.finding, want) << d.check.verification.text;
+  const auto files = daq::corrected_files(d.check);
+  EXPECT_EQ(files.size(), 1u);
+  if (!files.empty()) d.corrected = files[0].second;
+  return d;
+}
+
 // `right_ratio`: what the right sign may leave of the as-found error.
 void expect_loop(const LoopResult& r, const char* what, double right_ratio = 0.2) {
   EXPECT_GT(r.before_um, 3.0) << what;  // a table worth verifying
@@ -206,24 +225,20 @@ TEST(CrossLoop, SinumerikCecUnitAndReferenceErrorsAreDiagnosed) {
     };
   };
   a.compensation = inch(file[0]);
-  const auto unit_run = acquire(a, "E_YX");
-  const auto unit = check(unit_run);
-  EXPECT_EQ(unit.verification.finding, ct::Finding::unit_scale) << unit.verification.text;
+  const auto unit_d = diagnose(a, db, ct::Finding::unit_scale);
+  const auto& unit = unit_d.check;
+  const auto unit_run = unit_d.run;
   EXPECT_NEAR(unit.verification.scale, 25.4, 1e-9);
-  const auto unit_fixed = daq::corrected_files(unit);
-  ASSERT_EQ(unit_fixed.size(), 1u);
   a.compensation = y_off(file[0]);
-  const auto shifted_run = acquire(a, "E_YX");
-  const auto shifted = check(shifted_run);
-  EXPECT_EQ(shifted.verification.finding, ct::Finding::constant_shift) << shifted.verification.text;
+  const auto shifted_d = diagnose(a, db, ct::Finding::constant_shift);
+  const auto& shifted = shifted_d.check;
+  const auto shifted_run = shifted_d.run;
   EXPECT_NEAR(shifted.verification.offset_um, 2.0, 0.1);
-  const auto shift_fixed = daq::corrected_files(shifted);
-  ASSERT_EQ(shift_fixed.size(), 1u);
   // Each corrected file in the control that got it wrong: as predicted.
-  a.compensation = inch(unit_fixed[0].second);
+  a.compensation = inch(unit_d.corrected);
   const auto unit_again = acquire(a, "E_YX");
   EXPECT_EQ(check(unit_again).verification.finding, ct::Finding::as_predicted);
-  a.compensation = y_off(shift_fixed[0].second);
+  a.compensation = y_off(shifted_d.corrected);
   const auto shift_again = acquire(a, "E_YX");
   EXPECT_EQ(check(shift_again).verification.finding, ct::Finding::as_predicted);
   std::printf(
@@ -266,14 +281,12 @@ TEST(CrossLoop, SinumerikCecPositionShiftIsDiagnosedAndCorrected) {
         false);
   };
   a.compensation = shifted_control(file);
-  const auto shifted_run = acquire(a, "E_YX");
-  const auto shifted = check(shifted_run);
-  ASSERT_EQ(shifted.verification.finding, ct::Finding::position_shift) << shifted.verification.text;
+  const auto d = diagnose(a, db, ct::Finding::position_shift);
+  const auto& shifted = d.check;
+  const auto shifted_run = d.run;
   EXPECT_NEAR(shifted.verification.shift_mm, 50.0, 5.0);
-  const auto fixed = daq::corrected_files(shifted);
-  ASSERT_EQ(fixed.size(), 1u);
-  EXPECT_NE(fixed[0].second.find("$AN_CEC_MIN[0]=-50.0000"), std::string::npos) << fixed[0].second;
-  a.compensation = shifted_control(fixed[0].second);
+  EXPECT_NE(d.corrected.find("$AN_CEC_MIN[0]=-50.0000"), std::string::npos) << d.corrected;
+  a.compensation = shifted_control(d.corrected);
   const auto again = acquire(a, "E_YX");
   const auto ok = check(again);
   EXPECT_EQ(ok.verification.finding, ct::Finding::as_predicted) << ok.verification.text;
