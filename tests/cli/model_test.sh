@@ -73,7 +73,7 @@ check mixed_json 0 '"E_C0Y": "SIMULATED"' -- "$DAQ" model compensate "$TMP/mixed
 # ISG's CSV parameter file comments with "//" ("#" is a file break there).
 check isg_csv_origin 0 "^//   SIMULATED: E_C0Y$" -- sh -c "'$DAQ' model compensate '$TMP/mixed.json' -f isg-volumetric ${I[*]} --output-dir '$TMP/mvc' 2>/dev/null && cat '$TMP/mvc/volcomp.csv'"
 check isg_lis_origin 0 "^# MIXED data: do not load into a real control" -- cat "$TMP/mvc/volcomp.lis"
-check heidenhain_silent 0 "Y.COM: the format has no comments, so the file does not say it" -- "$DAQ" model compensate "$TMP/mixed.json" -f heidenhain "${I[@]}" --output-dir "$TMP/mhh"
+check heidenhain_silent 0 "Y.COM, config.cma: the format has no comments, so the file does not say it" -- "$DAQ" model compensate "$TMP/mixed.json" -f heidenhain "${I[@]}" --output-dir "$TMP/mhh"
 check sim_fanuc 0 "^SIMULATED data: do not load into a real control$" -- sh -c "'$DAQ' model compensate '$TMP/sim.json' -f fanuc ${I[*]} 2>/dev/null"
 check sim_matrixkins 0 "^# SIMULATED data: do not load into a real control$" -- sh -c "'$DAQ' model compensate '$TMP/sim.json' -f linuxcnc ${I[*]} --output-dir '$TMP/mlc' 2>/dev/null && cat '$TMP/mlc/matrixkins.hal'"
 check mixed_report 0 "<strong>MIXED</strong>: some errors of this model come from runs not measured on real instruments \(REPLAYED: E_XX; SIMULATED: E_C0Y\).*Do not load its compensation into a real control" -- sh -c "'$DAQ' model compensate '$TMP/mixed.json' -f siemens-cec ${I[*]} -o '$TMP/m2.mpf' --report '$TMP/mixed.html' 2>/dev/null && cat '$TMP/mixed.html'"
