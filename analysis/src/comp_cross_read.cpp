@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -46,6 +47,14 @@ std::vector<std::string_view> words(std::string_view s) {
     if (i > start) w.push_back(s.substr(start, i - start));
   }
   return w;
+}
+
+// A file's name as a *.CMA names it: without its directory (TNC:\\, /), in lower case.
+std::string name_key(std::string_view path) {
+  const auto slash = path.find_last_of("/\\:");
+  std::string b(slash == std::string_view::npos ? path : path.substr(slash + 1));
+  for (auto& c : b) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return b;
 }
 
 [[noreturn]] void fail(std::string_view what, std::size_t file, std::size_t line,
@@ -292,11 +301,92 @@ kin::Machine machine_of(const IsgVolumetric& v, std::array<std::array<double, 2>
   return m;
 }
 
+// HEIDENHAIN *.CMA (MANUALplus 620 technical manual p. 718): "[Axis in column from *.com] =
+// F(Axis in column from *.cma, in which *.com is entered)": a header line of the columns (ACTIVE
+// and one per input axis), rows of *.COM names, the row with * in ACTIVE the active one ("only
+// one table can be active"). Each *.COM name of the active row (without its directory, in
+// lower case) -> the input axis of its column.
+void read_cma(const std::vector<Line>& in, std::size_t file,
+              std::map<std::string, std::string>& input_of) {
+  constexpr std::string_view what = "HEIDENHAIN *.CMA";
+  std::vector<std::string_view> header;
+  std::size_t active = 0;
+  bool found = false;
+  for (const auto& [n, l] : in) {
+    const auto w = words(l);
+    if (w.empty()) continue;
+    if (header.empty()) {
+      header = w;
+      const auto it = std::find(header.begin(), header.end(), "ACTIVE");
+      if (it == header.end())
+        fail(what, file, n, "expected the header line: ACTIVE and a column per input axis");
+      active = static_cast<std::size_t>(it - header.begin());
+      continue;
+    }
+    if (w.size() != header.size()) fail(what, file, n, "a row of another width than the header");
+    if (w[active] != "*") continue;
+    if (found) fail(what, file, n, "a second active row (only one row can be active)");
+    found = true;
+    for (std::size_t k = 0; k < w.size(); ++k)
+      if (k != active && header[k] != "NR" && w[k] != "-")
+        input_of[name_key(w[k])] = std::string(header[k]);
+  }
+  if (!found) fail(what, file, 0, "no active row (* in the ACTIVE column)");
+}
+
+// HEIDENHAIN *.COM: the header "AXISPOS" and a column per output axis, rows of the position
+// (mm) and the values (mm) of each column; `input` from the *.CMA.
+void read_com(const std::vector<Line>& in, std::size_t file, const std::string& input,
+              std::vector<CrossTableApplied>& out) {
+  constexpr std::string_view what = "HEIDENHAIN *.COM";
+  std::vector<CrossTableApplied> t;
+  for (const auto& [n, l] : in) {
+    const auto w = words(l);
+    if (w.empty()) continue;
+    if (t.empty()) {
+      if (w[0] != "AXISPOS" || w.size() < 2)
+        fail(what, file, n, "expected the header line: AXISPOS and a column per axis");
+      for (std::size_t k = 1; k < w.size(); ++k) {
+        if (w[k] == "BACKLASH")
+          fail(what, file, n,
+               "a BACKLASH column (the negative direction's values) is not read as a cross-axis "
+               "table");
+        t.push_back({input, std::string(w[k]), {}, {}});
+      }
+      continue;
+    }
+    if (w.size() != t.size() + 1) fail(what, file, n, "a row of another width than the header");
+    const double x = number(what, file, n, w[0]);
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      t[k].position_mm.push_back(x);
+      t[k].correction_um.push_back(number(what, file, n, w[k + 1]) * 1e3);
+    }
+  }
+  if (t.empty()) fail(what, file, 0, "no header line (AXISPOS ...)");
+  for (auto& x : t) out.push_back(std::move(x));
+}
+
 // Which function a file of the set is, from its text.
-enum class Part { cec, isg_cross, isg_other, csv, matrixkins, hal_other, vol_list, vol_csv };
+enum class Part {
+  cec,
+  isg_cross,
+  isg_other,
+  csv,
+  matrixkins,
+  hal_other,
+  vol_list,
+  vol_csv,
+  com,
+  cma
+};
 
 Part part_of(std::string_view format, std::string_view text) {
   if (format == "siemens-cec") return Part::cec;
+  if (format == "heidenhain") {
+    const auto first = text.find_first_not_of(" \t\r\n");
+    return first != std::string_view::npos && text.substr(first).starts_with("AXISPOS") ? Part::com
+                                                                                        : Part::cma;
+  }
   if (format == "csv") return Part::csv;
   if (format == "isg-cross")
     return text.find("kw.crosscomp.") != std::string_view::npos ? Part::isg_cross : Part::isg_other;
@@ -311,21 +401,65 @@ Part part_of(std::string_view format, std::string_view text) {
 
 bool is_cross_format(std::string_view format) {
   return format == "csv" || format == "siemens-cec" || format == "isg-cross" ||
-         format == "linuxcnc-matrixkins" || format == "isg-volumetric";
+         format == "linuxcnc-matrixkins" || format == "isg-volumetric" || format == "heidenhain";
 }
 
 CrossApplied read_cross_applied(std::string_view format, std::span<const std::string> files,
                                 const std::map<std::string, int>& axis_numbers, bool inverted) {
+  std::vector<CompFile> named;
+  for (const auto& t : files) named.push_back({"", t});
+  return read_cross_applied(format, named, axis_numbers, inverted);
+}
+
+namespace {
+// HEIDENHAIN: each *.COM's input axis, from the active row of the set's *.CMA.
+std::map<std::string, std::string> com_inputs(std::span<const CompFile> files) {
+  std::map<std::string, std::string> input_of;
+  bool cma = false;
+  for (std::size_t f = 0; f < files.size(); ++f)
+    if (part_of("heidenhain", files[f].text) == Part::cma) {
+      if (cma) throw InputError("HEIDENHAIN: more than one *.CMA among the files");
+      cma = true;
+      read_cma(lines_of(files[f].text), f, input_of);
+    }
+  if (!cma)
+    throw InputError(
+        "HEIDENHAIN: no *.CMA among the files: a *.COM's input axis is named there, not in the "
+        "*.COM");
+  return input_of;
+}
+
+const std::string& com_input(const std::map<std::string, std::string>& input_of, const CompFile& f,
+                             std::size_t index) {
+  const auto it = input_of.find(name_key(f.name));
+  if (f.name.empty() || it == input_of.end())
+    throw InputError(fmt::format(
+        "HEIDENHAIN *.COM file {} ('{}'): not in the active row of the *.CMA, so its input axis "
+        "is unknown",
+        index + 1, f.name));
+  return it->second;
+}
+}  // namespace
+
+CrossApplied read_cross_applied(std::string_view format, std::span<const CompFile> files,
+                                const std::map<std::string, int>& axis_numbers, bool inverted) {
   if (!is_cross_format(format))
     throw InputError(fmt::format(
         "reading a '{}' cross-axis compensation back is not supported (csv, siemens-cec, "
-        "isg-cross, linuxcnc-matrixkins, isg-volumetric)",
+        "isg-cross, linuxcnc-matrixkins, isg-volumetric, heidenhain)",
         format));
   CrossApplied a;
   IsgVolumetric vol;
+  const auto input_of =
+      format == "heidenhain" ? com_inputs(files) : std::map<std::string, std::string>{};
   for (std::size_t f = 0; f < files.size(); ++f) {
-    const auto in = lines_of(files[f]);
-    switch (part_of(format, files[f])) {
+    const auto in = lines_of(files[f].text);
+    switch (part_of(format, files[f].text)) {
+      case Part::com:
+        read_com(in, f, com_input(input_of, files[f], f), a.tables);
+        break;
+      case Part::cma:
+        break;  // read above
       case Part::cec:
         read_cec(in, f, axis_numbers, a.tables);
         break;
@@ -425,6 +559,9 @@ std::string scale_cross_values(std::string_view format, std::string_view text, d
     } else if (part == Part::csv && w.size() == 5 && !l.starts_with("#") &&
                !l.starts_with("input,")) {
       line = fmt::format("{},{},{},{},{}", w[0], w[1], w[2], w[3], scaled(w[4]));
+    } else if (part == Part::com && w.size() >= 2 && w[0] != "AXISPOS") {
+      line = std::string(w[0]);  // the position; every column's value scaled
+      for (std::size_t k = 1; k < w.size(); ++k) line += " " + scaled(w[k]);
     } else if (part == Part::vol_csv && !l.starts_with("//") && !l.starts_with("#") && !w.empty() &&
                w[0] != "C0Y" && w[0] != "X" && w[0] != "Y" && w[0] != "Z") {
       // The location errors' line (3 values) and each row (the argument first, unchanged).
@@ -440,7 +577,7 @@ std::string scale_cross_values(std::string_view format, std::string_view text, d
 std::string shift_cross_values(std::string_view format, std::string_view text,
                                const std::string& output, double add_um,
                                const std::map<std::string, int>& axis_numbers, bool& with_table) {
-  if (format != "siemens-cec" && format != "isg-cross" && format != "csv")
+  if (format != "siemens-cec" && format != "isg-cross" && format != "csv" && format != "heidenhain")
     throw InputError(fmt::format(
         "a {} compensation cannot hold a constant of one axis: check the control's reference "
         "point (or the workpiece datum) instead",
@@ -466,6 +603,16 @@ std::string shift_cross_values(std::string_view format, std::string_view text,
     for (const auto& [n, l] : in)
       if (const auto w = words(l); w.size() == 5 && w[1] == output && !l.starts_with("#"))
         with_table = true;
+  // HEIDENHAIN: the column of `output` in a *.COM (the first file that has one is moved).
+  std::optional<std::size_t> com_column;
+  if (part == Part::com)
+    for (const auto& [n, l] : in)
+      if (const auto w = words(l); !w.empty() && w[0] == "AXISPOS") {
+        for (std::size_t k = 1; k < w.size(); ++k)
+          if (w[k] == output) com_column = k;
+        break;
+      }
+  if (com_column) with_table = true;
   const double sign = format_meaning(format).written == Sign::error ? -1.0 : 1.0;
   std::string out;
   for (const auto& [n, l] : in) {
@@ -484,9 +631,115 @@ std::string shift_cross_values(std::string_view format, std::string_view text,
     } else if (with_table && part == Part::csv && w.size() == 5 && w[1] == output &&
                !l.starts_with("#")) {
       line = fmt::format("{},{},{},{},{}", w[0], w[1], w[2], w[3], moved(w[4], 1e3));
+    } else if (com_column && w.size() > *com_column && w[0] != "AXISPOS") {
+      line = std::string(w[0]);
+      for (std::size_t k = 1; k < w.size(); ++k)
+        line += " " + (k == *com_column ? moved(w[k], 1e3) : std::string(w[k]));
     }
     out += line + "\n";
   }
+  return out;
+}
+
+namespace {
+// A position as written, moved by -shift (mm) in the file's unit (um per unit of the position).
+std::string position_moved(std::string_view format, std::size_t line, std::string_view v,
+                           double shift_mm, double mm_per_unit) {
+  // At least the decimals that hold the shift (0.001 mm: 3; 0.1 um units: 0).
+  const int d = std::max(decimals_written(v), mm_per_unit < 1e-3 ? 0 : 4);
+  return fixed(number(format, 0, line, v) - shift_mm / mm_per_unit, d);
+}
+}  // namespace
+
+std::vector<CompFile> shift_cross_positions(std::string_view format,
+                                            std::span<const CompFile> files,
+                                            const std::string& input, const std::string& output,
+                                            double shift_mm,
+                                            const std::map<std::string, int>& axis_numbers) {
+  if (format != "siemens-cec" && format != "isg-cross" && format != "csv" && format != "heidenhain")
+    throw InputError(fmt::format(
+        "a {} compensation has no positions of one table to shift ({}): check the machine "
+        "datum of {} instead",
+        format,
+        format == "linuxcnc-matrixkins" ? "matrixkins is a line: a shift of it is a constant"
+                                        : "its tables are the error parameters of whole axes",
+        input));
+  const auto number_of = [&](const std::string& axis) {
+    const auto it = axis_numbers.find(axis);
+    return it == axis_numbers.end() ? -1 : it->second;
+  };
+  const auto input_of =
+      format == "heidenhain" ? com_inputs(files) : std::map<std::string, std::string>{};
+  std::vector<CompFile> out;
+  bool any = false;
+  for (std::size_t f = 0; f < files.size(); ++f) {
+    const auto part = part_of(format, files[f].text);
+    const auto in = lines_of(files[f].text);
+    // Which lines hold this table's positions.
+    std::optional<int> cec;  // the CEC table of output over input
+    bool whole = false;      // every position line of the file (ISG list, *.COM)
+    if (part == Part::cec) {
+      std::map<int, std::pair<std::string, std::string>> io;
+      for (const auto& [n, l] : in) {
+        const auto ax = [&](std::string_view prefix) {
+          return l.starts_with(prefix) && l.find("(AX") != std::string::npos;
+        };
+        if (ax("$AN_CEC_INPUT_AXIS[")) io[indices(format, f, n, l).front()].first = l;
+        if (ax("$AN_CEC_OUTPUT_AXIS[")) io[indices(format, f, n, l).front()].second = l;
+      }
+      for (const auto& [t, p] : io)
+        if (!cec && p.first.ends_with(fmt::format("=(AX{})", number_of(input))) &&
+            p.second.ends_with(fmt::format("=(AX{})", number_of(output))))
+          cec = t;
+    }
+    if (part == Part::isg_cross) {
+      bool slave = false, master = false;
+      for (const auto& [n, l] : in) {
+        const auto w = words(l);
+        if (w.size() == 2 && w[0] == "kopf.log_achs_name" && w[1] == output) slave = true;
+        if (w.size() == 2 && w[0] == "kw.crosscomp.master_ax_nr" &&
+            number(format, f, n, w[1]) == number_of(input))
+          master = true;
+      }
+      whole = slave && master;
+    }
+    if (part == Part::com && com_input(input_of, files[f], f) == input)
+      for (const auto& [n, l] : in)
+        if (const auto w = words(l); !w.empty() && w[0] == "AXISPOS") {
+          whole = std::find(w.begin() + 1, w.end(), output) != w.end();
+          break;
+        }
+    std::string text;
+    for (const auto& [n, l] : in) {
+      std::string line = l;
+      const auto w = words(l);
+      if (cec && (l.starts_with("$AN_CEC_MIN[") || l.starts_with("$AN_CEC_MAX[")) &&
+          indices(format, f, n, l).front() == *cec) {
+        const auto eq = l.find('=');
+        line = l.substr(0, eq + 1) +
+               position_moved(format, n, std::string_view(l).substr(eq + 1), shift_mm, 1.0);
+        any = true;
+      } else if (whole && part == Part::isg_cross && w.size() == 2 &&
+                 w[0].starts_with("kw.crosscomp.table[") && w[0].ends_with(".setpoint")) {
+        line = fmt::format("{} {}", w[0], position_moved(format, n, w[1], shift_mm, 1e-4));
+        any = true;
+      } else if (whole && part == Part::com && w.size() >= 2 && w[0] != "AXISPOS") {
+        line = position_moved(format, n, w[0], shift_mm, 1.0);
+        for (std::size_t k = 1; k < w.size(); ++k) line += " " + std::string(w[k]);
+        any = true;
+      } else if (part == Part::csv && w.size() == 5 && w[0] == input && w[1] == output &&
+                 !l.starts_with("#")) {
+        line = fmt::format("{},{},{},{},{}", w[0], w[1], w[2],
+                           position_moved(format, n, w[3], shift_mm, 1.0), w[4]);
+        any = true;
+      }
+      text += line + "\n";
+    }
+    out.push_back({files[f].name, text});
+  }
+  if (!any)
+    throw InputError(fmt::format("{}: no table of {} over {} whose positions could be shifted",
+                                 format, output, input));
   return out;
 }
 

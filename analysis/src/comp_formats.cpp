@@ -312,6 +312,20 @@ std::string write_heidenhain_com(const Table& t) {
   return out;
 }
 
+std::string write_heidenhain_cma(
+    const std::vector<std::pair<std::string, std::string>>& input_and_com) {
+  if (input_and_com.empty()) throw InputError("HEIDENHAIN .CMA: no table to assign");
+  std::string header = "ACTIVE", row = "*";
+  for (const auto& [input, com] : input_and_com) {
+    if (!axis_name_ok(input)) throw InputError("HEIDENHAIN .CMA: the axis name must be one letter");
+    if (com.empty() || com.find_first_of(" \t\r\n") != std::string::npos)
+      throw InputError(fmt::format("HEIDENHAIN .CMA: '{}' is not a table name", com));
+    header += " " + input;
+    row += " " + com;
+  }
+  return header + "\n" + row + "\n";
+}
+
 FanucSteps fanuc_steps(const Table& t, const FanucOptions& o) {
   check_positioning(t, "FANUC pitch error compensation");
   if (t.spec.incremental)

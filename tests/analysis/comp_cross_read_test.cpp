@@ -122,6 +122,71 @@ TEST(CrossRead, ScaledFilesKeepTheirNotationAndNoNegativeZero) {
   EXPECT_NE(mk.find("setp matrixkins.C_xx 1.000000000000\n"), std::string::npos);
 }
 
+// HEIDENHAIN: a *.COM holds no input axis; the *.CMA names it ("[Axis in column from *.com] =
+// F(Axis in column from *.cma, in which *.com is entered)"). The columns hold the error curve
+// (comp_meaning.cpp): the control adds minus each value. Before, a HEIDENHAIN compensation was
+// not read back at all (is_cross_format said no).
+TEST(CrossRead, HeidenhainComIsReadWithItsCmaAssignment) {
+  const std::vector<CrossAxisTable> t{y_over_x()};
+  const std::vector<CompFile> files{{"TNC:\\table\\x.com", write_heidenhain_com(t)},
+                                    {"config.cma", write_heidenhain_cma({{"X", "X.COM"}})}};
+  EXPECT_EQ(files[1].text, "ACTIVE X\n* X.COM\n");
+  EXPECT_NE(files[0].text.find("400.0000 -0.0040\n"), std::string::npos) << files[0].text;
+  const auto a = read_cross_applied("heidenhain", files, kNumbers);
+  ASSERT_EQ(a.tables.size(), 1u);
+  EXPECT_EQ(a.tables[0].input, "X");
+  EXPECT_EQ(a.tables[0].output, "Y");
+  EXPECT_NEAR(y_at(a, 400), 4.0, 1e-9);
+  EXPECT_NEAR(y_at(a, 100), -2.5, 1e-9);
+  EXPECT_NEAR(y_at(read_cross_applied("heidenhain", files, kNumbers, true), 400), -4.0, 1e-9);
+  // The same *.COM assigned to the Z column acts over Z.
+  const std::vector<CompFile> over_z{files[0], {"c.cma", "NR ACTIVE X Z\n0 - - -\n1 * - X.COM\n"}};
+  const auto z = read_cross_applied("heidenhain", over_z, kNumbers);
+  EXPECT_EQ(z.tables.at(0).input, "Z");
+  EXPECT_NEAR(cross_correction_um(z, {0, 0, 400})[1], 4.0, 1e-9);
+  // Without the *.CMA, or a *.COM it does not name, the input axis is unknown: refused.
+  const std::vector<CompFile> alone{files[0]};
+  EXPECT_THROW(read_cross_applied("heidenhain", alone, kNumbers), cal::InputError);
+  const std::vector<CompFile> other{{"Y.COM", files[0].text}, files[1]};
+  EXPECT_THROW(read_cross_applied("heidenhain", other, kNumbers), cal::InputError);
+  const std::vector<CompFile> two_active{files[0], {"c.cma", "ACTIVE X\n* X.COM\n* X.COM\n"}};
+  EXPECT_THROW(read_cross_applied("heidenhain", two_active, kNumbers), cal::InputError);
+  // Negated for an inverted sign: the values, not the positions.
+  const std::string negated = scale_cross_values("heidenhain", files[0].text, -1.0);
+  EXPECT_NE(negated.find("400.0000 0.0040\n"), std::string::npos) << negated;
+  EXPECT_NE(negated.find("0.0000 0.0000\n"), std::string::npos) << negated;  // no -0
+}
+
+// A position shift undone (the control applied the table at x - 25 mm): each format's table of
+// Y over X moved by -25 mm, so that the control that shifts applies the values where they were
+// meant. Before, --corrected refused a cross table's position shift.
+TEST(CrossRead, PositionShiftMovesTheTablesPositions) {
+  const std::vector<CrossAxisTable> t{y_over_x()};
+  const auto shifted_right = [](const CrossApplied& a, double x) { return y_at(a, x - 25.0); };
+  const auto check = [&](const std::string& format, const std::vector<CompFile>& files) {
+    const auto moved = shift_cross_positions(format, files, "X", "Y", 25.0, kNumbers);
+    ASSERT_EQ(moved.size(), files.size()) << format;
+    const auto a = read_cross_applied(format, moved, kNumbers);
+    const auto orig = read_cross_applied(format, files, kNumbers);
+    for (const double x : {100.0, 237.5, 400.0})
+      EXPECT_NEAR(shifted_right(a, x), y_at(orig, x), 1e-9) << format << " at " << x;
+  };
+  check("siemens-cec", {{"", write_sinumerik_cec(t, kNumbers)}});
+  check("isg-cross", {{"", write_isg_cross(y_over_x(), 2, 1)}});
+  check("csv", {{"", write_cross_csv(t)}});
+  check("heidenhain", {{"X.COM", write_heidenhain_com(t)},
+                       {"config.cma", write_heidenhain_cma({{"X", "X.COM"}})}});
+  const std::vector<CompFile> one{{"", write_sinumerik_cec(t, kNumbers)}};
+  const auto cec = shift_cross_positions("siemens-cec", one, "X", "Y", 25.0, kNumbers);
+  EXPECT_NE(cec[0].text.find("$AN_CEC_MIN[0]=-25.0000\n"), std::string::npos) << cec[0].text;
+  // A table of another pair, matrixkins and volumetric: nothing to shift, said.
+  EXPECT_THROW(shift_cross_positions("siemens-cec", one, "Z", "Y", 25.0, kNumbers),
+               cal::InputError);
+  const std::vector<CompFile> mk{{"", write_linuxcnc_matrixkins({.c0y_urad = 15}, {})}};
+  EXPECT_THROW(shift_cross_positions("linuxcnc-matrixkins", mk, "Y", "X", 25.0, kNumbers),
+               cal::InputError);
+}
+
 TEST(CrossRead, RefusesWhatItCannotRead) {
   const std::vector<std::string> none{"M17\n"};
   EXPECT_THROW(read_cross_applied("siemens-cec", none, kNumbers), cal::InputError);

@@ -32,6 +32,12 @@ check matrixkins 0 "^setp matrixkins\.C_xy 0\.000050000000$" -- cat "$TMP/lc/mat
 check isg_volumetric 0 "^chain +YXZ$" -- sh -c "'$DAQ' model compensate '$Y' -f isg-volumetric --interval-mm 50 50 50 --output-dir '$TMP/vc' 2>/dev/null && cat '$TMP/vc/volcomp.lis'"
 check isg_cross_refused 2 "use -f isg-volumetric" -- "$DAQ" model compensate "$Y" -f isg-cross --interval-mm 50 50 50 --output-dir "$TMP/ic"
 check no_partial 1 "" -- test -e "$TMP/ic"
+# --machine with a format daq verify cannot read back is refused before anything is written
+# (it wrote the files, then refused).
+check fanuc_machine 2 "a FANUC compensation is not stored for daq verify: FANUC's pitch error tables correct each axis along itself.*nothing was written" -- "$DAQ" model compensate "$Y" -f fanuc --interval-mm 50 50 50 -o "$TMP/f.txt" --machine M --db "$TMP/m.sqlite"
+check fanuc_machine_no_file 1 "" -- test -e "$TMP/f.txt"
+check no_machine 2 "no machine 'M' .*nothing was written" -- "$DAQ" model compensate "$Y" -f siemens-cec --interval-mm 50 50 50 -o "$TMP/nm.mpf" --machine M --db "$TMP/m.sqlite"
+check no_machine_no_file 1 "" -- test -e "$TMP/nm.mpf"
 check several_files 2 "give --output-dir" -- "$DAQ" model compensate "$Y" -f heidenhain --interval-mm 50 50 50
 check bad_interval 2 "not a whole number of 30 mm intervals" -- "$DAQ" model compensate "$Y" -f csv --interval-mm 30 50 50
 check compensate_report 0 "report written" -- "$DAQ" model compensate "$Y" -f siemens-cec --interval-mm 50 50 50 -o "$TMP/y.mpf" --report "$TMP/comp.html"
@@ -67,7 +73,7 @@ check mixed_json 0 '"E_C0Y": "SIMULATED"' -- "$DAQ" model compensate "$TMP/mixed
 # ISG's CSV parameter file comments with "//" ("#" is a file break there).
 check isg_csv_origin 0 "^//   SIMULATED: E_C0Y$" -- sh -c "'$DAQ' model compensate '$TMP/mixed.json' -f isg-volumetric ${I[*]} --output-dir '$TMP/mvc' 2>/dev/null && cat '$TMP/mvc/volcomp.csv'"
 check isg_lis_origin 0 "^# MIXED data: do not load into a real control" -- cat "$TMP/mvc/volcomp.lis"
-check heidenhain_silent 0 "Y.COM: the format has no comments, so the file does not say it" -- "$DAQ" model compensate "$TMP/mixed.json" -f heidenhain "${I[@]}" --output-dir "$TMP/mhh"
+check heidenhain_silent 0 "Y.COM, config.cma: the format has no comments, so the file does not say it" -- "$DAQ" model compensate "$TMP/mixed.json" -f heidenhain "${I[@]}" --output-dir "$TMP/mhh"
 check sim_fanuc 0 "^SIMULATED data: do not load into a real control$" -- sh -c "'$DAQ' model compensate '$TMP/sim.json' -f fanuc ${I[*]} 2>/dev/null"
 check sim_matrixkins 0 "^# SIMULATED data: do not load into a real control$" -- sh -c "'$DAQ' model compensate '$TMP/sim.json' -f linuxcnc ${I[*]} --output-dir '$TMP/mlc' 2>/dev/null && cat '$TMP/mlc/matrixkins.hal'"
 check mixed_report 0 "<strong>MIXED</strong>: some errors of this model come from runs not measured on real instruments \(REPLAYED: E_XX; SIMULATED: E_C0Y\).*Do not load its compensation into a real control" -- sh -c "'$DAQ' model compensate '$TMP/mixed.json' -f siemens-cec ${I[*]} -o '$TMP/m2.mpf' --report '$TMP/mixed.html' 2>/dev/null && cat '$TMP/mixed.html'"

@@ -22,6 +22,7 @@
 #include "../support/daq_cli.hpp"
 #include "../support/temp_db.hpp"
 #include "cal/analysis/comp_formats.hpp"
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
 #include "compensation/compensation_check.hpp"
@@ -140,6 +141,25 @@ LoopResult loop(const char* name, const std::string& component, const std::strin
   return r;
 }
 
+// An as-left E_YX run in a control that applies the stored file otherwise than meant: its check
+// must name `want`; the one corrected file daq verify --corrected writes.
+struct Diagnosed {
+  std::int64_t run = 0;
+  daq::LoopCheck check;
+  std::string corrected;
+};
+Diagnosed diagnose(const daq::SimulatedAcquisition& a, const fs::path& db, ct::Finding want) {
+  Diagnosed d;
+  d.run = acquire(a, "E_YX");
+  cal::storage::Store store(db, {.read_only = true});
+  d.check = daq::check_run(store, d.run).value();
+  EXPECT_EQ(d.check.verification.finding, want) << d.check.verification.text;
+  const auto files = daq::corrected_files(d.check);
+  EXPECT_EQ(files.size(), 1u);
+  if (!files.empty()) d.corrected = files[0].second;
+  return d;
+}
+
 // `right_ratio`: what the right sign may leave of the as-found error.
 void expect_loop(const LoopResult& r, const char* what, double right_ratio = 0.2) {
   EXPECT_GT(r.before_um, 3.0) << what;  // a table worth verifying
@@ -205,24 +225,20 @@ TEST(CrossLoop, SinumerikCecUnitAndReferenceErrorsAreDiagnosed) {
     };
   };
   a.compensation = inch(file[0]);
-  const auto unit_run = acquire(a, "E_YX");
-  const auto unit = check(unit_run);
-  EXPECT_EQ(unit.verification.finding, ct::Finding::unit_scale) << unit.verification.text;
+  const auto unit_d = diagnose(a, db, ct::Finding::unit_scale);
+  const auto& unit = unit_d.check;
+  const auto unit_run = unit_d.run;
   EXPECT_NEAR(unit.verification.scale, 25.4, 1e-9);
-  const auto unit_fixed = daq::corrected_files(unit);
-  ASSERT_EQ(unit_fixed.size(), 1u);
   a.compensation = y_off(file[0]);
-  const auto shifted_run = acquire(a, "E_YX");
-  const auto shifted = check(shifted_run);
-  EXPECT_EQ(shifted.verification.finding, ct::Finding::constant_shift) << shifted.verification.text;
+  const auto shifted_d = diagnose(a, db, ct::Finding::constant_shift);
+  const auto& shifted = shifted_d.check;
+  const auto shifted_run = shifted_d.run;
   EXPECT_NEAR(shifted.verification.offset_um, 2.0, 0.1);
-  const auto shift_fixed = daq::corrected_files(shifted);
-  ASSERT_EQ(shift_fixed.size(), 1u);
   // Each corrected file in the control that got it wrong: as predicted.
-  a.compensation = inch(unit_fixed[0].second);
+  a.compensation = inch(unit_d.corrected);
   const auto unit_again = acquire(a, "E_YX");
   EXPECT_EQ(check(unit_again).verification.finding, ct::Finding::as_predicted);
-  a.compensation = y_off(shift_fixed[0].second);
+  a.compensation = y_off(shifted_d.corrected);
   const auto shift_again = acquire(a, "E_YX");
   EXPECT_EQ(check(shift_again).verification.finding, ct::Finding::as_predicted);
   std::printf(
@@ -233,6 +249,54 @@ TEST(CrossLoop, SinumerikCecUnitAndReferenceErrorsAreDiagnosed) {
       largest_um(db, unit_again), largest_um(db, shifted_run),
       std::string(ct::to_string(shifted.verification.finding)).c_str(),
       shifted.verification.offset_um, largest_um(db, shift_again));
+  cal::test::remove_db(db);
+}
+
+// A control that applies a CEC table at positions shifted by +50 mm (its X datum is not the
+// table's): a table with a bump (10 um at X 200 mm, not a line, which a shift would turn into a
+// constant) is stored and loaded there; daq verify names the position shift, and the corrected
+// file (the table's positions moved by -50 mm) in that control acts as predicted. Before, the
+// cross check had no table positions (no shift was ever found) and --corrected refused it.
+TEST(CrossLoop, SinumerikCecPositionShiftIsDiagnosedAndCorrected) {
+  const auto db = cal::test::temp_path("caldaq-crossloop", "cecshift");
+  auto a = acquisition(db);
+  const auto found = acquire(a, "E_YX");
+  const std::vector<ct::CrossAxisTable> t{{"X", "Y", 0.0, 100.0, {0.0, 0.0, 0.010, 0.0, 0.0, 0.0}}};
+  const std::map<std::string, int> numbers{{"X", 1}, {"Y", 2}, {"Z", 3}};
+  const std::string file = ct::write_sinumerik_cec(t, numbers);
+  {
+    cal::storage::Store store(db);
+    daq::store_cross_compensation(store, store.run(found)->machine_id, found, "run",
+                                  {.format = "siemens-cec", .files = {{"", file}}});
+  }
+  const auto check = [&](std::int64_t run) {
+    cal::storage::Store store(db, {.read_only = true});
+    return daq::check_run(store, run).value();
+  };
+  // The control reads the table's positions 50 mm further out than they are written.
+  const auto shifted_control = [&](const std::string& text) {
+    const std::vector<ct::CompFile> one{{"", text}};
+    return daq::control_loads(
+        "siemens-cec", ct::shift_cross_positions("siemens-cec", one, "X", "Y", -50.0, numbers),
+        false);
+  };
+  a.compensation = shifted_control(file);
+  const auto d = diagnose(a, db, ct::Finding::position_shift);
+  const auto& shifted = d.check;
+  const auto shifted_run = d.run;
+  EXPECT_NEAR(shifted.verification.shift_mm, 50.0, 5.0);
+  EXPECT_NE(d.corrected.find("$AN_CEC_MIN[0]=-50.0000"), std::string::npos) << d.corrected;
+  a.compensation = shifted_control(d.corrected);
+  const auto again = acquire(a, "E_YX");
+  const auto ok = check(again);
+  EXPECT_EQ(ok.verification.finding, ct::Finding::as_predicted) << ok.verification.text;
+  std::printf(
+      "cross loop siemens-cec (E_YX, a 10 um bump at X 200): as found %.3f um; the control 50 mm "
+      "off %.3f um (%s, %+.1f mm); corrected file there %.3f um (%s)\n",
+      largest_um(db, found), largest_um(db, shifted_run),
+      std::string(ct::to_string(shifted.verification.finding)).c_str(),
+      shifted.verification.shift_mm, largest_um(db, again),
+      std::string(ct::to_string(ok.verification.finding)).c_str());
   cal::test::remove_db(db);
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -167,10 +168,21 @@ std::string straightness_run_text(CompensateOptions& o, const ct::Spec& spec,
   const std::string text = straightness_text(o, t);
   if (o.json) return text;
   const std::string format = o.format == "isg" ? "isg-cross" : o.format;
-  if (!cal::comptable::is_cross_format(format)) return text;  // heidenhain: not read back
   try {
     cal::storage::Store rw(database_path(o.db));
     CrossCompensation c{.format = format, .files = {{"", text}}};
+    if (format == "heidenhain") {
+      // The *.COM's input axis is in the control's *.CMA: stored with the assignment it needs
+      // (the table in the column of this axis), which the output names.
+      const std::string name = o.output.empty()
+                                   ? fmt::format("{}.COM", o.axis)
+                                   : std::filesystem::path(o.output).filename().string();
+      c.files = {{name, text}, {"config.cma", ct::write_heidenhain_cma({{o.axis, name}})}};
+      fmt::print(stderr,
+                 "HEIDENHAIN: enter {} in the column {} of the active row of the control's "
+                 "*.CMA ({} = F({})); stored with that assignment\n",
+                 name, o.axis, o.output_axis, o.axis);
+    }
     c.axis_numbers = {{o.axis, o.axis_number}, {o.output_axis, o.output_axis_number}};
     const auto id = store_cross_compensation(rw, s.machine_id, o.run, fmt::format("run {}", o.run),
                                              c, {{"label", o.origin_label}});

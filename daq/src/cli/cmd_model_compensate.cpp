@@ -192,14 +192,21 @@ Written write_format(const Options& o, const mdl::Model& m, const std::array<vc:
         "docs/compensation-tables.md). The squareness goes to the control as the ISO 230-1 "
         "location errors: the carriers chosen in the model file do not apply.");
   } else if (o.format == "heidenhain") {
+    std::vector<std::pair<std::string, std::string>> assigned;
     for (std::size_t in = 0; in < 3; ++in) {
       std::vector<ct::CrossAxisTable> same;
       for (const auto& t : nonzero)
         if (t.input == kAxis[in]) same.push_back(t);
-      if (!same.empty())
-        w.files.push_back({fmt::format("{}.COM", kAxis[in]), ct::write_heidenhain_com(same)});
+      if (same.empty()) continue;
+      const std::string name = fmt::format("{}.COM", kAxis[in]);
+      w.files.push_back({name, ct::write_heidenhain_com(same)});
+      assigned.emplace_back(kAxis[in], name);
     }
-    w.what = "HEIDENHAIN nonlinear axis error compensation tables (*.COM, one per input axis)";
+    // The input axis of each *.COM is named in the *.CMA, not in the *.COM.
+    w.files.push_back({"config.cma", ct::write_heidenhain_cma(assigned)});
+    w.what =
+        "HEIDENHAIN nonlinear axis error compensation tables (*.COM, one per input axis, and "
+        "their assignment config.cma)";
     w.correction_um = all;
     w.notes.push_back(frozen);
   } else if (o.format == "fanuc") {
@@ -348,26 +355,50 @@ std::vector<std::string> say_origin(Written& w, const std::string& format,
 
 // The cross-axis part of what was written, stored with the machine (--machine) so that the next
 // straightness run of an axis it corrects is compared with it (daq verify RUN). LinuxCNC's
-// COMP_FILEs are positioning tables: only matrixkins.hal is kept; FANUC and HEIDENHAIN files
-// are not read back (docs/compensation-tables.md, "Verification").
-void store_with_machine(const Options& o, const Written& w, const std::string& origin) {
+// COMP_FILEs are positioning tables: only matrixkins.hal is kept. Made and checked (the format,
+// the files read back as the control reads them, the machine) before anything is written: a
+// refused --machine leaves no files behind (docs/compensation-tables.md, "Verification").
+struct ToStore {
+  CrossCompensation compensation;
+  std::int64_t machine_id = 0;
+};
+
+std::optional<ToStore> to_store(const Options& o, const Written& w) {
+  if (o.machine.empty()) return std::nullopt;
   const std::string format = o.format == "linuxcnc" ? "linuxcnc-matrixkins" : o.format;
-  if (!ct::is_cross_format(format))
+  if (o.format == "fanuc")
     throw cal::InputError(
-        fmt::format("--machine: a {} compensation is not verified by daq verify yet (siemens-cec, "
-                    "isg-cross, isg-volumetric, linuxcnc, csv are)",
-                    o.format));
-  CrossCompensation c{.format = format, .files = {}, .axis_numbers = numbers_of(o)};
+        "--machine: a FANUC compensation is not stored for daq verify: FANUC's pitch error "
+        "tables correct each axis along itself, which a straightness run cannot verify (a "
+        "positioning run verifies a pitch table: daq compensate --run RUN -f fanuc); nothing "
+        "was written");
+  if (!ct::is_cross_format(format))
+    throw cal::InputError(fmt::format(
+        "--machine: a {} compensation cannot be read back for daq verify; nothing was written",
+        o.format));
+  ToStore s{CrossCompensation{.format = format, .files = {}, .axis_numbers = numbers_of(o)}, 0};
+  std::vector<ct::CompFile> texts;
   for (const auto& [name, text] : w.files)
-    if (format != "linuxcnc-matrixkins" || name == "matrixkins.hal")
-      c.files.push_back({name, text});
+    if (format != "linuxcnc-matrixkins" || name == "matrixkins.hal") {
+      s.compensation.files.push_back({name, text});
+      texts.push_back({name, text});
+    }
+  // What daq verify will read: refused now, not after the files are written.
+  (void)ct::read_cross_applied(format, texts, s.compensation.axis_numbers);
   cal::storage::Store store(database_path(o.db));
   const auto machine = store.machine_by_name(o.machine);
   if (!machine)
     throw cal::InputError(
-        fmt::format("{}: no machine '{}' (daq runs lists them)", store.path().string(), o.machine));
-  const auto id = store_cross_compensation(store, machine->id, 0, fmt::format("model {}", o.file),
-                                           c, {{"label", origin}});
+        fmt::format("{}: no machine '{}' (daq runs lists them); nothing was written",
+                    store.path().string(), o.machine));
+  s.machine_id = machine->id;
+  return s;
+}
+
+void store_with_machine(const Options& o, const ToStore& s, const std::string& origin) {
+  cal::storage::Store store(database_path(o.db));
+  const auto id = store_cross_compensation(store, s.machine_id, 0, fmt::format("model {}", o.file),
+                                           s.compensation, {{"label", origin}});
   fmt::print(stderr,
              "stored as compensation {} of machine '{}': the next straightness run of an axis it "
              "corrects is compared with it (daq verify RUN)\n",
@@ -401,7 +432,8 @@ void run(const Options& o) {
     e.interval_mm = (end - e.start_mm) / (e.points - 1);
   }
   const Extremes b = largest(eval, before), a = largest(eval, after);
-  // Write only once everything is computed: a refused format leaves no partial files.
+  const auto storing = to_store(o, w);
+  // Write only once everything is computed and checked: a refusal leaves no partial files.
   std::vector<std::string> written;
   const bool several = w.files.size() > 1 || !w.files.front().first.empty();
   if (several) {
@@ -420,7 +452,7 @@ void run(const Options& o) {
   } else if (!o.json) {
     fmt::print("{}", w.files.front().second);
   }
-  if (!o.machine.empty()) store_with_machine(o, w, origin);
+  if (storing) store_with_machine(o, *storing, origin);
   if (!o.report.empty()) {
     kin::Grid grid;
     for (std::size_t i = 0; i < 3; ++i) {

@@ -158,10 +158,10 @@ void run_sim(SimOptions o) {
   }
   if (!o.compensate.empty() && !o.control_table.empty())
     throw cal::InputError("--compensate or --control-table: the control applies one of them");
-  if (o.acquire && (o.start_after_s || o.speed != 1.0 || volumetric))
+  if (o.acquire && (o.start_after_s || o.speed != 1.0))
     throw cal::InputError(
         "--acquire runs the program when its own run starts, on simulated time: without "
-        "--start-after-s, --speed or --measure");
+        "--start-after-s or --speed");
   boost::asio::io_context io;
   // --acquire: the shop, the instruments and the run on one simulated time line that jumps
   // from event to event (cal/drivers/loop_time.hpp), as in daq demo.
@@ -182,11 +182,13 @@ void run_sim(SimOptions o) {
     });
   }
   if (!o.control_table.empty()) {
-    std::vector<std::string> texts;
+    // With their names: a HEIDENHAIN *.CMA assigns the *.COM tables by name.
+    std::vector<cal::comptable::CompFile> texts;
     for (const auto& f : o.control_table) {
       std::ifstream in(f, std::ios::binary);
       if (!in) throw cal::InputError(fmt::format("{}: cannot read", f));
-      texts.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      texts.push_back({std::filesystem::path(f).filename().string(),
+                       {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}});
     }
     shop.set_compensation(control_loads(o.control_format, texts, o.control_inverted));
     fmt::print("daq sim: the SIMULATED control applies {} ({}{})\n",
@@ -349,15 +351,16 @@ void add_sim_command(CLI::App& app) {
                   "compensate)")
       ->take_all();
   cmd->add_option("--control-format", o->control_format,
-                  "Their format: siemens-cec, isg-cross, linuxcnc-matrixkins, isg-volumetric or "
-                  "csv")
-      ->check(CLI::IsMember(
-          {"siemens-cec", "isg-cross", "linuxcnc-matrixkins", "isg-volumetric", "csv"}));
+                  "Their format: siemens-cec, isg-cross, linuxcnc-matrixkins, isg-volumetric, "
+                  "heidenhain (the *.COM tables and their *.CMA) or csv")
+      ->check(CLI::IsMember({"siemens-cec", "isg-cross", "linuxcnc-matrixkins", "isg-volumetric",
+                             "heidenhain", "csv"}));
   cmd->add_flag("--control-inverted", o->control_inverted,
                 "The control reads the values with the other sign than caldaq's reading of the "
                 "vendor's text (to see daq verify diagnose it)");
   cmd->add_flag("--acquire", o->acquire,
-                "Acquire the --test here instead of waiting for `daq run` in another process: "
+                "Acquire the --test (or the --measure component's test) here instead of waiting "
+                "for `daq run` in another process: "
                 "`daq run TEST --config FILE` runs in this process on SIMULATED time (as fast as "
                 "the CPU allows, the same on a loaded machine), prints what it prints and stores "
                 "into --db");

@@ -87,7 +87,8 @@ void add_verify_command(CLI::App& app) {
                   "The stored compensation to compare with (default: the newest of the run's "
                   "machine and axis stored before the run)");
   cmd->add_option("--corrected", o->corrected,
-                  "Write the table corrected for what was found (sign, units, reference point); "
+                  "Write the table corrected for what was found (sign, units, reference point, "
+                  "position shift); "
                   "a compensation of several files goes into this directory");
   cmd->add_flag("--list", o->list, "List the stored compensation tables");
   cmd->add_flag("--json", o->json, "Print caldaq.verification.v1 JSON");

@@ -92,9 +92,9 @@ bool is_cross(const cal::storage::CompensationRecord& c) {
 
 // The compensation the run is checked against: the one given, else the newest of the run's
 // machine and axis stored before the run started.
-std::optional<cal::storage::CompensationRecord> compensation_for(const cal::storage::RunReader& store,
-                                                                 const cal::storage::RunRecord& run,
-                                                                 std::optional<std::int64_t> id) {
+std::optional<cal::storage::CompensationRecord> compensation_for(
+    const cal::storage::RunReader& store, const cal::storage::RunRecord& run,
+    std::optional<std::int64_t> id) {
   if (id) {
     for (const auto& c : store.compensations())
       if (c.id == *id) {
@@ -125,15 +125,16 @@ std::map<std::string, int> axis_numbers_of(const json& doc) {
   return n;
 }
 
-std::vector<std::string> texts_of(const json& doc) {
-  std::vector<std::string> t;
-  for (const auto& f : doc.value("files", json::array())) t.push_back(f.value("text", ""));
+std::vector<ct::CompFile> files_of(const json& doc) {
+  std::vector<ct::CompFile> t;
+  for (const auto& f : doc.value("files", json::array()))
+    t.push_back({f.value("name", ""), f.value("text", "")});
   return t;
 }
 
 // What the compensation's files make the control add (the vendor's reading).
 ct::CrossApplied applied_cross(const json& doc) {
-  return ct::read_cross_applied(doc.value("format", ""), texts_of(doc), axis_numbers_of(doc));
+  return ct::read_cross_applied(doc.value("format", ""), files_of(doc), axis_numbers_of(doc));
 }
 
 json settings_of(const cal::storage::RunRecord& r) {
@@ -226,6 +227,19 @@ std::optional<LoopCheck> check_cross_run(const cal::storage::RunReader& store,
   const auto before = stats_of(store, found->id);
   const auto after = stats_of(store, run.id);
   ct::VerifyInput in;
+  // What the files add along the line at the points of their table of the read axis over the
+  // moving one (linear between them, as the control interpolates): a table acting at shifted
+  // positions is then found as a position shift (verify's best_shift).
+  const std::string moving(1, "XYZ"[axis]);
+  for (const auto& t : applied.tables)
+    if (t.input == moving && t.output == direction && t.position_mm.size() >= 2 &&
+        in.table_position_mm.empty() && t.position_mm.size() <= 10000)
+      for (const double x : t.position_mm) {
+        cal::kinematics::Vec3 p = at;
+        p[axis] = x;
+        in.table_position_mm.push_back(x);
+        in.table_applied_um.push_back(ct::cross_correction_um(applied, p)[dir]);
+      }
   std::vector<double> spread;
   for (const auto& s : after) {
     const auto b = std::find_if(before.begin(), before.end(), [&](const auto& x) {
@@ -258,12 +272,12 @@ std::int64_t store_cross_compensation(cal::storage::Store& store, std::int64_t m
                                       std::int64_t source_run_id, const std::string& source,
                                       const CrossCompensation& c, const json& origin) {
   json files = json::array();
-  std::vector<std::string> texts;
+  std::vector<ct::CompFile> named;
   for (const auto& [name, text] : c.files) {
     files.push_back({{"name", name}, {"text", text}});
-    texts.push_back(text);
+    named.push_back({name, text});
   }
-  const auto applied = ct::read_cross_applied(c.format, texts, c.axis_numbers);
+  const auto applied = ct::read_cross_applied(c.format, named, c.axis_numbers);
   // The axes the files correct: what a straightness run reads to verify them.
   std::string axes;
   for (const auto& t : applied.tables)
@@ -312,17 +326,22 @@ std::vector<std::pair<std::string, std::string>> corrected_files(const LoopCheck
                                         c.compensation.id, c.compensation.format, output));
     return out;
   }
+  if (v.finding == ct::Finding::position_shift && c.component.size() == 4) {
+    // The control applied the table of the read axis over the moving one at the moving axis's
+    // position minus shift_mm (component E_<read><moving>): its positions move by -shift_mm.
+    const std::string output(1, c.component[2]), input(1, c.component[3]);
+    for (auto& f : ct::shift_cross_positions(c.compensation.format, files_of(doc), input, output,
+                                             v.shift_mm, axis_numbers_of(doc)))
+      out.emplace_back(std::move(f.name), std::move(f.text));
+    return out;
+  }
   double factor = 0;
   if (v.finding == ct::Finding::inverted_sign) factor = -1.0;
   if (v.finding == ct::Finding::unit_scale) factor = 1.0 / v.scale;
   if (factor == 0)
     throw cal::InputError(fmt::format(
         "compensation {} ({}): '{}' is not corrected in the files: {}", c.compensation.id,
-        c.compensation.format, ct::to_string(v.finding),
-        v.finding == ct::Finding::position_shift
-            ? "check the table's start position against the control's axis position (the "
-              "machine datum)"
-            : "nothing to correct"));
+        c.compensation.format, ct::to_string(v.finding), "nothing to correct"));
   for (const auto& f : doc.value("files", json::array()))
     out.emplace_back(f.value("name", ""),
                      ct::scale_cross_values(c.compensation.format, f.value("text", ""), factor));

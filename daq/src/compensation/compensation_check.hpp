@@ -75,7 +75,9 @@ std::optional<LoopCheck> check_run(const cal::storage::RunReader& store, std::in
 std::string corrected_table(const LoopCheck& c);
 // The same for any compensation: its files corrected (name, text; one file named ""). A
 // cross-axis compensation is corrected for an inverted sign or a unit error (every value
-// scaled); a reference or position error there is the control's setting: cal::InputError.
+// scaled), a reference-point error (the table of the read axis moved by the constant) and a
+// position shift (the positions of the read axis's table over the moving axis shifted);
+// cal::InputError for a format that cannot hold the fix (matrixkins, volumetric).
 std::vector<std::pair<std::string, std::string>> corrected_files(const LoopCheck& c);
 nlohmann::json to_json(const LoopCheck& c);
 // A line or two for the terminal: the finding and what to do.

@@ -178,6 +178,14 @@ cal::daq::LinearTestConfig volumetric_test(std::string_view component) {
 std::function<kin::Vec3(const kin::Vec3&)> control_loads(
     std::string_view format, std::span<const std::string> files, bool inverted,
     const std::map<std::string, int>& axis_numbers) {
+  std::vector<cal::comptable::CompFile> named;
+  for (const auto& t : files) named.push_back({"", t});
+  return control_loads(format, named, inverted, axis_numbers);
+}
+
+std::function<kin::Vec3(const kin::Vec3&)> control_loads(
+    std::string_view format, std::span<const cal::comptable::CompFile> files, bool inverted,
+    const std::map<std::string, int>& axis_numbers) {
   const auto applied = cal::comptable::read_cross_applied(format, files, axis_numbers, inverted);
   return [applied](const kin::Vec3& p) { return cal::comptable::cross_correction_um(applied, p); };
 }

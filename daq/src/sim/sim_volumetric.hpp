@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/kinematics.hpp"
 #include "cal/daq/config.hpp"
 #include "linear_run.hpp"
@@ -49,6 +50,10 @@ cal::daq::LinearTestConfig volumetric_test(std::string_view component);
 // SimulatedAcquisition::compensation and `daq sim --control-table`. Throws cal::InputError.
 std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> control_loads(
     std::string_view format, std::span<const std::string> files, bool inverted,
+    const std::map<std::string, int>& axis_numbers = {{"X", 1}, {"Y", 2}, {"Z", 3}});
+// The same with the files' names (HEIDENHAIN: the *.CMA assigns the *.COM tables by name).
+std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> control_loads(
+    std::string_view format, std::span<const cal::comptable::CompFile> files, bool inverted,
     const std::map<std::string, int>& axis_numbers = {{"X", 1}, {"Y", 2}, {"Z", 3}});
 
 // One test acquired in this process on a fresh simulated shop with `truth`, through the real

@@ -91,6 +91,13 @@ std::string write_isg_volumetric_csv(const kinematics::Machine& m,
 // written: the text holds the header line of the columns and the rows.
 std::string write_heidenhain_com(std::span<const CrossAxisTable> same_input);
 std::string write_heidenhain_com(const Table& positioning);
+// The *.CMA assignment of *.COM tables to their input axes (MANUALplus 620 technical manual p.
+// 718: "[Axis in column from *.com] = F(Axis in column from *.cma, in which *.com is
+// entered)"): the header line ACTIVE and a column per input axis, and one row, active (*),
+// with each table's name in its input axis's column. The file's frame is not confirmed, as for
+// the *.COM. Throws cal::InputError for an empty list or an axis name that is not one letter.
+std::string write_heidenhain_cma(
+    const std::vector<std::pair<std::string, std::string>>& input_and_com);
 
 // FANUC stored pitch error compensation (parameters 3620-3624 of the Series 0i/16i/18i
 // parameter manuals): the compensation points numbered from `first_point`, the reference

@@ -41,8 +41,15 @@ struct CrossApplied {
 };
 // The formats whose files read_cross_applied reads (docs/compensation-tables.md): csv (caldaq's
 // cross CSV), siemens-cec, isg-cross (kw.crosscomp lists), linuxcnc-matrixkins (matrixkins.hal),
-// isg-volumetric (the configuration list and the ISG CSV parameter file), heidenhain (*.COM).
+// isg-volumetric (the configuration list and the ISG CSV parameter file), heidenhain (the *.COM
+// tables with the *.CMA assignment that names each one's input axis).
 bool is_cross_format(std::string_view format);
+// A file of a compensation: its name as the control knows it ("" for a one-file format; a
+// HEIDENHAIN *.CMA names its *.COM tables, matched by the name without its directory, in any
+// case) and its text.
+struct CompFile {
+  std::string name, text;
+};
 // The files of a compensation in `format`, read as its control reads them: with the vendor's
 // meaning of the values (comp_meaning.hpp) unless `inverted`. `axis_numbers` maps the control's
 // axis numbers (AXn, logical axis numbers) back to X, Y, Z. Files of the set that are not of the
@@ -50,6 +57,10 @@ bool is_cross_format(std::string_view format);
 // matrixkins.hal) are left out: they are positioning tables (read_applied). Throws
 // cal::InputError naming the file and line for text that is not such a file.
 CrossApplied read_cross_applied(std::string_view format, std::span<const std::string> files,
+                                const std::map<std::string, int>& axis_numbers,
+                                bool inverted = false);
+// The same with the files' names (needed for heidenhain: its *.CMA assigns the *.COM by name).
+CrossApplied read_cross_applied(std::string_view format, std::span<const CompFile> files,
                                 const std::map<std::string, int>& axis_numbers,
                                 bool inverted = false);
 // The correction the control adds at the commanded position p (um, X Y Z).
@@ -67,5 +78,17 @@ std::string scale_cross_values(std::string_view format, std::string_view text, d
 std::string shift_cross_values(std::string_view format, std::string_view text,
                                const std::string& output, double add_um,
                                const std::map<std::string, int>& axis_numbers, bool& with_table);
+// The files with the table of `output` over `input` acting at positions shifted by -shift_mm (a
+// position shift undone: the control applied the table at the input axis's position minus
+// shift_mm, so its positions move by -shift_mm): SINUMERIK CEC $AN_CEC_MIN/_MAX of that table,
+// the ISG cross list's setpoints, the cross CSV's positions, HEIDENHAIN the AXISPOS of the *.COM
+// of that input (its other columns share them and move too). Throws cal::InputError for a
+// format without positions of one table (matrixkins: a line, where a shift is a constant;
+// volumetric: the error parameters of the whole axis) or a set with no such table.
+std::vector<CompFile> shift_cross_positions(std::string_view format,
+                                            std::span<const CompFile> files,
+                                            const std::string& input, const std::string& output,
+                                            double shift_mm,
+                                            const std::map<std::string, int>& axis_numbers);
 
 }  // namespace cal::comptable
