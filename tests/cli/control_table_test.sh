@@ -28,6 +28,17 @@ check vol_loaded 0 "the SIMULATED control applies .*volcomp.lis, .*volcomp.csv \
 verify_run 2 "compensation 1 \(isg-volumetric, .*E_YX against run 1 \(as found\): as predicted"
 check vol_inverted 0 "read with the other sign" -- sim E_YX --control-table "$TMP/vol/volcomp.lis" "$TMP/vol/volcomp.csv" --control-format isg-volumetric --control-inverted  # run 3
 verify_run 3 "compensation 1 \(isg-volumetric, .*: inverted sign"
+# A stored file name that leaves --corrected (a store from elsewhere may hold any text) is
+# refused before anything is written.
+cp "$DB" "$TMP/hostile.sqlite"
+"$PY" - "$TMP/hostile.sqlite" <<'PY'
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1])
+db.execute("""UPDATE compensations SET json = replace(json, '"name":"volcomp.lis"', '"name":"../evil.lis"') WHERE id = 1""")
+db.commit()
+PY
+check corrected_name_refused 2 'compensation 1 names a file "\.\./evil\.lis", which is not a plain file name: nothing written' -- "$DAQ" verify 3 --db "$TMP/hostile.sqlite" --corrected "$TMP/fixed-vol"
+check corrected_name_nothing_written 0 "^none$" -- bash -c "ls \"$TMP/evil.lis\" \"$TMP/fixed-vol\" 2>/dev/null || echo none"
 
 # From the as-found run (daq compensate --run stores it with run 1 as its source).
 table() {  # table FORMAT FILE: the table of run 1 in FORMAT, stored with it

@@ -1,6 +1,7 @@
 // daq verify: the as-left run of an axis against the compensation table written before it.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -32,6 +33,20 @@ void list_compensations(const cal::storage::RunReader& store) {
                c.machine_id);
 }
 
+// A stored file name as a name inside --corrected: the store may come from elsewhere (a
+// central server, a colleague's file), so a name that leaves the directory ("../x", "/etc/x")
+// or is no file name at all is refused before anything is written.
+void check_file_name(const std::string& name, std::int64_t compensation_id) {
+  const bool plain =
+      !name.empty() && name != "." && name != ".." &&
+      name.find_first_of(std::string_view("/\\\0", 3)) == std::string::npos &&
+      std::none_of(name.begin(), name.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; });
+  if (!plain)
+    throw cal::InputError(fmt::format(
+        "verify: compensation {} names a file {}, which is not a plain file name: nothing written",
+        compensation_id, nlohmann::json(name).dump()));
+}
+
 void run(const VerifyOptions& o) {
   const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
   const auto& store = *reader;
@@ -61,6 +76,8 @@ void run(const VerifyOptions& o) {
   // and its CSV) into --corrected as a directory, by their names.
   const auto files = corrected_files(*check);
   const bool one = files.size() == 1 && files.front().first.empty();
+  if (!one)
+    for (const auto& f : files) check_file_name(f.first, check->compensation.id);
   if (!one) std::filesystem::create_directories(o.corrected);
   for (const auto& [name, text] : files) {
     const auto path =
