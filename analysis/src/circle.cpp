@@ -281,7 +281,6 @@ class Design {
   }
 
   const Model& model() const { return m_; }
-  std::span<const Sample> samples() const { return samples_; }
   double k() const { return m_.wave_number(period_mm_); }  // of the period last solved for
   const Gram& ata() const { return ata_; }
   const TermVector& aty() const { return aty_; }
@@ -622,22 +621,30 @@ class Reporter {
   }
 
   // Those found in the residual (their contributions are given, no basis is needed), then all
-  // of them into the result.
-  void finish() {
+  // of them into the result. The samples' cos, sin and deviation are recomputed from the traces
+  // as flatten made them (the same operations, so the same values): the fit's records are gone.
+  void finish(std::span<const Trace> traces, double offset_um) {
     if (!ldlt_) ldlt_.emplace(d_.ata().topLeftCorner<3, 3>());
-    const auto samples = d_.samples();
+    const auto each_sample = [&](auto&& f) {
+      std::size_t i = 0;
+      for (const auto& t : traces)
+        for (std::size_t j = 0; j < t.angle_deg.size(); ++j, ++i) {
+          const double theta = t.angle_deg[j] * deg;
+          f(i, std::cos(theta), std::sin(theta), t.deviation_um[j] + offset_um);
+        }
+    };
     for (auto& p : pending_) {
       if (!p.found) continue;
       const auto& contrib = p.found->contribution;
       Eigen::Vector3d ct_contrib = Eigen::Vector3d::Zero();
-      for (std::size_t i = 0; i < samples.size(); ++i)
-        ct_contrib += Eigen::Vector3d(samples[i].c, samples[i].n, 1.0) * contrib[i];
+      each_sample([&](std::size_t i, double c, double n, double) {
+        ct_contrib += Eigen::Vector3d(c, n, 1.0) * contrib[i];
+      });
       p.centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib);
-      for (std::size_t i = 0; i < samples.size(); ++i) {
-        const Sample& x = samples[i];
+      each_sample([&](std::size_t i, double c, double n, double y) {
         p.contrib.add(contrib[i]);
-        p.without.add(x.y - contrib[i] - p.centre[0] * x.c - p.centre[1] * x.n);
-      }
+        p.without.add(y - contrib[i] - p.centre[0] * c - p.centre[1] * n);
+      });
     }
     const double g_bi = res_.iso.G_bi_um;
     for (auto& p : pending_) {
@@ -765,7 +772,7 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   const double offset_um =
       1e3 * (setup.calibrated_radius_mm.value_or(setup.radius_mm) - setup.radius_mm);
   std::vector<Span> spans;
-  const auto samples =
+  auto samples =
       flatten(Model{setup.radius_mm, setup.spike_decay_deg * deg, {}}, traces, offset_um, spans);
   res.iso = iso_values(samples, spans);
 
@@ -789,9 +796,7 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   // Stick-slip and vibration live in what the geometric model leaves.
   std::vector<dynamics::TraceResidual> residuals;
   for (const auto& sp : spans) {
-    dynamics::TraceResidual tr{.s = sign_of(sp.trace->direction)};
-    tr.theta_rad.reserve(sp.end - sp.begin);
-    for (double a : sp.trace->angle_deg) tr.theta_rad.push_back(a * deg);
+    dynamics::TraceResidual tr{.s = sign_of(sp.trace->direction), .angle_deg = sp.trace->angle_deg};
     tr.r_um.resize(sp.end - sp.begin);
     residuals.push_back(std::move(tr));
   }
@@ -807,6 +812,11 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
       residuals[t].r_um[at - spans[t].begin] = r[i];
     }
   });
+  // The fit's records (48 bytes a sample) are done with: what follows needs the residual, and
+  // rep.finish rebuilds the little it needs from the traces. Freed before the spectra, the peak
+  // of the analysis (issue 32).
+  const std::size_t sample_count = samples.size();
+  samples = std::vector<Sample>();  // (= {} would keep the capacity)
   const dynamics::Settings dyn{.radius_mm = setup.radius_mm,
                                .feed_mm_per_min = setup.feed_mm_per_min,
                                .window_deg = setup.stick_slip_window_deg,
@@ -817,13 +827,13 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   double ss = 0.0;  // what is left after the geometric model and a vibration
   for (const auto& tr : residuals)
     for (double x : tr.r_um) ss += x * x;
-  res.residual_rms_um = std::sqrt(ss / static_cast<double>(samples.size()));
+  res.residual_rms_um = std::sqrt(ss / static_cast<double>(sample_count));
   residuals.clear();
   residuals.shrink_to_fit();
 
   if (vibration) rep.add(*vibration);
   for (const auto& f : stick_slip) rep.add(f);
-  rep.finish();
+  rep.finish(traces, offset_um);
   // Ranked by what correcting each would gain (G with its term removed), as a ballbar user
   // reads the list: the first is the one to fix first. Equal gains (terms absent) by PV.
   std::stable_sort(res.diagnostics.begin(), res.diagnostics.end(),

@@ -65,9 +65,9 @@ struct Timed {
 
 Timed timed(const TraceResidual& t, double w) {
   Timed out;
-  const std::size_t n = out.n = t.theta_rad.size();
+  const std::size_t n = out.n = t.angle_deg.size();
   const auto before = [&](std::size_t a, std::size_t b) {
-    return t.s * t.theta_rad[a] < t.s * t.theta_rad[b];
+    return t.s * t.theta_rad(a) < t.s * t.theta_rad(b);
   };
   // A trace from time is in travel order already: checked in one pass, and then no
   // permutation is kept (8 bytes a sample); sorted only if not.
@@ -80,8 +80,8 @@ Timed timed(const TraceResidual& t, double w) {
   }
   out.time_s.resize(n);
   if (n == 0) return out;
-  const double first = t.s * t.theta_rad[out.order(0)];
-  for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad[i] - first) / w;
+  const double first = t.s * t.theta_rad(out.order(0));
+  for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad(i) - first) / w;
   out.duration_s = out.time_s[out.order(n - 1)];
   std::vector<double> steps;
   for (std::size_t i = 1; i < n; ++i) {
@@ -299,8 +299,8 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   }
   std::vector<std::vector<double>> ps;
   std::vector<double> mean(npad / 2 + 1, 0.0);
-  for (const auto& x : series) {
-    ps.push_back(periodogram(x, npad));
+  for (auto& x : series) {  // each series becomes its padded copy, freed with it (issue 32)
+    ps.push_back(periodogram(std::move(x), npad));
     for (std::size_t k = 0; k < mean.size(); ++k)
       mean[k] += ps.back()[k] / static_cast<double>(series.size());
   }
@@ -337,6 +337,9 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
           all.centroid_hz, traces[i].s > 0 ? "cw" : "ccw"));
       return std::nullopt;
     }
+  // The spectra are done with: freed before the line fit keeps its own per-sample tables.
+  series = std::vector<std::vector<double>>(), ps = std::vector<std::vector<double>>();
+  mean = std::vector<double>();  // (= {} would keep the capacity)
   // The frequency that explains most, on a grid over +-1 / T, refined about the best point.
   const LineFit fit(traces, tms, f0);
   double best_f = all.centroid_hz, best = -1.0, step = 0.1 / duration;
@@ -415,7 +418,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
   std::array<std::size_t, 2> in_n{};
   for (std::size_t i = 0; i < traces.size(); ++i)
     for (std::size_t j = 0; j < hp[i].size(); ++j) {
-      const double th = traces[i].theta_rad[j], du = from_u(th), dv = from_v(th);
+      const double th = traces[i].theta_rad(j), du = from_u(th), dv = from_v(th);
       const double sq = hp[i][j] * hp[i][j];
       if (du > window && dv > window) out_ss += sq, ++out_n;
       if (du >= core && du <= window) in_ss[0] += sq, ++in_n[0];
@@ -437,7 +440,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
             .value = std::sqrt(ms_in - ms_out)};
     for (std::size_t i = 0; i < traces.size(); ++i)
       for (std::size_t j = 0; j < hp[i].size(); ++j) {
-        const double th = traces[i].theta_rad[j], d = axis_u ? from_u(th) : from_v(th);
+        const double th = traces[i].theta_rad(j), d = axis_u ? from_u(th) : from_v(th);
         f.contribution.push_back(d >= core && d <= window ? hp[i][j] : 0.0);
       }
     found.push_back(std::move(f));
