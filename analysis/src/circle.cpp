@@ -633,17 +633,24 @@ class Reporter {
           f(i, std::cos(theta), std::sin(theta), t.deviation_um[j] + offset_um);
         }
     };
-    for (auto& p : pending_) {
-      if (!p.found) continue;
-      const auto& contrib = p.found->contribution;
-      Eigen::Vector3d ct_contrib = Eigen::Vector3d::Zero();
+    // Two passes for all of them: C' times each contribution, then each one's ranges.
+    std::vector<Pending*> found;
+    for (auto& p : pending_)
+      if (p.found) found.push_back(&p);
+    if (!found.empty()) {
+      std::vector<Eigen::Vector3d> ct_contrib(found.size(), Eigen::Vector3d::Zero());
       each_sample([&](std::size_t i, double c, double n, double) {
-        ct_contrib += Eigen::Vector3d(c, n, 1.0) * contrib[i];
+        for (std::size_t f = 0; f < found.size(); ++f)
+          ct_contrib[f] += Eigen::Vector3d(c, n, 1.0) * found[f]->found->contribution[i];
       });
-      p.centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib);
+      for (std::size_t f = 0; f < found.size(); ++f)
+        found[f]->centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib[f]);
       each_sample([&](std::size_t i, double c, double n, double y) {
-        p.contrib.add(contrib[i]);
-        p.without.add(y - contrib[i] - p.centre[0] * c - p.centre[1] * n);
+        for (Pending* p : found) {
+          const double contrib = p->found->contribution[i];
+          p->contrib.add(contrib);
+          p->without.add(y - contrib - p->centre[0] * c - p->centre[1] * n);
+        }
       });
     }
     const double g_bi = res_.iso.G_bi_um;
