@@ -331,11 +331,56 @@ class Design {
   double yty_ = 0.0;
 };
 
+// The minimum of f in [a, b] to about tol (Brent, "Algorithms for Minimization without
+// Derivatives", 1973, ch. 5: golden section steps, and parabolic ones where they are safe).
+template <class F>
+double brent_min(double a, double b, double tol, F f) {
+  const double c = (3.0 - std::sqrt(5.0)) / 2;
+  double x = a + c * (b - a), w = x, v = x, fx = f(x), fw = fx, fv = fx, d = 0.0, e = 0.0;
+  for (int iter = 0; iter < 100; ++iter) {
+    const double m = (a + b) / 2, t2 = 2 * tol;
+    if (std::abs(x - m) <= t2 - (b - a) / 2) break;
+    bool golden = true;
+    if (std::abs(e) > tol) {  // try the parabola through x, w, v
+      double r = (x - w) * (fx - fv), q = (x - v) * (fx - fw), p = (x - v) * q - (x - w) * r;
+      q = 2 * (q - r);
+      if (q > 0) p = -p;
+      q = std::abs(q);
+      const double e_prev = e;
+      e = d;
+      if (std::abs(p) < std::abs(q * e_prev / 2) && p > q * (a - x) && p < q * (b - x)) {
+        d = p / q;
+        const double u = x + d;
+        if (u - a < t2 || b - u < t2) d = x < m ? tol : -tol;
+        golden = false;
+      }
+    }
+    if (golden) {
+      e = (x < m ? b : a) - x;
+      d = c * e;
+    }
+    const double u = std::abs(d) >= tol ? x + d : x + (d > 0 ? tol : -tol);
+    const double fu = f(u);
+    if (fu <= fx) {
+      (u < x ? b : a) = x;
+      v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
+    } else {
+      (u < x ? a : b) = u;
+      if (fu <= fw || w == x) {
+        v = w, fv = fw, w = u, fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u, fv = fu;
+      }
+    }
+  }
+  return x;
+}
+
 // The cyclic period that leaves the least residual. The residual dips where the trial period
 // keeps the phase along the whole travel 2R: a period off by dp drifts by 2 pi 2R dp / p^2,
 // half a cycle when dp / p = p / (4R). So the grid steps by p / (8R) (at most 800 steps), on
 // a decimated copy of the samples (>= 8 samples per shortest period along the path), and the
-// best grid point is refined by golden section on all samples.
+// best grid point is refined by Brent's method (parabolic and golden section steps) on all samples.
 double search_period(const Model& m, std::span<const Sample> samples, const Setup& setup,
                      Design& full) {
   const double p_min = setup.cyclic_search_min_mm, p_max = setup.cyclic_search_max_mm;
@@ -352,19 +397,12 @@ double search_period(const Model& m, std::span<const Sample> samples, const Setu
     if (const double rss = coarse.solve(p).rss; rss < best_rss)
       best_rss = rss, best_p = p, best_step = step;
   }
-  // Golden section over log p in [best / e^step, best * e^step].
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double lo = std::log(best_p) - best_step, hi = std::log(best_p) + best_step;
-  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-  double f1 = full.solve(std::exp(x1)).rss, f2 = full.solve(std::exp(x2)).rss;
-  for (int i = 0; i < 24; ++i) {
-    if (f1 < f2) {
-      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = full.solve(std::exp(x1)).rss;
-    } else {
-      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = full.solve(std::exp(x2)).rss;
-    }
-  }
-  return std::exp((lo + hi) / 2);
+  // Brent's minimisation over log p in [best / e^step, best * e^step] on all samples: each
+  // trial is a pass over them, and near the minimum the residual is a smooth parabola in
+  // log p, which parabolic steps find in about a third of the 26 trials that golden section
+  // alone took (issue 32). Located to 1e-7 in log p (a 4 nm shift of a 40 mm period).
+  return std::exp(brent_min(std::log(best_p) - best_step, std::log(best_p) + best_step, 1e-7,
+                            [&](double x) { return full.solve(std::exp(x)).rss; }));
 }
 
 // Sorts v by key in linear time when it is a rotation of a strictly increasing sequence, or the
