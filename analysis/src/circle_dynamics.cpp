@@ -58,9 +58,13 @@ double omega_rad_s(const Settings& s) { return s.feed_mm_per_min / 60.0 / s.radi
 struct Timed {
   std::size_t n = 0;
   std::vector<std::size_t> sorted;  // travel order -> index in the trace; empty: the identity
-  std::vector<double> time_s;       // per sample, in the trace's order; 0 at the first in travel
+  const TraceResidual* trace = nullptr;
+  double first = 0.0, w = 1.0;  // s theta of the first sample in travel; the angular speed
   double duration_s = 0.0, step_s = 0.0;
   std::size_t order(std::size_t k) const { return sorted.empty() ? k : sorted[k]; }
+  // The time of sample i (in the trace's order), 0 at the first in travel: computed when asked
+  // rather than kept, 8 bytes a sample less at the spectra's peak (issue 32).
+  double time_s(std::size_t i) const { return (trace->s * trace->theta_rad(i) - first) / w; }
 };
 
 Timed timed(const TraceResidual& t, double w) {
@@ -78,14 +82,14 @@ Timed timed(const TraceResidual& t, double w) {
     std::iota(out.sorted.begin(), out.sorted.end(), std::size_t{0});
     std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
   }
-  out.time_s.resize(n);
+  out.trace = &t;
+  out.w = w;
   if (n == 0) return out;
-  const double first = t.s * t.theta_rad(out.order(0));
-  for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad(i) - first) / w;
-  out.duration_s = out.time_s[out.order(n - 1)];
+  out.first = t.s * t.theta_rad(out.order(0));
+  out.duration_s = out.time_s(out.order(n - 1));
   std::vector<double> steps;
   for (std::size_t i = 1; i < n; ++i) {
-    const double d = out.time_s[out.order(i)] - out.time_s[out.order(i - 1)];
+    const double d = out.time_s(out.order(i)) - out.time_s(out.order(i - 1));
     if (d > 0) steps.push_back(d);
   }
   if (!steps.empty()) {
@@ -102,9 +106,9 @@ std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt)
   std::size_t j = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double at = static_cast<double>(k) * dt;
-    while (j + 2 < tm.n && tm.time_s[tm.order(j + 1)] < at) ++j;
+    while (j + 2 < tm.n && tm.time_s(tm.order(j + 1)) < at) ++j;
     const std::size_t a = tm.order(j), b = tm.order(std::min(j + 1, tm.n - 1));
-    const double ta = tm.time_s[a], tb = tm.time_s[b];
+    const double ta = tm.time_s(a), tb = tm.time_s(b);
     const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
     out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
   }
@@ -170,7 +174,9 @@ struct LineFit {
       : traces(t), tms(tm), f0_hz(f0) {
     for (const auto& x : tms) {
       c0.emplace_back(), s0.emplace_back();
-      for (double ts : x.time_s) {
+      c0.back().reserve(x.n), s0.back().reserve(x.n);
+      for (std::size_t j = 0; j < x.n; ++j) {
+        const double ts = x.time_s(j);
         c0.back().push_back(std::cos(2 * pi * f0 * ts));
         s0.back().push_back(std::sin(2 * pi * f0 * ts));
       }
@@ -179,7 +185,7 @@ struct LineFit {
 
   using Row = Eigen::Matrix<double, 6, 1>;
   Row row(std::size_t i, std::size_t j, double f_hz) const {
-    const double ph = 2 * pi * f_hz * tms[i].time_s[j];
+    const double ph = 2 * pi * f_hz * tms[i].time_s(j);
     const double sa = std::sin(ph), ca = std::cos(ph), sb = s0[i][j], cb = c0[i][j];
     Row r;
     r << sa * cb - ca * sb, ca * cb + sa * sb, sa, ca, sa * cb + ca * sb, ca * cb - sa * sb;
