@@ -124,10 +124,13 @@ std::vector<double> periodogram(std::vector<double> x, std::size_t npad) {
            (0.5 - 0.5 * std::cos(2 * pi * static_cast<double>(i) /
                                  static_cast<double>(std::max<std::size_t>(1, n - 1))));
   x.resize(npad, 0.0);
-  Eigen::FFT<double> fft;
-  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
   std::vector<std::complex<double>> spec;
-  fft.fwd(spec, x);
+  {
+    Eigen::FFT<double> fft;
+    fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
+    fft.fwd(spec, x);
+  }  // the transform's tables go here, and the padded series next: before p is made (issue 32)
+  x = std::vector<double>();
   std::vector<double> p(npad / 2 + 1);
   for (std::size_t k = 0; k < p.size(); ++k) p[k] = std::norm(spec[k]);
   return p;
