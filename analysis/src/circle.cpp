@@ -62,11 +62,12 @@ double sgn(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; }
 double sign_of(Direction d) { return d == Direction::ccw ? 1.0 : -1.0; }
 const char* name_of(Direction d) { return d == Direction::cw ? "cw" : "ccw"; }
 
-// What the fit keeps of a sample (48 bytes; a dense row of the design took 144 more): the
+// What the fit keeps of a sample (40 bytes; a dense row of the design took 144 more): the
 // basis is rebuilt from it on every pass over the samples, except the two reversal-spike
-// columns (four exponentials), which cost more to rebuild than to keep.
+// columns (four exponentials), which cost more to rebuild than to keep. The direction is the
+// trace's, known from the sample's index (Model::direction).
 struct Sample {
-  double c, n, y, s, spike_u, spike_v;  // cos, sin of the angle; deviation; direction
+  double c, n, y, spike_u, spike_v;  // cos, sin of the angle; deviation
 };
 
 std::string axis_names(Plane p) {
@@ -119,6 +120,11 @@ constexpr std::array<const char*, term_count> term_names = {"centre offset (firs
 struct Model {
   double r_mm, phi_rad;
   std::array<bool, term_count> on{};
+  // The flattened samples' directions: s_before below index split (the first trace), s_after
+  // from it (the second).
+  std::size_t split = 0;
+  double s_before = 1.0, s_after = 1.0;
+  double direction(std::size_t index) const { return index < split ? s_before : s_after; }
 
   double spike(double theta, double s, double first) const {
     double sum = 0.0;
@@ -131,16 +137,16 @@ struct Model {
   }
 
   Sample sample(double theta, double s, double y) const {
-    return {std::cos(theta), std::sin(theta), y, s, spike(theta, s, 0.0), spike(theta, s, pi / 2)};
+    return {std::cos(theta), std::sin(theta), y, spike(theta, s, 0.0), spike(theta, s, pi / 2)};
   }
 
   // k = 2 pi R / period: the cyclic columns' wave number along the axes.
   double wave_number(double period_mm) const { return 2 * pi * r_mm / period_mm; }
 
-  // The basis row of a sample, the terms that are off left at 0.
+  // The basis row of a sample in direction s, the terms that are off left at 0.
   template <class RowRef>
-  void row(const Sample& x, double k, RowRef&& out) const {
-    const double c = x.c, n = x.n, s = x.s;
+  void row(const Sample& x, double s, double k, RowRef&& out) const {
+    const double c = x.c, n = x.n;
     const double c2 = c * c - n * n, s2 = 2 * c * n;  // cos 2t, sin 2t
     const double pu = k * c, pv = k * n;
     const std::array<double, term_count> b = {c,
@@ -182,8 +188,9 @@ void for_each_block(const Model& m, std::span<const Sample> samples, std::size_t
   for (std::size_t first = 0; first < n; first += block_rows) {
     const auto rows = static_cast<Eigen::Index>(std::min(block_rows, n - first));
     for (Eigen::Index i = 0; i < rows; ++i) {
-      const Sample& x = samples[(first + static_cast<std::size_t>(i)) * stride];
-      m.row(x, k, b.row(i));
+      const std::size_t at = (first + static_cast<std::size_t>(i)) * stride;
+      const Sample& x = samples[at];
+      m.row(x, m.direction(at), k, b.row(i));
       y[i] = x.y;
     }
     f(b.topRows(rows), y.head(rows), first);
@@ -821,7 +828,10 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
       flatten(Model{setup.radius_mm, setup.spike_decay_deg * deg, {}}, traces, offset_um, spans);
   res.iso = iso_values(samples, spans);
 
-  const Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
+  Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
+  m.split = spans[0].end;
+  m.s_before = sign_of(spans[0].trace->direction);
+  m.s_after = sign_of(spans.back().trace->direction);
   double period_mm = setup.cyclic_period_mm.value_or(10.0);
   Design full(m, samples, 1, period_mm);
   if (m.on[cyclic_first] && !setup.cyclic_period_mm)
@@ -857,7 +867,7 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
       residuals[t].r_um[at - spans[t].begin] = r[i];
     }
   });
-  // The fit's records (48 bytes a sample) are done with: what follows needs the residual, and
+  // The fit's records (40 bytes a sample) are done with: what follows needs the residual, and
   // rep.finish rebuilds the little it needs from the traces. Freed before the spectra, the peak
   // of the analysis (issue 32).
   const std::size_t sample_count = samples.size();
