@@ -58,16 +58,20 @@ double omega_rad_s(const Settings& s) { return s.feed_mm_per_min / 60.0 / s.radi
 struct Timed {
   std::size_t n = 0;
   std::vector<std::size_t> sorted;  // travel order -> index in the trace; empty: the identity
-  std::vector<double> time_s;       // per sample, in the trace's order; 0 at the first in travel
+  const TraceResidual* trace = nullptr;
+  double first = 0.0, w = 1.0;  // s theta of the first sample in travel; the angular speed
   double duration_s = 0.0, step_s = 0.0;
   std::size_t order(std::size_t k) const { return sorted.empty() ? k : sorted[k]; }
+  // The time of sample i (in the trace's order), 0 at the first in travel: computed when asked
+  // rather than kept, 8 bytes a sample less at the spectra's peak (issue 32).
+  double time_s(std::size_t i) const { return (trace->s * trace->theta_rad(i) - first) / w; }
 };
 
 Timed timed(const TraceResidual& t, double w) {
   Timed out;
-  const std::size_t n = out.n = t.theta_rad.size();
+  const std::size_t n = out.n = t.angle_deg.size();
   const auto before = [&](std::size_t a, std::size_t b) {
-    return t.s * t.theta_rad[a] < t.s * t.theta_rad[b];
+    return t.s * t.theta_rad(a) < t.s * t.theta_rad(b);
   };
   // A trace from time is in travel order already: checked in one pass, and then no
   // permutation is kept (8 bytes a sample); sorted only if not.
@@ -78,14 +82,14 @@ Timed timed(const TraceResidual& t, double w) {
     std::iota(out.sorted.begin(), out.sorted.end(), std::size_t{0});
     std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
   }
-  out.time_s.resize(n);
+  out.trace = &t;
+  out.w = w;
   if (n == 0) return out;
-  const double first = t.s * t.theta_rad[out.order(0)];
-  for (std::size_t i = 0; i < n; ++i) out.time_s[i] = (t.s * t.theta_rad[i] - first) / w;
-  out.duration_s = out.time_s[out.order(n - 1)];
+  out.first = t.s * t.theta_rad(out.order(0));
+  out.duration_s = out.time_s(out.order(n - 1));
   std::vector<double> steps;
   for (std::size_t i = 1; i < n; ++i) {
-    const double d = out.time_s[out.order(i)] - out.time_s[out.order(i - 1)];
+    const double d = out.time_s(out.order(i)) - out.time_s(out.order(i - 1));
     if (d > 0) steps.push_back(d);
   }
   if (!steps.empty()) {
@@ -102,9 +106,9 @@ std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt)
   std::size_t j = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double at = static_cast<double>(k) * dt;
-    while (j + 2 < tm.n && tm.time_s[tm.order(j + 1)] < at) ++j;
+    while (j + 2 < tm.n && tm.time_s(tm.order(j + 1)) < at) ++j;
     const std::size_t a = tm.order(j), b = tm.order(std::min(j + 1, tm.n - 1));
-    const double ta = tm.time_s[a], tb = tm.time_s[b];
+    const double ta = tm.time_s(a), tb = tm.time_s(b);
     const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
     out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
   }
@@ -120,10 +124,13 @@ std::vector<double> periodogram(std::vector<double> x, std::size_t npad) {
            (0.5 - 0.5 * std::cos(2 * pi * static_cast<double>(i) /
                                  static_cast<double>(std::max<std::size_t>(1, n - 1))));
   x.resize(npad, 0.0);
-  Eigen::FFT<double> fft;
-  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
   std::vector<std::complex<double>> spec;
-  fft.fwd(spec, x);
+  {
+    Eigen::FFT<double> fft;
+    fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
+    fft.fwd(spec, x);
+  }  // the transform's tables go here, and the padded series next: before p is made (issue 32)
+  x = std::vector<double>();
   std::vector<double> p(npad / 2 + 1);
   for (std::size_t k = 0; k < p.size(); ++k) p[k] = std::norm(spec[k]);
   return p;
@@ -170,7 +177,9 @@ struct LineFit {
       : traces(t), tms(tm), f0_hz(f0) {
     for (const auto& x : tms) {
       c0.emplace_back(), s0.emplace_back();
-      for (double ts : x.time_s) {
+      c0.back().reserve(x.n), s0.back().reserve(x.n);
+      for (std::size_t j = 0; j < x.n; ++j) {
+        const double ts = x.time_s(j);
         c0.back().push_back(std::cos(2 * pi * f0 * ts));
         s0.back().push_back(std::sin(2 * pi * f0 * ts));
       }
@@ -179,7 +188,7 @@ struct LineFit {
 
   using Row = Eigen::Matrix<double, 6, 1>;
   Row row(std::size_t i, std::size_t j, double f_hz) const {
-    const double ph = 2 * pi * f_hz * tms[i].time_s[j];
+    const double ph = 2 * pi * f_hz * tms[i].time_s(j);
     const double sa = std::sin(ph), ca = std::cos(ph), sb = s0[i][j], cb = c0[i][j];
     Row r;
     r << sa * cb - ca * sb, ca * cb + sa * sb, sa, ca, sa * cb + ca * sb, ca * cb - sa * sb;
@@ -299,8 +308,8 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   }
   std::vector<std::vector<double>> ps;
   std::vector<double> mean(npad / 2 + 1, 0.0);
-  for (const auto& x : series) {
-    ps.push_back(periodogram(x, npad));
+  for (auto& x : series) {  // each series becomes its padded copy, freed with it (issue 32)
+    ps.push_back(periodogram(std::move(x), npad));
     for (std::size_t k = 0; k < mean.size(); ++k)
       mean[k] += ps.back()[k] / static_cast<double>(series.size());
   }
@@ -337,6 +346,9 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
           all.centroid_hz, traces[i].s > 0 ? "cw" : "ccw"));
       return std::nullopt;
     }
+  // The spectra are done with: freed before the line fit keeps its own per-sample tables.
+  series = std::vector<std::vector<double>>(), ps = std::vector<std::vector<double>>();
+  mean = std::vector<double>();  // (= {} would keep the capacity)
   // The frequency that explains most, on a grid over +-1 / T, refined about the best point.
   const LineFit fit(traces, tms, f0);
   double best_f = all.centroid_hz, best = -1.0, step = 0.1 / duration;
@@ -415,7 +427,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
   std::array<std::size_t, 2> in_n{};
   for (std::size_t i = 0; i < traces.size(); ++i)
     for (std::size_t j = 0; j < hp[i].size(); ++j) {
-      const double th = traces[i].theta_rad[j], du = from_u(th), dv = from_v(th);
+      const double th = traces[i].theta_rad(j), du = from_u(th), dv = from_v(th);
       const double sq = hp[i][j] * hp[i][j];
       if (du > window && dv > window) out_ss += sq, ++out_n;
       if (du >= core && du <= window) in_ss[0] += sq, ++in_n[0];
@@ -437,7 +449,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
             .value = std::sqrt(ms_in - ms_out)};
     for (std::size_t i = 0; i < traces.size(); ++i)
       for (std::size_t j = 0; j < hp[i].size(); ++j) {
-        const double th = traces[i].theta_rad[j], d = axis_u ? from_u(th) : from_v(th);
+        const double th = traces[i].theta_rad(j), d = axis_u ? from_u(th) : from_v(th);
         f.contribution.push_back(d >= core && d <= window ? hp[i][j] : 0.0);
       }
     found.push_back(std::move(f));

@@ -8,16 +8,19 @@
 // revolution lasts 2 pi R / F; its frequency f0 = F / (2 pi R) is "the frequency of the feed":
 // the geometric terms sit at 1 and 2 f0 (and a few more harmonics), so only the band above
 // 10 f0 is searched for a vibration.
+#include <numbers>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace cal::circle::dynamics {
 
 struct TraceResidual {
-  double s = 1.0;                 // +1 ccw, -1 cw
-  std::vector<double> theta_rad;  // in the trace's own sample order
-  std::vector<double> r_um;       // what the geometric model left
+  double s = 1.0;                     // +1 ccw, -1 cw
+  std::span<const double> angle_deg;  // the trace's own angles (a view: no copy a sample)
+  std::vector<double> r_um;           // what the geometric model left
+  double theta_rad(std::size_t j) const { return angle_deg[j] * (std::numbers::pi / 180.0); }
 };
 
 struct Settings {

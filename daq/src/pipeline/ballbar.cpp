@@ -67,8 +67,13 @@ std::vector<circle::Trace> BallbarSegmenter::traces() const {
     circle::Trace t{k == 0 ? circle::Direction::ccw : circle::Direction::cw, {}, {}};
     const double first = arc_start_s + p_.overshoot_deg / rate_deg_s;
     const double last = arc_start_s + (p_.overshoot_deg + p_.arc_deg) / rate_deg_s;
-    for (auto i = static_cast<std::size_t>(std::ceil(first * p_.sample_rate_hz));
-         static_cast<double>(i) < last * p_.sample_rate_hz; ++i) {
+    const auto i0 = static_cast<std::size_t>(std::ceil(first * p_.sample_rate_hz));
+    // Exactly the samples below (i < last * rate): no growth slack, which held up to a third
+    // more of the trace at the analysis' peak (issue 32).
+    const auto i1 = static_cast<std::size_t>(std::ceil(last * p_.sample_rate_hz));
+    t.angle_deg.reserve(i1 > i0 ? i1 - i0 : 0);
+    t.deviation_um.reserve(i1 > i0 ? i1 - i0 : 0);
+    for (auto i = i0; static_cast<double>(i) < last * p_.sample_rate_hz; ++i) {
       const double t_s = static_cast<double>(i) / p_.sample_rate_hz;
       // ccw starts at start_deg; cw starts where ccw ended (start + arc + 2 overshoot).
       const double start = k == 0 ? p_.start_deg : p_.start_deg + p_.arc_deg + 2 * p_.overshoot_deg;
