@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/storage/store.hpp"
@@ -49,12 +50,7 @@ using nlohmann::json;
 namespace st = cal::storage;
 
 std::string iso_time(std::int64_t unix_ms) {
-  const std::time_t s = unix_ms / 1000;
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  std::array<char, 32> buf{};
-  std::strftime(buf.data(), buf.size(), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf.data();
+  return cal::text::utc_text(unix_ms / 1000, "%Y-%m-%dT%H:%M:%SZ");
 }
 
 json run_json(const st::RunRecord& r) {
@@ -75,8 +71,7 @@ json run_json(const st::RunRecord& r) {
 
 st::RunRecord need_run(const st::RunReader& store, std::int64_t id) {
   auto r = store.run(id);
-  if (!r)
-    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
+  if (!r) throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
   return *r;
 }
 

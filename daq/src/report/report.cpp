@@ -14,6 +14,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/analysis/uncertainty.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
@@ -48,12 +49,7 @@ std::string um(double v) { return fixed(v, 3); }
 std::string unit_text(std::string_view u) { return ::daq::unit_html(u); }
 
 std::string iso_time(std::int64_t unix_ms) {
-  const std::time_t s = unix_ms / 1000;
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
+  return cal::text::utc_text(unix_ms / 1000, "%Y-%m-%d %H:%M:%S UTC");
 }
 
 // `align`: one letter per column, 'r' right-aligns (numbers), anything else left; columns
