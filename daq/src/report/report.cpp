@@ -452,26 +452,24 @@ std::string environment_section(const Environment& env) {
     l.dashed = true;
     temps.push_back(std::move(l));
   }
-  h += figure(svg(XyChart{.title = "Temperatures",
-                          .x_label = "time (min)",
-                          .y_label = "temperature (°C)",
-                          .lines = temps,
-                          .height_pt = 240}),
-              "Air and material temperature during the run.");
+  // One plot of the run's time: all environment plots share the axis and the height.
+  const auto time_plot = [&](const char* title, const char* y_label, std::vector<Line> lines,
+                             const char* caption) {
+    h += figure(svg(XyChart{.title = title,
+                            .x_label = "time (min)",
+                            .y_label = y_label,
+                            .lines = std::move(lines),
+                            .height_pt = 240}),
+                caption);
+  };
+  time_plot("Temperatures", "temperature (°C)", std::move(temps),
+            "Air and material temperature during the run.");
   if (!env.pressure_hpa.empty())
-    h += figure(svg(XyChart{.title = "Air pressure",
-                            .x_label = "time (min)",
-                            .y_label = "pressure (hPa)",
-                            .lines = lines_of(env.pressure_hpa, 2),
-                            .height_pt = 240}),
-                "Air pressure during the run.");
+    time_plot("Air pressure", "pressure (hPa)", lines_of(env.pressure_hpa, 2),
+              "Air pressure during the run.");
   if (!env.humidity.empty())
-    h += figure(svg(XyChart{.title = "Relative humidity",
-                            .x_label = "time (min)",
-                            .y_label = "humidity (%RH)",
-                            .lines = lines_of(env.humidity, 5),
-                            .height_pt = 240}),
-                "Relative humidity during the run.");
+    time_plot("Relative humidity", "humidity (%RH)", lines_of(env.humidity, 5),
+              "Relative humidity during the run.");
   return h;
 }
 
