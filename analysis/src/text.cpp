@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <ctime>
 
 #include "cal/analysis/error.hpp"
 
@@ -113,6 +114,15 @@ std::string terminal_safe(std::string_view s) {
     i += n;
   }
   return out;
+}
+
+std::string utc_text(std::int64_t unix_s, const char* strftime_format) {
+  const auto t = static_cast<std::time_t>(unix_s);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  std::array<char, 32> buf{};
+  const auto n = std::strftime(buf.data(), buf.size(), strftime_format, &tm);
+  return std::string(buf.data(), n);
 }
 
 }  // namespace cal::text

@@ -24,6 +24,7 @@
 #include "verdict.hpp"
 
 namespace py = pybind11;
+using namespace pybind11::literals;  // "name"_a = value: a dict's fields in one call
 
 namespace caldaq_py {
 namespace {
@@ -65,12 +66,9 @@ py::dict refractive_index(double temperature_degc, double pressure_pa, double hu
                          .co2_umol_per_mol = co2_umol_per_mol,
                          .wavelength_vacuum_nm = wavelength_nm};
   const auto r = cal::air::refractive_index(c, cal::air::equation_from_string(equation));
-  py::dict d;
-  d["n"] = r.n;
-  d["water_vapour_pressure_pa"] = r.water_vapour_pressure_pa;
-  d["equation"] = std::string(cal::air::to_string(r.equation));
-  d["warnings"] = r.warnings;
-  return d;
+  return py::dict("n"_a = r.n, "water_vapour_pressure_pa"_a = r.water_vapour_pressure_pa,
+                  "equation"_a = std::string(cal::air::to_string(r.equation)),
+                  "warnings"_a = r.warnings);
 }
 
 // --- ISO 230-2 ------------------------------------------------------------------------------
@@ -188,20 +186,13 @@ py::dict straightness_evaluate(const Doubles& position_mm, const Doubles& deviat
     py::gil_scoped_release release;
     r = cal::straightness::evaluate(p, dv, ref);
   }
-  py::dict d;
-  d["reference"] = std::string(cal::straightness::to_string(r.reference));
-  d["straightness_um"] = r.straightness_um;
-  d["slope_um_per_m"] = r.slope_um_per_m;
-  d["intercept_um"] = r.intercept_um;
-  d["residual_um"] = to_array(r.residual_um);
-  return d;
+  return py::dict("reference"_a = std::string(cal::straightness::to_string(r.reference)),
+                  "straightness_um"_a = r.straightness_um, "slope_um_per_m"_a = r.slope_um_per_m,
+                  "intercept_um"_a = r.intercept_um, "residual_um"_a = to_array(r.residual_um));
 }
 
 py::dict squareness_dict(const cal::squareness::Result& r) {
-  py::dict d;
-  d["squareness_um_per_m"] = r.squareness_um_per_m;
-  d["arcsec"] = r.arcsec();
-  return d;
+  return py::dict("squareness_um_per_m"_a = r.squareness_um_per_m, "arcsec"_a = r.arcsec());
 }
 
 // --- uncertainty ----------------------------------------------------------------------------
@@ -331,15 +322,10 @@ void bind_analysis(py::module_& m) {
       "compensation_factor",
       [](double n_air, double alpha_per_k, double material_degc) {
         const auto f = cal::comp::combined_factor(n_air, alpha_per_k, material_degc);
-        py::dict d;
-        d["n_air"] = f.n_air;
-        d["material_degc"] = f.material_degc;
-        d["alpha_per_k"] = f.alpha_per_k;
-        d["factor"] = f.factor;
-        d["air_ppm"] = f.air_ppm;
-        d["material_ppm"] = f.material_ppm;
-        d["total_ppm"] = f.total_ppm;
-        return d;
+        return py::dict("n_air"_a = f.n_air, "material_degc"_a = f.material_degc,
+                        "alpha_per_k"_a = f.alpha_per_k, "factor"_a = f.factor,
+                        "air_ppm"_a = f.air_ppm, "material_ppm"_a = f.material_ppm,
+                        "total_ppm"_a = f.total_ppm);
       },
       py::arg("n_air"), py::arg("alpha_per_k"), py::arg("material_degc"));
 }

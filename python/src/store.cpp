@@ -12,6 +12,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -27,6 +28,7 @@
 
 namespace py = pybind11;
 namespace st = cal::storage;
+using namespace pybind11::literals;  // "name"_a = value: a dict's fields in one call
 
 namespace caldaq_py {
 namespace {
@@ -45,114 +47,68 @@ auto locked(SharedStore& s, F&& f) {
   return f(s.store);
 }
 
+// A stored direction ('+' or '-') as the dicts name it.
+const char* direction_name(char direction) { return direction == '+' ? "up" : "down"; }
+
 template <class T>
 py::object optional_value(const std::optional<T>& v) {
   return v ? py::cast(*v) : py::none();
 }
 
 py::dict run_dict(const st::RunRecord& r) {
-  py::dict d;
-  d["id"] = r.id;
-  d["machine_id"] = r.machine_id;
-  d["campaign"] = r.campaign;
-  d["kind"] = r.kind;
-  d["axis"] = r.axis;
-  d["settings_json"] = r.settings_json;
-  d["capture_path"] = r.capture_path;
-  d["software_version"] = r.software_version;
-  d["started_unix_ms"] = r.started_unix_ms;
-  d["ended_unix_ms"] = optional_value(r.ended_unix_ms);
-  d["status"] = std::string(st::to_string(r.status));
-  d["note"] = r.note;
-  d["origin_session_ns"] = optional_value(r.origin_session_ns);
-  d["origin_unix_ns"] = optional_value(r.origin_unix_ns);
-  return d;
+  return py::dict("id"_a = r.id, "machine_id"_a = r.machine_id, "campaign"_a = r.campaign,
+                  "kind"_a = r.kind, "axis"_a = r.axis, "settings_json"_a = r.settings_json,
+                  "capture_path"_a = r.capture_path, "software_version"_a = r.software_version,
+                  "started_unix_ms"_a = r.started_unix_ms,
+                  "ended_unix_ms"_a = optional_value(r.ended_unix_ms),
+                  "status"_a = std::string(st::to_string(r.status)), "note"_a = r.note,
+                  "origin_session_ns"_a = optional_value(r.origin_session_ns),
+                  "origin_unix_ns"_a = optional_value(r.origin_unix_ns));
 }
 
 py::dict instrument_dict(const st::InstrumentRecord& i) {
-  py::dict d;
-  d["device"] = i.device;
-  d["driver"] = i.driver;
-  d["transport"] = i.transport;
-  d["settings_json"] = i.settings_json;
-  d["origin"] = i.origin;
-  d["origin_detail"] = i.origin_detail;
-  return d;
+  return py::dict("device"_a = i.device, "driver"_a = i.driver, "transport"_a = i.transport,
+                  "settings_json"_a = i.settings_json, "origin"_a = i.origin,
+                  "origin_detail"_a = i.origin_detail);
 }
 
 py::dict target_dict(const st::CapturedTarget& t) {
-  py::dict d;
-  d["target_index"] = t.target_index;
-  d["run"] = t.run_number;
-  d["direction"] = t.direction == '+' ? "up" : "down";
-  d["nominal_mm"] = t.nominal_mm;
-  d["time_ns"] = t.time_ns;
-  d["raw_m"] = t.raw_m;
-  d["deviation_um"] = t.deviation_um;
-  d["refractive_index"] = t.refractive_index;
-  d["material_temperature_degc"] = t.material_temperature_degc;
-  return d;
+  return py::dict("target_index"_a = t.target_index, "run"_a = t.run_number,
+                  "direction"_a = direction_name(t.direction), "nominal_mm"_a = t.nominal_mm,
+                  "time_ns"_a = t.time_ns, "raw_m"_a = t.raw_m, "deviation_um"_a = t.deviation_um,
+                  "refractive_index"_a = t.refractive_index,
+                  "material_temperature_degc"_a = t.material_temperature_degc);
 }
 
 py::dict result_dict(const st::ResultRecord& r) {
-  py::dict d;
-  d["id"] = r.id;
-  d["standard"] = r.standard;
-  d["json"] = r.json;
-  d["created_unix_ms"] = r.created_unix_ms;
-  d["provenance_json"] = r.provenance_json;
-  d["superseded_by"] = optional_value(r.superseded_by);
-  d["current"] = r.current();
-  return d;
+  return py::dict("id"_a = r.id, "standard"_a = r.standard, "json"_a = r.json,
+                  "created_unix_ms"_a = r.created_unix_ms, "provenance_json"_a = r.provenance_json,
+                  "superseded_by"_a = optional_value(r.superseded_by), "current"_a = r.current());
 }
 
 py::dict missed_dict(const st::MissedStop& m) {
-  py::dict d;
-  d["run"] = m.run_number;
-  d["direction"] = m.direction == '+' ? "up" : "down";
-  d["target_index"] = m.target_index;
-  d["nominal_mm"] = m.nominal_mm;
-  return d;
+  return py::dict("run"_a = m.run_number, "direction"_a = direction_name(m.direction),
+                  "target_index"_a = m.target_index, "nominal_mm"_a = m.nominal_mm);
 }
 
 py::object quality_obj(const std::optional<st::RunQuality>& q) {
   if (!q) return py::none();
-  py::dict d;
-  d["state"] = q->state;
-  d["summary"] = q->summary;
   py::list suspects;
-  for (const auto& s : q->suspects) {
-    py::dict m;
-    m["run"] = s.run_number;
-    m["direction"] = s.direction == '+' ? "up" : "down";
-    m["target_index"] = s.target_index;
-    m["reason"] = s.reason;
-    suspects.append(m);
-  }
-  d["suspects"] = suspects;
-  return d;
+  for (const auto& s : q->suspects)
+    suspects.append(py::dict("run"_a = s.run_number, "direction"_a = direction_name(s.direction),
+                             "target_index"_a = s.target_index, "reason"_a = s.reason));
+  return py::dict("state"_a = q->state, "summary"_a = q->summary, "suspects"_a = suspects);
 }
 
 py::dict compensation_dict(const st::CompensationRecord& c) {
-  py::dict d;
-  d["id"] = c.id;
-  d["machine_id"] = c.machine_id;
-  d["source_run_id"] = c.source_run_id;
-  d["source"] = c.source;
-  d["axis"] = c.axis;
-  d["format"] = c.format;
-  d["created_unix_ms"] = c.created_unix_ms;
-  d["json"] = c.json;
-  return d;
+  return py::dict("id"_a = c.id, "machine_id"_a = c.machine_id, "source_run_id"_a = c.source_run_id,
+                  "source"_a = c.source, "axis"_a = c.axis, "format"_a = c.format,
+                  "created_unix_ms"_a = c.created_unix_ms, "json"_a = c.json);
 }
 
 py::dict machine_dict(const st::MachineRecord& m) {
-  py::dict d;
-  d["id"] = m.id;
-  d["name"] = m.name;
-  d["description"] = m.description;
-  d["config_json"] = m.config_json;
-  return d;
+  return py::dict("id"_a = m.id, "name"_a = m.name, "description"_a = m.description,
+                  "config_json"_a = m.config_json);
 }
 
 template <class T, class F>
@@ -160,6 +116,15 @@ py::list list_of(const std::vector<T>& v, F&& f) {
   py::list out;
   for (const auto& x : v) out.append(f(x));
   return out;
+}
+
+// A Store method that lists one run's records (instruments, targets, ...) as a Python method
+// that returns them as dicts.
+template <class Get, class F>
+auto run_records(Get get, F to_dict) {
+  return [get, to_dict](SharedStore& s, std::int64_t run_id) {
+    return list_of(locked(s, [&](st::Store& st) { return std::invoke(get, st, run_id); }), to_dict);
+  };
 }
 
 // A column of a chunk as a new numpy array.
@@ -364,42 +329,21 @@ void bind_store(py::module_& m) {
              const auto r = locked(s, [&](st::Store& st) { return st.machine(id); });
              return r ? py::object(machine_dict(*r)) : py::none();
            })
-      .def("instruments",
-           [](SharedStore& s, std::int64_t id) {
-             return list_of(locked(s, [&](st::Store& st) { return st.instruments(id); }),
-                            instrument_dict);
-           })
-      .def("series",
-           [](SharedStore& s, std::int64_t id) {
-             return list_of(locked(s, [&](st::Store& st) { return st.series(id); }),
-                            [](const st::Store::Series& x) {
-                              py::dict d;
-                              d["device"] = x.device;
-                              d["channel"] = x.channel;
-                              d["quantity"] = x.quantity;
-                              d["count"] = x.count;
-                              d["first_ns"] = x.first_ns;
-                              d["last_ns"] = x.last_ns;
-                              return d;
-                            });
-           })
+      .def("instruments", run_records(&st::Store::instruments, instrument_dict))
+      .def("series", run_records(&st::Store::series,
+                                 [](const st::Store::Series& x) {
+                                   return py::dict("device"_a = x.device, "channel"_a = x.channel,
+                                                   "quantity"_a = x.quantity, "count"_a = x.count,
+                                                   "first_ns"_a = x.first_ns,
+                                                   "last_ns"_a = x.last_ns);
+                                 }))
       .def("reading_count",
            [](SharedStore& s, std::int64_t id) {
              return locked(s, [&](st::Store& st) { return st.reading_count(id); });
            })
-      .def("targets",
-           [](SharedStore& s, std::int64_t id) {
-             return list_of(locked(s, [&](st::Store& st) { return st.targets(id); }), target_dict);
-           })
-      .def("results",
-           [](SharedStore& s, std::int64_t id) {
-             return list_of(locked(s, [&](st::Store& st) { return st.results(id); }), result_dict);
-           })
-      .def("missed_stops",
-           [](SharedStore& s, std::int64_t id) {
-             return list_of(locked(s, [&](st::Store& st) { return st.missed_stops(id); }),
-                            missed_dict);
-           })
+      .def("targets", run_records(&st::Store::targets, target_dict))
+      .def("results", run_records(&st::Store::results, result_dict))
+      .def("missed_stops", run_records(&st::Store::missed_stops, missed_dict))
       .def("quality",
            [](SharedStore& s, std::int64_t id) {
              return quality_obj(locked(s, [&](st::Store& st) { return st.quality(id); }));

@@ -45,21 +45,8 @@ class SqliteChunks final : public ChunkSource {
     const int rc = sqlite3_step(s);
     if (rc == SQLITE_DONE) return false;
     if (rc != SQLITE_ROW) store_.fail(fmt::format("read the reading chunks of run {}", run_id_));
-    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(s, 7));
-    out.order = sqlite3_column_int64(s, 0);
-    out.device = sqlite3_column_int64(s, 1);
-    out.channel = sqlite3_column_int64(s, 2);
-    out.quantity = sqlite3_column_int64(s, 3);
-    out.first_ns = sqlite3_column_int64(s, 4);
-    out.last_ns = sqlite3_column_int64(s, 5);
-    out.count = sqlite3_column_int64(s, 6);
-    out.data.assign(data, data + sqlite3_column_bytes(s, 7));
-    out.encoding = sqlite3_column_int64(s, 8);
-    out.seq.reset();
-    if (sqlite3_column_type(s, 9) != SQLITE_NULL) out.seq = sqlite3_column_int64(s, 9);
-    out.crc.reset();
-    if (sqlite3_column_type(s, 10) != SQLITE_NULL)
-      out.crc = static_cast<std::uint32_t>(sqlite3_column_int64(s, 10));
+    detail::read_all(s, out.order, out.device, out.channel, out.quantity, out.first_ns, out.last_ns,
+                     out.count, out.data, out.encoding, out.seq, out.crc);
     return true;
   }
 

@@ -51,6 +51,10 @@ void bind_value(sqlite3_stmt* s, int i, const std::optional<T>& v) {
 
 inline void read_value(sqlite3_stmt* s, int i, std::int64_t& v) { v = sqlite3_column_int64(s, i); }
 inline void read_value(sqlite3_stmt* s, int i, int& v) { v = sqlite3_column_int(s, i); }
+// A CRC-32C, stored as an integer.
+inline void read_value(sqlite3_stmt* s, int i, std::uint32_t& v) {
+  v = static_cast<std::uint32_t>(sqlite3_column_int64(s, i));
+}
 inline void read_value(sqlite3_stmt* s, int i, double& v) { v = sqlite3_column_double(s, i); }
 inline void read_value(sqlite3_stmt* s, int i, std::string& v) {
   const auto* p = sqlite3_column_text(s, i);

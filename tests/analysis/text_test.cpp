@@ -50,6 +50,14 @@ TEST(Text, TerminalSafeEscapesControlsAndKeepsText) {
   EXPECT_EQ(terminal_safe("\x7f"), "\\x7F");
 }
 
+TEST(Text, UtcTextFormatsWholeSecondsAsUtc) {
+  EXPECT_EQ(utc_text(0, "%Y-%m-%dT%H:%M:%SZ"), "1970-01-01T00:00:00Z");
+  // 2026-11-28 09:13:58 UTC, whatever the machine's time zone.
+  EXPECT_EQ(utc_text(1795857238, "%Y-%m-%d %H:%M:%S UTC"), "2026-11-28 09:13:58 UTC");
+  EXPECT_EQ(utc_text(-1, "%Y-%m-%dT%H:%M:%S"), "1969-12-31T23:59:59");  // before 1970
+  EXPECT_EQ(utc_text(0, ""), "");
+}
+
 }  // namespace
 
 // JSON structure without parsing (json_scan.hpp): brackets and quotes inside strings, escaped

@@ -24,6 +24,17 @@ check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
   passes=$((passes + 1))
 }
 
+# check_file FILE <<'END' ... END: what FILE must hold, as a table: each line "NAME PATTERN"
+# (PATTERN, as check's, runs to the end of the line and is taken as written: no quoting, no
+# expansion) is `check NAME 0 PATTERN -- cat FILE`; empty lines and lines of '#' are skipped.
+check_file() {
+  local file=$1 name pattern
+  while read -r name pattern; do
+    [[ -z $name || $name == \#* ]] && continue
+    check "$name" 0 "$pattern" -- cat "$file"
+  done
+}
+
 # scratch_dir [PID_VARIABLE...]: TMP, a new directory removed when the script exits, and SIM_PID
 # (a `daq sim` the script starts) and each named variable (other processes it starts, e.g.
 # RUN_PID) set empty now and, if they hold a process that still runs, killed then.

@@ -33,14 +33,18 @@ for key in E_bi M B R_bi A_bi E_up; do
   number "$v"
   check "linear_value_$key" 0 ">$v<" -- cat r1.html
 done
-check linear_standard 0 "Evaluated by <strong>ISO 230-2:2014</strong>" -- cat r1.html
-check linear_uncertainty 0 "expanded uncertainty U = [0-9.]+ µm \(k = 2\)" -- cat r1.html
-check linear_targets 0 "<td class=\"r\">500.000</td>" -- cat r1.html
+check_file r1.html <<'END'
+linear_standard Evaluated by <strong>ISO 230-2:2014</strong>
+linear_uncertainty expanded uncertainty U = [0-9.]+ µm \(k = 2\)
+linear_targets <td class="r">500.000</td>
+END
 # Two ISO 230-2 plots (means with bands, run by run) and three environment plots.
 check linear_plots 0 "^5$" -- count r1.html "<svg class=\"plot\""
-check linear_band 0 "x̄ ± 2s" -- cat r1.html
-check simulated_said 0 "<strong>SIMULATED</strong>: this run was made on the simulated machine" -- cat r1.html
-check environment 0 "Air temperature</td>" -- cat r1.html
+check_file r1.html <<'END'
+linear_band x̄ ± 2s
+simulated_said <strong>SIMULATED</strong>: this run was made on the simulated machine
+environment Air temperature</td>
+END
 # Self-contained: nothing is loaded from elsewhere (the SVG namespaces are names, not loads).
 check no_external 1 "^0$" -- grep -cE "(src|href)=\"(https?:)?//" r1.html
 # Another standard on request.
@@ -90,15 +94,17 @@ check ids_campaign 0 "all unique" -- "$PY" "$TESTS/../web/report_ids_test.py" ca
 check ids_compare 0 "all unique" -- "$PY" "$TESTS/../web/report_ids_test.py" cmp.html 7
 
 # --- what a customer receives (the demo's configuration, cmd_demo.cpp) --------------------------
-check customer 0 "<td>Customer</td><td>Demo customer \(simulated\)</td>" -- cat r1.html
-check machine_serial 0 "<td>Serial number</td><td>SIM-0001</td>" -- cat r1.html
-check operator 0 "<td>Operator</td><td>demo operator</td>" -- cat r1.html
-check instrument_serial 0 "<td>SIM-IDS-0001</td><td>none \(simulated instrument\)</td><td>2099-12-31</td>" -- cat r1.html
-check past_due 0 "2020-01-31 &mdash; PAST DUE" -- cat r1.html
-check past_due_warning 0 "the calibration of material was past due on the test date" -- cat r1.html
-check conditions 0 "<td>Controller compensation</td><td>off" -- cat r1.html
-check sign_convention 0 "<td>Sign convention</td><td>Positional deviation" -- cat r1.html
-check provenance 0 "<td>Obtained</td><td>acquired</td>" -- cat r1.html
+check_file r1.html <<'END'
+customer <td>Customer</td><td>Demo customer \(simulated\)</td>
+machine_serial <td>Serial number</td><td>SIM-0001</td>
+operator <td>Operator</td><td>demo operator</td>
+instrument_serial <td>SIM-IDS-0001</td><td>none \(simulated instrument\)</td><td>2099-12-31</td>
+past_due 2020-01-31 &mdash; PAST DUE
+past_due_warning the calibration of material was past due on the test date
+conditions <td>Controller compensation</td><td>off
+sign_convention <td>Sign convention</td><td>Positional deviation
+provenance <td>Obtained</td><td>acquired</td>
+END
 # Verdicts: the demo's limits E 10, R 6, B 3, A 12, M 8 um and, in XY, G 10 um, backlash X 3 um,
 # squareness 30 um/m; the injected backlash of 4 um fails B and backlash X, the rest pass.
 B=$(json_value lin.json "d['axis']['B']['value_um']")
@@ -132,11 +138,13 @@ check as_found_mixed 2 "give the same test before and after" -- "$DAQ" report --
 "$PY" "$TESTS/../cli/render_reports.py" "r1=$TMP/r1.html:$TMP/r1.png:SIMULATED — Run " "r2=$TMP/r2.html:$TMP/r2.png:SIMULATED — Run " \
   "camp=$TMP/camp.html:$TMP/camp.png:Campaign" "cmp=$TMP/cmp.html:$TMP/cmp.png:Comparison" \
   "af=$TMP/af.html:$TMP/af.png:As found" >rendered.txt 2>&1
-check rendered 0 "^r1: rendered 5 plots" -- cat rendered.txt
-check rendered_circle 0 "^r2: rendered 1 plots" -- cat rendered.txt
-check rendered_campaign 0 "^camp: rendered 11 plots" -- cat rendered.txt
-check rendered_compare 0 "^cmp: rendered [0-9]+ plots" -- cat rendered.txt
-check rendered_as_found 0 "^af: rendered [0-9]+ plots" -- cat rendered.txt
+check_file rendered.txt <<'END'
+rendered ^r1: rendered 5 plots
+rendered_circle ^r2: rendered 1 plots
+rendered_campaign ^camp: rendered 11 plots
+rendered_compare ^cmp: rendered [0-9]+ plots
+rendered_as_found ^af: rendered [0-9]+ plots
+END
 # Chromium prints once (1-2 s), to a pipe: its bytes are the PDF checked page by page below.
 "$DAQ" report 1 --db demo.sqlite --format pdf -o /dev/stdout 2>pdf.status | cat >r1-pipe.pdf
 check pdf_to_pipe 0 "^%PDF-1" -- head -c 8 r1-pipe.pdf
@@ -171,11 +179,13 @@ done
 check budget_before 0 "<td>material temperature</td><td class=\"r\">0.5750</td>" -- cat r1.html
 check recompensate 0 "stored as result [0-9]+, superseding result 1" -- "$DAQ" recompensate 1 --alpha-ppm 12 --db demo.sqlite
 "$DAQ" report 1 --db demo.sqlite -o r1b.html >/dev/null
-check recomp_setting 0 "11.5 ppm/K <span class=\"changed\">\(as acquired; the current result uses 12\)</span>" -- cat r1b.html
-check recomp_coefficients 0 "Expansion coefficient \(ppm/K\)</td><td class=\"r\">11.5</td><td class=\"r\"><span class=\"changed\">12</span>" -- cat r1b.html
-check recomp_values 0 "Original \(result 1\) and re-compensated \(result [0-9]+\) values" -- cat r1b.html
-check recomp_budget 0 "<td>material temperature</td><td class=\"r\">0.6000</td>" -- cat r1b.html
-check recomp_of 0 "<td>Re-compensation of</td><td>result 1</td>" -- cat r1b.html
+check_file r1b.html <<'END'
+recomp_setting 11.5 ppm/K <span class="changed">\(as acquired; the current result uses 12\)</span>
+recomp_coefficients Expansion coefficient \(ppm/K\)</td><td class="r">11.5</td><td class="r"><span class="changed">12</span>
+recomp_values Original \(result 1\) and re-compensated \(result [0-9]+\) values
+recomp_budget <td>material temperature</td><td class="r">0.6000</td>
+recomp_of <td>Re-compensation of</td><td>result 1</td>
+END
 "$DAQ" report --compare 1 3 --db demo.sqlite -o cmp2.html >/dev/null
 check compare_recompensated 0 "<td>1<br><span class=\"changed\">re-compensated</span>" -- cat cmp2.html
 check show_superseded 0 "result 1: ISO 230-2:2014 \(superseded by result [0-9]+\)" -- "$DAQ" show 1 --db demo.sqlite

@@ -49,12 +49,9 @@ std::string time_text(const d::DecodedItem& i) {
   if (!i.time_text.empty()) return i.time_text;
   if (i.device_time_unix_ns) {
     const std::int64_t ns = *i.device_time_unix_ns;
-    const std::time_t s = static_cast<std::time_t>(ns / 1'000'000'000 - (ns % 1'000'000'000 < 0));
-    std::tm tm{};
-    gmtime_r(&s, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
-    return fmt::format("{}.{:09}Z", buf, ((ns % 1'000'000'000) + 1'000'000'000) % 1'000'000'000);
+    const std::int64_t s = ns / 1'000'000'000 - (ns % 1'000'000'000 < 0);
+    return fmt::format("{}.{:09}Z", cal::text::utc_text(s, "%Y-%m-%dT%H:%M:%S"),
+                       ((ns % 1'000'000'000) + 1'000'000'000) % 1'000'000'000);
   }
   if (i.device_time_relative_s) return fmt::format("+{:.6f} s", *i.device_time_relative_s);
   return {};

@@ -16,6 +16,7 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "csv_columns.hpp"
+#include "output_file.hpp"
 #include "report/report.hpp"
 
 namespace daq {
@@ -39,21 +40,14 @@ struct StraightnessOptions {
   CsvOptions csv;
 };
 
-void write_report(const std::string& path, const std::string& html) {
-  std::ofstream out(path, std::ios::binary);
-  if (!(out << html) || !(out.close(), out))
-    throw cal::InputError(fmt::format("{}: cannot write the report", path));
-  fmt::print(stderr, "report written to {}\n", path);
-}
-
 void run_straightness(const StraightnessOptions& o) {
   auto cols = read_columns(o.input, {"position_mm", "deviation_um"}, o.csv);
   const auto ref = cal::straightness::reference_from_string(o.reference);
   const auto r = cal::straightness::evaluate(cols["position_mm"], cols["deviation_um"], ref);
   if (!o.report.empty())
-    write_report(o.report, cal::daq::report::straightness_report(
-                               {o.input, cols["position_mm"], cols["deviation_um"]},
-                               {.software = "daq 0.1.0"}));
+    write_report_page(o.report, cal::daq::report::straightness_report(
+                                    {o.input, cols["position_mm"], cols["deviation_um"]},
+                                    {.software = "daq 0.1.0"}));
   if (o.json) {
     json j{{"schema", "caldaq.straightness.v1"},
            {"standard", "ISO 230-1:2012"},
@@ -97,10 +91,10 @@ void run_squareness(const SquarenessOptions& o) {
                                            {b["position_mm"], b["deviation_um"]}, o.square_error);
     how = "two straightness runs (least-squares lines)";
     if (!o.report.empty())
-      write_report(o.report, cal::daq::report::squareness_report(
-                                 {o.along_a, a["position_mm"], a["deviation_um"]},
-                                 {o.along_b, b["position_mm"], b["deviation_um"]}, o.square_error,
-                                 {.software = "daq 0.1.0"}));
+      write_report_page(o.report, cal::daq::report::squareness_report(
+                                      {o.along_a, a["position_mm"], a["deviation_um"]},
+                                      {o.along_b, b["position_mm"], b["deviation_um"]},
+                                      o.square_error, {.software = "daq 0.1.0"}));
   } else if (!o.report.empty()) {
     throw cal::InputError("squareness --report draws the two runs of --method straightness");
   } else if (o.method == "diagonal") {

@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
+#include "output_file.hpp"
 #include "terminal.hpp"
 
 namespace daq {
@@ -21,6 +22,16 @@ namespace daq {
 namespace kin = cal::kinematics;
 namespace mdl = cal::daq::model;
 using nlohmann::json;
+
+json vec_json(const kin::Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+json grid_json(const kin::Grid& g) {
+  return {{"min_mm", vec_json(g.min_mm)},
+          {"max_mm", vec_json(g.max_mm)},
+          {"count", {g.count[0], g.count[1], g.count[2]}}};
+}
+
+double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
 
 namespace {
 constexpr std::array kAxis{"X", "Y", "Z"};
@@ -131,13 +142,6 @@ cal::daq::report::ModelPage model_page_of(const mdl::Model& m, const std::string
   for (auto& r : describe_components(m, true)) page.components.push_back(std::move(r));
   page.software = "daq 0.1.0";
   return page;
-}
-
-void write_page(const std::string& path, const std::string& html) {
-  std::ofstream out(path, std::ios::binary);
-  if (!(out << html) || !(out.close(), out))
-    throw cal::InputError(fmt::format("{}: cannot write the report", path));
-  fmt::print(stderr, "report written to {}\n", path);
 }
 
 void require_finite(std::span<const double> values, std::string_view what) {
@@ -301,11 +305,6 @@ kin::Grid grid_of(const MapOptions& o, const mdl::Model& m) {
   return g;
 }
 
-json vec_json(const kin::Vec3& v) { return json::array({v[0], v[1], v[2]}); }
-
-// Three decimals without a "-0.000".
-double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
-
 void run_map(const MapOptions& o) {
   const mdl::Model m = mdl::read(o.file);
   const kin::Method method = method_from_string(o.method);
@@ -368,7 +367,7 @@ void run_map(const MapOptions& o) {
   for (const auto& c : contributions)
     require_finite(std::array{c.max_norm_um, c.rms_um}, "the contribution of " + c.name);
   if (!o.report.empty())
-    write_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
+    write_report_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
   if (o.json) {
     json pts = json::array();
     for (std::size_t p = 0; p < map.size(); ++p)
@@ -388,10 +387,7 @@ void run_map(const MapOptions& o) {
     fmt::print("{}\n", json{{"schema", "caldaq.volumetric-map.v1"},
                             {"model", o.file},
                             {"method", method_name},
-                            {"grid",
-                             {{"min_mm", vec_json(g.min_mm)},
-                              {"max_mm", vec_json(g.max_mm)},
-                              {"count", {g.count[0], g.count[1], g.count[2]}}}},
+                            {"grid", grid_json(g)},
                             {"summary",
                              {{"max_norm_um", s.max_norm_um},
                               {"max_norm_at_mm", vec_json(s.max_norm_at_mm)},

@@ -18,6 +18,7 @@
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
 #include "model_cli.hpp"
+#include "output_file.hpp"
 #include "provenance.hpp"
 
 namespace daq {
@@ -462,7 +463,7 @@ void run(const Options& o) {
     }
     auto page = model_page_of(m, o.file, grid, kin::Method::htm);
     page.compensated = cal::daq::report::ModelPage::Compensated{w.what, after, w.notes};
-    write_page(o.report, cal::daq::report::model_page(page));
+    write_report_page(o.report, cal::daq::report::model_page(page));
   }
   if (o.json) {
     fmt::print("{}\n", json{{"schema", "caldaq.model-compensation.v1"},

@@ -10,6 +10,7 @@
 #include "cal/analysis/trt_kins.hpp"
 #include "command.hpp"
 #include "model_cli.hpp"
+#include "output_file.hpp"
 
 namespace daq {
 
@@ -37,9 +38,7 @@ void run(const Options& o) {
   for (const auto& n : pins.not_represented)
     fmt::print(stderr, "not represented by {} (left uncorrected): {}\n", pins.module, n);
   if (o.output.empty()) return fmt::print("{}", hal);
-  std::ofstream out(o.output, std::ios::binary);
-  if (!(out << hal) || !(out.close(), out))
-    throw cal::InputError(fmt::format("{}: cannot write the HAL file", o.output));
+  write_output_file(o.output, hal, "HAL file");
   fmt::print(stderr, "written {}\n", o.output);
 }
 

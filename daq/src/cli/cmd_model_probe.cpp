@@ -22,6 +22,7 @@
 #include "command.hpp"
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
+#include "output_file.hpp"
 
 namespace daq {
 
@@ -356,9 +357,7 @@ void run_probe_sim(const SimOptions& o) {
                         c[2]);
   }
   if (o.output.empty()) return fmt::print("{}", text);
-  std::ofstream out(o.output, std::ios::binary);
-  if (!(out << text) || !(out.close(), out))
-    throw cal::InputError(fmt::format("{}: cannot write the centres", o.output));
+  write_output_file(o.output, text, "centres");
   fmt::print(stderr, "{} probed centres written to {}\n", o.angles_deg.size(), o.output);
 }
 

@@ -191,9 +191,6 @@ std::vector<RotaryContribution> contributions(const mdl::Model& m, const std::ve
   return out;
 }
 
-json vec_json(const kin::Vec3& v) { return json::array({v[0], v[1], v[2]}); }
-double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
-
 json point_json(const mdl::Model& m, const PoseError& pe) {
   json angles = json::object();
   for (std::size_t i = 0; i < m.rotary.size(); ++i)
@@ -269,14 +266,12 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
                     {"max_norm_um", c.max_norm_um},
                     {"rms_um", c.rms_um},
                     {"max_rotation_urad", c.max_rotation_urad}});
+    json grid = grid_json(g);  // and the rotary axes' ranges
+    grid["rotary"] = std::move(ranges);
     fmt::print("{}\n", json{{"schema", "caldaq.five-axis-map.v1"},
                             {"model", q.file},
                             {"method", method_name},
-                            {"grid",
-                             {{"min_mm", vec_json(g.min_mm)},
-                              {"max_mm", vec_json(g.max_mm)},
-                              {"count", {g.count[0], g.count[1], g.count[2]}},
-                              {"rotary", ranges}}},
+                            {"grid", std::move(grid)},
                             {"summary",
                              {{"max_norm_um", norm(largest->e.translation_um)},
                               {"max_norm_at", point_json(m, *largest)},

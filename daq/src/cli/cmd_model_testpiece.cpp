@@ -29,9 +29,6 @@ struct Options {
   bool json = false;
 };
 
-// Three decimals without a "-0.000".
-double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
-
 // One row per result: name, quantity, predicted, measured (if any).
 struct Row {
   std::string feature, quantity;

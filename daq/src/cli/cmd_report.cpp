@@ -24,6 +24,7 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "output_file.hpp"
 #include "progress.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
@@ -173,11 +174,7 @@ std::size_t print_pdf_text(std::string_view html, const fs::path& pdf, const fs:
         fmt::format("{}: cannot make the directory to print in", page.parent_path().string()));
   const auto printed = dir.path() / "report.pdf";
   const auto output = dir.path() / "chromium.log";
-  {
-    std::ofstream out(page, std::ios::binary);
-    if (!(out << html) || !(out.close(), out))
-      throw cal::InputError(fmt::format("{}: cannot write the report to print", page.string()));
-  }
+  write_output_file(page, html, "report to print");
   const std::vector<std::string> args{
       browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
       "--print-to-pdf-no-header", "--user-data-dir=" + (dir.path() / "profile").string(),
@@ -202,9 +199,7 @@ std::size_t print_pdf_text(std::string_view html, const fs::path& pdf, const fs:
                                 : fmt::format("killed by signal {}", WTERMSIG(e.status)),
                     log.string()));
   }
-  std::ofstream out(pdf, std::ios::binary);
-  if (!(out << bytes) || !(out.close(), out))
-    throw cal::InputError(fmt::format("{}: cannot write the PDF", pdf.string()));
+  write_output_file(pdf, bytes, "PDF");
   return bytes.size();
 }
 
@@ -216,13 +211,6 @@ void print_pdf(const fs::path& html_file, const fs::path& pdf) {
 }
 
 namespace {
-
-void write_file(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) throw cal::InputError(fmt::format("{}: cannot write the report", path.string()));
-}
 
 void run_report_command(ReportOptions o) {
   if (o.format != "html" && o.format != "pdf")
@@ -289,7 +277,7 @@ void run_report_command(ReportOptions o) {
   const fs::path out = o.output.empty() ? fs::path(stem + "." + o.format) : named_output;
   std::uintmax_t streamed_bytes = html.size();  // what went to a stream, which has no size
   if (o.format == "html") {
-    write_file(out, html);
+    write_output_file(out, html, "report");
   } else {
     // Chromium's output, if it fails, beside the PDF; a stream (-o /dev/stdout, a pipe) has no
     // "beside", so in the temporary directory.

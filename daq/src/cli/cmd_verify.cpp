@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "compensation/compensation_check.hpp"
 #include "database.hpp"
+#include "output_file.hpp"
 #include "terminal.hpp"
 
 namespace daq {
@@ -82,9 +83,7 @@ void run(const VerifyOptions& o) {
   for (const auto& [name, text] : files) {
     const auto path =
         one ? std::filesystem::path(o.corrected) : std::filesystem::path(o.corrected) / name;
-    std::ofstream out(path, std::ios::binary);
-    if (!(out << text) || !(out.close(), out))
-      throw cal::InputError(fmt::format("{}: cannot write the corrected table", path.string()));
+    write_output_file(path, text, "corrected table");
     fmt::print(stderr, "written {}: the corrected table ({})\n", path.string(),
                check->compensation.format);
   }

@@ -2,6 +2,7 @@
 // What the `daq model` subcommands share (cmd_model*.cpp): reading the model and describing it.
 #include <CLI/CLI.hpp>
 #include <map>
+#include <nlohmann/json_fwd.hpp>
 #include <span>
 #include <string>
 #include <string_view>
@@ -22,8 +23,12 @@ std::vector<std::vector<std::string>> describe_components(const cal::daq::model:
 cal::daq::report::ModelPage model_page_of(const cal::daq::model::Model& m, const std::string& path,
                                           const cal::kinematics::Grid& g,
                                           cal::kinematics::Method method);
-// Writes an HTML page, saying where on stderr; InputError if it cannot.
-void write_page(const std::string& path, const std::string& html);
+// A point or a vector as JSON [x, y, z].
+nlohmann::json vec_json(const cal::kinematics::Vec3& v);
+// A map's grid as JSON: min_mm, max_mm, count (the maps' "grid").
+nlohmann::json grid_json(const cal::kinematics::Grid& g);
+// A value to print with three decimals, without a "-0.000".
+double shown(double v);
 
 // InputError "WHAT: not a finite number (...)" unless every value is finite: checked before
 // anything is printed, so that no map or prediction shows inf or nan.

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "json_input.hpp"
 
 namespace daq {
@@ -18,12 +19,7 @@ using nlohmann::json;
 namespace {
 
 std::string utc(std::int64_t unix_ms) {
-  const std::time_t t = unix_ms / 1000;
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
+  return cal::text::utc_text(unix_ms / 1000, "%Y-%m-%dT%H:%M:%SZ");
 }
 
 cal::kinematics::Vec3 vec(const json& j, const char* key) {
@@ -37,8 +33,7 @@ cal::kinematics::Vec3 vec(const json& j, const char* key) {
 
 StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine) {
   const auto m = store.machine_by_name(machine);
-  if (!m)
-    throw cal::InputError(fmt::format("no machine '{}' in {}", machine, store.name()));
+  if (!m) throw cal::InputError(fmt::format("no machine '{}' in {}", machine, store.name()));
   StoredProfiles out;
   auto runs = store.runs();
   std::sort(runs.begin(), runs.end(), [](const auto& a, const auto& b) { return a.id > b.id; });

@@ -12,6 +12,7 @@
 #include <ctime>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "report/markup.hpp"
 #include "report/plot.hpp"
 #include "result_rows.hpp"
@@ -240,12 +241,8 @@ footer { margin-top: 3rem; font-size: .8rem; color: #666; border-top: 1px solid 
 )";
 
 std::string now_utc() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
+  return cal::text::utc_text(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now()),
+                             "%Y-%m-%d %H:%M:%S UTC");
 }
 
 }  // namespace

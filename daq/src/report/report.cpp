@@ -14,6 +14,7 @@
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/squareness.hpp"
 #include "cal/analysis/straightness.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/analysis/uncertainty.hpp"
 #include "cal/daq/ballbar.hpp"
 #include "cal/drivers/instrument.hpp"
@@ -48,12 +49,7 @@ std::string um(double v) { return fixed(v, 3); }
 std::string unit_text(std::string_view u) { return ::daq::unit_html(u); }
 
 std::string iso_time(std::int64_t unix_ms) {
-  const std::time_t s = unix_ms / 1000;
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
+  return cal::text::utc_text(unix_ms / 1000, "%Y-%m-%d %H:%M:%S UTC");
 }
 
 // `align`: one letter per column, 'r' right-aligns (numbers), anything else left; columns
@@ -456,26 +452,24 @@ std::string environment_section(const Environment& env) {
     l.dashed = true;
     temps.push_back(std::move(l));
   }
-  h += figure(svg(XyChart{.title = "Temperatures",
-                          .x_label = "time (min)",
-                          .y_label = "temperature (°C)",
-                          .lines = temps,
-                          .height_pt = 240}),
-              "Air and material temperature during the run.");
+  // One plot of the run's time: all environment plots share the axis and the height.
+  const auto time_plot = [&](const char* title, const char* y_label, std::vector<Line> lines,
+                             const char* caption) {
+    h += figure(svg(XyChart{.title = title,
+                            .x_label = "time (min)",
+                            .y_label = y_label,
+                            .lines = std::move(lines),
+                            .height_pt = 240}),
+                caption);
+  };
+  time_plot("Temperatures", "temperature (°C)", std::move(temps),
+            "Air and material temperature during the run.");
   if (!env.pressure_hpa.empty())
-    h += figure(svg(XyChart{.title = "Air pressure",
-                            .x_label = "time (min)",
-                            .y_label = "pressure (hPa)",
-                            .lines = lines_of(env.pressure_hpa, 2),
-                            .height_pt = 240}),
-                "Air pressure during the run.");
+    time_plot("Air pressure", "pressure (hPa)", lines_of(env.pressure_hpa, 2),
+              "Air pressure during the run.");
   if (!env.humidity.empty())
-    h += figure(svg(XyChart{.title = "Relative humidity",
-                            .x_label = "time (min)",
-                            .y_label = "humidity (%RH)",
-                            .lines = lines_of(env.humidity, 5),
-                            .height_pt = 240}),
-                "Relative humidity during the run.");
+    time_plot("Relative humidity", "humidity (%RH)", lines_of(env.humidity, 5),
+              "Relative humidity during the run.");
   return h;
 }
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <ctime>
 
+#include "cal/analysis/text.hpp"
 #include "config_json.hpp"
 #include "json_input.hpp"
 
@@ -150,14 +151,9 @@ CompensationUsed compensation_used(const json& settings,
 }
 
 std::string utc_iso(std::int64_t unix_ms) {
-  const std::time_t s =
-      static_cast<std::time_t>(unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000);
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
-  return fmt::format("{}.{:03d}Z", buf,
-                     static_cast<int>(unix_ms - static_cast<std::int64_t>(s) * 1000));
+  const std::int64_t s = unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000;
+  return fmt::format("{}.{:03d}Z", cal::text::utc_text(s, "%Y-%m-%dT%H:%M:%S"),
+                     static_cast<int>(unix_ms - s * 1000));
 }
 
 json bar_calibration_json(const cal::storage::BarCalibration& c) {

@@ -9,6 +9,7 @@
 #include <ctime>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/daq/config_fields.hpp"
 #include "config_json.hpp"
 
@@ -241,12 +242,7 @@ cal::daq::Config config_from_json(const json& j) {
 std::string capture_header(const cal::daq::Config& c, const std::vector<InstrumentSpec>& specs,
                            const std::string& software) {
   json j{{"format", "caldaq.capture-header.v1"}, {"software", software}, {"config", to_json(c)}};
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  j["started_utc"] = buf;
+  j["started_utc"] = cal::text::utc_text(std::time(nullptr), "%Y-%m-%dT%H:%M:%SZ");
   j["instruments"] = json::array();
   for (const auto& s : specs) j["instruments"].push_back(to_json(s));
   return j.dump(1);

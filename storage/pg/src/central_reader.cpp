@@ -17,14 +17,29 @@ RunStatus status_from(std::string_view s) {
   return RunStatus::running;
 }
 
-std::optional<std::int64_t> optional_int(const pqxx::field& f) {
-  if (f.is_null()) return std::nullopt;
-  return f.as<std::int64_t>();
-}
-
 char direction_of(const pqxx::field& f) {
   const auto s = f.as<std::string>();
   return s.empty() ? '+' : s.front();
+}
+
+// A field into a record's member, as the SQLite store reads its rows (store_impl.hpp,
+// read_value): an optional is empty where the field is NULL; a char is a stop's direction.
+template <class T>
+void read_field(const pqxx::field& f, T& v) {
+  v = f.as<T>();
+}
+void read_field(const pqxx::field& f, char& v) { v = direction_of(f); }
+void read_field(const pqxx::field& f, RunStatus& v) { v = status_from(f.as<std::string>()); }
+template <class T>
+void read_field(const pqxx::field& f, std::optional<T>& v) {
+  v.reset();
+  if (!f.is_null()) v = f.as<T>();
+}
+// Reads the fields 0, 1, ... of `row` into `fields`, in order (the SQLite store's read_all).
+template <class... T>
+void read_row(const pqxx::row& row, T&... fields) {
+  pqxx::row::size_type i = 0;
+  (read_field(row[i++], fields), ...);
 }
 
 constexpr const char* kRunColumns =
@@ -34,29 +49,16 @@ constexpr const char* kRunColumns =
 
 RunRecord run_row(const pqxx::row& row) {
   RunRecord r;
-  r.id = row[0].as<std::int64_t>();
-  r.machine_id = row[1].as<std::int64_t>();
-  r.campaign = row[2].as<std::string>();
-  r.kind = row[3].as<std::string>();
-  r.axis = row[4].as<std::string>();
-  r.settings_json = row[5].as<std::string>();
-  r.capture_path = row[6].as<std::string>();
-  r.software_version = row[7].as<std::string>();
-  r.started_unix_ms = row[8].as<std::int64_t>();
-  r.ended_unix_ms = optional_int(row[9]);
-  r.status = status_from(row[10].as<std::string>());
-  r.note = row[11].as<std::string>();
-  r.origin_session_ns = optional_int(row[12]);
-  r.origin_unix_ns = optional_int(row[13]);
-  r.uuid = row[14].as<std::string>();
+  read_row(row, r.id, r.machine_id, r.campaign, r.kind, r.axis, r.settings_json, r.capture_path,
+           r.software_version, r.started_unix_ms, r.ended_unix_ms, r.status, r.note,
+           r.origin_session_ns, r.origin_unix_ns, r.uuid);
   return r;
 }
 
 MachineRecord machine_row(const pqxx::row& row) {
-  return {.id = row[0].as<std::int64_t>(),
-          .name = row[1].as<std::string>(),
-          .description = row[2].as<std::string>(),
-          .config_json = row[3].as<std::string>()};
+  MachineRecord m;
+  read_row(row, m.id, m.name, m.description, m.config_json);
+  return m;
 }
 
 constexpr const char* kCalibrationColumns =
@@ -64,17 +66,9 @@ constexpr const char* kCalibrationColumns =
     "zero_length_mm, temperature_degc, calibrated_unix_ms, note FROM caldaq.bar_calibrations";
 
 BarCalibration calibration_row(const pqxx::row& row) {
-  BarCalibration c{.id = row[0].as<std::int64_t>(),
-                   .bar = row[1].as<std::string>(),
-                   .nominal_mm = row[2].as<double>(),
-                   .extensions = row[3].as<std::string>(),
-                   .calibrator = row[4].as<std::string>(),
-                   .calibrator_length_mm = row[5].as<double>(),
-                   .reading_mm = row[6].as<double>(),
-                   .zero_length_mm = row[7].as<double>(),
-                   .calibrated_unix_ms = row[9].as<std::int64_t>(),
-                   .note = row[10].as<std::string>()};
-  if (!row[8].is_null()) c.temperature_degc = row[8].as<double>();
+  BarCalibration c;
+  read_row(row, c.id, c.bar, c.nominal_mm, c.extensions, c.calibrator, c.calibrator_length_mm,
+           c.reading_mm, c.zero_length_mm, c.temperature_degc, c.calibrated_unix_ms, c.note);
   return c;
 }
 
@@ -188,8 +182,8 @@ class CentralReader final : public RunReader {
   std::optional<MachineRecord> machine(std::int64_t id) const override {
     return one<MachineRecord>(
         fmt::format("read machine {}", id),
-        "SELECT id, name, description, config_json FROM caldaq.machines WHERE id = $1",
-        machine_row, id);
+        "SELECT id, name, description, config_json FROM caldaq.machines WHERE id = $1", machine_row,
+        id);
   }
 
   std::vector<RunRecord> runs() const override {
@@ -207,13 +201,10 @@ class CentralReader final : public RunReader {
         "caldaq.instruments AS i JOIN caldaq.runs AS r ON r.uuid = i.run_uuid WHERE r.id = $1 "
         "ORDER BY i.device",
         [&](const pqxx::row& row) {
-          return InstrumentRecord{.run_id = run_id,
-                                  .device = row[0].as<int>(),
-                                  .driver = row[1].as<std::string>(),
-                                  .transport = row[2].as<std::string>(),
-                                  .settings_json = row[3].as<std::string>(),
-                                  .origin = row[4].as<std::string>(),
-                                  .origin_detail = row[5].as<std::string>()};
+          InstrumentRecord i{.run_id = run_id};
+          read_row(row, i.device, i.driver, i.transport, i.settings_json, i.origin,
+                   i.origin_detail);
+          return i;
         },
         run_id);
   }
@@ -258,7 +249,8 @@ class CentralReader final : public RunReader {
           return SeriesInfo{static_cast<std::uint16_t>(row[0].as<int>()),
                             static_cast<std::uint8_t>(row[1].as<int>()),
                             static_cast<std::uint8_t>(row[2].as<int>()),
-                            row[3].as<std::int64_t>(), row[4].as<std::int64_t>(),
+                            row[3].as<std::int64_t>(),
+                            row[4].as<std::int64_t>(),
                             row[5].as<std::int64_t>()};
         },
         run_id);
@@ -272,16 +264,10 @@ class CentralReader final : public RunReader {
         "caldaq.captured_targets AS t JOIN caldaq.runs AS r ON r.uuid = t.run_uuid WHERE r.id = "
         "$1 ORDER BY t.time_ns, t.run_number, t.target_index",
         [&](const pqxx::row& row) {
-          return CapturedTarget{.run_id = run_id,
-                                .target_index = row[0].as<int>(),
-                                .run_number = row[1].as<int>(),
-                                .direction = direction_of(row[2]),
-                                .nominal_mm = row[3].as<double>(),
-                                .time_ns = row[4].as<std::int64_t>(),
-                                .raw_m = row[5].as<double>(),
-                                .deviation_um = row[6].as<double>(),
-                                .refractive_index = row[7].as<double>(),
-                                .material_temperature_degc = row[8].as<double>()};
+          CapturedTarget t{.run_id = run_id};
+          read_row(row, t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns, t.raw_m,
+                   t.deviation_um, t.refractive_index, t.material_temperature_degc);
+          return t;
         },
         run_id);
   }
@@ -293,13 +279,10 @@ class CentralReader final : public RunReader {
         "s.superseded_by FROM caldaq.results AS s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid "
         "WHERE r.id = $1 ORDER BY s.source_result_id",
         [&](const pqxx::row& row) {
-          return ResultRecord{.run_id = run_id,
-                              .standard = row[0].as<std::string>(),
-                              .json = row[1].as<std::string>(),
-                              .created_unix_ms = row[2].as<std::int64_t>(),
-                              .provenance_json = row[3].as<std::string>(),
-                              .id = row[4].as<std::int64_t>(),
-                              .superseded_by = optional_int(row[5])};
+          ResultRecord r{.run_id = run_id};
+          read_row(row, r.standard, r.json, r.created_unix_ms, r.provenance_json, r.id,
+                   r.superseded_by);
+          return r;
         },
         run_id);
   }
@@ -310,7 +293,9 @@ class CentralReader final : public RunReader {
         "SELECT quality_state, quality_summary FROM caldaq.runs WHERE id = $1 AND "
         "quality_state IS NOT NULL",
         [](const pqxx::row& row) {
-          return RunQuality{.state = row[0].as<std::string>(), .summary = row[1].as<std::string>()};
+          RunQuality q;
+          read_row(row, q.state, q.summary);
+          return q;
         },
         run_id);
     if (!head) return std::nullopt;
@@ -320,10 +305,9 @@ class CentralReader final : public RunReader {
         "SELECT s.run_number, s.direction, s.target_index, s.reason FROM caldaq.suspect_stops AS "
         "s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid WHERE r.id = $1 ORDER BY s.ordinal",
         [](const pqxx::row& row) {
-          return StopMark{.run_number = row[0].as<int>(),
-                          .direction = direction_of(row[1]),
-                          .target_index = row[2].as<int>(),
-                          .reason = row[3].as<std::string>()};
+          StopMark m;
+          read_row(row, m.run_number, m.direction, m.target_index, m.reason);
+          return m;
         },
         run_id);
     return q;
@@ -336,11 +320,9 @@ class CentralReader final : public RunReader {
         "AS m JOIN caldaq.runs AS r ON r.uuid = m.run_uuid WHERE r.id = $1 ORDER BY "
         "m.run_number, m.direction COLLATE \"C\", m.target_index",
         [&](const pqxx::row& row) {
-          return MissedStop{.run_id = run_id,
-                            .run_number = row[0].as<int>(),
-                            .direction = direction_of(row[1]),
-                            .target_index = row[2].as<int>(),
-                            .nominal_mm = row[3].as<double>()};
+          MissedStop m{.run_id = run_id};
+          read_row(row, m.run_number, m.direction, m.target_index, m.nominal_mm);
+          return m;
         },
         run_id);
   }
@@ -394,14 +376,10 @@ class CentralReader final : public RunReader {
         "r.uuid = c.source_run_uuid WHERE ($1 = 0 OR c.machine_id = $1) AND ($2 = '' OR c.axis "
         "= $2) ORDER BY c.created_unix_ms, c.id",
         [](const pqxx::row& row) {
-          return CompensationRecord{.id = row[0].as<std::int64_t>(),
-                                    .machine_id = row[1].as<std::int64_t>(),
-                                    .source_run_id = row[2].as<std::int64_t>(),
-                                    .source = row[3].as<std::string>(),
-                                    .axis = row[4].as<std::string>(),
-                                    .format = row[5].as<std::string>(),
-                                    .created_unix_ms = row[6].as<std::int64_t>(),
-                                    .json = row[7].as<std::string>()};
+          CompensationRecord c;
+          read_row(row, c.id, c.machine_id, c.source_run_id, c.source, c.axis, c.format,
+                   c.created_unix_ms, c.json);
+          return c;
         },
         machine_id, std::string(axis));
   }

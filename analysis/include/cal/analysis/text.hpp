@@ -8,6 +8,7 @@
 //   (or a title bar, or the clipboard through OSC 52); terminal_safe() is applied to every
 //   stored or foreign string a command prints as text.
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -33,5 +34,9 @@ std::string windows1252_to_utf8(std::string_view s);
 // \xNN or \u{NNNN}, and the backslash as \\ so that an escape cannot be forged; printable
 // text (any script) unchanged.
 std::string terminal_safe(std::string_view s);
+
+// A Unix time in whole seconds as UTC text by a strftime(3) format, e.g. "%Y-%m-%dT%H:%M:%SZ"
+// (at most 31 characters of text).
+std::string utc_text(std::int64_t unix_s, const char* strftime_format);
 
 }  // namespace cal::text
