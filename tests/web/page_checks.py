@@ -57,6 +57,23 @@ def post(url, body):
         return e.code, json.load(e)
 
 
+def get_json(url):
+    """The JSON a GET of URL answers (30 s at most)."""
+    with urllib.request.urlopen(url, timeout=30) as r:
+        return json.load(r)
+
+
+def waiter(b, tmp, explain, timeout_s):
+    """A wait(script, what, timeout_s) on browser B that, on a time-out, says what the page showed
+    (the script EXPLAIN) and the end of the service's log in TMP."""
+    def wait(script, what, timeout_s=timeout_s):
+        try:
+            return b.wait(script, timeout_s=timeout_s, what=what, explain=explain)
+        except AssertionError as e:
+            raise AssertionError(f"{e}\n--- serve.log:\n{log_tail(tmp)}") from None
+    return wait
+
+
 def start_simulated_service(daq, tmp, db):
     """Starts `daq serve --simulate` at 20x on a free port with its log in tmp; returns the
     process and the page's URL once the service prints it (or fails with the log)."""
