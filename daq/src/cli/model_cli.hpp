@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "model/model_file.hpp"
+#include "model/model_map.hpp"
 #include "report/model_report.hpp"
 
 namespace daq {
@@ -25,9 +26,8 @@ cal::daq::report::ModelPage model_page_of(const cal::daq::model::Model& m, const
 // Writes an HTML page, saying where on stderr; InputError if it cannot.
 void write_page(const std::string& path, const std::string& html);
 
-// InputError "WHAT: not a finite number (...)" unless every value is finite: checked before
-// anything is printed, so that no map or prediction shows inf or nan.
-void require_finite(std::span<const double> values, std::string_view what);
+// Every value finite, or InputError (model_map.hpp).
+using cal::daq::model::require_finite;
 
 // Where the model's measurements came from, from its provenance ("origin", written by `daq
 // model build` and `daq sim --truth-out`): "SIMULATED", "REPLAYED", "IMPORTED", "MIXED", ...;

@@ -47,6 +47,7 @@
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
+#include "serve/model_view.hpp"
 #include "serve/setup_form.hpp"
 #include "serve/volumetric_checklist.hpp"
 #include "sim_shop.hpp"
@@ -310,6 +311,7 @@ class Service {
     get("/api/detected", &Service::detected);
     get("/api/machines", &Service::machines);
     get("/api/volumetric", &Service::volumetric);
+    get("/api/model", &Service::model);
     get("/api/runs/", &Service::run_doc);
     get("/reports/", &Service::report);
     post("/api/setup/check", &Service::setup_check);
@@ -641,6 +643,13 @@ class Service {
     const auto db = read_store();
     return ok(volumetric_checklist(db ? &*db : nullptr, config_.machine_name,
                                    database_path(o_.run.db).string()));
+  }
+
+  // GET /api/model: the set-up's machine's model built from the store as `daq model build`
+  // builds it (missing errors allowed and listed) and its map (model_view.hpp); nothing written.
+  web::Response model(std::string_view) {
+    const auto db = read_store();
+    return ok(model_view(db ? &*db : nullptr, config_.machine_name));
   }
 
   // --- stored runs and reports -----------------------------------------------------------
