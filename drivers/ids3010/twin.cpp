@@ -193,6 +193,11 @@ IdsTwin::IdsTwin(std::shared_ptr<Impl> impl) : TcpTwin(impl), impl_(std::move(im
 void IdsTwin::set_beam_lost(int axis, bool lost) {
   impl_->beam_lost.at(static_cast<std::size_t>(axis)) = lost;
 }
+void IdsTwin::set_optics(const std::array<int, 3>& machine_axis,
+                         const std::array<std::optional<Vec3>, 3>& reflector_mm) {
+  impl_->config.machine_axis = machine_axis;
+  impl_->config.reflector_mm = reflector_mm;
+}
 std::uint64_t IdsTwin::requests_served() const { return impl_->served; }
 
 }  // namespace cal::drivers::sim

@@ -40,6 +40,10 @@ class IdsTwin final : public TcpTwin {
   // Simulates a blocked beam on one axis: its displacement requests answer with an error
   // code (the twin's stand-in for the device's signal-lost warning) until restored.
   void set_beam_lost(int axis, bool lost);
+  // The optics set up for another test (the operator moved them between tests): which machine
+  // axis each interferometer axis measures and where its reflector sits (IdsTwinConfig).
+  void set_optics(const std::array<int, 3>& machine_axis,
+                  const std::array<std::optional<Vec3>, 3>& reflector_mm);
   // Drops every client connection (as a power cycle or a pulled cable would).
   void drop_connections() { unplug(); }
   std::uint64_t requests_served() const;

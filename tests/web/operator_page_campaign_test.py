@@ -2,14 +2,17 @@
 """The 21-error volumetric campaign on the operator's page (issue 29), driven in headless Chromium:
 
 a short campaign on the simulated shop (`daq sim --measure` and `daq run linear`, as
-docs/volumetric-walkthrough.md measures it): positioning E_XX and the two straightness runs of
-the XY plane (E_YX, E_XY, read against one square), the first of them dated a day earlier (a
-campaign over two days); then `daq serve -c` on that store. The Results view lists the 18
+docs/volumetric-walkthrough.md measures it): positioning E_XX, the two straightness runs of
+the XY plane (E_YX, E_XY, read against one square) and positioning E_ZZ (every axis has a run:
+the model's travel is known), the first of them dated a day earlier (a campaign over two days); then `daq serve -c` on that store. The Results view lists the 18
 component tests and the three squarenesses, each with its test and instrument; the measured
 ones with the run `daq model build` uses for them (its --json `used`, the CLI's own code), their
 day and where the other axes stood; the XY squareness measured from its two runs; the others
-"to do"; the days; and the commands that build the model and its map. Screenshots at
-1366 x 768 and 560 px.
+"to do"; the days; and the commands that build the model and its map. Under it the model itself
+(GET /api/model): built by `daq model build`'s own function (the same runs used and errors
+missing as `daq model build --allow-missing --json`), the 21 errors with what each adds to the
+map and its summary as `daq model map --json` gives them, and the map's XY slice drawn.
+Screenshots at 1366 x 768 and 560 px.
 
 Waits: each simulated run about 15 s on a loaded 2-core machine; the page's load up to 60 s.
 Usage: operator_page_campaign_test.py DAQ_BINARY SHOT_DIR
@@ -54,7 +57,7 @@ def measure(component):
         sim.wait(timeout=120)
 
 
-for component in ("E_XX", "E_YX", "E_XY"):
+for component in ("E_XX", "E_YX", "E_XY", "E_ZZ"):
     measure(component)
 con = sqlite3.connect(DB)
 con.execute("UPDATE runs SET started_unix_ms = started_unix_ms - 86400000, ended_unix_ms = ended_unix_ms - 86400000 WHERE id = 1")
@@ -72,8 +75,8 @@ try:
     b.js("document.getElementById('tab-results').click();")
     head = b.wait("const h = document.getElementById('vol-head').textContent; return /Volumetric/.test(h) && h;",
                   timeout_s=60, what="the campaign's checklist")
-    ok(head == f"Volumetric campaign of {MACHINE}: 4 of 21 errors measured",
-       f"3 component tests and the XY squareness of 21: {head!r}")
+    ok(head == f"Volumetric campaign of {MACHINE}: 5 of 21 errors measured",
+       f"4 component tests and the XY squareness of 21: {head!r}")
     rows = b.js("return Object.fromEntries([...document.querySelectorAll('#vol-table tbody tr')].map(r => "
                 "[r.dataset.component, [...r.cells].map(c => c.textContent)]));")
     ok(len(rows) == 21, f"a row for each of the 18 components and 3 squarenesses: {len(rows)}")
@@ -94,13 +97,47 @@ try:
        f"the XY squareness from its two straightness runs: {rows['E_C0Y']}")
     ok(rows["E_B0Z"][4] == "to do", "the ZX squareness still to do")
     text = b.js("return document.getElementById('vol-box').textContent;")
-    ok(f"{days[0]}: 1 measured: E_XX" in text and f"{days[1]}: 2 measured: E_YX, E_XY" in text,
+    ok(f"{days[0]}: 1 measured: E_XX" in text and f"{days[1]}: 3 measured: E_YX, E_XY, E_ZZ" in text,
        "the campaign's progress by day")
-    ok(f"17 still to measure: then build the model with `daq model build --machine '{MACHINE}' --db '{DB}' -o model.json`"
+    ok(f"16 still to measure: then build the model with `daq model build --machine '{MACHINE}' --db '{DB}' -o model.json`"
        in text and "daq model map model.json" in text, "the commands that build the model and its map")
     b.js("document.getElementById('vol-panel').scrollIntoView();")
     page_checks.shot(b, SHOTS, "c01-campaign-1366x768.png")
     page_checks.fits_narrow(b, SHOTS, "c02-campaign-560.png", "the checklist fits 560 px (its table scrolls)")
+
+    # --- the model of these runs and its map, as the CLI builds and maps it ----------------
+    model = page_checks.get_json(url + "api/model")
+    ok(model["schema"] == "caldaq.model-view.v1" and model["state"] == "partial" and model["machine"] == MACHINE,
+       f"GET /api/model: a partial model of {MACHINE}: {model['state']!r}")
+    ok(model["build"]["used"] == cli["used"] and model["build"]["missing"] == cli["missing"] and
+       model["build"]["origin"] == cli["origin"] == "SIMULATED",
+       f"the runs used and the errors missing are `daq model build`'s: {model['build']['used']} vs {cli['used']}")
+    cmap = json.loads(subprocess.run([DAQ, "model", "map", os.path.join(TMP, "model.json"), "--json"],
+                                     capture_output=True, text=True, check=True).stdout)
+    ok(model["map"] is not None and model["map"]["grid"] == cmap["grid"] and
+       abs(model["map"]["summary"]["max_norm_um"] - cmap["summary"]["max_norm_um"]) < 1e-9 and
+       model["map"]["summary"]["max_norm_um"] > 1,
+       f"the map's summary is `daq model map --json`'s: {model['map'] and model['map']['summary']} vs {cmap['summary']}")
+    want = {c["error"]: f"{c['max_norm_um']:.2f}" for c in cmap["contributions"]}
+    shown = b.wait("const r = [...document.querySelectorAll('#model-table tbody tr')]; return r.length === 21 && "
+                   "Object.fromEntries(r.map(x => [x.dataset.error, [...x.cells].map(c => c.textContent)]));",
+                   timeout_s=60, what="the model's 21 errors on the page")
+    ok(all(shown[e][3] == want[e] for e in want) and len(want) == 21,
+       f"each error's contribution as `daq model map` ranks it: E_XX {shown['E_XX']} vs {want['E_XX']}")
+    ok(shown["E_XX"][1] == ", ".join(map(str, cli["used"]["E_XX"])) and shown["E_XX"][2] == "measured" and
+       shown["E_BX"][1] == "—" and shown["E_BX"][2] == "not measured: zero",
+       f"measured errors with their runs, the others said to be zero: {shown['E_XX']} {shown['E_BX']}")
+    state = b.js("return document.getElementById('model-state').textContent;")
+    ok(state == f"Partial model: {len(cli['missing'])} of 21 errors not measured yet, taken as zero "
+       "(as `daq model build --allow-missing`).", f"the page says the model is partial: {state!r}")
+    painted = b.wait("const c = document.getElementById('model-map'); if (c.hidden) return false; "
+                     "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; "
+                     "for (let i = 0; i < d.length; i += 4) if (d[i + 2] > 200 && d[i] < 120) n++; return n;",
+                     timeout_s=30, what="the model's map drawn")
+    ok(painted > 200, f"the map's error arrows are drawn ({painted} blue pixels)")
+    b.js("document.getElementById('model-box').scrollIntoView();")
+    page_checks.shot(b, SHOTS, "c03-model-1366x768.png")
+    page_checks.fits_narrow(b, SHOTS, "c04-model-560.png", "the model's table and map fit 560 px")
     ok(not b.js("return window.__errors || null;"), "no script error")
     print(f"{page_checks.passes} checks passed")
 finally:

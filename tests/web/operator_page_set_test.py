@@ -7,7 +7,10 @@
 2. Start: the page says what to do now (mount the bar, run the program; then leave it mounted
    while the program moves it onto the next plane) and what comes next, test k of 3;
 3. each test done shows its stored run, G and verdict (the same G as /api/runs/N);
-4. at the end the three-plane table, the same numbers `daq ballbar volumetric --runs` prints
+4. before the feed-in the big number is dashes and "waiting" (the bar's reading then is no circle
+   deviation); the simulated machine's squareness is measured in every plane; a circle's Results
+   say nothing of target stops;
+5. at the end the three-plane table, the same numbers `daq ballbar volumetric --runs` prints
    (the CLI's code), on the Run view and in the Results (opened by itself), at 1366 x 768 and
    560 px; updates per second and bytes per update measured during the set.
 
@@ -20,7 +23,6 @@ import subprocess
 import sys
 import tempfile
 import time
-import urllib.request
 
 sys.path.insert(0, os.path.dirname(__file__))
 import page_checks  # noqa: E402
@@ -34,9 +36,7 @@ DB = os.path.join(TMP, "runs.sqlite")
 WAIT_S = 60
 
 
-def get(url):
-    with urllib.request.urlopen(url, timeout=30) as r:
-        return json.load(r)
+get = page_checks.get_json
 
 
 def shot(b, name):
@@ -46,13 +46,9 @@ def shot(b, name):
 serve, url = page_checks.start_simulated_service(DAQ, TMP, DB)
 b = Browser(1366, 768)
 try:
-    def wait(script, what, timeout_s=WAIT_S):
-        try:
-            return b.wait(script, timeout_s=timeout_s, what=what, explain=(
-                "return JSON.stringify({status: window.caldaq.page && window.caldaq.page.status, "
-                "next: (document.getElementById('set-next') || {}).textContent, errors: window.__errors}).slice(0, 3000);"))
-        except AssertionError as e:
-            raise AssertionError(f"{e}\n--- serve.log:\n{page_checks.log_tail(TMP)}") from None
+    wait = page_checks.waiter(b, TMP, (
+        "return JSON.stringify({status: window.caldaq.page && window.caldaq.page.status, "
+        "next: (document.getElementById('set-next') || {}).textContent, errors: window.__errors}).slice(0, 3000);"), WAIT_S)
 
     b.get(url)
     wait("return window.caldaq.page && window.caldaq.page.status.start.circle.ready;", "Start ballbar ready")
@@ -81,6 +77,15 @@ try:
     post(url + "api/simulation/speed", {"speed": 1})  # the wait for test 1's feed-in is seen
     b.js("document.getElementById('start-circle').click();")
     first = wait("const s = window.caldaq.page.status; return s.running && s.set && s.set.tests[0].run;", "the set to start")
+    # While the run waits for the feed-in the bar streams, but its reading is no deviation from
+    # the circle (it showed "49999.97 µm"): dashes and what the run waits for, read in the same
+    # script as the live state the page drew them from.
+    waiting = wait("const r = window.caldaq.page.run; if (!(r && r.schema === 'caldaq.live-circle.v1' && "
+                   "r.state === 'waiting' && r.samples > 0)) return false; return [r.deviation_um, "
+                   "document.getElementById('reading').textContent, document.getElementById('reading-unit').textContent, "
+                   "document.getElementById('reading-label').textContent];", "the bar streaming before the feed-in")
+    ok(waiting[0] is None and waiting[1] == "—" and waiting[2] == "" and "waiting for the feed-in" in waiting[3],
+       f"before the feed-in: no deviation in the status, dashes and 'waiting' on the page: {waiting}")
     NEXT = "const n = document.getElementById('set-next'); return !n.hidden"
     text = wait(NEXT + " && /set: test 1 of 3/.test(n.textContent) && n.textContent;", "test 1's instruction")
     ok("Ballbar set: test 1 of 3: XY 360°, 3000 mm/min, R 100.0 mm" in text and
@@ -122,6 +127,14 @@ try:
         want = f"{p['squareness_um_per_m']:+.1f}"
         ok(r[3] == want and r[1] == str(p["runs"][0]),
            f"{p['plane']}: squareness {r[3]} µm/m as `daq ballbar volumetric` ({want}), from run {r[1]}")
+        # The simulated shop has squareness in every plane (`daq sim --test circle-set`'s truth:
+        # 20, 15 and 10 µm/m in size), so each plane's diagnostic is a real one, not a square 0.
+        ok(abs(p["squareness_um_per_m"]) >= 5,
+           f"{p['plane']}: the simulated machine's squareness is measured ({want} µm/m), not ~0")
+    # A ballbar test has no target stops: nothing is said of checking them ("Stops not checked:
+    # not checked: one run in one direction" was a linear test's notion, its state said twice).
+    quality = b.js("return document.getElementById('result-quality').textContent;")
+    ok("not checked" not in quality and "Stops" not in quality, f"no stop check on a circle's Results: {quality!r}")
     # The polar plot of the test shown (the last), from its stored readings, bounded in size.
     trace = get(url + f"api/runs/{runs[2]}")["trace"]
     n_ccw, n_cw, size = len(trace["ccw"]), len(trace["cw"]), len(json.dumps(trace))

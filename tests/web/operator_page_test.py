@@ -140,8 +140,9 @@ try:
         src = b.js("return document.getElementById('env-source').textContent;")
         ok(src.endswith(" air (ptu300)"), f"idle: the air values' source is named: {src!r}")
         states = b.js("return [...document.querySelectorAll('#devices li')].map(l => l.dataset.state);")
-        ok(states.count("streaming") == 3 and "open" in states,
-           f"idle: laser, air, material streaming, the ballbar's port open: {states}")
+        # The shop's indicator and level (the component tests' probes) stream too.
+        ok(states.count("streaming") == 5 and "open" in states,
+           f"idle: laser, air, material, indicator, level streaming, the ballbar's port open: {states}")
         ok(b.js("return document.getElementById('reading').textContent;") == "—",
            "idle: no run, no number")
         no_raw_keys(b, "idle")
@@ -171,8 +172,8 @@ try:
         set_field(b, "test.linear.feed_mm_per_min", "6000")
         wait_valid(b)
         # The whole form, instruments included (generated from the drivers' settings).
-        ok(b.js("return document.querySelectorAll('.device-card').length;") == 4,
-           "the instrument form has the four configured devices")
+        ok(b.js("return document.querySelectorAll('.device-card').length;") == 6,
+           "the instrument form has the six configured devices (the indicator and the level too)")
         # Each card's fields are the common keys and its driver's option table, as the drivers'
         # registry gives them (`daq devices --options --json`, run here as the reference).
         table = json.loads(subprocess.run([DAQ, "devices", "--options", "--json"],

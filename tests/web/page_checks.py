@@ -5,6 +5,8 @@ import os
 import re
 import signal
 import subprocess
+import sys
+import tempfile
 import time
 import urllib.error
 import urllib.request
@@ -55,6 +57,38 @@ def post(url, body):
             return r.status, json.load(r)
     except urllib.error.HTTPError as e:
         return e.code, json.load(e)
+
+
+def test_dirs(prefix):
+    """The test's arguments (DAQ_BINARY SHOT_DIR, the folder made) and a new temporary folder
+    named PREFIX... with the path of a run database in it: (daq, shots, tmp, db)."""
+    daq, shots = os.path.abspath(sys.argv[1]), sys.argv[2]
+    os.makedirs(shots, exist_ok=True)
+    tmp = tempfile.mkdtemp(prefix=prefix)
+    return daq, shots, tmp, os.path.join(tmp, "runs.sqlite")
+
+
+def no_script_error(b):
+    """The last check of a page test: the page raised no script error; the count of checks."""
+    ok(not b.js("return window.__errors || null;"), "no script error")
+    print(f"{passes} checks passed")
+
+
+def get_json(url):
+    """The JSON a GET of URL answers (30 s at most)."""
+    with urllib.request.urlopen(url, timeout=30) as r:
+        return json.load(r)
+
+
+def waiter(b, tmp, explain, timeout_s):
+    """A wait(script, what, timeout_s) on browser B that, on a time-out, says what the page showed
+    (the script EXPLAIN) and the end of the service's log in TMP."""
+    def wait(script, what, timeout_s=timeout_s):
+        try:
+            return b.wait(script, timeout_s=timeout_s, what=what, explain=explain)
+        except AssertionError as e:
+            raise AssertionError(f"{e}\n--- serve.log:\n{log_tail(tmp)}") from None
+    return wait
 
 
 def start_simulated_service(daq, tmp, db):

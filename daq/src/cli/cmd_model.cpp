@@ -144,14 +144,6 @@ cal::daq::report::ModelPage model_page_of(const mdl::Model& m, const std::string
   return page;
 }
 
-void require_finite(std::span<const double> values, std::string_view what) {
-  for (double v : values)
-    if (!std::isfinite(v))
-      throw cal::InputError(fmt::format(
-          "{}: {} is not a finite number (the model's values or coefficients overflow here)", what,
-          v));
-}
-
 namespace {
 
 // An origin's label as it may be printed into a controller file: capitals, commas and spaces.
@@ -359,44 +351,16 @@ void run_map(const MapOptions& o) {
     return;
   }
   const kin::Grid g = grid_of(o, m);
-  const auto map = kin::volumetric_error_map(m.machine, g, method);
-  const auto s = kin::summarize(map);
-  const auto contributions = kin::contributions(m.machine, g);
-  require_finite(map.errors_um, "the volumetric error over the grid");
-  require_finite(map.rotations_urad, "the rotation over the grid");
-  for (const auto& c : contributions)
-    require_finite(std::array{c.max_norm_um, c.rms_um}, "the contribution of " + c.name);
+  const auto mapped = mdl::model_map(m, g, method);
+  const auto& s = mapped.summary;
+  const auto& contributions = mapped.contributions;
   if (!o.report.empty())
     write_report_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
   if (o.json) {
-    json pts = json::array();
-    for (std::size_t p = 0; p < map.size(); ++p)
-      pts.push_back(
-          {{"position_mm", json::array({map.positions_mm[3 * p], map.positions_mm[3 * p + 1],
-                                        map.positions_mm[3 * p + 2]})},
-           {"error_um", json::array({map.errors_um[3 * p], map.errors_um[3 * p + 1],
-                                     map.errors_um[3 * p + 2]})},
-           {"rotation_urad", json::array({map.rotations_urad[3 * p], map.rotations_urad[3 * p + 1],
-                                          map.rotations_urad[3 * p + 2]})}});
-    json cs = json::array();
-    for (const auto& c : contributions)
-      cs.push_back({{"error", c.name},
-                    {"axis", kAxis[c.axis]},
-                    {"max_norm_um", c.max_norm_um},
-                    {"rms_um", c.rms_um}});
-    fmt::print("{}\n", json{{"schema", "caldaq.volumetric-map.v1"},
-                            {"model", o.file},
-                            {"method", method_name},
-                            {"grid", grid_json(g)},
-                            {"summary",
-                             {{"max_norm_um", s.max_norm_um},
-                              {"max_norm_at_mm", vec_json(s.max_norm_at_mm)},
-                              {"min_um", vec_json(s.min_um)},
-                              {"max_um", vec_json(s.max_um)},
-                              {"range_um", vec_json(s.range_um)}}},
-                            {"contributions", cs},
-                            {"points", pts}}
-                           .dump(2));
+    auto j =
+        json{{"schema", "caldaq.volumetric-map.v1"}, {"model", o.file}, {"method", method_name}};
+    j.update(mdl::model_map_json(mapped, true));
+    fmt::print("{}\n", j.dump(2));
     return;
   }
   fmt::print(

@@ -3,19 +3,15 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
-#include <map>
 #include <nlohmann/json.hpp>
-#include <set>
 
-#include "cal/analysis/error.hpp"
 #include "command.hpp"
 #include "database.hpp"
 #include "model/model_build.hpp"
 #include "model/model_file.hpp"
 #include "model_cli.hpp"
-#include "provenance.hpp"
+#include "model_from_runs.hpp"
 #include "run_quality.hpp"
-#include "stored_model.hpp"
 
 namespace daq {
 
@@ -24,41 +20,6 @@ namespace mdl = cal::daq::model;
 using nlohmann::json;
 
 namespace {
-
-// Where the runs of a model came from (provenance.hpp): "" when every run was measured on real
-// instruments, the label when all share one ("SIMULATED"), else "MIXED"; and each error whose
-// run was not real, with its run's label. Stored in the model's provenance, so that the model,
-// its map and its compensation say it whatever the machine is called.
-struct ModelOrigin {
-  std::string label;
-  std::map<std::string, std::string> errors;  // E_XX -> "SIMULATED"
-  std::size_t real = 0, other = 0;
-};
-
-ModelOrigin model_origin(const cal::storage::RunReader& store,
-                         const std::vector<std::pair<std::string, std::vector<std::int64_t>>>& used,
-                         const std::string& machine) {
-  ModelOrigin o;
-  std::map<std::int64_t, std::string> of_run;
-  std::set<std::string> labels;
-  for (const auto& [name, ids] : used) {
-    std::string error_label;
-    for (const auto id : ids) {
-      if (!of_run.count(id)) {
-        const auto run = store.run(id);
-        of_run[id] = run ? run_origin(*run, store.instruments(id), machine).label() : "";
-      }
-      if (!of_run[id].empty()) error_label = of_run[id];
-    }
-    labels.insert(error_label);
-    if (error_label.empty())
-      ++o.real;
-    else
-      ++o.other, o.errors[name] = error_label;
-  }
-  if (o.other > 0) o.label = labels.size() == 1 ? *labels.begin() : "MIXED";
-  return o;
-}
 
 struct BuildCliOptions {
   std::string machine, db, output;
@@ -71,52 +32,20 @@ struct BuildCliOptions {
 void run_build(const BuildCliOptions& o) {
   const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
   const auto& store = *reader;
-  const auto stored = stored_profiles(store, o.machine);
-  std::vector<std::int64_t> used_runs;
-  for (const auto& p : stored.profiles) used_runs.push_back(p.run_id);
-  const auto accepted = refuse_suspect_runs(store, used_runs, o.accept_suspect, "daq model build");
-  mdl::BuildOptions b{.machine = o.machine, .allow_missing = o.allow_missing};
-  if (!o.topology.empty())
-    b.topology = kin::topology_from_string(o.topology);
-  else if (stored.topology)
-    b.topology = *stored.topology;
-  else
-    throw cal::InputError(fmt::format(
-        "machine '{}': its runs do not say the kinematic chain ([machine] topology in the "
-        "configuration): give --topology",
-        o.machine));
-  b.tool_offset_mm = stored.tool_offset_mm;
-  b.table_offset_mm = stored.table_offset_mm;
+  ModelFromRunsOptions options{
+      .machine = o.machine, .accept_suspect = o.accept_suspect, .allow_missing = o.allow_missing};
+  if (!o.topology.empty()) options.topology = kin::topology_from_string(o.topology);
   if (!o.tool_offset_mm.empty())
-    b.tool_offset_mm = {o.tool_offset_mm[0], o.tool_offset_mm[1], o.tool_offset_mm[2]};
-  auto r = mdl::build(stored.profiles, b);
-  const auto origin = model_origin(store, r.used, o.machine);
-  {
-    auto prov = json::parse(r.model.provenance.json);
-    // the model says it was built from suspect runs, knowingly
-    if (!accepted.empty()) prov["accepted_suspect_runs"] = accepted;
-    if (!origin.label.empty()) prov["origin"] = origin.label, prov["origins"] = origin.errors;
-    r.model.provenance.json = prov.dump();
-  }
+    options.tool_offset_mm =
+        kin::Vec3{o.tool_offset_mm[0], o.tool_offset_mm[1], o.tool_offset_mm[2]};
+  const auto built = model_from_runs(store, options);
+  const auto& r = built.report;
+  const auto& stored = built.stored;
+  const auto& accepted = built.accepted;
+  const auto& origin = built.origin;
   mdl::write(r.model, o.output);
-  if (o.json) {
-    json used = json::object();
-    for (const auto& [name, ids] : r.used) used[name] = ids;
-    fmt::print("{}\n", json{{"schema", "caldaq.model-build.v1"},
-                            {"machine", o.machine},
-                            {"topology", kin::to_string(b.topology)},
-                            {"file", o.output},
-                            {"used", used},
-                            {"missing", r.missing},
-                            {"skipped", stored.skipped},
-                            {"accepted_suspect_runs", accepted},
-                            {"origin", origin.label},
-                            {"origins", origin.errors},
-                            {"notes", r.notes}}
-                           .dump(2));
-    return;
-  }
-  fmt::print("Model of '{}' ({}) written to {}\n", o.machine, describe_topology(b.topology),
+  if (o.json) return fmt::print("{}\n", model_build_json(built, o.machine, o.output).dump(2));
+  fmt::print("Model of '{}' ({}) written to {}\n", o.machine, describe_topology(built.topology),
              o.output);
   fmt::print("From the latest complete run of each component:\n");
   for (const auto& [name, ids] : r.used)

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "model/model_file.hpp"
+#include "model/model_map.hpp"
 #include "report/model_report.hpp"
 
 namespace daq {
@@ -30,9 +31,8 @@ nlohmann::json grid_json(const cal::kinematics::Grid& g);
 // A value to print with three decimals, without a "-0.000".
 double shown(double v);
 
-// InputError "WHAT: not a finite number (...)" unless every value is finite: checked before
-// anything is printed, so that no map or prediction shows inf or nan.
-void require_finite(std::span<const double> values, std::string_view what);
+// Every value finite, or InputError (model_map.hpp).
+using cal::daq::model::require_finite;
 
 // Where the model's measurements came from, from its provenance ("origin", written by `daq
 // model build` and `daq sim --truth-out`): "SIMULATED", "REPLAYED", "IMPORTED", "MIXED", ...;

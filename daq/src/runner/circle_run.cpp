@@ -261,12 +261,15 @@ std::string to_json_text(const CircleLive& s) {
     return a;
   };
   // Before the bar's first sample there is no deviation: null, never a 0 that looks measured.
+  // Nor before the feed-in: the bar's reading is then no deviation from the circle (a set's
+  // bar moving onto its next plane, the bar being fed in).
+  const bool deviation = s.samples > 0 && s.state != "waiting";
   return json{{"schema", "caldaq.live-circle.v1"},
               {"time_s", s.time_s},
               {"state", s.state},
               {"phase", s.phase},
               {"angle_deg", s.angle_deg},
-              {"deviation_um", s.samples ? json(s.deviation_um) : json(nullptr)},
+              {"deviation_um", deviation ? json(s.deviation_um) : json(nullptr)},
               {"fraction", s.fraction},
               {"samples", s.samples},
               {"trace", {{"ccw", trace(s.ccw)}, {"cw", trace(s.cw)}}}}

@@ -37,7 +37,9 @@ json common_option(std::string_view key) {
     o.help = "tcp HOST:PORT | serial DEVICE BAUD FRAME [FLOW] | hid VID:PID | hid /dev/hidrawN";
   } else if (key == "role") {
     o.type = OptionType::choice;
-    o.choices = {"laser", "air", "material", "ballbar", "position"};
+    // Every role the configuration loader knows: a straightness test reads an indicator, a
+    // roll test a level (a card without them lost the role and the test its probe).
+    o.choices = {"laser", "air", "material", "ballbar", "position", "indicator", "level"};
     o.help = "what a run uses it for";
   } else if (key == "poll_s") {
     o.type = OptionType::number;

@@ -36,6 +36,7 @@
 #include "database.hpp"
 #include "devices_list.hpp"
 #include "json_input.hpp"
+#include "kinds/kind.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
 #include "provenance.hpp"
@@ -47,6 +48,7 @@
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
+#include "serve/model_view.hpp"
 #include "serve/setup_form.hpp"
 #include "serve/volumetric_checklist.hpp"
 #include "sim_shop.hpp"
@@ -160,6 +162,19 @@ std::vector<std::pair<std::string, std::string>> devices_of(const cal::daq::Conf
   return out;
 }
 
+// The linear test kinds the set-up's instruments can measure (kinds/kind.hpp): positioning and
+// angular with a laser (an angular test's beams are checked at Start against the laser's axes),
+// straightness with an indicator, roll with a level.
+std::vector<std::string> linear_kinds(const cal::daq::Config& c) {
+  std::vector<std::string> out;
+  const bool laser = c.device_for("laser") != nullptr;
+  if (laser) out.push_back("positioning");
+  if (laser && c.device_for("indicator")) out.push_back("straightness");
+  if (laser) out.push_back("angular");
+  if (laser && c.device_for("level")) out.push_back("roll");
+  return out;
+}
+
 // "run-12.html" -> 12 with the extension; nullopt for anything else.
 std::optional<std::pair<std::int64_t, std::string>> report_name(std::string_view name) {
   if (!name.starts_with("run-")) return std::nullopt;
@@ -207,7 +222,10 @@ class Service {
       // (cal/drivers/loop_time.hpp), paced at `speed` times the wall clock for the person
       // watching; the page's own timers stay on the wall clock.
       cal::drivers::VirtualTime::install(io_).pace(o_.speed);
-      shop_ = std::make_unique<SimulatedShop>(io_, ShopTruth{}, o_.speed);
+      // The truth of `daq sim --test circle-set` (squareness in XY, ZX and YZ; X's linear
+      // errors as the default shop's): a ballbar set on the page shows real diagnostics in
+      // every plane, not the default shop's square vertical planes.
+      shop_ = std::make_unique<SimulatedShop>(io_, ShopTruth::three_planes(), o_.speed);
       o_.run.clock = shop_->clock_ns();
       o_.run.poll_scale = 1.0;  // the instruments' timers wait in simulated time
       const auto text = simulated_shop_config(*shop_, {.speed = o_.speed, .in_process = true});
@@ -307,6 +325,7 @@ class Service {
     get("/api/detected", &Service::detected);
     get("/api/machines", &Service::machines);
     get("/api/volumetric", &Service::volumetric);
+    get("/api/model", &Service::model);
     get("/api/runs/", &Service::run_doc);
     get("/reports/", &Service::report);
     post("/api/setup/check", &Service::setup_check);
@@ -351,7 +370,7 @@ class Service {
     const auto instruments_of = [&](std::string_view test) {
       json ids = json::array();
       for (const auto& d : c.devices)
-        if (uses(test, d)) ids.push_back(d.id);
+        if (uses(c, test, d)) ids.push_back(d.id);
       return ids;
     };
     if (c.linear) {
@@ -400,7 +419,7 @@ class Service {
                                                                      : 0;
     std::uint16_t n = 0;
     for (const auto& dc : config_.devices) {
-      if (!only_of_test.empty() && !uses(only_of_test, dc)) {
+      if (!only_of_test.empty() && !uses(config_, only_of_test, dc)) {
         ++n;
         continue;
       }
@@ -424,17 +443,22 @@ class Service {
     }
   }
 
-  // The devices a test's run opens itself: the ballbar for a circle, the rest for a linear run.
-  static bool uses(std::string_view test, const cal::daq::DeviceConfig& dc) {
-    return test == "circle" ? dc.role == "ballbar"
-                            : (dc.role == "laser" || dc.role == "air" || dc.role == "material" ||
-                               dc.role == "position");
+  // The devices a test's run opens itself: the ballbar for a circle; for a linear run the laser,
+  // air, material, position feed and the probe its kind reads (an indicator's idle monitor left
+  // open made a straightness run's own open of it "busy").
+  static bool uses(const cal::daq::Config& c, std::string_view test,
+                   const cal::daq::DeviceConfig& dc) {
+    if (test == "circle") return dc.role == "ballbar";
+    if (dc.role == "laser" || dc.role == "air" || dc.role == "material" || dc.role == "position")
+      return true;
+    return c.linear && !dc.role.empty() &&
+           dc.role == kinds::kind(c.linear->measure.kind).probe_role();
   }
 
   // Closes the idle monitors of the devices the run opens; the others stay watched.
   void stop_monitors_of(std::string_view test) {
     for (const auto& dc : config_.devices)
-      if (uses(test, dc)) monitors_.erase(dc.id);
+      if (uses(config_, test, dc)) monitors_.erase(dc.id);
   }
 
   web::Response setup_get(std::string_view) {
@@ -456,6 +480,8 @@ class Service {
                  {"cycles", {"linear", "pendulum", "pilgrim-step"}},
                  {"equations", {"ciddor", "edlen", "shop-floor"}},
                  {"axes", {"X", "Y", "Z"}},
+                 {"kinds", linear_kinds(config_)},
+                 {"directions", {"X", "Y", "Z", "A", "B", "C"}},
                  {"planes", {"XY", "YZ", "ZX"}}}}});
   }
 
@@ -638,6 +664,13 @@ class Service {
     const auto db = read_store();
     return ok(volumetric_checklist(db ? &*db : nullptr, config_.machine_name,
                                    database_path(o_.run.db).string()));
+  }
+
+  // GET /api/model: the set-up's machine's model built from the store as `daq model build`
+  // builds it (missing errors allowed and listed) and its map (model_view.hpp); nothing written.
+  web::Response model(std::string_view) {
+    const auto db = read_store();
+    return ok(model_view(db ? &*db : nullptr, config_.machine_name));
   }
 
   // --- stored runs and reports -----------------------------------------------------------
@@ -825,12 +858,10 @@ class Service {
     return j;
   }
 
-  // What the simulated shop cannot do: its laser measures X, its bar is 100 mm long.
+  // What the simulated shop cannot do: its bar is 100 mm long. (A linear test of any kind and
+  // axis: the shop is set up for it at Start, SimulatedShop::set_test.)
   std::optional<std::string> simulation_limits(std::string_view test) const {
-    if (!shop_) return std::nullopt;
-    if (test == "linear" && config_.linear && config_.linear->axis != "X")
-      return "the simulated laser measures the X axis: set the linear test's axis to X";
-    if (test != "circle" || !config_.circle) return std::nullopt;
+    if (!shop_ || test != "circle" || !config_.circle) return std::nullopt;
     // One circle: in XY only (the shop's single-test program); a set: any planes, over the
     // sphere about the table ball as `daq sim --test circle-set` runs it.
     const auto tests = circle_tests(config_);
@@ -1011,6 +1042,9 @@ class Service {
     const auto path = capture_path();
     capture_ = std::make_unique<SessionCapture>(path, config_, specs);
     watch_capture();
+    // The simulated instruments set up for this test (its axis, optics, probe and the other
+    // axes' positions), as the operator sets up the real ones before Start.
+    if (shop_) shop_->set_test(*config_.linear);
     LinearRunSetup setup;
     setup.config = config_;
     setup.database = database_path(o_.run.db);

@@ -243,8 +243,14 @@ void SimulatedShop::set_compensation(
   impl_->world.machine().set_compensation(std::move(f));
 }
 
+void SimulatedShop::set_test(const cal::daq::LinearTestConfig& test) {
+  impl_->test = test;
+  const auto optics = Impl::laser(test);
+  impl_->ids.set_optics(optics.machine_axis, optics.reflector_mm);
+}
+
 std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
-                                        bool serial_numbers) const {
+                                        bool serial_numbers, bool every_probe) const {
   // Serial numbers as a real set-up has them for its report (daq serve --simulate).
   const auto serial = [&](std::string_view number) {
     return serial_numbers ? fmt::format("serial_number = \"{}\"\n", number) : std::string{};
@@ -271,12 +277,12 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
         "{5}role = \"{0}\"\npoll_s = {6}\norigin = \"simulated\"\n\n",
         role, "", 14 - role.size(), what, path, unit_and_range, 4 * laser_poll_s);
   };
-  if (m.kind == "straightness")
+  if (m.kind == "straightness" || every_probe)
     probe = gauge("indicator", "straightness indicator against a straightedge",
                   impl_->indicator.device_path(), "unit = \"mm\"\nmin_si = -0.01\nmax_si = 0.01\n");
-  if (m.kind == "roll")
-    probe = gauge("level", "electronic level against a reference level", impl_->level.device_path(),
-                  "unit = \"urad\"\n");
+  if (m.kind == "roll" || every_probe)
+    probe += gauge("level", "electronic level against a reference level",
+                   impl_->level.device_path(), "unit = \"urad\"\n");
   return fmt::format(
       R"TOML([devices.laser]
 driver = "ids3010"
@@ -516,8 +522,10 @@ backlash_X = 3
                       fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
                       // In process the instruments read the shop's clock: every time is
                       // simulated time; the poll periods of the drivers' defaults too.
+                      // In process (daq serve) both probes: its tests may be of any kind.
                       fmt::arg("devices", shop.devices_toml(0.05 * wall, o.position_feed,
-                                                            /*serial_numbers=*/true)),
+                                                            /*serial_numbers=*/true,
+                                                            /*every_probe=*/o.in_process)),
                       fmt::arg("alpha", t.expansion_ppm_per_k),
                       fmt::arg("last_mm", 50 * (o.targets - 1)), fmt::arg("runs", o.runs),
                       // Simulated seconds: at a high speed the wall-clock timers' jitter is

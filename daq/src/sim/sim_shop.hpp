@@ -109,11 +109,18 @@ class SimulatedShop {
   // The controller's compensation (um added to the command), e.g. from a model: see
   // cal::drivers::sim::MachineConfig::compensation_um. Set before a program is loaded.
   void set_compensation(std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> f);
+  // The shop set up for another linear test (the constructor's `test`): the laser's optics on
+  // its axis and at its probe offset (an angular test's two beams), the indicator and the level
+  // read at its probe, the other axes at its stationary positions. `daq serve --simulate` sets
+  // it at each linear Start, as the operator sets up the instruments for that test.
+  void set_test(const cal::daq::LinearTestConfig& test);
   // The [devices.*] tables (TOML, docs/config.md) of the shop's twins: laser, air, material,
   // ballbar and, with position_feed, the SHDR position feed. `daq sim` writes them; the demo
   // reads them, so the twins the shop starts are named here only.
-  std::string devices_toml(double laser_poll_s, bool position_feed,
-                           bool serial_numbers = false) const;
+  // every_probe: both probes (the indicator and the level) whatever the shop's test, for a
+  // service that runs any test kind (`daq serve --simulate`).
+  std::string devices_toml(double laser_poll_s, bool position_feed, bool serial_numbers = false,
+                           bool every_probe = false) const;
 
   // A linear run's laser, air station and (o.material) material thermometer on this shop's
   // twins, each under its role's device number, polled on the shop's clock (the air and the
