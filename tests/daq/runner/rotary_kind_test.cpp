@@ -161,7 +161,9 @@ TEST(RotaryKind, AnyRepresentativeOfTheTurn) {
     EXPECT_NEAR(a[i]["mean"].get<double>(), b[i]["mean"].get<double>(), 1e-6);
 }
 
-TEST(RotaryKind, RefusesALinearAxisAndIsNotYetAcquiredByTheRunner) {
+// A linear axis is refused; a rotary axis is acquired, its stops recognised from its angular
+// reference (tests/e2e/rotary_e2e_test.cpp), not from a laser.
+TEST(RotaryKind, RefusesALinearAxisAndRecognisesStopsFromItsReference) {
   auto l = rotary_test();
   l.axis = "X";
   try {
@@ -170,13 +172,9 @@ TEST(RotaryKind, RefusesALinearAxisAndIsNotYetAcquiredByTheRunner) {
   } catch (const cal::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("rotary axis (A, B, C)"), std::string::npos) << e.what();
   }
-  try {
-    daq::kinds::kind("rotary").validate(rotary_test());
-    FAIL() << "the runner cannot acquire it yet: it must say so";
-  } catch (const cal::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("does not acquire a rotary axis yet"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_NO_THROW(daq::kinds::kind("rotary").validate(rotary_test()));
+  EXPECT_TRUE(daq::kinds::kind("rotary").stops_from_probe());
+  EXPECT_FALSE(daq::kinds::kind("roll").stops_from_probe());
   EXPECT_THROW(daq::kinds::kind("rotary").evaluate({}, rotary_test()), cal::InputError);
 }
 
