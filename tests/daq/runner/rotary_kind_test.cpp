@@ -15,6 +15,7 @@
 #include "cal/analysis/error.hpp"
 #include "kinds/kind.hpp"
 #include "linear_run.hpp"
+#include "sim_shop.hpp"
 
 namespace {
 
@@ -36,15 +37,10 @@ double injected_arcsec(double target_deg) {
          kCyclicArcsec * std::sin(2 * kPi * target_deg / 90.0);
 }
 
+// The simulated shop's rotary test (sim_shop.hpp) every 30 deg: 13 targets.
 cal::daq::LinearTestConfig rotary_test() {
-  cal::daq::LinearTestConfig l;
-  l.axis = "C";
-  l.measure.kind = "rotary";
-  l.first_mm = 0.0;  // deg
-  l.last_mm = 360.0;
-  l.interval_mm = 30.0;
-  l.runs = 5;
-  l.overrun_mm = 3.0;  // deg: the approach to 0 comes from -3 deg = 357 deg on the reference
+  auto l = daq::simulated_rotary_test(5);
+  l.interval_mm = 30.0;  // deg; overrun 3 deg: the approach to 0 comes from 357 deg
   return l;
 }
 
