@@ -206,10 +206,12 @@ struct SimulatedShop::Impl {
                .measure_on_answer = t.probe_measures_on_answer,
                .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}),
         angle(ctx, world, clock,
-              {.continuous = false,
-               .request = "?",
-               .decimals = 3,  // arcsec: 0.001" digits
-               .value = [this](const sim::World& w) { return reference_arcsec(w); }}) {}
+              polled(3, [this](const sim::World& w) { return reference_arcsec(w); })) {}
+
+  // A twin answering "?" with value(world) to `decimals` digits (arcsec: 0.001" digits).
+  static sim::GaugeTwinConfig polled(int decimals, std::function<double(const sim::World&)> value) {
+    return {.continuous = false, .request = "?", .decimals = decimals, .value = std::move(value)};
+  }
 
   // The angular reference's reading: the axis's angle with its scale error, zeroed
   // zero_arcsec off, modulo a turn as an indexer's readout gives it.
