@@ -90,4 +90,26 @@ check no_zero 2 "no centre of the [AC] axis at 0 deg" -- "$DAQ" model probe-chec
 printf 'loadrt xyzac-trt-kins\n' >"$TMP/bad.hal"
 check bad_hal 2 "bad.hal:1: 'loadrt': expected setp" -- "$DAQ" model probe-check "$TMP/centres1.csv" --model "$NOM" --hal "$TMP/bad.hal"
 check kins_refused 2 "rotary: LinuxCNC's trunnion kinematics .* \[C table, A table\]" -- "$DAQ" model kinematics "$TMP/x0c.json"
+# The angular positioning of a rotary axis acquired end to end (ISO 230-2, kind rotary): `daq sim
+# --test rotary --acquire` runs `daq run linear` on the configuration it writes, in one process
+# on simulated time: the SIMULATED C axis (injected: 10" over the turn, 4" three times a turn, 6"
+# of backlash, the reference zeroed -3" off; ShopTruth::Rotary) read by its angular reference
+# through the gauge driver (arcsec lines, modulo a turn), no laser. Then the capture replayed:
+# the same stops, the same evaluation, bit for bit.
+"$DAQ" sim --test rotary --runs 2 --acquire --json -o "$TMP/rot.toml" --db "$TMP/rot.sqlite" --capture "$TMP/rot.cdq" >"$TMP/rot.json" 2>"$TMP/rot.log"
+check rot_acquired 0 "^complete rotary E_CC caldaq\.rotary\.v1 9$" -- python3 -c "import json; d=json.load(open('$TMP/rot.json')); print(d['status'], d['kind'], d['component'], d['schema'], len(d['targets']))"
+check rot_config 0 'role = "angle"' -- cat "$TMP/rot.toml"
+# B within 0.45" of the 6" injected (the stops' settling tail: tests/e2e/rotary_e2e_test.cpp);
+# the 360 deg target's mean within 0.3" of -3 + 10 = 7".
+check rot_backlash 0 "^ok$" -- python3 -c "
+import json; d=json.load(open('$TMP/rot.json'))
+b=abs(d['axis']['B']['value']); m=d['targets'][-1]['mean']
+print('ok' if abs(b-6)<0.45 and abs(m-7)<0.3 else 'B %g, 360 deg %g' % (b, m))"
+"$DAQ" replay "$TMP/rot.cdq" --db "$TMP/rot.sqlite" --json >"$TMP/rot-replay.json" 2>"$TMP/rot-replay.log"
+check rot_replay_same 0 "^same$" -- python3 -c "
+import json; a=json.load(open('$TMP/rot.json')); b=json.load(open('$TMP/rot-replay.json'))
+print('same' if (a['targets'], a['axis']) == (b['targets'], b['axis']) and b['run_id'] == a['run_id'] + 1 else 'differ: %s' % b)"
+check rot_replay_text 0 "ISO 230-2:2014 E_CC \(targets in deg, deviations in arcsec\)" -- "$DAQ" replay "$TMP/rot.cdq" --db "$TMP/rot.sqlite"
+check rot_show 0 "rotary" -- "$DAQ" runs --db "$TMP/rot.sqlite"
+
 finish

@@ -18,6 +18,7 @@
 #include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
+#include "kinds/kind.hpp"
 #include "linear_run.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
@@ -164,20 +165,20 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
     resolve_calibration(analysis, s.config, program.radius_mm, store,
                         std::chrono::duration_cast<std::chrono::milliseconds>(now).count());
   }
-  CircleRunSetup setup{.config = s.config,
-                       .program = program,
-                       .analysis = analysis,
-                       .database = database_path(o.db),
-                       .ballbar = s.instrument(*it),
-                       .capture_path = std::filesystem::absolute(o.capture).string(),
-                       .software_version = s.software(),
-                       .context_json = s.original_context,
-                       .replay = true,
-                       .replay_of_run = s.original_run,
-                       .origins = {{"ballbar", origin_of(it->origin, std::filesystem::absolute(
-                                                                         o.capture)
-                                                                         .string())}},
-                       .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
+  CircleRunSetup setup{
+      .config = s.config,
+      .program = program,
+      .analysis = analysis,
+      .database = database_path(o.db),
+      .ballbar = s.instrument(*it),
+      .capture_path = std::filesystem::absolute(o.capture).string(),
+      .software_version = s.software(),
+      .context_json = s.original_context,
+      .replay = true,
+      .replay_of_run = s.original_run,
+      .origins = {{"ballbar",
+                   origin_of(it->origin, std::filesystem::absolute(o.capture).string())}},
+      .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
   CircleRun run(s.io, std::move(setup));
   const auto end = s.play(run, o.capture, "the capture ended before both arcs were recorded");
   const auto& out = run.outcome();
@@ -212,18 +213,20 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
   setup.context_json = s.original_context;
   setup.replay = true;
   setup.replay_of_run = s.original_run;
+  // The run's instruments as recorded, its kind's own instrument (indicator, level, angle) too.
+  const auto& kind = kinds::kind(s.config.linear->measure.kind);
   for (const auto& spec : s.specs)
     if (spec.role == "laser" || spec.role == "air" || spec.role == "material" ||
-        spec.role == "position")
+        spec.role == "position" || (!kind.probe_role().empty() && spec.role == kind.probe_role()))
       place_linear_instrument(spec, s.instrument(spec), setup);
-  if (!setup.laser || !setup.air)
+  if ((!setup.laser && !kind.stops_from_probe()) || !setup.air)
     throw cal::InputError(
         fmt::format("{}: the session has no laser or no air instrument", o.capture));
   LinearRun run(s.io, std::move(setup));
   const auto end = s.play(run, o.capture, "the capture ended before every stop was captured");
   const auto& out = run.outcome();
   if (o.json) {
-    json j = to_json(*out.evaluation);
+    json j = out.profile ? *out.profile : to_json(*out.evaluation);
     j["run_id"] = out.run_id;
     j["status"] = cal::storage::to_string(out.status);
     j["capture_damage"] = damage_json(end);
@@ -232,7 +235,10 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
     fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, out.run_id, out.readings);
     if (!out.missed.empty())
       fmt::print("INCOMPLETE: {} (daq show {} lists them)\n\n", out.reason, out.run_id);
-    print(*out.evaluation);
+    if (out.profile)
+      print_kind_result(*out.profile, out.component);
+    else
+      print(*out.evaluation);
   }
   report_damage(end, o, out.run_id);
 }

@@ -24,11 +24,11 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
-#include "progress.hpp"
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
+#include "progress.hpp"
 #include "provenance.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
@@ -117,8 +117,7 @@ struct ProgressOut {
         tty(!as_json && ::isatty(::fileno(out)) != 0) {}
   void event(const std::string& e) {
     if (json)
-      fmt::print(out, "{}\n",
-                 nlohmann::json{{"schema", "caldaq.event.v1"}, {"message", e}}.dump());
+      fmt::print(out, "{}\n", nlohmann::json{{"schema", "caldaq.event.v1"}, {"message", e}}.dump());
     else
       fmt::print(out, "{}  {}\n", tty ? "\r\033[K" : "", e);
     std::fflush(out);
@@ -149,8 +148,8 @@ std::string live_line(const LiveState& s) {
   const auto& p = s.progress;
   std::string line =
       fmt::format("run {} of {} {}  target {} of {}  stop {} of {}", p.run, p.runs,
-                  p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target,
-                  p.targets, std::min(s.stop_number, s.stop_count), s.stop_count);
+                  p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target, p.targets,
+                  std::min(s.stop_number, s.stop_count), s.stop_count);
   if (!s.has_reading) return line + "  waiting for the laser's first reading";
   if (!s.valid)
     line += "  laser signal lost";
@@ -175,7 +174,7 @@ Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
   return circle_verdict(run_context(c, "circle", plane)["tolerances"], result);
 }
 
-// The result of a straightness, angular or roll run (kinds/kind.hpp): its profile.
+// The result of a straightness, angular, roll or rotary run (kinds/kind.hpp).
 void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
   auto j = *out.profile;
   j["run_id"] = out.run_id;
@@ -183,17 +182,7 @@ void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
   if (json) return fmt::print("{}\n", j.dump(2));
   fmt::print("{}\nrun {} stored ({}): {} readings\n\n", tty ? "\r\033[K" : "", out.run_id,
              cal::storage::to_string(out.status), out.readings);
-  const std::string unit = j.value("unit", "");
-  fmt::print("{} {} (mean of the stops at each target, {})\n", j.value("kind", ""), out.component,
-             unit);
-  for (const auto& t : j["targets"])
-    fmt::print("  {:10.3f} mm  {:+10.3f}  (spread {:.3f}, {} stops)\n",
-               t["position_mm"].get<double>(), t["mean"].get<double>(), t["spread"].get<double>(),
-               t["count"].get<int>());
-  fmt::print("range {:.3f} {}\n", j["range"].get<double>(), unit);
-  if (j.contains("straightness_um"))
-    fmt::print("straightness {:.3f} um about the least-squares line (slope {:+.3f} um/m)\n",
-               j["straightness_um"].get<double>(), j["slope_um_per_m"].get<double>());
+  print_kind_result(j, out.component);
 }
 
 }  // namespace

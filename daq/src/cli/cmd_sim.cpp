@@ -143,10 +143,13 @@ void run_sim(SimOptions o) {
                       o.topology, o.truth_out);
   }
   if (!o.measure.empty()) o.test = "linear";  // a component's test is a linear one
-  if (o.test != "linear" && o.test != "circle" && o.test != "circle-set")
+  if (o.test != "linear" && o.test != "circle" && o.test != "circle-set" && o.test != "rotary")
     throw cal::InputError(
-        fmt::format("--test '{}' (expected linear, circle or circle-set)", o.test));
+        fmt::format("--test '{}' (expected linear, circle, circle-set or rotary)", o.test));
   const bool set = o.test == "circle-set";  // the standard set on the three-plane machine
+  const bool rotary = o.test == "rotary";   // a C axis read by its angular reference
+  if (rotary && (!o.measure.empty() || o.position_feed))
+    throw cal::InputError("--test rotary: without --measure or --position-feed");
   std::optional<cal::daq::LinearTestConfig> volumetric;
   ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
   if (!o.measure.empty()) {
@@ -166,7 +169,9 @@ void run_sim(SimOptions o) {
   // --acquire: the shop, the instruments and the run on one simulated time line that jumps
   // from event to event (cal/drivers/loop_time.hpp), as in daq demo.
   if (o.acquire) cal::drivers::VirtualTime::install(io);
-  SimulatedShop shop(io, truth, o.speed, volumetric.value_or(cal::daq::LinearTestConfig{}));
+  SimulatedShop shop(
+      io, truth, o.speed,
+      rotary ? simulated_rotary_test(o.runs) : volumetric.value_or(cal::daq::LinearTestConfig{}));
   if (!o.compensate.empty()) {
     // The control applies the model's full volumetric correction (cal::volcomp::correction_um,
     // what `daq model compensate -f isg-volumetric` writes for a controller), with each
@@ -203,6 +208,7 @@ void run_sim(SimOptions o) {
                                                 .runs = o.runs,
                                                 .targets = o.targets,
                                                 .circle_set = set,
+                                                .rotary = rotary,
                                                 .circle_feed_mm_per_min = o.feed_mm_per_min});
   {
     std::ofstream out(o.config_out);
@@ -231,7 +237,7 @@ void run_sim(SimOptions o) {
   if (o.acquire) {
     // `daq run TEST --config FILE` in this process: the same configuration, instruments, run,
     // output and capture.
-    const std::string test = o.test == "linear" ? "linear" : "circle";
+    const std::string test = o.test == "linear" || rotary ? "linear" : "circle";
     std::FILE* out = o.json ? stderr : stdout;  // stdout carries only the JSON then
     fmt::print(out,
                "daq sim: SIMULATED shop on simulated time in this process; acquiring as `daq run "
@@ -269,7 +275,7 @@ void run_sim(SimOptions o) {
         o.speed, o.config_out, o.test, o.config_out, *o.start_after_s);
     std::fflush(stdout);
     run_until(shop.now_s() + *o.start_after_s * o.speed);
-    return run_program(set ? "circle" : o.test);
+    return run_program(set ? "circle" : rotary ? "linear" : o.test);
   }
   // As an operator would: the program is started once the acquisition waits for it (a run has
   // begun in the database), and it is the program of that run's test.
@@ -310,9 +316,10 @@ void add_sim_command(CLI::App& app) {
       app, "sim", run_sim,
       "Run the built-in SIMULATED machine and instruments for `daq run` in another process");
   cmd->add_option("--test", o->test,
-                  "linear, circle or circle-set (the ballbar set on a machine with errors in all "
-                  "three planes): the program run after --start-after-s (waiting for runs, the "
-                  "run's own test is run)")
+                  "linear, circle, circle-set (the ballbar set on a machine with errors in all "
+                  "three planes) or rotary (a C axis's angular positioning, read by a SIMULATED "
+                  "angular reference): the program run after --start-after-s (waiting for runs, "
+                  "the run's own test is run)")
       ->capture_default_str();
   cmd->add_option("-o,--config-out", o->config_out, "Where to write the devices' configuration")
       ->capture_default_str();

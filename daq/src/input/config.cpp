@@ -322,7 +322,7 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   t.read("role", d.role);
   if (!d.role.empty())
     one_of(t, "role", d.role,
-           {"laser", "air", "material", "ballbar", "position", "indicator", "level"});
+           {"laser", "air", "material", "ballbar", "position", "indicator", "level", "angle"});
   t.read("origin", d.origin);
   one_of(t, "origin", d.origin, {"real", "simulated"});
   t.name("serial_number", d.serial_number);

@@ -145,6 +145,44 @@ void print(const cal::unc::Budget& b, double length_m) {
   for (const auto& w : b.warnings) fmt::print("warning: {}\n", w);
 }
 
+namespace {
+
+// A rotary axis's evaluation: its values, then each target's means, reversal and spread.
+void print_rotary(const nlohmann::json& j) {
+  fmt::print("{} {} (targets in deg, deviations in arcsec)\n", j.value("title", ""),
+             j.value("component", ""));
+  for (const auto& [key, a] : j["axis"].items())
+    fmt::print("  {:<6} {:>10.3f}\"  {}\n", key, a["value"].get<double>(),
+               a.value("description", ""));
+  fmt::print("\n{:>10} {:>10} {:>10} {:>10} {:>10}   (arcsec)\n", "target/deg", "mean up",
+             "mean down", "mean", "reversal");
+  const auto cell = [](const nlohmann::json& v) {
+    return v.is_number() ? fmt::format("{:+.3f}", v.get<double>()) : std::string("-");
+  };
+  for (const auto& t : j["targets"])
+    fmt::print("{:>10.3f} {:>10} {:>10} {:>10} {:>10}\n", t["position_deg"].get<double>(),
+               cell(t["mean_up"]), cell(t["mean_down"]), cell(t["mean"]), cell(t["reversal"]));
+  for (const auto& w : j.value("warnings", nlohmann::json::array()))
+    fmt::print("warning: {}\n", w.get<std::string>());
+}
+
+}  // namespace
+
+void print_kind_result(const nlohmann::json& j, const std::string& component) {
+  if (j.value("schema", "") == "caldaq.rotary.v1") return print_rotary(j);
+  const std::string unit = j.value("unit", "");
+  fmt::print("{} {} (mean of the stops at each target, {})\n", j.value("kind", ""), component,
+             unit);
+  for (const auto& t : j["targets"])
+    fmt::print("  {:10.3f} mm  {:+10.3f}  (spread {:.3f}, {} stops)\n",
+               t["position_mm"].get<double>(), t["mean"].get<double>(), t["spread"].get<double>(),
+               t["count"].get<int>());
+  fmt::print("range {:.3f} {}\n", j["range"].get<double>(), unit);
+  if (j.contains("straightness_um"))
+    fmt::print("straightness {:.3f} um about the least-squares line (slope {:+.3f} um/m)\n",
+               j["straightness_um"].get<double>(), j["slope_um_per_m"].get<double>());
+}
+
 std::vector<cal::iso230_2::Measurement> measurements(
     const std::vector<cal::storage::CapturedTarget>& targets) {
   std::vector<cal::iso230_2::Measurement> out;

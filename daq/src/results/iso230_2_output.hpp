@@ -17,6 +17,10 @@ void print(const cal::iso230_2::Evaluation& e);
 std::string runs_text(const cal::iso230_2::Evaluation& e);
 std::string runs_text(const nlohmann::json& evaluation);  // from a caldaq.iso230-2.v1 document
 void print(const cal::unc::Budget& b, double length_m);
+// The result of a test kind other than positioning (daq/src/runner/kinds): a profile
+// (caldaq.profile.v1: straightness, angular, roll) or a rotary axis's ISO 230-2 evaluation
+// (caldaq.rotary.v1, targets in deg and deviations in arcsec), as text.
+void print_kind_result(const nlohmann::json& j, const std::string& component);
 // The stored captured stops of a run as the deviations ISO 230-2 evaluates.
 std::vector<cal::iso230_2::Measurement> measurements(
     const std::vector<cal::storage::CapturedTarget>& targets);

@@ -9,6 +9,7 @@
 #include <deque>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
@@ -231,7 +232,11 @@ struct LinearRun::Impl : Runner {
     if (!kind.probe_role().empty() && !setup.probe)
       throw cal::InputError(fmt::format("a {} test needs a device with role = \"{}\"", kind.name(),
                                         kind.probe_role()));
-    if (setup.position)
+    if (!setup.laser && !kind.stops_from_probe())
+      throw cal::InputError(
+          fmt::format("a {} test needs a device with role = \"laser\"", kind.name()));
+    // A kind whose stops come from its own instrument (rotary) watches no feed of the linear axes.
+    if (setup.position && !kind.stops_from_probe())
       position_trigger.emplace(
           cal::daq::PositionTriggerSettings{.tolerance_um = setup.config.trigger.tolerance_um,
                                             .dwell_s = setup.config.trigger.dwell_s,
@@ -286,7 +291,7 @@ struct LinearRun::Impl : Runner {
     running = true;
     live.state = "waiting";
     expect_next();
-    start_instrument(*setup.laser, devices.device(Role::laser));
+    if (setup.laser) start_instrument(*setup.laser, devices.device(Role::laser));
     start_instrument(*setup.air, devices.device(Role::air));
     for (std::size_t k = 0; k < setup.material.size(); ++k)
       start_instrument(*setup.material[k], devices.device(Role::material, k));
@@ -396,6 +401,30 @@ struct LinearRun::Impl : Runner {
       samples.push_back(s);
       while (samples.size() > 1'000'000) samples.pop_front();  // bounded, whatever the rate
       resolve_pending(s);
+      if (source == kinds::Source::probe && kind.stops_from_probe() && !done)
+        on_reference(r.time_ns, *v / kArcsecPerDeg);
+    }
+  }
+
+  static constexpr double kArcsecPerDeg = 3600.0;
+
+  // A reading of the angular reference of a kind whose stops it gives (rotary): its continuous
+  // angle in degrees is the position the trigger and the sequencer watch, as the laser's length
+  // in mm is for a linear axis (the trigger's tolerance_um reads as millidegrees, window_mm as
+  // degrees). Not compensated for air or material, an angle is not a length: the air's
+  // staleness does not stop it (the air is recorded only).
+  void on_reference(std::int64_t time_ns, double angle_deg) {
+    live.time_s = static_cast<double>(time_ns - first_ns) * 1e-9;
+    live.position_mm = angle_deg;
+    if (const auto next = sequencer.next_expected_mm())
+      live.deviation_um = (angle_deg - *next) * 1e3;
+    live.state = "measuring";
+    show_motion(time_ns, angle_deg, true);
+    // The stop's value is the kind's (the window mean of the reference); raw 1 m, a factor 1.
+    if (auto cap = trigger.add(time_ns, angle_deg, true)) {
+      auto c = env.compensate(time_ns, 1.0);
+      c.length_m = c.raw_m;
+      on_capture(*cap, c);
     }
   }
 
@@ -554,7 +583,10 @@ struct LinearRun::Impl : Runner {
         .direction = s.direction == cal::iso230_2::Direction::up ? '+' : '-',
         .nominal_mm = s.position_mm,
         .time_ns = cap.end_ns,
-        .raw_m = (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
+        // A rotary stop's raw value is its reference's angle in SI (rad), as its readings are.
+        .raw_m = kind.stops_from_probe()
+                     ? cap.mean_mm * std::numbers::pi / 180.0
+                     : (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
         .deviation_um = value,  // the kind's value (um or urad: settings.measure.unit)
         .refractive_index = c.n,
         .material_temperature_degc = c.material_degc};
@@ -868,7 +900,7 @@ struct LinearRun::Impl : Runner {
   // Each instrument of the run with its role and its index in the role, in device order.
   template <typename F>
   void for_each_instrument(F&& f) {
-    f(*setup.laser, Role::laser, 0);
+    if (setup.laser) f(*setup.laser, Role::laser, 0);
     f(*setup.air, Role::air, 0);
     for (std::size_t k = 0; k < setup.material.size(); ++k)
       f(*setup.material[k], Role::material, k);

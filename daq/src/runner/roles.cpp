@@ -37,6 +37,8 @@ void StartupReadings::add(const cal::drivers::Reading& r) {
     air_ = true;
   else if (devices_.index(Role::material, r.device) == 0)
     material_ = true;
+  else if (devices_.is(Role::probe, r.device))
+    probe_ = true;
 }
 
 }  // namespace daq

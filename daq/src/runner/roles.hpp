@@ -57,15 +57,17 @@ class RunDevices {
 // Whether the laser (once it measures: its environment unit reads before that), the air and the
 // first material thermometer of a run have each given a reading: what a simulated session
 // waits for before the machine moves. Readings carry their device number (LinearRun sets it).
+// A run without a laser (rotary: its angular reference sees the stops) waits for its probe instead.
 class StartupReadings {
  public:
-  explicit StartupReadings(std::size_t materials) : devices_(materials) {}
+  explicit StartupReadings(std::size_t materials, bool laser = true)
+      : devices_(materials), laser_(!laser), probe_(laser) {}
   void add(const cal::drivers::Reading& r);
-  bool all() const { return laser_ && air_ && material_; }
+  bool all() const { return laser_ && air_ && material_ && probe_; }
 
  private:
   RunDevices devices_;
-  bool laser_ = false, air_ = false, material_ = false;
+  bool laser_, air_ = false, material_ = false, probe_;
 };
 
 }  // namespace daq

@@ -28,6 +28,7 @@ std::vector<d::Quantity> needed(std::string_view role) {
   if (role == "position") return {Q::machine_position_m};
   if (role == "indicator") return {Q::length_m};  // a straightness run's transducer
   if (role == "level") return {Q::angle_rad};     // a roll run's electronic level
+  if (role == "angle") return {Q::angle_rad};     // a rotary run's angular reference
   return {};
 }
 
@@ -202,13 +203,17 @@ std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
     throw cal::InputError(fmt::format("{}: {}", config.source.string(), e.what()));
   }
   const std::string probe(kind.probe_role());
+  // A kind whose stops come from its own instrument (rotary) opens no laser nor position feed:
+  // they would measure the linear axes, which do not move.
+  const bool linear_axes = !kind.stops_from_probe();
   for (const auto& dc : config.devices) {
-    if (dc.role != "laser" && dc.role != "air" && dc.role != "material" && dc.role != "position" &&
-        (probe.empty() || dc.role != probe))
+    if ((!linear_axes || (dc.role != "laser" && dc.role != "position")) && dc.role != "air" &&
+        dc.role != "material" && (probe.empty() || dc.role != probe))
       continue;
     specs.push_back(spec_of(dc, n++, axis));
   }
-  need(config, "laser"), need(config, "air");
+  if (linear_axes) need(config, "laser");
+  need(config, "air");
   if (!probe.empty()) need(config, probe.c_str());
   // An angular run reads two more laser axes: the laser must read them.
   if (const auto beams = kind.laser_channels(*config.linear); !beams.empty()) {
@@ -245,7 +250,7 @@ void place_linear_instrument(const InstrumentSpec& s, std::unique_ptr<d::Instrum
     setup.laser_channel = first;
   } else if (s.role == "air") {
     setup.air = std::move(inst);
-  } else if (s.role == "indicator" || s.role == "level") {
+  } else if (s.role == "indicator" || s.role == "level" || s.role == "angle") {
     setup.probe = std::move(inst);
   } else if (s.role == "position") {
     setup.position = std::move(inst);

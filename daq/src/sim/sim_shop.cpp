@@ -36,6 +36,30 @@ double ShopTruth::deviation_um(double x_mm, cal::iso230_2::Direction d) const {
          half * 1e3;
 }
 
+// The same lost motion and errors at the driven angle, in arcsec (1 deg = 3600").
+double ShopTruth::Rotary::deviation_arcsec(double target_deg, cal::iso230_2::Direction d) const {
+  const double half_deg =
+      0.5 * backlash_arcsec / 3600.0 * (d == cal::iso230_2::Direction::up ? -1 : 1);
+  const double driven_deg = target_deg + half_deg;
+  return zero_arcsec + scale_arcsec_per_turn * driven_deg / 360.0 +
+         cyclic_arcsec * std::sin(2 * std::numbers::pi * driven_deg / cyclic_period_deg) +
+         half_deg * 3600.0;
+}
+
+cal::daq::LinearTestConfig simulated_rotary_test(int runs) {
+  cal::daq::LinearTestConfig l;
+  l.axis = "C";
+  l.measure.kind = "rotary";
+  l.first_mm = 0.0;  // deg
+  l.last_mm = 360.0;
+  l.interval_mm = 45.0;
+  l.runs = runs;
+  l.overrun_mm = 3.0;
+  l.feed_mm_per_min = 1200.0;  // deg/min: 20 deg/s
+  l.dwell_s = 3.0;
+  return l;
+}
+
 struct SimulatedShop::Impl {
   boost::asio::io_context& io;
   ShopTruth truth;
@@ -65,8 +89,25 @@ struct SimulatedShop::Impl {
   cal::daq::LinearTestConfig test;
   sim::GaugeTwin indicator;  // SIMULATED: the straightness indicator of a straightness test
   sim::GaugeTwin level;      // SIMULATED: the differential electronic level of a roll test
+  sim::GaugeTwin angle;      // SIMULATED: the angular reference of a rotary test
 
-  static sim::MachineConfig machine(const ShopTruth& t) {
+  // A rotary test's axis on the first servo, in degrees (ShopTruth::Rotary): 1 um of it is
+  // 1 millidegree = 3.6"; at 20 degC, so its "scale" does not expand.
+  static sim::MachineConfig rotary_machine(const ShopTruth::Rotary& r) {
+    constexpr double kArcsecPerUm = 3.6;
+    sim::MachineConfig c;
+    c.servo[0] = {.kv_per_s = 30.0,
+                  .backlash_um = r.backlash_arcsec / kArcsecPerUm,
+                  .cyclic_amplitude_um = r.cyclic_arcsec / kArcsecPerUm,
+                  .cyclic_period_mm = r.cyclic_period_deg,
+                  .noise_um = r.noise_arcsec / kArcsecPerUm};
+    c.thermal = {.start_degc = 20.0, .expansion_ppm_per_k = 0.0};
+    c.acceleration_mm_per_s2 = 2000.0;  // deg/s^2
+    return c;
+  }
+
+  static sim::MachineConfig machine(const ShopTruth& t, const cal::daq::LinearTestConfig& l) {
+    if (l.measure.kind == "rotary") return rotary_machine(t.rotary);
     sim::MachineConfig c;
     c.geometry.axes[cal::kinematics::X].ex_um =
         cal::kinematics::ErrorFunction::polynomial({0.0, t.scale_um_per_m * 1e-3});
@@ -130,7 +171,7 @@ struct SimulatedShop::Impl {
         speed(s),
         virtual_time(cal::drivers::VirtualTime::of(ctx)),
         clock([this] { return now(); }),
-        world(machine(t), air(t)),
+        world(machine(t, l), air(t)),
         ids(ctx, world, clock, laser(l)),
         ptu(ctx, world, clock),
         material(ctx, world, clock,
@@ -157,14 +198,30 @@ struct SimulatedShop::Impl {
                          return st.axes_mm[dir()] - st.commanded_mm[dir()] +
                                 probe_error().translation_um[dir()] * 1e-3;
                        }}),
-        level(
-            ctx, world, clock,
-            {.continuous = false,
-             .request = "?",
-             .decimals = 3,  // urad: 1 nrad digits
-             .answer_delay = answer_delay(t, s, ctx),
-             .measure_on_answer = t.probe_measures_on_answer,
-             .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}) {}
+        level(ctx, world, clock,
+              {.continuous = false,
+               .request = "?",
+               .decimals = 3,  // urad: 1 nrad digits
+               .answer_delay = answer_delay(t, s, ctx),
+               .measure_on_answer = t.probe_measures_on_answer,
+               .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}),
+        angle(ctx, world, clock,
+              polled(3, [this](const sim::World& w) { return reference_arcsec(w); })) {}
+
+  // A twin answering "?" with value(world) to `decimals` digits (arcsec: 0.001" digits).
+  static sim::GaugeTwinConfig polled(int decimals, std::function<double(const sim::World&)> value) {
+    return {.continuous = false, .request = "?", .decimals = decimals, .value = std::move(value)};
+  }
+
+  // The angular reference's reading: the axis's angle with its scale error, zeroed
+  // zero_arcsec off, modulo a turn as an indexer's readout gives it.
+  double reference_arcsec(const sim::World& w) const {
+    constexpr double kTurnArcsec = 1296000.0;
+    const auto& r = truth.rotary;
+    const double a = w.state().axes_mm[0] * 3600.0 * (1.0 + r.scale_arcsec_per_turn / kTurnArcsec) +
+                     r.zero_arcsec;
+    return a - kTurnArcsec * std::floor(a / kTurnArcsec);
+  }
 
   // The probes' answer delay on the loop's time: simulated, or the wall clock at the speed.
   static std::chrono::nanoseconds answer_delay(const ShopTruth& shop_truth, double shop_speed,
@@ -217,8 +274,9 @@ void SimulatedShop::connect_linear(LinearRunSetup& setup, const ShopInstruments&
                                 .clock = clock_ns(),
                                 .recorder = o.recorder};
   };
-  setup.laser = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = laser_port()}),
-                                options(Role::laser, o.laser_poll_s), {.axes = o.laser_axes});
+  if (o.laser)
+    setup.laser = d::make_ids3010(io, t::make_tcp(io, {.host = "127.0.0.1", .port = laser_port()}),
+                                  options(Role::laser, o.laser_poll_s), {.axes = o.laser_axes});
   setup.air = d::make_ptu300(
       io, t::make_serial(io, t::parse_serial_settings("4800 7E1", {.device = air_device()})),
       options(Role::air, 1.0));
@@ -238,6 +296,7 @@ const std::string& SimulatedShop::indicator_device() const {
   return impl_->indicator.device_path();
 }
 const std::string& SimulatedShop::level_device() const { return impl_->level.device_path(); }
+const std::string& SimulatedShop::angle_device() const { return impl_->angle.device_path(); }
 void SimulatedShop::set_compensation(
     std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> f) {
   impl_->world.machine().set_compensation(std::move(f));
@@ -283,6 +342,13 @@ std::string SimulatedShop::devices_toml(double laser_poll_s, bool position_feed,
   if (m.kind == "roll" || every_probe)
     probe += gauge("level", "electronic level against a reference level",
                    impl_->level.device_path(), "unit = \"urad\"\n");
+  if (m.kind == "rotary")  // polled as often as the laser: it alone sees the stops
+    probe = fmt::format(
+        "[devices.angle]         # SIMULATED angular reference (rotary indexer's readout)\n"
+        "driver = \"gauge\"\ntransport = \"serial {} 9600 8N1\"\nrequest = \"?\\r\"\n"
+        "unit = \"arcsec\"\nmin_si = -7  # rad: a turn either way\nmax_si = 7\nrole = "
+        "\"angle\"\npoll_s = {}\norigin = \"simulated\"\n\n",
+        impl_->angle.device_path(), laser_poll_s);
   return fmt::format(
       R"TOML([devices.laser]
 driver = "ids3010"
@@ -456,6 +522,28 @@ std::vector<cal::iso230_2::Measurement> SimulatedShop::true_measurements(
   return out;
 }
 
+namespace {
+
+std::string linear_toml(const ShopConfigOptions& o) {
+  return fmt::format(
+      "[test.linear]\naxis = \"X\"\nfirst_mm = 0\nlast_mm = {}\ninterval_mm = 50\n"
+      "random_fraction = 0.2\nruns = {}\noverrun_mm = 3\nfeed_mm_per_min = 6000\ndwell_s = 3\n",
+      50 * (o.targets - 1), o.runs);
+}
+
+// simulated_rotary_test() as the configuration says it (docs/iso230-2.md, "Rotary axes").
+std::string rotary_toml(int runs) {
+  const auto l = simulated_rotary_test(runs);
+  return fmt::format(
+      "[test.linear]           # a rotary axis: the lengths below are degrees\n"
+      "axis = \"{}\"\nmeasure = \"rotary\"\nfirst_mm = {}\nlast_mm = {}\ninterval_mm = {}\n"
+      "runs = {}\noverrun_mm = {}\nfeed_mm_per_min = {}\ndwell_s = {}\n",
+      l.axis, l.first_mm, l.last_mm, l.interval_mm.value_or(45.0), l.runs, l.overrun_mm,
+      l.feed_mm_per_min, l.dwell_s);
+}
+
+}  // namespace
+
 std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOptions& o) {
   const auto& t = shop.truth();
   const double wall = o.in_process ? 1.0 : 1.0 / o.speed;  // simulated s -> the reader's s
@@ -487,17 +575,7 @@ tolerance_um = 1
 dwell_s = {trigger_dwell}
 window_mm = 0.5
 
-[test.linear]
-axis = "X"
-first_mm = 0
-last_mm = {last_mm}
-interval_mm = 50
-random_fraction = 0.2
-runs = {runs}
-overrun_mm = 3
-feed_mm_per_min = 6000
-dwell_s = 3
-
+{linear}
 [test.circle]
 {circle_tests}radius_mm = {radius}
 sample_rate_hz = 1000
@@ -527,7 +605,7 @@ backlash_X = 3
                                                             /*serial_numbers=*/true,
                                                             /*every_probe=*/o.in_process)),
                       fmt::arg("alpha", t.expansion_ppm_per_k),
-                      fmt::arg("last_mm", 50 * (o.targets - 1)), fmt::arg("runs", o.runs),
+                      fmt::arg("linear", o.rotary ? rotary_toml(o.runs) : linear_toml(o)),
                       // Simulated seconds: at a high speed the wall-clock timers' jitter is
                       // magnified, as in daq demo.
                       fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),

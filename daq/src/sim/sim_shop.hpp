@@ -28,12 +28,17 @@ namespace daq {
 
 struct LinearRunSetup;  // linear_run.hpp
 
+// The rotary test of the simulated shop (`daq sim --test rotary`): axis C, 0 .. 360 deg every
+// 45 deg with 3 deg of overrun, `runs` runs each way, 1200 deg/min, 3 s at each stop.
+cal::daq::LinearTestConfig simulated_rotary_test(int runs = 5);
+
 // How SimulatedShop::connect_linear connects a linear run's instruments to the shop's twins.
 struct ShopInstruments {
   // Simulated seconds between laser polls: 100 Hz sees the 3 mm overrun excursions, without
   // which a stop's approach is unknown (and an automatic capture without one is refused).
   double laser_poll_s = 0.01;
   std::array<bool, 3> laser_axes{true, false, false};  // the interferometer axes read
+  bool laser = true;     // false: no laser (a rotary test reads only its angular reference)
   bool material = true;  // a material thermometer besides the laser and the air station
   cal::drivers::WireRecorder* recorder = nullptr;  // records every instrument's bytes if set
 };
@@ -79,6 +84,23 @@ struct ShopTruth {
   bool probe_measures_on_answer = false;
   // The deviation at 20 degC of a stop at x approached from below (up) or above.
   double deviation_um(double x_mm, cal::iso230_2::Direction d) const;
+  // A rotary test (measure = "rotary", `daq sim --test rotary`): the test's axis (A, B or C)
+  // turns in degrees on the machine's first servo (its lengths read as angles: 1 um of it is
+  // 1 millidegree = 3.6"), at 20 degC, with these errors in arcsec; a SIMULATED angular
+  // reference (a rotary indexer's readout, through the gauge codec in arcsec) reads its angle
+  // modulo a turn, 0 .. 360 deg.
+  struct Rotary {
+    double scale_arcsec_per_turn = 10.0;  // the axis's encoder scale error
+    double cyclic_arcsec = 4.0;           // a cyclic error (a worm's) ...
+    double cyclic_period_deg = 120.0;     // ... three times a turn
+    double backlash_arcsec = 6.0;
+    double noise_arcsec = 0.3;  // rms of the axis's position noise
+    double zero_arcsec = -3.0;  // the reference reads this at the axis's 0 deg
+    // The deviation (the reference's angle minus the target) of a stop at target_deg
+    // approached from below (up) or above: the axis stops half the backlash short of its
+    // target, the scale and cyclic errors at the angle it is driven to.
+    double deviation_arcsec(double target_deg, cal::iso230_2::Direction d) const;
+  } rotary;
 };
 
 // On an io_context with cal::drivers::VirtualTime installed (loop_time.hpp), the shop runs on
@@ -106,6 +128,9 @@ class SimulatedShop {
   std::uint16_t position_port() const;  // MTConnect SHDR adapter: Xcom|Ycom|Zcom, commanded mm
   const std::string& indicator_device() const;  // SIMULATED straightness indicator (mm lines)
   const std::string& level_device() const;      // SIMULATED electronic level (urad lines)
+  // SIMULATED angular reference of a rotary test: "?" answered with the angle in arcsec, 0 ..
+  // 1296000 (ShopTruth::Rotary).
+  const std::string& angle_device() const;
   // The controller's compensation (um added to the command), e.g. from a model: see
   // cal::drivers::sim::MachineConfig::compensation_um. Set before a program is loaded.
   void set_compensation(std::function<cal::kinematics::Vec3(const cal::kinematics::Vec3&)> f);
@@ -179,6 +204,9 @@ struct ShopConfigOptions {
   int runs = 5;
   int targets = 11;
   bool circle_set = false;  // [test.circle] is the standard set (daq sim --test circle-set)
+  // [test.linear] is the rotary test of the shop's axis (daq sim --test rotary): 0 .. 360 deg
+  // every 45 deg, `runs` runs, read by the angular reference (role "angle").
+  bool rotary = false;
   // The single circle's feed: 1000 mm/min; a faster one is a shorter live run (fewer samples).
   double circle_feed_mm_per_min = 1000;
 };

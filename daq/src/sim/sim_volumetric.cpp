@@ -217,11 +217,12 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   };
   LinearRunSetup setup;
   setup.config = c;
-  for (const char* role : {"laser", "air", "material", "indicator", "level"})
+  for (const char* role : {"laser", "air", "material", "indicator", "level", "angle"})
     setup.origins[role] = {"simulated", "a twin of the built-in simulated shop (volumetric)"};
   setup.database = a.database;
   setup.store_options = a.store_options;
-  ShopInstruments instruments{.laser_poll_s = a.laser_poll_s};
+  const bool rotary = test.measure.kind == "rotary";  // its angular reference, no laser
+  ShopInstruments instruments{.laser_poll_s = a.laser_poll_s, .laser = !rotary};
   if (test.measure.kind == "angular")
     for (const int b : test.measure.beams)
       instruments.laser_axes[static_cast<std::size_t>(b)] = true;
@@ -230,17 +231,21 @@ LinearRunOutcome acquire_simulated(const SimulatedAcquisition& a,
   // longer at first: not a lost connection.
   const auto probe_silence = std::chrono::milliseconds(
       3000 + static_cast<std::int64_t>(a.truth.probe_answer_delay_s / pace * 1e3));
+  // The test's own instrument: a gauge twin of the shop, polled on the shop's clock.
+  const auto gauge = [&](const std::string& device, double poll_s, d::codec::GaugeUnit unit,
+                         double range_si) {
+    return d::make_gauge(
+        io, t::make_serial(io, {.device = device}),
+        {.poll_period = poll(poll_s), .silence_timeout = probe_silence, .clock = clock},
+        {.request = "?\r", .unit = unit, .min_si = -range_si, .max_si = range_si});
+  };
   if (test.measure.kind == "straightness")
-    setup.probe = d::make_gauge(
-        io, t::make_serial(io, {.device = shop.indicator_device()}),
-        {.poll_period = poll(0.1), .silence_timeout = probe_silence, .clock = clock},
-        {.request = "?\r", .unit = d::codec::GaugeUnit::mm, .min_si = -0.01, .max_si = 0.01});
+    setup.probe = gauge(shop.indicator_device(), 0.1, d::codec::GaugeUnit::mm, 0.01);
   if (test.measure.kind == "roll")
-    setup.probe = d::make_gauge(
-        io, t::make_serial(io, {.device = shop.level_device()}),
-        {.poll_period = poll(0.1), .silence_timeout = probe_silence, .clock = clock},
-        {.request = "?\r", .unit = d::codec::GaugeUnit::urad, .min_si = -0.01, .max_si = 0.01});
-  StartupReadings read(setup.material.size());
+    setup.probe = gauge(shop.level_device(), 0.1, d::codec::GaugeUnit::urad, 0.01);
+  if (rotary)  // polled as often as the laser would be: it alone sees the stops
+    setup.probe = gauge(shop.angle_device(), a.laser_poll_s, d::codec::GaugeUnit::arcsec, 10.0);
+  StartupReadings read(setup.material.size(), !rotary);
   setup.on_reading = [&read](const d::Reading& r) { read.add(r); };
   if (std::getenv("CALDAQ_SIM_EVENTS"))  // debugging aid: the run's events on stderr
     setup.on_event = [](const std::string& e) { std::fprintf(stderr, "  event: %s\n", e.c_str()); };

@@ -15,6 +15,7 @@
 #include "cal/analysis/error.hpp"
 #include "kinds/kind.hpp"
 #include "linear_run.hpp"
+#include "sim_shop.hpp"
 
 namespace {
 
@@ -36,15 +37,10 @@ double injected_arcsec(double target_deg) {
          kCyclicArcsec * std::sin(2 * kPi * target_deg / 90.0);
 }
 
+// The simulated shop's rotary test (sim_shop.hpp) every 30 deg: 13 targets.
 cal::daq::LinearTestConfig rotary_test() {
-  cal::daq::LinearTestConfig l;
-  l.axis = "C";
-  l.measure.kind = "rotary";
-  l.first_mm = 0.0;  // deg
-  l.last_mm = 360.0;
-  l.interval_mm = 30.0;
-  l.runs = 5;
-  l.overrun_mm = 3.0;  // deg: the approach to 0 comes from -3 deg = 357 deg on the reference
+  auto l = daq::simulated_rotary_test(5);
+  l.interval_mm = 30.0;  // deg; overrun 3 deg: the approach to 0 comes from 357 deg
   return l;
 }
 
@@ -161,7 +157,9 @@ TEST(RotaryKind, AnyRepresentativeOfTheTurn) {
     EXPECT_NEAR(a[i]["mean"].get<double>(), b[i]["mean"].get<double>(), 1e-6);
 }
 
-TEST(RotaryKind, RefusesALinearAxisAndIsNotYetAcquiredByTheRunner) {
+// A linear axis is refused; a rotary axis is acquired, its stops recognised from its angular
+// reference (tests/e2e/rotary_e2e_test.cpp), not from a laser.
+TEST(RotaryKind, RefusesALinearAxisAndRecognisesStopsFromItsReference) {
   auto l = rotary_test();
   l.axis = "X";
   try {
@@ -170,13 +168,9 @@ TEST(RotaryKind, RefusesALinearAxisAndIsNotYetAcquiredByTheRunner) {
   } catch (const cal::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("rotary axis (A, B, C)"), std::string::npos) << e.what();
   }
-  try {
-    daq::kinds::kind("rotary").validate(rotary_test());
-    FAIL() << "the runner cannot acquire it yet: it must say so";
-  } catch (const cal::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("does not acquire a rotary axis yet"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_NO_THROW(daq::kinds::kind("rotary").validate(rotary_test()));
+  EXPECT_TRUE(daq::kinds::kind("rotary").stops_from_probe());
+  EXPECT_FALSE(daq::kinds::kind("roll").stops_from_probe());
   EXPECT_THROW(daq::kinds::kind("rotary").evaluate({}, rotary_test()), cal::InputError);
 }
 

@@ -75,6 +75,12 @@ class TestKind {
   virtual std::vector<int> laser_channels(const cal::daq::LinearTestConfig& /*l*/) const {
     return {};
   }
+  // True when the stops are recognised from the kind's own instrument (its probe role) instead
+  // of the laser or the position feed: rotary, whose angular reference is the only instrument
+  // that sees the axis (its angle in degrees is the position the trigger and the sequencer
+  // watch; the trigger's lengths then read as angles: tolerance_um in millidegrees, window_mm
+  // in degrees). Such a kind needs no laser.
+  virtual bool stops_from_probe() const { return false; }
   // nullptr for positioning: its value is the sequencer's deviation of the laser position.
   virtual std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const = 0;
   // The stops evaluated (not called for positioning: ISO 230-2 evaluates those).

@@ -5,9 +5,11 @@
 // with an angle unit (probe role "angle": a laser's angular optics over a rotary indexer, an
 // autocollimator on a polygon, an electronic level): it reads the axis's angle, zeroed with
 // the axis at 0 deg, modulo one turn as an indexer or encoder gives it (0 .. 360 deg or
-// -180 .. 180 deg: any representative). Assumed: between two successive readings the axis turns
-// less than half a turn, so the reader follows the turns (a stop at 360 deg averages readings
-// on both sides of 0 without a jump); a stop's deviation is taken modulo one turn into
+// -180 .. 180 deg: any representative). Its stream alone recognises the stops
+// (stops_from_probe): the runner watches its continuous angle in degrees as a linear run
+// watches the laser's length in mm; no laser is read. Assumed: between two successive readings the
+// axis turns less than half a turn, so the reader follows the turns (a stop at 360 deg averages
+// readings on both sides of 0 without a jump); a stop's deviation is taken modulo one turn into
 // [-180, 180) deg, so targets 0 and 360 deg are told apart only by the plan, as on the machine.
 #include <fmt/format.h>
 
@@ -37,7 +39,10 @@ class Reader final : public SampleReader {
   std::optional<double> add(Source source, std::uint8_t, std::int64_t, double angle_rad) override {
     if (source != Source::probe) return std::nullopt;
     const double reading = sign_ * angle_rad * 180.0 / kPi * kArcsecPerDeg;
-    angle_ = previous_ ? *previous_ + wrapped_arcsec(reading - *previous_) : reading;
+    // The first reading in [-180, 180) deg: the run starts near its first target, 0 deg read
+    // as 359.999 deg is -0.001 deg (the runner's stops are recognised on this angle).
+    angle_ =
+        previous_ ? *previous_ + wrapped_arcsec(reading - *previous_) : wrapped_arcsec(reading);
     previous_ = angle_;
     return angle_;
   }
@@ -60,14 +65,8 @@ class Rotary final : public TestKind {
     if (l.axis != "A" && l.axis != "B" && l.axis != "C")
       throw cal::InputError(fmt::format(
           "test.linear.axis '{}': a rotary test measures a rotary axis (A, B, C)", l.axis));
-    // The runner recognises stops from the laser's or the control's position, not yet from
-    // the angular reference's own stream: refused before any instrument is opened.
-    throw cal::InputError(fmt::format(
-        "measure = \"rotary\" (axis {}): the runner does not acquire a rotary axis yet (its "
-        "stops would be recognised from the angular reference's stream, which is not done); "
-        "the evaluation is ready (docs/iso230-2.md, \"Rotary axes\")",
-        l.axis));
   }
+  bool stops_from_probe() const override { return true; }
   std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override {
     return std::make_unique<Reader>(l.measure.sign);
   }
