@@ -24,12 +24,13 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
-#include "progress.hpp"
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "linear_run.hpp"
 #include "part_program.hpp"
+#include "progress.hpp"
 #include "provenance.hpp"
+#include "result_rows.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
 #include "verdict.hpp"
@@ -117,8 +118,7 @@ struct ProgressOut {
         tty(!as_json && ::isatty(::fileno(out)) != 0) {}
   void event(const std::string& e) {
     if (json)
-      fmt::print(out, "{}\n",
-                 nlohmann::json{{"schema", "caldaq.event.v1"}, {"message", e}}.dump());
+      fmt::print(out, "{}\n", nlohmann::json{{"schema", "caldaq.event.v1"}, {"message", e}}.dump());
     else
       fmt::print(out, "{}  {}\n", tty ? "\r\033[K" : "", e);
     std::fflush(out);
@@ -149,8 +149,8 @@ std::string live_line(const LiveState& s) {
   const auto& p = s.progress;
   std::string line =
       fmt::format("run {} of {} {}  target {} of {}  stop {} of {}", p.run, p.runs,
-                  p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target,
-                  p.targets, std::min(s.stop_number, s.stop_count), s.stop_count);
+                  p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target, p.targets,
+                  std::min(s.stop_number, s.stop_count), s.stop_count);
   if (!s.has_reading) return line + "  waiting for the laser's first reading";
   if (!s.valid)
     line += "  laser signal lost";
@@ -176,10 +176,12 @@ Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
 }
 
 // The result of a straightness, angular or roll run (kinds/kind.hpp): its profile.
-void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
+void print_profile(const LinearRunOutcome& out, const Verdict& verdict, bool json, bool tty) {
   auto j = *out.profile;
   j["run_id"] = out.run_id;
   j["status"] = cal::storage::to_string(out.status);
+  j["values"] = rows_json(result_rows(j));
+  j["verdict"] = to_json(verdict);
   if (json) return fmt::print("{}\n", j.dump(2));
   fmt::print("{}\nrun {} stored ({}): {} readings\n\n", tty ? "\r\033[K" : "", out.run_id,
              cal::storage::to_string(out.status), out.readings);
@@ -190,10 +192,9 @@ void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
     fmt::print("  {:10.3f} mm  {:+10.3f}  (spread {:.3f}, {} stops)\n",
                t["position_mm"].get<double>(), t["mean"].get<double>(), t["spread"].get<double>(),
                t["count"].get<int>());
-  fmt::print("range {:.3f} {}\n", j["range"].get<double>(), unit);
-  if (j.contains("straightness_um"))
-    fmt::print("straightness {:.3f} um about the least-squares line (slope {:+.3f} um/m)\n",
-               j["straightness_um"].get<double>(), j["slope_um_per_m"].get<double>());
+  fmt::print("\n");
+  print_result(j);  // the values as daq show and daq analyse print them
+  print_verdict(verdict);
 }
 
 }  // namespace
@@ -223,11 +224,12 @@ void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const Run
       o.config));
   watch_keyboard(io, [&] { run.manual_capture(); });
   const auto& out = run_to_end(io, run, capture, drive);
-  if (out.profile) return print_profile(out, o.json, progress->tty);
   const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
-  const auto v =
-      verdict_of(settings ? cal::daq::parse_stored_json(settings->settings_json) : nlohmann::json(),
-                 to_json(*out.evaluation));
+  const auto stored =
+      settings ? cal::daq::parse_stored_json(settings->settings_json) : nlohmann::json();
+  if (out.profile)
+    return print_profile(out, verdict_of(stored, *out.profile), o.json, progress->tty);
+  const auto v = verdict_of(stored, to_json(*out.evaluation));
   if (o.json) {
     auto j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;
@@ -278,11 +280,11 @@ void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const Run
     const std::string key = fmt::format("{} {}", s.phase, s.samples > 0);
     if (progress->json) return progress->live(key, to_json_text(s));
     if (s.samples == 0)  // no deviation before the bar has sent one
-      return progress->live(key, fmt::format("{:<24} waiting for the ballbar's first reading",
-                                             s.phase));
-    std::string line = fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed",
-                                   s.phase, s.angle_deg, s.deviation_um, 100 * s.fraction,
-                                   clock_text(s.time_s));
+      return progress->live(key,
+                            fmt::format("{:<24} waiting for the ballbar's first reading", s.phase));
+    std::string line =
+        fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed", s.phase, s.angle_deg,
+                    s.deviation_um, 100 * s.fraction, clock_text(s.time_s));
     if (const auto left = remaining_s(s.time_s, s.fraction, 1.0))
       line += fmt::format(", about {} left", clock_text(*left));
     progress->live(key, line);
