@@ -344,6 +344,23 @@ a1 = text["asfound"][0]
 check("as found / as left: table and verdicts on page one",
       "as found, run 1" in a1 and "as left, run 3" in a1 and "verdict" in a1, a1)
 
+# A circle's comparison: its table, then the trends on page one (the polar overlay under the
+# table left half of page one empty); a diagnostic with its sign, as every run's own table has it
+# (the demo's squareness +20.019 µm/m was printed 20.019).
+cc1 = text["comparison-circle"][0]
+check("circle comparison: the trends on page one", "Each value over time" in cc1
+      and "G(b) (µm)" in cc1, cc1)
+check("circle comparison: the polar overlay after the trends",
+      " ".join(text["comparison-circle"]).index("Polar plots overlaid")
+      > " ".join(text["comparison-circle"]).index("Each value over time"), "")
+cc_rows = {row[0]: row[1:] for row in cells(open("comparison-circle.html", encoding="utf-8").read(),
+                                            "num")}
+square_cells = next((v for k, v in cc_rows.items() if k.startswith("Squareness")), [])
+check("circle comparison: squareness signed", len(square_cells) == 2 and all(
+    re.match(r"[+-][0-9]+\.[0-9]{3}", c) for c in square_cells), str(cc_rows)[:600])
+check("circle comparison: G unsigned",
+      all(re.match(r"[0-9]+\.[0-9]{3}", c) for k, v in cc_rows.items() if k.startswith("G")
+          for c in v), str(cc_rows)[:600])
 comparison_html = open("comparison.html", encoding="utf-8").read()
 check("comparison: the trends' minimum span is stated", "Each y axis spans at least" in
       comparison_html, "")
@@ -439,6 +456,88 @@ for name in reports:
     check(f"{name}: no 'air air ch' legend", " ch 0" not in plot_text, "")
     if "Temperatures" in html:
         check(f"{name}: legends name the instrument", "ptu300 SIM-PTU-0001" in plot_text, "")
+
+# --- straightness, angular and roll runs: page one is their ISO 230-1 answer ------------------
+# One live run of each on the volumetric shop (`daq sim --measure`, as every_command_test.sh); the
+# straightness judged by a limit appended to its configuration, the roll by another, the angular
+# run by none. Their reports showed only the raw readings against time.
+def measure(component, tolerances=""):
+    """A live run of a component on the simulated volumetric shop; its run number."""
+    if os.path.exists("m.toml"):
+        os.remove("m.toml")
+    sim = subprocess.Popen([DAQ, "sim", "--measure", component, "--topology", "YFXZ", "--speed",
+                            "10", "--db", "demo.sqlite", "-o", "m.toml"],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(300):
+        if os.path.exists("m.toml") and "devices" in open("m.toml", encoding="utf-8").read():
+            break
+        time.sleep(0.1)
+    with open("m.toml", "a", encoding="utf-8") as f:
+        f.write(tolerances)
+    out = daq("run", "linear", "-c", "m.toml", *db)
+    sim.wait(timeout=120)
+    return re.search(r"run (\d+) stored", out).group(1), out
+
+
+import time  # noqa: E402
+
+profile_runs = {
+    "straightness": measure("E_YX", "\n[tolerances.X]\nstraightness_um = 0.1\n"),
+    "angular": measure("E_BX"),
+    "roll": measure("E_AX", "\n[tolerances.X]\nangular_urad = 1000\n"),
+}
+for kind, (run, run_out) in profile_runs.items():
+    daq("report", run, *db, "--format", "pdf", "-o", f"{kind}.pdf")
+    daq("report", run, *db, "-o", f"{kind}.html")
+    p = [squash(x) for x in pages(f"{kind}.pdf")]
+    p1 = p[0]
+    component = {"straightness": "E_YX", "angular": "E_BX", "roll": "E_AX"}[kind]
+    check(f"{kind}: the ISO 230-1 results on page one",
+          re.search(rf"Results: (straightness|angular deviation) {component} Evaluated by ISO "
+                    r"230-1:2012", p1) is not None, p1[:1500])
+    # (pdftotext may read the head's cells between the first row's)
+    check(f"{kind}: the values table on page one",
+          all(w in p1 for w in ("symbol", "value", "meaning", "limit", "verdict")), p1)
+    title = "Straightness E_YX along the axis" if kind == "straightness" else (
+        f"Angular {component} along the axis")
+    check(f"{kind}: the deviation plot on page one", title in " ".join(
+        html_mod.unescape(t) for t in re.findall(r"<tspan[^>]*>(.*?)</tspan>", open(
+            f"{kind}.html", encoding="utf-8").read())) and "mean of the stops" in p1, p1)
+    # The numbers: the report's table, daq show --json (the stored result), daq analyse --json
+    # (evaluated again from the stops) and the terminal of daq show and daq run are one.
+    doc = json.loads(daq("show", run, *db, "--json"))
+    stored = current(doc)
+    analysed = json.loads(daq("analyse", run, *db, "--json"))
+    report_values = [row[1].split(" ")[0] for row in cells(open(f"{kind}.html",
+                                                                encoding="utf-8").read(),
+                                                           "num results profile")]
+    three = lambda x: "0.000" if f"{x:.3f}" == "-0.000" else f"{x:.3f}"  # noqa: E731
+    json_values = [(f"{v['value']:+.3f}" if v["key"] == "slope_um_per_m" else three(v["value"]))
+                   for v in stored["result"]["values"]]
+    check(f"{kind}: the report's values as daq show --json", report_values == json_values
+          and len(json_values) >= 1, f"{report_values} / {json_values}")
+    check(f"{kind}: daq analyse --json as daq show --json",
+          [three(v["value"]) for v in analysed["values"]]
+          == [three(v["value"]) for v in stored["result"]["values"]], str(analysed)[:500])
+    show_text = daq("show", run, *db)
+    check(f"{kind}: daq show prints the values", all(v in show_text for v in json_values)
+          and "0 runs per direction" not in show_text, show_text)
+    check(f"{kind}: daq run printed the same values", all(v in run_out for v in json_values),
+          run_out[-800:])
+    verdict = stored["verdict"]
+    if kind == "straightness":  # about 0.4 um against 0.1 um
+        check("straightness: judged against straightness_um, failing value named",
+              re.search(r"FAIL.*E_YX = [0-9.]+ µm \(limit ≤ 0\.100 µm\)", p1) is not None
+              and verdict["summary"] == "FAIL" and analysed["verdict"]["summary"] == "FAIL", p1)
+    elif kind == "roll":
+        check("roll: judged against angular_urad", "PASS" in p1 and verdict["summary"] == "PASS"
+              and re.search(r"E_AX [0-9.]+ µrad angular deviation.* ≤ 1000\.000 µrad pass", p1)
+              is not None, p1)
+    else:
+        check("angular: no tolerance stated, and where it would be",
+              "No tolerance configured" in p1 and "angular_urad under [tolerances.X]" in p1
+              and verdict["summary"] == "no tolerance configured", p1)
+    check(f"{kind}: nothing past the right margin", not words_beyond_margin(f"{kind}.pdf"), "")
 
 print(f"{fails} failed" if fails else "all passed")
 sys.exit(1 if fails else 0)

@@ -30,6 +30,7 @@
 #include "part_program.hpp"
 #include "progress.hpp"
 #include "provenance.hpp"
+#include "result_rows.hpp"
 #include "run_setup.hpp"
 #include "session_spec.hpp"
 #include "verdict.hpp"
@@ -175,14 +176,29 @@ Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
 }
 
 // The result of a straightness, angular, roll or rotary run (kinds/kind.hpp).
-void print_profile(const LinearRunOutcome& out, bool json, bool tty) {
+void print_profile(const LinearRunOutcome& out, const Verdict& verdict, bool json, bool tty) {
   auto j = *out.profile;
   j["run_id"] = out.run_id;
   j["status"] = cal::storage::to_string(out.status);
+  j["values"] = rows_json(result_rows(j));
+  j["verdict"] = to_json(verdict);
   if (json) return fmt::print("{}\n", j.dump(2));
   fmt::print("{}\nrun {} stored ({}): {} readings\n\n", tty ? "\r\033[K" : "", out.run_id,
              cal::storage::to_string(out.status), out.readings);
-  print_kind_result(j, out.component);
+  if (j.value("schema", "") == "caldaq.rotary.v1") {  // its table in deg and arcsec
+    print_kind_result(j, out.component);
+    return print_verdict(verdict);
+  }
+  const std::string unit = j.value("unit", "");
+  fmt::print("{} {} (mean of the stops at each target, {})\n", j.value("kind", ""), out.component,
+             unit);
+  for (const auto& t : j["targets"])
+    fmt::print("  {:10.3f} mm  {:+10.3f}  (spread {:.3f}, {} stops)\n",
+               t["position_mm"].get<double>(), t["mean"].get<double>(), t["spread"].get<double>(),
+               t["count"].get<int>());
+  fmt::print("\n");
+  print_result(j);  // the values as daq show and daq analyse print them
+  print_verdict(verdict);
 }
 
 }  // namespace
@@ -212,11 +228,12 @@ void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const Run
       o.config));
   watch_keyboard(io, [&] { run.manual_capture(); });
   const auto& out = run_to_end(io, run, capture, drive);
-  if (out.profile) return print_profile(out, o.json, progress->tty);
   const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
-  const auto v =
-      verdict_of(settings ? cal::daq::parse_stored_json(settings->settings_json) : nlohmann::json(),
-                 to_json(*out.evaluation));
+  const auto stored =
+      settings ? cal::daq::parse_stored_json(settings->settings_json) : nlohmann::json();
+  if (out.profile)
+    return print_profile(out, verdict_of(stored, *out.profile), o.json, progress->tty);
+  const auto v = verdict_of(stored, to_json(*out.evaluation));
   if (o.json) {
     auto j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;

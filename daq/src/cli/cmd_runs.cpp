@@ -172,6 +172,10 @@ json run_document(const st::RunReader& store, std::int64_t id) {
   const json& settings = j["settings"];
   for (const auto& res : store.results(id)) {
     json doc = cal::daq::parse_stored_json(res.json);
+    // A profile was stored without its values (kinds/ does not reach results/): as every output
+    // lists them.
+    if (doc.is_object() && is_profile_schema(doc.value("schema", "")) && !doc.contains("values"))
+      doc["values"] = rows_json(result_rows(doc));
     json one{{"id", res.id},
              {"standard", res.standard},
              {"created", iso_time(res.created_unix_ms)},

@@ -2,8 +2,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
@@ -19,8 +19,10 @@
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "provenance.hpp"
+#include "result_rows.hpp"
 #include "roles.hpp"
 #include "run_quality.hpp"
+#include "stored_profile.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
 
@@ -32,8 +34,7 @@ using nlohmann::json;
 
 st::RunRecord linear_run(const st::RunReader& store, std::int64_t id) {
   const auto r = store.run(id);
-  if (!r)
-    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
+  if (!r) throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), id));
   if (r->kind != "linear")
     throw cal::InputError(
         fmt::format("run {} is a {} test; this needs a linear (ISO 230-2) run", id, r->kind));
@@ -96,15 +97,33 @@ void analyse_circle_run(const st::RunReader& store, st::Store* writer, const st:
     json prov = provenance("reanalysed", software_version);
     prov["analysis"] = circle_settings_json(program, analysis);
     const auto id = writer->add_result({.run_id = o.run,
-                                      .standard = standard_label(analysis),
-                                      .json = j.dump(),
-                                      .provenance_json = prov.dump()});
+                                        .standard = standard_label(analysis),
+                                        .json = j.dump(),
+                                        .provenance_json = prov.dump()});
     j["result_id"] = id;
   }
   const auto v = verdict_of(settings, j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print_circle_result(result, program, analysis);
+  print_verdict(v);
+}
+
+// A straightness, angular or roll run again from its stored stops (ISO 230-1): printed as
+// daq show prints its stored result, with its verdict.
+void analyse_profile_run(const st::RunReader& store, const st::RunRecord& run,
+                         const AnalyseRunOptions& o) {
+  if (!o.standard.empty() || o.store)
+    throw cal::InputError(fmt::format(
+        "run {} is a {} test, evaluated by ISO 230-1 only: --standard and --store apply to "
+        "positioning and circular runs",
+        run.id, run.kind));
+  json j = stored_profile(store, run);
+  j["values"] = rows_json(result_rows(j));
+  const auto v = verdict_of(cal::daq::parse_stored_json(run.settings_json), j);
+  j["verdict"] = to_json(v);
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
+  print_result(j);
   print_verdict(v);
 }
 
@@ -117,6 +136,7 @@ void analyse_run(const AnalyseRunOptions& o) {
   const auto run = store.run(o.run);
   if (run && run->kind == "circle")
     return analyse_circle_run(store, writer ? &*writer : nullptr, *run, o);
+  if (run && is_profile_kind(run->kind)) return analyse_profile_run(store, *run, o);
   const std::string standard = o.standard.empty() ? "iso230-2:2014" : o.standard;
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
@@ -134,9 +154,9 @@ void analyse_run(const AnalyseRunOptions& o) {
     prov["sensor_offsets"] = to_json(used.offsets);
     if (used.result_id) prov["of_result"] = *used.result_id;
     j["result_id"] = writer->add_result({.run_id = o.run,
-                                       .standard = std::string(e.standard.title),
-                                       .json = j.dump(),
-                                       .provenance_json = prov.dump()});
+                                         .standard = std::string(e.standard.title),
+                                         .json = j.dump(),
+                                         .provenance_json = prov.dump()});
   }
   const auto v = verdict_of(cal::daq::parse_stored_json(run->settings_json), j);
   j["verdict"] = to_json(v);

@@ -23,11 +23,13 @@
 #include "circle_run.hpp"
 #include "compensation/compensation_check.hpp"
 #include "iso230_2_output.hpp"
+#include "json_input.hpp"
 #include "markup.hpp"
 #include "plot.hpp"
 #include "provenance.hpp"
 #include "result_rows.hpp"
 #include "run_quality.hpp"
+#include "stored_profile.hpp"
 #include "verdict.hpp"
 
 namespace cal::daq::report {
@@ -225,9 +227,18 @@ std::vector<Line> lines_of(const std::vector<Series>& series, std::size_t first_
 
 // "Positioning test (ISO 230-2), axis X".
 std::string test_name(const RunView& v) {
+  const json m = v.settings.value("measure", json::object());
+  const std::string component =
+      m.is_object() && m.contains("component") && m["component"].is_string()
+          ? " " + m["component"].get<std::string>()
+          : "";
   const std::string what = v.run.kind == "linear"    ? "Positioning test (ISO 230-2)"
                            : v.run.kind == "circle"  ? "Circular test (ISO 230-4, ballbar)"
                            : v.run.kind == "dynamic" ? "Dynamic capture"
+                           : v.run.kind == "straightness"
+                               ? "Straightness test (ISO 230-1)" + component
+                           : v.run.kind == "angular" ? "Angular test (ISO 230-1)" + component
+                           : v.run.kind == "roll"    ? "Roll test (ISO 230-1)" + component
                                                      : v.run.kind + " test";
   return fmt::format("{}, axis {}", what, v.run.axis);
 }
@@ -641,6 +652,15 @@ std::string conditions_section(const RunView& v) {
           ? "Radial deviation = measured radius &minus; nominal radius: positive outward. Angles "
             "counter-clockwise from the first axis of the plane, seen from the positive third "
             "axis; ccw and cw are the directions of travel (ISO 230-4)."
+      : v.run.kind == "straightness"
+          ? "Straightness deviation: the indicator's reading across the axis, positive when the "
+            "tool is displaced in the positive direction read relative to the workpiece (ISO "
+            "230-1; docs/kinematics.md). ↑: approach in the positive direction, ↓: in the "
+            "negative."
+      : v.run.kind == "angular" || v.run.kind == "roll"
+          ? "Angular deviation: the tool's rotation relative to the workpiece about the axis "
+            "named by the component, positive by the right-hand rule (ISO 230-1; "
+            "docs/kinematics.md). ↑: approach in the positive direction, ↓: in the negative."
           : "Positional deviation x<sub>ij</sub> = actual position reached &minus; target "
             "position (ISO 230-2), the laser reading compensated for the air's refractive index "
             "and the machine's expansion to 20 °C: positive when the axis stopped beyond the "
@@ -1457,6 +1477,183 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
   return h;
 }
 
+struct Lines {
+  std::vector<Line> lines;
+  std::vector<std::vector<std::string>> rows;
+};
+
+// The profile and its reference lines: least squares and end point as lines, the minimum zone
+// as its two parallel bounding lines.
+Lines reference_lines(const Profile& p, std::size_t colour, std::string_view prefix) {
+  namespace sl = cal::straightness;
+  Lines out;
+  double lo = INFINITY, hi = -INFINITY;
+  for (double x : p.position_mm) lo = std::min(lo, x), hi = std::max(hi, x);
+  out.lines.push_back({.x = p.position_mm,
+                       .y = p.deviation_um,
+                       .label = std::string(prefix) + "measured",
+                       .colour = palette(colour),
+                       .width = 1.6,
+                       .markers = true});
+  const struct {
+    sl::Reference ref;
+    Rgb colour;
+    const char* name;
+  } refs[] = {{sl::Reference::least_squares, grey, "least squares"},
+              {sl::Reference::end_point, orange, "end point"},
+              {sl::Reference::minimum_zone, green, "minimum zone"}};
+  for (const auto& r : refs) {
+    const auto res = sl::evaluate(p.position_mm, p.deviation_um, r.ref);
+    const auto at = [&](double x_mm, double offset) {
+      return res.intercept_um + res.slope_um_per_m * x_mm * 1e-3 + offset;
+    };
+    const double rmin = *std::min_element(res.residual_um.begin(), res.residual_um.end());
+    const double rmax = *std::max_element(res.residual_um.begin(), res.residual_um.end());
+    if (r.ref == sl::Reference::minimum_zone) {
+      for (const double off : {rmin, rmax})
+        out.lines.push_back({.x = {lo, hi},
+                             .y = {at(lo, off), at(hi, off)},
+                             .label = off == rmin ? std::string(prefix) + r.name : "",
+                             .colour = r.colour,
+                             .width = 1.0,
+                             .dashed = true});
+    } else {
+      out.lines.push_back({.x = {lo, hi},
+                           .y = {at(lo, 0), at(hi, 0)},
+                           .label = std::string(prefix) + r.name,
+                           .colour = r.colour,
+                           .width = 1.0});
+    }
+    out.rows.push_back({std::string(prefix) + r.name, um(res.straightness_um),
+                        signed_text(res.slope_um_per_m, 3), um(res.intercept_um)});
+  }
+  return out;
+}
+
+// --- ISO 230-1: straightness, angular (pitch, yaw) and roll runs ------------------------------
+
+// A profile's values, their limits and verdicts: the table on page one.
+std::string profile_values_table(const std::vector<::daq::ResultRow>& rows,
+                                 const ::daq::Verdict& verdict) {
+  std::vector<std::vector<std::string>> cells;
+  for (const auto& r : rows) {
+    const auto* c = ::daq::find_check(verdict, r.key);
+    const std::string value = r.key == "slope_um_per_m" ? signed_text(r.value, 3) : um(r.value);
+    cells.push_back({esc(r.symbol), value + " " + esc(unit_text(r.unit)), esc(r.description),
+                     c ? limit_cell(c) + " " + esc(unit_text(c->unit)) : limit_cell(c),
+                     verdict_cell(c)});
+  }
+  return table({"symbol", "value", "meaning", "limit", "verdict"}, cells, "num results profile",
+               "lrlrl");
+}
+
+// The means at each target (and each direction's), with the reference lines of a straightness.
+std::string profile_plot(const json& doc, std::string_view unit) {
+  std::vector<double> x, mean, up, down;
+  for (const auto& t : doc.value("targets", json::array())) {
+    x.push_back(t.value("position_mm", 0.0));
+    mean.push_back(t.value("mean", 0.0));
+    if (t["mean_up"].is_number()) up.push_back(t["mean_up"].get<double>());
+    if (t["mean_down"].is_number()) down.push_back(t["mean_down"].get<double>());
+  }
+  const bool straight = doc.value("kind", "") == "straightness";
+  const std::string quantity = straight ? "straightness deviation" : "angular deviation";
+  XyChart chart{.title = fmt::format("{} {} along the axis", straight ? "Straightness" : "Angular",
+                                     ctx(doc, "component")),
+                .x_label = "target position (mm)",
+                .y_label = fmt::format("{} ({})", quantity, unit_text(unit)),
+                .height_pt = 220,
+                .zero_line = !straight};
+  std::string caption;
+  if (straight && x.size() >= 2) {
+    chart.lines = reference_lines(Profile{.position_mm = x, .deviation_um = mean}, 0, "").lines;
+    chart.lines.front().label = "mean of the stops";
+    caption =
+        "The mean at each target with the reference lines of ISO 230-1: least squares (its "
+        "straightness is the result), end point, and the minimum zone's two parallel lines "
+        "(dashed) enclosing every mean.";
+  } else {
+    chart.lines.push_back(
+        {.x = x, .y = mean, .label = "mean of the stops", .colour = black, .markers = true});
+    caption = "The mean at each target; the angular deviation is their range.";
+  }
+  // Each direction's means where the run went both ways (a difference is reversal).
+  if (up.size() == x.size() && down.size() == x.size() && !x.empty()) {
+    chart.lines.push_back({.x = x, .y = up, .label = "mean ↑", .colour = blue, .width = 0.8});
+    chart.lines.push_back(
+        {.x = x, .y = down, .label = "mean ↓", .colour = vermilion, .width = 0.8, .dashed = true});
+  }
+  return figure(svg(chart), caption);
+}
+
+// Per target: the mean, each direction's, the spread and the stops.
+std::string profile_targets_table(const json& doc, std::string_view unit) {
+  const auto cell = [](const json& t, const char* key) {
+    return t.contains(key) && t[key].is_number()
+               ? signed_text(t[key].get<double>(), 3)
+               : std::string("<span class=\"unstated\">&ndash;</span>");
+  };
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& t : doc.value("targets", json::array()))
+    rows.push_back({fmt::format("{:.3f}", t.value("position_mm", 0.0)), cell(t, "mean"),
+                    cell(t, "mean_up"), cell(t, "mean_down"), um(t.value("spread", 0.0)),
+                    std::to_string(t.value("count", 0))});
+  const std::string u = unit_text(unit);
+  return "<h4>Per target</h4>\n" +
+         table({"target (mm)", fmt::format("mean ({})", u), fmt::format("mean ↑ ({})", u),
+                fmt::format("mean ↓ ({})", u), fmt::format("spread ({})", u), "stops"},
+               rows, "num");
+}
+
+Sections profile_section(const st::RunReader& store, const RunView& v, const Options& o,
+                         Headline& headline) {
+  // The stored result (what daq show prints), else the same evaluation of the stored stops.
+  const auto stored = ::daq::current_result(v.results, "caldaq.profile.v1");
+  const json doc =
+      stored ? cal::daq::parse_stored_json(stored->json) : ::daq::stored_profile(store, v.run);
+  const std::string unit = ctx(doc, "unit");
+  const auto rows = ::daq::profile_rows(doc);
+  const auto verdict = ::daq::verdict_of(v.settings, doc);
+  const bool straight = ctx(doc, "kind") == "straightness";
+  headline.standard = "ISO 230-1";
+  headline.verdict = ::daq::summary(verdict);
+  for (const auto& r : rows) {
+    const auto* c = ::daq::find_check(verdict, r.key);
+    headline.values.push_back(
+        {r.symbol, r.value, unit_text(r.unit), c && !c->pass, r.key == "slope_um_per_m"});
+  }
+  Sections out;
+  out.answer = fmt::format(
+      "<h3>Results: {} {}</h3>\n<p class=\"standard\">Evaluated by <strong>ISO 230-1:2012</strong> "
+      "from the mean of the stops at each of {} targets{}.</p>\n",
+      straight ? "straightness" : "angular deviation", esc(ctx(doc, "component")),
+      doc.value("targets", json::array()).size(),
+      stored ? "" : " (no result was stored with the run: evaluated from its stops now)");
+  out.answer += verdict_banner(verdict);
+  if (!verdict.configured && verdict.notes.empty())
+    out.answer += fmt::format(
+        "<p class=\"note\">No tolerance stated for this axis: a limit is given as <code>{}</code> "
+        "under <code>[tolerances.{}]</code> (docs/config.md).</p>\n",
+        straight ? "straightness_um" : "angular_urad", esc(v.run.axis));
+  out.answer += profile_values_table(rows, verdict);
+  out.answer += profile_plot(doc, unit);
+  std::string& d = out.details;
+  d = "<h3>Details of the results</h3>\n";
+  if (straight) {
+    std::vector<double> x, mean;
+    for (const auto& t : doc.value("targets", json::array()))
+      x.push_back(t.value("position_mm", 0.0)), mean.push_back(t.value("mean", 0.0));
+    if (x.size() >= 2)
+      d += "<h4>Reference lines (ISO 230-1)</h4>\n" +
+           table({"reference line", "straightness (µm)", "slope (µm/m)", "intercept (µm)"},
+                 reference_lines(Profile{.position_mm = x, .deviation_um = mean}, 0, "").rows,
+                 "num", "lrrr");
+  }
+  d += profile_targets_table(doc, unit);
+  d += generic_section(store, v, o);
+  return out;
+}
+
 // --- pages ---------------------------------------------------------------------------------------
 
 constexpr std::string_view css = R"(
@@ -1618,6 +1815,8 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
       results = linear_section(store, v, o, hl);
     else if (v.run.kind == "circle")
       results = circle_section(store, v, o, hl);
+    else if (::daq::is_profile_kind(v.run.kind))
+      results = profile_section(store, v, o, hl);
     else
       results.answer = generic_section(store, v, o);
   } catch (const cal::InputError& e) {
@@ -1640,8 +1839,10 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
   h += customer_section(v);
   h += conditions_section(v);
   h += instruments_section(v);
-  if (v.run.kind == "linear" || v.run.kind == "circle")
-    h += provenance_section(v, v.run.kind == "linear" ? "caldaq.iso230-2.v1" : "caldaq.circle.v2");
+  if (v.run.kind == "linear" || v.run.kind == "circle" || ::daq::is_profile_kind(v.run.kind))
+    h += provenance_section(v, v.run.kind == "linear"   ? "caldaq.iso230-2.v1"
+                               : v.run.kind == "circle" ? "caldaq.circle.v2"
+                                                        : "caldaq.profile.v1");
   h += setup_section(v);
   h += environment_section(v.env);
   h += settings_appendix(v);
@@ -1861,6 +2062,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   struct Value {
     std::string key, symbol, unit;
     double value = 0;
+    bool is_signed = false;  // a diagnostic: its sign is the error's direction
   };
   static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
                                                     "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
@@ -1902,7 +2104,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       for (const auto& r : ::daq::circle_rows(doc))
         if (r.key.starts_with("G")) values.push_back({r.key, r.symbol, unit_text(r.unit), r.value});
       for (const auto& r : ::daq::diagnostic_rows(doc))
-        values.push_back({r.key, r.symbol, unit_text(r.unit), r.value});
+        values.push_back({r.key, r.symbol, unit_text(r.unit), r.value, true});
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
     // A re-compensated run is compared with the values it has now, and says so.
@@ -1929,9 +2131,10 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       trends[x.key].y.push_back(x.value);
       const auto* check = ::daq::find_check(verdict, x.key);
       if (check) limits[x.key] = check->limit;
-      by_key[x.key] = um(x.value) + (check ? (check->pass ? " <span class=\"pass\">✓</span>"
-                                                          : " <span class=\"fail\">✗</span>")
-                                           : "");
+      by_key[x.key] = (x.is_signed ? signed_text(x.value, 3) : um(x.value)) +
+                      (check ? (check->pass ? " <span class=\"pass\">✓</span>"
+                                            : " <span class=\"fail\">✗</span>")
+                             : "");
     }
     row.push_back(!verdict.configured ? "<span class=\"unstated\">no tolerance</span>"
                   : verdict.pass      ? "<span class=\"pass\">PASS</span>"
@@ -1965,6 +2168,10 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   // The run and date cells are text that may wrap (a cell of class "r" does not: "3
   // re-compensated" and "run 3 11-28 07:31" unbroken printed the page shrunk to 0.9).
   body += head.size() <= max_run_columns ? table(head, rows, "num", "ll") : transposed(head, rows);
+  // A linear comparison's overlay follows its table on page one; a circle's polar overlay
+  // (as tall as the page is wide) comes after the trends, which fill page one below the
+  // table (the overlay left half of it empty).
+  std::string overlay_figure;
   if (first.run.kind == "linear") {
     body += figure(svg(overlay),
                    "The mean bidirectional positional deviation x̄i of each run "
@@ -1978,7 +2185,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     }
     for (auto& p : polars)
       for (auto& t : p.traces) all.traces.push_back(std::move(t));
-    body += figure(svg(all), "Both directions of every run on one scale.");
+    overlay_figure = figure(svg(all), "Both directions of every run on one scale.");
   }
   // One small plot per value: each on its own scale, the runs in date order, the limit dashed.
   body += "<h3>Each value over time</h3>\n<div class=\"multiples\">\n";
@@ -2019,6 +2226,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
                 fixed(std::max(4 * u_max_um, 1.0), 3), fixed(u_max_um, 3))
           : "<p class=\"note\">Each y axis spans at least 1 of its value's unit (0.1 ms): a "
             "smaller change is not drawn as a slope across the plot.</p>\n";
+  body += overlay_figure;
   return page(fmt::format("Comparison: {} test of axis {}", first.run.kind, first.run.axis), body,
               o, who_of(first));
 }
@@ -2111,63 +2319,6 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   return page(fmt::format("As found and as left: {} test of {}", found.run.kind, found.run.axis),
               body, o, who_of(found));
 }
-
-namespace {
-
-struct Lines {
-  std::vector<Line> lines;
-  std::vector<std::vector<std::string>> rows;
-};
-
-// The profile and its reference lines: least squares and end point as lines, the minimum zone
-// as its two parallel bounding lines.
-Lines reference_lines(const Profile& p, std::size_t colour, std::string_view prefix) {
-  namespace sl = cal::straightness;
-  Lines out;
-  double lo = INFINITY, hi = -INFINITY;
-  for (double x : p.position_mm) lo = std::min(lo, x), hi = std::max(hi, x);
-  out.lines.push_back({.x = p.position_mm,
-                       .y = p.deviation_um,
-                       .label = std::string(prefix) + "measured",
-                       .colour = palette(colour),
-                       .width = 1.6,
-                       .markers = true});
-  const struct {
-    sl::Reference ref;
-    Rgb colour;
-    const char* name;
-  } refs[] = {{sl::Reference::least_squares, grey, "least squares"},
-              {sl::Reference::end_point, orange, "end point"},
-              {sl::Reference::minimum_zone, green, "minimum zone"}};
-  for (const auto& r : refs) {
-    const auto res = sl::evaluate(p.position_mm, p.deviation_um, r.ref);
-    const auto at = [&](double x_mm, double offset) {
-      return res.intercept_um + res.slope_um_per_m * x_mm * 1e-3 + offset;
-    };
-    const double rmin = *std::min_element(res.residual_um.begin(), res.residual_um.end());
-    const double rmax = *std::max_element(res.residual_um.begin(), res.residual_um.end());
-    if (r.ref == sl::Reference::minimum_zone) {
-      for (const double off : {rmin, rmax})
-        out.lines.push_back({.x = {lo, hi},
-                             .y = {at(lo, off), at(hi, off)},
-                             .label = off == rmin ? std::string(prefix) + r.name : "",
-                             .colour = r.colour,
-                             .width = 1.0,
-                             .dashed = true});
-    } else {
-      out.lines.push_back({.x = {lo, hi},
-                           .y = {at(lo, 0), at(hi, 0)},
-                           .label = std::string(prefix) + r.name,
-                           .colour = r.colour,
-                           .width = 1.0});
-    }
-    out.rows.push_back({std::string(prefix) + r.name, um(res.straightness_um),
-                        signed_text(res.slope_um_per_m, 3), um(res.intercept_um)});
-  }
-  return out;
-}
-
-}  // namespace
 
 std::string straightness_report(const Profile& p, const Options& o) {
   const auto l = reference_lines(p, 0, "");

@@ -106,6 +106,21 @@ void print_circle_doc(const json& doc, std::string_view in) {
     if (n.is_string()) fmt::print("{}  note: {}\n", in, safe(n.get<std::string>()));
 }
 
+// A profile's values as every output prints them (the slope signed: its sign is the line's
+// direction; the straightness and the range are spans).
+std::string profile_value_text(const ResultRow& r) {
+  return r.key == "slope_um_per_m" ? signed_number_text(r.value) : number_text(r.value);
+}
+
+void print_profile_doc(const json& doc, std::string_view in) {
+  fmt::print("{}{} {} (ISO 230-1), {} targets, the mean of the stops at each\n", in,
+             safe(text_of(doc, "kind")), safe(text_of(doc, "component")),
+             doc.value("targets", json::array()).size());
+  for (const auto& r : profile_rows(doc))
+    fmt::print("{}  {:<12} {:>10} {:<4}   {}\n", in, safe(r.symbol), profile_value_text(r),
+               safe(r.unit), safe(r.description));
+}
+
 }  // namespace
 
 std::string number_text(double value, int decimals) {
@@ -192,7 +207,32 @@ std::vector<ResultRow> diagnostic_rows(const json& doc) {
   return rows;
 }
 
+bool is_profile_schema(std::string_view schema) { return schema == "caldaq.profile.v1"; }
+
+std::vector<ResultRow> profile_rows(const json& doc) {
+  const std::string kind = text_of(doc, "kind"), component = text_of(doc, "component");
+  const std::string unit = text_of(doc, "unit");
+  std::vector<ResultRow> rows;
+  if (kind == "straightness") {
+    if (doc.contains("straightness_um"))
+      rows.push_back({"straightness_um", component,
+                      "straightness: the range of the means about the least-squares line",
+                      number_of(doc, "straightness_um"), "um"});
+    if (doc.contains("slope_um_per_m"))
+      rows.push_back({"slope_um_per_m", "slope",
+                      "of the least-squares line (the straightedge's alignment, removed)",
+                      number_of(doc, "slope_um_per_m"), "um/m"});
+    rows.push_back(
+        {"range", "range", "of the means, no line removed", number_of(doc, "range"), unit});
+  } else {
+    rows.push_back({"range", component, "angular deviation: the range of the means",
+                    number_of(doc, "range"), unit});
+  }
+  return rows;
+}
+
 std::vector<ResultRow> result_rows(const json& doc) {
+  if (is_profile_schema(doc.value("schema", ""))) return profile_rows(doc);
   if (!is_circle_schema(doc.value("schema", ""))) return linear_rows(doc);
   auto rows = circle_rows(doc);
   for (auto& d : diagnostic_rows(doc)) rows.push_back(std::move(d));
@@ -211,7 +251,9 @@ json rows_json(const std::vector<ResultRow>& rows) {
 }
 
 void print_result(const json& doc, std::string_view indent) {
-  if (is_circle_schema(doc.value("schema", "")))
+  if (is_profile_schema(doc.value("schema", "")))
+    print_profile_doc(doc, indent);
+  else if (is_circle_schema(doc.value("schema", "")))
     print_circle_doc(doc, indent);
   else
     print_linear(doc, indent);

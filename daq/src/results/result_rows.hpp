@@ -1,9 +1,10 @@
 #pragma once
 // One presentation of each result (issue 30): the rows of a result document (caldaq.iso230-2.v1,
-// caldaq.circle.v1/v2) in one order, with one name, unit and rounding, read by every output: the
-// terminal (daq run, replay, recompensate, analyse and show print the same block), the JSON (its
-// "values" array), and the reports (their tables, the campaign summary, the comparison). Numbers
-// are printed to 0.001 of their unit (the verdict compares the value as printed) and never read
+// caldaq.circle.v1/v2, caldaq.profile.v1) in one order, with one name, unit and rounding, read by
+// every output: the terminal (daq run, replay, recompensate, analyse and show print the same
+// block), the JSON (its "values" array), and the reports (their tables, the campaign summary, the
+// comparison). Numbers are printed to 0.001 of their unit (the verdict compares the value as
+// printed) and never read
 // "-0.000".
 #include <nlohmann/json.hpp>
 #include <string>
@@ -41,7 +42,15 @@ std::vector<ResultRow> linear_rows(const nlohmann::json& doc);
 std::vector<ResultRow> circle_rows(const nlohmann::json& doc);
 // The diagnostics of a circular test as ranked (by what correcting each would gain).
 std::vector<ResultRow> diagnostic_rows(const nlohmann::json& doc);
-// The rows of any result document: linear_rows or circle_rows then diagnostic_rows.
+// Whether a document is the profile of a straightness, angular (pitch, yaw) or roll run
+// (caldaq.profile.v1, runner/kinds/kind.hpp).
+bool is_profile_schema(std::string_view schema);
+// The ISO 230-1 values of a profile: a straightness run's straightness about the least-squares
+// line, that line's slope and the range; an angular or roll run's angular deviation (the range
+// of its target means).
+std::vector<ResultRow> profile_rows(const nlohmann::json& doc);
+// The rows of any result document: linear_rows, profile_rows, or circle_rows then
+// diagnostic_rows.
 std::vector<ResultRow> result_rows(const nlohmann::json& doc);
 
 // The rows as JSON, for the document's "values" array.

@@ -19,13 +19,37 @@ bool within(double value, double limit) {
   return std::round(std::abs(value) * 1e3) / 1e3 <= limit + 1e-12;
 }
 
-double travel_mm(const json& result) {
+// The travel of a result's targets (a position key: "target_mm" of ISO 230-2, "position_mm"
+// of a profile).
+double travel_mm(const json& result, const char* position_key) {
   double lo = INFINITY, hi = -INFINITY;
   for (const auto& t : result.value("targets", json::array())) {
-    const double x = t.value("target_mm", 0.0);
+    const double x = t.value(position_key, 0.0);
     lo = std::min(lo, x), hi = std::max(hi, x);
   }
   return hi >= lo ? hi - lo : 0.0;
+}
+
+// An axis's limits for a measured travel: the axis' own, replaced by those of the first
+// by_length entry long enough; `basis` names where they come from.
+json limits_for_travel(const json& tolerances, double travel, std::string& basis) {
+  json limits = tolerances;
+  basis = tolerances.value("source", std::string("tolerances"));
+  for (const auto& e : tolerances.value("by_length", json::array()))
+    if (travel <= e.value("up_to_mm", 0.0) + 1e-9) {
+      for (const auto& [k, val] : e.items())
+        if (k != "up_to_mm") limits[k] = val;
+      basis += fmt::format(" (measured travel {:g} mm, up to {:g} mm)", travel,
+                           e.value("up_to_mm", 0.0));
+      break;
+    }
+  return limits;
+}
+
+void conclude(Verdict& v) {
+  v.configured = !v.checks.empty();
+  v.pass = v.configured;
+  for (const auto& c : v.checks) v.pass = v.pass && c.pass;
 }
 
 }  // namespace
@@ -33,17 +57,7 @@ double travel_mm(const json& result) {
 Verdict linear_verdict(const json& tolerances, const json& result) {
   Verdict v;
   if (!tolerances.is_object()) return v;
-  const double travel = travel_mm(result);
-  json limits = tolerances;
-  v.basis = tolerances.value("source", std::string("tolerances"));
-  for (const auto& e : tolerances.value("by_length", json::array()))
-    if (travel <= e.value("up_to_mm", 0.0) + 1e-9) {
-      for (const auto& [k, val] : e.items())
-        if (k != "up_to_mm") limits[k] = val;
-      v.basis += fmt::format(" (measured travel {:g} mm, up to {:g} mm)", travel,
-                             e.value("up_to_mm", 0.0));
-      break;
-    }
+  const json limits = limits_for_travel(tolerances, travel_mm(result, "target_mm"), v.basis);
   const bool bi = result.value("bidirectional", true);
   const auto& axis = result.value("axis", json::object());
   const std::string title = result.contains("standard")
@@ -87,9 +101,26 @@ Verdict linear_verdict(const json& tolerances, const json& result) {
         "the limits configured ({}) are for {} values; {} is judged by {}", fmt::join(other, ", "),
         vdi ? "ISO 230-2" : "VDI/DGQ 3441", title,
         vdi ? "P_um, Pa_um, Ps_um, U_um (docs/config.md)" : "E_um, R_um, B_um, A_um, M_um"));
-  v.configured = !v.checks.empty();
-  v.pass = v.configured;
-  for (const auto& c : v.checks) v.pass = v.pass && c.pass;
+  conclude(v);
+  return v;
+}
+
+Verdict profile_verdict(const json& tolerances, const json& result) {
+  Verdict v;
+  if (!tolerances.is_object()) return v;
+  const json limits = limits_for_travel(tolerances, travel_mm(result, "position_mm"), v.basis);
+  // A straightness's limit applies to its straightness about the least-squares line; an
+  // angular or roll run's to its angular deviation (the range).
+  const bool straight = result.value("kind", "") == "straightness";
+  const char* limit_key = straight ? "straightness_um" : "angular_urad";
+  const std::string row_key = straight ? "straightness_um" : "range";
+  if (!limits.contains(limit_key)) return v;
+  for (const auto& r : profile_rows(result))
+    if (r.key == row_key) {
+      const double lim = limits[limit_key].get<double>();
+      v.checks.push_back({r.key, r.symbol, r.value, lim, r.unit, within(r.value, lim)});
+    }
+  conclude(v);
   return v;
 }
 
@@ -127,9 +158,7 @@ Verdict circle_verdict(const json& tolerances, const json& result) {
     v.checks.push_back({key, found->value("name", key), value, lim.get<double>(),
                         found->value("unit", ""), within(value, lim.get<double>())});
   }
-  v.configured = !v.checks.empty();
-  v.pass = v.configured;
-  for (const auto& c : v.checks) v.pass = v.pass && c.pass;
+  conclude(v);
   return v;
 }
 
@@ -141,6 +170,7 @@ Verdict verdict_of(const json& settings, const json& result) {
                         ? settings["context"]["tolerances"]
                         : none;
   if (is_circle_schema(result.value("schema", ""))) return circle_verdict(tol, result);
+  if (is_profile_schema(result.value("schema", ""))) return profile_verdict(tol, result);
   return linear_verdict(tol, result);
 }
 

@@ -32,6 +32,9 @@ struct Verdict {
 // or caldaq.circle.v1 document.
 Verdict linear_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
 Verdict circle_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
+// A straightness, angular or roll profile (caldaq.profile.v1) against the axis's
+// straightness_um or angular_urad (docs/config.md).
+Verdict profile_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
 // The verdict of a result of a stored run by its settings (the context's tolerances).
 Verdict verdict_of(const nlohmann::json& settings, const nlohmann::json& result);
 

@@ -161,6 +161,8 @@ const std::vector<std::string_view>& key_order() {
                                                    "Pa_um",
                                                    "Ps_um",
                                                    "U_um",
+                                                   "straightness_um",
+                                                   "angular_urad",
                                                    "G_um",
                                                    "machine",
                                                    "customer",

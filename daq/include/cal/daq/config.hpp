@@ -130,6 +130,9 @@ struct TestConditions {
 struct PositioningLimits {
   std::optional<double> E_um, R_um, B_um, A_um, M_um;
   std::optional<double> P_um, Pa_um, Ps_um, U_um;
+  // The axis's other linear tests (ISO 230-1): its straightness about the least-squares line,
+  // and its angular deviations (pitch, yaw, roll: the range of each).
+  std::optional<double> straightness_um, angular_urad;
   bool empty() const;
 };
 // Each limit's key in the configuration and the run's stored context, in docs/config.md's order.
@@ -142,7 +145,8 @@ inline constexpr PositioningLimitKey positioning_limit_keys[] = {
     {"B_um", &PositioningLimits::B_um},  {"A_um", &PositioningLimits::A_um},
     {"M_um", &PositioningLimits::M_um},  {"P_um", &PositioningLimits::P_um},
     {"Pa_um", &PositioningLimits::Pa_um}, {"Ps_um", &PositioningLimits::Ps_um},
-    {"U_um", &PositioningLimits::U_um}};
+    {"U_um", &PositioningLimits::U_um},  {"straightness_um", &PositioningLimits::straightness_um},
+    {"angular_urad", &PositioningLimits::angular_urad}};
 inline bool PositioningLimits::empty() const {
   for (const auto& k : positioning_limit_keys)
     if (this->*k.member) return false;

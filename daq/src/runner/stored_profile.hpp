@@ -1,0 +1,18 @@
+#pragma once
+// The profile of a stored straightness, angular or roll run evaluated again from its stored
+// stops (daq analyse RUN, and a report of a run whose result was not stored): the same
+// evaluation the run made when it ended (kinds/kind.hpp, caldaq.profile.v1).
+#include <nlohmann/json.hpp>
+
+#include "cal/storage/store.hpp"
+
+namespace daq {
+
+// Whether a run's kind is one evaluated as a profile (straightness, angular, roll).
+bool is_profile_kind(std::string_view run_kind);
+
+// Throws cal::InputError naming the run when it has no stops or is not of such a kind.
+nlohmann::json stored_profile(const cal::storage::RunReader& store,
+                              const cal::storage::RunRecord& run);
+
+}  // namespace daq
