@@ -111,5 +111,14 @@ import json; a=json.load(open('$TMP/rot.json')); b=json.load(open('$TMP/rot-repl
 print('same' if (a['targets'], a['axis']) == (b['targets'], b['axis']) and b['run_id'] == a['run_id'] + 1 else 'differ: %s' % b)"
 check rot_replay_text 0 "ISO 230-2:2014 E_CC \(targets in deg, deviations in arcsec\)" -- "$DAQ" replay "$TMP/rot.cdq" --db "$TMP/rot.sqlite"
 check rot_show 0 "rotary" -- "$DAQ" runs --db "$TMP/rot.sqlite"
+# daq show reads the stored rotary result as one (it printed an ISO 230-2 block of 0.000 um and
+# "0 runs per direction"): B in arcsec as acquired, in the evaluation's order, and no um limit
+# judged against arcsec.
+B_ARCSEC=$(python3 -c "import json; print(format(json.load(open('$TMP/rot.json'))['axis']['B']['value'], '.3f'))")
+SHOW=$("$DAQ" show 1 --db "$TMP/rot.sqlite")
+check rot_show_result 0 "^ +B +$B_ARCSEC arcsec +reversal value" -- echo "$SHOW"
+check rot_show_runs 0 "9 targets, 2 runs per direction" -- echo "$SHOW"
+check rot_show_order 0 "^ok$" -- bash -c "grep -nE '^ +(E↑|B̄) ' <<<\"$SHOW\" | awk -F: 'NR==1 && /E↑/ {e=1} NR==2 && /B̄/ && e {print \"ok\"}'"
+check rot_show_no_um 1 "" -- grep -E "[0-9] um " <<<"$SHOW"
 
 finish

@@ -94,8 +94,11 @@ std::string diagnostic_advice(std::string_view key) {
   };
   const std::string axis =
       key.size() > 2 && key[key.size() - 2] == '_' ? std::string(1, key.back()) : std::string();
+  // Only the prefix then the axis letter: "straightness_um" (a straightness run's limit) is no
+  // circle term and gets no advice.
   for (const auto& t : kAxisTerms)
-    if (key.starts_with(t.prefix)) return std::string(t.before) + axis + std::string(t.after);
+    if (!axis.empty() && key.size() == t.prefix.size() + 1 && key.starts_with(t.prefix))
+      return std::string(t.before) + axis + std::string(t.after);
   for (const auto& [term, advice] : kPlaneTerms)
     if (key == term) return std::string(advice);
   return "";  // not a diagnostic (a value of the standard, e.g. G)

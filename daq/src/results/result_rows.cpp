@@ -123,6 +123,33 @@ void print_profile_doc(const json& doc, std::string_view in) {
 
 }  // namespace
 
+bool is_rotary_schema(std::string_view schema) { return schema == "caldaq.rotary.v1"; }
+
+// A rotary axis's ISO 230-2 values (caldaq.rotary.v1): in arcsec, in the order evaluated.
+std::vector<ResultRow> rotary_rows(const json& doc) {
+  if (doc.contains("values")) return linear_rows(doc);  // in the evaluation's order, in arcsec
+  std::vector<ResultRow> rows;
+  const json axis = doc.value("axis", json::object());  // held: items() refers into it
+  for (const auto& [key, a] : axis.items())
+    if (a.is_object())
+      rows.push_back(
+          {key, text_of(a, "symbol"), text_of(a, "description"), number_of(a, "value"), "arcsec"});
+  return rows;
+}
+
+void print_rotary_doc(const json& doc, std::string_view in) {
+  fmt::print("{}{} rotary {} (targets in deg, deviations in arcsec)\n", in,
+             safe(text_of(doc, "title")), safe(text_of(doc, "component")));
+  fmt::print("{}{} targets, {} runs per direction, {}\n", in,
+             doc.value("targets", json::array()).size(), number_of(doc, "runs"),
+             doc.value("bidirectional", true) ? "bidirectional" : "unidirectional");
+  for (const auto& r : rotary_rows(doc))
+    fmt::print("{}  {:<8} {:>10} arcsec   {}\n", in, safe(r.symbol), number_text(r.value),
+               safe(r.description));
+  for (const auto& w : doc.value("warnings", json::array()))
+    if (w.is_string()) fmt::print("{}warning: {}\n", in, safe(w.get<std::string>()));
+}
+
 std::string number_text(double value, int decimals) {
   const double scale = std::pow(10.0, decimals);
   if (!(std::round(std::abs(value) * scale) > 0)) value = 0.0;  // also NaN's sign
@@ -233,6 +260,7 @@ std::vector<ResultRow> profile_rows(const json& doc) {
 
 std::vector<ResultRow> result_rows(const json& doc) {
   if (is_profile_schema(doc.value("schema", ""))) return profile_rows(doc);
+  if (is_rotary_schema(doc.value("schema", ""))) return rotary_rows(doc);
   if (!is_circle_schema(doc.value("schema", ""))) return linear_rows(doc);
   auto rows = circle_rows(doc);
   for (auto& d : diagnostic_rows(doc)) rows.push_back(std::move(d));
@@ -253,6 +281,8 @@ json rows_json(const std::vector<ResultRow>& rows) {
 void print_result(const json& doc, std::string_view indent) {
   if (is_profile_schema(doc.value("schema", "")))
     print_profile_doc(doc, indent);
+  else if (is_rotary_schema(doc.value("schema", "")))
+    print_rotary_doc(doc, indent);
   else if (is_circle_schema(doc.value("schema", "")))
     print_circle_doc(doc, indent);
   else

@@ -45,6 +45,8 @@ std::vector<ResultRow> diagnostic_rows(const nlohmann::json& doc);
 // Whether a document is the profile of a straightness, angular (pitch, yaw) or roll run
 // (caldaq.profile.v1, runner/kinds/kind.hpp).
 bool is_profile_schema(std::string_view schema);
+// A rotary axis's ISO 230-2 evaluation (caldaq.rotary.v1: targets in deg, values in arcsec).
+bool is_rotary_schema(std::string_view schema);
 // The ISO 230-1 values of a profile: a straightness run's straightness about the least-squares
 // line, that line's slope and the range; an angular or roll run's angular deviation (the range
 // of its target means).

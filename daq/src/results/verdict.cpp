@@ -162,6 +162,22 @@ Verdict circle_verdict(const json& tolerances, const json& result) {
   return v;
 }
 
+namespace {
+
+// A rotary axis's values are in arcsec; [tolerances.AXIS] holds limits in µm for a linear
+// axis, so none applies (no rotary limits are configurable yet): not configured, and said so,
+// rather than a µm limit compared with arcsec or a value read as 0.
+Verdict rotary_verdict(const json& tolerances) {
+  Verdict v;
+  if (tolerances.is_object() && !tolerances.empty())
+    v.notes.push_back(
+        "the configured limits are in µm for linear axes: none applies to a rotary axis's values "
+        "in arcsec (rotary limits cannot be configured yet)");
+  return v;
+}
+
+}  // namespace
+
 Verdict verdict_of(const json& settings, const json& result) {
   const json none;
   const json& tol = settings.is_object() && settings.contains("context") &&
@@ -171,6 +187,7 @@ Verdict verdict_of(const json& settings, const json& result) {
                         : none;
   if (is_circle_schema(result.value("schema", ""))) return circle_verdict(tol, result);
   if (is_profile_schema(result.value("schema", ""))) return profile_verdict(tol, result);
+  if (is_rotary_schema(result.value("schema", ""))) return rotary_verdict(tol);
   return linear_verdict(tol, result);
 }
 

@@ -101,9 +101,15 @@ class Rotary final : public TestKind {
                          {"s_down", t.runs_down ? json(t.s_down_um) : json(nullptr)},
                          {"mean", t.mean_bi_um},
                          {"reversal", t.runs_down ? json(t.reversal_um) : json(nullptr)}});
-    json axis = json::object();
-    for (const auto& a : e.axis)
+    json axis = json::object(), values = json::array();  // values: in the evaluation's order
+    for (const auto& a : e.axis) {
       axis[a.key] = {{"symbol", a.symbol}, {"description", a.description}, {"value", a.value_um}};
+      values.push_back({{"key", a.key},
+                        {"symbol", a.symbol},
+                        {"description", a.description},
+                        {"value", a.value_um},
+                        {"unit", "arcsec"}});
+    }
     return {{"schema", "caldaq.rotary.v1"},
             {"kind", "rotary"},
             {"component", component},
@@ -115,6 +121,7 @@ class Rotary final : public TestKind {
             {"bidirectional", e.bidirectional},
             {"targets", targets},
             {"axis", axis},
+            {"values", values},
             {"warnings", e.warnings}};
   }
 };
