@@ -164,6 +164,7 @@ std::string signed_number_text(double value, int decimals) {
 std::string unit_html(std::string_view unit) {
   if (unit == "um") return "µm";
   if (unit == "um/m") return "µm/m";
+  if (unit == "urad") return "µrad";  // an angular or roll run's unit
   return std::string(unit);
 }
 
