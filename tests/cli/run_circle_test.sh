@@ -86,7 +86,7 @@ check volumetric_both 2 "--runs or --machine, not both" -- "$DAQ" ballbar volume
 # Refusals name what is missing.
 check no_ballbar 2 "no device with role = \"ballbar\"" -- "$DAQ" run circle -c "$DATA/run/refused.toml" --db "$TMP/x.sqlite"
 check bad_sim_test 2 "--test 'spiral'" -- "$DAQ" sim --test spiral -o "$TMP/y.toml"
-check acquire_not_paced 2 "--acquire runs the program when its own run starts, on simulated time: without --start-after-s, --speed or --measure" -- "$DAQ" sim --test circle --acquire --speed 5 -o "$TMP/y.toml" --db "$TMP/y.sqlite"
+check acquire_not_paced 2 "--acquire runs the program when its own run starts, on simulated time: without --start-after-s or --speed" -- "$DAQ" sim --test circle --acquire --speed 5 -o "$TMP/y.toml" --db "$TMP/y.sqlite"
 # Bar calibrations: refusals name the option; nothing is stored by a refused one.
 check cal_far_calibrator 2 "calibrator of 150 mm does not fit a 100 mm bar" -- "$DAQ" ballbar calibrate --db "$TMP/run.sqlite" --bar SIM-BAR --nominal-mm 100 --calibrator-mm 150 --reading-mm 0
 check cal_big_reading 2 "reading of 7 mm is beyond" -- "$DAQ" ballbar calibrate --db "$TMP/run.sqlite" --bar SIM-BAR --nominal-mm 100 --calibrator-mm 100 --reading-mm 7
