@@ -191,23 +191,13 @@ std::string circle_capture_path(const std::string& linear_capture) {
 int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop, cal::daq::Config config,
                     const DemoOptions& o) {
   const auto& t = shop.truth();
-  const cal::daq::BallbarProgram program{.radius_mm = t.ballbar_mm,
-                                         .feed_mm_per_min = 1000,
-                                         .sample_rate_hz = 1000,
-                                         .feed_in_mm = 1.5,
-                                         .dwell_s = 1.0,
-                                         .overshoot_deg = 45};
+  // [test.circle] as its defaults configure it (XY, 1000 mm/min, 1 kHz, 45° overshoot, 1.5 mm
+  // feed-in, 1 s dwell) about the shop's bar: in the run's context and the capture's header,
+  // so `daq replay` of the capture runs the same program.
+  config.circle = cal::daq::CircleTestConfig{.radius_mm = t.ballbar_mm};
+  const auto program = circle_test(config).first;
   fmt::print("\ndaq demo: ballbar circle in XY, R {} mm at {} mm/min, on {} (simulated)\n",
              program.radius_mm, program.feed_mm_per_min, shop.ballbar_device());
-  // The test as [test.circle] would configure it, in the run's context and the capture's
-  // header: `daq replay` of the capture runs the same program.
-  config.circle = cal::daq::CircleTestConfig{.plane = "XY",
-                                             .radius_mm = program.radius_mm,
-                                             .feed_mm_per_min = program.feed_mm_per_min,
-                                             .sample_rate_hz = program.sample_rate_hz,
-                                             .overshoot_deg = program.overshoot_deg,
-                                             .feed_in_mm = program.feed_in_mm,
-                                             .dwell_s = program.dwell_s};
   const auto& dc = need(config, "ballbar");
   const auto spec = spec_of(dc, 0);
   // The circle's bytes in a capture of their own (a capture holds one session's instruments),
