@@ -681,8 +681,9 @@ std::vector<CompFile> shift_cross_positions(std::string_view format,
     if (part == Part::cec) {
       std::map<int, std::pair<std::string, std::string>> io;
       for (const auto& [n, l] : in) {
-        const auto ax = [&](std::string_view prefix) {
-          return l.starts_with(prefix) && l.find("(AX") != std::string::npos;
+        // `line` by copy: clang 14 (the fuzz build) cannot capture a structured binding.
+        const auto ax = [line = l](std::string_view prefix) {
+          return line.starts_with(prefix) && line.find("(AX") != std::string::npos;
         };
         if (ax("$AN_CEC_INPUT_AXIS[")) io[indices(format, f, n, l).front()].first = l;
         if (ax("$AN_CEC_OUTPUT_AXIS[")) io[indices(format, f, n, l).front()].second = l;
