@@ -147,13 +147,10 @@ void print(const cal::unc::Budget& b, double length_m) {
 
 namespace {
 
-// A rotary axis's evaluation: its values, then each target's means, reversal and spread.
+// A rotary axis's evaluation: its values as every output prints them (print_result, as daq
+// show), then each target's means and reversal.
 void print_rotary(const nlohmann::json& j) {
-  fmt::print("{} {} (targets in deg, deviations in arcsec)\n", j.value("title", ""),
-             j.value("component", ""));
-  for (const auto& [key, a] : j["axis"].items())
-    fmt::print("  {:<6} {:>10.3f}\"  {}\n", key, a["value"].get<double>(),
-               a.value("description", ""));
+  print_result(j);
   fmt::print("\n{:>10} {:>10} {:>10} {:>10} {:>10}   (arcsec)\n", "target/deg", "mean up",
              "mean down", "mean", "reversal");
   const auto cell = [](const nlohmann::json& v) {
@@ -162,8 +159,6 @@ void print_rotary(const nlohmann::json& j) {
   for (const auto& t : j["targets"])
     fmt::print("{:>10.3f} {:>10} {:>10} {:>10} {:>10}\n", t["position_deg"].get<double>(),
                cell(t["mean_up"]), cell(t["mean_down"]), cell(t["mean"]), cell(t["reversal"]));
-  for (const auto& w : j.value("warnings", nlohmann::json::array()))
-    fmt::print("warning: {}\n", w.get<std::string>());
 }
 
 }  // namespace

@@ -138,8 +138,8 @@ std::vector<ResultRow> rotary_rows(const json& doc) {
 }
 
 void print_rotary_doc(const json& doc, std::string_view in) {
-  fmt::print("{}{} rotary {} (targets in deg, deviations in arcsec)\n", in,
-             safe(text_of(doc, "title")), safe(text_of(doc, "component")));
+  fmt::print("{}{} {} (targets in deg, deviations in arcsec)\n", in, safe(text_of(doc, "title")),
+             safe(text_of(doc, "component")));
   fmt::print("{}{} targets, {} runs per direction, {}\n", in,
              doc.value("targets", json::array()).size(), number_of(doc, "runs"),
              doc.value("bidirectional", true) ? "bidirectional" : "unidirectional");
