@@ -9,6 +9,7 @@
 
 #include "cal/analysis/air.hpp"
 #include "cal/analysis/compensation.hpp"
+#include "kinds/kind.hpp"
 
 namespace daq::serve {
 
@@ -256,13 +257,19 @@ std::optional<std::string> DeviceBoard::not_ready(const Device& d, bool may_be_s
   return fmt::format("{} is {}{}", name, state, why);
 }
 
+bool run_uses(const cal::daq::Config& c, std::string_view test, const cal::daq::DeviceConfig& dc) {
+  if (test == "circle") return dc.role == "ballbar";
+  if (dc.role == "air" || dc.role == "material") return true;
+  if (!c.linear) return dc.role == "laser" || dc.role == "position";
+  const auto& kind = kinds::kind(c.linear->measure.kind);
+  if (dc.role == "laser" || dc.role == "position") return !kind.stops_from_probe();
+  return !dc.role.empty() && dc.role == kind.probe_role();
+}
+
 std::optional<std::string> DeviceBoard::refusal(std::string_view test) const {
   std::vector<std::string> reasons;
   for (const auto& c : config_.devices) {
-    const bool used = test == "circle" ? c.role == "ballbar"
-                                       : (c.role == "laser" || c.role == "air" ||
-                                          c.role == "material" || c.role == "position");
-    if (!used) continue;
+    if (!run_uses(config_, test, c)) continue;
     if (auto why = not_ready(devices_.at(c.id), test == "circle")) reasons.push_back(*why);
   }
   // Every device that is not ready is named: the operator fixes them all at once.

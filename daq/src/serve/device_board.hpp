@@ -25,6 +25,12 @@
 
 namespace daq::serve {
 
+// Whether a run of `test` ("linear" | "circle") opens device `dc` itself: the ballbar for a
+// circle; for a linear run the air, the material thermometers, the instrument its kind reads
+// (indicator, level, angle) and, unless that instrument gives the stops (rotary), the laser and
+// the position feed. Start's readiness and the idle monitors both ask this one question.
+bool run_uses(const cal::daq::Config& c, std::string_view test, const cal::daq::DeviceConfig& dc);
+
 class DeviceBoard {
  public:
   using Clock = std::chrono::steady_clock;

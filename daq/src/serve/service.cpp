@@ -370,7 +370,7 @@ class Service {
     const auto instruments_of = [&](std::string_view test) {
       json ids = json::array();
       for (const auto& d : c.devices)
-        if (uses(c, test, d)) ids.push_back(d.id);
+        if (run_uses(c, test, d)) ids.push_back(d.id);
       return ids;
     };
     if (c.linear) {
@@ -419,7 +419,7 @@ class Service {
                                                                      : 0;
     std::uint16_t n = 0;
     for (const auto& dc : config_.devices) {
-      if (!only_of_test.empty() && !uses(config_, only_of_test, dc)) {
+      if (!only_of_test.empty() && !run_uses(config_, only_of_test, dc)) {
         ++n;
         continue;
       }
@@ -443,22 +443,10 @@ class Service {
     }
   }
 
-  // The devices a test's run opens itself: the ballbar for a circle; for a linear run the laser,
-  // air, material, position feed and the probe its kind reads (an indicator's idle monitor left
-  // open made a straightness run's own open of it "busy").
-  static bool uses(const cal::daq::Config& c, std::string_view test,
-                   const cal::daq::DeviceConfig& dc) {
-    if (test == "circle") return dc.role == "ballbar";
-    if (dc.role == "laser" || dc.role == "air" || dc.role == "material" || dc.role == "position")
-      return true;
-    return c.linear && !dc.role.empty() &&
-           dc.role == kinds::kind(c.linear->measure.kind).probe_role();
-  }
-
   // Closes the idle monitors of the devices the run opens; the others stay watched.
   void stop_monitors_of(std::string_view test) {
     for (const auto& dc : config_.devices)
-      if (uses(config_, test, dc)) monitors_.erase(dc.id);
+      if (run_uses(config_, test, dc)) monitors_.erase(dc.id);
   }
 
   web::Response setup_get(std::string_view) {

@@ -3,7 +3,10 @@
 // environment from a published refractive index.
 #include "serve/device_board.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 namespace {
 
@@ -108,6 +111,98 @@ TEST(DeviceBoard, ReconnectingCountsTheAttemptsOfItsLimit) {
   EXPECT_EQ(*b.board.refusal("linear"),
             "not ready: laser (tcp 127.0.0.1:9090) is closed; "
             "table (serial /dev/ttyUSB1 9600 8N1) is closed");
+}
+
+// A straightness run reads its indicator: Start must wait for it as for the laser. (Before,
+// only the laser, air, material and position feed were asked: a run started with its
+// indicator's port held by another program, captured every stop with the laser and waited for
+// indicator values that never came.) A rotary run's stops come from its angular reference:
+// the laser and the position feed are not its devices.
+cal::daq::Config with_kind(std::string_view kind) {
+  return cal::daq::parse_config(
+      fmt::format(R"(
+[devices.laser]
+driver = "ids3010"
+transport = "tcp 127.0.0.1:9090"
+role = "laser"
+[devices.air]
+driver = "ptu300"
+transport = "serial /dev/ttyUSB0 4800 7E1"
+role = "air"
+[devices.indicator]
+driver = "gauge"
+transport = "serial /dev/ttyUSB3 9600 8N1"
+role = "indicator"
+[devices.table]
+driver = "gauge"
+transport = "serial /dev/ttyUSB4 9600 8N1"
+unit = "arcsec"
+role = "angle"
+[environment]
+wavelength_nm = 633
+co2_umol_per_mol = 450
+expansion_ppm_per_k = 11.5
+[trigger]
+tolerance_um = 1
+dwell_s = 1.5
+window_mm = 0.5
+[test.linear]
+axis = "{}"
+first_mm = 0
+last_mm = {}
+interval_mm = {}
+runs = 1
+feed_mm_per_min = 1000
+dwell_s = 4
+measure = "{}"
+{}
+)",
+                  kind == "rotary" ? "C" : "X", kind == "rotary" ? 360 : 200,
+                  kind == "rotary" ? 90 : 100, kind, kind == "rotary" ? "" : "direction = \"Y\""),
+      "kinds.toml");
+}
+
+// A device streaming with a fresh reading (the board's clock stands still).
+void live(DeviceBoard& board, const std::string& id, Quantity q) {
+  board.expect(id, 1000ms, 20);
+  board.on_state(id, InstrumentState::streaming, "");
+  board.on_reading(id, Reading{.quantity = q, .status = ReadingStatus::ok, .value = 0.001});
+}
+
+TEST(DeviceBoard, StartWaitsForTheInstrumentTheKindReads) {
+  const auto c = with_kind("straightness");
+  DeviceBoard board(c, [] { return DeviceBoard::Clock::time_point{}; });
+  live(board, "laser", Quantity::displacement_m);
+  live(board, "air", Quantity::air_pressure_pa);
+  board.expect("indicator", 1000ms, 20);
+  board.on_state("indicator", InstrumentState::connecting, "");
+  board.on_state("indicator", InstrumentState::reconnecting, "busy: pid 7 (flock)");
+  const auto why = board.refusal("linear");
+  ASSERT_TRUE(why);
+  EXPECT_EQ(*why,
+            "not ready: indicator (serial /dev/ttyUSB3 9600 8N1) is reconnecting (attempt 1 of "
+            "20): busy: pid 7 (flock)");
+  const auto device = [&c](std::string_view id) {
+    return *std::find_if(c.devices.begin(), c.devices.end(),
+                         [id](const auto& d) { return d.id == id; });
+  };
+  EXPECT_TRUE(daq::serve::run_uses(c, "linear", device("indicator")));
+  EXPECT_FALSE(daq::serve::run_uses(c, "linear", device("table")));  // the angle: not this kind's
+  EXPECT_FALSE(daq::serve::run_uses(c, "circle", device("indicator")));
+  live(board, "indicator", Quantity::length_m);
+  EXPECT_EQ(board.refusal("linear"), std::nullopt);
+}
+
+TEST(DeviceBoard, ARotaryRunDoesNotWaitForTheLaser) {
+  const auto c = with_kind("rotary");
+  DeviceBoard board(c, [] { return DeviceBoard::Clock::time_point{}; });
+  live(board, "air", Quantity::air_pressure_pa);
+  live(board, "table", Quantity::angle_rad);
+  EXPECT_EQ(board.refusal("linear"), std::nullopt);  // the laser closed, the indicator too
+  board.expect("table", 1000ms, 20);
+  board.on_state("table", InstrumentState::reconnecting, "gone");
+  ASSERT_TRUE(board.refusal("linear"));
+  EXPECT_NE(board.refusal("linear")->find("table (serial /dev/ttyUSB4"), std::string::npos);
 }
 
 TEST(DeviceBoard, GivenUpIsFailedStoppedIsClosed) {
