@@ -198,11 +198,8 @@ TEST(IdsDecode, ACaptureOfBothDirectionsAsAttocubesClientWritesThem) {
       R"("id": 8}{"jsonrpc":"2.0","result":[0,20.5],"id":8})"
       "\r\n";
   namespace d = cal::drivers;
-  const auto& drv = d::driver("ids3010");
-  auto decoder = drv.make_decoder(d::options_from_text(drv, {}));
-  std::vector<d::DecodedItem> items;
-  decoder->feed(std::as_bytes(std::span(capture)), items);
-  decoder->finish(items);
+  d::codec::CodecStats stats;
+  const auto items = codec_test::decode_whole("ids3010", capture, &stats);
   std::vector<d::DecodedItem> readings;
   for (const auto& i : items) {
     EXPECT_NE(i.kind, d::DecodedItem::Kind::error) << i.text;
@@ -214,7 +211,7 @@ TEST(IdsDecode, ACaptureOfBothDirectionsAsAttocubesClientWritesThem) {
   EXPECT_EQ(readings[1].channel, 1);
   EXPECT_EQ(readings[3].quantity, d::Quantity::air_temperature_degc);
   EXPECT_DOUBLE_EQ(readings[3].value, 20.5);
-  EXPECT_EQ(decoder->stats().errors(), 0u);
+  EXPECT_EQ(stats.errors(), 0u);
 }
 
 TEST(IdsCodec, JsonObjectsOfALineBracesInStringsAndStrayText) {

@@ -1,13 +1,17 @@
 #pragma once
 // Helpers shared by the codec tests: feed a stream whole, one byte at a time, or in seeded
-// random chunks, and collect what the codec produced.
+// random chunks, and collect what the codec produced; run a driver's decoder over a text.
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <random>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "cal/drivers/codec/common.hpp"
+#include "cal/drivers/registry.hpp"
 
 namespace codec_test {
 
@@ -26,11 +30,24 @@ Decoded<typename Codec::Frame> feed_whole(Codec codec, std::string_view stream) 
   return d;
 }
 
+// The frames of `stream` fed whole to a codec the test keeps (to read its counters after); the
+// stream must give no codec error.
+template <class Codec>
+std::vector<typename Codec::Frame> frames_without_errors(Codec& codec, std::string_view stream) {
+  std::vector<typename Codec::Frame> frames;
+  std::vector<cal::drivers::codec::CodecError> errors;
+  codec.feed(stream, frames, errors);
+  EXPECT_TRUE(errors.empty()) << errors.size() << " codec errors, the first: "
+                              << (errors.empty() ? "" : errors.front().description);
+  return frames;
+}
+
 // Every chunk boundary: the stream is fed one byte at a time.
 template <class Codec>
 Decoded<typename Codec::Frame> feed_bytewise(Codec codec, std::string_view stream) {
   Decoded<typename Codec::Frame> d;
-  for (std::size_t i = 0; i < stream.size(); ++i) codec.feed(stream.substr(i, 1), d.frames, d.errors);
+  for (std::size_t i = 0; i < stream.size(); ++i)
+    codec.feed(stream.substr(i, 1), d.frames, d.errors);
   d.stats = codec.stats();
   return d;
 }
@@ -50,6 +67,20 @@ Decoded<typename Codec::Frame> feed_random_chunks(Codec codec, std::string_view 
   }
   d.stats = codec.stats();
   return d;
+}
+
+// What the decoder of `driver` (default options, as `daq decode DRIVER`) makes of `bytes` fed
+// whole, then finished; its stats too when asked.
+inline std::vector<cal::drivers::DecodedItem> decode_whole(
+    std::string_view driver, std::string_view bytes,
+    cal::drivers::codec::CodecStats* stats = nullptr) {
+  const auto& drv = cal::drivers::driver(driver);
+  auto decoder = drv.make_decoder(cal::drivers::options_from_text(drv, {}));
+  std::vector<cal::drivers::DecodedItem> items;
+  decoder->feed(std::as_bytes(std::span(bytes)), items);
+  decoder->finish(items);
+  if (stats != nullptr) *stats = decoder->stats();
+  return items;
 }
 
 inline bool same_errors(const std::vector<cal::drivers::codec::CodecError>& a,

@@ -95,17 +95,14 @@ TEST(ShdrCodec, PositionsTimestampAndOtherItemsIgnored) {
 
 TEST(ShdrCodec, HeartbeatsUnavailableMultilineAndNoTimestamp) {
   ShdrCodec c;
-  std::vector<PositionFrame> frames;
-  std::vector<CodecError> errors;
-  c.feed(
+  const auto frames = codec_test::frames_without_errors(
+      c,
       "* PING\n* PONG 10000\n"
       "2024-01-01T12:00:01Z|Xact|UNAVAILABLE\n"
       "2024-01-01T12:00:02Z|@ASSET@|T1|CuttingTool|--multiline--AAAA\n"
       "<CuttingTool><Xact|5|Yact|6></CuttingTool>\n"
       "--multiline--AAAA\n"
-      "|Xact|1\n",
-      frames, errors);
-  EXPECT_TRUE(errors.empty());
+      "|Xact|1\n");
   EXPECT_EQ(c.pings(), 1u);
   EXPECT_EQ(c.pongs(), 1u);
   EXPECT_EQ(c.pong_timeout_ms(), 10000);
@@ -157,15 +154,11 @@ TEST(ShdrCodec, EveryTimestampFormOfTheAgent) {
   // @duration suffixes are cut off (kept as the frame's duration); a number without 'T' is a
   // relative time in ms (from the first); empty: the agent's own time. Spaces are trimmed.
   ShdrCodec c({.keys = {{"Xact", 0}}});
-  std::vector<PositionFrame> frames;
-  std::vector<CodecError> errors;
-  c.feed(
-      "2024-01-01T12:00:00.5Z@100.0|Xact| 1.5 \n"
-      "1000.5|Xact|2\n"
-      "1250.5@10|Xact|3\n"
-      "|Xact|4\n",
-      frames, errors);
-  EXPECT_TRUE(errors.empty());
+  const auto frames = codec_test::frames_without_errors(c,
+                                                        "2024-01-01T12:00:00.5Z@100.0|Xact| 1.5 \n"
+                                                        "1000.5|Xact|2\n"
+                                                        "1250.5@10|Xact|3\n"
+                                                        "|Xact|4\n");
   ASSERT_EQ(frames.size(), 4u);
   EXPECT_EQ(*frames[0].time_unix_ns, 1'704'110'400'500'000'000);
   EXPECT_DOUBLE_EQ(*frames[0].duration_s, 100.0);
@@ -185,9 +178,8 @@ TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
   // space after '*' are not data; an asset's body is skipped up to a line equal to its
   // terminator.
   ShdrCodec c({.keys = {{"Xact", 0}, {"Zact", 2}}});
-  std::vector<PositionFrame> frames;
-  std::vector<CodecError> errors;
-  c.feed(
+  const auto frames = codec_test::frames_without_errors(
+      c,
       "2024-01-01T00:00:00.5Z|Xact|10\n"
       "2024-01-01T00:00:01Z|Xcond|WARNING|42|HIGH||too close\n"
       "2024-01-01T00:00:01.5Z|Zact|-5\n"
@@ -196,9 +188,7 @@ TEST(ShdrCodec, ConditionsMessagesAssetsAndCommandsDoNotHidePositions) {
       "2024-01-01T00:00:02Z|@ASSET@|T1|CuttingTool|--multiline--0FF1CE\n"
       "<CuttingTool>|Xact|99|</CuttingTool>\n"
       "--multiline--0FF1CE\r\n"
-      "2024-01-01T00:00:03Z|Xact|UNAVAILABLE|Zact|7\n",
-      frames, errors);
-  EXPECT_TRUE(errors.empty());
+      "2024-01-01T00:00:03Z|Xact|UNAVAILABLE|Zact|7\n");
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_DOUBLE_EQ(*frames[0].position_m[0], 0.010);
   EXPECT_DOUBLE_EQ(*frames[1].position_m[2], -0.005);

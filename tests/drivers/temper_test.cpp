@@ -260,13 +260,7 @@ TEST(TemperCodec, Sht2xSi7005AndSi7006Equations) {
 
 // `daq decode temper` on a text of hex reports (one per line), as the command feeds it.
 std::vector<cal::drivers::DecodedItem> decode_temper(const std::string& text) {
-  namespace d = cal::drivers;
-  const auto& drv = d::driver("temper");
-  auto decoder = drv.make_decoder(d::options_from_text(drv, {}));
-  std::vector<d::DecodedItem> items;
-  decoder->feed(std::as_bytes(std::span(text)), items);
-  decoder->finish(items);
-  return items;
+  return codec_test::decode_whole("temper", text);
 }
 
 std::vector<cal::drivers::DecodedItem> of_kind(const std::vector<cal::drivers::DecodedItem>& all,

@@ -23,18 +23,13 @@ import os
 import sqlite3
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
 import page_checks  # noqa: E402
 from page_checks import ok  # noqa: E402
-from webdriver import Browser  # noqa: E402
 
-DAQ, SHOTS = os.path.abspath(sys.argv[1]), sys.argv[2]
-os.makedirs(SHOTS, exist_ok=True)
-TMP = tempfile.mkdtemp(prefix="operator-page-campaign-")
-DB = os.path.join(TMP, "vol.sqlite")
+DAQ, SHOTS, TMP, DB = page_checks.test_dirs("operator-page-campaign-")
 MACHINE = "SIMULATED YFXZ"
 
 
@@ -68,9 +63,7 @@ con.close()
 cli = json.loads(subprocess.run([DAQ, "model", "build", "--machine", MACHINE, "--db", DB, "--allow-missing", "--json",
                                  "-o", os.path.join(TMP, "model.json")], capture_output=True, text=True, check=True).stdout)
 
-serve, url = page_checks.start_service(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--db", DB])
-b = Browser(1366, 768)
-try:
+with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--db", DB]) as (serve, url, b):
     b.get(url)
     b.js("document.getElementById('tab-results').click();")
     head = b.wait("const h = document.getElementById('vol-head').textContent; return /Volumetric/.test(h) && h;",
@@ -138,8 +131,4 @@ try:
     b.js("document.getElementById('model-box').scrollIntoView();")
     page_checks.shot(b, SHOTS, "c03-model-1366x768.png")
     page_checks.fits_narrow(b, SHOTS, "c04-model-560.png", "the model's table and map fit 560 px")
-    ok(not b.js("return window.__errors || null;"), "no script error")
-    print(f"{page_checks.passes} checks passed")
-finally:
-    b.close()
-    page_checks.stop_service(serve)
+    page_checks.no_script_error(b)

@@ -22,7 +22,6 @@ import sys
 sys.path.insert(0, os.path.dirname(__file__))
 import page_checks  # noqa: E402
 from page_checks import ok, TYPE  # noqa: E402
-from webdriver import Browser  # noqa: E402
 
 DAQ, SHOTS, TMP, DB = page_checks.test_dirs("operator-page-kinds-")
 WAIT_S = 120
@@ -40,9 +39,7 @@ def model_build(run):
                                      capture_output=True, text=True, check=True).stdout)
 
 
-serve, url = page_checks.start_simulated_service(DAQ, TMP, DB)
-b = Browser(1366, 768)
-try:
+with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url, b):
     wait = page_checks.waiter(b, TMP, (
         "const s = window.caldaq.page && window.caldaq.page.status; return JSON.stringify({running: s && s.running, "
         "last: s && s.last, check: window.caldaq.check, errors: window.__errors}).slice(0, 3000);"), WAIT_S)
@@ -106,6 +103,3 @@ try:
     b.js("document.getElementById('tab-setup').click();")
     page_checks.fits_narrow(b, SHOTS, "k-setup-560.png", "the form with the test kind fits 560 px")
     page_checks.no_script_error(b)
-finally:
-    b.close()
-    page_checks.stop_service(serve)

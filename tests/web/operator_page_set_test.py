@@ -21,18 +21,13 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
 import page_checks  # noqa: E402
 from page_checks import ok, post, TYPE  # noqa: E402
-from webdriver import Browser  # noqa: E402
 
-DAQ, SHOTS = os.path.abspath(sys.argv[1]), sys.argv[2]
-os.makedirs(SHOTS, exist_ok=True)
-TMP = tempfile.mkdtemp(prefix="operator-page-set-")
-DB = os.path.join(TMP, "runs.sqlite")
+DAQ, SHOTS, TMP, DB = page_checks.test_dirs("operator-page-set-")
 WAIT_S = 60
 
 
@@ -43,9 +38,7 @@ def shot(b, name):
     page_checks.shot(b, SHOTS, name)
 
 
-serve, url = page_checks.start_simulated_service(DAQ, TMP, DB)
-b = Browser(1366, 768)
-try:
+with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url, b):
     wait = page_checks.waiter(b, TMP, (
         "return JSON.stringify({status: window.caldaq.page && window.caldaq.page.status, "
         "next: (document.getElementById('set-next') || {}).textContent, errors: window.__errors}).slice(0, 3000);"), WAIT_S)
@@ -158,8 +151,4 @@ try:
     page_checks.fits_narrow(b, SHOTS, "s05-set-end-run-560.png", "the set's table fits 560 px")
     b.js("document.getElementById('tab-results').click();")
     page_checks.fits_narrow(b, SHOTS, "s06-set-results-560.png", "the Results with the set fit 560 px")
-    ok(not b.js("return window.__errors || null;"), "no script error")
-    print(f"{page_checks.passes} checks passed")
-finally:
-    b.close()
-    page_checks.stop_service(serve)
+    page_checks.no_script_error(b)

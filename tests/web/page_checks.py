@@ -1,5 +1,7 @@
-"""What the operator-page tests share: a counted check, a screenshot that must not be blank, and a
-JSON POST that returns (status, body) for errors too."""
+"""What the operator-page tests share: a counted check, a screenshot that must not be blank, a
+JSON POST that returns (status, body) for errors too, the test's folders, and the service with a
+browser on its page."""
+import contextlib
 import json
 import os
 import re
@@ -11,7 +13,7 @@ import time
 import urllib.error
 import urllib.request
 
-from webdriver import png_size
+from webdriver import Browser, png_size
 
 passes = 0
 
@@ -94,7 +96,7 @@ def waiter(b, tmp, explain, timeout_s):
 def start_simulated_service(daq, tmp, db):
     """Starts `daq serve --simulate` at 20x on a free port with its log in tmp; returns the
     process and the page's URL once the service prints it (or fails with the log)."""
-    return start_service(daq, tmp, ["--simulate", "--speed", "20", "--db", db])
+    return start_service(daq, tmp, simulated(db))
 
 
 def start_service(daq, tmp, args):
@@ -112,6 +114,26 @@ def start_service(daq, tmp, args):
         time.sleep(0.02)
     log.seek(0)
     raise AssertionError(f"daq serve {' '.join(args)} did not start: " + log.read())
+
+
+@contextlib.contextmanager
+def served_page(daq, tmp, args):
+    """`daq serve ARGS` (as start_service) and a 1366x768 headless browser for its page: yields
+    (service, url, browser); the browser is closed and the service ended however the test ends."""
+    proc, url = start_service(daq, tmp, args)
+    try:
+        b = Browser(1366, 768)
+        try:
+            yield proc, url, b
+        finally:
+            b.close()
+    finally:
+        stop_service(proc)
+
+
+def simulated(db):
+    """The arguments of `daq serve --simulate` at 20x storing into DB (start_simulated_service)."""
+    return ["--simulate", "--speed", "20", "--db", db]
 
 
 def log_tail(tmp, name="serve.log", lines=30):

@@ -19,10 +19,6 @@
 
 namespace daq {
 
-namespace kin = cal::kinematics;
-namespace mdl = cal::daq::model;
-using nlohmann::json;
-
 json vec_json(const kin::Vec3& v) { return json::array({v[0], v[1], v[2]}); }
 
 json grid_json(const kin::Grid& g) {
@@ -185,6 +181,14 @@ kin::Method method_from_string(const std::string& s) {
   throw cal::InputError(fmt::format("method '{}' (expected htm or first-order)", s));
 }
 
+std::string method_name(kin::Method method) {
+  return method == kin::Method::htm ? "htm" : "first-order";
+}
+
+json map_json_head(std::string_view schema, const std::string& file, kin::Method method) {
+  return {{"schema", schema}, {"model", file}, {"method", method_name(method)}};
+}
+
 namespace {
 
 // --- show ------------------------------------------------------------------------------------
@@ -300,7 +304,6 @@ kin::Grid grid_of(const MapOptions& o, const mdl::Model& m) {
 void run_map(const MapOptions& o) {
   const mdl::Model m = mdl::read(o.file);
   const kin::Method method = method_from_string(o.method);
-  const std::string method_name = method == kin::Method::htm ? "htm" : "first-order";
   if (!m.rotary.empty()) {
     if (!o.report.empty())
       throw cal::InputError(fmt::format(
@@ -342,12 +345,11 @@ void run_map(const MapOptions& o) {
                    shown(p[1]), shown(p[2]), shown(t[0]), shown(t[1]), shown(t[2]),
                    std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]));
     }
-    if (o.json)
-      fmt::print("{}\n", json{{"schema", "caldaq.volumetric-map.v1"},
-                              {"model", o.file},
-                              {"method", method_name},
-                              {"points", pts}}
-                             .dump(2));
+    if (o.json) {
+      auto j = map_json_head("caldaq.volumetric-map.v1", o.file, method);
+      j["points"] = std::move(pts);
+      fmt::print("{}\n", j.dump(2));
+    }
     return;
   }
   const kin::Grid g = grid_of(o, m);
@@ -357,8 +359,7 @@ void run_map(const MapOptions& o) {
   if (!o.report.empty())
     write_report_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
   if (o.json) {
-    auto j =
-        json{{"schema", "caldaq.volumetric-map.v1"}, {"model", o.file}, {"method", method_name}};
+    auto j = map_json_head("caldaq.volumetric-map.v1", o.file, method);
     j.update(mdl::model_map_json(mapped, true));
     fmt::print("{}\n", j.dump(2));
     return;
@@ -366,7 +367,7 @@ void run_map(const MapOptions& o) {
   fmt::print(
       "Volumetric error of {} ({} model), {} x {} x {} points over ({:g} .. {:g}, {:g} .. "
       "{:g}, {:g} .. {:g}) mm\n",
-      m.name.empty() ? o.file : m.name, method_name, g.count[0], g.count[1], g.count[2],
+      m.name.empty() ? o.file : m.name, method_name(method), g.count[0], g.count[1], g.count[2],
       g.min_mm[0], g.max_mm[0], g.min_mm[1], g.max_mm[1], g.min_mm[2], g.max_mm[2]);
   fmt::print("  largest |e|  {:.3f} um at ({:g}, {:g}, {:g}) mm\n", s.max_norm_um,
              s.max_norm_at_mm[0], s.max_norm_at_mm[1], s.max_norm_at_mm[2]);

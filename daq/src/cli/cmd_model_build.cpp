@@ -15,10 +15,6 @@
 
 namespace daq {
 
-namespace kin = cal::kinematics;
-namespace mdl = cal::daq::model;
-using nlohmann::json;
-
 namespace {
 
 struct BuildCliOptions {

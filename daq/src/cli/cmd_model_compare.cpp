@@ -15,9 +15,6 @@
 
 namespace daq {
 
-namespace mdl = cal::daq::model;
-using nlohmann::json;
-
 namespace {
 
 struct CompareOptions {

@@ -24,11 +24,8 @@
 namespace daq {
 namespace {
 
-namespace kin = cal::kinematics;
 namespace vc = cal::volcomp;
 namespace ct = cal::comptable;
-namespace mdl = cal::daq::model;
-using nlohmann::json;
 
 constexpr std::array kAxis{"X", "Y", "Z"};
 constexpr double kResolutionMm = 0.0001;  // what the writers keep: 0.1 um

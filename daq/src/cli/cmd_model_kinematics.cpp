@@ -14,9 +14,6 @@
 
 namespace daq {
 
-namespace kin = cal::kinematics;
-namespace mdl = cal::daq::model;
-
 namespace {
 
 struct Options {

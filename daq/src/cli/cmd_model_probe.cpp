@@ -26,10 +26,6 @@
 
 namespace daq {
 
-namespace kin = cal::kinematics;
-namespace mdl = cal::daq::model;
-using nlohmann::json;
-
 namespace {
 
 // --- probe: the fit ---------------------------------------------------------------------------

@@ -13,10 +13,6 @@
 
 namespace daq {
 
-namespace kin = cal::kinematics;
-namespace mdl = cal::daq::model;
-using nlohmann::json;
-
 namespace {
 
 constexpr double kMaxPoses = 2e6;  // held in memory, as the 3-axis map
@@ -222,7 +218,6 @@ void print_points(const mdl::Model& m, const std::vector<PoseError>& errors) {
 
 void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
   const kin::FiveAxisMachine machine = mdl::five_axis(m);
-  const std::string method_name = q.method == kin::Method::htm ? "htm" : "first-order";
   std::vector<int> lines;
   const std::vector<Pose> poses =
       q.points.empty() ? grid_poses(m, q.grid, q.angle_count) : csv_poses(m, q.points, lines);
@@ -231,11 +226,9 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
     if (!q.json) return print_points(m, errors);
     json pts = json::array();
     for (const auto& pe : errors) pts.push_back(point_json(m, pe));
-    fmt::print("{}\n", json{{"schema", "caldaq.five-axis-map.v1"},
-                            {"model", q.file},
-                            {"method", method_name},
-                            {"points", pts}}
-                           .dump(2));
+    auto j = map_json_head("caldaq.five-axis-map.v1", q.file, q.method);
+    j["points"] = std::move(pts);
+    fmt::print("{}\n", j.dump(2));
     return;
   }
   const auto largest =
@@ -268,20 +261,18 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
                     {"max_rotation_urad", c.max_rotation_urad}});
     json grid = grid_json(g);  // and the rotary axes' ranges
     grid["rotary"] = std::move(ranges);
-    fmt::print("{}\n", json{{"schema", "caldaq.five-axis-map.v1"},
-                            {"model", q.file},
-                            {"method", method_name},
-                            {"grid", std::move(grid)},
-                            {"summary",
-                             {{"max_norm_um", norm(largest->e.translation_um)},
-                              {"max_norm_at", point_json(m, *largest)},
-                              {"max_rotation_urad", norm(turned->e.rotation_urad)},
-                              {"max_rotation_at", point_json(m, *turned)},
-                              {"min_um", vec_json(lo)},
-                              {"max_um", vec_json(hi)}}},
-                            {"contributions", cs},
-                            {"points", pts}}
-                           .dump(2));
+    auto j = map_json_head("caldaq.five-axis-map.v1", q.file, q.method);
+    j.update(json{{"grid", std::move(grid)},
+                  {"summary",
+                   {{"max_norm_um", norm(largest->e.translation_um)},
+                    {"max_norm_at", point_json(m, *largest)},
+                    {"max_rotation_urad", norm(turned->e.rotation_urad)},
+                    {"max_rotation_at", point_json(m, *turned)},
+                    {"min_um", vec_json(lo)},
+                    {"max_um", vec_json(hi)}}},
+                  {"contributions", cs},
+                  {"points", pts}});
+    fmt::print("{}\n", j.dump(2));
     return;
   }
   std::string rotary_grid;
@@ -291,7 +282,7 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
   fmt::print(
       "Five-axis error of {} ({} model), {} x {} x {} points over ({:g} .. {:g}, {:g} .. {:g}, "
       "{:g} .. {:g}) mm{}: {} poses\n",
-      m.name.empty() ? q.file : m.name, method_name, g.count[0], g.count[1], g.count[2],
+      m.name.empty() ? q.file : m.name, method_name(q.method), g.count[0], g.count[1], g.count[2],
       g.min_mm[0], g.max_mm[0], g.min_mm[1], g.max_mm[1], g.min_mm[2], g.max_mm[2], rotary_grid,
       errors.size());
   const auto& lp = largest->pose.p_mm;

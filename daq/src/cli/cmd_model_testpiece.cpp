@@ -18,8 +18,6 @@ namespace daq {
 namespace {
 
 namespace tp = cal::testpiece;
-namespace mdl = cal::daq::model;
-using nlohmann::json;
 
 struct Options {
   std::string file, cmm;

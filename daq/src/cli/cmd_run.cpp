@@ -284,14 +284,14 @@ void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const Run
     const std::string key = fmt::format("{} {}", s.phase, s.samples > 0);
     if (progress->json) return progress->live(key, to_json_text(s));
     if (s.samples == 0)  // no deviation before the bar has sent one
-      return progress->live(key, fmt::format("{:<24} waiting for the ballbar's first reading",
-                                             s.phase));
+      return progress->live(key,
+                            fmt::format("{:<24} waiting for the ballbar's first reading", s.phase));
     if (s.state == "waiting")  // nor before the feed-in: no deviation from the circle yet
-      return progress->live(key, fmt::format("{:<24} the bar streams; waiting for the feed-in",
-                                             s.phase));
-    std::string line = fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed",
-                                   s.phase, s.angle_deg, s.deviation_um, 100 * s.fraction,
-                                   clock_text(s.time_s));
+      return progress->live(
+          key, fmt::format("{:<24} the bar streams; waiting for the feed-in", s.phase));
+    std::string line =
+        fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed", s.phase, s.angle_deg,
+                    s.deviation_um, 100 * s.fraction, clock_text(s.time_s));
     if (const auto left = remaining_s(s.time_s, s.fraction, 1.0))
       line += fmt::format(", about {} left", clock_text(*left));
     progress->live(key, line);
@@ -360,6 +360,28 @@ void gcode(const GcodeOptions& o, bool circle) {
   if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.output));
 }
 
+// What the help of `daq run linear` and `daq run circle` says differently about the options
+// both take.
+struct AcquisitionHelp {
+  std::string config;
+  std::string give_up_after;
+  std::string check_s;
+  std::string json;
+};
+
+// The options of an acquisition: the set-up, the run store, the capture, the reconnection and
+// start-up checks, and the result as JSON. Both kinds parse into the same RunOptions.
+void add_acquisition_options(CLI::App& cmd, RunOptions& o, const AcquisitionHelp& help) {
+  cmd.add_option("-c,--config", o.config, help.config)->required();
+  add_db_option(cmd, o.db);
+  cmd.add_option("--capture", o.capture, "Record the wire-level capture to this file");
+  cmd.add_option("--give-up-after", o.give_up_after, help.give_up_after)->capture_default_str();
+  cmd.add_option("--check-s", o.check_s, help.check_s)
+      ->capture_default_str()
+      ->check(finite_non_negative());
+  cmd.add_flag("--json", o.json, help.json);
+}
+
 }  // namespace
 
 void add_run_commands(CLI::App& app) {
@@ -369,36 +391,23 @@ void add_run_commands(CLI::App& app) {
       "linear",
       "Linear test: ISO 230-2 positioning (laser, air, material), or by [test.linear] measure a "
       "straightness (indicator), pitch or yaw (two laser axes) or roll (level) run");
-  lin->add_option("-c,--config", o->config, "Machine/campaign TOML (docs/config.md)")->required();
-  add_db_option(*lin, o->db);
-  lin->add_option("--capture", o->capture, "Record the wire-level capture to this file");
-  lin->add_option("--give-up-after", o->give_up_after,
-                  "Reconnection attempts before a device is given up")
-      ->capture_default_str();
-  lin->add_option("--check-s", o->check_s,
-                  "Before the run, every device must open and speak within this time (0: no "
-                  "check)")
-      ->capture_default_str()
-      ->check(finite_non_negative());
-  lin->add_flag("--json", o->json,
-                "Print the result as caldaq.iso230-2.v1 JSON with run_id, status, missed_stops "
-                "and verdict (progress goes to stderr)");
+  add_acquisition_options(
+      *lin, *o,
+      {.config = "Machine/campaign TOML (docs/config.md)",
+       .give_up_after = "Reconnection attempts before a device is given up",
+       .check_s = "Before the run, every device must open and speak within this time (0: no "
+                  "check)",
+       .json = "Print the result as caldaq.iso230-2.v1 JSON with run_id, status, missed_stops "
+               "and verdict (progress goes to stderr)"});
   lin->callback([o] { run_linear(*o); });
   auto* circ = run->add_subcommand("circle", "ISO 230-4 circular test with a ballbar");
-  circ->add_option("-c,--config", o->config, "Machine/campaign TOML with [test.circle]")
-      ->required();
-  add_db_option(*circ, o->db);
-  circ->add_option("--capture", o->capture, "Record the wire-level capture to this file");
-  circ->add_option("--give-up-after", o->give_up_after,
-                   "Reconnection attempts before the ballbar is given up")
-      ->capture_default_str();
-  circ->add_option("--check-s", o->check_s,
-                   "Before the run, the ballbar must open within this time (0: no check)")
-      ->capture_default_str()
-      ->check(finite_non_negative());
-  circ->add_flag("--json", o->json,
-                 "Print the result as caldaq.circle.v2 JSON with run_id and verdict (progress "
-                 "goes to stderr)");
+  add_acquisition_options(
+      *circ, *o,
+      {.config = "Machine/campaign TOML with [test.circle]",
+       .give_up_after = "Reconnection attempts before the ballbar is given up",
+       .check_s = "Before the run, the ballbar must open within this time (0: no check)",
+       .json = "Print the result as caldaq.circle.v2 JSON with run_id and verdict (progress "
+               "goes to stderr)"});
   circ->callback([o] { run_circle(*o); });
 
   auto g = std::make_shared<GcodeOptions>();

@@ -15,6 +15,12 @@
 
 namespace daq {
 
+// The names every model command uses, for the kinematics library and the model file (a private
+// header of the model commands only).
+namespace kin = cal::kinematics;
+namespace mdl = cal::daq::model;
+using nlohmann::json;
+
 // "YFXZ: workpiece <- Y <- F -> X -> Z -> tool (Y carries the workpiece; ...)".
 std::string describe_topology(cal::kinematics::Topology t);
 // One line per component for show and the report: name, form, values, source.
@@ -46,6 +52,12 @@ std::map<std::string, std::string> model_origin_parts(const cal::daq::model::Mod
 
 // --method htm|first-order
 cal::kinematics::Method method_from_string(const std::string& s);
+// The method as a map prints it: "htm" or "first-order".
+std::string method_name(cal::kinematics::Method method);
+// What every map's JSON starts with (daq model map, with or without rotary axes):
+// {"schema": SCHEMA, "model": FILE, "method": method_name(METHOD)}.
+nlohmann::json map_json_head(std::string_view schema, const std::string& file,
+                             cal::kinematics::Method method);
 
 // daq model map of a model with rotary axes (cmd_model_rotary.cpp): the grid (the linear
 // volume) times angle_count angles over each rotary axis's range, or the poses of a CSV

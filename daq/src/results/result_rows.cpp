@@ -41,17 +41,23 @@ const ci::StandardInfo& circle_standard(const json& doc) {
   }
 }
 
+// A result's rows (symbol, value in UNIT, description), then its warnings.
+void print_rows_and_warnings(const std::vector<ResultRow>& rows, std::string_view unit,
+                             const json& doc, std::string_view in) {
+  for (const auto& r : rows)
+    fmt::print("{}  {:<8} {:>10} {}   {}\n", in, safe(r.symbol), number_text(r.value), unit,
+               safe(r.description));
+  for (const auto& w : doc.value("warnings", json::array()))
+    if (w.is_string()) fmt::print("{}warning: {}\n", in, safe(w.get<std::string>()));
+}
+
 void print_linear(const json& doc, std::string_view in) {
   const json standard = doc.value("standard", json::object());
   fmt::print("{}{} ({})\n", in, safe(text_of(standard, "title")), safe(text_of(standard, "note")));
   fmt::print("{}{} targets, {}, {}\n", in, doc.value("targets", json::array()).size(),
              safe(runs_text(doc)),
              doc.value("bidirectional", true) ? "bidirectional" : "unidirectional");
-  for (const auto& r : linear_rows(doc))
-    fmt::print("{}  {:<8} {:>10} um   {}\n", in, safe(r.symbol), number_text(r.value),
-               safe(r.description));
-  for (const auto& w : doc.value("warnings", json::array()))
-    if (w.is_string()) fmt::print("{}warning: {}\n", in, safe(w.get<std::string>()));
+  print_rows_and_warnings(linear_rows(doc), "um", doc, in);
   for (const auto& n : doc.value("notes", json::array()))
     if (n.is_string()) fmt::print("{}note: {}\n", in, safe(n.get<std::string>()));
 }
@@ -143,11 +149,7 @@ void print_rotary_doc(const json& doc, std::string_view in) {
   fmt::print("{}{} targets, {} runs per direction, {}\n", in,
              doc.value("targets", json::array()).size(), number_of(doc, "runs"),
              doc.value("bidirectional", true) ? "bidirectional" : "unidirectional");
-  for (const auto& r : rotary_rows(doc))
-    fmt::print("{}  {:<8} {:>10} arcsec   {}\n", in, safe(r.symbol), number_text(r.value),
-               safe(r.description));
-  for (const auto& w : doc.value("warnings", json::array()))
-    if (w.is_string()) fmt::print("{}warning: {}\n", in, safe(w.get<std::string>()));
+  print_rows_and_warnings(rotary_rows(doc), "arcsec", doc, in);
 }
 
 std::string number_text(double value, int decimals) {

@@ -175,42 +175,42 @@ struct SimulatedShop::Impl {
         ids(ctx, world, clock, laser(l)),
         ptu(ctx, world, clock),
         material(ctx, world, clock,
-                 {.continuous = false,
-                  .request = "?",
-                  .decimals = 3,
-                  .value = [](const sim::World& w) { return w.state().machine_temperature_degc; }}),
+                 polled(3, [](const sim::World& w) { return w.state().machine_temperature_degc; })),
         ballbar(ctx, world, clock,
                 {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}),
         position(ctx, world, clock),
         test(l),
+        // The indicator reads the probe point's deviation from the nominal line it is commanded
+        // on: where the axes stand off the command across the travel (a control's compensation
+        // moves them) plus the geometric error there; in mm, to 10 nm digits.
         indicator(ctx, world, clock,
-                  {.continuous = false,
-                   .request = "?",
-                   .decimals = 5,  // mm: 10 nm digits
-                   .answer_delay = answer_delay(t, s, ctx),
-                   .measure_on_answer = t.probe_measures_on_answer,
-                   // The probe point's deviation from the nominal line it is commanded on:
-                   // where the axes stand off the command across the travel (a control's
-                   // compensation moves them) plus the geometric error there.
-                   .value =
-                       [this](const sim::World& w) {
-                         const auto& st = w.state();
-                         return st.axes_mm[dir()] - st.commanded_mm[dir()] +
-                                probe_error().translation_um[dir()] * 1e-3;
-                       }}),
+                  polled_probe(t, s, ctx, 5,
+                               [this](const sim::World& w) {
+                                 const auto& st = w.state();
+                                 return st.axes_mm[dir()] - st.commanded_mm[dir()] +
+                                        probe_error().translation_um[dir()] * 1e-3;
+                               })),
+        // The level reads the rotation about the test axis, in urad to 1 nrad digits.
         level(ctx, world, clock,
-              {.continuous = false,
-               .request = "?",
-               .decimals = 3,  // urad: 1 nrad digits
-               .answer_delay = answer_delay(t, s, ctx),
-               .measure_on_answer = t.probe_measures_on_answer,
-               .value = [this](const sim::World&) { return probe_error().rotation_urad[axis()]; }}),
+              polled_probe(
+                  t, s, ctx, 3,
+                  [this](const sim::World&) { return probe_error().rotation_urad[axis()]; })),
         angle(ctx, world, clock,
               polled(3, [this](const sim::World& w) { return reference_arcsec(w); })) {}
 
   // A twin answering "?" with value(world) to `decimals` digits (arcsec: 0.001" digits).
   static sim::GaugeTwinConfig polled(int decimals, std::function<double(const sim::World&)> value) {
     return {.continuous = false, .request = "?", .decimals = decimals, .value = std::move(value)};
+  }
+  // A probe of the linear tests (indicator, level): polled as above, answering after the
+  // probes' delay and, when the truth says so, measuring at the answer instead of the request.
+  static sim::GaugeTwinConfig polled_probe(const ShopTruth& shop_truth, double shop_speed,
+                                           boost::asio::io_context& loop, int decimals,
+                                           std::function<double(const sim::World&)> value) {
+    auto c = polled(decimals, std::move(value));
+    c.answer_delay = answer_delay(shop_truth, shop_speed, loop);
+    c.measure_on_answer = shop_truth.probe_measures_on_answer;
+    return c;
   }
 
   // The angular reference's reading: the axis's angle with its scale error, zeroed

@@ -367,13 +367,10 @@ struct LiveServer::Impl : std::enable_shared_from_this<LiveServer::Impl> {
     s->stream.expires_after(std::min<Clock::duration>(options.request_timeout, max_linger));
     boost::system::error_code ignored;
     s->stream.socket().shutdown(tcp::socket::shutdown_send, ignored);
-    s->stream.async_read_some(asio::buffer(s->discard),
-                              [self = shared_from_this(), s](beast::error_code ec, std::size_t) {
-                                if (s->closed) return;
-                                if (ec) return self->close(s);
-                                self->linger_more(s);
-                              });
+    linger_more(s);
   }
+  // Reads and drops one piece of what the client still sends, until the client closes, an
+  // error, or the time-out set by linger.
   void linger_more(const SessionPtr& s) {
     s->stream.async_read_some(asio::buffer(s->discard),
                               [self = shared_from_this(), s](beast::error_code ec, std::size_t) {
