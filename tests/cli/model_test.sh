@@ -21,6 +21,11 @@ check map_json 0 '"schema": "caldaq.volumetric-map.v1"' -- "$DAQ" model map "$Y"
 check map_report 0 "report written to $TMP/map.html" -- "$DAQ" model map "$Y" --report "$TMP/map.html"
 check map_report_svg 0 "^3$" -- grep -c "<svg class=\"plot\"" "$TMP/map.html"
 check map_report_rank 0 "<td>E_YY</td>" -- cat "$TMP/map.html"
+# Each error's source in words, not the model file's raw JSON object.
+"$DAQ" sim --truth-out "$TMP/truth.json" >/dev/null
+"$DAQ" model map "$TMP/truth.json" --count 3 3 3 --report "$TMP/truth.html" >/dev/null
+check map_report_source 0 "<td>origin: simulated; what: injected</td>" -- cat "$TMP/truth.html"
+check map_report_no_raw_json 0 "^0$" -- bash -c 'grep -c "{&quot;origin\|{\"origin" "$1"; true' _ "$TMP/truth.html"
 check map_outside 2 "E_YY: position 450 mm is outside the error table" -- "$DAQ" model map "$Y" --min-mm 0 0 -300 --max-mm 500 450 0
 # Compensation: the squareness on its carrier Y is the table X = f(Y), +0.05 um per mm of y:
 # 0.0050 mm at y = 100 (point 2 of 0, 50, ...). Exact up to the rotation's second order.

@@ -45,6 +45,8 @@ check history 0 "ZX at 3000 mm/min, R 100 mm" -- "$DAQ" ballbar history --db "$T
 "$DAQ" report --campaign simulated --db "$TMP/run.sqlite" -o "$TMP/campaign.html" >/dev/null
 check report_table 0 "<h3>Three-plane table</h3>" -- cat "$TMP/campaign.html"
 check report_b0z 0 "E_B0Z = \+1[45]\.[0-9]{3}" -- cat "$TMP/campaign.html"
+# The runs averaged by number, said so (a bare "1" under "runs" read as a count).
+check report_runs_named 0 "<td[^>]*>XY</td><td[^>]*>runs? [0-9]+(, [0-9]+)*</td>" -- cat "$TMP/campaign.html"
 # The capture replayed: the whole set again, as runs 7..12, with the same squareness.
 REP=$("$DAQ" replay "$TMP/set.cdq" --db "$TMP/run.sqlite" 2>&1)
 check replay_all 0 "replayed .* into run 12 " -- echo "$REP"

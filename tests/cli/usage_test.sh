@@ -89,6 +89,10 @@ check run_no_distance_to_target 0 "^absent$" -- absent "[-+][0-9]{4,}\.[0-9]+ um
 check run_stop_k_of_n 0 "^run 2 of 2 down  target 1 of 2  stop 8 of 8  " -- cat "$TMP/run.log"
 check run_air_when_sampled 0 "air [12][0-9]\.[0-9]{2} degC  material [12][0-9]\.[0-9]{2} degC  [0-9]+:[0-9]{2} elapsed" -- cat "$TMP/run.log"
 check run_time_left 0 "stop [2-8] of 8  .* elapsed, about [0-9]+:[0-9]{2} left$" -- cat "$TMP/run.log"
+# daq sim --tolerances: only tolerance tables, only with --measure; refused before anything runs.
+printf '[tolerances.X]\nstraightness_um = 1\n[machine]\nname = "x"\n' >"$TMP/tol-bad.toml"
+check sim_tolerances_only 2 "tol-bad.toml:3:1: 'machine': only \[tolerances.AXIS\] and \[tolerances.PLANE\] tables" -- "$DAQ" sim --measure E_YX --acquire --tolerances "$TMP/tol-bad.toml" --db "$TMP/tol.sqlite" -o "$TMP/tol.toml"
+check sim_tolerances_measure 2 "--tolerances applies to --measure" -- "$DAQ" sim --test linear --acquire --tolerances "$TMP/tol-bad.toml" --db "$TMP/tol.sqlite" -o "$TMP/tol.toml"
 # --json: the result alone on stdout, the progress as JSON lines on stderr.
 (cd "$TMP" && "$DAQ" sim --test linear --acquire --json --runs 2 --targets 2 --db "$TMP/run.sqlite" -o "$TMP/sim2.toml" >"$TMP/run.json" 2>"$TMP/run.err")
 check run_json_result 0 "^linear complete 0$" -- python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print("linear", d["status"], len(d["missed_stops"]))' "$TMP/run.json"

@@ -51,6 +51,28 @@ std::string describe_topology(kin::Topology t) {
                      tool_axes.empty() ? "no axis" : tool_axes);
 }
 
+// An error's source (the model file's free-form JSON object) as words for the page,
+// "origin: simulated; what: injected", not the raw {"origin":"simulated",...}; the terminal and
+// anything not an object keep the text as stored.
+static std::string source_words(const std::string& source, bool html) {
+  const auto j = json::parse(source, nullptr, false);
+  if (!html || !j.is_object()) return source;
+  std::string out;
+  for (const auto& [key, value] : j.items()) {
+    std::string v;
+    if (value.is_string()) {
+      v = value.get<std::string>();
+    } else if (value.is_array()) {
+      for (const auto& x : value)
+        v += (v.empty() ? "" : ", ") + (x.is_string() ? x.get<std::string>() : x.dump());
+    } else {
+      v = value.dump();
+    }
+    out += (out.empty() ? "" : "; ") + key + ": " + v;
+  }
+  return out;
+}
+
 std::vector<std::vector<std::string>> describe_components(const mdl::Model& m, bool html) {
   const char* um_unit = html ? "µm" : "um";
   const char* urad_unit = html ? "µrad" : "urad";
@@ -86,7 +108,8 @@ std::vector<std::vector<std::string>> describe_components(const mdl::Model& m, b
         values = fmt::format("{:.3f} {} at 0", f(0.0), unit);
       }
     }
-    rows.push_back({std::string(kin::to_string(c)), form, values, entry.source.json});
+    rows.push_back(
+        {std::string(kin::to_string(c)), form, values, source_words(entry.source.json, html)});
   }
   for (kin::Plane p : {kin::Plane::xy, kin::Plane::xz, kin::Plane::yz}) {
     const auto& s = m.squareness[static_cast<std::size_t>(p)];
@@ -103,7 +126,7 @@ std::vector<std::vector<std::string>> describe_components(const mdl::Model& m, b
                     fmt::format("{:+.3f} {} ({:+.3f} {}), carried by {}", v, urad_unit,
                                 kin::angle_over_90_from_location_error(p, v), over_90,
                                 kAxis[m.carriers.of(p)]),
-                    s.source.json});
+                    source_words(s.source.json, html)});
   }
   return rows;
 }

@@ -23,6 +23,7 @@
 #include "cli_checks.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "config_tolerances.hpp"
 #include "database.hpp"
 #include "linear_run.hpp"
 #include "model/model_file.hpp"
@@ -57,6 +58,7 @@ struct SimOptions {
   std::string capture;    // with acquire: the run's capture file
   bool json = false;      // with acquire: the result as JSON on stdout (as daq run --json)
   std::string truth_out;  // write the volumetric machine's injected errors as a model, exit
+  std::string tolerances;  // with measure: a file of [tolerances] tables added to the config
   std::vector<double> truth_tool_offset_mm;  // with truth_out: the tool the model is for
 };
 
@@ -110,6 +112,17 @@ window_mm = 0.5
       fmt::arg("alpha", shop.truth().expansion_ppm_per_k), fmt::arg("trigger_dwell", 1.5 / speed),
       fmt::arg("topology", cal::kinematics::to_string(shop.truth().geometry->topology)),
       fmt::arg("linear", linear_toml(test)));
+}
+
+// The [tolerances] tables of a file, as text to add to the configuration `daq sim --measure`
+// writes (which has none: the volumetric machine has no specification of its own). Anything
+// else in the file is refused, naming it: the rest of the configuration is the shop's.
+std::string tolerances_toml(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw cal::InputError(fmt::format("--tolerances {}: cannot read", file));
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  cal::daq::parse_tolerances(text, file);  // checked, naming file:line:column
+  return "\n# Added by daq sim --tolerances\n" + text + "\n";
 }
 
 // A run that has started in the database since `after` (its id), or nullopt. The database may
@@ -200,8 +213,13 @@ void run_sim(SimOptions o) {
                fmt::join(o.control_table, ", "), o.control_format,
                o.control_inverted ? ", read with the other sign" : "");
   }
+  if (!o.tolerances.empty() && !volumetric)
+    throw cal::InputError(
+        "--tolerances applies to --measure (the other tests' configurations have the demo's "
+        "specification)");
   const std::string text =
-      volumetric ? volumetric_config(shop, o.speed, *volumetric)
+      volumetric ? volumetric_config(shop, o.speed, *volumetric) +
+                       (o.tolerances.empty() ? "" : tolerances_toml(o.tolerances))
                  : simulated_shop_config(shop, {.speed = o.speed,
                                                 .position_feed = o.position_feed,
                                                 .in_process = false,
@@ -371,6 +389,9 @@ void add_sim_command(CLI::App& app) {
                 "`daq run TEST --config FILE` runs in this process on SIMULATED time (as fast as "
                 "the CPU allows, the same on a loaded machine), prints what it prints and stores "
                 "into --db");
+  cmd->add_option("--tolerances", o->tolerances,
+                  "With --measure: a TOML file of [tolerances.AXIS] tables (docs/config.md) "
+                  "added to the configuration written, so the run is judged against them");
   cmd->add_option("--truth-out", o->truth_out,
                   "Write the SIMULATED volumetric machine's injected errors (of --topology) as a "
                   "model file and exit: compare a built model with it (`daq model compare`)");

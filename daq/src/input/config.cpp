@@ -21,6 +21,7 @@
 #include "cal/daq/config_fields.hpp"
 #include "cal/drivers/registry.hpp"
 #include "cal/drivers/transport/transport.hpp"
+#include "config_tolerances.hpp"
 
 namespace cal::daq {
 namespace {
@@ -571,14 +572,28 @@ const DeviceConfig* Config::device_for(std::string_view role) const {
   return nullptr;
 }
 
-Config parse_config(std::string_view text, const std::filesystem::path& file) {
-  toml::table root;
+namespace {
+toml::table parse_toml(std::string_view text, const std::filesystem::path& file) {
   try {
-    root = toml::parse(text, file.string());
+    return toml::parse(text, file.string());
   } catch (const toml::parse_error& e) {
     throw InputError(fmt::format("{}:{}:{}: {}", file.string(), e.source().begin.line,
                                  e.source().begin.column, e.description()));
   }
+}
+}  // namespace
+
+Config parse_tolerances(std::string_view text, const std::filesystem::path& file) {
+  for (const auto& [key, value] : parse_toml(text, file))
+    if (key.str() != "tolerances")
+      throw InputError(fmt::format(
+          "{}:{}:{}: '{}': only [tolerances.AXIS] and [tolerances.PLANE] tables are taken here",
+          file.string(), value.source().begin.line, value.source().begin.column, key.str()));
+  return parse_config(text, file);
+}
+
+Config parse_config(std::string_view text, const std::filesystem::path& file) {
+  const toml::table root = parse_toml(text, file);
   Config c;
   c.source = file;
   Table top(root, "", file);

@@ -407,7 +407,8 @@ std::string svg(const PolarChart& chart) {
   // Under the plot: two lines (the rings' scale and the nominal one, the start marks), then the
   // legend's rows.
   const int notes = chart.mark_start ? 2 : 1;
-  const double legend_top_pt = (1.25 * notes + 0.6) * char_pt;
+  // 1.5 lines apart: at 1.25 the "µ" of the first touched the "○" of the second.
+  const double legend_top_pt = (1.5 * notes + 0.35) * char_pt;
   const double height =
       top + side + legend_top_pt + (rows > 0 ? 1.7 * char_pt * rows + 0.6 * char_pt : 0.0);
   SvgStream s(chart.size_pt, static_cast<int>(height));
@@ -464,7 +465,7 @@ std::string svg(const PolarChart& chart) {
   // once the plot was drawn narrow enough to stand beside a table.
   plmtex("b", 1.2, 0.0, 0.0,
          fmt::format("rings every {:g} µm, the dark one nominal", div_um).c_str());
-  if (chart.mark_start) plmtex("b", 2.45, 0.0, 0.0, "○ start, arrow: direction of travel");
+  if (chart.mark_start) plmtex("b", 2.7, 0.0, 0.0, "○ start, arrow: direction of travel");
   if (max_abs_um == 0.0 && chart.traces.empty()) plptex(0, 0, 1, 0, 0.5, "no data");
   // Below the scale's line.
   draw_legend(legend, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,

@@ -1851,6 +1851,17 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
 
 std::string date_of(const RunView& v) { return iso_time(v.run.started_unix_ms).substr(0, 10); }
 
+// A comparison table's date cell (the run column names the run): the day, and its time when
+// runs share a day. It may wrap between its parts, not inside one: "11-" over "28" read as no
+// date (nothing unbroken either: "run 3 11-28 07:31" on one line printed the page shrunk).
+std::string date_cell(const std::string& iso, bool with_time) {
+  const auto part = [](std::string_view t) {
+    return fmt::format("<span class=\"nw\">{}</span>", t);
+  };
+  return with_time ? part(iso.substr(5, 5)) + " " + part(iso.substr(11, 5))
+                   : part(iso.substr(0, 5)) + "<wbr>" + part(iso.substr(5, 5));
+}
+
 }  // namespace
 
 std::string run_report(const st::RunReader& store, std::int64_t run, const Options& o) {
@@ -1894,6 +1905,8 @@ std::string volumetric_section(const st::RunReader& store, std::span<const std::
     if (!pv) continue;
     std::string used;
     for (auto r : v.used[i].runs) used += (used.empty() ? "" : ", ") + std::to_string(r);
+    // The runs by number, said so: a bare "2" under "runs" read as a count of two.
+    used = (v.used[i].runs.size() == 1 ? "run " : "runs ") + used;
     const auto mp = cal::circle::model_plane(pv->plane);
     planes.push_back({i == 0   ? "XY"
                       : i == 1 ? "YZ"
@@ -1911,7 +1924,7 @@ std::string volumetric_section(const st::RunReader& store, std::span<const std::
   }
   h += "<h3>Three-plane table</h3>\n";
   if (!planes.empty())
-    h += table({"plane", "runs", "feed (mm/min)", "squareness α (µm/m)",
+    h += table({"plane", "averaged", "feed (mm/min)", "squareness α (µm/m)",
                 "model location error (µrad)", "scale mismatch (µm/m)", "mean scale (µm/m)"},
                planes, "num", "llrrrrr");
   h += "<p>Each plane at its slowest feed (servo errors grow with the feed, geometric errors do "
@@ -2111,7 +2124,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     std::vector<std::string> row{
         std::to_string(v.run.id) +
             (v.used.recompensated ? "<br><span class=\"changed\">re-compensated</span>" : ""),
-        dates[i]};  // may wrap: the table of a re-compensated run printed shrunk to fit
+        date_cell(iso_time(v.run.started_unix_ms), same_day)};
     std::map<std::string, std::string> by_key;  // the value cells, placed by key below
     // A linear run's table keeps to the values a specification limits (the unidirectional ones
     // are in each run's report): all twelve would not fit a printed page.
@@ -2190,7 +2203,12 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   // One small plot per value: each on its own scale, the runs in date order, the limit dashed.
   body += "<h3>Each value over time</h3>\n<div class=\"multiples\">\n";
   std::size_t plotted = 0;
-  for (const auto& k : trend_order) {
+  // Those with a limit first: of a circle's 17 values the ten plotted left out the failing
+  // backlash X (ranked last by its gain).
+  auto plot_order = trend_order;
+  std::stable_partition(plot_order.begin(), plot_order.end(),
+                        [&](const std::string& k) { return limits.count(k) > 0; });
+  for (const auto& k : plot_order) {
     if (first.run.kind == "linear" &&
         std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
       continue;
@@ -2244,7 +2262,17 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   struct Side {
     json doc;
     ::daq::Verdict verdict;
-    std::vector<std::tuple<std::string, std::string, double>> values;  // key, symbol, value
+    struct Entry {
+      std::string key, label;  // the label with its unit: "Squareness XY (µm/m)"
+      double value = 0;
+      bool is_signed = false;  // a diagnostic: its sign is the error's direction
+    };
+    std::vector<Entry> values;
+  };
+  // A circle's table mixed µm, µm/m and ms under a head without units.
+  const auto entry = [](const auto& r, bool is_signed) {
+    return Side::Entry{r.key, fmt::format("{} ({})", r.symbol, unit_text(r.unit)), r.value,
+                       is_signed};
   };
   XyChart overlay{.title = "Mean bidirectional deviation, as found and as left",
                   .x_label = "target position (mm)",
@@ -2264,8 +2292,7 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
       sd.doc = ::daq::to_json(l.e);
-      for (const auto& r : ::daq::linear_rows(sd.doc))
-        sd.values.emplace_back(r.key, r.symbol, r.value);
+      for (const auto& r : ::daq::linear_rows(sd.doc)) sd.values.push_back(entry(r, false));
     } else {
       const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
@@ -2273,24 +2300,24 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
       for (auto& t : p.traces) polar.traces.push_back(std::move(t));
       sd.doc = ::daq::circle_document(c.result, c.program, c.analysis);
       for (const auto& r : ::daq::circle_rows(sd.doc))
-        if (r.key.starts_with("G")) sd.values.emplace_back(r.key, r.symbol, r.value);
-      for (const auto& r : ::daq::diagnostic_rows(sd.doc))
-        sd.values.emplace_back(r.key, r.symbol, r.value);
+        if (r.key.starts_with("G")) sd.values.push_back(entry(r, false));
+      for (const auto& r : ::daq::diagnostic_rows(sd.doc)) sd.values.push_back(entry(r, true));
     }
     sd.verdict = ::daq::verdict_of(v.settings, sd.doc);
     return sd;
   };
   const auto a = side(found, 1, "as found"), b = side(left, 2, "as left");
   std::vector<std::vector<std::string>> rows;
-  for (const auto& [key, symbol, va] : a.values) {
+  for (const auto& e : a.values) {
     std::optional<double> vb;
-    for (const auto& [k2, s2, x] : b.values)
-      if (k2 == key) vb = x;
-    const auto* ca = ::daq::find_check(a.verdict, key);
-    const auto* cb = ::daq::find_check(b.verdict, key);
-    rows.push_back({esc(symbol), um(va) + " " + (ca ? verdict_cell(ca) : ""),
-                    vb ? um(*vb) + " " + (cb ? verdict_cell(cb) : "") : "&ndash;",
-                    vb ? signed_text(*vb - va, 3) : "&ndash;", limit_cell(cb ? cb : ca)});
+    for (const auto& other : b.values)
+      if (other.key == e.key) vb = other.value;
+    const auto text = [&](double x) { return e.is_signed ? signed_text(x, 3) : um(x); };
+    const auto* ca = ::daq::find_check(a.verdict, e.key);
+    const auto* cb = ::daq::find_check(b.verdict, e.key);
+    rows.push_back({esc(e.label), text(e.value) + " " + (ca ? verdict_cell(ca) : ""),
+                    vb ? text(*vb) + " " + (cb ? verdict_cell(cb) : "") : "&ndash;",
+                    vb ? signed_text(*vb - e.value, 3) : "&ndash;", limit_cell(cb ? cb : ca)});
   }
   const auto banner = [](const ::daq::Verdict& v) {
     return !v.configured ? std::string("<span class=\"unstated\">no tolerance configured</span>")
