@@ -343,13 +343,14 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
     const std::size_t n = lengths[i], len = std::min(n, cap);
     const std::size_t count = n <= cap ? 1 : (n - cap) / (cap / 2) + 1;
     segments.push_back(n <= cap ? 1 : n / cap);  // the line fit's: cap samples, the last longer
-    std::vector<double> p(npad / 2 + 1, 0.0);
+    std::vector<double> p;  // one segment's periodogram, or the average of them
     for (std::size_t k = 0; k < count; ++k) {
       auto one = periodogram(resample(traces[i], tms[i], dt, k * (cap / 2), len), npad);
       if (count == 1) {
         p = std::move(one);
         break;
       }
+      if (p.empty()) p.assign(one.size(), 0.0);
       for (std::size_t b = 0; b < p.size(); ++b) p[b] += one[b] / static_cast<double>(count);
     }
     for (std::size_t k = 0; k < mean.size(); ++k)
