@@ -339,13 +339,20 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   std::vector<std::vector<double>> ps;
   std::vector<std::size_t> segments;
   std::vector<double> mean(npad / 2 + 1, 0.0);
+  // Every trace's first segment is resampled before the transforms, as the whole series were:
+  // freed in the same order, the allocator reuses the same blocks on the next analysis instead
+  // of returning them (interleaved, 17 times the page faults: 10 ms of 70 on 2 x 36,000).
+  std::vector<std::vector<double>> first;
+  for (std::size_t i = 0; i < traces.size(); ++i)
+    first.push_back(resample(traces[i], tms[i], dt, 0, std::min(lengths[i], cap)));
   for (std::size_t i = 0; i < traces.size(); ++i) {
     const std::size_t n = lengths[i], len = std::min(n, cap);
     const std::size_t count = n <= cap ? 1 : (n - cap) / (cap / 2) + 1;
     segments.push_back(n <= cap ? 1 : n / cap);  // the line fit's: cap samples, the last longer
     std::vector<double> p;  // one segment's periodogram, or the average of them
     for (std::size_t k = 0; k < count; ++k) {
-      auto one = periodogram(resample(traces[i], tms[i], dt, k * (cap / 2), len), npad);
+      auto one = periodogram(
+          k == 0 ? std::move(first[i]) : resample(traces[i], tms[i], dt, k * (cap / 2), len), npad);
       if (count == 1) {
         p = std::move(one);
         break;
