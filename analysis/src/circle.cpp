@@ -463,6 +463,9 @@ void validate_setup(const Setup& setup) {
   if (!(setup.stick_slip_window_deg > 1.0 && setup.stick_slip_window_deg <= 45.0))
     throw InputError(fmt::format("circle: stick-slip window {} degrees must be > 1 and <= 45",
                                  setup.stick_slip_window_deg));
+  if (setup.vibration_segment_samples < 256)
+    throw InputError(fmt::format("circle: vibration segment of {} samples, at least 256 needed",
+                                 setup.vibration_segment_samples));
 }
 
 void validate_trace(const Trace& t) {
@@ -875,6 +878,7 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
   const dynamics::Settings dyn{.radius_mm = setup.radius_mm,
                                .feed_mm_per_min = setup.feed_mm_per_min,
                                .window_deg = setup.stick_slip_window_deg,
+                               .segment_samples = setup.vibration_segment_samples,
                                .u = ax[0],
                                .v = ax[1]};
   const auto vibration = dynamics::vibration(dyn, residuals, res.notes);

@@ -27,7 +27,10 @@ struct Settings {
   double radius_mm = 100.0;
   double feed_mm_per_min = 1000.0;
   double window_deg = 10.0;  // stick-slip: the low-speed window about each reversal of an axis
-  char u = 'X', v = 'Y';     // the plane's axes, for the names
+  // Vibration: the spectrum is averaged over segments of at most this many samples (Welch), so
+  // its memory does not grow with the run; a trace no longer than this is one segment.
+  std::size_t segment_samples = 131072;
+  char u = 'X', v = 'Y';  // the plane's axes, for the names
 };
 
 struct Found {

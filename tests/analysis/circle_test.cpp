@@ -551,6 +551,80 @@ TEST(CircleDynamics, AVibrationInOneDirectionOnlyIsNotReported) {
   EXPECT_TRUE(noted);
 }
 
+// The vibration's spectrum in segments (Welch, issue 32): a trace longer than
+// vibration_segment_samples is cut into segments of that many samples, half overlapping, whose
+// periodograms are averaged, and the lines are fitted per segment. The truth is the injected
+// vibration (as in VibrationAlongAnAxisFromTheSpectrum); the frequency is located to a
+// fraction of the segment's resolution 1 / T_segment instead of the trace's 1 / T.
+Result vibrating(const Machine& m, std::size_t n, std::size_t segment_samples) {
+  const Trace t[] = {simulate(m, Direction::ccw, n, 1), simulate(m, Direction::cw, n, 2)};
+  return analyse({.radius_mm = R,
+                  .feed_mm_per_min = feed,
+                  .cyclic_period_mm = m.cyclic_period_mm,
+                  .vibration_segment_samples = segment_samples},
+                 t);
+}
+
+TEST(CircleDynamics, VibrationFromSegmentsOfTheTrace) {
+  // 3600 samples a trace (95.5 Hz), segments of 1024 (T_segment = 1023 / 95.5 = 10.7 s, six a
+  // trace): 1 um along X at 23.7 Hz, rms A / 2 = 0.5 um within 5 % as from the whole trace (the
+  // lines fitted in three segments a trace take 36 / 7200 of the noise power, 2e-4 um^2), the
+  // frequency within 0.2 / T_segment = 0.019 Hz.
+  const Machine m{
+      .square_um_per_m = 20, .lag_v_ms = 1.0, .noise = 0.2, .vib_um = 1.0, .vib_hz = 23.7};
+  const auto seg = vibrating(m, 3600, 1024), whole = vibrating(m, 3600, 4096);
+  const auto* v = find(seg, "vibration");
+  ASSERT_NE(v, nullptr);
+  EXPECT_NEAR(v->value, 0.5, 0.025);
+  ASSERT_TRUE(v->frequency_hz);
+  EXPECT_NEAR(*v->frequency_hz, 23.7, 0.019);
+  EXPECT_NEAR(seg.residual_rms_um, 0.2, 0.02);
+  EXPECT_NEAR(values(seg).at("squareness"), 20, 1.0);
+  EXPECT_EQ(find(seg, "stick_slip_X"), nullptr);
+  // Beside the whole trace's spectrum (one segment: the same as the default for 3600 samples).
+  const auto* full = find(whole, "vibration");
+  ASSERT_NE(full, nullptr);
+  EXPECT_NEAR(v->value, full->value, 0.02 * full->value);
+  EXPECT_NEAR(*v->frequency_hz, *full->frequency_hz, 0.019);
+  // A radial one (one line at f, rms A / sqrt 2).
+  const Machine radial{.noise = 0.1, .vib_um = 0.6, .vib_hz = 31.1, .vib_dir_deg = std::nan("")};
+  const auto r = vibrating(radial, 3600, 1024);
+  const auto* rv = find(r, "vibration");
+  ASSERT_NE(rv, nullptr);
+  EXPECT_NEAR(rv->value, 0.6 / std::sqrt(2.0), 0.02);
+  EXPECT_NEAR(*rv->frequency_hz, 31.1, 0.019);
+}
+
+TEST(CircleDynamics, NoVibrationFoundInSegmentsOfNoiseOrStickSlip) {
+  // Segments see a quarter of the circle each: noise, a stick-slip about the reversals (local,
+  // broadband) and the geometric errors must not become a vibration there either.
+  const std::vector<Machine> machines = {{.noise = 0.2},
+                                         {.backlash_u = 4, .noise = 0.1, .stick_u = 3.0},
+                                         {.backlash_u = 6, .backlash_v = 4, .noise = 0.05},
+                                         {.cyclic_u = 1.5, .cyclic_v = 0.8, .noise = 0.05},
+                                         {.spike_u = 3, .spike_v = -2, .noise = 0.05}};
+  for (std::size_t i = 0; i < machines.size(); ++i)
+    EXPECT_EQ(find(vibrating(machines[i], 3600, 1024), "vibration"), nullptr) << "machine " << i;
+}
+
+TEST(CircleDynamics, VibrationOfALongTraceInManySegments) {
+  // 100,000 samples a trace (2.65 kHz over 37.7 s) in segments of 16,384 (6.2 s, eleven a trace
+  // averaged; the spectrum holds one): the injected 1 um at 23.7 Hz along X, rms 0.5 um within
+  // 5 %, frequency within 0.2 / 6.2 s = 0.032 Hz.
+  const Machine m{.noise = 0.2, .vib_um = 1.0, .vib_hz = 23.7};
+  const auto r = vibrating(m, 100'000, 16'384);
+  const auto* v = find(r, "vibration");
+  ASSERT_NE(v, nullptr);
+  EXPECT_NEAR(v->value, 0.5, 0.025);
+  EXPECT_NEAR(*v->frequency_hz, 23.7, 0.032);
+  EXPECT_NEAR(r.residual_rms_um, 0.2, 0.02);
+}
+
+TEST(CircleDynamics, RefusesATooShortVibrationSegment) {
+  const Trace t = simulate({}, Direction::ccw, 360, 1);
+  EXPECT_THROW(analyse({.vibration_segment_samples = 255}, std::span(&t, 1)), cal::InputError);
+}
+
 TEST(CircleDynamics, StickSlipOfOneAxisAtItsReversals) {
   // X sticks and slips by 3 um where it moves slower than 0.2 F (|sin theta| < 0.2, 11.5 deg
   // about its reversals at 0 and 180 degrees): a sawtooth lag uniform over 0..3 um, rms about

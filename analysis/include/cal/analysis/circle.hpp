@@ -57,6 +57,11 @@ struct Setup {
   double start_deg = 0.0;      // where the ccw arc move starts (the end of the feed-in)
   double arc_deg = 360.0;      // the measured arc, 180..360
   double overshoot_deg = 0.0;  // run before and after the measured arc, trimmed
+  // The vibration's spectrum: a trace (resampled to its time step) of at most this many samples
+  // is one periodogram; a longer one is cut into segments of this many, half overlapping, whose
+  // periodograms are averaged (Welch), so the spectrum's memory does not grow with the run
+  // (issue 32). At least 256. The default holds 131 s at 1 kHz, 13 s at 10 kHz.
+  std::size_t vibration_segment_samples = 131072;
 };
 
 // theta(t) = start + s * (feed / R) * t, s = +1 ccw, -1 cw: the tool moves at the feed along
