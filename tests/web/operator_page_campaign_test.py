@@ -115,11 +115,17 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--
     shown = b.wait("const r = [...document.querySelectorAll('#model-table tbody tr')]; return r.length === 21 && "
                    "Object.fromEntries(r.map(x => [x.dataset.error, [...x.cells].map(c => c.textContent)]));",
                    timeout_s=60, what="the model's 21 errors on the page")
-    ok(all(shown[e][3] == want[e] for e in want) and len(want) == 21,
-       f"each error's contribution as `daq model map` ranks it: E_XX {shown['E_XX']} vs {want['E_XX']}")
+    measured = [e for e in want if e not in cli["missing"]]
+    ok(measured and all(shown[e][3] == want[e] for e in measured) and len(want) == 21,
+       f"each measured error's contribution as `daq model map` ranks it: E_XX {shown['E_XX']} vs {want['E_XX']}")
+    # An error not measured has no number (the model takes it as zero: a 0.00 would read as a
+    # measurement): a dash in both value columns, "not measured", and the note under the table.
+    ok(all(shown[e][2:] == ["not measured", "—", "—"] for e in cli["missing"]) and len(cli["missing"]) == 16,
+       f"each error not measured shows a dash, no number: {shown['E_BX']}")
     ok(shown["E_XX"][1] == ", ".join(map(str, cli["used"]["E_XX"])) and shown["E_XX"][2] == "measured" and
-       shown["E_BX"][1] == "—" and shown["E_BX"][2] == "not measured: zero",
-       f"measured errors with their runs, the others said to be zero: {shown['E_XX']} {shown['E_BX']}")
+       shown["E_BX"][1] == "—", f"measured errors with their runs: {shown['E_XX']} {shown['E_BX']}")
+    note = b.js("const n = document.getElementById('model-note'); return !n.hidden && n.textContent;")
+    ok(note and note.startswith("— not measured") and "as zero" in note, f"the note says what the dash means: {note!r}")
     state = b.js("return document.getElementById('model-state').textContent;")
     ok(state == f"Partial model: {len(cli['missing'])} of 21 errors not measured yet, taken as zero "
        "(as `daq model build --allow-missing`).", f"the page says the model is partial: {state!r}")

@@ -100,6 +100,22 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     build = model_build(run)
     ok(build["used"].get("E_XY") == [run], f"`daq model build` takes run {run} for E_XY: {build['used']}")
 
+    # --- 3. the kinds follow the form's instruments, not the applied set-up -----------------
+    # The level removed in the form (not applied): roll is no longer offered (the kinds came
+    # from the applied set-up and still offered it); the Run view names the unapplied edit.
+    b.js("document.getElementById('tab-setup').click();")
+    wait("return !!document.querySelector('[data-key=\"test.linear.measure\"]');", "the form again")
+    b.js("const card = [...document.querySelectorAll('.device-card')].find(c => c.querySelector('[data-device-id]').value === 'level');"
+         "card.querySelector('button.stop').click();")
+    offered = wait("const c = window.caldaq.check; const o = [...document.querySelector('[data-key=\"test.linear.measure\"]').options]"
+                   ".map(o => o.value); return c && c.kinds && !c.kinds.includes('roll') && !o.includes('roll') && o;",
+                   "the kinds of the form's instruments")
+    ok(offered == ["", "positioning", "straightness", "angular"], f"without the level, no roll test is offered: {offered}")
+    b.js("document.getElementById('tab-run').click();")
+    pending = wait("const p = document.getElementById('pending-edits'); return !p.hidden && p.textContent;", "the unapplied edit named")
+    ok("level" in pending, f"the Run view says Start runs the applied set-up, not the edit: {pending!r}")
+    page_checks.shot(b, SHOTS, "k-edited-run-1366x768.png")
+
     b.js("document.getElementById('tab-setup').click();")
     page_checks.fits_narrow(b, SHOTS, "k-setup-560.png", "the form with the test kind fits 560 px")
     page_checks.no_script_error(b)

@@ -109,6 +109,12 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     wait("const s = window.caldaq.page.status.set; return s && s.state === 'complete' && s.table;", "the set's end")
     runs = b.js("return window.caldaq.page.status.set.tests.map(t => t.run);")
     ok(len(runs) == 3 and runs == sorted(runs) and runs[0] == first, f"three runs, one per test: {runs}")
+    # The simulated shop's specification covers every plane of the set (it had XY's alone: YZ
+    # and ZX said "no tolerance configured"): each test's verdict is judged.
+    verdicts = wait("const r = [...document.querySelectorAll('#set-box tr[data-set-test]')]; return r.length === 3 && "
+                    "r.every(x => x.cells[6].textContent !== '—') && r.map(x => [x.cells[1].textContent, x.cells[6].textContent]);",
+                    "the set's three verdicts")
+    ok(all(v in ("PASS", "FAIL") for _, v in verdicts), f"each plane judged against its tolerance: {verdicts}")
     cli = json.loads(subprocess.run([DAQ, "ballbar", "volumetric", "--db", DB, "--runs", ",".join(map(str, runs)), "--json"],
                                     capture_output=True, text=True, check=True).stdout)
     wait("return !document.getElementById('result-set').hidden;", "the Results with the set's table")

@@ -484,6 +484,9 @@ class Service {
         check.problems.push_back({refused->device + ".transport", refused->message});
     auto j = to_json(check);
     j["toml"] = check.toml;
+    // The kinds the form's instruments can measure: the page offers these while the operator
+    // edits (the applied set-up's kinds would offer a roll test with the level removed).
+    if (check.config) j["kinds"] = linear_kinds(*check.config);
     return ok(j);
   }
 

@@ -596,6 +596,17 @@ G_um = 10
 [tolerances.XY.diagnostics]
 squareness = 30
 backlash_X = 3
+
+# The set's other planes (YZ, ZX), judged by the same specification of G and squareness.
+[tolerances.YZ]
+G_um = 10
+[tolerances.YZ.diagnostics]
+squareness = 30
+
+[tolerances.ZX]
+G_um = 10
+[tolerances.ZX.diagnostics]
+squareness = 30
 )TOML",
                       fmt::arg("who", o.in_process ? "daq serve --simulate" : "daq sim"),
                       // In process the instruments read the shop's clock: every time is
