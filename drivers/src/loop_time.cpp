@@ -76,14 +76,25 @@ bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t unti
   // Bytes in flight are waited for until kSettle of wall time passes with no progress; a
   // deadline on the wall clock, not a count of 1 ms polls: a starved process polls less often
   // than that and would forget bytes still on their way (then jump past their answer).
+  // Only the counted I/O moving restarts the wait: a wall-clock handler (the page's publish
+  // timer, an HTTP request of `daq serve --simulate`) runs every few ms and would otherwise
+  // restart it for ever, so bytes a closed reader never takes stopped simulated time for good
+  // (every instrument silent after a set-up was applied, while the page kept updating).
   const auto settle_deadline = [] { return std::chrono::steady_clock::now() + kSettle; };
   auto settle_by = settle_deadline();
+  auto counted = std::pair(operations_, in_flight_);
+  const auto counted_moved = [&] {
+    const auto now = std::pair(operations_, in_flight_);
+    const bool moved = now != counted;
+    counted = now;
+    return moved;
+  };
   while (!finished()) {
     if (io_.stopped()) io_.restart();
     // Everything runnable now, I/O the kernel has ready included (poll checks it without
     // blocking). The clock stands still meanwhile.
     if (io_.poll_one() > 0) {
-      settle_by = settle_deadline();
+      if (counted_moved()) settle_by = settle_deadline();
       continue;
     }
     if (operations_ > 0 || in_flight_ > 0) {
@@ -91,7 +102,7 @@ bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t unti
       // time, then run what they complete, before any simulated time passes.
       if (io_.stopped()) io_.restart();
       if (io_.run_one_for(std::chrono::milliseconds(1)) > 0) {
-        settle_by = settle_deadline();
+        if (counted_moved()) settle_by = settle_deadline();
         continue;
       }
       if (std::chrono::steady_clock::now() < settle_by) continue;
@@ -104,6 +115,7 @@ bool VirtualTime::run_until(const std::function<bool()>& done, std::int64_t unti
       in_flight_ = 0;
     }
     settle_by = settle_deadline();
+    counted = std::pair(operations_, in_flight_);
     auto& waits = queue_->waits;
     if (waits.empty()) {
       // Nothing simulated is pending: only wall-clock work (a socket of a client in another

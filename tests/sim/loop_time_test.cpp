@@ -6,7 +6,9 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <chrono>
+#include <functional>
 #include <vector>
 
 #include "ptu300/instrument.hpp"
@@ -103,6 +105,41 @@ TEST(VirtualTime, PacedItWaitsForTheWallClockAndStillLandsOnTheDeadlines) {
   EXPECT_TRUE(time.run_for(10s, [&] { return fired_at >= 0; }));
   EXPECT_GE(steady_now_ns() - start, 50'000'000);
   EXPECT_EQ(fired_at, 500'000'000);
+}
+
+// Bytes counted in flight whose reader has gone (a monitor closed when `daq serve --simulate`
+// applied a set-up) are forgotten after kSettle of wall time even while wall-clock work keeps
+// running (the page's publish timer every few ms). Before, every such handler restarted the
+// wait: simulated time stood still for good and every instrument fell silent. The wall-clock
+// ticker stops by itself after 30 s, so the old code ends too, but with the timer fired only
+// after the ticker had stopped.
+TEST(VirtualTime, BytesNeverReadAreForgottenWhileWallClockWorkGoesOn) {
+  boost::asio::io_context io;
+  auto& time = d::VirtualTime::install(io);
+  time.pace(10.0);
+  time.bytes_written(5);  // never read
+  boost::asio::steady_timer ticker(io);
+  const std::int64_t start = steady_now_ns();
+  bool ticking = true;
+  std::function<void()> tick = [&] {
+    if (steady_now_ns() - start > 30'000'000'000) return void(ticking = false);
+    ticker.expires_after(5ms);
+    ticker.async_wait([&](const boost::system::error_code& ec) {
+      if (!ec) tick();
+    });
+  };
+  tick();
+  d::Timer timer(io);
+  bool fired_while_ticking = false, fired = false;
+  timer.expires_after(100ms);
+  timer.async_wait([&](const boost::system::error_code& ec) {
+    fired = !ec;
+    fired_while_ticking = ticking;
+  });
+  EXPECT_TRUE(time.run_for(10s, [&] { return fired; }));
+  ticker.cancel();
+  EXPECT_TRUE(fired_while_ticking);
+  EXPECT_EQ(time.stats().settle_timeouts, 1u);
 }
 
 TEST(VirtualTime, AnInstrumentPollsItsTwinOnSimulatedTimeAndStampsItsReadingsWithIt) {
