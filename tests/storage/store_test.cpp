@@ -475,7 +475,9 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 
 // What schema 7 added (the runs' UUIDs), taken off a new file to make a version 6 one; a macro so
 // that it prefixes the other undo strings as a literal.
-#define CALDAQ_UNDO_SCHEMA7 "DROP INDEX runs_by_uuid; ALTER TABLE runs DROP COLUMN uuid; "
+#define CALDAQ_UNDO_SCHEMA8 "DROP INDEX machines_by_uuid; ALTER TABLE machines DROP COLUMN uuid; "
+#define CALDAQ_UNDO_SCHEMA7 \
+  CALDAQ_UNDO_SCHEMA8 "DROP INDEX runs_by_uuid; ALTER TABLE runs DROP COLUMN uuid; "
 // What schema 5 added (origins, compensations, the stop quality), taken off a new file to
 // make a version 4 one (schema 7's and 6's go first).
 constexpr const char* kUndoSchema5 = CALDAQ_UNDO_SCHEMA7
@@ -734,7 +736,7 @@ TEST(Store, MigrationSevenGivesEveryStoredRunAUuid) {
     EXPECT_EQ(ro.runs().front().uuid, "");
   }
   Store rw(file);
-  EXPECT_EQ(rw.version(), 7);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
   std::set<std::string> seen;
   for (const auto& r : rw.runs()) {
     EXPECT_TRUE(cal::storage::is_uuid(r.uuid)) << r.uuid;
@@ -743,6 +745,42 @@ TEST(Store, MigrationSevenGivesEveryStoredRunAUuid) {
     seen.insert(r.uuid);
   }
   EXPECT_EQ(seen.size(), 50u);
+}
+
+// Migration 7 -> 8 gives the machines already stored each their own UUID (two sites' machines of
+// one name stay apart centrally); read-only, a version 7 file shows none; add_machine keeps a
+// UUID given (a machine brought by daq sync --from) and refuses one that is not.
+TEST(Store, MigrationEightGivesEveryMachineAUuid) {
+  TempDir dir;
+  const auto file = dir.path / "v7.sqlite";
+  {
+    Store store(file);
+    store.add_machine({.name = "Mill 1"});
+    store.add_machine({.name = "Mill 2"});
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(
+        sqlite3_exec(db, CALDAQ_UNDO_SCHEMA8 "PRAGMA user_version = 7;", nullptr, nullptr, nullptr),
+        SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 7);
+    EXPECT_EQ(ro.machine_by_name("Mill 1")->uuid, "");
+  }
+  Store rw(file);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
+  const auto one = rw.machine_by_name("Mill 1")->uuid, two = rw.machine_by_name("Mill 2")->uuid;
+  EXPECT_TRUE(cal::storage::is_uuid(one)) << one;
+  EXPECT_TRUE(cal::storage::is_uuid(two)) << two;
+  EXPECT_NE(one, two);
+  const std::string given = "0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b";
+  const auto id = rw.add_machine({.name = "Mill 3", .uuid = given});
+  EXPECT_EQ(rw.machine(id)->uuid, given);
+  EXPECT_THROW(rw.add_machine({.name = "Mill 4", .uuid = "Mill 4"}), StoreError);
 }
 
 // The chunks as stored, for daq sync: in the order written, paged, each checksum verified; a
