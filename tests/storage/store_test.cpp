@@ -748,15 +748,25 @@ TEST(Store, MigrationSevenGivesEveryStoredRunAUuid) {
 }
 
 // Migration 7 -> 8 gives the machines already stored each their own UUID (two sites' machines of
-// one name stay apart centrally); read-only, a version 7 file shows none; add_machine keeps a
+// one name stay apart centrally) and keeps every stored run as it was (its UUID, machine,
+// readings, stops and results); read-only, a version 7 file shows none; add_machine keeps a
 // UUID given (a machine brought by daq sync --from) and refuses one that is not.
 TEST(Store, MigrationEightGivesEveryMachineAUuid) {
   TempDir dir;
   const auto file = dir.path / "v7.sqlite";
+  std::vector<cal::storage::RunRecord> before;
   {
     Store store(file);
-    store.add_machine({.name = "Mill 1"});
-    store.add_machine({.name = "Mill 2"});
+    const auto mill1 = store.add_machine({.name = "Mill 1"});
+    const auto mill2 = store.add_machine({.name = "Mill 2"});
+    for (int i = 0; i < 20; ++i) {
+      const auto run = store.begin_run({.machine_id = i % 2 ? mill2 : mill1, .kind = "linear"});
+      store.append_readings(run, std::vector<RawReading>{{.time_ns = i, .value = 1e-3 * i}});
+      store.add_targets(std::vector<cal::storage::CapturedTarget>{
+          {.run_id = run, .target_index = i, .direction = '+', .deviation_um = 0.5 * i}});
+      store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+    }
+    before = store.runs();
   }
   {
     sqlite3* db = nullptr;
@@ -770,6 +780,7 @@ TEST(Store, MigrationEightGivesEveryMachineAUuid) {
     Store ro(file, {.read_only = true});
     EXPECT_EQ(ro.version(), 7);
     EXPECT_EQ(ro.machine_by_name("Mill 1")->uuid, "");
+    EXPECT_EQ(ro.runs().size(), before.size());
   }
   Store rw(file);
   EXPECT_EQ(rw.version(), cal::storage::schema_version);
@@ -777,6 +788,22 @@ TEST(Store, MigrationEightGivesEveryMachineAUuid) {
   EXPECT_TRUE(cal::storage::is_uuid(one)) << one;
   EXPECT_TRUE(cal::storage::is_uuid(two)) << two;
   EXPECT_NE(one, two);
+  const auto after = rw.runs();
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    const auto& r = after[i];
+    EXPECT_EQ(r.id, before[i].id);
+    EXPECT_EQ(r.uuid, before[i].uuid);
+    EXPECT_TRUE(cal::storage::is_uuid(r.uuid)) << r.uuid;
+    EXPECT_EQ(r.machine_id, before[i].machine_id);
+    const auto readings = rw.readings(r.id);
+    ASSERT_EQ(readings.size(), 1u) << "run " << r.id;
+    EXPECT_EQ(readings[0].value, 1e-3 * static_cast<double>(i));
+    const auto stops = rw.targets(r.id);
+    ASSERT_EQ(stops.size(), 1u) << "run " << r.id;
+    EXPECT_EQ(stops[0].deviation_um, 0.5 * static_cast<double>(i));
+    EXPECT_EQ(rw.results(r.id).size(), 1u) << "run " << r.id;
+  }
   const std::string given = "0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b";
   const auto id = rw.add_machine({.name = "Mill 3", .uuid = given});
   EXPECT_EQ(rw.machine(id)->uuid, given);
