@@ -235,6 +235,15 @@ bool process_alive(std::int64_t pid) {
   return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
 }
 
+// The owner_pid of a run another store recorded (Store::import_run, daq sync --from): its
+// acquisition is not a process here, so a running one is not interrupted when none here runs it.
+constexpr std::int64_t kAcquiredElsewhere = -1;
+
+// Whether a running run's writing process here is gone (kill -9, power loss, crash).
+bool interrupted_here(std::int64_t owner_pid) {
+  return owner_pid != kAcquiredElsewhere && !process_alive(owner_pid);
+}
+
 std::int64_t query_int(const Store::Impl& m, const char* sql, std::string_view what) {
   auto s = m.prepare(sql);
   if (sqlite3_step(s.get()) != SQLITE_ROW) m.fail(what);
@@ -446,7 +455,7 @@ Store::Store(const std::filesystem::path& path, StoreOptions options)
   {
     auto s = m.prepare("SELECT id, owner_pid FROM runs WHERE status = 'running'");
     while (sqlite3_step(s.get()) == SQLITE_ROW)
-      if (!process_alive(sqlite3_column_int64(s.get(), 1)))
+      if (interrupted_here(sqlite3_column_int64(s.get(), 1)))
         orphans.push_back(sqlite3_column_int64(s.get(), 0));
   }
   for (auto id : orphans) finish_run(id, RunStatus::incomplete, kInterrupted);
@@ -569,7 +578,7 @@ RunRecord read_run(sqlite3_stmt* s, bool read_only) {
            r.software_version, r.started_unix_ms, r.ended_unix_ms, status, r.note, owner_pid,
            r.origin_session_ns, r.origin_unix_ns, r.uuid);
   r.status = status_from(status);
-  if (read_only && r.status == RunStatus::running && !process_alive(owner_pid)) {
+  if (read_only && r.status == RunStatus::running && interrupted_here(owner_pid)) {
     r.status = RunStatus::incomplete;
     r.note = fmt::format("{} (not yet marked so in the database, which was opened read-only)",
                          kInterrupted);
@@ -1017,10 +1026,11 @@ std::int64_t Store::import_run(const RunRecord& r) {
   auto s = impl_->prepare(
       "INSERT INTO runs(machine_id, campaign, kind, axis, settings_json, capture_path, "
       "software_version, started_unix_ms, ended_unix_ms, status, note, origin_session_ns, "
-      "origin_unix_ns, uuid) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      "origin_unix_ns, uuid, owner_pid) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   bind_all(s.get(), id_or_null(r.machine_id), r.campaign, r.kind, r.axis, r.settings_json,
            r.capture_path, r.software_version, r.started_unix_ms, r.ended_unix_ms,
-           to_string(r.status), r.note, r.origin_session_ns, r.origin_unix_ns, r.uuid);
+           to_string(r.status), r.note, r.origin_session_ns, r.origin_unix_ns, r.uuid,
+           kAcquiredElsewhere);
   impl_->step_done(s.get(), fmt::format("import run {}", r.uuid));
   return sqlite3_last_insert_rowid(impl_->db.get());
 }

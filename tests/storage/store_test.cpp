@@ -810,6 +810,61 @@ TEST(Store, MigrationEightGivesEveryMachineAUuid) {
   EXPECT_THROW(rw.add_machine({.name = "Mill 4", .uuid = "Mill 4"}), StoreError);
 }
 
+// What daq sync --from writes: another store's run imported with its UUID, status and times,
+// under another id; its chunks stored with checksums for the id here (read back and verified);
+// a UUID already here, or a chunk that does not follow, refused; in_transaction all or nothing.
+// A run still running where it was recorded is not "interrupted" by opening this store.
+TEST(Store, AnImportedRunKeepsItsIdentityAndItsReadings) {
+  TempDir dir;
+  Store source(dir.path / "site.sqlite");
+  a_run(source);  // the ids differ between the two stores
+  const auto run = a_run(source);
+  for (int batch = 0; batch < 3; ++batch)
+    source.append_readings(run, make_readings(200, static_cast<std::uint64_t>(batch)));
+  const auto record = *source.run(run);  // still running
+  const auto chunks = source.stored_chunks(run, 0, 100);
+  ASSERT_GT(chunks.size(), 2u);
+  const auto laptop_file = dir.path / "laptop.sqlite";
+  std::int64_t here = 0;
+  {
+    Store laptop(laptop_file);
+    here = laptop.import_run(record);
+    EXPECT_NE(here, run);
+    EXPECT_THROW(laptop.import_run(record), StoreError);  // its UUID is here
+    EXPECT_THROW(laptop.import_run({.kind = "linear", .uuid = "x"}), StoreError);
+    laptop.add_stored_chunks(here, std::span(chunks).first(2));
+    EXPECT_THROW(laptop.add_stored_chunks(here, std::span(chunks).subspan(3)), StoreError);
+    EXPECT_EQ(laptop.chunk_count(here), 2);
+    // A failure inside in_transaction takes back what the inner writes did.
+    EXPECT_THROW(laptop.in_transaction([&] {
+      laptop.add_stored_chunks(here, std::span(chunks).subspan(2));
+      throw StoreError("cut");
+    }),
+                 StoreError);
+    EXPECT_EQ(laptop.chunk_count(here), 2);
+    laptop.in_transaction([&] { laptop.add_stored_chunks(here, std::span(chunks).subspan(2)); });
+  }
+  {
+    Store ro(laptop_file, {.read_only = true});
+    EXPECT_EQ(ro.run(here)->status, RunStatus::running);
+  }
+  Store laptop(laptop_file);  // a writing open marks the interrupted runs: not this one
+  const auto back = *laptop.run(here);
+  EXPECT_EQ(back.uuid, record.uuid);
+  EXPECT_EQ(back.status, RunStatus::running);
+  EXPECT_EQ(back.started_unix_ms, record.started_unix_ms);
+  EXPECT_EQ(laptop.run_by_uuid(record.uuid)->id, here);
+  const auto readings = laptop.readings(here), original = source.readings(run);
+  ASSERT_EQ(readings.size(), original.size());
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    EXPECT_EQ(readings[i].time_ns, original[i].time_ns);
+    EXPECT_EQ(readings[i].value, original[i].value);
+  }
+  for (const auto& c : laptop.stored_chunks(here, 0, 100))  // checksums for the id here
+    EXPECT_EQ(c.crc,
+              cal::storage::chunk::checksum(cal::storage::chunk::key_of(here, c.seq, c), c.data));
+}
+
 // The chunks as stored, for daq sync: in the order written, paged, each checksum verified; a
 // damaged chunk is an error naming it.
 TEST(Store, StoredChunksComeInOrderWithTheirChecksumsVerified) {
