@@ -12,10 +12,7 @@ DAQ=$1
 
 source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
-pg_with_demo
-
-visit_records
-check send 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+pg_with_visit
 MACHINE=$("$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute('SELECT name FROM machines ORDER BY id').fetchone()[0])" "$DB")
 
 # value DB SQL: one value from a local store.
@@ -60,10 +57,18 @@ RUNS=$(value "$DB" "SELECT count(*) FROM runs")
 CHUNKS=$(value "$DB" "SELECT count(*) FROM reading_chunks")
 RESULTS=$(value "$DB" "SELECT count(*) FROM results")
 
-# Refused: no machine, an unknown machine (nothing created), both directions, not a URI.
+# Refused: no machine, an unknown machine, an unreachable server (nothing created by any), both
+# directions, not a URI.
 check no_machine 2 "--from needs --machine NAME" -- "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL"
 check unknown_machine 2 "no machine 'Mill 9' in the central store" -- \
   "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL" --machine "Mill 9"
+check unknown_uuid 2 "no machine '0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b' in the central store" -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL" --machine 0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b
+check unknown_escaped 2 "no machine 'Mill\\x1B\[2J' in the central store" -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL" --machine $'Mill\e[2J'
+check from_unreachable 2 "postgresql://127\.0\.0\.1:1/caldaq: connect" -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from postgresql://127.0.0.1:1/caldaq --machine "$MACHINE"
+check refused_nothing_created 0 "^none$" -- bash -c "ls '$TMP'/laptop.sqlite* 2>/dev/null || echo none"
 check both_ways 2 "give one of --to .* and --from" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --from "$PG_URL" --machine x
 check from_not_uri 2 "--from: '/tmp/x.sqlite' is not a PostgreSQL URI" -- "$DAQ" sync --db "$DB" --from /tmp/x.sqlite --machine x
 

@@ -11,10 +11,7 @@ DAQ=$1
 
 source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
-pg_with_demo
-
-visit_records
-check sync 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+pg_with_visit
 # Synced twice: the calibration and the tables stored once.
 check sync_again 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
 check calibration_once 0 "^1$" -- psql_value "SELECT count(*) FROM caldaq.bar_calibrations"

@@ -54,6 +54,14 @@ visit_records() {
     --start-mm 0 --interval-mm 50 --points 11 --outside hold -o "$TMP/lec.mpf"
 }
 
+# pg_with_visit (after check.sh, DAQ set): pg_with_demo, visit_records, and the store sent to
+# the server (the check "sync").
+pg_with_visit() {
+  pg_with_demo
+  visit_records
+  check sync 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+}
+
 pg_stop() {
   if [ -n "${PG_STARTED:-}" ]; then
     pg_as_owner "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m immediate -w stop >/dev/null 2>&1

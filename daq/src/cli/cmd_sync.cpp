@@ -132,7 +132,7 @@ void run_pull(const SyncCliOptions& o) {
     throw cal::InputError("--from needs --machine NAME: which machine's history to bring");
   if (!o.runs.empty() || o.verify)
     throw cal::InputError("--run and --verify are for --to (--from checks every chunk it brings)");
-  st::Store local(database_path(o.db));
+  const auto path = database_path(o.db);
   st::pg::PullOptions options;
   options.machine = o.machine;
   options.chunks_per_transaction = o.chunks_per_transaction;
@@ -146,10 +146,10 @@ void run_pull(const SyncCliOptions& o) {
                  received, already);
       std::fflush(stdout);
     };
-  const auto report = st::pg::sync_from(local, o.from, options);
+  const auto report = st::pg::sync_from(path, o.from, options);
   if (o.json)
     return fmt::print("{}\n", nlohmann::json{{"schema", "caldaq.sync-from.v1"},
-                                             {"db", local.path().string()},
+                                             {"db", path.string()},
                                              {"from", st::pg::redacted(o.from)},
                                              {"machine", o.machine},
                                              {"server_schema", report.server_schema},
@@ -166,10 +166,10 @@ void run_pull(const SyncCliOptions& o) {
       "{}: {} runs of machine '{}' brought from {} (central schema {}): {} new, {} new results; "
       "{} chunks received ({} bytes), {} already here; {} compensation tables, {} ballbar "
       "calibrations new",
-      local.path().string(), report.runs, cal::text::terminal_safe(o.machine),
-      st::pg::redacted(o.from), report.server_schema, report.runs_new, report.results_new,
-      report.chunks_received, report.bytes_received, report.chunks_already,
-      report.compensations_new, report.calibrations_new);
+      path.string(), report.runs, cal::text::terminal_safe(o.machine), st::pg::redacted(o.from),
+      report.server_schema, report.runs_new, report.results_new, report.chunks_received,
+      report.bytes_received, report.chunks_already, report.compensations_new,
+      report.calibrations_new);
 }
 
 void run_sync(const SyncCliOptions& o) {
@@ -241,7 +241,9 @@ void add_sync_command(CLI::App& app) {
   cmd->add_option("--from", o->from,
                   "Bring a machine's history (runs, results, readings, compensation tables, "
                   "ballbar calibrations) from this central store into the local one (--machine)");
-  cmd->add_option("--machine", o->machine, "With --from: the machine, by its name on the server");
+  cmd->add_option("--machine", o->machine,
+                  "With --from: the machine, by its name on the server or by its UUID (when "
+                  "two sites' machines share the name)");
   cmd->add_option("--run", o->runs, "Only these runs (local ids; default: every run)");
   cmd->add_flag("--verify", o->verify,
                 "Read every chunk of the synced runs back from the server and verify its "

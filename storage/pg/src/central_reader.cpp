@@ -3,6 +3,7 @@
 // result keeps the id it had where it was made; text is ordered as SQLite orders it, by byte).
 #include <optional>
 
+#include "cal/analysis/text.hpp"
 #include "cal/storage/pg/central.hpp"
 #include "cal/storage/pg/sync.hpp"
 #include "central_schema.hpp"
@@ -170,10 +171,10 @@ class CentralReader final : public RunReader {
         "ORDER BY id",
         machine_row, std::string(name));
     if (rows.size() > 1)
-      throw StoreError(fmt::format(
-          "{}: {} machines are named '{}' (UUIDs {}, {}{}): name one by "
-          "its UUID",
-          shown_, rows.size(), name, rows[0].uuid, rows[1].uuid, rows.size() > 2 ? ", ..." : ""));
+      throw StoreError(
+          fmt::format("{}: {} machines are named '{}' (UUIDs {}, {}{}): name one by its UUID",
+                      shown_, rows.size(), text::terminal_safe(name), rows[0].uuid, rows[1].uuid,
+                      rows.size() > 2 ? ", ..." : ""));
     if (rows.empty()) return std::nullopt;
     return rows.front();
   }
@@ -391,14 +392,10 @@ class CentralReader final : public RunReader {
         "t.version = v.version), v.version = r.current_version FROM caldaq.run_versions AS v "
         "JOIN caldaq.runs AS r ON r.uuid = v.run_uuid WHERE r.id = $1 ORDER BY v.version",
         [](const pqxx::row& row) {
-          return RunVersion{.version = row[0].as<int>(),
-                            .status = row[1].as<std::string>(),
-                            .sent_by = row[2].as<std::string>(),
-                            .sent_from = row[3].as<std::string>(),
-                            .sent_store = row[4].as<std::string>(),
-                            .sent_unix_ms = row[5].as<std::int64_t>(),
-                            .stops = row[6].as<std::int64_t>(),
-                            .current = row[7].as<bool>()};
+          RunVersion v;
+          read_row(row, v.version, v.status, v.sent_by, v.sent_from, v.sent_store, v.sent_unix_ms,
+                   v.stops, v.current);
+          return v;
         },
         run_id);
   }

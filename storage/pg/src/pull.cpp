@@ -1,8 +1,10 @@
 // daq sync --from: one machine's history brought from the central store into a local store
 // (sync.hpp, sync_from).
 #include <algorithm>
+#include <filesystem>
 #include <map>
 
+#include "cal/analysis/text.hpp"
 #include "cal/storage/chunk.hpp"
 #include "cal/storage/pg/central.hpp"
 #include "cal/storage/pg/sync.hpp"
@@ -11,22 +13,57 @@
 namespace cal::storage::pg {
 namespace {
 
+// The server's side of a pull: its connections and the machine asked for, found before anything
+// is written here.
+struct Source {
+  std::string shown;  // the URI, password hidden
+  std::unique_ptr<pqxx::connection> conn;
+  std::unique_ptr<RunReader> reader;  // checks the central schema's version (never migrates)
+  MachineRecord machine;
+};
+
+// --machine: a machine's UUID, or a name only one machine on the server has.
+MachineRecord find_machine(Source& source, const std::string& machine) {
+  if (is_uuid(machine)) {
+    const auto id = guarded(source.shown, "read the machines", [&] {
+      pqxx::nontransaction n(*source.conn);
+      const auto rows = n.exec_params("SELECT id FROM caldaq.machines WHERE uuid = $1", machine);
+      return rows.empty() ? std::int64_t{0} : rows[0][0].as<std::int64_t>();
+    });
+    if (const auto m = id ? source.reader->machine(id) : std::nullopt) return *m;
+  } else if (const auto m = source.reader->machine_by_name(machine)) {
+    return *m;
+  }
+  throw StoreError(fmt::format("{}: no machine '{}' in the central store", source.shown,
+                               text::terminal_safe(machine)));
+}
+
+Source open_source(std::string_view url, const std::string& machine) {
+  Source source{.shown = redacted(url)};
+  source.conn = connect(source.shown, url);
+  source.reader = open_central(url);
+  source.machine = find_machine(source, machine);
+  return source;
+}
+
 class Pull {
  public:
-  Pull(Store& local, std::string_view url, const PullOptions& options)
-      : local_(local), shown_(redacted(url)), options_(options), conn_(connect(shown_, url)) {
+  Pull(Store& local, Source source, const PullOptions& options)
+      : local_(local),
+        shown_(std::move(source.shown)),
+        options_(options),
+        conn_(std::move(source.conn)),
+        server_(std::move(source.reader)),
+        machine_(std::move(source.machine)) {
     if (options_.chunks_per_transaction == 0) options_.chunks_per_transaction = 1;
-    // The reader checks the central schema's version (a pull never migrates the server).
-    server_ = open_central(url);
   }
 
   PullReport run() {
     report_.server_schema = central_schema_version;
-    const auto machine = server_machine();
-    local_machine_ = local_machine(machine);
+    local_machine_ = local_machine(machine_);
     for (const auto& r : server_->runs())
-      if (r.machine_id == machine.id) pull_run(r);
-    pull_compensations(machine.id);
+      if (r.machine_id == machine_.id) pull_run(r);
+    pull_compensations(machine_.id);
     pull_calibrations();
     return report_;
   }
@@ -37,25 +74,9 @@ class Pull {
   PullOptions options_;
   std::unique_ptr<pqxx::connection> conn_;
   std::unique_ptr<RunReader> server_;
+  MachineRecord machine_;  // the server's
   std::int64_t local_machine_ = 0;
   PullReport report_;
-
-  // --machine: a machine's UUID, or a name only one machine on the server has.
-  MachineRecord server_machine() const {
-    if (is_uuid(options_.machine)) {
-      const auto id = guarded(shown_, "read the machines", [&] {
-        pqxx::nontransaction n(*conn_);
-        const auto rows =
-            n.exec_params("SELECT id FROM caldaq.machines WHERE uuid = $1", options_.machine);
-        return rows.empty() ? std::int64_t{0} : rows[0][0].as<std::int64_t>();
-      });
-      if (const auto m = id ? server_->machine(id) : std::nullopt) return *m;
-    } else if (const auto m = server_->machine_by_name(options_.machine)) {
-      return *m;
-    }
-    throw StoreError(
-        fmt::format("{}: no machine '{}' in the central store", shown_, options_.machine));
-  }
 
   // The server's machine here: known by its UUID; added (with it) when this store has none of
   // its name. Another machine of its name here (another site's) is an error: they stay apart.
@@ -67,7 +88,7 @@ class Pull {
       throw StoreError(fmt::format(
           "{}: this store's machine '{}' is another one (UUID {}) than the server's (UUID {}): "
           "bring its history into another store",
-          local_.path().string(), m.name, here->uuid, m.uuid));
+          local_.path().string(), text::terminal_safe(m.name), here->uuid, m.uuid));
     }
     return local_.add_machine({.name = m.name,
                                .description = m.description,
@@ -275,8 +296,11 @@ class Pull {
 
 }  // namespace
 
-PullReport sync_from(Store& local, std::string_view url, const PullOptions& options) {
-  return Pull(local, url, options).run();
+PullReport sync_from(const std::filesystem::path& local_path, std::string_view url,
+                     const PullOptions& options) {
+  auto source = open_source(url, options.machine);
+  Store local(local_path);  // created only now: a refused pull leaves nothing behind
+  return Pull(local, std::move(source), options).run();
 }
 
 }  // namespace cal::storage::pg

@@ -235,10 +235,9 @@ class Sync {
     return source_id;
   }
 
-  // The run's instruments, stops, missed stops and operator's actions are replaced as a whole
-  // (they are small, and the local store may have replaced them: a re-compensation rewrites the
-  // stops); results are added by their local id and their superseded mark updated, so a result
-  // is stored once however often it is sent.
+  // The run's instruments, missed stops, suspect stops and operator's actions are replaced as a
+  // whole (they are small; the last sender's are kept); its stops become a version (send_stops),
+  // never replaced, since a re-compensation elsewhere rewrites them.
   void send_children(pqxx::work& w, const RunRecord& r) {
     for (const char* table : {"instruments", "missed_stops", "operator_actions", "suspect_stops"})
       w.exec_params(fmt::format("DELETE FROM caldaq.{} WHERE run_uuid = $1", table), r.uuid);

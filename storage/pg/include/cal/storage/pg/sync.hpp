@@ -6,6 +6,7 @@
 //
 // libpqxx and libpq stay in storage/pg/src: this header names neither.
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -99,8 +100,11 @@ struct PullReport {
 // brought again: runs by UUID, results by content, chunks by number and checksum) and resumable
 // (a cut pull continues from the chunks here). Every chunk received is checked against the
 // checksum the server holds for it; a chunk here that differs from the server's is an error
-// naming the run and the chunk, and nothing of that run is overwritten. Throws StoreError.
-PullReport sync_from(Store& local, std::string_view url, const PullOptions& options);
+// naming the run and the chunk, and nothing of that run is overwritten. The local store at
+// `local_path` is opened (created when missing, migrated when older) only once the server and
+// the machine are found: a refused pull leaves no file behind. Throws StoreError.
+PullReport sync_from(const std::filesystem::path& local_path, std::string_view url,
+                     const PullOptions& options);
 
 // Creates or migrates the central schema; returns its version. Refuses a newer one.
 int migrate(std::string_view url);
