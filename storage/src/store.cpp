@@ -34,6 +34,13 @@ RunStatus status_from(std::string_view s) {
   return value_named(kStatusNames, s).value_or(RunStatus::running);
 }
 
+// A random (version 4) UUID in canonical lower-case text, made by SQLite for each row a
+// migration gives one (as new_uuid() makes them).
+#define CALDAQ_RANDOM_UUID                                                                       \
+  "lower(hex(randomblob(4)) || '-' || hex(randomblob(2)) || '-4' || substr(hex(randomblob(2)), " \
+  "2) || '-' || substr('89AB', 1 + (abs(random()) % 4), 1) || substr(hex(randomblob(2)), 2) || " \
+  "'-' || hex(randomblob(6)))"
+
 // The schema, one entry per version: entry k migrates from version k to k + 1. A migration
 // runs in one transaction with the user_version update, so a crash mid-migration leaves the
 // previous version intact.
@@ -193,10 +200,15 @@ CREATE INDEX operator_actions_by_run ON operator_actions(run_id, id);
     // (daq sync) knows it whatever its local id; the runs already stored get theirs now.
     R"sql(
 ALTER TABLE runs ADD COLUMN uuid TEXT;
-UPDATE runs SET uuid = lower(hex(randomblob(4)) || '-' || hex(randomblob(2)) || '-4' ||
-  substr(hex(randomblob(2)), 2) || '-' || substr('89AB', 1 + (abs(random()) % 4), 1) ||
-  substr(hex(randomblob(2)), 2) || '-' || hex(randomblob(6)));
+UPDATE runs SET uuid = )sql" CALDAQ_RANDOM_UUID R"sql(;
 CREATE UNIQUE INDEX runs_by_uuid ON runs(uuid);
+)sql",
+    // 7 -> 8 (issue 35): a stable identity per machine, a random UUID, by which the central
+    // store tells machines apart (two sites may each have a "Mill 1").
+    R"sql(
+ALTER TABLE machines ADD COLUMN uuid TEXT;
+UPDATE machines SET uuid = )sql" CALDAQ_RANDOM_UUID R"sql(;
+CREATE UNIQUE INDEX machines_by_uuid ON machines(uuid);
 )sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
@@ -221,6 +233,15 @@ void bind_text(sqlite3_stmt* s, int i, std::string_view v) { detail::bind_value(
 bool process_alive(std::int64_t pid) {
   if (pid <= 0) return false;
   return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
+}
+
+// The owner_pid of a run another store recorded (Store::import_run, daq sync --from): its
+// acquisition is not a process here, so a running one is not interrupted when none here runs it.
+constexpr std::int64_t kAcquiredElsewhere = -1;
+
+// Whether a running run's writing process here is gone (kill -9, power loss, crash).
+bool interrupted_here(std::int64_t owner_pid) {
+  return owner_pid != kAcquiredElsewhere && !process_alive(owner_pid);
 }
 
 std::int64_t query_int(const Store::Impl& m, const char* sql, std::string_view what) {
@@ -408,6 +429,9 @@ CREATE TEMP TABLE operator_actions(id INTEGER PRIMARY KEY, run_id INTEGER, time_
   if (version >= 2 && version < 7)  // before the runs' UUIDs: none (RunRecord::uuid "")
     exec("CREATE TEMP VIEW runs AS SELECT *, NULL AS uuid FROM main.runs;",
          "present an older schema without run UUIDs (read-only)");
+  if (version < 8)  // before the machines' UUIDs: none (MachineRecord::uuid "")
+    exec("CREATE TEMP VIEW machines AS SELECT *, NULL AS uuid FROM main.machines;",
+         "present an older schema without machine UUIDs (read-only)");
   has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
@@ -431,7 +455,7 @@ Store::Store(const std::filesystem::path& path, StoreOptions options)
   {
     auto s = m.prepare("SELECT id, owner_pid FROM runs WHERE status = 'running'");
     while (sqlite3_step(s.get()) == SQLITE_ROW)
-      if (!process_alive(sqlite3_column_int64(s.get(), 1)))
+      if (interrupted_here(sqlite3_column_int64(s.get(), 1)))
         orphans.push_back(sqlite3_column_int64(s.get(), 0));
   }
   for (auto id : orphans) finish_run(id, RunStatus::incomplete, kInterrupted);
@@ -448,8 +472,12 @@ bool Store::read_only() const { return impl_->read_only; }
 
 std::int64_t Store::add_machine(const MachineRecord& r) {
   impl_->need_writable("add machine");
-  auto s = impl_->prepare("INSERT INTO machines(name, description, config_json) VALUES(?, ?, ?)");
-  bind_all(s.get(), r.name, r.description, r.config_json);
+  if (!r.uuid.empty() && !is_uuid(r.uuid))
+    throw StoreError(fmt::format("{}: add machine '{}': '{}' is not a UUID", impl_->path.string(),
+                                 r.name, r.uuid));
+  auto s = impl_->prepare(
+      "INSERT INTO machines(name, description, config_json, uuid) VALUES(?, ?, ?, ?)");
+  bind_all(s.get(), r.name, r.description, r.config_json, r.uuid.empty() ? new_uuid() : r.uuid);
   impl_->step_done(s.get(), fmt::format("add machine '{}'", r.name));
   return sqlite3_last_insert_rowid(impl_->db.get());
 }
@@ -458,20 +486,29 @@ namespace {
 std::optional<MachineRecord> machine_row(sqlite3_stmt* s) {
   if (sqlite3_step(s) != SQLITE_ROW) return std::nullopt;
   MachineRecord r;
-  read_all(s, r.id, r.name, r.description, r.config_json);
+  read_all(s, r.id, r.name, r.description, r.config_json, r.uuid);
   return r;
 }
 }  // namespace
 
 std::optional<MachineRecord> Store::machine_by_name(std::string_view name) const {
-  auto s = impl_->prepare("SELECT id, name, description, config_json FROM machines WHERE name = ?");
+  auto s = impl_->prepare(
+      "SELECT id, name, description, config_json, uuid FROM machines WHERE name = ?");
   bind_text(s.get(), 1, name);
   return machine_row(s.get());
 }
 
 std::optional<MachineRecord> Store::machine(std::int64_t id) const {
-  auto s = impl_->prepare("SELECT id, name, description, config_json FROM machines WHERE id = ?");
+  auto s =
+      impl_->prepare("SELECT id, name, description, config_json, uuid FROM machines WHERE id = ?");
   sqlite3_bind_int64(s.get(), 1, id);
+  return machine_row(s.get());
+}
+
+std::optional<MachineRecord> Store::machine_by_uuid(std::string_view uuid) const {
+  auto s = impl_->prepare(
+      "SELECT id, name, description, config_json, uuid FROM machines WHERE uuid = ?");
+  bind_text(s.get(), 1, uuid);
   return machine_row(s.get());
 }
 
@@ -541,7 +578,7 @@ RunRecord read_run(sqlite3_stmt* s, bool read_only) {
            r.software_version, r.started_unix_ms, r.ended_unix_ms, status, r.note, owner_pid,
            r.origin_session_ns, r.origin_unix_ns, r.uuid);
   r.status = status_from(status);
-  if (read_only && r.status == RunStatus::running && !process_alive(owner_pid)) {
+  if (read_only && r.status == RunStatus::running && interrupted_here(owner_pid)) {
     r.status = RunStatus::incomplete;
     r.note = fmt::format("{} (not yet marked so in the database, which was opened read-only)",
                          kInterrupted);
@@ -973,6 +1010,62 @@ void Store::set_time_origin(std::int64_t run_id, std::int64_t session_ns, std::i
   auto s = impl_->prepare("UPDATE runs SET origin_session_ns = ?, origin_unix_ns = ? WHERE id = ?");
   bind_all(s.get(), session_ns, unix_ns, run_id);
   impl_->step_done(s.get(), fmt::format("set the time origin of run {}", run_id));
+}
+
+void Store::in_transaction(const std::function<void()>& f) {
+  Impl::Transaction tx(*impl_);
+  f();
+  tx.commit();
+}
+
+std::int64_t Store::import_run(const RunRecord& r) {
+  impl_->need_writable("import run");
+  if (!is_uuid(r.uuid))
+    throw StoreError(fmt::format("{}: import run: '{}' is not a UUID (8-4-4-4-12 lower-case hex)",
+                                 impl_->path.string(), r.uuid));
+  auto s = impl_->prepare(
+      "INSERT INTO runs(machine_id, campaign, kind, axis, settings_json, capture_path, "
+      "software_version, started_unix_ms, ended_unix_ms, status, note, origin_session_ns, "
+      "origin_unix_ns, uuid, owner_pid) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  bind_all(s.get(), id_or_null(r.machine_id), r.campaign, r.kind, r.axis, r.settings_json,
+           r.capture_path, r.software_version, r.started_unix_ms, r.ended_unix_ms,
+           to_string(r.status), r.note, r.origin_session_ns, r.origin_unix_ns, r.uuid,
+           kAcquiredElsewhere);
+  impl_->step_done(s.get(), fmt::format("import run {}", r.uuid));
+  return sqlite3_last_insert_rowid(impl_->db.get());
+}
+
+void Store::add_stored_chunks(std::int64_t run_id, std::span<const StoredChunk> chunks) {
+  Impl& m = *impl_;
+  Impl::Transaction tx(m);
+  std::int64_t next = chunk_count(run_id);
+  auto s = m.prepare(
+      "INSERT INTO reading_chunks(run_id, device, channel, quantity, first_ns, last_ns, count, "
+      "data, encoding, seq, crc) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  for (const auto& c : chunks) {
+    if (c.seq != next++)
+      throw StoreError(
+          fmt::format("{}: run {}: reading chunk {} does not follow the run's {} "
+                      "chunks",
+                      m.path.string(), run_id, c.seq, next - 1));
+    bind_all(s.get(), run_id, c.device, c.channel, c.quantity, c.first_ns, c.last_ns, c.count,
+             std::span<const unsigned char>(c.data), c.encoding, c.seq,
+             std::int64_t{chunk::checksum(chunk::key_of(run_id, c.seq, c), c.data)});
+    m.step_done(s.get(), fmt::format("store reading chunk {} of run {}", c.seq, run_id));
+  }
+  tx.commit();
+}
+
+void Store::set_superseded(std::int64_t result_id, std::int64_t by_result_id) {
+  impl_->need_writable("mark a result superseded");
+  auto s = impl_->prepare(
+      "UPDATE results SET superseded_by = ? WHERE id = ? AND run_id = (SELECT run_id FROM "
+      "results WHERE id = ?)");
+  bind_all(s.get(), by_result_id, result_id, by_result_id);
+  impl_->step_done(s.get(), fmt::format("mark result {} superseded", result_id));
+  if (sqlite3_changes(impl_->db.get()) == 0)
+    throw StoreError(fmt::format("{}: no result {} of the run of result {}", impl_->path.string(),
+                                 result_id, by_result_id));
 }
 
 namespace {

@@ -159,19 +159,22 @@ struct Store::Impl {
 
   // A transaction that rolls back unless committed (RAII), so a failed batch leaves the
   // database as it was before the batch, never half-written.
+  // Inside an outer one (Store::in_transaction) it is part of it: the outer one commits or
+  // rolls back the whole (a failure here throws through it).
   struct Transaction {
     Impl& impl;
     bool done = false;
+    bool outer = sqlite3_get_autocommit(impl.db.get()) != 0;
     explicit Transaction(Impl& i) : impl(i) {
       impl.need_writable("write");
-      impl.step_cached(impl.begin_tx, "BEGIN IMMEDIATE", "begin transaction");
+      if (outer) impl.step_cached(impl.begin_tx, "BEGIN IMMEDIATE", "begin transaction");
     }
     void commit() {
-      impl.step_cached(impl.commit_tx, "COMMIT", "commit");
+      if (outer) impl.step_cached(impl.commit_tx, "COMMIT", "commit");
       done = true;
     }
     ~Transaction() {
-      if (!done) sqlite3_exec(impl.db.get(), "ROLLBACK", nullptr, nullptr, nullptr);
+      if (!done && outer) sqlite3_exec(impl.db.get(), "ROLLBACK", nullptr, nullptr, nullptr);
     }
     Transaction(const Transaction&) = delete;
     Transaction& operator=(const Transaction&) = delete;

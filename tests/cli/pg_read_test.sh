@@ -11,21 +11,7 @@ DAQ=$1
 
 source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
-TMP=$(mktemp -d)
-PGTMP=$(mktemp -d /tmp/caldaq-pg.XXXXXX)  # short, and reachable by nobody (pg_server.sh)
-trap 'pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
-mkdir "$TMP/local"
-pg_start "$PGTMP"
-demo_runs "$TMP/local"
-DB=$TMP/local/demo.sqlite
-
-check replay 0 "" -- "$DAQ" replay "$DEMO_CDQ" --db "$DB"
-check recompensate 0 "" -- "$DAQ" recompensate 1 --alpha-ppm 12.0 --db "$DB"
-check calibrate 0 "" -- "$DAQ" ballbar calibrate --bar QC20-1 --nominal-mm 100 --calibrator-mm 100.0021 \
-  --reading-mm 0.0012 --date 2026-01-05 --db "$DB"
-check compensate 0 "stored as compensation 1" -- "$DAQ" compensate --run 1 --db "$DB" -f siemens \
-  --start-mm 0 --interval-mm 50 --points 11 --outside hold -o "$TMP/lec.mpf"
-check sync 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+pg_with_visit
 # Synced twice: the calibration and the tables stored once.
 check sync_again 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
 check calibration_once 0 "^1$" -- psql_value "SELECT count(*) FROM caldaq.bar_calibrations"

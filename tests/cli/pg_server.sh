@@ -42,6 +42,26 @@ pg_with_demo() {
   DB=$TMP/local/demo.sqlite
 }
 
+# visit_records (after pg_with_demo or demo_runs into DB): what a visit adds to the demo's store:
+# a replay (run 3), a re-compensation (a superseded result), a ballbar calibration and a
+# compensation table; each a check.
+visit_records() {
+  check replay 0 "" -- "$DAQ" replay "$DEMO_CDQ" --db "$DB"
+  check recompensate 0 "" -- "$DAQ" recompensate 1 --alpha-ppm 12.0 --db "$DB"
+  check calibrate 0 "" -- "$DAQ" ballbar calibrate --bar QC20-1 --nominal-mm 100 --calibrator-mm 100.0021 \
+    --reading-mm 0.0012 --date 2026-01-05 --db "$DB"
+  check compensate 0 "stored as compensation 1" -- "$DAQ" compensate --run 1 --db "$DB" -f siemens \
+    --start-mm 0 --interval-mm 50 --points 11 --outside hold -o "$TMP/lec.mpf"
+}
+
+# pg_with_visit (after check.sh, DAQ set): pg_with_demo, visit_records, and the store sent to
+# the server (the check "sync").
+pg_with_visit() {
+  pg_with_demo
+  visit_records
+  check sync 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+}
+
 pg_stop() {
   if [ -n "${PG_STARTED:-}" ]; then
     pg_as_owner "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m immediate -w stop >/dev/null 2>&1

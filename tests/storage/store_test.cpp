@@ -475,7 +475,9 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 
 // What schema 7 added (the runs' UUIDs), taken off a new file to make a version 6 one; a macro so
 // that it prefixes the other undo strings as a literal.
-#define CALDAQ_UNDO_SCHEMA7 "DROP INDEX runs_by_uuid; ALTER TABLE runs DROP COLUMN uuid; "
+#define CALDAQ_UNDO_SCHEMA8 "DROP INDEX machines_by_uuid; ALTER TABLE machines DROP COLUMN uuid; "
+#define CALDAQ_UNDO_SCHEMA7 \
+  CALDAQ_UNDO_SCHEMA8 "DROP INDEX runs_by_uuid; ALTER TABLE runs DROP COLUMN uuid; "
 // What schema 5 added (origins, compensations, the stop quality), taken off a new file to
 // make a version 4 one (schema 7's and 6's go first).
 constexpr const char* kUndoSchema5 = CALDAQ_UNDO_SCHEMA7
@@ -734,7 +736,7 @@ TEST(Store, MigrationSevenGivesEveryStoredRunAUuid) {
     EXPECT_EQ(ro.runs().front().uuid, "");
   }
   Store rw(file);
-  EXPECT_EQ(rw.version(), 7);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
   std::set<std::string> seen;
   for (const auto& r : rw.runs()) {
     EXPECT_TRUE(cal::storage::is_uuid(r.uuid)) << r.uuid;
@@ -743,6 +745,124 @@ TEST(Store, MigrationSevenGivesEveryStoredRunAUuid) {
     seen.insert(r.uuid);
   }
   EXPECT_EQ(seen.size(), 50u);
+}
+
+// Migration 7 -> 8 gives the machines already stored each their own UUID (two sites' machines of
+// one name stay apart centrally) and keeps every stored run as it was (its UUID, machine,
+// readings, stops and results); read-only, a version 7 file shows none; add_machine keeps a
+// UUID given (a machine brought by daq sync --from) and refuses one that is not.
+TEST(Store, MigrationEightGivesEveryMachineAUuid) {
+  TempDir dir;
+  const auto file = dir.path / "v7.sqlite";
+  std::vector<cal::storage::RunRecord> before;
+  {
+    Store store(file);
+    const auto mill1 = store.add_machine({.name = "Mill 1"});
+    const auto mill2 = store.add_machine({.name = "Mill 2"});
+    for (int i = 0; i < 20; ++i) {
+      const auto run = store.begin_run({.machine_id = i % 2 ? mill2 : mill1, .kind = "linear"});
+      store.append_readings(run, std::vector<RawReading>{{.time_ns = i, .value = 1e-3 * i}});
+      store.add_targets(std::vector<cal::storage::CapturedTarget>{
+          {.run_id = run, .target_index = i, .direction = '+', .deviation_um = 0.5 * i}});
+      store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+    }
+    before = store.runs();
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(
+        sqlite3_exec(db, CALDAQ_UNDO_SCHEMA8 "PRAGMA user_version = 7;", nullptr, nullptr, nullptr),
+        SQLITE_OK);
+    sqlite3_close(db);
+  }
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 7);
+    EXPECT_EQ(ro.machine_by_name("Mill 1")->uuid, "");
+    EXPECT_EQ(ro.runs().size(), before.size());
+  }
+  Store rw(file);
+  EXPECT_EQ(rw.version(), cal::storage::schema_version);
+  const auto one = rw.machine_by_name("Mill 1")->uuid, two = rw.machine_by_name("Mill 2")->uuid;
+  EXPECT_TRUE(cal::storage::is_uuid(one)) << one;
+  EXPECT_TRUE(cal::storage::is_uuid(two)) << two;
+  EXPECT_NE(one, two);
+  const auto after = rw.runs();
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    const auto& r = after[i];
+    EXPECT_EQ(r.id, before[i].id);
+    EXPECT_EQ(r.uuid, before[i].uuid);
+    EXPECT_TRUE(cal::storage::is_uuid(r.uuid)) << r.uuid;
+    EXPECT_EQ(r.machine_id, before[i].machine_id);
+    const auto readings = rw.readings(r.id);
+    ASSERT_EQ(readings.size(), 1u) << "run " << r.id;
+    EXPECT_EQ(readings[0].value, 1e-3 * static_cast<double>(i));
+    const auto stops = rw.targets(r.id);
+    ASSERT_EQ(stops.size(), 1u) << "run " << r.id;
+    EXPECT_EQ(stops[0].deviation_um, 0.5 * static_cast<double>(i));
+    EXPECT_EQ(rw.results(r.id).size(), 1u) << "run " << r.id;
+  }
+  const std::string given = "0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b";
+  const auto id = rw.add_machine({.name = "Mill 3", .uuid = given});
+  EXPECT_EQ(rw.machine(id)->uuid, given);
+  EXPECT_THROW(rw.add_machine({.name = "Mill 4", .uuid = "Mill 4"}), StoreError);
+}
+
+// What daq sync --from writes: another store's run imported with its UUID, status and times,
+// under another id; its chunks stored with checksums for the id here (read back and verified);
+// a UUID already here, or a chunk that does not follow, refused; in_transaction all or nothing.
+// A run still running where it was recorded is not "interrupted" by opening this store.
+TEST(Store, AnImportedRunKeepsItsIdentityAndItsReadings) {
+  TempDir dir;
+  Store source(dir.path / "site.sqlite");
+  a_run(source);  // the ids differ between the two stores
+  const auto run = a_run(source);
+  for (int batch = 0; batch < 3; ++batch)
+    source.append_readings(run, make_readings(200, static_cast<std::uint64_t>(batch)));
+  const auto record = *source.run(run);  // still running
+  const auto chunks = source.stored_chunks(run, 0, 100);
+  ASSERT_GT(chunks.size(), 2u);
+  const auto laptop_file = dir.path / "laptop.sqlite";
+  std::int64_t here = 0;
+  {
+    Store laptop(laptop_file);
+    here = laptop.import_run(record);
+    EXPECT_NE(here, run);
+    EXPECT_THROW(laptop.import_run(record), StoreError);  // its UUID is here
+    EXPECT_THROW(laptop.import_run({.kind = "linear", .uuid = "x"}), StoreError);
+    laptop.add_stored_chunks(here, std::span(chunks).first(2));
+    EXPECT_THROW(laptop.add_stored_chunks(here, std::span(chunks).subspan(3)), StoreError);
+    EXPECT_EQ(laptop.chunk_count(here), 2);
+    // A failure inside in_transaction takes back what the inner writes did.
+    EXPECT_THROW(laptop.in_transaction([&] {
+      laptop.add_stored_chunks(here, std::span(chunks).subspan(2));
+      throw StoreError("cut");
+    }),
+                 StoreError);
+    EXPECT_EQ(laptop.chunk_count(here), 2);
+    laptop.in_transaction([&] { laptop.add_stored_chunks(here, std::span(chunks).subspan(2)); });
+  }
+  {
+    Store ro(laptop_file, {.read_only = true});
+    EXPECT_EQ(ro.run(here)->status, RunStatus::running);
+  }
+  Store laptop(laptop_file);  // a writing open marks the interrupted runs: not this one
+  const auto back = *laptop.run(here);
+  EXPECT_EQ(back.uuid, record.uuid);
+  EXPECT_EQ(back.status, RunStatus::running);
+  EXPECT_EQ(back.started_unix_ms, record.started_unix_ms);
+  EXPECT_EQ(laptop.run_by_uuid(record.uuid)->id, here);
+  const auto readings = laptop.readings(here), original = source.readings(run);
+  ASSERT_EQ(readings.size(), original.size());
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    EXPECT_EQ(readings[i].time_ns, original[i].time_ns);
+    EXPECT_EQ(readings[i].value, original[i].value);
+  }
+  for (const auto& c : laptop.stored_chunks(here, 0, 100))  // checksums for the id here
+    EXPECT_EQ(c.crc,
+              cal::storage::chunk::checksum(cal::storage::chunk::key_of(here, c.seq, c), c.data));
 }
 
 // The chunks as stored, for daq sync: in the order written, paged, each checksum verified; a

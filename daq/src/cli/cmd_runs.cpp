@@ -155,6 +155,20 @@ json run_document(const st::RunReader& store, std::int64_t id) {
   }();
   j["origin"] = to_json(run_origin(r, instruments, machine));
   j["targets"] = store.targets(id).size();
+  // The versions of the stops (issue 35): a central store keeps one per place that changed the
+  // run (re-compensated on two laptops); named only when there is more than one.
+  if (const auto versions = store.versions(id); versions.size() > 1) {
+    j["versions"] = json::array();
+    for (const auto& v : versions)
+      j["versions"].push_back({{"version", v.version},
+                               {"current", v.current},
+                               {"status", v.status},
+                               {"stops", v.stops},
+                               {"sent", iso_time(v.sent_unix_ms)},
+                               {"sent_by", v.sent_by},
+                               {"sent_from", v.sent_from},
+                               {"sent_store", v.sent_store}});
+  }
   const auto missed = store.missed_stops(id);
   j["missed_stops"] = json::array();
   for (const auto& m : missed) j["missed_stops"].push_back(missed_json(m));
@@ -203,6 +217,16 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
              iso_time(r.started_unix_ms), r.note.empty() ? "" : " - " + r.note);
   print_line("  readings: {}, captured targets: {}", j["readings"].get<std::int64_t>(),
              j["targets"].get<std::size_t>());
+  if (j.contains("versions")) {
+    print_line("  versions ({}; the run was changed in more than one place, none overwritten):",
+               j["versions"].size());
+    for (const auto& v : j["versions"])
+      print_line("    version {}{}: {} stops, sent {} by {} from {} ({})", v["version"].get<int>(),
+                 v["current"].get<bool>() ? " (current, shown)" : "",
+                 v["stops"].get<std::int64_t>(), v["sent"].get<std::string>(),
+                 v["sent_by"].get<std::string>(), v["sent_from"].get<std::string>(),
+                 v["sent_store"].get<std::string>());
+  }
   if (!missed.empty()) {
     print_line("  missed stops ({}):", missed.size());
     for (const auto& m : missed) print_line("    {}", missed_text(m));

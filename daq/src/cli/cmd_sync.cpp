@@ -1,5 +1,8 @@
 // daq sync --to postgresql://...: the local runs copied to the central store (issue 35;
 // docs/storage.md, "Central store").
+#include <pwd.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +28,8 @@ namespace st = cal::storage;
 struct SyncCliOptions {
   std::string db;
   std::string to;
+  std::string from;
+  std::string machine;
   bool verify = false;
   std::size_t chunks_per_transaction = 64;
   std::vector<std::int64_t> runs;
@@ -43,6 +48,19 @@ std::int64_t cut_after_chunks() {
     throw cal::InputError(
         fmt::format("CALDAQ_SYNC_CUT_AFTER_CHUNKS: '{}' is not a positive whole number", env));
   return n;
+}
+
+// Who sends (recorded with a new version of a run's stops): $USER, else the account's name.
+std::string user_name() {
+  if (const char* user = std::getenv("USER"); user && *user) return user;
+  if (const passwd* pw = getpwuid(geteuid())) return pw->pw_name;
+  return "?";
+}
+
+std::string host_name() {
+  char name[256] = {};
+  if (gethostname(name, sizeof name - 1) != 0) return "?";
+  return name;
 }
 
 // The sync's progress (issue 34), hooked into `options` beside the test's cut: the chunks done
@@ -98,12 +116,68 @@ std::shared_ptr<TerminalProgress> attach_progress(st::pg::SyncOptions& options,
   return bar;
 }
 
+void need_postgresql_url(std::string_view option, std::string_view url) {
+  if (!st::pg::is_postgresql_url(url))
+    throw cal::InputError(
+        fmt::format("{}: '{}' is not a PostgreSQL URI (postgresql://[user@]host[:port]/database or "
+                    "postgresql:///database?host=/socket/dir)",
+                    option, st::pg::redacted(url)));
+}
+
+// daq sync --from URL --machine NAME: the machine's history brought into the local store
+// (created when missing: a laptop before a visit), a line per run and a summary.
+void run_pull(const SyncCliOptions& o) {
+  need_postgresql_url("--from", o.from);
+  if (o.machine.empty())
+    throw cal::InputError("--from needs --machine NAME: which machine's history to bring");
+  if (!o.runs.empty() || o.verify)
+    throw cal::InputError("--run and --verify are for --to (--from checks every chunk it brings)");
+  const auto path = database_path(o.db);
+  st::pg::PullOptions options;
+  options.machine = o.machine;
+  options.chunks_per_transaction = o.chunks_per_transaction;
+  if (const auto cut = cut_after_chunks(); cut > 0)
+    options.after_chunk = [cut](std::int64_t received) {
+      if (received >= cut) std::_Exit(75);
+    };
+  if (!o.quiet && !o.json)
+    options.run_done = [](const st::RunRecord& r, std::int64_t received, std::int64_t already) {
+      print_line("run {:>4}  {}  {:>6} chunks received, {:>6} already here (checked)", r.id, r.uuid,
+                 received, already);
+      std::fflush(stdout);
+    };
+  const auto report = st::pg::sync_from(path, o.from, options);
+  if (o.json)
+    return fmt::print("{}\n", nlohmann::json{{"schema", "caldaq.sync-from.v1"},
+                                             {"db", path.string()},
+                                             {"from", st::pg::redacted(o.from)},
+                                             {"machine", o.machine},
+                                             {"server_schema", report.server_schema},
+                                             {"runs", report.runs},
+                                             {"runs_new", report.runs_new},
+                                             {"results_new", report.results_new},
+                                             {"chunks_received", report.chunks_received},
+                                             {"bytes_received", report.bytes_received},
+                                             {"chunks_already", report.chunks_already},
+                                             {"compensations_new", report.compensations_new},
+                                             {"calibrations_new", report.calibrations_new}}
+                                  .dump(2));
+  print_line(
+      "{}: {} runs of machine '{}' brought from {} (central schema {}): {} new, {} new results; "
+      "{} chunks received ({} bytes), {} already here; {} compensation tables, {} ballbar "
+      "calibrations new",
+      path.string(), report.runs, cal::text::terminal_safe(o.machine), st::pg::redacted(o.from),
+      report.server_schema, report.runs_new, report.results_new, report.chunks_received,
+      report.bytes_received, report.chunks_already, report.compensations_new,
+      report.calibrations_new);
+}
+
 void run_sync(const SyncCliOptions& o) {
-  if (!st::pg::is_postgresql_url(o.to))
-    throw cal::InputError(fmt::format(
-        "--to: '{}' is not a PostgreSQL URI (postgresql://[user@]host[:port]/database or "
-        "postgresql:///database?host=/socket/dir)",
-        st::pg::redacted(o.to)));
+  if (o.to.empty() == o.from.empty())
+    throw cal::InputError("give one of --to (send the local runs) and --from (bring a machine's)");
+  if (!o.from.empty()) return run_pull(o);
+  if (!o.machine.empty()) throw cal::InputError("--machine is for --from");
+  need_postgresql_url("--to", o.to);
   // Opened for writing: an older database is migrated (schema 7 gives each run its UUID). The
   // sync itself only reads it; WAL lets a running acquisition write meanwhile.
   const auto path = database_path(o.db);
@@ -115,6 +189,8 @@ void run_sync(const SyncCliOptions& o) {
   options.verify_bytes = o.verify;
   options.chunks_per_transaction = o.chunks_per_transaction;
   options.run_ids = o.runs;
+  options.sent_by = user_name();
+  options.sent_from = host_name();
   if (const auto cut = cut_after_chunks(); cut > 0)
     options.after_chunk = [cut](std::int64_t sent) {
       if (sent >= cut) std::_Exit(75);
@@ -132,16 +208,21 @@ void run_sync(const SyncCliOptions& o) {
                                              {"chunks_sent", report.chunks_sent},
                                              {"bytes_sent", report.bytes_sent},
                                              {"chunks_already", report.chunks_already},
-                                             {"chunks_verified", report.chunks_verified_bytes}}
+                                             {"chunks_verified", report.chunks_verified_bytes},
+                                             {"versions_new", report.versions_new}}
                                   .dump(2));
   print_line(
       "{}: {} runs synced to {} (central schema {}): {} new; {} chunks sent ({} bytes), {} "
-      "already there{}",
+      "already there{}{}",
       local.path().string(), report.runs, st::pg::redacted(o.to), report.server_schema,
       report.runs_new, report.chunks_sent, report.bytes_sent, report.chunks_already,
       o.verify ? fmt::format("; {} chunks read back and their checksums verified",
                              report.chunks_verified_bytes)
-               : std::string());
+               : std::string(),
+      report.versions_new ? fmt::format("; {} runs' stops differ from the server's: kept as a new "
+                                        "version (daq show names the versions)",
+                                        report.versions_new)
+                          : std::string());
 }
 
 }  // namespace
@@ -150,13 +231,19 @@ void add_sync_command(CLI::App& app) {
   auto o = std::make_shared<SyncCliOptions>();
   auto* cmd = app.add_subcommand(
       "sync",
-      "Copy the local runs to the central store on PostgreSQL: each run once (by its UUID), "
-      "resuming a cut sync from the chunks already there (docs/storage.md, \"Central store\")");
+      "Copy the local runs to the central store on PostgreSQL (--to), or bring one machine's "
+      "history from it (--from URI --machine NAME): each run once (by its UUID), resuming a cut "
+      "sync from the chunks already there (docs/storage.md, \"Central store\")");
   add_db_option(*cmd, o->db);
   cmd->add_option("--to", o->to,
                   "The central store: postgresql://[user[:password]@]host[:port]/database "
-                  "(libpq URI; also ?host=/socket/dir)")
-      ->required();
+                  "(libpq URI; also ?host=/socket/dir)");
+  cmd->add_option("--from", o->from,
+                  "Bring a machine's history (runs, results, readings, compensation tables, "
+                  "ballbar calibrations) from this central store into the local one (--machine)");
+  cmd->add_option("--machine", o->machine,
+                  "With --from: the machine, by its name on the server or by its UUID (when "
+                  "two sites' machines share the name)");
   cmd->add_option("--run", o->runs, "Only these runs (local ids; default: every run)");
   cmd->add_flag("--verify", o->verify,
                 "Read every chunk of the synced runs back from the server and verify its "

@@ -3,6 +3,7 @@
 // result keeps the id it had where it was made; text is ordered as SQLite orders it, by byte).
 #include <optional>
 
+#include "cal/analysis/text.hpp"
 #include "cal/storage/pg/central.hpp"
 #include "cal/storage/pg/sync.hpp"
 #include "central_schema.hpp"
@@ -58,6 +59,8 @@ RunRecord run_row(const pqxx::row& row) {
 MachineRecord machine_row(const pqxx::row& row) {
   MachineRecord m;
   read_row(row, m.id, m.name, m.description, m.config_json);
+  // A machine a v2-4 server stored before schema 5 gave it one has no UUID yet.
+  if (!row[4].is_null()) m.uuid = row[4].as<std::string>();
   return m;
 }
 
@@ -130,25 +133,14 @@ class PgChunks final : public ChunkSource {
     guarded(shown_, fmt::format("read the reading chunks of run {}", run_id_), [&] {
       pqxx::nontransaction n(conn_);
       const auto rows = n.exec_params(
-          "SELECT seq, device, channel, quantity, first_ns, last_ns, count, encoding, crc, data "
-          "FROM caldaq.reading_chunks AS k WHERE k.run_uuid = $1 AND ($2 OR (k.first_ns, k.seq) > "
-          "($3, $4))" +
-              filter_ + fmt::format(" ORDER BY k.first_ns, k.seq LIMIT {}", kPage),
+          fmt::format("SELECT {} FROM caldaq.reading_chunks AS k WHERE k.run_uuid = $1 AND ($2 "
+                      "OR (k.first_ns, k.seq) > ($3, $4)){} ORDER BY k.first_ns, k.seq LIMIT {}",
+                      kChunkColumns, filter_, kPage),
           uuid_, !started_, last_first_ns_, last_seq_);
       for (const auto& row : rows) {
         SourceChunk c;
-        c.seq = row[0].as<std::int64_t>();
+        read_chunk(row, c);
         c.order = *c.seq;
-        c.device = row[1].as<std::int64_t>();
-        c.channel = row[2].as<std::int64_t>();
-        c.quantity = row[3].as<std::int64_t>();
-        c.first_ns = row[4].as<std::int64_t>();
-        c.last_ns = row[5].as<std::int64_t>();
-        c.count = row[6].as<std::int64_t>();
-        c.encoding = row[7].as<std::int64_t>();
-        c.crc = static_cast<std::uint32_t>(row[8].as<std::int64_t>());
-        const pqxx::binarystring data(row[9]);
-        c.data.assign(data.data(), data.data() + data.size());
         page_.push_back(std::move(c));
       }
     });
@@ -164,26 +156,33 @@ class PgChunks final : public ChunkSource {
 class CentralReader final : public RunReader {
  public:
   explicit CentralReader(std::string_view url)
-      : shown_(redacted(url)), conn_(guarded(shown_, "connect", [&] {
-          return std::make_unique<pqxx::connection>(std::string(url));
-        })) {
+      : shown_(redacted(url)), conn_(connect(shown_, url)) {
     guarded(shown_, "read the central schema version", [&] { check_schema(); });
   }
 
   std::string name() const override { return shown_; }
 
   std::optional<MachineRecord> machine_by_name(std::string_view name) const override {
-    return one<MachineRecord>(
+    // Two sites may each have a machine of this name (machines are known by UUID): then the
+    // name alone does not say which.
+    const auto rows = all<MachineRecord>(
         fmt::format("read the machine '{}'", name),
-        "SELECT id, name, description, config_json FROM caldaq.machines WHERE name = $1 "
-        "ORDER BY id LIMIT 1",
+        "SELECT id, name, description, config_json, uuid FROM caldaq.machines WHERE name = $1 "
+        "ORDER BY id",
         machine_row, std::string(name));
+    if (rows.size() > 1)
+      throw StoreError(
+          fmt::format("{}: {} machines are named '{}' (UUIDs {}, {}{}): name one by its UUID",
+                      shown_, rows.size(), text::terminal_safe(name), rows[0].uuid, rows[1].uuid,
+                      rows.size() > 2 ? ", ..." : ""));
+    if (rows.empty()) return std::nullopt;
+    return rows.front();
   }
   std::optional<MachineRecord> machine(std::int64_t id) const override {
     return one<MachineRecord>(
         fmt::format("read machine {}", id),
-        "SELECT id, name, description, config_json FROM caldaq.machines WHERE id = $1", machine_row,
-        id);
+        "SELECT id, name, description, config_json, uuid FROM caldaq.machines WHERE id = $1",
+        machine_row, id);
   }
 
   std::vector<RunRecord> runs() const override {
@@ -261,8 +260,9 @@ class CentralReader final : public RunReader {
         fmt::format("read the captured stops of run {}", run_id),
         "SELECT t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns, t.raw_m, "
         "t.deviation_um, t.refractive_index, t.material_temperature_degc FROM "
-        "caldaq.captured_targets AS t JOIN caldaq.runs AS r ON r.uuid = t.run_uuid WHERE r.id = "
-        "$1 ORDER BY t.time_ns, t.run_number, t.target_index",
+        "caldaq.captured_targets AS t JOIN caldaq.runs AS r ON r.uuid = t.run_uuid AND "
+        "t.version = r.current_version WHERE r.id = $1 ORDER BY t.time_ns, t.run_number, "
+        "t.target_index",
         [&](const pqxx::row& row) {
           CapturedTarget t{.run_id = run_id};
           read_row(row, t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns, t.raw_m,
@@ -382,6 +382,22 @@ class CentralReader final : public RunReader {
           return c;
         },
         machine_id, std::string(axis));
+  }
+
+  std::vector<RunVersion> versions(std::int64_t run_id) const override {
+    return all<RunVersion>(
+        fmt::format("read the versions of run {}", run_id),
+        "SELECT v.version, v.status, v.sent_by, v.sent_from, v.sent_store, v.sent_unix_ms, "
+        "(SELECT count(*) FROM caldaq.captured_targets AS t WHERE t.run_uuid = v.run_uuid AND "
+        "t.version = v.version), v.version = r.current_version FROM caldaq.run_versions AS v "
+        "JOIN caldaq.runs AS r ON r.uuid = v.run_uuid WHERE r.id = $1 ORDER BY v.version",
+        [](const pqxx::row& row) {
+          RunVersion v;
+          read_row(row, v.version, v.status, v.sent_by, v.sent_from, v.sent_store, v.sent_unix_ms,
+                   v.stops, v.current);
+          return v;
+        },
+        run_id);
   }
 
  private:

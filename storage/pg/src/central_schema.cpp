@@ -142,10 +142,65 @@ CREATE TABLE caldaq.bar_calibrations(
   note text NOT NULL,
   fingerprint text NOT NULL UNIQUE);
 )sql",
+    // 3 (daq sync --from): a result is known by its content's fingerprint (kResultFingerprint),
+    // so the same result brought to a laptop and sent back (its local id changed) is stored
+    // once, and results made apart (re-analysed on two laptops) are both kept.
+    R"sql(
+ALTER TABLE caldaq.results ADD COLUMN fingerprint text;
+UPDATE caldaq.results SET fingerprint =
+  md5(concat_ws('|', standard, created_unix_ms::text, json, provenance_json));
+ALTER TABLE caldaq.results ALTER COLUMN fingerprint SET NOT NULL;
+ALTER TABLE caldaq.results ADD UNIQUE (run_uuid, fingerprint);
+)sql",
+    // 4: the same run changed in two places (re-compensated on two laptops) is kept as versions
+    // of its stops, never overwritten: each with who sent it, from where and when. The readers
+    // read the current version (the newest sent); `daq show` names them all.
+    R"sql(
+ALTER TABLE caldaq.captured_targets ADD COLUMN version integer NOT NULL DEFAULT 1;
+ALTER TABLE caldaq.captured_targets DROP CONSTRAINT captured_targets_pkey;
+ALTER TABLE caldaq.captured_targets
+  ADD PRIMARY KEY (run_uuid, version, run_number, direction, target_index);
+ALTER TABLE caldaq.runs ADD COLUMN current_version integer NOT NULL DEFAULT 1;
+CREATE FUNCTION caldaq.stops_fingerprint(run uuid, v integer) RETURNS text LANGUAGE sql STABLE
+AS $$
+  SELECT md5(COALESCE(string_agg(concat_ws('|', run_number, direction, target_index, nominal_mm,
+    time_ns, raw_m, deviation_um, refractive_index, material_temperature_degc), ';'
+    ORDER BY run_number, direction COLLATE "C", target_index), ''))
+  FROM caldaq.captured_targets WHERE run_uuid = run AND version = v
+$$;
+CREATE TABLE caldaq.run_versions(
+  run_uuid uuid NOT NULL REFERENCES caldaq.runs(uuid) ON DELETE CASCADE,
+  version integer NOT NULL,
+  fingerprint text NOT NULL,
+  status text NOT NULL,
+  sent_by text NOT NULL,
+  sent_from text NOT NULL,
+  sent_store text NOT NULL,
+  sent_unix_ms bigint NOT NULL,
+  PRIMARY KEY(run_uuid, version));
+INSERT INTO caldaq.run_versions
+  SELECT uuid, 1, caldaq.stops_fingerprint(uuid, 1), status, '', '', '', synced_unix_ms
+  FROM caldaq.runs;
+)sql",
+    // 5: machines known by their stable id (the local store's machines.uuid), not by name: two
+    // sites' "Mill 1" stay apart. A machine sent before (uuid NULL) is adopted by the first
+    // store that sends a machine of its name (daq sync --to, server_machine).
+    R"sql(
+ALTER TABLE caldaq.machines ADD COLUMN uuid uuid UNIQUE;
+ALTER TABLE caldaq.machines DROP CONSTRAINT machines_name_key;
+CREATE INDEX machines_by_name ON caldaq.machines(name);
+)sql",
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 
 }  // namespace
+
+std::string result_fingerprint(pqxx::transaction_base& t, const ResultRecord& r) {
+  return t
+      .exec_params1("SELECT md5(concat_ws('|', $1::text, $2::bigint::text, $3::text, $4::text))",
+                    r.standard, r.created_unix_ms, r.json, r.provenance_json)[0]
+      .as<std::string>();
+}
 
 int migrate_schema(pqxx::connection& conn, std::string_view shown_url) {
   return guarded(shown_url, "create or migrate the central schema", [&] {

@@ -2,6 +2,7 @@
 // Private to storage/pg: the central schema's migrations and the connection's error handling.
 #include <fmt/format.h>
 
+#include <memory>
 #include <pqxx/pqxx>
 #include <string>
 #include <string_view>
@@ -13,6 +14,31 @@ namespace cal::storage::pg {
 // Creates or migrates the schema `caldaq` on this connection, in one transaction under an
 // advisory lock (two syncs starting at once migrate it once); returns the version.
 int migrate_schema(pqxx::connection& conn, std::string_view shown_url);
+
+// A result's identity on the server (schema 3): md5 of its standard, creation time, document and
+// provenance, computed by the server as the migration computed it for the rows it had.
+std::string result_fingerprint(pqxx::transaction_base& t, const ResultRecord& r);
+
+// The columns of a reading chunk's row that read_chunk() reads, in its order.
+inline constexpr const char* kChunkColumns =
+    "seq, device, channel, quantity, first_ns, last_ns, count, encoding, crc, data";
+
+// A chunk's row (kChunkColumns) into a record with those members (SourceChunk for the readers,
+// Store::StoredChunk for daq sync --from); crc is the server's, not checked here.
+template <class Chunk>
+void read_chunk(const pqxx::row& row, Chunk& c) {
+  c.seq = row[0].as<std::int64_t>();
+  c.device = row[1].as<std::int64_t>();
+  c.channel = row[2].as<std::int64_t>();
+  c.quantity = row[3].as<std::int64_t>();
+  c.first_ns = row[4].as<std::int64_t>();
+  c.last_ns = row[5].as<std::int64_t>();
+  c.count = row[6].as<std::int64_t>();
+  c.encoding = row[7].as<std::int64_t>();
+  c.crc = static_cast<std::uint32_t>(row[8].as<std::int64_t>());
+  const pqxx::binarystring data(row[9]);
+  c.data.assign(data.data(), data.data() + data.size());
+}
 
 // Runs f, turning libpqxx's exceptions into StoreError naming the server and what was done.
 template <class F>
@@ -37,6 +63,12 @@ auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
     while (!text.empty() && text.back() == ' ') text.pop_back();
     throw StoreError(fmt::format("{}: {}: {}", shown_url, what, text));
   }
+}
+
+// A connection to the server at url (shown as shown_url in errors).
+inline std::unique_ptr<pqxx::connection> connect(std::string_view shown_url, std::string_view url) {
+  return guarded(shown_url, "connect",
+                 [&] { return std::make_unique<pqxx::connection>(std::string(url)); });
 }
 
 }  // namespace cal::storage::pg

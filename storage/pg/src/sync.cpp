@@ -2,6 +2,7 @@
 #include "cal/storage/pg/sync.hpp"
 
 #include <chrono>
+#include <filesystem>
 #include <map>
 #include <optional>
 
@@ -83,11 +84,7 @@ struct ServerChunk {
 class Sync {
  public:
   Sync(const Store& local, std::string_view url, const SyncOptions& options)
-      : local_(local),
-        shown_(redacted(url)),
-        options_(options),
-        conn_(guarded(shown_, "connect",
-                      [&] { return std::make_unique<pqxx::connection>(std::string(url)); })) {
+      : local_(local), shown_(redacted(url)), options_(options), conn_(connect(shown_, url)) {
     if (options_.chunks_per_transaction == 0) options_.chunks_per_transaction = 1;
   }
 
@@ -133,34 +130,38 @@ class Sync {
       throw StoreError(fmt::format(
           "{}: run {} has no UUID (the database was opened read-only at an older schema)",
           local_.path().string(), r.id));
+    // A run brought here by daq sync --from has another id here than in the store that first
+    // sent it, whose id the server's checksums cover: they are compared and sent for that id.
     const auto source_id =
         guarded(shown_, fmt::format("store {}", run_name(r)), [&] { return send_metadata(r); });
-    if (source_id != r.id)
-      throw StoreError(fmt::format(
-          "{}: {} is on the server as run {} of another store: its chunks (whose checksums "
-          "cover that id) were not sent",
-          shown_, run_name(r), source_id));
     const auto before = report_.chunks_sent;
     const auto already_before = report_.chunks_already;
     guarded(shown_, fmt::format("send the reading chunks of {}", run_name(r)),
-            [&] { send_chunks(r); });
+            [&] { send_chunks(r, source_id); });
     ++report_.runs;
     if (options_.run_done)
       options_.run_done(r, report_.chunks_sent - before, report_.chunks_already - already_before);
   }
 
-  // The server's id of a local machine ("" for none), adding it. Machines are known by name: a
-  // no-op update returns the id of an existing one.
+  // The server's id of a local machine ("" for none), adding it. Machines are known by their
+  // UUID (schema 5); one sent before, known by name only, is adopted by the first store that
+  // sends a machine of that name.
   std::string server_machine(pqxx::work& w, std::int64_t local_id) const {
     if (local_id <= 0) return {};
     const auto m = local_.machine(local_id);
     if (!m) return {};
-    return w
-        .exec_params1(
-            "INSERT INTO caldaq.machines(name, description, config_json) VALUES($1, $2, $3) "
-            "ON CONFLICT (name) DO UPDATE SET name = EXCLUDED.name RETURNING id",
-            m->name, m->description, m->config_json)[0]
-        .as<std::string>();
+    auto rows = w.exec_params("SELECT id FROM caldaq.machines WHERE uuid = $1", m->uuid);
+    if (rows.empty())
+      rows = w.exec_params(
+          "UPDATE caldaq.machines SET uuid = $1 WHERE id = (SELECT id FROM caldaq.machines WHERE "
+          "uuid IS NULL AND name = $2 ORDER BY id LIMIT 1) RETURNING id",
+          m->uuid, m->name);
+    if (rows.empty())
+      rows = w.exec_params(
+          "INSERT INTO caldaq.machines(uuid, name, description, config_json) "
+          "VALUES($1, $2, $3, $4) RETURNING id",
+          m->uuid, m->name, m->description, m->config_json);
+    return rows[0][0].as<std::string>();
   }
 
   // The compensation tables and ballbar calibrations of the local store, each stored once
@@ -205,7 +206,6 @@ class Sync {
         w.exec_params("SELECT source_run_id FROM caldaq.runs WHERE uuid = $1 FOR UPDATE", r.uuid);
     if (existing.empty()) ++report_.runs_new;
     const std::int64_t source_id = existing.empty() ? r.id : existing[0][0].as<std::int64_t>();
-    if (source_id != r.id) return source_id;
     const auto quality = quality_json(local_.quality(r.id));
     if (existing.empty())
       w.exec_params(
@@ -230,30 +230,23 @@ class Sync {
           nullable(r.ended_unix_ms), std::string(to_string(r.status)), r.note,
           nullable(r.origin_session_ns), nullable(r.origin_unix_ns), quality, unix_ms_now());
     send_children(w, r);
+    send_results(w, r, source_id);
     w.commit();
     return source_id;
   }
 
-  // The run's instruments, stops, missed stops and operator's actions are replaced as a whole
-  // (they are small, and the local store may have replaced them: a re-compensation rewrites the
-  // stops); results are added by their local id and their superseded mark updated, so a result
-  // is stored once however often it is sent.
+  // The run's instruments, missed stops, suspect stops and operator's actions are replaced as a
+  // whole (they are small; the last sender's are kept); its stops become a version (send_stops),
+  // never replaced, since a re-compensation elsewhere rewrites them.
   void send_children(pqxx::work& w, const RunRecord& r) {
-    for (const char* table :
-         {"instruments", "captured_targets", "missed_stops", "operator_actions", "suspect_stops"})
+    for (const char* table : {"instruments", "missed_stops", "operator_actions", "suspect_stops"})
       w.exec_params(fmt::format("DELETE FROM caldaq.{} WHERE run_uuid = $1", table), r.uuid);
     for (const auto& i : local_.instruments(r.id))
       w.exec_params(
           "INSERT INTO caldaq.instruments(run_uuid, device, driver, transport, settings_json, "
           "origin, origin_detail) VALUES($1, $2, $3, $4, $5, $6, $7)",
           r.uuid, i.device, i.driver, i.transport, i.settings_json, i.origin, i.origin_detail);
-    for (const auto& t : local_.targets(r.id))
-      w.exec_params(
-          "INSERT INTO caldaq.captured_targets(run_uuid, target_index, run_number, direction, "
-          "nominal_mm, time_ns, raw_m, deviation_um, refractive_index, "
-          "material_temperature_degc) VALUES($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)",
-          r.uuid, t.target_index, t.run_number, std::string(1, t.direction), t.nominal_mm,
-          t.time_ns, t.raw_m, t.deviation_um, t.refractive_index, t.material_temperature_degc);
+    send_stops(w, r);
     for (const auto& m : local_.missed_stops(r.id))
       w.exec_params(
           "INSERT INTO caldaq.missed_stops(run_uuid, run_number, direction, target_index, "
@@ -270,8 +263,7 @@ class Sync {
         w.exec_params(
             "INSERT INTO caldaq.suspect_stops(run_uuid, ordinal, run_number, direction, "
             "target_index, reason) VALUES($1, $2, $3, $4, $5, $6)",
-            r.uuid, ordinal++, m.run_number, std::string(1, m.direction), m.target_index,
-            m.reason);
+            r.uuid, ordinal++, m.run_number, std::string(1, m.direction), m.target_index, m.reason);
     ordinal = 0;
     for (const auto& a : local_.operator_actions(r.id)) {
       const bool has_stop = a.stop.has_value();
@@ -286,15 +278,96 @@ class Sync {
           has_stop ? std::to_string(a.stop->target_index) : std::string(),
           has_stop ? fmt::format("{}", a.stop->nominal_mm) : std::string(), a.detail);
     }
-    for (const auto& res : local_.results(r.id))
+  }
+
+  // The run's stops as a version (schema 4): stops the server has as a version already add
+  // nothing; others become a new version, the current one, with who sent them, from where and
+  // when, the earlier versions kept. Only a run this store sent while it was still running grows
+  // its version in place (the acquisition went on; nothing was changed elsewhere).
+  void send_stops(pqxx::work& w, const RunRecord& r) {
+    const auto fresh =
+        w.exec_params1(
+             "SELECT COALESCE(MAX(version), 0) + 1 FROM caldaq.run_versions WHERE run_uuid = $1",
+             r.uuid)[0]
+            .as<int>();
+    for (const auto& t : local_.targets(r.id))
       w.exec_params(
-          "INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, "
-          "created_unix_ms, provenance_json, superseded_by) "
-          "VALUES($1, $2, $3, $4, $5, $6, NULLIF($7, '')::bigint) "
-          "ON CONFLICT (run_uuid, source_result_id) DO UPDATE SET "
-          "superseded_by = EXCLUDED.superseded_by",
-          r.uuid, res.id, res.standard, res.json, res.created_unix_ms, res.provenance_json,
-          nullable(res.superseded_by));
+          "INSERT INTO caldaq.captured_targets(run_uuid, version, target_index, run_number, "
+          "direction, nominal_mm, time_ns, raw_m, deviation_um, refractive_index, "
+          "material_temperature_degc) VALUES($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)",
+          r.uuid, fresh, t.target_index, t.run_number, std::string(1, t.direction), t.nominal_mm,
+          t.time_ns, t.raw_m, t.deviation_um, t.refractive_index, t.material_temperature_degc);
+    const auto fp = w.exec_params1("SELECT caldaq.stops_fingerprint($1, $2)", r.uuid, fresh)[0]
+                        .as<std::string>();
+    const auto drop_fresh = [&] {
+      w.exec_params("DELETE FROM caldaq.captured_targets WHERE run_uuid = $1 AND version = $2",
+                    r.uuid, fresh);
+    };
+    const auto same = w.exec_params(
+        "SELECT 1 FROM caldaq.run_versions WHERE run_uuid = $1 AND fingerprint = $2", r.uuid, fp);
+    if (!same.empty()) return drop_fresh();
+    const auto store = std::filesystem::absolute(local_.path()).string();
+    const auto growing = w.exec_params(
+        "SELECT v.version FROM caldaq.run_versions AS v JOIN caldaq.runs AS r ON r.uuid = "
+        "v.run_uuid AND v.version = r.current_version WHERE v.run_uuid = $1 AND v.status = "
+        "'running' AND v.sent_store = $2 AND v.sent_from = $3",
+        r.uuid, store, options_.sent_from);
+    int version = fresh;
+    if (!growing.empty()) {
+      version = growing[0][0].as<int>();
+      w.exec_params("DELETE FROM caldaq.captured_targets WHERE run_uuid = $1 AND version = $2",
+                    r.uuid, version);
+      w.exec_params(
+          "UPDATE caldaq.captured_targets SET version = $3 WHERE run_uuid = $1 AND version = $2",
+          r.uuid, fresh, version);
+      w.exec_params("DELETE FROM caldaq.run_versions WHERE run_uuid = $1 AND version = $2", r.uuid,
+                    version);
+    } else if (fresh > 1) {
+      ++report_.versions_new;
+    }
+    w.exec_params(
+        "INSERT INTO caldaq.run_versions(run_uuid, version, fingerprint, status, sent_by, "
+        "sent_from, sent_store, sent_unix_ms) VALUES($1, $2, $3, $4, $5, $6, $7, $8)",
+        r.uuid, version, fp, std::string(to_string(r.status)), options_.sent_by, options_.sent_from,
+        store, unix_ms_now());
+    w.exec_params("UPDATE caldaq.runs SET current_version = $2 WHERE uuid = $1", r.uuid, version);
+  }
+
+  // Results are known on the server by their content's fingerprint: one already there is not
+  // stored again (whatever its id here: a run brought by daq sync --from numbers them anew); a
+  // new one keeps its local id when this store first sent the run (source_id), else takes the
+  // next free number. A supersession is added, never changed: a result superseded there stays
+  // superseded by what superseded it there (results made apart are all kept).
+  void send_results(pqxx::work& w, const RunRecord& r, std::int64_t source_id) {
+    const auto local = local_.results(r.id);
+    std::map<std::int64_t, std::int64_t> server_id;  // local id -> the server's
+    for (const auto& res : local) {
+      const auto fp = result_fingerprint(w, res);
+      const auto there = w.exec_params(
+          "SELECT source_result_id FROM caldaq.results WHERE run_uuid = $1 AND fingerprint = $2",
+          r.uuid, fp);
+      if (!there.empty()) {
+        server_id[res.id] = there[0][0].as<std::int64_t>();
+        continue;
+      }
+      server_id[res.id] =
+          w.exec_params1(
+               "INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, "
+               "created_unix_ms, provenance_json, fingerprint) VALUES($1::uuid, CASE WHEN $2 AND "
+               "NOT EXISTS (SELECT 1 FROM caldaq.results WHERE run_uuid = $1::uuid AND "
+               "source_result_id = $3) THEN $3 ELSE (SELECT COALESCE(MAX(source_result_id), 0) + "
+               "1 FROM caldaq.results WHERE run_uuid = $1::uuid) END, $4, $5, $6, $7, $8) "
+               "RETURNING source_result_id",
+               r.uuid, source_id == r.id, res.id, res.standard, res.json, res.created_unix_ms,
+               res.provenance_json, fp)[0]
+              .as<std::int64_t>();
+    }
+    for (const auto& res : local)
+      if (res.superseded_by && server_id.contains(*res.superseded_by))
+        w.exec_params(
+            "UPDATE caldaq.results SET superseded_by = $3 WHERE run_uuid = $1 AND "
+            "source_result_id = $2 AND superseded_by IS NULL",
+            r.uuid, server_id[res.id], server_id[*res.superseded_by]);
   }
 
   std::map<std::int64_t, ServerChunk> server_chunks(const RunRecord& r) {
@@ -324,9 +397,17 @@ class Sync {
         shown_, run_name(r), seq, how));
   }
 
-  void check_same(const RunRecord& r, const Store::StoredChunk& c, const ServerChunk& s) const {
-    if (s.crc != c.crc)
-      differs(r, c.seq, fmt::format("checksum {:08x} there, {:08x} here", s.crc, c.crc));
+  // The local chunk's checksum as the server holds it: for the run's id in its source store.
+  static std::uint32_t crc_for(const Store::StoredChunk& c, std::int64_t local_id,
+                               std::int64_t source_id) {
+    return source_id == local_id ? c.crc
+                                 : chunk::checksum(chunk::key_of(source_id, c.seq, c), c.data);
+  }
+
+  void check_same(const RunRecord& r, const Store::StoredChunk& c, std::uint32_t crc,
+                  const ServerChunk& s) const {
+    if (s.crc != crc)
+      differs(r, c.seq, fmt::format("checksum {:08x} there, {:08x} here", s.crc, crc));
     if (s.device != c.device || s.channel != c.channel || s.quantity != c.quantity ||
         s.first_ns != c.first_ns || s.last_ns != c.last_ns || s.count != c.count ||
         s.encoding != c.encoding)
@@ -337,7 +418,7 @@ class Sync {
 
   // Pages of the local chunks: those the server has are checked, the others sent, one
   // transaction per page (a cut loses at most that page, sent again next time).
-  void send_chunks(const RunRecord& r) {
+  void send_chunks(const RunRecord& r, std::int64_t source_id) {
     const auto on_server = server_chunks(r);
     const std::int64_t local_count = local_.chunk_count(r.id);
     if (!on_server.empty() && on_server.rbegin()->first >= local_count)
@@ -350,9 +431,9 @@ class Sync {
       first += static_cast<std::int64_t>(page.size());
       std::vector<const Store::StoredChunk*> missing;
       for (const auto& c : page) {
-        local_crcs.push_back(c.crc);
+        local_crcs.push_back(crc_for(c, r.id, source_id));
         if (const auto it = on_server.find(c.seq); it != on_server.end()) {
-          check_same(r, c, it->second);
+          check_same(r, c, local_crcs.back(), it->second);
           ++report_.chunks_already;
         } else {
           missing.push_back(&c);
@@ -363,7 +444,7 @@ class Sync {
       for (const auto* c : missing) {
         w.exec_prepared("insert_chunk", r.uuid, c->seq, c->device, c->channel, c->quantity,
                         c->first_ns, c->last_ns, c->count, c->encoding,
-                        static_cast<std::int64_t>(c->crc), c->stored_checksum,
+                        static_cast<std::int64_t>(crc_for(*c, r.id, source_id)), c->stored_checksum,
                         pqxx::binarystring(c->data.data(), c->data.size()));
         ++report_.chunks_sent;
         report_.bytes_sent += static_cast<std::int64_t>(c->data.size());
@@ -371,12 +452,13 @@ class Sync {
       }
       w.commit();
     }
-    if (options_.verify_bytes) verify_bytes(r, local_crcs);
+    if (options_.verify_bytes) verify_bytes(r, source_id, local_crcs);
   }
 
   // Every chunk of the run read back from the server and its checksum recomputed over the
   // server's bytes (with the run's id in its source store, which the checksum covers).
-  void verify_bytes(const RunRecord& r, const std::vector<std::uint32_t>& local_crcs) {
+  void verify_bytes(const RunRecord& r, std::int64_t source_id,
+                    const std::vector<std::uint32_t>& local_crcs) {
     const auto page_size = static_cast<std::int64_t>(options_.chunks_per_transaction);
     std::int64_t seen = 0;
     for (std::int64_t first = 0;; first += page_size) {
@@ -387,7 +469,7 @@ class Sync {
           r.uuid, first, page_size);
       if (rows.empty()) break;
       for (const auto& row : rows) {
-        const chunk::Key key{.run_id = r.id,
+        const chunk::Key key{.run_id = source_id,
                              .seq = row[0].as<std::int64_t>(),
                              .device = row[1].as<std::int64_t>(),
                              .channel = row[2].as<std::int64_t>(),
@@ -420,8 +502,7 @@ SyncReport sync_to(const Store& local, std::string_view url, const SyncOptions& 
 
 int migrate(std::string_view url) {
   const auto shown = redacted(url);
-  auto conn = guarded(shown, "connect",
-                      [&] { return std::make_unique<pqxx::connection>(std::string(url)); });
+  auto conn = connect(shown, url);
   return migrate_schema(*conn, shown);
 }
 

@@ -9,6 +9,7 @@
 // sqlite3.h stays out of this header.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -32,8 +33,9 @@ class StoreError : public std::runtime_error {
 // (real, simulated, replay), the compensation tables written with their predicted residual, and
 // the quality of a run's stops (suspect stops, the run's verdict). 6 (issue 29): the operator's
 // actions during a run (OperatorAction). 7 (issue 35): every run has a stable identity, a UUID
-// (RunRecord::uuid), by which the central store (daq sync) knows it.
-inline constexpr int schema_version = 7;
+// (RunRecord::uuid), by which the central store (daq sync) knows it. 8 (issue 35): every machine
+// has one too (MachineRecord::uuid): two sites' machines of the same name stay apart centrally.
+inline constexpr int schema_version = 8;
 
 // A new random (version 4) UUID in its canonical lower-case text form.
 std::string new_uuid();
@@ -48,6 +50,9 @@ struct MachineRecord {
   std::string name;
   std::string description;
   std::string config_json = "{}";
+  // Its stable identity (schema 8): given at add_machine (a new one when empty); the central
+  // store tells machines apart by it. "" only for an older database opened read-only.
+  std::string uuid;
 };
 
 struct RunRecord {
@@ -211,6 +216,19 @@ struct StoreOptions {
 
 class ReadingStream;
 
+// One version of a run's stops in the central store (issue 35): the same run changed in two
+// places (re-compensated on two laptops) is kept as versions, never overwritten.
+struct RunVersion {
+  int version = 0;         // 1, 2, ... in the order the server got them
+  std::string status;      // the run's status when this version was sent
+  std::string sent_by;     // the user who sent it
+  std::string sent_from;   // the host it came from
+  std::string sent_store;  // the store (path) it came from
+  std::int64_t sent_unix_ms = 0;
+  std::int64_t stops = 0;  // captured stops in this version
+  bool current = false;    // the version the read commands read (the newest sent)
+};
+
 // The series of a run (one per device, channel and quantity) with their counts and time spans,
 // from the chunks' rows alone (no reading is decoded).
 struct SeriesInfo {
@@ -264,6 +282,8 @@ class RunReader {
   // Compensation tables written, of a machine's axis, oldest first (machine_id 0 / axis "": any).
   virtual std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
                                                         std::string_view axis = {}) const = 0;
+  // The versions of a run's stops, oldest first (empty: the store keeps one, as a local one).
+  virtual std::vector<RunVersion> versions(std::int64_t /*run_id*/) const { return {}; }
 };
 
 // A reading chunk as a store hands it to a ReadingStream: its row and its bytes.
@@ -324,12 +344,13 @@ class Store : public RunReader {
 
   const std::filesystem::path& path() const;
   std::string name() const override;  // the path
-  int version() const;  // the schema version found on disk after migration
+  int version() const;                // the schema version found on disk after migration
   bool read_only() const;
 
   std::int64_t add_machine(const MachineRecord& m);
   std::optional<MachineRecord> machine_by_name(std::string_view name) const override;
   std::optional<MachineRecord> machine(std::int64_t id) const override;
+  std::optional<MachineRecord> machine_by_uuid(std::string_view uuid) const;
 
   std::int64_t begin_run(const RunRecord& r);  // returns the new run id
   void add_instrument(const InstrumentRecord& i);
@@ -423,6 +444,20 @@ class Store : public RunReader {
   std::int64_t add_compensation(const CompensationRecord& c);
   std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
                                                 std::string_view axis = {}) const override;
+
+  // What daq sync --from brings from the central store (issue 35). f runs in one transaction:
+  // every write it makes (by the methods here) is committed together, or none on a throw.
+  void in_transaction(const std::function<void()>& f);
+  // A run as another store recorded it, its UUID, status, times and origin kept (begin_run
+  // starts a new one); returns its new local id. A UUID already here is a StoreError.
+  std::int64_t import_run(const RunRecord& r);
+  // Another store's reading chunks of the run, appended with their numbers, which must continue
+  // the run's (0, 1, 2, ...). Each one's checksum is computed for this store's run id: the
+  // caller has checked the bytes against the checksum they came with.
+  void add_stored_chunks(std::int64_t run_id, std::span<const StoredChunk> chunks);
+  // Marks a result superseded by another of the same run (as the store it came from had it).
+  void set_superseded(std::int64_t result_id, std::int64_t by_result_id);
+
   struct Impl;  // implementation, shared with ReadingStream (store.cpp)
 
  private:

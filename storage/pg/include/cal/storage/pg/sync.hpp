@@ -6,6 +6,7 @@
 //
 // libpqxx and libpq stay in storage/pg/src: this header names neither.
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -20,7 +21,11 @@ namespace cal::storage::pg {
 // captured stops, missed stops, results with provenance, the operator's actions.
 // 2: the stop quality as rows (suspect stops), compensation tables, ballbar calibrations: what
 // the read commands read from either store.
-inline constexpr int central_schema_version = 2;
+// 3: results known by a fingerprint of their content (daq sync --from and back stores one).
+// 4: a run's stops kept as versions (run_versions: who sent them, from where, when) when the
+// same run was changed in two places.
+// 5: machines known by a stable id (their UUID), not by name.
+inline constexpr int central_schema_version = 5;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
@@ -42,6 +47,9 @@ struct SyncOptions {
   std::function<void(std::int64_t chunks_sent)> after_chunk;
   // Called when a run is done (for progress lines).
   std::function<void(const RunRecord&, std::int64_t sent, std::int64_t already)> run_done;
+  // Who sends and from where (a user and a host name): recorded with each version of a run's
+  // stops (with the local store's path and the time).
+  std::string sent_by, sent_from;
 };
 
 struct SyncReport {
@@ -51,7 +59,8 @@ struct SyncReport {
   std::int64_t chunks_already = 0;  // chunks the server had (from an earlier or cut sync), checked
   std::int64_t chunks_verified_bytes = 0;  // chunks whose server bytes were re-read (verify_bytes)
   std::int64_t bytes_sent = 0;             // chunk BLOB bytes copied now
-  int server_schema = 0;                   // the central schema version after migration
+  std::int64_t versions_new = 0;  // runs whose stops differ from every version the server had
+  int server_schema = 0;          // the central schema version after migration
 };
 
 // Copies the runs of `local` to the central store at `url` (migrating its schema first).
@@ -59,6 +68,43 @@ struct SyncReport {
 // holds that differs from the local one (checksum, row or length) is an error naming the run
 // and the chunk, and nothing of that run is overwritten.
 SyncReport sync_to(const Store& local, std::string_view url, const SyncOptions& options = {});
+
+struct PullOptions {
+  // The machine whose history is brought: its name on the server, or its UUID (when two
+  // sites' machines have the name).
+  std::string machine;
+  // Chunks received per local transaction: what a cut pull receives again.
+  std::size_t chunks_per_transaction = 64;
+  // Called after each chunk is received, before its transaction commits (the tests' cut).
+  std::function<void(std::int64_t chunks_received)> after_chunk;
+  // Called when a run is done, with its local record.
+  std::function<void(const RunRecord&, std::int64_t received, std::int64_t already)> run_done;
+};
+
+struct PullReport {
+  std::int64_t runs = 0;               // the machine's runs on the server
+  std::int64_t runs_new = 0;           // of which this store did not have before
+  std::int64_t results_new = 0;        // results brought (of runs new or not)
+  std::int64_t chunks_received = 0;    // chunks copied now, each checked against its checksum
+  std::int64_t chunks_already = 0;     // chunks this store had, checked against the server's
+  std::int64_t bytes_received = 0;     // chunk BLOB bytes copied now
+  std::int64_t compensations_new = 0;  // compensation tables of the machine brought
+  std::int64_t calibrations_new = 0;   // ballbar calibrations brought
+  int server_schema = 0;
+};
+
+// daq sync --from: brings one machine's history from the central store at `url` into `local`
+// (the machine added by name if this store lacks it): its runs with their UUIDs, instruments,
+// stops, results with their provenance, the quality, the operator's actions and every reading
+// chunk; its compensation tables; the ballbar calibrations. Idempotent (what is here is not
+// brought again: runs by UUID, results by content, chunks by number and checksum) and resumable
+// (a cut pull continues from the chunks here). Every chunk received is checked against the
+// checksum the server holds for it; a chunk here that differs from the server's is an error
+// naming the run and the chunk, and nothing of that run is overwritten. The local store at
+// `local_path` is opened (created when missing, migrated when older) only once the server and
+// the machine are found: a refused pull leaves no file behind. Throws StoreError.
+PullReport sync_from(const std::filesystem::path& local_path, std::string_view url,
+                     const PullOptions& options);
 
 // Creates or migrates the central schema; returns its version. Refuses a newer one.
 int migrate(std::string_view url);

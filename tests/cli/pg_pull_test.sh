@@ -1,0 +1,204 @@
+#!/usr/bin/env bash
+# Issue 35: daq sync --from postgresql://... --machine NAME brings a machine's history into a
+# local store (a laptop before a visit), against a real PostgreSQL server started here
+# (tests/cli/pg_server.sh): the demo's runs (with a replay, a re-compensation, a compensation
+# table and a ballbar calibration) sent, brought into a store whose run ids differ (every chunk's
+# checksum checked, the UUIDs kept, every read command's output the same), brought again (nothing
+# twice), cut and resumed, sent back (nothing twice), a result made on the laptop carried both
+# ways, a damaged chunk on the server refused.
+# Usage: pg_pull_test.sh DAQ_BINARY
+set -u
+DAQ=$1
+
+source "$(dirname "$0")/check.sh"
+source "$(dirname "$0")/pg_server.sh"
+pg_with_visit
+MACHINE=$("$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute('SELECT name FROM machines ORDER BY id').fetchone()[0])" "$DB")
+
+# value DB SQL: one value from a local store.
+value() {
+  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
+}
+# rows DB: what a store holds, by UUID (not by local id): runs, results, chunks with the md5 of
+# their bytes, stops, compensation tables, calibrations; the same text for the same history.
+rows() {
+  "$PY" - "$1" <<'PY'
+import hashlib, sqlite3, sys
+c = sqlite3.connect(sys.argv[1])
+md5 = lambda *v: hashlib.md5("|".join(str(x) for x in v).encode()).hexdigest()
+lines = []
+for r in c.execute("SELECT uuid, kind, axis, status, started_unix_ms, ended_unix_ms, settings_json FROM runs"):
+    lines.append(("run",) + r)
+for r in c.execute("SELECT u.uuid, s.standard, s.created_unix_ms, s.json, s.provenance_json, "
+                   "s.superseded_by IS NULL FROM results s JOIN runs u ON u.id = s.run_id"):
+    lines.append(("result", r[0], r[1], r[2], md5(r[3], r[4]), r[5]))
+for u, seq, data in c.execute("SELECT r.uuid, k.seq, k.data FROM reading_chunks k JOIN runs r ON r.id = k.run_id"):
+    lines.append(("chunk", u, seq, hashlib.md5(data).hexdigest()))
+for r in c.execute("SELECT u.uuid, t.run_number, t.direction, t.target_index, t.deviation_um "
+                   "FROM captured_targets t JOIN runs u ON u.id = t.run_id"):
+    lines.append(("stop",) + r)
+for r in c.execute("SELECT source, axis, format, created_unix_ms, json FROM compensations"):
+    lines.append(("compensation", r[0], r[1], r[2], r[3], md5(r[4])))
+for r in c.execute("SELECT bar, nominal_mm, calibrated_unix_ms FROM ballbar_calibrations"):
+    lines.append(("calibration",) + r)
+for l in lines:
+    print(*l)
+PY
+}
+# same_rows NAME A B: the two stores hold the same history (not vacuously: runs and chunks).
+same_rows() {
+  rows "$2" | sort >"$TMP/a.txt"
+  rows "$3" | sort >"$TMP/b.txt"
+  check "$1" 0 "^same [1-9][0-9]* lines, [1-9][0-9]* chunks$" -- bash -c \
+    "diff '$TMP/a.txt' '$TMP/b.txt' | head -5 && cmp -s '$TMP/a.txt' '$TMP/b.txt' && echo same \$(wc -l <'$TMP/a.txt') lines, \$(grep -c ^chunk '$TMP/a.txt') chunks"
+}
+
+RUNS=$(value "$DB" "SELECT count(*) FROM runs")
+CHUNKS=$(value "$DB" "SELECT count(*) FROM reading_chunks")
+RESULTS=$(value "$DB" "SELECT count(*) FROM results")
+
+# Refused: no machine, an unknown machine, an unreachable server (nothing created by any), both
+# directions, not a URI.
+check no_machine 2 "--from needs --machine NAME" -- "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL"
+check unknown_machine 2 "no machine 'Mill 9' in the central store" -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL" --machine "Mill 9"
+check unknown_uuid 2 "no machine '0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b' in the central store" -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL" --machine 0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b
+check unknown_escaped 2 'no machine .Mill\\x1B\[2J. in the central store' -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from "$PG_URL" --machine $'Mill\e[2J'
+check from_unreachable 2 "postgresql://127\.0\.0\.1:1/caldaq: connect" -- \
+  "$DAQ" sync --db "$TMP/laptop.sqlite" --from postgresql://127.0.0.1:1/caldaq --machine "$MACHINE"
+check refused_nothing_created 0 "^none$" -- bash -c "ls '$TMP'/laptop.sqlite* 2>/dev/null || echo none"
+check both_ways 2 "give one of --to .* and --from" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --from "$PG_URL" --machine x
+check from_not_uri 2 "--from: '/tmp/x.sqlite' is not a PostgreSQL URI" -- "$DAQ" sync --db "$DB" --from /tmp/x.sqlite --machine x
+
+# The laptop already holds a run of its own: the runs brought get other ids than on the server
+# and in the store that sent them (whose ids their checksums cover), so every checksum is
+# checked across ids.
+LAPTOP=$TMP/laptop.sqlite
+check laptop_own_run 0 "" -- "$DAQ" replay "$DEMO_CDQ" --db "$LAPTOP"
+# ... of another machine (a replay records the capture's machine: renamed, it is the bench's).
+"$PY" -c "import sqlite3, sys; c = sqlite3.connect(sys.argv[1]); c.execute(\"UPDATE machines SET name = 'Bench'\"); c.commit()" "$LAPTOP"
+check pull 0 "$RUNS runs of machine '$MACHINE' brought from .*: $RUNS new, $RESULTS new results; $CHUNKS chunks received \([1-9][0-9]* bytes\), 0 already here; 1 compensation tables, 1 ballbar calibrations new" -- \
+  "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
+check pull_ids_shifted 0 "^$((RUNS + 1))$" -- value "$LAPTOP" "SELECT max(id) FROM runs"
+"$PY" - "$LAPTOP" <<'PY'
+import sqlite3, sys
+c = sqlite3.connect(sys.argv[1]); c.execute("PRAGMA foreign_keys = OFF")
+# A copy without the laptop's own run: the same history as the store that sent it.
+c.execute("DELETE FROM reading_chunks WHERE run_id = 1"); c.execute("DELETE FROM results WHERE run_id = 1")
+c.execute("DELETE FROM captured_targets WHERE run_id = 1"); c.execute("DELETE FROM instruments WHERE run_id = 1")
+c.execute("DELETE FROM runs WHERE id = 1"); c.commit()
+PY
+same_rows pull_same_history "$DB" "$LAPTOP"
+# Every chunk readable with its checksum for the laptop's ids, and the readings the same.
+check pull_export_same 0 "^same [1-9]" -- bash -c \
+  "diff <('$DAQ' export 1 --db '$DB') <('$DAQ' export 2 --db '$LAPTOP') >/dev/null && echo same \$('$DAQ' export 1 --db '$DB' | wc -l)"
+# (the results numbered by each store: the laptop's own run took result 1)
+check pull_show_same 0 "^same$" -- bash -c \
+  "diff <('$DAQ' show 1 --db '$DB' | grep -v '^Run 1\|run 1\b' | sed 's/result [0-9]*/result N/g') <('$DAQ' show 2 --db '$LAPTOP' | grep -v '^Run 2\|run 2\b' | sed 's/result [0-9]*/result N/g') && echo same"
+check pull_results_superseded 0 "^$(value "$DB" "SELECT count(*) FROM results WHERE superseded_by IS NOT NULL")$" -- \
+  value "$LAPTOP" "SELECT count(*) FROM results WHERE superseded_by IS NOT NULL"
+
+# Brought again: nothing twice, every chunk here checked against the server's checksum.
+check pull_again 0 "$RUNS runs .*: 0 new, 0 new results; 0 chunks received \(0 bytes\), $CHUNKS already here; 0 compensation tables, 0 ballbar calibrations new" -- \
+  "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
+same_rows pull_again_same "$DB" "$LAPTOP"
+
+# Sent back from the laptop: nothing twice on the server (the results known by their content,
+# the chunks by their checksums for the ids of the store that first sent them).
+check send_back 0 "$RUNS runs synced .*: 0 new; 0 chunks sent \(0 bytes\), $CHUNKS already there" -- \
+  "$DAQ" sync --db "$LAPTOP" --to "$PG_URL" --verify
+check send_back_results 0 "^$RESULTS$" -- psql_value "SELECT count(*) FROM caldaq.results"
+check send_back_chunks 0 "^$CHUNKS$" -- psql_value "SELECT count(*) FROM caldaq.reading_chunks"
+
+# A result made on the laptop (a re-analysis) goes to the server once and from there to the
+# store that sent the run, where it supersedes the result it superseded on the laptop.
+check laptop_analyse 0 "" -- "$DAQ" analyse 2 --store --db "$LAPTOP"
+check laptop_send 0 "0 new" -- "$DAQ" sync --db "$LAPTOP" --to "$PG_URL" --quiet
+check laptop_send_again 0 "0 new" -- "$DAQ" sync --db "$LAPTOP" --to "$PG_URL" --quiet
+check laptop_result_once 0 "^$((RESULTS + 1))$" -- psql_value "SELECT count(*) FROM caldaq.results"
+check back_home 0 "0 new, 1 new results; 0 chunks received" -- \
+  "$DAQ" sync --db "$DB" --from "$PG_URL" --machine "$MACHINE" --quiet
+check back_home_superseded 0 "^$(value "$LAPTOP" "SELECT count(*) FROM results WHERE superseded_by IS NOT NULL")$" -- \
+  value "$DB" "SELECT count(*) FROM results WHERE superseded_by IS NOT NULL"
+same_rows back_home_same "$DB" "$LAPTOP"
+
+# A pull cut mid-transaction (after its 10th chunk, pages of 4: two committed), then resumed:
+# nothing lost, nothing twice.
+CUT=$TMP/cut.sqlite
+check cut 75 "" -- env CALDAQ_SYNC_CUT_AFTER_CHUNKS=10 "$DAQ" sync --db "$CUT" --from "$PG_URL" --machine "$MACHINE" --chunks-per-transaction 4
+check cut_committed 0 "^8$" -- value "$CUT" "SELECT count(*) FROM reading_chunks"
+check resume 0 "$RUNS runs .*: $((RUNS - 1)) new, [0-9]+ new results; $((CHUNKS - 8)) chunks received .*, 8 already here" -- \
+  "$DAQ" sync --db "$CUT" --from "$PG_URL" --machine "$MACHINE" --chunks-per-transaction 4 --quiet
+same_rows resume_same "$LAPTOP" "$CUT"
+
+# Conflicts kept as versions: run 1 re-compensated on two laptops, alice's and bob's, each sent.
+# The server keeps the three sets of stops (none overwritten) with who sent them, from where and
+# when, and both new results; the newest is what the read commands read; daq show names them.
+ALICE=$TMP/alice.sqlite
+BOB=$TMP/bob.sqlite
+RUN1=$(psql_value "SELECT uuid FROM caldaq.runs WHERE id = 1")
+check alice_pull 0 "" -- "$DAQ" sync --db "$ALICE" --from "$PG_URL" --machine "$MACHINE" --quiet
+check bob_pull 0 "" -- "$DAQ" sync --db "$BOB" --from "$PG_URL" --machine "$MACHINE" --quiet
+check alice_recompensate 0 "" -- "$DAQ" recompensate 1 --alpha-ppm 9.0 --db "$ALICE"
+check bob_recompensate 0 "" -- "$DAQ" recompensate 1 --alpha-ppm 14.0 --db "$BOB"
+check alice_send 0 "; 1 runs' stops differ from the server's: kept as a new version" -- \
+  env USER=alice "$DAQ" sync --db "$ALICE" --to "$PG_URL" --run 1 --quiet
+check bob_send 0 "; 1 runs' stops differ from the server's: kept as a new version" -- \
+  env USER=bob "$DAQ" sync --db "$BOB" --to "$PG_URL" --run 1 --quiet
+check versions_kept 0 "^1 2 3$" -- psql_value "SELECT string_agg(version::text, ' ' ORDER BY version) FROM caldaq.run_versions WHERE run_uuid = '$RUN1'"
+check stops_kept 0 "^3$" -- psql_value "SELECT count(DISTINCT version) FROM caldaq.captured_targets WHERE run_uuid = '$RUN1'"
+check others_one_version 0 "^1$" -- psql_value "SELECT max(current_version) FROM caldaq.runs WHERE uuid <> '$RUN1'"
+check versions_who 0 "^2 alice .*alice.sqlite\|3 bob .*bob.sqlite$" -- \
+  psql_value "SELECT string_agg(version || ' ' || sent_by || ' ' || sent_from || ' ' || sent_store, '|' ORDER BY version) FROM caldaq.run_versions WHERE run_uuid = '$RUN1' AND version > 1"
+check both_results_current 0 "^2$" -- psql_value "SELECT count(*) FROM caldaq.results WHERE run_uuid = '$RUN1' AND superseded_by IS NULL"
+check show_versions 0 "versions \(3; the run was changed in more than one place, none overwritten\): +version 1: [0-9]+ stops, sent .* +version 2: [0-9]+ stops, sent [0-9T:-]+.* by alice from .* \(.*alice.sqlite\) +version 3 \(current, shown\): [0-9]+ stops, sent .* by bob from .*bob.sqlite" -- \
+  bash -c "'$DAQ' show 1 --db '$PG_URL' | tr '\n' ' '"
+check show_json_versions 0 "^3 bob True$" -- bash -c \
+  "'$DAQ' show 1 --json --db '$PG_URL' | '$PY' -c 'import json, sys; v = json.load(sys.stdin)[\"versions\"]; print(len(v), v[-1][\"sent_by\"], v[-1][\"current\"])'"
+# The current version's stops are bob's, as his laptop has them.
+check current_is_bobs 0 "^same [1-9]" -- bash -c \
+  "diff <('$DAQ' export 1 --what targets --db '$BOB') <('$DAQ' export 1 --what targets --db '$PG_URL') && echo same \$('$DAQ' export 1 --what targets --db '$BOB' | wc -l)"
+# Sent again by either: nothing new; the current version stays bob's.
+check alice_again 0 "0 new; 0 chunks sent \(0 bytes\), [0-9]+ already there$" -- \
+  env USER=alice "$DAQ" sync --db "$ALICE" --to "$PG_URL" --run 1 --quiet
+check still_three 0 "^3 3$" -- psql_value "SELECT count(*) || ' ' || max(r.current_version) FROM caldaq.run_versions v JOIN caldaq.runs r ON r.uuid = v.run_uuid WHERE v.run_uuid = '$RUN1'"
+# A store without the conflict reads as one version: nothing named.
+check show_one_version 0 "^none$" -- bash -c "'$DAQ' show 2 --db '$PG_URL' | grep -q versions && echo named || echo none"
+
+# Damage on the server is found, and nothing of it stored: a changed byte in a chunk to bring;
+# a changed checksum of a chunk the laptop has.
+psql_value "UPDATE caldaq.reading_chunks SET data = set_byte(data, 3, (get_byte(data, 3) + 1) % 256) WHERE seq = 2 AND run_uuid = (SELECT uuid FROM caldaq.runs WHERE id = 1)" >/dev/null
+check damaged 2 "run 1 \(.*\): the server's reading chunk 2 does not match its checksum .*nothing of it was stored" -- \
+  "$DAQ" sync --db "$TMP/fresh.sqlite" --from "$PG_URL" --machine "$MACHINE" --quiet
+check damaged_not_stored 0 "^0$" -- value "$TMP/fresh.sqlite" "SELECT count(*) FROM reading_chunks"
+psql_value "UPDATE caldaq.reading_chunks SET crc = crc # 1 WHERE seq = 0 AND run_uuid = (SELECT uuid FROM caldaq.runs WHERE id = 1)" >/dev/null
+check damaged_here 2 "run 1 \(.*\): the local reading chunk 0 differs from the server's \(checksum .* there, .* here\); nothing of it was overwritten" -- \
+  "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE" --quiet
+
+# Machines known by their UUID, not by name: another site's machine of the same name (a replay
+# into a store of its own makes one) is another machine on the server, and a name two machines
+# have is refused where it would pick one; the UUID picks it.
+SITE2=$TMP/site2.sqlite
+check site2_run 0 "" -- "$DAQ" replay "$DEMO_CDQ" --db "$SITE2"
+check site2_send 0 "1 runs synced .*: 1 new" -- "$DAQ" sync --db "$SITE2" --to "$PG_URL" --quiet
+check two_machines 0 "^2 2$" -- psql_value "SELECT count(*) || ' ' || count(DISTINCT uuid) FROM caldaq.machines WHERE name = '$MACHINE'"
+check site2_machine_own 0 "^1$" -- psql_value "SELECT count(*) FROM caldaq.runs r JOIN caldaq.machines m ON m.id = r.machine_id WHERE m.uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'"
+check name_ambiguous 2 "2 machines are named '$MACHINE' \(UUIDs .*\): name one by its UUID" -- \
+  "$DAQ" sync --db "$TMP/visit.sqlite" --from "$PG_URL" --machine "$MACHINE"
+check by_uuid 0 "1 runs of machine .* 1 new" -- \
+  "$DAQ" sync --db "$TMP/visit.sqlite" --from "$PG_URL" --machine "$(value "$SITE2" "SELECT uuid FROM machines")" --quiet
+check by_uuid_same 0 "^$(value "$SITE2" "SELECT uuid FROM machines")$" -- value "$TMP/visit.sqlite" "SELECT uuid FROM machines"
+check other_site_here 2 "this store's machine '$MACHINE' is another one \(UUID .*\) than the server's" -- \
+  "$DAQ" sync --db "$TMP/visit.sqlite" --from "$PG_URL" --machine "$(value "$DB" "SELECT uuid FROM machines")"
+
+# A server of central schema 4 (machines by name, before their UUIDs) migrated by a sync: its
+# machines are adopted by the first store that sends a machine of their name, not duplicated.
+psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); UPDATE caldaq.schema_version SET version = 4" >/dev/null
+check old_server 0 "^4 1$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.machines) FROM caldaq.schema_version"
+check migrate_5 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --quiet
+check adopted 0 "^5 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
+  psql_value "SELECT (SELECT version FROM caldaq.schema_version) || ' ' || count(*) || ' ' || max(uuid::text) FROM caldaq.machines"
+
+finish
