@@ -120,5 +120,9 @@ check rot_show_result 0 "^ +B +$B_ARCSEC arcsec +reversal value" -- echo "$SHOW"
 check rot_show_runs 0 "9 targets, 2 runs per direction" -- echo "$SHOW"
 check rot_show_order 0 "^ok$" -- bash -c "grep -nE '^ +(E↑|B̄) ' <<<\"$SHOW\" | awk -F: 'NR==1 && /E↑/ {e=1} NR==2 && /B̄/ && e {print \"ok\"}'"
 check rot_show_no_um 1 "" -- grep -E "[0-9] um " <<<"$SHOW"
+# An option the rotary test would not use is refused, not ignored (--measure ran the linear
+# test of that component instead).
+check rot_measure_refused 2 "--measure E_XX with --test rotary: .* linear test" -- "$DAQ" sim --measure E_XX --test rotary --acquire -o "$TMP/m.toml" --db "$TMP/m.sqlite"
+check rot_targets_refused 2 "--targets with --test rotary" -- "$DAQ" sim --test rotary --targets 5 --acquire -o "$TMP/m.toml" --db "$TMP/m.sqlite"
 
 finish
