@@ -151,14 +151,15 @@ std::string live_line(const LiveState& s) {
       fmt::format("run {} of {} {}  target {} of {}  stop {} of {}", p.run, p.runs,
                   p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target, p.targets,
                   std::min(s.stop_number, s.stop_count), s.stop_count);
-  if (!s.has_reading) return line + "  waiting for the laser's first reading";
+  if (!s.has_reading)
+    return line + fmt::format("  waiting for the {}'s first reading", s.reference);
   if (!s.valid)
     line += "  laser signal lost";
   else if (s.at_target_mm)
-    line += fmt::format("  {:<8} {:+8.2f} um at {:.3f} mm", s.motion, s.at_target_deviation_um,
-                        *s.at_target_mm);
+    line += fmt::format("  {:<8} {:+8.2f} {} at {:.3f} {}", s.motion, s.at_target_deviation_um,
+                        s.units.deviation, *s.at_target_mm, s.units.position);
   else
-    line += fmt::format("  {:<8} at {:.3f} mm", s.motion, s.position_mm);
+    line += fmt::format("  {:<8} at {:.3f} {}", s.motion, s.position_mm, s.units.position);
   if (s.pressure_pa > 0)  // the first air sample has come (env_stage.hpp)
     line += fmt::format("  air {:.2f} degC  material {:.2f} degC{}", s.air_temperature_degc,
                         s.material_degc, s.fallback ? " (fallback)" : "");
@@ -284,14 +285,14 @@ void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const Run
     const std::string key = fmt::format("{} {}", s.phase, s.samples > 0);
     if (progress->json) return progress->live(key, to_json_text(s));
     if (s.samples == 0)  // no deviation before the bar has sent one
-      return progress->live(key, fmt::format("{:<24} waiting for the ballbar's first reading",
-                                             s.phase));
+      return progress->live(key,
+                            fmt::format("{:<24} waiting for the ballbar's first reading", s.phase));
     if (s.state == "waiting")  // nor before the feed-in: no deviation from the circle yet
-      return progress->live(key, fmt::format("{:<24} the bar streams; waiting for the feed-in",
-                                             s.phase));
-    std::string line = fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed",
-                                   s.phase, s.angle_deg, s.deviation_um, 100 * s.fraction,
-                                   clock_text(s.time_s));
+      return progress->live(
+          key, fmt::format("{:<24} the bar streams; waiting for the feed-in", s.phase));
+    std::string line =
+        fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed", s.phase, s.angle_deg,
+                    s.deviation_um, 100 * s.fraction, clock_text(s.time_s));
     if (const auto left = remaining_s(s.time_s, s.fraction, 1.0))
       line += fmt::format(", about {} left", clock_text(*left));
     progress->live(key, line);
