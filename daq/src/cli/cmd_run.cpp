@@ -285,14 +285,14 @@ void run_circle_test(const RunOptions& o, boost::asio::io_context& io, const Run
     const std::string key = fmt::format("{} {}", s.phase, s.samples > 0);
     if (progress->json) return progress->live(key, to_json_text(s));
     if (s.samples == 0)  // no deviation before the bar has sent one
-      return progress->live(key,
-                            fmt::format("{:<24} waiting for the ballbar's first reading", s.phase));
+      return progress->live(key, fmt::format("{:<24} waiting for the ballbar's first reading",
+                                             s.phase));
     if (s.state == "waiting")  // nor before the feed-in: no deviation from the circle yet
-      return progress->live(
-          key, fmt::format("{:<24} the bar streams; waiting for the feed-in", s.phase));
-    std::string line =
-        fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed", s.phase, s.angle_deg,
-                    s.deviation_um, 100 * s.fraction, clock_text(s.time_s));
+      return progress->live(key, fmt::format("{:<24} the bar streams; waiting for the feed-in",
+                                             s.phase));
+    std::string line = fmt::format("{:<24} {:7.1f} deg  {:+9.2f} um  {:5.1f} %  {} elapsed",
+                                   s.phase, s.angle_deg, s.deviation_um, 100 * s.fraction,
+                                   clock_text(s.time_s));
     if (const auto left = remaining_s(s.time_s, s.fraction, 1.0))
       line += fmt::format(", about {} left", clock_text(*left));
     progress->live(key, line);
