@@ -103,9 +103,9 @@ struct LinearRunSetup {
   // A replay of a capture: the results record it, and the original run when it is known.
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
-  Origins origins;                           // by role: stored with each instrument (origin.hpp)
-  cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
-  std::function<void(const LiveState&)> on_live;     // about 10 Hz
+  Origins origins;  // by role: stored with each instrument (origin.hpp)
+  cal::storage::StoreOptions store_options;       // the run's and the writer's (tests: max_pages)
+  std::function<void(const LiveState&)> on_live;  // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
 };
