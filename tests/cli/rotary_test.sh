@@ -120,5 +120,51 @@ check rot_show_result 0 "^ +B +$B_ARCSEC arcsec +reversal value" -- echo "$SHOW"
 check rot_show_runs 0 "9 targets, 2 runs per direction" -- echo "$SHOW"
 check rot_show_order 0 "^ok$" -- bash -c "grep -nE '^ +(E↑|B̄) ' <<<\"$SHOW\" | awk -F: 'NR==1 && /E↑/ {e=1} NR==2 && /B̄/ && e {print \"ok\"}'"
 check rot_show_no_um 1 "" -- grep -E "[0-9] um " <<<"$SHOW"
+# The run's events name degrees and arcsec (they said "target 2 (45.000 mm) run 1 up: -0.519 um",
+# the deviation in millidegrees).
+check rot_events 0 '"message":"target 2 \(45\.000 deg\) run 1 up: [+-][0-9]+\.[0-9]{3} arcsec"' -- cat "$TMP/rot.log"
+check rot_events_no_mm 1 "" -- grep -E "[0-9] (mm|um)([^a-z/]|$)" "$TMP/rot.log"
+check rot_live_line 0 "stable +[+-][0-9.]+ arcsec at 45\.000 deg" -- "$DAQ" sim --test rotary --runs 2 --acquire -o "$TMP/live.toml" --db "$TMP/live.sqlite"
+# daq analyse evaluates the stored stops again (it refused a rotary run): the numbers the run
+# printed, in arcsec; the stored stops are deviations in arcsec, not the reference's angle.
+check rot_analyse 0 "^ +B +$B_ARCSEC arcsec +reversal value" -- "$DAQ" analyse 1 --db "$TMP/rot.sqlite"
+"$DAQ" analyse 1 --db "$TMP/rot.sqlite" --json >"$TMP/rot-analyse.json" 2>&1
+check rot_analyse_same 0 "^same$" -- python3 -c "
+import json; a=json.load(open('$TMP/rot.json')); b=json.load(open('$TMP/rot-analyse.json'))
+print('same' if (a['targets'], a['axis']) == (b['targets'], b['axis']) else 'differ')"
+check rot_analyse_standard 0 "VDI/DGQ 3441" -- "$DAQ" analyse 1 --db "$TMP/rot.sqlite" --standard vdi3441
+check rot_analyse_circle_option 2 "rotary test: --calibrated-radius-mm" -- "$DAQ" analyse 1 --db "$TMP/rot.sqlite" --calibrated-radius-mm 100
+# Export: the stops as deviations in arcsec at targets in deg (the CSV was refused as "no
+# captured stops"; the JSON gave the 45 deg stop's angle, 162000", as deviation_um).
+check rot_export_csv_head 0 "^target_deg,run,direction,deviation_arcsec,target_index,time_s,utc,raw_rad," -- "$DAQ" export 1 --db "$TMP/rot.sqlite" --format csv --what targets
+check rot_export_csv_row 0 "^45,1,up,-?[0-9]\.[0-9]+,2," -- "$DAQ" export 1 --db "$TMP/rot.sqlite" --format csv --what targets
+"$DAQ" export 1 --db "$TMP/rot.sqlite" --format json -o "$TMP/rot-export.json" 2>/dev/null
+check rot_export_json 0 "^ok$" -- python3 -c "
+import json; d=json.load(open('$TMP/rot-export.json')); t=d['targets']
+ok = len(t) == 36 and all(abs(x['deviation_arcsec']) < 30 and 'deviation_um' not in x and 'target_deg' in x for x in t)
+print('ok' if ok else t[:2])"
+# The report: the rotary results in arcsec (the values daq show prints), the verdict, the plot
+# of the deviations per target, the settings in angle units (it had no results section, and its
+# settings said mm, mm/min and um).
+"$DAQ" report 1 --db "$TMP/rot.sqlite" -o "$TMP/rot.html" >/dev/null 2>&1
+check_file "$TMP/rot.html" <<'END'
+rot_report_title Rotary positioning test \(ISO 230-2\) E_CC, axis C
+rot_report_results <h3>Results: ISO 230-2:2014 &mdash; angular positioning of axis C</h3>
+rot_report_grid value \(arcsec\)</th>
+rot_report_verdict No tolerance configured</strong> for this test
+rot_report_plot aria-label="Mean positional deviation with ±2s"
+rot_report_sign Angular positional deviation = the angle reached
+rot_report_feed Feed</td><td>1200 deg/min</td>
+rot_report_targets Targets</td><td>0, 45, 90, 135, 180, 225, 270, 315, 360 deg</td>
+rot_report_tolerance within</td><td>1 millidegrees</td>
+END
+check rot_report_B 0 "^ok$" -- python3 -c "
+import re; h=open('$TMP/rot.html').read()
+print('ok' if re.search(r'reversal value, max \|B<sub>i</sub>\|</td>(<td[^>]*>.*?</td>){2}<td class=.r.>$B_ARCSEC</td>', h) else 'no B $B_ARCSEC')"
+check rot_report_no_um 1 "" -- grep -E "[0-9] (mm|µm)(/min)?</td>|\((µm|mm)\)" "$TMP/rot.html"
+# An option the rotary test would not use is refused, not ignored (--measure ran the linear
+# test of that component instead).
+check rot_measure_refused 2 "--measure E_XX with --test rotary: .* linear test" -- "$DAQ" sim --measure E_XX --test rotary --acquire -o "$TMP/m.toml" --db "$TMP/m.sqlite"
+check rot_targets_refused 2 "--targets with --test rotary" -- "$DAQ" sim --test rotary --targets 5 --acquire -o "$TMP/m.toml" --db "$TMP/m.sqlite"
 
 finish

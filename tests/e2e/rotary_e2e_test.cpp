@@ -76,14 +76,15 @@ TEST(RotaryAcquisition, StopsFromTheAngularReferenceRecoverTheInjectedErrors) {
   // The 360 deg target read as 0 deg by the reference: its deviation is the turn's 10" from
   // the zero's -3", not -1296000".
   EXPECT_NEAR(targets.back()["mean"].get<double>(), r.zero_arcsec + r.scale_arcsec_per_turn, 0.25);
-  // Stored: 9 targets x 5 runs x 2 directions, each stop's value in arcsec, its raw value the
+  // Stored: 9 targets x 5 runs x 2 directions, each stop's deviation in arcsec (the 45 deg
+  // target's is a few arcsec, not its angle of 162000"), its raw value the
   // reference's angle in rad; the run is a rotary one, measured by the angular reference.
   cal::storage::Store store(db, {.read_only = true});
   const auto stops = store.targets(out.run_id);
   ASSERT_EQ(stops.size(), 90u);
   for (const auto& s : stops) {
     const double truth = truth_arcsec(r, s.nominal_mm, s.direction == '+');
-    EXPECT_NEAR(s.deviation_um - s.nominal_mm * 3600.0, truth, 0.5)
+    EXPECT_NEAR(s.deviation_um, truth, 0.5)  // the deviation, not the angle
         << s.nominal_mm << " deg run " << s.run_number << s.direction;
     EXPECT_NEAR(s.raw_m * 180.0 / std::numbers::pi, s.nominal_mm, 0.01);
   }

@@ -151,14 +151,15 @@ std::string live_line(const LiveState& s) {
       fmt::format("run {} of {} {}  target {} of {}  stop {} of {}", p.run, p.runs,
                   p.direction == cal::iso230_2::Direction::up ? "up" : "down", p.target, p.targets,
                   std::min(s.stop_number, s.stop_count), s.stop_count);
-  if (!s.has_reading) return line + "  waiting for the laser's first reading";
+  if (!s.has_reading)
+    return line + fmt::format("  waiting for the {}'s first reading", s.reference);
   if (!s.valid)
     line += "  laser signal lost";
   else if (s.at_target_mm)
-    line += fmt::format("  {:<8} {:+8.2f} um at {:.3f} mm", s.motion, s.at_target_deviation_um,
-                        *s.at_target_mm);
+    line += fmt::format("  {:<8} {:+8.2f} {} at {:.3f} {}", s.motion, s.at_target_deviation_um,
+                        s.units.deviation, *s.at_target_mm, s.units.position);
   else
-    line += fmt::format("  {:<8} at {:.3f} mm", s.motion, s.position_mm);
+    line += fmt::format("  {:<8} at {:.3f} {}", s.motion, s.position_mm, s.units.position);
   if (s.pressure_pa > 0)  // the first air sample has come (env_stage.hpp)
     line += fmt::format("  air {:.2f} degC  material {:.2f} degC{}", s.air_temperature_degc,
                         s.material_degc, s.fallback ? " (fallback)" : "");

@@ -394,13 +394,20 @@ std::string csv_field(const std::string& s) {
 constexpr const char* kReadingColumns =
     "time_s,utc,device,device_name,channel,quantity,status,value,time_ns";
 constexpr const char* kTargetColumns =
-    "target_mm,run,direction,{},target_index,time_s,utc,raw_m,refractive_index,"
-    "material_temperature_degc";
+    "{},run,direction,{},target_index,time_s,utc,{},refractive_index,material_temperature_degc";
+
+// The names of a stop's target, value and raw value: mm, the value's column and the laser's
+// raw length in m; a rotary run's target in deg, its deviation in arcsec and its angular
+// reference's raw angle in rad (kinds/rotary.cpp).
+struct StopColumns {
+  std::string target = "target_mm", value = "deviation_um", raw = "raw_m";
+};
 
 // The column of a stop's value: a positioning run's deviation (what `daq analyse iso230-2`
 // reads); the other linear kinds' value in their unit (straightness um; angular and roll urad).
 std::optional<std::string> stop_value_column(const st::RunRecord& run, const json& settings) {
   if (run.kind == "linear") return "deviation_um";
+  if (run.kind == "rotary") return "deviation_arcsec";
   if (run.kind != "straightness" && run.kind != "angular" && run.kind != "roll")
     return std::nullopt;
   std::string unit = run.kind == "straightness" ? "um" : "urad";
@@ -457,6 +464,11 @@ void export_readings_csv(const st::RunReader& store, const st::RunRecord& run, c
   b.write();
 }
 
+StopColumns stop_columns(const st::RunRecord& run) {
+  if (run.kind == "rotary") return {"target_deg", "deviation_arcsec", "raw_rad"};
+  return {};
+}
+
 void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, const json& settings,
                         std::FILE* out) {
   const auto value_column = stop_value_column(run, settings);
@@ -467,7 +479,9 @@ void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, co
   const ExportClock clock(store, run, settings);
   // The header of a positioning run is what `daq analyse iso230-2 --input` reads (target_mm,
   // run, direction, deviation_um); the rest it ignores.
-  fmt::print(out, "{}\n", fmt::format(fmt::runtime(kTargetColumns), *value_column));
+  const auto names = stop_columns(run);
+  fmt::print(out, "{}\n",
+             fmt::format(fmt::runtime(kTargetColumns), names.target, *value_column, names.raw));
   for (const auto& t : store.targets(run.id)) {
     const auto at = static_cast<double>(t.time_ns);
     fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,
@@ -533,15 +547,16 @@ void export_json(const st::RunReader& store, const st::RunRecord& run, const jso
                           "quantity", "status", "value",  "time_ns"};
   j["readings"] = nullptr;  // the place of the rows, found in the text below
   json targets = json::array();
+  const auto columns = stop_columns(run);
   for (const auto& t : store.targets(run.id))
-    targets.push_back({{"target_mm", t.nominal_mm},
+    targets.push_back({{columns.target, t.nominal_mm},
                        {"run", t.run_number},
                        {"direction", t.direction == '+' ? "up" : "down"},
-                       {"deviation_um", t.deviation_um},
+                       {columns.value, t.deviation_um},
                        {"target_index", t.target_index + 1},
                        {"time_s", clock.seconds(static_cast<double>(t.time_ns))},
                        {"utc", clock.utc(static_cast<double>(t.time_ns))},
-                       {"raw_m", t.raw_m},
+                       {columns.raw, t.raw_m},
                        {"refractive_index", t.refractive_index},
                        {"material_temperature_degc", t.material_temperature_degc}});
   j["targets"] = std::move(targets);

@@ -38,12 +38,13 @@ using namespace std::chrono_literals;
 
 struct SimOptions {
   std::string config_out = "caldaq-sim.toml";
-  std::string test = "circle";
+  std::string test;  // empty: circle, or linear with --measure (resolved by test_of)
   double speed = 1.0;
   std::optional<double> start_after_s;  // unset: wait for a run in the database
   std::string db;
   bool position_feed = false;
-  int runs = 5, targets = 11;     // the linear program's size (ShopConfigOptions)
+  int runs = 5;                   // the linear program's size (ShopConfigOptions)
+  std::optional<int> targets;     // unset: 11 (the linear program's; the rotary test has 9)
   double feed_mm_per_min = 1000;  // the circle's
   std::string measure;            // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
@@ -145,6 +146,21 @@ std::int64_t newest_run(const std::filesystem::path& db) {
   return id;
 }
 
+// The test to run: --test, else a --measure component's (a linear one), else circle. An
+// option the chosen test would not use is refused, not ignored.
+std::string test_of(const SimOptions& o) {
+  if (!o.measure.empty() && !o.test.empty() && o.test != "linear")
+    throw cal::InputError(fmt::format(
+        "--measure {} with --test {}: a component of the volumetric campaign is measured by a "
+        "linear test; leave out --test (or give --test linear)",
+        o.measure, o.test));
+  if (o.test == "rotary" && o.targets)
+    throw cal::InputError(
+        "--targets with --test rotary: the rotary test's targets are fixed (0 .. 360 deg every "
+        "45 deg); --targets sizes the linear program");
+  return !o.test.empty() ? o.test : !o.measure.empty() ? "linear" : "circle";
+}
+
 void run_sim(SimOptions o) {
   if (!o.truth_out.empty()) {
     auto truth = volumetric_truth_model(cal::kinematics::topology_from_string(o.topology));
@@ -155,7 +171,7 @@ void run_sim(SimOptions o) {
     return fmt::print("The SIMULATED volumetric machine's injected errors ({}) written to {}\n",
                       o.topology, o.truth_out);
   }
-  if (!o.measure.empty()) o.test = "linear";  // a component's test is a linear one
+  o.test = test_of(o);
   if (o.test != "linear" && o.test != "circle" && o.test != "circle-set" && o.test != "rotary")
     throw cal::InputError(
         fmt::format("--test '{}' (expected linear, circle, circle-set or rotary)", o.test));
@@ -224,7 +240,7 @@ void run_sim(SimOptions o) {
                                                 .position_feed = o.position_feed,
                                                 .in_process = false,
                                                 .runs = o.runs,
-                                                .targets = o.targets,
+                                                .targets = o.targets.value_or(11),
                                                 .circle_set = set,
                                                 .rotary = rotary,
                                                 .circle_feed_mm_per_min = o.feed_mm_per_min});
@@ -337,8 +353,8 @@ void add_sim_command(CLI::App& app) {
                   "linear, circle, circle-set (the ballbar set on a machine with errors in all "
                   "three planes) or rotary (a C axis's angular positioning, read by a SIMULATED "
                   "angular reference): the program run after --start-after-s (waiting for runs, "
-                  "the run's own test is run)")
-      ->capture_default_str();
+                  "the run's own test is run). Default: circle; linear with --measure, which "
+                  "takes no other test");
   cmd->add_option("-o,--config-out", o->config_out, "Where to write the devices' configuration")
       ->capture_default_str();
   cmd->add_option("--speed", o->speed, "Simulated time per real time")
@@ -353,8 +369,8 @@ void add_sim_command(CLI::App& app) {
       ->capture_default_str()
       ->check(whole_in(2, 10));
   cmd->add_option("--targets", o->targets,
-                  "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11)")
-      ->capture_default_str()
+                  "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11; default "
+                  "11; not with --test rotary, whose targets are fixed)")
       ->check(whole_in(2, 11));
   cmd->add_option("--feed-mm-per-min", o->feed_mm_per_min,
                   "The circle test's feed (--test circle; the set has its own two)")

@@ -127,6 +127,36 @@ void analyse_profile_run(const st::RunReader& store, const st::RunRecord& run,
   print_verdict(v);
 }
 
+// A rotary axis's angular positioning run again from its stored stops (each one's deviation in
+// arcsec): ISO 230-2 by the run's standard or --standard, printed as the run printed it.
+void analyse_rotary_run(const st::RunReader& store, st::Store* writer, const st::RunRecord& run,
+                        const AnalyseRunOptions& o) {
+  if (o.calibrated_radius_mm || o.cyclic_period_mm || o.uncalibrated)
+    throw cal::InputError(fmt::format(
+        "run {} is a rotary test: --calibrated-radius-mm, --cyclic-period-mm and --uncalibrated "
+        "apply to circle runs",
+        run.id));
+  if (!o.standard.empty()) cal::iso230_2::standard_from_string(o.standard);  // refused if unknown
+  json j = stored_rotary(store, run, o.standard);
+  j["values"] = rows_json(result_rows(j));
+  if (o.store) {
+    json prov = provenance("reanalysed", software_version);
+    prov["standard"] = j.value("standard", "");
+    prov["measure"] = "rotary";
+    j["result_id"] =
+        writer->add_result({.run_id = run.id,
+                            .standard = fmt::format("{} rotary {} ({})", j.value("title", ""),
+                                                    run.axis, j.value("component", "")),
+                            .json = j.dump(),
+                            .provenance_json = prov.dump()});
+  }
+  const auto v = verdict_of(cal::daq::parse_stored_json(run.settings_json), j);
+  j["verdict"] = to_json(v);
+  if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
+  print_kind_result(j, j.value("component", ""));
+  print_verdict(v);
+}
+
 void analyse_run(const AnalyseRunOptions& o) {
   // Only --store writes (the local file); without it the store is opened read-only, either.
   std::optional<st::Store> writer;
@@ -137,6 +167,8 @@ void analyse_run(const AnalyseRunOptions& o) {
   if (run && run->kind == "circle")
     return analyse_circle_run(store, writer ? &*writer : nullptr, *run, o);
   if (run && is_profile_kind(run->kind)) return analyse_profile_run(store, *run, o);
+  if (run && run->kind == "rotary")
+    return analyse_rotary_run(store, writer ? &*writer : nullptr, *run, o);
   const std::string standard = o.standard.empty() ? "iso230-2:2014" : o.standard;
   linear_run(store, o.run);
   const auto targets = store.targets(o.run);
@@ -337,8 +369,9 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
   analyse.add_option("RUN", a->run, "A stored run to evaluate again (see daq runs)");
   add_read_db_option(analyse, a->db);
   analyse.add_option("-s,--standard", a->standard,
-                     "Standard for a stored run: a linear run iso230-2:2014 (default), ...; a "
-                     "circle run iso230-4:2005, gb/t17421.4-2016 or iso230-4:1996 (default: as "
+                     "Standard for a stored run: a linear or rotary run iso230-2:2014 (default: "
+                     "a rotary run's own), ...; a circle run iso230-4:2005, gb/t17421.4-2016 or "
+                     "iso230-4:1996 (default: as "
                      "run)");
   analyse.add_flag("--store", a->store, "Store the result with the run");
   analyse
@@ -350,7 +383,9 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
                   "Circle runs: the cyclic-error period (default: as run, else searched)")
       ->check(finite_positive());
   analyse.add_flag("--uncalibrated", a->uncalibrated, "Circle runs: no radius error");
-  analyse.add_flag("--json", a->json, "Print JSON (caldaq.iso230-2.v1 or caldaq.circle.v2)");
+  analyse.add_flag(
+      "--json", a->json,
+      "Print JSON (caldaq.iso230-2.v1, caldaq.circle.v2, caldaq.profile.v1 or caldaq.rotary.v1)");
   analyse.callback([a, &analyse] {
     if (!analyse.get_subcommands().empty()) return;
     if (a->run <= 0)

@@ -10,7 +10,8 @@ namespace cal::daq {
 
 using iso230_2::Direction;
 
-Sequencer::Sequencer(const iso230_2::Plan& plan, double window_mm) : window_mm_(window_mm) {
+Sequencer::Sequencer(const iso230_2::Plan& plan, double window_mm, AxisUnits units)
+    : window_mm_(window_mm), units_(units) {
   for (const auto& m : plan.moves) {
     if (m.kind != iso230_2::MoveKind::measure) continue;
     stops_.push_back({m.target_index, m.run, m.direction, m.position_mm});
@@ -34,8 +35,8 @@ bool Sequencer::fits(const ExpectedStop& e, const Capture& c) const {
 }
 
 std::string Sequencer::describe(const ExpectedStop& e) const {
-  return fmt::format("target {} ({:.3f} mm) run {} {}", e.target_index, e.position_mm, e.run,
-                     e.direction == Direction::up ? "up" : "down");
+  return fmt::format("target {} ({:.3f} {}) run {} {}", e.target_index, e.position_mm,
+                     units_.position, e.run, e.direction == Direction::up ? "up" : "down");
 }
 
 std::size_t Sequencer::pass_end(std::size_t i) const {
@@ -63,7 +64,7 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
     ExpectedStop& e = stops_[i];
     e.captured = true;
     e.missed = false;
-    e.deviation_um = (c.mean_mm - e.position_mm) * 1e3;
+    e.deviation_um = units_.deviation_of(c.mean_mm, e.position_mm);
     e.time_ns = c.end_ns;
     if (c.approach == Approach::unknown) text += " (approach direction unknown: plan's assumed)";
     events.push_back({kind, i, std::move(text)});
@@ -80,8 +81,8 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
       events.push_back({SequenceEvent::Kind::missed, k, "missed " + describe(stops_[k])});
     }
     take(j, SequenceEvent::Kind::captured,
-         fmt::format("{}: {:+.3f} um", describe(stops_[j]),
-                     (c.mean_mm - stops_[j].position_mm) * 1e3));
+         fmt::format("{}: {:+.3f} {}", describe(stops_[j]),
+                     units_.deviation_of(c.mean_mm, stops_[j].position_mm), units_.deviation));
     next_ = j + 1;
     if (complete()) {
       // The end of the plan: "all stops captured" only when it is true.
@@ -103,24 +104,24 @@ std::vector<SequenceEvent> Sequencer::on_capture(const Capture& c) {
   }
   if (c.approach == Approach::unknown && !c.manual) {
     events.push_back({SequenceEvent::Kind::extra, next_,
-                      fmt::format("stop at {:.4f} mm without an approach move (the axis has not "
+                      fmt::format("stop at {:.4f} {} without an approach move (the axis has not "
                                   "moved yet): ignored",
-                                  c.mean_mm)});
+                                  c.mean_mm, units_.position)});
     return events;
   }
   // Right place, wrong side: not a valid approach for the expected stop.
   if (!complete() && std::abs(c.mean_mm - stops_[next_].position_mm) <= window_mm_) {
     events.push_back(
         {SequenceEvent::Kind::wrong_direction, next_,
-         fmt::format("stop at {:.4f} mm approached from {}, but {} expects {}: ignored", c.mean_mm,
-                     c.approach == Approach::from_below ? "below" : "above",
+         fmt::format("stop at {:.4f} {} approached from {}, but {} expects {}: ignored", c.mean_mm,
+                     units_.position, c.approach == Approach::from_below ? "below" : "above",
                      describe(stops_[next_]),
                      stops_[next_].direction == Direction::up ? "up" : "down")});
     return events;
   }
   events.push_back({SequenceEvent::Kind::extra, next_,
-                    fmt::format("extra stop at {:.4f} mm: no expected stop within {} mm, ignored",
-                                c.mean_mm, window_mm_)});
+                    fmt::format("extra stop at {:.4f} {}: no expected stop within {} {}, ignored",
+                                c.mean_mm, units_.position, window_mm_, units_.position)});
   return events;
 }
 

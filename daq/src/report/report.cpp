@@ -108,6 +108,19 @@ struct RunView {
   ::daq::CompensationUsed used;  // linear runs: what the stored deviations were made with
 };
 
+// How a positioning run's report names its units: a linear axis's mm and µm; a rotary axis's
+// deg and arcsec (the runner carries its angles in the *_mm fields and stores each stop's
+// deviation in arcsec: kinds/rotary.cpp).
+struct AxisText {
+  std::string_view position, deviation, x_label;
+};
+constexpr AxisText linear_text{"mm", "µm", "target position (mm)"};
+constexpr AxisText rotary_text{"deg", "arcsec", "target angle (deg)"};
+
+const AxisText& axis_text(const RunView& v) {
+  return v.run.kind == "rotary" ? rotary_text : linear_text;
+}
+
 std::string instrument_name(const RunView& v, int device) {
   for (const auto& i : v.instruments)
     if (i.device == device) return i.driver;
@@ -232,14 +245,15 @@ std::string test_name(const RunView& v) {
       m.is_object() && m.contains("component") && m["component"].is_string()
           ? " " + m["component"].get<std::string>()
           : "";
-  const std::string what = v.run.kind == "linear"    ? "Positioning test (ISO 230-2)"
-                           : v.run.kind == "circle"  ? "Circular test (ISO 230-4, ballbar)"
-                           : v.run.kind == "dynamic" ? "Dynamic capture"
-                           : v.run.kind == "straightness"
-                               ? "Straightness test (ISO 230-1)" + component
-                           : v.run.kind == "angular" ? "Angular test (ISO 230-1)" + component
-                           : v.run.kind == "roll"    ? "Roll test (ISO 230-1)" + component
-                                                     : v.run.kind + " test";
+  const std::string what =
+      v.run.kind == "linear"         ? "Positioning test (ISO 230-2)"
+      : v.run.kind == "rotary"       ? "Rotary positioning test (ISO 230-2)" + component
+      : v.run.kind == "circle"       ? "Circular test (ISO 230-4, ballbar)"
+      : v.run.kind == "dynamic"      ? "Dynamic capture"
+      : v.run.kind == "straightness" ? "Straightness test (ISO 230-1)" + component
+      : v.run.kind == "angular"      ? "Angular test (ISO 230-1)" + component
+      : v.run.kind == "roll"         ? "Roll test (ISO 230-1)" + component
+                                     : v.run.kind + " test";
   return fmt::format("{}, axis {}", what, v.run.axis);
 }
 
@@ -262,9 +276,10 @@ std::string setting_text(const json& v) {
   return v.dump();
 }
 
-std::string missed_text(const st::MissedStop& m) {
-  return fmt::format("run {} {} target {} ({:.3f} mm)", m.run_number,
-                     m.direction == '+' ? "↑" : "↓", m.target_index + 1, m.nominal_mm);
+std::string missed_text(const RunView& v, const st::MissedStop& m) {
+  return fmt::format("run {} {} target {} ({:.3f} {})", m.run_number,
+                     m.direction == '+' ? "↑" : "↓", m.target_index + 1, m.nominal_mm,
+                     axis_text(v).position);
 }
 
 std::string connections_table(const RunView& v);
@@ -276,7 +291,7 @@ std::string operator_actions_section(const RunView& v) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& a : v.actions)
     rows.push_back(
-        {iso_time(a.time_unix_ms), esc(a.action), a.stop ? esc(missed_text(*a.stop)) : "",
+        {iso_time(a.time_unix_ms), esc(a.action), a.stop ? esc(missed_text(v, *a.stop)) : "",
          esc(a.source) + (a.operator_name.empty() ? "" : " (" + esc(a.operator_name) + ")"),
          esc(a.detail)});
   return "<h4>Operator actions (" + std::to_string(v.actions.size()) + ")</h4>\n" +
@@ -298,7 +313,7 @@ std::string setup_section(const RunView& v) {
                            "</span>"}};
   if (!v.missed.empty()) {
     std::string list;
-    for (const auto& m : v.missed) list += (list.empty() ? "" : "; ") + missed_text(m);
+    for (const auto& m : v.missed) list += (list.empty() ? "" : "; ") + missed_text(v, m);
     rows.insert(rows.begin() + 6, {"Missed stops", fmt::format("<span class=\"fail\">{} never "
                                                                "captured:</span> {}",
                                                                v.missed.size(), esc(list))});
@@ -366,12 +381,25 @@ bool setting_applies(const RunView& v, const std::string& key, const json& val) 
                   [](const json& x) { return x.is_number() && x.get<double>() == 0.0; }))
     return false;
   const json measure = v.settings.value("measure", json::object());
-  const bool positioning = measure.is_object() && measure.value("kind", "") == "positioning";
-  if (positioning && (key == "measure.beams" || key == "measure.separation_mm" ||
-                      key == "measure.square" || key == "measure.sign"))
+  // The laser's beams and the square apply neither to positioning nor to a rotary axis read by
+  // its angular reference (whose reading's sign does).
+  const std::string kind = measure.is_object() ? measure.value("kind", "") : "";
+  if ((kind == "positioning" || kind == "rotary") &&
+      (key == "measure.beams" || key == "measure.separation_mm" || key == "measure.square" ||
+       (key == "measure.sign" && kind == "positioning")))
     return false;
   if (key == "uncalibrated" && val.is_boolean() && !val.get<bool>()) return false;
   return true;
+}
+
+// A rotary run's plan and trigger are in degrees (kinds/rotary.cpp): its keys named in mm read
+// as degrees, the trigger's tolerance_um as millidegrees.
+std::string_view setting_unit(const RunView& v, std::string_view key, std::string_view unit) {
+  if (v.run.kind != "rotary") return unit;
+  if (key == "trigger.tolerance_um") return "millidegrees";
+  if (key == "feed_mm_per_min") return "deg/min";
+  if (key == "targets_mm" || key == "datum_mm" || key == "trigger.window_mm") return "deg";
+  return unit;
 }
 
 std::string setting_value(const json& val, std::string_view unit) {
@@ -421,7 +449,8 @@ std::string settings_appendix(const RunView& v) {
     const auto i = rank(key);
     const bool known = i < std::size(setting_labels);
     rows.push_back({known ? esc(setting_labels[i].label) : "<code>" + esc(key) + "</code>",
-                    setting_value(val, known ? setting_labels[i].unit : "") + used_note(key, val)});
+                    setting_value(val, known ? setting_unit(v, key, setting_labels[i].unit) : "") +
+                        used_note(key, val)});
   }
   if (rows.empty()) return "";
   return "<h3>Appendix: settings of the run</h3>\n<p class=\"note\">As recorded at the start "
@@ -657,6 +686,11 @@ std::string conditions_section(const RunView& v) {
             "tool is displaced in the positive direction read relative to the workpiece (ISO "
             "230-1; docs/kinematics.md). ↑: approach in the positive direction, ↓: in the "
             "negative."
+      : v.run.kind == "rotary"
+          ? "Angular positional deviation = the angle reached, read by the angular reference, "
+            "&minus; the target angle (ISO 230-2 applied to a rotary axis), modulo one turn: "
+            "positive when the axis stopped beyond the target in its positive direction of "
+            "rotation. ↑: approach in the positive direction, ↓: in the negative."
       : v.run.kind == "angular" || v.run.kind == "roll"
           ? "Angular deviation: the tool's rotation relative to the workpiece about the axis "
             "named by the component, positive by the right-hand rule (ISO 230-1; "
@@ -825,10 +859,11 @@ struct Headline {
 struct Linear {
   std::vector<st::CapturedTarget> targets;
   cal::iso230_2::Evaluation e;
+  AxisText text = linear_text;
 };
 
 Linear evaluate_linear(const st::RunReader& store, const RunView& v, const Options& o) {
-  Linear l{.targets = store.targets(v.run.id)};
+  Linear l{.targets = store.targets(v.run.id), .text = axis_text(v)};
   if (l.targets.empty())
     throw cal::InputError(
         fmt::format("{}: run {} has no captured targets to report", store.name(), v.run.id));
@@ -886,8 +921,8 @@ std::string means_plot(const Linear& l) {
     bi.push_back(t.mean_bi_um);
   }
   XyChart means{.title = "Mean positional deviation with ±2s",
-                .x_label = "target position (mm)",
-                .y_label = "deviation (µm)",
+                .x_label = std::string(l.text.x_label),
+                .y_label = fmt::format("deviation ({})", l.text.deviation),
                 .height_pt = 170,  // page one holds it below the verdict and the grid
                 .zero_line = true};
   // The bands x̄ ± 2s, and their edges drawn as thin dotted lines so they read in print too.
@@ -926,8 +961,8 @@ std::string runs_plot(const Linear& l) {
   for (const auto& t : l.targets)
     runs[{t.run_number, t.direction}].push_back({t.nominal_mm, t.deviation_um});
   XyChart traces{.title = "Run-by-run deviations",
-                 .x_label = "target position (mm)",
-                 .y_label = "deviation (µm)",
+                 .x_label = std::string(l.text.x_label),
+                 .y_label = fmt::format("deviation ({})", l.text.deviation),
                  .height_pt = 300,
                  .zero_line = true};
   for (auto& [key, pts] : runs) {
@@ -948,7 +983,8 @@ std::string runs_plot(const Linear& l) {
 // The ISO 230-2 values as a grid: one row per kind of value, columns up, down and
 // bidirectional, then the limit and verdict of the value the specification limits. Standards
 // with other values (VDI/DGQ 3441) get a list.
-std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdict& verdict) {
+std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdict& verdict,
+                         std::string_view unit) {
   const auto value = [&](const char* key) -> const cal::iso230_2::AxisResult* {
     for (const auto& a : e.axis)
       if (a.key == key) return &a;
@@ -985,12 +1021,21 @@ std::string results_grid(const cal::iso230_2::Evaluation& e, const ::daq::Verdic
       axis.push_back(
           {esc(r.symbol), um(r.value), esc(r.description), limit_cell(c), verdict_cell(c)});
     }
-    return table({"symbol", "value (µm)", "meaning", "limit (µm)", "verdict"}, axis, "num results",
-                 "lrlrl");
+    return table({"symbol", fmt::format("value ({})", unit), "meaning",
+                  fmt::format("limit ({})", unit), "verdict"},
+                 axis, "num results", "lrlrl");
   }
-  return table(
-      {"value (µm)", "↑&nbsp;up", "↓&nbsp;down", "bidirectional", "limit&nbsp;(µm)", "verdict"},
-      rows, "num results grid", "lrrrrl");
+  return table({fmt::format("value ({})", unit), "↑&nbsp;up", "↓&nbsp;down", "bidirectional",
+                fmt::format("limit&nbsp;({})", unit), "verdict"},
+               rows, "num results grid", "lrrrrl");
+}
+
+// A rotary run's caldaq.rotary.v1 document: the stored current result (what daq show prints),
+// else (or by another standard) the same evaluation of its stored stops now.
+json rotary_doc(const st::RunReader& store, const RunView& v, const Options& o) {
+  const auto stored = ::daq::current_result(v.results, "caldaq.rotary.v1");
+  if (stored && o.standard.empty()) return cal::daq::parse_stored_json(stored->json);
+  return ::daq::stored_rotary(store, v.run, o.standard);
 }
 
 // A run's results in two parts: the answer (page one: verdict, main table, main plot) and the
@@ -999,22 +1044,31 @@ struct Sections {
   std::string answer, details;
 };
 
+// A rotary axis's angular positioning run (ISO 230-2 in deg and arcsec) is reported as a
+// linear axis's is, in its units, without the laser's uncertainty budget (an angular reference
+// has its own): its values are the stored caldaq.rotary.v1 document's, the numbers daq show
+// prints.
 Sections linear_section(const st::RunReader& store, const RunView& v, const Options& o,
                         Headline& headline) {
   const auto l = evaluate_linear(store, v, o);
   const auto& e = l.e;
+  const bool rotary = v.run.kind == "rotary";
+  const std::string unit(l.text.deviation), position(l.text.position);
   headline.standard = std::string(e.standard.title);
   Sections out;
   std::string& h = out.answer;
   h = fmt::format(
-      "<h3>Results: {}</h3>\n<p class=\"standard\">Evaluated by <strong>{}</strong> ({}). {} "
-      "targets, {}, {}.</p>\n",
-      esc(e.standard.title), esc(e.standard.title), esc(e.standard.note), e.targets.size(),
-      esc(::daq::runs_text(e)), e.bidirectional ? "bidirectional" : "unidirectional");
+      "<h3>Results: {}{}</h3>\n<p class=\"standard\">Evaluated by <strong>{}</strong> ({}). {} "
+      "targets, {}, {}{}.</p>\n",
+      esc(e.standard.title),
+      rotary ? " &mdash; angular positioning of axis " + esc(v.run.axis) : "",
+      esc(e.standard.title), esc(e.standard.note), e.targets.size(), esc(::daq::runs_text(e)),
+      e.bidirectional ? "bidirectional" : "unidirectional",
+      rotary ? "; targets in degrees, deviations in arcseconds" : "");
   // The headline (campaign summary): the bidirectional values a specification limits, or
   // every value of a standard without them (VDI/DGQ 3441).
-  const auto doc = ::daq::to_json(e);
-  const auto values = ::daq::linear_rows(doc);
+  const auto doc = rotary ? rotary_doc(store, v, o) : ::daq::to_json(e);
+  const auto values = ::daq::result_rows(doc);
   const auto verdict = ::daq::verdict_of(v.settings, doc);
   const auto failing = [&](const auto& r) {
     const auto* check = ::daq::find_check(verdict, r.key);
@@ -1029,7 +1083,7 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
       headline.values.push_back({r.symbol, r.value, unit_text(r.unit), failing(r)});
   headline.verdict = ::daq::summary(verdict);
   h += verdict_banner(verdict);
-  h += results_grid(e, verdict);
+  h += results_grid(e, verdict, unit);
   h += means_plot(l);
   std::string& d = out.details;
   d = "<h3>Details of the results</h3>\n";
@@ -1038,8 +1092,8 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
          "approaches in one direction; the limits apply to the bidirectional values (ISO "
          "230-2).</p>\n";
   d += runs_plot(l);
-  std::vector<std::string> head{"target (mm)"};
-  for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (µm)");
+  std::vector<std::string> head{fmt::format("target ({})", position)};
+  for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (" + unit + ")");
   std::vector<std::vector<std::string>> rows;
   for (std::size_t i = 0; i < e.targets.size(); ++i) {
     std::vector<std::string> r{fmt::format("{:.3f}", e.targets[i].target_mm)};
@@ -1048,6 +1102,13 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
   }
   d += "<h4>Per target</h4>\n" + table(head, rows, "num");
   for (const auto& w : e.warnings) d += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
+  if (rotary) {
+    d += "<p class=\"note\">Each stop's deviation is its angular reference's reading minus the "
+         "target, modulo one turn (so 360 deg reads as 0 deg on the reference). The laser's "
+         "uncertainty budget (ISO 230-2 Annex A) does not apply to an angular reference: state "
+         "its own calibration's uncertainty with the results.</p>\n";
+    return out;
+  }
 
   double length_m = 0;
   const auto b = linear_budget(v, l, length_m);
@@ -1811,7 +1872,7 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
   // was stored, and says why there are no results.
   Sections results;
   try {
-    if (v.run.kind == "linear")
+    if (v.run.kind == "linear" || v.run.kind == "rotary")
       results = linear_section(store, v, o, hl);
     else if (v.run.kind == "circle")
       results = circle_section(store, v, o, hl);
@@ -1833,15 +1894,18 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
       rows.push_back({std::to_string(m.run_number), m.direction == '+' ? "↑ up" : "↓ down",
                       std::to_string(m.target_index + 1), fmt::format("{:.3f}", m.nominal_mm)});
     h += "<h4>Missed stops (never captured)</h4>\n" +
-         table({"run", "direction", "target", "nominal (mm)"}, rows, "num", "rlrr");
+         table({"run", "direction", "target", fmt::format("nominal ({})", axis_text(v).position)},
+               rows, "num", "rlrr");
   }
   h += operator_actions_section(v);
   h += customer_section(v);
   h += conditions_section(v);
   h += instruments_section(v);
-  if (v.run.kind == "linear" || v.run.kind == "circle" || ::daq::is_profile_kind(v.run.kind))
+  if (v.run.kind == "linear" || v.run.kind == "circle" || v.run.kind == "rotary" ||
+      ::daq::is_profile_kind(v.run.kind))
     h += provenance_section(v, v.run.kind == "linear"   ? "caldaq.iso230-2.v1"
                                : v.run.kind == "circle" ? "caldaq.circle.v2"
+                               : v.run.kind == "rotary" ? "caldaq.rotary.v1"
                                                         : "caldaq.profile.v1");
   h += setup_section(v);
   h += environment_section(v.env);

@@ -22,6 +22,7 @@
 #include "iso230_2_output.hpp"
 #include "kinds/kind.hpp"
 #include "provenance.hpp"
+#include "result_rows.hpp"
 #include "roles.hpp"
 #include "run_quality.hpp"
 #include "runner.hpp"
@@ -77,12 +78,14 @@ std::string to_json_text(const LiveState& s) {
   else if (s.at_target_mm)
     j["display"] = {{"mode", "deviation"},
                     {"value", s.at_target_deviation_um},
-                    {"unit", "µm"},
+                    {"unit", ::daq::unit_html(s.units.deviation)},
                     {"decimals", 2},
                     {"target_mm", *s.at_target_mm}};
   else
-    j["display"] = {
-        {"mode", "position"}, {"value", s.position_mm}, {"unit", "mm"}, {"decimals", 3}};
+    j["display"] = {{"mode", "position"},
+                    {"value", s.position_mm},
+                    {"unit", s.units.position},
+                    {"decimals", 3}};
   j["stop"] = {{"number", s.stop_number}, {"count", s.stop_count}};
   json stops = json::array();
   for (const auto& x : s.stops)
@@ -222,13 +225,16 @@ struct LinearRun::Impl : Runner {
         trigger({.tolerance_um = setup.config.trigger.tolerance_um,
                  .dwell_s = setup.config.trigger.dwell_s,
                  .window_mm = setup.config.trigger.window_mm}),
-        sequencer(plan, setup.config.trigger.window_mm),
+        sequencer(plan, setup.config.trigger.window_mm,
+                  kinds::kind(setup.config.linear->measure.kind).axis_units()),
         kind(kinds::kind(setup.config.linear->measure.kind)),
         motion({.tolerance_um = setup.config.trigger.tolerance_um,
                 .dwell_s = setup.config.trigger.dwell_s,
                 .window_mm = setup.config.trigger.window_mm}) {
     kind.validate(*setup.config.linear);
     reader = kind.reader(*setup.config.linear);
+    live.units = kind.axis_units();
+    if (kind.stops_from_probe()) live.reference = "angular reference";  // rotary: no laser
     if (!kind.probe_role().empty() && !setup.probe)
       throw cal::InputError(fmt::format("a {} test needs a device with role = \"{}\"", kind.name(),
                                         kind.probe_role()));
@@ -417,7 +423,7 @@ struct LinearRun::Impl : Runner {
     live.time_s = static_cast<double>(time_ns - first_ns) * 1e-9;
     live.position_mm = angle_deg;
     if (const auto next = sequencer.next_expected_mm())
-      live.deviation_um = (angle_deg - *next) * 1e3;
+      live.deviation_um = sequencer.units().deviation_of(angle_deg, *next);
     live.state = "measuring";
     show_motion(time_ns, angle_deg, true);
     // The stop's value is the kind's (the window mean of the reference); raw 1 m, a factor 1.
@@ -532,7 +538,8 @@ struct LinearRun::Impl : Runner {
     live.motion = std::string(cal::daq::to_string(motion.motion()));
     live.stable_fraction = motion.stable_fraction();
     live.at_target_mm = motion.target_mm();
-    if (live.at_target_mm) live.at_target_deviation_um = (position_mm - *live.at_target_mm) * 1e3;
+    if (live.at_target_mm)
+      live.at_target_deviation_um = sequencer.units().deviation_of(position_mm, *live.at_target_mm);
   }
 
   void on_capture(const cal::daq::Capture& cap, const cal::daq::Compensated& c) {
@@ -569,8 +576,9 @@ struct LinearRun::Impl : Runner {
 
   // Stores a captured stop with the kind's value; false when the store failed (run aborted).
   bool store_stop(std::size_t stop, const cal::daq::Capture& cap, const cal::daq::Compensated& c,
-                  double value) {
+                  double window_mean) {
     const auto& s = sequencer.stops()[stop];
+    const double value = kind.stop_value(s.position_mm, window_mean);
     values.push_back({.position_mm = s.position_mm,
                       .target_index = s.target_index - 1,
                       .run = s.run,
@@ -587,7 +595,7 @@ struct LinearRun::Impl : Runner {
         .raw_m = kind.stops_from_probe()
                      ? cap.mean_mm * std::numbers::pi / 180.0
                      : (cap.mean_mm - setup.datum_mm) * 1e-3 / (c.length_m / c.raw_m),
-        .deviation_um = value,  // the kind's value (um or urad: settings.measure.unit)
+        .deviation_um = value,  // the kind's value (um, urad; arcsec: settings.measure.unit)
         .refractive_index = c.n,
         .material_temperature_degc = c.material_degc};
     try {
@@ -780,8 +788,9 @@ struct LinearRun::Impl : Runner {
     }
     stop = last_taken;
     const auto& s = sequencer.stops()[*stop];
-    return {true, fmt::format("captured by hand: {}: {:+.3f} um", describe(s),
-                              (cap->mean_mm - s.position_mm) * 1e3)};
+    const auto& u = sequencer.units();
+    return {true, fmt::format("captured by hand: {}: {:+.3f} {}", describe(s),
+                              u.deviation_of(cap->mean_mm, s.position_mm), u.deviation)};
   }
 
   ControlOutcome skip(std::optional<std::size_t>& stop) {
@@ -803,7 +812,8 @@ struct LinearRun::Impl : Runner {
     if (!stop || !before) return {false, "no stop passed yet: nothing to measure again"};
     std::string dropped = before->skipped ? " (it was skipped)" : " (it was missed)";
     if (before->captured) {
-      dropped = fmt::format(" (the value {:+.3f} um discarded)", before->deviation_um);
+      dropped = fmt::format(" (the value {:+.3f} {} discarded)", before->deviation_um,
+                            sequencer.units().deviation);
       if (!forget_stop(*before)) return {false, "storage failed: the run was aborted"};
     }
     if (*stop < manual.size()) manual[*stop] = false;
@@ -829,10 +839,7 @@ struct LinearRun::Impl : Runner {
     if (position_trigger) position_trigger->rearm();
   }
 
-  static std::string describe(const cal::daq::ExpectedStop& s) {
-    return fmt::format("target {} ({:.3f} mm) run {} {}", s.target_index, s.position_mm, s.run,
-                       s.direction == cal::iso230_2::Direction::up ? "up" : "down");
-  }
+  std::string describe(const cal::daq::ExpectedStop& s) const { return sequencer.describe(s); }
 
   // A stop's value out of the run: the kind's values, a value still waiting for its probe, and
   // the stored target. False when the store failed (the run is then aborted).

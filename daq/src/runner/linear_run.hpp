@@ -42,7 +42,11 @@ struct LiveState {
   // What the operator's page shows (cal/daq/motion.hpp): the axis moving, settling, stable or
   // captured; while the position is within the capture window of a target, the deviation from
   // that target (not from the next expected one, which is meaningless while the axis moves).
-  bool has_reading = false;  // a laser reading arrived (until then: no number at all)
+  // The *_mm and *_um values in these units (deg and arcsec on a rotary axis), and the
+  // instrument whose readings give the position (the laser, or a rotary axis's reference).
+  cal::daq::AxisUnits units;
+  std::string reference = "laser";
+  bool has_reading = false;  // a reference reading arrived (until then: no number at all)
   bool valid = true;         // the newest laser reading was valid (not signal lost)
   std::string motion = "moving";
   double stable_fraction = 0.0;

@@ -15,4 +15,11 @@ bool is_profile_kind(std::string_view run_kind);
 nlohmann::json stored_profile(const cal::storage::RunReader& store,
                               const cal::storage::RunRecord& run);
 
+// A stored rotary run (kinds/rotary.cpp) evaluated again from its stored stops (each one's
+// deviation in arcsec) by `standard` (a key of daq analyse --standard; empty: the run's own):
+// caldaq.rotary.v1, the numbers the run stored when evaluated by the same standard. Throws
+// cal::InputError naming the run when it has no stops or is not a rotary run.
+nlohmann::json stored_rotary(const cal::storage::RunReader& store,
+                             const cal::storage::RunRecord& run, std::string_view standard = {});
+
 }  // namespace daq

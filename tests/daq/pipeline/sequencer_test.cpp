@@ -203,3 +203,17 @@ TEST(Sequencer, ASkippedStopIsNeverTakenAndTheLastStopCanBeMeasuredAgain) {
 }
 
 }  // namespace
+
+// A rotary axis's plan carries degrees in its *_mm fields: its events name degrees and arcsec
+// (they said "target 2 (50.000 mm) ... +7.200 um" for 50 deg and 7.2").
+TEST(Sequencer, ARotaryAxisEventsInDegreesAndArcsec) {
+  Sequencer s(plan(), 0.5, rotary_units);
+  EXPECT_EQ(s.on_capture(at(0.0, up))[0].message, "target 1 (0.000 deg) run 1 up: +0.000 arcsec");
+  auto ev = s.on_capture(at(100.002, up));
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(ev[0].message, "missed target 2 (50.000 deg) run 1 up");
+  EXPECT_EQ(ev[1].message, "target 3 (100.000 deg) run 1 up: +7.200 arcsec");
+  EXPECT_NEAR(s.stops()[2].deviation_um, 7.2, 1e-9);  // in the run's unit, arcsec
+  EXPECT_EQ(s.on_capture(at(73.0, up))[0].message,
+            "extra stop at 73.0000 deg: no expected stop within 0.5 deg, ignored");
+}

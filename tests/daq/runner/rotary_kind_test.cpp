@@ -78,7 +78,8 @@ std::vector<StopValue> acquire(const cal::daq::LinearTestConfig& l, double noise
                      .target_index = mv.target_index - 1,
                      .run = mv.run,
                      .direction = up ? '+' : '-',
-                     .value = sum / 20});
+                     // stored and evaluated as the runner does: the deviation
+                     .value = daq::kinds::kind("rotary").stop_value(mv.position_mm, sum / 20)});
   }
   return stops;
 }

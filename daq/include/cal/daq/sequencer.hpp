@@ -16,6 +16,21 @@
 
 namespace cal::daq {
 
+// How a run's positions and deviations read in its events and live line: a linear axis in mm
+// and µm; a rotary axis, whose positions the runner carries in the *_mm fields as degrees
+// (kinds/rotary.cpp), in deg and arcsec.
+struct AxisUnits {
+  const char* position = "mm";
+  const char* deviation = "um";
+  double deviation_per_position = 1e3;  // um per mm
+  double deviation_of(double at, double target) const {
+    return (at - target) * deviation_per_position;
+  }
+};
+inline constexpr AxisUnits linear_units{};
+inline constexpr AxisUnits rotary_units{
+    .position = "deg", .deviation = "arcsec", .deviation_per_position = 3600.0};
+
 struct ExpectedStop {
   int target_index = 0;  // 1-based
   int run = 1;
@@ -23,8 +38,8 @@ struct ExpectedStop {
   double position_mm = 0.0;
   bool captured = false;
   bool missed = false;
-  bool skipped = false;  // given up by the operator: missed, and never taken late
-  double deviation_um = 0.0;
+  bool skipped = false;       // given up by the operator: missed, and never taken late
+  double deviation_um = 0.0;  // in the run's AxisUnits::deviation (arcsec on a rotary axis)
   std::int64_t time_ns = 0;
 };
 
@@ -45,8 +60,9 @@ struct Progress {
 
 class Sequencer {
  public:
-  // window_mm: how far a stop may be from its target (the trigger's window).
-  Sequencer(const iso230_2::Plan& plan, double window_mm);
+  // window_mm: how far a stop may be from its target (the trigger's window); `units`: how its
+  // events name positions and deviations.
+  Sequencer(const iso230_2::Plan& plan, double window_mm, AxisUnits units = linear_units);
 
   std::optional<double> next_expected_mm() const;
   // Every position a capture could be labelled at now: the rest of the current pass, the first
@@ -71,16 +87,19 @@ class Sequencer {
   const std::vector<ExpectedStop>& stops() const { return stops_; }
   // The stops passed without a capture (marked missed and not captured late), in plan order.
   std::vector<std::size_t> missed() const;
+  // "target 2 (45.000 deg) run 1 up".
+  std::string describe(const ExpectedStop& e) const;
+  const AxisUnits& units() const { return units_; }
   // The captured stops as the ISO 230-2 evaluation wants them.
   std::vector<iso230_2::Measurement> measurements() const;
 
  private:
   bool fits(const ExpectedStop& e, const Capture& c) const;
-  std::string describe(const ExpectedStop& e) const;
   std::size_t pass_end(std::size_t i) const;
 
   std::vector<ExpectedStop> stops_;
   double window_mm_;
+  AxisUnits units_;
   int runs_ = 0, targets_ = 0;
   std::size_t next_ = 0;
 };

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cal/daq/config.hpp"
+#include "cal/daq/sequencer.hpp"
 
 namespace daq::kinds {
 
@@ -81,6 +82,15 @@ class TestKind {
   // watch; the trigger's lengths then read as angles: tolerance_um in millidegrees, window_mm
   // in degrees). Such a kind needs no laser.
   virtual bool stops_from_probe() const { return false; }
+  // How the run's events and live line name its positions and deviations (mm and µm; a rotary
+  // axis's deg and arcsec).
+  virtual cal::daq::AxisUnits axis_units() const { return cal::daq::linear_units; }
+  // A captured stop's value as stored and evaluated, from its reader's window mean at the
+  // target `position_mm`: the mean itself, but a rotary axis's continuous angle becomes its
+  // deviation (arcsec, modulo a turn), so a stored stop reads as a deviation everywhere.
+  virtual double stop_value(double /*position_mm*/, double window_mean) const {
+    return window_mean;
+  }
   // nullptr for positioning: its value is the sequencer's deviation of the laser position.
   virtual std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const = 0;
   // The stops evaluated (not called for positioning: ISO 230-2 evaluates those).

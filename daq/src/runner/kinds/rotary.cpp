@@ -67,11 +67,16 @@ class Rotary final : public TestKind {
           "test.linear.axis '{}': a rotary test measures a rotary axis (A, B, C)", l.axis));
   }
   bool stops_from_probe() const override { return true; }
+  cal::daq::AxisUnits axis_units() const override { return cal::daq::rotary_units; }
+  // The reference's angle at the stop minus its target, modulo a turn into [-180, 180) deg.
+  double stop_value(double position_deg, double angle_arcsec) const override {
+    return wrapped_arcsec(angle_arcsec - position_deg * kArcsecPerDeg);
+  }
   std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override {
     return std::make_unique<Reader>(l.measure.sign);
   }
-  // Each stop's deviation (its reference angle minus its target, modulo a turn) evaluated by
-  // the configured standard, in degrees and arcseconds.
+  // Each stop's deviation (stop_value: its reference angle minus its target, modulo a turn)
+  // evaluated by the configured standard, in degrees and arcseconds.
   Evaluation evaluate(std::span<const StopValue> stops,
                       const cal::daq::LinearTestConfig& l) const override {
     if (stops.empty()) throw cal::InputError("no stop was captured: nothing to evaluate");
@@ -81,7 +86,7 @@ class Rotary final : public TestKind {
       m.push_back({.target_mm = s.position_mm,  // deg
                    .run = s.run,
                    .direction = s.direction == '+' ? iso::Direction::up : iso::Direction::down,
-                   .deviation_um = wrapped_arcsec(s.value - s.position_mm * kArcsecPerDeg)});
+                   .deviation_um = wrapped_arcsec(s.value)});  // any turn's representative
     const auto e = iso::evaluate(m, iso::standard_from_string(l.standard));
     return {fmt::format("{} rotary {} ({})", e.standard.title, l.axis, component(l)),
             rotary_json(e, component(l))};
