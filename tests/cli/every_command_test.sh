@@ -78,6 +78,7 @@ measure() {  # measure COMPONENT
   wait_for "$TMP/m.toml" "devices" 10 || { echo "FAIL: daq sim --measure $1 wrote no configuration"; cat "$TMP/sim.log"; fails=$((fails + 1)); }
   "$DAQ" run linear -c "$TMP/m.toml" --db "$DB" >"$TMP/m.log" 2>&1
   check "measure_$1" 0 "stored" -- cat "$TMP/m.log"
+  cp "$TMP/m.log" "$TMP/m-$1.log"
   wait "$SIM_PID" 2>/dev/null
   SIM_PID=
   rm -f "$TMP/m.toml"
@@ -85,6 +86,12 @@ measure() {  # measure COMPONENT
 measure E_YX  # straightness
 measure E_BX  # angular (pitch)
 measure E_AX  # roll
+# A stop of a straightness or roll run is told with the kind's own value in its unit; the
+# laser's positioning deviation ("target 1 (0.000 mm) run 1 up: -6.112 um", what the live
+# line and the page also showed) is not what such a stop measures.
+check straightness_stop_event 0 "target 1 \(0\.000 mm\) run 1 up: straightness [+-][0-9]+\.[0-9]{3} um" -- cat "$TMP/m-E_YX.log"
+check roll_stop_event 0 "run 1 up: roll [+-][0-9]+\.[0-9]{3} urad" -- cat "$TMP/m-E_AX.log"
+check no_laser_deviation_as_value 1 "" -- grep -E "run [0-9]+ (up|down): [+-][0-9]" "$TMP/m-E_YX.log"
 # A straightness run's stops export with their value in its unit (it said "no captured stops").
 STRAIGHT=$("$DAQ" runs --db "$DB" | awk '$3 == "straightness" { id = $1 } END { print id }')
 check export_straightness_targets 0 "^target_mm,run,direction,value_um,.*" -- "$DAQ" export "$STRAIGHT" --what targets --db "$DB"

@@ -155,8 +155,9 @@ std::string live_line(const LiveState& s) {
     return line + fmt::format("  waiting for the {}'s first reading", s.reference);
   if (!s.valid)
     line += "  laser signal lost";
-  else if (s.at_target_mm)
-    line += fmt::format("  {:<8} {:+8.2f} {} at {:.3f} {}", s.motion, s.at_target_deviation_um,
+  else if (s.at_target_mm)  // a straightness, angular or roll stop's value is its event's, not this
+    line += fmt::format("  {:<8} {}{:+8.2f} {} at {:.3f} {}", s.motion,
+                        s.stop_value == "deviation" ? "" : "laser ", s.at_target_deviation_um,
                         s.units.deviation, *s.at_target_mm, s.units.position);
   else
     line += fmt::format("  {:<8} at {:.3f} {}", s.motion, s.position_mm, s.units.position);

@@ -94,11 +94,13 @@ std::string to_json_text(const LiveState& s) {
                      {"direction", x.up ? "up" : "down"},
                      {"target", x.target},
                      {"nominal_mm", x.nominal_mm},
-                     {"deviation_um", x.missed ? json(nullptr) : json(x.deviation_um)},
+                     {"deviation_um", x.missed || x.pending ? json(nullptr) : json(x.deviation_um)},
+                     {"pending", x.pending},
                      {"missed", x.missed},
                      {"skipped", x.skipped},
                      {"manual", x.manual}});
   j["stops"] = std::move(stops);
+  j["stop_value"] = {{"what", s.stop_value}, {"unit", ::daq::unit_html(s.stop_unit)}};
   j["paused"] = s.paused;
   return j.dump();
 }
@@ -212,8 +214,12 @@ struct LinearRun::Impl : Runner {
   LiveState live;
   std::int64_t first_ns = -1;
   double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
-  std::optional<std::size_t> last_taken;  // the stop the last capture was labelled as
-  std::vector<bool> manual;               // by stop: captured by hand
+  std::optional<std::size_t> last_taken;           // the stop the last capture was labelled as
+  std::vector<bool> manual;                        // by stop: captured by hand
+  std::vector<std::optional<double>> kind_values;  // by stop: a kind's own value, once stored
+  // True for a kind whose stop value is its own instrument's (straightness, angular, roll), not
+  // the deviation the sequencer computed from the position (positioning, rotary).
+  bool own_value() const { return reader && !kind.stops_from_probe(); }
 
   Impl(boost::asio::io_context& i, LinearRunSetup s)
       : Runner(i, s.database, s.store_options),
@@ -234,6 +240,8 @@ struct LinearRun::Impl : Runner {
     kind.validate(*setup.config.linear);
     reader = kind.reader(*setup.config.linear);
     live.units = kind.axis_units();
+    live.stop_value = own_value() ? std::string(kind.name()) : "deviation";
+    live.stop_unit = own_value() ? std::string(kind.unit()) : live.units.deviation;
     if (kind.stops_from_probe()) live.reference = "angular reference";  // rotary: no laser
     if (!kind.probe_role().empty() && !setup.probe)
       throw cal::InputError(fmt::format("a {} test needs a device with role = \"{}\"", kind.name(),
@@ -544,8 +552,10 @@ struct LinearRun::Impl : Runner {
 
   void on_capture(const cal::daq::Capture& cap, const cal::daq::Compensated& c) {
     for (const auto& e : sequencer.on_capture(cap)) {
-      event(e.message);
       using Kind = cal::daq::SequenceEvent::Kind;
+      // A kind with its own value says it when stored (store_stop): the sequencer's text holds
+      // the laser's positioning deviation, which is not what the stop measures.
+      if (!(own_value() && e.kind == Kind::captured)) event(e.message);
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
         last_taken = e.stop;
         manual.resize(sequencer.stops().size());
@@ -579,6 +589,12 @@ struct LinearRun::Impl : Runner {
                   double window_mean) {
     const auto& s = sequencer.stops()[stop];
     const double value = kind.stop_value(s.position_mm, window_mean);
+    if (own_value()) {
+      kind_values.resize(sequencer.stops().size());
+      kind_values[stop] = value;
+      event(
+          fmt::format("{}: {} {:+.3f} {}", sequencer.describe(s), kind.name(), value, kind.unit()));
+    }
     values.push_back({.position_mm = s.position_mm,
                       .target_index = s.target_index - 1,
                       .run = s.run,
@@ -925,15 +941,18 @@ struct LinearRun::Impl : Runner {
     for (std::size_t i = 0; i < stops.size(); ++i) {
       const auto& s = stops[i];
       if (!s.captured && !s.missed) continue;
-      live.stops.push_back({.number = i + 1,
-                            .run = s.run,
-                            .target = s.target_index,
-                            .up = s.direction == cal::iso230_2::Direction::up,
-                            .nominal_mm = s.position_mm,
-                            .deviation_um = s.deviation_um,
-                            .missed = s.missed && !s.captured,
-                            .skipped = s.skipped,
-                            .manual = s.captured && i < manual.size() && manual[i]});
+      live.stops.push_back(
+          {.number = i + 1,
+           .run = s.run,
+           .target = s.target_index,
+           .up = s.direction == cal::iso230_2::Direction::up,
+           .nominal_mm = s.position_mm,
+           .deviation_um = own_value() && i < kind_values.size() && kind_values[i] ? *kind_values[i]
+                                                                                   : s.deviation_um,
+           .missed = s.missed && !s.captured,
+           .skipped = s.skipped,
+           .manual = s.captured && i < manual.size() && manual[i],
+           .pending = s.captured && own_value() && !(i < kind_values.size() && kind_values[i])});
     }
     setup.on_live(live);
   }

@@ -64,7 +64,13 @@ struct LiveState {
     bool missed = false;
     bool skipped = false;  // given up by the operator
     bool manual = false;   // captured by hand
+    bool pending = false;  // captured, its value still waiting for the kind's instrument
   };
+  // What a captured stop's value is, and its unit: the deviation from the target (positioning,
+  // rotary), or the kind's own value (straightness um, angular and roll urad), never the
+  // laser's positioning deviation under the kind's name.
+  std::string stop_value = "deviation";
+  std::string stop_unit = "um";
   bool paused = false;      // no automatic capture until resumed (the operator's pause)
   std::vector<Stop> stops;  // captured or missed so far, in plan order
 };
@@ -103,9 +109,9 @@ struct LinearRunSetup {
   // A replay of a capture: the results record it, and the original run when it is known.
   bool replay = false;
   std::optional<std::int64_t> replay_of_run;
-  Origins origins;  // by role: stored with each instrument (origin.hpp)
-  cal::storage::StoreOptions store_options;       // the run's and the writer's (tests: max_pages)
-  std::function<void(const LiveState&)> on_live;  // about 10 Hz
+  Origins origins;                           // by role: stored with each instrument (origin.hpp)
+  cal::storage::StoreOptions store_options;  // the run's and the writer's (tests: max_pages)
+  std::function<void(const LiveState&)> on_live;     // about 10 Hz
   std::function<void(const std::string&)> on_event;  // captures, missed stops, stale sensors
   std::function<void(const cal::drivers::Reading&)> on_reading;  // every reading (capture, web)
 };
