@@ -82,7 +82,8 @@ number "$e1"
 check compare_values 0 "^2$" -- count cmp.html ">$e1 <span"  # the replay gives the same E
 check compare_multiples 0 "class=\"multiples\"" -- cat cmp.html
 check compare_small_plots 0 "^([7-9]|[1-9][0-9])$" -- count cmp.html "<svg class=\"plot\""
-check compare_dates 0 "run 1 [0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2}" -- cat cmp.html
+# Runs of one day: the date cell gives the day and the time, each unbroken, the run its own column.
+check compare_dates 0 "<td>1</td><td><span class=\"nw\">[0-9]{2}-[0-9]{2}</span> <span class=\"nw\">[0-9]{2}:[0-9]{2}</span>" -- cat cmp.html
 check compare_mixed 2 "compare the same test" -- "$DAQ" report --compare 1 2 --db demo.sqlite
 check unknown_run 2 "no run 99" -- "$DAQ" report 99 --db demo.sqlite
 check bad_format 2 "use html or pdf" -- "$DAQ" report 1 --db demo.sqlite --format docx
