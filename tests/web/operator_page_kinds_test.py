@@ -74,11 +74,23 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
         b.js("document.getElementById('tab-run').click();")
         wait("return window.caldaq.page.status.start.linear.ready;", f"{what}: Start ready")
         before = b.js("return (window.caldaq.page.status.last || {}).run || 0;")
+        # What the stops table showed while the run ran, recorded in the page (a 20x run may
+        # end between two WebDriver looks): its value column's head and each stop's value.
+        b.js("window.__stops = {head: '', rows: {}}; clearInterval(window.__stopsTimer);"
+             "window.__stopsTimer = setInterval(() => { const rows = document.querySelectorAll('#stops tbody tr');"
+             " if (!rows.length) return; window.__stops.head = document.getElementById('stops-value').textContent;"
+             " for (const r of rows) { const c = [...r.cells].map(x => x.textContent);"
+             " if (/^[-+]?[0-9]/.test(c[5])) window.__stops.rows[c[0]] = [c[3], c[2], c[5]]; } }, 20);")
         b.js("document.getElementById('start-linear').click();")
         # Started (a short run at 20x may end between two looks: its end counts too).
         wait("const s = window.caldaq.page.status; return s.running || (s.last && s.last.run > %d);" % before,
              f"{what}: started")
         page_checks.shot(b, SHOTS, f"k-{kind}-run-1366x768.png")
+        wait("const s = window.caldaq.page.status; return Object.keys(window.__stops.rows).length >= 3 || "
+             "!s.running;", f"{what}: three stops in the table")
+        b.js("document.getElementById('stops-panel').scrollIntoView();")
+        page_checks.shot(b, SHOTS, f"k-{kind}-stops-1366x768.png")
+        b.js("window.scrollTo(0, 0);")
         last = wait("const l = window.caldaq.page.status.last; return !window.caldaq.page.status.running && l && "
                     "l.run > %d && l;" % before, f"{what}: the run's end")
         ok(last["status"] == "complete" and last["test"] == "linear", f"{what}: complete: {last}")
@@ -87,6 +99,14 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     # --- 2. straightness of X read in Y ----------------------------------------------------
     run = run_kind("straightness", "Y", "X", "straightness of Y in X")
     doc = get(url + f"api/runs/{run}")
+    # The stops table showed the indicator's values (as stored), under their name and unit; it
+    # showed the laser's positioning deviation under "Deviation (µm)" before.
+    shown = b.js("clearInterval(window.__stopsTimer); return window.__stops;")
+    stored = {(s["target_index"] + 1, "↑" if s["direction"] == "up" else "↓"): s["deviation_um"] for s in doc["stops"]}
+    seen = [(int(t), d, float(v)) for t, d, v in shown["rows"].values()]
+    ok(shown["head"] == "Straightness (µm)" and seen and
+       all(abs(v - stored[(t, d)]) < 0.006 for t, d, v in seen),
+       f"the stops table showed each stop's straightness value as stored: {shown['head']} {seen} {stored}")
     ok(doc["kind"] == "straightness" and doc["axis"] == "Y", f"stored as a straightness run of Y: {doc['kind']} {doc['axis']}")
     settings = doc["settings"]
     ok(settings["measure"]["component"] == "E_XY" and settings["measure"]["stationary_mm"] == [200, 0, 150],
