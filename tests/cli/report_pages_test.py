@@ -433,8 +433,10 @@ imported = re.search(r"run (\d+)", daq("import", "rtx", "lin.rtx", *db)).group(1
 daq("report", imported, *db, "-o", "imported.html")
 imported_plot = " ".join(html_mod.unescape(t) for t in re.findall(
     r"<tspan[^>]*>(.*?)</tspan>", open("imported.html", encoding="utf-8").read()))
-check("imported run: the plot says displacement (m), not displacement_m",
-      "displacement (m)" in imported_plot and "displacement_m" not in imported_plot
+# In mm (the run moves metres: 1 m, -2.5 m, 0), not in m with a "x10^3" at the axis.
+check("imported run: the plot says displacement (mm), not displacement_m or (m)",
+      "displacement (mm)" in imported_plot and "displacement_m" not in imported_plot
+      and "displacement (m)" not in imported_plot
       and " ch 0" not in imported_plot, imported_plot[:300])
 
 # --- straightness and squareness: signed values through the shared formatter -----------------

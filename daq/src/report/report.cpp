@@ -1482,6 +1482,36 @@ std::string quantity_label(Q q) {
   }
 }
 
+// The unit a plot of a stored quantity reads best in, from the span of its values: a length in
+// mm, or in µm when it moves less than a millimetre (an indicator's few µm printed in m read
+// "×10⁻³" at the axis); an angle in µrad below a hundredth of a radian, else in degrees. The
+// name keeps the quantity's ("length (µm)"); other quantities as stored.
+struct PlotUnit {
+  std::string label;
+  double factor = 1.0;  // stored SI value -> plotted value
+};
+PlotUnit plot_unit(Q q, std::span<const double> values_si) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (const double x : values_si) lo = std::min(lo, x), hi = std::max(hi, x);
+  const double span = hi >= lo ? hi - lo : 0.0;
+  const auto name = [&](std::string_view unit) {
+    auto l = quantity_label(q);
+    return l.substr(0, l.rfind(" (")) + " (" + std::string(unit) + ")";
+  };
+  switch (q) {
+    case Q::displacement_m:
+    case Q::machine_position_m:
+      return {name("mm"), 1e3};
+    case Q::length_m:
+      return span < 1e-3 ? PlotUnit{name("µm"), 1e6} : PlotUnit{name("mm"), 1e3};
+    case Q::angle_rad:
+      return span < 1e-2 ? PlotUnit{name("µrad"), 1e6}
+                         : PlotUnit{name("°"), 180.0 / std::numbers::pi};
+    default:
+      return {quantity_label(q), 1.0};
+  }
+}
+
 std::string generic_section(const st::RunReader& store, const RunView& v, const Options& o) {
   // Streamed: every series is thinned to about 4000 points for its plot (every step-th
   // reading, the step from the series' count), so the memory does not grow with the run.
@@ -1493,6 +1523,7 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
   }
   struct Thinned {
     Series s;
+    std::string channel;  // ", channel 2" (after the quantity in the title)
     std::size_t step = 1, seen = 0;
   };
   std::map<std::tuple<int, int, int>, Thinned> by;
@@ -1506,8 +1537,8 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     to_read += static_cast<std::uint64_t>(x.count);
     auto& t = by[{x.quantity, x.device, x.channel}];
     t.step = std::max<std::size_t>(1, static_cast<std::size_t>(x.count) / 4000);
-    t.s.label = fmt::format("{} {}{}", instrument_name(v, x.device), quantity_label(q),
-                            x.channel > 0 ? fmt::format(", channel {}", x.channel) : "");
+    t.s.label = instrument_name(v, x.device);
+    t.channel = x.channel > 0 ? fmt::format(", channel {}", x.channel) : "";
     if (std::find(plotted.begin(), plotted.end(), x.quantity) == plotted.end())
       plotted.push_back(x.quantity);
   }
@@ -1528,10 +1559,12 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
   std::string h = fmt::format("<h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
   std::size_t i = 0;
   for (auto& [key, t] : by) {
-    const auto q = static_cast<Q>(std::get<0>(key));
+    const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
+    for (auto& x : t.s.value) x *= unit.factor;
+    t.s.label += " " + unit.label + t.channel;
     h += figure(svg(XyChart{.title = t.s.label,
                             .x_label = "time (min)",
-                            .y_label = quantity_label(q),
+                            .y_label = unit.label,
                             .lines = lines_of({t.s}, i++, 4000)}),
                 t.s.label + " over the run.");
   }
