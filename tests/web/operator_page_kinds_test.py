@@ -73,6 +73,10 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
              % version, f"{what}: applied")
         b.js("document.getElementById('tab-run').click();")
         wait("return window.caldaq.page.status.start.linear.ready;", f"{what}: Start ready")
+        # The Run view names what Start runs by its kind and component, not "Linear test".
+        plan = b.js("return document.getElementById('plan').textContent;")
+        ok(f"{kind.capitalize()} test E_" in plan and f"axis {axis}: 0.000 → 100.000 mm" in plan,
+           f"{what}: the Run view names the kind: {plan!r}")
         before = b.js("return (window.caldaq.page.status.last || {}).run || 0;")
         # What the stops table showed while the run ran, recorded in the page (a 20x run may
         # end between two WebDriver looks): its value column's head and each stop's value.

@@ -235,7 +235,8 @@ try:
            what="the edit named (the conditions typed back to empty are no edit)")
     seen = b.js("return [document.getElementById('plan').textContent, "
                 "document.getElementById('pending-edits').textContent];")
-    ok("axis X: 0.000 → 100.000 mm, 3 targets × 2 runs ↑↓ = 12 stops" in seen[0] and "laser (ids3010)" in seen[0],
+    ok("Positioning test E_XX, axis X: 0.000 → 100.000 mm, 3 targets × 2 runs ↑↓ = 12 stops" in seen[0]
+       and "laser (ids3010)" in seen[0],
        f"the Run view shows the test Start runs: {seen[0]!r}")
     ok("Last target 100 → 50" in seen[1], f"and the edit that is not in use: {seen[1]!r}")
     shot(b, "s06-unapplied-edit-1366x768.png")

@@ -383,7 +383,11 @@ class Service {
              {"cycle", l.cycle},
              {"feed_mm_per_min", l.feed_mm_per_min},
              {"instruments", instruments_of("linear")}};
-      try {
+      try {  // what it measures: the Run view names the kind, not only "linear"
+        const auto& kind = kinds::kind(l.measure.kind);
+        t["kind"] = kind.name();
+        t["component"] = kind.component(l);
+        t["rotary"] = kind.stops_from_probe();
         const auto plan = linear_plan(l);
         t["targets"] = plan.targets_mm.size();
         t["stops"] = std::count_if(plan.moves.begin(), plan.moves.end(), [](const auto& m) {
