@@ -17,8 +17,8 @@ using cal::drivers::ReadingStatus;
 using daq::serve::DeviceBoard;
 using namespace std::chrono_literals;
 
-cal::daq::Config config() {
-  return cal::daq::parse_config(R"(
+// Every fixture's laser and air station, and its environment.
+constexpr std::string_view kLaserAndAir = R"(
 [devices.laser]
 driver = "ids3010"
 transport = "tcp 127.0.0.1:9090"
@@ -27,6 +27,16 @@ role = "laser"
 driver = "ptu300"
 transport = "serial /dev/ttyUSB0 4800 7E1"
 role = "air"
+)";
+constexpr std::string_view kEnvironment = R"(
+[environment]
+wavelength_nm = 633
+co2_umol_per_mol = 450
+expansion_ppm_per_k = 11.5
+)";
+
+cal::daq::Config config() {
+  return cal::daq::parse_config(fmt::format("{}{}{}", kLaserAndAir, R"(
 [devices.table]
 driver = "gauge"
 transport = "serial /dev/ttyUSB1 9600 8N1"
@@ -36,11 +46,8 @@ role = "material"
 driver = "gauge"
 transport = "serial /dev/ttyUSB2 115200 8N1"
 role = "ballbar"
-[environment]
-wavelength_nm = 633
-co2_umol_per_mol = 450
-expansion_ppm_per_k = 11.5
 )",
+                                            kEnvironment),
                                 "board.toml");
 }
 
@@ -120,15 +127,7 @@ TEST(DeviceBoard, ReconnectingCountsTheAttemptsOfItsLimit) {
 // the laser and the position feed are not its devices.
 cal::daq::Config with_kind(std::string_view kind) {
   return cal::daq::parse_config(
-      fmt::format(R"(
-[devices.laser]
-driver = "ids3010"
-transport = "tcp 127.0.0.1:9090"
-role = "laser"
-[devices.air]
-driver = "ptu300"
-transport = "serial /dev/ttyUSB0 4800 7E1"
-role = "air"
+      fmt::format(R"({}
 [devices.indicator]
 driver = "gauge"
 transport = "serial /dev/ttyUSB3 9600 8N1"
@@ -138,10 +137,7 @@ driver = "gauge"
 transport = "serial /dev/ttyUSB4 9600 8N1"
 unit = "arcsec"
 role = "angle"
-[environment]
-wavelength_nm = 633
-co2_umol_per_mol = 450
-expansion_ppm_per_k = 11.5
+{}
 [trigger]
 tolerance_um = 1
 dwell_s = 1.5
@@ -157,8 +153,9 @@ dwell_s = 4
 measure = "{}"
 {}
 )",
-                  kind == "rotary" ? "C" : "X", kind == "rotary" ? 360 : 200,
-                  kind == "rotary" ? 90 : 100, kind, kind == "rotary" ? "" : "direction = \"Y\""),
+                  kLaserAndAir, kEnvironment, kind == "rotary" ? "C" : "X",
+                  kind == "rotary" ? 360 : 200, kind == "rotary" ? 90 : 100, kind,
+                  kind == "rotary" ? "" : "direction = \"Y\""),
       "kinds.toml");
 }
 
