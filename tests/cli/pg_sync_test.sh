@@ -96,6 +96,17 @@ check new_result_count 0 "^$(local_value "SELECT count(*) FROM results")$" -- ps
 check new_result_superseded 0 "^$(local_value "SELECT count(*) FROM results WHERE superseded_by IS NOT NULL")$" -- \
   psql_value "SELECT count(*) FROM caldaq.results WHERE superseded_by IS NOT NULL"
 
+# daq bench sync: a generated run sent and measured beside the server's own binary COPY of the
+# same chunk rows; its run and its scratch table deleted again (the server's runs as before).
+SERVER_RUNS=$(psql_value "SELECT count(*) FROM caldaq.runs")
+check bench_sync 0 "median: daq sync [0-9]+ readings/s, COPY ceiling [0-9]+ readings/s: sync at [0-9]+ % of the ceiling" -- \
+  "$DAQ" bench sync --to "$PG_URL" --minutes 1 --rounds 1 --dir "$TMP"
+# 60 s of 10 kHz readings and 60 air samples of three quantities each: 600,000 + 180.
+check bench_sync_readings 0 "^ +1 +600180 " -- bash -c "'$DAQ' bench sync --to '$PG_URL' --minutes 1 --rounds 1 --dir '$TMP' | sed -n 2p"
+check bench_sync_runs_gone 0 "^$SERVER_RUNS$" -- psql_value "SELECT count(*) FROM caldaq.runs"
+check bench_sync_table_gone 0 "^t$" -- psql_value "SELECT to_regclass('public.caldaq_bench_reading_chunks') IS NULL"
+check bench_sync_not_a_uri 2 "bench sync: --to: '/tmp/x.sqlite' is not a PostgreSQL URI" -- "$DAQ" bench sync --to /tmp/x.sqlite
+
 # Every chunk read back and its checksum recomputed over the server's bytes.
 check verify 0 "$CHUNKS chunks read back and their checksums verified" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --verify --quiet
 

@@ -52,6 +52,8 @@
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
 #include "cal/storage/chunk.hpp"
+#include "cal/storage/pg/copy_ceiling.hpp"
+#include "cal/storage/pg/sync.hpp"
 #include "cal/storage/store.hpp"
 #include "cal/storage/writer.hpp"
 #include "cli_checks.hpp"
@@ -783,6 +785,68 @@ void bench_export(const ExportBenchOptions& o) {
       fmt::join(ceilings, "\n"));
 }
 
+struct SyncBenchOptions {
+  std::string to;
+  int minutes = 10;
+  int rounds = 3;
+  std::string dir;
+};
+
+// daq sync of generated runs against PostgreSQL's own COPY of the same chunk rows, in alternate
+// rounds on the same server and load (issue 35's "sync throughput against COPY").
+void bench_sync(const SyncBenchOptions& o) {
+  namespace pg = cal::storage::pg;
+  if (!pg::is_postgresql_url(o.to))
+    throw cal::InputError(
+        fmt::format("bench sync: --to: '{}' is not a PostgreSQL URI "
+                    "(postgresql://...; a scratch database: the bench's runs are "
+                    "sent there and deleted again)",
+                    o.to));
+  if (o.minutes < 1 || o.rounds < 1)
+    throw cal::InputError("bench sync: --minutes and --rounds must be at least 1");
+  const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
+  const fs::path db = dir / fmt::format("caldaq-bench-sync-{}.sqlite", ::getpid());
+  const Cleanup cleanup({db});
+  remove_db(db);
+  std::int64_t run = 0, readings = 0;
+  std::string uuid;
+  {
+    cal::storage::Store store(db, {.full_sync = false});
+    run = generate_run(store, o.minutes * 60);
+    readings = store.reading_count(run);
+    uuid = store.run(run)->uuid;
+  }
+  const std::vector<std::string> uuids{uuid};
+  const std::vector<std::int64_t> runs{run};
+  pg::delete_central_runs(o.to, uuids);  // a run left by a cut bench
+  std::vector<double> sync_s, ceiling_s;
+  fmt::print("{:>5} {:>10} {:>8}  {:>24}  {:>34}  {:>5}\n", "round", "readings", "MB",
+             "daq sync: wall, readings/s", "COPY ceiling: read + copy, readings/s", "%");
+  for (int k = 1; k <= o.rounds; ++k) {
+    const auto s = run_child({"sync", "--db", db.string(), "--to", o.to, "--quiet"});
+    pg::delete_central_runs(o.to, uuids);
+    const cal::storage::Store store(db, {.read_only = true});
+    const auto c = pg::copy_ceiling(store, o.to, runs);
+    const double ceiling = c.read_s + c.copy_s;
+    sync_s.push_back(s.seconds);
+    ceiling_s.push_back(ceiling);
+    fmt::print(
+        "{:>5} {:>10} {:>8.1f}  {:>8.2f} s {:>11.0f}/s  {:>6.2f} + {:>6.2f} s {:>11.0f}/s  "
+        "{:>4.0f}\n",
+        k, readings, static_cast<double>(c.bytes) / 1e6, s.seconds,
+        static_cast<double>(readings) / s.seconds, c.read_s, c.copy_s,
+        static_cast<double>(readings) / ceiling, 100.0 * ceiling / s.seconds);
+  }
+  const double ms = median(sync_s), mc = median(ceiling_s);
+  fmt::print(
+      "median: daq sync {:.0f} readings/s, COPY ceiling {:.0f} readings/s: sync at {:.0f} % of "
+      "the ceiling\n(wall times; daq sync is a child process that opens, checks and sends the run "
+      "with its instruments and results; the ceiling reads the same chunks from the store and "
+      "COPYs their rows in binary into a scratch table shaped like caldaq.reading_chunks, "
+      "primary key included)\n",
+      static_cast<double>(readings) / ms, static_cast<double>(readings) / mc, 100.0 * mc / ms);
+}
+
 }  // namespace
 
 void add_bench_commands(CLI::App& app) {
@@ -815,6 +879,17 @@ void add_bench_commands(CLI::App& app) {
   ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
   ex->add_option("--keep-db", e->keep,
                  "Store the generated runs in this new file and keep it (to export or inspect)");
+
+  const auto [sy, y] = add_command<SyncBenchOptions>(
+      *bench, "sync", bench_sync,
+      "Send a generated run of a 10 kHz stream to a PostgreSQL server with daq sync and measure "
+      "it beside the server's own COPY of the same chunk rows (a scratch database: the bench's "
+      "run is deleted from it again)");
+  sy->add_option("--to", y->to, "The server (postgresql://...)")->required();
+  sy->add_option("--minutes", y->minutes, "Length of the generated run")->capture_default_str();
+  sy->add_option("--rounds", y->rounds, "Rounds (sync, then its ceiling); medians are reported")
+      ->capture_default_str();
+  sy->add_option("--dir", y->dir, "Directory for the generated database (default: $TMPDIR)");
 }
 
 }  // namespace daq
