@@ -81,5 +81,8 @@ void add_model_compare_command(CLI::App& model);
 // (cmd_model_kinematics.cpp): sphere probing of rotary axes and the controls' kinematics.
 void add_model_probe_commands(CLI::App& model);
 void add_model_kinematics_command(CLI::App& model);
+// daq model ballbar5x | ballbar5x-sim | ballbar5x-program (cmd_model_ballbar5x.cpp): the
+// ballbar on a rotary table axis.
+void add_model_ballbar5x_commands(CLI::App& model);
 
 }  // namespace daq

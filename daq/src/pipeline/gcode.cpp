@@ -296,6 +296,17 @@ std::vector<ArcMove> transition(Plane p1, double a1, Plane p2, double a2) {
   return best;
 }
 
+void comment_block(Writer& w, const std::string& text) {
+  if (w.d == Dialect::fanuc)
+    w.add("(" + text + ")");
+  else
+    w.add("; " + text);
+}
+
+void stop_block(Writer& w) {
+  w.add(w.d == Dialect::fanuc ? "M00" : w.d == Dialect::siemens ? "M0" : "STOP");
+}
+
 class CircleWriter {
  public:
   CircleWriter(Writer& w, const CircleProgramSetup& s) : w_(w), s_(s) {}
@@ -349,14 +360,9 @@ class CircleWriter {
     return at;
   }
 
-  void comment(const std::string& text) {
-    if (w_.d == Dialect::fanuc)
-      w_.add("(" + text + ")");
-    else
-      w_.add("; " + text);
-  }
+  void comment(const std::string& text) { comment_block(w_, text); }
 
-  void stop() { w_.add(w_.d == Dialect::fanuc ? "M00" : w_.d == Dialect::siemens ? "M0" : "STOP"); }
+  void stop() { stop_block(w_); }
 
  private:
   PlaneFrame frame_of(Plane p) const {
@@ -481,6 +487,42 @@ std::string circle_set_program(std::span<const BallbarSetTest> tests, const Circ
 std::string circle_program(const BallbarProgram& b, const CircleProgramSetup& s, Dialect d) {
   const BallbarSetTest one{s.plane, b};
   return circle_set_program(std::span(&one, 1), s, d);
+}
+
+std::string rotary_ballbar_program(std::span<const RotaryProgramPoint> points,
+                                   const RotaryProgramSetup& s, Dialect d) {
+  if (points.empty()) throw InputError("program: the rotary ballbar test has no point");
+  check_name(s.name);
+  check_feed_dwell(s.feed_mm_per_min, s.dwell_s);
+  if (s.rotary != 'A' && s.rotary != 'B' && s.rotary != 'C')
+    throw InputError(fmt::format("program: rotary axis '{}' (expected A, B or C)", s.rotary));
+  const bool plain = std::all_of(s.what.begin(), s.what.end(), [](unsigned char c) {
+    return std::isalnum(c) ||
+           std::string_view(" -.,:=+/").find(static_cast<char>(c)) != std::string_view::npos;
+  });
+  if (!plain || s.what.size() > 120)
+    throw InputError(
+        "program: the title may hold letters, digits, spaces and - . , : = + / only, at most "
+        "120 characters");
+  Writer w{d, s.fanuc_dwell, Plane::xy, {}, 0};
+  w.begin(s.name, upper(s.what));
+  comment_block(
+      w, "X Y Z: THE SPINDLE BALL CENTRE; " + std::string(1, s.rotary) + ": THE TABLE ANGLE");
+  const auto words = [&](const RotaryProgramPoint& p) {
+    return axis_word(d, 'X', p.x_mm) + " " + axis_word(d, 'Y', p.y_mm) + " " +
+           axis_word(d, 'Z', p.z_mm) + " " + axis_word(d, s.rotary, p.angle_deg);
+  };
+  w.line_to(words(points.front()), s.feed_mm_per_min);
+  comment_block(w, "FIT THE BAR");
+  stop_block(w);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i > 0) w.line_to(words(points[i]), s.feed_mm_per_min);
+    if (points[i].measure) w.dwell(s.dwell_s);
+  }
+  comment_block(w, "REMOVE THE BAR");
+  stop_block(w);
+  w.end(s.name);
+  return w.text();
 }
 
 }  // namespace cal::daq

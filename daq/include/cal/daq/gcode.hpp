@@ -118,4 +118,29 @@ struct SetArc {
 // that the simulated machine runs what the program says).
 std::vector<SetArc> ballbar_transition(Plane p1, double a1_deg, Plane p2, double a2_deg);
 
+// A ballbar test on a rotary table axis in simultaneous motion (docs/kinematics.md, "The
+// ballbar on a rotary axis"): every block moves the three linear axes and the rotary axis
+// together by linear interpolation (G01 / L / G1 with X Y Z and the axis's word), in steps the
+// caller chooses small enough that the bar stays within its range between the points; the
+// program stops (M00 / STOP / M0) for the bar to be fitted at the first point and removed at the
+// end, and dwells at each point where the bar is read. The coordinates are those of the
+// spindle ball's centre (the tool tip) in the caller's coordinates; the angle is written as
+// given. No tool-centre-point mode is used, so no control's kinematics enters the program.
+struct RotaryProgramPoint {
+  double x_mm = 0.0, y_mm = 0.0, z_mm = 0.0, angle_deg = 0.0;
+  bool measure = false;  // dwell here: the bar is read at this point
+};
+struct RotaryProgramSetup {
+  std::string name = "BB5X";
+  char rotary = 'C';  // A, B or C
+  double feed_mm_per_min = 500.0;
+  double dwell_s = 2.0;
+  // The program's title comment: letters, digits, spaces and - . , : = + / only (InputError
+  // otherwise: a parenthesis or a semicolon would end a comment early in some dialect).
+  std::string what;
+  FanucDwell fanuc_dwell = FanucDwell::p_ms;
+};
+std::string rotary_ballbar_program(std::span<const RotaryProgramPoint> points,
+                                   const RotaryProgramSetup& s, Dialect d);
+
 }  // namespace cal::daq
