@@ -47,6 +47,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cal/analysis/circle_records.hpp"
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "circle_dynamics.hpp"
@@ -172,6 +173,56 @@ struct Model {
   }
 };
 
+// The samples of each trace: [begin, end) in the flattened samples, and the trace itself.
+struct Span {
+  const Trace* trace;
+  std::size_t begin, end;
+};
+
+// The fit's samples: the traces flattened in order, sample i of trace t at spans()[t].begin + j.
+// Each one's record is held (40 bytes a sample) for a run of at most
+// fit_records_held_max_samples samples (circle_records.hpp), and otherwise rebuilt from its trace
+// whenever it is read, by the same operations and so to the same values: then the fit holds nothing
+// per sample beyond the traces, at the price of a sine, a cosine and four exponentials a sample on
+// every pass (issue 32: a 10 kHz circle's records were most of its peak memory).
+class Samples {
+ public:
+  Samples(std::span<const Trace> traces, double offset_um, double spike_decay_rad,
+          std::size_t held_max)
+      : m_{0.0, spike_decay_rad, {}}, offset_um_(offset_um) {
+    for (const auto& t : traces) {
+      spans_.push_back({&t, size_, size_ + t.angle_deg.size()});
+      size_ += t.angle_deg.size();
+    }
+    if (size_ > held_max) return;
+    held_.reserve(size_);
+    for (std::size_t i = 0; i < size_; ++i) held_.push_back(make(i, true));
+  }
+
+  std::size_t size() const { return size_; }
+  const std::vector<Span>& spans() const { return spans_; }
+  Sample operator[](std::size_t i) const { return held_.empty() ? make(i, true) : held_[i]; }
+  // Cos, sin and deviation only (the spike columns are left 0 when rebuilt): the circle's.
+  Sample plain(std::size_t i) const { return held_.empty() ? make(i, false) : held_[i]; }
+  // The held records go (40 bytes a sample); the samples are rebuilt from then on.
+  void release() { held_ = std::vector<Sample>(); }  // (= {} would keep the capacity)
+
+ private:
+  Sample make(std::size_t i, bool spikes) const {
+    const Span& sp = spans_.size() > 1 && i >= spans_[1].begin ? spans_[1] : spans_[0];
+    const std::size_t j = i - sp.begin;
+    const double theta = sp.trace->angle_deg[j] * deg, y = sp.trace->deviation_um[j] + offset_um_;
+    if (!spikes) return {std::cos(theta), std::sin(theta), y, 0.0, 0.0};
+    return m_.sample(theta, sign_of(sp.trace->direction), y);
+  }
+
+  Model m_;  // for its spike columns
+  double offset_um_;
+  std::vector<Span> spans_;
+  std::size_t size_ = 0;
+  std::vector<Sample> held_;
+};
+
 using Gram = Eigen::Matrix<double, term_count, term_count>;
 using TermVector = Eigen::Matrix<double, term_count, 1>;
 
@@ -179,8 +230,7 @@ using TermVector = Eigen::Matrix<double, term_count, 1>;
 // the block's first row's index. A pass holds one block (18 kB), never the n x 18 design.
 using Block = Eigen::Matrix<double, Eigen::Dynamic, term_count>;
 template <class F>
-void for_each_block(const Model& m, std::span<const Sample> samples, std::size_t stride, double k,
-                    F&& f) {
+void for_each_block(const Model& m, const Samples& samples, std::size_t stride, double k, F&& f) {
   constexpr std::size_t block_rows = 128;  // 18 kB: the rows are written where they are read
   const std::size_t n = (samples.size() + stride - 1) / stride;
   Block b(static_cast<Eigen::Index>(std::min(n, block_rows)), term_count);
@@ -189,7 +239,7 @@ void for_each_block(const Model& m, std::span<const Sample> samples, std::size_t
     const auto rows = static_cast<Eigen::Index>(std::min(block_rows, n - first));
     for (Eigen::Index i = 0; i < rows; ++i) {
       const std::size_t at = (first + static_cast<std::size_t>(i)) * stride;
-      const Sample& x = samples[at];
+      const Sample x = samples[at];
       m.row(x, m.direction(at), k, b.row(i));
       y[i] = x.y;
     }
@@ -258,7 +308,7 @@ Solution solve_in_order(const Gram& ata, const TermVector& aty,
 // recomputes only the four cyclic columns' rows of the Gram matrix, in one more pass.
 class Design {
  public:
-  Design(const Model& m, std::span<const Sample> samples, std::size_t stride, double period_mm)
+  Design(const Model& m, const Samples& samples, std::size_t stride, double period_mm)
       : m_(m), samples_(samples), stride_(stride), period_mm_(period_mm) {
     ata_.setZero();
     aty_.setZero();
@@ -301,7 +351,7 @@ class Design {
     if (dense_.rows() > 0) {  // only the cyclic columns change
       const double kc = k();
       for (Eigen::Index i = 0; i < dense_.rows(); ++i) {
-        const Sample& x = samples_[static_cast<std::size_t>(i) * stride_];
+        const Sample x = samples_[static_cast<std::size_t>(i) * stride_];
         const double pu = kc * x.c, pv = kc * x.n;
         dense_(i, cyclic_u_a) = x.c * std::sin(pu);
         dense_(i, cyclic_u_b) = x.c * std::cos(pu);
@@ -328,7 +378,7 @@ class Design {
   // trial period recomputes only its four cyclic columns.
   static constexpr std::size_t dense_max_rows = 8192;
   Model m_;
-  std::span<const Sample> samples_;
+  const Samples& samples_;
   std::size_t stride_;
   Block dense_;
   Eigen::VectorXd dense_y_;
@@ -388,8 +438,7 @@ double brent_min(double a, double b, double tol, F f) {
 // half a cycle when dp / p = p / (4R). So the grid steps by p / (8R) (at most 800 steps), on
 // a decimated copy of the samples (>= 8 samples per shortest period along the path), and the
 // best grid point is refined by Brent's method (parabolic and golden section steps) on all samples.
-double search_period(const Model& m, std::span<const Sample> samples, const Setup& setup,
-                     Design& full) {
+double search_period(const Model& m, const Samples& samples, const Setup& setup, Design& full) {
   const double p_min = setup.cyclic_search_min_mm, p_max = setup.cyclic_search_max_mm;
   const double path_per_sample_mm =
       2 * pi * setup.radius_mm / std::max(1.0, static_cast<double>(samples.size()) / 2.0);
@@ -496,12 +545,6 @@ void validate(const Setup& setup, std::span<const Trace> traces) {
   for (const auto& t : traces) validate_trace(t);
 }
 
-// The samples of each trace: [begin, end) in the flattened samples, and the trace itself.
-struct Span {
-  const Trace* trace;
-  std::size_t begin, end;
-};
-
 // Least-squares circle, linearised as the bar length itself (dr = r0 + cu cos + cv sin, the
 // first-order form above; the exact circle differs by O(e^2 / R)); the radial deviations about
 // its centre, from the nominal radius, are y - cu cos - cv sin.
@@ -510,10 +553,12 @@ struct Circle {
   double residual(const Sample& x) const { return x.y - cu * x.c - cv * x.n; }
 };
 
-Circle lsq_circle(std::span<const Sample> samples) {
+// Over the samples [begin, end).
+Circle lsq_circle(const Samples& samples, std::size_t begin, std::size_t end) {
   Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
   Eigen::Vector3d aty = Eigen::Vector3d::Zero();
-  for (const auto& x : samples) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const Sample x = samples.plain(i);
     const Eigen::Vector3d a(1.0, x.c, x.n);
     ata += a * a.transpose();
     aty += a * x.y;
@@ -528,18 +573,18 @@ struct Range {
   double pv() const { return hi - lo; }
 };
 
-Range residual_range(const Circle& c, std::span<const Sample> samples) {
+Range residual_range(const Circle& c, const Samples& samples, std::size_t begin, std::size_t end) {
   Range r;
-  for (const auto& x : samples) r.add(c.residual(x));
+  for (std::size_t i = begin; i < end; ++i) r.add(c.residual(samples.plain(i)));
   return r;
 }
 
 // Largest |r_a(theta) - r_b(theta)|, r_b interpolated (periodically) at the angles of a.
-double hysteresis(const Circle& c, std::span<const Sample> samples, const Span& a, const Span& b) {
+double hysteresis(const Circle& c, const Samples& samples, const Span& a, const Span& b) {
   std::vector<std::pair<double, double>> pts;
   pts.reserve(b.end - b.begin);
   for (std::size_t i = b.begin; i < b.end; ++i)
-    pts.emplace_back(mod360(b.trace->angle_deg[i - b.begin]), c.residual(samples[i]));
+    pts.emplace_back(mod360(b.trace->angle_deg[i - b.begin]), c.residual(samples.plain(i)));
   sort_circular(pts, [](const auto& p) { return p.first; });
   double h = 0.0;
   for (std::size_t i = a.begin; i < a.end; ++i) {
@@ -553,43 +598,27 @@ double hysteresis(const Circle& c, std::span<const Sample> samples, const Span& 
     if (off < 0) off += 360.0;
     if (span > 10.0) continue;  // outside the other trace's arc
     const double rbi = p0.second + (p1.second - p0.second) * (span > 0 ? off / span : 0.0);
-    h = std::max(h, std::abs(c.residual(samples[i]) - rbi));
+    h = std::max(h, std::abs(c.residual(samples.plain(i)) - rbi));
   }
   return h;
 }
 
-Iso230_4 iso_values(std::span<const Sample> samples, std::span<const Span> traces) {
+Iso230_4 iso_values(const Samples& samples) {
   Iso230_4 iso;
+  const auto& traces = samples.spans();
   for (const auto& t : traces) {
-    const auto own = samples.subspan(t.begin, t.end - t.begin);
     (t.trace->direction == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) =
-        residual_range(lsq_circle(own), own).pv();
+        residual_range(lsq_circle(samples, t.begin, t.end), samples, t.begin, t.end).pv();
     iso.arc_deg = std::min(iso.arc_deg, coverage_deg(t.trace->angle_deg));
   }
-  const Circle common = lsq_circle(samples);
-  const Range f = residual_range(common, samples);
+  const Circle common = lsq_circle(samples, 0, samples.size());
+  const Range f = residual_range(common, samples, 0, samples.size());
   iso.G_bi_um = f.pv();
   iso.centre_u_um = common.cu;
   iso.centre_v_um = common.cv;
   iso.F_max_um = f.hi, iso.F_min_um = f.lo;
   if (traces.size() == 2) iso.H_um = hysteresis(common, samples, traces[0], traces[1]);
   return iso;
-}
-
-std::vector<Sample> flatten(const Model& m, std::span<const Trace> traces, double offset_um,
-                            std::vector<Span>& spans) {
-  std::vector<Sample> samples;
-  std::size_t total = 0;
-  for (const auto& t : traces) total += t.angle_deg.size();
-  samples.reserve(total);
-  for (const auto& t : traces) {
-    const double s = sign_of(t.direction);
-    const std::size_t begin = samples.size();
-    for (std::size_t i = 0; i < t.angle_deg.size(); ++i)
-      samples.push_back(m.sample(t.angle_deg[i] * deg, s, t.deviation_um[i] + offset_um));
-    spans.push_back({&t, begin, samples.size()});
-  }
-  return samples;
 }
 
 // Which terms the data can carry, with a note for each that it cannot.
@@ -669,37 +698,30 @@ class Reporter {
   }
 
   // Those found in the residual (their contributions are given, no basis is needed), then all
-  // of them into the result. The samples' cos, sin and deviation are recomputed from the traces
-  // as flatten made them (the same operations, so the same values): the fit's records are gone.
-  void finish(std::span<const Trace> traces, double offset_um) {
+  // of them into the result, in two passes for all of them: C' times each contribution, then
+  // each one's ranges.
+  void finish(const Samples& samples) {
     if (!ldlt_) ldlt_.emplace(d_.ata().topLeftCorner<3, 3>());
-    const auto each_sample = [&](auto&& f) {
-      std::size_t i = 0;
-      for (const auto& t : traces)
-        for (std::size_t j = 0; j < t.angle_deg.size(); ++j, ++i) {
-          const double theta = t.angle_deg[j] * deg;
-          f(i, std::cos(theta), std::sin(theta), t.deviation_um[j] + offset_um);
-        }
-    };
-    // Two passes for all of them: C' times each contribution, then each one's ranges.
     std::vector<Pending*> found;
     for (auto& p : pending_)
       if (p.found) found.push_back(&p);
     if (!found.empty()) {
       std::vector<Eigen::Vector3d> ct_contrib(found.size(), Eigen::Vector3d::Zero());
-      each_sample([&](std::size_t i, double c, double n, double) {
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        const Sample x = samples.plain(i);
         for (std::size_t f = 0; f < found.size(); ++f)
-          ct_contrib[f] += Eigen::Vector3d(c, n, 1.0) * found[f]->found->contribution[i];
-      });
+          ct_contrib[f] += Eigen::Vector3d(x.c, x.n, 1.0) * found[f]->found->contribution[i];
+      }
       for (std::size_t f = 0; f < found.size(); ++f)
         found[f]->centre = ldlt_->solve(d_.aty().head<3>() - ct_contrib[f]);
-      each_sample([&](std::size_t i, double c, double n, double y) {
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        const Sample x = samples.plain(i);
         for (Pending* p : found) {
           const double contrib = p->found->contribution[i];
           p->contrib.add(contrib);
-          p->without.add(y - contrib - p->centre[0] * c - p->centre[1] * n);
+          p->without.add(x.y - contrib - p->centre[0] * x.c - p->centre[1] * x.n);
         }
-      });
+      }
     }
     const double g_bi = res_.iso.G_bi_um;
     for (auto& p : pending_) {
@@ -821,15 +843,19 @@ Trace trace_from_samples(const Setup& setup, Direction d, std::span<const double
 }
 
 Result analyse(const Setup& setup, std::span<const Trace> traces) {
+  return analyse(setup, traces, fit_records_held_max_samples);
+}
+
+Result analyse(const Setup& setup, std::span<const Trace> traces,
+               std::size_t records_held_max_samples) {
   validate(setup, traces);
   Result res;
   // Deviations from the nominal radius: the bar reads 0 at its calibrated length.
   const double offset_um =
       1e3 * (setup.calibrated_radius_mm.value_or(setup.radius_mm) - setup.radius_mm);
-  std::vector<Span> spans;
-  auto samples =
-      flatten(Model{setup.radius_mm, setup.spike_decay_deg * deg, {}}, traces, offset_um, spans);
-  res.iso = iso_values(samples, spans);
+  Samples samples(traces, offset_um, setup.spike_decay_deg * deg, records_held_max_samples);
+  const auto& spans = samples.spans();
+  res.iso = iso_values(samples);
 
   Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
   m.split = spans[0].end;
@@ -870,11 +896,11 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
       residuals[t].r_um[at - spans[t].begin] = r[i];
     }
   });
-  // The fit's records (40 bytes a sample) are done with: what follows needs the residual, and
-  // rep.finish rebuilds the little it needs from the traces. Freed before the spectra, the peak
-  // of the analysis (issue 32).
+  // The fit's records (40 bytes a sample, if held) are done with: what follows needs the
+  // residual, and rep.finish rebuilds the little it needs from the traces. Freed before the
+  // spectra, the peak of the analysis at 1 kHz (issue 32).
   const std::size_t sample_count = samples.size();
-  samples = std::vector<Sample>();  // (= {} would keep the capacity)
+  samples.release();
   const dynamics::Settings dyn{.radius_mm = setup.radius_mm,
                                .feed_mm_per_min = setup.feed_mm_per_min,
                                .window_deg = setup.stick_slip_window_deg,
@@ -892,7 +918,7 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
 
   if (vibration) rep.add(*vibration);
   for (const auto& f : stick_slip) rep.add(f);
-  rep.finish(traces, offset_um);
+  rep.finish(samples);
   // Ranked by what correcting each would gain (G with its term removed), as a ballbar user
   // reads the list: the first is the one to fix first. Equal gains (terms absent) by PV.
   std::stable_sort(res.diagnostics.begin(), res.diagnostics.end(),

@@ -45,6 +45,8 @@
 #include <numeric>
 #include <unsupported/Eigen/FFT>
 
+#include "cal/analysis/moving_median.hpp"
+
 namespace cal::circle::dynamics {
 namespace {
 
@@ -251,43 +253,13 @@ double mean_power(const std::vector<double>& p, std::ptrdiff_t a, std::ptrdiff_t
 }
 
 // The residual minus its centred moving median, in the trace's own order: at travel position i
-// the median of every stride-th sample from i - m to i + m (clipped at the ends). Away from the
-// ends the window of i + stride is that of i less its first sample plus one more, so each
-// residue class mod stride slides one sorted window along (an erase and an insert) instead of
-// selecting the median of every window anew; the median is the same element either way.
-std::vector<double> high_pass(const TraceResidual& t, const Timed& tm, std::size_t m,
-                              std::size_t stride) {
-  const std::size_t n = t.r_um.size();
+// the median of every stride-th sample from i - m to i + m (clipped at the ends). Into h, one
+// value a sample of the trace.
+void high_pass(const TraceResidual& t, const Timed& tm, std::size_t m, std::size_t stride,
+               std::span<double> h) {
   const auto at = [&](std::size_t k) { return t.r_um[tm.order(k)]; };
-  std::vector<double> h(n), win;
-  const auto clipped = [&](std::size_t i) {  // the window selected anew
-    const std::size_t a = i > m ? i - m : 0, b = std::min(n, i + m + 1);
-    win.clear();
-    for (std::size_t k = a; k < b; k += stride) win.push_back(at(k));
-    std::nth_element(win.begin(), win.begin() + static_cast<std::ptrdiff_t>(win.size() / 2),
-                     win.end());
-    return win[win.size() / 2];
-  };
-  const bool slides = n >= 2 * m + 1;  // some window lies wholly inside
-  for (std::size_t i = 0; i < n; ++i)
-    if (!slides || i < m || i + m + 1 > n) h[tm.order(i)] = at(i) - clipped(i);
-  if (!slides) return h;
-  const std::size_t count = (2 * m + 1 + stride - 1) / stride;  // samples in an inner window
-  for (std::size_t r = 0; r < stride && m + r + m + 1 <= n; ++r) {
-    std::size_t i = m + r;
-    win.clear();
-    for (std::size_t k = 0; k < count; ++k) win.push_back(at(i - m + k * stride));
-    std::sort(win.begin(), win.end());
-    for (;;) {
-      h[tm.order(i)] = at(i) - win[count / 2];
-      if (i + stride + m + 1 > n) break;
-      const double out = at(i - m), in = at(i - m + count * stride);
-      win.erase(std::lower_bound(win.begin(), win.end(), out));
-      win.insert(std::upper_bound(win.begin(), win.end(), in), in);
-      i += stride;
-    }
-  }
-  return h;
+  moving_median(h.size(), m, stride, at,
+                [&](std::size_t i, double median) { h[tm.order(i)] = at(i) - median; });
 }
 
 }  // namespace
@@ -454,9 +426,13 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
 std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual>& traces,
                               std::vector<std::string>& notes) {
   const double w = omega_rad_s(s), core = 1.0 * deg, window = s.window_deg * deg;
-  // The high-passed residual, per trace in its own order.
-  std::vector<std::vector<double>> hp;
-  for (const auto& t : traces) {
+  // The high-passed residual of every sample, the traces one after the other (as a Found's
+  // contribution), each in its own order.
+  std::size_t total = 0;
+  for (const auto& t : traces) total += t.r_um.size();
+  std::vector<double> hp(total);
+  for (std::size_t i = 0, first = 0; i < traces.size(); first += traces[i++].r_um.size()) {
+    const auto& t = traces[i];
     const Timed tm = timed(t, w);
     const double step_rad = tm.step_s * w;
     const std::size_t m =
@@ -465,45 +441,54 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
             : 1;
     // At most 41 samples of the window (every stride-th): the median of the local level needs
     // no more, and 2 x 36,000 samples at 0.01 degrees would otherwise cost 401 per sample.
-    hp.push_back(high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41)));
+    high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41),
+              std::span(hp).subspan(first, t.r_um.size()));
   }
   // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2).
   const auto from_u = [](double th) { return std::abs(std::remainder(th, pi)); };
   const auto from_v = [](double th) { return std::abs(std::remainder(th - pi / 2, pi)); };
+  const auto each_sample = [&](auto&& f) {  // f(index in hp, theta)
+    for (std::size_t i = 0, k = 0; i < traces.size(); ++i)
+      for (std::size_t j = 0; j < traces[i].r_um.size(); ++j, ++k) f(k, traces[i].theta_rad(j));
+  };
   // One pass for the mean squares in and out of the windows; a contribution is made only for
   // an axis that is reported.
   double out_ss = 0.0;
   std::size_t out_n = 0;
   std::array<double, 2> in_ss{};
   std::array<std::size_t, 2> in_n{};
-  for (std::size_t i = 0; i < traces.size(); ++i)
-    for (std::size_t j = 0; j < hp[i].size(); ++j) {
-      const double th = traces[i].theta_rad(j), du = from_u(th), dv = from_v(th);
-      const double sq = hp[i][j] * hp[i][j];
-      if (du > window && dv > window) out_ss += sq, ++out_n;
-      if (du >= core && du <= window) in_ss[0] += sq, ++in_n[0];
-      if (dv >= core && dv <= window) in_ss[1] += sq, ++in_n[1];
-    }
+  each_sample([&](std::size_t k, double th) {
+    const double du = from_u(th), dv = from_v(th), sq = hp[k] * hp[k];
+    if (du > window && dv > window) out_ss += sq, ++out_n;
+    if (du >= core && du <= window) in_ss[0] += sq, ++in_n[0];
+    if (dv >= core && dv <= window) in_ss[1] += sq, ++in_n[1];
+  });
   std::vector<Found> found;
   if (out_n < min_window_samples) return found;
   const double ms_out = out_ss / static_cast<double>(out_n);
+  std::vector<bool> of_u;  // found[i] is of the first axis
   for (const bool axis_u : {true, false}) {
     const std::size_t a = axis_u ? 0 : 1;
     if (in_n[a] < min_window_samples) continue;  // the arc does not pass a reversal of the axis
     const double ms_in = in_ss[a] / static_cast<double>(in_n[a]);
     if (ms_in < 2.0 * ms_out || std::sqrt(ms_in - ms_out) < 0.01) continue;
     const char axis = axis_u ? s.u : s.v;
-    Found f{.key = fmt::format("stick_slip_{}", axis),
-            .name = fmt::format("Stick-slip {} (rms, 1-{:g} deg from its reversals)", axis,
-                                s.window_deg),
-            .unit = "um",
-            .value = std::sqrt(ms_in - ms_out)};
-    for (std::size_t i = 0; i < traces.size(); ++i)
-      for (std::size_t j = 0; j < hp[i].size(); ++j) {
-        const double th = traces[i].theta_rad(j), d = axis_u ? from_u(th) : from_v(th);
-        f.contribution.push_back(d >= core && d <= window ? hp[i][j] : 0.0);
-      }
-    found.push_back(std::move(f));
+    found.push_back({.key = fmt::format("stick_slip_{}", axis),
+                     .name = fmt::format("Stick-slip {} (rms, 1-{:g} deg from its reversals)", axis,
+                                         s.window_deg),
+                     .unit = "um",
+                     .value = std::sqrt(ms_in - ms_out)});
+    of_u.push_back(axis_u);
+  }
+  // Each one's contribution: the high-passed residual in its axis' windows, 0 elsewhere. The
+  // last one takes hp's memory (8 bytes a sample: issue 32).
+  for (std::size_t f = 0; f < found.size(); ++f) {
+    std::vector<double> c = f + 1 == found.size() ? std::move(hp) : hp;
+    each_sample([&](std::size_t k, double th) {
+      const double d = of_u[f] ? from_u(th) : from_v(th);
+      if (!(d >= core && d <= window)) c[k] = 0.0;
+    });
+    found[f].contribution = std::move(c);
   }
   if (!found.empty())
     notes.push_back(

@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <numbers>
 #include <random>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "cal/analysis/circle.hpp"
+#include "cal/analysis/circle_records.hpp"
 
 namespace {
 
@@ -55,6 +57,24 @@ void BM_BallbarDiagnosticsPeriodSearch_2x36000(benchmark::State& state) {
 }
 BENCHMARK(BM_BallbarDiagnosticsPeriodSearch_2x36000)->Unit(benchmark::kMillisecond);
 
+// The two above with the fit's records rebuilt on every pass, as for a run of more than
+// fit_records_held_max_samples samples: what the bounded memory costs.
+void BM_BallbarDiagnosticsRebuilt_2x36000(benchmark::State& state) {
+  const auto t = traces();
+  const Setup setup{.radius_mm = 100, .feed_mm_per_min = 1047, .cyclic_period_mm = 10.0};
+  for (auto _ : state) benchmark::DoNotOptimize(analyse(setup, t, 0));
+  state.SetItemsProcessed(state.iterations() * 72'000);
+}
+BENCHMARK(BM_BallbarDiagnosticsRebuilt_2x36000)->Unit(benchmark::kMillisecond);
+
+void BM_BallbarDiagnosticsPeriodSearchRebuilt_2x36000(benchmark::State& state) {
+  const auto t = traces();
+  const Setup setup{.radius_mm = 100, .feed_mm_per_min = 1047};
+  for (auto _ : state) benchmark::DoNotOptimize(analyse(setup, t, 0));
+  state.SetItemsProcessed(state.iterations() * 72'000);
+}
+BENCHMARK(BM_BallbarDiagnosticsPeriodSearchRebuilt_2x36000)->Unit(benchmark::kMillisecond);
+
 // The floor of any fit of this model: one pass over the samples, each angle's cos and sin
 // and the deviation summed against them (the least a fit must do with every sample once).
 void BM_BallbarOnePassFloor_2x36000(benchmark::State& state) {
@@ -84,8 +104,9 @@ long status_kb(const std::string& key) {
 // the feed makes each trace last n / 10,000 s). The peak (VmHWM) is reset to the current RSS
 // (clear_refs 5) once the traces are made, so peak_MB is the process' whole footprint during
 // the analysis and analysis_B_per_sample what the analysis adds per sample beyond its input
-// (the traces, 16 bytes per sample).
-void BM_BallbarPeakRss(benchmark::State& state) {
+// (the traces, 16 bytes per sample). The fit's records are held as analyse(setup, traces)
+// holds them (for 2 n above fit_records_held_max_samples: rebuilt on every pass).
+void peak_rss(benchmark::State& state, std::size_t records_held_max_samples) {
   const int n = static_cast<int>(state.range(0));
   const auto t = traces(n);
   const double duration_s = n / 10'000.0;
@@ -96,7 +117,7 @@ void BM_BallbarPeakRss(benchmark::State& state) {
   for (auto _ : state) {
     std::ofstream("/proc/self/clear_refs") << "5";
     before_kb = status_kb("VmRSS");
-    benchmark::DoNotOptimize(analyse(setup, t));
+    benchmark::DoNotOptimize(analyse(setup, t, records_held_max_samples));
     peak_kb = status_kb("VmHWM");
   }
   state.counters["peak_MB"] = static_cast<double>(peak_kb) / 1024.0;
@@ -104,11 +125,15 @@ void BM_BallbarPeakRss(benchmark::State& state) {
       static_cast<double>(peak_kb - before_kb) * 1024.0 / (2.0 * n);
   state.SetItemsProcessed(state.iterations() * 2 * n);
 }
+void BM_BallbarPeakRss(benchmark::State& state) { peak_rss(state, fit_records_held_max_samples); }
 BENCHMARK(BM_BallbarPeakRss)
     ->Arg(36'000)
     ->Arg(360'000)
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
+// The same with every record held, as before issue 32's rebuilt records (the same results).
+void BM_BallbarPeakRssHeld(benchmark::State& state) { peak_rss(state, SIZE_MAX); }
+BENCHMARK(BM_BallbarPeakRssHeld)->Arg(360'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 // Six minutes of a 10 kHz circle (2 x 1.8 M samples): not in the suite's smoke run.
 void BM_BallbarPeakRssLong(benchmark::State& state) { BM_BallbarPeakRss(state); }
 BENCHMARK(BM_BallbarPeakRssLong)->Arg(1'800'000)->Iterations(1)->Unit(benchmark::kMillisecond);

@@ -39,8 +39,14 @@ void BallbarSegmenter::add(double v) {
   if (v > 0.5 * p_.feed_in_mm) saw_out_ = true, settle_count_ = 0;
   if (!saw_out_) return;
   if (std::abs(v) < 0.05 * p_.feed_in_mm) {
-    if (++settle_count_ >= static_cast<std::size_t>(0.05 * p_.sample_rate_hz) + 1)
+    if (++settle_count_ >= static_cast<std::size_t>(0.05 * p_.sample_rate_hz) + 1) {
       feed_in_end_ = values_.size() - settle_count_;
+      // Room for the dwells and arcs (and a second more) at once: grown by doubling, the
+      // samples' vector held up to twice their size, three times while it copied, beside the
+      // traces cut from it at the end (issue 32). Over 2 GB of samples it grows as before.
+      const double rest = (2 * p_.dwell_s + 2 * arc_duration_s() + 1.0) * p_.sample_rate_hz;
+      if (rest < 268435456.0) values_.reserve(*feed_in_end_ + static_cast<std::size_t>(rest));
+    }
   } else {
     settle_count_ = 0;
   }
