@@ -154,7 +154,8 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(not any(b.js(SHOWN, k) for k in BEAMS), "no beams in the form of a straightness test")
     for key, value in (("test.linear.measure", "angular"), ("test.linear.axis", "X"), ("test.linear.direction", "B")):
         ok(b.js(TYPE, key, value) == "ok", f"angular: typed {key} = {value}")
-    ok(all(b.js(SHOWN, k) for k in BEAMS), "an angular test's beams and their separation in the form")
+    ok(all(b.js(SHOWN, k) for k in BEAMS) and b.js(SHOWN, "test.linear.direction") and not b.js(SHOWN, "test.linear.square"),
+       "an angular test's beams and their separation and its direction in the form, no square")
     labels = b.js("return arguments[0].map(k => { const f = [...document.querySelectorAll('[data-field]')].find(x => x.dataset.field === k);"
                   " return f.querySelector('label').textContent + ' [' + (f.querySelector('.u') || {textContent: ''}).textContent + ']'; });",
                   list(BEAMS))
@@ -197,7 +198,8 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     shown_as_stored(shown, doc, "Roll (µrad)", "roll")
     ok(doc["kind"] == "roll" and doc["settings"]["measure"]["component"] == "E_AX",
        f"stored as a roll run of X: {doc['kind']} {doc['settings']['measure']}")
-    ok(not any(b.js(SHOWN, k) for k in BEAMS), "no beams in the form of a roll test")
+    ok(not any(b.js(SHOWN, k) for k in (*BEAMS, "test.linear.direction", "test.linear.square")),
+       "no beams, direction or square in the form of a roll test")
     stored = stored_stops(doc)
     ok(len(stored) == 6 and all(abs(v) < 1.0 for v in stored.values()), f"roll: no roll injected, none read: {stored}")
     captured = list(shown["captured"].values())
