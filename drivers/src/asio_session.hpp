@@ -12,6 +12,7 @@
 
 #include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/transport/transport.hpp"
+#include "reader_bytes.hpp"
 
 namespace cal::drivers::transport::detail {
 
@@ -24,13 +25,18 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   Session(Stream stream, std::string description)
       : stream_(std::move(stream)),
         description_(std::move(description)),
-        time_(VirtualTime::of(stream_.get_executor().context())) {}
+        time_(VirtualTime::of(stream_.get_executor().context())),
+        readers_(::cal::drivers::detail::ReaderBytes::of(stream_.get_executor().context())) {}
 
   Stream& stream() { return stream_; }
   const std::string& description() const { return description_; }
   bool active() const { return static_cast<bool>(on_data_); }
 
-  void start(Transport::Handlers handlers) {
+  // reader: this end's name in simulated time's accounting of a twin's bytes (its
+  // pseudo-terminal's path, "tcp:PORT" by our port; see reader_bytes.hpp).
+  void start(Transport::Handlers handlers, std::string reader) {
+    reader_ = std::move(reader);
+    if (readers_) readers_->opened(reader_);
     on_data_ = std::move(handlers.data);
     on_error_ = std::move(handlers.error);
     read_next();
@@ -52,6 +58,8 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   }
 
   void close() {
+    // What the twin sent us and we did not read is read by nobody: not waited for any more.
+    if (readers_ && !reader_.empty()) readers_->closed(reader_);
     on_data_ = nullptr;
     on_error_ = nullptr;
     queue_.clear();
@@ -76,7 +84,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   }
 
   void on_read(const boost::system::error_code& ec, std::size_t n) {
-    if (time_) time_->bytes_read(n);
+    if (readers_) readers_->read(n, reader_);
     if (!active()) return;  // closed while the read was in flight
     if (n > 0) on_data_(std::span<const std::byte>(buffer_.data(), n));
     if (!active()) return;  // the data handler closed us
@@ -103,6 +111,9 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   std::array<std::byte, 4096> buffer_{};
   std::deque<std::vector<char>> queue_;
   VirtualTime* time_;  // simulated mode only (see loop_time.hpp)
+  // Simulated mode only: the bytes our twin sent us (reader_bytes.hpp).
+  ::cal::drivers::detail::ReaderBytes* readers_;
+  std::string reader_;
 };
 
 }  // namespace cal::drivers::transport::detail

@@ -187,7 +187,7 @@ class SerialTransport final : public Transport {
       problem = "cannot open: " + ec.message();
     else
       problem = take(session_->stream().native_handle());
-    if (problem.empty()) return session_->start(std::move(handlers));
+    if (problem.empty()) return session_->start(std::move(handlers), settings_.device);
     // Reported from the event loop, like every other error, so callers see one code path.
     close();
     asio::post(io_, [on_error = std::move(handlers.error), message = describe() + ": " + problem] {

@@ -59,7 +59,8 @@ struct Connect : std::enable_shared_from_this<Connect> {
     boost::system::error_code ignored;
     // Requests are small and latency-bound (one JSON-RPC line per poll): no Nagle delay.
     session->stream().set_option(tcp::no_delay(true), ignored);
-    session->start(std::move(handlers));
+    const auto port = session->stream().local_endpoint(ignored).port();
+    session->start(std::move(handlers), fmt::format("tcp:{}", port));
   }
 
   void finish(ErrorKind kind, const std::string& what) {

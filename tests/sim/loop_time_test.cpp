@@ -9,8 +9,12 @@
 #include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <functional>
+#include <span>
+#include <string>
 #include <vector>
 
+#include "cal/drivers/transport/transport.hpp"
+#include "line_gauge/twin.hpp"
 #include "ptu300/instrument.hpp"
 #include "ptu300/twin.hpp"
 
@@ -140,6 +144,52 @@ TEST(VirtualTime, BytesNeverReadAreForgottenWhileWallClockWorkGoesOn) {
   ticker.cancel();
   EXPECT_TRUE(fired_while_ticking);
   EXPECT_EQ(time.stats().settle_timeouts, 1u);
+}
+
+// A driver that closes its port while its twin's answer is on the way (`daq serve --simulate`
+// closes every monitor when a set-up is applied, and a run closes those it opens itself) is
+// not waited for: the answer nobody will read no longer holds simulated time for kSettle (2 s
+// of wall time) before it is forgotten. Before, the answer stayed counted in flight: one
+// settle timeout, and the next timer fired 2 s of wall time later.
+TEST(VirtualTime, BytesToADriverThatClosedAreNotWaitedFor) {
+  boost::asio::io_context io;
+  auto& time = d::VirtualTime::install(io);
+  sim::World world = quiet_world();
+  sim::GaugeTwin twin(
+      io, world, [&time] { return time.now_s(); },
+      {.continuous = false, .request = "?", .value = [](const sim::World&) { return 0.5; }});
+  auto port =
+      t::make_serial(io, t::parse_serial_settings("115200 8N1", {.device = twin.device_path()}));
+  std::string received;
+  bool opened = false;
+  port->open({.opened = [&] { opened = true; },
+              .data =
+                  [&](std::span<const std::byte> b) {
+                    received.append(reinterpret_cast<const char*>(b.data()), b.size());
+                  }});
+  ASSERT_TRUE(time.run_for(1s, [&] { return opened; }));
+  const auto ask = [&] {
+    const std::string request = "?\r";
+    port->write(std::as_bytes(std::span(request)));
+  };
+  // One answer read as usual: the accounting of a reader that stays is unchanged.
+  ask();
+  ASSERT_TRUE(time.run_for(1s, [&] { return received.find('\n') != std::string::npos; }));
+  // Asked again, and closed as soon as the twin has answered (before the answer is read).
+  const auto sent = twin.lines_sent();
+  ask();
+  const std::int64_t give_up = steady_now_ns() + 10'000'000'000;
+  while (twin.lines_sent() == sent && steady_now_ns() < give_up) io.run_one_for(1ms);
+  ASSERT_EQ(twin.lines_sent(), sent + 1);
+  port->close();
+  d::Timer timer(io);
+  bool fired = false;
+  timer.expires_after(100ms);
+  timer.async_wait([&](const boost::system::error_code& ec) { fired = !ec; });
+  const std::int64_t start = steady_now_ns();
+  EXPECT_TRUE(time.run_for(1s, [&] { return fired; }));
+  EXPECT_EQ(time.stats().settle_timeouts, 0u);
+  EXPECT_LT(steady_now_ns() - start, 1'000'000'000);  // not kSettle (2 s)
 }
 
 TEST(VirtualTime, AnInstrumentPollsItsTwinOnSimulatedTimeAndStampsItsReadingsWithIt) {

@@ -8,9 +8,17 @@ driven in headless Chromium against `daq serve --simulate`:
 2. a straightness test of Y read in X typed in the form, applied and started (the laser on Y):
    the simulated indicator reads the machine's XY squareness (20 µm/m injected) across the
    travel, and the run is stored as `daq run linear` stores it (kind, component in its
-   settings): `daq model build` takes it for E_XY.
+   settings): `daq model build` takes it for E_XY;
+3. an angular test (pitch of X, two laser beams 80 mm apart in Z) and a roll test of X (the
+   level) from the form: the beams' fields only for the angular kind, checked at the field as
+   typed; each run stored with what was typed, the stops table under "Angular deviation (µrad)"
+   and "Roll (µrad)" with the stored values, the captured number in µrad (the shop injects no
+   rotation: each stop reads 0 within the noise);
+4. the kinds offered follow the form's instruments.
 
-Waits: up to 120 s for each run (6 stops at 20x on a loaded 2-core machine take some 20 s).
+What the page showed during a run is recorded in the page (a setInterval), not by WebDriver
+looks racing a 50x run. Waits: up to 120 s for each run (6 stops at 20x on a loaded 2-core
+machine take some 20 s; the angular and roll runs go at 50x).
 Usage: operator_page_kinds_test.py DAQ_BINARY SHOT_DIR
 """
 import json
@@ -51,16 +59,17 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     b.get(url)
     wait("return window.caldaq.page && window.caldaq.page.status.start.linear.ready;", "Start linear ready")
 
-    def run_kind(kind, axis, direction, what):
-        """Types a short test of KIND in the form, applies it and starts it from the Run view;
-        returns the stored run's id once it is complete."""
+    def run_kind(kind, axis, direction, what, extra=()):
+        """Types a short test of KIND in the form (and the fields EXTRA: (key, value) pairs),
+        applies it and starts it from the Run view; returns the stored run's id once it is
+        complete and what the page showed of its stops (recorded in the page)."""
         b.js("document.getElementById('tab-setup').click();")
         wait("return !!document.querySelector('[data-key=\"test.linear.measure\"]');", "the test kind in the form")
         offered = b.js("return [...document.querySelector('[data-key=\"test.linear.measure\"]').options].map(o => o.value);")
         ok(offered == ["", "positioning", "straightness", "angular", "roll"], f"the form offers the kinds: {offered}")
         for key, value in (("test.linear.measure", kind), ("test.linear.axis", axis), ("test.linear.direction", direction),
                            ("test.linear.last_mm", "100"), ("test.linear.runs", "1"),
-                           ("test.linear.stationary_mm", "200, 0, 150")):
+                           ("test.linear.stationary_mm", "200, 0, 150"), *extra):
             ok(b.js(TYPE, key, value) == "ok", f"{what}: typed {key} = {value}")
         # The instruments' cards keep the probe's role (they offered only the positioning roles:
         # the indicator's card lost it and the test its probe).
@@ -80,8 +89,13 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
         before = b.js("return (window.caldaq.page.status.last || {}).run || 0;")
         # What the stops table showed while the run ran, recorded in the page (a 20x run may
         # end between two WebDriver looks): its value column's head and each stop's value.
-        b.js("window.__stops = {head: '', rows: {}}; clearInterval(window.__stopsTimer);"
-             "window.__stopsTimer = setInterval(() => { const rows = document.querySelectorAll('#stops tbody tr');"
+        # The big number at CAPTURED too: its label names the stop, the number and unit are its own.
+        b.js("window.__stops = {head: '', rows: {}, captured: {}}; clearInterval(window.__stopsTimer);"
+             "window.__stopsTimer = setInterval(() => {"
+             " const m = /\\(stop ([0-9]+)\\)/.exec(document.getElementById('reading-label').textContent);"
+             " const v = document.getElementById('reading').textContent;"
+             " if (m && /^[-+]?[0-9]/.test(v)) window.__stops.captured[m[1]] = [v, document.getElementById('reading-unit').textContent];"
+             " const rows = document.querySelectorAll('#stops tbody tr');"
              " if (!rows.length) return; window.__stops.head = document.getElementById('stops-value').textContent;"
              " for (const r of rows) { const c = [...r.cells].map(x => x.textContent);"
              " if (/^[-+]?[0-9]/.test(c[5])) window.__stops.rows[c[0]] = [c[3], c[2], c[5]]; } }, 20);")
@@ -98,19 +112,25 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
         last = wait("const l = window.caldaq.page.status.last; return !window.caldaq.page.status.running && l && "
                     "l.run > %d && l;" % before, f"{what}: the run's end")
         ok(last["status"] == "complete" and last["test"] == "linear", f"{what}: complete: {last}")
-        return last["run"]
+        return last["run"], b.js("clearInterval(window.__stopsTimer); return window.__stops;")
+
+    def stored_stops(doc):
+        """A run's stored stop values by (target number, arrow) as the stops table names them."""
+        return {(s["target_index"] + 1, "↑" if s["direction"] == "up" else "↓"): s["deviation_um"] for s in doc["stops"]}
+
+    def shown_as_stored(shown, doc, head, what):
+        """The stops table's head was HEAD and each value it showed (2 decimals) is the stored one."""
+        stored = stored_stops(doc)
+        seen = [(int(t), d, float(v)) for t, d, v in shown["rows"].values()]
+        ok(shown["head"] == head and len(seen) >= 3 and all(abs(v - stored[(t, d)]) < 0.006 for t, d, v in seen),
+           f"{what}: the stops table showed each stop's value as stored under {head!r}: {shown['head']} {seen} {stored}")
 
     # --- 2. straightness of X read in Y ----------------------------------------------------
-    run = run_kind("straightness", "Y", "X", "straightness of Y in X")
+    run, shown = run_kind("straightness", "Y", "X", "straightness of Y in X")
     doc = get(url + f"api/runs/{run}")
     # The stops table showed the indicator's values (as stored), under their name and unit; it
     # showed the laser's positioning deviation under "Deviation (µm)" before.
-    shown = b.js("clearInterval(window.__stopsTimer); return window.__stops;")
-    stored = {(s["target_index"] + 1, "↑" if s["direction"] == "up" else "↓"): s["deviation_um"] for s in doc["stops"]}
-    seen = [(int(t), d, float(v)) for t, d, v in shown["rows"].values()]
-    ok(shown["head"] == "Straightness (µm)" and seen and
-       all(abs(v - stored[(t, d)]) < 0.006 for t, d, v in seen),
-       f"the stops table showed each stop's straightness value as stored: {shown['head']} {seen} {stored}")
+    shown_as_stored(shown, doc, "Straightness (µm)", "straightness")
     ok(doc["kind"] == "straightness" and doc["axis"] == "Y", f"stored as a straightness run of Y: {doc['kind']} {doc['axis']}")
     settings = doc["settings"]
     ok(settings["measure"]["component"] == "E_XY" and settings["measure"]["stationary_mm"] == [200, 0, 150],
@@ -124,11 +144,74 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     build = model_build(run)
     ok(build["used"].get("E_XY") == [run], f"`daq model build` takes run {run} for E_XY: {build['used']}")
 
-    # --- 3. the kinds follow the form's instruments, not the applied set-up -----------------
+    # --- 3. an angular test (pitch of X, E_BX) and a roll test (E_AX) from the form -----------
+    # The shop at 50x from here (the page's recorder, not WebDriver's looks, sees each stop).
+    status, _ = page_checks.post(url + "api/simulation/speed", {"speed": 50})
+    ok(status == 200, f"the simulated shop at 50x: {status}")
+    b.js("document.getElementById('tab-setup').click();")
+    SHOWN = "const f = [...document.querySelectorAll('[data-field]')].find(x => x.dataset.field === arguments[0]); return !!f && !f.hidden;"
+    BEAMS = ("test.linear.beams", "test.linear.separation_mm")
+    ok(not any(b.js(SHOWN, k) for k in BEAMS), "no beams in the form of a straightness test")
+    for key, value in (("test.linear.measure", "angular"), ("test.linear.axis", "X"), ("test.linear.direction", "B")):
+        ok(b.js(TYPE, key, value) == "ok", f"angular: typed {key} = {value}")
+    ok(all(b.js(SHOWN, k) for k in BEAMS) and b.js(SHOWN, "test.linear.direction") and not b.js(SHOWN, "test.linear.square"),
+       "an angular test's beams and their separation and its direction in the form, no square")
+    labels = b.js("return arguments[0].map(k => { const f = [...document.querySelectorAll('[data-field]')].find(x => x.dataset.field === k);"
+                  " return f.querySelector('label').textContent + ' [' + (f.querySelector('.u') || {textContent: ''}).textContent + ']'; });",
+                  list(BEAMS))
+    ok(labels == ["Laser axes of beam a and beam b (0, 1, 2) []", "Beam a's reflector from beam b's, across the travel [mm]"],
+       f"labelled in words, the separation in mm: {labels}")
+    # The error shown at the field of KEY once it says NEEDLE (arguments: key, needle).
+    BAD = ("const f = [...document.querySelectorAll('[data-field]')].find(x => x.dataset.field === '%s');"
+           " const t = f.classList.contains('bad') && f.querySelector('.err').textContent; return t && t.includes('%s') && t;")
+    # Checked as typed, at the field: the loader's (no separation), the kind's (one along the
+    # travel sees no pitch), the laser's (it reads axis 0 only).
+    err = wait(BAD % ("test.linear.separation_mm", "separation"), "no separation named at its field")
+    ok("needs the separation" in err, f"angular: an angular test needs its separation: {err}")
+    ok(b.js(TYPE, "test.linear.separation_mm", "0, 100, 0") == "ok", "typed a separation across Y")
+    err = wait(BAD % ("test.linear.separation_mm", "apart along"), "a separation that sees no pitch named at its field")
+    ok("apart along Z" in err, f"angular: X about B is seen by beams apart along Z: {err}")
+    ok(b.js(TYPE, "test.linear.separation_mm", "0, 0, 80") == "ok" and b.js(TYPE, "test.linear.beams", "2, 1") == "ok",
+       "typed beams 2, 1 and 80 mm apart in Z")
+    err = wait(BAD % ("test.linear.beams", "axis"), "beams the laser does not read named at their field")
+    ok("does not read axis" in err, f"angular: the laser reads only axis 0: {err}")
+    status = b.js("return document.getElementById('setup-status').textContent;")
+    ok("linear test cannot start" in status, f"angular: not called valid beside the field in red: {status!r}")
+    page_checks.shot(b, SHOTS, "k-angular-beams-1366x768.png")
+    run, shown = run_kind("angular", "X", "B", "pitch of X",
+                          (("test.linear.beams", "2, 1"), ("test.linear.separation_mm", "0, 0, 80"), ("devices.laser.axes", "0, 1, 2")))
+    doc = get(url + f"api/runs/{run}")
+    shown_as_stored(shown, doc, "Angular deviation (µrad)", "angular")
+    measure = doc["settings"]["measure"]
+    ok(doc["kind"] == "angular" and measure["component"] == "E_BX" and measure["beams"] == [2, 1]
+       and measure["separation_mm"] == [0, 0, 80],
+       f"the run used the beams and separation typed: {doc['kind']} {measure}")
+    # The shop injects no rotation (its truth: squareness and servo errors): each stop reads 0
+    # within the noise; the captured number is the stop's own, in µrad.
+    stored = stored_stops(doc)
+    ok(len(stored) == 6 and all(abs(v) < 1.0 for v in stored.values()), f"angular: no pitch injected, none read: {stored}")
+    captured = list(shown["captured"].values())
+    ok(captured and all(u == "µrad" for _, u in captured), f"angular: the captured stop's number in µrad: {captured}")
+
+    run, shown = run_kind("roll", "X", "", "roll of X")
+    doc = get(url + f"api/runs/{run}")
+    shown_as_stored(shown, doc, "Roll (µrad)", "roll")
+    ok(doc["kind"] == "roll" and doc["settings"]["measure"]["component"] == "E_AX",
+       f"stored as a roll run of X: {doc['kind']} {doc['settings']['measure']}")
+    ok(not any(b.js(SHOWN, k) for k in (*BEAMS, "test.linear.direction", "test.linear.square")),
+       "no beams, direction or square in the form of a roll test")
+    stored = stored_stops(doc)
+    ok(len(stored) == 6 and all(abs(v) < 1.0 for v in stored.values()), f"roll: no roll injected, none read: {stored}")
+    captured = list(shown["captured"].values())
+    ok(captured and all(u == "µrad" for _, u in captured), f"roll: the captured stop's number in µrad: {captured}")
+
+    # --- 4. the kinds follow the form's instruments, not the applied set-up -----------------
     # The level removed in the form (not applied): roll is no longer offered (the kinds came
     # from the applied set-up and still offered it); the Run view names the unapplied edit.
     b.js("document.getElementById('tab-setup').click();")
     wait("return !!document.querySelector('[data-key=\"test.linear.measure\"]');", "the form again")
+    # (a positioning test chosen: the roll test just run would stay offered, as chosen)
+    ok(b.js(TYPE, "test.linear.measure", "positioning") == "ok", "typed test.linear.measure = positioning")
     b.js("const card = [...document.querySelectorAll('.device-card')].find(c => c.querySelector('[data-device-id]').value === 'level');"
          "card.querySelector('button.stop').click();")
     offered = wait("const c = window.caldaq.check; const o = [...document.querySelector('[data-key=\"test.linear.measure\"]').options]"

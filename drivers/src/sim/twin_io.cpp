@@ -41,15 +41,17 @@ void LineServer::start(std::function<void(const ClientPtr&, const std::string&)>
 }
 
 void LineServer::accept() {
-  acceptor_.async_accept(
-      [self = shared_from_this()](const boost::system::error_code& ec, tcp::socket socket) {
-        if (ec || self->closed_) return;  // acceptor closed
-        auto client = std::make_shared<Client>(std::move(socket));
-        self->clients_.push_back(client);
-        if (self->on_connect_) self->on_connect_(client);
-        self->read(client);
-        self->accept();
-      });
+  acceptor_.async_accept([self = shared_from_this()](const boost::system::error_code& ec,
+                                                     tcp::socket socket) {
+    if (ec || self->closed_) return;  // acceptor closed
+    auto client = std::make_shared<Client>(std::move(socket));
+    boost::system::error_code ignored;
+    client->writer.reader = fmt::format("tcp:{}", client->socket.remote_endpoint(ignored).port());
+    self->clients_.push_back(client);
+    if (self->on_connect_) self->on_connect_(client);
+    self->read(client);
+    self->accept();
+  });
 }
 
 void LineServer::read(const ClientPtr& client) {
@@ -129,6 +131,7 @@ PtyDevice::PtyDevice(asio::io_context& io) : master(io) {
   tcsetattr(m, TCSANOW, &raw);
   master.assign(m);
   path = name.data();
+  writer.reader = path;
 }
 
 PtyDevice::~PtyDevice() { unplug(); }

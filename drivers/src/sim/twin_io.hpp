@@ -15,6 +15,7 @@
 
 #include "cal/drivers/loop_time.hpp"
 #include "cal/drivers/sim/twin.hpp"
+#include "reader_bytes.hpp"
 
 namespace cal::drivers::sim::detail {
 
@@ -30,17 +31,20 @@ struct LineWriter {
   static constexpr std::size_t max_queued = 1 << 16;
   std::deque<std::string> queue;
   std::uint64_t dropped = 0;
-  // Simulated mode: the bytes count as in flight until the driver reads them (loop_time.hpp).
-  VirtualTime* time = nullptr;
+  // Simulated mode: the bytes count as in flight until the driver reads them, while it is open
+  // (reader_bytes.hpp); the driver named by `reader`: the pseudo-terminal's path, or
+  // "tcp:PORT" by the client's port.
+  ::cal::drivers::detail::ReaderBytes* time = nullptr;
   bool looked_up = false;
+  std::string reader;
   void send(Stream& s, std::string line, std::shared_ptr<void> keep_alive) {
     if (queue.size() >= max_queued) {
       ++dropped;
       return;
     }
-    if (!looked_up) time = VirtualTime::of(s.get_executor().context());
+    if (!looked_up) time = ::cal::drivers::detail::ReaderBytes::of(s.get_executor().context());
     looked_up = true;
-    if (time) time->bytes_written(line.size());
+    if (time) time->written(line.size(), reader);
     queue.push_back(std::move(line));
     if (queue.size() == 1) next(s, std::move(keep_alive));
   }
@@ -49,7 +53,7 @@ struct LineWriter {
                       [this, &s, keep_alive](const boost::system::error_code& ec, std::size_t) {
                         if (ec) {  // what was not written never arrives
                           if (time)
-                            for (const auto& q : queue) time->bytes_read(q.size());
+                            for (const auto& q : queue) time->read(q.size(), reader);
                           return queue.clear();
                         }
                         queue.pop_front();
