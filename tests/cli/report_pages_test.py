@@ -307,8 +307,15 @@ check("settings appendix: the standard and the equation by their names",
       lin_settings.get("Standard") == "ISO 230-2:2014"
       and lin_settings.get("Refractive index equation") == "Ciddor (1996)"
       and "iso230-2:2014" not in lin and "ciddor" not in lin, str(lin_settings))
-check("circle settings appendix: the standard by its name",
-      appendix("circle").get("Standard") == "ISO 230-4:2005", str(appendix("circle")))
+check("circle settings appendix: the standard by its name, an angle as 360°",
+      appendix("circle").get("Standard") == "ISO 230-4:2005"
+      and appendix("circle").get("Arc") == "360°", str(appendix("circle")))
+# The analysis's notes as sentences; the uncalibrated bar said once, by the Bar calibration section
+# (its note, "uncalibrated bar: the radius error is fitted but not reported", stood above it).
+circle_words = " ".join(text["circle"])
+check("circle: notes as sentences, the uncalibrated bar said once",
+      "uncalibrated bar:" not in circle_words and "vibration:" not in circle_words
+      and "The radius error is not evaluated" in circle_words, circle_words[-3000:])
 check("appendix after the results",
       lin.index("Appendix: settings") > lin.index("Measurement uncertainty"), "")
 

@@ -466,7 +466,8 @@ std::string setting_value(const json& val, std::string_view unit) {
   // A unit as a value (measure.unit = "um") as documents print it (µm).
   const std::string text =
       esc(val.is_string() ? ::daq::unit_html(val.get<std::string>()) : setting_text(val));
-  return unit.empty() ? text : text + " " + esc(unit);
+  // A plane angle's degree sign follows the number without a space (360°, not 360 °).
+  return unit.empty() ? text : text + (unit == "°" ? "" : " ") + esc(unit);
 }
 
 // The settings as recorded at the start, as an appendix: labels and units, only the keys that
@@ -1557,7 +1558,15 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
       "deviation that error alone causes on this circle. A limit applies to the magnitude of "
       "the value, in its unit.</p>\n",
       r.iso.G_bi_um);
-  for (const auto& n : r.notes) d += "<p class=\"note\">" + esc(n) + "</p>\n";
+  // The analysis's notes ("vibration: ...") as sentences, their subject capitalised; not the
+  // uncalibrated bar's, which the Bar calibration section right under it says in full.
+  for (const auto& n : r.notes) {
+    if (n.starts_with("uncalibrated bar:")) continue;
+    std::string note = n;
+    if (!note.empty() && note[0] >= 'a' && note[0] <= 'z')
+      note[0] = static_cast<char>(note[0] - 32);
+    d += "<p class=\"note\">" + esc(note) + "</p>\n";
+  }
   d += bar_calibration_section(c, v);
   d += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>The error model leaves a residual of {:.3f} µm rms "
