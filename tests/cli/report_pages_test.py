@@ -287,6 +287,15 @@ for name in reports:
     words = html_mod.unescape(re.sub(r"<[^>]+>", " ", body))
     found = re.findall(r".{30}\b(?:um|um/m|urad|degC)\b", words)
     check(f"{name}: µm and °C, not um or degC", not found, str(found[:3]))
+# The instruments' calibration by their names, once: "role | device | instrument" read
+# "air | air | ptu300".
+calib = open("linear.html", encoding="utf-8").read()
+calib = calib[calib.index("Instruments and calibration"):]
+calib = calib[:calib.index("</table>")]
+check("instruments and calibration: each by its name, then model",
+      [html_mod.unescape(c) for c in re.findall(r"<th>(.*?)</th>", calib)]
+      == ["instrument", "model", "serial number", "certificate", "calibration due"]
+      and re.findall(r"<tr><td>(.*?)</td><td>", calib) == ["air", "laser", "material"], calib)
 # The settings: an appendix with labels and units, no raw keys, no empty values.
 lin = " ".join(text["linear"])
 # The appendix read from the HTML, label by value (pdftotext may read a two-column table's cells

@@ -626,15 +626,20 @@ std::string instruments_section(const RunView& v) {
     std::string due_cell = stated(due);
     if (!due.empty() && due < test_day)
       due_cell = "<span class=\"fail\">" + esc(due) + " &mdash; PAST DUE</span>";
-    rows.push_back({esc(ctx(i, "role")), esc(ctx(i, "id")), esc(ctx(i, "driver")),
-                    stated(ctx(i, "serial_number")), stated(ctx(i, "certificate")), due_cell});
+    // The instrument by the name the Instruments table and the plots' legends give it, its
+    // role only where it differs ("air | air | ptu300" said the name twice).
+    const std::string id = ctx(i, "id"), role = ctx(i, "role");
+    rows.push_back({esc(id.empty() ? role : id) +
+                        (role.empty() || role == id || id.empty() ? "" : " (" + esc(role) + ")"),
+                    esc(ctx(i, "driver")), stated(ctx(i, "serial_number")),
+                    stated(ctx(i, "certificate")), due_cell});
   }
   return h +
-         table({"role", "device", "instrument", "serial number", "certificate", "calibration due"},
-               rows);
+         table({"instrument", "model", "serial number", "certificate", "calibration due"}, rows);
 }
 
-// The gaps in the traceability of the readings, one warning per instrument: a calibration due
+// The gaps in the traceability of the readings, a warning per instrument or per gap shared by
+// several: a calibration due
 // before the test day, or a serial number, certificate or due date not stated. Without them a
 // reader cannot tell whether the instrument was calibrated when it measured.
 std::vector<std::string> traceability_gaps(const RunView& v) {
