@@ -227,11 +227,19 @@ check("vdi3441: the failing value as the table prints it",
       re.search(r"U max = [0-9.]+ µm \(limit ≤", v1) is not None
       and re.search(r"[0-9.]+ largest reversal span", v1) is not None, v1)
 check("vdi3441: main plot on page one", "Mean positional deviation with ±2s" in v1, v1)
+# The title names the standard the page is evaluated by (it said ISO 230-2).
+check("vdi3441: the title names VDI/DGQ 3441",
+      "Run 1: Positioning test (VDI/DGQ 3441:1977), axis X" in v1
+      and "Positioning test (ISO 230-2)" not in " ".join(text["vdi3441"]), v1[:300])
 check("run quality says its state once",
       all("ok — ok" not in p and "ok - ok" not in p for n in text for p in text[n]), "")
 check("suspect: SUSPECT RUN on page one with its stop",
       "SUSPECT RUN" in text["suspect"][0] and "run 2 ↑ target 4" in text["suspect"][0],
       text["suspect"][0])
+# Each suspect stop said once: "run 2 ↑ target 4: run 2 up at 149.024 mm: ..." named it twice.
+check("suspect: the stop named once, with its position",
+      re.search(r"run 2 ↑ target 4 \(149\.024 mm\): \+[0-9.]+ µm from the median", text["suspect"][0])
+      is not None and "run 2 up at" not in text["suspect"][0], text["suspect"][0])
 check("linear (clean): no SUSPECT", all("SUSPECT RUN" not in p for p in text["linear"]), "")
 c1 = text["circle"][0]
 check("circle: main table on page one", "symbol and meaning" in c1
@@ -261,6 +269,14 @@ check("circle: a failing error with a negative gain is explained",
       re.search(r"Backlash X is outside its limit, but correcting it alone would make G [0-9.]+ "
                 r"µm larger: it partly offsets [^.]*Servo mismatch", circle_all) is not None,
       circle_all[:3000])
+# The details' diagnostics give each limit in its unit (a squareness's µm/m beside a backlash's
+# µm under one head without any).
+details_diag = cells(circle_html.split("Details of the results")[1], "num diag")
+limits = [r[6] for r in details_diag if r[6]]
+check("circle details: each limit in its unit",
+      len(limits) >= 2 and all(re.match(r"≤ [0-9.]+ (µm|µm/m|ms|µrad) (pass|FAIL)$", c)
+                               for c in limits)
+      and any("µm/m" in c for c in limits), str(limits))
 check("circle: then the largest gain", re.search(r"2 Cyclic error X", circle_all) is not None, "")
 check("no -0.000 anywhere", all("-0.000" not in p for n in text for p in text[n]), "")
 # Documents print µm, °C (the terminal keeps um, degC): no unit word of the terminal in any
@@ -271,12 +287,44 @@ for name in reports:
     words = html_mod.unescape(re.sub(r"<[^>]+>", " ", body))
     found = re.findall(r".{30}\b(?:um|um/m|urad|degC)\b", words)
     check(f"{name}: µm and °C, not um or degC", not found, str(found[:3]))
+# The instruments' calibration by their names, once: "role | device | instrument" read
+# "air | air | ptu300".
+calib = open("linear.html", encoding="utf-8").read()
+calib = calib[calib.index("Instruments and calibration"):]
+calib = calib[:calib.index("</table>")]
+check("instruments and calibration: each by its name, then model",
+      [html_mod.unescape(c) for c in re.findall(r"<th>(.*?)</th>", calib)]
+      == ["instrument", "model", "serial number", "certificate", "calibration due"]
+      and re.findall(r"<tr><td>(.*?)</td><td>", calib) == ["air", "laser", "material"], calib)
 # The settings: an appendix with labels and units, no raw keys, no empty values.
 lin = " ".join(text["linear"])
+# The appendix read from the HTML, label by value (pdftotext may read a two-column table's cells
+# out of their rows).
+def appendix(name):
+    html = open(f"{name}.html", encoding="utf-8").read()
+    return {row[0]: row[1] for row in cells(html.split("Appendix: settings of the run")[1], "kv")}
+
+
+lin_settings = appendix("linear")
 check("settings appendix with labels",
-      "Appendix: settings of the run" in lin and "Expansion coefficient 11.5 ppm/K" in lin, lin[-2000:])
+      "Appendix: settings of the run" in lin
+      and lin_settings.get("Expansion coefficient") == "11.5 ppm/K", str(lin_settings))
 check("no raw setting keys", "machine_model.topology" not in lin and "probe_offset_mm" not in lin,
       "")
+# Values that are keys, as the reader knows them: the standard's title, the equation's name.
+check("settings appendix: the standard and the equation by their names",
+      lin_settings.get("Standard") == "ISO 230-2:2014"
+      and lin_settings.get("Refractive index equation") == "Ciddor (1996)"
+      and "iso230-2:2014" not in lin and "ciddor" not in lin, str(lin_settings))
+check("circle settings appendix: the standard by its name, an angle as 360°",
+      appendix("circle").get("Standard") == "ISO 230-4:2005"
+      and appendix("circle").get("Arc") == "360°", str(appendix("circle")))
+# The analysis's notes as sentences; the uncalibrated bar said once, by the Bar calibration section
+# (its note, "uncalibrated bar: the radius error is fitted but not reported", stood above it).
+circle_words = " ".join(text["circle"])
+check("circle: notes as sentences, the uncalibrated bar said once",
+      "uncalibrated bar:" not in circle_words and "vibration:" not in circle_words
+      and "The radius error is not evaluated" in circle_words, circle_words[-3000:])
 check("appendix after the results",
       lin.index("Appendix: settings") > lin.index("Measurement uncertainty"), "")
 
@@ -334,6 +382,55 @@ for name in reports:
     # the whole page at about 5 pt).
     check(f"{name}: printed at full size", title_height_pt(f"{name}.pdf") > 15,
           f"{title_height_pt(name + '.pdf'):.1f} pt")
+# --- every plot's legend inside its canvas ---------------------------------------------------
+def edge_lines(html):
+    """(plot, x) of each line drawn at the left or right edge of a plot's canvas, other than the
+    canvas's own background: the legend's box, wider than the plot, ran past the canvas, which
+    cut it there (three columns of "x̄↑ ± 2s" under the main plot lost the box's right side;
+    "counter-clockwise", "clockwise" under the polar plot both sides)."""
+    found = []
+    for m in re.finditer(r'<svg[^>]*aria-label="([^"]*)"(.*?)</svg>', html, re.S):
+        width = float(re.search(r'viewBox="0 0 ([0-9.]+) ', m.group(0)).group(1))
+        for pts in re.findall(r'points="([^"]*)"', m.group(2)):
+            xy = [tuple(float(c) for c in p.split(",")) for p in pts.split()]
+            xs, ys = [x for x, _ in xy], [y for _, y in xy]
+            if min(xs) <= 0.01 and min(ys) <= 0.01:  # the background, the whole canvas
+                continue
+            found += [(html_mod.unescape(m.group(1)), x) for x in xs
+                      if x <= 0.5 or x >= width - 0.5]
+    return found
+
+
+for name in reports:
+    edges = edge_lines(open(f"{name}.html", encoding="utf-8").read())
+    check(f"{name}: every legend inside its plot", not edges, str(sorted(set(edges))[:6]))
+
+
+# --- no page left nearly empty before the last ----------------------------------------------
+def page_fill(pdf):
+    """How far down each page its text reaches, as a share of the page's height, without the
+    running header and the footer (in the margins)."""
+    out = subprocess.run(["pdftotext", "-bbox", pdf, "-"], capture_output=True, text=True,
+                         check=True).stdout
+    fills = []
+    for _, height, body in re.findall(r'<page width="([0-9.]+)" height="([0-9.]+)">(.*?)</page>',
+                                      out, re.S):
+        h = float(height)
+        ys = [float(y) / h for y in re.findall(r'yMax="([0-9.]+)"', body)]
+        fills.append(max([y for y in ys if 0.05 < y < 0.95], default=0.0))
+    return fills
+
+
+# A circle's page one overflowed by the three lines under "What to fix first", and the details'
+# page break left them alone on page two.
+for name in ("linear", "vdi3441", "suspect", "circle"):
+    fills = page_fill(f"{name}.pdf")
+    check(f"{name}: no page but the last less than half full",
+          len(fills) >= 2 and all(f > 0.5 for f in fills[:-1]),
+          " ".join(f"{f:.2f}" for f in fills))
+check("circle: the details follow what to fix first on page two",
+      "Details of the results" in text["circle"][1], text["circle"][1][:300])
+
 check("as found / as left: each run's report starts on a page of its own",
       "As found: SIMULATED" not in text["asfound"][0], text["asfound"][0][-300:])
 
@@ -421,7 +518,7 @@ con.close()
 daq("report", "1", "--db", "gaps.sqlite", "--format", "pdf", "-o", "gaps.pdf")
 g1 = squash(pages("gaps.pdf")[0])
 check("traceability: a missing certificate and due date warned on page one",
-      "Traceability: laser: no certificate, calibration due date stated" in g1, g1[:1500])
+      "Traceability: laser: no certificate or calibration due date stated" in g1, g1[:1500])
 
 # --- other runs (an imported .rtx): the plots name the quantity and its unit, not its key -------
 with open("lin.rtx", "wb") as f:
@@ -581,6 +678,25 @@ for kind, (run, run_out) in profile_runs.items():
               "No tolerance configured" in p1 and "angular_urad under [tolerances.X]" in p1
               and verdict["summary"] == "no tolerance configured", p1)
     check(f"{kind}: nothing past the right margin", not words_beyond_margin(f"{kind}.pdf"), "")
+    html_text = open(f"{kind}.html", encoding="utf-8").read()
+    check(f"{kind}: every legend inside its plot", not edge_lines(html_text),
+          str(edge_lines(html_text)[:4]))
+    if kind == "straightness":
+        # The instruments by name, model and connection: the acquisition's device numbers
+        # (0, 1, 2, 4: the unused device 3 a gap) meant nothing to the reader.
+        inst = html_text[html_text.index("<h4>Instruments</h4>"):]
+        inst = inst[:inst.index("</table>")]
+        head = [html_mod.unescape(re.sub(r"<[^>]+>", "", c)) for c in
+                re.findall(r"<th>(.*?)</th>", inst)]
+        first = [re.sub(r"<[^>]+>", "", c) for c in re.findall(r"<tr><td>(.*?)</td>", inst)]
+        check("straightness: the instruments by name, not device number",
+              head == ["instrument", "model and serial number", "connection"]
+              and first == ["laser", "air", "material", "indicator"], f"{head} {first}")
+        # The same gaps of several instruments in one warning, in words ("or", not a list).
+        check("straightness: one traceability warning for the instruments lacking the same",
+              re.search(r"Traceability: (\w+, ){3}\w+: no serial number, certificate or "
+                        r"calibration due date stated\.", p1) is not None
+              and p1.count("Traceability:") == 1, p1[:1200])
 
 print(f"{fails} failed" if fails else "all passed")
 sys.exit(1 if fails else 0)

@@ -140,6 +140,22 @@ struct LegendEntry {
   double width = 1.5;
 };
 
+// How many columns of legend entries fit under a viewport `viewport_pt` wide. PLplot makes each
+// column as wide as its estimate of the longest label, which grows with the label's bytes of
+// UTF-8, not its characters ("x̄↑ ± 2s" is 7 characters in 12 bytes): measured on the SVGs,
+// about 0.66 of a character's height per byte plus 4 for the text's offset and spacing. Then
+// the line sample, 0.05 of the viewport (the plot_width draw_legend passes). Counted in
+// characters and without the sample, three columns ran past the canvas, which cut the box's
+// right edge off. Some room for the box's own margins.
+PLINT legend_columns(std::size_t labelled, std::size_t longest_bytes, double viewport_pt,
+                     double char_pt, std::size_t most) {
+  if (labelled == 0) return 0;
+  const double column_pt =
+      0.66 * char_pt * static_cast<double>(longest_bytes + 4) + 0.05 * viewport_pt;
+  const auto fit = static_cast<std::size_t>(std::max(0.0, viewport_pt - char_pt) / column_pt);
+  return static_cast<PLINT>(std::clamp<std::size_t>(fit, 1, std::min(labelled, most)));
+}
+
 // `columns` 0: one column; `y` the offset from the position, in the viewport's height.
 // text_scale: the legend's text against PLplot's default size (pllegend does not follow plschr).
 void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
@@ -234,41 +250,20 @@ std::string svg(const XyChart& chart) {
   // The legend goes below the plot, in as many columns of the longest label as fit the width:
   // to the right it took a quarter of the width and clipped long instrument names. The page
   // grows by its rows, so the plot keeps its height.
-  // Lengths in characters, not bytes: "x̄↑ ± 2s" is 7 characters in 12 bytes of UTF-8.
-  const auto characters = [](const std::string& s) {
-    return static_cast<std::size_t>(
-        std::count_if(s.begin(), s.end(), [](char c) { return (c & 0xC0) != 0x80; }));
-  };
   std::size_t labelled = 0, longest = 0;
   for (const auto& l : chart.lines)
-    if (!l.label.empty()) ++labelled, longest = std::max(longest, characters(l.label));
+    if (!l.label.empty()) ++labelled, longest = std::max(longest, l.label.size());
   for (const auto& b : chart.bands)
-    if (!b.label.empty()) ++labelled, longest = std::max(longest, characters(b.label));
+    if (!b.label.empty()) ++labelled, longest = std::max(longest, b.label.size());
   const double char_pt = 13.0 * chart.text_scale;
-  const auto columns = static_cast<PLINT>(
-      legend ? std::clamp<std::size_t>(static_cast<std::size_t>(chart.width_pt / (char_pt * 0.62) /
-                                                                static_cast<double>(longest + 6)),
-                                       1, std::min<std::size_t>(labelled, 4))
-             : 0);
-  const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
-  const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
-  const double total_pt = chart.height_pt + legend_pt;
-  SvgStream s(chart.width_pt, static_cast<int>(total_pt));
-  plschr(0, 1.05 * chart.text_scale);
-  // Room on every side: no point or marker sits on the frame.
-  const Range xr = x.empty() ? Range{0, 1}
-                   : !chart.x_labels.empty()
-                       ? Range{-0.5, static_cast<double>(chart.x_labels.size()) - 0.5}
-                       : x.padded(0.04);
+  // Room on the left for the widest tick label and the axis label beyond it ("1006.8" needs
+  // more than "2"): the label is placed past the ticks, never over them.
   Range yr = y.padded(0.08);
   if (chart.min_y_span > 0 && !y.empty() && yr.hi - yr.lo < chart.min_y_span) {
     const double mid = (y.lo + y.hi) / 2;  // the data in the middle of the span asked for
     yr = {mid - chart.min_y_span / 2, mid + chart.min_y_span / 2};
   }
-  const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
   const auto [ystep, ydigits] = ticks_for(yr.hi - yr.lo, 6);
-  // Room on the left for the widest tick label and the axis label beyond it ("1006.8" needs
-  // more than "2"): the label is placed past the ticks, never over them.
   const std::size_t tick_chars = std::max(fmt::format("{:.{}f}", yr.lo, ydigits).size(),
                                           fmt::format("{:.{}f}", yr.hi, ydigits).size());
   const double label_disp = 0.8 * static_cast<double>(tick_chars) + 1.6;  // character heights
@@ -279,6 +274,20 @@ std::string svg(const XyChart& chart) {
       chart.y_label.empty()
           ? (0.62 * static_cast<double>(tick_chars) + 1.2) * 0.52 * char_pt / chart.width_pt + 0.01
           : std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
+  // The legend as wide as the plot's frame at most (it is centred under it).
+  const PLINT columns =
+      legend ? legend_columns(labelled, longest, (0.97 - left) * chart.width_pt, char_pt, 4) : 0;
+  const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
+  const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
+  const double total_pt = chart.height_pt + legend_pt;
+  SvgStream s(chart.width_pt, static_cast<int>(total_pt));
+  plschr(0, 1.05 * chart.text_scale);
+  // Room on every side: no point or marker sits on the frame.
+  const Range xr = x.empty() ? Range{0, 1}
+                   : !chart.x_labels.empty()
+                       ? Range{-0.5, static_cast<double>(chart.x_labels.size()) - 0.5}
+                       : x.padded(0.04);
+  const auto [xstep, xdigits] = ticks_for(xr.hi - xr.lo, 6);
   const double bottom =
       ((chart.x_label.empty() && !legend ? 1.35 : 4.0) * char_pt + legend_pt) / total_pt;
   const double top = 1.0 - (chart.x_label.empty() && !legend ? 1.6 : 2.2) * char_pt / total_pt;
@@ -393,17 +402,17 @@ std::string svg(const PolarChart& chart) {
   // on the angle labels.
   const auto labelled = std::count_if(chart.traces.begin(), chart.traces.end(),
                                       [](const Line& l) { return !l.label.empty(); });
-  // As many columns of the longest label as fit the width (about 60 characters), up to 3.
   std::size_t longest = 0;
   for (const auto& t : chart.traces) longest = std::max(longest, t.label.size());
-  const auto fit = static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(
-      static_cast<std::size_t>(66 / chart.text_scale) / (longest + 6), 1, 3));
-  const PLINT columns = static_cast<PLINT>(std::min<std::ptrdiff_t>(labelled, fit));
-  const int rows = columns > 0 ? static_cast<int>((labelled + columns - 1) / columns) : 0;
   // PLplot's text grows with the canvas: about 11 pt on 400 pt, times text_scale.
   const double char_pt = 11.0 * chart.size_pt / 400.0 * chart.text_scale;
   const double width = chart.size_pt, side = 0.88 * width,
                top = std::max(0.07 * width, 2.4 * char_pt);
+  // As many columns of the longest label as fit under the plot, up to 3 (two of
+  // "counter-clockwise" beside a table ran past both sides of the canvas).
+  const PLINT columns =
+      legend_columns(static_cast<std::size_t>(labelled), longest, side, char_pt, 3);
+  const int rows = columns > 0 ? static_cast<int>((labelled + columns - 1) / columns) : 0;
   // Under the plot: two lines (the rings' scale and the nominal one, the start marks), then the
   // legend's rows.
   const int notes = chart.mark_start ? 2 : 1;

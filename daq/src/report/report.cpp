@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "ballbar_campaign.hpp"
+#include "cal/analysis/air.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/analysis/squareness.hpp"
@@ -239,17 +240,41 @@ std::vector<Line> lines_of(const std::vector<Series>& series, std::size_t first_
 // --- sections shared by every kind ---------------------------------------------------------------
 
 // "Positioning test (ISO 230-2), axis X".
-std::string test_name(const RunView& v) {
+// The standard a positioning test is reported by, as its title names it: "ISO 230-2" for every
+// edition, else the one asked for (`daq report -s vdi3441`: the title said ISO 230-2 over a page
+// evaluated by VDI/DGQ 3441).
+// An unknown key is named by the results' own error, not here.
+std::string positioning_standard(std::string_view standard_key) {
+  if (standard_key.empty()) return "ISO 230-2";
+  try {
+    const std::string_view title =
+        cal::iso230_2::info(cal::iso230_2::standard_from_string(standard_key)).title;
+    return title.starts_with("ISO 230-2") ? "ISO 230-2" : std::string(title);
+  } catch (const cal::InputError&) {
+    return "ISO 230-2";
+  }
+}
+
+// The standard a linear run's report evaluates by: the one asked for, else the run's own.
+std::string linear_standard_key(const RunView& v, const Options& o) {
+  if (v.run.kind != "linear") return "";
+  if (!o.standard.empty()) return o.standard;
+  const auto standard = v.settings.value("standard", json());
+  return standard.is_string() ? standard.get<std::string>() : "";
+}
+
+// standard_key: the standard the report evaluates by when it is not the run's own (-s).
+std::string test_name(const RunView& v, std::string_view standard_key = {}) {
   const json m = v.settings.value("measure", json::object());
   const std::string component =
       m.is_object() && m.contains("component") && m["component"].is_string()
           ? " " + m["component"].get<std::string>()
           : "";
   const std::string what =
-      v.run.kind == "linear"         ? "Positioning test (ISO 230-2)"
-      : v.run.kind == "rotary"       ? "Rotary positioning test (ISO 230-2)" + component
-      : v.run.kind == "circle"       ? "Circular test (ISO 230-4, ballbar)"
-      : v.run.kind == "dynamic"      ? "Dynamic capture"
+      v.run.kind == "linear"    ? "Positioning test (" + positioning_standard(standard_key) + ")"
+      : v.run.kind == "rotary"  ? "Rotary positioning test (ISO 230-2)" + component
+      : v.run.kind == "circle"  ? "Circular test (ISO 230-4, ballbar)"
+      : v.run.kind == "dynamic" ? "Dynamic capture"
       : v.run.kind == "straightness" ? "Straightness test (ISO 230-1)" + component
       : v.run.kind == "angular"      ? "Angular test (ISO 230-1)" + component
       : v.run.kind == "roll"         ? "Roll test (ISO 230-1)" + component
@@ -257,10 +282,11 @@ std::string test_name(const RunView& v) {
   return fmt::format("{}, axis {}", what, v.run.axis);
 }
 
-std::string run_title(const RunView& v) {
+std::string run_title(const RunView& v, std::string_view standard_key = {}) {
   // The origin leads the title, so it is on every printed page's running header too.
   const auto label = ::daq::run_origin(v.run, v.instruments, v.machine).label();
-  return fmt::format("{}Run {}: {}", label.empty() ? "" : label + " — ", v.run.id, test_name(v));
+  return fmt::format("{}Run {}: {}", label.empty() ? "" : label + " — ", v.run.id,
+                     test_name(v, standard_key));
 }
 
 // A setting as an engineer reads it: strings without quotes, numbers without binary noise
@@ -402,12 +428,46 @@ std::string_view setting_unit(const RunView& v, std::string_view key, std::strin
   return unit;
 }
 
+// A refractive-index equation by the name its authors gave it ("ciddor" is Ciddor (1996)).
+std::string equation_name(const std::string& key) {
+  try {
+    switch (cal::air::equation_from_string(key)) {
+      case cal::air::Equation::edlen:
+        return "Edlén (Birch and Downs)";
+      case cal::air::Equation::ciddor:
+        return "Ciddor (1996)";
+      case cal::air::Equation::shop_floor:
+        return "NIST shop floor";
+    }
+  } catch (const cal::InputError&) {
+  }
+  return key;  // not one caldaq knows: as recorded
+}
+
+// A setting whose recorded value is a key, as the reader knows it: the standard by its title
+// ("ISO 230-2:2014", not "iso230-2:2014"), the equation by its name.
+json shown_setting(const RunView& v, const std::string& key, const json& val) {
+  if (!val.is_string()) return val;
+  const std::string text = val.get<std::string>();
+  try {
+    if (key == "standard" && v.run.kind == "circle")
+      return cal::circle::info(cal::circle::circular_standard_from_key(text)).label;
+    if (key == "standard" && (v.run.kind == "linear" || v.run.kind == "rotary"))
+      return std::string(cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
+  } catch (const cal::InputError&) {
+    return val;  // not one caldaq knows: as recorded
+  }
+  if (key == "environment.equation") return equation_name(text);
+  return val;
+}
+
 std::string setting_value(const json& val, std::string_view unit) {
   if (val.is_boolean()) return val.get<bool>() ? "yes" : "no";
   // A unit as a value (measure.unit = "um") as documents print it (µm).
   const std::string text =
       esc(val.is_string() ? ::daq::unit_html(val.get<std::string>()) : setting_text(val));
-  return unit.empty() ? text : text + " " + esc(unit);
+  // A plane angle's degree sign follows the number without a space (360°, not 360 °).
+  return unit.empty() ? text : text + (unit == "°" ? "" : " ") + esc(unit);
 }
 
 // The settings as recorded at the start, as an appendix: labels and units, only the keys that
@@ -449,7 +509,8 @@ std::string settings_appendix(const RunView& v) {
     const auto i = rank(key);
     const bool known = i < std::size(setting_labels);
     rows.push_back({known ? esc(setting_labels[i].label) : "<code>" + esc(key) + "</code>",
-                    setting_value(val, known ? setting_unit(v, key, setting_labels[i].unit) : "") +
+                    setting_value(shown_setting(v, key, val),
+                                  known ? setting_unit(v, key, setting_labels[i].unit) : "") +
                         used_note(key, val)});
   }
   if (rows.empty()) return "";
@@ -458,14 +519,19 @@ std::string settings_appendix(const RunView& v) {
          table({"setting", "value"}, rows, "kv");
 }
 
-// The instruments and their connections.
+// The instruments and their connections, by the names the set-up gave them and their model and
+// serial number. Not by the acquisition's device numbers: those have gaps where a configured
+// device was not used (0, 1, 2, 4 on a straightness run) and mean nothing to the reader.
 std::string connections_table(const RunView& v) {
   std::string h;
   std::vector<std::vector<std::string>> inst;
-  for (const auto& i : v.instruments)
-    inst.push_back({std::to_string(i.device), esc(i.driver), esc(i.transport)});
+  for (const auto& i : v.instruments) {
+    const std::string model = instrument_label(v, i.device);
+    inst.push_back({esc(i.driver), model == i.driver ? "" : esc(model), esc(i.transport)});
+  }
   if (!inst.empty())
-    h += "<h4>Instruments</h4>\n" + table({"device", "instrument", "connection"}, inst);
+    h += "<h4>Instruments</h4>\n" +
+         table({"instrument", "model and serial number", "connection"}, inst);
   return h;
 }
 
@@ -560,15 +626,20 @@ std::string instruments_section(const RunView& v) {
     std::string due_cell = stated(due);
     if (!due.empty() && due < test_day)
       due_cell = "<span class=\"fail\">" + esc(due) + " &mdash; PAST DUE</span>";
-    rows.push_back({esc(ctx(i, "role")), esc(ctx(i, "id")), esc(ctx(i, "driver")),
-                    stated(ctx(i, "serial_number")), stated(ctx(i, "certificate")), due_cell});
+    // The instrument by the name the Instruments table and the plots' legends give it, its
+    // role only where it differs ("air | air | ptu300" said the name twice).
+    const std::string id = ctx(i, "id"), role = ctx(i, "role");
+    rows.push_back({esc(id.empty() ? role : id) +
+                        (role.empty() || role == id || id.empty() ? "" : " (" + esc(role) + ")"),
+                    esc(ctx(i, "driver")), stated(ctx(i, "serial_number")),
+                    stated(ctx(i, "certificate")), due_cell});
   }
   return h +
-         table({"role", "device", "instrument", "serial number", "certificate", "calibration due"},
-               rows);
+         table({"instrument", "model", "serial number", "certificate", "calibration due"}, rows);
 }
 
-// The gaps in the traceability of the readings, one warning per instrument: a calibration due
+// The gaps in the traceability of the readings, a warning per instrument or per gap shared by
+// several: a calibration due
 // before the test day, or a serial number, certificate or due date not stated. Without them a
 // reader cannot tell whether the instrument was calibrated when it measured.
 std::vector<std::string> traceability_gaps(const RunView& v) {
@@ -579,6 +650,10 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
         "recorded with this run"};
   std::vector<std::string> out;
   const std::string test_day = ymd(v.run.started_unix_ms);
+  // The instruments that lack the same things, in one warning ("air, laser: no serial number,
+  // certificate or calibration due date stated"): one line each filled page one with four
+  // lines saying the same.
+  std::vector<std::pair<std::string, std::vector<std::string>>> lacking;
   for (const auto& i : list) {
     const std::string name = ctx(i, "id").empty() ? ctx(i, "role") : ctx(i, "id");
     const std::string due = ctx(i, "calibration_due");
@@ -591,9 +666,21 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
     if (ctx(i, "serial_number").empty()) missing.push_back("serial number");
     if (ctx(i, "certificate").empty()) missing.push_back("certificate");
     if (due.empty()) missing.push_back("calibration due date");
-    if (!missing.empty())
-      out.push_back(fmt::format("{}: no {} stated", name, fmt::join(missing, ", ")));
+    if (missing.empty()) continue;
+    const std::string what =
+        missing.size() == 1
+            ? missing.front()
+            : fmt::format("{} or {}", fmt::join(missing.begin(), missing.end() - 1, ", "),
+                          missing.back());
+    const auto same = std::find_if(lacking.begin(), lacking.end(),
+                                   [&](const auto& l) { return l.first == what; });
+    if (same == lacking.end())
+      lacking.push_back({what, {name}});
+    else
+      same->second.push_back(name);
   }
+  for (const auto& [what, names] : lacking)
+    out.push_back(fmt::format("{}: no {} stated", fmt::join(names, ", "), what));
   return out;
 }
 
@@ -623,10 +710,19 @@ std::string quality_banner(const st::RunReader& store, const RunView& v, bool pa
                              esc(::daq::units_html(::daq::quality_text(q))));
   if (!page_one) return "";
   std::string stops;
-  for (const auto& m : q.suspects)
-    stops += fmt::format("<li>run {} {} target {}: {}</li>", m.run_number,
-                         m.direction == '+' ? "↑" : "↓", m.target_index + 1,
-                         esc(::daq::units_html(m.reason)));
+  for (const auto& m : q.suspects) {
+    // The reason begins with where the stop was ("run 2 up at 149.024 mm: +4.953 µm ..."): said
+    // once, with the target's number and its position ("run 2 up at" repeated "run 2 ↑").
+    const std::string where =
+        fmt::format("run {} {} at ", m.run_number, m.direction == '+' ? "up" : "down");
+    const auto colon = m.reason.find(": ");
+    const bool placed = m.reason.starts_with(where) && colon != std::string::npos;
+    const std::string at =
+        placed ? " (" + m.reason.substr(where.size(), colon - where.size()) + ")" : "";
+    stops += fmt::format("<li>run {} {} target {}{}: {}</li>", m.run_number,
+                         m.direction == '+' ? "↑" : "↓", m.target_index + 1, esc(at),
+                         esc(::daq::units_html(placed ? m.reason.substr(colon + 2) : m.reason)));
+  }
   // The stops, each with its reason and limit, are the message: the summary sentence repeats
   // them (the box took page one's room for the main plot), so it is said only without a list.
   if (q.suspects.empty())
@@ -799,8 +895,8 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
     coeff.push_back({name, esc(acquired),
                      changed ? "<span class=\"changed\">" + esc(now) + "</span>" : esc(now)});
   };
-  row("Refractive index equation", env.value("equation", "ciddor"),
-      u.coefficients.value("equation", "ciddor"));
+  row("Refractive index equation", equation_name(env.value("equation", "ciddor")),
+      equation_name(u.coefficients.value("equation", "ciddor")));
   row("Expansion coefficient (ppm/K)", setting_text(env.value("expansion_ppm_per_k", json(11.5))),
       setting_text(u.coefficients.value("expansion_ppm_per_k", json(11.5))));
   row("CO2 (µmol/mol)", setting_text(env.value("co2_umol_per_mol", json(450))),
@@ -946,13 +1042,17 @@ std::string means_plot(const Linear& l) {
     means.lines.push_back({.x = x, .y = down, .label = "x̄↓", .colour = vermilion, .markers = true});
     means.lines.push_back({.x = x,
                            .y = bi,
-                           .label = "x̄ (bidirectional)",
+                           // Short enough for three columns of legend ("x̄ (bidirectional)"
+                           // took two, three rows, and the plot off a suspect run's page one).
+                           .label = "x̄ ↑↓",
                            .colour = black,
                            .width = 1.0,
                            .dashed = true});
   }
   // One line of caption (the legend names the lines): a suspect run's page one holds it too.
-  return figure(svg(means), "Bands x̄ ± 2s, s: the estimator of the unidirectional repeatability.");
+  return figure(svg(means),
+                "Bands x̄ ± 2s, s: the estimator of the unidirectional repeatability; x̄ ↑↓: the "
+                "mean bidirectional deviation.");
 }
 
 std::string runs_plot(const Linear& l) {
@@ -1042,6 +1142,9 @@ json rotary_doc(const st::RunReader& store, const RunView& v, const Options& o) 
 // details that support it.
 struct Sections {
   std::string answer, details;
+  // The details follow the answer without a page break: a circle's answer fills page one, and
+  // the break left page two with the last three lines of "What to fix first".
+  bool details_flow = false;
 };
 
 // A rotary axis's angular positioning run (ISO 230-2 in deg and arcsec) is reported as a
@@ -1113,9 +1216,15 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
   double length_m = 0;
   const auto b = linear_budget(v, l, length_m);
   std::vector<std::vector<std::string>> contrib;
-  for (const auto& c : b.contributors)
-    contrib.push_back(
-        {esc(c.name), fmt::format("{:.4f}", c.u_um), esc(::daq::units_html(c.model))});
+  for (const auto& c : b.contributors) {
+    // The refractive-index equation's own uncertainty by the equation's name ("ciddor
+    // equation" is the budget's key for it): "Ciddor (1996) equation".
+    const auto space = c.name.find(' ');
+    const std::string name = c.name.ends_with(" equation") && space != std::string::npos
+                                 ? equation_name(c.name.substr(0, space)) + c.name.substr(space)
+                                 : c.name;
+    contrib.push_back({esc(name), fmt::format("{:.4f}", c.u_um), esc(::daq::units_html(c.model))});
+  }
   d += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>Of a positional deviation at the measured travel "
       "L = {:.3f} m (ISO 230-2 Annex A, ISO/TR 230-9): combined standard uncertainty "
@@ -1191,11 +1300,12 @@ PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_
   // machine's: it is removed, as ISO 230-4 evaluates about that centre.
   const double cu = c.result.iso.centre_u_um, cv = c.result.iso.centre_v_um;
   for (const auto& t : c.traces) {
-    Line l{
-        .label = std::string(label_prefix) +
-                 (t.direction == cal::circle::Direction::ccw ? "counter-clockwise" : "clockwise"),
-        .colour = palette(colour_offset + (t.direction == cal::circle::Direction::ccw ? 0 : 1)),
-        .width = 1.2};
+    // "ccw" and "cw", as G (ccw) and G (cw) name them: "counter-clockwise" took the legend to
+    // one column a row beside the values table, which pushed what to fix first off page one.
+    Line l{.label = std::string(label_prefix) +
+                    (t.direction == cal::circle::Direction::ccw ? "ccw" : "cw"),
+           .colour = palette(colour_offset + (t.direction == cal::circle::Direction::ccw ? 0 : 1)),
+           .width = 1.2};
     // At most ~3600 points a trace (0.1 degree): more cannot be seen, and would bloat the file.
     const std::size_t step = std::max<std::size_t>(1, t.angle_deg.size() / 3600);
     for (std::size_t i = 0; i < t.angle_deg.size(); i += step) {
@@ -1313,7 +1423,10 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
     if (!top) row.push_back(share);
     if (!top) {
       row.push_back(um(d.pv_um));
-      row.push_back(check ? fmt::format("≤ {}", fixed(check->limit, 3)) + " " + verdict_cell(check)
+      // The limit in its unit: the column holds a backlash's µm beside a squareness's µm/m.
+      row.push_back(check ? fmt::format("<span class=\"nw\">≤ {} {}</span> ",
+                                        fixed(check->limit, 3), esc(unit_text(check->unit))) +
+                                verdict_cell(check)
                           : "");
     }
     if (!top) row.push_back(check_text);
@@ -1432,6 +1545,7 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
     headline.values.push_back({x.name, x.value, unit_text(x.unit), check && !check->pass, true});
   }
 
+  out.details_flow = true;
   std::string& d = out.details;
   d = "<h3>Details of the results</h3>\n" + evaluated +
       table({"symbol", "value (µm)", "meaning"}, other, "num results", "lrl") +
@@ -1449,7 +1563,15 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
       "deviation that error alone causes on this circle. A limit applies to the magnitude of "
       "the value, in its unit.</p>\n",
       r.iso.G_bi_um);
-  for (const auto& n : r.notes) d += "<p class=\"note\">" + esc(n) + "</p>\n";
+  // The analysis's notes ("vibration: ...") as sentences, their subject capitalised; not the
+  // uncalibrated bar's, which the Bar calibration section right under it says in full.
+  for (const auto& n : r.notes) {
+    if (n.starts_with("uncalibrated bar:")) continue;
+    std::string note = n;
+    if (!note.empty() && note[0] >= 'a' && note[0] <= 'z')
+      note[0] = static_cast<char>(note[0] - 32);
+    d += "<p class=\"note\">" + esc(note) + "</p>\n";
+  }
   d += bar_calibration_section(c, v);
   d += fmt::format(
       "<h3>Measurement uncertainty</h3>\n<p>The error model leaves a residual of {:.3f} µm rms "
@@ -1798,6 +1920,7 @@ table.beside td:first-child { white-space: normal; } table.beside td.r, table.di
 svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
+.details.flow { break-before: auto; page-break-before: auto; }
 .pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
         align-items: start; }
 .pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
@@ -1889,7 +2012,7 @@ std::string compensation_check(const st::RunReader& store, const RunView& v) {
 // Then the details, the conditions and traceability, and the settings as an appendix.
 std::string run_body(const st::RunReader& store, const RunView& v, const Options& o, Headline& hl) {
   std::string h = origin_banner(v);
-  h += summary_block(v, test_name(v));
+  h += summary_block(v, test_name(v, linear_standard_key(v, o)));
   if (v.run.status != st::RunStatus::complete)
     h += fmt::format(
         "<p class=\"warning\">This run is {}{}: the results cover only what was stored{}.</p>\n",
@@ -1920,7 +2043,8 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
         esc(e.what()));
   }
   h += results.answer;
-  h += "<div class=\"details\">\n" + results.details + quality_banner(store, v, false);
+  h += (results.details_flow ? "<div class=\"details flow\">\n" : "<div class=\"details\">\n") +
+       results.details + quality_banner(store, v, false);
   if (!v.missed.empty()) {
     std::vector<std::vector<std::string>> rows;
     for (const auto& m : v.missed)
@@ -1964,7 +2088,7 @@ std::string date_cell(const std::string& iso, bool with_time) {
 std::string run_report(const st::RunReader& store, std::int64_t run, const Options& o) {
   const auto v = load(store, run);
   Headline hl;
-  return page(run_title(v), run_body(store, v, o, hl), o, who_of(v));
+  return page(run_title(v, linear_standard_key(v, o)), run_body(store, v, o, hl), o, who_of(v));
 }
 
 // The campaign's ballbar tests side by side and the three-plane table (docs/circle.md, "The
