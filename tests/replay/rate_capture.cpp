@@ -150,9 +150,12 @@ class Generator {
       if (kind_ == "temper")
         for (auto& i : header_["instruments"])
           if (i["device"] == target_)
-            i = {{"device", target_},        {"driver", "temper"},
-                 {"role", "material"},       {"origin", "simulated"},
-                 {"test_axis", 0},           {"transport", "hid 413d:2107"},
+            i = {{"device", target_},
+                 {"driver", "temper"},
+                 {"role", "material"},
+                 {"origin", "simulated"},
+                 {"test_axis", 0},
+                 {"transport", "hid 413d:2107"},
                  {"serial_number", "SIM-TEMPER-0001"},
                  {"options", {{"family", "gold"}, {"channels", {0}}}}};
     } else if (kind_ == "ballbar") {
@@ -223,9 +226,9 @@ class Generator {
           ++id_shift_;
           const auto v = static_cast<std::int64_t>(std::llround(series_.at(when)));
           o.push_back({when, RecordKind::sent, shift_id(last_sent_, id - id_of(last_sent_))});
-          o.push_back({when, RecordKind::received,
-                       fmt::format("{{\"id\":{},\"jsonrpc\":\"2.0\",\"result\":[0,{},0,0]}}\r\n",
-                                   id, v)});
+          o.push_back(
+              {when, RecordKind::received,
+               fmt::format("{{\"id\":{},\"jsonrpc\":\"2.0\",\"result\":[0,{},0,0]}}\r\n", id, v)});
         });
       }
       return out;
@@ -285,8 +288,8 @@ class Generator {
     const auto read = [&](std::vector<Out>& o, std::int64_t when) {
       const auto centi = static_cast<int>(std::lround(series_.at(when) * 100));
       o.push_back({when, RecordKind::sent, report({0x01, 0x80, 0x33, 0x01})});
-      o.push_back({when, RecordKind::received,
-                   report({0x80, 0x80, (centi >> 8) & 0xFF, centi & 0xFF})});
+      o.push_back(
+          {when, RecordKind::received, report({0x80, 0x80, (centi >> 8) & 0xFF, centi & 0xFF})});
     };
     read(out, r.time_ns);
     fill(out, r.time_ns, next, read);
@@ -310,7 +313,8 @@ class Generator {
     for (std::size_t k = 0; k < values.size(); ++k) {
       const double next = k + 1 < values.size() ? values[k + 1] : values[k];
       for (int j = 0; j < factor; ++j)
-        text += fmt::format("{:+010.5f}\r\n", values[k] + (next - values[k]) * static_cast<double>(j) / factor);
+        text += fmt::format("{:+010.5f}\r\n",
+                            values[k] + (next - values[k]) * static_cast<double>(j) / factor);
     }
     return {{r.time_ns, r.kind, text}};
   }
