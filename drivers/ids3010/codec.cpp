@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <unordered_map>
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/json_scan.hpp"
@@ -125,9 +126,15 @@ const KnownRequest* find_request(std::string_view name) {
           t.push_back({full_name(m, api), &m, api});
     return t;
   }();
-  for (const auto& k : table)
-    if (k.name == name) return &k;
-  return nullptr;
+  // Looked up by hash: replay asks once per recorded request, and a linear search compared
+  // the name with most of the table's 32 (emplace keeps the first of equal names, as it did).
+  static const std::unordered_map<std::string_view, const KnownRequest*> by_name = [] {
+    std::unordered_map<std::string_view, const KnownRequest*> m;
+    for (const auto& k : table) m.emplace(k.name, &k);
+    return m;
+  }();
+  const auto it = by_name.find(name);
+  return it == by_name.end() ? nullptr : it->second;
 }
 
 // The one-pass reader of the lines caldaq and the device write: a JSON object whose members

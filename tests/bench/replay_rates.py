@@ -26,7 +26,7 @@ KINDS = [
     ("ids3010", "lin", 10000, "IDS3010 getAxesDisplacement, JSON-RPC"),
     ("ptu300", "lin", 10, "PTU300 SEND lines at 4800 7E1"),
     ("gauge", "lin", 90, "serial thermometer (line gauge, polled) at 9600 8N1"),
-    ("ballbar", "circ", 10000, "ballbar (line gauge, streaming) at 115200 8N1"),
+    ("ballbar", "circ", 10000, "ballbar (line gauge, streaming), the issue's 10 kHz"),
     ("shdr", "lin", 1000, "MTConnect SHDR Xcom lines while moving"),
     ("halsampler", "lin", 1000, "halsampler lines (servo thread)"),
     ("temper", "lin", 200, "TEMPer HID reports (the 5 ms HID poll)"),

@@ -148,16 +148,8 @@ class Generator {
         if (r.device == target_ && r.kind == RecordKind::received)
           add(r.time_ns, std::strtod(std::string(r.text()).c_str(), nullptr));
       if (kind_ == "temper")
-        for (auto& i : header_["instruments"])
-          if (i["device"] == target_)
-            i = {{"device", target_},
-                 {"driver", "temper"},
-                 {"role", "material"},
-                 {"origin", "simulated"},
-                 {"test_axis", 0},
-                 {"transport", "hid 413d:2107"},
-                 {"serial_number", "SIM-TEMPER-0001"},
-                 {"options", {{"family", "gold"}, {"channels", {0}}}}};
+        replace_instrument("temper", "material", "hid 413d:2107",
+                           {{"family", "gold"}, {"channels", {0}}});
     } else if (kind_ == "ballbar") {
       target_ = find_device(header_, "role", "ballbar");
       header_["config"]["circle"]["sample_rate_hz"] = rate_hz_;
@@ -168,20 +160,26 @@ class Generator {
         if (r.device == target_ && r.kind == RecordKind::received)
           if (const auto v = xcom(r.text())) add(r.time_ns, *v);
       if (kind_ == "halsampler")
-        for (auto& i : header_["instruments"])
-          if (i["device"] == target_)
-            i = {{"device", target_},
-                 {"driver", "halsampler"},
-                 {"role", "position"},
-                 {"origin", "simulated"},
-                 {"test_axis", 0},
-                 {"transport", "tcp 127.0.0.1:5000"},
-                 {"options", {{"tagged", false}, {"column", 0}, {"unit", "mm"}}}};
+        replace_instrument("halsampler", "position", "tcp 127.0.0.1:5000",
+                           {{"tagged", false}, {"column", 0}, {"unit", "mm"}});
     } else {
       throw std::runtime_error("unknown KIND " + kind_);
     }
     if (series_.t.empty() && kind_ != "ptu300" && kind_ != "ballbar")
       throw std::runtime_error("the capture has no values of the device to densify");
+  }
+  // The target device's entry in the header, as another driver's (daq replay builds it).
+  void replace_instrument(const char* driver, const char* role, const char* transport,
+                          json options) {
+    for (auto& i : header_["instruments"])
+      if (i["device"] == target_)
+        i = {{"device", target_},
+             {"driver", driver},
+             {"role", role},
+             {"origin", "simulated"},
+             {"test_axis", 0},
+             {"transport", transport},
+             {"options", std::move(options)}};
   }
   void add(std::int64_t t, double v) {
     series_.t.push_back(t);
