@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <unordered_map>
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/json_scan.hpp"
@@ -125,9 +126,15 @@ const KnownRequest* find_request(std::string_view name) {
           t.push_back({full_name(m, api), &m, api});
     return t;
   }();
-  for (const auto& k : table)
-    if (k.name == name) return &k;
-  return nullptr;
+  // Looked up by hash: replay asks once per recorded request, and a linear search compared
+  // the name with most of the table's 32 (emplace keeps the first of equal names, as it did).
+  static const std::unordered_map<std::string_view, const KnownRequest*> by_name = [] {
+    std::unordered_map<std::string_view, const KnownRequest*> m;
+    for (const auto& k : table) m.emplace(k.name, &k);
+    return m;
+  }();
+  const auto it = by_name.find(name);
+  return it == by_name.end() ? nullptr : it->second;
 }
 
 // The one-pass reader of the lines caldaq and the device write: a JSON object whose members
@@ -166,6 +173,45 @@ struct FlatObject {
   }
 };
 
+// A JSON number (RFC 8259 section 6) at s[i]: -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)?;
+// i is moved past it.
+bool scan_number(std::string_view s, std::size_t& i, FlatNumber& n) {
+  const auto digit = [&] { return i < s.size() && s[i] >= '0' && s[i] <= '9'; };
+  const std::size_t start = i;
+  if (i < s.size() && s[i] == '-') ++i;
+  const std::size_t int_start = i;
+  if (!digit()) return false;
+  if (s[i++] != '0')
+    while (digit()) ++i;
+  const std::size_t int_digits = i - int_start;
+  bool fraction_or_exponent = false;
+  if (i < s.size() && s[i] == '.') {
+    ++i;
+    if (!digit()) return false;
+    while (digit()) ++i;
+    fraction_or_exponent = true;
+  }
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    ++i;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    if (!digit()) return false;
+    while (digit()) ++i;
+    fraction_or_exponent = true;
+  }
+  const char* first = s.data() + start;
+  const char* last = s.data() + i;
+  if (!fraction_or_exponent) {
+    if (int_digits > 18) return false;  // the parser's uint64 or double: left to it
+    n.integer = true;
+    std::from_chars(first, last, n.i);  // cannot fail: at most 18 digits
+    n.d = static_cast<double>(n.i);
+    return true;
+  }
+  n.integer = false;
+  const auto [end, ec] = std::from_chars(first, last, n.d);
+  return ec == std::errc{} && end == last;  // out of range: the parser decides
+}
+
 class FlatScanner {
  public:
   explicit FlatScanner(std::string_view s) : s_(s) {}
@@ -203,7 +249,6 @@ class FlatScanner {
     space();
     return i_ == s_.size();
   }
-  bool digit() const { return i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9'; }
 
   bool value(FlatObject& o, FlatValue& v) {
     if (peek('"')) {
@@ -240,47 +285,108 @@ class FlatScanner {
     return true;
   }
 
-  // A JSON number (RFC 8259 section 6): -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)?
   bool number(FlatNumber& n) {
     space();
-    const std::size_t start = i_;
-    if (i_ < s_.size() && s_[i_] == '-') ++i_;
-    const std::size_t int_start = i_;
-    if (!digit()) return false;
-    if (s_[i_++] != '0')
-      while (digit()) ++i_;
-    const std::size_t int_digits = i_ - int_start;
-    bool fraction_or_exponent = false;
-    if (i_ < s_.size() && s_[i_] == '.') {
-      ++i_;
-      if (!digit()) return false;
-      while (digit()) ++i_;
-      fraction_or_exponent = true;
-    }
-    if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
-      ++i_;
-      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
-      if (!digit()) return false;
-      while (digit()) ++i_;
-      fraction_or_exponent = true;
-    }
-    const char* first = s_.data() + start;
-    const char* last = s_.data() + i_;
-    if (!fraction_or_exponent) {
-      if (int_digits > 18) return false;  // the parser's uint64 or double: left to it
-      n.integer = true;
-      std::from_chars(first, last, n.i);  // cannot fail: at most 18 digits
-      n.d = static_cast<double>(n.i);
-      return true;
-    }
-    n.integer = false;
-    const auto [end, ec] = std::from_chars(first, last, n.d);
-    return ec == std::errc{} && end == last;  // out of range: the parser decides
+    return scan_number(s_, i_, n);
   }
 
   std::string_view s_;
   std::size_t i_ = 0;
 };
+
+// An integer as the scanner takes it without a fraction or exponent: -?(0|[1-9][0-9]*), at
+// most 18 digits (exact in int64). At s[i]; i is moved past it.
+bool plain_integer(std::string_view s, std::size_t& i, std::int64_t& out) {
+  const std::size_t start = i;
+  if (i < s.size() && s[i] == '-') ++i;
+  const std::size_t digits = i;
+  if (i == s.size() || s[i] < '0' || s[i] > '9') return false;
+  if (s[i++] != '0')
+    while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+  if (i - digits > 18) return false;
+  std::from_chars(s.data() + start, s.data() + i, out);  // cannot fail: at most 18 digits
+  return true;
+}
+
+// JSON white space after the object (a line's own terminator is not in it; a CR may be).
+std::string_view without_trailing_space(std::string_view line) {
+  while (!line.empty() &&
+         (line.back() == ' ' || line.back() == '\t' || line.back() == '\n' || line.back() == '\r'))
+    line.remove_suffix(1);
+  return line;
+}
+
+bool take(std::string_view s, std::size_t& i, std::string_view literal) {
+  if (s.substr(i, literal.size()) != literal) return false;
+  i += literal.size();
+  return true;
+}
+
+// The request line encode() writes, byte for byte:
+//   {"jsonrpc":"2.0","method":"NAME","params":[P,...],"id":N,"api":2}
+// NAME printable ASCII without '"' or '\', the params and N integers as plain_integer takes
+// them, JSON white space only after the closing brace. What this takes, FlatScanner reads to
+// the same id, method and integer params; anything else returns false (and goes the general
+// way). Replay learns every recorded request, so this is one compare per byte, no scan of
+// keys.
+struct EncodedRequest {
+  std::int64_t id = 0;
+  std::string_view method;
+  std::vector<std::int64_t> params;
+};
+bool match_encoded_request(std::string_view line, EncodedRequest& r) {
+  line = without_trailing_space(line);
+  std::size_t i = 0;
+  if (!take(line, i, R"({"jsonrpc":"2.0","method":")")) return false;
+  const std::size_t name = i;
+  while (i < line.size() && line[i] != '"') {
+    const auto u = static_cast<unsigned char>(line[i]);
+    if (u < 0x20 || u > 0x7e || u == '\\') return false;
+    ++i;
+  }
+  r.method = line.substr(name, i - name);
+  if (!take(line, i, R"(","params":[)")) return false;
+  if (!take(line, i, "]")) {
+    do {
+      std::int64_t p = 0;
+      if (r.params.size() == 8 || !plain_integer(line, i, p)) return false;  // the scanner's 8
+      r.params.push_back(p);
+    } while (take(line, i, ","));
+    if (!take(line, i, "]")) return false;
+  }
+  return take(line, i, R"(,"id":)") && plain_integer(line, i, r.id) &&
+         take(line, i, R"(,"api":2})") && i == line.size();
+}
+
+// An answer as the device (and the twin) writes it, byte for byte, members in one of the two
+// orders seen: {"id":N,"jsonrpc":"2.0","result":[X,...]} or {"jsonrpc":"2.0","result":[X,...],
+// "id":N}, N as plain_integer takes it, the X JSON numbers without white space (at most
+// FlatObject's 8), JSON white space only after the closing brace. What this takes,
+// FlatScanner reads to the same id and numbers; anything else returns false.
+struct EncodedAnswer {
+  std::int64_t id = 0;
+  std::array<FlatNumber, FlatObject::max_elements> numbers{};
+  std::size_t count = 0;
+  std::span<const FlatNumber> result() const { return std::span(numbers).first(count); }
+};
+bool match_result_array(std::string_view line, std::size_t& i, EncodedAnswer& a) {
+  if (!take(line, i, R"("result":[)")) return false;
+  if (take(line, i, "]")) return true;
+  do {
+    if (a.count == a.numbers.size() || !scan_number(line, i, a.numbers[a.count++])) return false;
+  } while (take(line, i, ","));
+  return take(line, i, "]");
+}
+bool match_encoded_answer(std::string_view line, EncodedAnswer& a) {
+  line = without_trailing_space(line);
+  std::size_t i = 0;
+  if (take(line, i, R"({"id":)"))
+    return plain_integer(line, i, a.id) && take(line, i, R"(,"jsonrpc":"2.0",)") &&
+           match_result_array(line, i, a) && take(line, i, "}") && i == line.size();
+  return take(line, i, R"({"jsonrpc":"2.0",)") && match_result_array(line, i, a) &&
+         take(line, i, R"(,"id":)") && plain_integer(line, i, a.id) && take(line, i, "}") &&
+         i == line.size();
+}
 
 }  // namespace
 
@@ -365,8 +471,11 @@ void IdsCodec::note_requests(std::span<const std::byte> bytes) {
 }
 
 void IdsCodec::note_request(std::string_view line) {
-  // The request lines encode() writes are taken in one pass; others (attocube's client puts
-  // spaces and "api" before "id") go through the JSON parser, with the same result.
+  // The request lines encode() writes are matched byte for byte; other flat objects are taken
+  // in one pass; others (attocube's client puts spaces and "api" before "id") go through the
+  // JSON parser, with the same result.
+  if (EncodedRequest r; match_encoded_request(line, r))
+    return learn(r.id, r.method, std::move(r.params));
   if (FlatObject o; FlatScanner(line).object(o)) {
     const FlatValue* id = o.find("id");
     const FlatValue* method = o.find("method");
@@ -442,6 +551,12 @@ void IdsCodec::decode_line(std::string_view line, std::uint64_t offset,
   // The answers the device writes ({"jsonrpc":"2.0","result":[0,...],"id":n}, members in any
   // order) in one pass; everything else through the JSON parser. A line the fast path takes
   // has no control bytes (its strings are printable, its white space cannot be in a line).
+  // The two byte layouts the device writes are matched without a scan of keys first.
+  if (EncodedAnswer a; match_encoded_answer(line, a)) {
+    if (auto r = take_pending(a.id, offset, errors))
+      decode_result(std::move(*r), ResultView(a.result()), offset, frames, errors);
+    return;
+  }
   if (FlatObject o; FlatScanner(line).object(o)) {
     const FlatValue* id = o.find("id");
     const FlatValue* res = o.find("result");

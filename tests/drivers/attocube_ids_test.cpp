@@ -2,6 +2,7 @@
 // the device sends them (result[0] the error code, displacements in picometres), then every
 // kind of bad answer. Expected values by hand in the comments.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -400,6 +401,98 @@ TEST(IdsCodec, AnswersReadInOnePassGiveTheParsersValues) {
   EXPECT_EQ(errors[0].description, "IDS: flag result is not a boolean");
   EXPECT_EQ(errors[1].description, "IDS: text result is not a string");
   EXPECT_FALSE(frames[0].flag.has_value());
+}
+
+// Replay matches the request and answer lines in the device's own byte layouts without a scan
+// of keys (issue 32). The same line with a blank after its '{' is the same JSON and is read the
+// general way (FlatScanner, else the parser): both must give the same requests learnt, frames
+// and errors, for every id, params and result form, taken or refused.
+std::string described(const IdsResponse& r) {
+  std::string s = fmt::format("id {} method {} api {} params [{}] rpc_error {} code {} '{}'", r.id,
+                              static_cast<int>(r.method), static_cast<int>(r.api),
+                              fmt::join(r.params, ","), r.rpc_error, r.error_code, r.text);
+  for (const auto& d : r.displacement_m) s += d ? fmt::format(" {:.17g}", *d) : " -";
+  for (const auto& v : {r.temperature_degc, r.pressure_pa, r.humidity_pct_rh, r.refractive_index})
+    s += v ? fmt::format(" {:.17g}", *v) : " -";
+  return s;
+}
+
+std::string replayed(std::string_view request, std::string_view answer, bool spaced) {
+  const auto respace = [&](std::string_view line) {
+    std::string s(line);
+    if (spaced && !s.empty() && s[0] == '{') s.insert(1, " ");
+    return s + "\n";
+  };
+  IdsCodec c;
+  const std::string sent = respace(request);
+  c.note_requests(std::as_bytes(std::span(sent)));
+  std::string out = fmt::format("pending {} last id {}\n", c.pending(), c.last_id());
+  std::vector<IdsResponse> frames;
+  std::vector<CodecError> errors;
+  c.feed(respace(answer), frames, errors);
+  for (const auto& f : frames) out += described(f) + "\n";
+  for (const auto& e : errors) out += fmt::format("error {}\n", static_cast<int>(e.kind));
+  return out;
+}
+
+TEST(IdsCodec, LinesMatchedByteForByteGiveWhatTheGeneralReaderGives) {
+  const std::string_view displacement = "com.attocube.sen.displacement.getAxesDisplacement";
+  const std::vector<std::string> requests = {
+      fmt::format(R"({{"jsonrpc":"2.0","method":"{}","params":[],"id":7,"api":2}})", displacement),
+      fmt::format(R"({{"jsonrpc":"2.0","method":"{}","params":[],"id":7,"api":2}})",
+                  "com.attocube.ids.displacement.getAxesDisplacement"),
+      R"({"jsonrpc":"2.0","method":"com.attocube.system.errorNumberToString","params":[0,-3],"id":7,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ids.displacement.getAxisDisplacement","params":[2],"id":7,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ids.displacement.getAxisDisplacement","params":[1.5],"id":7,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ids.displacement.getAxisDisplacement","params":[01],"id":7,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.system.errorNumberToString","params":[1,2,3,4,5,6,7,8,9],"id":7,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","params":[],"id":-0,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","params":[],"id":123456789012345678,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","params":[],"id":1234567890123456789,"api":2})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","params":[],"id":7,"api":3})",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","params":[],"id":7,"api":2}  )",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.enable","params":[],"id":7,"api":2}x)",
+      R"({"jsonrpc":"2.0","method":"com.attocube.ecu.en\able","params":[],"id":7,"api":2})",
+      R"({"jsonrpc":"2.0","method":"nothing.known","params":[],"id":7,"api":2})",
+  };
+  const std::vector<std::string_view> ids = {
+      "7", "-0", "123456789012345678", "1234567890123456789", "07", "7.0"};
+  const std::vector<std::string_view> results = {"0,-864831475,0,0",
+                                                 "0,1.5e3,-2E-2,0.30000000000000004",
+                                                 "0",
+                                                 "",
+                                                 "3",
+                                                 "0,1,2,3,4,5,6,7",
+                                                 "0,1,2,3,4,5,6,7,8",
+                                                 "0,99999999999999999999,0,0",
+                                                 "0, 1,2,3",
+                                                 "0,-,0,0",
+                                                 "0,1.,0,0",
+                                                 "0,1e,0,0",
+                                                 "0,\"a\",0,0",
+                                                 "0,1e999,0,0"};
+  std::size_t compared = 0;
+  for (const auto& request : requests)
+    for (const auto id : ids)
+      for (const auto result : results)
+        for (const auto* form : {R"({{"id":{},"jsonrpc":"2.0","result":[{}]}})",
+                                 R"({{"jsonrpc":"2.0","result":[{}],"id":{}}})"}) {
+          // The second with the CR the device ends its lines with (CR LF).
+          const bool id_first = form[3] == 'i';
+          const std::string answer = id_first ? fmt::format(fmt::runtime(form), id, result)
+                                              : fmt::format(fmt::runtime(form), result, id) + "\r";
+          SCOPED_TRACE(request + " / " + answer);
+          EXPECT_EQ(replayed(request, answer, false), replayed(request, answer, true));
+          ++compared;
+        }
+  EXPECT_EQ(compared, requests.size() * ids.size() * results.size() * 2);
+  // The device's own line is matched and read: a displacement in metres.
+  EXPECT_NE(replayed(requests[0],
+                     R"({"id":7,"jsonrpc":"2.0","result":[0,-864831475,0,0]})"
+                     "\r",
+                     false)
+                .find(" -0.00086483147"),
+            std::string::npos);
 }
 
 }  // namespace
