@@ -40,6 +40,7 @@
 #include "run_document.hpp"
 #include "run_quality.hpp"
 #include "shortest_number.hpp"
+#include "stored_profile.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
 
@@ -482,7 +483,11 @@ void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, co
   const auto names = stop_columns(run);
   fmt::print(out, "{}\n",
              fmt::format(fmt::runtime(kTargetColumns), names.target, *value_column, names.raw));
-  for (const auto& t : store.targets(run.id)) {
+  std::string note;  // a rotary run stored the old way: its stops' angles read as deviations
+  const auto targets = stored_targets(store, run, &note);
+  if (!note.empty())
+    fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
+  for (const auto& t : targets) {
     const auto at = static_cast<double>(t.time_ns);
     fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,
                t.direction == '+' ? "up" : "down", num(t.deviation_um), t.target_index + 1,
@@ -548,7 +553,8 @@ void export_json(const st::RunReader& store, const st::RunRecord& run, const jso
   j["readings"] = nullptr;  // the place of the rows, found in the text below
   json targets = json::array();
   const auto columns = stop_columns(run);
-  for (const auto& t : store.targets(run.id))
+  std::string note;  // a rotary run stored the old way: its stops' angles read as deviations
+  for (const auto& t : stored_targets(store, run, &note))
     targets.push_back({{columns.target, t.nominal_mm},
                        {"run", t.run_number},
                        {"direction", t.direction == '+' ? "up" : "down"},
@@ -560,6 +566,7 @@ void export_json(const st::RunReader& store, const st::RunRecord& run, const jso
                        {"refractive_index", t.refractive_index},
                        {"material_temperature_degc", t.material_temperature_degc}});
   j["targets"] = std::move(targets);
+  if (!note.empty()) j["notes"] = json::array({note});
   j["missed_stops"] = json::array();
   for (const auto& m : store.missed_stops(run.id)) j["missed_stops"].push_back(missed_json(m));
   j["quality"] = quality_json(run_quality(store, run.id));  // suspect stops (issue 26)

@@ -126,6 +126,25 @@ std::string tolerances_toml(const std::string& file) {
   return "\n# Added by daq sim --tolerances\n" + text + "\n";
 }
 
+// The rotary test's specification: a file of [tolerances.A|B|C] tables only (the shop's
+// configuration has the demo's linear axes' and planes' tables already).
+std::string rotary_tolerances_toml(const std::string& file) {
+  const std::string text = tolerances_toml(file);
+  const auto c = cal::daq::parse_tolerances(text, file);
+  for (const auto& [name, t] : c.axis_tolerances)
+    if (name != "A" && name != "B" && name != "C")
+      throw cal::InputError(fmt::format(
+          "--tolerances {}: [tolerances.{}]: with --test rotary only a rotary axis's table "
+          "(A, B, C) is added (the shop's configuration has its own linear limits)",
+          file, name));
+  if (!c.plane_tolerances.empty())
+    throw cal::InputError(fmt::format(
+        "--tolerances {}: [tolerances.{}]: with --test rotary only a rotary axis's table (A, B, "
+        "C) is added",
+        file, c.plane_tolerances.begin()->first));
+  return text;
+}
+
 // A run that has started in the database since `after` (its id), or nullopt. The database may
 // be busy with the acquiring process's writes: a failed look is retried at the next poll.
 std::optional<cal::storage::RunRecord> new_run(const std::filesystem::path& db,
@@ -229,10 +248,10 @@ void run_sim(SimOptions o) {
                fmt::join(o.control_table, ", "), o.control_format,
                o.control_inverted ? ", read with the other sign" : "");
   }
-  if (!o.tolerances.empty() && !volumetric)
+  if (!o.tolerances.empty() && !volumetric && !rotary)
     throw cal::InputError(
-        "--tolerances applies to --measure (the other tests' configurations have the demo's "
-        "specification)");
+        "--tolerances applies to --measure and --test rotary (the other tests' configurations "
+        "have the demo's specification)");
   const std::string text =
       volumetric ? volumetric_config(shop, o.speed, *volumetric) +
                        (o.tolerances.empty() ? "" : tolerances_toml(o.tolerances))
@@ -243,7 +262,9 @@ void run_sim(SimOptions o) {
                                                 .targets = o.targets.value_or(11),
                                                 .circle_set = set,
                                                 .rotary = rotary,
-                                                .circle_feed_mm_per_min = o.feed_mm_per_min});
+                                                .circle_feed_mm_per_min = o.feed_mm_per_min}) +
+                       (rotary && !o.tolerances.empty() ? rotary_tolerances_toml(o.tolerances)
+                                                        : "");
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -407,7 +428,8 @@ void add_sim_command(CLI::App& app) {
                 "into --db");
   cmd->add_option("--tolerances", o->tolerances,
                   "With --measure: a TOML file of [tolerances.AXIS] tables (docs/config.md) "
-                  "added to the configuration written, so the run is judged against them");
+                  "added to the configuration written, so the run is judged against them; "
+                  "with --test rotary: its [tolerances.C] (limits in arcsec)");
   cmd->add_option("--truth-out", o->truth_out,
                   "Write the SIMULATED volumetric machine's injected errors (of --topology) as a "
                   "model file and exit: compare a built model with it (`daq model compare`)");

@@ -402,6 +402,11 @@ void read_measure(Table& t, LinearTestConfig& l) {
         rotary_axis
             ? fmt::format("a rotary axis {} is measured by measure = \"rotary\"", l.axis)
             : fmt::format("measure = \"rotary\" measures a rotary axis (A, B, C), not {}", l.axis));
+  if (!m.reference.empty() && m.kind != "rotary")
+    t.fail(t.node("reference"), "reference",
+           "the angular reference's kind applies to a rotary test (measure = \"rotary\")");
+  if (!m.reference.empty())  // "" (not given): not stated
+    one_of(t, "reference", m.reference, {"laser", "autocollimator", "level", "encoder"});
   if (m.kind == "straightness") {
     one_of(t, "direction", m.direction, {"X", "Y", "Z"});
     if (m.direction == l.axis)
@@ -485,10 +490,28 @@ CircleTestConfig read_circle(Table& t) {
   return c;
 }
 
-AxisTolerance read_axis_tolerance(Table& t) {
+// A rotary axis (A, B, C) is limited in arcsec, a linear one in um (and urad): a limit of the
+// other kind is refused at its line, never compared with values in another unit.
+void check_limit_units(Table& t, const PositioningLimits& l, bool rotary_axis) {
+  for (const auto& k : cal::daq::positioning_limit_keys)
+    if (l.*k.member && k.rotary != rotary_axis)
+      t.fail(t.node(k.key), k.key,
+             rotary_axis ? "a rotary axis's limits are angles in arcsec (E_arcsec, R_arcsec, "
+                           "B_arcsec, A_arcsec, M_arcsec; P_arcsec, Pa_arcsec, Ps_arcsec, "
+                           "U_arcsec), not lengths (docs/config.md)"
+                         : "arcsec limits are a rotary axis's (A, B, C); a linear axis's are in "
+                           "um (E_um, R_um, B_um, A_um, M_um, ...; docs/config.md)");
+}
+
+AxisTolerance read_axis_tolerance(Table& t, bool rotary_axis) {
   AxisTolerance a;
   a.limits = read_limits(t);
+  check_limit_units(t, a.limits, rotary_axis);
   t.known("by_length");
+  if (rotary_axis && t.node("by_length"))
+    t.fail(t.node("by_length"), "by_length",
+           "a rotary axis's limits do not depend on a travel in mm: give them in the axis's "
+           "own table");
   if (const auto* node = t.node("by_length")) {
     const auto* arr = node->as_array();
     if (!arr || !arr->is_array_of_tables())
@@ -499,6 +522,7 @@ AxisTolerance read_axis_tolerance(Table& t) {
       if (!up_to || !std::isfinite(*up_to) || *up_to <= 0)
         b.fail(b.node("up_to_mm"), "up_to_mm", "each entry needs up_to_mm, a length > 0 in mm");
       auto limits = read_limits(b);
+      check_limit_units(b, limits, false);
       if (limits.empty()) b.fail(nullptr, "up_to_mm", "the entry sets no limit (E_um, R_um, ...)");
       b.check_unknown();
       if (!a.by_length.empty() && a.by_length.back().first >= *up_to)
@@ -555,11 +579,13 @@ void read_tolerances(Config& c, Table& top) {
     if (!table) continue;
     Table t(*table, "tolerances." + name, top.file());
     if (name == "X" || name == "Y" || name == "Z")
-      c.axis_tolerances[name] = read_axis_tolerance(t);
+      c.axis_tolerances[name] = read_axis_tolerance(t, false);
+    else if (name == "A" || name == "B" || name == "C")
+      c.axis_tolerances[name] = read_axis_tolerance(t, true);
     else if (name == "XY" || name == "YZ" || name == "ZX")
       c.plane_tolerances[name] = read_circle_tolerance(t, name);
     else
-      tt.fail(&v, name, "expected an axis (X, Y, Z) or a plane (XY, YZ, ZX)");
+      tt.fail(&v, name, "expected an axis (X, Y, Z; A, B, C) or a plane (XY, YZ, ZX)");
   }
   tt.check_unknown();
 }

@@ -85,6 +85,7 @@ const Field<M> kMeasure[] = {
     {.key = "separation_mm", .member = &M::separation_mm, .range = position},
     {.key = "sign", .member = &M::sign},  // 1 or -1: checked by the reader
     {.key = "square", .member = &M::square},
+    {.key = "reference", .member = &M::reference},  // rotary only: checked by the reader
 };
 
 const Field<C> kCircle[] = {

@@ -959,7 +959,8 @@ struct Linear {
 };
 
 Linear evaluate_linear(const st::RunReader& store, const RunView& v, const Options& o) {
-  Linear l{.targets = store.targets(v.run.id), .text = axis_text(v)};
+  std::string note;  // a rotary run stored the old way (its stops' angles), read as deviations
+  Linear l{.targets = ::daq::stored_targets(store, v.run, &note), .text = axis_text(v)};
   if (l.targets.empty())
     throw cal::InputError(
         fmt::format("{}: run {} has no captured targets to report", store.name(), v.run.id));
@@ -972,6 +973,7 @@ Linear evaluate_linear(const st::RunReader& store, const RunView& v, const Optio
     throw cal::InputError(fmt::format("{}: run {} ({} captured stops): {}", store.name(), v.run.id,
                                       l.targets.size(), e.what()));
   }
+  if (!note.empty()) l.e.warnings.push_back(note);
   return l;
 }
 
@@ -1138,6 +1140,106 @@ json rotary_doc(const st::RunReader& store, const RunView& v, const Options& o) 
   return ::daq::stored_rotary(store, v.run, o.standard);
 }
 
+// The instruments of a run's context with a role ("angle", "laser"), as the configuration named
+// them.
+std::vector<json> instruments_with_role(const RunView& v, std::string_view role) {
+  std::vector<json> out;
+  for (const auto& i : v.context.value("instruments", json::array()))
+    if (i.is_object() && ctx(i, "role") == role) out.push_back(i);
+  return out;
+}
+
+std::string instrument_text(const json& i) {
+  std::string t = "<strong>" + esc(ctx(i, "id")) + "</strong> (" + esc(ctx(i, "driver")) + ")";
+  if (!ctx(i, "serial_number").empty()) t += ", serial number " + esc(ctx(i, "serial_number"));
+  if (!ctx(i, "certificate").empty()) t += ", certificate " + esc(ctx(i, "certificate"));
+  return t;
+}
+
+// What a rotary run's angular reference is ([test.linear] reference, docs/config.md): "laser",
+// "autocollimator", "level", "encoder", or "" (not stated).
+std::string angular_reference_kind(const RunView& v) {
+  const json m = v.settings.value("measure", json::object());
+  return m.is_object() ? ctx(m, "reference") : "";
+}
+
+std::string angular_reference_kind_text(std::string_view kind) {
+  if (kind == "laser") return "a laser's angular optics over a rotary indexer";
+  if (kind == "autocollimator") return "an autocollimator on a polygon";
+  if (kind == "level") return "an electronic level";
+  if (kind == "encoder") return "a reference encoder (an indexer's readout)";
+  return "<span class=\"unstated\">its kind not stated</span> (<code>reference</code> in "
+         "[test.linear], docs/config.md)";
+}
+
+// A rotary run's angular reference, as configured (the device with role "angle", what it is,
+// and the laser when it is a laser's angular optics), on page one.
+std::string angular_reference_line(const RunView& v) {
+  const std::string kind = angular_reference_kind(v);
+  std::vector<std::string> devices;
+  for (const auto& i : instruments_with_role(v, "angle")) devices.push_back(instrument_text(i));
+  if (kind == "laser")
+    for (const auto& i : instruments_with_role(v, "laser"))
+      devices.push_back("the laser " + instrument_text(i));
+  return fmt::format("<p>Angular reference: {}, {}.</p>\n",
+                     devices.empty() ? "<span class=\"unstated\">its device not recorded</span>"
+                                     : fmt::format("{}", fmt::join(devices, "; ")),
+                     angular_reference_kind_text(kind));
+}
+
+// The air's refractive index of a rotary run read with a laser's angular optics (the laser's
+// wavelength in air scales the angle it reads), from the run's air readings by the configured
+// equation; an autocollimator, level or encoder reads no wavelength in air: it does not apply.
+std::string refractive_index_text(const RunView& v) {
+  if (v.env.air_temperature.empty() || v.env.pressure_hpa.empty())
+    return "<span class=\"unstated\">not known: the run stored no air temperature and "
+           "pressure</span>";
+  // As the linear budget reads the air (with the sensors' stored offsets).
+  const auto& c = v.used.coefficients;
+  const auto& off = v.used.offsets;
+  cal::air::Conditions air{
+      .temperature_degc = stats(v.env.air_temperature).mean + off.air_temperature_k,
+      .pressure_pa = stats(v.env.pressure_hpa).mean * 100.0 + off.pressure_pa,
+      .co2_umol_per_mol = c.value("co2_umol_per_mol", 450.0),
+      .wavelength_vacuum_nm = c.value("wavelength_nm", 632.991)};
+  if (!v.env.humidity.empty())
+    air.humidity =
+        cal::air::Humidity::relative_pct(stats(v.env.humidity).mean + off.humidity_pct);
+  try {
+    const auto eq = cal::air::equation_from_string(c.value("equation", "ciddor"));
+    return fmt::format(
+        "{:.8f} ({}, from the run's mean air temperature {:.2f} °C, pressure {:.2f} hPa, {}); "
+        "the angles arrive evaluated by the reference's own software: caldaq does not "
+        "compensate them",
+        cal::air::refractive_index(air, eq).n, esc(cal::air::to_string(eq)),
+        air.temperature_degc, air.pressure_pa / 100.0,
+        v.env.humidity.empty() ? std::string("humidity not measured: 50 %RH")
+                               : fmt::format("humidity {:.1f} %RH", air.humidity.value));
+  } catch (const cal::InputError& e) {
+    return esc(e.what());
+  }
+}
+
+std::string angular_reference_details(const RunView& v) {
+  const std::string kind = angular_reference_kind(v);
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& i : instruments_with_role(v, "angle"))
+    rows.push_back({"Angular reference (role angle)", instrument_text(i)});
+  rows.push_back({"What it is", angular_reference_kind_text(kind)});
+  if (kind == "laser")
+    for (const auto& i : instruments_with_role(v, "laser"))
+      rows.push_back({"Laser", instrument_text(i)});
+  rows.push_back(
+      {"Refractive index of the air",
+       kind == "laser" ? refractive_index_text(v)
+       : kind.empty()
+           ? "applies to a laser's angular optics only; the configuration does not say what the "
+             "reference is"
+           : fmt::format("does not apply: {} reads no wavelength in air",
+                         angular_reference_kind_text(kind))});
+  return "<h4>Angular reference</h4>\n" + table({"", ""}, rows, "kv");
+}
+
 // A run's results in two parts: the answer (page one: verdict, main table, main plot) and the
 // details that support it.
 struct Sections {
@@ -1185,6 +1287,7 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
     for (const auto& r : values)
       headline.values.push_back({r.symbol, r.value, unit_text(r.unit), failing(r)});
   headline.verdict = ::daq::summary(verdict);
+  if (rotary) h += angular_reference_line(v);
   h += verdict_banner(verdict);
   h += results_grid(e, verdict, unit);
   h += means_plot(l);
@@ -1206,6 +1309,7 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
   d += "<h4>Per target</h4>\n" + table(head, rows, "num");
   for (const auto& w : e.warnings) d += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
   if (rotary) {
+    d += angular_reference_details(v);
     d += "<p class=\"note\">Each stop's deviation is its angular reference's reading minus the "
          "target, modulo one turn (so 360 deg reads as 0 deg on the reference). The laser's "
          "uncertainty budget (ISO 230-2 Annex A) does not apply to an angular reference: state "
@@ -2265,10 +2369,14 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
           "comparison report: run {} is a {} test of axis {}, run {} a {} test of axis {}; "
           "compare the same test",
           first.run.id, first.run.kind, first.run.axis, v.run.id, v.run.kind, v.run.axis));
-  if (first.run.kind != "linear" && first.run.kind != "circle")
-    throw cal::InputError(
-        fmt::format("comparison report: {} runs cannot be compared (linear and circle runs can)",
-                    first.run.kind));
+  if (first.run.kind != "linear" && first.run.kind != "circle" && first.run.kind != "rotary")
+    throw cal::InputError(fmt::format(
+        "comparison report: {} runs cannot be compared (linear, rotary and circle runs can)",
+        first.run.kind));
+  // A rotary axis's angular positioning is compared as a linear axis's positioning is, in its
+  // units (deg, arcsec: axis_text).
+  const bool positioning = first.run.kind == "linear" || first.run.kind == "rotary";
+  const AxisText& text = axis_text(first);
 
   // The runs' dates as x labels: the day, or with the time (UTC) when two runs share a day.
   std::vector<std::string> dates;
@@ -2308,8 +2416,8 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   std::vector<std::vector<std::string>> rows;
   std::vector<std::map<std::string, std::string>> cells;  // per run: key -> its value's cell
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
-                  .x_label = "target position (mm)",
-                  .y_label = "deviation (µm)",
+                  .x_label = std::string(text.x_label),
+                  .y_label = fmt::format("deviation ({})", text.deviation),
                   .height_pt = 300,
                   .zero_line = true};
   std::vector<PolarChart> polars;
@@ -2319,17 +2427,20 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     const std::string label = same_day ? dates[i] : fmt::format("run {} ({})", v.run.id, dates[i]);
     std::vector<Value> values;
     json doc;
-    if (v.run.kind == "linear") {
+    if (positioning) {
       const auto l = evaluate_linear(store, v, o);
       double length_m = 0;
-      u_max_um = std::max(u_max_um, linear_budget(v, l, length_m).expanded_um);
+      // The laser's budget (ISO 230-2 Annex A) is a length's: not an angular reference's.
+      if (v.run.kind == "linear")
+        u_max_um = std::max(u_max_um, linear_budget(v, l, length_m).expanded_um);
       Line line{.label = label, .colour = palette(i), .width = 1.4, .markers = true};
       for (const auto& t : l.e.targets)
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
-      doc = ::daq::to_json(l.e);
+      // A rotary run's caldaq.rotary.v1 (its values in arcsec, judged by its arcsec limits).
+      doc = v.run.kind == "rotary" ? rotary_doc(store, v, o) : ::daq::to_json(l.e);
       // In the order of every output (result_rows.hpp).
-      for (const auto& r : ::daq::linear_rows(doc))
+      for (const auto& r : ::daq::result_rows(doc))
         values.push_back({r.key, r.symbol, unit_text(r.unit), r.value});
     } else {
       const auto c = analyse_circle(store, v, o);
@@ -2349,7 +2460,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     std::map<std::string, std::string> by_key;  // the value cells, placed by key below
     // A linear run's table keeps to the values a specification limits (the unidirectional ones
     // are in each run's report): all twelve would not fit a printed page.
-    if (v.run.kind == "linear" &&
+    if (positioning &&
         std::any_of(values.begin(), values.end(), [](const Value& x) { return x.key == "E_bi"; }))
       std::erase_if(values, [](const Value& x) {
         return std::find(linear_keys.begin(), linear_keys.end(), x.key) == linear_keys.end();
@@ -2406,7 +2517,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   // (as tall as the page is wide) comes after the trends, which fill page one below the
   // table (the overlay left half of it empty).
   std::string overlay_figure;
-  if (first.run.kind == "linear") {
+  if (positioning) {
     body += figure(svg(overlay),
                    "The mean bidirectional positional deviation x̄i of each run "
                    "at each target: a change of shape or slope shows wear, a "
@@ -2430,8 +2541,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   std::stable_partition(plot_order.begin(), plot_order.end(),
                         [&](const std::string& k) { return limits.count(k) > 0; });
   for (const auto& k : plot_order) {
-    if (first.run.kind == "linear" &&
-        std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
+    if (positioning && std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
       continue;
     if (plotted++ >= 10) break;
     XyChart small{.title = names[k],

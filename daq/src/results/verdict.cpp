@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "cal/analysis/text.hpp"
+#include "cal/daq/config.hpp"
 #include "circle_output.hpp"
 #include "result_rows.hpp"
 
@@ -54,55 +55,106 @@ void conclude(Verdict& v) {
 
 }  // namespace
 
-Verdict linear_verdict(const json& tolerances, const json& result) {
-  Verdict v;
-  if (!tolerances.is_object()) return v;
-  const json limits = limits_for_travel(tolerances, travel_mm(result, "target_mm"), v.basis);
+namespace {
+
+// How a positioning evaluation's values and its axis's limits are named: a linear axis's in µm
+// (E_um; caldaq.iso230-2.v1's "value_um"), a rotary axis's in arcsec (E_arcsec;
+// caldaq.rotary.v1's "value").
+struct PositioningUnits {
+  const char* suffix;     // of the limits' keys: "_um", "_arcsec"
+  const char* value_key;  // of a value in the result's "axis"
+  const char* unit;       // of a check: "um", "arcsec"
+  const char* shown;      // in a note: "µm", "arcsec"
+};
+constexpr PositioningUnits linear_units{"_um", "value_um", "um", "µm"};
+constexpr PositioningUnits rotary_units{"_arcsec", "value", "arcsec", "arcsec"};
+
+// The standard's title: caldaq.iso230-2.v1 nests it in "standard", caldaq.rotary.v1 has it at
+// the top.
+std::string standard_title(const json& result) {
+  if (result.contains("standard") && result["standard"].is_object())
+    return result["standard"].value("title", std::string("this standard"));
+  return result.value("title", std::string("this standard"));
+}
+
+Verdict positioning_verdict(const json& limits, const json& result, const PositioningUnits& u,
+                            Verdict v) {
   const bool bi = result.value("bidirectional", true);
   const auto& axis = result.value("axis", json::object());
-  const std::string title = result.contains("standard")
-                                ? result["standard"].value("title", std::string("this standard"))
-                                : "this standard";
+  const std::string title = standard_title(result);
   // Which value of the evaluation each limit applies to. ISO 230-2's limits apply to the ISO
   // family (every edition, JIS, GB/T), VDI/DGQ 3441's to a VDI evaluation (it gives P).
   const bool vdi = axis.contains("P");
   const struct {
-    const char* limit;
+    const char* limit;  // the key without its unit
     const char* name;
     const char* bi_key;
     const char* uni_key;
     bool vdi;
-  } map[] = {{"E_um", "E", "E_bi", "E_up", false},     {"R_um", "R", "R_bi", "R_up", false},
-             {"B_um", "B", "B", nullptr, false},       {"A_um", "A", "A_bi", "A_up", false},
-             {"M_um", "M", "M", nullptr, false},       {"P_um", "P", "P", nullptr, true},
-             {"Pa_um", "Pa", "Pa", nullptr, true},     {"Ps_um", "Ps max", "Ps_max", nullptr, true},
-             {"U_um", "U max", "U_max", nullptr, true}};
+  } map[] = {{"E", "E", "E_bi", "E_up", false},    {"R", "R", "R_bi", "R_up", false},
+             {"B", "B", "B", nullptr, false},      {"A", "A", "A_bi", "A_up", false},
+             {"M", "M", "M", nullptr, false},      {"P", "P", "P", nullptr, true},
+             {"Pa", "Pa", "Pa", nullptr, true},    {"Ps", "Ps max", "Ps_max", nullptr, true},
+             {"U", "U max", "U_max", nullptr, true}};
+  const auto keys = [&](bool of_vdi) {
+    std::vector<std::string> k;
+    for (const auto& m : map)
+      if (m.vdi == of_vdi) k.push_back(m.limit + std::string(u.suffix));
+    return fmt::format("{}", fmt::join(k, ", "));
+  };
   std::vector<std::string> other;  // limits of the other family
   for (const auto& m : map) {
-    if (!limits.contains(m.limit)) continue;
+    const std::string limit_key = m.limit + std::string(u.suffix);
+    if (!limits.contains(limit_key)) continue;
     if (m.vdi != vdi) {
-      other.push_back(m.limit);
+      other.push_back(limit_key);
       continue;
     }
     const char* key = bi ? m.bi_key : m.uni_key;
+    const double lim = limits[limit_key].get<double>();
     if (!key || !axis.contains(key)) {
-      v.notes.push_back(fmt::format("{} limit {:g} µm not applied: {} gives no {}{}", m.name,
-                                    limits[m.limit].get<double>(), title, m.name,
-                                    bi ? "" : " for a one-way test"));
+      v.notes.push_back(fmt::format("{} limit {:g} {} not applied: {} gives no {}{}", m.name, lim,
+                                    u.shown, title, m.name, bi ? "" : " for a one-way test"));
       continue;
     }
-    const double value = axis[key].value("value_um", 0.0), lim = limits[m.limit].get<double>();
-    v.checks.push_back({key, axis[key].value("symbol", std::string(m.name)), value, lim, "um",
+    const double value = axis[key].value(u.value_key, 0.0);
+    v.checks.push_back({key, axis[key].value("symbol", std::string(m.name)), value, lim, u.unit,
                         within(value, lim)});
   }
   // Limits only of the other family: none applies, and the note says which keys would.
   if (v.checks.empty() && !other.empty())
-    v.notes.push_back(fmt::format(
-        "the limits configured ({}) are for {} values; {} is judged by {}", fmt::join(other, ", "),
-        vdi ? "ISO 230-2" : "VDI/DGQ 3441", title,
-        vdi ? "P_um, Pa_um, Ps_um, U_um (docs/config.md)" : "E_um, R_um, B_um, A_um, M_um"));
+    v.notes.push_back(fmt::format("the limits configured ({}) are for {} values; {} is judged by {}",
+                                  fmt::join(other, ", "), vdi ? "ISO 230-2" : "VDI/DGQ 3441",
+                                  title,
+                                  vdi ? keys(true) + " (docs/config.md)" : keys(false)));
   conclude(v);
   return v;
+}
+
+// A rotary axis's values (arcsec) against its [tolerances.A|B|C] limits in arcsec. A run
+// stored with a linear axis's limits in µm has none that applies: said so, never a µm limit
+// compared with arcsec.
+Verdict rotary_verdict(const json& tolerances, const json& result) {
+  Verdict v;
+  if (!tolerances.is_object()) return v;
+  v.basis = tolerances.value("source", std::string("tolerances"));
+  bool lengths = false;
+  for (const auto& k : cal::daq::positioning_limit_keys)
+    lengths = lengths || (!k.rotary && tolerances.contains(k.key));
+  if (lengths)
+    v.notes.push_back(
+        "the configured limits are in µm for a linear axis: none applies to a rotary axis's "
+        "values in arcsec (its limits are E_arcsec, R_arcsec, ...: docs/config.md)");
+  return positioning_verdict(tolerances, result, rotary_units, std::move(v));
+}
+
+}  // namespace
+
+Verdict linear_verdict(const json& tolerances, const json& result) {
+  Verdict v;
+  if (!tolerances.is_object()) return v;
+  const json limits = limits_for_travel(tolerances, travel_mm(result, "target_mm"), v.basis);
+  return positioning_verdict(limits, result, linear_units, std::move(v));
 }
 
 Verdict profile_verdict(const json& tolerances, const json& result) {
@@ -162,22 +214,6 @@ Verdict circle_verdict(const json& tolerances, const json& result) {
   return v;
 }
 
-namespace {
-
-// A rotary axis's values are in arcsec; [tolerances.AXIS] holds limits in µm for a linear
-// axis, so none applies (no rotary limits are configurable yet): not configured, and said so,
-// rather than a µm limit compared with arcsec or a value read as 0.
-Verdict rotary_verdict(const json& tolerances) {
-  Verdict v;
-  if (tolerances.is_object() && !tolerances.empty())
-    v.notes.push_back(
-        "the configured limits are in µm for linear axes: none applies to a rotary axis's values "
-        "in arcsec (rotary limits cannot be configured yet)");
-  return v;
-}
-
-}  // namespace
-
 Verdict verdict_of(const json& settings, const json& result) {
   const json none;
   const json& tol = settings.is_object() && settings.contains("context") &&
@@ -187,7 +223,7 @@ Verdict verdict_of(const json& settings, const json& result) {
                         : none;
   if (is_circle_schema(result.value("schema", ""))) return circle_verdict(tol, result);
   if (is_profile_schema(result.value("schema", ""))) return profile_verdict(tol, result);
-  if (is_rotary_schema(result.value("schema", ""))) return rotary_verdict(tol);
+  if (is_rotary_schema(result.value("schema", ""))) return rotary_verdict(tol, result);
   return linear_verdict(tol, result);
 }
 

@@ -57,6 +57,7 @@ cal::daq::LinearTestConfig simulated_rotary_test(int runs) {
   l.overrun_mm = 3.0;
   l.feed_mm_per_min = 1200.0;  // deg/min: 20 deg/s
   l.dwell_s = 3.0;
+  l.measure.reference = "encoder";  // the SIMULATED rotary indexer's readout (docs/config.md)
   return l;
 }
 
@@ -537,9 +538,9 @@ std::string rotary_toml(int runs) {
   return fmt::format(
       "[test.linear]           # a rotary axis: the lengths below are degrees\n"
       "axis = \"{}\"\nmeasure = \"rotary\"\nfirst_mm = {}\nlast_mm = {}\ninterval_mm = {}\n"
-      "runs = {}\noverrun_mm = {}\nfeed_mm_per_min = {}\ndwell_s = {}\n",
+      "runs = {}\noverrun_mm = {}\nfeed_mm_per_min = {}\ndwell_s = {}\nreference = \"{}\"\n",
       l.axis, l.first_mm, l.last_mm, l.interval_mm.value_or(45.0), l.runs, l.overrun_mm,
-      l.feed_mm_per_min, l.dwell_s);
+      l.feed_mm_per_min, l.dwell_s, l.measure.reference);
 }
 
 }  // namespace

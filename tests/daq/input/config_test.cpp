@@ -364,6 +364,43 @@ vibration = 0.3
   EXPECT_EQ(xy.diagnostics.at("vibration"), 0.3);
 }
 
+// A rotary axis's limits are in arcsec, the unit of its values, named in each key (issue 36:
+// the rotary run's verdict said "No tolerance configured", [tolerances.C] was refused); a
+// length limit on a rotary axis, an angle limit on a linear one, are refused at their line.
+TEST(Config, RotaryAxisLimitsInArcsec) {
+  const auto c = cal::daq::parse_config(
+      "[tolerances.C]\nE_arcsec = 12\nB_arcsec = 3.5\nPs_arcsec = 4\n[tolerances.X]\nE_um = 10\n",
+      "m.toml");
+  const auto& cl = c.axis_tolerances.at("C").limits;
+  EXPECT_EQ(cl.E_arcsec, 12.0);
+  EXPECT_EQ(cl.B_arcsec, 3.5);
+  EXPECT_EQ(cl.Ps_arcsec, 4.0);
+  EXPECT_FALSE(cl.E_um.has_value());
+  EXPECT_FALSE(cl.R_arcsec.has_value());
+  EXPECT_EQ(c.axis_tolerances.at("X").limits.E_um, 10.0);
+  EXPECT_EQ(error_of("[tolerances.C]\nR_arcsec = 2\nE_um = 3\n"),
+            "machine.toml:3:8: key 'tolerances.C.E_um': a rotary axis's limits are angles in "
+            "arcsec (E_arcsec, R_arcsec, B_arcsec, A_arcsec, M_arcsec; P_arcsec, Pa_arcsec, "
+            "Ps_arcsec, U_arcsec), not lengths (docs/config.md)");
+  EXPECT_NE(error_of("[tolerances.A]\nangular_urad = 3\n")
+                .find("machine.toml:2:16: key 'tolerances.A.angular_urad': a rotary axis's"),
+            std::string::npos);
+  EXPECT_EQ(error_of("[tolerances.Y]\nE_arcsec = 3\n"),
+            "machine.toml:2:12: key 'tolerances.Y.E_arcsec': arcsec limits are a rotary axis's "
+            "(A, B, C); a linear axis's are in um (E_um, R_um, B_um, A_um, M_um, ...; "
+            "docs/config.md)");
+  EXPECT_NE(error_of("[[tolerances.X.by_length]]\nup_to_mm = 500\nA_arcsec = 8\n")
+                .find("machine.toml:3:12: key 'tolerances.X.by_length.A_arcsec': arcsec limits"),
+            std::string::npos);
+  EXPECT_NE(error_of("[tolerances.B]\nE_arcsec = 3\n[[tolerances.B.by_length]]\nup_to_mm = 90\n"
+                     "E_arcsec = 2\n")
+                .find("key 'tolerances.B.by_length': a rotary axis's limits do not depend on a "
+                      "travel"),
+            std::string::npos);
+  EXPECT_EQ(error_of("[tolerances.C]\nE_arcsec = 0\n"),
+            "machine.toml:2:12: key 'tolerances.C.E_arcsec': a limit is a finite number > 0, not 0");
+}
+
 TEST(Config, RefusesBadLimitsDatesAndNames) {
   // nan and inf are refused where every number of the file is read (issue 15).
   EXPECT_EQ(error_of("[tolerances.X]\nE_um = nan\n"),
@@ -375,8 +412,8 @@ TEST(Config, RefusesBadLimitsDatesAndNames) {
   EXPECT_EQ(error_of("[tolerances.X]\nF_um = 3\n"),
             "machine.toml:2:8: key 'tolerances.X.F_um': unknown key (a typo?)");
   EXPECT_EQ(error_of("[tolerances.Q]\nE_um = 3\n"),
-            "machine.toml:1:1: key 'tolerances.Q': expected an axis (X, Y, Z) or a plane (XY, YZ, "
-            "ZX)");
+            "machine.toml:1:1: key 'tolerances.Q': expected an axis (X, Y, Z; A, B, C) or a "
+            "plane (XY, YZ, ZX)");
   EXPECT_NE(
       error_of("[tolerances.XY.diagnostics]\nbacklash_Z = 3\n")
           .find("key 'tolerances.XY.diagnostics.backlash_Z': not a diagnostic of a circle in XY"),

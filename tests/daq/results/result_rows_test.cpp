@@ -155,4 +155,49 @@ TEST(Verdict, Vdi3441IsJudgedByItsOwnLimits) {
   EXPECT_EQ(v2.checks[0].key, "E_bi");
 }
 
+// A rotary axis's values (caldaq.rotary.v1, arcsec) against its [tolerances.C] limits in arcsec
+// (issue 36: the verdict said "no tolerance configured" whatever was configured), and never
+// against a linear axis's µm limits.
+TEST(Verdict, RotaryAxisIsJudgedInArcsec) {
+  const json doc = {{"schema", "caldaq.rotary.v1"},
+                    {"title", "ISO 230-2:2014"},
+                    {"standard", "iso230-2:2014"},
+                    {"bidirectional", true},
+                    {"axis",
+                     {{"E_bi", {{"symbol", "E"}, {"value", 8.25}}},
+                      {"B", {{"symbol", "B"}, {"value", -4.5}}},
+                      {"M", {{"symbol", "M"}, {"value", 3.0}}}}}};
+  const auto settings = [](json tolerances) {
+    return json{{"context", {{"tolerances", std::move(tolerances)}}}};
+  };
+  const auto v = daq::verdict_of(
+      settings({{"E_arcsec", 10.0}, {"B_arcsec", 4.0}, {"source", "tolerances.C"}}), doc);
+  EXPECT_TRUE(v.configured);
+  EXPECT_FALSE(v.pass);  // |B| 4.5" above 4"
+  EXPECT_EQ(v.basis, "tolerances.C");
+  ASSERT_EQ(v.checks.size(), 2u);
+  EXPECT_EQ(v.checks[0].key, "E_bi");
+  EXPECT_DOUBLE_EQ(v.checks[0].value, 8.25);
+  EXPECT_EQ(v.checks[0].unit, "arcsec");
+  EXPECT_TRUE(v.checks[0].pass);
+  EXPECT_EQ(v.checks[1].key, "B");
+  EXPECT_FALSE(v.checks[1].pass);
+  EXPECT_EQ(daq::summary(v), "FAIL");
+  // A limit the evaluation does not give (R of a result without it) is named in arcsec.
+  const auto r = daq::verdict_of(settings({{"R_arcsec", 2.0}, {"M_arcsec", 5.0}}), doc);
+  EXPECT_TRUE(r.pass);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_NE(r.notes[0].find("R limit 2 arcsec not applied"), std::string::npos) << r.notes[0];
+  // µm limits (a linear axis's) are not compared with arcsec: none applies, and said so.
+  const auto um = daq::verdict_of(settings({{"E_um", 10.0}, {"B_um", 3.0}}), doc);
+  EXPECT_FALSE(um.configured);
+  EXPECT_EQ(daq::summary(um), "no tolerance applies");
+  ASSERT_FALSE(um.notes.empty());
+  EXPECT_NE(um.notes[0].find("E_arcsec"), std::string::npos) << um.notes[0];
+  // And a linear axis is not judged by arcsec limits.
+  const auto iso_doc =
+      daq::to_json(iso::evaluate(bidirectional_data(), iso::Standard::iso230_2_2014));
+  EXPECT_FALSE(daq::linear_verdict(json{{"E_arcsec", 1e-3}}, iso_doc).configured);
+}
+
 }  // namespace

@@ -102,7 +102,8 @@ TEST(ConfigSections, TheExampleSetsEveryKeyOfEveryTable) {
   EXPECT_TRUE(at_default(c.environment, fd::environment()).empty());
   EXPECT_TRUE(at_default(c.trigger, fd::trigger()).empty());
   EXPECT_EQ(at_default(*c.linear, fd::linear()), (std::vector<std::string>{"count"}));
-  EXPECT_TRUE(at_default(c.linear->measure, fd::measure()).empty());
+  // reference is a rotary test's key (the example is a straightness test: it is refused there).
+  EXPECT_EQ(at_default(c.linear->measure, fd::measure()), (std::vector<std::string>{"reference"}));
   EXPECT_EQ(at_default(*c.circle, fd::circle()),
             (std::vector<std::string>{"plane", "calibrated_radius_mm"}));
 }
@@ -113,7 +114,8 @@ TEST(ConfigSections, EveryKeySurvivesTheCaptureHeader) {
   EXPECT_TRUE(at_default(back.trigger, fd::trigger()).empty());
   ASSERT_TRUE(back.linear && back.circle);
   EXPECT_EQ(at_default(*back.linear, fd::linear()), (std::vector<std::string>{"count"}));
-  EXPECT_TRUE(at_default(back.linear->measure, fd::measure()).empty());
+  EXPECT_EQ(at_default(back.linear->measure, fd::measure()),
+            (std::vector<std::string>{"reference"}));
   // Spot checks against the file's text.
   EXPECT_EQ(back.environment.on_stale, cal::daq::StalePolicy::fallback);
   EXPECT_DOUBLE_EQ(back.environment.fallback_pressure_pa, 99000);
@@ -168,7 +170,9 @@ TEST(ConfigSections, TheSetUpFormKeepsTheMeasureAndSetKeys) {
   const auto text =
       daq::serve::setup_toml(daq::serve::setup_of(cal::daq::parse_config(kEveryKey, "every.toml")));
   const auto again = cal::daq::parse_config(text, "again.toml");
-  EXPECT_TRUE(at_default(again.linear->measure, fd::measure()).empty()) << text;
+  EXPECT_EQ(at_default(again.linear->measure, fd::measure()),
+            (std::vector<std::string>{"reference"}))
+      << text;
   EXPECT_EQ(again.linear->measure.direction, "Z");
   EXPECT_TRUE(again.linear->measure.square);
   EXPECT_EQ(again.circle->feeds_mm_per_min, (std::vector<double>{500, 2000}));

@@ -69,6 +69,11 @@ struct MeasureConfig {
   std::array<double, 3> separation_mm{};     // angular: from beam b's reflector to beam a's
   double sign = 1.0;  // straightness, roll: -1 when the instrument reads the other way round
   bool square = false;  // straightness read against a square's edge: one of a squareness pair
+  // rotary: what the angular reference (the device with role "angle") is, for the report:
+  // "laser" (a laser's angular optics over a rotary indexer), "autocollimator" (on a polygon),
+  // "level" (an electronic level), "encoder" (a reference encoder or indexer's readout); "": not
+  // stated.
+  std::string reference;
 };
 
 struct LinearTestConfig {
@@ -133,12 +138,17 @@ struct PositioningLimits {
   // The axis's other linear tests (ISO 230-1): its straightness about the least-squares line,
   // and its angular deviations (pitch, yaw, roll: the range of each).
   std::optional<double> straightness_um, angular_urad;
+  // A rotary axis's (A, B, C: [tolerances.C]) angular positioning values in arcsec, ISO 230-2's
+  // and VDI/DGQ 3441's as above; a rotary axis takes only these, a linear axis none of them.
+  std::optional<double> E_arcsec, R_arcsec, B_arcsec, A_arcsec, M_arcsec;
+  std::optional<double> P_arcsec, Pa_arcsec, Ps_arcsec, U_arcsec;
   bool empty() const;
 };
 // Each limit's key in the configuration and the run's stored context, in docs/config.md's order.
 struct PositioningLimitKey {
   const char* key;
   std::optional<double> PositioningLimits::*member;
+  bool rotary = false;  // a rotary axis's limit (arcsec), else a linear axis's (um, urad)
 };
 inline constexpr PositioningLimitKey positioning_limit_keys[] = {
     {"E_um", &PositioningLimits::E_um},  {"R_um", &PositioningLimits::R_um},
@@ -146,7 +156,16 @@ inline constexpr PositioningLimitKey positioning_limit_keys[] = {
     {"M_um", &PositioningLimits::M_um},  {"P_um", &PositioningLimits::P_um},
     {"Pa_um", &PositioningLimits::Pa_um}, {"Ps_um", &PositioningLimits::Ps_um},
     {"U_um", &PositioningLimits::U_um},  {"straightness_um", &PositioningLimits::straightness_um},
-    {"angular_urad", &PositioningLimits::angular_urad}};
+    {"angular_urad", &PositioningLimits::angular_urad},
+    {"E_arcsec", &PositioningLimits::E_arcsec, true},
+    {"R_arcsec", &PositioningLimits::R_arcsec, true},
+    {"B_arcsec", &PositioningLimits::B_arcsec, true},
+    {"A_arcsec", &PositioningLimits::A_arcsec, true},
+    {"M_arcsec", &PositioningLimits::M_arcsec, true},
+    {"P_arcsec", &PositioningLimits::P_arcsec, true},
+    {"Pa_arcsec", &PositioningLimits::Pa_arcsec, true},
+    {"Ps_arcsec", &PositioningLimits::Ps_arcsec, true},
+    {"U_arcsec", &PositioningLimits::U_arcsec, true}};
 inline bool PositioningLimits::empty() const {
   for (const auto& k : positioning_limit_keys)
     if (this->*k.member) return false;
@@ -178,7 +197,7 @@ struct Config {
   std::string operator_name;  // the top-level key `operator`
   CustomerConfig customer;
   TestConditions conditions;
-  std::map<std::string, AxisTolerance> axis_tolerances;     // by axis: X, Y, Z
+  std::map<std::string, AxisTolerance> axis_tolerances;     // by axis: X, Y, Z, A, B, C
   std::map<std::string, CircleTolerance> plane_tolerances;  // by plane: XY, YZ, ZX
   std::vector<DeviceConfig> devices;
   EnvironmentConfig environment;

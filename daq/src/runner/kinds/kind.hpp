@@ -119,6 +119,9 @@ const TestKind& straightness();
 const TestKind& angular();
 const TestKind& roll();
 const TestKind& rotary();  // a rotary axis's angular positioning (ISO 230-2 in deg, arcsec)
+// An angle in arcsec modulo one turn into [-180 deg, 180 deg), as a rotary stop's deviation is
+// stored.
+double wrapped_arcsec(double arcsec);
 
 // The profile of a run: per target, the mean of all its stops, of the stops up and down, and
 // the spread; for straightness also the least-squares line and the straightness about it.

@@ -26,11 +26,6 @@ constexpr double kArcsecPerDeg = 3600.0;
 constexpr double kTurnArcsec = 360.0 * kArcsecPerDeg;
 constexpr double kPi = 3.14159265358979323846;
 
-// x modulo one turn into [-half a turn, half a turn).
-double wrapped_arcsec(double x) {
-  return x - kTurnArcsec * std::floor((x + kTurnArcsec / 2) / kTurnArcsec);
-}
-
 // The reference's angle (rad, modulo a turn) as a continuous angle in arcsec: each reading
 // taken within half a turn of the previous one.
 class Reader final : public SampleReader {
@@ -132,6 +127,10 @@ class Rotary final : public TestKind {
 };
 
 }  // namespace
+
+double wrapped_arcsec(double x) {
+  return x - kTurnArcsec * std::floor((x + kTurnArcsec / 2) / kTurnArcsec);
+}
 
 const TestKind& rotary() {
   static const Rotary k;
