@@ -142,9 +142,10 @@ struct LegendEntry {
 
 // `columns` 0: one column; `y` the offset from the position, in the viewport's height.
 // text_scale: the legend's text against PLplot's default size (pllegend does not follow plschr).
-void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
-                 PLFLT y = 0.0, PLFLT text_scale = 1.0) {
-  if (entries.empty()) return;
+// Returns the legend's width in the viewport's width (0: none drawn).
+PLFLT draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
+                  PLFLT y = 0.0, PLFLT text_scale = 1.0) {
+  if (entries.empty()) return 0.0;
   const auto n = static_cast<PLINT>(entries.size());
   std::vector<PLINT> opt, colours, text_colours, styles, box_patterns, symbol_numbers;
   std::vector<PLFLT> widths, scales;
@@ -168,6 +169,7 @@ void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT 
            text_colours.data(), texts.data(), colours.data(), box_patterns.data(), scales.data(),
            widths.data(), colours.data(), styles.data(), widths.data(), colours.data(),
            scales.data(), symbol_numbers.data(), symbols.data());
+  return w;
 }
 
 void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
@@ -211,9 +213,15 @@ void category_label(PLINT axis, PLFLT value, char* out, PLINT length, PLPointer 
   std::snprintf(out, static_cast<std::size_t>(length), "%s", text.c_str());
 }
 
-}  // namespace
+// An XY chart drawn with at most `max_columns` legend columns; `legend_right` is told where the
+// legend's right edge fell, in the canvas's width (> 1: past its edge, the frame cut off).
+struct XyDrawn {
+  std::string svg;
+  PLINT columns = 0;
+  double legend_right = 0.0;
+};
 
-std::string svg(const XyChart& chart) {
+XyDrawn draw_xy(const XyChart& chart, std::size_t max_columns) {
   Range x, y;
   for (const auto& b : chart.bands) {
     for (double v : b.x) x.add(v);
@@ -248,7 +256,7 @@ std::string svg(const XyChart& chart) {
   const auto columns = static_cast<PLINT>(
       legend ? std::clamp<std::size_t>(static_cast<std::size_t>(chart.width_pt / (char_pt * 0.62) /
                                                                 static_cast<double>(longest + 6)),
-                                       1, std::min<std::size_t>(labelled, 4))
+                                       1, std::min<std::size_t>(labelled, max_columns))
              : 0);
   const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
   const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
@@ -336,10 +344,25 @@ std::string svg(const XyChart& chart) {
   plmtex("l", label_disp, 0.5, 0.5, plot_text(chart.y_label).c_str());
   plmtex("t", 1.5, 0.5, 0.5, plot_text(chart.title).c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
-  if (legend)
-    draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
-                3.7 * char_pt / ((top - bottom) * total_pt));
-  return s.finish(chart.title);
+  // The legend is centred under the viewport (shifted by pllegend's x offset, 0.015).
+  const double legend_w =
+      legend ? draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT,
+                           columns, 3.7 * char_pt / ((top - bottom) * total_pt))
+             : 0.0;
+  const double right = left + (0.97 - left) * (0.5 + 0.015 + legend_w / 2);
+  return {s.finish(chart.title), columns, legend_w > 0 ? right : 0.0};
+}
+
+}  // namespace
+
+// The legend's columns are estimated from the labels' lengths; PLplot measures the text itself,
+// and a legend wider than the canvas lost its right edge (the environment plot's frame was cut
+// off after "material: gauge"): drawn again with a column fewer until it fits.
+std::string svg(const XyChart& chart) {
+  auto drawn = draw_xy(chart, 4);
+  while (drawn.legend_right > 0.995 && drawn.columns > 1)
+    drawn = draw_xy(chart, static_cast<std::size_t>(drawn.columns - 1));
+  return std::move(drawn.svg);
 }
 
 namespace {
