@@ -1889,11 +1889,16 @@ std::string origin_label(const RunView& v) {
 Origins origins_of(const RunLabels& runs) {
   // By each word of a label ("SIMULATED, REPLAYED" is both): a replay of a simulated run is
   // simulated like the run it replays, and replayed besides.
-  std::map<std::string, std::vector<std::int64_t>> by_origin;
+  // In the order the runs' labels name them ("SIMULATED, REPLAYED", as a run's title).
+  std::vector<std::pair<std::string, std::vector<std::int64_t>>> by_origin;
   for (const auto& [id, label] : runs)
     for (std::size_t at = 0; at < label.size();) {
       const auto end = std::min(label.find(", ", at), label.size());
-      by_origin[label.substr(at, end - at)].push_back(id);
+      const auto word = label.substr(at, end - at);
+      auto it = std::find_if(by_origin.begin(), by_origin.end(),
+                             [&](const auto& b) { return b.first == word; });
+      if (it == by_origin.end()) it = by_origin.insert(by_origin.end(), {word, {}});
+      it->second.push_back(id);
       at = end + 2;
     }
   Origins o;
