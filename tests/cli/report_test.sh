@@ -137,8 +137,8 @@ check as_found_mixed 2 "give the same test before and after" -- "$DAQ" report --
 # All five in one Chromium (render_reports.py runs report_render_test.py on each, its checks
 # unchanged; a browser's start-up costs about 1 s).
 "$PY" "$TESTS/../cli/render_reports.py" "r1=$TMP/r1.html:$TMP/r1.png:SIMULATED — Run " "r2=$TMP/r2.html:$TMP/r2.png:SIMULATED — Run " \
-  "camp=$TMP/camp.html:$TMP/camp.png:Campaign" "cmp=$TMP/cmp.html:$TMP/cmp.png:Comparison" \
-  "af=$TMP/af.html:$TMP/af.png:As found" >rendered.txt 2>&1
+  "camp=$TMP/camp.html:$TMP/camp.png:SIMULATED, REPLAYED — Campaign" "cmp=$TMP/cmp.html:$TMP/cmp.png:Comparison" \
+  "af=$TMP/af.html:$TMP/af.png:SIMULATED, REPLAYED — As found" >rendered.txt 2>&1
 check_file rendered.txt <<'END'
 rendered ^r1: rendered 5 plots
 rendered_circle ^r2: rendered 1 plots

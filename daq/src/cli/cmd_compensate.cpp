@@ -170,7 +170,7 @@ std::string straightness_run_text(CompensateOptions& o, const ct::Spec& spec,
   const std::string format = o.format == "isg" ? "isg-cross" : o.format;
   try {
     cal::storage::Store rw(database_path(o.db));
-    CrossCompensation c{.format = format, .files = {{"", text}}};
+    CrossCompensation c{.format = format, .files = {{"", text}}, .file = o.output};
     if (format == "heidenhain") {
       // The *.COM's input axis is in the control's *.CMA: stored with the assignment it needs
       // (the table in the column of this axis), which the output names.
@@ -302,6 +302,8 @@ std::int64_t store_compensation_record(const CompensateOptions& o, const ct::Tab
     const auto& m = meaning_of(o);
     const nlohmann::json doc{{"schema", "caldaq.compensation.v1"},
                              {"format", o.format},
+                             // The file written (empty: stdout), named by daq report --verify.
+                             {"file", o.output},
                              {"writer", to_json(writer_of(o))},
                              {"meaning",
                               {{"values", m.written == ct::Sign::error ? "error" : "correction"},

@@ -1,12 +1,14 @@
 // daq model show | map: the machine model file (caldaq.model.v1/v2) and its volumetric error
 // (with rotary axes: cmd_model_rotary.cpp).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "cal/analysis/error.hpp"
 #include "cli_checks.hpp"
@@ -51,26 +53,52 @@ std::string describe_topology(kin::Topology t) {
                      tool_axes.empty() ? "no axis" : tool_axes);
 }
 
-// An error's source (the model file's free-form JSON object) as words for the page,
-// "origin: simulated; what: injected", not the raw {"origin":"simulated",...}; the terminal and
-// anything not an object keep the text as stored.
+// An error's source (the model file's free-form JSON object) as words for the page: a run that
+// daq model build took it from as "run 3 (roll, 2026-11-28T15:53:53Z); stationary axes at (200,
+// 240, 180) mm; probe offset (0, 0, -100) mm; relative to the first target", other keys as "key:
+// value" (it printed every key, "kind: run; measure: roll; probe_offset_mm: 0.0, 0.0, -100.0;
+// run_id: 3; ..."); the terminal and anything not an object keep the text as stored.
 static std::string source_words(const std::string& source, bool html) {
   const auto j = json::parse(source, nullptr, false);
   if (!html || !j.is_object()) return source;
-  std::string out;
-  for (const auto& [key, value] : j.items()) {
+  const auto text = [](const json& value) {
     std::string v;
-    if (value.is_string()) {
-      v = value.get<std::string>();
-    } else if (value.is_array()) {
-      for (const auto& x : value)
-        v += (v.empty() ? "" : ", ") + (x.is_string() ? x.get<std::string>() : x.dump());
-    } else {
-      v = value.dump();
-    }
-    out += (out.empty() ? "" : "; ") + key + ": " + v;
+    if (value.is_string()) return value.get<std::string>();
+    if (!value.is_array()) return value.dump();
+    for (const auto& x : value)
+      v += (v.empty() ? "" : ", ") + (x.is_string()   ? x.get<std::string>()
+                                      : x.is_number() ? fmt::format("{:g}", x.get<double>())
+                                                      : x.dump());
+    return v;
+  };
+  std::vector<std::string> parts;
+  std::set<std::string> said;
+  const auto say = [&](const char* key, const std::string& words) {
+    if (!j.contains(key)) return;
+    parts.push_back(words);
+    said.insert(key);
+  };
+  const std::string kind = j.value("kind", "");
+  if (kind == "run" && j.contains("run_id")) {
+    std::string what = "run " + text(j["run_id"]);
+    std::string detail;
+    if (j.contains("measure")) detail = text(j["measure"]);
+    if (j.contains("started_utc")) detail += (detail.empty() ? "" : ", ") + text(j["started_utc"]);
+    parts.push_back(detail.empty() ? what : what + " (" + detail + ")");
+    said.insert({"kind", "run_id", "measure", "started_utc"});
+  } else if (kind == "runs" && j.contains("run_ids")) {
+    parts.push_back("runs " + text(j["run_ids"]));
+    said.insert({"kind", "run_ids"});
   }
-  return out;
+  if (j.contains("stationary_mm"))
+    say("stationary_mm", "stationary axes at (" + text(j["stationary_mm"]) + ") mm");
+  if (j.contains("probe_offset_mm"))
+    say("probe_offset_mm", "probe offset (" + text(j["probe_offset_mm"]) + ") mm");
+  if (j.contains("treatment")) say("treatment", text(j["treatment"]));
+  if (j.contains("from")) say("from", text(j["from"]));
+  for (const auto& [key, value] : j.items())
+    if (!said.count(key)) parts.push_back(key + ": " + text(value));
+  return fmt::format("{}", fmt::join(parts, "; "));
 }
 
 std::vector<std::vector<std::string>> describe_components(const mdl::Model& m, bool html) {

@@ -374,7 +374,9 @@ std::optional<ToStore> to_store(const Options& o, const Written& w) {
     throw cal::InputError(fmt::format(
         "--machine: a {} compensation cannot be read back for daq verify; nothing was written",
         o.format));
-  ToStore s{CrossCompensation{.format = format, .files = {}, .axis_numbers = numbers_of(o)}, 0};
+  ToStore s{CrossCompensation{
+                .format = format, .files = {}, .axis_numbers = numbers_of(o), .file = o.output},
+            0};
   std::vector<ct::CompFile> texts;
   for (const auto& [name, text] : w.files)
     if (format != "linuxcnc-matrixkins" || name == "matrixkins.hal") {

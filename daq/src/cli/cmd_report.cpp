@@ -40,6 +40,8 @@ struct ReportOptions {
   std::string campaign;
   bool compare = false;
   std::int64_t as_found = 0, as_left = 0;
+  std::int64_t verify = 0;                   // the as-left run of a compensation loop
+  std::optional<std::int64_t> compensation;  // with --verify: the table (default: daq verify's)
   std::string format = "html";
   std::string output;
   std::string standard;
@@ -224,16 +226,22 @@ void run_report_command(ReportOptions o) {
       throw cal::InputError(
           fmt::format("{}: no runs in campaign \"{}\" (see daq runs)", store.name(), o.campaign));
   }
-  if (o.runs.empty() && !o.as_found && !o.as_left)
+  if (o.runs.empty() && !o.as_found && !o.as_left && !o.verify)
     throw cal::InputError(
-        "report: give one or more RUN numbers, --campaign, or --as-found and --as-left");
+        "report: give one or more RUN numbers, --campaign, --as-found and --as-left, or "
+        "--verify RUN");
+  if (o.verify && (!o.runs.empty() || o.as_found || o.as_left || o.compare))
+    throw cal::InputError("report: --verify RUN reports that run alone (no other runs)");
+  if (o.compensation && !o.verify)
+    throw cal::InputError("report: --compensation is for --verify RUN");
   const fs::path named_output(o.output);
   // How far a long report is, on the terminal (stderr) only, as daq export shows it; not when
   // the report itself goes to a stream (-o /dev/stdout), which may be that terminal.
   std::error_code stream_error;
   const bool show_progress = o.output.empty() || !fs::exists(named_output, stream_error) ||
                              fs::is_regular_file(named_output, stream_error);
-  const std::string job = o.as_found || o.as_left
+  const std::string job = o.verify ? fmt::format("verification report of run {}", o.verify)
+                          : o.as_found || o.as_left
                               ? fmt::format("report of runs {} and {}", o.as_found, o.as_left)
                               : fmt::format("report of run{} {}", o.runs.size() > 1 ? "s" : "",
                                             fmt::join(o.runs, ", "));
@@ -250,7 +258,12 @@ void run_report_command(ReportOptions o) {
     shown = done;
   };
   std::string html, kind, stem;
-  if (o.as_found || o.as_left) {
+  if (o.verify) {
+    html = cal::daq::report::verification_report(store, o.verify, o.compensation, ro);
+    kind = "verification";
+    stem = fmt::format("verification-run-{}", o.verify);
+    o.runs = {o.verify};
+  } else if (o.as_found || o.as_left) {
     if (!o.as_found || !o.as_left)
       throw cal::InputError("report: give both --as-found RUN and --as-left RUN");
     html = cal::daq::report::as_found_as_left_report(store, o.as_found, o.as_left, ro);
@@ -327,9 +340,17 @@ void add_report_command(CLI::App& app) {
       "--as-found", o->as_found,
       "With --as-left: the run before the compensation, side by side with the run after");
   cmd->add_option("--as-left", o->as_left, "With --as-found: the run after the compensation");
+  cmd->add_option("--verify", o->verify,
+                  "The compensation loop's report of this as-left run (what daq verify checks): "
+                  "the table, the as-found and as-left runs, what the table was to remove and "
+                  "what it did, the finding and the verdict");
+  cmd->add_option("--compensation", o->compensation,
+                  "With --verify: the stored compensation (default: daq verify's, the newest "
+                  "of the run's machine and axis stored before it)");
   cmd->add_option("-f,--format", o->format, "html or pdf")->capture_default_str();
   cmd->add_option("-o,--output", o->output,
-                  "Output file (default report-run-N.html, report-runs-..., comparison-runs-...)");
+                  "Output file (default report-run-N.html, report-runs-..., comparison-runs-..., "
+                  "verification-run-N...)");
   cmd->add_option("-s,--standard", o->standard,
                   "Linear runs: evaluate by this standard (default: the run's)");
   cmd->add_flag("--json", o->json, "Print what was written as JSON (caldaq.report.v1)");

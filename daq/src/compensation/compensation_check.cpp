@@ -241,6 +241,7 @@ std::optional<LoopCheck> check_cross_run(const cal::storage::RunReader& store,
         in.table_applied_um.push_back(ct::cross_correction_um(applied, p)[dir]);
       }
   std::vector<double> spread;
+  std::vector<char> sense;  // of each point: '+' approached upwards, '-' downwards
   for (const auto& s : after) {
     const auto b = std::find_if(before.begin(), before.end(), [&](const auto& x) {
       return std::abs(x.target_mm - s.target_mm) < 1e-6;
@@ -257,13 +258,13 @@ std::optional<LoopCheck> check_cross_run(const cal::storage::RunReader& store,
       in.applied_um.push_back(c);
       in.after_um.push_back(forward ? s.mean_up_um : s.mean_down_um);
       spread.push_back(forward ? s.s_up_um : s.s_down_um);
+      sense.push_back(forward ? '+' : '-');
     }
   }
   if (in.target_mm.size() < 2) return std::nullopt;
   std::sort(spread.begin(), spread.end());
   in.noise_um = spread[spread.size() / 2];
-  LoopCheck out{*comp, ct::verify(in), in.target_mm.size(), component, found->id};
-  return out;
+  return LoopCheck{*comp, ct::verify(in), in.target_mm.size(), component, found->id, in, sense};
 }
 
 }  // namespace
@@ -294,6 +295,7 @@ std::int64_t store_cross_compensation(cal::storage::Store& store, std::int64_t m
                    {"evidence", ct::to_string(m.evidence)},
                    {"source", m.source}}},
                  {"files", files},
+                 {"file", c.file},
                  {"origin", origin}};
   return store.add_compensation({.machine_id = machine_id,
                                  .source_run_id = source_run_id,
@@ -382,6 +384,7 @@ std::optional<LoopCheck> check_run(const cal::storage::RunReader& store, std::in
   const auto stats = cal::iso230_2::target_stats(m, 1);
   ct::VerifyInput in{.table_position_mm = table_x, .table_applied_um = fwd};
   std::vector<double> spread;
+  std::vector<char> sense;  // of each point: '+' approached upwards, '-' downwards
   for (const auto& s : stats) {
     const auto up = before_at(src_x, src_up, s.target_mm);
     const auto down = before_at(src_x, src_down, s.target_mm);
@@ -393,12 +396,14 @@ std::optional<LoopCheck> check_run(const cal::storage::RunReader& store, std::in
       in.applied_um.push_back(ct::correction_at_um(table_x, forward ? fwd : rev, s.target_mm));
       in.after_um.push_back(forward ? s.mean_up_um : s.mean_down_um);
       spread.push_back(forward ? s.s_up_um : s.s_down_um);
+      sense.push_back(forward ? '+' : '-');
     }
   }
   if (in.target_mm.size() < 2) return std::nullopt;
   std::sort(spread.begin(), spread.end());
   in.noise_um = spread[spread.size() / 2];
-  return LoopCheck{*comp, ct::verify(in), in.target_mm.size()};
+  // The as-found run is the table's source (0: a table from a model or a file).
+  return LoopCheck{*comp, ct::verify(in), in.target_mm.size(), "", comp->source_run_id, in, sense};
 }
 
 std::string corrected_table(const LoopCheck& c) {

@@ -42,6 +42,7 @@ struct CrossCompensation {
   std::string format;
   std::vector<std::pair<std::string, std::string>> files;  // name ("" for one file), text
   std::map<std::string, int> axis_numbers{{"X", 1}, {"Y", 2}, {"Z", 3}};
+  std::string file;  // the path one file was written to (-o), named by the report; "": stdout
 };
 // Stored with the machine (returns the id); `source_run_id` 0 for one from a model. The
 // compensation's axis is the axes it corrects ("Y", "XYZ"). Throws cal::InputError for files the
@@ -60,6 +61,10 @@ struct LoopCheck {
   // newest run of the component before the compensation was stored).
   std::string component;
   std::int64_t as_found_run = 0;
+  // What was compared, per point (a target and a direction, '+' or '-'): the as-found error,
+  // what the table adds there, the as-left error (um); the report draws and lists them.
+  cal::comptable::VerifyInput input;
+  std::vector<char> direction;
 };
 // The newest compensation stored for the run's machine and axis before the run started (or the
 // one given), checked against the run's captured stops. A straightness run is checked against

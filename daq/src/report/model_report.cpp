@@ -173,24 +173,34 @@ Stats stats_over(const kin::Grid& g, const ErrorOf& error) {
   return s;
 }
 
-std::string stats_table(const Stats& s) {
-  std::vector<std::vector<std::string>> rows{
-      {"largest |e|", fmt::format("{:.3f} µm at ({:g}, {:g}, {:g}) mm", s.max_norm_um, s.at_mm[0],
-                                  s.at_mm[1], s.at_mm[2])},
-      {"RMS |e| over the grid", fmt::format("{:.3f} µm", s.rms_um)}};
-  for (std::size_t a = 0; a < 3; ++a)
-    rows.push_back({fmt::format("e<sub>{}</sub> range", kAxis[a]),
-                    fmt::format("{} .. {} µm (span {})", ::daq::number_text(s.min_um[a]),
-                                ::daq::number_text(s.max_um[a]),
-                                ::daq::number_text(s.max_um[a] - s.min_um[a]))});
-  return table({"", ""}, rows, "kv");
+// The grid's statistics, one column per map (the model; after a compensation, the residual
+// beside it): the answer, on page one.
+std::string stats_table(const std::vector<std::string>& head, const std::vector<Stats>& maps) {
+  std::vector<std::vector<std::string>> rows(5);
+  rows[0] = {"largest |e|"};
+  rows[1] = {"RMS |e| over the grid"};
+  for (std::size_t a = 0; a < 3; ++a) rows[2 + a] = {fmt::format("e<sub>{}</sub> range", kAxis[a])};
+  for (const auto& s : maps) {
+    rows[0].push_back(fmt::format("{:.3f} µm at ({:g}, {:g}, {:g}) mm", s.max_norm_um, s.at_mm[0],
+                                  s.at_mm[1], s.at_mm[2]));
+    rows[1].push_back(fmt::format("{:.3f} µm", s.rms_um));
+    for (std::size_t a = 0; a < 3; ++a)
+      rows[2 + a].push_back(fmt::format("{} .. {} µm (span {})", ::daq::number_text(s.min_um[a]),
+                                        ::daq::number_text(s.max_um[a]),
+                                        ::daq::number_text(s.max_um[a] - s.min_um[a])));
+  }
+  return table(head, rows, maps.size() > 1 ? "stats" : "kv");
 }
 
-std::string slices_section(const kin::Grid& g, const ErrorOf& error, std::string_view what) {
+// `mag` 0: the magnification that shows this map's errors; else the one given (a residual is
+// drawn at the model's scale, so that what is left reads against what was there: drawn at its
+// own, 0.000 µm of rounding noise was magnified 1e+08 times into a distorted grid).
+std::string slices_section(const kin::Grid& g, const ErrorOf& error, std::string_view what,
+                           double mag = 0.0) {
   const auto ss = slices(g, error);
   if (ss.empty())
     return "<p class=\"note\">The grid is flat in at least two axes: no slice to draw.</p>\n";
-  const double mag = magnification(ss);
+  if (mag <= 0.0) mag = magnification(ss);
   std::string h;
   for (const auto& s : ss)
     h += figure(slice_chart(s, mag, what),
@@ -212,9 +222,9 @@ std::string contributions_section(const ModelPage& p) {
                     fmt::format("{:.3f}", c.max_norm_um), fmt::format("{:.3f}", c.rms_um),
                     fmt::format("<div class=\"bar\" style=\"width:{:.1f}%\"></div>", w)});
   }
-  return "<h2>Contributions, ranked</h2>\n<p>What each error alone gives over the grid (first "
-         "order: the contributions add up to the whole map). Squareness is listed under the axis "
-         "it tilts.</p>\n" +
+  return "<h3>Contributions, ranked</h3>\n<p>What each error alone gives over the grid (first "
+         "order: the contributions add up to the whole map): the first are the ones to correct "
+         "first. Squareness is listed under the axis it tilts.</p>\n" +
          table({"rank", "error", "axis", "largest |e| (µm)", "RMS (µm)", ""}, rows, "rank");
 }
 
@@ -237,8 +247,23 @@ figcaption { font-size: .85rem; color: #444; }
 .note { color: #444; font-size: .9rem; }
 .simulated { background: #fff3cd; border: 1px solid #e0b000; padding: .5rem; }
 footer { margin-top: 3rem; font-size: .8rem; color: #666; border-top: 1px solid #ccc; }
-@page { size: A4; margin: 14mm; }
+h3 { font-size: 1.1rem; margin-top: 1.2rem; break-after: avoid; }
+table.stats td:not(:first-child) { white-space: nowrap; }
+.appendix { break-before: page; }
+@media print { html, body { font-size: 10pt; } body { margin: 0; padding: 0; max-width: none; }
+  h2 { margin-top: 1rem; } figure { margin: .4rem 0; } }
 )";
+
+// The printed page's margins: the title at the top (data: css_string keeps it inside its
+// string), "page n of m" at the bottom, as the run reports print.
+std::string print_css(std::string_view title) {
+  return fmt::format(
+      "@page {{ size: A4; margin: 16mm 14mm 16mm 14mm;\n"
+      "  @top-left {{ content: {}; font: 8pt \"DejaVu Sans\", sans-serif; color: #555; }}\n"
+      "  @bottom-right {{ content: \"page \" counter(page) \" of \" counter(pages); "
+      "font: 8pt \"DejaVu Sans\", sans-serif; color: #555; }} }}\n",
+      css_string(title));
+}
 
 std::string now_utc() {
   return cal::text::utc_text(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now()),
@@ -272,7 +297,40 @@ std::string model_page(const ModelPage& p) {
         "the numbers show what the software computes, not a real machine.{}</p>\n",
         not_to_load);
   }
-  body += "<h2>Model</h2>\n";
+  // Page one is the answer: how large the error is (and after a compensation, what is left),
+  // and which errors make it; then the slices; the model itself is the appendix.
+  const auto model_stats = stats_over(p.grid, before);
+  body +=
+      "<h2>Volumetric error</h2>\n<p>The error of the tool tip relative to the workpiece "
+      "(actual minus commanded), over the grid";
+  if (p.compensated) {
+    const auto& c = *p.compensated;
+    body += fmt::format(
+        ", as the model gives it and with the compensation applied ({}: the "
+        "exact model driven to the corrected position):</p>\n",
+        esc(c.what));
+    body += stats_table({"", "the model", "after the compensation"},
+                        {model_stats, stats_over(p.grid, c.residual_um)});
+    for (const auto& n : c.notes) body += "<p class=\"note\">" + esc(n) + "</p>\n";
+  } else {
+    body += ":</p>\n" + stats_table({"", ""}, {model_stats});
+  }
+  body += contributions_section(p);
+  const auto model_slices = slices(p.grid, before);
+  const double mag = model_slices.empty() ? 1.0 : magnification(model_slices);
+  body +=
+      "<h3>The error over the volume</h3>\n" + slices_section(p.grid, before, "with error", mag);
+  if (p.compensated) {
+    const auto& c = *p.compensated;
+    body += fmt::format("<h2>After compensation: {}</h2>\n", esc(c.what));
+    body += fmt::format(
+        "<p>What the tool tip does relative to the commanded position with the compensation "
+        "applied, drawn at the model's scale ({:g} times) so that what is left reads against what "
+        "was there.</p>\n",
+        mag);
+    body += slices_section(p.grid, c.residual_um, "residual", mag);
+  }
+  body += "<div class=\"appendix\">\n<h2>Appendix: the model</h2>\n";
   std::vector<std::vector<std::string>> facts{{"file", esc(p.source)}};
   for (const auto& [k, v] : p.facts) facts.push_back({esc(k), esc(v)});
   facts.push_back({"method", method == kin::Method::htm ? "exact (homogeneous transformations)"
@@ -292,30 +350,14 @@ std::string model_page(const ModelPage& p) {
     }
     body += table({"error", "given as", "values", "source"}, rows);
   }
-  body +=
-      "<h2>Volumetric error</h2>\n<p>The error of the tool tip relative to the workpiece "
-      "(actual minus commanded), over the grid:</p>\n";
-  body += stats_table(stats_over(p.grid, before));
-  body += slices_section(p.grid, before, "with error");
-  body += contributions_section(p);
-  if (p.compensated) {
-    const auto& c = *p.compensated;
-    body += fmt::format("<h2>After compensation: {}</h2>\n", esc(c.what));
-    body +=
-        "<p>What the tool tip does relative to the commanded position with the "
-        "compensation applied to the model (exact model, driven to the corrected "
-        "position):</p>\n";
-    body += stats_table(stats_over(p.grid, c.residual_um));
-    for (const auto& n : c.notes) body += "<p class=\"note\">" + esc(n) + "</p>\n";
-    body += slices_section(p.grid, c.residual_um, "residual");
-  }
+  body += "</div>\n";
   const std::string title = p.title.empty() ? "Volumetric error" : "Volumetric error: " + p.title;
   return fmt::format(
       "<!doctype html>\n<html lang=\"en\">\n<head>\n{}\n<meta charset=\"utf-8\">\n"
-      "<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<footer>Generated "
+      "<title>{}</title>\n<style>{}{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<footer>Generated "
       "by {} on {}. Plots drawn with PLplot. Self-contained: no external resources.</footer>\n"
       "</body>\n</html>\n",
-      csp_meta(), esc(title), kCss, esc(title), body, esc(p.software), now_utc());
+      csp_meta(), esc(title), kCss, print_css(title), esc(title), body, esc(p.software), now_utc());
 }
 
 }  // namespace cal::daq::report

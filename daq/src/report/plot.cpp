@@ -158,9 +158,10 @@ PLINT legend_columns(std::size_t labelled, std::size_t longest_bytes, double vie
 
 // `columns` 0: one column; `y` the offset from the position, in the viewport's height.
 // text_scale: the legend's text against PLplot's default size (pllegend does not follow plschr).
-void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
-                 PLFLT y = 0.0, PLFLT text_scale = 1.0) {
-  if (entries.empty()) return;
+// Returns the legend's width in the viewport's width (0: none drawn).
+PLFLT draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT columns = 0,
+                  PLFLT y = 0.0, PLFLT text_scale = 1.0, PLFLT x = 0.015) {
+  if (entries.empty()) return 0.0;
   const auto n = static_cast<PLINT>(entries.size());
   std::vector<PLINT> opt, colours, text_colours, styles, box_patterns, symbol_numbers;
   std::vector<PLFLT> widths, scales;
@@ -179,11 +180,12 @@ void draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT 
   }
   PLFLT w = 0, h = 0;
   const PLINT rows = columns > 0 ? (n + columns - 1) / columns : 0;
-  pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.015, y, 0.05, 0,
+  pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, x, y, 0.05, 0,
            axes_colour, 1, rows, columns, n, opt.data(), 0.6, text_scale, 1.8, 0.0,
            text_colours.data(), texts.data(), colours.data(), box_patterns.data(), scales.data(),
            widths.data(), colours.data(), styles.data(), widths.data(), colours.data(),
            scales.data(), symbol_numbers.data(), symbols.data());
+  return w;
 }
 
 void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
@@ -227,9 +229,17 @@ void category_label(PLINT axis, PLFLT value, char* out, PLINT length, PLPointer 
   std::snprintf(out, static_cast<std::size_t>(length), "%s", text.c_str());
 }
 
-}  // namespace
+// An XY chart drawn with at most `max_columns` legend columns, the legend's centre `legend_x`
+// from the viewport's (in its width); told the legend's width and where the viewport is, in
+// the canvas's width.
+struct XyDrawn {
+  std::string svg;
+  PLINT columns = 0;
+  double legend_w = 0.0;  // in the viewport's width
+  double left = 0.0, right = 0.97;
+};
 
-std::string svg(const XyChart& chart) {
+XyDrawn draw_xy(const XyChart& chart, std::size_t max_columns, double legend_x = 0.015) {
   Range x, y;
   for (const auto& b : chart.bands) {
     for (double v : b.x) x.add(v);
@@ -276,7 +286,8 @@ std::string svg(const XyChart& chart) {
           : std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
   // The legend as wide as the plot's frame at most (it is centred under it).
   const PLINT columns =
-      legend ? legend_columns(labelled, longest, (0.97 - left) * chart.width_pt, char_pt, 4) : 0;
+      legend ? legend_columns(labelled, longest, (0.97 - left) * chart.width_pt, char_pt, max_columns)
+             : 0;
   const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
   const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
   const double total_pt = chart.height_pt + legend_pt;
@@ -345,10 +356,35 @@ std::string svg(const XyChart& chart) {
   plmtex("l", label_disp, 0.5, 0.5, plot_text(chart.y_label).c_str());
   plmtex("t", 1.5, 0.5, 0.5, plot_text(chart.title).c_str());
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
-  if (legend)
-    draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, columns,
-                3.7 * char_pt / ((top - bottom) * total_pt));
-  return s.finish(chart.title);
+  const double legend_w =
+      legend ? draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT,
+                           columns, 3.7 * char_pt / ((top - bottom) * total_pt), 1.0, legend_x)
+             : 0.0;
+  return {s.finish(chart.title), columns, legend_w, left, 0.97};
+}
+
+}  // namespace
+
+// The legend's columns are estimated from the labels' lengths; PLplot measures the text itself,
+// and a legend wider than the plot, centred under it, lost its right edge past the canvas's (the
+// environment plot's frame was cut off after "material: gauge"). Such a legend is drawn again
+// centred on the canvas (the room left of the plot, under the y axis's labels, is free), and
+// only when it is wider than the canvas with a column fewer (a row more moved the plot of a
+// report off its page one).
+std::string svg(const XyChart& chart) {
+  auto drawn = draw_xy(chart, 4);
+  for (;;) {
+    const double span = drawn.right - drawn.left;  // the viewport, in the canvas's width
+    const double width = drawn.legend_w * span;    // the legend, in the canvas's width
+    if (drawn.legend_w <= 0 || drawn.left + span * (0.5 + 0.015) + width / 2 <= 0.995)
+      return std::move(drawn.svg);
+    if (width <= 0.99)  // centred on the canvas: its centre 0.5, in the viewport's width
+      return std::move(
+          draw_xy(chart, static_cast<std::size_t>(drawn.columns), (0.5 - drawn.left) / span - 0.5)
+              .svg);
+    if (drawn.columns <= 1) return std::move(drawn.svg);
+    drawn = draw_xy(chart, static_cast<std::size_t>(drawn.columns - 1));
+  }
 }
 
 namespace {

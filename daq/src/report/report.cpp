@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <ctime>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <regex>
 
 #include "ballbar_campaign.hpp"
 #include "cal/analysis/air.hpp"
@@ -1748,7 +1750,8 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     count += series[i].count;
   }
   struct Thinned {
-    Series s;
+    Series s;             // labelled by the instrument ("ids3010 SIM-IDS-0001, channel 2")
+    std::string title;    // by its role ("laser"), the quantity and the channel follow
     std::string channel;  // ", channel 2" (after the quantity in the title)
     std::size_t step = 1, seen = 0;
   };
@@ -1763,8 +1766,11 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     to_read += static_cast<std::uint64_t>(x.count);
     auto& t = by[{x.quantity, x.device, x.channel}];
     t.step = std::max<std::size_t>(1, static_cast<std::size_t>(x.count) / 4000);
-    t.s.label = instrument_name(v, x.device);
     t.channel = x.channel > 0 ? fmt::format(", channel {}", x.channel) : "";
+    // The legend names the instrument (its driver and serial), as the environment plots do; it
+    // read "laser displacement (mm)", the title again.
+    t.title = instrument_name(v, x.device);
+    t.s.label = instrument_label(v, x.device) + t.channel;
     if (std::find(plotted.begin(), plotted.end(), x.quantity) == plotted.end())
       plotted.push_back(x.quantity);
   }
@@ -1787,12 +1793,12 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
   for (auto& [key, t] : by) {
     const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
     for (auto& x : t.s.value) x *= unit.factor;
-    t.s.label += " " + unit.label + t.channel;
-    h += figure(svg(XyChart{.title = t.s.label,
+    t.title += " " + unit.label + t.channel;
+    h += figure(svg(XyChart{.title = t.title,
                             .x_label = "time (min)",
                             .y_label = unit.label,
                             .lines = lines_of({t.s}, i++, 4000)}),
-                t.s.label + " over the run.");
+                t.title + " over the run.");
   }
   return h;
 }
@@ -2034,7 +2040,7 @@ table.results, table.diag { width: 100%; }
   figure { margin: .3rem 0; } .verdict { margin: .3rem 0; } p { margin: .3rem 0; }
   h2 { page-break-before: always; } h2:first-of-type { page-break-before: auto; }
   svg.plot { max-width: 100%; margin: 0 auto; } svg.plot.polar { max-width: 72%; }
-  .pair svg.plot.polar { max-width: 100%; }
+  .pair svg.plot.polar { max-width: 100%; } .overlay-polar svg.plot.polar { max-width: 50%; }
   h2.run { break-before: page; page-break-before: always; } }
 .pair svg.plot.polar { max-width: 100%; }
 )";
@@ -2094,6 +2100,70 @@ std::string origin_banner(const RunView& v) {
   if (o.imported)
     h += "<p class=\"simulated\"><strong>IMPORTED</strong> from another tool's file.</p>\n";
   return h;
+}
+
+// A report of several runs: which of them were not measured on real instruments, by origin
+// ("SIMULATED: all 18 runs of this report ..."), for its page one, and the origins as the title's
+// prefix ("SIMULATED, REPLAYED"): the names (a campaign, a machine) may say nothing of it.
+struct Origins {
+  std::string banner, label;
+};
+// Each run's origin label ("" for real instruments), in the report's order.
+using RunLabels = std::vector<std::pair<std::int64_t, std::string>>;
+std::string origin_label(const RunView& v) {
+  return ::daq::run_origin(v.run, v.instruments, v.machine).label();
+}
+Origins origins_of(const RunLabels& runs) {
+  // By each word of a label ("SIMULATED, REPLAYED" is both): a replay of a simulated run is
+  // simulated like the run it replays, and replayed besides.
+  // In the order the runs' labels name them ("SIMULATED, REPLAYED", as a run's title).
+  std::vector<std::pair<std::string, std::vector<std::int64_t>>> by_origin;
+  for (const auto& [id, label] : runs)
+    for (std::size_t at = 0; at < label.size();) {
+      const auto end = std::min(label.find(", ", at), label.size());
+      const auto word = label.substr(at, end - at);
+      auto it = std::find_if(by_origin.begin(), by_origin.end(),
+                             [&](const auto& b) { return b.first == word; });
+      if (it == by_origin.end()) it = by_origin.insert(by_origin.end(), {word, {}});
+      it->second.push_back(id);
+      at = end + 2;
+    }
+  Origins o;
+  for (const auto& [origin, ids] : by_origin) {
+    const std::string which =
+        ids.size() == runs.size()
+            ? (runs.size() == 1   ? std::string("the run of this report")
+               : runs.size() == 2 ? std::string("both runs of this report")
+                                  : fmt::format("all {} runs of this report", runs.size()))
+            : fmt::format("run{} {} ({} of {})", ids.size() > 1 ? "s" : "", fmt::join(ids, ", "),
+                          ids.size(), runs.size());
+    const bool several = ids.size() > 1;
+    const std::string what =
+        origin == "SIMULATED"
+            ? fmt::format(
+                  "{} made on the simulated machine and instruments: the numbers show "
+                  "what the software measures, not a real machine",
+                  several ? "were" : "was")
+        : origin == "REPLAYED"
+            ? fmt::format(
+                  "{} pushed through the drivers again from a recorded capture, not "
+                  "measured now",
+                  several ? "were" : "was")
+        : origin == "IMPORTED"
+            ? fmt::format("{} imported from another tool's file", several ? "were" : "was")
+            : fmt::format(
+                  "{} not measured on real instruments alone (each run's section says "
+                  "which instruments were what)",
+                  several ? "were" : "was");
+    o.banner += fmt::format("<p class=\"simulated\"><strong>{}</strong>: {} {}.</p>\n", esc(origin),
+                            which, what);
+    o.label += (o.label.empty() ? "" : ", ") + origin;
+  }
+  return o;
+}
+
+std::string titled(const Origins& o, std::string title) {
+  return o.label.empty() ? title : o.label + " — " + title;
 }
 
 // The as-left check of a compensation written before this run (compensation_check.hpp).
@@ -2294,8 +2364,12 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
   if (runs.empty()) throw cal::InputError("campaign report: no runs to report");
   std::vector<std::vector<std::string>> summary;
   std::string sections, who;
+  // The runs not measured on real instruments: page one says so whatever the campaign and the
+  // machine are named (it relied on the names).
+  RunLabels labels;
   for (const auto id : runs) {
     const auto v = load(store, id);
+    labels.emplace_back(id, origin_label(v));
     Headline hl;
     const auto body = run_body(store, v, o, hl);
     // Each value kept whole on its line with its name ("E 8.576 µm", "Backlash X +4.084 µm"),
@@ -2325,12 +2399,14 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
         fmt::format("<h2 class=\"run\" id=\"run-{}\">{}</h2>\n{}", id, esc(run_title(v)), body);
     if (who.empty()) who = who_of(v);
   }
+  const auto origins = origins_of(labels);
   const std::string body =
-      fmt::format("<p>{} runs.</p>\n", runs.size()) +
+      origins.banner + fmt::format("<p>{} runs.</p>\n", runs.size()) +
       table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
             "campaign", "r") +
       volumetric_section(store, runs) + sections;
-  return page(title, body, o, who);
+  // The origin leads the title, so it is on every printed page's running header too.
+  return page(titled(origins, std::string(title)), body, o, who);
 }
 
 namespace {
@@ -2608,9 +2684,9 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   XyChart overlay{.title = "Mean bidirectional deviation, as found and as left",
                   .x_label = "target position (mm)",
                   .y_label = "deviation (µm)",
-                  .height_pt = 300,
+                  .height_pt = 240,
                   .zero_line = true};
-  PolarChart polar{.title = "As found and as left (least-squares centres removed)"};
+  PolarChart polar{.title = "As found and as left"};
   const auto side = [&](const RunView& v, std::size_t colour, const char* label) {
     Side sd;
     if (v.run.kind == "linear") {
@@ -2655,18 +2731,48 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
            : v.pass      ? std::string("<span class=\"pass\">PASS</span>")
                          : std::string("<span class=\"fail\">FAIL</span>");
   };
-  std::string body = fmt::format(
+  // Page one: where the readings came from, who and what, the verdict of each run with its
+  // failing values, the plot, the table (it began with the table and its verdict row at the
+  // bottom, no SIMULATED banner, and a circle's polar plot was pushed to page two).
+  const auto origins = origins_of({{found_id, origin_label(found)}, {left_id, origin_label(left)}});
+  std::string body = origins.banner + summary_block(left, test_name(left));
+  const auto verdict_words = [&](const Side& sd, const char* when, std::int64_t id) {
+    std::string failing;
+    for (const auto& c : sd.verdict.checks)
+      if (!c.pass)
+        failing += fmt::format(
+            "{}{} = {} {} (limit ≤ {} {})", failing.empty() ? "" : "; ", esc(c.symbol),
+            ::daq::diagnostic_advice(c.key).empty() ? um(c.value) : signed_text(c.value, 3),
+            esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+    return fmt::format("{} (run {}): <strong>{}</strong>{}", when, id, banner(sd.verdict),
+                       failing.empty() ? "" : " &mdash; " + failing);
+  };
+  const bool left_fails = b.verdict.configured && !b.verdict.pass;
+  body += fmt::format("<p class=\"verdict {}\">{}.<br>{}.</p>\n",
+                      left_fails                               ? "fail"
+                      : b.verdict.configured && b.verdict.pass ? "pass"
+                                                               : "none",
+                      verdict_words(a, "As found", found_id), verdict_words(b, "As left", left_id));
+  body += fmt::format(
       "<p>The machine as it was found (run {}, {}) and as it was left after the compensation "
       "(run {}, {}): the same test, side by side. Each run's full report follows.</p>\n",
       found_id, date_of(found), left_id, date_of(left));
+  if (found.run.kind == "linear") {
+    body += figure(svg(overlay), "The mean bidirectional positional deviation before and after.");
+  } else {
+    // Half the page's width, so that the table fits under it on page one; its text scaled as a
+    // polar plot beside a table is, to print at 9 pt or larger.
+    polar.text_scale = polar_beside_text_scale;
+    body +=
+        "<div class=\"overlay-polar\">" +
+        figure(svg(polar),
+               "Both directions of both runs on one scale, their least-squares centres removed.") +
+        "</div>\n";
+  }
   rows.push_back({"<strong>verdict</strong>", banner(a.verdict), banner(b.verdict), "", ""});
   body += table({"value", fmt::format("as found, run {}", found_id),
                  fmt::format("as left, run {}", left_id), "change", "limit"},
                 rows, "num results", "lrrrr");
-  if (found.run.kind == "linear")
-    body += figure(svg(overlay), "The mean bidirectional positional deviation before and after.");
-  else
-    body += figure(svg(polar), "Both directions of both runs on one scale.");
   Headline hl;
   body += fmt::format("<h2 class=\"run\" id=\"run-{}\">As found: {}</h2>\n", found_id,
                       esc(run_title(found))) +
@@ -2674,8 +2780,252 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   body += fmt::format("<h2 class=\"run\" id=\"run-{}\">As left: {}</h2>\n", left_id,
                       esc(run_title(left))) +
           run_body(store, left, o, hl);
-  return page(fmt::format("As found and as left: {} test of {}", found.run.kind, found.run.axis),
+  return page(titled(origins, fmt::format("As found and as left: {} test of {}", found.run.kind,
+                                          found.run.axis)),
               body, o, who_of(found));
+}
+
+// --- the compensation loop: an as-left run against the table written before it ------------------
+
+namespace {
+
+namespace ct = cal::comptable;
+
+// Per target (the mean of the directions compared there): as found, what the table adds
+// (expected change), as left.
+struct LoopProfile {
+  std::vector<double> target_mm, found_um, change_um, left_um;
+};
+LoopProfile loop_profile(const ct::VerifyInput& in) {
+  LoopProfile p;
+  for (std::size_t i = 0; i < in.target_mm.size();) {
+    std::size_t j = i;
+    double f = 0, c = 0, l = 0;
+    for (; j < in.target_mm.size() && std::abs(in.target_mm[j] - in.target_mm[i]) < 1e-9; ++j)
+      f += in.before_um[j], c += in.applied_um[j], l += in.after_um[j];
+    const double n = static_cast<double>(j - i);
+    p.target_mm.push_back(in.target_mm[i]);
+    p.found_um.push_back(f / n), p.change_um.push_back(c / n), p.left_um.push_back(l / n);
+    i = j;
+  }
+  return p;
+}
+
+Line loop_line(const std::vector<double>& x, const std::vector<double>& y, std::string label,
+               Rgb colour, bool dashed) {
+  return {.x = x,
+          .y = y,
+          .label = std::move(label),
+          .colour = colour,
+          .width = 1.6,
+          .dashed = dashed,
+          .markers = !dashed};
+}
+
+// Whether the control applied the table's sign, units, reference point and positions as written:
+// what the finding says about each (a finding explains the whole change by one of them).
+std::vector<std::vector<std::string>> loop_checks(const ct::Verification& v) {
+  using F = ct::Finding;
+  const auto ok = std::string("<span class=\"pass\">as written</span>");
+  const auto bad = [](const std::string& s) { return "<span class=\"fail\">" + s + "</span>"; };
+  const bool decided = v.finding == F::as_predicted || v.finding == F::inverted_sign ||
+                       v.finding == F::unit_scale || v.finding == F::constant_shift ||
+                       v.finding == F::position_shift;
+  const std::string unknown =
+      "<span class=\"unstated\">not determined (" + esc(ct::to_string(v.finding)) + ")</span>";
+  if (!decided)
+    return {{"Sign", unknown},
+            {"Units", unknown},
+            {"Reference point", unknown},
+            {"Table positions", unknown}};
+  return {{"Sign", v.finding == F::inverted_sign ? bad("inverted: the control applies −1 × the "
+                                                       "values")
+                                                 : ok},
+          {"Units",
+           v.finding == F::unit_scale
+               ? bad(fmt::format("wrong: the control applies {} × the values", fixed(v.scale, 4)))
+               : ok},
+          {"Reference point",
+           v.finding == F::constant_shift
+               ? bad(fmt::format("off: a constant {} µm added", signed_text(v.offset_um, 3)))
+               : ok},
+          {"Table positions", v.finding == F::position_shift
+                                  ? bad(fmt::format("shifted by {} mm", signed_text(v.shift_mm, 3)))
+                                  : ok}};
+}
+
+// The table checked: its number, format, files, where it came from, the machine, when written,
+// and what its values mean by the vendor's text.
+std::vector<std::vector<std::string>> loop_table_rows(const ::daq::LoopCheck& c,
+                                                      const std::string& machine) {
+  const json doc = json::parse(c.compensation.json, nullptr, false);
+  // The path a single file was written to (stored since the report was added), else the files'
+  // names (a compensation of several files).
+  const std::string written = doc.is_object() && doc.contains("file") && doc["file"].is_string()
+                                  ? doc["file"].get<std::string>()
+                                  : "";
+  std::string files;
+  const json listed = doc.is_object() ? doc.value("files", json::array()) : json::array();
+  for (const auto& f : listed)
+    if (f.is_object() && f.contains("name") && f["name"].is_string()) {
+      const auto name = f["name"].get<std::string>();
+      files += (files.empty() ? "" : ", ") + esc(name.empty() ? written : name);
+    }
+  if (!listed.is_array() || listed.empty()) files = esc(written);
+  if (files.empty()) files = "<span class=\"unstated\">not stored (written to the terminal)</span>";
+  return {{"Table", fmt::format("compensation {}, {} format, axis {}", c.compensation.id,
+                                esc(c.compensation.format), esc(c.compensation.axis))},
+          {"File", "<span class=\"path\">" + files + "</span>"},
+          {"Machine", esc(machine)},
+          {"Written",
+           iso_time(c.compensation.created_unix_ms) + ", from " + esc(c.compensation.source)}};
+}
+
+// What the table's values are by the vendor's text, as stored with it (for the details).
+std::string loop_meaning(const ::daq::LoopCheck& c) {
+  const json doc = json::parse(c.compensation.json, nullptr, false);
+  const json m = doc.is_object() ? doc.value("meaning", json::object()) : json::object();
+  if (!m.is_object() || m.empty()) return "";
+  return fmt::format(
+      "<p>The table's values are <strong>the {}</strong> by the vendor's text ({}: {}); "
+      "docs/compensation-tables.md.</p>\n",
+      esc(ctx(m, "values")), esc(ctx(m, "evidence")), esc(ctx(m, "source")));
+}
+
+std::string loop_verdict(const ::daq::LoopCheck& c) {
+  using F = ct::Finding;
+  const auto& v = c.verification;
+  const bool pass = v.finding == F::as_predicted;
+  const bool none = v.finding == F::too_small;
+  // A sentence of its own here, its micrometres as the report writes them (the terminal's "um").
+  std::string advice = std::regex_replace(v.text, std::regex(R"((\d) um\b)"), "$1 µm");
+  if (!advice.empty()) advice[0] = static_cast<char>(std::toupper(advice[0]));
+  return fmt::format(
+      "<p class=\"verdict {}\">Verdict: <strong>{}</strong> &mdash; finding: <strong>{}</strong>. "
+      "{}.</p>\n",
+      pass   ? "pass"
+      : none ? "none"
+             : "fail",
+      pass   ? "PASS"
+      : none ? "NOT DECIDED"
+             : "FAIL",
+      esc(ct::to_string(v.finding)), esc(advice));
+}
+
+}  // namespace
+
+std::string verification_report(const st::RunReader& store, std::int64_t run,
+                                std::optional<std::int64_t> compensation, const Options& o) {
+  const auto left = load(store, run);
+  const auto check = ::daq::check_run(store, run, compensation);
+  if (!check)
+    throw cal::InputError(fmt::format(
+        "{}: run {}: no compensation of its axis on its machine was stored before it (or none of "
+        "its stops lies where the table was made): nothing to verify (daq verify --list)",
+        store.name(), run));
+  const auto& c = *check;
+  const auto& v = c.verification;
+  std::optional<RunView> found;
+  if (c.as_found_run != 0 && store.run(c.as_found_run)) found = load(store, c.as_found_run);
+  const std::string found_name = found ? fmt::format("run {}", c.as_found_run)
+                                       : "the table's source (" + c.compensation.source + ")";
+  // What the run reads: a positioning run its own axis, a straightness run the axis it names.
+  const std::string read = c.component.empty() ? "deviation" : "deviation of " + c.component;
+  const auto p = loop_profile(c.input);
+  std::vector<double> expected;
+  for (std::size_t i = 0; i < p.target_mm.size(); ++i)
+    expected.push_back(p.found_um[i] + p.change_um[i]);
+  const std::string x_label = fmt::format("position of axis {} (mm)", left.run.axis);
+  XyChart overlay{.title = "As found, as left and as the table should leave it",
+                  .x_label = x_label,
+                  .y_label = read + " (µm)",
+                  .height_pt = 250,
+                  .zero_line = true};
+  overlay.lines.push_back(
+      loop_line(p.target_mm, p.found_um, "as found (" + found_name + ")", orange, false));
+  overlay.lines.push_back(
+      loop_line(p.target_mm, expected, "expected as left (as found + table)", green, true));
+  overlay.lines.push_back(
+      loop_line(p.target_mm, p.left_um, fmt::format("as left (run {})", run), blue, false));
+
+  RunLabels labels;
+  if (found) labels.emplace_back(found->run.id, origin_label(*found));
+  labels.emplace_back(run, origin_label(left));
+  const auto origins = origins_of(labels);
+  std::string body = origins.banner + summary_block(left, test_name(left)) + loop_verdict(c);
+  body += figure(svg(overlay),
+                 "Each target's mean of the directions compared (µm). Dashed: the as-found error "
+                 "plus what the table adds there, what the as-left run should read; a table "
+                 "applied as written puts the as-left run on it.");
+  // The numbers in the order daq verify prints them.
+  double found_max = 0;
+  for (const double x : c.input.before_um) found_max = std::max(found_max, std::abs(x));
+  std::vector<std::vector<std::string>> numbers = {
+      {"Largest |deviation| as found", um(found_max) + " µm"},
+      {"Largest |deviation| as left, predicted", um(v.predicted_max_um) + " µm"},
+      {"Largest |deviation| as left, measured", um(v.measured_max_um) + " µm"},
+      {"Points compared", fmt::format("{} (targets × directions)", c.points)},
+      {"Agreement with the finding", fmt::format("{} µm rms (within {} µm: twice the runs' "
+                                                 "repeatability, at least 0.3 µm)",
+                                                 um(v.mismatch_rms_um), um(v.tolerance_um))}};
+  body += "<div class=\"pair\"><div><h3>The finding</h3>\n" +
+          table({"", ""}, loop_checks(v), "kv") + table({"", ""}, numbers, "kv") +
+          "</div><div><h3>The table</h3>\n" +
+          table({"", ""}, loop_table_rows(c, left.machine), "kv") +
+          fmt::format("<p>As found: {}{}; as left: run {}, {}.</p>", esc(found_name),
+                      found ? ", " + date_of(*found) : std::string(), run, date_of(left)) +
+          "</div></div>\n";
+  const std::string meaning = loop_meaning(c);
+
+  // Details: what the table was to remove, what it did, point by point.
+  std::vector<double> measured;
+  for (std::size_t i = 0; i < p.target_mm.size(); ++i)
+    measured.push_back(p.left_um[i] - p.found_um[i]);
+  XyChart change{.title = "The change: expected (the table) and measured (as left − as found)",
+                 .x_label = x_label,
+                 .y_label = "change (µm)",
+                 .height_pt = 300,
+                 .zero_line = true};
+  change.lines.push_back(
+      loop_line(p.target_mm, p.change_um, "expected: what the table adds", green, true));
+  change.lines.push_back(
+      loop_line(p.target_mm, measured, "measured: as left − as found", vermilion, false));
+  body += "<div class=\"details\">\n<h3>What the table was to remove, and what it did</h3>\n";
+  body += figure(svg(change),
+                 "A table applied as written changes the deviation by what it adds (the expected "
+                 "change, which is minus the as-found error where it corrects it fully); the "
+                 "other sign mirrors it about zero, a unit error scales it, a reference-point "
+                 "error moves it up or down, a position shift moves it along the axis.");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t i = 0; i < c.input.target_mm.size(); ++i) {
+    const auto& in = c.input;
+    const char d = i < c.direction.size() ? c.direction[i] : '+';
+    rows.push_back(
+        {fixed(in.target_mm[i], 3), d == '+' ? "↑" : "↓", signed_text(in.before_um[i], 3),
+         signed_text(in.applied_um[i], 3), signed_text(in.before_um[i] + in.applied_um[i], 3),
+         signed_text(in.after_um[i], 3), signed_text(in.after_um[i] - in.before_um[i], 3),
+         signed_text(in.after_um[i] - in.before_um[i] - in.applied_um[i], 3)});
+  }
+  body += table(
+      {"target (mm)", "dir.", "as found (µm)", "expected change (µm)", "expected as left (µm)",
+       "as left (µm)", "measured change (µm)", "measured − expected (µm)"},
+      rows, "num", "rlrrrrrr");
+  body +=
+      "<p class=\"note\">↑: approach in the positive direction, ↓: in the negative. Each "
+      "value is the mean of the run's stops at that target in that direction. The "
+      "corrected table: <code>daq verify RUN --corrected FILE</code>.</p>\n" +
+      meaning + "</div>\n";
+  Headline hl;
+  if (found)
+    body += fmt::format("<h2 class=\"run\" id=\"run-{}\">As found: {}</h2>\n", found->run.id,
+                        esc(run_title(*found))) +
+            run_body(store, *found, o, hl);
+  body +=
+      fmt::format("<h2 class=\"run\" id=\"run-{}\">As left: {}</h2>\n", run, esc(run_title(left))) +
+      run_body(store, left, o, hl);
+  return page(titled(origins, fmt::format("Verification of compensation {}: {}", c.compensation.id,
+                                          test_name(left))),
+              body, o, who_of(left));
 }
 
 std::string straightness_report(const Profile& p, const Options& o) {

@@ -4,6 +4,7 @@
 // the same test over time. Content and layout: docs/reports.md.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -36,6 +37,13 @@ std::string comparison_report(const storage::RunReader& store, std::span<const s
 // both runs' reports.
 std::string as_found_as_left_report(const storage::RunReader& store, std::int64_t found,
                                     std::int64_t left, const Options& o = {});
+
+// The compensation loop (daq verify): the as-left run against the compensation table written
+// before it (the newest of its machine and axis, or the one given): the verdict and the
+// as-found, expected and as-left deviations on page one, the change point by point, then both
+// runs' reports. cal::InputError when there is no compensation to check the run against.
+std::string verification_report(const storage::RunReader& store, std::int64_t run,
+                                std::optional<std::int64_t> compensation, const Options& o = {});
 
 // Straightness and squareness are analysed from measured profiles (CSV files, not stored
 // runs): the report shows the deviations with the ISO 230-1 reference lines.

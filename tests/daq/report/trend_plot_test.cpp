@@ -125,3 +125,55 @@ TEST(TrendPlot, NoEmptyBandUnderTheLabels) {
 }
 
 }  // namespace
+
+namespace {
+
+// The largest x of any line or shape drawn (polyline and polygon points; a clip path, the whole
+// canvas, is not drawn), and the canvas width.
+std::pair<double, double> rightmost_drawn(const std::string& svg_text) {
+  static const std::regex points(R"re(points="([^"]*)")re");
+  static const std::regex view_box(R"re(viewBox="0 0 ([0-9.]+) )re");
+  static const std::regex clip(R"re(<clipPath[^]*?</clipPath>)re");
+  const std::string svg = std::regex_replace(svg_text, clip, "");
+  std::smatch vb;
+  const double width = std::regex_search(svg, vb, view_box) ? std::stod(vb[1].str()) : 0.0;
+  double right = 0.0;
+  for (std::sregex_iterator it(svg.begin(), svg.end(), points), end; it != end; ++it) {
+    std::istringstream in((*it)[1].str());
+    for (std::string xy; in >> xy;) right = std::max(right, std::stod(xy.substr(0, xy.find(','))));
+  }
+  return {right, width};
+}
+
+}  // namespace
+
+TEST(XyPlot, TheLegendFrameStaysOnTheCanvas) {
+  // The environment plot of a run (report.cpp): three instruments in one row of the legend.
+  // PLplot's legend came out wider than the canvas and its frame was cut at the right edge
+  // (drawn up to x = 600 of 600, the right side of the box missing in the printed report).
+  XyChart c{.title = "Temperatures",
+            .x_label = "time (min)",
+            .y_label = "temperature (°C)",
+            .height_pt = 240};
+  const char* labels[] = {"air: ids3010", "air: ptu300", "material: gauge"};
+  for (std::size_t i = 0; i < 3; ++i)
+    c.lines.push_back(Line{.x = {0.0, 0.5, 1.0},
+                           .y = {20.6, 20.61, 20.6 - 0.3 * static_cast<double>(i)},
+                           .label = labels[i],
+                           .colour = cal::daq::report::palette(i),
+                           .dashed = i == 2});
+  const auto svg = cal::daq::report::svg(c);
+  const auto [right, width] = rightmost_drawn(svg);
+  ASSERT_GT(width, 0.0) << svg.substr(0, 400);
+  EXPECT_LT(right, width - 1.0) << "the legend's frame reaches the canvas's edge (cut off)";
+  // Every label still in the legend (PLplot writes each character as a reference).
+  for (const std::string l : labels) {
+    std::string refs;
+    for (const char ch : l) {
+      std::ostringstream ref;
+      ref << "&#x" << std::hex << static_cast<int>(ch) << ';';
+      refs += ref.str();
+    }
+    EXPECT_NE(svg.find(refs), std::string::npos) << l;
+  }
+}
