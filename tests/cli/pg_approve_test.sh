@@ -59,7 +59,7 @@ check no_such_result 2 "run 1 has no result 99" -- "$DAQ" approve 1 --result 99 
 check no_such_run 2 "no run 77" -- "$DAQ" approve 77 --db "$REV"
 check approve 0 "run 1: result $CUR approved by rev at 20[0-9-]{8}T[0-9:]{8}Z \(fingerprint [0-9a-f]{32}, version 1 of its stops\)" -- \
   "$DAQ" approve 1 --db "$REV"
-check approval_row 0 "^rev $CUR 1 t$" -- psql_value \
+check approval_row 0 "^rev $CUR 1 true$" -- psql_value \
   "SELECT a.approved_by || ' ' || s.source_result_id || ' ' || a.run_version || ' ' || (s.fingerprint = a.result_fingerprint) FROM caldaq.approvals a JOIN caldaq.results s ON s.run_uuid = a.run_uuid AND s.fingerprint = a.result_fingerprint"
 check approve_twice 2 "result $CUR is approved already \(by rev" -- "$DAQ" approve 1 --db "$REV"
 check show_approval 0 "approved by rev at" -- "$DAQ" show 1 --db "$ENG"
@@ -67,7 +67,7 @@ check show_json_approval 0 "\"approved_by\": \"rev\"" -- "$DAQ" show 1 --db "$EN
 check report_issued 0 "written to" -- "$DAQ" report 1 --db "$ENG" -o "$TMP/issued.html"
 check_file "$TMP/issued.html" <<END
 issued_marked ISSUED CERTIFICATE</strong>: result $CUR approved by <span class="approver">rev</span> on 20
-issued_provenance <th>Approved</th><td>by rev on 20
+issued_provenance <td>Approved</td><td>by rev on 20
 END
 check issued_not_draft 1 "" -- grep -c "NOT APPROVED" "$TMP/issued.html"
 
