@@ -210,6 +210,16 @@ ALTER TABLE machines ADD COLUMN uuid TEXT;
 UPDATE machines SET uuid = )sql" CALDAQ_RANDOM_UUID R"sql(;
 CREATE UNIQUE INDEX machines_by_uuid ON machines(uuid);
 )sql",
+    // 8 -> 9 (issue 35): sign-off. A reviewer's approval of one result (the exact one: a
+    // re-analysis makes a new result, not approved), who and when; a report is issued as a
+    // certificate only for an approved result. Central schema 6 holds the server's approvals.
+    R"sql(
+CREATE TABLE approvals(
+  id INTEGER PRIMARY KEY,
+  result_id INTEGER NOT NULL UNIQUE REFERENCES results(id) ON DELETE CASCADE,
+  approved_by TEXT NOT NULL,
+  approved_unix_ms INTEGER NOT NULL);
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -432,6 +442,11 @@ CREATE TEMP TABLE operator_actions(id INTEGER PRIMARY KEY, run_id INTEGER, time_
   if (version < 8)  // before the machines' UUIDs: none (MachineRecord::uuid "")
     exec("CREATE TEMP VIEW machines AS SELECT *, NULL AS uuid FROM main.machines;",
          "present an older schema without machine UUIDs (read-only)");
+  if (version < 9)  // before sign-off: nothing approved
+    exec(
+        "CREATE TEMP TABLE approvals(id INTEGER PRIMARY KEY, result_id INTEGER, approved_by "
+        "TEXT, approved_unix_ms INTEGER);",
+        "present an older schema without approvals (read-only)");
   has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
@@ -1054,6 +1069,57 @@ void Store::add_stored_chunks(std::int64_t run_id, std::span<const StoredChunk> 
     m.step_done(s.get(), fmt::format("store reading chunk {} of run {}", c.seq, run_id));
   }
   tx.commit();
+}
+
+Approval Store::approve(std::int64_t run_id, std::int64_t result_id, std::string_view approved_by) {
+  Impl& m = *impl_;
+  m.need_writable("approve a result");
+  Impl::Transaction tx(m);
+  const auto results = this->results(run_id);
+  const auto it = std::find_if(results.begin(), results.end(),
+                               [&](const ResultRecord& r) { return r.id == result_id; });
+  if (it == results.end())
+    throw StoreError(
+        fmt::format("{}: run {} has no result {}", m.path.string(), run_id, result_id));
+  if (it->superseded_by)
+    throw StoreError(fmt::format(
+        "{}: result {} of run {} is superseded by result {} (re-analysed or re-compensated "
+        "since): it cannot be approved; approve the current one",
+        m.path.string(), result_id, run_id, *it->superseded_by));
+  for (const auto& a : approvals(run_id))
+    if (a.result_id == result_id)
+      throw StoreError(
+          fmt::format("{}: result {} of run {} is approved already (by {}, unix ms {})",
+                      m.path.string(), result_id, run_id, a.approved_by, a.approved_unix_ms));
+  const Approval a{.result_id = result_id,
+                   .approved_by = std::string(approved_by),
+                   .approved_unix_ms = unix_ms_now()};
+  auto s =
+      m.prepare("INSERT INTO approvals(result_id, approved_by, approved_unix_ms) VALUES(?, ?, ?)");
+  bind_all(s.get(), a.result_id, a.approved_by, a.approved_unix_ms);
+  m.step_done(s.get(), fmt::format("approve result {} of run {}", result_id, run_id));
+  tx.commit();
+  return a;
+}
+
+std::vector<Approval> Store::approvals(std::int64_t run_id) const {
+  return rows_of<Approval>(
+      *impl_,
+      "SELECT a.result_id, a.approved_by, a.approved_unix_ms FROM approvals AS a JOIN results AS "
+      "r ON r.id = a.result_id WHERE r.run_id = ? ORDER BY a.id",
+      [](sqlite3_stmt* s, Approval& a) {
+        read_all(s, a.result_id, a.approved_by, a.approved_unix_ms);
+      },
+      run_id);
+}
+
+bool Store::update_imported_run(const RunRecord& r) {
+  impl_->need_writable("update a run brought from the central store");
+  auto s = impl_->prepare(
+      "UPDATE runs SET status = ?, ended_unix_ms = ?, note = ? WHERE id = ? AND owner_pid = ?");
+  bind_all(s.get(), to_string(r.status), r.ended_unix_ms, r.note, r.id, kAcquiredElsewhere);
+  impl_->step_done(s.get(), fmt::format("update run {}", r.id));
+  return sqlite3_changes(impl_->db.get()) > 0;
 }
 
 void Store::set_superseded(std::int64_t result_id, std::int64_t by_result_id) {

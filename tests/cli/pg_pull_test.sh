@@ -105,6 +105,23 @@ check pull_again 0 "$RUNS runs .*: 0 new, 0 new results; 0 chunks received \(0 b
   "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
 same_rows pull_again_same "$DB" "$LAPTOP"
 
+# A run brought while it was still running there (a sync during its acquisition leaves it so on
+# the server: here run 2 set back to running, its last chunk not there yet) stays running here
+# until a later pull brings its end with its last chunk, not only the chunk.
+UUID2=$(psql_value "SELECT uuid FROM caldaq.runs WHERE id = 2")
+ENDED2=$(psql_value "SELECT ended_unix_ms FROM caldaq.runs WHERE id = 2")
+LAST2=$(psql_value "SELECT max(seq) FROM caldaq.reading_chunks WHERE run_uuid = '$UUID2'")
+psql_value "CREATE TABLE caldaq.held AS SELECT * FROM caldaq.reading_chunks WHERE run_uuid = '$UUID2' AND seq = $LAST2; DELETE FROM caldaq.reading_chunks WHERE run_uuid = '$UUID2' AND seq = $LAST2; UPDATE caldaq.runs SET status = 'running', ended_unix_ms = NULL WHERE id = 2" >/dev/null
+RUNNING=$TMP/running.sqlite
+check pull_while_running 0 "runs of machine" -- "$DAQ" sync --db "$RUNNING" --from "$PG_URL" --machine "$MACHINE" --quiet
+check running_here 0 "^running None $LAST2$" -- \
+  value "$RUNNING" "SELECT status || ' ' || ifnull(ended_unix_ms, 'None') || ' ' || (SELECT count(*) FROM reading_chunks k WHERE k.run_id = r.id) FROM runs r WHERE uuid = '$UUID2'"
+psql_value "INSERT INTO caldaq.reading_chunks SELECT * FROM caldaq.held; DROP TABLE caldaq.held; UPDATE caldaq.runs SET status = 'complete', ended_unix_ms = $ENDED2 WHERE id = 2" >/dev/null
+check pull_after_end 0 "0 new, 0 new results; 1 chunks received" -- "$DAQ" sync --db "$RUNNING" --from "$PG_URL" --machine "$MACHINE" --quiet
+check ended_here 0 "^complete $ENDED2 $((LAST2 + 1))$" -- \
+  value "$RUNNING" "SELECT status || ' ' || ifnull(ended_unix_ms, 'None') || ' ' || (SELECT count(*) FROM reading_chunks k WHERE k.run_id = r.id) FROM runs r WHERE uuid = '$UUID2'"
+same_rows running_same_history "$DB" "$RUNNING"
+
 # Sent back from the laptop: nothing twice on the server (the results known by their content,
 # the chunks by their checksums for the ids of the store that first sent them).
 check send_back 0 "$RUNS runs synced .*: 0 new; 0 chunks sent \(0 bytes\), $CHUNKS already there" -- \
@@ -195,10 +212,10 @@ check other_site_here 2 "this store's machine '$MACHINE' is another one \(UUID .
 
 # A server of central schema 4 (machines by name, before their UUIDs) migrated by a sync: its
 # machines are adopted by the first store that sends a machine of their name, not duplicated.
-psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); UPDATE caldaq.schema_version SET version = 4" >/dev/null
+psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); DROP FUNCTION caldaq.approve(uuid, text); DROP TABLE caldaq.approvals; UPDATE caldaq.schema_version SET version = 4" >/dev/null
 check old_server 0 "^4 1$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.machines) FROM caldaq.schema_version"
 check migrate_5 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --quiet
-check adopted 0 "^5 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
+check adopted 0 "^6 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
   psql_value "SELECT (SELECT version FROM caldaq.schema_version) || ' ' || count(*) || ' ' || max(uuid::text) FROM caldaq.machines"
 
 finish

@@ -294,6 +294,36 @@ TEST(Store, ANewResultSupersedesTheSameStandardOnlyAndKeepsTheOldOne) {
   EXPECT_EQ(rs[0].provenance_json, "{}");
 }
 
+// Sign-off (schema 9): an approval names the exact result and who approved it; a result of
+// another run, one superseded since and one approved already are refused; a re-analysis after
+// the approval leaves the new result unapproved. A version 8 file has none, read-only.
+TEST(Store, AnApprovalNamesTheExactCurrentResult) {
+  TempDir dir;
+  const auto file = dir.path / "site.sqlite";
+  Store store(file);
+  const auto run = a_run(store), other = a_run(store);
+  const auto first = store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  const auto second = store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  const auto elsewhere =
+      store.add_result({.run_id = other, .standard = "ISO 230-2:2014", .json = "{}"});
+  EXPECT_THROW(store.approve(run, first, "rev"), StoreError);      // superseded by `second`
+  EXPECT_THROW(store.approve(run, elsewhere, "rev"), StoreError);  // not this run's
+  EXPECT_TRUE(store.approvals(run).empty());
+  const auto a = store.approve(run, second, "rev");
+  EXPECT_EQ(a.result_id, second);
+  EXPECT_EQ(a.approved_by, "rev");
+  EXPECT_GT(a.approved_unix_ms, 0);
+  EXPECT_THROW(store.approve(run, second, "other"), StoreError);  // approved already
+  const auto third = store.add_result({.run_id = run, .standard = "ISO 230-2:2014", .json = "{}"});
+  const auto kept = store.approvals(run);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].result_id, second);  // not the re-analysis
+  EXPECT_EQ(kept[0].approved_by, "rev");
+  EXPECT_EQ(kept[0].approved_unix_ms, a.approved_unix_ms);
+  EXPECT_NE(third, second);
+  EXPECT_TRUE(store.approvals(other).empty());
+}
+
 TEST(Store, ReplacingTheTargetsSupersedesEveryResultInOneTransaction) {
   TempDir dir;
   Store store(dir.path / "site.sqlite");
@@ -475,7 +505,9 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 
 // What schema 7 added (the runs' UUIDs), taken off a new file to make a version 6 one; a macro so
 // that it prefixes the other undo strings as a literal.
-#define CALDAQ_UNDO_SCHEMA8 "DROP INDEX machines_by_uuid; ALTER TABLE machines DROP COLUMN uuid; "
+#define CALDAQ_UNDO_SCHEMA9 "DROP TABLE approvals; "
+#define CALDAQ_UNDO_SCHEMA8 \
+  CALDAQ_UNDO_SCHEMA9 "DROP INDEX machines_by_uuid; ALTER TABLE machines DROP COLUMN uuid; "
 #define CALDAQ_UNDO_SCHEMA7 \
   CALDAQ_UNDO_SCHEMA8 "DROP INDEX runs_by_uuid; ALTER TABLE runs DROP COLUMN uuid; "
 // What schema 5 added (origins, compensations, the stop quality), taken off a new file to
@@ -779,6 +811,7 @@ TEST(Store, MigrationEightGivesEveryMachineAUuid) {
   {
     Store ro(file, {.read_only = true});
     EXPECT_EQ(ro.version(), 7);
+    EXPECT_TRUE(ro.approvals(before.front().id).empty());  // before sign-off: none
     EXPECT_EQ(ro.machine_by_name("Mill 1")->uuid, "");
     EXPECT_EQ(ro.runs().size(), before.size());
   }

@@ -137,6 +137,17 @@ std::string provenance_text(const json& p) {
 
 }  // namespace
 
+json approval_json(const st::Approval& a) {
+  json j{{"result", a.result_id},
+         {"approved_by", a.approved_by},
+         {"approved", iso_time(a.approved_unix_ms)}};
+  if (!a.result_fingerprint.empty()) {
+    j["result_fingerprint"] = a.result_fingerprint;
+    j["run_version"] = a.run_version;
+  }
+  return j;
+}
+
 json run_document(const st::RunReader& store, std::int64_t id) {
   const auto r = need_run(store, id);
   json j = run_json(r);
@@ -185,6 +196,7 @@ json run_document(const st::RunReader& store, std::int64_t id) {
                                      {"detail", a.detail}});
   j["results"] = json::array();
   const json& settings = j["settings"];
+  const auto approvals = store.approvals(id);  // sign-off (issue 35): named where given
   for (const auto& res : store.results(id)) {
     json doc = cal::daq::parse_stored_json(res.json);
     // A profile was stored without its values (kinds/ does not reach results/): as every output
@@ -200,6 +212,8 @@ json run_document(const st::RunReader& store, std::int64_t id) {
              {"result", doc.is_discarded() ? json(res.json) : doc}};
     if (one["provenance"].is_discarded()) one["provenance"] = json::object();
     if (!doc.is_discarded()) one["verdict"] = to_json(verdict_of(settings, doc));
+    for (const auto& a : approvals)
+      if (a.result_id == res.id) one["approval"] = approval_json(a);
     j["results"].push_back(std::move(one));
   }
   return j;
@@ -269,6 +283,9 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
                 : fmt::format("superseded by result {}", res["superseded_by"].get<std::int64_t>()),
         "");
     print_line("    {}", provenance_text(res["provenance"]));
+    if (res.contains("approval"))
+      print_line("    approved by {} at {}", res["approval"]["approved_by"].get<std::string>(),
+                 res["approval"]["approved"].get<std::string>());
     if (!current) continue;                 // the old values stay in --json
     print_result(res["result"], "      ");  // as daq run and daq analyse print it
     if (res.contains("verdict")) print_verdict(res["verdict"], "      ");

@@ -1,5 +1,6 @@
 // daq sync --to postgresql://...: the local runs copied to the central store (issue 35;
-// docs/storage.md, "Central store").
+// docs/storage.md, "Central store"); daq approve: a reviewer's sign-off of a result, in either
+// store ("Sign-off").
 #include <pwd.h>
 #include <unistd.h>
 
@@ -13,11 +14,15 @@
 #include <vector>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
+#include "cal/storage/pg/central.hpp"
 #include "cal/storage/pg/sync.hpp"
 #include "cli_checks.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
 #include "progress.hpp"
+#include "run_document.hpp"
 #include "terminal.hpp"
 
 namespace daq {
@@ -225,7 +230,77 @@ void run_sync(const SyncCliOptions& o) {
                           : std::string());
 }
 
+struct ApproveOptions {
+  std::string db;
+  std::int64_t run = 0;
+  std::int64_t result = 0;  // 0: the run's one current result
+  bool json = false;
+};
+
+// The result to approve: the one named (it must be the run's), else the run's one current result.
+std::int64_t result_to_approve(const st::RunReader& store, const ApproveOptions& o) {
+  if (!store.run(o.run)) throw cal::InputError(fmt::format("{}: no run {}", store.name(), o.run));
+  if (o.result) return o.result;  // the store refuses one not of the run, or superseded
+  std::vector<std::int64_t> current;
+  for (const auto& r : store.results(o.run))
+    if (r.current()) current.push_back(r.id);
+  if (current.empty())
+    throw cal::InputError(
+        fmt::format("{}: run {} has no result to approve (daq analyse {} --store "
+                    "stores one)",
+                    store.name(), o.run, o.run));
+  if (current.size() > 1)
+    throw cal::InputError(fmt::format(
+        "{}: run {} has {} current results (results {}; daq show {} names them): approve one "
+        "with --result",
+        store.name(), o.run, current.size(), fmt::join(current, ", "), o.run));
+  return current.front();
+}
+
+// daq approve RUN: on the central store the server checks the reviewer's role and records the
+// login; in a local store (no accounts of its own) the approver is this account.
+void run_approve(const ApproveOptions& o) {
+  st::Approval a;
+  std::string where;
+  if (st::pg::is_postgresql_url(o.db)) {
+    const auto reader = st::pg::open_central(o.db);
+    a = st::pg::approve_central(o.db, o.run, result_to_approve(*reader, o));
+    where = reader->name();
+  } else {
+    const auto path = database_path(o.db);
+    if (std::error_code ec; !std::filesystem::exists(path, ec))
+      throw cal::InputError(fmt::format("{}: no such database (see --db)", path.string()));
+    st::Store store(path);
+    a = store.approve(o.run, result_to_approve(store, o), user_name());
+    where = store.name();
+  }
+  auto j = approval_json(a);
+  j["schema"] = "caldaq.approval.v1";
+  j["run"] = o.run;
+  j["db"] = where;
+  if (o.json) return fmt::print("{}\n", j.dump(2));
+  print_line("{}: run {}: result {} approved by {} at {}{}", where, o.run, a.result_id,
+             a.approved_by, j["approved"].get<std::string>(),
+             a.result_fingerprint.empty()
+                 ? std::string()
+                 : fmt::format(" (fingerprint {}, version {} of its stops)", a.result_fingerprint,
+                               a.run_version));
+}
+
 }  // namespace
+
+void add_approve_command(CLI::App& app) {
+  const auto [cmd, o] = add_command<ApproveOptions>(
+      app, "approve", run_approve,
+      "Sign off a stored run's result as a reviewer: its report is then issued as a certificate "
+      "naming who approved it and when (docs/storage.md, \"Sign-off\")");
+  cmd->add_option("RUN", o->run, "The stored run (see daq runs)")->required();
+  cmd->add_option("--result", o->result,
+                  "The result to approve (see daq show RUN; default: the run's current result, "
+                  "when it has one). A result superseded since is refused");
+  add_read_db_option(*cmd, o->db);
+  cmd->add_flag("--json", o->json, "Print the approval as JSON (caldaq.approval.v1)");
+}
 
 void add_sync_command(CLI::App& app) {
   auto o = std::make_shared<SyncCliOptions>();

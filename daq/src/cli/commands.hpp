@@ -13,6 +13,8 @@ void add_devices_command(CLI::App& app);
 void add_decode_command(CLI::App& app);
 // sync --to postgresql://...: the local runs copied to the central store
 void add_sync_command(CLI::App& app);
+// approve RUN: a reviewer's sign-off of a result (either store)
+void add_approve_command(CLI::App& app);
 // runs, show, export: stored runs
 void add_runs_commands(CLI::App& app);
 // analyse RUN, recompensate RUN: stored runs

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   daq::add_decode_command(app);
   daq::add_runs_commands(app);
   daq::add_sync_command(app);
+  daq::add_approve_command(app);
   daq::add_stored_run_commands(app, *analyse);
   daq::add_replay_command(app);
   daq::add_run_commands(app);

@@ -108,6 +108,7 @@ struct RunView {
   std::vector<st::ResultRecord> results;
   std::vector<st::MissedStop> missed;
   std::vector<st::OperatorAction> actions;  // what the operator did during the run (issue 29)
+  std::vector<st::Approval> approvals;      // sign-off of its results (issue 35)
   ::daq::CompensationUsed used;  // linear runs: what the stored deviations were made with
 };
 
@@ -200,6 +201,7 @@ RunView load(const st::RunReader& store, std::int64_t id) {
   v.results = store.results(id);
   v.missed = store.missed_stops(id);
   v.actions = store.operator_actions(id);
+  v.approvals = store.approvals(id);
   v.used = ::daq::compensation_used(v.settings, v.results);
   return v;
 }
@@ -881,6 +883,10 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
   if (p.is_object() && p.contains("of_result") && !p["of_result"].is_null())
     rows.push_back(
         {"Re-compensation of", fmt::format("result {}", p["of_result"].get<std::int64_t>())});
+  for (const auto& a : v.approvals)
+    if (a.result_id == current->id)
+      rows.push_back({"Approved", fmt::format("by {} on {}", esc(a.approved_by),
+                                              iso_time(a.approved_unix_ms))});
   std::size_t older = 0;
   for (const auto& r : v.results) older += r.current() ? 0 : 1;
   if (older)
@@ -2024,6 +2030,9 @@ table.results td:first-child { white-space: nowrap; }
 table.beside td:first-child { white-space: normal; } table.beside td.r, table.diag td.r { width: 1%; }
 .meaning { font-weight: normal; color: #444; }
 .verdict.suspect { background: #fff0d9; border: 1px solid #d68000; }
+.approval { padding: .4rem .6rem; border-radius: 3px; margin: .6rem 0; }
+.approval.issued { background: #e3f4ea; border: 2px solid #2e8b57; }
+.approval.draft { background: #fde8e4; border: 2px dashed #c0392b; }
 .verdict.suspect ul, ul.failing { margin: .2rem 0 .4rem; }
 .verdict.fail + ul.failing { background: #fde8e4; margin-top: -.6rem; padding: .2rem 1.5rem;
   border: 1px solid #c0392b; border-top: none; }
@@ -2181,11 +2190,54 @@ std::string compensation_check(const st::RunReader& store, const RunView& v) {
                      ok ? "pass" : "fail", esc(::daq::loop_text(*c)));
 }
 
+// The schema of the result a run's report shows ("" for a kind without a stored result).
+std::string_view result_schema(const RunView& v) {
+  const auto& kind = v.run.kind;
+  if (kind == "linear") return "caldaq.iso230-2.v1";
+  if (kind == "circle") return "caldaq.circle.v2";
+  if (kind == "rotary") return "caldaq.rotary.v1";
+  if (::daq::is_profile_kind(kind)) return "caldaq.profile.v1";
+  return "";
+}
+
+// Sign-off (issue 35; docs/reports.md): the report is an issued certificate only when the result
+// it shows was approved (daq approve), naming the reviewer and when; otherwise a draft. The
+// approval names an exact result: one re-analysed since is a new result, not approved.
+std::string approval_banner(const RunView& v) {
+  const auto schema = result_schema(v);
+  std::optional<st::ResultRecord> shown;
+  if (!schema.empty()) {
+    shown = ::daq::current_result(v.results, schema);
+  } else {
+    for (const auto& r : v.results)
+      if (r.current()) shown = r;
+  }
+  if (shown)
+    for (const auto& a : v.approvals)
+      if (a.result_id == shown->id)
+        return fmt::format(
+            "<div class=\"approval issued\"><strong>ISSUED CERTIFICATE</strong>: result {} "
+            "approved by <span class=\"approver\">{}</span> on {}{}.</div>\n",
+            shown->id, esc(a.approved_by), iso_time(a.approved_unix_ms),
+            a.result_fingerprint.empty()
+                ? std::string()
+                : fmt::format(" (result fingerprint {}, version {} of the run's stops)",
+                              esc(a.result_fingerprint), a.run_version));
+  // One line: page one keeps its room for the answer.
+  return fmt::format(
+      "<div class=\"approval draft\"><strong>DRAFT — NOT APPROVED</strong>: {} (daq approve "
+      "{}).</div>\n",
+      shown ? fmt::format("result {} has not been approved", shown->id)
+            : std::string("no stored result to approve"),
+      v.run.id);
+}
+
 // Page one is the answer: who, which machine and test, when; where the readings came from and
 // how good they are; the verdict with the failing values, the main table and the main plot.
 // Then the details, the conditions and traceability, and the settings as an appendix.
 std::string run_body(const st::RunReader& store, const RunView& v, const Options& o, Headline& hl) {
-  std::string h = origin_banner(v);
+  std::string h = approval_banner(v);
+  h += origin_banner(v);
   h += summary_block(v, test_name(v, linear_standard_key(v, o)));
   if (v.run.status != st::RunStatus::complete)
     h += fmt::format(
@@ -2232,12 +2284,7 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
   h += customer_section(v);
   h += conditions_section(v);
   h += instruments_section(v);
-  if (v.run.kind == "linear" || v.run.kind == "circle" || v.run.kind == "rotary" ||
-      ::daq::is_profile_kind(v.run.kind))
-    h += provenance_section(v, v.run.kind == "linear"   ? "caldaq.iso230-2.v1"
-                               : v.run.kind == "circle" ? "caldaq.circle.v2"
-                               : v.run.kind == "rotary" ? "caldaq.rotary.v1"
-                                                        : "caldaq.profile.v1");
+  if (!result_schema(v).empty()) h += provenance_section(v, result_schema(v));
   h += setup_section(v);
   h += environment_section(v.env);
   h += settings_appendix(v);

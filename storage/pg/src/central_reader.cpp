@@ -400,6 +400,22 @@ class CentralReader final : public RunReader {
         run_id);
   }
 
+  std::vector<Approval> approvals(std::int64_t run_id) const override {
+    return all<Approval>(
+        fmt::format("read the approvals of run {}", run_id),
+        "SELECT s.source_result_id, a.result_fingerprint, a.run_version, a.approved_by, "
+        "a.approved_unix_ms FROM caldaq.approvals AS a JOIN caldaq.runs AS r ON r.uuid = "
+        "a.run_uuid JOIN caldaq.results AS s ON s.run_uuid = a.run_uuid AND s.fingerprint = "
+        "a.result_fingerprint WHERE r.id = $1 ORDER BY a.approved_unix_ms, s.source_result_id",
+        [](const pqxx::row& row) {
+          Approval a;
+          read_row(row, a.result_id, a.result_fingerprint, a.run_version, a.approved_by,
+                   a.approved_unix_ms);
+          return a;
+        },
+        run_id);
+  }
+
  private:
   std::string shown_;
   std::unique_ptr<pqxx::connection> conn_;
@@ -450,6 +466,31 @@ class CentralReader final : public RunReader {
 
 std::unique_ptr<RunReader> open_central(std::string_view url) {
   return std::make_unique<CentralReader>(url);
+}
+
+Approval approve_central(std::string_view url, std::int64_t run_id, std::int64_t result_id) {
+  const std::string shown = redacted(url);
+  const auto conn = connect(shown, url);
+  return guarded(shown, fmt::format("approve result {} of run {}", result_id, run_id), [&] {
+    pqxx::work w(*conn);
+    const auto found = w.exec_params(
+        "SELECT r.uuid, s.fingerprint FROM caldaq.runs AS r LEFT JOIN caldaq.results AS s ON "
+        "s.run_uuid = r.uuid AND s.source_result_id = $2 WHERE r.id = $1",
+        run_id, result_id);
+    if (found.empty()) throw StoreError(fmt::format("{}: no run {}", shown, run_id));
+    if (found[0][1].is_null())
+      throw StoreError(fmt::format("{}: run {} has no result {}", shown, run_id, result_id));
+    Approval a{.result_id = result_id, .result_fingerprint = found[0][1].as<std::string>()};
+    // The server checks the rest (a reviewer's login; the result current, not approved yet) and
+    // names the reviewer: nothing the client says is taken for who approved.
+    const auto row = w.exec_params1(
+        "SELECT approved_by, approved_unix_ms, run_version FROM "
+        "caldaq.approve($1::uuid, $2::text)",
+        found[0][0].as<std::string>(), a.result_fingerprint);
+    read_row(row, a.approved_by, a.approved_unix_ms, a.run_version);
+    w.commit();
+    return a;
+  });
 }
 
 }  // namespace cal::storage::pg

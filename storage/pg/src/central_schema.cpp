@@ -3,6 +3,7 @@
 #include "central_schema.hpp"
 
 #include <iterator>
+#include <optional>
 
 #include "cal/storage/pg/sync.hpp"
 
@@ -190,6 +191,70 @@ ALTER TABLE caldaq.machines ADD COLUMN uuid uuid UNIQUE;
 ALTER TABLE caldaq.machines DROP CONSTRAINT machines_name_key;
 CREATE INDEX machines_by_name ON caldaq.machines(name);
 )sql",
+    // 6 (local schema 9): users, roles and sign-off. Engineers (role caldaq_engineer) send runs;
+    // reviewers (caldaq_reviewer) approve results, through caldaq.approve only, which records
+    // the reviewer's login (session_user: the server authenticated it, the client cannot name
+    // another) and refuses a result superseded since. Nothing for PUBLIC: a login of neither role
+    // reads and writes nothing. The roles are the cluster's: made once, kept if there already.
+    R"sql(
+DO $roles$ BEGIN
+  IF NOT EXISTS (SELECT FROM pg_roles WHERE rolname = 'caldaq_engineer') THEN
+    CREATE ROLE caldaq_engineer NOLOGIN;
+  END IF;
+  IF NOT EXISTS (SELECT FROM pg_roles WHERE rolname = 'caldaq_reviewer') THEN
+    CREATE ROLE caldaq_reviewer NOLOGIN;
+  END IF;
+END $roles$;
+CREATE TABLE caldaq.approvals(
+  run_uuid uuid NOT NULL,
+  result_fingerprint text NOT NULL,
+  run_version integer NOT NULL,
+  approved_by text NOT NULL,
+  approved_unix_ms bigint NOT NULL,
+  PRIMARY KEY(run_uuid, result_fingerprint),
+  FOREIGN KEY(run_uuid, result_fingerprint) REFERENCES caldaq.results(run_uuid, fingerprint)
+    ON DELETE CASCADE);
+CREATE FUNCTION caldaq.approve(run uuid, fp text)
+  RETURNS TABLE(approved_by text, approved_unix_ms bigint, run_version integer)
+  LANGUAGE plpgsql SECURITY DEFINER SET search_path = pg_catalog, pg_temp
+AS $fn$
+DECLARE
+  res record;
+  earlier record;
+  v integer;
+BEGIN
+  SELECT s.source_result_id AS id, s.superseded_by INTO res FROM caldaq.results AS s
+    WHERE s.run_uuid = run AND s.fingerprint = fp;
+  IF NOT FOUND THEN
+    RAISE EXCEPTION 'no result of fingerprint % in run %', fp, run USING ERRCODE = 'no_data_found';
+  END IF;
+  IF res.superseded_by IS NOT NULL THEN
+    RAISE EXCEPTION 'result % is superseded by result % (re-analysed or re-compensated since): it cannot be approved; approve the current one',
+      res.id, res.superseded_by USING ERRCODE = 'object_not_in_prerequisite_state';
+  END IF;
+  SELECT a.approved_by, a.approved_unix_ms INTO earlier FROM caldaq.approvals AS a
+    WHERE a.run_uuid = run AND a.result_fingerprint = fp;
+  IF FOUND THEN
+    RAISE EXCEPTION 'result % is approved already (by %, unix ms %)', res.id,
+      earlier.approved_by, earlier.approved_unix_ms USING ERRCODE = 'unique_violation';
+  END IF;
+  SELECT r.current_version INTO v FROM caldaq.runs AS r WHERE r.uuid = run FOR SHARE;
+  RETURN QUERY INSERT INTO caldaq.approvals AS a VALUES(run, fp, v, session_user::text,
+    (extract(epoch FROM clock_timestamp()) * 1000)::bigint)
+    RETURNING a.approved_by, a.approved_unix_ms, a.run_version;
+END
+$fn$;
+REVOKE ALL ON SCHEMA caldaq FROM PUBLIC;
+REVOKE ALL ON ALL TABLES IN SCHEMA caldaq FROM PUBLIC;
+REVOKE ALL ON ALL FUNCTIONS IN SCHEMA caldaq FROM PUBLIC;
+GRANT USAGE ON SCHEMA caldaq TO caldaq_engineer, caldaq_reviewer;
+GRANT SELECT ON ALL TABLES IN SCHEMA caldaq TO caldaq_engineer, caldaq_reviewer;
+GRANT INSERT, UPDATE, DELETE ON ALL TABLES IN SCHEMA caldaq TO caldaq_engineer;
+REVOKE INSERT, UPDATE, DELETE ON caldaq.approvals, caldaq.schema_version FROM caldaq_engineer;
+GRANT USAGE ON ALL SEQUENCES IN SCHEMA caldaq TO caldaq_engineer;
+GRANT EXECUTE ON FUNCTION caldaq.stops_fingerprint(uuid, integer) TO caldaq_engineer;
+GRANT EXECUTE ON FUNCTION caldaq.approve(uuid, text) TO caldaq_reviewer;
+)sql",
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 
@@ -202,7 +267,26 @@ std::string result_fingerprint(pqxx::transaction_base& t, const ResultRecord& r)
       .as<std::string>();
 }
 
+namespace {
+
+// The schema's version where it is there and readable, else nullopt: what a login that may not
+// create or alter anything (an engineer's) needs to send to a server already migrated.
+std::optional<int> present_version(pqxx::connection& conn) {
+  pqxx::nontransaction n(conn);
+  if (n.exec1("SELECT to_regclass('caldaq.schema_version') IS NULL")[0].as<bool>())
+    return std::nullopt;
+  const auto rows = n.exec("SELECT version FROM caldaq.schema_version");
+  if (rows.size() != 1) return std::nullopt;
+  return rows[0][0].as<int>();
+}
+
+}  // namespace
+
 int migrate_schema(pqxx::connection& conn, std::string_view shown_url) {
+  // Migrating takes the schema owner's rights; sending to a migrated server does not.
+  if (guarded(shown_url, "read the central schema version",
+              [&] { return present_version(conn); }) == central_schema_version)
+    return central_schema_version;
   return guarded(shown_url, "create or migrate the central schema", [&] {
     pqxx::work w(conn);
     w.exec("SELECT pg_advisory_xact_lock(1128352836)");  // "CALD", as the SQLite application id

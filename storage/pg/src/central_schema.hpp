@@ -40,6 +40,20 @@ void read_chunk(const pqxx::row& row, Chunk& c) {
   c.data.assign(data.data(), data.data() + data.size());
 }
 
+// libpq's text on one line, as every daq error: it spans lines ("...failed: Connection
+// refused\n\tIs the server running...?\n"; a server's "ERROR:  permission denied ...\n").
+inline std::string one_line(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c != '\n' && c != '\t')
+      out += c;
+    else if (!out.empty() && out.back() != ' ')
+      out += ' ';
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
 // Runs f, turning libpqxx's exceptions into StoreError naming the server and what was done.
 template <class F>
 auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
@@ -48,20 +62,11 @@ auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
   } catch (const StoreError&) {
     throw;
   } catch (const pqxx::sql_error& e) {
-    throw StoreError(fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what,
-                                 std::string_view(e.what()), e.sqlstate()));
+    throw StoreError(fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what, one_line(e.what()),
+                                 e.sqlstate()));
   } catch (const std::exception& e) {
-    // broken_connection and the like: libpq's text spans lines ("...failed: Connection
-    // refused\n\tIs the server running...?\n"): one line, as every daq error.
-    std::string text;
-    for (const char c : std::string_view(e.what())) {
-      if (c != '\n' && c != '\t')
-        text += c;
-      else if (!text.empty() && text.back() != ' ')
-        text += ' ';
-    }
-    while (!text.empty() && text.back() == ' ') text.pop_back();
-    throw StoreError(fmt::format("{}: {}: {}", shown_url, what, text));
+    // broken_connection and the like.
+    throw StoreError(fmt::format("{}: {}: {}", shown_url, what, one_line(e.what())));
   }
 }
 

@@ -110,6 +110,7 @@ class Pull {
     local_.in_transaction([&] {
       const auto existing = local_.run_by_uuid(r.uuid);
       local_id = existing ? existing->id : import_metadata(r);
+      if (existing && existing->status == RunStatus::running) update_running(r, local_id);
       pull_results(r, local_id);
     });
     const auto received = report_.chunks_received, already = report_.chunks_already;
@@ -142,6 +143,20 @@ class Pull {
       local_.add_operator_action(a);
     }
     return id;
+  }
+
+  // A run brought while it was still running: what the server holds of it now (its status, end
+  // and note; its stops, missed stops and quality, which grow as it runs). A run acquired here
+  // is left as it is (its own acquisition writes it).
+  void update_running(const RunRecord& r, std::int64_t local_id) {
+    RunRecord now = r;
+    now.id = local_id;
+    if (!local_.update_imported_run(now)) return;
+    auto targets = server_->targets(r.id);
+    for (auto& t : targets) t.run_id = local_id;
+    local_.replace_targets(local_id, targets);
+    local_.set_missed_stops(local_id, server_->missed_stops(r.id));
+    if (const auto q = server_->quality(r.id)) local_.set_quality(local_id, *q);
   }
 
   // The server's results this store lacks (known by their content's fingerprint, as the server

@@ -35,7 +35,9 @@ class StoreError : public std::runtime_error {
 // actions during a run (OperatorAction). 7 (issue 35): every run has a stable identity, a UUID
 // (RunRecord::uuid), by which the central store (daq sync) knows it. 8 (issue 35): every machine
 // has one too (MachineRecord::uuid): two sites' machines of the same name stay apart centrally.
-inline constexpr int schema_version = 8;
+// 9 (issue 35): sign-off: a result's approval (Approval: who, when), which a report needs to be
+// issued as a certificate (central schema 6 has its own, with the reviewers' role).
+inline constexpr int schema_version = 9;
 
 // A new random (version 4) UUID in its canonical lower-case text form.
 std::string new_uuid();
@@ -229,6 +231,19 @@ struct RunVersion {
   bool current = false;    // the version the read commands read (the newest sent)
 };
 
+// A reviewer's sign-off of one result of a run (issue 35; docs/storage.md, "Sign-off"): a report
+// is issued as a certificate only when the result it shows is approved. It names the exact
+// result: a re-analysis or re-compensation since makes a new result, which is not approved.
+struct Approval {
+  std::int64_t result_id = 0;  // the result approved (its id in the store read)
+  // The central store: the result's content fingerprint and the run's version of its stops when
+  // it was approved ("" and 0 in a local store, where the result id is the exact version).
+  std::string result_fingerprint;
+  int run_version = 0;
+  std::string approved_by;  // the reviewer: the server's login role; locally the OS account
+  std::int64_t approved_unix_ms = 0;
+};
+
 // The series of a run (one per device, channel and quantity) with their counts and time spans,
 // from the chunks' rows alone (no reading is decoded).
 struct SeriesInfo {
@@ -284,6 +299,8 @@ class RunReader {
                                                         std::string_view axis = {}) const = 0;
   // The versions of a run's stops, oldest first (empty: the store keeps one, as a local one).
   virtual std::vector<RunVersion> versions(std::int64_t /*run_id*/) const { return {}; }
+  // The approvals of the run's results, oldest first.
+  virtual std::vector<Approval> approvals(std::int64_t run_id) const = 0;
 };
 
 // A reading chunk as a store hands it to a ReadingStream: its row and its bytes.
@@ -444,6 +461,17 @@ class Store : public RunReader {
   std::int64_t add_compensation(const CompensationRecord& c);
   std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
                                                 std::string_view axis = {}) const override;
+
+  // Sign-off (schema 9): records that `approved_by` approved result `result_id` of the run, now.
+  // Refused (StoreError saying why) for a result of another run, one superseded since (a
+  // re-analysis or re-compensation: approve the current one), or one approved already.
+  Approval approve(std::int64_t run_id, std::int64_t result_id, std::string_view approved_by);
+  std::vector<Approval> approvals(std::int64_t run_id) const override;
+
+  // A run brought by daq sync --from while it was still running there (acquired elsewhere): its
+  // status, end and note as the server has them now (r.id: the local run). False, and nothing
+  // changed, for a run acquired here.
+  bool update_imported_run(const RunRecord& r);
 
   // What daq sync --from brings from the central store (issue 35). f runs in one transaction:
   // every write it makes (by the methods here) is committed together, or none on a throw.

@@ -14,4 +14,11 @@ namespace cal::storage::pg {
 // them), not by the laptops they came from.
 std::unique_ptr<RunReader> open_central(std::string_view url);
 
+// daq approve RUN --db postgresql://... (central schema 6): the login of this connection approves
+// result `result_id` of run `run_id` (the server's ids, as daq show lists them) through the
+// server's caldaq.approve, which records that login and the time, the result's fingerprint and
+// the run's current version, and refuses a login without the role caldaq_reviewer, a result
+// superseded since and one approved already (StoreError with the server's reason).
+Approval approve_central(std::string_view url, std::int64_t run_id, std::int64_t result_id);
+
 }  // namespace cal::storage::pg

@@ -25,7 +25,9 @@ namespace cal::storage::pg {
 // 4: a run's stops kept as versions (run_versions: who sent them, from where, when) when the
 // same run was changed in two places.
 // 5: machines known by a stable id (their UUID), not by name.
-inline constexpr int central_schema_version = 5;
+// 6 (with local schema 9): roles (caldaq_engineer sends, caldaq_reviewer approves; nothing for
+// other logins) and sign-off (approvals, made by caldaq.approve).
+inline constexpr int central_schema_version = 6;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
