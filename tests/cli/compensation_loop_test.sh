@@ -43,7 +43,8 @@ db.execute("UPDATE runs SET campaign = 'annual calibration'")
 db.execute("UPDATE instruments SET transport = 'tcp 192.0.2.5:9090'")
 db.commit()
 PYEOF
-check renamed_show 0 "^  SIMULATED: laser simulated" -- "$DAQ" show 1 --db "$DB"
+# The three twins named together, their origin's detail said once.
+check renamed_show 0 "^  SIMULATED: laser, air and material simulated \(a twin of the built-in simulated shop\)$" -- "$DAQ" show 1 --db "$DB"
 check renamed_report 0 "report of run 1 written" -- "$DAQ" report 1 --db "$DB" -o "$T/r1.html"
 check renamed_banner 0 "<strong>SIMULATED</strong>: this run was made on the simulated" -- cat "$T/r1.html"
 check renamed_title 0 "<h1>SIMULATED — Run 1" -- cat "$T/r1.html"

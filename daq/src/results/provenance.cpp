@@ -193,7 +193,14 @@ RunOrigin run_origin(const cal::storage::RunRecord& run,
     return s.find("SIMULATED") != std::string_view::npos ||
            s.find("simulated") != std::string_view::npos;
   };
-  std::vector<std::string> parts;
+  // Instruments of the same origin and detail said once, named together ("laser, air and
+  // material simulated (a twin of ...)"): a run of four twins repeated the detail four times,
+  // five lines above the fold of the operator's page.
+  struct Group {
+    std::string origin, detail;
+    std::vector<std::string> drivers;
+  };
+  std::vector<Group> groups;
   for (const auto& i : instruments) {
     if (i.origin.empty()) {
       o.unrecorded = true;
@@ -204,8 +211,21 @@ RunOrigin run_origin(const cal::storage::RunRecord& run,
                   (i.origin == "replay" && i.origin_detail.find("simulated") != std::string::npos);
     o.replayed = o.replayed || i.origin == "replay";
     o.imported = o.imported || i.origin == "imported";
-    parts.push_back(fmt::format("{} {}{}", i.driver, i.origin,
-                                i.origin_detail.empty() ? "" : " (" + i.origin_detail + ")"));
+    const auto g = std::find_if(groups.begin(), groups.end(), [&](const Group& x) {
+      return x.origin == i.origin && x.detail == i.origin_detail;
+    });
+    if (g == groups.end())
+      groups.push_back({i.origin, i.origin_detail, {i.driver}});
+    else
+      g->drivers.push_back(i.driver);
+  }
+  std::vector<std::string> parts;
+  for (const auto& g : groups) {
+    std::string names = g.drivers.front();
+    for (std::size_t k = 1; k < g.drivers.size(); ++k)
+      names += (k + 1 == g.drivers.size() ? " and " : ", ") + g.drivers[k];
+    parts.push_back(
+        fmt::format("{} {}{}", names, g.origin, g.detail.empty() ? "" : " (" + g.detail + ")"));
   }
   if (instruments.empty()) o.unrecorded = true;
   if (o.unrecorded) o.simulated = o.simulated || by_name(machine_name) || by_name(run.campaign);
