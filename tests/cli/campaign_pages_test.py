@@ -104,7 +104,7 @@ daq("sim", "--test", "circle", "--acquire", *db, "-o", "circle.toml")  # run 20
 daq("report", "--as-found", "20", "--as-left", "20", *db, "-f", "pdf", "-o", "circle.pdf")
 one = pdf_pages("circle.pdf")[0]
 check("as found / as left, circle: the polar plot and the table on page one",
-      "as left clockwise" in one and "rings every" in one and "G(b)" in one
+      "as left cw" in one and "rings every" in one and "G(b)" in one
       and "Squareness XY" in one, one)
 
 # --- the model map ----------------------------------------------------------------------------
