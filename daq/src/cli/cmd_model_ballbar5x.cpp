@@ -31,6 +31,17 @@ namespace {
 constexpr const char* kColumns =
     "test,axis,setup,ball_x_mm,ball_y_mm,ball_z_mm,length_mm,angle_deg,reading_um";
 
+// The columns as help and man pages print them: a space after each comma, so a line can break
+// there (one 78-character word made groff warn "cannot adjust line" in the man page).
+std::string columns_text() {
+  std::string s;
+  for (const char c : std::string_view(kColumns)) {
+    s += c;
+    if (c == ',') s += ' ';
+  }
+  return s;
+}
+
 // The options that define one test (sim and program).
 struct TestOptions {
   std::string axis, setup = "radial", name;
@@ -326,7 +337,7 @@ void add_model_ballbar5x_commands(CLI::App& model) {
       "readings taken while the axis turned and the linear axes followed (a CSV as "
       "ballbar5x-sim writes)");
   fit->add_option("readings", f->readings,
-                  std::string("CSV of readings: ") + kColumns +
+                  "CSV of readings with the columns " + columns_text() +
                       " (one test per name; several tests and axes in one file)")
       ->required();
   fit->add_option("--model", f->model,
