@@ -47,6 +47,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cal/analysis/angle_reduce.hpp"
 #include "cal/analysis/circle_records.hpp"
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
@@ -130,7 +131,7 @@ struct Model {
   double spike(double theta, double s, double first) const {
     double sum = 0.0;
     for (double tr : {first, first + pi}) {
-      double d = std::fmod(s * (theta - tr), 2 * pi);
+      double d = fmod_near(s * (theta - tr), 2 * pi);  // std::fmod's value (angle_reduce.hpp)
       if (d < 0) d += 2 * pi;
       sum += std::exp(-d / phi_rad);
     }
@@ -477,7 +478,7 @@ void sort_circular(std::vector<T>& v, Key key) {
   std::sort(v.begin(), v.end());
 }
 
-double mod360(double x) { return std::fmod(std::fmod(x, 360.0) + 360.0, 360.0); }
+double mod360(double x) { return fmod_near(fmod_near(x, 360.0) + 360.0, 360.0); }
 
 // The smallest arc covering the angles: 360 minus the largest gap between sorted angles.
 double coverage_deg(std::span<const double> angles) {
@@ -517,7 +518,8 @@ void validate_setup(const Setup& setup) {
                                  setup.vibration_segment_samples));
 }
 
-void validate_trace(const Trace& t) {
+// Returns the trace's arc (coverage_deg), which the ISO values report.
+double validate_trace(const Trace& t) {
   const char* name = name_of(t.direction);
   if (t.angle_deg.size() != t.deviation_um.size())
     throw InputError(fmt::format("circle: {} trace has {} angles but {} deviations", name,
@@ -529,12 +531,15 @@ void validate_trace(const Trace& t) {
     if (!std::isfinite(t.angle_deg[i]) || !std::isfinite(t.deviation_um[i]))
       throw InputError(fmt::format("circle: {} trace sample {} is not finite (angle {}, {} um)",
                                    name, i, t.angle_deg[i], t.deviation_um[i]));
-  if (const double arc = coverage_deg(t.angle_deg); arc < 180.0 - 1e-9)
+  const double arc = coverage_deg(t.angle_deg);
+  if (arc < 180.0 - 1e-9)
     throw InputError(
         fmt::format("circle: {} trace covers {:.1f} degrees, at least 180 needed", name, arc));
+  return arc;
 }
 
-void validate(const Setup& setup, std::span<const Trace> traces) {
+// Returns the smallest arc of the traces (validate_trace).
+double validate(const Setup& setup, std::span<const Trace> traces) {
   if (traces.empty()) throw InputError("circle: no trace given");
   if (traces.size() > 2)
     throw InputError(fmt::format("circle: {} traces given, at most 2 (cw, ccw)", traces.size()));
@@ -542,7 +547,9 @@ void validate(const Setup& setup, std::span<const Trace> traces) {
     throw InputError(
         fmt::format("circle: two traces in the same direction ({})", name_of(traces[0].direction)));
   validate_setup(setup);
-  for (const auto& t : traces) validate_trace(t);
+  double arc_deg = 360.0;
+  for (const auto& t : traces) arc_deg = std::min(arc_deg, validate_trace(t));
+  return arc_deg;
 }
 
 // Least-squares circle, linearised as the bar length itself (dr = r0 + cu cos + cv sin, the
@@ -553,31 +560,29 @@ struct Circle {
   double residual(const Sample& x) const { return x.y - cu * x.c - cv * x.n; }
 };
 
-// Over the samples [begin, end).
-Circle lsq_circle(const Samples& samples, std::size_t begin, std::size_t end) {
+// The sums of the least-squares circle: C'C and C'y, C the columns (1, cos, sin), sample by
+// sample (the terms as a * a' adds them).
+struct CircleSums {
   Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
   Eigen::Vector3d aty = Eigen::Vector3d::Zero();
-  for (std::size_t i = begin; i < end; ++i) {
-    const Sample x = samples.plain(i);
-    const Eigen::Vector3d a(1.0, x.c, x.n);
-    ata += a * a.transpose();
-    aty += a * x.y;
+  void add(const Sample& x) {
+    const std::array<double, 3> a = {1.0, x.c, x.n};
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        ata(i, j) += a[static_cast<std::size_t>(i)] * a[static_cast<std::size_t>(j)];
+    for (int i = 0; i < 3; ++i) aty(i) += a[static_cast<std::size_t>(i)] * x.y;
   }
-  const Eigen::Vector3d sol = ata.ldlt().solve(aty);
-  return {sol[1], sol[2]};
-}
+  Circle circle() const {
+    const Eigen::Vector3d sol = ata.ldlt().solve(aty);
+    return {sol[1], sol[2]};
+  }
+};
 
 struct Range {
   double lo = 1e300, hi = -1e300;
   void add(double x) { lo = std::min(lo, x), hi = std::max(hi, x); }
   double pv() const { return hi - lo; }
 };
-
-Range residual_range(const Circle& c, const Samples& samples, std::size_t begin, std::size_t end) {
-  Range r;
-  for (std::size_t i = begin; i < end; ++i) r.add(c.residual(samples.plain(i)));
-  return r;
-}
 
 // Largest |r_a(theta) - r_b(theta)|, r_b interpolated (periodically) at the angles of a.
 double hysteresis(const Circle& c, const Samples& samples, const Span& a, const Span& b) {
@@ -587,9 +592,23 @@ double hysteresis(const Circle& c, const Samples& samples, const Span& a, const 
     pts.emplace_back(mod360(b.trace->angle_deg[i - b.begin]), c.residual(samples.plain(i)));
   sort_circular(pts, [](const auto& p) { return p.first; });
   double h = 0.0;
+  // The lower bound of each angle of a, looked for first a few places on from the last one
+  // (a's angles mostly rise or fall through pts in order), else by bisection: the same place
+  // either way, without a bisection's mispredicted branches on every sample (issue 32).
+  std::size_t last = 0;
+  const auto lower_bound = [&](const std::pair<double, double>& key) {
+    const auto is_bound = [&](std::size_t j) {
+      return (j == 0 || pts[j - 1] < key) && (j == pts.size() || !(pts[j] < key));
+    };
+    for (std::size_t j = last > 2 ? last - 2 : 0; j <= std::min(pts.size(), last + 2); ++j)
+      if (is_bound(j)) return pts.begin() + static_cast<std::ptrdiff_t>(last = j);
+    const auto at = std::lower_bound(pts.begin(), pts.end(), key);
+    last = static_cast<std::size_t>(at - pts.begin());
+    return at;
+  };
   for (std::size_t i = a.begin; i < a.end; ++i) {
     const double t = mod360(a.trace->angle_deg[i - a.begin]);
-    auto hi = std::lower_bound(pts.begin(), pts.end(), std::make_pair(t, -1e300));
+    auto hi = lower_bound(std::make_pair(t, -1e300));
     const auto& p1 = hi == pts.end() ? pts.front() : *hi;
     const auto& p0 = hi == pts.begin() ? pts.back() : *std::prev(hi);
     double span = p1.first - p0.first;
@@ -603,16 +622,36 @@ double hysteresis(const Circle& c, const Samples& samples, const Span& a, const 
   return h;
 }
 
-Iso230_4 iso_values(const Samples& samples) {
+// `arc_deg`: the smallest arc of the traces (validate's, found once).
+Iso230_4 iso_values(const Samples& samples, double arc_deg) {
   Iso230_4 iso;
+  iso.arc_deg = arc_deg;
   const auto& traces = samples.spans();
-  for (const auto& t : traces) {
-    (t.trace->direction == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) =
-        residual_range(lsq_circle(samples, t.begin, t.end), samples, t.begin, t.end).pv();
-    iso.arc_deg = std::min(iso.arc_deg, coverage_deg(t.trace->angle_deg));
+  // The circles of each trace and of all of them in one pass: the common sums run on from the
+  // first trace's, the same sums in the same order as a pass of their own (issue 32: six
+  // passes over the samples were one twentieth of the analysis).
+  std::vector<CircleSums> own(traces.size());
+  CircleSums all;
+  for (std::size_t t = 0; t < traces.size(); ++t) {
+    for (std::size_t i = traces[t].begin; i < traces[t].end; ++i) {
+      const Sample x = samples.plain(i);
+      own[t].add(x);
+      if (t > 0) all.add(x);
+    }
+    if (t == 0) all = own[0];
   }
-  const Circle common = lsq_circle(samples, 0, samples.size());
-  const Range f = residual_range(common, samples, 0, samples.size());
+  const Circle common = all.circle();
+  Range f;
+  for (std::size_t t = 0; t < traces.size(); ++t) {
+    const Circle c = own[t].circle();
+    Range r;
+    for (std::size_t i = traces[t].begin; i < traces[t].end; ++i) {
+      const Sample x = samples.plain(i);
+      r.add(c.residual(x));
+      f.add(common.residual(x));
+    }
+    (traces[t].trace->direction == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) = r.pv();
+  }
   iso.G_bi_um = f.pv();
   iso.centre_u_um = common.cu;
   iso.centre_v_um = common.cv;
@@ -848,14 +887,14 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
 
 Result analyse(const Setup& setup, std::span<const Trace> traces,
                std::size_t records_held_max_samples) {
-  validate(setup, traces);
+  const double arc_deg = validate(setup, traces);
   Result res;
   // Deviations from the nominal radius: the bar reads 0 at its calibrated length.
   const double offset_um =
       1e3 * (setup.calibrated_radius_mm.value_or(setup.radius_mm) - setup.radius_mm);
   Samples samples(traces, offset_um, setup.spike_decay_deg * deg, records_held_max_samples);
   const auto& spans = samples.spans();
-  res.iso = iso_values(samples);
+  res.iso = iso_values(samples, arc_deg);
 
   Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
   m.split = spans[0].end;

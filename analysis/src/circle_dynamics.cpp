@@ -45,6 +45,7 @@
 #include <numeric>
 #include <unsupported/Eigen/FFT>
 
+#include "cal/analysis/angle_reduce.hpp"
 #include "cal/analysis/moving_median.hpp"
 
 namespace cal::circle::dynamics {
@@ -444,9 +445,10 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
     high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41),
               std::span(hp).subspan(first, t.r_um.size()));
   }
-  // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2).
-  const auto from_u = [](double th) { return std::abs(std::remainder(th, pi)); };
-  const auto from_v = [](double th) { return std::abs(std::remainder(th - pi / 2, pi)); };
+  // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2)
+  // (|std::remainder|, without its call: angle_reduce.hpp).
+  const auto from_u = [](double th) { return abs_remainder(th, pi); };
+  const auto from_v = [](double th) { return abs_remainder(th - pi / 2, pi); };
   const auto each_sample = [&](auto&& f) {  // f(index in hp, theta)
     for (std::size_t i = 0, k = 0; i < traces.size(); ++i)
       for (std::size_t j = 0; j < traces[i].r_um.size(); ++j, ++k) f(k, traces[i].theta_rad(j));

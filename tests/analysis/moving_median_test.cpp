@@ -67,3 +67,29 @@ TEST(MovingMedian, FollowsASortedAndAReversedRamp) {
 }
 
 }  // namespace
+
+namespace {
+
+// The branch-free bisection gives std::lower_bound's place in every case: each length up to 90,
+// keys below, above, between and equal to the values, with many ties.
+TEST(MovingMedian, LowerPlaceIsStdLowerBound) {
+  std::mt19937_64 rng(33);
+  std::uniform_int_distribution<int> few(-6, 6);
+  int checked = 0;
+  for (std::size_t n = 1; n <= 90; ++n)
+    for (int round = 0; round < 20; ++round) {
+      std::vector<double> v(n);
+      for (auto& x : v) x = few(rng) / 2.0;
+      std::sort(v.begin(), v.end());
+      for (int key = -15; key <= 15; ++key) {
+        const double x = key / 4.0;
+        const auto want =
+            static_cast<std::size_t>(std::lower_bound(v.begin(), v.end(), x) - v.begin());
+        ASSERT_EQ(cal::lower_place(v.data(), n, x), want) << "n " << n << " key " << x;
+        ++checked;
+      }
+    }
+  EXPECT_EQ(checked, 90 * 20 * 31);
+}
+
+}  // namespace

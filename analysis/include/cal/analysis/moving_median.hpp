@@ -18,6 +18,18 @@ namespace cal {
 // shift of the values between the leaving and the entering one) instead of selecting every
 // window's median anew: O(n w) for a window of w values, and w is small (the ballbar's is at
 // most about 80), where a sorted array beats a pair of heaps. The ends select anew.
+// std::lower_bound's place in the sorted v[0, n), n >= 1 (the first not less than x), by a
+// bisection whose steps are selects rather than branches.
+inline std::size_t lower_place(const double* v, std::size_t n, double x) {
+  const double* base = v;
+  while (n > 1) {
+    const std::size_t half = n / 2;
+    base = base[half] < x ? base + half : base;
+    n -= half;
+  }
+  return static_cast<std::size_t>(base - v) + (*base < x ? 1 : 0);
+}
+
 template <class At, class Out>
 void moving_median(std::size_t n, std::size_t m, std::size_t stride, At&& at, Out&& out) {
   std::vector<double> win;
@@ -43,17 +55,18 @@ void moving_median(std::size_t n, std::size_t m, std::size_t stride, At&& at, Ou
       out(i, win[count / 2]);
       if (i + stride + m + 1 > n) break;
       const double leaving = at(i - m), entering = at(i - m + count * stride);
-      // Replace `leaving` by `entering` and keep the window sorted: shift the values between.
-      auto gone = std::lower_bound(win.begin(), win.end(), leaving);
+      // Replace `leaving` by `entering` and keep the window sorted: shift the values between,
+      // one at a time towards where `entering` goes (the first value above it on that side, as
+      // std::upper_bound finds it). `leaving` is found by a bisection without branches: on
+      // residuals its place is random, and the mispredicted branches of std::lower_bound and
+      // std::upper_bound were most of the stick-slip's time (issue 32).
+      std::size_t j = lower_place(win.data(), count, leaving);
       if (entering >= leaving) {
-        const auto to = std::upper_bound(gone + 1, win.end(), entering);
-        std::move(gone + 1, to, gone);
-        *(to - 1) = entering;
+        for (; j + 1 < count && win[j + 1] <= entering; ++j) win[j] = win[j + 1];
       } else {
-        const auto to = std::upper_bound(win.begin(), gone, entering);
-        std::move_backward(to, gone, gone + 1);
-        *to = entering;
+        for (; j > 0 && win[j - 1] > entering; --j) win[j] = win[j - 1];
       }
+      win[j] = entering;
       i += stride;
     }
   }
