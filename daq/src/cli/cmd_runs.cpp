@@ -1,5 +1,4 @@
 // daq runs / show / export: stored runs.
-#include <fmt/compile.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -437,13 +436,54 @@ std::optional<std::string> stop_value_column(const st::RunRecord& run, const jso
   return "value_" + unit;
 }
 
+// The fields between a reading's UTC time and its status, the same for every reading of one
+// stream (device, device name, channel, quantity), as write_reading_fields writes them: made
+// once per stream, so a row copies them (formatting them per row was an eighth of an export,
+// issue 32). Looked up when the stream changes from the row before (a handful a second).
+template <bool Json>
+class StreamFields {
+ public:
+  explicit StreamFields(const DeviceNames& names) : names_(names) {}
+  std::string_view operator()(const st::RawReading& r) {
+    const StreamKey key = key_of(r);
+    if (last_ == nullptr || last_key_ != key) {
+      auto [at, added] = text_.try_emplace(key);
+      if (added) {
+        const auto quantity =
+            cal::drivers::to_string(static_cast<cal::drivers::Quantity>(r.quantity));
+        at->second =
+            Json ? fmt::format("\",{},{},{},\"{}\",", r.device, names_[r.device], r.channel,
+                               quantity)
+                 : fmt::format(",{},{},{},{},", r.device, names_[r.device], r.channel, quantity);
+      }
+      last_key_ = key;
+      last_ = &at->second;
+    }
+    return *last_;
+  }
+
+ private:
+  const DeviceNames& names_;
+  std::map<StreamKey, std::string> text_;
+  StreamKey last_key_{};
+  const std::string* last_ = nullptr;
+};
+
+// A small unsigned integer (a status) as fmt's "{}" writes it.
+char* write_small(char* p, std::uint8_t v) {
+  if (v >= 100) *p++ = static_cast<char>('0' + v / 100);
+  if (v >= 10) *p++ = static_cast<char>('0' + v / 10 % 10);
+  *p++ = static_cast<char>('0' + v % 10);
+  return p;
+}
+
 // One reading's fields in kReadingColumns order: a CSV line's (Json false; names as CSV fields),
 // or the items of a JSON array (Json true; names as JSON strings, the UTC time and the
 // quantity quoted, what a JSON number cannot hold, inf and nan, as null as nlohmann writes
 // it). Both exports write their rows through this; a template, so that each one's loop stays
 // as fast as a hand-written one (daq bench export).
 template <bool Json>
-char* write_reading_fields(char* p, const ExportClock& clock, const DeviceNames& names,
+char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>& fields,
                            const ExportRow& x) {
   const auto number = [](char* q, double v) {
     if (!Json || std::isfinite(v)) return write_shortest(q, v);
@@ -451,15 +491,14 @@ char* write_reading_fields(char* p, const ExportClock& clock, const DeviceNames&
   };
   p = number(p, clock.seconds(x.session_ns));
   p = Json ? std::copy_n(",\"", 2, p) : std::copy_n(",", 1, p);
-  const auto utc = clock.utc_view(x.session_ns);
-  p = std::copy(utc.begin(), utc.end(), p);
-  const auto quantity = cal::drivers::to_string(static_cast<cal::drivers::Quantity>(x.r.quantity));
-  if constexpr (Json)
-    p = fmt::format_to(p, FMT_COMPILE("\",{},{},{},\"{}\",{},"), x.r.device, names[x.r.device],
-                       x.r.channel, quantity, x.r.status);
-  else
-    p = fmt::format_to(p, FMT_COMPILE(",{},{},{},{},{},"), x.r.device, names[x.r.device],
-                       x.r.channel, quantity, x.r.status);
+  if (clock.has_utc()) {  // (a run without a time origin leaves it empty: no call per row)
+    const auto utc = clock.utc_view(x.session_ns);
+    p = std::copy(utc.begin(), utc.end(), p);
+  }
+  const auto middle = fields(x.r);
+  p = std::copy(middle.begin(), middle.end(), p);
+  p = write_small(p, x.r.status);
+  *p++ = ',';
   p = number(p, x.r.value);
   *p++ = ',';
   return write_integer(p, x.r.time_ns);
@@ -471,9 +510,10 @@ void export_readings_csv(const st::RunReader& store, const st::RunRecord& run, c
   const DeviceNames names(store, run.id, csv_field, "");  // CSV fields, quoted where needed
   const std::size_t row_max = kRowNumbersMax + names.longest() + 40;
   fmt::print(out, "{}\n", kReadingColumns);
+  StreamFields<false> fields(names);
   RowBuffer b(out);
   each_export_row(store, run.id, clock, [&](const ExportRow& x) {
-    char* p = write_reading_fields<false>(b.room(row_max), clock, names, x);
+    char* p = write_reading_fields<false>(b.room(row_max), clock, fields, x);
     *p++ = '\n';
     b.commit(p);
     b.row_done();
@@ -502,8 +542,7 @@ void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, co
              fmt::format(fmt::runtime(kTargetColumns), names.target, *value_column, names.raw));
   std::string note;  // a rotary run stored the old way: its stops' angles read as deviations
   const auto targets = stored_targets(store, run, &note);
-  if (!note.empty())
-    fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
+  if (!note.empty()) fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
   for (const auto& t : targets) {
     const auto at = static_cast<double>(t.time_ns);
     fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,
@@ -602,11 +641,12 @@ void export_json(const st::RunReader& store, const st::RunRecord& run, const jso
   fmt::print(out, "{}\n \"readings\": [", std::string_view(text).substr(0, at));
   bool first = true;
   {
+    StreamFields<true> fields(names);
     RowBuffer b(out);
     each_export_row(store, run.id, clock, [&](const ExportRow& x) {
       char* p = b.room(row_max);
       p = std::copy_n(first ? "\n  [" : ",\n  [", first ? 4 : 5, p);
-      p = write_reading_fields<true>(p, clock, names, x);
+      p = write_reading_fields<true>(p, clock, fields, x);
       *p++ = ']';
       b.commit(p);
       b.row_done();

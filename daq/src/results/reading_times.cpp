@@ -84,6 +84,15 @@ std::string_view ExportClock::utc_view(double session_ns) const {
 }
 
 void ExportRows::flush(std::vector<ExportRow>& out) {
+  if (held_ == 1) {  // the usual case, a reading per stored time: it is the last one added
+    auto& e = pending_[last_];
+    out.push_back({e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns), e.tags[0]});
+    e.group.clear();
+    e.tags.clear();
+    held_ = 0;
+    return;
+  }
+  held_ = 0;
   for (auto& e : pending_) {
     if (e.group.empty()) continue;
     if (e.group.size() == 1) {
@@ -118,6 +127,7 @@ void ExportRows::add(const st::RawReading& r, std::vector<ExportRow>& out, std::
   }
   pending_[last_].group.push_back(r);
   pending_[last_].tags.push_back(tag);
+  ++held_;
 }
 
 void ExportRows::finish(std::vector<ExportRow>& out) { flush(out); }

@@ -107,6 +107,7 @@ class ExportRows {
   ExportClock& clock_;
   std::vector<Pending> pending_;  // one per stream seen, by key (a handful: found by a scan)
   std::size_t last_ = 0;          // the entry of the last reading (most follow their stream)
+  std::size_t held_ = 0;          // readings in the groups (1: only the last one, at last_)
   std::vector<double> times_;
   std::int64_t current_ = 0;
   bool first_ = true;
