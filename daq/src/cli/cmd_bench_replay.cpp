@@ -279,7 +279,7 @@ void bench_replay(const ReplayBenchOptions& o) {
       load_before, load_after, o.rounds, runs, targets, feed);
   fmt::print(
       "peer (the ingest bench's pipeline, {} s of a 10 kHz gauge stream, median of the rounds): "
-      "{:.3f} us CPU per reading without storage ({}), {:.3f} us with storage ({})\n",
+      "{:.3f} us CPU per reading without storage ({:.3f}), {:.3f} us with storage ({:.3f})\n",
       o.bench_seconds, pipeline_us, fmt::join(peer.pipeline_us, ", "), ingest_us,
       fmt::join(peer.ingest_us, ", "));
   for (const auto& t : templates)
