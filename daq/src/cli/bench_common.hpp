@@ -10,6 +10,10 @@
 
 #include "cal/storage/writer.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace daq::bench {
 
 double median(std::vector<double> v);
@@ -66,3 +70,8 @@ ChildResult spawn_child(const std::vector<std::string>& args, const std::string&
 ChildResult run_child(const std::vector<std::string>& args);
 
 }  // namespace daq::bench
+
+namespace daq {
+// daq bench replay (cmd_bench_replay.cpp), added to the `bench` group by add_bench_commands.
+void add_bench_replay_command(CLI::App& bench);
+}  // namespace daq

@@ -41,8 +41,6 @@ void add_serve_command(CLI::App& app);
 void add_report_command(CLI::App& app);
 // bench ingest: throughput against the storage ceilings, measured on this machine
 void add_bench_commands(CLI::App& app);
-// bench replay: every device kind at its highest rate (cmd_bench_replay.cpp), under `bench`
-void add_bench_replay_command(CLI::App& bench);
 // model show|map|compensate|testpiece: the machine model file
 void add_model_commands(CLI::App& app);
 // ballbar calibrate|calibrations|volumetric|history
