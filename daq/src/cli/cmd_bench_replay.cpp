@@ -321,19 +321,21 @@ void bench_replay(const ReplayBenchOptions& o) {
     const auto added = readings - tpl.rounds.front().readings;
     // The device's readings without the run's fixed start-up and analysis (the ballbar's
     // analysis grows with its samples and is in).
-    const double per_us = added > 0 ? (cpu - median_of(tpl.rounds, &Replayed::cpu_s)) /
-                                          static_cast<double>(added) * 1e6
-                                    : std::nan("");
+    const double above_s = cpu - median_of(tpl.rounds, &Replayed::cpu_s);
+    const double per_us = added > 0 ? above_s / static_cast<double>(added) * 1e6 : std::nan("");
+    // The same replay's CPU scatters by some 10 ms between rounds on a loaded machine: a device
+    // adding less than 20 ms to its template's replay has no per-reading figure to speak of.
+    const char* noise = above_s < 0.02 ? " (noise: < 20 ms above the template)" : "";
     const bool complete =
         std::all_of(s.rounds.begin(), s.rounds.end(), [](const Replayed& r) { return r.complete; });
     all_complete = all_complete && complete;
     std::vector<std::string> cpus;
     for (const auto& r : s.rounds) cpus.push_back(fmt::format("{:.3f}", r.cpu_s));
     fmt::print(
-        "| {} | {:g} Hz | {} | {:.1f} s | {:.2f} s | {:.3f} s ({}) | {:.0f}x | {:.3f} | {:.1f} | "
+        "| {} | {:g} Hz | {} | {:.1f} s | {:.2f} s | {:.3f} s ({}) | {:.0f}x | {:.3f}{} | {:.1f} | "
         "{:.1f} | {:.1f} MB | {} |\n",
         s.what, s.rate_hz, readings, s.recorded_s, wall, cpu, fmt::join(cpus, ", "),
-        s.recorded_s / cpu, per_us, per_us / pipeline_us, per_us / ingest_us,
+        s.recorded_s / cpu, per_us, noise, per_us / pipeline_us, per_us / ingest_us,
         static_cast<double>(max_rss_kib(s.rounds)) / 1024,
         run_text(complete ? s.rounds.front()
                           : *std::find_if(s.rounds.begin(), s.rounds.end(),
@@ -351,6 +353,7 @@ void bench_replay(const ReplayBenchOptions& o) {
                               {"wall_s", wall},
                               {"real_time_factor_cpu", s.recorded_s / cpu},
                               {"us_cpu_per_added_reading", per_us},
+                              {"cpu_above_template_s", above_s},
                               {"x_pipeline", per_us / pipeline_us},
                               {"x_ingest", per_us / ingest_us},
                               {"peak_rss_kib", max_rss_kib(s.rounds)},
