@@ -66,7 +66,11 @@ struct ChildResult {
 };
 // Runs this daq binary with `args`, its stdout and stderr to the file `output`.
 ChildResult spawn_child(const std::vector<std::string>& args, const std::string& output);
-// The same, its output to /dev/null; throws unless it exits with 0.
+// Runs `program` (a path) with `args` the same way. Its peak RSS from wait4 is at least this
+// process's at the spawn (Linux keeps the larger of the old and the new image's across exec).
+ChildResult spawn_program(const std::string& program, const std::vector<std::string>& args,
+                          const std::string& output);
+// spawn_child, its output to /dev/null; throws unless it exits with 0.
 ChildResult run_child(const std::vector<std::string>& args);
 
 }  // namespace daq::bench

@@ -615,8 +615,13 @@ namespace bench {
 // Runs this daq binary with `args`, its output (stdout and stderr) to `output`: its wall time,
 // CPU and peak RSS (wait4) and how it exited.
 ChildResult spawn_child(const std::vector<std::string>& args, const std::string& output) {
+  return spawn_program("/proc/self/exe", args, output);
+}
+
+ChildResult spawn_program(const std::string& program, const std::vector<std::string>& args,
+                          const std::string& output) {
   std::vector<char*> argv;
-  std::string self = "/proc/self/exe";
+  std::string self = program;
   argv.push_back(self.data());
   std::vector<std::string> copy = args;
   for (auto& a : copy) argv.push_back(a.data());
@@ -627,7 +632,7 @@ ChildResult spawn_child(const std::vector<std::string>& args, const std::string&
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
   const auto t0 = Clock::now();
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw cal::InputError(fmt::format("bench: cannot start daq: {}", std::strerror(rc)));
   int status = 0;

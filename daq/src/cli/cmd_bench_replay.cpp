@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -104,7 +105,32 @@ Replayed replay_once(const Subject& s, const fs::path& template_db, const fs::pa
   const fs::path db = dir / "replay.sqlite";
   const fs::path log = dir / "replay.log";
   copy_db(template_db, db);
-  const auto c = bench::spawn_child({"replay", s.capture.string(), "--db", db.string()}, log);
+  // Under GNU time when there is one: wait4's peak RSS of a child of this process is at least
+  // this process's own (Linux keeps the larger of the image before and after exec; this one
+  // holds the captures' figures and the ingest bench's heap), so the replay's own peak is
+  // time's %M, the peak of its child, spawned from its small image. CPU and wall from wait4
+  // (they include time's own, about a millisecond).
+  const fs::path rss = dir / "replay.rss";
+  fs::remove(rss);
+  const bool gnu_time = fs::exists("/usr/bin/time");
+  const std::vector<std::string> replay{"replay", s.capture.string(), "--db", db.string()};
+  auto wrapped = std::vector<std::string>{"-f", "%M", "-o", rss.string(),
+                                          fs::read_symlink("/proc/self/exe").string()};
+  wrapped.insert(wrapped.end(), replay.begin(), replay.end());
+  auto c = gnu_time ? bench::spawn_program("/usr/bin/time", wrapped, log.string())
+                    : bench::spawn_child(replay, log.string());
+  if (gnu_time) {
+    // "%M" on the last line (a "Command exited with non-zero status 2" line may come first).
+    std::ifstream in(rss);
+    std::string line, last;
+    while (std::getline(in, line))
+      if (!line.empty()) last = line;
+    char* end = nullptr;
+    c.peak_rss_kib = std::strtol(last.c_str(), &end, 10);
+    if (last.empty() || *end != '\0')
+      throw cal::InputError(
+          fmt::format("bench replay: /usr/bin/time gave no peak RSS ('{}')", last));
+  }
   // 2: stored incomplete (or another error: then no run of this capture is found below).
   if (c.exit_code != 0 && c.exit_code != 2)
     throw cal::InputError(fmt::format("bench replay: daq replay {} failed (exit {}):\n{}",
