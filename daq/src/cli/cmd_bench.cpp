@@ -46,6 +46,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/daq/env_stage.hpp"
 #include "cal/drivers/registry.hpp"
@@ -61,7 +62,7 @@
 #include "commands.hpp"
 
 namespace daq {
-namespace {
+namespace bench {  // shared with daq bench replay (bench_common.hpp)
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -102,19 +103,6 @@ void remove_db(const fs::path& p) {
   for (const char* s : {"", "-wal", "-shm"}) fs::remove(p.string() + s);
 }
 
-// Removes the benchmark's files when it ends, also by an error (they can be hundreds of MB).
-struct Cleanup {
-  std::vector<fs::path> files;
-  explicit Cleanup(std::vector<fs::path> f) : files(std::move(f)) {}
-  Cleanup(const Cleanup&) = delete;
-  Cleanup& operator=(const Cleanup&) = delete;
-  ~Cleanup() {
-    std::error_code ec;
-    for (const auto& f : files)
-      for (const char* s : {"", "-wal", "-shm"}) fs::remove(f.string() + s, ec);
-  }
-};
-
 void write_capture(const fs::path& path, int seconds) {
   cal::replay::CaptureWriter w(path, R"({"format": "daq bench ingest"})");
   const auto bytes = [](const std::string& s) {
@@ -147,23 +135,6 @@ void write_capture(const fs::path& path, int seconds) {
   }
 }
 
-struct IngestResult {
-  std::uint64_t readings = 0;
-  std::uint64_t handovers = 0;  // calls that brought the gauge's readings (one per chunk)
-  double wall_s = 0.0, cpu_s = 0.0;
-  double checksum = 0.0;  // sum of the compensated lengths: the same in every round and version
-  cal::storage::WriterStats writer;
-  std::vector<std::pair<int, long>> rss_marks;  // (recorded minute, current RSS KiB)
-};
-
-// Where the threads of one ingest run (-1: the OS decides): the event loop on one CPU, the
-// storage threads (the batch encoder and the SQLite writer) on another. (The encoder beside
-// the loop instead was slower: 64 - 71 %, the loop's CPU then being the limit.)
-struct Placement {
-  int loop_cpu = -1, storage_cpu = -1;
-  bool pinned() const { return loop_cpu >= 0; }
-};
-
 // Runs this thread on `cpu` until destroyed, then where it ran before.
 class PinThisThread {
  public:
@@ -191,7 +162,7 @@ class PinThisThread {
 
 // The ingest pipeline; `db` empty: the pipeline alone, readings go nowhere.
 IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t batch_readings,
-                    Placement where = {}) {
+                    Placement where) {
   IngestResult res;
   std::int64_t run = 0;
   std::unique_ptr<cal::storage::BatchWriter> writer;
@@ -286,6 +257,10 @@ IngestResult ingest(const fs::path& capture, const fs::path& db, std::size_t bat
   res.cpu_s = cpu_seconds() - cpu0;
   return res;
 }
+
+}  // namespace bench
+namespace {
+using namespace bench;
 
 struct SqliteDb {
   sqlite3* db = nullptr;
@@ -635,39 +610,53 @@ std::int64_t generate_run(cal::storage::Store& store, int seconds) {
   return run;
 }
 
-struct ChildResult {
-  double seconds = 0.0;
-  double cpu_s = 0.0;  // user and system
-  long peak_rss_kib = 0;
-};
+}  // namespace
+namespace bench {
+// Runs this daq binary with `args`, its output (stdout and stderr) to `output`: its wall time,
+// CPU and peak RSS (wait4) and how it exited.
+ChildResult spawn_child(const std::vector<std::string>& args, const std::string& output) {
+  return spawn_program("/proc/self/exe", args, output);
+}
 
-// Runs this daq binary with `args`, its output to /dev/null; throws unless it exits with 0.
-ChildResult run_child(const std::vector<std::string>& args) {
+ChildResult spawn_program(const std::string& program, const std::vector<std::string>& args,
+                          const std::string& output) {
   std::vector<char*> argv;
-  std::string self = "/proc/self/exe";
+  std::string self = program;
   argv.push_back(self.data());
   std::vector<std::string> copy = args;
   for (auto& a : copy) argv.push_back(a.data());
   argv.push_back(nullptr);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
   const auto t0 = Clock::now();
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw cal::InputError(fmt::format("bench: cannot start daq: {}", std::strerror(rc)));
   int status = 0;
   rusage usage{};
-  if (::wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw cal::InputError(
-        fmt::format("bench: daq {} failed (status {})", fmt::join(args, " "), status));
+  if (::wait4(pid, &status, 0, &usage) != pid)
+    throw cal::InputError(fmt::format("bench: lost daq {}", fmt::join(args, " ")));
   const auto tv = [](const timeval& t) {
     return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
   };
-  return {seconds_since(t0), tv(usage.ru_utime) + tv(usage.ru_stime), usage.ru_maxrss};
+  return {.seconds = seconds_since(t0),
+          .cpu_s = tv(usage.ru_utime) + tv(usage.ru_stime),
+          .peak_rss_kib = usage.ru_maxrss,
+          .exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
+
+ChildResult run_child(const std::vector<std::string>& args) {
+  auto r = spawn_child(args, "/dev/null");
+  if (r.exit_code != 0)
+    throw cal::InputError(
+        fmt::format("bench: daq {} failed (exit {})", fmt::join(args, " "), r.exit_code));
+  return r;
+}
+}  // namespace bench
+namespace {
 
 // The ceiling of an export, measured in this process beside it: what any export must do at the
 // least, read the run's readings from the store (every chunk decoded, nothing formatted) and
@@ -850,7 +839,9 @@ void bench_sync(const SyncBenchOptions& o) {
 }  // namespace
 
 void add_bench_commands(CLI::App& app) {
-  auto* bench = add_group(app, "bench", "Measure this machine: ingest throughput and ceilings");
+  auto* bench = add_group(
+      app, "bench",
+      "Measure this machine: ingest, replay, export and sync beside their peers and ceilings");
   const auto [in, o] = add_command<BenchOptions>(
       *bench, "ingest", bench_ingest,
       "Replay a generated 10 kHz capture through the real instruments, compensation and store; "
@@ -879,6 +870,8 @@ void add_bench_commands(CLI::App& app) {
   ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
   ex->add_option("--keep-db", e->keep,
                  "Store the generated runs in this new file and keep it (to export or inspect)");
+
+  add_bench_replay_command(*bench);
 
   const auto [sy, y] = add_command<SyncBenchOptions>(
       *bench, "sync", bench_sync,

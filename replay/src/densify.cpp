@@ -1,37 +1,25 @@
-// Makes a capture of one device at its highest rate from a capture of the simulated shop
-// (`daq sim --acquire --capture`), for measuring `daq replay` per device kind
-// (tests/bench/replay_rates.sh, docs/benchmarks.md "Replay speed per device kind").
-//
-// Usage: rate_capture IN.cdq OUT.cdq KIND RATE_HZ
-//   ids3010     the laser's getAxesDisplacement pairs, more of them between the recorded ones
-//               (new ids; every later id of the laser shifted), displacements interpolated
-//   ptu300      the air's SEND and its line, repeated at the rate
-//   gauge       the material thermometer's "?" and its answer, repeated at the rate
-//   ballbar     the bar's streamed lines at the rate (config.circle.sample_rate_hz too),
-//               lengths interpolated between the recorded samples
-//   shdr        the position feed's Xcom lines at the rate while the axis moves (gaps up to
-//               50 ms between recorded lines), positions interpolated
-//   halsampler  the SHDR feed replaced by halsampler lines at the rate, the same positions
-//   temper      the material thermometer replaced by a TEMPer (family gold, channel 0) read
-//               at the rate, the same temperatures
-// The other devices' records are copied unchanged, every record stays in time order; the run
-// is the same run, only denser, so `daq replay` of OUT finishes as the original did.
+// One device of a capture at its highest rate (see densify.hpp).
+#include "cal/replay/densify.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
-#include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "cal/replay/capture.hpp"
 
+namespace cal::replay {
 namespace {
 
-using cal::replay::Record;
-using cal::replay::RecordKind;
 using nlohmann::json;
 
 struct Out {
@@ -88,7 +76,7 @@ class Generator {
 
   void write(const std::string& path) {
     prepare();
-    cal::replay::CaptureWriter writer(path, header_.dump());
+    CaptureWriter writer(path, header_.dump());
     std::deque<Out> pending;
     const auto flush_until = [&](std::int64_t t) {
       while (!pending.empty() && pending.front().time_ns <= t) {
@@ -257,7 +245,7 @@ class Generator {
            });
       return out;
     }
-    return halsampler(r, next_target_time(i, true));
+    return halsampler(r, i);
   }
   static std::int64_t id_of(const std::string& s) {
     std::int64_t id = 0;
@@ -322,7 +310,30 @@ class Generator {
     return recorded_hz_;
   }
 
-  std::vector<Out> halsampler(const Record& r, std::int64_t next) {
+  // The end of the feed: the device's "closed" after record i, else the capture's last record.
+  std::int64_t feed_end_time(std::size_t i) const {
+    for (std::size_t j = i + 1; j < records_.size(); ++j)
+      if (records_[j].device == target_ && records_[j].kind == RecordKind::event &&
+          records_[j].text() == "closed")
+        return records_[j].time_ns;
+    return records_.back().time_ns;
+  }
+  bool position_after(std::size_t i) const {
+    for (std::size_t j = i + 1; j < records_.size(); ++j)
+      if (records_[j].device == target_ && records_[j].kind == RecordKind::received &&
+          xcom(records_[j].text()))
+        return true;
+    return false;
+  }
+
+  // A line at each recorded position and every period between (the servo thread samples
+  // whether the axis moves or not). After the last recorded position the lines go on to the
+  // end of the feed, and one is at its very last instant: the original run ended on a reading
+  // of the laser right after its last stop's dwell (the SHDR adapter's feed holds its value,
+  // so its trigger needed no later sample), and a periodic feed proves the axis still only up
+  // to its newest sample. Without that line the feed stopped short of the laser's last reading
+  // and the last stop was never captured (issue 32: 109 of 110 stops).
+  std::vector<Out> halsampler(const Record& r, std::size_t i) {
     std::vector<Out> out;
     if (r.kind == RecordKind::event) {
       if (r.text() == "opened" || r.text() == "closed")
@@ -334,33 +345,48 @@ class Generator {
       o.push_back({when, RecordKind::received, fmt::format("{:.6f} \n", series_.at(when))});
     };
     line(out, r.time_ns);
-    fill(out, r.time_ns, next, line);
+    if (position_after(i)) {
+      fill(out, r.time_ns, next_target_time(i, true), line);
+      return out;
+    }
+    const auto end = feed_end_time(i);
+    fill(out, r.time_ns, end, line);
+    if (out.back().time_ns < end) line(out, end);
     return out;
   }
 };
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr,
-                 "usage: rate_capture IN.cdq OUT.cdq "
-                 "ids3010|ptu300|gauge|ballbar|shdr|halsampler|temper RATE_HZ\n");
-    return 2;
-  }
-  try {
-    cal::replay::CaptureReader reader(argv[1]);
-    std::vector<Record> records;
-    while (auto r = reader.next()) records.push_back(std::move(*r));
-    if (reader.damage())
-      throw std::runtime_error(std::string(argv[1]) + ": " + describe(*reader.damage()));
-    const double rate = std::strtod(argv[4], nullptr);
-    if (!(rate > 0 && rate <= 1e6)) throw std::runtime_error("RATE_HZ must be in (0, 1e6]");
-    Generator g(std::move(records), json::parse(reader.header_json()), argv[3], rate);
-    g.write(argv[2]);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rate_capture: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+std::span<const DenseKind> dense_kinds() {
+  static constexpr std::array<DenseKind, 7> kinds{{
+      {"ids3010", "linear", 10000, "IDS3010 getAxesDisplacement, JSON-RPC"},
+      {"ptu300", "linear", 10, "PTU300 SEND lines at 4800 7E1"},
+      {"gauge", "linear", 90, "serial thermometer (line gauge, polled) at 9600 8N1"},
+      {"ballbar", "circle", 10000, "ballbar (line gauge, streaming), the issue's 10 kHz"},
+      {"shdr", "linear", 1000, "MTConnect SHDR Xcom lines while moving"},
+      {"halsampler", "linear", 1000, "halsampler lines (servo thread)"},
+      {"temper", "linear", 200, "TEMPer HID reports (the 5 ms HID poll)"},
+  }};
+  return kinds;
 }
+
+void densify(const std::filesystem::path& in, const std::filesystem::path& out,
+             std::string_view kind, double rate_hz) {
+  if (!(rate_hz > 0 && rate_hz <= 1e6))
+    throw std::runtime_error(fmt::format("densify: rate {} Hz: expected (0, 1e6]", rate_hz));
+  CaptureReader reader(in);
+  std::vector<Record> records;
+  while (auto r = reader.next()) records.push_back(std::move(*r));
+  if (reader.damage()) throw std::runtime_error(in.string() + ": " + describe(*reader.damage()));
+  if (records.empty()) throw std::runtime_error(in.string() + ": no records");
+  try {
+    Generator g(std::move(records), nlohmann::json::parse(reader.header_json()), std::string(kind),
+                rate_hz);
+    g.write(out.string());
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(fmt::format("{}: header: {}", in.string(), e.what()));
+  }
+}
+
+}  // namespace cal::replay
