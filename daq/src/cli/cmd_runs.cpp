@@ -145,6 +145,8 @@ json approval_json(const st::Approval& a) {
     j["result_fingerprint"] = a.result_fingerprint;
     j["run_version"] = a.run_version;
   }
+  // Made on the central server (read there, or brought by daq sync --from): which one.
+  if (!a.central_server.empty()) j["central_server"] = a.central_server;
   return j;
 }
 
@@ -284,8 +286,9 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
         "");
     print_line("    {}", provenance_text(res["provenance"]));
     if (res.contains("approval"))
-      print_line("    approved by {} at {}", res["approval"]["approved_by"].get<std::string>(),
-                 res["approval"]["approved"].get<std::string>());
+      print_line("    approved by {} at {}{}", res["approval"]["approved_by"].get<std::string>(),
+                 res["approval"]["approved"].get<std::string>(),
+                 res["approval"].contains("central_server") ? " on the central server" : "");
     if (!current) continue;                 // the old values stay in --json
     print_result(res["result"], "      ");  // as daq run and daq analyse print it
     if (res.contains("verdict")) print_verdict(res["verdict"], "      ");
@@ -502,8 +505,7 @@ void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, co
              fmt::format(fmt::runtime(kTargetColumns), names.target, *value_column, names.raw));
   std::string note;  // a rotary run stored the old way: its stops' angles read as deviations
   const auto targets = stored_targets(store, run, &note);
-  if (!note.empty())
-    fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
+  if (!note.empty()) fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
   for (const auto& t : targets) {
     const auto at = static_cast<double>(t.time_ns);
     fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,
