@@ -220,6 +220,20 @@ CREATE TABLE approvals(
   approved_by TEXT NOT NULL,
   approved_unix_ms INTEGER NOT NULL);
 )sql",
+    // 9 -> 10 (issue 35): the central server's approvals of the results a laptop brought (daq
+    // sync --from), read-only here: who approved there, when, the result's fingerprint and the
+    // run's version there, and the server (its URI, password hidden). A report on the laptop is
+    // issued as the server would issue it.
+    R"sql(
+CREATE TABLE central_approvals(
+  id INTEGER PRIMARY KEY,
+  result_id INTEGER NOT NULL UNIQUE REFERENCES results(id) ON DELETE CASCADE,
+  result_fingerprint TEXT NOT NULL,
+  run_version INTEGER NOT NULL,
+  approved_by TEXT NOT NULL,
+  approved_unix_ms INTEGER NOT NULL,
+  server TEXT NOT NULL);
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -447,6 +461,12 @@ CREATE TEMP TABLE operator_actions(id INTEGER PRIMARY KEY, run_id INTEGER, time_
         "CREATE TEMP TABLE approvals(id INTEGER PRIMARY KEY, result_id INTEGER, approved_by "
         "TEXT, approved_unix_ms INTEGER);",
         "present an older schema without approvals (read-only)");
+  if (version < 10)  // before the central approvals were brought: none
+    exec(
+        "CREATE TEMP TABLE central_approvals(id INTEGER PRIMARY KEY, result_id INTEGER, "
+        "result_fingerprint TEXT, run_version INTEGER, approved_by TEXT, approved_unix_ms "
+        "INTEGER, server TEXT);",
+        "present an older schema without central approvals (read-only)");
   has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
@@ -1089,8 +1109,9 @@ Approval Store::approve(std::int64_t run_id, std::int64_t result_id, std::string
   for (const auto& a : approvals(run_id))
     if (a.result_id == result_id)
       throw StoreError(
-          fmt::format("{}: result {} of run {} is approved already (by {}, unix ms {})",
-                      m.path.string(), result_id, run_id, a.approved_by, a.approved_unix_ms));
+          fmt::format("{}: result {} of run {} is approved already (by {}, unix ms {}{})",
+                      m.path.string(), result_id, run_id, a.approved_by, a.approved_unix_ms,
+                      a.central_server.empty() ? "" : ", on the central server"));
   const Approval a{.result_id = result_id,
                    .approved_by = std::string(approved_by),
                    .approved_unix_ms = unix_ms_now()};
@@ -1102,15 +1123,54 @@ Approval Store::approve(std::int64_t run_id, std::int64_t result_id, std::string
   return a;
 }
 
+// The central server's approvals (brought by daq sync --from) first: of a result approved both
+// there and here, the server's is the one a report names.
 std::vector<Approval> Store::approvals(std::int64_t run_id) const {
   return rows_of<Approval>(
       *impl_,
-      "SELECT a.result_id, a.approved_by, a.approved_unix_ms FROM approvals AS a JOIN results AS "
-      "r ON r.id = a.result_id WHERE r.run_id = ? ORDER BY a.id",
+      "SELECT c.result_id, c.result_fingerprint, c.run_version, c.approved_by, "
+      "c.approved_unix_ms, c.server, 0 AS here, c.id FROM central_approvals AS c JOIN results AS "
+      "r ON r.id = c.result_id WHERE r.run_id = ?1 UNION ALL SELECT a.result_id, '', 0, "
+      "a.approved_by, a.approved_unix_ms, '', 1, a.id FROM approvals AS a JOIN results AS r ON "
+      "r.id = a.result_id WHERE r.run_id = ?1 ORDER BY 7, 5, 8",
       [](sqlite3_stmt* s, Approval& a) {
-        read_all(s, a.result_id, a.approved_by, a.approved_unix_ms);
+        read_all(s, a.result_id, a.result_fingerprint, a.run_version, a.approved_by,
+                 a.approved_unix_ms, a.central_server);
       },
       run_id);
+}
+
+bool Store::add_central_approval(const Approval& a) {
+  impl_->need_writable("store an approval brought from the central store");
+  auto s = impl_->prepare(
+      "INSERT OR IGNORE INTO central_approvals(result_id, result_fingerprint, run_version, "
+      "approved_by, approved_unix_ms, server) VALUES(?, ?, ?, ?, ?, ?)");
+  bind_all(s.get(), a.result_id, a.result_fingerprint, a.run_version, a.approved_by,
+           a.approved_unix_ms, a.central_server);
+  impl_->step_done(s.get(), fmt::format("store the central approval of result {}", a.result_id));
+  return sqlite3_changes(impl_->db.get()) > 0;
+}
+
+bool Store::replace_imported_operator_actions(std::int64_t run_id,
+                                              std::span<const OperatorAction> actions) {
+  Impl& m = *impl_;
+  m.need_writable("refresh the operator's actions of a run brought from the central store");
+  Impl::Transaction tx(m);
+  {
+    auto is = m.prepare("SELECT 1 FROM runs WHERE id = ? AND owner_pid = ?");
+    bind_all(is.get(), run_id, kAcquiredElsewhere);
+    if (sqlite3_step(is.get()) != SQLITE_ROW) return false;  // acquired here (or no such run)
+  }
+  auto del = m.prepare("DELETE FROM operator_actions WHERE run_id = ?");
+  bind_all(del.get(), run_id);
+  m.step_done(del.get(), fmt::format("replace the operator's actions of run {}", run_id));
+  for (auto a : actions) {
+    a.run_id = run_id;
+    if (a.stop) a.stop->run_id = run_id;
+    add_operator_action(a);
+  }
+  tx.commit();
+  return true;
 }
 
 bool Store::update_imported_run(const RunRecord& r) {

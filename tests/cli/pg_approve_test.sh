@@ -5,7 +5,9 @@
 # cannot approve; a reviewer's approval names the exact result (its fingerprint, the run's version)
 # and the reviewer's login, and a result superseded since is refused. A report is an issued
 # certificate only for an approved result, a draft otherwise; the local store approves too
-# (schema 9). Names from the store are escaped in the report.
+# (schema 9). Names from the store are escaped in the report. A laptop that brings the machine's
+# history (daq sync --from) brings the server's approvals, read-only (local schema 10): its report
+# is issued as the server's, naming the reviewer "on the central server".
 # Usage: pg_approve_test.sh DAQ_BINARY
 set -u
 DAQ=$1
@@ -19,10 +21,15 @@ value() {
 }
 # as ROLE: the test's server for that login (trust authentication: the login is the role).
 as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
-check schema 0 "^6 2$" -- psql_value \
+check schema 0 "^7 2$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM pg_roles WHERE rolname IN ('caldaq_engineer', 'caldaq_reviewer')) FROM caldaq.schema_version"
-check local_schema 0 "^9$" -- value "$DB" "PRAGMA user_version"
+check local_schema 0 "^10$" -- value "$DB" "PRAGMA user_version"
 psql_value "CREATE ROLE eng LOGIN IN ROLE caldaq_engineer; CREATE ROLE rev LOGIN IN ROLE caldaq_reviewer; CREATE ROLE visitor LOGIN; CREATE ROLE \"r<i>&\" LOGIN IN ROLE caldaq_reviewer" >/dev/null
+# Each login granted the demo's site (central schema 7: the [customer] site of the configuration
+# its runs were measured with, docs/storage.md "Sites"); the visitor none.
+SITE=$(psql_value "SELECT site FROM caldaq.machines")
+check demo_site 0 "^caldaq built-in simulated shop$" -- echo "$SITE"
+psql_value "INSERT INTO caldaq.site_grants VALUES ('eng', '$SITE'), ('rev', '$SITE'), ('\"r<i>&\"', '$SITE')" >/dev/null
 ENG=$(as eng)
 REV=$(as rev)
 VISITOR=$(as visitor)
@@ -107,5 +114,43 @@ END
 check local_show 0 "approved by a<b>&c at" -- "$DAQ" show 2 --db "$DB"
 # Local approvals stay local: the server's are made there, by a reviewer's login.
 check local_not_sent 0 "^2$" -- bash -c "'$DAQ' sync --db '$DB' --to '$ENG' --quiet >/dev/null && '$PG_BIN/psql' -X -At '$PG_URL' -c 'SELECT count(*) FROM caldaq.approvals'"
+
+# A laptop brings the machine's history before a visit (as the engineer): the server's approvals
+# come with it, read-only. Run 1's current result ($NEW, approved on the server by r<i>&) is
+# issued on the laptop, naming the reviewer on the central server; run 2's, not approved there,
+# is a draft (its local approval stays in the store that made it).
+MACHINE=$(value "$DB" "SELECT name FROM machines")
+LAPTOP=$TMP/laptop.sqlite
+check pull_approvals 0 ", 2 approvals new; 0 runs' operator actions refreshed" -- \
+  "$DAQ" sync --db "$LAPTOP" --from "$ENG" --machine "$MACHINE"
+UUID1=$(value "$DB" "SELECT uuid FROM runs WHERE id = 1")
+L1=$(value "$LAPTOP" "SELECT id FROM runs WHERE uuid = '$UUID1'")
+LNEW=$(value "$LAPTOP" "SELECT id FROM results WHERE run_id = $L1 AND superseded_by IS NULL")
+check laptop_approval_row 0 "^r<i>& 2 [0-9a-f]{32}$" -- value "$LAPTOP" \
+  "SELECT approved_by || ' ' || run_version || ' ' || result_fingerprint FROM central_approvals WHERE result_id = $LNEW"
+check laptop_show 0 "approved by r<i>& at 20[0-9-]{8}T[0-9:]{8}Z on the central server" -- "$DAQ" show "$L1" --db "$LAPTOP"
+check laptop_show_json 0 "^r<i>& True 2$" -- bash -c \
+  "'$DAQ' show $L1 --json --db '$LAPTOP' | '$PY' -c 'import json, sys; a = [r[\"approval\"] for r in json.load(sys.stdin)[\"results\"] if r[\"current\"]][0]; print(a[\"approved_by\"], a[\"central_server\"].startswith(\"postgresql://\"), a[\"run_version\"])'"
+check laptop_report 0 "written to" -- "$DAQ" report "$L1" --db "$LAPTOP" -o "$TMP/laptop.html"
+check_file "$TMP/laptop.html" <<END
+laptop_issued ISSUED CERTIFICATE</strong>: result $LNEW approved by <span class="approver">r&lt;i&gt;&amp;</span> on 20[0-9: -]+ UTC, on the central server \(result fingerprint [0-9a-f]{32}, version 2 of the run's stops\)
+laptop_provenance <td>Approved</td><td>by r&lt;i&gt;&amp; on 20[0-9: -]+ UTC, on the central server</td>
+END
+check laptop_not_draft 1 "" -- grep -c "NOT APPROVED" "$TMP/laptop.html"
+# Read-only here: the laptop's account cannot approve what the server approved.
+check laptop_approved_already 2 "result $LNEW of run $L1 is approved already \(by r<i>&, unix ms [0-9]+, on the central server\)" -- \
+  "$DAQ" approve "$L1" --db "$LAPTOP"
+UUID2=$(value "$DB" "SELECT uuid FROM runs WHERE id = 2")
+L2=$(value "$LAPTOP" "SELECT id FROM runs WHERE uuid = '$UUID2'")
+check laptop_report_draft 0 "written to" -- "$DAQ" report "$L2" --db "$LAPTOP" -o "$TMP/laptop-draft.html"
+check laptop_draft 0 "DRAFT — NOT APPROVED" -- cat "$TMP/laptop-draft.html"
+# Brought again: nothing twice. Approved on the server since (run 2, by rev): the next pull
+# brings it, and the laptop's report of run 2 is issued.
+check pull_again 0 ", 0 approvals new" -- "$DAQ" sync --db "$LAPTOP" --from "$ENG" --machine "$MACHINE"
+check approve_run2 0 "approved by rev" -- "$DAQ" approve 2 --db "$REV"
+check pull_new_approval 0 ", 1 approvals new" -- "$DAQ" sync --db "$LAPTOP" --from "$ENG" --machine "$MACHINE"
+check laptop_report_now 0 "written to" -- "$DAQ" report "$L2" --db "$LAPTOP" -o "$TMP/laptop-now.html"
+check laptop_now_issued 0 "approved by <span class=\"approver\">rev</span> on 20[0-9: -]+ UTC, on the central server" -- cat "$TMP/laptop-now.html"
+check laptop_central_count 0 "^3$" -- value "$LAPTOP" "SELECT count(*) FROM central_approvals"
 
 finish

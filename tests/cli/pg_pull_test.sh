@@ -79,7 +79,7 @@ LAPTOP=$TMP/laptop.sqlite
 check laptop_own_run 0 "" -- "$DAQ" replay "$DEMO_CDQ" --db "$LAPTOP"
 # ... of another machine (a replay records the capture's machine: renamed, it is the bench's).
 "$PY" -c "import sqlite3, sys; c = sqlite3.connect(sys.argv[1]); c.execute(\"UPDATE machines SET name = 'Bench'\"); c.commit()" "$LAPTOP"
-check pull 0 "$RUNS runs of machine '$MACHINE' brought from .*: $RUNS new, $RESULTS new results; $CHUNKS chunks received \([1-9][0-9]* bytes\), 0 already here; 1 compensation tables, 1 ballbar calibrations new" -- \
+check pull 0 "$RUNS runs of machine '$MACHINE' brought from .*: $RUNS new, $RESULTS new results; $CHUNKS chunks received \([1-9][0-9]* bytes\), 0 already here; 1 compensation tables, 1 ballbar calibrations, 0 approvals new; 0 runs' operator actions refreshed" -- \
   "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
 check pull_ids_shifted 0 "^$((RUNS + 1))$" -- value "$LAPTOP" "SELECT max(id) FROM runs"
 "$PY" - "$LAPTOP" <<'PY'
@@ -101,9 +101,34 @@ check pull_results_superseded 0 "^$(value "$DB" "SELECT count(*) FROM results WH
   value "$LAPTOP" "SELECT count(*) FROM results WHERE superseded_by IS NOT NULL"
 
 # Brought again: nothing twice, every chunk here checked against the server's checksum.
-check pull_again 0 "$RUNS runs .*: 0 new, 0 new results; 0 chunks received \(0 bytes\), $CHUNKS already here; 0 compensation tables, 0 ballbar calibrations new" -- \
+check pull_again 0 "$RUNS runs .*: 0 new, 0 new results; 0 chunks received \(0 bytes\), $CHUNKS already here; 0 compensation tables, 0 ballbar calibrations, 0 approvals new; 0 runs' operator actions refreshed" -- \
   "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
 same_rows pull_again_same "$DB" "$LAPTOP"
+
+# The operator's actions refreshed on a pull: a manual capture and a skip of run 2 recorded at the
+# machine after the laptop brought the run (written into its store as daq run writes them), sent,
+# and brought again: the laptop has them as the server has them, once.
+"$PY" - "$DB" <<'PY'
+import sqlite3, sys
+c = sqlite3.connect(sys.argv[1])
+for row in [(1764000000000, 'capture', 'web page', 3, 150.0, 'captured by hand: 12.3 um'),
+            (1764000001000, 'skip', 'keyboard (daq run)', 4, 200.0, 'skipped: the probe was off')]:
+    c.execute("INSERT INTO operator_actions(run_id, time_unix_ms, action, source, operator, "
+              "run_number, direction, target_index, nominal_mm, detail) "
+              "VALUES (2, ?, ?, ?, 'J. Smith', 1, '+', ?, ?, ?)", row)
+c.commit()
+PY
+LAPTOP2=$(value "$LAPTOP" "SELECT id FROM runs WHERE uuid = '$(value "$DB" "SELECT uuid FROM runs WHERE id = 2")'")
+check actions_none_yet 0 "^0$" -- value "$LAPTOP" "SELECT count(*) FROM operator_actions WHERE run_id = $LAPTOP2"
+check actions_sent 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+check actions_refreshed 0 "0 new, 0 new results; 0 chunks received .*, 0 approvals new; 1 runs' operator actions refreshed" -- \
+  "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
+check actions_here 0 "operator actions \(2\): +2025-11-24T16:00:00Z capture from the web page by J\. Smith: captured by hand: 12\.3 um +2025-11-24T16:00:01Z skip from the keyboard \(daq run\) by J\. Smith: skipped: the probe was off" -- \
+  bash -c "'$DAQ' show $LAPTOP2 --db '$LAPTOP' | tr '\n' ' '"
+check actions_same 0 "^same$" -- bash -c \
+  "diff <('$DAQ' show 2 --json --db '$DB' | '$PY' -c 'import json, sys; print(json.load(sys.stdin)[\"operator_actions\"])') <('$DAQ' show $LAPTOP2 --json --db '$LAPTOP' | '$PY' -c 'import json, sys; print(json.load(sys.stdin)[\"operator_actions\"])') && echo same"
+check actions_once 0 "0 runs' operator actions refreshed" -- "$DAQ" sync --db "$LAPTOP" --from "$PG_URL" --machine "$MACHINE"
+check actions_count 0 "^2$" -- value "$LAPTOP" "SELECT count(*) FROM operator_actions WHERE run_id = $LAPTOP2"
 
 # A run brought while it was still running there (a sync during its acquisition leaves it so on
 # the server: here run 2 set back to running, its last chunk not there yet) stays running here
@@ -212,10 +237,11 @@ check other_site_here 2 "this store's machine '$MACHINE' is another one \(UUID .
 
 # A server of central schema 4 (machines by name, before their UUIDs) migrated by a sync: its
 # machines are adopted by the first store that sends a machine of their name, not duplicated.
+pg_undo_central_7
 psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); DROP FUNCTION caldaq.approve(uuid, text); DROP TABLE caldaq.approvals; UPDATE caldaq.schema_version SET version = 4" >/dev/null
 check old_server 0 "^4 1$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.machines) FROM caldaq.schema_version"
 check migrate_5 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --quiet
-check adopted 0 "^6 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
+check adopted 0 "^7 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
   psql_value "SELECT (SELECT version FROM caldaq.schema_version) || ' ' || count(*) || ' ' || max(uuid::text) FROM caldaq.machines"
 
 finish

@@ -73,3 +73,30 @@ pg_stop() {
 psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
+
+# pg_undo_central_7: the test's server taken back to central schema 6, what migration 7 (sites)
+# added dropped: a server of the version before, with its data, for the migrations' tests.
+pg_undo_central_7() {
+  psql_value "
+DO \$undo\$ DECLARE t text; BEGIN
+  FOREACH t IN ARRAY ARRAY['machines', 'runs', 'compensations', 'instruments', 'reading_chunks',
+      'captured_targets', 'missed_stops', 'results', 'operator_actions', 'suspect_stops',
+      'run_versions', 'approvals'] LOOP
+    EXECUTE format('DROP POLICY by_site ON caldaq.%I', t);
+    EXECUTE format('ALTER TABLE caldaq.%I DISABLE ROW LEVEL SECURITY', t);
+  END LOOP;
+END \$undo\$;
+DROP TRIGGER machine_moved ON caldaq.machines;
+DROP FUNCTION caldaq.machine_moved();
+ALTER TABLE caldaq.machines DROP COLUMN site;
+ALTER TABLE caldaq.runs DROP COLUMN site;
+ALTER TABLE caldaq.compensations DROP COLUMN site;
+DROP TABLE caldaq.site_grants;
+DROP FUNCTION caldaq.session_sites();
+DROP FUNCTION caldaq.context_site(text);
+GRANT UPDATE ON caldaq.machines TO caldaq_engineer;
+DROP FUNCTION caldaq.approve(uuid, text);
+ALTER FUNCTION caldaq.approve_any_site(uuid, text) RENAME TO approve;
+GRANT EXECUTE ON FUNCTION caldaq.approve(uuid, text) TO caldaq_reviewer;
+UPDATE caldaq.schema_version SET version = 6" >/dev/null
+}

@@ -505,7 +505,8 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 
 // What schema 7 added (the runs' UUIDs), taken off a new file to make a version 6 one; a macro so
 // that it prefixes the other undo strings as a literal.
-#define CALDAQ_UNDO_SCHEMA9 "DROP TABLE approvals; "
+#define CALDAQ_UNDO_SCHEMA10 "DROP TABLE central_approvals; "
+#define CALDAQ_UNDO_SCHEMA9 CALDAQ_UNDO_SCHEMA10 "DROP TABLE approvals; "
 #define CALDAQ_UNDO_SCHEMA8 \
   CALDAQ_UNDO_SCHEMA9 "DROP INDEX machines_by_uuid; ALTER TABLE machines DROP COLUMN uuid; "
 #define CALDAQ_UNDO_SCHEMA7 \
@@ -841,6 +842,103 @@ TEST(Store, MigrationEightGivesEveryMachineAUuid) {
   const auto id = rw.add_machine({.name = "Mill 3", .uuid = given});
   EXPECT_EQ(rw.machine(id)->uuid, given);
   EXPECT_THROW(rw.add_machine({.name = "Mill 4", .uuid = "Mill 4"}), StoreError);
+}
+
+// Schema 10 (daq sync --from): the central server's approvals of results brought here, read-only:
+// listed before the local ones with their server, fingerprint and version; a second one of the
+// same result not stored; a result approved there refused by a local approve (approved already);
+// the operator's actions of a run brought here replaced as the server has them, those of a run
+// acquired here left alone. A version 9 file, read-only, has no central approvals; migrated, it
+// keeps its local approval.
+TEST(Store, CentralApprovalsAndOperatorActionsBroughtFromTheServer) {
+  TempDir dir;
+  const auto file = dir.path / "laptop.sqlite";
+  std::int64_t local_result = 0, own = 0;
+  {
+    Store store(file);
+    own = a_run(store);
+    local_result = store.add_result({.run_id = own, .standard = "ISO 230-2:2014", .json = "{}"});
+    store.approve(own, local_result, "me");
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, CALDAQ_UNDO_SCHEMA10 "PRAGMA user_version = 9;", nullptr, nullptr,
+                           nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 9);
+    ASSERT_EQ(ro.approvals(own).size(), 1u);
+    EXPECT_EQ(ro.approvals(own)[0].central_server, "");
+  }
+  Store store(file);
+  EXPECT_EQ(store.version(), cal::storage::schema_version);
+  ASSERT_EQ(store.approvals(own).size(), 1u);
+  const auto brought = store.import_run({.kind = "linear",
+                                         .status = RunStatus::complete,
+                                         .uuid = "0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b"});
+  const auto result =
+      store.add_result({.run_id = brought, .standard = "ISO 230-2:2014", .json = "{}"});
+  const cal::storage::Approval there{.result_id = result,
+                                     .result_fingerprint = "0123456789abcdef0123456789abcdef",
+                                     .run_version = 2,
+                                     .approved_by = "rev",
+                                     .approved_unix_ms = 1764000000000,
+                                     .central_server = "postgresql://central/caldaq"};
+  EXPECT_TRUE(store.add_central_approval(there));
+  EXPECT_FALSE(store.add_central_approval({.result_id = result,
+                                           .result_fingerprint = "x",
+                                           .approved_by = "other",
+                                           .central_server = "postgresql://central/caldaq"}));
+  EXPECT_THROW(store.approve(brought, result, "me"), StoreError);  // approved there already
+  const auto approvals = store.approvals(brought);
+  ASSERT_EQ(approvals.size(), 1u);
+  EXPECT_EQ(approvals[0].result_id, result);
+  EXPECT_EQ(approvals[0].approved_by, "rev");
+  EXPECT_EQ(approvals[0].approved_unix_ms, 1764000000000);
+  EXPECT_EQ(approvals[0].result_fingerprint, "0123456789abcdef0123456789abcdef");
+  EXPECT_EQ(approvals[0].run_version, 2);
+  EXPECT_EQ(approvals[0].central_server, "postgresql://central/caldaq");
+  // A result approved there and here: the server's first.
+  EXPECT_TRUE(store.add_central_approval({.result_id = local_result,
+                                          .result_fingerprint = "f",
+                                          .run_version = 1,
+                                          .approved_by = "rev",
+                                          .approved_unix_ms = 1,
+                                          .central_server = "postgresql://central/caldaq"}));
+  const auto both = store.approvals(own);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0].approved_by, "rev");
+  EXPECT_EQ(both[1].approved_by, "me");
+  EXPECT_EQ(both[1].central_server, "");
+
+  // The operator's actions: the brought run's replaced, the run acquired here's kept.
+  store.add_operator_action({.run_id = brought, .time_unix_ms = 5, .action = "pause"});
+  store.add_operator_action({.run_id = own, .time_unix_ms = 6, .action = "pause"});
+  const std::vector<cal::storage::OperatorAction> theirs{
+      {.time_unix_ms = 7,
+       .action = "capture",
+       .source = "web page",
+       .operator_name = "J. Smith",
+       .stop =
+           cal::storage::MissedStop{
+               .run_number = 1, .direction = '-', .target_index = 3, .nominal_mm = 150.0},
+       .detail = "captured by hand"},
+      {.time_unix_ms = 8, .action = "resume", .source = "web page"}};
+  EXPECT_TRUE(store.replace_imported_operator_actions(brought, theirs));
+  EXPECT_FALSE(store.replace_imported_operator_actions(own, theirs));
+  const auto now = store.operator_actions(brought);
+  ASSERT_EQ(now.size(), 2u);
+  EXPECT_EQ(now[0].action, "capture");
+  EXPECT_EQ(now[0].run_id, brought);
+  ASSERT_TRUE(now[0].stop.has_value());
+  EXPECT_EQ(now[0].stop->target_index, 3);
+  EXPECT_EQ(now[0].stop->direction, '-');
+  EXPECT_EQ(now[1].action, "resume");
+  const auto kept = store.operator_actions(own);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].time_unix_ms, 6);
 }
 
 // What daq sync --from writes: another store's run imported with its UUID, status and times,

@@ -779,6 +779,7 @@ struct SyncBenchOptions {
   int minutes = 10;
   int rounds = 3;
   std::string dir;
+  std::string site = "daq bench";
 };
 
 // daq sync of generated runs against PostgreSQL's own COPY of the same chunk rows, in alternate
@@ -812,7 +813,8 @@ void bench_sync(const SyncBenchOptions& o) {
   fmt::print("{:>5} {:>10} {:>8}  {:>24}  {:>34}  {:>5}\n", "round", "readings", "MB",
              "daq sync: wall, readings/s", "COPY ceiling: read + copy, readings/s", "%");
   for (int k = 1; k <= o.rounds; ++k) {
-    const auto s = run_child({"sync", "--db", db.string(), "--to", o.to, "--quiet"});
+    const auto s =
+        run_child({"sync", "--db", db.string(), "--to", o.to, "--site", o.site, "--quiet"});
     pg::delete_central_runs(o.to, uuids);
     const cal::storage::Store store(db, {.read_only = true});
     const auto c = pg::copy_ceiling(store, o.to, runs);
@@ -883,6 +885,10 @@ void add_bench_commands(CLI::App& app) {
   sy->add_option("--rounds", y->rounds, "Rounds (sync, then its ceiling); medians are reported")
       ->capture_default_str();
   sy->add_option("--dir", y->dir, "Directory for the generated database (default: $TMPDIR)");
+  sy->add_option("--site", y->site,
+                 "The site the generated run is sent as (central schema 7: one the login may "
+                 "write; the run has no machine and its configuration names none)")
+      ->capture_default_str();
 }
 
 }  // namespace daq

@@ -144,6 +144,8 @@ json approval_json(const st::Approval& a) {
     j["result_fingerprint"] = a.result_fingerprint;
     j["run_version"] = a.run_version;
   }
+  // Made on the central server (read there, or brought by daq sync --from): which one.
+  if (!a.central_server.empty()) j["central_server"] = a.central_server;
   return j;
 }
 
@@ -283,8 +285,9 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
         "");
     print_line("    {}", provenance_text(res["provenance"]));
     if (res.contains("approval"))
-      print_line("    approved by {} at {}", res["approval"]["approved_by"].get<std::string>(),
-                 res["approval"]["approved"].get<std::string>());
+      print_line("    approved by {} at {}{}", res["approval"]["approved_by"].get<std::string>(),
+                 res["approval"]["approved"].get<std::string>(),
+                 res["approval"].contains("central_server") ? " on the central server" : "");
     if (!current) continue;                 // the old values stay in --json
     print_result(res["result"], "      ");  // as daq run and daq analyse print it
     if (res.contains("verdict")) print_verdict(res["verdict"], "      ");

@@ -35,6 +35,7 @@ struct SyncCliOptions {
   std::string to;
   std::string from;
   std::string machine;
+  std::string site;
   bool verify = false;
   std::size_t chunks_per_transaction = 64;
   std::vector<std::int64_t> runs;
@@ -135,8 +136,9 @@ void run_pull(const SyncCliOptions& o) {
   need_postgresql_url("--from", o.from);
   if (o.machine.empty())
     throw cal::InputError("--from needs --machine NAME: which machine's history to bring");
-  if (!o.runs.empty() || o.verify)
-    throw cal::InputError("--run and --verify are for --to (--from checks every chunk it brings)");
+  if (!o.runs.empty() || o.verify || !o.site.empty())
+    throw cal::InputError(
+        "--run, --verify and --site are for --to (--from checks every chunk it brings)");
   const auto path = database_path(o.db);
   st::pg::PullOptions options;
   options.machine = o.machine;
@@ -153,28 +155,31 @@ void run_pull(const SyncCliOptions& o) {
     };
   const auto report = st::pg::sync_from(path, o.from, options);
   if (o.json)
-    return fmt::print("{}\n", nlohmann::json{{"schema", "caldaq.sync-from.v1"},
-                                             {"db", path.string()},
-                                             {"from", st::pg::redacted(o.from)},
-                                             {"machine", o.machine},
-                                             {"server_schema", report.server_schema},
-                                             {"runs", report.runs},
-                                             {"runs_new", report.runs_new},
-                                             {"results_new", report.results_new},
-                                             {"chunks_received", report.chunks_received},
-                                             {"bytes_received", report.bytes_received},
-                                             {"chunks_already", report.chunks_already},
-                                             {"compensations_new", report.compensations_new},
-                                             {"calibrations_new", report.calibrations_new}}
-                                  .dump(2));
+    return fmt::print(
+        "{}\n", nlohmann::json{{"schema", "caldaq.sync-from.v1"},
+                               {"db", path.string()},
+                               {"from", st::pg::redacted(o.from)},
+                               {"machine", o.machine},
+                               {"server_schema", report.server_schema},
+                               {"runs", report.runs},
+                               {"runs_new", report.runs_new},
+                               {"results_new", report.results_new},
+                               {"chunks_received", report.chunks_received},
+                               {"bytes_received", report.bytes_received},
+                               {"chunks_already", report.chunks_already},
+                               {"compensations_new", report.compensations_new},
+                               {"calibrations_new", report.calibrations_new},
+                               {"approvals_new", report.approvals_new},
+                               {"operator_actions_refreshed", report.operator_actions_refreshed}}
+                    .dump(2));
   print_line(
       "{}: {} runs of machine '{}' brought from {} (central schema {}): {} new, {} new results; "
       "{} chunks received ({} bytes), {} already here; {} compensation tables, {} ballbar "
-      "calibrations new",
+      "calibrations, {} approvals new; {} runs' operator actions refreshed",
       path.string(), report.runs, cal::text::terminal_safe(o.machine), st::pg::redacted(o.from),
       report.server_schema, report.runs_new, report.results_new, report.chunks_received,
       report.bytes_received, report.chunks_already, report.compensations_new,
-      report.calibrations_new);
+      report.calibrations_new, report.approvals_new, report.operator_actions_refreshed);
 }
 
 void run_sync(const SyncCliOptions& o) {
@@ -196,6 +201,7 @@ void run_sync(const SyncCliOptions& o) {
   options.run_ids = o.runs;
   options.sent_by = user_name();
   options.sent_from = host_name();
+  options.site = o.site;
   if (const auto cut = cut_after_chunks(); cut > 0)
     options.after_chunk = [cut](std::int64_t sent) {
       if (sent >= cut) std::_Exit(75);
@@ -319,6 +325,13 @@ void add_sync_command(CLI::App& app) {
   cmd->add_option("--machine", o->machine,
                   "With --from: the machine, by its name on the server or by its UUID (when "
                   "two sites' machines share the name)");
+  cmd->add_option("--site", o->site,
+                  "With --to: the site of the machines new to the server (default: the [customer] "
+                  "site of their runs' configuration, else the one site the login may write); a "
+                  "machine on the server keeps its site (docs/storage.md, \"Sites\")")
+      ->check(CLI::Validator(
+          [](const std::string& v) { return v.empty() ? std::string("a site is not empty") : ""; },
+          "SITE"));
   cmd->add_option("--run", o->runs, "Only these runs (local ids; default: every run)");
   cmd->add_flag("--verify", o->verify,
                 "Read every chunk of the synced runs back from the server and verify its "

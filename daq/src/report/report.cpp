@@ -885,8 +885,9 @@ std::string provenance_section(const RunView& v, std::string_view schema) {
         {"Re-compensation of", fmt::format("result {}", p["of_result"].get<std::int64_t>())});
   for (const auto& a : v.approvals)
     if (a.result_id == current->id)
-      rows.push_back({"Approved", fmt::format("by {} on {}", esc(a.approved_by),
-                                              iso_time(a.approved_unix_ms))});
+      rows.push_back({"Approved",
+                      fmt::format("by {} on {}{}", esc(a.approved_by), iso_time(a.approved_unix_ms),
+                                  a.central_server.empty() ? "" : ", on the central server")});
   std::size_t older = 0;
   for (const auto& r : v.results) older += r.current() ? 0 : 1;
   if (older)
@@ -2227,8 +2228,9 @@ std::string approval_banner(const RunView& v) {
       if (a.result_id == shown->id)
         return fmt::format(
             "<div class=\"approval issued\"><strong>ISSUED CERTIFICATE</strong>: result {} "
-            "approved by <span class=\"approver\">{}</span> on {}{}.</div>\n",
+            "approved by <span class=\"approver\">{}</span> on {}{}{}.</div>\n",
             shown->id, esc(a.approved_by), iso_time(a.approved_unix_ms),
+            a.central_server.empty() ? "" : ", on the central server",
             a.result_fingerprint.empty()
                 ? std::string()
                 : fmt::format(" (result fingerprint {}, version {} of the run's stops)",

@@ -407,8 +407,8 @@ class CentralReader final : public RunReader {
         "a.approved_unix_ms FROM caldaq.approvals AS a JOIN caldaq.runs AS r ON r.uuid = "
         "a.run_uuid JOIN caldaq.results AS s ON s.run_uuid = a.run_uuid AND s.fingerprint = "
         "a.result_fingerprint WHERE r.id = $1 ORDER BY a.approved_unix_ms, s.source_result_id",
-        [](const pqxx::row& row) {
-          Approval a;
+        [&](const pqxx::row& row) {
+          Approval a{.central_server = shown_};
           read_row(row, a.result_id, a.result_fingerprint, a.run_version, a.approved_by,
                    a.approved_unix_ms);
           return a;
@@ -480,7 +480,9 @@ Approval approve_central(std::string_view url, std::int64_t run_id, std::int64_t
     if (found.empty()) throw StoreError(fmt::format("{}: no run {}", shown, run_id));
     if (found[0][1].is_null())
       throw StoreError(fmt::format("{}: run {} has no result {}", shown, run_id, result_id));
-    Approval a{.result_id = result_id, .result_fingerprint = found[0][1].as<std::string>()};
+    Approval a{.result_id = result_id,
+               .result_fingerprint = found[0][1].as<std::string>(),
+               .central_server = shown};
     // The server checks the rest (a reviewer's login; the result current, not approved yet) and
     // names the reviewer: nothing the client says is taken for who approved.
     const auto row = w.exec_params1(

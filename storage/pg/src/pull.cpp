@@ -111,6 +111,7 @@ class Pull {
       const auto existing = local_.run_by_uuid(r.uuid);
       local_id = existing ? existing->id : import_metadata(r);
       if (existing && existing->status == RunStatus::running) update_running(r, local_id);
+      if (existing) refresh_operator_actions(r, local_id);
       pull_results(r, local_id);
     });
     const auto received = report_.chunks_received, already = report_.chunks_already;
@@ -159,8 +160,29 @@ class Pull {
     if (const auto q = server_->quality(r.id)) local_.set_quality(local_id, *q);
   }
 
+  // The operator's actions of a run brought here before, as the server has them now (a manual
+  // capture or skip made after the last pull, sent from the machine since). A run acquired here
+  // keeps its own (its acquisition wrote them).
+  void refresh_operator_actions(const RunRecord& r, std::int64_t local_id) {
+    const auto theirs = server_->operator_actions(r.id);
+    const auto here = local_.operator_actions(local_id);
+    const auto same = [](const OperatorAction& a, const OperatorAction& b) {
+      const bool stops_same = a.stop.has_value() == b.stop.has_value() &&
+                              (!a.stop || (a.stop->run_number == b.stop->run_number &&
+                                           a.stop->direction == b.stop->direction &&
+                                           a.stop->target_index == b.stop->target_index &&
+                                           a.stop->nominal_mm == b.stop->nominal_mm));
+      return stops_same && a.time_unix_ms == b.time_unix_ms && a.action == b.action &&
+             a.source == b.source && a.operator_name == b.operator_name && a.detail == b.detail;
+    };
+    if (std::equal(theirs.begin(), theirs.end(), here.begin(), here.end(), same)) return;
+    if (local_.replace_imported_operator_actions(local_id, theirs))
+      ++report_.operator_actions_refreshed;
+  }
+
   // The server's results this store lacks (known by their content's fingerprint, as the server
-  // knows them), and the supersessions the server records between results this store has.
+  // knows them), the supersessions the server records between results this store has, and the
+  // server's approvals of them (read-only here: a report here is issued as the server's).
   void pull_results(const RunRecord& r, std::int64_t local_id) {
     const auto theirs = server_->results(r.id);
     std::map<std::string, std::int64_t> local_by_fp;  // fingerprint -> local id
@@ -191,6 +213,13 @@ class Pull {
       if (!res.superseded_by || !fp_of.contains(*res.superseded_by)) continue;
       const auto id = local_by_fp.at(fp_of[res.id]);
       if (local_current[id]) local_.set_superseded(id, local_by_fp.at(fp_of[*res.superseded_by]));
+    }
+    for (auto a : server_->approvals(r.id)) {
+      const auto here = local_by_fp.find(a.result_fingerprint);
+      if (here == local_by_fp.end()) continue;  // every result of the run was brought above
+      a.result_id = here->second;
+      a.central_server = shown_;
+      if (local_.add_central_approval(a)) ++report_.approvals_new;
     }
   }
 

@@ -1,11 +1,13 @@
 // daq sync --to: the runs of a local store copied to the central store (sync.hpp).
 #include "cal/storage/pg/sync.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <map>
 #include <optional>
 
+#include "cal/analysis/text.hpp"
 #include "cal/storage/chunk.hpp"
 #include "central_schema.hpp"
 
@@ -91,6 +93,7 @@ class Sync {
   SyncReport run() {
     report_.server_schema = migrate_schema(*conn_, shown_);
     guarded(shown_, "prepare the statements", [&] { prepare(); });
+    guarded(shown_, "read the sites this login may write", [&] { read_sites(); });
     std::vector<RunRecord> runs;
     if (options_.run_ids.empty()) {
       runs = local_.runs();
@@ -113,6 +116,7 @@ class Sync {
   SyncOptions options_;
   std::unique_ptr<pqxx::connection> conn_;
   SyncReport report_;
+  std::vector<std::string> sites_;  // the sites this login may write (schema 7); "*": all
 
   void prepare() {
     conn_->prepare("insert_chunk",
@@ -123,6 +127,56 @@ class Sync {
 
   std::string run_name(const RunRecord& r) const {
     return fmt::format("run {} ({})", r.id, r.uuid);
+  }
+
+  void read_sites() {
+    pqxx::nontransaction n(*conn_);
+    for (const auto& row : n.exec("SELECT unnest(caldaq.session_sites())"))
+      sites_.push_back(row[0].as<std::string>());
+  }
+
+  // The login's sites in words, for messages.
+  std::string sites_text() const {
+    if (std::find(sites_.begin(), sites_.end(), "*") != sites_.end()) return "every site";
+    if (sites_.empty())
+      return "none: the administrator grants sites in caldaq.site_grants (docs/storage.md, "
+             "\"Sites\")";
+    std::string out;
+    for (const auto& s : sites_) out += (out.empty() ? "'" : ", '") + text::terminal_safe(s) + "'";
+    return out;
+  }
+
+  // The site of something new to the server (`what`: a machine, a run without one): --site, else
+  // the login's one site (all it may write), else the [customer] site of the configuration it
+  // was measured with (a login of several sites or all, the administrator's).
+  std::string new_site(pqxx::work& w, const std::string& what, std::string_view settings_json) {
+    if (!options_.site.empty()) return options_.site;
+    if (sites_.size() == 1 && sites_[0] != "*") return sites_[0];
+    if (!settings_json.empty()) {
+      const auto row = w.exec_params1("SELECT caldaq.context_site($1)", std::string(settings_json));
+      if (!row[0].is_null()) return row[0].as<std::string>();
+    }
+    throw StoreError(fmt::format(
+        "{}: {} is new to the server and no site is known for it (no --site, no [customer] site "
+        "in its configuration; this login may write {}): give --site SITE",
+        shown_, what, sites_text()));
+  }
+
+  // A row refused by the sites' policies (SQLSTATE 42501), or one of that key the server holds
+  // under a site this login may not see (23505: the policies hide it, its key is taken), in words.
+  [[noreturn]] void refused(const pqxx::sql_error& e, const std::string& what,
+                            std::string_view site) const {
+    if (e.sqlstate() == "42501")
+      throw StoreError(fmt::format(
+          "{}: {} would be of site '{}', which this login may not write (it may write {}): give "
+          "--site, or ask the administrator for a grant (docs/storage.md, \"Sites\")",
+          shown_, what, text::terminal_safe(site), sites_text()));
+    if (e.sqlstate() == "23505")
+      throw StoreError(
+          fmt::format("{}: the server holds {} under a site this login may not read or write (it "
+                      "may write {}); nothing of it was sent",
+                      shown_, what, sites_text()));
+    throw;
   }
 
   void sync_run(const RunRecord& r) {
@@ -143,25 +197,46 @@ class Sync {
       options_.run_done(r, report_.chunks_sent - before, report_.chunks_already - already_before);
   }
 
-  // The server's id of a local machine ("" for none), adding it. Machines are known by their
-  // UUID (schema 5); one sent before, known by name only, is adopted by the first store that
-  // sends a machine of that name.
-  std::string server_machine(pqxx::work& w, std::int64_t local_id) const {
+  struct ServerMachine {
+    std::string id;    // "" for none
+    std::string site;  // its site on the server (schema 7)
+  };
+
+  // The server's id and site of a local machine (none for no machine), adding it. Machines are
+  // known by their UUID (schema 5); one sent before, known by name only, is adopted by the first
+  // store that sends a machine of that name. A new machine's site: new_site (settings_json: the
+  // configuration of a run of it); a machine's site on the server is the administrator's.
+  ServerMachine server_machine(pqxx::work& w, std::int64_t local_id,
+                               std::string_view settings_json) {
     if (local_id <= 0) return {};
     const auto m = local_.machine(local_id);
     if (!m) return {};
-    auto rows = w.exec_params("SELECT id FROM caldaq.machines WHERE uuid = $1", m->uuid);
+    const auto what = fmt::format("machine '{}' ({})", text::terminal_safe(m->name), m->uuid);
+    auto rows = w.exec_params("SELECT id, site FROM caldaq.machines WHERE uuid = $1", m->uuid);
     if (rows.empty())
       rows = w.exec_params(
           "UPDATE caldaq.machines SET uuid = $1 WHERE id = (SELECT id FROM caldaq.machines WHERE "
-          "uuid IS NULL AND name = $2 ORDER BY id LIMIT 1) RETURNING id",
+          "uuid IS NULL AND name = $2 ORDER BY id LIMIT 1) RETURNING id, site",
           m->uuid, m->name);
-    if (rows.empty())
+    if (!rows.empty()) {
+      ServerMachine there{rows[0][0].as<std::string>(), rows[0][1].as<std::string>()};
+      if (!options_.site.empty() && options_.site != there.site)
+        throw StoreError(fmt::format(
+            "{}: {} is of site '{}' on the server, not '{}' (--site): which site a machine is of "
+            "is the administrator's to change (docs/storage.md, \"Sites\")",
+            shown_, what, text::terminal_safe(there.site), text::terminal_safe(options_.site)));
+      return there;
+    }
+    const auto site = new_site(w, what, settings_json);
+    try {
       rows = w.exec_params(
-          "INSERT INTO caldaq.machines(uuid, name, description, config_json) "
-          "VALUES($1, $2, $3, $4) RETURNING id",
-          m->uuid, m->name, m->description, m->config_json);
-    return rows[0][0].as<std::string>();
+          "INSERT INTO caldaq.machines(uuid, name, description, config_json, site) "
+          "VALUES($1, $2, $3, $4, $5) RETURNING id",
+          m->uuid, m->name, m->description, m->config_json, site);
+    } catch (const pqxx::sql_error& e) {
+      refused(e, what, site);
+    }
+    return {rows[0][0].as<std::string>(), site};
   }
 
   // The compensation tables and ballbar calibrations of the local store, each stored once
@@ -170,17 +245,33 @@ class Sync {
   void send_records() {
     pqxx::work w(*conn_);
     for (const auto& c : local_.compensations()) {
-      const auto machine_id = server_machine(w, c.machine_id);
-      std::string source_uuid;
+      std::string source_uuid, settings;
       if (c.source_run_id > 0)
-        if (const auto run = local_.run(c.source_run_id)) source_uuid = run->uuid;
-      w.exec_params(
-          "INSERT INTO caldaq.compensations(machine_id, source_run_uuid, source, axis, format, "
-          "created_unix_ms, json, fingerprint) VALUES(NULLIF($1::text, '')::bigint, "
-          "NULLIF($2::text, '')::uuid, $3::text, $4::text, $5::text, $6::bigint, $7::text, "
-          "md5(concat_ws('|', $1::text, $2::text, $3::text, $4::text, $5::text, "
-          "$6::bigint::text, $7::text))) ON CONFLICT (fingerprint) DO NOTHING",
-          machine_id, source_uuid, c.source, c.axis, c.format, c.created_unix_ms, c.json);
+        if (const auto run = local_.run(c.source_run_id)) {
+          source_uuid = run->uuid;
+          settings = run->settings_json;
+        }
+      const auto machine = server_machine(w, c.machine_id, settings);
+      // Its machine's site; without one, its run's (or as for a new machine).
+      auto site = machine.site;
+      if (site.empty() && !source_uuid.empty())
+        if (const auto rows =
+                w.exec_params("SELECT site FROM caldaq.runs WHERE uuid = $1", source_uuid);
+            !rows.empty())
+          site = rows[0][0].as<std::string>();
+      const auto what = fmt::format("compensation table {}", c.id);
+      if (site.empty()) site = new_site(w, what, settings);
+      try {
+        w.exec_params(
+            "INSERT INTO caldaq.compensations(machine_id, source_run_uuid, source, axis, format, "
+            "created_unix_ms, json, fingerprint, site) VALUES(NULLIF($1::text, '')::bigint, "
+            "NULLIF($2::text, '')::uuid, $3::text, $4::text, $5::text, $6::bigint, $7::text, "
+            "md5(concat_ws('|', $1::text, $2::text, $3::text, $4::text, $5::text, "
+            "$6::bigint::text, $7::text)), $8::text) ON CONFLICT (fingerprint) DO NOTHING",
+            machine.id, source_uuid, c.source, c.axis, c.format, c.created_unix_ms, c.json, site);
+      } catch (const pqxx::sql_error& e) {
+        refused(e, what, site);
+      }
     }
     for (const auto& c : local_.bar_calibrations())
       w.exec_params(
@@ -201,34 +292,43 @@ class Sync {
   // store the server's copy came from (this one's unless a copy of this database synced it).
   std::int64_t send_metadata(const RunRecord& r) {
     pqxx::work w(*conn_);
-    const std::string machine_id = server_machine(w, r.machine_id);
+    const auto machine = server_machine(w, r.machine_id, r.settings_json);
     const auto existing =
         w.exec_params("SELECT source_run_id FROM caldaq.runs WHERE uuid = $1 FOR UPDATE", r.uuid);
     if (existing.empty()) ++report_.runs_new;
     const std::int64_t source_id = existing.empty() ? r.id : existing[0][0].as<std::int64_t>();
     const auto quality = quality_json(local_.quality(r.id));
-    if (existing.empty())
-      w.exec_params(
-          "INSERT INTO caldaq.runs(uuid, source_run_id, kind, axis, software_version, "
-          "started_unix_ms, machine_id, campaign, settings_json, capture_path, ended_unix_ms, "
-          "status, note, origin_session_ns, origin_unix_ns, quality_json, synced_unix_ms) "
-          "VALUES($1, $2, $3, $4, $5, $6, NULLIF($7, '')::bigint, $8, $9, $10, "
-          "NULLIF($11, '')::bigint, $12, $13, NULLIF($14, '')::bigint, NULLIF($15, '')::bigint, "
-          "NULLIF($16, ''), $17)",
-          r.uuid, r.id, r.kind, r.axis, r.software_version, r.started_unix_ms, machine_id,
-          r.campaign, r.settings_json, r.capture_path, nullable(r.ended_unix_ms),
-          std::string(to_string(r.status)), r.note, nullable(r.origin_session_ns),
-          nullable(r.origin_unix_ns), quality, unix_ms_now());
-    else  // what can change at the machine after the run began (its identity cannot)
-      w.exec_params(
-          "UPDATE caldaq.runs SET machine_id = NULLIF($2, '')::bigint, campaign = $3, "
-          "settings_json = $4, capture_path = $5, ended_unix_ms = NULLIF($6, '')::bigint, "
-          "status = $7, note = $8, origin_session_ns = NULLIF($9, '')::bigint, "
-          "origin_unix_ns = NULLIF($10, '')::bigint, quality_json = NULLIF($11, ''), "
-          "synced_unix_ms = $12 WHERE uuid = $1",
-          r.uuid, machine_id, r.campaign, r.settings_json, r.capture_path,
-          nullable(r.ended_unix_ms), std::string(to_string(r.status)), r.note,
-          nullable(r.origin_session_ns), nullable(r.origin_unix_ns), quality, unix_ms_now());
+    // A run is of its machine's site; one without a machine, of a site as a new machine.
+    const auto site = !machine.site.empty() ? machine.site
+                      : existing.empty()    ? new_site(w, run_name(r), r.settings_json)
+                                            : std::string();
+    try {
+      if (existing.empty())
+        w.exec_params(
+            "INSERT INTO caldaq.runs(uuid, source_run_id, kind, axis, software_version, "
+            "started_unix_ms, machine_id, campaign, settings_json, capture_path, ended_unix_ms, "
+            "status, note, origin_session_ns, origin_unix_ns, quality_json, synced_unix_ms, site) "
+            "VALUES($1, $2, $3, $4, $5, $6, NULLIF($7, '')::bigint, $8, $9, $10, "
+            "NULLIF($11, '')::bigint, $12, $13, NULLIF($14, '')::bigint, "
+            "NULLIF($15, '')::bigint, NULLIF($16, ''), $17, $18)",
+            r.uuid, r.id, r.kind, r.axis, r.software_version, r.started_unix_ms, machine.id,
+            r.campaign, r.settings_json, r.capture_path, nullable(r.ended_unix_ms),
+            std::string(to_string(r.status)), r.note, nullable(r.origin_session_ns),
+            nullable(r.origin_unix_ns), quality, unix_ms_now(), site);
+      else  // what can change at the machine after the run began (its identity cannot)
+        w.exec_params(
+            "UPDATE caldaq.runs SET machine_id = NULLIF($2, '')::bigint, campaign = $3, "
+            "settings_json = $4, capture_path = $5, ended_unix_ms = NULLIF($6, '')::bigint, "
+            "status = $7, note = $8, origin_session_ns = NULLIF($9, '')::bigint, "
+            "origin_unix_ns = NULLIF($10, '')::bigint, quality_json = NULLIF($11, ''), "
+            "synced_unix_ms = $12, site = COALESCE(NULLIF($13, ''), site) WHERE uuid = $1",
+            r.uuid, machine.id, r.campaign, r.settings_json, r.capture_path,
+            nullable(r.ended_unix_ms), std::string(to_string(r.status)), r.note,
+            nullable(r.origin_session_ns), nullable(r.origin_unix_ns), quality, unix_ms_now(),
+            site);
+    } catch (const pqxx::sql_error& e) {
+      refused(e, run_name(r), site);
+    }
     send_children(w, r);
     send_results(w, r, source_id);
     w.commit();

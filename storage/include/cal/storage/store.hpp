@@ -36,8 +36,9 @@ class StoreError : public std::runtime_error {
 // (RunRecord::uuid), by which the central store (daq sync) knows it. 8 (issue 35): every machine
 // has one too (MachineRecord::uuid): two sites' machines of the same name stay apart centrally.
 // 9 (issue 35): sign-off: a result's approval (Approval: who, when), which a report needs to be
-// issued as a certificate (central schema 6 has its own, with the reviewers' role).
-inline constexpr int schema_version = 9;
+// issued as a certificate (central schema 6 has its own, with the reviewers' role). 10 (issue
+// 35): the central server's approvals of the results brought by daq sync --from, read-only here.
+inline constexpr int schema_version = 10;
 
 // A new random (version 4) UUID in its canonical lower-case text form.
 std::string new_uuid();
@@ -242,6 +243,9 @@ struct Approval {
   int run_version = 0;
   std::string approved_by;  // the reviewer: the server's login role; locally the OS account
   std::int64_t approved_unix_ms = 0;
+  // Made on the central server: that server (its URI, password hidden), read there or brought
+  // from there by daq sync --from (read-only in the local store); "" for a local approval.
+  std::string central_server;
 };
 
 // The series of a run (one per device, channel and quantity) with their counts and time spans,
@@ -466,7 +470,16 @@ class Store : public RunReader {
   // Refused (StoreError saying why) for a result of another run, one superseded since (a
   // re-analysis or re-compensation: approve the current one), or one approved already.
   Approval approve(std::int64_t run_id, std::int64_t result_id, std::string_view approved_by);
+  // The run's approvals: the central server's (brought by daq sync --from) first, then the local.
   std::vector<Approval> approvals(std::int64_t run_id) const override;
+  // daq sync --from: the central server's approval of a result here (a.result_id: the local id;
+  // a.central_server set). False, and nothing stored, when that result has one already (the
+  // server's approvals are made once and never changed).
+  bool add_central_approval(const Approval& a);
+  // daq sync --from: the operator's actions of a run brought from the central store, as the server
+  // has them now (replacing those here). False, and nothing changed, for a run acquired here.
+  bool replace_imported_operator_actions(std::int64_t run_id,
+                                         std::span<const OperatorAction> actions);
 
   // A run brought by daq sync --from while it was still running there (acquired elsewhere): its
   // status, end and note as the server has them now (r.id: the local run). False, and nothing

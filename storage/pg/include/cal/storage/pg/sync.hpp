@@ -27,7 +27,10 @@ namespace cal::storage::pg {
 // 5: machines known by a stable id (their UUID), not by name.
 // 6 (with local schema 9): roles (caldaq_engineer sends, caldaq_reviewer approves; nothing for
 // other logins) and sign-off (approvals, made by caldaq.approve).
-inline constexpr int central_schema_version = 6;
+// 7 (with local schema 10): sites. A login reads and writes only the machines, runs (with every
+// row of a run) and compensation tables of the sites caldaq.site_grants grants it ('*': all);
+// row-level security, and caldaq.approve checks the reviewer's sites.
+inline constexpr int central_schema_version = 7;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
@@ -52,6 +55,12 @@ struct SyncOptions {
   // Who sends and from where (a user and a host name): recorded with each version of a run's
   // stops (with the local store's path and the time).
   std::string sent_by, sent_from;
+  // The site of the machines new to the server (and of runs without a machine), central schema 7.
+  // Empty: the one site the login may write, else (a login of several sites, or all) the
+  // [customer] site of the configuration their runs were measured with. A machine on the server
+  // keeps its site (another one here is an error): which site a machine is of is the
+  // administrator's.
+  std::string site;
 };
 
 struct SyncReport {
@@ -92,13 +101,16 @@ struct PullReport {
   std::int64_t bytes_received = 0;     // chunk BLOB bytes copied now
   std::int64_t compensations_new = 0;  // compensation tables of the machine brought
   std::int64_t calibrations_new = 0;   // ballbar calibrations brought
+  std::int64_t approvals_new = 0;      // the server's approvals of results here brought (schema 7)
+  std::int64_t operator_actions_refreshed = 0;  // runs brought before whose actions changed there
   int server_schema = 0;
 };
 
 // daq sync --from: brings one machine's history from the central store at `url` into `local`
 // (the machine added by name if this store lacks it): its runs with their UUIDs, instruments,
-// stops, results with their provenance, the quality, the operator's actions and every reading
-// chunk; its compensation tables; the ballbar calibrations. Idempotent (what is here is not
+// stops, results with their provenance and the server's approvals of them (read-only here), the
+// quality, the operator's actions (refreshed for runs brought before) and every reading chunk;
+// its compensation tables; the ballbar calibrations. Idempotent (what is here is not
 // brought again: runs by UUID, results by content, chunks by number and checksum) and resumable
 // (a cut pull continues from the chunks here). Every chunk received is checked against the
 // checksum the server holds for it; a chunk here that differs from the server's is an error
