@@ -256,7 +256,9 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     }
   }
   // The stop quality (run_quality.hpp): the verdict, each suspect stop by name.
-  print_line("  stop quality: {}", j["quality"]["summary"].get<std::string>());
+  print_line("  stop quality: {}",
+             quality_text({.state = j["quality"]["state"].get<std::string>(),
+                           .summary = j["quality"]["summary"].get<std::string>()}));
   for (const auto& q : j["quality"]["suspect_stops"])
     print_line("    SUSPECT {}", q["reason"].get<std::string>());
   for (const auto& i : j["instruments"])
@@ -502,8 +504,7 @@ void export_targets_csv(const st::RunReader& store, const st::RunRecord& run, co
              fmt::format(fmt::runtime(kTargetColumns), names.target, *value_column, names.raw));
   std::string note;  // a rotary run stored the old way: its stops' angles read as deviations
   const auto targets = stored_targets(store, run, &note);
-  if (!note.empty())
-    fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
+  if (!note.empty()) fmt::print(stderr, "daq export: note: {}\n", cal::text::terminal_safe(note));
   for (const auto& t : targets) {
     const auto at = static_cast<double>(t.time_ns);
     fmt::print(out, "{},{},{},{},{},{},{},{},{},{}\n", num(t.nominal_mm), t.run_number,
