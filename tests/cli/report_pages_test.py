@@ -622,8 +622,14 @@ for name in reports:
     plot_text = " ".join(html_mod.unescape(t) for t in re.findall(r"<tspan[^>]*>(.*?)</tspan>",
                                                                   html))
     check(f"{name}: no 'air air ch' legend", " ch 0" not in plot_text, "")
+    # ... by its role, product and serial number as an engineer reads them ("air: ids3010" named
+    # neither the laser nor its sensor).
     if "Temperatures" in html:
-        check(f"{name}: legends name the instrument", "ptu300 SIM-PTU-0001" in plot_text, "")
+        check(f"{name}: legends name the instrument",
+              "air sensor PTU300 (serial SIM-PTU-0001)" in plot_text
+              and "material sensor (serial SIM-TH-0001)" in plot_text, plot_text[:600])
+        check(f"{name}: no legend by a driver's key", re.search(
+            r"(air|material): |\b(ids3010|ptu300)\b", plot_text) is None, plot_text[:600])
 
 # --- straightness, angular and roll runs: page one is their ISO 230-1 answer ------------------
 # One run of each on the volumetric shop, acquired by `daq sim --measure --acquire` in its own
