@@ -1627,8 +1627,7 @@ std::string fix_first_notes(const cal::circle::Result& r, const ::daq::Verdict& 
                             std::size_t top) {
   std::string h =
       "<p class=\"note\">Errors outside their limit first, then by the gain in G (what "
-      "correcting that error alone takes off G); the rank is the error's place in the ranking "
-      "by gain, every error under Details.</p>\n";
+      "correcting that error alone takes off G); every error under Details.</p>\n";
   for (std::size_t i : fix_first_order(r, verdict, top)) {
     const auto& d = r.diagnostics[i];
     if (std::round(d.g_reduction_um * 1e3) >= 0) continue;
