@@ -66,8 +66,9 @@ TEST(SeriesStyle, TheMarksAreDrawnAndInTheLegend) {
     for (auto at = svg.find(glyph); at != std::string::npos; at = svg.find(glyph, at + 1)) ++n;
     return n;
   };
-  EXPECT_EQ(count("▲"), 3u + 2u) << svg.substr(0, 2000);
-  EXPECT_EQ(count("▽"), 3u + 2u);
+  // PLplot writes each character as a numeric reference: ▲ U+25B2, ▽ U+25BD.
+  EXPECT_EQ(count("&#x25b2;"), 3u + 2u) << svg.substr(0, 2000);
+  EXPECT_EQ(count("&#x25bd;"), 3u + 2u);
 }
 
 }  // namespace
