@@ -60,7 +60,7 @@ db.execute("UPDATE runs SET quality = 'suspect', quality_note = 'planted verdict
 db.execute("UPDATE captured_targets SET suspect = 'planted stop' WHERE run_id = 2 AND target_index = 3")
 db.commit()
 PYEOF
-check planted 0 "stop quality: planted verdict" -- "$DAQ" show 2 --db "$DB"
+check planted 0 "stop quality: suspect, planted verdict" -- "$DAQ" show 2 --db "$DB"
 check recompensate_quality 0 "^  stop quality: ok" -- "$DAQ" recompensate 2 --alpha-ppm 11.6 --db "$DB"
 check quality_stored 0 "^  stop quality: ok" -- "$DAQ" show 2 --db "$DB"
 check planted_gone 0 '"suspect_stops": \[\]' -- "$DAQ" show 2 --db "$DB" --json

@@ -251,6 +251,12 @@ check("vdi3441: the title names VDI/DGQ 3441",
       and "Positioning test (ISO 230-2)" not in " ".join(text["vdi3441"]), v1[:300])
 check("run quality says its state once",
       all("ok — ok" not in p and "ok - ok" not in p for n in text for p in text[n]), "")
+# One colon after the label: "Run quality: ok: every stop ..." had two in a row.
+quality_lines = [m for n in text for p in text[n] for m in re.findall(r"Run quality: [^.]{0,60}", p)]
+check("run quality: one colon, the state then a comma",
+      quality_lines and all(re.match(r"Run quality: (ok|not checked|suspect), ", q) for q in quality_lines)
+      and any(q.startswith("Run quality: ok, every stop within") for q in quality_lines),
+      str(quality_lines[:4]))
 check("suspect: SUSPECT RUN on page one with its stop",
       "SUSPECT RUN" in text["suspect"][0] and "run 2 ↑ target 4" in text["suspect"][0],
       text["suspect"][0])
@@ -269,11 +275,12 @@ check("circle: main table on page one", "symbol and meaning" in c1
 check("circle: the polar plot on page one", "Polar plot, least-squares centre removed" in c1
       and "G = " in c1, c1)
 check("circle: all of what to fix first on page one",
-      re.search(r"What to fix first .* 1 Backlash X .* 2 \w.* 3 \w", c1) is not None, c1)
+      re.search(r"What to fix first .* \d+ Backlash X .* 1 \w.* 2 \w", c1) is not None, c1)
 # (pdftotext may read the value and gain columns, or only the gain column, after the rest of
 # the page)
 check("circle: what to fix first on page one", "What to fix first" in c1
-      and re.search(r"rank error, and what to check (value (G gain \(share of G\) )?)?1 \w", c1)
+      and re.search(r"rank by gain error, and what to check (value (G gain \(share of G\) )?)?"
+                    r"\d+ \w", c1)
       is not None and re.search(r"G gain \(share of G\) \+[0-9.]+ µm", c1) is not None, c1)
 check("circle: failing value named on page one",
       re.search(r"FAIL.*= [+-]?[0-9.]+ µm \(limit ≤", c1) is not None, c1)
@@ -281,8 +288,8 @@ check("circle: failing value named on page one",
 # first" though correcting it alone would make G larger (it partly offsets the servo mismatch),
 # and the report says so; the others follow by their gain.
 check("circle: the failing error first in what to fix first",
-      re.search(r"What to fix first rank error, and what to check (value (G gain \(share of G\) )?)?"
-                r"1 Backlash X FAIL \(limit ≤ 3\.000 µm\)", c1) is not None, c1)
+      re.search(r"What to fix first rank by gain error, and what to check (value (G gain \(share "
+                r"of G\) )?)?\d+ Backlash X FAIL \(limit ≤ 3\.000 µm\)", c1) is not None, c1)
 circle_all = " ".join(text["circle"])
 check("circle: a failing error with a negative gain is explained",
       re.search(r"Backlash X is outside its limit, but correcting it alone would make G [0-9.]+ "
@@ -296,7 +303,23 @@ check("circle details: each limit in its unit",
       len(limits) >= 2 and all(re.match(r"≤ [0-9.]+ (µm|µm/m|ms|µrad) (pass|FAIL)$", c)
                                for c in limits)
       and any("µm/m" in c for c in limits), str(limits))
-check("circle: then the largest gain", re.search(r"2 Cyclic error X", circle_all) is not None, "")
+check("circle: then the largest gain", re.search(r"1 Cyclic error X", circle_all) is not None, "")
+# One ranking by gain, the same number for an error in both tables: page one numbered its own rows
+# 1, 2, 3 (the failing backlash X "1"), the details ranked it 8th. The details' ranks are 1, 2, ...
+# down the table, their gains never rising; each of page one's rows has the rank the details give
+# the same error.
+first_diag = cells(circle_html.split("Details of the results")[0], "num diag")
+details_rank = {r[1]: r[0] for r in details_diag}
+gains = [float(r[3]) for r in details_diag]
+check("circle: the details ranked 1, 2, ... by their gain",
+      [r[0] for r in details_diag] == [str(k + 1) for k in range(len(details_diag))]
+      and all(a >= b for a, b in zip(gains, gains[1:])), str(details_diag))
+check("circle: what to fix first ranks each error as the details do",
+      len(first_diag) == 3 and all(
+          any(row[1].startswith(name) and row[0] == rank for name, rank in details_rank.items())
+          for row in first_diag)
+      and any(row[1].startswith("Backlash X") and row[0] != "1" for row in first_diag),
+      f"{[r[:2] for r in first_diag]} / {details_rank}")
 check("no -0.000 anywhere", all("-0.000" not in p for n in text for p in text[n]), "")
 # Documents print µm, °C (the terminal keeps um, degC): no unit word of the terminal in any
 # report's text (the run quality, the uncertainty budget's models, the demo's warm-up).
@@ -571,16 +594,18 @@ check("squareness report: no -0.000 or +0.000", "-0.000" not in square and "+0.0
 # Printed widths (pt): A4 less the 14 mm margins is 516 pt; a polar plot 72 % of it, a small
 # multiple half of it less the gap.
 content_pt = (210 - 28) / 25.4 * 72
+MARKS = ("", "•", "▲", "▽", "■", "□", "◆", "◇", "●", "○")
 for name in reports:
     html = open(f"{name}.html", encoding="utf-8").read()
     for m in re.finditer(r"<svg class=\"([^\"]*)\"[^>]*aria-label=\"([^\"]*)\"[^>]*viewBox=\"0 0 "
                          r"(\d+) (\d+)\"", html):
         cls, title, width = m.group(1), m.group(2), float(m.group(3))
         end = html.find("</svg>", m.end())
-        # Each text's size, but not the markers (PLplot draws a data point as a "•" glyph).
+        # Each text's size, but not the markers (PLplot draws a data point as a "•" glyph, a
+        # run-by-run plot's as triangles, also beside each legend entry's line).
         sizes = [float(size) for size, text in re.findall(
             r'font-size="([0-9.]+)"[^<]*(?:<[^t][^>]*>[^<]*)*?<tspan[^>]*>(.*?)</tspan>',
-            html[m.end():end]) if html_mod.unescape(text).strip() not in ("•", "")]
+            html[m.end():end]) if html_mod.unescape(text).strip() not in MARKS]
         if not sizes:
             continue
         inside_multiples = html.rfind('<div class="multiples">', 0, m.start()) > html.rfind(
@@ -597,8 +622,14 @@ for name in reports:
     plot_text = " ".join(html_mod.unescape(t) for t in re.findall(r"<tspan[^>]*>(.*?)</tspan>",
                                                                   html))
     check(f"{name}: no 'air air ch' legend", " ch 0" not in plot_text, "")
+    # ... by its role, product and serial number as an engineer reads them ("air: ids3010" named
+    # neither the laser nor its sensor).
     if "Temperatures" in html:
-        check(f"{name}: legends name the instrument", "ptu300 SIM-PTU-0001" in plot_text, "")
+        check(f"{name}: legends name the instrument",
+              "air sensor PTU300 (serial SIM-PTU-0001)" in plot_text
+              and "material sensor (serial SIM-TH-0001)" in plot_text, plot_text[:600])
+        check(f"{name}: no legend by a driver's key", re.search(
+            r"(air|material): |\b(ids3010|ptu300)\b", plot_text) is None, plot_text[:600])
 
 # --- straightness, angular and roll runs: page one is their ISO 230-1 answer ------------------
 # One run of each on the volumetric shop, acquired by `daq sim --measure --acquire` in its own

@@ -209,6 +209,8 @@ try:
         return document.getElementById('result-quality').textContent;""")
     ok("SUSPECT STOPS: 1" in suspect and "target 2: run 2 up at 50 mm" in suspect and "--accept-suspect 7" in suspect,
        f"a suspect run names its stops: {suspect!r}")
+    # Its summary without its state again ("SUSPECT STOPS: 1suspect: 1 stop" said it twice).
+    ok("suspect: 1 stop" not in suspect and "1 stop" in suspect, f"the state said once: {suspect!r}")
     shot(b, "s05b-suspect-results-1366x768.png")
     b.js("document.getElementById('tab-run').click();")
 

@@ -53,7 +53,7 @@ void run_build(const BuildCliOptions& o) {
     fmt::print(
         "  SUSPECT run {} used as told (--accept-suspect; recorded in the model's "
         "provenance): {}\n",
-        id, run_quality(store, id).summary);
+        id, quality_text(run_quality(store, id)));
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
   if (origin.label == "MIXED") {
     std::vector<std::string> parts;

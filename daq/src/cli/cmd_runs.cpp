@@ -257,7 +257,9 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
     }
   }
   // The stop quality (run_quality.hpp): the verdict, each suspect stop by name.
-  print_line("  stop quality: {}", j["quality"]["summary"].get<std::string>());
+  print_line("  stop quality: {}",
+             quality_text({.state = j["quality"]["state"].get<std::string>(),
+                           .summary = j["quality"]["summary"].get<std::string>()}));
   for (const auto& q : j["quality"]["suspect_stops"])
     print_line("    SUSPECT {}", q["reason"].get<std::string>());
   for (const auto& i : j["instruments"])

@@ -352,7 +352,7 @@ void recompensate(const RecompensateOptions& o) {
   if (used.result_id) fmt::print(", superseding result {}", *used.result_id);
   print_line("");
   if (changed.empty()) print_line("  nothing changed: the same coefficients and offsets again");
-  print_line("  stop quality: {}", quality.summary);
+  print_line("  stop quality: {}", quality_text(quality));
   for (const auto& s : quality.suspects) print_line("    SUSPECT {}", s.reason);
   for (const auto& c : changed)
     fmt::print("  {}: {} -> {}\n", c["name"].get<std::string>(), c["from"].dump(), c["to"].dump());

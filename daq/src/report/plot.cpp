@@ -22,6 +22,16 @@ Rgb palette(std::size_t i) {
   return colours[i % std::size(colours)];
 }
 
+SeriesStyle paired_style(std::size_t pair, bool second) {
+  // Filled for the first of a pair, open for the second; the shape by the palette's round.
+  static constexpr std::string_view filled[] = {"▲", "■", "◆", "●"}, open[] = {"▽", "□", "◇", "○"};
+  constexpr std::size_t colours = 8;  // palette()'s
+  const std::size_t shape = (pair / colours) % std::size(filled);
+  return {.colour = palette(pair),
+          .dashed = second,
+          .marker = std::string(second ? open[shape] : filled[shape])};
+}
+
 namespace {
 
 // Colour map 0: 0 background, 1 axes, 2 grid, 3 reference lines; the rest per item.
@@ -138,6 +148,7 @@ struct LegendEntry {
   PLINT opt = PL_LEGEND_LINE;
   PLINT style = 1;
   double width = 1.5;
+  std::string symbol;  // a glyph beside the line sample (PL_LEGEND_SYMBOL)
 };
 
 // How many columns of legend entries fit under a viewport `viewport_pt` wide. PLplot makes each
@@ -174,9 +185,9 @@ PLFLT draw_legend(const std::vector<LegendEntry>& entries, PLINT position, PLINT
     widths.push_back(e.width);
     box_patterns.push_back(0);
     scales.push_back(0.8);
-    symbol_numbers.push_back(0);
+    symbol_numbers.push_back(e.symbol.empty() ? 0 : 2);
     texts.push_back(e.text.c_str());
-    symbols.push_back("");
+    symbols.push_back(e.symbol.c_str());
   }
   PLFLT w = 0, h = 0;
   const PLINT rows = columns > 0 ? (n + columns - 1) / columns : 0;
@@ -196,10 +207,22 @@ void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
   plwidth(l.width);
   pllsty(l.dashed ? 2 : 1);
   plline(n, l.x.data(), l.y.data());
-  if (l.markers) plpoin(n, l.x.data(), l.y.data(), 17);
+  const std::string marker = plot_text(l.marker);
+  if (l.markers && marker.empty()) plpoin(n, l.x.data(), l.y.data(), 17);
+  if (l.markers && !marker.empty()) {
+    // A mark about as large as the dot (at the text's size a triangle hid its neighbours).
+    PLFLT default_mm = 0, height_mm = 0;
+    plgchr(&default_mm, &height_mm);
+    const PLFLT scale = default_mm > 0 ? height_mm / default_mm : 1.0;
+    plschr(0, 0.6 * scale);
+    plstring(n, l.x.data(), l.y.data(), marker.c_str());
+    plschr(0, scale);
+  }
   pllsty(1);
   if (!l.label.empty())
-    legend.push_back({plot_text(l.label), c, PL_LEGEND_LINE, l.dashed ? 2 : 1, l.width});
+    legend.push_back({plot_text(l.label), c,
+                      marker.empty() ? PL_LEGEND_LINE : PL_LEGEND_LINE | PL_LEGEND_SYMBOL,
+                      l.dashed ? 2 : 1, l.width, marker});
 }
 
 // A tick interval of 1, 2 or 5 times a power of ten giving about `ticks` intervals over a
@@ -285,9 +308,9 @@ XyDrawn draw_xy(const XyChart& chart, std::size_t max_columns, double legend_x =
           ? (0.62 * static_cast<double>(tick_chars) + 1.2) * 0.52 * char_pt / chart.width_pt + 0.01
           : std::min(0.3, (label_disp + 1.4) * char_pt / chart.width_pt + 0.01);
   // The legend as wide as the plot's frame at most (it is centred under it).
-  const PLINT columns =
-      legend ? legend_columns(labelled, longest, (0.97 - left) * chart.width_pt, char_pt, max_columns)
-             : 0;
+  const PLINT columns = legend ? legend_columns(labelled, longest, (0.97 - left) * chart.width_pt,
+                                                char_pt, max_columns)
+                               : 0;
   const PLINT rows = columns > 0 ? (static_cast<PLINT>(labelled) + columns - 1) / columns : 0;
   const double legend_pt = legend ? (1.6 * rows + 0.8) * char_pt : 0.0;
   const double total_pt = chart.height_pt + legend_pt;

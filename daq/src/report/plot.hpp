@@ -27,7 +27,21 @@ struct Line {
   double width = 1.5;
   bool dashed = false;
   bool markers = false;  // a dot at each point
+  // The glyph drawn at each point instead of the dot, and beside the line in the legend ("▲"):
+  // series that share a colour stay apart by their marks.
+  std::string marker;
 };
+
+// The style of one series of a chart whose series come in pairs (a run's approach in each
+// direction, run by run): the pair's colour, the first of a pair solid with filled marks, the
+// second dashed with open ones, the marks' shape changing once the palette's colours are used
+// up, so that no two of up to 64 series share their colour, line and mark.
+struct SeriesStyle {
+  Rgb colour;
+  bool dashed = false;
+  std::string marker;
+};
+SeriesStyle paired_style(std::size_t pair, bool second);
 
 // A filled band between lo and hi (e.g. mean +/- 2 s).
 struct Band {

@@ -125,6 +125,10 @@ const AxisText& axis_text(const RunView& v) {
   return v.run.kind == "rotary" ? rotary_text : linear_text;
 }
 
+std::string ctx(const json& j, const char* key) {
+  return j.is_object() && j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : "";
+}
+
 std::string instrument_name(const RunView& v, int device) {
   for (const auto& i : v.instruments)
     if (i.device == device) return i.driver;
@@ -143,6 +147,56 @@ std::string instrument_label(const RunView& v, int device) {
         return i.value("driver", "") + (serial.empty() ? "" : " " + serial);
       }
   return name;
+}
+
+// A driver's product as an engineer names it ("IDS3010", not the driver's key "ids3010"); ""
+// for a generic driver (a line gauge reads whatever it is wired to: its configured name says
+// what it is).
+std::string product_name(std::string_view driver) {
+  static constexpr std::pair<std::string_view, std::string_view> products[] = {
+      {"ids3010", "IDS3010"},
+      {"ptu300", "PTU300"},
+      {"temper", "TEMPer"},
+      {"shdr", "MTConnect SHDR"},
+      {"halsampler", "LinuxCNC halsampler"}};
+  for (const auto& [key, name] : products)
+    if (driver == key) return std::string(name);
+  return driver == "gauge" ? "" : std::string(driver);
+}
+
+// A plot's legend entry for a series of `device`: the instrument by its role, its product and
+// serial number, and for an environment quantity the sensor ("air sensor PTU300 (serial
+// SIM-PTU-0001)"; the laser's own air sensor "air sensor of laser IDS3010 (serial ...)", which
+// read "air: ids3010"). `sensor`: "air" or "material" for those quantities, else "".
+std::string legend_label(const RunView& v, int device, int channel, std::string_view sensor) {
+  const std::string stored = instrument_name(v, device);
+  json inst = json::object();
+  const auto list = v.context.value("instruments", json::array());
+  // By the name the run stored it under (its configured id), else by its driver (a replay).
+  for (const char* key : {"id", "driver"})
+    if (inst.empty() && list.is_array())
+      for (const auto& i : list)
+        if (i.is_object() && ctx(i, key) == stored) {
+          inst = i;
+          break;
+        }
+  const std::string id = ctx(inst, "id").empty() ? stored : ctx(inst, "id");
+  const std::string role = ctx(inst, "role").empty() ? id : ctx(inst, "role");
+  const std::string product =
+      product_name(ctx(inst, "driver").empty() ? stored : ctx(inst, "driver"));
+  // The instrument's own name where the role does not say it ("spindle" on a material gauge).
+  const std::string named = id != role && id != ctx(inst, "driver") ? " " + id : "";
+  std::string label;
+  if (sensor.empty())
+    label = role + named + (product.empty() ? "" : " " + product);
+  else if (role == sensor)
+    label = std::string(sensor) + " sensor" + named + (product.empty() ? "" : " " + product);
+  else  // the sensor of another instrument (a laser's environmental unit)
+    label = fmt::format("{} sensor of {}{}{}", sensor, role, named,
+                        product.empty() ? "" : " " + product);
+  const std::string serial = ctx(inst, "serial_number");
+  if (!serial.empty()) label += " (serial " + serial + ")";
+  return label + (channel ? fmt::format(", channel {}", channel) : "");
 }
 
 Environment load_environment(const st::RunReader& store, const RunView& v) {
@@ -164,7 +218,10 @@ Environment load_environment(const st::RunReader& store, const RunView& v) {
   }
   for (auto& [key, s] : by_source) {
     const auto [q, device, channel] = key;
-    s.label = instrument_label(v, device) + (channel ? fmt::format(" channel {}", channel) : "");
+    const auto sensor_of = static_cast<Q>(q) == Q::material_temperature_degc ? "material"
+                           : static_cast<Q>(q) == Q::refractive_index        ? ""
+                                                                             : "air";
+    s.label = legend_label(v, device, channel, sensor_of);
     switch (static_cast<Q>(q)) {
       case Q::air_temperature_degc:
         env.air_temperature.push_back(std::move(s));
@@ -555,10 +612,10 @@ std::string environment_section(const Environment& env) {
   row("Relative humidity", env.humidity, "%RH", 1);
   row("Refractive index (instrument)", env.index, "", 9);
   h += table({"quantity", "min", "mean", "max", "unit", "samples"}, rows, "num", "lrrrlr");
+  // The legends say which sensor ("air sensor PTU300 ...", "material sensor ..."), so the
+  // quantity needs no prefix of its own ("air: ids3010" named neither).
   auto temps = lines_of(env.air_temperature, 0);
-  for (auto& l : temps) l.label = "air: " + l.label;
   for (auto& l : lines_of(env.material_temperature, env.air_temperature.size())) {
-    l.label = "material: " + l.label;
     l.dashed = true;
     temps.push_back(std::move(l));
   }
@@ -585,9 +642,6 @@ std::string environment_section(const Environment& env) {
 
 // --- what a customer report states ------------------------------------------------------------
 
-std::string ctx(const json& j, const char* key) {
-  return j.is_object() && j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : "";
-}
 std::string stated(const std::string& s) {
   return s.empty() ? "<span class=\"unstated\">not stated</span>" : esc(s);
 }
@@ -1076,19 +1130,25 @@ std::string runs_plot(const Linear& l) {
                  .y_label = fmt::format("deviation ({})", l.text.deviation),
                  .height_pt = 300,
                  .zero_line = true};
+  // Each run and direction its own style: the run's colour, ↑ solid with filled triangles, ↓
+  // dashed with open ones (the two directions of a run, in one colour, told apart only by a
+  // dash the marks hid, read as one colour repeated).
   for (auto& [key, pts] : runs) {
     std::sort(pts.begin(), pts.end());
+    const auto style =
+        paired_style(static_cast<std::size_t>(std::max(key.first - 1, 0)), key.second == '-');
     Line line{.label = fmt::format("run {} {}", key.first, key.second == '+' ? "↑" : "↓"),
-              .colour = palette(static_cast<std::size_t>(key.first - 1)),
+              .colour = style.colour,
               .width = 1.0,
-              .dashed = key.second == '-',
-              .markers = true};
+              .dashed = style.dashed,
+              .markers = true,
+              .marker = style.marker};
     for (const auto& [px, py] : pts) line.x.push_back(px), line.y.push_back(py);
     traces.lines.push_back(std::move(line));
   }
   return figure(svg(traces),
-                "Every captured deviation x_ij: solid lines approach in the "
-                "positive direction (↑), dashed lines in the negative (↓).");
+                "Every captured deviation x_ij: solid lines and filled marks approach in the "
+                "positive direction (↑), dashed lines and open marks in the negative (↓).");
 }
 
 // The ISO 230-2 values as a grid: one row per kind of value, columns up, down and
@@ -1498,7 +1558,10 @@ std::vector<std::size_t> fix_first_order(const cal::circle::Result& r,
 
 // The diagnostics as a table: rank, error, value in its own unit, what correcting it would
 // gain (µm and share of G), PV, limit and verdict, and what to check. `top`: page one's "what
-// to fix first" (fix_first_order), else every error in the ranking by gain.
+// to fix first" (fix_first_order), else every error in the ranking by gain. The rank is the
+// error's place in the one ranking by gain (r.diagnostics' order) in both tables: page one
+// numbered its rows 1, 2, 3 in its own order (a failing backlash first), so its "1" was the
+// details' "8".
 std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict& verdict,
                               std::size_t top) {
   std::vector<std::size_t> order;
@@ -1524,7 +1587,7 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
     // Page one's rows: the error with what to check under it (a column of its own was squeezed
     // to a word a line).
     std::vector<std::string> row{
-        std::to_string(diag.size() + 1),
+        std::to_string(i + 1),
         top ? "<strong>" + esc(d.name) + "</strong>" + failing + "<br><span class=\"note\">" +
                   check_text + "</span>"
             : esc(d.name),
@@ -1545,7 +1608,8 @@ std::string diagnostics_table(const cal::circle::Result& r, const ::daq::Verdict
     diag.push_back(std::move(row));
   }
   if (diag.empty()) return "";
-  std::vector<std::string> head{"rank", top ? "error, and what to check" : "error", "value"};
+  std::vector<std::string> head{"rank by gain", top ? "error, and what to check" : "error",
+                                "value"};
   if (top) head.push_back("G gain (share of G)");
   if (!top) {
     head.push_back("G gain (µm)");
@@ -1776,7 +1840,7 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     // The legend names the instrument (its driver and serial), as the environment plots do; it
     // read "laser displacement (mm)", the title again.
     t.title = instrument_name(v, x.device);
-    t.s.label = instrument_label(v, x.device) + t.channel;
+    t.s.label = legend_label(v, x.device, x.channel, "");
     if (std::find(plotted.begin(), plotted.end(), x.quantity) == plotted.end())
       plotted.push_back(x.quantity);
   }

@@ -693,7 +693,7 @@ struct LinearRun::Impl : Runner {
   void check_quality() {
     outcome.quality = assess_stops(store->targets(outcome.run_id), kind.unit());
     store->set_quality(outcome.run_id, outcome.quality);
-    event(fmt::format("stop quality: {}", outcome.quality.summary));
+    event(fmt::format("stop quality: {}", quality_text(outcome.quality)));
     for (const auto& s : outcome.quality.suspects) event("SUSPECT stop: " + s.reason);
   }
 

@@ -59,9 +59,17 @@ cal::storage::RunQuality run_quality(const cal::storage::RunReader& store, std::
 }
 
 std::string quality_text(const cal::storage::RunQuality& q) {
-  if (q.summary.empty()) return q.state;
-  if (q.state.empty() || q.summary.starts_with(q.state)) return q.summary;
-  return q.state + ": " + q.summary;
+  // An assessment's summary begins with its state ("ok: every stop within ..."); a stored one
+  // may not. Printed after a label ("Run quality: ", "stop quality: ") a colon after the state
+  // made two in a row ("Run quality: ok: every stop ..."): the state, a comma, the rest.
+  std::string_view rest = q.summary;
+  if (!q.state.empty() && rest.starts_with(q.state)) {
+    rest.remove_prefix(q.state.size());
+    while (!rest.empty() && (rest.front() == ':' || rest.front() == ' ')) rest.remove_prefix(1);
+  }
+  if (q.state.empty()) return std::string(rest);
+  if (rest.empty()) return q.state;
+  return q.state + ", " + std::string(rest);
 }
 
 json quality_json(const cal::storage::RunQuality& q) {
@@ -87,7 +95,7 @@ std::vector<std::int64_t> refuse_suspect_runs(const cal::storage::RunReader& sto
       taken.push_back(id);
       continue;
     }
-    refused += fmt::format("\n  run {}: {}", id, q.summary);
+    refused += fmt::format("\n  run {}: {}", id, quality_text(q));
     for (const auto& s : q.suspects) refused += fmt::format("\n    {}", s.reason);
   }
   if (!refused.empty())

@@ -26,8 +26,9 @@ cal::storage::RunQuality run_quality(const cal::storage::RunReader& store, std::
 // {"state", "summary", "suspect_stops": [{"run", "direction": "up"|"down", "target_index",
 // "reason"}]}: the "quality" of a run's JSON.
 nlohmann::json quality_json(const cal::storage::RunQuality& q);
-// The quality in one line: "ok: every stop within ...", the state said once (the summary of an
-// assessment begins with it; a stored one may not).
+// The quality in one line, printed after a label: "ok, every stop within ...", "suspect, 1
+// stop(s) beyond ...", the state said once and followed by a comma (the summary of an
+// assessment begins with "ok: "; a stored one may not).
 std::string quality_text(const cal::storage::RunQuality& q);
 
 // The builders' gate: throws cal::InputError naming every suspect run of `runs` that is not in
