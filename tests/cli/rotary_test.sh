@@ -162,6 +162,10 @@ check rot_report_B 0 "^ok$" -- python3 -c "
 import re; h=open('$TMP/rot.html').read()
 print('ok' if re.search(r'reversal value, max \|B<sub>i</sub>\|</td>(<td[^>]*>.*?</td>){2}<td class=.r.>$B_ARCSEC</td>', h) else 'no B $B_ARCSEC')"
 check rot_report_no_um 1 "" -- grep -E "[0-9] (mm|µm)(/min)?</td>|\((µm|mm)\)" "$TMP/rot.html"
+# The settings appendix names the angular reference, and leaves out the laser's wavelength, the
+# refractive index's equation, CO2 and the expansion coefficient (an encoder reads no light).
+check rot_report_reference 0 "Angular reference</td><td>encoder</td>" -- cat "$TMP/rot.html"
+check rot_report_no_laser_settings 1 "" -- grep -E "Laser vacuum wavelength|Refractive index equation|CO2 content|Expansion coefficient" "$TMP/rot.html"
 # An option the rotary test would not use is refused, not ignored (--measure ran the linear
 # test of that component instead).
 check rot_measure_refused 2 "--measure E_XX with --test rotary: .* linear test" -- "$DAQ" sim --measure E_XX --test rotary --acquire -o "$TMP/m.toml" --db "$TMP/m.sqlite"

@@ -441,6 +441,7 @@ constexpr SettingLabel setting_labels[] = {
     {"measure.separation_mm", "Beam separation", "mm"},
     {"measure.sign", "Sign of the reading", ""},
     {"measure.square", "Against a square", ""},
+    {"measure.reference", "Angular reference", ""},
     {"measure.stationary_mm", "Stationary position", "mm"},
     {"measure.probe_offset_mm", "Probe offset", "mm"},
     {"machine_model.topology", "Machine model: kinematic chain", ""},
@@ -474,6 +475,12 @@ bool setting_applies(const RunView& v, const std::string& key, const json& val) 
   if ((kind == "positioning" || kind == "rotary") &&
       (key == "measure.beams" || key == "measure.separation_mm" || key == "measure.square" ||
        (key == "measure.sign" && kind == "positioning")))
+    return false;
+  // A rotary axis read by a reference other than a laser's optics reads no wavelength in air:
+  // the refractive index's equation, CO2 and wavelength, and the scale's expansion, say nothing.
+  if (kind == "rotary" && measure.value("reference", "") != "laser" &&
+      (key == "environment.equation" || key == "environment.co2_umol_per_mol" ||
+       key == "environment.wavelength_nm" || key == "environment.expansion_ppm_per_k"))
     return false;
   if (key == "uncalibrated" && val.is_boolean() && !val.get<bool>()) return false;
   return true;
