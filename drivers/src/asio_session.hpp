@@ -25,7 +25,6 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   Session(Stream stream, std::string description)
       : stream_(std::move(stream)),
         description_(std::move(description)),
-        time_(VirtualTime::of(stream_.get_executor().context())),
         readers_(::cal::drivers::detail::ReaderBytes::of(stream_.get_executor().context())) {}
 
   Stream& stream() { return stream_; }
@@ -36,6 +35,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   // pseudo-terminal's path, "tcp:PORT" by our port; see reader_bytes.hpp).
   void start(Transport::Handlers handlers, std::string reader) {
     reader_ = std::move(reader);
+    to_twin_ = ::cal::drivers::detail::ReaderBytes::to_twin(reader_);
     if (readers_) readers_->opened(reader_);
     on_data_ = std::move(handlers.data);
     on_error_ = std::move(handlers.error);
@@ -52,8 +52,9 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
     if (!active()) return;
     const auto* p = reinterpret_cast<const char*>(bytes.data());
     queue_.emplace_back(p, p + bytes.size());
-    // Simulated time waits for these bytes to reach their reader (a twin in this process).
-    if (time_) time_->bytes_written(bytes.size());
+    // Simulated time waits for these bytes to reach their reader (a twin in this process),
+    // counted as this driver's (reader_bytes.hpp).
+    if (readers_) readers_->written(bytes.size(), to_twin_);
     if (queue_.size() == 1) write_next();
   }
 
@@ -62,6 +63,10 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
     if (readers_ && !reader_.empty()) readers_->closed(reader_);
     on_data_ = nullptr;
     on_error_ = nullptr;
+    // Ours not yet handed to the stream never reach the twin (the first one's handler takes
+    // off what of it was not written).
+    if (readers_)
+      for (std::size_t i = 1; i < queue_.size(); ++i) readers_->read(queue_[i].size(), to_twin_);
     queue_.clear();
     boost::system::error_code ignored;
     stream_.close(ignored);
@@ -94,14 +99,18 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   }
 
   void write_next() {
-    boost::asio::async_write(
-        stream_, boost::asio::buffer(queue_.front()),
-        [self = this->shared_from_this()](const boost::system::error_code& ec, std::size_t) {
-          if (!self->active()) return;
-          if (ec) return self->fail(ErrorKind::write_failed, "write failed: " + ec.message());
-          self->queue_.pop_front();
-          if (!self->queue_.empty()) self->write_next();
-        });
+    boost::asio::async_write(stream_, boost::asio::buffer(queue_.front()),
+                             [self = this->shared_from_this(), size = queue_.front().size()](
+                                 const boost::system::error_code& ec, std::size_t written) {
+                               if (self->readers_ && written < size)  // never reaches the twin
+                                 self->readers_->read(size - written, self->to_twin_);
+                               if (!self->active()) return;
+                               if (ec)
+                                 return self->fail(ErrorKind::write_failed,
+                                                   "write failed: " + ec.message());
+                               self->queue_.pop_front();
+                               if (!self->queue_.empty()) self->write_next();
+                             });
   }
 
   Stream stream_;
@@ -110,10 +119,10 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   Transport::ErrorHandler on_error_;
   std::array<std::byte, 4096> buffer_{};
   std::deque<std::vector<char>> queue_;
-  VirtualTime* time_;  // simulated mode only (see loop_time.hpp)
   // Simulated mode only: the bytes our twin sent us (reader_bytes.hpp).
   ::cal::drivers::detail::ReaderBytes* readers_;
   std::string reader_;
+  std::string to_twin_;  // our bytes to the twin count under this name
 };
 
 }  // namespace cal::drivers::transport::detail

@@ -141,6 +141,12 @@ void validate(const MachineConfig& c) {
       throw InputError(fmt::format("axis {}: Kv {} 1/s must be > 0", names[k], s.kv_per_s));
     if (!(s.backlash_um >= 0.0) || !(s.noise_um >= 0.0))
       throw InputError(fmt::format("axis {}: backlash and noise must be >= 0", names[k]));
+    if (!(s.vibration_um >= 0.0) || !std::isfinite(s.vibration_um))
+      throw InputError(fmt::format("axis {}: vibration {} um must be finite and >= 0", names[k],
+                                   s.vibration_um));
+    if (s.vibration_um > 0.0 && !(s.vibration_hz > 0.0 && std::isfinite(s.vibration_hz)))
+      throw InputError(fmt::format("axis {}: vibration frequency {} Hz must be finite and > 0",
+                                   names[k], s.vibration_hz));
     if (!(s.cyclic_period_mm > 0.0))
       throw InputError(
           fmt::format("axis {}: cyclic period {} mm must be > 0", names[k], s.cyclic_period_mm));
@@ -226,6 +232,8 @@ struct Machine::Impl {
       double q = played_mm[k] + 1e-3 * s.cyclic_amplitude_um *
                                     std::sin(2.0 * pi * played_mm[k] / s.cyclic_period_mm);
       if (s.noise_um > 0.0) q += 1e-3 * s.noise_um * normal(rng);
+      if (s.vibration_um > 0.0)
+        q += 1e-3 * s.vibration_um * std::sin(2.0 * pi * s.vibration_hz * t);
       axes[k] = q * scale;
     }
     state.time_s = t;

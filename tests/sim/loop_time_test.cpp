@@ -192,6 +192,56 @@ TEST(VirtualTime, BytesToADriverThatClosedAreNotWaitedFor) {
   EXPECT_LT(steady_now_ns() - start, 1'000'000'000);  // not kSettle (2 s)
 }
 
+// The bytes each driver sends to its twin count as that driver's: two drivers send 6 and 2
+// bytes, the first's twin is unplugged before it reads them; the second's twin answers. Only the
+// first's 6 bytes are forgotten with its twin: the clock then runs on at once. Counted for all
+// drivers together, the 6 bytes stayed in flight and the loop waited kSettle (2 s of wall time)
+// for them (1 settle timeout).
+TEST(VirtualTime, BytesADriverSentToATwinThatWentAreThatDriversOnly) {
+  boost::asio::io_context io;
+  auto& time = d::VirtualTime::install(io);
+  sim::World world = quiet_world();
+  const auto polled = [] {
+    return sim::GaugeTwinConfig{
+        .continuous = false, .request = "?", .value = [](const sim::World&) { return 0.5; }};
+  };
+  sim::GaugeTwin gone(
+      io, world, [&time] { return time.now_s(); }, polled());
+  sim::GaugeTwin stays(
+      io, world, [&time] { return time.now_s(); }, polled());
+  const auto open = [&](const sim::GaugeTwin& twin, std::string& received, int& opened) {
+    auto port =
+        t::make_serial(io, t::parse_serial_settings("115200 8N1", {.device = twin.device_path()}));
+    port->open({.opened = [&opened] { ++opened; },
+                .data =
+                    [&received](std::span<const std::byte> b) {
+                      received.append(reinterpret_cast<const char*>(b.data()), b.size());
+                    },
+                .error = [](const t::Error&) {}});
+    return port;
+  };
+  std::string to_gone, to_stays;
+  int opened = 0;
+  auto port_gone = open(gone, to_gone, opened);
+  auto port_stays = open(stays, to_stays, opened);
+  ASSERT_TRUE(time.run_for(1s, [&] { return opened == 2; }));
+  const auto send = [](t::Transport& port, const std::string& request) {
+    port.write(std::as_bytes(std::span(request)));
+  };
+  send(*port_gone, "?\r?\r?\r");  // 6 bytes, never read: the twin goes at once
+  gone.unplug();
+  send(*port_stays, "?\r");  // 2 bytes, read and answered
+  d::Timer timer(io);
+  bool fired = false;
+  timer.expires_after(100ms);
+  timer.async_wait([&](const boost::system::error_code& ec) { fired = !ec; });
+  const std::int64_t start = steady_now_ns();
+  EXPECT_TRUE(time.run_for(1s, [&] { return fired; }));
+  EXPECT_NE(to_stays.find('\n'), std::string::npos) << "the twin that stays answered";
+  EXPECT_EQ(time.stats().settle_timeouts, 0u);
+  EXPECT_LT(steady_now_ns() - start, 1'000'000'000);  // not kSettle (2 s)
+}
+
 TEST(VirtualTime, AnInstrumentPollsItsTwinOnSimulatedTimeAndStampsItsReadingsWithIt) {
   boost::asio::io_context io;
   auto& time = d::VirtualTime::install(io);

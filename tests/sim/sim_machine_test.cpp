@@ -110,6 +110,26 @@ TEST(SimMachine, GeometricAndThermalErrorsAtRest) {
   EXPECT_NEAR(m.state().tool_mm[1], 100.00115, 1e-6);
 }
 
+// A vibration of Y of 0.6 um at 25 Hz on a standing machine: Y is 0.6 sin(2 pi 25 t) um off,
+// +0.6 um at t = 1/(4 x 25) = 10 ms, -0.6 um at 30 ms, 0 at 20 ms; X does not move.
+TEST(SimMachine, VibrationIsASineInTime) {
+  auto c = ideal();
+  c.servo[1].vibration_um = 0.6;
+  c.servo[1].vibration_hz = 25.0;
+  sim::Machine m(c);
+  EXPECT_NEAR(run_to(m, 0.010, 1e-4).axes_mm[1] * 1e3, 0.6, 1e-9);
+  EXPECT_NEAR(run_to(m, 0.020, 1e-4).axes_mm[1] * 1e3, 0.0, 1e-9);
+  EXPECT_NEAR(run_to(m, 0.030, 1e-4).axes_mm[1] * 1e3, -0.6, 1e-9);
+  EXPECT_NEAR(m.state().tool_mm[1] * 1e3, -0.6, 1e-9);
+  EXPECT_EQ(m.state().axes_mm[0], 0.0);
+  auto no_frequency = ideal();
+  no_frequency.servo[1].vibration_um = 0.6;
+  EXPECT_THROW(sim::Machine{no_frequency}, cal::InputError);
+  auto negative = ideal();
+  negative.servo[2] = {.vibration_um = -1.0, .vibration_hz = 10.0};
+  EXPECT_THROW(sim::Machine{negative}, cal::InputError);
+}
+
 // advance_to skips the geometric error of the intermediate steps (nothing reads them): the
 // state it reaches must be the step-by-step one bit for bit, errors, noise and backlash
 // included, and the tool's position must carry the geometric error of the last step.

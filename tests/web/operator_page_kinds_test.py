@@ -12,8 +12,9 @@ driven in headless Chromium against `daq serve --simulate`:
 3. an angular test (pitch of X, two laser beams 80 mm apart in Z) and a roll test of X (the
    level) from the form: the beams' fields only for the angular kind, checked at the field as
    typed; each run stored with what was typed, the stops table under "Angular deviation (µrad)"
-   and "Roll (µrad)" with the stored values, the captured number in µrad (the shop injects no
-   rotation: each stop reads 0 within the noise);
+   and "Roll (µrad)" with the stored values, the captured number in µrad; each stop reads the
+   rotation the shop injects there (ShopTruth::served: E_BX = +40 µrad/m x X and E_AX =
+   +40 µrad/m x X, so +4 µrad at X = 100 mm) within 0.3 µrad, with its sign;
 4. the kinds offered follow the form's instruments.
 
 What the page showed during a run is recorded in the page (a setInterval), not by WebDriver
@@ -114,6 +115,23 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
         ok(last["status"] == "complete" and last["test"] == "linear", f"{what}: complete: {last}")
         return last["run"], b.js("clearInterval(window.__stopsTimer); return window.__stops;")
 
+    # The rotations of X the simulated shop injects (daq/src/sim/sim_shop.hpp, ShopTruth::served;
+    # docs/web.md): linear in X from 0 at X = 0.
+    PITCH_URAD_PER_M = 40.0  # E_BX
+    ROLL_URAD_PER_M = 40.0  # E_AX
+    TOLERANCE_URAD = 0.3  # the laser's and the level's digits and the stop's noise are far below
+
+    def read_as_injected(doc, urad_per_m, what):
+        """Every stored stop of DOC is the injected rotation at its target, urad_per_m x X, within
+        TOLERANCE_URAD: a run reading zeros (nothing injected) or the other sign fails (at 100 mm
+        the rotation is 4 µrad)."""
+        stops = [(s["nominal_mm"], s["deviation_um"]) for s in doc["stops"]]
+        want = [(x, urad_per_m * x * 1e-3) for x, _ in stops]
+        ok(len(stops) == 6 and max(x for x, _ in stops) >= 99.0
+           and all(abs(v - w) <= TOLERANCE_URAD for (_, v), (_, w) in zip(stops, want)),
+           f"{what}: each stop reads the injected {urad_per_m:+g} µrad/m x X within {TOLERANCE_URAD} µrad: "
+           f"read {[(round(x, 3), round(v, 3)) for x, v in stops]}, injected {[(round(x, 3), round(w, 3)) for x, w in want]}")
+
     def stored_stops(doc):
         """A run's stored stop values by (target number, arrow) as the stops table names them."""
         return {(s["target_index"] + 1, "↑" if s["direction"] == "up" else "↓"): s["deviation_um"] for s in doc["stops"]}
@@ -138,7 +156,8 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     cur = [r for r in doc["results"] if r["current"]]
     slope = re.search(r'"slope_um_per_m":\s*(-?[0-9.e+-]+)', json.dumps(cur))
     # The indicator reads the machine's XY squareness as the line's slope (20 µm/m injected: X
-    # is off by E_C0Y x y as Y moves; the straightness proper is about the noise).
+    # is off by E_C0Y x y as Y moves; the straightness proper is about the noise), changed by
+    # 4 µm/m by X's yaw at X = 200 mm (E_CX = -20 µrad/m x X: -4 µrad, Y riding on X).
     ok(slope and 10 <= abs(float(slope.group(1))) <= 30,
        f"the simulated indicator reads the injected XY squareness as the profile's slope: {slope and slope.group(1)} µm/m")
     build = model_build(run)
@@ -186,10 +205,10 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(doc["kind"] == "angular" and measure["component"] == "E_BX" and measure["beams"] == [2, 1]
        and measure["separation_mm"] == [0, 0, 80],
        f"the run used the beams and separation typed: {doc['kind']} {measure}")
-    # The shop injects no rotation (its truth: squareness and servo errors): each stop reads 0
-    # within the noise; the captured number is the stop's own, in µrad.
-    stored = stored_stops(doc)
-    ok(len(stored) == 6 and all(abs(v) < 1.0 for v in stored.values()), f"angular: no pitch injected, none read: {stored}")
+    # The shop's X carriage pitches by E_BX = +40 µrad/m x X (ShopTruth::served, zero at X = 0
+    # where the run starts): each stop reads it, with its sign; the captured number is the
+    # stop's own, in µrad.
+    read_as_injected(doc, PITCH_URAD_PER_M, "angular: the pitch of X")
     captured = list(shown["captured"].values())
     ok(captured and all(u == "µrad" for _, u in captured), f"angular: the captured stop's number in µrad: {captured}")
 
@@ -200,8 +219,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
        f"stored as a roll run of X: {doc['kind']} {doc['settings']['measure']}")
     ok(not any(b.js(SHOWN, k) for k in (*BEAMS, "test.linear.direction", "test.linear.square")),
        "no beams, direction or square in the form of a roll test")
-    stored = stored_stops(doc)
-    ok(len(stored) == 6 and all(abs(v) < 1.0 for v in stored.values()), f"roll: no roll injected, none read: {stored}")
+    read_as_injected(doc, ROLL_URAD_PER_M, "roll: the roll of X")
     captured = list(shown["captured"].values())
     ok(captured and all(u == "µrad" for _, u in captured), f"roll: the captured stop's number in µrad: {captured}")
 

@@ -8,7 +8,8 @@
    while the program moves it onto the next plane) and what comes next, test k of 3;
 3. each test done shows its stored run, G and verdict (the same G as /api/runs/N);
 4. before the feed-in the big number is dashes and "waiting" (the bar's reading then is no circle
-   deviation); the simulated machine's squareness is measured in every plane; a circle's Results
+   deviation); the simulated machine's squareness is measured in every plane, and its vibration of Y (0.6 µm at
+   23.7 Hz) in XY and YZ, not in ZX; a circle's Results
    say nothing of target stops;
 5. at the end the three-plane table, the same numbers `daq ballbar volumetric --runs` prints
    (the CLI's code), on the Run view and in the Results (opened by itself), at 1366 x 768 and
@@ -130,6 +131,17 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
         # 20, 15 and 10 µm/m in size), so each plane's diagnostic is a real one, not a square 0.
         ok(abs(p["squareness_um_per_m"]) >= 5,
            f"{p['plane']}: the simulated machine's squareness is measured ({want} µm/m), not ~0")
+    # The simulated shop's Y vibrates 0.6 µm (peak) at 23.7 Hz (ShopTruth::served, docs/web.md):
+    # an axial vibration of amplitude A reads A/2 rms over a full circle (docs/circle.md), so
+    # the XY test finds 0.3 µm rms at 23.7 Hz; the ZX plane has no Y in it and finds none.
+    def vibration(run):
+        cur = next(r["result"] for r in get(url + f"api/runs/{run}")["results"] if r["current"])
+        return next((d for d in cur.get("diagnostics", []) if d["key"] == "vibration"), None)
+    vib = {plane: vibration(run) for plane, run in zip(("XY", "ZX", "YZ"), runs)}
+    ok(vib["XY"] and abs(vib["XY"]["frequency_hz"] - 23.7) < 0.2 and abs(vib["XY"]["value"] - 0.3) < 0.05,
+       f"XY: the injected vibration of Y read at 23.7 Hz, 0.3 µm rms (within 0.05): {vib['XY']}")
+    ok(vib["YZ"] and abs(vib["YZ"]["frequency_hz"] - 23.7) < 0.2, f"YZ: the vibration of Y at 23.7 Hz: {vib['YZ']}")
+    ok(vib["ZX"] is None, f"ZX: no vibration (Y is not in the plane): {vib['ZX']}")
     # A ballbar test has no target stops: nothing is said of checking them ("Stops not checked:
     # not checked: one run in one direction" was a linear test's notion, its state said twice).
     quality = b.js("return document.getElementById('result-quality').textContent;")

@@ -223,9 +223,10 @@ class Service {
       // watching; the page's own timers stay on the wall clock.
       cal::drivers::VirtualTime::install(io_).pace(o_.speed);
       // The truth of `daq sim --test circle-set` (squareness in XY, ZX and YZ; X's linear
-      // errors as the default shop's): a ballbar set on the page shows real diagnostics in
-      // every plane, not the default shop's square vertical planes.
-      shop_ = std::make_unique<SimulatedShop>(io_, ShopTruth::three_planes(), o_.speed);
+      // errors as the default shop's) with X's roll, pitch and yaw and a vibration of Y
+      // (ShopTruth::served): a ballbar set on the page shows real diagnostics in every plane,
+      // and its angular and roll tests read known non-zero rotations.
+      shop_ = std::make_unique<SimulatedShop>(io_, ShopTruth::served(), o_.speed);
       o_.run.clock = shop_->clock_ns();
       o_.run.poll_scale = 1.0;  // the instruments' timers wait in simulated time
       const auto text = simulated_shop_config(*shop_, {.speed = o_.speed, .in_process = true});

@@ -128,6 +128,19 @@ struct SimulatedShop::Impl {
                   .cyclic_period_mm = t.cyclic_z_period_mm,
                   .noise_um = t.noise_yz_um};
     c.servo[0].kv_per_s = t.kv_x_per_s;
+    c.servo[1].vibration_um = t.vibration_y_um;
+    c.servo[1].vibration_hz = t.vibration_y_hz;
+    // urad per m of X x 1e-3 = urad per mm, the polynomial's coefficient of X in mm (none set
+    // when zero: a zero function is skipped by the kinematics).
+    const auto slope = [](double urad_per_m) {
+      return urad_per_m == 0.0
+                 ? cal::kinematics::ErrorFunction{}
+                 : cal::kinematics::ErrorFunction::polynomial({0.0, urad_per_m * 1e-3});
+    };
+    auto& x = c.geometry.axes[cal::kinematics::X];
+    x.ea_urad = slope(t.roll_x_urad_per_m);
+    x.eb_urad = slope(t.pitch_x_urad_per_m);
+    x.ec_urad = slope(t.yaw_x_urad_per_m);
     c.geometry.squareness.c0y_urad = t.squareness_um_per_m;
     c.geometry.squareness.b0z_urad = t.b0z_urad;
     c.geometry.squareness.a0z_urad = t.a0z_urad;
@@ -441,6 +454,16 @@ ShopTruth ShopTruth::three_planes() {
   t.backlash_y_um = 3.0, t.backlash_z_um = 2.0;
   t.cyclic_y_amplitude_um = 0.8, t.cyclic_z_amplitude_um = 0.6;
   t.noise_yz_um = t.noise_um;
+  return t;
+}
+
+ShopTruth ShopTruth::served() {
+  ShopTruth t = three_planes();
+  t.roll_x_urad_per_m = 40.0;
+  t.pitch_x_urad_per_m = 40.0;
+  t.yaw_x_urad_per_m = -20.0;
+  t.vibration_y_um = 0.6;
+  t.vibration_y_hz = 23.7;
   return t;
 }
 

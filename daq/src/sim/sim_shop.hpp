@@ -73,6 +73,25 @@ struct ShopTruth {
   // share X's 40 mm period (screws of one pitch): the circle analysis fits one period per
   // plane (docs/circle.md).
   static ShopTruth three_planes();
+  // Rotations of the X carriage, linear in X from 0 at X = 0 (urad per metre of X travel; ISO
+  // 230-1's E_AX roll, E_BX pitch, E_CX yaw, the kinematic model's signs): what an angular
+  // test (two laser beams) and a roll test (a level) read. They act on the tool through the
+  // other axes' positions (FXYZ: Y and Z ride on X), so at Y = Z = 0 a positioning test of X
+  // does not see them.
+  double roll_x_urad_per_m = 0.0, pitch_x_urad_per_m = 0.0, yaw_x_urad_per_m = 0.0;
+  // A vibration of the Y axis (cal::drivers::sim::ServoAxis::vibration_um): its amplitude
+  // (peak, um) at a frequency, moving or standing. A ballbar in XY or YZ sees it; a laser or
+  // indicator reading X does not.
+  double vibration_y_um = 0.0, vibration_y_hz = 0.0;
+  // The machine of `daq serve --simulate`: three_planes() with non-zero rotations of X and a
+  // vibration of Y, so that the page's angular, roll and ballbar tests measure something
+  // known (docs/web.md, "The simulated shop"):
+  //   E_AX roll  +40 urad/m x X (+4 urad at X = 100 mm)
+  //   E_BX pitch +40 urad/m x X (+4 urad at X = 100 mm)
+  //   E_CX yaw   -20 urad/m x X (-2 urad at X = 100 mm)
+  //   Y vibrates 0.6 um (peak) at 23.7 Hz: a ballbar circle in XY reads it as 0.3 um rms
+  //   (docs/circle.md: an axial vibration of amplitude A is A/2 rms over a circle).
+  static ShopTruth served();
   // All 21 geometric errors (sim_volumetric.hpp): when set, the machine's geometry is this
   // instead of the E_XX scale and E_C0Y above (the servo, thermal and air settings stay).
   std::optional<cal::kinematics::Machine> geometry;

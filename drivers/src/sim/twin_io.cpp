@@ -30,6 +30,8 @@ Clock steady_clock(double speed) {
 
 namespace detail {
 
+using ::cal::drivers::detail::ReaderBytes;
+
 LineServer::LineServer(asio::io_context& io, std::uint16_t port)
     : acceptor_(io, tcp::endpoint(asio::ip::address_v4::loopback(), port)) {}
 
@@ -47,6 +49,10 @@ void LineServer::accept() {
     auto client = std::make_shared<Client>(std::move(socket));
     boost::system::error_code ignored;
     client->writer.reader = fmt::format("tcp:{}", client->socket.remote_endpoint(ignored).port());
+    // The driver's bytes to us count as its own from now on (reader_bytes.hpp): a port used
+    // again by another connection counts again.
+    if (auto* readers = ReaderBytes::of(client->socket.get_executor().context()))
+      readers->opened(ReaderBytes::to_twin(client->writer.reader));
     self->clients_.push_back(client);
     if (self->on_connect_) self->on_connect_(client);
     self->read(client);
@@ -58,9 +64,11 @@ void LineServer::read(const ClientPtr& client) {
   client->socket.async_read_some(
       asio::buffer(client->chunk),
       [self = shared_from_this(), client](const boost::system::error_code& ec, std::size_t n) {
-        if (auto* time = VirtualTime::of(client->socket.get_executor().context()))
-          time->bytes_read(n);
+        auto* readers = ReaderBytes::of(client->socket.get_executor().context());
+        const auto from = ReaderBytes::to_twin(client->writer.reader);
+        if (readers) readers->read(n, from);
         if (ec || self->closed_) {
+          if (readers) readers->closed(from);  // what the driver sends now nobody reads
           self->clients_.remove(client);
           return;
         }
@@ -68,6 +76,7 @@ void LineServer::read(const ClientPtr& client) {
         self->hand_on_requests(client);
         if (self->closed_) return;
         if (client->input.size() > max_request_bytes) {
+          if (readers) readers->closed(from);
           boost::system::error_code ignored;
           client->socket.close(ignored);
           self->clients_.remove(client);
@@ -105,6 +114,8 @@ void LineServer::broadcast(const std::string& text, const ClientPtr& except) {
 
 void LineServer::drop_clients() {
   for (auto& c : clients_) {
+    if (auto* readers = ReaderBytes::of(c->socket.get_executor().context()))
+      readers->closed(ReaderBytes::to_twin(c->writer.reader));
     boost::system::error_code ignored;
     c->socket.shutdown(tcp::socket::shutdown_both, ignored);
     c->socket.close(ignored);
@@ -137,6 +148,10 @@ PtyDevice::PtyDevice(asio::io_context& io) : master(io) {
 PtyDevice::~PtyDevice() { unplug(); }
 
 void PtyDevice::unplug() {
+  // What a driver sent us and we did not read is read by nobody now (reader_bytes.hpp).
+  if (master.is_open())
+    if (auto* readers = ReaderBytes::of(master.get_executor().context()))
+      readers->closed(ReaderBytes::to_twin(path));
   boost::system::error_code ignored;
   master.close(ignored);
   if (slave_fd >= 0) ::close(slave_fd);

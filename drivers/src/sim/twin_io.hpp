@@ -167,8 +167,11 @@ void read_commands(const std::shared_ptr<Self>& self) {
   asio::async_read_until(
       self->pty.master, self->pty.input, EndOfCommand{},
       [self, buffered](const boost::system::error_code& ec, std::size_t n) {
-        if (auto* time = VirtualTime::of(self->pty.master.get_executor().context()))
-          time->bytes_read(self->pty.input.size() - buffered);
+        // The driver's bytes to this twin, counted as that driver's (reader_bytes.hpp).
+        if (auto* readers =
+                ::cal::drivers::detail::ReaderBytes::of(self->pty.master.get_executor().context()))
+          readers->read(self->pty.input.size() - buffered,
+                        ::cal::drivers::detail::ReaderBytes::to_twin(self->pty.path));
         if (ec) return;
         std::string line(asio::buffers_begin(self->pty.input.data()),
                          asio::buffers_begin(self->pty.input.data()) + static_cast<long>(n) - 1);

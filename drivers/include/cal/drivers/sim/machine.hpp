@@ -42,7 +42,11 @@ struct ServoAxis {
   double backlash_um = 0.0;          // lost motion at a reversal (play of width backlash_um)
   double cyclic_amplitude_um = 0.0;  // pitch error A sin(2 pi q / period)
   double cyclic_period_mm = 5.0;
-  double noise_um = 0.0;  // rms of white position noise (vibration), per sample
+  double noise_um = 0.0;  // rms of white position noise, per sample
+  // A vibration of the axis (a resonance kept up by a pump or the drive, moving or standing):
+  // vibration_um x sin(2 pi vibration_hz t) added to its position, t the simulated time.
+  double vibration_um = 0.0;  // amplitude (peak), >= 0
+  double vibration_hz = 0.0;  // > 0 when vibration_um is
 };
 
 // Temperature of the machine's structure and scales; the scales expand by
@@ -83,8 +87,8 @@ struct MachineState {
 
 class Machine {
  public:
-  // Throws cal::InputError for a non-positive Kv, acceleration or period, negative backlash
-  // or noise.
+  // Throws cal::InputError for a non-positive Kv, acceleration or period, negative backlash,
+  // noise or vibration, or a vibration without a positive finite frequency.
   explicit Machine(MachineConfig config);
   ~Machine();
   Machine(Machine&&) noexcept;
