@@ -2119,6 +2119,7 @@ table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 .details.flow { break-before: auto; page-break-before: auto; }
 h3.appendix { break-before: page; page-break-before: always; }
+.pair.keep { break-inside: avoid; page-break-inside: avoid; }
 .pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
         align-items: start; }
 .pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
@@ -3226,7 +3227,9 @@ std::string verification_report(const st::RunReader& store, std::int64_t run,
   XyChart overlay{.title = "As found, as left and as the table should leave it",
                   .x_label = x_label,
                   .y_label = read + " (µm)",
-                  .height_pt = 250,
+                  // Page one holds it, the finding and the table: at 250 the finding's last
+                  // row ("Agreement with the finding") fell onto page two, alone.
+                  .height_pt = 190,
                   .zero_line = true};
   overlay.lines.push_back(
       loop_line(p.target_mm, p.found_um, "as found (" + found_name + ")", orange, false));
@@ -3255,7 +3258,8 @@ std::string verification_report(const st::RunReader& store, std::int64_t run,
       {"Agreement with the finding", fmt::format("{} µm rms (within {} µm: twice the runs' "
                                                  "repeatability, at least 0.3 µm)",
                                                  um(v.mismatch_rms_um), um(v.tolerance_um))}};
-  body += "<div class=\"pair\"><div><h3>The finding</h3>\n" +
+  // The finding and the table are not split across pages (class keep).
+  body += "<div class=\"pair keep\"><div><h3>The finding</h3>\n" +
           table({"", ""}, loop_checks(v), "kv") + table({"", ""}, numbers, "kv") +
           "</div><div><h3>The table</h3>\n" +
           table({"", ""}, loop_table_rows(c, left.machine), "kv") +
