@@ -87,7 +87,7 @@ daq("sim", "--truth-out", "truth.json", "--topology", "YFXZ")
 truth = __import__("json").load(open("truth.json", encoding="utf-8"))
 found = {}
 for w in words:
-    if re.fullmatch(r"E_[XYZABC][XYZ0][XYZ]", w[4]):
+    if re.fullmatch(r"E_[XYZABC]0?[XYZ]", w[4]):
         line = sorted((x for x in words if abs(x[1] - w[1]) < 3 and x[0] > w[2]), key=lambda x: x[0])
         texts = [x[4] for x in line]
         for i, t in enumerate(texts[:-1]):

@@ -242,7 +242,9 @@ for name in ("linear", "vdi3441", "suspect"):
     fills = [page_fill(*p) for p in pdf_words(f"{name}.pdf")]
     check(f"{name}: page one filled to its foot (>= 90 % of the text area)", fills[0] >= 0.9,
           str(fills))
-    check(f"{name}: the details begin on page one", "Per target" in text[name][0], text[name][0])
+    if name != "suspect":  # (its page one is full with the SUSPECT RUN box)
+        check(f"{name}: the details begin on page one", "Per target" in text[name][0],
+              text[name][0])
     check(f"{name}: the last page not almost empty (>= 30 % of the text area)",
           len(fills) > 1 and fills[-1] >= 0.3, str(fills))
 

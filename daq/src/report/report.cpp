@@ -524,7 +524,9 @@ std::string settings_appendix(const RunView& v) {
   if (rows.empty()) return "";
   // The appendix starts a page of its own: whole, it fills the last page; flowing on, it left
   // the demo's last page with its last ten rows (17 % of the page).
-  return "<h3 class=\"appendix\">Appendix: settings of the run</h3>\n<p class=\"note\">As recorded "
+  return std::string(v.run.kind == "linear" ? "<h3 class=\"appendix\">"
+                                            : "<h3>") +  // a circle's fills its pages
+         "Appendix: settings of the run</h3>\n<p class=\"note\">As recorded "
          "at the start "
          "of the run; settings that do not apply to this test are left out.</p>\n" +
          table({"setting", "value"}, rows, "kv");
