@@ -23,7 +23,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report_checks import check, finish, pdf_pages, runner  # noqa: E402
+from report_checks import check, finish, pdf_pages, pdf_words, runner  # noqa: E402
 
 daq = runner(os.path.abspath(sys.argv[1]))
 
@@ -79,6 +79,33 @@ one = pdf_pages("campaign.pdf")[0]
 check("campaign: page one says SIMULATED for all its runs",
       "SIMULATED: all 19 runs of this report were made on the simulated machine" in one
       and "SIMULATED — Campaign annual calibration" in one, one[:400])
+# Page one sums up the 21 errors: each name with its value and unit on its line (read from the
+# PDF's words: the two halves of the summary stand side by side). Units: a translation in µm, an
+# angle (angular, roll, squareness) in µrad.
+words, _ = pdf_words("campaign.pdf")[0]
+daq("sim", "--truth-out", "truth.json", "--topology", "YFXZ")
+truth = __import__("json").load(open("truth.json", encoding="utf-8"))
+found = {}
+for w in words:
+    if re.fullmatch(r"E_[XYZABC]0?[XYZ]", w[4]):
+        line = sorted((x for x in words if abs(x[1] - w[1]) < 3 and x[0] > w[2]), key=lambda x: x[0])
+        texts = [x[4] for x in line]
+        for i, t in enumerate(texts[:-1]):
+            if re.fullmatch(r"[+−-]?\d+\.\d{3}", t) and texts[i + 1] in ("µm", "µrad"):
+                found.setdefault(w[4], (float(t.replace("−", "-")), texts[i + 1]))
+                break
+names = [a + b for b in "XYZ" for a in ("E_X", "E_Y", "E_Z", "E_A", "E_B", "E_C")]
+expected_unit = {n: "µrad" if n[2] in "ABC" else "µm" for n in names}
+expected_unit.update({"E_C0Y": "µrad", "E_B0Z": "µrad", "E_A0Z": "µrad"})
+check("campaign: page one names all 21 errors, each with its value in its unit",
+      "The 21 geometric errors (ISO 230-1): 21 of 21 measured" in one
+      and {n: u for n, (_, u) in found.items()} == expected_unit, (sorted(found), found))
+# The squareness from the straightness pairs against the injected truth (urad; the straightness
+# runs' noise and the Abbe terms removed leave a few hundredths).
+for n in ("E_C0Y", "E_B0Z", "E_A0Z"):
+    check(f"campaign: {n} as injected", n in found
+          and abs(found[n][0] - truth["squareness"][n]["iso230_1_urad"]) < 0.2,
+          (found.get(n), truth["squareness"][n]))
 svgs = re.findall(r"<svg.*?</svg>", camp, re.S)
 readings = [s for s in svgs if 'aria-label="laser displacement (mm)' in s]
 check("campaign: each laser's readings plot names the instrument in its legend",

@@ -232,6 +232,36 @@ for name in ("linear", "suspect"):
           re.search(r"FAIL.*limit ≤ [0-9.]+ µm\)", p1) is not None, p1)
     # The main plot on page one too (it was on page two).
     check(f"{name}: main plot on page one", "Mean positional deviation with ±2s" in p1, p1)
+# Page one is full and the last page is not a line or two (the lead saw page one a third blank:
+# the details began on page two; and a last page with the appendix's last ten rows, 17 % of it).
+# Measured from the words' positions (pdftotext -bbox): how far down the text area between the
+# margins the content reaches.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report_checks import page_fill, pdf_words  # noqa: E402
+for name in ("linear", "vdi3441", "suspect"):
+    fills = [page_fill(*p) for p in pdf_words(f"{name}.pdf")]
+    check(f"{name}: page one filled to its foot (>= 90 % of the text area)", fills[0] >= 0.9,
+          str(fills))
+    if name != "suspect":  # (its page one is full with the SUSPECT RUN box)
+        check(f"{name}: the details begin on page one", "Per target" in text[name][0],
+              text[name][0])
+    check(f"{name}: the last page not almost empty (>= 30 % of the text area)",
+          len(fills) > 1 and fills[-1] >= 0.3, str(fills))
+
+# The demo's capture replayed into a database without its original run: no limits (a capture
+# does not carry them), and the report says which keys, where, and why the replay has none.
+daq("replay", capture, "--db", "fresh.sqlite")
+daq("report", "1", "--db", "fresh.sqlite", "--format", "pdf", "-o", "fresh.pdf")
+f1 = squash(pages("fresh.pdf")[0])
+check("replay without its original run: which limits, where, and why none",
+      "No tolerance configured" in f1
+      and "E_um, R_um, A_um, B_um or M_um under [tolerances.X]" in f1
+      and "this capture's original run is not in it" in f1, f1[:1500])
+daq("report", "3", *db, "-o", "replay.html")
+check("replay in the demo's database: judged by its original run's limits",
+      "Verdict against the machine specification (tolerances.X)" in open(
+          "replay.html", encoding="utf-8").read(), "")
+
 # The VDI 3441 main table is on page one, judged by its configured limits (the demo's P_um...;
 # the report said "No tolerance applies").
 v1 = text["vdi3441"][0]

@@ -147,6 +147,11 @@ if shutil.which("pdftotext") and (shutil.which("chromium") or os.environ.get("CA
           < one.find("The finding") and "expected as left" in one, one[:900])
     check("PDF page one: the largest deviations and the table", "Largest |deviation| as found"
           in one and "cec.mpf" in one, one)
+    # The finding and the table whole on page one: its last row fell onto page two, alone.
+    two = pdf_pages("verify-3.pdf")[1]
+    check("PDF page one: the finding's last row and the table's on page one",
+          "Agreement with the finding" in one and "Written" in one
+          and "Agreement with the finding" not in two and "Points compared" not in two, two[:300])
 else:
     check("pdftotext and chromium to print the report", False, "not found")
 

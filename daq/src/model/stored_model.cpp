@@ -31,7 +31,8 @@ cal::kinematics::Vec3 vec(const json& j, const char* key) {
 
 }  // namespace
 
-StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine) {
+StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine,
+                               std::span<const std::int64_t> only) {
   const auto m = store.machine_by_name(machine);
   if (!m) throw cal::InputError(fmt::format("no machine '{}' in {}", machine, store.name()));
   StoredProfiles out;
@@ -41,6 +42,7 @@ StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::
   bool any = false;
   for (const auto& r : runs) {
     if (r.machine_id != m->id) continue;
+    if (!only.empty() && std::find(only.begin(), only.end(), r.id) == only.end()) continue;
     const json s = cal::daq::parse_stored_json(r.settings_json);
     if (!s.is_object()) continue;
     const auto measure = s.find("measure");

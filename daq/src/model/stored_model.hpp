@@ -2,7 +2,9 @@
 // `daq model build` from the run store: the latest complete run of each component of a
 // machine (the test kinds store their component and set-up in the run's settings, see
 // kinds/kind.hpp), turned into profiles for cal::daq::model::build (model/model_build.hpp).
+#include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,7 +22,9 @@ struct StoredProfiles {
   cal::kinematics::Vec3 tool_offset_mm{}, table_offset_mm{};
 };
 
-// Throws cal::InputError when the machine is unknown or has no run of any test kind.
-StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine);
+// Throws cal::InputError when the machine is unknown or has no run of any test kind. With
+// `only` given, only those runs are read (a campaign's, for its report).
+StoredProfiles stored_profiles(const cal::storage::RunReader& store, const std::string& machine,
+                               std::span<const std::int64_t> only = {});
 
 }  // namespace daq

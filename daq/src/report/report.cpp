@@ -9,7 +9,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <regex>
+#include <span>
 
 #include "ballbar_campaign.hpp"
 #include "cal/analysis/air.hpp"
@@ -28,6 +30,8 @@
 #include "iso230_2_output.hpp"
 #include "json_input.hpp"
 #include "markup.hpp"
+#include "model/model_build.hpp"
+#include "model/stored_model.hpp"
 #include "plot.hpp"
 #include "provenance.hpp"
 #include "result_rows.hpp"
@@ -582,7 +586,12 @@ std::string settings_appendix(const RunView& v) {
                         used_note(key, val)});
   }
   if (rows.empty()) return "";
-  return "<h3>Appendix: settings of the run</h3>\n<p class=\"note\">As recorded at the start "
+  // The appendix starts a page of its own: whole, it fills the last page; flowing on, it left
+  // the demo's last page with its last ten rows (17 % of the page).
+  return std::string(v.run.kind == "linear" ? "<h3 class=\"appendix\">"
+                                            : "<h3>") +  // a circle's fills its pages
+         "Appendix: settings of the run</h3>\n<p class=\"note\">As recorded "
+         "at the start "
          "of the run; settings that do not apply to this test are left out.</p>\n" +
          table({"setting", "value"}, rows, "kv");
 }
@@ -865,14 +874,46 @@ std::string conditions_section(const RunView& v) {
   return "<h3>Test conditions</h3>\n" + table({"", ""}, rows, "kv");
 }
 
-// The verdict of a result as a coloured line: pass, fail, or no tolerance configured.
-std::string verdict_banner(const ::daq::Verdict& v) {
+// Where the limits of a run stored without them are set, for its verdict line: the keys
+// (`keys`, markup), the table of its axis or plane, and the configuration the run started
+// with (the limits in force when a run starts are stored with it and judge it; a replay keeps
+// its original run's). A run replayed from a capture whose original run is not in this
+// database has none: a capture's header does not carry the tolerances.
+std::string tolerance_hint(const RunView& v, std::string_view keys) {
+  const std::string config = ctx(v.context, "configuration");
+  bool orphan_replay = false;  // replayed, of no run in this database
+  for (const auto& r : v.results) {
+    const json p = json::parse(r.provenance_json, nullptr, false);
+    if (p.is_object() && p.value("how", "") == "replayed")
+      orphan_replay = p.contains("replay_of_run") && p["replay_of_run"].is_null();
+  }
+  return fmt::format(
+      "No limit was stored with this run: {} under <code>[tolerances.{}]</code> in {} judge{} "
+      "the runs made with it (docs/config.md).{}",
+      keys, esc(v.run.axis),
+      config.empty()
+          ? std::string("the configuration")
+          : "the configuration it was made with (<span class=\"path\">" + esc(config) + "</span>)",
+      keys.find(',') == std::string_view::npos && keys.find(" or ") == std::string_view::npos ? "s"
+                                                                                              : "",
+      orphan_replay ? " A replay takes the limits of its original run in the same database; "
+                      "this capture's original run is not in it, and a capture does not carry "
+                      "the limits."
+                    : "");
+}
+
+// The verdict of a result as a coloured line: pass, fail, or no tolerance configured (then
+// `hint`: which limits would judge it and where they are set, tolerance_hint).
+std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}) {
   if (!v.configured) {
     std::string h =
         v.notes.empty()
             ? "<p class=\"verdict none\"><strong>No tolerance configured</strong> for this test: "
-              "the results are not judged (a machine specification is given as [tolerances] in "
-              "the configuration, docs/config.md).</p>\n"
+              "the results are not judged" +
+                  (hint.empty() ? std::string(" (a machine specification is given as [tolerances] "
+                                              "in the configuration, docs/config.md).")
+                                : ". " + hint) +
+                  "</p>\n"
             : "<p class=\"verdict none\"><strong>No tolerance applies</strong>: the configured "
               "limits are for values this evaluation does not give, so the results are not "
               "judged.</p>\n";
@@ -1017,7 +1058,23 @@ struct Headline {
   std::vector<Value> values;
   std::string standard;
   std::string verdict;  // PASS, FAIL, no tolerance configured
+  // The ISO 230-1 error the run measured, for a volumetric campaign's summary of its 21 errors:
+  // a positioning run's E (E_XX), a straightness about its least-squares line (E_YX), an
+  // angular deviation (E_BX). Empty component: the run measured none of them.
+  struct Error {
+    std::string component, unit;  // "E_YX", "µm"
+    double value = 0;
+    std::optional<double> limit;  // in unit, where the run's tolerances give one
+    bool pass = false;
+  } error;
 };
+
+// The check of a result row as the summary of the 21 errors takes it.
+void set_error(Headline::Error& e, std::string component, double value, std::string unit,
+               const ::daq::Check* c) {
+  e = {.component = std::move(component), .unit = std::move(unit), .value = value};
+  if (c) e.limit = c->limit, e.pass = c->pass;
+}
 
 // --- ISO 230-2
 // ------------------------------------------------------------------------------------
@@ -1362,8 +1419,30 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
     for (const auto& r : values)
       headline.values.push_back({r.symbol, r.value, unit_text(r.unit), failing(r)});
   headline.verdict = ::daq::summary(verdict);
+  if (!rotary)
+    for (const auto& r : values)
+      if (r.key == "E_bi" || (r.key == "E_up" && !e.bidirectional))
+        set_error(headline.error,
+                  ctx(v.settings.value("measure", json::object()), "component").empty()
+                      ? "E_" + v.run.axis + v.run.axis
+                      : ctx(v.settings.value("measure", json::object()), "component"),
+                  r.value, unit, ::daq::find_check(verdict, r.key));
   if (rotary) h += angular_reference_line(v);
-  h += verdict_banner(verdict);
+  // The limits that would judge it, of this standard, in the axis's unit.
+  const std::string u = rotary ? "arcsec" : "um";
+  const bool vdi = e.standard.title.find("3441") != std::string::npos;
+  const auto keys = [&](std::initializer_list<std::string_view> names) {
+    std::string k;
+    std::size_t i = 0;
+    for (const auto n : names) {
+      if (i > 0) k += i + 1 == names.size() ? " or " : ", ";
+      k += fmt::format("<code>{}_{}</code>", n, u);
+      ++i;
+    }
+    return k;
+  };
+  h += verdict_banner(verdict, tolerance_hint(v, vdi ? keys({"P", "Pa", "Ps", "U"})
+                                                     : keys({"E", "R", "A", "B", "M"})));
   h += results_grid(e, verdict, unit);
   h += means_plot(l);
   std::string& d = out.details;
@@ -1372,7 +1451,9 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
     d += "<p class=\"note\">Unidirectional values (↑, ↓) of the grid on page one come from the "
          "approaches in one direction; the limits apply to the bidirectional values (ISO "
          "230-2).</p>\n";
-  d += runs_plot(l);
+  // The per-target table first: it follows the main plot on page one (its rows may break over
+  // to page two, the run-by-run plot may not), so page one has no third left blank.
+  out.details_flow = true;
   std::vector<std::string> head{fmt::format("target ({})", position)};
   for (const auto& p : e.per_target) head.push_back(esc(p.symbol) + " (" + unit + ")");
   std::vector<std::vector<std::string>> rows;
@@ -1382,6 +1463,7 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
     rows.push_back(std::move(r));
   }
   d += "<h4>Per target</h4>\n" + table(head, rows, "num");
+  d += runs_plot(l);
   for (const auto& w : e.warnings) d += "<p class=\"warning\">Warning: " + esc(w) + "</p>\n";
   if (rotary) {
     d += angular_reference_details(v);
@@ -1705,7 +1787,7 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
   for (const auto& x : st.informative)
     other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
                      "<em>informative</em>: " + esc(x.meaning)});
-  h += verdict_banner(verdict);
+  h += verdict_banner(verdict, tolerance_hint(v, "<code>G_um</code>"));
   // Page one holds the verdict, the values, the polar plot and what to fix first: the values
   // beside the plot (one under the other pushed "what to fix first" onto page two). The plot's
   // text is drawn larger so that, shown at half the page's width, it still prints at 9 pt.
@@ -2025,6 +2107,9 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
     headline.values.push_back(
         {r.symbol, r.value, unit_text(r.unit), c && !c->pass, r.key == "slope_um_per_m"});
   }
+  if (!rows.empty())  // the straightness, or the angular deviation
+    set_error(headline.error, ctx(doc, "component"), rows.front().value,
+              unit_text(rows.front().unit), ::daq::find_check(verdict, rows.front().key));
   Sections out;
   out.answer = fmt::format(
       "<h3>Results: {} {}</h3>\n<p class=\"standard\">Evaluated by <strong>ISO 230-1:2012</strong> "
@@ -2032,12 +2117,8 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
       straight ? "straightness" : "angular deviation", esc(ctx(doc, "component")),
       doc.value("targets", json::array()).size(),
       stored ? "" : " (no result was stored with the run: evaluated from its stops now)");
-  out.answer += verdict_banner(verdict);
-  if (!verdict.configured && verdict.notes.empty())
-    out.answer += fmt::format(
-        "<p class=\"note\">No tolerance stated for this axis: a limit is given as <code>{}</code> "
-        "under <code>[tolerances.{}]</code> (docs/config.md).</p>\n",
-        straight ? "straightness_um" : "angular_urad", esc(v.run.axis));
+  out.answer += verdict_banner(verdict, tolerance_hint(v, straight ? "<code>straightness_um</code>"
+                                                                   : "<code>angular_urad</code>"));
   out.answer += profile_values_table(rows, verdict);
   out.answer += profile_plot(doc, unit);
   std::string& d = out.details;
@@ -2111,6 +2192,8 @@ svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 .details.flow { break-before: auto; page-break-before: auto; }
+h3.appendix { break-before: page; page-break-before: always; }
+.pair.keep { break-inside: avoid; page-break-inside: avoid; }
 .pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
         align-items: start; }
 .pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
@@ -2480,6 +2563,153 @@ std::string volumetric_section(const st::RunReader& store, std::span<const std::
 }
 
 namespace {
+
+namespace kin = cal::kinematics;
+
+// What a component is, in words short enough for a half-page table: "straightness in Y",
+// "angular about Z", "roll", "positioning E" (E_<error><moving axis>, docs/kinematics.md).
+std::string error_words(std::string_view c) {
+  const char error = c[2], axis = c[3];
+  if (error == axis) return "positioning, E";
+  if (error - 'A' == axis - 'X') return "roll";  // E_AX, E_BY, E_CZ
+  if (error == 'A' || error == 'B' || error == 'C')
+    return fmt::format("angular about {}", static_cast<char>(error - 'A' + 'X'));
+  return fmt::format("straightness in {}", error);
+}
+
+struct ErrorRow {
+  std::string name, words;  // "E_YX", "straightness in Y"
+  std::int64_t run = 0;     // 0: not measured
+  Headline::Error e;
+  bool is_signed = false;  // a squareness has a direction
+};
+
+std::string error_rows_table(const std::vector<ErrorRow>& rows) {
+  std::vector<std::vector<std::string>> cells;
+  for (const auto& r : rows) {
+    const std::string name = r.run
+                                 ? fmt::format("<a href=\"#run-{}\"><strong>{}</strong></a> {}",
+                                               r.run, esc(r.name), esc(r.words))
+                                 : fmt::format("<strong>{}</strong> {}", esc(r.name), esc(r.words));
+    if (!r.run) {
+      cells.push_back({name, "<span class=\"unstated\">not measured</span>", "", ""});
+      continue;
+    }
+    const auto& e = r.e;
+    cells.push_back({name,
+                     fmt::format("<span class=\"nw\">{} {}</span>",
+                                 r.is_signed ? signed_text(e.value, 3) : um(e.value), esc(e.unit)),
+                     e.limit ? "<span class=\"nw\">≤ " + fixed(*e.limit, 3) + "</span>"
+                             : "<span class=\"unstated\">&ndash;</span>",
+                     !e.limit ? "<span class=\"unstated\">&ndash;</span>"
+                     : e.pass ? "<span class=\"pass\">pass</span>"
+                              : "<span class=\"fail\">FAIL</span>"});
+  }
+  return table({"error", "value", "limit", "verdict"}, cells, "num errors", "lrrl");
+}
+
+// A volumetric campaign's answer on its page one: each of the 21 geometric errors of ISO
+// 230-1 with its value in its own unit, its limit and verdict where the run's tolerances give
+// one (the latest complete run of each component, as daq model build takes them), and the
+// three squareness errors from the slopes of each plane's straightness pair against one square,
+// computed as daq model build computes them. Empty for a campaign that measured no
+// straightness, angular or roll run (a positioning test and a circle are reported as such).
+std::string errors_section(const st::RunReader& store, std::span<const std::int64_t> runs,
+                           const std::map<std::int64_t, Headline::Error>& measured) {
+  std::map<std::string, std::int64_t> latest;  // component -> run
+  bool volumetric = false;
+  for (const auto& [id, e] : measured) {
+    if (e.component.size() != 4) continue;
+    const auto r = store.run(id);
+    if (!r || r->status != st::RunStatus::complete) continue;
+    volumetric = volumetric || ::daq::is_profile_kind(r->kind);
+    auto& l = latest[e.component];
+    l = std::max(l, id);
+  }
+  if (!volumetric) return {};
+  std::vector<ErrorRow> rows;
+  for (const auto c : kin::all_components()) {
+    const std::string name(kin::to_string(c));
+    ErrorRow row{.name = name, .words = error_words(name)};
+    if (const auto it = latest.find(name); it != latest.end())
+      row.run = it->second, row.e = measured.at(it->second);
+    rows.push_back(std::move(row));
+  }
+  // Squareness: the model build's own computation on this campaign's runs (the Abbe terms of
+  // the measured angles removed from each straightness before its slope is taken).
+  std::string note;
+  std::optional<cal::daq::model::BuildReport> built;
+  try {
+    const auto first = store.run(runs.front());
+    const auto machine = first ? store.machine(first->machine_id) : std::nullopt;
+    if (machine) {
+      const auto stored = ::daq::stored_profiles(store, machine->name, runs);
+      if (stored.topology)
+        built = cal::daq::model::build(
+            stored.profiles,
+            {.machine = machine->name, .topology = *stored.topology, .allow_missing = true});
+      else
+        note =
+            "the runs do not state the machine's chain ([machine] topology), so the "
+            "squareness is not evaluated";
+    }
+  } catch (const cal::InputError& x) {
+    note = fmt::format("the squareness is not evaluated: {}", x.what());
+  }
+  for (const auto p : {kin::Plane::xy, kin::Plane::xz, kin::Plane::yz}) {
+    ErrorRow row{.name = std::string(kin::location_error_name(p)),
+                 .words = fmt::format("squareness {}", kin::to_string(p)),
+                 .is_signed = true};
+    const auto& sq = built ? built->model.squareness[static_cast<std::size_t>(p)]
+                           : cal::daq::model::SquarenessEntry{};
+    if (built && sq.given) {
+      const json src = json::parse(sq.source.json, nullptr, false);
+      const json ids = src.is_object() ? src.value("run_ids", json::array()) : json::array();
+      row.run = ids.empty() ? 0 : ids.back().get<std::int64_t>();
+      row.e = {
+          .component = row.name, .unit = "µrad", .value = built->model.machine.squareness.of(p)};
+      // A limit on the squareness is a circular test's ([tolerances.PLANE.diagnostics]
+      // squareness, on |α| in µm/m, and |α| = |location error|): a circle of the plane in
+      // the campaign carries it.
+      for (const auto id : runs)
+        if (const auto r = store.run(id); r && r->kind == "circle") {
+          try {
+            if (kin::plane_from_string(r->axis) != p) continue;
+          } catch (const cal::InputError&) {
+            continue;
+          }
+          const json s = cal::daq::parse_stored_json(r->settings_json);
+          const json t =
+              s.is_object() ? s.value("context", json::object()).value("tolerances", json::object())
+                            : json::object();
+          const json d = t.is_object() ? t.value("diagnostics", json::object()) : json::object();
+          if (d.is_object() && d.contains("squareness") && d["squareness"].is_number()) {
+            row.e.limit = d["squareness"].get<double>();
+            row.e.pass = std::abs(std::round(row.e.value * 1000) / 1000) <= *row.e.limit;
+          }
+        }
+    }
+    rows.push_back(std::move(row));
+  }
+  std::size_t done = 0;
+  for (const auto& r : rows) done += r.run ? 1 : 0;
+  const auto half = rows.begin() + 12;  // X and Y beside Z and the squareness
+  std::string h = fmt::format(
+      "<h3 id=\"errors\">The 21 geometric errors (ISO 230-1): {} of 21 measured</h3>\n", done);
+  h += "<div class=\"pair\"><div>" + error_rows_table({rows.begin(), half}) + "</div><div>" +
+       error_rows_table({half, rows.end()}) + "</div></div>\n";
+  h += "<p class=\"note\">Positioning: E, the bidirectional systematic positional deviation "
+       "(ISO 230-2); straightness: about the least-squares line; angular and roll: the range "
+       "of the means; squareness: the location error from the slopes of the plane's two "
+       "straightness runs against one square, as <code>daq model build</code> takes it (1 µrad "
+       "= 1 µm/m). Limits: <code>E_um</code>, <code>straightness_um</code>, "
+       "<code>angular_urad</code> under <code>[tolerances.AXIS]</code>; a squareness's is "
+       "<code>squareness</code> under <code>[tolerances.PLANE.diagnostics]</code>, stored with "
+       "a circular test of the plane. Each error's run links to its section.</p>\n";
+  if (!note.empty()) h += "<p class=\"warning\">" + esc(note) + ".</p>\n";
+  return h;
+}
+
 // A value's name in a table cell that only breaks before its parenthesis ("Cyclic error X" /
 // "(40.01 mm period)"), the rest kept whole.
 std::string breakable_name(std::string_view name) {
@@ -2497,11 +2727,13 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
   // The runs not measured on real instruments: page one says so whatever the campaign and the
   // machine are named (it relied on the names).
   RunLabels labels;
+  std::map<std::int64_t, Headline::Error> errors;  // run -> the ISO 230-1 error it measured
   for (const auto id : runs) {
     const auto v = load(store, id);
     labels.emplace_back(id, origin_label(v));
     Headline hl;
     const auto body = run_body(store, v, o, hl);
+    if (!hl.error.component.empty()) errors[id] = hl.error;
     // Each value kept whole on its line with its name ("E 8.576 µm", "Backlash X +4.084 µm"),
     // but a long name may break before its parenthesis: whole, "Cyclic error X (40.01 mm
     // period) +0.997 µm" pushed the table past the page's margin. Up to eight, never leaving
@@ -2531,7 +2763,8 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
   }
   const auto origins = origins_of(labels);
   const std::string body =
-      origins.banner + fmt::format("<p>{} runs.</p>\n", runs.size()) +
+      origins.banner + errors_section(store, runs, errors) +
+      fmt::format("<p>{} runs.</p>\n", runs.size()) +
       table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
             "campaign", "r") +
       volumetric_section(store, runs) + sections;
@@ -3069,7 +3302,9 @@ std::string verification_report(const st::RunReader& store, std::int64_t run,
   XyChart overlay{.title = "As found, as left and as the table should leave it",
                   .x_label = x_label,
                   .y_label = read + " (µm)",
-                  .height_pt = 250,
+                  // Page one holds it, the finding and the table: at 250 the finding's last
+                  // row ("Agreement with the finding") fell onto page two, alone.
+                  .height_pt = 190,
                   .zero_line = true};
   overlay.lines.push_back(
       loop_line(p.target_mm, p.found_um, "as found (" + found_name + ")", orange, false));
@@ -3098,7 +3333,8 @@ std::string verification_report(const st::RunReader& store, std::int64_t run,
       {"Agreement with the finding", fmt::format("{} µm rms (within {} µm: twice the runs' "
                                                  "repeatability, at least 0.3 µm)",
                                                  um(v.mismatch_rms_um), um(v.tolerance_um))}};
-  body += "<div class=\"pair\"><div><h3>The finding</h3>\n" +
+  // The finding and the table are not split across pages (class keep).
+  body += "<div class=\"pair keep\"><div><h3>The finding</h3>\n" +
           table({"", ""}, loop_checks(v), "kv") + table({"", ""}, numbers, "kv") +
           "</div><div><h3>The table</h3>\n" +
           table({"", ""}, loop_table_rows(c, left.machine), "kv") +
