@@ -27,7 +27,9 @@ namespace cal::storage::pg {
 // 5: machines known by a stable id (their UUID), not by name.
 // 6 (with local schema 9): roles (caldaq_engineer sends, caldaq_reviewer approves; nothing for
 // other logins) and sign-off (approvals, made by caldaq.approve).
-inline constexpr int central_schema_version = 6;
+// 7: the fleet view's tables (per run, result, value and instrument), kept by triggers on the
+// server (daq serve --db postgresql://...: docs/web.md "The fleet view").
+inline constexpr int central_schema_version = 7;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
