@@ -68,7 +68,7 @@ json machines_by_site(pqxx::transaction_base& t) {
       "SELECT m.id, COALESCE(m.uuid::text, ''), m.name, COALESCE(l.site, ''), l.started_unix_ms "
       "FROM caldaq.machines AS m LEFT JOIN LATERAL (SELECT f.site, f.started_unix_ms FROM "
       "caldaq.fleet_runs AS f WHERE f.machine_id = m.id ORDER BY f.started_unix_ms DESC LIMIT 1) "
-      "AS l ON true ORDER BY 4 COLLATE \"C\", m.name COLLATE \"C\", m.id");
+      "AS l ON true ORDER BY COALESCE(l.site, '') COLLATE \"C\", m.name COLLATE \"C\", m.id");
   json sites = json::array();
   for (const auto& r : rows) {
     const auto site = r[3].as<std::string>();
@@ -88,10 +88,8 @@ json machines_by_site(pqxx::transaction_base& t) {
 // radius) with its verdict.
 void add_verdicts(pqxx::transaction_base& t, std::map<std::int64_t, json*>& machines) {
   const auto rows = t.exec(
-      "SELECT x.machine_id, x.kind, x.test, r.id, x.result_id, x.started_unix_ms, x.verdict, "
-      "x.failed FROM (SELECT DISTINCT ON (machine_id, kind, test) * FROM caldaq.fleet_results "
-      "WHERE current ORDER BY machine_id, kind, test, started_unix_ms DESC, result_id DESC) AS x "
-      "JOIN caldaq.runs AS r ON r.uuid = x.run_uuid ORDER BY x.machine_id, x.kind, x.test");
+      "SELECT machine_id, kind, test, run_id, result_id, started_unix_ms, verdict, failed FROM "
+      "caldaq.fleet_tests ORDER BY machine_id, kind COLLATE \"C\", test COLLATE \"C\"");
   for (const auto& r : rows) {
     const auto m = machines.find(r[0].as<std::int64_t>());
     if (m == machines.end()) continue;
@@ -106,16 +104,13 @@ void add_verdicts(pqxx::transaction_base& t, std::map<std::int64_t, json*>& mach
 }
 
 // Each trend series: a least-squares line of the value on the run's start over every current
-// result of the series (regr_slope, regr_intercept: PostgreSQL's own), the latest value and limit.
+// result of the series (regr_slope, regr_intercept: PostgreSQL's own, kept per series by
+// caldaq.fleet_refresh), the latest value and limit.
 void add_trends(pqxx::transaction_base& t, std::map<std::int64_t, json*>& machines) {
   const auto rows = t.exec(
-      "SELECT machine_id, kind, test, key, min(symbol), min(unit), count(*), "
-      "regr_slope(value, started_unix_ms::float8), regr_intercept(value, started_unix_ms::float8), "
-      "min(started_unix_ms), max(started_unix_ms), "
-      "(array_agg(value ORDER BY started_unix_ms DESC, result_id DESC))[1], "
-      "(array_agg(limit_value ORDER BY started_unix_ms DESC, result_id DESC))[1] "
-      "FROM caldaq.fleet_values WHERE current AND trend GROUP BY machine_id, kind, test, key "
-      "ORDER BY machine_id, kind, test, key");
+      "SELECT machine_id, kind, test, key, symbol, unit, runs, slope_per_ms, intercept, "
+      "first_unix_ms, last_unix_ms, latest, limit_value FROM caldaq.fleet_series ORDER BY "
+      "machine_id, kind COLLATE \"C\", test COLLATE \"C\", key COLLATE \"C\"");
   for (const auto& r : rows) {
     const auto m = machines.find(r[0].as<std::int64_t>());
     if (m == machines.end()) continue;
@@ -190,19 +185,17 @@ json instruments(pqxx::transaction_base& t, std::chrono::sys_days today) {
   return out;
 }
 
-// Current results without an approval (the approvals table names a result by its fingerprint).
+// Current results without an approval (fleet_results.approved, kept by a trigger on the
+// approvals; the partial index fleet_results_awaiting holds just these).
 json awaiting_approval(pqxx::transaction_base& t) {
   const auto rows = t.exec_params(
-      "SELECT count(*) OVER (), r.id, s.source_result_id, s.standard, s.created_unix_ms, "
-      "r.started_unix_ms, r.kind, COALESCE(x.test, r.axis), COALESCE(x.verdict, 'none'), "
-      "r.machine_id, COALESCE(m.name, ''), COALESCE(f.site, '') FROM caldaq.results AS s "
-      "JOIN caldaq.runs AS r ON r.uuid = s.run_uuid "
-      "LEFT JOIN caldaq.machines AS m ON m.id = r.machine_id "
-      "LEFT JOIN caldaq.fleet_runs AS f ON f.run_uuid = s.run_uuid "
-      "LEFT JOIN caldaq.fleet_results AS x ON x.run_uuid = s.run_uuid AND x.result_id = "
-      "s.source_result_id WHERE s.superseded_by IS NULL AND NOT EXISTS (SELECT FROM "
-      "caldaq.approvals AS a WHERE a.run_uuid = s.run_uuid AND a.result_fingerprint = "
-      "s.fingerprint) ORDER BY r.started_unix_ms DESC, r.id DESC, s.source_result_id LIMIT $1",
+      "SELECT count(*) OVER (), x.run_id, x.result_id, x.standard, x.created_unix_ms, "
+      "x.started_unix_ms, x.kind, x.test, x.verdict, x.machine_id, COALESCE(m.name, ''), "
+      "COALESCE(f.site, '') FROM caldaq.fleet_results AS x "
+      "LEFT JOIN caldaq.machines AS m ON m.id = x.machine_id "
+      "LEFT JOIN caldaq.fleet_runs AS f ON f.run_uuid = x.run_uuid "
+      "WHERE x.current AND NOT x.approved "
+      "ORDER BY x.started_unix_ms DESC, x.run_id DESC, x.result_id LIMIT $1",
       fleet_awaiting_listed);
   json list = json::array();
   for (const auto& r : rows)
@@ -214,7 +207,7 @@ json awaiting_approval(pqxx::transaction_base& t) {
                     {"kind", r[6].as<std::string>()},
                     {"test", r[7].as<std::string>()},
                     {"verdict", r[8].as<std::string>()},
-                    {"machine_id", nullable<std::int64_t>(r[9])},
+                    {"machine_id", r[9].as<std::int64_t>()},
                     {"machine", r[10].as<std::string>()},
                     {"site", r[11].as<std::string>()}});
   return {{"count", rows.empty() ? 0 : rows[0][0].as<std::int64_t>()},
@@ -302,11 +295,10 @@ std::optional<std::string> fleet_machine_json(std::string_view url, std::int64_t
         if (m.empty()) return std::nullopt;
         const auto rows = t.exec_params(
             "SELECT v.kind, v.test, v.key, min(v.symbol), min(v.unit), json_agg(json_build_array("
-            "v.started_unix_ms, v.value, r.id, v.limit_value) ORDER BY v.started_unix_ms, "
-            "v.result_id)::text FROM caldaq.fleet_values AS v JOIN caldaq.runs AS r ON r.uuid = "
-            "v.run_uuid WHERE v.machine_id = $1 AND v.current AND v.trend GROUP BY 1, 2, 3 ORDER "
-            "BY "
-            "1, 2, 3",
+            "v.started_unix_ms, v.value, r.run_id, v.limit_value) ORDER BY "
+            "v.started_unix_ms, v.result_id)::text FROM caldaq.fleet_values AS v JOIN "
+            "caldaq.fleet_results AS r ON r.run_uuid = v.run_uuid AND r.result_id = v.result_id "
+            "WHERE v.machine_id = $1 AND v.current AND v.trend GROUP BY 1, 2, 3 ORDER BY 1, 2, 3",
             machine_id);
         json series = json::array();
         for (const auto& r : rows)

@@ -35,22 +35,30 @@ CREATE TABLE caldaq.fleet_runs(
   tolerances jsonb);
 CREATE INDEX fleet_runs_by_machine ON caldaq.fleet_runs(machine_id, started_unix_ms DESC);
 CREATE TABLE caldaq.fleet_results(
-  run_uuid uuid NOT NULL REFERENCES caldaq.runs(uuid) ON DELETE CASCADE,
+  run_uuid uuid NOT NULL,
   result_id bigint NOT NULL,
-  machine_id bigint,
+  run_id bigint NOT NULL,
+  machine_id bigint NOT NULL,
   started_unix_ms bigint NOT NULL,
   kind text NOT NULL,
   test text NOT NULL,
+  standard text NOT NULL,
+  created_unix_ms bigint NOT NULL,
+  fingerprint text NOT NULL,
   current boolean NOT NULL,
+  approved boolean NOT NULL,
   verdict text NOT NULL CHECK(verdict IN ('pass', 'fail', 'none')),
   failed text NOT NULL,
   PRIMARY KEY(run_uuid, result_id));
-CREATE INDEX fleet_results_latest ON caldaq.fleet_results(machine_id, kind, test, started_unix_ms DESC)
+CREATE INDEX fleet_results_of_test ON caldaq.fleet_results(machine_id, kind, test, started_unix_ms DESC)
   WHERE current;
+CREATE INDEX fleet_results_awaiting ON caldaq.fleet_results(started_unix_ms DESC)
+  WHERE current AND NOT approved;
+CREATE INDEX fleet_results_by_fingerprint ON caldaq.fleet_results(run_uuid, fingerprint);
 CREATE TABLE caldaq.fleet_values(
   run_uuid uuid NOT NULL,
   result_id bigint NOT NULL,
-  machine_id bigint,
+  machine_id bigint NOT NULL,
   started_unix_ms bigint NOT NULL,
   kind text NOT NULL,
   test text NOT NULL,
@@ -61,9 +69,38 @@ CREATE TABLE caldaq.fleet_values(
   limit_value double precision,
   trend boolean NOT NULL,
   current boolean NOT NULL,
-  PRIMARY KEY(run_uuid, result_id, key));
+  PRIMARY KEY(run_uuid, result_id, key),
+  FOREIGN KEY(run_uuid, result_id) REFERENCES caldaq.fleet_results ON DELETE CASCADE);
 CREATE INDEX fleet_values_trend ON caldaq.fleet_values(machine_id, kind, test, key, started_unix_ms)
   WHERE current AND trend;
+-- Per test of a machine, its latest current result; per trend series, its line (kept by
+-- caldaq.fleet_refresh when one of their results changes: the page reads these few rows).
+CREATE TABLE caldaq.fleet_tests(
+  machine_id bigint NOT NULL,
+  kind text NOT NULL,
+  test text NOT NULL,
+  run_uuid uuid NOT NULL,
+  result_id bigint NOT NULL,
+  run_id bigint NOT NULL,
+  started_unix_ms bigint NOT NULL,
+  verdict text NOT NULL,
+  failed text NOT NULL,
+  PRIMARY KEY(machine_id, kind, test));
+CREATE TABLE caldaq.fleet_series(
+  machine_id bigint NOT NULL,
+  kind text NOT NULL,
+  test text NOT NULL,
+  key text NOT NULL,
+  symbol text NOT NULL,
+  unit text NOT NULL,
+  runs bigint NOT NULL,
+  slope_per_ms double precision,
+  intercept double precision,
+  first_unix_ms bigint NOT NULL,
+  last_unix_ms bigint NOT NULL,
+  latest double precision NOT NULL,
+  limit_value double precision,
+  PRIMARY KEY(machine_id, kind, test, key));
 CREATE TABLE caldaq.fleet_instruments(
   instrument text PRIMARY KEY,
   id text NOT NULL,
@@ -197,59 +234,116 @@ BEGIN
   END IF;
 END $$;
 
+-- A test's latest verdict and its series' lines, from its current results (the index
+-- fleet_results_of_test, fleet_values_trend: some tens of rows).
+CREATE FUNCTION caldaq.fleet_refresh(m bigint, k text, t text) RETURNS void LANGUAGE sql AS $$
+  DELETE FROM caldaq.fleet_tests WHERE machine_id = m AND kind = k AND test = t;
+  INSERT INTO caldaq.fleet_tests
+    SELECT machine_id, kind, test, run_uuid, result_id, run_id, started_unix_ms, verdict, failed
+    FROM caldaq.fleet_results WHERE machine_id = m AND kind = k AND test = t AND current
+    ORDER BY started_unix_ms DESC, result_id DESC LIMIT 1;
+  DELETE FROM caldaq.fleet_series WHERE machine_id = m AND kind = k AND test = t;
+  INSERT INTO caldaq.fleet_series
+    SELECT m, k, t, key, min(symbol), min(unit), count(*),
+      regr_slope(value, started_unix_ms::float8), regr_intercept(value, started_unix_ms::float8),
+      min(started_unix_ms), max(started_unix_ms),
+      (array_agg(value ORDER BY started_unix_ms DESC, result_id DESC))[1],
+      (array_agg(limit_value ORDER BY started_unix_ms DESC, result_id DESC))[1]
+    FROM caldaq.fleet_values WHERE machine_id = m AND kind = k AND test = t AND current AND trend
+    GROUP BY key;
+$$;
+
 CREATE FUNCTION caldaq.fleet_result_changed() RETURNS trigger LANGUAGE plpgsql SECURITY DEFINER
   SET search_path = pg_catalog, pg_temp AS $$
 DECLARE
   r record;
-  d jsonb := caldaq.fleet_jsonb(NEW.json);
+  d jsonb;
   v_test text;
+  was_machine bigint;
+  was_kind text;
+  was_test text;
 BEGIN
-  DELETE FROM caldaq.fleet_values WHERE run_uuid = NEW.run_uuid AND result_id = NEW.source_result_id;
-  DELETE FROM caldaq.fleet_results WHERE run_uuid = NEW.run_uuid AND result_id = NEW.source_result_id;
-  SELECT u.kind, u.axis, u.machine_id, u.started_unix_ms, f.tolerances INTO r
-    FROM caldaq.runs AS u LEFT JOIN caldaq.fleet_runs AS f ON f.run_uuid = u.uuid
-    WHERE u.uuid = NEW.run_uuid;
-  IF NOT FOUND OR d IS NULL OR jsonb_typeof(d) <> 'object' THEN RETURN NULL; END IF;
-  -- A circle's test is its plane, feed and radius (as daq ballbar history groups them).
-  v_test := CASE WHEN caldaq.fleet_text(d, 'schema') LIKE 'caldaq.circle.%' THEN
-      concat_ws(' ', COALESCE(NULLIF(caldaq.fleet_text(d, 'plane'), ''), r.axis),
-                'F' || (d ->> 'feed_mm_per_min'), 'R' || (d ->> 'radius_mm'))
-    ELSE r.axis END;
-  WITH p AS (SELECT * FROM caldaq.fleet_result_values(d, r.tolerances)),
-  verdict AS (
-    INSERT INTO caldaq.fleet_results
+  -- Without a foreign key to the results (this trigger removes their rows, then refreshes).
+  IF TG_OP <> 'INSERT' THEN
+    SELECT machine_id, kind, test INTO was_machine, was_kind, was_test FROM caldaq.fleet_results
+      WHERE run_uuid = OLD.run_uuid AND result_id = OLD.source_result_id;
+    DELETE FROM caldaq.fleet_results WHERE run_uuid = OLD.run_uuid AND result_id = OLD.source_result_id;
+  END IF;
+  IF TG_OP <> 'DELETE' THEN
+    d := caldaq.fleet_jsonb(NEW.json);
+    IF jsonb_typeof(d) IS DISTINCT FROM 'object' THEN d := '{}'; END IF;
+    SELECT u.id, u.kind, u.axis, COALESCE(u.machine_id, 0) AS machine_id, u.started_unix_ms,
+        f.tolerances INTO r
+      FROM caldaq.runs AS u LEFT JOIN caldaq.fleet_runs AS f ON f.run_uuid = u.uuid
+      WHERE u.uuid = NEW.run_uuid;
+    -- A circle's test is its plane, feed and radius (as daq ballbar history groups them).
+    v_test := CASE WHEN caldaq.fleet_text(d, 'schema') LIKE 'caldaq.circle.%' THEN
+        concat_ws(' ', COALESCE(NULLIF(caldaq.fleet_text(d, 'plane'), ''), r.axis),
+                  'F' || (d ->> 'feed_mm_per_min'), 'R' || (d ->> 'radius_mm'))
+      ELSE r.axis END;
+    WITH p AS (SELECT * FROM caldaq.fleet_result_values(d, r.tolerances)),
+    verdict AS (
+      INSERT INTO caldaq.fleet_results
+        SELECT NEW.run_uuid, NEW.source_result_id, r.id, r.machine_id, r.started_unix_ms, r.kind,
+          v_test, NEW.standard, NEW.created_unix_ms, NEW.fingerprint, NEW.superseded_by IS NULL,
+          EXISTS (SELECT FROM caldaq.approvals AS a WHERE a.run_uuid = NEW.run_uuid
+                  AND a.result_fingerprint = NEW.fingerprint),
+          CASE WHEN count(p.limit_value) = 0 THEN 'none'
+               WHEN bool_and(round(abs(p.value)::numeric, 3) <= p.limit_value + 1e-12)
+                    FILTER (WHERE p.limit_value IS NOT NULL) THEN 'pass'
+               ELSE 'fail' END,
+          COALESCE(string_agg(p.symbol, ', ' ORDER BY p.key)
+                   FILTER (WHERE round(abs(p.value)::numeric, 3) > p.limit_value + 1e-12), '')
+        FROM p
+        RETURNING 1)
+    INSERT INTO caldaq.fleet_values
       SELECT NEW.run_uuid, NEW.source_result_id, r.machine_id, r.started_unix_ms, r.kind, v_test,
-        NEW.superseded_by IS NULL,
-        CASE WHEN count(p.limit_value) = 0 THEN 'none'
-             WHEN bool_and(round(abs(p.value)::numeric, 3) <= p.limit_value + 1e-12)
-                  FILTER (WHERE p.limit_value IS NOT NULL) THEN 'pass'
-             ELSE 'fail' END,
-        COALESCE(string_agg(p.symbol, ', ' ORDER BY p.key)
-                 FILTER (WHERE round(abs(p.value)::numeric, 3) > p.limit_value + 1e-12), '')
-      FROM p)
-  INSERT INTO caldaq.fleet_values
-    SELECT NEW.run_uuid, NEW.source_result_id, r.machine_id, r.started_unix_ms, r.kind, v_test,
-      p.key, p.symbol, p.unit, p.value, p.limit_value, p.trend, NEW.superseded_by IS NULL
-    FROM p;
+        p.key, p.symbol, p.unit, p.value, p.limit_value, p.trend, NEW.superseded_by IS NULL
+      FROM p, (SELECT count(*) FROM verdict) AS after_verdict;
+    PERFORM caldaq.fleet_refresh(r.machine_id, r.kind, v_test);
+    IF was_machine = r.machine_id AND was_kind = r.kind AND was_test = v_test THEN
+      RETURN NULL;  -- refreshed already
+    END IF;
+  END IF;
+  IF was_machine IS NOT NULL THEN
+    PERFORM caldaq.fleet_refresh(was_machine, was_kind, was_test);
+  END IF;
+  RETURN NULL;
+END $$;
+
+-- A result approved (caldaq.approve) or its approval removed: awaiting approval or not.
+CREATE FUNCTION caldaq.fleet_approval_changed() RETURNS trigger LANGUAGE plpgsql SECURITY DEFINER
+  SET search_path = pg_catalog, pg_temp AS $$
+BEGIN
+  IF TG_OP = 'INSERT' THEN
+    UPDATE caldaq.fleet_results SET approved = true
+      WHERE run_uuid = NEW.run_uuid AND fingerprint = NEW.result_fingerprint;
+  ELSE
+    UPDATE caldaq.fleet_results SET approved = false
+      WHERE run_uuid = OLD.run_uuid AND fingerprint = OLD.result_fingerprint;
+  END IF;
   RETURN NULL;
 END $$;
 
 CREATE TRIGGER fleet_run AFTER INSERT OR UPDATE OF settings_json, machine_id, started_unix_ms, kind
   ON caldaq.runs FOR EACH ROW EXECUTE FUNCTION caldaq.fleet_run_changed();
-CREATE TRIGGER fleet_result AFTER INSERT OR UPDATE OF json, superseded_by
-  ON caldaq.results FOR EACH ROW EXECUTE FUNCTION caldaq.fleet_result_changed();
+CREATE TRIGGER fleet_result AFTER INSERT OR DELETE OR UPDATE OF json, superseded_by, standard,
+  created_unix_ms, fingerprint ON caldaq.results FOR EACH ROW EXECUTE FUNCTION caldaq.fleet_result_changed();
+CREATE TRIGGER fleet_approval AFTER INSERT OR DELETE ON caldaq.approvals
+  FOR EACH ROW EXECUTE FUNCTION caldaq.fleet_approval_changed();
 
 -- What the server held before this version, through the same functions.
 UPDATE caldaq.runs SET settings_json = settings_json;
 UPDATE caldaq.results SET json = json;
 
-REVOKE ALL ON caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
-  caldaq.fleet_instruments FROM PUBLIC;
+REVOKE ALL ON caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values, caldaq.fleet_tests,
+  caldaq.fleet_series, caldaq.fleet_instruments FROM PUBLIC;
 REVOKE ALL ON FUNCTION caldaq.fleet_jsonb(text), caldaq.fleet_text(jsonb, text),
   caldaq.fleet_number(jsonb), caldaq.fleet_run_changed(), caldaq.fleet_result_values(jsonb, jsonb),
-  caldaq.fleet_result_changed() FROM PUBLIC;
-GRANT SELECT ON caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
-  caldaq.fleet_instruments TO caldaq_engineer, caldaq_reviewer;
+  caldaq.fleet_result_changed(), caldaq.fleet_refresh(bigint, text, text),
+  caldaq.fleet_approval_changed() FROM PUBLIC;
+GRANT SELECT ON caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values, caldaq.fleet_tests,
+  caldaq.fleet_series, caldaq.fleet_instruments TO caldaq_engineer, caldaq_reviewer;
 )sql";
 
 }  // namespace cal::storage::pg
