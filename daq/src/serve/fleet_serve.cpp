@@ -100,18 +100,7 @@ void serve_fleet(const ServeOptions& o) {
   // or one of another schema version is refused at start with the reason.
   (void)pg::fleet_json(url, now_unix_ms());
   boost::asio::io_context io;
-  web::LiveServer server(
-      io,
-      web::ServerOptions{
-          .address = o.address,
-          .port = o.port,
-          .token = o.token,
-          .allowed_hosts = o.allowed_hosts,
-          .max_connections = o.max_connections,
-          .max_connections_per_client = o.max_connections_per_client,
-          .request_timeout = std::chrono::milliseconds(std::llround(o.request_timeout_s * 1000.0)),
-          .log = [](std::string_view text) { fmt::print(stderr, "daq serve: {}\n", text); }},
-      fleet_api(url));
+  web::LiveServer server(io, server_options(o), fleet_api(url));
   fmt::print("daq serve: http://{}/ (the fleet view of {}, reader only); Ctrl-C stops\n",
              web::host_port(o.address, server.port()), pg::redacted(url));
   std::fflush(stdout);
