@@ -46,7 +46,8 @@ with Browser(width=1366, height=768) as b:
          f"the markup name shown as text: {page['names'][0]!r}")
     need(page["scripts"] == 1 and page["imgs"] == 0 and page["pwned"] is None,
          "no element made of the name, no script ran")
-    need(sorted(set(page["verdicts"])) == ["fail", "none", "pass"], f"verdict chips {page['verdicts']}")
+    need(len(page["verdicts"]) == 4 and "pass" in page["verdicts"] and "fail" in page["verdicts"],
+         f"verdict chips {page['verdicts']}")
     need("leaving" in page["statuses"] and "outside" in page["statuses"]
          and "not enough history" in page["statuses"] and "steady" in page["statuses"],
          f"trend statuses {page['statuses']}")

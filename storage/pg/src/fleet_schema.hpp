@@ -279,7 +279,8 @@ BEGIN
     -- A circle's test is its plane, feed and radius (as daq ballbar history groups them).
     v_test := CASE WHEN caldaq.fleet_text(d, 'schema') LIKE 'caldaq.circle.%' THEN
         concat_ws(' ', COALESCE(NULLIF(caldaq.fleet_text(d, 'plane'), ''), r.axis),
-                  'F' || (d ->> 'feed_mm_per_min'), 'R' || (d ->> 'radius_mm'))
+                  'F' || caldaq.fleet_number(d -> 'feed_mm_per_min')::text,
+                  'R' || caldaq.fleet_number(d -> 'radius_mm')::text)
       ELSE r.axis END;
     WITH p AS (SELECT * FROM caldaq.fleet_result_values(d, r.tolerances)),
     verdict AS (
@@ -292,7 +293,7 @@ BEGIN
                WHEN bool_and(round(abs(p.value)::numeric, 3) <= p.limit_value + 1e-12)
                     FILTER (WHERE p.limit_value IS NOT NULL) THEN 'pass'
                ELSE 'fail' END,
-          COALESCE(string_agg(p.symbol, ', ' ORDER BY p.key)
+          COALESCE(string_agg(p.symbol, ', ' ORDER BY p.symbol COLLATE "C")
                    FILTER (WHERE round(abs(p.value)::numeric, 3) > p.limit_value + 1e-12), '')
         FROM p
         RETURNING 1)
