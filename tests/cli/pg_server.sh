@@ -74,6 +74,17 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
+# pg_undo_central_8: the test's server taken back to central schema 7, the fleet view's tables
+# and triggers (migration 8) dropped.
+pg_undo_central_8() {
+  psql_value "DROP TABLE caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
+  caldaq.fleet_tests, caldaq.fleet_series, caldaq.fleet_instruments;
+DROP FUNCTION caldaq.fleet_run_changed, caldaq.fleet_result_changed, caldaq.fleet_approval_changed,
+  caldaq.fleet_refresh, caldaq.fleet_result_values, caldaq.fleet_jsonb, caldaq.fleet_text,
+  caldaq.fleet_number CASCADE;
+UPDATE caldaq.schema_version SET version = 7" >/dev/null
+}
+
 # pg_undo_central_7: the test's server taken back to central schema 6, what migration 7 (sites)
 # added dropped: a server of the version before, with its data, for the migrations' tests.
 pg_undo_central_7() {

@@ -1,9 +1,11 @@
 // daq serve: the operator's page and an HTTP/WebSocket API (docs/web.md); the service itself is
 // in serve/service.cpp.
 #include "cal/analysis/error.hpp"
+#include "cal/storage/pg/sync.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "serve/fleet_serve.hpp"
 #include "serve/service.hpp"
 
 namespace daq {
@@ -13,7 +15,9 @@ void add_serve_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "serve",
       "Serve the operator's page (set-up, instruments, runs, results, reports) and its "
-      "HTTP/WebSocket API on 127.0.0.1 (docs/web.md)");
+      "HTTP/WebSocket API on 127.0.0.1 (docs/web.md); with --db postgresql://... the fleet view "
+      "of the central store instead (machines by site, trends, due dates, approvals; reader "
+      "only)");
   auto* config =
       cmd->add_option("-c,--config", o->run.config,
                       "Machine/campaign TOML (docs/config.md): the set-up to start with");
@@ -27,7 +31,11 @@ void add_serve_command(CLI::App& app) {
                   "changes it while serving)")
       ->capture_default_str()
       ->check(finite_in(1.0, 100.0));
-  add_db_option(*cmd, o->run.db);
+  cmd->add_option(
+      "--db", o->run.db,
+      "Run database (default: $CALDAQ_DB, else ~/.local/share/caldaq/site.sqlite) the runs are "
+      "written to; a postgresql:// URI serves the fleet view of that central store instead "
+      "(nothing written; no -c or --simulate): docs/web.md, \"The fleet view\"");
   cmd->add_option("--address", o->address, "Listen address; not loopback only with --token")
       ->capture_default_str();
   cmd->add_option("--port", o->port, "TCP port (0: any free port)")->capture_default_str();
@@ -70,9 +78,12 @@ void add_serve_command(CLI::App& app) {
       ->capture_default_str()
       ->check(finite_non_negative());
   cmd->callback([o] {
+    // --db postgresql://...: the fleet view of the central store, a reader only.
+    if (cal::storage::pg::is_postgresql_url(o->run.db)) return serve::serve_fleet(*o);
     if (!o->simulate && o->run.config.empty())
       throw cal::InputError(
-          "daq serve needs a set-up: give -c FILE (a configuration) or --simulate");
+          "daq serve needs a set-up: give -c FILE (a configuration) or --simulate (or --db "
+          "postgresql://... for the fleet view of a central store)");
     serve::serve(*o);
   });
 }

@@ -334,19 +334,7 @@ class Service {
     post("/api/setup/apply", &Service::setup_apply);
     post("/api/compensation", &Service::compensation);
     if (o_.simulate) post("/api/simulation/speed", &Service::simulation_speed);
-    server_ = std::make_unique<web::LiveServer>(
-        io_,
-        web::ServerOptions{
-            .address = o_.address,
-            .port = o_.port,
-            .token = o_.token,
-            .allowed_hosts = o_.allowed_hosts,
-            .max_connections = o_.max_connections,
-            .max_connections_per_client = o_.max_connections_per_client,
-            .request_timeout =
-                std::chrono::milliseconds(std::llround(o_.request_timeout_s * 1000.0)),
-            .log = [](std::string_view text) { fmt::print(stderr, "daq serve: {}\n", text); }},
-        std::move(api));
+    server_ = std::make_unique<web::LiveServer>(io_, server_options(o_), std::move(api));
   }
 
   // --- the set-up and the idle instruments --------------------------------------------------
@@ -1225,6 +1213,17 @@ class Service {
 };
 
 }  // namespace
+
+web::ServerOptions server_options(const ServeOptions& o) {
+  return {.address = o.address,
+          .port = o.port,
+          .token = o.token,
+          .allowed_hosts = o.allowed_hosts,
+          .max_connections = o.max_connections,
+          .max_connections_per_client = o.max_connections_per_client,
+          .request_timeout = std::chrono::milliseconds(std::llround(o.request_timeout_s * 1000.0)),
+          .log = [](std::string_view text) { fmt::print(stderr, "daq serve: {}\n", text); }};
+}
 
 void serve(const ServeOptions& o) {
   boost::asio::io_context io;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "run_setup.hpp"
+#include "server.hpp"
 
 namespace daq::serve {
 
@@ -23,6 +24,9 @@ struct ServeOptions {
   bool simulate = false;  // the SIMULATED shop in this process, its configuration as set-up
   double speed = 10.0;    // of the simulated shop
 };
+
+// The HTTP server's options from the command line's (address, port, token, hosts, limits).
+cal::daq::web::ServerOptions server_options(const ServeOptions& o);
 
 // Runs until SIGINT or SIGTERM. Throws cal::InputError for options or a configuration at fault
 // (the capture directory that cannot be created or written, an address without a token).

@@ -4,6 +4,7 @@
 
 namespace caldaq_assets {
 extern const std::string_view page_html;
+extern const std::string_view fleet_html;
 extern const std::string_view strings_en;
 extern const std::string_view uplot_js;
 extern const std::string_view uplot_css;
@@ -30,6 +31,13 @@ std::string operator_page(std::string_view nonce) {
   replace(page, "/*STRINGS*/", caldaq_assets::strings_en);
   replace(page, "/*UPLOT_CSS*/", caldaq_assets::uplot_css);
   replace(page, "/*UPLOT_JS*/", caldaq_assets::uplot_js);
+  return page;
+}
+
+std::string fleet_page(std::string_view nonce) {
+  std::string page(caldaq_assets::fleet_html);
+  if (!nonce.empty())
+    replace_all(page, "<script>", "<script nonce=\"" + std::string(nonce) + "\">");
   return page;
 }
 

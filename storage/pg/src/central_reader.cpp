@@ -441,25 +441,7 @@ class CentralReader final : public RunReader {
     return std::move(rows.front());
   }
 
-  void check_schema() {
-    pqxx::nontransaction n(*conn_);
-    if (n.exec1("SELECT to_regclass('caldaq.schema_version') IS NULL")[0].as<bool>())
-      throw StoreError(fmt::format(
-          "{}: no caldaq central store in this database (daq sync --to creates it)", shown_));
-    const auto rows = n.exec("SELECT version FROM caldaq.schema_version");
-    const int version = rows.size() == 1 ? rows[0][0].as<int>() : -1;
-    // Version 1 lacks what the read commands need beside the runs (the stop quality, the
-    // compensation tables, the ballbar calibrations): a sync by this daq migrates it.
-    if (version < central_schema_version)
-      throw StoreError(fmt::format(
-          "{}: central schema version {} is older than this daq reads ({}): a daq sync --to by "
-          "this daq migrates it",
-          shown_, version, central_schema_version));
-    if (version > central_schema_version)
-      throw StoreError(fmt::format(
-          "{}: central schema version {} is newer than this daq reads ({}); use a newer daq",
-          shown_, version, central_schema_version));
-  }
+  void check_schema() { check_reader_schema(*conn_, shown_); }
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "cal/storage/pg/sync.hpp"
+#include "fleet_schema.hpp"
 
 namespace cal::storage::pg {
 namespace {
@@ -380,6 +381,8 @@ GRANT EXECUTE ON FUNCTION caldaq.machine_moved() TO caldaq_engineer;
 REVOKE UPDATE ON caldaq.machines FROM caldaq_engineer;
 GRANT UPDATE (uuid) ON caldaq.machines TO caldaq_engineer;
 )sql",
+    // 8: the fleet view's tables, kept by triggers (fleet_schema.hpp).
+    kFleetMigration,
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 
@@ -406,6 +409,26 @@ std::optional<int> present_version(pqxx::connection& conn) {
 }
 
 }  // namespace
+
+void check_reader_schema(pqxx::connection& conn, std::string_view shown_url) {
+  pqxx::nontransaction n(conn);
+  if (n.exec1("SELECT to_regclass('caldaq.schema_version') IS NULL")[0].as<bool>())
+    throw StoreError(fmt::format(
+        "{}: no caldaq central store in this database (daq sync --to creates it)", shown_url));
+  const auto rows = n.exec("SELECT version FROM caldaq.schema_version");
+  const int version = rows.size() == 1 ? rows[0][0].as<int>() : -1;
+  // An older version lacks what the readers read (version 1: the stop quality, the compensation
+  // tables, the ballbar calibrations; 6: the fleet view's tables): a sync by this daq migrates it.
+  if (version < central_schema_version)
+    throw StoreError(fmt::format(
+        "{}: central schema version {} is older than this daq reads ({}): a daq sync --to by "
+        "this daq migrates it",
+        shown_url, version, central_schema_version));
+  if (version > central_schema_version)
+    throw StoreError(fmt::format(
+        "{}: central schema version {} is newer than this daq reads ({}); use a newer daq",
+        shown_url, version, central_schema_version));
+}
 
 int migrate_schema(pqxx::connection& conn, std::string_view shown_url) {
   // Migrating takes the schema owner's rights; sending to a migrated server does not.

@@ -15,6 +15,10 @@ namespace cal::storage::pg {
 // advisory lock (two syncs starting at once migrate it once); returns the version.
 int migrate_schema(pqxx::connection& conn, std::string_view shown_url);
 
+// What a reader (that never creates or migrates anything) checks first: a caldaq central store of
+// exactly this daq's version is there. Throws StoreError naming the server and what is wrong.
+void check_reader_schema(pqxx::connection& conn, std::string_view shown_url);
+
 // A result's identity on the server (schema 3): md5 of its standard, creation time, document and
 // provenance, computed by the server as the migration computed it for the rows it had.
 std::string result_fingerprint(pqxx::transaction_base& t, const ResultRecord& r);
@@ -62,8 +66,8 @@ auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
   } catch (const StoreError&) {
     throw;
   } catch (const pqxx::sql_error& e) {
-    throw StoreError(fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what, one_line(e.what()),
-                                 e.sqlstate()));
+    throw StoreError(
+        fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what, one_line(e.what()), e.sqlstate()));
   } catch (const std::exception& e) {
     // broken_connection and the like.
     throw StoreError(fmt::format("{}: {}: {}", shown_url, what, one_line(e.what())));

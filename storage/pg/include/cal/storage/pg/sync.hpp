@@ -30,7 +30,9 @@ namespace cal::storage::pg {
 // 7 (with local schema 10): sites. A login reads and writes only the machines, runs (with every
 // row of a run) and compensation tables of the sites caldaq.site_grants grants it ('*': all);
 // row-level security, and caldaq.approve checks the reviewer's sites.
-inline constexpr int central_schema_version = 7;
+// 8: the fleet view's tables (per run, result, value and instrument), kept by triggers on the
+// server (daq serve --db postgresql://...: docs/web.md "The fleet view").
+inline constexpr int central_schema_version = 8;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.

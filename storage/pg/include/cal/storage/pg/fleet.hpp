@@ -1,0 +1,56 @@
+#pragma once
+// The fleet view (issue 35; docs/web.md "The fleet view"): what `daq serve --db postgresql://...`
+// shows of a central store, read in a few queries of the tables central schema 7 keeps by
+// triggers (storage/pg/src/fleet_schema.hpp), never a reading, never a write (every query runs in
+// a READ ONLY transaction). libpqxx stays in storage/pg/src.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace cal::storage::pg {
+
+// Fewer current results than this in a series: "not enough history", no projection.
+inline constexpr int fleet_min_runs_for_trend = 3;
+// An instrument whose calibration falls due within this many days is flagged "due soon".
+inline constexpr int fleet_due_soon_days = 30;
+// The runs awaiting approval listed (the newest first; the count says how many there are).
+inline constexpr int fleet_awaiting_listed = 200;
+
+// A series' least-squares line (value = intercept + slope * t, t in unix ms) over its history,
+// the latest value and the latest run's limit (nullopt: no limit configured).
+struct TrendFit {
+  std::int64_t runs = 0;
+  std::optional<double> slope_per_ms, intercept;
+  std::int64_t last_unix_ms = 0;
+  double latest = 0;
+  std::optional<double> limit;
+  bool signed_value = false;  // a diagnostic (either sign leaves); else a magnitude (E, M, G)
+};
+
+enum class TrendStatus {
+  no_tolerance,        // no limit configured for it
+  outside,             // the latest value is outside its limit already
+  not_enough_history,  // fewer than fleet_min_runs_for_trend runs
+  steady,              // the line does not move toward the limit (or is flat)
+  leaving,             // the line reaches the limit at projected_unix_ms
+};
+struct Projection {
+  TrendStatus status = TrendStatus::no_tolerance;
+  std::optional<double> projected_unix_ms;  // leaving: when the line reaches the limit
+};
+// Where the line reaches +limit (rising) or, for a signed value, -limit (falling); a magnitude
+// that falls, or a flat line, is steady. The latest value is judged as a verdict judges it (to
+// 0.001 of its unit).
+Projection project(const TrendFit& fit);
+std::string_view to_string(TrendStatus s);
+
+// The fleet at `now_unix_ms` (the due dates are judged against its UTC day) as a JSON document
+// (caldaq.fleet.v1: docs/web.md). Throws StoreError naming the server (password hidden) and what
+// failed; a store of another schema version is refused as the read commands refuse it.
+std::string fleet_json(std::string_view url, std::int64_t now_unix_ms);
+// One machine's trend series with every point (caldaq.fleet-machine.v1), or nullopt when the
+// server has no machine of that id.
+std::optional<std::string> fleet_machine_json(std::string_view url, std::int64_t machine_id);
+
+}  // namespace cal::storage::pg

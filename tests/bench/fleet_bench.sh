@@ -1,0 +1,146 @@
+#!/usr/bin/env bash
+# The fleet view at scale (issue 35; docs/benchmarks.md "The fleet view at 1,000 machines"): a
+# synthetic central store of MACHINES machines x MONTHS monthly runs (results only: no reading
+# chunks, which the fleet view never reads), made on a throwaway PostgreSQL server by
+# generate_series on the server (through the schema's own triggers, as a sync fills them); then
+# the fleet's JSON endpoint timed with curl (and one machine's history), beside the peer measured
+# in the same run: one scan of the fleet's values table (the trend aggregation reads each value
+# once); and the page's render in headless Chromium (navigation to rendered, at 1366x768).
+# Usage: fleet_bench.sh DAQ_BINARY [MACHINES=1000] [MONTHS=120] [SCREENSHOT_DIR]
+set -eu
+DAQ=$1
+MACHINES=${2:-1000}
+MONTHS=${3:-120}
+SHOTS=${4:-}
+HERE=$(cd "$(dirname "$0")" && pwd)
+source "$HERE/../cli/check.sh"
+source "$HERE/../cli/pg_server.sh"
+TMP=$(mktemp -d)
+PGTMP=$(mktemp -d /tmp/caldaq-pg.XXXXXX)
+SERVE_PID=
+trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
+pg_start "$PGTMP" >/dev/null
+# The schema, made by a sync as on a real server: the demo's store sent.
+(cd "$TMP" && "$DAQ" demo --quiet --db demo.sqlite --capture demo.cdq >demo.log 2>&1)
+"$DAQ" sync --db "$TMP/demo.sqlite" --to "$PG_URL" --quiet >/dev/null
+sql() { "$PG_BIN/psql" -X -q -At -v ON_ERROR_STOP=1 "$PG_URL" "$@"; }
+secs() { date +%s.%N; }
+
+t=$(secs)
+sql -v machines="$MACHINES" -v months="$MONTHS" <<'EOF'
+-- 20 sites; a month between runs; each machine's axes X, Y, Z and a circle in XY in turn; E drifts
+-- by 0 to 1.8 um a year by machine (some leave their 10 um limit within the 10 years), G by 0 to
+-- 2 um a year, squareness about a machine's own offset; noise 0.5 um.
+INSERT INTO caldaq.machines(name, uuid)
+  SELECT format('Machine %s', lpad(i::text, 4, '0')), gen_random_uuid()
+  FROM generate_series(1, :machines) AS i;
+INSERT INTO caldaq.runs(uuid, machine_id, source_run_id, campaign, kind, axis, settings_json,
+    capture_path, software_version, started_unix_ms, ended_unix_ms, status, note, synced_unix_ms)
+  SELECT gen_random_uuid(), m.id, mo + 1, 'bench', CASE WHEN mo % 4 = 3 THEN 'circle' ELSE 'linear' END,
+    (ARRAY['X', 'Y', 'Z', 'XY'])[mo % 4 + 1],
+    json_build_object('context', json_build_object(
+      'customer', json_build_object('name', 'Bench', 'site', format('Site %s', lpad((m.id % 20)::text, 2, '0'))),
+      'machine', json_build_object('name', m.name, 'make', 'Bench', 'model', 'B-1', 'serial_number', m.id::text),
+      'operator', 'bench',
+      'tolerances', CASE WHEN mo % 4 = 3 THEN '{"G_um": 15, "diagnostics": {"squareness": 20}}'::json
+                         ELSE '{"E_um": 10, "M_um": 8, "R_um": 4, "B_um": 3}'::json END,
+      'instruments', json_build_array(
+        json_build_object('id', 'laser', 'role', 'laser', 'driver', 'ids3010', 'serial_number',
+          format('L-%s', m.id % 200), 'certificate', 'C-L', 'calibration_due',
+          to_char(date '2026-06-01' + (m.id * 37 % 500)::int, 'YYYY-MM-DD')),
+        json_build_object('id', 'air', 'role', 'weather station', 'driver', 'ptu300',
+          'serial_number', format('P-%s', m.id), 'certificate', 'C-P', 'calibration_due',
+          to_char(date '2026-09-01' + (m.id * 11 % 400)::int, 'YYYY-MM-DD')))))::text,
+    '', 'bench', s.ms, s.ms + 3600000, 'complete', '', 0
+  FROM caldaq.machines AS m, generate_series(0, :months - 1) AS mo,
+    LATERAL (SELECT (extract(epoch FROM now() - make_interval(months => :months)) * 1000)::bigint
+                    + mo::bigint * 2629800000 + (m.id % 28) * 86400000 AS ms) AS s
+  WHERE m.name LIKE 'Machine %';
+INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, created_unix_ms,
+    provenance_json, fingerprint)
+  SELECT r.uuid, 1, CASE r.kind WHEN 'circle' THEN 'ISO 230-4:2005' ELSE 'ISO 230-2:2014' END, d.doc,
+    r.started_unix_ms + 3600000, '{"how": "acquired", "software": "bench"}', md5(d.doc)
+  FROM caldaq.runs AS r JOIN caldaq.machines AS m ON m.id = r.machine_id,
+    LATERAL (SELECT (r.source_run_id - 1) / 12.0 AS years) AS y,
+    LATERAL (SELECT 3 + (m.id % 7) * 0.3 * y.years + random() * 0.5 AS e,
+                    5 + (m.id % 5) * 0.4 * y.years + random() * 0.5 AS g,
+                    (m.id % 9 - 4) * 2 + random() - 0.5 AS sq) AS v,
+    LATERAL (SELECT CASE WHEN r.kind = 'circle' THEN json_build_object(
+        'schema', 'caldaq.circle.v2', 'standard', 'ISO 230-4:2005', 'standard_key', 'iso230-4:2005',
+        'radius_mm', 100, 'feed_mm_per_min', 1000, 'plane', 'XY',
+        'iso230_4', json_build_object('G_bi_um', v.g, 'G_ccw_um', v.g * 0.9, 'G_cw_um', v.g,
+                                      'F_max_um', v.g / 2, 'F_min_um', -v.g / 2, 'arc_deg', 360),
+        'diagnostics', json_build_array(
+          json_build_object('key', 'squareness', 'name', 'Squareness', 'value', v.sq, 'unit', 'um/m'),
+          json_build_object('key', 'servo_mismatch', 'name', 'Servo mismatch', 'value', 0.2, 'unit', 'ms'),
+          json_build_object('key', 'scale_mismatch', 'name', 'Scale mismatch', 'value', 3, 'unit', 'um/m')),
+        'notes', json_build_array())
+      ELSE json_build_object(
+        'schema', 'caldaq.iso230-2.v1', 'standard', json_build_object('key', 'iso230-2:2014', 'title', 'ISO 230-2:2014'),
+        'bidirectional', true, 'runs_per_direction', 5,
+        'targets', (SELECT json_agg(json_build_object('target_mm', k * 50, 'runs_up', 5,
+            'mean_up_um', v.e * k / 10, 's_up_um', 0.3, 'mean_bi_um', v.e * k / 10, 'runs_down', 5,
+            'mean_down_um', v.e * k / 10 - 0.4, 's_down_um', 0.3, 'reversal_um', 0.4))
+          FROM generate_series(0, 10) AS k),
+        'axis', json_build_object(
+          'E_bi', json_build_object('symbol', 'E', 'value_um', v.e),
+          'M', json_build_object('symbol', 'M', 'value_um', v.e * 0.6),
+          'R_bi', json_build_object('symbol', 'R', 'value_um', 1.4),
+          'B', json_build_object('symbol', 'B', 'value_um', 0.4),
+          'A_bi', json_build_object('symbol', 'A', 'value_um', v.e + 1.4)),
+        'warnings', json_build_array(), 'notes', json_build_array()) END::text AS doc) AS d
+  WHERE r.campaign = 'bench';
+-- A reviewer approved every result older than 90 days.
+INSERT INTO caldaq.approvals
+  SELECT s.run_uuid, s.fingerprint, 1, 'reviewer', s.created_unix_ms + 86400000
+  FROM caldaq.results AS s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid
+  WHERE r.campaign = 'bench' AND r.started_unix_ms < (extract(epoch FROM now() - interval '90 days') * 1000)::bigint;
+-- Loaded in one go, every run rewrote its instruments' rows (240,000 row versions of 1,200 rows):
+-- syncs spread over time leave autovacuum room to reuse that space; here it is compacted once.
+VACUUM FULL caldaq.fleet_instruments;
+ANALYZE;
+EOF
+made=$(echo "$(secs) - $t" | bc)
+read -r runs results values approvals doc_bytes db_mb <<<"$(sql -F ' ' -c "SELECT (SELECT count(*) FROM caldaq.runs), (SELECT count(*) FROM caldaq.results), (SELECT count(*) FROM caldaq.fleet_values), (SELECT count(*) FROM caldaq.approvals), (SELECT avg(length(json))::int FROM caldaq.results), pg_database_size(current_database()) / 1000000")"
+echo "store: $MACHINES machines x $MONTHS months: $runs runs, $results results (about $doc_bytes bytes of JSON each), $values fleet values, $approvals approvals; made in ${made} s; database $db_mb MB"
+
+# The peer: one scan of every value the trends aggregate.
+for i in 1 2 3; do
+  t=$(secs); sql -c "SELECT count(*), sum(value) FROM caldaq.fleet_values WHERE current AND trend" >/dev/null
+  echo "peer: one scan of the trend values (psql, connect included): $(echo "($(secs) - $t) * 1000" | bc | cut -d. -f1) ms"
+done
+
+"$DAQ" serve --db "$PG_URL" --port 0 >"$TMP/serve.log" 2>&1 &
+SERVE_PID=$!
+for _ in $(seq 300); do grep -q "http://" "$TMP/serve.log" && break; sleep 0.1; done
+URL=$(sed -n 's|.*\(http://127.0.0.1:[0-9]*\)/.*|\1|p' "$TMP/serve.log")
+[ -n "$URL" ] || { cat "$TMP/serve.log"; exit 1; }
+for i in 1 2 3 4 5; do
+  curl -sf -o "$TMP/fleet.json" -w "GET /api/fleet: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet"
+done
+curl -sf -o /dev/null -w "GET /api/fleet/machines/500: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500"
+"$PY" - "$TMP/fleet.json" <<'EOF'
+import collections, json, sys
+d = json.load(open(sys.argv[1]))
+machines = [m for s in d["sites"] for m in s["machines"]]
+st = collections.Counter(t["status"] for m in machines for t in m["trends"])
+inst = collections.Counter(i["status"] for i in d["instruments"])
+print(f"answer: {len(d['sites'])} sites, {len(machines)} machines, trends {dict(st)}, "
+      f"instruments {dict(inst)}, awaiting approval {d['awaiting_approval']['count']}")
+EOF
+HERE=$HERE "$PY" - "$URL" "${SHOTS:-$TMP}" <<'EOF'
+import os, sys
+sys.path.insert(0, os.path.join(os.environ["HERE"], "..", "web"))
+from webdriver import Browser
+url, shots = sys.argv[1], sys.argv[2]
+with Browser(width=1366, height=768) as b:
+    for i in range(3):
+        b.get(url + "/")
+        b.wait("return document.body.dataset.rendered !== undefined", timeout_s=60, what="the fleet")
+        ms = b.js("return Number(document.body.dataset.rendered);")
+        n = b.js("return document.querySelectorAll('details.machine').length;")
+        print(f"page: navigation to rendered {ms:.0f} ms ({n} machines)")
+    b.screenshot(os.path.join(shots, "fleet-bench.png"))
+EOF
+kill $SERVE_PID
+SERVE_PID=
