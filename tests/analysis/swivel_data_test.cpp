@@ -135,7 +135,7 @@ TEST(SwivelData, AcRecordByHand) {
                            "\nM30\n",
                            "; SIMULATED\n"})
     EXPECT_NE(p.find(line), std::string::npos) << line << "\n" << p;
-  EXPECT_EQ(p.find("$TC_CARR13"), std::string::npos) << p;  // the angles come from the axes
+  EXPECT_EQ(p.find("\n$TC_CARR13["), std::string::npos) << p;  // angles: from the axes
   // Record number and reversed angles: V negated, the I vectors unchanged.
   const SwivelRecord rev =
       sinumerik_swivel_record(trunnion(), {.number = 3, .reverse_angles = true});
