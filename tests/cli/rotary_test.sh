@@ -75,6 +75,27 @@ check kins_not_represented 0 "not represented by xyzac-trt-kins \(left uncorrect
 check probe_again 0 "" -- probe 2 "$TMP/centres2.csv"
 check after 0 "largest deviation [0-5]\.[0-9]+ um" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --hal "$TMP/trt.hal"
 check after_json 0 '"schema": "caldaq.probe-check.v1"' -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --hal "$TMP/trt.hal" --json
+# The same correction as a SINUMERIK CYCLE800 swivel data record (kinematics type P): the A
+# cradle is the 1st axis, its line's point I2 at z = -300 mm + E_Z0A (about -22 um); I3 from it to
+# the C line's point at the C pivot's plane, -50 mm in z less E_Z0A; the tilts in V1, V2. Applied
+# to the simulated control with its tilts, the residual is the fit's (docs/kinematics.md).
+check swivel 0 "written $TMP/swivel.mpf" -- "$DAQ" model kinematics "$TMP/fitted.json" -f sinumerik-cycle800 -o "$TMP/swivel.mpf"
+check_file "$TMP/swivel.mpf" <<'END'
+swivel_type ^\$TC_CARR23\[1\]="P"$
+swivel_axis1 ^\$TC_CARR21\[1\]=A$
+swivel_axis2 ^\$TC_CARR22\[1\]=C$
+swivel_i2z ^\$TC_CARR6\[1\]=-300\.02[0-9]{4}$
+swivel_i3z ^\$TC_CARR17\[1\]=-49\.97[0-9]{4}$
+swivel_v2z ^\$TC_CARR12\[1\]=1\.000000000$
+swivel_fine ^\$TC_CARR44\[1\]=0$
+swivel_end ^M30$
+END
+check after_swivel 0 "largest deviation [0-3]\.[0-9]+ um" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf"
+check swivel_and_hal 2 "--hal and --swivel" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --hal "$TMP/trt.hal"
+printf '$TC_CARR4[1]=1\n$TC_CARR4[1]=2\n' >"$TMP/bad.mpf"
+check bad_swivel 2 "bad.mpf:2: \\\$TC_CARR4 given twice" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/bad.mpf"
+check heidenhain_refused 2 "HEIDENHAIN kinematics are not written: .* which rows cycle 451" -- "$DAQ" model kinematics "$TMP/fitted.json" -f heidenhain
+check swivel_record_option 2 "--record and --reverse-angles are for -f sinumerik-cycle800" -- "$DAQ" model kinematics "$TMP/fitted.json" --record 2
 
 # Bad input says what and where.
 printf 'axis,angle_deg,x_mm,y_mm,z_mm\nC,0,1,2,3\nD,90,1,2,3\n' >"$TMP/bad_axis.csv"
@@ -166,6 +187,11 @@ check rot_report_no_um 1 "" -- grep -E "[0-9] (mm|µm)(/min)?</td>|\((µm|mm)\)"
 # refractive index's equation, CO2 and the expansion coefficient (an encoder reads no light).
 check rot_report_reference 0 "Angular reference</td><td>encoder</td>" -- cat "$TMP/rot.html"
 check rot_report_no_laser_settings 1 "" -- grep -E "Laser vacuum wavelength|Refractive index equation|CO2 content|Expansion coefficient" "$TMP/rot.html"
+# The run lists the instruments it read: the angular reference, air and material, not the
+# configuration's laser (SIM-IDS-0001), which a rotary run never opens (its context listed every
+# device but the ballbar; the report's instruments table and traceability warnings named it).
+check rot_report_instruments 0 "<td>SIM-PTU-0001</td>" -- cat "$TMP/rot.html"
+check rot_report_no_laser 1 "" -- grep -E "SIM-IDS-0001|<td>laser" "$TMP/rot.html"
 # An option the rotary test would not use is refused, not ignored (--measure ran the linear
 # test of that component instead).
 check rot_measure_refused 2 "--measure E_XX with --test rotary: .* linear test" -- "$DAQ" sim --measure E_XX --test rotary --acquire -o "$TMP/m.toml" --db "$TMP/m.sqlite"

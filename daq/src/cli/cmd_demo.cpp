@@ -237,7 +237,7 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop, cal::daq::
   print_result(doc, "  ");
   std::map<std::string, double> found;
   for (const auto& dg : r.diagnostics) found[dg.key] = dg.value;
-  print_verdict(circle_verdict(run_context(config, "circle", "XY")["tolerances"], doc));
+  print_verdict(circle_verdict(run_tolerances(config, "circle", "XY"), doc));
   fmt::print("\nSimulated truth vs measured (ballbar):\n");
   const double lag_ms = (1.0 / t.kv_y_per_s - 1.0 / t.kv_x_per_s) * 1e3;
   const auto row = [&](const char* name, double truth, const char* key, const char* unit) {
@@ -367,8 +367,7 @@ int run_demo(const DemoOptions& o) {
                  m.direction == '+' ? "up" : "down", m.target_index + 1, m.nominal_mm);
   }
   print(*out.evaluation);
-  print_verdict(
-      linear_verdict(run_context(config, "linear", "X")["tolerances"], to_json(*out.evaluation)));
+  print_verdict(linear_verdict(run_tolerances(config, "linear", "X"), to_json(*out.evaluation)));
   const auto truth =
       cal::iso230_2::evaluate(shop.true_measurements(run.plan()), out.evaluation->standard.id);
   print_comparison(*out.evaluation, truth, shop.truth());

@@ -16,6 +16,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/rotary.hpp"
+#include "cal/analysis/swivel_data.hpp"
 #include "cal/analysis/text.hpp"
 #include "cal/analysis/trt_kins.hpp"
 #include "cli_checks.hpp"
@@ -225,7 +226,7 @@ void run_probe(const ProbeOptions& o) {
 // --- probe-check: the centres against the control's kinematics --------------------------------
 
 struct CheckOptions {
-  std::string centres, model, hal, axis;
+  std::string centres, model, hal, swivel, axis;
   bool json = false;
 };
 
@@ -243,13 +244,20 @@ std::string read_text(const std::string& path, std::string_view what) {
 void run_probe_check(const CheckOptions& o) {
   const mdl::Model m = mdl::read(o.model);
   kin::FiveAxisMachine control = mdl::five_axis(m);
-  if (!o.hal.empty()) {
-    try {
+  if (!o.hal.empty() && !o.swivel.empty())
+    throw cal::InputError("--hal and --swivel: give one control's kinematics");
+  // The correction as the control holds it: the kinematics file applied to the nominal model.
+  const std::string& correction = o.hal.empty() ? o.swivel : o.hal;
+  try {
+    if (!o.hal.empty())
       control = kin::trt_control_machine(
           kin::parse_linuxcnc_trt_hal(read_text(o.hal, "HAL file"), o.hal), control);
-    } catch (const cal::InputError& e) {
-      throw cal::InputError(fmt::format("{} with {}: {}", o.hal, o.model, e.what()));
-    }
+    if (!o.swivel.empty())
+      control = kin::swivel_control_machine(
+          kin::parse_sinumerik_swivel_program(read_text(o.swivel, "swivel data"), o.swivel),
+          control);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("{} with {}: {}", correction, o.model, e.what()));
   }
   const ProbeOptions as_probe{o.centres, "", "", o.axis, {}, 0.0, false};
   json axes = json::array();
@@ -283,8 +291,8 @@ void run_probe_check(const CheckOptions& o) {
     if (!o.json)
       fmt::print("Axis {}: {} centres against {}{}\n  {:>6} {:>10} {:>9} {:>9} {:>9} {:>9}\n",
                  kin::to_string(letter), a.centres.size(), o.model,
-                 o.hal.empty() ? "" : " with " + o.hal, "line", "angle_deg", "dx_um", "dy_um",
-                 "dz_um", "|d|_um");
+                 correction.empty() ? "" : " with " + correction, "line", "angle_deg", "dx_um",
+                 "dy_um", "dz_um", "|d|_um");
     for (std::size_t k = 0; k < a.centres.size(); ++k) {
       const auto want = kin::probed_centre_mm(control, sphere, angles_at(a.centres[k].angle_deg));
       kin::Vec3 d;
@@ -314,6 +322,7 @@ void run_probe_check(const CheckOptions& o) {
                             {"centres_file", o.centres},
                             {"model", o.model},
                             {"hal", o.hal},
+                            {"swivel", o.swivel},
                             {"axes", axes}}
                            .dump(2));
 }
@@ -392,8 +401,8 @@ void add_model_probe_commands(CLI::App& model) {
   const auto [check, c] = add_command<CheckOptions>(
       model, "probe-check", run_probe_check,
       "Compare probed sphere centres with where the control's kinematics expects them (the "
-      "model's, or LinuxCNC trunnion pins from --hal): the residual before and after a "
-      "correction");
+      "model's, LinuxCNC trunnion pins from --hal or a SINUMERIK swivel data record from "
+      "--swivel): the residual before and after a correction");
   check->add_option("centres", c->centres, "CSV of probed centres, as for daq model probe")
       ->required();
   check->add_option("--model", c->model, "Model file: the machine as the control believes it")
@@ -401,6 +410,10 @@ void add_model_probe_commands(CLI::App& model) {
   check->add_option("--hal", c->hal,
                     "HAL file of xyzac-trt-kins / xyzbc-trt-kins pivot pins (setp lines, as daq "
                     "model kinematics writes them): the control's rotary axes on those lines");
+  check->add_option("--swivel", c->swivel,
+                    "SINUMERIK CYCLE800 swivel data record ($TC_CARR assignments, as daq model "
+                    "kinematics -f sinumerik-cycle800 writes them): the control's table axes on "
+                    "its lines");
   check->add_option("--axis", c->axis, "The rotary axis of every centre (no axis column)")
       ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
   check->add_flag("--json", c->json, "Print caldaq.probe-check.v1 JSON");

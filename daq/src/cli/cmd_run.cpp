@@ -174,7 +174,7 @@ std::string live_line(const LiveState& s) {
 
 Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
                        const nlohmann::json& result) {
-  return circle_verdict(run_context(c, "circle", plane)["tolerances"], result);
+  return circle_verdict(run_tolerances(c, "circle", plane), result);
 }
 
 // The result of a straightness, angular, roll or rotary run (kinds/kind.hpp).

@@ -15,7 +15,34 @@ namespace daq {
 
 using nlohmann::json;
 
-json run_context(const cal::daq::Config& c, std::string_view kind, std::string_view where) {
+json run_tolerances(const cal::daq::Config& c, std::string_view kind, std::string_view where) {
+  const std::string key(where);
+  if (kind == "linear") {
+    if (const auto it = c.axis_tolerances.find(key); it != c.axis_tolerances.end()) {
+      json t = limits_json(it->second.limits);
+      t["by_length"] = json::array();
+      for (const auto& [up_to, l] : it->second.by_length) {
+        json e = limits_json(l);
+        e["up_to_mm"] = up_to;
+        t["by_length"].push_back(e);
+      }
+      t["source"] = "tolerances." + key;
+      return t;
+    }
+  } else if (kind == "circle") {
+    if (const auto it = c.plane_tolerances.find(key); it != c.plane_tolerances.end()) {
+      json t = json::object();
+      if (it->second.G_um) t["G_um"] = *it->second.G_um;
+      t["diagnostics"] = it->second.diagnostics;
+      t["source"] = "tolerances." + key;
+      return t;
+    }
+  }
+  return nullptr;
+}
+
+json run_context(const cal::daq::Config& c, std::string_view kind, std::string_view where,
+                 std::span<const std::string> roles) {
   json j{{"customer",
           {{"name", c.customer.name}, {"site", c.customer.site}, {"contact", c.customer.contact}}},
          {"machine",
@@ -36,9 +63,7 @@ json run_context(const cal::daq::Config& c, std::string_view kind, std::string_v
          {"configuration", c.source.empty() ? "" : c.source.string()}};
   j["instruments"] = json::array();
   for (const auto& d : c.devices) {
-    // A linear run uses laser, air, material and position; a circle the ballbar.
-    const bool used = kind == "circle" ? d.role == "ballbar" : d.role != "ballbar";
-    if (!used || d.role.empty()) continue;
+    if (d.role.empty() || std::find(roles.begin(), roles.end(), d.role) == roles.end()) continue;
     j["instruments"].push_back({{"id", d.id},
                                 {"role", d.role},
                                 {"driver", d.driver},
@@ -47,29 +72,7 @@ json run_context(const cal::daq::Config& c, std::string_view kind, std::string_v
                                 {"certificate", d.certificate},
                                 {"calibration_due", d.calibration_due}});
   }
-  j["tolerances"] = nullptr;
-  const std::string key(where);
-  if (kind == "linear") {
-    if (const auto it = c.axis_tolerances.find(key); it != c.axis_tolerances.end()) {
-      json t = limits_json(it->second.limits);
-      t["by_length"] = json::array();
-      for (const auto& [up_to, l] : it->second.by_length) {
-        json e = limits_json(l);
-        e["up_to_mm"] = up_to;
-        t["by_length"].push_back(e);
-      }
-      t["source"] = "tolerances." + key;
-      j["tolerances"] = t;
-    }
-  } else if (kind == "circle") {
-    if (const auto it = c.plane_tolerances.find(key); it != c.plane_tolerances.end()) {
-      json t = json::object();
-      if (it->second.G_um) t["G_um"] = *it->second.G_um;
-      t["diagnostics"] = it->second.diagnostics;
-      t["source"] = "tolerances." + key;
-      j["tolerances"] = t;
-    }
-  }
+  j["tolerances"] = run_tolerances(c, kind, where);
   return j;
 }
 

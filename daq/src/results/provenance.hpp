@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,9 +19,17 @@
 namespace daq {
 
 // The context of a run of `kind` ("linear" on an axis, "circle" in a plane) from its
-// configuration; `tolerances` holds only the axis' or plane's entry (null: none configured).
+// configuration; `tolerances` holds only the axis' or plane's entry (null: none configured);
+// `instruments` the configured devices whose role is in `roles`: the ones the run opens (a
+// linear run's kinds::linear_run_roles, a circle's ballbar), so that a run never lists an
+// instrument it did not read.
 nlohmann::json run_context(const cal::daq::Config& c, std::string_view kind,
-                           std::string_view axis_or_plane);
+                           std::string_view axis_or_plane, std::span<const std::string> roles);
+
+// The tolerances that apply to a run of `kind` on that axis or plane (run_context's
+// "tolerances"; null: none configured).
+nlohmann::json run_tolerances(const cal::daq::Config& c, std::string_view kind,
+                              std::string_view axis_or_plane);
 
 // The coefficients of an environmental compensation, as the provenance records them.
 nlohmann::json compensation_json(const cal::daq::EnvironmentConfig& e);

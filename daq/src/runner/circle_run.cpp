@@ -322,8 +322,10 @@ struct CircleRun::Impl : Runner {
     settings["context"] = setup.context_json.empty()
                               ? json(nullptr)
                               : json::parse(setup.context_json, nullptr, false);
-    if (!settings["context"].is_object())
-      settings["context"] = run_context(c, "circle", setup.analysis.plane);
+    if (!settings["context"].is_object()) {
+      const std::string opened[] = {"ballbar"};  // the one instrument a circle reads
+      settings["context"] = run_context(c, "circle", setup.analysis.plane, opened);
+    }
     // Where the table ball was: a circle's squareness is local to it (the three-plane table).
     if (c.circle && c.circle->centre_mm.size() == 3) settings["centre_mm"] = c.circle->centre_mm;
     outcome.run_id = store->begin_run({.machine_id = machine_id(c),

@@ -123,8 +123,9 @@ json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, d
                    const std::string& context_json) {
   const auto& l = *c.linear;
   json context = context_json.empty() ? json(nullptr) : json::parse(context_json, nullptr, false);
-  if (!context.is_object()) context = run_context(c, "linear", l.axis);
   const auto& kind = kinds::kind(l.measure.kind);
+  if (!context.is_object())
+    context = run_context(c, "linear", l.axis, kinds::linear_run_roles(kind));
   json measure = measure_json(l.measure);
   measure["component"] = kind.component(l);
   measure["unit"] = kind.unit();

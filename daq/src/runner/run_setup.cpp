@@ -203,16 +203,12 @@ std::vector<InstrumentSpec> linear_specs(const cal::daq::Config& config) {
     throw cal::InputError(fmt::format("{}: {}", config.source.string(), e.what()));
   }
   const std::string probe(kind.probe_role());
-  // A kind whose stops come from its own instrument (rotary) opens no laser nor position feed:
-  // they would measure the linear axes, which do not move.
-  const bool linear_axes = !kind.stops_from_probe();
-  for (const auto& dc : config.devices) {
-    if ((!linear_axes || (dc.role != "laser" && dc.role != "position")) && dc.role != "air" &&
-        dc.role != "material" && (probe.empty() || dc.role != probe))
-      continue;
-    specs.push_back(spec_of(dc, n++, axis));
-  }
-  if (linear_axes) need(config, "laser");
+  // The roles it opens (a rotary run: no laser nor position feed), as its context lists them.
+  const auto roles = kinds::linear_run_roles(kind);
+  for (const auto& dc : config.devices)
+    if (std::find(roles.begin(), roles.end(), dc.role) != roles.end())
+      specs.push_back(spec_of(dc, n++, axis));
+  if (!kind.stops_from_probe()) need(config, "laser");
   need(config, "air");
   if (!probe.empty()) need(config, probe.c_str());
   // An angular run reads two more laser axes: the laser must read them.

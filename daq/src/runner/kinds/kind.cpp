@@ -43,6 +43,14 @@ std::span<const TestKind* const> all_kinds() {
   return k;
 }
 
+std::vector<std::string> linear_run_roles(const TestKind& k) {
+  std::vector<std::string> roles;
+  if (!k.stops_from_probe()) roles = {"laser", "position"};
+  roles.insert(roles.end(), {"air", "material"});
+  if (!k.probe_role().empty()) roles.emplace_back(k.probe_role());
+  return roles;
+}
+
 const TestKind& kind(std::string_view name) {
   for (const auto* k : all_kinds())
     if (k->name() == name) return *k;

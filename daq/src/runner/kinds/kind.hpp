@@ -109,6 +109,11 @@ class ProbeKind : public TestKind {
   std::unique_ptr<SampleReader> reader(const cal::daq::LinearTestConfig& l) const override;
 };
 
+// The roles of the devices a linear run of kind `k` opens, and so lists as its instruments:
+// the laser and the position feed (not for a kind whose stops come from its own instrument:
+// they would measure linear axes that do not move), air, material, and the kind's probe role.
+std::vector<std::string> linear_run_roles(const TestKind& k);
+
 // The kind of a `measure` name; throws cal::InputError listing the kinds.
 const TestKind& kind(std::string_view name);
 std::span<const TestKind* const> all_kinds();
