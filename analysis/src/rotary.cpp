@@ -345,6 +345,24 @@ Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
   return arr(p + vec(machine.linear.tool_offset_mm));
 }
 
+LinearCorrection remove_linear_errors(const Machine& linear,
+                                      std::span<const ProbedCentre> centres) {
+  LinearCorrection out;
+  out.centres.reserve(centres.size());
+  out.correction_um.reserve(centres.size());
+  for (const auto& c : centres) {
+    check_finite(c.centre_mm, "centre_mm");
+    Vec3 position{};
+    for (std::size_t i = 0; i < 3; ++i) position[i] = c.centre_mm[i] - linear.tool_offset_mm[i];
+    const Vec3 e = volumetric_error(linear, position, Method::htm).translation_um;
+    ProbedCentre moved = c;
+    for (std::size_t i = 0; i < 3; ++i) moved.centre_mm[i] += kMmPerUm * e[i];
+    out.centres.push_back(moved);
+    out.correction_um.push_back(e);
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Sphere probing: the axis average line
 

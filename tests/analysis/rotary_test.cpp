@@ -617,6 +617,41 @@ TEST(RotarySphereProbing, RecoversTheLocationErrorsWithoutNoise) {
   expect_near(fa.orientation_urad, {0, kB0A, kC0A}, 1e-3, "A orientation");
 }
 
+// Linear axes' errors in the probed centres: the trunnion above with X positioning (20 um/m
+// plus 3 um), X yaw (15 urad plus 0.05 urad/mm) and Y straightness in X (E_XY, 0.02 um/mm)
+// added. Unremoved, they pass into the C axis's fitted line: its position moves by about the
+// X error at the pivot's X plus the yaw's tilt of the 350 mm tool-and-sphere lever, micrometres.
+// Removed with the same linear errors (what a volumetric campaign measured), the fit gives the
+// injected location errors again, to first order in the errors: the second-order remainder
+// (products of um-level errors over 100 mm levers) is below 1e-3 um and 0.01 urad.
+TEST(RotarySphereProbing, LinearAxisErrorsAreRemovedFromTheCentresBeforeTheFit) {
+  FiveAxisMachine m = trunnion();
+  m.linear.axes[X].ex_um = ErrorFunction::polynomial({3, 0.02});
+  m.linear.axes[X].ec_urad = ErrorFunction::polynomial({15, 0.05});
+  m.linear.axes[Y].ex_um = ErrorFunction::polynomial({0, 0.02});
+  const auto centres = probe_c(m, 12, 0.0, 1);
+  const auto raw = fit_axis_line(RotaryLetter::c, kPivot, centres);
+  // The bias the linear errors leave when nothing is removed (guards the test: were it below
+  // the tolerance, the correction would prove nothing).
+  EXPECT_GT(std::abs(raw.position_um[0] - kX0C) + std::abs(raw.position_um[1] - kY0C), 1.0);
+
+  Machine linear = m.linear;  // the measured linear axes, no rotary axis
+  const auto corrected = remove_linear_errors(linear, centres);
+  ASSERT_EQ(corrected.centres.size(), centres.size());
+  // Nothing along Z: no linear error here moves the tip in Z (no E_Z?, the tool along -Z
+  // is not moved by the yaw). X and Y are the errors at each centre's own position.
+  for (const auto& e : corrected.correction_um) EXPECT_NEAR(e[2], 0.0, 1e-9);
+  const auto fit = fit_axis_line(RotaryLetter::c, kPivot, corrected.centres);
+  expect_near(fit.position_um, {kX0C, kY0C, 0}, 1e-3, "position after removal");
+  expect_near(fit.orientation_urad, {kA0C, kB0C, 0}, 1e-2, "orientation after removal");
+  // A position outside a linear error table is refused, not extrapolated.
+  linear.axes[X].ex_um = ErrorFunction::table(std::vector{-10.0, 10.0}, std::vector{0.0, 1.0});
+  EXPECT_THROW(remove_linear_errors(linear, centres), cal::InputError);
+  std::vector<ProbedCentre> nan = centres;
+  nan[3].centre_mm[1] = std::nan("");
+  EXPECT_THROW(remove_linear_errors(m.linear, nan), cal::InputError);
+}
+
 TEST(RotarySphereProbing, RecoversTheLocationErrorsWithinTheirUncertaintyUnderNoise) {
   // 12 centres evenly over 360 deg, Gaussian noise sigma = 1 um per coordinate (seeded). For
   // evenly spaced centres on a circle of radius R = 153 mm, H = 100 mm above the pivot's plane,

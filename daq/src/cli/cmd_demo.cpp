@@ -217,15 +217,22 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop, cal::daq::
                          if (!o.quiet) fmt::print("  {}\n", e);
                        }};
   CircleRun run(io, std::move(setup));
+  // A capture that cannot be written (a full disk) aborts the circle as it does the linear run
+  // (posted: the failure is seen inside the bar's handler).
+  capture.recorder->on_failure([&io, &run](const std::string& e) {
+    boost::asio::post(io, [&run, e] { run.stop("capture failed: " + e); });
+  });
   run.start();
   shop.run_circle(program);
   shop.run_program([&] { return run.finished(); }, 20.0);
   if (!run.finished()) run.stop("the simulated circle ended before both traces were complete");
   capture.recorder->close();
-  if (const auto& failure = capture.recorder->failure())
-    throw cal::InputError(
-        fmt::format("the circle's capture {} failed: {}", capture_file, *failure));
   const auto& out = run.outcome();
+  if (const auto& failure = capture.recorder->failure())
+    throw cal::InputError(fmt::format("the circle (run {}) {}: its capture {} failed: {}",
+                                      out.run_id,
+                                      out.complete ? "is complete and stored" : "was aborted",
+                                      capture_file, *failure));
   if (!out.complete) {
     fmt::print(stderr, "daq demo: the circle did not complete: {}\n", out.reason);
     return 1;

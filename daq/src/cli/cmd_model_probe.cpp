@@ -36,6 +36,7 @@ struct ProbeOptions {
   std::vector<double> pivot_mm;
   double probe_u_um = 0.0;
   bool json = false;
+  bool keep_linear = false;
 };
 
 struct AxisCentres {
@@ -182,6 +183,45 @@ void put_fit(mdl::RotaryEntry& r, const kin::AxisLineFit& f, const std::string& 
   }
 }
 
+// Whether the model holds any measured linear-axis error (a component or a squareness).
+bool has_linear_errors(const mdl::Model& m) {
+  return std::any_of(m.components.begin(), m.components.end(),
+                     [](const auto& c) { return c.given; }) ||
+         std::any_of(m.squareness.begin(), m.squareness.end(),
+                     [](const auto& q) { return q.given; });
+}
+
+// The model's linear-axis errors taken out of one axis's centres (kin::remove_linear_errors),
+// said on standard error (text) or returned for the JSON: the largest correction and where.
+json remove_linear(const mdl::Model& m, const ProbeOptions& o, kin::RotaryLetter letter,
+                   AxisCentres& a) {
+  kin::LinearCorrection c;
+  try {
+    c = kin::remove_linear_errors(m.machine, a.centres);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(
+        fmt::format("{}: removing {}'s linear-axis errors from the {} axis's "
+                    "centres: {} (--keep-linear-errors fits them as probed)",
+                    o.centres, o.model, kin::to_string(letter), e.what()));
+  }
+  std::size_t worst = 0;
+  double worst_um = 0.0;
+  for (std::size_t k = 0; k < c.correction_um.size(); ++k) {
+    const auto& e = c.correction_um[k];
+    const double n = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    if (n > worst_um) worst_um = n, worst = k;
+  }
+  a.centres = c.centres;
+  if (!o.json)
+    fmt::print(
+        "Axis {}: the linear axes' errors of {} removed from the centres before the fit "
+        "(largest {:.3f} um, line {}; --keep-linear-errors to fit them as probed)\n",
+        kin::to_string(letter), o.model, worst_um, a.lines.empty() ? 0 : a.lines[worst]);
+  json rows = json::array();
+  for (const auto& e : c.correction_um) rows.push_back(json::array({e[0], e[1], e[2]}));
+  return {{"model", o.model}, {"largest_um", worst_um}, {"correction_um", rows}};
+}
+
 void run_probe(const ProbeOptions& o) {
   if (o.model.empty() && (o.axis.empty() || o.pivot_mm.size() != 3))
     throw cal::InputError("give --model (the pivots of its table axes) or --axis and --pivot-mm");
@@ -191,10 +231,13 @@ void run_probe(const ProbeOptions& o) {
     throw cal::InputError("--write needs --model (the model the fitted errors go into)");
   std::optional<mdl::Model> m;
   if (!o.model.empty()) m = mdl::read(o.model);
-  const auto by_axis = read_centres(o);
+  auto by_axis = read_centres(o);
+  const bool remove = m && has_linear_errors(*m) && !o.keep_linear;
   json fits = json::array();
-  for (const auto& [letter, a] : by_axis) {
+  for (auto& [letter, a] : by_axis) {
     const kin::Vec3 pivot = pivot_of(o, m, letter);
+    json removed = nullptr;
+    if (remove) removed = remove_linear(*m, o, letter, a);
     kin::AxisLineFit f;
     try {
       f = kin::fit_axis_line(letter, pivot, a.centres, o.probe_u_um);
@@ -203,10 +246,12 @@ void run_probe(const ProbeOptions& o) {
                                         o.centres, kin::to_string(letter), a.centres.size(),
                                         a.lines.front(), a.lines.back(), e.what()));
     }
-    if (o.json)
+    if (o.json) {
       fits.push_back(fit_json(f, pivot, a));
-    else
+      fits.back()["linear_errors_removed"] = removed;
+    } else {
       print_fit(f, pivot, a);
+    }
     if (m)
       for (auto& r : m->rotary)
         if (r.axis.letter == letter) put_fit(r, f, o.centres, a.centres.size());
@@ -215,6 +260,7 @@ void run_probe(const ProbeOptions& o) {
     fmt::print("{}\n", json{{"schema", "caldaq.axis-line-fit.v1"},
                             {"centres_file", o.centres},
                             {"probe_u_um", o.probe_u_um},
+                            {"linear_errors_removed", remove},
                             {"axes", fits}}
                            .dump(2));
   if (!o.write.empty()) {
@@ -259,7 +305,7 @@ void run_probe_check(const CheckOptions& o) {
   } catch (const cal::InputError& e) {
     throw cal::InputError(fmt::format("{} with {}: {}", correction, o.model, e.what()));
   }
-  const ProbeOptions as_probe{o.centres, "", "", o.axis, {}, 0.0, false};
+  const ProbeOptions as_probe{o.centres, "", "", o.axis, {}, 0.0, false, false};
   json axes = json::array();
   for (const auto& [letter, a] : read_centres(as_probe)) {
     std::size_t index = control.rotary.size();
@@ -396,6 +442,9 @@ void add_model_probe_commands(CLI::App& model) {
   probe->add_option("--write", p->write,
                     "Write the model with the fitted location errors (and their uncertainty and "
                     "source) to this file");
+  probe->add_flag("--keep-linear-errors", p->keep_linear,
+                  "Fit the centres as probed, even when --model holds linear-axis errors "
+                  "(by default those are removed from each centre first)");
   probe->add_flag("--json", p->json, "Print caldaq.axis-line-fit.v1 JSON");
 
   const auto [check, c] = add_command<CheckOptions>(

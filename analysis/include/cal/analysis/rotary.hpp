@@ -131,6 +131,21 @@ struct AxisLineFit {
   int dof = 0;            // 2 N - 6: radial and axial residuals less the 6 parameters
 };
 
+// The linear axes' errors taken out of probed centres, before the fit: each centre plus the
+// error of the tool tip relative to the workpiece that `linear` (the machine's measured linear
+// axes: their 21 errors, topology and tool offset; no rotary axis) has at the linear position
+// the centre was probed at (the centre minus the tool offset). Why plus: the probe touches the
+// sphere where the ACTUAL tip is, nominal + error, and the control reports the nominal; so the
+// sphere is at the reported centre + error. The table axes sit on the workpiece-side linear
+// axes, so to first order in the errors the corrected centres are the ones a machine with
+// perfect linear axes reports, and the fit sees the rotary axis alone. correction_um[k] is what
+// was added to centre k. Throws InputError as volumetric_error (a position outside a table).
+struct LinearCorrection {
+  std::vector<ProbedCentre> centres;
+  std::vector<Vec3> correction_um;
+};
+LinearCorrection remove_linear_errors(const Machine& linear, std::span<const ProbedCentre> centres);
+
 // probe_u_um: the standard uncertainty of one probed centre per coordinate; 0 estimates it from
 // the residuals (needs 4 or more centres). Throws InputError for fewer than 3 distinct angles,
 // non-finite input, centres that are (nearly) collinear or coincident, a circle whose plane is
