@@ -8,6 +8,7 @@
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/swivel_data.hpp"
 #include "cal/analysis/trt_kins.hpp"
+#include "cli_checks.hpp"
 #include "command.hpp"
 #include "model_cli.hpp"
 #include "output_file.hpp"
@@ -81,7 +82,7 @@ void add_model_kinematics_command(CLI::App& model) {
       ->capture_default_str();
   cmd->add_option("--record", o->record,
                   "sinumerik-cycle800: the swivel data record n of $TC_CARRk[n]")
-      ->check(CLI::Range(1, 9999))
+      ->check(whole_in(1, 9999))
       ->capture_default_str();
   cmd->add_flag("--reverse-angles", o->reverse_angles,
                 "sinumerik-cycle800: the machine's positive angle turns the table the other way "
