@@ -109,7 +109,7 @@ for n in ("E_C0Y", "E_B0Z", "E_A0Z"):
 svgs = re.findall(r"<svg.*?</svg>", camp, re.S)
 readings = [s for s in svgs if 'aria-label="laser displacement (mm)' in s]
 check("campaign: each laser's readings plot names the instrument in its legend",
-      len(readings) >= 18 and all("ids3010" in svg_text(s) for s in readings),
+      len(readings) >= 18 and all("laser IDS3010" in svg_text(s) for s in readings),
       [svg_text(s) for s in readings[:2]])
 cut = [(rightmost(s), re.search(r'aria-label="([^"]*)"', s).group(1)) for s in svgs]
 cut = [c for c in cut if c[0][0] > c[0][1] - 1.0]

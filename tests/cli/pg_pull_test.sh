@@ -224,7 +224,7 @@ check damaged_here 2 "run 1 \(.*\): the local reading chunk 0 differs from the s
 # have is refused where it would pick one; the UUID picks it.
 SITE2=$TMP/site2.sqlite
 check site2_run 0 "" -- "$DAQ" replay "$DEMO_CDQ" --db "$SITE2"
-check site2_send 0 "1 runs synced .*: 1 new" -- "$DAQ" sync --db "$SITE2" --to "$PG_URL" --quiet
+check site2_send 0 "1 runs synced .*: 1 new" -- "$DAQ" sync --db "$SITE2" --to "$PG_URL" --site "Plant 2" --quiet
 check two_machines 0 "^2 2$" -- psql_value "SELECT count(*) || ' ' || count(DISTINCT uuid) FROM caldaq.machines WHERE name = '$MACHINE'"
 check site2_machine_own 0 "^1$" -- psql_value "SELECT count(*) FROM caldaq.runs r JOIN caldaq.machines m ON m.id = r.machine_id WHERE m.uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'"
 check name_ambiguous 2 "2 machines are named '$MACHINE' \(UUIDs .*\): name one by its UUID" -- \
