@@ -34,7 +34,7 @@ mount_tmpfs() {  # mount_tmpfs SIZE
 }
 
 # 1. The store on a full disk: room for the schema and a little more, not for the run.
-mount_tmpfs 320k
+mount_tmpfs 384k
 check store_full_exit 2 "daq: error: run 1 aborted: storage failed: $MNT/d.sqlite: .*(full|No space)" -- \
   "$DAQ" demo --quiet --db "$MNT/d.sqlite" --capture "$TMP/d.cdq"
 # What was committed stays readable (read from a copy: opening the store still writes). The

@@ -62,6 +62,11 @@ import json, sqlite3, sys
 db = sqlite3.connect(sys.argv[1])
 s = json.loads(db.execute("SELECT settings_json FROM runs WHERE id = 1").fetchone()[0])
 s["measure"]["reference"] = "laser"
+# A run made with a laser reference lists the laser (its angles arrive through the angle device;
+# the laser, not opened, is what they are traceable to): the run here was made with the encoder.
+s["context"]["instruments"].append({"calibration_due": "", "certificate": "", "driver": "ids3010",
+                                    "id": "laser", "role": "laser", "serial_number": "SIM-IDS-0001",
+                                    "transport": "tcp 127.0.0.1:1"})
 db.execute("UPDATE runs SET settings_json = ? WHERE id = 1", (json.dumps(s),))
 db.commit()
 PYEOF

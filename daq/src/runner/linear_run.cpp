@@ -124,8 +124,14 @@ json settings_json(const cal::daq::Config& c, const cal::iso230_2::Plan& plan, d
   const auto& l = *c.linear;
   json context = context_json.empty() ? json(nullptr) : json::parse(context_json, nullptr, false);
   const auto& kind = kinds::kind(l.measure.kind);
-  if (!context.is_object())
-    context = run_context(c, "linear", l.axis, kinds::linear_run_roles(kind));
+  if (!context.is_object()) {
+    auto roles = kinds::linear_run_roles(kind);
+    // A laser's angular optics over a rotary indexer: its angles arrive through the angle
+    // device, and the laser is not opened, but it is the reference the angles are traceable to
+    // (its serial number and certificate, the air's index of its wavelength): listed.
+    if (l.measure.kind == "rotary" && l.measure.reference == "laser") roles.emplace_back("laser");
+    context = run_context(c, "linear", l.axis, roles);
+  }
   json measure = measure_json(l.measure);
   measure["component"] = kind.component(l);
   measure["unit"] = kind.unit();

@@ -166,7 +166,12 @@ class Sync {
   // under a site this login may not see (23505: the policies hide it, its key is taken), in words.
   [[noreturn]] void refused(const pqxx::sql_error& e, const std::string& what,
                             std::string_view site) const {
-    if (e.sqlstate() == "42501")
+    // libpqxx 6 leaves sqlstate() empty for some refusals (seen for a row-level security
+    // policy's on INSERT ... RETURNING): the server's own words then say it.
+    const bool by_policy =
+        e.sqlstate() == "42501" ||
+        std::string_view(e.what()).find("row-level security policy") != std::string_view::npos;
+    if (by_policy)
       throw StoreError(fmt::format(
           "{}: {} would be of site '{}', which this login may not write (it may write {}): give "
           "--site, or ask the administrator for a grant (docs/storage.md, \"Sites\")",
