@@ -58,6 +58,10 @@ with Browser(width=1366, height=768) as b:
     need(page["overflow"] <= 0, "nothing wider than 1366 px")
     leaving = b.js("return document.querySelector('td[data-status=\"leaving\"]').textContent;")
     need(leaving.startswith("leaves its limit about 20"), f"the projection in words: {leaving!r}")
+    # Units in the signs an engineer reads (the store writes um, urad): µm, the slope a year.
+    cells = b.js("return [...document.querySelectorAll('td.num')].map(c => c.textContent);")
+    need(any(c.endswith(" µm") for c in cells) and any(c.endswith(" µm/yr") for c in cells)
+         and not any(c.endswith((" um", " urad", " um/m")) for c in cells), f"units {cells[:12]}")
     for name, script in (("fleet.png", "window.scrollTo(0, 0);"),
                          ("fleet-foot.png", "window.scrollTo(0, document.body.scrollHeight);")):
         b.js(script)
