@@ -141,7 +141,10 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(vib["XY"] and abs(vib["XY"]["frequency_hz"] - 23.7) < 0.2 and abs(vib["XY"]["value"] - 0.3) < 0.05,
        f"XY: the injected vibration of Y read at 23.7 Hz, 0.3 µm rms (within 0.05): {vib['XY']}")
     ok(vib["YZ"] and abs(vib["YZ"]["frequency_hz"] - 23.7) < 0.2, f"YZ: the vibration of Y at 23.7 Hz: {vib['YZ']}")
-    ok(vib["ZX"] is None, f"ZX: no vibration (Y is not in the plane): {vib['ZX']}")
+    # ZX: nothing at the injected frequency, and nothing of its size. (The diagnostic may name
+    # a component of the trace's noise: once 0.06 µm at 1.05 Hz, seen in a clean clone's run.)
+    ok(vib["ZX"] is None or (abs(vib["ZX"]["frequency_hz"] - 23.7) > 1.0 and vib["ZX"]["value"] < 0.15),
+       f"ZX: no vibration of Y (Y is not in the plane): {vib['ZX']}")
     # A ballbar test has no target stops: nothing is said of checking them ("Stops not checked:
     # not checked: one run in one direction" was a linear test's notion, its state said twice).
     quality = b.js("return document.getElementById('result-quality').textContent;")
