@@ -42,10 +42,10 @@ check v1_rotary_refused 2 "v1rot.json: rotary: rotary axes need \"schema\": \"ca
 TRUTH=$DATA/trunnion_truth.json
 NOM=$DATA/trunnion_nominal.json
 S="150 100 -250"
-probe() {  # probe SEED OUT: C at 12 angles, A at 7, noise 1 um per coordinate
-  "$DAQ" model probe-sim "$TRUTH" --axis C --sphere-mm $S --noise-um 1 --seed "$1" \
+probe() {  # probe SEED OUT [NOISE]: C at 12 angles, A at 7, noise 1 um per coordinate
+  "$DAQ" model probe-sim "$TRUTH" --axis C --sphere-mm $S --noise-um "${3:-1}" --seed "$1" \
     --angles-deg 0 30 60 90 120 150 180 210 240 270 300 330 -o "$TMP/c.csv" 2>/dev/null &&
-  "$DAQ" model probe-sim "$TRUTH" --axis A --sphere-mm $S --noise-um 1 --seed "$(($1 + 100))" \
+  "$DAQ" model probe-sim "$TRUTH" --axis A --sphere-mm $S --noise-um "${3:-1}" --seed "$(($1 + 100))" \
     --angles-deg -90 -60 -30 0 30 60 90 -o "$TMP/a.csv" 2>/dev/null &&
   { cat "$TMP/c.csv"; grep -v '^axis\|^#' "$TMP/a.csv"; } >"$2"
 }
@@ -91,6 +91,65 @@ swivel_fine ^\$TC_CARR44\[1\]=0$
 swivel_end ^M30$
 END
 check after_swivel 0 "largest deviation [0-3]\.[0-9]+ um" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf"
+# The location errors after (the loop's second measurement): the lines fitted again, against the
+# control holding each correction. Before: fit_within_4u above (the injected truth within 4 u).
+# After the SINUMERIK record (which holds the tilts): all eight within 4 u of zero, u the before
+# and after fits' combined (the record carries the first fit's error, the second fit adds its
+# own). After the LinuxCNC pins (no tilt pin): the four positions within 4 u of zero, the four
+# tilts still the injected ones (within 4 u of the after fit's own u: the truth is exact).
+"$DAQ" model probe "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --json >"$TMP/after_swivel.json" 2>/dev/null
+"$DAQ" model probe "$TMP/centres2.csv" --model "$NOM" --hal "$TMP/trt.hal" --json >"$TMP/after_hal.json" 2>/dev/null
+after_fit() {  # after_fit FILE TILTS_LEFT: "ok" when every location error is where it should be
+  "$PY" - "$TMP/fit.json" "$1" "$2" <<'PYEOF'
+import json, math, sys
+before = {n: v for a in json.load(open(sys.argv[1]))["axes"] for n, v in a["location"].items()}
+after_doc = json.load(open(sys.argv[2]))
+truth = {"E_X0C": 25, "E_Y0C": -18, "E_A0C": 10, "E_B0C": -6,
+         "E_Y0A": 30, "E_Z0A": -22, "E_B0A": 8, "E_C0A": -5}
+tilts_left = sys.argv[3] == "tilts-left"
+bad = []
+for axis in after_doc["axes"]:
+    for name, v in axis["location"].items():
+        tilt = v["unit"] == "urad"
+        if tilts_left and tilt:
+            want, u = truth[name], v["uncertainty"]
+        else:
+            want, u = 0.0, math.hypot(v["uncertainty"], before[name]["uncertainty"])
+        if abs(v["value"] - want) > 4 * u:
+            bad.append(f"{name} {v['value']:.3f} vs {want} (4 u = {4 * u:.3f})")
+print("ok" if not bad else "; ".join(bad))
+PYEOF
+}
+check after_swivel_location 0 "^ok$" -- after_fit "$TMP/after_swivel.json" none-left
+check after_hal_location 0 "^ok$" -- after_fit "$TMP/after_hal.json" tilts-left
+# The same without noise (the probe exact): what each correction left is exactly the truth less
+# what it was written from (the first fit), the tilts the pins cannot hold the truth itself, to
+# 0.005 um and 0.05 urad (second order: urad x urad x mm). A control ignoring the record's tilts,
+# or a fit that did not take them off, is off by 2 to 10 urad here.
+check probe_exact 0 "" -- probe 3 "$TMP/centres0.csv" 0
+"$DAQ" model probe "$TMP/centres0.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --probe-u-um 0.001 --json >"$TMP/exact_swivel.json" 2>/dev/null
+"$DAQ" model probe "$TMP/centres0.csv" --model "$NOM" --hal "$TMP/trt.hal" --probe-u-um 0.001 --json >"$TMP/exact_hal.json" 2>/dev/null
+exact_left() {  # exact_left FILE TILTS_LEFT
+  "$PY" - "$TMP/fit.json" "$1" "$2" <<'PYEOF'
+import json, sys
+before = {n: v["value"] for a in json.load(open(sys.argv[1]))["axes"] for n, v in a["location"].items()}
+after = {n: v for a in json.load(open(sys.argv[2]))["axes"] for n, v in a["location"].items()}
+truth = {"E_X0C": 25, "E_Y0C": -18, "E_A0C": 10, "E_B0C": -6,
+         "E_Y0A": 30, "E_Z0A": -22, "E_B0A": 8, "E_C0A": -5}
+bad = []
+for name, v in after.items():
+    tilt = v["unit"] == "urad"
+    want = truth[name] if tilt and sys.argv[3] == "tilts-left" else truth[name] - before[name]
+    if abs(v["value"] - want) > (0.05 if tilt else 0.005):
+        bad.append(f"{name} {v['value']:.4f} vs {want:.4f}")
+print("ok" if len(after) == 8 and not bad else "; ".join(bad) or "not 8 errors")
+PYEOF
+}
+check exact_swivel_left 0 "^ok$" -- exact_left "$TMP/exact_swivel.json" none-left
+check exact_hal_left 0 "^ok$" -- exact_left "$TMP/exact_hal.json" tilts-left
+check after_swivel_against 0 "\"against\": \".*swivel\.mpf\"" -- cat "$TMP/after_swivel.json"
+check after_swivel_text 0 "the location errors below are what the correction left" -- "$DAQ" model probe "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf"
+check after_write_refused 2 "--write with --hal or --swivel" -- "$DAQ" model probe "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --write "$TMP/x.json"
 check swivel_and_hal 2 "--hal and --swivel" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --hal "$TMP/trt.hal"
 printf '$TC_CARR4[1]=1\n$TC_CARR4[1]=2\n' >"$TMP/bad.mpf"
 check bad_swivel 2 "bad.mpf:2: \\\$TC_CARR4 given twice" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/bad.mpf"

@@ -33,6 +33,7 @@ namespace {
 
 struct ProbeOptions {
   std::string centres, model, write, axis;
+  std::string hal, swivel;  // the control's correction: the fit is against its lines
   std::vector<double> pivot_mm;
   double probe_u_um = 0.0;
   bool json = false;
@@ -72,17 +73,21 @@ std::map<kin::RotaryLetter, AxisCentres> read_centres(const ProbeOptions& o) {
   return out;
 }
 
-// The nominal pivot of a table axis: from the model's rotary axis of that letter, or --pivot-mm.
-kin::Vec3 pivot_of(const ProbeOptions& o, const std::optional<mdl::Model>& m, kin::RotaryLetter l) {
-  if (!m) return {o.pivot_mm.at(0), o.pivot_mm.at(1), o.pivot_mm.at(2)};
-  for (const auto& r : m->rotary) {
-    if (r.axis.letter != l) continue;
-    if (r.axis.side != kin::Side::table)
+// The table axis of that letter the fit is against: the model's (its nominal pivot, no location
+// error) or, with --hal / --swivel, the control's holding that correction (its line's point and
+// direction). nullptr without --model (--pivot-mm).
+const kin::RotaryAxis* reference_axis(const ProbeOptions& o,
+                                      const std::optional<kin::FiveAxisMachine>& reference,
+                                      kin::RotaryLetter l) {
+  if (!reference) return nullptr;
+  for (const auto& r : reference->rotary) {
+    if (r.letter != l) continue;
+    if (r.side != kin::Side::table)
       throw cal::InputError(
           fmt::format("{}: the {} axis is on the spindle side: sphere probing "
                       "fits table axes only (docs/kinematics.md)",
                       o.model, kin::to_string(l)));
-    return r.axis.pivot_mm;
+    return &r;
   }
   throw cal::InputError(
       fmt::format("{}: {} has centres of the {} axis, the model has no such "
@@ -113,7 +118,10 @@ std::vector<LocationValue> location_values(const kin::AxisLineFit& f) {
   return out;
 }
 
-json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
+// `against_control`: the fit was made against a corrected control's line (probe --hal /
+// --swivel), so the pivot is the control's, not the nominal one.
+json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a,
+              bool against_control) {
   json loc = json::object();
   for (const auto& l : location_values(f))
     loc[l.name] = {{"value", l.value},
@@ -127,7 +135,8 @@ json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentr
                    {"axial_um", f.axial_um[k]},
                    {"tangential_um", f.tangential_um[k]}});
   return {{"axis", kin::to_string(f.letter)},
-          {"nominal_pivot_mm", json::array({pivot[0], pivot[1], pivot[2]})},
+          {against_control ? "control_pivot_mm" : "nominal_pivot_mm",
+           json::array({pivot[0], pivot[1], pivot[2]})},
           {"centres", a.centres.size()},
           {"location", loc},
           {"radius_mm", f.radius_mm},
@@ -138,9 +147,11 @@ json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentr
           {"residuals", res}};
 }
 
-void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a) {
-  fmt::print("Axis {}: {} probed centres, nominal pivot ({:g}, {:g}, {:g}) mm\n",
-             kin::to_string(f.letter), a.centres.size(), pivot[0], pivot[1], pivot[2]);
+void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a,
+               bool against_control) {
+  fmt::print("Axis {}: {} probed centres, {} pivot ({:g}, {:g}, {:g}) mm\n",
+             kin::to_string(f.letter), a.centres.size(),
+             against_control ? "the control's" : "nominal", pivot[0], pivot[1], pivot[2]);
   for (const auto& l : location_values(f))
     fmt::print("  {:6} {:+10.3f} {:4}  u = {}\n", l.name, l.value, l.unit,
                std::isnan(l.uncertainty)
@@ -222,6 +233,48 @@ json remove_linear(const mdl::Model& m, const ProbeOptions& o, kin::RotaryLetter
   return {{"model", o.model}, {"largest_um", worst_um}, {"correction_um", rows}};
 }
 
+std::string read_text(const std::string& path, std::string_view what) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  if (!in || !(ss << in.rdbuf()))
+    throw cal::InputError(fmt::format("{}: cannot read the {}", path, what));
+  return ss.str();
+}
+
+// The control's kinematics: the model's machine, or with a correction file (LinuxCNC trunnion
+// pins from --hal, a SINUMERIK swivel data record from --swivel) the nominal model with its
+// rotary axes on that file's lines (trt_control_machine, swivel_control_machine). Shared by
+// probe-check (the centres against it) and probe (the lines fitted against it).
+kin::FiveAxisMachine control_machine(const mdl::Model& m, const std::string& model,
+                                     const std::string& hal, const std::string& swivel) {
+  kin::FiveAxisMachine control = mdl::five_axis(m);
+  if (!hal.empty() && !swivel.empty())
+    throw cal::InputError("--hal and --swivel: give one control's kinematics");
+  const std::string& correction = hal.empty() ? swivel : hal;
+  try {
+    if (!hal.empty())
+      control = kin::trt_control_machine(
+          kin::parse_linuxcnc_trt_hal(read_text(hal, "HAL file"), hal), control);
+    if (!swivel.empty())
+      control = kin::swivel_control_machine(
+          kin::parse_sinumerik_swivel_program(read_text(swivel, "swivel data"), swivel), control);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("{} with {}: {}", correction, model, e.what()));
+  }
+  return control;
+}
+
+// The fit made against the control's line instead of the nominal one: the location errors the
+// correction left (the actual line less the control's). The fit is made at the control's pivot,
+// so the positions are already relative to its line's point; the control's tilts (a swivel
+// record's V) are taken off the fitted ones (first order: both are micro-radians).
+void relative_to(kin::AxisLineFit& f, const kin::RotaryAxis& control) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    f.position_um[k] -= control.location_position_um[k];
+    f.orientation_urad[k] -= control.location_orientation_urad[k];
+  }
+}
+
 void run_probe(const ProbeOptions& o) {
   if (o.model.empty() && (o.axis.empty() || o.pivot_mm.size() != 3))
     throw cal::InputError("give --model (the pivots of its table axes) or --axis and --pivot-mm");
@@ -229,13 +282,35 @@ void run_probe(const ProbeOptions& o) {
     throw cal::InputError("--pivot-mm is for a fit without --model (the model has the pivots)");
   if (!o.write.empty() && o.model.empty())
     throw cal::InputError("--write needs --model (the model the fitted errors go into)");
+  const std::string& correction = o.hal.empty() ? o.swivel : o.hal;
+  if (!correction.empty() && o.model.empty())
+    throw cal::InputError("--hal and --swivel need --model (the nominal machine they correct)");
+  if (!correction.empty() && !o.write.empty())
+    throw cal::InputError(
+        "--write with --hal or --swivel: the fit against a correction is what it left, not the "
+        "machine's location errors; fit against the nominal model to write them");
   std::optional<mdl::Model> m;
-  if (!o.model.empty()) m = mdl::read(o.model);
+  // What the fit is against: the nominal lines of the model's table axes (its pivots, no
+  // location error), or the control's lines with the correction applied.
+  std::optional<kin::FiveAxisMachine> reference;
+  if (!o.model.empty()) {
+    m = mdl::read(o.model);
+    reference = control_machine(*m, o.model, o.hal, o.swivel);
+    if (correction.empty())
+      for (auto& r : reference->rotary) r.location_position_um = r.location_orientation_urad = {};
+  }
   auto by_axis = read_centres(o);
   const bool remove = m && has_linear_errors(*m) && !o.keep_linear;
+  if (!correction.empty() && !o.json)
+    fmt::print(
+        "The lines fitted against the control's kinematics ({} with {}): the location errors "
+        "below are what the correction left\n",
+        o.model, correction);
   json fits = json::array();
   for (auto& [letter, a] : by_axis) {
-    const kin::Vec3 pivot = pivot_of(o, m, letter);
+    const kin::RotaryAxis* axis = reference_axis(o, reference, letter);
+    const kin::Vec3 pivot =
+        axis ? axis->pivot_mm : kin::Vec3{o.pivot_mm.at(0), o.pivot_mm.at(1), o.pivot_mm.at(2)};
     json removed = nullptr;
     if (remove) removed = remove_linear(*m, o, letter, a);
     kin::AxisLineFit f;
@@ -246,13 +321,14 @@ void run_probe(const ProbeOptions& o) {
                                         o.centres, kin::to_string(letter), a.centres.size(),
                                         a.lines.front(), a.lines.back(), e.what()));
     }
+    if (axis) relative_to(f, *axis);
     if (o.json) {
-      fits.push_back(fit_json(f, pivot, a));
+      fits.push_back(fit_json(f, pivot, a, !correction.empty()));
       fits.back()["linear_errors_removed"] = removed;
     } else {
-      print_fit(f, pivot, a);
+      print_fit(f, pivot, a, !correction.empty());
     }
-    if (m)
+    if (m && correction.empty())
       for (auto& r : m->rotary)
         if (r.axis.letter == letter) put_fit(r, f, o.centres, a.centres.size());
   }
@@ -260,6 +336,7 @@ void run_probe(const ProbeOptions& o) {
     fmt::print("{}\n", json{{"schema", "caldaq.axis-line-fit.v1"},
                             {"centres_file", o.centres},
                             {"probe_u_um", o.probe_u_um},
+                            {"against", correction.empty() ? json(nullptr) : json(correction)},
                             {"linear_errors_removed", remove},
                             {"axes", fits}}
                            .dump(2));
@@ -276,36 +353,17 @@ struct CheckOptions {
   bool json = false;
 };
 
-std::string read_text(const std::string& path, std::string_view what) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  if (!in || !(ss << in.rdbuf()))
-    throw cal::InputError(fmt::format("{}: cannot read the {}", path, what));
-  return ss.str();
-}
-
 // The deviation of each probed centre from where the control's kinematics expects it: the
 // sphere's place on the workpiece is what the control saw at angle 0 (where location errors
 // move nothing), found so that the control's own prediction there is the centre probed there.
 void run_probe_check(const CheckOptions& o) {
   const mdl::Model m = mdl::read(o.model);
-  kin::FiveAxisMachine control = mdl::five_axis(m);
-  if (!o.hal.empty() && !o.swivel.empty())
-    throw cal::InputError("--hal and --swivel: give one control's kinematics");
   // The correction as the control holds it: the kinematics file applied to the nominal model.
+  const kin::FiveAxisMachine control = control_machine(m, o.model, o.hal, o.swivel);
   const std::string& correction = o.hal.empty() ? o.swivel : o.hal;
-  try {
-    if (!o.hal.empty())
-      control = kin::trt_control_machine(
-          kin::parse_linuxcnc_trt_hal(read_text(o.hal, "HAL file"), o.hal), control);
-    if (!o.swivel.empty())
-      control = kin::swivel_control_machine(
-          kin::parse_sinumerik_swivel_program(read_text(o.swivel, "swivel data"), o.swivel),
-          control);
-  } catch (const cal::InputError& e) {
-    throw cal::InputError(fmt::format("{} with {}: {}", correction, o.model, e.what()));
-  }
-  const ProbeOptions as_probe{o.centres, "", "", o.axis, {}, 0.0, false, false};
+  ProbeOptions as_probe;
+  as_probe.centres = o.centres;
+  as_probe.axis = o.axis;
   json axes = json::array();
   for (const auto& [letter, a] : read_centres(as_probe)) {
     std::size_t index = control.rotary.size();
@@ -445,6 +503,12 @@ void add_model_probe_commands(CLI::App& model) {
   probe->add_flag("--keep-linear-errors", p->keep_linear,
                   "Fit the centres as probed, even when --model holds linear-axis errors "
                   "(by default those are removed from each centre first)");
+  probe->add_option("--hal", p->hal,
+                    "Fit against the control holding these LinuxCNC trunnion pins (--model the "
+                    "nominal machine): the location errors the correction left");
+  probe->add_option("--swivel", p->swivel,
+                    "Fit against the control holding this SINUMERIK CYCLE800 swivel data record "
+                    "(--model the nominal machine): the location errors the correction left");
   probe->add_flag("--json", p->json, "Print caldaq.axis-line-fit.v1 JSON");
 
   const auto [check, c] = add_command<CheckOptions>(
