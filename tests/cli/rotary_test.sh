@@ -150,6 +150,19 @@ check exact_hal_left 0 "^ok$" -- exact_left "$TMP/exact_hal.json" tilts-left
 check after_swivel_against 0 "\"against\": \".*swivel\.mpf\"" -- cat "$TMP/after_swivel.json"
 check after_swivel_text 0 "the location errors below are what the correction left" -- "$DAQ" model probe "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf"
 check after_write_refused 2 "--write with --hal or --swivel" -- "$DAQ" model probe "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --write "$TMP/x.json"
+# The residual per axis, every axis (the lines above match any one): before > 40 um, after the
+# pins < 6 um (the tilts they leave, up to about 4 um here), after the record < 4 um (noise).
+largest() {  # largest CENTRES [CORRECTION...]: each axis's largest deviation, "A:x C:y"
+  "$DAQ" model probe-check "$@" --model "$NOM" --json 2>/dev/null |
+    "$PY" -c "import json, sys; print(' '.join('%s:%.3f' % (a['axis'], a['max_um']) for a in json.load(sys.stdin)['axes']))"
+}
+check residual_per_axis 0 "^ok$" -- "$PY" - "$(largest "$TMP/centres1.csv")" "$(largest "$TMP/centres2.csv" --hal "$TMP/trt.hal")" "$(largest "$TMP/centres2.csv" --swivel "$TMP/swivel.mpf")" <<'PYEOF'
+import sys
+rows = [dict(x.split(":") for x in a.split()) for a in sys.argv[1:4]]
+ok = all(len(r) == 2 for r in rows) and all(float(v) > 40 for v in rows[0].values()) and \
+     all(float(v) < 6 for v in rows[1].values()) and all(float(v) < 4 for v in rows[2].values())
+print("ok" if ok else sys.argv[1:4])
+PYEOF
 check swivel_and_hal 2 "--hal and --swivel" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/swivel.mpf" --hal "$TMP/trt.hal"
 printf '$TC_CARR4[1]=1\n$TC_CARR4[1]=2\n' >"$TMP/bad.mpf"
 check bad_swivel 2 "bad.mpf:2: \\\$TC_CARR4 given twice" -- "$DAQ" model probe-check "$TMP/centres2.csv" --model "$NOM" --swivel "$TMP/bad.mpf"
