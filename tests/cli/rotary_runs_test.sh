@@ -90,6 +90,53 @@ END
 check cmp_no_um 1 "" -- grep -E "\((µm|mm)\)" "$TMP/cmp.html"
 check cmp_json 0 '"kind": "comparison"' -- "$DAQ" report --compare 1 2 --db "$DB" -o "$TMP/cmp2.html" --json
 
+# --- As found and as left: the SIMULATED control's correction of the C axis ---------------------
+# Run 1 as found (the injected 10" per turn, 4" three times a turn, 6" of backlash, zero -3"); run
+# 2 as left, with the control's backlash compensation (6") and scale correction (10"/turn) set
+# from it. Expected from the injected errors alone (the deviation formula restated below, stops
+# at 0 .. 360 deg every 45 deg): as found E = 19.0", B = 6.0"; as left only the cyclic error
+# is left: E = 2 x 4" = 8.0" (its peaks at 90 and 270 deg), B = 0. The two runs share their noise
+# seed, so the change is known closer than each value: within 0.3" (each value within 0.5": the
+# stops' settling tail, tests/e2e/rotary_e2e_test.cpp).
+AF=$TMP/af.sqlite
+printf '[tolerances.C]\nE_arcsec = 12\nB_arcsec = 2\n' >"$TMP/af_tol.toml"
+check af_found 0 "" -- "$DAQ" sim --test rotary --runs 2 --acquire --json --tolerances "$TMP/af_tol.toml" -o "$TMP/af1.toml" --db "$AF"
+check af_left 0 "" -- "$DAQ" sim --test rotary --runs 2 --acquire --json --tolerances "$TMP/af_tol.toml" --control-backlash-arcsec 6 --control-scale-arcsec-per-turn 10 -o "$TMP/af2.toml" --db "$AF"
+check af_report 0 "as-found-as-left report of runs 1, 2 written" -- "$DAQ" report --as-found 1 --as-left 2 --db "$AF" -o "$TMP/af.html"
+check_file "$TMP/af.html" <<'END'
+af_title <title>SIMULATED — As found and as left: rotary test of C</title>
+af_verdict As found \(run 1\): <strong><span class="fail">FAIL</span></strong> &mdash; E = [0-9.]+ arcsec \(limit ≤ 12\.000 arcsec\); B = [0-9.]+ arcsec \(limit ≤ 2\.000 arcsec\)\.<br>As left \(run 2\): <strong><span class="pass">PASS</span></strong>
+af_overlay aria-label="Mean bidirectional deviation, as found and as left"
+af_as_found_body <h2 class="run" id="run-1">As found: .*Rotary positioning test
+END
+check af_no_um 1 "" -- grep -E "\((µm|mm)\)" "$TMP/af.html"
+check af_values 0 "^ok$" -- "$PY" - "$TMP/af.html" <<'PYEOF'
+import math, re, sys
+h = open(sys.argv[1]).read()
+def dev(t, up, scale, backlash):  # ShopTruth::Rotary: the reference's angle less the target
+    half = 0.5 * backlash / 3600 * (-1 if up else 1)
+    d = t + half
+    return -3 + scale * d / 360 + 4 * math.sin(2 * math.pi * d / 120) + half * 3600
+def expected(scale, backlash):
+    up = [dev(t, True, scale, backlash) for t in range(0, 361, 45)]
+    down = [dev(t, False, scale, backlash) for t in range(0, 361, 45)]
+    return {"E": max(up + down) - min(up + down), "B": max(abs(a - b) for a, b in zip(up, down))}
+found, left = expected(10, 6), expected(0, 0)  # 19.0, 6.0 and 8.0, 0.0
+bad = []
+for key, sym in (("E", "E"), ("B", "B")):
+    m = re.search(r"<tr><td>%s \(arcsec\)</td><td class=\"r\">([-0-9.]+) .*?</td><td class=\"r\">([-0-9.]+) .*?</td><td class=\"r\">([-+0-9.]+)</td>" % sym, h)
+    if not m:
+        bad.append("no row " + sym); continue
+    f, l, c = map(float, m.groups())
+    if abs(f - found[key]) > 0.5 or abs(l - left[key]) > 0.5 or abs(c - (left[key] - found[key])) > 0.3:
+        bad.append(f"{sym}: {f} -> {l} ({c}) vs {found[key]:.3f} -> {left[key]:.3f}")
+print("ok" if not bad else bad)
+PYEOF
+check af_json 0 '"kind": "as-found-as-left"' -- "$DAQ" report --as-found 1 --as-left 2 --db "$AF" -o "$TMP/af2.html" --json
+check af_over_compensated 2 "--control-backlash-arcsec 7: more than the SIMULATED C axis's backlash \(6\"\)" -- "$DAQ" sim --test rotary --acquire --control-backlash-arcsec 7 -o "$TMP/x.toml" --db "$TMP/x2.sqlite"
+check af_correction_not_rotary 2 "--control-backlash-arcsec and --control-scale-arcsec-per-turn correct the SIMULATED rotary axis" -- "$DAQ" sim --test linear --acquire --control-scale-arcsec-per-turn 1 -o "$TMP/x.toml" --db "$TMP/x3.sqlite"
+check af_other_kind 2 "run 1 is a rotary test of C, run 3 a linear test of X" -- bash -c "'$DAQ' sim --test linear --runs 2 --targets 3 --acquire -o '$TMP/lin.toml' --db '$AF' >/dev/null 2>&1; '$DAQ' report --as-found 1 --as-left 3 --db '$AF' -o '$TMP/x.html'"
+
 # --- A run stored the old way: each stop's reference angle, not its deviation ---------------
 # Before a452795 a rotary stop stored the reference's continuous angle (arcsec) where it now
 # stores the angle minus the target (modulo a turn). Made here from run 1: each stop's angle,

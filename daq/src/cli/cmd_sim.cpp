@@ -55,13 +55,33 @@ struct SimOptions {
   std::vector<std::string> control_table;
   std::string control_format;
   bool control_inverted = false;
-  bool acquire = false;   // run the acquisition in this process, on simulated time
-  std::string capture;    // with acquire: the run's capture file
-  bool json = false;      // with acquire: the result as JSON on stdout (as daq run --json)
-  std::string truth_out;  // write the volumetric machine's injected errors as a model, exit
+  bool acquire = false;    // run the acquisition in this process, on simulated time
+  std::string capture;     // with acquire: the run's capture file
+  bool json = false;       // with acquire: the result as JSON on stdout (as daq run --json)
+  std::string truth_out;   // write the volumetric machine's injected errors as a model, exit
   std::string tolerances;  // with measure: a file of [tolerances] tables added to the config
   std::vector<double> truth_tool_offset_mm;  // with truth_out: the tool the model is for
+  // With --test rotary: the SIMULATED control's correction of the C axis (an as left run after
+  // it): its backlash compensation (arcsec) and its scale (pitch) correction (arcsec per turn),
+  // taken off the injected lost motion and scale error (ShopTruth::Rotary).
+  std::optional<double> control_backlash_arcsec, control_scale_arcsec_per_turn;
 };
+
+// The rotary axis as the control moves it with its corrections (--control-backlash-arcsec,
+// --control-scale-arcsec-per-turn): the injected backlash and scale error less them. The
+// simulated servo's lost motion cannot be negative, so a backlash compensation larger than the
+// injected 6" is refused rather than clamped.
+void apply_rotary_correction(const SimOptions& o, ShopTruth::Rotary& r) {
+  if (o.control_backlash_arcsec) {
+    if (*o.control_backlash_arcsec > r.backlash_arcsec)
+      throw cal::InputError(fmt::format(
+          "--control-backlash-arcsec {}: more than the SIMULATED C axis's backlash ({}\"): the "
+          "simulated servo cannot over-compensate",
+          *o.control_backlash_arcsec, r.backlash_arcsec));
+    r.backlash_arcsec -= *o.control_backlash_arcsec;
+  }
+  if (o.control_scale_arcsec_per_turn) r.scale_arcsec_per_turn -= *o.control_scale_arcsec_per_turn;
+}
 
 std::string numbers(const std::array<double, 3>& v) {
   return fmt::format("[{}, {}, {}]", v[0], v[1], v[2]);
@@ -198,8 +218,13 @@ void run_sim(SimOptions o) {
   const bool rotary = o.test == "rotary";   // a C axis read by its angular reference
   if (rotary && (!o.measure.empty() || o.position_feed))
     throw cal::InputError("--test rotary: without --measure or --position-feed");
+  if (!rotary && (o.control_backlash_arcsec || o.control_scale_arcsec_per_turn))
+    throw cal::InputError(
+        "--control-backlash-arcsec and --control-scale-arcsec-per-turn correct the SIMULATED "
+        "rotary axis: give --test rotary");
   std::optional<cal::daq::LinearTestConfig> volumetric;
   ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
+  apply_rotary_correction(o, truth.rotary);
   if (!o.measure.empty()) {
     volumetric = volumetric_test(o.measure);
     truth = volumetric_truth(cal::kinematics::topology_from_string(o.topology), 0.02);
@@ -253,18 +278,18 @@ void run_sim(SimOptions o) {
         "--tolerances applies to --measure and --test rotary (the other tests' configurations "
         "have the demo's specification)");
   const std::string text =
-      volumetric ? volumetric_config(shop, o.speed, *volumetric) +
-                       (o.tolerances.empty() ? "" : tolerances_toml(o.tolerances))
-                 : simulated_shop_config(shop, {.speed = o.speed,
-                                                .position_feed = o.position_feed,
-                                                .in_process = false,
-                                                .runs = o.runs,
-                                                .targets = o.targets.value_or(11),
-                                                .circle_set = set,
-                                                .rotary = rotary,
-                                                .circle_feed_mm_per_min = o.feed_mm_per_min}) +
-                       (rotary && !o.tolerances.empty() ? rotary_tolerances_toml(o.tolerances)
-                                                        : "");
+      volumetric
+          ? volumetric_config(shop, o.speed, *volumetric) +
+                (o.tolerances.empty() ? "" : tolerances_toml(o.tolerances))
+          : simulated_shop_config(shop, {.speed = o.speed,
+                                         .position_feed = o.position_feed,
+                                         .in_process = false,
+                                         .runs = o.runs,
+                                         .targets = o.targets.value_or(11),
+                                         .circle_set = set,
+                                         .rotary = rotary,
+                                         .circle_feed_mm_per_min = o.feed_mm_per_min}) +
+                (rotary && !o.tolerances.empty() ? rotary_tolerances_toml(o.tolerances) : "");
   {
     std::ofstream out(o.config_out);
     if (!(out << text)) throw cal::InputError(fmt::format("{}: cannot write", o.config_out));
@@ -438,6 +463,15 @@ void add_sim_command(CLI::App& app) {
                   "`daq model build --tool-offset-mm`)")
       ->expected(3)
       ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
+  cmd->add_option("--control-backlash-arcsec", o->control_backlash_arcsec,
+                  "With --test rotary: the SIMULATED control's backlash compensation of the C "
+                  "axis (as set from an as-found run's B), taken off its injected 6\" of lost "
+                  "motion (at most that)")
+      ->check(finite_in(0.0, 3600.0));
+  cmd->add_option("--control-scale-arcsec-per-turn", o->control_scale_arcsec_per_turn,
+                  "With --test rotary: the SIMULATED control's scale (pitch) correction of the C "
+                  "axis, taken off its injected 10\" per turn")
+      ->check(finite_in(-3600.0, 3600.0));
   cmd->add_option("--capture", o->capture, "--acquire: record the run's wire-level capture here");
   cmd->add_flag(
       "--json", o->json,

@@ -3027,8 +3027,14 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
         "as found / as left: run {} is a {} test of {}, run {} a {} test of {}; give the same test "
         "before and after the compensation",
         found_id, found.run.kind, found.run.axis, left_id, left.run.kind, left.run.axis));
-  if (found.run.kind != "linear" && found.run.kind != "circle")
-    throw cal::InputError("as found / as left: linear or circle runs");
+  if (found.run.kind != "linear" && found.run.kind != "circle" && found.run.kind != "rotary")
+    throw cal::InputError(fmt::format(
+        "as found / as left: runs {} and {} are {} tests; linear, rotary or circle runs", found_id,
+        left_id, found.run.kind));
+  // A rotary axis's angular positioning is put side by side as a linear axis's is, in its units
+  // (targets in deg, deviations and values in arcsec: axis_text), judged by its arcsec limits.
+  const bool positioning = found.run.kind == "linear" || found.run.kind == "rotary";
+  const AxisText& words = axis_text(found);
   struct Side {
     json doc;
     ::daq::Verdict verdict;
@@ -3045,14 +3051,14 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
                        is_signed};
   };
   XyChart overlay{.title = "Mean bidirectional deviation, as found and as left",
-                  .x_label = "target position (mm)",
-                  .y_label = "deviation (µm)",
+                  .x_label = std::string(words.x_label),
+                  .y_label = fmt::format("deviation ({})", words.deviation),
                   .height_pt = 240,
                   .zero_line = true};
   PolarChart polar{.title = "As found and as left"};
   const auto side = [&](const RunView& v, std::size_t colour, const char* label) {
     Side sd;
-    if (v.run.kind == "linear") {
+    if (positioning) {
       const auto l = evaluate_linear(store, v, o);
       Line line{.label = fmt::format("{} (run {})", label, v.run.id),
                 .colour = palette(colour),
@@ -3061,8 +3067,9 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
       for (const auto& t : l.e.targets)
         line.x.push_back(t.target_mm), line.y.push_back(t.mean_bi_um);
       overlay.lines.push_back(std::move(line));
-      sd.doc = ::daq::to_json(l.e);
-      for (const auto& r : ::daq::linear_rows(sd.doc)) sd.values.push_back(entry(r, false));
+      // A rotary run's caldaq.rotary.v1 (the values daq show prints, in arcsec).
+      sd.doc = v.run.kind == "rotary" ? rotary_doc(store, v, o) : ::daq::to_json(l.e);
+      for (const auto& r : ::daq::result_rows(sd.doc)) sd.values.push_back(entry(r, false));
     } else {
       const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
@@ -3120,7 +3127,7 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
       "<p>The machine as it was found (run {}, {}) and as it was left after the compensation "
       "(run {}, {}): the same test, side by side. Each run's full report follows.</p>\n",
       found_id, date_of(found), left_id, date_of(left));
-  if (found.run.kind == "linear") {
+  if (positioning) {
     body += figure(svg(overlay), "The mean bidirectional positional deviation before and after.");
   } else {
     // Half the page's width, so that the table fits under it on page one; its text scaled as a
