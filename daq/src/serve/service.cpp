@@ -48,10 +48,12 @@
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
+#include "serve/live_trace.hpp"
 #include "serve/model_view.hpp"
 #include "serve/setup_form.hpp"
 #include "serve/volumetric_checklist.hpp"
 #include "sim_shop.hpp"
+#include "unit_signs.hpp"
 #include "web/assets.hpp"
 #include "web/server.hpp"
 
@@ -296,7 +298,10 @@ class Service {
   }
 
   void make_server() {
-    web::Api api{.page = [](std::string_view nonce) { return web::operator_page(nonce); },
+    web::Api api{.page =
+                     [](std::string_view nonce) {
+                       return web::operator_page(nonce, ::daq::unit_signs_json());
+                     },
                  .runs = [this] { return runs(); },
                  .status = [this] { return ok(status()); },
                  .start = [this](const std::string& body) { return start(body); },
@@ -327,6 +332,7 @@ class Service {
     get("/api/machines", &Service::machines);
     get("/api/volumetric", &Service::volumetric);
     get("/api/model", &Service::model);
+    get("/api/live/trace", &Service::live_trace);
     get("/api/runs/", &Service::run_doc);
     get("/reports/", &Service::report);
     post("/api/setup/check", &Service::setup_check);
@@ -612,6 +618,11 @@ class Service {
   }
 
   web::Response devices(std::string_view) { return ok(board_->to_json()); }
+  // The live circle's whole polar trace, for a page that missed some of its new points.
+  web::Response live_trace(std::string_view) {
+    if (circle_live_.empty()) return error(404, "no circle run has a live trace");
+    return ok(circle_live_.whole());
+  }
   web::Response drivers(std::string_view) { return ok(driver_descriptions()); }
   web::Response detected(std::string_view) { return ok(list_devices({})); }
 
@@ -899,6 +910,7 @@ class Service {
       return error(409, fmt::format("Start refused: {}", *refusal));
     stop_monitors_of(*test);  // the run opens them itself (its capture starts at the connection)
     run_live_.clear();
+    circle_live_.clear();
     try {
       if (*test == "linear")
         start_linear();
@@ -1067,7 +1079,7 @@ class Service {
         .origins = {{"ballbar", origin_of(specs[0].origin, "")}},
         .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
     mark_simulated(setup.origins);
-    setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
+    setup.on_live = [this](const CircleLive& s) { circle_live_.update(s, run_id_); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
     circle_->start();
@@ -1173,10 +1185,15 @@ class Service {
   // changed): the status, every device, and the run's live state (kept after it ends, so the
   // page still shows its last table).
   void publish_loop() {
+    // A circle's trace: its new points only (serve/live_trace.hpp).
+    const std::string run = !run_live_.empty() ? run_live_
+                            : !circle_live_.empty()
+                                ? circle_live_.page_json(LiveTraceFeed::Clock::now()).dump()
+                                : "null";
     std::string page = R"({"schema":"caldaq.page.v1","status":)" + status().dump() +
                        R"(,"devices":)" +
                        board_->to_json().dump(-1, ' ', false, json::error_handler_t::replace) +
-                       R"(,"run":)" + (run_live_.empty() ? "null" : run_live_) + "}";
+                       R"(,"run":)" + run + "}";
     server_->publish(std::move(page));
     publish_timer_.expires_after(100ms);
     publish_timer_.async_wait([this](const boost::system::error_code& ec) {
@@ -1200,7 +1217,8 @@ class Service {
   std::size_t set_done_ = 0;               // its tests whose stored values were read
   std::int64_t run_id_ = 0;
   std::string test_;
-  std::string run_live_;
+  std::string run_live_;            // a linear run's live state
+  LiveTraceFeed circle_live_;       // a circle run's
   json run_origin_;                 // stored_origin(run_id_) of the run in progress
   json setup_summary_;              // summary_of(config_): what Start runs
   std::vector<std::string> twins_;  // --simulate: the shop's devices (device_address)
