@@ -104,22 +104,24 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     shot(b, "s01-set-test1-1366x768.png")
     page_checks.fits_narrow(b, SHOTS, "s01b-set-waiting-560.png", "the wait for the feed-in fits 560 px")
     post(url + "api/simulation/speed", {"speed": 10})
-    c0, bytes0, t0 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];") + [time.time()]
+    c0, bytes0, s0, t0 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0, window.caldaq.statusMessages];") + [time.time()]
     b.js("window.__biggest = 0; window.__sizes = setInterval(() => { window.__biggest = Math.max(window.__biggest, window.caldaq.bytes || 0); }, 5);")
     text = wait(NEXT + " && /set: test 2 of 3/.test(n.textContent) && n.textContent;", "test 2's instruction")
     ok("Next: test 3 of 3, YZ 220°" in text and
        ("Leave the bar mounted: the set's program moves it from the XY plane onto the ZX plane" in text or
         "Measuring" in text), f"test 2: the bar stays (the program moves it), then YZ: {text!r}")
-    c1, bytes1, t1 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];") + [time.time()]
+    c1, bytes1, s1, t1 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0, window.caldaq.statusMessages];") + [time.time()]
     print(f"measured during the set's first test: {(c1 - c0) / (t1 - t0):.1f} page updates per second, "
           f"{(bytes1 - bytes0) / max(1, c1 - c0):.0f} bytes per update", flush=True)
     ok((c1 - c0) / (t1 - t0) >= 2, "the page is updated at least twice a second during the set")
-    # The whole trace in every message made 15 kB an update at this pace (the shop at 10x: about
-    # 290 new points a second of wall time, each ~16 bytes); now each carries the last 0.5 s of
-    # points (~1.7 kB at 10x) with the status, the devices and the run's state (~3.5 kB).
+    # The whole trace and the status in every message made 11 to 15 kB an update at this pace
+    # (the shop at 10x: about 290 new points a second of wall time, ~14 bytes each); now each
+    # carries the last 0.4 s of points (~1.5 kB at 10x), the devices' values (~1.8 kB) and the
+    # run's state, and the status (1 to 2.5 kB) only after it changed.
     biggest = b.js("clearInterval(window.__sizes); return window.__biggest;")
-    ok((bytes1 - bytes0) / max(1, c1 - c0) < 8000 and biggest < 12000,
+    ok((bytes1 - bytes0) / max(1, c1 - c0) < 6000 and biggest < 10000,
        f"an update is not the whole trace again: {(bytes1 - bytes0) / max(1, c1 - c0):.0f} bytes on average, {biggest} at most")
+    ok(s1 - s0 < (c1 - c0) / 2, f"the status is not in every update: in {s1 - s0} of {c1 - c0}")
     row = wait("const r = document.querySelector('#set-box tr[data-set-test=\"1\"]'); return r && "
                "r.cells[3].textContent === 'done' && r.cells[4].textContent !== '—' && [...r.cells].map(c => c.textContent);",
                "test 1 done in the set's table")
@@ -129,6 +131,9 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(row[2] == str(first) and row[6] in ("PASS", "FAIL", "no tolerance configured"), f"with its run and verdict: {row}")
     post(url + "api/simulation/speed", {"speed": 50})
     shot(b, "s02-set-test2-1366x768.png")
+    # The live polar plot beside the number at 1366 x 768, whole (it was under the fold).
+    polar = b.js("const e = document.getElementById('polar').getBoundingClientRect(); return [e.top, e.bottom, e.width, window.innerHeight];")
+    ok(polar[2] > 300 and polar[0] >= 0 and polar[1] <= polar[3], f"the live polar plot on screen, {polar[2]:.0f} px wide: {polar}")
 
     # --- 3. the end: the three-plane table as the CLI prints it ---------------------------
     wait("const s = window.caldaq.page.status.set; return s && s.state === 'complete' && s.table;", "the set's end")
@@ -223,6 +228,12 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
                  "present.signed(-0.01, 1), present.unit('urad'), present.unit('arcsec')];")
     ok(shown == ["stop quality 0.050 µrad, spread 1.5 µm/m, drum", "captured by hand: stop 3: 0.000 µrad", "0.00", "-0.01",
                  "+0.0", "µrad", "arcsec"], f"present.js: units as signs, no negative zero: {shown}")
+
+    # The page's status (kept from the messages that carried it) is the service's.
+    mine = b.js("return window.caldaq.page.status;")
+    theirs = get(url + "api/status")
+    ok({k: v for k, v in mine.items() if k != "seq"} == {k: v for k, v in theirs.items() if k != "seq"},
+       f"the page's status is the service's: {json.dumps(mine)[:300]} vs {json.dumps(theirs)[:300]}")
 
     # --- 4. the live trace: the page's, from the new points, is the service's whole ----------
     b.js("document.getElementById('tab-run').click();")

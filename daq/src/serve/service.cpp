@@ -303,7 +303,7 @@ class Service {
                        return web::operator_page(nonce, ::daq::unit_signs_json());
                      },
                  .runs = [this] { return runs(); },
-                 .status = [this] { return ok(status()); },
+                 .status = [this] { return ok(status_with_seq()); },
                  .start = [this](const std::string& body) { return start(body); },
                  .stop = [this](const std::string& body) { return stop_request(body); }};
     const auto get = [&](std::string path, auto handler) {
@@ -884,6 +884,14 @@ class Service {
     return j;
   }
 
+  // GET /api/status: the status and the version of the one last published (the page's, which
+  // asks when its version is older than a message's; see publish_loop).
+  json status_with_seq() const {
+    json j = status();
+    j["seq"] = status_seq_;
+    return j;
+  }
+
   // 400 for what the client got wrong (the body, a test the set-up lacks, a device that cannot
   // be opened); 409 while a run runs or a device it needs is not ready (the reason named);
   // 500 for the store or the capture failing.
@@ -1184,13 +1192,25 @@ class Service {
   // The page's state, 10 times a second (the server sends only the latest, and only when it
   // changed): the status, every device, and the run's live state (kept after it ends, so the
   // page still shows its last table).
+  //
+  // The status changes a few times a run (a start, a set's next test, the end) and weighed 1 to
+  // 2.5 kB of every message: it is sent in the messages of the 0.4 s after each change (a page
+  // skips a message or two at most while it keeps up) and every message names its version,
+  // `status_seq`; a page whose version is older asks GET /api/status (with `seq`). Likewise a
+  // circle's trace: its new points only (serve/live_trace.hpp).
   void publish_loop() {
-    // A circle's trace: its new points only (serve/live_trace.hpp).
-    const std::string run = !run_live_.empty() ? run_live_
-                            : !circle_live_.empty()
-                                ? circle_live_.page_json(LiveTraceFeed::Clock::now()).dump()
-                                : "null";
-    std::string page = R"({"schema":"caldaq.page.v1","status":)" + status().dump() +
+    const auto now = LiveTraceFeed::Clock::now();
+    if (std::string s = status().dump(); s != status_text_) {
+      status_text_ = std::move(s);
+      ++status_seq_;
+      status_changed_ = now;
+    }
+    const bool with_status = now - status_changed_ < LiveTraceFeed::repeat_for;
+    const std::string run = !run_live_.empty()      ? run_live_
+                            : !circle_live_.empty() ? circle_live_.page_json(now).dump()
+                                                    : "null";
+    std::string page = R"({"schema":"caldaq.page.v1","status_seq":)" + std::to_string(status_seq_) +
+                       (with_status ? R"(,"status":)" + status_text_ : std::string()) +
                        R"(,"devices":)" +
                        board_->to_json().dump(-1, ' ', false, json::error_handler_t::replace) +
                        R"(,"run":)" + run + "}";
@@ -1217,6 +1237,9 @@ class Service {
   std::size_t set_done_ = 0;               // its tests whose stored values were read
   std::int64_t run_id_ = 0;
   std::string test_;
+  std::string status_text_;  // the status last published, its version and when it changed
+  std::uint64_t status_seq_ = 0;
+  LiveTraceFeed::Clock::time_point status_changed_{};
   std::string run_live_;            // a linear run's live state
   LiveTraceFeed circle_live_;       // a circle run's
   json run_origin_;                 // stored_origin(run_id_) of the run in progress
