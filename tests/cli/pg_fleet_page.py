@@ -8,6 +8,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "web"))
 from webdriver import Browser, png_size  # noqa: E402
+from page_checks import ascii_units  # noqa: E402
 
 url, shots = sys.argv[1], sys.argv[2]
 os.makedirs(shots, exist_ok=True)
@@ -62,6 +63,10 @@ with Browser(width=1366, height=768) as b:
     cells = b.js("return [...document.querySelectorAll('td.num')].map(c => c.textContent);")
     need(any(c.endswith(" µm") for c in cells) and any(c.endswith(" µm/yr") for c in cells)
          and not any(c.endswith((" um", " urad", " um/m")) for c in cells), f"units {cells[:12]}")
+    # Its numbers through the operator page's presentation (daq/web/present.js): never "-0.000".
+    need(not any(ascii_units(c) for c in cells), f"no ASCII unit nor '-0.000' in a cell: {[c for c in cells if ascii_units(c)][:5]}")
+    need(b.js("return [present.fixed(-0.0004, 3), present.text('slope -0.0001 um/yr')];") == ["0.000", "slope -0.0001 µm/yr"],
+         "the shared presentation is the fleet page's")
     for name, script in (("fleet.png", "window.scrollTo(0, 0);"),
                          ("fleet-foot.png", "window.scrollTo(0, document.body.scrollHeight);")):
         b.js(script)

@@ -215,6 +215,22 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     captured = list(shown["captured"].values())
     ok(captured and all(u == "µrad" for _, u in captured), f"angular: the captured stop's number in µrad: {captured}")
 
+    # Its Results in the signs an engineer reads: the stops' check said "0.050 urad" (the
+    # service's words, for terminals), and no number reads "-0.00" (a stop at X = 0 reads ~0).
+    b.js("document.getElementById('tab-results').click();")
+    wait(f"return !!document.querySelector('[data-show-run=\"{run}\"]');", "the angular run listed")
+    b.js(f"document.querySelector('[data-show-run=\"{run}\"]').click();")
+    panel = wait(f"return window.caldaq.result && window.caldaq.result.id === {run} && document.getElementById('result-values') && "
+                 "[document.getElementById('result-panel').innerText, document.getElementById('result-quality').innerText];",
+                 "the angular run's Results")
+    summary = (doc.get("quality") or {}).get("summary", "")
+    ok("urad" not in panel[1] and ("urad" not in summary or "µrad" in panel[1]),
+       f"angular: the stops' check in µrad (stored: {summary!r}): {panel[1]!r}")
+    bad = page_checks.ascii_units(panel[0])
+    ok(not bad, f"angular: no 'um', 'urad' nor '-0.00' in its Results: {bad}")
+    page_checks.shot(b, SHOTS, "k-angular-results-1366x768.png")
+    b.js("document.getElementById('tab-run').click();")
+
     run, shown = run_kind("roll", "X", "", "roll of X")
     doc = get(url + f"api/runs/{run}")
     shown_as_stored(shown, doc, "Roll (µrad)", "roll")

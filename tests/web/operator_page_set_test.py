@@ -7,13 +7,19 @@
 2. Start: the page says what to do now (mount the bar, run the program; then leave it mounted
    while the program moves it onto the next plane) and what comes next, test k of 3;
 3. each test done shows its stored run, G and verdict (the same G as /api/runs/N);
-4. before the feed-in the big number is dashes and "waiting" (the bar's reading then is no circle
-   deviation); the simulated machine's squareness is measured in every plane, and its vibration of Y (0.6 µm at
-   23.7 Hz) in XY and YZ, not in ZX; a circle's Results
-   say nothing of target stops;
+4. before the feed-in the big number's place says "Waiting for the feed-in" in words (never blank,
+   never a number: the bar's reading then is no circle deviation), with the test it is about to
+   measure and the bar's live reading (the device board's, in the same message); the simulated
+   machine's squareness is measured in every plane, and its vibration of Y (0.6 µm at 23.7 Hz) in
+   XY and YZ, not in ZX; a circle's Results say nothing of target stops;
 5. at the end the three-plane table, the same numbers `daq ballbar volumetric --runs` prints
    (the CLI's code), on the Run view and in the Results (opened by itself), at 1366 x 768 and
-   560 px; updates per second and bytes per update measured during the set.
+   560 px; the Results' verdict, what failed (the stored run's checks) and the polar plot all
+   within the 1366 x 768 window without scrolling;
+6. updates per second and bytes per update measured during the set: the polar trace is not resent
+   whole in every message (it was: 15 kB an update), and the page's trace, built from the new
+   points, is the service's whole trace (also for a page loaded after the test, which fetches it);
+   units as their signs (µm, µrad, never "um", "urad") and no "-0.00" anywhere on the page.
 
 Waits: up to 60 s for each phase (a 2-core machine under ctest -j3; the whole set is about 250 s
 of simulated time, 5 s at the shop's 50x). Usage: operator_page_set_test.py DAQ_BINARY SHOT_DIR
@@ -72,30 +78,50 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     b.js("document.getElementById('start-circle').click();")
     first = wait("const s = window.caldaq.page.status; return s.running && s.set && s.set.tests[0].run;", "the set to start")
     # While the run waits for the feed-in the bar streams, but its reading is no deviation from
-    # the circle (it showed "49999.97 µm"): dashes and what the run waits for, read in the same
+    # the circle (it showed "49999.97 µm"): what the run waits for in words where the number goes
+    # (it was an empty area), the test it measures and the bar's own reading, read in the same
     # script as the live state the page drew them from.
     waiting = wait("const r = window.caldaq.page.run; if (!(r && r.schema === 'caldaq.live-circle.v1' && "
-                   "r.state === 'waiting' && r.samples > 0)) return false; return [r.deviation_um, "
+                   "r.state === 'waiting' && r.samples > 0)) return false; "
+                   "const d = window.caldaq.page.devices.devices.find(x => x.role === 'ballbar'); "
+                   "const q = Object.keys(d.values || {}).find(k => k.startsWith('length_m')); if (!q) return false; "
+                   "const big = document.getElementById('big'); return [r.deviation_um, "
                    "document.getElementById('reading').textContent, document.getElementById('reading-unit').textContent, "
-                   "document.getElementById('reading-label').textContent];", "the bar streaming before the feed-in")
-    ok(waiting[0] is None and waiting[1] == "—" and waiting[2] == "" and "waiting for the feed-in" in waiting[3],
-       f"before the feed-in: no deviation in the status, dashes and 'waiting' on the page: {waiting}")
+                   "document.getElementById('reading-label').textContent, document.getElementById('progress').textContent, "
+                   "d.values[q], getComputedStyle(big).visibility, big.getBoundingClientRect().height];",
+                   "the bar streaming before the feed-in")
+    ok(waiting[0] is None and waiting[1] == "Waiting for the feed-in" and waiting[2] == "" and waiting[6] == "visible"
+       and waiting[7] > 40, f"before the feed-in: no deviation in the status, 'Waiting for the feed-in' where the number goes: {waiting}")
+    ok("XY 360°, 3000 mm/min, R 100.0 mm" in waiting[3] and "no circle deviation before the feed-in" in waiting[3],
+       f"the test about to be measured named above it: {waiting[3]!r}")
+    ok(waiting[4] == f"Bar reading now: {waiting[5] * 1e3:.4f} mm",
+       f"the bar's live reading below it, the device board's value in mm: {waiting[4]!r} vs {waiting[5]} m")
     NEXT = "const n = document.getElementById('set-next'); return !n.hidden"
     text = wait(NEXT + " && /set: test 1 of 3/.test(n.textContent) && n.textContent;", "test 1's instruction")
     ok("Ballbar set: test 1 of 3: XY 360°, 3000 mm/min, R 100.0 mm" in text and
        "Mount the bar in the XY plane on the table ball and run the set's program" in text and
        "Next: test 2 of 3, ZX 220°" in text, f"test 1: what to do and what comes next: {text!r}")
     shot(b, "s01-set-test1-1366x768.png")
+    page_checks.fits_narrow(b, SHOTS, "s01b-set-waiting-560.png", "the wait for the feed-in fits 560 px")
     post(url + "api/simulation/speed", {"speed": 10})
-    c0, bytes0, t0 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];") + [time.time()]
+    c0, bytes0, s0, t0 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0, window.caldaq.statusMessages];") + [time.time()]
+    b.js("window.__biggest = 0; window.__sizes = setInterval(() => { window.__biggest = Math.max(window.__biggest, window.caldaq.bytes || 0); }, 5);")
     text = wait(NEXT + " && /set: test 2 of 3/.test(n.textContent) && n.textContent;", "test 2's instruction")
     ok("Next: test 3 of 3, YZ 220°" in text and
        ("Leave the bar mounted: the set's program moves it from the XY plane onto the ZX plane" in text or
         "Measuring" in text), f"test 2: the bar stays (the program moves it), then YZ: {text!r}")
-    c1, bytes1, t1 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0];") + [time.time()]
+    c1, bytes1, s1, t1 = b.js("return [window.caldaq.messages, window.caldaq.bytesTotal || 0, window.caldaq.statusMessages];") + [time.time()]
     print(f"measured during the set's first test: {(c1 - c0) / (t1 - t0):.1f} page updates per second, "
           f"{(bytes1 - bytes0) / max(1, c1 - c0):.0f} bytes per update", flush=True)
     ok((c1 - c0) / (t1 - t0) >= 2, "the page is updated at least twice a second during the set")
+    # The whole trace and the status in every message made 11 to 15 kB an update at this pace
+    # (the shop at 10x: about 290 new points a second of wall time, ~14 bytes each); now each
+    # carries the last 0.4 s of points (~1.5 kB at 10x), the devices' values (~1.8 kB) and the
+    # run's state, and the status (1 to 2.5 kB) only after it changed.
+    biggest = b.js("clearInterval(window.__sizes); return window.__biggest;")
+    ok((bytes1 - bytes0) / max(1, c1 - c0) < 6000 and biggest < 10000,
+       f"an update is not the whole trace again: {(bytes1 - bytes0) / max(1, c1 - c0):.0f} bytes on average, {biggest} at most")
+    ok(s1 - s0 < (c1 - c0) / 2, f"the status is not in every update: in {s1 - s0} of {c1 - c0}")
     row = wait("const r = document.querySelector('#set-box tr[data-set-test=\"1\"]'); return r && "
                "r.cells[3].textContent === 'done' && r.cells[4].textContent !== '—' && [...r.cells].map(c => c.textContent);",
                "test 1 done in the set's table")
@@ -105,6 +131,9 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(row[2] == str(first) and row[6] in ("PASS", "FAIL", "no tolerance configured"), f"with its run and verdict: {row}")
     post(url + "api/simulation/speed", {"speed": 50})
     shot(b, "s02-set-test2-1366x768.png")
+    # The live polar plot beside the number at 1366 x 768, whole (it was under the fold).
+    polar = b.js("const e = document.getElementById('polar').getBoundingClientRect(); return [e.top, e.bottom, e.width, window.innerHeight];")
+    ok(polar[2] > 300 and polar[0] >= 0 and polar[1] <= polar[3], f"the live polar plot on screen, {polar[2]:.0f} px wide: {polar}")
 
     # --- 3. the end: the three-plane table as the CLI prints it ---------------------------
     wait("const s = window.caldaq.page.status.set; return s && s.state === 'complete' && s.table;", "the set's end")
@@ -161,6 +190,22 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
                    "the polar plot on the Results")
     ok(painted > 500, f"the ccw trace is drawn on the Results ({painted} blue pixels)")
     shot(b, "s03-set-results-1366x768.png")
+    # At 1366 x 768 the verdict, what failed and the polar plot are on screen without scrolling
+    # (they were under the set's tables). What failed is the stored run's checks that failed.
+    fold = b.js("const r = (id) => { const e = document.getElementById(id).getBoundingClientRect(); return [e.top, e.bottom]; };"
+                "return {h: window.innerHeight, y: window.scrollY, verdict: r('result-verdict'), failed: r('result-failed'),"
+                " polar: r('result-polar'), text: document.getElementById('result-verdict').textContent,"
+                " items: [...document.querySelectorAll('#result-failed [data-failed]')].map(e => e.textContent)};")
+    ok(fold["y"] == 0 and all(0 <= fold[k][0] and fold[k][1] <= fold["h"] for k in ("verdict", "polar")),
+       f"the verdict and the polar plot above the fold at 1366 x 768: {fold}")
+    cur = next(r for r in get(url + f"api/runs/{runs[2]}")["results"] if r["current"])
+    failed = [c for c in cur["verdict"]["checks"] if not c["pass"]]
+    ok(fold["text"] == ("FAIL" if failed else "PASS") and len(fold["items"]) == len(failed) and
+       (not failed or fold["failed"][1] <= fold["h"]), f"the verdict with each failed value beside it: {fold['items']} vs {failed}")
+    for c, text in zip(failed, fold["items"]):
+        unit = {"um": "µm", "um/m": "µm/m"}.get(c["unit"], c["unit"])
+        ok(text == f"{c['symbol']} {c['value']:.3f} {unit} over its limit {c['limit']:.3f} {unit}",
+           f"the failed value as stored, in its unit's sign: {text!r}")
     b.js("document.getElementById('result-polar').scrollIntoView();")
     shot(b, "s03b-set-results-polar-1366x768.png")
     b.js("window.scrollTo(0, 0);")
@@ -172,4 +217,34 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     page_checks.fits_narrow(b, SHOTS, "s05-set-end-run-560.png", "the set's table fits 560 px")
     b.js("document.getElementById('tab-results').click();")
     page_checks.fits_narrow(b, SHOTS, "s06-set-results-560.png", "the Results with the set fit 560 px")
+    # Units as their signs and numbers without a negative zero, on every view shown; the shared
+    # presentation itself (daq/web/present.js) on the service's own words, checked by hand.
+    for view in ("run", "results"):
+        b.js(f"document.getElementById('tab-{view}').click();")
+        bad = page_checks.ascii_units(b.js("return document.body.innerText;"))
+        ok(not bad, f"the {view} view writes no 'um', 'urad' nor '-0.00': {bad}")
+    shown = b.js("return [present.text('stop quality 0.050 urad, spread 1.5 um/m, drum'), "
+                 "present.text('captured by hand: stop 3: -0.000 urad'), present.fixed(-0.004, 2), present.fixed(-0.006, 2), "
+                 "present.signed(-0.01, 1), present.unit('urad'), present.unit('arcsec')];")
+    ok(shown == ["stop quality 0.050 µrad, spread 1.5 µm/m, drum", "captured by hand: stop 3: 0.000 µrad", "0.00", "-0.01",
+                 "+0.0", "µrad", "arcsec"], f"present.js: units as signs, no negative zero: {shown}")
+
+    # The page's status (kept from the messages that carried it) is the service's.
+    mine = b.js("return window.caldaq.page.status;")
+    theirs = get(url + "api/status")
+    ok({k: v for k, v in mine.items() if k != "seq"} == {k: v for k, v in theirs.items() if k != "seq"},
+       f"the page's status is the service's: {json.dumps(mine)[:300]} vs {json.dumps(theirs)[:300]}")
+
+    # --- 4. the live trace: the page's, from the new points, is the service's whole ----------
+    b.js("document.getElementById('tab-run').click();")
+    whole = get(url + "api/live/trace")
+    mine = b.js("const t = window.caldaq.liveTrace; return t && {epoch: t.epoch, ccw: t.ccw, cw: t.cw};")
+    ok(mine and mine["epoch"] == whole["epoch"] and mine["ccw"] == whole["ccw"] and mine["cw"] == whole["cw"] and len(whole["ccw"]) > 150,
+       f"the page's trace is the service's: {len(whole['ccw'])} + {len(whole['cw'])} points, the page "
+       f"{mine and (len(mine['ccw']), len(mine['cw']))}")
+    # A page loaded now missed every new point: it asks for the whole trace once.
+    b.get(url)
+    again = wait("const t = window.caldaq.liveTrace; return t && t.ccw.length > 150 && [t.ccw.length, t.cw.length, window.caldaq.traceFetches];",
+                 "the trace on a page loaded after the test")
+    ok(again == [len(whole["ccw"]), len(whole["cw"]), 1], f"fetched whole once by a page loaded late: {again}")
     page_checks.no_script_error(b)

@@ -428,14 +428,14 @@ try:
         b.wait("return window.caldaq.page.status.start.circle.ready;", timeout_s=30,
                what="Start ballbar ready")
         b.js("window.__ccwSeen = 0; window.__ccwTimer = setInterval(() => {"
-             " const r = window.caldaq.page.run;"
-             " if (r && r.trace) window.__ccwSeen = Math.max(window.__ccwSeen, r.trace.ccw.length);"
+             " const t = window.caldaq.liveTrace;"  # the page's own trace, built from the new points
+             " if (t) window.__ccwSeen = Math.max(window.__ccwSeen, t.ccw.length);"
              " }, 10);")
         b.js("document.getElementById('start-circle').click();")
         b.wait("return window.__ccwSeen > 150;", timeout_s=90, what="the polar trace",
                explain="return JSON.stringify({seen: window.__ccwSeen, run: window.caldaq.page.run"
-                       " && {state: window.caldaq.page.run.state, ccw: window.caldaq.page.run.trace"
-                       " && window.caldaq.page.run.trace.ccw.length}, last: window.caldaq.page.status.last});")
+                       " && {state: window.caldaq.page.run.state, ccw: window.caldaq.liveTrace"
+                       " && window.caldaq.liveTrace.ccw.length}, last: window.caldaq.page.status.last});")
         b.js("clearInterval(window.__ccwTimer);")
         shot(b, "10-ballbar-live.png")
         # Measured, not asserted (a timing assert has no place in a test): the page's update

@@ -51,6 +51,16 @@ def fits_narrow(b, directory, name, what):
     b.set_size(1366, 768)
 
 
+# A unit as a terminal writes it ("um", "urad", "um/m") as a word, or a number that rounds to
+# zero written with a minus ("-0.00"): neither belongs on a page (daq/web/present.js).
+ASCII_UNIT_OR_NEGATIVE_ZERO = re.compile(r"(?<![A-Za-z0-9])(?:um|urad|um/m)(?![A-Za-z0-9])|(?<![0-9.])-0\.0+(?![0-9])")
+
+
+def ascii_units(text):
+    """Where TEXT writes a unit in ASCII or a negative zero: up to 3 excerpts (none: [])."""
+    return [text[max(0, m.start() - 30):m.end() + 10] for m in ASCII_UNIT_OR_NEGATIVE_ZERO.finditer(text)][:3]
+
+
 def post(url, body):
     req = urllib.request.Request(url, data=json.dumps(body).encode(), method="POST",
                                  headers={"Content-Type": "application/json"})

@@ -227,6 +227,23 @@ TEST(OperatorPage, IsOneSelfContainedDocument) {
   EXPECT_EQ(page.find("<script src="), std::string::npos);
   EXPECT_EQ(page.find("<link"), std::string::npos);
   EXPECT_NE(page.find("new WebSocket"), std::string::npos);
+  EXPECT_EQ(page.find("/*PRESENT_JS*/"), std::string::npos);
+  EXPECT_EQ(page.find("/*UNIT_SIGNS*/"), std::string::npos);
+}
+
+// The units' signs given by the service reach both pages with the presentation they share
+// (daq/web/present.js), which is in each page once.
+TEST(OperatorPage, BothPagesShareThePresentationAndItsUnits) {
+  const std::string signs = R"([["urad","µrad"]])";
+  for (const std::string& page :
+       {cal::daq::web::operator_page("N", signs), cal::daq::web::fleet_page("N", signs)}) {
+    EXPECT_NE(page.find("const UNIT_SIGNS = " + signs + ";"), std::string::npos);
+    const auto at = page.find("const present = ");
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_EQ(page.find("const present = ", at + 1), std::string::npos);
+    EXPECT_EQ(page.find("/*PRESENT_JS*/"), std::string::npos);
+    EXPECT_EQ(page.find("<script>"), std::string::npos);  // every script with its nonce
+  }
 }
 
 // The request rules (http_policy.hpp) apart from the sockets; the hostile-client suite

@@ -12,6 +12,7 @@
 #include "cal/analysis/text.hpp"
 #include "circle_output.hpp"
 #include "iso230_2_output.hpp"
+#include "unit_signs.hpp"
 
 namespace daq {
 
@@ -163,16 +164,27 @@ std::string signed_number_text(double value, int decimals) {
   return s.front() == '-' || s.find_first_not_of("0.") == std::string::npos ? s : "+" + s;
 }
 
+std::span<const std::pair<std::string_view, std::string_view>> unit_signs() {
+  // "urad": an angular or roll run's unit. Longest first: "um/m" is not "um" and "/m".
+  static constexpr std::pair<std::string_view, std::string_view> signs[] = {
+      {"um/m", "µm/m"}, {"um", "µm"}, {"urad", "µrad"}, {"degC", "°C"}};
+  return signs;
+}
+
+std::string unit_signs_json() {
+  json a = json::array();
+  for (const auto& [ascii, sign] : unit_signs()) a.push_back({ascii, sign});
+  return a.dump();
+}
+
 std::string unit_html(std::string_view unit) {
-  if (unit == "um") return "µm";
-  if (unit == "um/m") return "µm/m";
-  if (unit == "urad") return "µrad";  // an angular or roll run's unit
+  for (const auto& [ascii, sign] : unit_signs())
+    if (unit == ascii) return std::string(sign);
   return std::string(unit);
 }
 
 std::string units_html(std::string_view text) {
-  static constexpr std::pair<std::string_view, std::string_view> units[] = {
-      {"um/m", "µm/m"}, {"um", "µm"}, {"urad", "µrad"}, {"degC", "°C"}};
+  const auto units = unit_signs();
   const auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
   std::string out;
   for (std::size_t i = 0; i < text.size();) {

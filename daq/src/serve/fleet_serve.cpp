@@ -16,6 +16,7 @@
 #include "cal/storage/pg/fleet.hpp"
 #include "cal/storage/pg/sync.hpp"
 #include "server.hpp"
+#include "unit_signs.hpp"
 
 namespace daq::serve {
 namespace {
@@ -53,9 +54,11 @@ web::Response answer(F&& f) {
 }
 
 web::Api fleet_api(const std::string& url) {
-  web::Api api{.page = [](std::string_view nonce) { return web::fleet_page(nonce); },
-               .start = [](const std::string&) { return error(403, kReaderOnly); },
-               .stop = [](const std::string&) { return error(403, kReaderOnly); }};
+  web::Api api{
+      .page =
+          [](std::string_view nonce) { return web::fleet_page(nonce, ::daq::unit_signs_json()); },
+      .start = [](const std::string&) { return error(403, kReaderOnly); },
+      .stop = [](const std::string&) { return error(403, kReaderOnly); }};
   // The queries run on the event loop, one at a time: the page asks for the fleet once and a
   // machine's history when it is opened, each well under a second at 1,000 machines
   // (docs/benchmarks.md, "The fleet view").

@@ -48,10 +48,12 @@
 #include "serve/device_allow.hpp"
 #include "serve/device_board.hpp"
 #include "serve/instrument_form.hpp"
+#include "serve/live_trace.hpp"
 #include "serve/model_view.hpp"
 #include "serve/setup_form.hpp"
 #include "serve/volumetric_checklist.hpp"
 #include "sim_shop.hpp"
+#include "unit_signs.hpp"
 #include "web/assets.hpp"
 #include "web/server.hpp"
 
@@ -296,9 +298,12 @@ class Service {
   }
 
   void make_server() {
-    web::Api api{.page = [](std::string_view nonce) { return web::operator_page(nonce); },
+    web::Api api{.page =
+                     [](std::string_view nonce) {
+                       return web::operator_page(nonce, ::daq::unit_signs_json());
+                     },
                  .runs = [this] { return runs(); },
-                 .status = [this] { return ok(status()); },
+                 .status = [this] { return ok(status_with_seq()); },
                  .start = [this](const std::string& body) { return start(body); },
                  .stop = [this](const std::string& body) { return stop_request(body); }};
     const auto get = [&](std::string path, auto handler) {
@@ -327,6 +332,7 @@ class Service {
     get("/api/machines", &Service::machines);
     get("/api/volumetric", &Service::volumetric);
     get("/api/model", &Service::model);
+    get("/api/live/trace", &Service::live_trace);
     get("/api/runs/", &Service::run_doc);
     get("/reports/", &Service::report);
     post("/api/setup/check", &Service::setup_check);
@@ -612,6 +618,11 @@ class Service {
   }
 
   web::Response devices(std::string_view) { return ok(board_->to_json()); }
+  // The live circle's whole polar trace, for a page that missed some of its new points.
+  web::Response live_trace(std::string_view) {
+    if (circle_live_.empty()) return error(404, "no circle run has a live trace");
+    return ok(circle_live_.whole());
+  }
   web::Response drivers(std::string_view) { return ok(driver_descriptions()); }
   web::Response detected(std::string_view) { return ok(list_devices({})); }
 
@@ -873,6 +884,14 @@ class Service {
     return j;
   }
 
+  // GET /api/status: the status and the version of the one last published (the page's, which
+  // asks when its version is older than a message's; see publish_loop).
+  json status_with_seq() const {
+    json j = status();
+    j["seq"] = status_seq_;
+    return j;
+  }
+
   // 400 for what the client got wrong (the body, a test the set-up lacks, a device that cannot
   // be opened); 409 while a run runs or a device it needs is not ready (the reason named);
   // 500 for the store or the capture failing.
@@ -899,6 +918,7 @@ class Service {
       return error(409, fmt::format("Start refused: {}", *refusal));
     stop_monitors_of(*test);  // the run opens them itself (its capture starts at the connection)
     run_live_.clear();
+    circle_live_.clear();
     try {
       if (*test == "linear")
         start_linear();
@@ -1067,7 +1087,7 @@ class Service {
         .origins = {{"ballbar", origin_of(specs[0].origin, "")}},
         .following = std::vector<CircleTest>(tests.begin() + 1, tests.end())};
     mark_simulated(setup.origins);
-    setup.on_live = [this](const CircleLive& s) { run_live_ = to_json_text(s); };
+    setup.on_live = [this](const CircleLive& s) { circle_live_.update(s, run_id_); };
     setup.on_event = [](const std::string& e) { fmt::print("  {}\n", e); };
     circle_ = std::make_unique<CircleRun>(io_, std::move(setup));
     circle_->start();
@@ -1172,11 +1192,28 @@ class Service {
   // The page's state, 10 times a second (the server sends only the latest, and only when it
   // changed): the status, every device, and the run's live state (kept after it ends, so the
   // page still shows its last table).
+  //
+  // The status changes a few times a run (a start, a set's next test, the end) and weighed 1 to
+  // 2.5 kB of every message: it is sent in the messages of the 0.4 s after each change (a page
+  // skips a message or two at most while it keeps up) and every message names its version,
+  // `status_seq`; a page whose version is older asks GET /api/status (with `seq`). Likewise a
+  // circle's trace: its new points only (serve/live_trace.hpp).
   void publish_loop() {
-    std::string page = R"({"schema":"caldaq.page.v1","status":)" + status().dump() +
+    const auto now = LiveTraceFeed::Clock::now();
+    if (std::string s = status().dump(); s != status_text_) {
+      status_text_ = std::move(s);
+      ++status_seq_;
+      status_changed_ = now;
+    }
+    const bool with_status = now - status_changed_ < LiveTraceFeed::repeat_for;
+    const std::string run = !run_live_.empty()      ? run_live_
+                            : !circle_live_.empty() ? circle_live_.page_json(now).dump()
+                                                    : "null";
+    std::string page = R"({"schema":"caldaq.page.v1","status_seq":)" + std::to_string(status_seq_) +
+                       (with_status ? R"(,"status":)" + status_text_ : std::string()) +
                        R"(,"devices":)" +
                        board_->to_json().dump(-1, ' ', false, json::error_handler_t::replace) +
-                       R"(,"run":)" + (run_live_.empty() ? "null" : run_live_) + "}";
+                       R"(,"run":)" + run + "}";
     server_->publish(std::move(page));
     publish_timer_.expires_after(100ms);
     publish_timer_.async_wait([this](const boost::system::error_code& ec) {
@@ -1200,7 +1237,11 @@ class Service {
   std::size_t set_done_ = 0;               // its tests whose stored values were read
   std::int64_t run_id_ = 0;
   std::string test_;
-  std::string run_live_;
+  std::string status_text_;  // the status last published, its version and when it changed
+  std::uint64_t status_seq_ = 0;
+  LiveTraceFeed::Clock::time_point status_changed_{};
+  std::string run_live_;            // a linear run's live state
+  LiveTraceFeed circle_live_;       // a circle run's
   json run_origin_;                 // stored_origin(run_id_) of the run in progress
   json setup_summary_;              // summary_of(config_): what Start runs
   std::vector<std::string> twins_;  // --simulate: the shop's devices (device_address)
