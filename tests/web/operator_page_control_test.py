@@ -159,7 +159,7 @@ try:
 
     # --- 2. capture by hand -------------------------------------------------------------------
     c = control(b, "c", "capture")
-    ok(c["ok"] and re.match(r"Done: captured by hand: target \d \(\d+\.000 mm\) run \d (up|down): [+-]\d+\.\d{3} µm$",
+    ok(c["ok"] and re.match(r"Done: captured by hand: target \d \(\d+\.000 mm\) run \d (up|down): [+-]?\d+\.\d{3} µm$",
                             c["text"]), f"C captures the stop, confirmed with its value: {c['text']!r}")
     run = b.wait("const r = window.caldaq.page.run; return r.captured === arguments[0] + 1 && r;".replace(
         "arguments[0]", str(captured0)), what="the captured stop in the live state")

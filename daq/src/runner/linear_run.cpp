@@ -599,8 +599,8 @@ struct LinearRun::Impl : Runner {
     if (own_value()) {
       kind_values.resize(sequencer.stops().size());
       kind_values[stop] = value;
-      event(
-          fmt::format("{}: {} {:+.3f} {}", sequencer.describe(s), kind.name(), value, kind.unit()));
+      event(fmt::format("{}: {} {} {}", sequencer.describe(s), kind.name(),
+                        signed_number_text(value), kind.unit()));
     }
     values.push_back({.position_mm = s.position_mm,
                       .target_index = s.target_index - 1,
@@ -812,8 +812,9 @@ struct LinearRun::Impl : Runner {
     stop = last_taken;
     const auto& s = sequencer.stops()[*stop];
     const auto& u = sequencer.units();
-    return {true, fmt::format("captured by hand: {}: {:+.3f} {}", describe(s),
-                              u.deviation_of(cap->mean_mm, s.position_mm), u.deviation)};
+    return {true, fmt::format("captured by hand: {}: {} {}", describe(s),
+                              signed_number_text(u.deviation_of(cap->mean_mm, s.position_mm)),
+                              u.deviation)};
   }
 
   ControlOutcome skip(std::optional<std::size_t>& stop) {
@@ -835,8 +836,8 @@ struct LinearRun::Impl : Runner {
     if (!stop || !before) return {false, "no stop passed yet: nothing to measure again"};
     std::string dropped = before->skipped ? " (it was skipped)" : " (it was missed)";
     if (before->captured) {
-      dropped = fmt::format(" (the value {:+.3f} {} discarded)", before->deviation_um,
-                            sequencer.units().deviation);
+      dropped = fmt::format(" (the value {} {} discarded)",
+                            signed_number_text(before->deviation_um), sequencer.units().deviation);
       if (!forget_stop(*before)) return {false, "storage failed: the run was aborted"};
     }
     if (*stop < manual.size()) manual[*stop] = false;
