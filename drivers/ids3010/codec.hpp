@@ -156,6 +156,7 @@ class IdsCodec : public CodecBase<IdsCodec, IdsResponse> {
   std::int64_t next_id_ = 1;
   IdsApi api_ = IdsApi::ids;
   std::map<std::int64_t, Pending> pending_;
+  std::map<std::int64_t, Pending>::node_type spare_;  // an answered request's node, for reuse
 };
 
 }  // namespace cal::drivers::codec

@@ -184,6 +184,60 @@ TEST(IdsCodec, PendingRequestsAreBounded) {
   EXPECT_EQ(c.stats().malformed, 1u);
 }
 
+// An answered request's map node is used again for the next request (issue 32): a request
+// noted again under an id still pending replaces the first (the answer is read as the second
+// method's), and the bound still forgets the oldest.
+TEST(IdsCodec, ReusedRequestNodesKeepTheLastRequestOfAnId) {
+  IdsCodec c;
+  const auto request = [](std::string_view method, int id) {
+    return fmt::format(
+        R"({{"jsonrpc":"2.0","method":"com.attocube.{}","params":[],"id":{},"api":2}})"
+        "\n",
+        method, id);
+  };
+  const auto note = [&](std::string_view method, int id) {
+    const std::string line = request(method, id);
+    c.note_requests(std::as_bytes(std::span(line)));
+  };
+  std::vector<IdsResponse> frames;
+  note("sen.displacement.getAxesDisplacement", 1);
+  c.feed(R"({"jsonrpc":"2.0","result":[0,1000,2000,3000],"id":1})"
+         "\n",
+         frames);  // answered: its node is kept for the next request
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(c.pending(), 0u);
+  note("ecu.getTemperatureInDegrees", 2);  // into the kept node
+  note("sen.displacement.getAxesDisplacement", 9);
+  c.feed(R"({"jsonrpc":"2.0","result":[0,1,1,1],"id":9})"
+         "\n",
+         frames);                                   // answered: a node kept again
+  note("sen.displacement.getAxesDisplacement", 2);  // id 2 again, in the kept node: replaces it
+  EXPECT_EQ(c.pending(), 1u);
+  c.feed(R"({"jsonrpc":"2.0","result":[0,20,0,0],"id":2})"
+         "\n",
+         frames);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[2].method, IdsMethod::get_axes_displacement);
+  EXPECT_DOUBLE_EQ(*frames[2].displacement_m[0], 20e-12);  // 20 pm, not 20 degC
+  EXPECT_FALSE(frames[2].temperature_degc.has_value());
+  // Past the bound (the first of these into the node kept from id 2's answer): the oldest go.
+  for (int id = 3; id < 3 + static_cast<int>(IdsCodec::max_pending) + 10; ++id)
+    note("sen.displacement.getAxesDisplacement", id);
+  EXPECT_EQ(c.pending(), IdsCodec::max_pending);
+  c.feed(R"({"jsonrpc":"2.0","result":[0,1,2,3],"id":3})"
+         "\n",
+         frames);  // the oldest were forgotten: id 3 no longer matches
+  EXPECT_EQ(frames.size(), 3u);
+  EXPECT_EQ(c.stats().malformed, 1u);
+  const int last = 2 + static_cast<int>(IdsCodec::max_pending) + 10;
+  c.feed(fmt::format(R"({{"jsonrpc":"2.0","result":[0,5,6,7],"id":{}}})"
+                     "\n",
+                     last),
+         frames);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_DOUBLE_EQ(*frames[3].displacement_m[2], 7e-12);
+}
+
 TEST(IdsDecode, ACaptureOfBothDirectionsAsAttocubesClientWritesThem) {
   // IDS-APIs python/ACS.py writes json.dumps(request) with no terminator and reads each answer
   // with readline() on a socket file opened with newline='\r\n': a TCP stream capture has

@@ -342,7 +342,8 @@ class RowBuffer {
 };
 
 // The most a row's numbers and fixed text take (a double in the shortest form is at most 24
-// characters, an int64 20); the names and the time of day are added to it.
+// characters, an int64 20, each with up to 8 bytes of no meaning written after it and then
+// written over: kSpill in shortest_number.hpp); the names and the time of day are added to it.
 constexpr std::size_t kRowNumbersMax = 256;
 
 // Device names by device number (a handful, small numbers): a vector rather than a map lookup
@@ -392,17 +393,8 @@ void each_reading(const st::RunReader& store, std::int64_t run, F&& f,
 template <class F>
 void each_export_row(const st::RunReader& store, std::int64_t run, ExportClock& clock, F&& f) {
   ExportRows rows(clock);
-  std::vector<ExportRow> out;
-  const auto hand_on = [&] {
-    for (const auto& x : out) f(x);
-    out.clear();
-  };
-  each_reading(store, run, [&](const st::RawReading& r) {
-    rows.add(r, out);
-    hand_on();
-  });
-  rows.finish(out);
-  hand_on();
+  each_reading(store, run, [&](const st::RawReading& r) { rows.add_each(r, f); });
+  rows.finish_each(f);
 }
 
 // A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
@@ -494,7 +486,15 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
     if (!Json || std::isfinite(v)) return write_shortest(q, v);
     return std::copy_n("null", 4, q);
   };
-  p = number(p, clock.seconds(x.session_ns));
+  // The time in seconds, from its nanoseconds: where their decimal is its shortest form
+  // (most readings), written without the shortest-digit search; the text is the same either
+  // way (write_shortest_scaled).
+  const double since_ns = clock.since_origin_ns(x.session_ns);
+  const double seconds = since_ns * 1e-9;  // = clock.seconds(x.session_ns)
+  if (std::abs(since_ns) < 0x1p53)
+    p = write_shortest_scaled(p, seconds, static_cast<std::int64_t>(since_ns), 9);
+  else
+    p = number(p, seconds);
   p = Json ? std::copy_n(",\"", 2, p) : std::copy_n(",", 1, p);
   if (clock.has_utc()) {  // (a run without a time origin leaves it empty: no call per row)
     const auto utc = clock.utc_view(x.session_ns);

@@ -83,53 +83,14 @@ std::string_view ExportClock::utc_view(double session_ns) const {
   return {cached_text_.data(), cached_length_ + 8};
 }
 
-void ExportRows::flush(std::vector<ExportRow>& out) {
-  if (held_ == 1) {  // the usual case, a reading per stored time: it is the last one added
-    auto& e = pending_[last_];
-    out.push_back({e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns), e.tags[0]});
-    e.group.clear();
-    e.tags.clear();
-    held_ = 0;
-    return;
-  }
-  held_ = 0;
-  for (auto& e : pending_) {
-    if (e.group.empty()) continue;
-    if (e.group.size() == 1) {
-      out.push_back(
-          {e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns), e.tags[0]});
-      e.group.clear();
-      e.tags.clear();
-      continue;
-    }
-    ExportClock::spread(*e.stream, e.group, times_);
-    for (std::size_t i = 0; i < e.group.size(); ++i)
-      out.push_back({e.group[i], times_[i], e.tags[i]});
-    e.group.clear();
-    e.tags.clear();
-  }
-}
-
-void ExportRows::add(const st::RawReading& r, std::vector<ExportRow>& out, std::uint64_t tag) {
-  // Readings come in time order: the groups are complete when a later time arrives.
-  if (!first_ && r.time_ns != current_) flush(out);
-  first_ = false;
-  current_ = r.time_ns;
+void ExportRows::find_stream(const st::RawReading& r) {
   const StreamKey key = key_of(r);
-  if (last_ >= pending_.size() || pending_[last_].key != key) {
-    const auto it =
-        std::lower_bound(pending_.begin(), pending_.end(), key,
-                         [](const Pending& e, const StreamKey& k) { return e.key < k; });
-    const auto at = it == pending_.end() || it->key != key
-                        ? pending_.insert(it, Pending{key, &clock_.stream(key), {}, {}})
-                        : it;
-    last_ = static_cast<std::size_t>(at - pending_.begin());  // after the insertion
-  }
-  pending_[last_].group.push_back(r);
-  pending_[last_].tags.push_back(tag);
-  ++held_;
+  const auto it = std::lower_bound(pending_.begin(), pending_.end(), key,
+                                   [](const Pending& e, const StreamKey& k) { return e.key < k; });
+  const auto at = it == pending_.end() || it->key != key
+                      ? pending_.insert(it, Pending{key, &clock_.stream(key), {}, {}})
+                      : it;
+  last_ = static_cast<std::size_t>(at - pending_.begin());  // after the insertion
 }
-
-void ExportRows::finish(std::vector<ExportRow>& out) { flush(out); }
 
 }  // namespace daq

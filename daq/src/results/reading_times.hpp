@@ -53,8 +53,10 @@ class ExportClock {
     s.has_last = true;
     return s.last_ns;
   }
-  double seconds(double session_ns) const {
-    return (session_ns - static_cast<double>(t0_ns_)) * 1e-9;
+  double seconds(double session_ns) const { return since_origin_ns(session_ns) * 1e-9; }
+  // The nanoseconds that seconds() scales (exact for a whole session_ns below 2^53).
+  double since_origin_ns(double session_ns) const {
+    return session_ns - static_cast<double>(t0_ns_);
   }
   // Unix ns of a session time (rounded to the ns), or nullopt when the run has no time origin
   // (stored before it was recorded, or imported).
@@ -90,11 +92,34 @@ struct ExportRow {
 class ExportRows {
  public:
   explicit ExportRows(ExportClock& clock) : clock_(clock) {}
-  // Appends to `out` the rows that `r` completes; `tag` goes out with r's row (the caller's
-  // number for what it computed from r in the store's order, e.g. its compensation).
-  void add(const cal::storage::RawReading& r, std::vector<ExportRow>& out, std::uint64_t tag = 0);
-  // Appends the rows still held (after the last reading).
-  void finish(std::vector<ExportRow>& out);
+  // Hands to `emit` (called with an ExportRow) the rows that `r` completes; `tag` goes out with
+  // r's row (the caller's number for what it computed from r in the store's order, e.g. its
+  // compensation). A template, so that an export's row goes from the store's batch to its text
+  // without a vector between them (the rows' vector, pushed and read back per reading, was a
+  // sixth of an export: issue 32).
+  template <class Emit>
+  void add_each(const cal::storage::RawReading& r, Emit&& emit, std::uint64_t tag = 0) {
+    // Readings come in time order: the groups are complete when a later time arrives.
+    if (held_ != 0 && r.time_ns != current_) flush_each(emit);
+    current_ = r.time_ns;
+    if (last_ >= pending_.size() || pending_[last_].key != key_of(r)) find_stream(r);
+    pending_[last_].group.push_back(r);
+    pending_[last_].tags.push_back(tag);
+    ++held_;
+  }
+  // Hands on the rows still held (after the last reading).
+  template <class Emit>
+  void finish_each(Emit&& emit) {
+    flush_each(emit);
+  }
+  // The same into a vector: appends to `out`.
+  void add(const cal::storage::RawReading& r, std::vector<ExportRow>& out, std::uint64_t tag = 0) {
+    add_each(
+        r, [&](const ExportRow& x) { out.push_back(x); }, tag);
+  }
+  void finish(std::vector<ExportRow>& out) {
+    finish_each([&](const ExportRow& x) { out.push_back(x); });
+  }
 
  private:
   struct Pending {
@@ -103,14 +128,40 @@ class ExportRows {
     std::vector<cal::storage::RawReading> group;
     std::vector<std::uint64_t> tags;
   };
-  void flush(std::vector<ExportRow>& out);
+  // Sets last_ to r's stream's entry, made if it is new.
+  void find_stream(const cal::storage::RawReading& r);
+  template <class Emit>
+  void flush_each(Emit& emit) {
+    if (held_ == 1) {  // the usual case, a reading per stored time: it is the last one added
+      auto& e = pending_[last_];
+      emit(
+          ExportRow{e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns), e.tags[0]});
+      e.group.clear();
+      e.tags.clear();
+      held_ = 0;
+      return;
+    }
+    held_ = 0;
+    for (auto& e : pending_) {
+      if (e.group.empty()) continue;
+      if (e.group.size() == 1) {
+        emit(ExportRow{e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns),
+                       e.tags[0]});
+      } else {
+        ExportClock::spread(*e.stream, e.group, times_);
+        for (std::size_t i = 0; i < e.group.size(); ++i)
+          emit(ExportRow{e.group[i], times_[i], e.tags[i]});
+      }
+      e.group.clear();
+      e.tags.clear();
+    }
+  }
   ExportClock& clock_;
   std::vector<Pending> pending_;  // one per stream seen, by key (a handful: found by a scan)
   std::size_t last_ = 0;          // the entry of the last reading (most follow their stream)
   std::size_t held_ = 0;          // readings in the groups (1: only the last one, at last_)
   std::vector<double> times_;
   std::int64_t current_ = 0;
-  bool first_ = true;
 };
 
 }  // namespace daq

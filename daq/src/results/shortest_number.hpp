@@ -30,6 +30,17 @@ inline void write_pair(char* p, std::uint32_t x) {  // x < 100
   p[1] = kPairs[x * 2 + 1];
 }
 
+// The 8 digits of x < 10^8 as write8 writes them, as the bytes of a word (little-endian only).
+inline std::uint64_t digits8(std::uint32_t x) {
+  const std::uint64_t halves = (x / 10000) | (static_cast<std::uint64_t>(x % 10000) << 32);
+  const std::uint64_t high_pairs = ((halves * 10486) >> 20) & 0x0000007F0000007FULL;
+  const std::uint64_t low_pairs = halves - 100 * high_pairs;
+  const std::uint64_t pairs = (low_pairs << 16) | high_pairs;  // 16-bit lanes, in order
+  const std::uint64_t tens = ((pairs * 103) >> 10) & 0x000F000F000F000FULL;
+  const std::uint64_t digits = tens | ((pairs - 10 * tens) << 8);
+  return digits | 0x3030303030303030ULL;
+}
+
 // Exactly 8 digits of x < 10^8, leading zeros included, with no division chain: the two
 // halves of four digits in the two 32-bit lanes of one word, each split into pairs (x 10486
 // >> 20 is / 100 below 10^4), each pair into digits (x 103 >> 10 is / 10 below 100), all lanes
@@ -37,13 +48,7 @@ inline void write_pair(char* p, std::uint32_t x) {  // x < 100
 // Two divisions per pair were the largest cost of an export's digits (issue 32).
 inline void write8(char* p, std::uint32_t x) {
   if constexpr (std::endian::native == std::endian::little) {
-    const std::uint64_t halves = (x / 10000) | (static_cast<std::uint64_t>(x % 10000) << 32);
-    const std::uint64_t high_pairs = ((halves * 10486) >> 20) & 0x0000007F0000007FULL;
-    const std::uint64_t low_pairs = halves - 100 * high_pairs;
-    const std::uint64_t pairs = (low_pairs << 16) | high_pairs;  // 16-bit lanes, in order
-    const std::uint64_t tens = ((pairs * 103) >> 10) & 0x000F000F000F000FULL;
-    const std::uint64_t digits = tens | ((pairs - 10 * tens) << 8);
-    const std::uint64_t text = digits | 0x3030303030303030ULL;
+    const std::uint64_t text = digits8(x);
     std::memcpy(p, &text, 8);
   } else {
     const std::uint32_t hi = x / 10000, lo = x % 10000;
@@ -54,55 +59,48 @@ inline void write8(char* p, std::uint32_t x) {
   }
 }
 
-// The `size` decimal digits of v (size = count_digits(v)), written to [p, p + size).
+// The last `n` (1..8) digits of x < 10^8 at p, in one 8-byte store: the n characters, then
+// 8 - n bytes of no meaning after them (kSpill: a caller leaves that room and writes over it).
+inline void write_last(char* p, std::uint32_t x, int n) {
+  if constexpr (std::endian::native == std::endian::little) {
+    const std::uint64_t text = digits8(x) >> (8 * (8 - n));  // the first 8 - n digits out
+    std::memcpy(p, &text, 8);
+  } else {
+    char all[8];
+    write8(all, x);
+    std::memcpy(p, all + 8 - n, static_cast<std::size_t>(n));
+  }
+}
+
+// The `size` decimal digits of v (size = count_digits(v)), written to [p, p + size), left to
+// right: the leading group of 1..8 digits in one store, then whole groups of 8, each written
+// over the spill of the one before. Up to kSpill bytes after p + size are written too (no
+// meaning: the caller's room, written over by what follows). The leading group's pairs
+// divided by 100 one at a time (a multiplication and a table look-up each) were the larger
+// part of an export's digit writing (issue 32).
+inline constexpr int kSpill = 8;
 inline void write_digits(char* p, std::uint64_t v, int size) {
-  char* end = p + size;
-  while (v >= 100'000'000) {
-    end -= 8;
-    write8(end, static_cast<std::uint32_t>(v % 100'000'000));
-    v /= 100'000'000;
+  if (size <= 8) return write_last(p, static_cast<std::uint32_t>(v), size);
+  if (size <= 16) {
+    const int lead = size - 8;
+    write_last(p, static_cast<std::uint32_t>(v / 100'000'000), lead);
+    return write8(p + lead, static_cast<std::uint32_t>(v % 100'000'000));
   }
-  auto x = static_cast<std::uint32_t>(v);
-  while (x >= 100) {
-    end -= 2;
-    write_pair(end, x % 100);
-    x /= 100;
-  }
-  if (x >= 10)
-    write_pair(end - 2, x);
-  else
-    end[-1] = static_cast<char>('0' + x);
+  const int lead = size - 16;  // 1..4 (v < 2^64 < 10^20)
+  const std::uint64_t low16 = v % 10'000'000'000'000'000ULL;
+  write_last(p, static_cast<std::uint32_t>(v / 10'000'000'000'000'000ULL), lead);
+  write8(p + lead, static_cast<std::uint32_t>(low16 / 100'000'000));
+  write8(p + lead + 8, static_cast<std::uint32_t>(low16 % 100'000'000));
 }
 
-}  // namespace shortest_detail
-
-// An integer as fmt's "{}" writes it (at most 20 characters); returns the end.
-inline char* write_integer(char* p, std::int64_t v) {
-  std::uint64_t u = static_cast<std::uint64_t>(v);
-  if (v < 0) {
-    *p++ = '-';
-    u = 0 - u;
-  }
-  const int size = fmt::detail::count_digits(u);
-  shortest_detail::write_digits(p, u, size);
-  return p + size;
-}
-
-// Writes v at p (at most 24 characters) and returns the end.
-inline char* write_shortest(char* p, double v) {
-  using namespace shortest_detail;
-  if (!std::isfinite(v)) return fmt::format_to(p, "{}", v);  // inf, nan as fmt writes them
-  if (std::signbit(v)) {
-    *p++ = '-';
-    v = -v;
-  }
-  const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
-  const std::uint64_t sig = dec.significand;
-  const int exponent = dec.exponent;                // v = sig x 10^exponent
+// sig x 10^exponent (sig without trailing zeros, as Dragonbox gives it; {0, 0} for zero) laid
+// out as fmt's "{}" lays out a double's shortest digits: fixed for a decimal exponent of the
+// first digit in [-4, 16), else d[.ddd]e[+-]XX. Returns the end.
+inline char* write_decimal(char* p, std::uint64_t sig, int exponent) {
   const int size = fmt::detail::count_digits(sig);  // branch-free (a table by bit length)
   const int out_exp = exponent + size - 1;          // of the first digit
   if (out_exp < -4 || out_exp >= 16) {              // d[.ddd]e[+-]XX
-    char digits[20];
+    char digits[20 + kSpill];
     write_digits(digits, sig, size);
     *p++ = digits[0];
     if (size > 1) {
@@ -145,6 +143,83 @@ inline char* write_shortest(char* p, double v) {
   for (int i = 0; i < -whole; ++i) *p++ = '0';
   write_digits(p, sig, size);
   return p + size;
+}
+
+// Exact powers of ten as doubles (10^22 is the last one a double holds exactly).
+inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                    1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                    1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+}  // namespace shortest_detail
+
+// An integer as fmt's "{}" writes it (at most 20 characters, and up to kSpill bytes of no
+// meaning after them: room for 28); returns the end.
+inline char* write_integer(char* p, std::int64_t v) {
+  std::uint64_t u = static_cast<std::uint64_t>(v);
+  if (v < 0) {
+    *p++ = '-';
+    u = 0 - u;
+  }
+  const int size = fmt::detail::count_digits(u);
+  shortest_detail::write_digits(p, u, size);
+  return p + size;
+}
+
+// Writes v at p (at most 24 characters, and up to kSpill bytes of no meaning after them: room
+// for 32) and returns the end.
+inline char* write_shortest(char* p, double v) {
+  if (!std::isfinite(v)) return fmt::format_to(p, "{}", v);  // inf, nan as fmt writes them
+  if (std::signbit(v)) {
+    *p++ = '-';
+    v = -v;
+  }
+  const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
+  return shortest_detail::write_decimal(p, dec.significand, dec.exponent);
+}
+
+// The same text as write_shortest(p, v), for a v the caller computed from m x 10^-k (an export's
+// time in seconds from its integer nanoseconds, k = 9): where the decimal m x 10^-k is v's
+// shortest round trip, it is written without the shortest-digit search (Dragonbox, a quarter
+// of an export's time, issue 32); otherwise write_shortest. m is only a guess: the decimal is
+// taken only where it is proven to be what Dragonbox gives, so any m gives the same text.
+//
+// The proof: strip m's trailing zeros, m = q x 10^z, d = k - z decimals, c = q x 10^-d.
+//  1. c reads back as v: q < 2^53 and 10^d (d <= 22) are exact doubles, so q / 10^d is one
+//     correctly rounded division, what strtod makes of c's text; it must equal v.
+//  2. c is the only shortest: the decimals that read back as v lie in v's rounding interval,
+//     no wider than ulp(v) <= |v| 2^-52. Two distinct numbers with at most d decimals differ
+//     by 10^-d or more, so with |v| 10^d < 2^51 (the interval under half of 10^-d) c is the
+//     only one in it with at most d decimals; one with more decimals and fewer significant
+//     digits would be below c's leading power of ten with the same d decimals (so again at
+//     least 10^-d away). Dragonbox gives the shortest, so it gives c: significand q,
+//     exponent -d (its trailing zeros removed, as here).
+inline char* write_shortest_scaled(char* p, double v, std::int64_t m, int k) {
+  using namespace shortest_detail;
+  constexpr std::int64_t kExact = std::int64_t{1} << 53;
+  // Normal, finite, nonzero v of m's sign; q < 2^53; 0 <= k <= 22 (else the general way).
+  if (m == 0 || m <= -kExact || m >= kExact || k < 0 || k > 22 || (m < 0) != std::signbit(v) ||
+      !(std::abs(v) >= 0x1p-1022) || !(std::abs(v) < 0x1p53))
+    return write_shortest(p, v);
+  std::uint64_t q = static_cast<std::uint64_t>(m < 0 ? -m : m);
+  int d = k;
+  while (d >= 4 && q % 10000 == 0) {  // four zeros a step (a 100 us grid has five)
+    q /= 10000;
+    d -= 4;
+  }
+  while (d > 0 && q % 10 == 0) {
+    q /= 10;
+    --d;
+  }
+  const double a = std::abs(v);
+  if (static_cast<double>(q) / kPow10[d] != a || !(a * kPow10[d] < 0x1p51))
+    return write_shortest(p, v);
+  int exponent = -d;
+  while (q % 10 == 0) {  // a whole number's zeros: Dragonbox leaves none in its significand
+    q /= 10;
+    ++exponent;
+  }
+  if (m < 0) *p++ = '-';
+  return write_decimal(p, q, exponent);
 }
 
 }  // namespace daq

@@ -9,6 +9,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <random>
 #include <string>
@@ -102,6 +103,83 @@ TEST(ShortestNumber, ValuesLikeAnExportsNumbers) {
     values.push_back((unit(rng) - 0.5) * std::pow(10.0, static_cast<int>(rng() % 40) - 20));
   }
   EXPECT_EQ(first_difference(values), "");
+}
+
+// write_shortest_scaled(v, m, k) skips the digit search where the decimal m x 10^-k is v's
+// shortest form: its text must be fmt's "{}" of v whatever m and k are, and read back as v.
+std::string scaled_difference(double v, std::int64_t m, int k) {
+  char buf[64];
+  const std::string got(buf, daq::write_shortest_scaled(buf, v, m, k));
+  const std::string want = fmt::format("{}", v);
+  if (got != want || got.size() > 24)
+    return fmt::format("{:a} from {} x 10^-{}: fmt \"{}\", write_shortest_scaled \"{}\"", v, m, k,
+                       want, got);
+  if (std::isfinite(v) && std::strtod(got.c_str(), nullptr) != v)
+    return fmt::format("{:a}: \"{}\" reads back as {:a}", v, got,
+                       std::strtod(got.c_str(), nullptr));
+  return {};
+}
+
+TEST(ShortestNumber, ScaledTimesAsFmtWritesThem) {
+  std::mt19937_64 rng(11);
+  std::size_t checked = 0;
+  const auto check = [&](double v, std::int64_t m, int k) {
+    ++checked;
+    const auto d = scaled_difference(v, m, k);
+    ASSERT_EQ(d, "");
+  };
+  // An export's times: nanoseconds of every magnitude up to 10 days, as the export scales
+  // them (x 1e-9, not always the double nearest the decimal), on grids of 100 us to 1 ns.
+  for (int i = 0; i < 1'000'000; ++i) {
+    const std::int64_t grid = std::int64_t{1} << (rng() % 4) * 6;  // 1, 64, 4096, 262144
+    const std::int64_t ns =
+        static_cast<std::int64_t>(rng() % (864'000'000'000'000ULL >> (rng() % 40))) / grid * grid *
+        (i % 7 == 0 ? -1 : 1);
+    check(static_cast<double>(ns) * 1e-9, ns, 9);
+    check(static_cast<double>(ns) / 1e9, ns, 9);
+    check(static_cast<double>(ns / 100'000 * 100'000) * 1e-9, ns / 100'000 * 100'000, 9);
+  }
+  // Every k a double's power of ten holds, m of every length, v the decimal and its
+  // neighbours (the decimal is then not v's shortest form or not v at all).
+  for (int i = 0; i < 1'000'000; ++i) {
+    const int k = static_cast<int>(rng() % 25) - 1;  // -1 and 23: outside the fast path
+    const auto m = static_cast<std::int64_t>(rng() >> (1 + rng() % 63)) * (i % 5 == 0 ? -1 : 1);
+    const double v = k >= 0 ? static_cast<double>(m) / std::pow(10.0, k) : static_cast<double>(m);
+    check(v, m, k);
+    check(std::nextafter(v, 0.0), m, k);
+    check(std::nextafter(v, std::numeric_limits<double>::infinity()), m, k);
+    check(-v, m, k);
+  }
+  // Whole numbers and their zeros, zero itself, powers of ten, the limits of the fast path
+  // (2^53, 2^51 x 10^-k), and guesses that are wrong.
+  for (int k = 0; k <= 22; ++k)
+    for (std::int64_t m :
+         {std::int64_t{1}, std::int64_t{10}, std::int64_t{1000000000}, std::int64_t{120000},
+          (std::int64_t{1} << 53) - 1, std::int64_t{1} << 53, (std::int64_t{1} << 51) + 7,
+          std::int64_t{9007199254740990}, std::int64_t{0}}) {
+      const double v = static_cast<double>(m) / std::pow(10.0, k);
+      check(v, m, k);
+      check(v, m + 1, k);
+      check(v * 10, m, k);
+      check(std::ldexp(1.0, 51 - 4 * k), m, k);
+    }
+  check(0.0, 0, 9);
+  check(-0.0, 0, 9);
+  check(DBL_TRUE_MIN, 1, 9);
+  check(std::numeric_limits<double>::infinity(), 1, 9);
+  check(std::numeric_limits<double>::quiet_NaN(), 1, 9);
+  EXPECT_GT(checked, 6'000'000U);
+}
+
+// Values whose shortest form is known by hand: times on a 100 us grid, a whole number, a guess
+// with its decimal point outside the fast path (k < 0).
+TEST(ShortestNumber, ScaledTimesOfAFineGridAreTheirDecimals) {
+  char buf[64];
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 12.3456, 12'345'600'000, 9)),
+            "12.3456");
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, -0.0001, -100'000, 9)), "-0.0001");
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 600.0, 600'000'000'000, 9)), "600");
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 1e15, 1, -15)), "1000000000000000");
 }
 
 TEST(ShortestNumber, IntegersAsFmtWritesThem) {
