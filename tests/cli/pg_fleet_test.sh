@@ -118,9 +118,11 @@ need(vb[("linear", "X")]["verdict"] == "fail" and vb[("linear", "X")]["failed"] 
 need(vb[("linear", "Z")]["verdict"] == "pass", f"B's Z verdict {vb}")
 circle_b = [v for k, v in vb.items() if k[0] == "circle"]
 need(len(circle_b) == 1 and circle_b[0]["test"].startswith("XY F"), f"B's circle test {circle_b}")
-# Counts on the page of machines: A's X E, Y E and E_YX leaving; E_BX outside. B's X E outside.
-need(a["trends"]["leaving"] == 3 and a["trends"]["outside"] == 1, f"A's counts {a['trends']}")
-need(b["trends"]["leaving"] == 0 and b["trends"]["outside"] == 1, f"B's counts {b['trends']}")
+# Counts on the page of machines: A's X E, Y E and E_YX leaving; E_BX and its circle's backlash
+# (the demo's own limit, which its circle fails) outside. B's X E and its circle's squareness (the
+# limit half its value) outside.
+need(a["trends"]["leaving"] == 3 and a["trends"]["outside"] == 2 and a["trends"]["series"] == 12, f"A's counts {a['trends']}")
+need(b["trends"]["leaving"] == 0 and b["trends"]["outside"] == 2 and b["trends"]["series"] == 8, f"B's counts {b['trends']}")
 # Trends (the machine opened), by hand: X's E = 4, 5, 6 um at 0, 30, 60 days: slope 1 um / 30 days
 # = 365.25 / 30 um a year; the line E = 4 + t / 30 d reaches the 10 um limit at t = 180 d. No
 # table of X: the whole history.
