@@ -3,12 +3,14 @@
 # synthetic central store of MACHINES machines x MONTHS monthly runs (results only: no reading
 # chunks, which the fleet view never reads), made on a throwaway PostgreSQL server by
 # generate_series on the server (through the schema's own triggers, as a sync fills them); then
-# the fleet's JSON endpoint timed with curl (and one machine's history), beside the peer measured
-# in the same run: one scan of the fleet's values table (the trend aggregation reads each value
-# once); and the page's render in headless Chromium (navigation to rendered, at 1366x768).
+# the first view's requests timed with curl (the fleet's summary and the first site's first page of
+# machines), a machine opened (its trends and history, with and without a chosen date), beside the
+# peer measured in the same run: one scan of the fleet's values table (the trend aggregation reads
+# each value once); and the page's render in headless Chromium (navigation to the first view
+# rendered, at 1366x768). The machine's load (uptime) is printed before and after.
 # Usage: fleet_bench.sh DAQ_BINARY [MACHINES=1000] [MONTHS=120] [SCREENSHOT_DIR]
 set -eu
-DAQ=$1
+DAQ=$(realpath "$1")
 MACHINES=${2:-1000}
 MONTHS=${3:-120}
 SHOTS=${4:-}
@@ -31,11 +33,13 @@ sql -v machines="$MACHINES" -v months="$MONTHS" <<'EOF'
 -- 20 sites; a month between runs; each machine's axes X, Y, Z and a circle in XY in turn; E drifts
 -- by 0 to 1.8 um a year by machine (some leave their 10 um limit within the 10 years), G by 0 to
 -- 2 um a year, squareness about a machine's own offset; noise 0.5 um.
-INSERT INTO caldaq.machines(name, uuid)
-  SELECT format('Machine %s', lpad(i::text, 4, '0')), gen_random_uuid()
+INSERT INTO caldaq.machines(name, uuid, site)
+  SELECT format('Machine %s', lpad(i::text, 4, '0')), gen_random_uuid(), ''
   FROM generate_series(1, :machines) AS i;
+UPDATE caldaq.machines SET site = format('Site %s', lpad((id % 20)::text, 2, '0')) WHERE name LIKE 'Machine %';
 INSERT INTO caldaq.runs(uuid, machine_id, source_run_id, campaign, kind, axis, settings_json,
-    capture_path, software_version, started_unix_ms, ended_unix_ms, status, note, synced_unix_ms)
+    capture_path, software_version, started_unix_ms, ended_unix_ms, status, note, synced_unix_ms,
+    site)
   SELECT gen_random_uuid(), m.id, mo + 1, 'bench', CASE WHEN mo % 4 = 3 THEN 'circle' ELSE 'linear' END,
     (ARRAY['X', 'Y', 'Z', 'XY'])[mo % 4 + 1],
     json_build_object('context', json_build_object(
@@ -51,7 +55,7 @@ INSERT INTO caldaq.runs(uuid, machine_id, source_run_id, campaign, kind, axis, s
         json_build_object('id', 'air', 'role', 'weather station', 'driver', 'ptu300',
           'serial_number', format('P-%s', m.id), 'certificate', 'C-P', 'calibration_due',
           to_char(date '2026-09-01' + (m.id * 11 % 400)::int, 'YYYY-MM-DD')))))::text,
-    '', 'bench', s.ms, s.ms + 3600000, 'complete', '', 0
+    '', 'bench', s.ms, s.ms + 3600000, 'complete', '', 0, m.site
   FROM caldaq.machines AS m, generate_series(0, :months - 1) AS mo,
     LATERAL (SELECT (extract(epoch FROM now() - make_interval(months => :months)) * 1000)::bigint
                     + mo::bigint * 2629800000 + (m.id % 28) * 86400000 AS ms) AS s
@@ -90,6 +94,11 @@ INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, created_u
           'A_bi', json_build_object('symbol', 'A', 'value_um', v.e + 1.4)),
         'warnings', json_build_array(), 'notes', json_build_array()) END::text AS doc) AS d
   WHERE r.campaign = 'bench';
+-- Every tenth machine's X compensated 5 years ago (a positioning table): X's lines start there.
+INSERT INTO caldaq.compensations(machine_id, source, axis, format, created_unix_ms, json, fingerprint, site)
+  SELECT m.id, 'bench', 'X', 'csv', (extract(epoch FROM now() - interval '5 years') * 1000)::bigint,
+    '{"schema": "caldaq.compensation.v1", "format": "csv"}', md5('bench ' || m.id), m.site
+  FROM caldaq.machines AS m WHERE m.name LIKE 'Machine %' AND m.id % 10 = 0;
 -- A reviewer approved every result older than 90 days.
 INSERT INTO caldaq.approvals
   SELECT s.run_uuid, s.fingerprint, 1, 'reviewer', s.created_unix_ms + 86400000
@@ -115,18 +124,32 @@ SERVE_PID=$!
 for _ in $(seq 300); do grep -q "http://" "$TMP/serve.log" && break; sleep 0.1; done
 URL=$(sed -n 's|.*\(http://127.0.0.1:[0-9]*\)/.*|\1|p' "$TMP/serve.log")
 [ -n "$URL" ] || { cat "$TMP/serve.log"; exit 1; }
+echo "load before the requests: $(uptime)"
+# The first view: the summary, then the first site's first page (what the page asks for).
+curl -sf -o "$TMP/fleet.json" "$URL/api/fleet"
+SITE=$("$PY" -c 'import json, sys, urllib.parse; print(urllib.parse.quote(json.load(open(sys.argv[1]))["sites"][0]["site"], safe=""))' "$TMP/fleet.json")
 for i in 1 2 3 4 5; do
-  curl -sf -o "$TMP/fleet.json" -w "GET /api/fleet: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet"
+  a=$(curl -sf -o "$TMP/fleet.json" -w "%{time_total} %{size_download}" "$URL/api/fleet")
+  b=$(curl -sf -o "$TMP/site.json" -w "%{time_total} %{size_download}" "$URL/api/fleet/sites/$SITE/page/1")
+  echo "first view: GET /api/fleet ${a% *} s (${a#* } bytes) + GET /api/fleet/sites/$SITE/page/1 ${b% *} s (${b#* } bytes) = $(echo "${a% *} + ${b% *}" | bc) s"
 done
-curl -sf -o /dev/null -w "GET /api/fleet/machines/500: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500"
-"$PY" - "$TMP/fleet.json" <<'EOF'
+for i in 1 2 3; do
+  curl -sf -o "$TMP/machine.json" -w "a machine opened: GET /api/fleet/machines/500: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500" || echo "no machine 500"
+  curl -sf -o /dev/null -w "a date chosen: GET /api/fleet/machines/500/since/2024-01-01: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500/since/2024-01-01" || echo "no machine 500"
+done
+curl -sf -o "$TMP/site-last.json" -w "another page: GET /api/fleet/sites/$SITE/page/2: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/sites/$SITE/page/2" || echo "no page 2"
+"$PY" - "$TMP/fleet.json" "$TMP/site.json" "$TMP/machine.json" <<'EOF'
 import collections, json, sys
-d = json.load(open(sys.argv[1]))
-machines = [m for s in d["sites"] for m in s["machines"]]
-st = collections.Counter(t["status"] for m in machines for t in m["trends"])
-inst = collections.Counter(i["status"] for i in d["instruments"])
-print(f"answer: {len(d['sites'])} sites, {len(machines)} machines, trends {dict(st)}, "
-      f"instruments {dict(inst)}, awaiting approval {d['awaiting_approval']['count']}")
+d, site, machine = (json.load(open(p)) for p in sys.argv[1:4])
+inst = d["instruments"]["statuses"]
+counts = collections.Counter()
+for m in site["machines"]:
+    counts.update(m["trends"])
+windows = collections.Counter(t["window"]["reason"] for t in machine["trends"])
+print(f"answer: {len(d['sites'])} sites, {d['machines']} machines; the first site {site['count']} machines, "
+      f"{site['pages']} pages, its first page's trend counts {dict(counts)}; instruments {inst} "
+      f"({d['instruments']['listed']} listed); awaiting approval {d['awaiting_approval']['count']}; "
+      f"machine 500's windows {dict(windows)}")
 EOF
 HERE=$HERE "$PY" - "$URL" "${SHOTS:-$TMP}" <<'EOF'
 import os, sys
@@ -139,8 +162,9 @@ with Browser(width=1366, height=768) as b:
         b.wait("return document.body.dataset.rendered !== undefined", timeout_s=60, what="the fleet")
         ms = b.js("return Number(document.body.dataset.rendered);")
         n = b.js("return document.querySelectorAll('details.machine').length;")
-        print(f"page: navigation to rendered {ms:.0f} ms ({n} machines)")
+        print(f"page: navigation to the first view rendered {ms:.0f} ms ({n} machines listed)")
     b.screenshot(os.path.join(shots, "fleet-bench.png"))
 EOF
+echo "load after: $(uptime)"
 kill $SERVE_PID
 SERVE_PID=

@@ -74,14 +74,16 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
-# pg_undo_central_8: the test's server taken back to central schema 7, the fleet view's tables
-# and triggers (migration 8) dropped.
+# pg_undo_central_8: the test's server taken back to central schema 7, the fleet view's tables,
+# functions and triggers (migrations 8 and 9) dropped.
 pg_undo_central_8() {
   psql_value "DROP TABLE caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
   caldaq.fleet_tests, caldaq.fleet_series, caldaq.fleet_instruments;
+DROP INDEX caldaq.compensations_by_machine;
 DROP FUNCTION caldaq.fleet_run_changed, caldaq.fleet_result_changed, caldaq.fleet_approval_changed,
   caldaq.fleet_refresh, caldaq.fleet_result_values, caldaq.fleet_jsonb, caldaq.fleet_text,
-  caldaq.fleet_number CASCADE;
+  caldaq.fleet_number, caldaq.fleet_limits_for_travel, caldaq.fleet_travel, caldaq.fleet_fit,
+  caldaq.fleet_compensation_resets, caldaq.fleet_window, caldaq.fleet_compensation_changed CASCADE;
 UPDATE caldaq.schema_version SET version = 7" >/dev/null
 }
 

@@ -284,6 +284,14 @@ TEST(HttpPolicy, QueryParameterIsTheWholeNameAndDecoded) {
   EXPECT_EQ(web::query_parameter("/?token=%zz%4", "token"), "%zz%4");  // bad escapes kept
 }
 
+// A path segment (the fleet view's site, encodeURIComponent'd): '+' is itself there, not a space.
+TEST(HttpPolicy, PercentDecodedPathKeepsPlus) {
+  EXPECT_EQ(web::percent_decoded("Plant%20North%2FHall+B", false), "Plant North/Hall+B");
+  EXPECT_EQ(web::percent_decoded("Plant%20North%2FHall+B", true), "Plant North/Hall B");
+  EXPECT_EQ(web::percent_decoded("%C3%A9%zz%4", false), "\xc3\xa9%zz%4");  // é; bad escapes kept
+  EXPECT_EQ(web::percent_decoded("", false), "");
+}
+
 TEST(HttpPolicy, HostMustBeThisServer) {
   const web::Policy p{.allowed_hosts = {"Machine.Local"}};
   for (const char* ok :

@@ -10,11 +10,13 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "assets.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/storage/pg/fleet.hpp"
 #include "cal/storage/pg/sync.hpp"
+#include "http_policy.hpp"
 #include "server.hpp"
 #include "unit_signs.hpp"
 
@@ -43,6 +45,14 @@ std::int64_t now_unix_ms() {
       .count();
 }
 
+// A whole number > 0 written in decimal digits alone, or nullopt.
+std::optional<std::int64_t> whole_number(std::string_view text) {
+  std::int64_t n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || end != text.data() + text.size() || n <= 0) return std::nullopt;
+  return n;
+}
+
 // Store errors (the server gone, a permission refused) are the answer's, not the service's end.
 template <class F>
 web::Response answer(F&& f) {
@@ -59,24 +69,48 @@ web::Api fleet_api(const std::string& url) {
           [](std::string_view nonce) { return web::fleet_page(nonce, ::daq::unit_signs_json()); },
       .start = [](const std::string&) { return error(403, kReaderOnly); },
       .stop = [](const std::string&) { return error(403, kReaderOnly); }};
-  // The queries run on the event loop, one at a time: the page asks for the fleet once and a
-  // machine's history when it is opened, each well under a second at 1,000 machines
-  // (docs/benchmarks.md, "The fleet view").
+  // The queries run on the event loop, one at a time: the page asks for the fleet's first view,
+  // a site's page of machines when the site is opened and a machine's trends and history when
+  // the machine is opened, each small whatever the fleet's size (docs/benchmarks.md, "The fleet
+  // view").
   api.routes.push_back(
       {"GET", "/api/fleet", [url](std::string_view, const std::string&) {
          return answer([&] { return web::Response{.body = pg::fleet_json(url, now_unix_ms())}; });
        }});
+  // /api/fleet/sites/SITE/page/N, SITE percent-encoded (encodeURIComponent: a '/' in it is %2F).
+  api.routes.push_back(
+      {"GET", "/api/fleet/sites/", [url](std::string_view path, const std::string&) {
+         const auto rest = path.substr(std::string_view("/api/fleet/sites/").size());
+         const auto at = rest.rfind("/page/");
+         const auto page =
+             at == std::string_view::npos ? std::nullopt : whole_number(rest.substr(at + 6));
+         if (!page || *page > 1'000'000)
+           return error(404, "give a site's page as /api/fleet/sites/SITE/page/N (N from 1)");
+         const auto site = web::percent_decoded(rest.substr(0, at), false);
+         return answer([&] {
+           auto doc = pg::fleet_site_json(url, site, static_cast<int>(*page));
+           if (!doc)
+             return error(404, fmt::format("no machine of site '{}' on page {}", site, *page));
+           return web::Response{.body = std::move(*doc)};
+         });
+       }});
+  // /api/fleet/machines/ID, or /api/fleet/machines/ID/since/YYYY-MM-DD (the lines from that day).
   api.routes.push_back(
       {"GET", "/api/fleet/machines/", [url](std::string_view path, const std::string&) {
-         const auto id_text = path.substr(std::string_view("/api/fleet/machines/").size());
-         std::int64_t id = 0;
-         const auto [end, ec] =
-             std::from_chars(id_text.data(), id_text.data() + id_text.size(), id);
-         if (ec != std::errc() || end != id_text.data() + id_text.size() || id <= 0)
-           return error(404, "no such machine: give its id, a whole number > 0");
+         auto rest = path.substr(std::string_view("/api/fleet/machines/").size());
+         std::optional<std::int64_t> since;
+         if (const auto at = rest.find("/since/"); at != std::string_view::npos) {
+           since = pg::day_start_unix_ms(rest.substr(at + 7));
+           if (!since)
+             return error(
+                 404, fmt::format("'{}' is not a date written YYYY-MM-DD", rest.substr(at + 7)));
+           rest = rest.substr(0, at);
+         }
+         const auto id = whole_number(rest);
+         if (!id) return error(404, "no such machine: give its id, a whole number > 0");
          return answer([&] {
-           auto doc = pg::fleet_machine_json(url, id);
-           if (!doc) return error(404, fmt::format("no machine {} in the central store", id));
+           auto doc = pg::fleet_machine_json(url, *id, since);
+           if (!doc) return error(404, fmt::format("no machine {} in the central store", *id));
            return web::Response{.body = std::move(*doc)};
          });
        }});

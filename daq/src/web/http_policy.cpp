@@ -130,20 +130,24 @@ std::optional<std::string> query_parameter(std::string_view target, std::string_
     rest = amp == std::string_view::npos ? std::string_view{} : rest.substr(amp + 1);
     const auto eq = pair.find('=');
     if (pair.substr(0, eq) != name) continue;
-    const auto raw = eq == std::string_view::npos ? std::string_view{} : pair.substr(eq + 1);
-    std::string value;
-    for (std::size_t i = 0; i < raw.size(); ++i) {
-      if (raw[i] == '%' && i + 2 < raw.size() && hex_digit(raw[i + 1]) >= 0 &&
-          hex_digit(raw[i + 2]) >= 0) {
-        value += static_cast<char>(hex_digit(raw[i + 1]) * 16 + hex_digit(raw[i + 2]));
-        i += 2;
-      } else {
-        value += raw[i] == '+' ? ' ' : raw[i];
-      }
-    }
-    return value;
+    return percent_decoded(eq == std::string_view::npos ? std::string_view{} : pair.substr(eq + 1),
+                           true);
   }
   return std::nullopt;
+}
+
+std::string percent_decoded(std::string_view raw, bool plus_is_space) {
+  std::string value;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    if (raw[i] == '%' && i + 2 < raw.size() && hex_digit(raw[i + 1]) >= 0 &&
+        hex_digit(raw[i + 2]) >= 0) {
+      value += static_cast<char>(hex_digit(raw[i + 1]) * 16 + hex_digit(raw[i + 2]));
+      i += 2;
+    } else {
+      value += plus_is_space && raw[i] == '+' ? ' ' : raw[i];
+    }
+  }
+  return value;
 }
 
 bool host_allowed(std::string_view host, std::string_view local_address, const Policy& p) {

@@ -34,6 +34,9 @@ bool same_token(std::string_view given, std::string_view expected);
 
 // The value of query parameter `name` in a request target, percent-decoded; nullopt if absent.
 std::optional<std::string> query_parameter(std::string_view target, std::string_view name);
+// `raw` with each %XX replaced by its byte (and '+' by a space when `plus_is_space`: a query's
+// form encoding, not a path's); a '%' not followed by two hex digits stays as it is.
+std::string percent_decoded(std::string_view raw, bool plus_is_space);
 
 // Whether a Host header value names this server: `local_address` is the connection's local
 // address as text ("127.0.0.1", "::1"). The port, if any, is not compared.

@@ -7,6 +7,7 @@
 
 #include "cal/storage/pg/sync.hpp"
 #include "fleet_schema.hpp"
+#include "fleet_schema_9.hpp"
 
 namespace cal::storage::pg {
 namespace {
@@ -383,6 +384,9 @@ GRANT UPDATE (uuid) ON caldaq.machines TO caldaq_engineer;
 )sql",
     // 8: the fleet view's tables, kept by triggers (fleet_schema.hpp).
     kFleetMigration,
+    // 9: the fleet's straightness, angular and roll runs, and each trend's window
+    // (fleet_schema_9.hpp).
+    kFleetKindsWindowMigration,
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 

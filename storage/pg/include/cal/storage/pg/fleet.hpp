@@ -1,8 +1,12 @@
 #pragma once
 // The fleet view (issue 35; docs/web.md "The fleet view"): what `daq serve --db postgresql://...`
-// shows of a central store, read in a few queries of the tables central schema 7 keeps by
-// triggers (storage/pg/src/fleet_schema.hpp), never a reading, never a write (every query runs in
-// a READ ONLY transaction). libpqxx stays in storage/pg/src.
+// shows of a central store, read in a few queries of the tables central schemas 8 and 9 keep by
+// triggers (storage/pg/src/fleet_schema.hpp, fleet_schema_9.hpp), never a reading, never a write
+// (every query runs in a READ ONLY transaction). libpqxx stays in storage/pg/src. The first view
+// is small whatever the fleet's size: the sites with their counts, the instruments and results
+// most in need (the first of each, with the counts of all); a site's machines a page at a time,
+// each with its verdicts and how many of its values leave their limits; a machine's trends and
+// history when it is opened.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -16,9 +20,14 @@ inline constexpr int fleet_min_runs_for_trend = 3;
 inline constexpr int fleet_due_soon_days = 30;
 // The runs awaiting approval listed (the newest first; the count says how many there are).
 inline constexpr int fleet_awaiting_listed = 200;
+// The instruments listed (the earliest due first; the counts say how many of each status).
+inline constexpr int fleet_instruments_listed = 100;
+// A site's machines a page holds (in byte order of their names).
+inline constexpr int fleet_machines_per_page = 25;
 
-// A series' least-squares line (value = intercept + slope * t, t in unix ms) over its history,
-// the latest value and the latest run's limit (nullopt: no limit configured).
+// A series' least-squares line (value = intercept + slope * t, t in unix ms) over its window
+// (runs: the results in it), the latest value and the latest run's limit (nullopt: no limit
+// configured).
 struct TrendFit {
   std::int64_t runs = 0;
   std::optional<double> slope_per_ms, intercept;
@@ -45,12 +54,22 @@ struct Projection {
 Projection project(const TrendFit& fit);
 std::string_view to_string(TrendStatus s);
 
-// The fleet at `now_unix_ms` (the due dates are judged against its UTC day) as a JSON document
-// (caldaq.fleet.v1: docs/web.md). Throws StoreError naming the server (password hidden) and what
-// failed; a store of another schema version is refused as the read commands refuse it.
+// The start (00:00 UTC, unix ms) of a day written YYYY-MM-DD, or nullopt when `text` is not a
+// real date so written.
+std::optional<std::int64_t> day_start_unix_ms(std::string_view text);
+
+// The fleet's first view at `now_unix_ms` (the due dates are judged against its UTC day) as a
+// JSON document (caldaq.fleet.v2: docs/web.md). Throws StoreError naming the server (password
+// hidden) and what failed; a store of another schema version is refused as the read commands
+// refuse it.
 std::string fleet_json(std::string_view url, std::int64_t now_unix_ms);
-// One machine's trend series with every point (caldaq.fleet-machine.v1), or nullopt when the
+// Page `page` (1, 2, ...) of the machines of `site` (caldaq.fleet-site.v1), or nullopt when the
+// site has no machine on that page.
+std::optional<std::string> fleet_site_json(std::string_view url, std::string_view site, int page);
+// One machine's trends and their series with every point (caldaq.fleet-machine.v2), each line
+// fitted from the later of its window's start and `since_unix_ms` when given; nullopt when the
 // server has no machine of that id.
-std::optional<std::string> fleet_machine_json(std::string_view url, std::int64_t machine_id);
+std::optional<std::string> fleet_machine_json(std::string_view url, std::int64_t machine_id,
+                                              std::optional<std::int64_t> since_unix_ms = {});
 
 }  // namespace cal::storage::pg

@@ -32,7 +32,9 @@ namespace cal::storage::pg {
 // row-level security, and caldaq.approve checks the reviewer's sites.
 // 8: the fleet view's tables (per run, result, value and instrument), kept by triggers on the
 // server (daq serve --db postgresql://...: docs/web.md "The fleet view").
-inline constexpr int central_schema_version = 8;
+// 9: the fleet's straightness, angular and roll runs; each trend line's window (the last
+// compensation table or switch of the control's compensation that resets it).
+inline constexpr int central_schema_version = 9;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
