@@ -90,6 +90,8 @@ std::string figure(std::string svg, std::string_view caption) {
 
 struct Series {
   std::string label;
+  std::string short_label;  // for a plot half the page wide ("PTU300 (SIM-PTU-0001)")
+  int device = -1;          // the instrument's (the same sensor in several plots)
   std::vector<double> t_min, value;
 };
 
@@ -172,7 +174,11 @@ std::string product_name(std::string_view driver) {
 // serial number, and for an environment quantity the sensor ("air sensor PTU300 (serial
 // SIM-PTU-0001)"; the laser's own air sensor "air sensor of laser IDS3010 (serial ...)", which
 // read "air: ids3010"). `sensor`: "air" or "material" for those quantities, else "".
-std::string legend_label(const RunView& v, int device, int channel, std::string_view sensor) {
+// `compact`: for a plot half the page wide, whose title names the quantity: the instrument and
+// its serial number only ("laser IDS3010 (SIM-IDS-0001)", "PTU300 (SIM-PTU-0001)"); the full
+// label (50 characters) was wider than such a plot.
+std::string legend_label(const RunView& v, int device, int channel, std::string_view sensor,
+                         bool compact = false) {
   const std::string stored = instrument_name(v, device);
   json inst = json::object();
   const auto list = v.context.value("instruments", json::array());
@@ -191,7 +197,9 @@ std::string legend_label(const RunView& v, int device, int channel, std::string_
   // The instrument's own name where the role does not say it ("spindle" on a material gauge).
   const std::string named = id != role && id != ctx(inst, "driver") ? " " + id : "";
   std::string label;
-  if (sensor.empty())
+  if (compact && !product.empty())
+    label = (sensor.empty() || role == sensor ? "" : role + " ") + product + named;
+  else if (sensor.empty())
     label = role + named + (product.empty() ? "" : " " + product);
   else if (role == sensor)
     label = std::string(sensor) + " sensor" + named + (product.empty() ? "" : " " + product);
@@ -199,7 +207,7 @@ std::string legend_label(const RunView& v, int device, int channel, std::string_
     label = fmt::format("{} sensor of {}{}{}", sensor, role, named,
                         product.empty() ? "" : " " + product);
   const std::string serial = ctx(inst, "serial_number");
-  if (!serial.empty()) label += " (serial " + serial + ")";
+  if (!serial.empty()) label += (compact ? " (" : " (serial ") + serial + ")";
   return label + (channel ? fmt::format(", channel {}", channel) : "");
 }
 
@@ -226,6 +234,8 @@ Environment load_environment(const st::RunReader& store, const RunView& v) {
                            : static_cast<Q>(q) == Q::refractive_index        ? ""
                                                                              : "air";
     s.label = legend_label(v, device, channel, sensor_of);
+    s.short_label = legend_label(v, device, channel, sensor_of, true);
+    s.device = device;
     switch (static_cast<Q>(q)) {
       case Q::air_temperature_degc:
         env.air_temperature.push_back(std::move(s));
@@ -586,10 +596,10 @@ std::string settings_appendix(const RunView& v) {
                         used_note(key, val)});
   }
   if (rows.empty()) return "";
-  // The appendix starts a page of its own: whole, it fills the last page; flowing on, it left
-  // the demo's last page with its last ten rows (17 % of the page).
-  return std::string(v.run.kind == "linear" ? "<h3 class=\"appendix\">"
-                                            : "<h3>") +  // a circle's fills its pages
+  // The appendix flows on after the environment: starting a page of its own, it left the page
+  // before it as full as the environment's plots made it (the suspect demo run's 29 %, when
+  // the pressure and humidity plots did not fit under the temperatures).
+  return std::string("<h3 class=\"appendix\">") +
          "Appendix: settings of the run</h3>\n<p class=\"note\">As recorded "
          "at the start "
          "of the run; settings that do not apply to this test are left out.</p>\n" +
@@ -631,28 +641,68 @@ std::string environment_section(const Environment& env) {
   // The legends say which sensor ("air sensor PTU300 ...", "material sensor ..."), so the
   // quantity needs no prefix of its own ("air: ids3010" named neither).
   auto temps = lines_of(env.air_temperature, 0);
+  std::map<int, Rgb> colour_of;  // an air sensor's device -> its colour in the temperature plot
+  for (std::size_t i = 0; i < temps.size(); ++i)
+    colour_of.emplace(env.air_temperature[i].device, temps[i].colour);
   for (auto& l : lines_of(env.material_temperature, env.air_temperature.size())) {
     l.dashed = true;
     temps.push_back(std::move(l));
   }
-  // One plot of the run's time: all environment plots share the axis and the height.
-  const auto time_plot = [&](const char* title, const char* y_label, std::vector<Line> lines,
-                             const char* caption) {
-    h += figure(svg(XyChart{.title = title,
-                            .x_label = "time (min)",
-                            .y_label = y_label,
-                            .lines = std::move(lines),
-                            .height_pt = 240}),
-                caption);
+  // Plots of the run's time, sharing the axis: the temperatures across the page, then pressure
+  // and humidity side by side, each half the page wide (one under the other at full width, the
+  // pressure plot fell to the next page: the demo's environment page was 71 % full, the next
+  // 60 %). Half as wide, a plot's text is drawn 1.6 times larger (PLplot's shrinks with its
+  // canvas: 7.5 at 320 x 290 against 11 at 600 x 290), so it prints at 9 pt or more (12 x 253 /
+  // 320 = 9.5 pt). Each air sensor keeps its colour of the temperature plot, whose legend names
+  // it, so the pair needs no legends of their own (two rows of legend took a third of each).
+  const auto time_chart = [](const char* title, const char* y_label, std::vector<Line> lines,
+                             int width_pt, int height_pt, double text_scale, bool legend) {
+    return svg(XyChart{.title = title,
+                       .x_label = "time (min)",
+                       .y_label = y_label,
+                       .lines = std::move(lines),
+                       .width_pt = width_pt,
+                       .height_pt = height_pt,
+                       .legend = legend,
+                       .text_scale = text_scale});
   };
-  time_plot("Temperatures", "temperature (°C)", std::move(temps),
-            "Air and material temperature during the run.");
+  h += figure(time_chart("Temperatures", "temperature (°C)", std::move(temps), 600, 170, 1.0, true),
+              "Air and material temperature during the run.");
+  // The pair's lines in the temperature plot's colours; `keyed` false when a sensor is not in
+  // that plot (then each plot has its own colours and a legend naming the instruments short).
+  bool keyed = true;
+  const auto air_lines = [&](const std::vector<Series>& series, std::size_t colour) {
+    auto lines = lines_of(series, colour);
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      lines[i].label = series[i].short_label;
+      if (const auto it = colour_of.find(series[i].device); it != colour_of.end())
+        lines[i].colour = it->second;
+      else
+        keyed = false;
+    }
+    return lines;
+  };
+  auto pressure = air_lines(env.pressure_hpa, 2);
+  auto humidity = air_lines(env.humidity, 5);
+  if (!keyed) pressure = lines_of(env.pressure_hpa, 2), humidity = lines_of(env.humidity, 5);
+  const bool both = !env.pressure_hpa.empty() && !env.humidity.empty();
+  const char* key = keyed ? " (each sensor in its colour of the temperature plot)" : "";
+  std::string plots;
   if (!env.pressure_hpa.empty())
-    time_plot("Air pressure", "pressure (hPa)", lines_of(env.pressure_hpa, 2),
-              "Air pressure during the run.");
+    plots += figure(both ? time_chart("Air pressure", "pressure (hPa)", std::move(pressure), 320,
+                                      240, 1.6, !keyed)
+                         : time_chart("Air pressure", "pressure (hPa)",
+                                      lines_of(env.pressure_hpa, 2), 600, 200, 1.0, true),
+                    fmt::format("Air pressure during the run{}.", both ? key : ""));
   if (!env.humidity.empty())
-    time_plot("Relative humidity", "humidity (%RH)", lines_of(env.humidity, 5),
-              "Relative humidity during the run.");
+    plots += figure(both ? time_chart("Relative humidity", "humidity (%RH)", std::move(humidity),
+                                      320, 240, 1.6, !keyed)
+                         : time_chart("Relative humidity", "humidity (%RH)",
+                                      lines_of(env.humidity, 5), 600, 200, 1.0, true),
+                    fmt::format("Relative humidity during the run{}.", both ? key : ""));
+  // The figures are the pair's own children (no wrapping div), each a grid cell.
+  if (both) plots = "<div class=\"pair\">" + plots.substr(0, plots.size() - 1) + "</div>\n";
+  h += plots;
   return h;
 }
 
@@ -2192,7 +2242,6 @@ svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 .details.flow { break-before: auto; page-break-before: auto; }
-h3.appendix { break-before: page; page-break-before: always; }
 .pair.keep { break-inside: avoid; page-break-inside: avoid; }
 .pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
         align-items: start; }
