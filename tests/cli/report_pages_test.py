@@ -262,7 +262,18 @@ for name in ("linear", "vdi3441", "suspect"):
 
 # The demo's capture replayed into a database without its original run: no limits (a capture
 # does not carry them), and the report says which keys, where, and why the replay has none.
-daq("replay", capture, "--db", "fresh.sqlite")
+fresh_out = daq("replay", capture, "--db", "fresh.sqlite")
+# The terminal says the same as the report: which limits, under which table, and why a replay
+# has none (it printed no verdict; daq run's general "[tolerances] in the configuration").
+check("replay without its original run: the terminal names the keys, the table and the database",
+      re.search(r"verdict: no tolerance configured: E_um, R_um, A_um, B_um or M_um under "
+                r"\[tolerances\.X\] would judge it .*original run is not in \S*fresh\.sqlite, "
+                r"and a capture does not carry the limits", fresh_out) is not None,
+      fresh_out[-800:])
+# A replay into the database with its original run: judged by that run's limits, as daq run.
+check("replay with its original run: the verdict by its limits",
+      re.search(r"verdict against tolerances\.X[^:]*: FAIL", replay_out) is not None,
+      replay_out[-800:])
 daq("report", "1", "--db", "fresh.sqlite", "--format", "pdf", "-o", "fresh.pdf")
 f1 = squash(pages("fresh.pdf")[0])
 check("replay without its original run: which limits, where, and why none",

@@ -929,6 +929,12 @@ std::string conditions_section(const RunView& v) {
 // with (the limits in force when a run starts are stored with it and judge it; a replay keeps
 // its original run's). A run replayed from a capture whose original run is not in this
 // database has none: a capture's header does not carry the tolerances.
+// Keys as markup: "<code>E_um</code>, ... or <code>M_um</code>".
+std::string code_keys(std::vector<std::string> keys) {
+  for (auto& k : keys) k = "<code>" + esc(k) + "</code>";
+  return ::daq::either_of(keys);
+}
+
 std::string tolerance_hint(const RunView& v, std::string_view keys) {
   const std::string config = ctx(v.context, "configuration");
   bool orphan_replay = false;  // replayed, of no run in this database
@@ -1479,20 +1485,8 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
                   r.value, unit, ::daq::find_check(verdict, r.key));
   if (rotary) h += angular_reference_line(v);
   // The limits that would judge it, of this standard, in the axis's unit.
-  const std::string u = rotary ? "arcsec" : "um";
-  const bool vdi = e.standard.title.find("3441") != std::string::npos;
-  const auto keys = [&](std::initializer_list<std::string_view> names) {
-    std::string k;
-    std::size_t i = 0;
-    for (const auto n : names) {
-      if (i > 0) k += i + 1 == names.size() ? " or " : ", ";
-      k += fmt::format("<code>{}_{}</code>", n, u);
-      ++i;
-    }
-    return k;
-  };
-  h += verdict_banner(verdict, tolerance_hint(v, vdi ? keys({"P", "Pa", "Ps", "U"})
-                                                     : keys({"E", "R", "A", "B", "M"})));
+  h += verdict_banner(
+      verdict, tolerance_hint(v, code_keys(::daq::tolerance_keys(v.run.kind, e.standard.title))));
   h += results_grid(e, verdict, unit);
   h += means_plot(l);
   std::string& d = out.details;
@@ -1837,7 +1831,7 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
   for (const auto& x : st.informative)
     other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
                      "<em>informative</em>: " + esc(x.meaning)});
-  h += verdict_banner(verdict, tolerance_hint(v, "<code>G_um</code>"));
+  h += verdict_banner(verdict, tolerance_hint(v, code_keys(::daq::tolerance_keys("circle"))));
   // Page one holds the verdict, the values, the polar plot and what to fix first: the values
   // beside the plot (one under the other pushed "what to fix first" onto page two). The plot's
   // text is drawn larger so that, shown at half the page's width, it still prints at 9 pt.
@@ -2167,8 +2161,9 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
       straight ? "straightness" : "angular deviation", esc(ctx(doc, "component")),
       doc.value("targets", json::array()).size(),
       stored ? "" : " (no result was stored with the run: evaluated from its stops now)");
-  out.answer += verdict_banner(verdict, tolerance_hint(v, straight ? "<code>straightness_um</code>"
-                                                                   : "<code>angular_urad</code>"));
+  out.answer += verdict_banner(
+      verdict,
+      tolerance_hint(v, code_keys(::daq::tolerance_keys(straight ? "straightness" : "angular"))));
   out.answer += profile_values_table(rows, verdict);
   out.answer += profile_plot(doc, unit);
   std::string& d = out.details;
@@ -2615,15 +2610,16 @@ namespace {
 
 namespace kin = cal::kinematics;
 
-// What a component is, in words short enough for a half-page table: "straightness in Y",
-// "angular about Z", "roll", "positioning E" (E_<error><moving axis>, docs/kinematics.md).
+// What a component is, in one word that fits a line of a half-page table beside its symbol,
+// value, limit and verdict: "straightness", "angular", "roll", "positioning" (the symbol
+// E_<error><moving axis> says in which direction and of which axis, docs/kinematics.md, and
+// the note under the table reads it; "straightness in X" wrapped over two lines).
 std::string error_words(std::string_view c) {
   const char error = c[2], axis = c[3];
-  if (error == axis) return "positioning, E";
+  if (error == axis) return "positioning";
   if (error - 'A' == axis - 'X') return "roll";  // E_AX, E_BY, E_CZ
-  if (error == 'A' || error == 'B' || error == 'C')
-    return fmt::format("angular about {}", static_cast<char>(error - 'A' + 'X'));
-  return fmt::format("straightness in {}", error);
+  if (error == 'A' || error == 'B' || error == 'C') return "angular";
+  return "straightness";
 }
 
 struct ErrorRow {
@@ -2636,10 +2632,12 @@ struct ErrorRow {
 std::string error_rows_table(const std::vector<ErrorRow>& rows) {
   std::vector<std::vector<std::string>> cells;
   for (const auto& r : rows) {
-    const std::string name = r.run
-                                 ? fmt::format("<a href=\"#run-{}\"><strong>{}</strong></a> {}",
-                                               r.run, esc(r.name), esc(r.words))
-                                 : fmt::format("<strong>{}</strong> {}", esc(r.name), esc(r.words));
+    const std::string name = r.run ? fmt::format(
+                                         "<span class=\"nw\"><a href=\"#run-{}\"><strong>{}"
+                                         "</strong></a> {}</span>",
+                                         r.run, esc(r.name), esc(r.words))
+                                   : fmt::format("<span class=\"nw\"><strong>{}</strong> {}</span>",
+                                                 esc(r.name), esc(r.words));
     if (!r.run) {
       cells.push_back({name, "<span class=\"unstated\">not measured</span>", "", ""});
       continue;
@@ -2747,7 +2745,10 @@ std::string errors_section(const st::RunReader& store, std::span<const std::int6
       "<h3 id=\"errors\">The 21 geometric errors (ISO 230-1): {} of 21 measured</h3>\n", done);
   h += "<div class=\"pair\"><div>" + error_rows_table({rows.begin(), half}) + "</div><div>" +
        error_rows_table({half, rows.end()}) + "</div></div>\n";
-  h += "<p class=\"note\">Positioning: E, the bidirectional systematic positional deviation "
+  h += "<p class=\"note\">E_YX reads: the error in Y (X, Y, Z a straightness or, along the "
+       "axis itself, the positioning; A, B, C an angle about X, Y, Z, about the axis itself its "
+       "roll) of the motion of X. "
+       "Positioning: E, the bidirectional systematic positional deviation "
        "(ISO 230-2); straightness: about the least-squares line; angular and roll: the range "
        "of the means; squareness: the location error from the slopes of the plane's two "
        "straightness runs against one square, as <code>daq model build</code> takes it (1 µrad "
