@@ -97,6 +97,31 @@ for w in words:
 names = [a + b for b in "XYZ" for a in ("E_X", "E_Y", "E_Z", "E_A", "E_B", "E_C")]
 expected_unit = {n: "µrad" if n[2] in "ABC" else "µm" for n in names}
 expected_unit.update({"E_C0Y": "µrad", "E_B0Z": "µrad", "E_A0Z": "µrad"})
+# Each error's name on one line, whole, before its value: "E_XZ straightness in" over "X" in
+# the right half (the words between the symbol and the value on the symbol's line).
+def kind_words(n):
+    if n[3] == "0":
+        return ["squareness", {"E_C0Y": "XY", "E_B0Z": "XZ", "E_A0Z": "YZ"}[n]]
+    if n[2] == n[3]:
+        return ["positioning"]
+    if n[2] in "ABC":
+        return ["roll" if "ABC".index(n[2]) == "XYZ".index(n[3]) else "angular"]
+    return ["straightness"]
+
+
+named = {}
+for w in words:
+    if re.fullmatch(r"E_[XYZABC]0?[XYZ]", w[4]):
+        line = sorted((x for x in words if abs(x[1] - w[1]) < 3 and x[0] > w[2]),
+                      key=lambda x: x[0])
+        texts = [x[4] for x in line]
+        value = next((i for i, t in enumerate(texts) if re.fullmatch(r"[+−-]?\d+\.\d{3}", t)),
+                     len(texts))
+        named.setdefault(w[4], texts[:value])
+check("campaign: each of the 21 errors named whole on its line",
+      len(named) == 21 and all(named[n][:len(kind_words(n))] == kind_words(n)
+                               and len(named[n]) <= len(kind_words(n)) for n in named),
+      {n: (named[n], kind_words(n)) for n in named if named[n] != kind_words(n)})
 check("campaign: page one names all 21 errors, each with its value in its unit",
       "The 21 geometric errors (ISO 230-1): 21 of 21 measured" in one
       and {n: u for n, (_, u) in found.items()} == expected_unit, (sorted(found), found))

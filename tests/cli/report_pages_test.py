@@ -247,10 +247,33 @@ for name in ("linear", "vdi3441", "suspect"):
               text[name][0])
     check(f"{name}: the last page not almost empty (>= 30 % of the text area)",
           len(fills) > 1 and fills[-1] >= 0.3, str(fills))
+    # No page but the last under 80 %: the pressure plot, under the temperatures at full width,
+    # fell to the next page (the demo's environment page 71 % full, the next 60 %), and the
+    # appendix's page break left the suspect run's page before it 29 % full.
+    check(f"{name}: no page but the last under 80 % of the text area",
+          all(f >= 0.8 for f in fills[:-1]), str(fills))
+    # Pressure and humidity side by side: their figure captions start on one line of one page.
+    captions = [(i, w[1]) for i, (ws, _) in enumerate(pdf_words(f"{name}.pdf")) for k, w in
+                enumerate(ws) if w[4] in ("Air", "Relative") and k + 2 < len(ws)
+                and ws[k + 1][4] in ("pressure", "humidity") and ws[k + 2][4] == "during"]
+    check(f"{name}: pressure and humidity plots side by side",
+          len(captions) == 2 and captions[0][0] == captions[1][0]
+          and abs(captions[0][1] - captions[1][1]) < 1.0, str(captions))
 
 # The demo's capture replayed into a database without its original run: no limits (a capture
 # does not carry them), and the report says which keys, where, and why the replay has none.
-daq("replay", capture, "--db", "fresh.sqlite")
+fresh_out = daq("replay", capture, "--db", "fresh.sqlite")
+# The terminal says the same as the report: which limits, under which table, and why a replay
+# has none (it printed no verdict; daq run's general "[tolerances] in the configuration").
+check("replay without its original run: the terminal names the keys, the table and the database",
+      re.search(r"verdict: no tolerance configured: E_um, R_um, A_um, B_um or M_um under "
+                r"\[tolerances\.X\] would judge it .*original run is not in \S*fresh\.sqlite, "
+                r"and a capture does not carry the limits", fresh_out) is not None,
+      fresh_out[-800:])
+# A replay into the database with its original run: judged by that run's limits, as daq run.
+check("replay with its original run: the verdict by its limits",
+      re.search(r"verdict against tolerances\.X[^:]*: FAIL", replay_out) is not None,
+      replay_out[-800:])
 daq("report", "1", "--db", "fresh.sqlite", "--format", "pdf", "-o", "fresh.pdf")
 f1 = squash(pages("fresh.pdf")[0])
 check("replay without its original run: which limits, where, and why none",

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/text.hpp"
 #include "cal/replay/session.hpp"
 #include "cal/storage/store.hpp"
 #include "circle_output.hpp"
@@ -23,6 +24,7 @@
 #include "run_setup.hpp"
 #include "session_spec.hpp"
 #include "terminal.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -120,6 +122,40 @@ struct ReplaySession {
   }
 };
 
+// The replayed run's verdict, by the limits stored with it (its original run's), as daq run
+// prints one. With none it says which keys would judge it, under which table, and why a replay
+// has none: the report's verdict line named them, the terminal said only "[tolerances] in the
+// configuration". `kind`: the stored run's (verdict.hpp, tolerance_keys); `table`: its axis or
+// plane.
+void print_replay_verdict(const ReplaySession& s, const ReplayOptions& o, const json& result,
+                          std::string_view kind, std::string_view table) {
+  const auto v = verdict_of(s.original_settings, result);
+  if (v.configured || !v.notes.empty()) return print_verdict(v);
+  const json standard = result.value("standard", json::object());
+  const std::string title = standard.is_object() ? standard.value("title", "") : "";
+  const auto keys = tolerance_keys(kind, title);
+  const std::string which = fmt::format("{} under [tolerances.{}]", either_of(keys), table);
+  const bool one = keys.size() == 1;
+  if (!s.original_run) {
+    fmt::print(
+        "verdict: no tolerance configured: {} would judge it (docs/config.md), but a replay "
+        "takes the limits of its original run in the same database; this capture's original "
+        "run is not in {}, and a capture does not carry the limits\n",
+        which, cal::text::terminal_safe(database_path(o.db).string()));
+    return;
+  }
+  const json context = s.original_settings.value("context", json::object());
+  const std::string config = context.is_object() ? context.value("configuration", "") : "";
+  fmt::print(
+      "verdict: no tolerance configured: no limit was stored with run {}, this capture's "
+      "original run: {} in {} judge{} the runs made with it (docs/config.md)\n",
+      *s.original_run, which,
+      config.empty()
+          ? std::string("the configuration it was made with")
+          : "the configuration it was made with (" + cal::text::terminal_safe(config) + ")",
+      one ? "s" : "");
+}
+
 // A complete run from a capture damaged further on: the results stand (printed), and the
 // damage is an error (status 2) so that no script takes the file for a sound one.
 void report_damage(const cal::replay::ReplayEnd& end, const ReplayOptions& o, std::int64_t run_id) {
@@ -192,6 +228,7 @@ void replay_circle(ReplaySession& s, const ReplayOptions& o) {
     if (!o.json) {
       fmt::print("replayed {} into run {} ({} readings)\n\n", o.capture, x->run_id, x->readings);
       print_circle_result(*x->result, x->program, x->analysis);
+      print_replay_verdict(s, o, j, "circle", x->analysis.plane);
     }
     all.push_back(std::move(j));
   }
@@ -239,6 +276,12 @@ void replay_linear(ReplaySession& s, const ReplayOptions& o) {
       print_kind_result(*out.profile, out.component);
     else
       print(*out.evaluation);
+    const json result = out.profile ? *out.profile : to_json(*out.evaluation);
+    const std::string run_kind = !out.profile ? "linear"
+                                 : out.profile->value("schema", "") == "caldaq.rotary.v1"
+                                     ? "rotary"
+                                     : out.profile->value("kind", "");
+    print_replay_verdict(s, o, result, run_kind, s.config.linear->axis);
   }
   report_damage(end, o, out.run_id);
 }

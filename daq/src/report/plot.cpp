@@ -381,7 +381,8 @@ XyDrawn draw_xy(const XyChart& chart, std::size_t max_columns, double legend_x =
   if (x.empty()) plptex(0.5, 0.5, 1, 0, 0.5, "no data");
   const double legend_w =
       legend ? draw_legend(entries, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT,
-                           columns, 3.7 * char_pt / ((top - bottom) * total_pt), 1.0, legend_x)
+                           columns, 3.7 * char_pt / ((top - bottom) * total_pt), chart.text_scale,
+                           legend_x)
              : 0.0;
   return {s.finish(chart.title), columns, legend_w, left, 0.97};
 }

@@ -90,6 +90,8 @@ std::string figure(std::string svg, std::string_view caption) {
 
 struct Series {
   std::string label;
+  std::string short_label;  // for a plot half the page wide ("PTU300 (SIM-PTU-0001)")
+  int device = -1;          // the instrument's (the same sensor in several plots)
   std::vector<double> t_min, value;
 };
 
@@ -172,7 +174,11 @@ std::string product_name(std::string_view driver) {
 // serial number, and for an environment quantity the sensor ("air sensor PTU300 (serial
 // SIM-PTU-0001)"; the laser's own air sensor "air sensor of laser IDS3010 (serial ...)", which
 // read "air: ids3010"). `sensor`: "air" or "material" for those quantities, else "".
-std::string legend_label(const RunView& v, int device, int channel, std::string_view sensor) {
+// `compact`: for a plot half the page wide, whose title names the quantity: the instrument and
+// its serial number only ("laser IDS3010 (SIM-IDS-0001)", "PTU300 (SIM-PTU-0001)"); the full
+// label (50 characters) was wider than such a plot.
+std::string legend_label(const RunView& v, int device, int channel, std::string_view sensor,
+                         bool compact = false) {
   const std::string stored = instrument_name(v, device);
   json inst = json::object();
   const auto list = v.context.value("instruments", json::array());
@@ -191,7 +197,9 @@ std::string legend_label(const RunView& v, int device, int channel, std::string_
   // The instrument's own name where the role does not say it ("spindle" on a material gauge).
   const std::string named = id != role && id != ctx(inst, "driver") ? " " + id : "";
   std::string label;
-  if (sensor.empty())
+  if (compact && !product.empty())
+    label = (sensor.empty() || role == sensor ? "" : role + " ") + product + named;
+  else if (sensor.empty())
     label = role + named + (product.empty() ? "" : " " + product);
   else if (role == sensor)
     label = std::string(sensor) + " sensor" + named + (product.empty() ? "" : " " + product);
@@ -199,7 +207,7 @@ std::string legend_label(const RunView& v, int device, int channel, std::string_
     label = fmt::format("{} sensor of {}{}{}", sensor, role, named,
                         product.empty() ? "" : " " + product);
   const std::string serial = ctx(inst, "serial_number");
-  if (!serial.empty()) label += " (serial " + serial + ")";
+  if (!serial.empty()) label += (compact ? " (" : " (serial ") + serial + ")";
   return label + (channel ? fmt::format(", channel {}", channel) : "");
 }
 
@@ -226,6 +234,8 @@ Environment load_environment(const st::RunReader& store, const RunView& v) {
                            : static_cast<Q>(q) == Q::refractive_index        ? ""
                                                                              : "air";
     s.label = legend_label(v, device, channel, sensor_of);
+    s.short_label = legend_label(v, device, channel, sensor_of, true);
+    s.device = device;
     switch (static_cast<Q>(q)) {
       case Q::air_temperature_degc:
         env.air_temperature.push_back(std::move(s));
@@ -586,10 +596,10 @@ std::string settings_appendix(const RunView& v) {
                         used_note(key, val)});
   }
   if (rows.empty()) return "";
-  // The appendix starts a page of its own: whole, it fills the last page; flowing on, it left
-  // the demo's last page with its last ten rows (17 % of the page).
-  return std::string(v.run.kind == "linear" ? "<h3 class=\"appendix\">"
-                                            : "<h3>") +  // a circle's fills its pages
+  // The appendix flows on after the environment: starting a page of its own, it left the page
+  // before it as full as the environment's plots made it (the suspect demo run's 29 %, when
+  // the pressure and humidity plots did not fit under the temperatures).
+  return std::string("<h3 class=\"appendix\">") +
          "Appendix: settings of the run</h3>\n<p class=\"note\">As recorded "
          "at the start "
          "of the run; settings that do not apply to this test are left out.</p>\n" +
@@ -631,28 +641,68 @@ std::string environment_section(const Environment& env) {
   // The legends say which sensor ("air sensor PTU300 ...", "material sensor ..."), so the
   // quantity needs no prefix of its own ("air: ids3010" named neither).
   auto temps = lines_of(env.air_temperature, 0);
+  std::map<int, Rgb> colour_of;  // an air sensor's device -> its colour in the temperature plot
+  for (std::size_t i = 0; i < temps.size(); ++i)
+    colour_of.emplace(env.air_temperature[i].device, temps[i].colour);
   for (auto& l : lines_of(env.material_temperature, env.air_temperature.size())) {
     l.dashed = true;
     temps.push_back(std::move(l));
   }
-  // One plot of the run's time: all environment plots share the axis and the height.
-  const auto time_plot = [&](const char* title, const char* y_label, std::vector<Line> lines,
-                             const char* caption) {
-    h += figure(svg(XyChart{.title = title,
-                            .x_label = "time (min)",
-                            .y_label = y_label,
-                            .lines = std::move(lines),
-                            .height_pt = 240}),
-                caption);
+  // Plots of the run's time, sharing the axis: the temperatures across the page, then pressure
+  // and humidity side by side, each half the page wide (one under the other at full width, the
+  // pressure plot fell to the next page: the demo's environment page was 71 % full, the next
+  // 60 %). Half as wide, a plot's text is drawn 1.6 times larger (PLplot's shrinks with its
+  // canvas: 7.5 at 320 x 290 against 11 at 600 x 290), so it prints at 9 pt or more (12 x 253 /
+  // 320 = 9.5 pt). Each air sensor keeps its colour of the temperature plot, whose legend names
+  // it, so the pair needs no legends of their own (two rows of legend took a third of each).
+  const auto time_chart = [](const char* title, const char* y_label, std::vector<Line> lines,
+                             int width_pt, int height_pt, double text_scale, bool legend) {
+    return svg(XyChart{.title = title,
+                       .x_label = "time (min)",
+                       .y_label = y_label,
+                       .lines = std::move(lines),
+                       .width_pt = width_pt,
+                       .height_pt = height_pt,
+                       .legend = legend,
+                       .text_scale = text_scale});
   };
-  time_plot("Temperatures", "temperature (°C)", std::move(temps),
-            "Air and material temperature during the run.");
+  h += figure(time_chart("Temperatures", "temperature (°C)", std::move(temps), 600, 170, 1.0, true),
+              "Air and material temperature during the run.");
+  // The pair's lines in the temperature plot's colours; `keyed` false when a sensor is not in
+  // that plot (then each plot has its own colours and a legend naming the instruments short).
+  bool keyed = true;
+  const auto air_lines = [&](const std::vector<Series>& series, std::size_t colour) {
+    auto lines = lines_of(series, colour);
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      lines[i].label = series[i].short_label;
+      if (const auto it = colour_of.find(series[i].device); it != colour_of.end())
+        lines[i].colour = it->second;
+      else
+        keyed = false;
+    }
+    return lines;
+  };
+  auto pressure = air_lines(env.pressure_hpa, 2);
+  auto humidity = air_lines(env.humidity, 5);
+  if (!keyed) pressure = lines_of(env.pressure_hpa, 2), humidity = lines_of(env.humidity, 5);
+  const bool both = !env.pressure_hpa.empty() && !env.humidity.empty();
+  const char* key = keyed ? " (each sensor in its colour of the temperature plot)" : "";
+  std::string plots;
   if (!env.pressure_hpa.empty())
-    time_plot("Air pressure", "pressure (hPa)", lines_of(env.pressure_hpa, 2),
-              "Air pressure during the run.");
+    plots += figure(both ? time_chart("Air pressure", "pressure (hPa)", std::move(pressure), 320,
+                                      240, 1.6, !keyed)
+                         : time_chart("Air pressure", "pressure (hPa)",
+                                      lines_of(env.pressure_hpa, 2), 600, 200, 1.0, true),
+                    fmt::format("Air pressure during the run{}.", both ? key : ""));
   if (!env.humidity.empty())
-    time_plot("Relative humidity", "humidity (%RH)", lines_of(env.humidity, 5),
-              "Relative humidity during the run.");
+    plots += figure(both ? time_chart("Relative humidity", "humidity (%RH)", std::move(humidity),
+                                      320, 240, 1.6, !keyed)
+                         : time_chart("Relative humidity", "humidity (%RH)",
+                                      lines_of(env.humidity, 5), 600, 200, 1.0, true),
+                    fmt::format("Relative humidity during the run{}.", both ? key : ""));
+  // The figures are the pair's own children (no wrapping div), each a grid cell.
+  if (both) plots = "<div class=\"pair\">" + plots.substr(0, plots.size() - 1) + "</div>\n";
+  h += plots;
   return h;
 }
 
@@ -879,6 +929,12 @@ std::string conditions_section(const RunView& v) {
 // with (the limits in force when a run starts are stored with it and judge it; a replay keeps
 // its original run's). A run replayed from a capture whose original run is not in this
 // database has none: a capture's header does not carry the tolerances.
+// Keys as markup: "<code>E_um</code>, ... or <code>M_um</code>".
+std::string code_keys(std::vector<std::string> keys) {
+  for (auto& k : keys) k = "<code>" + esc(k) + "</code>";
+  return ::daq::either_of(keys);
+}
+
 std::string tolerance_hint(const RunView& v, std::string_view keys) {
   const std::string config = ctx(v.context, "configuration");
   bool orphan_replay = false;  // replayed, of no run in this database
@@ -1429,20 +1485,8 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
                   r.value, unit, ::daq::find_check(verdict, r.key));
   if (rotary) h += angular_reference_line(v);
   // The limits that would judge it, of this standard, in the axis's unit.
-  const std::string u = rotary ? "arcsec" : "um";
-  const bool vdi = e.standard.title.find("3441") != std::string::npos;
-  const auto keys = [&](std::initializer_list<std::string_view> names) {
-    std::string k;
-    std::size_t i = 0;
-    for (const auto n : names) {
-      if (i > 0) k += i + 1 == names.size() ? " or " : ", ";
-      k += fmt::format("<code>{}_{}</code>", n, u);
-      ++i;
-    }
-    return k;
-  };
-  h += verdict_banner(verdict, tolerance_hint(v, vdi ? keys({"P", "Pa", "Ps", "U"})
-                                                     : keys({"E", "R", "A", "B", "M"})));
+  h += verdict_banner(
+      verdict, tolerance_hint(v, code_keys(::daq::tolerance_keys(v.run.kind, e.standard.title))));
   h += results_grid(e, verdict, unit);
   h += means_plot(l);
   std::string& d = out.details;
@@ -1787,7 +1831,7 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
   for (const auto& x : st.informative)
     other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
                      "<em>informative</em>: " + esc(x.meaning)});
-  h += verdict_banner(verdict, tolerance_hint(v, "<code>G_um</code>"));
+  h += verdict_banner(verdict, tolerance_hint(v, code_keys(::daq::tolerance_keys("circle"))));
   // Page one holds the verdict, the values, the polar plot and what to fix first: the values
   // beside the plot (one under the other pushed "what to fix first" onto page two). The plot's
   // text is drawn larger so that, shown at half the page's width, it still prints at 9 pt.
@@ -2117,8 +2161,9 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
       straight ? "straightness" : "angular deviation", esc(ctx(doc, "component")),
       doc.value("targets", json::array()).size(),
       stored ? "" : " (no result was stored with the run: evaluated from its stops now)");
-  out.answer += verdict_banner(verdict, tolerance_hint(v, straight ? "<code>straightness_um</code>"
-                                                                   : "<code>angular_urad</code>"));
+  out.answer += verdict_banner(
+      verdict,
+      tolerance_hint(v, code_keys(::daq::tolerance_keys(straight ? "straightness" : "angular"))));
   out.answer += profile_values_table(rows, verdict);
   out.answer += profile_plot(doc, unit);
   std::string& d = out.details;
@@ -2192,7 +2237,6 @@ svg.plot.polar { max-width: 30rem; margin: 0 auto; }
 table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 .details.flow { break-before: auto; page-break-before: auto; }
-h3.appendix { break-before: page; page-break-before: always; }
 .pair.keep { break-inside: avoid; page-break-inside: avoid; }
 .pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
         align-items: start; }
@@ -2566,15 +2610,16 @@ namespace {
 
 namespace kin = cal::kinematics;
 
-// What a component is, in words short enough for a half-page table: "straightness in Y",
-// "angular about Z", "roll", "positioning E" (E_<error><moving axis>, docs/kinematics.md).
+// What a component is, in one word that fits a line of a half-page table beside its symbol,
+// value, limit and verdict: "straightness", "angular", "roll", "positioning" (the symbol
+// E_<error><moving axis> says in which direction and of which axis, docs/kinematics.md, and
+// the note under the table reads it; "straightness in X" wrapped over two lines).
 std::string error_words(std::string_view c) {
   const char error = c[2], axis = c[3];
-  if (error == axis) return "positioning, E";
+  if (error == axis) return "positioning";
   if (error - 'A' == axis - 'X') return "roll";  // E_AX, E_BY, E_CZ
-  if (error == 'A' || error == 'B' || error == 'C')
-    return fmt::format("angular about {}", static_cast<char>(error - 'A' + 'X'));
-  return fmt::format("straightness in {}", error);
+  if (error == 'A' || error == 'B' || error == 'C') return "angular";
+  return "straightness";
 }
 
 struct ErrorRow {
@@ -2587,10 +2632,12 @@ struct ErrorRow {
 std::string error_rows_table(const std::vector<ErrorRow>& rows) {
   std::vector<std::vector<std::string>> cells;
   for (const auto& r : rows) {
-    const std::string name = r.run
-                                 ? fmt::format("<a href=\"#run-{}\"><strong>{}</strong></a> {}",
-                                               r.run, esc(r.name), esc(r.words))
-                                 : fmt::format("<strong>{}</strong> {}", esc(r.name), esc(r.words));
+    const std::string name = r.run ? fmt::format(
+                                         "<span class=\"nw\"><a href=\"#run-{}\"><strong>{}"
+                                         "</strong></a> {}</span>",
+                                         r.run, esc(r.name), esc(r.words))
+                                   : fmt::format("<span class=\"nw\"><strong>{}</strong> {}</span>",
+                                                 esc(r.name), esc(r.words));
     if (!r.run) {
       cells.push_back({name, "<span class=\"unstated\">not measured</span>", "", ""});
       continue;
@@ -2698,7 +2745,10 @@ std::string errors_section(const st::RunReader& store, std::span<const std::int6
       "<h3 id=\"errors\">The 21 geometric errors (ISO 230-1): {} of 21 measured</h3>\n", done);
   h += "<div class=\"pair\"><div>" + error_rows_table({rows.begin(), half}) + "</div><div>" +
        error_rows_table({half, rows.end()}) + "</div></div>\n";
-  h += "<p class=\"note\">Positioning: E, the bidirectional systematic positional deviation "
+  h += "<p class=\"note\">E_YX reads: the error in Y (X, Y, Z a straightness or, along the "
+       "axis itself, the positioning; A, B, C an angle about X, Y, Z, about the axis itself its "
+       "roll) of the motion of X. "
+       "Positioning: E, the bidirectional systematic positional deviation "
        "(ISO 230-2); straightness: about the least-squares line; angular and roll: the range "
        "of the means; squareness: the location error from the slopes of the plane's two "
        "straightness runs against one square, as <code>daq model build</code> takes it (1 µrad "

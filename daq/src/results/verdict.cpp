@@ -91,10 +91,10 @@ Verdict positioning_verdict(const json& limits, const json& result, const Positi
     const char* bi_key;
     const char* uni_key;
     bool vdi;
-  } map[] = {{"E", "E", "E_bi", "E_up", false},    {"R", "R", "R_bi", "R_up", false},
-             {"B", "B", "B", nullptr, false},      {"A", "A", "A_bi", "A_up", false},
-             {"M", "M", "M", nullptr, false},      {"P", "P", "P", nullptr, true},
-             {"Pa", "Pa", "Pa", nullptr, true},    {"Ps", "Ps max", "Ps_max", nullptr, true},
+  } map[] = {{"E", "E", "E_bi", "E_up", false},     {"R", "R", "R_bi", "R_up", false},
+             {"B", "B", "B", nullptr, false},       {"A", "A", "A_bi", "A_up", false},
+             {"M", "M", "M", nullptr, false},       {"P", "P", "P", nullptr, true},
+             {"Pa", "Pa", "Pa", nullptr, true},     {"Ps", "Ps max", "Ps_max", nullptr, true},
              {"U", "U max", "U_max", nullptr, true}};
   const auto keys = [&](bool of_vdi) {
     std::vector<std::string> k;
@@ -123,10 +123,10 @@ Verdict positioning_verdict(const json& limits, const json& result, const Positi
   }
   // Limits only of the other family: none applies, and the note says which keys would.
   if (v.checks.empty() && !other.empty())
-    v.notes.push_back(fmt::format("the limits configured ({}) are for {} values; {} is judged by {}",
-                                  fmt::join(other, ", "), vdi ? "ISO 230-2" : "VDI/DGQ 3441",
-                                  title,
-                                  vdi ? keys(true) + " (docs/config.md)" : keys(false)));
+    v.notes.push_back(
+        fmt::format("the limits configured ({}) are for {} values; {} is judged by {}",
+                    fmt::join(other, ", "), vdi ? "ISO 230-2" : "VDI/DGQ 3441", title,
+                    vdi ? keys(true) + " (docs/config.md)" : keys(false)));
   conclude(v);
   return v;
 }
@@ -268,6 +268,26 @@ void print_verdict(const json& v, std::string_view in) {
   for (const auto& n : notes)
     if (n.is_string())
       fmt::print("{}  note: {}\n", in, cal::text::terminal_safe(n.get<std::string>()));
+}
+
+std::vector<std::string> tolerance_keys(std::string_view kind, std::string_view standard_title) {
+  if (kind == "circle") return {"G_um"};
+  if (kind == "straightness") return {"straightness_um"};
+  if (kind == "angular" || kind == "roll") return {"angular_urad"};
+  const std::string unit = kind == "rotary" ? "_arcsec" : "_um";
+  const bool vdi = standard_title.find("3441") != std::string_view::npos;
+  std::vector<std::string> keys;
+  for (const char* k : vdi ? std::vector<const char*>{"P", "Pa", "Ps", "U"}
+                           : std::vector<const char*>{"E", "R", "A", "B", "M"})
+    keys.push_back(k + unit);
+  return keys;
+}
+
+std::string either_of(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == items.size() ? " or " : ", ") + items[i];
+  return out;
 }
 
 const Check* find_check(const Verdict& v, const std::string& key) {

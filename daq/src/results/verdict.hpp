@@ -47,6 +47,15 @@ void print_verdict(const Verdict& v);
 // The same of a verdict's JSON (to_json; daq show prints a stored result's), each line led by
 // `indent`.
 void print_verdict(const nlohmann::json& verdict, std::string_view indent = "");
+// The limits that would judge a run's result, as keys under its [tolerances.AXIS] or
+// [tolerances.PLANE] table (docs/config.md): `kind` the stored run's ("linear", "rotary",
+// "circle", "straightness", "angular", "roll"), `standard_title` a positioning result's
+// ("VDI/DGQ 3441:1977" takes P, Pa, Ps, U). One list for the report's verdict line and the
+// terminal's (daq replay named only "[tolerances] in the configuration").
+std::vector<std::string> tolerance_keys(std::string_view kind,
+                                        std::string_view standard_title = {});
+// "a", "a or b", "a, b or c".
+std::string either_of(const std::vector<std::string>& items);
 // The check of a result key, or nullptr.
 const Check* find_check(const Verdict& v, const std::string& key);
 
