@@ -27,7 +27,8 @@ check probe_sim 0 "" -- probe 1 "$NOM" "$TMP/b1.csv"
 check probe_sim_row 0 "^B,90,119\.96[0-9]+,(40\.00|39\.99)[0-9]+,-300\.00[0-9]+$" -- cat "$TMP/b1.csv"
 check before 0 "largest deviation (3[0-9]|4[0-9])\.[0-9]+ um" -- "$DAQ" model probe-check "$TMP/b1.csv" --model "$NOM"
 check fit 0 "Axis B \(spindle side\): 13 probed centres" -- "$DAQ" model probe "$TMP/b1.csv" --model "$NOM" --write "$TMP/fitted.json"
-check fit_sphere 0 "sphere at \(120\.000[0-9], 40\.000[0-9], -300\.000[0-9]\) mm" -- "$DAQ" model probe "$TMP/b1.csv" --model "$NOM"
+# The sphere within 2 um of where it was put (its u is 0.3 to 0.4 um).
+check fit_sphere 0 "sphere at \((119\.99[89]|120\.00[01])[0-9], (39\.99[89]|40\.00[01])[0-9], -(299\.99[89]|300\.00[01])[0-9]\) mm" -- "$DAQ" model probe "$TMP/b1.csv" --model "$NOM"
 # Tolerance: every fitted value within 4 u of the injected one (u from the residuals; by hand
 # for sigma = 1 um: 0.34 um, 3.2 and 1.5 urad, tests/analysis/rotary_head_test.cpp).
 "$DAQ" model probe "$TMP/b1.csv" --model "$NOM" --json >"$TMP/fit.json" 2>/dev/null
@@ -47,9 +48,10 @@ check fit_side 0 '"side": "spindle"' -- cat "$TMP/fit.json"
 check fitted_model 0 '"E_X0B": \{' -- cat "$TMP/fitted.json"
 # The simulated control corrected: it holds the fitted B line (position and orientation) as its
 # kinematics and reports the centres where that puts the tip. Probed again (seed 2): what is left
-# is the probe's noise and the fit's uncertainty.
+# is the probe's noise (each deviation holds two centres' noise, the sphere's place being the 0
+# deg centre: |d| about sqrt(6) = 2.4 um, the largest of 12 up to about 5) and the fit's u.
 check probe_again 0 "" -- probe 2 "$TMP/fitted.json" "$TMP/b2.csv"
-check after 0 "largest deviation [0-4]\.[0-9]+ um" -- "$DAQ" model probe-check "$TMP/b2.csv" --model "$TMP/fitted.json"
+check after 0 "largest deviation [0-5]\.[0-9]+ um" -- "$DAQ" model probe-check "$TMP/b2.csv" --model "$TMP/fitted.json"
 # Refused: the linear axes' raw positions instead of the control's tip; a fit without a model.
 "$PY" - "$TMP/b1.csv" "$TMP/raw.csv" <<'PYEOF'
 import math, sys
@@ -119,3 +121,5 @@ printf 'c_deg,x_mm,y_mm,z_mm\n0,1,2,3\n' >"$TMP/no_a.csv"
 check poses_missing_column 2 "no_a.csv.*a_deg" -- "$DAQ" model probe-poses "$TMP/no_a.csv" --model "$TN"
 { echo "c_deg,a_deg,x_mm,y_mm,z_mm"; for c in 0 0 0 0 0; do echo "$c,0,1,2,3"; done; } >"$TMP/still.csv"
 check poses_none_turns 2 "still.csv: no rotary axis turns in its 5 poses" -- "$DAQ" model probe-poses "$TMP/still.csv" --model "$TN"
+
+finish
