@@ -620,12 +620,7 @@ AxisLineFit fit_axis_line(RotaryLetter letter, const Vec3& nominal_pivot_mm,
   fit.dof = 2 * static_cast<int>(pts.size()) - 6;
   const double ss = r.squaredNorm();
   fit.rms_um = std::sqrt(ss / static_cast<double>(r.size())) / kMmPerUm;
-  double sigma_mm = std::numeric_limits<double>::quiet_NaN();
-  if (probe_u_um > 0.0) {
-    sigma_mm = probe_u_um * kMmPerUm;
-  } else if (fit.dof > 0) {
-    sigma_mm = std::sqrt(ss / fit.dof);
-  }
+  const double sigma_mm = fit_sigma_mm(ss, fit.dof, probe_u_um);
   fit.sigma_um = sigma_mm / kMmPerUm;
   const Eigen::Matrix<double, 6, 6> cov = sigma_mm * sigma_mm * (j.transpose() * j).inverse();
   for (std::size_t k = 0; k < 2; ++k) {

@@ -150,6 +150,12 @@ Vector3d initial_sphere(const FiveAxisMachine& nominal, std::span<const ProbedPo
 
 }  // namespace
 
+double fit_sigma_mm(double sum_sq_mm2, int dof, double probe_u_um) {
+  if (probe_u_um > 0.0) return probe_u_um * kMmPerUm;
+  if (dof > 0) return std::sqrt(sum_sq_mm2 / dof);
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 LocationFit fit_location_errors(const FiveAxisMachine& control, std::span<const std::size_t> axes,
                                 std::span<const ProbedPose> poses, double probe_u_um,
                                 bool with_linear_errors) {
@@ -207,12 +213,7 @@ LocationFit fit_location_errors(const FiveAxisMachine& control, std::span<const 
   fit.dof = static_cast<int>(r.size() - n_par);
   const double ss = r.squaredNorm();
   fit.rms_um = std::sqrt(ss / static_cast<double>(r.size())) / kMmPerUm;
-  double sigma_mm = std::numeric_limits<double>::quiet_NaN();
-  if (probe_u_um > 0.0) {
-    sigma_mm = probe_u_um * kMmPerUm;
-  } else if (fit.dof > 0) {
-    sigma_mm = std::sqrt(ss / fit.dof);
-  }
+  const double sigma_mm = fit_sigma_mm(ss, fit.dof, probe_u_um);
   fit.sigma_um = sigma_mm / kMmPerUm;
   const MatrixXd cov = sigma_mm * sigma_mm * (j.transpose() * j).inverse();
   fit.covariance.assign(cov.data(), cov.data() + cov.size());  // symmetric: any order

@@ -50,6 +50,11 @@ LocationFit fit_location_errors(const FiveAxisMachine& control, std::span<const 
                                 std::span<const ProbedPose> poses, double probe_u_um = 0.0,
                                 bool with_linear_errors = true);
 
+// The point standard deviation of a least-squares fit, in mm: the probe's if given (probe_u_um
+// > 0, in um), else sqrt(sum_sq_mm2 / dof) from the residuals; NaN when neither (dof <= 0).
+// Shared by the fits of rotary.hpp and this file.
+double fit_sigma_mm(double sum_sq_mm2, int dof, double probe_u_um);
+
 // The offset between two fitted axes' lines: for lines that are not parallel, the signed length
 // of their common perpendicular, (p2 - p1) . n, n = d1 x d2 normalised (for a C line and an A
 // line, n is about +Y: the second line passes that far on +Y of the first); for parallel lines
