@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/rotary_fit.hpp"
 
 namespace cal::kinematics {
 namespace {
@@ -314,15 +315,59 @@ Vec3 five_axis_nominal_tip_mm(const FiveAxisMachine& machine, const Vec3& linear
   return arr(nominal_pose(f) * vec(machine.linear.tool_offset_mm));
 }
 
-Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
-                      std::span<const double> angles_deg) {
+FiveAxisMachine control_kinematics(const FiveAxisMachine& m) {
+  FiveAxisMachine k;
+  k.linear.topology = m.linear.topology;
+  k.linear.tool_offset_mm = m.linear.tool_offset_mm;
+  k.linear.table_offset_mm = m.linear.table_offset_mm;
+  for (const RotaryAxis& r : m.rotary) {
+    RotaryAxis a;
+    a.letter = r.letter;
+    a.side = r.side;
+    a.pivot_mm = r.pivot_mm;
+    a.location_position_um = r.location_position_um;
+    a.location_orientation_urad = r.location_orientation_urad;
+    k.rotary.push_back(a);
+  }
+  return k;
+}
+
+FiveAxisMachine nominal_kinematics(const FiveAxisMachine& m) {
+  FiveAxisMachine k = control_kinematics(m);
+  for (RotaryAxis& r : k.rotary) {
+    r.location_position_um = {};
+    r.location_orientation_urad = {};
+  }
+  return k;
+}
+
+Vec3 control_tip_mm(const FiveAxisMachine& control, const Vec3& linear_mm,
+                    std::span<const double> angles_deg) {
+  check_machine(control, angles_deg);
+  const FiveAxisMachine k = control_kinematics(control);
+  std::vector<double> angles(angles_deg.begin(), angles_deg.end());
+  for (std::size_t i = 0; i < k.rotary.size(); ++i) {
+    if (k.rotary[i].side == Side::table) angles[i] = 0.0;
+  }
+  const Vec3 tip = five_axis_nominal_tip_mm(k, linear_mm, angles);
+  const Vec3 e_um = five_axis_error(k, linear_mm, angles, Method::htm).translation_um;
+  return {tip[0] + kMmPerUm * e_um[0], tip[1] + kMmPerUm * e_um[1], tip[2] + kMmPerUm * e_um[2]};
+}
+
+Vec3 probed_centre_mm(const FiveAxisMachine& machine, const FiveAxisMachine& control,
+                      const Vec3& sphere_mm, std::span<const double> angles_deg) {
   check_machine(machine, angles_deg);
+  check_machine(control, angles_deg);
   check_finite(sphere_mm, "sphere_mm");
-  for (std::size_t i = 0; i < machine.rotary.size(); ++i) {
-    if (machine.rotary[i].side == Side::spindle && angles_deg[i] != 0.0) {
-      throw InputError(fmt::format("{} at {} deg: a simulated probe needs the spindle axes at 0",
-                                   rotary_name(machine.rotary[i], i), angles_deg[i]));
-    }
+  bool same = machine.rotary.size() == control.rotary.size();
+  for (std::size_t i = 0; same && i < machine.rotary.size(); ++i) {
+    same = machine.rotary[i].letter == control.rotary[i].letter &&
+           machine.rotary[i].side == control.rotary[i].side;
+  }
+  if (!same) {
+    throw InputError(
+        "the machine and the control's kinematics have different rotary axes (letters, sides "
+        "or order): a control reports for its own chain");
   }
   // The nominal tip is b + A p: A from unit steps (exact: it is affine).
   const auto tip = [&](const Vector3d& p) {
@@ -342,7 +387,12 @@ Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
     p -= solve.solve(miss);
     if (miss.norm() < 1e-12) break;
   }
-  return arr(p + vec(machine.linear.tool_offset_mm));
+  return control_tip_mm(control, arr(p), angles_deg);
+}
+
+Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
+                      std::span<const double> angles_deg) {
+  return probed_centre_mm(machine, nominal_kinematics(machine), sphere_mm, angles_deg);
 }
 
 LinearCorrection remove_linear_errors(const Machine& linear,
@@ -570,12 +620,7 @@ AxisLineFit fit_axis_line(RotaryLetter letter, const Vec3& nominal_pivot_mm,
   fit.dof = 2 * static_cast<int>(pts.size()) - 6;
   const double ss = r.squaredNorm();
   fit.rms_um = std::sqrt(ss / static_cast<double>(r.size())) / kMmPerUm;
-  double sigma_mm = std::numeric_limits<double>::quiet_NaN();
-  if (probe_u_um > 0.0) {
-    sigma_mm = probe_u_um * kMmPerUm;
-  } else if (fit.dof > 0) {
-    sigma_mm = std::sqrt(ss / fit.dof);
-  }
+  const double sigma_mm = fit_sigma_mm(ss, fit.dof, probe_u_um);
   fit.sigma_um = sigma_mm / kMmPerUm;
   const Eigen::Matrix<double, 6, 6> cov = sigma_mm * sigma_mm * (j.transpose() * j).inverse();
   for (std::size_t k = 0; k < 2; ++k) {
@@ -606,6 +651,90 @@ AxisLineFit fit_axis_line(RotaryLetter letter, const Vec3& nominal_pivot_mm,
   const double mean_phi = std::atan2(sum_sin, sum_cos);
   for (double d : dphi) fit.tangential_um.push_back(q[5] * wrap_rad(d - mean_phi) / kMmPerUm);
   return fit;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sphere probing of a head axis
+
+namespace {
+
+// Head centres are the control's computed tip: within the location errors of one another. A
+// spread beyond this is not such a file (the linear axes' raw positions describe a circle of
+// the tool's arm, hundreds of mm).
+constexpr double kMaxHeadSpreadMm = 2.0;
+
+}  // namespace
+
+HeadAxisFit fit_head_axis_line(const FiveAxisMachine& control, std::size_t index,
+                               std::span<const ProbedCentre> centres, double probe_u_um,
+                               bool with_linear_errors) {
+  check_machine(control, std::vector<double>(control.rotary.size(), 0.0));
+  if (index >= control.rotary.size() || control.rotary[index].side != Side::spindle) {
+    throw InputError(fmt::format(
+        "rotary axis {} of {}: the head fit needs a spindle-side axis (a table axis is fitted "
+        "by fit_axis_line)",
+        index, control.rotary.size()));
+  }
+  check_centres(centres);  // probe_u_um: checked by fit_location_errors
+  const RotaryAxis& axis = control.rotary[index];
+  std::vector<Vector3d> pts;
+  Vector3d mean = Vector3d::Zero();
+  for (const auto& c : centres) {
+    pts.push_back(vec(c.centre_mm));
+    mean += pts.back();
+  }
+  mean /= static_cast<double>(pts.size());
+  double spread = 0.0;
+  for (const auto& p : pts) spread = std::max(spread, (p - mean).norm());
+  if (spread > kMaxHeadSpreadMm) {
+    throw InputError(fmt::format(
+        "the centres of the {} head axis lie up to {:.3f} mm from their mean (expected within "
+        "{} mm): a control reports the probed centre where its kinematics puts the turned probe "
+        "tip, so they lie within the head's location errors of one another; were these the "
+        "linear axes' raw positions?",
+        to_string(axis.letter), spread, kMaxHeadSpreadMm));
+  }
+
+  std::vector<ProbedPose> poses;
+  for (const auto& c : centres) {
+    poses.push_back({std::vector<double>(control.rotary.size(), 0.0), c.centre_mm});
+    poses.back().angles_deg[index] = c.angle_deg;
+  }
+  const std::array<std::size_t, 1> axes{index};
+  const LocationFit lf = fit_location_errors(control, axes, poses, probe_u_um, with_linear_errors);
+
+  HeadAxisFit out;
+  AxisLineFit& fit = out.line;
+  fit.letter = axis.letter;
+  fit.position_um = lf.position_um[0];
+  fit.position_u_um = lf.position_u_um[0];
+  fit.orientation_urad = lf.orientation_urad[0];
+  fit.orientation_u_urad = lf.orientation_u_urad[0];
+  fit.rms_um = lf.rms_um;
+  fit.sigma_um = lf.sigma_um;
+  fit.dof = lf.dof;
+  out.sphere_mm = lf.sphere_mm;
+  out.sphere_u_um = lf.sphere_u_um;
+
+  // The probe tip relative to the fitted line, in the head's carrier (the machine's axes to
+  // first order): w = tool - actual pivot, turned about the fitted direction n.
+  Vector3d d = Vector3d::Zero();
+  d[static_cast<Eigen::Index>(direction_index(axis.letter))] = 1.0;
+  const Vector3d n = rotation(kRadPerUrad * vec(fit.orientation_urad)) * d;
+  const Vector3d w =
+      vec(control.linear.tool_offset_mm) - vec(axis.pivot_mm) - kMmPerUm * vec(fit.position_um);
+  fit.plane_offset_mm = w.dot(n);
+  fit.radius_mm = (w - w.dot(n) * n).norm();
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const Vector3d wk = Eigen::AngleAxisd(centres[k].angle_deg * kRadPerDeg, n) * w;
+    Vector3d radial = wk - wk.dot(n) * n;
+    radial = radial.norm() > 1e-9 ? Vector3d(radial.normalized()) : n.unitOrthogonal();
+    const Vector3d motion = -vec(lf.residual_um[k]);
+    fit.radial_um.push_back(motion.dot(radial));
+    fit.axial_um.push_back(motion.dot(n));
+    fit.tangential_um.push_back(motion.dot(n.cross(radial)));
+  }
+  return out;
 }
 
 }  // namespace cal::kinematics

@@ -29,43 +29,20 @@
 #include <vector>
 
 #include "cal/analysis/error.hpp"
+#include "rotary_fixtures.hpp"
 
 namespace {
 
 using namespace cal::kinematics;
 
-RotaryAxis axis(RotaryLetter l, const Vec3& pivot, const Vec3& pos_um, const Vec3& orient_urad) {
-  RotaryAxis r;
-  r.letter = l;
-  r.side = Side::table;
-  r.pivot_mm = pivot;
-  r.location_position_um = pos_um;
-  r.location_orientation_urad = orient_urad;
-  return r;
-}
+using cal::test::table_axis;
+using cal::test::turn;
 
+// The small trunnion (rotary_fixtures.hpp) with the orientation errors of the head comment: C
+// E_A0C = 20, E_B0C = -8 urad; A E_C0A = 30 urad, or B E_A0B = 11 urad.
 FiveAxisMachine trunnion(RotaryLetter cradle = RotaryLetter::a) {
-  FiveAxisMachine m;
-  m.linear.topology = Topology::fxyz;
-  m.rotary.push_back(axis(RotaryLetter::c, {10, 20, -300}, {12, -5, 0}, {20, -8, 0}));
-  if (cradle == RotaryLetter::a)
-    m.rotary.push_back(axis(RotaryLetter::a, {0, 25, -280}, {0, 7, -15}, {0, 0, 30}));
-  else  // B cradle: E_X0B = 9, E_Z0B = -15 um, E_A0B = 11 urad
-    m.rotary.push_back(axis(RotaryLetter::b, {-4, 0, -280}, {9, 0, -15}, {11, 0, 0}));
-  return m;
-}
-
-// v turned by `deg` right-handed about the line through q along u (any length).
-Vec3 turn(const Vec3& v, const Vec3& q, const Vec3& u, double deg) {
-  const double n = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  const Vec3 k{u[0] / n, u[1] / n, u[2] / n};
-  const double t = deg * std::numbers::pi / 180.0, c = std::cos(t), s = std::sin(t);
-  const Vec3 w{v[0] - q[0], v[1] - q[1], v[2] - q[2]};
-  const double kw = k[0] * w[0] + k[1] * w[1] + k[2] * w[2];
-  const Vec3 kxw{k[1] * w[2] - k[2] * w[1], k[2] * w[0] - k[0] * w[2], k[0] * w[1] - k[1] * w[0]};
-  Vec3 out{};
-  for (std::size_t i = 0; i < 3; ++i) out[i] = q[i] + w[i] * c + kxw[i] * s + k[i] * kw * (1 - c);
-  return out;
+  return cal::test::small_trunnion(cradle, {20, -8, 0},
+                                   cradle == RotaryLetter::a ? Vec3{0, 0, 30} : Vec3{11, 0, 0});
 }
 
 Vec3 add(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
@@ -181,7 +158,7 @@ TEST(SwivelData, TheRecordsChainIsTheModelsActualMachine) {
 TEST(SwivelData, OneTableAxis) {
   FiveAxisMachine m;
   m.linear.topology = Topology::xyfz;
-  m.rotary.push_back(axis(RotaryLetter::c, {100, 50, -200}, {4, 6, 0}, {0, 0, 0}));
+  m.rotary.push_back(table_axis(RotaryLetter::c, {100, 50, -200}, {4, 6, 0}, {0, 0, 0}));
   const SwivelRecord r = sinumerik_swivel_record(m);
   EXPECT_EQ(r.axis1, "C");
   EXPECT_EQ(r.axis2, "");

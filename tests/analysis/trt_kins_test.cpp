@@ -13,34 +13,17 @@
 #include <vector>
 
 #include "cal/analysis/error.hpp"
+#include "rotary_fixtures.hpp"
 
 namespace {
 
 using namespace cal::kinematics;
 
-RotaryAxis axis(RotaryLetter l, const Vec3& pivot, const Vec3& pos_um, const Vec3& orient_urad) {
-  RotaryAxis r;
-  r.letter = l;
-  r.side = Side::table;
-  r.pivot_mm = pivot;
-  r.location_position_um = pos_um;
-  r.location_orientation_urad = orient_urad;
-  return r;
-}
-
-// A C table on an A or B cradle with position errors on both axes, the C axis's orientation
-// errors `c_orient` and E_C0A (E_C0B) = `cradle_c0_urad`.
+// The small trunnion (rotary_fixtures.hpp) with the C axis's orientation errors `c_orient` and
+// E_C0A (E_C0B) = `cradle_c0_urad`.
 FiveAxisMachine trunnion(RotaryLetter cradle, const Vec3& c_orient = {},
                          double cradle_c0_urad = 30.0) {
-  FiveAxisMachine m;
-  m.linear.topology = Topology::fxyz;
-  m.rotary.push_back(axis(RotaryLetter::c, {10, 20, -300}, {12, -5, 0}, c_orient));
-  const Vec3 cradle_orient{0, 0, cradle_c0_urad};
-  if (cradle == RotaryLetter::a)
-    m.rotary.push_back(axis(RotaryLetter::a, {0, 25, -280}, {0, 7, -15}, cradle_orient));
-  else
-    m.rotary.push_back(axis(RotaryLetter::b, {-4, 0, -280}, {9, 0, -15}, cradle_orient));
-  return m;
+  return cal::test::small_trunnion(cradle, c_orient, {0, 0, cradle_c0_urad});
 }
 
 TEST(TrtKins, XyzacPinsByHand) {
@@ -74,14 +57,11 @@ TEST(TrtKins, XyzbcPinsByHand) {
   EXPECT_NE(hal.find("setp xyzbc-trt-kins.x-offset -14.003000\n"), std::string::npos) << hal;
 }
 
-// Rodrigues: v turned by `deg` about the line through q along the unit axis `dir`.
+// v turned by `deg` about the line through q along the unit axis of index `dir`.
 Vec3 turn(const Vec3& v, const Vec3& q, std::size_t dir, double deg) {
-  const double t = deg * std::numbers::pi / 180.0, c = std::cos(t), s = std::sin(t);
-  Vec3 w{v[0] - q[0], v[1] - q[1], v[2] - q[2]}, out = w;
-  const std::size_t i = (dir + 1) % 3, j = (dir + 2) % 3;
-  out[i] = c * w[i] - s * w[j];
-  out[j] = s * w[i] + c * w[j];
-  return {out[0] + q[0], out[1] + q[1], out[2] + q[2]};
+  Vec3 u{};
+  u[dir] = 1.0;
+  return cal::test::turn(v, q, u, deg);
 }
 
 // The lines the pins describe turn a point W of the C table (first about C, then the cradle

@@ -477,6 +477,7 @@ void add_model_commands(CLI::App& app) {
   add_model_compensate_command(*model);
   add_model_testpiece_command(*model);
   add_model_probe_commands(*model);
+  add_model_probe_poses_command(*model);
   add_model_ballbar5x_commands(*model);
   add_model_kinematics_command(*model);
 }

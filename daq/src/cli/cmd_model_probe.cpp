@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -73,21 +74,30 @@ std::map<kin::RotaryLetter, AxisCentres> read_centres(const ProbeOptions& o) {
   return out;
 }
 
-// The table axis of that letter the fit is against: the model's (its nominal pivot, no location
+// The rotary axis of that letter the fit is against: the model's (its nominal pivot, no location
 // error) or, with --hal / --swivel, the control's holding that correction (its line's point and
-// direction). nullptr without --model (--pivot-mm).
-const kin::RotaryAxis* reference_axis(const ProbeOptions& o,
-                                      const std::optional<kin::FiveAxisMachine>& reference,
-                                      kin::RotaryLetter l) {
-  if (!reference) return nullptr;
-  for (const auto& r : reference->rotary) {
+// direction; table axes only). `index`: its place in the chain; `line` nullptr without --model
+// (--pivot-mm: a table axis).
+struct AxisRef {
+  kin::Vec3 pivot{};
+  kin::Side side = kin::Side::table;
+  std::size_t index = 0;
+  const kin::RotaryAxis* line = nullptr;
+};
+
+AxisRef axis_of(const ProbeOptions& o, const std::optional<kin::FiveAxisMachine>& reference,
+                kin::RotaryLetter l) {
+  if (!reference)
+    return {{o.pivot_mm.at(0), o.pivot_mm.at(1), o.pivot_mm.at(2)}, kin::Side::table, 0, nullptr};
+  for (std::size_t i = 0; i < reference->rotary.size(); ++i) {
+    const auto& r = reference->rotary[i];
     if (r.letter != l) continue;
-    if (r.side != kin::Side::table)
+    if (r.side != kin::Side::table && (!o.hal.empty() || !o.swivel.empty()))
       throw cal::InputError(
-          fmt::format("{}: the {} axis is on the spindle side: sphere probing "
-                      "fits table axes only (docs/kinematics.md)",
+          fmt::format("{}: the {} axis is on the spindle side: the fit against a control's "
+                      "correction (--hal, --swivel) is of table axes only (docs/kinematics.md)",
                       o.model, kin::to_string(l)));
-    return &r;
+    return {r.pivot_mm, r.side, i, &r};
   }
   throw cal::InputError(
       fmt::format("{}: {} has centres of the {} axis, the model has no such "
@@ -120,8 +130,9 @@ std::vector<LocationValue> location_values(const kin::AxisLineFit& f) {
 
 // `against_control`: the fit was made against a corrected control's line (probe --hal /
 // --swivel), so the pivot is the control's, not the nominal one.
-json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a,
-              bool against_control) {
+json fit_json(const kin::AxisLineFit& f, const AxisRef& ax, const AxisCentres& a,
+              const kin::HeadAxisFit* head, bool against_control) {
+  const kin::Vec3& pivot = ax.pivot;
   json loc = json::object();
   for (const auto& l : location_values(f))
     loc[l.name] = {{"value", l.value},
@@ -134,9 +145,16 @@ json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentr
                    {"radial_um", f.radial_um[k]},
                    {"axial_um", f.axial_um[k]},
                    {"tangential_um", f.tangential_um[k]}});
+  json sphere = nullptr;
+  if (head)
+    sphere = {
+        {"mm", json::array({head->sphere_mm[0], head->sphere_mm[1], head->sphere_mm[2]})},
+        {"u_um", json::array({head->sphere_u_um[0], head->sphere_u_um[1], head->sphere_u_um[2]})}};
   return {{"axis", kin::to_string(f.letter)},
+          {"side", kin::to_string(ax.side)},
           {against_control ? "control_pivot_mm" : "nominal_pivot_mm",
            json::array({pivot[0], pivot[1], pivot[2]})},
+          {"sphere", sphere},
           {"centres", a.centres.size()},
           {"location", loc},
           {"radius_mm", f.radius_mm},
@@ -147,22 +165,35 @@ json fit_json(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentr
           {"residuals", res}};
 }
 
-void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCentres& a,
-               bool against_control) {
-  fmt::print("Axis {}: {} probed centres, {} pivot ({:g}, {:g}, {:g}) mm\n",
-             kin::to_string(f.letter), a.centres.size(),
+void print_fit(const kin::AxisLineFit& f, const AxisRef& ax, const AxisCentres& a,
+               const kin::HeadAxisFit* head, bool against_control) {
+  const kin::Vec3& pivot = ax.pivot;
+  fmt::print("Axis {} ({} side): {} probed centres, {} pivot ({:g}, {:g}, {:g}) mm\n",
+             kin::to_string(f.letter), kin::to_string(ax.side), a.centres.size(),
              against_control ? "the control's" : "nominal", pivot[0], pivot[1], pivot[2]);
   for (const auto& l : location_values(f))
     fmt::print("  {:6} {:+10.3f} {:4}  u = {}\n", l.name, l.value, l.unit,
                std::isnan(l.uncertainty)
                    ? std::string("not estimated (3 angles: give --probe-u-um)")
                    : fmt::format("{:.3f} {}", l.uncertainty, l.unit));
-  fmt::print("  circle radius {:.4f} mm, its plane {:+.4f} mm from the pivot along the axis\n",
-             f.radius_mm, f.plane_offset_mm);
+  if (head) {
+    const auto& s = head->sphere_mm;
+    const auto& u = head->sphere_u_um;
+    fmt::print("  sphere at ({:.4f}, {:.4f}, {:.4f}) mm (u = {:.3f}, {:.3f}, {:.3f} um)\n", s[0],
+               s[1], s[2], u[0], u[1], u[2]);
+    fmt::print(
+        "  probe tip {:.4f} mm from the fitted line, {:+.4f} mm along it from the pivot's plane "
+        "(the tool offset must be calibrated: an error of it across the axis reads as the "
+        "line's position)\n",
+        f.radius_mm, f.plane_offset_mm);
+  } else {
+    fmt::print("  circle radius {:.4f} mm, its plane {:+.4f} mm from the pivot along the axis\n",
+               f.radius_mm, f.plane_offset_mm);
+  }
   fmt::print(
-      "  residuals (the axis's error motion at the sphere, and probing noise): RMS {:.3f} "
+      "  residuals (the axis's error motion at the {}, and probing noise): RMS {:.3f} "
       "um, sigma {:.3f} um, {} degrees of freedom\n",
-      f.rms_um, f.sigma_um, f.dof);
+      head ? "probe tip" : "sphere", f.rms_um, f.sigma_um, f.dof);
   fmt::print("  {:>6} {:>10} {:>10} {:>10} {:>12}\n", "line", "angle_deg", "radial_um", "axial_um",
              "tangential_um");
   for (std::size_t k = 0; k < a.centres.size(); ++k)
@@ -170,28 +201,13 @@ void print_fit(const kin::AxisLineFit& f, const kin::Vec3& pivot, const AxisCent
                a.centres[k].angle_deg, f.radial_um[k], f.axial_um[k], f.tangential_um[k]);
 }
 
-// The fitted location errors into the model's axis, with their uncertainty and where they came
-// from.
 void put_fit(mdl::RotaryEntry& r, const kin::AxisLineFit& f, const std::string& centres,
              std::size_t count) {
-  const std::size_t own = kin::direction_index(f.letter);
-  std::size_t n = 0;
-  for (std::size_t slot = 0; slot < 6; ++slot) {
-    if (slot % 3 == own) continue;
-    const bool pos = slot < 3;
-    (pos ? r.axis.location_position_um[slot] : r.axis.location_orientation_urad[slot - 3]) =
-        pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
-    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
-    auto& e = r.location[n++];
-    e.given = true;
-    e.uncertainty = std::isnan(u) ? std::optional<double>{} : std::optional<double>{u};
-    e.source = {json{
-        {"kind", "sphere probing"},
-        {"centres_file", centres},
-        {"centres", count},
-        {"rms_um",
-         f.rms_um}}.dump()};
-  }
+  put_location_fit(r, f,
+                   json{{"kind", "sphere probing"},
+                        {"centres_file", centres},
+                        {"centres", count},
+                        {"rms_um", f.rms_um}});
 }
 
 // Whether the model holds any measured linear-axis error (a component or a squareness).
@@ -275,9 +291,22 @@ void relative_to(kin::AxisLineFit& f, const kin::RotaryAxis& control) {
   }
 }
 
+// The fit of a head axis: against the model as the control's kinematics (what computed the
+// centres), with the model's linear-axis errors in the fitted machine unless kept out.
+kin::HeadAxisFit fit_head(const ProbeOptions& o, const mdl::Model& m, const AxisRef& ax,
+                          kin::RotaryLetter letter, const AxisCentres& a, bool linear) {
+  if (linear && !o.json)
+    fmt::print(
+        "Axis {}: the linear axes' errors of {} are in the fitted machine (a head axis's "
+        "centres are not corrected one by one; --keep-linear-errors to fit as if the linear "
+        "axes were perfect)\n",
+        kin::to_string(letter), o.model);
+  return kin::fit_head_axis_line(mdl::five_axis(m), ax.index, a.centres, o.probe_u_um, linear);
+}
+
 void run_probe(const ProbeOptions& o) {
   if (o.model.empty() && (o.axis.empty() || o.pivot_mm.size() != 3))
-    throw cal::InputError("give --model (the pivots of its table axes) or --axis and --pivot-mm");
+    throw cal::InputError("give --model (the pivots of its rotary axes) or --axis and --pivot-mm");
   if (!o.model.empty() && !o.pivot_mm.empty())
     throw cal::InputError("--pivot-mm is for a fit without --model (the model has the pivots)");
   if (!o.write.empty() && o.model.empty())
@@ -308,29 +337,34 @@ void run_probe(const ProbeOptions& o) {
         o.model, correction);
   json fits = json::array();
   for (auto& [letter, a] : by_axis) {
-    const kin::RotaryAxis* axis = reference_axis(o, reference, letter);
-    const kin::Vec3 pivot =
-        axis ? axis->pivot_mm : kin::Vec3{o.pivot_mm.at(0), o.pivot_mm.at(1), o.pivot_mm.at(2)};
+    const AxisRef ax = axis_of(o, reference, letter);
+    const bool is_head = ax.side == kin::Side::spindle;
     json removed = nullptr;
-    if (remove) removed = remove_linear(*m, o, letter, a);
+    if (remove && !is_head) removed = remove_linear(*m, o, letter, a);
     kin::AxisLineFit f;
+    std::optional<kin::HeadAxisFit> head;
     try {
-      f = kin::fit_axis_line(letter, pivot, a.centres, o.probe_u_um);
+      if (is_head) {
+        head = fit_head(o, *m, ax, letter, a, remove);
+        f = head->line;
+      } else {
+        f = kin::fit_axis_line(letter, ax.pivot, a.centres, o.probe_u_um);
+      }
     } catch (const cal::InputError& e) {
       throw cal::InputError(fmt::format("{}: the {} axis's {} centres (lines {} .. {}): {}",
                                         o.centres, kin::to_string(letter), a.centres.size(),
                                         a.lines.front(), a.lines.back(), e.what()));
     }
-    if (axis) relative_to(f, *axis);
+    if (ax.line && !is_head) relative_to(f, *ax.line);
+    const kin::HeadAxisFit* h = head ? &*head : nullptr;
     if (o.json) {
-      fits.push_back(fit_json(f, pivot, a, !correction.empty()));
+      fits.push_back(fit_json(f, ax, a, h, !correction.empty()));
       fits.back()["linear_errors_removed"] = removed;
+      if (is_head) fits.back()["linear_errors_in_fit"] = remove;
     } else {
-      print_fit(f, pivot, a, !correction.empty());
+      print_fit(f, ax, a, h, !correction.empty());
     }
-    if (m && correction.empty())
-      for (auto& r : m->rotary)
-        if (r.axis.letter == letter) put_fit(r, f, o.centres, a.centres.size());
+    if (m && correction.empty()) put_fit(m->rotary.at(ax.index), f, o.centres, a.centres.size());
   }
   if (o.json)
     fmt::print("{}\n", json{{"schema", "caldaq.axis-line-fit.v1"},
@@ -387,7 +421,7 @@ void run_probe_check(const CheckOptions& o) {
                       o.centres, kin::to_string(letter)));
     kin::Vec3 sphere = zero->centre_mm;
     for (int it = 0; it < 6; ++it) {
-      const auto at0 = kin::probed_centre_mm(control, sphere, angles_at(zero->angle_deg));
+      const auto at0 = kin::probed_centre_mm(control, control, sphere, angles_at(zero->angle_deg));
       for (std::size_t k = 0; k < 3; ++k) sphere[k] += zero->centre_mm[k] - at0[k];
     }
     double sum = 0.0, worst = 0.0;
@@ -398,7 +432,10 @@ void run_probe_check(const CheckOptions& o) {
                  correction.empty() ? "" : " with " + correction, "line", "angle_deg", "dx_um",
                  "dy_um", "dz_um", "|d|_um");
     for (std::size_t k = 0; k < a.centres.size(); ++k) {
-      const auto want = kin::probed_centre_mm(control, sphere, angles_at(a.centres[k].angle_deg));
+      // What the control reports on a machine that is as it believes (for a head axis: the
+      // sphere itself at every angle).
+      const auto want =
+          kin::probed_centre_mm(control, control, sphere, angles_at(a.centres[k].angle_deg));
       kin::Vec3 d;
       for (std::size_t i = 0; i < 3; ++i) d[i] = 1e3 * (a.centres[k].centre_mm[i] - want[i]);
       const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -434,7 +471,7 @@ void run_probe_check(const CheckOptions& o) {
 // --- probe-sim: the simulated touch probe ----------------------------------------------------
 
 struct SimOptions {
-  std::string truth, axis, output;
+  std::string truth, control, axis, output;
   std::vector<double> sphere_mm, angles_deg;
   double noise_um = 0.0;
   unsigned seed = 1;
@@ -444,6 +481,10 @@ void run_probe_sim(const SimOptions& o) {
   const mdl::Model m = mdl::read(o.truth);
   const kin::RotaryLetter letter = kin::rotary_letter_from_string(o.axis);
   const auto machine = mdl::five_axis(m);
+  // The control that reports the centres: its kinematics (a head axis's centres are where it
+  // puts the turned tip); by default the truth's nominal kinematics.
+  const auto control =
+      o.control.empty() ? kin::nominal_kinematics(machine) : mdl::five_axis(mdl::read(o.control));
   std::size_t index = machine.rotary.size();
   for (std::size_t i = 0; i < machine.rotary.size(); ++i)
     if (machine.rotary[i].letter == letter) index = i;
@@ -455,12 +496,20 @@ void run_probe_sim(const SimOptions& o) {
   std::normal_distribution<double> noise(0.0, o.noise_um * 1e-3);
   std::string text = fmt::format(
       "# simulated touch probe: sphere at ({:g}, {:g}, {:g}) mm on the workpiece, machine {}, "
-      "noise {:g} um per coordinate (seed {})\naxis,angle_deg,x_mm,y_mm,z_mm\n",
-      sphere[0], sphere[1], sphere[2], o.truth, o.noise_um, o.seed);
+      "control {}, noise {:g} um per coordinate (seed {})\naxis,angle_deg,x_mm,y_mm,z_mm\n",
+      sphere[0], sphere[1], sphere[2], o.truth,
+      o.control.empty() ? "nominal" : cal::text::terminal_safe(o.control), o.noise_um, o.seed);
   for (double deg : o.angles_deg) {
     std::vector<double> angles(machine.rotary.size(), 0.0);
     angles[index] = deg;
-    kin::Vec3 c = kin::probed_centre_mm(machine, sphere, angles);
+    kin::Vec3 c;
+    try {
+      c = kin::probed_centre_mm(machine, control, sphere, angles);
+    } catch (const cal::InputError& e) {
+      throw cal::InputError(fmt::format("{} probed by {}: {}", o.truth,
+                                        o.control.empty() ? "its nominal control" : o.control,
+                                        e.what()));
+    }
     for (double& x : c) x += o.noise_um > 0.0 ? noise(rng) : 0.0;
     text += fmt::format("{},{:g},{:.6f},{:.6f},{:.6f}\n", kin::to_string(letter), deg, c[0], c[1],
                         c[2]);
@@ -472,11 +521,27 @@ void run_probe_sim(const SimOptions& o) {
 
 }  // namespace
 
+void put_location_fit(mdl::RotaryEntry& r, const kin::AxisLineFit& f, const json& source) {
+  const std::size_t own = kin::direction_index(f.letter);
+  std::size_t n = 0;
+  for (std::size_t slot = 0; slot < 6; ++slot) {
+    if (slot % 3 == own) continue;
+    const bool pos = slot < 3;
+    (pos ? r.axis.location_position_um[slot] : r.axis.location_orientation_urad[slot - 3]) =
+        pos ? f.position_um[slot] : f.orientation_urad[slot - 3];
+    const double u = pos ? f.position_u_um[slot] : f.orientation_u_urad[slot - 3];
+    auto& e = r.location[n++];
+    e.given = true;
+    e.uncertainty = std::isnan(u) ? std::optional<double>{} : std::optional<double>{u};
+    e.source = {source.dump()};
+  }
+}
+
 void add_model_probe_commands(CLI::App& model) {
   const auto [probe, p] = add_command<ProbeOptions>(
       model, "probe", run_probe,
-      "Fit each rotary table axis's average line to probed sphere centres (a CSV: axis, "
-      "angle_deg, x_mm, y_mm, z_mm): its location errors with their uncertainty and the "
+      "Fit each rotary axis's average line (table or head) to probed sphere centres (a CSV: "
+      "axis, angle_deg, x_mm, y_mm, z_mm): its location errors with their uncertainty and the "
       "residuals");
   probe
       ->add_option("centres", p->centres,
@@ -484,7 +549,8 @@ void add_model_probe_commands(CLI::App& model) {
                    "and axis (A, B or C) unless --axis is given")
       ->required();
   probe->add_option("--model", p->model,
-                    "Model file (caldaq.model.v2) giving each table axis's nominal pivot");
+                    "Model file (caldaq.model.v2) giving each rotary axis's nominal pivot; for a "
+                    "head axis also the control's kinematics that computed the centres");
   probe
       ->add_option("--axis", p->axis,
                    "The rotary axis of every centre (the file has no axis column)")
@@ -534,9 +600,14 @@ void add_model_probe_commands(CLI::App& model) {
   const auto [sim, s] = add_command<SimOptions>(
       model, "probe-sim", run_probe_sim,
       "Simulated touch probe: the sphere centres a model (the simulated machine's truth) reports "
-      "at the given angles of one table axis, the other at 0, as a CSV for daq model probe");
+      "at the given angles of one rotary axis (table or head), the other at 0, as a CSV for daq "
+      "model probe");
   sim->add_option("truth", s->truth, "Model file of the simulated machine (its truth)")->required();
-  sim->add_option("--axis", s->axis, "The table axis turned")
+  sim->add_option("--control", s->control,
+                  "Model file of the control's kinematics that reports the centres (a head "
+                  "axis's centres are where it puts the turned probe tip; default: the truth's "
+                  "nominal kinematics)");
+  sim->add_option("--axis", s->axis, "The rotary axis turned (table or head)")
       ->required()
       ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
   sim->add_option("--sphere-mm", s->sphere_mm, "Sphere centre on the workpiece X Y Z (home)")

@@ -75,11 +75,7 @@ std::vector<Pose> grid_poses(const mdl::Model& m, const kin::Grid& g, std::size_
 
 std::vector<Pose> csv_poses(const mdl::Model& m, const std::string& path, std::vector<int>& lines) {
   std::vector<std::string> columns{"x_mm", "y_mm", "z_mm"};
-  for (const auto& r : m.rotary) {
-    std::string c(kin::to_string(r.axis.letter));
-    c[0] = static_cast<char>(c[0] - 'A' + 'a');
-    columns.push_back(c + "_deg");
-  }
+  for (const auto& c : rotary_angle_columns(m)) columns.push_back(c);
   const auto csv = read_csv_columns(path, columns);
   std::vector<Pose> poses;
   for (std::size_t r = 0; r < csv.rows(); ++r) {
@@ -215,6 +211,16 @@ void print_points(const mdl::Model& m, const std::vector<PoseError>& errors) {
 }
 
 }  // namespace
+
+std::vector<std::string> rotary_angle_columns(const mdl::Model& m) {
+  std::vector<std::string> columns;
+  for (const auto& r : m.rotary) {
+    std::string c(kin::to_string(r.axis.letter));
+    c[0] = static_cast<char>(c[0] - 'A' + 'a');
+    columns.push_back(c + "_deg");
+  }
+  return columns;
+}
 
 void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
   const kin::FiveAxisMachine machine = mdl::five_axis(m);

@@ -71,6 +71,8 @@ struct FiveAxisMapRequest {
   bool json = false;
 };
 void run_five_axis_map(const cal::daq::model::Model& m, const FiveAxisMapRequest& q);
+// The CSV columns of a pose's angles, one per rotary axis in chain order: "c_deg", "a_deg", ...
+std::vector<std::string> rotary_angle_columns(const cal::daq::model::Model& m);
 
 // daq model compensate / daq model testpiece (their own files).
 void add_model_compensate_command(CLI::App& model);
@@ -80,6 +82,13 @@ void add_model_compare_command(CLI::App& model);
 // daq model probe | probe-sim (cmd_model_probe.cpp), daq model kinematics
 // (cmd_model_kinematics.cpp): sphere probing of rotary axes and the controls' kinematics.
 void add_model_probe_commands(CLI::App& model);
+// A fitted axis line's four location errors into the model's axis, with their uncertainty and
+// `source` (what was probed) in each.
+void put_location_fit(cal::daq::model::RotaryEntry& r, const cal::kinematics::AxisLineFit& f,
+                      const nlohmann::json& source);
+// daq model probe-poses (cmd_model_probe_poses.cpp): several rotary axes fitted together to
+// centres probed at poses that turn them at once.
+void add_model_probe_poses_command(CLI::App& model);
 void add_model_kinematics_command(CLI::App& model);
 // daq model ballbar5x | ballbar5x-sim | ballbar5x-program (cmd_model_ballbar5x.cpp): the
 // ballbar on a rotary table axis.

@@ -5,7 +5,8 @@
 // functions of the angle; the tool tip's position and orientation error relative to the
 // workpiece by the exact HTM product or its first-order expansion; and the fit of an axis
 // average line to sphere centres probed at several angles of one table axis (the method of
-// HEIDENHAIN KinematicsOpt and SINUMERIK CYCLE996). Conventions, derivations and sources:
+// HEIDENHAIN KinematicsOpt and SINUMERIK CYCLE996), and of a head axis's line to the sphere
+// centres a control reports as the head turns. Conventions, derivations and sources:
 // docs/kinematics.md, section "Rotary axes".
 //
 // Units as in kinematics.hpp: mm for positions, um for translational errors, urad for angular
@@ -93,12 +94,33 @@ VolumetricError five_axis_error(const FiveAxisMachine& machine, const Vec3& line
 Vec3 five_axis_nominal_tip_mm(const FiveAxisMachine& machine, const Vec3& linear_mm,
                               std::span<const double> angles_deg);
 
+// The machine as a control's kinematics holds it: the same chain, pivots, location errors (the
+// lines as the control believes them) and tool offset; no component error of a rotary axis and
+// no linear-axis error (those are the machine's, not the control's kinematics).
+FiveAxisMachine control_kinematics(const FiveAxisMachine& m);
+// The control's nominal kinematics: control_kinematics with the location errors cleared too.
+FiveAxisMachine nominal_kinematics(const FiveAxisMachine& m);
+
+// The tool tip the control's kinematics (control_kinematics(control)) computes at the linear
+// position linear_mm and these angles, in MACHINE coordinates: the table axes taken at 0
+// (machine coordinates do not turn with the table), the spindle axes at their angles (the
+// control turns the tool offset about its head axes). What a control reports as a probed point.
+Vec3 control_tip_mm(const FiveAxisMachine& control, const Vec3& linear_mm,
+                    std::span<const double> angles_deg);
+
 // A simulated touch probe: the centre of a sphere fixed at sphere_mm on the workpiece (home
-// coordinates) as the control reports it when the ACTUAL machine probes it at these angles: the
-// linear position at which the actual tool tip is on the centre, plus the tool offset (the
-// nominal tip is affine in the linear position, so Newton's steps on it converge to 1e-12 mm in
-// a few). Spindle axes must be at 0 (what a control adds for a turned tool is its own
-// kinematics). Throws InputError as five_axis_error, and for a spindle axis not at 0.
+// coordinates) as `control` reports it when the ACTUAL `machine` probes it at these angles: the
+// linear position p at which the actual tool tip is on the centre (the nominal tip is affine in
+// p, so Newton's steps on it converge to 1e-12 mm in a few), and control_tip_mm(control, p). With
+// the spindle axes at 0 this is p plus the tool offset, whatever the control (the location errors
+// move nothing at 0); with a spindle axis turned it is where the control's kinematics puts the
+// turned probe tip: the sphere less the actual tip's error relative to the control's belief.
+// The two machines must have the same chain (letters and sides). Throws InputError as
+// five_axis_error, and for chains that differ.
+Vec3 probed_centre_mm(const FiveAxisMachine& machine, const FiveAxisMachine& control,
+                      const Vec3& sphere_mm, std::span<const double> angles_deg);
+// The same reported by a control holding the machine's nominal kinematics
+// (nominal_kinematics(machine)).
 Vec3 probed_centre_mm(const FiveAxisMachine& machine, const Vec3& sphere_mm,
                       std::span<const double> angles_deg);
 
@@ -152,5 +174,43 @@ LinearCorrection remove_linear_errors(const Machine& linear, std::span<const Pro
 // not (nearly) perpendicular to the nominal direction, or a negative probe_u_um.
 AxisLineFit fit_axis_line(RotaryLetter letter, const Vec3& nominal_pivot_mm,
                           std::span<const ProbedCentre> centres, double probe_u_um = 0.0);
+
+// ---------------------------------------------------------------------------------------------
+// Sphere probing of one SPINDLE (head) axis: the sphere fixed on the table, the probe carried
+// by the head, probed at several angles of the head axis (every other rotary axis at 0). Each
+// centre is what the control reports (control_tip_mm: the probe tip where the control's
+// kinematics puts it, machine coordinates), so on a machine that matches the control every
+// centre is the sphere's; the spread of the centres is the head's error as the tool turns:
+// reported = S - (actual tip - control's tip). docs/kinematics.md, "Sphere probing of a head
+// axis".
+//
+// Fitted by Gauss-Newton on the exact model (probed_centre_mm with the candidate machine): the
+// sphere S (3 parameters) and the axis's four location errors, relative to its NOMINAL pivot
+// (not to the control's belief: the control's own location errors only say how it computed the
+// centres). 3 N residuals; u from sigma^2 (J^T J)^-1, sigma the probe's if given, else the
+// residuals' sqrt(sum r^2 / (3 N - 7)).
+//
+// The tool offset must be right: an error of the probe tip across the axis moves the tip exactly
+// as a position error of the line does (a tip that stands off by delta turns about the line like
+// one whose line stands off by -delta), so the probe's length and offset must be calibrated, as
+// for any head probing cycle. with_linear_errors: the machine's linear-axis errors (control's
+// `linear`, e.g. a volumetric campaign's) are part of the fitted machine, so they are not read
+// as the head's; false fits the centres as if the linear axes were perfect.
+struct HeadAxisFit {
+  // Location errors and uncertainties as for a table axis; radius_mm: the probe tip's distance
+  // from the fitted line, plane_offset_mm: along the line from the pivot's plane; residuals: the
+  // error motion at the probe tip (predicted minus reported: the actual tip's displacement),
+  // radial (outward from the line), axial (along it), tangential (in the sense of rotation);
+  // rms_um over the 3 N coordinates; dof = 3 N - 7.
+  AxisLineFit line;
+  Vec3 sphere_mm{}, sphere_u_um{};  // the sphere's centre on the workpiece, home coordinates
+};
+// Throws InputError for an index that is not a spindle axis, fewer than 3 distinct angles,
+// non-finite input, centres spread more than 2 mm (not a control's computed tip: the linear
+// axes' raw positions?), centres that cannot separate the line's position from its orientation
+// (the probe tip on the axis line), a negative probe_u_um.
+HeadAxisFit fit_head_axis_line(const FiveAxisMachine& control, std::size_t index,
+                               std::span<const ProbedCentre> centres, double probe_u_um = 0.0,
+                               bool with_linear_errors = true);
 
 }  // namespace cal::kinematics
