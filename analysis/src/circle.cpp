@@ -49,6 +49,7 @@
 
 #include "cal/analysis/angle_reduce.hpp"
 #include "cal/analysis/circle_records.hpp"
+#include "cal/analysis/circle_source.hpp"
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "circle_dynamics.hpp"
@@ -176,7 +177,7 @@ struct Model {
 
 // The samples of each trace: [begin, end) in the flattened samples, and the trace itself.
 struct Span {
-  const Trace* trace;
+  const TraceSource* trace;
   std::size_t begin, end;
 };
 
@@ -188,12 +189,12 @@ struct Span {
 // every pass (issue 32: a 10 kHz circle's records were most of its peak memory).
 class Samples {
  public:
-  Samples(std::span<const Trace> traces, double offset_um, double spike_decay_rad,
+  Samples(std::span<const TraceSource> traces, double offset_um, double spike_decay_rad,
           std::size_t held_max)
       : m_{0.0, spike_decay_rad, {}}, offset_um_(offset_um) {
     for (const auto& t : traces) {
-      spans_.push_back({&t, size_, size_ + t.angle_deg.size()});
-      size_ += t.angle_deg.size();
+      spans_.push_back({&t, size_, size_ + t.size()});
+      size_ += t.size();
     }
     if (size_ > held_max) return;
     held_.reserve(size_);
@@ -212,9 +213,9 @@ class Samples {
   Sample make(std::size_t i, bool spikes) const {
     const Span& sp = spans_.size() > 1 && i >= spans_[1].begin ? spans_[1] : spans_[0];
     const std::size_t j = i - sp.begin;
-    const double theta = sp.trace->angle_deg[j] * deg, y = sp.trace->deviation_um[j] + offset_um_;
+    const double theta = sp.trace->angle_deg(j) * deg, y = sp.trace->deviation_um(j) + offset_um_;
     if (!spikes) return {std::cos(theta), std::sin(theta), y, 0.0, 0.0};
-    return m_.sample(theta, sign_of(sp.trace->direction), y);
+    return m_.sample(theta, sign_of(sp.trace->direction()), y);
   }
 
   Model m_;  // for its spike columns
@@ -480,11 +481,55 @@ void sort_circular(std::vector<T>& v, Key key) {
 
 double mod360(double x) { return fmod_near(fmod_near(x, 360.0) + 360.0, 360.0); }
 
-// The smallest arc covering the angles: 360 minus the largest gap between sorted angles.
-double coverage_deg(std::span<const double> angles) {
+// The sorted order of key(0 .. n - 1) without sorting or holding them, when they are a rotation
+// of a strictly rising sequence or of a strictly falling one (a trace that runs one way round
+// the circle): the k-th smallest is key(at(k)). Found in one pass counting the cyclic pairs out
+// of order: exactly one means such a rotation. Sorting the keys gives the same sequence.
+struct CircularOrder {
+  std::size_t n = 0, start = 0;
+  bool falling = false;
+  std::size_t at(std::size_t k) const {
+    if (!falling) return start + k < n ? start + k : start + k - n;
+    return k <= start ? start - k : start + n - k;
+  }
+};
+template <class Key>
+std::optional<CircularOrder> circular_order(std::size_t n, Key key) {
+  if (n == 0) return std::nullopt;
+  if (n == 1) return CircularOrder{1, 0, false};
+  std::size_t not_rising = 0, not_falling = 0, last_not_rising = 0, last_not_falling = 0;
+  double prev = key(0);
+  const double first = prev;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double next = i + 1 < n ? key(i + 1) : first;
+    if (!(prev < next)) ++not_rising, last_not_rising = i;
+    if (!(next < prev)) ++not_falling, last_not_falling = i;
+    if (not_rising > 1 && not_falling > 1) return std::nullopt;
+    prev = next;
+  }
+  if (not_rising == 1)
+    return CircularOrder{n, last_not_rising + 1 < n ? last_not_rising + 1 : 0, false};
+  if (not_falling == 1) return CircularOrder{n, last_not_falling, true};
+  return std::nullopt;
+}
+
+// The smallest arc covering the angles: 360 minus the largest gap between sorted angles. A trace
+// that runs one way round is read in its sorted order in place (nothing held: issue 32).
+double coverage_deg(const TraceSource& t) {
+  const auto key = [&](std::size_t j) { return mod360(t.angle_deg(j)); };
+  if (const auto o = circular_order(t.size(), key)) {
+    double below = key(o->at(0));
+    double gap = below + 360.0 - key(o->at(t.size() - 1));
+    for (std::size_t k = 1; k < t.size(); ++k) {
+      const double x = key(o->at(k));
+      gap = std::max(gap, x - below);
+      below = x;
+    }
+    return 360.0 - gap;
+  }
   std::vector<double> a;
-  a.reserve(angles.size());
-  for (double x : angles) a.push_back(mod360(x));
+  a.reserve(t.size());
+  for (std::size_t j = 0; j < t.size(); ++j) a.push_back(key(j));
   sort_circular(a, [](double x) { return x; });
   double gap = a.front() + 360.0 - a.back();
   for (std::size_t i = 1; i < a.size(); ++i) gap = std::max(gap, a[i] - a[i - 1]);
@@ -519,19 +564,19 @@ void validate_setup(const Setup& setup) {
 }
 
 // Returns the trace's arc (coverage_deg), which the ISO values report.
-double validate_trace(const Trace& t) {
-  const char* name = name_of(t.direction);
-  if (t.angle_deg.size() != t.deviation_um.size())
-    throw InputError(fmt::format("circle: {} trace has {} angles but {} deviations", name,
-                                 t.angle_deg.size(), t.deviation_um.size()));
-  if (t.angle_deg.size() < min_samples)
+double validate_trace(const TraceSource& t) {
+  const char* name = name_of(t.direction());
+  if (t.size() != t.deviation_count())
+    throw InputError(fmt::format("circle: {} trace has {} angles but {} deviations", name, t.size(),
+                                 t.deviation_count()));
+  if (t.size() < min_samples)
     throw InputError(fmt::format("circle: {} trace has {} samples, at least {} needed", name,
-                                 t.angle_deg.size(), min_samples));
-  for (std::size_t i = 0; i < t.angle_deg.size(); ++i)
-    if (!std::isfinite(t.angle_deg[i]) || !std::isfinite(t.deviation_um[i]))
+                                 t.size(), min_samples));
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (!std::isfinite(t.angle_deg(i)) || !std::isfinite(t.deviation_um(i)))
       throw InputError(fmt::format("circle: {} trace sample {} is not finite (angle {}, {} um)",
-                                   name, i, t.angle_deg[i], t.deviation_um[i]));
-  const double arc = coverage_deg(t.angle_deg);
+                                   name, i, t.angle_deg(i), t.deviation_um(i)));
+  const double arc = coverage_deg(t);
   if (arc < 180.0 - 1e-9)
     throw InputError(
         fmt::format("circle: {} trace covers {:.1f} degrees, at least 180 needed", name, arc));
@@ -539,13 +584,13 @@ double validate_trace(const Trace& t) {
 }
 
 // Returns the smallest arc of the traces (validate_trace).
-double validate(const Setup& setup, std::span<const Trace> traces) {
+double validate(const Setup& setup, std::span<const TraceSource> traces) {
   if (traces.empty()) throw InputError("circle: no trace given");
   if (traces.size() > 2)
     throw InputError(fmt::format("circle: {} traces given, at most 2 (cw, ccw)", traces.size()));
-  if (traces.size() == 2 && traces[0].direction == traces[1].direction)
-    throw InputError(
-        fmt::format("circle: two traces in the same direction ({})", name_of(traces[0].direction)));
+  if (traces.size() == 2 && traces[0].direction() == traces[1].direction())
+    throw InputError(fmt::format("circle: two traces in the same direction ({})",
+                                 name_of(traces[0].direction())));
   validate_setup(setup);
   double arc_deg = 360.0;
   for (const auto& t : traces) arc_deg = std::min(arc_deg, validate_trace(t));
@@ -584,39 +629,73 @@ struct Range {
   double pv() const { return hi - lo; }
 };
 
-// Largest |r_a(theta) - r_b(theta)|, r_b interpolated (periodically) at the angles of a.
+// Largest |r_a(theta) - r_b(theta)|, r_b interpolated (periodically) at the angles of a. The
+// points of b in the order of their angles: when b runs one way round (circular_order), read
+// in place in that order (nothing held a sample: issue 32), else sorted into a vector.
 double hysteresis(const Circle& c, const Samples& samples, const Span& a, const Span& b) {
-  std::vector<std::pair<double, double>> pts;
-  pts.reserve(b.end - b.begin);
-  for (std::size_t i = b.begin; i < b.end; ++i)
-    pts.emplace_back(mod360(b.trace->angle_deg[i - b.begin]), c.residual(samples.plain(i)));
-  sort_circular(pts, [](const auto& p) { return p.first; });
+  const std::size_t nb = b.end - b.begin;
+  const auto angle_b = [&](std::size_t j) { return mod360(b.trace->angle_deg(j)); };
+  const auto order = circular_order(nb, angle_b);
+  std::vector<std::pair<double, double>> held;  // only when b does not run one way round
+  if (!order) {
+    held.reserve(nb);
+    for (std::size_t i = b.begin; i < b.end; ++i)
+      held.emplace_back(angle_b(i - b.begin), c.residual(samples.plain(i)));
+    sort_circular(held, [](const auto& p) { return p.first; });
+  }
+  // The k-th point in angle order: its angle, and (computed when needed, the last two kept)
+  // its residual.
+  const auto angle_at = [&](std::size_t k) {
+    return order ? angle_b(order->at(k)) : held[k].first;
+  };
+  std::array<std::pair<std::size_t, double>, 2> recent{{{SIZE_MAX, 0.0}, {SIZE_MAX, 0.0}}};
+  const auto residual_at = [&](std::size_t k) {
+    if (!order) return held[k].second;
+    for (const auto& r : recent)
+      if (r.first == k) return r.second;
+    const double r = c.residual(samples.plain(b.begin + order->at(k)));
+    recent[1] = recent[0];
+    recent[0] = {k, r};
+    return r;
+  };
+  // pts[k] < (t, -1e300), as the pairs compare.
+  const auto below = [&](std::size_t k, double t) {
+    const double x = angle_at(k);
+    return x < t || (x == t && residual_at(k) < -1e300);
+  };
   double h = 0.0;
   // The lower bound of each angle of a, looked for first a few places on from the last one
   // (a's angles mostly rise or fall through pts in order), else by bisection: the same place
   // either way, without a bisection's mispredicted branches on every sample (issue 32).
   std::size_t last = 0;
-  const auto lower_bound = [&](const std::pair<double, double>& key) {
+  const auto lower_bound = [&](double t) {
     const auto is_bound = [&](std::size_t j) {
-      return (j == 0 || pts[j - 1] < key) && (j == pts.size() || !(pts[j] < key));
+      return (j == 0 || below(j - 1, t)) && (j == nb || !below(j, t));
     };
-    for (std::size_t j = last > 2 ? last - 2 : 0; j <= std::min(pts.size(), last + 2); ++j)
-      if (is_bound(j)) return pts.begin() + static_cast<std::ptrdiff_t>(last = j);
-    const auto at = std::lower_bound(pts.begin(), pts.end(), key);
-    last = static_cast<std::size_t>(at - pts.begin());
-    return at;
+    for (std::size_t j = last > 2 ? last - 2 : 0; j <= std::min(nb, last + 2); ++j)
+      if (is_bound(j)) return last = j;
+    std::size_t lo = 0, len = nb;  // std::lower_bound's bisection
+    while (len > 0) {
+      const std::size_t half = len / 2;
+      if (below(lo + half, t))
+        lo += half + 1, len -= half + 1;
+      else
+        len = half;
+    }
+    return last = lo;
   };
   for (std::size_t i = a.begin; i < a.end; ++i) {
-    const double t = mod360(a.trace->angle_deg[i - a.begin]);
-    auto hi = lower_bound(std::make_pair(t, -1e300));
-    const auto& p1 = hi == pts.end() ? pts.front() : *hi;
-    const auto& p0 = hi == pts.begin() ? pts.back() : *std::prev(hi);
-    double span = p1.first - p0.first;
+    const double t = mod360(a.trace->angle_deg(i - a.begin));
+    const std::size_t hi = lower_bound(t);
+    const std::size_t k1 = hi == nb ? 0 : hi, k0 = hi == 0 ? nb - 1 : hi - 1;
+    const double a0 = angle_at(k0), a1 = angle_at(k1);
+    double span = a1 - a0;
     if (span <= 0) span += 360.0;
-    double off = t - p0.first;
+    double off = t - a0;
     if (off < 0) off += 360.0;
     if (span > 10.0) continue;  // outside the other trace's arc
-    const double rbi = p0.second + (p1.second - p0.second) * (span > 0 ? off / span : 0.0);
+    const double r0 = residual_at(k0), r1 = residual_at(k1);
+    const double rbi = r0 + (r1 - r0) * (span > 0 ? off / span : 0.0);
     h = std::max(h, std::abs(c.residual(samples.plain(i)) - rbi));
   }
   return h;
@@ -650,7 +729,7 @@ Iso230_4 iso_values(const Samples& samples, double arc_deg) {
       r.add(c.residual(x));
       f.add(common.residual(x));
     }
-    (traces[t].trace->direction == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) = r.pv();
+    (traces[t].trace->direction() == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) = r.pv();
   }
   iso.G_bi_um = f.pv();
   iso.centre_u_um = common.cu;
@@ -887,6 +966,13 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
 
 Result analyse(const Setup& setup, std::span<const Trace> traces,
                std::size_t records_held_max_samples) {
+  std::vector<TraceSource> sources;
+  for (const auto& t : traces) sources.emplace_back(t);
+  return analyse(setup, sources, records_held_max_samples, PageOptions{});
+}
+
+Result analyse(const Setup& setup, std::span<const TraceSource> traces,
+               std::size_t records_held_max_samples, PageOptions pages) {
   const double arc_deg = validate(setup, traces);
   Result res;
   // Deviations from the nominal radius: the bar reads 0 at its calibrated length.
@@ -898,8 +984,8 @@ Result analyse(const Setup& setup, std::span<const Trace> traces,
 
   Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
   m.split = spans[0].end;
-  m.s_before = sign_of(spans[0].trace->direction);
-  m.s_after = sign_of(spans.back().trace->direction);
+  m.s_before = sign_of(spans[0].trace->direction());
+  m.s_after = sign_of(spans.back().trace->direction());
   double period_mm = setup.cyclic_period_mm.value_or(10.0);
   Design full(m, samples, 1, period_mm);
   if (m.on[cyclic_first] && !setup.cyclic_period_mm)
@@ -919,9 +1005,9 @@ Result analyse(const Setup& setup, std::span<const Trace> traces,
   // Stick-slip and vibration live in what the geometric model leaves.
   std::vector<dynamics::TraceResidual> residuals;
   for (const auto& sp : spans) {
-    dynamics::TraceResidual tr{.s = sign_of(sp.trace->direction), .angle_deg = sp.trace->angle_deg};
-    tr.r_um.resize(sp.end - sp.begin);
-    residuals.push_back(std::move(tr));
+    residuals.push_back({.s = sign_of(sp.trace->direction()),
+                         .trace = sp.trace,
+                         .r_um = PagedDoubles(sp.end - sp.begin, pages)});
   }
   // One pass: the residual, and the fitted diagnostics' contributions.
   Reporter rep(res, reported, full, sol.coef);
@@ -932,7 +1018,7 @@ Result analyse(const Setup& setup, std::span<const Trace> traces,
     for (Eigen::Index i = 0; i < r.size(); ++i) {
       const std::size_t at = first + static_cast<std::size_t>(i);
       const std::size_t t = at < spans[0].end ? 0 : 1;
-      residuals[t].r_um[at - spans[t].begin] = r[i];
+      residuals[t].r_um.set(at - spans[t].begin, r[i]);
     }
   });
   // The fit's records (40 bytes a sample, if held) are done with: what follows needs the
@@ -944,13 +1030,14 @@ Result analyse(const Setup& setup, std::span<const Trace> traces,
                                .feed_mm_per_min = setup.feed_mm_per_min,
                                .window_deg = setup.stick_slip_window_deg,
                                .segment_samples = setup.vibration_segment_samples,
+                               .pages = pages,
                                .u = ax[0],
                                .v = ax[1]};
   const auto vibration = dynamics::vibration(dyn, residuals, res.notes);
   const auto stick_slip = dynamics::stick_slip(dyn, residuals, res.notes);
   double ss = 0.0;  // what is left after the geometric model and a vibration
   for (const auto& tr : residuals)
-    for (double x : tr.r_um) ss += x * x;
+    for (std::size_t j = 0; j < tr.r_um.size(); ++j) ss += tr.r_um[j] * tr.r_um[j];
   res.residual_rms_um = std::sqrt(ss / static_cast<double>(sample_count));
   residuals.clear();
   residuals.shrink_to_fit();

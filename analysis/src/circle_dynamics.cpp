@@ -41,6 +41,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <map>
 #include <numbers>
 #include <numeric>
 #include <unsupported/Eigen/FFT>
@@ -72,7 +73,7 @@ struct Timed {
 
 Timed timed(const TraceResidual& t, double w) {
   Timed out;
-  const std::size_t n = out.n = t.angle_deg.size();
+  const std::size_t n = out.n = t.r_um.size();
   const auto before = [&](std::size_t a, std::size_t b) {
     return t.s * t.theta_rad(a) < t.s * t.theta_rad(b);
   };
@@ -90,11 +91,33 @@ Timed timed(const TraceResidual& t, double w) {
   if (n == 0) return out;
   out.first = t.s * t.theta_rad(out.order(0));
   out.duration_s = out.time_s(out.order(n - 1));
-  std::vector<double> steps;
-  for (std::size_t i = 1; i < n; ++i) {
-    const double d = out.time_s(out.order(i)) - out.time_s(out.order(i - 1));
-    if (d > 0) steps.push_back(d);
+  // The median step: the element of rank count / 2 of the positive steps (nth_element's), from
+  // a count of each distinct step. A trace from time has a handful of distinct steps (rounding),
+  // so nothing is held a sample (issue 32); one with very many is held as before.
+  const auto step = [&](std::size_t i) {
+    return out.time_s(out.order(i)) - out.time_s(out.order(i - 1));
+  };
+  constexpr std::size_t max_distinct = 4096;
+  std::map<double, std::size_t> counts;
+  std::size_t count = 0;
+  for (std::size_t i = 1; i < n && counts.size() <= max_distinct; ++i)
+    if (const double d = step(i); d > 0) ++counts[d], ++count;
+  if (counts.size() <= max_distinct) {
+    if (count > 0) {
+      std::size_t rank = count / 2;
+      for (const auto& c : counts) {
+        if (rank < c.second) {
+          out.step_s = c.first;
+          break;
+        }
+        rank -= c.second;
+      }
+    }
+    return out;
   }
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < n; ++i)
+    if (const double d = step(i); d > 0) steps.push_back(d);
   if (!steps.empty()) {
     std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
     out.step_s = steps[steps.size() / 2];
@@ -192,6 +215,7 @@ struct LineFit {
   double f0_hz;
   std::vector<std::size_t> segments;  // per trace: 1, or its spectrum's segment count
   double segment_s = 0.0;             // the fit's segments' duration (segments > 1)
+  PageOptions pages;                  // of the contributions
 
   std::size_t segment(std::size_t i, std::size_t j) const {
     if (segments[i] == 1) return 0;
@@ -208,7 +232,7 @@ struct LineFit {
     return r;
   }
 
-  double operator()(double f_hz, std::vector<std::vector<double>>* contribution = nullptr,
+  double operator()(double f_hz, std::vector<PagedDoubles>* contribution = nullptr,
                     std::array<double, 3>* line_power = nullptr) const {
     using Gram6 = Eigen::Matrix<double, 6, 6>;
     double explained = 0.0;
@@ -232,10 +256,9 @@ struct LineFit {
                 x[g][2 * k] * x[g][2 * k] + x[g][2 * k + 1] * x[g][2 * k + 1];
       }
       if (contribution) {
-        contribution->emplace_back();
-        contribution->back().reserve(y.size());
+        contribution->emplace_back(y.size(), pages);
         for (std::size_t j = 0; j < y.size(); ++j)
-          contribution->back().push_back(row(i, j, f_hz).dot(x[segment(i, j)]));
+          contribution->back().set(j, row(i, j, f_hz).dot(x[segment(i, j)]));
       }
     }
     return explained;
@@ -254,13 +277,13 @@ double mean_power(const std::vector<double>& p, std::ptrdiff_t a, std::ptrdiff_t
 }
 
 // The residual minus its centred moving median, in the trace's own order: at travel position i
-// the median of every stride-th sample from i - m to i + m (clipped at the ends). Into h, one
-// value a sample of the trace.
+// the median of every stride-th sample from i - m to i + m (clipped at the ends). Into h from
+// `first`, one value a sample of the trace.
 void high_pass(const TraceResidual& t, const Timed& tm, std::size_t m, std::size_t stride,
-               std::span<double> h) {
+               PagedDoubles& h, std::size_t first) {
   const auto at = [&](std::size_t k) { return t.r_um[tm.order(k)]; };
-  moving_median(h.size(), m, stride, at,
-                [&](std::size_t i, double median) { h[tm.order(i)] = at(i) - median; });
+  moving_median(t.r_um.size(), m, stride, at,
+                [&](std::size_t i, double median) { h.set(first + tm.order(i), at(i) - median); });
 }
 
 }  // namespace
@@ -374,7 +397,7 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   ps = std::vector<std::vector<double>>();
   mean = std::vector<double>();  // (= {} would keep the capacity)
   // The frequency that explains most, on a grid over +-1 / T, refined about the best point.
-  const LineFit fit{traces, tms, f0, segments, static_cast<double>(cap) * dt};
+  const LineFit fit{traces, tms, f0, segments, static_cast<double>(cap) * dt, s.pages};
   double best_f = all.centroid_hz, best = -1.0, step = 0.1 / duration;
   for (int k = -10; k <= 10; ++k) {
     const double f = all.centroid_hz + k * step;
@@ -388,7 +411,7 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
       if (const double e = fit(f); e > best) best = e, best_f = f;
     }
   }
-  std::vector<std::vector<double>> parts;
+  std::vector<PagedDoubles> parts;
   std::array<double, 3> power{};
   fit(best_f, &parts, &power);
   if (parts.size() == 1) {
@@ -408,17 +431,20 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
             .frequency_hz = f_hz};
   double ss = 0.0;
   std::size_t n = 0;
+  out.contribution = PagedDoubles(0, s.pages);
   for (std::size_t i = 0; i < parts.size(); ++i)
     for (std::size_t j = 0; j < parts[i].size(); ++j) {
-      ss += parts[i][j] * parts[i][j];
+      const double p = parts[i][j];
+      ss += p * p;
       ++n;
-      out.contribution.push_back(parts[i][j]);
-      traces[i].r_um[j] -= parts[i][j];
+      out.contribution.push_back(p);
+      traces[i].r_um.set(j, traces[i].r_um[j] - p);
     }
   out.value = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, n)));
   if (out.value < 0.01) {
     for (std::size_t i = 0; i < parts.size(); ++i)  // too small to matter: put it back
-      for (std::size_t j = 0; j < parts[i].size(); ++j) traces[i].r_um[j] += parts[i][j];
+      for (std::size_t j = 0; j < parts[i].size(); ++j)
+        traces[i].r_um.set(j, traces[i].r_um[j] + parts[i][j]);
     return std::nullopt;
   }
   return out;
@@ -431,7 +457,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
   // contribution), each in its own order.
   std::size_t total = 0;
   for (const auto& t : traces) total += t.r_um.size();
-  std::vector<double> hp(total);
+  PagedDoubles hp(total, s.pages);
   for (std::size_t i = 0, first = 0; i < traces.size(); first += traces[i++].r_um.size()) {
     const auto& t = traces[i];
     const Timed tm = timed(t, w);
@@ -442,8 +468,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
             : 1;
     // At most 41 samples of the window (every stride-th): the median of the local level needs
     // no more, and 2 x 36,000 samples at 0.01 degrees would otherwise cost 401 per sample.
-    high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41),
-              std::span(hp).subspan(first, t.r_um.size()));
+    high_pass(t, tm, m, std::max<std::size_t>(1, (2 * m + 1) / 41), hp, first);
   }
   // Angular distance of theta from the nearest reversal of u (0, pi) or of v (+-pi / 2)
   // (|std::remainder|, without its call: angle_reduce.hpp).
@@ -485,10 +510,10 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
   // Each one's contribution: the high-passed residual in its axis' windows, 0 elsewhere. The
   // last one takes hp's memory (8 bytes a sample: issue 32).
   for (std::size_t f = 0; f < found.size(); ++f) {
-    std::vector<double> c = f + 1 == found.size() ? std::move(hp) : hp;
+    PagedDoubles c = f + 1 == found.size() ? std::move(hp) : hp.copy();
     each_sample([&](std::size_t k, double th) {
       const double d = of_u[f] ? from_u(th) : from_v(th);
-      if (!(d >= core && d <= window)) c[k] = 0.0;
+      if (!(d >= core && d <= window)) c.set(k, 0.0);
     });
     found[f].contribution = std::move(c);
   }

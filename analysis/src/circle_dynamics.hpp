@@ -14,13 +14,16 @@
 #include <string>
 #include <vector>
 
+#include "cal/analysis/circle_source.hpp"
+#include "cal/analysis/paged_doubles.hpp"
+
 namespace cal::circle::dynamics {
 
 struct TraceResidual {
-  double s = 1.0;                     // +1 ccw, -1 cw
-  std::span<const double> angle_deg;  // the trace's own angles (a view: no copy a sample)
-  std::vector<double> r_um;           // what the geometric model left
-  double theta_rad(std::size_t j) const { return angle_deg[j] * (std::numbers::pi / 180.0); }
+  double s = 1.0;                      // +1 ccw, -1 cw
+  const TraceSource* trace = nullptr;  // the trace's own angles (read in place: no copy)
+  PagedDoubles r_um;                   // what the geometric model left
+  double theta_rad(std::size_t j) const { return trace->angle_deg(j) * (std::numbers::pi / 180.0); }
 };
 
 struct Settings {
@@ -30,6 +33,7 @@ struct Settings {
   // Vibration: the spectrum is averaged over segments of at most this many samples (Welch), so
   // its memory does not grow with the run; a trace no longer than this is one segment.
   std::size_t segment_samples = 131072;
+  PageOptions pages;      // of every per-sample array made (issue 32)
   char u = 'X', v = 'Y';  // the plane's axes, for the names
 };
 
@@ -37,7 +41,7 @@ struct Found {
   std::string key, name, unit;
   double value = 0.0;
   std::optional<double> frequency_hz;
-  std::vector<double> contribution;  // every sample of every trace, traces in the given order
+  PagedDoubles contribution;  // every sample of every trace, traces in the given order
 };
 
 // The strongest narrow-band component above 10 f0 when it stands out of the residual's noise in

@@ -77,20 +77,21 @@ void analyse_circle_run(const st::RunReader& store, st::Store* writer, const st:
     cal::circle::circular_standard_from_key(o.standard);  // refused here if unknown
     analysis.standard = o.standard;
   }
-  // Only the bar's series is read (streamed; the analysis needs its values in memory).
+  // Only the bar's series is read, streamed into the segmenter, whose samples are paged: the
+  // analysis reads them in place, in bounded memory however long the run (issue 32).
   static constexpr std::uint8_t bar[] = {
       static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
-  std::vector<double> bar_mm;
+  cal::daq::BallbarSegmenter segmenter(program);
   auto stream = store.stream_readings(o.run, bar);
   std::vector<st::RawReading> batch;
   while (stream.next(batch))
-    for (const auto& r : batch) bar_mm.push_back(r.value * 1e3);
+    for (const auto& r : batch) segmenter.add(r.value * 1e3);
   cal::circle::Result result;
   try {
-    result = analyse_ballbar(program, analysis, bar_mm);
+    result = analyse_traces(program, analysis, segmenter.sources());
   } catch (const cal::InputError& e) {
     throw cal::InputError(
-        fmt::format("run {} ({} bar readings stored): {}", o.run, bar_mm.size(), e.what()));
+        fmt::format("run {} ({} bar readings stored): {}", o.run, segmenter.samples(), e.what()));
   }
   auto j = circle_document(result, program, analysis);
   if (o.store) {

@@ -45,12 +45,12 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                                     std::span<const double> deviation_mm) {
   cal::daq::BallbarSegmenter segmenter(program);
   for (double v : deviation_mm) segmenter.add(v);
-  return analyse_traces(program, analysis, segmenter.traces());
+  return analyse_traces(program, analysis, segmenter.sources());
 }
 
 cal::circle::Result analyse_traces(const cal::daq::BallbarProgram& program,
                                    const BallbarAnalysis& analysis,
-                                   std::span<const cal::circle::Trace> traces) {
+                                   std::span<const cal::circle::TraceSource> traces) {
   return cal::circle::analyse({.plane = circle_plane(analysis.plane),
                                .radius_mm = program.radius_mm,
                                .feed_mm_per_min = program.feed_mm_per_min,
@@ -430,10 +430,10 @@ struct CircleRun::Impl : Runner {
       return abort(fmt::format("storage failed: {}", e.what()));
     }
     try {
-      // The traces from the run's own segmenter, whose copy of every sample then goes before
-      // the analysis (a second segmenter over a copy of the samples had held it twice more:
-      // issue 32, docs/benchmarks.md).
-      const auto traces = segmenter.traces();
+      // The traces read in place from the run's own segmenter's (paged) samples, which the
+      // sources keep after the segmenter is renewed: nothing a sample is held in memory
+      // (issue 32, docs/benchmarks.md).
+      const auto traces = segmenter.sources();
       segmenter = cal::daq::BallbarSegmenter(setup.program);
       outcome.result = analyse_traces(setup.program, setup.analysis, traces);
     } catch (const std::exception& e) {

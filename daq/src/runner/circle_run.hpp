@@ -55,10 +55,11 @@ void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double r
 cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                                     const BallbarAnalysis& analysis,
                                     std::span<const double> deviation_mm);
-// The same for traces already cut (cal::daq::BallbarSegmenter::traces).
+// The same for traces already cut (cal::daq::BallbarSegmenter::sources: read in place, in
+// bounded memory).
 cal::circle::Result analyse_traces(const cal::daq::BallbarProgram& program,
                                    const BallbarAnalysis& analysis,
-                                   std::span<const cal::circle::Trace> traces);
+                                   std::span<const cal::circle::TraceSource> traces);
 
 // The result document (caldaq.circle.v2) of a ballbar test by the analysis' standard, and the
 // same for a terminal.

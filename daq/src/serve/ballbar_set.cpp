@@ -31,24 +31,31 @@ json circle_trace_json(const cal::storage::Store& store, std::int64_t run, const
   const auto [program, analysis] = circle_settings_from_json(settings);
   static constexpr std::uint8_t bar[] = {
       static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
+  // Streamed into the segmenter (its samples paged) and decimated as the traces are read: the
+  // plot holds a point a degree, not the run (issue 32).
   cal::daq::BallbarSegmenter segmenter(program);
-  for (const auto& r : store.readings(run, bar)) segmenter.add(r.value * 1e3);
+  {
+    auto stream = store.stream_readings(run, bar);
+    std::vector<cal::storage::RawReading> batch;
+    while (stream.next(batch))
+      for (const auto& r : batch) segmenter.add(r.value * 1e3);
+  }
   double cu = 0.0, cv = 0.0;
   if (const auto c = result.value("/iso230_4/centre_um"_json_pointer, json());
       c.is_array() && c.size() == 2 && c[0].is_number() && c[1].is_number())
     cu = c[0].get<double>(), cv = c[1].get<double>();
   const auto rounded = [](double x, double unit) { return std::round(x / unit) * unit; };
   json out{{"schema", "caldaq.circle-trace.v1"}, {"ccw", json::array()}, {"cw", json::array()}};
-  for (const auto& t : segmenter.traces()) {
-    auto& points = out[t.direction == cal::circle::Direction::ccw ? "ccw" : "cw"];
+  for (const auto& t : segmenter.sources()) {
+    auto& points = out[t.direction() == cal::circle::Direction::ccw ? "ccw" : "cw"];
     double last = -1e9;
-    for (std::size_t i = 0; i < t.angle_deg.size(); ++i) {
-      const double a = t.angle_deg[i];
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const double a = t.angle_deg(i);
       if (std::abs(a - last) < 1.0) continue;
       last = a;
       const double th = a * std::numbers::pi / 180.0;
       points.push_back({rounded(a, 0.01),
-                        rounded(t.deviation_um[i] - cu * std::cos(th) - cv * std::sin(th), 0.001)});
+                        rounded(t.deviation_um(i) - cu * std::cos(th) - cv * std::sin(th), 0.001)});
     }
   }
   return out;

@@ -46,29 +46,36 @@ void moving_median(std::size_t n, std::size_t m, std::size_t stride, At&& at, Ou
     if (!slides || i < m || i + m + 1 > n) out(i, clipped(i));
   if (!slides) return;
   const std::size_t count = (2 * m + 1 + stride - 1) / stride;  // values in an inner window
-  for (std::size_t r = 0; r < stride && m + r + m + 1 <= n; ++r) {
-    std::size_t i = m + r;
-    win.clear();
-    for (std::size_t k = 0; k < count; ++k) win.push_back(at(i - m + k * stride));
-    std::sort(win.begin(), win.end());
-    for (;;) {
-      out(i, win[count / 2]);
-      if (i + stride + m + 1 > n) break;
-      const double leaving = at(i - m), entering = at(i - m + count * stride);
-      // Replace `leaving` by `entering` and keep the window sorted: shift the values between,
-      // one at a time towards where `entering` goes (the first value above it on that side, as
-      // std::upper_bound finds it). `leaving` is found by a bisection without branches: on
-      // residuals its place is random, and the mispredicted branches of std::lower_bound and
-      // std::upper_bound were most of the stick-slip's time (issue 32).
-      std::size_t j = lower_place(win.data(), count, leaving);
-      if (entering >= leaving) {
-        for (; j + 1 < count && win[j + 1] <= entering; ++j) win[j] = win[j + 1];
-      } else {
-        for (; j > 0 && win[j - 1] > entering; --j) win[j] = win[j - 1];
-      }
-      win[j] = entering;
-      i += stride;
+  // Every residue class's window slides along together, i in order: the same operations per
+  // class as one class after the other, but the values are read in one forward pass (two
+  // reading positions, i - m and i - m + count stride), not one strided pass a class over the
+  // whole series, which through a paged array read every page once per class (issue 32). The
+  // windows hold stride x count values, about the window's 2m + 1 samples: not the series'.
+  std::size_t classes = 0;
+  while (classes < stride && m + classes + m + 1 <= n) ++classes;
+  std::vector<double> wins(classes * count);
+  for (std::size_t r = 0; r < classes; ++r) {
+    double* w = wins.data() + r * count;
+    for (std::size_t k = 0; k < count; ++k) w[k] = at(r + k * stride);
+    std::sort(w, w + count);
+  }
+  for (std::size_t i = m, r = 0; i + m + 1 <= n; ++i, r = r + 1 == stride ? 0 : r + 1) {
+    double* w = wins.data() + r * count;
+    out(i, w[count / 2]);
+    if (i + stride + m + 1 > n) continue;
+    const double leaving = at(i - m), entering = at(i - m + count * stride);
+    // Replace `leaving` by `entering` and keep the window sorted: shift the values between,
+    // one at a time towards where `entering` goes (the first value above it on that side, as
+    // std::upper_bound finds it). `leaving` is found by a bisection without branches: on
+    // residuals its place is random, and the mispredicted branches of std::lower_bound and
+    // std::upper_bound were most of the stick-slip's time (issue 32).
+    std::size_t j = lower_place(w, count, leaving);
+    if (entering >= leaving) {
+      for (; j + 1 < count && w[j + 1] <= entering; ++j) w[j] = w[j + 1];
+    } else {
+      for (; j > 0 && w[j - 1] > entering; --j) w[j] = w[j - 1];
     }
+    w[j] = entering;
   }
 }
 

@@ -12,12 +12,15 @@
 // rate, the dwell, the feed and the radius; the overshoot arcs (acceleration, reversal) are
 // trimmed. Samples are timed by their index at the gauge's fixed rate, not by the arrival of
 // USB chunks.
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "cal/analysis/circle.hpp"
+#include "cal/analysis/circle_source.hpp"
+#include "cal/analysis/paged_doubles.hpp"
 
 namespace cal::daq {
 
@@ -45,6 +48,8 @@ struct BallbarProgress {
 class BallbarSegmenter {
  public:
   explicit BallbarSegmenter(BallbarProgram p);  // throws cal::InputError for bad values
+  BallbarSegmenter(BallbarSegmenter&&) noexcept = default;
+  BallbarSegmenter& operator=(BallbarSegmenter&&) noexcept = default;
   // One bar reading: the deviation of the bar from its calibrated length, in mm.
   void add(double deviation_mm);
   std::optional<std::size_t> feed_in_end() const { return feed_in_end_; }
@@ -53,14 +58,25 @@ class BallbarSegmenter {
   // The trimmed traces (ccw, cw); throws cal::InputError if not complete, naming what is
   // missing (no feed-in found, or how many samples short).
   std::vector<circle::Trace> traces() const;
+  // The same traces read in place (circle_source.hpp): the angles from the program, the
+  // deviations from the segmenter's samples, which the sources share (so they outlive the
+  // segmenter). The samples are paged (paged_doubles.hpp): a run of any length holds a few
+  // pages of them (issue 32). Same errors as traces().
+  std::vector<circle::TraceSource> sources() const;
   double arc_duration_s() const;  // of one arc with its overshoots
-  std::size_t samples() const { return values_.size(); }
-  const std::vector<double>& values() const { return values_; }  // every sample, in mm
+  std::size_t samples() const { return values_->size(); }
   BallbarProgress progress() const;
 
  private:
+  struct Cut {  // one trace's samples, values_[offset, offset + count), and their angles
+    circle::Direction direction;
+    std::size_t offset, count;
+    circle::ProgramAngles angles;
+  };
+  std::vector<Cut> cuts() const;
+
   BallbarProgram p_;
-  std::vector<double> values_;
+  std::shared_ptr<PagedDoubles> values_ = std::make_shared<PagedDoubles>();
   bool saw_out_ = false;
   std::optional<std::size_t> feed_in_end_;
   std::size_t settle_count_ = 0;
