@@ -40,7 +40,9 @@ CUR=$(value "$DB" "SELECT id FROM results WHERE run_id = 1 AND superseded_by IS 
 check engineer_sends 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$ENG" --quiet
 check engineer_reads 0 "linear" -- "$DAQ" runs --db "$ENG"
 check visitor_cannot_send 2 "permission denied for schema caldaq" -- "$DAQ" sync --db "$DB" --to "$VISITOR" --quiet
-check visitor_cannot_read 2 "permission denied for schema caldaq" -- "$DAQ" runs --db "$VISITOR"
+# The server's SQLSTATE in the message: libpqxx 6.4 gives none with its insufficient_privilege
+# exception (central_schema.hpp, sqlstate()): 42501 is PostgreSQL's insufficient_privilege.
+check visitor_cannot_read 2 "permission denied for schema caldaq \(SQLSTATE 42501\)" -- "$DAQ" runs --db "$VISITOR"
 check visitor_cannot_insert 1 "permission denied" -- \
   "$PG_BIN/psql" -X -At "$VISITOR" -c "INSERT INTO caldaq.machines(name) VALUES ('intruder')"
 check visitor_cannot_approve 2 "permission denied" -- "$DAQ" approve 1 --db "$VISITOR"

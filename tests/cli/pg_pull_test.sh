@@ -53,6 +53,13 @@ same_rows() {
     "diff '$TMP/a.txt' '$TMP/b.txt' | head -5 && cmp -s '$TMP/a.txt' '$TMP/b.txt' && echo same \$(wc -l <'$TMP/a.txt') lines, \$(grep -c ^chunk '$TMP/a.txt') chunks"
 }
 
+# same_targets NAME DB_A RUN_A DB_B RUN_B [OPTION...]: the two runs' stops exported alike (not
+# vacuously: some rows); the options go to the second export (--version N).
+same_targets() {
+  check "$1" 0 "^same [1-9]" -- bash -c \
+    "diff <('$DAQ' export $3 --what targets --db '$2') <('$DAQ' export $5 --what targets --db '$4' ${*:6}) && echo same \$('$DAQ' export $3 --what targets --db '$2' | wc -l)"
+}
+
 RUNS=$(value "$DB" "SELECT count(*) FROM runs")
 CHUNKS=$(value "$DB" "SELECT count(*) FROM reading_chunks")
 RESULTS=$(value "$DB" "SELECT count(*) FROM results")
@@ -200,14 +207,48 @@ check show_versions 0 "versions \(3; the run was changed in more than one place,
 check show_json_versions 0 "^3 bob True$" -- bash -c \
   "'$DAQ' show 1 --json --db '$PG_URL' | '$PY' -c 'import json, sys; v = json.load(sys.stdin)[\"versions\"]; print(len(v), v[-1][\"sent_by\"], v[-1][\"current\"])'"
 # The current version's stops are bob's, as his laptop has them.
-check current_is_bobs 0 "^same [1-9]" -- bash -c \
-  "diff <('$DAQ' export 1 --what targets --db '$BOB') <('$DAQ' export 1 --what targets --db '$PG_URL') && echo same \$('$DAQ' export 1 --what targets --db '$BOB' | wc -l)"
+same_targets current_is_bobs "$BOB" 1 "$PG_URL" 1
 # Sent again by either: nothing new; the current version stays bob's.
 check alice_again 0 "0 new; 0 chunks sent \(0 bytes\), [0-9]+ already there$" -- \
   env USER=alice "$DAQ" sync --db "$ALICE" --to "$PG_URL" --run 1 --quiet
 check still_three 0 "^3 3$" -- psql_value "SELECT count(*) || ' ' || max(r.current_version) FROM caldaq.run_versions v JOIN caldaq.runs r ON r.uuid = v.run_uuid WHERE v.run_uuid = '$RUN1'"
 # A store without the conflict reads as one version: nothing named.
 check show_one_version 0 "^none$" -- bash -c "'$DAQ' show 2 --db '$PG_URL' | grep -q versions && echo named || echo none"
+
+# Every version readable, and one brought (issue 35): daq show, export and analyse read version N
+# of run 1 with --version N; a laptop that lacks the run brings alice's version with --version
+# RUN:N. The stops compared are those of the stores that sent each version (version 1: the
+# store first sent; 2: alice's laptop), read there, never the server's own output.
+ALICE1=$(value "$ALICE" "SELECT id FROM runs WHERE uuid = '$RUN1'")
+check versions_differ 0 "^differ$" -- bash -c \
+  "cmp -s <('$DAQ' export 1 --what targets --db '$DB') <('$DAQ' export $ALICE1 --what targets --db '$ALICE') && echo same || echo differ"
+same_targets version1_is_first "$DB" 1 "$PG_URL" 1 --version 1
+same_targets version2_is_alices "$ALICE" "$ALICE1" "$PG_URL" 1 --version 2
+check show_version1 0 "version 1 \(shown\): [0-9]+ stops.* version 3 \(current\): .*the stops counted above are version 1's, not the current version's" -- \
+  bash -c "'$DAQ' show 1 --version 1 --db '$PG_URL' | tr '\n' ' '"
+check show_json_version2 0 "^2 False$" -- bash -c \
+  "'$DAQ' show 1 --version 2 --json --db '$PG_URL' | '$PY' -c 'import json, sys; v = [x for x in json.load(sys.stdin)[\"versions\"] if x[\"shown\"]]; print(v[0][\"version\"], v[0][\"current\"]) if len(v) == 1 else print(v)'"
+check analyse_version2_is_alices 0 "^same [1-9]" -- bash -c \
+  "diff <('$DAQ' analyse $ALICE1 --db '$ALICE') <('$DAQ' analyse 1 --version 2 --db '$PG_URL') && echo same \$('$DAQ' analyse $ALICE1 --db '$ALICE' | wc -l)"
+check no_version4 2 "run 1 has no version 4 \(it has 1 to 3" -- "$DAQ" show 1 --version 4 --db "$PG_URL"
+check local_one_version 2 "run $ALICE1 has no version 2 here: a local store keeps one version" -- \
+  "$DAQ" export "$ALICE1" --version 2 --db "$ALICE"
+VISIT2=$TMP/visit-v2.sqlite
+check pull_version_bad 2 "--version '1': give RUN:N" -- \
+  "$DAQ" sync --db "$VISIT2" --from "$PG_URL" --machine "$MACHINE" --version 1
+check pull_version_none 2 "run 1 has no version 9" -- \
+  "$DAQ" sync --db "$VISIT2" --from "$PG_URL" --machine "$MACHINE" --version 1:9
+check pull_version_refused_nothing 0 "^none$" -- bash -c "ls '$VISIT2'* 2>/dev/null || echo none"
+check pull_version 0 "runs of machine" -- \
+  "$DAQ" sync --db "$VISIT2" --from "$PG_URL" --machine "$MACHINE" --version "$RUN1:2" --quiet
+VISIT1=$(value "$VISIT2" "SELECT id FROM runs WHERE uuid = '$RUN1'")
+same_targets pulled_is_alices "$ALICE" "$ALICE1" "$VISIT2" "$VISIT1"
+check pull_version_here 2 "run $VISIT1 \($RUN1\) is here already" -- \
+  "$DAQ" sync --db "$VISIT2" --from "$PG_URL" --machine "$MACHINE" --version 1:1
+# Sent back: its stops are version 2's, so nothing new (still three versions, bob's current).
+check pulled_version_sent 0 "0 new; 0 chunks sent" -- "$DAQ" sync --db "$VISIT2" --to "$PG_URL" --run "$VISIT1" --quiet
+check pulled_still_three 0 "^3 3$" -- psql_value "SELECT count(*) || ' ' || max(r.current_version) FROM caldaq.run_versions v JOIN caldaq.runs r ON r.uuid = v.run_uuid WHERE v.run_uuid = '$RUN1'"
+check to_no_version 2 "--version is for --from" -- "$DAQ" sync --db "$VISIT2" --to "$PG_URL" --version 1:1
 
 # Damage on the server is found, and nothing of it stored: a changed byte in a chunk to bring;
 # a changed checksum of a chunk the laptop has.

@@ -102,7 +102,10 @@ SERVER_RUNS=$(psql_value "SELECT count(*) FROM caldaq.runs")
 check bench_sync 0 "median: daq sync [0-9]+ readings/s, COPY ceiling [0-9]+ readings/s: sync at [0-9]+ % of the ceiling" -- \
   "$DAQ" bench sync --to "$PG_URL" --minutes 1 --rounds 1 --dir "$TMP"
 # 60 s of 10 kHz readings and 60 air samples of three quantities each: 600,000 + 180.
-check bench_sync_readings 0 "^ +1 +600180 " -- bash -c "'$DAQ' bench sync --to '$PG_URL' --minutes 1 --rounds 1 --dir '$TMP' | sed -n 2p"
+check bench_sync_readings 0 "^ +1 +600180 " -- bash -c "'$DAQ' bench sync --to '$PG_URL' --minutes 1 --rounds 1 --dir '$TMP' | sed -n 3p"
+# A store of several runs (--runs), all sent by one sync and all deleted again: 3 x 600,180.
+check bench_sync_runs 0 "^3 runs of 1 min .*: 1800540 readings.* +1 +1800540 " -- bash -c \
+  "'$DAQ' bench sync --to '$PG_URL' --minutes 1 --runs 3 --rounds 1 --dir '$TMP' | sed -n '1p;3p' | tr '\n' ' '"
 check bench_sync_runs_gone 0 "^$SERVER_RUNS$" -- psql_value "SELECT count(*) FROM caldaq.runs"
 check bench_sync_table_gone 0 "^t$" -- psql_value "SELECT to_regclass('public.caldaq_bench_reading_chunks') IS NULL"
 check bench_sync_not_a_uri 2 "bench sync: --to: '/tmp/x.sqlite' is not a PostgreSQL URI" -- "$DAQ" bench sync --to /tmp/x.sqlite

@@ -777,6 +777,7 @@ void bench_export(const ExportBenchOptions& o) {
 struct SyncBenchOptions {
   std::string to;
   int minutes = 10;
+  int runs = 1;  // runs of --minutes each in the generated store
   int rounds = 3;
   std::string dir;
   std::string site = "daq bench";
@@ -792,23 +793,28 @@ void bench_sync(const SyncBenchOptions& o) {
                     "(postgresql://...; a scratch database: the bench's runs are "
                     "sent there and deleted again)",
                     o.to));
-  if (o.minutes < 1 || o.rounds < 1)
-    throw cal::InputError("bench sync: --minutes and --rounds must be at least 1");
+  if (o.minutes < 1 || o.rounds < 1 || o.runs < 1)
+    throw cal::InputError("bench sync: --minutes, --runs and --rounds must be at least 1");
   const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
   const fs::path db = dir / fmt::format("caldaq-bench-sync-{}.sqlite", ::getpid());
   const Cleanup cleanup({db});
   remove_db(db);
-  std::int64_t run = 0, readings = 0;
-  std::string uuid;
+  std::int64_t readings = 0;
+  std::vector<std::string> uuids;
+  std::vector<std::int64_t> runs;
   {
     cal::storage::Store store(db, {.full_sync = false});
-    run = generate_run(store, o.minutes * 60);
-    readings = store.reading_count(run);
-    uuid = store.run(run)->uuid;
+    for (int k = 0; k < o.runs; ++k) {
+      runs.push_back(generate_run(store, o.minutes * 60));
+      readings += store.reading_count(runs.back());
+      uuids.push_back(store.run(runs.back())->uuid);
+    }
   }
-  const std::vector<std::string> uuids{uuid};
-  const std::vector<std::int64_t> runs{run};
-  pg::delete_central_runs(o.to, uuids);  // a run left by a cut bench
+  fmt::print("{} run{} of {} min of a 10 kHz length stream with 1 Hz air: {} readings, {:.1f} MB "
+             "store\n",
+             o.runs, o.runs == 1 ? "" : "s", o.minutes, readings,
+             static_cast<double>(fs::file_size(db)) / 1e6);
+  pg::delete_central_runs(o.to, uuids);  // runs left by a cut bench
   std::vector<double> sync_s, ceiling_s;
   fmt::print("{:>5} {:>10} {:>8}  {:>24}  {:>34}  {:>5}\n", "round", "readings", "MB",
              "daq sync: wall, readings/s", "COPY ceiling: read + copy, readings/s", "%");
@@ -831,8 +837,8 @@ void bench_sync(const SyncBenchOptions& o) {
   const double ms = median(sync_s), mc = median(ceiling_s);
   fmt::print(
       "median: daq sync {:.0f} readings/s, COPY ceiling {:.0f} readings/s: sync at {:.0f} % of "
-      "the ceiling\n(wall times; daq sync is a child process that opens, checks and sends the run "
-      "with its instruments and results; the ceiling reads the same chunks from the store and "
+      "the ceiling\n(wall times; daq sync is a child process that opens, checks and sends the runs "
+      "with their instruments and results; the ceiling reads the same chunks from the store and "
       "COPYs their rows in binary into a scratch table shaped like caldaq.reading_chunks, "
       "primary key included)\n",
       static_cast<double>(readings) / ms, static_cast<double>(readings) / mc, 100.0 * mc / ms);
@@ -881,7 +887,11 @@ void add_bench_commands(CLI::App& app) {
       "it beside the server's own COPY of the same chunk rows (a scratch database: the bench's "
       "run is deleted from it again)");
   sy->add_option("--to", y->to, "The server (postgresql://...)")->required();
-  sy->add_option("--minutes", y->minutes, "Length of the generated run")->capture_default_str();
+  sy->add_option("--minutes", y->minutes, "Length of each generated run")->capture_default_str();
+  sy->add_option("--runs", y->runs,
+                 "Generated runs in the store, each sent by the same daq sync (a store of many "
+                 "runs: each run's row, instruments and results in a transaction of its own)")
+      ->capture_default_str();
   sy->add_option("--rounds", y->rounds, "Rounds (sync, then its ceiling); medians are reported")
       ->capture_default_str();
   sy->add_option("--dir", y->dir, "Directory for the generated database (default: $TMPDIR)");

@@ -38,6 +38,7 @@
 #include "result_rows.hpp"
 #include "run_document.hpp"
 #include "run_quality.hpp"
+#include "run_version.hpp"
 #include "shortest_number.hpp"
 #include "stored_profile.hpp"
 #include "terminal.hpp"
@@ -222,11 +223,16 @@ json run_document(const st::RunReader& store, std::int64_t id) {
 
 namespace {
 
-void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
+void cmd_show(const std::string& db, std::int64_t id, bool as_json, int version) {
   const auto reader = open_run_reader(db);  // either store (--db postgresql://...)
+  choose_version(*reader, db, id, version);
   const auto& store = *reader;
   const auto r = need_run(store, id);
-  const json j = run_document(store, id);
+  json j = run_document(store, id);
+  // Which version's stops are counted: the chosen one, else the current one.
+  if (j.contains("versions"))
+    for (auto& v : j["versions"])
+      v["shown"] = version != 0 ? v["version"].get<int>() == version : v["current"].get<bool>();
   const auto missed = store.missed_stops(id);
   if (as_json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print_line("run {}: {} {} ({}), started {}{}", r.id, r.kind, r.axis, st::to_string(r.status),
@@ -236,12 +242,26 @@ void cmd_show(const std::string& db, std::int64_t id, bool as_json) {
   if (j.contains("versions")) {
     print_line("  versions ({}; the run was changed in more than one place, none overwritten):",
                j["versions"].size());
-    for (const auto& v : j["versions"])
+    for (const auto& v : j["versions"]) {
+      const bool current = v["current"].get<bool>(), shown = v["shown"].get<bool>();
       print_line("    version {}{}: {} stops, sent {} by {} from {} ({})", v["version"].get<int>(),
-                 v["current"].get<bool>() ? " (current, shown)" : "",
+                 current && shown ? " (current, shown)"
+                 : current        ? " (current)"
+                 : shown          ? " (shown)"
+                                  : "",
                  v["stops"].get<std::int64_t>(), v["sent"].get<std::string>(),
                  v["sent_by"].get<std::string>(), v["sent_from"].get<std::string>(),
                  v["sent_store"].get<std::string>());
+    }
+    const auto& all = j["versions"];
+    if (std::any_of(all.begin(), all.end(), [](const json& x) {
+          return x["shown"].get<bool>() && !x["current"].get<bool>();
+        }))
+      print_line(
+          "  the stops counted above are version {}'s, not the current version's; the results "
+          "below are all the run's (daq export {} --version {} --what targets: that version's "
+          "stops)",
+          version, id, version);
   }
   if (!missed.empty()) {
     print_line("  missed stops ({}):", missed.size());
@@ -669,10 +689,12 @@ struct ExportOptions {
   std::string format = "csv";
   std::string what = "readings";
   std::string output;
+  int version = 0;  // 0: the current version of the run's stops
 };
 
 void cmd_export(const ExportOptions& o) {
   const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
+  choose_version(*reader, o.db, o.run, o.version);
   const auto& store = *reader;
   need_run(store, o.run);  // before a file is created
   std::FILE* out = stdout;
@@ -728,11 +750,13 @@ void add_runs_commands(CLI::App& app) {
   auto show_db = std::make_shared<std::string>();
   auto show_json = std::make_shared<bool>(false);
   auto show_id = std::make_shared<std::int64_t>(0);
+  auto show_version = std::make_shared<int>(0);
   CLI::App* show = app.add_subcommand("show", "Show one stored run: set-up, instruments, results");
   show->add_option("RUN", *show_id, "Run number (see daq runs)")->required();
   add_read_db_option(*show, *show_db);
   show->add_flag("--json", *show_json, "Print caldaq.run.v1 JSON");
-  show->callback([=] { cmd_show(*show_db, *show_id, *show_json); });
+  add_version_option(*show, *show_version);
+  show->callback([=] { cmd_show(*show_db, *show_id, *show_json, *show_version); });
 
   const auto [exp, ex] =
       add_command<ExportOptions>(app, "export", cmd_export, "Export a stored run as CSV or JSON");
@@ -745,6 +769,7 @@ void add_runs_commands(CLI::App& app) {
                   "circle reads them)")
       ->check(CLI::IsMember({"readings", "targets", "circle"}));
   exp->add_option("-o,--output", ex->output, "Write to this file instead of stdout");
+  add_version_option(*exp, ex->version);
 }
 
 }  // namespace daq

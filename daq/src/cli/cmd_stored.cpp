@@ -22,6 +22,7 @@
 #include "result_rows.hpp"
 #include "roles.hpp"
 #include "run_quality.hpp"
+#include "run_version.hpp"
 #include "stored_profile.hpp"
 #include "terminal.hpp"
 #include "verdict.hpp"
@@ -50,6 +51,7 @@ struct AnalyseRunOptions {
   // Circle runs: what may be corrected after the fact.
   std::optional<double> calibrated_radius_mm, cyclic_period_mm;
   bool uncalibrated = false;
+  int version = 0;  // --version: of the run's stops (0: the current one)
 };
 
 // A stored ballbar run again from its raw bar readings, with the analysis settings it was
@@ -163,6 +165,8 @@ void analyse_run(const AnalyseRunOptions& o) {
   std::optional<st::Store> writer;
   if (o.store) writer.emplace(database_path(o.db));
   const auto reader = writer ? nullptr : open_run_reader(o.db);
+  // A version other than the current one is read, not stored: --store (a local store) refuses it.
+  choose_version(writer ? *writer : *reader, o.db, o.run, o.version);
   const st::RunReader& store = writer ? *writer : *reader;
   const auto run = store.run(o.run);
   if (run && run->kind == "circle")
@@ -384,6 +388,7 @@ void add_stored_run_commands(CLI::App& app, CLI::App& analyse) {
                   "Circle runs: the cyclic-error period (default: as run, else searched)")
       ->check(finite_positive());
   analyse.add_flag("--uncalibrated", a->uncalibrated, "Circle runs: no radius error");
+  add_version_option(analyse, a->version);
   analyse.add_flag(
       "--json", a->json,
       "Print JSON (caldaq.iso230-2.v1, caldaq.circle.v2, caldaq.profile.v1 or caldaq.rotary.v1)");

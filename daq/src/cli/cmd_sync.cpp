@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -39,6 +40,7 @@ struct SyncCliOptions {
   bool verify = false;
   std::size_t chunks_per_transaction = 64;
   std::vector<std::int64_t> runs;
+  std::vector<std::string> versions;  // --from: RUN:N, a run brought at version N of its stops
   bool quiet = false;
   bool json = false;
 };
@@ -130,6 +132,24 @@ void need_postgresql_url(std::string_view option, std::string_view url) {
                     option, st::pg::redacted(url)));
 }
 
+// --version RUN:N: the server's run id or UUID, and a version number (1, 2, ...).
+st::pg::PullOptions::VersionChoice version_choice(const std::string& text) {
+  const auto colon = text.rfind(':');
+  const auto bad = [&] {
+    return cal::InputError(fmt::format(
+        "--version '{}': give RUN:N, the run (its id on the server or its UUID) and the version "
+        "of its stops (daq show RUN --db postgresql://... lists them), e.g. 3:2",
+        cal::text::terminal_safe(text)));
+  };
+  if (colon == std::string::npos || colon == 0) throw bad();
+  const std::string number = text.substr(colon + 1);
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(number.c_str(), &end, 10);
+  if (number.empty() || *end != '\0' || errno != 0 || v < 1 || v > 1000000) throw bad();
+  return {.run = text.substr(0, colon), .version = static_cast<int>(v)};
+}
+
 // daq sync --from URL --machine NAME: the machine's history brought into the local store
 // (created when missing: a laptop before a visit), a line per run and a summary.
 void run_pull(const SyncCliOptions& o) {
@@ -142,6 +162,7 @@ void run_pull(const SyncCliOptions& o) {
   const auto path = database_path(o.db);
   st::pg::PullOptions options;
   options.machine = o.machine;
+  for (const auto& v : o.versions) options.versions.push_back(version_choice(v));
   options.chunks_per_transaction = o.chunks_per_transaction;
   if (const auto cut = cut_after_chunks(); cut > 0)
     options.after_chunk = [cut](std::int64_t received) {
@@ -187,6 +208,8 @@ void run_sync(const SyncCliOptions& o) {
     throw cal::InputError("give one of --to (send the local runs) and --from (bring a machine's)");
   if (!o.from.empty()) return run_pull(o);
   if (!o.machine.empty()) throw cal::InputError("--machine is for --from");
+  if (!o.versions.empty())
+    throw cal::InputError("--version is for --from (a run is sent with the stops it has here)");
   need_postgresql_url("--to", o.to);
   // Opened for writing: an older database is migrated (schema 7 gives each run its UUID). The
   // sync itself only reads it; WAL lets a running acquisition write meanwhile.
@@ -333,6 +356,10 @@ void add_sync_command(CLI::App& app) {
           [](const std::string& v) { return v.empty() ? std::string("a site is not empty") : ""; },
           "SITE"));
   cmd->add_option("--run", o->runs, "Only these runs (local ids; default: every run)");
+  cmd->add_option("--version", o->versions,
+                  "With --from, RUN:N (repeatable): bring that run (its id on the server, or its "
+                  "UUID) with version N of its stops instead of the current one, into a store "
+                  "that lacks it (daq show RUN --db postgresql://... lists the versions)");
   cmd->add_flag("--verify", o->verify,
                 "Read every chunk of the synced runs back from the server and verify its "
                 "checksum over the server's bytes");

@@ -7,6 +7,8 @@
 #include "cal/analysis/error.hpp"
 #include "cal/storage/pg/central.hpp"
 #include "cal/storage/pg/sync.hpp"
+#include "cli_checks.hpp"
+#include "run_version.hpp"
 
 namespace daq {
 namespace {
@@ -58,6 +60,28 @@ void add_read_db_option(CLI::App& cmd, std::string& target) {
   cmd.add_option("--db", target,
                  "Run database (default: $CALDAQ_DB, else ~/.local/share/caldaq/site.sqlite), "
                  "or the central store: postgresql://... (docs/storage.md, \"Central store\")");
+}
+
+void add_version_option(CLI::App& cmd, int& target) {
+  cmd.add_option("--version", target,
+                 "Read this version of the run's stops, not the current one (a central store "
+                 "keeps one per place the run was changed in: daq show RUN --db postgresql://... "
+                 "lists them)")
+      ->check(whole_in(1, 1000000));
+}
+
+void choose_version(cal::storage::RunReader& store, const std::string& db, std::int64_t run,
+                    int version) {
+  if (version == 0) return;
+  if (!store.run(run))
+    throw cal::InputError(fmt::format("{}: no run {} (see daq runs)", store.name(), run));
+  if (!cal::storage::pg::is_postgresql_url(db))
+    throw cal::InputError(fmt::format(
+        "{}: run {} has no version {} here: a local store keeps one version of each run (the "
+        "versions of a run changed in two places are the central store's: daq show RUN --db "
+        "postgresql://... lists them)",
+        store.name(), run, version));
+  cal::storage::pg::read_version(store, run, version);
 }
 
 }  // namespace daq

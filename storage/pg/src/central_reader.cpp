@@ -1,6 +1,8 @@
 // The central store read through RunReader (central.hpp): every read command's queries, on
 // PostgreSQL, giving what the SQLite Store gives for the same runs (ids are the server's; a
 // result keeps the id it had where it was made; text is ordered as SQLite orders it, by byte).
+#include <algorithm>
+#include <map>
 #include <optional>
 
 #include "cal/analysis/text.hpp"
@@ -261,15 +263,15 @@ class CentralReader final : public RunReader {
         "SELECT t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns, t.raw_m, "
         "t.deviation_um, t.refractive_index, t.material_temperature_degc FROM "
         "caldaq.captured_targets AS t JOIN caldaq.runs AS r ON r.uuid = t.run_uuid AND "
-        "t.version = r.current_version WHERE r.id = $1 ORDER BY t.time_ns, t.run_number, "
-        "t.target_index",
+        "t.version = COALESCE(NULLIF($2, 0), r.current_version) WHERE r.id = $1 ORDER BY "
+        "t.time_ns, t.run_number, t.target_index",
         [&](const pqxx::row& row) {
           CapturedTarget t{.run_id = run_id};
           read_row(row, t.target_index, t.run_number, t.direction, t.nominal_mm, t.time_ns, t.raw_m,
                    t.deviation_um, t.refractive_index, t.material_temperature_degc);
           return t;
         },
-        run_id);
+        run_id, chosen_version(run_id));
   }
 
   std::vector<ResultRecord> results(std::int64_t run_id) const override {
@@ -400,6 +402,22 @@ class CentralReader final : public RunReader {
         run_id);
   }
 
+  // read_version (central.hpp).
+
+  void read_version(std::int64_t run_id, int version) {
+    if (!run(run_id)) throw StoreError(fmt::format("{}: no run {}", shown_, run_id));
+    const auto there = versions(run_id);
+    if (std::none_of(there.begin(), there.end(),
+                     [&](const RunVersion& v) { return v.version == version; }))
+      throw StoreError(fmt::format(
+          "{}: run {} has no version {} (it has {}: daq show {} --db ... lists them)", shown_,
+          run_id, version,
+          there.size() == 1 ? std::string("one, 1")
+                            : fmt::format("1 to {}", there.empty() ? 0 : there.back().version),
+          run_id));
+    chosen_[run_id] = version;
+  }
+
   std::vector<Approval> approvals(std::int64_t run_id) const override {
     return all<Approval>(
         fmt::format("read the approvals of run {}", run_id),
@@ -419,6 +437,13 @@ class CentralReader final : public RunReader {
  private:
   std::string shown_;
   std::unique_ptr<pqxx::connection> conn_;
+  std::map<std::int64_t, int> chosen_;  // run id -> the version read_version chose
+
+  // The version of the run's stops to read; 0: the current one.
+  int chosen_version(std::int64_t run_id) const {
+    const auto it = chosen_.find(run_id);
+    return it == chosen_.end() ? 0 : it->second;
+  }
 
   // The rows of a query, each made into a T; errors name the server and `what`.
   template <class T, class F, class... Args>
@@ -448,6 +473,14 @@ class CentralReader final : public RunReader {
 
 std::unique_ptr<RunReader> open_central(std::string_view url) {
   return std::make_unique<CentralReader>(url);
+}
+
+void read_version(RunReader& central, std::int64_t run_id, int version) {
+  auto* reader = dynamic_cast<CentralReader*>(&central);
+  if (reader == nullptr)
+    throw StoreError(
+        fmt::format("{}: not a central store: it keeps one version of each run", central.name()));
+  reader->read_version(run_id, version);
 }
 
 Approval approve_central(std::string_view url, std::int64_t run_id, std::int64_t result_id) {

@@ -17,7 +17,17 @@ namespace {
 // `daq runs --db postgresql://...` lists); the rows of a run by the run's UUID and what identifies
 // them in the store they came from (a chunk's seq, a result's local id), so that sending them again
 // finds them. The chunk's checksum covers the run's id in its source store (source_run_id).
-constexpr const char* kCentralMigrations[] = {
+// The head of caldaq.approve(run, fingerprint): made by migration 6, and made again by 7 as the
+// sites' wrapper of the first (renamed approve_any_site); each adds its DECLARE list and body.
+constexpr std::string_view kApproveHead =
+    R"sql(CREATE FUNCTION caldaq.approve(run uuid, fp text)
+  RETURNS TABLE(approved_by text, approved_unix_ms bigint, run_version integer)
+  LANGUAGE plpgsql SECURITY DEFINER SET search_path = pg_catalog, pg_temp
+AS $fn$
+DECLARE
+)sql";
+
+const std::string kCentralMigrations[] = {
     R"sql(
 CREATE TABLE caldaq.machines(
   id bigserial PRIMARY KEY,
@@ -216,12 +226,8 @@ CREATE TABLE caldaq.approvals(
   PRIMARY KEY(run_uuid, result_fingerprint),
   FOREIGN KEY(run_uuid, result_fingerprint) REFERENCES caldaq.results(run_uuid, fingerprint)
     ON DELETE CASCADE);
-CREATE FUNCTION caldaq.approve(run uuid, fp text)
-  RETURNS TABLE(approved_by text, approved_unix_ms bigint, run_version integer)
-  LANGUAGE plpgsql SECURITY DEFINER SET search_path = pg_catalog, pg_temp
-AS $fn$
-DECLARE
-  res record;
+)sql" + std::string(kApproveHead) +
+        R"sql(  res record;
   earlier record;
   v integer;
 BEGIN
@@ -354,12 +360,8 @@ END $policies$;
 -- policies), so it checks the site itself, first, then approves as schema 6 did.
 ALTER FUNCTION caldaq.approve(uuid, text) RENAME TO approve_any_site;
 REVOKE ALL ON FUNCTION caldaq.approve_any_site(uuid, text) FROM PUBLIC, caldaq_reviewer;
-CREATE FUNCTION caldaq.approve(run uuid, fp text)
-  RETURNS TABLE(approved_by text, approved_unix_ms bigint, run_version integer)
-  LANGUAGE plpgsql SECURITY DEFINER SET search_path = pg_catalog, pg_temp
-AS $fn$
-DECLARE
-  s text;
+)sql" + std::string(kApproveHead) +
+        R"sql(  s text;
 BEGIN
   SELECT r.site INTO s FROM caldaq.runs AS r WHERE r.uuid = run;
   IF FOUND AND NOT ARRAY[s, '*'] && caldaq.session_sites() THEN

@@ -58,6 +58,17 @@ inline std::string one_line(std::string_view text) {
   return out;
 }
 
+// The server's SQLSTATE of a refusal. libpqxx 6.4 (Debian 12's 6.4.5) throws
+// pqxx::insufficient_privilege for SQLSTATE 42501 without passing the code on, so its sqlstate()
+// is empty (src/result.cxx, result::ThrowSQLError: `throw insufficient_privilege{Err, Query};`,
+// where every other class gets `code`; fixed upstream by libpqxx PR #1077, December 2025, in 8.0):
+// the exception's type says it then.
+inline std::string sqlstate(const pqxx::sql_error& e) {
+  if (!e.sqlstate().empty()) return e.sqlstate();
+  if (dynamic_cast<const pqxx::insufficient_privilege*>(&e) != nullptr) return "42501";
+  return {};
+}
+
 // Runs f, turning libpqxx's exceptions into StoreError naming the server and what was done.
 template <class F>
 auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
@@ -67,7 +78,7 @@ auto guarded(std::string_view shown_url, std::string_view what, F&& f) {
     throw;
   } catch (const pqxx::sql_error& e) {
     throw StoreError(
-        fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what, one_line(e.what()), e.sqlstate()));
+        fmt::format("{}: {}: {} (SQLSTATE {})", shown_url, what, one_line(e.what()), sqlstate(e)));
   } catch (const std::exception& e) {
     // broken_connection and the like.
     throw StoreError(fmt::format("{}: {}: {}", shown_url, what, one_line(e.what())));

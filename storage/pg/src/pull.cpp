@@ -20,7 +20,32 @@ struct Source {
   std::unique_ptr<pqxx::connection> conn;
   std::unique_ptr<RunReader> reader;  // checks the central schema's version (never migrates)
   MachineRecord machine;
+  std::vector<std::string> chosen;  // the UUIDs of the runs brought at a chosen version
 };
+
+// --version RUN:N: the run (the server's id or its UUID), of the machine, read at version N.
+void choose_versions(Source& source, const std::vector<PullOptions::VersionChoice>& choices) {
+  for (const auto& c : choices) {
+    const auto rows = guarded(source.shown, "read the runs", [&] {
+      pqxx::nontransaction n(*source.conn);
+      return n.exec_params(
+          "SELECT id, uuid, COALESCE(machine_id, 0) FROM caldaq.runs WHERE uuid::text = $1 OR "
+          "id::text = $1",
+          c.run);
+    });
+    if (rows.empty())
+      throw StoreError(fmt::format("{}: no run {} in the central store (--version {}:{})",
+                                   source.shown, text::terminal_safe(c.run),
+                                   text::terminal_safe(c.run), c.version));
+    const auto id = rows[0][0].as<std::int64_t>();
+    if (rows[0][2].as<std::int64_t>() != source.machine.id)
+      throw StoreError(fmt::format("{}: run {} is not of machine '{}' (--version {}:{})",
+                                   source.shown, id, text::terminal_safe(source.machine.name),
+                                   text::terminal_safe(c.run), c.version));
+    read_version(*source.reader, id, c.version);
+    source.chosen.push_back(rows[0][1].as<std::string>());
+  }
+}
 
 // --machine: a machine's UUID, or a name only one machine on the server has.
 MachineRecord find_machine(Source& source, const std::string& machine) {
@@ -38,12 +63,24 @@ MachineRecord find_machine(Source& source, const std::string& machine) {
                                text::terminal_safe(machine)));
 }
 
-Source open_source(std::string_view url, const std::string& machine) {
+Source open_source(std::string_view url, const std::string& machine,
+                   const std::vector<PullOptions::VersionChoice>& versions) {
   Source source{.shown = redacted(url)};
   source.conn = connect(source.shown, url);
   source.reader = open_central(url);
   source.machine = find_machine(source, machine);
+  choose_versions(source, versions);
   return source;
+}
+
+// A run brought at a chosen version must be new here: this store keeps one version of it.
+void check_chosen_new(const Store& local, const Source& source) {
+  for (const auto& uuid : source.chosen)
+    if (const auto here = local.run_by_uuid(uuid))
+      throw StoreError(fmt::format(
+          "{}: run {} ({}) is here already, with its stops as they were brought or measured: a "
+          "store keeps one version of a run; bring another version into another store (--db)",
+          local.path().string(), here->id, uuid));
 }
 
 class Pull {
@@ -342,8 +379,9 @@ class Pull {
 
 PullReport sync_from(const std::filesystem::path& local_path, std::string_view url,
                      const PullOptions& options) {
-  auto source = open_source(url, options.machine);
+  auto source = open_source(url, options.machine, options.versions);
   Store local(local_path);  // created only now: a refused pull leaves nothing behind
+  check_chosen_new(local, source);
   return Pull(local, std::move(source), options).run();
 }
 

@@ -166,17 +166,14 @@ class Sync {
   // under a site this login may not see (23505: the policies hide it, its key is taken), in words.
   [[noreturn]] void refused(const pqxx::sql_error& e, const std::string& what,
                             std::string_view site) const {
-    // libpqxx 6 leaves sqlstate() empty for some refusals (seen for a row-level security
-    // policy's on INSERT ... RETURNING): the server's own words then say it.
-    const bool by_policy =
-        e.sqlstate() == "42501" ||
-        std::string_view(e.what()).find("row-level security policy") != std::string_view::npos;
+    const auto state = sqlstate(e);
+    const bool by_policy = state == "42501";
     if (by_policy)
       throw StoreError(fmt::format(
           "{}: {} would be of site '{}', which this login may not write (it may write {}): give "
           "--site, or ask the administrator for a grant (docs/storage.md, \"Sites\")",
           shown_, what, text::terminal_safe(site), sites_text()));
-    if (e.sqlstate() == "23505")
+    if (state == "23505")
       throw StoreError(
           fmt::format("{}: the server holds {} under a site this login may not read or write (it "
                       "may write {}); nothing of it was sent",

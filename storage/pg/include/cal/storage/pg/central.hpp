@@ -14,6 +14,12 @@ namespace cal::storage::pg {
 // them), not by the laptops they came from.
 std::unique_ptr<RunReader> open_central(std::string_view url);
 
+// From now on `central` (a reader open_central made) reads version `version` of run `run_id`'s
+// stops instead of its current one (targets(); daq show|export|analyse RUN --version N, daq sync
+// --from ... --version RUN:N). Throws StoreError naming the run and the versions it has when
+// there is no such version.
+void read_version(RunReader& central, std::int64_t run_id, int version);
+
 // daq approve RUN --db postgresql://... (central schema 6): the login of this connection approves
 // result `result_id` of run `run_id` (the server's ids, as daq show lists them) through the
 // server's caldaq.approve, which records that login and the time, the result's fingerprint and

@@ -94,6 +94,14 @@ struct PullOptions {
   std::function<void(std::int64_t chunks_received)> after_chunk;
   // Called when a run is done, with its local record.
   std::function<void(const RunRecord&, std::int64_t received, std::int64_t already)> run_done;
+  // Runs brought with another version of their stops than the current one (--version RUN:N):
+  // the run's id on the server or its UUID, and the version. Each must be a run of the machine
+  // that this store does not have yet (a store keeps one version of a run).
+  struct VersionChoice {
+    std::string run;
+    int version = 0;
+  };
+  std::vector<VersionChoice> versions;
 };
 
 struct PullReport {
