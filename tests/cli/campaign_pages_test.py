@@ -79,6 +79,19 @@ one = pdf_pages("campaign.pdf")[0]
 check("campaign: page one says SIMULATED for all its runs",
       "SIMULATED: all 19 runs of this report were made on the simulated machine" in one
       and "SIMULATED — Campaign annual calibration" in one, one[:400])
+# Issue 30: the runs' traceability gaps (the simulated instruments state no serial number,
+# certificate or due date) warned on page one, as a single run's report does: each gap that a
+# run's section warns of is on page one, once, with the runs it concerns when not all of them.
+# Before, only each run's section, pages later, said so.
+head, _, runs_part = camp.partition('<h2 class="run"')
+in_runs = set(re.findall(r'<p class="warning">Traceability: ([^<]*)</p>', runs_part))
+on_top = re.findall(r'<p class="warning">Traceability(?: \(runs? [0-9, ]+\))?: ([^<]*)</p>',
+                    head)
+check("campaign: each run's traceability gap warned on page one, once",
+      in_runs and set(on_top) == in_runs and len(on_top) == len(in_runs), (in_runs, on_top))
+check("campaign: the traceability warning printed on page one",
+      re.search(r"Traceability(?: \(runs? [0-9, ]+\))?: .* no serial number, certificate or "
+                r"calibration due date stated", one) is not None, one[:1200])
 # Page one sums up the 21 errors: each name with its value and unit on its line (read from the
 # PDF's words: the two halves of the summary stand side by side). Units: a translation in µm, an
 # angle (angular, roll, squareness) in µrad.

@@ -147,6 +147,14 @@ if shutil.which("pdftotext") and (shutil.which("chromium") or os.environ.get("CA
           < one.find("The finding") and "expected as left" in one, one[:900])
     check("PDF page one: the largest deviations and the table", "Largest |deviation| as found"
           in one and "cec.mpf" in one, one)
+    # Issue 30: the traceability gaps of the runs compared warned on page one, as a linear or
+    # circle report does (the simulated instruments state no serial number, certificate or due
+    # date); both runs lack the same, so one line without run numbers. Before, the warning was
+    # only in each run's section, pages later.
+    check("PDF page one: the traceability gaps of both runs, said once",
+          one.count("Traceability: air, indicator, laser, material: no serial number, "
+                    "certificate or calibration due date stated.") == 1
+          and one.count("Traceability") == 1, one[:1500])
     # The finding and the table whole on page one: its last row fell onto page two, alone.
     two = pdf_pages("verify-3.pdf")[1]
     check("PDF page one: the finding's last row and the table's on page one",

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <ctime>
@@ -808,11 +809,35 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
   return out;
 }
 
-std::string traceability_warnings(const RunView& v) {
+// The traceability gaps of the runs a report covers (one run; a verification's as found and as
+// left; a campaign), for its page one: each gap once, with the runs it concerns when not all of
+// them (a campaign of 19 runs on the same instruments said the same line 19 times in the runs'
+// sections, and nothing on page one).
+std::string traceability_warnings(std::span<const RunView* const> views) {
+  std::vector<std::pair<std::string, std::vector<std::int64_t>>> gaps;  // gap -> its runs
+  for (const auto* v : views)
+    for (auto& g : traceability_gaps(*v)) {
+      const auto same =
+          std::find_if(gaps.begin(), gaps.end(), [&](const auto& x) { return x.first == g; });
+      if (same == gaps.end())
+        gaps.push_back({std::move(g), {v->run.id}});
+      else
+        same->second.push_back(v->run.id);
+    }
   std::string h;
-  for (const auto& g : traceability_gaps(v))
-    h += "<p class=\"warning\">Traceability: " + esc(g) + ".</p>\n";
+  for (const auto& [gap, ids] : gaps)
+    h += fmt::format(
+        "<p class=\"warning\">Traceability{}: {}.</p>\n",
+        ids.size() == views.size()
+            ? ""
+            : fmt::format(" ({} {})", ids.size() == 1 ? "run" : "runs", fmt::join(ids, ", ")),
+        esc(gap));
   return h;
+}
+
+std::string traceability_warnings(const RunView& v) {
+  const std::array<const RunView*, 1> one{&v};
+  return traceability_warnings(one);
 }
 
 // The quality of the run's stops (run_quality.hpp, docs/iso230-2.md "Suspect stops"): a suspect
@@ -2778,8 +2803,10 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
   // machine are named (it relied on the names).
   RunLabels labels;
   std::map<std::int64_t, Headline::Error> errors;  // run -> the ISO 230-1 error it measured
+  std::vector<RunView> views;                      // for page one's traceability gaps
+  views.reserve(runs.size());                      // `v` below stays valid
   for (const auto id : runs) {
-    const auto v = load(store, id);
+    const auto& v = views.emplace_back(load(store, id));
     labels.emplace_back(id, origin_label(v));
     Headline hl;
     const auto body = run_body(store, v, o, hl);
@@ -2812,8 +2839,10 @@ std::string campaign_report(const st::RunReader& store, std::span<const std::int
     if (who.empty()) who = who_of(v);
   }
   const auto origins = origins_of(labels);
+  std::vector<const RunView*> each;
+  for (const auto& v : views) each.push_back(&v);
   const std::string body =
-      origins.banner + errors_section(store, runs, errors) +
+      origins.banner + traceability_warnings(each) + errors_section(store, runs, errors) +
       fmt::format("<p>{} runs.</p>\n", runs.size()) +
       table({"run", "date", "test", "axis", "status", "standard", "results", "verdict"}, summary,
             "campaign", "r") +
@@ -2999,6 +3028,9 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       "the limit of that run's specification.</p>\n",
       esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
       date_of(views.back()));
+  std::vector<const RunView*> each;
+  for (const auto& v : views) each.push_back(&v);
+  body += traceability_warnings(each);
   // The run and date cells are text that may wrap (a cell of class "r" does not: "3
   // re-compensated" and "run 3 11-28 07:31" unbroken printed the page shrunk to 0.9).
   body += head.size() <= max_run_columns ? table(head, rows, "num", "ll") : transposed(head, rows);
@@ -3173,6 +3205,7 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
                       : b.verdict.configured && b.verdict.pass ? "pass"
                                                                : "none",
                       verdict_words(a, "As found", found_id), verdict_words(b, "As left", left_id));
+  body += traceability_warnings(std::array<const RunView*, 2>{&found, &left});
   body += fmt::format(
       "<p>The machine as it was found (run {}, {}) and as it was left after the compensation "
       "(run {}, {}): the same test, side by side. Each run's full report follows.</p>\n",
@@ -3360,8 +3393,9 @@ std::string verification_report(const st::RunReader& store, std::int64_t run,
                   .x_label = x_label,
                   .y_label = read + " (µm)",
                   // Page one holds it, the finding and the table: at 250 the finding's last
-                  // row ("Agreement with the finding") fell onto page two, alone.
-                  .height_pt = 190,
+                  // row ("Agreement with the finding") fell onto page two, alone; at 190 with
+                  // a line of traceability warning above it, the finding and the table did.
+                  .height_pt = 165,
                   .zero_line = true};
   overlay.lines.push_back(
       loop_line(p.target_mm, p.found_um, "as found (" + found_name + ")", orange, false));
@@ -3374,7 +3408,11 @@ std::string verification_report(const st::RunReader& store, std::int64_t run,
   if (found) labels.emplace_back(found->run.id, origin_label(*found));
   labels.emplace_back(run, origin_label(left));
   const auto origins = origins_of(labels);
-  std::string body = origins.banner + summary_block(left, test_name(left)) + loop_verdict(c);
+  std::vector<const RunView*> both;
+  if (found) both.push_back(&*found);
+  both.push_back(&left);
+  std::string body = origins.banner + summary_block(left, test_name(left)) + loop_verdict(c) +
+                     traceability_warnings(both);
   body += figure(svg(overlay),
                  "Each target's mean of the directions compared (µm). Dashed: the as-found error "
                  "plus what the table adds there, what the as-left run should read; a table "
