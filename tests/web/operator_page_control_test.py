@@ -85,7 +85,9 @@ try:
     b.js("document.getElementById('tab-align').click();")
     shown, data = b.wait("const t = document.getElementById('align-reading').textContent; "
                          "const a = laserAxes(device('laser')); "
-                         "return /^-?\\d+\\.\\d{4}$/.test(t) && a.length && [t, a[0].mm.toFixed(4)];",
+                         "return /^-?\\d+\\.\\d{4}$/.test(t) && a.length && "
+                         # the value to 4 places, a negative zero shown as 0 (never "-0.0000")
+                         "[t, a[0].mm.toFixed(4).replace(/^-(0\\.0+)$/, '$1')];",
                          timeout_s=20, what="the laser's reading on the Align view")
     ok(shown == data, f"Align: the laser's current reading in mm: {shown} (its value {data})")
     align = b.js("const g = id => document.getElementById(id); return {label: g('align-label').textContent, "
