@@ -897,30 +897,38 @@ std::vector<double> numbers(const Result& r) {
 // from the traces on every pass instead of held (40 bytes a sample). On circles with every kind
 // of injected error, the rebuilt path gives bit for bit the result of the held one, with the
 // period given and searched, and finds what was injected.
-void expect_rebuilt_equals_held(const Trace (&t)[2], const cal::circle::Setup& setup) {
-  ASSERT_GT(fit_records_held_max_samples, t[0].angle_deg.size() + t[1].angle_deg.size());
-  const Result held = analyse(setup, t), rebuilt = analyse(setup, t, 0);
-  ASSERT_EQ(held.diagnostics.size(), rebuilt.diagnostics.size());
+// Two analyses of the same circles give the same result: every diagnostic (by key, in order),
+// every number bit for bit, every note.
+void expect_same_result(const Result& held, const Result& other) {
+  ASSERT_EQ(held.diagnostics.size(), other.diagnostics.size());
   for (std::size_t k = 0; k < held.diagnostics.size(); ++k)
-    EXPECT_EQ(held.diagnostics[k].key, rebuilt.diagnostics[k].key);
-  EXPECT_EQ(numbers(held), numbers(rebuilt));
-  EXPECT_EQ(held.notes, rebuilt.notes);
+    EXPECT_EQ(held.diagnostics[k].key, other.diagnostics[k].key);
+  EXPECT_EQ(numbers(held), numbers(other));
+  EXPECT_EQ(held.notes, other.notes);
 }
 
+void expect_rebuilt_equals_held(const Trace (&t)[2], const cal::circle::Setup& setup) {
+  ASSERT_GT(fit_records_held_max_samples, t[0].angle_deg.size() + t[1].angle_deg.size());
+  expect_same_result(analyse(setup, t), analyse(setup, t, 0));
+}
+
+// A simulated machine with every kind of error the diagnostics find injected.
+const Machine kEveryError{.cu = 3,
+                          .cv = -2,
+                          .radius_error = 1.5,
+                          .square_um_per_m = -30,
+                          .lag_v_ms = 0.6,
+                          .backlash_u = 6,
+                          .backlash_v = 2,
+                          .cyclic_u = 0.8,
+                          .bow_u = 1,
+                          .spike_u = 2,
+                          .noise = 0.1,
+                          .vib_um = 1.0,
+                          .vib_hz = 23.7};
+
 TEST(CircleDiagnostics, RecordsRebuiltFromTheTracesGiveTheHeldResultAndTheInjectedTruth) {
-  const Machine m{.cu = 3,
-                  .cv = -2,
-                  .radius_error = 1.5,
-                  .square_um_per_m = -30,
-                  .lag_v_ms = 0.6,
-                  .backlash_u = 6,
-                  .backlash_v = 2,
-                  .cyclic_u = 0.8,
-                  .bow_u = 1,
-                  .spike_u = 2,
-                  .noise = 0.1,
-                  .vib_um = 1.0,
-                  .vib_hz = 23.7};
+  const Machine& m = kEveryError;
   const Trace t[] = {simulate(m, Direction::ccw, 3600, 1), simulate(m, Direction::cw, 3600, 2)};
   for (const bool searched : {false, true}) {
     SCOPED_TRACE(searched ? "period searched" : "period given");
@@ -960,7 +968,6 @@ TEST(CircleDiagnostics, RecordsRebuiltFromTheTracesGiveTheHeldResultAndTheInject
   ASSERT_NE(x, nullptr);
   EXPECT_NEAR(x->value, 0.857, 0.086);
 }
-
 
 // Issue 32: a trace read in place (angles from the program's timing, deviations from a paged
 // array of the samples, as BallbarSegmenter::sources gives them) with every per-sample array of
@@ -1004,19 +1011,7 @@ ProgramCircle program_circle(const Machine& m, std::size_t n, cal::PageOptions p
 
 TEST(CircleDiagnostics, StreamedFromPagedSourcesEqualsTheHeldAnalysisBitForBitAndTheTruth) {
   const cal::PageOptions tiny{.page_values = 64, .pages_held = 2};
-  const Machine m{.cu = 3,
-                  .cv = -2,
-                  .radius_error = 1.5,
-                  .square_um_per_m = -30,
-                  .lag_v_ms = 0.6,
-                  .backlash_u = 6,
-                  .backlash_v = 2,
-                  .cyclic_u = 0.8,
-                  .bow_u = 1,
-                  .spike_u = 2,
-                  .noise = 0.1,
-                  .vib_um = 1.0,
-                  .vib_hz = 23.7};
+  const Machine& m = kEveryError;
   const auto c = program_circle(m, 3600, tiny);
   for (const bool searched : {false, true}) {
     SCOPED_TRACE(searched ? "period searched" : "period given");
@@ -1025,11 +1020,7 @@ TEST(CircleDiagnostics, StreamedFromPagedSourcesEqualsTheHeldAnalysisBitForBitAn
     const auto spilled = cal::PagedDoubles::pages_spilled();
     const Result held = analyse(setup, c.held), paged = analyse(setup, c.paged, 0, tiny);
     EXPECT_GT(cal::PagedDoubles::pages_spilled() - spilled, 100u);  // it did page (574)
-    ASSERT_EQ(held.diagnostics.size(), paged.diagnostics.size());
-    for (std::size_t k = 0; k < held.diagnostics.size(); ++k)
-      EXPECT_EQ(held.diagnostics[k].key, paged.diagnostics[k].key);
-    EXPECT_EQ(numbers(held), numbers(paged));
-    EXPECT_EQ(held.notes, paged.notes);
+    expect_same_result(held, paged);
     const auto v = values(paged);
     EXPECT_NEAR(v.at("centre_X"), 3, 0.05);
     EXPECT_NEAR(v.at("squareness"), -30, 0.5);
