@@ -5,7 +5,8 @@ a short campaign on the simulated shop (`daq sim --measure` and `daq run linear`
 docs/volumetric-walkthrough.md measures it): positioning E_XX, the two straightness runs of
 the XY plane (E_YX, E_XY, read against one square) and positioning E_ZZ (every axis has a run:
 the model's travel is known), the first of them dated a day earlier (a campaign over two days); then `daq serve -c` on that store. The Results view lists the 18
-component tests and the three squarenesses, each with its test and instrument; the measured
+component tests and the three squarenesses, one line each (at 560 px too), each with its test and instrument, the next one to
+measure in full above them; the measured
 ones with the run `daq model build` uses for them (its --json `used`, the CLI's own code), their
 day and where the other axes stood; the XY squareness measured from its two runs; the others
 "to do"; the days; and the commands that build the model and its map. Under it the model itself
@@ -79,24 +80,47 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--
                f"{component}: run {rows[component][3]}, the one `daq model build` uses ({ids})")
     ok(rows["E_XX"][4] == days[0] and rows["E_YX"][4] == days[1],
        f"each with its day: E_XX {rows['E_XX'][4]}, E_YX {rows['E_YX'][4]}")
-    ok(rows["E_XX"][1] == "Positioning of X: the laser along X" and rows["E_XX"][2] == "laser",
-       f"the test and its instrument in words: {rows['E_XX'][:3]}")
-    ok(rows["E_YX"][1].startswith("Straightness of X read in Y") and "against a square" in rows["E_YX"][5] and
+    titles = b.js("return Object.fromEntries([...document.querySelectorAll('#vol-table tbody tr')].map(r => [r.dataset.component, r.cells[1].title]));")
+    ok(rows["E_XX"][1] == "Positioning of X" and titles["E_XX"] == "Positioning of X: the laser along X" and rows["E_XX"][2] == "laser",
+       f"the test by its short name (its set-up in words on pointing) and its instrument: {rows['E_XX'][:3]} {titles['E_XX']!r}")
+    ok(rows["E_YX"][1] == "Straightness of X in Y" and "against a square" in rows["E_YX"][5] and
        rows["E_YX"][5].startswith("other axes at "), f"the set-up as measured: {rows['E_YX']}")
-    ok(rows["E_BX"][3] == "—" and rows["E_BX"][4] == "to do" and rows["E_BX"][1] == (
-        "Angle of X about B: two laser beams side by side, reflectors apart across the travel"),
-       f"what is left, with its set-up: {rows['E_BX']}")
+    ok(rows["E_BX"][3] == "to do" and rows["E_BX"][4] == "" and rows["E_BX"][1] == "Angle of X about B" and
+       titles["E_BX"] == "Angle of X about B: two laser beams side by side, reflectors apart across the travel",
+       f"what is left: {rows['E_BX']}")
+    # The next step to measure (the first left in the walkthrough's order) in full above the
+    # table, and marked in it.
+    current = b.js("return [...document.querySelectorAll('#vol-table tr.current')].map(r => r.dataset.component);")
+    first_left = next(c for c in rows if rows[c][3] == "to do")
+    nxt = b.js("return document.getElementById('camp-next').textContent;")
+    ok(current == [first_left] and nxt.startswith(f"Next: {first_left}, ") and "Instrument: " in nxt and
+       "put the other axes at targets of their own angular runs" in nxt, f"the next step {first_left} in full: {nxt!r}")
     ok(rows["E_C0Y"][3] == f"{cli['used']['E_YX'][0]}, {cli['used']['E_XY'][0]}" and rows["E_C0Y"][4] == "",
        f"the XY squareness from its two straightness runs: {rows['E_C0Y']}")
-    ok(rows["E_B0Z"][4] == "to do", "the ZX squareness still to do")
+    ok(rows["E_B0Z"][3] == "to do", "the ZX squareness still to do")
     text = b.js("return document.getElementById('vol-box').textContent;")
     ok(f"{days[0]}: 1 measured: E_XX" in text and f"{days[1]}: 3 measured: E_YX, E_XY, E_ZZ" in text,
        "the campaign's progress by day")
-    ok(f"16 still to measure: then build the model with `daq model build --machine '{MACHINE}' --db '{DB}' -o model.json`"
-       in text and "daq model map model.json" in text, "the commands that build the model and its map")
+    ok("16 still to measure. The model below is built from the runs measured so far" in text and
+       f"From the command line: `daq model build --machine '{MACHINE}' --db '{DB}' -o model.json`" in text and
+       "daq model map model.json" in text, "the model is below; the commands that build it and its map")
     b.js("document.getElementById('vol-panel').scrollIntoView();")
     page_checks.shot(b, SHOTS, "c01-campaign-1366x768.png")
-    page_checks.fits_narrow(b, SHOTS, "c02-campaign-560.png", "the checklist fits 560 px (its table scrolls)")
+    page_checks.fits_narrow(b, SHOTS, "c02-campaign-560.png", "the checklist fits 560 px")
+    # At 560 px one line a step (a row was two to six lines: the checklist 2,700 px tall), its
+    # table as wide as the screen, and the next step's line on screen once the checklist's head is.
+    b.set_size(560, 900)
+    narrow = b.wait("const rows = [...document.querySelectorAll('#vol-table tbody tr')]; if (rows[0].cells[2].offsetParent !== null) return false;"
+                    " const line = parseFloat(getComputedStyle(rows[0].cells[0]).lineHeight);"
+                    " const box = document.querySelector('#vol-box .scroll-x');"
+                    " document.getElementById('vol-head').scrollIntoView();"
+                    " const next = document.getElementById('camp-next').getBoundingClientRect();"
+                    " return {tallest: Math.max(...rows.map(r => r.getBoundingClientRect().height)), line,"
+                    " wide: box.scrollWidth - box.clientWidth, table: document.getElementById('vol-table').getBoundingClientRect().height,"
+                    " next: next.bottom <= window.innerHeight};", timeout_s=10, what="the checklist at 560 px")
+    ok(narrow["tallest"] <= 2 * narrow["line"] and narrow["wide"] <= 0 and narrow["table"] < 1000 and narrow["next"],
+       f"560 px: one line a step, nothing scrolls sideways, the next step on screen: {narrow}")
+    b.set_size(1366, 768)
 
     # --- the model of these runs and its map, as the CLI builds and maps it ----------------
     model = page_checks.get_json(url + "api/model")

@@ -10,7 +10,9 @@ against `daq serve --simulate` with the keys an operator (or a foot switch) pres
    not taken), R measures the last captured stop again (its value discarded, captured anew);
 4. the API answers 409 (with the reason) when an action does not apply, 400 for a bad body;
 5. the stored run lists every action in order, with its stop, source and operator
-   (/api/runs/N and `daq show N`), and the skipped stop among the missed ones.
+   (/api/runs/N and `daq show N`), and the skipped stop among the missed ones; the run ends by
+   itself with that stop missed, and the page says INCOMPLETE as the store does;
+6. Start (idle), Stop and the manual keys (running) on the 1366 x 768 screen without scrolling.
 
 Usage: operator_page_control_test.py DAQ_BINARY ARTEFACT_DIR
 """
@@ -133,6 +135,12 @@ try:
     b.js("window.scrollTo(0, 0);")
     b.js("document.getElementById('tab-run').click();")
 
+    # On the screen of 1366 x 768 (less the browser's bar) without scrolling: Start (it was under
+    # the instruments' column's height), and during the run Stop and the manual keys (under the
+    # big number and the run's lines).
+    IN_VIEW = ("return arguments[0].map(id => { const r = document.getElementById(id).getBoundingClientRect();"
+               " return r.height > 0 && r.top >= 0 && r.bottom <= window.innerHeight; });")
+    ok(b.js(IN_VIEW, ["start-linear", "start-circle"]) == [True, True], "idle: Start on screen without scrolling")
     post(url + "api/simulation/speed", {"speed": 2})
     b.js("document.getElementById('start-linear').click();")
     b.wait("const r = window.caldaq.page.run; return window.caldaq.page.status.running && r && r.stop;",
@@ -141,6 +149,9 @@ try:
     labels = b.js("return [...document.querySelectorAll('#manual button')].map(b => b.textContent);")
     ok(labels == ["Capture (C)", "Skip target (S)", "Measure again (R)", "Pause (P)"],
        f"a linear run: the controls with their keys: {labels}")
+    b.wait("return window.caldaq.page.run.display && document.getElementById('reading').textContent !== '—';", what="the number")
+    ok(b.js(IN_VIEW, ["stop", "ctl-capture", "ctl-skip", "ctl-retry", "ctl-pause"]) == [True] * 5,
+       "running: Stop and the manual keys on screen without scrolling")
 
     # --- 1. pause: no automatic capture at a stop ----------------------------------------------
     c = control(b, "p", "pause")
@@ -226,10 +237,18 @@ try:
     page_checks.shot(b, SHOTS, "c03-skip-retry-1366x768.png")
     page_checks.fits_narrow(b, SHOTS, "c04-controls-560px.png", "560 px: the controls fit")
 
-    # --- 5. the run's record ---------------------------------------------------------------------
-    status, body = post(url + "api/runs/stop", {})
-    ok(status == 200, "the run stopped")
-    b.wait("return !window.caldaq.page.status.running;", what="the run's end")
+    # --- 5. the run's end and record ----------------------------------------------------------
+    # The run goes on to its end by itself with the skipped stop missed: too few runs are left
+    # at that target to evaluate it, and it is stored as incomplete. The page says so (it said
+    # ABORTED in red, as if stopped, while the store and the Results said incomplete).
+    post(url + "api/simulation/speed", {"speed": 50})
+    end = b.wait("const s = window.caldaq.page.status; return !s.running && s.last && s.last.run === %d && "
+                 "[s.last.status, document.getElementById('reading').textContent, document.getElementById('run-line').textContent];" % run_id,
+                 timeout_s=120, what="the run's end", explain=EXPLAIN)
+    stored = get(url + "api/runs")
+    stored = next(r for r in stored["runs"] if r["id"] == run_id)
+    ok(end[0] == "incomplete" == stored["status"] and end[1] == "INCOMPLETE" and "missed" in end[2],
+       f"its end as stored, in words: {end} (stored {stored['status']})")
     ok(b.js("return document.getElementById('manual').hidden;"), "no run: the controls go")
     status, body = post(url + "api/runs/retry", {})
     ok(status == 409, f"retry after the run: 409 ({body.get('error')})")

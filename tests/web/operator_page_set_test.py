@@ -215,6 +215,27 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(b.js("return document.querySelectorAll('#set-box-vol tbody tr').length;") == 3, "the table on the Run view too")
     shot(b, "s04-set-end-run-1366x768.png")
     page_checks.fits_narrow(b, SHOTS, "s05-set-end-run-560.png", "the set's table fits 560 px")
+    # At 560 px each test on one line of the set's table, which does not scroll sideways, nor
+    # does the three-plane table (the names wrapped to three lines and both tables scrolled, the
+    # verdicts out of sight), on the Run view and in the Results.
+    COMPACT = ("const box = document.getElementById(arguments[0]); const rows = [...box.querySelectorAll('.set-table tbody tr')];"
+               " if (rows.length !== 3 || rows[0].cells[1].textContent !== arguments[1]) return false;"
+               " const line = parseFloat(getComputedStyle(rows[0].cells[1]).lineHeight);"
+               " return {names: rows.map(r => r.cells[1].textContent), line,"
+               " tallest: Math.max(...rows.map(r => r.cells[1].getBoundingClientRect().height)),"
+               " sideways: [...box.querySelectorAll('.scroll-x')].map(x => x.scrollWidth - x.clientWidth),"
+               " verdict: rows[0].cells[6].getBoundingClientRect().right <= box.getBoundingClientRect().right + 1};")
+    for view, box in (("run", "set-box"), ("results", "result-set")):
+        b.js(f"document.getElementById('tab-{view}').click();")
+        b.set_size(560, 900)
+        narrow = wait("return (() => {" + COMPACT.replace("arguments[0]", repr(box)).replace("arguments[1]", "'XY 360° 3000 R100'") + "})();",
+                      f"the set's table at 560 px ({view})")
+        ok(narrow["names"] == ["XY 360° 3000 R100", "ZX 220° 3000 R100", "YZ 220° 3000 R100"] and
+           narrow["tallest"] < 1.5 * narrow["line"] and max(narrow["sideways"]) <= 0 and narrow["verdict"],
+           f"560 px ({view}): each test on one line, its verdict in sight, no table scrolls sideways: {narrow}")
+        b.set_size(1366, 768)
+        wait(f"const r = document.querySelector('#{box} .set-table tbody tr'); return r && r.cells[1].textContent === 'XY 360°, 3000 mm/min, R 100.0 mm';",
+             f"the whole names again at 1366 px ({view})")
     b.js("document.getElementById('tab-results').click();")
     page_checks.fits_narrow(b, SHOTS, "s06-set-results-560.png", "the Results with the set fit 560 px")
     # Units as their signs and numbers without a negative zero, on every view shown; the shared

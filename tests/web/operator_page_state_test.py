@@ -238,7 +238,7 @@ try:
     seen = b.js("return [document.getElementById('plan').textContent, "
                 "document.getElementById('pending-edits').textContent];")
     ok("Positioning test E_XX, axis X: 0.000 → 100.000 mm, 3 targets × 2 runs ↑↓ = 12 stops" in seen[0]
-       and "laser (ids3010)" in seen[0],
+       and "instruments: air (air station), laser, material (thermometer)" in seen[0],  # roles, not drivers ("gauge")
        f"the Run view shows the test Start runs: {seen[0]!r}")
     ok("Last target 100 → 50" in seen[1], f"and the edit that is not in use: {seen[1]!r}")
     shot(b, "s06-unapplied-edit-1366x768.png")

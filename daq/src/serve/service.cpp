@@ -1135,7 +1135,14 @@ class Service {
                                   : circle_->outcome().complete;
     const bool evaluated = linear_ ? linear_->outcome().complete : circle_->outcome().complete;
     const std::string reason = linear_ ? linear_->outcome().reason : circle_->outcome().reason;
-    const char* status = complete ? "complete" : evaluated ? "incomplete" : "aborted";
+    // A linear run's end as stored: one that reached the end of its plan with a stop missed is
+    // incomplete also when too few stops were left to evaluate (it read "aborted", i.e.
+    // stopped, on the page while the store and the Results said "incomplete").
+    const auto stored = linear_ ? linear_->outcome().status : cal::storage::RunStatus::running;
+    const char* status = complete                                        ? "complete"
+                         : evaluated                                     ? "incomplete"
+                         : stored == cal::storage::RunStatus::incomplete ? "incomplete"
+                                                                         : "aborted";
     follow_set();
     if (set_ && circle_) {
       const auto db = read_store_quietly();
@@ -1145,7 +1152,7 @@ class Service {
                  {"status", status},     {"reason", reason}, {"evaluated", evaluated},
                  {"origin", run_origin_}};
     if (capture_ && capture_->recorder) capture_->recorder->close();
-    const char* how = complete ? "complete" : evaluated ? "incomplete: " : "stopped: ";
+    const char* how = complete ? "complete" : status[0] == 'i' ? "incomplete: " : "stopped: ";
     fmt::print("run {} {}{}\n", run_id_, how, reason);
     std::fflush(stdout);
     linear_.reset(), circle_.reset(), capture_.reset();

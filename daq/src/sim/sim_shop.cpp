@@ -600,6 +600,7 @@ std::string simulated_shop_config(const SimulatedShop& shop, const ShopConfigOpt
 [machine]
 name = "SIMULATED VMC"
 description = "built-in simulated 3-axis machine with injected errors ({who})"
+topology = "FXYZ"
 
 {devices}
 [environment]
