@@ -143,6 +143,9 @@ const std::vector<std::string_view>& key_order() {
                                                    "make",
                                                    "model",
                                                    "serial_number",
+                                                   "topology",
+                                                   "tool_offset_mm",
+                                                   "table_offset_mm",
                                                    "certificate",
                                                    "calibration_due",
                                                    "controller_compensation",
@@ -351,6 +354,12 @@ json setup_of(const cal::daq::Config& c) {
   put_text(m, "make", c.machine_make);
   put_text(m, "model", c.machine_model);
   put_text(m, "serial_number", c.machine_serial);
+  // The kinematic chain and its offsets (stored with every run for `daq model build`): a set-up
+  // applied from the page lost them, and the page's model was refused ("give --topology").
+  put_text(m, "topology", c.machine_topology);
+  for (const auto& [key, v] : {std::pair{"tool_offset_mm", &c.machine_tool_offset_mm},
+                               std::pair{"table_offset_mm", &c.machine_table_offset_mm}})
+    if (*v != std::array<double, 3>{}) m[key] = *v;
   j["machine"] = m;
   json cu = json::object();
   put_text(cu, "name", c.customer.name);

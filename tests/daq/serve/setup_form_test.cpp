@@ -29,6 +29,9 @@ description = "3-axis vertical machining centre"
 make = "Hermle"
 model = "C 42"
 serial_number = "42-0815"
+topology = "YFXZ"
+tool_offset_mm = [0, 0, 120]
+table_offset_mm = [10, -5, 0]
 [conditions]
 controller_compensation = false
 warm_up = "20 min"
@@ -111,6 +114,11 @@ TEST(SetupForm, AConfigurationSurvivesTheTripThroughTheForm) {
   // Spot checks against the file itself, not against the code's own output.
   EXPECT_EQ(again.customer.name, "ACME \"Precision\" Ltd");
   EXPECT_EQ(again.customer.site, "Plant 2\nhall B");
+  // The kinematic chain and its offsets (the volumetric model's), as the file gives them: a
+  // set-up applied from the page lost them and the page's model asked for --topology.
+  EXPECT_EQ(again.machine_topology, "YFXZ");
+  EXPECT_EQ(again.machine_tool_offset_mm, (std::array<double, 3>{0, 0, 120}));
+  EXPECT_EQ(again.machine_table_offset_mm, (std::array<double, 3>{10, -5, 0}));
   EXPECT_EQ(again.devices.size(), 4u);
   // A simulated twin stays one through the page's form (else a run of the simulated shop set
   // up on the page would be stored as measured on real instruments).
