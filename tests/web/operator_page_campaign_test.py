@@ -90,8 +90,10 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--
        f"what is left: {rows['E_BX']}")
     # The next step to measure (the first left in the walkthrough's order) in full above the
     # table, and marked in it.
+    # (E_BX: the walkthrough's first test, docs/volumetric-walkthrough.md; this campaign measured
+    # positioning and straightness only)
     current = b.js("return [...document.querySelectorAll('#vol-table tr.current')].map(r => r.dataset.component);")
-    first_left = next(c for c in rows if rows[c][3] == "to do")
+    first_left = "E_BX"
     nxt = b.js("return document.getElementById('camp-next').textContent;")
     ok(current == [first_left] and nxt.startswith(f"Next: {first_left}, ") and "Instrument: " in nxt and
        "put the other axes at targets of their own angular runs" in nxt, f"the next step {first_left} in full: {nxt!r}")
@@ -111,7 +113,7 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--
     # table as wide as the screen, and the next step's line on screen once the checklist's head is.
     b.set_size(560, 900)
     narrow = b.wait("const rows = [...document.querySelectorAll('#vol-table tbody tr')]; if (rows[0].cells[2].offsetParent !== null) return false;"
-                    " const line = parseFloat(getComputedStyle(rows[0].cells[0]).lineHeight);"
+                    " const line = 1.25 * parseFloat(getComputedStyle(rows[0].cells[0]).fontSize);"
                     " const box = document.querySelector('#vol-box .scroll-x');"
                     " document.getElementById('vol-head').scrollIntoView();"
                     " const next = document.getElementById('camp-next').getBoundingClientRect();"

@@ -79,7 +79,7 @@ try:
     ok(status == 400 and "must be empty or {}" in body["error"], f"a bad body: {status} {body}")
 
     b.get(url)
-    b.wait("return window.caldaq.page && window.caldaq.page.status.start.linear.ready;",
+    b.wait("return window.caldaq.page && window.caldaq.page.status && window.caldaq.page.status.start.linear.ready;",
            timeout_s=30, what="Start linear ready")
     ok(b.js("return document.getElementById('manual').hidden;"), "no run: no manual control shown")
 

@@ -62,7 +62,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(kinds == ["positioning", "straightness", "angular", "roll"],
        f"the simulated shop's laser, indicator and level measure every linear kind: {kinds}")
     b.get(url)
-    wait("return window.caldaq.page && window.caldaq.page.status.start.linear.ready;", "Start linear ready")
+    wait("return window.caldaq.page && window.caldaq.page.status && window.caldaq.page.status.start.linear.ready;", "Start linear ready")
 
     def run_kind(kind, axis, direction, what, extra=()):
         """Types a short test of KIND in the form (and the fields EXTRA: (key, value) pairs),

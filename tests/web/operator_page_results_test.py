@@ -111,7 +111,7 @@ try:
 
     # --- 1. the Run view: the run's stored origin while it runs and once it ended -------------
     b.get(url)
-    wait("return window.caldaq.page && window.caldaq.page.status.start.linear.ready;", "Start linear ready")
+    wait("return window.caldaq.page && window.caldaq.page.status && window.caldaq.page.status.start.linear.ready;", "Start linear ready")
     ok(b.js("return document.getElementById('sim-badge').hidden;") and
        not b.js("return window.caldaq.page.status.simulated;"), "not --simulate: no SIMULATED shop badge")
     b.js("document.getElementById('start-linear').click();")

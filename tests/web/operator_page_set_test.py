@@ -51,7 +51,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
         "next: (document.getElementById('set-next') || {}).textContent, errors: window.__errors}).slice(0, 3000);"), WAIT_S)
 
     b.get(url)
-    wait("return window.caldaq.page && window.caldaq.page.status.start.circle.ready;", "Start ballbar ready")
+    wait("return window.caldaq.page && window.caldaq.page.status && window.caldaq.page.status.start.circle.ready;", "Start ballbar ready")
 
     # --- 1. the set typed in the form and applied ----------------------------------------
     b.js("document.getElementById('tab-setup').click();")
@@ -220,7 +220,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     # verdicts out of sight), on the Run view and in the Results.
     COMPACT = ("const box = document.getElementById(arguments[0]); const rows = [...box.querySelectorAll('.set-table tbody tr')];"
                " if (rows.length !== 3 || rows[0].cells[1].textContent !== arguments[1]) return false;"
-               " const line = parseFloat(getComputedStyle(rows[0].cells[1]).lineHeight);"
+               " const line = 1.25 * parseFloat(getComputedStyle(rows[0].cells[1]).fontSize);"
                " return {names: rows.map(r => r.cells[1].textContent), line,"
                " tallest: Math.max(...rows.map(r => r.cells[1].getBoundingClientRect().height)),"
                " sideways: [...box.querySelectorAll('.scroll-x')].map(x => x.scrollWidth - x.clientWidth),"

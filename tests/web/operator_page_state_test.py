@@ -96,7 +96,7 @@ try:
     status, body = post(url + "api/setup/apply", {"setup": setup})
     ok(status == 200, f"a short linear test applied: {status} {body.get('error', '')}")
     b.get(url)
-    b.wait("return window.caldaq.page && window.caldaq.page.status.start.linear.ready;",
+    b.wait("return window.caldaq.page && window.caldaq.page.status && window.caldaq.page.status.start.linear.ready;",
            timeout_s=30, what="Start linear ready")
     ok(b.js("return document.getElementById('stale').hidden;"), "live data: no banner")
 
