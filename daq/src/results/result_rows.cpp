@@ -162,8 +162,11 @@ bool is_ballbar5x_schema(std::string_view schema) { return schema == "caldaq.bal
 std::vector<ResultRow> ballbar5x_rows(const json& doc) {
   std::vector<ResultRow> rows;
   for (const auto& a : doc.value("axes", json::array())) {
-    const json loc = a.value("location", json::object());  // held: items() refers into it
-    for (const auto& [name, v] : loc.items())
+    const json loc = a.value("location", json::object());
+    for (const auto& n : a.value("names", json::array())) {  // ISO 230-1's order
+      const std::string name = n.is_string() ? n.get<std::string>() : std::string();
+      if (!loc.contains(name)) continue;
+      const json& v = loc[name];
       rows.push_back(
           {name, name,
            fmt::format("location error of the {} axis, u = {} (k = 1); left against "
@@ -171,6 +174,7 @@ std::vector<ResultRow> ballbar5x_rows(const json& doc) {
                        safe(text_of(a, "axis")), number_text(number_of(v, "uncertainty"), 3),
                        signed_number_text(number_of(v, "left"), 3)),
            number_of(v, "value"), text_of(v, "unit")});
+    }
   }
   return rows;
 }
