@@ -89,6 +89,14 @@ void add_test_options(CLI::App* cmd, TestOptions& t) {
                   "letters, digits, '-' and '_')");
 }
 
+// The simulated machine and its control (ballbar5x-sim, ballbar5x-run).
+void add_machine_options(CLI::App& cmd, std::string& truth, std::string& control) {
+  cmd.add_option("truth", truth, "Model file of the simulated machine (its truth)")->required();
+  cmd.add_option("--control", control,
+                 "Model file the control's kinematics holds (the program is computed with it)")
+      ->required();
+}
+
 void check_test_name(const std::string& name) {
   const bool ok = !name.empty() && name.size() <= 40 &&
                   std::all_of(name.begin(), name.end(), [](unsigned char c) {
@@ -346,17 +354,17 @@ struct RunOptions5x {
   bool json = false;
 };
 
-// The tests of the run: each table axis of the control in each set-up, in the chain's order
-// from the workpiece (a C table before its A cradle).
+// The tests of the run: each table axis of the control in each set-up, in the model's order
+// (the trunnion's: C, then A).
 std::vector<kin::RotaryBallbarTest> run_tests(const kin::FiveAxisMachine& control,
                                               const RunOptions5x& o) {
   std::vector<kin::RotaryBallbarTest> out;
-  for (auto r = control.rotary.begin(); r != control.rotary.end(); ++r) {
-    if (r->side != kin::Side::table) continue;
-    const std::string letter(kin::to_string(r->letter));
+  for (const auto& r : control.rotary) {
+    if (r.side != kin::Side::table) continue;
+    const std::string letter(kin::to_string(r.letter));
     for (const auto& setup : o.setups) {
       kin::RotaryBallbarTest t;
-      t.axis = r->letter;
+      t.axis = r.letter;
       t.setup = kin::bar_setup_from_string(setup);
       t.name = fmt::format("{}-{}", letter, setup);
       t.table_ball_mm = {o.ball_mm.at(0), o.ball_mm.at(1), o.ball_mm.at(2)};
@@ -496,10 +504,7 @@ void add_model_ballbar5x_commands(CLI::App& model) {
       "five-axis ballbar program for each table axis and set-up while the bar's gauge twin "
       "streams; the gauge driver reads the stream, the run stores it (kind ballbar5x, see daq "
       "runs / daq show) and fits each axis's location errors with their uncertainty");
-  run->add_option("truth", r->truth, "Model file of the simulated machine (its truth)")->required();
-  run->add_option("--control", r->control,
-                  "Model file the control's kinematics holds (the program is computed with it)")
-      ->required();
+  add_machine_options(*run, r->truth, r->control);
   run->add_option("--hal", r->hal,
                   "The control holds these LinuxCNC trunnion pins (daq model kinematics) over "
                   "--control's rotary lines");
@@ -542,10 +547,7 @@ void add_model_ballbar5x_commands(CLI::App& model) {
       "Simulated ballbar on a rotary table axis: the readings a model (the simulated machine's "
       "truth) gives when it runs the program the control's model computed, as a CSV for daq "
       "model ballbar5x");
-  sim->add_option("truth", s->truth, "Model file of the simulated machine (its truth)")->required();
-  sim->add_option("--control", s->control,
-                  "Model file the control's kinematics holds (the program is computed with it)")
-      ->required();
+  add_machine_options(*sim, s->truth, s->control);
   add_test_options(sim, s->t);
   sim->add_option("--offset-um", s->offset_um,
                   "A constant added to every reading (the bar's zero and the balls' set-up)")
