@@ -21,8 +21,11 @@
 #include "cli_checks.hpp"
 #include "command.hpp"
 #include "csv_columns.hpp"
+#include "database.hpp"
 #include "model_cli.hpp"
 #include "output_file.hpp"
+#include "probe_cli.hpp"
+#include "sim_ballbar5x.hpp"
 
 namespace daq {
 
@@ -84,6 +87,14 @@ void add_test_options(CLI::App* cmd, TestOptions& t) {
   cmd->add_option("--name", t.name,
                   "The test's name in the readings file (default AXIS-SETUP, e.g. C-radial; "
                   "letters, digits, '-' and '_')");
+}
+
+// The simulated machine and its control (ballbar5x-sim, ballbar5x-run).
+void add_machine_options(CLI::App& cmd, std::string& truth, std::string& control) {
+  cmd.add_option("truth", truth, "Model file of the simulated machine (its truth)")->required();
+  cmd.add_option("--control", control,
+                 "Model file the control's kinematics holds (the program is computed with it)")
+      ->required();
 }
 
 void check_test_name(const std::string& name) {
@@ -328,6 +339,141 @@ void run_fit(const FitOptions& o) {
   }
 }
 
+// --- ballbar5x-run: the tests as a stored run on the simulated shop ----------------------------
+
+struct RunOptions5x {
+  std::string truth, control, hal, swivel, db, write;
+  std::vector<double> ball_mm, offsets_um;
+  std::vector<std::string> setups{"radial", "tangential", "axial"};
+  std::map<std::string, std::vector<double>> angles_deg{
+      {"C", {0, 30, 60, 90, 120, 150, 180, 210, 240, 270, 300, 330}},
+      {"A", {-90, -75, -60, -45, -30, -15, 0, 15, 30, 45, 60, 75, 90}},
+      {"B", {-90, -75, -60, -45, -30, -15, 0, 15, 30, 45, 60, 75, 90}}};
+  double length_mm = 100.0, noise_um = 0.5;
+  unsigned seed = 1;
+  bool json = false;
+};
+
+// The tests of the run: each table axis of the control in each set-up, in the model's order
+// (the trunnion's: C, then A).
+std::vector<kin::RotaryBallbarTest> run_tests(const kin::FiveAxisMachine& control,
+                                              const RunOptions5x& o) {
+  std::vector<kin::RotaryBallbarTest> out;
+  for (const auto& r : control.rotary) {
+    if (r.side != kin::Side::table) continue;
+    const std::string letter(kin::to_string(r.letter));
+    for (const auto& setup : o.setups) {
+      kin::RotaryBallbarTest t;
+      t.axis = r.letter;
+      t.setup = kin::bar_setup_from_string(setup);
+      t.name = fmt::format("{}-{}", letter, setup);
+      t.table_ball_mm = {o.ball_mm.at(0), o.ball_mm.at(1), o.ball_mm.at(2)};
+      t.length_mm = o.length_mm;
+      t.angles_deg = o.angles_deg.at(letter);
+      (void)kin::bar_direction(control, t);  // refused here, naming the test, when unusable
+      out.push_back(std::move(t));
+    }
+  }
+  if (out.empty())
+    throw cal::InputError(fmt::format(
+        "{}: no rotary table axis: the five-axis ballbar tests here are of table axes", o.control));
+  return out;
+}
+
+void print_run_result(const json& doc, std::int64_t run_id, bool corrected) {
+  fmt::print("run {}: five-axis ballbar, location errors{}\n", run_id,
+             corrected ? " (left: the fitted less the control's own)" : "");
+  for (const auto& a : doc["axes"]) {
+    fmt::print(
+        "Axis {}: {} tests, residual RMS {:.3f} um, sigma {:.3f} um, {} degrees of freedom\n",
+        a["axis"].get<std::string>(), a["tests"].size(), a["rms_um"].get<double>(),
+        a["sigma_um"].get<double>(), a["dof"].get<int>());
+    for (const auto& name : a["names"]) {
+      const auto& v = a["location"][name.get<std::string>()];
+      fmt::print("  {:6} {:+10.3f} {:4}  u = {:.3f}{}\n", name.get<std::string>(),
+                 v["value"].get<double>(), v["unit"].get<std::string>(),
+                 v["uncertainty"].get<double>(),
+                 corrected ? fmt::format("  left {:+.3f}", v["left"].get<double>()) : "");
+    }
+    for (const auto& t : a["tests"])
+      fmt::print("  test {} ({} stops): bar offset {:+.3f} um\n", t["test"].get<std::string>(),
+                 t["stops"].size(), t["offset_um"].get<double>());
+  }
+}
+
+void run_run(const RunOptions5x& o) {
+  const auto truth = mdl::five_axis(mdl::read(o.truth));
+  mdl::Model nominal = mdl::read(o.control);
+  const kin::FiveAxisMachine control = control_machine(nominal, o.control, o.hal, o.swivel);
+  const bool corrected = !o.hal.empty() || !o.swivel.empty() || [&] {
+    for (const auto& r : control.rotary)
+      for (std::size_t i = 0; i < 3; ++i)
+        if (r.location_position_um.at(i) != 0.0 || r.location_orientation_urad.at(i) != 0.0)
+          return true;
+    return false;
+  }();
+  RotaryBallbarRunSetup setup;
+  setup.config.machine_name = fmt::format("SIMULATED five-axis ({})", o.truth);
+  setup.config.machine_description =
+      "built-in simulated five-axis machine with injected location errors (daq model "
+      "ballbar5x-run)";
+  setup.config.campaign = "five-axis ballbar (simulated)";
+  setup.control = control;
+  setup.tests = run_tests(control, o);
+  setup.database = database_path(o.db);
+  const std::string database = setup.database.string();
+  setup.extra_settings_json =
+      json{{"simulated", true}, {"truth_model", o.truth},    {"control_model", o.control},
+           {"hal", o.hal},      {"swivel", o.swivel},        {"noise_um", o.noise_um},
+           {"seed", o.seed},    {"offsets_um", o.offsets_um}}
+          .dump();
+  std::FILE* log = o.json ? stderr : stdout;
+  setup.on_event = [log](const std::string& e) { fmt::print(log, "{}\n", e); };
+  fmt::print(log,
+             "SIMULATED five-axis ballbar: {} running the control's program ({}{}), {} tests, "
+             "{:g} um of noise per sample\n",
+             o.truth, o.control,
+             o.hal.empty() ? o.swivel.empty() ? "" : " with " + o.swivel : " with " + o.hal,
+             setup.tests.size(), o.noise_um);
+  const auto out = run_simulated_ballbar5x(
+      {.truth = truth, .noise_um = o.noise_um, .offset_um = o.offsets_um, .seed = o.seed},
+      std::move(setup));
+  const json doc = json::parse(out.result_json);
+  if (o.json)
+    fmt::print("{}\n",
+               json{{"run_id", out.run_id}, {"readings", out.readings}, {"result", doc}}.dump(2));
+  else
+    print_run_result(doc, out.run_id, corrected);
+  if (o.write.empty()) return;
+  if (corrected)
+    throw cal::InputError(
+        "--write against a corrected control: the fit is what the correction left; write the "
+        "model from a run against the nominal kinematics");
+  const auto fitted = fitted_locations(doc);
+  for (auto& r : nominal.rotary) {
+    const auto names = kin::location_error_names(r.axis.letter);
+    std::array<const FittedLocation*, 4> found{};
+    for (std::size_t k = 0; k < 4; ++k)
+      for (const auto& f : fitted)
+        if (f.name == names[k]) found.at(k) = &f;
+    if (!found[0]) continue;  // an axis the run did not measure (a head axis)
+    std::array<double, 4> value{};
+    for (std::size_t k = 0; k < 4; ++k) value.at(k) = found.at(k)->value;
+    kin::FiveAxisMachine one;
+    one.rotary = {r.axis};
+    r.axis = kin::with_location_errors(one, r.axis.letter, value).rotary.front();
+    for (std::size_t k = 0; k < 4; ++k) {
+      r.location[k].given = true;
+      r.location[k].uncertainty = found.at(k)->uncertainty;
+      r.location[k].source = {json{
+          {"kind", "ballbar, rotary axis"},
+          {"run", out.run_id},
+          {"database", database}}.dump()};
+    }
+  }
+  mdl::write(nominal, o.write);
+  fmt::print(stderr, "model with the fitted location errors written to {}\n", o.write);
+}
 }  // namespace
 
 void add_model_ballbar5x_commands(CLI::App& model) {
@@ -352,15 +498,56 @@ void add_model_ballbar5x_commands(CLI::App& model) {
                   "source) to this file");
   fit->add_flag("--json", f->json, "Print caldaq.rotary-ballbar-fit.v1 JSON");
 
+  const auto [run, r] = add_command<RunOptions5x>(
+      model, "ballbar5x-run", run_run,
+      "SIMULATED five-axis ballbar run: the simulated machine (its truth) runs the control's "
+      "five-axis ballbar program for each table axis and set-up while the bar's gauge twin "
+      "streams; the gauge driver reads the stream, the run stores it (kind ballbar5x, see daq "
+      "runs / daq show) and fits each axis's location errors with their uncertainty");
+  add_machine_options(*run, r->truth, r->control);
+  run->add_option("--hal", r->hal,
+                  "The control holds these LinuxCNC trunnion pins (daq model kinematics) over "
+                  "--control's rotary lines");
+  run->add_option("--swivel", r->swivel,
+                  "The control holds this SINUMERIK CYCLE800 swivel data record over --control's "
+                  "rotary lines");
+  add_db_option(*run, r->db);
+  run->add_option("--ball-mm", r->ball_mm,
+                  "The table ball's centre on the workpiece X Y Z (home coordinates)")
+      ->required()
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
+  run->add_option("--length-mm", r->length_mm, "The bar's nominal length")
+      ->check(finite_in(1.0, 2000.0))
+      ->capture_default_str();
+  run->add_option("--setups", r->setups, "The set-ups of the bar, each a test of each table axis")
+      ->check(CLI::IsMember({"radial", "tangential", "axial"}))
+      ->capture_default_str();
+  for (const char* letter : {"C", "A", "B"})
+    run->add_option(fmt::format("--{}-angles-deg", char(std::tolower(letter[0]))),
+                    r->angles_deg[letter],
+                    fmt::format("The angles at which the {} axis's tests read the bar", letter))
+        ->check(finite_in(-3600.0, 3600.0))
+        ->capture_default_str();
+  run->add_option("--offsets-um", r->offsets_um,
+                  "Each test's bar zero (the bar's length calibration and the set-up), in the "
+                  "order of the tests")
+      ->check(finite_in(-1e3, 1e3));
+  run->add_option("--noise-um", r->noise_um, "Gaussian noise of each bar sample (100 Hz)")
+      ->check(finite_in(0.0, 100.0))
+      ->capture_default_str();
+  run->add_option("--seed", r->seed, "Seed of the noise")->capture_default_str();
+  run->add_option("--write", r->write,
+                  "Write the control's model with the fitted location errors (a run against the "
+                  "nominal kinematics only)");
+  run->add_flag("--json", r->json, "Print the run id and its result (caldaq.ballbar5x.v1)");
+
   const auto [sim, s] = add_command<SimOptions>(
       model, "ballbar5x-sim", run_sim,
       "Simulated ballbar on a rotary table axis: the readings a model (the simulated machine's "
       "truth) gives when it runs the program the control's model computed, as a CSV for daq "
       "model ballbar5x");
-  sim->add_option("truth", s->truth, "Model file of the simulated machine (its truth)")->required();
-  sim->add_option("--control", s->control,
-                  "Model file the control's kinematics holds (the program is computed with it)")
-      ->required();
+  add_machine_options(*sim, s->truth, s->control);
   add_test_options(sim, s->t);
   sim->add_option("--offset-um", s->offset_um,
                   "A constant added to every reading (the bar's zero and the balls' set-up)")

@@ -25,6 +25,7 @@
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
 #include "output_file.hpp"
+#include "probe_cli.hpp"
 
 namespace daq {
 
@@ -32,13 +33,10 @@ namespace {
 
 // --- probe: the fit ---------------------------------------------------------------------------
 
-struct ProbeOptions {
-  std::string centres, model, write, axis;
+struct ProbeOptions : ProbeFitOptions {
+  std::string axis;
   std::string hal, swivel;  // the control's correction: the fit is against its lines
   std::vector<double> pivot_mm;
-  double probe_u_um = 0.0;
-  bool json = false;
-  bool keep_linear = false;
 };
 
 struct AxisCentres {
@@ -257,29 +255,6 @@ std::string read_text(const std::string& path, std::string_view what) {
   return ss.str();
 }
 
-// The control's kinematics: the model's machine, or with a correction file (LinuxCNC trunnion
-// pins from --hal, a SINUMERIK swivel data record from --swivel) the nominal model with its
-// rotary axes on that file's lines (trt_control_machine, swivel_control_machine). Shared by
-// probe-check (the centres against it) and probe (the lines fitted against it).
-kin::FiveAxisMachine control_machine(const mdl::Model& m, const std::string& model,
-                                     const std::string& hal, const std::string& swivel) {
-  kin::FiveAxisMachine control = mdl::five_axis(m);
-  if (!hal.empty() && !swivel.empty())
-    throw cal::InputError("--hal and --swivel: give one control's kinematics");
-  const std::string& correction = hal.empty() ? swivel : hal;
-  try {
-    if (!hal.empty())
-      control = kin::trt_control_machine(
-          kin::parse_linuxcnc_trt_hal(read_text(hal, "HAL file"), hal), control);
-    if (!swivel.empty())
-      control = kin::swivel_control_machine(
-          kin::parse_sinumerik_swivel_program(read_text(swivel, "swivel data"), swivel), control);
-  } catch (const cal::InputError& e) {
-    throw cal::InputError(fmt::format("{} with {}: {}", correction, model, e.what()));
-  }
-  return control;
-}
-
 // The fit made against the control's line instead of the nominal one: the location errors the
 // correction left (the actual line less the control's). The fit is made at the control's pivot,
 // so the positions are already relative to its line's point; the control's tilts (a swivel
@@ -470,11 +445,9 @@ void run_probe_check(const CheckOptions& o) {
 
 // --- probe-sim: the simulated touch probe ----------------------------------------------------
 
-struct SimOptions {
-  std::string truth, control, axis, output;
-  std::vector<double> sphere_mm, angles_deg;
-  double noise_um = 0.0;
-  unsigned seed = 1;
+struct SimOptions : ProbeSimOptions {
+  std::string axis;
+  std::vector<double> angles_deg;
 };
 
 void run_probe_sim(const SimOptions& o) {
@@ -521,6 +494,53 @@ void run_probe_sim(const SimOptions& o) {
 
 }  // namespace
 
+// model_control.hpp. Shared by probe-check (the centres against it), probe (the lines fitted
+// against it) and ballbar5x-run (the simulated control's program).
+kin::FiveAxisMachine control_machine(const mdl::Model& m, const std::string& model,
+                                     const std::string& hal, const std::string& swivel) {
+  kin::FiveAxisMachine control = mdl::five_axis(m);
+  if (!hal.empty() && !swivel.empty())
+    throw cal::InputError("--hal and --swivel: give one control's kinematics");
+  const std::string& correction = hal.empty() ? swivel : hal;
+  try {
+    if (!hal.empty())
+      control = kin::trt_control_machine(
+          kin::parse_linuxcnc_trt_hal(read_text(hal, "HAL file"), hal), control);
+    if (!swivel.empty())
+      control = kin::swivel_control_machine(
+          kin::parse_sinumerik_swivel_program(read_text(swivel, "swivel data"), swivel), control);
+  } catch (const cal::InputError& e) {
+    throw cal::InputError(fmt::format("{} with {}: {}", correction, model, e.what()));
+  }
+  return control;
+}
+
+void add_probe_fit_options(CLI::App& cmd, ProbeFitOptions& o, const ProbeFitHelp& help) {
+  cmd.add_option("centres", o.centres, help.centres)->required();
+  auto* model = cmd.add_option("--model", o.model, help.model);
+  if (help.model_required) model->required();
+  cmd.add_option("--probe-u-um", o.probe_u_um, help.probe_u)->check(finite_in(0.0, 1e4));
+  cmd.add_option("--write", o.write,
+                 "Write the model with the fitted location errors (and their uncertainty and "
+                 "source) to this file");
+  cmd.add_flag("--keep-linear-errors", o.keep_linear, help.keep_linear);
+  cmd.add_flag("--json", o.json, help.json);
+}
+
+void add_probe_sim_options(CLI::App& cmd, ProbeSimOptions& o, const std::string& control_help) {
+  cmd.add_option("truth", o.truth, "Model file of the simulated machine (its truth)")->required();
+  cmd.add_option("--control", o.control, control_help);
+  cmd.add_option("--sphere-mm", o.sphere_mm, "Sphere centre on the workpiece X Y Z (home)")
+      ->required()
+      ->expected(3)
+      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
+  cmd.add_option("--noise-um", o.noise_um,
+                 "Gaussian noise per coordinate of each centre, standard deviation")
+      ->check(finite_in(0.0, 1e4));
+  cmd.add_option("--seed", o.seed, "Seed of the noise")->capture_default_str();
+  cmd.add_option("-o,--output", o.output, "Write the CSV here (default: standard output)");
+}
+
 void put_location_fit(mdl::RotaryEntry& r, const kin::AxisLineFit& f, const json& source) {
   const std::size_t own = kin::direction_index(f.letter);
   std::size_t n = 0;
@@ -543,14 +563,17 @@ void add_model_probe_commands(CLI::App& model) {
       "Fit each rotary axis's average line (table or head) to probed sphere centres (a CSV: "
       "axis, angle_deg, x_mm, y_mm, z_mm): its location errors with their uncertainty and the "
       "residuals");
-  probe
-      ->add_option("centres", p->centres,
-                   "CSV of probed centres in machine coordinates: angle_deg, x_mm, y_mm, z_mm, "
-                   "and axis (A, B or C) unless --axis is given")
-      ->required();
-  probe->add_option("--model", p->model,
-                    "Model file (caldaq.model.v2) giving each rotary axis's nominal pivot; for a "
-                    "head axis also the control's kinematics that computed the centres");
+  add_probe_fit_options(
+      *probe, *p,
+      {.centres = "CSV of probed centres in machine coordinates: angle_deg, x_mm, y_mm, z_mm, "
+                  "and axis (A, B or C) unless --axis is given",
+       .model = "Model file (caldaq.model.v2) giving each rotary axis's nominal pivot; for a head "
+                "axis also the control's kinematics that computed the centres",
+       .probe_u = "Standard uncertainty of one probed centre per coordinate (0: from the "
+                  "residuals, needs 4 or more angles)",
+       .keep_linear = "Fit the centres as probed, even when --model holds linear-axis errors (by "
+                      "default those are removed from each centre first)",
+       .json = "Print caldaq.axis-line-fit.v1 JSON"});
   probe
       ->add_option("--axis", p->axis,
                    "The rotary axis of every centre (the file has no axis column)")
@@ -558,24 +581,12 @@ void add_model_probe_commands(CLI::App& model) {
   probe->add_option("--pivot-mm", p->pivot_mm, "Nominal pivot X Y Z (with --axis, no --model)")
       ->expected(3)
       ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
-  probe
-      ->add_option("--probe-u-um", p->probe_u_um,
-                   "Standard uncertainty of one probed centre per coordinate (0: from the "
-                   "residuals, needs 4 or more angles)")
-      ->check(finite_in(0.0, 1e4));
-  probe->add_option("--write", p->write,
-                    "Write the model with the fitted location errors (and their uncertainty and "
-                    "source) to this file");
-  probe->add_flag("--keep-linear-errors", p->keep_linear,
-                  "Fit the centres as probed, even when --model holds linear-axis errors "
-                  "(by default those are removed from each centre first)");
   probe->add_option("--hal", p->hal,
                     "Fit against the control holding these LinuxCNC trunnion pins (--model the "
                     "nominal machine): the location errors the correction left");
   probe->add_option("--swivel", p->swivel,
                     "Fit against the control holding this SINUMERIK CYCLE800 swivel data record "
                     "(--model the nominal machine): the location errors the correction left");
-  probe->add_flag("--json", p->json, "Print caldaq.axis-line-fit.v1 JSON");
 
   const auto [check, c] = add_command<CheckOptions>(
       model, "probe-check", run_probe_check,
@@ -602,26 +613,16 @@ void add_model_probe_commands(CLI::App& model) {
       "Simulated touch probe: the sphere centres a model (the simulated machine's truth) reports "
       "at the given angles of one rotary axis (table or head), the other at 0, as a CSV for daq "
       "model probe");
-  sim->add_option("truth", s->truth, "Model file of the simulated machine (its truth)")->required();
-  sim->add_option("--control", s->control,
-                  "Model file of the control's kinematics that reports the centres (a head "
-                  "axis's centres are where it puts the turned probe tip; default: the truth's "
-                  "nominal kinematics)");
+  add_probe_sim_options(*sim, *s,
+                        "Model file of the control's kinematics that reports the centres (a head "
+                        "axis's centres are where it puts the turned probe tip; default: the "
+                        "truth's nominal kinematics)");
   sim->add_option("--axis", s->axis, "The rotary axis turned (table or head)")
       ->required()
       ->check(CLI::IsMember({"A", "B", "C", "a", "b", "c"}));
-  sim->add_option("--sphere-mm", s->sphere_mm, "Sphere centre on the workpiece X Y Z (home)")
-      ->required()
-      ->expected(3)
-      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
   sim->add_option("--angles-deg", s->angles_deg, "Angles of the axis at which to probe")
       ->required()
       ->check(finite_in(-3600.0, 3600.0));
-  sim->add_option("--noise-um", s->noise_um,
-                  "Gaussian noise per coordinate of each centre, standard deviation")
-      ->check(finite_in(0.0, 1e4));
-  sim->add_option("--seed", s->seed, "Seed of the noise")->capture_default_str();
-  sim->add_option("-o,--output", s->output, "Write the CSV here (default: standard output)");
 }
 
 }  // namespace daq

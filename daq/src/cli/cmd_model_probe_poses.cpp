@@ -18,17 +18,13 @@
 #include "csv_columns.hpp"
 #include "model_cli.hpp"
 #include "output_file.hpp"
+#include "probe_cli.hpp"
 
 namespace daq {
 
 namespace {
 
-struct PosesOptions {
-  std::string centres, model, write;
-  double probe_u_um = 0.0;
-  bool json = false;
-  bool keep_linear = false;
-};
+struct PosesOptions : ProbeFitOptions {};
 
 struct Poses {
   std::vector<kin::ProbedPose> poses;
@@ -194,11 +190,8 @@ void run_poses(const PosesOptions& o) {
   }
 }
 
-struct PosesSimOptions {
-  std::string truth, control, poses, output;
-  std::vector<double> sphere_mm;
-  double noise_um = 0.0;
-  unsigned seed = 1;
+struct PosesSimOptions : ProbeSimOptions {
+  std::string poses;
 };
 
 void run_poses_sim(const PosesSimOptions& o) {
@@ -243,46 +236,29 @@ void add_model_probe_poses_command(CLI::App& model) {
       "Fit the location errors of every rotary axis that turns in a probing program together "
       "(poses that turn several axes at once): a CSV of c_deg, a_deg, ... (one per rotary axis "
       "of the model), x_mm, y_mm, z_mm");
-  fit->add_option("centres", p->centres,
-                  "CSV of probed poses: the angle of each rotary axis (c_deg, a_deg, ...) and the "
-                  "centre as the control reports it (x_mm, y_mm, z_mm, machine coordinates)")
-      ->required();
-  fit->add_option("--model", p->model,
-                  "Model file (caldaq.model.v2): the nominal pivots, and the control's kinematics "
-                  "that computed the centres")
-      ->required();
-  fit->add_option("--probe-u-um", p->probe_u_um,
-                  "Standard uncertainty of one probed centre per coordinate (0: from the "
-                  "residuals)")
-      ->check(finite_in(0.0, 1e4));
-  fit->add_option("--write", p->write,
-                  "Write the model with the fitted location errors (and their uncertainty and "
-                  "source) to this file");
-  fit->add_flag("--keep-linear-errors", p->keep_linear,
-                "Fit as if the linear axes were perfect, even when --model holds their errors "
-                "(by default they are part of the fitted machine)");
-  fit->add_flag("--json", p->json, "Print caldaq.location-fit.v1 JSON");
+  add_probe_fit_options(
+      *fit, *p,
+      {.centres = "CSV of probed poses: the angle of each rotary axis (c_deg, a_deg, ...) and the "
+                  "centre as the control reports it (x_mm, y_mm, z_mm, machine coordinates)",
+       .model = "Model file (caldaq.model.v2): the nominal pivots, and the control's kinematics "
+                "that computed the centres",
+       .probe_u = "Standard uncertainty of one probed centre per coordinate (0: from the "
+                  "residuals)",
+       .keep_linear = "Fit as if the linear axes were perfect, even when --model holds their "
+                      "errors (by default they are part of the fitted machine)",
+       .json = "Print caldaq.location-fit.v1 JSON",
+       .model_required = true});
 
   const auto [sim, s] = add_command<PosesSimOptions>(
       model, "probe-poses-sim", run_poses_sim,
       "Simulated touch probe at poses that turn several rotary axes: the centres a model (the "
       "simulated machine's truth) reports, as a CSV for daq model probe-poses");
-  sim->add_option("truth", s->truth, "Model file of the simulated machine (its truth)")->required();
+  add_probe_sim_options(*sim, *s,
+                        "Model file of the control's kinematics that reports the centres "
+                        "(default: the truth's nominal kinematics)");
   sim->add_option("--poses", s->poses,
                   "CSV of the poses: one column per rotary axis of the model (c_deg, a_deg, ...)")
       ->required();
-  sim->add_option("--control", s->control,
-                  "Model file of the control's kinematics that reports the centres (default: the "
-                  "truth's nominal kinematics)");
-  sim->add_option("--sphere-mm", s->sphere_mm, "Sphere centre on the workpiece X Y Z (home)")
-      ->required()
-      ->expected(3)
-      ->check(finite_in(-kMaxPositionMm, kMaxPositionMm));
-  sim->add_option("--noise-um", s->noise_um,
-                  "Gaussian noise per coordinate of each centre, standard deviation")
-      ->check(finite_in(0.0, 1e4));
-  sim->add_option("--seed", s->seed, "Seed of the noise")->capture_default_str();
-  sim->add_option("-o,--output", s->output, "Write the CSV here (default: standard output)");
 }
 
 }  // namespace daq

@@ -153,6 +153,48 @@ void print_rotary_doc(const json& doc, std::string_view in) {
   print_rows_and_warnings(rotary_rows(doc), "arcsec", doc, in);
 }
 
+namespace {
+
+bool is_ballbar5x_schema(std::string_view schema) { return schema == "caldaq.ballbar5x.v1"; }
+
+// A five-axis ballbar run's location errors (caldaq.ballbar5x.v1, runner/ballbar5x_run.hpp):
+// each axis's four, in um and urad, with their standard uncertainty in the description.
+std::vector<ResultRow> ballbar5x_rows(const json& doc) {
+  std::vector<ResultRow> rows;
+  for (const auto& a : doc.value("axes", json::array())) {
+    const json loc = a.value("location", json::object());
+    for (const auto& n : a.value("names", json::array())) {  // ISO 230-1's order
+      const std::string name = n.is_string() ? n.get<std::string>() : std::string();
+      if (!loc.contains(name)) continue;
+      const json& v = loc[name];
+      rows.push_back(
+          {name, name,
+           fmt::format("location error of the {} axis, u = {} (k = 1); left against "
+                       "the control's: {}",
+                       safe(text_of(a, "axis")), number_text(number_of(v, "uncertainty"), 3),
+                       signed_number_text(number_of(v, "left"), 3)),
+           number_of(v, "value"), text_of(v, "unit")});
+    }
+  }
+  return rows;
+}
+
+void print_ballbar5x_doc(const json& doc, std::string_view in) {
+  fmt::print(
+      "{}five-axis ballbar: the rotary axes' location errors (fitted to the bar's mean "
+      "reading at each stop)\n",
+      in);
+  for (const auto& a : doc.value("axes", json::array()))
+    fmt::print("{}axis {}: {} tests, residual RMS {} um, sigma {} um\n", in,
+               safe(text_of(a, "axis")), a.value("tests", json::array()).size(),
+               number_text(number_of(a, "rms_um"), 3), number_text(number_of(a, "sigma_um"), 3));
+  for (const auto& r : ballbar5x_rows(doc))
+    fmt::print("{}  {:<8} {:>10} {:<4}  {}\n", in, safe(r.symbol), signed_number_text(r.value, 3),
+               safe(r.unit), r.description);
+}
+
+}  // namespace
+
 std::string number_text(double value, int decimals) {
   const double scale = std::pow(10.0, decimals);
   if (!(std::round(std::abs(value) * scale) > 0)) value = 0.0;  // also NaN's sign
@@ -276,6 +318,7 @@ std::vector<ResultRow> profile_rows(const json& doc) {
 std::vector<ResultRow> result_rows(const json& doc) {
   if (is_profile_schema(doc.value("schema", ""))) return profile_rows(doc);
   if (is_rotary_schema(doc.value("schema", ""))) return rotary_rows(doc);
+  if (is_ballbar5x_schema(doc.value("schema", ""))) return ballbar5x_rows(doc);
   if (!is_circle_schema(doc.value("schema", ""))) return linear_rows(doc);
   auto rows = circle_rows(doc);
   for (auto& d : diagnostic_rows(doc)) rows.push_back(std::move(d));
@@ -298,6 +341,8 @@ void print_result(const json& doc, std::string_view indent) {
     print_profile_doc(doc, indent);
   else if (is_rotary_schema(doc.value("schema", "")))
     print_rotary_doc(doc, indent);
+  else if (is_ballbar5x_schema(doc.value("schema", "")))
+    print_ballbar5x_doc(doc, indent);
   else if (is_circle_schema(doc.value("schema", "")))
     print_circle_doc(doc, indent);
   else
