@@ -102,7 +102,19 @@ class ExportRows {
     // Readings come in time order: the groups are complete when a later time arrives.
     if (held_ != 0 && r.time_ns != current_) flush_each(emit);
     current_ = r.time_ns;
+    // A second reading of this time: the one held apart goes into its stream's group first
+    // (last_ is still its entry: find_stream may insert before it).
+    if (held_ == 1) {
+      pending_[last_].group.push_back(one_);
+      pending_[last_].tags.push_back(one_tag_);
+    }
     if (last_ >= pending_.size() || pending_[last_].key != key_of(r)) find_stream(r);
+    if (held_ == 0) {  // most readings: held apart, no vector pushed and cleared for it
+      one_ = r;
+      one_tag_ = tag;
+      held_ = 1;
+      return;
+    }
     pending_[last_].group.push_back(r);
     pending_[last_].tags.push_back(tag);
     ++held_;
@@ -132,13 +144,10 @@ class ExportRows {
   void find_stream(const cal::storage::RawReading& r);
   template <class Emit>
   void flush_each(Emit& emit) {
-    if (held_ == 1) {  // the usual case, a reading per stored time: it is the last one added
-      auto& e = pending_[last_];
-      emit(
-          ExportRow{e.group[0], ExportClock::spread_one(*e.stream, e.group[0].time_ns), e.tags[0]});
-      e.group.clear();
-      e.tags.clear();
+    if (held_ == 1) {  // the usual case, a reading per stored time: held apart in one_
       held_ = 0;
+      emit(ExportRow{one_, ExportClock::spread_one(*pending_[last_].stream, one_.time_ns),
+                     one_tag_});
       return;
     }
     held_ = 0;
@@ -159,7 +168,9 @@ class ExportRows {
   ExportClock& clock_;
   std::vector<Pending> pending_;  // one per stream seen, by key (a handful: found by a scan)
   std::size_t last_ = 0;          // the entry of the last reading (most follow their stream)
-  std::size_t held_ = 0;          // readings in the groups (1: only the last one, at last_)
+  std::size_t held_ = 0;          // readings held (1: only one_, of the stream at last_)
+  cal::storage::RawReading one_;  // the only reading of the current time, while held_ is 1
+  std::uint64_t one_tag_ = 0;
   std::vector<double> times_;
   std::int64_t current_ = 0;
 };

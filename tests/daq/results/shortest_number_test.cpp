@@ -10,9 +10,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace {
@@ -171,6 +173,52 @@ TEST(ShortestNumber, ScaledTimesAsFmtWritesThem) {
   EXPECT_GT(checked, 6'000'000U);
 }
 
+// The nanoseconds' own way (k = 9): the edges of its conditions, each against fmt and strtod.
+// fmt's fixed notation starts at 1e-4 s (10^5 ns; 99,999 ns is 9.9999e-05); a whole second
+// has no point; a fraction whose only nonzero decimal is the first has one (its other eight
+// digits are the word the trailing zeros are counted in); 2^51 / 10^d is where a decimal with
+// d decimals stops being the only one that close to v.
+TEST(ShortestNumber, ScaledNanosecondsAtTheEdgesOfTheirOwnWay) {
+  std::vector<std::int64_t> ns = {1,
+                                  99'999,
+                                  100'000,
+                                  100'001,
+                                  999'999'999,
+                                  1'000'000'000,
+                                  1'000'000'001,
+                                  1'500'000'000,
+                                  1'050'000'000,
+                                  1'000'000'010,
+                                  600'000'000'000,
+                                  (std::int64_t{1} << 53) - 1,
+                                  std::int64_t{1} << 53};
+  for (int d = 0; d <= 9; ++d) {  // about 2^51 / 10^d seconds, a decimal of d decimals
+    const double limit_s = std::ldexp(1.0, 51) / std::pow(10.0, d);
+    const auto at = static_cast<std::int64_t>(limit_s) * 1'000'000'000;
+    for (std::int64_t step : {std::int64_t{-1}, std::int64_t{0}, std::int64_t{1}})
+      for (std::int64_t fraction : {std::int64_t{0}, std::int64_t{100'000'000}, std::int64_t{1}})
+        if (at + step * 1'000'000'000 + fraction < (std::int64_t{1} << 53))
+          ns.push_back(at + step * 1'000'000'000 + fraction);
+  }
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 200'000; ++i)  // every count of trailing zeros in the fraction
+    ns.push_back(static_cast<std::int64_t>(rng() % 100'000'000'000'000ULL) /
+                 static_cast<std::int64_t>(std::pow(10.0, rng() % 10)) *
+                 static_cast<std::int64_t>(std::pow(10.0, rng() % 10)));
+  for (const auto n : ns) {
+    for (const double v : {static_cast<double>(n) * 1e-9, static_cast<double>(n) / 1e9}) {
+      ASSERT_EQ(scaled_difference(v, n, 9), "") << n;
+      ASSERT_EQ(scaled_difference(std::nextafter(v, 0.0), n, 9), "") << n;
+      ASSERT_EQ(scaled_difference(std::nextafter(v, 1e300), n, 9), "") << n;
+    }
+  }
+  char buf[64];
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 1.5, 1'500'000'000, 9)), "1.5");
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 1e-4, 100'000, 9)), "0.0001");
+  EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 1.000000001, 1'000'000'001, 9)),
+            "1.000000001");
+}
+
 // Values whose shortest form is known by hand: times on a 100 us grid, a whole number, a guess
 // with its decimal point outside the fast path (k < 0).
 TEST(ShortestNumber, ScaledTimesOfAFineGridAreTheirDecimals) {
@@ -181,6 +229,34 @@ TEST(ShortestNumber, ScaledTimesOfAFineGridAreTheirDecimals) {
   EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 600.0, 600'000'000'000, 9)), "600");
   EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 1e15, 1, -15)), "1000000000000000");
 }
+
+#if defined(__SSE2__)
+// write16 (both halves of 8 digits in one SSE2 register) against write8 on each half (the
+// scalar way, itself checked against fmt above): every seventh low half with a high half
+// running the other way, random values, and the edges of its divisions (10^4, 10^8 and their
+// neighbours, 9...9).
+TEST(ShortestNumber, SixteenDigitsAtOnceAsEightAndEight) {
+  const auto difference = [](std::uint64_t v) -> std::string {
+    char got[16], want[16];
+    daq::shortest_detail::write16(got, v);
+    daq::shortest_detail::write8(want, static_cast<std::uint32_t>(v / 100'000'000));
+    daq::shortest_detail::write8(want + 8, static_cast<std::uint32_t>(v % 100'000'000));
+    if (std::memcmp(got, want, 16) == 0) return {};
+    return fmt::format("{}: \"{}\" for \"{}\"", v, std::string_view(got, 16),
+                       std::string_view(want, 16));
+  };
+  for (std::uint64_t low = 0; low < 100'000'000; low += 7)
+    ASSERT_EQ(difference((99'999'999 - low) * 100'000'000 + low), "");
+  std::mt19937_64 rng(17);
+  for (int i = 0; i < 1'000'000; ++i) ASSERT_EQ(difference(rng() % 10'000'000'000'000'000ULL), "");
+  for (std::uint64_t v : {0ULL, 9'999ULL, 10'000ULL, 10'001ULL, 99'999'999ULL, 100'000'000ULL,
+                          100'000'001ULL, 999'999'999'999ULL, 9'999'999'999'999'999ULL})
+    EXPECT_EQ(difference(v), "");
+  char buf[16];
+  daq::shortest_detail::write16(buf, 1'234'567'890'123'456ULL);
+  EXPECT_EQ(std::string_view(buf, 16), "1234567890123456");
+}
+#endif
 
 TEST(ShortestNumber, IntegersAsFmtWritesThem) {
   std::vector<std::int64_t> values = {0,
