@@ -548,7 +548,28 @@ check("comparison: the table on page one", all(w in text["comparison"][0] for w 
     "run date E (µm)", "R (µm)", "A (µm)", "B (µm)", "B̄ (µm)", "verdict air")) and re.search(
     r"[0-9.]+ ✓ [0-9.]+ ✓ [0-9.]+ ✓ [0-9.]+ ✓ [0-9.]+ ✗ -?[0-9.]+ FAIL [0-9.]+ [0-9.]+",
     text["comparison"][0]) is not None, text["comparison"][0])
+# Page one says in words why a comparison fails: which value of which run, against which limit
+# (it said so only by the table's ✗). The demo's runs 1 and 3 both fail B (4 µm of backlash
+# injected, limit 3 µm); the circle's backlash X (limit 3 µm) with what to check.
+c1 = text["comparison"][0]
+check("comparison: page one says which value of which run fails, against which limit",
+      re.search(r"The newest run, run 3 \([0-9-]+ [0-9:]+\): FAIL — B = 4\.0[0-9]{2} µm \(limit ≤ "
+                r"3\.000 µm\)\. Earlier runs outside their specification: 1 of 1 — run 1 \([0-9-]+ "
+                r"[0-9:]+\): B = 4\.0[0-9]{2} µm \(limit ≤ 3\.000 µm\)\.", c1) is not None, c1[:1200])
+check("circle comparison: the failing backlash X in words, with what to check",
+      re.search(r"The newest run, run 2 \([^)]*\): FAIL — Backlash X = \+4\.0[0-9]{2} µm \(limit ≤ "
+                r"3\.000 µm\): check the X axis' backlash compensation",
+                text["comparison-circle"][0]) is not None, text["comparison-circle"][0][:1200])
 a1 = text["asfound"][0]
+# Page one keeps room: the table of the values a specification limits (the unidirectional six
+# are in each run's report), so a second warning above does not push its verdict row off it.
+check("as found / as left: the bidirectional values only, the verdict row on page one",
+      "E↑" not in a1 and "B̄ (µm)" in a1 and re.search(r"verdict (-?[0-9.]+ )?FAIL", a1)
+      is not None, a1)
+import report_checks  # noqa: E402  (its page_fill: page_fill above is this file's own)
+af_fill = report_checks.page_fill(*pdf_words("asfound.pdf")[0])
+check("as found / as left: page one not full to its last line (< 95 %)", af_fill < 0.95,
+      f"{af_fill:.2f}")
 check("as found / as left: table and verdicts on page one",
       "as found, run 1" in a1 and "as left, run 3" in a1 and "verdict" in a1, a1)
 # Each value with its unit: a circle's table mixed µm, µm/m and ms under a head without any, and

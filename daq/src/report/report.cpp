@@ -983,6 +983,26 @@ std::string tolerance_hint(const RunView& v, std::string_view keys) {
                     : "");
 }
 
+// A value outside its limit, as the tables print it: "B = 4.023 µm (limit ≤ 3.000 µm)". A
+// diagnostic (an error with a direction, what to check) with its sign, a deviation or span (E,
+// B, U max, G) without ("U max = +4.023" read as the table's 4.023 with a sign the value does
+// not have). `strong`: the symbol in bold (a list's item; inside a bold verdict line, plain).
+std::string failing_value(const ::daq::Check& c, bool strong) {
+  const std::string symbol = strong ? "<strong>" + esc(c.symbol) + "</strong>" : esc(c.symbol);
+  return fmt::format("{} = {} {} (limit ≤ {} {})", symbol,
+                     ::daq::diagnostic_advice(c.key).empty() ? um(c.value)
+                                                             : signed_text(c.value, 3),
+                     esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+}
+
+// The failing values of a verdict, "; " between them (empty when none fails).
+std::string failing_values(const ::daq::Verdict& v, bool strong) {
+  std::string h;
+  for (const auto& c : v.checks)
+    if (!c.pass) h += (h.empty() ? "" : "; ") + failing_value(c, strong);
+  return h;
+}
+
 // The verdict of a result as a coloured line: pass, fail, or no tolerance configured (then
 // `hint`: which limits would judge it and where they are set, tolerance_hint).
 std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}) {
@@ -1016,13 +1036,8 @@ std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}
     for (const auto& c : v.checks)
       if (!c.pass) {
         const auto advice = ::daq::diagnostic_advice(c.key);
-        // As the tables print it: a diagnostic (an error with a direction, what to check) with
-        // its sign, a deviation or span (E, B, U max, G) without ("U max = +4.023" read as the
-        // table's 4.023 with a sign the value does not have).
-        items += fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {} {}){}</li>",
-                             esc(c.symbol), advice.empty() ? um(c.value) : signed_text(c.value, 3),
-                             esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)),
-                             advice.empty() ? "" : ": " + esc(advice));
+        items += "<li>" + failing_value(c, true) + (advice.empty() ? "" : ": " + esc(advice)) +
+                 "</li>";
       }
     h += "<ul class=\"failing\">" + items + "</ul>\n";
   }
@@ -2857,6 +2872,70 @@ namespace {
 // values down the page, one column per run.
 constexpr std::size_t max_run_columns = 11;
 
+// The positioning values a specification limits (ISO 230-2's bidirectional ones, VDI/DGQ 3441's):
+// the tables of several runs side by side keep to them, the unidirectional ones are in each
+// run's own report (all twelve would not fit a printed page).
+bool is_specified_value(std::string_view key) {
+  static constexpr std::string_view keys[] = {"E_bi", "R_bi", "A_bi", "M",      "B",
+                                              "B_mean", "P",  "Pa",   "Ps_max", "U_max"};
+  return std::find(std::begin(keys), std::end(keys), key) != std::end(keys);
+}
+
+// A comparison's verdict in words, for page one (it was said only by the table's ✓ and ✗): the
+// newest run's verdict, then each failing run (newest first) with its failing values and their
+// limits, what to check beside the newest run's diagnostics. `verdicts` in the order of `views`
+// (by date).
+std::string comparison_verdict(const std::vector<RunView>& views,
+                               const std::vector<::daq::Verdict>& verdicts, bool same_day) {
+  constexpr std::size_t max_listed = 4;  // earlier failing runs named; the rest counted
+  const auto when = [&](const RunView& v) {
+    return fmt::format("run {} ({})", v.run.id,
+                       same_day ? iso_time(v.run.started_unix_ms).substr(0, 16) : date_of(v));
+  };
+  std::vector<std::size_t> failing;  // newest first
+  std::size_t configured = 0;
+  for (std::size_t i = verdicts.size(); i-- > 0;) {
+    configured += verdicts[i].configured ? 1 : 0;
+    if (verdicts[i].configured && !verdicts[i].pass) failing.push_back(i);
+  }
+  if (!configured)
+    return "<p class=\"verdict none\"><strong>No tolerance configured</strong> for these runs: "
+           "their values are not judged (a machine specification is given as [tolerances] in "
+           "the configuration, docs/config.md).</p>\n";
+  // A run's failing values, each with what to check where a diagnostic says (the newest run's:
+  // what to fix first).
+  const auto failing_words = [](const ::daq::Verdict& v, bool advise) {
+    std::string h;
+    for (const auto& c : v.checks) {
+      if (c.pass) continue;
+      const auto advice = advise ? ::daq::diagnostic_advice(c.key) : std::string();
+      h += (h.empty() ? "" : "; ") + failing_value(c, false) +
+           (advice.empty() ? "" : ": " + esc(advice));
+    }
+    return h;
+  };
+  const auto& newest = verdicts.back();
+  std::string h = fmt::format(
+      "<p class=\"verdict {}\">The newest run, {}: <strong>{}</strong>{}.",
+      !newest.configured ? "none"
+      : newest.pass      ? "pass"
+                         : "fail",
+      when(views.back()), ::daq::summary(newest),
+      newest.configured && !newest.pass ? " &mdash; " + failing_words(newest, true) : "");
+  std::vector<std::size_t> earlier;  // the failing runs before the newest, newest first
+  for (const auto i : failing)
+    if (i + 1 != views.size()) earlier.push_back(i);
+  h += fmt::format("<br>Earlier runs outside their specification: {} of {}{}",
+                   earlier.size(), views.size() - 1, earlier.empty() ? "." : "");
+  for (std::size_t k = 0; k < earlier.size() && k < max_listed; ++k)
+    h += fmt::format("{} {}: {}", k ? ";" : " &mdash;", when(views[earlier[k]]),
+                     failing_words(verdicts[earlier[k]], false));
+  if (earlier.size() > max_listed)
+    h += fmt::format("; and {} more (their ✗ in the table)", earlier.size() - max_listed);
+  if (!earlier.empty()) h += ".";
+  return h + "</p>\n";
+}
+
 std::string transposed(const std::vector<std::string>& head,
                        const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::string> runs{"value"};
@@ -2924,8 +3003,6 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     double value = 0;
     bool is_signed = false;  // a diagnostic: its sign is the error's direction
   };
-  static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
-                                                    "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
   std::map<std::string, Line> trends;        // key -> value run by run
   std::map<std::string, double> limits;      // key -> the limit of the newest run that has one
   std::map<std::string, std::string> names;  // key -> symbol (unit)
@@ -2936,9 +3013,12 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
                   .x_label = std::string(text.x_label),
                   .y_label = fmt::format("deviation ({})", text.deviation),
-                  .height_pt = 300,
+                  // (300 pushed the first row of the trends below off page one, leaving a
+                  // quarter of it empty, once the verdict was said in words above the table)
+                  .height_pt = 260,
                   .zero_line = true};
   std::vector<PolarChart> polars;
+  std::vector<::daq::Verdict> verdicts;  // run by run, in date order
   for (std::size_t i = 0; i < views.size(); ++i) {
     const auto& v = views[i];
     // (With runs on one day the date label already names the run.)
@@ -2970,6 +3050,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
         values.push_back({r.key, r.symbol, unit_text(r.unit), r.value, true});
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
+    verdicts.push_back(verdict);
     // A re-compensated run is compared with the values it has now, and says so.
     std::vector<std::string> row{
         std::to_string(v.run.id) +
@@ -2981,7 +3062,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     if (positioning &&
         std::any_of(values.begin(), values.end(), [](const Value& x) { return x.key == "E_bi"; }))
       std::erase_if(values, [](const Value& x) {
-        return std::find(linear_keys.begin(), linear_keys.end(), x.key) == linear_keys.end();
+        return !is_specified_value(x.key);
       });
     for (const auto& x : values) {
       if (!trends.count(x.key)) {
@@ -3028,6 +3109,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       "the limit of that run's specification.</p>\n",
       esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
       date_of(views.back()));
+  body += comparison_verdict(views, verdicts, same_day);
   std::vector<const RunView*> each;
   for (const auto& v : views) each.push_back(&v);
   body += traceability_warnings(each);
@@ -3062,14 +3144,16 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   std::stable_partition(plot_order.begin(), plot_order.end(),
                         [&](const std::string& k) { return limits.count(k) > 0; });
   for (const auto& k : plot_order) {
-    if (positioning && std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
+    if (positioning && !is_specified_value(k))
       continue;
     if (plotted++ >= 10) break;
     XyChart small{.title = names[k],
                   .x_label = "",
                   .y_label = "",  // the title names it (a rotated label at this size was clipped)
                   .width_pt = 300,
-                  .height_pt = 200,
+                  // Four rows to a printed page (at 200, three: a circle's trends left a page
+                  // 76 % full before the next)
+                  .height_pt = 180,
                   .x_labels = short_dates,
                   .legend = false,
                   .text_scale = 1.65};
@@ -3151,7 +3235,13 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
       overlay.lines.push_back(std::move(line));
       // A rotary run's caldaq.rotary.v1 (the values daq show prints, in arcsec).
       sd.doc = v.run.kind == "rotary" ? rotary_doc(store, v, o) : ::daq::to_json(l.e);
-      for (const auto& r : ::daq::result_rows(sd.doc)) sd.values.push_back(entry(r, false));
+      // The values a specification limits: with the unidirectional six too the table filled
+      // page one to its last line (a second warning above pushed its verdict row off it).
+      const auto rows = ::daq::result_rows(sd.doc);
+      const bool iso = std::any_of(rows.begin(), rows.end(),
+                                   [](const auto& r) { return r.key == "E_bi"; });
+      for (const auto& r : rows)
+        if (!iso || is_specified_value(r.key)) sd.values.push_back(entry(r, false));
     } else {
       const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
@@ -3189,13 +3279,7 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   const auto origins = origins_of({{found_id, origin_label(found)}, {left_id, origin_label(left)}});
   std::string body = origins.banner + summary_block(left, test_name(left));
   const auto verdict_words = [&](const Side& sd, const char* when, std::int64_t id) {
-    std::string failing;
-    for (const auto& c : sd.verdict.checks)
-      if (!c.pass)
-        failing += fmt::format(
-            "{}{} = {} {} (limit ≤ {} {})", failing.empty() ? "" : "; ", esc(c.symbol),
-            ::daq::diagnostic_advice(c.key).empty() ? um(c.value) : signed_text(c.value, 3),
-            esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+    const std::string failing = failing_values(sd.verdict, false);
     return fmt::format("{} (run {}): <strong>{}</strong>{}", when, id, banner(sd.verdict),
                        failing.empty() ? "" : " &mdash; " + failing);
   };
@@ -3208,8 +3292,11 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   body += traceability_warnings(std::array<const RunView*, 2>{&found, &left});
   body += fmt::format(
       "<p>The machine as it was found (run {}, {}) and as it was left after the compensation "
-      "(run {}, {}): the same test, side by side. Each run's full report follows.</p>\n",
-      found_id, date_of(found), left_id, date_of(left));
+      "(run {}, {}): the same test, side by side{}. Each run's full report follows.</p>\n",
+      found_id, date_of(found), left_id, date_of(left),
+      positioning ? ", by the values a specification limits (the unidirectional ones are in the "
+                    "runs' reports)"
+                  : "");
   if (positioning) {
     body += figure(svg(overlay), "The mean bidirectional positional deviation before and after.");
   } else {
