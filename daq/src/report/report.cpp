@@ -537,6 +537,12 @@ json shown_setting(const RunView& v, const std::string& key, const json& val) {
       return cal::circle::info(cal::circle::circular_standard_from_key(text)).label;
     if (key == "standard" && (v.run.kind == "linear" || v.run.kind == "rotary"))
       return std::string(cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
+    // A straightness, angular or roll run moves through the targets of a positioning test; its
+    // result is ISO 230-1's (the appendix read "iso230-2:2014", a key, as if it were judged so).
+    if (key == "standard" && ::daq::is_profile_kind(v.run.kind))
+      return fmt::format(
+          "{} (its targets and cycle; the result is evaluated by ISO 230-1:2012)",
+          cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
   } catch (const cal::InputError&) {
     return val;  // not one caldaq knows: as recorded
   }
@@ -763,9 +769,9 @@ std::string instruments_section(const RunView& v) {
          table({"instrument", "model", "serial number", "certificate", "calibration due"}, rows);
 }
 
-// The gaps in the traceability of the readings, a warning per instrument or per gap shared by
-// several: a calibration due
-// before the test day, or a serial number, certificate or due date not stated. Without them a
+// The gaps in the traceability of the readings other than a calibration past due (past_due),
+// a warning per gap shared by several instruments: a serial number, certificate or due date
+// not stated. Without them a
 // reader cannot tell whether the instrument was calibrated when it measured.
 std::vector<std::string> traceability_gaps(const RunView& v) {
   const auto list = v.context.value("instruments", json::array());
@@ -774,7 +780,6 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
         "the instruments' serial numbers, certificates and calibration due dates were not "
         "recorded with this run"};
   std::vector<std::string> out;
-  const std::string test_day = ymd(v.run.started_unix_ms);
   // The instruments that lack the same things, in one warning ("air, laser: no serial number,
   // certificate or calibration due date stated"): one line each filled page one with four
   // lines saying the same.
@@ -782,11 +787,6 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
   for (const auto& i : list) {
     const std::string name = ctx(i, "id").empty() ? ctx(i, "role") : ctx(i, "id");
     const std::string due = ctx(i, "calibration_due");
-    if (!due.empty() && due < test_day)
-      out.push_back(
-          fmt::format("the calibration of {} was past due on the test date ({} < {}): "
-                      "its readings are not traceable to a valid certificate",
-                      name, due, test_day));
     std::vector<std::string> missing;
     if (ctx(i, "serial_number").empty()) missing.push_back("serial number");
     if (ctx(i, "certificate").empty()) missing.push_back("certificate");
@@ -813,6 +813,65 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
 // left; a campaign), for its page one: each gap once, with the runs it concerns when not all of
 // them (a campaign of 19 runs on the same instruments said the same line 19 times in the runs'
 // sections, and nothing on page one).
+// The instruments whose calibration was due before the test day of a run: (name, due date).
+std::vector<std::pair<std::string, std::string>> past_due(const RunView& v) {
+  const auto list = v.context.value("instruments", json::array());
+  std::vector<std::pair<std::string, std::string>> out;
+  if (!list.is_array()) return out;
+  const std::string test_day = ymd(v.run.started_unix_ms);
+  for (const auto& i : list) {
+    const std::string due = ctx(i, "calibration_due");
+    if (!due.empty() && due < test_day)
+      out.push_back({ctx(i, "id").empty() ? ctx(i, "role") : ctx(i, "id"), due});
+  }
+  return out;
+}
+
+// "a", "a and b", "a, b and c".
+std::string and_list(const std::vector<std::string>& items) {
+  if (items.size() <= 1) return items.empty() ? std::string() : items.front();
+  return fmt::format("{} and {}", fmt::join(items.begin(), items.end() - 1, ", "), items.back());
+}
+
+// The past-due calibrations of the runs a report covers, in one warning: each instrument with
+// its due date (and its runs when not all of them), then the test days. A warning per run and
+// date ("... (2020-01-31 < 2026-11-28)", "... (2020-01-31 < 2026-11-29)") said the same twice
+// for runs of two days.
+std::string past_due_warning(std::span<const RunView* const> views) {
+  struct Late {
+    std::string name, due;
+    std::vector<std::int64_t> runs;
+  };
+  std::vector<Late> late;
+  std::vector<std::string> days;  // the test days of the runs concerned, in order
+  for (const auto* v : views)
+    for (auto& [name, due] : past_due(*v)) {
+      auto it = std::find_if(late.begin(), late.end(),
+                             [&](const Late& l) { return l.name == name && l.due == due; });
+      if (it == late.end()) it = late.insert(late.end(), Late{name, due, {}});
+      if (it->runs.empty() || it->runs.back() != v->run.id) it->runs.push_back(v->run.id);
+      if (const auto day = ymd(v->run.started_unix_ms);
+          std::find(days.begin(), days.end(), day) == days.end())
+        days.push_back(day);
+    }
+  if (late.empty()) return {};
+  std::sort(days.begin(), days.end());
+  std::vector<std::string> each;
+  for (const auto& l : late)
+    each.push_back(fmt::format(
+        "{} (due {}{})", l.name, l.due,
+        l.runs.size() == views.size()
+            ? ""
+            : fmt::format(", {} {}", l.runs.size() == 1 ? "run" : "runs", fmt::join(l.runs, ", "))));
+  const bool one = late.size() == 1;
+  return fmt::format(
+      "<p class=\"warning\">Traceability: the calibration{} of {} {} past due on the test "
+      "date{} ({}): {} readings are not traceable to a valid certificate.</p>\n",
+      one ? "" : "s", esc(and_list(each)), one ? "was" : "were", days.size() == 1 ? "" : "s",
+      days.size() <= 3 ? and_list(days) : days.front() + " to " + days.back(),
+      one ? "its" : "their");
+}
+
 std::string traceability_warnings(std::span<const RunView* const> views) {
   std::vector<std::pair<std::string, std::vector<std::int64_t>>> gaps;  // gap -> its runs
   for (const auto* v : views)
@@ -824,7 +883,7 @@ std::string traceability_warnings(std::span<const RunView* const> views) {
       else
         same->second.push_back(v->run.id);
     }
-  std::string h;
+  std::string h = past_due_warning(views);
   for (const auto& [gap, ids] : gaps)
     h += fmt::format(
         "<p class=\"warning\">Traceability{}: {}.</p>\n",
@@ -2037,10 +2096,13 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
     for (auto& x : t.s.value) x *= unit.factor;
     t.title += " " + unit.label + t.channel;
+    // Lower than a result's plot (the raw readings support it): at 300 pt each of an angular
+    // run's three (the displacement and each beam) took most of a page, its pages 65 % full.
     h += figure(svg(XyChart{.title = t.title,
                             .x_label = "time (min)",
                             .y_label = unit.label,
-                            .lines = lines_of({t.s}, i++, 4000)}),
+                            .lines = lines_of({t.s}, i++, 4000),
+                            .height_pt = 220}),
                 t.title + " over the run.");
   }
   return h;
@@ -2206,6 +2268,9 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
       tolerance_hint(v, code_keys(::daq::tolerance_keys(straight ? "straightness" : "angular"))));
   out.answer += profile_values_table(rows, verdict);
   out.answer += profile_plot(doc, unit);
+  // The details follow on page one (after a page break, page one of an angular run was 70 %
+  // full and its per-target table alone on page two).
+  out.details_flow = true;
   std::string& d = out.details;
   d = "<h3>Details of the results</h3>\n";
   if (straight) {
