@@ -540,9 +540,8 @@ json shown_setting(const RunView& v, const std::string& key, const json& val) {
     // A straightness, angular or roll run moves through the targets of a positioning test; its
     // result is ISO 230-1's (the appendix read "iso230-2:2014", a key, as if it were judged so).
     if (key == "standard" && ::daq::is_profile_kind(v.run.kind))
-      return fmt::format(
-          "{} (its targets and cycle; the result is evaluated by ISO 230-1:2012)",
-          cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
+      return fmt::format("{} (its targets and cycle; the result is evaluated by ISO 230-1:2012)",
+                         cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
   } catch (const cal::InputError&) {
     return val;  // not one caldaq knows: as recorded
   }
@@ -858,11 +857,11 @@ std::string past_due_warning(std::span<const RunView* const> views) {
   std::sort(days.begin(), days.end());
   std::vector<std::string> each;
   for (const auto& l : late)
-    each.push_back(fmt::format(
-        "{} (due {}{})", l.name, l.due,
-        l.runs.size() == views.size()
-            ? ""
-            : fmt::format(", {} {}", l.runs.size() == 1 ? "run" : "runs", fmt::join(l.runs, ", "))));
+    each.push_back(fmt::format("{} (due {}{})", l.name, l.due,
+                               l.runs.size() == views.size()
+                                   ? ""
+                                   : fmt::format(", {} {}", l.runs.size() == 1 ? "run" : "runs",
+                                                 fmt::join(l.runs, ", "))));
   const bool one = late.size() == 1;
   return fmt::format(
       "<p class=\"warning\">Traceability: the calibration{} of {} {} past due on the test "
@@ -1048,10 +1047,10 @@ std::string tolerance_hint(const RunView& v, std::string_view keys) {
 // not have). `strong`: the symbol in bold (a list's item; inside a bold verdict line, plain).
 std::string failing_value(const ::daq::Check& c, bool strong) {
   const std::string symbol = strong ? "<strong>" + esc(c.symbol) + "</strong>" : esc(c.symbol);
-  return fmt::format("{} = {} {} (limit ≤ {} {})", symbol,
-                     ::daq::diagnostic_advice(c.key).empty() ? um(c.value)
-                                                             : signed_text(c.value, 3),
-                     esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+  return fmt::format(
+      "{} = {} {} (limit ≤ {} {})", symbol,
+      ::daq::diagnostic_advice(c.key).empty() ? um(c.value) : signed_text(c.value, 3),
+      esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
 }
 
 // The failing values of a verdict, "; " between them (empty when none fails).
@@ -1095,8 +1094,8 @@ std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}
     for (const auto& c : v.checks)
       if (!c.pass) {
         const auto advice = ::daq::diagnostic_advice(c.key);
-        items += "<li>" + failing_value(c, true) + (advice.empty() ? "" : ": " + esc(advice)) +
-                 "</li>";
+        items +=
+            "<li>" + failing_value(c, true) + (advice.empty() ? "" : ": " + esc(advice)) + "</li>";
       }
     h += "<ul class=\"failing\">" + items + "</ul>\n";
   }
@@ -2941,8 +2940,8 @@ constexpr std::size_t max_run_columns = 11;
 // the tables of several runs side by side keep to them, the unidirectional ones are in each
 // run's own report (all twelve would not fit a printed page).
 bool is_specified_value(std::string_view key) {
-  static constexpr std::string_view keys[] = {"E_bi", "R_bi", "A_bi", "M",      "B",
-                                              "B_mean", "P",  "Pa",   "Ps_max", "U_max"};
+  static constexpr std::string_view keys[] = {"E_bi",   "R_bi", "A_bi", "M",      "B",
+                                              "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
   return std::find(std::begin(keys), std::end(keys), key) != std::end(keys);
 }
 
@@ -2990,8 +2989,8 @@ std::string comparison_verdict(const std::vector<RunView>& views,
   std::vector<std::size_t> earlier;  // the failing runs before the newest, newest first
   for (const auto i : failing)
     if (i + 1 != views.size()) earlier.push_back(i);
-  h += fmt::format("<br>Earlier runs outside their specification: {} of {}{}",
-                   earlier.size(), views.size() - 1, earlier.empty() ? "." : "");
+  h += fmt::format("<br>Earlier runs outside their specification: {} of {}{}", earlier.size(),
+                   views.size() - 1, earlier.empty() ? "." : "");
   for (std::size_t k = 0; k < earlier.size() && k < max_listed; ++k)
     h += fmt::format("{} {}: {}", k ? ";" : " &mdash;", when(views[earlier[k]]),
                      failing_words(verdicts[earlier[k]], false));
@@ -3126,9 +3125,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     // are in each run's report): all twelve would not fit a printed page.
     if (positioning &&
         std::any_of(values.begin(), values.end(), [](const Value& x) { return x.key == "E_bi"; }))
-      std::erase_if(values, [](const Value& x) {
-        return !is_specified_value(x.key);
-      });
+      std::erase_if(values, [](const Value& x) { return !is_specified_value(x.key); });
     for (const auto& x : values) {
       if (!trends.count(x.key)) {
         trend_order.push_back(x.key);
@@ -3209,8 +3206,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   std::stable_partition(plot_order.begin(), plot_order.end(),
                         [&](const std::string& k) { return limits.count(k) > 0; });
   for (const auto& k : plot_order) {
-    if (positioning && !is_specified_value(k))
-      continue;
+    if (positioning && !is_specified_value(k)) continue;
     if (plotted++ >= 10) break;
     XyChart small{.title = names[k],
                   .x_label = "",
@@ -3303,8 +3299,8 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
       // The values a specification limits: with the unidirectional six too the table filled
       // page one to its last line (a second warning above pushed its verdict row off it).
       const auto rows = ::daq::result_rows(sd.doc);
-      const bool iso = std::any_of(rows.begin(), rows.end(),
-                                   [](const auto& r) { return r.key == "E_bi"; });
+      const bool iso =
+          std::any_of(rows.begin(), rows.end(), [](const auto& r) { return r.key == "E_bi"; });
       for (const auto& r : rows)
         if (!iso || is_specified_value(r.key)) sd.values.push_back(entry(r, false));
     } else {
