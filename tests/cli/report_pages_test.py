@@ -19,6 +19,7 @@ import sqlite3
 import subprocess
 import sys
 import tempfile
+import time
 
 
 DAQ = os.path.abspath(sys.argv[1])
@@ -219,15 +220,16 @@ for name in ("linear", "vdi3441", "suspect", "circle"):
           is not None, p1[:600])
     if name != "circle":  # the demo's thermometer is past due; the ballbar's calibration is not
         check(f"{name}: traceability warning on page one",
-              "Traceability: the calibration of material was past due" in p1, p1[:800])
+              "Traceability: the calibration of material (due 2020-01-31) was past due" in p1,
+              p1[:800])
 # A report of several runs warns of their traceability gaps on page one too, each gap once (the
 # demo's linear runs share their thermometer past due; the campaign's circle does not, so
 # there the runs it concerns are named). Before, only each run's section said so, pages later.
 for name in ("asfound", "comparison", "campaign"):
     p1 = text[name][0]
     check(f"{name}: traceability warning on page one, once",
-          re.search(r"Traceability( \(runs [0-9, ]+\))?: the calibration of material was past due",
-                    p1) is not None and p1.count("the calibration of material was past due") == 1,
+          re.search(r"Traceability: the calibration of material \(due 2020-01-31(, runs? [0-9, ]+)?\) "
+                    r"was past due", p1) is not None and p1.count("was past due") == 1,
           p1[:1200])
 for name in ("linear", "suspect"):
     p1 = text[name][0]
@@ -548,7 +550,28 @@ check("comparison: the table on page one", all(w in text["comparison"][0] for w 
     "run date E (µm)", "R (µm)", "A (µm)", "B (µm)", "B̄ (µm)", "verdict air")) and re.search(
     r"[0-9.]+ ✓ [0-9.]+ ✓ [0-9.]+ ✓ [0-9.]+ ✓ [0-9.]+ ✗ -?[0-9.]+ FAIL [0-9.]+ [0-9.]+",
     text["comparison"][0]) is not None, text["comparison"][0])
+# Page one says in words why a comparison fails: which value of which run, against which limit
+# (it said so only by the table's ✗). The demo's runs 1 and 3 both fail B (4 µm of backlash
+# injected, limit 3 µm); the circle's backlash X (limit 3 µm) with what to check.
+c1 = text["comparison"][0]
+check("comparison: page one says which value of which run fails, against which limit",
+      re.search(r"The newest run, run 3 \([0-9-]+ [0-9:]+\): FAIL — B = 4\.0[0-9]{2} µm \(limit ≤ "
+                r"3\.000 µm\)\. Earlier runs outside their specification: 1 of 1 — run 1 \([0-9-]+ "
+                r"[0-9:]+\): B = 4\.0[0-9]{2} µm \(limit ≤ 3\.000 µm\)\.", c1) is not None, c1[:1200])
+check("circle comparison: the failing backlash X in words, with what to check",
+      re.search(r"The newest run, run 2 \([^)]*\): FAIL — Backlash X = \+4\.0[0-9]{2} µm \(limit ≤ "
+                r"3\.000 µm\): check the X axis' backlash compensation",
+                text["comparison-circle"][0]) is not None, text["comparison-circle"][0][:1200])
 a1 = text["asfound"][0]
+# Page one keeps room: the table of the values a specification limits (the unidirectional six
+# are in each run's report), so a second warning above does not push its verdict row off it.
+check("as found / as left: the bidirectional values only, the verdict row on page one",
+      "E↑" not in a1 and "B̄ (µm)" in a1 and re.search(r"verdict (-?[0-9.]+ )?FAIL", a1)
+      is not None, a1)
+import report_checks  # noqa: E402  (its page_fill: page_fill above is this file's own)
+af_fill = report_checks.page_fill(*pdf_words("asfound.pdf")[0])
+check("as found / as left: page one not full to its last line (< 95 %)", af_fill < 0.95,
+      f"{af_fill:.2f}")
 check("as found / as left: table and verdicts on page one",
       "as found, run 1" in a1 and "as left, run 3" in a1 and "verdict" in a1, a1)
 # Each value with its unit: a circle's table mixed µm, µm/m and ms under a head without any, and
@@ -626,6 +649,30 @@ daq("report", "1", "--db", "gaps.sqlite", "--format", "pdf", "-o", "gaps.pdf")
 g1 = squash(pages("gaps.pdf")[0])
 check("traceability: a missing certificate and due date warned on page one",
       "Traceability: laser: no certificate or calibration due date stated" in g1, g1[:1500])
+
+# Past-due calibrations of runs of different days in one warning, each instrument with its due
+# date: the demo's thermometer (due 2020-01-31) in runs 1 and 3, run 3 a day later, and in run 1
+# a laser due 2021-06-30 too. Before, a line per run and date: "material was past due on the
+# test date (2020-01-31 < DAY 1)", the same again for day 2, and one more for the laser.
+shutil.copy("demo.sqlite", "late.sqlite")
+con = sqlite3.connect("late.sqlite")
+settings = json.loads(con.execute("SELECT settings_json FROM runs WHERE id = 1").fetchone()[0])
+next(i for i in settings["context"]["instruments"]
+     if i["role"] == "laser")["calibration_due"] = "2021-06-30"
+con.execute("UPDATE runs SET settings_json = ? WHERE id = 1", (json.dumps(settings),))
+con.execute("UPDATE runs SET started_unix_ms = started_unix_ms + 86400000, "
+            "ended_unix_ms = ended_unix_ms + 86400000 WHERE id = 3")
+day1, day2 = [time.strftime("%Y-%m-%d", time.gmtime(ms / 1000)) for (ms,) in con.execute(
+    "SELECT started_unix_ms FROM runs WHERE id IN (1, 3) ORDER BY id")]
+con.commit()
+con.close()
+for args in (["--compare", "1", "3"], ["--as-found", "1", "--as-left", "3"]):
+    daq("report", *args, "--db", "late.sqlite", "--format", "pdf", "-o", "late.pdf")
+    l1 = squash(pages("late.pdf")[0])
+    check(f"traceability ({args[0]}): past-due calibrations of two days in one warning",
+          f"Traceability: the calibrations of laser (due 2021-06-30, run 1) and material (due "
+          f"2020-01-31) were past due on the test dates ({day1} and {day2}): their readings are "
+          f"not traceable to a valid certificate." in l1 and l1.count("past due") == 1, l1[:1500])
 
 # --- other runs (an imported .rtx): the plots name the quantity and its unit, not its key -------
 with open("lin.rtx", "wb") as f:
@@ -792,6 +839,17 @@ for kind, (run, run_out) in profile_runs.items():
         check("angular: no tolerance stated, and where it would be",
               "No tolerance configured" in p1 and "angular_urad under [tolerances.X]" in p1
               and verdict["summary"] == "no tolerance configured", p1)
+    # The details follow the plot on page one (after a page break, page one of the angular run
+    # was 70 % full, the roll's 66 %, the per-target table alone on page two).
+    fills = [report_checks.page_fill(*x) for x in pdf_words(f"{kind}.pdf")]
+    check(f"{kind}: the details begin on page one, filled to >= 85 %",
+          "Details of the results" in p1 and fills[0] >= 0.85, f"{fills}")
+    # The positioning cycle's standard by its title, said to be the cycle's only (the appendix
+    # read "iso230-2:2014", a key, of a run evaluated by ISO 230-1).
+    standard = appendix(kind).get("Standard", "")
+    check(f"{kind}: the appendix's standard by its title, the cycle's",
+          standard.startswith("ISO 230-2:2014 (its targets and cycle; the result is evaluated by "
+                              "ISO 230-1:2012)"), standard)
     check(f"{kind}: nothing past the right margin", not words_beyond_margin(f"{kind}.pdf"), "")
     html_text = open(f"{kind}.html", encoding="utf-8").read()
     check(f"{kind}: every legend inside its plot", not edge_lines(html_text),

@@ -101,7 +101,7 @@ machine_serial <td>Serial number</td><td>SIM-0001</td>
 operator <td>Operator</td><td>demo operator</td>
 instrument_serial <td>SIM-IDS-0001</td><td>none \(simulated instrument\)</td><td>2099-12-31</td>
 past_due 2020-01-31 &mdash; PAST DUE
-past_due_warning the calibration of material was past due on the test date
+past_due_warning the calibration of material \(due 2020-01-31\) was past due on the test date
 conditions <td>Controller compensation</td><td>off
 sign_convention <td>Sign convention</td><td>Positional deviation
 provenance <td>Obtained</td><td>acquired</td>

@@ -537,6 +537,11 @@ json shown_setting(const RunView& v, const std::string& key, const json& val) {
       return cal::circle::info(cal::circle::circular_standard_from_key(text)).label;
     if (key == "standard" && (v.run.kind == "linear" || v.run.kind == "rotary"))
       return std::string(cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
+    // A straightness, angular or roll run moves through the targets of a positioning test; its
+    // result is ISO 230-1's (the appendix read "iso230-2:2014", a key, as if it were judged so).
+    if (key == "standard" && ::daq::is_profile_kind(v.run.kind))
+      return fmt::format("{} (its targets and cycle; the result is evaluated by ISO 230-1:2012)",
+                         cal::iso230_2::info(cal::iso230_2::standard_from_string(text)).title);
   } catch (const cal::InputError&) {
     return val;  // not one caldaq knows: as recorded
   }
@@ -763,9 +768,9 @@ std::string instruments_section(const RunView& v) {
          table({"instrument", "model", "serial number", "certificate", "calibration due"}, rows);
 }
 
-// The gaps in the traceability of the readings, a warning per instrument or per gap shared by
-// several: a calibration due
-// before the test day, or a serial number, certificate or due date not stated. Without them a
+// The gaps in the traceability of the readings other than a calibration past due (past_due),
+// a warning per gap shared by several instruments: a serial number, certificate or due date
+// not stated. Without them a
 // reader cannot tell whether the instrument was calibrated when it measured.
 std::vector<std::string> traceability_gaps(const RunView& v) {
   const auto list = v.context.value("instruments", json::array());
@@ -774,7 +779,6 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
         "the instruments' serial numbers, certificates and calibration due dates were not "
         "recorded with this run"};
   std::vector<std::string> out;
-  const std::string test_day = ymd(v.run.started_unix_ms);
   // The instruments that lack the same things, in one warning ("air, laser: no serial number,
   // certificate or calibration due date stated"): one line each filled page one with four
   // lines saying the same.
@@ -782,11 +786,6 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
   for (const auto& i : list) {
     const std::string name = ctx(i, "id").empty() ? ctx(i, "role") : ctx(i, "id");
     const std::string due = ctx(i, "calibration_due");
-    if (!due.empty() && due < test_day)
-      out.push_back(
-          fmt::format("the calibration of {} was past due on the test date ({} < {}): "
-                      "its readings are not traceable to a valid certificate",
-                      name, due, test_day));
     std::vector<std::string> missing;
     if (ctx(i, "serial_number").empty()) missing.push_back("serial number");
     if (ctx(i, "certificate").empty()) missing.push_back("certificate");
@@ -813,6 +812,65 @@ std::vector<std::string> traceability_gaps(const RunView& v) {
 // left; a campaign), for its page one: each gap once, with the runs it concerns when not all of
 // them (a campaign of 19 runs on the same instruments said the same line 19 times in the runs'
 // sections, and nothing on page one).
+// The instruments whose calibration was due before the test day of a run: (name, due date).
+std::vector<std::pair<std::string, std::string>> past_due(const RunView& v) {
+  const auto list = v.context.value("instruments", json::array());
+  std::vector<std::pair<std::string, std::string>> out;
+  if (!list.is_array()) return out;
+  const std::string test_day = ymd(v.run.started_unix_ms);
+  for (const auto& i : list) {
+    const std::string due = ctx(i, "calibration_due");
+    if (!due.empty() && due < test_day)
+      out.push_back({ctx(i, "id").empty() ? ctx(i, "role") : ctx(i, "id"), due});
+  }
+  return out;
+}
+
+// "a", "a and b", "a, b and c".
+std::string and_list(const std::vector<std::string>& items) {
+  if (items.size() <= 1) return items.empty() ? std::string() : items.front();
+  return fmt::format("{} and {}", fmt::join(items.begin(), items.end() - 1, ", "), items.back());
+}
+
+// The past-due calibrations of the runs a report covers, in one warning: each instrument with
+// its due date (and its runs when not all of them), then the test days. A warning per run and
+// date ("... (2020-01-31 < 2026-11-28)", "... (2020-01-31 < 2026-11-29)") said the same twice
+// for runs of two days.
+std::string past_due_warning(std::span<const RunView* const> views) {
+  struct Late {
+    std::string name, due;
+    std::vector<std::int64_t> runs;
+  };
+  std::vector<Late> late;
+  std::vector<std::string> days;  // the test days of the runs concerned, in order
+  for (const auto* v : views)
+    for (auto& [name, due] : past_due(*v)) {
+      auto it = std::find_if(late.begin(), late.end(),
+                             [&](const Late& l) { return l.name == name && l.due == due; });
+      if (it == late.end()) it = late.insert(late.end(), Late{name, due, {}});
+      if (it->runs.empty() || it->runs.back() != v->run.id) it->runs.push_back(v->run.id);
+      if (const auto day = ymd(v->run.started_unix_ms);
+          std::find(days.begin(), days.end(), day) == days.end())
+        days.push_back(day);
+    }
+  if (late.empty()) return {};
+  std::sort(days.begin(), days.end());
+  std::vector<std::string> each;
+  for (const auto& l : late)
+    each.push_back(fmt::format("{} (due {}{})", l.name, l.due,
+                               l.runs.size() == views.size()
+                                   ? ""
+                                   : fmt::format(", {} {}", l.runs.size() == 1 ? "run" : "runs",
+                                                 fmt::join(l.runs, ", "))));
+  const bool one = late.size() == 1;
+  return fmt::format(
+      "<p class=\"warning\">Traceability: the calibration{} of {} {} past due on the test "
+      "date{} ({}): {} readings are not traceable to a valid certificate.</p>\n",
+      one ? "" : "s", esc(and_list(each)), one ? "was" : "were", days.size() == 1 ? "" : "s",
+      days.size() <= 3 ? and_list(days) : days.front() + " to " + days.back(),
+      one ? "its" : "their");
+}
+
 std::string traceability_warnings(std::span<const RunView* const> views) {
   std::vector<std::pair<std::string, std::vector<std::int64_t>>> gaps;  // gap -> its runs
   for (const auto* v : views)
@@ -824,7 +882,7 @@ std::string traceability_warnings(std::span<const RunView* const> views) {
       else
         same->second.push_back(v->run.id);
     }
-  std::string h;
+  std::string h = past_due_warning(views);
   for (const auto& [gap, ids] : gaps)
     h += fmt::format(
         "<p class=\"warning\">Traceability{}: {}.</p>\n",
@@ -983,6 +1041,26 @@ std::string tolerance_hint(const RunView& v, std::string_view keys) {
                     : "");
 }
 
+// A value outside its limit, as the tables print it: "B = 4.023 µm (limit ≤ 3.000 µm)". A
+// diagnostic (an error with a direction, what to check) with its sign, a deviation or span (E,
+// B, U max, G) without ("U max = +4.023" read as the table's 4.023 with a sign the value does
+// not have). `strong`: the symbol in bold (a list's item; inside a bold verdict line, plain).
+std::string failing_value(const ::daq::Check& c, bool strong) {
+  const std::string symbol = strong ? "<strong>" + esc(c.symbol) + "</strong>" : esc(c.symbol);
+  return fmt::format(
+      "{} = {} {} (limit ≤ {} {})", symbol,
+      ::daq::diagnostic_advice(c.key).empty() ? um(c.value) : signed_text(c.value, 3),
+      esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+}
+
+// The failing values of a verdict, "; " between them (empty when none fails).
+std::string failing_values(const ::daq::Verdict& v, bool strong) {
+  std::string h;
+  for (const auto& c : v.checks)
+    if (!c.pass) h += (h.empty() ? "" : "; ") + failing_value(c, strong);
+  return h;
+}
+
 // The verdict of a result as a coloured line: pass, fail, or no tolerance configured (then
 // `hint`: which limits would judge it and where they are set, tolerance_hint).
 std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}) {
@@ -1016,13 +1094,8 @@ std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}
     for (const auto& c : v.checks)
       if (!c.pass) {
         const auto advice = ::daq::diagnostic_advice(c.key);
-        // As the tables print it: a diagnostic (an error with a direction, what to check) with
-        // its sign, a deviation or span (E, B, U max, G) without ("U max = +4.023" read as the
-        // table's 4.023 with a sign the value does not have).
-        items += fmt::format("<li><strong>{}</strong> = {} {} (limit ≤ {} {}){}</li>",
-                             esc(c.symbol), advice.empty() ? um(c.value) : signed_text(c.value, 3),
-                             esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)),
-                             advice.empty() ? "" : ": " + esc(advice));
+        items +=
+            "<li>" + failing_value(c, true) + (advice.empty() ? "" : ": " + esc(advice)) + "</li>";
       }
     h += "<ul class=\"failing\">" + items + "</ul>\n";
   }
@@ -2022,10 +2095,13 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
     for (auto& x : t.s.value) x *= unit.factor;
     t.title += " " + unit.label + t.channel;
+    // Lower than a result's plot (the raw readings support it): at 300 pt each of an angular
+    // run's three (the displacement and each beam) took most of a page, its pages 65 % full.
     h += figure(svg(XyChart{.title = t.title,
                             .x_label = "time (min)",
                             .y_label = unit.label,
-                            .lines = lines_of({t.s}, i++, 4000)}),
+                            .lines = lines_of({t.s}, i++, 4000),
+                            .height_pt = 220}),
                 t.title + " over the run.");
   }
   return h;
@@ -2191,6 +2267,9 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
       tolerance_hint(v, code_keys(::daq::tolerance_keys(straight ? "straightness" : "angular"))));
   out.answer += profile_values_table(rows, verdict);
   out.answer += profile_plot(doc, unit);
+  // The details follow on page one (after a page break, page one of an angular run was 70 %
+  // full and its per-target table alone on page two).
+  out.details_flow = true;
   std::string& d = out.details;
   d = "<h3>Details of the results</h3>\n";
   if (straight) {
@@ -2857,6 +2936,70 @@ namespace {
 // values down the page, one column per run.
 constexpr std::size_t max_run_columns = 11;
 
+// The positioning values a specification limits (ISO 230-2's bidirectional ones, VDI/DGQ 3441's):
+// the tables of several runs side by side keep to them, the unidirectional ones are in each
+// run's own report (all twelve would not fit a printed page).
+bool is_specified_value(std::string_view key) {
+  static constexpr std::string_view keys[] = {"E_bi",   "R_bi", "A_bi", "M",      "B",
+                                              "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
+  return std::find(std::begin(keys), std::end(keys), key) != std::end(keys);
+}
+
+// A comparison's verdict in words, for page one (it was said only by the table's ✓ and ✗): the
+// newest run's verdict, then each failing run (newest first) with its failing values and their
+// limits, what to check beside the newest run's diagnostics. `verdicts` in the order of `views`
+// (by date).
+std::string comparison_verdict(const std::vector<RunView>& views,
+                               const std::vector<::daq::Verdict>& verdicts, bool same_day) {
+  constexpr std::size_t max_listed = 4;  // earlier failing runs named; the rest counted
+  const auto when = [&](const RunView& v) {
+    return fmt::format("run {} ({})", v.run.id,
+                       same_day ? iso_time(v.run.started_unix_ms).substr(0, 16) : date_of(v));
+  };
+  std::vector<std::size_t> failing;  // newest first
+  std::size_t configured = 0;
+  for (std::size_t i = verdicts.size(); i-- > 0;) {
+    configured += verdicts[i].configured ? 1 : 0;
+    if (verdicts[i].configured && !verdicts[i].pass) failing.push_back(i);
+  }
+  if (!configured)
+    return "<p class=\"verdict none\"><strong>No tolerance configured</strong> for these runs: "
+           "their values are not judged (a machine specification is given as [tolerances] in "
+           "the configuration, docs/config.md).</p>\n";
+  // A run's failing values, each with what to check where a diagnostic says (the newest run's:
+  // what to fix first).
+  const auto failing_words = [](const ::daq::Verdict& v, bool advise) {
+    std::string h;
+    for (const auto& c : v.checks) {
+      if (c.pass) continue;
+      const auto advice = advise ? ::daq::diagnostic_advice(c.key) : std::string();
+      h += (h.empty() ? "" : "; ") + failing_value(c, false) +
+           (advice.empty() ? "" : ": " + esc(advice));
+    }
+    return h;
+  };
+  const auto& newest = verdicts.back();
+  std::string h = fmt::format(
+      "<p class=\"verdict {}\">The newest run, {}: <strong>{}</strong>{}.",
+      !newest.configured ? "none"
+      : newest.pass      ? "pass"
+                         : "fail",
+      when(views.back()), ::daq::summary(newest),
+      newest.configured && !newest.pass ? " &mdash; " + failing_words(newest, true) : "");
+  std::vector<std::size_t> earlier;  // the failing runs before the newest, newest first
+  for (const auto i : failing)
+    if (i + 1 != views.size()) earlier.push_back(i);
+  h += fmt::format("<br>Earlier runs outside their specification: {} of {}{}", earlier.size(),
+                   views.size() - 1, earlier.empty() ? "." : "");
+  for (std::size_t k = 0; k < earlier.size() && k < max_listed; ++k)
+    h += fmt::format("{} {}: {}", k ? ";" : " &mdash;", when(views[earlier[k]]),
+                     failing_words(verdicts[earlier[k]], false));
+  if (earlier.size() > max_listed)
+    h += fmt::format("; and {} more (their ✗ in the table)", earlier.size() - max_listed);
+  if (!earlier.empty()) h += ".";
+  return h + "</p>\n";
+}
+
 std::string transposed(const std::vector<std::string>& head,
                        const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::string> runs{"value"};
@@ -2924,8 +3067,6 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     double value = 0;
     bool is_signed = false;  // a diagnostic: its sign is the error's direction
   };
-  static const std::vector<std::string> linear_keys{"E_bi",   "R_bi", "A_bi", "M",      "B",
-                                                    "B_mean", "P",    "Pa",   "Ps_max", "U_max"};
   std::map<std::string, Line> trends;        // key -> value run by run
   std::map<std::string, double> limits;      // key -> the limit of the newest run that has one
   std::map<std::string, std::string> names;  // key -> symbol (unit)
@@ -2936,9 +3077,12 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   XyChart overlay{.title = "Mean bidirectional deviation, run by run",
                   .x_label = std::string(text.x_label),
                   .y_label = fmt::format("deviation ({})", text.deviation),
-                  .height_pt = 300,
+                  // (300 pushed the first row of the trends below off page one, leaving a
+                  // quarter of it empty, once the verdict was said in words above the table)
+                  .height_pt = 260,
                   .zero_line = true};
   std::vector<PolarChart> polars;
+  std::vector<::daq::Verdict> verdicts;  // run by run, in date order
   for (std::size_t i = 0; i < views.size(); ++i) {
     const auto& v = views[i];
     // (With runs on one day the date label already names the run.)
@@ -2970,6 +3114,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
         values.push_back({r.key, r.symbol, unit_text(r.unit), r.value, true});
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
+    verdicts.push_back(verdict);
     // A re-compensated run is compared with the values it has now, and says so.
     std::vector<std::string> row{
         std::to_string(v.run.id) +
@@ -2980,9 +3125,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     // are in each run's report): all twelve would not fit a printed page.
     if (positioning &&
         std::any_of(values.begin(), values.end(), [](const Value& x) { return x.key == "E_bi"; }))
-      std::erase_if(values, [](const Value& x) {
-        return std::find(linear_keys.begin(), linear_keys.end(), x.key) == linear_keys.end();
-      });
+      std::erase_if(values, [](const Value& x) { return !is_specified_value(x.key); });
     for (const auto& x : values) {
       if (!trends.count(x.key)) {
         trend_order.push_back(x.key);
@@ -3028,6 +3171,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       "the limit of that run's specification.</p>\n",
       esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
       date_of(views.back()));
+  body += comparison_verdict(views, verdicts, same_day);
   std::vector<const RunView*> each;
   for (const auto& v : views) each.push_back(&v);
   body += traceability_warnings(each);
@@ -3062,14 +3206,15 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
   std::stable_partition(plot_order.begin(), plot_order.end(),
                         [&](const std::string& k) { return limits.count(k) > 0; });
   for (const auto& k : plot_order) {
-    if (positioning && std::find(linear_keys.begin(), linear_keys.end(), k) == linear_keys.end())
-      continue;
+    if (positioning && !is_specified_value(k)) continue;
     if (plotted++ >= 10) break;
     XyChart small{.title = names[k],
                   .x_label = "",
                   .y_label = "",  // the title names it (a rotated label at this size was clipped)
                   .width_pt = 300,
-                  .height_pt = 200,
+                  // Four rows to a printed page (at 200, three: a circle's trends left a page
+                  // 76 % full before the next)
+                  .height_pt = 180,
                   .x_labels = short_dates,
                   .legend = false,
                   .text_scale = 1.65};
@@ -3151,7 +3296,13 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
       overlay.lines.push_back(std::move(line));
       // A rotary run's caldaq.rotary.v1 (the values daq show prints, in arcsec).
       sd.doc = v.run.kind == "rotary" ? rotary_doc(store, v, o) : ::daq::to_json(l.e);
-      for (const auto& r : ::daq::result_rows(sd.doc)) sd.values.push_back(entry(r, false));
+      // The values a specification limits: with the unidirectional six too the table filled
+      // page one to its last line (a second warning above pushed its verdict row off it).
+      const auto rows = ::daq::result_rows(sd.doc);
+      const bool iso =
+          std::any_of(rows.begin(), rows.end(), [](const auto& r) { return r.key == "E_bi"; });
+      for (const auto& r : rows)
+        if (!iso || is_specified_value(r.key)) sd.values.push_back(entry(r, false));
     } else {
       const auto c = analyse_circle(store, v, o);
       auto p = polar_of(c, "", 2 * colour, std::string(label) + " ");
@@ -3189,13 +3340,7 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   const auto origins = origins_of({{found_id, origin_label(found)}, {left_id, origin_label(left)}});
   std::string body = origins.banner + summary_block(left, test_name(left));
   const auto verdict_words = [&](const Side& sd, const char* when, std::int64_t id) {
-    std::string failing;
-    for (const auto& c : sd.verdict.checks)
-      if (!c.pass)
-        failing += fmt::format(
-            "{}{} = {} {} (limit ≤ {} {})", failing.empty() ? "" : "; ", esc(c.symbol),
-            ::daq::diagnostic_advice(c.key).empty() ? um(c.value) : signed_text(c.value, 3),
-            esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+    const std::string failing = failing_values(sd.verdict, false);
     return fmt::format("{} (run {}): <strong>{}</strong>{}", when, id, banner(sd.verdict),
                        failing.empty() ? "" : " &mdash; " + failing);
   };
@@ -3208,8 +3353,11 @@ std::string as_found_as_left_report(const st::RunReader& store, std::int64_t fou
   body += traceability_warnings(std::array<const RunView*, 2>{&found, &left});
   body += fmt::format(
       "<p>The machine as it was found (run {}, {}) and as it was left after the compensation "
-      "(run {}, {}): the same test, side by side. Each run's full report follows.</p>\n",
-      found_id, date_of(found), left_id, date_of(left));
+      "(run {}, {}): the same test, side by side{}. Each run's full report follows.</p>\n",
+      found_id, date_of(found), left_id, date_of(left),
+      positioning ? ", by the values a specification limits (the unidirectional ones are in the "
+                    "runs' reports)"
+                  : "");
   if (positioning) {
     body += figure(svg(overlay), "The mean bidirectional positional deviation before and after.");
   } else {
