@@ -36,7 +36,7 @@ check migrated 0 "^11$" -- value "$DB" "PRAGMA user_version"
 check runs_kept 0 "^$RUNS_BEFORE$" -- value "$DB" "SELECT group_concat(uuid) FROM (SELECT uuid FROM runs ORDER BY id)"
 UUID=$(value "$DB" "SELECT uuid FROM models WHERE id = 1")
 # Its provenance: every run it was built from by UUID (those of the store), who stored it.
-check provenance 0 "^ok [1-9][0-9]* runs$" -- "$PY" - "$DAQ" "$DB" "$USER" <<'PY'
+check provenance 0 "^ok [1-9][0-9]* runs$" -- "$PY" - "$DAQ" "$DB" "${USER:-$(id -un)}" <<'PY'
 import json, sqlite3, subprocess, sys
 daq, db, user = sys.argv[1:]
 listed = json.loads(subprocess.run([daq, "model", "list", "--json", "--db", db], capture_output=True, text=True, check=True).stdout)

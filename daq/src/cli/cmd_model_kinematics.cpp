@@ -44,9 +44,9 @@ Written sinumerik(const kin::FiveAxisMachine& m, const std::string& origin, cons
 }
 
 void run(const Options& given) {
-  if (o.format == "heidenhain")
+  if (given.format == "heidenhain")
     throw cal::InputError(std::string(kin::heidenhain_not_written_reason()));
-  if (o.format != "sinumerik-cycle800" && (o.record != 1 || o.reverse_angles))
+  if (given.format != "sinumerik-cycle800" && (given.record != 1 || given.reverse_angles))
     throw cal::InputError("--record and --reverse-angles are for -f sinumerik-cycle800");
   const auto in = read_model_input(given.file, given.db);
   Options o = given;

@@ -115,8 +115,9 @@ void print_kept(const st::ModelRecord& r, const std::string& db) {
 namespace {
 
 // The runs of a model built (`used`: error -> run ids), each once with the errors it gave.
-nlohmann::json built_model_runs(const st::RunReader& store,
-                                const std::map<std::string, std::vector<std::int64_t>>& used) {
+nlohmann::json built_model_runs(
+    const st::RunReader& store,
+    std::span<const std::pair<std::string, std::vector<std::int64_t>>> used) {
   std::map<std::int64_t, std::vector<std::string>> errors_of;  // run -> the errors it gave
   for (const auto& [name, ids] : used)
     for (const auto id : ids) errors_of[id].push_back(name);
@@ -142,9 +143,9 @@ nlohmann::json built_model_runs(const st::RunReader& store,
 
 }  // namespace
 
-st::ModelRecord store_built_model(const std::string& db, const st::RunReader& read_from,
-                                  const std::string& machine, const mdl::Model& m,
-                                  const std::map<std::string, std::vector<std::int64_t>>& used) {
+st::ModelRecord store_built_model(
+    const std::string& db, const st::RunReader& read_from, const std::string& machine,
+    const mdl::Model& m, std::span<const std::pair<std::string, std::vector<std::int64_t>>> used) {
   auto provenance = model_provenance("daq model build");
   provenance["built_from"] = read_from.name();
   provenance["runs"] = built_model_runs(read_from, used);

@@ -89,7 +89,8 @@ void add_model_db_option(CLI::App& cmd, std::string& db);
 // the runs it was built from (`used`: error -> run ids in `read_from`), their UUIDs and versions.
 cal::storage::ModelRecord store_built_model(
     const std::string& db, const cal::storage::RunReader& read_from, const std::string& machine,
-    const cal::daq::model::Model& m, const std::map<std::string, std::vector<std::int64_t>>& used);
+    const cal::daq::model::Model& m,
+    std::span<const std::pair<std::string, std::vector<std::int64_t>>> used);
 // daq model store | list (cmd_model_store.cpp).
 void add_model_store_commands(CLI::App& model);
 
