@@ -234,6 +234,23 @@ CREATE TABLE central_approvals(
   approved_unix_ms INTEGER NOT NULL,
   server TEXT NOT NULL);
 )sql",
+    // 10 -> 11 (issue 35): machine models kept in the store (daq model build --store, daq model
+    // store), each with a stable UUID (daq sync sends and brings it once), the model file's text
+    // as written and its provenance (the runs it was built from, their versions; who stored it,
+    // from where, when). A model is never changed once stored.
+    R"sql(
+CREATE TABLE models(
+  id INTEGER PRIMARY KEY,
+  uuid TEXT NOT NULL UNIQUE,
+  machine_id INTEGER NOT NULL REFERENCES machines(id),
+  name TEXT NOT NULL DEFAULT '',
+  json TEXT NOT NULL CHECK(json <> ''),
+  provenance_json TEXT NOT NULL DEFAULT '{}',
+  stored_by TEXT NOT NULL DEFAULT '',
+  stored_from TEXT NOT NULL DEFAULT '',
+  stored_unix_ms INTEGER NOT NULL);
+CREATE INDEX models_by_machine ON models(machine_id, id);
+)sql",
 };
 static_assert(std::size(kMigrations) == schema_version);
 
@@ -467,6 +484,12 @@ CREATE TEMP TABLE operator_actions(id INTEGER PRIMARY KEY, run_id INTEGER, time_
         "result_fingerprint TEXT, run_version INTEGER, approved_by TEXT, approved_unix_ms "
         "INTEGER, server TEXT);",
         "present an older schema without central approvals (read-only)");
+  if (version < 11)  // before models were kept: none
+    exec(
+        "CREATE TEMP TABLE models(id INTEGER PRIMARY KEY, uuid TEXT, machine_id INTEGER, name "
+        "TEXT, json TEXT, provenance_json TEXT, stored_by TEXT, stored_from TEXT, stored_unix_ms "
+        "INTEGER);",
+        "present an older schema without models (read-only)");
   has_quality = version >= 5;  // older: read as it is, every run never checked
   auto has = prepare(
       "SELECT count(*) FROM pragma_table_info('reading_chunks') WHERE name IN "
@@ -677,6 +700,62 @@ std::vector<CompensationRecord> Store::compensations(std::int64_t machine_id,
                  c.created_unix_ms, c.json);
       },
       machine_id, machine_id, axis, axis);
+}
+
+std::int64_t Store::add_model(const ModelRecord& m) {
+  Impl& impl = *impl_;
+  impl.need_writable("store a model");
+  if (!m.uuid.empty() && !is_uuid(m.uuid))
+    throw StoreError(
+        fmt::format("{}: store a model: '{}' is not a UUID (8-4-4-4-12 lower-case hex)",
+                    impl.path.string(), m.uuid));
+  if (m.json.empty())
+    throw StoreError(fmt::format("{}: store a model: its text is empty", impl.path.string()));
+  if (!machine(m.machine_id))
+    throw StoreError(
+        fmt::format("{}: store a model: no machine {} here", impl.path.string(), m.machine_id));
+  const auto uuid = m.uuid.empty() ? new_uuid() : m.uuid;
+  if (model_by_uuid(uuid))
+    throw StoreError(
+        fmt::format("{}: store a model: model {} is here already", impl.path.string(), uuid));
+  auto s = impl.prepare(
+      "INSERT INTO models(uuid, machine_id, name, json, provenance_json, stored_by, stored_from, "
+      "stored_unix_ms) VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
+  bind_all(s.get(), uuid, m.machine_id, m.name, m.json, m.provenance_json, m.stored_by,
+           m.stored_from, m.stored_unix_ms ? m.stored_unix_ms : unix_ms_now());
+  impl.step_done(s.get(), fmt::format("store model {}", uuid));
+  return sqlite3_last_insert_rowid(impl.db.get());
+}
+
+namespace {
+constexpr const char* kModelColumns =
+    "SELECT id, uuid, machine_id, name, json, provenance_json, stored_by, stored_from, "
+    "stored_unix_ms FROM models";
+
+void read_model(sqlite3_stmt* s, ModelRecord& m) {
+  read_all(s, m.id, m.uuid, m.machine_id, m.name, m.json, m.provenance_json, m.stored_by,
+           m.stored_from, m.stored_unix_ms);
+}
+}  // namespace
+
+std::vector<ModelRecord> Store::models(std::int64_t machine_id) const {
+  return rows_of<ModelRecord>(
+      *impl_, std::string(kModelColumns) + " WHERE ? = 0 OR machine_id = ? ORDER BY id", read_model,
+      machine_id, machine_id);
+}
+
+std::optional<ModelRecord> Store::model(std::int64_t id) const {
+  auto rows =
+      rows_of<ModelRecord>(*impl_, std::string(kModelColumns) + " WHERE id = ?", read_model, id);
+  if (rows.empty()) return std::nullopt;
+  return std::move(rows.front());
+}
+
+std::optional<ModelRecord> Store::model_by_uuid(std::string_view uuid) const {
+  auto rows = rows_of<ModelRecord>(*impl_, std::string(kModelColumns) + " WHERE uuid = ?",
+                                   read_model, uuid);
+  if (rows.empty()) return std::nullopt;
+  return std::move(rows.front());
 }
 
 void PreparedBatch::prepare(std::span<const RawReading> readings) {

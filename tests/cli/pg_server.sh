@@ -74,9 +74,16 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
+# pg_undo_central_10: the test's server taken back to central schema 9, the models (migration 10)
+# dropped.
+pg_undo_central_10() {
+  psql_value "DROP TABLE caldaq.models; UPDATE caldaq.schema_version SET version = 9" >/dev/null
+}
+
 # pg_undo_central_8: the test's server taken back to central schema 7, the fleet view's tables,
-# functions and triggers (migrations 8 and 9) dropped.
+# functions and triggers (migrations 8, 9 and 10) dropped.
 pg_undo_central_8() {
+  pg_undo_central_10
   psql_value "DROP TABLE caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
   caldaq.fleet_tests, caldaq.fleet_series, caldaq.fleet_instruments;
 DROP INDEX caldaq.compensations_by_machine;

@@ -48,18 +48,18 @@ check password_hidden 2 "postgresql://engineer:\*\*\*@127\.0\.0\.1:1/caldaq: con
 check password_not_printed 0 "^hidden$" -- bash -c \
   "'$DAQ' sync --db '$DB' --to 'postgresql://engineer:s3cret@127.0.0.1:1/caldaq' 2>&1 | grep -q s3cret || echo hidden"
 
-# The demo's store migrated to schema 10 by the first writing open: every run and machine has its own UUID.
+# The demo's store migrated to schema 11 by the first writing open: every run and machine has its own UUID.
 RUNS=$(local_value "SELECT count(*) FROM runs")
 CHUNKS=$(local_value "SELECT count(*) FROM reading_chunks")
 check local_runs 0 "^[1-9][0-9]*$" -- echo "$RUNS"
 
 # A sync cut mid-transaction: after its 10th chunk (pages of 4: two committed, the third lost).
 check cut 75 "" -- env CALDAQ_SYNC_CUT_AFTER_CHUNKS=10 "$DAQ" sync --db "$DB" --to "$PG_URL" --chunks-per-transaction 4
-check local_schema 0 "^10$" -- local_value "PRAGMA user_version"
+check local_schema 0 "^11$" -- local_value "PRAGMA user_version"
 check local_uuids 0 "^$RUNS$" -- local_value "SELECT count(DISTINCT uuid) FROM runs WHERE uuid LIKE '________-____-4___-____-____________'"
 CUT=$(psql_value "SELECT count(*) FROM caldaq.reading_chunks")
 check cut_left_committed_pages 0 "^8$" -- echo "$CUT"
-check cut_schema 0 "^9$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check cut_schema 0 "^10$" -- psql_value "SELECT version FROM caldaq.schema_version"
 
 # Resumed: the chunks there are checked, the rest sent; every chunk once, the same bytes.
 check resume 0 "$RUNS runs synced .* $((CHUNKS - CUT)) chunks sent .*, $CUT already there" -- \

@@ -505,7 +505,8 @@ TEST(Store, BallbarCalibrationsByBarLengthAndDate) {
 
 // What schema 7 added (the runs' UUIDs), taken off a new file to make a version 6 one; a macro so
 // that it prefixes the other undo strings as a literal.
-#define CALDAQ_UNDO_SCHEMA10 "DROP TABLE central_approvals; "
+#define CALDAQ_UNDO_SCHEMA11 "DROP TABLE models; "
+#define CALDAQ_UNDO_SCHEMA10 CALDAQ_UNDO_SCHEMA11 "DROP TABLE central_approvals; "
 #define CALDAQ_UNDO_SCHEMA9 CALDAQ_UNDO_SCHEMA10 "DROP TABLE approvals; "
 #define CALDAQ_UNDO_SCHEMA8 \
   CALDAQ_UNDO_SCHEMA9 "DROP INDEX machines_by_uuid; ALTER TABLE machines DROP COLUMN uuid; "
@@ -1044,3 +1045,76 @@ TEST(Store, StoredChunksComeInOrderWithTheirChecksumsVerified) {
     EXPECT_NE(std::string(e.what()).find("checksum does not match"), std::string::npos) << e.what();
   }
 }
+
+namespace {
+
+// Issue 35: models kept in the store (schema 11). A schema 10 file (with a run) is read
+// read-only as having none and migrated in place by the next writing open, its run kept; a model
+// is kept with its text, provenance and who stored it, under a new UUID or the one it came with
+// (brought from the central store), never twice, and only for a machine of the store.
+TEST(Store, ModelsAreKeptWithTheirUuidAndASchema10FileMigratesInPlace) {
+  TempDir dir;
+  const auto file = dir.path / "laptop.sqlite";
+  std::int64_t mill = 0, run = 0;
+  std::string run_uuid;
+  {
+    Store store(file);
+    mill = store.add_machine({.name = "Mill 1"});
+    run = store.begin_run({.machine_id = mill, .kind = "linear", .axis = "X"});
+    run_uuid = store.run(run)->uuid;
+  }
+  ASSERT_EQ(exec_sql(file, CALDAQ_UNDO_SCHEMA11 "PRAGMA user_version = 10;"), "");
+  {
+    Store ro(file, {.read_only = true});
+    EXPECT_EQ(ro.version(), 10);
+    EXPECT_TRUE(ro.models().empty());
+    EXPECT_FALSE(ro.model(1));
+    EXPECT_THROW(ro.add_model({.machine_id = mill, .json = "{}"}), StoreError);
+  }
+  const std::string text = R"({"schema": "caldaq.model.v1", "name": "Mill 1"})";
+  const std::string provenance = R"({"schema": "caldaq.model-provenance.v1", "runs": []})";
+  std::int64_t first = 0;
+  std::string first_uuid;
+  {
+    Store store(file);
+    EXPECT_EQ(store.version(), 11);
+    EXPECT_EQ(store.run(run)->uuid, run_uuid);  // the run kept as it was
+    first = store.add_model({.machine_id = mill,
+                             .name = "Mill 1",
+                             .json = text,
+                             .provenance_json = provenance,
+                             .stored_by = "anna",
+                             .stored_from = "laptop-a",
+                             .stored_unix_ms = 1764000000000});
+    first_uuid = store.model(first)->uuid;
+    EXPECT_TRUE(cal::storage::is_uuid(first_uuid)) << first_uuid;
+    const auto brought = store.add_model(
+        {.uuid = "0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b", .machine_id = mill, .json = text});
+    EXPECT_EQ(brought, first + 1);
+    EXPECT_THROW(store.add_model({.uuid = first_uuid, .machine_id = mill, .json = text}),
+                 StoreError);  // here already
+    EXPECT_THROW(store.add_model({.uuid = "not-a-uuid", .machine_id = mill, .json = text}),
+                 StoreError);
+    EXPECT_THROW(store.add_model({.machine_id = mill + 7, .json = text}), StoreError);
+    EXPECT_THROW(store.add_model({.machine_id = mill, .json = ""}), StoreError);
+  }
+  Store ro(file, {.read_only = true});
+  const auto all = ro.models();
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0].id, first);
+  EXPECT_EQ(all[0].uuid, first_uuid);
+  EXPECT_EQ(all[0].machine_id, mill);
+  EXPECT_EQ(all[0].name, "Mill 1");
+  EXPECT_EQ(all[0].json, text);
+  EXPECT_EQ(all[0].provenance_json, provenance);
+  EXPECT_EQ(all[0].stored_by, "anna");
+  EXPECT_EQ(all[0].stored_from, "laptop-a");
+  EXPECT_EQ(all[0].stored_unix_ms, 1764000000000);
+  EXPECT_GT(all[1].stored_unix_ms, 1764000000000);  // 0 given: now (after 2025-11-24)
+  EXPECT_EQ(ro.model_by_uuid("0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5b")->id, first + 1);
+  EXPECT_FALSE(ro.model_by_uuid("0b6a4f1e-2c3d-4e5f-8a9b-0c1d2e3f4a5c"));
+  EXPECT_EQ(ro.models(mill).size(), 2u);
+  EXPECT_TRUE(ro.models(mill + 7).empty());
+}
+
+}  // namespace

@@ -245,7 +245,7 @@ namespace {
 // --- show ------------------------------------------------------------------------------------
 
 struct ShowOptions {
-  std::string file;
+  std::string file, db;
   bool json = false;
 };
 
@@ -287,9 +287,10 @@ void print_rotary(const mdl::RotaryEntry& r) {
 }
 
 void run_show(const ShowOptions& o) {
-  const mdl::Model m = mdl::read(o.file);
+  const auto in = read_model_input(o.file, o.db);
+  const mdl::Model& m = in.model;
   if (o.json) return fmt::print("{}", mdl::to_json(m));
-  print_line("Model {}{}", m.name.empty() ? "(unnamed)" : m.name, " (" + o.file + ")");
+  print_line("Model {}{}", m.name.empty() ? "(unnamed)" : m.name, " (" + in.label + ")");
   if (const auto origin = model_origin(m); !origin.empty()) {
     print_line("  {}: not measured on a real machine (the model's provenance)", origin);
     if (origin == "MIXED")
@@ -321,7 +322,7 @@ void run_show(const ShowOptions& o) {
 // --- map -------------------------------------------------------------------------------------
 
 struct MapOptions {
-  std::string file, points, report, method = "htm";
+  std::string file, db, points, report, method = "htm";
   std::vector<double> min_mm, max_mm;
   std::vector<std::size_t> count{5, 5, 5};
   std::size_t angle_count = 5;
@@ -353,15 +354,17 @@ kin::Grid grid_of(const MapOptions& o, const mdl::Model& m) {
 }
 
 void run_map(const MapOptions& o) {
-  const mdl::Model m = mdl::read(o.file);
+  const auto in = read_model_input(o.file, o.db);
+  const mdl::Model& m = in.model;
+  const std::string& file = in.label;  // the file, or the stored model
   const kin::Method method = method_from_string(o.method);
   if (!m.rotary.empty()) {
     if (!o.report.empty())
       throw cal::InputError(fmt::format(
-          "{}: rotary: --report does not draw a model with rotary axes yet (use --json)", o.file));
+          "{}: rotary: --report does not draw a model with rotary axes yet (use --json)", file));
     if (!o.points.empty() && !o.min_mm.empty())
       throw cal::InputError("--points maps the given poses: no grid options with it");
-    FiveAxisMapRequest q{o.file, o.points, {}, o.angle_count, method, o.json};
+    FiveAxisMapRequest q{file, o.points, {}, o.angle_count, method, o.json};
     if (o.points.empty()) q.grid = grid_of(o, m);
     return run_five_axis_map(m, q);
   }
@@ -397,7 +400,7 @@ void run_map(const MapOptions& o) {
                    std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]));
     }
     if (o.json) {
-      auto j = map_json_head("caldaq.volumetric-map.v1", o.file, method);
+      auto j = map_json_head("caldaq.volumetric-map.v1", file, method);
       j["points"] = std::move(pts);
       fmt::print("{}\n", j.dump(2));
     }
@@ -408,9 +411,9 @@ void run_map(const MapOptions& o) {
   const auto& s = mapped.summary;
   const auto& contributions = mapped.contributions;
   if (!o.report.empty())
-    write_report_page(o.report, cal::daq::report::model_page(model_page_of(m, o.file, g, method)));
+    write_report_page(o.report, cal::daq::report::model_page(model_page_of(m, file, g, method)));
   if (o.json) {
-    auto j = map_json_head("caldaq.volumetric-map.v1", o.file, method);
+    auto j = map_json_head("caldaq.volumetric-map.v1", file, method);
     j.update(mdl::model_map_json(mapped, true));
     fmt::print("{}\n", j.dump(2));
     return;
@@ -418,7 +421,7 @@ void run_map(const MapOptions& o) {
   fmt::print(
       "Volumetric error of {} ({} model), {} x {} x {} points over ({:g} .. {:g}, {:g} .. "
       "{:g}, {:g} .. {:g}) mm\n",
-      m.name.empty() ? o.file : m.name, method_name(method), g.count[0], g.count[1], g.count[2],
+      m.name.empty() ? file : m.name, method_name(method), g.count[0], g.count[1], g.count[2],
       g.min_mm[0], g.max_mm[0], g.min_mm[1], g.max_mm[1], g.min_mm[2], g.max_mm[2]);
   fmt::print("  largest |e|  {:.3f} um at ({:g}, {:g}, {:g}) mm\n", s.max_norm_um,
              s.max_norm_at_mm[0], s.max_norm_at_mm[1], s.max_norm_at_mm[2]);
@@ -446,6 +449,7 @@ void add_model_commands(CLI::App& app) {
   show->add_option("file", s->file, "Model file (caldaq.model.v1 JSON, docs/model-file.md)")
       ->required();
   show->add_flag("--json", s->json, "Print the model as normalised caldaq.model.v1 JSON");
+  add_model_db_option(*show, s->db);
 
   const auto [map, o] = add_command<MapOptions>(
       *model, "map", run_map,
@@ -471,8 +475,10 @@ void add_model_commands(CLI::App& app) {
   map->add_option("--report", o->report,
                   "Also write an HTML page: error vectors in three slices, contributions ranked");
   map->add_flag("--json", o->json, "Print caldaq.volumetric-map.v1 JSON");
+  add_model_db_option(*map, o->db);
 
   add_model_build_command(*model);
+  add_model_store_commands(*model);
   add_model_compare_command(*model);
   add_model_compensate_command(*model);
   add_model_testpiece_command(*model);

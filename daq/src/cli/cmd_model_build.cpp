@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cal/analysis/error.hpp"
+#include "cal/storage/pg/sync.hpp"
 #include "command.hpp"
 #include "database.hpp"
 #include "model/model_build.hpp"
@@ -12,6 +14,7 @@
 #include "model_cli.hpp"
 #include "model_from_runs.hpp"
 #include "run_quality.hpp"
+#include "terminal.hpp"
 
 namespace daq {
 
@@ -22,10 +25,18 @@ struct BuildCliOptions {
   std::string topology;
   std::vector<double> tool_offset_mm;
   std::vector<std::int64_t> accept_suspect;  // suspect runs used knowingly (run_quality.hpp)
-  bool allow_missing = false, json = false;
+  bool allow_missing = false, json = false, store = false;
 };
 
 void run_build(const BuildCliOptions& o) {
+  if (o.output.empty() && !o.store)
+    throw cal::InputError(
+        "give -o FILE (write the model), --store (keep it in the store), or both");
+  if (o.store && cal::storage::pg::is_postgresql_url(o.db))
+    throw cal::InputError(
+        "--store keeps the model in the local store, which it is built from: build it from the "
+        "local store (daq sync --from brings a machine's runs), or write it (-o) and keep the "
+        "file with daq model store");
   const auto reader = open_run_reader(o.db);  // either store (--db postgresql://...)
   const auto& store = *reader;
   ModelFromRunsOptions options{
@@ -39,10 +50,20 @@ void run_build(const BuildCliOptions& o) {
   const auto& stored = built.stored;
   const auto& accepted = built.accepted;
   const auto& origin = built.origin;
-  mdl::write(r.model, o.output);
-  if (o.json) return fmt::print("{}\n", model_build_json(built, o.machine, o.output).dump(2));
-  fmt::print("Model of '{}' ({}) written to {}\n", o.machine, describe_topology(built.topology),
-             o.output);
+  if (!o.output.empty()) mdl::write(r.model, o.output);
+  std::optional<cal::storage::ModelRecord> kept;
+  if (o.store) kept = store_built_model(o.db, store, o.machine, r.model, r.used);
+  if (o.json) {
+    auto j = model_build_json(built, o.machine, o.output);
+    if (kept)
+      j["stored"] = {{"db", database_path(o.db).string()}, {"id", kept->id}, {"uuid", kept->uuid}};
+    return fmt::print("{}\n", j.dump(2));
+  }
+  print_line("Model of '{}' ({}) {}", o.machine, describe_topology(built.topology),
+             o.output.empty() ? std::string("built") : "written to " + o.output);
+  if (kept)
+    print_line("Kept in {} as model {}, {} (daq model map {} --db ...)",
+               database_path(o.db).string(), kept->id, kept->uuid, kept->uuid);
   fmt::print("From the latest complete run of each component:\n");
   for (const auto& [name, ids] : r.used)
     fmt::print("  {:6} run{} {}\n", name, ids.size() > 1 ? "s" : "", fmt::join(ids, ", "));
@@ -77,7 +98,11 @@ void add_model_build_command(CLI::App& model) {
       "Assemble the model from a machine's stored runs (the latest complete run of each of the "
       "21 errors); missing errors are refused unless --allow-missing");
   cmd->add_option("--machine", o->machine, "The machine's name ([machine] name)")->required();
-  cmd->add_option("-o,--output", o->output, "The model file to write")->required();
+  cmd->add_option("-o,--output", o->output, "The model file to write (-o, --store or both)");
+  cmd->add_flag("--store", o->store,
+                "Keep the model in the local store (--db) with the runs it was built from (their "
+                "UUIDs and versions), who and when, under a stable UUID: daq model list, daq sync "
+                "and the model commands' --db read it");
   cmd->add_option("--topology", o->topology,
                   "The kinematic chain (e.g. YFXZ), when the runs do not say it");
   cmd->add_option("--tool-offset-mm", o->tool_offset_mm, "Tool tip from the tool reference point")

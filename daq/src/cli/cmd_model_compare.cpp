@@ -18,7 +18,7 @@ namespace daq {
 namespace {
 
 struct CompareOptions {
-  std::string reference, other;
+  std::string reference, other, db;
   std::vector<std::size_t> count{11, 11, 11};
   bool json = false;
 };
@@ -87,12 +87,17 @@ void print_text(const CompareOptions& o, const mdl::Model& ref, const mdl::Compa
       print_line("  {:6} {:9.4f}  at {:g} mm", d.name, d.max_abs, d.at_mm);
 }
 
-void run_compare(const CompareOptions& o) {
-  if (o.count.size() != 3 ||
-      std::any_of(o.count.begin(), o.count.end(), [](auto n) { return n == 0 || n > 101; }))
+void run_compare(const CompareOptions& given) {
+  if (given.count.size() != 3 ||
+      std::any_of(given.count.begin(), given.count.end(), [](auto n) { return n == 0 || n > 101; }))
     throw cal::InputError("--count needs three counts from 1 to 101 (X Y Z)");
-  const auto ref = mdl::read(o.reference);
-  const auto other = mdl::read(o.other);
+  const auto ref_in = read_model_input(given.reference, given.db);
+  const auto other_in = read_model_input(given.other, given.db);
+  CompareOptions o = given;  // the files, or the stored models: what the output names
+  o.reference = ref_in.label;
+  o.other = other_in.label;
+  const auto& ref = ref_in.model;
+  const auto& other = other_in.model;
   mdl::require_no_rotary(ref, o.reference, "daq model compare");
   mdl::require_no_rotary(other, o.other, "daq model compare");
   const auto c = mdl::compare(ref, other, {o.count[0], o.count[1], o.count[2]});
@@ -114,6 +119,7 @@ void add_model_compare_command(CLI::App& model) {
       ->expected(3)
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print caldaq.model-compare.v1 JSON");
+  add_model_db_option(*cmd, o->db);
 }
 
 }  // namespace daq

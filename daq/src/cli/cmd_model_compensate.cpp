@@ -397,16 +397,21 @@ std::optional<ToStore> to_store(const Options& o, const Written& w) {
 
 void store_with_machine(const Options& o, const ToStore& s, const std::string& origin) {
   cal::storage::Store store(database_path(o.db));
-  const auto id = store_cross_compensation(store, s.machine_id, 0, fmt::format("model {}", o.file),
-                                           s.compensation, {{"label", origin}});
+  // The source: "model FILE", or a stored model's label ("model UUID") as it is.
+  const auto source = o.file.starts_with("model ") ? o.file : "model " + o.file;
+  const auto id =
+      store_cross_compensation(store, s.machine_id, 0, source, s.compensation, {{"label", origin}});
   fmt::print(stderr,
              "stored as compensation {} of machine '{}': the next straightness run of an axis it "
              "corrects is compared with it (daq verify RUN)\n",
              id, o.machine);
 }
 
-void run(const Options& o) {
-  const mdl::Model m = mdl::read(o.file);
+void run(const Options& given) {
+  const auto in = read_model_input(given.file, given.db);
+  Options o = given;
+  o.file = in.label;  // the file, or the stored model: what the output names
+  const mdl::Model& m = in.model;
   mdl::require_no_rotary(m, o.file, "daq model compensate (the linear axes' tables)");
   const auto g = grid_of(o, m);
   const kin::Vec3 ref = reference_of(o, g);
@@ -503,7 +508,10 @@ void add_model_compensate_command(CLI::App& model) {
   const auto [cmd, o] = add_command<Options>(
       model, "compensate", run,
       "The model's compensation in a controller format, with what remains when applied");
-  cmd->add_option("file", o->file, "Model file (caldaq.model.v1)")->required();
+  cmd->add_option("file", o->file,
+                  "Model file (caldaq.model.v1), or a model kept in the store --db names (its "
+                  "UUID or number: daq model list)")
+      ->required();
   cmd->add_option("-f,--format", o->format,
                   "csv, siemens-cec, isg-cross, isg-volumetric, heidenhain, fanuc or linuxcnc")
       ->capture_default_str();

@@ -18,7 +18,7 @@ namespace daq {
 namespace {
 
 struct Options {
-  std::string file, format = "linuxcnc-trt", output;
+  std::string file, format = "linuxcnc-trt", output, db;
   int record = 1;
   bool reverse_angles = false;
 };
@@ -43,12 +43,15 @@ Written sinumerik(const kin::FiveAxisMachine& m, const std::string& origin, cons
   return {kin::sinumerik_swivel_program(record, origin), "swivel data", {}};
 }
 
-void run(const Options& o) {
-  if (o.format == "heidenhain")
+void run(const Options& given) {
+  if (given.format == "heidenhain")
     throw cal::InputError(std::string(kin::heidenhain_not_written_reason()));
-  if (o.format != "sinumerik-cycle800" && (o.record != 1 || o.reverse_angles))
+  if (given.format != "sinumerik-cycle800" && (given.record != 1 || given.reverse_angles))
     throw cal::InputError("--record and --reverse-angles are for -f sinumerik-cycle800");
-  const mdl::Model m = mdl::read(o.file);
+  const auto in = read_model_input(given.file, given.db);
+  Options o = given;
+  o.file = in.label;  // the file, or the stored model: what the output names
+  const mdl::Model& m = in.model;
   const std::string origin = model_origin(m);
   const std::string from = fmt::format(
       "from the model {}{}", o.file, origin.empty() ? "" : " (" + origin + ": not a real machine)");
@@ -75,6 +78,7 @@ void add_model_kinematics_command(CLI::App& model) {
       "SINUMERIK CYCLE800 swivel data record ($TC_CARR, kinematics type P) for one or two table "
       "axes; HEIDENHAIN is refused (the public text does not state the values' meaning)");
   cmd->add_option("file", o->file, "Model file with rotary axes (caldaq.model.v2)")->required();
+  add_model_db_option(*cmd, o->db);
   cmd->add_option("-f,--format", o->format,
                   "linuxcnc-trt (the module follows the model's axes), sinumerik-cycle800, or "
                   "heidenhain (refused, says why)")

@@ -20,7 +20,7 @@ namespace {
 namespace tp = cal::testpiece;
 
 struct Options {
-  std::string file, cmm;
+  std::string file, cmm, db;
   std::vector<double> origin_mm;
   double tool_radius_mm = 0.0;
   tp::Layout layout;
@@ -82,8 +82,11 @@ std::vector<Row> rows_of(const tp::Result& p, const std::optional<tp::Result>& m
   return rows;
 }
 
-void run(const Options& o) {
-  const mdl::Model model = mdl::read(o.file);
+void run(const Options& given) {
+  const auto in = read_model_input(given.file, given.db);
+  Options o = given;
+  o.file = in.label;  // the file, or the stored model: what the output names
+  const mdl::Model& model = in.model;
   mdl::require_no_rotary(model, o.file, "daq model testpiece");
   if (o.origin_mm.size() != 3)
     throw cal::InputError("--origin-mm needs X Y Z (Z: the cutting height)");
@@ -155,6 +158,7 @@ void add_model_testpiece_command(CLI::App& model) {
       "Predict the test piece (faces' straightness, squareness, parallelism; bores' circularity "
       "and position) and compare CMM points");
   cmd->add_option("file", o->file, "Model file (caldaq.model.v1)")->required();
+  add_model_db_option(*cmd, o->db);
   cmd->add_option("--origin-mm", o->origin_mm,
                   "Machine position of the part's centre X Y and the cutting height Z")
       ->expected(3)

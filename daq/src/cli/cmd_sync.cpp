@@ -1,9 +1,6 @@
 // daq sync --to postgresql://...: the local runs copied to the central store (issue 35;
 // docs/storage.md, "Central store"); daq approve: a reviewer's sign-off of a result, in either
 // store ("Sign-off").
-#include <pwd.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -56,19 +53,6 @@ std::int64_t cut_after_chunks() {
     throw cal::InputError(
         fmt::format("CALDAQ_SYNC_CUT_AFTER_CHUNKS: '{}' is not a positive whole number", env));
   return n;
-}
-
-// Who sends (recorded with a new version of a run's stops): $USER, else the account's name.
-std::string user_name() {
-  if (const char* user = std::getenv("USER"); user && *user) return user;
-  if (const passwd* pw = getpwuid(geteuid())) return pw->pw_name;
-  return "?";
-}
-
-std::string host_name() {
-  char name[256] = {};
-  if (gethostname(name, sizeof name - 1) != 0) return "?";
-  return name;
 }
 
 // The sync's progress (issue 34), hooked into `options` beside the test's cut: the chunks done
@@ -191,16 +175,18 @@ void run_pull(const SyncCliOptions& o) {
                                {"compensations_new", report.compensations_new},
                                {"calibrations_new", report.calibrations_new},
                                {"approvals_new", report.approvals_new},
-                               {"operator_actions_refreshed", report.operator_actions_refreshed}}
+                               {"operator_actions_refreshed", report.operator_actions_refreshed},
+                               {"models_new", report.models_new}}
                     .dump(2));
   print_line(
       "{}: {} runs of machine '{}' brought from {} (central schema {}): {} new, {} new results; "
       "{} chunks received ({} bytes), {} already here; {} compensation tables, {} ballbar "
-      "calibrations, {} approvals new; {} runs' operator actions refreshed",
+      "calibrations, {} approvals new; {} runs' operator actions refreshed; {} models new",
       path.string(), report.runs, cal::text::terminal_safe(o.machine), st::pg::redacted(o.from),
       report.server_schema, report.runs_new, report.results_new, report.chunks_received,
       report.bytes_received, report.chunks_already, report.compensations_new,
-      report.calibrations_new, report.approvals_new, report.operator_actions_refreshed);
+      report.calibrations_new, report.approvals_new, report.operator_actions_refreshed,
+      report.models_new);
 }
 
 void run_sync(const SyncCliOptions& o) {
@@ -243,11 +229,13 @@ void run_sync(const SyncCliOptions& o) {
                                              {"bytes_sent", report.bytes_sent},
                                              {"chunks_already", report.chunks_already},
                                              {"chunks_verified", report.chunks_verified_bytes},
-                                             {"versions_new", report.versions_new}}
+                                             {"versions_new", report.versions_new},
+                                             {"models", report.models},
+                                             {"models_new", report.models_new}}
                                   .dump(2));
   print_line(
       "{}: {} runs synced to {} (central schema {}): {} new; {} chunks sent ({} bytes), {} "
-      "already there{}{}",
+      "already there{}{}{}",
       local.path().string(), report.runs, st::pg::redacted(o.to), report.server_schema,
       report.runs_new, report.chunks_sent, report.bytes_sent, report.chunks_already,
       o.verify ? fmt::format("; {} chunks read back and their checksums verified",
@@ -256,7 +244,10 @@ void run_sync(const SyncCliOptions& o) {
       report.versions_new ? fmt::format("; {} runs' stops differ from the server's: kept as a new "
                                         "version (daq show names the versions)",
                                         report.versions_new)
-                          : std::string());
+                          : std::string(),
+      // Only for a store that keeps models (the line is as before otherwise).
+      report.models ? fmt::format("; {} models synced, {} new", report.models, report.models_new)
+                    : std::string());
 }
 
 struct ApproveOptions {
@@ -342,9 +333,10 @@ void add_sync_command(CLI::App& app) {
   cmd->add_option("--to", o->to,
                   "The central store: postgresql://[user[:password]@]host[:port]/database "
                   "(libpq URI; also ?host=/socket/dir)");
-  cmd->add_option("--from", o->from,
-                  "Bring a machine's history (runs, results, readings, compensation tables, "
-                  "ballbar calibrations) from this central store into the local one (--machine)");
+  cmd->add_option(
+      "--from", o->from,
+      "Bring a machine's history (runs, results, readings, compensation tables, "
+      "models, ballbar calibrations) from this central store into the local one (--machine)");
   cmd->add_option("--machine", o->machine,
                   "With --from: the machine, by its name on the server or by its UUID (when "
                   "two sites' machines share the name)");

@@ -1,6 +1,8 @@
 #include "database.hpp"
 
 #include <fmt/format.h>
+#include <pwd.h>
+#include <unistd.h>
 
 #include <cstdlib>
 
@@ -49,6 +51,18 @@ cal::storage::Store open_database_read_only(const std::string& option) {
 std::unique_ptr<cal::storage::RunReader> open_run_reader(const std::string& option) {
   if (cal::storage::pg::is_postgresql_url(option)) return cal::storage::pg::open_central(option);
   return std::make_unique<cal::storage::Store>(open_database_read_only(option));
+}
+
+std::string user_name() {
+  if (const char* user = std::getenv("USER"); user && *user) return user;
+  if (const passwd* pw = getpwuid(geteuid())) return pw->pw_name;
+  return "?";
+}
+
+std::string host_name() {
+  char name[256] = {};
+  if (gethostname(name, sizeof name - 1) != 0) return "?";
+  return name;
 }
 
 void add_db_option(CLI::App& cmd, std::string& target) {

@@ -23,6 +23,10 @@ cal::storage::Store open_database_read_only(const std::string& option);
 // postgresql:// URI, the central store (storage/pg), through one interface. The commands that
 // write refuse such a URI with that reason (database_path, open_database_read_only).
 std::unique_ptr<cal::storage::RunReader> open_run_reader(const std::string& option);
+// Who and where, recorded with what is stored or sent (a run's version, a model): $USER, else
+// the account's name; the host's name ("?" when unknown).
+std::string user_name();
+std::string host_name();
 // Adds the --db option to a command; add_read_db_option's help names the central store too.
 void add_db_option(CLI::App& cmd, std::string& target);
 void add_read_db_option(CLI::App& cmd, std::string& target);

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "cal/storage/store.hpp"
 #include "model/model_file.hpp"
 #include "model/model_map.hpp"
 #include "report/model_report.hpp"
@@ -73,6 +74,25 @@ struct FiveAxisMapRequest {
 void run_five_axis_map(const cal::daq::model::Model& m, const FiveAxisMapRequest& q);
 // The CSV columns of a pose's angles, one per rotary axis in chain order: "c_deg", "a_deg", ...
 std::vector<std::string> rotary_angle_columns(const cal::daq::model::Model& m);
+
+// The model a command reads (cmd_model_store.cpp): a file, or with `db` given (--db) a model
+// kept in that store, local or central, named by its UUID or its number there. `label` names it
+// in the output: the file, or "model UUID" (the same from every store).
+struct ModelInput {
+  cal::daq::model::Model model;
+  std::string label;
+};
+ModelInput read_model_input(const std::string& arg, const std::string& db);
+// --db for a command that reads a model (the model argument then names a stored one).
+void add_model_db_option(CLI::App& cmd, std::string& db);
+// daq model build --store: keeps the model built in the local store at `db` for `machine`, with
+// the runs it was built from (`used`: error -> run ids in `read_from`), their UUIDs and versions.
+cal::storage::ModelRecord store_built_model(
+    const std::string& db, const cal::storage::RunReader& read_from, const std::string& machine,
+    const cal::daq::model::Model& m,
+    std::span<const std::pair<std::string, std::vector<std::int64_t>>> used);
+// daq model store | list (cmd_model_store.cpp).
+void add_model_store_commands(CLI::App& model);
 
 // daq model compensate / daq model testpiece (their own files).
 void add_model_compensate_command(CLI::App& model);

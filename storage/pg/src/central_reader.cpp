@@ -77,6 +77,17 @@ BarCalibration calibration_row(const pqxx::row& row) {
   return c;
 }
 
+constexpr const char* kModelColumns =
+    "SELECT id, uuid, machine_id, name, json, provenance_json, stored_by, stored_from, "
+    "stored_unix_ms FROM caldaq.models";
+
+ModelRecord model_row(const pqxx::row& row) {
+  ModelRecord m;
+  read_row(row, m.id, m.uuid, m.machine_id, m.name, m.json, m.provenance_json, m.stored_by,
+           m.stored_from, m.stored_unix_ms);
+  return m;
+}
+
 // " AND k.quantity IN (1, 2)": the quantities are small numbers, written into the SQL.
 std::string quantity_filter(std::span<const std::uint8_t> quantities) {
   if (quantities.empty()) return {};
@@ -384,6 +395,23 @@ class CentralReader final : public RunReader {
           return c;
         },
         machine_id, std::string(axis));
+  }
+
+  std::vector<ModelRecord> models(std::int64_t machine_id = 0) const override {
+    return all<ModelRecord>(
+        "read the models",
+        std::string(kModelColumns) + " WHERE $1 = 0 OR machine_id = $1 ORDER BY id", model_row,
+        machine_id);
+  }
+  std::optional<ModelRecord> model(std::int64_t id) const override {
+    return one<ModelRecord>(fmt::format("read model {}", id),
+                            std::string(kModelColumns) + " WHERE id = $1", model_row, id);
+  }
+  std::optional<ModelRecord> model_by_uuid(std::string_view uuid) const override {
+    if (!is_uuid(uuid)) return std::nullopt;  // the server would refuse it as a uuid
+    return one<ModelRecord>(fmt::format("read model {}", uuid),
+                            std::string(kModelColumns) + " WHERE uuid = $1::uuid", model_row,
+                            std::string(uuid));
   }
 
   std::vector<RunVersion> versions(std::int64_t run_id) const override {

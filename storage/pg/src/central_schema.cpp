@@ -389,6 +389,31 @@ GRANT UPDATE (uuid) ON caldaq.machines TO caldaq_engineer;
     // 9: the fleet's straightness, angular and roll runs, and each trend's window
     // (fleet_schema_9.hpp).
     kFleetKindsWindowMigration,
+    // 10 (local schema 11): machine models, known by their UUID (sent twice, stored once), each
+    // of a machine of the server; never changed once stored (an engineer inserts, nobody
+    // updates). A model is visible and writable where its machine is: the machines' own policy
+    // decides, so a machine moved to another site takes its models along.
+    R"sql(
+CREATE TABLE caldaq.models(
+  uuid uuid PRIMARY KEY,
+  id bigint GENERATED ALWAYS AS IDENTITY UNIQUE,
+  machine_id bigint NOT NULL REFERENCES caldaq.machines(id),
+  name text NOT NULL,
+  json text NOT NULL CHECK(json <> ''),
+  provenance_json text NOT NULL,
+  stored_by text NOT NULL,
+  stored_from text NOT NULL,
+  stored_unix_ms bigint NOT NULL,
+  sent_by text NOT NULL DEFAULT session_user,
+  synced_unix_ms bigint NOT NULL);
+CREATE INDEX models_by_machine ON caldaq.models(machine_id, id);
+ALTER TABLE caldaq.models ENABLE ROW LEVEL SECURITY;
+CREATE POLICY by_site ON caldaq.models
+  USING (EXISTS (SELECT 1 FROM caldaq.machines AS m WHERE m.id = machine_id));
+REVOKE ALL ON caldaq.models FROM PUBLIC;
+GRANT SELECT ON caldaq.models TO caldaq_engineer, caldaq_reviewer;
+GRANT INSERT ON caldaq.models TO caldaq_engineer;
+)sql",
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 

@@ -102,6 +102,7 @@ class Pull {
       if (r.machine_id == machine_.id) pull_run(r);
     pull_compensations(machine_.id);
     pull_calibrations();
+    pull_models(machine_.id);
     return report_;
   }
 
@@ -357,6 +358,17 @@ class Pull {
       c.source_run_id = source_here ? source_here->id : 0;
       local_.add_compensation(c);
       ++report_.compensations_new;
+    }
+  }
+
+  // The machine's models this store lacks (by UUID), as stored where they were made: their
+  // text, provenance, who stored them, from where and when.
+  void pull_models(std::int64_t server_machine) {
+    for (auto m : server_->models(server_machine)) {
+      if (local_.model_by_uuid(m.uuid)) continue;
+      m.machine_id = local_machine_;
+      local_.add_model(m);
+      ++report_.models_new;
     }
   }
 

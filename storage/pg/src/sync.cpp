@@ -107,6 +107,7 @@ class Sync {
     for (const auto& r : runs) sync_run(r);
     guarded(shown_, "store the compensation tables and ballbar calibrations",
             [&] { send_records(); });
+    guarded(shown_, "store the models", [&] { send_models(); });
     return report_;
   }
 
@@ -287,6 +288,34 @@ class Sync {
           c.bar, c.nominal_mm, c.extensions, c.calibrator, c.calibrator_length_mm, c.reading_mm,
           c.zero_length_mm, c.temperature_degc ? fmt::format("{}", *c.temperature_degc) : "",
           c.calibrated_unix_ms, c.note);
+    w.commit();
+  }
+
+  // The local store's models (schema 11), each stored once by its UUID (a model is never changed,
+  // so one the server has is left as it is), of its machine's server id and site.
+  void send_models() {
+    const auto models = local_.models();
+    if (models.empty()) return;
+    // A machine new to the server takes its site from its latest run, as when its runs are sent.
+    std::map<std::int64_t, std::string> settings;  // machine -> its latest run's settings
+    for (const auto& r : local_.runs()) settings[r.machine_id] = r.settings_json;
+    pqxx::work w(*conn_);
+    for (const auto& m : models) {
+      const auto what = fmt::format("model {}", m.uuid);
+      const auto machine = server_machine(w, m.machine_id, settings[m.machine_id]);
+      try {
+        const auto rows = w.exec_params(
+            "INSERT INTO caldaq.models(uuid, machine_id, name, json, provenance_json, stored_by, "
+            "stored_from, stored_unix_ms, synced_unix_ms) VALUES($1, $2, $3, $4, $5, $6, $7, $8, "
+            "$9) ON CONFLICT (uuid) DO NOTHING RETURNING id",
+            m.uuid, machine.id, m.name, m.json, m.provenance_json, m.stored_by, m.stored_from,
+            m.stored_unix_ms, unix_ms_now());
+        ++report_.models;
+        if (!rows.empty()) ++report_.models_new;
+      } catch (const pqxx::sql_error& e) {
+        refused(e, what, machine.site);
+      }
+    }
     w.commit();
   }
 

@@ -38,7 +38,9 @@ class StoreError : public std::runtime_error {
 // 9 (issue 35): sign-off: a result's approval (Approval: who, when), which a report needs to be
 // issued as a certificate (central schema 6 has its own, with the reviewers' role). 10 (issue
 // 35): the central server's approvals of the results brought by daq sync --from, read-only here.
-inline constexpr int schema_version = 10;
+// 11 (issue 35): machine models kept in the store (ModelRecord), with their provenance and a
+// stable UUID, which daq sync sends and brings like runs.
+inline constexpr int schema_version = 11;
 
 // A new random (version 4) UUID in its canonical lower-case text form.
 std::string new_uuid();
@@ -104,6 +106,25 @@ struct CompensationRecord {
   std::string format;
   std::int64_t created_unix_ms = 0;  // 0: now
   std::string json;                  // caldaq.compensation.v1 (docs/compensation-tables.md)
+};
+
+// A machine model kept in a store (schema 11; central schema 10): the model file's JSON
+// (caldaq.model.v1/v2, docs/model-file.md) as daq model build wrote it, with where it came from.
+// Never changed once stored (a model built again is another one); known in every store by its
+// UUID, so sending it twice stores it once.
+struct ModelRecord {
+  std::int64_t id = 0;  // the store's number (set when stored; the central store numbers its own)
+  std::string uuid;     // its stable identity (a new one when stored without)
+  std::int64_t machine_id = 0;  // the store's machine it models
+  std::string name;             // the model's name (its "name")
+  std::string json;             // the model file's text
+  // caldaq.model-provenance.v1 (docs/storage.md, "Models"): how it was made and stored: the
+  // command, the runs it was built from (their UUIDs, ids, kinds, start times and versions of
+  // their stops), the file it was read from.
+  std::string provenance_json = "{}";
+  std::string stored_by;            // who stored it (the OS account where it was stored)
+  std::string stored_from;          // the host
+  std::int64_t stored_unix_ms = 0;  // when (0 when stored: now)
 };
 
 // One raw reading (the storage's own POD, so storage does not depend on drivers).
@@ -305,6 +326,11 @@ class RunReader {
   virtual std::vector<RunVersion> versions(std::int64_t /*run_id*/) const { return {}; }
   // The approvals of the run's results, oldest first.
   virtual std::vector<Approval> approvals(std::int64_t run_id) const = 0;
+  // The models kept (schema 11), by id (machine_id 0: every machine's); one by the store's
+  // number or by its UUID (nullopt: none).
+  virtual std::vector<ModelRecord> models(std::int64_t machine_id = 0) const = 0;
+  virtual std::optional<ModelRecord> model(std::int64_t id) const = 0;
+  virtual std::optional<ModelRecord> model_by_uuid(std::string_view uuid) const = 0;
 };
 
 // A reading chunk as a store hands it to a ReadingStream: its row and its bytes.
@@ -465,6 +491,14 @@ class Store : public RunReader {
   std::int64_t add_compensation(const CompensationRecord& c);
   std::vector<CompensationRecord> compensations(std::int64_t machine_id = 0,
                                                 std::string_view axis = {}) const override;
+
+  // Keeps a model (returns its id): its UUID kept when given (a model brought by daq sync
+  // --from), else a new one. Throws StoreError for a machine not here, a UUID that is not one or
+  // is here already, an empty model text.
+  std::int64_t add_model(const ModelRecord& m);
+  std::vector<ModelRecord> models(std::int64_t machine_id = 0) const override;
+  std::optional<ModelRecord> model(std::int64_t id) const override;
+  std::optional<ModelRecord> model_by_uuid(std::string_view uuid) const override;
 
   // Sign-off (schema 9): records that `approved_by` approved result `result_id` of the run, now.
   // Refused (StoreError saying why) for a result of another run, one superseded since (a

@@ -34,7 +34,9 @@ namespace cal::storage::pg {
 // server (daq serve --db postgresql://...: docs/web.md "The fleet view").
 // 9: the fleet's straightness, angular and roll runs; each trend line's window (the last
 // compensation table or switch of the control's compensation that resets it).
-inline constexpr int central_schema_version = 9;
+// 10 (with local schema 11): machine models (caldaq.models), known by their UUID, of a machine
+// (visible and writable where their machine is).
+inline constexpr int central_schema_version = 10;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
@@ -75,6 +77,8 @@ struct SyncReport {
   std::int64_t chunks_verified_bytes = 0;  // chunks whose server bytes were re-read (verify_bytes)
   std::int64_t bytes_sent = 0;             // chunk BLOB bytes copied now
   std::int64_t versions_new = 0;  // runs whose stops differ from every version the server had
+  std::int64_t models = 0;        // models of the local store (schema 11) synced
+  std::int64_t models_new = 0;    // of which the server did not have before
   int server_schema = 0;          // the central schema version after migration
 };
 
@@ -113,6 +117,7 @@ struct PullReport {
   std::int64_t bytes_received = 0;     // chunk BLOB bytes copied now
   std::int64_t compensations_new = 0;  // compensation tables of the machine brought
   std::int64_t calibrations_new = 0;   // ballbar calibrations brought
+  std::int64_t models_new = 0;         // models of the machine brought (central schema 10)
   std::int64_t approvals_new = 0;      // the server's approvals of results here brought (schema 7)
   std::int64_t operator_actions_refreshed = 0;  // runs brought before whose actions changed there
   int server_schema = 0;
