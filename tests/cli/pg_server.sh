@@ -75,9 +75,11 @@ psql_value() {
 }
 
 # pg_undo_central_8: the test's server taken back to central schema 7, the fleet view's tables,
-# functions and triggers (migrations 8 and 9) dropped.
+# functions and triggers (migrations 8 and 9) dropped, and what later migrations added (11: the
+# results' versions).
 pg_undo_central_8() {
-  psql_value "DROP TABLE caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
+  psql_value "DROP TABLE IF EXISTS caldaq.result_versions;
+DROP TABLE caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,
   caldaq.fleet_tests, caldaq.fleet_series, caldaq.fleet_instruments;
 DROP INDEX caldaq.compensations_by_machine;
 DROP FUNCTION caldaq.fleet_run_changed, caldaq.fleet_result_changed, caldaq.fleet_approval_changed,

@@ -34,7 +34,10 @@ namespace cal::storage::pg {
 // server (daq serve --db postgresql://...: docs/web.md "The fleet view").
 // 9: the fleet's straightness, angular and roll runs; each trend line's window (the last
 // compensation table or switch of the control's compensation that resets it).
-inline constexpr int central_schema_version = 9;
+// 10: h35a's (local models), merged before 11.
+// 11: each result tied to the version of the run's stops it was computed from (result_versions);
+// the readers read the chosen (else current) version's results only.
+inline constexpr int central_schema_version = 11;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
