@@ -146,7 +146,7 @@ def paged(b):
 
 with Browser(width=1366, height=768) as b:
     b.get(url + "/")
-    b.wait("return document.body.dataset.rendered !== undefined", what="the fleet to render")
+    b.wait("return document.body.dataset.complete !== undefined", what="the fleet to render")
     if mode == "few":
         few(b, sys.argv[4])
     else:

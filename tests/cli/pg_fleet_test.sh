@@ -27,7 +27,7 @@ trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP"
 
 check sync_a 0 "runs synced" -- "$DAQ" sync --db "$A" --to "$PG_URL" --quiet
 check sync_b 0 "runs synced" -- "$DAQ" sync --db "$B" --to "$PG_URL" --quiet
-check schema 0 "^10$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check schema 0 "^11$" -- psql_value "SELECT version FROM caldaq.schema_version"
 # A reviewer approves laptop A's first linear run (server run 1).
 psql_value "CREATE ROLE rev LOGIN IN ROLE caldaq_reviewer; CREATE ROLE eng LOGIN IN ROLE caldaq_engineer; INSERT INTO caldaq.site_grants VALUES ('rev', '*'), ('eng', '*')" >/dev/null
 check approve 0 "approved by rev" -- "$DAQ" approve 1 --db "postgresql:///caldaq?host=$PGTMP&user=rev"
@@ -237,6 +237,31 @@ if names[:5] != [f"Machine {i}" for i in range(26, 31)] or not names[5].startswi
 print("paged ok")
 EOF
 check paged_page 0 "page ok" -- "$PY" "$(dirname "$0")/pg_fleet_page.py" "$URL" "${SHOTS:-$TMP}" paged
+
+# A few connections, kept (issue 35): the serve's connections to the server (login eng) stay
+# between requests, at most 4 of them however many requests come at once, and the same ones
+# answer the next requests (a connection per request, as before, left none open between them).
+eng_backends() {
+  psql_value "SELECT string_agg(pid::text, ' ' ORDER BY pid) FROM pg_stat_activity WHERE usename = 'eng' AND backend_type = 'client backend'"
+}
+at_once() {  # 24 requests for machine MID, 12 at a time: how many answered as the first did
+  local i n=0
+  for i in $(seq 24); do curl -sf -o "$TMP/c$i.json" "$URL/api/fleet/machines/$MID" & [ $((i % 12)) -eq 0 ] && wait; done
+  for i in $(seq 24); do cmp -s "$TMP/c1.json" "$TMP/c$i.json" && n=$((n + 1)); done
+  echo "$n answered alike"
+}
+check pool_at_once 0 "^24 answered alike$" -- at_once
+KEPT=$(eng_backends)
+check pool_bounded 0 "^[1-4]$" -- bash -c "echo '$KEPT' | wc -w"
+curl -sf -o /dev/null "$URL/api/fleet"
+check pool_reused 0 "^$KEPT$" -- eng_backends
+# The server restarted under the running serve: its kept connections are broken; the next
+# request is answered (on a new connection), as are those after it.
+check pg_restart 0 "" -- pg_as_owner "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m fast -w restart -l "$PG_DIR/server.log"
+check after_restart 0 "^200 .*caldaq.fleet.v2" -- bash -c "curl -s -o '$TMP/after.json' -w '%{http_code} ' '$URL/api/fleet'; cat '$TMP/after.json'"
+check after_restart_all 0 "^24 answered alike$" -- at_once
+AFTER=$(eng_backends)
+check new_connections 0 "^differ [1-4]$" -- bash -c "[ '$AFTER' != '$KEPT' ] && echo differ \$(echo '$AFTER' | wc -w)"
 kill $SERVE_PID
 wait $SERVE_PID 2>/dev/null
 SERVE_PID=

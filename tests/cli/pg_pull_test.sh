@@ -231,6 +231,48 @@ check show_json_version2 0 "^2 False$" -- bash -c \
 check analyse_version2_is_alices 0 "^same [1-9]" -- bash -c \
   "diff <('$DAQ' analyse $ALICE1 --db '$ALICE') <('$DAQ' analyse 1 --version 2 --db '$PG_URL') && echo same \$('$DAQ' analyse $ALICE1 --db '$ALICE' | wc -l)"
 check no_version4 2 "run 1 has no version 4 \(it has 1 to 3" -- "$DAQ" show 1 --version 4 --db "$PG_URL"
+# Results tied to their version (central schema 11): a version's current results are those
+# computed from its stops, never another version's beside them (before, version 1's stops were
+# shown beside alice's and bob's results, both current). E and M (ISO 230-2) computed here from
+# the stops of the store that sent each version, never from daq's output: the mean deviation per
+# target and direction; E the range of those means, M the range of their bidirectional means
+# (the mean of the two directions' at each target).
+cat >"$TMP/hand_em.py" <<'PY'
+import sqlite3, sys
+from collections import defaultdict
+stops = defaultdict(list)
+for t, d, dev in sqlite3.connect(sys.argv[1]).execute(
+        "SELECT target_index, direction, deviation_um FROM captured_targets WHERE run_id = ?",
+        (int(sys.argv[2]),)):
+    stops[(t, d)].append(dev)
+mean = {k: sum(v) / len(v) for k, v in stops.items()}
+bi = [(mean[(t, "+")] + mean[(t, "-")]) / 2 for t in {t for t, _ in mean}]
+print(f"{max(mean.values()) - min(mean.values()):.6f} {max(bi) - min(bi):.6f}")
+PY
+# The current results of daq show --json (stdin): "COUNT E M ..." of each.
+cat >"$TMP/shown_em.py" <<'PY'
+import json, sys
+current = [r for r in json.load(sys.stdin)["results"] if r["current"]]
+axis = lambda r: r["result"]["axis"]
+print(len(current), *(f"{axis(r)[k]['value_um']:.6f}" for r in current for k in ("E_bi", "M")))
+PY
+BOB1=$(value "$BOB" "SELECT id FROM runs WHERE uuid = '$RUN1'")
+EM1=$("$PY" "$TMP/hand_em.py" "$DB" 1)
+EM2=$("$PY" "$TMP/hand_em.py" "$ALICE" "$ALICE1")
+EM3=$("$PY" "$TMP/hand_em.py" "$BOB" "$BOB1")
+check em_differ 0 "^3$" -- bash -c "printf '%s\n' '$EM1' '$EM2' '$EM3' | sort -u | wc -l"
+check results_version1 0 "^1 $EM1$" -- bash -c "'$DAQ' show 1 --version 1 --json --db '$PG_URL' | '$PY' '$TMP/shown_em.py'"
+check results_version2 0 "^1 $EM2$" -- bash -c "'$DAQ' show 1 --version 2 --json --db '$PG_URL' | '$PY' '$TMP/shown_em.py'"
+check results_current 0 "^1 $EM3$" -- bash -c "'$DAQ' show 1 --json --db '$PG_URL' | '$PY' '$TMP/shown_em.py'"
+# The report of version 2: page one names it and gives its E (3 decimals, as printed).
+E2=$(printf '%.3f' "${EM2% *}")
+check report_version2 0 "written to" -- "$DAQ" report 1 --version 2 --db "$PG_URL" -f pdf -o "$TMP/v2.pdf"
+check report_version2_page1 0 "^named $E2$" -- bash -c \
+  "pdftotext -f 1 -l 1 '$TMP/v2.pdf' - | tr '\n' ' ' | grep -q \"Version 2 of 3 of the run's stops: sent by alice\" && pdftotext -f 1 -l 1 '$TMP/v2.pdf' - | grep -o -m1 '$E2' | sed 's/^/named /'"
+check report_version_local 2 "run 1 has no version 2 here: a local store keeps one version" -- \
+  "$DAQ" report 1 --version 2 --db "$DB"
+check report_version_one_run 2 "--version N is for the report of one RUN" -- \
+  "$DAQ" report 1 2 --version 2 --db "$PG_URL"
 check local_one_version 2 "run $ALICE1 has no version 2 here: a local store keeps one version" -- \
   "$DAQ" export "$ALICE1" --version 2 --db "$ALICE"
 VISIT2=$TMP/visit-v2.sqlite
@@ -243,6 +285,8 @@ check pull_version 0 "runs of machine" -- \
   "$DAQ" sync --db "$VISIT2" --from "$PG_URL" --machine "$MACHINE" --version "$RUN1:2" --quiet
 VISIT1=$(value "$VISIT2" "SELECT id FROM runs WHERE uuid = '$RUN1'")
 same_targets pulled_is_alices "$ALICE" "$ALICE1" "$VISIT2" "$VISIT1"
+# With version 2's results only: alice's, current; not bob's beside her stops.
+check pulled_results_alices 0 "^1 $EM2$" -- bash -c "'$DAQ' show $VISIT1 --json --db '$VISIT2' | '$PY' '$TMP/shown_em.py'"
 check pull_version_here 2 "run $VISIT1 \($RUN1\) is here already" -- \
   "$DAQ" sync --db "$VISIT2" --from "$PG_URL" --machine "$MACHINE" --version 1:1
 # Sent back: its stops are version 2's, so nothing new (still three versions, bob's current).
@@ -283,7 +327,7 @@ pg_undo_central_7
 psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); DROP FUNCTION caldaq.approve(uuid, text); DROP TABLE caldaq.approvals; UPDATE caldaq.schema_version SET version = 4" >/dev/null
 check old_server 0 "^4 1$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.machines) FROM caldaq.schema_version"
 check migrate_5 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --quiet
-check adopted 0 "^9 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
+check adopted 0 "^11 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
   psql_value "SELECT (SELECT version FROM caldaq.schema_version) || ' ' || count(*) || ' ' || max(uuid::text) FROM caldaq.machines"
 
 finish

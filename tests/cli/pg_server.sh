@@ -74,14 +74,21 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
-# pg_undo_central_10: the test's server taken back to central schema 9, the models (migration 10)
-# dropped.
+# pg_undo_central_11: the test's server taken back to central schema 10, the results' versions
+# (migration 11) dropped.
+pg_undo_central_11() {
+  psql_value "DROP TABLE IF EXISTS caldaq.result_versions; UPDATE caldaq.schema_version SET version = 10" >/dev/null
+}
+
+# pg_undo_central_10: the test's server taken back to central schema 9, what migrations 10 (the
+# models) and 11 added dropped.
 pg_undo_central_10() {
+  pg_undo_central_11
   psql_value "DROP TABLE caldaq.models; UPDATE caldaq.schema_version SET version = 9" >/dev/null
 }
 
 # pg_undo_central_8: the test's server taken back to central schema 7, the fleet view's tables,
-# functions and triggers (migrations 8, 9 and 10) dropped.
+# functions and triggers (migrations 8 and 9) dropped, and what later migrations added (10 and 11).
 pg_undo_central_8() {
   pg_undo_central_10
   psql_value "DROP TABLE caldaq.fleet_runs, caldaq.fleet_results, caldaq.fleet_values,

@@ -28,6 +28,7 @@
 #include "progress.hpp"
 #include "report/report.hpp"
 #include "report_pdf.hpp"
+#include "run_version.hpp"
 
 namespace daq {
 namespace {
@@ -46,6 +47,7 @@ struct ReportOptions {
   std::string output;
   std::string standard;
   bool json = false;
+  int version = 0;  // of the one run's stops (central store); 0: the current one
 };
 
 // $CALDAQ_CHROMIUM, else the first of the usual names on the PATH.
@@ -234,6 +236,12 @@ void run_report_command(ReportOptions o) {
     throw cal::InputError("report: --verify RUN reports that run alone (no other runs)");
   if (o.compensation && !o.verify)
     throw cal::InputError("report: --compensation is for --verify RUN");
+  if (o.version != 0) {
+    if (o.runs.size() != 1 || !o.campaign.empty() || o.compare || o.as_found || o.as_left ||
+        o.verify)
+      throw cal::InputError("report: --version N is for the report of one RUN");
+    choose_version(*reader, o.db, o.runs.front(), o.version);
+  }
   const fs::path named_output(o.output);
   // How far a long report is, on the terminal (stderr) only, as daq export shows it; not when
   // the report itself goes to a stream (-o /dev/stdout), which may be that terminal.
@@ -250,6 +258,7 @@ void run_report_command(ReportOptions o) {
   std::optional<TerminalProgress> reading;
   std::uint64_t shown = 0;
   cal::daq::report::Options ro{.standard = o.standard, .software = "daq 0.1.0"};
+  ro.version = o.version;
   ro.reading_progress = [&](std::uint64_t done, std::uint64_t total) {
     if (done < shown) reading.reset(), shown = 0;  // the next run of a campaign: its own count
     if (!reading) reading.emplace(job, "readings", total, show_progress);
@@ -340,6 +349,7 @@ void add_report_command(CLI::App& app) {
       "of several runs or a campaign, or a comparison of the same test over time");
   cmd->add_option("RUN", o->runs, "Stored run numbers (see daq runs)");
   add_read_db_option(*cmd, o->db);
+  add_version_option(*cmd, o->version);
   cmd->add_option("--campaign", o->campaign, "Report every run of this campaign");
   cmd->add_flag("--compare", o->compare,
                 "Overlay the same test of several runs and show the results over time");

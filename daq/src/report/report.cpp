@@ -2546,12 +2546,40 @@ std::string approval_banner(const RunView& v) {
       v.run.id);
 }
 
+// A run changed in more than one place (the central store keeps each version of its stops,
+// docs/storage.md "Conflicts are versions"): which version this report shows, who sent it, and
+// that its results are that version's (the store reads only those); nothing for one version.
+std::string version_line(const st::RunReader& store, const RunView& v, int chosen) {
+  const auto versions = store.versions(v.run.id);
+  if (versions.size() < 2 && chosen == 0) return {};
+  const auto shown = std::find_if(versions.begin(), versions.end(), [&](const st::RunVersion& x) {
+    return chosen ? x.version == chosen : x.current;
+  });
+  if (shown == versions.end()) return {};
+  const auto current = std::find_if(versions.begin(), versions.end(),
+                                    [](const st::RunVersion& x) { return x.current; });
+  const auto sender =
+      shown->sent_by.empty() && shown->sent_from.empty()
+          ? std::string("sent")
+          : fmt::format("sent by {} from {}", esc(shown->sent_by), esc(shown->sent_from));
+  return fmt::format(
+      "<p class=\"warning\"><strong>Version {} of {} of the run's stops</strong>{}: {} on {}; the "
+      "results below are those computed from these stops.{}</p>\n",
+      shown->version, versions.size(), shown->current ? " (the current one)" : "", sender,
+      iso_time(shown->sent_unix_ms),
+      shown->current || current == versions.end()
+          ? std::string()
+          : fmt::format(" The current version is {} (daq report {} without --version).",
+                        current->version, v.run.id));
+}
+
 // Page one is the answer: who, which machine and test, when; where the readings came from and
 // how good they are; the verdict with the failing values, the main table and the main plot.
 // Then the details, the conditions and traceability, and the settings as an appendix.
 std::string run_body(const st::RunReader& store, const RunView& v, const Options& o, Headline& hl) {
   std::string h = approval_banner(v);
   h += origin_banner(v);
+  h += version_line(store, v, o.version);
   h += summary_block(v, test_name(v, linear_standard_key(v, o)));
   if (v.run.status != st::RunStatus::complete)
     h += fmt::format(

@@ -24,6 +24,9 @@ struct Options {
   // Told, after each batch, how many of a long run's readings have been read for its plots
   // and how many there are to read (daq report's progress on a terminal). Empty: not told.
   std::function<void(std::uint64_t done, std::uint64_t total)> reading_progress;
+  // The version of the run's stops the store reads (daq report RUN --version N on the central
+  // store); 0: the current one. Named on page one when the run has more than one.
+  int version = 0;
 };
 
 // Each throws cal::InputError naming the database and run for an unknown run, a run without

@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/thread_pool.hpp>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -15,6 +17,7 @@
 #include "assets.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/storage/pg/fleet.hpp"
+#include "cal/storage/pg/pool.hpp"
 #include "cal/storage/pg/sync.hpp"
 #include "http_policy.hpp"
 #include "server.hpp"
@@ -63,23 +66,51 @@ web::Response answer(F&& f) {
   }
 }
 
-web::Api fleet_api(const std::string& url) {
+// Requests answered at once (on the workers and the pool's connections, not the event loop):
+// as many as the pool has connections; more wait for one.
+constexpr std::size_t kConnections = 4;
+
+// f's answer computed on a worker thread, off the event loop (a query holds no other request
+// up); f must not refer to the request's arguments by reference.
+template <class F>
+web::Response on_worker(boost::asio::thread_pool& workers, F f) {
+  web::Response r;
+  r.deferred = [&workers, f = std::move(f)](std::function<void(web::Response)> done) {
+    boost::asio::post(workers, [f, done = std::move(done)] { done(answer(f)); });
+  };
+  return r;
+}
+
+// Each request leases one of the pool's connections for its one READ ONLY transaction (a
+// connection per request cost a connection's start-up and the schema check every time).
+web::Api fleet_api(pg::ConnectionPool& pool, boost::asio::thread_pool& workers) {
   web::Api api{
       .page =
           [](std::string_view nonce) { return web::fleet_page(nonce, ::daq::unit_signs_json()); },
       .start = [](const std::string&) { return error(403, kReaderOnly); },
       .stop = [](const std::string&) { return error(403, kReaderOnly); }};
-  // The queries run on the event loop, one at a time: the page asks for the fleet's first view,
-  // a site's page of machines when the site is opened and a machine's trends and history when
-  // the machine is opened, each small whatever the fleet's size (docs/benchmarks.md, "The fleet
-  // view").
+  // The queries run on the workers, one per connection of the pool: the page asks for the fleet's
+  // first view, a site's page of machines when the site is opened and a machine's trends and
+  // history when the machine is opened, each small whatever the fleet's size (docs/benchmarks.md,
+  // "The fleet view").
   api.routes.push_back(
-      {"GET", "/api/fleet", [url](std::string_view, const std::string&) {
-         return answer([&] { return web::Response{.body = pg::fleet_json(url, now_unix_ms())}; });
+      {"GET", "/api/fleet", [&pool, &workers](std::string_view, const std::string&) {
+         return on_worker(workers, [&pool] {
+           return web::Response{.body = pg::fleet_json(pool, now_unix_ms())};
+         });
+       }});
+  // The first site's first page, which the page asks for beside /api/fleet.
+  api.routes.push_back(
+      {"GET", "/api/fleet/first-site", [&pool, &workers](std::string_view, const std::string&) {
+         return on_worker(workers, [&pool] {
+           auto doc = pg::fleet_first_site_json(pool);
+           if (!doc) return error(404, "no machine in the central store");
+           return web::Response{.body = std::move(*doc)};
+         });
        }});
   // /api/fleet/sites/SITE/page/N, SITE percent-encoded (encodeURIComponent: a '/' in it is %2F).
   api.routes.push_back(
-      {"GET", "/api/fleet/sites/", [url](std::string_view path, const std::string&) {
+      {"GET", "/api/fleet/sites/", [&pool, &workers](std::string_view path, const std::string&) {
          const auto rest = path.substr(std::string_view("/api/fleet/sites/").size());
          const auto at = rest.rfind("/page/");
          const auto page =
@@ -87,16 +118,16 @@ web::Api fleet_api(const std::string& url) {
          if (!page || *page > 1'000'000)
            return error(404, "give a site's page as /api/fleet/sites/SITE/page/N (N from 1)");
          const auto site = web::percent_decoded(rest.substr(0, at), false);
-         return answer([&] {
-           auto doc = pg::fleet_site_json(url, site, static_cast<int>(*page));
+         return on_worker(workers, [&pool, site, page = static_cast<int>(*page)] {
+           auto doc = pg::fleet_site_json(pool, site, page);
            if (!doc)
-             return error(404, fmt::format("no machine of site '{}' on page {}", site, *page));
+             return error(404, fmt::format("no machine of site '{}' on page {}", site, page));
            return web::Response{.body = std::move(*doc)};
          });
        }});
   // /api/fleet/machines/ID, or /api/fleet/machines/ID/since/YYYY-MM-DD (the lines from that day).
   api.routes.push_back(
-      {"GET", "/api/fleet/machines/", [url](std::string_view path, const std::string&) {
+      {"GET", "/api/fleet/machines/", [&pool, &workers](std::string_view path, const std::string&) {
          auto rest = path.substr(std::string_view("/api/fleet/machines/").size());
          std::optional<std::int64_t> since;
          if (const auto at = rest.find("/since/"); at != std::string_view::npos) {
@@ -108,9 +139,9 @@ web::Api fleet_api(const std::string& url) {
          }
          const auto id = whole_number(rest);
          if (!id) return error(404, "no such machine: give its id, a whole number > 0");
-         return answer([&] {
-           auto doc = pg::fleet_machine_json(url, *id, since);
-           if (!doc) return error(404, fmt::format("no machine {} in the central store", *id));
+         return on_worker(workers, [&pool, id = *id, since] {
+           auto doc = pg::fleet_machine_json(pool, id, since);
+           if (!doc) return error(404, fmt::format("no machine {} in the central store", id));
            return web::Response{.body = std::move(*doc)};
          });
        }});
@@ -133,11 +164,13 @@ void serve_fleet(const ServeOptions& o) {
         "daq serve --db postgresql://... (the fleet view) records no captures: --capture-dir is "
         "for a serve that acquires (-c FILE or --simulate)");
   const std::string& url = o.run.db;
+  pg::ConnectionPool pool(url, kConnections);
   // The store is read once before serving: an absent server, a database without a caldaq store
   // or one of another schema version is refused at start with the reason.
-  (void)pg::fleet_json(url, now_unix_ms());
+  (void)pg::fleet_json(pool, now_unix_ms());
   boost::asio::io_context io;
-  web::LiveServer server(io, server_options(o), fleet_api(url));
+  boost::asio::thread_pool workers(kConnections);
+  web::LiveServer server(io, server_options(o), fleet_api(pool, workers));
   fmt::print("daq serve: http://{}/ (the fleet view of {}, reader only); Ctrl-C stops\n",
              web::host_port(o.address, server.port()), pg::redacted(url));
   std::fflush(stdout);
@@ -146,6 +179,8 @@ void serve_fleet(const ServeOptions& o) {
     if (!ec) io.stop();
   });
   io.run();
+  // The requests under way end before the server, the pool and the loop they answer to go.
+  workers.join();
 }
 
 }  // namespace daq::serve

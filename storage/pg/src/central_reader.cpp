@@ -285,19 +285,23 @@ class CentralReader final : public RunReader {
         run_id, chosen_version(run_id));
   }
 
+  // The results of the version read (schema 11, result_versions): those computed from its stops
+  // and that version's history, with its supersessions; never another version's results.
   std::vector<ResultRecord> results(std::int64_t run_id) const override {
     return all<ResultRecord>(
         fmt::format("read the results of run {}", run_id),
         "SELECT s.standard, s.json, s.created_unix_ms, s.provenance_json, s.source_result_id, "
-        "s.superseded_by FROM caldaq.results AS s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid "
-        "WHERE r.id = $1 ORDER BY s.source_result_id",
+        "m.superseded_by FROM caldaq.results AS s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid "
+        "JOIN caldaq.result_versions AS m ON m.run_uuid = s.run_uuid AND m.source_result_id = "
+        "s.source_result_id AND m.version = COALESCE(NULLIF($2, 0), r.current_version) WHERE "
+        "r.id = $1 ORDER BY s.source_result_id",
         [&](const pqxx::row& row) {
           ResultRecord r{.run_id = run_id};
           read_row(row, r.standard, r.json, r.created_unix_ms, r.provenance_json, r.id,
                    r.superseded_by);
           return r;
         },
-        run_id);
+        run_id, chosen_version(run_id));
   }
 
   std::optional<RunQuality> quality(std::int64_t run_id) const override {
@@ -446,20 +450,23 @@ class CentralReader final : public RunReader {
     chosen_[run_id] = version;
   }
 
+  // The approvals of the version's results (results()).
   std::vector<Approval> approvals(std::int64_t run_id) const override {
     return all<Approval>(
         fmt::format("read the approvals of run {}", run_id),
         "SELECT s.source_result_id, a.result_fingerprint, a.run_version, a.approved_by, "
         "a.approved_unix_ms FROM caldaq.approvals AS a JOIN caldaq.runs AS r ON r.uuid = "
         "a.run_uuid JOIN caldaq.results AS s ON s.run_uuid = a.run_uuid AND s.fingerprint = "
-        "a.result_fingerprint WHERE r.id = $1 ORDER BY a.approved_unix_ms, s.source_result_id",
+        "a.result_fingerprint JOIN caldaq.result_versions AS m ON m.run_uuid = s.run_uuid AND "
+        "m.source_result_id = s.source_result_id AND m.version = COALESCE(NULLIF($2, 0), "
+        "r.current_version) WHERE r.id = $1 ORDER BY a.approved_unix_ms, s.source_result_id",
         [&](const pqxx::row& row) {
           Approval a{.central_server = shown_};
           read_row(row, a.result_id, a.result_fingerprint, a.run_version, a.approved_by,
                    a.approved_unix_ms);
           return a;
         },
-        run_id);
+        run_id, chosen_version(run_id));
   }
 
  private:

@@ -414,6 +414,36 @@ REVOKE ALL ON caldaq.models FROM PUBLIC;
 GRANT SELECT ON caldaq.models TO caldaq_engineer, caldaq_reviewer;
 GRANT INSERT ON caldaq.models TO caldaq_engineer;
 )sql",
+    // 11: a run's results tied to the version of its stops they were computed from. Each
+    // version's results are those the store that sent those stops held then (its current ones
+    // were computed from them; its superseded ones are its history), with that store's
+    // supersessions: what the sender's own store showed. The readers read a version's results
+    // only, so a version's stops are never shown beside another version's results (before,
+    // two laptops' re-compensations were both "current" beside whichever stops were read).
+    // Results already here: a run of one version, every result in version 1 (each sender's
+    // current results were computed from its current stops, which were version 1's); a run of
+    // several versions, none placed (which laptop's stops each came from was not recorded):
+    // each sender's next daq sync --to places its own.
+    R"sql(
+CREATE TABLE caldaq.result_versions(
+  run_uuid uuid NOT NULL,
+  version integer NOT NULL,
+  source_result_id bigint NOT NULL,
+  superseded_by bigint,
+  PRIMARY KEY(run_uuid, version, source_result_id),
+  FOREIGN KEY(run_uuid, version) REFERENCES caldaq.run_versions(run_uuid, version)
+    ON DELETE CASCADE,
+  FOREIGN KEY(run_uuid, source_result_id) REFERENCES caldaq.results(run_uuid, source_result_id)
+    ON DELETE CASCADE);
+INSERT INTO caldaq.result_versions
+  SELECT s.run_uuid, 1, s.source_result_id, s.superseded_by FROM caldaq.results AS s
+  WHERE (SELECT count(*) FROM caldaq.run_versions AS v WHERE v.run_uuid = s.run_uuid) = 1;
+ALTER TABLE caldaq.result_versions ENABLE ROW LEVEL SECURITY;
+CREATE POLICY by_site ON caldaq.result_versions
+  USING (EXISTS (SELECT 1 FROM caldaq.runs AS r WHERE r.uuid = run_uuid));
+GRANT SELECT ON caldaq.result_versions TO caldaq_engineer, caldaq_reviewer;
+GRANT INSERT, UPDATE, DELETE ON caldaq.result_versions TO caldaq_engineer;
+)sql",
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 

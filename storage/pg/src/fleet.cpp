@@ -15,6 +15,7 @@
 
 #include "cal/storage/pg/sync.hpp"
 #include "central_schema.hpp"
+#include "pool.hpp"
 
 namespace cal::storage::pg {
 
@@ -266,17 +267,6 @@ void add_verdicts_and_counts(pqxx::transaction_base& t, json& machines) {
   }
 }
 
-template <class F>
-auto read_only(std::string_view url, std::string_view what, F&& f) {
-  const std::string shown = redacted(url);
-  const auto conn = connect(shown, url);
-  guarded(shown, "read the central schema version", [&] { check_reader_schema(*conn, shown); });
-  return guarded(shown, what, [&] {
-    pqxx::read_transaction t(*conn);
-    return f(t);
-  });
-}
-
 }  // namespace
 
 std::string_view to_string(TrendStatus s) {
@@ -314,14 +304,14 @@ Projection project(const TrendFit& fit) {
   return {TrendStatus::leaving, at};
 }
 
-std::string fleet_json(std::string_view url, std::int64_t now_unix_ms) {
-  return read_only(url, "read the fleet", [&](pqxx::transaction_base& t) {
+std::string fleet_json(ConnectionPool& pool, std::int64_t now_unix_ms) {
+  return with_connection(pool, "read the fleet", [&](pqxx::transaction_base& t) {
     const auto today = day_of(static_cast<double>(now_unix_ms));
     json sites = sites_summary(t);
     std::int64_t machines = 0;
     for (const auto& s : sites) machines += s["machines"].get<std::int64_t>();
     json doc{{"schema", "caldaq.fleet.v2"},
-             {"store", redacted(url)},
+             {"store", pool.shown_url()},
              {"generated_unix_ms", now_unix_ms},
              {"today", iso_day(today)},
              {"trend",
@@ -342,41 +332,60 @@ std::string fleet_json(std::string_view url, std::int64_t now_unix_ms) {
   });
 }
 
-std::optional<std::string> fleet_site_json(std::string_view url, std::string_view site, int page) {
-  return read_only(
-      url, "read the machines of a site",
-      [&](pqxx::transaction_base& t) -> std::optional<std::string> {
-        const auto total = t.exec_params1("SELECT count(*) FROM caldaq.machines WHERE site = $1",
-                                          std::string(site))[0]
-                               .as<std::int64_t>();
-        const std::int64_t pages = (total + fleet_machines_per_page - 1) / fleet_machines_per_page;
-        if (page < 1 || page > pages) return std::nullopt;
-        json machines = json::array();
-        for (const auto& r : t.exec_params(
-                 "SELECT m.id, COALESCE(m.uuid::text, '') AS uuid, m.name, (SELECT "
-                 "max(f.started_unix_ms) FROM caldaq.fleet_runs AS f WHERE f.machine_id = m.id) "
-                 "AS last_run_unix_ms FROM caldaq.machines AS m WHERE m.site = $1 ORDER BY m.name "
-                 "COLLATE \"C\", m.id LIMIT $2 OFFSET $3",
-                 std::string(site), fleet_machines_per_page,
-                 static_cast<std::int64_t>(page - 1) * fleet_machines_per_page))
-          machines.push_back(row_object(r));
-        add_verdicts_and_counts(t, machines);
-        return json{{"schema", "caldaq.fleet-site.v1"},
-                    {"site", site},
-                    {"page", page},
-                    {"pages", pages},
-                    {"per_page", fleet_machines_per_page},
-                    {"count", total},
-                    {"first", (page - 1) * fleet_machines_per_page + 1},
-                    {"machines", std::move(machines)}}
-            .dump(-1, ' ', false, json::error_handler_t::replace);
-      });
+namespace {
+
+// Page `page` of the machines of `site` (fleet_site_json), in the caller's transaction.
+std::optional<std::string> site_page(pqxx::transaction_base& t, const std::string& site, int page) {
+  const auto total = t.exec_params1("SELECT count(*) FROM caldaq.machines WHERE site = $1", site)[0]
+                         .as<std::int64_t>();
+  const std::int64_t pages = (total + fleet_machines_per_page - 1) / fleet_machines_per_page;
+  if (page < 1 || page > pages) return std::nullopt;
+  json machines = json::array();
+  for (const auto& r : t.exec_params(
+           "SELECT m.id, COALESCE(m.uuid::text, '') AS uuid, m.name, (SELECT "
+           "max(f.started_unix_ms) FROM caldaq.fleet_runs AS f WHERE f.machine_id = m.id) "
+           "AS last_run_unix_ms FROM caldaq.machines AS m WHERE m.site = $1 ORDER BY m.name "
+           "COLLATE \"C\", m.id LIMIT $2 OFFSET $3",
+           site, fleet_machines_per_page,
+           static_cast<std::int64_t>(page - 1) * fleet_machines_per_page))
+    machines.push_back(row_object(r));
+  add_verdicts_and_counts(t, machines);
+  return json{{"schema", "caldaq.fleet-site.v1"},
+              {"site", site},
+              {"page", page},
+              {"pages", pages},
+              {"per_page", fleet_machines_per_page},
+              {"count", total},
+              {"first", (page - 1) * fleet_machines_per_page + 1},
+              {"machines", std::move(machines)}}
+      .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-std::optional<std::string> fleet_machine_json(std::string_view url, std::int64_t machine_id,
+}  // namespace
+
+std::optional<std::string> fleet_site_json(ConnectionPool& pool, std::string_view site, int page) {
+  return with_connection(pool, "read the machines of a site",
+                         [&](pqxx::transaction_base& t) -> std::optional<std::string> {
+                           return site_page(t, std::string(site), page);
+                         });
+}
+
+std::optional<std::string> fleet_first_site_json(ConnectionPool& pool) {
+  return with_connection(pool, "read the machines of the first site",
+                         [&](pqxx::transaction_base& t) -> std::optional<std::string> {
+                           // The first of the sites in fleet_json's order (byte order), of those
+                           // this login sees.
+                           const auto first =
+                               t.exec("SELECT min(site COLLATE \"C\") FROM caldaq.machines");
+                           if (first.empty() || first[0][0].is_null()) return std::nullopt;
+                           return site_page(t, first[0][0].as<std::string>(), 1);
+                         });
+}
+
+std::optional<std::string> fleet_machine_json(ConnectionPool& pool, std::int64_t machine_id,
                                               std::optional<std::int64_t> since_unix_ms) {
-  return read_only(
-      url, fmt::format("read machine {}", machine_id),
+  return with_connection(
+      pool, fmt::format("read machine {}", machine_id),
       [&](pqxx::transaction_base& t) -> std::optional<std::string> {
         const auto m = t.exec_params(
             "SELECT name, COALESCE(uuid::text, ''), site FROM caldaq.machines WHERE id = $1",

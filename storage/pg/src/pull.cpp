@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <tuple>
 
 #include "cal/analysis/text.hpp"
 #include "cal/storage/chunk.hpp"
@@ -150,7 +151,9 @@ class Pull {
       local_id = existing ? existing->id : import_metadata(r);
       if (existing && existing->status == RunStatus::running) update_running(r, local_id);
       if (existing) refresh_operator_actions(r, local_id);
-      pull_results(r, local_id);
+      // A run here already: the results of the version its stops here are (none when they are
+      // no version the server has: re-compensated here and not sent yet).
+      pull_results(r, local_id, !existing || version_of_stops_here(r, local_id));
     });
     const auto received = report_.chunks_received, already = report_.chunks_already;
     pull_chunks(r, local_id, source_id);
@@ -221,8 +224,10 @@ class Pull {
   // The server's results this store lacks (known by their content's fingerprint, as the server
   // knows them), the supersessions the server records between results this store has, and the
   // server's approvals of them (read-only here: a report here is issued as the server's).
-  void pull_results(const RunRecord& r, std::int64_t local_id) {
-    const auto theirs = server_->results(r.id);
+  // Only the results of the version read (the server's reader reads one version's), and none
+  // when `bring` is false: results are brought only beside the stops they were computed from.
+  void pull_results(const RunRecord& r, std::int64_t local_id, bool bring) {
+    const auto theirs = bring ? server_->results(r.id) : std::vector<ResultRecord>{};
     std::map<std::string, std::int64_t> local_by_fp;  // fingerprint -> local id
     std::map<std::int64_t, bool> local_current;       // local id -> not superseded
     std::map<std::int64_t, std::string> fp_of;        // server id -> fingerprint
@@ -259,6 +264,32 @@ class Pull {
       a.central_server = shown_;
       if (local_.add_central_approval(a)) ++report_.approvals_new;
     }
+  }
+
+  // Whether this store's stops of the run are one of the server's versions; if so the server's
+  // reader reads that version from now on.
+  bool version_of_stops_here(const RunRecord& r, std::int64_t local_id) {
+    const auto sorted = [](std::vector<CapturedTarget> v) {
+      const auto key = [](const CapturedTarget& t) {
+        return std::tuple(t.run_number, t.direction, t.target_index, t.nominal_mm, t.time_ns,
+                          t.raw_m, t.deviation_um, t.refractive_index, t.material_temperature_degc);
+      };
+      std::sort(v.begin(), v.end(),
+                [&](const CapturedTarget& a, const CapturedTarget& b) { return key(a) < key(b); });
+      std::vector<decltype(key(v.front()))> keys;
+      for (const auto& t : v) keys.push_back(key(t));
+      return keys;
+    };
+    const auto here = sorted(local_.targets(local_id));
+    auto versions = server_->versions(r.id);
+    // The current version first (the usual case), then the others in order.
+    std::stable_partition(versions.begin(), versions.end(),
+                          [](const RunVersion& v) { return v.current; });
+    for (const auto& v : versions) {
+      read_version(*server_, r.id, v.version);
+      if (sorted(server_->targets(r.id)) == here) return true;
+    }
+    return false;
   }
 
   // The checksums the server holds for the run's chunks, by number.

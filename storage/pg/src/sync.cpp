@@ -360,16 +360,16 @@ class Sync {
     } catch (const pqxx::sql_error& e) {
       refused(e, run_name(r), site);
     }
-    send_children(w, r);
-    send_results(w, r, source_id);
+    const int version = send_children(w, r);
+    send_results(w, r, source_id, version);
     w.commit();
     return source_id;
   }
 
   // The run's instruments, missed stops, suspect stops and operator's actions are replaced as a
   // whole (they are small; the last sender's are kept); its stops become a version (send_stops),
-  // never replaced, since a re-compensation elsewhere rewrites them.
-  void send_children(pqxx::work& w, const RunRecord& r) {
+  // never replaced, since a re-compensation elsewhere rewrites them. Returns that version.
+  int send_children(pqxx::work& w, const RunRecord& r) {
     for (const char* table : {"instruments", "missed_stops", "operator_actions", "suspect_stops"})
       w.exec_params(fmt::format("DELETE FROM caldaq.{} WHERE run_uuid = $1", table), r.uuid);
     for (const auto& i : local_.instruments(r.id))
@@ -377,7 +377,7 @@ class Sync {
           "INSERT INTO caldaq.instruments(run_uuid, device, driver, transport, settings_json, "
           "origin, origin_detail) VALUES($1, $2, $3, $4, $5, $6, $7)",
           r.uuid, i.device, i.driver, i.transport, i.settings_json, i.origin, i.origin_detail);
-    send_stops(w, r);
+    const int version = send_stops(w, r);
     for (const auto& m : local_.missed_stops(r.id))
       w.exec_params(
           "INSERT INTO caldaq.missed_stops(run_uuid, run_number, direction, target_index, "
@@ -409,13 +409,15 @@ class Sync {
           has_stop ? std::to_string(a.stop->target_index) : std::string(),
           has_stop ? fmt::format("{}", a.stop->nominal_mm) : std::string(), a.detail);
     }
+    return version;
   }
 
   // The run's stops as a version (schema 4): stops the server has as a version already add
   // nothing; others become a new version, the current one, with who sent them, from where and
   // when, the earlier versions kept. Only a run this store sent while it was still running grows
-  // its version in place (the acquisition went on; nothing was changed elsewhere).
-  void send_stops(pqxx::work& w, const RunRecord& r) {
+  // its version in place (the acquisition went on; nothing was changed elsewhere). Returns the
+  // version the stops are (found or new).
+  int send_stops(pqxx::work& w, const RunRecord& r) {
     const auto fresh =
         w.exec_params1(
              "SELECT COALESCE(MAX(version), 0) + 1 FROM caldaq.run_versions WHERE run_uuid = $1",
@@ -435,8 +437,12 @@ class Sync {
                     r.uuid, fresh);
     };
     const auto same = w.exec_params(
-        "SELECT 1 FROM caldaq.run_versions WHERE run_uuid = $1 AND fingerprint = $2", r.uuid, fp);
-    if (!same.empty()) return drop_fresh();
+        "SELECT version FROM caldaq.run_versions WHERE run_uuid = $1 AND fingerprint = $2", r.uuid,
+        fp);
+    if (!same.empty()) {
+      drop_fresh();
+      return same[0][0].as<int>();
+    }
     const auto store = std::filesystem::absolute(local_.path()).string();
     const auto growing = w.exec_params(
         "SELECT v.version FROM caldaq.run_versions AS v JOIN caldaq.runs AS r ON r.uuid = "
@@ -462,6 +468,7 @@ class Sync {
         r.uuid, version, fp, std::string(to_string(r.status)), options_.sent_by, options_.sent_from,
         store, unix_ms_now());
     w.exec_params("UPDATE caldaq.runs SET current_version = $2 WHERE uuid = $1", r.uuid, version);
+    return version;
   }
 
   // Results are known on the server by their content's fingerprint: one already there is not
@@ -469,7 +476,10 @@ class Sync {
   // new one keeps its local id when this store first sent the run (source_id), else takes the
   // next free number. A supersession is added, never changed: a result superseded there stays
   // superseded by what superseded it there (results made apart are all kept).
-  void send_results(pqxx::work& w, const RunRecord& r, std::int64_t source_id) {
+  // Every result here is also one of `version`'s (schema 11): the version of the stops this store
+  // holds, from which its current results were computed (a re-compensation supersedes every
+  // current result with the new stops); its superseded ones are that version's history, as here.
+  void send_results(pqxx::work& w, const RunRecord& r, std::int64_t source_id, int version) {
     const auto local = local_.results(r.id);
     std::map<std::int64_t, std::int64_t> server_id;  // local id -> the server's
     for (const auto& res : local) {
@@ -493,12 +503,23 @@ class Sync {
                res.provenance_json, fp)[0]
               .as<std::int64_t>();
     }
-    for (const auto& res : local)
-      if (res.superseded_by && server_id.contains(*res.superseded_by))
+    for (const auto& res : local) {
+      const bool superseded = res.superseded_by && server_id.contains(*res.superseded_by);
+      if (superseded)
         w.exec_params(
             "UPDATE caldaq.results SET superseded_by = $3 WHERE run_uuid = $1 AND "
             "source_result_id = $2 AND superseded_by IS NULL",
             r.uuid, server_id[res.id], server_id[*res.superseded_by]);
+      // In the version too, added and never cleared: another store of the same stops may have
+      // superseded it there (a re-analysis), which this store's copy does not undo.
+      w.exec_params(
+          "INSERT INTO caldaq.result_versions(run_uuid, version, source_result_id, superseded_by) "
+          "VALUES($1, $2, $3, NULLIF($4, '')::bigint) ON CONFLICT (run_uuid, version, "
+          "source_result_id) DO UPDATE SET superseded_by = COALESCE("
+          "caldaq.result_versions.superseded_by, EXCLUDED.superseded_by)",
+          r.uuid, version, server_id[res.id],
+          superseded ? std::to_string(server_id[*res.superseded_by]) : std::string());
+    }
   }
 
   std::map<std::int64_t, ServerChunk> server_chunks(const RunRecord& r) {

@@ -12,6 +12,8 @@
 #include <string>
 #include <string_view>
 
+#include "cal/storage/pg/pool.hpp"
+
 namespace cal::storage::pg {
 
 // Fewer current results than this in a series: "not enough history", no projection.
@@ -62,14 +64,17 @@ std::optional<std::int64_t> day_start_unix_ms(std::string_view text);
 // JSON document (caldaq.fleet.v2: docs/web.md). Throws StoreError naming the server (password
 // hidden) and what failed; a store of another schema version is refused as the read commands
 // refuse it.
-std::string fleet_json(std::string_view url, std::int64_t now_unix_ms);
+std::string fleet_json(ConnectionPool& pool, std::int64_t now_unix_ms);
 // Page `page` (1, 2, ...) of the machines of `site` (caldaq.fleet-site.v1), or nullopt when the
 // site has no machine on that page.
-std::optional<std::string> fleet_site_json(std::string_view url, std::string_view site, int page);
+std::optional<std::string> fleet_site_json(ConnectionPool& pool, std::string_view site, int page);
+// Page 1 of the first site's machines (the first in fleet_json's order): what the page shows first,
+// asked for beside fleet_json (not after it, to learn the site's name); nullopt: no machine.
+std::optional<std::string> fleet_first_site_json(ConnectionPool& pool);
 // One machine's trends and their series with every point (caldaq.fleet-machine.v2), each line
 // fitted from the later of its window's start and `since_unix_ms` when given; nullopt when the
 // server has no machine of that id.
-std::optional<std::string> fleet_machine_json(std::string_view url, std::int64_t machine_id,
+std::optional<std::string> fleet_machine_json(ConnectionPool& pool, std::int64_t machine_id,
                                               std::optional<std::int64_t> since_unix_ms = {});
 
 }  // namespace cal::storage::pg

@@ -36,7 +36,9 @@ namespace cal::storage::pg {
 // compensation table or switch of the control's compensation that resets it).
 // 10 (with local schema 11): machine models (caldaq.models), known by their UUID, of a machine
 // (visible and writable where their machine is).
-inline constexpr int central_schema_version = 10;
+// 11: each result tied to the version of the run's stops it was computed from (result_versions);
+// the readers read the chosen (else current) version's results only.
+inline constexpr int central_schema_version = 11;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
