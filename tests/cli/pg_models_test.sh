@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 35: machine models in both stores (local schema 11, central schema 10), against a real
+# Issue 35: machine models in both stores (local schema 11, central schema 10; the server here is at 11), against a real
 # PostgreSQL server started here (tests/cli/pg_server.sh). Laptop A's store, taken back to schema
 # 10, is migrated in place by `daq model build --store`, which keeps the model with the runs it was
 # built from (their UUIDs), who and when; `daq model store FILE` keeps a file. Both are synced up
@@ -105,7 +105,7 @@ check central_list 0 "$UUID" -- "$DAQ" model list --db "$PG_URL" --machine "$MAC
 # migrated in place by the next sync, which sends the models again.
 pg_undo_central_10
 RUNS_CENTRAL=$(psql_value "SELECT count(*) FROM caldaq.runs")
-check central_9_refused 2 "central schema version 9 is older than this daq reads \(10\)" -- \
+check central_9_refused 2 "central schema version 9 is older than this daq reads \(11\)" -- \
   "$DAQ" model list --db "$PG_URL"
 check central_migrated 0 "central schema 11\): 0 new; .*; 2 models synced, 2 new$" -- \
   "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
