@@ -49,6 +49,8 @@ NUMERIC_OPTIONS=(
   "sim|--runs|11"
   "sim|--targets|12"
   "sim|--feed-mm-per-min|5"
+  "sim|--ballbar-rate-hz|50"
+  "bench replay|--circle-feed-mm-per-min|5"
   "demo|--speed|300"
   "replay $TMP/none.cdq|--speed|-1"
   "run linear -c $TMP/none.toml|--check-s|-1"

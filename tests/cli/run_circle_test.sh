@@ -52,6 +52,23 @@ check servo 0 "Servo mismatch \(Y lags X\) +\+0\.3[3-5][0-9]* ms" -- echo "$ACQ"
 check backlash 0 "Backlash X +\+(3\.9[0-9]|4\.[01][0-9])[0-9]* um" -- echo "$ACQ"
 check cyclic 0 "Cyclic error X \(40\.00 mm period\) +\+(0\.9[7-9]|1\.0[0-3])[0-9]* um" -- echo "$ACQ"
 GA=$(grep -E "^  G\(b\) " <<<"$ACQ")
+# A faster bar (daq sim --ballbar-rate-hz, issue 32's long 10 kHz runs made live): the twin
+# streams at the rate the configuration's sample_rate_hz says, so the segmenter's timing holds
+# (the same injected squareness, +20 um/m; a bar at 1 kHz read as 4 kHz would put the arcs in
+# the wrong places) and the run stores 4 readings a millisecond: at 3000 mm/min the program is
+# 2 x 450 deg of R 100 mm (2 x 15.71 s) and 2 x 1 s dwell, so more than 4000 x 33.4 = 133,600
+# readings, and less than 4000 x 45 s (the feed-in and -out add a few seconds; at 1 kHz the same
+# run stores about 39,000).
+"$DAQ" sim --test circle --acquire --feed-mm-per-min 3000 --ballbar-rate-hz 4000 -o "$TMP/fast.toml" --db "$TMP/fast.sqlite" >"$TMP/fast.log" 2>&1 ||
+  { echo "FAIL acquire at 4 kHz: exit $?"; tail -20 "$TMP/fast.log"; fails=$((fails + 1)); }
+check fast_rate_config 0 "^sample_rate_hz = 4000$" -- cat "$TMP/fast.toml"
+check fast_squareness 0 "Squareness XY +\+(19\.[5-9]|20\.[0-4])[0-9]* um/m" -- cat "$TMP/fast.log"
+FAST_READINGS=$("$DAQ" show 1 --db "$TMP/fast.sqlite" --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["readings"])' 2>/dev/null || echo 0)
+if [ "${FAST_READINGS:-0}" -gt 133600 ] && [ "${FAST_READINGS:-0}" -lt 180000 ]; then
+  passes=$((passes + 1))
+else
+  echo "FAIL fast_readings: $FAST_READINGS readings at 4 kHz, expected 133,600 .. 180,000"; fails=$((fails + 1))
+fi
 # The capture replays into run 2 with the same G to the last printed digit.
 check replay 0 "replayed .* into run 2" -- "$DAQ" replay "$TMP/acq.cdq" --db "$TMP/acq.sqlite"
 check replay_same_g 0 "$(sed 's/[()]/\\&/g' <<<"$GA")" -- "$DAQ" analyse 2 --db "$TMP/acq.sqlite"

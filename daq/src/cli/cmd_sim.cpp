@@ -46,6 +46,7 @@ struct SimOptions {
   int runs = 5;                   // the linear program's size (ShopConfigOptions)
   std::optional<int> targets;     // unset: 11 (the linear program's; the rotary test has 9)
   double feed_mm_per_min = 1000;  // the circle's
+  double ballbar_rate_hz = 1000;  // the simulated bar's output rate
   std::string measure;            // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
   std::string compensate;  // a model file whose volumetric correction the control applies
@@ -224,6 +225,7 @@ void run_sim(SimOptions o) {
         "rotary axis: give --test rotary");
   std::optional<cal::daq::LinearTestConfig> volumetric;
   ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
+  truth.ballbar_rate_hz = o.ballbar_rate_hz;
   apply_rotary_correction(o, truth.rotary);
   if (!o.measure.empty()) {
     volumetric = volumetric_test(o.measure);
@@ -418,10 +420,17 @@ void add_sim_command(CLI::App& app) {
                   "Targets of the linear program, 50 mm apart from 0 mm (ISO 230-2: 11; default "
                   "11; not with --test rotary, whose targets are fixed)")
       ->check(whole_in(2, 11));
+  // Down to 10 mm/min: a slow circle is the ballbar's static test (the servo's errors vanish,
+  // stick-slip grows: docs/circle.md); at 26 mm/min the 100 mm bar's circle takes an hour.
   cmd->add_option("--feed-mm-per-min", o->feed_mm_per_min,
                   "The circle test's feed (--test circle; the set has its own two)")
       ->capture_default_str()
-      ->check(finite_in(100.0, 10000.0));
+      ->check(finite_in(10.0, 10000.0));
+  cmd->add_option("--ballbar-rate-hz", o->ballbar_rate_hz,
+                  "The SIMULATED ballbar's output rate and [test.circle] sample_rate_hz (a QC20-W "
+                  "streams 1000 Hz; a faster gauge for long high-rate runs)")
+      ->capture_default_str()
+      ->check(finite_in(100.0, 20000.0));
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->add_option("--measure", o->measure,

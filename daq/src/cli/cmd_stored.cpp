@@ -81,13 +81,7 @@ void analyse_circle_run(const st::RunReader& store, st::Store* writer, const st:
   }
   // Only the bar's series is read, streamed into the segmenter, whose samples are paged: the
   // analysis reads them in place, in bounded memory however long the run (issue 32).
-  static constexpr std::uint8_t bar[] = {
-      static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
-  cal::daq::BallbarSegmenter segmenter(program);
-  auto stream = store.stream_readings(o.run, bar);
-  std::vector<st::RawReading> batch;
-  while (stream.next(batch))
-    for (const auto& r : batch) segmenter.add(r.value * 1e3);
+  const auto segmenter = segment_stored_run(store, o.run, program);
   cal::circle::Result result;
   try {
     result = analyse_traces(program, analysis, segmenter.sources());

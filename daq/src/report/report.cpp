@@ -1651,6 +1651,9 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
 struct Circle {
   cal::daq::BallbarProgram program;
   ::daq::BallbarAnalysis analysis;
+  // What the polar plot draws: every step-th sample of each trace (at most ~3600 points a
+  // trace, 0.1 degree: more cannot be seen and would bloat the file), taken as the trace is
+  // read, so the report holds no run-sized array (issue 32).
   std::vector<cal::circle::Trace> traces;
   cal::circle::Result result;
 };
@@ -1673,18 +1676,23 @@ Circle analyse_circle(const st::RunReader& store, const RunView& v, const Option
         fmt::format("{}: run {}: its circle settings are missing", store.name(), v.run.id));
   auto [program, analysis] = ::daq::circle_settings_from_json(v.settings);
   analysis.standard = circular_key(o, analysis.standard);
-  static constexpr std::uint8_t bar[] = {static_cast<std::uint8_t>(Q::length_m)};
-  std::vector<double> bar_mm;
-  for (const auto& r : store.readings(v.run.id, bar)) bar_mm.push_back(r.value * 1e3);
   Circle c{.program = program, .analysis = analysis};
+  const auto segmenter = ::daq::segment_stored_run(store, v.run.id, program);
   try {
-    cal::daq::BallbarSegmenter segmenter(program);
-    for (double x : bar_mm) segmenter.add(x);
-    c.traces = segmenter.traces();
-    c.result = ::daq::analyse_ballbar(program, analysis, bar_mm);
+    const auto sources = segmenter.sources();
+    for (const auto& t : sources) {
+      cal::circle::Trace shown{t.direction(), {}, {}};
+      const std::size_t step = std::max<std::size_t>(1, t.size() / 3600);
+      for (std::size_t i = 0; i < t.size(); i += step) {
+        shown.angle_deg.push_back(t.angle_deg(i));
+        shown.deviation_um.push_back(t.deviation_um(i));
+      }
+      c.traces.push_back(std::move(shown));
+    }
+    c.result = ::daq::analyse_traces(program, analysis, sources);
   } catch (const cal::InputError& e) {
     throw cal::InputError(fmt::format("{}: run {} ({} bar readings): {}", store.name(), v.run.id,
-                                      bar_mm.size(), e.what()));
+                                      segmenter.samples(), e.what()));
   }
   return c;
 }
@@ -1709,9 +1717,8 @@ PolarChart polar_of(const Circle& c, std::string_view title, std::size_t colour_
                     (t.direction == cal::circle::Direction::ccw ? "ccw" : "cw"),
            .colour = palette(colour_offset + (t.direction == cal::circle::Direction::ccw ? 0 : 1)),
            .width = 1.2};
-    // At most ~3600 points a trace (0.1 degree): more cannot be seen, and would bloat the file.
-    const std::size_t step = std::max<std::size_t>(1, t.angle_deg.size() / 3600);
-    for (std::size_t i = 0; i < t.angle_deg.size(); i += step) {
+    // Every point of the trace as analyse_circle decimated it.
+    for (std::size_t i = 0; i < t.angle_deg.size(); ++i) {
       const double th = t.angle_deg[i] * std::numbers::pi / 180.0;
       l.x.push_back(t.angle_deg[i]);
       l.y.push_back(t.deviation_um[i] - cu * std::cos(th) - cv * std::sin(th));

@@ -48,6 +48,19 @@ cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
   return analyse_traces(program, analysis, segmenter.sources());
 }
 
+cal::daq::BallbarSegmenter segment_stored_run(const cal::storage::RunReader& store,
+                                              std::int64_t run_id,
+                                              const cal::daq::BallbarProgram& program) {
+  static constexpr std::uint8_t bar[] = {
+      static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
+  cal::daq::BallbarSegmenter segmenter(program);
+  auto stream = store.stream_readings(run_id, bar);
+  std::vector<cal::storage::RawReading> batch;
+  while (stream.next(batch))
+    for (const auto& r : batch) segmenter.add(r.value * 1e3);
+  return segmenter;
+}
+
 cal::circle::Result analyse_traces(const cal::daq::BallbarProgram& program,
                                    const BallbarAnalysis& analysis,
                                    std::span<const cal::circle::TraceSource> traces) {

@@ -55,6 +55,12 @@ void resolve_calibration(BallbarAnalysis& a, const cal::daq::Config& c, double r
 cal::circle::Result analyse_ballbar(const cal::daq::BallbarProgram& program,
                                     const BallbarAnalysis& analysis,
                                     std::span<const double> deviation_mm);
+// A stored run's bar readings streamed into the program's segmenter, whose samples are paged:
+// its sources() are read in place, in bounded memory however long the run (issue 32; daq
+// analyse RUN, the report and the served trace plot).
+cal::daq::BallbarSegmenter segment_stored_run(const cal::storage::RunReader& store,
+                                              std::int64_t run_id,
+                                              const cal::daq::BallbarProgram& program);
 // The same for traces already cut (cal::daq::BallbarSegmenter::sources: read in place, in
 // bounded memory).
 cal::circle::Result analyse_traces(const cal::daq::BallbarProgram& program,

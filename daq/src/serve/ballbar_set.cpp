@@ -29,17 +29,9 @@ json result_json(const BallbarTest& t) {
 json circle_trace_json(const cal::storage::Store& store, std::int64_t run, const json& settings,
                        const json& result) {
   const auto [program, analysis] = circle_settings_from_json(settings);
-  static constexpr std::uint8_t bar[] = {
-      static_cast<std::uint8_t>(cal::drivers::Quantity::length_m)};
   // Streamed into the segmenter (its samples paged) and decimated as the traces are read: the
   // plot holds a point a degree, not the run (issue 32).
-  cal::daq::BallbarSegmenter segmenter(program);
-  {
-    auto stream = store.stream_readings(run, bar);
-    std::vector<cal::storage::RawReading> batch;
-    while (stream.next(batch))
-      for (const auto& r : batch) segmenter.add(r.value * 1e3);
-  }
+  const auto segmenter = segment_stored_run(store, run, program);
   double cu = 0.0, cv = 0.0;
   if (const auto c = result.value("/iso230_4/centre_um"_json_pointer, json());
       c.is_array() && c.size() == 2 && c[0].is_number() && c[1].is_number())

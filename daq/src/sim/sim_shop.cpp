@@ -203,7 +203,10 @@ struct SimulatedShop::Impl {
         material(ctx, world, clock,
                  polled(3, [](const sim::World& w) { return w.state().machine_temperature_degc; })),
         ballbar(ctx, world, clock,
-                {.pivot_mm = t.pivot_mm, .zero_length_mm = t.ballbar_mm, .continuous = false}),
+                {.pivot_mm = t.pivot_mm,
+                 .zero_length_mm = t.ballbar_mm,
+                 .sample_rate_hz = t.ballbar_rate_hz,
+                 .continuous = false}),
         position(ctx, world, clock),
         test(l),
         // The indicator reads the probe point's deviation from the nominal line it is commanded
@@ -615,7 +618,7 @@ window_mm = 0.5
 {linear}
 [test.circle]
 {circle_tests}radius_mm = {radius}
-sample_rate_hz = 1000
+sample_rate_hz = {ballbar_rate}
 overshoot_deg = 45
 centre_mm = [{cx}, {cy}, {cz}]
 
@@ -658,8 +661,8 @@ squareness = 30
                       // magnified, as in daq demo.
                       fmt::arg("stale", o.in_process ? "stale_after_s = 30\n" : ""),
                       fmt::arg("trigger_dwell", 1.5 * wall), fmt::arg("radius", t.ballbar_mm),
-                      fmt::arg("cx", t.pivot_mm[0]), fmt::arg("cy", t.pivot_mm[1]),
-                      fmt::arg("cz", t.pivot_mm[2]),
+                      fmt::arg("ballbar_rate", t.ballbar_rate_hz), fmt::arg("cx", t.pivot_mm[0]),
+                      fmt::arg("cy", t.pivot_mm[1]), fmt::arg("cz", t.pivot_mm[2]),
                       // One full circle in XY, or the standard set: XY 360 deg, ZX and YZ 220
                       // deg over the top, each at a slow and a fast feed (docs/circle.md).
                       fmt::arg("circle_tests",

@@ -60,6 +60,10 @@ struct ShopTruth {
   double kv_x_per_s = 30.0, kv_y_per_s = 29.7;  // Y lags X by 0.337 ms
   std::array<double, 3> pivot_mm{150.0, 0.0, 0.0};
   double ballbar_mm = 100.0;
+  // The bar's continuous output rate (simulated time) and [test.circle] sample_rate_hz: a
+  // QC20-W streams 1 kHz; a faster gauge (daq sim --ballbar-rate-hz) makes the long 10 kHz
+  // runs of issue 32's bounded-memory goal live.
+  double ballbar_rate_hz = 1000.0;
   // The vertical planes (three_planes()): E_B0Z and E_A0Z (urad; the ballbar's alpha_ZX =
   // -E_B0Z, alpha_YZ = +E_A0Z), Z's position loop, backlash and cyclic error of Y and Z.
   double b0z_urad = 0.0, a0z_urad = 0.0;
