@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/fixed_text.hpp"
 
@@ -52,6 +53,7 @@ void check_name(const std::string& name) {
 
 const char* plane_word(Dialect d, Plane p) {
   static constexpr std::array<const char*, 3> fanuc{"G17", "G18", "G19"};
+  static_assert(one_per_value<Plane>(fanuc));
   (void)d;  // the same words in ISO/Fanuc and SINUMERIK
   return fanuc[static_cast<std::size_t>(p)];
 }
