@@ -121,6 +121,7 @@ constexpr EnumName<Equation> kEquationNames[] = {
     {Equation::edlen, "edlen"},           {Equation::edlen, "edlen-birch-downs"},
     {Equation::ciddor, "ciddor"},         {Equation::shop_floor, "shop-floor"},
     {Equation::shop_floor, "shop_floor"}, {Equation::shop_floor, "nist-shop-floor"}};
+static_assert(cal::names_every_value(kEquationNames));
 }  // namespace
 
 std::string_view to_string(Equation e) { return name_of(kEquationNames, e); }

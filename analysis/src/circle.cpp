@@ -87,6 +87,7 @@ struct Sample {
 std::string axis_names(Plane p) {
   using enum Plane;
   static constexpr cal::EnumName<Plane> kNames[] = {{xy, "XY"}, {yz, "YZ"}, {zx, "ZX"}};
+  static_assert(cal::names_every_value(kNames));
   return std::string(cal::name_of(kNames, p, "XY"));
 }
 
@@ -130,6 +131,8 @@ constexpr std::array<const char*, term_count> term_names = {"centre offset (firs
                                                             "cyclic error (second axis)",
                                                             "straightness (first axis)",
                                                             "straightness (second axis)"};
+// A name for every term: an array given fewer names than term_count holds null pointers.
+static_assert(term_names.back() != nullptr);
 
 struct Model {
   double r_mm, phi_rad;

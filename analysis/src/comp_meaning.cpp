@@ -105,6 +105,7 @@ std::string_view to_string(Evidence e) {
       {stated, "stated by the vendor"},
       {best_reading, "the best reading of the vendor's text, not stated in so many words"},
       {not_found, "NOT STATED in the public text read"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, e, "unknown");
 }
 

@@ -9,6 +9,7 @@
 
 #include "cal/analysis/comp_meaning.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/analysis/straightness.hpp"
 
 namespace cal::comptable {
@@ -108,10 +109,7 @@ std::vector<double> grid(const Spec& s) {
 }  // namespace
 
 std::string fixed(double v, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  double r = std::round(v * scale) / scale;
-  if (r == 0.0) r = 0.0;  // -0 and values that round to zero print as 0
-  return fmt::format("{:.{}f}", r, decimals);
+  return control_text(v, decimals, "a value of a compensation table");
 }
 
 double um_per_unit(Units u) { return u == Units::mm ? 1e3 : u == Units::inch ? 25400.0 : 1.0; }

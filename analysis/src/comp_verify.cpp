@@ -21,6 +21,7 @@ std::string_view to_string(Finding f) {
       {constant_shift, "reference-point error"}, {position_shift, "position shift"},
       {too_small, "too small to tell"}, {unexplained, "unexplained"}};
   // clang-format on
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, f, "unknown");
 }
 

@@ -77,6 +77,7 @@ constexpr EnumName<Cycle> kCycleNames[] = {{Cycle::linear, "linear"},
                                            {Cycle::pilgrim_step, "pilgrim-step"},
                                            {Cycle::pilgrim_step, "pilgrim_step"},
                                            {Cycle::pilgrim_step, "step"}};
+static_assert(cal::names_every_value(kCycleNames));
 
 }  // namespace
 

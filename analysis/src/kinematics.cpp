@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 
 namespace cal::kinematics {
@@ -135,6 +136,10 @@ constexpr std::array<std::string_view, 18> kComponentNames{
     "E_XX", "E_YX", "E_ZX", "E_AX", "E_BX", "E_CX", "E_XY", "E_YY", "E_ZY",
     "E_AY", "E_BY", "E_CY", "E_XZ", "E_YZ", "E_ZZ", "E_AZ", "E_BZ", "E_CZ",
 };
+// One entry per value of each enum (a new value that is not added here does not compile).
+static_assert(one_per_value<Topology>(kTopologyNames));
+static_assert(one_per_value<Component>(kComponentNames));
+static_assert(kComponents.size() == enumerator_count<Component>());
 
 std::string upper(std::string_view s) {
   std::string u(s);
@@ -183,6 +188,8 @@ constexpr std::array<std::string_view, 3> kLocationNames{"E_C0Y", "E_B0Z", "E_A0
 // The sign that takes alpha (angle over 90 deg) to the ISO 230-1 location error: see
 // kinematics.hpp. Only the rotation about Y closes the angle when positive.
 constexpr std::array<double, 3> kAlphaToLocation{+1.0, -1.0, +1.0};
+static_assert(one_per_value<Plane>(kPlaneNames) && one_per_value<Plane>(kLocationNames) &&
+              one_per_value<Plane>(kAlphaToLocation));
 }  // namespace
 
 std::string_view to_string(Plane p) { return kPlaneNames.at(static_cast<std::size_t>(p)); }

@@ -12,6 +12,7 @@
 #include <limits>
 #include <numbers>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/rotary_fit.hpp"
 
@@ -67,6 +68,7 @@ Isometry3d pose(const Matrix3d& r, const Vector3d& t) {
 
 std::string_view to_string(RotaryLetter l) {
   static constexpr std::array<std::string_view, 3> names{"A", "B", "C"};
+  static_assert(one_per_value<RotaryLetter>(names));
   return names.at(static_cast<std::size_t>(l));
 }
 

@@ -103,6 +103,7 @@ std::string_view to_string(Reference r) {
   using enum Reference;
   static constexpr EnumName<Reference> kNames[] = {
       {least_squares, "least squares"}, {end_point, "end point"}, {minimum_zone, "minimum zone"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, r);
 }
 
@@ -112,6 +113,7 @@ Reference reference_from_string(std::string_view s) {
   static constexpr EnumName<Reference> kWords[] = {
       {least_squares, "lsq"},   {least_squares, "least-squares"}, {end_point, "endpoint"},
       {end_point, "end-point"}, {minimum_zone, "minzone"},        {minimum_zone, "minimum-zone"}};
+  static_assert(cal::names_every_value(kWords));
   if (const auto r = value_named(kWords, s)) return *r;
   throw InputError(
       fmt::format("unknown reference line '{}' (expected lsq, endpoint or minzone)", s));

@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/analysis/text.hpp"
 
 namespace cal::kinematics {
@@ -91,11 +92,6 @@ Vec3 orientation_of(RotaryLetter l, const Vector3d& u) {
       break;
   }
   return {e[0] / kRadPerUrad, e[1] / kRadPerUrad, e[2] / kRadPerUrad};
-}
-
-std::string number(double v, int decimals) {
-  const double tiny = 0.5 * std::pow(10.0, -decimals);
-  return fmt::format("{:.{}f}", std::abs(v) < tiny ? 0.0 : v, decimals);
 }
 
 // The variable numbers written: k of $TC_CARRk, its slot in the record, its decimals.
@@ -186,7 +182,8 @@ std::string sinumerik_swivel_program(const SwivelRecord& r, std::string_view ori
   if (!origin_comment.empty()) s += fmt::format("; {}\n", text::terminal_safe(origin_comment));
   for (const auto& slot : vector_slots())
     s += fmt::format("$TC_CARR{}[{}]={}\n", slot.k, n,
-                     number((r.*slot.vector)[slot.component], slot.decimals));
+                     control_text((r.*slot.vector)[slot.component], slot.decimals,
+                                  fmt::format("$TC_CARR{}[{}]", slot.k, n)));
   s += fmt::format("$TC_CARR21[{}]={}\n", n, r.axis1.empty() ? "0" : r.axis1);
   s += fmt::format("$TC_CARR22[{}]={}\n", n, r.axis2.empty() ? "0" : r.axis2);
   s += fmt::format("$TC_CARR23[{}]=\"{}\"\n", n, r.kind);

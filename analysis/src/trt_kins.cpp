@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/analysis/text.hpp"
 
 namespace cal::kinematics {
@@ -83,7 +84,8 @@ std::string linuxcnc_trt_hal(const TrtPins& p, std::string_view origin_comment) 
     s.back() = '\n';
   }
   const auto pin = [&](std::string_view name, double v) {
-    s += fmt::format("setp {}.{} {:.6f}\n", p.module, name, std::abs(v) < 5e-7 ? 0.0 : v);
+    s += fmt::format("setp {}.{} {}\n", p.module, name,
+                     control_text(v, 6, fmt::format("the pin {}.{}", p.module, name)));
   };
   pin("x-rot-point", p.x_rot_point_mm);
   pin("y-rot-point", p.y_rot_point_mm);

@@ -15,6 +15,7 @@ std::string_view to_string(ErrorKind kind) {
       {garbage, "garbage"}, {overlong_line, "overlong_line"}, {bad_checksum, "bad_checksum"},
       {out_of_range, "out_of_range"}, {malformed, "malformed"}};
   // clang-format on
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, kind, "unknown");
 }
 

@@ -21,6 +21,7 @@ std::string_view to_string(Quantity q) {
       {material_temperature_degc, "material_temperature_degc"},
       {machine_position_m, "machine_position_m"},
       {angle_rad, "angle_rad"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, q, "unknown");
 }
 
@@ -28,6 +29,7 @@ std::string_view to_string(ReadingStatus s) {
   using enum ReadingStatus;
   static constexpr EnumName<ReadingStatus> kNames[] = {
       {ok, "ok"}, {signal_lost, "signal_lost"}, {out_of_range, "out_of_range"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, s, "unknown");
 }
 
@@ -35,6 +37,7 @@ constexpr EnumName<InstrumentState> kInstrumentStateNames[] = {
     {InstrumentState::closed, "closed"},           {InstrumentState::connecting, "connecting"},
     {InstrumentState::configuring, "configuring"}, {InstrumentState::streaming, "streaming"},
     {InstrumentState::signal_lost, "signal lost"}, {InstrumentState::reconnecting, "reconnecting"}};
+static_assert(cal::names_every_value(kInstrumentStateNames));
 
 std::string_view to_string(InstrumentState s) {
   return name_of(kInstrumentStateNames, s, "unknown");
@@ -44,6 +47,7 @@ constexpr EnumName<DeviceMessage::Severity> kSeverityNames[] = {
     {DeviceMessage::Severity::info, "info"},
     {DeviceMessage::Severity::warning, "warning"},
     {DeviceMessage::Severity::error, "error"}};
+static_assert(cal::names_every_value(kSeverityNames));
 
 std::string_view to_string(DeviceMessage::Severity s) {
   return name_of(kSeverityNames, s, "unknown");

@@ -72,6 +72,7 @@ std::string_view to_string(OptionType type) {
   static constexpr EnumName<OptionType> kNames[] = {
       {boolean, "boolean"}, {integer, "integer"}, {number, "number"},
       {string, "string"},   {choice, "choice"},   {integer_list, "integer list"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, type, "unknown");
 }
 

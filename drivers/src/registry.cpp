@@ -13,6 +13,7 @@ std::string_view to_string(DecodedItem::Kind k) {
   using enum DecodedItem::Kind;
   static constexpr EnumName<DecodedItem::Kind> kNames[] = {
       {reading, "reading"}, {error, "error"}, {gap, "gap"}, {note, "note"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, k, "unknown");
 }
 

@@ -323,6 +323,7 @@ std::string_view to_string(ErrorKind kind) {
       {open_failed, "open failed"}, {read_failed, "read failed"}, {write_failed, "write failed"},
       {closed_by_peer, "closed by peer"}, {timeout, "timeout"}};
   // clang-format on
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, kind, "unknown");
 }
 

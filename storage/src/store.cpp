@@ -21,6 +21,7 @@ constexpr EnumName<RunStatus> kStatusNames[] = {{RunStatus::running, "running"},
                                                 {RunStatus::complete, "complete"},
                                                 {RunStatus::incomplete, "incomplete"},
                                                 {RunStatus::aborted, "aborted"}};
+static_assert(cal::names_every_value(kStatusNames));
 }  // namespace
 
 std::string_view to_string(RunStatus s) { return name_of(kStatusNames, s, "unknown"); }

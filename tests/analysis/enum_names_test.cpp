@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <string>
+#include <string_view>
 
 #include "cal/analysis/air.hpp"
 #include "cal/analysis/iso230_2_targets.hpp"
@@ -63,6 +65,44 @@ TEST(EnumNames, AnalysisNamesReadBothWays) {
   EXPECT_EQ(cal::straightness::reference_from_string("end-point"), Reference::end_point);
   EXPECT_EQ(error_of([] { cal::straightness::reference_from_string("minimum zone"); }),
             "unknown reference line 'minimum zone' (expected lsq, endpoint or minzone)");
+}
+
+// The compile-time checks beside every table: the compiler's own list of an enum's values.
+enum class Sparse { first = 0, fifth = 5, last = 63 };  // numbered with gaps, up to the limit
+constexpr cal::EnumName<Sparse> kSparseAll[] = {
+    {Sparse::first, "first"}, {Sparse::fifth, "fifth"}, {Sparse::last, "last"}};
+constexpr cal::EnumName<Sparse> kSparseNoFifth[] = {{Sparse::first, "first"},
+                                                    {Sparse::last, "last"}};
+constexpr cal::EnumName<Colour> kColoursAll[] = {{Colour::red, "red"},
+                                                 {Colour::green, "green"},
+                                                 {Colour::blue, "blue"},
+                                                 {Colour::unnamed, "unnamed"}};
+enum class Dense { a, b, c };
+constexpr std::array<std::string_view, 3> kDense{"A", "B", "C"};
+constexpr std::array<std::string_view, 3> kDenseShort{"A", "B"};  // the third is empty
+constexpr std::array<const char*, 3> kDenseShortPointers{"A", "B"};
+constexpr std::array<std::string_view, 2> kDenseTooFew{"A", "B"};
+constexpr std::array<double, 3> kDenseNumbers{1.0, -1.0, 0.0};  // a 0.0 is a value, not a gap
+
+TEST(EnumNames, TheCompilerCountsTheValuesAndFindsOneWithoutAName) {
+  static_assert(cal::enumerator_count<Colour>() == 4);  // red, green, blue, unnamed
+  static_assert(cal::enumerator_count<Sparse>() == 3);
+  static_assert(cal::enumerator_count<Dense>() == 3);
+  static_assert(!cal::names_every_value(kColours));  // Colour::unnamed has none
+  static_assert(cal::names_every_value(kColoursAll));
+  static_assert(cal::names_every_value(kSparseAll));
+  static_assert(!cal::names_every_value(kSparseNoFifth));
+  static_assert(cal::one_per_value<Dense>(kDense));
+  static_assert(cal::one_per_value<Dense>(kDenseNumbers));
+  static_assert(!cal::one_per_value<Dense>(kDenseShort));
+  static_assert(!cal::one_per_value<Dense>(kDenseShortPointers));
+  static_assert(!cal::one_per_value<Dense>(kDenseTooFew));
+  static_assert(!cal::one_per_value<Sparse>(std::array<int, 3>{1, 2, 3}));  // not 0, 1, 2
+  // The same, evaluated when the test runs (a constexpr function gives the same answer).
+  EXPECT_EQ(cal::enumerator_count<Colour>(), 4u);
+  EXPECT_FALSE(cal::names_every_value(kColours));
+  EXPECT_FALSE(cal::names_every_value(kSparseNoFifth));
+  EXPECT_TRUE(cal::names_every_value(kSparseAll));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "cal/analysis/comp_read.hpp"
 #include "cal/analysis/comp_table.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/analysis/iso230_2.hpp"
 #include "cal/storage/store.hpp"
 #include "cli_checks.hpp"
@@ -400,7 +401,8 @@ void run(CompensateOptions& o) {
     fmt::print(stderr,
                "predicted: largest |mean deviation| {} um before, {} um left by this table as "
                "written (its rounding, sign and reference applied to the measured means)\n",
-               ct::fixed(predicted->before_max_um, 3), ct::fixed(predicted->after_max_um, 3));
+               cal::fixed_text(predicted->before_max_um, 3),
+               cal::fixed_text(predicted->after_max_um, 3));
 }
 
 }  // namespace

@@ -41,6 +41,7 @@ std::string_view unit_of(d::Quantity q) {
                                                           {air_humidity_pct, "%RH"},
                                                           {angle_rad, "rad"},
                                                           {refractive_index, ""}};
+  static_assert(cal::names_every_value(kNames));
   return cal::name_of(kNames, q, "");
 }
 

@@ -29,8 +29,6 @@ json grid_json(const kin::Grid& g) {
           {"count", {g.count[0], g.count[1], g.count[2]}}};
 }
 
-double shown(double v) { return std::abs(v) < 5e-4 ? 0.0 : v; }
-
 namespace {
 constexpr std::array kAxis{"X", "Y", "Z"};
 }
@@ -395,8 +393,9 @@ void run_map(const MapOptions& o) {
                        {"error_um", vec_json(t)},
                        {"rotation_urad", vec_json(e.rotation_urad)}});
       else
-        fmt::print("{:10.3f} {:10.3f} {:10.3f} {:10.3f} {:10.3f} {:10.3f} {:10.3f}\n", shown(p[0]),
-                   shown(p[1]), shown(p[2]), shown(t[0]), shown(t[1]), shown(t[2]),
+        fmt::print("{:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:10.3f}\n", fixed_text(p[0], 3),
+                   fixed_text(p[1], 3), fixed_text(p[2], 3), fixed_text(t[0], 3),
+                   fixed_text(t[1], 3), fixed_text(t[2], 3),
                    std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]));
     }
     if (o.json) {
@@ -426,8 +425,8 @@ void run_map(const MapOptions& o) {
   fmt::print("  largest |e|  {:.3f} um at ({:g}, {:g}, {:g}) mm\n", s.max_norm_um,
              s.max_norm_at_mm[0], s.max_norm_at_mm[1], s.max_norm_at_mm[2]);
   for (std::size_t i = 0; i < 3; ++i)
-    fmt::print("  e{}  {:9.3f} .. {:9.3f} um (range {:.3f})\n", static_cast<char>('x' + i),
-               shown(s.min_um[i]), shown(s.max_um[i]), s.range_um[i]);
+    fmt::print("  e{}  {:>9} .. {:>9} um (range {:.3f})\n", static_cast<char>('x' + i),
+               fixed_text(s.min_um[i], 3), fixed_text(s.max_um[i], 3), s.range_um[i]);
   fmt::print("Contributions, ranked (largest |e| of each error alone, first order):\n");
   for (std::size_t k = 0; k < contributions.size(); ++k) {
     const auto& c = contributions[k];

@@ -203,10 +203,12 @@ void print_points(const mdl::Model& m, const std::vector<PoseError>& errors) {
     const auto& p = pe.pose.p_mm;
     const auto& t = pe.e.translation_um;
     const auto& r = pe.e.rotation_urad;
-    fmt::print("{:10.3f} {:10.3f} {:10.3f}", shown(p[0]), shown(p[1]), shown(p[2]));
-    for (double a : pe.pose.angles_deg) fmt::print(" {:9.3f}", shown(a));
-    fmt::print(" {:9.3f} {:9.3f} {:9.3f} {:9.3f} {:9.3f} {:9.3f} {:9.3f}\n", shown(t[0]),
-               shown(t[1]), shown(t[2]), norm(t), shown(r[0]), shown(r[1]), shown(r[2]));
+    fmt::print("{:>10} {:>10} {:>10}", fixed_text(p[0], 3), fixed_text(p[1], 3),
+               fixed_text(p[2], 3));
+    for (double a : pe.pose.angles_deg) fmt::print(" {:>9}", fixed_text(a, 3));
+    fmt::print(" {:>9} {:>9} {:>9} {:9.3f} {:>9} {:>9} {:>9}\n", fixed_text(t[0], 3),
+               fixed_text(t[1], 3), fixed_text(t[2], 3), norm(t), fixed_text(r[0], 3),
+               fixed_text(r[1], 3), fixed_text(r[2], 3));
   }
 }
 
@@ -300,8 +302,8 @@ void run_five_axis_map(const mdl::Model& m, const FiveAxisMapRequest& q) {
              norm(turned->e.rotation_urad), tp[0], tp[1], tp[2],
              angles_text(m, turned->pose.angles_deg));
   for (std::size_t i = 0; i < 3; ++i)
-    fmt::print("  e{}  {:9.3f} .. {:9.3f} um (range {:.3f})\n", static_cast<char>('x' + i),
-               shown(lo[i]), shown(hi[i]), hi[i] - lo[i]);
+    fmt::print("  e{}  {:>9} .. {:>9} um (range {:.3f})\n", static_cast<char>('x' + i),
+               fixed_text(lo[i], 3), fixed_text(hi[i], 3), hi[i] - lo[i]);
   fmt::print(
       "Contributions, ranked (largest |e| of each error alone, first order; workpiece frame):\n");
   std::size_t k = 0;

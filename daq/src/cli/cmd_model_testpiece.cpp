@@ -141,10 +141,10 @@ void run(const Options& given) {
   for (const auto& r : rows) {
     std::string extra;
     if (measured)
-      extra = r.measured ? fmt::format(" {:10.3f} {:10.3f}", shown(*r.measured),
-                                       shown(*r.measured - r.predicted))
+      extra = r.measured ? fmt::format(" {:>10} {:>10}", fixed_text(*r.measured, 3),
+                                       fixed_text(*r.measured - r.predicted, 3))
                          : fmt::format(" {:>10} {:>10}", "-", "-");
-    fmt::print("{:18} {:22} {:10.3f}{}\n", r.feature, r.quantity, shown(r.predicted), extra);
+    fmt::print("{:18} {:22} {:>10}{}\n", r.feature, r.quantity, fixed_text(r.predicted, 3), extra);
   }
   if (measured && !measured->aligned)
     fmt::print("note: the CMM points lack face-Y or bore0, so bore positions are not compared\n");

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/storage/store.hpp"
 #include "model/model_file.hpp"
 #include "model/model_map.hpp"
@@ -35,8 +36,8 @@ cal::daq::report::ModelPage model_page_of(const cal::daq::model::Model& m, const
 nlohmann::json vec_json(const cal::kinematics::Vec3& v);
 // A map's grid as JSON: min_mm, max_mm, count (the maps' "grid").
 nlohmann::json grid_json(const cal::kinematics::Grid& g);
-// A value to print with three decimals, without a "-0.000".
-double shown(double v);
+// Numbers in fixed notation, never "-0.000" (fixed_text.hpp).
+using cal::fixed_text;
 
 // Every value finite, or InputError (model_map.hpp).
 using cal::daq::model::require_finite;

@@ -18,8 +18,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::array<const char*, 3> kSquareness{"E_C0Y", "E_B0Z", "E_A0Z"};
-
 std::size_t axis_of(kin::Component c) { return static_cast<std::size_t>(c) / 6; }
 bool is_angle(kin::Component c) { return static_cast<std::size_t>(c) % 6 >= 3; }
 // The direction of a translational component (E_YX -> Y).
@@ -156,14 +154,15 @@ BuildReport build(const std::vector<MeasuredProfile>& profiles, const BuildOptio
              {"run_ids", {a->second.second, b->second.second}},
              {"from", fmt::format("slopes of {} and {} against one square", q.first, q.second)}}
             .dump();
-    r.used.push_back({std::string(kSquareness[static_cast<std::size_t>(q.plane)]),
-                      {a->second.second, b->second.second}});
+    r.used.push_back(
+        {std::string(kin::location_error_name(q.plane)), {a->second.second, b->second.second}});
   }
 
   for (kin::Component c : kin::all_components())
     if (!by.count(c)) r.missing.emplace_back(kin::to_string(c));
   for (std::size_t k = 0; k < 3; ++k)
-    if (!m.squareness[k].given) r.missing.emplace_back(kSquareness[k]);
+    if (!m.squareness[k].given)
+      r.missing.emplace_back(kin::location_error_name(static_cast<kin::Plane>(k)));
   if (!r.missing.empty() && !o.allow_missing)
     throw InputError(fmt::format(
         "machine '{}': {} of the 21 errors {} no stored run: {} (measure them, or allow a "

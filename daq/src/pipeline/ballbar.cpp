@@ -115,6 +115,7 @@ std::string_view to_string(BallbarPhase p) {
       {feed_in, "waiting for the feed-in"}, {dwell, "dwell"}, {ccw_arc, "ccw arc"},
       {cw_arc, "cw arc"}, {complete, "complete"}};
   // clang-format on
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, p);
 }
 

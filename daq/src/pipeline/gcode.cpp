@@ -12,7 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/fixed_text.hpp"
 
 namespace cal::daq {
 namespace {
@@ -27,15 +29,13 @@ double checked(double v, std::string_view what) {
         fmt::format("program: {} {} is not a finite value within +-{}", what, v, kMaxWordValue));
   return v;
 }
-std::string num(double v) {  // 4 decimals, no "-0.0000"
-  checked(v, "value");
-  if (std::abs(v) < 5e-5) v = 0.0;
-  return fmt::format("{:.4f}", v);
+// A word's number: 4 decimals (0.1 um, 0.0001 s), no "-0.0000" (cal::control_text).
+std::string num(double v, std::string_view what = "value") {
+  return control_text(checked(v, what), 4, what);
 }
-std::string signed_num(double v) {  // Heidenhain writes the sign: X+12.5000
-  checked(v, "value");
-  if (std::abs(v) < 5e-5) v = 0.0;
-  return fmt::format("{:+.4f}", v);
+std::string signed_num(double v, std::string_view what) {  // Heidenhain: X+12.5000, R+50.0000
+  const std::string s = num(v, what);
+  return s.front() == '-' ? s : "+" + s;
 }
 
 // A program name every dialect takes: letters, digits and '_', a letter first, at most 24
@@ -53,6 +53,7 @@ void check_name(const std::string& name) {
 
 const char* plane_word(Dialect d, Plane p) {
   static constexpr std::array<const char*, 3> fanuc{"G17", "G18", "G19"};
+  static_assert(one_per_value<Plane>(fanuc));
   (void)d;  // the same words in ISO/Fanuc and SINUMERIK
   return fanuc[static_cast<std::size_t>(p)];
 }
@@ -95,14 +96,14 @@ struct Writer {
   void dwell(double s) {
     if (d == Dialect::heidenhain) {
       add("CYCL DEF 9.0 DWELL TIME");
-      add(fmt::format("CYCL DEF 9.1 DWELL {}", num(s)));
+      add(fmt::format("CYCL DEF 9.1 DWELL {}", num(s, "dwell")));
     } else if (d == Dialect::fanuc) {
       if (fanuc_dwell == FanucDwell::p_ms)
         add(fmt::format("G04 P{}", std::lround(checked(s, "dwell") * 1000)));  // ms, no point
-      else
-        add(fmt::format("G04 X{:.3f}", checked(s, "dwell")));  // s; 3 decimals fit IS-B, IS-C
+      else  // s; 3 decimals fit IS-B, IS-C
+        add(fmt::format("G04 X{}", control_text(checked(s, "dwell"), 3, "dwell")));
     } else {
-      add(fmt::format("G4 F{}", num(s)));  // F: seconds in a G4 block
+      add(fmt::format("G4 F{}", num(s, "dwell")));  // F: seconds in a G4 block
     }
   }
   void end(const std::string& name) {
@@ -120,8 +121,9 @@ struct Writer {
 };
 
 std::string axis_word(Dialect d, char axis, double v) {
-  return d == Dialect::heidenhain ? fmt::format("{}{}", axis, signed_num(v))
-                                  : fmt::format("{}{}", axis, num(v));
+  const std::string what = fmt::format("{} word", axis);
+  return d == Dialect::heidenhain ? fmt::format("{}{}", axis, signed_num(v, what))
+                                  : fmt::format("{}{}", axis, num(v, what));
 }
 
 // The circle's plane: its axes (u, v) with u x v along the positive third axis, and the centre.
@@ -153,8 +155,9 @@ std::string centre_words(Dialect d, char a, double va, char b, double vb) {
   if (a > b) std::swap(a, b), std::swap(va, vb);
   const auto word = [&](char axis, double v) {
     const char letter = static_cast<char>('I' + (axis - 'X'));
-    return d == Dialect::siemens ? fmt::format("{}={}", letter, num(v))
-                                 : fmt::format("{}{}", letter, num(v));
+    const std::string what = fmt::format("{} word", letter);
+    return d == Dialect::siemens ? fmt::format("{}={}", letter, num(v, what))
+                                 : fmt::format("{}{}", letter, num(v, what));
   };
   return word(a, va) + " " + word(b, vb);
 }
@@ -348,10 +351,10 @@ class CircleWriter {
       // Every piece is at most 180 degrees: the radius is written positive in all dialects.
       if (w_.d == Dialect::heidenhain)
         w_.add(by_centre ? fmt::format("C {} {} {}", end, dr, fw)
-                         : fmt::format("CR {} R{} {} {}", end, signed_num(r), dr, fw));
+                         : fmt::format("CR {} R{} {} {}", end, signed_num(r, "radius"), dr, fw));
       else if (!by_centre)
-        w_.add(
-            fmt::format("{} {} {}{} {}", g, end, w_.d == Dialect::fanuc ? "R" : "CR=", num(r), fw));
+        w_.add(fmt::format("{} {} {}{} {}", g, end,
+                           w_.d == Dialect::fanuc ? "R" : "CR=", num(r, "radius"), fw));
       else
         w_.add(fmt::format("{} {} {} {}", g, end,
                            centre_words(w_.d, f.u, f.cu - fu, f.v, f.cv - fv), fw));

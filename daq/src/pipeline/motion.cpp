@@ -13,6 +13,7 @@ std::string_view to_string(Motion m) {
   using enum Motion;
   static constexpr EnumName<Motion> kNames[] = {
       {moving, "moving"}, {settling, "settling"}, {stable, "stable"}, {captured, "captured"}};
+  static_assert(cal::names_every_value(kNames));
   return name_of(kNames, m, "moving");
 }
 

@@ -4,11 +4,11 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <utility>
 
 #include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/analysis/text.hpp"
 #include "circle_output.hpp"
 #include "iso230_2_output.hpp"
@@ -195,11 +195,7 @@ void print_ballbar5x_doc(const json& doc, std::string_view in) {
 
 }  // namespace
 
-std::string number_text(double value, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  if (!(std::round(std::abs(value) * scale) > 0)) value = 0.0;  // also NaN's sign
-  return fmt::format("{:.{}f}", value, decimals);
-}
+std::string number_text(double value, int decimals) { return cal::fixed_text(value, decimals); }
 
 std::string signed_number_text(double value, int decimals) {
   const std::string s = number_text(value, decimals);

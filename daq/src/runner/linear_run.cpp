@@ -983,6 +983,7 @@ std::string_view to_string(Control c) {
   using enum Control;
   static constexpr cal::EnumName<Control> kNames[] = {
       {capture, "capture"}, {skip, "skip"}, {retry, "retry"}, {pause, "pause"}, {resume, "resume"}};
+  static_assert(cal::names_every_value(kNames));
   return cal::name_of(kNames, c);
 }
 bool LinearRun::finished() const { return impl_->done; }

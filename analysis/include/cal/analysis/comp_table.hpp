@@ -67,8 +67,8 @@ std::string units_name(Units u);
 double um_per_unit(Units u);
 Units units_from_string(const std::string& s);
 
-// A number in fixed notation with `decimals` places, rounded, never "-0.000" (a controller or a
-// reader could take the sign for a direction).
+// A number of a controller table: cal::control_text (fixed_text.hpp), rounded half away from
+// zero, never "-0.000"; a value that is not finite is refused.
 std::string fixed(double v, int decimals);
 
 // Writers. Each refuses a table whose sign is not its format's (comp_meaning.hpp: LinuxCNC
