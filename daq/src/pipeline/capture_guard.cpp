@@ -66,11 +66,11 @@ std::string CaptureGuard::moving_reason(std::int64_t now_ns, Motion shown) const
   return {};
 }
 
-std::string CaptureGuard::refusal(const std::string& moving) const {
+std::string CaptureGuard::refusal(const std::string& moving, std::string_view key) const {
   return fmt::format(
-      "not captured: the axis is moving ({}); capture when it has stopped, or press Capture "
+      "not captured: the axis is moving ({}); capture when it has stopped, or press {} "
       "again within {:g} s to take it anyway",
-      moving, s_.force_within_s);
+      moving, key, s_.force_within_s);
 }
 
 CaptureVerdict CaptureGuard::press(std::int64_t now_ns, Motion shown) {

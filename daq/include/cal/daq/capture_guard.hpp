@@ -14,6 +14,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "cal/daq/motion.hpp"
 
@@ -43,8 +44,10 @@ class CaptureGuard {
   CaptureVerdict press(std::int64_t now_ns, Motion shown);
   // Why the axis counts as moving now ("" when it does not).
   std::string moving_reason(std::int64_t now_ns, Motion shown) const;
-  // The message of a refusal, with the way to force it.
-  std::string refusal(const std::string& moving) const;
+  // The message of a refusal, with the way to force it (`key`: the page's Capture, the CLI's
+  // Enter).
+  std::string refusal(const std::string& moving, std::string_view key = "Capture") const;
+  double force_within_s() const { return s_.force_within_s; }
 
  private:
   CaptureGuardSettings s_;
