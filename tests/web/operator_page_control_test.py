@@ -184,6 +184,19 @@ try:
            what="the table row saying 'by hand'")
     page_checks.shot(b, SHOTS, "c02-captured-by-hand-1366x768.png")
 
+    # --- 2b. capture by hand while the axis moves: refused, and the way to force it said -------
+    b.wait("return window.caldaq.page.run.motion.state === 'moving';", timeout_s=60,
+           what="the axis moving to the next target", explain=EXPLAIN)
+    c = control(b, "c", "capture")
+    ok(not c["ok"] and c["status"] == 409 and "not captured: the axis is moving (" in c["text"]
+       and "press Capture (C) again within 3 s to take it anyway" in c["text"],
+       f"C while moving: refused, saying how to force it: {c['text']!r}")
+    ok(b.js("return document.getElementById('ctl-capture').textContent;") == "Capture anyway, while moving (C)",
+       "the Capture button says a second press takes it anyway")
+    page_checks.shot(b, SHOTS, "c02b-refused-while-moving-1366x768.png")
+    b.wait("return document.getElementById('ctl-capture').textContent === 'Capture (C)';", timeout_s=10,
+           what="the Capture button back after 3 s")
+
     # --- 3. resume, skip, measure again --------------------------------------------------------
     status, body = post(url + "api/runs/pause", {"why": 1})
     ok(status == 400, f"pause with a body of keys: 400 ({body.get('error')})")

@@ -207,7 +207,8 @@ try:
             suspect_stops: [{run: 2, direction: 'up', target_index: 1,
                              reason: 'run 2 up at 50 mm: +1.200 µm from the median of its target\\'s runs (limit 0.3)'}]}});
         return document.getElementById('result-quality').textContent;""")
-    ok("SUSPECT STOPS: 1" in suspect and "target 2: run 2 up at 50 mm" in suspect and "--accept-suspect 7" in suspect,
+    ok("SUSPECT STOPS: 1" in suspect and "target 2: run 2 up at 50 mm" in suspect
+       and "refuse run 7 while it has suspect stops: measure the test again" in suspect and "--accept" not in suspect,
        f"a suspect run names its stops: {suspect!r}")
     # Its summary without its state again ("SUSPECT STOPS: 1suspect: 1 stop" said it twice).
     ok("suspect: 1 stop" not in suspect and "1 stop" in suspect, f"the state said once: {suspect!r}")

@@ -13,6 +13,7 @@
 
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/daq/capture_guard.hpp"
 #include "cal/daq/env_stage.hpp"
 #include "cal/daq/motion.hpp"
 #include "cal/daq/trigger.hpp"
@@ -98,7 +99,8 @@ std::string to_json_text(const LiveState& s) {
                      {"pending", x.pending},
                      {"missed", x.missed},
                      {"skipped", x.skipped},
-                     {"manual", x.manual}});
+                     {"manual", x.manual},
+                     {"while_moving", x.while_moving}});
   j["stops"] = std::move(stops);
   j["stop_value"] = {{"what", s.stop_value}, {"unit", ::daq::unit_html(s.stop_unit)}};
   j["paused"] = s.paused;
@@ -216,13 +218,20 @@ struct LinearRun::Impl : Runner {
   };
   std::vector<Pending> pending;
   cal::daq::MotionIndicator motion;
+  // A capture by hand while the axis moves is refused unless pressed again (capture_guard.hpp).
+  cal::daq::CaptureGuard guard;
+  std::int64_t last_ns = 0;        // the newest laser, reference or feed reading's time
   std::vector<double> acceptable;  // sorted: the positions a stop could be at now
   LinearRunOutcome outcome;
   LiveState live;
   std::int64_t first_ns = -1;
   double last_raw_m = 0.0;  // the newest laser reading, for a capture made on a feed sample
-  std::optional<std::size_t> last_taken;           // the stop the last capture was labelled as
-  std::vector<bool> manual;                        // by stop: captured by hand
+  std::optional<std::size_t> last_taken;  // the stop the last capture was labelled as
+  std::vector<bool> manual;               // by stop: captured by hand
+  std::vector<bool> while_moving;         // by stop: captured by hand, forced while the axis moved
+  bool forcing = false;                   // the capture by hand being labelled is a forced one
+  std::string_view again_key =
+      "Capture (C)";  // the key that forces it: the page's, the CLI's Enter
   std::vector<std::optional<double>> kind_values;  // by stop: a kind's own value, once stored
   // True for a kind whose stop value is its own instrument's (straightness, angular, roll), not
   // the deviation the sequencer computed from the position (positioning, rotary).
@@ -243,7 +252,8 @@ struct LinearRun::Impl : Runner {
         kind(kinds::kind(setup.config.linear->measure.kind)),
         motion({.tolerance_um = setup.config.trigger.tolerance_um,
                 .dwell_s = setup.config.trigger.dwell_s,
-                .window_mm = setup.config.trigger.window_mm}) {
+                .window_mm = setup.config.trigger.window_mm}),
+        guard({.tolerance_um = setup.config.trigger.tolerance_um}) {
     kind.validate(*setup.config.linear);
     reader = kind.reader(*setup.config.linear);
     live.units = kind.axis_units();
@@ -402,13 +412,16 @@ struct LinearRun::Impl : Runner {
         return;
       case Quantity::machine_position_m:
         if (position_trigger && devices.is(Role::position, device) &&
-            r.channel == setup.position_channel)
+            r.channel == setup.position_channel) {
+          if (r.status == ReadingStatus::ok) guard.add_feed(r.time_ns, r.value * 1e3);
+          last_ns = std::max(last_ns, r.time_ns);
           // A feed without a position (SHDR UNAVAILABLE) ends the stillness it held.
           if (auto cap = position_trigger->add_position(
                   r.time_ns, r.status == ReadingStatus::ok
                                  ? r.value * 1e3
                                  : std::numeric_limits<double>::quiet_NaN()))
             on_capture(*cap, env.compensate(r.time_ns, last_raw_m));
+        }
         return;
       default:
         return;
@@ -441,6 +454,8 @@ struct LinearRun::Impl : Runner {
       live.deviation_um = sequencer.units().deviation_of(angle_deg, *next);
     live.state = "measuring";
     show_motion(time_ns, angle_deg, true);
+    guard.add_reading(time_ns, angle_deg, true);
+    last_ns = std::max(last_ns, time_ns);
     // The stop's value is the kind's (the window mean of the reference); raw 1 m, a factor 1.
     if (auto cap = trigger.add(time_ns, angle_deg, true)) {
       auto c = env.compensate(time_ns, 1.0);
@@ -536,6 +551,8 @@ struct LinearRun::Impl : Runner {
     const bool valid = r.status == ReadingStatus::ok;
     last_raw_m = r.value;
     show_motion(r.time_ns, position_mm, valid);
+    guard.add_reading(r.time_ns, position_mm, valid);
+    last_ns = std::max(last_ns, r.time_ns);
     if (position_trigger) {
       if (auto cap = position_trigger->add_reading(r.time_ns, position_mm, valid))
         on_capture(*cap, c);
@@ -567,6 +584,8 @@ struct LinearRun::Impl : Runner {
         last_taken = e.stop;
         manual.resize(sequencer.stops().size());
         manual[e.stop] = cap.manual;
+        while_moving.resize(sequencer.stops().size());
+        while_moving[e.stop] = cap.manual && forcing;
         {
           const auto& s = sequencer.stops()[e.stop];
           motion.captured(cap.mean_mm, s.position_mm, cap.end_ns);
@@ -795,8 +814,15 @@ struct LinearRun::Impl : Runner {
   }
 
   // The current window, whatever its spread, labelled by the sequencer as an automatic capture
-  // is; a capture it does not take (no target there) changes nothing.
+  // is; a capture it does not take (no target there) changes nothing. While the trigger sees
+  // the axis moving (capture_guard.hpp) it is refused, unless pressed again within 3 s: then
+  // taken and marked as taken while moving (the stop table, the run's record, the report).
   ControlOutcome capture_by_hand(std::optional<std::size_t>& stop) {
+    const auto verdict = guard.press(last_ns, motion.motion());
+    if (!verdict.take)
+      return {.applied = false,
+              .message = guard.refusal(verdict.moving, again_key),
+              .force_within_s = guard.force_within_s()};
     auto cap = position_trigger ? position_trigger->capture_now() : trigger.capture_now();
     if (!cap)
       return {false, "nothing to capture: no laser reading since the last capture or the start"};
@@ -804,7 +830,9 @@ struct LinearRun::Impl : Runner {
     // temperature): any non-zero raw length gives it, 0 would give 0 / 0.
     const auto comp = env.compensate(cap->end_ns, 0.1);
     last_taken.reset();
+    forcing = verdict.while_moving;  // read by on_capture for this capture only
     on_capture(*cap, comp);
+    forcing = false;
     if (!last_taken) {
       rearm();  // the automatic trigger watches this stop again
       return {false, fmt::format("not captured: {}", live.message)};
@@ -812,9 +840,13 @@ struct LinearRun::Impl : Runner {
     stop = last_taken;
     const auto& s = sequencer.stops()[*stop];
     const auto& u = sequencer.units();
-    return {true, fmt::format("captured by hand: {}: {} {}", describe(s),
-                              signed_number_text(u.deviation_of(cap->mean_mm, s.position_mm)),
-                              u.deviation)};
+    const auto value =
+        fmt::format("{}: {} {}", describe(s),
+                    signed_number_text(u.deviation_of(cap->mean_mm, s.position_mm)), u.deviation);
+    if (verdict.while_moving)
+      return {true, fmt::format("captured by hand WHILE MOVING ({}), forced by a second press: {}",
+                                verdict.moving, value)};
+    return {true, fmt::format("captured by hand: {}", value)};
   }
 
   ControlOutcome skip(std::optional<std::size_t>& stop) {
@@ -841,6 +873,7 @@ struct LinearRun::Impl : Runner {
       if (!forget_stop(*before)) return {false, "storage failed: the run was aborted"};
     }
     if (*stop < manual.size()) manual[*stop] = false;
+    if (*stop < while_moving.size()) while_moving[*stop] = false;
     if ((before->missed || before->skipped) && !store_missed())
       return {false, "storage failed: the run was aborted"};
     rearm();
@@ -960,6 +993,7 @@ struct LinearRun::Impl : Runner {
            .missed = s.missed && !s.captured,
            .skipped = s.skipped,
            .manual = s.captured && i < manual.size() && manual[i],
+           .while_moving = s.captured && i < while_moving.size() && while_moving[i],
            .pending = s.captured && own_value() && !(i < kind_values.size() && kind_values[i])});
     }
     setup.on_live(live);
@@ -972,6 +1006,7 @@ LinearRun::~LinearRun() { impl_->stop_if_running(); }
 void LinearRun::start() { impl_->start(); }
 void LinearRun::stop(const std::string& reason) { impl_->abort(reason); }
 void LinearRun::manual_capture() {
+  impl_->again_key = "Enter";  // daq run's keyboard: Enter is its capture
   const auto out = impl_->control(Control::capture, "keyboard (daq run)");
   if (!out.applied) impl_->event(out.message);
 }

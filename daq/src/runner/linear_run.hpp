@@ -62,9 +62,10 @@ struct LiveState {
     bool up = true;
     double nominal_mm = 0.0, deviation_um = 0.0;
     bool missed = false;
-    bool skipped = false;  // given up by the operator
-    bool manual = false;   // captured by hand
-    bool pending = false;  // captured, its value still waiting for the kind's instrument
+    bool skipped = false;       // given up by the operator
+    bool manual = false;        // captured by hand
+    bool while_moving = false;  // captured by hand, forced while the axis moved
+    bool pending = false;       // captured, its value still waiting for the kind's instrument
   };
   // What a captured stop's value is, and its unit: the deviation from the target (positioning,
   // rotary), or the kind's own value (straightness um, angular and roll urad), never the
@@ -156,6 +157,9 @@ std::string_view to_string(Control c);
 struct ControlOutcome {
   bool applied = false;  // false: not applicable now, `message` says why
   std::string message;   // what happened, in words (the stop, its value)
+  // A capture refused because the axis moves: a second press within this many seconds forces
+  // it (0: nothing to force).
+  double force_within_s = 0.0;
 };
 
 // A store or capture that fails (a full disk) ends the run as aborted with the reason

@@ -967,7 +967,11 @@ class Service {
                                     "resume are for linear runs (a circle has no stops)",
                                     run_id_));
     const auto out = linear_->control(c, "web page");
-    if (!out.applied) return error(409, out.message, {{"action", to_string(c)}});
+    if (!out.applied) {
+      json extra{{"action", to_string(c)}};
+      if (out.force_within_s > 0) extra["force_within_s"] = out.force_within_s;
+      return error(409, out.message, extra);
+    }
     fmt::print("  {} (from the web page)\n", out.message);
     std::fflush(stdout);
     return ok({{"run", run_id_}, {"action", to_string(c)}, {"message", out.message}});
