@@ -31,7 +31,7 @@ RUNS_BEFORE=$(value "$DB" "SELECT group_concat(uuid) FROM (SELECT uuid FROM runs
 check schema_10 0 "^10$" -- value "$DB" "PRAGMA user_version"
 check list_schema_10 0 "0 models" -- "$DAQ" model list --db "$DB"
 check build_store 0 "Kept in .*demo.sqlite as model 1, [0-9a-f-]{36}" -- \
-  "$DAQ" model build --machine "$MACHINE" --allow-missing --store -o "$TMP/a-model.json" --db "$DB"
+  "$DAQ" model build --machine "$MACHINE" --topology FXYZ --allow-missing --store -o "$TMP/a-model.json" --db "$DB"
 check migrated 0 "^11$" -- value "$DB" "PRAGMA user_version"
 check runs_kept 0 "^$RUNS_BEFORE$" -- value "$DB" "SELECT group_concat(uuid) FROM (SELECT uuid FROM runs ORDER BY id)"
 UUID=$(value "$DB" "SELECT uuid FROM models WHERE id = 1")
