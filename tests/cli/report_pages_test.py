@@ -241,6 +241,11 @@ for name in ("linear", "suspect"):
           p1)
     check(f"{name}: failing values named on page one",
           re.search(r"FAIL.*limit ≤ [0-9.]+ µm\)", p1) is not None, p1)
+    # What to fix first, beside the failing value (the demo's B: the reversal value of ISO
+    # 230-2 is the axis' backlash; the page named only the value and its limit).
+    check(f"{name}: what to check for the failing B on page one",
+          re.search(r"B = [0-9.]+ µm \(limit ≤ 3\.000 µm\): check the backlash "
+                    r"compensation", p1) is not None, p1)
     # The main plot on page one too (it was on page two).
     check(f"{name}: main plot on page one", "Mean positional deviation with ±2s" in p1, p1)
 # Page one is full and the last page is not a line or two (the lead saw page one a third blank:
@@ -308,6 +313,9 @@ check("vdi3441: a verdict, not 'No tolerance'", "Verdict against the machine spe
 check("vdi3441: the failing value as the table prints it",
       re.search(r"U max = [0-9.]+ µm \(limit ≤", v1) is not None
       and re.search(r"[0-9.]+ largest reversal span", v1) is not None, v1)
+check("vdi3441: what to check for the failing U max on page one",
+      re.search(r"U max = [0-9.]+ µm \(limit ≤ [0-9.]+ µm\): check the backlash", v1)
+      is not None, v1)
 check("vdi3441: main plot on page one", "Mean positional deviation with ±2s" in v1, v1)
 # The title names the standard the page is evaluated by (it said ISO 230-2).
 check("vdi3441: the title names VDI/DGQ 3441",

@@ -1053,6 +1053,31 @@ std::string failing_value(const ::daq::Check& c, bool strong) {
       esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
 }
 
+// What to check first for a value outside its limit: a circle diagnostic's own advice, else, for
+// the values of a positioning test (ISO 230-2, VDI/DGQ 3441), the usual cause of each. Empty for
+// a value with no single usual cause (straightness, angular, roll: their reports' plots say where).
+std::string what_to_check(const ::daq::Check& c) {
+  if (auto advice = ::daq::diagnostic_advice(c.key); !advice.empty()) return advice;
+  const std::string_view key = c.key;
+  const std::string_view head = key.substr(0, key.find('_'));
+  // Short enough that "B = 4.023 µm (limit ≤ 3.000 µm): ..." stays one line on page one (a
+  // longer advice pushed the suspect report's main plot to page two).
+  static constexpr std::pair<std::string_view, std::string_view> kPositioning[] = {
+      {"E", "check the pitch error compensation and thermal state"},
+      {"M", "check the pitch error compensation"},
+      {"A", "check the pitch error compensation, then B and R"},
+      {"R", "check the drive and guideways for play, stick-slip"},
+      {"B", "check the backlash compensation and the drive's play"},
+      {"P", "check the pitch error compensation, then U and Ps"},
+      {"Pa", "check the pitch error compensation"},
+      {"Ps", "check the drive and guideways for play, stick-slip"},
+      {"U", "check the backlash compensation and the drive's play"},
+  };
+  for (const auto& [k, advice] : kPositioning)
+    if (head == k) return std::string(advice);
+  return {};
+}
+
 // The failing values of a verdict, "; " between them (empty when none fails).
 std::string failing_values(const ::daq::Verdict& v, bool strong) {
   std::string h;
@@ -1093,7 +1118,7 @@ std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}
     std::string items;
     for (const auto& c : v.checks)
       if (!c.pass) {
-        const auto advice = ::daq::diagnostic_advice(c.key);
+        const auto advice = what_to_check(c);
         items +=
             "<li>" + failing_value(c, true) + (advice.empty() ? "" : ": " + esc(advice)) + "</li>";
       }
@@ -2096,8 +2121,12 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
       if (o.reading_progress) o.reading_progress(read, to_read);
     }
   }
-  std::string h = fmt::format("<h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
+  // The heading, its count and the first plot kept on one page: a heading and a line at the foot
+  // of a page with their plot on the next read as an empty section (the angular report's page 1).
+  std::string h = fmt::format(
+      "<div class=\"keep-with-next\"><h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
   std::size_t i = 0;
+  bool kept = false;
   for (auto& [key, t] : by) {
     const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
     for (auto& x : t.s.value) x *= unit.factor;
@@ -2110,7 +2139,9 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
                             .lines = lines_of({t.s}, i++, 4000),
                             .height_pt = 220}),
                 t.title + " over the run.");
+    if (!kept) h += "</div>\n", kept = true;
   }
+  if (!kept) h += "</div>\n";
   return h;
 }
 
@@ -2349,6 +2380,7 @@ table.results, table.diag { width: 100%; }
 .details { break-before: page; page-break-before: always; }
 .details.flow { break-before: auto; page-break-before: auto; }
 .pair.keep { break-inside: avoid; page-break-inside: avoid; }
+.keep-with-next { break-inside: avoid; page-break-inside: avoid; }
 .pair { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 0 1rem;
         align-items: start; }
 .pair figure { margin: .5rem 0; } .pair table { margin-top: .5rem; }
