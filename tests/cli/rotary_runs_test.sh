@@ -34,7 +34,7 @@ print(j['results'][0]['verdict']['summary'] if 'results' in j else j['verdict'][
 "$DAQ" report 1 --db "$DB" -o "$TMP/rot1.html" >/dev/null 2>&1
 check_file "$TMP/rot1.html" <<'END'
 report_verdict Verdict against the machine specification \(tolerances\.C\): <strong>FAIL</strong>
-report_failing <li><strong>B</strong> = -?[0-9.]+ arcsec \(limit ≤ 2\.000 arcsec\)</li>
+report_failing <li><strong>B</strong> = -?[0-9.]+ arcsec \(limit ≤ 2\.000 arcsec\): check the backlash compensation and the drive('|&#39;|&#x27;)s play</li>
 report_limit_head limit&nbsp;\(arcsec\)
 report_E_limit ≤ 30\.000
 END
