@@ -2126,7 +2126,6 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
   std::string h = fmt::format(
       "<div class=\"keep-with-next\"><h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
   std::size_t i = 0;
-  bool kept = false;
   for (auto& [key, t] : by) {
     const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
     for (auto& x : t.s.value) x *= unit.factor;
@@ -2139,9 +2138,9 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
                             .lines = lines_of({t.s}, i++, 4000),
                             .height_pt = 220}),
                 t.title + " over the run.");
-    if (!kept) h += "</div>\n", kept = true;
+    if (i == 1) h += "</div>\n";  // after the first plot
   }
-  if (!kept) h += "</div>\n";
+  if (i == 0) h += "</div>\n";  // no plot
   return h;
 }
 
