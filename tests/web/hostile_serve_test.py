@@ -852,4 +852,6 @@ check("no doubled prefix in an error", status.returncode == 2 and "daq serve: da
       status.stderr and "needs --token" in status.stderr, status.stderr[-300:])
 
 print(f"{passes} passed, {len(fails)} failed")
+if not fails:  # a failure keeps the servers' logs and stores for whoever looks at it
+    shutil.rmtree(TMP, ignore_errors=True)
 sys.exit(1 if fails else 0)

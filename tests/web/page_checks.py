@@ -1,10 +1,12 @@
 """What the operator-page tests share: a counted check, a screenshot that must not be blank, a
 JSON POST that returns (status, body) for errors too, the test's folders, and the service with a
 browser on its page."""
+import atexit
 import contextlib
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -77,13 +79,23 @@ def test_dirs(prefix):
     daq, shots = os.path.abspath(sys.argv[1]), sys.argv[2]
     os.makedirs(shots, exist_ok=True)
     tmp = tempfile.mkdtemp(prefix=prefix)
+    _made.append(tmp)
     return daq, shots, tmp, os.path.join(tmp, "runs.sqlite")
+
+
+_made = []  # the tests' temporary folders: removed after the last check passed, kept otherwise
+
+
+def _remove_made():
+    for d in _made:
+        shutil.rmtree(d, ignore_errors=True)
 
 
 def no_script_error(b):
     """The last check of a page test: the page raised no script error; the count of checks."""
     ok(not b.js("return window.__errors || null;"), "no script error")
     print(f"{passes} checks passed")
+    atexit.register(_remove_made)
 
 
 def get_json(url):
