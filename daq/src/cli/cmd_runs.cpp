@@ -524,7 +524,11 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
   p = std::copy(middle.begin(), middle.end(), p);
   p = write_small(p, x.r.status);
   *p++ = ',';
-  p = number(p, x.r.value);
+  // The reading as its instrument gave it (a gauge's printed digits, an interferometer's
+  // picometres, in SI): where it is its decimal's own double, written without the digit search
+  // (write_shortest_quantised); the same text either way.
+  p = !Json || std::isfinite(x.r.value) ? write_shortest_quantised(p, x.r.value)
+                                        : std::copy_n("null", 4, p);
   *p++ = ',';
   return write_integer(p, x.r.time_ns);
 }

@@ -10,6 +10,7 @@
 // switch), so a change of fmt's layout fails there rather than changing an export.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #if defined(__SSE2__)
@@ -234,6 +235,48 @@ inline char* write_shortest(char* p, double v) {
   }
   const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
   return shortest_detail::write_decimal(p, dec.significand, dec.exponent);
+}
+
+// The same text as write_shortest(p, v), for a stored reading: where v is the double of a
+// decimal with at most about 15 significant digits (an instrument's reading at its resolution,
+// as its driver stores it: a gauge's printed millimetres x 1e-3, an IDS3010's integer picometres
+// x 1e-12; docs/benchmarks.md, "Exports, fourth pass"), that decimal is written without the
+// shortest-digit search (Dragonbox, 150 instructions a value, issue 32); otherwise
+// write_shortest. The decimal is proven, not assumed, so any v gives fmt's "{}" text.
+//
+// The guess: k, the most decimals that keep |v| 10^k below 2^51 (from v's binary exponent e:
+// |v| < 2^(e+1), so 10^k <= 2^(50 - e); floor((50 - e) log10 2) by x 78913 >> 18), and
+// m = |v| 10^k rounded to the nearest integer. The proof is write_shortest_scaled's with that
+// m and k: m < 2^51 and 10^k (k <= 22) are exact doubles, so m / 10^k is one correctly rounded
+// division, what strtod makes of the decimal m x 10^-k; it must equal |v|. With the trailing
+// zeros cut (m = q 10^z, d = k - z decimals, the same rational, so the same double), |v| 10^d
+// <= |v| 10^k < 2^51, so v's rounding interval is under half of 10^-d wide and that decimal
+// is the only one in it with d or fewer decimals, hence Dragonbox's shortest: significand q,
+// exponent -d. A value the guess misses (16 - 17 significant digits, or a reading whose unit
+// conversion rounded it off its decimal's own double: a quarter of a gauge's, docs) costs
+// the guess (a multiplication, a division, a comparison) and then Dragonbox as before.
+inline char* write_shortest_quantised(char* p, double v) {
+  using namespace shortest_detail;
+  const double a = std::abs(v);
+  const int e = static_cast<int>(std::bit_cast<std::uint64_t>(a) >> 52) - 1023;
+  // Zero and subnormals (e = -1023), inf and nan (1024), |v| >= 2^51 (no decimals left): the
+  // general way. A normal v keeps the rounding interval's bound used above.
+  if (e < -1022 || e > 50) return write_shortest(p, v);
+  const int k = std::min(22, ((50 - e) * 78913) >> 18);
+  const double x = a * kPow10[k];                // < 2^51: its ulp <= 1/4, x + 0.5 exact
+  auto q = static_cast<std::uint64_t>(x + 0.5);  // the nearest integer (a guess)
+  if (q == 0 || static_cast<double>(q) / kPow10[k] != a) return write_shortest(p, v);
+  int exponent = -k;
+  while (q % 10000 == 0) {  // Dragonbox leaves no trailing zero in its significand
+    q /= 10000;
+    exponent += 4;
+  }
+  while (q % 10 == 0) {
+    q /= 10;
+    ++exponent;
+  }
+  if (std::signbit(v)) *p++ = '-';
+  return write_decimal(p, q, exponent);
 }
 
 // The same text as write_shortest(p, v), for a v the caller computed from m x 10^-k (an export's
