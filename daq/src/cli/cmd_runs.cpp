@@ -363,7 +363,8 @@ class RowBuffer {
 
 // The most a row's numbers and fixed text take (a double in the shortest form is at most 24
 // characters, an int64 20, each with up to 8 bytes of no meaning written after it and then
-// written over: kSpill in shortest_number.hpp); the names and the time of day are added to it.
+// written over: kSpill in shortest_number.hpp; the value column's write_shortest_quantised up
+// to 16); the names and the time of day are added to it.
 constexpr std::size_t kRowNumbersMax = 256;
 
 // Device names by device number (a handful, small numbers): a vector rather than a map lookup
