@@ -23,7 +23,10 @@
 // length stream plus 1 Hz air (temperature, pressure, humidity), written as the batch writer
 // writes them, of 1/k ... k/k of the given length; `daq export` (CSV and JSON) and `daq report`
 // are run on each as child processes of this same binary, and each child's peak RSS (wait4)
-// and wall time are reported: flat memory and linear time are what is asked.
+// and wall time are reported: flat memory and linear time are what is asked. Each length is
+// generated twice (--values both): quantised as a 1 nm gauge's driver stores it, as real
+// readings are stored, and unquantised (16 - 17 digits); --peer-daq measures another build's
+// exports of the same runs beside this one's.
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <pthread.h>
