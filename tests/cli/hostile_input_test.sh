@@ -23,6 +23,9 @@ CPU0=$(python3 -c 'import os; print(min(os.sched_getaffinity(0)))')
 check bench_cpu_not_ours 2 "CPU 4096: not one this process may run on" -- "$DAQ" bench ingest --seconds 1 --rounds 1 --dir "$TMP" --loop-cpu "$CPU0" --storage-cpu 4096
 check bench_cpu_half 2 "give both --loop-cpu and --storage-cpu" -- "$DAQ" bench ingest --seconds 1 --rounds 1 --dir "$TMP" --loop-cpu "$CPU0"
 check bench_cpu_before_the_capture 0 "^refused, 0 capture lines$" -- sh -c "out=\$(\"$DAQ\" bench ingest --seconds 1 --rounds 1 --dir \"$TMP\" --loop-cpu 4096 --storage-cpu $CPU0 2>&1); test \$? -eq 2 && echo \"\$out\" | grep -q 'CPU 4096' && echo \"refused, \$(echo \"\$out\" | grep -c '^capture:') capture lines\""
+# daq bench export's generated values and the build it compares with: a clear refusal, nothing run.
+check bench_export_values 2 "^daq: error: --values: nonsense not in \{quantised,unquantised,both\}" -- "$DAQ" bench export --minutes 1 --steps 1 --dir "$TMP" --values nonsense
+check bench_export_peer_missing 2 "^daq: error: --peer-daq: File does not exist: $TMP/no-daq" -- "$DAQ" bench export --minutes 1 --steps 1 --dir "$TMP" --peer-daq "$TMP/no-daq"
 
 # Command-line numbers: finite, plain, in range, sizes bounded.
 check cli_nan 2 "--temperature: 'nan' is not a finite decimal number" -- "$DAQ" env -t nan

@@ -72,6 +72,8 @@ ChildResult spawn_program(const std::string& program, const std::vector<std::str
                           const std::string& output);
 // spawn_child, its output to /dev/null; throws unless it exits with 0.
 ChildResult run_child(const std::vector<std::string>& args);
+// The same for another daq binary (`daq bench export --peer-daq`).
+ChildResult run_program(const std::string& program, const std::vector<std::string>& args);
 
 }  // namespace daq::bench
 

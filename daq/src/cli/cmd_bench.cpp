@@ -23,7 +23,10 @@
 // length stream plus 1 Hz air (temperature, pressure, humidity), written as the batch writer
 // writes them, of 1/k ... k/k of the given length; `daq export` (CSV and JSON) and `daq report`
 // are run on each as child processes of this same binary, and each child's peak RSS (wait4)
-// and wall time are reported: flat memory and linear time are what is asked.
+// and wall time are reported: flat memory and linear time are what is asked. Each length is
+// generated twice (--values both): quantised as a 1 nm gauge's driver stores it, as real
+// readings are stored, and unquantised (16 - 17 digits); --peer-daq measures another build's
+// exports of the same runs beside this one's.
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <pthread.h>
@@ -576,13 +579,39 @@ void bench_ingest(const BenchOptions& o) {
         where.loop_cpu, where.storage_cpu, median(pinned_rate), 100.0 * median(ratio_pinned));
 }
 
+// The generated readings' values: exactly as a real instrument's driver stores them, or not.
+enum class BenchValues {
+  // The length as `daq bench ingest`'s gauge prints it ("%+011.6f" mm: 1 nm, six decimals of a
+  // millimetre) and the line-gauge driver stores it: the printed decimal read as one correctly
+  // rounded division (parse_plain_decimal: the integer nanometres / 10^6), then
+  // (printed x scale + offset) x 1e-3 with the default scale 1 and offset 0 (GaugeCodec::to_si,
+  // unit_factor(mm)); the air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=  50.0
+  // %RH": hPa x 100, two decimals of degC, one of %RH). What a store holds: raw readings, at
+  // the instrument's resolution, converted to SI by one multiplication (docs/storage.md).
+  quantised,
+  // 0.1 + 1e-6 sin(...) + 1e-9 k computed in doubles: 16 - 17 significant digits a value, as
+  // no instrument stores them (a compensated length would be; the store holds none).
+  unquantised,
+};
+
+// printed_units x 10^-decimals as a driver reads the printed decimal (Clinger's one division,
+// cal::drivers::codec::parse_plain_decimal), times the driver's factor to SI.
+double as_printed(double value, int decimals, double factor_to_si) {
+  const double scale = std::pow(10.0, decimals);  // exact for decimals <= 22
+  return std::round(value * scale) / scale * factor_to_si;
+}
+
 // A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
 // batches of 16384 readings as the batch writer stores them. Not timed: this is the input.
-std::int64_t generate_run(cal::storage::Store& store, int seconds) {
-  const auto run = store.begin_run({.campaign = "daq bench export",
-                                    .kind = "bench",
-                                    .axis = "X",
-                                    .settings_json = R"({"generated": "daq bench export"})"});
+std::int64_t generate_run(cal::storage::Store& store, int seconds,
+                          BenchValues values = BenchValues::unquantised) {
+  const bool quantised = values == BenchValues::quantised;
+  const auto run = store.begin_run(
+      {.campaign = "daq bench export",
+       .kind = "bench",
+       .axis = "X",
+       .settings_json = quantised ? R"({"generated": "daq bench export", "values": "quantised"})"
+                                  : R"({"generated": "daq bench export"})"});
   store.add_instrument({.run_id = run, .device = 0, .driver = "gauge", .transport = "generated"});
   store.add_instrument({.run_id = run, .device = 1, .driver = "ptu300", .transport = "generated"});
   std::vector<cal::storage::RawReading> batch;
@@ -590,15 +619,26 @@ std::int64_t generate_run(cal::storage::Store& store, int seconds) {
   const std::int64_t n = static_cast<std::int64_t>(seconds) * 10'000;
   for (std::int64_t i = 0; i < n; ++i) {
     const std::int64_t t = i * 100'000;
+    const double length_m =
+        0.1 + 1e-6 * std::sin(1e-4 * static_cast<double>(i)) + 1e-9 * static_cast<double>(i % 977);
     batch.push_back({.time_ns = t,
                      .quantity = 1,
-                     .value = 0.1 + 1e-6 * std::sin(1e-4 * static_cast<double>(i)) +
-                              1e-9 * static_cast<double>(i % 977)});
+                     .value = quantised ? as_printed(length_m * 1e3, 6, 1e-3) : length_m});
     if (i % 10'000 == 0) {
       const double s = static_cast<double>(i / 10'000);
-      batch.push_back({.time_ns = t, .device = 1, .quantity = 2, .value = 20.0 + 1e-3 * s});
-      batch.push_back({.time_ns = t, .device = 1, .quantity = 3, .value = 101325.0 - 0.1 * s});
-      batch.push_back({.time_ns = t, .device = 1, .quantity = 4, .value = 45.0 + 1e-2 * s});
+      const double air[3] = {20.0 + 1e-3 * s, 101325.0 - 0.1 * s, 45.0 + 1e-2 * s};
+      batch.push_back({.time_ns = t,
+                       .device = 1,
+                       .quantity = 2,
+                       .value = quantised ? as_printed(air[0], 2, 1.0) : air[0]});
+      batch.push_back({.time_ns = t,
+                       .device = 1,
+                       .quantity = 3,
+                       .value = quantised ? as_printed(air[1] / 100.0, 2, 100.0) : air[1]});
+      batch.push_back({.time_ns = t,
+                       .device = 1,
+                       .quantity = 4,
+                       .value = quantised ? as_printed(air[2], 1, 1.0) : air[2]});
     }
     if (batch.size() >= 16384) {
       store.append_readings(run, batch);
@@ -649,7 +689,11 @@ ChildResult spawn_program(const std::string& program, const std::vector<std::str
 }
 
 ChildResult run_child(const std::vector<std::string>& args) {
-  auto r = spawn_child(args, "/dev/null");
+  return run_program("/proc/self/exe", args);
+}
+
+ChildResult run_program(const std::string& program, const std::vector<std::string>& args) {
+  auto r = spawn_program(program, args, "/dev/null");
   if (r.exit_code != 0)
     throw cal::InputError(
         fmt::format("bench: daq {} failed (exit {})", fmt::join(args, " "), r.exit_code));
@@ -709,8 +753,24 @@ struct ExportBenchOptions {
   int minutes = 60;
   int steps = 4;
   std::string dir;
-  std::string keep;  // the generated database, kept under this name
+  std::string keep;             // the generated database, kept under this name
+  std::string values = "both";  // quantised | unquantised | both (a run of each, in turn)
+  std::string peer;             // another daq binary whose exports are measured alternately
 };
+
+// Whether two files hold the same bytes.
+bool same_bytes(const fs::path& a, const fs::path& b) {
+  if (fs::file_size(a) != fs::file_size(b)) return false;
+  std::ifstream x(a, std::ios::binary), y(b, std::ios::binary);
+  std::vector<char> bx(1 << 16), by(1 << 16);
+  while (x && y) {
+    x.read(bx.data(), static_cast<std::streamsize>(bx.size()));
+    y.read(by.data(), static_cast<std::streamsize>(by.size()));
+    if (x.gcount() != y.gcount() || !std::equal(bx.begin(), bx.begin() + x.gcount(), by.begin()))
+      return false;
+  }
+  return true;
+}
 
 void bench_export(const ExportBenchOptions& o) {
   if (o.minutes < 1 || o.steps < 1)
@@ -729,44 +789,83 @@ void bench_export(const ExportBenchOptions& o) {
         "bench export: --keep-db {}: the file exists; name a new one (nothing was written)",
         db.string()));
   remove_db(db);
-  fmt::print("{:>7} {:>10} {:>7}  {:>31}  {:>31}  {:>16}\n", "minutes", "readings", "MB",
+  std::vector<BenchValues> kinds;
+  if (o.values != "unquantised") kinds.push_back(BenchValues::quantised);
+  if (o.values != "quantised") kinds.push_back(BenchValues::unquantised);
+  fmt::print(
+      "values: {}\n",
+      o.values == "unquantised"
+          ? "unquantised (0.1 + 1e-6 sin + 1e-9 k in doubles: 16 - 17 significant digits, which "
+            "no instrument stores)"
+          : "quantised (q): the 10 kHz length as daq bench ingest's line gauge prints it (mm with "
+            "six decimals, 1 nm) and its driver stores it (the decimal read, x 1e-3 to metres: "
+            "raw readings are stored at the instrument's resolution, docs/storage.md); the air "
+            "as a PTU300 prints it (0.01 hPa, 0.01 degC, 0.1 %RH)" +
+                std::string(o.values == "both"
+                                ? "; then unquantised (u): 0.1 + 1e-6 sin + 1e-9 k in doubles, "
+                                  "16 - 17 significant digits, the bench's values before"
+                                : ""));
+  fmt::print("{:>9} {:>10} {:>7}  {:>31}  {:>31}  {:>16}\n", "minutes", "readings", "MB",
              "export csv: wall, CPU, RSS, %", "export json: wall, CPU, RSS, %", "report (html)");
   std::vector<std::string> ceilings;
-  for (int k = 1; k <= o.steps; ++k) {
-    const int seconds = o.minutes * 60 * k / o.steps;
-    std::int64_t run = 0, count = 0;
-    const auto size_before = fs::exists(db) ? fs::file_size(db) : 0;
-    {
-      cal::storage::Store store(db, {.full_sync = false});
-      run = generate_run(store, seconds);
-      count = store.reading_count(run);
+  const std::string self = "/proc/self/exe";
+  const fs::path mine = dir / ("caldaq-bench-export-" + tag + ".this");
+  const Cleanup cleanup_mine({mine});
+  bool identical = true;
+  for (int k = 1; k <= o.steps; ++k)
+    for (const auto values : kinds) {
+      const int seconds = o.minutes * 60 * k / o.steps;
+      const char* const tag_values = values == BenchValues::quantised ? "q" : "u";
+      std::int64_t run = 0, count = 0;
+      const auto size_before = fs::exists(db) ? fs::file_size(db) : 0;
+      {
+        cal::storage::Store store(db, {.full_sync = false});
+        run = generate_run(store, seconds, values);
+        count = store.reading_count(run);
+      }
+      const double stored_mb = static_cast<double>(fs::file_size(db) - size_before) / 1e6;
+      const auto id = std::to_string(run);
+      // Each export to a file, then its ceiling for the same bytes (both on the same load); with
+      // --peer-daq, the peer's export of the same run right after, its ceiling measured again,
+      // and its bytes compared with this binary's.
+      const auto measure = [&](const std::string& program, const char* who, const char* format) {
+        const auto r = run_program(program, {"export", id, "--db", db.string(), "--format", format,
+                                             "-o", exported.string()});
+        const auto c = export_ceiling(db, run, exported, scratch);
+        const double mb = static_cast<double>(fs::file_size(exported)) / 1e6;
+        ceilings.push_back(fmt::format(
+            "  {:5.1f} min {} {:4} {}: {:6.0f} MB written; store read {:.2f} s (CPU {:.2f} s), "
+            "writing the same bytes {:.2f} s (CPU {:.2f} s): export at {:.0f} % of that ceiling by "
+            "CPU, {:.0f} % by wall time",
+            seconds / 60.0, tag_values, format, who, mb, c.read_s, c.read_cpu_s, c.write_s,
+            c.write_cpu_s, 100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s,
+            100.0 * (c.read_s + c.write_s) / r.seconds));
+        return fmt::format("{:6.2f} s {:6.2f} s {:4.0f} MB {:3.0f} %", r.seconds, r.cpu_s,
+                           static_cast<double>(r.peak_rss_kib) / 1024,
+                           100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s);
+      };
+      const auto with_peer = [&](const char* format) {
+        std::string text = measure(self, "this", format);
+        if (o.peer.empty()) return std::pair{text, std::string()};
+        fs::rename(exported, mine);
+        std::string peer = measure(o.peer, "peer", format);
+        peer += same_bytes(mine, exported) ? "" : " DIFFERENT BYTES";
+        identical = identical && same_bytes(mine, exported);
+        return std::pair{text, peer};
+      };
+      const auto csv = with_peer("csv");
+      const auto json = with_peer("json");
+      const auto report =
+          run_program(self, {"report", id, "--db", db.string(), "-o", html.string()});
+      fmt::print("{:>7.1f} {} {:>10} {:>7.1f}  {:>31}  {:>31}  {:6.2f} s {:4.0f} MB\n",
+                 seconds / 60.0, tag_values, count, stored_mb, csv.first, json.first,
+                 report.seconds, static_cast<double>(report.peak_rss_kib) / 1024);
+      if (!o.peer.empty())
+        fmt::print("{:>9} {:>10} {:>7}  {:>31}  {:>31}\n", "peer", "", "", csv.second, json.second);
     }
-    const double stored_mb = static_cast<double>(fs::file_size(db) - size_before) / 1e6;
-    const auto id = std::to_string(run);
-    // Each export to a file, then its ceiling for the same bytes (both on the same load).
-    const auto measure = [&](const char* format) {
-      const auto r = run_child(
-          {"export", id, "--db", db.string(), "--format", format, "-o", exported.string()});
-      const auto c = export_ceiling(db, run, exported, scratch);
-      const double mb = static_cast<double>(fs::file_size(exported)) / 1e6;
-      ceilings.push_back(fmt::format(
-          "  {:5.1f} min {:4}: {:6.0f} MB written; store read {:.2f} s (CPU {:.2f} s), writing "
-          "the same bytes {:.2f} s (CPU {:.2f} s): export at {:.0f} % of that ceiling by CPU, "
-          "{:.0f} % by wall time",
-          seconds / 60.0, format, mb, c.read_s, c.read_cpu_s, c.write_s, c.write_cpu_s,
-          100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s,
-          100.0 * (c.read_s + c.write_s) / r.seconds));
-      return fmt::format("{:6.2f} s {:6.2f} s {:4.0f} MB {:3.0f} %", r.seconds, r.cpu_s,
-                         static_cast<double>(r.peak_rss_kib) / 1024,
-                         100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s);
-    };
-    const auto csv = measure("csv");
-    const auto json = measure("json");
-    const auto report = run_child({"report", id, "--db", db.string(), "-o", html.string()});
-    fmt::print("{:>7.1f} {:>10} {:>7.1f}  {:>31}  {:>31}  {:6.2f} s {:4.0f} MB\n", seconds / 60.0,
-               count, stored_mb, csv, json, report.seconds,
-               static_cast<double>(report.peak_rss_kib) / 1024);
-  }
+  if (!o.peer.empty())
+    fmt::print("peer: {}; its exports {} this binary's, byte for byte\n", o.peer,
+               identical ? "are the same as" : "DIFFER from");
   fmt::print(
       "(wall time, CPU time and peak RSS of each daq process; %: the export's CPU time against "
       "its ceiling's, measured beside it: reading the run from the store and writing the same "
@@ -810,10 +909,11 @@ void bench_sync(const SyncBenchOptions& o) {
       uuids.push_back(store.run(runs.back())->uuid);
     }
   }
-  fmt::print("{} run{} of {} min of a 10 kHz length stream with 1 Hz air: {} readings, {:.1f} MB "
-             "store\n",
-             o.runs, o.runs == 1 ? "" : "s", o.minutes, readings,
-             static_cast<double>(fs::file_size(db)) / 1e6);
+  fmt::print(
+      "{} run{} of {} min of a 10 kHz length stream with 1 Hz air: {} readings, {:.1f} MB "
+      "store\n",
+      o.runs, o.runs == 1 ? "" : "s", o.minutes, readings,
+      static_cast<double>(fs::file_size(db)) / 1e6);
   pg::delete_central_runs(o.to, uuids);  // runs left by a cut bench
   std::vector<double> sync_s, ceiling_s;
   fmt::print("{:>5} {:>10} {:>8}  {:>24}  {:>34}  {:>5}\n", "round", "readings", "MB",
@@ -878,6 +978,15 @@ void add_bench_commands(CLI::App& app) {
   ex->add_option("--dir", e->dir, "Directory for the database (default: $TMPDIR)");
   ex->add_option("--keep-db", e->keep,
                  "Store the generated runs in this new file and keep it (to export or inspect)");
+  ex->add_option("--values", e->values,
+                 "The generated readings: quantised (as a 1 nm gauge's driver stores them, "
+                 "run first), unquantised (16 - 17 significant digits) or both")
+      ->check(CLI::IsMember({"quantised", "unquantised", "both"}))
+      ->capture_default_str();
+  ex->add_option("--peer-daq", e->peer,
+                 "Also measure this daq binary's exports of the same runs, each right after this "
+                 "one's with its own ceiling, and compare their bytes (a build to compare with)")
+      ->check(CLI::ExistingFile);
 
   add_bench_replay_command(*bench);
 

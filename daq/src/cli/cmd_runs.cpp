@@ -363,7 +363,8 @@ class RowBuffer {
 
 // The most a row's numbers and fixed text take (a double in the shortest form is at most 24
 // characters, an int64 20, each with up to 8 bytes of no meaning written after it and then
-// written over: kSpill in shortest_number.hpp); the names and the time of day are added to it.
+// written over: kSpill in shortest_number.hpp; the value column's write_shortest_quantised up
+// to 16); the names and the time of day are added to it.
 constexpr std::size_t kRowNumbersMax = 256;
 
 // Device names by device number (a handful, small numbers): a vector rather than a map lookup
@@ -524,7 +525,11 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
   p = std::copy(middle.begin(), middle.end(), p);
   p = write_small(p, x.r.status);
   *p++ = ',';
-  p = number(p, x.r.value);
+  // The reading as its instrument gave it (a gauge's printed digits, an interferometer's
+  // picometres, in SI): where it is its decimal's own double, written without the digit search
+  // (write_shortest_quantised); the same text either way.
+  p = !Json || std::isfinite(x.r.value) ? write_shortest_quantised(p, x.r.value)
+                                        : std::copy_n("null", 4, p);
   *p++ = ',';
   return write_integer(p, x.r.time_ns);
 }

@@ -10,6 +10,7 @@
 // switch), so a change of fmt's layout fails there rather than changing an export.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #if defined(__SSE2__)
@@ -82,7 +83,7 @@ inline void write_last(char* p, std::uint32_t x, int n) {
 // below 43,699 and / 10 is (x 103) >> 10 below 100. Half the instructions of two digits8 (the
 // digit writing was a fifth of an export, issue 32); the test compares it with write8 on both
 // halves over 2 x 10^8 values.
-inline void write16(char* p, std::uint64_t v) {
+inline __m128i digits16(std::uint64_t v) {
   const auto high = static_cast<std::uint32_t>(v / 100'000'000);
   const auto low = static_cast<std::uint32_t>(v % 100'000'000);
   const __m128i x = _mm_set_epi64x(low, high);  // 64-bit lanes, the high half first
@@ -97,9 +98,12 @@ inline void write16(char* p, std::uint64_t v) {
   const __m128i pairs = _mm_or_si128(high_pairs, _mm_slli_epi32(low_pairs, 16));
   const __m128i tens = _mm_srli_epi16(_mm_mullo_epi16(pairs, _mm_set1_epi16(103)), 10);
   const __m128i ones = _mm_sub_epi16(pairs, _mm_mullo_epi16(tens, _mm_set1_epi16(10)));
-  const __m128i text =
-      _mm_or_si128(_mm_or_si128(tens, _mm_slli_epi16(ones, 8)), _mm_set1_epi8('0'));
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(p), text);
+  return _mm_or_si128(_mm_or_si128(tens, _mm_slli_epi16(ones, 8)), _mm_set1_epi8('0'));
+}
+
+// The 16 digits of digits16, stored at p.
+inline void write16(char* p, std::uint64_t v) {
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(p), digits16(v));
 }
 
 // 10^k as integers, for moving a number's digits to the front of write16's 16.
@@ -234,6 +238,82 @@ inline char* write_shortest(char* p, double v) {
   }
   const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
   return shortest_detail::write_decimal(p, dec.significand, dec.exponent);
+}
+
+// The same text as write_shortest(p, v), for a stored reading: where v is the double of a
+// decimal with at most about 15 significant digits (an instrument's reading at its resolution,
+// as its driver stores it: a gauge's printed millimetres x 1e-3, an IDS3010's integer picometres
+// x 1e-12; docs/benchmarks.md, "Exports, fourth pass"), that decimal is written without the
+// shortest-digit search (Dragonbox, 150 instructions a value, issue 32); otherwise
+// write_shortest. The decimal is proven, not assumed, so any v gives fmt's "{}" text.
+//
+// The guess: k, the most decimals that keep |v| 10^k below 2^51 (from v's binary exponent e:
+// |v| < 2^(e+1), so 10^k <= 2^(50 - e); floor((50 - e) log10 2) by x 78913 >> 18), and
+// m = |v| 10^k rounded to the nearest integer. The proof is write_shortest_scaled's with that
+// m and k: m < 2^51 and 10^k (k <= 22) are exact doubles, so m / 10^k is one correctly rounded
+// division, what strtod makes of the decimal m x 10^-k; it must equal |v|. With the trailing
+// zeros cut (m = q 10^z, d = k - z decimals, the same rational, so the same double), |v| 10^d
+// <= |v| 10^k < 2^51, so v's rounding interval is under half of 10^-d wide and that decimal
+// is the only one in it with d or fewer decimals, hence Dragonbox's shortest: significand q,
+// exponent -d. A value the guess misses (16 - 17 significant digits, or a reading whose unit
+// conversion rounded it off its decimal's own double: a quarter of a gauge's, docs) costs
+// the guess (a multiplication, a division, a comparison) and then Dragonbox as before.
+// At most 24 characters, and up to 16 bytes of no meaning after them: room for 40.
+inline char* write_shortest_quantised(char* p, double v) {
+  using namespace shortest_detail;
+  const double a = std::abs(v);
+  const int e = static_cast<int>(std::bit_cast<std::uint64_t>(a) >> 52) - 1023;
+  // Zero and subnormals (e = -1023), inf and nan (1024), |v| >= 2^51 (no decimals left): the
+  // general way. A normal v keeps the rounding interval's bound used above.
+  if (e < -1022 || e > 50) return write_shortest(p, v);
+  const int k = std::min(22, ((50 - e) * 78913) >> 18);
+  const double x = a * kPow10[k];                     // < 2^51: its ulp <= 1/4, x + 0.5 exact
+  const auto m = static_cast<std::int64_t>(x + 0.5);  // the nearest integer (a guess)
+  if (m == 0 || static_cast<double>(m) / kPow10[k] != a) return write_shortest(p, v);
+  if (std::signbit(v)) *p++ = '-';
+#if defined(__SSE2__)
+  // m < 2^51 has at most 16 digits: all 16 (leading zeros included) in one register; where its
+  // first and last digits other than 0 are comes from one comparison (no loop cutting zeros,
+  // no second pass writing the digits). Digit i weighs 10^(15 - i - k): the point goes before
+  // digit 16 - k. fmt's fixed notation (the first digit's exponent at least -4) is written
+  // here in two or three stores of up to 16 bytes; smaller values take write_decimal.
+  alignas(16) char digits[32];
+  const __m128i text = digits16(static_cast<std::uint64_t>(m));
+  _mm_store_si128(reinterpret_cast<__m128i*>(digits), text);
+  _mm_store_si128(reinterpret_cast<__m128i*>(digits + 16), _mm_setzero_si128());
+  const auto nonzero = static_cast<unsigned>(
+      ~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);  // m > 0: not 0
+  const int first = std::countr_zero(nonzero), last = 31 - std::countl_zero(nonzero);
+  const int point = 16 - k;  // digits [0, point) are the whole part
+  if (point - 1 - first >= -4) {
+    if (last < point) {  // a whole number: its digits up to the point
+      std::memcpy(p, digits + first, 16);
+      return p + point - first;
+    }
+    if (first < point) {  // digits, the point, the decimals up to the last one not 0
+      const int whole = point - first;
+      std::memcpy(p, digits + first, 16);
+      p[whole] = '.';
+      std::memcpy(p + whole + 1, digits + point, 16);
+      return p + whole + 1 + (last + 1 - point);
+    }
+    const int zeros = first - point;  // 0..3 after "0."
+    std::memcpy(p, "0.000000", 8);
+    std::memcpy(p + 2 + zeros, digits + first, 16);
+    return p + 2 + zeros + (last + 1 - first);
+  }
+#endif
+  auto q = static_cast<std::uint64_t>(m);
+  int exponent = -k;
+  while (q % 10000 == 0) {  // Dragonbox leaves no trailing zero in its significand
+    q /= 10000;
+    exponent += 4;
+  }
+  while (q % 10 == 0) {
+    q /= 10;
+    ++exponent;
+  }
+  return write_decimal(p, q, exponent);
 }
 
 // The same text as write_shortest(p, v), for a v the caller computed from m x 10^-k (an export's

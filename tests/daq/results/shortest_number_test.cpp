@@ -230,6 +230,79 @@ TEST(ShortestNumber, ScaledTimesOfAFineGridAreTheirDecimals) {
   EXPECT_EQ(std::string(buf, daq::write_shortest_scaled(buf, 1e15, 1, -15)), "1000000000000000");
 }
 
+// write_shortest_quantised skips the digit search where a reading is its decimal's own double:
+// its text must be fmt's "{}" for every double, and read back as it. Readings as drivers store
+// them (a gauge's printed mm with 0 - 6 decimals x 1e-3, an IDS3010's integer pm x 1e-12, um x
+// 1e-6, a PTU300's hPa x 100: about a quarter of them rounded off their decimal's double by the
+// conversion, so both ways are taken), decimals m / 10^d of every d and length, each with its
+// neighbours (not the decimal's double: the digit search), and unquantised values (random bit
+// patterns, the bench's 16 - 17 digit lengths, values around 2^51 where the guess stops).
+std::string quantised_difference(double v) {
+  char buf[64];
+  const std::string got(buf, daq::write_shortest_quantised(buf, v));
+  const std::string want = fmt::format("{}", v);
+  if (got != want || got.size() > 24)
+    return fmt::format("{:a}: fmt \"{}\", write_shortest_quantised \"{}\"", v, want, got);
+  if (std::isfinite(v) && std::strtod(got.c_str(), nullptr) != v)
+    return fmt::format("{:a}: \"{}\" reads back as {:a}", v, got,
+                       std::strtod(got.c_str(), nullptr));
+  return {};
+}
+
+TEST(ShortestNumber, QuantisedReadingsAsFmtWritesThem) {
+  std::mt19937_64 rng(32);
+  std::size_t checked = 0;
+  const auto check = [&](double v) {
+    for (const double w : {v, -v, std::nextafter(v, 0.0), std::nextafter(v, 1e300)}) {
+      ++checked;
+      ASSERT_EQ(quantised_difference(w), "");
+    }
+  };
+  const auto below = [&](std::uint64_t n) { return static_cast<double>(rng() % n); };
+  for (int i = 0; i < 300'000; ++i) {
+    const int mm_decimals = static_cast<int>(rng() % 7);
+    check(below(2'000'000'000) / std::pow(10.0, mm_decimals) * 1e-3);  // a gauge, mm
+    check(below(5'000'000'000'000) * 1e-12);                           // an IDS3010, pm
+    check(below(100'000'000) / 10.0 * 1e-6);                           // um, 0.1 um
+    check(below(120'000) / 100.0 * 100.0);                             // a PTU300, hPa
+    check(below(1'000'000) / 100.0);                                   // degC, %RH
+    const int d = static_cast<int>(rng() % 23);                        // every d, any length
+    check(static_cast<double>(rng() >> (11 + rng() % 53)) / std::pow(10.0, d));
+    check(std::bit_cast<double>(rng()));                        // unquantised
+    check(0.1 + 1e-6 * std::sin(1e-4 * i) + 1e-9 * (i % 977));  // the bench's lengths
+    check(std::ldexp(1.0 + below(1'000'000) * 1e-6, static_cast<int>(rng() % 120) - 60));
+  }
+  // Where the guess's conditions change: around 2^51 (no decimals left) and 2^50, powers of
+  // ten of every size, the smallest normal and subnormals, zero, inf and nan.
+  for (int e = -80; e <= 60; ++e) check(std::ldexp(1.0, e));
+  for (int e = -30; e <= 30; ++e) check(std::pow(10.0, e));
+  for (double v :
+       {0.0, DBL_MIN, DBL_TRUE_MIN, DBL_MAX, 0x1p51 - 0.25, 0x1p51 + 1.0, 2251.8,
+        std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+    check(v);
+  EXPECT_GT(checked, 10'000'000U);
+}
+
+// Readings whose text is known by hand: the bench's gauge at 100.000124 mm (1 nm) in metres;
+// at 100.000123 mm the driver's x 1e-3 lands one ulp off 0.100000123's double (above it:
+// 0.100000123 reads back as the next double down), so its shortest has 17 digits; an IDS3010's
+// 123,456,789,012 pm, a pressure of 1013.25 hPa, a length of 123 nm (fmt's exponent form
+// below 1e-4), and the bench's unquantised length of row 5 (17 digits: the digit search).
+TEST(ShortestNumber, QuantisedReadingsAreTheirDecimals) {
+  char buf[64];
+  const auto text = [&](double v) {
+    return std::string(buf, daq::write_shortest_quantised(buf, v));
+  };
+  EXPECT_EQ(text(100000124.0 / 1e6 * 1e-3), "0.100000124");
+  EXPECT_EQ(text(100000123.0 / 1e6 * 1e-3), "0.10000012300000001");
+  EXPECT_GT(100000123.0 / 1e6 * 1e-3, 0.100000123);
+  EXPECT_EQ(text(123456789012.0 * 1e-12), "0.123456789012");
+  EXPECT_EQ(text(1013.25 * 100.0), "101325");
+  EXPECT_EQ(text(-123e-9), "-1.23e-07");
+  EXPECT_EQ(text(0.1 + 1e-6 * std::sin(5e-4) + 5e-9), "0.10000000549999999");
+  EXPECT_EQ(text(20.5), "20.5");
+}
+
 #if defined(__SSE2__)
 // write16 (both halves of 8 digits in one SSE2 register) against write8 on each half (the
 // scalar way, itself checked against fmt above): every seventh low half with a high half
