@@ -59,7 +59,7 @@ check local_schema 0 "^11$" -- local_value "PRAGMA user_version"
 check local_uuids 0 "^$RUNS$" -- local_value "SELECT count(DISTINCT uuid) FROM runs WHERE uuid LIKE '________-____-4___-____-____________'"
 CUT=$(psql_value "SELECT count(*) FROM caldaq.reading_chunks")
 check cut_left_committed_pages 0 "^8$" -- echo "$CUT"
-check cut_schema 0 "^11$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check cut_schema 0 "^12$" -- psql_value "SELECT version FROM caldaq.schema_version"
 
 # Resumed: the chunks there are checked, the rest sent; every chunk once, the same bytes.
 check resume 0 "$RUNS runs synced .* $((CHUNKS - CUT)) chunks sent .*, $CUT already there" -- \
