@@ -105,7 +105,7 @@ check central_list 0 "$UUID" -- "$DAQ" model list --db "$PG_URL" --machine "$MAC
 # migrated in place by the next sync, which sends the models again.
 pg_undo_central_10
 RUNS_CENTRAL=$(psql_value "SELECT count(*) FROM caldaq.runs")
-check central_9_refused 2 "central schema version 9 is older than this daq reads \(11\)" -- \
+check central_9_refused 2 "central schema version 9 is older than this daq reads \(12\)" -- \
   "$DAQ" model list --db "$PG_URL"
 check central_migrated 0 "central schema 12\): 0 new; .*; 2 models synced, 2 new$" -- \
   "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet

@@ -149,7 +149,7 @@ pg_undo_central_7
 psql_value "UPDATE caldaq.runs SET settings_json = 'not json' WHERE uuid = '$UUIDB'" >/dev/null
 check v6 0 "^6 2 $RUNS_ALL$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM caldaq.approvals) || ' ' || (SELECT count(*) FROM caldaq.runs) FROM caldaq.schema_version"
-check v6_refused_by_readers 2 "central schema version 6 is older than this daq reads \(11\)" -- "$DAQ" runs --db "$ENGA"
+check v6_refused_by_readers 2 "central schema version 6 is older than this daq reads \(12\)" -- "$DAQ" runs --db "$ENGA"
 check engineer_cannot_migrate 2 "create or migrate the central schema: .*(must be owner|permission denied)" -- \
   "$DAQ" sync --db "$DB" --to "$ENGA" --quiet
 check migrate 0 "$RUNS_A runs synced .*central schema 12.*: 0 new; 0 chunks sent" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet

@@ -123,6 +123,6 @@ check damaged_crc 2 "the server's reading chunk 0 differs from the local one \(c
 
 # A server of a newer central schema is refused.
 psql_value "UPDATE caldaq.schema_version SET version = 99" >/dev/null
-check newer_schema 2 "central schema version 99 is newer than this daq understands \(11\)" -- "$DAQ" sync --db "$DB" --to "$PG_URL"
+check newer_schema 2 "central schema version 99 is newer than this daq understands \(12\)" -- "$DAQ" sync --db "$DB" --to "$PG_URL"
 
 finish

@@ -22,8 +22,9 @@
 //   shown as 'none'. The limits beside the trends (fleet_values.limit_value) are still looked up
 //   here (fleet_result_values): they draw the line, they decide no verdict.
 // - Approval: caldaq.approve records the version of the stops the approved result was computed
-//   from (the version in which it is not superseded), not the run's current version, and refuses
-//   a result superseded in every version that holds it, or in none yet.
+//   from (the version in which it is not superseded), not the run's current version; it refuses a
+//   result superseded by its own store (in every version that holds it, or in a later version sent
+//   from the store that sent its own) and one of no version yet.
 // Written to be run again over itself (IF NOT EXISTS, OR REPLACE, DROP ... IF EXISTS): the tests'
 // pg_undo_central_12 takes a server back to 11 by dropping what it added.
 
@@ -136,7 +137,11 @@ BEGIN
       SELECT NEW.run_uuid, NEW.source_result_id, r.machine_id, r.started_unix_ms, r.kind, v_test,
         p.key, p.symbol, p.unit, p.value, p.limit_value, p.trend, v_current
       FROM caldaq.fleet_result_values(d, r.tolerances) AS p;
-    PERFORM caldaq.fleet_refresh(r.machine_id, r.kind, v_test);
+    -- A new result of no current version yet changes no test (the sync places it in its
+    -- version next: fleet_mark_current refreshes then), so one refresh per result sent.
+    IF v_current OR TG_OP <> 'INSERT' THEN
+      PERFORM caldaq.fleet_refresh(r.machine_id, r.kind, v_test);
+    END IF;
     IF was_machine = r.machine_id AND was_kind = r.kind AND was_test = v_test THEN
       RETURN NULL;  -- refreshed already
     END IF;
@@ -160,8 +165,8 @@ AS $fn$
 DECLARE
   res record;
   earlier record;
+  later record;
   v integer;
-  held integer;
 BEGIN
   SELECT s.source_result_id AS id INTO res FROM caldaq.results AS s
     WHERE s.run_uuid = run AND s.fingerprint = fp;
@@ -175,14 +180,23 @@ BEGIN
       ON r.uuid = m.run_uuid
     WHERE m.run_uuid = run AND m.source_result_id = res.id AND m.superseded_by IS NULL
     ORDER BY m.version = r.current_version DESC, m.version DESC LIMIT 1;
+  -- Superseded by its own store: in every version that holds it, or in a later version sent
+  -- from the store that sent its own (that laptop re-analysed or re-compensated it since). One
+  -- superseded only in another laptop's version (which brought it and re-compensated) is still
+  -- the result of its own version's stops.
+  SELECT m.superseded_by AS id INTO later FROM caldaq.result_versions AS m
+      JOIN caldaq.run_versions AS w ON w.run_uuid = m.run_uuid AND w.version = m.version
+      LEFT JOIN caldaq.run_versions AS o ON o.run_uuid = m.run_uuid AND o.version = v
+    WHERE m.run_uuid = run AND m.source_result_id = res.id AND m.superseded_by IS NOT NULL
+      AND (v IS NULL OR (m.version > v AND w.sent_store = o.sent_store
+                         AND w.sent_from = o.sent_from))
+    ORDER BY m.version DESC LIMIT 1;
+  IF FOUND THEN
+    RAISE EXCEPTION 'result % is superseded by result % (re-analysed or re-compensated since): it cannot be approved; approve the current one',
+      res.id, later.id USING ERRCODE = 'object_not_in_prerequisite_state';
+  END IF;
   IF v IS NULL THEN
-    SELECT count(*) INTO held FROM caldaq.result_versions AS m
-      WHERE m.run_uuid = run AND m.source_result_id = res.id;
-    IF held = 0 THEN
-      RAISE EXCEPTION 'result % is of no version of the run''s stops yet (sent before central schema 11 to a run changed in more than one place): a daq sync --to by the laptop that computed it places it; approve it then',
-        res.id USING ERRCODE = 'object_not_in_prerequisite_state';
-    END IF;
-    RAISE EXCEPTION 'result % is superseded (re-analysed or re-compensated since) in every version of the run''s stops that holds it: it cannot be approved; approve the current one',
+    RAISE EXCEPTION 'result % is of no version of the run''s stops yet (sent before central schema 11 to a run changed in more than one place): a daq sync --to by the laptop that computed it places it; approve it then',
       res.id USING ERRCODE = 'object_not_in_prerequisite_state';
   END IF;
   SELECT a.approved_by, a.approved_unix_ms INTO earlier FROM caldaq.approvals AS a
