@@ -237,18 +237,6 @@ check no_version4 2 "run 1 has no version 4 \(it has 1 to 3" -- "$DAQ" show 1 --
 # the stops of the store that sent each version, never from daq's output: the mean deviation per
 # target and direction; E the range of those means, M the range of their bidirectional means
 # (the mean of the two directions' at each target).
-cat >"$TMP/hand_em.py" <<'PY'
-import sqlite3, sys
-from collections import defaultdict
-stops = defaultdict(list)
-for t, d, dev in sqlite3.connect(sys.argv[1]).execute(
-        "SELECT target_index, direction, deviation_um FROM captured_targets WHERE run_id = ?",
-        (int(sys.argv[2]),)):
-    stops[(t, d)].append(dev)
-mean = {k: sum(v) / len(v) for k, v in stops.items()}
-bi = [(mean[(t, "+")] + mean[(t, "-")]) / 2 for t in {t for t, _ in mean}]
-print(f"{max(mean.values()) - min(mean.values()):.6f} {max(bi) - min(bi):.6f}")
-PY
 # The current results of daq show --json (stdin): "COUNT E M ..." of each.
 cat >"$TMP/shown_em.py" <<'PY'
 import json, sys
@@ -257,9 +245,9 @@ axis = lambda r: r["result"]["axis"]
 print(len(current), *(f"{axis(r)[k]['value_um']:.6f}" for r in current for k in ("E_bi", "M")))
 PY
 BOB1=$(value "$BOB" "SELECT id FROM runs WHERE uuid = '$RUN1'")
-EM1=$("$PY" "$TMP/hand_em.py" "$DB" 1)
-EM2=$("$PY" "$TMP/hand_em.py" "$ALICE" "$ALICE1")
-EM3=$("$PY" "$TMP/hand_em.py" "$BOB" "$BOB1")
+EM1=$("$PY" "$(dirname "$0")/hand_em.py" "$DB" 1)
+EM2=$("$PY" "$(dirname "$0")/hand_em.py" "$ALICE" "$ALICE1")
+EM3=$("$PY" "$(dirname "$0")/hand_em.py" "$BOB" "$BOB1")
 check em_differ 0 "^3$" -- bash -c "printf '%s\n' '$EM1' '$EM2' '$EM3' | sort -u | wc -l"
 check results_version1 0 "^1 $EM1$" -- bash -c "'$DAQ' show 1 --version 1 --json --db '$PG_URL' | '$PY' '$TMP/shown_em.py'"
 check results_version2 0 "^1 $EM2$" -- bash -c "'$DAQ' show 1 --version 2 --json --db '$PG_URL' | '$PY' '$TMP/shown_em.py'"
@@ -327,7 +315,7 @@ pg_undo_central_7
 psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); DROP FUNCTION caldaq.approve(uuid, text); DROP TABLE caldaq.approvals; UPDATE caldaq.schema_version SET version = 4" >/dev/null
 check old_server 0 "^4 1$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.machines) FROM caldaq.schema_version"
 check migrate_5 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --quiet
-check adopted 0 "^11 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
+check adopted 0 "^12 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
   psql_value "SELECT (SELECT version FROM caldaq.schema_version) || ' ' || count(*) || ' ' || max(uuid::text) FROM caldaq.machines"
 
 finish

@@ -74,9 +74,22 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
+# pg_undo_central_12: the test's server taken back to central schema 11 as far as its data goes:
+# the results' verdicts and the fleet's triggers of migration 12 dropped (the fleet's result
+# trigger too: migration 12 makes it again; schema 11's text of it is not restored).
+pg_undo_central_12() {
+  psql_value "SET client_min_messages = warning;
+DROP FUNCTION IF EXISTS caldaq.fleet_version_changed, caldaq.fleet_mark_current,
+  caldaq.fleet_is_current CASCADE;
+DROP TRIGGER IF EXISTS fleet_result ON caldaq.results;
+ALTER TABLE caldaq.results DROP COLUMN IF EXISTS verdict, DROP COLUMN IF EXISTS verdict_failed;
+UPDATE caldaq.schema_version SET version = 11" >/dev/null
+}
+
 # pg_undo_central_11: the test's server taken back to central schema 10, the results' versions
-# (migration 11) dropped.
+# (migration 11) dropped, and what migration 12 added.
 pg_undo_central_11() {
+  pg_undo_central_12
   psql_value "DROP TABLE IF EXISTS caldaq.result_versions; UPDATE caldaq.schema_version SET version = 10" >/dev/null
 }
 

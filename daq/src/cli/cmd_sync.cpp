@@ -19,9 +19,11 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "database.hpp"
+#include "json_input.hpp"
 #include "progress.hpp"
 #include "run_document.hpp"
 #include "terminal.hpp"
+#include "verdict.hpp"
 
 namespace daq {
 namespace {
@@ -53,6 +55,30 @@ std::int64_t cut_after_chunks() {
     throw cal::InputError(
         fmt::format("CALDAQ_SYNC_CUT_AFTER_CHUNKS: '{}' is not a positive whole number", env));
   return n;
+}
+
+// daq's verdict of a stored result by its run's settings, as the central store keeps it with the
+// result (central schema 12) for the fleet view: verdict.cpp's, the one rule (the value as
+// cal::fixed_text prints it against the limit). A document that is not JSON is judged "none".
+st::pg::StoredVerdict stored_verdict(std::string_view settings_json, std::string_view result_json) {
+  const auto result = cal::daq::parse_stored_json(result_json);
+  if (!result.is_object()) return {.verdict = "none", .failed = ""};
+  auto settings = cal::daq::parse_stored_json(settings_json);
+  if (!settings.is_object()) settings = nlohmann::json::object();
+  Verdict v;
+  try {
+    v = verdict_of(settings, result);
+  } catch (const std::exception&) {  // a limit or value of the wrong type: daq show fails too
+    return {.verdict = "none", .failed = ""};
+  }
+  std::vector<std::string> failed;
+  for (const auto& c : v.checks)
+    if (!c.pass) failed.push_back(c.symbol);
+  std::sort(failed.begin(), failed.end());
+  return {.verdict = !v.configured ? "none"
+                     : v.pass      ? "pass"
+                                   : "fail",
+          .failed = fmt::format("{}", fmt::join(failed, ", "))};
 }
 
 // The sync's progress (issue 34), hooked into `options` beside the test's cut: the chunks done
@@ -211,6 +237,7 @@ void run_sync(const SyncCliOptions& o) {
   options.sent_by = user_name();
   options.sent_from = host_name();
   options.site = o.site;
+  options.verdict = stored_verdict;
   if (const auto cut = cut_after_chunks(); cut > 0)
     options.after_chunk = [cut](std::int64_t sent) {
       if (sent >= cut) std::_Exit(75);
@@ -231,7 +258,8 @@ void run_sync(const SyncCliOptions& o) {
                                              {"chunks_verified", report.chunks_verified_bytes},
                                              {"versions_new", report.versions_new},
                                              {"models", report.models},
-                                             {"models_new", report.models_new}}
+                                             {"models_new", report.models_new},
+                                             {"verdicts_judged", report.verdicts_judged}}
                                   .dump(2));
   print_line(
       "{}: {} runs synced to {} (central schema {}): {} new; {} chunks sent ({} bytes), {} "

@@ -7,6 +7,7 @@
 
 #include "cal/storage/pg/sync.hpp"
 #include "fleet_schema.hpp"
+#include "fleet_schema_12.hpp"
 #include "fleet_schema_9.hpp"
 
 namespace cal::storage::pg {
@@ -444,6 +445,9 @@ CREATE POLICY by_site ON caldaq.result_versions
 GRANT SELECT ON caldaq.result_versions TO caldaq_engineer, caldaq_reviewer;
 GRANT INSERT, UPDATE, DELETE ON caldaq.result_versions TO caldaq_engineer;
 )sql",
+    // 12: the fleet's current results those of the run's current version, daq's verdict stored
+    // with each result, an approval's version the result's own (fleet_schema_12.hpp).
+    kFleetCurrentVerdictMigration,
 };
 static_assert(std::size(kCentralMigrations) == central_schema_version);
 

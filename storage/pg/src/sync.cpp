@@ -94,6 +94,8 @@ class Sync {
     report_.server_schema = migrate_schema(*conn_, shown_);
     guarded(shown_, "prepare the statements", [&] { prepare(); });
     guarded(shown_, "read the sites this login may write", [&] { read_sites(); });
+    guarded(shown_, "judge the results the server holds without a verdict",
+            [&] { judge_unjudged(); });
     std::vector<RunRecord> runs;
     if (options_.run_ids.empty()) {
       runs = local_.runs();
@@ -145,6 +147,33 @@ class Sync {
     std::string out;
     for (const auto& s : sites_) out += (out.empty() ? "'" : ", '") + text::terminal_safe(s) + "'";
     return out;
+  }
+
+  // The results on the server without daq's verdict (central schema 12; those of a server
+  // migrated from 11), judged by the run's settings there, a page at a time (each its own
+  // transaction): all of them by the sync that migrates (the schema owner's login sees every
+  // site), those of its sites by any other's. A page that judges nothing ends it.
+  void judge_unjudged() {
+    if (!options_.verdict) return;
+    for (;;) {
+      pqxx::work w(*conn_);
+      const auto rows = w.exec(
+          "SELECT s.run_uuid, s.source_result_id, r.settings_json, s.json FROM caldaq.results AS "
+          "s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid WHERE s.verdict IS NULL "
+          "ORDER BY s.run_uuid, s.source_result_id LIMIT 500");
+      std::int64_t judged = 0;
+      for (const auto& row : rows) {
+        const auto v = options_.verdict(row[2].c_str(), row[3].c_str());
+        judged += static_cast<std::int64_t>(
+            w.exec_params("UPDATE caldaq.results SET verdict = $3, verdict_failed = $4 WHERE "
+                          "run_uuid = $1 AND source_result_id = $2 AND verdict IS NULL",
+                          row[0].as<std::string>(), row[1].as<std::int64_t>(), v.verdict, v.failed)
+                .affected_rows());
+      }
+      w.commit();
+      report_.verdicts_judged += judged;
+      if (rows.size() < 500 || judged == 0) return;
+    }
   }
 
   // The site of something new to the server (`what`: a machine, a run without one): --site, else
@@ -484,23 +513,35 @@ class Sync {
     std::map<std::int64_t, std::int64_t> server_id;  // local id -> the server's
     for (const auto& res : local) {
       const auto fp = result_fingerprint(w, res);
+      // daq's verdict by the run's settings as sent (schema 12); NULL without a judge.
+      const auto v =
+          options_.verdict ? options_.verdict(r.settings_json, res.json) : StoredVerdict{};
+      const bool judged = static_cast<bool>(options_.verdict);
       const auto there = w.exec_params(
           "SELECT source_result_id FROM caldaq.results WHERE run_uuid = $1 AND fingerprint = $2",
           r.uuid, fp);
       if (!there.empty()) {
         server_id[res.id] = there[0][0].as<std::int64_t>();
+        // Judged again: the run's tolerances may have changed since it was sent.
+        if (judged)
+          w.exec_params(
+              "UPDATE caldaq.results SET verdict = $3, verdict_failed = $4 WHERE run_uuid = $1 "
+              "AND source_result_id = $2 AND (verdict, verdict_failed) IS DISTINCT FROM ($3, $4)",
+              r.uuid, server_id[res.id], v.verdict, v.failed);
         continue;
       }
       server_id[res.id] =
           w.exec_params1(
                "INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, "
-               "created_unix_ms, provenance_json, fingerprint) VALUES($1::uuid, CASE WHEN $2 AND "
-               "NOT EXISTS (SELECT 1 FROM caldaq.results WHERE run_uuid = $1::uuid AND "
-               "source_result_id = $3) THEN $3 ELSE (SELECT COALESCE(MAX(source_result_id), 0) + "
-               "1 FROM caldaq.results WHERE run_uuid = $1::uuid) END, $4, $5, $6, $7, $8) "
-               "RETURNING source_result_id",
+               "created_unix_ms, provenance_json, fingerprint, verdict, verdict_failed) "
+               "VALUES($1::uuid, CASE WHEN $2 AND NOT EXISTS (SELECT 1 FROM caldaq.results WHERE "
+               "run_uuid = $1::uuid AND source_result_id = $3) THEN $3 ELSE (SELECT "
+               "COALESCE(MAX(source_result_id), 0) + 1 FROM caldaq.results WHERE run_uuid = "
+               "$1::uuid) END, $4, $5, $6, $7, $8, CASE WHEN $9::boolean THEN $10::text END, CASE "
+               "WHEN $9::boolean THEN "
+               "$11::text END) RETURNING source_result_id",
                r.uuid, source_id == r.id, res.id, res.standard, res.json, res.created_unix_ms,
-               res.provenance_json, fp)[0]
+               res.provenance_json, fp, judged, v.verdict, v.failed)[0]
               .as<std::int64_t>();
     }
     for (const auto& res : local) {

@@ -38,13 +38,24 @@ namespace cal::storage::pg {
 // (visible and writable where their machine is).
 // 11: each result tied to the version of the run's stops it was computed from (result_versions);
 // the readers read the chosen (else current) version's results only.
-inline constexpr int central_schema_version = 11;
+// 12: the fleet's current results those of the run's current version; daq's verdict stored with
+// each result (results.verdict, verdict_failed: the fleet reads it, the server judges nothing); an
+// approval records the approved result's own version.
+inline constexpr int central_schema_version = 12;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
 bool is_postgresql_url(std::string_view text);
 // The URI with any password replaced by "***": what messages print.
 std::string redacted(std::string_view url);
+
+// daq's verdict of a result (daq/src/results/verdict.cpp), as the server keeps it with the result
+// (central schema 12) for the fleet view.
+struct StoredVerdict {
+  std::string verdict;  // "pass", "fail", or "none" (no limit applies)
+  std::string failed;   // the symbols of the values that failed, ", " between them, byte order
+  bool operator==(const StoredVerdict&) const = default;
+};
 
 struct SyncOptions {
   // Chunks sent per transaction: what a cut can lose and then sends again.
@@ -69,6 +80,13 @@ struct SyncOptions {
   // keeps its site (another one here is an error): which site a machine is of is the
   // administrator's.
   std::string site;
+  // The verdict of a result by its run's settings (both JSON text, as stored): storage/ does not
+  // judge, daq does (daq sync passes verdict.cpp's). Sent with every result, and sent again when
+  // it changed (the run's tolerances edited); a sync also judges the results on the server that
+  // have none (those of a server migrated from schema 11: the sync that migrates judges them
+  // all). Empty: results go without one (the fleet shows "none").
+  std::function<StoredVerdict(std::string_view settings_json, std::string_view result_json)>
+      verdict;
 };
 
 struct SyncReport {
@@ -78,10 +96,11 @@ struct SyncReport {
   std::int64_t chunks_already = 0;  // chunks the server had (from an earlier or cut sync), checked
   std::int64_t chunks_verified_bytes = 0;  // chunks whose server bytes were re-read (verify_bytes)
   std::int64_t bytes_sent = 0;             // chunk BLOB bytes copied now
-  std::int64_t versions_new = 0;  // runs whose stops differ from every version the server had
-  std::int64_t models = 0;        // models of the local store (schema 11) synced
-  std::int64_t models_new = 0;    // of which the server did not have before
-  int server_schema = 0;          // the central schema version after migration
+  std::int64_t versions_new = 0;     // runs whose stops differ from every version the server had
+  std::int64_t models = 0;           // models of the local store (schema 11) synced
+  std::int64_t models_new = 0;       // of which the server did not have before
+  int server_schema = 0;             // the central schema version after migration
+  std::int64_t verdicts_judged = 0;  // results on the server judged without their laptop's copy
 };
 
 // Copies the runs of `local` to the central store at `url` (migrating its schema first).
