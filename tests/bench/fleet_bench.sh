@@ -8,12 +8,17 @@
 # peer measured in the same run: one scan of the fleet's values table (the trend aggregation reads
 # each value once); and the page's render in headless Chromium (navigation to the first view
 # rendered, at 1366x768). The machine's load (uptime) is printed before and after.
-# Usage: fleet_bench.sh DAQ_BINARY [MACHINES=1000] [MONTHS=120] [SCREENSHOT_DIR]
+# With READING_MONTHS > 0, each machine's last READING_MONTHS runs get readings: the chunks of the
+# demo's own runs of the same kind (a linear run of X's stops; a ballbar circle), as daq stored
+# and sent them (their checksums hold), copied on the server under each run; then `daq bench
+# sync` is run against the same server (sync throughput beside COPY's, in the same run).
+# Usage: fleet_bench.sh DAQ_BINARY [MACHINES=1000] [MONTHS=120] [SCREENSHOT_DIR] [READING_MONTHS=0]
 set -eu
 DAQ=$(realpath "$1")
 MACHINES=${2:-1000}
 MONTHS=${3:-120}
 SHOTS=${4:-}
+READING_MONTHS=${5:-0}
 HERE=$(cd "$(dirname "$0")" && pwd)
 source "$HERE/../cli/check.sh"
 source "$HERE/../cli/pg_server.sh"
@@ -110,6 +115,29 @@ VACUUM FULL caldaq.fleet_instruments;
 ANALYZE;
 EOF
 made=$(echo "$(secs) - $t" | bc)
+if [ "$READING_MONTHS" -gt 0 ]; then
+  t=$(secs)
+  sql -v months="$MONTHS" -v reading_months="$READING_MONTHS" <<'EOF'
+-- The demo's two runs (a linear run of X: 11 targets, 5 runs each way, 3 s dwells; a ballbar
+-- circle at 1 kHz), their chunks as the demo's sync sent them, under each bench run of the same
+-- kind in the last :reading_months months of every machine.
+INSERT INTO caldaq.reading_chunks
+  SELECT r.uuid, c.seq, c.device, c.channel, c.quantity, c.first_ns, c.last_ns, c.count, c.encoding,
+    c.crc, c.stored_checksum, c.data
+  FROM caldaq.runs AS r
+    JOIN (SELECT DISTINCT ON (kind) kind, uuid FROM caldaq.runs WHERE campaign <> 'bench'
+          ORDER BY kind, started_unix_ms) AS d ON d.kind = r.kind
+    JOIN caldaq.reading_chunks AS c ON c.run_uuid = d.uuid
+  WHERE r.campaign = 'bench' AND r.source_run_id > :months - :reading_months;
+ANALYZE caldaq.reading_chunks;
+EOF
+  read_made=$(echo "$(secs) - $t" | bc)
+  read -r chunk_runs readings chunk_mb table_mb <<<"$(sql -F ' ' -c "SELECT count(DISTINCT run_uuid), sum(count), sum(length(data)) / 1000000, pg_total_relation_size('caldaq.reading_chunks') / 1000000 FROM caldaq.reading_chunks")"
+  echo "readings: $readings in $chunk_runs runs ($chunk_mb MB of chunk data, the table and its index $table_mb MB); made in ${read_made} s"
+  # Sync throughput into this store, beside COPY's ceiling into it, in the same run.
+  echo "load before the sync bench: $(uptime)"
+  "$DAQ" bench sync --to "$PG_URL" --minutes 2 --runs 5 --rounds 3 --dir "$TMP"
+fi
 read -r runs results values approvals doc_bytes db_mb <<<"$(sql -F ' ' -c "SELECT (SELECT count(*) FROM caldaq.runs), (SELECT count(*) FROM caldaq.results), (SELECT count(*) FROM caldaq.fleet_values), (SELECT count(*) FROM caldaq.approvals), (SELECT avg(length(json))::int FROM caldaq.results), pg_database_size(current_database()) / 1000000")"
 echo "store: $MACHINES machines x $MONTHS months: $runs runs, $results results (about $doc_bytes bytes of JSON each), $values fleet values, $approvals approvals; made in ${made} s; database $db_mb MB"
 
@@ -160,24 +188,42 @@ print(f"answer: {len(d['sites'])} sites, {d['machines']} machines; the first sit
       f"({d['instruments']['listed']} listed); awaiting approval {d['awaiting_approval']['count']}; "
       f"machine 500's windows {dict(windows)}")
 EOF
-HERE=$HERE "$PY" - "$URL" "${SHOTS:-$TMP}" <<'EOF'
-import os, sys
+kill $SERVE_PID
+wait $SERVE_PID 2>/dev/null || true
+SERVE_PID=
+# The page in Chromium: twice a new `daq serve` and its first load, then two more: the first
+# time with the browser's own first page too, the second with the browser warm.
+HERE=$HERE "$PY" - "$DAQ" "$PG_URL" "${SHOTS:-$TMP}" <<'EOF'
+import os, re, subprocess, sys, time
 sys.path.insert(0, os.path.join(os.environ["HERE"], "..", "web"))
 from webdriver import Browser
-url, shots = sys.argv[1], sys.argv[2]
+daq, pg_url, shots = sys.argv[1:4]
 with Browser(width=1366, height=768) as b:
-    for i in range(3):
-        b.get(url + "/")
-        b.wait("return document.body.dataset.complete !== undefined", timeout_s=60, what="the fleet")
-        ms, done, n, api = b.js("return [Number(document.body.dataset.rendered), "
-                                "Number(document.body.dataset.complete), "
-                                "document.querySelectorAll('details.machine').length, "
-                                "Math.max(...performance.getEntriesByType('resource')"
-                                ".filter(r => r.name.includes('/api/')).map(r => r.responseEnd))];")
-        print(f"page: navigation to the first view rendered and painted {ms:.0f} ms ({n} machines "
-              f"listed; its answers in at {api:.0f} ms); the lists below it too {done:.0f} ms")
-    b.screenshot(os.path.join(shots, "fleet-bench.png"))
+    for serve in ("the browser's first page", "the browser warm"):
+        t0 = time.monotonic()
+        p = subprocess.Popen([daq, "serve", "--db", pg_url, "--port", "0"], stdout=subprocess.PIPE,
+                             text=True)
+        line = p.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+", line).group(0)
+        print(f"daq serve started ({serve}): ready in {time.monotonic() - t0:.2f} s")
+        try:
+            for i in range(3):
+                b.get(url + "/")
+                b.wait("return document.body.dataset.complete !== undefined", timeout_s=60,
+                       what="the fleet")
+                ms, done, n, api = b.js(
+                    "return [Number(document.body.dataset.rendered), "
+                    "Number(document.body.dataset.complete), "
+                    "document.querySelectorAll('details.machine').length, "
+                    "Math.max(...performance.getEntriesByType('resource')"
+                    ".filter(r => r.name.includes('/api/')).map(r => r.responseEnd))];")
+                which = "first load after the serve started" if i == 0 else "then"
+                print(f"page ({which}): navigation to the first view rendered and painted {ms:.0f} "
+                      f"ms ({n} machines listed; its answers in at {api:.0f} ms); the lists below "
+                      f"it too {done:.0f} ms")
+            b.screenshot(os.path.join(shots, "fleet-bench.png"))
+        finally:
+            p.terminate()
+            p.wait()
 EOF
 echo "load after: $(uptime)"
-kill $SERVE_PID
-SERVE_PID=

@@ -304,31 +304,41 @@ Projection project(const TrendFit& fit) {
   return {TrendStatus::leaving, at};
 }
 
+namespace {
+
+// The fleet's first view (fleet_json) in the caller's transaction.
+std::string first_view(pqxx::transaction_base& t, const ConnectionPool& pool,
+                       std::int64_t now_unix_ms) {
+  const auto today = day_of(static_cast<double>(now_unix_ms));
+  json sites = sites_summary(t);
+  std::int64_t machines = 0;
+  for (const auto& s : sites) machines += s["machines"].get<std::int64_t>();
+  json doc{{"schema", "caldaq.fleet.v2"},
+           {"store", pool.shown_url()},
+           {"generated_unix_ms", now_unix_ms},
+           {"today", iso_day(today)},
+           {"trend",
+            {{"method",
+              "least squares line of each value on its run's start time, over its current "
+              "results since the last change that resets it (a compensation table stored for "
+              "an axis the test measures, the control's compensation switched on or off, or a "
+              "date chosen when the machine is opened); projected where the line reaches the "
+              "limit of the latest run"},
+             {"min_runs", fleet_min_runs_for_trend}}},
+           {"due_soon_days", fleet_due_soon_days},
+           {"machines_per_page", fleet_machines_per_page},
+           {"machines", machines},
+           {"sites", std::move(sites)},
+           {"instruments", instruments(t, today)},
+           {"awaiting_approval", awaiting_approval(t)}};
+  return doc.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+}  // namespace
+
 std::string fleet_json(ConnectionPool& pool, std::int64_t now_unix_ms) {
   return with_connection(pool, "read the fleet", [&](pqxx::transaction_base& t) {
-    const auto today = day_of(static_cast<double>(now_unix_ms));
-    json sites = sites_summary(t);
-    std::int64_t machines = 0;
-    for (const auto& s : sites) machines += s["machines"].get<std::int64_t>();
-    json doc{{"schema", "caldaq.fleet.v2"},
-             {"store", pool.shown_url()},
-             {"generated_unix_ms", now_unix_ms},
-             {"today", iso_day(today)},
-             {"trend",
-              {{"method",
-                "least squares line of each value on its run's start time, over its current "
-                "results since the last change that resets it (a compensation table stored for "
-                "an axis the test measures, the control's compensation switched on or off, or a "
-                "date chosen when the machine is opened); projected where the line reaches the "
-                "limit of the latest run"},
-               {"min_runs", fleet_min_runs_for_trend}}},
-             {"due_soon_days", fleet_due_soon_days},
-             {"machines_per_page", fleet_machines_per_page},
-             {"machines", machines},
-             {"sites", std::move(sites)},
-             {"instruments", instruments(t, today)},
-             {"awaiting_approval", awaiting_approval(t)}};
-    return doc.dump(-1, ' ', false, json::error_handler_t::replace);
+    return first_view(t, pool, now_unix_ms);
   });
 }
 
@@ -370,16 +380,33 @@ std::optional<std::string> fleet_site_json(ConnectionPool& pool, std::string_vie
                          });
 }
 
+namespace {
+
+// Page 1 of the first of the sites in fleet_json's order (byte order), of those this login sees.
+std::optional<std::string> first_site_page(pqxx::transaction_base& t) {
+  const auto first = t.exec("SELECT min(site COLLATE \"C\") FROM caldaq.machines");
+  if (first.empty() || first[0][0].is_null()) return std::nullopt;
+  return site_page(t, first[0][0].as<std::string>(), 1);
+}
+
+}  // namespace
+
 std::optional<std::string> fleet_first_site_json(ConnectionPool& pool) {
-  return with_connection(pool, "read the machines of the first site",
-                         [&](pqxx::transaction_base& t) -> std::optional<std::string> {
-                           // The first of the sites in fleet_json's order (byte order), of those
-                           // this login sees.
-                           const auto first =
-                               t.exec("SELECT min(site COLLATE \"C\") FROM caldaq.machines");
-                           if (first.empty() || first[0][0].is_null()) return std::nullopt;
-                           return site_page(t, first[0][0].as<std::string>(), 1);
-                         });
+  return with_connection(pool, "read the machines of the first site", first_site_page);
+}
+
+void fleet_warm(ConnectionPool& pool, std::int64_t now_unix_ms) {
+  guarded(pool.shown_url(), "open the pool's connections and read the first view", [&] {
+    // All leased at once, so that each lease is another connection.
+    std::vector<std::unique_ptr<Lease>> leases;
+    for (std::size_t i = 0; i < pool.max_connections(); ++i)
+      leases.push_back(std::make_unique<Lease>(pool.impl()));
+    for (auto& lease : leases) {
+      pqxx::read_transaction t(lease->connection());
+      (void)first_view(t, pool, now_unix_ms);
+      (void)first_site_page(t);
+    }
+  });
 }
 
 std::optional<std::string> fleet_machine_json(ConnectionPool& pool, std::int64_t machine_id,
