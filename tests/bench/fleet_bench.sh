@@ -26,12 +26,19 @@ TMP=$(mktemp -d)
 PGTMP=$(mktemp -d /tmp/caldaq-pg.XXXXXX)
 SERVE_PID=
 trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
+sql() { "$PG_BIN/psql" -X -q -At -v ON_ERROR_STOP=1 "$PG_URL" "$@"; }
+secs() { date +%s.%N; }
+# FLEET_STORE=URI: a store this script made before, on a server still running (another daq
+# binary measured on the same store): its history is not made again (READING_MONTHS > 0 still
+# adds readings, once).
+made="not made here (FLEET_STORE)"
+if [ -n "${FLEET_STORE:-}" ]; then
+  PG_URL=$FLEET_STORE
+else
 pg_start "$PGTMP" >/dev/null
 # The schema, made by a sync as on a real server: the demo's store sent.
 (cd "$TMP" && "$DAQ" demo --quiet --db demo.sqlite --capture demo.cdq >demo.log 2>&1)
 "$DAQ" sync --db "$TMP/demo.sqlite" --to "$PG_URL" --quiet >/dev/null
-sql() { "$PG_BIN/psql" -X -q -At -v ON_ERROR_STOP=1 "$PG_URL" "$@"; }
-secs() { date +%s.%N; }
 
 t=$(secs)
 sql -v machines="$MACHINES" -v months="$MONTHS" <<'EOF'
@@ -115,6 +122,7 @@ VACUUM FULL caldaq.fleet_instruments;
 ANALYZE;
 EOF
 made=$(echo "$(secs) - $t" | bc)
+fi
 if [ "$READING_MONTHS" -gt 0 ]; then
   t=$(secs)
   sql -v months="$MONTHS" -v reading_months="$READING_MONTHS" <<'EOF'
