@@ -27,7 +27,7 @@ trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP"
 
 check sync_a 0 "runs synced" -- "$DAQ" sync --db "$A" --to "$PG_URL" --quiet
 check sync_b 0 "runs synced" -- "$DAQ" sync --db "$B" --to "$PG_URL" --quiet
-check schema 0 "^11$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check schema 0 "^13$" -- psql_value "SELECT version FROM caldaq.schema_version"
 # A reviewer approves laptop A's first linear run (server run 1).
 psql_value "CREATE ROLE rev LOGIN IN ROLE caldaq_reviewer; CREATE ROLE eng LOGIN IN ROLE caldaq_engineer; INSERT INTO caldaq.site_grants VALUES ('rev', '*'), ('eng', '*')" >/dev/null
 check approve 0 "approved by rev" -- "$DAQ" approve 1 --db "postgresql:///caldaq?host=$PGTMP&user=rev"

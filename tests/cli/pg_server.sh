@@ -74,9 +74,16 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
+# pg_undo_central_13: the test's server taken back to central schema 11: the failing tests'
+# index (13) dropped; 12 (a placeholder on branch s48-h35b, h35a's at the merge) undone.
+pg_undo_central_13() {
+  psql_value "DROP INDEX IF EXISTS caldaq.fleet_tests_failing; UPDATE caldaq.schema_version SET version = 11" >/dev/null
+}
+
 # pg_undo_central_11: the test's server taken back to central schema 10, the results' versions
-# (migration 11) dropped.
+# (migration 11) dropped, and what later migrations added.
 pg_undo_central_11() {
+  pg_undo_central_13
   psql_value "DROP TABLE IF EXISTS caldaq.result_versions; UPDATE caldaq.schema_version SET version = 10" >/dev/null
 }
 

@@ -38,7 +38,10 @@ namespace cal::storage::pg {
 // (visible and writable where their machine is).
 // 11: each result tied to the version of the run's stops it was computed from (result_versions);
 // the readers read the chosen (else current) version's results only.
-inline constexpr int central_schema_version = 11;
+// 12: h35a's fleet rules (a placeholder on branch s48-h35b).
+// 13: the failing tests' index (fleet_tests_failing): the fleet's first view reads rows that
+// grow with the machines, not with the results synced.
+inline constexpr int central_schema_version = 13;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
