@@ -168,8 +168,8 @@ void serve_fleet(const ServeOptions& o) {
   // The store is read before serving, on each of the pool's connections: an absent server, a
   // database without a caldaq store or one of another schema version is refused at start with
   // the reason, and the first page's requests find their connections open and their server
-  // processes' caches filled (a connection opened by the first page cost it 0.1 - 0.3 s more at
-  // 1,000 machines; docs/benchmarks.md).
+  // processes' caches filled (the page's first load after a start at 1,000 machines: 0.87 s
+  // before, 0.23 - 0.31 s with it, load 9 - 13; docs/benchmarks.md).
   pg::fleet_warm(pool, now_unix_ms());
   boost::asio::io_context io;
   boost::asio::thread_pool workers(kConnections);
