@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 35: machine models in both stores (local schema 11, central schema 10; the server here is at 11), against a real
+# Issue 35: machine models in both stores (local schema 11, central schema 10; the server here is at 13), against a real
 # PostgreSQL server started here (tests/cli/pg_server.sh). Laptop A's store, taken back to schema
 # 10, is migrated in place by `daq model build --store`, which keeps the model with the runs it was
 # built from (their UUIDs), who and when; `daq model store FILE` keeps a file. Both are synced up

@@ -155,7 +155,7 @@ check engineer_cannot_migrate 2 "create or migrate the central schema: .*(must b
 check migrate 0 "$RUNS_A runs synced .*central schema 13.*: 0 new; 0 chunks sent" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
 check migrated_sites 0 "^Lathe 7 unassigned unassigned\|SIMULATED VMC caldaq built-in simulated shop caldaq built-in simulated shop$" -- psql_value \
   "SELECT string_agg(x, '|' ORDER BY x) FROM (SELECT DISTINCT m.name || ' ' || m.site || ' ' || r.site AS x FROM caldaq.machines m JOIN caldaq.runs r ON r.machine_id = m.id) AS d"
-check migrated_kept 0 "^11 2 $RUNS_ALL 0$" -- psql_value \
+check migrated_kept 0 "^13 2 $RUNS_ALL 0$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM caldaq.approvals) || ' ' || (SELECT count(*) FROM caldaq.runs) || ' ' || (SELECT count(*) FROM caldaq.site_grants) FROM caldaq.schema_version"
 check migrated_engineer_nothing 0 "\(0 runs\)" -- "$DAQ" runs --db "$ENGA"
 psql_value "INSERT INTO caldaq.site_grants VALUES ('eng_a', 'caldaq built-in simulated shop')" >/dev/null
