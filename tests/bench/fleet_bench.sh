@@ -8,12 +8,17 @@
 # peer measured in the same run: one scan of the fleet's values table (the trend aggregation reads
 # each value once); and the page's render in headless Chromium (navigation to the first view
 # rendered, at 1366x768). The machine's load (uptime) is printed before and after.
-# Usage: fleet_bench.sh DAQ_BINARY [MACHINES=1000] [MONTHS=120] [SCREENSHOT_DIR]
+# With READING_MONTHS > 0, each machine's last READING_MONTHS runs get readings: the chunks of the
+# demo's own runs of the same kind (a linear run of X's stops; a ballbar circle), as daq stored
+# and sent them (their checksums hold), copied on the server under each run; then `daq bench
+# sync` is run against the same server (sync throughput beside COPY's, in the same run).
+# Usage: fleet_bench.sh DAQ_BINARY [MACHINES=1000] [MONTHS=120] [SCREENSHOT_DIR] [READING_MONTHS=0]
 set -eu
 DAQ=$(realpath "$1")
 MACHINES=${2:-1000}
 MONTHS=${3:-120}
 SHOTS=${4:-}
+READING_MONTHS=${5:-0}
 HERE=$(cd "$(dirname "$0")" && pwd)
 source "$HERE/../cli/check.sh"
 source "$HERE/../cli/pg_server.sh"
@@ -21,12 +26,19 @@ TMP=$(mktemp -d)
 PGTMP=$(mktemp -d /tmp/caldaq-pg.XXXXXX)
 SERVE_PID=
 trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
+sql() { "$PG_BIN/psql" -X -q -At -v ON_ERROR_STOP=1 "$PG_URL" "$@"; }
+secs() { date +%s.%N; }
+# FLEET_STORE=URI: a store this script made before, on a server still running (another daq
+# binary measured on the same store): its history is not made again (READING_MONTHS > 0 still
+# adds readings, once).
+made="not made here (FLEET_STORE)"
+if [ -n "${FLEET_STORE:-}" ]; then
+  PG_URL=$FLEET_STORE
+else
 pg_start "$PGTMP" >/dev/null
 # The schema, made by a sync as on a real server: the demo's store sent.
 (cd "$TMP" && "$DAQ" demo --quiet --db demo.sqlite --capture demo.cdq >demo.log 2>&1)
 "$DAQ" sync --db "$TMP/demo.sqlite" --to "$PG_URL" --quiet >/dev/null
-sql() { "$PG_BIN/psql" -X -q -At -v ON_ERROR_STOP=1 "$PG_URL" "$@"; }
-secs() { date +%s.%N; }
 
 t=$(secs)
 sql -v machines="$MACHINES" -v months="$MONTHS" <<'EOF'
@@ -60,10 +72,14 @@ INSERT INTO caldaq.runs(uuid, machine_id, source_run_id, campaign, kind, axis, s
     LATERAL (SELECT (extract(epoch FROM now() - make_interval(months => :months)) * 1000)::bigint
                     + mo::bigint * 2629800000 + (m.id % 28) * 86400000 AS ms) AS s
   WHERE m.name LIKE 'Machine %';
+-- Each result's verdict as daq's sync stores it (central schema 12: the server judges nothing),
+-- against the bench's own tolerances above, the value as printed to 0.001: a synthetic store's
+-- judgement, not a second copy of daq's rule (the fleet reads only the stored verdict).
 INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, created_unix_ms,
-    provenance_json, fingerprint)
+    provenance_json, fingerprint, verdict, verdict_failed)
   SELECT r.uuid, 1, CASE r.kind WHEN 'circle' THEN 'ISO 230-4:2005' ELSE 'ISO 230-2:2014' END, d.doc,
-    r.started_unix_ms + 3600000, '{"how": "acquired", "software": "bench"}', md5(d.doc)
+    r.started_unix_ms + 3600000, '{"how": "acquired", "software": "bench"}', md5(d.doc),
+    CASE WHEN f.failed = '' THEN 'pass' ELSE 'fail' END, f.failed
   FROM caldaq.runs AS r JOIN caldaq.machines AS m ON m.id = r.machine_id,
     LATERAL (SELECT (r.source_run_id - 1) / 12.0 AS years) AS y,
     LATERAL (SELECT 3 + (m.id % 7) * 0.3 * y.years + random() * 0.5 AS e,
@@ -92,8 +108,22 @@ INSERT INTO caldaq.results(run_uuid, source_result_id, standard, json, created_u
           'R_bi', json_build_object('symbol', 'R', 'value_um', 1.4),
           'B', json_build_object('symbol', 'B', 'value_um', 0.4),
           'A_bi', json_build_object('symbol', 'A', 'value_um', v.e + 1.4)),
-        'warnings', json_build_array(), 'notes', json_build_array()) END::text AS doc) AS d
+        'warnings', json_build_array(), 'notes', json_build_array()) END::text AS doc) AS d,
+    LATERAL (SELECT CASE WHEN r.kind = 'circle'
+                      THEN CASE WHEN round(v.g::numeric, 3) > 15 THEN 'G' ELSE '' END
+                      ELSE concat_ws(', ', CASE WHEN round(v.e::numeric, 3) > 10 THEN 'E' END,
+                                     CASE WHEN round((v.e * 0.6)::numeric, 3) > 8 THEN 'M' END)
+                    END AS failed) AS f
   WHERE r.campaign = 'bench';
+-- Each run sent once (version 1) and its result placed in that version (central schemas 11, 12:
+-- the fleet counts only the results of a run's current version).
+INSERT INTO caldaq.run_versions(run_uuid, version, fingerprint, status, sent_by, sent_from,
+    sent_store, sent_unix_ms)
+  SELECT r.uuid, 1, md5(r.uuid::text), r.status, 'bench', 'bench', 'bench', r.started_unix_ms + 3600000
+  FROM caldaq.runs AS r WHERE r.campaign = 'bench';
+INSERT INTO caldaq.result_versions(run_uuid, version, source_result_id, superseded_by)
+  SELECT s.run_uuid, 1, s.source_result_id, NULL
+  FROM caldaq.results AS s JOIN caldaq.runs AS r ON r.uuid = s.run_uuid WHERE r.campaign = 'bench';
 -- Every tenth machine's X compensated 5 years ago (a positioning table): X's lines start there.
 INSERT INTO caldaq.compensations(machine_id, source, axis, format, created_unix_ms, json, fingerprint, site)
   SELECT m.id, 'bench', 'X', 'csv', (extract(epoch FROM now() - interval '5 years') * 1000)::bigint,
@@ -110,6 +140,30 @@ VACUUM FULL caldaq.fleet_instruments;
 ANALYZE;
 EOF
 made=$(echo "$(secs) - $t" | bc)
+fi
+if [ "$READING_MONTHS" -gt 0 ]; then
+  t=$(secs)
+  sql -v months="$MONTHS" -v reading_months="$READING_MONTHS" <<'EOF'
+-- The demo's two runs (a linear run of X: 11 targets, 5 runs each way, 3 s dwells; a ballbar
+-- circle at 1 kHz), their chunks as the demo's sync sent them, under each bench run of the same
+-- kind in the last :reading_months months of every machine.
+INSERT INTO caldaq.reading_chunks
+  SELECT r.uuid, c.seq, c.device, c.channel, c.quantity, c.first_ns, c.last_ns, c.count, c.encoding,
+    c.crc, c.stored_checksum, c.data
+  FROM caldaq.runs AS r
+    JOIN (SELECT DISTINCT ON (kind) kind, uuid FROM caldaq.runs WHERE campaign <> 'bench'
+          ORDER BY kind, started_unix_ms) AS d ON d.kind = r.kind
+    JOIN caldaq.reading_chunks AS c ON c.run_uuid = d.uuid
+  WHERE r.campaign = 'bench' AND r.source_run_id > :months - :reading_months;
+ANALYZE caldaq.reading_chunks;
+EOF
+  read_made=$(echo "$(secs) - $t" | bc)
+  read -r chunk_runs readings chunk_mb table_mb <<<"$(sql -F ' ' -c "SELECT count(DISTINCT run_uuid), sum(count), sum(length(data)) / 1000000, pg_total_relation_size('caldaq.reading_chunks') / 1000000 FROM caldaq.reading_chunks")"
+  echo "readings: $readings in $chunk_runs runs ($chunk_mb MB of chunk data, the table and its index $table_mb MB); made in ${read_made} s"
+  # Sync throughput into this store, beside COPY's ceiling into it, in the same run.
+  echo "load before the sync bench: $(uptime)"
+  "$DAQ" bench sync --to "$PG_URL" --minutes 2 --runs 5 --rounds 3 --dir "$TMP"
+fi
 read -r runs results values approvals doc_bytes db_mb <<<"$(sql -F ' ' -c "SELECT (SELECT count(*) FROM caldaq.runs), (SELECT count(*) FROM caldaq.results), (SELECT count(*) FROM caldaq.fleet_values), (SELECT count(*) FROM caldaq.approvals), (SELECT avg(length(json))::int FROM caldaq.results), pg_database_size(current_database()) / 1000000")"
 echo "store: $MACHINES machines x $MONTHS months: $runs runs, $results results (about $doc_bytes bytes of JSON each), $values fleet values, $approvals approvals; made in ${made} s; database $db_mb MB"
 
@@ -135,12 +189,13 @@ for i in 1 2 3 4 5; do
 done
 # As the page asks: the summary and the first site's first page at once (two of the serve's
 # pooled connections).
+# Each curl's own time_total (the wall time around them is mostly starting two curl processes:
+# 0.4 - 0.7 s at load 9 - 12 for answers of 0.02 - 0.06 s).
 for i in 1 2 3 4 5; do
-  t=$(secs)
-  curl -sf -o "$TMP/fleet.json" "$URL/api/fleet" &
-  curl -sf -o "$TMP/first.json" "$URL/api/fleet/first-site"
-  wait
-  echo "first view, both at once: GET /api/fleet and /api/fleet/first-site $(echo "$(secs) - $t" | bc | cut -c1-5) s"
+  curl -sf -o "$TMP/fleet.json" -w "%{time_total}" "$URL/api/fleet" >"$TMP/a.time" &
+  b=$(curl -sf -o "$TMP/first.json" -w "%{time_total}" "$URL/api/fleet/first-site")
+  wait $!
+  echo "first view, both at once: GET /api/fleet $(cat "$TMP/a.time") s and /api/fleet/first-site $b s"
 done
 for i in 1 2 3; do
   curl -sf -o "$TMP/machine.json" -w "a machine opened: GET /api/fleet/machines/500: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500" || echo "no machine 500"
@@ -160,24 +215,42 @@ print(f"answer: {len(d['sites'])} sites, {d['machines']} machines; the first sit
       f"({d['instruments']['listed']} listed); awaiting approval {d['awaiting_approval']['count']}; "
       f"machine 500's windows {dict(windows)}")
 EOF
-HERE=$HERE "$PY" - "$URL" "${SHOTS:-$TMP}" <<'EOF'
-import os, sys
+kill $SERVE_PID
+wait $SERVE_PID 2>/dev/null || true
+SERVE_PID=
+# The page in Chromium: twice a new `daq serve` and its first load, then two more: the first
+# time with the browser's own first page too, the second with the browser warm.
+HERE=$HERE "$PY" - "$DAQ" "$PG_URL" "${SHOTS:-$TMP}" <<'EOF'
+import os, re, subprocess, sys, time
 sys.path.insert(0, os.path.join(os.environ["HERE"], "..", "web"))
 from webdriver import Browser
-url, shots = sys.argv[1], sys.argv[2]
+daq, pg_url, shots = sys.argv[1:4]
 with Browser(width=1366, height=768) as b:
-    for i in range(3):
-        b.get(url + "/")
-        b.wait("return document.body.dataset.complete !== undefined", timeout_s=60, what="the fleet")
-        ms, done, n, api = b.js("return [Number(document.body.dataset.rendered), "
-                                "Number(document.body.dataset.complete), "
-                                "document.querySelectorAll('details.machine').length, "
-                                "Math.max(...performance.getEntriesByType('resource')"
-                                ".filter(r => r.name.includes('/api/')).map(r => r.responseEnd))];")
-        print(f"page: navigation to the first view rendered and painted {ms:.0f} ms ({n} machines "
-              f"listed; its answers in at {api:.0f} ms); the lists below it too {done:.0f} ms")
-    b.screenshot(os.path.join(shots, "fleet-bench.png"))
+    for serve in ("the browser's first page", "the browser warm"):
+        t0 = time.monotonic()
+        p = subprocess.Popen([daq, "serve", "--db", pg_url, "--port", "0"], stdout=subprocess.PIPE,
+                             text=True)
+        line = p.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+", line).group(0)
+        print(f"daq serve started ({serve}): ready in {time.monotonic() - t0:.2f} s")
+        try:
+            for i in range(3):
+                b.get(url + "/")
+                b.wait("return document.body.dataset.complete !== undefined", timeout_s=60,
+                       what="the fleet")
+                ms, done, n, api = b.js(
+                    "return [Number(document.body.dataset.rendered), "
+                    "Number(document.body.dataset.complete), "
+                    "document.querySelectorAll('details.machine').length, "
+                    "Math.max(...performance.getEntriesByType('resource')"
+                    ".filter(r => r.name.includes('/api/')).map(r => r.responseEnd))];")
+                which = "first load after the serve started" if i == 0 else "then"
+                print(f"page ({which}): navigation to the first view rendered and painted {ms:.0f} "
+                      f"ms ({n} machines listed; its answers in at {api:.0f} ms); the lists below "
+                      f"it too {done:.0f} ms")
+            b.screenshot(os.path.join(shots, "fleet-bench.png"))
+        finally:
+            p.terminate()
+            p.wait()
 EOF
 echo "load after: $(uptime)"
-kill $SERVE_PID
-SERVE_PID=

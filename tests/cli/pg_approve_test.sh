@@ -21,7 +21,7 @@ value() {
 }
 # as ROLE: the test's server for that login (trust authentication: the login is the role).
 as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
-check schema 0 "^12 2$" -- psql_value \
+check schema 0 "^13 2$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM pg_roles WHERE rolname IN ('caldaq_engineer', 'caldaq_reviewer')) FROM caldaq.schema_version"
 check local_schema 0 "^11$" -- value "$DB" "PRAGMA user_version"
 psql_value "CREATE ROLE eng LOGIN IN ROLE caldaq_engineer; CREATE ROLE rev LOGIN IN ROLE caldaq_reviewer; CREATE ROLE visitor LOGIN; CREATE ROLE \"r<i>&\" LOGIN IN ROLE caldaq_reviewer" >/dev/null

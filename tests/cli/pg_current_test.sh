@@ -57,7 +57,7 @@ PY
 set_context "$DB" 2 'ctx["tolerances"] = {"G_um": 2.062, "diagnostics": {"squareness": 2.062}}'
 check tie_shown 0 "G +2\.063 .*Squareness.* 2\.062 " -- bash -c "'$DAQ' show 2 --db '$DB' | tr '\n' ' '"
 check sync 0 "runs synced" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
-check schema 0 "^12$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check schema 0 "^13$" -- psql_value "SELECT version FROM caldaq.schema_version"
 check tie_stored 0 "^fail G$" -- psql_value "SELECT verdict || ' ' || verdict_failed FROM caldaq.results WHERE run_uuid = (SELECT uuid FROM caldaq.runs WHERE id = 2)"
 
 # Run 1 re-compensated on two laptops, alice's sent first (version 2), bob's then (3: current).
@@ -178,7 +178,7 @@ psql_value "UPDATE caldaq.fleet_results SET current = true, verdict = 'none', fa
 check old_server 0 "^11 [1-9]" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.results) FROM caldaq.schema_version"
 TOTAL=$(psql_value "SELECT count(*) FROM caldaq.results")
 check migrate_judges 0 "\"verdicts_judged\": $TOTAL\b" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --json
-check migrated 0 "^12 0$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.results WHERE verdict IS NULL) FROM caldaq.schema_version"
+check migrated 0 "^13 0$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.results WHERE verdict IS NULL) FROM caldaq.schema_version"
 check migrated_verdicts 0 "^$BOB_VERDICT $ALICE_VERDICT fail G$" -- psql_value \
   "SELECT (SELECT verdict FROM caldaq.results WHERE run_uuid = '$RUN1' AND source_result_id = $R3) || ' ' || (SELECT verdict FROM caldaq.results WHERE run_uuid = '$RUN1' AND source_result_id = $R2) || ' ' || (SELECT verdict || ' ' || verdict_failed FROM caldaq.results WHERE run_uuid = (SELECT uuid FROM caldaq.runs WHERE id = 2))"
 start_serve

@@ -27,7 +27,7 @@ trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP"
 
 check sync_a 0 "runs synced" -- "$DAQ" sync --db "$A" --to "$PG_URL" --quiet
 check sync_b 0 "runs synced" -- "$DAQ" sync --db "$B" --to "$PG_URL" --quiet
-check schema 0 "^12$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check schema 0 "^13$" -- psql_value "SELECT version FROM caldaq.schema_version"
 # A reviewer approves laptop A's first linear run (server run 1).
 psql_value "CREATE ROLE rev LOGIN IN ROLE caldaq_reviewer; CREATE ROLE eng LOGIN IN ROLE caldaq_engineer; INSERT INTO caldaq.site_grants VALUES ('rev', '*'), ('eng', '*')" >/dev/null
 check approve 0 "approved by rev" -- "$DAQ" approve 1 --db "postgresql:///caldaq?host=$PGTMP&user=rev"
@@ -64,6 +64,12 @@ for _ in $(seq 100); do grep -q "http://" "$TMP/serve.log" && break; sleep 0.1; 
 check serve_line 0 "the fleet view of postgresql:///caldaq.*reader only" -- cat "$TMP/serve.log"
 PORT=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$TMP/serve.log")
 URL=http://127.0.0.1:$PORT
+eng_backends() {
+  psql_value "SELECT string_agg(pid::text, ' ' ORDER BY pid) FROM pg_stat_activity WHERE usename = 'eng' AND backend_type = 'client backend'"
+}
+# Warmed before serving (docs/web.md): when the serve says where it listens, before any request,
+# its 4 connections are open (each has read the first view), not only the one that checked the store.
+check warmed_before_serving 0 "^4$" -- bash -c "echo '$(eng_backends)' | wc -w"
 COUNTS="SELECT (SELECT count(*) FROM caldaq.runs) || ' ' || (SELECT count(*) FROM caldaq.results) || ' ' || (SELECT count(*) FROM caldaq.approvals)"
 BEFORE=$(psql_value "$COUNTS")
 
@@ -241,9 +247,6 @@ check paged_page 0 "page ok" -- "$PY" "$(dirname "$0")/pg_fleet_page.py" "$URL" 
 # A few connections, kept (issue 35): the serve's connections to the server (login eng) stay
 # between requests, at most 4 of them however many requests come at once, and the same ones
 # answer the next requests (a connection per request, as before, left none open between them).
-eng_backends() {
-  psql_value "SELECT string_agg(pid::text, ' ' ORDER BY pid) FROM pg_stat_activity WHERE usename = 'eng' AND backend_type = 'client backend'"
-}
 at_once() {  # 24 requests for machine MID, 12 at a time: how many answered as the first did
   local i n=0
   for i in $(seq 24); do curl -sf -o "$TMP/c$i.json" "$URL/api/fleet/machines/$MID" & [ $((i % 12)) -eq 0 ] && wait; done

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 35: machine models in both stores (local schema 11, central schema 10; the server here is at 11), against a real
+# Issue 35: machine models in both stores (local schema 11, central schema 10; the server here is at 13), against a real
 # PostgreSQL server started here (tests/cli/pg_server.sh). Laptop A's store, taken back to schema
 # 10, is migrated in place by `daq model build --store`, which keeps the model with the runs it was
 # built from (their UUIDs), who and when; `daq model store FILE` keeps a file. Both are synced up
@@ -94,7 +94,7 @@ check bad_ref 2 "a stored model is named by its UUID or its number" -- "$DAQ" mo
 check compare_stored 0 "^same [1-9]" -- bash -c "diff '$TMP/compare-file.txt' '$TMP/compare-stored.txt' && echo same \$(wc -l <'$TMP/compare-file.txt')"
 
 # Up: the administrator's sync names the site; sent twice, stored once.
-check sync_up 0 "runs synced .*central schema 12.*; 2 models synced, 2 new$" -- \
+check sync_up 0 "runs synced .*central schema 13.*; 2 models synced, 2 new$" -- \
   "$DAQ" sync --db "$DB" --to "$PG_URL" --site "Plant A" --quiet
 check sync_up_again 0 "; 2 models synced, 0 new$" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
 check central_two 0 "^2 2$" -- psql_value "SELECT count(*) || ' ' || count(DISTINCT uuid) FROM caldaq.models"
@@ -105,9 +105,9 @@ check central_list 0 "$UUID" -- "$DAQ" model list --db "$PG_URL" --machine "$MAC
 # migrated in place by the next sync, which sends the models again.
 pg_undo_central_10
 RUNS_CENTRAL=$(psql_value "SELECT count(*) FROM caldaq.runs")
-check central_9_refused 2 "central schema version 9 is older than this daq reads \(12\)" -- \
+check central_9_refused 2 "central schema version 9 is older than this daq reads \(13\)" -- \
   "$DAQ" model list --db "$PG_URL"
-check central_migrated 0 "central schema 12\): 0 new; .*; 2 models synced, 2 new$" -- \
+check central_migrated 0 "central schema 13\): 0 new; .*; 2 models synced, 2 new$" -- \
   "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
 check central_runs_kept 0 "^$RUNS_CENTRAL 2$" -- psql_value "SELECT (SELECT count(*) FROM caldaq.runs) || ' ' || (SELECT count(*) FROM caldaq.models)"
 

@@ -315,7 +315,7 @@ pg_undo_central_7
 psql_value "DELETE FROM caldaq.runs WHERE machine_id = (SELECT id FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'); DELETE FROM caldaq.machines WHERE uuid = '$(value "$SITE2" "SELECT uuid FROM machines")'; DROP INDEX caldaq.machines_by_name; ALTER TABLE caldaq.machines DROP COLUMN uuid; ALTER TABLE caldaq.machines ADD UNIQUE (name); DROP FUNCTION caldaq.approve(uuid, text); DROP TABLE caldaq.approvals; UPDATE caldaq.schema_version SET version = 4" >/dev/null
 check old_server 0 "^4 1$" -- psql_value "SELECT version || ' ' || (SELECT count(*) FROM caldaq.machines) FROM caldaq.schema_version"
 check migrate_5 0 "0 new" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --run 2 --quiet
-check adopted 0 "^12 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
+check adopted 0 "^13 1 $(value "$DB" "SELECT uuid FROM machines")$" -- \
   psql_value "SELECT (SELECT version FROM caldaq.schema_version) || ' ' || count(*) || ' ' || max(uuid::text) FROM caldaq.machines"
 
 finish

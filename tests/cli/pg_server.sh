@@ -74,10 +74,17 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
+# pg_undo_central_13: the test's server taken back to central schema 12: the failing tests'
+# index (13) dropped.
+pg_undo_central_13() {
+  psql_value "DROP INDEX IF EXISTS caldaq.fleet_tests_failing; UPDATE caldaq.schema_version SET version = 12" >/dev/null
+}
+
 # pg_undo_central_12: the test's server taken back to central schema 11 as far as its data goes:
-# the results' verdicts and the fleet's triggers of migration 12 dropped (the fleet's result
-# trigger too: migration 12 makes it again; schema 11's text of it is not restored).
+# what 13 added, then the results' verdicts and the fleet's triggers of migration 12 dropped (the
+# fleet's result trigger too: migration 12 makes it again; schema 11's text of it is not restored).
 pg_undo_central_12() {
+  pg_undo_central_13
   psql_value "SET client_min_messages = warning;
 DROP FUNCTION IF EXISTS caldaq.fleet_version_changed, caldaq.fleet_mark_current,
   caldaq.fleet_is_current CASCADE;
@@ -87,7 +94,7 @@ UPDATE caldaq.schema_version SET version = 11" >/dev/null
 }
 
 # pg_undo_central_11: the test's server taken back to central schema 10, the results' versions
-# (migration 11) dropped, and what migration 12 added.
+# (migration 11) dropped, and what migrations 12 and 13 added.
 pg_undo_central_11() {
   pg_undo_central_12
   psql_value "DROP TABLE IF EXISTS caldaq.result_versions; UPDATE caldaq.schema_version SET version = 10" >/dev/null

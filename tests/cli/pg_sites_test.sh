@@ -32,7 +32,7 @@ RUNS_A=$(value "$DB" "SELECT count(*) FROM runs")
 
 # The administrator (the server's owner) migrates the server by sending site A's runs, naming the
 # site; then makes the logins and grants the sites (docs/storage.md, "Sites").
-check owner_sends_a 0 "$RUNS_A runs synced .*central schema 12.*: $RUNS_A new" -- \
+check owner_sends_a 0 "$RUNS_A runs synced .*central schema 13.*: $RUNS_A new" -- \
   "$DAQ" sync --db "$DB" --to "$PG_URL" --site "Plant A" --quiet
 check site_a 0 "^Plant A Plant A $RUNS_A$" -- psql_value \
   "SELECT m.site || ' ' || max(r.site) || ' ' || count(*) FROM caldaq.machines m JOIN caldaq.runs r ON r.machine_id = m.id GROUP BY m.site"
@@ -149,13 +149,13 @@ pg_undo_central_7
 psql_value "UPDATE caldaq.runs SET settings_json = 'not json' WHERE uuid = '$UUIDB'" >/dev/null
 check v6 0 "^6 2 $RUNS_ALL$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM caldaq.approvals) || ' ' || (SELECT count(*) FROM caldaq.runs) FROM caldaq.schema_version"
-check v6_refused_by_readers 2 "central schema version 6 is older than this daq reads \(12\)" -- "$DAQ" runs --db "$ENGA"
+check v6_refused_by_readers 2 "central schema version 6 is older than this daq reads \(13\)" -- "$DAQ" runs --db "$ENGA"
 check engineer_cannot_migrate 2 "create or migrate the central schema: .*(must be owner|permission denied)" -- \
   "$DAQ" sync --db "$DB" --to "$ENGA" --quiet
-check migrate 0 "$RUNS_A runs synced .*central schema 12.*: 0 new; 0 chunks sent" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
+check migrate 0 "$RUNS_A runs synced .*central schema 13.*: 0 new; 0 chunks sent" -- "$DAQ" sync --db "$DB" --to "$PG_URL" --quiet
 check migrated_sites 0 "^Lathe 7 unassigned unassigned\|SIMULATED VMC caldaq built-in simulated shop caldaq built-in simulated shop$" -- psql_value \
   "SELECT string_agg(x, '|' ORDER BY x) FROM (SELECT DISTINCT m.name || ' ' || m.site || ' ' || r.site AS x FROM caldaq.machines m JOIN caldaq.runs r ON r.machine_id = m.id) AS d"
-check migrated_kept 0 "^12 2 $RUNS_ALL 0$" -- psql_value \
+check migrated_kept 0 "^13 2 $RUNS_ALL 0$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM caldaq.approvals) || ' ' || (SELECT count(*) FROM caldaq.runs) || ' ' || (SELECT count(*) FROM caldaq.site_grants) FROM caldaq.schema_version"
 check migrated_engineer_nothing 0 "\(0 runs\)" -- "$DAQ" runs --db "$ENGA"
 psql_value "INSERT INTO caldaq.site_grants VALUES ('eng_a', 'caldaq built-in simulated shop')" >/dev/null

@@ -59,7 +59,7 @@ check local_schema 0 "^11$" -- local_value "PRAGMA user_version"
 check local_uuids 0 "^$RUNS$" -- local_value "SELECT count(DISTINCT uuid) FROM runs WHERE uuid LIKE '________-____-4___-____-____________'"
 CUT=$(psql_value "SELECT count(*) FROM caldaq.reading_chunks")
 check cut_left_committed_pages 0 "^8$" -- echo "$CUT"
-check cut_schema 0 "^12$" -- psql_value "SELECT version FROM caldaq.schema_version"
+check cut_schema 0 "^13$" -- psql_value "SELECT version FROM caldaq.schema_version"
 
 # Resumed: the chunks there are checked, the rest sent; every chunk once, the same bytes.
 check resume 0 "$RUNS runs synced .* $((CHUNKS - CUT)) chunks sent .*, $CUT already there" -- \
@@ -123,6 +123,6 @@ check damaged_crc 2 "the server's reading chunk 0 differs from the local one \(c
 
 # A server of a newer central schema is refused.
 psql_value "UPDATE caldaq.schema_version SET version = 99" >/dev/null
-check newer_schema 2 "central schema version 99 is newer than this daq understands \(12\)" -- "$DAQ" sync --db "$DB" --to "$PG_URL"
+check newer_schema 2 "central schema version 99 is newer than this daq understands \(13\)" -- "$DAQ" sync --db "$DB" --to "$PG_URL"
 
 finish

@@ -165,9 +165,12 @@ void serve_fleet(const ServeOptions& o) {
         "for a serve that acquires (-c FILE or --simulate)");
   const std::string& url = o.run.db;
   pg::ConnectionPool pool(url, kConnections);
-  // The store is read once before serving: an absent server, a database without a caldaq store
-  // or one of another schema version is refused at start with the reason.
-  (void)pg::fleet_json(pool, now_unix_ms());
+  // The store is read before serving, on each of the pool's connections: an absent server, a
+  // database without a caldaq store or one of another schema version is refused at start with
+  // the reason, and the first page's requests find their connections open and their server
+  // processes' caches filled (the page's first load after a start at 1,000 machines: 0.87 s
+  // before, 0.23 - 0.31 s with it, load 9 - 13; docs/benchmarks.md).
+  pg::fleet_warm(pool, now_unix_ms());
   boost::asio::io_context io;
   boost::asio::thread_pool workers(kConnections);
   web::LiveServer server(io, server_options(o), fleet_api(pool, workers));

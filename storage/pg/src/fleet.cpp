@@ -164,14 +164,15 @@ json trend_json(const pqxx::row& r, std::optional<std::int64_t> since) {
 }
 
 // Each site (the machine's, caldaq.machines.site: the one its rows are granted by) with its
-// count of machines and of those whose latest verdict of some test fails.
+// count of machines and of those whose latest verdict of some test fails: a probe per machine
+// of the failing tests' index (central schema 13), not a scan of fleet_tests, whose pages grow
+// with the results synced between two vacuums (each leaves its test's old row dead).
 json sites_summary(pqxx::transaction_base& t) {
   json sites = json::array();
   for (const auto& r :
-       t.exec("SELECT m.site, count(*) AS machines, count(*) FILTER (WHERE f.failing > 0) AS "
-              "failing_machines FROM caldaq.machines AS m LEFT JOIN (SELECT x.machine_id, count(*) "
-              "FILTER (WHERE x.verdict = 'fail') AS failing FROM caldaq.fleet_tests AS x GROUP BY "
-              "x.machine_id) AS f ON f.machine_id = m.id GROUP BY m.site ORDER BY m.site COLLATE "
+       t.exec("SELECT m.site, count(*) AS machines, count(*) FILTER (WHERE EXISTS (SELECT FROM "
+              "caldaq.fleet_tests AS x WHERE x.machine_id = m.id AND x.verdict = 'fail')) AS "
+              "failing_machines FROM caldaq.machines AS m GROUP BY m.site ORDER BY m.site COLLATE "
               "\"C\""))
     sites.push_back(row_object(r));
   return sites;
@@ -213,24 +214,25 @@ json instruments(pqxx::transaction_base& t, std::chrono::sys_days today) {
 }
 
 // Current results without an approval (fleet_results.approved, kept by a trigger on the
-// approvals; the partial index fleet_results_awaiting holds just these).
+// approvals; the partial index fleet_results_awaiting holds just these): their count from the
+// index alone, and the newest fleet_awaiting_listed with their machines (a count over the listed
+// query's rows joined every awaiting result to its machine first).
 json awaiting_approval(pqxx::transaction_base& t) {
-  const auto rows = t.exec_params(
-      "SELECT count(*) OVER () AS total, x.run_id AS run, x.result_id AS result, x.standard, "
-      "x.created_unix_ms, x.started_unix_ms, x.kind, x.test, x.verdict, x.machine_id, "
-      "COALESCE(m.name, '') AS machine, COALESCE(m.site, '') AS site FROM caldaq.fleet_results "
-      "AS x LEFT JOIN caldaq.machines AS m ON m.id = x.machine_id "
-      "WHERE x.current AND NOT x.approved "
-      "ORDER BY x.started_unix_ms DESC, x.run_id DESC, x.result_id LIMIT $1",
-      fleet_awaiting_listed);
+  const auto count = t.exec1(
+                          "SELECT count(*) FROM caldaq.fleet_results AS x WHERE x.current "
+                          "AND NOT x.approved")[0]
+                         .as<std::int64_t>();
   json list = json::array();
-  for (const auto& r : rows) {
+  for (const auto& r : t.exec_params(
+           "SELECT x.run_id AS run, x.result_id AS result, x.standard, x.created_unix_ms, "
+           "x.started_unix_ms, x.kind, x.test, x.verdict, x.machine_id, COALESCE(m.name, '') AS "
+           "machine, COALESCE(m.site, '') AS site FROM (SELECT * FROM caldaq.fleet_results AS y "
+           "WHERE y.current AND NOT y.approved ORDER BY y.started_unix_ms DESC, y.run_id DESC, "
+           "y.result_id LIMIT $1) AS x LEFT JOIN caldaq.machines AS m ON m.id = x.machine_id "
+           "ORDER BY x.started_unix_ms DESC, x.run_id DESC, x.result_id",
+           fleet_awaiting_listed))
     list.push_back(row_object(r));
-    list.back().erase("total");
-  }
-  return {{"count", rows.empty() ? 0 : rows[0]["total"].as<std::int64_t>()},
-          {"listed", list.size()},
-          {"results", std::move(list)}};
+  return {{"count", count}, {"listed", list.size()}, {"results", std::move(list)}};
 }
 
 // The machines of a page, each with its tests' latest verdicts and how many of its trend values
@@ -304,31 +306,41 @@ Projection project(const TrendFit& fit) {
   return {TrendStatus::leaving, at};
 }
 
+namespace {
+
+// The fleet's first view (fleet_json) in the caller's transaction.
+std::string first_view(pqxx::transaction_base& t, const ConnectionPool& pool,
+                       std::int64_t now_unix_ms) {
+  const auto today = day_of(static_cast<double>(now_unix_ms));
+  json sites = sites_summary(t);
+  std::int64_t machines = 0;
+  for (const auto& s : sites) machines += s["machines"].get<std::int64_t>();
+  json doc{{"schema", "caldaq.fleet.v2"},
+           {"store", pool.shown_url()},
+           {"generated_unix_ms", now_unix_ms},
+           {"today", iso_day(today)},
+           {"trend",
+            {{"method",
+              "least squares line of each value on its run's start time, over its current "
+              "results since the last change that resets it (a compensation table stored for "
+              "an axis the test measures, the control's compensation switched on or off, or a "
+              "date chosen when the machine is opened); projected where the line reaches the "
+              "limit of the latest run"},
+             {"min_runs", fleet_min_runs_for_trend}}},
+           {"due_soon_days", fleet_due_soon_days},
+           {"machines_per_page", fleet_machines_per_page},
+           {"machines", machines},
+           {"sites", std::move(sites)},
+           {"instruments", instruments(t, today)},
+           {"awaiting_approval", awaiting_approval(t)}};
+  return doc.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+}  // namespace
+
 std::string fleet_json(ConnectionPool& pool, std::int64_t now_unix_ms) {
   return with_connection(pool, "read the fleet", [&](pqxx::transaction_base& t) {
-    const auto today = day_of(static_cast<double>(now_unix_ms));
-    json sites = sites_summary(t);
-    std::int64_t machines = 0;
-    for (const auto& s : sites) machines += s["machines"].get<std::int64_t>();
-    json doc{{"schema", "caldaq.fleet.v2"},
-             {"store", pool.shown_url()},
-             {"generated_unix_ms", now_unix_ms},
-             {"today", iso_day(today)},
-             {"trend",
-              {{"method",
-                "least squares line of each value on its run's start time, over its current "
-                "results since the last change that resets it (a compensation table stored for "
-                "an axis the test measures, the control's compensation switched on or off, or a "
-                "date chosen when the machine is opened); projected where the line reaches the "
-                "limit of the latest run"},
-               {"min_runs", fleet_min_runs_for_trend}}},
-             {"due_soon_days", fleet_due_soon_days},
-             {"machines_per_page", fleet_machines_per_page},
-             {"machines", machines},
-             {"sites", std::move(sites)},
-             {"instruments", instruments(t, today)},
-             {"awaiting_approval", awaiting_approval(t)}};
-    return doc.dump(-1, ' ', false, json::error_handler_t::replace);
+    return first_view(t, pool, now_unix_ms);
   });
 }
 
@@ -370,16 +382,33 @@ std::optional<std::string> fleet_site_json(ConnectionPool& pool, std::string_vie
                          });
 }
 
+namespace {
+
+// Page 1 of the first of the sites in fleet_json's order (byte order), of those this login sees.
+std::optional<std::string> first_site_page(pqxx::transaction_base& t) {
+  const auto first = t.exec("SELECT min(site COLLATE \"C\") FROM caldaq.machines");
+  if (first.empty() || first[0][0].is_null()) return std::nullopt;
+  return site_page(t, first[0][0].as<std::string>(), 1);
+}
+
+}  // namespace
+
 std::optional<std::string> fleet_first_site_json(ConnectionPool& pool) {
-  return with_connection(pool, "read the machines of the first site",
-                         [&](pqxx::transaction_base& t) -> std::optional<std::string> {
-                           // The first of the sites in fleet_json's order (byte order), of those
-                           // this login sees.
-                           const auto first =
-                               t.exec("SELECT min(site COLLATE \"C\") FROM caldaq.machines");
-                           if (first.empty() || first[0][0].is_null()) return std::nullopt;
-                           return site_page(t, first[0][0].as<std::string>(), 1);
-                         });
+  return with_connection(pool, "read the machines of the first site", first_site_page);
+}
+
+void fleet_warm(ConnectionPool& pool, std::int64_t now_unix_ms) {
+  guarded(pool.shown_url(), "open the pool's connections and read the first view", [&] {
+    // All leased at once, so that each lease is another connection.
+    std::vector<std::unique_ptr<Lease>> leases;
+    for (std::size_t i = 0; i < pool.max_connections(); ++i)
+      leases.push_back(std::make_unique<Lease>(pool.impl()));
+    for (auto& lease : leases) {
+      pqxx::read_transaction t(lease->connection());
+      (void)first_view(t, pool, now_unix_ms);
+      (void)first_site_page(t);
+    }
+  });
 }
 
 std::optional<std::string> fleet_machine_json(ConnectionPool& pool, std::int64_t machine_id,

@@ -71,6 +71,12 @@ std::optional<std::string> fleet_site_json(ConnectionPool& pool, std::string_vie
 // Page 1 of the first site's machines (the first in fleet_json's order): what the page shows first,
 // asked for beside fleet_json (not after it, to learn the site's name); nullopt: no machine.
 std::optional<std::string> fleet_first_site_json(ConnectionPool& pool);
+// Every connection of the pool opened (each checks the schema once, as a lease does) and the
+// first view and the first site's page read on each: the queries' catalog entries, plans and
+// pages are then in each server process and its cache before the first page asks (docs/web.md).
+// Throws StoreError as fleet_json does.
+void fleet_warm(ConnectionPool& pool, std::int64_t now_unix_ms);
+
 // One machine's trends and their series with every point (caldaq.fleet-machine.v2), each line
 // fitted from the later of its window's start and `since_unix_ms` when given; nullopt when the
 // server has no machine of that id.

@@ -41,7 +41,9 @@ namespace cal::storage::pg {
 // 12: the fleet's current results those of the run's current version; daq's verdict stored with
 // each result (results.verdict, verdict_failed: the fleet reads it, the server judges nothing); an
 // approval records the approved result's own version.
-inline constexpr int central_schema_version = 12;
+// 13: the failing tests' index (fleet_tests_failing): the fleet's first view reads rows that
+// grow with the machines, not with the results synced.
+inline constexpr int central_schema_version = 13;
 
 // Whether `text` names a PostgreSQL server (a postgresql:// or postgres:// URI) rather than a
 // SQLite file.
