@@ -398,7 +398,7 @@ try:
            f"the number and its unit fit the panel: {[(k, x['big'], x['fits']) for k, x in first.items()]}")
         moving = first.get("moving")
         ok(moving and moving["display"]["mode"] == "position"
-           and moving["label"] == "Position: the laser's reading compensated (air, material)",
+           and moving["label"] == "Position (laser, compensated)",
            f"while moving the number is a position, said to be the compensated one: {moving and moving['big']} mm "
            f"({moving and moving['label']!r})")
         rows = b.js("return document.querySelectorAll('#stops tbody tr').length;")
