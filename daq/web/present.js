@@ -16,12 +16,20 @@ const present = ((signs) => {
   // service's sentences print with a sign, "{:+.3f}").
   const noNegativeZero = (t) => t.replace(/(^|[^0-9A-Za-z_.])-(0(?:\.0+)?)(?![0-9.])/g, "$1$2");
   const text = (t) => noNegativeZero(inText ? String(t ?? "").replace(inText, (_, before, u) => before + sign.get(u)) : String(t ?? ""));
-  // A number to d decimals, "—" when there is none; a value that rounds to zero has no sign
-  // ("0.00", never "-0.00": a captured stop at 0 is not below zero).
+  // A number to d decimals as the terminal and the reports write it (cal::fixed_text,
+  // analysis/src/fixed_text.cpp, step for step): rounded half away from zero at the last place
+  // by Math.round of v x 10^d, not by the binary value's digits as toFixed alone does (0.0045 to
+  // 3 places is "0.005", toFixed's "0.004"); from 2^52 on the product is whole and v is written
+  // as it is. "—" when there is none; a value that rounds to zero has no sign ("0.00", never
+  // "-0.00": a captured stop at 0 is not below zero).
   const fixed = (v, d) => {
     if (v === null || v === undefined || !Number.isFinite(Number(v))) return "—";
-    const s = Number(v).toFixed(d);
-    return /^-0(\.0*)?$/.test(s) ? s.slice(1) : s;
+    const x = Number(v), scale = 10 ** d, scaled = x * scale;
+    // Math.round takes a tie up (-2.5 to -2): rounded by size, the sign put back (-3).
+    let r = Math.abs(scaled) < 2 ** 52 ? Math.sign(scaled) * Math.round(Math.abs(scaled)) / scale : x;
+    if (r === 0) r = 0;  // -0 and whatever rounds to zero
+    // toFixed writes 1e21 and over as "1e+21": such a value is whole, its digits from BigInt.
+    return Math.abs(r) < 1e21 ? r.toFixed(d) : BigInt(r).toString() + (d > 0 ? "." + "0".repeat(d) : "");
   };
   // With its sign: "+1.2", "-0.4", "+0.0".
   const signed = (v, d) => {

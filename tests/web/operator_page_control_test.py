@@ -95,7 +95,7 @@ try:
     align = b.js("const g = id => document.getElementById(id); return {label: g('align-label').textContent, "
                  "signal: g('align-signal').textContent, note: g('align-note').textContent, "
                  "size: parseFloat(getComputedStyle(g('align-big')).fontSize), unit: g('align-unit').textContent};")
-    ok(align["label"] == "laser (ids3010), axis 1: raw reading, not compensated" and align["unit"] == "mm", f"which laser and axis: {align['label']!r}")
+    ok(align["label"] == "laser (IDS3010), axis 1: raw reading, not compensated" and align["unit"] == "mm", f"which laser and axis: {align['label']!r}")
     ok(align["signal"] == "Beam: streaming · valid readings 100 %", f"its beam: {align['signal']!r}")
     ok("reports no signal strength" in align["note"], f"and that it gives no signal strength: {align['note']!r}")
     ok(align["size"] >= 100, f"in digits readable from 2 m: {align['size']:.0f} px")

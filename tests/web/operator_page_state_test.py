@@ -3,7 +3,8 @@
 driven in headless Chromium against `daq serve --simulate` at 1366 x 768 (and 560 px):
 
 1. at CAPTURED the big number is the captured stop's value with its target, and the line
-   below names the next target;
+   below names the next target; while the axis moves the big position is the laser's raw
+   reading on its card (of the same moment), compensated;
 2. a hung service (SIGSTOP: the connection stays open, nothing arrives): within 3 s every live
    value is dashes and a blocking banner gives the time of the last data; values return after
    SIGCONT;
@@ -132,6 +133,24 @@ try:
     t1 = time.time()
     print(f"measured: {(c1 - c0) / (t1 - t0):.1f} page updates/s during a linear run, "
           f"{(bytes1 - bytes0) / max(1, c1 - c0):.0f} bytes per update", flush=True)
+
+    # --- 1b. the big position and the laser's raw reading on its card: of the same moment ------
+    # While the axis moves (the number a position, not a deviation), recorded in the page every
+    # 10 ms: the position is the card's raw reading compensated, raw x (1 + the compensation in
+    # ppm), the datum 0 (the laser zeroed at X = 0). The run's state was up to 100 ms older than
+    # the card's reading: at 6000 mm/min and 2x, "Position 21.175" beside "raw 31.1810 mm".
+    b.js("""window.__pairs = []; window.__pairTimer = setInterval(() => {
+        const g = id => document.getElementById(id), card = document.querySelector('#devices li[data-device="laser"] .dev-values');
+        const raw = card && /raw (-?[0-9.]+) mm/.exec(card.textContent), f = /^(-?[0-9.]+) ppm$/.exec(g('env-factor').textContent);
+        if (g('reading-label').textContent.startsWith('Position') && raw && f)
+          window.__pairs.push([Number(g('reading').textContent), Number(raw[1]), Number(f[1])]); }, 10);""")
+    b.wait("return new Set(window.__pairs.map(p => p[0])).size >= 4;", timeout_s=20,
+           what="the axis moving between targets", explain="return JSON.stringify(window.__pairs.slice(-5));")
+    pairs = b.js("clearInterval(window.__pairTimer); return window.__pairs;")
+    off = max(abs(pos - raw * (1 + ppm * 1e-6)) for pos, raw, ppm in pairs)
+    moving = sorted({pos for pos, _, _ in pairs})
+    ok(off <= 0.0015, f"while moving the position shown is the laser's raw reading shown beside it, compensated: "
+                      f"at most {off * 1e3:.2f} µm apart over {len(pairs)} samples at {moving} mm")
 
     # --- 2. a hung service: the connection stays, nothing arrives ------------------------------
     serve.send_signal(signal.SIGSTOP)

@@ -138,11 +138,21 @@ try:
         ok(abs(float(env["n"]) - 1.000269) < 5e-6, f"idle: n {env['n']}")
         ok(abs(float(env["material"].split()[0]) - 21.5) < 0.1, f"idle: material {env['material']}")
         src = b.js("return document.getElementById('env-source').textContent;")
-        ok(src.endswith(" air (ptu300)"), f"idle: the air values' source is named: {src!r}")
+        ok(src == "Air values from air (PTU300)", f"idle: the air values' source is named: {src!r}")
         states = b.js("return [...document.querySelectorAll('#devices li')].map(l => l.dataset.state);")
         # The shop's indicator and level (the component tests' probes) stream too.
         ok(states.count("streaming") == 5 and "open" in states,
            f"idle: laser, air, material, indicator, level streaming, the ballbar's port open: {states}")
+        # Each instrument's line says what it is: its role in words, the product and serial
+        # number where the driver names them (the shop's configuration), then its connection;
+        # not the driver's key ("gauge · serial ..." said nothing of a ballbar or an indicator).
+        details = b.js("return Object.fromEntries([...document.querySelectorAll('#devices li')]"
+                       ".map(l => [l.dataset.device, l.querySelector('.dev-detail').textContent]));")
+        said = {"laser": "laser · IDS3010 SIM-IDS-0001 · tcp 127.0.0.1:", "air": "air station · PTU300 SIM-PTU-0001 · serial ",
+                "material": "thermometer · SIM-TH-0001 · serial ", "ballbar": "ballbar · SIM-BB-0001 · serial ",
+                "indicator": "indicator · serial ", "level": "electronic level · serial "}
+        ok(sorted(details) == sorted(said) and all(details[k].startswith(v) for k, v in said.items()),
+           f"idle: each instrument by its role and device: {details}")
         ok(b.js("return document.getElementById('reading').textContent;") == "—",
            "idle: no run, no number")
         no_raw_keys(b, "idle")
@@ -387,8 +397,10 @@ try:
         ok(all(x["fits"] for x in first.values()),
            f"the number and its unit fit the panel: {[(k, x['big'], x['fits']) for k, x in first.items()]}")
         moving = first.get("moving")
-        ok(moving and moving["display"]["mode"] == "position" and moving["label"] == "Position",
-           f"while moving the number is a position: {moving and moving['big']} mm")
+        ok(moving and moving["display"]["mode"] == "position"
+           and moving["label"] == "Position (laser, compensated)",
+           f"while moving the number is a position, said to be the compensated one: {moving and moving['big']} mm "
+           f"({moving and moving['label']!r})")
         rows = b.js("return document.querySelectorAll('#stops tbody tr').length;")
         ok(rows == 12, f"the table of captured stops has all 12 stops: {rows}")
         last_run = b.js("return window.caldaq.page.status.last;")

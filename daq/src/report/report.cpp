@@ -36,6 +36,7 @@
 #include "plot.hpp"
 #include "provenance.hpp"
 #include "result_rows.hpp"
+#include "roles.hpp"
 #include "run_quality.hpp"
 #include "stored_profile.hpp"
 #include "verdict.hpp"
@@ -156,21 +157,6 @@ std::string instrument_label(const RunView& v, int device) {
   return name;
 }
 
-// A driver's product as an engineer names it ("IDS3010", not the driver's key "ids3010"); ""
-// for a generic driver (a line gauge reads whatever it is wired to: its configured name says
-// what it is).
-std::string product_name(std::string_view driver) {
-  static constexpr std::pair<std::string_view, std::string_view> products[] = {
-      {"ids3010", "IDS3010"},
-      {"ptu300", "PTU300"},
-      {"temper", "TEMPer"},
-      {"shdr", "MTConnect SHDR"},
-      {"halsampler", "LinuxCNC halsampler"}};
-  for (const auto& [key, name] : products)
-    if (driver == key) return std::string(name);
-  return driver == "gauge" ? "" : std::string(driver);
-}
-
 // A plot's legend entry for a series of `device`: the instrument by its role, its product and
 // serial number, and for an environment quantity the sensor ("air sensor PTU300 (serial
 // SIM-PTU-0001)"; the laser's own air sensor "air sensor of laser IDS3010 (serial ...)", which
@@ -194,7 +180,7 @@ std::string legend_label(const RunView& v, int device, int channel, std::string_
   const std::string id = ctx(inst, "id").empty() ? stored : ctx(inst, "id");
   const std::string role = ctx(inst, "role").empty() ? id : ctx(inst, "role");
   const std::string product =
-      product_name(ctx(inst, "driver").empty() ? stored : ctx(inst, "driver"));
+      ::daq::product_name(ctx(inst, "driver").empty() ? stored : ctx(inst, "driver"));
   // The instrument's own name where the role does not say it ("spindle" on a material gauge).
   const std::string named = id != role && id != ctx(inst, "driver") ? " " + id : "";
   std::string label;

@@ -1021,6 +1021,9 @@ std::string_view to_string(Control c) {
   static_assert(cal::names_every_value(kNames));
   return cal::name_of(kNames, c);
 }
+void LinearRun::publish_live() {
+  if (!impl_->done) impl_->publish();
+}
 bool LinearRun::finished() const { return impl_->done; }
 const LinearRunOutcome& LinearRun::outcome() const { return impl_->outcome; }
 const cal::iso230_2::Plan& LinearRun::plan() const { return impl_->plan; }

@@ -174,6 +174,10 @@ class LinearRun {
   void manual_capture();                 // the operator's "capture now" (from the keyboard)
   // `source` says where it came from ("web page", "keyboard (daq run)"), stored with it.
   ControlOutcome control(Control c, std::string_view source);
+  // Gives the run's live state to `on_live` now (it does so every 100 ms by itself): a page that
+  // shows it beside the instruments' newest readings takes both at the same moment (the laser's
+  // raw reading and the run's position from it, not one from up to 100 ms before).
+  void publish_live();
   bool finished() const;
   const LinearRunOutcome& outcome() const;
   const cal::iso230_2::Plan& plan() const;

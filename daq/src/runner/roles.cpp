@@ -1,6 +1,8 @@
 // Device numbers by role (see roles.hpp).
 #include "roles.hpp"
 
+#include <utility>
+
 #include "cal/drivers/instrument.hpp"
 
 namespace daq {
@@ -39,6 +41,18 @@ void StartupReadings::add(const cal::drivers::Reading& r) {
     material_ = true;
   else if (devices_.is(Role::probe, r.device))
     probe_ = true;
+}
+
+std::string product_name(std::string_view driver) {
+  static constexpr std::pair<std::string_view, std::string_view> products[] = {
+      {"ids3010", "IDS3010"},
+      {"ptu300", "PTU300"},
+      {"temper", "TEMPer"},
+      {"shdr", "MTConnect SHDR"},
+      {"halsampler", "LinuxCNC halsampler"}};
+  for (const auto& [key, product] : products)
+    if (driver == key) return std::string(product);
+  return driver == "gauge" ? "" : std::string(driver);
 }
 
 }  // namespace daq

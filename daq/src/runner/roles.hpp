@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace cal::drivers {
@@ -38,6 +39,11 @@ inline constexpr RoleEntry kRoles[] = {
 
 // The role's name in kRoles ("laser", "material", ...).
 std::string_view name(Role role);
+
+// A driver's product as an engineer names it ("IDS3010", not the driver's key "ids3010"); ""
+// for a generic driver (a line gauge reads whatever it is wired to: its configured name and
+// role say what it is). The reports' legends and the operator page's instrument cards.
+std::string product_name(std::string_view driver);
 
 // The device numbers of one run's instruments, given how many a role with many has.
 class RunDevices {

@@ -10,6 +10,7 @@
 #include "cal/analysis/air.hpp"
 #include "cal/analysis/compensation.hpp"
 #include "kinds/kind.hpp"
+#include "roles.hpp"
 
 namespace daq::serve {
 
@@ -89,6 +90,9 @@ void DeviceBoard::on_reading(const std::string& id, const cal::drivers::Reading&
   }
   if (r.status != cal::drivers::ReadingStatus::ok || !std::isfinite(r.value)) {
     ++d.bad[0];
+    // Its last valid value is no longer the current one (an indicator out of range, a beam
+    // interrupted while the device stays streaming): none is shown until a valid one comes.
+    d.values.erase({static_cast<int>(r.quantity), r.channel});
     return;
   }
   ++d.ok[0];
@@ -144,6 +148,8 @@ json DeviceBoard::device_json(const Device& d) const {
   json j{{"id", c.id},
          {"role", c.role},
          {"driver", c.driver},
+         {"product", product_name(c.driver)},
+         {"serial_number", c.serial_number},
          {"transport", c.transport},
          {"state", state},
          {"reason", d.reason},

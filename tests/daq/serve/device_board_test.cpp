@@ -91,6 +91,28 @@ TEST(DeviceBoard, StreamingDeviceShowsItsValuesUntilItFallsSilent) {
   EXPECT_TRUE(d["valid_pct"].is_null());
 }
 
+// A device that stays streaming while a reading is flagged (an indicator out of its range):
+// its last valid value is not the current one any more, and is not shown as if it were; the next
+// valid reading is. The card names the instrument's product and serial number, not only its
+// driver's key.
+TEST(DeviceBoard, AFlaggedReadingHidesTheLastValidValue) {
+  Board b;
+  b.stream("bar", 100ms);
+  b.read("bar", Quantity::length_m, 0.002);
+  EXPECT_DOUBLE_EQ(b.device("bar")["values"]["length_m"].get<double>(), 0.002);
+  b.t += 100ms;
+  b.read("bar", Quantity::length_m, 0.5, ReadingStatus::out_of_range);
+  auto d = b.device("bar");
+  EXPECT_EQ(d["state"], "streaming");
+  EXPECT_TRUE(d["values"].empty()) << "the value 0.002 m, 100 ms old, shown as current";
+  EXPECT_DOUBLE_EQ(d["valid_pct"].get<double>(), 50.0);
+  b.t += 100ms;
+  b.read("bar", Quantity::length_m, 0.003);
+  EXPECT_DOUBLE_EQ(b.device("bar")["values"]["length_m"].get<double>(), 0.003);
+  EXPECT_EQ(b.device("laser")["product"], "IDS3010");
+  EXPECT_EQ(b.device("bar")["product"], "") << "a gauge reads whatever it is wired to";
+}
+
 TEST(DeviceBoard, ReconnectingCountsTheAttemptsOfItsLimit) {
   Board b;
   b.board.expect("air", 1000ms, 20);
