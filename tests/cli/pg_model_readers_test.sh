@@ -16,10 +16,6 @@ source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
 pg_with_demo # DB: laptop A (the demo's runs); the server, empty
 
-value() {
-  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
-}
-as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
 MACHINE=$(value "$DB" "SELECT name FROM machines ORDER BY id")
 TRUTH=$DATA/trunnion_truth.json
 NOM=$DATA/trunnion_nominal.json
@@ -154,6 +150,8 @@ check sim_models_from_db 0 "E_YX" -- "$DAQ" sim --measure E_YX --topology YFXZ -
   --compensate "$UV" -o "$TMP/visit.toml" --db "$TMP/visit.sqlite"
 check run_to_central_refused 2 "--db postgresql:.*: this command writes the local store" -- \
   "$DAQ" "${BB5X[@]/@[TN]@/$UT}" --db "$PG_URL"
+check demo_to_central_refused 2 "--db postgresql:.*: this command writes the local store" -- \
+  bash -c "cd '$TMP' && '$DAQ' demo --quiet --db '$PG_URL'"
 
 # A UUID not in the store: named in the error, for each kind of option.
 for where in "$DB" "$PG_URL"; do

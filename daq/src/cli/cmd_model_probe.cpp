@@ -457,17 +457,11 @@ struct SimOptions : ProbeSimOptions {
 };
 
 void run_probe_sim(const SimOptions& given) {
-  const auto models = read_truth_control(given);
-  SimOptions o = given;  // the files, or the stored models' labels: what the output names
-  o.truth = models.truth.label;
-  if (models.control) o.control = models.control->label;
-  const mdl::Model& m = models.truth.model;
-  const kin::RotaryLetter letter = kin::rotary_letter_from_string(o.axis);
-  const auto machine = mdl::five_axis(m);
+  SimOptions o = given;
   // The control that reports the centres: its kinematics (a head axis's centres are where it
-  // puts the turned tip); by default the truth's nominal kinematics.
-  const auto control =
-      models.control ? mdl::five_axis(models.control->model) : kin::nominal_kinematics(machine);
+  // puts the turned tip).
+  const auto [m, machine, control] = read_probe_sim_models(o);
+  const kin::RotaryLetter letter = kin::rotary_letter_from_string(o.axis);
   std::size_t index = machine.rotary.size();
   for (std::size_t i = 0; i < machine.rotary.size(); ++i)
     if (machine.rotary[i].letter == letter) index = i;
@@ -537,6 +531,16 @@ void add_probe_fit_options(CLI::App& cmd, ProbeFitOptions& o, const ProbeFitHelp
                  "source) to this file");
   cmd.add_flag("--keep-linear-errors", o.keep_linear, help.keep_linear);
   cmd.add_flag("--json", o.json, help.json);
+}
+
+ProbeSimModels read_probe_sim_models(ProbeSimOptions& o) {
+  auto models = read_truth_control(o);
+  o.truth = models.truth.label;
+  if (models.control) o.control = models.control->label;
+  auto machine = mdl::five_axis(models.truth.model);
+  auto control =
+      models.control ? mdl::five_axis(models.control->model) : kin::nominal_kinematics(machine);
+  return {std::move(models.truth.model), std::move(machine), std::move(control)};
 }
 
 void add_probe_sim_options(CLI::App& cmd, ProbeSimOptions& o, const std::string& control_help) {

@@ -198,14 +198,8 @@ struct PosesSimOptions : ProbeSimOptions {
 };
 
 void run_poses_sim(const PosesSimOptions& given) {
-  const auto models = read_truth_control(given);
-  PosesSimOptions o = given;  // the files, or the stored models' labels: what the output names
-  o.truth = models.truth.label;
-  if (models.control) o.control = models.control->label;
-  const mdl::Model& m = models.truth.model;
-  const auto machine = mdl::five_axis(m);
-  const auto control =
-      models.control ? mdl::five_axis(models.control->model) : kin::nominal_kinematics(machine);
+  PosesSimOptions o = given;
+  const auto [m, machine, control] = read_probe_sim_models(o);
   const Poses in = read_poses(o.poses, m, false);
   const kin::Vec3 sphere{o.sphere_mm.at(0), o.sphere_mm.at(1), o.sphere_mm.at(2)};
   std::mt19937 rng(o.seed);

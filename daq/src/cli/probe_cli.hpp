@@ -40,5 +40,13 @@ struct ProbeSimOptions : TruthControlOptions {
   unsigned seed = 1;
 };
 void add_probe_sim_options(CLI::App& cmd, ProbeSimOptions& o, const std::string& control_help);
+// What a simulated probe reads (probe-sim, probe-poses-sim): the truth's model and machine, and
+// the control's kinematics that report the centres (--control's, by default the truth's nominal
+// kinematics). `o.truth` and `o.control` become the models' labels: what the output names.
+struct ProbeSimModels {
+  mdl::Model truth;
+  kin::FiveAxisMachine machine, control;
+};
+ProbeSimModels read_probe_sim_models(ProbeSimOptions& o);
 
 }  // namespace daq
