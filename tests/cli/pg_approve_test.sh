@@ -16,11 +16,6 @@ source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
 pg_with_visit  # the demo's runs, run 1 re-compensated, sent by the server's owner (migrating it)
 
-value() {
-  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
-}
-# as ROLE: the test's server for that login (trust authentication: the login is the role).
-as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
 check schema 0 "^13 2$" -- psql_value \
   "SELECT version || ' ' || (SELECT count(*) FROM pg_roles WHERE rolname IN ('caldaq_engineer', 'caldaq_reviewer')) FROM caldaq.schema_version"
 check local_schema 0 "^11$" -- value "$DB" "PRAGMA user_version"

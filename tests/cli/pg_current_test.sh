@@ -21,10 +21,7 @@ source "$(dirname "$0")/pg_server.sh"
 pg_with_demo  # DB: run 1 linear (X), run 2 circle (XY)
 SERVE_PID=
 trap '[ -n "$SERVE_PID" ] && kill $SERVE_PID 2>/dev/null; pg_stop; rm -rf "$TMP" "$PGTMP"' EXIT
-MACHINE=$("$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute('SELECT name FROM machines').fetchone()[0])" "$DB")
-value() {
-  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
-}
+MACHINE=$(value "$DB" "SELECT name FROM machines")  # value: pg_server.sh's
 # set_context DB RUN PYTHON: the run's settings' context edited (ctx) by a Python statement.
 set_context() {
   "$PY" - "$1" "$2" "$3" <<'PY'

@@ -17,11 +17,6 @@ source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
 pg_with_demo  # DB: laptop A (the demo's runs); the server, empty
 
-value() {
-  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
-}
-as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
-sql() { "$PG_BIN/psql" -X -At -v ON_ERROR_STOP=1 "$(as "$1")" -c "$2"; }
 MACHINE=$(value "$DB" "SELECT name FROM machines ORDER BY id")
 LAPTOP_B=$TMP/b.sqlite
 

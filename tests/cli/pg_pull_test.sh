@@ -15,10 +15,6 @@ source "$(dirname "$0")/pg_server.sh"
 pg_with_visit
 MACHINE=$("$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute('SELECT name FROM machines ORDER BY id').fetchone()[0])" "$DB")
 
-# value DB SQL: one value from a local store.
-value() {
-  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
-}
 # rows DB: what a store holds, by UUID (not by local id): runs, results, chunks with the md5 of
 # their bytes, stops, compensation tables, calibrations; the same text for the same history.
 rows() {

@@ -74,6 +74,14 @@ psql_value() {
   "$PG_BIN/psql" -X -At "$PG_URL" -c "$1"
 }
 
+# value FILE SQL: one value from a SQLite store (a laptop's). as LOGIN: the test server's URI for
+# that login (a role the test made). sql LOGIN SQL: SQL run as that login, unaligned.
+value() {
+  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
+}
+as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
+sql() { "$PG_BIN/psql" -X -At -v ON_ERROR_STOP=1 "$(as "$1")" -c "$2"; }
+
 # pg_undo_central_13: the test's server taken back to central schema 12: the failing tests'
 # index (13) dropped.
 pg_undo_central_13() {

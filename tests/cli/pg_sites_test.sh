@@ -17,12 +17,6 @@ source "$(dirname "$0")/check.sh"
 source "$(dirname "$0")/pg_server.sh"
 pg_with_demo  # DB: the demo's runs (site A's laptop); the server, empty
 
-value() {
-  "$PY" -c "import sqlite3, sys; print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchone()[0])" "$1" "$2"
-}
-as() { echo "postgresql:///caldaq?host=$PGTMP&user=$1"; }
-# sql LOGIN SQL: a statement as that login (psql's status and messages, for check).
-sql() { "$PG_BIN/psql" -X -At -v ON_ERROR_STOP=1 "$(as "$1")" -c "$2"; }
 
 # Site B's laptop: a machine of its own (a replay of the demo's capture, the machine renamed).
 SITEB=$TMP/siteb.sqlite

@@ -28,6 +28,7 @@
 #include "circle_run.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
+#include "database.hpp"
 #include "iso230_2_output.hpp"
 #include "linear_run.hpp"
 #include "provenance.hpp"
@@ -229,10 +230,9 @@ int run_circle_demo(boost::asio::io_context& io, SimulatedShop& shop, cal::daq::
   capture.recorder->close();
   const auto& out = run.outcome();
   if (const auto& failure = capture.recorder->failure())
-    throw cal::InputError(fmt::format("the circle (run {}) {}: its capture {} failed: {}",
-                                      out.run_id,
-                                      out.complete ? "is complete and stored" : "was aborted",
-                                      capture_file, *failure));
+    throw cal::InputError(fmt::format(
+        "the circle (run {}) {}: its capture {} failed: {}", out.run_id,
+        out.complete ? "is complete and stored" : "was aborted", capture_file, *failure));
   if (!out.complete) {
     fmt::print(stderr, "daq demo: the circle did not complete: {}\n", out.reason);
     return 1;
@@ -295,8 +295,10 @@ int run_demo(const DemoOptions& o) {
                                      capture_header(config, specs, "daq 0.1.0 demo (simulated)"));
   cal::replay::CaptureRecorder recorder(capture);
   // The database and the capture open before the banner: a bad --db or --capture is the only
-  // thing printed (the banner after the error read as if the demo had started).
-  cal::storage::Store{o.db};
+  // thing printed (the banner after the error read as if the demo had started). database_path:
+  // a postgresql:// URI is refused saying why (the demo writes the local store), not as a file
+  // SQLite cannot open.
+  cal::storage::Store{database_path(o.db)};
   fmt::print("daq demo: ISO 230-2 test of the X axis of a SIMULATED machine (0 .. 500 mm)\n");
   fmt::print("  laser: simulated IDS3010 on tcp 127.0.0.1:{}\n", shop.laser_port());
   fmt::print("  air: simulated PTU300 on {} (4800 7E1)\n", shop.air_device());

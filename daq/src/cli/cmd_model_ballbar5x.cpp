@@ -90,11 +90,12 @@ void add_test_options(CLI::App* cmd, TestOptions& t) {
 }
 
 // The simulated machine and its control (ballbar5x-sim, ballbar5x-run).
-void add_machine_options(CLI::App& cmd, std::string& truth, std::string& control) {
-  cmd.add_option("truth", truth, "Model file of the simulated machine (its truth)")->required();
-  cmd.add_option("--control", control,
-                 "Model file the control's kinematics holds (the program is computed with it)")
-      ->required();
+void add_machine_options(CLI::App& cmd, TruthControlOptions& o, bool writes_runs) {
+  add_truth_control_options(cmd, o,
+                            {.control = "Model the control's kinematics holds (the program is "
+                                        "computed with it): a file or a stored model",
+                             .control_required = true,
+                             .writes_runs = writes_runs});
 }
 
 void check_test_name(const std::string& name) {
@@ -110,16 +111,20 @@ void check_test_name(const std::string& name) {
 
 // --- ballbar5x-sim ----------------------------------------------------------------------------
 
-struct SimOptions {
-  std::string truth, control, output;
+struct SimOptions : TruthControlOptions {
+  std::string output;
   TestOptions t;
   double noise_um = 0.0, offset_um = 0.0;
   unsigned seed = 1;
 };
 
-void run_sim(const SimOptions& o) {
-  const auto truth = mdl::five_axis(mdl::read(o.truth));
-  const auto control = mdl::five_axis(mdl::read(o.control));
+void run_sim(const SimOptions& given) {
+  const auto models = read_truth_control(given);
+  SimOptions o = given;  // the files, or the stored models' labels: what the output names
+  o.truth = models.truth.label;
+  o.control = models.control->label;
+  const auto truth = mdl::five_axis(models.truth.model);
+  const auto control = mdl::five_axis(models.control->model);
   const kin::RotaryBallbarTest t = o.t.test();
   check_test_name(t.name);
   auto readings = kin::rotary_ballbar_readings_um(truth, control, t);
@@ -144,13 +149,13 @@ void run_sim(const SimOptions& o) {
 // --- ballbar5x-program ------------------------------------------------------------------------
 
 struct ProgramOptions {
-  std::string model, output, dialect = "fanuc", program_name = "BB5X";
+  std::string model, db, output, dialect = "fanuc", program_name = "BB5X";
   TestOptions t;
   double feed = 500.0, dwell_s = 2.0, max_step_deg = 1.0;
 };
 
 void run_program(const ProgramOptions& o) {
-  const auto control = mdl::five_axis(mdl::read(o.model));
+  const auto control = mdl::five_axis(read_model_input(o.model, o.db).model);
   const kin::RotaryBallbarTest t = o.t.test();
   check_test_name(t.name);
   const kin::Vec3 ball = kin::tool_ball_mm(control, t);
@@ -200,7 +205,7 @@ void run_program(const ProgramOptions& o) {
 // --- ballbar5x: the fit -----------------------------------------------------------------------
 
 struct FitOptions {
-  std::string readings, model, write;
+  std::string readings, model, db, write;
   double reading_u_um = 0.0;
   bool json = false;
 };
@@ -291,8 +296,11 @@ void print_fit(const kin::RotaryBallbarFit& f, const std::vector<ReadRun>& runs)
              f.sigma_um, f.dof);
 }
 
-void run_fit(const FitOptions& o) {
-  mdl::Model m = mdl::read(o.model);
+void run_fit(const FitOptions& given) {
+  auto in = read_model_input(given.model, given.db);
+  FitOptions o = given;
+  o.model = in.label;  // the file, or the stored model: what the output names
+  mdl::Model m = std::move(in.model);
   const auto control = mdl::five_axis(m);
   json fits = json::array();
   for (const auto& [letter, read] : read_runs(o.readings)) {
@@ -341,8 +349,8 @@ void run_fit(const FitOptions& o) {
 
 // --- ballbar5x-run: the tests as a stored run on the simulated shop ----------------------------
 
-struct RunOptions5x {
-  std::string truth, control, hal, swivel, db, write;
+struct RunOptions5x : TruthControlOptions {
+  std::string hal, swivel, db, write;  // db: where the run is written (models: --model-db)
   std::vector<double> ball_mm, offsets_um;
   std::vector<std::string> setups{"radial", "tangential", "axial"};
   std::map<std::string, std::vector<double>> angles_deg{
@@ -401,9 +409,13 @@ void print_run_result(const json& doc, std::int64_t run_id, bool corrected) {
   }
 }
 
-void run_run(const RunOptions5x& o) {
-  const auto truth = mdl::five_axis(mdl::read(o.truth));
-  mdl::Model nominal = mdl::read(o.control);
+void run_run(const RunOptions5x& given) {
+  auto models = read_truth_control(given, given.db);
+  RunOptions5x o = given;  // the files, or the stored models' labels: what the run records
+  o.truth = models.truth.label;
+  o.control = models.control->label;
+  const auto truth = mdl::five_axis(models.truth.model);
+  mdl::Model nominal = std::move(models.control->model);
   const kin::FiveAxisMachine control = control_machine(nominal, o.control, o.hal, o.swivel);
   const bool corrected = !o.hal.empty() || !o.swivel.empty() || [&] {
     for (const auto& r : control.rotary)
@@ -487,9 +499,11 @@ void add_model_ballbar5x_commands(CLI::App& model) {
                       " (one test per name; several tests and axes in one file)")
       ->required();
   fit->add_option("--model", f->model,
-                  "Model file (caldaq.model.v2): the machine as the control believes it, the "
-                  "kinematics the test's program was computed with")
+                  "Model file (caldaq.model.v2), or a stored model's UUID or number with --db: "
+                  "the machine as the control believes it, the kinematics the test's program was "
+                  "computed with")
       ->required();
+  add_model_db_option(*fit, f->db);
   fit->add_option("--reading-u-um", f->reading_u_um,
                   "Standard uncertainty of one reading (0: from the residuals)")
       ->check(finite_in(0.0, 1e4));
@@ -504,7 +518,7 @@ void add_model_ballbar5x_commands(CLI::App& model) {
       "five-axis ballbar program for each table axis and set-up while the bar's gauge twin "
       "streams; the gauge driver reads the stream, the run stores it (kind ballbar5x, see daq "
       "runs / daq show) and fits each axis's location errors with their uncertainty");
-  add_machine_options(*run, r->truth, r->control);
+  add_machine_options(*run, *r, true);
   run->add_option("--hal", r->hal,
                   "The control holds these LinuxCNC trunnion pins (daq model kinematics) over "
                   "--control's rotary lines");
@@ -547,7 +561,7 @@ void add_model_ballbar5x_commands(CLI::App& model) {
       "Simulated ballbar on a rotary table axis: the readings a model (the simulated machine's "
       "truth) gives when it runs the program the control's model computed, as a CSV for daq "
       "model ballbar5x");
-  add_machine_options(*sim, s->truth, s->control);
+  add_machine_options(*sim, *s, false);
   add_test_options(sim, s->t);
   sim->add_option("--offset-um", s->offset_um,
                   "A constant added to every reading (the bar's zero and the balls' set-up)")
@@ -561,8 +575,11 @@ void add_model_ballbar5x_commands(CLI::App& model) {
       model, "ballbar5x-program", run_program,
       "Part program of a ballbar test on a rotary table axis: the axis turns, X Y Z follow the "
       "ball (computed with the model's kinematics), a dwell at each angle read");
-  prog->add_option("--model", p->model, "Model file: the machine as the control believes it")
+  prog->add_option("--model", p->model,
+                   "Model file, or a stored model's UUID or number with --db: the machine as the "
+                   "control believes it")
       ->required();
+  add_model_db_option(*prog, p->db);
   add_test_options(prog, p->t);
   prog->add_option("--dialect", p->dialect, "fanuc, iso, heidenhain, siemens or sinumerik")
       ->check(CLI::IsMember({"fanuc", "iso", "heidenhain", "siemens", "sinumerik"}))

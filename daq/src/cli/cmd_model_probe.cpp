@@ -279,7 +279,8 @@ kin::HeadAxisFit fit_head(const ProbeOptions& o, const mdl::Model& m, const Axis
   return kin::fit_head_axis_line(mdl::five_axis(m), ax.index, a.centres, o.probe_u_um, linear);
 }
 
-void run_probe(const ProbeOptions& o) {
+void run_probe(const ProbeOptions& given) {
+  ProbeOptions o = given;  // o.model: the file, or the stored model's label (what the output names)
   if (o.model.empty() && (o.axis.empty() || o.pivot_mm.size() != 3))
     throw cal::InputError("give --model (the pivots of its rotary axes) or --axis and --pivot-mm");
   if (!o.model.empty() && !o.pivot_mm.empty())
@@ -298,7 +299,9 @@ void run_probe(const ProbeOptions& o) {
   // location error), or the control's lines with the correction applied.
   std::optional<kin::FiveAxisMachine> reference;
   if (!o.model.empty()) {
-    m = mdl::read(o.model);
+    auto in = read_model_input(o.model, o.db);
+    o.model = in.label;
+    m = std::move(in.model);
     reference = control_machine(*m, o.model, o.hal, o.swivel);
     if (correction.empty())
       for (auto& r : reference->rotary) r.location_position_um = r.location_orientation_urad = {};
@@ -358,15 +361,18 @@ void run_probe(const ProbeOptions& o) {
 // --- probe-check: the centres against the control's kinematics --------------------------------
 
 struct CheckOptions {
-  std::string centres, model, hal, swivel, axis;
+  std::string centres, model, hal, swivel, axis, db;
   bool json = false;
 };
 
 // The deviation of each probed centre from where the control's kinematics expects it: the
 // sphere's place on the workpiece is what the control saw at angle 0 (where location errors
 // move nothing), found so that the control's own prediction there is the centre probed there.
-void run_probe_check(const CheckOptions& o) {
-  const mdl::Model m = mdl::read(o.model);
+void run_probe_check(const CheckOptions& given) {
+  auto in = read_model_input(given.model, given.db);
+  CheckOptions o = given;
+  o.model = in.label;  // the file, or the stored model: what the output names
+  const mdl::Model m = std::move(in.model);
   // The correction as the control holds it: the kinematics file applied to the nominal model.
   const kin::FiveAxisMachine control = control_machine(m, o.model, o.hal, o.swivel);
   const std::string& correction = o.hal.empty() ? o.swivel : o.hal;
@@ -450,14 +456,12 @@ struct SimOptions : ProbeSimOptions {
   std::vector<double> angles_deg;
 };
 
-void run_probe_sim(const SimOptions& o) {
-  const mdl::Model m = mdl::read(o.truth);
-  const kin::RotaryLetter letter = kin::rotary_letter_from_string(o.axis);
-  const auto machine = mdl::five_axis(m);
+void run_probe_sim(const SimOptions& given) {
+  SimOptions o = given;
   // The control that reports the centres: its kinematics (a head axis's centres are where it
-  // puts the turned tip); by default the truth's nominal kinematics.
-  const auto control =
-      o.control.empty() ? kin::nominal_kinematics(machine) : mdl::five_axis(mdl::read(o.control));
+  // puts the turned tip).
+  const auto [m, machine, control] = read_probe_sim_models(o);
+  const kin::RotaryLetter letter = kin::rotary_letter_from_string(o.axis);
   std::size_t index = machine.rotary.size();
   for (std::size_t i = 0; i < machine.rotary.size(); ++i)
     if (machine.rotary[i].letter == letter) index = i;
@@ -517,8 +521,10 @@ kin::FiveAxisMachine control_machine(const mdl::Model& m, const std::string& mod
 
 void add_probe_fit_options(CLI::App& cmd, ProbeFitOptions& o, const ProbeFitHelp& help) {
   cmd.add_option("centres", o.centres, help.centres)->required();
-  auto* model = cmd.add_option("--model", o.model, help.model);
+  auto* model = cmd.add_option("--model", o.model,
+                               help.model + "; or a stored model's UUID or number with --db");
   if (help.model_required) model->required();
+  add_model_db_option(cmd, o.db);
   cmd.add_option("--probe-u-um", o.probe_u_um, help.probe_u)->check(finite_in(0.0, 1e4));
   cmd.add_option("--write", o.write,
                  "Write the model with the fitted location errors (and their uncertainty and "
@@ -527,9 +533,18 @@ void add_probe_fit_options(CLI::App& cmd, ProbeFitOptions& o, const ProbeFitHelp
   cmd.add_flag("--json", o.json, help.json);
 }
 
+ProbeSimModels read_probe_sim_models(ProbeSimOptions& o) {
+  auto models = read_truth_control(o);
+  o.truth = models.truth.label;
+  if (models.control) o.control = models.control->label;
+  auto machine = mdl::five_axis(models.truth.model);
+  auto control =
+      models.control ? mdl::five_axis(models.control->model) : kin::nominal_kinematics(machine);
+  return {std::move(models.truth.model), std::move(machine), std::move(control)};
+}
+
 void add_probe_sim_options(CLI::App& cmd, ProbeSimOptions& o, const std::string& control_help) {
-  cmd.add_option("truth", o.truth, "Model file of the simulated machine (its truth)")->required();
-  cmd.add_option("--control", o.control, control_help);
+  add_truth_control_options(cmd, o, {.control = control_help});
   cmd.add_option("--sphere-mm", o.sphere_mm, "Sphere centre on the workpiece X Y Z (home)")
       ->required()
       ->expected(3)
@@ -595,8 +610,12 @@ void add_model_probe_commands(CLI::App& model) {
       "--swivel): the residual before and after a correction");
   check->add_option("centres", c->centres, "CSV of probed centres, as for daq model probe")
       ->required();
-  check->add_option("--model", c->model, "Model file: the machine as the control believes it")
+  check
+      ->add_option("--model", c->model,
+                   "Model file, or a stored model's UUID or number with --db: the machine as the "
+                   "control believes it")
       ->required();
+  add_model_db_option(*check, c->db);
   check->add_option("--hal", c->hal,
                     "HAL file of xyzac-trt-kins / xyzbc-trt-kins pivot pins (setp lines, as daq "
                     "model kinematics writes them): the control's rotary axes on those lines");

@@ -85,8 +85,11 @@ std::vector<Named> named(const kin::AxisLineFit& v) {
   return out;
 }
 
-void run_poses(const PosesOptions& o) {
-  mdl::Model m = mdl::read(o.model);
+void run_poses(const PosesOptions& given) {
+  auto in_model = read_model_input(given.model, given.db);
+  PosesOptions o = given;
+  o.model = in_model.label;  // the file, or the stored model: what the output names
+  mdl::Model m = std::move(in_model.model);
   const kin::FiveAxisMachine machine = mdl::five_axis(m);
   if (machine.rotary.empty())
     throw cal::InputError(fmt::format("{}: the model has no rotary axis", o.model));
@@ -194,11 +197,9 @@ struct PosesSimOptions : ProbeSimOptions {
   std::string poses;
 };
 
-void run_poses_sim(const PosesSimOptions& o) {
-  const mdl::Model m = mdl::read(o.truth);
-  const auto machine = mdl::five_axis(m);
-  const auto control =
-      o.control.empty() ? kin::nominal_kinematics(machine) : mdl::five_axis(mdl::read(o.control));
+void run_poses_sim(const PosesSimOptions& given) {
+  PosesSimOptions o = given;
+  const auto [m, machine, control] = read_probe_sim_models(o);
   const Poses in = read_poses(o.poses, m, false);
   const kin::Vec3 sphere{o.sphere_mm.at(0), o.sphere_mm.at(1), o.sphere_mm.at(2)};
   std::mt19937 rng(o.seed);

@@ -66,11 +66,37 @@ ModelInput read_model_input(const std::string& arg, const std::string& db) {
   return {mdl::parse(record.json, label), label};
 }
 
-void add_model_db_option(CLI::App& cmd, std::string& db) {
+void add_model_db_option(CLI::App& cmd, std::string& db, bool writes_runs) {
+  if (writes_runs) {
+    cmd.add_option("--model-db", db,
+                   "Read the models from this store when a model argument is not a file: its "
+                   "UUID or its number there (daq model list); a SQLite file or the central "
+                   "store, postgresql://... (default: --db; docs/storage.md, \"Models\")");
+    return;
+  }
   cmd.add_option("--db", db,
                  "Read the model from this store when the model argument is not a file: its UUID "
                  "or its number there (daq model list); a SQLite file or the central store, "
                  "postgresql://... (docs/storage.md, \"Models\")");
+}
+
+void add_truth_control_options(CLI::App& cmd, TruthControlOptions& o,
+                               const TruthControlHelp& help) {
+  cmd.add_option("truth", o.truth,
+                 "Model of the simulated machine (its truth): a file, or a stored model's UUID or "
+                 "number with " +
+                     std::string(help.writes_runs ? "--model-db" : "--db"))
+      ->required();
+  auto* control = cmd.add_option("--control", o.control, help.control);
+  if (help.control_required) control->required();
+  add_model_db_option(cmd, o.model_db, help.writes_runs);
+}
+
+TruthControl read_truth_control(const TruthControlOptions& o, const std::string& db) {
+  const auto& from = model_db_of(o.model_db, db);
+  TruthControl out{read_model_input(o.truth, from), std::nullopt};
+  if (!o.control.empty()) out.control = read_model_input(o.control, from);
+  return out;
 }
 
 namespace {

@@ -27,6 +27,7 @@
 #include "database.hpp"
 #include "linear_run.hpp"
 #include "model/model_file.hpp"
+#include "model_cli.hpp"
 #include "run_setup.hpp"
 #include "sim_shop.hpp"
 #include "sim_volumetric.hpp"
@@ -49,7 +50,8 @@ struct SimOptions {
   double ballbar_rate_hz = 1000;  // the simulated bar's output rate
   std::string measure;            // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
-  std::string compensate;  // a model file whose volumetric correction the control applies
+  std::string compensate;  // a model whose volumetric correction the control applies
+  std::string model_db;    // where --compensate is kept when not a file (default: --db)
   // Or the files of a cross-axis or volumetric compensation the control loads (control_loads),
   // read as its vendor says or with the other sign (docs/compensation-tables.md,
   // "Verification").
@@ -251,9 +253,10 @@ void run_sim(SimOptions o) {
     // The control applies the model's full volumetric correction (cal::volcomp::correction_um,
     // what `daq model compensate -f isg-volumetric` writes for a controller), with each
     // position held within the model's tables (the overrun moves go a few mm past them).
-    const auto model = cal::daq::model::read(o.compensate);
-    cal::daq::model::require_no_rotary(model, o.compensate, "daq sim --compensate");
-    if (!model.travel_mm) throw cal::InputError(fmt::format("{}: no travel_mm", o.compensate));
+    auto in = read_model_input(o.compensate, model_db_of(o.model_db, o.db));
+    const auto model = std::move(in.model);
+    cal::daq::model::require_no_rotary(model, in.label, "daq sim --compensate");
+    if (!model.travel_mm) throw cal::InputError(fmt::format("{}: no travel_mm", in.label));
     shop.set_compensation([model](const cal::kinematics::Vec3& p) {
       cal::kinematics::Vec3 q = p;
       for (std::size_t k = 0; k < 3; ++k)
@@ -440,7 +443,9 @@ void add_sim_command(CLI::App& app) {
   cmd->add_option("--topology", o->topology, "The simulated machine's chain with --measure")
       ->capture_default_str();
   cmd->add_option("--compensate", o->compensate,
-                  "With --measure: the control applies this model's volumetric correction");
+                  "With --measure: the control applies this model's volumetric correction (a "
+                  "file, or a stored model's UUID or number: see --model-db)");
+  add_model_db_option(*cmd, o->model_db, true);
   cmd->add_option("--control-table", o->control_table,
                   "With --measure: the files of a cross-axis or volumetric compensation the "
                   "control loads (daq compensate --run on a straightness run, daq model "

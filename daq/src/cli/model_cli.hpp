@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <map>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -84,8 +85,34 @@ struct ModelInput {
   std::string label;
 };
 ModelInput read_model_input(const std::string& arg, const std::string& db);
-// --db for a command that reads a model (the model argument then names a stored one).
-void add_model_db_option(CLI::App& cmd, std::string& db);
+// --db for a command that reads a model (the model argument then names a stored one). A command
+// whose --db is where it writes a run (daq sim, daq model ballbar5x-run) reads stored models
+// with --model-db (`writes_runs`), by default from its --db (model_db_of).
+void add_model_db_option(CLI::App& cmd, std::string& db, bool writes_runs = false);
+// The store such a command reads stored models from: --model-db, else its --db.
+inline const std::string& model_db_of(const std::string& model_db, const std::string& db) {
+  return model_db.empty() ? db : model_db;
+}
+
+// A simulated machine and its control (probe-sim, probe-poses-sim, ballbar5x-sim,
+// ballbar5x-run): the truth's model, the control's (either a file or a stored model) and the
+// store they may be kept in.
+struct TruthControlOptions {
+  std::string truth, control, model_db;
+};
+struct TruthControlHelp {
+  std::string control;            // what --control holds
+  bool control_required = false;  // else a missing --control has a meaning the help says
+  bool writes_runs = false;       // the command's --db is where it writes (--model-db here)
+};
+void add_truth_control_options(CLI::App& cmd, TruthControlOptions& o, const TruthControlHelp& help);
+// The two models read: `control` empty without --control. `db` is the command's --db when it
+// writes runs (model_db_of).
+struct TruthControl {
+  ModelInput truth;
+  std::optional<ModelInput> control;
+};
+TruthControl read_truth_control(const TruthControlOptions& o, const std::string& db = "");
 // daq model build --store: keeps the model built in the local store at `db` for `machine`, with
 // the runs it was built from (`used`: error -> run ids in `read_from`), their UUIDs and versions.
 cal::storage::ModelRecord store_built_model(

@@ -19,7 +19,7 @@ kin::FiveAxisMachine control_machine(const mdl::Model& m, const std::string& mod
 
 // The options of a fit of probed centres (probe, probe-poses).
 struct ProbeFitOptions {
-  std::string centres, model, write;
+  std::string centres, model, write, db;  // db: where --model is kept when not a file
   double probe_u_um = 0.0;
   bool json = false;
   bool keep_linear = false;
@@ -33,12 +33,20 @@ void add_probe_fit_options(CLI::App& cmd, ProbeFitOptions& o, const ProbeFitHelp
 
 // The options of a simulated probe (probe-sim, probe-poses-sim); `control_help` says what a
 // missing --control means.
-struct ProbeSimOptions {
-  std::string truth, control, output;
+struct ProbeSimOptions : TruthControlOptions {
+  std::string output;
   std::vector<double> sphere_mm;
   double noise_um = 0.0;
   unsigned seed = 1;
 };
 void add_probe_sim_options(CLI::App& cmd, ProbeSimOptions& o, const std::string& control_help);
+// What a simulated probe reads (probe-sim, probe-poses-sim): the truth's model and machine, and
+// the control's kinematics that report the centres (--control's, by default the truth's nominal
+// kinematics). `o.truth` and `o.control` become the models' labels: what the output names.
+struct ProbeSimModels {
+  mdl::Model truth;
+  kin::FiveAxisMachine machine, control;
+};
+ProbeSimModels read_probe_sim_models(ProbeSimOptions& o);
 
 }  // namespace daq
