@@ -3,10 +3,15 @@
 // linearised basis), the bar length computed as a distance, and the analysis must recover
 // what was injected.
 #include "cal/analysis/circle.hpp"
+#include "cal/analysis/circle_records.hpp"
+#include "cal/analysis/circle_search.hpp"
+#include "cal/analysis/circle_source.hpp"
+#include "cal/analysis/paged_doubles.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -15,12 +20,8 @@
 #include <random>
 #include <tuple>
 
-#include "cal/analysis/circle_records.hpp"
-#include "cal/analysis/circle_search.hpp"
-#include "cal/analysis/circle_source.hpp"
 #include "cal/analysis/circle_standards.hpp"
 #include "cal/analysis/error.hpp"
-#include "cal/analysis/paged_doubles.hpp"
 
 namespace {
 
@@ -741,41 +742,13 @@ TEST(CircleDiagnostics, EachGainIsGWithoutThatErrorAndTheRankingFollowsIt) {
                   .backlash_v = 2,
                   .cyclic_u = 0.8};
   const auto r = both(m);
-  const std::map<std::string, Machine> without = {{"scale_mismatch",
-                                                   [&] {
-                                                     auto x = m;
-                                                     x.su_ppm = 0;
-                                                     return x;
-                                                   }()},
-                                                  {"squareness",
-                                                   [&] {
-                                                     auto x = m;
-                                                     x.square_um_per_m = 0;
-                                                     return x;
-                                                   }()},
-                                                  {"servo_mismatch",
-                                                   [&] {
-                                                     auto x = m;
-                                                     x.lag_v_ms = 0;
-                                                     return x;
-                                                   }()},
-                                                  {"backlash_X",
-                                                   [&] {
-                                                     auto x = m;
-                                                     x.backlash_u = 0;
-                                                     return x;
-                                                   }()},
-                                                  {"backlash_Y",
-                                                   [&] {
-                                                     auto x = m;
-                                                     x.backlash_v = 0;
-                                                     return x;
-                                                   }()},
-                                                  {"cyclic_X", [&] {
-                                                     auto x = m;
-                                                     x.cyclic_u = 0;
-                                                     return x;
-                                                   }()}};
+  const std::map<std::string, Machine> without = {
+      {"scale_mismatch", [&] { auto x = m; x.su_ppm = 0; return x; }()},
+      {"squareness", [&] { auto x = m; x.square_um_per_m = 0; return x; }()},
+      {"servo_mismatch", [&] { auto x = m; x.lag_v_ms = 0; return x; }()},
+      {"backlash_X", [&] { auto x = m; x.backlash_u = 0; return x; }()},
+      {"backlash_Y", [&] { auto x = m; x.backlash_v = 0; return x; }()},
+      {"cyclic_X", [&] { auto x = m; x.cyclic_u = 0; return x; }()}};
   std::size_t checked = 0;
   for (const auto& d : r.diagnostics) {
     const auto other = without.find(d.key);
