@@ -45,11 +45,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <utility>
 
 #include "cal/analysis/angle_reduce.hpp"
 #include "cal/analysis/circle_records.hpp"
+#include "cal/analysis/circle_search.hpp"
 #include "cal/analysis/circle_source.hpp"
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
@@ -73,6 +75,27 @@ std::pair<double, double> cos_sin(double x) {
   ::sincos(x, &s, &c);
   return {c, s};
 }
+// cos x and sin x for |x| <= 1.5 by their Taylor series to x^22 and x^23 (the rest is below
+// 1.5^24 / 24! = 3e-20), branch-free so that a loop of them is vectorised.
+inline void cos_sin_small(double x, double& c, double& s) {
+  constexpr int terms = 12;
+  constexpr auto coef = [] {  // (-1)^m / (2m)! and (-1)^m / (2m + 1)!
+    std::array<std::array<double, 2>, terms> a{};
+    double f = 1.0;
+    for (int m = 0; m < terms; ++m) {
+      if (m > 0) f *= -1.0 / ((2.0 * m - 1) * (2.0 * m));
+      a[static_cast<std::size_t>(m)] = {f, f / (2.0 * m + 1)};
+    }
+    return a;
+  }();
+  const double x2 = x * x;
+  double pc = coef[terms - 1][0], ps = coef[terms - 1][1];
+  for (int m = terms - 2; m >= 0; --m)
+    pc = pc * x2 + coef[static_cast<std::size_t>(m)][0],
+    ps = ps * x2 + coef[static_cast<std::size_t>(m)][1];
+  c = pc, s = ps * x;
+}
+
 double sign_of(Direction d) { return d == Direction::ccw ? 1.0 : -1.0; }
 const char* name_of(Direction d) { return d == Direction::cw ? "cw" : "ccw"; }
 
@@ -323,12 +346,164 @@ Solution solve_in_order(const Gram& ata, const TermVector& aty,
   return out;
 }
 
+// The four cyclic rows of the normal equations (A'A's and A'y's) at one wave number.
+struct CyclicRows {
+  Eigen::Matrix<double, cyclic_count, term_count> cross;
+  Eigen::Matrix<double, cyclic_count, 1> cty;
+};
+
+// The cyclic rows of the normal equations at any wave number k in [k0 - d, k0 + d], from sums
+// made in one pass over the samples (issue 32: the period search's refinement took a pass over
+// every sample for each of its 10 - 26 trials). With x = k - k0, a cyclic column is
+//   c sin(kc) = Im(c e^{i k c}),  c cos(kc) = Re(c e^{i k c}),  c e^{i k c} = sum_q (i x)^q / q!
+//   c^{q+1} e^{i k0 c},
+// so its products with any other column w (and y) are sum_q (i x)^q / q! S_q, with
+// S_q = sum w c^{q+1} e^{i k0 c} summed once; |c| <= 1, so the terms after q are below
+// d^{q+1} / (q+1)! sum |w| and the series is cut where that is under 1e-17 of sum |w| (about
+// the rounding of the sums themselves). The cyclic columns' own products, by
+//   sin^2 a = (1 - cos 2a) / 2, sin a cos a = sin 2a / 2, cos^2 a = (1 + cos 2a) / 2,
+//   sin a sin b = (cos(a - b) - cos(a + b)) / 2, sin a cos b = (sin(a + b) + sin(a - b)) / 2, ...
+// need sum c^2 e^{2ikc} (series in 2x), sum c n e^{ik(c + n)} and sum c n e^{ik(c - n)} (series
+// in x (c +- n), |c +- n| <= sqrt 2), the same way.
+class CyclicSeries {
+ public:
+  // The other columns (all but the four cyclic ones), in term order, and then y.
+  static constexpr std::array<int, term_count - cyclic_count> others = {
+      centre_u,   centre_v,  radius,    scale,   squareness, servo, backlash_u,
+      backlash_v, lateral_u, lateral_v, spike_u, spike_v,    bow_u, bow_v};
+  static constexpr int weights = static_cast<int>(others.size()) + 1;
+
+  // `d`: the largest |k - k0| asked for.
+  CyclicSeries(double k0, double d)
+      : k0_(k0),
+        q_(terms_for(d)),
+        qx_(terms_for(2 * d)),
+        qy_(terms_for(std::sqrt(2.0) * d)),
+        su_(Eigen::MatrixXd::Zero(weights, 2 * q_)),
+        sv_(Eigen::MatrixXd::Zero(weights, 2 * q_)),
+        xu_(static_cast<std::size_t>(qx_)),
+        xv_(static_cast<std::size_t>(qx_)),
+        yp_(static_cast<std::size_t>(qy_)),
+        ym_(static_cast<std::size_t>(qy_)) {}
+
+  // The number of terms of a series in x^q / q! with |x| <= d that leaves less than 1e-17.
+  static int terms_for(double d) {
+    int q = 0;
+    for (double t = 1.0, tail = 1.0; tail > 1e-17; ++q) {
+      t *= d / (q + 1);                                        // d^{q+1} / (q+1)!
+      tail = t * (q + 2 > d ? (q + 2) / (q + 2 - d) : 1e300);  // geometric bound of the rest
+    }
+    return q;
+  }
+
+  // One block of rows of the design (any k: the cyclic columns are not read) and its y.
+  template <class B, class Y>
+  void add(const B& b, const Y& y) {
+    const Eigen::Index rows = b.rows();
+    w_.resize(rows, weights);
+    for (int j = 0; j < weights - 1; ++j) w_.col(j) = b.col(others[static_cast<std::size_t>(j)]);
+    w_.col(weights - 1) = y;
+    pu_.resize(rows, 2 * q_);
+    pv_.resize(rows, 2 * q_);
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      const double c = b(i, centre_u), n = b(i, centre_v);
+      const auto [cu, su] = cos_sin(k0_ * c);
+      const auto [cv, sv] = cos_sin(k0_ * n);
+      double pc = c, pn = n;
+      for (int q = 0; q < q_; ++q) {
+        pu_(i, q) = pc * cu, pu_(i, q_ + q) = pc * su;
+        pv_(i, q) = pn * cv, pv_(i, q_ + q) = pn * sv;
+        pc *= c, pn *= n;
+      }
+      const std::complex<double> eu(cu, su), ev(cv, sv);
+      accumulate(xu_, c * c, c, eu * eu);
+      accumulate(xv_, n * n, n, ev * ev);
+      accumulate(yp_, c * n, c + n, eu * ev);
+      accumulate(ym_, c * n, c - n, eu * std::conj(ev));
+    }
+    su_.noalias() += w_.transpose() * pu_;
+    sv_.noalias() += w_.transpose() * pv_;
+  }
+
+  // The cyclic rows at k. `ata`: the design's Gram matrix (its sums of c^2 and n^2).
+  CyclicRows rows(double k, const Gram& ata) const {
+    const double x = k - k0_;
+    CyclicRows out;
+    out.cross.setZero();
+    out.cty.setZero();
+    const auto cross_of = [&](const Eigen::MatrixXd& s, int a_row, int b_row) {
+      for (int j = 0; j < weights; ++j) {
+        const std::complex<double> v = series_at(s, j, x);
+        if (j == weights - 1) {
+          out.cty[a_row] = v.imag(), out.cty[b_row] = v.real();
+        } else {
+          const int t = others[static_cast<std::size_t>(j)];
+          out.cross(a_row, t) = v.imag(), out.cross(b_row, t) = v.real();
+        }
+      }
+    };
+    cross_of(su_, 0, 1);
+    cross_of(sv_, 2, 3);
+    // The 4 x 4 block of the cyclic columns (u_a, u_b, v_a, v_b = rows 0 .. 3).
+    const auto square = [&](const std::vector<std::complex<double>>& xs, double sum_sq, int a) {
+      const std::complex<double> v = sum_at(xs, 2 * x);  // sum w^2 e^{2 i k w}
+      const int ca = cyclic_first + a;
+      out.cross(a, ca) = (sum_sq - v.real()) / 2;
+      out.cross(a, ca + 1) = out.cross(a + 1, ca) = v.imag() / 2;
+      out.cross(a + 1, ca + 1) = (sum_sq + v.real()) / 2;
+    };
+    square(xu_, ata(centre_u, centre_u), 0);
+    square(xv_, ata(centre_v, centre_v), 2);
+    const std::complex<double> p = sum_at(yp_, x), m = sum_at(ym_, x);  // sum c n e^{ik(c +- n)}
+    const double uava = (m.real() - p.real()) / 2, uavb = (p.imag() + m.imag()) / 2;
+    const double ubva = (p.imag() - m.imag()) / 2, ubvb = (m.real() + p.real()) / 2;
+    out.cross(0, cyclic_v_a) = out.cross(2, cyclic_u_a) = uava;
+    out.cross(0, cyclic_v_b) = out.cross(3, cyclic_u_a) = uavb;
+    out.cross(1, cyclic_v_a) = out.cross(2, cyclic_u_b) = ubva;
+    out.cross(1, cyclic_v_b) = out.cross(3, cyclic_u_b) = ubvb;
+    return out;
+  }
+
+ private:
+  // sums[q] += w t^q e (q = 0, 1, ...).
+  static void accumulate(std::vector<std::complex<double>>& sums, double w, double t,
+                         std::complex<double> e) {
+    for (auto& s : sums) s += w * e, w *= t;
+  }
+  // sum_q (i x)^q / q! sums[q].
+  static std::complex<double> sum_at(const std::vector<std::complex<double>>& sums, double x) {
+    std::complex<double> out = 0.0, t = 1.0;
+    for (std::size_t q = 0; q < sums.size(); ++q) {
+      out += t * sums[q];
+      t *= std::complex<double>(0.0, x / static_cast<double>(q + 1));
+    }
+    return out;
+  }
+  // sum_q (i x)^q / q! S_q of weight j (S_q's real part in column q, imaginary in q_ + q).
+  std::complex<double> series_at(const Eigen::MatrixXd& s, int j, double x) const {
+    std::complex<double> out = 0.0, t = 1.0;
+    for (int q = 0; q < q_; ++q) {
+      out += t * std::complex<double>(s(j, q), s(j, q_ + q));
+      t *= std::complex<double>(0.0, x / (q + 1));
+    }
+    return out;
+  }
+
+  double k0_;
+  int q_, qx_, qy_;
+  Eigen::MatrixXd su_, sv_;  // weights x 2 q_
+  std::vector<std::complex<double>> xu_, xv_, yp_, ym_;
+  Eigen::MatrixXd w_, pu_, pv_;  // one block's weights and powers
+};
+
 // The normal equations of one sample set (every stride-th sample), accumulated block by block
 // (for_each_block): memory independent of the number of samples. A trial cyclic period
 // recomputes only the four cyclic columns' rows of the Gram matrix, in one more pass.
 class Design {
  public:
-  Design(const Model& m, const Samples& samples, std::size_t stride, double period_mm)
+  // `series`, if given, takes every block of the design's pass too (the period search's sums).
+  Design(const Model& m, const Samples& samples, std::size_t stride, double period_mm,
+         CyclicSeries* series = nullptr)
       : m_(m), samples_(samples), stride_(stride), period_mm_(period_mm) {
     ata_.setZero();
     aty_.setZero();
@@ -342,6 +517,7 @@ class Design {
                      ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
                      aty_.noalias() += b.transpose() * y;
                      yty_ += y.squaredNorm();
+                     if (series) series->add(b, y);
                      if (dense_.rows() > 0) {
                        dense_.middleRows(static_cast<Eigen::Index>(first), b.rows()) = b;
                        dense_y_.segment(static_cast<Eigen::Index>(first), b.rows()) = y;
@@ -353,6 +529,82 @@ class Design {
   Solution solve(double period_mm) {
     if (m_.on[cyclic_first] && period_mm != period_mm_) set_cyclic(period_mm);
     Solution out = solve_in_order(ata_, aty_, m_.on);
+    out.rss += yty_;
+    return out;
+  }
+
+  // solve() for the period search's grid, on a dense design: each row's e^{i k c} and e^{i k n}
+  // are carried from the last trial's k by a rotation by e^{i dk c} (cos_sin_small: no library
+  // call), and computed afresh (cos_sin) every 16th trial or after a step in k above 1.5. The
+  // rotations' rounding (a few ulps a step, so at most ~1e-14 of each column after 15 steps)
+  // is the only difference from solve(): the grid's residuals move by ~1e-14 of themselves,
+  // which changes its best point only for two points within that of each other (issue 32:
+  // the grid's 2 x ~5,000 sines and cosines a trial were most of a short run's search).
+  Solution solve_grid(double period_mm) {
+    if (dense_.rows() == 0 || !m_.on[cyclic_first]) return solve(period_mm);
+    period_mm_ = period_mm;
+    const double kc = k();
+    const auto rows = static_cast<std::size_t>(dense_.rows());
+    if (phase_.size() != 4 * rows || phase_steps_ >= 15 || !(std::abs(kc - phase_k_) <= 1.5)) {
+      phase_.resize(4 * rows);
+      for (std::size_t i = 0; i < rows; ++i) {
+        const auto ei = static_cast<Eigen::Index>(i);
+        const auto [cu, su] = cos_sin(kc * dense_(ei, centre_u));
+        const auto [cv, sv] = cos_sin(kc * dense_(ei, centre_v));
+        phase_[4 * i] = cu, phase_[4 * i + 1] = su, phase_[4 * i + 2] = cv, phase_[4 * i + 3] = sv;
+      }
+      phase_steps_ = 0;
+    } else {
+      const double dk = kc - phase_k_;
+      double* ph = phase_.data();
+      const double* c = dense_.col(centre_u).data();
+      const double* n = dense_.col(centre_v).data();
+      for (std::size_t i = 0; i < rows; ++i) {
+        double cu, su, cv, sv;
+        cos_sin_small(dk * c[i], cu, su);
+        cos_sin_small(dk * n[i], cv, sv);
+        const double a = ph[4 * i], b = ph[4 * i + 1], e = ph[4 * i + 2], f = ph[4 * i + 3];
+        ph[4 * i] = a * cu - b * su, ph[4 * i + 1] = b * cu + a * su;
+        ph[4 * i + 2] = e * cv - f * sv, ph[4 * i + 3] = f * cv + e * sv;
+      }
+      ++phase_steps_;
+    }
+    phase_k_ = kc;
+    Eigen::Matrix<double, cyclic_count, term_count> cross =
+        Eigen::Matrix<double, cyclic_count, term_count>::Zero();
+    Eigen::Matrix<double, cyclic_count, 1> cty = Eigen::Matrix<double, cyclic_count, 1>::Zero();
+    // In blocks of rows, so that the product reads the columns just written from the cache.
+    constexpr Eigen::Index block = 256;
+    for (Eigen::Index first = 0; first < dense_.rows(); first += block) {
+      const Eigen::Index len = std::min(block, dense_.rows() - first);
+      for (Eigen::Index i = first; i < first + len; ++i) {
+        const double* ph = &phase_[4 * static_cast<std::size_t>(i)];
+        const double c = dense_(i, centre_u), n = dense_(i, centre_v);
+        dense_(i, cyclic_u_a) = c * ph[1], dense_(i, cyclic_u_b) = c * ph[0];
+        dense_(i, cyclic_v_a) = n * ph[3], dense_(i, cyclic_v_b) = n * ph[2];
+      }
+      const auto b = dense_.middleRows(first, len);
+      const auto cyc = b.middleCols<cyclic_count>(cyclic_first);
+      cross.noalias() += cyc.transpose() * b;
+      cty.noalias() += cyc.transpose() * dense_y_.segment(first, len);
+    }
+    ata_.middleRows<cyclic_count>(cyclic_first) = cross;
+    ata_.middleCols<cyclic_count>(cyclic_first) = cross.transpose();
+    aty_.segment<cyclic_count>(cyclic_first) = cty;
+    Solution out = solve_in_order(ata_, aty_, m_.on);
+    out.rss += yty_;
+    return out;
+  }
+
+  // The solution with the cyclic rows of the normal equations given (CyclicSeries::rows); the
+  // design itself is left as it is.
+  Solution solve_with(const CyclicRows& rows) const {
+    Gram ata = ata_;
+    TermVector aty = aty_;
+    ata.middleRows<cyclic_count>(cyclic_first) = rows.cross;
+    ata.middleCols<cyclic_count>(cyclic_first) = rows.cross.transpose();
+    aty.segment<cyclic_count>(cyclic_first) = rows.cty;
+    Solution out = solve_in_order(ata, aty, m_.on);
     out.rss += yty_;
     return out;
   }
@@ -406,6 +658,10 @@ class Design {
   Gram ata_;
   TermVector aty_;
   double yty_ = 0.0;
+  // solve_grid's e^{i k c}, e^{i k n} of each dense row (cos, sin, cos, sin), at phase_k_.
+  std::vector<double> phase_;
+  double phase_k_ = 0.0;
+  int phase_steps_ = 0;
 };
 
 // The minimum of f in [a, b] to about tol (Brent, "Algorithms for Minimization without
@@ -458,7 +714,13 @@ double brent_min(double a, double b, double tol, F f) {
 // half a cycle when dp / p = p / (4R). So the grid steps by p / (8R) (at most 800 steps), on
 // a decimated copy of the samples (>= 8 samples per shortest period along the path), and the
 // best grid point is refined by Brent's method (parabolic and golden section steps) on all samples.
-double search_period(const Model& m, const Samples& samples, const Setup& setup, Design& full) {
+// The grid's part: the bracket [best / e^step, best * e^step] of the refinement.
+struct Bracket {
+  double best_p, step;
+  double k0(double r_mm) const { return 2 * pi * r_mm / best_p * std::cosh(step); }
+  double half_width_k(double r_mm) const { return 2 * pi * r_mm / best_p * std::sinh(step); }
+};
+Bracket search_grid(const Model& m, const Samples& samples, const Setup& setup) {
   const double p_min = setup.cyclic_search_min_mm, p_max = setup.cyclic_search_max_mm;
   const double path_per_sample_mm =
       2 * pi * setup.radius_mm / std::max(1.0, static_cast<double>(samples.size()) / 2.0);
@@ -470,15 +732,20 @@ double search_period(const Model& m, const Samples& samples, const Setup& setup,
   double best_p = p_min, best_rss = 1e300, best_step = min_step;
   for (double p = p_min, step = min_step; p <= p_max * (1 + 1e-12); p *= std::exp(step)) {
     step = std::max(min_step, p / (8 * setup.radius_mm));
-    if (const double rss = coarse.solve(p).rss; rss < best_rss)
+    if (const double rss = coarse.solve_grid(p).rss; rss < best_rss)
       best_rss = rss, best_p = p, best_step = step;
   }
-  // Brent's minimisation over log p in [best / e^step, best * e^step] on all samples: each
-  // trial is a pass over them, and near the minimum the residual is a smooth parabola in
-  // log p, which parabolic steps find in about a third of the 26 trials that golden section
-  // alone took (issue 32). Located to 1e-7 in log p (a 4 nm shift of a 40 mm period).
-  return std::exp(brent_min(std::log(best_p) - best_step, std::log(best_p) + best_step, 1e-7,
-                            [&](double x) { return full.solve(std::exp(x)).rss; }));
+  return {best_p, best_step};
+}
+
+// Brent's minimisation over log p in the grid's bracket: near the minimum the residual is a
+// smooth parabola in log p, which parabolic steps find in about a third of the 26 trials that
+// golden section alone took (issue 32). Located to 1e-7 in log p (a 4 nm shift of a 40 mm
+// period). `rss_at(p)`: the residual of the fit with period p.
+template <class F>
+double refine_period(const Bracket& b, F rss_at) {
+  return std::exp(brent_min(std::log(b.best_p) - b.step, std::log(b.best_p) + b.step, 1e-7,
+                            [&](double x) { return rss_at(std::exp(x)); }));
 }
 
 // Sorts v by key in linear time when it is a rotation of a strictly increasing sequence, or the
@@ -984,13 +1251,24 @@ Result analyse(const Setup& setup, std::span<const Trace> traces) {
 
 Result analyse(const Setup& setup, std::span<const Trace> traces,
                std::size_t records_held_max_samples) {
+  return analyse(setup, traces, records_held_max_samples, PeriodRefinement::one_pass_series);
+}
+
+Result analyse(const Setup& setup, std::span<const Trace> traces,
+               std::size_t records_held_max_samples, PeriodRefinement refinement) {
   std::vector<TraceSource> sources;
   for (const auto& t : traces) sources.emplace_back(t);
-  return analyse(setup, sources, records_held_max_samples, PageOptions{});
+  return analyse(setup, sources, records_held_max_samples, PageOptions{}, refinement);
 }
 
 Result analyse(const Setup& setup, std::span<const TraceSource> traces,
                std::size_t records_held_max_samples, PageOptions pages) {
+  return analyse(setup, traces, records_held_max_samples, pages, PeriodRefinement::one_pass_series);
+}
+
+Result analyse(const Setup& setup, std::span<const TraceSource> traces,
+               std::size_t records_held_max_samples, PageOptions pages,
+               PeriodRefinement refinement) {
   const double arc_deg = validate(setup, traces);
   Result res;
   // Deviations from the nominal radius: the bar reads 0 at its calibrated length.
@@ -1005,9 +1283,26 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
   m.s_before = sign_of(spans[0].trace->direction());
   m.s_after = sign_of(spans.back().trace->direction());
   double period_mm = setup.cyclic_period_mm.value_or(10.0);
-  Design full(m, samples, 1, period_mm);
-  if (m.on[cyclic_first] && !setup.cyclic_period_mm)
-    period_mm = search_period(m, samples, setup, full);
+  std::optional<Design> fitted;
+  if (m.on[cyclic_first] && !setup.cyclic_period_mm) {
+    const Bracket bracket = search_grid(m, samples, setup);
+    period_mm = bracket.best_p;
+    if (refinement == PeriodRefinement::pass_per_trial) {
+      fitted.emplace(m, samples, 1, period_mm);
+      period_mm = refine_period(bracket, [&](double p) { return fitted->solve(p).rss; });
+    } else {
+      // The refinement's trials from sums made in the design's own pass (CyclicSeries): the
+      // search costs that pass's extra sums and the pass at the period found below.
+      CyclicSeries series(bracket.k0(m.r_mm), bracket.half_width_k(m.r_mm) * (1 + 1e-6));
+      fitted.emplace(m, samples, 1, period_mm, &series);
+      period_mm = refine_period(bracket, [&](double p) {
+        return fitted->solve_with(series.rows(m.wave_number(p), fitted->ata())).rss;
+      });
+    }
+  } else {
+    fitted.emplace(m, samples, 1, period_mm);
+  }
+  Design& full = *fitted;
   const Solution sol = full.solve(period_mm);
   Model reported = m;
   for (int k = 0; k < term_count; ++k)

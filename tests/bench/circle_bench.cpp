@@ -14,6 +14,7 @@
 
 #include "cal/analysis/circle.hpp"
 #include "cal/analysis/circle_records.hpp"
+#include "cal/analysis/circle_search.hpp"
 
 namespace {
 
@@ -56,6 +57,18 @@ void BM_BallbarDiagnosticsPeriodSearch_2x36000(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 72'000);
 }
 BENCHMARK(BM_BallbarDiagnosticsPeriodSearch_2x36000)->Unit(benchmark::kMillisecond);
+
+// The same search with a pass over every sample for each of its refinement's trials, as before
+// the one-pass series (issue 32): the results agree (OnePassPeriodSearchEqualsThePassPerTrial...).
+void BM_BallbarDiagnosticsPeriodSearchPassPerTrial_2x36000(benchmark::State& state) {
+  const auto t = traces();
+  const Setup setup{.radius_mm = 100, .feed_mm_per_min = 1047};
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        analyse(setup, t, fit_records_held_max_samples, PeriodRefinement::pass_per_trial));
+  state.SetItemsProcessed(state.iterations() * 72'000);
+}
+BENCHMARK(BM_BallbarDiagnosticsPeriodSearchPassPerTrial_2x36000)->Unit(benchmark::kMillisecond);
 
 // The two above with the fit's records rebuilt on every pass, as for a run of more than
 // fit_records_held_max_samples samples: what the bounded memory costs.
