@@ -18,6 +18,7 @@ DAQ=$(realpath "$1")
 MACHINES=${2:-1000}
 MONTHS=${3:-120}
 SHOTS=${4:-}
+[ -z "$SHOTS" ] || mkdir -p "$SHOTS"
 READING_MONTHS=${5:-0}
 HERE=$(cd "$(dirname "$0")" && pwd)
 source "$HERE/../cli/check.sh"
