@@ -51,6 +51,13 @@ def few(b, since):
         sparks: document.querySelectorAll('svg.spark circle.pt').length,
         old: document.querySelectorAll('svg.spark circle.pt.old').length,
         rules: document.querySelectorAll('svg.spark line.win').length,
+        // The narrowest share of a plot's width its points span (plots of points at two times
+        // or more): the projected line is not allowed to squeeze the history to one edge.
+        spread: Math.min(...[...document.querySelectorAll('svg.spark')].map(g => {
+          const xs = [...g.querySelectorAll('circle.pt')].map(c => +c.getAttribute('cx'));
+          const w = Math.max(...xs) - Math.min(...xs);
+          return w > 0 ? w / (220 - 2 * 3) : 1;
+        })),
         past: text('td.past'), soon: text('td.soon'), count: text('#instrument-count'),
         awaiting: document.querySelectorAll('#awaiting-list tr[data-run]').length,
         error: document.getElementById('error').textContent,
@@ -81,6 +88,7 @@ def few(b, since):
     # each of those four windows.
     need(page["old"] == 8 and page["rules"] == 4, f"points before the windows {page['old']}, rules {page['rules']}")
     need(page["sparks"] >= 30, f"history points drawn ({page['sparks']})")
+    need(page["spread"] >= 0.45, f"every plot's points span half its width or more ({page['spread']:.3f})")
     need(len(page["past"]) == 1 and page["past"][0].startswith("past due (10 days ago)"), f"past due {page['past']}")
     need(len(page["soon"]) == 1 and page["soon"][0].startswith("due soon (in 12 days)"), f"due soon {page['soon']}")
     need(page["count"] and "1 past due, 1 due within 30 days, 1 later" in page["count"][0], f"instrument counts {page['count']}")
