@@ -198,12 +198,13 @@ for i in 1 2 3 4 5; do
   wait $!
   echo "first view, both at once: GET /api/fleet $(cat "$TMP/a.time") s and /api/fleet/first-site $b s"
 done
+OPEN=$(((MACHINES + 1) / 2))  # a machine in the middle of the fleet (500 of 1,000)
 for i in 1 2 3; do
-  curl -sf -o "$TMP/machine.json" -w "a machine opened: GET /api/fleet/machines/500: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500" || echo "no machine 500"
-  curl -sf -o /dev/null -w "a date chosen: GET /api/fleet/machines/500/since/2024-01-01: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/500/since/2024-01-01" || echo "no machine 500"
+  curl -sf -o "$TMP/machine.json" -w "a machine opened: GET /api/fleet/machines/$OPEN: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/$OPEN" || echo "no machine $OPEN"
+  curl -sf -o /dev/null -w "a date chosen: GET /api/fleet/machines/$OPEN/since/2024-01-01: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/machines/$OPEN/since/2024-01-01" || echo "no machine $OPEN"
 done
 curl -sf -o "$TMP/site-last.json" -w "another page: GET /api/fleet/sites/$SITE/page/2: %{time_total} s, %{size_download} bytes\n" "$URL/api/fleet/sites/$SITE/page/2" || echo "no page 2"
-"$PY" - "$TMP/fleet.json" "$TMP/site.json" "$TMP/machine.json" <<'EOF'
+"$PY" - "$TMP/fleet.json" "$TMP/site.json" "$TMP/machine.json" "$OPEN" <<'EOF'
 import collections, json, sys
 d, site, machine = (json.load(open(p)) for p in sys.argv[1:4])
 inst = d["instruments"]["statuses"]
@@ -214,7 +215,7 @@ windows = collections.Counter(t["window"]["reason"] for t in machine["trends"])
 print(f"answer: {len(d['sites'])} sites, {d['machines']} machines; the first site {site['count']} machines, "
       f"{site['pages']} pages, its first page's trend counts {dict(counts)}; instruments {inst} "
       f"({d['instruments']['listed']} listed); awaiting approval {d['awaiting_approval']['count']}; "
-      f"machine 500's windows {dict(windows)}")
+      f"machine {sys.argv[4]}'s windows {dict(windows)}")
 EOF
 kill $SERVE_PID
 wait $SERVE_PID 2>/dev/null || true
