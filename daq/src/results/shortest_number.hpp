@@ -259,6 +259,8 @@ inline char* write_shortest(char* p, double v) {
 // conversion rounded it off its decimal's own double: a quarter of a gauge's, docs) costs
 // the guess (a multiplication, a division, a comparison) and then Dragonbox as before.
 // At most 24 characters, and up to 16 bytes of no meaning after them: room for 40.
+inline char* write_shortest_scaled(char* p, double v, std::int64_t m, int k);  // below
+
 inline char* write_shortest_quantised(char* p, double v) {
   using namespace shortest_detail;
   const double a = std::abs(v);
@@ -270,6 +272,7 @@ inline char* write_shortest_quantised(char* p, double v) {
   const double x = a * kPow10[k];                     // < 2^51: its ulp <= 1/4, x + 0.5 exact
   const auto m = static_cast<std::int64_t>(x + 0.5);  // the nearest integer (a guess)
   if (m == 0 || static_cast<double>(m) / kPow10[k] != a) return write_shortest(p, v);
+  char* const start = p;
   if (std::signbit(v)) *p++ = '-';
 #if defined(__SSE2__)
   // m < 2^51 has at most 16 digits: all 16 (leading zeros included) in one register; where its
@@ -303,17 +306,9 @@ inline char* write_shortest_quantised(char* p, double v) {
     return p + 2 + zeros + (last + 1 - first);
   }
 #endif
-  auto q = static_cast<std::uint64_t>(m);
-  int exponent = -k;
-  while (q % 10000 == 0) {  // Dragonbox leaves no trailing zero in its significand
-    q /= 10000;
-    exponent += 4;
-  }
-  while (q % 10 == 0) {
-    q /= 10;
-    ++exponent;
-  }
-  return write_decimal(p, q, exponent);
+  // Exponent notation (or no SSE2): m x 10^-k is v's decimal, written as write_shortest_scaled
+  // writes one (its trailing zeros cut, then write_decimal).
+  return write_shortest_scaled(start, v, std::signbit(v) ? -m : m, k);
 }
 
 // The same text as write_shortest(p, v), for a v the caller computed from m x 10^-k (an export's
