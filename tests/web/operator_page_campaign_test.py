@@ -137,7 +137,7 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "sim.toml"), "--
        abs(model["map"]["summary"]["max_norm_um"] - cmap["summary"]["max_norm_um"]) < 1e-9 and
        model["map"]["summary"]["max_norm_um"] > 1,
        f"the map's summary is `daq model map --json`'s: {model['map'] and model['map']['summary']} vs {cmap['summary']}")
-    want = {c["error"]: f"{c['max_norm_um']:.2f}" for c in cmap["contributions"]}
+    want = {c["error"]: page_checks.fixed(c['max_norm_um'], 2) for c in cmap["contributions"]}
     shown = b.wait("const r = [...document.querySelectorAll('#model-table tbody tr')]; return r.length === 21 && "
                    "Object.fromEntries(r.map(x => [x.dataset.error, [...x.cells].map(c => c.textContent)]));",
                    timeout_s=60, what="the model's 21 errors on the page")

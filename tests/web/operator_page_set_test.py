@@ -94,7 +94,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
        and waiting[7] > 40, f"before the feed-in: no deviation in the status, 'Waiting for the feed-in' where the number goes: {waiting}")
     ok("XY 360°, 3000 mm/min, R 100.0 mm" in waiting[3] and "no circle deviation before the feed-in" in waiting[3],
        f"the test about to be measured named above it: {waiting[3]!r}")
-    ok(waiting[4] == f"Bar reading now: {waiting[5] * 1e3:.4f} mm",
+    ok(waiting[4] == f"Bar reading now: {page_checks.fixed(waiting[5] * 1e3, 4)} mm",
        f"the bar's live reading below it, the device board's value in mm: {waiting[4]!r} vs {waiting[5]} m")
     NEXT = "const n = document.getElementById('set-next'); return !n.hidden"
     text = wait(NEXT + " && /set: test 1 of 3/.test(n.textContent) && n.textContent;", "test 1's instruction")
@@ -127,7 +127,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
                "test 1 done in the set's table")
     doc = get(url + f"api/runs/{first}")
     g = [v for r in doc["results"] if r["current"] for v in r["values"] if v["symbol"] in ("G(b)", "G")]
-    ok(g and row[4] == f"{g[0]['value']:.2f}", f"test 1's G is its stored run's: {row} vs {g[:1]}")
+    ok(g and row[4] == page_checks.fixed(g[0]['value'], 2), f"test 1's G is its stored run's: {row} vs {g[:1]}")
     ok(row[2] == str(first) and row[6] in ("PASS", "FAIL", "no tolerance configured"), f"with its run and verdict: {row}")
     post(url + "api/simulation/speed", {"speed": 50})
     shot(b, "s02-set-test2-1366x768.png")
@@ -153,7 +153,7 @@ with page_checks.served_page(DAQ, TMP, page_checks.simulated(DB)) as (serve, url
     ok(len(shown) == 3 and sorted(r[0] for r in shown) == ["XY", "YZ", "ZX"], f"a row per plane: {shown}")
     for p in cli["planes"]:
         r = next(x for x in shown if x[0] == p["plane"])
-        want = f"{p['squareness_um_per_m']:+.1f}"
+        want = page_checks.fixed(p['squareness_um_per_m'], 1, "+")
         ok(r[3] == want and r[1] == str(p["runs"][0]),
            f"{p['plane']}: squareness {r[3]} µm/m as `daq ballbar volumetric` ({want}), from run {r[1]}")
         # The simulated shop has squareness in every plane (`daq sim --test circle-set`'s truth:

@@ -117,7 +117,7 @@ try:
     ok(captured is not None, "a stop seen at CAPTURED")
     stops = [x for x in captured["run"]["stops"] if not x["missed"]]
     last = stops[-1]
-    ok(captured["big"] == f"{last['deviation_um']:.2f}" and captured["unit"] == "µm",
+    ok(captured["big"] == page_checks.fixed(last['deviation_um'], 2) and captured["unit"] == "µm",
        f"at CAPTURED the number is the captured stop's value: {captured['big']} µm = stop "
        f"{last['number']}'s {last['deviation_um']:.4f}")
     ok(captured["label"] == f"Captured at {last['nominal_mm']:.3f} mm (stop {last['number']})",

@@ -3,6 +3,7 @@ JSON POST that returns (status, body) for errors too, the test's folders, and th
 browser on its page."""
 import atexit
 import contextlib
+import decimal
 import json
 import os
 import re
@@ -35,6 +36,20 @@ def ok(cond, what):
         raise AssertionError(what)
     passes += 1
     print("ok", what, flush=True)
+
+
+def fixed(v, d, sign=""):
+    """V to D decimals by the rule the page and the terminal share (cal::fixed_text): the
+    double V x 10^D rounded half away from zero, not V's binary digits as "%.4f" rounds them.
+    They differ on a decimal tie: 0.04923945 m is 49.23945 mm, whose double lies just under
+    the tie (49.2394499...), so "%.4f" writes 49.2394 where the page writes 49.2395. SIGN "+"
+    writes a plus on what is not negative, as the page's signed() does."""
+    scaled = v * 10.0 ** d
+    if abs(scaled) < 2.0 ** 52:
+        whole = decimal.Decimal(scaled).quantize(decimal.Decimal(1), rounding=decimal.ROUND_HALF_UP)
+        v = float(whole) / 10.0 ** d
+    v = v if v != 0 else 0.0  # "0.00", never "-0.00"
+    return f"{v:{sign}.{d}f}"
 
 
 def shot(b, directory, name):
