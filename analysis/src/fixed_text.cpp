@@ -18,13 +18,19 @@ std::string fixed_text(double v, int decimals) {
   // the binary digits give "0.004" twice). The product lands on such a tie exactly; a value
   // within an ulp or so of a tie rounds as the product does (12.34565 x 10^4 is 123456.49...).
   if (std::isnan(v)) return "nan";  // whatever its sign bit
+  return fmt::format("{:.{}f}", fixed_value(v, decimals), decimals);
+}
+
+double fixed_value(double v, int decimals) {
+  if (decimals < 0)
+    throw InputError(fmt::format("{} decimal places: expected 0 or more", decimals));
   const double scale = std::pow(10.0, decimals);
   const double scaled = v * scale;
   // From 2^52 on the product is whole and dividing it back would move v (1e20 to 3 places
   // would read 99999999999999983616.000): v has no digits that fine to round, write it as is.
   double r = std::abs(scaled) < 0x1p52 ? std::round(scaled) / scale : v;
   if (r == 0.0) r = 0.0;  // -0.0 and whatever rounds to zero: "0.000", never "-0.000"
-  return fmt::format("{:.{}f}", r, decimals);
+  return r;
 }
 
 std::string control_text(double v, int decimals, std::string_view role) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -100,6 +101,18 @@ TEST(FixedText, LinuxCncPinsRefuseANonFiniteValue) {
     EXPECT_NE(std::string(e.what()).find("xyzac-trt-kins.y-offset is nan"), std::string::npos)
         << e.what();
   }
+}
+
+// The value a verdict compares with its limit is the one printed: 0.0045 is stored just under
+// 9/2000 yet prints "0.005", so 0.0045 against a limit of 0.004 must fail as the reader sees;
+// the central store's tie, 2.0624999999999996 (printed "2.062"), is within 2.062.
+TEST(FixedText, FixedValueIsThePrintedNumber) {
+  EXPECT_EQ(cal::fixed_value(0.0045, 3), 0.005);
+  EXPECT_EQ(cal::fixed_value(2.0624999999999996, 3), 2.062);
+  EXPECT_EQ(cal::fixed_value(-2.5, 0), -3.0);                // half away from zero, as "-3"
+  EXPECT_FALSE(std::signbit(cal::fixed_value(-0.0004, 3)));  // "0.000", no sign
+  EXPECT_EQ(cal::fixed_value(1e20, 3), 1e20);                // past 2^52: as it is
+  EXPECT_THROW(cal::fixed_value(1.0, -1), cal::InputError);
 }
 
 }  // namespace

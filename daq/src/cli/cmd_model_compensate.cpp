@@ -546,7 +546,13 @@ void add_model_compensate_command(CLI::App& model) {
   cmd->add_option("--machine", o->machine,
                   "Store the written compensation with this machine of --db: the next "
                   "straightness run of an axis it corrects is checked against it (daq verify)");
-  add_db_option(*cmd, o->db);
+  // Not add_db_option's "Run database": here --db is where a stored model is read from (the
+  // central store too) and where --machine keeps the written compensation (local only).
+  cmd->add_option("--db", o->db,
+                  "Store the model is read from when FILE is a UUID or number (a local file, or "
+                  "the central store postgresql://...), and where --machine keeps the "
+                  "compensation (a local file only; default: $CALDAQ_DB, else "
+                  "~/.local/share/caldaq/site.sqlite)");
 }
 
 }  // namespace daq

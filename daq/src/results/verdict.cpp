@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/analysis/text.hpp"
 #include "cal/daq/config.hpp"
 #include "circle_output.hpp"
@@ -17,7 +18,7 @@ namespace {
 
 // The value as it is printed (3 decimals), so the verdict agrees with what the reader sees.
 bool within(double value, double limit) {
-  return std::round(std::abs(value) * 1e3) / 1e3 <= limit + 1e-12;
+  return cal::fixed_value(std::abs(value), 3) <= limit + 1e-12;
 }
 
 // The travel of a result's targets (a position key: "target_mm" of ISO 230-2, "position_mm"

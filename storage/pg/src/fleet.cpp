@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "cal/analysis/fixed_text.hpp"
 #include "cal/storage/pg/sync.hpp"
 #include "central_schema.hpp"
 #include "pool.hpp"
@@ -28,7 +29,7 @@ constexpr double kMsPerYear = 365.25 * kMsPerDay;
 
 // As a verdict judges a value: its magnitude as printed (0.001 of its unit) against the limit.
 bool within(double value, double limit) {
-  return std::round(std::abs(value) * 1e3) / 1e3 <= limit + 1e-12;
+  return cal::fixed_value(std::abs(value), 3) <= limit + 1e-12;
 }
 
 std::string iso_day(std::chrono::sys_days d) {

@@ -17,6 +17,11 @@ namespace cal {
 // "nan", "inf" or "-inf", never as a number.
 std::string fixed_text(double v, int decimals);
 
+// The value fixed_text writes, as a number: `v` rounded half away from zero at `decimals`
+// places (0.0045 to 3 is 0.005). What a verdict compares with its limit, so that a value is
+// judged as the reader sees it printed (daq's verdicts and the central store's fleet trends).
+double fixed_value(double v, int decimals);
+
 // The same for a value that goes into a controller table or a part program: a value that is
 // not finite is refused with cal::InputError naming `role` ("the X axis's value at 100 mm"),
 // "ROLE is nan: nothing non-finite goes into a controller table or a part program".
