@@ -160,9 +160,11 @@ try:
                and cap["message"].endswith(" arcsec"), f"the run's event in degrees and arcsec: {cap['message']!r}")
             page_checks.shot(b, SHOTS, "r-rotary-live-captured-1366x768.png")
             b.set_size(560, 900)
-            render("captured")
-            ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0, "560 px: the rotary live view fits")
-            page_checks.shot(b, SHOTS, "r-rotary-live-captured-560.png")
+            for mode, name in (("position", "turning"), ("deviation", "at-target"), ("captured", "captured")):
+                again = render(mode)
+                ok(b.js("return document.documentElement.scrollWidth - window.innerWidth;") <= 0 and again["label"] == {
+                   "position": moving, "deviation": at, "captured": cap}[mode]["label"], f"560 px: the rotary live view fits, {name}")
+                page_checks.shot(b, SHOTS, f"r-rotary-live-{name}-560.png")
             b.js("document.getElementById('stops-panel').scrollIntoView();")
             render("captured")
             page_checks.shot(b, SHOTS, "r-rotary-live-stops-560.png")
