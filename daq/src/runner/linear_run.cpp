@@ -242,7 +242,8 @@ struct LinearRun::Impl : Runner {
   bool forcing = false;                   // the capture by hand being labelled is a forced one
   std::string_view again_key =
       "Capture (C)";  // the key that forces it: the page's, the CLI's Enter
-  std::vector<std::optional<double>> kind_values;  // by stop: a kind's own value, once stored
+  // By stop, once stored: the value of a kind with a reader (its own; a rotary stop's deviation).
+  std::vector<std::optional<double>> kind_values;
   // True for a kind whose stop value is its own instrument's (straightness, angular, roll), not
   // the deviation the sequencer computed from the position (positioning, rotary).
   bool own_value() const { return reader && !kind.stops_from_probe(); }
