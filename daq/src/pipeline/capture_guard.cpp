@@ -11,9 +11,12 @@ namespace cal::daq {
 
 CaptureGuard::CaptureGuard(CaptureGuardSettings s) : s_(s) {
   if (!(s.tolerance_um > 0) || !(s.span_s > 0) || !(s.drift_tolerances > 0) ||
-      !(s.force_within_s > 0))
-    throw cal::InputError("capture guard: tolerance, span, drift and force time must be > 0");
+      !(s.force_within_s > 0) || !(s.departure_lag_s > 0) || !(s.departure_lag_s < s.span_s))
+    throw cal::InputError(
+        "capture guard: tolerance, span, drift and force time must be > 0, the departure's lag "
+        "> 0 and shorter than the span");
   span_ns_ = static_cast<std::int64_t>(s.span_s * 1e9);
+  lag_ns_ = static_cast<std::int64_t>(s.departure_lag_s * 1e9);
 }
 
 void CaptureGuard::trim(std::deque<std::pair<std::int64_t, double>>& d, std::int64_t keep_ns) {
@@ -62,6 +65,26 @@ std::string CaptureGuard::moving_reason(std::int64_t now_ns, Motion shown) const
       if (std::abs(slope_um_per_s) * s_.span_s > s_.drift_tolerances * s_.tolerance_um)
         return fmt::format("the laser reads it drifting {:.0f} um/s", slope_um_per_s);
     }
+  }
+  // The axis leaving where it stood: the newest reading more than the trigger's band (2
+  // tolerances) beyond every reading of the span up to departure_lag_s before it. The drift
+  // above is blind to the first ~10 ms of a motion (the 0.5 s line of readings at 10 kHz tilts
+  // by 4 um over the span 10 ms into a start at 2 m/s^2 to 1000 mm/min, ~100 um travelled),
+  // while the trigger's window has already shrunk to the departing readings (beyond its band
+  // from the rest), so a press then stored them as the stop (+10.4 um, runner_control_tests). A
+  // vibration stays within its own range; the lag keeps the departure's first readings out of
+  // the reference while the axis keeps moving.
+  if (laser_.size() >= 2 && laser_.front().first <= laser_.back().first - lag_ns_) {
+    const double x = laser_.back().second;
+    double lo = laser_.front().second, hi = lo;
+    for (const auto& [t, v] : laser_) {
+      if (t > laser_.back().first - lag_ns_) break;  // in time order
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    const double beyond_mm = std::max(x - hi, lo - x);
+    if (beyond_mm > 2 * tol_mm)
+      return fmt::format("the laser reads it {:.1f} um from where it stood", beyond_mm * 1e3);
   }
   return {};
 }

@@ -36,17 +36,29 @@ using cal::drivers::Reading;
 using cal::drivers::ReadingStatus;
 using nlohmann::json;
 
+namespace {
+// A unit of the live state as the page writes it: deg as the degree sign (the terminal's "deg"
+// is not in unit_html's table, whose words the reports' sentences share), um as µm.
+std::string page_unit(std::string_view unit) {
+  return unit == "deg" ? std::string("°") : ::daq::unit_html(unit);
+}
+}  // namespace
+
 std::string to_json_text(const LiveState& s) {
+  const std::string position_unit = page_unit(s.units.position);
+  const std::string deviation_unit = page_unit(s.units.deviation);
   json j{{"schema", "caldaq.live.v1"},
          {"time_s", s.time_s},
          {"state", s.state},
          {"message", s.message},
          {"reading",
           {{"value", s.deviation_um},
-           {"unit", "µm"},
+           {"unit", deviation_unit},
            {"decimals", 2},
            {"position_mm", s.position_mm}}},
-         {"fallback", s.fallback}};
+         {"fallback", s.fallback},
+         // Every *_mm and *_um value's unit (a rotary axis's: degrees and arcsec), for the page.
+         {"units", {{"position", position_unit}, {"deviation", deviation_unit}}}};
   // Until the first air sample the compensation is not known: no numbers rather than zeros.
   if (s.pressure_pa > 0) {
     j["air"] = {{"temperature_degc", s.air_temperature_degc},
@@ -79,14 +91,12 @@ std::string to_json_text(const LiveState& s) {
   else if (s.at_target_mm)
     j["display"] = {{"mode", "deviation"},
                     {"value", s.at_target_deviation_um},
-                    {"unit", ::daq::unit_html(s.units.deviation)},
+                    {"unit", deviation_unit},
                     {"decimals", 2},
                     {"target_mm", *s.at_target_mm}};
   else
-    j["display"] = {{"mode", "position"},
-                    {"value", s.position_mm},
-                    {"unit", s.units.position},
-                    {"decimals", 3}};
+    j["display"] = {
+        {"mode", "position"}, {"value", s.position_mm}, {"unit", position_unit}, {"decimals", 3}};
   j["stop"] = {{"number", s.stop_number}, {"count", s.stop_count}};
   json stops = json::array();
   for (const auto& x : s.stops)
@@ -232,7 +242,8 @@ struct LinearRun::Impl : Runner {
   bool forcing = false;                   // the capture by hand being labelled is a forced one
   std::string_view again_key =
       "Capture (C)";  // the key that forces it: the page's, the CLI's Enter
-  std::vector<std::optional<double>> kind_values;  // by stop: a kind's own value, once stored
+  // By stop, once stored: the value of a kind with a reader (its own; a rotary stop's deviation).
+  std::vector<std::optional<double>> kind_values;
   // True for a kind whose stop value is its own instrument's (straightness, angular, roll), not
   // the deviation the sequencer computed from the position (positioning, rotary).
   bool own_value() const { return reader && !kind.stops_from_probe(); }
@@ -577,9 +588,11 @@ struct LinearRun::Impl : Runner {
   void on_capture(const cal::daq::Capture& cap, const cal::daq::Compensated& c) {
     for (const auto& e : sequencer.on_capture(cap)) {
       using Kind = cal::daq::SequenceEvent::Kind;
-      // A kind with its own value says it when stored (store_stop): the sequencer's text holds
-      // the laser's positioning deviation, which is not what the stop measures.
-      if (!(own_value() && e.kind == Kind::captured)) event(e.message);
+      // A kind with a reader says its stop's value when stored (store_stop): the sequencer's
+      // text holds the trigger's mean, which is not what the stop stores (the laser's
+      // positioning deviation; a rotary stop's trigger mean, up to 0.25" from the window mean
+      // of its reference that is stored and evaluated).
+      if (!(reader && e.kind == Kind::captured)) event(e.message);
       if (e.kind == Kind::captured || e.kind == Kind::out_of_order) {
         last_taken = e.stop;
         manual.resize(sequencer.stops().size());
@@ -615,11 +628,15 @@ struct LinearRun::Impl : Runner {
                   double window_mean) {
     const auto& s = sequencer.stops()[stop];
     const double value = kind.stop_value(s.position_mm, window_mean);
-    if (own_value()) {
+    if (reader) {  // the live table and the event show the value stored, not the trigger's
       kind_values.resize(sequencer.stops().size());
       kind_values[stop] = value;
-      event(fmt::format("{}: {} {} {}", sequencer.describe(s), kind.name(),
-                        signed_number_text(value), kind.unit()));
+      if (own_value())
+        event(fmt::format("{}: {} {} {}", sequencer.describe(s), kind.name(),
+                          signed_number_text(value), kind.unit()));
+      else  // rotary: the sequencer's words, with the stored deviation
+        event(fmt::format("{}: {} {}", sequencer.describe(s), signed_number_text(value),
+                          sequencer.units().deviation));
     }
     values.push_back({.position_mm = s.position_mm,
                       .target_index = s.target_index - 1,
@@ -988,13 +1005,13 @@ struct LinearRun::Impl : Runner {
            .target = s.target_index,
            .up = s.direction == cal::iso230_2::Direction::up,
            .nominal_mm = s.position_mm,
-           .deviation_um = own_value() && i < kind_values.size() && kind_values[i] ? *kind_values[i]
-                                                                                   : s.deviation_um,
+           .deviation_um =
+               i < kind_values.size() && kind_values[i] ? *kind_values[i] : s.deviation_um,
            .missed = s.missed && !s.captured,
            .skipped = s.skipped,
            .manual = s.captured && i < manual.size() && manual[i],
            .while_moving = s.captured && i < while_moving.size() && while_moving[i],
-           .pending = s.captured && own_value() && !(i < kind_values.size() && kind_values[i])});
+           .pending = s.captured && reader && !(i < kind_values.size() && kind_values[i])});
     }
     setup.on_live(live);
   }

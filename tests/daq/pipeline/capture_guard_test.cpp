@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -26,10 +27,10 @@ struct Feed {
       {.tolerance_um = 1.0, .span_s = 0.5, .drift_tolerances = 10.0, .force_within_s = 3.0}};
   MotionIndicator motion{{.tolerance_um = 1.0, .dwell_s = 1.5, .window_mm = 0.5}};
   std::int64_t now_ns = 0;
-  // Laser readings every 10 ms up to `until_ms`, at position(t_s) in mm.
+  // Laser readings every `step_ns` (10 ms) up to `until_ms`, at position(t_s) in mm.
   template <typename F>
-  void run_until(std::int64_t until_ms, F position_mm) {
-    for (; now_ns <= until_ms * ms; now_ns += 10 * ms) {
+  void run_until(std::int64_t until_ms, F position_mm, std::int64_t step_ns = 10 * ms) {
+    for (; now_ns <= until_ms * ms; now_ns += step_ns) {
       const double t_s = static_cast<double>(now_ns) * 1e-9;
       // +/- 0.15 um of deterministic noise (the simulated laser's)
       const double x = position_mm(t_s) + 0.15e-3 * std::sin(12345.0 * t_s);
@@ -110,9 +111,48 @@ TEST(CaptureGuard, APositionFeedStillTravellingRefuses) {
   EXPECT_TRUE(g.guard.press(2000 * ms, g.motion.motion()).take);
 }
 
+// The axis leaving 100 mm at 2 s, as a machine starts: 2 m/s^2 (the simulated shop's) up to
+// 1000 mm/min. After 5 ms it has moved 1/2 * 2000 * 0.005^2 = 0.025 mm.
+double starting(double t_s) {
+  constexpr double a = 2000.0, v = 16.667, tv = v / a;  // mm/s^2, mm/s, s to full speed
+  const double d = std::max(0.0, t_s - 2.0);
+  return 100.0 + (d < tv ? 0.5 * a * d * d : 0.5 * a * tv * tv + v * (d - tv));
+}
+
+TEST(CaptureGuard, APressInTheFirstMillisecondsOfAMotionIsRefused) {
+  // A laser at 10 kHz (the IDS3010's rate). 5 ms into the motion, 25 um from the rest: the
+  // indicator still shows the stop (within its 0.5 mm window) and the least-squares line of the
+  // 0.5 s tilts by about 0.5 um (a parabola's tail: worked out numerically, 4 um at 10 ms), far
+  // below the 10 um of drift; but the newest reading is 25 um beyond every reading up to 50 ms
+  // before it (the rest, +/- 0.15 um), more than the 2 um band.
+  Feed f;
+  f.run_until(2005, starting, ms / 10);
+  EXPECT_NE(f.motion.motion(), Motion::moving);
+  const auto v = f.guard.press(f.now_ns - ms / 10, f.motion.motion());
+  EXPECT_FALSE(v.take);
+  EXPECT_NE(v.moving.find("from where it stood"), std::string::npos) << v.moving;
+  // 1 ms in (1 um moved, within the band): the newest readings are still the stop's.
+  Feed g;
+  g.run_until(2001, starting, ms / 10);
+  EXPECT_TRUE(g.guard.press(g.now_ns - ms / 10, g.motion.motion()).take);
+}
+
+TEST(CaptureGuard, AVibrationAt10kHzIsNoDeparture) {
+  // +/- 5 um at 25 Hz read at 10 kHz: every new reading lies within the range of the readings
+  // before it (the vibration's own), so it is taken as at rest, as at 100 Hz above.
+  Feed f;
+  f.run_until(
+      1000, [](double t) { return 100.0 + 5e-3 * std::sin(2 * std::numbers::pi * 25 * t); },
+      ms / 10);
+  const auto v = f.guard.press(f.now_ns - ms / 10, f.motion.motion());
+  EXPECT_TRUE(v.take);
+  EXPECT_TRUE(v.moving.empty()) << v.moving;
+}
+
 TEST(CaptureGuard, NonPositiveSettingsAreRefused) {
   EXPECT_THROW(CaptureGuard({.tolerance_um = 0.0}), cal::InputError);
   EXPECT_THROW(CaptureGuard({.force_within_s = -1.0}), cal::InputError);
+  EXPECT_THROW(CaptureGuard({.departure_lag_s = 0.5}), cal::InputError);  // not within the span
 }
 
 }  // namespace

@@ -7,7 +7,10 @@
 // - the position feed (when there is one) travelling more than the tolerance in the last span_s,
 // - the laser's drift: the least-squares slope of the last span_s of valid readings, times
 //   span_s, above drift_tolerances tolerances (a vibration averages out of a slope; a late
-//   press while the axis leaves the stop does not: 16.7 mm/s at 1000 mm/min).
+//   press while the axis leaves the stop does not: 16.7 mm/s at 1000 mm/min),
+// - the laser's newest reading more than the trigger's band (2 tolerances) beyond every reading
+//   of the span up to departure_lag_s before it: the axis has just left where it stood (the
+//   drift needs some 10 ms of motion to see it; a vibration stays within its own range).
 // A refused press is forced by a second press within force_within_s (of reading time): that
 // capture is taken and said to be taken while moving, so the run's record and report name it.
 #include <cstdint>
@@ -25,6 +28,7 @@ struct CaptureGuardSettings {
   double span_s = 0.5;             // how far back the feed's travel and the laser's drift look
   double drift_tolerances = 10.0;  // drift over span_s that counts as moving (the re-arm rule)
   double force_within_s = 3.0;     // a second press within this forces the capture
+  double departure_lag_s = 0.05;   // the readings a departure is judged against are this old
 };
 
 struct CaptureVerdict {
@@ -51,7 +55,7 @@ class CaptureGuard {
 
  private:
   CaptureGuardSettings s_;
-  std::int64_t span_ns_;
+  std::int64_t span_ns_, lag_ns_;
   std::deque<std::pair<std::int64_t, double>> laser_, feed_;
   std::optional<std::int64_t> refused_ns_;
   static void trim(std::deque<std::pair<std::int64_t, double>>& d, std::int64_t keep_ns);
