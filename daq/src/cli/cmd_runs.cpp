@@ -507,15 +507,16 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
     if (!Json || std::isfinite(v)) return write_shortest(q, v);
     return std::copy_n("null", 4, q);
   };
-  // The time in seconds, from its nanoseconds: where their decimal is its shortest form
-  // (most readings), written without the shortest-digit search; the text is the same either
-  // way (write_shortest_scaled).
+  // The time in seconds: its nanoseconds / 10^9, correctly rounded, in the shortest form (as
+  // clock.seconds(), fmt's "{}"). A reading's own time (most rows: whole nanoseconds) is the
+  // exact decimal of its integer, written from the integer's digits (write_seconds_of_ns); a
+  // time spread inside a group (fractional nanoseconds) goes through the digit search.
   const double since_ns = clock.since_origin_ns(x.session_ns);
-  const double seconds = since_ns * 1e-9;  // = clock.seconds(x.session_ns)
-  if (std::abs(since_ns) < 0x1p53)
-    p = write_shortest_scaled(p, seconds, static_cast<std::int64_t>(since_ns), 9);
+  const auto whole_ns = std::abs(since_ns) < 0x1p62 ? static_cast<std::int64_t>(since_ns) : 0;
+  if (static_cast<double>(whole_ns) == since_ns)
+    p = write_seconds_of_ns(p, whole_ns);
   else
-    p = number(p, seconds);
+    p = number(p, since_ns / 1e9);
   p = Json ? std::copy_n(",\"", 2, p) : std::copy_n(",", 1, p);
   if (clock.has_utc()) {  // (a run without a time origin leaves it empty: no call per row)
     const auto utc = clock.utc_view(x.session_ns);
