@@ -801,7 +801,7 @@ void bench_export(const ExportBenchOptions& o) {
           ? "unquantised (0.1 + 1e-6 sin + 1e-9 k in doubles: 16 - 17 significant digits, which "
             "no instrument stores)"
           : "quantised (q): the 10 kHz length as daq bench ingest's line gauge prints it (mm with "
-            "six decimals, 1 nm) and its driver stores it (the decimal read, x 1e-3 to metres: "
+            "six decimals, 1 nm) and its driver stores it (the decimal in metres, its own double: "
             "raw readings are stored at the instrument's resolution, docs/storage.md); the air "
             "as a PTU300 prints it (0.01 hPa, 0.01 degC, 0.1 %RH)" +
                 std::string(o.values == "both"

@@ -213,6 +213,49 @@ inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e
                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+// The decimal m x 10^-k (0 < m < 10^16, k >= 0) as fmt's "{}" lays out a double whose shortest
+// digits it is, where that layout is fixed notation (its first digit's exponent at least -4);
+// nullptr (nothing written) where it is exponent notation. All 16 digits of m (leading zeros
+// included) in one register; where its first and last digits other than 0 are comes from one
+// comparison (no loop cutting zeros, no second pass writing the digits). Digit i weighs
+// 10^(15 - i - k): the point goes before digit 16 - k. The digits are moved to their places as
+// one 128-bit integer shifted by whole bytes (byte i is digit i), never stored and read back
+// at another offset: that read spans the store and cannot take its data from it (store
+// forwarding fails, a stall of some 15 cycles each time), which made this a third of an
+// export's time while it was a fifth of its instructions (issue 32). The text in two or
+// three stores of 16 bytes: at most 24 characters and up to 16 bytes of no meaning after them.
+__extension__ typedef unsigned __int128 u128;  // (GCC and Clang; __extension__: not ISO C++)
+inline char* write_fixed16(char* p, std::uint64_t m, int k) {
+  const __m128i text = digits16(m);
+  const auto nonzero = static_cast<unsigned>(
+      ~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);  // m > 0: not 0
+  const int first = std::countr_zero(nonzero), last = 31 - std::countl_zero(nonzero);
+  const int point = 16 - k;  // digits [0, point) are the whole part
+  if (point - 1 - first < -4) return nullptr;
+  const auto low = static_cast<std::uint64_t>(_mm_cvtsi128_si64(text));
+  const auto high = static_cast<std::uint64_t>(_mm_cvtsi128_si64(_mm_unpackhi_epi64(text, text)));
+  const u128 all = (static_cast<u128>(high) << 64) | low;  // little-endian: byte i, digit i
+  const auto put = [](char* at, u128 bytes) { std::memcpy(at, &bytes, 16); };
+  const u128 from_first = all >> (8 * first);
+  if (last < point) {  // a whole number: its digits up to the point
+    put(p, from_first);
+    return p + point - first;
+  }
+  if (first < point) {  // digits, the point, the decimals up to the last one not 0
+    const int whole = point - first;
+    put(p, from_first);
+    p[whole] = '.';
+    put(p + whole + 1, all >> (8 * point));
+    return p + whole + 1 + (last + 1 - point);
+  }
+  const int zeros = first - point;  // 0..3 after "0."
+  std::memcpy(p, "0.000000", 8);
+  put(p + 2 + zeros, from_first);
+  return p + 2 + zeros + (last + 1 - first);
+}
+#endif
+
 }  // namespace shortest_detail
 
 // An integer as fmt's "{}" writes it (at most 20 characters, and up to kSpill bytes of no
@@ -274,37 +317,9 @@ inline char* write_shortest_quantised(char* p, double v) {
   if (m == 0 || static_cast<double>(m) / kPow10[k] != a) return write_shortest(p, v);
   char* const start = p;
   if (std::signbit(v)) *p++ = '-';
-#if defined(__SSE2__)
-  // m < 2^51 has at most 16 digits: all 16 (leading zeros included) in one register; where its
-  // first and last digits other than 0 are comes from one comparison (no loop cutting zeros,
-  // no second pass writing the digits). Digit i weighs 10^(15 - i - k): the point goes before
-  // digit 16 - k. fmt's fixed notation (the first digit's exponent at least -4) is written
-  // here in two or three stores of up to 16 bytes; smaller values take write_decimal.
-  alignas(16) char digits[32];
-  const __m128i text = digits16(static_cast<std::uint64_t>(m));
-  _mm_store_si128(reinterpret_cast<__m128i*>(digits), text);
-  _mm_store_si128(reinterpret_cast<__m128i*>(digits + 16), _mm_setzero_si128());
-  const auto nonzero = static_cast<unsigned>(
-      ~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);  // m > 0: not 0
-  const int first = std::countr_zero(nonzero), last = 31 - std::countl_zero(nonzero);
-  const int point = 16 - k;  // digits [0, point) are the whole part
-  if (point - 1 - first >= -4) {
-    if (last < point) {  // a whole number: its digits up to the point
-      std::memcpy(p, digits + first, 16);
-      return p + point - first;
-    }
-    if (first < point) {  // digits, the point, the decimals up to the last one not 0
-      const int whole = point - first;
-      std::memcpy(p, digits + first, 16);
-      p[whole] = '.';
-      std::memcpy(p + whole + 1, digits + point, 16);
-      return p + whole + 1 + (last + 1 - point);
-    }
-    const int zeros = first - point;  // 0..3 after "0."
-    std::memcpy(p, "0.000000", 8);
-    std::memcpy(p + 2 + zeros, digits + first, 16);
-    return p + 2 + zeros + (last + 1 - first);
-  }
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+  // m < 2^51 has at most 16 digits; fmt's fixed notation in a few stores (write_fixed16).
+  if (char* const end = write_fixed16(p, static_cast<std::uint64_t>(m), k)) return end;
 #endif
   // Exponent notation (or no SSE2): m x 10^-k is v's decimal, written as write_shortest_scaled
   // writes one (its trailing zeros cut, then write_decimal).
@@ -389,32 +404,17 @@ inline char* write_seconds_of_ns(char* p, std::int64_t ns) {
     return p + 1;
   }
   if (ns < 0) *p++ = '-';
-  if (std::endian::native != std::endian::little || u < 100'000) {
-    // Under 1e-4 s (fmt's exponent notation), or a big-endian machine: the decimal's
-    // significand without its trailing zeros, laid out as write_shortest lays out Dragonbox's.
-    int exponent = -9;
-    while (u % 10 == 0) {
-      u /= 10;
-      ++exponent;
-    }
-    return write_decimal(p, u, exponent);
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+  if (u >= 100'000) return shortest_detail::write_fixed16(p, u, 9);  // from 1e-4 s: fixed
+#endif
+  // Under 1e-4 s (fmt's exponent notation), or no SSE2: the decimal's significand without its
+  // trailing zeros, laid out as write_shortest lays out Dragonbox's.
+  int exponent = -9;
+  while (u % 10 == 0) {
+    u /= 10;
+    ++exponent;
   }
-  const std::uint64_t whole = u / 1'000'000'000;  // < 10^6: one store
-  const auto fraction = static_cast<std::uint32_t>(u - whole * 1'000'000'000);
-  const int size = fmt::detail::count_digits(whole);
-  write_last(p, static_cast<std::uint32_t>(whole), size);
-  p += size;
-  if (fraction == 0) return p;  // a whole second: no point
-  // Decimals 2..9 in one word (little-endian: decimal 9 its top byte); its top bytes that are
-  // '0' are the trailing zeros cut (no loop dividing by 10, whose branches the varied zeros of
-  // a time mispredicted).
-  const std::uint64_t last8 = digits8(fraction % 100'000'000);
-  const std::uint64_t nonzero = last8 ^ 0x3030303030303030ULL;  // a '0' byte becomes 0
-  const int decimals = nonzero == 0 ? 1 : 9 - std::countl_zero(nonzero) / 8;
-  p[0] = '.';
-  p[1] = static_cast<char>('0' + fraction / 100'000'000);
-  std::memcpy(p + 2, &last8, 8);
-  return p + 1 + decimals;
+  return shortest_detail::write_decimal(p, u, exponent);
 }
 
 }  // namespace daq
