@@ -226,7 +226,7 @@ inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e
 // export's time while it was a fifth of its instructions (issue 32). The text in two or
 // three stores of 16 bytes: at most 24 characters and up to 16 bytes of no meaning after them.
 __extension__ typedef unsigned __int128 u128;  // (GCC and Clang; __extension__: not ISO C++)
-inline char* write_fixed16(char* p, std::uint64_t m, int k) {
+[[gnu::always_inline]] inline char* write_fixed16(char* p, std::uint64_t m, int k) {
   const __m128i text = digits16(m);
   const auto nonzero = static_cast<unsigned>(
       ~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);  // m > 0: not 0
