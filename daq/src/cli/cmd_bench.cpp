@@ -600,7 +600,7 @@ enum class BenchValues {
 // si_exponent), one correctly rounded division (or n x 10^(si_exponent - decimals), exact).
 double as_printed(double value, int decimals, int si_exponent) {
   const double n = std::round(value * std::pow(10.0, decimals));  // the digits, < 2^53
-  const int shift = decimals - si_exponent;                         // |shift| <= 22
+  const int shift = decimals - si_exponent;                       // |shift| <= 22
   return shift >= 0 ? n / std::pow(10.0, shift) : n * std::pow(10.0, -shift);
 }
 

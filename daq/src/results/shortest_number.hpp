@@ -285,8 +285,8 @@ inline char* write_shortest(char* p, double v) {
 
 // The same text as write_shortest(p, v), for a stored reading: where v is the double of a
 // decimal with at most about 15 significant digits (an instrument's reading at its resolution,
-// as its driver stores it: a gauge's printed millimetres x 1e-3, an IDS3010's integer picometres
-// x 1e-12; docs/benchmarks.md, "Exports, fourth pass"), that decimal is written without the
+// as its driver stores it: a gauge's printed millimetres, an IDS3010's integer picometres, in
+// metres; docs/benchmarks.md, "Exports, fourth pass"), that decimal is written without the
 // shortest-digit search (Dragonbox, 150 instructions a value, issue 32); otherwise
 // write_shortest. The decimal is proven, not assumed, so any v gives fmt's "{}" text.
 //
