@@ -582,23 +582,26 @@ void bench_ingest(const BenchOptions& o) {
 // The generated readings' values: exactly as a real instrument's driver stores them, or not.
 enum class BenchValues {
   // The length as `daq bench ingest`'s gauge prints it ("%+011.6f" mm: 1 nm, six decimals of a
-  // millimetre) and the line-gauge driver stores it: the printed decimal read as one correctly
-  // rounded division (parse_plain_decimal: the integer nanometres / 10^6), then
-  // (printed x scale + offset) x 1e-3 with the default scale 1 and offset 0 (GaugeCodec::to_si,
-  // unit_factor(mm)); the air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=  50.0
-  // %RH": hPa x 100, two decimals of degC, one of %RH). What a store holds: raw readings, at
-  // the instrument's resolution, converted to SI by one multiplication (docs/storage.md).
+  // millimetre) and the line-gauge driver stores it: the printed decimal in SI, the double
+  // nearest it (the printed digits as an integer divided by the exact power of ten: 10^9 for
+  // nanometres in metres); the air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=
+  // 50.0 %RH": two decimals of hPa in Pa, two of degC, one of %RH). What a store holds: raw
+  // readings at the instrument's resolution, each its decimal's own double (docs/storage.md;
+  // before issue 32's last pass the drivers multiplied by 1e-3, which left a quarter of the
+  // lengths one ulp off their decimal).
   quantised,
   // 0.1 + 1e-6 sin(...) + 1e-9 k computed in doubles: 16 - 17 significant digits a value, as
   // no instrument stores them (a compensated length would be; the store holds none).
   unquantised,
 };
 
-// printed_units x 10^-decimals as a driver reads the printed decimal (Clinger's one division,
-// cal::drivers::codec::parse_plain_decimal), times the driver's factor to SI.
-double as_printed(double value, int decimals, double factor_to_si) {
-  const double scale = std::pow(10.0, decimals);  // exact for decimals <= 22
-  return std::round(value * scale) / scale * factor_to_si;
+// value rounded to `decimals` decimals as printed, in SI units of 10^si_exponent printed units
+// (mm in m: -3; hPa in Pa: 2): the printed digits as an integer n, then n / 10^(decimals -
+// si_exponent), one correctly rounded division (or n x 10^(si_exponent - decimals), exact).
+double as_printed(double value, int decimals, int si_exponent) {
+  const double n = std::round(value * std::pow(10.0, decimals));  // the digits, < 2^53
+  const int shift = decimals - si_exponent;                       // |shift| <= 22
+  return shift >= 0 ? n / std::pow(10.0, shift) : n * std::pow(10.0, -shift);
 }
 
 // A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
@@ -623,22 +626,22 @@ std::int64_t generate_run(cal::storage::Store& store, int seconds,
         0.1 + 1e-6 * std::sin(1e-4 * static_cast<double>(i)) + 1e-9 * static_cast<double>(i % 977);
     batch.push_back({.time_ns = t,
                      .quantity = 1,
-                     .value = quantised ? as_printed(length_m * 1e3, 6, 1e-3) : length_m});
+                     .value = quantised ? as_printed(length_m * 1e3, 6, -3) : length_m});
     if (i % 10'000 == 0) {
       const double s = static_cast<double>(i / 10'000);
       const double air[3] = {20.0 + 1e-3 * s, 101325.0 - 0.1 * s, 45.0 + 1e-2 * s};
       batch.push_back({.time_ns = t,
                        .device = 1,
                        .quantity = 2,
-                       .value = quantised ? as_printed(air[0], 2, 1.0) : air[0]});
+                       .value = quantised ? as_printed(air[0], 2, 0) : air[0]});
       batch.push_back({.time_ns = t,
                        .device = 1,
                        .quantity = 3,
-                       .value = quantised ? as_printed(air[1] / 100.0, 2, 100.0) : air[1]});
+                       .value = quantised ? as_printed(air[1] / 100.0, 2, 2) : air[1]});
       batch.push_back({.time_ns = t,
                        .device = 1,
                        .quantity = 4,
-                       .value = quantised ? as_printed(air[2], 1, 1.0) : air[2]});
+                       .value = quantised ? as_printed(air[2], 1, 0) : air[2]});
     }
     if (batch.size() >= 16384) {
       store.append_readings(run, batch);
@@ -798,7 +801,7 @@ void bench_export(const ExportBenchOptions& o) {
           ? "unquantised (0.1 + 1e-6 sin + 1e-9 k in doubles: 16 - 17 significant digits, which "
             "no instrument stores)"
           : "quantised (q): the 10 kHz length as daq bench ingest's line gauge prints it (mm with "
-            "six decimals, 1 nm) and its driver stores it (the decimal read, x 1e-3 to metres: "
+            "six decimals, 1 nm) and its driver stores it (the decimal in metres, its own double: "
             "raw readings are stored at the instrument's resolution, docs/storage.md); the air "
             "as a PTU300 prints it (0.01 hPa, 0.01 degC, 0.1 %RH)" +
                 std::string(o.values == "both"

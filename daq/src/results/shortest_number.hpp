@@ -213,6 +213,49 @@ inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e
                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+// The decimal m x 10^-k (0 < m < 10^16, k >= 0) as fmt's "{}" lays out a double whose shortest
+// digits it is, where that layout is fixed notation (its first digit's exponent at least -4);
+// nullptr (nothing written) where it is exponent notation. All 16 digits of m (leading zeros
+// included) in one register; where its first and last digits other than 0 are comes from one
+// comparison (no loop cutting zeros, no second pass writing the digits). Digit i weighs
+// 10^(15 - i - k): the point goes before digit 16 - k. The digits are moved to their places as
+// one 128-bit integer shifted by whole bytes (byte i is digit i), never stored and read back
+// at another offset: that read spans the store and cannot take its data from it (store
+// forwarding fails, a stall of some 15 cycles each time), which made this a third of an
+// export's time while it was a fifth of its instructions (issue 32). The text in two or
+// three stores of 16 bytes: at most 24 characters and up to 16 bytes of no meaning after them.
+__extension__ typedef unsigned __int128 u128;  // (GCC and Clang; __extension__: not ISO C++)
+[[gnu::always_inline]] inline char* write_fixed16(char* p, std::uint64_t m, int k) {
+  const __m128i text = digits16(m);
+  const auto nonzero = static_cast<unsigned>(
+      ~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);  // m > 0: not 0
+  const int first = std::countr_zero(nonzero), last = 31 - std::countl_zero(nonzero);
+  const int point = 16 - k;  // digits [0, point) are the whole part
+  if (point - 1 - first < -4) return nullptr;
+  const auto low = static_cast<std::uint64_t>(_mm_cvtsi128_si64(text));
+  const auto high = static_cast<std::uint64_t>(_mm_cvtsi128_si64(_mm_unpackhi_epi64(text, text)));
+  const u128 all = (static_cast<u128>(high) << 64) | low;  // little-endian: byte i, digit i
+  const auto put = [](char* at, u128 bytes) { std::memcpy(at, &bytes, 16); };
+  const u128 from_first = all >> (8 * first);
+  if (last < point) {  // a whole number: its digits up to the point
+    put(p, from_first);
+    return p + point - first;
+  }
+  if (first < point) {  // digits, the point, the decimals up to the last one not 0
+    const int whole = point - first;
+    put(p, from_first);
+    p[whole] = '.';
+    put(p + whole + 1, all >> (8 * point));
+    return p + whole + 1 + (last + 1 - point);
+  }
+  const int zeros = first - point;  // 0..3 after "0."
+  std::memcpy(p, "0.000000", 8);
+  put(p + 2 + zeros, from_first);
+  return p + 2 + zeros + (last + 1 - first);
+}
+#endif
+
 }  // namespace shortest_detail
 
 // An integer as fmt's "{}" writes it (at most 20 characters, and up to kSpill bytes of no
@@ -242,8 +285,8 @@ inline char* write_shortest(char* p, double v) {
 
 // The same text as write_shortest(p, v), for a stored reading: where v is the double of a
 // decimal with at most about 15 significant digits (an instrument's reading at its resolution,
-// as its driver stores it: a gauge's printed millimetres x 1e-3, an IDS3010's integer picometres
-// x 1e-12; docs/benchmarks.md, "Exports, fourth pass"), that decimal is written without the
+// as its driver stores it: a gauge's printed millimetres, an IDS3010's integer picometres, in
+// metres; docs/benchmarks.md, "Exports, fourth pass"), that decimal is written without the
 // shortest-digit search (Dragonbox, 150 instructions a value, issue 32); otherwise
 // write_shortest. The decimal is proven, not assumed, so any v gives fmt's "{}" text.
 //
@@ -274,48 +317,20 @@ inline char* write_shortest_quantised(char* p, double v) {
   if (m == 0 || static_cast<double>(m) / kPow10[k] != a) return write_shortest(p, v);
   char* const start = p;
   if (std::signbit(v)) *p++ = '-';
-#if defined(__SSE2__)
-  // m < 2^51 has at most 16 digits: all 16 (leading zeros included) in one register; where its
-  // first and last digits other than 0 are comes from one comparison (no loop cutting zeros,
-  // no second pass writing the digits). Digit i weighs 10^(15 - i - k): the point goes before
-  // digit 16 - k. fmt's fixed notation (the first digit's exponent at least -4) is written
-  // here in two or three stores of up to 16 bytes; smaller values take write_decimal.
-  alignas(16) char digits[32];
-  const __m128i text = digits16(static_cast<std::uint64_t>(m));
-  _mm_store_si128(reinterpret_cast<__m128i*>(digits), text);
-  _mm_store_si128(reinterpret_cast<__m128i*>(digits + 16), _mm_setzero_si128());
-  const auto nonzero = static_cast<unsigned>(
-      ~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);  // m > 0: not 0
-  const int first = std::countr_zero(nonzero), last = 31 - std::countl_zero(nonzero);
-  const int point = 16 - k;  // digits [0, point) are the whole part
-  if (point - 1 - first >= -4) {
-    if (last < point) {  // a whole number: its digits up to the point
-      std::memcpy(p, digits + first, 16);
-      return p + point - first;
-    }
-    if (first < point) {  // digits, the point, the decimals up to the last one not 0
-      const int whole = point - first;
-      std::memcpy(p, digits + first, 16);
-      p[whole] = '.';
-      std::memcpy(p + whole + 1, digits + point, 16);
-      return p + whole + 1 + (last + 1 - point);
-    }
-    const int zeros = first - point;  // 0..3 after "0."
-    std::memcpy(p, "0.000000", 8);
-    std::memcpy(p + 2 + zeros, digits + first, 16);
-    return p + 2 + zeros + (last + 1 - first);
-  }
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+  // m < 2^51 has at most 16 digits; fmt's fixed notation in a few stores (write_fixed16).
+  if (char* const end = write_fixed16(p, static_cast<std::uint64_t>(m), k)) return end;
 #endif
   // Exponent notation (or no SSE2): m x 10^-k is v's decimal, written as write_shortest_scaled
   // writes one (its trailing zeros cut, then write_decimal).
   return write_shortest_scaled(start, v, std::signbit(v) ? -m : m, k);
 }
 
-// The same text as write_shortest(p, v), for a v the caller computed from m x 10^-k (an export's
-// time in seconds from its integer nanoseconds, k = 9): where the decimal m x 10^-k is v's
-// shortest round trip, it is written without the shortest-digit search (Dragonbox, a quarter
-// of an export's time, issue 32); otherwise write_shortest. m is only a guess: the decimal is
-// taken only where it is proven to be what Dragonbox gives, so any m gives the same text.
+// The same text as write_shortest(p, v), for a v the caller knows to be near the decimal
+// m x 10^-k (write_shortest_quantised's proven guess): where that decimal is v's shortest round
+// trip, it is written without the shortest-digit search (Dragonbox, a quarter of an export's
+// time, issue 32); otherwise write_shortest. m is only a guess: the decimal is taken only where
+// it is proven to be what Dragonbox gives, so any m gives the same text.
 //
 // The proof: strip m's trailing zeros, m = q x 10^z, d = k - z decimals, c = q x 10^-d.
 //  1. c reads back as v: q < 2^53 and 10^d (d <= 22) are exact doubles, so q / 10^d is one
@@ -327,41 +342,9 @@ inline char* write_shortest_quantised(char* p, double v) {
 //     digits would be below c's leading power of ten with the same d decimals (so again at
 //     least 10^-d away). Dragonbox gives the shortest, so it gives c: significand q,
 //     exponent -d (its trailing zeros removed, as here).
-//
-// Nanoseconds (k = 9, the export's times) take a shorter way to the same decimal, with the same
-// two conditions: v = |m| / 10^9 as one correctly rounded division (the same rational as
-// q / 10^d, so the same double), and |v| 10^d < 2^51, d the decimals left when the nine-digit
-// fraction's trailing zeros are cut; the fraction's digits are written in one 8-byte store and
-// its trailing zeros counted from that word (no loop dividing by 10, whose branches the varied
-// zeros of a time mispredicted: the old way saved only a tenth of the digit search, issue 32).
 inline char* write_shortest_scaled(char* p, double v, std::int64_t m, int k) {
   using namespace shortest_detail;
   constexpr std::int64_t kExact = std::int64_t{1} << 53;
-  if constexpr (std::endian::native == std::endian::little) {
-    // From 10^5 ns (1e-4 s: fmt's fixed notation starts there) to below 2^53.
-    if (k == 9 && m >= 100'000 && m < kExact && v > 0.0) {
-      // Not the division's double: no decimal with at most 9 decimals reads back as v (the
-      // division is what strtod makes of the decimal), so the digit search it is.
-      if (static_cast<double>(m) / 1e9 != v) return write_shortest(p, v);
-      const auto n = static_cast<std::uint64_t>(m);
-      const std::uint64_t whole = n / 1'000'000'000;  // < 2^53 / 10^9 < 10^7: one store
-      const auto fraction = static_cast<std::uint32_t>(n - whole * 1'000'000'000);
-      const std::uint64_t last8 = digits8(fraction % 100'000'000);  // decimals 2..9, in order
-      const std::uint64_t nonzero = last8 ^ 0x3030303030303030ULL;  // a '0' byte becomes 0
-      // Decimals after the cut: 0 for a whole second, 1 when only the first is not zero.
-      const int d = fraction == 0 ? 0 : nonzero == 0 ? 1 : 9 - std::countl_zero(nonzero) / 8;
-      if (v * kPow10[d] < 0x1p51) {
-        const int size = fmt::detail::count_digits(whole);
-        write_last(p, static_cast<std::uint32_t>(whole), size);
-        p += size;
-        if (d == 0) return p;
-        p[0] = '.';
-        p[1] = static_cast<char>('0' + fraction / 100'000'000);
-        std::memcpy(p + 2, &last8, 8);
-        return p + 1 + d;
-      }
-    }
-  }
   // Normal, finite, nonzero v of m's sign; q < 2^53; 0 <= k <= 22 (else the general way).
   if (m == 0 || m <= -kExact || m >= kExact || k < 0 || k > 22 || (m < 0) != std::signbit(v) ||
       !(std::abs(v) >= 0x1p-1022) || !(std::abs(v) < 0x1p53))
@@ -386,6 +369,52 @@ inline char* write_shortest_scaled(char* p, double v, std::int64_t m, int k) {
   }
   if (m < 0) *p++ = '-';
   return write_decimal(p, q, exponent);
+}
+
+// Seconds from integer nanoseconds, as the exports' time_s column writes them: the same text as
+// write_shortest(p, static_cast<double>(ns) / 1e9), the correctly rounded quotient's shortest
+// round trip, for every ns; below 10^15 ns (11.5 days) that text is the exact decimal of ns
+// 10^-9, written here from the integer's digits (the point placed, trailing zeros cut, fmt's
+// layout: fixed from 1e-4 s, 99,999 ns and less as d.ddde-XX) with no digit search and no
+// proof. The exports once wrote ns x 1e-9, whose second rounding gave 41 % of a 100 us grid's
+// times as 17-digit neighbours of their decimals (0.00030000000000000003): issue 32.
+//
+// Why the decimal is the shortest round trip: c = |ns| / 10^9 is a decimal of at most 15
+// significant digits (|ns| < 10^15), in the decade [10^e, 10^(e+1)), so a multiple of
+// 10^(e-14). v, the double nearest c (one correctly rounded division: ns and 10^9 are exact
+// doubles), lies in [2^b, 2^(b+1)) with 2^b <= v <= 10^(e+1) (1 + 2^-53), so ulp(v) = 2^(b-52)
+// < 10^(e+1) 2^-52 (1 + 2^-53) < 0.23 x 10^(e-14). The decimals that read back as v lie in v's
+// rounding interval, at most ulp(v) wide, and c is one of them; any other x in it is within
+// 0.23 x 10^(e-14) of c. In c's decade, x of at most 15 significant digits is a multiple of
+// 10^(e-14): not that close. Above it, x >= 10^(e+1) >= c + 10^(e-14): neither. Below it,
+// x < 10^e <= c, so c - x < 0.23 x 10^(e-14) leaves only c = 10^e, a single digit. So no
+// decimal shorter than c, and none other as short, reads back as v: Dragonbox's shortest is
+// c (significand and exponent with trailing zeros cut), and fmt lays it out as here. (This is
+// why DBL_DIG is 15.) From 10^15 ns on, a 16-digit decimal need not be the shortest text of
+// its double (ulp(v) reaches 10^(e-15)): those go to write_shortest of the quotient, whose
+// text reads back as the same double but may differ from the exact decimal in its last digit
+// (the time_ns column keeps the integer).
+inline char* write_seconds_of_ns(char* p, std::int64_t ns) {
+  using namespace shortest_detail;
+  std::uint64_t u = static_cast<std::uint64_t>(ns);
+  if (ns < 0) u = 0 - u;
+  if (u >= 1'000'000'000'000'000ULL) return write_shortest(p, static_cast<double>(ns) / 1e9);
+  if (u == 0) {
+    *p = '0';
+    return p + 1;
+  }
+  if (ns < 0) *p++ = '-';
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+  if (u >= 100'000) return shortest_detail::write_fixed16(p, u, 9);  // from 1e-4 s: fixed
+#endif
+  // Under 1e-4 s (fmt's exponent notation), or no SSE2: the decimal's significand without its
+  // trailing zeros, laid out as write_shortest lays out Dragonbox's.
+  int exponent = -9;
+  while (u % 10 == 0) {
+    u /= 10;
+    ++exponent;
+  }
+  return shortest_detail::write_decimal(p, u, exponent);
 }
 
 }  // namespace daq

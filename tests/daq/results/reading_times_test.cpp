@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,27 @@ TEST(ExportRows, SingleReadingsKeepTheirTimeAndGroupsAreSpreadStreamByStream) {
     EXPECT_NEAR(out[i].session_ns, want[i].session_ns, 1e-6) << i;
     EXPECT_EQ(out[i].tag, want[i].tag) << i;
     EXPECT_EQ(out[i].r.value, static_cast<double>(out[i].r.time_ns)) << i;  // the reading's own
+  }
+  // add_batch (the exports' way, which hands a reading alone at its time straight on): the same
+  // rows and times by hand, however the store cuts the readings into batches (every cut).
+  for (unsigned cuts = 0; cuts < (1U << (in.size() - 1)); ++cuts) {
+    daq::ExportClock batch_clock(store, *store.run(run), nlohmann::json::object());
+    daq::ExportRows batch_rows(batch_clock);
+    std::vector<daq::ExportRow> got;
+    const auto keep = [&](const daq::ExportRow& x) { got.push_back(x); };
+    std::size_t from = 0;
+    for (std::size_t i = 1; i <= in.size(); ++i)
+      if (i == in.size() || ((cuts >> (i - 1)) & 1U) != 0) {
+        batch_rows.add_batch(std::span(in).subspan(from, i - from), keep);
+        from = i;
+      }
+    batch_rows.finish_each(keep);
+    ASSERT_EQ(got.size(), want.size()) << cuts;
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      ASSERT_EQ(got[i].r.device, want[i].device) << cuts << " " << i;
+      ASSERT_NEAR(got[i].session_ns, want[i].session_ns, 1e-6) << cuts << " " << i;
+      ASSERT_EQ(got[i].r.value, static_cast<double>(got[i].r.time_ns)) << cuts << " " << i;
+    }
   }
   fs::remove(db);
 }

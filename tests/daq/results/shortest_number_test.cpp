@@ -355,4 +355,80 @@ TEST(ShortestNumber, IntegersAsFmtWritesThem) {
   }
 }
 
+// write_seconds_of_ns, the exports' time_s column: fmt's "{}" of ns / 1e9 (the correctly rounded
+// quotient) for every ns, read back by strtod as that double; below 10^15 ns also the exact
+// decimal of ns x 10^-9, built here with strings (the integer's digits, the point put nine
+// from the end, trailing zeros cut), independent of fmt and of the code.
+std::string seconds_difference(std::int64_t ns) {
+  char buf[64];
+  const std::string got(buf, daq::write_seconds_of_ns(buf, ns));
+  const double v = static_cast<double>(ns) / 1e9;
+  const std::string want = fmt::format("{}", v);
+  if (got != want || got.size() > 24)
+    return fmt::format("{} ns: fmt \"{}\", write_seconds_of_ns \"{}\"", ns, want, got);
+  if (std::strtod(got.c_str(), nullptr) != v) return fmt::format("{} ns: \"{}\" misread", ns, got);
+  const std::uint64_t u =
+      ns < 0 ? 0 - static_cast<std::uint64_t>(ns) : static_cast<std::uint64_t>(ns);
+  if (u >= 1'000'000'000'000'000ULL || u < 100'000) return {};  // beyond 15 digits; d.ddde-XX
+  std::string digits = std::to_string(u);
+  digits.insert(0, std::string(digits.size() < 10 ? 10 - digits.size() : 0, '0'));
+  std::string exact = digits.substr(0, digits.size() - 9) + "." + digits.substr(digits.size() - 9);
+  while (exact.back() == '0') exact.pop_back();
+  if (exact.back() == '.') exact.pop_back();
+  if (ns < 0) exact.insert(0, "-");
+  if (got != exact) return fmt::format("{} ns: \"{}\", the exact decimal \"{}\"", ns, got, exact);
+  return {};
+}
+
+TEST(ShortestNumber, SecondsOfNanosecondsAreTheirExactDecimal) {
+  std::vector<std::int64_t> ns = {0,
+                                  1,
+                                  -1,
+                                  10,
+                                  99'999,
+                                  100'000,
+                                  100'001,
+                                  300'000,
+                                  999'999'999,
+                                  1'000'000'000,
+                                  1'000'000'001,
+                                  1'100'000'000,
+                                  -1'500'000'000,
+                                  999'999'999'999'999,
+                                  1'000'000'000'000'000,
+                                  1'000'000'000'000'001,
+                                  (std::int64_t{1} << 53) - 1,
+                                  std::int64_t{1} << 53,
+                                  (std::int64_t{1} << 53) + 1,
+                                  std::numeric_limits<std::int64_t>::max(),
+                                  std::numeric_limits<std::int64_t>::min()};
+  std::mt19937_64 rng(9);
+  for (int i = 0; i < 2'000'000; ++i) {  // every length and count of trailing zeros, both signs
+    const auto grid = static_cast<std::int64_t>(std::pow(10.0, rng() % 10));
+    const auto n = static_cast<std::int64_t>(rng() >> (1 + rng() % 63)) / grid * grid;
+    ns.push_back(i % 5 == 0 ? -n : n);
+  }
+  for (std::int64_t t = 0; t < 36'000'000'000'000; t += 3'600'000'017)  // 10 h on odd steps
+    for (std::int64_t step : {0, 100'000, 1})  // the bench's 100 us grid, 1 ns off it
+      ns.push_back(t / 100'000 * 100'000 + step);
+  for (int e = 0; e <= 17; ++e) {  // every power of ten and its neighbours
+    const auto p = static_cast<std::int64_t>(std::pow(10.0, e));
+    for (std::int64_t n : {p - 1, p, p + 1, 3 * p, 9 * p + p - 1}) ns.push_back(n);
+  }
+  for (const auto n : ns) ASSERT_EQ(seconds_difference(n), "");
+  char buf[64];
+  const auto text = [&](std::int64_t n) {
+    return std::string(buf, daq::write_seconds_of_ns(buf, n));
+  };
+  // By hand: 300 us, which ns x 1e-9 made 0.00030000000000000003; fmt's exponent notation
+  // below 1e-4 s; a whole second; the last 15-digit time.
+  EXPECT_EQ(text(300'000), "0.0003");
+  EXPECT_NE(fmt::format("{}", 300'000.0 * 1e-9), "0.0003");  // why the column changed
+  EXPECT_EQ(text(99'999), "9.9999e-05");
+  EXPECT_EQ(text(5), "5e-09");
+  EXPECT_EQ(text(-1'500'000'000), "-1.5");
+  EXPECT_EQ(text(600'000'000'000), "600");
+  EXPECT_EQ(text(999'999'999'999'999), "999999.999999999");
+}
+
 }  // namespace
