@@ -184,9 +184,11 @@ struct Model {
   // k = 2 pi R / period: the cyclic columns' wave number along the axes.
   double wave_number(double period_mm) const { return 2 * pi * r_mm / period_mm; }
 
-  // The basis row of a sample in direction s, the terms that are off left at 0.
+  // The basis row of a sample in direction s, the terms that are off left at 0; with `cyclic`
+  // false the four cyclic columns are left at 0 too, without their sines and cosines (a pass
+  // whose cyclic rows of the normal equations come from CyclicSeries: issue 32).
   template <class RowRef>
-  void row(const Sample& x, double s, double k, RowRef&& out) const {
+  void row(const Sample& x, double s, double k, RowRef&& out, bool cyclic = true) const {
     const double c = x.c, n = x.n;
     const double c2 = c * c - n * n, s2 = 2 * c * n;  // cos 2t, sin 2t
     const double pu = k * c, pv = k * n;
@@ -202,14 +204,17 @@ struct Model {
                                               -s * std::abs(n),
                                               x.spike_u,
                                               x.spike_v,
-                                              c * std::sin(pu),
-                                              c * std::cos(pu),
-                                              n * std::sin(pv),
-                                              n * std::cos(pv),
+                                              cyclic ? c * std::sin(pu) : 0.0,
+                                              cyclic ? c * std::cos(pu) : 0.0,
+                                              cyclic ? n * std::sin(pv) : 0.0,
+                                              cyclic ? n * std::cos(pv) : 0.0,
                                               n * n * c,
                                               c * c * n};
     for (int j = 0; j < term_count; ++j)
-      out(j) = on[static_cast<std::size_t>(j)] ? b[static_cast<std::size_t>(j)] : 0.0;
+      out(j) = on[static_cast<std::size_t>(j)] &&
+                       (cyclic || j < cyclic_first || j >= cyclic_first + cyclic_count)
+                   ? b[static_cast<std::size_t>(j)]
+                   : 0.0;
   }
 };
 
@@ -272,8 +277,15 @@ using TermVector = Eigen::Matrix<double, term_count, 1>;
 // The samples in blocks of rows of the design (every stride-th sample): f(block, y, first) with
 // the block's first row's index. A pass holds one block (18 kB), never the n x 18 design.
 using Block = Eigen::Matrix<double, Eigen::Dynamic, term_count>;
-template <class F>
-void for_each_block(const Model& m, const Samples& samples, std::size_t stride, double k, F&& f) {
+// `each(at, x)`, if given, sees every sample's record as it is read (another pass's per-sample
+// work done in this one: each record rebuilt costs a sine, a cosine and four exponentials);
+// `cyclic` false leaves the cyclic columns 0 (Model::row).
+struct NoHook {
+  void operator()(std::size_t, const Sample&) const {}
+};
+template <class F, class Each = NoHook>
+void for_each_block(const Model& m, const Samples& samples, std::size_t stride, double k, F&& f,
+                    Each&& each = {}, bool cyclic = true) {
   constexpr std::size_t block_rows = 128;  // 18 kB: the rows are written where they are read
   const std::size_t n = (samples.size() + stride - 1) / stride;
   Block b(static_cast<Eigen::Index>(std::min(n, block_rows)), term_count);
@@ -283,7 +295,8 @@ void for_each_block(const Model& m, const Samples& samples, std::size_t stride, 
     for (Eigen::Index i = 0; i < rows; ++i) {
       const std::size_t at = (first + static_cast<std::size_t>(i)) * stride;
       const Sample x = samples[at];
-      m.row(x, m.direction(at), k, b.row(i));
+      each(at, x);
+      m.row(x, m.direction(at), k, b.row(i), cyclic);
       y[i] = x.y;
     }
     f(b.topRows(rows), y.head(rows), first);
@@ -501,9 +514,12 @@ class CyclicSeries {
 // recomputes only the four cyclic columns' rows of the Gram matrix, in one more pass.
 class Design {
  public:
-  // `series`, if given, takes every block of the design's pass too (the period search's sums).
+  // `series`, if given, takes every block of the design's pass too (the period search's sums),
+  // and then the cyclic columns are not made: their rows of the normal equations are the
+  // series' (use_cyclic_rows). `each(at, x)` sees every sample read (for_each_block).
+  template <class Each = NoHook>
   Design(const Model& m, const Samples& samples, std::size_t stride, double period_mm,
-         CyclicSeries* series = nullptr)
+         CyclicSeries* series = nullptr, Each&& each = {})
       : m_(m), samples_(samples), stride_(stride), period_mm_(period_mm) {
     ata_.setZero();
     aty_.setZero();
@@ -512,18 +528,31 @@ class Design {
       dense_.resize(static_cast<Eigen::Index>(rows), term_count);
       dense_y_.resize(static_cast<Eigen::Index>(rows));
     }
-    for_each_block(m_, samples_, stride_, k(),
-                   [&](const auto& b, const auto& y, std::size_t first) {
-                     ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
-                     aty_.noalias() += b.transpose() * y;
-                     yty_ += y.squaredNorm();
-                     if (series) series->add(b, y);
-                     if (dense_.rows() > 0) {
-                       dense_.middleRows(static_cast<Eigen::Index>(first), b.rows()) = b;
-                       dense_y_.segment(static_cast<Eigen::Index>(first), b.rows()) = y;
-                     }
-                   });
+    for_each_block(
+        m_, samples_, stride_, k(),
+        [&](const auto& b, const auto& y, std::size_t first) {
+          ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
+          aty_.noalias() += b.transpose() * y;
+          yty_ += y.squaredNorm();
+          if (series) series->add(b, y);
+          if (dense_.rows() > 0) {
+            dense_.middleRows(static_cast<Eigen::Index>(first), b.rows()) = b;
+            dense_y_.segment(static_cast<Eigen::Index>(first), b.rows()) = y;
+          }
+        },
+        each, series == nullptr);
     ata_.triangularView<Eigen::StrictlyUpper>() = ata_.transpose();
+    if (series) dense_.resize(0, term_count);  // its cyclic columns were not made
+  }
+
+  // The cyclic rows of the normal equations at `period_mm` given (CyclicSeries::rows at the
+  // period found), as set_cyclic's pass would make them to the sums' rounding (issue 32: that
+  // pass was a tenth of a long replay).
+  void use_cyclic_rows(const CyclicRows& rows, double period_mm) {
+    period_mm_ = period_mm;
+    ata_.middleRows<cyclic_count>(cyclic_first) = rows.cross;
+    ata_.middleCols<cyclic_count>(cyclic_first) = rows.cross.transpose();
+    aty_.segment<cyclic_count>(cyclic_first) = rows.cty;
   }
 
   Solution solve(double period_mm) {
@@ -986,43 +1015,67 @@ double hysteresis(const Circle& c, const Samples& samples, const Span& a, const 
   return h;
 }
 
-// `arc_deg`: the smallest arc of the traces (validate's, found once).
-Iso230_4 iso_values(const Samples& samples, double arc_deg) {
-  Iso230_4 iso;
-  iso.arc_deg = arc_deg;
-  const auto& traces = samples.spans();
-  // The circles of each trace and of all of them in one pass: the common sums run on from the
-  // first trace's, the same sums in the same order as a pass of their own (issue 32: six
-  // passes over the samples were one twentieth of the analysis).
-  std::vector<CircleSums> own(traces.size());
-  CircleSums all;
-  for (std::size_t t = 0; t < traces.size(); ++t) {
-    for (std::size_t i = traces[t].begin; i < traces[t].end; ++i) {
-      const Sample x = samples.plain(i);
-      own[t].add(x);
-      if (t > 0) all.add(x);
-    }
-    if (t == 0) all = own[0];
+// The ISO 230-4 values, from two passes over the samples that are the fit's own (issue 32:
+// each pass of their own rebuilt every record): the circles of each trace and of all of them
+// from the design's pass (add_circle), then each trace's range about its circle and the
+// common circle's from the residual's pass (add_range). The common sums run on from the first
+// trace's, the same sums in the same order as a pass of their own; the ranges are minima and
+// maxima, the same in any order.
+class IsoPasses {
+ public:
+  IsoPasses(const Samples& samples, double arc_deg) : samples_(samples), own_(2) {
+    iso_.arc_deg = arc_deg;
   }
-  const Circle common = all.circle();
-  Range f;
-  for (std::size_t t = 0; t < traces.size(); ++t) {
-    const Circle c = own[t].circle();
-    Range r;
-    for (std::size_t i = traces[t].begin; i < traces[t].end; ++i) {
-      const Sample x = samples.plain(i);
-      r.add(c.residual(x));
-      f.add(common.residual(x));
+
+  // Every sample once, in order (the design's pass, stride 1).
+  void add_circle(std::size_t at, const Sample& x) {
+    if (at < split()) {
+      own_[0].add(x);
+      return;
     }
-    (traces[t].trace->direction() == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) = r.pv();
+    if (!all_from_first_) all_ = own_[0], all_from_first_ = true;
+    own_[1].add(x);
+    all_.add(x);
   }
-  iso.G_bi_um = f.pv();
-  iso.centre_u_um = common.cu;
-  iso.centre_v_um = common.cv;
-  iso.F_max_um = f.hi, iso.F_min_um = f.lo;
-  if (traces.size() == 2) iso.H_um = hysteresis(common, samples, traces[0], traces[1]);
-  return iso;
-}
+  // After the first pass: the circles, and H (its own reading of the traces).
+  void circles() {
+    if (!all_from_first_) all_ = own_[0], all_from_first_ = true;
+    common_ = all_.circle();
+    for (std::size_t t = 0; t < traces(); ++t) circle_[t] = own_[t].circle();
+    const auto& spans = samples_.spans();
+    if (spans.size() == 2) iso_.H_um = hysteresis(common_, samples_, spans[0], spans[1]);
+  }
+  // Every sample once, in any order (the residual's pass).
+  void add_range(std::size_t at, const Sample& x) {
+    const std::size_t t = at < split() ? 0 : 1;
+    range_[t].add(circle_[t].residual(x));
+    f_.add(common_.residual(x));
+  }
+  Iso230_4 values() const {
+    Iso230_4 iso = iso_;
+    for (std::size_t t = 0; t < traces(); ++t)
+      (samples_.spans()[t].trace->direction() == Direction::cw ? iso.G_cw_um : iso.G_ccw_um) =
+          range_[t].pv();
+    iso.G_bi_um = f_.pv();
+    iso.centre_u_um = common_.cu;
+    iso.centre_v_um = common_.cv;
+    iso.F_max_um = f_.hi, iso.F_min_um = f_.lo;
+    return iso;
+  }
+
+ private:
+  std::size_t split() const { return samples_.spans()[0].end; }
+  std::size_t traces() const { return samples_.spans().size(); }
+  const Samples& samples_;
+  Iso230_4 iso_;
+  std::vector<CircleSums> own_;
+  CircleSums all_;
+  bool all_from_first_ = false;
+  Circle common_;
+  std::array<Circle, 2> circle_{};
+  std::array<Range, 2> range_{};
+  Range f_;
+};
 
 // Which terms the data can carry, with a note for each that it cannot.
 Model choose_terms(const Setup& setup, bool both, double arc_deg, std::vector<std::string>& notes) {
@@ -1276,9 +1329,10 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
       1e3 * (setup.calibrated_radius_mm.value_or(setup.radius_mm) - setup.radius_mm);
   Samples samples(traces, offset_um, setup.spike_decay_deg * deg, records_held_max_samples);
   const auto& spans = samples.spans();
-  res.iso = iso_values(samples, arc_deg);
+  IsoPasses iso(samples, arc_deg);
+  const auto add_circle = [&](std::size_t at, const Sample& x) { iso.add_circle(at, x); };
 
-  Model m = choose_terms(setup, traces.size() == 2, res.iso.arc_deg, res.notes);
+  Model m = choose_terms(setup, traces.size() == 2, arc_deg, res.notes);
   m.split = spans[0].end;
   m.s_before = sign_of(spans[0].trace->direction());
   m.s_after = sign_of(spans.back().trace->direction());
@@ -1288,20 +1342,22 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
     const Bracket bracket = search_grid(m, samples, setup);
     period_mm = bracket.best_p;
     if (refinement == PeriodRefinement::pass_per_trial) {
-      fitted.emplace(m, samples, 1, period_mm);
+      fitted.emplace(m, samples, 1, period_mm, nullptr, add_circle);
       period_mm = refine_period(bracket, [&](double p) { return fitted->solve(p).rss; });
     } else {
-      // The refinement's trials from sums made in the design's own pass (CyclicSeries): the
-      // search costs that pass's extra sums and the pass at the period found below.
+      // The refinement's trials, and the normal equations at the period found, from sums made
+      // in the design's own pass (CyclicSeries): the search costs that pass's extra sums.
       CyclicSeries series(bracket.k0(m.r_mm), bracket.half_width_k(m.r_mm) * (1 + 1e-6));
-      fitted.emplace(m, samples, 1, period_mm, &series);
+      fitted.emplace(m, samples, 1, period_mm, &series, add_circle);
       period_mm = refine_period(bracket, [&](double p) {
         return fitted->solve_with(series.rows(m.wave_number(p), fitted->ata())).rss;
       });
+      fitted->use_cyclic_rows(series.rows(m.wave_number(period_mm), fitted->ata()), period_mm);
     }
   } else {
-    fitted.emplace(m, samples, 1, period_mm);
+    fitted.emplace(m, samples, 1, period_mm, nullptr, add_circle);
   }
+  iso.circles();
   Design& full = *fitted;
   const Solution sol = full.solve(period_mm);
   Model reported = m;
@@ -1325,15 +1381,19 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
   // One pass: the residual, and the fitted diagnostics' contributions.
   Reporter rep(res, reported, full, sol.coef);
   report(rep, setup, ax, period_mm);
-  for_each_block(m, samples, 1, full.k(), [&](const auto& b, const auto& y, std::size_t first) {
-    rep.observe(b, y);
-    const Eigen::VectorXd r = y - b * sol.coef;
-    for (Eigen::Index i = 0; i < r.size(); ++i) {
-      const std::size_t at = first + static_cast<std::size_t>(i);
-      const std::size_t t = at < spans[0].end ? 0 : 1;
-      residuals[t].r_um.set(at - spans[t].begin, r[i]);
-    }
-  });
+  for_each_block(
+      m, samples, 1, full.k(),
+      [&](const auto& b, const auto& y, std::size_t first) {
+        rep.observe(b, y);
+        const Eigen::VectorXd r = y - b * sol.coef;
+        for (Eigen::Index i = 0; i < r.size(); ++i) {
+          const std::size_t at = first + static_cast<std::size_t>(i);
+          const std::size_t t = at < spans[0].end ? 0 : 1;
+          residuals[t].r_um.set(at - spans[t].begin, r[i]);
+        }
+      },
+      [&](std::size_t at, const Sample& x) { iso.add_range(at, x); });
+  res.iso = iso.values();
   // The fit's records (40 bytes a sample, if held) are done with: what follows needs the
   // residual, and rep.finish rebuilds the little it needs from the traces. Freed before the
   // spectra, the peak of the analysis at 1 kHz (issue 32).

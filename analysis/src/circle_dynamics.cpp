@@ -102,8 +102,14 @@ Timed timed(const TraceResidual& t, double w) {
   constexpr std::size_t max_distinct = 4096;
   std::map<double, std::size_t> counts;
   std::size_t count = 0;
+  // The step of the last sample counted again without a search of the map (a trace from time
+  // repeats a step many times over: the map's search was most of this pass, issue 32).
+  auto last = counts.end();
   for (std::size_t i = 1; i < n && counts.size() <= max_distinct; ++i)
-    if (const double d = step(i); d > 0) ++counts[d], ++count;
+    if (const double d = step(i); d > 0) {
+      if (last == counts.end() || last->first != d) last = counts.try_emplace(d, 0).first;
+      ++last->second, ++count;
+    }
   if (counts.size() <= max_distinct) {
     if (count > 0) {
       std::size_t rank = count / 2;
@@ -130,9 +136,10 @@ Timed timed(const TraceResidual& t, double w) {
 // The residual at the times k dt, k = k0 .. k0 + count - 1, linearly interpolated in travel
 // order. The interpolation starts where a walk from k = 0 would have reached (a binary search:
 // the times rise in travel order), so a segment is the same as that part of the whole series.
-std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt, std::size_t k0,
-                             std::size_t count) {
-  std::vector<double> out(count);
+// Into `out` (count values; its memory kept from one segment to the next).
+void resample(const TraceResidual& t, const Timed& tm, double dt, std::size_t k0, std::size_t count,
+              std::vector<double>& out) {
+  out.resize(count);
   const auto walk = [&](std::size_t j, double at) {
     return j + 2 < tm.n && tm.time_s(tm.order(j + 1)) < at;
   };
@@ -154,7 +161,6 @@ std::vector<double> resample(const TraceResidual& t, const Timed& tm, double dt,
     const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
     out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
   }
-  return out;
 }
 
 // |X_k|^2 of the Hann-windowed, mean-removed series zero-padded to npad, k = 0 .. npad / 2, for
@@ -169,7 +175,9 @@ class Periodograms {
     fft_.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
   }
 
-  std::vector<double> operator()(const std::vector<double>& x) {
+  // The periodogram of x, valid until the next call. The padding's zeros are written when the
+  // length changes, not for every segment (the transform reads its input only).
+  const std::vector<double>& operator()(const std::vector<double>& x) {
     const auto n = x.size();
     if (window_.size() != n) {
       window_.resize(n);
@@ -180,17 +188,21 @@ class Periodograms {
     const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(n);
     padded_.resize(npad_);
     for (std::size_t i = 0; i < n; ++i) padded_[i] = (x[i] - mean) * window_[i];
-    std::fill(padded_.begin() + static_cast<std::ptrdiff_t>(n), padded_.end(), 0.0);
+    if (n != zeros_from_) {
+      std::fill(padded_.begin() + static_cast<std::ptrdiff_t>(n), padded_.end(), 0.0);
+      zeros_from_ = n;
+    }
     fft_.fwd(spec_, padded_);
-    std::vector<double> p(npad_ / 2 + 1);
-    for (std::size_t k = 0; k < p.size(); ++k) p[k] = std::norm(spec_[k]);
-    return p;
+    p_.resize(npad_ / 2 + 1);
+    for (std::size_t k = 0; k < p_.size(); ++k) p_[k] = std::norm(spec_[k]);
+    return p_;
   }
 
  private:
   std::size_t npad_;
   Eigen::FFT<double> fft_;
-  std::vector<double> window_, padded_;
+  std::vector<double> window_, padded_, p_;
+  std::size_t zeros_from_ = SIZE_MAX;  // padded_ is 0 from here on
   std::vector<std::complex<double>> spec_;
 };
 
@@ -353,12 +365,10 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   std::vector<std::vector<double>> ps;
   std::vector<std::size_t> segments;
   std::vector<double> mean(npad / 2 + 1, 0.0);
-  // Every trace's first segment is resampled before the transforms, as the whole series were:
-  // freed in the same order, the allocator reuses the same blocks on the next analysis instead
-  // of returning them (interleaved, 17 times the page faults: 10 ms of 70 on 2 x 36,000).
-  std::vector<std::vector<double>> first;
-  for (std::size_t i = 0; i < traces.size(); ++i)
-    first.push_back(resample(traces[i], tms[i], dt, 0, std::min(lengths[i], cap)));
+  // One segment's samples and the transform's buffers are kept from one segment (and trace) to
+  // the next: made afresh, their page faults and zeros were a third of the spectra's time in a
+  // long run (issue 32).
+  std::vector<double> segment;
   std::optional<Periodograms> periodogram(npad);
   for (std::size_t i = 0; i < traces.size(); ++i) {
     const std::size_t n = lengths[i], len = std::min(n, cap);
@@ -366,10 +376,10 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
     segments.push_back(n <= cap ? 1 : n / cap);  // the line fit's: cap samples, the last longer
     std::vector<double> p;  // one segment's periodogram, or the average of them
     for (std::size_t k = 0; k < count; ++k) {
-      auto one = (*periodogram)(k == 0 ? std::exchange(first[i], {})
-                                       : resample(traces[i], tms[i], dt, k * (cap / 2), len));
+      resample(traces[i], tms[i], dt, k * (cap / 2), len, segment);
+      const std::vector<double>& one = (*periodogram)(segment);
       if (count == 1) {
-        p = std::move(one);
+        p = one;
         break;
       }
       if (p.empty()) p.assign(one.size(), 0.0);
@@ -380,6 +390,7 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
     ps.push_back(std::move(p));
   }
   periodogram.reset();  // its tables and buffers, before the line fit's
+  segment = std::vector<double>();
   const auto peak = static_cast<std::size_t>(
       std::max_element(mean.begin() + static_cast<std::ptrdiff_t>(lo),
                        mean.begin() + static_cast<std::ptrdiff_t>(hi) + 1) -
