@@ -52,6 +52,7 @@
 #include "bench_common.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/daq/env_stage.hpp"
+#include "cal/drivers/codec/common.hpp"
 #include "cal/drivers/registry.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
@@ -582,23 +583,24 @@ void bench_ingest(const BenchOptions& o) {
 // The generated readings' values: exactly as a real instrument's driver stores them, or not.
 enum class BenchValues {
   // The length as `daq bench ingest`'s gauge prints it ("%+011.6f" mm: 1 nm, six decimals of a
-  // millimetre) and the line-gauge driver stores it: the printed decimal read as one correctly
-  // rounded division (parse_plain_decimal: the integer nanometres / 10^6), then
-  // (printed x scale + offset) x 1e-3 with the default scale 1 and offset 0 (GaugeCodec::to_si,
-  // unit_factor(mm)); the air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=  50.0
-  // %RH": hPa x 100, two decimals of degC, one of %RH). What a store holds: raw readings, at
-  // the instrument's resolution, converted to SI by one multiplication (docs/storage.md).
+  // millimetre) and the line-gauge driver stores it: the printed decimal in metres as one
+  // correctly rounded division (parse_plain_decimal_scaled: the integer nanometres / 10^9); the
+  // air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH": the hPa decimal in
+  // Pa, two decimals of degC, one of %RH). What a store holds: raw readings, at
+  // the instrument's resolution, each the correctly rounded double of its decimal in SI.
   quantised,
   // 0.1 + 1e-6 sin(...) + 1e-9 k computed in doubles: 16 - 17 significant digits a value, as
   // no instrument stores them (a compensated length would be; the store holds none).
   unquantised,
 };
 
-// printed_units x 10^-decimals as a driver reads the printed decimal (Clinger's one division,
-// cal::drivers::codec::parse_plain_decimal), times the driver's factor to SI.
-double as_printed(double value, int decimals, double factor_to_si) {
+// `value` printed with `decimals` decimals in a unit 10^exponent_to_si of SI, as a driver
+// stores it: the printed decimal in SI, correctly rounded (the count over the exact power of
+// ten, cal::drivers::codec::scaled_count; docs/codecs.md, "Readings in SI").
+double as_printed(double value, int decimals, int exponent_to_si) {
   const double scale = std::pow(10.0, decimals);  // exact for decimals <= 22
-  return std::round(value * scale) / scale * factor_to_si;
+  return cal::drivers::codec::scaled_count(std::llround(value * scale),
+                                           {1, exponent_to_si - decimals});
 }
 
 // A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in
@@ -623,22 +625,22 @@ std::int64_t generate_run(cal::storage::Store& store, int seconds,
         0.1 + 1e-6 * std::sin(1e-4 * static_cast<double>(i)) + 1e-9 * static_cast<double>(i % 977);
     batch.push_back({.time_ns = t,
                      .quantity = 1,
-                     .value = quantised ? as_printed(length_m * 1e3, 6, 1e-3) : length_m});
+                     .value = quantised ? as_printed(length_m * 1e3, 6, -3) : length_m});
     if (i % 10'000 == 0) {
       const double s = static_cast<double>(i / 10'000);
       const double air[3] = {20.0 + 1e-3 * s, 101325.0 - 0.1 * s, 45.0 + 1e-2 * s};
       batch.push_back({.time_ns = t,
                        .device = 1,
                        .quantity = 2,
-                       .value = quantised ? as_printed(air[0], 2, 1.0) : air[0]});
+                       .value = quantised ? as_printed(air[0], 2, 0) : air[0]});
       batch.push_back({.time_ns = t,
                        .device = 1,
                        .quantity = 3,
-                       .value = quantised ? as_printed(air[1] / 100.0, 2, 100.0) : air[1]});
+                       .value = quantised ? as_printed(air[1] / 100.0, 2, 2) : air[1]});
       batch.push_back({.time_ns = t,
                        .device = 1,
                        .quantity = 4,
-                       .value = quantised ? as_printed(air[2], 1, 1.0) : air[2]});
+                       .value = quantised ? as_printed(air[2], 1, 0) : air[2]});
     }
     if (batch.size() >= 16384) {
       store.append_readings(run, batch);
