@@ -369,20 +369,8 @@ TEST(IdsCodec, RecordedRequestsAreLearntAsTheJsonParserReadsThem) {
   }
 }
 
-// The independent value of a number in another unit: its decimal text with the exponent moved
-// ("1013.27" hPa: strtod("1013.27e2") Pa; 1500 pm: strtod("1500e-12") m).
-double strtod_shifted(std::string s, int shift) {
-  const auto e = s.find_first_of("eE");
-  long exponent = shift;
-  if (e != std::string::npos) {
-    exponent += std::strtol(s.c_str() + e + 1, nullptr, 10);
-    s.erase(e);
-  }
-  s += "e" + std::to_string(exponent);
-  return std::strtod(s.c_str(), nullptr);
-}
-
-std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
+using codec_test::bits;
+using codec_test::strtod_shifted;
 
 TEST(IdsCodec, ReadingsAreTheirDecimalsInSiBitForBit) {
   // Picometre counts as the device writes them (both answer layouts, a blank after '{' for the

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "cal/drivers/codec/common.hpp"
+#include "codec_test_util.hpp"
 
 namespace {
 
@@ -197,20 +198,6 @@ using cal::drivers::codec::parse_number_scaled;
 using cal::drivers::codec::scaled_count;
 using cal::drivers::codec::scaled_double;
 
-// The independent value: the decimal text with its exponent changed, read by strtod
-// ("100.000123" in mm: strtod("100.000123e-3")); a text with an exponent has it moved.
-double shifted_strtod(std::string s, int shift) {
-  if (!s.empty() && s.front() == '+') s.erase(0, 1);
-  const auto e = s.find_first_of("eE");
-  long exponent = shift;
-  if (e != std::string::npos) {
-    exponent += std::strtol(s.c_str() + e + 1, nullptr, 10);
-    s.erase(e);
-  }
-  s += "e" + std::to_string(exponent);
-  return std::strtod(s.c_str(), nullptr);
-}
-
 constexpr DecimalScale kMm{1, -3}, kUm{1, -6}, kPm{1, -12}, kHpa{1, 2}, kM{1, 0};
 
 TEST(ScaledDecimal, HandValuesAreTheDecimalsInSi) {
@@ -283,7 +270,7 @@ TEST(ScaledDecimal, PrintedReadingsAreStrtodOfTheTextWithItsExponentMoved) {
       SCOPED_TRACE(s + " x 10^" + std::to_string(shift));
       const auto v = parse_number_scaled(s, scale);
       ASSERT_TRUE(v);
-      ASSERT_EQ(bits(*v), bits(shifted_strtod(s, shift)));
+      ASSERT_EQ(bits(*v), bits(codec_test::strtod_shifted(s, shift)));
       if (shift < 0) {
         ++cases;
         product_missed += *v != *parse_number(s) * std::pow(10.0, shift);
@@ -326,12 +313,13 @@ TEST(ScaledDecimal, CountsAreTheirDecimalsInSi) {
     const std::int64_t n = i % 4 == 3 ? any(rng) : small(rng);
     SCOPED_TRACE(n);
     const double v = scaled_count(n, kPm);
-    ASSERT_EQ(bits(v), bits(shifted_strtod(std::to_string(n), -12)));
+    ASSERT_EQ(bits(v), bits(codec_test::strtod_shifted(std::to_string(n), -12)));
     product_missed += v != static_cast<double>(n) * 1e-12;
   }
   for (const std::int64_t n :
        {INT64_MIN, INT64_MAX, std::int64_t{0}, std::int64_t{1} << 53, -(std::int64_t{1} << 53) - 1})
-    EXPECT_EQ(bits(scaled_count(n, kPm)), bits(shifted_strtod(std::to_string(n), -12))) << n;
+    EXPECT_EQ(bits(scaled_count(n, kPm)), bits(codec_test::strtod_shifted(std::to_string(n), -12)))
+        << n;
   EXPECT_GT(product_missed, 200'000u / 20);  // n x 1e-12 misses about 14 %
 }
 
@@ -347,7 +335,7 @@ TEST(ScaledDecimal, DoublesThatStandForShortDecimalsGiveThoseDecimalsInSi) {
     const double sample = std::strtod(text.c_str(), nullptr);
     SCOPED_TRACE(text);
     const double v = scaled_double(sample, kMm);
-    ASSERT_EQ(bits(v), bits(shifted_strtod(text, -3)));
+    ASSERT_EQ(bits(v), bits(codec_test::strtod_shifted(text, -3)));
     division_missed += v != sample / 1e3;
   }
   EXPECT_GT(division_missed, 200'000u / 10);

@@ -163,15 +163,8 @@ TEST(GaugePresets, EveryPresetReadsItsOwnDocumentedExampleAndAGivenKeyWins) {
 
 namespace {
 
-// The independent value of a printed reading in SI: its decimal text with the exponent moved,
-// read by strtod ("100.000123" mm: strtod("100.000123e-3")).
-double strtod_shifted(std::string text, int shift) {
-  if (!text.empty() && text.front() == '+') text.erase(0, 1);
-  text += "e" + std::to_string(shift);
-  return std::strtod(text.c_str(), nullptr);
-}
-
-std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
+using codec_test::bits;
+using codec_test::strtod_shifted;
 
 TEST(GaugeCodec, ReadingsAreTheirPrintedDecimalsInSiBitForBit) {
   // 100.000123 mm is stored as 0.100000123 m (the literal: the correctly rounded double), not

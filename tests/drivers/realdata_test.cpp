@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "cal/drivers/registry.hpp"
+#include "codec_test_util.hpp"
 #include "halsampler/codec.hpp"
 
 namespace {
@@ -409,11 +410,8 @@ TEST(RealData, HalsamplerLimitMaxVelocityGivesSamples0To799WithNoGap) {
 // ("1039.897" mm is strtod("1039.897e-3")). Before, the drivers stored the printed double x
 // 1e-3, one ulp off for a share of them (counted: the test would not see the change otherwise).
 
-double printed_in_metres(std::string text) {
-  text += "e-3";
-  return std::strtod(text.c_str(), nullptr);
-}
-std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
+double printed_in_metres(const std::string& text) { return codec_test::strtod_shifted(text, -3); }
+using codec_test::bits;
 
 // Compares the readings of `items` with the printed decimals; returns how many the old
 // product (the printed double x 1e-3) misses.

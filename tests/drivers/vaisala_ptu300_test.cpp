@@ -179,12 +179,7 @@ TEST(Ptu300Codec, TheInformationalAnswersAreNoMeasurement) {
   }
 }
 
-// The independent value of a printed pressure in Pa: its text with the exponent moved, read
-// by strtod ("1024.4" hPa: strtod("1024.4e2") = 102440).
-double strtod_shifted(std::string text, int shift) {
-  text += "e" + std::to_string(shift);
-  return std::strtod(text.c_str(), nullptr);
-}
+using codec_test::strtod_shifted;
 
 TEST(Ptu300Codec, PressuresInDecimalUnitsAreTheirPrintedDecimalsInPascalsBitForBit) {
   // 1024.4 hPa is 102440 Pa; 1024.4 x 100 (what the codec stored before) is 102440.00000000001.
