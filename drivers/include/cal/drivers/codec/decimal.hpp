@@ -33,61 +33,7 @@ inline constexpr std::uint64_t kMaxExact = std::uint64_t{1} << 53;
 
 inline bool is_digit(char c) { return static_cast<unsigned>(c) - '0' < 10; }
 
-// The general loop, a digit at a time, counting significant digits (long strings).
-inline bool parse_plain_decimal_long(const char* p, const char* end, bool negative, double& out) {
-  std::uint64_t m = 0;
-  int significant = 0, fraction = 0;
-  bool any_digit = false, point = false;
-  for (; p != end; ++p) {
-    const unsigned d = static_cast<unsigned>(*p) - '0';
-    if (d < 10) {
-      any_digit = true;
-      // Leading zeros add nothing to m; 19 significant digits always fit in 64 bits.
-      if ((m != 0 || d != 0) && ++significant > 19) return false;
-      m = m * 10 + d;
-      if (point) ++fraction;
-    } else if (*p == '.' && !point) {
-      point = true;
-    } else {
-      return false;
-    }
-  }
-  if (!any_digit || m > kMaxExact || fraction > 22) return false;
-  const double v = static_cast<double>(m) / kPow10[fraction];
-  out = negative ? -v : v;
-  return true;
-}
-
 }  // namespace detail
-
-// Parses the whole of `s` as [+-]digits[.digits] (at least one digit, either side of the point
-// may be empty) into `out`; false (out untouched) when `s` is not of that form or outside the
-// exact range above, in which case the caller must use the general parser.
-inline bool parse_plain_decimal(std::string_view s, double& out) {
-  const char* p = s.data();
-  const char* const end = p + s.size();
-  bool negative = false;
-  if (p != end && (*p == '+' || *p == '-')) negative = *p++ == '-';
-  // At most 19 characters: at most 19 digits, which always fit in 64 bits, so the digits need
-  // no counting; two plain loops (integer digits, fraction digits) with one multiply-add each.
-  if (end - p > 19) return detail::parse_plain_decimal_long(p, end, negative, out);
-  const char* const int_begin = p;
-  std::uint64_t m = 0;
-  for (; p != end && detail::is_digit(*p); ++p) m = m * 10 + static_cast<unsigned>(*p - '0');
-  const auto n_int = p - int_begin;
-  std::ptrdiff_t n_frac = 0;
-  if (p != end) {
-    if (*p != '.') return false;
-    const char* const frac_begin = ++p;
-    for (; p != end && detail::is_digit(*p); ++p) m = m * 10 + static_cast<unsigned>(*p - '0');
-    if (p != end) return false;
-    n_frac = p - frac_begin;
-  }
-  if (n_int + n_frac == 0 || m > detail::kMaxExact) return false;
-  const double v = static_cast<double>(m) / detail::kPow10[n_frac];
-  out = negative ? -v : v;
-  return true;
-}
 
 // An exact factor to SI: multiplier x 10^exponent, both exact (mm {1, -3}, inch {254, -4}
 // (25.4 mm by the 1959 definition), hPa {1, 2}). A reading x the factor is a decimal again, so
@@ -128,8 +74,10 @@ inline bool scale_exact(std::uint64_t m, int fraction, bool negative, DecimalSca
 }
 
 // The digits of [+-]digits[.digits] as m (at most 19 significant digits) and the count of
-// fraction digits; false when `s` is not of that form. The same two loops as
-// parse_plain_decimal for up to 19 characters (no digit counting needed), else a digit at a time.
+// fraction digits; false when `s` is not of that form. Up to 19 characters there are at most 19
+// digits, which always fit in 64 bits: two plain loops (integer digits, fraction digits) with one
+// multiply-add each; a longer string a digit at a time, counting significant digits (leading
+// zeros add nothing to m).
 inline bool plain_decimal_digits(std::string_view s, std::uint64_t& m, int& fraction,
                                  bool& negative) {
   const char* p = s.data();
@@ -181,6 +129,14 @@ inline bool parse_plain_decimal_scaled(std::string_view s, DecimalScale scale, d
   bool negative = false;
   if (!detail::plain_decimal_digits(s, m, fraction, negative)) return false;
   return detail::scale_exact(m, fraction, negative, scale, out);
+}
+
+// Parses the whole of `s` as [+-]digits[.digits] (at least one digit, either side of the point
+// may be empty) into `out`; false (out untouched) when `s` is not of that form or outside the
+// exact range above (m <= 2^53, at most 22 fraction digits), in which case the caller must use
+// the general parser. The same reader as parse_plain_decimal_scaled with no scale.
+inline bool parse_plain_decimal(std::string_view s, double& out) {
+  return parse_plain_decimal_scaled(s, kUnitScale, out);
 }
 
 // An integer count (picometres) in SI: n x scale correctly rounded (n / 10^12 for pm: one
