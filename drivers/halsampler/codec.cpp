@@ -12,9 +12,8 @@
 namespace cal::drivers::codec {
 HalsamplerCodec::HalsamplerCodec(HalsamplerConfig config)
     : config_(config), splitter_(config.max_line_bytes) {
-  if (!(config_.metres_per_unit > 0))
-    throw InputError(
-        fmt::format("halsampler: metres per unit {} must be > 0", config_.metres_per_unit));
+  if (config_.metres_per_unit.multiplier == 0)
+    throw InputError("halsampler: metres per unit must be > 0");
 }
 
 void HalsamplerCodec::do_feed(std::span<const std::byte> bytes, std::vector<PositionFrame>& frames,
@@ -56,12 +55,13 @@ void HalsamplerCodec::decode(std::string_view line, std::uint64_t offset,
     if (static_cast<std::size_t>(col) >= tokens.size())
       return report(errors, ErrorKind::malformed, offset,
                     fmt::format("halsampler: {} values, column {} expected", tokens.size(), col));
-    const auto v = parse_number(tokens[static_cast<std::size_t>(col)]);
+    const auto v =
+        parse_number_scaled(tokens[static_cast<std::size_t>(col)], config_.metres_per_unit);
     if (!v || !std::isfinite(*v))
       return report(errors, ErrorKind::malformed, offset,
                     fmt::format("halsampler: column {} '{}' is not a number", col,
                                 tokens[static_cast<std::size_t>(col)]));
-    f.position_m[axis] = *v * config_.metres_per_unit;
+    f.position_m[axis] = *v;
   }
   f.lost_before = std::exchange(pending_lost_, 0);
   f.overrun = std::exchange(pending_overrun_, false);

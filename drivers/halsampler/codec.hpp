@@ -20,7 +20,9 @@ namespace cal::drivers::codec {
 struct HalsamplerConfig {
   bool sample_numbers = false;         // true for halsampler -t (the sample number first)
   std::array<int, 3> column{0, 1, 2};  // value column of X, Y, Z (0-based, after the number); -1
-  double metres_per_unit = 1e-3;       // machine units: mm (1e-3) or inch (0.0254)
+  // Machine units to metres, exact: mm (kMillimetresToMetres) or inch (kInchesToMetres). A
+  // printed "%f" position is stored as its decimal in metres, correctly rounded.
+  DecimalScale metres_per_unit = kMillimetresToMetres;
   std::size_t max_line_bytes = 1024;
 };
 

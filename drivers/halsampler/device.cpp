@@ -35,7 +35,9 @@ const std::vector<OptionSpec>& table() {
 codec::HalsamplerConfig config_of(const Options& o, int axis) {
   codec::HalsamplerConfig c{.sample_numbers = o.boolean("tagged"),
                             .column = {-1, -1, -1},
-                            .metres_per_unit = o.text("unit") == "in" ? 0.0254 : 1e-3};
+                            .metres_per_unit = o.text("unit") == "in"
+                                                   ? codec::kInchesToMetres
+                                                   : codec::kMillimetresToMetres};
   c.column[static_cast<std::size_t>(axis)] = static_cast<int>(o.integer("column"));
   return c;
 }

@@ -99,8 +99,11 @@ std::string full_name(const MethodInfo& m, IdsApi api) {
   return std::string(m.name);
 }
 
-constexpr double kMetresPerPicometre = 1e-12;
-constexpr double kPascalPerHectopascal = 100.0;
+// Exact factors: a reading is stored as the correctly rounded double of its value in SI
+// (n pm is n / 10^12 m, one division of exact operands; "1013.27" hPa is strtod("1013.27e2")
+// Pa), never n x 1e-12, which rounds twice and misses it for 14 % of picometre counts.
+constexpr DecimalScale kMetresPerPicometre = kPicometresToMetres;
+constexpr DecimalScale kPascalPerHectopascal = kHectopascalsToPascals;
 
 bool has_control_bytes(std::string_view line) {
   for (char c : line) {
@@ -151,7 +154,8 @@ const KnownRequest* find_request(std::string_view name) {
 struct FlatNumber {
   bool integer = false;  // no fraction or exponent and at most 18 digits (exact in int64)
   std::int64_t i = 0;
-  double d = 0;  // as nlohmann's get<double>() gives it (strtod and from_chars both round)
+  double d = 0;           // as nlohmann's get<double>() gives it (strtod and from_chars both round)
+  std::string_view text;  // the number as written (valid while its line is)
 };
 
 struct FlatValue {
@@ -206,6 +210,7 @@ bool scan_number(std::string_view s, std::size_t& i, FlatNumber& n) {
   }
   const char* first = s.data() + start;
   const char* last = s.data() + i;
+  n.text = s.substr(start, i - start);
   if (!fraction_or_exponent) {
     if (int_digits > 18) return false;  // the parser's uint64 or double: left to it
     n.integer = true;
@@ -559,6 +564,24 @@ class IdsCodec::ResultView {
   double number(std::size_t i) const {
     return json_ != nullptr ? (*json_)[i].get<double>() : numbers_[i].d;
   }
+  // number(i) x scale, correctly rounded: an integer count divided by the exact power of ten,
+  // a fraction from its text with the exponent moved. The JSON parser keeps no text: its
+  // double's shortest decimal stands for it (the same value for a number written with at most
+  // 15 significant digits, as the device writes them).
+  double scaled(std::size_t i, DecimalScale scale) const {
+    if (json_ != nullptr) {
+      const auto& v = (*json_)[i];
+      if (v.is_number_integer() &&
+          !(v.is_number_unsigned() &&
+            v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX)))
+        return scaled_count(v.get<std::int64_t>(), scale);
+      return scaled_double(v.get<double>(), scale);
+    }
+    const FlatNumber& n = numbers_[i];
+    if (n.integer) return scaled_count(n.i, scale);
+    if (const auto v = parse_number_scaled(n.text, scale)) return *v;
+    return scaled_double(n.d, scale);  // beyond the double's range: what the product gives
+  }
   bool is_boolean(std::size_t i) const { return json_ != nullptr && (*json_)[i].is_boolean(); }
   bool boolean(std::size_t i) const { return (*json_)[i].get<bool>(); }
   bool is_string(std::size_t i) const { return json_ != nullptr && (*json_)[i].is_string(); }
@@ -668,14 +691,14 @@ void IdsCodec::decode_result(IdsResponse r, const ResultView& res, std::uint64_t
     emit(frames, std::move(r));
     return;
   }
-  auto number = [&](std::size_t i, std::string_view what, double scale, double lo,
+  auto number = [&](std::size_t i, std::string_view what, DecimalScale scale, double lo,
                     double hi) -> std::optional<double> {
     if (!res.is_number(i)) {
       report(errors, ErrorKind::malformed, offset,
              fmt::format("IDS: {} is not a number: {}", what, res.dump(i)));
       return std::nullopt;
     }
-    const double x = res.number(i) * scale;
+    const double x = scale == kUnitScale ? res.number(i) : res.scaled(i, scale);
     if (!std::isfinite(x) || x < lo || x > hi) {
       report(errors, ErrorKind::out_of_range, offset,
              fmt::format("IDS: {} = {} outside [{}, {}]", what, x, lo, hi));
@@ -699,20 +722,20 @@ void IdsCodec::decode_result(IdsResponse r, const ResultView& res, std::uint64_t
       r.displacement_m[0] = number(1, "displacement (m)", kMetresPerPicometre, -dmax, dmax);
       break;
     case ResultKind::temperature_degc:
-      r.temperature_degc = number(1, "ECU temperature (degC)", 1.0, limits_.min_temperature_degc,
-                                  limits_.max_temperature_degc);
+      r.temperature_degc = number(1, "ECU temperature (degC)", kUnitScale,
+                                  limits_.min_temperature_degc, limits_.max_temperature_degc);
       break;
     case ResultKind::pressure_hpa:
       r.pressure_pa = number(1, "ECU pressure (Pa)", kPascalPerHectopascal, limits_.min_pressure_pa,
                              limits_.max_pressure_pa);
       break;
     case ResultKind::humidity:
-      r.humidity_pct_rh = number(1, "ECU humidity (%RH)", 1.0, limits_.min_humidity_pct_rh,
+      r.humidity_pct_rh = number(1, "ECU humidity (%RH)", kUnitScale, limits_.min_humidity_pct_rh,
                                  limits_.max_humidity_pct_rh);
       break;
     case ResultKind::index:
-      r.refractive_index = number(1, "ECU refractive index", 1.0, limits_.min_refractive_index,
-                                  limits_.max_refractive_index);
+      r.refractive_index = number(1, "ECU refractive index", kUnitScale,
+                                  limits_.min_refractive_index, limits_.max_refractive_index);
       break;
     case ResultKind::flag:
       if (res.is_boolean(1)) {

@@ -91,6 +91,26 @@ double unit_factor(GaugeUnit u) {
   return 1.0;
 }
 
+std::optional<DecimalScale> decimal_scale(GaugeUnit u) {
+  switch (u) {
+    case GaugeUnit::mm:
+    case GaugeUnit::mrad:
+      return kMillimetresToMetres;  // 10^-3 (mrad to rad alike)
+    case GaugeUnit::um:
+    case GaugeUnit::urad:
+      return kMicrometresToMetres;  // 10^-6
+    case GaugeUnit::inch:
+      return kInchesToMetres;  // 0.0254 exactly (1959)
+    case GaugeUnit::m:
+    case GaugeUnit::degc:
+    case GaugeUnit::none:
+      return kUnitScale;
+    case GaugeUnit::arcsec:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
 bool is_angle(GaugeUnit u) {
   return u == GaugeUnit::urad || u == GaugeUnit::mrad || u == GaugeUnit::arcsec;
 }
@@ -99,6 +119,7 @@ GaugeCodec::GaugeCodec(GaugeConfig config)
     : config_(std::move(config)), splitter_(config_.max_line_bytes) {
   if (config_.pattern.empty()) {
     fast_factor_ = unit_factor(config_.unit);
+    exact_ = exact_scale(config_.unit);
     return;
   }
   try {
@@ -127,10 +148,19 @@ void GaugeCodec::report_overlong(std::uint64_t off, std::vector<CodecError>& err
          fmt::format("gauge: line longer than {} bytes", config_.max_line_bytes));
 }
 
-std::optional<double> GaugeCodec::to_si(double printed,
+std::optional<DecimalScale> GaugeCodec::exact_scale(GaugeUnit unit) const {
+  if (config_.scale != 1.0 || config_.offset != 0.0) return std::nullopt;
+  return decimal_scale(unit);
+}
+
+std::optional<double> GaugeCodec::to_si(std::string_view text, double printed,
                                         std::optional<GaugeUnit> printed_unit) const {
-  return (printed * config_.scale + config_.offset) *
-         unit_factor(printed_unit.value_or(config_.unit));
+  const GaugeUnit unit = printed_unit.value_or(config_.unit);
+  // The printed decimal itself in SI (strtod of its digits with the exponent moved), where
+  // the unit is an exact decimal and nothing is added: "100.000123" mm is 0.100000123 m, not
+  // 100.000123 x 1e-3 = 0.10000012300000001.
+  if (const auto exact = exact_scale(unit)) return parse_number_scaled(text, *exact);
+  return (printed * config_.scale + config_.offset) * unit_factor(unit);
 }
 
 std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
@@ -141,10 +171,14 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
   }
   std::optional<double> number;
   std::optional<GaugeUnit> printed_unit;
+  std::string matched;    // the regex's number group
+  std::string_view text;  // the number as printed
   if (regex_) {
     std::match_results<std::string_view::const_iterator> m;
     if (std::regex_search(line.begin(), line.end(), m, *regex_)) {
-      number = parse_number(trim(m[1].str()));
+      matched = m[1].str();
+      text = trim(matched);
+      number = parse_number(text);
       if (m.size() > 2 && m[2].matched) {  // a printed unit word
         printed_unit = unit_word(m[2].str());
         if (!printed_unit || is_angle(*printed_unit) != is_angle(config_.unit)) number.reset();
@@ -154,7 +188,8 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
     std::array<std::string_view, 2> tokens;
     const std::size_t count = split_whitespace(line, tokens);
     if (count == 1 || count == 2) {
-      number = parse_number(tokens[0]);
+      text = tokens[0];
+      number = parse_number(text);
       if (count == 2) {
         printed_unit = unit_word(tokens[1]);
         // A printed unit of the other kind (an angle on a length gauge) is not this gauge's.
@@ -167,7 +202,7 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
            fmt::format("gauge: no value in '{}'", line.substr(0, 40)));
     return std::nullopt;
   }
-  const auto si = to_si(*number, printed_unit);
+  const auto si = to_si(text, *number, printed_unit);
   if (!si || *si < config_.min_si || *si > config_.max_si) {
     report(
         errors, ErrorKind::out_of_range, off,

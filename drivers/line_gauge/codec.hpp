@@ -24,6 +24,10 @@ GaugeUnit gauge_unit_from_string(std::string_view s);
 bool is_angle(GaugeUnit u);
 // The factor from the unit to SI (m, rad; 1 for degC and none).
 double unit_factor(GaugeUnit u);
+// The same factor as an exact decimal (mm {1, -3}, in {254, -4}, ...); nullopt for arcsec
+// (pi / 648000 is no decimal). A reading in such a unit is stored as the correctly rounded
+// double of its printed decimal in SI (parse_number_scaled), never printed x 1e-3.
+std::optional<DecimalScale> decimal_scale(GaugeUnit u);
 
 // The output formats of common gauge families, each from its maker's public documentation
 // (docs/drivers.md, "Gauge presets"): the request that polls it, the pattern of its line and the
@@ -47,8 +51,11 @@ struct GaugeConfig {
   // followed by a unit word (mm, um, in, inch), is the number.
   std::string pattern;
   GaugeUnit unit = GaugeUnit::mm;  // the unit of the printed number (a printed unit wins)
-  double scale = 1.0;              // applied to the printed number before the unit
-  double offset = 0.0;             // added after scaling, in the printed unit
+  // Applied to the printed number before the unit, and added after scaling (in the printed
+  // unit). With the defaults (1, 0) a reading is its printed decimal in SI, correctly rounded;
+  // otherwise (printed x scale + offset) x unit_factor, a computed value, not the printed one.
+  double scale = 1.0;
+  double offset = 0.0;
   // Plausible range of the value in SI (m, or degC for temperatures); outside: out_of_range.
   double min_si = -10.0, max_si = 10.0;
   std::size_t max_line_bytes = 256;
@@ -97,19 +104,28 @@ class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
     if (fast_factor_ == 0.0) return false;  // a pattern: decode_line() only
     while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
     while (!line.empty() && (line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
-    double printed;
-    if (!parse_plain_decimal(line, printed)) return false;
-    si = (printed * config_.scale + config_.offset) * fast_factor_;  // to_si() without a unit
+    if (exact_) {  // the printed decimal in SI, one correctly rounded operation
+      if (!parse_plain_decimal_scaled(line, *exact_, si)) return false;
+    } else {
+      double printed;
+      if (!parse_plain_decimal(line, printed)) return false;
+      si = (printed * config_.scale + config_.offset) * fast_factor_;  // to_si() without a unit
+    }
     return si >= config_.min_si && si <= config_.max_si;
   }
   // The value of one line in SI, or nullopt after reporting why not.
   std::optional<double> decode_line(std::string_view line, std::uint64_t offset,
                                     std::vector<CodecError>& errors);
   void report_overlong(std::uint64_t offset, std::vector<CodecError>& errors);
-  std::optional<double> to_si(double printed, std::optional<GaugeUnit> printed_unit) const;
+  std::optional<double> to_si(std::string_view text, double printed,
+                              std::optional<GaugeUnit> printed_unit) const;
+  // The unit's exact scale when the configuration leaves the printed decimal as it is
+  // (scale 1, offset 0); nullopt otherwise.
+  std::optional<DecimalScale> exact_scale(GaugeUnit unit) const;
 
   GaugeConfig config_;
   double fast_factor_ = 0.0;  // the configured unit's factor to SI; 0 when there is a pattern
+  std::optional<DecimalScale> exact_;  // exact_scale(config_.unit) without a pattern
   std::optional<std::regex> regex_;
   LineSplitter splitter_;
 };

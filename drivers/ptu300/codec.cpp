@@ -32,26 +32,32 @@ struct UnitInfo {
   UnitKind kind;
   double zero;
   double factor;
+  // The factor as an exact power of ten (hPa {1, 2}); multiplier 0 where it is not one. A
+  // reading in such a unit is stored as its printed decimal in SI, correctly rounded ("1033.7"
+  // hPa is strtod("1033.7e2") = 103370 Pa; 1033.7 x 100 would round twice: 15 % of one-decimal
+  // hPa readings end one ulp off).
+  DecimalScale exact;
 };
+constexpr DecimalScale kNotDecimal{0, 0};
 constexpr UnitInfo kUnits[] = {
-    {"Pa", UnitKind::pressure, 0.0, 1.0},
-    {"hPa", UnitKind::pressure, 0.0, 100.0},
-    {"mbar", UnitKind::pressure, 0.0, 100.0},
-    {"kPa", UnitKind::pressure, 0.0, 1000.0},
-    {"bar", UnitKind::pressure, 0.0, 1e5},
-    {"bara", UnitKind::pressure, 0.0, 1e5},
-    {"barg", UnitKind::gauge_pressure, 0.0, 1e5},
-    {"mmH2O", UnitKind::pressure, 0.0, 9.80665},
-    {"mmHg", UnitKind::pressure, 0.0, 133.322387415},
-    {"torr", UnitKind::pressure, 0.0, 101325.0 / 760.0},
-    {"inHg", UnitKind::pressure, 0.0, 3386.389},
-    {"inH2O", UnitKind::pressure, 0.0, 249.0889},
-    {"psi", UnitKind::pressure, 0.0, 6894.757},
-    {"psia", UnitKind::pressure, 0.0, 6894.757},
-    {"psig", UnitKind::gauge_pressure, 0.0, 6894.757},
-    {"'C", UnitKind::temperature, 0.0, 1.0},
-    {"'F", UnitKind::temperature, 32.0, 5.0 / 9.0},
-    {"%RH", UnitKind::humidity, 0.0, 1.0},
+    {"Pa", UnitKind::pressure, 0.0, 1.0, {1, 0}},
+    {"hPa", UnitKind::pressure, 0.0, 100.0, {1, 2}},
+    {"mbar", UnitKind::pressure, 0.0, 100.0, {1, 2}},
+    {"kPa", UnitKind::pressure, 0.0, 1000.0, {1, 3}},
+    {"bar", UnitKind::pressure, 0.0, 1e5, {1, 5}},
+    {"bara", UnitKind::pressure, 0.0, 1e5, {1, 5}},
+    {"barg", UnitKind::gauge_pressure, 0.0, 1e5, {1, 5}},
+    {"mmH2O", UnitKind::pressure, 0.0, 9.80665, kNotDecimal},
+    {"mmHg", UnitKind::pressure, 0.0, 133.322387415, kNotDecimal},
+    {"torr", UnitKind::pressure, 0.0, 101325.0 / 760.0, kNotDecimal},
+    {"inHg", UnitKind::pressure, 0.0, 3386.389, kNotDecimal},
+    {"inH2O", UnitKind::pressure, 0.0, 249.0889, kNotDecimal},
+    {"psi", UnitKind::pressure, 0.0, 6894.757, kNotDecimal},
+    {"psia", UnitKind::pressure, 0.0, 6894.757, kNotDecimal},
+    {"psig", UnitKind::gauge_pressure, 0.0, 6894.757, kNotDecimal},
+    {"'C", UnitKind::temperature, 0.0, 1.0, {1, 0}},
+    {"'F", UnitKind::temperature, 32.0, 5.0 / 9.0, kNotDecimal},
+    {"%RH", UnitKind::humidity, 0.0, 1.0, {1, 0}},
 };
 
 bool iequals(std::string_view a, std::string_view b) {
@@ -112,6 +118,7 @@ void lex_token(std::string_view t, std::vector<Atom>& atoms) {
 struct RawField {
   std::string_view label;
   double value = 0.0;
+  std::string_view text;  // the number as printed
   std::string_view unit;
   bool stars = false;
 };
@@ -130,7 +137,7 @@ std::vector<RawField> group_fields(const std::vector<Atom>& atoms) {
         break;
       case Atom::number:
       case Atom::stars:
-        fields.push_back({label, a.value, {}, a.kind == Atom::stars});
+        fields.push_back({label, a.value, a.text, {}, a.kind == Atom::stars});
         label = {};
         awaiting_unit = true;
         break;
@@ -341,7 +348,11 @@ void Ptu300Codec::decode_line(std::string_view line, std::uint64_t offset,
                            raw.unit));
         continue;
       }
-      field.value_si = (raw.value - u->zero) * u->factor;
+      if (u->exact.multiplier != 0) {
+        field.value_si = parse_number_scaled(raw.text, u->exact).value_or(NAN);
+      } else {
+        field.value_si = (raw.value - u->zero) * u->factor;
+      }
     }
     double lo = -INFINITY, hi = INFINITY;
     switch (q) {

@@ -190,11 +190,11 @@ void ShdrCodec::decode(std::string_view line, std::uint64_t offset,
       any = true;
       continue;
     }
-    const auto v = parse_number(value);
+    const auto v = parse_number_scaled(value, config_.metres_per_unit);
     if (!v || !std::isfinite(*v))
       return report(errors, ErrorKind::malformed, offset,
                     fmt::format("SHDR: {} = '{}' is not a number", it->first, value.substr(0, 40)));
-    const double m = *v * config_.metres_per_unit;
+    const double m = *v;
     if (std::abs(m) > config_.max_abs_m)
       return report(errors, ErrorKind::out_of_range, offset,
                     fmt::format("SHDR: {} = {} m beyond +/-{} m", it->first, m, config_.max_abs_m));

@@ -40,8 +40,10 @@ namespace cal::drivers::codec {
 struct ShdrConfig {
   // Data item key -> axis (0 X, 1 Y, 2 Z), e.g. {"Xact", 0}, {"Yact", 1}, {"Zact", 2}.
   std::map<std::string, int, std::less<>> keys{{"Xact", 0}, {"Yact", 1}, {"Zact", 2}};
-  double metres_per_unit = 1e-3;  // MTConnect positions are in millimetres
-  double max_abs_m = 100.0;       // plausibility: beyond it, out_of_range
+  // MTConnect positions are in millimetres (or inches, configured): exact, so a printed value
+  // is stored as its decimal in metres, correctly rounded.
+  DecimalScale metres_per_unit = kMillimetresToMetres;
+  double max_abs_m = 100.0;  // plausibility: beyond it, out_of_range
   std::size_t max_line_bytes = 8192;
   // daq decode: note the keys of the other items whose values are numbers (a hint for a user
   // whose control names its positions otherwise); off in runs.

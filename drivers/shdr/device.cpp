@@ -68,7 +68,9 @@ std::array<std::string, 3> axis_keys(const Options& o) {
   return out;
 }
 
-double metres_per_unit(const Options& o) { return o.text("unit") == "in" ? 0.0254 : 1e-3; }
+codec::DecimalScale metres_per_unit(const Options& o) {
+  return o.text("unit") == "in" ? codec::kInchesToMetres : codec::kMillimetresToMetres;
+}
 
 // A run: the test axis only.
 codec::ShdrConfig run_config(const Options& o, int axis) {
@@ -118,7 +120,7 @@ class ShdrDecoder final : public Decoder {
             detail::reading_item(offset, axis, Quantity::machine_position_m, *f.position_m[axis]);
         item.device_time_unix_ns = f.time_unix_ns;
         ++positions_;
-        if (f.relative_time_ms) item.device_time_relative_s = *f.relative_time_ms * 1e-3;
+        if (f.relative_time_ms) item.device_time_relative_s = *f.relative_time_ms / 1e3;
         out.push_back(item);
       }
   }

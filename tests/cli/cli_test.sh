@@ -121,6 +121,16 @@ check import_rtx 0 "^  range -2\.500000 \.\. 1\.000000 mm" -- "$DAQ" import rtx 
 check import_rtx_export 0 "^0\.001,,0,renishaw-rtx \(CARTO-Dynamic 4\.13\),0,displacement_m,0,-0\.0025,1000000$" -- "$DAQ" export 1 --db "$TMP/rtx.sqlite"
 check import_rtx_cut 0 "note: the file ends inside a sample \(4 bytes dropped\)" -- "$DAQ" import rtx "$TMP/cut.rtx" --db "$TMP/rtx.sqlite"
 check import_rtx_cut_incomplete 0 "2 +2026.*dynamic +Y +incomplete +2" -- "$DAQ" runs --db "$TMP/rtx.sqlite"
+# Samples that stand for 1 nm readings in mm are stored as those decimals in metres, as the
+# export prints them: 100.000123 mm is 0.100000123 m (the sample x 1e-3 was 0.10000012300000001),
+# -250.000001 mm is -0.250000001 m (x / 1e3 gives -0.25000000099999997), 33.333333 mm is
+# 0.033333333 m (both gave 0.03333333300000001). The samples' bytes: Python's struct.pack('<d').
+RTX_NM='\x8e\x3e\xe6\x03\x02\x00\x59\x40\xf4\xde\x18\x02\x00\x40\x6f\xc0\xbb\xd6\xde\xa7\xaa\xaa\x40\x40'
+{ printf "$RTX_HEAD"; printf "$RTX_NM"; printf '\r\nEOF::\r\n'; } >"$TMP/nm.rtx"
+check import_rtx_nm 0 "^  range -250\.000001 \.\. 100\.000123 mm" -- "$DAQ" import rtx "$TMP/nm.rtx" --db "$TMP/rtx_nm.sqlite"
+check import_rtx_nm_0 0 "^0,.*,displacement_m,0,0\.100000123,0$" -- "$DAQ" export 1 --db "$TMP/rtx_nm.sqlite"
+check import_rtx_nm_1 0 "^0\.001,.*,displacement_m,0,-0\.250000001,1000000$" -- "$DAQ" export 1 --db "$TMP/rtx_nm.sqlite"
+check import_rtx_nm_2 0 "^0\.002,.*,displacement_m,0,0\.033333333,2000000$" -- "$DAQ" export 1 --db "$TMP/rtx_nm.sqlite"
 check import_not_rtx 2 "data/run/refused.toml: byte 0: not a Renishaw .rtx file" -- "$DAQ" import rtx "$DATA/run/refused.toml" --db "$TMP/rtx.sqlite"
 
 finish

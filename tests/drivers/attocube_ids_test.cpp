@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <span>
 #include <string>
 #include <utility>
@@ -366,6 +369,60 @@ TEST(IdsCodec, RecordedRequestsAreLearntAsTheJsonParserReadsThem) {
   }
 }
 
+using codec_test::bits;
+using codec_test::strtod_shifted;
+
+TEST(IdsCodec, ReadingsAreTheirDecimalsInSiBitForBit) {
+  // Picometre counts as the device writes them (both answer layouts, a blank after '{' for the
+  // one-pass scanner, an escaped string for the JSON parser) are n / 10^12 m correctly rounded:
+  // strtod("<n>e-12"), not n x 1e-12 (one ulp off for about 14 %).
+  std::mt19937_64 rng(1129);
+  std::uniform_int_distribution<std::int64_t> pm(-10'000'000'000'000, 10'000'000'000'000);
+  const char* forms[] = {R"({{"jsonrpc":"2.0","result":[0,{},{},{}],"id":1}})",
+                         R"({{"id":1,"jsonrpc":"2.0","result":[0,{},{},{}]}})",
+                         R"({{ "jsonrpc":"2.0","result":[0,{},{},{}],"id":1}})",
+                         R"({{"jsonrpc":"2.0","note":"a\"b","result":[0,{},{},{}],"id":1}})"};
+  std::size_t product_missed = 0, n = 0;
+  for (int i = 0; i < 20'000; ++i) {
+    const std::int64_t v[3] = {pm(rng), pm(rng), pm(rng)};
+    for (const char* form : forms) {
+      IdsCodec c;
+      c.encode(IdsMethod::get_axes_displacement);
+      std::vector<IdsResponse> frames;
+      std::vector<CodecError> errors;
+      c.feed(fmt::format(fmt::runtime(form), v[0], v[1], v[2]) + "\n", frames, errors);
+      ASSERT_EQ(frames.size(), 1u) << form;
+      ASSERT_TRUE(errors.empty()) << form;
+      for (int a = 0; a < 3; ++a) {
+        const double want = strtod_shifted(std::to_string(v[a]), -12);
+        ASSERT_TRUE(frames[0].displacement_m[a]);
+        ASSERT_EQ(bits(*frames[0].displacement_m[a]), bits(want)) << form << " " << v[a];
+      }
+    }
+    for (const std::int64_t x : v) {
+      product_missed += static_cast<double>(x) * 1e-12 != strtod_shifted(std::to_string(x), -12);
+      ++n;
+    }
+  }
+  EXPECT_GT(product_missed, n / 20);
+  // The ECU's pressure in hPa: 1024.09 hPa is 102409 Pa exactly; 1024.09 x 100 is
+  // 102408.99999999999.
+  IdsCodec c;
+  c.encode(IdsMethod::ecu_get_pressure);
+  c.encode(IdsMethod::ecu_get_pressure);
+  std::vector<IdsResponse> frames;
+  c.feed(R"({"jsonrpc":"2.0","result":[0,1024.09],"id":1})"
+         "\n"
+         R"({"jsonrpc":"2.0","note":"a\"b","result":[0,1024.4],"id":2})"
+         "\n",
+         frames);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(*frames[0].pressure_pa, 102409.0);
+  EXPECT_EQ(*frames[1].pressure_pa, 102440.0);  // through the JSON parser
+  EXPECT_NE(1024.09 * 100.0, 102409.0);         // what the codec stored before
+  EXPECT_NE(1024.4 * 100.0, 102440.0);
+}
+
 // The answers are read in one pass where they are as the device and the twin write them, and
 // through the JSON parser otherwise: each value must come out as the parser reads it.
 TEST(IdsCodec, AnswersReadInOnePassGiveTheParsersValues) {
@@ -384,7 +441,8 @@ TEST(IdsCodec, AnswersReadInOnePassGiveTheParsersValues) {
                                      "1e-300"};
   for (const std::string_view v : values) {
     SCOPED_TRACE(v);
-    const double expected_m = nlohmann::json::parse(v).get<double>() * 1e-12;
+    // The number in metres: its text with the exponent moved by -12, read by strtod.
+    const double expected_m = strtod_shifted(std::string(v), -12);
     for (const auto* form :
          {R"({{"jsonrpc":"2.0","result":[0,{},0,0],"id":1}})",
           R"({{"id":1,"jsonrpc":"2.0","result":[0,{},0,0]}})",

@@ -3,7 +3,9 @@
 // random chunks, and collect what the codec produced; run a driver's decoder over a text.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstdint>
+#include <cstdlib>
 #include <random>
 #include <span>
 #include <string>
@@ -14,6 +16,23 @@
 #include "cal/drivers/registry.hpp"
 
 namespace codec_test {
+
+// The independent value of a printed reading in SI: its decimal text with the exponent moved by
+// `shift`, read by strtod ("100.000123" mm in metres: strtod("100.000123e-3"); "1.5e3" pm:
+// strtod("1.5e-9")). A leading '+' (as gauges print it) is dropped.
+inline double strtod_shifted(std::string text, int shift) {
+  if (!text.empty() && text.front() == '+') text.erase(0, 1);
+  const auto e = text.find_first_of("eE");
+  long exponent = shift;
+  if (e != std::string::npos) {
+    exponent += std::strtol(text.c_str() + e + 1, nullptr, 10);
+    text.erase(e);
+  }
+  text += "e" + std::to_string(exponent);
+  return std::strtod(text.c_str(), nullptr);
+}
+
+inline std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
 
 template <class Frame>
 struct Decoded {

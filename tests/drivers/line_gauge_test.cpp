@@ -2,6 +2,14 @@
 // configured, a custom pattern, and every error kind counted, whatever the chunking.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
 #include "cal/analysis/error.hpp"
 #include "cal/drivers/registry.hpp"
 #include "codec_test_util.hpp"
@@ -149,6 +157,100 @@ TEST(GaugePresets, EveryPresetReadsItsOwnDocumentedExampleAndAGivenKeyWins) {
   ASSERT_EQ(d.values.size(), 1u);
   EXPECT_DOUBLE_EQ(d.values[0], 1e-3);
   EXPECT_EQ(decode_gauge("+1.0\r", {{"preset", "mitutoyo_digimatic"}}).errors, 1u);
+}
+
+}  // namespace
+
+namespace {
+
+using codec_test::bits;
+using codec_test::strtod_shifted;
+
+TEST(GaugeCodec, ReadingsAreTheirPrintedDecimalsInSiBitForBit) {
+  // 100.000123 mm is stored as 0.100000123 m (the literal: the correctly rounded double), not
+  // as 100.000123 x 1e-3 = 0.10000012300000001, by every path: the instrument's fast path
+  // (feed_values), frames, a printed unit word, a preset's pattern.
+  {
+    GaugeCodec g;
+    std::vector<GaugeFrame> f;
+    g.feed("+100.000123\n100.000123 mm\n-250.000001\n33.333333 mm\n", f);
+    ASSERT_EQ(f.size(), 4u);
+    EXPECT_EQ(f[0].value_si, 0.100000123);
+    EXPECT_EQ(f[1].value_si, 0.100000123);
+    EXPECT_EQ(f[2].value_si, -0.250000001);
+    EXPECT_EQ(f[3].value_si, 0.033333333);
+    GaugeCodec fast;
+    std::vector<double> values;
+    std::vector<CodecError> errors;
+    fast.feed_values(
+        as_bytes(std::string_view("+100.000123\n-250.000001\n")),
+        [&](double si, std::string_view) { values.push_back(si); }, errors);
+    EXPECT_EQ(values, (std::vector<double>{0.100000123, -0.250000001}));
+  }
+  // Random readings at 1 nm .. 0.1 um in each unit's form, against strtod of the moved text.
+  std::mt19937_64 rng(29);
+  std::uniform_int_distribution<std::int64_t> counts(-300'000'000, 300'000'000);
+  std::uniform_int_distribution<int> decimals(3, 6);
+  const GaugePreset* mahr = gauge_preset("mahr_millimar");
+  ASSERT_NE(mahr, nullptr);
+  GaugeCodec plain({.min_si = -1e3, .max_si = 1e3}),
+      in_um({.unit = GaugeUnit::um, .min_si = -1e3, .max_si = 1e3}),
+      preset({.pattern = std::string(mahr->pattern), .min_si = -1e3, .max_si = 1e3});
+  std::size_t product_missed = 0, n = 0;
+  char buf[64];
+  for (int i = 0; i < 50'000; ++i) {
+    const int k = decimals(rng);
+    std::snprintf(buf, sizeof buf, "%+.*f", k,
+                  static_cast<double>(counts(rng)) * std::pow(10.0, -k));
+    const std::string text = buf;
+    SCOPED_TRACE(text);
+    const double mm = strtod_shifted(text, -3), um = strtod_shifted(text, -6);
+    std::vector<GaugeFrame> f;
+    std::vector<double> fast;
+    std::vector<CodecError> errors;
+    plain.feed(text + "\n" + text + " mm\n" + text + " um\n", f);
+    plain.feed_values(
+        as_bytes(std::string_view(text + "\n")),
+        [&](double si, std::string_view) { fast.push_back(si); }, errors);
+    in_um.feed(text + "\n", f);
+    preset.feed(text + "mm\n" + text + "um\n", f);
+    ASSERT_EQ(f.size(), 6u);
+    ASSERT_EQ(fast.size(), 1u);
+    EXPECT_EQ(bits(f[0].value_si), bits(mm));
+    EXPECT_EQ(bits(fast[0]), bits(mm));
+    EXPECT_EQ(bits(f[1].value_si), bits(mm));
+    EXPECT_EQ(bits(f[2].value_si), bits(um));
+    EXPECT_EQ(bits(f[3].value_si), bits(um));
+    EXPECT_EQ(bits(f[4].value_si), bits(mm));
+    EXPECT_EQ(bits(f[5].value_si), bits(um));
+    if (::testing::Test::HasFailure()) break;
+    ++n;
+    product_missed += std::strtod(buf, nullptr) * 1e-3 != mm;
+  }
+  // The product the codec used to store misses a share of them (what this test is about).
+  EXPECT_GT(product_missed, n / 20);
+  // Inches: 1.2345 in = 1.2345 x 0.0254 m = 0.0313563 m exactly (12345 x 254 = 3135630).
+  GaugeCodec inches({.unit = GaugeUnit::inch});
+  std::vector<GaugeFrame> f;
+  inches.feed("1.2345\n1.2345 in\n", f);
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_EQ(f[0].value_si, 0.0313563);
+  EXPECT_EQ(f[1].value_si, 0.0313563);
+  // A scale or an offset makes a computed value, not the printed one: as before.
+  GaugeCodec counts_01um({.unit = GaugeUnit::um, .scale = 0.1});
+  f.clear();
+  counts_01um.feed("12345\n", f);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].value_si, 12345 * 0.1 * 1e-6);
+}
+
+TEST(GaugeCodec, TheGaugeDriverStoresThePrintedDecimalInSi) {
+  // Through the registry's decoder, as `daq decode gauge` and a run read the lines.
+  const auto items = codec_test::decode_whole("gauge", "+100.000123\r\n-250.000001\r\n");
+  std::vector<double> values;
+  for (const auto& i : items)
+    if (i.kind == cal::drivers::DecodedItem::Kind::reading) values.push_back(i.value);
+  EXPECT_EQ(values, (std::vector<double>{0.100000123, -0.250000001}));
 }
 
 }  // namespace

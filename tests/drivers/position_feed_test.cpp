@@ -34,7 +34,9 @@ TEST(HalsamplerCodec, NoSampleNumbersOtherColumnsAndInches) {
   // halsampler without -t, pins in the order Z, spindle, X; inch machine: 1.25 in = 0.03175 m,
   // 0.5 in = 0.0127 m; Y not fed.
   const auto d = codec_test::feed_whole(
-      HalsamplerCodec({.sample_numbers = false, .column = {2, -1, 0}, .metres_per_unit = 0.0254}),
+      HalsamplerCodec({.sample_numbers = false,
+                       .column = {2, -1, 0},
+                       .metres_per_unit = cal::drivers::codec::kInchesToMetres}),
       "0.5 7 1.25\n");
   ASSERT_EQ(d.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(*d.frames[0].position_m[0], 0.03175);
@@ -54,7 +56,7 @@ TEST(HalsamplerCodec, BadLinesAreCountedAndTheNextOneRead) {
   EXPECT_EQ(d.stats.garbage, 1u);
   ASSERT_EQ(d.frames.size(), 1u);
   EXPECT_DOUBLE_EQ(*d.frames[0].position_m[2], 0.003);
-  EXPECT_THROW(HalsamplerCodec({.metres_per_unit = 0}), cal::InputError);
+  EXPECT_THROW(HalsamplerCodec({.metres_per_unit = {.multiplier = 0}}), cal::InputError);
 }
 
 TEST(HalsamplerCodec, UntaggedByDefaultAndOverrunIsAGapNotAnError) {

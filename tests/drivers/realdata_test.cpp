@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "cal/drivers/registry.hpp"
+#include "codec_test_util.hpp"
 #include "halsampler/codec.hpp"
 
 namespace {
@@ -119,6 +122,7 @@ struct ShdrExpected {
   std::int64_t time_ns;
   std::uint8_t axis;
   double value_m;
+  std::string printed;  // the value as the file prints it (mm)
 };
 std::vector<ShdrExpected> shdr_expected(const std::vector<std::string>& lines,
                                         const std::vector<std::string>& keys,
@@ -132,7 +136,8 @@ std::vector<ShdrExpected> shdr_expected(const std::vector<std::string>& lines,
     for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
       for (std::uint8_t a = 0; a < keys.size(); ++a)
         if (tokens[i] == keys[a]) {
-          of_line.push_back({unix_ns(tokens[0]), a, std::stod(tokens[i + 1]) * 1e-3});
+          of_line.push_back(
+              {unix_ns(tokens[0]), a, std::stod(tokens[i + 1]) * 1e-3, tokens[i + 1]});
           ++per_axis[a];
         }
     std::sort(of_line.begin(), of_line.end(),
@@ -158,14 +163,12 @@ void expect_readings(const std::vector<d::DecodedItem>& items,
   }
 }
 
-TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
-  // README: 3,989 position frames for X1actw, YI1actw, Z1actw, every one with the file's time
-  // and value, no codec error. Expected: lines outside the --multiline-- asset blocks and not
-  // '*' commands, with one of the keys at a key position (1, 3, 5, ...).
-  const std::string text = read("shdr_okuma_osp_p300.txt");
+// The Okuma recording's expected readings: lines outside the --multiline-- asset blocks and not
+// '*' commands, with one of the keys at a key position (1, 3, 5, ...); `frames` counts the lines.
+std::vector<ShdrExpected> okuma_expected(const std::string& text, std::size_t& frames) {
   const std::map<std::string, std::uint8_t> keys{{"X1actw", 0}, {"YI1actw", 1}, {"Z1actw", 2}};
   std::vector<ShdrExpected> expected;
-  std::size_t frames = 0;
+  frames = 0;
   std::string terminator;
   for (const auto& line : lines_of(text)) {
     if (!terminator.empty()) {
@@ -181,12 +184,22 @@ TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
     std::vector<ShdrExpected> of_line;  // a frame's readings come X, Y, Z whatever the line's order
     for (std::size_t i = 1; i + 1 < tokens.size(); i += 2)
       if (const auto k = keys.find(tokens[i]); k != keys.end())
-        of_line.push_back({unix_ns(tokens[0]), k->second, std::stod(tokens[i + 1]) * 1e-3});
+        of_line.push_back(
+            {unix_ns(tokens[0]), k->second, std::stod(tokens[i + 1]) * 1e-3, tokens[i + 1]});
     std::sort(of_line.begin(), of_line.end(),
               [](const ShdrExpected& a, const ShdrExpected& b) { return a.axis < b.axis; });
     expected.insert(expected.end(), of_line.begin(), of_line.end());
     frames += !of_line.empty();
   }
+  return expected;
+}
+
+TEST(RealData, OkumaShdrGivesItsPositionFramesWithTheFilesTimesAndValues) {
+  // README: 3,989 position frames for X1actw, YI1actw, Z1actw, every one with the file's time
+  // and value, no codec error.
+  const std::string text = read("shdr_okuma_osp_p300.txt");
+  std::size_t frames = 0;
+  const auto expected = okuma_expected(text, frames);
   EXPECT_EQ(frames, 3989u);
   cal::drivers::codec::CodecStats stats;
   const auto items = decode("shdr", text, {{"keys", "X1actw,YI1actw,Z1actw"}}, &stats);
@@ -390,6 +403,100 @@ TEST(RealData, HalsamplerLimitMaxVelocityGivesSamples0To799WithNoGap) {
     EXPECT_EQ(f[k].lost_before, 0u);
     EXPECT_DOUBLE_EQ(*f[k].position_m[0], 0.5 * static_cast<double>(k + 1) * 1e-3);
   }
+}
+
+// ---- Every position as its printed decimal in metres, bit for bit ----
+// The independent value: the file's own text with its exponent moved, read by strtod
+// ("1039.897" mm is strtod("1039.897e-3")). Before, the drivers stored the printed double x
+// 1e-3, one ulp off for a share of them (counted: the test would not see the change otherwise).
+
+double printed_in_metres(const std::string& text) { return codec_test::strtod_shifted(text, -3); }
+using codec_test::bits;
+
+// Compares the readings of `items` with the printed decimals; returns how many the old
+// product (the printed double x 1e-3) misses.
+std::size_t expect_printed_decimals(const std::vector<d::DecodedItem>& items,
+                                    const std::vector<ShdrExpected>& expected) {
+  std::vector<double> values;
+  for (const auto& i : items)
+    if (i.kind == d::DecodedItem::Kind::reading) values.push_back(i.value);
+  EXPECT_EQ(values.size(), expected.size());
+  std::size_t product_missed = 0;
+  for (std::size_t k = 0; k < std::min(values.size(), expected.size()); ++k) {
+    const double want = printed_in_metres(expected[k].printed);
+    EXPECT_EQ(bits(values[k]), bits(want))
+        << "reading " << k << " '" << expected[k].printed << "': " << values[k];
+    product_missed += std::stod(expected[k].printed) * 1e-3 != want;
+  }
+  return product_missed;
+}
+
+TEST(RealData, ShdrPositionsAreTheirPrintedDecimalsInMetresBitForBit) {
+  std::size_t frames = 0;
+  const std::string okuma = read("shdr_okuma_osp_p300.txt");
+  const auto okuma_missed = expect_printed_decimals(
+      decode("shdr", okuma, {{"keys", "X1actw,YI1actw,Z1actw"}}), okuma_expected(okuma, frames));
+  std::array<std::size_t, 3> per_axis{};
+  const std::string gf = read("shdr_gf_agie_hpm600u_2015.txt");
+  const auto gf_missed = expect_printed_decimals(
+      decode("shdr", gf, {{"keys", "Xposition,Yposition,Zposition"}}),
+      shdr_expected(lines_of(gf), {"Xposition", "Yposition", "Zposition"}, per_axis));
+  const std::string handtmann = read("shdr_handtmann482_840d_telnet.txt");
+  std::size_t at = 0;
+  for (int k = 0; k < 9; ++k) at = handtmann.find('\n', at) + 1;
+  const std::string first9 = handtmann.substr(0, at);
+  const auto handtmann_missed = expect_printed_decimals(
+      decode("shdr", first9, {{"keys", "X11_actual,Y11_actual,Z11_actual"}}),
+      shdr_expected(lines_of(first9), {"X11_actual", "Y11_actual", "Z11_actual"}, per_axis));
+  // Of 4,905 Okuma and 9,597 GF Agie readings the product missed (counted when written):
+  EXPECT_GT(okuma_missed, 100u);
+  EXPECT_GT(gf_missed, 100u);
+  RecordProperty("product_missed", std::to_string(okuma_missed) + " okuma, " +
+                                       std::to_string(gf_missed) + " gf agie, " +
+                                       std::to_string(handtmann_missed) + " handtmann");
+}
+
+TEST(RealData, HalsamplerValuesAreTheirPrintedDecimalsInMetresBitForBit) {
+  // Every column of every recording (bit pins "0" and "1" too), through the driver's decoder.
+  const struct {
+    const char* file;
+    bool tagged;
+    int columns;
+  } files[] = {{"halsampler_tagged_limit3.txt", true, 1},
+               {"halsampler_tagged_limit_max_velocity.txt", true, 1},
+               {"halsampler_tagged_timedelay0.txt", true, 2},
+               {"halsampler_untagged_near0.txt", false, 4},
+               {"halsampler_untagged_abs0.txt", false, 2},
+               {"halsampler_untagged_biquad.txt", false, 3},
+               {"halsampler_untagged_mux.txt", false, 20},
+               {"halsampler_untagged_and_or_not_mux.txt", false, 5}};
+  std::size_t product_missed = 0, values = 0;
+  for (const auto& f : files) {
+    const std::string text = read(f.file);
+    const auto lines = lines_of(text);
+    for (int column = 0; column < f.columns; ++column) {
+      SCOPED_TRACE(std::string(f.file) + " column " + std::to_string(column));
+      const auto items =
+          decode("halsampler", text,
+                 {{"column", std::to_string(column)}, {"tagged", f.tagged ? "true" : "false"}});
+      std::size_t k = 0;
+      for (const auto& i : items) {
+        if (i.kind != d::DecodedItem::Kind::reading) continue;
+        ASSERT_LT(k, lines.size());
+        std::istringstream in(lines[k++]);
+        std::string token;
+        for (int c = 0; c <= column + (f.tagged ? 1 : 0); ++c) in >> token;
+        const double want = printed_in_metres(token);
+        EXPECT_EQ(bits(i.value), bits(want)) << "line " << k << " '" << token << "'";
+        product_missed += std::stod(token) * 1e-3 != want;
+        ++values;
+      }
+      EXPECT_EQ(k, lines.size());
+    }
+  }
+  EXPECT_GT(product_missed, 0u);
+  RecordProperty("values", std::to_string(values));
+  RecordProperty("product_missed", std::to_string(product_missed));
 }
 
 }  // namespace

@@ -2,6 +2,13 @@
 // other units, the CS2/CS4/CSX checksums worked out by hand, and every bad line.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+
 #include "cal/analysis/error.hpp"
 #include "codec_test_util.hpp"
 #include "ptu300/codec.hpp"
@@ -170,6 +177,41 @@ TEST(Ptu300Codec, TheInformationalAnswersAreNoMeasurement) {
     EXPECT_FALSE(f.relative_humidity_pct);
     EXPECT_FALSE(f.dew_point_degc);
   }
+}
+
+using codec_test::strtod_shifted;
+
+TEST(Ptu300Codec, PressuresInDecimalUnitsAreTheirPrintedDecimalsInPascalsBitForBit) {
+  // 1024.4 hPa is 102440 Pa; 1024.4 x 100 (what the codec stored before) is 102440.00000000001.
+  const auto d = codec_test::feed_whole(Ptu300Codec{}, "P= 1024.4 hPa T= 22.2 'C\r\n");
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_EQ(*d.frames[0].pressure_pa, 102440.0);
+  EXPECT_NE(1024.4 * 100.0, 102440.0);
+  EXPECT_EQ(*d.frames[0].temperature_degc, 22.2);
+  // Random readings in every unit that is a power of ten of the pascal, as FORM prints them.
+  const std::pair<const char*, int> units[] = {{"hPa", 2}, {"mbar", 2}, {"kPa", 3},
+                                               {"bar", 5}, {"bara", 5}, {"Pa", 0}};
+  std::mt19937_64 rng(300);
+  std::uniform_real_distribution<double> hpa(500.0, 1200.0);
+  std::uniform_int_distribution<int> decimals(0, 3);
+  std::size_t product_missed = 0, n = 0;
+  char buf[32];
+  for (int i = 0; i < 20'000; ++i) {
+    for (const auto& [unit, shift] : units) {
+      const int k = decimals(rng);
+      std::snprintf(buf, sizeof buf, "%.*f", k + shift, hpa(rng) * 100.0 / std::pow(10.0, shift));
+      const std::string line = std::string("P= ") + buf + " " + unit + "\r\n";
+      SCOPED_TRACE(line);
+      const auto f = codec_test::feed_whole(Ptu300Codec{}, line);
+      ASSERT_EQ(f.frames.size(), 1u);
+      const double want = strtod_shifted(buf, shift);
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(*f.frames[0].pressure_pa),
+                std::bit_cast<std::uint64_t>(want));
+      product_missed += std::strtod(buf, nullptr) * std::pow(10.0, shift) != want;
+      ++n;
+    }
+  }
+  EXPECT_GT(product_missed, n / 50);
 }
 
 }  // namespace

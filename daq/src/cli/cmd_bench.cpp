@@ -52,6 +52,7 @@
 #include "bench_common.hpp"
 #include "cal/analysis/error.hpp"
 #include "cal/daq/env_stage.hpp"
+#include "cal/drivers/codec/common.hpp"
 #include "cal/drivers/registry.hpp"
 #include "cal/replay/capture.hpp"
 #include "cal/replay/session.hpp"
@@ -582,26 +583,24 @@ void bench_ingest(const BenchOptions& o) {
 // The generated readings' values: exactly as a real instrument's driver stores them, or not.
 enum class BenchValues {
   // The length as `daq bench ingest`'s gauge prints it ("%+011.6f" mm: 1 nm, six decimals of a
-  // millimetre) and the line-gauge driver stores it: the printed decimal in SI, the double
-  // nearest it (the printed digits as an integer divided by the exact power of ten: 10^9 for
-  // nanometres in metres); the air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=
-  // 50.0 %RH": two decimals of hPa in Pa, two of degC, one of %RH). What a store holds: raw
-  // readings at the instrument's resolution, each its decimal's own double (docs/storage.md;
-  // before issue 32's last pass the drivers multiplied by 1e-3, which left a quarter of the
-  // lengths one ulp off their decimal).
+  // millimetre) and the line-gauge driver stores it: the printed decimal in metres as one
+  // correctly rounded division (parse_plain_decimal_scaled: the integer nanometres / 10^9); the
+  // air as a PTU300 prints it ("P= 1013.25 hPa T=  20.00 'C RH=  50.0 %RH": the hPa decimal in
+  // Pa, two decimals of degC, one of %RH). What a store holds: raw readings, at
+  // the instrument's resolution, each the correctly rounded double of its decimal in SI.
   quantised,
   // 0.1 + 1e-6 sin(...) + 1e-9 k computed in doubles: 16 - 17 significant digits a value, as
   // no instrument stores them (a compensated length would be; the store holds none).
   unquantised,
 };
 
-// value rounded to `decimals` decimals as printed, in SI units of 10^si_exponent printed units
-// (mm in m: -3; hPa in Pa: 2): the printed digits as an integer n, then n / 10^(decimals -
-// si_exponent), one correctly rounded division (or n x 10^(si_exponent - decimals), exact).
-double as_printed(double value, int decimals, int si_exponent) {
-  const double n = std::round(value * std::pow(10.0, decimals));  // the digits, < 2^53
-  const int shift = decimals - si_exponent;                       // |shift| <= 22
-  return shift >= 0 ? n / std::pow(10.0, shift) : n * std::pow(10.0, -shift);
+// `value` printed with `decimals` decimals in a unit 10^exponent_to_si of SI, as a driver
+// stores it: the printed decimal in SI, correctly rounded (the count over the exact power of
+// ten, cal::drivers::codec::scaled_count; docs/codecs.md, "Readings in SI").
+double as_printed(double value, int decimals, int exponent_to_si) {
+  const double scale = std::pow(10.0, decimals);  // exact for decimals <= 22
+  return cal::drivers::codec::scaled_count(std::llround(value * scale),
+                                           {1, exponent_to_si - decimals});
 }
 
 // A run of `seconds` of a 10 kHz length stream (device 0) and 1 Hz air (device 1), stored in

@@ -8,6 +8,7 @@
 
 #include "cal/analysis/error.hpp"
 #include "cal/analysis/text.hpp"
+#include "cal/drivers/codec/common.hpp"
 #include "cal/drivers/instrument.hpp"
 #include "cal/replay/rtx.hpp"
 #include "cal/storage/store.hpp"
@@ -36,6 +37,10 @@ struct Interpretation {
   std::string unit;    // as given or defaulted
   double si_per_unit;  // metres or radians per unit
   std::string si;      // "m" or "rad"
+  // si_per_unit as an exact decimal (mm {1, -3}, in {254, -4}); multiplier 0 for arcsec and
+  // deg (pi is no decimal). With it a sample that stands for a decimal (its shortest form has
+  // at most 15 digits) is stored as that decimal in SI, correctly rounded (scaled_double).
+  cal::drivers::codec::DecimalScale exact{0, 0};
 };
 
 Interpretation interpret(cal::replay::RtxKind kind, const std::string& unit,
@@ -44,16 +49,19 @@ Interpretation interpret(cal::replay::RtxKind kind, const std::string& unit,
   constexpr double pi = 3.14159265358979323846;
   if (kind == cal::replay::RtxKind::linear) {
     const std::string u = unit.empty() ? "mm" : unit;
-    if (u == "mm") return {Q::displacement_m, u, 1e-3, "m"};
-    if (u == "um") return {Q::displacement_m, u, 1e-6, "m"};
-    if (u == "m") return {Q::displacement_m, u, 1.0, "m"};
-    if (u == "in") return {Q::displacement_m, u, 25.4e-3, "m"};
+    using namespace cal::drivers::codec;
+    if (u == "mm") return {Q::displacement_m, u, 1e-3, "m", kMillimetresToMetres};
+    if (u == "um") return {Q::displacement_m, u, 1e-6, "m", kMicrometresToMetres};
+    if (u == "m") return {Q::displacement_m, u, 1.0, "m", kUnitScale};
+    if (u == "in") return {Q::displacement_m, u, 25.4e-3, "m", kInchesToMetres};
     throw cal::InputError(
         fmt::format("{}: a Linear capture: --unit '{}' (expected mm, um, m or in)", file, u));
   }
   if (unit == "arcsec") return {Q::angle_rad, unit, pi / (180.0 * 3600.0), "rad"};
-  if (unit == "urad" || unit == "um/m") return {Q::angle_rad, unit, 1e-6, "rad"};
-  if (unit == "mrad" || unit == "mm/m") return {Q::angle_rad, unit, 1e-3, "rad"};
+  if (unit == "urad" || unit == "um/m")
+    return {Q::angle_rad, unit, 1e-6, "rad", cal::drivers::codec::kMicrometresToMetres};
+  if (unit == "mrad" || unit == "mm/m")
+    return {Q::angle_rad, unit, 1e-3, "rad", cal::drivers::codec::kMillimetresToMetres};
   if (unit == "deg") return {Q::angle_rad, unit, pi / 180.0, "rad"};
   throw cal::InputError(fmt::format(
       "{}: an Angular capture: give --unit arcsec, urad, um/m, mrad, mm/m or deg (the .rtx "
@@ -77,7 +85,9 @@ void copy_samples(cal::replay::RtxReader& r, st::Store& store, const Interpretat
   while (const auto n = r.read(buf)) {
     rows.clear();
     for (std::size_t i = 0; i < n; ++i, ++s.samples) {
-      const double v = buf[i] * scale;
+      const double v = how.exact.multiplier != 0
+                           ? cal::drivers::codec::scaled_double(buf[i], how.exact)
+                           : buf[i] * scale;
       const bool ok = std::isfinite(v);
       if (ok) s.min_m = std::min(s.min_m, v), s.max_m = std::max(s.max_m, v);
       s.invalid += ok ? 0 : 1;
@@ -154,7 +164,8 @@ void import_rtx(const ImportOptions& o) {
        .transport = "file " + o.file,
        .settings_json = json{{"serial", field("Serial No")}}.dump(),
        .origin = "imported",
-       .origin_detail = "Renishaw .rtx file " + o.file + " (the file does not say whether the "
+       .origin_detail = "Renishaw .rtx file " + o.file +
+                        " (the file does not say whether the "
                         "instrument was real)"});
   try {
     copy_samples(reader, store, how, s);

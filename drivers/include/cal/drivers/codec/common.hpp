@@ -15,6 +15,8 @@
 #include <string_view>
 #include <vector>
 
+#include "cal/drivers/codec/decimal.hpp"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -192,6 +194,22 @@ bool is_printable_ascii(std::string_view line);
 // Parses the whole of `s` as a decimal number (a leading '+' is allowed, as gauges print it);
 // nullopt if anything is left over or nothing is a number.
 std::optional<double> parse_number(std::string_view s);
+
+// The same number in another unit by an exact factor (docs/codecs.md, "Readings in SI"):
+// the correctly rounded double of the printed decimal times `scale`, as strtod reads the decimal
+// with its exponent moved ("100.000123" in mm to m is strtod("100.000123e-3")), never the
+// printed value times an inexact 1e-3. inf and nan are returned as parse_number reads them;
+// nullopt where parse_number gives nullopt, and for a result beyond the double's range.
+std::optional<double> parse_number_scaled(std::string_view s, DecimalScale scale);
+
+// A double that stands for a decimal (a float64 sample a vendor's software wrote, a JSON number
+// already parsed) in another unit: when its shortest round-trip decimal (std::to_chars) has at
+// most 15 significant digits, that decimal times `scale`, correctly rounded. A double nearest
+// to a decimal of at most 15 significant digits has that decimal as its shortest form, so the
+// result is the decimal's own value in SI (x / 1e3 rounds twice and misses it for about a
+// quarter of 1 nm readings in mm). A double with no such decimal (16-17 digits: binary data)
+// is x x multiplier, then divided (or multiplied) by the exact power of ten.
+double scaled_double(double x, DecimalScale scale);
 
 // Parses the whole of `s` as an integer of type Int (no leading '+'); nullopt if anything is
 // left over, nothing is a number, or it does not fit.
