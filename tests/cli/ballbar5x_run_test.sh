@@ -116,7 +116,7 @@ if len(got) and len(got[0]) != int(sys.argv[5]):
     bad.append(f"{len(got[0])} columns")
 tests = rows("num tests")
 setups = [(r[0], r[1], r[2], r[3], r[4], r[6]) for r in tests]
-expect = [(f"{a}-{s}", a, s, "(150.000, 0.000, -250.000)", "100.000", n)
+expect = [(f"{a}-{s}", a, s, "(150, 0, -250)", "100", n)
           for a, n in (("C", "12"), ("A", "13")) for s in ("radial", "tangential", "axial")]
 if setups != expect:
     bad.append(f"tests {setups}")
@@ -159,7 +159,30 @@ check verdict_swivel_pass 0 "^PASS 8 $" -- verdict 2
 check verdict_hal_tilts_fail 0 "^FAIL 8 E_A0C E_B0A E_B0C E_C0A$" -- verdict 3
 "$DAQ" report 3 --db "$DB" -o "$TMP/r3.html" >/dev/null 2>&1
 check report_fail 0 "<strong>FAIL</strong> &mdash; 4 of 8 limited values outside their limits" -- cat "$TMP/r3.html"
-check report_failing_value 0 "<li><strong>E_B0C</strong> = -[56]\.[0-9]{3} µrad \(limit ≤ 3\.000 µrad\): correct the axis&#39;s tilt" -- cat "$TMP/r3.html"
+check report_failing_value 0 "<li><strong>E_B0C</strong> = -[56]\.[0-9]{3} µrad \(limit ≤ 3\.000 µrad\): correct the axis&#39;s tilt in the control&#39;s kinematics</li>" -- cat "$TMP/r3.html"
+# Printed on A4 by Chromium: page one holds the failing verdict, the location errors and the
+# whole table of the tests; printed at full size (the appendix's raw list of the tests, a line
+# too wide, once shrank every page to fit) and no word past the right margin.
+"$DAQ" report 3 --db "$DB" -f pdf -o "$TMP/r3.pdf" >/dev/null 2>&1
+printed_a4() {
+  "$PY" - "$1" "$(dirname "$0")" <<'PYEOF'
+import sys
+sys.path.insert(0, sys.argv[2])
+from report_checks import MM, pdf_words
+pages = pdf_words(sys.argv[1])
+words, _ = pages[0]
+one = " ".join(w[4] for w in words)
+bad = [k for k in ("FAIL", "E_X0C", "E_C0A", "C-radial", "A-axial", "(150, 0, -250)") if k not in one]
+title = words[0][3] - words[0][1]
+if title < 16:  # 14 pt type: 16.3 pt at full size, 15.3 when the appendix shrank the page
+    bad.append(f"title {title:.1f} pt high: the page was shrunk")
+wide = [w[4] for ws, _ in pages for w in ws if w[2] > (210 - 14) * MM + 1]
+if wide:
+    bad.append(f"past the right margin: {wide[:5]}")
+print("ok" if not bad else "; ".join(bad))
+PYEOF
+}
+check printed_a4 0 "^ok$" -- printed_a4 "$TMP/r3.pdf"
 printf '[tolerances.C]\nE_arcsec = 12\n' >"$TMP/tol-none.toml"
 check tolerances_none 2 "no location_um or location_urad in \[tolerances.C\] or \[tolerances.A\]" -- "$DAQ" model ballbar5x-run "$TRUTH" --control "$NOM" --db "$DB" --ball-mm $BALL --tolerances "$TMP/tol-none.toml"
 printf '[tolerances.X]\nlocation_um = 5\n' >"$TMP/tol-x.toml"

@@ -473,6 +473,7 @@ constexpr SettingLabel setting_labels[] = {
 bool setting_applies(const RunView& v, const std::string& key, const json& val) {
   if (val.is_null() || (val.is_string() && val.get<std::string>().empty())) return false;
   if (val.is_array() && val.empty()) return false;
+  if (v.run.kind == "ballbar5x" && key == "tests") return false;  // page one's table of the tests
   if (val.is_array() && key.ends_with("_mm") && key != "targets_mm" &&
       std::all_of(val.begin(), val.end(),
                   [](const json& x) { return x.is_number() && x.get<double>() == 0.0; }))
@@ -1068,10 +1069,8 @@ std::string what_to_check(const ::daq::Check& c) {
   // What the control's kinematics leave of a rotary axis's line: its pivot or its tilt (which
   // LinuxCNC's trunnion pins cannot hold: docs/five-axis-walkthrough.md, section 4).
   if (is_location_error(c.key))
-    return c.unit == "um" ? "correct the axis's line in the control's kinematics (daq model "
-                            "kinematics)"
-                          : "correct the axis's tilt in the control's kinematics (a SINUMERIK "
-                            "record holds it, LinuxCNC's trunnion pins do not)";
+    return c.unit == "um" ? "correct the axis's line in the control's kinematics"
+                          : "correct the axis's tilt in the control's kinematics";
   const std::string_view key = c.key;
   const std::string_view head = key.substr(0, key.find('_'));
   // Short enough that "B = 4.023 µm (limit ≤ 3.000 µm): ..." stays one line on page one (a
@@ -2360,7 +2359,7 @@ std::string angles_text(const json& stops) {
   bool even = a.size() > 2;
   for (std::size_t k = 1; k < a.size(); ++k) even = even && std::abs(a[k] - a[k - 1] - step) < 1e-9;
   if (even)
-    return fmt::format("{} to {}° by {}°", setting_text(a.front()), setting_text(a.back()),
+    return fmt::format("{} … {}° by {}°", setting_text(a.front()), setting_text(a.back()),
                        setting_text(step));
   std::vector<std::string> each;
   for (double x : a) each.push_back(setting_text(x));
@@ -2381,7 +2380,8 @@ std::string dialect_text(const RunView& v) {
 // One test's bar deviation (the reading less the test's fitted bar offset) at each stop against
 // the rotary angle, with what the fitted location errors alone give there (reading − residual).
 std::string ballbar5x_plot(const json& axis, const json& test) {
-  Line measured{.label = "measured", .colour = blue, .width = 0.0, .markers = true};
+  // A dot as large as the other plots' marks: PLplot's own point (plpoin) printed too small to see.
+  Line measured{.label = "measured", .colour = blue, .width = 0.0, .markers = true, .marker = "●"};
   Line fitted{.label = "fitted", .colour = vermilion, .width = 1.0, .dashed = true};
   const double offset = test.value("offset_um", 0.0);
   for (const auto& s : test.value("stops", json::array())) {
@@ -2494,10 +2494,10 @@ Sections ballbar5x_section(const st::RunReader& store, const RunView& v, const O
     for (const auto& t : a.value("tests", json::array())) {
       std::vector<std::string> ball;
       for (const auto& x : t.value("ball_mm", json::array()))
-        ball.push_back(fixed(x.is_number() ? x.get<double>() : 0.0, 3));
+        ball.push_back(esc(setting_text(x)));  // as given: "150", not "150.000"
       trows.push_back({esc(ctx(t, "test")), esc(ctx(a, "axis")), esc(ctx(t, "setup")),
                        fmt::format("({})", fmt::join(ball, ", ")),
-                       fixed(t.value("length_mm", 0.0), 3),
+                       esc(setting_text(t.value("length_mm", json(0.0)))),
                        esc(angles_text(t.value("stops", json::array()))),
                        std::to_string(t.value("stops", json::array()).size()),
                        signed_text(t.value("offset_um", 0.0), 3) + " ± " +
@@ -2551,8 +2551,11 @@ Sections ballbar5x_section(const st::RunReader& store, const RunView& v, const O
       prog.push_back({label, esc(setting_text(j[key])) + (*unit ? " " + std::string(unit) : "")});
   };
   setting("Dwell at each angle", timing, "dwell_s", "s");
-  setting("Averaged from", timing, "settle_s",
-          "s after a stop's start (and until half of it before its end)");
+  if (timing.is_object() && timing.contains("settle_s") && timing["settle_s"].is_number())
+    prog.push_back(
+        {"Each stop averaged", fmt::format("from {} s after its start to {} s before its end",
+                                           setting_text(timing["settle_s"]),
+                                           setting_text(0.5 * timing["settle_s"].get<double>()))});
   setting("Rotary axis's rate between stops", timing, "rate_deg_per_s", "deg/s");
   setting("Bar's sample rate", timing, "sample_rate_hz", "Hz");
   setting("Feed-in", timing, "feed_in_mm", "mm");
