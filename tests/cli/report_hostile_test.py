@@ -6,7 +6,8 @@ site, operator, notes, campaign and instruments' serial numbers and certificates
 (`</style><script>`, `"><img onerror>`, `<iframe src=file://...>`, `</title>`); a replayed
 capture whose header's configuration (docs/capture-format.md) names the machine and campaign so;
 an imported Renishaw .rtx whose `Machine:` and `Owner:` lines (the latter a plot's title and
-legend) do the same; a machine model file with a hostile name. Each report (run, campaign, comparison, as found / as
+legend) do the same; a machine model file with a hostile name; a five-axis ballbar run whose simulated machine and
+control models have hostile paths. Each report (run, campaign, comparison, as found / as
 left, the model's page) is then
   (a) parsed with html.parser: only the report's own elements, no event-handler attribute, the
       Content-Security-Policy first in <head>, one <style> block with no `<` in it, and the
@@ -178,6 +179,19 @@ model = json.load(open(os.path.join(os.path.dirname(__file__), "..", "data", "mo
 model["machine"] = names["machine"]
 json.dump(model, open(os.path.join(TMP, "hostile-model.json"), "w"))
 
+# A five-axis ballbar run (issue 36) whose models' paths are markup: the run names its machine
+# by the simulated truth's path and records the control's kinematics by its path (each '/' of a
+# name a directory here).
+MODELS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "model")
+bb5x_models = {"truth": names["machine"] + ".json", "control": names["make"] + ".json"}
+for which, path in bb5x_models.items():
+    os.makedirs(os.path.join(TMP, os.path.dirname(path)), exist_ok=True)
+    shutil.copy(os.path.join(MODELS, f"trunnion_{'truth' if which == 'truth' else 'nominal'}.json"),
+                os.path.join(TMP, path))
+r = daq("model", "ballbar5x-run", bb5x_models["truth"], "--control", bb5x_models["control"],
+        "--db", "bb5x.sqlite", "--ball-mm", "150", "0", "-250", "--setups", "radial", "axial")
+check("ballbar5x_hostile_models", r.returncode == 0, r.stdout[-1500:] + r.stderr)
+
 # --- the reports --------------------------------------------------------------------------------
 reports = {
     "run": (["report", RUN, "--db", "demo.sqlite"], ["machine", "customer", "site", "operator",
@@ -189,6 +203,7 @@ reports = {
     "compare": (["report", "--compare", "1", RUN, "--db", "demo.sqlite"], []),
     "asfound": (["report", "--as-found", "1", "--as-left", RUN, "--db", "demo.sqlite"],
                 ["machine", "customer", "operator"]),
+    "ballbar5x": (["report", "1", "--db", "bb5x.sqlite"], ["machine", "make"]),
 }
 
 
@@ -275,7 +290,8 @@ def pdf_text(path):
 
 squash = lambda s: re.sub(r"\s+", "", s)  # noqa: E731  (pdftotext breaks lines in table cells)
 for name, what in (("run", ["report", RUN, "--db", "demo.sqlite"]),
-                   ("rtx", ["report", "1", "--db", "rtx.sqlite"])):
+                   ("rtx", ["report", "1", "--db", "rtx.sqlite"]),
+                   ("ballbar5x", ["report", "1", "--db", "bb5x.sqlite"])):
     pdf = os.path.join(TMP, f"{name}.pdf")
     r = daq(*what, "--format", "pdf", "-o", pdf)
     check(f"{name}_pdf_written", r.returncode == 0 and open(pdf, "rb").read(4) == b"%PDF",

@@ -5,10 +5,13 @@
 // program for Fanuc/ISO, HEIDENHAIN or SINUMERIK. The maths: cal::kinematics (ballbar5x.hpp),
 // docs/kinematics.md "The ballbar on a rotary axis".
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -20,6 +23,7 @@
 #include "cal/daq/gcode.hpp"
 #include "cli_checks.hpp"
 #include "command.hpp"
+#include "config_tolerances.hpp"
 #include "csv_columns.hpp"
 #include "database.hpp"
 #include "model_cli.hpp"
@@ -351,6 +355,7 @@ void run_fit(const FitOptions& given) {
 
 struct RunOptions5x : TruthControlOptions {
   std::string hal, swivel, db, write;  // db: where the run is written (models: --model-db)
+  std::string tolerances;  // a file of [tolerances.C] ... tables: location_um, location_urad
   std::vector<double> ball_mm, offsets_um;
   std::vector<std::string> setups{"radial", "tangential", "axial"};
   std::map<std::string, std::vector<double>> angles_deg{
@@ -409,6 +414,30 @@ void print_run_result(const json& doc, std::int64_t run_id, bool corrected) {
   }
 }
 
+// The location limits of the rotary axes tested, from a file of [tolerances] tables only
+// (docs/config.md); a file with none for these axes is refused (it would judge nothing).
+std::map<std::string, cal::daq::AxisTolerance> location_tolerances(
+    const std::string& file, const std::vector<kin::RotaryBallbarTest>& tests) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw cal::InputError(fmt::format("--tolerances {}: cannot read", file));
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  auto c = cal::daq::parse_tolerances(text, file);  // checked, naming file:line:column
+  std::vector<std::string> axes;
+  for (const auto& t : tests) {
+    const std::string a(kin::to_string(t.axis));
+    if (std::find(axes.begin(), axes.end(), a) != axes.end()) continue;
+    axes.push_back(a);
+    const auto it = c.axis_tolerances.find(a);
+    if (it != c.axis_tolerances.end() &&
+        (it->second.limits.location_um || it->second.limits.location_urad))
+      return std::move(c.axis_tolerances);
+  }
+  throw cal::InputError(fmt::format(
+      "--tolerances {}: no location_um or location_urad in [tolerances.{}]: nothing would judge "
+      "the location errors of the axes tested (docs/config.md)",
+      file, fmt::join(axes, "] or [tolerances.")));
+}
+
 void run_run(const RunOptions5x& given) {
   auto models = read_truth_control(given, given.db);
   RunOptions5x o = given;  // the files, or the stored models' labels: what the run records
@@ -432,6 +461,8 @@ void run_run(const RunOptions5x& given) {
   setup.config.campaign = "five-axis ballbar (simulated)";
   setup.control = control;
   setup.tests = run_tests(control, o);
+  if (!o.tolerances.empty())
+    setup.config.axis_tolerances = location_tolerances(o.tolerances, setup.tests);
   setup.database = database_path(o.db);
   const std::string database = setup.database.string();
   setup.extra_settings_json =
@@ -554,6 +585,10 @@ void add_model_ballbar5x_commands(CLI::App& model) {
   run->add_option("--write", r->write,
                   "Write the control's model with the fitted location errors (a run against the "
                   "nominal kinematics only)");
+  run->add_option("--tolerances", r->tolerances,
+                  "A file of [tolerances.C] ... tables: location_um and location_urad limit each "
+                  "location error left (stored with the run: its verdict in daq show and the "
+                  "report; docs/config.md)");
   run->add_flag("--json", r->json, "Print the run id and its result (caldaq.ballbar5x.v1)");
 
   const auto [sim, s] = add_command<SimOptions>(

@@ -284,13 +284,6 @@ void run_report_command(ReportOptions o) {
     kind = "comparison";
     stem = fmt::format("comparison-runs-{}", fmt::join(o.runs, "-"));
   } else if (o.runs.size() == 1 && o.campaign.empty()) {
-    // A five-axis ballbar run's report would show its readings with a linear test's sign
-    // convention and none of its location errors: refused until it is built (issue 36).
-    if (const auto r = store.run(o.runs.front()); r && r->kind == "ballbar5x")
-      throw cal::InputError(fmt::format(
-          "run {} is a five-axis ballbar run: its report is not built yet; `daq show {}` (or "
-          "--json) gives its location errors with their uncertainty",
-          r->id, r->id));
     html = cal::daq::report::run_report(store, o.runs.front(), ro);
     kind = "run";
     stem = fmt::format("report-run-{}", o.runs.front());

@@ -325,6 +325,8 @@ std::string linear_standard_key(const RunView& v, const Options& o) {
   return standard.is_string() ? standard.get<std::string>() : "";
 }
 
+std::string and_list(const std::vector<std::string>& items);
+
 // standard_key: the standard the report evaluates by when it is not the run's own (-s).
 std::string test_name(const RunView& v, std::string_view standard_key = {}) {
   const json m = v.settings.value("measure", json::object());
@@ -341,6 +343,12 @@ std::string test_name(const RunView& v, std::string_view standard_key = {}) {
       : v.run.kind == "angular"      ? "Angular test (ISO 230-1)" + component
       : v.run.kind == "roll"         ? "Roll test (ISO 230-1)" + component
                                      : v.run.kind + " test";
+  if (v.run.kind == "ballbar5x") {  // its axes, "CA": each rotary axis tested
+    std::vector<std::string> axes;
+    for (char c : v.run.axis) axes.emplace_back(1, c);
+    return fmt::format("Five-axis ballbar test (rotary axes' location errors), {} {}",
+                       axes.size() > 1 ? "axes" : "axis", and_list(axes));
+  }
   return fmt::format("{}, axis {}", what, v.run.axis);
 }
 
@@ -465,6 +473,7 @@ constexpr SettingLabel setting_labels[] = {
 bool setting_applies(const RunView& v, const std::string& key, const json& val) {
   if (val.is_null() || (val.is_string() && val.get<std::string>().empty())) return false;
   if (val.is_array() && val.empty()) return false;
+  if (v.run.kind == "ballbar5x" && key == "tests") return false;  // page one's table of the tests
   if (val.is_array() && key.ends_with("_mm") && key != "targets_mm" &&
       std::all_of(val.begin(), val.end(),
                   [](const json& x) { return x.is_number() && x.get<double>() == 0.0; }))
@@ -975,6 +984,12 @@ std::string conditions_section(const RunView& v) {
             "tool is displaced in the positive direction read relative to the workpiece (ISO "
             "230-1; docs/kinematics.md). ↑: approach in the positive direction, ↓: in the "
             "negative."
+      : v.run.kind == "ballbar5x"
+          ? "Bar reading: the distance between the balls less the bar's nominal length, positive "
+            "when the balls are further apart; bar deviation = reading &minus; the test's fitted "
+            "bar offset. Angles of the rotary axis as the control commands them. A location "
+            "error is the axis average line's position (µm) or tilt (µrad, right-hand rule) "
+            "from its nominal place in the machine's model (ISO 230-1; docs/kinematics.md)."
       : v.run.kind == "rotary"
           ? "Angular positional deviation = the angle reached, read by the angular reference, "
             "&minus; the target angle (ISO 230-2 applied to a rotary axis), modulo one turn: "
@@ -1027,16 +1042,23 @@ std::string tolerance_hint(const RunView& v, std::string_view keys) {
                     : "");
 }
 
+// A rotary axis's location error (ISO 230-1: E_X0C ... of a five-axis ballbar run), by its key.
+bool is_location_error(std::string_view key) {
+  return key.size() == 5 && key.starts_with("E_") && key[3] == '0' &&
+         std::string_view("ABC").find(key[4]) != std::string_view::npos;
+}
+
 // A value outside its limit, as the tables print it: "B = 4.023 µm (limit ≤ 3.000 µm)". A
 // diagnostic (an error with a direction, what to check) with its sign, a deviation or span (E,
 // B, U max, G) without ("U max = +4.023" read as the table's 4.023 with a sign the value does
 // not have). `strong`: the symbol in bold (a list's item; inside a bold verdict line, plain).
 std::string failing_value(const ::daq::Check& c, bool strong) {
   const std::string symbol = strong ? "<strong>" + esc(c.symbol) + "</strong>" : esc(c.symbol);
-  return fmt::format(
-      "{} = {} {} (limit ≤ {} {})", symbol,
-      ::daq::diagnostic_advice(c.key).empty() ? um(c.value) : signed_text(c.value, 3),
-      esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
+  return fmt::format("{} = {} {} (limit ≤ {} {})", symbol,
+                     ::daq::diagnostic_advice(c.key).empty() && !is_location_error(c.key)
+                         ? um(c.value)
+                         : signed_text(c.value, 3),
+                     esc(unit_text(c.unit)), fixed(c.limit, 3), esc(unit_text(c.unit)));
 }
 
 // What to check first for a value outside its limit: a circle diagnostic's own advice, else, for
@@ -1044,6 +1066,11 @@ std::string failing_value(const ::daq::Check& c, bool strong) {
 // a value with no single usual cause (straightness, angular, roll: their reports' plots say where).
 std::string what_to_check(const ::daq::Check& c) {
   if (auto advice = ::daq::diagnostic_advice(c.key); !advice.empty()) return advice;
+  // What the control's kinematics leave of a rotary axis's line: its pivot or its tilt (which
+  // LinuxCNC's trunnion pins cannot hold: docs/five-axis-walkthrough.md, section 4).
+  if (is_location_error(c.key))
+    return c.unit == "um" ? "correct the axis's line in the control's kinematics"
+                          : "correct the axis's tilt in the control's kinematics";
   const std::string_view key = c.key;
   const std::string_view head = key.substr(0, key.find('_'));
   // Short enough that "B = 4.023 µm (limit ≤ 3.000 µm): ..." stays one line on page one (a
@@ -2310,6 +2337,244 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
   return out;
 }
 
+// --- five-axis ballbar: the rotary axes' location errors
+// ------------------------------------------
+
+// What a location error is, from its name (ISO 230-1's E_<direction>0<axis>): E_X0C and E_Y0C
+// place the C axis's average line (µm), E_A0C and E_B0C tilt it about X and Y (µrad).
+std::string location_meaning(std::string_view name, std::string_view unit) {
+  if (name.size() != 5 || !name.starts_with("E_") || name[3] != '0') return {};
+  const char d = name[2], axis = name[4];
+  if (unit == "um") return fmt::format("position of the {} axis's line in {}", axis, d);
+  const char about = d == 'A' ? 'X' : d == 'B' ? 'Y' : 'Z';
+  return fmt::format("tilt of the {} axis's line about {}", axis, about);
+}
+
+// A test's angles as read: "0 to 330° by 30°" when evenly spaced, else each one.
+std::string angles_text(const json& stops) {
+  std::vector<double> a;
+  for (const auto& s : stops) a.push_back(s.value("angle_deg", 0.0));
+  if (a.empty()) return "none";
+  const double step = a.size() > 1 ? a[1] - a[0] : 0.0;
+  bool even = a.size() > 2;
+  for (std::size_t k = 1; k < a.size(); ++k) even = even && std::abs(a[k] - a[k - 1] - step) < 1e-9;
+  if (even)
+    return fmt::format("{} … {}° by {}°", setting_text(a.front()), setting_text(a.back()),
+                       setting_text(step));
+  std::vector<std::string> each;
+  for (double x : a) each.push_back(setting_text(x));
+  return fmt::format("{}°", fmt::join(each, ", "));
+}
+
+// The part program's dialect, as recorded with the run; the simulated shop's control runs the
+// program's points, not a text in a control's dialect, and says so.
+std::string dialect_text(const RunView& v) {
+  const auto d = ctx(v.settings, "dialect");
+  if (!d.empty()) return esc(d);
+  return v.settings.value("simulated", false)
+             ? "<span class=\"unstated\">none: the simulated control ran the program's points "
+               "(daq model ballbar5x-program writes them for a real control)</span>"
+             : "<span class=\"unstated\">not recorded</span>";
+}
+
+// One test's bar deviation (the reading less the test's fitted bar offset) at each stop against
+// the rotary angle, with what the fitted location errors alone give there (reading − residual).
+std::string ballbar5x_plot(const json& axis, const json& test) {
+  // A dot as large as the other plots' marks: PLplot's own point (plpoin) printed too small to see.
+  Line measured{.label = "measured", .colour = blue, .width = 0.0, .markers = true, .marker = "●"};
+  Line fitted{.label = "fitted", .colour = vermilion, .width = 1.0, .dashed = true};
+  const double offset = test.value("offset_um", 0.0);
+  for (const auto& s : test.value("stops", json::array())) {
+    const double angle = s.value("angle_deg", 0.0), reading = s.value("reading_um", 0.0);
+    measured.x.push_back(angle), measured.y.push_back(reading - offset);
+    fitted.x.push_back(angle), fitted.y.push_back(reading - s.value("residual_um", 0.0) - offset);
+  }
+  const std::string letter = ctx(axis, "axis");
+  // Half the page wide: the title names the quantities (axis labels at this size were clipped
+  // and left a third of the figure empty), its text drawn larger to print at 9 pt.
+  return figure(
+      svg(XyChart{.title = fmt::format("{}: bar deviation (µm) against {} (deg)", ctx(test, "test"),
+                                       letter),
+                  .x_label = "",
+                  .y_label = "",
+                  .lines = {fitted, measured},
+                  .width_pt = 300,
+                  .height_pt = 180,
+                  .zero_line = true,
+                  .legend = false,
+                  .min_y_span = 1.0,
+                  .text_scale = 1.65}),
+      fmt::format("{}: the bar's deviation against the {} angle.", ctx(test, "test"), letter));
+}
+
+Sections ballbar5x_section(const st::RunReader& store, const RunView& v, const Options& o,
+                           Headline& headline) {
+  const auto stored = ::daq::current_result(v.results, "caldaq.ballbar5x.v1");
+  if (!stored)
+    throw cal::InputError(fmt::format(
+        "run {} has no stored five-axis ballbar result (it ended {} before its tests were "
+        "read)",
+        v.run.id, st::to_string(v.run.status)));
+  const json doc = cal::daq::parse_stored_json(stored->json);
+  // The axes in the order they were tested (the run's axis, "CA"), not the document's (by letter).
+  json axes = doc.value("axes", json::array());
+  if (axes.is_array())
+    std::stable_sort(axes.begin(), axes.end(), [&](const json& a, const json& b) {
+      return v.run.axis.find(ctx(a, "axis")) < v.run.axis.find(ctx(b, "axis"));
+    });
+  const auto verdict = ::daq::verdict_of(v.settings, doc);
+  headline.standard = "five-axis ballbar";
+  headline.verdict = ::daq::summary(verdict);
+  bool corrected = false;  // a control holding location errors: each value's `left` differs
+  std::size_t tests = 0, stops = 0;
+  for (const auto& a : axes) {
+    const json loc = a.value("location", json::object());  // named: items() of a temporary dangles
+    for (const auto& l : loc) corrected = corrected || l.value("control", 0.0) != 0.0;
+    for (const auto& t : a.value("tests", json::array()))
+      ++tests, stops += t.value("stops", json::array()).size();
+  }
+  Sections out;
+  std::string& h = out.answer;
+  h = fmt::format(
+      "<h3>Results: location errors of the rotary axes</h3>\n<p class=\"standard\">Each axis's "
+      "four location errors (ISO 230-1: the position and tilt of its average line) fitted by "
+      "least squares to the bar's mean reading at {} stops of {} tests, one bar offset per test; "
+      "the kinematic tests of ISO 10791-6's kind, as the literature does them (docs/kinematics.md, "
+      "&ldquo;The ballbar on a rotary axis&rdquo;): caldaq does not claim ISO 10791-6's own test "
+      "definitions, which are not public.</p>\n",
+      stops, tests);
+  std::vector<std::string> tables;
+  for (const auto& a : axes)
+    tables.push_back("<code>[tolerances." + esc(ctx(a, "axis")) + "]</code>");
+  h += verdict_banner(
+      verdict,
+      fmt::format("No limit was stored with this run: <code>location_um</code> (each position) "
+                  "and <code>location_urad</code> (each tilt) under {} in a file given to "
+                  "<code>daq model ballbar5x-run --tolerances</code> judge what the control's "
+                  "kinematics leave of each location error (docs/config.md).",
+                  and_list(tables)));
+  // The values: every axis's four, as daq show prints them (result_rows.hpp), with u (k = 1).
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& a : axes) {
+    const json loc = a.value("location", json::object());
+    for (const auto& n : a.value("names", json::array())) {
+      const std::string name = n.is_string() ? n.get<std::string>() : std::string();
+      if (!loc.contains(name)) continue;
+      const json& l = loc[name];
+      const std::string unit = ctx(l, "unit");
+      const auto* c = ::daq::find_check(verdict, name);
+      std::vector<std::string> row{esc(name), signed_text(l.value("value", 0.0), 3),
+                                   fixed(l.value("uncertainty", 0.0), 3), esc(unit_text(unit)),
+                                   esc(location_meaning(name, unit))};
+      if (corrected)
+        row.push_back(signed_text(l.value("control", 0.0), 3)),
+            row.push_back(signed_text(l.value("left", 0.0), 3));
+      row.push_back(limit_cell(c));
+      row.push_back(verdict_cell(c));
+      rows.push_back(std::move(row));
+      headline.values.push_back(
+          {name, l.value("value", 0.0), unit_text(unit), c && !c->pass, true});
+    }
+  }
+  std::vector<std::string> head{"error", "value", "u (k = 1)", "unit", "what it is"};
+  if (corrected) head.push_back("in the control"), head.push_back("left");
+  head.push_back("limit"), head.push_back("verdict");
+  h += table(head, rows, "num results location", corrected ? "lrrllrrrl" : "lrrllrl");
+  h += fmt::format(
+      "<p class=\"note\">u: the standard uncertainty (k = 1) of each value from the fit's "
+      "residuals.{} Corrected in the control by <code>daq model kinematics</code>: LinuxCNC's "
+      "trunnion pins hold the positions only, a SINUMERIK CYCLE800 record all four "
+      "(docs/five-axis-walkthrough.md).</p>\n",
+      corrected ? " The control already held location errors (<em>in the control</em>): "
+                  "<em>left</em> is the fitted less the control's own, what its correction left."
+                : "");
+  // The tests run: what the bar was set up as, and its deviation at each stop.
+  std::vector<std::vector<std::string>> trows;
+  for (const auto& a : axes)
+    for (const auto& t : a.value("tests", json::array())) {
+      std::vector<std::string> ball;
+      for (const auto& x : t.value("ball_mm", json::array()))
+        ball.push_back(esc(setting_text(x)));  // as given: "150", not "150.000"
+      trows.push_back({esc(ctx(t, "test")), esc(ctx(a, "axis")), esc(ctx(t, "setup")),
+                       fmt::format("({})", fmt::join(ball, ", ")),
+                       esc(setting_text(t.value("length_mm", json(0.0)))),
+                       esc(angles_text(t.value("stops", json::array()))),
+                       std::to_string(t.value("stops", json::array()).size()),
+                       signed_text(t.value("offset_um", 0.0), 3) + " ± " +
+                           fixed(t.value("offset_u_um", 0.0), 3)});
+    }
+  h += "<h4>The tests</h4>\n" +
+       table({"test", "axis", "set-up", "table ball (mm)", "bar (mm)", "angles read", "stops",
+              "bar offset (µm)"},
+             trows, "num tests", "llllrlrr") +
+       "<p class=\"note\">Set-up: the bar's direction relative to the axis (radial, tangential, "
+       "axial); the table ball in machine coordinates at the axis's zero. Program dialect: " +
+       dialect_text(v) + ".</p>\n";
+  h += "<div class=\"multiples\">\n";
+  for (const auto& a : axes)
+    for (const auto& t : a.value("tests", json::array())) h += ballbar5x_plot(a, t);
+  h += "</div>\n<p class=\"note\">Bar deviation: the bar's reading less the test's fitted bar "
+       "offset; dots the mean of each stop's samples, the dashed line what the fitted location "
+       "errors alone give (the difference is the residual).</p>\n";
+  // Details: each axis's fit and each stop.
+  std::string& d = out.details;
+  d = "<h3>Details of the results</h3>\n";
+  std::vector<std::vector<std::string>> fits;
+  for (const auto& a : axes)
+    fits.push_back({esc(ctx(a, "axis")), std::to_string(a.value("tests", json::array()).size()),
+                    fixed(a.value("rms_um", 0.0), 3), fixed(a.value("sigma_um", 0.0), 3),
+                    std::to_string(a.value("dof", 0))});
+  d += "<h4>The fit of each axis</h4>\n" +
+       table({"axis", "tests", "residual RMS (µm)", "σ (µm)", "degrees of freedom"}, fits, "num",
+             "lrrrr");
+  for (const auto& a : axes)
+    for (const auto& t : a.value("tests", json::array())) {
+      std::vector<std::vector<std::string>> srows;
+      const double offset = t.value("offset_um", 0.0);
+      for (const auto& s : t.value("stops", json::array()))
+        srows.push_back({setting_text(s.value("angle_deg", json(0.0))),
+                         signed_text(s.value("reading_um", 0.0), 3),
+                         signed_text(s.value("reading_um", 0.0) - offset, 3),
+                         fixed(s.value("spread_um", 0.0), 3), std::to_string(s.value("samples", 0)),
+                         signed_text(s.value("residual_um", 0.0), 3)});
+      d += fmt::format("<h4>Test {} ({} axis, {})</h4>\n", esc(ctx(t, "test")), esc(ctx(a, "axis")),
+                       esc(ctx(t, "setup"))) +
+           table({"angle (deg)", "reading (µm)", "deviation (µm)", "spread (µm)", "samples",
+                  "residual (µm)"},
+                 srows, "num");
+    }
+  // How the stops were read: the program's timing, and on the simulated shop its machine.
+  const json timing = v.settings.value("timing", json::object());
+  std::vector<std::vector<std::string>> prog;
+  const auto setting = [&](const char* label, const json& j, const char* key, const char* unit) {
+    if (j.is_object() && j.contains(key))
+      prog.push_back({label, esc(setting_text(j[key])) + (*unit ? " " + std::string(unit) : "")});
+  };
+  setting("Dwell at each angle", timing, "dwell_s", "s");
+  if (timing.is_object() && timing.contains("settle_s") && timing["settle_s"].is_number())
+    prog.push_back(
+        {"Each stop averaged", fmt::format("from {} s after its start to {} s before its end",
+                                           setting_text(timing["settle_s"]),
+                                           setting_text(0.5 * timing["settle_s"].get<double>()))});
+  setting("Rotary axis's rate between stops", timing, "rate_deg_per_s", "deg/s");
+  setting("Bar's sample rate", timing, "sample_rate_hz", "Hz");
+  setting("Feed-in", timing, "feed_in_mm", "mm");
+  prog.push_back({"Program dialect", dialect_text(v)});
+  setting("Control's kinematics", v.settings, "control_model", "");
+  setting("LinuxCNC pins applied", v.settings, "hal", "");
+  setting("SINUMERIK record applied", v.settings, "swivel", "");
+  if (v.settings.value("simulated", false)) {
+    setting("Simulated machine (truth)", v.settings, "truth_model", "");
+    setting("Bar noise per sample", v.settings, "noise_um", "µm");
+    setting("Bar zeros injected", v.settings, "offsets_um", "µm");
+    setting("Noise seed", v.settings, "seed", "");
+  }
+  std::erase_if(prog, [](const auto& r) { return r[1].empty() || r[1] == "\"\""; });
+  d += "<h4>The program and how its stops were read</h4>\n" + table({"", ""}, prog, "kv");
+  d += generic_section(store, v, o);
+  return out;
+}
+
 // --- pages ---------------------------------------------------------------------------------------
 
 constexpr std::string_view css = R"(
@@ -2533,6 +2798,7 @@ std::string_view result_schema(const RunView& v) {
   if (kind == "linear") return "caldaq.iso230-2.v1";
   if (kind == "circle") return "caldaq.circle.v2";
   if (kind == "rotary") return "caldaq.rotary.v1";
+  if (kind == "ballbar5x") return "caldaq.ballbar5x.v1";
   if (::daq::is_profile_kind(kind)) return "caldaq.profile.v1";
   return "";
 }
@@ -2626,6 +2892,8 @@ std::string run_body(const st::RunReader& store, const RunView& v, const Options
       results = circle_section(store, v, o, hl);
     else if (::daq::is_profile_kind(v.run.kind))
       results = profile_section(store, v, o, hl);
+    else if (v.run.kind == "ballbar5x")
+      results = ballbar5x_section(store, v, o, hl);
     else
       results.answer = generic_section(store, v, o);
   } catch (const cal::InputError& e) {

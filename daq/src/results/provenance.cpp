@@ -29,6 +29,25 @@ json run_tolerances(const cal::daq::Config& c, std::string_view kind, std::strin
       t["source"] = "tolerances." + key;
       return t;
     }
+  } else if (kind == "ballbar5x") {
+    // Each rotary axis tested (`where`: "CA"), its location limits alone.
+    json t = json::object();
+    std::vector<std::string> sources;
+    for (const char letter : where) {
+      const std::string axis(1, letter);
+      const auto it = c.axis_tolerances.find(axis);
+      if (it == c.axis_tolerances.end()) continue;
+      const auto& l = it->second.limits;
+      json own = json::object();
+      if (l.location_um) own["location_um"] = *l.location_um;
+      if (l.location_urad) own["location_urad"] = *l.location_urad;
+      if (own.empty()) continue;
+      t[axis] = own;
+      sources.push_back("tolerances." + axis);
+    }
+    if (t.empty()) return nullptr;
+    t["source"] = fmt::format("{}", fmt::join(sources, ", "));
+    return t;
   } else if (kind == "circle") {
     if (const auto it = c.plane_tolerances.find(key); it != c.plane_tolerances.end()) {
       json t = json::object();

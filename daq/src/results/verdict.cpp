@@ -177,6 +177,30 @@ Verdict profile_verdict(const json& tolerances, const json& result) {
   return v;
 }
 
+// A five-axis ballbar run's location errors against each axis's location_um (positions) and
+// location_urad (tilts): the magnitude of what the control's kinematics leave (`left`: the
+// fitted value less the control's own; against a nominal control, the fitted value).
+Verdict ballbar5x_verdict(const json& tolerances, const json& result) {
+  Verdict v;
+  if (!tolerances.is_object()) return v;
+  v.basis = tolerances.value("source", std::string("tolerances"));
+  for (const auto& a : result.value("axes", json::array())) {
+    const json limits = tolerances.value(a.value("axis", std::string()), json::object());
+    const json loc = a.value("location", json::object());
+    for (const auto& n : a.value("names", json::array())) {
+      const std::string name = n.is_string() ? n.get<std::string>() : std::string();
+      if (!loc.contains(name) || !loc[name].is_object()) continue;
+      const std::string unit = loc[name].value("unit", std::string());
+      const char* key = unit == "um" ? "location_um" : "location_urad";
+      if (!limits.contains(key) || !limits[key].is_number()) continue;
+      const double left = loc[name].value("left", 0.0), lim = limits[key].get<double>();
+      v.checks.push_back({name, name, left, lim, unit, within(left, lim)});
+    }
+  }
+  conclude(v);
+  return v;
+}
+
 Verdict circle_verdict(const json& tolerances, const json& result) {
   Verdict v;
   if (!tolerances.is_object()) return v;
@@ -225,10 +249,7 @@ Verdict verdict_of(const json& settings, const json& result) {
   if (is_circle_schema(result.value("schema", ""))) return circle_verdict(tol, result);
   if (is_profile_schema(result.value("schema", ""))) return profile_verdict(tol, result);
   if (is_rotary_schema(result.value("schema", ""))) return rotary_verdict(tol, result);
-  // A five-axis ballbar run's location errors (result_rows.cpp): corrected, not judged.
-  if (result.value("schema", "") == "caldaq.ballbar5x.v1")
-    return {.notes = {"no tolerance applies to location errors: the control's kinematics take "
-                      "them (daq model kinematics)"}};
+  if (result.value("schema", "") == "caldaq.ballbar5x.v1") return ballbar5x_verdict(tol, result);
   return linear_verdict(tol, result);
 }
 

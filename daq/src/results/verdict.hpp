@@ -35,6 +35,9 @@ Verdict circle_verdict(const nlohmann::json& tolerances, const nlohmann::json& r
 // A straightness, angular or roll profile (caldaq.profile.v1) against the axis's
 // straightness_um or angular_urad (docs/config.md).
 Verdict profile_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
+// A five-axis ballbar run (caldaq.ballbar5x.v1) against each rotary axis's location_um and
+// location_urad ([tolerances.C] ...): the magnitude of each location error left.
+Verdict ballbar5x_verdict(const nlohmann::json& tolerances, const nlohmann::json& result);
 // The verdict of a result of a stored run by its settings (the context's tolerances).
 Verdict verdict_of(const nlohmann::json& settings, const nlohmann::json& result);
 

@@ -211,11 +211,11 @@ struct RotaryBallbarRun::Impl : Runner {
                                    {"length_mm", t.length_mm},
                                    {"angles_deg", t.angles_deg}});
     if (!setup.extra_settings_json.empty()) settings.update(json::parse(setup.extra_settings_json));
-    const std::string opened[] = {"ballbar"};
-    settings["context"] = run_context(setup.config, "ballbar5x", "", opened);
     std::string axes;
     for (const auto& t : setup.tests)
       if (axes.find(kin::to_string(t.axis)) == std::string::npos) axes += kin::to_string(t.axis);
+    const std::string opened[] = {"ballbar"};
+    settings["context"] = run_context(setup.config, "ballbar5x", axes, opened);
     outcome.run_id = store->begin_run({.machine_id = machine_id(setup.config),
                                        .campaign = setup.config.campaign,
                                        .kind = "ballbar5x",

@@ -142,6 +142,10 @@ struct PositioningLimits {
   // and VDI/DGQ 3441's as above; a rotary axis takes only these, a linear axis none of them.
   std::optional<double> E_arcsec, R_arcsec, B_arcsec, A_arcsec, M_arcsec;
   std::optional<double> P_arcsec, Pa_arcsec, Ps_arcsec, U_arcsec;
+  // A rotary axis's location errors (ISO 230-1: E_X0C, E_Y0C in um, E_A0C, E_B0C in urad for a
+  // C axis) as a five-axis ballbar run fits them: the magnitude of each position and each tilt
+  // of its average line that the control's kinematics leave.
+  std::optional<double> location_um, location_urad;
   bool empty() const;
 };
 // Each limit's key in the configuration and the run's stored context, in docs/config.md's order.
@@ -165,7 +169,9 @@ inline constexpr PositioningLimitKey positioning_limit_keys[] = {
     {"P_arcsec", &PositioningLimits::P_arcsec, true},
     {"Pa_arcsec", &PositioningLimits::Pa_arcsec, true},
     {"Ps_arcsec", &PositioningLimits::Ps_arcsec, true},
-    {"U_arcsec", &PositioningLimits::U_arcsec, true}};
+    {"U_arcsec", &PositioningLimits::U_arcsec, true},
+    {"location_um", &PositioningLimits::location_um, true},
+    {"location_urad", &PositioningLimits::location_urad, true}};
 inline bool PositioningLimits::empty() const {
   for (const auto& k : positioning_limit_keys)
     if (this->*k.member) return false;
