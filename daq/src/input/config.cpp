@@ -498,8 +498,8 @@ void check_limit_units(Table& t, const PositioningLimits& l, bool rotary_axis) {
       t.fail(t.node(k.key), k.key,
              rotary_axis ? "a rotary axis's limits are angles in arcsec (E_arcsec, R_arcsec, "
                            "B_arcsec, A_arcsec, M_arcsec; P_arcsec, Pa_arcsec, Ps_arcsec, "
-                           "U_arcsec), not lengths, and its location errors' (location_um, "
-                           "location_urad) (docs/config.md)"
+                           "U_arcsec), not lengths; only its location errors take um and urad "
+                           "(location_um, location_urad; docs/config.md)"
                          : "arcsec and location limits are a rotary axis's (A, B, C); a linear "
                            "axis's are in um (E_um, R_um, B_um, A_um, M_um, ...; "
                            "docs/config.md)");

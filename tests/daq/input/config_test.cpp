@@ -381,24 +381,31 @@ TEST(Config, RotaryAxisLimitsInArcsec) {
   EXPECT_EQ(error_of("[tolerances.C]\nR_arcsec = 2\nE_um = 3\n"),
             "machine.toml:3:8: key 'tolerances.C.E_um': a rotary axis's limits are angles in "
             "arcsec (E_arcsec, R_arcsec, B_arcsec, A_arcsec, M_arcsec; P_arcsec, Pa_arcsec, "
-            "Ps_arcsec, U_arcsec), not lengths (docs/config.md)");
+            "Ps_arcsec, U_arcsec), not lengths; only its location errors take um and urad "
+            "(location_um, location_urad; docs/config.md)");
   EXPECT_NE(error_of("[tolerances.A]\nangular_urad = 3\n")
                 .find("machine.toml:2:16: key 'tolerances.A.angular_urad': a rotary axis's"),
             std::string::npos);
   EXPECT_EQ(error_of("[tolerances.Y]\nE_arcsec = 3\n"),
-            "machine.toml:2:12: key 'tolerances.Y.E_arcsec': arcsec limits are a rotary axis's "
-            "(A, B, C); a linear axis's are in um (E_um, R_um, B_um, A_um, M_um, ...; "
-            "docs/config.md)");
+            "machine.toml:2:12: key 'tolerances.Y.E_arcsec': arcsec and location limits are a "
+            "rotary axis's (A, B, C); a linear axis's are in um (E_um, R_um, B_um, A_um, M_um, "
+            "...; docs/config.md)");
+  EXPECT_NE(error_of("[tolerances.X]\nlocation_um = 3\n")
+                .find("machine.toml:2:15: key 'tolerances.X.location_um': arcsec and location "
+                      "limits are a rotary axis's"),
+            std::string::npos);
   EXPECT_NE(error_of("[[tolerances.X.by_length]]\nup_to_mm = 500\nA_arcsec = 8\n")
-                .find("machine.toml:3:12: key 'tolerances.X.by_length.A_arcsec': arcsec limits"),
+                .find("machine.toml:3:12: key 'tolerances.X.by_length.A_arcsec': arcsec and "
+                      "location limits"),
             std::string::npos);
   EXPECT_NE(error_of("[tolerances.B]\nE_arcsec = 3\n[[tolerances.B.by_length]]\nup_to_mm = 90\n"
                      "E_arcsec = 2\n")
                 .find("key 'tolerances.B.by_length': a rotary axis's limits do not depend on a "
                       "travel"),
             std::string::npos);
-  EXPECT_EQ(error_of("[tolerances.C]\nE_arcsec = 0\n"),
-            "machine.toml:2:12: key 'tolerances.C.E_arcsec': a limit is a finite number > 0, not 0");
+  EXPECT_EQ(
+      error_of("[tolerances.C]\nE_arcsec = 0\n"),
+      "machine.toml:2:12: key 'tolerances.C.E_arcsec': a limit is a finite number > 0, not 0");
 }
 
 TEST(Config, RefusesBadLimitsDatesAndNames) {
