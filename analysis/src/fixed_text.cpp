@@ -10,6 +10,12 @@
 namespace cal {
 
 std::string fixed_text(double v, int decimals) {
+  const double r = fixed_value(v, decimals);  // refuses decimals < 0 first, as before
+  if (std::isnan(r)) return "nan";            // whatever its sign bit
+  return fmt::format("{:.{}f}", r, decimals);
+}
+
+double fixed_value(double v, int decimals) {
   if (decimals < 0)
     throw InputError(fmt::format("{} decimal places: expected 0 or more", decimals));
   // Rounded at the last place by std::round of v x 10^decimals (half away from zero) rather
@@ -17,13 +23,6 @@ std::string fixed_text(double v, int decimals) {
   // little under 9/2000, yet a table of decimal data should round both up ("0.004", "0.005";
   // the binary digits give "0.004" twice). The product lands on such a tie exactly; a value
   // within an ulp or so of a tie rounds as the product does (12.34565 x 10^4 is 123456.49...).
-  if (std::isnan(v)) return "nan";  // whatever its sign bit
-  return fmt::format("{:.{}f}", fixed_value(v, decimals), decimals);
-}
-
-double fixed_value(double v, int decimals) {
-  if (decimals < 0)
-    throw InputError(fmt::format("{} decimal places: expected 0 or more", decimals));
   const double scale = std::pow(10.0, decimals);
   const double scaled = v * scale;
   // From 2^52 on the product is whole and dividing it back would move v (1e20 to 3 places
