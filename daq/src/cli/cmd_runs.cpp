@@ -519,7 +519,7 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
   if (static_cast<double>(whole_ns) == since_ns)
     p = write_seconds_of_ns(p, whole_ns);
   else
-    p = number(p, since_ns / 1e9);
+    p = number(p, clock.seconds(x.session_ns));  // the same division, in its one place
   p = Json ? std::copy_n(",\"", 2, p) : std::copy_n(",", 1, p);
   if (clock.has_utc()) {  // (a run without a time origin leaves it empty: no call per row)
     const auto utc = clock.utc_view(x.session_ns);
