@@ -9,6 +9,7 @@ the shop injects 6" of backlash on C (ShopTruth::Rotary): at every target the up
 on that database, at 1366 x 768 and 560 px.
 Usage: operator_page_rotary_test.py DAQ_BINARY ARTEFACT_DIR
 """
+import math
 import os
 import re
 import signal
@@ -103,9 +104,18 @@ try:
                                   "kept: window.keptStates && Object.keys(window.keptStates), errors: window.__errors}).slice(0, 3000);", 90)
         b.get(url)
         wait("return window.caldaq.page && window.caldaq.page.status && window.caldaq.page.status.start.linear.ready;", "Start ready")
-        b.js("""window.shown = []; window.keptStates = {};
+        b.js("""window.shown = []; window.keptStates = {}; window.cards = [];
             setInterval(() => {
               const g = (id) => document.getElementById(id).textContent, run = window.caldaq.page && window.caldaq.page.run;
+              // The angular reference's card with the value (rad) and the display it was shown with.
+              const card = document.querySelector('#devices li[data-device="angle"] .dev-values');
+              const dev = ((window.caldaq.page && window.caldaq.page.devices && window.caldaq.page.devices.devices) || []).find((d) => d.id === 'angle');
+              if (card && dev && window.cards.length < 3000) {
+                const rec = [card.textContent, dev.values && dev.values.angle_rad !== undefined ? dev.values.angle_rad : null,
+                             run && run.display ? run.display.mode : '', run && run.display ? run.display.target_mm : null, dev.state];
+                const last = window.cards[window.cards.length - 1];
+                if (!last || last[0] !== rec[0] || last[2] !== rec[2]) window.cards.push(rec);
+              }
               if (!run || run.schema !== 'caldaq.live.v1' || run.state !== 'measuring') return;
               const row = [g('reading-label'), g('reading'), g('reading-unit'), g('progress'), g('run-line'), g('message'),
                            g('chart-title'), document.getElementById('stops').tHead.innerText,
@@ -119,6 +129,18 @@ try:
              "the axis turning, at a target and captured, 3 stops")
         kept = b.js("return window.keptStates;")
         shown = b.js("return window.shown;")
+        # The angular reference's card: its position in degrees (the value the page had, by hand:
+        # rad x 180 / pi to 4 decimals), never the level's µrad ("level 785386.60 µrad" at 45°).
+        cards = [c for c in b.js("return window.cards;") if c[1] is not None]
+        wrong = [c for c in cards if c[0] != f"angle {page_checks.fixed(c[1] * 180 / math.pi, 4)}°"]
+        ok(len(cards) >= 10 and not wrong, f"{len(cards)} angle cards in degrees to 4 decimals: {wrong[:3]}")
+        # At a target the reference reads the target within the axis's error (the simulated C
+        # axis's few arcsec, 0.01° = 36" at most), modulo a turn: the card is the axis's angle.
+        at_target = [(c[0], c[3]) for c in cards if c[2] == "deviation"]
+        off = [(t, c) for t, c in ((t, float(c[len("angle "):-1])) for c, t in at_target)
+               if abs((c - t + 180) % 360 - 180) > 0.01]
+        ok(len({t for _, t in at_target}) >= 2 and not off,
+           f"at {len({t for _, t in at_target})} targets the card reads the target in degrees: {off[:3]} {at_target[:3]}")
         serve.send_signal(signal.SIGSTOP)  # nothing new meanwhile: the states kept are rendered again
         try:
             def render(mode):
@@ -191,6 +213,14 @@ try:
         ok(cap["value"] == page_checks.fixed(first["deviation_um"], 2)
            and cap["message"].endswith(f": {page_checks.fixed(first['deviation_um'], 3, '+')} arcsec"),
            f"the captured stop as stored ({first['deviation_um']:.4f}): {cap['value']}, {cap['message']!r}")
+        # Never a stale angle: the simulator ended, the reference falls silent and its card shows
+        # no value (the device board's age rules), not the last one.
+        sim.terminate()
+        sim.wait(timeout=30)
+        silent = wait("const li = document.querySelector('#devices li[data-device=\"angle\"]');"
+                      " return li && li.dataset.state !== 'streaming' && [li.dataset.state, li.querySelector('.dev-values').textContent];",
+                      "the reference's card once it is silent", 30)
+        ok(silent[1] == "—", f"the silent reference's card shows no angle: {silent}")
         page_checks.no_script_error(b)
 finally:
     sim.terminate()
