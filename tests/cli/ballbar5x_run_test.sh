@@ -138,6 +138,29 @@ check report_no_tolerance 0 "<strong>No tolerance configured</strong>.*<code>loc
 check report_title 0 "<h1>SIMULATED — Run 1: Five-axis ballbar test \(rotary axes&#39;? location errors\), axes C and A</h1>" -- cat "$TMP/r1.html"
 check report_draft 0 "DRAFT — NOT APPROVED</strong>: result [0-9]+ has not been approved" -- cat "$TMP/r1.html"
 check report_dialect 0 "Program dialect: <span class=\"unstated\">none: the simulated control ran the program" -- cat "$TMP/r1.html"
+# Made without a configuration, on a simulated bar: the report says which twin measured and that
+# it has no calibration to trace, on page one and under Instruments; not the advice for a
+# configured run ("give serial_number ... in the configuration", a file this run never had).
+TWIN="a twin of a ballbar on the simulated five-axis machine of daq model ballbar5x-run"
+check report_trace_simulated 0 "<p class=\"warning\">Traceability: the ballbar is simulated \($TWIN\): a simulated instrument has no serial number, certificate or calibration due date\.</p>" -- cat "$TMP/r1.html"
+check report_instruments_simulated 0 "<h3>Instruments and calibration</h3>.<p class=\"unstated\">The ballbar is simulated \($TWIN\): a simulated" -- tr '\n' ' ' <"$TMP/r1.html"
+check report_origin_twin 0 "Origin of the readings</td><td>ballbar simulated \($TWIN\)</td>" -- cat "$TMP/r1.html"
+check show_origin_twin 0 "^  SIMULATED: ballbar simulated \($TWIN\)$" -- "$DAQ" show 1 --db "$DB"
+check report_no_config_advice 1 "^0$" -- grep -c "give serial_number" "$TMP/r1.html"
+# The readings plot's legend names the bar once: "ballbar", not "ballbar ballbar" (the texts of
+# an SVG figure are PLplot's tspans, one character entity each).
+readings_legend() {
+  "$PY" - "$1" <<'PYEOF'
+import html, re, sys
+page = open(sys.argv[1], encoding="utf-8").read()
+svg = re.search(r'<svg class="plot"[^>]*aria-label="ballbar length \(mm\)".*?</svg>', page, re.S)
+texts = [html.unescape(t) for t in re.findall(r"<tspan[^>]*>(.*?)</tspan>", svg.group(0))] if svg else []
+print("ok" if texts.count("ballbar") == 1 and not any("ballbar ballbar" in t for t in texts)
+      else f"legend texts {texts[-4:]}")
+PYEOF
+}
+check report_legend_once 0 "^ok$" -- readings_legend "$TMP/r1.html"
+check report_offsets_injected 0 "Bar zeros injected</td><td>2, -1, 1.5, -2, 0.5, 1 µm</td>" -- cat "$TMP/r1.html"
 check fitted_model 0 '"kind": "ballbar, rotary axis"' -- cat "$TMP/fitted.json"
 # The correction written for each control, taken by the simulated control, measured again.
 "$DAQ" model kinematics "$TMP/fitted.json" -o "$TMP/trt.hal" >/dev/null 2>&1
@@ -198,6 +221,10 @@ check after_swivel_zero 0 "^ok$" -- within "$TMP/r2s.json" zero "$TMP/r1.json"
 check after_hal_tilts 0 "^ok$" -- within "$TMP/r2h.json" tilts "$TMP/r1.json"
 check after_model_zero 0 "^ok$" -- within "$TMP/r2f.json" zero "$TMP/r1.json"
 check after_text 0 "E_A0C +\+[0-9.]+ urad +u = [0-9.]+ +left \+(9\.|10\.)" -- "$DAQ" model ballbar5x-run "$TRUTH" --control "$NOM" --hal "$TMP/trt.hal" --db "$DB" --ball-mm $BALL --seed 5
+# That run (5) was given no bar zeros: its report leaves the row out, not "Bar zeros injected µm".
+"$DAQ" report 5 --db "$DB" -o "$TMP/r5.html" >/dev/null 2>&1
+check report_no_offsets_row 1 "^0$" -- grep -c "Bar zeros injected" "$TMP/r5.html"
+check report_seed_row 0 "Noise seed</td><td>5</td>" -- cat "$TMP/r5.html"
 check write_refused 2 "write against a corrected control" -- "$DAQ" model ballbar5x-run "$TRUTH" --control "$NOM" --hal "$TMP/trt.hal" --db "$DB" --ball-mm $BALL --write "$TMP/x.json"
 # Bad input says what and where.
 check on_the_line 2 "the table ball is 0\.000 mm from the C axis line" -- "$DAQ" model ballbar5x-run "$TRUTH" --control "$NOM" --db "$DB" --ball-mm 0 0 -250

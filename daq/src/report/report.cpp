@@ -143,6 +143,17 @@ std::string instrument_name(const RunView& v, int device) {
   return fmt::format("device {}", device);
 }
 
+// The serial number a run stored with its instrument `device` itself, not from a configuration:
+// an imported file's ("Serial No" of a Renishaw .rtx header, daq import); "" when none.
+std::string stored_serial(const RunView& v, int device) {
+  for (const auto& i : v.instruments)
+    if (i.device == device) {
+      const json s = json::parse(i.settings_json, nullptr, false);
+      return s.is_object() ? ctx(s, "serial") : "";
+    }
+  return "";
+}
+
 // An instrument as a legend names it: its driver and serial number from the run's context
 // ("ptu300 SIM-PTU-0001"), else the name it was given in the configuration.
 std::string instrument_label(const RunView& v, int device) {
@@ -177,6 +188,20 @@ std::string legend_label(const RunView& v, int device, int channel, std::string_
           inst = i;
           break;
         }
+  // No configured instrument names it (a simulated run of daq model, an imported file): its
+  // stored name once, as its product where that is known ("IDS3010"), and the serial number its
+  // file stated. The stored name is its role, or its file's instrument: taken as the product too,
+  // it read "ballbar ballbar".
+  if (inst.empty()) {
+    const std::string product = ::daq::product_name(stored);
+    const std::string name = product.empty() ? stored : product;
+    std::string label =
+        sensor.empty() || name == sensor ? name : fmt::format("{} sensor of {}", sensor, name);
+    if (sensor == name) label += " sensor";
+    const std::string serial = stored_serial(v, device);
+    if (!serial.empty()) label += (compact ? " (" : " (serial ") + serial + ")";
+    return label + (channel ? fmt::format(", channel {}", channel) : "");
+  }
   const std::string id = ctx(inst, "id").empty() ? stored : ctx(inst, "id");
   const std::string role = ctx(inst, "role").empty() ? id : ctx(inst, "role");
   const std::string product =
@@ -733,17 +758,69 @@ std::string customer_section(const RunView& v) {
 // YYYY-MM-DD of a unix time, to compare with a calibration due date.
 std::string ymd(std::int64_t unix_ms) { return iso_time(unix_ms).substr(0, 10); }
 
+// Why a run holds no configured instrument's serial number and calibration, for what its
+// instruments are (without the "is"/"are" and what follows): every one simulated ("the ballbar
+// is simulated (a twin of ...)"), every one imported from a file (which states a serial number
+// or not); nullopt for any other run, which should have had them in its configuration. "Give
+// serial_number ... in the configuration" asked a simulated run of daq model, made without any,
+// for a calibration its twin cannot have.
+struct Untraceable {
+  std::string what;     // "the ballbar is simulated (a twin of ...)"
+  std::string because;  // ": a simulated instrument has no serial number, ..."
+};
+std::optional<Untraceable> untraceable(const RunView& v) {
+  if (v.instruments.empty()) return std::nullopt;
+  const auto all = [&](std::string_view origin) {
+    return std::all_of(v.instruments.begin(), v.instruments.end(),
+                       [&](const st::InstrumentRecord& i) { return i.origin == origin; });
+  };
+  std::vector<std::string> names, details, serials;
+  for (const auto& i : v.instruments) {
+    names.push_back(i.driver);
+    if (!i.origin_detail.empty() &&
+        std::find(details.begin(), details.end(), i.origin_detail) == details.end())
+      details.push_back(i.origin_detail);
+    if (const auto serial = stored_serial(v, i.device); !serial.empty())
+      serials.push_back(v.instruments.size() == 1 ? serial : serial + " of " + i.driver);
+  }
+  const bool one = names.size() == 1;
+  const std::string detail =
+      details.empty() ? "" : " (" + fmt::format("{}", fmt::join(details, "; ")) + ")";
+  if (all("simulated"))
+    return Untraceable{
+        fmt::format("the {} {} simulated{}", and_list(names), one ? "is" : "are", detail),
+        ": a simulated instrument has no serial number, certificate or calibration due date"};
+  // The detail names the file ("Renishaw .rtx file X (the file does not say ...)").
+  if (all("imported"))
+    return Untraceable{
+        fmt::format(
+            "the readings of {} were imported from {}", and_list(names),
+            details.empty() ? "another tool's file" : fmt::format("{}", fmt::join(details, "; "))),
+        serials.empty()
+            ? std::string(", which states no serial number, certificate or calibration due date")
+            : fmt::format(", which states the serial number {} but no certificate or "
+                          "calibration due date",
+                          and_list(serials))};
+  return std::nullopt;
+}
+
 // The instruments with their serial numbers and calibration; a due date before the test is
 // flagged (the instrument was out of calibration when it measured). The warnings themselves
 // are on page one (traceability_warnings).
 std::string instruments_section(const RunView& v) {
   const auto list = v.context.value("instruments", json::array());
   std::string h = "<h3>Instruments and calibration</h3>\n";
-  if (list.empty())
+  if (list.empty()) {
+    if (const auto u = untraceable(v)) {
+      std::string text = u->what + u->because + ".";
+      text[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+      return h + "<p class=\"unstated\">" + esc(text) + "</p>\n";
+    }
     return h +
            "<p class=\"unstated\">The instruments' serial numbers and calibration "
            "certificates were not recorded with this run (give serial_number, certificate "
            "and calibration_due of each device in the configuration).</p>\n";
+  }
   std::vector<std::vector<std::string>> rows;
   const std::string test_day = ymd(v.run.started_unix_ms);
   for (const auto& i : list) {
@@ -769,10 +846,12 @@ std::string instruments_section(const RunView& v) {
 // reader cannot tell whether the instrument was calibrated when it measured.
 std::vector<std::string> traceability_gaps(const RunView& v) {
   const auto list = v.context.value("instruments", json::array());
-  if (!list.is_array() || list.empty())
+  if (!list.is_array() || list.empty()) {
+    if (const auto u = untraceable(v)) return {u->what + u->because};
     return {
         "the instruments' serial numbers, certificates and calibration due dates were not "
         "recorded with this run"};
+  }
   std::vector<std::string> out;
   // The instruments that lack the same things, in one warning ("air, laser: no serial number,
   // certificate or calibration due date stated"): one line each filled page one with four
@@ -2547,7 +2626,8 @@ Sections ballbar5x_section(const st::RunReader& store, const RunView& v, const O
   const json timing = v.settings.value("timing", json::object());
   std::vector<std::vector<std::string>> prog;
   const auto setting = [&](const char* label, const json& j, const char* key, const char* unit) {
-    if (j.is_object() && j.contains(key))
+    // (an empty one left out: "Bar zeros injected µm" said a unit of nothing)
+    if (j.is_object() && j.contains(key) && !setting_text(j[key]).empty())
       prog.push_back({label, esc(setting_text(j[key])) + (*unit ? " " + std::string(unit) : "")});
   };
   setting("Dwell at each angle", timing, "dwell_s", "s");

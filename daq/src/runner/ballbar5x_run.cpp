@@ -226,8 +226,8 @@ struct RotaryBallbarRun::Impl : Runner {
                            .device = ballbar_device,
                            .driver = std::string(name(Role::ballbar)),
                            .transport = setup.ballbar->describe(),
-                           .origin = "simulated",
-                           .origin_detail = ""});
+                           .origin = setup.ballbar_origin.kind,
+                           .origin_detail = setup.ballbar_origin.detail});
     open_writer(outcome.run_id);
     running = true;
     event(fmt::format("run {}: five-axis ballbar, {} tests; waiting for the feed-in of {}",

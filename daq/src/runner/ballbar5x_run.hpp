@@ -19,6 +19,7 @@
 #include "cal/analysis/ballbar5x.hpp"
 #include "cal/daq/config.hpp"
 #include "cal/drivers/instrument.hpp"
+#include "origin.hpp"
 
 namespace boost::asio {
 class io_context;
@@ -98,6 +99,9 @@ struct RotaryBallbarRunSetup {
   std::string extra_settings_json;  // an object merged into the run's settings (its files)
   std::filesystem::path database;
   std::unique_ptr<cal::drivers::Instrument> ballbar;
+  // Where the bar's readings come from, stored with the run (docs/storage.md "Origin"); every
+  // run is the simulated one of daq model ballbar5x-run so far, which says which twin.
+  InstrumentOrigin ballbar_origin{.kind = "simulated", .detail = ""};
   std::string software_version = "daq 0.1.0";
   std::function<void(const std::string&)> on_event;
 };

@@ -111,6 +111,11 @@ RotaryBallbarRunOutcome run_simulated_ballbar5x(const SimulatedBallbar5x& s,
        .name = "ballbar",
        .clock = [&vt] { return vt.now_ns(); }},
       {.min_si = -0.1, .max_si = 0.1});
+  // Which twin: a run's origin says it (daq show, the report's banner and instruments).
+  setup.ballbar_origin = {.kind = "simulated",
+                          .detail =
+                              "a twin of a ballbar on the simulated five-axis machine of "
+                              "daq model ballbar5x-run"};
   const double end_s = kProgramStartS + simulated_program_s(program) + 5.0;
   RotaryBallbarRun run(io, std::move(setup));
   run.start();
