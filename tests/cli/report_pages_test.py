@@ -684,7 +684,7 @@ for args in (["--compare", "1", "3"], ["--as-found", "1", "--as-left", "3"]):
 
 # --- other runs (an imported .rtx): the plots name the quantity and its unit, not its key -------
 with open("lin.rtx", "wb") as f:
-    f.write(b"HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nFile Type: Linear\r\n"
+    f.write(b"HEADER::\r\nOwner: CARTO-Dynamic\r\nVersion no: 4.13\r\nSerial No: XL-8123\r\nFile Type: Linear\r\n"
             b"Sample rate: 50000\r\nSample no: 3\r\nActual sample rate: 1000\r\nAxis: X\r\n"
             b"Data:\r\n" + b"\x00" * 6 + b"\xf0\x3f" + b"\x00" * 6 + b"\x04\xc0" + b"\x00" * 8
             + b"\r\nEOF::\r\n")
@@ -697,6 +697,22 @@ check("imported run: the plot says displacement (mm), not displacement_m or (m)"
       "displacement (mm)" in imported_plot and "displacement_m" not in imported_plot
       and "displacement (m)" not in imported_plot
       and " ch 0" not in imported_plot, imported_plot[:300])
+# Its legend names the file's instrument once, with the serial number its header states (it
+# read "renishaw-rtx (CARTO-Dynamic 4.13) renishaw-rtx (CARTO-Dynamic 4.13)").
+instrument = "renishaw-rtx (CARTO-Dynamic 4.13)"
+check("imported run: the legend names the file's instrument once, with its serial number",
+      f"{instrument} (serial XL-8123)" in imported_plot and f"{instrument} {instrument}" not in imported_plot,
+      imported_plot[-200:])
+# Made without a configuration: the report says what the file states (the serial number, no
+# calibration), not "give serial_number ... in the configuration".
+imported_text = html_mod.unescape(re.sub(r"<[^>]+>", "", open("imported.html", encoding="utf-8").read()))
+said = (f"the readings of {instrument} were imported from Renishaw .rtx file lin.rtx (the file does "
+        "not say whether the instrument was real), which states the serial number XL-8123 but no "
+        "certificate or calibration due date.")
+check("imported run: page one and Instruments say what the file states of its instrument",
+      f"Traceability: {said}" in imported_text and "The" + said[3:] in imported_text
+      and "give serial_number" not in imported_text,
+      str(re.findall(r"Traceability:[^\n]*|The (?:readings|instruments)[^\n]*", imported_text)[:3]))
 
 # --- straightness and squareness: signed values through the shared formatter -----------------
 # Two profiles whose slopes differ by 1e-7 µm/m: the squareness printed "-0.000".
