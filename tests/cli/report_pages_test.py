@@ -658,6 +658,33 @@ g1 = squash(pages("gaps.pdf")[0])
 check("traceability: a missing certificate and due date warned on page one",
       "Traceability: laser: no certificate or calibration due date stated" in g1, g1[:1500])
 
+# --- instruments configured under ids other than their roles ([devices.ids] with role "laser",
+# [devices.table] with role "material"): a run stores each under its role, and the legends found
+# no configured instrument by that name ("air sensor of laser laser", "material sensor material").
+# By the role now, with the configured id and serial number; the Instruments table too.
+shutil.copy("demo.sqlite", "ids.sqlite")
+con = sqlite3.connect("ids.sqlite")
+settings = json.loads(con.execute("SELECT settings_json FROM runs WHERE id = 1").fetchone()[0])
+renamed = {"laser": "ids", "material": "table"}
+for i in settings["context"]["instruments"]:
+    i["id"] = renamed.get(i["role"], i["id"])
+con.execute("UPDATE runs SET settings_json = ? WHERE id = 1", (json.dumps(settings),))
+con.commit()
+con.close()
+daq("report", "1", "--db", "ids.sqlite", "-o", "ids.html")
+ids_page = open("ids.html", encoding="utf-8").read()
+ids_plots = [html_mod.unescape(t) for t in re.findall(r"<tspan[^>]*>(.*?)</tspan>", ids_page)]
+ids_rows = [[html_mod.unescape(re.sub(r"<[^>]+>", "", c)) for c in re.findall(r"<td[^>]*>(.*?)</td>", r)]
+            for r in re.findall(r"<tr>(.*?)</tr>", ids_page.split("<h4>Instruments</h4>")[-1].split("</table>")[0])]
+check("configured ids: the legends name each instrument by its role, id and serial number",
+      "air sensor of laser ids IDS3010 (serial SIM-IDS-0001)" in ids_plots
+      and "material sensor table (serial SIM-TH-0001)" in ids_plots
+      and not any(re.search(r"\b(laser laser|material material)\b", t) for t in ids_plots),
+      str([t for t in ids_plots if "sensor" in t]))
+check("configured ids: the Instruments table gives the configured model and serial number",
+      ["laser", "ids3010 SIM-IDS-0001"] in [r[:2] for r in ids_rows]
+      and ["material", "gauge SIM-TH-0001"] in [r[:2] for r in ids_rows], str(ids_rows))
+
 # Past-due calibrations of runs of different days in one warning, each instrument with its due
 # date: the demo's thermometer (due 2020-01-31) in runs 1 and 3, run 3 a day later, and in run 1
 # a laser due 2021-06-30 too. Before, a line per run and date: "material was past due on the

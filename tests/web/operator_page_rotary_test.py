@@ -112,9 +112,10 @@ try:
               const dev = ((window.caldaq.page && window.caldaq.page.devices && window.caldaq.page.devices.devices) || []).find((d) => d.id === 'angle');
               if (card && dev && window.cards.length < 3000) {
                 const rec = [card.textContent, dev.values && dev.values.angle_rad !== undefined ? dev.values.angle_rad : null,
-                             run && run.display ? run.display.mode : '', run && run.display ? run.display.target_mm : null, dev.state];
+                             run && run.display ? run.display.mode : '', run && run.display ? run.display.target_mm : null, dev.state,
+                             run && run.motion ? run.motion.state : ''];
                 const last = window.cards[window.cards.length - 1];
-                if (!last || last[0] !== rec[0] || last[2] !== rec[2]) window.cards.push(rec);
+                if (!last || last[0] !== rec[0] || last[5] !== rec[5]) window.cards.push(rec);
               }
               if (!run || run.schema !== 'caldaq.live.v1' || run.state !== 'measuring') return;
               const row = [g('reading-label'), g('reading'), g('reading-unit'), g('progress'), g('run-line'), g('message'),
@@ -134,9 +135,10 @@ try:
         cards = [c for c in b.js("return window.cards;") if c[1] is not None]
         wrong = [c for c in cards if c[0] != f"angle {page_checks.fixed(c[1] * 180 / math.pi, 4)}°"]
         ok(len(cards) >= 10 and not wrong, f"{len(cards)} angle cards in degrees to 4 decimals: {wrong[:3]}")
-        # At a target the reference reads the target within the axis's error (the simulated C
-        # axis's few arcsec, 0.01° = 36" at most), modulo a turn: the card is the axis's angle.
-        at_target = [(c[0], c[3]) for c in cards if c[2] == "deviation"]
+        # Stopped at a target (settled: "stable") the reference reads the target within the axis's
+        # error (the simulated C axis's few arcsec, 0.01° = 36" at most), modulo a turn: the card is
+        # the axis's angle. (Only at rest: "deviation" is shown from 0.5° before the target on.)
+        at_target = [(c[0], c[3]) for c in cards if c[2] == "deviation" and c[5] == "stable"]
         off = [(t, c) for t, c in ((t, float(c[len("angle "):-1])) for c, t in at_target)
                if abs((c - t + 180) % 360 - 180) > 0.01]
         ok(len({t for _, t in at_target}) >= 2 and not off,

@@ -154,18 +154,31 @@ std::string stored_serial(const RunView& v, int device) {
   return "";
 }
 
+// The configured instrument (the run's context) that stored instrument `device` is, or an empty
+// object: by the name the run stored it under (its configured id), by its driver (a replay), or
+// by its role where one configured instrument has it (a linear or circle run stores each
+// instrument under its role: [devices.ids] with role "laser" is stored as "laser", and read
+// "laser laser" in a legend). Two of one role (material thermometers) are not told apart here.
+json configured_instrument(const RunView& v, int device) {
+  const std::string stored = instrument_name(v, device);
+  const auto list = v.context.value("instruments", json::array());
+  if (!list.is_array()) return json::object();
+  for (const char* key : {"id", "driver"})
+    for (const auto& i : list)
+      if (i.is_object() && ctx(i, key) == stored) return i;
+  const auto same_role = [&](const json& i) { return ctx(i, "role") == stored; };
+  const auto role = std::find_if(list.begin(), list.end(), same_role);
+  if (role != list.end() && std::count_if(list.begin(), list.end(), same_role) == 1) return *role;
+  return json::object();
+}
+
 // An instrument as a legend names it: its driver and serial number from the run's context
 // ("ptu300 SIM-PTU-0001"), else the name it was given in the configuration.
 std::string instrument_label(const RunView& v, int device) {
-  const std::string name = instrument_name(v, device);
-  const auto list = v.context.value("instruments", json::array());
-  if (list.is_array())
-    for (const auto& i : list)
-      if (i.is_object() && i.value("id", "") == name && i.value("driver", "") != "") {
-        const std::string serial = i.value("serial_number", "");
-        return i.value("driver", "") + (serial.empty() ? "" : " " + serial);
-      }
-  return name;
+  const json i = configured_instrument(v, device);
+  if (ctx(i, "driver").empty()) return instrument_name(v, device);
+  const std::string serial = ctx(i, "serial_number");
+  return ctx(i, "driver") + (serial.empty() ? "" : " " + serial);
 }
 
 // A plot's legend entry for a series of `device`: the instrument by its role, its product and
@@ -178,16 +191,7 @@ std::string instrument_label(const RunView& v, int device) {
 std::string legend_label(const RunView& v, int device, int channel, std::string_view sensor,
                          bool compact = false) {
   const std::string stored = instrument_name(v, device);
-  json inst = json::object();
-  const auto list = v.context.value("instruments", json::array());
-  // By the name the run stored it under (its configured id), else by its driver (a replay).
-  for (const char* key : {"id", "driver"})
-    if (inst.empty() && list.is_array())
-      for (const auto& i : list)
-        if (i.is_object() && ctx(i, key) == stored) {
-          inst = i;
-          break;
-        }
+  const json inst = configured_instrument(v, device);
   // No configured instrument names it (a simulated run of daq model, an imported file): its
   // stored name once, as its product where that is known ("IDS3010"), and the serial number its
   // file stated. The stored name is its role, or its file's instrument: taken as the product too,
