@@ -415,7 +415,9 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
     ps.push_back(std::move(p));
   }
   periodogram.reset();  // its tables and buffers, before the line fit's
-  segment = std::vector<double>();
+  // The band tests' scratch in the segment's memory, whose pages are already the process's
+  // (a fresh 1 MB was page faults: issue 32); it grows if a band needs more.
+  std::vector<double> rest = std::move(segment);
   const auto peak = static_cast<std::size_t>(
       std::max_element(mean.begin() + static_cast<std::ptrdiff_t>(lo),
                        mean.begin() + static_cast<std::ptrdiff_t>(hi) + 1) -
@@ -423,7 +425,6 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   const auto half = static_cast<std::size_t>(std::ceil((f0 + 2.5 / duration) / df));
   const std::size_t b0 = std::max(lo, peak > half ? peak - half : 0),
                     b1 = std::min(hi, peak + half);
-  std::vector<double> rest;
   const BandTest all = band_test(mean, lo, hi, b0, b1, df, rest);
   if (all.snr < 10.0) return std::nullopt;
   // Narrow: the band stands out of its neighbourhood (three band widths each side). An error

@@ -45,35 +45,55 @@ PowerSpectrum::PowerSpectrum(std::size_t n) : n_(n) {
 }
 
 // The m complex values at z (interleaved) transformed in place, their transform in bit-reversed
-// order: one radix-2 stage (the sums, and the differences times e^(-2 pi i j / m), which is
-// e^(-2 pi i k / n) for k = j stride), then each half the same way. k < n / 4 in the first
-// half of the j and at least n / 4 in the second, so each half reads its cosines and sines
-// without a test a value.
+// order: radix-2 stages of decimation in frequency, each the sums of the halves of a group of
+// `size` values and their differences times e^(-2 pi i j / size), which is e^(-2 pi i k / n)
+// for k = j stride. Above `block` values one stage, then each half the same way (depth first:
+// a half of at most `block` values, 16 kB, stays in the cache for all its stages); at most
+// `block`, its stages one after the other, without a call a group.
 void PowerSpectrum::dif(double* z, std::size_t m, std::size_t stride) const {
-  const std::size_t h = m / 2;
-  double* a = z;
-  double* b = z + 2 * h;
-  if (m == 2) {
-    const double ar = a[0], ai = a[1];
-    a[0] = ar + b[0], a[1] = ai + b[1];
-    b[0] = ar - b[0], b[1] = ai - b[1];
-    return;
-  }
+  constexpr std::size_t block = 1024;
   const double* c = cosine_.data();
   const std::size_t quarter = n_ / 4, half = n_ / 2;
-  const auto butterfly = [&](std::size_t j, double wr, double wi) {
-    const double ar = a[2 * j], ai = a[2 * j + 1], br = b[2 * j], bi = b[2 * j + 1];
-    const double dr = ar - br, di = ai - bi;
-    a[2 * j] = ar + br, a[2 * j + 1] = ai + bi;
-    b[2 * j] = dr * wr - di * wi, b[2 * j + 1] = dr * wi + di * wr;
+  // One stage over the groups of `size` values in z[0, m): size >= 8. k < n / 4 in the first
+  // half of the j and at least n / 4 in the second, so each half reads its cosine and sine
+  // without a test a value: e^(-i a) = cos a - i sin a, sin(2 pi k / n) = cos(2 pi (n / 4 - k) /
+  // n), and past a quarter cos(2 pi k / n) = -cos(2 pi (n / 2 - k) / n), sin = cos(2 pi (k -
+  // n / 4) / n).
+  const auto stage = [&](std::size_t size, std::size_t step) {
+    const std::size_t h = size / 2;
+    for (double* a = z; a < z + 2 * m; a += 2 * size) {
+      double* b = a + 2 * h;
+      const auto butterfly = [&](std::size_t j, double wr, double wi) {
+        const double ar = a[2 * j], ai = a[2 * j + 1], br = b[2 * j], bi = b[2 * j + 1];
+        const double dr = ar - br, di = ai - bi;
+        a[2 * j] = ar + br, a[2 * j + 1] = ai + bi;
+        b[2 * j] = dr * wr - di * wi, b[2 * j + 1] = dr * wi + di * wr;
+      };
+      for (std::size_t j = 0; j < h / 2; ++j) butterfly(j, c[j * step], -c[quarter - j * step]);
+      for (std::size_t j = h / 2; j < h; ++j)
+        butterfly(j, -c[half - j * step], -c[j * step - quarter]);
+    }
   };
-  // e^(-i a) = cos a - i sin a; sin(2 pi k / n) = cos(2 pi (n / 4 - k) / n), and past a quarter
-  // cos(2 pi k / n) = -cos(2 pi (n / 2 - k) / n), sin = cos(2 pi (k - n / 4) / n).
-  for (std::size_t j = 0; j < h / 2; ++j) butterfly(j, c[j * stride], -c[quarter - j * stride]);
-  for (std::size_t j = h / 2; j < h; ++j)
-    butterfly(j, -c[half - j * stride], -c[j * stride - quarter]);
-  dif(a, h, 2 * stride);
-  dif(b, h, 2 * stride);
+  if (m > block) {
+    stage(m, stride);
+    dif(z, m / 2, 2 * stride);
+    dif(z + m, m / 2, 2 * stride);
+    return;
+  }
+  if (m == 2) {  // n = 4: one stage of two values
+    const double ar = z[0], ai = z[1];
+    z[0] = ar + z[2], z[1] = ai + z[3], z[2] = ar - z[2], z[3] = ai - z[3];
+    return;
+  }
+  for (std::size_t size = m; size >= 8; size /= 2, stride *= 2) stage(size, stride);
+  // The last two stages: e^(-2 pi i j / 4) is 1 or -i, e^(-2 pi i j / 2) is 1.
+  for (double* a = z; a < z + 2 * m; a += 8) {
+    const double d0r = a[0] - a[4], d0i = a[1] - a[5], d1r = a[2] - a[6], d1i = a[3] - a[7];
+    const double s0r = a[0] + a[4], s0i = a[1] + a[5], s1r = a[2] + a[6], s1i = a[3] + a[7];
+    // size 4: (s0, s1 | d0, -i d1), then size 2 on each pair
+    a[0] = s0r + s1r, a[1] = s0i + s1i, a[2] = s0r - s1r, a[3] = s0i - s1i;
+    a[4] = d0r + d1i, a[5] = d0i - d1r, a[6] = d0r - d1i, a[7] = d0i + d1r;
+  }
 }
 
 void PowerSpectrum::add(std::span<double> x, double divisor, std::span<double> p) const {
