@@ -47,6 +47,7 @@
 #include <utility>
 
 #include "cal/analysis/angle_reduce.hpp"
+#include "cal/analysis/even_resample.hpp"
 #include "cal/analysis/moving_median.hpp"
 #include "cal/analysis/power_spectrum.hpp"
 
@@ -157,40 +158,15 @@ Timed timed(const TraceResidual& t, double w) {
   return out;
 }
 
-// The residual at the times k dt, k = 0, 1, 2, ..., linearly interpolated in travel order, handed
-// out in consecutive pieces (the Welch segments overlap by half: the caller keeps the half it
-// has). Each sample's time and value are read once, when the walk reaches it, not once for each
-// time between it and the next and again for the walk (issue 32); the values are those of the
-// same walk reading them anew, bit for bit.
-class Resampler {
- public:
-  Resampler(const TraceResidual& t, const Timed& tm, double dt) : t_(t), tm_(tm), dt_(dt) {
-    if (tm.n == 0) return;
-    const std::size_t a = tm.order(0), b = tm.order(std::min<std::size_t>(1, tm.n - 1));
-    ta_ = tm.time_s(a), tb_ = tm.time_s(b), ra_ = t.r_um[a], rb_ = t.r_um[b];
-  }
-
-  // The next `count` values into out[0, count).
-  void next(std::size_t count, double* out) {
-    for (std::size_t c = 0; c < count; ++c, ++k_) {
-      const double at = static_cast<double>(k_) * dt_;
-      while (j_ + 2 < tm_.n && tb_ < at) {  // sample j + 1 is before `at`: on to the next pair
-        ++j_;
-        const std::size_t b = tm_.order(j_ + 1);
-        ta_ = tb_, ra_ = rb_, tb_ = tm_.time_s(b), rb_ = t_.r_um[b];
-      }
-      const double f = tb_ > ta_ ? std::clamp((at - ta_) / (tb_ - ta_), 0.0, 1.0) : 0.0;
-      out[c] = ra_ + f * (rb_ - ra_);
-    }
-  }
-
- private:
-  const TraceResidual& t_;
-  const Timed& tm_;
-  double dt_;
-  std::size_t k_ = 0, j_ = 0;  // the next time step; the pair (j, j + 1) in travel order
-  double ta_ = 0.0, tb_ = 0.0, ra_ = 0.0, rb_ = 0.0;
-};
+// The residual at the times k dt, k = 0, 1, 2, ..., linearly interpolated in travel order
+// (even_resample.hpp): each sample's time and value are read once, when the walk reaches it,
+// not once for each time between it and the next and again for the walk (issue 32); the values
+// are those of the same walk reading them anew, bit for bit.
+auto resampled(const TraceResidual& t, const Timed& tm, double dt) {
+  return EvenResampler(
+      tm.n, dt, [&tm](std::size_t j) { return tm.time_s(tm.order(j)); },
+      [&t, &tm](std::size_t j) { return t.r_um[tm.order(j)]; });
+}
 
 // |X_k|^2 of the Hann-windowed, mean-removed series zero-padded to npad, k = 0 .. npad / 2, for
 // the Welch segments of a run one after another: the transform (its twiddle table), the window
@@ -398,18 +374,10 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
     segments.push_back(n <= cap ? 1 : n / cap);  // the line fit's: cap samples, the last longer
     // One segment's periodogram, or the average of them (0 + x / 1 is x: one segment's values).
     std::vector<double> p(npad / 2 + 1, 0.0);
-    Resampler resampled(traces[i], tms[i], dt);
-    segment.resize(len);
-    for (std::size_t k = 0; k < count; ++k) {
-      if (k == 0) {
-        resampled.next(len, segment.data());
-      } else {  // samples [k half, k half + cap): the last segment's from half on, then half more
-        std::copy(segment.begin() + static_cast<std::ptrdiff_t>(half), segment.end(),
-                  segment.begin());
-        resampled.next(half, segment.data() + (cap - half));
-      }
-      periodogram->add(segment, static_cast<double>(count), p);
-    }
+    auto series = resampled(traces[i], tms[i], dt);
+    overlapping_segments(series, count, len, half, segment, [&](const std::vector<double>& x) {
+      periodogram->add(x, static_cast<double>(count), p);
+    });
     for (std::size_t k = 0; k < mean.size(); ++k)
       mean[k] += p[k] / static_cast<double>(traces.size());
     ps.push_back(std::move(p));
