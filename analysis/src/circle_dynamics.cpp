@@ -173,9 +173,11 @@ auto resampled(const TraceResidual& t, const Timed& tm, double dt) {
 // and the buffer are made once and kept from one segment to the next. Made afresh for each
 // segment, the tables' sines and cosines and the buffers' page faults cost more than the
 // transform itself (21 % of a 16-minute 10 kHz replay, issue 32). The transform is
-// cal::PowerSpectrum, in place in the padded series: Eigen's kissfft took 2 - 3 times as long
-// on 262,144 points and held three more arrays of 1 - 2 MB (issue 32; its spectra agree with
-// kissfft's within 1e-15 of their peak, tests/analysis/power_spectrum_test.cpp).
+// cal::PowerSpectrum, in place in the padded series: Eigen's kissfft made its plan on each
+// analysis and held three more arrays of 1 - 2 MB, each page a fault on first use, and its
+// arithmetic was some 20 % slower (issue 32, docs/benchmarks.md, tenth pass (b); the spectra
+// agree with kissfft's within 1e-15 of their peak and with the direct DFT likewise,
+// tests/analysis/power_spectrum_test.cpp).
 class Periodograms {
  public:
   explicit Periodograms(std::size_t npad) : spectrum_(npad), padded_(npad) {}
