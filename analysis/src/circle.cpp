@@ -1406,8 +1406,8 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
                                .pages = pages,
                                .u = ax[0],
                                .v = ax[1]};
-  const auto vibration = dynamics::vibration(dyn, residuals, res.notes);
-  const auto stick_slip = dynamics::stick_slip(dyn, residuals, res.notes);
+  const dynamics::Dynamics in_residual =
+      dynamics::vibration_and_stick_slip(dyn, residuals, res.notes);
   double ss = 0.0;  // what is left after the geometric model and a vibration
   for (const auto& tr : residuals)
     for (std::size_t j = 0; j < tr.r_um.size(); ++j) ss += tr.r_um[j] * tr.r_um[j];
@@ -1415,8 +1415,8 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
   residuals.clear();
   residuals.shrink_to_fit();
 
-  if (vibration) rep.add(*vibration);
-  for (const auto& f : stick_slip) rep.add(f);
+  if (in_residual.vibration) rep.add(*in_residual.vibration);
+  for (const auto& f : in_residual.stick_slip) rep.add(f);
   rep.finish(samples);
   // Ranked by what correcting each would gain (G with its term removed), as a ballbar user
   // reads the list: the first is the one to fix first. Equal gains (terms absent) by PV.

@@ -40,16 +40,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <complex>
 #include <map>
 #include <numbers>
 #include <numeric>
 #include <optional>
-#include <unsupported/Eigen/FFT>
 #include <utility>
 
 #include "cal/analysis/angle_reduce.hpp"
+#include "cal/analysis/even_resample.hpp"
 #include "cal/analysis/moving_median.hpp"
+#include "cal/analysis/power_spectrum.hpp"
 
 namespace cal::circle::dynamics {
 namespace {
@@ -73,111 +73,118 @@ struct Timed {
   double time_s(std::size_t i) const { return (trace->s * trace->theta_rad(i) - first) / w; }
 };
 
+// The median of the positive steps between samples: the element of rank count / 2 (nth_element's),
+// from a count of each distinct step. A trace from time has a handful of distinct steps
+// (rounding), so nothing is held a sample (issue 32); past `max_distinct` the count stops and
+// the caller takes the steps one by one.
+class StepMedian {
+ public:
+  static constexpr std::size_t max_distinct = 4096;
+  void add(double d) {
+    if (!(d > 0) || overflowed()) return;
+    // The step of the last sample counted again without a search of the map (a trace from time
+    // repeats a step many times over: the map's search was most of this pass, issue 32).
+    if (last_ == counts_.end() || last_->first != d) last_ = counts_.try_emplace(d, 0).first;
+    ++last_->second, ++count_;
+  }
+  bool overflowed() const { return counts_.size() > max_distinct; }
+  double median() const {
+    std::size_t rank = count_ / 2;
+    for (const auto& c : counts_) {
+      if (rank < c.second) return c.first;
+      rank -= c.second;
+    }
+    return 0.0;  // no positive step
+  }
+
+ private:
+  std::map<double, std::size_t> counts_;
+  std::map<double, std::size_t>::iterator last_ = counts_.end();
+  std::size_t count_ = 0;
+};
+
 Timed timed(const TraceResidual& t, double w) {
   Timed out;
   const std::size_t n = out.n = t.r_um.size();
-  const auto before = [&](std::size_t a, std::size_t b) {
-    return t.s * t.theta_rad(a) < t.s * t.theta_rad(b);
-  };
-  // A trace from time is in travel order already: checked in one pass, and then no
-  // permutation is kept (8 bytes a sample); sorted only if not.
-  bool in_order = true;
-  for (std::size_t i = 1; i < n && in_order; ++i) in_order = !before(i, i - 1);
-  if (!in_order) {
-    out.sorted.resize(n);
-    std::iota(out.sorted.begin(), out.sorted.end(), std::size_t{0});
-    std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
-  }
   out.trace = &t;
   out.w = w;
   if (n == 0) return out;
-  out.first = t.s * t.theta_rad(out.order(0));
-  out.duration_s = out.time_s(out.order(n - 1));
-  // The median step: the element of rank count / 2 of the positive steps (nth_element's), from
-  // a count of each distinct step. A trace from time has a handful of distinct steps (rounding),
-  // so nothing is held a sample (issue 32); one with very many is held as before.
+  // A trace from time is in travel order already: one pass checks that and counts the steps,
+  // each sample's angle computed once (it was four times, in two passes: issue 32), and no
+  // permutation is kept (8 bytes a sample). The times are time_s's, by the same operations.
+  StepMedian steps;
+  out.first = t.s * t.theta_rad(0);
+  double key = out.first, before_s = 0.0;  // s theta and time of the last sample
+  bool in_order = true;
+  for (std::size_t i = 1; i < n; ++i) {
+    const double k = t.s * t.theta_rad(i);
+    if (k < key) {
+      in_order = false;
+      break;
+    }
+    const double at_s = (k - out.first) / w;
+    steps.add(at_s - before_s);
+    key = k, before_s = at_s;
+  }
   const auto step = [&](std::size_t i) {
     return out.time_s(out.order(i)) - out.time_s(out.order(i - 1));
   };
-  constexpr std::size_t max_distinct = 4096;
-  std::map<double, std::size_t> counts;
-  std::size_t count = 0;
-  // The step of the last sample counted again without a search of the map (a trace from time
-  // repeats a step many times over: the map's search was most of this pass, issue 32).
-  auto last = counts.end();
-  for (std::size_t i = 1; i < n && counts.size() <= max_distinct; ++i)
-    if (const double d = step(i); d > 0) {
-      if (last == counts.end() || last->first != d) last = counts.try_emplace(d, 0).first;
-      ++last->second, ++count;
-    }
-  if (counts.size() <= max_distinct) {
-    if (count > 0) {
-      std::size_t rank = count / 2;
-      for (const auto& c : counts) {
-        if (rank < c.second) {
-          out.step_s = c.first;
-          break;
-        }
-        rank -= c.second;
-      }
-    }
+  if (in_order) {
+    out.duration_s = before_s;
+  } else {  // sorted, and the steps counted in travel order
+    const auto before = [&](std::size_t a, std::size_t b) {
+      return t.s * t.theta_rad(a) < t.s * t.theta_rad(b);
+    };
+    out.sorted.resize(n);
+    std::iota(out.sorted.begin(), out.sorted.end(), std::size_t{0});
+    std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
+    out.first = t.s * t.theta_rad(out.order(0));
+    out.duration_s = out.time_s(out.order(n - 1));
+    steps = StepMedian();
+    for (std::size_t i = 1; i < n && !steps.overflowed(); ++i) steps.add(step(i));
+  }
+  if (!steps.overflowed()) {
+    out.step_s = steps.median();
     return out;
   }
-  std::vector<double> steps;
+  // Very many distinct steps: held, one a sample.
+  std::vector<double> all;
   for (std::size_t i = 1; i < n; ++i)
-    if (const double d = step(i); d > 0) steps.push_back(d);
-  if (!steps.empty()) {
-    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-    out.step_s = steps[steps.size() / 2];
+    if (const double d = step(i); d > 0) all.push_back(d);
+  if (!all.empty()) {
+    std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+    out.step_s = all[all.size() / 2];
   }
   return out;
 }
 
-// The residual at the times k dt, k = k0 .. k0 + count - 1, linearly interpolated in travel
-// order. The interpolation starts where a walk from k = 0 would have reached (a binary search:
-// the times rise in travel order), so a segment is the same as that part of the whole series.
-// Into `out` (count values; its memory kept from one segment to the next).
-void resample(const TraceResidual& t, const Timed& tm, double dt, std::size_t k0, std::size_t count,
-              std::vector<double>& out) {
-  out.resize(count);
-  const auto walk = [&](std::size_t j, double at) {
-    return j + 2 < tm.n && tm.time_s(tm.order(j + 1)) < at;
-  };
-  std::size_t j = 0;
-  if (k0 > 0) {
-    std::size_t lo = 0, hi = tm.n;  // the first j where the walk stops
-    while (lo < hi)
-      if (const std::size_t mid = lo + (hi - lo) / 2; walk(mid, static_cast<double>(k0) * dt))
-        lo = mid + 1;
-      else
-        hi = mid;
-    j = lo;
-  }
-  for (std::size_t k = 0; k < count; ++k) {
-    const double at = static_cast<double>(k0 + k) * dt;
-    while (walk(j, at)) ++j;
-    const std::size_t a = tm.order(j), b = tm.order(std::min(j + 1, tm.n - 1));
-    const double ta = tm.time_s(a), tb = tm.time_s(b);
-    const double f = tb > ta ? std::clamp((at - ta) / (tb - ta), 0.0, 1.0) : 0.0;
-    out[k] = t.r_um[a] + f * (t.r_um[b] - t.r_um[a]);
-  }
+// The residual at the times k dt, k = 0, 1, 2, ..., linearly interpolated in travel order
+// (even_resample.hpp): each sample's time and value are read once, when the walk reaches it,
+// not once for each time between it and the next and again for the walk (issue 32); the values
+// are those of the same walk reading them anew, bit for bit.
+auto resampled(const TraceResidual& t, const Timed& tm, double dt) {
+  return EvenResampler(
+      tm.n, dt, [&tm](std::size_t j) { return tm.time_s(tm.order(j)); },
+      [&t, &tm](std::size_t j) { return t.r_um[tm.order(j)]; });
 }
 
 // |X_k|^2 of the Hann-windowed, mean-removed series zero-padded to npad, k = 0 .. npad / 2, for
-// the Welch segments of a run one after another: the transform (its plan and twiddle tables),
-// the window and the buffers are made once and kept from one segment to the next. Made afresh
-// for each segment, the tables' sines and cosines and the buffers' page faults cost more than
-// the transform itself (21 % of a 16-minute 10 kHz replay, issue 32). The values are those of
-// a fresh transform bit for bit: the tables and the window are computed by the same operations.
+// the Welch segments of a run one after another: the transform (its twiddle table), the window
+// and the buffer are made once and kept from one segment to the next. Made afresh for each
+// segment, the tables' sines and cosines and the buffers' page faults cost more than the
+// transform itself (21 % of a 16-minute 10 kHz replay, issue 32). The transform is
+// cal::PowerSpectrum, in place in the padded series: Eigen's kissfft made its plan on each
+// analysis and held three more arrays of 1 - 2 MB, each page a fault on first use, and its
+// arithmetic was some 20 % slower (issue 32, docs/benchmarks.md, tenth pass (b); the spectra
+// agree with kissfft's within 1e-15 of their peak and with the direct DFT likewise,
+// tests/analysis/power_spectrum_test.cpp).
 class Periodograms {
  public:
-  explicit Periodograms(std::size_t npad) : npad_(npad) {
-    fft_.SetFlag(Eigen::FFT<double>::HalfSpectrum);  // k = 0 .. npad / 2 only: half the memory
-  }
+  explicit Periodograms(std::size_t npad) : spectrum_(npad), padded_(npad) {}
 
-  // The periodogram of x, valid until the next call. The padding's zeros are written when the
-  // length changes, not for every segment (the transform reads its input only).
-  const std::vector<double>& operator()(const std::vector<double>& x) {
+  // The periodogram of x divided by `segments` added to p (npad / 2 + 1 values): one of the
+  // Welch average's terms.
+  void add(const std::vector<double>& x, double segments, std::vector<double>& p) {
     const auto n = x.size();
     if (window_.size() != n) {
       window_.resize(n);
@@ -186,24 +193,15 @@ class Periodograms {
                                           static_cast<double>(std::max<std::size_t>(1, n - 1)));
     }
     const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(n);
-    padded_.resize(npad_);
     for (std::size_t i = 0; i < n; ++i) padded_[i] = (x[i] - mean) * window_[i];
-    if (n != zeros_from_) {
-      std::fill(padded_.begin() + static_cast<std::ptrdiff_t>(n), padded_.end(), 0.0);
-      zeros_from_ = n;
-    }
-    fft_.fwd(spec_, padded_);
-    p_.resize(npad_ / 2 + 1);
-    for (std::size_t k = 0; k < p_.size(); ++k) p_[k] = std::norm(spec_[k]);
-    return p_;
+    // The transform works in the buffer: the padding is written again for each segment.
+    std::fill(padded_.begin() + static_cast<std::ptrdiff_t>(n), padded_.end(), 0.0);
+    spectrum_.add(padded_, segments, p);
   }
 
  private:
-  std::size_t npad_;
-  Eigen::FFT<double> fft_;
-  std::vector<double> window_, padded_, p_;
-  std::size_t zeros_from_ = SIZE_MAX;  // padded_ is 0 from here on
-  std::vector<std::complex<double>> spec_;
+  PowerSpectrum spectrum_;
+  std::vector<double> window_, padded_;
 };
 
 struct BandTest {
@@ -211,9 +209,11 @@ struct BandTest {
   double centroid_hz = 0.0;
 };
 
+// `rest` is scratch (up to a spectrum's length): kept by the caller from one test to the next, a
+// fresh 1 MB on each was page faults (issue 32).
 BandTest band_test(const std::vector<double>& p, std::size_t lo, std::size_t hi, std::size_t b0,
-                   std::size_t b1, double df) {
-  std::vector<double> rest;
+                   std::size_t b1, double df, std::vector<double>& rest) {
+  rest.clear();
   double band = 0.0, moment = 0.0;
   for (std::size_t k = lo; k <= hi; ++k) {
     if (k >= b0 && k <= b1) {
@@ -316,19 +316,18 @@ void high_pass(const TraceResidual& t, const Timed& tm, std::size_t m, std::size
                 [&](std::size_t i, double median) { h.set(first + tm.order(i), at(i) - median); });
 }
 
-}  // namespace
-
+// The strongest narrow-band component above 10 f0 when it stands out of the residual's noise in
+// every trace; its fitted contribution is subtracted from `traces`. Notes say what was searched
+// and why nothing was reported when a candidate was refused.
 std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& traces,
-                               std::vector<std::string>& notes) {
+                               const std::vector<Timed>& tms, std::vector<std::string>& notes) {
   const double w = omega_rad_s(s), f0 = w / (2 * pi);
-  std::vector<Timed> tms;
   double dt = 1e300, duration = 1e300;
   std::size_t longest = 0;
-  for (const auto& t : traces) {
-    tms.push_back(timed(t, w));
-    if (!(tms.back().step_s > 0)) return std::nullopt;
-    dt = std::min(dt, tms.back().step_s);
-    duration = std::min(duration, tms.back().duration_s);
+  for (const auto& tm : tms) {
+    if (!(tm.step_s > 0)) return std::nullopt;
+    dt = std::min(dt, tm.step_s);
+    duration = std::min(duration, tm.duration_s);
   }
   // Each trace resampled to the step dt: n_i samples, one segment if n_i <= L (its whole
   // periodogram, padded to a power of two at least twice the longest), else segments of L
@@ -367,30 +366,28 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   std::vector<double> mean(npad / 2 + 1, 0.0);
   // One segment's samples and the transform's buffers are kept from one segment (and trace) to
   // the next: made afresh, their page faults and zeros were a third of the spectra's time in a
-  // long run (issue 32).
+  // long run (issue 32). Each segment's second half is the next one's first (Welch's overlap):
+  // kept, not resampled again.
   std::vector<double> segment;
   std::optional<Periodograms> periodogram(npad);
   for (std::size_t i = 0; i < traces.size(); ++i) {
-    const std::size_t n = lengths[i], len = std::min(n, cap);
-    const std::size_t count = n <= cap ? 1 : (n - cap) / (cap / 2) + 1;
+    const std::size_t n = lengths[i], len = std::min(n, cap), half = cap / 2;
+    const std::size_t count = n <= cap ? 1 : (n - cap) / half + 1;
     segments.push_back(n <= cap ? 1 : n / cap);  // the line fit's: cap samples, the last longer
-    std::vector<double> p;  // one segment's periodogram, or the average of them
-    for (std::size_t k = 0; k < count; ++k) {
-      resample(traces[i], tms[i], dt, k * (cap / 2), len, segment);
-      const std::vector<double>& one = (*periodogram)(segment);
-      if (count == 1) {
-        p = one;
-        break;
-      }
-      if (p.empty()) p.assign(one.size(), 0.0);
-      for (std::size_t b = 0; b < p.size(); ++b) p[b] += one[b] / static_cast<double>(count);
-    }
+    // One segment's periodogram, or the average of them (0 + x / 1 is x: one segment's values).
+    std::vector<double> p(npad / 2 + 1, 0.0);
+    auto series = resampled(traces[i], tms[i], dt);
+    overlapping_segments(series, count, len, half, segment, [&](const std::vector<double>& x) {
+      periodogram->add(x, static_cast<double>(count), p);
+    });
     for (std::size_t k = 0; k < mean.size(); ++k)
       mean[k] += p[k] / static_cast<double>(traces.size());
     ps.push_back(std::move(p));
   }
   periodogram.reset();  // its tables and buffers, before the line fit's
-  segment = std::vector<double>();
+  // The band tests' scratch in the segment's memory, whose pages are already the process's
+  // (a fresh 1 MB was page faults: issue 32); it grows if a band needs more.
+  std::vector<double> rest = std::move(segment);
   const auto peak = static_cast<std::size_t>(
       std::max_element(mean.begin() + static_cast<std::ptrdiff_t>(lo),
                        mean.begin() + static_cast<std::ptrdiff_t>(hi) + 1) -
@@ -398,7 +395,7 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   const auto half = static_cast<std::size_t>(std::ceil((f0 + 2.5 / duration) / df));
   const std::size_t b0 = std::max(lo, peak > half ? peak - half : 0),
                     b1 = std::min(hi, peak + half);
-  const BandTest all = band_test(mean, lo, hi, b0, b1, df);
+  const BandTest all = band_test(mean, lo, hi, b0, b1, df, rest);
   if (all.snr < 10.0) return std::nullopt;
   // Narrow: the band stands out of its neighbourhood (three band widths each side). An error
   // that is locked to the position but local (steps, a stick-slip's mean lag about the
@@ -416,7 +413,7 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
     return std::nullopt;
   }
   for (std::size_t i = 0; i < ps.size(); ++i)
-    if (band_test(ps[i], lo, hi, b0, b1, df).snr < 4.0) {
+    if (band_test(ps[i], lo, hi, b0, b1, df, rest).snr < 4.0) {
       // Trace i lacks it, so (two traces) the other direction has it.
       notes.push_back(fmt::format(
           "vibration: a narrow-band component near {:.2f} Hz stands out in the {} trace only; "
@@ -427,6 +424,7 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   // The spectra are done with: freed before the line fit keeps its own per-sample tables.
   ps = std::vector<std::vector<double>>();
   mean = std::vector<double>();  // (= {} would keep the capacity)
+  rest = std::vector<double>();
   // The frequency that explains most, on a grid over +-1 / T, refined about the best point.
   const LineFit fit{traces, tms, f0, segments, static_cast<double>(cap) * dt, s.pages};
   double best_f = all.centroid_hz, best = -1.0, step = 0.1 / duration;
@@ -481,8 +479,10 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   return out;
 }
 
+// Per axis, the high-frequency residual concentrated where that axis moves slowly (about its
+// reversals), in excess of the rest of the circle.
 std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual>& traces,
-                              std::vector<std::string>& notes) {
+                              const std::vector<Timed>& tms, std::vector<std::string>& notes) {
   const double w = omega_rad_s(s), core = 1.0 * deg, window = s.window_deg * deg;
   // The high-passed residual of every sample, the traces one after the other (as a Found's
   // contribution), each in its own order.
@@ -491,7 +491,7 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
   PagedDoubles hp(total, s.pages);
   for (std::size_t i = 0, first = 0; i < traces.size(); first += traces[i++].r_um.size()) {
     const auto& t = traces[i];
-    const Timed tm = timed(t, w);
+    const Timed& tm = tms[i];
     const double step_rad = tm.step_s * w;
     const std::size_t m =
         step_rad > 0
@@ -554,6 +554,18 @@ std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual
         "and a fast feed before blaming friction (an error locked to the position does not "
         "change with the feed)");
   return found;
+}
+
+}  // namespace
+
+Dynamics vibration_and_stick_slip(const Settings& s, std::vector<TraceResidual>& traces,
+                                  std::vector<std::string>& notes) {
+  std::vector<Timed> tms;  // made once for both (issue 32); the vibration changes no angle
+  for (const auto& t : traces) tms.push_back(timed(t, omega_rad_s(s)));
+  Dynamics out;
+  out.vibration = vibration(s, traces, tms, notes);
+  out.stick_slip = stick_slip(s, traces, tms, notes);
+  return out;
 }
 
 }  // namespace cal::circle::dynamics

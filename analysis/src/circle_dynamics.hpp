@@ -44,15 +44,18 @@ struct Found {
   PagedDoubles contribution;  // every sample of every trace, traces in the given order
 };
 
-// The strongest narrow-band component above 10 f0 when it stands out of the residual's noise in
-// every trace; its fitted contribution is subtracted from `traces`. Notes say what was searched
-// and why nothing was reported when a candidate was refused.
-std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& traces,
-                               std::vector<std::string>& notes);
+struct Dynamics {
+  // The strongest narrow-band component above 10 f0 when it stands out of the residual's noise
+  // in every trace; its fitted contribution is subtracted from the traces. Notes say what was
+  // searched and why nothing was reported when a candidate was refused.
+  std::optional<Found> vibration;
+  // Per axis, the high-frequency residual concentrated where that axis moves slowly (about its
+  // reversals), in excess of the rest of the circle: found in what the vibration leaves.
+  std::vector<Found> stick_slip;
+};
 
-// Per axis, the high-frequency residual concentrated where that axis moves slowly (about its
-// reversals), in excess of the rest of the circle.
-std::vector<Found> stick_slip(const Settings& s, const std::vector<TraceResidual>& traces,
-                              std::vector<std::string>& notes);
+// Both, each trace's time base (its travel order and median step) made once for the two.
+Dynamics vibration_and_stick_slip(const Settings& s, std::vector<TraceResidual>& traces,
+                                  std::vector<std::string>& notes);
 
 }  // namespace cal::circle::dynamics

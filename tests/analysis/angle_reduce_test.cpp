@@ -16,8 +16,8 @@ namespace {
 
 constexpr double pi = std::numbers::pi;
 
-// Values about every boundary of the fast paths (0, y / 2, y, 1.5 y, 2 y, 3 y) and their
-// neighbours a few ulps away, both signs, plus random ones over a few turns and far beyond.
+// Values about every boundary of the fast paths (0, y / 2, y, 1.5 y, 2 y, 3 y, 3.5 y, 4 y) and
+// their neighbours a few ulps away, both signs, plus random ones over a few turns and far beyond.
 std::vector<double> cases(double y) {
   std::vector<double> v = {0.0,
                            -0.0,
@@ -25,7 +25,7 @@ std::vector<double> cases(double y) {
                            std::numeric_limits<double>::infinity(),
                            std::numeric_limits<double>::quiet_NaN(),
                            1e300};
-  for (double m : {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0}) {
+  for (double m : {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5}) {
     double x = m * y;
     for (int k = 0; k < 4; ++k) x = std::nextafter(x, 0.0);
     for (int k = 0; k < 9; ++k, x = std::nextafter(x, 1e300)) v.push_back(x);
@@ -69,6 +69,10 @@ TEST(AngleReduce, AbsRemainderIsStdRemainderBitForBit) {
   // By hand: 2.9 pi is 0.9 pi past 2 pi, 0.1 pi short of 3 pi; 1.2 pi is 0.2 pi past pi.
   EXPECT_NEAR(cal::abs_remainder(1.2 * pi, pi), 0.2 * pi, 1e-15);
   EXPECT_NEAR(cal::abs_remainder(-1.7 * pi, pi), 0.3 * pi, 1e-15);
+  // Past two periods (the ballbar's angles): 3.2 pi is 0.2 pi past 3 pi, -3.6 pi 0.4 pi short
+  // of -4 pi.
+  EXPECT_NEAR(cal::abs_remainder(3.2 * pi, pi), 0.2 * pi, 1e-15);
+  EXPECT_NEAR(cal::abs_remainder(-3.6 * pi, pi), 0.4 * pi, 1e-15);
 }
 
 }  // namespace

@@ -21,9 +21,13 @@ inline double fmod_near(double x, double y) {
 // |std::remainder(x, y)|, y > 0. Where |x| <= 2 y the nearest multiple of y is 0, y or 2 y:
 // |x| - y is exact (Sterbenz: y / 2 <= |x| <= 2 y), as is |x| - 2 y from |x| >= y, and below y
 // |x| - 2 y exceeds y however it rounds, so the smaller is the exact one (a tie, |x| = 1.5 y,
-// gives y / 2 either way); elsewhere the call.
+// gives y / 2 either way). Where 2 y < |x| <= 4 y, |x| - 2 y is exact (Sterbenz again, with
+// 2 y) and has the same remainder (its quotient is 2 less, so a tie rounds to even alike):
+// the ballbar's angles run past two half turns of the reversals (the stick-slip's distances,
+// issue 32). Elsewhere the call.
 inline double abs_remainder(double x, double y) {
-  const double a = std::abs(x);
+  double a = std::abs(x);
+  if (a > 2 * y && a <= 4 * y) a -= 2 * y;
   if (a <= 0.5 * y) return a;
   if (a <= 2 * y) return std::min(std::abs(a - y), std::abs(a - 2 * y));
   return std::abs(std::remainder(x, y));
