@@ -55,6 +55,8 @@
 #include "cal/analysis/circle_source.hpp"
 #include "cal/analysis/enum_names.hpp"
 #include "cal/analysis/error.hpp"
+#include "cal/analysis/outer_sums.hpp"
+#include "cal/analysis/sin_cos.hpp"
 #include "circle_dynamics.hpp"
 
 namespace cal::circle {
@@ -66,14 +68,13 @@ constexpr std::size_t min_samples = 20;
 
 double sgn(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; }
 
-// std::cos(x) and std::sin(x) in one call: glibc's sincos reduces the argument once and
-// evaluates both with the code of its sin and cos, so the values are theirs bit for bit
-// (checked on 10^8 random angles in [-20, 20] rad, and by the replays' --json before and after:
-// docs/benchmarks.md); two separate calls were 15 % of a long run's replay (issue 32).
+// cos x and sin x in one call, without the library's (sin_cos.hpp: within 0.8 ulp, where
+// glibc's are within 0.52; its sincos was 10 - 14 % of a long run's replay at five or six calls
+// a sample: issue 32). Every sine and cosine of the fit's passes is this one's, so a record
+// rebuilt is the record held, bit for bit.
 std::pair<double, double> cos_sin(double x) {
-  double s = 0.0, c = 0.0;
-  ::sincos(x, &s, &c);
-  return {c, s};
+  const SinCos sc = sin_cos(x);
+  return {sc.c, sc.s};
 }
 // cos x and sin x for |x| <= 1.5 by their Taylor series to x^22 and x^23 (the rest is below
 // 1.5^24 / 24! = 3e-20), branch-free so that a loop of them is vectorised.
@@ -191,7 +192,8 @@ struct Model {
   void row(const Sample& x, double s, double k, RowRef&& out, bool cyclic = true) const {
     const double c = x.c, n = x.n;
     const double c2 = c * c - n * n, s2 = 2 * c * n;  // cos 2t, sin 2t
-    const double pu = k * c, pv = k * n;
+    const auto [cu, su] = cyclic ? cos_sin(k * c) : std::pair<double, double>{};
+    const auto [cv, sv] = cyclic ? cos_sin(k * n) : std::pair<double, double>{};
     const std::array<double, term_count> b = {c,
                                               n,
                                               1.0,
@@ -204,10 +206,10 @@ struct Model {
                                               -s * std::abs(n),
                                               x.spike_u,
                                               x.spike_v,
-                                              cyclic ? c * std::sin(pu) : 0.0,
-                                              cyclic ? c * std::cos(pu) : 0.0,
-                                              cyclic ? n * std::sin(pv) : 0.0,
-                                              cyclic ? n * std::cos(pv) : 0.0,
+                                              c * su,
+                                              c * cu,
+                                              n * sv,
+                                              n * cv,
                                               n * n * c,
                                               c * c * n};
     for (int j = 0; j < term_count; ++j)
@@ -384,7 +386,8 @@ class CyclicSeries {
   static constexpr std::array<int, term_count - cyclic_count> others = {
       centre_u,   centre_v,  radius,    scale,   squareness, servo, backlash_u,
       backlash_v, lateral_u, lateral_v, spike_u, spike_v,    bow_u, bow_v};
-  static constexpr int weights = static_cast<int>(others.size()) + 1;
+  static constexpr std::size_t weights = others.size() + 1;
+  static constexpr std::size_t lanes = 16;  // the weights and a 0
 
   // `d`: the largest |k - k0| asked for.
   CyclicSeries(double k0, double d)
@@ -392,8 +395,8 @@ class CyclicSeries {
         q_(terms_for(d)),
         qx_(terms_for(2 * d)),
         qy_(terms_for(std::sqrt(2.0) * d)),
-        su_(Eigen::MatrixXd::Zero(weights, 2 * q_)),
-        sv_(Eigen::MatrixXd::Zero(weights, 2 * q_)),
+        np_(static_cast<std::size_t>(4 * q_ + lanes)),
+        s_(lanes * np_, 0.0),
         xu_(static_cast<std::size_t>(qx_)),
         xv_(static_cast<std::size_t>(qx_)),
         yp_(static_cast<std::size_t>(qy_)),
@@ -409,33 +412,77 @@ class CyclicSeries {
     return q;
   }
 
-  // One block of rows of the design (any k: the cyclic columns are not read) and its y.
+  // One block of rows of the design (the cyclic columns are not read) and its y. Each row's
+  // weights w (the other columns, y and a 0: 16, a multiple of the products' tile) and its
+  // powers p = (c^{q+1} e^{i k0 c}, n^{q+1} e^{i k0 n} for q < Q, as Re, Im, Re, Im; then w
+  // itself), and S += w' p (add_outer_products): the series' sums and the weights' own Gram
+  // matrix (the design's normal equations but for the cyclic rows) in one product. The four
+  // sums of the cyclic columns' own products as column sums of their powers, over the block.
   template <class B, class Y>
   void add(const B& b, const Y& y) {
-    const Eigen::Index rows = b.rows();
-    w_.resize(rows, weights);
-    for (int j = 0; j < weights - 1; ++j) w_.col(j) = b.col(others[static_cast<std::size_t>(j)]);
-    w_.col(weights - 1) = y;
-    pu_.resize(rows, 2 * q_);
-    pv_.resize(rows, 2 * q_);
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      const double c = b(i, centre_u), n = b(i, centre_v);
+    const auto rows = static_cast<std::size_t>(b.rows());
+    w_.resize(rows * lanes);
+    p_.resize(rows * np_);
+    e_.resize(b.rows(), 4);  // cos, sin of k0 c; of k0 n
+    const auto q = static_cast<std::size_t>(q_);
+    for (std::size_t i = 0; i < rows; ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      double* w = &w_[i * lanes];
+      for (std::size_t j = 0; j + 1 < weights; ++j) w[j] = b(ei, others[j]);
+      w[weights - 1] = y[ei];
+      w[weights] = 0.0;
+      const double c = b(ei, centre_u), n = b(ei, centre_v);
       const auto [cu, su] = cos_sin(k0_ * c);
       const auto [cv, sv] = cos_sin(k0_ * n);
-      double pc = c, pn = n;
-      for (int q = 0; q < q_; ++q) {
-        pu_(i, q) = pc * cu, pu_(i, q_ + q) = pc * su;
-        pv_(i, q) = pn * cv, pv_(i, q_ + q) = pn * sv;
-        pc *= c, pn *= n;
+      e_(ei, 0) = cu, e_(ei, 1) = su, e_(ei, 2) = cv, e_(ei, 3) = sv;
+      double* p = &p_[i * np_];
+      double a0 = c * cu, a1 = c * su, a2 = n * cv, a3 = n * sv;
+      for (std::size_t k = 0; k < q; ++k) {
+        p[4 * k] = a0, p[4 * k + 1] = a1, p[4 * k + 2] = a2, p[4 * k + 3] = a3;
+        a0 *= c, a1 *= c, a2 *= n, a3 *= n;
       }
-      const std::complex<double> eu(cu, su), ev(cv, sv);
-      accumulate(xu_, c * c, c, eu * eu);
-      accumulate(xv_, n * n, n, ev * ev);
-      accumulate(yp_, c * n, c + n, eu * ev);
-      accumulate(ym_, c * n, c - n, eu * std::conj(ev));
+      std::copy(w, w + lanes, p + 4 * q);
     }
-    su_.noalias() += w_.transpose() * pu_;
-    sv_.noalias() += w_.transpose() * pv_;
+    add_outer_products(s_.data(), w_.data(), p_.data(), rows, lanes, np_);
+    // e^{2 i k0 c}, e^{2 i k0 n}, e^{i k0 (c + n)}, e^{i k0 (c - n)} (Re, Im).
+    const auto c = b.col(centre_u).array(), n = b.col(centre_v).array();
+    const auto eu_re = e_.col(0).array(), eu_im = e_.col(1).array();
+    const auto ev_re = e_.col(2).array(), ev_im = e_.col(3).array();
+    e2_.resize(b.rows(), 8);
+    e2_.col(0).array() = eu_re * eu_re - eu_im * eu_im, e2_.col(1).array() = 2 * eu_re * eu_im;
+    e2_.col(2).array() = ev_re * ev_re - ev_im * ev_im, e2_.col(3).array() = 2 * ev_re * ev_im;
+    e2_.col(4).array() = eu_re * ev_re - eu_im * ev_im;
+    e2_.col(5).array() = eu_re * ev_im + eu_im * ev_re;
+    e2_.col(6).array() = eu_re * ev_re + eu_im * ev_im;
+    e2_.col(7).array() = eu_im * ev_re - eu_re * ev_im;
+    // sum w t^q e (q = 0, 1, ...) of the block's rows into sums[q].
+    t_.resize(b.rows());
+    const auto sums_of = [&](std::vector<std::complex<double>>& sums, const auto& wt, const auto& t,
+                             int e) {
+      t_.array() = wt;
+      const auto re = e2_.col(e).array(), im = e2_.col(e + 1).array();
+      for (auto& sum : sums) {
+        sum += std::complex<double>((t_.array() * re).sum(), (t_.array() * im).sum());
+        t_.array() *= t;
+      }
+    };
+    sums_of(xu_, c * c, c, 0);
+    sums_of(xv_, n * n, n, 2);
+    sums_of(yp_, c * n, c + n, 4);
+    sums_of(ym_, c * n, c - n, 6);
+  }
+
+  // The design's normal equations but for the cyclic rows (left 0), from the weights' Gram
+  // matrix summed in add().
+  void normal_equations(Gram& ata, TermVector& aty, double& yty) const {
+    ata.setZero();
+    aty.setZero();
+    const auto g = [&](std::size_t j, std::size_t l) { return s_[j * np_ + 4 * q_ + l]; };
+    for (std::size_t j = 0; j + 1 < weights; ++j) {
+      for (std::size_t l = 0; l + 1 < weights; ++l) ata(others[j], others[l]) = g(j, l);
+      aty[others[j]] = g(j, weights - 1);
+    }
+    yty = g(weights - 1, weights - 1);
   }
 
   // The cyclic rows at k. `ata`: the design's Gram matrix (its sums of c^2 and n^2).
@@ -444,19 +491,19 @@ class CyclicSeries {
     CyclicRows out;
     out.cross.setZero();
     out.cty.setZero();
-    const auto cross_of = [&](const Eigen::MatrixXd& s, int a_row, int b_row) {
-      for (int j = 0; j < weights; ++j) {
-        const std::complex<double> v = series_at(s, j, x);
+    const auto cross_of = [&](std::size_t first, int a_row, int b_row) {
+      for (std::size_t j = 0; j < weights; ++j) {
+        const std::complex<double> v = series_at(first, j, x);
         if (j == weights - 1) {
           out.cty[a_row] = v.imag(), out.cty[b_row] = v.real();
         } else {
-          const int t = others[static_cast<std::size_t>(j)];
+          const int t = others[j];
           out.cross(a_row, t) = v.imag(), out.cross(b_row, t) = v.real();
         }
       }
     };
-    cross_of(su_, 0, 1);
-    cross_of(sv_, 2, 3);
+    cross_of(0, 0, 1);
+    cross_of(2, 2, 3);
     // The 4 x 4 block of the cyclic columns (u_a, u_b, v_a, v_b = rows 0 .. 3).
     const auto square = [&](const std::vector<std::complex<double>>& xs, double sum_sq, int a) {
       const std::complex<double> v = sum_at(xs, 2 * x);  // sum w^2 e^{2 i k w}
@@ -478,11 +525,6 @@ class CyclicSeries {
   }
 
  private:
-  // sums[q] += w t^q e (q = 0, 1, ...).
-  static void accumulate(std::vector<std::complex<double>>& sums, double w, double t,
-                         std::complex<double> e) {
-    for (auto& s : sums) s += w * e, w *= t;
-  }
   // sum_q (i x)^q / q! sums[q].
   static std::complex<double> sum_at(const std::vector<std::complex<double>>& sums, double x) {
     std::complex<double> out = 0.0, t = 1.0;
@@ -492,11 +534,13 @@ class CyclicSeries {
     }
     return out;
   }
-  // sum_q (i x)^q / q! S_q of weight j (S_q's real part in column q, imaginary in q_ + q).
-  std::complex<double> series_at(const Eigen::MatrixXd& s, int j, double x) const {
+  // sum_q (i x)^q / q! S_q of weight j (S_q's real part in column 4 q + first, imaginary in
+  // 4 q + first + 1: first 0 for the u series, 2 for the v series).
+  std::complex<double> series_at(std::size_t first, std::size_t j, double x) const {
     std::complex<double> out = 0.0, t = 1.0;
     for (int q = 0; q < q_; ++q) {
-      out += t * std::complex<double>(s(j, q), s(j, q_ + q));
+      const double* sq = &s_[j * np_ + 4 * static_cast<std::size_t>(q) + first];
+      out += t * std::complex<double>(sq[0], sq[1]);
       t *= std::complex<double>(0.0, x / (q + 1));
     }
     return out;
@@ -504,9 +548,12 @@ class CyclicSeries {
 
   double k0_;
   int q_, qx_, qy_;
-  Eigen::MatrixXd su_, sv_;  // weights x 2 q_
+  std::size_t np_;         // the powers of a row: 4 q_, then the 16 weights
+  std::vector<double> s_;  // 16 x np_, row-major: each weight's sums with every power
   std::vector<std::complex<double>> xu_, xv_, yp_, ym_;
-  Eigen::MatrixXd w_, pu_, pv_;  // one block's weights and powers
+  std::vector<double> w_, p_;  // one block's weights and powers, row-major
+  Eigen::MatrixXd e_, e2_;     // one block's phases
+  Eigen::VectorXd t_;
 };
 
 // The normal equations of one sample set (every stride-th sample), accumulated block by block
@@ -531,18 +578,46 @@ class Design {
     for_each_block(
         m_, samples_, stride_, k(),
         [&](const auto& b, const auto& y, std::size_t first) {
-          ata_.selfadjointView<Eigen::Lower>().rankUpdate(b.transpose());
-          aty_.noalias() += b.transpose() * y;
-          yty_ += y.squaredNorm();
-          if (series) series->add(b, y);
+          if (series)
+            series->add(b, y);  // and the rest of the normal equations with it
+          else
+            add_gram(b, y);
           if (dense_.rows() > 0) {
             dense_.middleRows(static_cast<Eigen::Index>(first), b.rows()) = b;
             dense_y_.segment(static_cast<Eigen::Index>(first), b.rows()) = y;
           }
         },
         each, series == nullptr);
-    ata_.triangularView<Eigen::StrictlyUpper>() = ata_.transpose();
-    if (series) dense_.resize(0, term_count);  // its cyclic columns were not made
+    if (series) {
+      series->normal_equations(ata_, aty_, yty_);
+      dense_.resize(0, term_count);  // its cyclic columns were not made
+    } else {
+      const auto g = [&](std::size_t j, std::size_t l) { return gram_[j * gram_lanes + l]; };
+      for (std::size_t j = 0; j < term_count; ++j) {
+        for (std::size_t l = 0; l < term_count; ++l)
+          ata_(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(l)) = g(j, l);
+        aty_[static_cast<Eigen::Index>(j)] = g(j, term_count);
+      }
+      yty_ = g(term_count, term_count);
+    }
+  }
+
+  // A block's products into the normal equations: [b y 0]' [b y 0] (add_outer_products),
+  // each sum over the rows in order, as CyclicSeries::add sums the same products of the
+  // columns it takes (so both give the same bits for those: the one-pass refinement then
+  // differs from the pass per trial only by its series).
+  template <class B, class Y>
+  void add_gram(const B& b, const Y& y) {
+    const auto rows = static_cast<std::size_t>(b.rows());
+    w_.resize(rows * gram_lanes);
+    for (std::size_t i = 0; i < rows; ++i) {
+      const auto ei = static_cast<Eigen::Index>(i);
+      double* w = &w_[i * gram_lanes];
+      for (std::size_t j = 0; j < term_count; ++j) w[j] = b(ei, static_cast<Eigen::Index>(j));
+      w[term_count] = y[ei];
+      w[term_count + 1] = 0.0;
+    }
+    add_outer_products(gram_.data(), w_.data(), w_.data(), rows, gram_lanes, gram_lanes);
   }
 
   // The cyclic rows of the normal equations at `period_mm` given (CyclicSeries::rows at the
@@ -653,11 +728,12 @@ class Design {
       const double kc = k();
       for (Eigen::Index i = 0; i < dense_.rows(); ++i) {
         const Sample x = samples_[static_cast<std::size_t>(i) * stride_];
-        const double pu = kc * x.c, pv = kc * x.n;
-        dense_(i, cyclic_u_a) = x.c * std::sin(pu);
-        dense_(i, cyclic_u_b) = x.c * std::cos(pu);
-        dense_(i, cyclic_v_a) = x.n * std::sin(pv);
-        dense_(i, cyclic_v_b) = x.n * std::cos(pv);
+        const auto [cu, su] = cos_sin(kc * x.c);
+        const auto [cv, sv] = cos_sin(kc * x.n);
+        dense_(i, cyclic_u_a) = x.c * su;
+        dense_(i, cyclic_u_b) = x.c * cu;
+        dense_(i, cyclic_v_a) = x.n * sv;
+        dense_(i, cyclic_v_b) = x.n * cv;
       }
       const auto cyc = dense_.middleCols<cyclic_count>(cyclic_first);
       cross.noalias() = cyc.transpose() * dense_;
@@ -678,6 +754,9 @@ class Design {
   // the radius and the shortest period, not by the run's length) is also kept dense, so that a
   // trial period recomputes only its four cyclic columns.
   static constexpr std::size_t dense_max_rows = 8192;
+  static constexpr std::size_t gram_lanes = term_count + 2;  // the columns, y and a 0
+  std::vector<double> gram_ = std::vector<double>(gram_lanes * gram_lanes, 0.0);
+  std::vector<double> w_;  // one block's rows [b y 0]
   Model m_;
   const Samples& samples_;
   std::size_t stride_;
@@ -743,13 +822,46 @@ double brent_min(double a, double b, double tol, F f) {
 // half a cycle when dp / p = p / (4R). So the grid steps by p / (8R) (at most 800 steps), on
 // a decimated copy of the samples (>= 8 samples per shortest period along the path), and the
 // best grid point is refined by Brent's method (parabolic and golden section steps) on all samples.
-// The grid's part: the bracket [best / e^step, best * e^step] of the refinement.
+// A bracket of that refinement, [lo, hi] in log p.
 struct Bracket {
-  double best_p, step;
-  double k0(double r_mm) const { return 2 * pi * r_mm / best_p * std::cosh(step); }
-  double half_width_k(double r_mm) const { return 2 * pi * r_mm / best_p * std::sinh(step); }
+  double lo, hi;
+  // Its wave numbers k = 2 pi R / p: their middle and half their range.
+  double k0(double r_mm) const { return pi * r_mm * (std::exp(-lo) + std::exp(-hi)); }
+  double half_width_k(double r_mm) const { return pi * r_mm * (std::exp(-lo) - std::exp(-hi)); }
 };
-Bracket search_grid(const Model& m, const Samples& samples, const Setup& setup) {
+// The grid's bracket, [best / e^step, best * e^step], and a narrower one within it about the
+// decimated design's own minimum (the refinement's trials on the grid's ~5,000 rows): the full
+// samples' minimum lies within a few of that minimum's standard deviations of it, and the
+// series of the one-pass refinement need about half the terms over the narrower bracket
+// (CyclicSeries::terms_for: 18 -> 9 at R = 100 mm; issue 32). Its edges are checked after the
+// refinement (at_edge): a minimum found there is refined again over the grid's bracket.
+struct Brackets {
+  Bracket grid, narrow;
+  // x = log p found in `narrow` lies at one of its edges that the grid's bracket does not share.
+  bool at_edge(double x) const {
+    constexpr double margin = 4 * refine_tol;
+    return (narrow.lo > grid.lo && x - narrow.lo < margin) ||
+           (narrow.hi < grid.hi && narrow.hi - x < margin);
+  }
+  static constexpr double refine_tol = 1e-7;  // in log p (a 4 nm shift of a 40 mm period)
+};
+
+// The decimated minimum's standard deviation in log p, from the residual's curvature there:
+// near its minimum x1 the residual is f1 + a (x - x1)^2, and with the residuals' variance s^2 =
+// f1 / (rows - terms) the least-squares x moves by s / sqrt(a) (one standard deviation: where the
+// residual has grown by s^2). Sixteen of those (or the grid's step, if less), not less than
+// 100 times the refinement's tolerance; none (the grid's bracket) without a clear minimum.
+template <class F>
+double narrowed_half_width(F rss, double x1, double step, double rows) {
+  const double h = step / 4;
+  const double f1 = rss(x1), fp = rss(x1 + h), fm = rss(x1 - h);
+  const double a = (fp + fm - 2 * f1) / (2 * h * h);
+  const double var = f1 / std::max(1.0, rows - static_cast<double>(term_count));
+  if (!(a > 0) || !(var > 0) || !std::isfinite(a)) return step;
+  return std::clamp(16 * std::sqrt(var / a), 100 * Brackets::refine_tol, step);
+}
+
+Brackets search_grid(const Model& m, const Samples& samples, const Setup& setup) {
   const double p_min = setup.cyclic_search_min_mm, p_max = setup.cyclic_search_max_mm;
   const double path_per_sample_mm =
       2 * pi * setup.radius_mm / std::max(1.0, static_cast<double>(samples.size()) / 2.0);
@@ -764,17 +876,22 @@ Bracket search_grid(const Model& m, const Samples& samples, const Setup& setup) 
     if (const double rss = coarse.solve_grid(p).rss; rss < best_rss)
       best_rss = rss, best_p = p, best_step = step;
   }
-  return {best_p, best_step};
+  const Bracket grid{std::log(best_p) - best_step, std::log(best_p) + best_step};
+  const auto rss = [&](double x) { return coarse.solve_grid(std::exp(x)).rss; };
+  const double x1 = brent_min(grid.lo, grid.hi, Brackets::refine_tol, rss);
+  const double rows = std::ceil(static_cast<double>(samples.size()) / static_cast<double>(stride));
+  const double half = narrowed_half_width(rss, x1, best_step, rows);
+  const Brackets out{grid, {std::max(grid.lo, x1 - half), std::min(grid.hi, x1 + half)}};
+  return out;
 }
 
-// Brent's minimisation over log p in the grid's bracket: near the minimum the residual is a
-// smooth parabola in log p, which parabolic steps find in about a third of the 26 trials that
-// golden section alone took (issue 32). Located to 1e-7 in log p (a 4 nm shift of a 40 mm
-// period). `rss_at(p)`: the residual of the fit with period p.
+// Brent's minimisation over log p in a bracket: near the minimum the residual is a smooth
+// parabola in log p, which parabolic steps find in about a third of the 26 trials that golden
+// section alone took (issue 32). Returns log p, located to Brackets::refine_tol. `rss_at(p)`:
+// the residual of the fit with period p.
 template <class F>
-double refine_period(const Bracket& b, F rss_at) {
-  return std::exp(brent_min(std::log(b.best_p) - b.step, std::log(b.best_p) + b.step, 1e-7,
-                            [&](double x) { return rss_at(std::exp(x)); }));
+double refine_log_period(const Bracket& b, F rss_at) {
+  return brent_min(b.lo, b.hi, Brackets::refine_tol, [&](double x) { return rss_at(std::exp(x)); });
 }
 
 // Sorts v by key in linear time when it is a rotation of a strictly increasing sequence, or the
@@ -1339,20 +1456,31 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
   double period_mm = setup.cyclic_period_mm.value_or(10.0);
   std::optional<Design> fitted;
   if (m.on[cyclic_first] && !setup.cyclic_period_mm) {
-    const Bracket bracket = search_grid(m, samples, setup);
-    period_mm = bracket.best_p;
+    const Brackets brackets = search_grid(m, samples, setup);
+    period_mm = std::exp((brackets.narrow.lo + brackets.narrow.hi) / 2);
     if (refinement == PeriodRefinement::pass_per_trial) {
       fitted.emplace(m, samples, 1, period_mm, nullptr, add_circle);
-      period_mm = refine_period(bracket, [&](double p) { return fitted->solve(p).rss; });
+      const auto rss = [&](double p) { return fitted->solve(p).rss; };
+      double x = refine_log_period(brackets.narrow, rss);
+      if (brackets.at_edge(x)) x = refine_log_period(brackets.grid, rss);
+      period_mm = std::exp(x);
     } else {
       // The refinement's trials, and the normal equations at the period found, from sums made
-      // in the design's own pass (CyclicSeries): the search costs that pass's extra sums.
-      CyclicSeries series(bracket.k0(m.r_mm), bracket.half_width_k(m.r_mm) * (1 + 1e-6));
-      fitted.emplace(m, samples, 1, period_mm, &series, add_circle);
-      period_mm = refine_period(bracket, [&](double p) {
-        return fitted->solve_with(series.rows(m.wave_number(p), fitted->ata())).rss;
-      });
-      fitted->use_cyclic_rows(series.rows(m.wave_number(period_mm), fitted->ata()), period_mm);
+      // in the design's own pass (CyclicSeries): the search costs that pass's extra sums, and
+      // one more such pass when the minimum falls on the narrow bracket's edge.
+      const auto refine = [&](const Bracket& b, auto&& each) {
+        CyclicSeries series(b.k0(m.r_mm), b.half_width_k(m.r_mm) * (1 + 1e-6));
+        fitted.emplace(m, samples, 1, period_mm, &series, each);
+        const double x = refine_log_period(b, [&](double p) {
+          return fitted->solve_with(series.rows(m.wave_number(p), fitted->ata())).rss;
+        });
+        fitted->use_cyclic_rows(series.rows(m.wave_number(std::exp(x)), fitted->ata()),
+                                std::exp(x));
+        return x;
+      };
+      double x = refine(brackets.narrow, add_circle);
+      if (brackets.at_edge(x)) x = refine(brackets.grid, NoHook{});  // the circles summed once
+      period_mm = std::exp(x);
     }
   } else {
     fitted.emplace(m, samples, 1, period_mm, nullptr, add_circle);

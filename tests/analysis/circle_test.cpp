@@ -1051,9 +1051,10 @@ namespace {
 // Issue 32: the period search refines its grid's best period from series summed in one pass
 // (CyclicSeries) instead of a pass over every sample per trial. On machines with known injected
 // cyclic errors (periods from 3 to 37 mm, of one axis or both, with other errors and noise), the
-// one-pass search finds the period the pass-per-trial search finds (Brent stops within 1e-7 of
-// log p of the minimum, but both take nearly the same steps: 5.3e-11 mm apart) and every number
-// of the result within 1e-7 um (or %, ms, um/m; 1.65e-9 measured), and it finds what was injected.
+// one-pass search finds the period the pass-per-trial search finds (both over the bracket
+// narrowed about the decimated design's minimum; Brent stops within 1e-7 of log p of the
+// minimum, but both take nearly the same steps: 2.6e-10 mm apart) and every number of the result
+// within 1e-7 um (or %, ms, um/m; 3.3e-8 measured), and it finds what was injected.
 TEST(CircleDiagnostics, OnePassPeriodSearchEqualsThePassPerTrialSearchAndTheTruth) {
   struct Case {
     Machine m;
@@ -1130,8 +1131,8 @@ TEST(CircleDiagnostics, OnePassPeriodSearchEqualsThePassPerTrialSearchAndTheTrut
   }
   std::printf("one-pass vs pass-per-trial search: period %.3g mm, other numbers %.3g apart\n",
               worst_period_mm, worst_um);
-  EXPECT_LT(worst_period_mm, 1e-9);  // 5.3e-11 measured
-  EXPECT_LT(worst_um, 1e-7);         // 1.65e-9 measured
+  EXPECT_LT(worst_period_mm, 1e-9);  // 2.6e-10 measured
+  EXPECT_LT(worst_um, 1e-7);         // 3.3e-8 measured
 }
 
 }  // namespace

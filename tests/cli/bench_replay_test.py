@@ -86,6 +86,24 @@ with tempfile.TemporaryDirectory() as tmp:
               d["real_time_factor_cpu"], str(d))
         check(f"{kind} peak RSS", 1000 < d["peak_rss_kib"] < 2_000_000, str(d["peak_rss_kib"]))
         check(f"{kind} recorded", 5 < d["recorded_s"] < 60, str(d["recorded_s"]))
+        # The summary over the rounds, recomputed from each round's replay and template.
+        o = d.get("over_rounds", {})
+        tpl_rounds = templates.get(d["template"], {}).get("rounds", [])
+        per = [(r["cpu_s"] - t["cpu_s"]) / d["added_readings"] * 1e6
+               for r, t in zip(d["rounds"], tpl_rounds)]
+        got = o.get("us_cpu_per_added_reading", [])
+        check(f"{kind} per-round figures", len(got) == len(per) == 1 and
+              all(abs(a - b) <= 1e-9 * abs(b) for a, b in zip(got, per)), f"{got} vs {per}")
+        check(f"{kind} min and median", per and o.get("us_cpu_per_added_reading_min") == min(got)
+              and o.get("us_cpu_per_added_reading_median") == got[0], str(o))
+        check(f"{kind} ratios", abs(o.get("x_ingest_from_mins", 0) * o.get(
+              "ingest_us_per_reading_min", 0) - o.get("us_cpu_per_added_reading_min", 1)) <
+              1e-9 and o.get("ingest_us_per_reading_min") == peer.get("ingest_us_per_reading"),
+              str(o))
+        check(f"{kind} summary line", re.search(
+            rf"^{kind}: us CPU per added reading min -?[0-9.]+, median -?[0-9.]+ \(.*\); "
+            rf"ingest peer min [0-9.]+, median [0-9.]+; x ingest from the mins -?[0-9.]+, "
+            rf"from the medians -?[0-9.]+$", text, re.M), text[-3000:])
     if "halsampler" in devices:
         d = devices["halsampler"]
         check("halsampler readings = 1 kHz x recorded",

@@ -227,6 +227,26 @@ long max_rss_kib(const std::vector<Replayed>& rs) {
   return m;
 }
 
+// A device's CPU per added reading in each round (its replay less the template's of the same
+// round), and the peer's with storage, each as their least and median.
+struct RoundFigures {
+  std::vector<double> per_us;
+  double per_min = 0, per_median = 0, ingest_min = 0, ingest_median = 0;
+};
+RoundFigures round_figures(const Subject& s, const Subject& tpl, const Peer& peer) {
+  RoundFigures f;
+  const auto added = s.rounds.front().readings - tpl.rounds.front().readings;
+  for (std::size_t r = 0; r < s.rounds.size() && r < tpl.rounds.size(); ++r)
+    f.per_us.push_back(added > 0 ? (s.rounds[r].cpu_s - tpl.rounds[r].cpu_s) /
+                                       static_cast<double>(added) * 1e6
+                                 : std::nan(""));
+  f.per_min = *std::min_element(f.per_us.begin(), f.per_us.end());
+  f.per_median = bench::median(f.per_us);
+  f.ingest_min = *std::min_element(peer.ingest_us.begin(), peer.ingest_us.end());
+  f.ingest_median = bench::median(peer.ingest_us);
+  return f;
+}
+
 std::string run_text(const Replayed& r, bool linear) {
   if (!r.complete)
     return fmt::format("INCOMPLETE ({}{})", r.note,
@@ -338,6 +358,7 @@ void bench_replay(const ReplayBenchOptions& o) {
     doc["templates"].push_back({{"test", t.name}, {"recorded_s", t.recorded_s}, {"rounds", rs}});
   }
   bool all_complete = true;
+  std::vector<std::string> summaries;
   for (const auto& s : subjects) {
     const auto& tpl = *std::find_if(templates.begin(), templates.end(),
                                     [&](const Subject& t) { return t.name == s.test; });
@@ -369,6 +390,12 @@ void bench_replay(const ReplayBenchOptions& o) {
                  s.test == "linear"));
     json rs = json::array();
     for (const auto& r : s.rounds) rs.push_back(round_json(r));
+    const RoundFigures f = round_figures(s, tpl, peer);
+    summaries.push_back(fmt::format(
+        "{}: us CPU per added reading min {:.3f}, median {:.3f} ({:.3f}); ingest peer min "
+        "{:.3f}, median {:.3f}; x ingest from the mins {:.1f}, from the medians {:.1f}",
+        s.name, f.per_min, f.per_median, fmt::join(f.per_us, ", "), f.ingest_min, f.ingest_median,
+        f.per_min / f.ingest_min, f.per_median / f.ingest_median));
     doc["devices"].push_back({{"kind", s.name},
                               {"template", s.test},
                               {"rate_hz", s.rate_hz},
@@ -384,7 +411,15 @@ void bench_replay(const ReplayBenchOptions& o) {
                               {"x_ingest", per_us / ingest_us},
                               {"peak_rss_kib", max_rss_kib(s.rounds)},
                               {"complete", complete},
-                              {"rounds", rs}});
+                              {"rounds", rs},
+                              {"over_rounds",
+                               {{"us_cpu_per_added_reading", f.per_us},
+                                {"us_cpu_per_added_reading_min", f.per_min},
+                                {"us_cpu_per_added_reading_median", f.per_median},
+                                {"ingest_us_per_reading_min", f.ingest_min},
+                                {"ingest_us_per_reading_median", f.ingest_median},
+                                {"x_ingest_from_mins", f.per_min / f.ingest_min},
+                                {"x_ingest_from_medians", f.per_median / f.ingest_median}}}});
   }
   fmt::print(
       "\n(wall, CPU (user + system) and peak RSS of each `daq replay` child, medians of the rounds "
@@ -395,6 +430,11 @@ void bench_replay(const ReplayBenchOptions& o) {
       "reading) as within 5x of ingest with storage, the x ingest column: 5x the pipeline alone "
       "is less than storing one reading costs the ingest bench (docs/benchmarks.md, \"The "
       "IDS3010 replay's goal, restated\").)\n");
+  fmt::print(
+      "\nOver the {} round(s) (each round's replay less the same round's template, per added "
+      "reading, and that round's ingest peer; the host's speed swings between rounds, so the "
+      "least of each is its figure on the quietest machine):\n{}\n",
+      o.rounds, fmt::join(summaries, "\n"));
   if (!o.json_out.empty()) {
     std::ofstream out(o.json_out);
     out << doc.dump(2) << '\n';

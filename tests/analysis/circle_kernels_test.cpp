@@ -1,0 +1,133 @@
+// The circle analysis' per-sample kernels (issue 32): cal::sin_cos against long double sin and
+// cos, and cal::add_outer_products against exact integer sums and its own portable loop, bit
+// for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "cal/analysis/outer_sums.hpp"
+#include "cal/analysis/sin_cos.hpp"
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+// |got - exact| in ulps of the exact value rounded to double.
+long double ulps(double got, long double exact) {
+  const double e = std::abs(static_cast<double>(exact));
+  const double ulp = std::nextafter(e, std::numeric_limits<double>::infinity()) - e;
+  return std::abs(static_cast<long double>(got) - exact) / ulp;
+}
+
+// Random arguments over the ranges the analysis meets (the reduced range itself, a few turns,
+// the phases k c of a short period on a large circle) and each quadrant's edges: within 0.8 ulp
+// of long double's sinl and cosl (64-bit mantissas: their own error is 2^-11 of a double's ulp).
+// glibc's sincos is within 0.52 ulp on the same arguments; a wrong quadrant, sign or reduction
+// constant is off by 1e14 ulps and more.
+TEST(SinCos, WithinOneUlpOfLongDouble) {
+  std::mt19937_64 rng(11);
+  for (const double limit : {pi / 4, 20.0, 2000.0, 800000.0}) {
+    SCOPED_TRACE(limit);
+    std::uniform_real_distribution<double> u(-limit, limit);
+    long double worst_s = 0, worst_c = 0;
+    for (int i = 0; i < 1'000'000; ++i) {
+      const double x = u(rng);
+      const cal::SinCos got = cal::sin_cos(x);
+      const long double lx = x;
+      worst_s = std::max(worst_s, ulps(got.s, std::sin(lx)));
+      worst_c = std::max(worst_c, ulps(got.c, std::cos(lx)));
+    }
+    EXPECT_LT(worst_s, 0.8L);
+    EXPECT_LT(worst_c, 0.8L);
+    std::printf("sin_cos, |x| < %g: sin within %.3Lf ulp, cos %.3Lf\n", limit, worst_s, worst_c);
+  }
+  // The edges between quadrants (n pi / 4, where the reduction rounds n one way or the other).
+  // Where a value is near 0 (x near a multiple of pi / 2) an absolute error below 1e-30 passes
+  // too: the reduction carries pi / 2 to 2^-122, so r is right to about 1e-31 whatever its size.
+  long double worst = 0;
+  for (int n = -400; n <= 400; ++n) {
+    double x = n * pi / 4;
+    for (int k = 0; k < 8; ++k) x = std::nextafter(x, -1e300);
+    for (int k = 0; k < 17; ++k, x = std::nextafter(x, 1e300)) {
+      const cal::SinCos got = cal::sin_cos(x);
+      const long double lx = x;
+      for (const auto& [g, e] : {std::pair<double, long double>{got.s, std::sin(lx)},
+                                 std::pair<double, long double>{got.c, std::cos(lx)}})
+        if (!(std::abs(static_cast<long double>(g) - e) < 1e-30L))
+          worst = std::max(worst, ulps(g, e));
+    }
+  }
+  EXPECT_LT(worst, 0.8L);
+  std::printf("sin_cos at the quadrants' edges: within %.3Lf ulp\n", worst);
+}
+
+// Beyond the reduction's range (|x| >= 2^19 pi / 2), and for inf and NaN, glibc's values.
+TEST(SinCos, LargeAndNonFiniteArgumentsAreGlibcs) {
+  for (const double x :
+       {823549.6, -823549.6, 1e6, -3e9, 1e300, std::numeric_limits<double>::infinity(),
+        std::numeric_limits<double>::quiet_NaN()}) {
+    double s = 0, c = 0;
+    ::sincos(x, &s, &c);
+    const cal::SinCos got = cal::sin_cos(x);
+    if (std::isnan(s)) {
+      EXPECT_TRUE(std::isnan(got.s) && std::isnan(got.c)) << x;
+    } else {
+      EXPECT_EQ(got.s, s) << x;
+      EXPECT_EQ(got.c, c) << x;
+    }
+  }
+}
+
+// Integers below 2^10 multiplied and summed over at most 300 rows stay below 2^29: every
+// product and sum is exact, so each path must give the exact integer sums (checked against
+// int64 arithmetic), and a wrong tile, index or row is found at once.
+TEST(OuterSums, EveryPathGivesTheExactSumsOfIntegers) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> v(-1000, 1000);
+  for (const std::size_t rows : {1u, 7u, 128u, 300u})
+    for (const std::size_t np : {4u, 8u, 12u, 24u, 36u, 52u, 68u}) {
+      const std::size_t nw = 16;
+      std::vector<double> w(rows * nw), p(rows * np), s(nw * np), sp(nw * np);
+      std::vector<std::int64_t> exact(nw * np);
+      for (auto& x : w) x = v(rng);
+      for (auto& x : p) x = v(rng);
+      for (std::size_t k = 0; k < s.size(); ++k) s[k] = sp[k] = static_cast<double>(v(rng));
+      for (std::size_t k = 0; k < s.size(); ++k) exact[k] = static_cast<std::int64_t>(s[k]);
+      for (std::size_t i = 0; i < rows; ++i)
+        for (std::size_t j = 0; j < nw; ++j)
+          for (std::size_t m = 0; m < np; ++m)
+            exact[j * np + m] +=
+                static_cast<std::int64_t>(w[i * nw + j]) * static_cast<std::int64_t>(p[i * np + m]);
+      cal::add_outer_products(s.data(), w.data(), p.data(), rows, nw, np);
+      cal::add_outer_products_portable(sp.data(), w.data(), p.data(), rows, nw, np);
+      for (std::size_t k = 0; k < s.size(); ++k) {
+        ASSERT_EQ(s[k], static_cast<double>(exact[k])) << rows << " rows, " << np << ", " << k;
+        ASSERT_EQ(sp[k], static_cast<double>(exact[k])) << rows << " rows, " << np << ", " << k;
+      }
+    }
+}
+
+// On values whose sums round, the dispatched path (AVX2 where the CPU has it, else SSE2) and
+// the portable loop agree bit for bit: the same products added in the same order.
+TEST(OuterSums, DispatchedPathEqualsThePortableLoopBitForBit) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> v(0.0, 1.0);
+  const std::size_t rows = 128, nw = 16, np = 52;
+  std::vector<double> w(rows * nw), p(rows * np), s(nw * np, 0.0), sp(nw * np, 0.0);
+  for (int block = 0; block < 20; ++block) {
+    for (auto& x : w) x = v(rng);
+    for (auto& x : p) x = v(rng) * 1e3;
+    cal::add_outer_products(s.data(), w.data(), p.data(), rows, nw, np);
+    cal::add_outer_products_portable(sp.data(), w.data(), p.data(), rows, nw, np);
+  }
+  EXPECT_EQ(s, sp);
+  std::printf("outer products: %s path\n", cal::outer_products_avx2() ? "AVX2" : "SSE2");
+}
+
+}  // namespace
