@@ -461,6 +461,7 @@ class StreamFields {
     std::size_t size = 0;
     RunningDecimal time_ns;   // the last row's stored time
     RunningDecimal since_ns;  // the last row's nanoseconds since the run's start (time_s)
+    RunningReading value;     // the last row's value
   };
   explicit StreamFields(const DeviceNames& names) : names_(names) {}
   // r's stream, made if it is new.
@@ -530,7 +531,7 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
   const auto whole_ns = std::abs(since_ns) < 0x1p62 ? static_cast<std::int64_t>(since_ns) : 0;
   if (static_cast<double>(whole_ns) != since_ns)
     p = number(p, clock.seconds(x.session_ns));  // the same division, in its one place
-  else if (char* end = stream.since_ns.set(whole_ns) ? stream.since_ns.write_seconds(p) : nullptr)
+  else if (char* end = stream.since_ns.set(whole_ns) ? stream.since_ns.write_decimal(p) : nullptr)
     p = end;
   else
     p = write_seconds_of_ns(p, whole_ns);
@@ -544,8 +545,9 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
   *p++ = ',';
   // The reading as its instrument gave it (a gauge's printed digits, an interferometer's
   // picometres, in SI): where it is its decimal's own double, written without the digit search
-  // (write_shortest_quantised); the same text either way.
-  p = !Json || std::isfinite(x.r.value) ? write_shortest_quantised(p, x.r.value)
+  // (write_shortest_quantised), and from the stream's last reading's digits where it is near
+  // it (RunningReading); the same text every way.
+  p = !Json || std::isfinite(x.r.value) ? stream.value.write(p, x.r.value)
                                         : std::copy_n("null", 4, p);
   *p++ = ',';
   // The stored time's integer: the stream's last one continued where it can be (as time_s).
