@@ -28,15 +28,18 @@ std::string seconds_by_hand(std::int64_t v) {
   return text;
 }
 
-// The first value of `values`, set in turn on one RunningDecimal, whose text differs from the
-// full conversions' or the by-hand decimal's; "" when every one agrees.
-std::string first_difference(const std::vector<std::int64_t>& values) {
+// The first value of `values`, set in turn on one RunningDecimal (steps back by the
+// subtraction with Back, else from scratch), whose text differs from the full conversions' or
+// the by-hand decimal's; "" when every one agrees.
+template <bool Back>
+std::string first_difference_of(const std::vector<std::int64_t>& values) {
   daq::RunningDecimal d;
   char got[64], want[64];
   for (std::size_t i = 0; i < values.size(); ++i) {
     const std::int64_t v = values[i];
     const bool in_range = v >= 0 && v < 10'000'000'000'000'000;
-    if (d.set(v) != in_range) return fmt::format("#{} {}: set() gave {}", i, v, !in_range);
+    if (d.template set<Back>(v) != in_range)
+      return fmt::format("#{} {}: set() gave {}", i, v, !in_range);
     if (!in_range) continue;
     const std::string integer(got, d.write_integer(got));
     if (integer != std::string(want, daq::write_integer(want, v)) ||
@@ -55,6 +58,11 @@ std::string first_difference(const std::vector<std::int64_t>& values) {
                          i ? values[i - 1] : -1, seconds, seconds_by_hand(v));
   }
   return {};
+}
+
+// Both ways.
+std::string first_difference(const std::vector<std::int64_t>& values) {
+  return first_difference_of<false>(values) + first_difference_of<true>(values);
 }
 
 TEST(RunningDecimal, ByHand) {
