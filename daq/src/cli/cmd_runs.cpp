@@ -466,9 +466,8 @@ class StreamFields {
   explicit StreamFields(const DeviceNames& names) : names_(names) {}
   // r's stream, made if it is new.
   Stream& of(const st::RawReading& r) {
-    const StreamKey key = key_of(r);
-    if (last_ == nullptr || last_key_ != key) {
-      auto [at, added] = streams_.try_emplace(key);
+    if (last_ == nullptr || last_key_ != packed_key(r)) {
+      auto [at, added] = streams_.try_emplace(key_of(r));
       if (added) {
         const auto quantity =
             cal::drivers::to_string(static_cast<cal::drivers::Quantity>(r.quantity));
@@ -479,7 +478,7 @@ class StreamFields {
         at->second.size = at->second.padded.size();
         at->second.padded.resize(at->second.size + 16);
       }
-      last_key_ = key;
+      last_key_ = packed_key(r);
       last_ = &at->second;
     }
     return *last_;
@@ -496,7 +495,7 @@ class StreamFields {
  private:
   const DeviceNames& names_;
   std::map<StreamKey, Stream> streams_;
-  StreamKey last_key_{};
+  std::uint32_t last_key_ = 0;  // packed_key of the last row's stream
   Stream* last_ = nullptr;
 };
 
