@@ -26,6 +26,7 @@ check bench_cpu_before_the_capture 0 "^refused, 0 capture lines$" -- sh -c "out=
 # daq bench export's generated values and the build it compares with: a clear refusal, nothing run.
 check bench_export_values 2 "^daq: error: --values: nonsense not in \{quantised,unquantised,both\}" -- "$DAQ" bench export --minutes 1 --steps 1 --dir "$TMP" --values nonsense
 check bench_export_peer_missing 2 "^daq: error: --peer-daq: File does not exist: $TMP/no-daq" -- "$DAQ" bench export --minutes 1 --steps 1 --dir "$TMP" --peer-daq "$TMP/no-daq"
+check bench_export_repeat_zero 2 "^daq: error: --repeat: '0' is not a whole number in \[1, 1000\]" -- "$DAQ" bench export --minutes 1 --steps 1 --dir "$TMP" --repeat 0
 
 # Command-line numbers: finite, plain, in range, sizes bounded.
 check cli_nan 2 "--temperature: 'nan' is not a finite decimal number" -- "$DAQ" env -t nan

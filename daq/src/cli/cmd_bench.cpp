@@ -758,6 +758,7 @@ struct ExportBenchOptions {
   std::string keep;             // the generated database, kept under this name
   std::string values = "both";  // quantised | unquantised | both (a run of each, in turn)
   std::string peer;             // another daq binary whose exports are measured alternately
+  int repeat = 1;               // rounds of each export and its ceiling
 };
 
 // Whether two files hold the same bytes.
@@ -774,18 +775,58 @@ bool same_bytes(const fs::path& a, const fs::path& b) {
   return true;
 }
 
+// One export's CPU time and its ceiling's in each round (--repeat), of one run and format by one
+// binary.
+struct ExportRounds {
+  std::string what;  // "10.0 min q csv  this"
+  std::vector<double> export_cpu_s, ceiling_cpu_s;
+};
+
+// "min 0.52 s, median 0.60 s" of CPU times.
+std::string min_and_median(const std::vector<double>& v) {
+  return fmt::format("min {:.2f} s, median {:.2f} s", *std::min_element(v.begin(), v.end()),
+                     median(v));
+}
+
+// The summary of --repeat: for each export, the least and the median CPU of it and of its
+// ceiling, and the % from each (the least ceiling against the least export: the rounds the
+// machine's noise touched least; the medians: the usual round).
+void print_repeated(const std::vector<ExportRounds>& all, int repeat) {
+  fmt::print(
+      "\nrepeated {} times (each round: the export, then its ceiling; with --peer-daq the other "
+      "binary's export and its ceiling in the same round, which of the two goes first swapped "
+      "every round); CPU:\n",
+      repeat);
+  for (const auto& e : all) {
+    const double min_export = *std::min_element(e.export_cpu_s.begin(), e.export_cpu_s.end());
+    const double min_ceiling = *std::min_element(e.ceiling_cpu_s.begin(), e.ceiling_cpu_s.end());
+    std::vector<std::string> per_round;
+    for (std::size_t i = 0; i < e.export_cpu_s.size(); ++i)
+      per_round.push_back(fmt::format("{:.0f}", 100.0 * e.ceiling_cpu_s[i] / e.export_cpu_s[i]));
+    fmt::print(
+        "  {}: export {}; ceiling {}: {:.0f} % by the mins, {:.0f} % by the medians (per round: "
+        "{} %)\n",
+        e.what, min_and_median(e.export_cpu_s), min_and_median(e.ceiling_cpu_s),
+        100.0 * min_ceiling / min_export, 100.0 * median(e.ceiling_cpu_s) / median(e.export_cpu_s),
+        fmt::join(per_round, ", "));
+  }
+}
+
 void bench_export(const ExportBenchOptions& o) {
   if (o.minutes < 1 || o.steps < 1)
     throw cal::InputError("bench export: --minutes and --steps must be at least 1");
+  if (o.repeat < 1) throw cal::InputError("bench export: --repeat must be at least 1");
   const fs::path dir = o.dir.empty() ? fs::temp_directory_path() : fs::path(o.dir);
   const auto tag = std::to_string(::getpid());
   const fs::path db =
       o.keep.empty() ? dir / ("caldaq-bench-export-" + tag + ".sqlite") : fs::path(o.keep);
   const fs::path html = dir / ("caldaq-bench-report-" + tag + ".html");
   const fs::path exported = dir / ("caldaq-bench-export-" + tag + ".out");
+  const fs::path exported_peer = dir / ("caldaq-bench-export-" + tag + ".peer");
   const fs::path scratch = dir / ("caldaq-bench-ceiling-" + tag + ".out");
-  const Cleanup cleanup(o.keep.empty() ? std::vector<fs::path>{db, html, exported, scratch}
-                                       : std::vector<fs::path>{html, exported, scratch});
+  const Cleanup cleanup(o.keep.empty()
+                            ? std::vector<fs::path>{db, html, exported, exported_peer, scratch}
+                            : std::vector<fs::path>{html, exported, exported_peer, scratch});
   if (!o.keep.empty() && fs::exists(db))
     throw cal::InputError(fmt::format(
         "bench export: --keep-db {}: the file exists; name a new one (nothing was written)",
@@ -810,9 +851,8 @@ void bench_export(const ExportBenchOptions& o) {
   fmt::print("{:>9} {:>10} {:>7}  {:>31}  {:>31}  {:>16}\n", "minutes", "readings", "MB",
              "export csv: wall, CPU, RSS, %", "export json: wall, CPU, RSS, %", "report (html)");
   std::vector<std::string> ceilings;
+  std::vector<ExportRounds> rounds;  // (--repeat)
   const std::string self = "/proc/self/exe";
-  const fs::path mine = dir / ("caldaq-bench-export-" + tag + ".this");
-  const Cleanup cleanup_mine({mine});
   bool identical = true;
   for (int k = 1; k <= o.steps; ++k)
     for (const auto values : kinds) {
@@ -827,43 +867,68 @@ void bench_export(const ExportBenchOptions& o) {
       }
       const double stored_mb = static_cast<double>(fs::file_size(db) - size_before) / 1e6;
       const auto id = std::to_string(run);
-      // Each export to a file, then its ceiling for the same bytes (both on the same load); with
-      // --peer-daq, the peer's export of the same run right after, its ceiling measured again,
-      // and its bytes compared with this binary's.
-      const auto measure = [&](const std::string& program, const char* who, const char* format) {
-        const auto r = run_program(program, {"export", id, "--db", db.string(), "--format", format,
-                                             "-o", exported.string()});
-        const auto c = export_ceiling(db, run, exported, scratch);
-        const double mb = static_cast<double>(fs::file_size(exported)) / 1e6;
+      // An export to a file, then its ceiling for the same bytes (both on the same load): the
+      // table's text, and the CPU times into `into`.
+      const auto measure = [&](const std::string& program, const char* who, const char* format,
+                               const fs::path& out, int round, ExportRounds& into) {
+        const auto r = run_program(
+            program, {"export", id, "--db", db.string(), "--format", format, "-o", out.string()});
+        const auto c = export_ceiling(db, run, out, scratch);
+        const double mb = static_cast<double>(fs::file_size(out)) / 1e6;
+        const double ceiling_cpu_s = c.read_cpu_s + c.write_cpu_s;
+        into.export_cpu_s.push_back(r.cpu_s);
+        into.ceiling_cpu_s.push_back(ceiling_cpu_s);
         ceilings.push_back(fmt::format(
-            "  {:5.1f} min {} {:4} {}: {:6.0f} MB written; store read {:.2f} s (CPU {:.2f} s), "
+            "  {:5.1f} min {} {:4} {}{}: {:6.0f} MB written; store read {:.2f} s (CPU {:.2f} s), "
             "writing the same bytes {:.2f} s (CPU {:.2f} s): export at {:.0f} % of that ceiling by "
             "CPU, {:.0f} % by wall time",
-            seconds / 60.0, tag_values, format, who, mb, c.read_s, c.read_cpu_s, c.write_s,
-            c.write_cpu_s, 100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s,
+            seconds / 60.0, tag_values, format, who,
+            o.repeat > 1 ? fmt::format(" round {}", round) : std::string(), mb, c.read_s,
+            c.read_cpu_s, c.write_s, c.write_cpu_s, 100.0 * ceiling_cpu_s / r.cpu_s,
             100.0 * (c.read_s + c.write_s) / r.seconds));
         return fmt::format("{:6.2f} s {:6.2f} s {:4.0f} MB {:3.0f} %", r.seconds, r.cpu_s,
                            static_cast<double>(r.peak_rss_kib) / 1024,
-                           100.0 * (c.read_cpu_s + c.write_cpu_s) / r.cpu_s);
+                           100.0 * ceiling_cpu_s / r.cpu_s);
       };
-      const auto with_peer = [&](const char* format) {
-        std::string text = measure(self, "this", format);
-        if (o.peer.empty()) return std::pair{text, std::string()};
-        fs::rename(exported, mine);
-        std::string peer = measure(o.peer, "peer", format);
-        peer += same_bytes(mine, exported) ? "" : " DIFFERENT BYTES";
-        identical = identical && same_bytes(mine, exported);
-        return std::pair{text, peer};
-      };
-      const auto csv = with_peer("csv");
-      const auto json = with_peer("json");
+      // Each format --repeat times, this binary's export and (--peer-daq) the peer's of the same
+      // run in each round, in turn first; their bytes compared. The table shows the first round.
+      std::pair<std::string, std::string> text[2];
+      const char* const formats[2] = {"csv", "json"};
+      ExportRounds mine[2], peers[2];
+      for (int f = 0; f < 2; ++f) {
+        const auto what =
+            fmt::format("{:5.1f} min {} {:4}", seconds / 60.0, tag_values, formats[f]);
+        mine[f].what = what + " this";
+        peers[f].what = what + " peer";
+      }
+      for (int round = 1; round <= o.repeat; ++round)
+        for (int f = 0; f < 2; ++f) {
+          const bool peer_first = !o.peer.empty() && round % 2 == 0;
+          std::string this_text, peer_text;
+          if (peer_first)
+            peer_text = measure(o.peer, "peer", formats[f], exported_peer, round, peers[f]);
+          this_text = measure(self, "this", formats[f], exported, round, mine[f]);
+          if (!o.peer.empty() && !peer_first)
+            peer_text = measure(o.peer, "peer", formats[f], exported_peer, round, peers[f]);
+          if (!o.peer.empty()) {
+            const bool same = same_bytes(exported, exported_peer);
+            peer_text += same ? "" : " DIFFERENT BYTES";
+            identical = identical && same;
+          }
+          if (round == 1) text[f] = {this_text, peer_text};
+        }
+      for (int f = 0; f < 2; ++f) {
+        rounds.push_back(mine[f]);
+        if (!o.peer.empty()) rounds.push_back(peers[f]);
+      }
       const auto report =
           run_program(self, {"report", id, "--db", db.string(), "-o", html.string()});
       fmt::print("{:>7.1f} {} {:>10} {:>7.1f}  {:>31}  {:>31}  {:6.2f} s {:4.0f} MB\n",
-                 seconds / 60.0, tag_values, count, stored_mb, csv.first, json.first,
+                 seconds / 60.0, tag_values, count, stored_mb, text[0].first, text[1].first,
                  report.seconds, static_cast<double>(report.peak_rss_kib) / 1024);
       if (!o.peer.empty())
-        fmt::print("{:>9} {:>10} {:>7}  {:>31}  {:>31}\n", "peer", "", "", csv.second, json.second);
+        fmt::print("{:>9} {:>10} {:>7}  {:>31}  {:>31}\n", "peer", "", "", text[0].second,
+                   text[1].second);
     }
   if (!o.peer.empty())
     fmt::print("peer: {}; its exports {} this binary's, byte for byte\n", o.peer,
@@ -873,6 +938,7 @@ void bench_export(const ExportBenchOptions& o) {
       "its ceiling's, measured beside it: reading the run from the store and writing the same "
       "number of bytes)\n{}\n",
       fmt::join(ceilings, "\n"));
+  if (o.repeat > 1) print_repeated(rounds, o.repeat);
 }
 
 struct SyncBenchOptions {
@@ -989,6 +1055,12 @@ void add_bench_commands(CLI::App& app) {
                  "Also measure this daq binary's exports of the same runs, each right after this "
                  "one's with its own ceiling, and compare their bytes (a build to compare with)")
       ->check(CLI::ExistingFile);
+  ex->add_option("--repeat", e->repeat,
+                 "Rounds of each export and its ceiling (with --peer-daq, the peer's in the same "
+                 "round); more than 1 adds the least and the median CPU of each and the % from "
+                 "them")
+      ->check(whole_in(1, 1000))
+      ->capture_default_str();
 
   add_bench_replay_command(*bench);
 

@@ -39,6 +39,7 @@
 #include "run_document.hpp"
 #include "run_quality.hpp"
 #include "run_version.hpp"
+#include "running_decimal.hpp"
 #include "shortest_number.hpp"
 #include "stored_profile.hpp"
 #include "terminal.hpp"
@@ -446,21 +447,27 @@ std::optional<std::string> stop_value_column(const st::RunRecord& run, const jso
   return "value_" + unit;
 }
 
-// The fields between a reading's UTC time and its status, the same for every reading of one
-// stream (device, device name, channel, quantity), as write_reading_fields writes them: made
-// once per stream, so a row copies them (formatting them per row was an eighth of an export,
-// issue 32). Looked up when the stream changes from the row before (a handful a second).
+// What a row copies or continues from the stream's row before it (device, channel, quantity):
+// the fields between its UTC time and its status (device, device name, channel, quantity), as
+// write_reading_fields writes them, made once per stream (formatting them per row was an
+// eighth of an export, issue 32); and the digits of its last `time_ns` and `time_s`, which the
+// next row's times continue by a decimal add (RunningDecimal: most rows are one period on).
+// Looked up when the stream changes from the row before (a handful a second).
 template <bool Json>
 class StreamFields {
  public:
+  struct Stream {
+    std::string padded;  // the fields, then 16 bytes of no meaning
+    std::size_t size = 0;
+    RunningDecimal time_ns;   // the last row's stored time
+    RunningDecimal since_ns;  // the last row's nanoseconds since the run's start (time_s)
+    RunningReading value;     // the last row's value
+  };
   explicit StreamFields(const DeviceNames& names) : names_(names) {}
-  // Writes r's stream's fields at p and returns their end: in 16-byte pieces from a text padded
-  // for them (up to 15 bytes of no meaning after the end), no library call per row (memcpy of a
-  // varying length was 2 - 3 % of an export, issue 32).
-  char* write(char* p, const st::RawReading& r) {
-    const StreamKey key = key_of(r);
-    if (last_ == nullptr || last_key_ != key) {
-      auto [at, added] = text_.try_emplace(key);
+  // r's stream, made if it is new.
+  Stream& of(const st::RawReading& r) {
+    if (last_ == nullptr || last_key_ != packed_key(r)) {
+      auto [at, added] = streams_.try_emplace(key_of(r));
       if (added) {
         const auto quantity =
             cal::drivers::to_string(static_cast<cal::drivers::Quantity>(r.quantity));
@@ -471,23 +478,25 @@ class StreamFields {
         at->second.size = at->second.padded.size();
         at->second.padded.resize(at->second.size + 16);
       }
-      last_key_ = key;
+      last_key_ = packed_key(r);
       last_ = &at->second;
     }
-    const char* text = last_->padded.data();
-    for (std::size_t i = 0; i < last_->size; i += 16) std::memcpy(p + i, text + i, 16);
-    return p + last_->size;
+    return *last_;
+  }
+  // Writes the stream's fields at p and returns their end: in 16-byte pieces from a text padded
+  // for them (up to 15 bytes of no meaning after the end), no library call per row (memcpy of a
+  // varying length was 2 - 3 % of an export, issue 32).
+  static char* write(char* p, const Stream& s) {
+    const char* text = s.padded.data();
+    for (std::size_t i = 0; i < s.size; i += 16) std::memcpy(p + i, text + i, 16);
+    return p + s.size;
   }
 
  private:
-  struct Text {
-    std::string padded;  // the fields, then 16 bytes of no meaning
-    std::size_t size = 0;
-  };
   const DeviceNames& names_;
-  std::map<StreamKey, Text> text_;
-  StreamKey last_key_{};
-  const Text* last_ = nullptr;
+  std::map<StreamKey, Stream> streams_;
+  std::uint32_t last_key_ = 0;  // packed_key of the last row's stream
+  Stream* last_ = nullptr;
 };
 
 // A small unsigned integer (a status) as fmt's "{}" writes it.
@@ -510,31 +519,39 @@ char* write_reading_fields(char* p, const ExportClock& clock, StreamFields<Json>
     if (!Json || std::isfinite(v)) return write_shortest(q, v);
     return std::copy_n("null", 4, q);
   };
+  auto& stream = fields.of(x.r);
   // The time in seconds: its nanoseconds / 10^9, correctly rounded, in the shortest form (as
   // clock.seconds(), fmt's "{}"). A reading's own time (most rows: whole nanoseconds) is the
-  // exact decimal of its integer, written from the integer's digits (write_seconds_of_ns); a
-  // time spread inside a group (fractional nanoseconds) goes through the digit search.
+  // exact decimal of its integer: the stream's last one's digits with the step added
+  // (RunningDecimal), or written from the integer's digits (write_seconds_of_ns) where those
+  // cannot be continued; a time spread inside a group (fractional nanoseconds) goes through
+  // the digit search.
   const double since_ns = clock.since_origin_ns(x.session_ns);
   const auto whole_ns = std::abs(since_ns) < 0x1p62 ? static_cast<std::int64_t>(since_ns) : 0;
-  if (static_cast<double>(whole_ns) == since_ns)
-    p = write_seconds_of_ns(p, whole_ns);
-  else
+  if (static_cast<double>(whole_ns) != since_ns)
     p = number(p, clock.seconds(x.session_ns));  // the same division, in its one place
+  else if (char* end = stream.since_ns.set(whole_ns) ? stream.since_ns.write_decimal(p) : nullptr)
+    p = end;
+  else
+    p = write_seconds_of_ns(p, whole_ns);
   p = Json ? std::copy_n(",\"", 2, p) : std::copy_n(",", 1, p);
   if (clock.has_utc()) {  // (a run without a time origin leaves it empty: no call per row)
     const auto utc = clock.utc_view(x.session_ns);
     p = std::copy(utc.begin(), utc.end(), p);
   }
-  p = fields.write(p, x.r);
+  p = StreamFields<Json>::write(p, stream);
   p = write_small(p, x.r.status);
   *p++ = ',';
   // The reading as its instrument gave it (a gauge's printed digits, an interferometer's
   // picometres, in SI): where it is its decimal's own double, written without the digit search
-  // (write_shortest_quantised); the same text either way.
-  p = !Json || std::isfinite(x.r.value) ? write_shortest_quantised(p, x.r.value)
+  // (write_shortest_quantised), and from the stream's last reading's digits where it is near
+  // it (RunningReading); the same text every way.
+  p = !Json || std::isfinite(x.r.value) ? stream.value.write(p, x.r.value)
                                         : std::copy_n("null", 4, p);
   *p++ = ',';
-  return write_integer(p, x.r.time_ns);
+  // The stored time's integer: the stream's last one continued where it can be (as time_s).
+  return stream.time_ns.set(x.r.time_ns) ? stream.time_ns.write_integer(p)
+                                         : write_integer(p, x.r.time_ns);
 }
 
 void export_readings_csv(const st::RunReader& store, const st::RunRecord& run, const json& settings,

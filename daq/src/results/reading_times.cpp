@@ -87,9 +87,10 @@ void ExportRows::find_stream(const st::RawReading& r) {
   const StreamKey key = key_of(r);
   const auto it = std::lower_bound(pending_.begin(), pending_.end(), key,
                                    [](const Pending& e, const StreamKey& k) { return e.key < k; });
-  const auto at = it == pending_.end() || it->key != key
-                      ? pending_.insert(it, Pending{key, &clock_.stream(key), {}, {}})
-                      : it;
+  const auto at =
+      it == pending_.end() || it->key != key
+          ? pending_.insert(it, Pending{key, packed_key(r), &clock_.stream(key), {}, {}})
+          : it;
   last_ = static_cast<std::size_t>(at - pending_.begin());  // after the insertion
 }
 

@@ -27,6 +27,11 @@ using StreamKey = std::tuple<std::uint16_t, std::uint8_t, std::uint8_t>;  // dev
 inline StreamKey key_of(const cal::storage::RawReading& r) {
   return {r.device, r.channel, r.quantity};
 }
+// The same three numbers in one word, for telling a reading's stream from the last one's with
+// one comparison (the tuple's three were about 15 instructions a row of an export, issue 32).
+inline std::uint32_t packed_key(const cal::storage::RawReading& r) {
+  return r.device | (std::uint32_t{r.channel} << 16) | (std::uint32_t{r.quantity} << 24);
+}
 
 class ExportClock {
  public:
@@ -112,7 +117,7 @@ class ExportRows {
       pending_[last_].group.push_back(one_);
       pending_[last_].tags.push_back(one_tag_);
     }
-    if (last_ >= pending_.size() || pending_[last_].key != key_of(r)) find_stream(r);
+    if (last_ >= pending_.size() || pending_[last_].packed != packed_key(r)) find_stream(r);
     if (held_ == 0) {  // most readings: held apart, no vector pushed and cleared for it
       one_ = r;
       one_tag_ = tag;
@@ -138,7 +143,7 @@ class ExportRows {
         continue;
       }
       if (held_ != 0) flush_each(emit);  // the readings of an earlier time
-      if (last_ >= pending_.size() || pending_[last_].key != key_of(r)) find_stream(r);
+      if (last_ >= pending_.size() || pending_[last_].packed != packed_key(r)) find_stream(r);
       emit(ExportRow{r, ExportClock::spread_one(*pending_[last_].stream, r.time_ns), 0});
     }
   }
@@ -159,6 +164,7 @@ class ExportRows {
  private:
   struct Pending {
     StreamKey key;
+    std::uint32_t packed;  // packed_key of its readings
     ExportClock::Stream* stream;
     std::vector<cal::storage::RawReading> group;
     std::vector<std::uint64_t> tags;
