@@ -1456,7 +1456,9 @@ Result analyse(const Setup& setup, std::span<const TraceSource> traces,
   double period_mm = setup.cyclic_period_mm.value_or(10.0);
   std::optional<Design> fitted;
   if (m.on[cyclic_first] && !setup.cyclic_period_mm) {
-    const Brackets brackets = search_grid(m, samples, setup);
+    Brackets brackets = search_grid(m, samples, setup);
+    if (refinement == PeriodRefinement::one_pass_series_from_an_edge)
+      brackets.narrow = {brackets.grid.lo, brackets.grid.lo + 100 * Brackets::refine_tol};
     period_mm = std::exp((brackets.narrow.lo + brackets.narrow.hi) / 2);
     if (refinement == PeriodRefinement::pass_per_trial) {
       fitted.emplace(m, samples, 1, period_mm, nullptr, add_circle);

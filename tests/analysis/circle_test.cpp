@@ -1135,4 +1135,37 @@ TEST(CircleDiagnostics, OnePassPeriodSearchEqualsThePassPerTrialSearchAndTheTrut
   EXPECT_LT(worst_um, 1e-7);         // 3.3e-8 measured
 }
 
+// The refinement's fallback: a minimum found on the narrow bracket's edge is refined again over
+// the grid's bracket (one more pass over the samples with the wider series). Forced here by a
+// narrow bracket 1e-5 wide at the grid's low edge, which the true period (12 mm, 37 mm) lies
+// well outside of (the grid's half width is 1.5 - 4.6 % of p, so its low edge is that far below
+// the period): without the fallback the period found would be the edge, 1.5 % or more off.
+TEST(CircleDiagnostics, AMinimumOnTheNarrowBracketsEdgeIsRefinedOverTheGridsBracket) {
+  const Machine machines[] = {{.cyclic_u = 2.0, .cyclic_period_mm = 12.0},
+                              {.cu = 3,
+                               .square_um_per_m = -30,
+                               .backlash_u = 6,
+                               .cyclic_v = 1.2,
+                               .cyclic_period_mm = 37.0,
+                               .noise = 0.2}};
+  for (const auto& m : machines) {
+    SCOPED_TRACE(m.cyclic_period_mm);
+    const Trace t[] = {simulate(m, Direction::ccw, 3600, 1), simulate(m, Direction::cw, 3600, 2)};
+    const cal::circle::Setup setup{.radius_mm = R, .feed_mm_per_min = feed};
+    const Result edge = analyse(setup, t, fit_records_held_max_samples,
+                                PeriodRefinement::one_pass_series_from_an_edge);
+    const Result per =
+        analyse(setup, t, fit_records_held_max_samples, PeriodRefinement::pass_per_trial);
+    ASSERT_TRUE(edge.cyclic_period_mm && per.cyclic_period_mm);
+    EXPECT_NEAR(*edge.cyclic_period_mm, m.cyclic_period_mm, 0.002 * m.cyclic_period_mm);
+    // The same minimum as the pass per trial's (to the refinement's tolerance, 1e-7 in log p).
+    EXPECT_NEAR(*edge.cyclic_period_mm, *per.cyclic_period_mm, 1e-6 * m.cyclic_period_mm);
+    const auto v = values(edge);
+    const char* key = m.cyclic_u > 0 ? "cyclic_X" : "cyclic_Y";
+    ASSERT_TRUE(v.count(key));
+    const double truth = m.cyclic_u > 0 ? m.cyclic_u : m.cyclic_v;
+    EXPECT_NEAR(v.at(key), truth, 0.05 * truth + 0.02);
+  }
+}
+
 }  // namespace
