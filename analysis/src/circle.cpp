@@ -858,6 +858,9 @@ double narrowed_half_width(F rss, double x1, double step, double rows) {
   const double a = (fp + fm - 2 * f1) / (2 * h * h);
   const double var = f1 / std::max(1.0, rows - static_cast<double>(term_count));
   if (!(a > 0) || !(var > 0) || !std::isfinite(a)) return step;
+  // (std::clamp needs its low bound under its high: a grid step below 100 tolerances, from a
+  // small p_min on a large radius or a narrow search range, keeps the grid's bracket.)
+  if (!(step > 100 * Brackets::refine_tol)) return step;
   return std::clamp(16 * std::sqrt(var / a), 100 * Brackets::refine_tol, step);
 }
 

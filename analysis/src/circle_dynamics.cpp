@@ -80,6 +80,16 @@ struct Timed {
 class StepMedian {
  public:
   static constexpr std::size_t max_distinct = 4096;
+  StepMedian() = default;
+  // Not copied or assigned: last_ points into this object's own map (a copy's would point into
+  // the source's, and a temporary's after it is gone).
+  StepMedian(const StepMedian&) = delete;
+  StepMedian& operator=(const StepMedian&) = delete;
+  void clear() {
+    counts_.clear();
+    last_ = counts_.end();
+    count_ = 0;
+  }
   void add(double d) {
     if (!(d > 0) || overflowed()) return;
     // The step of the last sample counted again without a search of the map (a trace from time
@@ -140,7 +150,7 @@ Timed timed(const TraceResidual& t, double w) {
     std::stable_sort(out.sorted.begin(), out.sorted.end(), before);
     out.first = t.s * t.theta_rad(out.order(0));
     out.duration_s = out.time_s(out.order(n - 1));
-    steps = StepMedian();
+    steps.clear();
     for (std::size_t i = 1; i < n && !steps.overflowed(); ++i) steps.add(step(i));
   }
   if (!steps.overflowed()) {

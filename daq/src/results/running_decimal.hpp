@@ -26,7 +26,8 @@ inline constexpr bool kRunningDecimalFast = std::endian::native == std::endian::
 
 class RunningDecimal {
  public:
-  // `decimals` (8 - 22): where write_decimal places the point (9: nanoseconds as seconds).
+  // `decimals` (8 - 15: pow10 of more overflows, and the callers learn at most 15): where
+  // write_decimal places the point (9: nanoseconds as seconds).
   explicit RunningDecimal(int decimals = 9) : decimals_(decimals) {}
   int decimals() const { return decimals_; }
   // Places the point elsewhere from the next value on (the digits are made from scratch).
@@ -167,7 +168,7 @@ class RunningDecimal {
     fixed_ = v > 0 && high_decimals >= 0 && size_ - 1 - decimals_ >= -4 && size_ <= 15 &&
              head_size_ <= 8;
     if (!fixed_) return;
-    char head[16];
+    char head[16]{};  // zeroed: head_ takes 8 bytes of it whatever head_size_ is
     char* h = head;
     if (negative) *h++ = '-';
     shortest_detail::write_last(h, static_cast<std::uint32_t>(whole), whole_size);

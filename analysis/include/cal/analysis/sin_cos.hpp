@@ -2,9 +2,11 @@
 // sin x and cos x together, without the library call, for the circle analysis' per-sample
 // angles and phases (issue 32: glibc's sincos, with its rounding-mode save and restore and its
 // slow-path checks, was 10 - 14 % of a long ballbar replay at five or six calls a sample).
-// Within 0.8 ulp of the exact values (measured against long double on 10^7 arguments in each of
-// three ranges: tests/analysis/angle_reduce_test.cpp, SinCos.*), where glibc's are within
-// 0.52: so about one value in 30 differs from glibc's, by one ulp. Branch-free for
+// Within 0.8 ulp of the exact values on 10^7 random arguments in each of three ranges and at
+// the quadrants' edges for |n| <= 400 (against long double: tests/analysis/circle_kernels_test.cpp,
+// SinCos.*), where glibc's are within 0.52: so about one value in 30 differs from glibc's, by one
+// ulp. Where the value is near 0 (x next to a multiple of pi / 2 far out) it is within 1.1 ulp:
+// 1.06 at x = 0x1.93c05c9ed3cbcp+18, the worst of the doubles nearest n pi / 2 for n < 2^19. Branch-free for
 // |x| < 2^19 pi / 2 (the analysis' angles are a few turns and its phases k c at most 2 pi R /
 // p_min); elsewhere glibc's sincos.
 //
