@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <thread>
 
 #include "cal/analysis/enum_names.hpp"
 #include "store_impl.hpp"
@@ -370,14 +371,39 @@ void Store::Impl::open_read_write(const StoreOptions& options) {
   if (rc != SQLITE_OK) fail("cannot open");
   sqlite3_busy_timeout(raw, 5000);  // a reader (daq runs) and the writer share the file
   check_caldaq_database();          // before anything is written to it
-  exec("PRAGMA journal_mode=WAL", "set WAL mode");
+  // WAL is kept in the file: set by whichever command opens a new store first. Setting it needs
+  // the file to itself, and SQLite does not wait for that through the busy timeout (no busy
+  // handler for that lock: it could deadlock), so two commands opening one new store at once
+  // (the demo writing it while another reads) failed with "database is locked". It is tried
+  // again every 10 ms for up to the busy timeout's 5 s.
+  for (int tries = 0;; ++tries) {
+    const int wal = sqlite3_exec(raw, "PRAGMA journal_mode=WAL", nullptr, nullptr, nullptr);
+    if (wal == SQLITE_OK) break;
+    if (((wal & 0xff) != SQLITE_BUSY && (wal & 0xff) != SQLITE_LOCKED) || tries == 500)
+      fail("set WAL mode");
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   exec(options.full_sync ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL",
        "set synchronous");
   exec("PRAGMA foreign_keys=ON", "enable foreign keys");
   if (options.max_pages > 0)
     exec(fmt::format("PRAGMA max_page_count={}", options.max_pages).c_str(), "set max pages");
-  for (int v = version; v < schema_version; ++v) {
-    Transaction tx(*this);
+  while (version < schema_version) {
+    Transaction tx(*this);  // BEGIN IMMEDIATE: the write lock before the version is read again
+    // Another process may have migrated while this one waited for the lock (two commands
+    // opening a new store at once: the second's migration 0 -> 1 failed with "table machines
+    // already exists"): the version read under the lock decides.
+    const int now =
+        static_cast<int>(query_int(*this, "PRAGMA user_version", "read schema version"));
+    if (now > schema_version)
+      throw StoreError(fmt::format(
+          "{}: schema version {} is newer than this daq understands ({}); use a newer daq",
+          path.string(), now, schema_version));
+    if (now != version) {
+      version = now;  // migrated by the other: nothing of this transaction to keep
+      continue;
+    }
+    const int v = version;
     exec(kMigrations[v], fmt::format("migrate schema {} -> {}", v, v + 1).c_str());
     exec(fmt::format("PRAGMA user_version={}", v + 1).c_str(), "set schema version");
     tx.commit();

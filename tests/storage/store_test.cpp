@@ -3,6 +3,7 @@
 // incomplete, and bad files and a full disk give errors that name the file.
 #include "cal/storage/store.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sqlite3.h>
@@ -10,11 +11,13 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <set>
+#include <vector>
 
 #include "../support/temp_dir.hpp"
 #include "cal/storage/chunk.hpp"
@@ -140,6 +143,48 @@ TEST(Store, RunLifeCycleAndBitExactReadings) {
   EXPECT_EQ(store.targets(run).at(1).deviation_um, -2.25);
   EXPECT_EQ(store.results(run).at(0).standard, "ISO 230-2:2014");
   EXPECT_THROW(store.finish_run(run + 100, RunStatus::complete), StoreError);
+}
+
+// Commands opening a new store at the same moment (the demo writing it while a test or `daq
+// runs` peeks at it): every one opens it. Each waits on the others' write lock and reads the
+// schema version again under it; before, the second to get the lock ran migration 0 -> 1 on the
+// migrated file and failed with "table machines already exists". Four processes released
+// together on each of 12 new files.
+TEST(Store, CommandsOpeningANewStoreAtOnceAllOpenIt) {
+  TempDir dir;
+  for (int round = 0; round < 12; ++round) {
+    const auto file = dir.path / fmt::format("new-{}.sqlite", round);
+    int go[2];
+    ASSERT_EQ(::pipe(go), 0);
+    std::vector<pid_t> children;
+    for (int k = 0; k < 4; ++k) {
+      const pid_t child = ::fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        ::close(go[1]);
+        char c = 0;
+        if (::read(go[0], &c, 1) != 0) ::_exit(3);  // released when the parent closes its end
+        try {
+          Store store(file);
+          (void)store.runs();
+          ::_exit(0);
+        } catch (const StoreError& e) {
+          std::fprintf(stderr, "round %d, process %d: %s\n", round, k, e.what());
+          ::_exit(1);
+        }
+      }
+      children.push_back(child);
+    }
+    ::close(go[0]);
+    ::close(go[1]);
+    for (const pid_t child : children) {
+      int status = 0;
+      ::waitpid(child, &status, 0);
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "round " << round;
+    }
+    Store after(file);
+    EXPECT_TRUE(after.runs().empty());
+  }
 }
 
 // The child writes batches of 1000 readings and tells the parent after each commit; the
