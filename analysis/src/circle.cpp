@@ -68,10 +68,10 @@ constexpr std::size_t min_samples = 20;
 
 double sgn(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; }
 
-// cos x and sin x in one call, without the library's (sin_cos.hpp: within 0.8 ulp, where
-// glibc's are within 0.52; its sincos was 10 - 14 % of a long run's replay at five or six calls
-// a sample: issue 32). Every sine and cosine of the fit's passes is this one's, so a record
-// rebuilt is the record held, bit for bit.
+// cos x and sin x in one call, without the library's (sin_cos.hpp: within 0.8 ulp, 1.1 where
+// the value is near 0, where glibc's are within 0.52; its sincos was 10 - 14 % of a long run's
+// replay at five or six calls a sample: issue 32). Every sine and cosine of the fit's passes is
+// this one's, so a record rebuilt is the record held, bit for bit.
 std::pair<double, double> cos_sin(double x) {
   const SinCos sc = sin_cos(x);
   return {sc.c, sc.s};
@@ -853,14 +853,15 @@ struct Brackets {
 // 100 times the refinement's tolerance; none (the grid's bracket) without a clear minimum.
 template <class F>
 double narrowed_half_width(F rss, double x1, double step, double rows) {
+  // A grid step below 100 tolerances (a small p_min on a large radius, or a narrow search
+  // range) keeps the grid's bracket: nothing to narrow, and std::clamp below needs its low bound
+  // under its high. Checked first, before the three trials of the curvature.
+  if (!(step > 100 * Brackets::refine_tol)) return step;
   const double h = step / 4;
   const double f1 = rss(x1), fp = rss(x1 + h), fm = rss(x1 - h);
   const double a = (fp + fm - 2 * f1) / (2 * h * h);
   const double var = f1 / std::max(1.0, rows - static_cast<double>(term_count));
   if (!(a > 0) || !(var > 0) || !std::isfinite(a)) return step;
-  // (std::clamp needs its low bound under its high: a grid step below 100 tolerances, from a
-  // small p_min on a large radius or a narrow search range, keeps the grid's bracket.)
-  if (!(step > 100 * Brackets::refine_tol)) return step;
   return std::clamp(16 * std::sqrt(var / a), 100 * Brackets::refine_tol, step);
 }
 
