@@ -88,6 +88,59 @@ void BM_BallbarDiagnosticsPeriodSearchRebuilt_2x36000(benchmark::State& state) {
 }
 BENCHMARK(BM_BallbarDiagnosticsPeriodSearchRebuilt_2x36000)->Unit(benchmark::kMillisecond);
 
+// A run in which the vibration diagnostic finds a vibration: the traces above (at n samples
+// over 360 degrees in 36 s, R = 100 mm at 1047 mm/min: 1 kHz for n = 36,000, 10 kHz for
+// 360,000, whose spectrum is then averaged over Welch segments and the lines fitted in two
+// pieces a trace) with 1 um (peak) at 123.4 Hz along X added: the bar reads
+// 1 um sin(2 pi 123.4 t) cos(theta), rms 0.5 um in the lines 123.4 -+ f0 (docs/circle.md). The
+// time is the angle's: t = |theta| / w, as the analysis reads it. Issue 32's other cases have no
+// vibration, so they never paid for its line fit (docs/benchmarks.md, eleventh pass).
+constexpr double vibration_hz = 123.4, vibration_um = 1.0;
+std::vector<Trace> vibrating_traces(int n) {
+  auto out = traces(n);
+  const double w = 1047.0 / 60.0 / 100.0;  // rad/s
+  for (auto& t : out)
+    for (std::size_t i = 0; i < t.angle_deg.size(); ++i) {
+      const double th = t.angle_deg[i] * std::numbers::pi / 180, t_s = std::abs(th) / w;
+      t.deviation_um[i] +=
+          vibration_um * std::sin(2 * std::numbers::pi * vibration_hz * t_s) * std::cos(th);
+    }
+  return out;
+}
+
+void vibration_case(benchmark::State& state, int n) {
+  const auto t = vibrating_traces(n);
+  const Setup setup{.radius_mm = 100, .feed_mm_per_min = 1047, .cyclic_period_mm = 10.0};
+  double found_hz = 0, found_um = 0;
+  for (auto _ : state) {
+    const auto r = analyse(setup, t);
+    for (const auto& d : r.diagnostics)
+      if (d.key == "vibration") found_hz = d.frequency_hz.value_or(0), found_um = d.value;
+    benchmark::DoNotOptimize(r);
+  }
+  // What it found, beside the injection (123.4 Hz, 0.5 um rms): the case measures the search
+  // it means to.
+  state.counters["vibration_hz"] = found_hz;
+  state.counters["vibration_um"] = found_um;
+  state.SetItemsProcessed(state.iterations() * 2 * n);
+}
+void BM_BallbarDiagnosticsVibration_2x36000(benchmark::State& state) {
+  vibration_case(state, 36'000);
+}
+BENCHMARK(BM_BallbarDiagnosticsVibration_2x36000)->Unit(benchmark::kMillisecond);
+void BM_BallbarDiagnosticsVibration_2x360000(benchmark::State& state) {
+  vibration_case(state, 360'000);
+}
+BENCHMARK(BM_BallbarDiagnosticsVibration_2x360000)->Unit(benchmark::kMillisecond);
+// The same 10 kHz traces without the vibration: what the search adds.
+void BM_BallbarDiagnostics_2x360000(benchmark::State& state) {
+  const auto t = traces(360'000);
+  const Setup setup{.radius_mm = 100, .feed_mm_per_min = 1047, .cyclic_period_mm = 10.0};
+  for (auto _ : state) benchmark::DoNotOptimize(analyse(setup, t));
+  state.SetItemsProcessed(state.iterations() * 720'000);
+}
+BENCHMARK(BM_BallbarDiagnostics_2x360000)->Unit(benchmark::kMillisecond);
+
 // The floor of any fit of this model: one pass over the samples, each angle's cos and sin
 // and the deviation summed against them (the least a fit must do with every sample once).
 void BM_BallbarOnePassFloor_2x36000(benchmark::State& state) {
