@@ -48,6 +48,7 @@
 
 #include "cal/analysis/angle_reduce.hpp"
 #include "cal/analysis/even_resample.hpp"
+#include "cal/analysis/line_trials.hpp"
 #include "cal/analysis/moving_median.hpp"
 #include "cal/analysis/power_spectrum.hpp"
 
@@ -246,9 +247,12 @@ BandTest band_test(const std::vector<double>& p, std::size_t lo, std::size_t hi,
 // Sines and cosines at f - f0, f, f + f0 fitted per trace, or per segment of a trace cut for
 // the spectrum (its own amplitudes and phases in each, the frequency common: the fit's
 // resolution is then that of the spectrum, and it holds 48 numbers a segment, nothing a
-// sample): the explained sum of squares, and (when asked) the fitted contribution in each
-// trace's order and the fitted power of each of the three lines, summed over the traces. The
-// lines at f -+ f0 come from the line at f and the rotation by f0 (angle sums).
+// sample): the explained sum of squares of several trial frequencies from one pass over the
+// samples (cal::LineTrials: three sin_cos a sample whatever the number of trials; a pass a
+// trial, each with four library sines and cosines a sample, made a run with a vibration cost
+// 15x one without, issue 32), the normal equations of the best kept; and the fitted
+// contribution in each trace's order and the fitted power of each of the three lines, summed
+// over the traces, at the frequency found.
 struct LineFit {
   const std::vector<TraceResidual>& traces;
   const std::vector<Timed>& tms;
@@ -257,51 +261,84 @@ struct LineFit {
   double segment_s = 0.0;             // the fit's segments' duration (segments > 1)
   PageOptions pages;                  // of the contributions
 
-  std::size_t segment(std::size_t i, std::size_t j) const {
+  using Row = Eigen::Matrix<double, 6, 1>;
+  using Gram6 = Eigen::Matrix<double, 6, 6>;
+  struct Normal {  // one piece's normal equations
+    Gram6 ata;
+    Row aty;
+  };
+  // The best trial so far: its frequency, explained sum of squares and normal equations (per
+  // trace, per piece).
+  struct Best {
+    double f_hz = 0.0, explained = -1.0;
+    std::vector<std::vector<Normal>> normal;
+  };
+
+  std::size_t segment(std::size_t i, double t_s) const {
     if (segments[i] == 1) return 0;
-    const auto k = static_cast<std::size_t>(std::max(0.0, tms[i].time_s(j) / segment_s));
+    const auto k = static_cast<std::size_t>(std::max(0.0, t_s / segment_s));
     return std::min(segments[i] - 1, k);
   }
 
-  using Row = Eigen::Matrix<double, 6, 1>;
-  Row row(std::size_t i, std::size_t j, double f_hz) const {
-    const double ts = tms[i].time_s(j), ph = 2 * pi * f_hz * ts, ph0 = 2 * pi * f0_hz * ts;
-    const double sa = std::sin(ph), ca = std::cos(ph), sb = std::sin(ph0), cb = std::cos(ph0);
-    Row r;
-    r << sa * cb - ca * sb, ca * cb + sa * sb, sa, ca, sa * cb + ca * sb, ca * cb - sa * sb;
-    return r;
+  // One piece's solution and the sum of squares it explains.
+  static Row solve(const Normal& n, double& explained) {
+    const Row x = n.ata.ldlt().solve(n.aty);
+    explained += x.dot(n.aty);
+    return x;
   }
 
-  double operator()(double f_hz, std::vector<PagedDoubles>* contribution = nullptr,
-                    std::array<double, 3>* line_power = nullptr) const {
-    using Gram6 = Eigen::Matrix<double, 6, 6>;
-    double explained = 0.0;
+  // The trials centre + k step, k = -reach .. reach (0 only if `centre`), in one pass; `best`
+  // takes the first (k rising) that explains more than it.
+  void trials(double centre_hz, double step_hz, int reach, bool centre, Best& best) const {
+    std::vector<LineTrials> sums;
     for (std::size_t i = 0; i < traces.size(); ++i) {
+      sums.emplace_back(f0_hz, centre_hz, step_hz, reach, centre, segments[i]);
       const auto& y = traces[i].r_um;
-      std::vector<Gram6> ata(segments[i], Gram6::Zero());
-      std::vector<Row> aty(segments[i], Row::Zero()), x(segments[i]);
       for (std::size_t j = 0; j < y.size(); ++j) {
-        const Row r = row(i, j, f_hz);
-        const std::size_t g = segment(i, j);
-        ata[g].selfadjointView<Eigen::Lower>().rankUpdate(r);
-        aty[g] += r * y[j];
-      }
-      for (std::size_t g = 0; g < segments[i]; ++g) {
-        ata[g].triangularView<Eigen::StrictlyUpper>() = ata[g].transpose();
-        x[g] = ata[g].ldlt().solve(aty[g]);
-        explained += x[g].dot(aty[g]);
-        if (line_power)
-          for (int k = 0; k < 3; ++k)
-            (*line_power)[static_cast<std::size_t>(k)] +=
-                x[g][2 * k] * x[g][2 * k] + x[g][2 * k + 1] * x[g][2 * k + 1];
-      }
-      if (contribution) {
-        contribution->emplace_back(y.size(), pages);
-        for (std::size_t j = 0; j < y.size(); ++j)
-          contribution->back().set(j, row(i, j, f_hz).dot(x[segment(i, j)]));
+        const double t_s = tms[i].time_s(j);
+        sums.back().add(segment(i, t_s), t_s, y[j]);
       }
     }
-    return explained;
+    if (sums.empty()) return;
+    for (const int k : sums.front().offsets()) {
+      std::vector<std::vector<Normal>> normal(traces.size());
+      double explained = 0.0;
+      for (std::size_t i = 0; i < traces.size(); ++i)
+        for (std::size_t g = 0; g < segments[i]; ++g) {
+          const auto s = sums[i].sums(k, g);
+          Normal n;
+          for (int a = 0, p = 0; a < 6; ++a)
+            for (int b = 0; b <= a; ++b, ++p) n.ata(a, b) = n.ata(b, a) = s.lower[p];
+          for (int a = 0; a < 6; ++a) n.aty[a] = s.ry[a];
+          solve(n, explained);
+          normal[i].push_back(n);
+        }
+      if (explained > best.explained)
+        best = {centre_hz + k * step_hz, explained, std::move(normal)};
+    }
+  }
+
+  // The best's fitted contribution in each trace's order and the fitted power of each of the
+  // three lines, summed over the traces.
+  void contribution(const Best& best, std::vector<PagedDoubles>& contribution,
+                    std::array<double, 3>& line_power) const {
+    for (std::size_t i = 0; i < traces.size(); ++i) {
+      std::vector<Row> x;
+      double explained = 0.0;
+      for (const auto& n : best.normal[i]) {
+        x.push_back(solve(n, explained));
+        for (int k = 0; k < 3; ++k)
+          line_power[static_cast<std::size_t>(k)] +=
+              x.back()[2 * k] * x.back()[2 * k] + x.back()[2 * k + 1] * x.back()[2 * k + 1];
+      }
+      const auto& y = traces[i].r_um;
+      contribution.emplace_back(y.size(), pages);
+      for (std::size_t j = 0; j < y.size(); ++j) {
+        const double t_s = tms[i].time_s(j);
+        const auto r = LineTrials::row(best.f_hz, f0_hz, t_s);
+        contribution.back().set(j, Eigen::Map<const Row>(r.data()).dot(x[segment(i, t_s)]));
+      }
+    }
   }
 };
 
@@ -437,22 +474,22 @@ std::optional<Found> vibration(const Settings& s, std::vector<TraceResidual>& tr
   rest = std::vector<double>();
   // The frequency that explains most, on a grid over +-1 / T, refined about the best point.
   const LineFit fit{traces, tms, f0, segments, static_cast<double>(cap) * dt, s.pages};
-  double best_f = all.centroid_hz, best = -1.0, step = 0.1 / duration;
-  for (int k = -10; k <= 10; ++k) {
-    const double f = all.centroid_hz + k * step;
-    if (const double e = fit(f); e > best) best = e, best_f = f;
-  }
+  LineFit::Best best;
+  double step = 0.1 / duration;
+  fit.trials(all.centroid_hz, step, 10, true, best);  // the centroid -+ 10 steps
   for (int round = 0; round < 3; ++round) {
     step /= 4;
-    const double centre = best_f;
-    for (int k : {-3, -2, -1, 1, 2, 3}) {
-      const double f = centre + k * step;
-      if (const double e = fit(f); e > best) best = e, best_f = f;
-    }
+    fit.trials(best.f_hz, step, 3, false, best);  // the best -+ 1, 2, 3 steps
   }
+  if (best.normal.empty()) {  // no trial's sum of squares was a number (a singular fit)
+    notes.push_back(fmt::format(
+        "vibration: the lines near {:.2f} Hz could not be fitted; not reported", all.centroid_hz));
+    return std::nullopt;
+  }
+  const double best_f = best.f_hz;
   std::vector<PagedDoubles> parts;
   std::array<double, 3> power{};
-  fit(best_f, &parts, &power);
+  fit.contribution(best, parts, power);
   if (parts.size() == 1) {
     notes.push_back(
         "vibration: one direction only, so a vibration cannot be told from an error locked to "
