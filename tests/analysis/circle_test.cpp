@@ -624,6 +624,32 @@ TEST(CircleDynamics, VibrationOfALongTraceInManySegments) {
   EXPECT_NEAR(r.residual_rms_um, 0.2, 0.02);
 }
 
+TEST(CircleDynamics, InjectedVibrationAt123HzFoundByTheOnePassTrials) {
+  // The line fit's search (a grid of 21 trials over +-1 / T, then three rounds of 6 about the
+  // best, each round one pass of cal::LineTrials) on 100,000 samples a trace (2.65 kHz, 37.7 s)
+  // in Welch segments of 16,384 (T = 16,383 / 2652.6 Hz = 6.18 s; the lines fitted in six
+  // pieces a trace), 0.05 um of noise. The truth is the injection: 1 um (peak) at 123.4 Hz
+  // along X, rms A / 2 = 0.5 um; 0.6 um radially, rms 0.6 / sqrt 2 = 0.4243 um. Tolerances: the
+  // frequency within 0.002 Hz, an eightieth of the spectrum's resolution 1 / T = 0.16 Hz and
+  // eight of the search's last step 0.1 / (64 T) = 2.5e-4 Hz (a trial's frequency taken with
+  // the wrong sign of its offset is 2 - 20 grid steps of 0.016 Hz off); the rms within 0.5 %
+  // (the noise the 72 fitted sines take is 0.05^2 72 / 200,000 = 1e-6 um^2, nothing).
+  for (const double dir : {0.0, std::nan("")}) {
+    SCOPED_TRACE(std::isnan(dir) ? "radial" : "along X");
+    const double amplitude = std::isnan(dir) ? 0.6 : 1.0;
+    const Machine m{.noise = 0.05, .vib_um = amplitude, .vib_hz = 123.4, .vib_dir_deg = dir};
+    const auto r = vibrating(m, 100'000, 16'384);
+    const auto* v = find(r, "vibration");
+    ASSERT_NE(v, nullptr);
+    const double rms = std::isnan(dir) ? amplitude / std::sqrt(2.0) : amplitude / 2;
+    EXPECT_NEAR(v->value, rms, 0.005 * rms);
+    ASSERT_TRUE(v->frequency_hz);
+    EXPECT_NEAR(*v->frequency_hz, 123.4, 0.002);
+    // The fitted lines are taken out: what remains is the noise.
+    EXPECT_NEAR(r.residual_rms_um, 0.05, 0.005);
+  }
+}
+
 TEST(CircleDynamics, RefusesATooShortVibrationSegment) {
   const Trace t = simulate({}, Direction::ccw, 360, 1);
   EXPECT_THROW(analyse({.vibration_segment_samples = 255}, std::span(&t, 1)), cal::InputError);
