@@ -46,6 +46,7 @@ struct ReplayBenchOptions {
   bool long_run = false;
   int runs = 2, targets = 3;
   double circle_feed_mm_per_min = 3000;
+  double circle_vibration_um = 0, circle_vibration_hz = 0;  // the circle template's, of Y
   int rounds = 2;
   int bench_seconds = 60;
   std::string kinds;  // empty: all
@@ -292,6 +293,9 @@ void bench_replay(const ReplayBenchOptions& o) {
                                std::to_string(targets)});
     else
       args.insert(args.end(), {"--feed-mm-per-min", fmt::format("{}", feed)});
+    if (name == "circle" && (o.circle_vibration_um > 0 || o.circle_vibration_hz > 0))
+      args.insert(args.end(), {"--vibration-y-um", fmt::format("{}", o.circle_vibration_um),
+                               "--vibration-y-hz", fmt::format("{}", o.circle_vibration_hz)});
     const auto log = dir / (name + ".log");
     const auto c = bench::spawn_child(args, log.string());
     if (c.exit_code != 0)
@@ -467,6 +471,13 @@ void add_bench_replay_command(CLI::App& bench) {
                   "The circle template's feed (without --long; 26 mm/min: a 1-hour circle)")
       ->capture_default_str()
       ->check(finite_in(10.0, 10000.0));
+  cmd->add_option("--circle-vibration-um", o->circle_vibration_um,
+                  "A vibration of Y in the circle template (peak, um; with "
+                  "--circle-vibration-hz): the analysis then finds it and fits its lines")
+      ->check(finite_in(0.0, 1000.0));
+  cmd->add_option("--circle-vibration-hz", o->circle_vibration_hz,
+                  "The circle template's vibration's frequency (Hz)")
+      ->check(finite_in(0.0, 100000.0));
   cmd->add_option("--rounds", o->rounds, "Rounds (the peer, then every replay); medians reported")
       ->capture_default_str();
   cmd->add_option("--bench-seconds", o->bench_seconds,

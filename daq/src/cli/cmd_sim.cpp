@@ -48,7 +48,10 @@ struct SimOptions {
   std::optional<int> targets;     // unset: 11 (the linear program's; the rotary test has 9)
   double feed_mm_per_min = 1000;  // the circle's
   double ballbar_rate_hz = 1000;  // the simulated bar's output rate
-  std::string measure;            // a component of the volumetric campaign, e.g. E_YX
+  // A vibration of Y (ShopTruth::vibration_y_um, _hz): a ballbar circle in XY with a vibration
+  // to find (issue 32: its line fit is paid only when one is found).
+  double vibration_y_um = 0, vibration_y_hz = 0;
+  std::string measure;  // a component of the volumetric campaign, e.g. E_YX
   std::string topology = "YFXZ";
   std::string compensate;  // a model whose volumetric correction the control applies
   std::string model_db;    // where --compensate is kept when not a file (default: --db)
@@ -228,6 +231,12 @@ void run_sim(SimOptions o) {
   std::optional<cal::daq::LinearTestConfig> volumetric;
   ShopTruth truth = set ? ShopTruth::three_planes() : ShopTruth{};
   truth.ballbar_rate_hz = o.ballbar_rate_hz;
+  if (o.vibration_y_um > 0 || o.vibration_y_hz > 0) {
+    if (!(o.vibration_y_um > 0 && o.vibration_y_hz > 0))
+      throw cal::InputError("--vibration-y-um and --vibration-y-hz go together, both above 0");
+    truth.vibration_y_um = o.vibration_y_um;
+    truth.vibration_y_hz = o.vibration_y_hz;
+  }
   apply_rotary_correction(o, truth.rotary);
   if (!o.measure.empty()) {
     volumetric = volumetric_test(o.measure);
@@ -434,6 +443,13 @@ void add_sim_command(CLI::App& app) {
                   "streams 1000 Hz; a faster gauge for long high-rate runs)")
       ->capture_default_str()
       ->check(finite_in(100.0, 20000.0));
+  cmd->add_option("--vibration-y-um", o->vibration_y_um,
+                  "A vibration of the SIMULATED Y axis: its amplitude (peak, um; a ballbar circle "
+                  "in XY reads half of it as rms); with --vibration-y-hz")
+      ->check(finite_in(0.0, 1000.0));
+  cmd->add_option("--vibration-y-hz", o->vibration_y_hz,
+                  "The SIMULATED Y axis' vibration's frequency (Hz)")
+      ->check(finite_in(0.0, 100000.0));
   cmd->add_flag("--position-feed", o->position_feed,
                 "Configure the MTConnect SHDR position feed (position-assisted trigger)");
   cmd->add_option("--measure", o->measure,
