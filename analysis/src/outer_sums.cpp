@@ -113,4 +113,27 @@ void add_outer_products(double* s, const double* w, const double* p, std::size_t
 
 bool outer_products_avx2() { return kAvx2; }
 
+bool detail::add_outer_products_sse2(double* s, const double* w, const double* p, std::size_t rows,
+                                     std::size_t nw, std::size_t np) {
+#if defined(__x86_64__)
+  add_sse2(s, w, p, rows, nw, np);
+  return true;
+#else
+  (void)s, (void)w, (void)p, (void)rows, (void)nw, (void)np;
+  return false;
+#endif
+}
+
+bool detail::add_outer_products_avx2(double* s, const double* w, const double* p, std::size_t rows,
+                                     std::size_t nw, std::size_t np) {
+#if defined(__x86_64__)
+  if (!detect_avx2()) return false;  // (not kAvx2: false too if read before it is set)
+  add_avx2(s, w, p, rows, nw, np);
+  return true;
+#else
+  (void)s, (void)w, (void)p, (void)rows, (void)nw, (void)np;
+  return false;
+#endif
+}
+
 }  // namespace cal

@@ -3,6 +3,7 @@
 // for bit.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -137,6 +138,55 @@ TEST(OuterSums, DispatchedPathEqualsThePortableLoopBitForBit) {
   }
   EXPECT_EQ(s, sp);
   std::printf("outer products: %s path\n", cal::outer_products_avx2() ? "AVX2" : "SSE2");
+}
+
+// The SSE2 tiles (2 doubles a register, 6 columns a tile) and the AVX2 ones (4, 12) against each
+// other, bit for bit, on sums that round: doubles of mixed signs and magnitudes (2^-30 .. 2^30,
+// so that nearly every addition rounds and any change in the order of a sum's terms shows),
+// onto sums already holding values, at shapes that take each path's wide and narrow tiles
+// (np = 4 .. 68) and short and long row counts. Both paths are called explicitly, whatever the
+// dispatch picks; without AVX2 on this CPU the SSE2 path is held to the portable loop instead
+// (the same order: the reference both tile paths must equal), and the output says which.
+TEST(OuterSums, SseTilesEqualAvx2TilesBitForBitOnRoundedSums) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> mantissa(1.0, 2.0);
+  std::uniform_int_distribution<int> exponent(-30, 30), sign(0, 1);
+  auto mixed = [&] { return (sign(rng) ? -1.0 : 1.0) * std::ldexp(mantissa(rng), exponent(rng)); };
+  // Nothing to sum: only whether the AVX2 path runs on this CPU.
+  const bool avx2 = cal::detail::add_outer_products_avx2(nullptr, nullptr, nullptr, 0, 0, 0);
+  std::size_t differing_from_unrounded = 0, compared = 0;
+  for (const std::size_t rows : {1u, 3u, 64u, 257u})
+    for (const std::size_t np : {4u, 8u, 12u, 16u, 20u, 24u, 36u, 52u, 68u}) {
+      const std::size_t nw = 8;
+      std::vector<double> w(rows * nw), p(rows * np), s0(nw * np);
+      for (auto& x : w) x = mixed();
+      for (auto& x : p) x = mixed();
+      for (auto& x : s0) x = mixed();
+      std::vector<double> sse = s0, other = s0;
+      ASSERT_TRUE(
+          cal::detail::add_outer_products_sse2(sse.data(), w.data(), p.data(), rows, nw, np));
+      if (avx2)
+        ASSERT_TRUE(
+            cal::detail::add_outer_products_avx2(other.data(), w.data(), p.data(), rows, nw, np));
+      else
+        cal::add_outer_products_portable(other.data(), w.data(), p.data(), rows, nw, np);
+      for (std::size_t k = 0; k < sse.size(); ++k) {
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(sse[k]), std::bit_cast<std::uint64_t>(other[k]))
+            << rows << " rows, np " << np << ", sum " << k << ": " << sse[k] << " vs " << other[k];
+        // That the sums do round: the same terms summed in long double (64-bit mantissas)
+        // mostly differ from the double sums (a test on exact sums could not see the order).
+        long double wide = s0[k];
+        for (std::size_t i = 0; i < rows; ++i)
+          wide += static_cast<long double>(w[i * nw + k / np]) * p[i * np + k % np];
+        differing_from_unrounded += static_cast<long double>(sse[k]) != wide;
+        ++compared;
+      }
+    }
+  // Of the 1 row cases' sums (one product added) some land exactly; the longer sums nearly never.
+  EXPECT_GT(differing_from_unrounded, compared / 2) << compared;
+  std::printf("outer products: SSE2 tiles against the %s, bit for bit, on %zu sums (%zu rounded)\n",
+              avx2 ? "AVX2 tiles" : "portable loop (no AVX2 on this CPU)", compared,
+              differing_from_unrounded);
 }
 
 }  // namespace
