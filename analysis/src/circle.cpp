@@ -68,7 +68,7 @@ constexpr std::size_t min_samples = 20;
 
 double sgn(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; }
 
-// cos x and sin x in one call, without the library's (sin_cos.hpp: within 0.8 ulp, 1.1 where
+// cos x and sin x in one call, without the library's (sin_cos.hpp: within 0.79 ulp, 1.07 where
 // the value is near 0, where glibc's are within 0.52; its sincos was 10 - 14 % of a long run's
 // replay at five or six calls a sample: issue 32). Every sine and cosine of the fit's passes is
 // this one's, so a record rebuilt is the record held, bit for bit.

@@ -113,4 +113,29 @@ void add_outer_products(double* s, const double* w, const double* p, std::size_t
 
 bool outer_products_avx2() { return kAvx2; }
 
+#if defined(__x86_64__)
+bool detail::add_outer_products_sse2(double* s, const double* w, const double* p, std::size_t rows,
+                                     std::size_t nw, std::size_t np) {
+  add_sse2(s, w, p, rows, nw, np);
+  return true;
+}
+
+bool detail::add_outer_products_avx2(double* s, const double* w, const double* p, std::size_t rows,
+                                     std::size_t nw, std::size_t np) {
+  if (!detect_avx2()) return false;  // (not kAvx2: false too if read before it is set)
+  add_avx2(s, w, p, rows, nw, np);
+  return true;
+}
+#else
+// Neither path on other CPUs: the caller is told so.
+bool detail::add_outer_products_sse2(double*, const double*, const double*, std::size_t,
+                                     std::size_t, std::size_t) {
+  return false;
+}
+bool detail::add_outer_products_avx2(double*, const double*, const double*, std::size_t,
+                                     std::size_t, std::size_t) {
+  return false;
+}
+#endif
+
 }  // namespace cal

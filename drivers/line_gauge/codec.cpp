@@ -153,14 +153,25 @@ std::optional<DecimalScale> GaugeCodec::exact_scale(GaugeUnit unit) const {
   return decimal_scale(unit);
 }
 
-std::optional<double> GaugeCodec::to_si(std::string_view text, double printed,
+std::optional<double> GaugeCodec::to_si(std::string_view text,
                                         std::optional<GaugeUnit> printed_unit) const {
   const GaugeUnit unit = printed_unit.value_or(config_.unit);
   // The printed decimal itself in SI (strtod of its digits with the exponent moved), where
   // the unit is an exact decimal and nothing is added: "100.000123" mm is 0.100000123 m, not
-  // 100.000123 x 1e-3 = 0.10000012300000001.
-  if (const auto exact = exact_scale(unit)) return parse_number_scaled(text, *exact);
-  return (printed * config_.scale + config_.offset) * unit_factor(unit);
+  // 100.000123 x 1e-3 = 0.10000012300000001. inf and nan come back as read (a positive factor).
+  if (const auto exact = exact_scale(unit)) {
+    const auto si = parse_number_scaled(text, *exact);
+    if (!si || !std::isfinite(*si)) return std::nullopt;
+    // A printed number beyond the double's range ("1e309" mm) is no value even where its SI
+    // value is one (1e306 m): read as printed only then (|si| > 1e290: the factors are >= 1e-6).
+    if (std::abs(*si) > 1e290)
+      if (const auto printed = parse_number(text); !printed || !std::isfinite(*printed))
+        return std::nullopt;
+    return si;
+  }
+  const auto printed = parse_number(text);
+  if (!printed || !std::isfinite(*printed)) return std::nullopt;
+  return (*printed * config_.scale + config_.offset) * unit_factor(unit);
 }
 
 std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64_t off,
@@ -169,8 +180,8 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
     report(errors, ErrorKind::garbage, off, "gauge: non-printable bytes in a line");
     return std::nullopt;
   }
-  std::optional<double> number;
   std::optional<GaugeUnit> printed_unit;
+  bool found = false;     // a number's text, with no unit or one of this gauge's kind
   std::string matched;    // the regex's number group
   std::string_view text;  // the number as printed
   if (regex_) {
@@ -178,10 +189,10 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
     if (std::regex_search(line.begin(), line.end(), m, *regex_)) {
       matched = m[1].str();
       text = trim(matched);
-      number = parse_number(text);
+      found = true;
       if (m.size() > 2 && m[2].matched) {  // a printed unit word
         printed_unit = unit_word(m[2].str());
-        if (!printed_unit || is_angle(*printed_unit) != is_angle(config_.unit)) number.reset();
+        found = printed_unit && is_angle(*printed_unit) == is_angle(config_.unit);
       }
     }
   } else {
@@ -189,27 +200,30 @@ std::optional<double> GaugeCodec::decode_line(std::string_view line, std::uint64
     const std::size_t count = split_whitespace(line, tokens);
     if (count == 1 || count == 2) {
       text = tokens[0];
-      number = parse_number(text);
+      found = true;
       if (count == 2) {
         printed_unit = unit_word(tokens[1]);
         // A printed unit of the other kind (an angle on a length gauge) is not this gauge's.
-        if (!printed_unit || is_angle(*printed_unit) != is_angle(config_.unit)) number.reset();
+        found = printed_unit && is_angle(*printed_unit) == is_angle(config_.unit);
       }
     }
   }
+  // The number parsed once, straight to SI (to_si): a good line ends here.
+  if (found)
+    if (const auto si = to_si(text, printed_unit);
+        si && *si >= config_.min_si && *si <= config_.max_si)
+      return si;
+  // A bad line: read again as printed, for what to say (no finite number, or one out of range:
+  // its SI value, or that value, beyond the double's range).
+  const auto number = found ? parse_number(text) : std::nullopt;
   if (!number || !std::isfinite(*number)) {
     report(errors, ErrorKind::malformed, off,
            fmt::format("gauge: no value in '{}'", line.substr(0, 40)));
     return std::nullopt;
   }
-  const auto si = to_si(text, *number, printed_unit);
-  if (!si || *si < config_.min_si || *si > config_.max_si) {
-    report(
-        errors, ErrorKind::out_of_range, off,
-        fmt::format("gauge: value {} outside [{}, {}]", *number, config_.min_si, config_.max_si));
-    return std::nullopt;
-  }
-  return si;
+  report(errors, ErrorKind::out_of_range, off,
+         fmt::format("gauge: value {} outside [{}, {}]", *number, config_.min_si, config_.max_si));
+  return std::nullopt;
 }
 
 }  // namespace cal::drivers::codec

@@ -117,8 +117,9 @@ class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
   std::optional<double> decode_line(std::string_view line, std::uint64_t offset,
                                     std::vector<CodecError>& errors);
   void report_overlong(std::uint64_t offset, std::vector<CodecError>& errors);
-  std::optional<double> to_si(std::string_view text, double printed,
-                              std::optional<GaugeUnit> printed_unit) const;
+  // The number `text` in SI, from one parse: nullopt when it is no finite number (or its SI
+  // value is beyond the double's range).
+  std::optional<double> to_si(std::string_view text, std::optional<GaugeUnit> printed_unit) const;
   // The unit's exact scale when the configuration leaves the printed decimal as it is
   // (scale 1, offset 0); nullopt otherwise.
   std::optional<DecimalScale> exact_scale(GaugeUnit unit) const;

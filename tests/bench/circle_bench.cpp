@@ -15,6 +15,7 @@
 #include "cal/analysis/circle.hpp"
 #include "cal/analysis/circle_records.hpp"
 #include "cal/analysis/circle_search.hpp"
+#include "cal/analysis/sin_cos.hpp"
 
 namespace {
 
@@ -203,5 +204,35 @@ BENCHMARK(BM_BallbarPeakRssHeld)->Arg(360'000)->Iterations(1)->Unit(benchmark::k
 // Six minutes of a 10 kHz circle (2 x 1.8 M samples): not in the suite's smoke run.
 void BM_BallbarPeakRssLong(benchmark::State& state) { BM_BallbarPeakRss(state); }
 BENCHMARK(BM_BallbarPeakRssLong)->Arg(1'800'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+// cal::sin_cos on 4096 phases |x| < 2000 (the fit's k c), independent calls; the peer in the
+// same run, BM_SinCosGlibc, is glibc's sincos on the same arguments.
+std::vector<double> phases() {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-2000.0, 2000.0);
+  std::vector<double> xs(4096);
+  for (auto& x : xs) x = u(rng);
+  return xs;
+}
+
+void BM_SinCos(benchmark::State& state) {
+  const auto xs = phases();
+  for (auto _ : state)
+    for (const double x : xs) benchmark::DoNotOptimize(cal::sin_cos(x));
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * xs.size()));
+}
+BENCHMARK(BM_SinCos);
+
+void BM_SinCosGlibc(benchmark::State& state) {
+  const auto xs = phases();
+  for (auto _ : state)
+    for (const double x : xs) {
+      cal::SinCos r{};
+      ::sincos(x, &r.s, &r.c);
+      benchmark::DoNotOptimize(r);
+    }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * xs.size()));
+}
+BENCHMARK(BM_SinCosGlibc);
 
 }  // namespace

@@ -19,4 +19,14 @@ void add_outer_products_portable(double* s, const double* w, const double* p, st
 // Whether add_outer_products takes the AVX2 path on this CPU.
 bool outer_products_avx2();
 
+namespace detail {
+// The x86-64 paths themselves, whatever add_outer_products would choose, for the test that
+// holds them to the same bits (tests/analysis/circle_kernels_test.cpp). Each returns false,
+// having done nothing, where it cannot run: not an x86-64 build, or (AVX2) not on this CPU.
+bool add_outer_products_sse2(double* s, const double* w, const double* p, std::size_t rows,
+                             std::size_t nw, std::size_t np);
+bool add_outer_products_avx2(double* s, const double* w, const double* p, std::size_t rows,
+                             std::size_t nw, std::size_t np);
+}  // namespace detail
+
 }  // namespace cal
