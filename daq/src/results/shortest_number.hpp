@@ -309,35 +309,32 @@ inline char* write_integer(char* p, std::int64_t v) {
   return p + size;
 }
 
+namespace shortest_detail {
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+// write_shortest's usual way, inlined into a caller's loop: v's shortest decimal by
+// shortest_decimal (Schubfach's method, shortest_decimal.hpp), laid out in a register
+// (write_fixed16, write_fixed17) where fmt's layout of it is fixed notation; nullptr (nothing
+// written) for anything else: |v| of 2^56 and above, zero, a power of two, exponent notation,
+// inf, nan.
+[[gnu::always_inline]] inline char* write_shortest_fixed(char* p, double v) {
+  const auto bits = std::bit_cast<std::uint64_t>(v);
+  const ShortestDecimal d = shortest_decimal(bits);
+  if (d.significand == 0) return nullptr;
+  if (bits >> 63) *p++ = '-';  // (left for write_shortest_general to write over on nullptr)
+  const int k = -d.exponent;   // >= 0
+  return d.significand < kPow10Int[16] ? write_fixed16(p, d.significand, k)
+                                       : write_fixed17(p, d.significand, k);
+}
+#endif
+}  // namespace shortest_detail
+
 // Writes v at p (at most 24 characters, and up to 16 bytes of no meaning after them: room for
 // 40) and returns the end. Below 2^56 (every export's lengths, angles and times) the digits
 // come from shortest_decimal (Schubfach's method, shortest_decimal.hpp) and are laid out in
-// a register (write_fixed16, write_fixed17) where fmt's layout is fixed notation: fmt's
-// Dragonbox and write_decimal's layout were about 220 instructions of an unquantised
-// reading's row (issue 32, "Exports, seventh pass"). The rest as before: fmt's Dragonbox.
-inline char* write_shortest(char* p, double v) {
-#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
-  {
-    using namespace shortest_detail;
-    const auto bits = std::bit_cast<std::uint64_t>(v);
-    const ShortestDecimal d = shortest_decimal(bits);
-    if (d.significand != 0) {
-      char* q = p;
-      if (bits >> 63) *q++ = '-';
-      const int k = -d.exponent;  // >= 0
-      char* const end = d.significand < kPow10Int[16] ? write_fixed16(q, d.significand, k)
-                                                      : write_fixed17(q, d.significand, k);
-      if (end != nullptr) return end;
-      std::uint64_t sig = d.significand;  // exponent notation: trailing zeros cut, as fmt's
-      int exponent = d.exponent;
-      while (sig % 10 == 0) {
-        sig /= 10;
-        ++exponent;
-      }
-      return write_decimal(q, sig, exponent);
-    }
-  }
-#endif
+// a register where fmt's layout is fixed notation (write_shortest_fixed): fmt's Dragonbox and
+// write_decimal's layout were about 220 instructions of an unquantised reading's row (issue
+// 32, "Exports, seventh pass"). The rest as before: fmt's Dragonbox.
+[[gnu::noinline]] inline char* write_shortest_general(char* p, double v) {
   if (!std::isfinite(v)) return fmt::format_to(p, "{}", v);  // inf, nan as fmt writes them
   if (std::signbit(v)) {
     *p++ = '-';
@@ -345,6 +342,13 @@ inline char* write_shortest(char* p, double v) {
   }
   const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
   return shortest_detail::write_decimal(p, dec.significand, dec.exponent);
+}
+
+inline char* write_shortest(char* p, double v) {
+#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
+  if (char* const end = shortest_detail::write_shortest_fixed(p, v)) return end;
+#endif
+  return write_shortest_general(p, v);
 }
 
 // The same text as write_shortest(p, v), for a stored reading: where v is the double of a

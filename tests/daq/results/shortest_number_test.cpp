@@ -92,6 +92,103 @@ TEST(ShortestNumber, RandomBitPatterns) {
   EXPECT_EQ(first_difference(values), "");
 }
 
+#if defined(__SIZEOF_INT128__)
+// shortest_decimal's table (daq/src/results/shortest_decimal.hpp): 10^j's top 128 bits and bit
+// length. Up to 10^38 (below 2^128) against 10^j made here by 128-bit multiplication, exactly;
+// beyond, its bit length against floor(j log2 10) + 1 and its top 64 bits against powl's
+// 10^j in long double (a 64-bit significand), to within a few units.
+TEST(ShortestDecimal, PowersOfTenTableIsTenToTheJ) {
+  using daq::shortest_detail::kPow10Top128;
+  using daq::shortest_detail::u128_t;
+  u128_t ten_to_j = 1;
+  for (int j = 0; j <= daq::shortest_detail::kMaxPow10; ++j) {
+    const auto& g = kPow10Top128[static_cast<std::size_t>(j)];
+    ASSERT_NE(g.hi >> 63, 0u) << j;  // normalised: the top bit set
+    if (j <= 38) {
+      const auto hi = static_cast<std::uint64_t>(ten_to_j >> 64);
+      const int bits = hi != 0 ? 128 - std::countl_zero(hi)
+                               : 64 - std::countl_zero(static_cast<std::uint64_t>(ten_to_j));
+      const u128_t top = ten_to_j << (128 - bits);
+      EXPECT_EQ(g.bits, bits) << j;
+      EXPECT_EQ(g.hi, static_cast<std::uint64_t>(top >> 64)) << j;
+      EXPECT_EQ(g.lo, static_cast<std::uint64_t>(top)) << j;
+      if (j < 38) ten_to_j *= 10;
+    }
+    const long double log2_ten_j = static_cast<long double>(j) * std::log2(10.0L);
+    EXPECT_EQ(g.bits, static_cast<int>(std::floor(log2_ten_j)) + 1) << j;
+    const long double top64 = std::ldexp(std::pow(10.0L, static_cast<long double>(j)), 64 - g.bits);
+    const long double diff = static_cast<long double>(g.hi) - top64;
+    EXPECT_LE(std::abs(diff), 8.0L) << j;
+  }
+  // 10^55 = 5^55 2^55 is the last exact one (5^55 < 2^128 < 5^56): 10^56's top bits rounded up.
+  EXPECT_EQ(kPow10Top128[56].lo & 1, 1u);
+}
+
+// k = floor(q log10 2) by x 315653 >> 20, at every binary exponent the table serves: the k with
+// 10^k <= 2^q < 10^(k+1), from long double logarithms.
+TEST(ShortestDecimal, DecimalExponentAtEveryBinaryExponent) {
+  for (int q = -1074; q <= 3; ++q) {
+    const int k = static_cast<int>(std::floor(static_cast<long double>(q) * std::log10(2.0L)));
+    EXPECT_EQ(-((q * 315653) >> 20), k) << q;
+  }
+}
+#endif
+
+// Random significands at every binary exponent (subnormals, the least and largest normal
+// significands of each), both signs: the shortest digits of Schubfach's way below 2^56 and
+// fmt's Dragonbox above must both be fmt's "{}".
+TEST(ShortestNumber, EveryBinaryExponentAsFmtWritesIt) {
+  std::mt19937_64 rng(2046);
+  std::vector<double> values;
+  for (std::uint64_t biased = 0; biased < 2047; ++biased)
+    for (int i = 0; i < 150; ++i) {
+      std::uint64_t fraction = rng() & ((std::uint64_t{1} << 52) - 1);
+      if (i == 0) fraction = 0;
+      if (i == 1) fraction = 1;
+      if (i == 2) fraction = (std::uint64_t{1} << 52) - 1;
+      const auto v = std::bit_cast<double>((biased << 52) | fraction);
+      values.push_back(v);
+      values.push_back(-v);
+    }
+  EXPECT_EQ(first_difference(values), "");
+}
+
+// Unquantised readings as an export holds them (16 - 17 significant digits, 1e-6 to 1e3),
+// every power of two with its neighbours (the narrower lower half-interval at 2^e), whole
+// numbers around 2^53 - 2^56 (the end of shortest_decimal's range), and the notation switches
+// at 1e-4 (fixed from there) and 1e16 (exponent from there) with 16 and 17 digits.
+TEST(ShortestNumber, UnquantisedReadingsAndEdgesAsFmtWritesThem) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> decade(-6.0, 3.0);
+  std::vector<double> values;
+  for (int i = 0; i < 1'500'000; ++i) {
+    const double v = std::pow(10.0, decade(rng));
+    values.push_back(i % 2 == 0 ? v : -v);
+  }
+  const auto with_neighbours = [&](double v, int n) {
+    double up = v, down = v;
+    for (int i = 0; i <= n; ++i) {
+      values.push_back(up);
+      values.push_back(down);
+      up = std::nextafter(up, std::numeric_limits<double>::infinity());
+      down = std::nextafter(down, 0.0);
+    }
+  };
+  for (int e = -1074; e <= 1023; ++e) with_neighbours(std::ldexp(1.0, e), 3);
+  for (int e = 52; e <= 57; ++e) with_neighbours(std::ldexp(1.0, e), 2000);
+  for (double edge : {1e-5, 1e-4, 1e-3, 1.0, 10.0, 1e15, 1e16, 1e17}) with_neighbours(edge, 3000);
+  for (double v :
+       {0.000099999999999999991, 0.00010000000000000002, 1234567890123456.8, 9999999999999998.0,
+        12345678901234568.0, 0.12345678901234568, 5e-324, 2.2250738585072009e-308})
+    with_neighbours(v, 2);
+  EXPECT_EQ(first_difference(values), "");
+  EXPECT_EQ(shortest(0.12345678901234568), "0.12345678901234568");  // 17 digits, fixed
+  EXPECT_EQ(shortest(1234567890123456.8), "1234567890123456.8");
+  EXPECT_EQ(shortest(0.00012345678901234567), "0.00012345678901234567");
+  EXPECT_EQ(shortest(1.2345678901234568e-05), "1.2345678901234568e-05");
+  EXPECT_EQ(shortest(12345678901234568.0), "1.2345678901234568e+16");
+}
+
 // What exports hold: times in seconds at ns resolution, lengths in m, air values, integers.
 TEST(ShortestNumber, ValuesLikeAnExportsNumbers) {
   std::mt19937_64 rng(7);
