@@ -228,13 +228,9 @@ class RunningReading {
       }
     }
     // A stream whose readings have more than 15 digits skips write_shortest_quantised's guess,
-    // which would fail for most of them (86 % of the bench's): write_shortest's own digit
-    // search (shortest_decimal) costs less than the guess and its failure together.
-    char* end = nullptr;
-#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
-    if (long_) end = shortest_detail::write_shortest_fixed(p, v);
-#endif
-    if (end == nullptr) end = long_ ? write_shortest_general(p, v) : write_shortest_quantised(p, v);
+    // which would fail for most of them (86 % of the bench's): its division and check, then
+    // write_shortest anyway.
+    char* const end = long_ ? write_shortest(p, v) : write_shortest_quantised(p, v);
     // Learn the decimals from this text (while the stream has none, from one reading in 256).
     if (decimals_ != 0 || ++skipped_ >= 256) learn(p, end);
     return end;

@@ -19,8 +19,6 @@
 #include <cstdint>
 #include <cstring>
 
-#include "shortest_decimal.hpp"
-
 namespace daq {
 
 namespace shortest_detail {
@@ -256,42 +254,6 @@ __extension__ typedef unsigned __int128 u128;  // (GCC and Clang; __extension__:
   put(p + 2 + zeros, from_first);
   return p + 2 + zeros + (last + 1 - first);
 }
-
-// m x 10^-k for 10^16 <= m < 10^17 (17 digits, as v's shortest decimal can have) as fmt's "{}"
-// lays it out where that is fixed notation (its first digit's exponent, 16 - k, in [-4, 16));
-// nullptr (nothing written) elsewhere. write_fixed16's way with the first digit apart: the
-// other 16 in one register, moved to their places as one 128-bit integer. At most 24
-// characters and up to 16 bytes of no meaning after them.
-[[gnu::always_inline]] inline char* write_fixed17(char* p, std::uint64_t m, int k) {
-  if (k < 1 || k > 20) return nullptr;
-  const auto lead = static_cast<char>('0' + m / kPow10Int[16]);
-  const __m128i text = digits16(m % kPow10Int[16]);
-  const auto nonzero =
-      static_cast<unsigned>(~_mm_movemask_epi8(_mm_cmpeq_epi8(text, _mm_set1_epi8('0'))) & 0xFFFF);
-  // The last digit other than 0 of all 17 (digit 0 the first; 0 if the 16 are all 0).
-  const int last = nonzero == 0 ? 0 : 32 - std::countl_zero(nonzero);
-  const auto low = static_cast<std::uint64_t>(_mm_cvtsi128_si64(text));
-  const auto high = static_cast<std::uint64_t>(_mm_cvtsi128_si64(_mm_unpackhi_epi64(text, text)));
-  const u128 rest = (static_cast<u128>(high) << 64) | low;  // byte i: digit i + 1
-  const auto put = [](char* at, u128 bytes) { std::memcpy(at, &bytes, 16); };
-  const int whole = 17 - k;  // digits before the point
-  if (whole > 0) {
-    *p = lead;
-    if (last < whole) {  // a whole number
-      put(p + 1, rest);
-      return p + whole;
-    }
-    put(p + 1, rest);
-    p[whole] = '.';
-    put(p + whole + 1, rest >> (8 * (whole - 1)));
-    return p + whole + 1 + (last + 1 - whole);
-  }
-  std::memcpy(p, "0.000000", 8);  // 0..3 zeros after the point
-  char* const q = p + 2 - whole;
-  *q = lead;
-  put(q + 1, rest);
-  return q + last + 1;
-}
 #endif
 
 }  // namespace shortest_detail
@@ -309,33 +271,9 @@ inline char* write_integer(char* p, std::int64_t v) {
   return p + size;
 }
 
-namespace shortest_detail {
-#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
-// write_shortest's usual way, inlined into a caller's loop: v's shortest decimal by
-// shortest_decimal (Schubfach's method, shortest_decimal.hpp), laid out in a register
-// (write_fixed16, write_fixed17) where fmt's layout of it is fixed notation; nullptr (nothing
-// written) for anything else: |v| of 2^56 and above, zero, a power of two, exponent notation,
-// inf, nan.
-[[gnu::always_inline]] inline char* write_shortest_fixed(char* p, double v) {
-  const auto bits = std::bit_cast<std::uint64_t>(v);
-  const ShortestDecimal d = shortest_decimal(bits);
-  if (d.significand == 0) return nullptr;
-  if (bits >> 63) *p++ = '-';  // (left for write_shortest_general to write over on nullptr)
-  // As 17 digits (one more 0 after a 16-digit significand, which write_fixed17 does not
-  // write): readings have 16 or 17 as good as at random, and a branch on it was mispredicted.
-  const bool sixteen = d.significand < kPow10Int[16];
-  return write_fixed17(p, sixteen ? d.significand * 10 : d.significand, -d.exponent + sixteen);
-}
-#endif
-}  // namespace shortest_detail
-
-// Writes v at p (at most 24 characters, and up to 16 bytes of no meaning after them: room for
-// 40) and returns the end. Below 2^56 (every export's lengths, angles and times) the digits
-// come from shortest_decimal (Schubfach's method, shortest_decimal.hpp) and are laid out in
-// a register where fmt's layout is fixed notation (write_shortest_fixed): fmt's Dragonbox and
-// write_decimal's layout were about 220 instructions of an unquantised reading's row (issue
-// 32, "Exports, seventh pass"). The rest as before: fmt's Dragonbox.
-[[gnu::noinline]] inline char* write_shortest_general(char* p, double v) {
+// Writes v at p (at most 24 characters, and up to kSpill bytes of no meaning after them: room
+// for 32) and returns the end.
+inline char* write_shortest(char* p, double v) {
   if (!std::isfinite(v)) return fmt::format_to(p, "{}", v);  // inf, nan as fmt writes them
   if (std::signbit(v)) {
     *p++ = '-';
@@ -343,13 +281,6 @@ namespace shortest_detail {
   }
   const auto dec = fmt::detail::dragonbox::to_decimal(v);  // {0, 0} for zero
   return shortest_detail::write_decimal(p, dec.significand, dec.exponent);
-}
-
-inline char* write_shortest(char* p, double v) {
-#if defined(__SSE2__) && defined(__SIZEOF_INT128__)
-  if (char* const end = shortest_detail::write_shortest_fixed(p, v)) return end;
-#endif
-  return write_shortest_general(p, v);
 }
 
 // The same text as write_shortest(p, v), for a stored reading: where v is the double of a

@@ -92,80 +92,8 @@ TEST(ShortestNumber, RandomBitPatterns) {
   EXPECT_EQ(first_difference(values), "");
 }
 
-#if defined(__SIZEOF_INT128__)
-// shortest_decimal's table (daq/src/results/shortest_decimal.hpp): 10^j's top 128 bits and bit
-// length. Up to 10^38 (below 2^128) against 10^j made here by 128-bit multiplication, exactly;
-// beyond, its bit length against floor(j log2 10) + 1 and its top 64 bits against powl's
-// 10^j in long double (a 64-bit significand), to within a few units.
-TEST(ShortestDecimal, PowersOfTenTableIsTenToTheJ) {
-  using daq::shortest_detail::kPow10Top128;
-  using daq::shortest_detail::u128_t;
-  u128_t ten_to_j = 1;
-  for (int j = 0; j <= daq::shortest_detail::kMaxPow10; ++j) {
-    const auto& g = kPow10Top128[static_cast<std::size_t>(j)];
-    ASSERT_NE(g.hi >> 63, 0u) << j;  // normalised: the top bit set
-    if (j <= 38) {
-      const auto hi = static_cast<std::uint64_t>(ten_to_j >> 64);
-      const int bits = hi != 0 ? 128 - std::countl_zero(hi)
-                               : 64 - std::countl_zero(static_cast<std::uint64_t>(ten_to_j));
-      const u128_t top = ten_to_j << (128 - bits);
-      EXPECT_EQ(g.bits, bits) << j;
-      EXPECT_EQ(g.hi, static_cast<std::uint64_t>(top >> 64)) << j;
-      EXPECT_EQ(g.lo, static_cast<std::uint64_t>(top)) << j;
-      if (j < 38) ten_to_j *= 10;
-    }
-    const long double log2_ten_j = static_cast<long double>(j) * std::log2(10.0L);
-    EXPECT_EQ(g.bits, static_cast<int>(std::floor(log2_ten_j)) + 1) << j;
-    const long double top64 = std::ldexp(std::pow(10.0L, static_cast<long double>(j)), 64 - g.bits);
-    const long double diff = static_cast<long double>(g.hi) - top64;
-    EXPECT_LE(std::abs(diff), 8.0L) << j;
-  }
-  // 10^55 = 5^55 2^55 is the last exact one (5^55 < 2^128 < 5^56): 10^56's top bits rounded up.
-  EXPECT_EQ(kPow10Top128[56].lo & 1, 1u);
-}
-
-// k = floor(q log10 2) by x 315653 >> 20, at every binary exponent the table serves: the k with
-// 10^k <= 2^q < 10^(k+1), from long double logarithms.
-TEST(ShortestDecimal, DecimalExponentAtEveryBinaryExponent) {
-  for (int q = -1074; q <= 3; ++q) {
-    const int k = static_cast<int>(std::floor(static_cast<long double>(q) * std::log10(2.0L)));
-    EXPECT_EQ((q * 315653) >> 20, k) << q;  // j = -k
-  }
-}
-#endif
-
-// shortest_decimal's decimal itself (its trailing zeros cut) against fmt's Dragonbox's, where
-// write_shortest lays it out in exponent notation through Dragonbox again: whole numbers of
-// 2^53 - 2^56, whose rounding interval's ends (v +- 1 or 2) can be multiples of ten and are
-// excluded for an odd significand, and random bit patterns below 2^56.
-TEST(ShortestDecimal, DecimalsAsDragonboxGivesThem) {
-  std::mt19937_64 rng(56);
-  std::vector<double> values;
-  for (std::uint64_t v = (std::uint64_t{1} << 54) - 200; v < (std::uint64_t{1} << 54) + 2000; ++v)
-    values.push_back(static_cast<double>(v));  // the spacing 2 then 4 at 2^54
-  for (int i = 0; i < 300'000; ++i) {
-    values.push_back(static_cast<double>((rng() >> 8) | (std::uint64_t{1} << 53)));  // < 2^56
-    values.push_back(std::bit_cast<double>(rng() % (std::uint64_t{1079} << 52)));
-  }
-  std::string first;
-  for (double v : values) {
-    auto got = daq::shortest_detail::shortest_decimal(std::bit_cast<std::uint64_t>(v));
-    if (got.significand == 0) continue;  // (zero, powers of two: Dragonbox's own)
-    while (got.significand % 10 == 0) {
-      got.significand /= 10;
-      ++got.exponent;
-    }
-    const auto want = fmt::detail::dragonbox::to_decimal(v);
-    if (first.empty() && (got.significand != want.significand || got.exponent != want.exponent))
-      first = fmt::format("{:a}: Dragonbox {}e{}, shortest_decimal {}e{}", v, want.significand,
-                          want.exponent, got.significand, got.exponent);
-  }
-  EXPECT_EQ(first, "");
-}
-
 // Random significands at every binary exponent (subnormals, the least and largest normal
-// significands of each), both signs: the shortest digits of Schubfach's way below 2^56 and
-// fmt's Dragonbox above must both be fmt's "{}".
+// significands of each), both signs, as fmt's "{}" writes them.
 TEST(ShortestNumber, EveryBinaryExponentAsFmtWritesIt) {
   std::mt19937_64 rng(2046);
   std::vector<double> values;
@@ -184,8 +112,8 @@ TEST(ShortestNumber, EveryBinaryExponentAsFmtWritesIt) {
 
 // Unquantised readings as an export holds them (16 - 17 significant digits, 1e-6 to 1e3),
 // every power of two with its neighbours (the narrower lower half-interval at 2^e), whole
-// numbers around 2^53 - 2^56 (the end of shortest_decimal's range), and the notation switches
-// at 1e-4 (fixed from there) and 1e16 (exponent from there) with 16 and 17 digits.
+// numbers around 2^53 - 2^56 (spacings of 2 and 4), and the notation switches at 1e-4 (fixed
+// from there) and 1e16 (exponent from there) with 16 and 17 digits.
 TEST(ShortestNumber, UnquantisedReadingsAndEdgesAsFmtWritesThem) {
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> decade(-6.0, 3.0);
