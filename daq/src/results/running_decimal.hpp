@@ -227,7 +227,10 @@ class RunningReading {
           if (char* const end = digits_.write_decimal(p)) return end;
       }
     }
-    char* const end = write_shortest_quantised(p, v);
+    // A stream whose readings have more than 15 digits skips write_shortest_quantised's guess,
+    // which would fail for most of them (86 % of the bench's): its division and check, then
+    // write_shortest anyway.
+    char* const end = long_ ? write_shortest(p, v) : write_shortest_quantised(p, v);
     // Learn the decimals from this text (while the stream has none, from one reading in 256).
     if (decimals_ != 0 || ++skipped_ >= 256) learn(p, end);
     return end;
@@ -242,10 +245,12 @@ class RunningReading {
     const int decimals = exponent || written > 15 ? 0 : std::max(8, written);
     if (decimals != decimals_ && decimals != 0) digits_.set_decimals(decimals);
     decimals_ = decimals;
+    long_ = written > 15;
   }
   RunningDecimal digits_{8};
   int decimals_ = 0;   // k (0: none yet, or the stream's readings have more than 15)
   int skipped_ = 255;  // (the first reading is learnt from)
+  bool long_ = false;  // the last reading learnt from had more than 15 decimals
 };
 
 }  // namespace daq

@@ -92,6 +92,60 @@ TEST(ShortestNumber, RandomBitPatterns) {
   EXPECT_EQ(first_difference(values), "");
 }
 
+// Random significands at every binary exponent (subnormals, the least and largest normal
+// significands of each), both signs, as fmt's "{}" writes them.
+TEST(ShortestNumber, EveryBinaryExponentAsFmtWritesIt) {
+  std::mt19937_64 rng(2046);
+  std::vector<double> values;
+  for (std::uint64_t biased = 0; biased < 2047; ++biased)
+    for (int i = 0; i < 150; ++i) {
+      std::uint64_t fraction = rng() & ((std::uint64_t{1} << 52) - 1);
+      if (i == 0) fraction = 0;
+      if (i == 1) fraction = 1;
+      if (i == 2) fraction = (std::uint64_t{1} << 52) - 1;
+      const auto v = std::bit_cast<double>((biased << 52) | fraction);
+      values.push_back(v);
+      values.push_back(-v);
+    }
+  EXPECT_EQ(first_difference(values), "");
+}
+
+// Unquantised readings as an export holds them (16 - 17 significant digits, 1e-6 to 1e3),
+// every power of two with its neighbours (the narrower lower half-interval at 2^e), whole
+// numbers around 2^53 - 2^56 (spacings of 2 and 4), and the notation switches at 1e-4 (fixed
+// from there) and 1e16 (exponent from there) with 16 and 17 digits.
+TEST(ShortestNumber, UnquantisedReadingsAndEdgesAsFmtWritesThem) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> decade(-6.0, 3.0);
+  std::vector<double> values;
+  for (int i = 0; i < 1'500'000; ++i) {
+    const double v = std::pow(10.0, decade(rng));
+    values.push_back(i % 2 == 0 ? v : -v);
+  }
+  const auto with_neighbours = [&](double v, int n) {
+    double up = v, down = v;
+    for (int i = 0; i <= n; ++i) {
+      values.push_back(up);
+      values.push_back(down);
+      up = std::nextafter(up, std::numeric_limits<double>::infinity());
+      down = std::nextafter(down, 0.0);
+    }
+  };
+  for (int e = -1074; e <= 1023; ++e) with_neighbours(std::ldexp(1.0, e), 3);
+  for (int e = 52; e <= 57; ++e) with_neighbours(std::ldexp(1.0, e), 2000);
+  for (double edge : {1e-5, 1e-4, 1e-3, 1.0, 10.0, 1e15, 1e16, 1e17}) with_neighbours(edge, 3000);
+  for (double v :
+       {0.000099999999999999991, 0.00010000000000000002, 1234567890123456.8, 9999999999999998.0,
+        12345678901234568.0, 0.12345678901234568, 5e-324, 2.2250738585072009e-308})
+    with_neighbours(v, 2);
+  EXPECT_EQ(first_difference(values), "");
+  EXPECT_EQ(shortest(0.12345678901234568), "0.12345678901234568");  // 17 digits, fixed
+  EXPECT_EQ(shortest(1234567890123456.8), "1234567890123456.8");
+  EXPECT_EQ(shortest(0.00012345678901234567), "0.00012345678901234567");
+  EXPECT_EQ(shortest(1.2345678901234568e-05), "1.2345678901234568e-05");
+  EXPECT_EQ(shortest(12345678901234568.0), "1.2345678901234568e+16");
+}
+
 // What exports hold: times in seconds at ns resolution, lengths in m, air values, integers.
 TEST(ShortestNumber, ValuesLikeAnExportsNumbers) {
   std::mt19937_64 rng(7);
