@@ -117,8 +117,9 @@ class GaugeCodec : public CodecBase<GaugeCodec, GaugeFrame> {
   std::optional<double> decode_line(std::string_view line, std::uint64_t offset,
                                     std::vector<CodecError>& errors);
   void report_overlong(std::uint64_t offset, std::vector<CodecError>& errors);
-  // The number `text` in SI, from one parse: nullopt when it is no finite number (or its SI
-  // value is beyond the double's range).
+  // The number `text` in SI, from one parse: nullopt when it is no finite number, or a printed
+  // number beyond the double's range (e.g. "1e309"). A configured scale or offset may still
+  // carry a finite number out of range (inf): the caller's range check refuses that.
   std::optional<double> to_si(std::string_view text, std::optional<GaugeUnit> printed_unit) const;
   // The unit's exact scale when the configuration leaves the printed decimal as it is
   // (scale 1, offset 0); nullopt otherwise.

@@ -71,6 +71,20 @@ TEST(GaugeCodec, CountsEveryKindOfBadLineAndResynchronises) {
   EXPECT_EQ(e[3].description, "gauge: value 60 outside [-0.05, 0.05]");
 }
 
+TEST(GaugeCodec, APrintedNumberBeyondTheDoublesRangeIsNoValueWhateverItsUnit) {
+  // "1e309" is no double (DBL_MAX is 1.8e308), though 1e309 mm would be 1e306 m, which is one:
+  // the line is refused as printed, even with a range that would take 1e306 m. 1e306 mm is
+  // 1e303 m and read.
+  GaugeCodec g({.min_si = -1e307, .max_si = 1e307});
+  std::vector<GaugeFrame> f;
+  std::vector<CodecError> e;
+  g.feed("1e309 mm\n1e309\n-1e309 um\n1e306 mm\n", f, e);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].value_si, 1e303);
+  EXPECT_EQ(g.stats().malformed, 3u);
+  EXPECT_EQ(e.size(), 3u);
+}
+
 TEST(GaugeCodec, RefusesABadPattern) {
   EXPECT_THROW(GaugeCodec({.pattern = "([0-9"}), cal::InputError);
   EXPECT_THROW(GaugeCodec({.pattern = "[0-9]+"}), cal::InputError);  // no capture group

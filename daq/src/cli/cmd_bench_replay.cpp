@@ -256,9 +256,36 @@ std::string run_text(const Replayed& r, bool linear) {
                 : std::string("complete");
 }
 
+// The circle template's vibration, checked here rather than by the child `daq sim` (whose
+// message would name its own options, after the linear template's minutes).
+void check_circle_vibration(const ReplayBenchOptions& o) {
+  if (o.circle_vibration_um <= 0 && o.circle_vibration_hz <= 0) return;
+  if (!(o.circle_vibration_um > 0 && o.circle_vibration_hz > 0))
+    throw cal::InputError(
+        "bench replay: --circle-vibration-um and --circle-vibration-hz go together, both above 0");
+  // The template's ballbar streams at daq sim's default 1000 Hz; the analysis looks below 0.45
+  // of the sample rate, and a faster vibration would alias.
+  if (o.circle_vibration_hz >= 450)
+    throw cal::InputError(fmt::format(
+        "bench replay: --circle-vibration-hz {} Hz: at or above 450 Hz, 0.45 x the circle "
+        "template's 1000 Hz ballbar, where its samples would alias it",
+        o.circle_vibration_hz));
+  const auto wanted = split_kinds(o.kinds);
+  const auto kinds = cal::replay::dense_kinds();
+  const bool circle = std::any_of(kinds.begin(), kinds.end(), [&](const auto& k) {
+    return k.test == std::string_view("circle") &&
+           (wanted.empty() || std::find(wanted.begin(), wanted.end(), k.kind) != wanted.end());
+  });
+  if (!circle)
+    throw cal::InputError(
+        "bench replay: --circle-vibration-um/-hz shape the circle template, which none of "
+        "--kinds is replayed from: add ballbar");
+}
+
 void bench_replay(const ReplayBenchOptions& o) {
   if (o.rounds < 1 || o.bench_seconds < 1)
     throw cal::InputError("bench replay: --rounds and --bench-seconds must be at least 1");
+  check_circle_vibration(o);
   const int runs = o.long_run ? 5 : o.runs;
   const int targets = o.long_run ? 11 : o.targets;
   const double feed = o.long_run ? 1000.0 : o.circle_feed_mm_per_min;

@@ -234,6 +234,14 @@ void run_sim(SimOptions o) {
   if (o.vibration_y_um > 0 || o.vibration_y_hz > 0) {
     if (!(o.vibration_y_um > 0 && o.vibration_y_hz > 0))
       throw cal::InputError("--vibration-y-um and --vibration-y-hz go together, both above 0");
+    // The analysis looks for a vibration below 0.45 of the sample rate (0.9 x Nyquist,
+    // docs/circle.md); a faster one would be sampled as an alias and reported at a false
+    // frequency.
+    if (o.vibration_y_hz >= 0.45 * o.ballbar_rate_hz)
+      throw cal::InputError(fmt::format(
+          "--vibration-y-hz {} Hz: at or above 0.45 x --ballbar-rate-hz ({} Hz), where the "
+          "ballbar's samples would alias it; give a lower frequency or a faster ballbar",
+          o.vibration_y_hz, 0.45 * o.ballbar_rate_hz));
     truth.vibration_y_um = o.vibration_y_um;
     truth.vibration_y_hz = o.vibration_y_hz;
   }

@@ -4,7 +4,7 @@
 // 32: Eigen's product, SSE2 only in this build, took 2.3 instructions a multiply-add at these
 // shapes). Each sum is taken over the rows in order, one multiplication and one addition a row
 // (no fused multiply-add), so every path gives the same bits: the portable loop, the SSE2 one
-// and, where the CPU has it, the AVX2 one (tests/analysis/outer_sums_test.cpp).
+// and, where the CPU has it, the AVX2 one (OuterSums.* in tests/analysis/circle_kernels_test.cpp).
 #include <cstddef>
 
 namespace cal {

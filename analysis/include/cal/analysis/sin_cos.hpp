@@ -2,21 +2,24 @@
 // sin x and cos x together, without the library call, for the circle analysis' per-sample
 // angles and phases (issue 32: glibc's sincos, with its rounding-mode save and restore and its
 // slow-path checks, was 10 - 14 % of a long ballbar replay at five or six calls a sample).
-// Error, measured (analysis/tools/sin_cos_ulps.cpp against long double, its worst cases
-// confirmed with mpmath at 400 bits): within 0.79 ulp of the exact values (0.7803 for sin,
-// 0.7881 for cos) on 10^7 random arguments in each of |x| < pi / 4, 20, 2000 and 823549.6;
-// within 0.78 on every double within 8 ulps of n pi / 4 (|n| <= 400); within 1.07 on every
-// double within 8 ulps of n pi / 2 (|n| < 2^19), where one value is near 0 (1.0631 for cos at
-// x = +-0x1.93c05c9ed3cbcp+18, cos x = -2.2756539951781543e-16: the reduction's error, n p2t's
-// rounding, is an ulp of so small a value; 0.78 elsewhere). glibc's are within 0.52, so about one
-// value in 30 differs from glibc's, by one ulp. The same bounds to 0.01 ulp as with fdlibm's
-// coefficients and expressions (this code's first version, measured alike). SinCos.* in
+// Error, the worst measured (analysis/tools/sin_cos_ulps.cpp against long double, its worst
+// cases confirmed with mpmath at 400 bits; sample maxima, not proven bounds): within 0.79 ulp of
+// the exact values (0.7803 for sin, 0.7881 for cos) on 10^7 random arguments in each of |x| < pi /
+// 4, 20, 2000 and 823549.6; within 0.78 on every double within 8 ulps of n pi / 4 (|n| <= 400);
+// within 1.07 on every double within 8 ulps of n pi / 2 (|n| < 2^19), where one value is near 0
+// (1.0631 for cos at x = +-0x1.93c05c9ed3cbcp+18, cos x = -2.2756539951781543e-16: the reduction's
+// error, n p2t's rounding, is an ulp of so small a value; 0.78 elsewhere). glibc's are within 0.52,
+// so about one value in 30 differs from glibc's, by one ulp. The same bounds to 0.01 ulp as with
+// fdlibm's coefficients and expressions (this code's first version, measured alike). SinCos.* in
 // tests/analysis/circle_kernels_test.cpp checks them. Branch-free for |x| < 2^19 pi / 2 (the
 // analysis' angles are a few turns and its phases k c at most 2 pi R / p_min); elsewhere glibc's
 // sincos.
 //
-// Method after fdlibm (Sun, 1993: e_rem_pio2.c, k_sin.c, k_cos.c, as FreeBSD's msun has them);
-// the code and its coefficients are this project's: the coefficients derived here by Remez, see
+// Method after fdlibm (Sun, 1993: e_rem_pio2.c, k_sin.c, k_cos.c, as FreeBSD's msun has them).
+// The steps are the textbook ones fdlibm takes too, so some expressions have its form: the
+// reduction's Cody-Waite steps as in e_rem_pio2.c, and cos's 1 - z / 2 with its rounding error
+// recovered by Dekker's Fast2Sum, which k_cos.c writes the same way. The polynomials (Estrin's
+// scheme) and every coefficient are this project's: derived here by Remez, see
 // analysis/tools/sin_cos_coefficients.py (which prints them, and checks this file with --check).
 //   * Reduction (Cody and Waite's): n = nearest(x 2 / pi), r + y = x - n pi / 2 with pi / 2 in
 //     three parts, p1 and p2 of 33 bits each, so that n p1 and n p2 are exact for |n| < 2^20,
