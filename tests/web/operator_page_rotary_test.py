@@ -235,19 +235,21 @@ finally:
 
 # --- where the limits come from: a five-axis ballbar run's --tolerances file, or none -------------
 # Its basis named its file as a set-up's table ("the set-up's tolerances for C, tolerances.A");
-# the live run above has no limit (live.toml has no [tolerances.C]): the page says which keys
-# under which table of which file would judge it.
+# a rotary run made without limits (its configuration has no [tolerances.C]): the page says which
+# keys under which table of which file would judge it.
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "model")
 with open(os.path.join(TMP, "loc.toml"), "w") as f:
     f.write("[tolerances.C]\nlocation_um = 30\nlocation_urad = 20\n")
+free = json.loads(subprocess.run([DAQ, "sim", "--test", "rotary", "--runs", "2", "--acquire", "--json", "-o", "free.toml", "--db", DB],
+                                  cwd=TMP, check=True, capture_output=True, text=True).stdout)["run_id"]
 bb = json.loads(subprocess.run([DAQ, "model", "ballbar5x-run", os.path.join(DATA, "trunnion_truth.json"), "--control",
                                 os.path.join(DATA, "trunnion_nominal.json"), "--ball-mm", "150", "0", "-250", "--db", DB,
                                 "--tolerances", "loc.toml", "--json"], cwd=TMP, check=True, capture_output=True, text=True).stdout)["run_id"]
 
 # --- the set-up form of a rotary test: the angular reference's role, and the rotary kind -------
-# The form offered every role but "angle" and every kind but "rotary": on this configuration its
-# reference's card showed no role and the test kind the default (positioning), which Apply would
-# have sent. The devices are the ended simulator's (not reachable): the form does not need them.
+# The form offered every role but "angle", every kind but "rotary" and the axes X, Y, Z: on this
+# configuration its reference's card showed no role, the test kind the default (positioning) and
+# the axis X, which Apply would have sent. The devices are the ended simulator's (not reachable): the form does not need them.
 with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "live.toml"), "--db", DB]) as (serve, url, b):
     wait = page_checks.waiter(b, TMP, "return JSON.stringify({check: window.caldaq.check, status: document.getElementById('setup-status').textContent,"
                               " problems: document.getElementById('setup-problems').innerText, errors: window.__errors}).slice(0, 3000);", 30)
@@ -255,7 +257,8 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "live.toml"), "-
     b.js("document.getElementById('tab-setup').click();")
     form = wait("const r = document.querySelector('[data-key=\"devices.angle.role\"]'), m = document.querySelector('[data-key=\"test.linear.measure\"]');"
                 " return r && m && document.getElementById('setup-status').className === 'ok' && {role: r.value, shown: r.options[r.selectedIndex].textContent,"
-                " roles: [...r.options].map(o => o.value), measure: m.value, kinds: [...m.options].map(o => [o.value, o.textContent])};",
+                " roles: [...r.options].map(o => o.value), measure: m.value, kinds: [...m.options].map(o => [o.value, o.textContent]),"
+                " axis: document.querySelector('[data-key=\"test.linear.axis\"]').value};",
                 "the set-up form with the reference's card")
     ok(form["role"] == "angle" and form["shown"] == "angular reference (angle)",
        f"the reference's card keeps its role, in words: {form['role']!r} {form['shown']!r}")
@@ -263,6 +266,7 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "live.toml"), "-
        f"every role offered, the angular reference's too: {form['roles']}")
     ok(form["measure"] == "rotary" and ["rotary", "rotary"] in form["kinds"],
        f"the test kind is the configuration's, offered for its instruments: {form['measure']!r} {form['kinds']}")
+    ok(form["axis"] == "C", f"the rotary axis is the configuration's (the form offered X, Y, Z only): {form['axis']!r}")
     page_checks.shot(b, SHOTS, "r-rotary-setup-1366x768.png")
     # Checked as the other roles are: a driver that reads no angle is refused for it, naming the
     # role and the drivers that can fill it; the test cannot start.
@@ -272,15 +276,16 @@ with page_checks.served_page(DAQ, TMP, ["-c", os.path.join(TMP, "live.toml"), "-
                " return c && c.tests && c.tests.linear.problem && {problem: c.tests.linear.problem, role: r && r.value,"
                " shown: document.getElementById('setup-problems').innerText, status: document.getElementById('setup-status').className};",
                "the check of a reference that reads no angle")
-    ok(bad["role"] == "angle" and "devices.angle: driver 'ptu300' (as configured) gives no angle_rad readings, which role \"angle\" needs" in bad["problem"]
+    ok(bad["role"] == "angle" and "devices.angle: driver 'ptu300' (as configured) gives no angle_rad readings, which role \"angle\" needs "
+       "(drivers that do: gauge with unit = " in bad["problem"] and 'unit = "arcsec"' in bad["problem"]
        and "which role \"angle\" needs" in bad["shown"] and bad["status"] == "bad",
        f"a reference that reads no angle is refused, on the page: {bad}")
     b.js("document.querySelector('[data-key=\"devices.angle.role\"]').scrollIntoView();")
     page_checks.shot(b, SHOTS, "r-rotary-setup-refused-1366x768.png")
     b.js("window.scrollTo(0, 0); document.getElementById('tab-results').click();")
-    for run, want in ((run_id, "No limit was stored with this run: E_arcsec, R_arcsec, A_arcsec, B_arcsec or M_arcsec under "
-                               f"[tolerances.C] in the configuration it was made with ({os.path.join(TMP, 'live.toml')}) judge the runs "
-                               "made with it (docs/config.md)."),
+    for run, want in ((free, "No limit was stored with this run: E_arcsec, R_arcsec, A_arcsec, B_arcsec or M_arcsec under "
+                             "[tolerances.C] in the configuration it was made with (free.toml) judge the runs made with it "
+                             "(docs/config.md)."),
                       (bb, f"Limits from tolerances.C in {os.path.join(TMP, 'loc.toml')} (--tolerances).")):
         wait("return !!document.querySelector('[data-show-run=\"%d\"]');" % run, f"run {run} listed")
         b.js("document.querySelector('[data-show-run=\"%d\"]').click();" % run)

@@ -468,7 +468,9 @@ class Service {
                  {"dialects", {"fanuc", "heidenhain", "siemens"}},
                  {"cycles", {"linear", "pendulum", "pilgrim-step"}},
                  {"equations", {"ciddor", "edlen", "shop-floor"}},
-                 {"axes", {"X", "Y", "Z"}},
+                 // A rotary test's axis too (A, B, C): the loader refuses an axis its kind
+                 // does not measure (the form of a rotary set-up lost its axis C).
+                 {"axes", {"X", "Y", "Z", "A", "B", "C"}},
                  {"kinds", linear_kinds(config_)},
                  {"directions", {"X", "Y", "Z", "A", "B", "C"}},
                  {"planes", {"XY", "YZ", "ZX"}}}}});

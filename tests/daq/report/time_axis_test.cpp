@@ -35,20 +35,28 @@ TEST(TimeAxis, EachSpanInTheLargestUnitItHoldsTwice) {
 
 TEST(TimeAxis, NoSpanIsInSeconds) {
   // A single sample, or times that are not numbers: seconds, never a division by 0.
-  for (const double span : {0.0, -1.0, NAN, INFINITY}) {
+  for (const double span : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
     const auto u = time_unit(span);
     EXPECT_EQ(u.name, "s") << span;
     EXPECT_EQ(u.seconds, 1.0) << span;
   }
 }
 
-// The tick labels PLplot writes (the texts of the SVG's x axis: numbers, and "(x10" where it
-// scales them).
+// The texts PLplot writes (each <text> element, its tspans joined, its characters written as
+// "&#x32;"): the tick labels, and "(x10" where it scales them. Characters past ASCII read "?".
 std::vector<std::string> texts(const std::string& svg) {
-  static const std::regex tspan(R"re(<tspan[^>]*>([^<]*))re");
+  static const std::regex text(R"re(<text[^>]*>([\s\S]*?)</text>)re");
+  static const std::regex tag("<[^>]+>"), character("&#x([0-9a-fA-F]+);");
   std::vector<std::string> out;
-  for (std::sregex_iterator it(svg.begin(), svg.end(), tspan), end; it != end; ++it)
-    out.push_back((*it)[1].str());
+  for (std::sregex_iterator it(svg.begin(), svg.end(), text), end; it != end; ++it) {
+    const std::string inner = std::regex_replace((*it)[1].str(), tag, "");
+    std::string plain;
+    for (std::sregex_iterator c(inner.begin(), inner.end(), character), e; c != e; ++c) {
+      const unsigned long code = std::stoul((*c)[1].str(), nullptr, 16);
+      plain += code < 128 ? static_cast<char>(code) : '?';
+    }
+    out.push_back(plain);
+  }
   return out;
 }
 
