@@ -207,12 +207,21 @@ try:
         ok(status == 200, f"the run stopped: {status} {body}")
         run_id = body["stopped"]
         wait("const s = window.caldaq.page.status; return !s.running && s.last && s.last.run === %d;" % run_id, "the run stored")
-        stored = page_checks.get_json(url + f"api/runs/{run_id}")["stops"]
+        stopped = page_checks.get_json(url + f"api/runs/{run_id}")
+        stored = stopped["stops"]
         rows = b.js("return [...document.getElementById('stops').tBodies[0].rows].map((r) => [...r.cells].map((c) => c.textContent));")
         want = [[page_checks.fixed(s["nominal_mm"], 3), page_checks.fixed(s["deviation_um"], 2)]
                 for s in sorted(stored, key=lambda s: s["target_index"]) if s["run"] == 1 and s["direction"] == "up"]
-        ok(len(rows) >= 3 and [[r[4], r[5]] for r in rows][:len(want)] == want,
-           f"the stops table after the end: each stop as stored, in degrees and arcsec: {rows[:3]} (stored: {want})")
+        # A stop the run missed (the axis had left it before it was captured: under load, the
+        # first stop of one run in 8 at a load of 11) is a row "missed" with no stored value, as
+        # the run's missed stops list it (the table was compared row for row with the stored stops
+        # and failed on that row).
+        missed = [page_checks.fixed(m["nominal_mm"], 3) for m in stopped["missed_stops"] if m["run"] == 1 and m["direction"] == "up"]
+        captured = [[r[4], r[5]] for r in rows if r[5] != "missed"]
+        ok(len(captured) >= 2 and captured[:len(want)] == want and [r[4] for r in rows if r[5] == "missed"] == missed[:len(
+           [r for r in rows if r[5] == "missed"])],
+           f"the stops table after the end: each stop as stored, in degrees and arcsec, a missed one said so: {rows[:3]} "
+           f"(stored: {want}, missed: {missed})")
         # The captured stop's number and event are its stored value (the window mean of the
         # reference that is evaluated), not the trigger's mean (they said -5.914 for a stop
         # stored -6.069, 0.25" apart at most on this axis).
