@@ -74,6 +74,9 @@ check fit_within_4u 0 "^ok$" -- within "$TMP/r1.json" truth
 check runs_list 0 "ballbar5x +CA +complete +[0-9]{5,}" -- "$DAQ" runs --db "$DB"
 check show 0 "E_X0C +\+2[45]\.[0-9]{3} um +location error of the C axis, u = 0\.[0-9]{3}" -- "$DAQ" show 1 --db "$DB"
 check show_kind 0 "^run 1: ballbar5x CA \(complete\)" -- "$DAQ" show 1 --db "$DB"
+# No limit: where they are given for this run, a file given to --tolerances (daq show said
+# "[tolerances] in the configuration", which a run of daq model ballbar5x-run does not have).
+check show_no_tolerance 0 "^ +verdict: no tolerance configured: no limit was stored with this run: location_um \(each position\) and location_urad \(each tilt\) under \[tolerances\.C\] and \[tolerances\.A\] in a file given to daq model ballbar5x-run --tolerances judge what the control's kinematics leave of each location error \(docs/config\.md\)$" -- "$DAQ" show 1 --db "$DB"
 check show_device 0 "device [0-9]+: ballbar on ballbar \(serial /dev/pts/[0-9]+ 115200 8N1\)" -- "$DAQ" show 1 --db "$DB"
 # The report (docs/reports.md): its numbers are daq show --json's (the stored result), each
 # within 0.0005 of its unit (printed to 0.001); the tests as run (six: C then A, each radial,
@@ -135,6 +138,9 @@ PYEOF
 READINGS=$("$PY" -c 'import json,sys; print(json.load(open(sys.argv[1]))["readings"])' "$TMP/r1.json")
 check report_as_show 0 "^ok$" -- report_vs_show "$TMP/r1.html" "$TMP/show1.json" "$READINGS" 7
 check report_no_tolerance 0 "<strong>No tolerance configured</strong>.*<code>location_um</code>.*<code>\[tolerances.C\]</code> and <code>\[tolerances.A\]</code>" -- cat "$TMP/r1.html"
+# Its Instruments table: the bar is a simulated twin, said where its model and serial number go
+# (the cell was blank, as if missing).
+check report_instrument_row 0 "<h4>Instruments</h4>.*<tr><td>ballbar</td><td><span class=\"unstated\">none: a simulated twin</span></td><td>ballbar \(serial /dev/pts/" -- "$PY" -c "import sys; print(open(sys.argv[1], encoding='utf-8').read().replace(chr(10), ' '))" "$TMP/r1.html"
 check report_title 0 "<h1>SIMULATED — Run 1: Five-axis ballbar test \(rotary axes&#39;? location errors\), axes C and A</h1>" -- cat "$TMP/r1.html"
 check report_draft 0 "DRAFT — NOT APPROVED</strong>: result [0-9]+ has not been approved" -- cat "$TMP/r1.html"
 check report_dialect 0 "Program dialect: <span class=\"unstated\">none: the simulated control ran the program" -- cat "$TMP/r1.html"
@@ -180,8 +186,12 @@ print(r["summary"], len(r["checks"]), " ".join(sorted(c["key"] for c in r["check
 }
 check verdict_swivel_pass 0 "^PASS 8 $" -- verdict 2
 check verdict_hal_tilts_fail 0 "^FAIL 8 E_A0C E_B0A E_B0C E_C0A$" -- verdict 3
+# The limits' file is stored with the run and named as the verdict's basis (it said
+# "tolerances.C, tolerances.A", as if from a configuration the run does not have).
+check show_basis_file 0 "^ +verdict against tolerances\.C, tolerances\.A in \S*/tol\.toml \(--tolerances\): PASS$" -- "$DAQ" show 2 --db "$DB"
 "$DAQ" report 3 --db "$DB" -o "$TMP/r3.html" >/dev/null 2>&1
 check report_fail 0 "<strong>FAIL</strong> &mdash; 4 of 8 limited values outside their limits" -- cat "$TMP/r3.html"
+check report_basis_file 0 "Verdict against the machine specification \(tolerances\.C, tolerances\.A in \S*/tol\.toml \(--tolerances\)\)" -- cat "$TMP/r3.html"
 check report_failing_value 0 "<li><strong>E_B0C</strong> = -[56]\.[0-9]{3} µrad \(limit ≤ 3\.000 µrad\): correct the axis&#39;s tilt in the control&#39;s kinematics</li>" -- cat "$TMP/r3.html"
 # Printed on A4 by Chromium: page one holds the failing verdict, the location errors and the
 # whole table of the tests; printed at full size (the appendix's raw list of the tests, a line

@@ -724,6 +724,11 @@ check("imported run: the plot says displacement (mm), not displacement_m or (m)"
       "displacement (mm)" in imported_plot and "displacement_m" not in imported_plot
       and "displacement (m)" not in imported_plot
       and " ch 0" not in imported_plot, imported_plot[:300])
+# Its three samples 1 ms apart on a time axis in ms, ticked to 2.0 (it was in minutes, ticked
+# 0.00000 to 3.00000 "(x10⁻⁵)").
+check("imported run: 2 ms of samples on a time axis in ms, in plain numbers",
+      "time (ms)" in imported_plot and " 2.0 " in imported_plot and "x10" not in imported_plot
+      and "time (min)" not in imported_plot, imported_plot[:300])
 # Its legend names the file's instrument once, with the serial number its header states (it
 # read "renishaw-rtx (CARTO-Dynamic 4.13) renishaw-rtx (CARTO-Dynamic 4.13)").
 instrument = "renishaw-rtx (CARTO-Dynamic 4.13)"
@@ -736,6 +741,14 @@ imported_text = html_mod.unescape(re.sub(r"<[^>]+>", "", open("imported.html", e
 said = (f"the readings of {instrument} were imported from Renishaw .rtx file lin.rtx (the file does "
         "not say whether the instrument was real), which states the serial number XL-8123 but no "
         "certificate or calibration due date.")
+# The Instruments table: the serial number the file states where the model and serial number
+# go (the cell was blank, as if the data were missing).
+instruments_row = re.search(r"<h4>Instruments</h4>.*?<tr><td>([^<]*)</td><td>(.*?)</td>",
+                            open("imported.html", encoding="utf-8").read(), re.S)
+check("imported run: the Instruments table gives the file's serial number, no blank cell",
+      instruments_row is not None and instruments_row.group(1) == html_mod.escape(instrument)
+      and instruments_row.group(2) == 'serial XL-8123 <span class="unstated">(model not stated)</span>',
+      str(instruments_row and instruments_row.groups()))
 check("imported run: page one and Instruments say what the file states of its instrument",
       f"Traceability: {said}" in imported_text and "The" + said[3:] in imported_text
       and "give serial_number" not in imported_text,

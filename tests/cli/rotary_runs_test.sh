@@ -38,6 +38,17 @@ report_failing <li><strong>B</strong> = -?[0-9.]+ arcsec \(limit ≤ 2\.000 arcs
 report_limit_head limit&nbsp;\(arcsec\)
 report_E_limit ≤ 30\.000
 END
+# Without limits, each output says where they would be given for this run: its axis's table in
+# the configuration it was made with (daq show said "[tolerances] in the configuration" for
+# every kind of run, daq run the same).
+"$DAQ" sim --test rotary --runs 2 --acquire -o "$TMP/free.toml" --db "$TMP/free.sqlite" >"$TMP/free.out" 2>&1
+FREE="verdict: no tolerance configured: no limit was stored with this run: E_arcsec, R_arcsec, A_arcsec, B_arcsec or M_arcsec under \[tolerances\.C\] in the configuration it was made with \(\S*free\.toml\) judge the runs made with it \(docs/config\.md\)$"
+check free_run 0 "^$FREE" -- cat "$TMP/free.out"
+check free_show 0 "^ +$FREE" -- "$DAQ" show 1 --db "$TMP/free.sqlite"
+check free_analyse 0 "^$FREE" -- "$DAQ" analyse 1 --db "$TMP/free.sqlite"
+"$DAQ" report 1 --db "$TMP/free.sqlite" -o "$TMP/free.html" >/dev/null 2>&1
+check free_report 0 "No limit was stored with this run: <code>E_arcsec</code>, <code>R_arcsec</code>, <code>A_arcsec</code>, <code>B_arcsec</code> or <code>M_arcsec</code> under <code>\[tolerances\.C\]</code> in the configuration it was made with \(<span class=\"path\">\S*free\.toml</span>\)" -- cat "$TMP/free.html"
+
 # A length limit on a rotary axis is refused at its line (a µm limit was never compared with
 # arcsec, but it was not refused either: [tolerances.C] was not read at all).
 { cat "$TMP/rot1.toml"; printf '\n[tolerances.A]\nR_arcsec = 3\nE_um = 10\n'; } >"$TMP/bad.toml"

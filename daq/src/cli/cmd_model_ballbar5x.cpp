@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -461,8 +462,10 @@ void run_run(const RunOptions5x& given) {
   setup.config.campaign = "five-axis ballbar (simulated)";
   setup.control = control;
   setup.tests = run_tests(control, o);
-  if (!o.tolerances.empty())
+  if (!o.tolerances.empty()) {
     setup.config.axis_tolerances = location_tolerances(o.tolerances, setup.tests);
+    setup.tolerances_file = std::filesystem::absolute(o.tolerances).string();
+  }
   setup.database = database_path(o.db);
   const std::string database = setup.database.string();
   setup.extra_settings_json =

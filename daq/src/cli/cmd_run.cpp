@@ -172,9 +172,16 @@ std::string live_line(const LiveState& s) {
   return line;
 }
 
+// A circle's verdict by the limits of its plane; with none, where they are given.
 Verdict verdict_circle(const cal::daq::Config& c, const std::string& plane,
                        const nlohmann::json& result) {
-  return circle_verdict(run_tolerances(c, "circle", plane), result);
+  auto v = circle_verdict(run_tolerances(c, "circle", plane), result);
+  if (!v.configured && v.notes.empty()) {
+    auto where = limits_where("circle", plane, nlohmann::json::object(), result);
+    where.configuration = c.source.string();
+    v.hint = to_text(where);
+  }
+  return v;
 }
 
 // The result of a straightness, angular, roll or rotary run (kinds/kind.hpp).
@@ -230,12 +237,16 @@ void run_linear_test(const RunOptions& o, boost::asio::io_context& io, const Run
       o.config));
   watch_keyboard(io, [&] { run.manual_capture(); });
   const auto& out = run_to_end(io, run, capture, drive);
-  const auto settings = cal::storage::Store(database_path(o.db)).run(out.run_id);
+  const auto run_record = cal::storage::Store(database_path(o.db)).run(out.run_id);
   const auto stored =
-      settings ? cal::daq::parse_stored_json(settings->settings_json) : nlohmann::json();
-  if (out.profile)
-    return print_profile(out, verdict_of(stored, *out.profile), o.json, progress->tty);
-  const auto v = verdict_of(stored, to_json(*out.evaluation));
+      run_record ? cal::daq::parse_stored_json(run_record->settings_json) : nlohmann::json();
+  // Judged by the limits stored with the run; with none, the verdict says where they are given.
+  const auto verdict = [&](const nlohmann::json& result) {
+    return run_record ? run_verdict(run_record->kind, run_record->axis, stored, result)
+                      : verdict_of(stored, result);
+  };
+  if (out.profile) return print_profile(out, verdict(*out.profile), o.json, progress->tty);
+  const auto v = verdict(to_json(*out.evaluation));
   if (o.json) {
     auto j = to_json(*out.evaluation);
     j["run_id"] = out.run_id;

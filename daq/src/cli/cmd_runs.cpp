@@ -214,7 +214,7 @@ json run_document(const st::RunReader& store, std::int64_t id) {
              {"provenance", cal::daq::parse_stored_json(res.provenance_json)},
              {"result", doc.is_discarded() ? json(res.json) : doc}};
     if (one["provenance"].is_discarded()) one["provenance"] = json::object();
-    if (!doc.is_discarded()) one["verdict"] = to_json(verdict_of(settings, doc));
+    if (!doc.is_discarded()) one["verdict"] = to_json(run_verdict(r.kind, r.axis, settings, doc));
     for (const auto& a : approvals)
       if (a.result_id == res.id) one["approval"] = approval_json(a);
     j["results"].push_back(std::move(one));

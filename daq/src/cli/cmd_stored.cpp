@@ -99,7 +99,7 @@ void analyse_circle_run(const st::RunReader& store, st::Store* writer, const st:
                                         .provenance_json = prov.dump()});
     j["result_id"] = id;
   }
-  const auto v = verdict_of(settings, j);
+  const auto v = run_verdict(run.kind, run.axis, settings, j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print_circle_result(result, program, analysis);
@@ -117,7 +117,7 @@ void analyse_profile_run(const st::RunReader& store, const st::RunRecord& run,
         run.id, run.kind));
   json j = stored_profile(store, run);
   j["values"] = rows_json(result_rows(j));
-  const auto v = verdict_of(cal::daq::parse_stored_json(run.settings_json), j);
+  const auto v = run_verdict(run.kind, run.axis, cal::daq::parse_stored_json(run.settings_json), j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print_result(j);
@@ -147,7 +147,7 @@ void analyse_rotary_run(const st::RunReader& store, st::Store* writer, const st:
                             .json = j.dump(),
                             .provenance_json = prov.dump()});
   }
-  const auto v = verdict_of(cal::daq::parse_stored_json(run.settings_json), j);
+  const auto v = run_verdict(run.kind, run.axis, cal::daq::parse_stored_json(run.settings_json), j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print_kind_result(j, j.value("component", ""));
@@ -189,7 +189,8 @@ void analyse_run(const AnalyseRunOptions& o) {
                                          .json = j.dump(),
                                          .provenance_json = prov.dump()});
   }
-  const auto v = verdict_of(cal::daq::parse_stored_json(run->settings_json), j);
+  const auto v =
+      run_verdict(run->kind, run->axis, cal::daq::parse_stored_json(run->settings_json), j);
   j["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(j, 2));
   print(e);
@@ -343,7 +344,7 @@ void recompensate(const RecompensateOptions& o) {
   const auto quality = assess_stops(store.targets(o.run), "um");
   store.set_quality(o.run, quality);
   doc["quality"] = quality_json(quality);
-  const auto v = verdict_of(settings, doc);
+  const auto v = run_verdict(run.kind, run.axis, settings, doc);
   doc["verdict"] = to_json(v);
   if (o.json) return fmt::print("{}\n", cal::daq::dump_output(doc, 2));
   fmt::print("run {}: {} stops recompensated (largest change {:.3f} um), stored as result {}",

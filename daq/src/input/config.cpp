@@ -9,6 +9,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <span>
 #include <sstream>
 
 #include "cal/analysis/air.hpp"
@@ -163,10 +164,14 @@ PositioningLimits read_limits(Table& t) {
 }
 
 void one_of(Table& t, std::string_view key, const std::string& value,
-            std::initializer_list<std::string_view> allowed) {
+            std::span<const std::string_view> allowed) {
   if (std::find(allowed.begin(), allowed.end(), value) == allowed.end())
     t.fail(t.node(key), key,
            fmt::format("'{}' is not one of: {}", value, fmt::join(allowed, ", ")));
+}
+void one_of(Table& t, std::string_view key, const std::string& value,
+            std::initializer_list<std::string_view> allowed) {
+  one_of(t, key, value, std::span(allowed.begin(), allowed.size()));
 }
 
 template <class S>
@@ -321,9 +326,7 @@ DeviceConfig read_device(const std::string& id, const toml::table& tbl,
   t.read("poll_s", d.poll_s);
   if (d.poll_s < 0) t.fail(t.node("poll_s"), "poll_s", "must be >= 0");
   t.read("role", d.role);
-  if (!d.role.empty())
-    one_of(t, "role", d.role,
-           {"laser", "air", "material", "ballbar", "position", "indicator", "level", "angle"});
+  if (!d.role.empty()) one_of(t, "role", d.role, device_roles);
   t.read("origin", d.origin);
   one_of(t, "origin", d.origin, {"real", "simulated"});
   t.name("serial_number", d.serial_number);

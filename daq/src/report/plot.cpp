@@ -225,6 +225,19 @@ void draw_line(SvgStream& s, const Line& l, std::vector<LegendEntry>& legend) {
                       l.dashed ? 2 : 1, l.width, marker});
 }
 
+}  // namespace
+
+TimeUnit time_unit(double span_s) {
+  static constexpr TimeUnit units[] = {
+      {3600.0, "h"}, {60.0, "min"}, {1.0, "s"}, {1e-3, "ms"}, {1e-6, "µs"}};
+  if (!(span_s > 0) || !std::isfinite(span_s)) return {};
+  for (const auto& u : units)
+    if (span_s >= 2 * u.seconds) return u;
+  return units[std::size(units) - 1];
+}
+
+namespace {
+
 // A tick interval of 1, 2 or 5 times a power of ten giving about `ticks` intervals over a
 // span, and the decimals its labels need (0.2 -> 1): PLplot's own choice printed 1006.8 and
 // 1007.0 hPa both as "1007".

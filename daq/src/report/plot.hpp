@@ -43,6 +43,16 @@ struct SeriesStyle {
 };
 SeriesStyle paired_style(std::size_t pair, bool second);
 
+// The unit of a time axis spanning `span_s` seconds: the largest of h, min, s, ms and µs the
+// span holds at least twice, so that its ticks are plain numbers (an imported run of three
+// samples, 40 µs, drawn in minutes had its ticks labelled "(x10⁻⁵)"; a two-minute run in hours,
+// 0.01 to 0.03). Seconds for a span of 0 or less (a single sample).
+struct TimeUnit {
+  double seconds = 1.0;         // one unit in seconds (60 for "min")
+  std::string_view name = "s";  // as an axis label gives it: "time (ms)"
+};
+TimeUnit time_unit(double span_s);
+
 // A filled band between lo and hi (e.g. mean +/- 2 s).
 struct Band {
   std::vector<double> x, lo, hi;

@@ -92,9 +92,9 @@ std::string figure(std::string svg, std::string_view caption) {
 
 struct Series {
   std::string label;
-  std::string short_label;  // for a plot half the page wide ("PTU300 (SIM-PTU-0001)")
-  int device = -1;          // the instrument's (the same sensor in several plots)
-  std::vector<double> t_min, value;
+  std::string short_label;         // for a plot half the page wide ("PTU300 (SIM-PTU-0001)")
+  int device = -1;                 // the instrument's (the same sensor in several plots)
+  std::vector<double> t_s, value;  // t_s: seconds since the run's first reading
 };
 
 struct Environment {
@@ -241,7 +241,7 @@ Environment load_environment(const st::RunReader& store, const RunView& v) {
   for (const auto& r : readings) {
     if (r.status != 0) continue;  // flagged values are not measurements
     auto& s = by_source[{r.quantity, r.device, r.channel}];
-    s.t_min.push_back(static_cast<double>(r.time_ns - env.t0_ns) / 60e9);
+    s.t_s.push_back(static_cast<double>(r.time_ns - env.t0_ns) * 1e-9);
     s.value.push_back(static_cast<Q>(r.quantity) == Q::air_pressure_pa ? r.value / 100.0 : r.value);
   }
   for (auto& [key, s] : by_source) {
@@ -311,16 +311,30 @@ Stats stats(const std::vector<Series>& series) {
   return s;
 }
 
-// At most `limit` points per series in a plot (every k-th): a plot cannot show more.
-std::vector<Line> lines_of(const std::vector<Series>& series, std::size_t first_colour,
-                           std::size_t limit = 1500) {
+// The times of the series plotted against one time axis, and the axis's unit for them
+// (time_unit: a run of seconds in seconds, not in minutes written "x10⁻²").
+struct TimeSpan {
+  double lo = INFINITY, hi = -INFINITY;
+  void add(const Series& s) {
+    for (const double t : s.t_s) lo = std::min(lo, t), hi = std::max(hi, t);
+  }
+  TimeUnit unit() const { return time_unit(hi >= lo ? hi - lo : 0.0); }
+};
+
+// "time (min)".
+std::string time_label(const TimeUnit& unit) { return fmt::format("time ({})", unit.name); }
+
+// At most `limit` points per series in a plot (every k-th): a plot cannot show more. Their time
+// in `unit`.
+std::vector<Line> lines_of(const std::vector<Series>& series, const TimeUnit& unit,
+                           std::size_t first_colour, std::size_t limit = 1500) {
   std::vector<Line> out;
   for (std::size_t i = 0; i < series.size(); ++i) {
     const auto& s = series[i];
-    const std::size_t step = std::max<std::size_t>(1, s.t_min.size() / limit);
+    const std::size_t step = std::max<std::size_t>(1, s.t_s.size() / limit);
     Line l{.label = s.label, .colour = palette(first_colour + i), .width = 1.2};
-    for (std::size_t k = 0; k < s.t_min.size(); k += step) {
-      l.x.push_back(s.t_min[k]);
+    for (std::size_t k = 0; k < s.t_s.size(); k += step) {
+      l.x.push_back(s.t_s[k] / unit.seconds);
       l.y.push_back(s.value[k]);
     }
     out.push_back(std::move(l));
@@ -636,16 +650,29 @@ std::string settings_appendix(const RunView& v) {
          table({"setting", "value"}, rows, "kv");
 }
 
+std::string stated(const std::string& s);
+
+// What is known of an instrument's model and serial number, never a blank cell (it read as
+// data missing): the configured driver and serial number, else for an instrument no
+// configuration named (a run of daq model ballbar5x-run, an imported file) that it is a
+// simulated twin, or the serial number its file stated; else that none was stated.
+std::string model_cell(const RunView& v, const st::InstrumentRecord& i) {
+  const std::string model = instrument_label(v, i.device);
+  if (model != i.driver) return esc(model);
+  if (i.origin == "simulated") return "<span class=\"unstated\">none: a simulated twin</span>";
+  if (const auto serial = stored_serial(v, i.device); !serial.empty())
+    return "serial " + esc(serial) + " <span class=\"unstated\">(model not stated)</span>";
+  return stated("");
+}
+
 // The instruments and their connections, by the names the set-up gave them and their model and
 // serial number. Not by the acquisition's device numbers: those have gaps where a configured
 // device was not used (0, 1, 2, 4 on a straightness run) and mean nothing to the reader.
 std::string connections_table(const RunView& v) {
   std::string h;
   std::vector<std::vector<std::string>> inst;
-  for (const auto& i : v.instruments) {
-    const std::string model = instrument_label(v, i.device);
-    inst.push_back({esc(i.driver), model == i.driver ? "" : esc(model), esc(i.transport)});
-  }
+  for (const auto& i : v.instruments)
+    inst.push_back({esc(i.driver), model_cell(v, i), esc(i.transport)});
   if (!inst.empty())
     h += "<h4>Instruments</h4>\n" +
          table({"instrument", "model and serial number", "connection"}, inst);
@@ -670,11 +697,17 @@ std::string environment_section(const Environment& env) {
   h += table({"quantity", "min", "mean", "max", "unit", "samples"}, rows, "num", "lrrrlr");
   // The legends say which sensor ("air sensor PTU300 ...", "material sensor ..."), so the
   // quantity needs no prefix of its own ("air: ids3010" named neither).
-  auto temps = lines_of(env.air_temperature, 0);
+  // One time unit for the section's plots (they share the run's time).
+  TimeSpan span;
+  for (const auto* g :
+       {&env.air_temperature, &env.material_temperature, &env.pressure_hpa, &env.humidity})
+    for (const auto& s : *g) span.add(s);
+  const auto unit = span.unit();
+  auto temps = lines_of(env.air_temperature, unit, 0);
   std::map<int, Rgb> colour_of;  // an air sensor's device -> its colour in the temperature plot
   for (std::size_t i = 0; i < temps.size(); ++i)
     colour_of.emplace(env.air_temperature[i].device, temps[i].colour);
-  for (auto& l : lines_of(env.material_temperature, env.air_temperature.size())) {
+  for (auto& l : lines_of(env.material_temperature, unit, env.air_temperature.size())) {
     l.dashed = true;
     temps.push_back(std::move(l));
   }
@@ -685,10 +718,10 @@ std::string environment_section(const Environment& env) {
   // canvas: 7.5 at 320 x 290 against 11 at 600 x 290), so it prints at 9 pt or more (12 x 253 /
   // 320 = 9.5 pt). Each air sensor keeps its colour of the temperature plot, whose legend names
   // it, so the pair needs no legends of their own (two rows of legend took a third of each).
-  const auto time_chart = [](const char* title, const char* y_label, std::vector<Line> lines,
-                             int width_pt, int height_pt, double text_scale, bool legend) {
+  const auto time_chart = [&unit](const char* title, const char* y_label, std::vector<Line> lines,
+                                  int width_pt, int height_pt, double text_scale, bool legend) {
     return svg(XyChart{.title = title,
-                       .x_label = "time (min)",
+                       .x_label = time_label(unit),
                        .y_label = y_label,
                        .lines = std::move(lines),
                        .width_pt = width_pt,
@@ -702,7 +735,7 @@ std::string environment_section(const Environment& env) {
   // that plot (then each plot has its own colours and a legend naming the instruments short).
   bool keyed = true;
   const auto air_lines = [&](const std::vector<Series>& series, std::size_t colour) {
-    auto lines = lines_of(series, colour);
+    auto lines = lines_of(series, unit, colour);
     for (std::size_t i = 0; i < lines.size(); ++i) {
       lines[i].label = series[i].short_label;
       if (const auto it = colour_of.find(series[i].device); it != colour_of.end())
@@ -714,7 +747,8 @@ std::string environment_section(const Environment& env) {
   };
   auto pressure = air_lines(env.pressure_hpa, 2);
   auto humidity = air_lines(env.humidity, 5);
-  if (!keyed) pressure = lines_of(env.pressure_hpa, 2), humidity = lines_of(env.humidity, 5);
+  if (!keyed)
+    pressure = lines_of(env.pressure_hpa, unit, 2), humidity = lines_of(env.humidity, unit, 5);
   const bool both = !env.pressure_hpa.empty() && !env.humidity.empty();
   const char* key = keyed ? " (each sensor in its colour of the temperature plot)" : "";
   std::string plots;
@@ -722,13 +756,13 @@ std::string environment_section(const Environment& env) {
     plots += figure(both ? time_chart("Air pressure", "pressure (hPa)", std::move(pressure), 320,
                                       240, 1.6, !keyed)
                          : time_chart("Air pressure", "pressure (hPa)",
-                                      lines_of(env.pressure_hpa, 2), 600, 200, 1.0, true),
+                                      lines_of(env.pressure_hpa, unit, 2), 600, 200, 1.0, true),
                     fmt::format("Air pressure during the run{}.", both ? key : ""));
   if (!env.humidity.empty())
     plots += figure(both ? time_chart("Relative humidity", "humidity (%RH)", std::move(humidity),
                                       320, 240, 1.6, !keyed)
                          : time_chart("Relative humidity", "humidity (%RH)",
-                                      lines_of(env.humidity, 5), 600, 200, 1.0, true),
+                                      lines_of(env.humidity, unit, 5), 600, 200, 1.0, true),
                     fmt::format("Relative humidity during the run{}.", both ? key : ""));
   // The figures are the pair's own children (no wrapping div), each a grid cell.
   if (both) plots = "<div class=\"pair\">" + plots.substr(0, plots.size() - 1) + "</div>\n";
@@ -1091,19 +1125,40 @@ std::string conditions_section(const RunView& v) {
   return "<h3>Test conditions</h3>\n" + table({"", ""}, rows, "kv");
 }
 
-// Where the limits of a run stored without them are set, for its verdict line: the keys
-// (`keys`, markup), the table of its axis or plane, and the configuration the run started
-// with (the limits in force when a run starts are stored with it and judge it; a replay keeps
-// its original run's). A run replayed from a capture whose original run is not in this
-// database has none: a capture's header does not carry the tolerances.
 // Keys as markup: "<code>E_um</code>, ... or <code>M_um</code>".
 std::string code_keys(std::vector<std::string> keys) {
   for (auto& k : keys) k = "<code>" + esc(k) + "</code>";
   return ::daq::either_of(keys);
 }
 
-std::string tolerance_hint(const RunView& v, std::string_view keys) {
-  const std::string config = ctx(v.context, "configuration");
+// Where the limits of a run stored without them are set, for its verdict line (`doc`: its
+// result): the keys, the table of its axis or plane (a five-axis ballbar run's, of each axis),
+// and the file that holds them: the configuration the run started with, or the one given to
+// daq model ballbar5x-run --tolerances (the limits in force when a run starts are stored with
+// it and judge it; a replay keeps its original run's). A run replayed from a capture whose
+// original run is not in this database has none: a capture's header does not carry the
+// tolerances. The terminal says the same in words (verdict.hpp, to_text of limits_where).
+// `several`: of a comparison's runs, `v` the newest.
+std::string tolerance_hint(const RunView& v, const json& doc, bool several = false) {
+  const auto w = ::daq::limits_where(v.run.kind, v.run.axis, v.settings, doc);
+  std::vector<std::string> tables;
+  for (const auto& t : w.tables) tables.push_back("<code>[" + esc(t) + "]</code>");
+  const std::string where = !w.option.empty() ? "a file given to <code>" + esc(w.option) + "</code>"
+                            : w.configuration.empty()
+                                ? std::string("the configuration")
+                                : fmt::format(
+                                      "the configuration {} was made with (<span "
+                                      "class=\"path\">{}</span>)",
+                                      several ? "the newest" : "it", esc(w.configuration));
+  if (!w.each.empty() && w.each.size() == w.keys.size()) {  // a five-axis ballbar run's
+    std::vector<std::string> keys;
+    for (std::size_t i = 0; i < w.keys.size(); ++i)
+      keys.push_back(fmt::format("<code>{}</code> ({})", esc(w.keys[i]), esc(w.each[i])));
+    return fmt::format(
+        "No limit was stored with this run: {} under {} in {} judge what the control's "
+        "kinematics leave of each location error (docs/config.md).",
+        and_list(keys), and_list(tables), where);
+  }
   bool orphan_replay = false;  // replayed, of no run in this database
   for (const auto& r : v.results) {
     const json p = json::parse(r.provenance_json, nullptr, false);
@@ -1111,14 +1166,10 @@ std::string tolerance_hint(const RunView& v, std::string_view keys) {
       orphan_replay = p.contains("replay_of_run") && p["replay_of_run"].is_null();
   }
   return fmt::format(
-      "No limit was stored with this run: {} under <code>[tolerances.{}]</code> in {} judge{} "
-      "the runs made with it (docs/config.md).{}",
-      keys, esc(v.run.axis),
-      config.empty()
-          ? std::string("the configuration")
-          : "the configuration it was made with (<span class=\"path\">" + esc(config) + "</span>)",
-      keys.find(',') == std::string_view::npos && keys.find(" or ") == std::string_view::npos ? "s"
-                                                                                              : "",
+      "No limit was stored with {}: {} under {} in {} judge{} the runs made with it "
+      "(docs/config.md).{}",
+      several ? "these runs" : "this run", code_keys(w.keys), and_list(tables), where,
+      w.keys.size() == 1 ? "s" : "",
       orphan_replay ? " A replay takes the limits of its original run in the same database; "
                       "this capture's original run is not in it, and a capture does not carry "
                       "the limits."
@@ -1184,16 +1235,13 @@ std::string failing_values(const ::daq::Verdict& v, bool strong) {
 
 // The verdict of a result as a coloured line: pass, fail, or no tolerance configured (then
 // `hint`: which limits would judge it and where they are set, tolerance_hint).
-std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint = {}) {
+std::string verdict_banner(const ::daq::Verdict& v, const std::string& hint) {
   if (!v.configured) {
     std::string h =
         v.notes.empty()
             ? "<p class=\"verdict none\"><strong>No tolerance configured</strong> for this test: "
-              "the results are not judged" +
-                  (hint.empty() ? std::string(" (a machine specification is given as [tolerances] "
-                                              "in the configuration, docs/config.md).")
-                                : ". " + hint) +
-                  "</p>\n"
+              "the results are not judged. " +
+                  hint + "</p>\n"
             : "<p class=\"verdict none\"><strong>No tolerance applies</strong>: the configured "
               "limits are for values this evaluation does not give, so the results are not "
               "judged.</p>\n";
@@ -1704,8 +1752,7 @@ Sections linear_section(const st::RunReader& store, const RunView& v, const Opti
                   r.value, unit, ::daq::find_check(verdict, r.key));
   if (rotary) h += angular_reference_line(v);
   // The limits that would judge it, of this standard, in the axis's unit.
-  h += verdict_banner(
-      verdict, tolerance_hint(v, code_keys(::daq::tolerance_keys(v.run.kind, e.standard.title))));
+  h += verdict_banner(verdict, tolerance_hint(v, doc));
   h += results_grid(e, verdict, unit);
   h += means_plot(l);
   std::string& d = out.details;
@@ -2057,7 +2104,7 @@ Sections circle_section(const st::RunReader& store, const RunView& v, const Opti
   for (const auto& x : st.informative)
     other.push_back({esc(x.symbol), um(::daq::iso_value(r.iso, x.key)),
                      "<em>informative</em>: " + esc(x.meaning)});
-  h += verdict_banner(verdict, tolerance_hint(v, code_keys(::daq::tolerance_keys("circle"))));
+  h += verdict_banner(verdict, tolerance_hint(v, doc));
   // Page one holds the verdict, the values, the polar plot and what to fix first: the values
   // beside the plot (one under the other pushed "what to fix first" onto page two). The plot's
   // text is drawn larger so that, shown at half the page's width, it still prints at 9 pt.
@@ -2210,7 +2257,7 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
       for (const auto& r : batch) {
         auto& t = by[{r.quantity, r.device, r.channel}];
         if (t.seen++ % t.step != 0) continue;
-        t.s.t_min.push_back(static_cast<double>(r.time_ns - t0) / 60e9);
+        t.s.t_s.push_back(static_cast<double>(r.time_ns - t0) * 1e-9);
         t.s.value.push_back(r.value);
       }
       read += batch.size();
@@ -2221,6 +2268,10 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
   // of a page with their plot on the next read as an empty section (the angular report's page 1).
   std::string h = fmt::format(
       "<div class=\"keep-with-next\"><h3>Readings</h3>\n<p>{} readings stored.</p>\n", count);
+  // One time unit for every plot of the readings (they share the run's time).
+  TimeSpan span;
+  for (const auto& [key, t] : by) span.add(t.s);
+  const auto time = span.unit();
   std::size_t i = 0;
   for (auto& [key, t] : by) {
     const auto unit = plot_unit(static_cast<Q>(std::get<0>(key)), t.s.value);
@@ -2229,9 +2280,9 @@ std::string generic_section(const st::RunReader& store, const RunView& v, const 
     // Lower than a result's plot (the raw readings support it): at 300 pt each of an angular
     // run's three (the displacement and each beam) took most of a page, its pages 65 % full.
     h += figure(svg(XyChart{.title = t.title,
-                            .x_label = "time (min)",
+                            .x_label = time_label(time),
                             .y_label = unit.label,
-                            .lines = lines_of({t.s}, i++, 4000),
+                            .lines = lines_of({t.s}, time, i++, 4000),
                             .height_pt = 220}),
                 t.title + " over the run.");
     if (i == 1) h += "</div>\n";  // after the first plot
@@ -2395,9 +2446,7 @@ Sections profile_section(const st::RunReader& store, const RunView& v, const Opt
       straight ? "straightness" : "angular deviation", esc(ctx(doc, "component")),
       doc.value("targets", json::array()).size(),
       stored ? "" : " (no result was stored with the run: evaluated from its stops now)");
-  out.answer += verdict_banner(
-      verdict,
-      tolerance_hint(v, code_keys(::daq::tolerance_keys(straight ? "straightness" : "angular"))));
+  out.answer += verdict_banner(verdict, tolerance_hint(v, doc));
   out.answer += profile_values_table(rows, verdict);
   out.answer += profile_plot(doc, unit);
   // The details follow on page one (after a page break, page one of an angular run was 70 %
@@ -2526,16 +2575,7 @@ Sections ballbar5x_section(const st::RunReader& store, const RunView& v, const O
       "&ldquo;The ballbar on a rotary axis&rdquo;): caldaq does not claim ISO 10791-6's own test "
       "definitions, which are not public.</p>\n",
       stops, tests);
-  std::vector<std::string> tables;
-  for (const auto& a : axes)
-    tables.push_back("<code>[tolerances." + esc(ctx(a, "axis")) + "]</code>");
-  h += verdict_banner(
-      verdict,
-      fmt::format("No limit was stored with this run: <code>location_um</code> (each position) "
-                  "and <code>location_urad</code> (each tilt) under {} in a file given to "
-                  "<code>daq model ballbar5x-run --tolerances</code> judge what the control's "
-                  "kinematics leave of each location error (docs/config.md).",
-                  and_list(tables)));
+  h += verdict_banner(verdict, tolerance_hint(v, doc));
   // The values: every axis's four, as daq show prints them (result_rows.hpp), with u (k = 1).
   std::vector<std::vector<std::string>> rows;
   for (const auto& a : axes) {
@@ -3352,9 +3392,11 @@ bool is_specified_value(std::string_view key) {
 // A comparison's verdict in words, for page one (it was said only by the table's ✓ and ✗): the
 // newest run's verdict, then each failing run (newest first) with its failing values and their
 // limits, what to check beside the newest run's diagnostics. `verdicts` in the order of `views`
-// (by date).
+// (by date); `newest_doc`: the newest run's result (with no limit: which would judge them,
+// where).
 std::string comparison_verdict(const std::vector<RunView>& views,
-                               const std::vector<::daq::Verdict>& verdicts, bool same_day) {
+                               const std::vector<::daq::Verdict>& verdicts, const json& newest_doc,
+                               bool same_day) {
   constexpr std::size_t max_listed = 4;  // earlier failing runs named; the rest counted
   const auto when = [&](const RunView& v) {
     return fmt::format("run {} ({})", v.run.id,
@@ -3368,8 +3410,8 @@ std::string comparison_verdict(const std::vector<RunView>& views,
   }
   if (!configured)
     return "<p class=\"verdict none\"><strong>No tolerance configured</strong> for these runs: "
-           "their values are not judged (a machine specification is given as [tolerances] in "
-           "the configuration, docs/config.md).</p>\n";
+           "their values are not judged. " +
+           tolerance_hint(views.back(), newest_doc, true) + "</p>\n";
   // A run's failing values, each with what to check where a diagnostic says (the newest run's:
   // what to fix first).
   const auto failing_words = [](const ::daq::Verdict& v, bool advise) {
@@ -3487,6 +3529,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
                   .zero_line = true};
   std::vector<PolarChart> polars;
   std::vector<::daq::Verdict> verdicts;  // run by run, in date order
+  json newest;                           // the last run's result
   for (std::size_t i = 0; i < views.size(); ++i) {
     const auto& v = views[i];
     // (With runs on one day the date label already names the run.)
@@ -3519,6 +3562,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
     }
     const auto verdict = ::daq::verdict_of(v.settings, doc);
     verdicts.push_back(verdict);
+    newest = doc;
     // A re-compensated run is compared with the values it has now, and says so.
     std::vector<std::string> row{
         std::to_string(v.run.id) +
@@ -3575,7 +3619,7 @@ std::string comparison_report(const st::RunReader& store, std::span<const std::i
       "the limit of that run's specification.</p>\n",
       esc(first.run.kind), esc(first.run.axis), views.size(), date_of(first),
       date_of(views.back()));
-  body += comparison_verdict(views, verdicts, same_day);
+  body += comparison_verdict(views, verdicts, newest, same_day);
   std::vector<const RunView*> each;
   for (const auto& v : views) each.push_back(&v);
   body += traceability_warnings(each);

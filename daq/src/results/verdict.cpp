@@ -253,10 +253,66 @@ Verdict verdict_of(const json& settings, const json& result) {
   return linear_verdict(tol, result);
 }
 
+LimitsWhere limits_where(std::string_view kind, std::string_view axis, const json& settings,
+                         const json& result) {
+  LimitsWhere w;
+  w.keys = tolerance_keys(kind, standard_title(result));
+  const json none = json::object();
+  const json& context =
+      settings.is_object() && settings.contains("context") && settings["context"].is_object()
+          ? settings["context"]
+          : none;
+  const json configuration = context.value("configuration", json());
+  if (configuration.is_string()) w.configuration = configuration.get<std::string>();
+  if (kind == "ballbar5x") {
+    // daq model ballbar5x-run makes these runs, with no configuration: its --tolerances file
+    // holds each rotary axis's table.
+    w.each = {"each position", "each tilt"};
+    for (const char letter : axis) w.tables.push_back("tolerances." + std::string(1, letter));
+    w.option = "daq model ballbar5x-run --tolerances";
+  } else {
+    w.tables.push_back("tolerances." + std::string(axis));
+  }
+  return w;
+}
+
+std::string to_text(const LimitsWhere& w) {
+  std::vector<std::string> tables;
+  for (const auto& t : w.tables) tables.push_back("[" + t + "]");
+  const std::string under = fmt::format("under {}", fmt::join(tables, " and "));
+  const std::string where = !w.option.empty() ? "a file given to " + w.option
+                            : w.configuration.empty()
+                                ? std::string("the configuration")
+                                : "the configuration it was made with (" + w.configuration + ")";
+  // A five-axis ballbar run's: each key judges its own values.
+  if (!w.each.empty() && w.each.size() == w.keys.size()) {
+    std::vector<std::string> keys;
+    for (std::size_t i = 0; i < w.keys.size(); ++i)
+      keys.push_back(fmt::format("{} ({})", w.keys[i], w.each[i]));
+    return fmt::format(
+        "no limit was stored with this run: {} {} in {} judge what the control's kinematics "
+        "leave of each location error (docs/config.md)",
+        fmt::join(keys, " and "), under, where);
+  }
+  return fmt::format(
+      "no limit was stored with this run: {} {} in {} judge{} the runs made with it "
+      "(docs/config.md)",
+      either_of(w.keys), under, where, w.keys.size() == 1 ? "s" : "");
+}
+
+Verdict run_verdict(std::string_view kind, std::string_view axis, const json& settings,
+                    const json& result) {
+  Verdict v = verdict_of(settings, result);
+  if (!v.configured && v.notes.empty())
+    v.hint = to_text(limits_where(kind, axis, settings, result));
+  return v;
+}
+
 json to_json(const Verdict& v) {
   json j{{"configured", v.configured}, {"pass", v.configured ? json(v.pass) : json(nullptr)},
          {"summary", summary(v)},      {"basis", v.basis},
-         {"notes", v.notes},           {"checks", json::array()}};
+         {"notes", v.notes},           {"hint", v.hint},
+         {"checks", json::array()}};
   for (const auto& c : v.checks)
     j["checks"].push_back({{"key", c.key},
                            {"symbol", c.symbol},
@@ -280,8 +336,13 @@ void print_verdict(const json& v, std::string_view in) {
   };
   const json notes = v.value("notes", json::array());
   if (!v.value("configured", false)) {
+    // Where the limits would be given, for the run's kind (a verdict made without the run: only
+    // that they are a specification, docs/config.md).
+    const std::string hint = safe(v, "hint");
     fmt::print("{}verdict: {}{}\n", in, safe(v, "summary"),
-               notes.empty() ? " ([tolerances] in the configuration, docs/config.md)" : "");
+               !notes.empty() ? ""
+               : hint.empty() ? " (no limit was stored with it: docs/config.md)"
+                              : ": " + hint);
   } else {
     fmt::print("{}verdict against {}: {}\n", in, safe(v, "basis"), safe(v, "summary"));
     for (const auto& c : v.value("checks", json::array())) {
@@ -298,6 +359,7 @@ void print_verdict(const json& v, std::string_view in) {
 
 std::vector<std::string> tolerance_keys(std::string_view kind, std::string_view standard_title) {
   if (kind == "circle") return {"G_um"};
+  if (kind == "ballbar5x") return {"location_um", "location_urad"};
   if (kind == "straightness") return {"straightness_um"};
   if (kind == "angular" || kind == "roll") return {"angular_urad"};
   const std::string unit = kind == "rotary" ? "_arcsec" : "_um";

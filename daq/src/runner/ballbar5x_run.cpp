@@ -216,6 +216,10 @@ struct RotaryBallbarRun::Impl : Runner {
       if (axes.find(kin::to_string(t.axis)) == std::string::npos) axes += kin::to_string(t.axis);
     const std::string opened[] = {"ballbar"};
     settings["context"] = run_context(setup.config, "ballbar5x", axes, opened);
+    if (json& tol = settings["context"]["tolerances"];
+        tol.is_object() && !setup.tolerances_file.empty())
+      tol["source"] = fmt::format("{} in {} (--tolerances)", tol.value("source", std::string()),
+                                  setup.tolerances_file);
     outcome.run_id = store->begin_run({.machine_id = machine_id(setup.config),
                                        .campaign = setup.config.campaign,
                                        .kind = "ballbar5x",

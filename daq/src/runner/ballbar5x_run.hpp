@@ -97,6 +97,9 @@ struct RotaryBallbarRunSetup {
   std::vector<cal::kinematics::RotaryBallbarTest> tests;
   RotaryBallbarTiming timing;
   std::string extra_settings_json;  // an object merged into the run's settings (its files)
+  // The file config's tolerances were read from (daq model ballbar5x-run --tolerances; "": the
+  // configuration's), named in the limits stored with the run: the verdict's basis says it.
+  std::string tolerances_file;
   std::filesystem::path database;
   std::unique_ptr<cal::drivers::Instrument> ballbar;
   // Where the bar's readings come from, stored with the run (docs/storage.md "Origin"); every

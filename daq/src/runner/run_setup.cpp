@@ -32,17 +32,38 @@ std::vector<d::Quantity> needed(std::string_view role) {
   return {};
 }
 
-// The drivers whose readings can fill the role (with their default options), for the message.
+// The drivers whose readings can fill the role, for the message: with their default options, or
+// with another choice of one of them ("gauge with unit = \"arcsec\"": with its default unit, mm,
+// no driver read angles, and the message of an angular reference or a level named none).
 std::string drivers_for(std::string_view role) {
-  std::vector<std::string_view> names;
+  std::vector<std::string> names;
   const auto want = needed(role);
+  const auto gives = [&](const d::DeviceDriver& drv, const d::Options& options) {
+    try {
+      const auto q = drv.quantities(options, {std::string(role), 0});
+      return std::any_of(want.begin(), want.end(), [&](d::Quantity w) {
+        return std::find(q.begin(), q.end(), w) != q.end();
+      });
+    } catch (const cal::InputError&) {  // a combination of options the driver refuses
+      return false;
+    }
+  };
   for (const auto* drv : d::device_drivers()) {
-    const auto q = drv->quantities(d::Options(drv->options()), {std::string(role), 0});
-    if (std::any_of(want.begin(), want.end(),
-                    [&](d::Quantity w) { return std::find(q.begin(), q.end(), w) != q.end(); }))
-      names.push_back(drv->name());
+    if (gives(*drv, d::Options(drv->options()))) {
+      names.emplace_back(drv->name());
+      continue;
+    }
+    std::vector<std::string> with;
+    for (const auto& spec : drv->options())
+      for (const auto& choice : spec.choices) {
+        d::Options other(drv->options());
+        other.set(spec.name, choice);
+        if (gives(*drv, other)) with.push_back(fmt::format("{} = \"{}\"", spec.name, choice));
+      }
+    if (!with.empty())
+      names.push_back(fmt::format("{} with {}", drv->name(), fmt::join(with, " or ")));
   }
-  return fmt::format("{}", fmt::join(names, ", "));
+  return names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "));
 }
 
 }  // namespace

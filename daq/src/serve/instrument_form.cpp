@@ -4,8 +4,10 @@
 
 #include <fmt/format.h>
 
+#include <iterator>
 #include <string_view>
 
+#include "cal/daq/config.hpp"
 #include "cal/drivers/registry.hpp"
 
 namespace daq::serve {
@@ -38,8 +40,9 @@ json common_option(std::string_view key) {
   } else if (key == "role") {
     o.type = OptionType::choice;
     // Every role the configuration loader knows: a straightness test reads an indicator, a
-    // roll test a level (a card without them lost the role and the test its probe).
-    o.choices = {"laser", "air", "material", "ballbar", "position", "indicator", "level"};
+    // roll test a level, a rotary test an angular reference (a card without them lost the role
+    // and the test its probe).
+    o.choices.assign(std::begin(cal::daq::device_roles), std::end(cal::daq::device_roles));
     o.help = "what a run uses it for";
   } else if (key == "poll_s") {
     o.type = OptionType::number;

@@ -166,7 +166,8 @@ std::vector<std::pair<std::string, std::string>> devices_of(const cal::daq::Conf
 
 // The linear test kinds the set-up's instruments can measure (kinds/kind.hpp): positioning and
 // angular with a laser (an angular test's beams are checked at Start against the laser's axes),
-// straightness with an indicator, roll with a level.
+// straightness with an indicator, roll with a level, a rotary axis's positioning with an
+// angular reference (its stops are the reference's: no laser).
 std::vector<std::string> linear_kinds(const cal::daq::Config& c) {
   std::vector<std::string> out;
   const bool laser = c.device_for("laser") != nullptr;
@@ -174,6 +175,7 @@ std::vector<std::string> linear_kinds(const cal::daq::Config& c) {
   if (laser && c.device_for("indicator")) out.push_back("straightness");
   if (laser) out.push_back("angular");
   if (laser && c.device_for("level")) out.push_back("roll");
+  if (c.device_for("angle")) out.push_back("rotary");
   return out;
 }
 
@@ -466,7 +468,9 @@ class Service {
                  {"dialects", {"fanuc", "heidenhain", "siemens"}},
                  {"cycles", {"linear", "pendulum", "pilgrim-step"}},
                  {"equations", {"ciddor", "edlen", "shop-floor"}},
-                 {"axes", {"X", "Y", "Z"}},
+                 // A rotary test's axis too (A, B, C): the loader refuses an axis its kind
+                 // does not measure (the form of a rotary set-up lost its axis C).
+                 {"axes", {"X", "Y", "Z", "A", "B", "C"}},
                  {"kinds", linear_kinds(config_)},
                  {"directions", {"X", "Y", "Z", "A", "B", "C"}},
                  {"planes", {"XY", "YZ", "ZX"}}}}});

@@ -56,13 +56,17 @@ TEST(InstrumentForm, TheCommonKeysAreThoseOfEveryDeviceTable) {
   EXPECT_EQ(common, want);
 }
 
-// The form's role choices are the configuration loader's: each is read, another is refused.
+// The form's role choices are the configuration loader's: each is read, another is refused, and
+// every role a run uses is offered (the angular reference of a rotary run, "angle", was not:
+// its card could not be given it).
 TEST(InstrumentForm, TheRoleChoicesAreTheLoaders) {
   const json doc = daq::serve::driver_descriptions();
   json roles;
   for (const auto& o : doc["common"])
     if (o["name"] == "role") roles = o["choices"];
   ASSERT_FALSE(roles.empty());
+  EXPECT_EQ(roles, json({"laser", "air", "material", "ballbar", "position", "indicator", "level",
+                         "angle"}));
   const std::string driver(cal::drivers::device_drivers().front()->name());
   const std::string transport(cal::drivers::device_drivers().front()->transport_example());
   const auto config = [&](const std::string& role) {

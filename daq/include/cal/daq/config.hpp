@@ -14,6 +14,14 @@
 
 namespace cal::daq {
 
+// What a device may be used for (its `role`): a linear run's laser, air station, material
+// thermometers and position feed, a circle's ballbar, a straightness run's indicator, a roll
+// run's electronic level, a rotary run's angular reference. The one list the loader accepts and
+// the operator page's instrument form offers (a role missing from the form, as "angle" was,
+// could not be chosen there).
+inline constexpr std::string_view device_roles[] = {"laser",    "air",       "material", "ballbar",
+                                                    "position", "indicator", "level",    "angle"};
+
 // One [devices.ID] table: the keys every device has, and the device's own options, checked
 // against its option table in the registry (drivers/include/cal/drivers/registry.hpp; listed
 // by `daq devices --options` and docs/drivers.md).
@@ -21,7 +29,7 @@ struct DeviceConfig {
   std::string id;         // the table name, e.g. "laser" in [devices.laser]
   std::string driver;     // a registered driver: ids3010 | ptu300 | gauge | temper | ...
   std::string transport;  // "tcp HOST:PORT", "serial DEVICE BAUD FRAME [FLOW]", "hid VID:PID"
-  std::string role;       // laser | air | material | ballbar | position (what the run uses it for)
+  std::string role;       // one of device_roles: what a run uses it for
   double poll_s = 0.0;    // 0: the driver's default
   // The instrument's identity and calibration, for the records and reports.
   std::string serial_number;
