@@ -29,7 +29,7 @@ check bench_export_peer_missing 2 "^daq: error: --peer-daq: File does not exist:
 check bench_export_repeat_zero 2 "^daq: error: --repeat: '0' is not a whole number in \[1, 1000\]" -- "$DAQ" bench export --minutes 1 --steps 1 --dir "$TMP" --repeat 0
 # A simulated vibration the ballbar would sample as an alias (at or above 0.45 of its rate, where
 # the analysis stops looking) is refused, as is half of the pair, before anything is recorded.
-check sim_vibration_alias 2 "--vibration-y-hz 876.6 Hz: at or above 0.45 x --ballbar-rate-hz \\(450 Hz\\)" -- "$DAQ" sim --acquire --test circle --db "$TMP/vib.sqlite" --vibration-y-um 1 --vibration-y-hz 876.6
+check sim_vibration_alias 2 "--vibration-y-hz 876.6 Hz: at or above 450 Hz \\(0.45 x --ballbar-rate-hz 1000\\)" -- "$DAQ" sim --acquire --test circle --db "$TMP/vib.sqlite" --vibration-y-um 1 --vibration-y-hz 876.6
 check bench_replay_vibration_alias 2 "--circle-vibration-hz 500 Hz: at or above 450 Hz" -- "$DAQ" bench replay --kinds ballbar --dir "$TMP" --circle-vibration-um 1 --circle-vibration-hz 500
 check bench_replay_vibration_half 2 "--circle-vibration-um and --circle-vibration-hz go together" -- "$DAQ" bench replay --kinds ballbar --dir "$TMP" --circle-vibration-um 1
 check bench_replay_vibration_no_circle 2 "none of --kinds is replayed from: add ballbar" -- "$DAQ" bench replay --kinds ids3010 --dir "$TMP" --circle-vibration-um 1 --circle-vibration-hz 100

@@ -82,6 +82,23 @@ number "$e1"
 check compare_values 0 "^2$" -- count cmp.html ">$e1 <span"  # the replay gives the same E
 check compare_multiples 0 "class=\"multiples\"" -- cat cmp.html
 check compare_small_plots 0 "^([7-9]|[1-9][0-9])$" -- count cmp.html "<svg class=\"plot\""
+# Limits stored that fit none of the values (P, a VDI 3441 one, on ISO 230-2 runs): the
+# comparison says no tolerance applies and why, not that no limit was stored (which is false).
+cp demo.sqlite p_only.sqlite
+"$PY" - p_only.sqlite <<'PYEOF'
+import json, sqlite3, sys
+con = sqlite3.connect(sys.argv[1])
+for rid in (1, 3):
+    (s,) = con.execute("SELECT settings_json FROM runs WHERE id = ?", (rid,)).fetchone()
+    d = json.loads(s)
+    d["context"]["tolerances"] = {"P_um": 15.0, "by_length": [], "source": "tolerances.X"}
+    con.execute("UPDATE runs SET settings_json = ? WHERE id = ?", (json.dumps(d), rid))
+con.commit()
+PYEOF
+check compare_p_only 0 "comparison report of runs 1, 3" -- "$DAQ" report --compare 1 3 --db p_only.sqlite -o p_only.html
+check compare_no_tolerance_applies 0 "<strong>No tolerance applies</strong> to these runs" -- cat p_only.html
+check compare_no_tolerance_note 0 "class=\"note\">[^<]*P" -- cat p_only.html
+check compare_no_false_hint 0 "^0$" -- count p_only.html "No limit was stored"
 # Runs of one day: the date cell gives the day and the time, each unbroken, the run its own column.
 check compare_dates 0 "<td>1</td><td><span class=\"nw\">[0-9]{2}-[0-9]{2}</span> <span class=\"nw\">[0-9]{2}:[0-9]{2}</span>" -- cat cmp.html
 check compare_mixed 2 "compare the same test" -- "$DAQ" report --compare 1 2 --db demo.sqlite

@@ -239,9 +239,9 @@ void run_sim(SimOptions o) {
     // frequency.
     if (o.vibration_y_hz >= 0.45 * o.ballbar_rate_hz)
       throw cal::InputError(fmt::format(
-          "--vibration-y-hz {} Hz: at or above 0.45 x --ballbar-rate-hz ({} Hz), where the "
+          "--vibration-y-hz {} Hz: at or above {} Hz (0.45 x --ballbar-rate-hz {}), where the "
           "ballbar's samples would alias it; give a lower frequency or a faster ballbar",
-          o.vibration_y_hz, 0.45 * o.ballbar_rate_hz));
+          o.vibration_y_hz, 0.45 * o.ballbar_rate_hz, o.ballbar_rate_hz));
     truth.vibration_y_um = o.vibration_y_um;
     truth.vibration_y_hz = o.vibration_y_hz;
   }

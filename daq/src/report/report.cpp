@@ -3408,10 +3408,23 @@ std::string comparison_verdict(const std::vector<RunView>& views,
     configured += verdicts[i].configured ? 1 : 0;
     if (verdicts[i].configured && !verdicts[i].pass) failing.push_back(i);
   }
-  if (!configured)
+  if (!configured) {
+    // Limits stored that fit none of the values (as verdict_banner says of one run): not "no
+    // limit was stored", which would be false; the newest such run's notes say which and why.
+    const auto noted = std::find_if(verdicts.rbegin(), verdicts.rend(),
+                                    [](const ::daq::Verdict& v) { return !v.notes.empty(); });
+    if (noted != verdicts.rend()) {
+      std::string h =
+          "<p class=\"verdict none\"><strong>No tolerance applies</strong> to these runs: the "
+          "limits stored with them are for values these evaluations do not give, so they are "
+          "not judged.</p>\n";
+      for (const auto& n : noted->notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+      return h;
+    }
     return "<p class=\"verdict none\"><strong>No tolerance configured</strong> for these runs: "
            "their values are not judged. " +
            tolerance_hint(views.back(), newest_doc, true) + "</p>\n";
+  }
   // A run's failing values, each with what to check where a diagnostic says (the newest run's:
   // what to fix first).
   const auto failing_words = [](const ::daq::Verdict& v, bool advise) {
