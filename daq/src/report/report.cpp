@@ -1125,55 +1125,36 @@ std::string conditions_section(const RunView& v) {
   return "<h3>Test conditions</h3>\n" + table({"", ""}, rows, "kv");
 }
 
-// Keys as markup: "<code>E_um</code>, ... or <code>M_um</code>".
-std::string code_keys(std::vector<std::string> keys) {
-  for (auto& k : keys) k = "<code>" + esc(k) + "</code>";
-  return ::daq::either_of(keys);
-}
-
 // Where the limits of a run stored without them are set, for its verdict line (`doc`: its
 // result): the keys, the table of its axis or plane (a five-axis ballbar run's, of each axis),
 // and the file that holds them: the configuration the run started with, or the one given to
 // daq model ballbar5x-run --tolerances (the limits in force when a run starts are stored with
 // it and judge it; a replay keeps its original run's). A run replayed from a capture whose
 // original run is not in this database has none: a capture's header does not carry the
-// tolerances. The terminal says the same in words (verdict.hpp, to_text of limits_where).
+// tolerances. The terminal's sentence marked as HTML (verdict.hpp, to_text of limits_where).
 // `several`: of a comparison's runs, `v` the newest.
 std::string tolerance_hint(const RunView& v, const json& doc, bool several = false) {
   const auto w = ::daq::limits_where(v.run.kind, v.run.axis, v.settings, doc);
-  std::vector<std::string> tables;
-  for (const auto& t : w.tables) tables.push_back("<code>[" + esc(t) + "]</code>");
-  const std::string where = !w.option.empty() ? "a file given to <code>" + esc(w.option) + "</code>"
-                            : w.configuration.empty()
-                                ? std::string("the configuration")
-                                : fmt::format(
-                                      "the configuration {} was made with (<span "
-                                      "class=\"path\">{}</span>)",
-                                      several ? "the newest" : "it", esc(w.configuration));
-  if (!w.each.empty() && w.each.size() == w.keys.size()) {  // a five-axis ballbar run's
-    std::vector<std::string> keys;
-    for (std::size_t i = 0; i < w.keys.size(); ++i)
-      keys.push_back(fmt::format("<code>{}</code> ({})", esc(w.keys[i]), esc(w.each[i])));
-    return fmt::format(
-        "No limit was stored with this run: {} under {} in {} judge what the control's "
-        "kinematics leave of each location error (docs/config.md).",
-        and_list(keys), and_list(tables), where);
-  }
+  static constexpr ::daq::LimitsMarkup html{
+      .code = [](std::string_view t) { return "<code>" + esc(t) + "</code>"; },
+      .path = [](std::string_view t) { return "<span class=\"path\">" + esc(t) + "</span>"; },
+      .text = [](std::string_view t) { return esc(t); }};
+  const bool each = !w.each.empty() && w.each.size() == w.keys.size();  // a five-axis run's
+  std::string h = ::daq::to_text(w, html, several && !each ? "these runs" : "this run",
+                                 several ? "the newest" : "it");
+  h[0] = 'N';
+  h += '.';
+  if (each) return h;
   bool orphan_replay = false;  // replayed, of no run in this database
   for (const auto& r : v.results) {
     const json p = json::parse(r.provenance_json, nullptr, false);
     if (p.is_object() && p.value("how", "") == "replayed")
       orphan_replay = p.contains("replay_of_run") && p["replay_of_run"].is_null();
   }
-  return fmt::format(
-      "No limit was stored with {}: {} under {} in {} judge{} the runs made with it "
-      "(docs/config.md).{}",
-      several ? "these runs" : "this run", code_keys(w.keys), and_list(tables), where,
-      w.keys.size() == 1 ? "s" : "",
-      orphan_replay ? " A replay takes the limits of its original run in the same database; "
-                      "this capture's original run is not in it, and a capture does not carry "
-                      "the limits."
-                    : "");
+  return orphan_replay ? h + " A replay takes the limits of its original run in the same "
+                             "database; this capture's original run is not in it, and a capture "
+                             "does not carry the limits."
+                       : h;
 }
 
 // A rotary axis's location error (ISO 230-1: E_X0C ... of a five-axis ballbar run), by its key.

@@ -276,28 +276,40 @@ LimitsWhere limits_where(std::string_view kind, std::string_view axis, const jso
   return w;
 }
 
-std::string to_text(const LimitsWhere& w) {
+std::string to_text(const LimitsWhere& w, const LimitsMarkup& m, std::string_view subject,
+                    std::string_view maker) {
+  const auto list = [](const std::vector<std::string>& items) {  // "a", "a and b", "a, b and c"
+    if (items.size() <= 1) return items.empty() ? std::string() : items.front();
+    return fmt::format("{} and {}", fmt::join(items.begin(), items.end() - 1, ", "), items.back());
+  };
   std::vector<std::string> tables;
-  for (const auto& t : w.tables) tables.push_back("[" + t + "]");
-  const std::string under = fmt::format("under {}", fmt::join(tables, " and "));
-  const std::string where = !w.option.empty() ? "a file given to " + w.option
-                            : w.configuration.empty()
-                                ? std::string("the configuration")
-                                : "the configuration it was made with (" + w.configuration + ")";
+  for (const auto& t : w.tables) tables.push_back(m.code("[" + t + "]"));
+  const std::string where =
+      !w.option.empty() ? "a file given to " + m.code(w.option)
+      : w.configuration.empty()
+          ? std::string("the configuration")
+          : fmt::format("the configuration {} was made with ({})", maker, m.path(w.configuration));
   // A five-axis ballbar run's: each key judges its own values.
   if (!w.each.empty() && w.each.size() == w.keys.size()) {
     std::vector<std::string> keys;
     for (std::size_t i = 0; i < w.keys.size(); ++i)
-      keys.push_back(fmt::format("{} ({})", w.keys[i], w.each[i]));
+      keys.push_back(fmt::format("{} ({})", m.code(w.keys[i]), m.text(w.each[i])));
     return fmt::format(
-        "no limit was stored with this run: {} {} in {} judge what the control's kinematics "
-        "leave of each location error (docs/config.md)",
-        fmt::join(keys, " and "), under, where);
+        "no limit was stored with this run: {} under {} in {} judge what the control's "
+        "kinematics leave of each location error (docs/config.md)",
+        list(keys), list(tables), where);
   }
+  std::vector<std::string> keys;
+  for (const auto& k : w.keys) keys.push_back(m.code(k));
   return fmt::format(
-      "no limit was stored with this run: {} {} in {} judge{} the runs made with it "
+      "no limit was stored with {}: {} under {} in {} judge{} the runs made with it "
       "(docs/config.md)",
-      either_of(w.keys), under, where, w.keys.size() == 1 ? "s" : "");
+      subject, either_of(keys), list(tables), where, w.keys.size() == 1 ? "s" : "");
+}
+
+std::string to_text(const LimitsWhere& w) {
+  const auto same = [](std::string_view t) { return std::string(t); };
+  return to_text(w, {.code = same, .path = same, .text = same});
 }
 
 Verdict run_verdict(std::string_view kind, std::string_view axis, const json& settings,

@@ -64,8 +64,20 @@ Verdict verdict_of(const nlohmann::json& settings, const nlohmann::json& result)
 // evaluation is judged by P_um, ...).
 LimitsWhere limits_where(std::string_view kind, std::string_view axis,
                          const nlohmann::json& settings, const nlohmann::json& result);
-// For a terminal: "no limit was stored with this run: E_um, ... or M_um under [tolerances.X] in
-// the configuration it was made with (cfg.toml) judge the runs made with it (docs/config.md)".
+// How to_text marks what it quotes: a key, a table or an option (`code`), a file's name
+// (`path`), other text (`text`). A terminal's: each as it is; a report's: escaped HTML.
+struct LimitsMarkup {
+  std::string (*code)(std::string_view);
+  std::string (*path)(std::string_view);
+  std::string (*text)(std::string_view);
+};
+// "no limit was stored with this run: E_um, ... or M_um under [tolerances.X] in the
+// configuration it was made with (cfg.toml) judge the runs made with it (docs/config.md)", its
+// quotes marked by `m`. `subject`: "this run" or "these runs"; `maker`: whose configuration
+// ("it", "the newest"). One sentence for the terminal and the report.
+std::string to_text(const LimitsWhere& w, const LimitsMarkup& m,
+                    std::string_view subject = "this run", std::string_view maker = "it");
+// The same for a terminal (nothing marked).
 std::string to_text(const LimitsWhere& w);
 // verdict_of, and where the limits would be given when none judged the result (Verdict::hint):
 // what daq show, daq analyse and daq run print, for every kind of run.
